@@ -1,0 +1,105 @@
+# lmgi — build, dependencies, tests, demo, benchmarks.
+#   make            build build/lmgi, build/liblmgi.a, build/liblmgi.so
+#   make deps       install missing Debian packages (apt-get, non-interactive; fast when nothing is missing)
+#   make test       deps + build + every test (cmocka), including the loader fuzz test under ASan
+#   make test-asan  the whole suite built with AddressSanitizer + UndefinedBehaviorSanitizer
+#   make demo       deps + the main job on a generated scene; pictures in demo/
+#   make bench      timings (never part of the tests)
+#   make scenes     regenerate scenes/ with tools/gen_scenes
+
+CC      ?= gcc
+CXX     ?= g++
+BUILD   ?= build
+OPT     ?= -O2 -g
+SAN     ?=
+WARN    := -Wall -Wextra -Werror
+CFLAGS_ALL   := -std=c11 $(OPT) $(WARN) -fPIC -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)
+CXXFLAGS_ALL := -std=c++17 $(OPT) $(WARN) -fPIC -fopenmp -Iinclude -I/usr/include/stb $(SAN) $(CXXFLAGS)
+LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lOSMesa -lgomp -lstdc++ -lm -lpthread
+LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
+
+DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
+                nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libcmocka-dev
+
+LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
+                             src/gpu/*.c src/update/*.c))
+LIB_CXX := $(sort $(wildcard src/scene/*.cpp src/charts/*.cpp))
+CLI_C   := $(sort $(wildcard src/cli/*.c))
+LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o)
+CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
+TEST_C  := $(sort $(wildcard tests/test_*.c))
+TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
+TEST_SUPPORT := $(BUILD)/obj/tests/support.o
+
+.PHONY: all deps test test-asan demo bench scenes clean
+all: $(BUILD)/lmgi $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
+
+deps:
+	@missing=""; for p in $(DEB_PACKAGES); do \
+	  dpkg-query -W -f='$${Status}' $$p 2>/dev/null | grep -q "install ok installed" || missing="$$missing $$p"; \
+	done; \
+	if [ -n "$$missing" ]; then \
+	  echo "deps: installing$$missing"; \
+	  SUDO=""; [ "$$(id -u)" = 0 ] || SUDO=sudo; \
+	  $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get update -qq && \
+	  $$SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+
+$(BUILD)/obj/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
+
+$(BUILD)/obj/%.o: %.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) -MMD -MP -c $< -o $@
+
+$(BUILD)/liblmgi.a: $(LIB_OBJ)
+	@rm -f $@
+	ar rcs $@ $^
+
+$(BUILD)/liblmgi.so: $(LIB_OBJ)
+	$(CC) -shared -o $@ $^ $(LDFLAGS_ALL) $(LIBS)
+
+$(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
+	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS)
+
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
+	@mkdir -p $(dir $@)
+	$(CC) -o $@ $< $(TEST_SUPPORT) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) -lcmocka
+
+$(BUILD)/gen_scenes: tools/gen_scenes.c
+	@mkdir -p $(dir $@)
+	$(CC) -std=c11 -O2 $(WARN) -D_DEFAULT_SOURCE -o $@ $< -lm
+
+# The fuzz test always runs under ASan + UBSan, whatever the main build is.
+FUZZ_BUILD := build/asan
+$(FUZZ_BUILD)/tests/fuzz_loader: FORCE
+	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) OPT="-O1 -g" \
+	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
+	  $(FUZZ_BUILD)/liblmgi.a $(FUZZ_BUILD)/obj/tests/support.o
+	@mkdir -p $(dir $@)
+	$(CC) -std=c11 -O1 -g $(WARN) -D_DEFAULT_SOURCE -Iinclude -fsanitize=address,undefined \
+	  -o $@ tests/fuzz_loader.c $(FUZZ_BUILD)/obj/tests/support.o $(FUZZ_BUILD)/liblmgi.a \
+	  -fsanitize=address,undefined -fopenmp $(LIBS) -lcmocka
+FORCE:
+
+test: deps all $(TESTS) $(if $(wildcard tests/fuzz_loader.c),$(FUZZ_BUILD)/tests/fuzz_loader)
+	@LMGI_BUILD=$(BUILD) sh tests/run_tests.sh $(TESTS) $(if $(wildcard tests/fuzz_loader.c),$(FUZZ_BUILD)/tests/fuzz_loader)
+
+test-asan: deps
+	@$(MAKE) --no-print-directory BUILD=build/asan OPT="-O1 -g" \
+	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" test
+
+demo: deps all
+	@sh tools/demo.sh $(BUILD)/lmgi
+
+bench: deps all
+	$(BUILD)/lmgi bench
+
+scenes: $(BUILD)/gen_scenes
+	$(BUILD)/gen_scenes scenes
+
+clean:
+	rm -rf build demo
+
+-include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)

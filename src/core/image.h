@@ -1,0 +1,24 @@
+/* Writing and reading images: PNG (8-bit sRGB, for people) and EXR (32-bit float, for numbers). */
+#ifndef LM_IMAGE_H
+#define LM_IMAGE_H
+
+#include <stdint.h>
+
+#include "error.h"
+
+/* rgba8: width*height*4 bytes, row 0 at the top. */
+lm_status lm_write_png(const char *path, int width, int height, const uint8_t *rgba8, lm_error *err);
+/* rgb: width*height*channels floats (channels 1, 3 or 4), row 0 at the top. */
+lm_status lm_write_exr(const char *path, int width, int height, int channels, const float *data, lm_error *err);
+/* Reads an EXR as RGBA floats (caller frees *out with free()). */
+lm_status lm_read_exr(const char *path, int *width, int *height, float **out, lm_error *err);
+/* Reads a PNG/JPEG as RGBA8 (caller frees *out with free()). */
+lm_status lm_read_image8(const char *path, int *width, int *height, uint8_t **out, lm_error *err);
+
+/* Linear <-> sRGB transfer (IEC 61966-2-1). */
+float lm_srgb_to_linear(float c);
+float lm_linear_to_srgb(float c);
+/* Creates a directory and its parents if missing. */
+lm_status lm_mkdir_p(const char *path, lm_error *err);
+
+#endif

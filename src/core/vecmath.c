@@ -1,0 +1,161 @@
+#include "vecmath.h"
+
+#include <string.h>
+
+void lm_mat4_identity(float m[16])
+{
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = m[5] = m[10] = m[15] = 1.0f;
+}
+
+void lm_mat4_mul(float out[16], const float a[16], const float b[16])
+{
+    float r[16];
+    for (int c = 0; c < 4; c++)
+        for (int row = 0; row < 4; row++) {
+            float s = 0.0f;
+            for (int k = 0; k < 4; k++)
+                s += a[k * 4 + row] * b[c * 4 + k];
+            r[c * 4 + row] = s;
+        }
+    memcpy(out, r, sizeof r);
+}
+
+void lm_mat4_from_trs(float m[16], const float t[3], const float q[4], const float s[3])
+{
+    float x = q[0], y = q[1], z = q[2], w = q[3];
+    float r[9] = {
+        1 - 2 * (y * y + z * z), 2 * (x * y + z * w),     2 * (x * z - y * w),
+        2 * (x * y - z * w),     1 - 2 * (x * x + z * z), 2 * (y * z + x * w),
+        2 * (x * z + y * w),     2 * (y * z - x * w),     1 - 2 * (x * x + y * y),
+    }; /* column-major 3x3 */
+    for (int c = 0; c < 3; c++) {
+        for (int row = 0; row < 3; row++)
+            m[c * 4 + row] = r[c * 3 + row] * s[c];
+        m[c * 4 + 3] = 0.0f;
+    }
+    m[12] = t[0];
+    m[13] = t[1];
+    m[14] = t[2];
+    m[15] = 1.0f;
+}
+
+int lm_mat4_invert_affine(float out[16], const float m[16])
+{
+    /* Inverse of the 3x3 part by cofactors, then the translation. */
+    float a = m[0], b = m[4], c = m[8];
+    float d = m[1], e = m[5], f = m[9];
+    float g = m[2], h = m[6], i = m[10];
+    float A = e * i - f * h, B = -(d * i - f * g), C = d * h - e * g;
+    float det = a * A + b * B + c * C;
+    if (!(fabsf(det) > 1e-30f))
+        return 0;
+    float inv = 1.0f / det;
+    float r[16];
+    r[0] = A * inv;
+    r[1] = B * inv;
+    r[2] = C * inv;
+    r[4] = -(b * i - c * h) * inv;
+    r[5] = (a * i - c * g) * inv;
+    r[6] = -(a * h - b * g) * inv;
+    r[8] = (b * f - c * e) * inv;
+    r[9] = -(a * f - c * d) * inv;
+    r[10] = (a * e - b * d) * inv;
+    r[3] = r[7] = r[11] = 0.0f;
+    r[15] = 1.0f;
+    for (int row = 0; row < 3; row++)
+        r[12 + row] = -(r[row] * m[12] + r[4 + row] * m[13] + r[8 + row] * m[14]);
+    memcpy(out, r, sizeof r);
+    return 1;
+}
+
+lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p)
+{
+    return lm_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
+                 m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+                 m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
+}
+
+lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d)
+{
+    return lm_v3(m[0] * d.x + m[4] * d.y + m[8] * d.z,
+                 m[1] * d.x + m[5] * d.y + m[9] * d.z,
+                 m[2] * d.x + m[6] * d.y + m[10] * d.z);
+}
+
+lm_vec3 lm_mat4_normal(const float m[16], lm_vec3 n)
+{
+    /* Cofactor matrix = det * inverse-transpose: the scale drops out on normalization, and flipping
+     * by the sign of det gives the true inverse-transpose for mirroring transforms too. */
+    lm_vec3 c0 = lm_v3(m[0], m[1], m[2]), c1 = lm_v3(m[4], m[5], m[6]), c2 = lm_v3(m[8], m[9], m[10]);
+    lm_vec3 r0 = lm_cross(c1, c2), r1 = lm_cross(c2, c0), r2 = lm_cross(c0, c1);
+    lm_vec3 out = lm_add(lm_add(lm_scale(r0, n.x), lm_scale(r1, n.y)), lm_scale(r2, n.z));
+    float det = lm_dot(c0, r0);
+    if (det < 0.0f)
+        out = lm_scale(out, -1.0f);
+    return lm_normalize(out);
+}
+
+int lm_mat4_finite(const float m[16])
+{
+    for (int i = 0; i < 16; i++)
+        if (!isfinite(m[i]))
+            return 0;
+    return 1;
+}
+
+void lm_mat4_perspective(float m[16], float yfov, float aspect, float znear, float zfar)
+{
+    float f = 1.0f / tanf(0.5f * yfov);
+    memset(m, 0, 16 * sizeof(float));
+    m[0] = f / aspect;
+    m[5] = f;
+    m[10] = (zfar + znear) / (znear - zfar);
+    m[11] = -1.0f;
+    m[14] = 2.0f * zfar * znear / (znear - zfar);
+}
+
+void lm_mat4_look_at(float m[16], lm_vec3 eye, lm_vec3 target, lm_vec3 up)
+{
+    lm_vec3 f = lm_normalize(lm_sub(target, eye));
+    lm_vec3 s = lm_normalize(lm_cross(f, up));
+    lm_vec3 u = lm_cross(s, f);
+    lm_mat4_identity(m);
+    m[0] = s.x; m[4] = s.y; m[8] = s.z;
+    m[1] = u.x; m[5] = u.y; m[9] = u.z;
+    m[2] = -f.x; m[6] = -f.y; m[10] = -f.z;
+    m[12] = -lm_dot(s, eye);
+    m[13] = -lm_dot(u, eye);
+    m[14] = lm_dot(f, eye);
+}
+
+void lm_quat_normalize(float q[4])
+{
+    float l = sqrtf(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    if (l > 0.0f)
+        for (int i = 0; i < 4; i++)
+            q[i] /= l;
+}
+
+void lm_quat_slerp(float out[4], const float a[4], const float b[4], float t)
+{
+    float bb[4] = {b[0], b[1], b[2], b[3]};
+    float d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    if (d < 0.0f) { /* take the short way round */
+        d = -d;
+        for (int i = 0; i < 4; i++)
+            bb[i] = -bb[i];
+    }
+    float wa, wb;
+    if (d > 0.9995f) { /* nearly parallel: lerp avoids dividing by sin(theta) ~ 0 */
+        wa = 1.0f - t;
+        wb = t;
+    } else {
+        float th = acosf(d), s = sinf(th);
+        wa = sinf((1.0f - t) * th) / s;
+        wb = sinf(t * th) / s;
+    }
+    for (int i = 0; i < 4; i++)
+        out[i] = wa * a[i] + wb * bb[i];
+    lm_quat_normalize(out);
+}

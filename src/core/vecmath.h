@@ -1,0 +1,55 @@
+/* Small vector and matrix helpers. Matrices are 4x4, column-major (as in glTF and OpenGL):
+ * element (row r, column c) is m[c * 4 + r]. */
+#ifndef LM_VECMATH_H
+#define LM_VECMATH_H
+
+#include <math.h>
+
+typedef struct { float x, y, z; } lm_vec3;
+
+static inline lm_vec3 lm_v3(float x, float y, float z) { lm_vec3 v = {x, y, z}; return v; }
+static inline lm_vec3 lm_v3_load(const float *p) { return lm_v3(p[0], p[1], p[2]); }
+static inline void lm_v3_store(float *p, lm_vec3 v) { p[0] = v.x; p[1] = v.y; p[2] = v.z; }
+static inline lm_vec3 lm_add(lm_vec3 a, lm_vec3 b) { return lm_v3(a.x + b.x, a.y + b.y, a.z + b.z); }
+static inline lm_vec3 lm_sub(lm_vec3 a, lm_vec3 b) { return lm_v3(a.x - b.x, a.y - b.y, a.z - b.z); }
+static inline lm_vec3 lm_scale(lm_vec3 a, float s) { return lm_v3(a.x * s, a.y * s, a.z * s); }
+static inline float lm_dot(lm_vec3 a, lm_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static inline lm_vec3 lm_cross(lm_vec3 a, lm_vec3 b)
+{
+    return lm_v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+static inline float lm_length(lm_vec3 a) { return sqrtf(lm_dot(a, a)); }
+static inline lm_vec3 lm_normalize(lm_vec3 a)
+{
+    float l = lm_length(a);
+    return l > 0.0f ? lm_scale(a, 1.0f / l) : lm_v3(0.0f, 0.0f, 0.0f);
+}
+static inline lm_vec3 lm_vmin(lm_vec3 a, lm_vec3 b)
+{
+    return lm_v3(fminf(a.x, b.x), fminf(a.y, b.y), fminf(a.z, b.z));
+}
+static inline lm_vec3 lm_vmax(lm_vec3 a, lm_vec3 b)
+{
+    return lm_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z));
+}
+static inline int lm_v3_finite(lm_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+
+void lm_mat4_identity(float m[16]);
+void lm_mat4_mul(float out[16], const float a[16], const float b[16]); /* out = a * b (out may alias) */
+/* Builds T * R * S from translation, unit quaternion (x, y, z, w) and scale, as glTF defines. */
+void lm_mat4_from_trs(float m[16], const float t[3], const float q[4], const float s[3]);
+/* Inverse of a general affine matrix; returns 0 if singular. */
+int lm_mat4_invert_affine(float out[16], const float m[16]);
+lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p);
+lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d);
+/* Normal transform: inverse-transpose of the upper 3x3, result normalized. */
+lm_vec3 lm_mat4_normal(const float m[16], lm_vec3 n);
+int lm_mat4_finite(const float m[16]);
+void lm_mat4_perspective(float m[16], float yfov, float aspect, float znear, float zfar);
+void lm_mat4_look_at(float m[16], lm_vec3 eye, lm_vec3 target, lm_vec3 up);
+
+/* Quaternions (x, y, z, w). */
+void lm_quat_normalize(float q[4]);
+void lm_quat_slerp(float out[4], const float a[4], const float b[4], float t);
+
+#endif

@@ -1,0 +1,20 @@
+#!/bin/sh
+# Runs each cmocka test binary, prints its output, and closes with the totals of test cases:
+# "N passed, N failed, N skipped". Exits non-zero if any binary failed or crashed.
+passed=0; failed=0; skipped=0; bad=""
+for t in "$@"; do
+    echo "=== $t"
+    out=$("$t" 2>&1); rc=$?
+    printf '%s\n' "$out"
+    p=$(printf '%s\n' "$out" | sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' | awk '{s+=$1} END {print s+0}')
+    f=$(printf '%s\n' "$out" | sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' | awk '{s+=$1} END {print s+0}')
+    s=$(printf '%s\n' "$out" | sed -n 's/^\[  SKIPPED \] \([0-9]*\) test.*/\1/p' | awk '{s+=$1} END {print s+0}')
+    passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + s))
+    if [ $rc -ne 0 ]; then
+        bad="$bad $t"
+        [ "$f" -eq 0 ] && failed=$((failed + 1))
+    fi
+done
+[ -n "$bad" ] && echo "failing test binaries:$bad"
+echo "$passed passed, $failed failed, $skipped skipped"
+[ -z "$bad" ]

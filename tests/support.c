@@ -1,0 +1,183 @@
+#include "support.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <stdint.h>
+#include <unistd.h>
+
+static const char *existing(char *buf, size_t n, const char *base, const char *sub, const char *rel)
+{
+    snprintf(buf, n, "%s/%s/%s", base, sub, rel);
+    return access(buf, R_OK) == 0 ? buf : NULL;
+}
+
+const char *lmt_shared_scene(const char *relative)
+{
+    static char buf[2048];
+    const char *env = getenv("LMGI_SHARED");
+    if (env && existing(buf, sizeof buf, env, "scenes", relative))
+        return buf;
+    return existing(buf, sizeof buf, "..", "shared/scenes", relative);
+}
+
+const char *lmt_project_scene(const char *relative)
+{
+    static char buf[2048];
+    return existing(buf, sizeof buf, ".", "scenes", relative);
+}
+
+const char *lmt_tmpdir(void)
+{
+    static char buf[256];
+    snprintf(buf, sizeof buf, "/tmp/lmgi-test-XXXXXX");
+    if (!mkdtemp(buf))
+        return "/tmp";
+    return buf;
+}
+
+static void add_vertex(lmt_mesh *m, float x, float y, float z)
+{
+    float *p = m->pos + 3 * m->vertex_count++;
+    p[0] = x;
+    p[1] = y;
+    p[2] = z;
+}
+
+void lmt_mesh_quad(lmt_mesh *m, const float c[3], const float u[3], const float v[3])
+{
+    uint16_t b = (uint16_t)m->vertex_count;
+    add_vertex(m, c[0], c[1], c[2]);
+    add_vertex(m, c[0] + u[0], c[1] + u[1], c[2] + u[2]);
+    add_vertex(m, c[0] + u[0] + v[0], c[1] + u[1] + v[1], c[2] + u[2] + v[2]);
+    add_vertex(m, c[0] + v[0], c[1] + v[1], c[2] + v[2]);
+    uint16_t t[6] = {b, (uint16_t)(b + 1), (uint16_t)(b + 2), b, (uint16_t)(b + 2), (uint16_t)(b + 3)};
+    memcpy(m->idx + m->index_count, t, sizeof t);
+    m->index_count += 6;
+}
+
+void lmt_mesh_cube(lmt_mesh *m, float h)
+{
+    /* For each axis and sign: a corner and two edges whose cross product points outward. */
+    for (int axis = 0; axis < 3; axis++)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+            float c[3], u[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+            c[axis] = sign * h;
+            c[a1] = -h;
+            c[a2] = -h;
+            if (sign > 0) {
+                u[a1] = 2 * h;
+                v[a2] = 2 * h;
+            } else {
+                u[a2] = 2 * h;
+                v[a1] = 2 * h;
+            }
+            lmt_mesh_quad(m, c, u, v);
+        }
+}
+
+static char *base64(const uint8_t *d, size_t n)
+{
+    static const char *A = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    char *o = malloc(4 * ((n + 2) / 3) + 1), *p = o;
+    for (size_t i = 0; o && i < n; i += 3) {
+        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
+        *p++ = A[(v >> 18) & 63];
+        *p++ = A[(v >> 12) & 63];
+        *p++ = i + 1 < n ? A[(v >> 6) & 63] : '=';
+        *p++ = i + 2 < n ? A[v & 63] : '=';
+    }
+    if (o)
+        *p = '\0';
+    return o;
+}
+
+static void float_min_max(const float *p, int count, float mn[3], float mx[3])
+{
+    for (int k = 0; k < 3; k++) {
+        mn[k] = 1e30f;
+        mx[k] = -1e30f;
+    }
+    for (int i = 0; i < count; i++)
+        for (int k = 0; k < 3; k++) {
+            mn[k] = p[3 * i + k] < mn[k] ? p[3 * i + k] : mn[k];
+            mx[k] = p[3 * i + k] > mx[k] ? p[3 * i + k] : mx[k];
+        }
+}
+
+static int comps(const char *type)
+{
+    return !strcmp(type, "VEC4") ? 4 : !strcmp(type, "VEC3") ? 3 : !strcmp(type, "VEC2") ? 2 : 1;
+}
+
+int lmt_write_gltf(const char *path, const lmt_mesh *meshes, int mesh_count, const char *nodes_json,
+                   const lmt_accessor *extra, int extra_count, const char *extra_json)
+{
+    size_t size = 0;
+    for (int i = 0; i < mesh_count; i++)
+        size += (size_t)meshes[i].vertex_count * 12 + (((size_t)meshes[i].index_count * 2 + 3) & ~(size_t)3);
+    for (int i = 0; i < extra_count; i++)
+        size += (size_t)extra[i].count * comps(extra[i].type) * 4;
+    uint8_t *buf = calloc(size ? size : 1, 1);
+    FILE *f = fopen(path, "w");
+    if (!buf || !f) {
+        free(buf);
+        if (f)
+            fclose(f);
+        return -1;
+    }
+    fprintf(f, "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}],\n");
+    fprintf(f, "\"nodes\": %s,\n", nodes_json);
+    if (extra_json)
+        fprintf(f, "%s\n", extra_json);
+    size_t off = 0;
+    int acc = 0;
+    fprintf(f, "\"meshes\": [");
+    for (int i = 0; i < mesh_count; i++)
+        fprintf(f, "%s{\"primitives\": [{\"attributes\": {\"POSITION\": %d}, \"indices\": %d}]}", i ? "," : "",
+                2 * i, 2 * i + 1);
+    fprintf(f, "],\n\"accessors\": [");
+    char views[8192] = "";
+    for (int i = 0; i < mesh_count; i++) {
+        const lmt_mesh *m = &meshes[i];
+        float mn[3], mx[3];
+        float_min_max(m->pos, m->vertex_count, mn, mx);
+        size_t pb = (size_t)m->vertex_count * 12, ib = (size_t)m->index_count * 2;
+        memcpy(buf + off, m->pos, pb);
+        memcpy(buf + off + pb, m->idx, ib);
+        fprintf(f, "%s{\"bufferView\": %d, \"componentType\": 5126, \"count\": %d, \"type\": \"VEC3\", "
+                "\"min\": [%g, %g, %g], \"max\": [%g, %g, %g]},", i ? "," : "", acc, m->vertex_count,
+                (double)mn[0], (double)mn[1], (double)mn[2], (double)mx[0], (double)mx[1], (double)mx[2]);
+        fprintf(f, "{\"bufferView\": %d, \"componentType\": 5123, \"count\": %d, \"type\": \"SCALAR\"}", acc + 1,
+                m->index_count);
+        snprintf(views + strlen(views), sizeof views - strlen(views),
+                 "%s{\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": %zu},"
+                 "{\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": %zu}",
+                 acc ? "," : "", off, pb, off + pb, ib);
+        off += pb + ((ib + 3) & ~(size_t)3);
+        acc += 2;
+    }
+    for (int i = 0; i < extra_count; i++) {
+        size_t bytes = (size_t)extra[i].count * comps(extra[i].type) * 4;
+        memcpy(buf + off, extra[i].data, bytes);
+        fprintf(f, "%s{\"bufferView\": %d, \"componentType\": 5126, \"count\": %d, \"type\": \"%s\"", acc ? "," : "",
+                acc, extra[i].count, extra[i].type);
+        if (!strcmp(extra[i].type, "SCALAR")) { /* animation inputs need min/max */
+            float lo = extra[i].data[0], hi = extra[i].data[extra[i].count - 1];
+            fprintf(f, ", \"min\": [%g], \"max\": [%g]", (double)lo, (double)hi);
+        }
+        fprintf(f, "}");
+        snprintf(views + strlen(views), sizeof views - strlen(views),
+                 "%s{\"buffer\": 0, \"byteOffset\": %zu, \"byteLength\": %zu}", acc ? "," : "", off, bytes);
+        off += bytes;
+        acc++;
+    }
+    char *b64 = base64(buf, size);
+    fprintf(f, "],\n\"bufferViews\": [%s],\n", views);
+    fprintf(f, "\"buffers\": [{\"byteLength\": %zu, \"uri\": \"data:application/octet-stream;base64,%s\"}]}\n", size,
+            b64 ? b64 : "");
+    free(b64);
+    free(buf);
+    return fclose(f) == 0 ? 0 : -1;
+}

@@ -1,0 +1,51 @@
+/* Helpers shared by the tests: where the shared and generated scenes are, and skipping when absent. */
+#ifndef LM_TEST_SUPPORT_H
+#define LM_TEST_SUPPORT_H
+
+#include <stddef.h>
+
+/* Path of a file under ../shared/scenes (or $LMGI_SHARED/scenes); NULL if it does not exist.
+ * The returned string is static storage, valid until the next call. */
+const char *lmt_shared_scene(const char *relative);
+/* Path of a file under the project's scenes/ (generated scenes); NULL if missing. */
+const char *lmt_project_scene(const char *relative);
+/* A fresh empty temporary directory for the calling test (static storage). */
+const char *lmt_tmpdir(void);
+
+/* Use in a cmocka test: skips (and says so) when the scene is not there. */
+#define LMT_REQUIRE_SCENE(var, path_expr)                                                     \
+    const char *var = (path_expr);                                                              \
+    do {                                                                                        \
+        if (!var) {                                                                             \
+            print_message("skipped: scene not found (%s)\n", #path_expr);                       \
+            skip();                                                                             \
+        }                                                                                       \
+    } while (0)
+
+#endif
+
+#include <stdint.h>
+
+/* A tiny mesh for hand-written test scenes: positions (3 floats each) and u16 triangle indices. */
+typedef struct {
+    int vertex_count, index_count;
+    float pos[64 * 3];
+    uint16_t idx[64 * 3];
+} lmt_mesh;
+
+void lmt_mesh_quad(lmt_mesh *m, const float corner[3], const float edge_u[3], const float edge_v[3]);
+/* Axis-aligned cube of half-size h centred at the origin, 6 faces, outward winding. */
+void lmt_mesh_cube(lmt_mesh *m, float h);
+
+/* Writes a .gltf at `path` with one buffer (base64 data URI) holding the meshes, and one mesh per
+ * entry. `nodes_json` is the JSON array of nodes (mesh i = meshes[i]); `extra_json` is inserted at the
+ * top level (e.g. "\"animations\": [...]," — may reference accessors from `extra_accessors`, which are
+ * appended as raw float data after the meshes: each entry is a float array with count and type).
+ * Returns 0 on success. */
+typedef struct {
+    const float *data;
+    int count;          /* elements */
+    const char *type;   /* "SCALAR", "VEC3", "VEC4" */
+} lmt_accessor;
+int lmt_write_gltf(const char *path, const lmt_mesh *meshes, int mesh_count, const char *nodes_json,
+                   const lmt_accessor *extra, int extra_count, const char *extra_json);

@@ -1,0 +1,167 @@
+/* core: matrices, quaternions, sRGB, images, palette. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/core/image.h"
+#include "../src/core/palette.h"
+#include "../src/core/vecmath.h"
+#include "support.h"
+
+static void test_trs_matches_composition(void **state)
+{
+    (void)state;
+    /* 90 degrees about Y: x -> -z. Then scale 2 and translate (1,2,3). */
+    float q[4] = {0, sinf((float)M_PI / 4), 0, cosf((float)M_PI / 4)};
+    float t[3] = {1, 2, 3}, s[3] = {2, 2, 2}, m[16];
+    lm_mat4_from_trs(m, t, q, s);
+    lm_vec3 p = lm_mat4_point(m, lm_v3(1, 0, 0));
+    assert_float_equal(p.x, 1.0f, 1e-5);
+    assert_float_equal(p.y, 2.0f, 1e-5);
+    assert_float_equal(p.z, 3.0f - 2.0f, 1e-5);
+}
+
+static void test_affine_inverse(void **state)
+{
+    (void)state;
+    float q[4] = {0.1f, 0.7f, -0.3f, 0.6f};
+    lm_quat_normalize(q);
+    float t[3] = {-4, 5, 0.5f}, s[3] = {0.5f, 3, 1.5f}, m[16], inv[16], id[16];
+    lm_mat4_from_trs(m, t, q, s);
+    assert_true(lm_mat4_invert_affine(inv, m));
+    lm_mat4_mul(id, m, inv);
+    for (int i = 0; i < 16; i++)
+        assert_float_equal(id[i], (i % 5 == 0) ? 1.0f : 0.0f, 1e-5);
+    float sing[16] = {0};
+    assert_false(lm_mat4_invert_affine(inv, sing));
+}
+
+static void test_normal_transform_non_uniform_scale(void **state)
+{
+    (void)state;
+    /* Scaling x by 4 tilts a 45-degree normal toward y: n' ~ (1/4, 1, 0). */
+    float m[16];
+    lm_mat4_identity(m);
+    m[0] = 4.0f;
+    lm_vec3 n = lm_mat4_normal(m, lm_normalize(lm_v3(1, 1, 0)));
+    lm_vec3 want = lm_normalize(lm_v3(0.25f, 1, 0));
+    assert_float_equal(n.x, want.x, 1e-5);
+    assert_float_equal(n.y, want.y, 1e-5);
+    /* A mirror in x leaves the plane z = c and its normal +z alone (glTF flips the winding instead). */
+    m[0] = -1.0f;
+    n = lm_mat4_normal(m, lm_v3(0, 0, 1));
+    assert_float_equal(n.z, 1.0f, 1e-6);
+}
+
+static void test_slerp(void **state)
+{
+    (void)state;
+    float a[4] = {0, 0, 0, 1}, b[4] = {0, 1, 0, 0}, q[4]; /* 0 and 180 degrees about Y */
+    lm_quat_slerp(q, a, b, 0.5f);
+    assert_float_equal(q[1], sinf((float)M_PI / 4), 1e-5);
+    assert_float_equal(q[3], cosf((float)M_PI / 4), 1e-5);
+    /* Opposite-sign quaternions are the same rotation: slerp takes the short way. */
+    float nb[4] = {0, -sinf(0.1f), 0, -cosf(0.1f)};
+    lm_quat_slerp(q, a, nb, 1.0f);
+    assert_float_equal(fabsf(q[3]), cosf(0.1f), 1e-5);
+}
+
+static void test_srgb_round_trip(void **state)
+{
+    (void)state;
+    for (int i = 0; i <= 100; i++) {
+        float c = i / 100.0f;
+        assert_float_equal(lm_srgb_to_linear(lm_linear_to_srgb(c)), c, 1e-5);
+    }
+    assert_float_equal(lm_srgb_to_linear(0.5f), 0.21404f, 1e-4);
+    assert_float_equal(lm_linear_to_srgb(NAN), 0.0f, 0.0);
+}
+
+static void test_exr_round_trip(void **state)
+{
+    (void)state;
+    const char *dir = lmt_tmpdir();
+    char path[512];
+    snprintf(path, sizeof path, "%s/x.exr", dir);
+    float data[4 * 3 * 3];
+    for (int i = 0; i < 36; i++)
+        data[i] = 0.01f * (float)(i * i) - 1.0f;
+    lm_error err;
+    assert_int_equal(lm_write_exr(path, 4, 3, 3, data, &err), LM_OK);
+    int w, h;
+    float *back = NULL;
+    assert_int_equal(lm_read_exr(path, &w, &h, &back, &err), LM_OK);
+    assert_int_equal(w, 4);
+    assert_int_equal(h, 3);
+    for (int i = 0; i < 12; i++)
+        for (int c = 0; c < 3; c++)
+            assert_float_equal(back[4 * i + c], data[3 * i + c], 1e-6);
+    free(back);
+    remove(path);
+    /* Unwritable path: an error naming it. */
+    assert_int_equal(lm_write_exr("/nonexistent-dir/x.exr", 4, 3, 3, data, &err), LM_ERR_IO);
+    assert_non_null(strstr(err.msg, "/nonexistent-dir/x.exr"));
+    assert_int_equal(lm_write_png("/nonexistent-dir/x.png", 1, 1, (const uint8_t *)"abcd", &err), LM_ERR_IO);
+    assert_non_null(strstr(err.msg, "x.png"));
+}
+
+static void test_png_round_trip(void **state)
+{
+    (void)state;
+    char path[512];
+    snprintf(path, sizeof path, "%s/x.png", lmt_tmpdir());
+    uint8_t px[2 * 2 * 4] = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 10, 20, 30, 255};
+    lm_error err;
+    assert_int_equal(lm_write_png(path, 2, 2, px, &err), LM_OK);
+    int w, h;
+    uint8_t *back = NULL;
+    assert_int_equal(lm_read_image8(path, &w, &h, &back, &err), LM_OK);
+    assert_memory_equal(back, px, sizeof px);
+    free(back);
+    remove(path);
+}
+
+static void test_palette_distinct(void **state)
+{
+    (void)state;
+    /* The first 64 ids (more surfaces than most single rooms) all get different colours. */
+    uint8_t c[64][3];
+    for (int i = 0; i < 64; i++)
+        lm_id_color(i, c[i]);
+    for (int i = 0; i < 64; i++)
+        for (int j = 0; j < i; j++)
+            assert_true(memcmp(c[i], c[j], 3) != 0);
+}
+
+static void test_mkdir_p(void **state)
+{
+    (void)state;
+    char path[512];
+    snprintf(path, sizeof path, "%s/a/b/c", lmt_tmpdir());
+    lm_error err;
+    assert_int_equal(lm_mkdir_p(path, &err), LM_OK);
+    assert_int_equal(lm_mkdir_p(path, &err), LM_OK); /* exists: fine */
+    assert_int_equal(lm_mkdir_p("/proc/lmgi-cannot-be-here", &err), LM_ERR_IO);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_trs_matches_composition),
+        cmocka_unit_test(test_affine_inverse),
+        cmocka_unit_test(test_normal_transform_non_uniform_scale),
+        cmocka_unit_test(test_slerp),
+        cmocka_unit_test(test_srgb_round_trip),
+        cmocka_unit_test(test_exr_round_trip),
+        cmocka_unit_test(test_png_round_trip),
+        cmocka_unit_test(test_palette_distinct),
+        cmocka_unit_test(test_mkdir_p),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
