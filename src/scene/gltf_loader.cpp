@@ -1,0 +1,808 @@
+// glTF loading: the one C++ file around tinygltf. It reads tinygltf's model into an lm_scene and leaves
+// everything format-independent (decoding, triangulation, normals, node resolution) to scene_build.c.
+// Every check against the file's own numbers (indices, accessor spans, bufferViews) is done here:
+// tinygltf 2.7 parses the JSON but does not validate those. docs/loading.md lists what is accepted.
+#include <tiny_gltf.h>
+#include <stb_image.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <new>
+#include <string>
+#include <vector>
+
+extern "C" {
+#include "../core/error.h"
+#include "../core/log.h"
+#include "scene.h"
+#include "scene_build.h"
+}
+
+namespace {
+
+const char *const k_supported_required[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
+                                            "KHR_materials_transmission", "KHR_materials_ior",
+                                            "KHR_texture_transform"};
+const long long k_max_texels = 1LL << 26;        // larger images are skipped with a warning
+const size_t k_max_unbacked_elems = 1u << 24;    // accessors without a bufferView (all zeros)
+const uint32_t k_glb_json = 0x4E4F534Au, k_glb_bin = 0x004E4942u;
+
+struct SceneDeleter {
+    void operator()(lm_scene *s) const { lm_scene_free(s); }
+};
+using ScenePtr = std::unique_ptr<lm_scene, SceneDeleter>;
+
+// A located accessor: where its elements are and how to decode them.
+struct Span {
+    const uint8_t *data = nullptr; // null: no bufferView, all zeros
+    size_t count = 0, stride = 0;
+    int comp_type = 0, ncomp = 0;
+    bool normalized = false;
+};
+
+template <typename T> T *copy_out(const std::vector<T> &v)
+{
+    if (v.empty())
+        return nullptr;
+    T *p = static_cast<T *>(malloc(v.size() * sizeof(T)));
+    if (!p)
+        throw std::bad_alloc();
+    memcpy(p, v.data(), v.size() * sizeof(T));
+    return p;
+}
+
+template <typename T> T *calloc_n(size_t n)
+{
+    if (n == 0)
+        return nullptr;
+    T *p = static_cast<T *>(calloc(n, sizeof(T)));
+    if (!p)
+        throw std::bad_alloc();
+    return p;
+}
+
+const tinygltf::Value *ext_obj(const tinygltf::ExtensionMap &m, const char *name)
+{
+    auto it = m.find(name);
+    return it != m.end() && it->second.IsObject() ? &it->second : nullptr;
+}
+
+double num(const tinygltf::Value *o, const char *key, double def)
+{
+    if (!o || !o->Has(key) || !o->Get(key).IsNumber())
+        return def;
+    return o->Get(key).GetNumberAsDouble();
+}
+
+// An integer property, or def when absent or not an integer in int range.
+int int_prop(const tinygltf::Value *o, const char *key, int def)
+{
+    double d = num(o, key, NAN);
+    return std::isfinite(d) && d >= -2147483648.0 && d <= 2147483647.0 && d == std::floor(d) ? int(d) : def;
+}
+
+void vec_or(const std::vector<double> &v, size_t n, const float *def, float *out)
+{
+    for (size_t i = 0; i < n; i++)
+        out[i] = v.size() == n ? float(v[i]) : def[i];
+}
+
+bool finite_all(const float *v, size_t n) { return lm_first_nonfinite(v, n) < 0; }
+
+// stb_image decoding for tinygltf, to 8-bit RGBA. An undecodable or oversized image is a warning (the
+// material keeps its factor), and an image whose bufferView lies outside its buffer is an error:
+// tinygltf hands us a pointer it never checked.
+bool decode_image(tinygltf::Image *img, const int idx, std::string *err, std::string *warn, int, int,
+                  const unsigned char *bytes, int size, void *user)
+{
+    const tinygltf::Model *model = static_cast<const tinygltf::Model *>(user);
+    if (img->bufferView >= 0) {
+        const tinygltf::BufferView &bv = model->bufferViews[size_t(img->bufferView)]; // range checked by tinygltf
+        const tinygltf::Buffer &buf = model->buffers[size_t(bv.buffer)];
+        if (!lm_span_fits(bv.byteOffset, 1, 0, bv.byteLength, buf.data.size()) || bv.byteLength > INT32_MAX) {
+            *err += "image " + std::to_string(idx) + ": bufferView " + std::to_string(img->bufferView) +
+                    " lies outside its buffer\n";
+            return false;
+        }
+    }
+    int w = 0, h = 0, comp = 0;
+    bool ok = size > 0 && stbi_info_from_memory(bytes, size, &w, &h, &comp) && w > 0 && h > 0 &&
+              (long long)w * h <= k_max_texels;
+    unsigned char *px = ok ? stbi_load_from_memory(bytes, size, &w, &h, &comp, 4) : nullptr;
+    img->image.clear();
+    img->width = img->height = 0;
+    if (!px) {
+        *warn += "image " + std::to_string(idx) + " (\"" + img->name + "\") could not be decoded; ignored\n";
+        return true;
+    }
+    img->image.assign(px, px + size_t(w) * size_t(h) * 4);
+    stbi_image_free(px);
+    img->width = w, img->height = h, img->component = 4, img->bits = 8;
+    img->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
+    return true;
+}
+
+std::string first_line(const std::string &s)
+{
+    size_t e = s.find('\n');
+    return e == std::string::npos ? s : s.substr(0, e);
+}
+
+class Loader {
+  public:
+    Loader(const char *path, const lm_load_options *opt, lm_error *err) : path_(path), err_(err)
+    {
+        strict_ = opt && opt->strict;
+    }
+    ~Loader()
+    {
+        for (lm_texture &t : textures_) // only textures not yet handed to the scene
+            free(t.rgba);
+    }
+    Loader(const Loader &) = delete;
+    Loader &operator=(const Loader &) = delete;
+    lm_status run(lm_scene **out);
+
+  private:
+    lm_status fail(lm_status st, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
+    lm_status read_file(std::vector<unsigned char> &bytes);
+    lm_status check_glb(const std::vector<unsigned char> &b);
+    lm_status parse(const std::vector<unsigned char> &bytes);
+    lm_status check_extensions();
+    lm_status locate(int acc, int type, const char *what, const std::string &ctx, Span &sp);
+    lm_status read_floats(int acc, int type, bool force_norm, const char *what, const std::string &ctx,
+                          std::vector<float> &out, size_t &count);
+    int texture(int tex_index, const std::string &ctx);
+    lm_status materials();
+    lm_status nodes();
+    lm_status node_instances();
+    lm_status geometry();
+    lm_status primitive(int node, int mesh, int prim);
+    lm_status animations();
+    lm_status finish();
+
+    const char *path_;
+    lm_error *err_;
+    bool strict_ = false;
+    tinygltf::Model model_;
+    ScenePtr s_;
+    std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted)
+    std::vector<lm_texture> textures_;
+    std::vector<unsigned char> animated_;
+    bool need_default_material_ = false;
+    bool any_uv1_ = false;
+    std::vector<float> pos_, nrm_, uv0_, uv1_;
+    std::vector<uint32_t> vnode_, tris_, tnode_;
+    std::vector<int> tmat_;
+};
+
+lm_status Loader::fail(lm_status st, const char *fmt, ...)
+{
+    char msg[768];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    return lm_fail(err_, st, "%s: %s", path_, msg);
+}
+
+lm_status Loader::read_file(std::vector<unsigned char> &bytes)
+{
+    FILE *f = fopen(path_, "rb");
+    if (!f)
+        return fail(LM_ERR_IO, "cannot open file: %s", strerror(errno));
+    unsigned char buf[65536];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        bytes.insert(bytes.end(), buf, buf + n);
+    bool bad = ferror(f);
+    fclose(f);
+    if (bad)
+        return fail(LM_ERR_IO, "read error");
+    if (bytes.size() > UINT32_MAX)
+        return fail(LM_ERR_FORMAT, "file larger than 4 GiB");
+    return LM_OK;
+}
+
+uint32_t le32(const unsigned char *p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
+
+// The GLB container: header, JSON chunk, optional BIN chunk, all lengths inside the file.
+lm_status Loader::check_glb(const std::vector<unsigned char> &b)
+{
+    uint64_t size = b.size();
+    if (size < 20)
+        return fail(LM_ERR_FORMAT, "truncated .glb: %llu bytes, shorter than the GLB header", (unsigned long long)size);
+    if (le32(&b[4]) != 2)
+        return fail(LM_ERR_FORMAT, "unsupported GLB container version %u", le32(&b[4]));
+    uint64_t total = le32(&b[8]), json_len = le32(&b[12]);
+    if (total > size)
+        return fail(LM_ERR_FORMAT, "truncated .glb: header says %llu bytes, file has %llu", (unsigned long long)total,
+                    (unsigned long long)size);
+    if (le32(&b[16]) != k_glb_json)
+        return fail(LM_ERR_FORMAT, "malformed .glb: first chunk is not JSON");
+    if (20 + json_len > total)
+        return fail(LM_ERR_FORMAT, "truncated .glb: JSON chunk of %llu bytes runs past the end", (unsigned long long)json_len);
+    uint64_t bin = 20 + ((json_len + 3) & ~3ull);
+    if (bin + 8 <= total) {
+        uint64_t bin_len = le32(&b[bin]);
+        if (le32(&b[bin + 4]) != k_glb_bin)
+            return fail(LM_ERR_FORMAT, "malformed .glb: second chunk is not BIN");
+        if (bin + 8 + bin_len > total)
+            return fail(LM_ERR_FORMAT, "truncated .glb: BIN chunk of %llu bytes runs past the end",
+                        (unsigned long long)bin_len);
+    }
+    return LM_OK;
+}
+
+lm_status Loader::parse(const std::vector<unsigned char> &bytes)
+{
+    bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
+    if (glb) {
+        lm_status st = check_glb(bytes);
+        if (st)
+            return st;
+    }
+    std::string p(path_), dir = ".";
+    size_t slash = p.find_last_of('/');
+    if (slash != std::string::npos)
+        dir = slash == 0 ? "/" : p.substr(0, slash);
+    tinygltf::TinyGLTF gltf;
+    gltf.SetImageLoader(decode_image, &model_);
+    std::string terr, twarn;
+    bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &terr, &twarn, bytes.data(), unsigned(bytes.size()), dir)
+                  : gltf.LoadASCIIFromString(&model_, &terr, &twarn, reinterpret_cast<const char *>(bytes.data()),
+                                             unsigned(bytes.size()), dir);
+    size_t start = 0;
+    while (start < twarn.size()) {
+        size_t e = twarn.find('\n', start);
+        std::string line = twarn.substr(start, e == std::string::npos ? std::string::npos : e - start);
+        if (!line.empty())
+            lm_warn("%s: %s", path_, line.c_str());
+        start = e == std::string::npos ? twarn.size() : e + 1;
+    }
+    if (!ok) {
+        std::string why = first_line(terr.empty() ? twarn : terr);
+        bool missing = why.find("not found") != std::string::npos || why.find("File open error") != std::string::npos;
+        return fail(missing ? LM_ERR_IO : LM_ERR_FORMAT, "%s", why.empty() ? "malformed glTF" : why.c_str());
+    }
+    return LM_OK;
+}
+
+lm_status Loader::check_extensions()
+{
+    for (const std::string &e : model_.extensionsRequired) {
+        bool known = false;
+        for (const char *k : k_supported_required)
+            known = known || e == k;
+        if (!known)
+            return fail(LM_ERR_UNSUPPORTED, "required extension %s is not supported", e.c_str());
+    }
+    std::string ignored;
+    for (const std::string &e : model_.extensionsUsed) {
+        bool known = false;
+        for (const char *k : k_supported_required)
+            known = known || e == k;
+        if (!known)
+            ignored += (ignored.empty() ? "" : ", ") + e;
+    }
+    if (!ignored.empty())
+        lm_info("%s: ignoring optional extensions %s", path_, ignored.c_str());
+    return LM_OK;
+}
+
+// Finds accessor `acc` and checks its whole element span lies inside its bufferView and buffer.
+lm_status Loader::locate(int acc, int type, const char *what, const std::string &ctx, Span &sp)
+{
+    if (acc < 0 || size_t(acc) >= model_.accessors.size())
+        return fail(LM_ERR_FORMAT, "%s: %s accessor %d out of range (%zu accessors)", ctx.c_str(), what, acc,
+                    model_.accessors.size());
+    const tinygltf::Accessor &a = model_.accessors[size_t(acc)];
+    size_t cs = lm_component_size(a.componentType);
+    if (a.type != type || cs == 0)
+        return fail(LM_ERR_FORMAT, "%s: %s accessor %d has the wrong type or component type", ctx.c_str(), what, acc);
+    if (a.sparse.isSparse)
+        return fail(LM_ERR_UNSUPPORTED, "%s: %s accessor %d is sparse (not supported)", ctx.c_str(), what, acc);
+    sp.count = a.count, sp.comp_type = a.componentType, sp.normalized = a.normalized;
+    sp.ncomp = tinygltf::GetNumComponentsInType(uint32_t(a.type));
+    size_t elem = cs * size_t(sp.ncomp);
+    if (a.bufferView < 0) {
+        if (a.count > k_max_unbacked_elems)
+            return fail(LM_ERR_FORMAT, "%s: %s accessor %d has no bufferView and %zu elements", ctx.c_str(), what,
+                        acc, a.count);
+        sp.data = nullptr, sp.stride = elem;
+        return LM_OK;
+    }
+    if (size_t(a.bufferView) >= model_.bufferViews.size())
+        return fail(LM_ERR_FORMAT, "%s: %s accessor %d: bufferView %d out of range", ctx.c_str(), what, acc,
+                    a.bufferView);
+    const tinygltf::BufferView &bv = model_.bufferViews[size_t(a.bufferView)];
+    if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
+        return fail(LM_ERR_FORMAT, "%s: bufferView %d: buffer %d out of range", ctx.c_str(), a.bufferView, bv.buffer);
+    const tinygltf::Buffer &buf = model_.buffers[size_t(bv.buffer)];
+    if (!lm_span_fits(bv.byteOffset, 1, 0, bv.byteLength, buf.data.size()))
+        return fail(LM_ERR_FORMAT, "%s: bufferView %d (offset %zu, length %zu) exceeds buffer %d of %zu bytes",
+                    ctx.c_str(), a.bufferView, bv.byteOffset, bv.byteLength, bv.buffer, buf.data.size());
+    sp.stride = bv.byteStride ? bv.byteStride : elem;
+    if (sp.stride < elem)
+        return fail(LM_ERR_FORMAT, "%s: %s accessor %d: byteStride %zu smaller than its element", ctx.c_str(), what,
+                    acc, sp.stride);
+    if (!lm_span_fits(a.byteOffset, a.count, sp.stride, elem, bv.byteLength))
+        return fail(LM_ERR_FORMAT, "%s: %s accessor %d (offset %zu, %zu elements, stride %zu) exceeds bufferView %d of %zu bytes",
+                    ctx.c_str(), what, acc, a.byteOffset, a.count, sp.stride, a.bufferView, bv.byteLength);
+    sp.data = buf.data.data() + bv.byteOffset + a.byteOffset;
+    return LM_OK;
+}
+
+lm_status Loader::read_floats(int acc, int type, bool force_norm, const char *what, const std::string &ctx,
+                              std::vector<float> &out, size_t &count)
+{
+    Span sp;
+    lm_status st = locate(acc, type, what, ctx, sp);
+    if (st)
+        return st;
+    count = sp.count;
+    out.assign(sp.count * size_t(sp.ncomp), 0.0f);
+    if (sp.data) // integer texcoords are normalised whatever the flag says (the spec requires it)
+        lm_decode_floats(sp.data, sp.count, sp.stride, sp.comp_type, sp.ncomp,
+                         sp.normalized || (force_norm && sp.comp_type != LM_COMP_FLOAT), out.data());
+    return LM_OK;
+}
+
+// lm texture index for glTF texture `tex_index` (-1 if none or undecodable); colour textures are sRGB.
+int Loader::texture(int tex_index, const std::string &ctx)
+{
+    if (tex_index < 0)
+        return -1;
+    if (size_t(tex_index) >= model_.textures.size() || model_.textures[size_t(tex_index)].source < 0 ||
+        size_t(model_.textures[size_t(tex_index)].source) >= model_.images.size()) {
+        lm_warn("%s: %s: texture %d is missing; using the factor alone", path_, ctx.c_str(), tex_index);
+        return -1;
+    }
+    size_t img = size_t(model_.textures[size_t(tex_index)].source);
+    if (image_tex_[img] >= 0)
+        return image_tex_[img];
+    const tinygltf::Image &im = model_.images[img];
+    if (im.width <= 0 || im.height <= 0 || im.image.size() != size_t(im.width) * size_t(im.height) * 4)
+        return -1; // decode failure, already warned
+    lm_texture t = {0, 0, nullptr};
+    if (!lm_texture_from_rgba8(&t, im.image.data(), im.width, im.height, 1))
+        throw std::bad_alloc();
+    textures_.push_back(t);
+    image_tex_[img] = int(textures_.size() - 1);
+    return image_tex_[img];
+}
+
+lm_status Loader::materials()
+{
+    size_t n = model_.materials.size();
+    s_->materials = calloc_n<lm_material>(n + 1); // room for the default material
+    image_tex_.assign(model_.images.size(), -1);
+    static const float one4[4] = {1, 1, 1, 1}, zero3[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        const tinygltf::Material &m = model_.materials[i];
+        lm_material &d = s_->materials[i];
+        std::string ctx = "material " + std::to_string(i) + " (\"" + m.name + "\")";
+        lm_copy_name(d.name, m.name.c_str());
+        const tinygltf::PbrMetallicRoughness &pbr = m.pbrMetallicRoughness;
+        vec_or(pbr.baseColorFactor, 4, one4, d.base_color);
+        d.base_color_tex = texture(pbr.baseColorTexture.index, ctx);
+        d.base_color_uv = pbr.baseColorTexture.texCoord == 1 ? 1 : 0;
+        d.uv_scale[0] = d.uv_scale[1] = 1.0f;
+        if (const tinygltf::Value *tt = ext_obj(pbr.baseColorTexture.extensions, "KHR_texture_transform")) {
+            for (int k = 0; k < 2; k++) {
+                if (tt->Get("offset").ArrayLen() == 2 && tt->Get("offset").Get(k).IsNumber())
+                    d.uv_offset[k] = float(tt->Get("offset").Get(k).GetNumberAsDouble());
+                if (tt->Get("scale").ArrayLen() == 2 && tt->Get("scale").Get(k).IsNumber())
+                    d.uv_scale[k] = float(tt->Get("scale").Get(k).GetNumberAsDouble());
+            }
+            d.uv_rotation = float(num(tt, "rotation", 0.0));
+            int tc = int_prop(tt, "texCoord", -1);
+            if (tc == 0 || tc == 1)
+                d.base_color_uv = tc;
+        }
+        d.metallic = float(pbr.metallicFactor);
+        d.roughness = float(pbr.roughnessFactor);
+        vec_or(m.emissiveFactor, 3, zero3, d.emissive);
+        float strength = float(num(ext_obj(m.extensions, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0));
+        for (int k = 0; k < 3; k++)
+            d.emissive[k] *= strength;
+        d.emissive_tex = texture(m.emissiveTexture.index, ctx);
+        d.transmission = float(num(ext_obj(m.extensions, "KHR_materials_transmission"), "transmissionFactor", 0.0));
+        d.ior = float(num(ext_obj(m.extensions, "KHR_materials_ior"), "ior", 1.5));
+        d.double_sided = m.doubleSided;
+        const float all[] = {d.base_color[0], d.base_color[1], d.base_color[2], d.base_color[3], d.uv_offset[0],
+                             d.uv_offset[1], d.uv_scale[0], d.uv_scale[1], d.uv_rotation, d.metallic, d.roughness,
+                             d.emissive[0], d.emissive[1], d.emissive[2], d.transmission, d.ior};
+        if (!finite_all(all, sizeof all / sizeof all[0]))
+            return fail(LM_ERR_INVALID, "%s has a non-finite parameter", ctx.c_str());
+        lm_material_classify(&d);
+    }
+    s_->material_count = int(n);
+    s_->textures = copy_out(textures_);
+    s_->texture_count = int(textures_.size());
+    textures_.clear(); // owned by the scene now
+    return LM_OK;
+}
+
+// Reads the lmgi extras of a node: -1 unset, 0/1 set.
+void read_settings(const tinygltf::Value &extras, lm_node_settings &st, const char *path, const std::string &ctx)
+{
+    st.dynamic = st.caustics = st.indirect = st.shadows = -1;
+    if (!extras.IsObject() || !extras.Has("lmgi"))
+        return;
+    const tinygltf::Value &l = extras.Get("lmgi");
+    if (!l.IsObject()) {
+        lm_warn("%s: %s: extras.lmgi is not an object; ignored", path, ctx.c_str());
+        return;
+    }
+    struct { const char *key; int *dst; } keys[] = {
+        {"dynamic", &st.dynamic}, {"caustics", &st.caustics}, {"indirect", &st.indirect}, {"shadows", &st.shadows}};
+    for (const std::string &k : l.Keys()) {
+        bool found = false;
+        for (auto &e : keys) {
+            if (k != e.key)
+                continue;
+            found = true;
+            const tinygltf::Value &v = l.Get(k);
+            if (v.IsBool())
+                *e.dst = v.Get<bool>() ? 1 : 0;
+            else if (v.IsNumber())
+                *e.dst = v.GetNumberAsDouble() != 0.0;
+            else
+                lm_warn("%s: %s: extras.lmgi.%s is not a boolean; ignored", path, ctx.c_str(), e.key);
+        }
+        if (!found)
+            lm_warn("%s: %s: unknown lmgi setting \"%s\" ignored", path, ctx.c_str(), k.c_str());
+    }
+}
+
+lm_status Loader::nodes()
+{
+    size_t n = model_.nodes.size();
+    if (n > INT32_MAX / 2)
+        return fail(LM_ERR_FORMAT, "too many nodes");
+    s_->nodes = calloc_n<lm_node>(n);
+    s_->node_count = int(n);
+    static const float t0[3] = {0, 0, 0}, r0[4] = {0, 0, 0, 1}, s1[3] = {1, 1, 1};
+    for (size_t i = 0; i < n; i++) {
+        const tinygltf::Node &g = model_.nodes[i];
+        lm_node &d = s_->nodes[i];
+        std::string ctx = "node " + std::to_string(i) + " (\"" + g.name + "\")";
+        lm_copy_name(d.name, g.name.c_str());
+        d.parent = -1, d.camera = -1, d.light = -1;
+        if ((!g.translation.empty() && g.translation.size() != 3) || (!g.rotation.empty() && g.rotation.size() != 4) ||
+            (!g.scale.empty() && g.scale.size() != 3) || (!g.matrix.empty() && g.matrix.size() != 16))
+            return fail(LM_ERR_FORMAT, "%s: transform arrays have the wrong length", ctx.c_str());
+        vec_or(g.translation, 3, t0, d.translation);
+        vec_or(g.rotation, 4, r0, d.rotation);
+        vec_or(g.scale, 3, s1, d.scale);
+        d.has_matrix = g.matrix.size() == 16;
+        for (size_t k = 0; k < 16 && d.has_matrix; k++)
+            d.matrix[k] = float(g.matrix[k]);
+        if (!finite_all(d.translation, 3) || !finite_all(d.rotation, 4) || !finite_all(d.scale, 3))
+            return fail(LM_ERR_INVALID, "%s has a non-finite transform", ctx.c_str());
+        if (g.mesh >= 0 && size_t(g.mesh) >= model_.meshes.size())
+            return fail(LM_ERR_FORMAT, "%s: mesh %d out of range", ctx.c_str(), g.mesh);
+        d.mesh = g.mesh < 0 ? -1 : g.mesh;
+        if (g.skin >= 0)
+            lm_warn("%s: %s: skinning ignored; the mesh is placed by the node", path_, ctx.c_str());
+        read_settings(g.extras, d.settings, path_, ctx);
+    }
+    for (size_t i = 0; i < n; i++) {
+        for (int c : model_.nodes[i].children) {
+            if (c < 0 || size_t(c) >= n)
+                return fail(LM_ERR_FORMAT, "node %zu: child %d out of range", i, c);
+            if (s_->nodes[c].parent >= 0 || size_t(c) == i)
+                return fail(LM_ERR_FORMAT, "node %d has more than one parent or is its own child", c);
+            s_->nodes[c].parent = int(i);
+        }
+    }
+    return node_instances();
+}
+
+// Lights and cameras are instanced per node that references them.
+lm_status Loader::node_instances()
+{
+    std::vector<lm_light> lights;
+    std::vector<lm_camera> cams;
+    for (int i = 0; i < s_->node_count; i++) {
+        const tinygltf::Node &g = model_.nodes[size_t(i)];
+        if (g.camera >= 0) {
+            if (size_t(g.camera) >= model_.cameras.size())
+                return fail(LM_ERR_FORMAT, "node %d: camera %d out of range", i, g.camera);
+            const tinygltf::Camera &c = model_.cameras[size_t(g.camera)];
+            lm_camera d = {};
+            lm_copy_name(d.name, c.name.c_str());
+            d.node = i;
+            d.perspective = c.type != "orthographic";
+            d.yfov = float(c.perspective.yfov), d.aspect = float(c.perspective.aspectRatio);
+            d.znear = float(d.perspective ? c.perspective.znear : c.orthographic.znear);
+            d.zfar = float(d.perspective ? c.perspective.zfar : c.orthographic.zfar);
+            d.xmag = float(c.orthographic.xmag), d.ymag = float(c.orthographic.ymag);
+            s_->nodes[i].camera = int(cams.size());
+            cams.push_back(d);
+        }
+        const tinygltf::Value *le = ext_obj(g.extensions, "KHR_lights_punctual");
+        if (!le)
+            continue;
+        int li = int_prop(le, "light", -1);
+        if (li < 0 || size_t(li) >= model_.lights.size())
+            return fail(LM_ERR_FORMAT, "node %d: KHR_lights_punctual light %d out of range", i, li);
+        const tinygltf::Light &l = model_.lights[size_t(li)];
+        lm_light d = {};
+        lm_copy_name(d.name, l.name.c_str());
+        if (l.type == "point")
+            d.type = LM_LIGHT_POINT;
+        else if (l.type == "spot")
+            d.type = LM_LIGHT_SPOT;
+        else if (l.type == "directional")
+            d.type = LM_LIGHT_DIRECTIONAL;
+        else {
+            lm_warn("%s: light %d (\"%s\"): unknown type \"%s\" ignored", path_, li, l.name.c_str(), l.type.c_str());
+            continue;
+        }
+        static const float white[3] = {1, 1, 1};
+        vec_or(l.color, 3, white, d.color);
+        d.intensity = float(l.intensity), d.range = float(l.range);
+        d.inner_cone = float(l.spot.innerConeAngle), d.outer_cone = float(l.spot.outerConeAngle);
+        d.node = i;
+        const float all[] = {d.color[0], d.color[1], d.color[2], d.intensity, d.range, d.inner_cone, d.outer_cone};
+        if (!finite_all(all, 7) || d.intensity < 0.0f)
+            return fail(LM_ERR_INVALID, "light %d (\"%s\") has a non-finite or negative parameter", li, l.name.c_str());
+        s_->nodes[i].light = int(lights.size());
+        lights.push_back(d);
+    }
+    s_->lights = copy_out(lights), s_->light_count = int(lights.size());
+    s_->cameras = copy_out(cams), s_->camera_count = int(cams.size());
+    return LM_OK;
+}
+
+lm_status Loader::primitive(int node, int mesh, int prim)
+{
+    const tinygltf::Mesh &m = model_.meshes[size_t(mesh)];
+    const tinygltf::Primitive &p = m.primitives[size_t(prim)];
+    std::string ctx = "mesh " + std::to_string(mesh) + " (\"" + m.name + "\") primitive " + std::to_string(prim);
+    int mode = p.mode < 0 ? TINYGLTF_MODE_TRIANGLES : p.mode;
+    if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP && mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+        lm_warn("%s: %s: mode %d is not triangles; skipped", path_, ctx.c_str(), mode);
+        return LM_OK;
+    }
+    auto attr = [&](const char *name) { auto it = p.attributes.find(name); return it == p.attributes.end() ? -1 : it->second; };
+    if (attr("POSITION") < 0) {
+        lm_warn("%s: %s: no POSITION attribute; skipped", path_, ctx.c_str());
+        return LM_OK;
+    }
+    std::vector<float> pos, nrm, uv[2];
+    size_t vcount = 0, c = 0;
+    lm_status st = read_floats(attr("POSITION"), TINYGLTF_TYPE_VEC3, false, "POSITION", ctx, pos, vcount);
+    if (st)
+        return st;
+    long bad = lm_first_nonfinite(pos.data(), pos.size());
+    if (bad >= 0)
+        return fail(LM_ERR_INVALID, "%s: vertex %ld has a non-finite position", ctx.c_str(), bad / 3);
+    if (pos_.size() / 3 + vcount > UINT32_MAX)
+        return fail(LM_ERR_FORMAT, "more than 2^32 vertices");
+    if (attr("NORMAL") >= 0) {
+        if ((st = read_floats(attr("NORMAL"), TINYGLTF_TYPE_VEC3, false, "NORMAL", ctx, nrm, c)))
+            return st;
+        if (c != vcount)
+            return fail(LM_ERR_FORMAT, "%s: NORMAL accessor has %zu elements, POSITION %zu", ctx.c_str(), c, vcount);
+        if (!finite_all(nrm.data(), nrm.size())) {
+            if (strict_)
+                return fail(LM_ERR_INVALID, "%s: non-finite normals", ctx.c_str());
+            lm_warn("%s: %s: non-finite normals; generating normals from faces", path_, ctx.c_str());
+            nrm.clear();
+        }
+    }
+    const char *uv_names[2] = {"TEXCOORD_0", "TEXCOORD_1"};
+    for (int k = 0; k < 2; k++) {
+        if (attr(uv_names[k]) < 0)
+            continue;
+        if ((st = read_floats(attr(uv_names[k]), TINYGLTF_TYPE_VEC2, true, uv_names[k], ctx, uv[k], c)))
+            return st;
+        if (c != vcount)
+            return fail(LM_ERR_FORMAT, "%s: %s accessor has %zu elements, POSITION %zu", ctx.c_str(), uv_names[k], c, vcount);
+        if (!finite_all(uv[k].data(), uv[k].size()))
+            return fail(LM_ERR_INVALID, "%s: non-finite %s", ctx.c_str(), uv_names[k]);
+    }
+    std::vector<uint32_t> idx;
+    if (p.indices >= 0) {
+        Span sp;
+        if ((st = locate(p.indices, TINYGLTF_TYPE_SCALAR, "index", ctx, sp)))
+            return st;
+        if (sp.count > UINT32_MAX)
+            return fail(LM_ERR_FORMAT, "%s: too many indices", ctx.c_str());
+        idx.assign(sp.count, 0);
+        if (sp.data && !lm_decode_indices(sp.data, sp.count, sp.stride, sp.comp_type, idx.data()))
+            return fail(LM_ERR_FORMAT, "%s: index accessor %d is not u8/u16/u32", ctx.c_str(), p.indices);
+        for (size_t i = 0; i < idx.size(); i++)
+            if (idx[i] >= vcount)
+                return fail(LM_ERR_FORMAT, "%s: index %u (at %zu) out of range of the vertex count %zu", ctx.c_str(),
+                            idx[i], i, vcount);
+    } else {
+        if (vcount > UINT32_MAX)
+            return fail(LM_ERR_FORMAT, "%s: too many vertices", ctx.c_str());
+        for (size_t i = 0; i < vcount; i++)
+            idx.push_back(uint32_t(i));
+    }
+    if (p.material >= 0 && size_t(p.material) >= model_.materials.size())
+        return fail(LM_ERR_FORMAT, "%s: material %d out of range", ctx.c_str(), p.material);
+    int mat = p.material >= 0 ? p.material : int(model_.materials.size());
+    need_default_material_ = need_default_material_ || p.material < 0;
+
+    uint32_t base = uint32_t(pos_.size() / 3), first_tri = uint32_t(tris_.size() / 3);
+    uint32_t ntri = lm_prim_tri_count(mode, uint32_t(idx.size()));
+    if (size_t(first_tri) + ntri > UINT32_MAX / 3)
+        return fail(LM_ERR_FORMAT, "too many triangles");
+    tris_.resize(tris_.size() + size_t(ntri) * 3);
+    lm_prim_triangles(mode, idx.data(), uint32_t(idx.size()), base, tris_.data() + size_t(first_tri) * 3);
+    tmat_.insert(tmat_.end(), ntri, mat);
+    tnode_.insert(tnode_.end(), ntri, uint32_t(node));
+    pos_.insert(pos_.end(), pos.begin(), pos.end());
+    vnode_.insert(vnode_.end(), vcount, uint32_t(node));
+    for (int k = 0; k < 2; k++)
+        uv[k].resize(vcount * 2, 0.0f);
+    uv0_.insert(uv0_.end(), uv[0].begin(), uv[0].end());
+    any_uv1_ = any_uv1_ || attr("TEXCOORD_1") >= 0;
+    uv1_.insert(uv1_.end(), uv[1].begin(), uv[1].end());
+    if (nrm.empty()) {
+        nrm_.resize(pos_.size());
+        lm_generate_normals(nrm_.data(), pos_.data(), tris_.data() + size_t(first_tri) * 3, ntri, base, uint32_t(vcount));
+    } else {
+        nrm_.insert(nrm_.end(), nrm.begin(), nrm.end());
+    }
+    return LM_OK;
+}
+
+// Each node gets its own copy of its mesh's triangles, contiguous, in node order.
+lm_status Loader::geometry()
+{
+    s_->mesh_count = int(model_.meshes.size());
+    for (int i = 0; i < s_->node_count; i++) {
+        lm_node &n = s_->nodes[i];
+        n.first_tri = uint32_t(tris_.size() / 3);
+        if (n.mesh >= 0) {
+            for (size_t k = 0; k < model_.meshes[size_t(n.mesh)].primitives.size(); k++) {
+                lm_status st = primitive(i, n.mesh, int(k));
+                if (st)
+                    return st;
+            }
+        }
+        n.tri_count = uint32_t(tris_.size() / 3) - n.first_tri;
+    }
+    if (need_default_material_) {
+        lm_material &d = s_->materials[s_->material_count++];
+        lm_copy_name(d.name, "lmgi_default");
+        for (int k = 0; k < 3; k++)
+            d.base_color[k] = 0.8f;
+        d.base_color[3] = 1.0f;
+        d.base_color_tex = d.emissive_tex = -1;
+        d.uv_scale[0] = d.uv_scale[1] = 1.0f;
+        d.roughness = 1.0f, d.ior = 1.5f;
+        lm_material_classify(&d);
+    }
+    s_->vertex_count = uint32_t(pos_.size() / 3);
+    s_->positions = copy_out(pos_), s_->normals = copy_out(nrm_), s_->uv0 = copy_out(uv0_);
+    s_->uv1 = any_uv1_ ? copy_out(uv1_) : nullptr;
+    s_->vertex_node = copy_out(vnode_);
+    s_->tri_count = uint32_t(tris_.size() / 3);
+    s_->tris = copy_out(tris_), s_->tri_material = copy_out(tmat_), s_->tri_node = copy_out(tnode_);
+    return LM_OK;
+}
+
+lm_status Loader::animations()
+{
+    size_t na = model_.animations.size();
+    animated_.assign(model_.nodes.size(), 0);
+    s_->animations = calloc_n<lm_animation>(na);
+    s_->animation_count = int(na);
+    for (size_t a = 0; a < na; a++) {
+        const tinygltf::Animation &g = model_.animations[a];
+        lm_animation &d = s_->animations[a];
+        std::string ctx = "animation " + std::to_string(a) + " (\"" + g.name + "\")";
+        lm_copy_name(d.name, g.name.c_str());
+        d.channels = calloc_n<lm_anim_channel>(g.channels.size());
+        for (const tinygltf::AnimationChannel &ch : g.channels) {
+            lm_anim_path path;
+            if (ch.target_path == "translation")
+                path = LM_PATH_TRANSLATION;
+            else if (ch.target_path == "rotation")
+                path = LM_PATH_ROTATION;
+            else if (ch.target_path == "scale")
+                path = LM_PATH_SCALE;
+            else {
+                lm_warn("%s: %s: \"%s\" channel ignored", path_, ctx.c_str(), ch.target_path.c_str());
+                continue;
+            }
+            if (ch.target_node < 0)
+                continue; // no target: nothing to animate (allowed by the spec)
+            if (size_t(ch.target_node) >= model_.nodes.size() || ch.sampler < 0 || size_t(ch.sampler) >= g.samplers.size())
+                return fail(LM_ERR_FORMAT, "%s: channel target node %d or sampler %d out of range", ctx.c_str(),
+                            ch.target_node, ch.sampler);
+            const tinygltf::AnimationSampler &sm = g.samplers[size_t(ch.sampler)];
+            lm_interp in = sm.interpolation == "STEP" ? LM_INTERP_STEP
+                         : sm.interpolation == "CUBICSPLINE" ? LM_INTERP_CUBIC : LM_INTERP_LINEAR;
+            if (sm.interpolation != "LINEAR" && sm.interpolation != "STEP" && sm.interpolation != "CUBICSPLINE")
+                return fail(LM_ERR_FORMAT, "%s: unknown interpolation \"%s\"", ctx.c_str(), sm.interpolation.c_str());
+            std::vector<float> times, values;
+            size_t nt = 0, nv = 0;
+            int comps = path == LM_PATH_ROTATION ? 4 : 3;
+            lm_status st = read_floats(sm.input, TINYGLTF_TYPE_SCALAR, false, "animation input", ctx, times, nt);
+            if (st || (st = read_floats(sm.output, comps == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3, false,
+                                        "animation output", ctx, values, nv)))
+                return st;
+            size_t per_key = in == LM_INTERP_CUBIC ? 3 : 1;
+            if (nt == 0 || nt > INT32_MAX || nv != nt * per_key)
+                return fail(LM_ERR_FORMAT, "%s: sampler %d has %zu keys and %zu output values", ctx.c_str(), ch.sampler, nt, nv);
+            for (size_t k = 0; k < nt; k++)
+                if (!std::isfinite(times[k]) || (k > 0 && times[k] < times[k - 1]))
+                    return fail(LM_ERR_FORMAT, "%s: sampler %d key times are not finite and increasing", ctx.c_str(), ch.sampler);
+            if (!finite_all(values.data(), values.size()))
+                return fail(LM_ERR_INVALID, "%s: sampler %d has non-finite values", ctx.c_str(), ch.sampler);
+            lm_anim_channel &c = d.channels[d.channel_count++];
+            c.node = ch.target_node, c.path = path, c.interp = in, c.key_count = int(nt), c.comps = comps;
+            c.times = copy_out(times), c.values = copy_out(values);
+            d.duration = std::fmax(d.duration, times.back());
+            animated_[size_t(ch.target_node)] = 1;
+        }
+    }
+    return LM_OK;
+}
+
+lm_status Loader::finish()
+{
+    lm_status st = lm_scene_finish_nodes(s_.get(), animated_.data(), err_);
+    if (st)
+        return st;
+    for (int i = 0; i < s_->node_count; i++) {
+        const lm_node &n = s_->nodes[i];
+        uint32_t bad = n.tri_count ? lm_count_degenerate(s_.get(), n.first_tri, n.tri_count) : 0;
+        if (!bad)
+            continue;
+        const char *mesh = model_.meshes[size_t(n.mesh)].name.c_str();
+        if (strict_)
+            return fail(LM_ERR_INVALID, "mesh \"%s\" (node %d) has %u degenerate triangles", mesh, i, bad);
+        lm_warn("%s: mesh \"%s\" (node %d) has %u degenerate (zero-area) triangles", path_, mesh, i, bad);
+    }
+    return LM_OK;
+}
+
+lm_status Loader::run(lm_scene **out)
+{
+    std::vector<unsigned char> bytes;
+    lm_status st = read_file(bytes);
+    if (st || (st = parse(bytes)) || (st = check_extensions()))
+        return st;
+    bytes = std::vector<unsigned char>(); // tinygltf has copied what it needs
+    s_.reset(calloc_n<lm_scene>(1));
+    snprintf(s_->path, sizeof s_->path, "%s", path_);
+    if ((st = materials()) || (st = nodes()) || (st = animations()) || (st = geometry()) || (st = finish()))
+        return st;
+    *out = s_.release();
+    return LM_OK;
+}
+
+} // namespace
+
+extern "C" lm_status lm_scene_load_gltf(const char *path, const lm_load_options *opt, lm_scene **out, lm_error *err)
+{
+    if (out)
+        *out = nullptr;
+    lm_error_clear(err);
+    if (!path || !out)
+        return lm_fail(err, LM_ERR_INVALID, "lm_scene_load_gltf: NULL %s", path ? "output" : "path");
+    try {
+        Loader loader(path, opt, err);
+        return loader.run(out);
+    } catch (const std::bad_alloc &) {
+        return lm_fail(err, LM_ERR_NOMEM, "%s: out of memory", path);
+    } catch (const std::exception &e) {
+        return lm_fail(err, LM_ERR_FORMAT, "%s: %s", path, e.what());
+    } catch (...) {
+        return lm_fail(err, LM_ERR_FORMAT, "%s: unexpected error while loading", path);
+    }
+}

@@ -1,0 +1,204 @@
+/* The scene model: freeing, world transforms, animation evaluation and geometric queries. */
+#include "scene.h"
+
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/vecmath.h"
+
+void lm_scene_free(lm_scene *s)
+{
+    if (!s)
+        return;
+    for (int i = 0; i < s->texture_count; i++)
+        free(s->textures[i].rgba);
+    for (int a = 0; a < s->animation_count; a++) {
+        for (int c = 0; c < s->animations[a].channel_count; c++) {
+            free(s->animations[a].channels[c].times);
+            free(s->animations[a].channels[c].values);
+        }
+        free(s->animations[a].channels);
+    }
+    free(s->nodes);
+    free(s->materials);
+    free(s->textures);
+    free(s->lights);
+    free(s->cameras);
+    free(s->animations);
+    free(s->positions);
+    free(s->normals);
+    free(s->uv0);
+    free(s->uv1);
+    free(s->vertex_node);
+    free(s->tris);
+    free(s->tri_material);
+    free(s->tri_node);
+    free(s);
+}
+
+static void local_matrix(lm_node *n)
+{
+    if (!n->has_matrix)
+        lm_mat4_from_trs(n->matrix, n->translation, n->rotation, n->scale);
+}
+
+/* world = parent chain product, computed by walking up from each node: no ordering or scratch memory
+ * needed, O(nodes x depth). The step bound keeps a corrupted (cyclic) hierarchy from looping. */
+void lm_scene_update_world(lm_scene *s)
+{
+    for (int i = 0; i < s->node_count; i++)
+        local_matrix(&s->nodes[i]);
+    for (int i = 0; i < s->node_count; i++) {
+        float *w = s->nodes[i].world;
+        memcpy(w, s->nodes[i].matrix, sizeof s->nodes[i].matrix);
+        int p = s->nodes[i].parent;
+        for (int steps = 0; p >= 0 && steps < s->node_count; steps++) {
+            lm_mat4_mul(w, s->nodes[p].matrix, w);
+            p = s->nodes[p].parent;
+        }
+    }
+}
+
+/* Index k of the last key with times[k] <= t (0 when t precedes every key). */
+static int find_key(const lm_anim_channel *c, float t)
+{
+    int lo = 0, hi = c->key_count - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (c->times[mid] <= t)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* Value (not tangent) of key k. */
+static const float *key_value(const lm_anim_channel *c, int k)
+{
+    int per_key = c->interp == LM_INTERP_CUBIC ? 3 : 1;
+    return c->values + ((size_t)k * (size_t)per_key + (per_key == 3)) * (size_t)c->comps;
+}
+
+/* glTF cubic Hermite spline between keys k and k+1 at fraction u, tangents scaled by the interval. */
+static void cubic(const lm_anim_channel *c, int k, float u, float dt, float *out)
+{
+    const float *p0 = key_value(c, k), *p1 = key_value(c, k + 1);
+    const float *b0 = p0 + c->comps;     /* out-tangent of k */
+    const float *a1 = p1 - c->comps;     /* in-tangent of k+1 */
+    float u2 = u * u, u3 = u2 * u;
+    float h00 = 2 * u3 - 3 * u2 + 1, h10 = u3 - 2 * u2 + u, h01 = -2 * u3 + 3 * u2, h11 = u3 - u2;
+    for (int i = 0; i < c->comps; i++)
+        out[i] = h00 * p0[i] + h10 * dt * b0[i] + h01 * p1[i] + h11 * dt * a1[i];
+}
+
+static void eval_channel(const lm_anim_channel *c, float t, float *out)
+{
+    int n = c->key_count, k = find_key(c, t);
+    if (t <= c->times[0] || k >= n - 1 || c->interp == LM_INTERP_STEP) {
+        memcpy(out, key_value(c, t <= c->times[0] ? 0 : k), (size_t)c->comps * sizeof(float));
+    } else {
+        float dt = c->times[k + 1] - c->times[k];
+        float u = dt > 0.0f ? (t - c->times[k]) / dt : 0.0f;
+        const float *a = key_value(c, k), *b = key_value(c, k + 1);
+        if (c->interp == LM_INTERP_CUBIC)
+            cubic(c, k, u, dt, out);
+        else if (c->path == LM_PATH_ROTATION)
+            lm_quat_slerp(out, a, b, u);
+        else
+            for (int i = 0; i < c->comps; i++)
+                out[i] = a[i] + (b[i] - a[i]) * u;
+    }
+    if (c->path == LM_PATH_ROTATION)
+        lm_quat_normalize(out);
+}
+
+static void apply_channel(lm_scene *s, const lm_anim_channel *c, float t)
+{
+    if (c->node < 0 || c->node >= s->node_count || c->key_count < 1)
+        return;
+    lm_node *n = &s->nodes[c->node];
+    float v[4];
+    eval_channel(c, t, v);
+    float *dst = c->path == LM_PATH_TRANSLATION ? n->translation : c->path == LM_PATH_ROTATION ? n->rotation : n->scale;
+    memcpy(dst, v, (size_t)(c->path == LM_PATH_ROTATION ? 4 : 3) * sizeof(float));
+    n->has_matrix = 0; /* an animated node is driven by its TRS (decomposed from any matrix at load) */
+}
+
+void lm_scene_eval_animation(lm_scene *s, int anim, float t)
+{
+    if (!isfinite(t))
+        t = 0.0f;
+    for (int a = 0; a < s->animation_count; a++) {
+        if (anim >= 0 && a != anim)
+            continue;
+        /* Clamping per channel to its key range is the same as clamping to the animation's range. */
+        for (int c = 0; c < s->animations[a].channel_count; c++)
+            apply_channel(s, &s->animations[a].channels[c], t);
+    }
+    lm_scene_update_world(s);
+}
+
+float lm_scene_animation_duration(const lm_scene *s)
+{
+    float d = 0.0f;
+    for (int a = 0; a < s->animation_count; a++)
+        d = fmaxf(d, s->animations[a].duration);
+    return d;
+}
+
+void lm_scene_vertex_world(const lm_scene *s, uint32_t v, float out[3])
+{
+    const float *m = s->nodes[s->vertex_node[v]].world;
+    lm_v3_store(out, lm_mat4_point(m, lm_v3_load(s->positions + 3 * (size_t)v)));
+}
+
+void lm_scene_normal_world(const lm_scene *s, uint32_t v, float out[3])
+{
+    const float *m = s->nodes[s->vertex_node[v]].world;
+    lm_v3_store(out, lm_mat4_normal(m, lm_v3_load(s->normals + 3 * (size_t)v)));
+}
+
+float lm_scene_tri_area_world(const lm_scene *s, uint32_t t)
+{
+    float p[3][3];
+    for (int k = 0; k < 3; k++)
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t + (size_t)k], p[k]);
+    lm_vec3 a = lm_v3_load(p[0]);
+    return 0.5f * lm_length(lm_cross(lm_sub(lm_v3_load(p[1]), a), lm_sub(lm_v3_load(p[2]), a)));
+}
+
+float lm_scene_size(const lm_scene *s)
+{
+    lm_vec3 d = lm_sub(lm_v3_load(s->bounds_max), lm_v3_load(s->bounds_min));
+    return d.x >= 0.0f ? lm_length(d) : 0.0f;
+}
+
+/* Bounds of the vertices that triangles use (unreferenced vertices don't count). An empty scene gets
+ * min > max (size 0). */
+void lm_scene_update_bounds(lm_scene *s)
+{
+    lm_vec3 lo = lm_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = lm_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        for (int k = 0; k < 3; k++) {
+            float p[3];
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)t + (size_t)k], p);
+            lo = lm_vmin(lo, lm_v3_load(p));
+            hi = lm_vmax(hi, lm_v3_load(p));
+        }
+    }
+    lm_v3_store(s->bounds_min, lo);
+    lm_v3_store(s->bounds_max, hi);
+}
+
+const char *lm_light_type_name(lm_light_type t)
+{
+    switch (t) {
+    case LM_LIGHT_POINT: return "point";
+    case LM_LIGHT_SPOT: return "spot";
+    case LM_LIGHT_DIRECTIONAL: return "directional";
+    }
+    return "unknown";
+}

@@ -1,0 +1,183 @@
+/* The scene model: what a glTF file becomes inside lmgi.
+ *
+ * Geometry is flattened per node: every node that references a mesh gets its own copy of that mesh's
+ * triangle primitives (a lightmap needs unique texels per instance anyway). Vertex positions and normals
+ * are kept in the node's local (object) space; a node's world matrix places them. Static and dynamic
+ * nodes are stored alike; `dynamic` says whether the node may move (lmgi extras, or animated).
+ *
+ * Units are the file's own (glTF metres, but lmgi never assumes a scale). Colours are linear RGB. */
+#ifndef LM_SCENE_H
+#define LM_SCENE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../core/error.h"
+
+#define LM_NAME_MAX 64
+
+/* Material classes for light transport (docs/materials.md gives the rule; lm_material_classify applies it). */
+typedef enum {
+    LM_MAT_DIFFUSE = 0,
+    LM_MAT_GLOSSY,
+    LM_MAT_MIRROR,
+    LM_MAT_GLASS,
+    LM_MAT_EMITTER,
+    LM_MAT_CLASS_COUNT
+} lm_material_class;
+
+typedef struct {
+    int width, height;
+    float *rgba; /* linear RGBA, row 0 at the top (v = 0), width*height*4 floats */
+} lm_texture;
+
+typedef struct {
+    char name[LM_NAME_MAX];
+    float base_color[4];   /* linear RGBA factor */
+    int base_color_tex;    /* index into lm_scene.textures, -1 if none */
+    int base_color_uv;     /* which TEXCOORD set the texture uses (0 or 1) */
+    float uv_offset[2], uv_scale[2], uv_rotation; /* KHR_texture_transform of the base colour texture */
+    float metallic, roughness;
+    float emissive[3];     /* emissiveFactor x KHR_materials_emissive_strength: emitted radiance */
+    int emissive_tex;      /* -1 if none */
+    float transmission;    /* KHR_materials_transmission factor */
+    float ior;             /* KHR_materials_ior (1.5 when absent) */
+    int double_sided;
+    lm_material_class cls;
+} lm_material;
+
+typedef enum { LM_LIGHT_POINT = 0, LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL } lm_light_type;
+
+typedef struct {
+    char name[LM_NAME_MAX];
+    lm_light_type type;
+    float color[3];
+    float intensity;       /* candela (point/spot) or lux (directional), as in the file */
+    float range;           /* 0 = infinite */
+    float inner_cone, outer_cone; /* spot only, radians */
+    int node;              /* node that places it; light shines down the node's local -Z */
+} lm_light;
+
+typedef struct {
+    char name[LM_NAME_MAX];
+    int perspective;       /* 1 perspective, 0 orthographic */
+    float yfov, aspect;    /* aspect 0 = use the image's */
+    float znear, zfar;     /* zfar 0 = infinite */
+    float xmag, ymag;      /* orthographic */
+    int node;
+} lm_camera;
+
+/* Per-node lmgi settings from glTF node extras {"lmgi": {...}}. Switches are -1 (unset: inherit from
+ * the parent, else on), 0 (off) or 1 (on). */
+typedef struct {
+    int dynamic;           /* extras "dynamic": true */
+    int caustics;          /* extras "caustics" */
+    int indirect;          /* extras "indirect" */
+    int shadows;           /* extras "shadows" */
+} lm_node_settings;
+
+typedef struct {
+    char name[LM_NAME_MAX];
+    int parent;            /* -1 for roots */
+    float translation[3], rotation[4], scale[3]; /* local TRS (rotation x, y, z, w) */
+    float matrix[16];      /* local matrix when the node gave one (has_matrix), else derived from TRS */
+    int has_matrix;
+    float world[16];       /* world matrix, kept current by lm_scene_update_world */
+    int mesh;              /* glTF mesh index, -1 if none */
+    int camera, light;     /* -1 if none */
+    int dynamic;           /* may move: extras dynamic, or targeted by an animation */
+    lm_node_settings settings; /* resolved: inherited switches already applied (never -1 after load) */
+    uint32_t first_tri, tri_count; /* this node's triangles in lm_scene.tris */
+} lm_node;
+
+typedef enum { LM_INTERP_LINEAR = 0, LM_INTERP_STEP, LM_INTERP_CUBIC } lm_interp;
+typedef enum { LM_PATH_TRANSLATION = 0, LM_PATH_ROTATION, LM_PATH_SCALE } lm_anim_path;
+
+typedef struct {
+    int node;
+    lm_anim_path path;
+    lm_interp interp;
+    int key_count;
+    float *times;          /* key_count, ascending */
+    float *values;         /* key_count * comps, or key_count * 3 * comps for cubic (in-tangent, value, out-tangent) */
+    int comps;             /* 3 or 4 */
+} lm_anim_channel;
+
+typedef struct {
+    char name[LM_NAME_MAX];
+    int channel_count;
+    lm_anim_channel *channels;
+    float duration;        /* last key time over all channels */
+} lm_animation;
+
+typedef struct {
+    char path[1024];       /* the file it came from */
+
+    int node_count;
+    lm_node *nodes;
+    int material_count;
+    lm_material *materials;
+    int texture_count;
+    lm_texture *textures;
+    int light_count;
+    lm_light *lights;
+    int camera_count;
+    lm_camera *cameras;
+    int animation_count;
+    lm_animation *animations;
+
+    /* Vertices, in their node's local space. uv1 is NULL when no primitive had TEXCOORD_1; when some
+     * had it, vertices of the others get (0, 0). */
+    uint32_t vertex_count;
+    float *positions;      /* 3 per vertex */
+    float *normals;        /* 3 per vertex (generated from faces when the file has none) */
+    float *uv0;            /* 2 per vertex (0,0 when absent) */
+    float *uv1;            /* 2 per vertex or NULL */
+    uint32_t *vertex_node; /* node index per vertex */
+
+    /* Triangles. Each node's triangles are contiguous (lm_node.first_tri). */
+    uint32_t tri_count;
+    uint32_t *tris;        /* 3 vertex indices per triangle */
+    int *tri_material;     /* material index per triangle (a default material is appended when needed) */
+    uint32_t *tri_node;    /* node index per triangle */
+
+    int mesh_count;        /* number of glTF meshes (for reporting) */
+    float bounds_min[3], bounds_max[3]; /* world-space bounds at load time (all nodes) */
+} lm_scene;
+
+typedef struct {
+    int strict;            /* degenerate triangles and non-finite data become errors, not warnings */
+} lm_load_options;
+
+/* Loads a .gltf or .glb file. On failure returns the status, fills err with a message that names the
+ * file and the problem, and leaves *out NULL. Implemented in gltf_loader.cpp. */
+lm_status lm_scene_load_gltf(const char *path, const lm_load_options *opt, lm_scene **out, lm_error *err);
+void lm_scene_free(lm_scene *s);
+
+/* Recomputes every node's world matrix from local transforms (parents before children). */
+void lm_scene_update_world(lm_scene *s);
+/* Sets the local TRS of every node that animation `anim` targets to its value at time t (seconds;
+ * clamped to the animation's range), then updates world matrices. anim < 0 evaluates all animations. */
+void lm_scene_eval_animation(lm_scene *s, int anim, float t);
+/* Duration of the longest animation (0 if none). */
+float lm_scene_animation_duration(const lm_scene *s);
+
+/* World-space position of a vertex / normal under the current node matrices. */
+void lm_scene_vertex_world(const lm_scene *s, uint32_t v, float out[3]);
+void lm_scene_normal_world(const lm_scene *s, uint32_t v, float out[3]);
+/* Geometric (face) normal and area of a triangle in world space. */
+float lm_scene_tri_area_world(const lm_scene *s, uint32_t t);
+/* Length of the world bounds' diagonal: the scene's size, used for relative tolerances. */
+float lm_scene_size(const lm_scene *s);
+/* Recomputes bounds_min/max from the current world matrices. */
+void lm_scene_update_bounds(lm_scene *s);
+
+/* Applies the material class rule to m's parameters (sets m->cls and returns it). */
+lm_material_class lm_material_classify(lm_material *m);
+const char *lm_material_class_name(lm_material_class c);
+/* Albedo at texture coordinate (u, v) of the base colour texture (with its transform), times the factor. */
+void lm_material_albedo(const lm_scene *s, const lm_material *m, float u, float v, float out[3]);
+
+const char *lm_light_type_name(lm_light_type t);
+
+#endif

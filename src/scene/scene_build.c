@@ -1,0 +1,294 @@
+/* File-format-independent parts of scene loading: decoding accessor data, triangulating primitives,
+ * generating normals, checking geometry, converting textures, and resolving the node graph. */
+#include "scene_build.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/log.h"
+#include "../core/vecmath.h"
+
+/* A triangle is degenerate when twice its area is below this fraction of its longest edge squared:
+ * such slivers have no usable normal or lightmap area in float precision. */
+#define LM_DEGENERATE_REL 1e-7f
+
+size_t lm_component_size(int comp_type)
+{
+    switch (comp_type) {
+    case LM_COMP_BYTE:
+    case LM_COMP_UNSIGNED_BYTE: return 1;
+    case LM_COMP_SHORT:
+    case LM_COMP_UNSIGNED_SHORT: return 2;
+    case LM_COMP_UNSIGNED_INT:
+    case LM_COMP_FLOAT: return 4;
+    }
+    return 0;
+}
+
+int lm_span_fits(uint64_t offset, uint64_t count, uint64_t stride, uint64_t elem, uint64_t avail)
+{
+    if (offset > avail)
+        return 0;
+    if (count == 0)
+        return 1;
+    uint64_t room = avail - offset;
+    if (elem > room)
+        return 0;
+    /* (count - 1) * stride + elem <= room, without overflow */
+    return stride == 0 || count - 1 <= (room - elem) / stride;
+}
+
+static float decode_one(const uint8_t *p, int comp_type, int normalized)
+{
+    switch (comp_type) {
+    case LM_COMP_BYTE: {
+        int8_t v = (int8_t)p[0];
+        return normalized ? fmaxf((float)v / 127.0f, -1.0f) : (float)v;
+    }
+    case LM_COMP_UNSIGNED_BYTE: return normalized ? (float)p[0] / 255.0f : (float)p[0];
+    case LM_COMP_SHORT: {
+        int16_t v;
+        memcpy(&v, p, 2);
+        return normalized ? fmaxf((float)v / 32767.0f, -1.0f) : (float)v;
+    }
+    case LM_COMP_UNSIGNED_SHORT: {
+        uint16_t v;
+        memcpy(&v, p, 2);
+        return normalized ? (float)v / 65535.0f : (float)v;
+    }
+    case LM_COMP_UNSIGNED_INT: {
+        uint32_t v;
+        memcpy(&v, p, 4);
+        return normalized ? (float)((double)v / 4294967295.0) : (float)v;
+    }
+    case LM_COMP_FLOAT: {
+        float v;
+        memcpy(&v, p, 4);
+        return v;
+    }
+    }
+    return 0.0f;
+}
+
+void lm_decode_floats(const uint8_t *src, size_t count, size_t stride, int comp_type, int ncomp,
+                      int normalized, float *out)
+{
+    size_t cs = lm_component_size(comp_type);
+    for (size_t i = 0; i < count; i++)
+        for (int c = 0; c < ncomp; c++)
+            out[i * (size_t)ncomp + (size_t)c] = decode_one(src + i * stride + (size_t)c * cs, comp_type, normalized);
+}
+
+int lm_decode_indices(const uint8_t *src, size_t count, size_t stride, int comp_type, uint32_t *out)
+{
+    if (comp_type != LM_COMP_UNSIGNED_BYTE && comp_type != LM_COMP_UNSIGNED_SHORT &&
+        comp_type != LM_COMP_UNSIGNED_INT)
+        return 0;
+    for (size_t i = 0; i < count; i++)
+        out[i] = (uint32_t)decode_one(src + i * stride, comp_type, 0);
+    return 1;
+}
+
+uint32_t lm_prim_tri_count(int mode, uint32_t n)
+{
+    if (mode == 4)
+        return n / 3;
+    if (mode == 5 || mode == 6)
+        return n >= 3 ? n - 2 : 0;
+    return 0;
+}
+
+void lm_prim_triangles(int mode, const uint32_t *idx, uint32_t n, uint32_t base, uint32_t *out)
+{
+    uint32_t t = lm_prim_tri_count(mode, n);
+    for (uint32_t i = 0; i < t; i++) {
+        uint32_t a, b, c;
+        if (mode == 4) {
+            a = idx[3 * i], b = idx[3 * i + 1], c = idx[3 * i + 2];
+        } else if (mode == 5) { /* strip: every other triangle swaps to keep the winding */
+            a = idx[i], b = idx[i + 1 + (i & 1)], c = idx[i + 2 - (i & 1)];
+        } else { /* fan around the first index */
+            a = idx[0], b = idx[i + 1], c = idx[i + 2];
+        }
+        out[3 * i] = a + base, out[3 * i + 1] = b + base, out[3 * i + 2] = c + base;
+    }
+}
+
+void lm_generate_normals(float *normals, const float *positions, const uint32_t *tris, uint32_t tri_count,
+                         uint32_t first_vertex, uint32_t vcount)
+{
+    float *n0 = normals + (size_t)first_vertex * 3;
+    memset(n0, 0, (size_t)vcount * 3 * sizeof(float));
+    for (uint32_t t = 0; t < tri_count; t++) {
+        const uint32_t *v = tris + 3 * (size_t)t;
+        lm_vec3 a = lm_v3_load(positions + 3 * (size_t)v[0]), b = lm_v3_load(positions + 3 * (size_t)v[1]);
+        lm_vec3 c = lm_v3_load(positions + 3 * (size_t)v[2]);
+        lm_vec3 fn = lm_cross(lm_sub(b, a), lm_sub(c, a)); /* length = 2 * area: area weighting */
+        for (int k = 0; k < 3; k++) {
+            float *n = normals + 3 * (size_t)v[k];
+            lm_v3_store(n, lm_add(lm_v3_load(n), fn));
+        }
+    }
+    for (uint32_t i = 0; i < vcount; i++) {
+        lm_vec3 n = lm_normalize(lm_v3_load(n0 + 3 * (size_t)i));
+        lm_v3_store(n0 + 3 * (size_t)i, lm_dot(n, n) > 0.0f ? n : lm_v3(0.0f, 0.0f, 1.0f));
+    }
+}
+
+uint32_t lm_count_degenerate(const lm_scene *s, uint32_t first, uint32_t count)
+{
+    uint32_t bad = 0;
+    for (uint32_t t = first; t < first + count; t++) {
+        const uint32_t *v = s->tris + 3 * (size_t)t;
+        lm_vec3 a = lm_v3_load(s->positions + 3 * (size_t)v[0]);
+        lm_vec3 b = lm_v3_load(s->positions + 3 * (size_t)v[1]);
+        lm_vec3 c = lm_v3_load(s->positions + 3 * (size_t)v[2]);
+        lm_vec3 e0 = lm_sub(b, a), e1 = lm_sub(c, a), e2 = lm_sub(c, b);
+        float longest = fmaxf(lm_dot(e0, e0), fmaxf(lm_dot(e1, e1), lm_dot(e2, e2)));
+        float twice_area = lm_length(lm_cross(e0, e1));
+        if (!(twice_area > LM_DEGENERATE_REL * longest))
+            bad++;
+    }
+    return bad;
+}
+
+long lm_first_nonfinite(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return (long)i;
+    return -1;
+}
+
+static float srgb_to_linear(float c)
+{
+    return c <= 0.04045f ? c / 12.92f : powf((c + 0.055f) / 1.055f, 2.4f);
+}
+
+int lm_texture_from_rgba8(lm_texture *t, const uint8_t *px, int w, int h, int srgb)
+{
+    float lut[256];
+    for (int i = 0; i < 256; i++)
+        lut[i] = srgb ? srgb_to_linear((float)i / 255.0f) : (float)i / 255.0f;
+    size_t n = (size_t)w * (size_t)h;
+    t->rgba = malloc(n * 4 * sizeof(float));
+    if (!t->rgba)
+        return 0;
+    t->width = w, t->height = h;
+    for (size_t i = 0; i < n; i++) {
+        for (int c = 0; c < 3; c++)
+            t->rgba[4 * i + (size_t)c] = lut[px[4 * i + (size_t)c]];
+        t->rgba[4 * i + 3] = (float)px[4 * i + 3] / 255.0f; /* alpha is always linear */
+    }
+    return 1;
+}
+
+void lm_copy_name(char *dst, const char *src)
+{
+    size_t n = src ? strlen(src) : 0;
+    if (n >= LM_NAME_MAX)
+        n = LM_NAME_MAX - 1;
+    if (n)
+        memcpy(dst, src, n);
+    dst[n] = '\0';
+}
+
+/* Walking up from any node must reach a root within node_count steps. */
+static int find_cycle(const lm_scene *s)
+{
+    for (int i = 0; i < s->node_count; i++) {
+        int p = i, steps = 0;
+        while (p >= 0 && steps <= s->node_count) {
+            p = s->nodes[p].parent;
+            steps++;
+        }
+        if (p >= 0)
+            return i;
+    }
+    return -1;
+}
+
+/* Splits a local matrix into T, R, S (exact for matrices without shear). */
+static void decompose(lm_node *n)
+{
+    const float *m = n->matrix;
+    lm_vec3 c[3];
+    for (int k = 0; k < 3; k++) {
+        c[k] = lm_v3(m[4 * k], m[4 * k + 1], m[4 * k + 2]);
+        n->scale[k] = lm_length(c[k]);
+        n->translation[k] = m[12 + k];
+    }
+    if (lm_dot(lm_cross(c[0], c[1]), c[2]) < 0.0f) { /* mirrored: put the sign in the x scale */
+        n->scale[0] = -n->scale[0];
+        c[0] = lm_scale(c[0], -1.0f);
+    }
+    for (int k = 0; k < 3; k++)
+        c[k] = n->scale[k] != 0.0f ? lm_normalize(c[k]) : lm_v3(k == 0, k == 1, k == 2);
+    /* rotation matrix r[row][col] = c[col] component row; quaternion from its trace */
+    float r00 = c[0].x, r11 = c[1].y, r22 = c[2].z, tr = r00 + r11 + r22;
+    float *q = n->rotation;
+    if (tr > 0.0f) {
+        float s = sqrtf(tr + 1.0f) * 2.0f;
+        q[3] = 0.25f * s, q[0] = (c[1].z - c[2].y) / s, q[1] = (c[2].x - c[0].z) / s, q[2] = (c[0].y - c[1].x) / s;
+    } else if (r00 > r11 && r00 > r22) {
+        float s = sqrtf(1.0f + r00 - r11 - r22) * 2.0f;
+        q[3] = (c[1].z - c[2].y) / s, q[0] = 0.25f * s, q[1] = (c[1].x + c[0].y) / s, q[2] = (c[2].x + c[0].z) / s;
+    } else if (r11 > r22) {
+        float s = sqrtf(1.0f + r11 - r00 - r22) * 2.0f;
+        q[3] = (c[2].x - c[0].z) / s, q[0] = (c[1].x + c[0].y) / s, q[1] = 0.25f * s, q[2] = (c[2].y + c[1].z) / s;
+    } else {
+        float s = sqrtf(1.0f + r22 - r00 - r11) * 2.0f;
+        q[3] = (c[0].y - c[1].x) / s, q[0] = (c[2].x + c[0].z) / s, q[1] = (c[2].y + c[1].z) / s, q[2] = 0.25f * s;
+    }
+    lm_quat_normalize(q);
+}
+
+static int resolve_switch(int own, int parent_value) { return own >= 0 ? own : parent_value; }
+
+/* Resolves node i after its ancestors (recursion depth is bounded: cycles were rejected). */
+static void resolve_node(lm_scene *s, int i, const unsigned char *animated, unsigned char *done)
+{
+    if (done[i])
+        return;
+    lm_node *n = &s->nodes[i];
+    const lm_node *p = NULL;
+    if (n->parent >= 0) {
+        resolve_node(s, n->parent, animated, done);
+        p = &s->nodes[n->parent];
+    }
+    /* A child of a moving node moves with it, whatever it says; otherwise its own flag or animation. */
+    n->dynamic = (animated && animated[i]) || n->settings.dynamic == 1 || (p && p->dynamic);
+    n->settings.dynamic = n->dynamic;
+    n->settings.caustics = resolve_switch(n->settings.caustics, p ? p->settings.caustics : 1);
+    n->settings.indirect = resolve_switch(n->settings.indirect, p ? p->settings.indirect : 1);
+    n->settings.shadows = resolve_switch(n->settings.shadows, p ? p->settings.shadows : 1);
+    done[i] = 1;
+}
+
+lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_error *err)
+{
+    int c = find_cycle(s);
+    if (c >= 0)
+        return lm_fail(err, LM_ERR_FORMAT, "%s: node %d (\"%s\") is part of a cycle in the node hierarchy",
+                       s->path, c, s->nodes[c].name);
+    for (int i = 0; i < s->node_count; i++) {
+        lm_node *n = &s->nodes[i];
+        if (n->has_matrix)
+            decompose(n);
+        else
+            lm_mat4_from_trs(n->matrix, n->translation, n->rotation, n->scale);
+        if (!lm_mat4_finite(n->matrix))
+            return lm_fail(err, LM_ERR_INVALID, "%s: node %d (\"%s\") has a non-finite transform", s->path, i,
+                           n->name);
+    }
+    unsigned char *done = calloc((size_t)s->node_count + 1, 1);
+    if (!done)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: out of memory resolving nodes", s->path);
+    for (int i = 0; i < s->node_count; i++)
+        resolve_node(s, i, animated, done);
+    free(done);
+    lm_scene_update_world(s);
+    lm_scene_update_bounds(s);
+    return LM_OK;
+}
