@@ -1,0 +1,129 @@
+/* lmgi — dynamic-scene lightmap global illumination (Larsen & Christensen 2004, made into a library).
+ *
+ * This header is the whole public API. Every function that can fail returns an lmgi_status and, when
+ * given an lmgi_error, fills it with a message that names the file or object and the problem.
+ * Nothing the caller passes in is modified unless the function says so. */
+#ifndef LMGI_H
+#define LMGI_H
+
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef enum {
+    LMGI_OK = 0,
+    LMGI_ERR_IO,          /* a file is missing, unreadable or unwritable */
+    LMGI_ERR_FORMAT,      /* a malformed file */
+    LMGI_ERR_INVALID,     /* an invalid argument or value (NaN, out-of-range id, degenerate data in strict mode) */
+    LMGI_ERR_UNSUPPORTED, /* a required glTF extension or feature lmgi does not implement */
+    LMGI_ERR_NOMEM,
+    LMGI_ERR_BACKEND      /* Embree or OpenGL failed */
+} lmgi_status;
+
+typedef struct {
+    lmgi_status status;
+    char message[1024];
+} lmgi_error;
+
+/* Settings for turning a scene file into surfaces, a lightmap atlas and a ray-tracing scene. */
+typedef struct {
+    float texel_size;       /* world units per lightmap texel; 0 = derived from the scene (~256k texels) */
+    int gutter;             /* minimum empty texels between charts (default 2) */
+    int use_file_uv1;       /* 1 = use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping */
+    int strict;             /* 1 = degenerate triangles and non-manifold edges are errors, not warnings */
+    float surface_cone_deg; /* max normal deviation within one surface, degrees (default 30) */
+    int max_atlas_size;     /* largest atlas side; texel size grows to fit (default 8192) */
+} lmgi_options;
+
+typedef struct lmgi_scene lmgi_scene;
+
+/* Time spent in each stage of lmgi_load, seconds. atlas = unwrap + pack + texels. */
+typedef struct {
+    double load, surfaces, unwrap, pack, texels, atlas, bvh, total;
+} lmgi_timings;
+
+typedef struct {
+    uint32_t triangles, vertices;
+    int nodes, dynamic_nodes, meshes, materials, textures, lights, cameras, animations;
+    int materials_by_class[5];  /* diffuse, glossy, mirror, glass, emitter */
+    int lights_by_type[3];      /* point, spot, directional */
+    int surfaces, charts;
+    uint32_t degenerate_triangles, nonmanifold_edges;
+    int atlas_width, atlas_height;
+    uint32_t texels;
+    float texel_size, utilization;
+    float bounds_min[3], bounds_max[3];
+    lmgi_timings timings;
+} lmgi_info;
+
+/* One effect of the pipeline, whether this scene calls for it, and why. */
+typedef struct {
+    const char *name;   /* "direct", "shadows", "indirect", "caustics", "reflections", "photon updates" */
+    int on;
+    char reason[256];
+} lmgi_effect;
+
+typedef struct {
+    int hit;
+    float t;
+    int node;           /* node index */
+    int surface;        /* surface id, -1 for specular triangles */
+    uint32_t triangle;  /* scene triangle id */
+    float normal[3];    /* world-space geometric normal */
+} lmgi_hit;
+
+typedef struct {
+    float position[3];  /* world position (centroid of the texel's overlap with its triangle) */
+    float normal[3];
+    int x, y;           /* texel coordinates in the atlas */
+    int surface;
+    uint32_t triangle;
+    float area;         /* world-space area the texel covers */
+} lmgi_texel;
+
+void lmgi_options_init(lmgi_options *o);
+
+/* Loads a .gltf/.glb file and builds surfaces, the lightmap atlas, the texel table and the BVHs. */
+lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out, lmgi_error *err);
+void lmgi_free(lmgi_scene *scene);
+
+void lmgi_get_info(const lmgi_scene *scene, lmgi_info *info);
+/* Writes the human-readable summary `lmgi info` prints. */
+void lmgi_print_info(const lmgi_scene *scene, FILE *f);
+int lmgi_effect_count(const lmgi_scene *scene);
+void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
+
+/* Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major). */
+int lmgi_node_count(const lmgi_scene *scene);
+int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent */
+const char *lmgi_node_name(const lmgi_scene *scene, int node);
+int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);
+lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
+/* Plays every glTF animation to time t (seconds) and moves the animated nodes. */
+lmgi_status lmgi_set_time(lmgi_scene *scene, float t, lmgi_error *err);
+
+/* Closest hit of the ray org + t dir, t in (0, tmax). */
+void lmgi_intersect(const lmgi_scene *scene, const float org[3], const float dir[3], float tmax, lmgi_hit *hit);
+
+uint32_t lmgi_texel_count(const lmgi_scene *scene);
+void lmgi_get_texel(const lmgi_scene *scene, uint32_t i, lmgi_texel *out);
+/* The lightmap UVs of a triangle's three corners (6 floats in [0,1]); returns 0 if it has none. */
+int lmgi_triangle_lightmap_uv(const lmgi_scene *scene, uint32_t triangle, float uv[6]);
+
+/* Writes DIR/atlas.png (each chart its own colour, gutters black) and DIR/surfaces.png (the scene from
+ * its camera, or an automatic one, each surface in a flat colour) at width x height (0 = 1024x768). */
+lmgi_status lmgi_write_charts(const lmgi_scene *scene, const char *dir, int width, int height, lmgi_error *err);
+
+const char *lmgi_status_name(lmgi_status s);
+/* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */
+void lmgi_set_verbosity(int level);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif

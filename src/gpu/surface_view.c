@@ -1,0 +1,113 @@
+#include "surface_view.h"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/gl.h>
+#include <GL/glext.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/palette.h"
+#include "../core/vecmath.h"
+#include "gl_shader.h"
+
+static const char *VS =
+    "#version 450 core\n"
+    "layout(location = 0) in vec3 pos;\n"
+    "layout(location = 1) in vec3 col;\n"
+    "uniform mat4 view_proj;\n"
+    "flat out vec3 v_col;\n"
+    "void main() { v_col = col; gl_Position = view_proj * vec4(pos, 1.0); }\n";
+static const char *FS =
+    "#version 450 core\n"
+    "flat in vec3 v_col;\n"
+    "out vec4 frag;\n"
+    "void main() { frag = vec4(v_col, 1.0); }\n";
+
+/* Interleaved position + colour, three unshared corners per triangle, world space. */
+static float *build_vertices(const lm_scene *s, const lm_surfaces *su)
+{
+    float *v = malloc(sizeof(float) * 18 * (size_t)(s->tri_count ? s->tri_count : 1));
+    if (!v)
+        return NULL;
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        uint8_t rgb[3];
+        lm_id_color(su->tri_surface[t], rgb);
+        for (int k = 0; k < 3; k++) {
+            float *o = v + 18 * (size_t)t + 6 * k;
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], o);
+            for (int c = 0; c < 3; c++)
+                o[3 + c] = rgb[c] / 255.0f;
+        }
+    }
+    return v;
+}
+
+lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width,
+                                int height, uint8_t *rgba8, lm_error *err)
+{
+    GLuint prog = 0;
+    lm_status st = lm_gl_program("surface_ids", VS, FS, &prog, err);
+    if (st != LM_OK)
+        return st;
+    float *verts = build_vertices(s, su);
+    if (!verts) {
+        glDeleteProgram(prog);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the surface view", s->path);
+    }
+
+    GLuint fbo, rb[2], vao, vbo;
+    glGenFramebuffers(1, &fbo);
+    glGenRenderbuffers(2, rb);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+        st = lm_fail(err, LM_ERR_BACKEND, "surface view: framebuffer %dx%d incomplete", width, height);
+
+    glGenVertexArrays(1, &vao);
+    glBindVertexArray(vao);
+    glGenBuffers(1, &vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 18 * (size_t)s->tri_count), verts, GL_STATIC_DRAW);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), (void *)0);
+    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), (void *)(3 * sizeof(float)));
+    glEnableVertexAttribArray(0);
+    glEnableVertexAttribArray(1);
+    free(verts);
+
+    if (st == LM_OK) {
+        float vp[16];
+        lm_mat4_mul(vp, view->proj, view->view);
+        glViewport(0, 0, width, height);
+        glEnable(GL_DEPTH_TEST);
+        glDisable(GL_CULL_FACE); /* lightmapped geometry is seen from both sides */
+        glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        glUseProgram(prog);
+        glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
+        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * s->tri_count));
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba8);
+        st = lm_gl_check("surface view", err);
+    }
+    /* GL's rows start at the bottom; images start at the top. */
+    uint8_t *tmp = malloc((size_t)width * 4);
+    for (int y = 0; tmp && y < height / 2; y++) {
+        uint8_t *a = rgba8 + (size_t)y * width * 4, *b = rgba8 + (size_t)(height - 1 - y) * width * 4;
+        memcpy(tmp, a, (size_t)width * 4);
+        memcpy(a, b, (size_t)width * 4);
+        memcpy(b, tmp, (size_t)width * 4);
+    }
+    free(tmp);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteBuffers(1, &vbo);
+    glDeleteVertexArrays(1, &vao);
+    glDeleteRenderbuffers(2, rb);
+    glDeleteFramebuffers(1, &fbo);
+    glDeleteProgram(prog);
+    return st;
+}

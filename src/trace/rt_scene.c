@@ -1,0 +1,293 @@
+#include "rt_scene.h"
+
+#include <embree3/rtcore.h>
+#include <pmmintrin.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <xmmintrin.h>
+
+#include "../core/vecmath.h"
+
+struct lm_rt {
+    RTCDevice device;
+    RTCScene top;
+    const lm_scene *scene;
+    const int *tri_surface;     /* from surfaces, or NULL */
+    unsigned static_geom;       /* geomID of the static triangles in top, RTC_INVALID_GEOMETRY_ID if none */
+    uint32_t static_count;
+    uint32_t *static_tri;       /* static primID -> scene triangle */
+    int instance_count;
+    int *inst_node;             /* instance geomID -> node */
+    int *node_inst;             /* node -> instance geomID, -1 for static nodes */
+    float (*inst_world)[16];    /* current world matrix of each instance */
+    char device_error[256];
+};
+
+static void on_device_error(void *user, enum RTCError code, const char *str)
+{
+    lm_rt *rt = user;
+    snprintf(rt->device_error, sizeof rt->device_error, "Embree error %d: %s", (int)code, str ? str : "");
+}
+
+void lm_rt_thread_init(void)
+{
+    _MM_SET_FLUSH_ZERO_MODE(_MM_FLUSH_ZERO_ON);
+    _MM_SET_DENORMALS_ZERO_MODE(_MM_DENORMALS_ZERO_ON);
+}
+
+/* A triangle geometry holding `count` scene triangles, in world space (each triangle placed by its
+ * node's current world matrix) or in node-local space. */
+static RTCGeometry make_triangles(lm_rt *rt, const lm_scene *s, const uint32_t *tris, uint32_t count,
+                                  int world_space)
+{
+    RTCGeometry g = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                        (size_t)count * 3);
+    unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(unsigned),
+                                           count);
+    if (!vb || !ib) {
+        rtcReleaseGeometry(g);
+        return NULL;
+    }
+    /* Unshared vertices, three per triangle: instanced copies and mixed nodes need no remapping. */
+#pragma omp parallel for schedule(static)
+    for (uint32_t i = 0; i < count; i++) {
+        const uint32_t *t = s->tris + 3 * (size_t)tris[i];
+        const float *world = s->nodes[s->tri_node[tris[i]]].world;
+        for (int k = 0; k < 3; k++) {
+            lm_vec3 p = lm_v3_load(s->positions + 3 * (size_t)t[k]);
+            if (world_space)
+                p = lm_mat4_point(world, p);
+            lm_v3_store(vb + 9 * (size_t)i + 3 * k, p);
+            ib[3 * (size_t)i + k] = 3 * i + k;
+        }
+    }
+    rtcCommitGeometry(g);
+    return g;
+}
+
+static lm_status fail_backend(lm_rt *rt, lm_error *err, const char *what)
+{
+    return lm_fail(err, LM_ERR_BACKEND, "%s: %s", what, rt->device_error[0] ? rt->device_error : "Embree failed");
+}
+
+static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
+{
+    for (int n = 0; n < s->node_count; n++)
+        if (!s->nodes[n].dynamic)
+            rt->static_count += s->nodes[n].tri_count;
+    rt->static_geom = RTC_INVALID_GEOMETRY_ID;
+    if (rt->static_count == 0)
+        return LM_OK;
+    rt->static_tri = malloc(sizeof(uint32_t) * rt->static_count);
+    if (!rt->static_tri)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %u static triangles", s->path, rt->static_count);
+    uint32_t k = 0;
+    for (int n = 0; n < s->node_count; n++)
+        if (!s->nodes[n].dynamic)
+            for (uint32_t i = 0; i < s->nodes[n].tri_count; i++)
+                rt->static_tri[k++] = s->nodes[n].first_tri + i;
+    RTCGeometry g = make_triangles(rt, s, rt->static_tri, rt->static_count, 1);
+    if (!g)
+        return fail_backend(rt, err, s->path);
+    rt->static_geom = rtcAttachGeometry(rt->top, g);
+    rtcReleaseGeometry(g);
+    return LM_OK;
+}
+
+static lm_status add_instance(lm_rt *rt, const lm_scene *s, int n, lm_error *err)
+{
+    const lm_node *node = &s->nodes[n];
+    uint32_t *ids = malloc(sizeof(uint32_t) * (node->tri_count ? node->tri_count : 1));
+    if (!ids)
+        return lm_fail(err, LM_ERR_NOMEM, "node '%s': no memory", node->name);
+    for (uint32_t i = 0; i < node->tri_count; i++)
+        ids[i] = node->first_tri + i;
+    RTCScene local = rtcNewScene(rt->device);
+    rtcSetSceneFlags(local, RTC_SCENE_FLAG_ROBUST);
+    RTCGeometry tg = make_triangles(rt, s, ids, node->tri_count, 0);
+    free(ids);
+    if (!tg) {
+        rtcReleaseScene(local);
+        return fail_backend(rt, err, node->name);
+    }
+    rtcAttachGeometry(local, tg);
+    rtcReleaseGeometry(tg);
+    rtcCommitScene(local);
+
+    RTCGeometry inst = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, local);
+    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, node->world);
+    rtcCommitGeometry(inst);
+    unsigned id = rtcAttachGeometry(rt->top, inst);
+    rtcReleaseGeometry(inst);
+    rtcReleaseScene(local); /* the instance holds a reference */
+    rt->inst_node[id] = n;
+    rt->node_inst[n] = (int)id;
+    memcpy(rt->inst_world[id], node->world, sizeof(float) * 16);
+    return LM_OK;
+}
+
+lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_error *err)
+{
+    *out = NULL;
+    lm_rt_thread_init();
+    lm_rt *rt = calloc(1, sizeof *rt);
+    if (!rt)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the ray-tracing scene", s->path);
+    rt->scene = s;
+    rt->tri_surface = su ? su->tri_surface : NULL;
+    rt->device = rtcNewDevice(NULL);
+    if (!rt->device) {
+        free(rt);
+        return lm_fail(err, LM_ERR_BACKEND, "cannot create an Embree device (error %d)", (int)rtcGetDeviceError(NULL));
+    }
+    rtcSetDeviceErrorFunction(rt->device, on_device_error, rt);
+    rt->top = rtcNewScene(rt->device);
+    rtcSetSceneFlags(rt->top, RTC_SCENE_FLAG_ROBUST);
+    /* Geometry ids are dense from 0: at most one static geometry plus one per dynamic node. */
+    size_t slots = (size_t)s->node_count + 1;
+    rt->inst_node = malloc(sizeof(int) * slots);
+    rt->node_inst = malloc(sizeof(int) * (s->node_count ? s->node_count : 1));
+    rt->inst_world = malloc(sizeof(float[16]) * slots);
+    if (!rt->inst_node || !rt->node_inst || !rt->inst_world) {
+        lm_rt_free(rt);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the ray-tracing scene", s->path);
+    }
+    for (size_t i = 0; i < slots; i++)
+        rt->inst_node[i] = -1;
+    for (int n = 0; n < s->node_count; n++)
+        rt->node_inst[n] = -1;
+
+    lm_status st = add_static(rt, s, err);
+    for (int n = 0; st == LM_OK && n < s->node_count; n++)
+        if (s->nodes[n].dynamic && s->nodes[n].tri_count > 0) {
+            st = add_instance(rt, s, n, err);
+            rt->instance_count += st == LM_OK;
+        }
+    if (st == LM_OK) {
+        rtcCommitScene(rt->top);
+        if (rtcGetDeviceError(rt->device) != RTC_ERROR_NONE)
+            st = fail_backend(rt, err, s->path);
+    }
+    if (st != LM_OK) {
+        lm_rt_free(rt);
+        return st;
+    }
+    *out = rt;
+    return LM_OK;
+}
+
+void lm_rt_free(lm_rt *rt)
+{
+    if (!rt)
+        return;
+    if (rt->top)
+        rtcReleaseScene(rt->top);
+    if (rt->device)
+        rtcReleaseDevice(rt->device);
+    free(rt->static_tri);
+    free(rt->inst_node);
+    free(rt->node_inst);
+    free(rt->inst_world);
+    free(rt);
+}
+
+static lm_status move_instance(lm_rt *rt, int node, const float world[16], lm_error *err)
+{
+    const lm_scene *s = rt->scene;
+    if (node < 0 || node >= s->node_count)
+        return lm_fail(err, LM_ERR_INVALID, "node id %d is out of range (scene has %d nodes)", node, s->node_count);
+    if (rt->node_inst[node] < 0)
+        return lm_fail(err, LM_ERR_INVALID, "node '%s' is static (or has no triangles) and cannot be moved; "
+                       "mark it dynamic with extras {\"lmgi\": {\"dynamic\": true}}", s->nodes[node].name);
+    if (!lm_mat4_finite(world))
+        return lm_fail(err, LM_ERR_INVALID, "node '%s': transform has NaN or Inf entries", s->nodes[node].name);
+    unsigned id = (unsigned)rt->node_inst[node];
+    RTCGeometry inst = rtcGetGeometry(rt->top, id);
+    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, world);
+    rtcCommitGeometry(inst);
+    memcpy(rt->inst_world[id], world, sizeof(float) * 16);
+    return LM_OK;
+}
+
+lm_status lm_rt_set_node_transform(lm_rt *rt, int node, const float world[16], lm_error *err)
+{
+    lm_status st = move_instance(rt, node, world, err);
+    if (st == LM_OK)
+        rtcCommitScene(rt->top);
+    return st;
+}
+
+lm_status lm_rt_sync_transforms(lm_rt *rt, const lm_scene *s, lm_error *err)
+{
+    for (int n = 0; n < s->node_count; n++) {
+        if (rt->node_inst[n] < 0)
+            continue;
+        lm_status st = move_instance(rt, n, s->nodes[n].world, err);
+        if (st != LM_OK)
+            return st;
+    }
+    rtcCommitScene(rt->top);
+    return LM_OK;
+}
+
+static void setup_ray(struct RTCRayHit *rh, const float org[3], const float dir[3], float tnear, float tfar)
+{
+    memset(rh, 0, sizeof *rh);
+    rh->ray.org_x = org[0];
+    rh->ray.org_y = org[1];
+    rh->ray.org_z = org[2];
+    rh->ray.dir_x = dir[0];
+    rh->ray.dir_y = dir[1];
+    rh->ray.dir_z = dir[2];
+    rh->ray.tnear = tnear;
+    rh->ray.tfar = tfar;
+    rh->ray.mask = 0xFFFFFFFFu;
+    rh->hit.geomID = RTC_INVALID_GEOMETRY_ID;
+    rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+}
+
+int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,
+                    lm_rt_hit *hit)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    setup_ray(&rh, org, dir, tnear, tfar);
+    rtcIntersect1(rt->top, &ctx, &rh);
+    if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
+        return 0;
+    lm_vec3 ng = lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+    unsigned inst = rh.hit.instID[0];
+    if (inst != RTC_INVALID_GEOMETRY_ID) {
+        int node = rt->inst_node[inst];
+        hit->node = node;
+        hit->tri = rt->scene->nodes[node].first_tri + rh.hit.primID;
+        ng = lm_mat4_normal(rt->inst_world[inst], ng);
+    } else {
+        hit->tri = rt->static_tri[rh.hit.primID];
+        hit->node = (int)rt->scene->tri_node[hit->tri];
+        ng = lm_normalize(ng);
+    }
+    hit->t = rh.ray.tfar;
+    hit->u = rh.hit.u;
+    hit->v = rh.hit.v;
+    hit->surface = rt->tri_surface ? rt->tri_surface[hit->tri] : -1;
+    lm_v3_store(hit->ng, ng);
+    return 1;
+}
+
+int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    struct RTCRayHit rh;
+    setup_ray(&rh, org, dir, tnear, tfar);
+    rtcOccluded1(rt->top, &ctx, &rh.ray);
+    return rh.ray.tfar < 0.0f; /* Embree sets tfar to -inf on occlusion */
+}
+
+int lm_rt_instance_count(const lm_rt *rt) { return rt->instance_count; }
+uint32_t lm_rt_static_triangle_count(const lm_rt *rt) { return rt->static_count; }

@@ -1,0 +1,50 @@
+/* The Embree scene used for every ray lmgi traces.
+ *
+ * Static nodes' triangles go, in world space, into one triangle geometry of the top-level scene.
+ * Each dynamic node gets its own Embree scene in node-local space, placed in the top level as an
+ * instance; moving the node is one transform update and one top-level commit (O(1) in the node's size).
+ * Hits report the node, the scene triangle id, its surface and a world-space geometric normal. */
+#ifndef LM_RT_SCENE_H
+#define LM_RT_SCENE_H
+
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../scene/scene.h"
+
+typedef struct lm_rt lm_rt;
+
+typedef struct {
+    float t;           /* ray parameter of the hit */
+    int node;          /* scene node */
+    uint32_t tri;      /* scene triangle id */
+    int surface;       /* surface id, -1 for specular triangles */
+    float u, v;        /* barycentrics of the hit on the triangle (Embree's: p = (1-u-v) v0 + u v1 + v v2) */
+    float ng[3];       /* world-space geometric normal, unit length, as wound in the file */
+} lm_rt_hit;
+
+/* Builds the BVHs from the scene's current node transforms. surfaces may be NULL (surface = -1). */
+lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_error *err);
+void lm_rt_free(lm_rt *rt);
+
+/* Moves dynamic node `node` to world matrix `world` and commits the top level. Fails for a static
+ * node, an out-of-range id or a non-finite matrix, naming the node. */
+lm_status lm_rt_set_node_transform(lm_rt *rt, int node, const float world[16], lm_error *err);
+/* Copies every dynamic node's world matrix from the scene, then commits the top level once. */
+lm_status lm_rt_sync_transforms(lm_rt *rt, const lm_scene *s, lm_error *err);
+
+/* Closest hit along org + t dir, t in (tnear, tfar). Returns 1 on a hit. dir need not be unit length. */
+int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,
+                    lm_rt_hit *hit);
+/* 1 if anything blocks the segment (tnear, tfar). */
+int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar);
+
+/* Sets flush-to-zero and denormals-are-zero; Embree wants it in every thread that traces. */
+void lm_rt_thread_init(void);
+
+/* Counts, for reports. */
+int lm_rt_instance_count(const lm_rt *rt);
+uint32_t lm_rt_static_triangle_count(const lm_rt *rt);
+
+#endif

@@ -1,0 +1,164 @@
+#include "effects.h"
+
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+const char *lm_effect_name(lm_effect_id e)
+{
+    static const char *names[LM_EFFECT_COUNT] = {"direct", "shadows", "indirect", "caustics", "reflections",
+                                                 "photon updates"};
+    return (unsigned)e < LM_EFFECT_COUNT ? names[e] : "?";
+}
+
+/* Materials of class `cls` used by triangles of nodes where `switch_of(node)` is on, and where off. */
+typedef struct {
+    int materials_on, materials_off;
+    int first_node_on, first_node_off;
+} usage;
+
+static usage count_usage(const lm_scene *s, lm_material_class cls, int settings_offset)
+{
+    usage u = {0, 0, -1, -1};
+    unsigned char *seen = calloc(2 * (size_t)s->material_count + 2, 1); /* [on][material] */
+    for (int n = 0; n < s->node_count; n++) {
+        const lm_node *node = &s->nodes[n];
+        int on = *(const int *)((const char *)&node->settings + settings_offset) != 0;
+        for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++) {
+            int m = s->tri_material[t];
+            if (s->materials[m].cls != cls)
+                continue;
+            int *count = on ? &u.materials_on : &u.materials_off;
+            int *first = on ? &u.first_node_on : &u.first_node_off;
+            if (*first < 0)
+                *first = n;
+            if (seen && !seen[2 * (size_t)m + on]) {
+                seen[2 * (size_t)m + on] = 1;
+                (*count)++;
+            }
+        }
+    }
+    free(seen);
+    return u;
+}
+
+static int count_lights(const lm_scene *s, int type)
+{
+    int n = 0;
+    for (int i = 0; i < s->light_count; i++)
+        n += (int)s->lights[i].type == type;
+    return n;
+}
+
+static void describe_lights(const lm_scene *s, char *buf, size_t n)
+{
+    int p = count_lights(s, LM_LIGHT_POINT), sp = count_lights(s, LM_LIGHT_SPOT);
+    int d = count_lights(s, LM_LIGHT_DIRECTIONAL);
+    snprintf(buf, n, "%d point, %d spot, %d directional light%s", p, sp, d, s->light_count == 1 ? "" : "s");
+}
+
+static void decide_direct(const lm_scene *s, lm_effects *e)
+{
+    char lights[128];
+    describe_lights(s, lights, sizeof lights);
+    e->on[LM_EFFECT_DIRECT] = s->light_count > 0;
+    snprintf(e->reason[LM_EFFECT_DIRECT], 256, "%s", s->light_count > 0 ? lights : "no point, spot or directional light");
+
+    int casting = 0;
+    for (int n = 0; n < s->node_count; n++)
+        casting += s->nodes[n].tri_count > 0 && s->nodes[n].settings.shadows;
+    e->on[LM_EFFECT_SHADOWS] = s->light_count > 0 && casting > 0;
+    if (s->light_count == 0)
+        snprintf(e->reason[LM_EFFECT_SHADOWS], 256, "no point, spot or directional light");
+    else if (casting == 0)
+        snprintf(e->reason[LM_EFFECT_SHADOWS], 256, "every node has extras shadows: false");
+    else
+        snprintf(e->reason[LM_EFFECT_SHADOWS], 256, "%d shadow-casting node%s under %s", casting,
+                 casting == 1 ? "" : "s", lights);
+}
+
+static void decide_indirect(const lm_scene *s, lm_effects *e)
+{
+    usage emit = count_usage(s, LM_MAT_EMITTER, (int)offsetof(lm_node_settings, indirect));
+    int receivers = 0;
+    for (int n = 0; n < s->node_count; n++)
+        receivers += s->nodes[n].tri_count > 0 && s->nodes[n].settings.indirect;
+    int emitters = emit.materials_on + emit.materials_off;
+    int first_emitter = emit.first_node_on >= 0 ? emit.first_node_on : emit.first_node_off;
+    char *r = e->reason[LM_EFFECT_INDIRECT];
+    e->on[LM_EFFECT_INDIRECT] = (s->light_count > 0 || emitters > 0) && receivers > 0;
+    if (s->light_count == 0 && emitters == 0)
+        snprintf(r, 256, "no light and no emissive material");
+    else if (receivers == 0)
+        snprintf(r, 256, "every node has extras indirect: false");
+    else if (emitters == 0)
+        snprintf(r, 256, "%d light%s bounce off %d node%s", s->light_count, s->light_count == 1 ? "" : "s",
+                 receivers, receivers == 1 ? "" : "s");
+    else
+        snprintf(r, 256, "%d light%s and %d emissive material%s (first on node '%s') bounce off %d node%s",
+                 s->light_count, s->light_count == 1 ? "" : "s", emitters, emitters == 1 ? "" : "s",
+                 s->nodes[first_emitter].name, receivers, receivers == 1 ? "" : "s");
+}
+
+/* Caustics and reflections both come from mirror and glass materials. */
+static void decide_specular(const lm_scene *s, lm_effects *e)
+{
+    size_t off = offsetof(lm_node_settings, caustics);
+    usage glass = count_usage(s, LM_MAT_GLASS, (int)off), mirror = count_usage(s, LM_MAT_MIRROR, (int)off);
+    int on = glass.materials_on + mirror.materials_on, off_count = glass.materials_off + mirror.materials_off;
+    int node = glass.first_node_on >= 0 ? glass.first_node_on : mirror.first_node_on;
+    char what[160] = "";
+    if (glass.materials_on && mirror.materials_on)
+        snprintf(what, sizeof what, "%d glass and %d mirror material%s", glass.materials_on, mirror.materials_on,
+                 mirror.materials_on == 1 ? "" : "s");
+    else if (on)
+        snprintf(what, sizeof what, "%d %s material%s", on, glass.materials_on ? "glass" : "mirror",
+                 on == 1 ? "" : "s");
+    int lit = s->light_count > 0 || count_usage(s, LM_MAT_EMITTER, (int)off).materials_on > 0;
+
+    e->on[LM_EFFECT_CAUSTICS] = on > 0 && lit;
+    if (on > 0 && lit)
+        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "%s on node '%s'", what, s->nodes[node].name);
+    else if (on > 0)
+        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "no light to focus (%s)", what);
+    else if (off_count > 0)
+        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "specular material only on nodes with extras caustics: false "
+                 "(first: '%s')", s->nodes[glass.first_node_off >= 0 ? glass.first_node_off : mirror.first_node_off].name);
+    else
+        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "no specular material");
+
+    int any = on + off_count;
+    e->on[LM_EFFECT_REFLECTIONS] = any > 0;
+    snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s", any > 0 ? "mirror or glass material present" : "no specular material");
+    if (any > 0 && on > 0)
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s on node '%s'", what, s->nodes[node].name);
+}
+
+static void decide_updates(const lm_scene *s, lm_effects *e)
+{
+    int dyn = 0, first = -1;
+    for (int n = 0; n < s->node_count; n++)
+        if (s->nodes[n].dynamic && s->nodes[n].tri_count > 0) {
+            if (first < 0)
+                first = n;
+            dyn++;
+        }
+    e->on[LM_EFFECT_PHOTON_UPDATES] = e->on[LM_EFFECT_INDIRECT] && dyn > 0;
+    if (!e->on[LM_EFFECT_INDIRECT])
+        snprintf(e->reason[LM_EFFECT_PHOTON_UPDATES], 256, "no indirect light to update");
+    else if (dyn > 0)
+        snprintf(e->reason[LM_EFFECT_PHOTON_UPDATES], 256, "%d dynamic node%s (first: '%s'); photons re-traced round robin",
+                 dyn, dyn == 1 ? "" : "s", s->nodes[first].name);
+    else
+        snprintf(e->reason[LM_EFFECT_PHOTON_UPDATES], 256, "nothing moves; photons traced once, updated only on edits");
+}
+
+void lm_effects_decide(const lm_scene *s, lm_effects *out)
+{
+    memset(out, 0, sizeof *out);
+    decide_direct(s, out);
+    decide_indirect(s, out);
+    decide_specular(s, out);
+    decide_updates(s, out);
+}

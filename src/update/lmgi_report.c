@@ -1,0 +1,168 @@
+/* What the public API reports about a loaded scene: counts, effects, and the charts pictures. */
+#include <lmgi.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../charts/atlas_image.h"
+#include "../core/image.h"
+#include "../gpu/camera.h"
+#include "../gpu/gl_context.h"
+#include "../gpu/surface_view.h"
+#include "lmgi_scene.h"
+
+void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
+{
+    const lm_scene *s = sc->scene;
+    memset(in, 0, sizeof *in);
+    in->triangles = s->tri_count;
+    in->vertices = s->vertex_count;
+    in->nodes = s->node_count;
+    for (int n = 0; n < s->node_count; n++)
+        in->dynamic_nodes += s->nodes[n].dynamic;
+    in->meshes = s->mesh_count;
+    in->materials = s->material_count;
+    for (int m = 0; m < s->material_count; m++)
+        in->materials_by_class[s->materials[m].cls]++;
+    in->textures = s->texture_count;
+    in->lights = s->light_count;
+    for (int l = 0; l < s->light_count; l++)
+        in->lights_by_type[s->lights[l].type]++;
+    in->cameras = s->camera_count;
+    in->animations = s->animation_count;
+    in->surfaces = sc->surfaces.surface_count;
+    in->charts = sc->atlas.chart_count;
+    in->degenerate_triangles = sc->surfaces.degenerate_tris;
+    in->nonmanifold_edges = sc->surfaces.nonmanifold_edges;
+    in->atlas_width = sc->atlas.width;
+    in->atlas_height = sc->atlas.height;
+    in->texels = sc->atlas.texel_count;
+    in->texel_size = sc->atlas.texel_size;
+    in->utilization = sc->atlas.utilization;
+    memcpy(in->bounds_min, s->bounds_min, sizeof in->bounds_min);
+    memcpy(in->bounds_max, s->bounds_max, sizeof in->bounds_max);
+    in->timings = sc->timings;
+}
+
+int lmgi_effect_count(const lmgi_scene *sc)
+{
+    (void)sc;
+    return LM_EFFECT_COUNT;
+}
+
+void lmgi_get_effect(const lmgi_scene *sc, int i, lmgi_effect *out)
+{
+    memset(out, 0, sizeof *out);
+    if (i < 0 || i >= LM_EFFECT_COUNT)
+        return;
+    out->name = lm_effect_name((lm_effect_id)i);
+    out->on = sc->effects.on[i];
+    snprintf(out->reason, sizeof out->reason, "%s", sc->effects.reason[i]);
+}
+
+static void print_materials(const lm_scene *s, const lmgi_info *in, FILE *f)
+{
+    fprintf(f, "materials   %d:", in->materials);
+    for (int c = 0; c < LM_MAT_CLASS_COUNT; c++)
+        if (in->materials_by_class[c])
+            fprintf(f, " %d %s", in->materials_by_class[c], lm_material_class_name((lm_material_class)c));
+    fputc('\n', f);
+    for (int m = 0; m < s->material_count; m++)
+        fprintf(f, "  %-28s %-8s base (%.2f %.2f %.2f)%s\n", s->materials[m].name,
+                lm_material_class_name(s->materials[m].cls), (double)s->materials[m].base_color[0],
+                (double)s->materials[m].base_color[1], (double)s->materials[m].base_color[2],
+                s->materials[m].base_color_tex >= 0 ? " + texture" : "");
+}
+
+static void print_nodes(const lm_scene *s, const lmgi_info *in, FILE *f)
+{
+    fprintf(f, "nodes       %d (%d static, %d dynamic)\n", in->nodes, in->nodes - in->dynamic_nodes,
+            in->dynamic_nodes);
+    for (int n = 0; n < s->node_count; n++)
+        if (s->nodes[n].dynamic)
+            fprintf(f, "  dynamic: '%s' (%u triangles)\n", s->nodes[n].name, s->nodes[n].tri_count);
+}
+
+static void print_lights(const lm_scene *s, const lmgi_info *in, FILE *f)
+{
+    fprintf(f, "lights      %d (%d point, %d spot, %d directional)\n", in->lights, in->lights_by_type[0],
+            in->lights_by_type[1], in->lights_by_type[2]);
+    for (int l = 0; l < s->light_count; l++) {
+        const lm_light *li = &s->lights[l];
+        fprintf(f, "  %-12s '%s' intensity %g colour (%.2f %.2f %.2f)\n", lm_light_type_name(li->type), li->name,
+                (double)li->intensity, (double)li->color[0], (double)li->color[1], (double)li->color[2]);
+    }
+}
+
+void lmgi_print_info(const lmgi_scene *sc, FILE *f)
+{
+    const lm_scene *s = sc->scene;
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    fprintf(f, "scene       %s\n", s->path);
+    fprintf(f, "triangles   %u (%u vertices, %d meshes)\n", in.triangles, in.vertices, in.meshes);
+    fprintf(f, "bounds      (%.4g %.4g %.4g) .. (%.4g %.4g %.4g)\n", (double)in.bounds_min[0],
+            (double)in.bounds_min[1], (double)in.bounds_min[2], (double)in.bounds_max[0], (double)in.bounds_max[1],
+            (double)in.bounds_max[2]);
+    print_nodes(s, &in, f);
+    print_materials(s, &in, f);
+    print_lights(s, &in, f);
+    fprintf(f, "cameras     %d, animations %d, textures %d\n", in.cameras, in.animations, in.textures);
+    fprintf(f, "surfaces    %d (%u degenerate triangles dropped, %u non-manifold edges)\n", in.surfaces,
+            in.degenerate_triangles, in.nonmanifold_edges);
+    fprintf(f, "charts      %d\n", in.charts);
+    fprintf(f, "atlas       %d x %d, texel %.4g units, %u texels, utilization %.1f%%\n", in.atlas_width,
+            in.atlas_height, (double)in.texel_size, in.texels, 100.0 * (double)in.utilization);
+    fprintf(f, "effects\n");
+    for (int i = 0; i < LM_EFFECT_COUNT; i++)
+        fprintf(f, "  %s: %s — %s\n", lm_effect_name((lm_effect_id)i), sc->effects.on[i] ? "on" : "off",
+                sc->effects.reason[i]);
+    fprintf(f, "time        load %.3f s, surfaces %.3f s, atlas %.3f s, BVH %.3f s, total %.3f s\n", in.timings.load,
+            in.timings.surfaces, in.timings.atlas, in.timings.bvh, in.timings.total);
+}
+
+static lm_status write_surface_view(const lmgi_scene *sc, const char *path, int w, int h, lm_error *e)
+{
+    lm_gl_context *gl = NULL;
+    lm_status st = lm_gl_context_create(&gl, e);
+    if (st != LM_OK)
+        return st;
+    uint8_t *img = malloc((size_t)w * h * 4);
+    if (!img) {
+        lm_gl_context_destroy(gl);
+        return lm_fail(e, LM_ERR_NOMEM, "no memory for a %dx%d picture", w, h);
+    }
+    lm_view view;
+    lm_view_for_scene(sc->scene, -1, w, h, &view);
+    st = lm_render_surface_ids(sc->scene, &sc->surfaces, &view, w, h, img, e);
+    if (st == LM_OK)
+        st = lm_write_png(path, w, h, img, e);
+    free(img);
+    lm_gl_context_destroy(gl);
+    return st;
+}
+
+lmgi_status lmgi_write_charts(const lmgi_scene *sc, const char *dir, int width, int height, lmgi_error *err)
+{
+    lm_error e;
+    lm_error_clear(&e);
+    if (width <= 0 || height <= 0) {
+        width = 1024;
+        height = 768;
+    }
+    char path[4096];
+    lm_status st = lm_mkdir_p(dir, &e);
+    if (st == LM_OK) {
+        uint8_t *img = lm_atlas_chart_image(&sc->atlas);
+        snprintf(path, sizeof path, "%s/atlas.png", dir);
+        st = img ? lm_write_png(path, sc->atlas.width, sc->atlas.height, img, &e)
+                 : lm_fail(&e, LM_ERR_NOMEM, "no memory for the atlas picture");
+        free(img);
+    }
+    if (st == LM_OK) {
+        snprintf(path, sizeof path, "%s/surfaces.png", dir);
+        st = write_surface_view(sc, path, width, height, &e);
+    }
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}

@@ -1,0 +1,237 @@
+/* The public API's scene: a loaded glTF scene with its surfaces, lightmap atlas, texel table and
+ * ray-tracing BVHs, plus the effects it calls for. */
+#include <lmgi.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../charts/charts.h"
+#include "../core/log.h"
+#include "../core/timing.h"
+#include "../core/vecmath.h"
+#include "../trace/rt_scene.h"
+#include "effects.h"
+#include "lmgi_scene.h"
+
+void lmgi_options_init(lmgi_options *o)
+{
+    lm_surface_options so;
+    lm_atlas_options ao;
+    lm_surface_options_default(&so);
+    lm_atlas_options_default(&ao);
+    memset(o, 0, sizeof *o);
+    o->texel_size = ao.texel_size;
+    o->gutter = ao.gutter;
+    o->use_file_uv1 = ao.use_file_uv1;
+    o->strict = so.strict;
+    o->surface_cone_deg = so.cone_deg;
+    o->max_atlas_size = ao.max_size;
+}
+
+lmgi_status lm_export_error(lmgi_error *out, const lm_error *in)
+{
+    if (out) {
+        out->status = (lmgi_status)in->status;
+        memcpy(out->message, in->msg, sizeof out->message);
+    }
+    return (lmgi_status)in->status;
+}
+
+static lm_status check_options(const char *path, const lmgi_options *o, lm_error *err)
+{
+    if (!(o->texel_size >= 0.0f) || !isfinite(o->texel_size))
+        return lm_fail(err, LM_ERR_INVALID, "%s: texel size %g must be a finite number >= 0 (0 = automatic)",
+                       path, (double)o->texel_size);
+    if (o->gutter < 1 || o->gutter > 64)
+        return lm_fail(err, LM_ERR_INVALID, "%s: gutter %d must be between 1 and 64 texels", path, o->gutter);
+    if (!(o->surface_cone_deg > 0.0f && o->surface_cone_deg < 90.0f))
+        return lm_fail(err, LM_ERR_INVALID, "%s: surface cone %g must be in (0, 90) degrees", path,
+                       (double)o->surface_cone_deg);
+    if (o->max_atlas_size < 64 || o->max_atlas_size > 32768)
+        return lm_fail(err, LM_ERR_INVALID, "%s: max atlas size %d must be in [64, 32768]", path, o->max_atlas_size);
+    return LM_OK;
+}
+
+static lm_status build(lmgi_scene *sc, const char *path, const lmgi_options *o, lm_error *err)
+{
+    double t0 = lm_now();
+    lm_load_options lo = {.strict = o->strict};
+    lm_status st = lm_scene_load_gltf(path, &lo, &sc->scene, err);
+    if (st != LM_OK)
+        return st;
+    double t1 = lm_now();
+
+    lm_surface_options so;
+    lm_surface_options_default(&so);
+    so.cone_deg = o->surface_cone_deg;
+    so.strict = o->strict;
+    st = lm_surfaces_build(sc->scene, &so, &sc->surfaces, err);
+    if (st != LM_OK)
+        return st;
+    sc->have_surfaces = 1;
+    double t2 = lm_now();
+
+    lm_atlas_options ao;
+    lm_atlas_options_default(&ao);
+    ao.texel_size = o->texel_size;
+    ao.gutter = o->gutter;
+    ao.use_file_uv1 = o->use_file_uv1;
+    ao.max_size = o->max_atlas_size;
+    st = lm_atlas_build(sc->scene, &sc->surfaces, &ao, &sc->atlas, err);
+    if (st != LM_OK)
+        return st;
+    sc->have_atlas = 1;
+    double t3 = lm_now();
+
+    st = lm_rt_build(sc->scene, &sc->surfaces, &sc->rt, err);
+    if (st != LM_OK)
+        return st;
+    double t4 = lm_now();
+
+    lm_effects_decide(sc->scene, &sc->effects);
+    sc->timings.load = t1 - t0;
+    sc->timings.surfaces = t2 - t1;
+    sc->timings.atlas = t3 - t2;
+    sc->timings.bvh = t4 - t3;
+    sc->timings.total = t4 - t0;
+    return LM_OK;
+}
+
+lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out, lmgi_error *err)
+{
+    lm_error e;
+    lm_error_clear(&e);
+    *out = NULL;
+    lmgi_options defaults;
+    if (!o) {
+        lmgi_options_init(&defaults);
+        o = &defaults;
+    }
+    if (!path) {
+        lm_fail(&e, LM_ERR_INVALID, "no scene file given");
+        return lm_export_error(err, &e);
+    }
+    lmgi_scene *sc = calloc(1, sizeof *sc);
+    if (!sc) {
+        lm_fail(&e, LM_ERR_NOMEM, "%s: no memory", path);
+        return lm_export_error(err, &e);
+    }
+    sc->options = *o;
+    lm_status st = check_options(path, o, &e);
+    if (st == LM_OK)
+        st = build(sc, path, o, &e);
+    if (st != LM_OK) {
+        lmgi_free(sc);
+        return lm_export_error(err, &e);
+    }
+    *out = sc;
+    return LMGI_OK;
+}
+
+void lmgi_free(lmgi_scene *sc)
+{
+    if (!sc)
+        return;
+    lm_rt_free(sc->rt);
+    if (sc->have_atlas)
+        lm_atlas_free(&sc->atlas);
+    if (sc->have_surfaces)
+        lm_surfaces_free(&sc->surfaces);
+    lm_scene_free(sc->scene);
+    free(sc);
+}
+
+int lmgi_node_count(const lmgi_scene *sc) { return sc->scene->node_count; }
+
+int lmgi_find_node(const lmgi_scene *sc, const char *name)
+{
+    for (int n = 0; name && n < sc->scene->node_count; n++)
+        if (strcmp(sc->scene->nodes[n].name, name) == 0)
+            return n;
+    return -1;
+}
+
+const char *lmgi_node_name(const lmgi_scene *sc, int node)
+{
+    return node >= 0 && node < sc->scene->node_count ? sc->scene->nodes[node].name : NULL;
+}
+
+int lmgi_node_is_dynamic(const lmgi_scene *sc, int node)
+{
+    return node >= 0 && node < sc->scene->node_count && sc->scene->nodes[node].dynamic;
+}
+
+lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[16], lmgi_error *err)
+{
+    lm_error e;
+    lm_error_clear(&e);
+    lm_status st = lm_rt_set_node_transform(sc->rt, node, world, &e);
+    if (st != LM_OK)
+        return lm_export_error(err, &e);
+    /* The scene model follows, so lightmap and picture code see the same placement as the rays. */
+    memcpy(sc->scene->nodes[node].world, world, sizeof(float) * 16);
+    return LMGI_OK;
+}
+
+lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
+{
+    lm_error e;
+    lm_error_clear(&e);
+    if (!isfinite(t)) {
+        lm_fail(&e, LM_ERR_INVALID, "%s: animation time is not a finite number", sc->scene->path);
+        return lm_export_error(err, &e);
+    }
+    lm_scene_eval_animation(sc->scene, -1, t);
+    if (lm_rt_sync_transforms(sc->rt, sc->scene, &e) != LM_OK)
+        return lm_export_error(err, &e);
+    return LMGI_OK;
+}
+
+void lmgi_intersect(const lmgi_scene *sc, const float org[3], const float dir[3], float tmax, lmgi_hit *hit)
+{
+    lm_rt_hit h;
+    memset(hit, 0, sizeof *hit);
+    hit->node = hit->surface = -1;
+    if (!lm_rt_intersect(sc->rt, org, dir, 0.0f, tmax, &h))
+        return;
+    hit->hit = 1;
+    hit->t = h.t;
+    hit->node = h.node;
+    hit->surface = h.surface;
+    hit->triangle = h.tri;
+    memcpy(hit->normal, h.ng, sizeof hit->normal);
+}
+
+uint32_t lmgi_texel_count(const lmgi_scene *sc) { return sc->atlas.texel_count; }
+
+void lmgi_get_texel(const lmgi_scene *sc, uint32_t i, lmgi_texel *out)
+{
+    memset(out, 0, sizeof *out);
+    if (i >= sc->atlas.texel_count) {
+        out->surface = -1;
+        return;
+    }
+    const lm_texel *t = &sc->atlas.texels[i];
+    memcpy(out->position, t->pos, sizeof out->position);
+    memcpy(out->normal, t->normal, sizeof out->normal);
+    out->x = t->x;
+    out->y = t->y;
+    out->surface = t->surface;
+    out->triangle = t->tri;
+    out->area = t->area;
+}
+
+int lmgi_triangle_lightmap_uv(const lmgi_scene *sc, uint32_t tri, float uv[6])
+{
+    if (tri >= sc->scene->tri_count || sc->atlas.tri_chart[tri] < 0)
+        return 0;
+    memcpy(uv, sc->atlas.corner_uv + 6 * (size_t)tri, 6 * sizeof(float));
+    return 1;
+}
+
+const char *lmgi_status_name(lmgi_status s) { return lm_status_name((lm_status)s); }
+
+void lmgi_set_verbosity(int level)
+{
+    lm_log_set_level(level <= 0 ? LM_LOG_ERROR : level == 1 ? LM_LOG_WARN : level == 2 ? LM_LOG_INFO : LM_LOG_DEBUG);
+}

@@ -1,0 +1,25 @@
+/* The inside of the public lmgi_scene handle (shared by the files that implement include/lmgi.h). */
+#ifndef LM_LMGI_SCENE_H
+#define LM_LMGI_SCENE_H
+
+#include <lmgi.h>
+
+#include "../charts/charts.h"
+#include "../trace/rt_scene.h"
+#include "effects.h"
+
+struct lmgi_scene {
+    lmgi_options options;
+    lm_scene *scene;
+    lm_surfaces surfaces;
+    lm_atlas atlas;
+    int have_surfaces, have_atlas;
+    lm_rt *rt;
+    lm_effects effects;
+    lmgi_timings timings;
+};
+
+/* Copies an internal error into the public one and returns its status. */
+lmgi_status lm_export_error(lmgi_error *out, const lm_error *in);
+
+#endif

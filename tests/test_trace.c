@@ -1,0 +1,143 @@
+/* trace: Embree hits the expected node, surface and point; a dynamic node's hits follow its transform. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <lmgi.h>
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "support.h"
+
+/* A static floor (y = 0, x and z in [-1, 1]) and back wall (z = -1), and a dynamic cube of half-size 0.25
+ * at (0, 0.5, 0) that an animation slides to x = 0.5 at t = 1. */
+static lmgi_scene *load_test_scene(void **state)
+{
+    (void)state;
+    static lmt_mesh mesh[3];
+    memset(mesh, 0, sizeof mesh);
+    float c0[3] = {-1, 0, 1}, u0[3] = {2, 0, 0}, v0[3] = {0, 0, -2};
+    lmt_mesh_quad(&mesh[0], c0, u0, v0);
+    float c1[3] = {-1, 0, -1}, u1[3] = {2, 0, 0}, v1[3] = {0, 2, 0};
+    lmt_mesh_quad(&mesh[1], c1, u1, v1);
+    lmt_mesh_cube(&mesh[2], 0.25f);
+    const char *nodes = "[{\"name\": \"root\", \"children\": [1, 2, 3]},"
+                        " {\"name\": \"floor\", \"mesh\": 0}, {\"name\": \"wall\", \"mesh\": 1},"
+                        " {\"name\": \"cube\", \"mesh\": 2, \"translation\": [0, 0.5, 0]}]";
+    static const float times[2] = {0, 1}, moves[6] = {0, 0.5f, 0, 0.5f, 0.5f, 0};
+    lmt_accessor acc[2] = {{times, 2, "SCALAR"}, {moves, 2, "VEC3"}};
+    const char *anim = "\"animations\": [{\"samplers\": [{\"input\": 6, \"output\": 7}],"
+                       " \"channels\": [{\"sampler\": 0, \"target\": {\"node\": 3, \"path\": \"translation\"}}]}],";
+    char path[512];
+    snprintf(path, sizeof path, "%s/trace.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, mesh, 3, nodes, acc, 2, anim), 0);
+    lmgi_scene *sc = NULL;
+    lmgi_error err;
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.texel_size = 0.05f;
+    if (lmgi_load(path, &o, &sc, &err) != LMGI_OK)
+        fail_msg("load failed: %s", err.message);
+    return sc;
+}
+
+static lmgi_hit shoot(const lmgi_scene *sc, float x, float y, float z, float dx, float dy, float dz)
+{
+    float o[3] = {x, y, z}, d[3] = {dx, dy, dz};
+    lmgi_hit h;
+    lmgi_intersect(sc, o, d, 1e30f, &h);
+    return h;
+}
+
+static void test_hits_expected_surfaces(void **state)
+{
+    lmgi_scene *sc = load_test_scene(state);
+    int floor = lmgi_find_node(sc, "floor"), wall = lmgi_find_node(sc, "wall"), cube = lmgi_find_node(sc, "cube");
+    assert_true(floor >= 0 && wall >= 0 && cube >= 0);
+    assert_false(lmgi_node_is_dynamic(sc, floor));
+    assert_true(lmgi_node_is_dynamic(sc, cube));
+
+    lmgi_hit h = shoot(sc, 0.6f, 2, 0.6f, 0, -1, 0);
+    assert_true(h.hit);
+    assert_int_equal(h.node, floor);
+    assert_float_equal(h.t, 2.0f, 1e-5);
+    assert_float_equal(h.normal[1], 1.0f, 1e-5);
+    int floor_surface = h.surface;
+    assert_true(floor_surface >= 0);
+
+    h = shoot(sc, 0.3f, 1, 1.5f, 0, 0, -1); /* towards the back wall */
+    assert_true(h.hit);
+    assert_int_equal(h.node, wall);
+    assert_float_equal(h.t, 2.5f, 1e-5);
+    assert_true(h.surface >= 0 && h.surface != floor_surface);
+
+    h = shoot(sc, 0.1f, 2, 0.1f, 0, -1, 0); /* the cube's top at y = 0.75 */
+    assert_true(h.hit);
+    assert_int_equal(h.node, cube);
+    assert_float_equal(h.t, 1.25f, 1e-5);
+    assert_float_equal(h.normal[1], 1.0f, 1e-5);
+    int top = h.surface;
+    h = shoot(sc, -2, 0.5f, 0.1f, 1, 0, 0); /* the cube's -x face */
+    assert_int_equal(h.node, cube);
+    assert_float_equal(h.t, 1.75f, 1e-5);
+    assert_float_equal(h.normal[0], -1.0f, 1e-5);
+    assert_true(h.surface >= 0 && h.surface != top); /* each cube face its own surface */
+    lmgi_free(sc);
+}
+
+static void test_dynamic_hits_follow_transform(void **state)
+{
+    lmgi_scene *sc = load_test_scene(state);
+    int cube = lmgi_find_node(sc, "cube");
+    /* Move the cube to (0.5, 0.5, 0.5), rotated 90 degrees about z and scaled by 2. */
+    float m[16] = {0, 2, 0, 0, -2, 0, 0, 0, 0, 0, 2, 0, 0.5f, 0.5f, 0.5f, 1};
+    lmgi_error err;
+    assert_int_equal(lmgi_set_node_transform(sc, cube, m, &err), LMGI_OK);
+    lmgi_hit h = shoot(sc, 0.1f, 2, 0.1f, 0, -1, 0);
+    assert_int_equal(h.node, cube); /* the cube now spans x in [0, 1], y in [0, 1] */
+    assert_float_equal(h.t, 1.0f, 1e-5);
+    assert_float_equal(h.normal[1], 1.0f, 1e-5);
+    h = shoot(sc, -0.5f, 2, -0.5f, 0, -1, 0); /* where nothing is now: the floor */
+    assert_int_equal(h.node, lmgi_find_node(sc, "floor"));
+    assert_float_equal(h.t, 2.0f, 1e-5);
+
+    /* The animation puts it at x = 0.25 (half way) at t = 0.5, original size. */
+    assert_int_equal(lmgi_set_time(sc, 0.5f, &err), LMGI_OK);
+    h = shoot(sc, 0.45f, 2, 0.0f, 0, -1, 0);
+    assert_int_equal(h.node, cube);
+    assert_float_equal(h.t, 1.25f, 1e-5);
+    h = shoot(sc, -0.05f, 2, 0.0f, 0, -1, 0); /* x = -0.05 is left of the cube at [0, 0.5] */
+    assert_int_equal(h.node, lmgi_find_node(sc, "floor"));
+    lmgi_free(sc);
+}
+
+static void test_bad_edits_are_refused(void **state)
+{
+    lmgi_scene *sc = load_test_scene(state);
+    float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    lmgi_error err;
+    assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "floor"), m, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "floor"));
+    assert_int_equal(lmgi_set_node_transform(sc, 99, m, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "99"));
+    m[5] = NAN;
+    assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "cube"), m, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "cube"));
+    assert_int_equal(lmgi_set_time(sc, INFINITY, &err), LMGI_ERR_INVALID);
+    /* Refused edits left the cube where it was. */
+    lmgi_hit h = shoot(sc, 0.1f, 2, 0.1f, 0, -1, 0);
+    assert_float_equal(h.t, 1.25f, 1e-5);
+    lmgi_free(sc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_hits_expected_surfaces),
+        cmocka_unit_test(test_dynamic_hits_follow_transform),
+        cmocka_unit_test(test_bad_edits_are_refused),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
