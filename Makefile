@@ -32,6 +32,7 @@ TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o
 
 .PHONY: all deps test test-asan demo bench scenes clean
+.SECONDARY:
 all: $(BUILD)/lmgi $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
 
 deps:
@@ -93,8 +94,12 @@ test-asan: deps
 demo: deps all
 	@sh tools/demo.sh $(BUILD)/lmgi
 
-bench: deps all
-	$(BUILD)/lmgi bench
+# The scaling rows use many-room scenes of 4, 16 and 64 rooms (about 89k, 354k and 1.4M triangles).
+BENCH_ROOMS := 4 16 64
+bench: deps all $(BUILD)/gen_scenes
+	@mkdir -p $(BUILD)/bench
+	@for n in $(BENCH_ROOMS); do [ -f $(BUILD)/bench/rooms_$$n.glb ] || $(BUILD)/gen_scenes --rooms $$n $(BUILD)/bench/rooms_$$n.glb >/dev/null; done
+	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb)
 
 scenes: $(BUILD)/gen_scenes
 	$(BUILD)/gen_scenes scenes

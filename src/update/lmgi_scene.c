@@ -91,6 +91,9 @@ static lm_status build(lmgi_scene *sc, const char *path, const lmgi_options *o, 
     lm_effects_decide(sc->scene, &sc->effects);
     sc->timings.load = t1 - t0;
     sc->timings.surfaces = t2 - t1;
+    sc->timings.unwrap = sc->atlas.time_unwrap;
+    sc->timings.pack = sc->atlas.time_pack;
+    sc->timings.texels = sc->atlas.time_texels;
     sc->timings.atlas = t3 - t2;
     sc->timings.bvh = t4 - t3;
     sc->timings.total = t4 - t0;

@@ -1,0 +1,202 @@
+/* lm_atlas_build: charts (unwrapped or from the file's TEXCOORD_1), packing, then the texel table. */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/log.h"
+#include "../core/timing.h"
+#include "charts_internal.h"
+
+/* Texels the default texel size aims at for the whole scene. */
+#define DEFAULT_TEXELS 262144.0
+
+void lm_atlas_options_default(lm_atlas_options *o)
+{
+    o->texel_size = 0.0f;
+    o->gutter = 2;
+    o->use_file_uv1 = 0;
+    o->max_size = 8192;
+}
+
+float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su)
+{
+    double area = 0.0;
+    for (int i = 0; i < su->surface_count; i++)
+        area += su->surfaces[i].area;
+    if (area > 0.0 && isfinite(area))
+        return (float)sqrt(area / DEFAULT_TEXELS);
+    float size = 0.0f;
+    float *pos = s && s->vertex_count ? lmc_world_positions(s, &size) : NULL;
+    free(pos);
+    return size > 0.0f ? size / 512.0f : 1.0f;
+}
+
+/* One chart per surface: its TEXCOORD_1 coordinates, shifted to the origin and scaled so that uv area
+ * matches world area (texel density then follows texel_size like unwrapped charts). */
+static lm_status uv1_chart(const lm_scene *s, const lm_surface *f, int sid, const float *pos, lmc_chart *ch,
+                           double *tri_uv, lm_error *err)
+{
+    double lo[2] = {DBL_MAX, DBL_MAX}, uv_area = 0.0, world = 0.0, n[3];
+    for (uint32_t i = 0; i < f->tri_count; i++) {
+        const uint32_t *v = s->tris + 3 * (size_t)f->tris[i];
+        const float *a = s->uv1 + 2 * (size_t)v[0], *b = s->uv1 + 2 * (size_t)v[1], *c = s->uv1 + 2 * (size_t)v[2];
+        uv_area += 0.5 * fabs(((double)b[0] - a[0]) * ((double)c[1] - a[1]) - ((double)c[0] - a[0]) * ((double)b[1] - a[1]));
+        world += lmc_tri_area(s, pos, f->tris[i], n);
+        for (int k = 0; k < 3; k++)
+            for (int x = 0; x < 2; x++)
+                lo[x] = fmin(lo[x], s->uv1[2 * (size_t)v[k] + x]);
+    }
+    if (!(uv_area > 0.0) || !isfinite(uv_area))
+        return lm_fail(err, LM_ERR_INVALID, "charts: node '%s' has no usable TEXCOORD_1 area (surface %d)",
+                       s->nodes[f->node].name, sid);
+    double scale = sqrt(world / uv_area);
+    ch->surface = sid;
+    ch->tri_count = f->tri_count;
+    ch->tris = malloc(((size_t)f->tri_count + 1) * sizeof *ch->tris);
+    if (!ch->tris)
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    memcpy(ch->tris, f->tris, (size_t)f->tri_count * sizeof *ch->tris);
+    ch->ext[0] = ch->ext[1] = 0.0;
+    for (uint32_t i = 0; i < f->tri_count; i++)
+        for (int k = 0; k < 3; k++)
+            for (int x = 0; x < 2; x++) {
+                uint32_t v = s->tris[3 * (size_t)f->tris[i] + k];
+                double u = ((double)s->uv1[2 * (size_t)v + x] - lo[x]) * scale;
+                tri_uv[6 * (size_t)f->tris[i] + 2 * k + x] = u;
+                ch->ext[x] = fmax(ch->ext[x], u);
+            }
+    return LM_OK;
+}
+
+lm_status lmc_charts_from_uv1(const lm_scene *s, const lm_surfaces *su, const float *pos, lmc_charts *out,
+                              lm_error *err)
+{
+    memset(out, 0, sizeof *out);
+    if (!s->uv1)
+        return lm_fail(err, LM_ERR_INVALID, "charts: use_file_uv1 is set but '%s' has no TEXCOORD_1", s->path);
+    out->tri_uv = malloc(6 * (size_t)s->tri_count * sizeof *out->tri_uv + 1);
+    out->charts = calloc((size_t)su->surface_count + 1, sizeof *out->charts);
+    if (!out->tri_uv || !out->charts) {
+        lmc_charts_free(out);
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    }
+    for (int i = 0; i < su->surface_count; i++) {
+        lm_status st = uv1_chart(s, &su->surfaces[i], i, pos, &out->charts[i], out->tri_uv, err);
+        out->count += st == LM_OK;
+        if (st != LM_OK) {
+            lmc_charts_free(out);
+            return st;
+        }
+    }
+    return LM_OK;
+}
+
+static lm_status check_options(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o, lm_error *err)
+{
+    lm_status st = lmc_check_scene(s, err);
+    if (st != LM_OK)
+        return st;
+    if (!su || (su->surface_count && (!su->surfaces || !su->tri_surface || !su->tri_adj || !su->vertex_weld)))
+        return lm_fail(err, LM_ERR_INVALID, "charts: surfaces missing (call lm_surfaces_build first)");
+    if (!isfinite(o->texel_size) || o->gutter < 0 || o->gutter > 64)
+        return lm_fail(err, LM_ERR_INVALID, "charts: texel_size %g must be finite and gutter %d in [0, 64]",
+                       (double)o->texel_size, o->gutter);
+    if (o->max_size < 4 * (o->gutter + 1) || o->max_size > 65536)
+        return lm_fail(err, LM_ERR_INVALID, "charts: max_size %d must be in [%d, 65536]", o->max_size,
+                       4 * (o->gutter + 1));
+    return LM_OK;
+}
+
+/* Records each surface's chart range (charts are ordered by surface). */
+static lm_status link_surfaces(const lm_surfaces *su, lm_atlas *a, lm_error *err)
+{
+    size_t n = (size_t)su->surface_count + 1;
+    a->surface_count = su->surface_count;
+    a->surface_first_chart = malloc(n * sizeof(int));
+    a->surface_chart_count = calloc(n, sizeof(int));
+    if (!a->surface_first_chart || !a->surface_chart_count)
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    for (int i = 0; i < su->surface_count; i++)
+        a->surface_first_chart[i] = -1;
+    for (int c = 0; c < a->chart_count; c++) {
+        int f = a->charts[c].surface;
+        if (a->surface_chart_count[f]++ == 0)
+            a->surface_first_chart[f] = c;
+    }
+    return LM_OK;
+}
+
+static lm_status copy_chart_tris(const lmc_charts *c, lm_atlas *a, lm_error *err)
+{
+    for (int i = 0; i < c->count; i++) {
+        lm_chart *r = &a->charts[i];
+        r->tri_count = c->charts[i].tri_count;
+        r->tris = malloc(((size_t)r->tri_count + 1) * sizeof *r->tris);
+        if (!r->tris)
+            return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+        memcpy(r->tris, c->charts[i].tris, (size_t)r->tri_count * sizeof *r->tris);
+    }
+    return LM_OK;
+}
+
+lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o, lm_atlas *out,
+                         lm_error *err)
+{
+    lm_atlas_options def;
+    if (!o) {
+        lm_atlas_options_default(&def);
+        o = &def;
+    }
+    memset(out, 0, sizeof *out);
+    lm_status st = check_options(s, su, o, err);
+    if (st != LM_OK)
+        return st;
+    float ts = o->texel_size > 0.0f ? o->texel_size : lm_atlas_default_texel_size(s, su), size;
+    double t0 = lm_now();
+    float *pos = lmc_world_positions(s, &size);
+    if (!pos)
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    lmc_charts c;
+    st = o->use_file_uv1 ? lmc_charts_from_uv1(s, su, pos, &c, err) : lmc_unwrap(s, su, pos, &c, err);
+    double t1 = lm_now(), t2 = t1;
+    if (st == LM_OK) {
+        st = lmc_pack(&c, ts, o->gutter, o->max_size, out, err);
+        t2 = lm_now();
+        if (st == LM_OK)
+            st = copy_chart_tris(&c, out, err);
+        if (st == LM_OK)
+            st = lmc_texels(s, &c, pos, out, err);
+        lmc_charts_free(&c);
+    }
+    free(pos);
+    if (st == LM_OK)
+        st = link_surfaces(su, out, err);
+    if (st != LM_OK) {
+        lm_atlas_free(out);
+        return st;
+    }
+    out->time_unwrap = t1 - t0;
+    out->time_pack = t2 - t1;
+    out->time_texels = lm_now() - t2;
+    lm_debug("charts: %d charts, atlas %dx%d, %u texels (%.1f%%); unwrap %.3f s, pack %.3f s, texels %.3f s",
+             out->chart_count, out->width, out->height, out->texel_count, 100.0 * out->utilization,
+             out->time_unwrap, out->time_pack, out->time_texels);
+    return LM_OK;
+}
+
+void lm_atlas_free(lm_atlas *a)
+{
+    if (!a)
+        return;
+    for (int i = 0; a->charts && i < a->chart_count; i++)
+        free(a->charts[i].tris);
+    free(a->charts);
+    free(a->corner_uv);
+    free(a->tri_chart);
+    free(a->texels);
+    free(a->texel_index);
+    free(a->surface_first_chart);
+    free(a->surface_chart_count);
+    memset(a, 0, sizeof *a);
+}

@@ -1,0 +1,98 @@
+/* Surfaces, lightmap charts, the atlas and its texel table.
+ *
+ * A surface is a connected set of triangles of one node and one material whose normals stay within a
+ * cone: the unit that owns a photon map, an approximated illumination map (AIM) and an indirect
+ * illumination map (IIM). Specular triangles (mirror, glass) store no photons and get no surface
+ * (tri_surface = -1) and no lightmap texels.
+ *
+ * Each surface is unwrapped into one or more charts (planar projection, split where the projection
+ * would fold or overlap); charts are packed into one atlas with gutters. The texel table lists every
+ * covered texel with its world position, normal, surface, triangle and world-space area. */
+#ifndef LM_CHARTS_H
+#define LM_CHARTS_H
+
+#include <stdint.h>
+
+#include "../core/error.h"
+#include "../scene/scene.h"
+
+typedef struct {
+    float cone_deg;        /* max angle between a triangle's normal and its surface's seed normal (default 30) */
+    float min_fragment_area; /* surfaces smaller than this fraction of the node's area are merged (default 1e-3) */
+    int strict;            /* non-manifold edges and degenerate triangles are errors */
+} lm_surface_options;
+
+typedef struct {
+    int node, material;
+    uint32_t tri_count;
+    uint32_t *tris;        /* triangle ids, ascending */
+    float area;            /* world-space area at load time */
+    float normal[3];       /* area-weighted mean normal, world space */
+} lm_surface;
+
+typedef struct {
+    int surface_count;
+    lm_surface *surfaces;
+    int *tri_surface;      /* per scene triangle; -1 for specular or degenerate triangles */
+    uint32_t degenerate_tris;  /* zero-area triangles (no surface) */
+    uint32_t nonmanifold_edges; /* edges shared by more than two triangles */
+    /* Topology kept for unwrapping (lm_atlas_build): */
+    uint32_t *vertex_weld; /* per scene vertex: the vertex it was welded to (itself if none) */
+    int32_t *tri_adj;      /* 3 per scene triangle: triangle across edge (corner k, k+1), -1 if none */
+} lm_surfaces;
+
+/* Splits the scene into surfaces. Fails (strict) or warns (default) on degenerate triangles and
+ * non-manifold edges, naming the node. */
+void lm_surface_options_default(lm_surface_options *o);
+lm_status lm_surfaces_build(const lm_scene *s, const lm_surface_options *o, lm_surfaces *out, lm_error *err);
+void lm_surfaces_free(lm_surfaces *su);
+
+typedef struct {
+    float texel_size;      /* world units per texel; <= 0 derives it from the scene (lm_atlas_default_texel_size) */
+    int gutter;            /* minimum empty texels between two charts (default 2) */
+    int use_file_uv1;      /* take charts from the file's TEXCOORD_1 instead of unwrapping */
+    int max_size;          /* largest atlas side allowed (default 8192); texel_size grows to fit */
+} lm_atlas_options;
+
+typedef struct {
+    int surface;
+    int x, y, w, h;        /* rectangle in the atlas, texels, gutters excluded */
+    uint32_t tri_count;
+    uint32_t *tris;
+} lm_chart;
+
+typedef struct {
+    float pos[3];          /* world position: centroid of the texel's overlap with its triangle */
+    float normal[3];       /* interpolated shading normal, world space */
+    int x, y;              /* texel coordinates */
+    int surface;
+    uint32_t tri;
+    float area;            /* world-space area of the texel's overlap with its surface */
+} lm_texel;
+
+typedef struct {
+    int width, height;
+    float texel_size;
+    int gutter;
+    int chart_count;
+    lm_chart *charts;
+    float *corner_uv;      /* lightmap UV per triangle corner, 6 floats per scene triangle, in [0,1]
+                              (texel (x, y) spans [x, x+1]/width); NaN for triangles with no surface */
+    int *tri_chart;        /* chart per triangle, -1 if none */
+    uint32_t texel_count;
+    lm_texel *texels;
+    int *texel_index;      /* width*height: index into texels, -1 where uncovered */
+    float utilization;     /* covered texels / (width*height) */
+    int surface_count;
+    int *surface_first_chart, *surface_chart_count; /* per surface: its charts (charts are ordered by surface) */
+    double time_unwrap, time_pack, time_texels; /* seconds spent in each stage of lm_atlas_build */
+} lm_atlas;
+
+void lm_atlas_options_default(lm_atlas_options *o);
+/* sqrt(total surface area / 2^18): about 256k texels for the whole scene. */
+float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su);
+lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o,
+                         lm_atlas *out, lm_error *err);
+void lm_atlas_free(lm_atlas *a);
+
+#endif

@@ -1,0 +1,65 @@
+/* Helpers shared by the files of src/charts; not part of the module's interface. */
+#ifndef LM_CHARTS_INTERNAL_H
+#define LM_CHARTS_INTERNAL_H
+
+#include <stdint.h>
+
+#include "../core/error.h"
+#include "../scene/scene.h"
+#include "charts.h"
+
+/* Checks that triangle, vertex, node and material indices are in range and arrays present. */
+lm_status lmc_check_scene(const lm_scene *s, lm_error *err);
+
+/* World-space positions of all vertices (3 floats each) under the current node matrices, and the
+ * diagonal of their bounds (the scene size used for tolerances). NULL when memory ran out. */
+float *lmc_world_positions(const lm_scene *s, float *size);
+/* World-space unit shading normals of all vertices (3 floats each). */
+float *lmc_world_normals(const lm_scene *s);
+
+/* Welds vertices of the same node closer than tol: returns, per vertex, its representative (the
+ * lowest-numbered vertex of its cluster, itself if alone). NULL when memory ran out. */
+uint32_t *lmc_weld(const lm_scene *s, const float *pos, float tol);
+
+/* Relative tolerances, as fractions of the scene size. */
+#define LMC_WELD_TOL 1e-6f
+#define LMC_DEGENERATE_AREA 1e-12 /* times size^2 */
+
+/* A chart while it is being built: triangles (ascending), extent of its oriented projection in world
+ * units, and per-triangle corner coordinates (6 doubles per scene triangle, chart-local, >= 0). */
+typedef struct {
+    int surface;
+    uint32_t tri_count;
+    uint32_t *tris;
+    double ext[2];
+} lmc_chart;
+
+typedef struct {
+    int count;
+    lmc_chart *charts;  /* ordered by surface, then by first triangle */
+    double *tri_uv;     /* 6 per scene triangle; world units (unwrap) or uv1 units scaled (uv1) */
+} lmc_charts;
+
+/* Planar-projection charts of every surface, split where the projection folds or overlaps. */
+lm_status lmc_unwrap(const lm_scene *s, const lm_surfaces *su, const float *pos, lmc_charts *out,
+                     lm_error *err);
+/* One chart per surface from the file's TEXCOORD_1, scaled to world units. */
+lm_status lmc_charts_from_uv1(const lm_scene *s, const lm_surfaces *su, const float *pos, lmc_charts *out,
+                              lm_error *err);
+void lmc_charts_free(lmc_charts *c);
+
+/* Packs the charts at texel_size into out->width/height and out->charts (rects); grows the texel size
+ * (with a warning) while the atlas would exceed max_size. Sets out->texel_size. */
+lm_status lmc_pack(const lmc_charts *c, float texel_size, int gutter, int max_size, lm_atlas *out,
+                   lm_error *err);
+
+/* Texel offset of a chart's projection inside its rect (centres the extent in the rect). */
+void lmc_chart_offset(const lmc_chart *c, const lm_chart *r, float texel_size, double off[2]);
+
+/* Fills corner_uv, tri_chart, the texel table, texel_index and utilization. */
+lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, lm_atlas *a, lm_error *err);
+
+/* Area and unnormalized normal (cross product) of triangle t from world positions, in double. */
+double lmc_tri_area(const lm_scene *s, const float *pos, uint32_t t, double n[3]);
+
+#endif

@@ -1,0 +1,132 @@
+/* Atlas packing: charts sorted by height go onto shelves (next-fit decreasing height), O(n log n). */
+#include <float.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/log.h"
+#include "charts_internal.h"
+
+/* Atlas width relative to the square root of the padded chart area: room for shelf waste. */
+#define WIDTH_SLACK 1.1
+#define MAX_RETRIES 64
+
+typedef struct {
+    int w, h, id;
+} rect_key;
+
+static int cmp_rect(const void *a, const void *b)
+{
+    const rect_key *p = a, *q = b;
+    if (p->h != q->h)
+        return p->h > q->h ? -1 : 1;
+    if (p->w != q->w)
+        return p->w > q->w ? -1 : 1;
+    return (p->id > q->id) - (p->id < q->id);
+}
+
+static int round4(double v) { return 4 * (int)ceil(v / 4.0); }
+
+/* Texels a chart extent needs: its covered texels stay strictly inside (see lmc_chart_offset). */
+static int texels_for(double ext, float texel_size)
+{
+    double t = ext / (double)texel_size;
+    return (int)floor(t + 0.01) + 1;
+}
+
+void lmc_chart_offset(const lmc_chart *c, const lm_chart *r, float texel_size, double off[2])
+{
+    off[0] = 0.5 * ((double)r->w - c->ext[0] / (double)texel_size);
+    off[1] = 0.5 * ((double)r->h - c->ext[1] / (double)texel_size);
+}
+
+/* Shelf-packs the sorted rects into width W (gutter g around every rect and the border); returns the
+ * height used. W is at least the widest rect plus two gutters. */
+static long shelf_pack(const rect_key *k, int n, int W, int g, lm_chart *ch)
+{
+    long x = g, y = g, shelf = 0;
+    for (int i = 0; i < n; i++) {
+        if (x + k[i].w + g > W) {
+            y += shelf + g;
+            x = g;
+            shelf = 0;
+        }
+        ch[k[i].id].x = (int)x;
+        ch[k[i].id].y = (int)y;
+        x += k[i].w + g;
+        if (k[i].h > shelf)
+            shelf = k[i].h;
+    }
+    return y + shelf + g;
+}
+
+/* One packing attempt at texel_size: 0 if it fits in max_size, else the atlas side it would need. */
+static double try_pack(const lmc_charts *c, rect_key *k, float ts, int g, int max_size, lm_atlas *out)
+{
+    double area = 0.0, widest = 0.0;
+    for (int i = 0; i < c->count; i++) {
+        lm_chart *r = &out->charts[i];
+        double ew = c->charts[i].ext[0] / (double)ts, eh = c->charts[i].ext[1] / (double)ts;
+        if (!(ew < max_size && eh < max_size))
+            return fmax(ew, eh) + 2.0 * g + 1.0;
+        r->w = texels_for(c->charts[i].ext[0], ts);
+        r->h = texels_for(c->charts[i].ext[1], ts);
+        k[i] = (rect_key){r->w, r->h, i};
+        area += (double)(r->w + g) * (double)(r->h + g);
+        widest = fmax(widest, r->w);
+    }
+    qsort(k, (size_t)c->count, sizeof *k, cmp_rect);
+    /* A few widths around the square root of the area; the smallest atlas that fits wins. */
+    static const double slack[] = {1.0, 1.05, WIDTH_SLACK, 1.2, 1.35, 1.5};
+    int best_w = 0, best_h = 0;
+    double need = DBL_MAX;
+    for (size_t i = 0; i < sizeof slack / sizeof *slack; i++) {
+        int W = round4(fmax(sqrt(area) * slack[i] + g, widest + 2.0 * g));
+        int H = round4((double)shelf_pack(k, c->count, W, g, out->charts));
+        if (W <= max_size && H <= max_size) {
+            if (!best_w || (double)W * H < (double)best_w * best_h) {
+                best_w = W;
+                best_h = H;
+            }
+        } else {
+            need = fmin(need, fmax(W, H));
+        }
+    }
+    if (!best_w)
+        return need;
+    shelf_pack(k, c->count, best_w, g, out->charts);
+    out->width = best_w;
+    out->height = best_h;
+    out->texel_size = ts;
+    return 0.0;
+}
+
+lm_status lmc_pack(const lmc_charts *c, float texel_size, int gutter, int max_size, lm_atlas *out, lm_error *err)
+{
+    out->charts = calloc((size_t)c->count + 1, sizeof *out->charts);
+    rect_key *k = malloc(((size_t)c->count + 1) * sizeof *k);
+    if (!out->charts || !k) {
+        free(k);
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory while packing");
+    }
+    out->chart_count = c->count;
+    out->gutter = gutter;
+    float ts = texel_size;
+    int ok = 0;
+    for (int i = 0; i < MAX_RETRIES && !ok; i++) {
+        double need = try_pack(c, k, ts, gutter, max_size, out);
+        ok = need == 0.0;
+        if (!ok) /* sides shrink in proportion to the texel size */
+            ts *= (float)fmax(1.02, need / max_size);
+    }
+    free(k);
+    if (!ok)
+        return lm_fail(err, LM_ERR_INVALID, "charts: %d charts do not fit a %dx%d atlas even at texel size %g",
+                       c->count, max_size, max_size, (double)ts);
+    if (ts != texel_size)
+        lm_warn("charts: atlas would exceed %d texels a side at texel size %g; texel size raised to %g (%dx%d)",
+                max_size, (double)texel_size, (double)ts, out->width, out->height);
+    for (int i = 0; i < c->count; i++)
+        out->charts[i].surface = c->charts[i].surface;
+    return LM_OK;
+}

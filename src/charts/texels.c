@@ -1,0 +1,257 @@
+/* The texel table: each chart's triangles clipped against the texel squares they touch. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "charts_internal.h"
+
+typedef struct {
+    double best;   /* largest single-triangle overlap (texel units) */
+    double cx, cy; /* centroid of that overlap, chart-local texel coordinates */
+    double area;   /* world area of all overlaps */
+    int tri;       /* triangle with the largest overlap, -1 if none */
+} texel_acc;
+
+typedef struct {
+    double x, y;
+} pt;
+
+/* Keeps the part of polygon in[0..n) left of the directed line a->b; returns the new count. */
+static int clip_half(const pt *in, int n, pt a, pt b, pt *out)
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        pt p = in[i], q = in[(i + 1) % n];
+        double dp = (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x);
+        double dq = (b.x - a.x) * (q.y - a.y) - (b.y - a.y) * (q.x - a.x);
+        if (dp >= 0.0)
+            out[m++] = p;
+        if ((dp >= 0.0) != (dq >= 0.0)) {
+            double s = dp / (dp - dq);
+            out[m++] = (pt){p.x + s * (q.x - p.x), p.y + s * (q.y - p.y)};
+        }
+    }
+    return m;
+}
+
+/* Area and centroid of the unit square at (ix, iy) clipped to the counter-clockwise triangle t. */
+static double clip_texel(const pt t[3], int ix, int iy, pt *centroid)
+{
+    pt a[16], b[16];
+    a[0] = (pt){ix, iy};
+    a[1] = (pt){ix + 1.0, iy};
+    a[2] = (pt){ix + 1.0, iy + 1.0};
+    a[3] = (pt){ix, iy + 1.0};
+    int n = 4;
+    n = clip_half(a, n, t[0], t[1], b);
+    n = clip_half(b, n, t[1], t[2], a);
+    n = clip_half(a, n, t[2], t[0], b);
+    double area2 = 0.0, cx = 0.0, cy = 0.0;
+    for (int i = 0; i < n; i++) {
+        pt p = b[i], q = b[(i + 1) % n];
+        double c = p.x * q.y - q.x * p.y;
+        area2 += c;
+        cx += (p.x + q.x) * c;
+        cy += (p.y + q.y) * c;
+    }
+    if (!(area2 > 0.0))
+        return 0.0;
+    centroid->x = cx / (3.0 * area2);
+    centroid->y = cy / (3.0 * area2);
+    return 0.5 * area2;
+}
+
+typedef struct {
+    const lm_scene *s;
+    const lmc_charts *c;
+    const float *pos, *nrm;
+    lm_atlas *a;
+} texel_job;
+
+/* Chart-local texel coordinates of triangle t's corners (counter-clockwise) and its signed uv area. */
+static double chart_corners(const texel_job *j, int ci, uint32_t t, pt out[3], int order[3])
+{
+    double off[2];
+    lmc_chart_offset(&j->c->charts[ci], &j->a->charts[ci], j->a->texel_size, off);
+    const double *uv = j->c->tri_uv + 6 * (size_t)t, inv = 1.0 / (double)j->a->texel_size;
+    for (int k = 0; k < 3; k++)
+        out[k] = (pt){off[0] + uv[2 * k] * inv, off[1] + uv[2 * k + 1] * inv};
+    double sa = 0.5 * ((out[1].x - out[0].x) * (out[2].y - out[0].y) - (out[2].x - out[0].x) * (out[1].y - out[0].y));
+    order[0] = 0;
+    order[1] = sa < 0.0 ? 2 : 1;
+    order[2] = sa < 0.0 ? 1 : 2;
+    if (sa < 0.0) {
+        pt tmp = out[1];
+        out[1] = out[2];
+        out[2] = tmp;
+    }
+    return fabs(sa);
+}
+
+static void accumulate(texel_acc *acc, const lm_chart *r, uint32_t t, const pt c[3], double scale, double world)
+{
+    double lo[2] = {fmin(c[0].x, fmin(c[1].x, c[2].x)), fmin(c[0].y, fmin(c[1].y, c[2].y))};
+    double hi[2] = {fmax(c[0].x, fmax(c[1].x, c[2].x)), fmax(c[0].y, fmax(c[1].y, c[2].y))};
+    int x0 = (int)fmax(floor(lo[0]), 0.0), x1 = (int)fmin(floor(hi[0]), r->w - 1.0);
+    int y0 = (int)fmax(floor(lo[1]), 0.0), y1 = (int)fmin(floor(hi[1]), r->h - 1.0);
+    int covered = 0;
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            pt m;
+            double ov = clip_texel(c, x, y, &m);
+            if (ov <= 0.0)
+                continue;
+            texel_acc *e = &acc[(size_t)y * r->w + x];
+            e->area += ov * scale;
+            covered = 1;
+            if (ov > e->best) {
+                e->best = ov;
+                e->tri = (int)t;
+                e->cx = m.x;
+                e->cy = m.y;
+            }
+        }
+    if (covered)
+        return;
+    /* A sliver too thin to clip to a positive area still gets the texel under its centroid. */
+    double mx = (c[0].x + c[1].x + c[2].x) / 3.0, my = (c[0].y + c[1].y + c[2].y) / 3.0;
+    int x = (int)fmin(fmax(floor(mx), 0.0), r->w - 1.0), y = (int)fmin(fmax(floor(my), 0.0), r->h - 1.0);
+    texel_acc *e = &acc[(size_t)y * r->w + x];
+    e->area += world;
+    if (e->tri < 0) {
+        e->tri = (int)t;
+        e->cx = mx;
+        e->cy = my;
+    }
+}
+
+/* World position and shading normal at chart-local point (px, py) of triangle t. */
+static void texel_point(const texel_job *j, int ci, uint32_t t, double px, double py, lm_texel *out)
+{
+    pt c[3];
+    int ord[3];
+    chart_corners(j, ci, t, c, ord);
+    double d = (c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y);
+    double b1 = d != 0.0 ? ((px - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (py - c[0].y)) / d : 1.0 / 3.0;
+    double b2 = d != 0.0 ? ((c[1].x - c[0].x) * (py - c[0].y) - (px - c[0].x) * (c[1].y - c[0].y)) / d : 1.0 / 3.0;
+    double w[3] = {fmax(1.0 - b1 - b2, 0.0), fmax(b1, 0.0), fmax(b2, 0.0)}, sum = w[0] + w[1] + w[2];
+    double p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+    for (int k = 0; k < 3; k++) {
+        uint32_t v = j->s->tris[3 * (size_t)t + ord[k]];
+        for (int a = 0; a < 3; a++) {
+            p[a] += w[k] / sum * j->pos[3 * (size_t)v + a];
+            n[a] += w[k] / sum * j->nrm[3 * (size_t)v + a];
+        }
+    }
+    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(l > 1e-12)) {
+        l = 2.0 * lmc_tri_area(j->s, j->pos, t, n);
+        l = l > 0.0 ? l : 1.0;
+    }
+    for (int a = 0; a < 3; a++) {
+        out->pos[a] = (float)p[a];
+        out->normal[a] = (float)(n[a] / l);
+    }
+}
+
+/* Fills this chart's corner UVs and returns its texels (row-major), or NULL when memory ran out. */
+static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
+{
+    const lmc_chart *ch = &j->c->charts[ci];
+    const lm_chart *r = &j->a->charts[ci];
+    texel_acc *acc = malloc((size_t)r->w * r->h * sizeof *acc);
+    if (!acc)
+        return NULL;
+    for (size_t i = 0; i < (size_t)r->w * r->h; i++)
+        acc[i] = (texel_acc){0.0, 0.0, 0.0, 0.0, -1};
+    for (uint32_t i = 0; i < ch->tri_count; i++) {
+        uint32_t t = ch->tris[i];
+        pt c[3];
+        int ord[3];
+        double uv_area = chart_corners(j, ci, t, c, ord), n[3], world = lmc_tri_area(j->s, j->pos, t, n);
+        for (int k = 0; k < 3; k++) {
+            j->a->corner_uv[6 * (size_t)t + 2 * ord[k]] = (float)((r->x + c[k].x) / j->a->width);
+            j->a->corner_uv[6 * (size_t)t + 2 * ord[k] + 1] = (float)((r->y + c[k].y) / j->a->height);
+        }
+        j->a->tri_chart[t] = ci;
+        accumulate(acc, r, t, c, uv_area > 0.0 ? world / uv_area : 0.0, world);
+    }
+    uint32_t n = 0;
+    for (size_t i = 0; i < (size_t)r->w * r->h; i++)
+        n += acc[i].tri >= 0;
+    lm_texel *tx = malloc(((size_t)n + 1) * sizeof *tx);
+    if (tx) {
+        n = 0;
+        for (int y = 0; y < r->h; y++)
+            for (int x = 0; x < r->w; x++) {
+                const texel_acc *e = &acc[(size_t)y * r->w + x];
+                if (e->tri < 0)
+                    continue;
+                lm_texel *o = &tx[n++];
+                texel_point(j, ci, (uint32_t)e->tri, e->cx, e->cy, o);
+                o->x = r->x + x;
+                o->y = r->y + y;
+                o->surface = ch->surface;
+                o->tri = (uint32_t)e->tri;
+                o->area = (float)e->area;
+            }
+        *count = n;
+    }
+    free(acc);
+    return tx;
+}
+
+static lm_status assemble(lm_atlas *a, lm_texel **per, const uint32_t *count, lm_error *err)
+{
+    size_t total = 0;
+    for (int i = 0; i < a->chart_count; i++)
+        total += count[i];
+    a->texels = malloc((total + 1) * sizeof *a->texels);
+    if (!a->texels)
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for %zu texels", total);
+    for (int i = 0; i < a->chart_count; i++) {
+        memcpy(a->texels + a->texel_count, per[i], count[i] * sizeof *per[i]);
+        a->texel_count += count[i];
+    }
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        a->texel_index[(size_t)a->texels[i].y * a->width + a->texels[i].x] = (int)i;
+    a->utilization = (float)((double)a->texel_count / ((double)a->width * a->height));
+    return LM_OK;
+}
+
+lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, lm_atlas *a, lm_error *err)
+{
+    size_t np = (size_t)a->width * a->height;
+    a->corner_uv = malloc(6 * (size_t)s->tri_count * sizeof *a->corner_uv + 1);
+    a->tri_chart = malloc((size_t)s->tri_count * sizeof *a->tri_chart + 1);
+    a->texel_index = malloc(np * sizeof *a->texel_index + 1);
+    lm_texel **per = calloc((size_t)a->chart_count + 1, sizeof *per);
+    uint32_t *count = calloc((size_t)a->chart_count + 1, sizeof *count);
+    float *nrm = lmc_world_normals(s);
+    lm_status st = LM_OK;
+    if (!a->corner_uv || !a->tri_chart || !a->texel_index || !per || !count || !nrm) {
+        st = lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for the texel table");
+        goto done;
+    }
+    for (size_t i = 0; i < 6 * (size_t)s->tri_count; i++)
+        a->corner_uv[i] = NAN;
+    for (uint32_t t = 0; t < s->tri_count; t++)
+        a->tri_chart[t] = -1;
+    for (size_t i = 0; i < np; i++)
+        a->texel_index[i] = -1;
+    texel_job j = {s, c, pos, nrm, a};
+    int failed = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
+    for (int i = 0; i < a->chart_count; i++) {
+        per[i] = chart_texels(&j, i, &count[i]);
+        failed |= per[i] == NULL;
+    }
+    st = failed ? lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for the texel table") : assemble(a, per, count, err);
+done:
+    for (int i = 0; per && i < a->chart_count; i++)
+        free(per[i]);
+    free(per);
+    free(count);
+    free(nrm);
+    return st;
+}

@@ -1,0 +1,718 @@
+/* Tests of src/charts: surface segmentation, unwrapping, packing and the texel table, on hand-made
+ * scenes and on the shared glTF scenes. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "../src/charts/charts.h"
+#include "../src/core/log.h"
+#include "../src/core/vecmath.h"
+#include "support.h"
+
+/* ---------- hand-made scenes ---------- */
+
+enum { MAT_DIFFUSE = 0, MAT_MIRROR, MAT_RED, MAT_COUNT };
+
+typedef struct {
+    lm_scene s;
+    uint32_t vcap, tcap;
+} tscene;
+
+static tscene *ts_new(int nodes)
+{
+    tscene *t = calloc(1, sizeof *t);
+    lm_scene *s = &t->s;
+    snprintf(s->path, sizeof s->path, "test-scene");
+    s->node_count = nodes;
+    s->nodes = calloc((size_t)nodes, sizeof *s->nodes);
+    for (int i = 0; i < nodes; i++) {
+        snprintf(s->nodes[i].name, LM_NAME_MAX, "node%d", i);
+        s->nodes[i].parent = -1;
+        s->nodes[i].mesh = i;
+        lm_mat4_identity(s->nodes[i].world);
+    }
+    s->material_count = MAT_COUNT;
+    s->materials = calloc(MAT_COUNT, sizeof *s->materials);
+    s->materials[MAT_MIRROR].cls = LM_MAT_MIRROR;
+    return t;
+}
+
+static void ts_free(tscene *t)
+{
+    lm_scene *s = &t->s;
+    free(s->nodes);
+    free(s->materials);
+    free(s->positions);
+    free(s->normals);
+    free(s->uv0);
+    free(s->uv1);
+    free(s->vertex_node);
+    free(s->tris);
+    free(s->tri_material);
+    free(s->tri_node);
+    free(t);
+}
+
+static uint32_t ts_vertex(tscene *t, int node, float x, float y, float z, float nx, float ny, float nz)
+{
+    lm_scene *s = &t->s;
+    if (s->vertex_count == t->vcap) {
+        t->vcap = t->vcap ? 2 * t->vcap : 64;
+        s->positions = realloc(s->positions, 3 * (size_t)t->vcap * sizeof(float));
+        s->normals = realloc(s->normals, 3 * (size_t)t->vcap * sizeof(float));
+        s->uv0 = realloc(s->uv0, 2 * (size_t)t->vcap * sizeof(float));
+        s->vertex_node = realloc(s->vertex_node, (size_t)t->vcap * sizeof(uint32_t));
+    }
+    uint32_t v = s->vertex_count++;
+    float p[3] = {x, y, z}, n[3] = {nx, ny, nz};
+    memcpy(s->positions + 3 * v, p, sizeof p);
+    memcpy(s->normals + 3 * v, n, sizeof n);
+    s->uv0[2 * v] = s->uv0[2 * v + 1] = 0.0f;
+    s->vertex_node[v] = (uint32_t)node;
+    return v;
+}
+
+/* Triangles must be added node by node (each node's triangles contiguous). */
+static void ts_tri(tscene *t, int node, int mat, uint32_t a, uint32_t b, uint32_t c)
+{
+    lm_scene *s = &t->s;
+    if (s->tri_count == t->tcap) {
+        t->tcap = t->tcap ? 2 * t->tcap : 64;
+        s->tris = realloc(s->tris, 3 * (size_t)t->tcap * sizeof(uint32_t));
+        s->tri_material = realloc(s->tri_material, (size_t)t->tcap * sizeof(int));
+        s->tri_node = realloc(s->tri_node, (size_t)t->tcap * sizeof(uint32_t));
+    }
+    uint32_t i = s->tri_count++;
+    s->tris[3 * i] = a;
+    s->tris[3 * i + 1] = b;
+    s->tris[3 * i + 2] = c;
+    s->tri_material[i] = mat;
+    s->tri_node[i] = (uint32_t)node;
+    if (s->nodes[node].tri_count == 0)
+        s->nodes[node].first_tri = i;
+    s->nodes[node].tri_count++;
+}
+
+/* A quad p + a u + b v, (a, b) in [0,1]^2, split into nu x nv cells with its own (unshared) vertices;
+ * height(x, z) displaces along the normal when given. */
+static void ts_quad(tscene *t, int node, int mat, const float p[3], const float u[3], const float v[3], int nu,
+                    int nv, float (*height)(float, float))
+{
+    lm_vec3 n = lm_normalize(lm_cross(lm_v3_load(u), lm_v3_load(v)));
+    uint32_t base = t->s.vertex_count;
+    for (int j = 0; j <= nv; j++)
+        for (int i = 0; i <= nu; i++) {
+            float a = (float)i / nu, b = (float)j / nv;
+            float h = height ? height(a, b) : 0.0f;
+            ts_vertex(t, node, p[0] + a * u[0] + b * v[0] + h * n.x, p[1] + a * u[1] + b * v[1] + h * n.y,
+                      p[2] + a * u[2] + b * v[2] + h * n.z, n.x, n.y, n.z);
+        }
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            uint32_t q = base + (uint32_t)(j * (nu + 1) + i);
+            ts_tri(t, node, mat, q, q + 1, q + (uint32_t)nu + 2);
+            ts_tri(t, node, mat, q, q + (uint32_t)nu + 2, q + (uint32_t)nu + 1);
+        }
+}
+
+/* Axis-aligned box [lo, hi] with outward faces, skipping face `skip` (0..5: -x +x -y +y -z +z, -1 none). */
+static void ts_box(tscene *t, int node, int mat, const float lo[3], const float hi[3], int skip, int cells)
+{
+    float d[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    for (int f = 0; f < 6; f++) {
+        if (f == skip)
+            continue;
+        int ax = f / 2, a1 = (ax + 1) % 3, a2 = (ax + 2) % 3, pos = f & 1;
+        float p[3] = {lo[0], lo[1], lo[2]}, u[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+        p[ax] = pos ? hi[ax] : lo[ax];
+        /* u x v must point outward: +axis for the high face */
+        if (pos) {
+            u[a1] = d[a1];
+            v[a2] = d[a2];
+        } else {
+            u[a2] = d[a2];
+            v[a1] = d[a1];
+        }
+        ts_quad(t, node, mat, p, u, v, cells, cells, NULL);
+    }
+}
+
+static void ts_sphere(tscene *t, int node, int mat, const float c[3], float r, int nu, int nv, int hemi)
+{
+    uint32_t base = t->s.vertex_count;
+    float vmax = hemi ? 0.5f * (float)M_PI : (float)M_PI;
+    for (int j = 0; j <= nv; j++)
+        for (int i = 0; i <= nu; i++) {
+            float th = vmax * j / nv, ph = 2.0f * (float)M_PI * i / nu;
+            float n[3] = {sinf(th) * cosf(ph), cosf(th), sinf(th) * sinf(ph)};
+            ts_vertex(t, node, c[0] + r * n[0], c[1] + r * n[1], c[2] + r * n[2], n[0], n[1], n[2]);
+        }
+    for (int j = 0; j < nv; j++)
+        for (int i = 0; i < nu; i++) {
+            uint32_t q = base + (uint32_t)(j * (nu + 1) + i), w = (uint32_t)nu + 1;
+            if (j > 0)
+                ts_tri(t, node, mat, q, q + 1, q + w);
+            if (!(j == nv - 1 && !hemi))
+                ts_tri(t, node, mat, q + 1, q + w + 1, q + w);
+        }
+}
+
+static float bumps(float a, float b)
+{
+    return 0.03f * sinf(6.0f * (float)M_PI * a) * cosf(4.0f * (float)M_PI * b);
+}
+
+/* ---------- invariants ---------- */
+
+typedef struct {
+    double x, y, z;
+} d3;
+
+static d3 d3_sub(d3 a, d3 b) { return (d3){a.x - b.x, a.y - b.y, a.z - b.z}; }
+static double d3_dot(d3 a, d3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+static d3 d3_mad(d3 a, d3 b, double s) { return (d3){a.x + b.x * s, a.y + b.y * s, a.z + b.z * s}; }
+static double d3_len(d3 a) { return sqrt(d3_dot(a, a)); }
+static d3 d3_load(const float *p) { return (d3){p[0], p[1], p[2]}; }
+
+/* Distance from p to triangle abc: closest point by Voronoi region (vertices, edges, face), in double. */
+static double pt_tri_dist(const float *p, const float *a, const float *b, const float *c)
+{
+    d3 P = d3_load(p), A = d3_load(a), B = d3_load(b), C = d3_load(c);
+    d3 ab = d3_sub(B, A), ac = d3_sub(C, A), ap = d3_sub(P, A), bp = d3_sub(P, B), cp = d3_sub(P, C);
+    double d1 = d3_dot(ab, ap), d2 = d3_dot(ac, ap), d3v = d3_dot(ab, bp), d4 = d3_dot(ac, bp);
+    double d5 = d3_dot(ab, cp), d6 = d3_dot(ac, cp);
+    if (d1 <= 0 && d2 <= 0)
+        return d3_len(ap);
+    if (d3v >= 0 && d4 <= d3v)
+        return d3_len(bp);
+    if (d6 >= 0 && d5 <= d6)
+        return d3_len(cp);
+    double vc = d1 * d4 - d3v * d2, vb = d5 * d2 - d1 * d6, va = d3v * d6 - d5 * d4;
+    if (vc <= 0 && d1 >= 0 && d3v <= 0)
+        return d3_len(d3_sub(P, d3_mad(A, ab, d1 / (d1 - d3v))));
+    if (vb <= 0 && d2 >= 0 && d6 <= 0)
+        return d3_len(d3_sub(P, d3_mad(A, ac, d2 / (d2 - d6))));
+    if (va <= 0 && d4 - d3v >= 0 && d5 - d6 >= 0)
+        return d3_len(d3_sub(P, d3_mad(B, d3_sub(C, B), (d4 - d3v) / ((d4 - d3v) + (d5 - d6)))));
+    double den = 1.0 / (va + vb + vc);
+    return d3_len(d3_sub(P, d3_mad(d3_mad(A, ab, vb * den), ac, vc * den)));
+}
+
+static void world_vertex(const lm_scene *s, uint32_t v, float out[3])
+{
+    lm_v3_store(out, lm_mat4_point(s->nodes[s->vertex_node[v]].world, lm_v3_load(s->positions + 3 * (size_t)v)));
+}
+
+static double scene_size(const lm_scene *s)
+{
+    lm_vec3 lo = lm_v3(1e30f, 1e30f, 1e30f), hi = lm_scale(lo, -1.0f);
+    for (uint32_t v = 0; v < s->vertex_count; v++) {
+        float p[3];
+        world_vertex(s, v, p);
+        lo = lm_vmin(lo, lm_v3_load(p));
+        hi = lm_vmax(hi, lm_v3_load(p));
+    }
+    return lm_length(lm_sub(hi, lo));
+}
+
+/* Rects disjoint, inside the atlas with a gutter border; every texel claimed once, inside its chart. */
+static void check_rects(const lm_atlas *a, int *owner)
+{
+    for (size_t i = 0; i < (size_t)a->width * a->height; i++)
+        owner[i] = -1;
+    for (int c = 0; c < a->chart_count; c++) {
+        const lm_chart *r = &a->charts[c];
+        assert_true(r->x >= a->gutter && r->y >= a->gutter);
+        assert_true(r->x + r->w <= a->width - a->gutter && r->y + r->h <= a->height - a->gutter);
+        for (int y = r->y; y < r->y + r->h; y++)
+            for (int x = r->x; x < r->x + r->w; x++) {
+                assert_int_equal(owner[(size_t)y * a->width + x], -1);
+                owner[(size_t)y * a->width + x] = c;
+            }
+    }
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        const lm_texel *t = &a->texels[i];
+        assert_int_equal(a->texel_index[(size_t)t->y * a->width + t->x], (int)i);
+        assert_int_equal(owner[(size_t)t->y * a->width + t->x], a->tri_chart[t->tri]);
+    }
+    uint32_t covered = 0;
+    for (size_t i = 0; i < (size_t)a->width * a->height; i++)
+        covered += a->texel_index[i] >= 0;
+    assert_int_equal(covered, a->texel_count);
+}
+
+/* No covered texel of another chart within `gutter` texels (Chebyshev) of a covered texel. */
+static void check_gutters(const lm_atlas *a)
+{
+    int g = a->gutter;
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        const lm_texel *t = &a->texels[i];
+        int c = a->tri_chart[t->tri];
+        for (int dy = -g; dy <= g; dy++)
+            for (int dx = -g; dx <= g; dx++) {
+                int x = t->x + dx, y = t->y + dy;
+                assert_true(x >= 0 && y >= 0 && x < a->width && y < a->height);
+                int j = a->texel_index[(size_t)y * a->width + x];
+                if (j >= 0)
+                    assert_int_equal(a->tri_chart[a->texels[j].tri], c);
+            }
+    }
+}
+
+static void check_corners(const lm_scene *s, const lm_surfaces *su, const lm_atlas *a)
+{
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        int c = a->tri_chart[t];
+        if (su->tri_surface[t] < 0) {
+            assert_int_equal(c, -1);
+            assert_true(isnan(a->corner_uv[6 * t]));
+            continue;
+        }
+        assert_true(c >= 0 && c < a->chart_count);
+        assert_int_equal(a->charts[c].surface, su->tri_surface[t]);
+        const lm_chart *r = &a->charts[c];
+        for (int k = 0; k < 3; k++) {
+            double x = a->corner_uv[6 * t + 2 * k] * (double)a->width, y = a->corner_uv[6 * t + 2 * k + 1] * (double)a->height;
+            assert_true(x >= r->x - 1e-3 && x <= r->x + r->w + 1e-3);
+            assert_true(y >= r->y - 1e-3 && y <= r->y + r->h + 1e-3);
+        }
+    }
+}
+
+/* Texel positions on their triangles; texel area per surface equals the surface's area. */
+static void check_texels(const lm_scene *s, const lm_surfaces *su, const lm_atlas *a, double area_tol)
+{
+    double size = scene_size(s);
+    double *sum = calloc((size_t)su->surface_count + 1, sizeof *sum);
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        const lm_texel *t = &a->texels[i];
+        float p[3][3];
+        for (int k = 0; k < 3; k++)
+            world_vertex(s, s->tris[3 * t->tri + k], p[k]);
+        double d = pt_tri_dist(t->pos, p[0], p[1], p[2]);
+        if (d > 1e-5 * size)
+            fail_msg("texel %u is %g from its triangle %u (size %g)", i, d, t->tri, size);
+        assert_int_equal(t->surface, su->tri_surface[t->tri]);
+        assert_true(fabsf(lm_length(lm_v3_load(t->normal)) - 1.0f) < 1e-3f);
+        sum[t->surface] += t->area;
+    }
+    for (int i = 0; i < su->surface_count; i++) {
+        double rel = fabs(sum[i] - su->surfaces[i].area) / su->surfaces[i].area;
+        if (rel > area_tol)
+            fail_msg("surface %d: texel area %g vs surface area %g", i, sum[i], (double)su->surfaces[i].area);
+    }
+    free(sum);
+}
+
+static void check_atlas(const lm_scene *s, const lm_surfaces *su, const lm_atlas *a, double area_tol)
+{
+    assert_true(a->width > 0 && a->height > 0 && a->width % 4 == 0 && a->height % 4 == 0);
+    int *owner = malloc((size_t)a->width * a->height * sizeof *owner);
+    check_rects(a, owner);
+    free(owner);
+    check_gutters(a);
+    check_corners(s, su, a);
+    check_texels(s, su, a, area_tol);
+    assert_int_equal(a->surface_count, su->surface_count);
+    for (int i = 0; i < su->surface_count; i++) {
+        int first = a->surface_first_chart[i], count = a->surface_chart_count[i];
+        assert_true(count >= 1);
+        for (int c = first; c < first + count; c++)
+            assert_int_equal(a->charts[c].surface, i);
+    }
+    assert_true(a->utilization > 0.0f && a->utilization <= 1.0f);
+}
+
+/* Surfaces and atlas with default options, checked; returns the surface count. */
+static int build_and_check(const lm_scene *s, double area_tol, lm_surfaces *su, lm_atlas *a)
+{
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(s, NULL, su, &err), LM_OK);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    if (lm_atlas_build(s, su, &o, a, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    check_atlas(s, su, a, area_tol);
+    return su->surface_count;
+}
+
+/* ---------- tests ---------- */
+
+static void test_unit_cube(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_box(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, (float[3]){1, 1, 1}, -1, 1);
+    lm_surfaces su;
+    lm_atlas a;
+    assert_int_equal(build_and_check(&t->s, 1e-4, &su, &a), 6);
+    assert_int_equal(a.chart_count, 6);
+    assert_int_equal(su.nonmanifold_edges, 0);
+    assert_int_equal(su.degenerate_tris, 0);
+    for (int i = 0; i < 6; i++)
+        assert_float_equal(su.surfaces[i].area, 1.0f, 1e-5f);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+static void test_flat_grid(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){-1, 0, 2}, (float[3]){0, 0, -3}, (float[3]){2, 0, 0}, 40, 40, NULL);
+    lm_surfaces su;
+    lm_atlas a;
+    assert_int_equal(build_and_check(&t->s, 1e-4, &su, &a), 1);
+    assert_int_equal(a.chart_count, 1);
+    assert_int_equal(su.surfaces[0].tri_count, 3200);
+    double sum = 0.0;
+    for (uint32_t i = 0; i < a.texel_count; i++)
+        sum += a.texels[i].area;
+    assert_true(fabs(sum - 6.0) < 6.0 * 1e-4);
+    /* about 256k texels by default, and a near-rectangular chart fills most of the atlas */
+    assert_true(a.texel_count > 200000 && a.texel_count < 300000);
+    assert_true(a.utilization > 0.7f);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+static void test_bumpy_field(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 1}, (float[3]){1, 0, 0}, (float[3]){0, 0, -1}, 60, 60, bumps);
+    lm_surfaces su;
+    lm_atlas a;
+    assert_int_equal(build_and_check(&t->s, 1e-3, &su, &a), 1);
+    assert_int_equal(a.chart_count, 1);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+static void test_l_shape(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, (float[3]){1, 0, 0}, (float[3]){0, 0, -1}, 1, 1, NULL);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){0, 0, -1}, (float[3]){1, 0, 0}, (float[3]){0, 1, 0}, 1, 1, NULL);
+    lm_surfaces su;
+    lm_atlas a;
+    assert_int_equal(build_and_check(&t->s, 1e-4, &su, &a), 2);
+    assert_int_equal(su.surfaces[0].tri_count, 2);
+    assert_int_equal(su.surfaces[0].tris[0], 0);
+    assert_float_equal(su.surfaces[0].normal[1], 1.0f, 1e-6f);
+    assert_float_equal(su.surfaces[1].normal[2], 1.0f, 1e-6f);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+/* Largest angle between a surface triangle's normal and its surface's mean normal, in degrees. */
+static double worst_cone(const lm_scene *s, const lm_surfaces *su)
+{
+    double worst = 0.0;
+    for (int i = 0; i < su->surface_count; i++) {
+        const lm_surface *f = &su->surfaces[i];
+        for (uint32_t k = 0; k < f->tri_count; k++) {
+            const uint32_t *v = s->tris + 3 * f->tris[k];
+            lm_vec3 p0 = lm_v3_load(s->positions + 3 * v[0]), p1 = lm_v3_load(s->positions + 3 * v[1]);
+            lm_vec3 n = lm_normalize(lm_cross(lm_sub(p1, p0), lm_sub(lm_v3_load(s->positions + 3 * v[2]), p0)));
+            worst = fmax(worst, acos(fmin(1.0, lm_dot(n, lm_v3_load(f->normal)))) * 180.0 / M_PI);
+        }
+    }
+    return worst;
+}
+
+static void test_hemisphere(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_sphere(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, 1.0f, 48, 24, 1);
+    lm_surfaces su;
+    lm_atlas a;
+    int n = build_and_check(&t->s, 2e-3, &su, &a);
+    double worst = worst_cone(&t->s, &su);
+    print_message("hemisphere: %d surfaces, %d charts, worst angle to the surface normal %.1f deg\n", n,
+                  a.chart_count, worst);
+    assert_true(n >= 6 && n <= 30);
+    /* merged tiny fragments may lean a little past the cone */
+    assert_true(worst <= 35.0);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    /* without fragment merging every triangle is within the cone of its surface's mean */
+    lm_surface_options o;
+    lm_surface_options_default(&o);
+    o.min_fragment_area = 0.0f;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, &o, &su, &err), LM_OK);
+    assert_true(worst_cone(&t->s, &su) <= 30.01);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+static void test_degenerate_and_strict(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, (float[3]){1, 0, 0}, (float[3]){0, 0, -1}, 2, 2, NULL);
+    uint32_t a0 = ts_vertex(t, 0, 5, 0, 0, 0, 1, 0), a1 = ts_vertex(t, 0, 6, 0, 0, 0, 1, 0),
+             a2 = ts_vertex(t, 0, 7, 0, 0, 0, 1, 0);
+    ts_tri(t, 0, MAT_DIFFUSE, a0, a1, a2); /* collinear: zero area */
+    lm_surfaces su;
+    lm_error err = {0};
+    lm_log_reset_warning_count();
+    lm_log_set_level(LM_LOG_ERROR);
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    lm_log_set_level(LM_LOG_WARN);
+    assert_int_equal(su.degenerate_tris, 1);
+    assert_int_equal(su.tri_surface[t->s.tri_count - 1], -1);
+    assert_int_equal(su.surface_count, 1);
+    assert_true(lm_log_warning_count() >= 1);
+    lm_atlas a;
+    assert_int_equal(lm_atlas_build(&t->s, &su, NULL, &a, &err), LM_OK);
+    check_atlas(&t->s, &su, &a, 1e-4);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+
+    lm_surface_options o;
+    lm_surface_options_default(&o);
+    o.strict = 1;
+    assert_int_equal(lm_surfaces_build(&t->s, &o, &su, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "node0"));
+    assert_null(su.surfaces);
+    ts_free(t);
+}
+
+static void test_nonmanifold_fin(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    /* three triangles on the edge (0,0,0)-(1,0,0) */
+    uint32_t e0 = ts_vertex(t, 0, 0, 0, 0, 0, 1, 0), e1 = ts_vertex(t, 0, 1, 0, 0, 0, 1, 0);
+    uint32_t p = ts_vertex(t, 0, 0.5f, 0, -1, 0, 1, 0), q = ts_vertex(t, 0, 0.5f, 0, 1, 0, 1, 0),
+             r = ts_vertex(t, 0, 0.5f, 1, 0, 0, 0, 1);
+    ts_tri(t, 0, MAT_DIFFUSE, e0, e1, p);
+    ts_tri(t, 0, MAT_DIFFUSE, e1, e0, q);
+    ts_tri(t, 0, MAT_DIFFUSE, e0, e1, r);
+    lm_surfaces su;
+    lm_error err = {0};
+    lm_log_set_level(LM_LOG_ERROR);
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    lm_log_set_level(LM_LOG_WARN);
+    assert_int_equal(su.nonmanifold_edges, 1);
+    /* the fin is no neighbour of anything; the two flat ones are not joined across the bad edge */
+    for (int k = 0; k < 9; k++)
+        assert_int_equal(su.tri_adj[k], -1);
+    lm_atlas a;
+    assert_int_equal(lm_atlas_build(&t->s, &su, NULL, &a, &err), LM_OK);
+    check_atlas(&t->s, &su, &a, 1e-4);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    lm_surface_options o;
+    lm_surface_options_default(&o);
+    o.strict = 1;
+    assert_int_equal(lm_surfaces_build(&t->s, &o, &su, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "non-manifold"));
+    ts_free(t);
+}
+
+/* Cornell box with a bumpy floor, a static block (5 faces), a dynamic cube and a mirror sphere. */
+static tscene *bumpy_cornell(void)
+{
+    tscene *t = ts_new(4);
+    float o[3] = {0, 0, 0};
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 1}, (float[3]){1, 0, 0}, (float[3]){0, 0, -1}, 80, 80, bumps);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){0, 1, 0}, (float[3]){1, 0, 0}, (float[3]){0, 0, 1}, 1, 1, NULL);
+    ts_quad(t, 0, MAT_DIFFUSE, o, (float[3]){1, 0, 0}, (float[3]){0, 1, 0}, 1, 1, NULL);
+    ts_quad(t, 0, MAT_RED, o, (float[3]){0, 1, 0}, (float[3]){0, 0, 1}, 1, 1, NULL);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){1, 0, 0}, (float[3]){0, 0, 1}, (float[3]){0, 1, 0}, 1, 1, NULL);
+    ts_box(t, 1, MAT_DIFFUSE, (float[3]){0.15f, 0.0f, 0.2f}, (float[3]){0.45f, 0.6f, 0.5f}, 2, 2);
+    ts_box(t, 2, MAT_DIFFUSE, (float[3]){-0.1f, -0.1f, -0.1f}, (float[3]){0.1f, 0.1f, 0.1f}, -1, 3);
+    float tr[3] = {0.7f, 0.2f, 0.7f};
+    lm_mat4_from_trs(t->s.nodes[2].world, tr, (float[4]){0, 0.3826834f, 0, 0.9238795f}, (float[3]){1, 1, 1});
+    t->s.nodes[2].dynamic = 1;
+    ts_sphere(t, 3, MAT_MIRROR, (float[3]){0.7f, 0.25f, 0.3f}, 0.15f, 32, 16, 0);
+    return t;
+}
+
+static void test_bumpy_cornell(void **state)
+{
+    (void)state;
+    tscene *t = bumpy_cornell();
+    assert_true(t->s.tri_count > 13000);
+    lm_surfaces su;
+    lm_atlas a;
+    assert_int_equal(build_and_check(&t->s, 2e-3, &su, &a), 16);
+    for (uint32_t i = 0; i < t->s.tri_count; i++)
+        if (t->s.tri_node[i] == 3)
+            assert_int_equal(su.tri_surface[i], -1);
+    assert_int_equal(su.nonmanifold_edges, 0);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+static void test_deterministic(void **state)
+{
+    (void)state;
+    tscene *t = bumpy_cornell();
+    lm_surfaces s1, s2;
+    lm_atlas a1, a2;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &s1, &err), LM_OK);
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &s2, &err), LM_OK);
+    assert_memory_equal(s1.tri_surface, s2.tri_surface, t->s.tri_count * sizeof(int));
+    assert_int_equal(lm_atlas_build(&t->s, &s1, NULL, &a1, &err), LM_OK);
+    assert_int_equal(lm_atlas_build(&t->s, &s2, NULL, &a2, &err), LM_OK);
+    assert_int_equal(a1.texel_count, a2.texel_count);
+    assert_memory_equal(a1.texels, a2.texels, a1.texel_count * sizeof *a1.texels);
+    assert_memory_equal(a1.corner_uv, a2.corner_uv, 6 * (size_t)t->s.tri_count * sizeof(float));
+    lm_atlas_free(&a1);
+    lm_atlas_free(&a2);
+    lm_surfaces_free(&s1);
+    lm_surfaces_free(&s2);
+    ts_free(t);
+}
+
+static void test_max_size_grows_texels(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_box(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, (float[3]){1, 1, 1}, -1, 2);
+    lm_surfaces su;
+    lm_atlas a;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    o.texel_size = 0.001f;
+    o.max_size = 256;
+    lm_log_reset_warning_count();
+    lm_log_set_level(LM_LOG_ERROR);
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    lm_log_set_level(LM_LOG_WARN);
+    assert_int_equal(lm_log_warning_count(), 1);
+    assert_true(a.width <= 256 && a.height <= 256);
+    assert_true(a.texel_size > 0.001f);
+    check_atlas(&t->s, &su, &a, 1e-4);
+    lm_atlas_free(&a);
+    o.texel_size = NAN;
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_ERR_INVALID);
+    o.texel_size = 0.0f;
+    o.use_file_uv1 = 1;
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "TEXCOORD_1"));
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+static void test_default_texel_size(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4}, 1, 1, NULL);
+    lm_surfaces su;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    assert_float_equal(lm_atlas_default_texel_size(&t->s, &su), 4.0f / 512.0f, 1e-6f);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+/* ---------- shared scenes ---------- */
+
+static void shared_scene(const char *rel, int expect_surfaces, int uv1)
+{
+    LMT_REQUIRE_SCENE(path, lmt_shared_scene(rel));
+    lm_scene *s = NULL;
+    lm_error err = {0};
+    lm_load_options lo = {0};
+    if (lm_scene_load_gltf(path, &lo, &s, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    lm_surfaces su;
+    lm_atlas a;
+    lm_log_set_level(LM_LOG_ERROR);
+    int n = build_and_check(s, 0.02, &su, &a);
+    lm_log_set_level(LM_LOG_WARN);
+    print_message("%s: %u triangles, %d surfaces, %d charts, atlas %dx%d, utilization %.2f\n", rel, s->tri_count, n,
+                  a.chart_count, a.width, a.height, (double)a.utilization);
+    if (expect_surfaces >= 0)
+        assert_int_equal(n, expect_surfaces);
+    lm_atlas_free(&a);
+    if (uv1) {
+        lm_atlas_options o;
+        lm_atlas_options_default(&o);
+        o.use_file_uv1 = 1;
+        if (lm_atlas_build(s, &su, &o, &a, &err) != LM_OK)
+            fail_msg("%s", err.msg);
+        check_atlas(s, &su, &a, 0.02);
+        assert_int_equal(a.chart_count, n);
+        lm_atlas_free(&a);
+    }
+    lm_surfaces_free(&su);
+    lm_scene_free(s);
+}
+
+/* 5 walls + 6 faces of each box + the light quad. */
+static void test_cornell_box(void **state)
+{
+    (void)state;
+    shared_scene("cornell-box/CornellBox.glb", 18, 1);
+}
+
+static void test_room(void **state)
+{
+    (void)state;
+    shared_scene("room/IrradianceVolumeExample.glb", -1, 0);
+}
+
+static void test_depth_of_field(void **state)
+{
+    (void)state;
+    shared_scene("depth-of-field/DepthOfFieldExample.glb", -1, 0);
+}
+
+static void test_mixed_lighting(void **state)
+{
+    (void)state;
+    shared_scene("mixed-lighting/MixedLightingExample.gltf", -1, 0);
+}
+
+static void test_cornell_suzanne(void **state)
+{
+    (void)state;
+    shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf", -1, 0);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_unit_cube),
+        cmocka_unit_test(test_flat_grid),
+        cmocka_unit_test(test_bumpy_field),
+        cmocka_unit_test(test_l_shape),
+        cmocka_unit_test(test_hemisphere),
+        cmocka_unit_test(test_degenerate_and_strict),
+        cmocka_unit_test(test_nonmanifold_fin),
+        cmocka_unit_test(test_bumpy_cornell),
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_max_size_grows_texels),
+        cmocka_unit_test(test_default_texel_size),
+        cmocka_unit_test(test_cornell_box),
+        cmocka_unit_test(test_room),
+        cmocka_unit_test(test_depth_of_field),
+        cmocka_unit_test(test_mixed_lighting),
+        cmocka_unit_test(test_cornell_suzanne),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,144 @@
+/* The lmgi command: exit codes and messages for bad input, and the pictures `lmgi charts` writes. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+
+#include "../src/core/image.h"
+#include "../src/core/palette.h"
+#include "support.h"
+
+static char output[65536];
+
+/* Runs `lmgi ARGS` (stdout and stderr together into `output`) and returns its exit status. */
+static int run(const char *args)
+{
+    const char *build = getenv("LMGI_BUILD");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "%s/lmgi %s 2>&1", build ? build : "build", args);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(output, 1, sizeof output - 1, p);
+    output[n] = '\0';
+    int status = pclose(p);
+    assert_true(WIFEXITED(status)); /* never a crash */
+    return WEXITSTATUS(status);
+}
+
+static void test_usage_errors(void **state)
+{
+    (void)state;
+    assert_int_equal(run(""), 2);
+    assert_int_equal(run("frobnicate scene.glb"), 2);
+    assert_non_null(strstr(output, "unknown command 'frobnicate'"));
+    assert_int_equal(run("info"), 2);
+    assert_int_equal(run("info a.glb --texel-size abc"), 2);
+    assert_non_null(strstr(output, "--texel-size abc"));
+    assert_int_equal(run("info a.glb --gutter 0"), 2);
+    assert_int_equal(run("info a.glb --wat"), 2);
+    assert_non_null(strstr(output, "'--wat'"));
+    assert_int_equal(run("charts scenes/cornell.glb"), 2);
+    assert_non_null(strstr(output, "--out"));
+    assert_int_equal(run("help"), 0);
+    assert_non_null(strstr(output, "charts SCENE --out DIR"));
+}
+
+static void test_bad_scene_files(void **state)
+{
+    (void)state;
+    assert_int_equal(run("info /nonexistent/scene.glb"), 1);
+    assert_non_null(strstr(output, "/nonexistent/scene.glb"));
+    char path[512];
+    snprintf(path, sizeof path, "%s/bad.gltf", lmt_tmpdir());
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("{\"asset\": {\"version\": \"2.0\"}, \"nodes\": [", f);
+    fclose(f);
+    char args[1024];
+    snprintf(args, sizeof args, "info %s", path);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "bad.gltf"));
+}
+
+static void test_info_on_generated_cornell(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    char args[1024];
+    snprintf(args, sizeof args, "info %s", path);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "surfaces    16 "));
+    assert_non_null(strstr(output, "caustics: on — 1 mirror material on node 'mirror_sphere'"));
+    assert_non_null(strstr(output, "1 point, 0 spot, 0 directional"));
+}
+
+/* Every pixel is black (background), grey (specular) or the colour of one surface id < count. */
+static int surface_of_pixel(const uint8_t *px, int count)
+{
+    for (int id = -1; id < count; id++) {
+        uint8_t rgb[3];
+        lm_id_color(id, rgb);
+        if (!memcmp(rgb, px, 3))
+            return id;
+    }
+    return px[0] == 0 && px[1] == 0 && px[2] == 0 ? -2 : -3;
+}
+
+static void test_charts_pictures(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    const char *dir = lmt_tmpdir();
+    char args[1024], file[1024];
+    snprintf(args, sizeof args, "charts %s --out %s/out --size 320x240", path, dir);
+    assert_int_equal(run(args), 0);
+
+    snprintf(file, sizeof file, "%s/out/surfaces.png", dir);
+    int w, h;
+    uint8_t *img = NULL;
+    lm_error err;
+    assert_int_equal(lm_read_image8(file, &w, &h, &img, &err), LM_OK);
+    assert_int_equal(w, 320);
+    assert_int_equal(h, 240);
+    int seen[16] = {0}, grey = 0, distinct = 0;
+    for (int i = 0; i < w * h; i++) {
+        int id = surface_of_pixel(img + 4 * i, 16);
+        assert_true(id >= -2); /* flat colours only: no blending, no stray values */
+        if (id >= 0 && !seen[id]++)
+            distinct++;
+        grey += id == -1;
+    }
+    free(img);
+    /* From the file's camera: the five walls, faces of the block and cube, and the grey mirror sphere. */
+    assert_true(distinct >= 9);
+    assert_true(grey > 100);
+
+    snprintf(file, sizeof file, "%s/out/atlas.png", dir);
+    assert_int_equal(lm_read_image8(file, &w, &h, &img, &err), LM_OK);
+    assert_true(w >= 64 && h >= 64);
+    int black = 0;
+    for (int i = 0; i < w * h; i++)
+        black += img[4 * i] == 0 && img[4 * i + 1] == 0 && img[4 * i + 2] == 0;
+    free(img);
+    assert_true(black > 0 && black < w * h / 2); /* gutters and free space, but mostly charts */
+
+    snprintf(args, sizeof args, "charts %s --out /proc/lmgi-not-writable", path);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "/proc/lmgi-not-writable"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_usage_errors),
+        cmocka_unit_test(test_bad_scene_files),
+        cmocka_unit_test(test_info_on_generated_cornell),
+        cmocka_unit_test(test_charts_pictures),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
