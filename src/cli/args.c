@@ -1,0 +1,107 @@
+#include "args.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int bad(const char *opt, const char *value, const char *want)
+{
+    fprintf(stderr, "lmgi: %s %s: expected %s\n", opt, value ? value : "(missing)", want);
+    return 2;
+}
+
+static int parse_float(const char *opt, const char *v, float lo, float *out)
+{
+    char *end = NULL;
+    if (!v)
+        return bad(opt, v, "a number");
+    errno = 0;
+    double d = strtod(v, &end);
+    if (errno || end == v || *end || !isfinite(d) || d < lo)
+        return bad(opt, v, "a finite number");
+    *out = (float)d;
+    return 0;
+}
+
+static int parse_int(const char *opt, const char *v, int lo, int hi, int *out)
+{
+    char *end = NULL;
+    if (!v)
+        return bad(opt, v, "an integer");
+    errno = 0;
+    long l = strtol(v, &end, 10);
+    if (errno || end == v || *end || l < lo || l > hi) {
+        char want[64];
+        snprintf(want, sizeof want, "an integer in [%d, %d]", lo, hi);
+        return bad(opt, v, want);
+    }
+    *out = (int)l;
+    return 0;
+}
+
+static int parse_size(const char *opt, const char *v, int *w, int *h)
+{
+    if (!v || sscanf(v, "%dx%d", w, h) != 2 || *w < 16 || *h < 16 || *w > 16384 || *h > 16384)
+        return bad(opt, v, "WxH with 16 <= W, H <= 16384");
+    return 0;
+}
+
+static int add_file(const char **list, int *count, const char *f)
+{
+    if (*count >= LM_CLI_MAX_FILES) {
+        fprintf(stderr, "lmgi: too many files (at most %d)\n", LM_CLI_MAX_FILES);
+        return 2;
+    }
+    list[(*count)++] = f;
+    return 0;
+}
+
+int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
+{
+    memset(a, 0, sizeof *a);
+    lmgi_options_init(&a->options);
+    a->repeats = 3;
+    int rc = 0;
+    for (int i = first; i < argc && rc == 0; i++) {
+        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        int takes = 1;
+        if (!strcmp(o, "--texel-size"))
+            rc = parse_float(o, v, 0.0f, &a->options.texel_size);
+        else if (!strcmp(o, "--gutter"))
+            rc = parse_int(o, v, 1, 64, &a->options.gutter);
+        else if (!strcmp(o, "--cone"))
+            rc = parse_float(o, v, 0.0f, &a->options.surface_cone_deg);
+        else if (!strcmp(o, "--max-atlas"))
+            rc = parse_int(o, v, 64, 32768, &a->options.max_atlas_size);
+        else if (!strcmp(o, "--out") || !strcmp(o, "-o"))
+            rc = v ? (a->out_dir = v, 0) : bad(o, v, "a directory");
+        else if (!strcmp(o, "--json"))
+            rc = v ? (a->json_path = v, 0) : bad(o, v, "a file name");
+        else if (!strcmp(o, "--size"))
+            rc = parse_size(o, v, &a->width, &a->height);
+        else if (!strcmp(o, "--repeats"))
+            rc = parse_int(o, v, 1, 100, &a->repeats);
+        else if (!strcmp(o, "--scaling"))
+            rc = v ? add_file(a->scaling, &a->scaling_count, v) : bad(o, v, "a scene file");
+        else {
+            takes = 0;
+            if (!strcmp(o, "--use-uv1"))
+                a->options.use_file_uv1 = 1;
+            else if (!strcmp(o, "--strict"))
+                a->options.strict = 1;
+            else if (!strcmp(o, "-v") || !strcmp(o, "--verbose"))
+                a->verbose = 1;
+            else if (!strcmp(o, "-q") || !strcmp(o, "--quiet"))
+                a->quiet = 1;
+            else if (o[0] == '-' && o[1]) {
+                fprintf(stderr, "lmgi: unknown option '%s' (see 'lmgi help')\n", o);
+                rc = 2;
+            } else
+                rc = add_file(a->files, &a->file_count, o);
+        }
+        i += takes;
+    }
+    return rc;
+}

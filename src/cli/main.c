@@ -1,0 +1,107 @@
+/* The lmgi command. */
+#include <lmgi.h>
+
+#include <stdio.h>
+#include <string.h>
+
+#include "args.h"
+#include "bench.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: lmgi COMMAND [OPTIONS] SCENE\n"
+            "\n"
+            "commands:\n"
+            "  info SCENE             counts, materials by class, lights, surfaces, charts, atlas, and which\n"
+            "                         effects the scene calls for and why\n"
+            "  charts SCENE --out DIR write DIR/atlas.png (charts coloured, gutters black) and DIR/surfaces.png\n"
+            "                         (the scene from its camera, each surface a flat colour)\n"
+            "  bench [SCENE...]       time load, surface split, atlas (unwrap, pack, texel table) and BVH build;\n"
+            "                         --scaling FILE (repeatable) adds a growth table\n"
+            "  help                   this text\n"
+            "\n"
+            "options:\n"
+            "  --texel-size S   world units per lightmap texel (default: about 256k texels for the scene)\n"
+            "  --gutter N       empty texels between charts (default 2)\n"
+            "  --use-uv1        use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping\n"
+            "  --cone DEG       max normal deviation inside one surface (default 30)\n"
+            "  --max-atlas N    largest atlas side; the texel size grows to fit (default 8192)\n"
+            "  --strict         degenerate triangles and non-manifold edges are errors\n"
+            "  --size WxH       picture size for 'charts' (default 1024x768)\n"
+            "  --repeats N      'bench': runs per scene, the median is reported (default 3)\n"
+            "  --json FILE      'bench': also write the results as JSON\n"
+            "  -v, -q           more / less on stderr\n");
+}
+
+static int load(const lm_cli_args *a, lmgi_scene **sc)
+{
+    if (a->file_count != 1) {
+        fprintf(stderr, "lmgi: expected exactly one scene file, got %d (see 'lmgi help')\n", a->file_count);
+        return 2;
+    }
+    lmgi_error err;
+    if (lmgi_load(a->files[0], &a->options, sc, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        return 1;
+    }
+    return 0;
+}
+
+static int cmd_info(const lm_cli_args *a)
+{
+    lmgi_scene *sc = NULL;
+    int rc = load(a, &sc);
+    if (rc)
+        return rc;
+    lmgi_print_info(sc, stdout);
+    lmgi_free(sc);
+    return 0;
+}
+
+static int cmd_charts(const lm_cli_args *a)
+{
+    if (!a->out_dir) {
+        fprintf(stderr, "lmgi: charts needs --out DIR\n");
+        return 2;
+    }
+    lmgi_scene *sc = NULL;
+    int rc = load(a, &sc);
+    if (rc)
+        return rc;
+    lmgi_error err;
+    if (lmgi_write_charts(sc, a->out_dir, a->width, a->height, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        rc = 1;
+    } else if (!a->quiet) {
+        lmgi_info in;
+        lmgi_get_info(sc, &in);
+        printf("wrote %s/atlas.png (%d x %d, %d charts, %.1f%% used) and %s/surfaces.png (%d surfaces)\n",
+               a->out_dir, in.atlas_width, in.atlas_height, in.charts, 100.0 * (double)in.utilization, a->out_dir,
+               in.surfaces);
+    }
+    lmgi_free(sc);
+    return rc;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    lm_cli_args a;
+    if (lm_cli_parse(argc, argv, 2, &a))
+        return 2;
+    lmgi_set_verbosity(a.quiet ? 0 : a.verbose ? 2 : 1);
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "info"))
+        return cmd_info(&a);
+    if (!strcmp(cmd, "charts"))
+        return cmd_charts(&a);
+    if (!strcmp(cmd, "bench"))
+        return lm_cli_bench(&a);
+    fprintf(stderr, "lmgi: unknown command '%s'\n\n", cmd);
+    usage(stderr);
+    return 2;
+}
