@@ -132,7 +132,7 @@ int lm_cli_bench(const lm_cli_args *a)
 {
     const char *const *files = a->files;
     int count = a->file_count;
-    if (count == 0 && a->scaling_count == 0) {
+    if (count == 0) {
         files = DEFAULT_SCENES;
         count = (int)(sizeof DEFAULT_SCENES / sizeof *DEFAULT_SCENES);
     }

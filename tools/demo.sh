@@ -1,0 +1,16 @@
+#!/bin/sh
+# make demo: the main job on our scenes, leaving pictures in demo/ (named in the README).
+set -eu
+LMGI=${1:-build/lmgi}
+mkdir -p demo
+for scene in scenes/cornell.glb scenes/two_rooms.glb ../shared/scenes/cornell-box/CornellBox.glb; do
+    name=$(basename "$scene" | sed 's/\.[^.]*$//')
+    if [ ! -r "$scene" ]; then
+        echo "demo: skipped $scene (not found)"
+        continue
+    fi
+    echo "== $scene"
+    "$LMGI" info "$scene" | tee "demo/$name-info.txt"
+    "$LMGI" charts "$scene" --out "demo/$name" --size 1024x768
+done
+echo "demo: pictures in demo/<scene>/atlas.png and demo/<scene>/surfaces.png"
