@@ -2,6 +2,9 @@
 # Runs each cmocka test binary, prints its output, and closes with the totals of test cases:
 # "N passed, N failed, N skipped". Exits non-zero if any binary failed or crashed.
 passed=0; failed=0; skipped=0; bad=""
+# Sanitizer builds: third-party leaks we cannot fix are listed in tests/lsan.supp.
+LSAN_OPTIONS="suppressions=$(cd "$(dirname "$0")" && pwd)/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
+export LSAN_OPTIONS
 for t in "$@"; do
     echo "=== $t"
     out=$("$t" 2>&1); rc=$?

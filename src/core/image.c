@@ -25,6 +25,11 @@ lm_status lm_write_exr(const char *path, int width, int height, int channels, co
     if (width <= 0 || height <= 0 || !data || (channels != 1 && channels != 3 && channels != 4))
         return lm_fail(err, LM_ERR_INVALID, "%s: cannot write a %dx%d EXR with %d channels", path, width,
                        height, channels);
+    /* tinyexr leaks when it cannot open the file, so find that out first. */
+    FILE *probe = fopen(path, "wb");
+    if (!probe)
+        return lm_fail(err, LM_ERR_IO, "%s: cannot write EXR (%s)", path, strerror(errno));
+    fclose(probe);
     const char *msg = NULL;
     if (SaveEXR(data, width, height, channels, 0, path, &msg) < 0) {
         lm_status st = lm_fail(err, LM_ERR_IO, "%s: cannot write EXR (%s)", path, msg ? msg : "unknown");
