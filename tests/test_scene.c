@@ -445,14 +445,22 @@ static void tri_case(const char *dir, const char *name, const tri_opts *o, char 
     write_tri_gltf(path, o);
 }
 
+/* A fresh directory holding tri.bin (the one-triangle buffer), with warnings silenced. */
+static const char *tri_setup(void)
+{
+    lm_log_set_level(LM_LOG_ERROR);
+    const char *dir = lmt_tmpdir();
+    char bin[512];
+    snprintf(bin, sizeof bin, "%s/tri.bin", dir);
+    write_tri_bin(bin, k_tri_pos, k_tri_idx);
+    return dir;
+}
+
 static void test_bad_input(void **state)
 {
     (void)state;
-    lm_log_set_level(LM_LOG_ERROR);
-    const char *dir = lmt_tmpdir();
+    const char *dir = tri_setup();
     char p[512], bin[512];
-    snprintf(bin, sizeof bin, "%s/tri.bin", dir);
-    write_tri_bin(bin, k_tri_pos, k_tri_idx);
     tri_opts o = tri_defaults();
 
     tri_case(dir, "good.gltf", &o, p, sizeof p);
@@ -542,11 +550,8 @@ static void test_bad_input(void **state)
 static void test_non_triangle_modes(void **state)
 {
     (void)state;
-    lm_log_set_level(LM_LOG_ERROR);
-    const char *dir = lmt_tmpdir();
-    char p[512], bin[512];
-    snprintf(bin, sizeof bin, "%s/tri.bin", dir);
-    write_tri_bin(bin, k_tri_pos, k_tri_idx);
+    const char *dir = tri_setup();
+    char p[512];
     tri_opts o = tri_defaults();
     o.mode = 1; /* lines: warned and skipped */
     tri_case(dir, "lines.gltf", &o, p, sizeof p);

@@ -1,6 +1,5 @@
 #include "effects.h"
 
-#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,19 +11,25 @@ const char *lm_effect_name(lm_effect_id e)
     return (unsigned)e < LM_EFFECT_COUNT ? names[e] : "?";
 }
 
-/* Materials of class `cls` used by triangles of nodes where `switch_of(node)` is on, and where off. */
+/* The per-node extras switch that governs an effect. */
+static int node_switch(const lm_node *node, lm_effect_id effect)
+{
+    return effect == LM_EFFECT_INDIRECT ? node->settings.indirect : node->settings.caustics;
+}
+
+/* Materials of class `cls` used by triangles of nodes where the effect's switch is on, and where off. */
 typedef struct {
     int materials_on, materials_off;
     int first_node_on, first_node_off;
 } usage;
 
-static usage count_usage(const lm_scene *s, lm_material_class cls, int settings_offset)
+static usage count_usage(const lm_scene *s, lm_material_class cls, lm_effect_id effect)
 {
     usage u = {0, 0, -1, -1};
     unsigned char *seen = calloc(2 * (size_t)s->material_count + 2, 1); /* [on][material] */
     for (int n = 0; n < s->node_count; n++) {
         const lm_node *node = &s->nodes[n];
-        int on = *(const int *)((const char *)&node->settings + settings_offset) != 0;
+        int on = node_switch(node, effect) != 0;
         for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++) {
             int m = s->tri_material[t];
             if (s->materials[m].cls != cls)
@@ -80,7 +85,7 @@ static void decide_direct(const lm_scene *s, lm_effects *e)
 
 static void decide_indirect(const lm_scene *s, lm_effects *e)
 {
-    usage emit = count_usage(s, LM_MAT_EMITTER, (int)offsetof(lm_node_settings, indirect));
+    usage emit = count_usage(s, LM_MAT_EMITTER, LM_EFFECT_INDIRECT);
     int receivers = 0;
     for (int n = 0; n < s->node_count; n++)
         receivers += s->nodes[n].tri_count > 0 && s->nodes[n].settings.indirect;
@@ -104,8 +109,8 @@ static void decide_indirect(const lm_scene *s, lm_effects *e)
 /* Caustics and reflections both come from mirror and glass materials. */
 static void decide_specular(const lm_scene *s, lm_effects *e)
 {
-    size_t off = offsetof(lm_node_settings, caustics);
-    usage glass = count_usage(s, LM_MAT_GLASS, (int)off), mirror = count_usage(s, LM_MAT_MIRROR, (int)off);
+    usage glass = count_usage(s, LM_MAT_GLASS, LM_EFFECT_CAUSTICS);
+    usage mirror = count_usage(s, LM_MAT_MIRROR, LM_EFFECT_CAUSTICS);
     int on = glass.materials_on + mirror.materials_on, off_count = glass.materials_off + mirror.materials_off;
     int node = glass.first_node_on >= 0 ? glass.first_node_on : mirror.first_node_on;
     char what[160] = "";
@@ -115,7 +120,8 @@ static void decide_specular(const lm_scene *s, lm_effects *e)
     else if (on)
         snprintf(what, sizeof what, "%d %s material%s", on, glass.materials_on ? "glass" : "mirror",
                  on == 1 ? "" : "s");
-    int lit = s->light_count > 0 || count_usage(s, LM_MAT_EMITTER, (int)off).materials_on > 0;
+    usage emit = count_usage(s, LM_MAT_EMITTER, LM_EFFECT_CAUSTICS);
+    int lit = s->light_count > 0 || emit.materials_on + emit.materials_off > 0;
 
     e->on[LM_EFFECT_CAUSTICS] = on > 0 && lit;
     if (on > 0 && lit)
