@@ -32,7 +32,8 @@ TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o
 
 .PHONY: all deps test test-asan demo bench scenes clean
-.SECONDARY:
+.PRECIOUS: $(BUILD)/obj/%.o
+.PHONY: FORCE
 all: $(BUILD)/lmgi $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
 
 deps:

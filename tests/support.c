@@ -1,4 +1,8 @@
+#define _XOPEN_SOURCE 700
 #include "support.h"
+
+#include <ftw.h>
+#include <sys/stat.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -27,12 +31,34 @@ const char *lmt_project_scene(const char *relative)
     return existing(buf, sizeof buf, ".", "scenes", relative);
 }
 
+static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
+{
+    (void)st;
+    (void)flag;
+    (void)ftw;
+    return remove(path);
+}
+
+/* Directories made by lmt_tmpdir, removed when the test program exits. */
+static char made[64][64];
+static int made_count;
+
+static void remove_tmpdirs(void)
+{
+    for (int i = 0; i < made_count; i++)
+        nftw(made[i], remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
 const char *lmt_tmpdir(void)
 {
-    static char buf[256];
+    static char buf[64];
     snprintf(buf, sizeof buf, "/tmp/lmgi-test-XXXXXX");
     if (!mkdtemp(buf))
         return "/tmp";
+    if (made_count == 0)
+        atexit(remove_tmpdirs);
+    if (made_count < 64)
+        memcpy(made[made_count++], buf, sizeof buf);
     return buf;
 }
 

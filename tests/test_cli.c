@@ -65,6 +65,33 @@ static void test_bad_scene_files(void **state)
     assert_non_null(strstr(output, "bad.gltf"));
 }
 
+/* Degenerate triangles are a warning by default (the scene still loads) and an error with --strict. */
+static void test_strict_refuses_degenerate_triangles(void **state)
+{
+    (void)state;
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    float c[3] = {0, 0, 0}, u[3] = {1, 0, 0}, v[3] = {0, 0, -1};
+    lmt_mesh_quad(&m, c, u, v);
+    /* A zero-area triangle: its third corner lies on the edge between the first two. */
+    float line[3][3] = {{0, 0, 0}, {1, 0, 0}, {0.5f, 0, 0}};
+    for (int k = 0; k < 3; k++) {
+        memcpy(m.pos + 3 * m.vertex_count, line[k], sizeof line[k]);
+        m.idx[m.index_count++] = (uint16_t)m.vertex_count++;
+    }
+    char path[512], args[1024];
+    snprintf(path, sizeof path, "%s/degenerate.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &m, 1, "[{\"name\": \"plate\", \"mesh\": 0}]", NULL, 0, NULL), 0);
+    snprintf(args, sizeof args, "info %s", path);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "warning"));
+    assert_non_null(strstr(output, "1 degenerate triangles dropped"));
+    snprintf(args, sizeof args, "info --strict %s", path);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "degenerate.gltf"));
+    assert_non_null(strstr(output, "degenerate"));
+}
+
 static void test_info_on_generated_cornell(void **state)
 {
     (void)state;
@@ -137,6 +164,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_usage_errors),
         cmocka_unit_test(test_bad_scene_files),
+        cmocka_unit_test(test_strict_refuses_degenerate_triangles),
         cmocka_unit_test(test_info_on_generated_cornell),
         cmocka_unit_test(test_charts_pictures),
     };
