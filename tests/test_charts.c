@@ -295,6 +295,14 @@ static void check_texels(const lm_scene *s, const lm_surfaces *su, const lm_atla
             fail_msg("texel %u is %g from its triangle %u (size %g)", i, d, t->tri, size);
         assert_int_equal(t->surface, su->tri_surface[t->tri]);
         assert_true(fabsf(lm_length(lm_v3_load(t->normal)) - 1.0f) < 1e-3f);
+        /* The local position and barycentrics name the same point. */
+        const float *world = s->nodes[s->tri_node[t->tri]].world;
+        lm_vec3 back = lm_mat4_point(world, lm_v3_load(t->local)), bp = lm_v3(0, 0, 0);
+        assert_true(lm_length(lm_sub(back, lm_v3_load(t->pos))) <= 1e-5 * size);
+        for (int k = 0; k < 3; k++)
+            bp = lm_add(bp, lm_scale(lm_v3_load(p[k]), t->bary[k]));
+        assert_true(lm_length(lm_sub(bp, lm_v3_load(t->pos))) <= 1e-5 * size);
+        assert_float_equal(t->bary[0] + t->bary[1] + t->bary[2], 1.0f, 1e-5);
         sum[t->surface] += t->area;
     }
     for (int i = 0; i < su->surface_count; i++) {

@@ -63,6 +63,8 @@ typedef struct {
 
 typedef struct {
     float pos[3];          /* world position: centroid of the texel's overlap with its triangle */
+    float local[3];        /* the same point in its node's local space (follows a dynamic node) */
+    float bary[3];         /* its barycentric weights on the triangle's corners 0, 1, 2 */
     float normal[3];       /* interpolated shading normal, world space */
     int x, y;              /* texel coordinates */
     int surface;

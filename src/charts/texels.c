@@ -135,12 +135,14 @@ static void texel_point(const texel_job *j, int ci, uint32_t t, double px, doubl
     double b1 = d != 0.0 ? ((px - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (py - c[0].y)) / d : 1.0 / 3.0;
     double b2 = d != 0.0 ? ((c[1].x - c[0].x) * (py - c[0].y) - (px - c[0].x) * (c[1].y - c[0].y)) / d : 1.0 / 3.0;
     double w[3] = {fmax(1.0 - b1 - b2, 0.0), fmax(b1, 0.0), fmax(b2, 0.0)}, sum = w[0] + w[1] + w[2];
-    double p[3] = {0, 0, 0}, n[3] = {0, 0, 0};
+    double p[3] = {0, 0, 0}, n[3] = {0, 0, 0}, local[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++) {
         uint32_t v = j->s->tris[3 * (size_t)t + ord[k]];
+        out->bary[ord[k]] = (float)(w[k] / sum);
         for (int a = 0; a < 3; a++) {
             p[a] += w[k] / sum * j->pos[3 * (size_t)v + a];
             n[a] += w[k] / sum * j->nrm[3 * (size_t)v + a];
+            local[a] += w[k] / sum * j->s->positions[3 * (size_t)v + a];
         }
     }
     double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
@@ -150,6 +152,7 @@ static void texel_point(const texel_job *j, int ci, uint32_t t, double px, doubl
     }
     for (int a = 0; a < 3; a++) {
         out->pos[a] = (float)p[a];
+        out->local[a] = (float)local[a];
         out->normal[a] = (float)(n[a] / l);
     }
 }
