@@ -11,6 +11,7 @@
 
 #include <cmocka.h>
 
+#include "../src/charts/atlas_dilate.h"
 #include "../src/charts/charts.h"
 #include "../src/core/log.h"
 #include "../src/core/vecmath.h"
@@ -628,6 +629,35 @@ static void test_default_texel_size(void **state)
     ts_free(t);
 }
 
+/* Dilating chart ids into the gutters never mixes two charts: every texel a bilinear lookup inside
+ * a chart can touch (within one texel of its covered texels) ends up with exactly that chart's id. */
+static void check_dilation(const lm_atlas *a)
+{
+    size_t n = (size_t)a->width * a->height;
+    float *data = calloc(n, sizeof *data);
+    assert_non_null(data);
+    for (size_t i = 0; i < n; i++)
+        if (a->texel_index[i] >= 0)
+            data[i] = (float)(a->tri_chart[a->texels[a->texel_index[i]].tri] + 1);
+    lm_atlas_dilate(a, data, 1, a->gutter);
+    for (int y = 0; y < a->height; y++)
+        for (int x = 0; x < a->width; x++) {
+            int ti = a->texel_index[(size_t)y * a->width + x];
+            if (ti < 0)
+                continue;
+            float id = (float)(a->tri_chart[a->texels[ti].tri] + 1);
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++) {
+                    int xx = x + dx, yy = y + dy;
+                    if (xx >= 0 && yy >= 0 && xx < a->width && yy < a->height &&
+                        data[(size_t)yy * a->width + xx] != id)
+                        fail_msg("texel (%d,%d) next to chart %g holds %g", xx, yy, (double)id,
+                                 (double)data[(size_t)yy * a->width + xx]);
+                }
+        }
+    free(data);
+}
+
 /* ---------- shared scenes ---------- */
 
 static void shared_scene(const char *rel, int expect_surfaces, int uv1)
@@ -647,6 +677,7 @@ static void shared_scene(const char *rel, int expect_surfaces, int uv1)
                   a.chart_count, a.width, a.height, (double)a.utilization);
     if (expect_surfaces >= 0)
         assert_int_equal(n, expect_surfaces);
+    check_dilation(&a);
     lm_atlas_free(&a);
     if (uv1) {
         lm_atlas_options o;

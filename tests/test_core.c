@@ -11,6 +11,7 @@
 
 #include "../src/core/image.h"
 #include "../src/core/palette.h"
+#include "../src/core/tonemap.h"
 #include "../src/core/vecmath.h"
 #include "support.h"
 
@@ -150,6 +151,24 @@ static void test_mkdir_p(void **state)
     assert_int_equal(lm_mkdir_p("/proc/lmgi-cannot-be-here", &err), LM_ERR_IO);
 }
 
+static void test_tonemap(void **state)
+{
+    (void)state;
+    /* 100 grey values 1..99 and a hot 1000: the 99th percentile (99) maps to 0.9; 1000 clips to 1. */
+    float rgb[100 * 3];
+    for (int i = 0; i < 100; i++)
+        rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = i < 99 ? (float)(i + 1) : 1000.0f;
+    float k = lm_auto_exposure(rgb, 100, 3);
+    assert_float_equal(k, 0.9f / 99.0f, 1e-6);
+    uint8_t out[100 * 4];
+    lm_tonemap_srgb8(rgb, 100, 3, k, out);
+    assert_int_equal(out[4 * 99], 255);
+    assert_int_equal(out[4 * 98], (int)(255.0f * lm_linear_to_srgb(0.9f) + 0.5f));
+    assert_int_equal(out[3], 255);
+    float zero[3] = {0, 0, 0};
+    assert_float_equal(lm_auto_exposure(zero, 1, 3), 1.0f, 0.0); /* nothing lit: no scaling */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -162,6 +181,7 @@ int main(void)
         cmocka_unit_test(test_png_round_trip),
         cmocka_unit_test(test_palette_distinct),
         cmocka_unit_test(test_mkdir_p),
+        cmocka_unit_test(test_tonemap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -9,6 +9,7 @@
 #include "../core/palette.h"
 #include "../core/vecmath.h"
 #include "gl_shader.h"
+#include "offscreen.h"
 
 static const char *VS =
     "#version 450 core\n"
@@ -54,20 +55,7 @@ lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const 
         glDeleteProgram(prog);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the surface view", s->path);
     }
-
-    GLuint fbo, rb[2], vao, vbo;
-    glGenFramebuffers(1, &fbo);
-    glGenRenderbuffers(2, rb);
-    glBindRenderbuffer(GL_RENDERBUFFER, rb[0]);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
-    glBindRenderbuffer(GL_RENDERBUFFER, rb[1]);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, rb[0]);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, rb[1]);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        st = lm_fail(err, LM_ERR_BACKEND, "surface view: framebuffer %dx%d incomplete", width, height);
-
+    GLuint vao, vbo;
     glGenVertexArrays(1, &vao);
     glBindVertexArray(vao);
     glGenBuffers(1, &vbo);
@@ -79,35 +67,18 @@ lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const 
     glEnableVertexAttribArray(1);
     free(verts);
 
+    lm_offscreen target;
+    st = lm_offscreen_begin(&target, width, height, err);
     if (st == LM_OK) {
         float vp[16];
         lm_mat4_mul(vp, view->proj, view->view);
-        glViewport(0, 0, width, height);
-        glEnable(GL_DEPTH_TEST);
-        glDisable(GL_CULL_FACE); /* lightmapped geometry is seen from both sides */
-        glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
         glUseProgram(prog);
         glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
         glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * s->tri_count));
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glReadPixels(0, 0, width, height, GL_RGBA, GL_UNSIGNED_BYTE, rgba8);
-        st = lm_gl_check("surface view", err);
+        st = lm_offscreen_end(&target, rgba8, err);
     }
-    /* GL's rows start at the bottom; images start at the top. */
-    uint8_t *tmp = malloc((size_t)width * 4);
-    for (int y = 0; tmp && y < height / 2; y++) {
-        uint8_t *a = rgba8 + (size_t)y * width * 4, *b = rgba8 + (size_t)(height - 1 - y) * width * 4;
-        memcpy(tmp, a, (size_t)width * 4);
-        memcpy(a, b, (size_t)width * 4);
-        memcpy(b, tmp, (size_t)width * 4);
-    }
-    free(tmp);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteBuffers(1, &vbo);
     glDeleteVertexArrays(1, &vao);
-    glDeleteRenderbuffers(2, rb);
-    glDeleteFramebuffers(1, &fbo);
     glDeleteProgram(prog);
     return st;
 }

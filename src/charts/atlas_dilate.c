@@ -1,0 +1,46 @@
+#include "atlas_dilate.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
+{
+    int w = a->width, h = a->height;
+    size_t n = (size_t)w * h;
+    unsigned char *filled = malloc(n), *next = malloc(n);
+    if (!filled || !next) {
+        free(filled);
+        free(next);
+        return;
+    }
+    for (size_t i = 0; i < n; i++)
+        filled[i] = a->texel_index[i] >= 0;
+    for (int pass = 0; pass < passes; pass++) {
+        memcpy(next, filled, n);
+        for (int y = 0; y < h; y++)
+            for (int x = 0; x < w; x++) {
+                size_t i = (size_t)y * w + x;
+                if (filled[i])
+                    continue;
+                float sum[4] = {0, 0, 0, 0};
+                int count = 0;
+                for (int dy = -1; dy <= 1; dy++)
+                    for (int dx = -1; dx <= 1; dx++) {
+                        int xx = x + dx, yy = y + dy;
+                        if (xx < 0 || yy < 0 || xx >= w || yy >= h || !filled[(size_t)yy * w + xx])
+                            continue;
+                        for (int c = 0; c < channels && c < 4; c++)
+                            sum[c] += data[((size_t)yy * w + xx) * channels + c];
+                        count++;
+                    }
+                if (!count)
+                    continue;
+                for (int c = 0; c < channels && c < 4; c++)
+                    data[i * channels + c] = sum[c] / (float)count;
+                next[i] = 1;
+            }
+        memcpy(filled, next, n);
+    }
+    free(filled);
+    free(next);
+}

@@ -1,0 +1,66 @@
+#include "offscreen.h"
+
+#define GL_GLEXT_PROTOTYPES 1
+#include <GL/gl.h>
+#include <GL/glext.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gl_shader.h"
+
+static void release(lm_offscreen *o)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteRenderbuffers(1, &o->color);
+    glDeleteRenderbuffers(1, &o->depth);
+    glDeleteFramebuffers(1, &o->fbo);
+    memset(o, 0, sizeof *o);
+}
+
+lm_status lm_offscreen_begin(lm_offscreen *o, int width, int height, lm_error *err)
+{
+    memset(o, 0, sizeof *o);
+    o->width = width;
+    o->height = height;
+    glGenFramebuffers(1, &o->fbo);
+    glGenRenderbuffers(1, &o->color);
+    glGenRenderbuffers(1, &o->depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, o->color);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    glBindRenderbuffer(GL_RENDERBUFFER, o->depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glBindFramebuffer(GL_FRAMEBUFFER, o->fbo);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, o->color);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, o->depth);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        release(o);
+        return lm_fail(err, LM_ERR_BACKEND, "offscreen target %dx%d is incomplete", width, height);
+    }
+    glViewport(0, 0, width, height);
+    glEnable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE); /* lightmapped geometry is seen from both sides */
+    glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    return LM_OK;
+}
+
+lm_status lm_offscreen_end(lm_offscreen *o, uint8_t *rgba8, lm_error *err)
+{
+    int w = o->width, h = o->height;
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba8);
+    lm_status st = lm_gl_check("reading back the picture", err);
+    release(o);
+    /* GL's rows start at the bottom; images start at the top. */
+    uint8_t *tmp = malloc((size_t)w * 4);
+    if (!tmp)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory to flip a %dx%d picture", w, h);
+    for (int y = 0; y < h / 2; y++) {
+        uint8_t *a = rgba8 + (size_t)y * w * 4, *b = rgba8 + (size_t)(h - 1 - y) * w * 4;
+        memcpy(tmp, a, (size_t)w * 4);
+        memcpy(a, b, (size_t)w * 4);
+        memcpy(b, tmp, (size_t)w * 4);
+    }
+    free(tmp);
+    return st;
+}
