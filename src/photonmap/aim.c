@@ -1,0 +1,568 @@
+/* Approximated illumination maps: per-surface kd-trees, N-nearest radiance estimates and the
+ * delta_f / area refresh schedule (see aim.h; Larsen & Christensen, section 3). */
+#include "aim.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/timing.h"
+
+#define PI_D 3.14159265358979323846
+#define MIN_COVERAGE 0.0625 /* the disc's part on the surface is never taken below 1/16 of it */
+
+void lm_aim_settings_default(lm_aim_settings *o)
+{
+    o->n_nearest = 128;
+    o->min_radius_texels = 1.0f;
+    o->delta_threshold = 0.01f;
+    o->front_only = 1;
+    o->boundary_correction = 1;
+    o->kernel = 1;
+}
+
+/* ---------- init: per-surface texel lists and boundary edges ---------- */
+
+static lm_status build_texel_lists(lm_aim *aim, const lm_atlas *a, lm_error *err)
+{
+    int ns = aim->surface_count;
+    aim->texel_first = calloc((size_t)ns + 1, sizeof *aim->texel_first);
+    aim->texel_list = malloc(sizeof *aim->texel_list * (a->texel_count ? a->texel_count : 1));
+    if (!aim->texel_first || !aim->texel_list)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u texels", a->texel_count);
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        const lm_texel *t = &a->texels[i];
+        if (t->surface < 0 || t->surface >= ns || t->x < 0 || t->y < 0 || t->x >= a->width || t->y >= a->height)
+            return lm_fail(err, LM_ERR_INVALID, "AIM: texel %u (surface %d at %d,%d) is outside the atlas", i,
+                           t->surface, t->x, t->y);
+        aim->texel_first[t->surface + 1]++;
+    }
+    for (int s = 0; s < ns; s++)
+        aim->texel_first[s + 1] += aim->texel_first[s];
+    uint32_t *fill = malloc(sizeof *fill * ((size_t)ns + 1));
+    if (!fill)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %d surfaces", ns);
+    memcpy(fill, aim->texel_first, sizeof *fill * ((size_t)ns + 1));
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        aim->texel_list[fill[a->texels[i].surface]++] = i;
+    free(fill);
+    return LM_OK;
+}
+
+/* Edge k of triangle t (corners k, k+1) is on its surface's boundary when nothing of the same surface
+ * lies across it. */
+static int is_boundary(const lm_surfaces *su, uint32_t t, int k, int surface)
+{
+    int32_t adj = su->tri_adj ? su->tri_adj[3 * (size_t)t + (size_t)k] : -1;
+    return adj < 0 || su->tri_surface[adj] != surface;
+}
+
+static lm_status build_edges(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, lm_error *err)
+{
+    int ns = aim->surface_count;
+    aim->edge_first = calloc((size_t)ns + 1, sizeof *aim->edge_first);
+    if (!aim->edge_first)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %d surfaces", ns);
+    for (int pass = 0; pass < 2; pass++) { /* count, then fill */
+        uint32_t e = 0;
+        for (int i = 0; i < ns; i++) {
+            const lm_surface *sf = &su->surfaces[i];
+            aim->edge_first[i] = e;
+            for (uint32_t j = 0; j < sf->tri_count; j++)
+                for (int k = 0; k < 3; k++) {
+                    if (!is_boundary(su, sf->tris[j], k, i))
+                        continue;
+                    if (pass) {
+                        aim->edges[2 * e] = s->tris[3 * (size_t)sf->tris[j] + (size_t)k];
+                        aim->edges[2 * e + 1] = s->tris[3 * (size_t)sf->tris[j] + (size_t)(k + 1) % 3];
+                    }
+                    e++;
+                }
+        }
+        aim->edge_first[ns] = e;
+        if (!pass && !(aim->edges = malloc(sizeof *aim->edges * 2 * (e ? e : 1))))
+            return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u boundary edges", e);
+    }
+    return LM_OK;
+}
+
+static lm_status check_settings(const lm_aim_settings *o, lm_error *err)
+{
+    if (o->n_nearest < 1 || !(o->min_radius_texels > 0.0f) || !isfinite(o->min_radius_texels) ||
+        !(o->delta_threshold >= 0.0f) || !isfinite(o->delta_threshold))
+        return lm_fail(err, LM_ERR_INVALID,
+                       "AIM settings: n_nearest %d (>= 1), min_radius_texels %g (> 0), delta_threshold %g (>= 0)",
+                       o->n_nearest, (double)o->min_radius_texels, (double)o->delta_threshold);
+    return LM_OK;
+}
+
+lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                      const lm_aim_settings *set, lm_error *err)
+{
+    memset(aim, 0, sizeof *aim);
+    if (set)
+        aim->set = *set;
+    else
+        lm_aim_settings_default(&aim->set);
+    lm_status st = check_settings(&aim->set, err);
+    if (st != LM_OK)
+        return st;
+    if (a->width <= 0 || a->height <= 0 || su->surface_count < 0 || a->surface_count != su->surface_count)
+        return lm_fail(err, LM_ERR_INVALID, "AIM: atlas %dx%d with %d surfaces, scene has %d surfaces", a->width,
+                       a->height, a->surface_count, su->surface_count);
+    aim->width = a->width;
+    aim->height = a->height;
+    aim->surface_count = su->surface_count;
+    aim->rgb = calloc((size_t)a->width * (size_t)a->height * 3, sizeof *aim->rgb);
+    aim->refresh_count = calloc((size_t)su->surface_count + 1, sizeof *aim->refresh_count);
+    if (!aim->rgb || !aim->refresh_count)
+        st = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for a %dx%d map", a->width, a->height);
+    if (st == LM_OK)
+        st = build_texel_lists(aim, a, err);
+    if (st == LM_OK)
+        st = build_edges(aim, s, su, err);
+    if (st != LM_OK)
+        lm_aim_free(aim);
+    return st;
+}
+
+void lm_aim_free(lm_aim *aim)
+{
+    free(aim->rgb);
+    free(aim->texel_first);
+    free(aim->texel_list);
+    free(aim->edge_first);
+    free(aim->edges);
+    free(aim->refresh_count);
+    memset(aim, 0, sizeof *aim);
+}
+
+const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
+
+/* ---------- the node's transform ---------- */
+
+typedef struct {
+    double m[3][3];   /* linear part of the node's world matrix, m[row][col] */
+    double inv[3][3]; /* its inverse */
+    double det;
+} linear_map;
+
+static void linear_map_of(const float w[16], linear_map *L)
+{
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            L->m[r][c] = w[c * 4 + r];
+    double(*m)[3] = L->m;
+    double cof[3][3];
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            cof[r][c] = m[(r + 1) % 3][(c + 1) % 3] * m[(r + 2) % 3][(c + 2) % 3] -
+                        m[(r + 1) % 3][(c + 2) % 3] * m[(r + 2) % 3][(c + 1) % 3];
+    L->det = m[0][0] * cof[0][0] + m[0][1] * cof[0][1] + m[0][2] * cof[0][2];
+    double id = L->det != 0.0 ? 1.0 / L->det : 0.0;
+    for (int r = 0; r < 3; r++)
+        for (int c = 0; c < 3; c++)
+            L->inv[r][c] = cof[c][r] * id;
+}
+
+/* World area per local area for a patch with local unit normal n (Nanson: |det M| |M^-T n|). */
+static double area_factor(const linear_map *L, const double n[3])
+{
+    double s2 = 0.0;
+    for (int c = 0; c < 3; c++) {
+        double v = L->inv[0][c] * n[0] + L->inv[1][c] * n[1] + L->inv[2][c] * n[2];
+        s2 += v * v;
+    }
+    double f = fabs(L->det) * sqrt(s2);
+    return f > 0.0 && isfinite(f) ? f : 1.0;
+}
+
+/* Unit face normal of triangle t in its node's local space (winding order: the front side). */
+static void local_face_normal(const lm_scene *s, uint32_t t, double n[3])
+{
+    const float *p[3];
+    for (int k = 0; k < 3; k++)
+        p[k] = s->positions + 3 * (size_t)s->tris[3 * (size_t)t + (size_t)k];
+    double e1[3], e2[3];
+    for (int a = 0; a < 3; a++) {
+        e1[a] = (double)p[1][a] - p[0][a];
+        e2[a] = (double)p[2][a] - p[0][a];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (int a = 0; a < 3; a++)
+        n[a] = l > 0.0 ? n[a] / l : (a == 2);
+}
+
+/* ---------- gathering a surface's hits ---------- */
+
+typedef struct {
+    float *pos;  /* local positions, 3 per hit */
+    float *flux; /* RGB, 3 per hit */
+    uint32_t count;
+} hit_set;
+
+/* A photon travelling along world direction d reaches the front of a triangle whose local normal is n
+ * when d . n_world < 0, with n_world = det(M) M^-T n (the cofactor map), i.e. det(M) (M^-1 d) . n < 0. */
+static int arrives_front(const linear_map *L, const lm_scene *s, const lm_hit *h)
+{
+    if (h->tri >= s->tri_count)
+        return 1;
+    double n[3], d = 0.0;
+    local_face_normal(s, h->tri, n);
+    for (int r = 0; r < 3; r++)
+        d += (L->inv[r][0] * h->dir[0] + L->inv[r][1] * h->dir[1] + L->inv[r][2] * h->dir[2]) * n[r];
+    return L->det * d < 0.0;
+}
+
+static lm_status gather_hits(const lm_photon_store *ps, int surface, const lm_scene *s, const linear_map *L,
+                             int front_only, hit_set *out, lm_error *err)
+{
+    uint32_t n = ps->surfaces[surface].count;
+    out->count = 0;
+    out->pos = malloc(sizeof *out->pos * 3 * (n ? n : 1));
+    out->flux = malloc(sizeof *out->flux * 3 * (n ? n : 1));
+    if (!out->pos || !out->flux)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u hits of surface %d", n, surface);
+    for (uint32_t h = ps->surfaces[surface].head; h != LM_NONE && out->count < n; h = ps->hits[h].next) {
+        const lm_hit *hit = &ps->hits[h];
+        if (front_only && !arrives_front(L, s, hit))
+            continue;
+        memcpy(out->pos + 3 * out->count, hit->local, sizeof hit->local);
+        memcpy(out->flux + 3 * out->count, hit->flux, sizeof hit->flux);
+        out->count++;
+    }
+    return LM_OK;
+}
+
+/* ---------- the area the gathered hits span ---------- */
+
+/* Areas below are weighted by the estimate's kernel w(d) over the disc of radius r: box (w = 1, the
+ * paper's sum / (pi r^2)) or Epanechnikov (w = 1 - d^2 / r^2, whose integral over the disc is pi r^2 / 2).
+ * In polar form a sector of angle theta weighs theta r^2 / 2 (box) or theta r^2 / 4 (Epanechnikov). */
+static double sector(const double a[2], const double b[2], double r2, int kernel)
+{
+    return (kernel ? 0.25 : 0.5) * r2 * atan2(a[0] * b[1] - a[1] * b[0], a[0] * b[0] + a[1] * b[1]);
+}
+
+/* Weighted signed area of triangle (0, a, b) lying inside the disc: A, or with the kernel
+ * A - (1 / r^2) * integral |x|^2 dA = A (1 - (|a|^2 + |b|^2 + a.b) / (6 r^2)). */
+static double inner_triangle(const double a[2], const double b[2], double r2, int kernel)
+{
+    double A = 0.5 * (a[0] * b[1] - a[1] * b[0]);
+    if (!kernel)
+        return A;
+    double m = a[0] * a[0] + a[1] * a[1] + b[0] * b[0] + b[1] * b[1] + a[0] * b[0] + a[1] * b[1];
+    return A * (1.0 - m / (6.0 * r2));
+}
+
+/* weighted area(disc(0, r) & triangle(0, a, b)) - sector(a, b): what edge a->b changes in the disc's
+ * weighted area (summed over a closed boundary around 0, the sectors alone give the full disc). 0 when
+ * the edge misses the disc. */
+static double edge_correction(const double a[2], const double b[2], double r2, int kernel)
+{
+    double d[2] = {b[0] - a[0], b[1] - a[1]};
+    double A = d[0] * d[0] + d[1] * d[1], B = a[0] * d[0] + a[1] * d[1], C = a[0] * a[0] + a[1] * a[1] - r2;
+    double disc = B * B - A * C;
+    if (!(A > 0.0) || disc <= 0.0)
+        return 0.0;
+    double sq = sqrt(disc), t1 = (-B - sq) / A, t2 = (-B + sq) / A;
+    if (t2 <= 0.0 || t1 >= 1.0)
+        return 0.0;
+    t1 = t1 > 0.0 ? t1 : 0.0;
+    t2 = t2 < 1.0 ? t2 : 1.0;
+    double p1[2] = {a[0] + t1 * d[0], a[1] + t1 * d[1]}, p2[2] = {a[0] + t2 * d[0], a[1] + t2 * d[1]};
+    double inside = inner_triangle(p1, p2, r2, kernel);
+    if (t1 > 0.0)
+        inside += sector(a, p1, r2, kernel);
+    if (t2 < 1.0)
+        inside += sector(p2, b, r2, kernel);
+    return inside - sector(a, b, r2, kernel);
+}
+
+typedef struct {
+    const float *pos;     /* scene positions (local) */
+    const uint32_t *edges;
+    uint32_t first, end;  /* this surface's edges */
+} boundary;
+
+/* Local-space (kernel-weighted) area of the disc of radius^2 r2 around q, in the tangent plane of normal
+ * n, that lies on the surface: the full disc's plus the corrections of the boundary edges crossing it. */
+static double disc_area_on_surface(const boundary *bd, const float q[3], const double n[3], double r2, int kernel)
+{
+    double t1[3], t2[3], h[3] = {fabs(n[0]) < 0.9 ? 1.0 : 0.0, fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    t1[0] = h[1] * n[2] - h[2] * n[1];
+    t1[1] = h[2] * n[0] - h[0] * n[2];
+    t1[2] = h[0] * n[1] - h[1] * n[0];
+    double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
+    for (int a = 0; a < 3; a++)
+        t1[a] /= l;
+    t2[0] = n[1] * t1[2] - n[2] * t1[1]; /* t1 x t2 = n: counter-clockwise seen from the front */
+    t2[1] = n[2] * t1[0] - n[0] * t1[2];
+    t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    double full = (kernel ? 0.5 : 1.0) * PI_D * r2, area = full;
+    for (uint32_t e = bd->first; e < bd->end; e++) {
+        double p[2][2];
+        for (int k = 0; k < 2; k++) {
+            const float *v = bd->pos + 3 * (size_t)bd->edges[2 * e + (uint32_t)k];
+            double rel[3] = {(double)v[0] - q[0], (double)v[1] - q[1], (double)v[2] - q[2]};
+            p[k][0] = rel[0] * t1[0] + rel[1] * t1[1] + rel[2] * t1[2];
+            p[k][1] = rel[0] * t2[0] + rel[1] * t2[1] + rel[2] * t2[2];
+        }
+        area += edge_correction(p[0], p[1], r2, kernel);
+    }
+    return fmin(fmax(area, MIN_COVERAGE * full), full);
+}
+
+/* ---------- per-texel estimate ---------- */
+
+typedef struct {
+    const lm_scene *s;
+    const lm_atlas *a;
+    const lm_kdtree *tree;
+    const hit_set *hits;
+    const linear_map *L;
+    boundary bd;
+    uint32_t n;           /* N, clamped to the hit count */
+    double rmin2_world;   /* squared smallest radius, world units */
+    int boundary_correction, kernel;
+} estimate_job;
+
+typedef struct {
+    const float *flux;
+    double inv_r2;  /* 1 / r^2 with the Epanechnikov kernel, 0 for the box */
+    double sum[3];
+} flux_sum;
+
+/* Adds w(d) Phi_i. */
+static void add_flux(void *ctx, uint32_t index, float d2)
+{
+    flux_sum *f = ctx;
+    double w = 1.0 - d2 * f->inv_r2;
+    w = w > 0.0 ? w : 0.0;
+    for (int c = 0; c < 3; c++)
+        f->sum[c] += w * f->flux[3 * (size_t)index + (size_t)c];
+}
+
+static void texel_albedo(const lm_scene *s, const lm_texel *t, float rho[3])
+{
+    const lm_material *m = &s->materials[s->tri_material[t->tri]];
+    const float *uv = (m->base_color_uv == 1 && s->uv1) ? s->uv1 : s->uv0;
+    float u = 0.0f, v = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        uint32_t vi = s->tris[3 * (size_t)t->tri + (size_t)k];
+        u += t->bary[k] * uv[2 * (size_t)vi];
+        v += t->bary[k] * uv[2 * (size_t)vi + 1];
+    }
+    lm_material_albedo(s, m, u, v, rho);
+}
+
+/* L = rho / pi * sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
+ * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. */
+static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t *idx, float *d2, float out[3])
+{
+    out[0] = out[1] = out[2] = 0.0f;
+    float r2 = 0.0f;
+    uint32_t k = lm_kdtree_nearest(j->tree, t->local, j->n, idx, d2, &r2);
+    if (k == 0)
+        return;
+    double n[3];
+    local_face_normal(j->s, t->tri, n);
+    double factor = area_factor(j->L, n), rmin2 = j->rmin2_world / factor;
+    int widened = (double)r2 < rmin2;
+    if (widened)
+        r2 = (float)rmin2;
+    flux_sum f = {j->hits->flux, j->kernel ? 1.0 / r2 : 0.0, {0.0, 0.0, 0.0}};
+    if (widened)
+        lm_kdtree_radius(j->tree, t->local, r2, add_flux, &f);
+    else
+        for (uint32_t i = 0; i < k; i++)
+            add_flux(&f, idx[i], d2[i]);
+    double area = j->boundary_correction ? disc_area_on_surface(&j->bd, t->local, n, r2, j->kernel)
+                                         : (j->kernel ? 0.5 : 1.0) * PI_D * r2;
+    float rho[3];
+    texel_albedo(j->s, t, rho);
+    for (int c = 0; c < 3; c++)
+        out[c] = (float)(rho[c] / PI_D * f.sum[c] / (area * factor));
+}
+
+static void write_texels(lm_aim *aim, const estimate_job *j, uint32_t first, uint32_t end, int *nomem)
+{
+#pragma omp parallel
+    {
+        uint32_t *idx = malloc(sizeof *idx * j->n);
+        float *d2 = malloc(sizeof *d2 * j->n);
+        if (!idx || !d2) {
+#pragma omp atomic write
+            *nomem = 1;
+        }
+#pragma omp for schedule(dynamic, 64)
+        for (int64_t i = first; i < (int64_t)end; i++) {
+            const lm_texel *t = &j->a->texels[aim->texel_list[i]];
+            float *px = aim->rgb + 3 * ((size_t)t->y * (size_t)aim->width + (size_t)t->x);
+            if (idx && d2)
+                estimate_texel(j, t, idx, d2, px);
+        }
+        free(idx);
+        free(d2);
+    }
+}
+
+static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_t end)
+{
+    for (uint32_t i = first; i < end; i++) {
+        const lm_texel *t = &a->texels[aim->texel_list[i]];
+        memset(aim->rgb + 3 * ((size_t)t->y * (size_t)aim->width + (size_t)t->x), 0, 3 * sizeof(float));
+    }
+}
+
+/* ---------- refreshing ---------- */
+
+static lm_status compute_surface(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                 const lm_photon_store *ps, int surface, lm_aim_stats *st, lm_error *err)
+{
+    const lm_surface *sf = &su->surfaces[surface];
+    const lm_material *m = &s->materials[sf->material];
+    linear_map L;
+    linear_map_of(s->nodes[sf->node].world, &L);
+    hit_set hits = {NULL, NULL, 0};
+    lm_kdtree tree;
+    lm_kdtree_init(&tree);
+    uint32_t first = aim->texel_first[surface], end = aim->texel_first[surface + 1];
+    lm_status rc = gather_hits(ps, surface, s, &L, aim->set.front_only && !m->double_sided && L.det != 0.0, &hits,
+                               err);
+    if (rc == LM_OK)
+        rc = lm_kdtree_build(&tree, hits.pos, 3, hits.count, err);
+    if (rc == LM_OK && hits.count == 0)
+        clear_texels(aim, a, first, end);
+    if (rc == LM_OK && hits.count > 0) {
+        uint32_t n = (uint32_t)aim->set.n_nearest < hits.count ? (uint32_t)aim->set.n_nearest : hits.count;
+        double rmin = (double)aim->set.min_radius_texels * a->texel_size;
+        estimate_job j = {s, a, &tree, &hits, &L, {s->positions, aim->edges, aim->edge_first[surface],
+                          aim->edge_first[surface + 1]}, n, rmin * rmin, aim->set.boundary_correction,
+                          aim->set.kernel};
+        int nomem = 0;
+        write_texels(aim, &j, first, end, &nomem);
+        if (nomem)
+            rc = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for N = %u lookups", n);
+    }
+    if (rc == LM_OK && st) {
+        st->surfaces_refreshed++;
+        st->texels_written += end - first;
+        st->hits_used += hits.count;
+    }
+    lm_kdtree_free(&tree);
+    free(hits.pos);
+    free(hits.flux);
+    return rc;
+}
+
+static lm_status check_inputs(const lm_aim *aim, const lm_surfaces *su, const lm_atlas *a,
+                              const lm_photon_store *ps, lm_error *err)
+{
+    if (ps->surface_count != aim->surface_count || su->surface_count != aim->surface_count ||
+        a->width != aim->width || a->height != aim->height)
+        return lm_fail(err, LM_ERR_INVALID,
+                       "AIM: built for %d surfaces and a %dx%d atlas, given %d/%d surfaces and %dx%d", aim->surface_count,
+                       aim->width, aim->height, ps->surface_count, su->surface_count, a->width, a->height);
+    return check_settings(&aim->set, err);
+}
+
+lm_status lm_aim_refresh_surface(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                 lm_photon_store *ps, int surface, lm_aim_stats *stats, lm_error *err)
+{
+    lm_status rc = check_inputs(aim, su, a, ps, err);
+    if (rc != LM_OK)
+        return rc;
+    if (surface < 0 || surface >= aim->surface_count)
+        return lm_fail(err, LM_ERR_INVALID, "AIM: surface %d out of range (0..%d)", surface, aim->surface_count - 1);
+    rc = compute_surface(aim, s, su, a, ps, surface, stats, err);
+    if (rc == LM_OK) {
+        lm_photon_store_reset_delta_f(ps, surface);
+        aim->refresh_count[surface]++;
+    }
+    return rc;
+}
+
+/* Mean luminance of the stored hits (0 when there are none): the unit of the refresh threshold. */
+static double mean_hit_energy(const lm_photon_store *ps)
+{
+    double sum = 0.0;
+    uint64_t n = 0;
+    for (int i = 0; i < ps->surface_count; i++)
+        n += ps->surfaces[i].count;
+    if (n == 0)
+        return 0.0;
+    for (uint32_t h = 0; h < ps->used; h++)
+        if (ps->hits[h].surface >= 0)
+            sum += lm_hit_energy(&ps->hits[h]);
+    return sum / (double)n;
+}
+
+typedef struct {
+    double key; /* delta_f / area */
+    int surface;
+} candidate;
+
+static int by_priority(const void *pa, const void *pb)
+{
+    const candidate *a = pa, *b = pb;
+    if (a->key != b->key)
+        return a->key < b->key ? 1 : -1;
+    return (a->surface > b->surface) - (a->surface < b->surface);
+}
+
+static lm_status run_schedule(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                              lm_photon_store *ps, int budget, int everything, lm_aim_stats *st, lm_error *err)
+{
+    double mean = mean_hit_energy(ps), threshold = everything ? -1.0 : aim->set.delta_threshold * mean;
+    aim->mean_hit_energy = (float)mean;
+    candidate *c = malloc(sizeof *c * (size_t)(aim->surface_count ? aim->surface_count : 1));
+    if (!c)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory to schedule %d surfaces", aim->surface_count);
+    int count = 0;
+    for (int i = 0; i < aim->surface_count; i++) {
+        double df = ps->surfaces[i].delta_f;
+        if (everything || (df > threshold && df > 0.0))
+            c[count++] = (candidate){df / fmax((double)su->surfaces[i].area, 1e-12), i};
+    }
+    qsort(c, (size_t)count, sizeof *c, by_priority);
+    int todo = budget < 0 || budget > count ? count : budget;
+    lm_status rc = LM_OK;
+    for (int i = 0; i < todo && rc == LM_OK; i++)
+        rc = lm_aim_refresh_surface(aim, s, su, a, ps, c[i].surface, st, err);
+    st->surfaces_pending = count - todo;
+    free(c);
+    return rc;
+}
+
+lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                         lm_photon_store *ps, int budget, lm_aim_stats *stats, lm_error *err)
+{
+    lm_aim_stats local;
+    lm_aim_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    double t0 = lm_now();
+    lm_status rc = check_inputs(aim, su, a, ps, err);
+    if (rc == LM_OK)
+        rc = run_schedule(aim, s, su, a, ps, budget, 0, st, err);
+    st->seconds = lm_now() - t0;
+    return rc;
+}
+
+lm_status lm_aim_refresh_all(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                             lm_photon_store *ps, lm_aim_stats *stats, lm_error *err)
+{
+    lm_aim_stats local;
+    lm_aim_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    double t0 = lm_now();
+    lm_status rc = check_inputs(aim, su, a, ps, err);
+    if (rc == LM_OK)
+        rc = run_schedule(aim, s, su, a, ps, -1, 1, st, err);
+    st->seconds = lm_now() - t0;
+    return rc;
+}

@@ -1,0 +1,91 @@
+/* Approximated illumination maps (AIMs), Larsen & Christensen section 3.
+ *
+ * An AIM is a float RGB map over the lightmap atlas holding, per covered texel, the outgoing diffuse
+ * radiance reconstructed from the photon hits stored on the texel's surface:
+ *
+ *     L = rho / pi * sum(Phi_i) / A          (the paper's "total energy of these photons divided by the
+ *                                             area that they span"; A = pi r^2 away from the surface's
+ *                                             boundary)
+ *
+ * over the N hits nearest to the texel (r = distance to the N-th), found in a balanced kd-tree built on
+ * the surface's hits only ("a structure belonging to the surface that was hit"). Distances are taken in
+ * the node's local space (hits and texels both carry node-local positions, so a moved dynamic node
+ * lines up), and A is converted to world area with the node's current transform. rho is the material's
+ * albedo at the texel's uv. Emission is not included: the gather adds emitters at their own radiance.
+ *
+ * Hard cases: fewer hits than N use them all; r is clamped to at least min_radius_texels texels, and
+ * when the N nearest lie inside that radius every hit within it is counted instead (so coincident hits
+ * give a bounded, consistent value); a surface with no hits gets 0; where the disc of radius r crosses
+ * the surface's boundary, A is the part of the disc on the surface (computed exactly against the
+ * surface's boundary edges, in the texel's tangent plane), so edge and corner texels are not darkened.
+ * Gutters and uncovered texels stay 0.
+ *
+ * Scheduling (section 3): a surface's AIM is refreshed only when its delta_f (energy of hits added or
+ * removed since its last refresh, kept by the photon store) exceeds a threshold; surfaces are taken in
+ * order of delta_f / area, largest first, at most `budget` per call, and a refreshed surface's delta_f
+ * is reset. Texels of a surface are computed in parallel (OpenMP); each texel's value depends only on
+ * the store's contents, so results are identical for any thread count. */
+#ifndef LM_AIM_H
+#define LM_AIM_H
+
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../scene/scene.h"
+#include "../trace/photon_store.h"
+#include "kdtree.h"
+
+typedef struct {
+    int n_nearest;           /* N hits per estimate (default 128; clamped to the surface's hit count) */
+    float min_radius_texels; /* smallest gather radius, in texels of the atlas (default 1) */
+    float delta_threshold;   /* refresh when delta_f > this x the mean stored hit energy (default 0.01) */
+    int front_only;          /* single-sided materials count only hits arriving from the front (default 1) */
+    int boundary_correction; /* use the disc's area on the surface near its boundary (default 1) */
+    int kernel;              /* 0: box, the paper's sum(Phi) / (pi r^2); 1: Epanechnikov weights
+                                w = 1 - d^2 / r^2, sum(w Phi) / (pi r^2 / 2): same mean, far less noise
+                                (default 1) */
+} lm_aim_settings;
+
+typedef struct {
+    int surfaces_refreshed;
+    int surfaces_pending;    /* over the threshold but left for a later call (budget) */
+    uint32_t texels_written;
+    uint64_t hits_used;      /* hits put in kd-trees */
+    double seconds;
+} lm_aim_stats;
+
+typedef struct {
+    lm_aim_settings set;
+    int width, height, surface_count;
+    float *rgb;              /* width * height * 3, radiance; 0 in gutters, uncovered texels, unlit surfaces */
+    uint32_t *texel_first;   /* per surface (surface_count + 1 offsets) into texel_list */
+    uint32_t *texel_list;    /* atlas texel indices grouped by surface */
+    uint32_t *edge_first;    /* per surface (surface_count + 1 offsets) into edges */
+    uint32_t *edges;         /* boundary edges, 2 scene vertex ids each, oriented with the surface on the left */
+    uint32_t *refresh_count; /* per surface: how many times it was refreshed */
+    float mean_hit_energy;   /* as of the last refresh call */
+} lm_aim;
+
+void lm_aim_settings_default(lm_aim_settings *o);
+/* Sets up per-surface texel and boundary lists for the atlas; the map starts at 0. s, su and a must be
+ * the ones the photon store's surfaces refer to; they are read again by the refresh calls. */
+lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                      const lm_aim_settings *set, lm_error *err);
+void lm_aim_free(lm_aim *aim);
+
+/* Refreshes up to `budget` surfaces (budget < 0: no limit) whose delta_f is over the threshold, in
+ * order of delta_f / area (ties: lower surface id first), and resets their delta_f. stats may be NULL. */
+lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                         lm_photon_store *ps, int budget, lm_aim_stats *stats, lm_error *err);
+/* Refreshes every surface (initialisation, or after a settings change) and resets every delta_f. */
+lm_status lm_aim_refresh_all(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                             lm_photon_store *ps, lm_aim_stats *stats, lm_error *err);
+/* Recomputes one surface's texels from its current hits and resets its delta_f. */
+lm_status lm_aim_refresh_surface(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                 lm_photon_store *ps, int surface, lm_aim_stats *stats, lm_error *err);
+
+/* The RGB float map (width * height * 3, row y at offset 3 * (y * width + x)). */
+const float *lm_aim_rgb(const lm_aim *aim);
+
+#endif

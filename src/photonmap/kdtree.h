@@ -1,0 +1,66 @@
+/* A balanced 3-d kd-tree over points, for the per-surface photon maps of Larsen & Christensen
+ * (section 3: "Kd-trees are fast for N-nearest neighbor queries").
+ *
+ * Layout: one array, no pointers. The subtree over the range [lo, hi) keeps its median (on the axis of
+ * the range's largest extent) at mid = (lo + hi) / 2, the points below it in [lo, mid) and the points
+ * above it in (mid, hi). Ranges of at most LM_KDTREE_LEAF points are left unsplit and scanned. Building
+ * selects medians in place (three-way quickselect, linear in the range even when all keys are equal),
+ * so it is O(n log n) and allocates only the node array (reused by later builds).
+ *
+ * Queries are read-only and may run from several threads at once. Results are deterministic: the same
+ * points in the same order give the same tree and the same answers. */
+#ifndef LM_KDTREE_H
+#define LM_KDTREE_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "../core/error.h"
+
+#define LM_KDTREE_LEAF 8u         /* ranges this small are scanned, not split */
+#define LM_KDTREE_MAX_POINTS (1u << 30)
+
+typedef struct {
+    float p[3];
+    uint32_t meta;                /* (caller's index << 2) | split axis (3 = leaf range, no split) */
+} lm_kd_node;
+
+typedef struct {
+    lm_kd_node *nodes;
+    uint32_t count, capacity;
+} lm_kdtree;
+
+void lm_kdtree_init(lm_kdtree *t);
+void lm_kdtree_free(lm_kdtree *t);
+/* Builds the tree over count points (xyz, `stride` floats apart, stride >= 3); index i of the answers is
+ * the i-th input point. count may be 0. Non-finite coordinates are an error (LM_ERR_INVALID), as is
+ * count > LM_KDTREE_MAX_POINTS. */
+lm_status lm_kdtree_build(lm_kdtree *t, const float *points, size_t stride, uint32_t count, lm_error *err);
+
+/* The n nearest points to q (Euclidean). Writes min(n, count) indices and their squared distances to
+ * out_index / out_d2 (caller's arrays of n entries; they are used as a max-heap, so the order is not
+ * sorted) and returns how many. *r2 (if non-NULL) receives the squared distance of the farthest one
+ * returned (0 if none). Among points tied at the n-th distance, which ones are returned is unspecified
+ * but deterministic. */
+uint32_t lm_kdtree_nearest(const lm_kdtree *t, const float q[3], uint32_t n, uint32_t *out_index, float *out_d2,
+                           float *r2);
+
+/* Calls visit(ctx, index, d2) for every point with squared distance d2 <= r2 from q, in a deterministic
+ * order; returns how many. */
+typedef void (*lm_kdtree_visit)(void *ctx, uint32_t index, float d2);
+uint32_t lm_kdtree_radius(const lm_kdtree *t, const float q[3], float r2, lm_kdtree_visit visit, void *ctx);
+
+/* Build and 100-nearest query times at 300, 500, 1000 and 2000 uniform random points (fixed seed,
+ * medians of several runs), next to Larsen & Christensen's Table 1 (2004). */
+typedef struct {
+    uint32_t points;
+    double build_ms, query_ms;           /* ours: one build, one 100-nearest query */
+    double paper_build_ms, paper_query_ms;
+} lm_kdtree_bench_row;
+
+#define LM_KDTREE_BENCH_ROWS 4
+void lm_kdtree_bench_run(lm_kdtree_bench_row rows[LM_KDTREE_BENCH_ROWS]);
+/* Runs the benchmark and prints it as a table with the speed-up over the paper. */
+void lm_kdtree_bench(FILE *out);
+
+#endif

@@ -1,0 +1,540 @@
+/* photonmap/aim: approximated illumination maps from hand-made photon stores on hand-made scenes:
+ * the analytic point-light plane, uniform light up to the plane's borders and corners, hard cases,
+ * the delta_f / area refresh schedule under a budget, and determinism. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <omp.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/charts/charts.h"
+#include "../src/photonmap/aim.h"
+#include "support.h"
+
+#define PI_F 3.14159265f
+
+typedef struct {
+    lm_scene *s;
+    lm_surfaces su;
+    lm_atlas a;
+} tscene;
+
+static void ts_load(tscene *t, const lmt_mesh *meshes, int count, const char *nodes, float texel_size)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/aim.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, meshes, count, nodes, NULL, 0, NULL), 0);
+    lm_error err;
+    lm_load_options lo = {0};
+    if (lm_scene_load_gltf(path, &lo, &t->s, &err) != LM_OK)
+        fail_msg("load: %s", err.msg);
+    for (int m = 0; m < t->s->material_count; m++) { /* albedo per channel, to check rho */
+        t->s->materials[m].base_color[0] = 0.5f;
+        t->s->materials[m].base_color[1] = 0.6f;
+        t->s->materials[m].base_color[2] = 0.7f;
+    }
+    lm_surface_options so;
+    lm_surface_options_default(&so);
+    assert_int_equal(lm_surfaces_build(t->s, &so, &t->su, &err), LM_OK);
+    lm_atlas_options ao;
+    lm_atlas_options_default(&ao);
+    ao.texel_size = texel_size;
+    assert_int_equal(lm_atlas_build(t->s, &t->su, &ao, &t->a, &err), LM_OK);
+}
+
+static void ts_free(tscene *t)
+{
+    lm_atlas_free(&t->a);
+    lm_surfaces_free(&t->su);
+    lm_scene_free(t->s);
+}
+
+/* One horizontal square (y = 0, facing +y) per node: x in [cx - h, cx + h], z in [cz - h, cz + h]. */
+static void square_mesh(lmt_mesh *m, float h)
+{
+    memset(m, 0, sizeof *m);
+    float c[3] = {-h, 0, h}, u[3] = {2 * h, 0, 0}, v[3] = {0, 0, -2 * h};
+    lmt_mesh_quad(m, c, u, v);
+}
+
+static uint64_t g_rng;
+static float rnd(void)
+{
+    g_rng = g_rng * 6364136223846793005ull + 1442695040888963407ull;
+    return (float)(g_rng >> 40) / 16777216.0f;
+}
+
+/* Point light of intensity I at lp: irradiance on the plane y = 0 (normal +y), E = I cos(theta) / d^2. */
+static float point_E(const float lp[3], float I, float x, float z)
+{
+    float dx = x - lp[0], dy = -lp[1], dz = z - lp[2], d2 = dx * dx + dy * dy + dz * dz;
+    return I * (lp[1] / sqrtf(d2)) / d2;
+}
+
+typedef float (*density_fn)(const float *param, float x, float z);
+
+static float density_point(const float *p, float x, float z) { return point_E(p, p[3], x, z); }
+static float density_const(const float *p, float x, float z)
+{
+    (void)x;
+    (void)z;
+    return p[0];
+}
+
+/* g x g jittered-stratified hits on the square [x0, x0 + w] x [z0, z0 + w] of surface `surface`, each
+ * carrying flux E(x_i) * area / count, so the hits' flux density is E. Local = world (scale `scale`
+ * maps local to world: local = world / scale). */
+static void add_hits(lm_photon_store *ps, const tscene *t, int surface, float x0, float z0, float w, int g,
+                     density_fn E, const float *param, float scale, const float from[3])
+{
+    float area = w * w;
+    for (int j = 0; j < g; j++)
+        for (int i = 0; i < g; i++) {
+            float x = x0 + (i + rnd()) / g * w, z = z0 + (j + rnd()) / g * w;
+            lm_hit h;
+            memset(&h, 0, sizeof h);
+            h.pos[0] = x;
+            h.pos[2] = z;
+            h.local[0] = x / scale;
+            h.local[2] = z / scale;
+            float d[3] = {x - from[0], -from[1], z - from[2]}, l = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int k = 0; k < 3; k++)
+                h.dir[k] = d[k] / l;
+            float phi = E(param, x, z) * area / (float)(g * g);
+            h.flux[0] = h.flux[1] = h.flux[2] = phi;
+            h.surface = surface;
+            h.tri = t->su.surfaces[surface].tris[0];
+            assert_true(lm_photon_store_add(ps, &h) != LM_NONE);
+        }
+}
+
+static const float *aim_px(const lm_aim *aim, const lm_texel *tx)
+{
+    return lm_aim_rgb(aim) + 3 * ((size_t)tx->y * (size_t)aim->width + (size_t)tx->x);
+}
+
+static void init_aim(lm_aim *aim, const tscene *t, const lm_aim_settings *set)
+{
+    lm_error err;
+    if (lm_aim_init(aim, t->s, &t->su, &t->a, set, &err) != LM_OK)
+        fail_msg("aim init: %s", err.msg);
+}
+
+/* (a) A point light over a large plane: the AIM's radiance is rho / pi * E(x) within 5% away from the
+ * plane's edges. */
+static void test_point_light_plane(void **state)
+{
+    (void)state;
+    lmt_mesh m;
+    square_mesh(&m, 2.0f);
+    tscene t;
+    ts_load(&t, &m, 1, "[{\"name\": \"plane\", \"mesh\": 0}]", 0.05f);
+    assert_int_equal(t.su.surface_count, 1);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 1, NULL), LM_OK);
+    const float light[4] = {0.3f, 1.5f, -0.2f, 10.0f};
+    g_rng = 1;
+    add_hits(&ps, &t, 0, -2.0f, -2.0f, 4.0f, 300, density_point, light, 1.0f, light);
+    lm_aim aim;
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    init_aim(&aim, &t, &set);
+    lm_aim_stats st;
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 1);
+    assert_int_equal(st.texels_written, t.a.texel_count);
+    assert_int_equal(st.hits_used, 300 * 300);
+    double worst = 0.0, sum = 0.0;
+    int checked = 0;
+    const float rho[3] = {0.5f, 0.6f, 0.7f};
+    for (uint32_t i = 0; i < t.a.texel_count; i++) {
+        const lm_texel *tx = &t.a.texels[i];
+        if (fabsf(tx->pos[0]) > 1.7f || fabsf(tx->pos[2]) > 1.7f)
+            continue;
+        float E = point_E(light, light[3], tx->pos[0], tx->pos[2]);
+        for (int c = 0; c < 3; c++) {
+            double want = rho[c] / PI_F * E, err = fabs(aim_px(&aim, tx)[c] - want) / want;
+            worst = fmax(worst, err);
+            sum += err;
+        }
+        checked++;
+    }
+    print_message("point light: %d texels, mean error %.2f%%, worst %.2f%% (refresh of %u texels from %llu hits: "
+                  "%.1f ms)\n", checked, 100.0 * sum / (3 * checked), 100.0 * worst, st.texels_written,
+                  (unsigned long long)st.hits_used, 1e3 * st.seconds);
+    assert_true(checked > 4000);
+    assert_true(worst < 0.05);
+    assert_true(sum / (3 * checked) < 0.015);
+    assert_true(ps.surfaces[0].delta_f == 0.0);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
+/* Interior mean and the worst deviation of any texel (edges and corners included) from it. */
+static void uniform_check(const lm_aim *aim, const tscene *t, float half, float expect, double tol)
+{
+    double sum = 0.0, worst = 0.0, worst_corner = 0.0;
+    int n = 0;
+    for (uint32_t i = 0; i < t->a.texel_count; i++) {
+        const lm_texel *tx = &t->a.texels[i];
+        if (fabsf(tx->pos[0]) < 0.6f * half && fabsf(tx->pos[2]) < 0.6f * half) {
+            sum += aim_px(aim, tx)[1];
+            n++;
+        }
+    }
+    double interior = sum / n;
+    assert_true(fabs(interior - expect) / expect < 0.02);
+    for (uint32_t i = 0; i < t->a.texel_count; i++) {
+        const lm_texel *tx = &t->a.texels[i];
+        double dev = fabs(aim_px(aim, tx)[1] - interior) / interior;
+        worst = fmax(worst, dev);
+        if (fabsf(tx->pos[0]) > half - t->a.texel_size && fabsf(tx->pos[2]) > half - t->a.texel_size)
+            worst_corner = fmax(worst_corner, dev);
+    }
+    print_message("uniform: interior %.5f (expect %.5f), worst texel %.2f%%, worst corner %.2f%%\n", interior,
+                  (double)expect, 100.0 * worst, 100.0 * worst_corner);
+    assert_true(worst < tol);
+}
+
+/* (b) Uniform flux density: constant radiance, and texels on the plane's borders and corners are not
+ * outliers against the interior (the disc's area is cut at the surface's boundary). Also under a
+ * scaled node: distances are node-local, areas world. */
+static void run_uniform(float scale, float texel)
+{
+    lmt_mesh m;
+    square_mesh(&m, 1.0f);
+    char nodes[128];
+    snprintf(nodes, sizeof nodes, "[{\"name\": \"plane\", \"mesh\": 0, \"scale\": [%g, %g, %g]}]", (double)scale,
+             (double)scale, (double)scale);
+    tscene t;
+    ts_load(&t, &m, 1, nodes, texel);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 1, NULL), LM_OK);
+    const float E[1] = {2.0f}, above[3] = {0.0f, 5.0f, 0.0f};
+    g_rng = 7;
+    add_hits(&ps, &t, 0, -scale, -scale, 2.0f * scale, 160, density_const, E, scale, above);
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    set.n_nearest = 150;
+    lm_aim aim;
+    init_aim(&aim, &t, &set);
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    uniform_check(&aim, &t, scale, 0.6f / PI_F * E[0], 0.05);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
+static void test_uniform_borders_and_corners(void **state)
+{
+    (void)state;
+    run_uniform(1.0f, 0.025f);
+    run_uniform(2.0f, 0.05f);
+}
+
+/* Without the boundary correction the corner texels are visibly dark: the correction is what keeps them
+ * in line (guards against it silently doing nothing). */
+static void test_boundary_correction_matters(void **state)
+{
+    (void)state;
+    lmt_mesh m;
+    square_mesh(&m, 1.0f);
+    tscene t;
+    ts_load(&t, &m, 1, "[{\"name\": \"plane\", \"mesh\": 0}]", 0.025f);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 1, NULL), LM_OK);
+    const float E[1] = {1.0f}, above[3] = {0.0f, 5.0f, 0.0f};
+    g_rng = 3;
+    add_hits(&ps, &t, 0, -1.0f, -1.0f, 2.0f, 100, density_const, E, 1.0f, above);
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    set.boundary_correction = 0;
+    lm_aim aim;
+    init_aim(&aim, &t, &set);
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    float lo = 1e30f;
+    for (uint32_t i = 0; i < t.a.texel_count; i++)
+        lo = fminf(lo, aim_px(&aim, &t.a.texels[i])[1]);
+    assert_true(lo < 0.5f * 0.6f / PI_F * E[0]);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
+/* (c) Hard cases: no hits, fewer hits than N, all hits at one point, hits arriving from behind. */
+static void test_hard_cases(void **state)
+{
+    (void)state;
+    lmt_mesh m;
+    square_mesh(&m, 1.0f);
+    tscene t;
+    ts_load(&t, &m, 1, "[{\"name\": \"plane\", \"mesh\": 0}]", 0.05f);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 1, NULL), LM_OK);
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    set.n_nearest = 50;
+    lm_aim aim;
+    init_aim(&aim, &t, &set);
+
+    /* No hits: 0 everywhere (also in the gutters). */
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    for (size_t i = 0; i < (size_t)aim.width * aim.height * 3; i++)
+        assert_true(lm_aim_rgb(&aim)[i] == 0.0f);
+
+    /* Three hits with N = 50: finite, positive, largest near them. */
+    lm_hit h;
+    memset(&h, 0, sizeof h);
+    h.dir[1] = -1.0f;
+    h.flux[0] = h.flux[1] = h.flux[2] = 1.0f;
+    h.tri = t.su.surfaces[0].tris[0];
+    uint32_t slots[3];
+    for (int i = 0; i < 3; i++) {
+        h.pos[0] = h.local[0] = 0.1f * (float)i;
+        slots[i] = lm_photon_store_add(&ps, &h);
+    }
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    for (uint32_t i = 0; i < t.a.texel_count; i++) {
+        const float *px = aim_px(&aim, &t.a.texels[i]);
+        for (int c = 0; c < 3; c++)
+            assert_true(isfinite(px[c]) && px[c] > 0.0f);
+    }
+    for (int i = 0; i < 3; i++)
+        lm_photon_store_remove(&ps, slots[i]);
+
+    /* 1000 hits at one point: bounded by the smallest radius, rho/pi * sum / (pi rmin^2 / 2) (the
+     * Epanechnikov kernel's normalisation; its weight is at most 1). */
+    h.pos[0] = h.local[0] = 0.013f;
+    h.pos[2] = h.local[2] = -0.021f;
+    for (int i = 0; i < 1000; i++)
+        assert_true(lm_photon_store_add(&ps, &h) != LM_NONE);
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    float rmin = t.a.texel_size, bound = 0.7f / PI_F * 1000.0f / (0.5f * PI_F * rmin * rmin), top = 0.0f;
+    for (uint32_t i = 0; i < t.a.texel_count; i++) {
+        const float *px = aim_px(&aim, &t.a.texels[i]);
+        for (int c = 0; c < 3; c++)
+            assert_true(isfinite(px[c]) && px[c] >= 0.0f);
+        top = fmaxf(top, px[2]);
+    }
+    assert_true(top > 0.25f * bound && top <= bound * 1.001f);
+
+    /* The same hits arriving from below a single-sided plane are not counted; double-sided, they are. */
+    for (uint32_t i = 0; i < ps.used; i++)
+        if (ps.hits[i].surface >= 0)
+            ps.hits[i].dir[1] = 1.0f;
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    for (uint32_t i = 0; i < t.a.texel_count; i++)
+        assert_true(aim_px(&aim, &t.a.texels[i])[0] == 0.0f);
+    t.s->materials[t.s->tri_material[h.tri]].double_sided = 1;
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    top = 0.0f;
+    for (uint32_t i = 0; i < t.a.texel_count; i++)
+        top = fmaxf(top, aim_px(&aim, &t.a.texels[i])[2]);
+    assert_true(top > 0.25f * bound && top <= bound * 1.001f);
+
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
+/* Three squares of areas 1, 4 and 9 as separate surfaces. */
+static void load_three(tscene *t)
+{
+    static lmt_mesh m[3];
+    square_mesh(&m[0], 0.5f);
+    square_mesh(&m[1], 1.0f);
+    square_mesh(&m[2], 1.5f);
+    ts_load(t, m, 3,
+            "[{\"name\": \"root\", \"children\": [1, 2, 3]}, {\"name\": \"a\", \"mesh\": 0, \"translation\": [-5, 0, 0]},"
+            " {\"name\": \"b\", \"mesh\": 1}, {\"name\": \"c\", \"mesh\": 2, \"translation\": [6, 0, 0]}]",
+            0.1f);
+    assert_int_equal(t->su.surface_count, 3);
+}
+
+/* Surface of node `name`. */
+static int surface_of(const tscene *t, const char *name)
+{
+    for (int i = 0; i < t->su.surface_count; i++)
+        if (!strcmp(t->s->nodes[t->su.surfaces[i].node].name, name))
+            return i;
+    fail_msg("no surface for node %s", name);
+    return -1;
+}
+
+static void add_uniform(lm_photon_store *ps, const tscene *t, int surface, float offset_x, float half, int g)
+{
+    const float E[1] = {1.0f}, above[3] = {offset_x, 5.0f, 0.0f};
+    add_hits(ps, t, surface, offset_x - half, -half, 2.0f * half, g, density_const, E, 1.0f, above);
+}
+
+/* Snapshot of one surface's texels. */
+static float *snapshot(const lm_aim *aim, const tscene *t, int surface, uint32_t *count)
+{
+    uint32_t first = aim->texel_first[surface], end = aim->texel_first[surface + 1];
+    float *v = malloc(sizeof *v * 3 * (end - first));
+    assert_non_null(v);
+    for (uint32_t i = first; i < end; i++)
+        memcpy(v + 3 * (i - first), aim_px(aim, &t->a.texels[aim->texel_list[i]]), 3 * sizeof *v);
+    *count = 3 * (end - first);
+    return v;
+}
+
+/* (d) Refresh order delta_f / area under a budget, delta_f reset, untouched surfaces unchanged, small
+ * changes below the threshold left alone. */
+static void test_schedule(void **state)
+{
+    (void)state;
+    tscene t;
+    load_three(&t);
+    int A = surface_of(&t, "a"), B = surface_of(&t, "b"), C = surface_of(&t, "c");
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 3, NULL), LM_OK);
+    g_rng = 11;
+    /* Each hit has energy E * area / g^2: delta_f = area on each; per area the same, so vary E by g. */
+    add_uniform(&ps, &t, A, -5.0f, 0.5f, 10);
+    add_uniform(&ps, &t, B, 0.0f, 1.0f, 20);
+    add_uniform(&ps, &t, C, 6.0f, 1.5f, 30);
+    ps.surfaces[A].delta_f = 3.0;  /* delta_f / area: A 3, B 0.5, C 1 */
+    ps.surfaces[B].delta_f = 2.0;
+    ps.surfaces[C].delta_f = 9.0;
+    lm_aim aim;
+    init_aim(&aim, &t, NULL);
+    lm_aim_stats st;
+    assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, 2, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 2);
+    assert_int_equal(st.surfaces_pending, 1);
+    assert_int_equal(aim.refresh_count[A], 1);
+    assert_int_equal(aim.refresh_count[C], 1);
+    assert_int_equal(aim.refresh_count[B], 0);
+    assert_true(ps.surfaces[A].delta_f == 0.0 && ps.surfaces[C].delta_f == 0.0);
+    assert_true(ps.surfaces[B].delta_f == 2.0);
+    uint32_t nb;
+    float *b0 = snapshot(&aim, &t, B, &nb);
+    for (uint32_t i = 0; i < nb; i++)
+        assert_true(b0[i] == 0.0f);
+    free(b0);
+
+    /* Budget 1: B is next. Then nothing is left. */
+    assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, 1, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 1);
+    assert_int_equal(aim.refresh_count[B], 1);
+    assert_true(st.texels_written == aim.texel_first[B + 1] - aim.texel_first[B]);
+    assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, -1, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 0);
+    assert_int_equal(st.surfaces_pending, 0);
+
+    /* A change below the threshold (0.01 x mean hit energy) waits; once it adds up, it is refreshed. */
+    uint32_t na, nc;
+    float *a0 = snapshot(&aim, &t, A, &na), *c0 = snapshot(&aim, &t, C, &nc);
+    ps.surfaces[B].delta_f = 1e-3 * aim.mean_hit_energy;
+    assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, -1, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 0);
+    add_uniform(&ps, &t, B, 0.0f, 1.0f, 20); /* B doubles */
+    assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, -1, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 1);
+    assert_int_equal(aim.refresh_count[B], 2);
+    uint32_t n2;
+    float *a1 = snapshot(&aim, &t, A, &n2), *c1 = snapshot(&aim, &t, C, &n2);
+    assert_memory_equal(a0, a1, sizeof *a0 * na);
+    assert_memory_equal(c0, c1, sizeof *c0 * nc);
+    float *b1 = snapshot(&aim, &t, B, &nb);
+    double mean = 0.0;
+    for (uint32_t i = 1; i < nb; i += 3)
+        mean += b1[i];
+    mean /= nb / 3;
+    assert_true(fabs(mean - 2.0 * 0.6 / PI_F) / (2.0 * 0.6 / PI_F) < 0.03);
+    free(a0);
+    free(a1);
+    free(b1);
+    free(c0);
+    free(c1);
+
+    /* Removing every hit of A is a change too: A goes dark. */
+    for (uint32_t i = 0; i < ps.used; i++)
+        if (ps.hits[i].surface == A)
+            lm_photon_store_remove(&ps, i);
+    assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, -1, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 1);
+    a0 = snapshot(&aim, &t, A, &na);
+    for (uint32_t i = 0; i < na; i++)
+        assert_true(a0[i] == 0.0f);
+    free(a0);
+
+    lm_error err;
+    assert_int_equal(lm_aim_refresh_surface(&aim, t.s, &t.su, &t.a, &ps, 3, NULL, &err), LM_ERR_INVALID);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
+/* (e) Same store, same map: across runs and thread counts, bit for bit. */
+static void test_deterministic(void **state)
+{
+    (void)state;
+    tscene t;
+    load_three(&t);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 3, NULL), LM_OK);
+    const float light[4] = {0.0f, 1.0f, 0.0f, 5.0f};
+    g_rng = 5;
+    for (int s = 0; s < 3; s++) {
+        float cx = t.s->nodes[t.su.surfaces[s].node].translation[0], h = sqrtf(t.su.surfaces[s].area) / 2;
+        add_hits(&ps, &t, s, cx - h, -h, 2 * h, 40, density_point, light, 1.0f, light);
+    }
+    lm_aim a1, a2;
+    init_aim(&a1, &t, NULL);
+    init_aim(&a2, &t, NULL);
+    int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    assert_int_equal(lm_aim_refresh_all(&a1, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    omp_set_num_threads(threads > 1 ? threads : 2);
+    assert_int_equal(lm_aim_refresh_all(&a2, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    omp_set_num_threads(threads);
+    assert_memory_equal(lm_aim_rgb(&a1), lm_aim_rgb(&a2), sizeof(float) * 3 * (size_t)a1.width * a1.height);
+    lm_aim_free(&a1);
+    lm_aim_free(&a2);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
+static void test_bad_settings(void **state)
+{
+    (void)state;
+    tscene t;
+    load_three(&t);
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    set.n_nearest = 0;
+    lm_aim aim;
+    lm_error err;
+    assert_int_equal(lm_aim_init(&aim, t.s, &t.su, &t.a, &set, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "n_nearest"));
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 2, NULL), LM_OK);
+    init_aim(&aim, &t, NULL);
+    assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, 1, NULL, &err), LM_ERR_INVALID);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_point_light_plane),
+        cmocka_unit_test(test_uniform_borders_and_corners),
+        cmocka_unit_test(test_boundary_correction_matters),
+        cmocka_unit_test(test_hard_cases),
+        cmocka_unit_test(test_schedule),
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_bad_settings),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
