@@ -1,0 +1,130 @@
+/* Scrambled Halton sequences (qmc.h).
+ *
+ * Dimension d uses the d-th prime b and one random digit permutation pi_d of {0..b-1} that fixes 0
+ * (Fisher-Yates over 1..b-1 from a fixed-seed splitmix64 stream, in the spirit of Braaten-Weller),
+ * applied to every digit: x = sum_k pi_d(digit_k(i)) b^-k. Fixing 0 keeps the zero digits above the
+ * index's top digit zero, so x is a finite sum exactly like the plain radical inverse (no tail that
+ * could round up to a cell boundary). A digit permutation keeps the low-digit structure: the first a
+ * digits of x depend only on i mod b^a, so the 2^a x 3^b strata of dims 0-1 are exactly those of the
+ * plain Halton sequence. (Base 2 has no such permutation but the identity: dim 0 is van der Corput.)
+ *
+ * Speed: digits are processed in chunks of k digits (b^k <= LM_QMC_CHUNK_MAX), one table lookup per
+ * chunk. */
+#include "qmc.h"
+
+#include <pthread.h>
+
+#define LM_QMC_CHUNK_MAX 4096u
+#define LM_QMC_SEED 0x6c6d6769514d4321ull /* fixed: sequences are identical on every run */
+#define LM_QMC_TABLE_TOTAL 226691u /* sum of the 256 chunk sizes: recompute if CHUNK_MAX or MAX_DIMS change */
+#define LM_QMC_LAST_PRIME 1619u
+
+typedef struct {
+    uint32_t base;
+    uint32_t chunk;          /* b^k */
+    double inv_chunk;        /* 1 / chunk */
+    double *table;           /* chunk entries: permuted radical inverse of k digits */
+} qmc_dim;
+
+static qmc_dim g_dims[LM_QMC_MAX_DIMS];
+static double g_storage[LM_QMC_TABLE_TOTAL];
+static pthread_once_t g_once = PTHREAD_ONCE_INIT;
+
+static uint64_t splitmix64(uint64_t *state)
+{
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+static int is_prime(uint32_t n)
+{
+    for (uint32_t q = 2; q * q <= n; q++)
+        if (n % q == 0)
+            return 0;
+    return n >= 2;
+}
+
+uint32_t lm_qmc_prime(uint32_t dim)
+{
+    uint32_t found = 0;
+    for (uint32_t n = 2;; n++)
+        if (is_prime(n) && found++ == dim)
+            return n;
+}
+
+/* Permutation of {0..b-1} with perm[0] = 0: Fisher-Yates over 1..b-1 from the dimension's own stream. */
+static void make_permutation(uint32_t dim, uint32_t b, uint32_t *perm)
+{
+    uint64_t state = LM_QMC_SEED ^ ((uint64_t)dim * 0xD1B54A32D192ED03ull);
+    for (uint32_t i = 0; i < b; i++)
+        perm[i] = i;
+    for (uint32_t i = b - 1; i > 1; i--) {
+        uint32_t j = 1 + (uint32_t)(splitmix64(&state) % i);
+        uint32_t t = perm[i];
+        perm[i] = perm[j];
+        perm[j] = t;
+    }
+}
+
+static void chunk_shape(uint32_t b, uint32_t *chunk, uint32_t *digits)
+{
+    uint32_t c = b, k = 1;
+    while ((uint64_t)c * b <= LM_QMC_CHUNK_MAX) {
+        c *= b;
+        k++;
+    }
+    *chunk = c;
+    *digits = k;
+}
+
+/* table[x] = sum_{j=1..k} perm(digit_j(x)) b^-j, digit_1 the lowest digit of x. */
+static void fill_table(qmc_dim *d, uint32_t digits, const uint32_t *perm)
+{
+    for (uint32_t x = 0; x < d->chunk; x++) {
+        double v = 0.0, scale = 1.0 / d->base;
+        uint32_t rest = x;
+        for (uint32_t j = 0; j < digits; j++) {
+            v += perm[rest % d->base] * scale;
+            rest /= d->base;
+            scale /= d->base;
+        }
+        d->table[x] = v;
+    }
+}
+
+static void init_once(void)
+{
+    static uint32_t perm[LM_QMC_LAST_PRIME];
+    size_t at = 0;
+    for (uint32_t i = 0, n = 2; i < LM_QMC_MAX_DIMS; n++) {
+        if (!is_prime(n))
+            continue;
+        qmc_dim *d = &g_dims[i];
+        uint32_t digits;
+        d->base = n;
+        chunk_shape(n, &d->chunk, &digits);
+        d->inv_chunk = 1.0 / d->chunk;
+        d->table = g_storage + at;
+        at += d->chunk;
+        make_permutation(i, n, perm);
+        fill_table(d, digits, perm);
+        i++;
+    }
+}
+
+void lm_qmc_init(void) { pthread_once(&g_once, init_once); }
+
+double lm_halton(uint32_t dim, uint64_t index)
+{
+    lm_qmc_init();
+    const qmc_dim *d = &g_dims[dim % LM_QMC_MAX_DIMS];
+    double v = 0.0, scale = 1.0;
+    while (index != 0) {
+        v += d->table[index % d->chunk] * scale;
+        index /= d->chunk;
+        scale *= d->inv_chunk;
+    }
+    return v < 1.0 ? v : 0x1.fffffffffffffp-1;
+}

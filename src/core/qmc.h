@@ -1,0 +1,21 @@
+/* Quasi-Monte Carlo numbers: scrambled Halton sequences.
+ *
+ * Dimension d of point i is the radical inverse of i in the d-th prime base with a fixed digit
+ * permutation per dimension (from a fixed seed), so sequences are identical on every run. Photon i's
+ * random decisions use its own dimensions: dims 0-1 the initial direction (bases 2 and 3, which makes
+ * `index mod 2^a 3^b` a stratum of the first two coordinates), the rest per bounce. */
+#ifndef LM_QMC_H
+#define LM_QMC_H
+
+#include <stdint.h>
+
+#define LM_QMC_MAX_DIMS 256
+
+/* Scrambled radical inverse, in [0, 1). dim < LM_QMC_MAX_DIMS. Thread-safe after lm_qmc_init. */
+double lm_halton(uint32_t dim, uint64_t index);
+/* Builds the permutation tables (idempotent; called by lm_halton on first use in a single thread). */
+void lm_qmc_init(void);
+/* The d-th prime (d = 0 -> 2). */
+uint32_t lm_qmc_prime(uint32_t dim);
+
+#endif

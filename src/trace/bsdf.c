@@ -1,0 +1,248 @@
+/* Scattering for the material classes (bsdf.h).
+ *
+ * Sides: the normals are turned to the side the light arrives from (the side of -wi). Glass and
+ * double-sided materials scatter on both sides; a single-sided opaque surface hit from behind
+ * absorbs (it is opaque, and glTF gives it no back face to shade). Reflected directions below the
+ * geometric surface are absorbed, so light never leaks through a surface.
+ *
+ * Lobes:
+ *   diffuse, emitter   f = albedo / pi, cosine-weighted sampling (weight = albedo).
+ *   glossy             f = kd / pi + ks (n + 2) / (2 pi) cos^n(alpha), alpha the angle between wo and
+ *                      the mirror direction of wi about ns (normalized Phong, Lafortune & Willems 1994);
+ *                      ks = lerp(0.04, albedo, metallic), kd = albedo (1 - metallic)(1 - max(ks)) so that
+ *                      kd + ks <= 1; n = lm_phong_exponent(roughness). Sampled as a mixture of the
+ *                      cosine lobe and the Phong lobe (pdf (n + 1) / (2 pi) cos^n alpha), picked by
+ *                      the luminances of kd and ks; the weight uses the mixture's pdf.
+ *   mirror             wo = reflect(wi, ns), weight = albedo.
+ *   glass              exact dielectric Fresnel F; reflect with probability F (weight 1), else refract
+ *                      by Snell's law (weight = albedo, the glass tint); total internal reflection
+ *                      reflects always. Inside/outside from the sign of dot(wi, ng). */
+#include "bsdf.h"
+
+#include <math.h>
+
+#include "../core/vecmath.h"
+
+#define LM_PI 3.14159265358979323846f
+#define LM_DIELECTRIC_F0 0.04f /* reflectance of a dielectric at normal incidence (index 1.5) */
+
+static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
+
+/* Orthonormal basis (t, b) around unit n (Duff et al. 2017, "Building an orthonormal basis, revisited"). */
+static void basis(lm_vec3 n, lm_vec3 *t, lm_vec3 *b)
+{
+    float sign = copysignf(1.0f, n.z);
+    float a = -1.0f / (sign + n.z), c = n.x * n.y * a;
+    *t = lm_v3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+    *b = lm_v3(c, sign + n.y * n.y * a, -n.y);
+}
+
+static lm_vec3 from_local(lm_vec3 n, float x, float y, float z)
+{
+    lm_vec3 t, b;
+    basis(n, &t, &b);
+    return lm_add(lm_add(lm_scale(t, x), lm_scale(b, y)), lm_scale(n, z));
+}
+
+/* Direction around n with density cos^e(angle) (e = 1: cosine-weighted, pdf cos / pi). */
+static lm_vec3 sample_power_cos(lm_vec3 n, float e, float u0, float u1)
+{
+    float c = powf(1.0f - u0, 1.0f / (e + 1.0f)), s = sqrtf(fmaxf(0.0f, 1.0f - c * c));
+    float phi = 2.0f * LM_PI * u1;
+    return lm_normalize(from_local(n, s * cosf(phi), s * sinf(phi), c));
+}
+
+static lm_vec3 reflect(lm_vec3 d, lm_vec3 n) { return lm_sub(d, lm_scale(n, 2.0f * lm_dot(d, n))); }
+
+static int is_specular(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLASS; }
+
+/* Turns ng, ns towards the side wi comes from. Returns 0 for the back of a single-sided opaque surface. */
+static int orient(const lm_shading *sh, lm_vec3 wi, lm_vec3 *ng, lm_vec3 *ns)
+{
+    *ng = lm_v3_load(sh->ng);
+    *ns = lm_v3_load(sh->ns);
+    if (lm_dot(wi, *ng) <= 0.0f)
+        return 1;
+    if (!sh->material->double_sided && sh->material->cls != LM_MAT_GLASS)
+        return 0;
+    *ng = lm_scale(*ng, -1.0f);
+    *ns = lm_scale(*ns, -1.0f);
+    return 1;
+}
+
+float lm_phong_exponent(float roughness)
+{
+    float r = clampf(roughness, 0.0f, 1.0f), r4 = r * r * r * r;
+    if (r4 < 2e-4f) /* 2 / r^4 beyond the clamp */
+        return 1e4f;
+    return clampf(2.0f / r4 - 2.0f, 1.0f, 1e4f);
+}
+
+float lm_fresnel_dielectric(float cos_i, float eta_i, float eta_t)
+{
+    cos_i = clampf(cos_i, 0.0f, 1.0f);
+    float sin_t = eta_i / eta_t * sqrtf(fmaxf(0.0f, 1.0f - cos_i * cos_i));
+    if (sin_t >= 1.0f)
+        return 1.0f; /* total internal reflection */
+    float cos_t = sqrtf(fmaxf(0.0f, 1.0f - sin_t * sin_t));
+    float rs = (eta_i * cos_i - eta_t * cos_t) / (eta_i * cos_i + eta_t * cos_t);
+    float rp = (eta_t * cos_i - eta_i * cos_t) / (eta_t * cos_i + eta_i * cos_t);
+    return 0.5f * (rs * rs + rp * rp);
+}
+
+typedef struct {
+    float kd[3], ks[3];
+    float n;       /* Phong exponent */
+    float p_spec;  /* probability of sampling the Phong lobe */
+} glossy_params;
+
+static void glossy(const lm_shading *sh, glossy_params *g)
+{
+    float m = clampf(sh->material->metallic, 0.0f, 1.0f), ksmax = 0.0f;
+    for (int c = 0; c < 3; c++) {
+        g->ks[c] = LM_DIELECTRIC_F0 * (1.0f - m) + sh->albedo[c] * m;
+        ksmax = fmaxf(ksmax, g->ks[c]);
+    }
+    for (int c = 0; c < 3; c++)
+        g->kd[c] = sh->albedo[c] * (1.0f - m) * (1.0f - ksmax);
+    g->n = lm_phong_exponent(sh->material->roughness);
+    float ls = lum(g->ks), ld = lum(g->kd);
+    g->p_spec = ls + ld > 0.0f ? ls / (ls + ld) : 0.5f;
+}
+
+/* Phong lobe value cos^n(alpha), alpha between wo and the mirror direction r. */
+static float phong(lm_vec3 r, lm_vec3 wo, float n)
+{
+    float c = lm_dot(r, wo);
+    return c > 0.0f ? powf(c, n) : 0.0f;
+}
+
+/* f cos and pdf of the non-specular lobes, with normals already oriented; 0 below the surface. */
+static void eval_oriented(const lm_shading *sh, lm_vec3 wi, lm_vec3 wo, lm_vec3 ng, lm_vec3 ns, float f[3],
+                          float *pdf)
+{
+    float cos_o = lm_dot(ns, wo);
+    f[0] = f[1] = f[2] = 0.0f;
+    *pdf = 0.0f;
+    if (cos_o <= 0.0f || lm_dot(ng, wo) <= 0.0f)
+        return;
+    if (sh->material->cls != LM_MAT_GLOSSY) {
+        for (int c = 0; c < 3; c++)
+            f[c] = sh->albedo[c] / LM_PI * cos_o;
+        *pdf = cos_o / LM_PI;
+        return;
+    }
+    glossy_params g;
+    glossy(sh, &g);
+    float lobe = phong(reflect(wi, ns), wo, g.n);
+    for (int c = 0; c < 3; c++)
+        f[c] = (g.kd[c] / LM_PI + g.ks[c] * (g.n + 2.0f) / (2.0f * LM_PI) * lobe) * cos_o;
+    *pdf = (1.0f - g.p_spec) * cos_o / LM_PI + g.p_spec * (g.n + 1.0f) / (2.0f * LM_PI) * lobe;
+}
+
+static int sample_glass(const lm_shading *sh, lm_vec3 wi, const float u[3], lm_bsdf_sample_t *out)
+{
+    lm_vec3 ng = lm_v3_load(sh->ng), ns = lm_v3_load(sh->ns);
+    int entering = lm_dot(wi, ng) < 0.0f;
+    float eta_i = entering ? 1.0f : sh->material->ior, eta_t = entering ? sh->material->ior : 1.0f;
+    if (!(eta_i > 0.0f) || !(eta_t > 0.0f))
+        return 0;
+    if (lm_dot(wi, ns) > 0.0f) /* normals against wi */
+        ns = lm_scale(ns, -1.0f);
+    if (!entering)
+        ng = lm_scale(ng, -1.0f);
+    float cos_i = -lm_dot(wi, ns), F = lm_fresnel_dielectric(cos_i, eta_i, eta_t);
+    out->specular = 1;
+    if (u[0] < F) { /* Fresnel-weighted reflection (also total internal reflection) */
+        lm_vec3 r = reflect(wi, ns);
+        if (lm_dot(r, ng) <= 0.0f)
+            return 0;
+        lm_v3_store(out->wo, r);
+        out->weight[0] = out->weight[1] = out->weight[2] = 1.0f;
+        out->transmitted = 0;
+        return 1;
+    }
+    /* Snell: wt = eta wi + (eta cos_i - cos_t) n, eta = eta_i / eta_t */
+    float eta = eta_i / eta_t, cos_t = sqrtf(fmaxf(0.0f, 1.0f - eta * eta * (1.0f - cos_i * cos_i)));
+    lm_vec3 t = lm_normalize(lm_add(lm_scale(wi, eta), lm_scale(ns, eta * cos_i - cos_t)));
+    if (lm_dot(t, ng) >= 0.0f)
+        return 0;
+    lm_v3_store(out->wo, t);
+    for (int c = 0; c < 3; c++)
+        out->weight[c] = sh->albedo[c];
+    out->transmitted = 1;
+    return 1;
+}
+
+static int sample_mirror(const lm_shading *sh, lm_vec3 ng, lm_vec3 ns, lm_vec3 wi, lm_bsdf_sample_t *out)
+{
+    lm_vec3 r = reflect(wi, ns);
+    if (lm_dot(r, ng) <= 0.0f)
+        return 0;
+    lm_v3_store(out->wo, r);
+    for (int c = 0; c < 3; c++)
+        out->weight[c] = sh->albedo[c];
+    out->specular = 1;
+    return 1;
+}
+
+int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], lm_bsdf_sample_t *out)
+{
+    lm_vec3 wi = lm_v3_load(wi_), ng, ns;
+    out->specular = out->transmitted = 0;
+    if (sh->material->cls == LM_MAT_GLASS)
+        return sample_glass(sh, wi, u, out);
+    if (!orient(sh, wi, &ng, &ns))
+        return 0;
+    if (sh->material->cls == LM_MAT_MIRROR)
+        return sample_mirror(sh, ng, ns, wi, out);
+    lm_vec3 wo;
+    if (sh->material->cls == LM_MAT_GLOSSY) {
+        glossy_params g;
+        glossy(sh, &g);
+        wo = u[2] < g.p_spec ? sample_power_cos(reflect(wi, ns), g.n, u[0], u[1]) : sample_power_cos(ns, 1.0f, u[0], u[1]);
+    } else {
+        wo = sample_power_cos(ns, 1.0f, u[0], u[1]);
+    }
+    float f[3], pdf;
+    eval_oriented(sh, wi, wo, ng, ns, f, &pdf);
+    if (!(pdf > 0.0f))
+        return 0;
+    lm_v3_store(out->wo, wo);
+    for (int c = 0; c < 3; c++)
+        out->weight[c] = f[c] / pdf;
+    return out->weight[0] > 0.0f || out->weight[1] > 0.0f || out->weight[2] > 0.0f;
+}
+
+void lm_bsdf_eval(const lm_shading *sh, const float wi_[3], const float wo_[3], float out[3])
+{
+    lm_vec3 wi = lm_v3_load(wi_), ng, ns;
+    float pdf;
+    out[0] = out[1] = out[2] = 0.0f;
+    if (is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
+        return;
+    eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, out, &pdf);
+}
+
+float lm_bsdf_pdf(const lm_shading *sh, const float wi_[3], const float wo_[3])
+{
+    lm_vec3 wi = lm_v3_load(wi_), ng, ns;
+    float f[3], pdf = 0.0f;
+    if (is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
+        return 0.0f;
+    eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, f, &pdf);
+    return pdf;
+}
+
+float lm_bsdf_survival(const lm_shading *sh)
+{
+    if (is_specular(sh->material->cls))
+        return 1.0f;
+    return clampf(lum(sh->albedo), 0.05f, 0.95f);
+}
+
+int lm_material_stores_hits(lm_material_class c)
+{
+    return c == LM_MAT_DIFFUSE || c == LM_MAT_GLOSSY || c == LM_MAT_EMITTER;
+}

@@ -1,0 +1,38 @@
+/* Scattering for the material classes (scene.h): diffuse (Lambert), glossy (Lambert + a normalized
+ * Phong lobe whose exponent follows roughness), mirror (perfect reflection, tinted by base colour) and
+ * glass (Fresnel-weighted reflection or refraction with the material's IOR). Emitters scatter as
+ * diffuse. Directions are unit vectors; `wi` points along the incoming travel direction (towards the
+ * surface), `wo` away from it. */
+#ifndef LM_BSDF_H
+#define LM_BSDF_H
+
+#include "shading.h"
+
+typedef struct {
+    float wo[3];         /* sampled outgoing direction */
+    float weight[3];     /* f * cos / pdf: what carried power or throughput is multiplied by */
+    int specular;        /* 1 for mirror reflection and glass (a delta lobe: no stored hit, no NEE) */
+    int transmitted;     /* 1 if it went through the surface */
+} lm_bsdf_sample_t;
+
+/* Samples an outgoing direction from three uniform numbers in [0,1). Returns 0 if the sample is
+ * absorbed or invalid (below the surface for a reflective lobe). */
+int lm_bsdf_sample(const lm_shading *sh, const float wi[3], const float u[3], lm_bsdf_sample_t *out);
+/* f(wi -> wo) * |cos(ns, wo)| for the non-specular part (0 for mirror and glass). */
+void lm_bsdf_eval(const lm_shading *sh, const float wi[3], const float wo[3], float out[3]);
+/* Luminance of the albedo, the Russian-roulette survival probability before a bounce, in (0, 1]. */
+float lm_bsdf_survival(const lm_shading *sh);
+/* True for classes that store photon hits (diffuse, glossy, emitter). */
+int lm_material_stores_hits(lm_material_class c);
+
+/* Additions used by the reference solver and the tests (bsdf.c documents the lobes):
+ * lm_bsdf_pdf: solid-angle density with which lm_bsdf_sample picks wo for the non-specular part
+ * (0 for mirror, glass, or wo on the wrong side), for multiple importance sampling.
+ * lm_fresnel_dielectric: unpolarized Fresnel reflectance for light arriving at cos_i (> 0) from a
+ * medium of index eta_i onto one of index eta_t; 1 under total internal reflection.
+ * lm_phong_exponent: the glossy lobe's exponent for a roughness, n = 2 / r^4 - 2 clamped to [1, 1e4]. */
+float lm_bsdf_pdf(const lm_shading *sh, const float wi[3], const float wo[3]);
+float lm_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
+float lm_phong_exponent(float roughness);
+
+#endif

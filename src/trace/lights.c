@@ -1,0 +1,406 @@
+/* Light emitters: flux, photon emission and next-event estimation (lights.h).
+ *
+ * Emission (lm_emitter_emit, u[0], u[1] always pick the direction or its stand-in):
+ *   point        uniform direction on the sphere; flux = 4 pi I / count.
+ *   spot         cos uniform in [cos outer, 1] (uniform over the outer cone's solid angle 2 pi (1 - cos
+ *                outer)); flux = I att(cos) 2 pi (1 - cos outer) / count, so its mean is I x the
+ *                attenuation-weighted solid angle.
+ *   directional  origin uniform on the disk (u[0] radius, u[1] angle) of radius R = half the bounds'
+ *                diagonal, centred on the bounds' centre and moved back by 1.001 R against the light's
+ *                direction (outside the bounding sphere); flux = E pi R^2 / count.
+ *   area         u[2] picks a triangle by its flux (CDF), its leftover the side (double-sided
+ *                materials) and then one barycentric coordinate, u[3] the other (uniform on the
+ *                triangle); u[0], u[1] a cosine-weighted direction about the emitting side's normal;
+ *                flux = flux of the triangle / (its probability x count). The origin is lifted off the
+ *                surface by 1e-5 x the scene size.
+ * Next-event estimation (lm_emitter_sample_toward): the delta lights are evaluated exactly (weight =
+ * I att / d^2, or E for directional); an area emitter gets a point chosen by u[0] (triangle, by flux)
+ * and u[1], u[2] (uniform on it), weight = Le cos_l / (d^2 pdf_area). The glTF `range` is ignored
+ * (physical inverse-square falloff everywhere), as are emissive textures. */
+#include "lights.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/vecmath.h"
+
+#define LM_PI 3.14159265358979323846
+#define LM_SPOT_MIN_WIDTH 1e-3f   /* the extension's max(0.001, cos inner - cos outer) */
+#define LM_EMIT_LIFT 1e-5f        /* area photon origins are lifted by this x scene size */
+
+static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
+
+/* ---- spot falloff ---- */
+
+static float spot_width(const lm_light *l)
+{
+    return fmaxf(LM_SPOT_MIN_WIDTH, cosf(l->inner_cone) - cosf(l->outer_cone));
+}
+
+float lm_spot_attenuation(const lm_light *l, float cos_angle)
+{
+    float t = (cos_angle - cosf(l->outer_cone)) / spot_width(l);
+    t = t < 0.0f ? 0.0f : t > 1.0f ? 1.0f : t;
+    return t * t;
+}
+
+/* 2 pi int_{-1}^{1} att(c) dc = 2 pi [ (up - co)^3 / (3 w^2) + (1 - up) ], up = min(1, co + w). */
+float lm_spot_solid_angle(const lm_light *l)
+{
+    double co = cos((double)l->outer_cone), w = (double)spot_width(l), up = fmin(1.0, co + w);
+    double ramp = (up - co) * (up - co) * (up - co) / (3.0 * w * w);
+    return (float)(2.0 * LM_PI * (ramp + (1.0 - up)));
+}
+
+/* ---- building and placement ---- */
+
+static int count_emissive(const lm_scene *s, const lm_node *n)
+{
+    int c = 0;
+    for (uint32_t t = n->first_tri; t < n->first_tri + n->tri_count; t++)
+        c += s->materials[s->tri_material[t]].cls == LM_MAT_EMITTER;
+    return c;
+}
+
+static lm_status add_area(const lm_scene *s, int node, lm_emitter *e, lm_error *err)
+{
+    const lm_node *n = &s->nodes[node];
+    memset(e, 0, sizeof *e);
+    e->kind = LM_EMIT_AREA;
+    e->light = -1;
+    e->node = node;
+    e->tri_count = (uint32_t)count_emissive(s, n);
+    e->tris = malloc(e->tri_count * sizeof *e->tris);
+    e->cdf = malloc(e->tri_count * sizeof *e->cdf);
+    if (!e->tris || !e->cdf)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the emissive triangles of node '%s'", s->path, n->name);
+    uint32_t k = 0;
+    for (uint32_t t = n->first_tri; t < n->first_tri + n->tri_count; t++)
+        if (s->materials[s->tri_material[t]].cls == LM_MAT_EMITTER)
+            e->tris[k++] = t;
+    return LM_OK;
+}
+
+lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
+{
+    memset(out, 0, sizeof *out);
+    int n = s->light_count;
+    for (int i = 0; i < s->node_count; i++)
+        n += count_emissive(s, &s->nodes[i]) > 0;
+    out->e = calloc(n > 0 ? (size_t)n : 1, sizeof *out->e);
+    if (!out->e)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %d emitters", s->path, n);
+    for (int i = 0; i < s->light_count; i++) {
+        lm_emitter *e = &out->e[out->count++];
+        lm_light_type t = s->lights[i].type;
+        e->kind = t == LM_LIGHT_POINT ? LM_EMIT_POINT : t == LM_LIGHT_SPOT ? LM_EMIT_SPOT : LM_EMIT_DIRECTIONAL;
+        e->light = i;
+        e->node = s->lights[i].node;
+        e->punctual = 1;
+    }
+    for (int i = 0; i < s->node_count; i++) {
+        if (count_emissive(s, &s->nodes[i]) == 0)
+            continue;
+        lm_status st = add_area(s, i, &out->e[out->count++], err);
+        if (st != LM_OK) {
+            lm_emitters_free(out);
+            return st;
+        }
+    }
+    lm_emitters_update(out, s);
+    return LM_OK;
+}
+
+void lm_emitters_free(lm_emitters *em)
+{
+    for (int i = 0; em->e && i < em->count; i++) {
+        free(em->e[i].tris);
+        free(em->e[i].cdf);
+    }
+    free(em->e);
+    memset(em, 0, sizeof *em);
+}
+
+static void place_punctual(lm_emitter *e, const lm_scene *s, float disk_radius)
+{
+    const lm_light *l = &s->lights[e->light];
+    const float *w = s->nodes[e->node].world;
+    lm_v3_store(e->pos, lm_v3(w[12], w[13], w[14]));
+    lm_v3_store(e->dir, lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1))));
+    float scale = e->kind == LM_EMIT_POINT ? (float)(4.0 * LM_PI)
+                : e->kind == LM_EMIT_SPOT  ? lm_spot_solid_angle(l)
+                                           : (float)LM_PI * disk_radius * disk_radius;
+    for (int c = 0; c < 3; c++) {
+        e->radiant[c] = l->color[c] * l->intensity;
+        e->power[c] = e->radiant[c] * scale;
+    }
+}
+
+/* Triangle corners and (unnormalized) geometric normal in world space. */
+static lm_vec3 tri_world(const lm_scene *s, uint32_t t, lm_vec3 p[3])
+{
+    for (int k = 0; k < 3; k++) {
+        float q[3];
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t + (size_t)k], q);
+        p[k] = lm_v3_load(q);
+    }
+    return lm_cross(lm_sub(p[1], p[0]), lm_sub(p[2], p[0]));
+}
+
+/* Flux of one emissive triangle: pi Le A per emitting side. */
+static void tri_flux(const lm_scene *s, uint32_t t, float out[3])
+{
+    const lm_material *m = &s->materials[s->tri_material[t]];
+    float f = (float)LM_PI * lm_scene_tri_area_world(s, t) * (m->double_sided ? 2.0f : 1.0f);
+    for (int c = 0; c < 3; c++)
+        out[c] = m->emissive[c] * f;
+}
+
+static void place_area(lm_emitter *e, const lm_scene *s)
+{
+    double acc = 0.0, area = 0.0, pw[3] = {0, 0, 0};
+    for (uint32_t k = 0; k < e->tri_count; k++) {
+        float f[3];
+        tri_flux(s, e->tris[k], f);
+        for (int c = 0; c < 3; c++)
+            pw[c] += f[c];
+        area += lm_scene_tri_area_world(s, e->tris[k]);
+        acc += lum(f);
+        e->cdf[k] = (float)acc;
+    }
+    for (uint32_t k = 0; k < e->tri_count; k++) /* normalize; a flux-less emitter picks nothing */
+        e->cdf[k] = acc > 0.0 ? (float)(e->cdf[k] / acc) : 0.0f;
+    if (e->tri_count && acc > 0.0)
+        e->cdf[e->tri_count - 1] = 1.0f;
+    e->area = (float)area;
+    for (int c = 0; c < 3; c++)
+        e->power[c] = (float)pw[c];
+}
+
+void lm_emitters_update(lm_emitters *em, const lm_scene *s)
+{
+    lm_vec3 lo = lm_v3_load(s->bounds_min), hi = lm_v3_load(s->bounds_max);
+    int empty = !(lo.x <= hi.x && lo.y <= hi.y && lo.z <= hi.z);
+    lm_v3_store(em->disk_center, empty ? lm_v3(0, 0, 0) : lm_scale(lm_add(lo, hi), 0.5f));
+    em->disk_radius = empty ? 0.0f : 0.5f * lm_length(lm_sub(hi, lo));
+    em->total_luminance = 0.0f;
+    for (int i = 0; i < em->count; i++) {
+        lm_emitter *e = &em->e[i];
+        if (e->punctual)
+            place_punctual(e, s, em->disk_radius);
+        else
+            place_area(e, s);
+        e->luminance = lum(e->power);
+        em->total_luminance += e->luminance;
+    }
+}
+
+/* ---- sampling helpers ---- */
+
+static lm_vec3 frame_dir(lm_vec3 n, float x, float y, float z)
+{
+    float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
+    lm_vec3 t = lm_v3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+    lm_vec3 bt = lm_v3(b, sign + n.y * n.y * a, -n.y);
+    return lm_normalize(lm_add(lm_add(lm_scale(t, x), lm_scale(bt, y)), lm_scale(n, z)));
+}
+
+/* Index of the triangle u falls on in the CDF; *rest = u's position inside that triangle's interval. */
+static uint32_t pick_tri(const lm_emitter *e, float u, float *rest, float *prob)
+{
+    uint32_t lo = 0, hi = e->tri_count - 1;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (e->cdf[mid] > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    float a = lo ? e->cdf[lo - 1] : 0.0f, b = e->cdf[lo];
+    *prob = b - a;
+    *rest = b > a ? fminf(fmaxf((u - a) / (b - a), 0.0f), 0.99999994f) : 0.5f;
+    return lo;
+}
+
+/* Uniform point on the triangle from two numbers: b = (1 - sqrt a, sqrt a (1 - c), sqrt a c). */
+static lm_vec3 tri_point(const lm_vec3 p[3], float a, float c)
+{
+    float r = sqrtf(a);
+    return lm_add(lm_add(lm_scale(p[0], 1.0f - r), lm_scale(p[1], r * (1.0f - c))), lm_scale(p[2], r * c));
+}
+
+/* ---- emission ---- */
+
+static void emit_area(const lm_emitters *em, const lm_scene *s, const lm_emitter *e, const float u[4],
+                      uint32_t count, lm_emission *out)
+{
+    (void)em;
+    float rest, prob;
+    uint32_t k = pick_tri(e, u[2], &rest, &prob);
+    uint32_t t = e->tris[k];
+    lm_vec3 p[3], n = lm_normalize(tri_world(s, t, p));
+    if (s->materials[s->tri_material[t]].double_sided) { /* leftover picks the side */
+        int back = rest >= 0.5f;
+        rest = back ? 2.0f * rest - 1.0f : 2.0f * rest;
+        n = back ? lm_scale(n, -1.0f) : n;
+    }
+    lm_vec3 x = tri_point(p, rest, u[3]);
+    float r = sqrtf(u[0]), phi = (float)(2.0 * LM_PI) * u[1];
+    lm_vec3 d = frame_dir(n, r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[0])));
+    lm_v3_store(out->org, lm_add(x, lm_scale(n, LM_EMIT_LIFT * lm_scene_size(s))));
+    lm_v3_store(out->dir, d);
+    float f[3];
+    tri_flux(s, t, f);
+    for (int c = 0; c < 3; c++)
+        out->flux[c] = prob > 0.0f ? f[c] / (prob * (float)count) : 0.0f;
+}
+
+static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emitter *e, const float u[4],
+                          uint32_t count, lm_emission *out)
+{
+    float phi = (float)(2.0 * LM_PI) * u[1], scale = 1.0f / (float)count;
+    lm_vec3 axis = lm_v3_load(e->dir), d, o = lm_v3_load(e->pos);
+    if (e->kind == LM_EMIT_POINT) {
+        float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        d = lm_v3(r * cosf(phi), r * sinf(phi), z);
+        scale *= (float)(4.0 * LM_PI);
+    } else if (e->kind == LM_EMIT_SPOT) {
+        const lm_light *l = &s->lights[e->light];
+        float co = cosf(l->outer_cone), z = 1.0f - u[0] * (1.0f - co), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        d = frame_dir(axis, r * cosf(phi), r * sinf(phi), z);
+        scale *= lm_spot_attenuation(l, z) * (float)(2.0 * LM_PI) * (1.0f - co);
+    } else {
+        float r = em->disk_radius * sqrtf(u[0]), back = 1.001f * em->disk_radius;
+        lm_vec3 c = lm_sub(lm_v3_load(em->disk_center), lm_scale(axis, back));
+        lm_vec3 off = frame_dir(axis, cosf(phi), sinf(phi), 0.0f);
+        o = lm_add(c, lm_scale(off, r));
+        d = axis;
+        scale *= (float)LM_PI * em->disk_radius * em->disk_radius;
+    }
+    lm_v3_store(out->org, o);
+    lm_v3_store(out->dir, d);
+    for (int c = 0; c < 3; c++)
+        out->flux[c] = e->radiant[c] * scale;
+}
+
+void lm_emitter_emit(const lm_emitters *em, const lm_scene *s, int e, const float u[4], uint32_t count,
+                     lm_emission *out)
+{
+    const lm_emitter *em_e = &em->e[e];
+    memset(out, 0, sizeof *out);
+    if (count == 0)
+        return;
+    if (em_e->punctual)
+        emit_punctual(em, s, em_e, u, count, out);
+    else if (em_e->tri_count > 0 && em_e->cdf[em_e->tri_count - 1] > 0.0f)
+        emit_area(em, s, em_e, u, count, out);
+}
+
+/* ---- next-event estimation ---- */
+
+int lm_emitted_radiance(const lm_material *m, const float ng[3], const float wo[3], float out[3])
+{
+    out[0] = out[1] = out[2] = 0.0f;
+    if (m->cls != LM_MAT_EMITTER)
+        return 0;
+    if (!m->double_sided && lm_dot(lm_v3_load(ng), lm_v3_load(wo)) <= 0.0f)
+        return 0;
+    for (int c = 0; c < 3; c++)
+        out[c] = m->emissive[c];
+    return out[0] > 0.0f || out[1] > 0.0f || out[2] > 0.0f;
+}
+
+static int toward_punctual(const lm_scene *s, const lm_emitter *e, lm_vec3 p, lm_light_sample *out)
+{
+    if (e->kind == LM_EMIT_DIRECTIONAL) {
+        lm_v3_store(out->dir, lm_scale(lm_v3_load(e->dir), -1.0f));
+        out->dist = INFINITY;
+        memcpy(out->weight, e->radiant, sizeof out->weight);
+        return 1;
+    }
+    lm_vec3 d = lm_sub(lm_v3_load(e->pos), p);
+    float d2 = lm_dot(d, d);
+    if (!(d2 > 0.0f))
+        return 0;
+    float dist = sqrtf(d2), att = 1.0f;
+    lm_vec3 dir = lm_scale(d, 1.0f / dist);
+    if (e->kind == LM_EMIT_SPOT)
+        att = lm_spot_attenuation(&s->lights[e->light], -lm_dot(dir, lm_v3_load(e->dir)));
+    lm_v3_store(out->dir, dir);
+    out->dist = dist;
+    for (int c = 0; c < 3; c++)
+        out->weight[c] = e->radiant[c] * att / d2; /* E = I att cos / d^2 */
+    return att > 0.0f;
+}
+
+/* Solid-angle density of picking x (on triangle k of e, normal n unnormalized) from p. */
+static float area_pdf(const lm_scene *s, const lm_emitter *e, uint32_t k, lm_vec3 p, lm_vec3 x, lm_vec3 n,
+                      float *cos_l)
+{
+    lm_vec3 d = lm_sub(x, p);
+    float d2 = lm_dot(d, d), nl = lm_length(n);
+    if (!(d2 > 0.0f) || !(nl > 0.0f))
+        return 0.0f;
+    float c = -lm_dot(n, d) / (nl * sqrtf(d2)); /* cosine at the light, towards p */
+    if (c <= 0.0f && !s->materials[s->tri_material[e->tris[k]]].double_sided)
+        return 0.0f;
+    *cos_l = fabsf(c);
+    float prob = e->cdf[k] - (k ? e->cdf[k - 1] : 0.0f), area = 0.5f * nl;
+    if (!(*cos_l > 1e-7f) || !(prob > 0.0f))
+        return 0.0f;
+    return prob / area * d2 / *cos_l; /* pdf_area d^2 / cos */
+}
+
+static int toward_area(const lm_scene *s, const lm_emitter *e, lm_vec3 p, const float u[3], lm_light_sample *out)
+{
+    if (e->tri_count == 0 || !(e->cdf[e->tri_count - 1] > 0.0f))
+        return 0;
+    float rest, prob, cos_l = 0.0f;
+    uint32_t k = pick_tri(e, u[0], &rest, &prob);
+    lm_vec3 c[3], n = tri_world(s, e->tris[k], c);
+    lm_vec3 x = tri_point(c, u[1], u[2]);
+    float pdf = area_pdf(s, e, k, p, x, n, &cos_l);
+    if (!(pdf > 0.0f) || !isfinite(pdf))
+        return 0;
+    lm_vec3 d = lm_sub(x, p);
+    float dist = lm_length(d);
+    const float *le = s->materials[s->tri_material[e->tris[k]]].emissive;
+    lm_v3_store(out->dir, lm_scale(d, 1.0f / dist));
+    out->dist = dist;
+    out->pdf = pdf;
+    for (int ch = 0; ch < 3; ch++)
+        out->weight[ch] = le[ch] / pdf;
+    return 1;
+}
+
+int lm_emitter_sample_toward(const lm_emitters *em, const lm_scene *s, int e, const float p[3],
+                             const float u[3], lm_light_sample *out)
+{
+    memset(out, 0, sizeof *out);
+    const lm_emitter *em_e = &em->e[e];
+    if (em_e->punctual)
+        return toward_punctual(s, em_e, lm_v3_load(p), out);
+    return toward_area(s, em_e, lm_v3_load(p), u, out);
+}
+
+float lm_emitter_pdf(const lm_emitters *em, const lm_scene *s, int e, uint32_t tri, const float p[3],
+                     const float x[3])
+{
+    const lm_emitter *em_e = &em->e[e];
+    if (em_e->punctual || em_e->tri_count == 0)
+        return 0.0f;
+    uint32_t lo = 0, hi = em_e->tri_count; /* tris are ascending */
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (em_e->tris[mid] < tri)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    if (lo >= em_e->tri_count || em_e->tris[lo] != tri)
+        return 0.0f;
+    lm_vec3 c[3], n = tri_world(s, tri, c);
+    float cos_l = 0.0f;
+    return area_pdf(s, em_e, lo, lm_v3_load(p), lm_v3_load(x), n, &cos_l);
+}

@@ -1,0 +1,87 @@
+/* Light emitters: every point, spot and directional light, and the emissive triangles of each node
+ * (one emitter per node with an emissive material), with the flux each emits.
+ *
+ * Units (docs/materials.md): glTF intensities are used as linear RGB radiometric quantities.
+ * Point: intensity I -> flux 4 pi I. Spot: I -> I times the solid angle of its cone (with the glTF
+ * smooth falloff between inner and outer angles integrated). Directional: illuminance E -> flux E times
+ * the area of a disk that covers the scene's bounds, perpendicular to the light. Emissive: radiance
+ * L = emissive x strength, flux pi L A per emitting side (double-sided materials emit on both sides). */
+#ifndef LM_LIGHTS_H
+#define LM_LIGHTS_H
+
+#include <stdint.h>
+
+#include "../core/error.h"
+#include "../scene/scene.h"
+
+typedef enum { LM_EMIT_POINT = 0, LM_EMIT_SPOT, LM_EMIT_DIRECTIONAL, LM_EMIT_AREA } lm_emitter_kind;
+
+typedef struct {
+    lm_emitter_kind kind;
+    int light;            /* scene light index, -1 for AREA */
+    int node;             /* node that places it */
+    float power[3];       /* emitted flux, RGB */
+    float luminance;      /* luminance of power: photon counts are split in proportion to it */
+    /* AREA: the node's emissive triangles and the CDF for choosing one by flux */
+    uint32_t tri_count;
+    uint32_t *tris;
+    float *cdf;
+    float area;           /* world area of those triangles */
+    int punctual;         /* point, spot, directional: their direct light is computed per pixel */
+    /* Placement, kept current by lm_emitters_update (added for NEE): */
+    float pos[3];         /* point/spot: world position (node world translation) */
+    float dir[3];         /* point/spot/directional: unit direction the light shines (node world -Z) */
+    float radiant[3];     /* point/spot: intensity x colour; directional: illuminance x colour */
+} lm_emitter;
+
+typedef struct {
+    int count;
+    lm_emitter *e;
+    float total_luminance;
+    float disk_center[3], disk_radius; /* directional lights emit from this disk (scene bounds) */
+} lm_emitters;
+
+lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err);
+void lm_emitters_free(lm_emitters *em);
+/* Re-reads emitter placement and flux after node moves or light edits (world matrices, bounds). */
+void lm_emitters_update(lm_emitters *em, const lm_scene *s);
+
+/* A photon leaving emitter e: origin, unit direction, and its flux for a total of `count` photons
+ * from this emitter (flux = power / count, times any falloff weight). u: 4 uniform numbers in [0,1)
+ * (u[0], u[1] choose the direction, so QMC strata of those two give photons of similar direction). */
+typedef struct {
+    float org[3], dir[3];
+    float flux[3];
+} lm_emission;
+void lm_emitter_emit(const lm_emitters *em, const lm_scene *s, int e, const float u[4], uint32_t count,
+                     lm_emission *out);
+
+/* Next-event estimation from point p: a sample on emitter e. dir is unit from p towards the light,
+ * dist its distance (INFINITY for directional), radiance_weight the incident radiance times the
+ * inverse pdf (so that E += radiance_weight * cos for one sample). Returns 0 if p gets nothing. */
+typedef struct {
+    float dir[3];
+    float dist;
+    float weight[3];
+    float pdf;            /* solid-angle density of dir (AREA; 0 for the delta lights), for MIS */
+} lm_light_sample;
+int lm_emitter_sample_toward(const lm_emitters *em, const lm_scene *s, int e, const float p[3],
+                             const float u[3], lm_light_sample *out);
+
+/* Additions (lights.c documents the details):
+ * lm_spot_attenuation: glTF KHR_lights_punctual's smooth cone falloff at cos_angle (cosine between the
+ * spot's axis and the direction to the lit point): t = clamp((cos_angle - cos outer) / max(1e-3,
+ * cos inner - cos outer), 0, 1), attenuation t^2, as the extension's reference implementation.
+ * lm_spot_solid_angle: the integral of that attenuation over the sphere (exact), so flux = I x it.
+ * lm_emitter_pdf: the solid-angle density with which lm_emitter_sample_toward(e, p) picks the point x
+ * on scene triangle tri (0 if tri is not one of e's triangles or p sees its non-emitting side).
+ * lm_emitted_radiance: radiance a surface of material m (geometric normal ng) emits along wo (unit,
+ * leaving the surface): the material's emissive for an emitter on an emitting side, else 0; returns
+ * whether it is non-zero. Emissive textures are not used (the emissive factor is). */
+float lm_spot_attenuation(const lm_light *l, float cos_angle);
+float lm_spot_solid_angle(const lm_light *l);
+float lm_emitter_pdf(const lm_emitters *em, const lm_scene *s, int e, uint32_t tri, const float p[3],
+                     const float x[3]);
+int lm_emitted_radiance(const lm_material *m, const float ng[3], const float wo[3], float out[3]);
+
+#endif

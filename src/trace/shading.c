@@ -1,0 +1,82 @@
+/* Hit point attributes for light transport (shading.h). */
+#include "shading.h"
+
+#include <string.h>
+
+#include "../core/vecmath.h"
+
+/* Barycentric weights of Embree's (u, v): p = (1-u-v) v0 + u v1 + v v2. */
+static void hit_weights(const lm_rt_hit *hit, float w[3])
+{
+    w[1] = hit->u;
+    w[2] = hit->v;
+    w[0] = 1.0f - hit->u - hit->v;
+}
+
+static lm_vec3 interp3(const float *attr, const uint32_t *idx, const float w[3])
+{
+    lm_vec3 r = lm_v3(0, 0, 0);
+    for (int k = 0; k < 3; k++)
+        r = lm_add(r, lm_scale(lm_v3_load(attr + 3 * (size_t)idx[k]), w[k]));
+    return r;
+}
+
+static void interp2(const float *attr, const uint32_t *idx, const float w[3], float out[2])
+{
+    out[0] = out[1] = 0.0f;
+    for (int k = 0; k < 3; k++) {
+        out[0] += w[k] * attr[2 * (size_t)idx[k]];
+        out[1] += w[k] * attr[2 * (size_t)idx[k] + 1];
+    }
+}
+
+/* Shading normal: interpolated vertex normals in world space, flipped to ng's side; ng where the
+ * interpolation degenerates. */
+static lm_vec3 shading_normal(const lm_scene *s, const uint32_t *idx, const float w[3], lm_vec3 ng)
+{
+    lm_vec3 n = lm_v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        float nk[3];
+        lm_scene_normal_world(s, idx[k], nk);
+        n = lm_add(n, lm_scale(lm_v3_load(nk), w[k]));
+    }
+    n = lm_normalize(n);
+    if (!lm_v3_finite(n) || lm_dot(n, n) < 0.5f)
+        return ng;
+    return lm_dot(n, ng) < 0.0f ? lm_scale(n, -1.0f) : n;
+}
+
+static void fill_albedo(const lm_scene *s, const uint32_t *idx, const float w[3], lm_shading *sh)
+{
+    const lm_material *m = sh->material;
+    float uv[2] = {sh->uv0[0], sh->uv0[1]};
+    if (m->base_color_uv == 1 && s->uv1)
+        interp2(s->uv1, idx, w, uv);
+    lm_material_albedo(s, m, uv[0], uv[1], sh->albedo);
+}
+
+void lm_shading_from_hit(const lm_scene *s, const lm_rt_hit *hit, const float org[3], const float dir[3],
+                         lm_shading *sh)
+{
+    memset(sh, 0, sizeof *sh);
+    const uint32_t *idx = s->tris + 3 * (size_t)hit->tri;
+    float w[3];
+    hit_weights(hit, w);
+    const lm_node *node = &s->nodes[hit->node];
+    lm_vec3 local = interp3(s->positions, idx, w);
+    lm_vec3 pos = lm_mat4_point(node->world, local);
+    if (!lm_v3_finite(pos)) /* fall back to the ray's own parameter */
+        pos = lm_add(lm_v3_load(org), lm_scale(lm_v3_load(dir), hit->t));
+    lm_v3_store(sh->pos, pos);
+    lm_v3_store(sh->local, local);
+    lm_vec3 ng = lm_v3_load(hit->ng);
+    lm_v3_store(sh->ng, ng);
+    lm_v3_store(sh->ns, shading_normal(s, idx, w, ng));
+    interp2(s->uv0, idx, w, sh->uv0);
+    sh->material_id = s->tri_material[hit->tri];
+    sh->material = &s->materials[sh->material_id];
+    fill_albedo(s, idx, w, sh);
+    sh->node = hit->node;
+    sh->surface = hit->surface;
+    sh->tri = hit->tri;
+}

@@ -1,0 +1,26 @@
+/* What a ray hit means for light transport: the hit point's position, normals, texture coordinates,
+ * albedo and material, all in world space. Shared by the photon tracer and the reference solver. */
+#ifndef LM_SHADING_H
+#define LM_SHADING_H
+
+#include "../scene/scene.h"
+#include "rt_scene.h"
+
+typedef struct {
+    float pos[3];        /* world position */
+    float local[3];      /* the same point in the hit node's local space */
+    float ng[3];         /* geometric normal, unit, as wound */
+    float ns[3];         /* shading normal, unit, flipped to the side of ng */
+    float uv0[2];
+    float albedo[3];     /* base colour factor x texture at uv0, linear */
+    const lm_material *material;
+    int material_id;
+    int node, surface;
+    uint32_t tri;
+} lm_shading;
+
+/* Fills sh from a hit of a ray with origin org and direction dir (current node transforms). */
+void lm_shading_from_hit(const lm_scene *s, const lm_rt_hit *hit, const float org[3], const float dir[3],
+                         lm_shading *sh);
+
+#endif
