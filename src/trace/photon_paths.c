@@ -1,0 +1,184 @@
+/* Stored photon paths (Larsen & Christensen 2004, section 2): every photon's (node, triangle)
+ * vertices, hit points and the store slots of its hits, so a changed path is found by comparison
+ * and its hits are removed in O(1) each. A group's paths lie back to back in one slab, rebuilt when
+ * the group is re-traced (only re-traced groups change paths). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/vecmath.h"
+#include "photons_internal.h"
+
+/* Relative flux change that counts as a different path (a light or material edit). */
+#define PH_FLUX_TOLERANCE 1e-4f
+
+const ph_vertex *ph_job_vertices(const ph_batch *b, const ph_job *j)
+{
+    return b->buffers[j->buffer].v + j->first;
+}
+
+static float dist2(const float a[3], const float b[3])
+{
+    float dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+    return dx * dx + dy * dy + dz * dz;
+}
+
+static int flux_changed(const float a[3], const float b[3])
+{
+    float scale = 0.0f;
+    for (int c = 0; c < 3; c++)
+        scale = fmaxf(scale, fmaxf(fabsf(a[c]), fabsf(b[c])));
+    for (int c = 0; c < 3; c++)
+        if (fabsf(a[c] - b[c]) > PH_FLUX_TOLERANCE * scale)
+            return 1;
+    return 0;
+}
+
+/* A stored hit still matches a new vertex if its node-local point, placed by the node's current
+ * matrix, lies within epsilon (a moved node carries its hits along) and its flux is the same. */
+static int hit_changed(const lm_photons *ph, const lm_hit *h, const ph_vertex *v, float eps2)
+{
+    lm_vec3 p = lm_mat4_point(ph->scene->nodes[v->node].world, lm_v3_load(h->local));
+    float placed[3];
+    lm_v3_store(placed, p);
+    return dist2(placed, v->pos) > eps2 || flux_changed(h->flux, v->flux);
+}
+
+int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n)
+{
+    uint32_t first = g->offsets[m];
+    if (g->offsets[m + 1] - first != n)
+        return 1;
+    float eps2 = ph->epsilon * ph->epsilon;
+    for (uint32_t i = 0; i < n; i++) {
+        const lm_path_vertex *p = &g->verts[first + i];
+        if (p->node != v[i].node || p->tri != v[i].tri || dist2(p->pos, v[i].pos) > eps2)
+            return 1;
+        int stored = v[i].surface >= 0;
+        if (stored != (p->slot != LM_NONE))
+            return 1;
+        if (stored && hit_changed(ph, &ph->store.hits[p->slot], &v[i], eps2))
+            return 1;
+    }
+    return 0;
+}
+
+/* Grows *verts to hold need vertices: doubling for scratch, exactly for a group's slab (rebuilt
+ * only when the group is re-traced, so slack would just be kept memory). */
+static int reserve_verts(lm_path_vertex **verts, uint32_t *cap, uint32_t need, int exact)
+{
+    if (need <= *cap)
+        return 1;
+    uint32_t n = exact ? need : (*cap ? *cap : 64);
+    while (n < need)
+        n *= 2;
+    lm_path_vertex *v = realloc(*verts, (size_t)n * sizeof *v);
+    if (!v)
+        return 0;
+    *verts = v;
+    *cap = n;
+    return 1;
+}
+
+static uint32_t store_vertex(lm_photons *ph, const ph_vertex *v, uint32_t photon, int punctual)
+{
+    lm_hit h;
+    memset(&h, 0, sizeof h);
+    memcpy(h.pos, v->pos, sizeof h.pos);
+    memcpy(h.local, v->local, sizeof h.local);
+    memcpy(h.dir, v->dir, sizeof h.dir);
+    memcpy(h.flux, v->flux, sizeof h.flux);
+    h.photon = photon;
+    h.tri = v->tri;
+    h.surface = v->surface;
+    h.bounce = v->bounce;
+    h.from_punctual = (uint8_t)(punctual != 0);
+    return lm_photon_store_add(&ph->store, &h);
+}
+
+/* Removes photon m's old hits and writes its new path (with new hits) at out. Returns 0 if a hit
+ * could not be stored (that vertex then keeps no slot, so the next check re-traces it). */
+static int replace_path(lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n,
+                        lm_path_vertex *out, lm_photon_frame_stats *st)
+{
+    for (uint32_t i = g->offsets[m]; i < g->offsets[m + 1]; i++)
+        if (g->verts[i].slot != LM_NONE) {
+            lm_photon_store_remove(&ph->store, g->verts[i].slot);
+            ph->live_hits--;
+            st->hits_removed++;
+        }
+    uint32_t photon = g->first_id + m * ph->G;
+    int punctual = ph->em->e[g->emitter].punctual, ok = 1;
+    for (uint32_t i = 0; i < n; i++) {
+        out[i].node = v[i].node;
+        out[i].tri = v[i].tri;
+        memcpy(out[i].pos, v[i].pos, sizeof out[i].pos);
+        out[i].slot = LM_NONE;
+        if (v[i].surface < 0)
+            continue;
+        out[i].slot = store_vertex(ph, &v[i], photon, punctual);
+        if (out[i].slot == LM_NONE) {
+            ok = 0;
+            continue;
+        }
+        ph->live_hits++;
+        st->hits_added++;
+    }
+    st->photons_updated++;
+    return ok;
+}
+
+/* Flags changed photons and sizes the new slab; reserves all memory before the store is touched. */
+static int prepare_apply(lm_photons *ph, ph_group *g, const ph_job *jobs, uint32_t *total)
+{
+    *total = 0;
+    for (uint32_t m = 0; m < g->photons; m++) {
+        const ph_job *j = &jobs[m];
+        ph->tmp_changed[m] = (uint8_t)ph_path_changed(ph, g, m, ph_job_vertices(&ph->batch, j), j->count);
+        *total += j->count; /* an unchanged path has the same length */
+    }
+    return reserve_verts(&ph->tmp_verts, &ph->tmp_cap, *total, 0) &&
+           reserve_verts(&g->verts, &g->vert_cap, *total, 1);
+}
+
+lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_job *jobs, lm_photon_frame_stats *st,
+                         lm_error *err)
+{
+    uint32_t total;
+    if (!prepare_apply(ph, g, jobs, &total))
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of group %u of emitter %d",
+                       g->index, g->emitter);
+    int ok = 1;
+    uint32_t at = 0;
+    for (uint32_t m = 0; m < g->photons; m++) {
+        ph->tmp_offsets[m] = at;
+        const ph_job *j = &jobs[m];
+        if (ph->tmp_changed[m])
+            ok &= replace_path(ph, g, m, ph_job_vertices(&ph->batch, j), j->count, ph->tmp_verts + at, st);
+        else if (j->count) /* an empty path may have no slab at all */
+            memcpy(ph->tmp_verts + at, g->verts + g->offsets[m], (size_t)j->count * sizeof *g->verts);
+        at += j->count;
+    }
+    ph->tmp_offsets[g->photons] = at;
+    if (total)
+        memcpy(g->verts, ph->tmp_verts, (size_t)total * sizeof *g->verts);
+    memcpy(g->offsets, ph->tmp_offsets, ((size_t)g->photons + 1) * sizeof *g->offsets);
+    if (!ok)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory to store the hits of group %u of emitter %d",
+                       g->index, g->emitter);
+    return LM_OK;
+}
+
+void ph_group_free(ph_group *g)
+{
+    free(g->offsets);
+    free(g->verts);
+    g->offsets = NULL;
+    g->verts = NULL;
+    g->vert_cap = 0;
+}
+
+size_t ph_group_bytes(const ph_group *g)
+{
+    return ((size_t)g->photons + 1) * sizeof *g->offsets + (size_t)g->vert_cap * sizeof *g->verts;
+}

@@ -1,0 +1,107 @@
+#include "photon_store.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error *err)
+{
+    memset(ps, 0, sizeof *ps);
+    ps->free_head = LM_NONE;
+    ps->surface_count = surface_count;
+    ps->surfaces = malloc(sizeof *ps->surfaces * (size_t)(surface_count > 0 ? surface_count : 1));
+    if (!ps->surfaces)
+        return lm_fail(err, LM_ERR_NOMEM, "photon store: no memory for %d surfaces", surface_count);
+    for (int i = 0; i < surface_count; i++) {
+        ps->surfaces[i].head = LM_NONE;
+        ps->surfaces[i].count = 0;
+        ps->surfaces[i].delta_f = ps->surfaces[i].delta_i = 0.0;
+    }
+    return LM_OK;
+}
+
+void lm_photon_store_free(lm_photon_store *ps)
+{
+    free(ps->hits);
+    free(ps->surfaces);
+    memset(ps, 0, sizeof *ps);
+    ps->free_head = LM_NONE;
+}
+
+double lm_hit_energy(const lm_hit *h)
+{
+    return 0.2126 * h->flux[0] + 0.7152 * h->flux[1] + 0.0722 * h->flux[2];
+}
+
+/* Both deltas grow by the hit's energy, whether it arrives or leaves: they measure change. */
+static void account(lm_photon_store *ps, const lm_hit *h)
+{
+    lm_surface_hits *sh = &ps->surfaces[h->surface];
+    double e = lm_hit_energy(h);
+    sh->delta_f += e;
+    if (!(h->bounce == 0 && h->from_punctual))
+        sh->delta_i += e;
+}
+
+static uint32_t take_slot(lm_photon_store *ps)
+{
+    if (ps->free_head != LM_NONE) {
+        uint32_t slot = ps->free_head;
+        ps->free_head = ps->hits[slot].next;
+        return slot;
+    }
+    if (ps->used == ps->capacity) {
+        if (ps->capacity >= LM_NONE / 2) /* slot ids must stay below LM_NONE */
+            return LM_NONE;
+        uint32_t cap = ps->capacity ? ps->capacity * 2 : 1024;
+        lm_hit *grown = realloc(ps->hits, sizeof *grown * cap);
+        if (!grown)
+            return LM_NONE;
+        ps->hits = grown;
+        ps->capacity = cap;
+    }
+    return ps->used++;
+}
+
+uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h)
+{
+    if (h->surface < 0 || h->surface >= ps->surface_count)
+        return LM_NONE;
+    uint32_t slot = take_slot(ps);
+    if (slot == LM_NONE)
+        return LM_NONE;
+    lm_surface_hits *sh = &ps->surfaces[h->surface];
+    lm_hit *d = &ps->hits[slot];
+    *d = *h;
+    d->prev = LM_NONE;
+    d->next = sh->head;
+    if (sh->head != LM_NONE)
+        ps->hits[sh->head].prev = slot;
+    sh->head = slot;
+    sh->count++;
+    account(ps, d);
+    return slot;
+}
+
+void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
+{
+    if (slot >= ps->used || ps->hits[slot].surface < 0) /* not a live hit: nothing to unlink */
+        return;
+    lm_hit *d = &ps->hits[slot];
+    lm_surface_hits *sh = &ps->surfaces[d->surface];
+    if (d->prev != LM_NONE)
+        ps->hits[d->prev].next = d->next;
+    else
+        sh->head = d->next;
+    if (d->next != LM_NONE)
+        ps->hits[d->next].prev = d->prev;
+    sh->count--;
+    account(ps, d);
+    d->surface = -1;
+    d->prev = LM_NONE;
+    d->next = ps->free_head;
+    ps->free_head = slot;
+}
+
+void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_f = 0.0; }
+void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_i = 0.0; }
+size_t lm_photon_store_bytes(const lm_photon_store *ps) { (void)ps; return sizeof(lm_hit); }

@@ -1,0 +1,60 @@
+/* Stored photon hits, linked into per-surface lists so that adding and removing a hit is O(1), with
+ * the change accumulators the update scheduler reads (Larsen & Christensen, section 2-3):
+ *   delta_f: energy of every hit added or removed since the surface's AIM was last refreshed;
+ *   delta_i: the same, leaving out first hits from punctual lights (an IIM holds everything but the
+ *            punctual lights' direct light, DESIGN.md), since the surface's IIM was last refreshed.
+ * Energy of a hit is the luminance of its flux. */
+#ifndef LM_PHOTON_STORE_H
+#define LM_PHOTON_STORE_H
+
+#include <stdint.h>
+
+#include "../core/error.h"
+
+#define LM_NONE 0xFFFFFFFFu
+
+typedef struct {
+    float pos[3];          /* world position when stored */
+    float local[3];        /* position in the hit node's local space (AIM lookups match texel.local) */
+    float dir[3];          /* unit direction the photon travelled, towards the surface */
+    float flux[3];         /* RGB flux */
+    uint32_t photon;       /* owning photon */
+    uint32_t tri;
+    int32_t surface;
+    uint16_t bounce;       /* 0 = first hit after leaving the emitter */
+    uint8_t from_punctual; /* the photon came from a point, spot or directional light */
+    uint8_t pad;
+    uint32_t prev, next;   /* links in the surface's hit list (LM_NONE at the ends); next also links free slots */
+} lm_hit;
+
+typedef struct {
+    uint32_t head;         /* first hit, LM_NONE if none */
+    uint32_t count;
+    double delta_f, delta_i;
+} lm_surface_hits;
+
+typedef struct {
+    lm_hit *hits;
+    uint32_t capacity, used; /* slots allocated / in use */
+    uint32_t free_head;      /* first free slot (chain through next), LM_NONE if none */
+    int surface_count;
+    lm_surface_hits *surfaces;
+} lm_photon_store;
+
+lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error *err);
+void lm_photon_store_free(lm_photon_store *ps);
+/* Copies h into a free slot, links it into its surface's list and adds its energy to the surface's
+ * deltas. Returns the slot, or LM_NONE when memory ran out (the store is unchanged then). */
+uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h);
+/* Unlinks a stored hit, adds its energy to the deltas and frees the slot. A slot that holds no live
+ * hit (already removed, or never used) is ignored. */
+void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot);
+/* Energy of a hit as the deltas count it. */
+double lm_hit_energy(const lm_hit *h);
+/* Sets a surface's delta_f (after its AIM refresh) or delta_i (after its IIM refresh) to zero. */
+void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface);
+void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface);
+/* Bytes held per stored hit slot (for the memory report). */
+size_t lm_photon_store_bytes(const lm_photon_store *ps);
+
+#endif

@@ -1,0 +1,204 @@
+/* Tracing one photon from its own QMC dimensions, and tracing batches of photons in parallel
+ * (Larsen & Christensen 2004, section 2: fixed QMC photons, Russian roulette).
+ *
+ * Dimensions of photon id (Halton index halton_base + id): 0-3 emission (0-1 the direction, so groups
+ * of equal id mod G leave in similar directions), then 4 per path vertex b: 4 + 4b .. 4 + 4b + 2 sample
+ * the BSDF, 4 + 4b + 3 decides Russian roulette. Past LM_QMC_MAX_DIMS a hash of (seed, id, dim) takes
+ * over, still a pure function of the photon. */
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/qmc.h"
+#include "../core/vecmath.h"
+#include "bsdf.h"
+#include "photons_internal.h"
+#include "shading.h"
+
+#define PH_EMIT_DIMS 4u
+/* Smaller batches (a round-robin frame) run on the calling thread: waking a thread team costs more
+ * than tracing a few hundred photons, and much more when the cores are shared. */
+#define PH_PARALLEL_MIN_JOBS 1024u
+#define PH_DIMS_PER_BOUNCE 4u
+
+static uint64_t mix64(uint64_t z)
+{
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* A uniform number in [0, 1) as float (never rounds up to 1). */
+static float photon_sample(const lm_photons *ph, uint32_t id, uint32_t dim)
+{
+    double u;
+    if (dim < LM_QMC_MAX_DIMS) {
+        u = lm_halton(dim, ph->halton_base + id);
+    } else {
+        uint64_t h = mix64(((uint64_t)ph->set.seed << 32 | id) + 0x9E3779B97F4A7C15ull * (dim + 1));
+        u = (double)(h >> 11) * 0x1.0p-53;
+    }
+    float f = (float)u;
+    return f < 1.0f ? f : 0x1.fffffep-1f;
+}
+
+static int buffer_reserve(ph_buffer *buf)
+{
+    if (buf->len < buf->cap)
+        return 1;
+    size_t cap = buf->cap ? buf->cap * 2 : 256;
+    ph_vertex *v = realloc(buf->v, cap * sizeof *v);
+    if (!v)
+        return 0;
+    buf->v = v;
+    buf->cap = cap;
+    return 1;
+}
+
+static int push_vertex(ph_buffer *buf, const lm_shading *sh, const float dir[3], const float flux[3], uint32_t b)
+{
+    if (!buffer_reserve(buf))
+        return 0;
+    ph_vertex *v = &buf->v[buf->len++];
+    v->node = sh->node;
+    v->tri = sh->tri;
+    v->surface = (sh->surface >= 0 && lm_material_stores_hits(sh->material->cls)) ? sh->surface : -1;
+    v->bounce = (uint16_t)b;
+    memcpy(v->pos, sh->pos, sizeof v->pos);
+    memcpy(v->local, sh->local, sizeof v->local);
+    memcpy(v->dir, dir, sizeof v->dir);
+    memcpy(v->flux, flux, sizeof v->flux);
+    return 1;
+}
+
+/* Russian roulette on the albedo, then a BSDF sample; flux *= weight / p_survive. Returns 0 when the
+ * photon is absorbed. On success org and dir hold the next ray. */
+static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shading *sh, float org[3],
+                   float dir[3], float flux[3])
+{
+    uint32_t d = PH_EMIT_DIMS + PH_DIMS_PER_BOUNCE * b;
+    float p = lm_bsdf_survival(sh);
+    if (photon_sample(ph, id, d + 3) >= p)
+        return 0;
+    float u[3] = {photon_sample(ph, id, d), photon_sample(ph, id, d + 1), photon_sample(ph, id, d + 2)};
+    lm_bsdf_sample_t bs;
+    if (!lm_bsdf_sample(sh, dir, u, &bs))
+        return 0;
+    for (int c = 0; c < 3; c++) {
+        flux[c] *= bs.weight[c] / p;
+        if (!isfinite(flux[c]))
+            return 0;
+    }
+    lm_vec3 ng = lm_v3_load(sh->ng), wo = lm_v3_load(bs.wo);
+    float side = lm_dot(ng, wo) >= 0.0f ? ph->ray_offset : -ph->ray_offset;
+    lm_v3_store(org, lm_add(lm_v3_load(sh->pos), lm_scale(ng, side)));
+    memcpy(dir, bs.wo, sizeof bs.wo);
+    return 1;
+}
+
+int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count)
+{
+    const ph_group *g = &ph->groups[group];
+    uint32_t id = g->first_id + m * ph->G;
+    float u[PH_EMIT_DIMS];
+    for (uint32_t k = 0; k < PH_EMIT_DIMS; k++)
+        u[k] = photon_sample(ph, id, k);
+    uint32_t emitter_photons = ph->emitter_first[g->emitter + 1] - ph->emitter_first[g->emitter];
+    lm_emission emi;
+    lm_emitter_emit(ph->em, ph->scene, g->emitter, u, emitter_photons, &emi);
+    float org[3], dir[3], flux[3];
+    memcpy(org, emi.org, sizeof org);
+    memcpy(dir, emi.dir, sizeof dir);
+    memcpy(flux, emi.flux, sizeof flux);
+    *count = 0;
+    if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) /* an emitter that emits nothing */
+        return 1;
+    for (uint32_t b = 0; b < ph->set.max_bounces; b++) {
+        lm_rt_hit hit;
+        if (!lm_rt_intersect(ph->rt, org, dir, 0.0f, INFINITY, &hit))
+            break;
+        lm_shading sh;
+        lm_shading_from_hit(ph->scene, &hit, org, dir, &sh);
+        if (!push_vertex(buf, &sh, dir, flux, b))
+            return 0;
+        (*count)++;
+        if (!scatter(ph, id, b, &sh, org, dir, flux))
+            break;
+    }
+    return 1;
+}
+
+void ph_batch_clear(ph_batch *b) { b->count = 0; }
+
+int ph_batch_push(ph_batch *b, uint32_t group, uint32_t m)
+{
+    if (b->count == b->cap) {
+        uint32_t cap = b->cap ? b->cap * 2 : 1024;
+        ph_job *jobs = realloc(b->jobs, cap * sizeof *jobs);
+        if (!jobs)
+            return 0;
+        b->jobs = jobs;
+        b->cap = cap;
+    }
+    ph_job *j = &b->jobs[b->count++];
+    memset(j, 0, sizeof *j);
+    j->group = group;
+    j->m = m;
+    return 1;
+}
+
+void ph_batch_free(ph_batch *b)
+{
+    for (int t = 0; t < b->buffer_count; t++)
+        free(b->buffers[t].v);
+    free(b->buffers);
+    free(b->jobs);
+    memset(b, 0, sizeof *b);
+}
+
+static int ensure_buffers(ph_batch *b, int threads)
+{
+    if (b->buffer_count >= threads)
+        return 1;
+    ph_buffer *bufs = realloc(b->buffers, (size_t)threads * sizeof *bufs);
+    if (!bufs)
+        return 0;
+    memset(bufs + b->buffer_count, 0, (size_t)(threads - b->buffer_count) * sizeof *bufs);
+    b->buffers = bufs;
+    b->buffer_count = threads;
+    return 1;
+}
+
+/* Each job writes only its own record and its thread's buffer; what a job traces depends on the
+ * photon alone, so results are the same whatever thread ran it. */
+lm_status ph_trace_batch(lm_photons *ph, lm_error *err)
+{
+    ph_batch *b = &ph->batch;
+    int threads = omp_get_max_threads();
+    if (!ensure_buffers(b, threads))
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %d trace buffers", threads);
+    for (int t = 0; t < b->buffer_count; t++)
+        b->buffers[t].len = 0;
+    int failed = 0;
+    const lm_photons *cph = ph;
+#pragma omp parallel num_threads(threads) if (b->count >= PH_PARALLEL_MIN_JOBS)
+    {
+        lm_rt_thread_init();
+        int t = omp_get_thread_num();
+        ph_buffer *buf = &b->buffers[t];
+#pragma omp for schedule(dynamic, 16)
+        for (long i = 0; i < (long)b->count; i++) {
+            ph_job *j = &b->jobs[i];
+            j->buffer = (uint32_t)t;
+            j->first = (uint32_t)buf->len;
+            if (!ph_trace_photon(cph, j->group, j->m, buf, &j->count)) {
+#pragma omp atomic write
+                failed = 1;
+            }
+        }
+    }
+    if (failed)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of %u photons", b->count);
+    return LM_OK;
+}

@@ -1,0 +1,437 @@
+/* The photon stage (photons.h): photon counts and groups, the full trace, the per-frame round robin
+ * check and the budgeted re-trace of invalid groups (Larsen & Christensen 2004, section 2). */
+#include "photons.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/timing.h"
+#include "photons_internal.h"
+
+/* Photons traced per batch in a group re-trace: bounds the trace buffers. */
+#define PH_BATCH_PHOTONS 16384u
+#define PH_MAX_PHOTONS (1u << 30)
+
+void lm_photon_settings_default(lm_photon_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->groups = 72;
+    s->per_group = 40;
+    s->retrace_per_group = 1;
+    s->group_budget = 16;
+    s->max_bounces = 32;
+}
+
+static int is_2a3b(uint32_t n)
+{
+    if (n == 0)
+        return 0;
+    while (n % 2 == 0)
+        n /= 2;
+    while (n % 3 == 0)
+        n /= 3;
+    return n == 1;
+}
+
+static lm_status check_settings(const lm_photon_settings *s, lm_error *err)
+{
+    if (!is_2a3b(s->groups) || s->groups > 1u << 20)
+        return lm_fail(err, LM_ERR_INVALID, "photon settings: groups %u must be 2^a 3^b, at most 2^20",
+                       s->groups);
+    if (s->total_photons == 0 && s->per_group == 0)
+        return lm_fail(err, LM_ERR_INVALID, "photon settings: per_group must be > 0 when total_photons is 0");
+    if (s->total_photons > PH_MAX_PHOTONS || s->per_group > PH_MAX_PHOTONS)
+        return lm_fail(err, LM_ERR_INVALID, "photon settings: at most %u photons", PH_MAX_PHOTONS);
+    if (s->max_bounces < 1 || s->max_bounces > 1024)
+        return lm_fail(err, LM_ERR_INVALID, "photon settings: max_bounces %u must be in [1, 1024]",
+                       s->max_bounces);
+    if (!isfinite(s->epsilon))
+        return lm_fail(err, LM_ERR_INVALID, "photon settings: epsilon must be finite");
+    return LM_OK;
+}
+
+/* M_e: photons per group of emitter e, in proportion to its luminance, at least 1. */
+static uint32_t emitter_per_group(const lm_photons *ph, int e, uint64_t total)
+{
+    const lm_emitters *em = ph->em;
+    double share = em->total_luminance > 0.0f ? em->e[e].luminance / (double)em->total_luminance
+                                               : 1.0 / em->count;
+    double m = floor((double)total * share / ph->G + 0.5);
+    return m < 1.0 ? 1u : (uint32_t)fmin(m, (double)PH_MAX_PHOTONS);
+}
+
+static lm_status plan_counts(lm_photons *ph, lm_error *err)
+{
+    uint32_t E = ph->emitter_count;
+    uint64_t total = ph->set.total_photons ? ph->set.total_photons : (uint64_t)ph->set.per_group * ph->G * E;
+    ph->emitter_first = calloc((size_t)E + 1, sizeof *ph->emitter_first);
+    if (!ph->emitter_first)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u emitters", E);
+    uint64_t at = 0;
+    for (uint32_t e = 0; e < E; e++) {
+        at += (uint64_t)emitter_per_group(ph, (int)e, total) * ph->G;
+        if (at > PH_MAX_PHOTONS)
+            return lm_fail(err, LM_ERR_INVALID, "photons: %llu photons over %u emitters exceed %u",
+                           (unsigned long long)at, E, PH_MAX_PHOTONS);
+        ph->emitter_first[e + 1] = (uint32_t)at;
+    }
+    ph->photon_count = (uint32_t)at;
+    return LM_OK;
+}
+
+static lm_status make_groups(lm_photons *ph, lm_error *err)
+{
+    ph->group_count = ph->emitter_count * ph->G;
+    size_t n = ph->group_count ? ph->group_count : 1;
+    ph->groups = calloc(n, sizeof *ph->groups);
+    ph->queue = malloc(n * sizeof *ph->queue);
+    ph->tmp_groups = malloc(n * sizeof *ph->tmp_groups);
+    if (!ph->groups || !ph->queue || !ph->tmp_groups)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u groups", ph->group_count);
+    for (uint32_t i = 0; i < ph->group_count; i++) {
+        ph_group *g = &ph->groups[i];
+        g->emitter = (int)(i / ph->G);
+        g->index = i % ph->G;
+        g->photons = (ph->emitter_first[g->emitter + 1] - ph->emitter_first[g->emitter]) / ph->G;
+        g->first_id = ph->emitter_first[g->emitter] + g->index;
+        g->offsets = calloc((size_t)g->photons + 1, sizeof *g->offsets);
+        if (!g->offsets)
+            return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for group %u", i);
+        if (g->photons > ph->max_group_photons)
+            ph->max_group_photons = g->photons;
+    }
+    ph->tmp_offsets = malloc(((size_t)ph->max_group_photons + 1) * sizeof *ph->tmp_offsets);
+    ph->tmp_changed = malloc((size_t)ph->max_group_photons + 1);
+    if (!ph->tmp_offsets || !ph->tmp_changed)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for group scratch");
+    return LM_OK;
+}
+
+static lm_status setup(lm_photons *ph, lm_error *err)
+{
+    lm_status st = check_settings(&ph->set, err);
+    if (st == LM_OK)
+        st = plan_counts(ph, err);
+    if (st == LM_OK)
+        st = make_groups(ph, err);
+    if (st == LM_OK)
+        st = lm_photon_store_init(&ph->store, ph->surfaces ? ph->surfaces->surface_count : 0, err);
+    float size = lm_scene_size(ph->scene);
+    if (!(size > 0.0f) || !isfinite(size))
+        size = 1.0f;
+    ph->epsilon = ph->set.epsilon > 0.0f ? ph->set.epsilon : 1e-4f * size;
+    ph->ray_offset = 1e-5f * size;
+    ph->halton_base = (uint64_t)ph->set.seed * ph->photon_count;
+    return st;
+}
+
+lm_status lm_photons_create(const lm_scene *s, const lm_surfaces *su, const lm_rt *rt, const lm_emitters *em,
+                            const lm_photon_settings *settings, lm_photons **out, lm_error *err)
+{
+    *out = NULL;
+    if (!s || !rt || !em || !settings)
+        return lm_fail(err, LM_ERR_INVALID, "photons: scene, BVH, emitters and settings are required");
+    lm_photons *ph = calloc(1, sizeof *ph);
+    if (!ph)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory");
+    ph->scene = s;
+    ph->surfaces = su;
+    ph->rt = rt;
+    ph->em = em;
+    ph->set = *settings;
+    ph->G = settings->groups;
+    ph->emitter_count = (uint32_t)(em->count > 0 ? em->count : 0);
+    ph->store.free_head = LM_NONE;
+    lm_status st = setup(ph, err);
+    if (st != LM_OK) {
+        lm_photons_free(ph);
+        return st;
+    }
+    *out = ph;
+    return LM_OK;
+}
+
+void lm_photons_free(lm_photons *ph)
+{
+    if (!ph)
+        return;
+    for (uint32_t i = 0; ph->groups && i < ph->group_count; i++)
+        ph_group_free(&ph->groups[i]);
+    free(ph->groups);
+    free(ph->queue);
+    free(ph->emitter_first);
+    free(ph->tmp_verts);
+    free(ph->tmp_offsets);
+    free(ph->tmp_changed);
+    free(ph->tmp_groups);
+    ph_batch_free(&ph->batch);
+    lm_photon_store_free(&ph->store);
+    free(ph);
+}
+
+/* ---- invalid-group queue: FIFO, each group at most once (oldest invalid first) ---- */
+
+static void mark_invalid(lm_photons *ph, uint32_t group)
+{
+    ph_group *g = &ph->groups[group];
+    if (g->invalid)
+        return;
+    g->invalid = 1;
+    ph->queue[(ph->queue_head + ph->queue_len) % ph->group_count] = group;
+    ph->queue_len++;
+}
+
+static uint32_t pop_invalid(lm_photons *ph)
+{
+    uint32_t group = ph->queue[ph->queue_head];
+    ph->queue_head = (ph->queue_head + 1) % ph->group_count;
+    ph->queue_len--;
+    ph->groups[group].invalid = 0;
+    return group;
+}
+
+lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err)
+{
+    if (e < 0 || (uint32_t)e >= ph->emitter_count)
+        return lm_fail(err, LM_ERR_INVALID, "photons: emitter %d out of range (%u emitters)", e,
+                       ph->emitter_count);
+    for (uint32_t g = 0; g < ph->G; g++)
+        mark_invalid(ph, (uint32_t)e * ph->G + g);
+    return LM_OK;
+}
+
+void lm_photons_invalidate_all(lm_photons *ph)
+{
+    for (uint32_t g = 0; g < ph->group_count; g++)
+        mark_invalid(ph, g);
+}
+
+/* ---- re-tracing groups: trace in parallel, apply serially in group and photon order ---- */
+
+static lm_status apply_batch(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
+{
+    for (uint32_t k = 0; k < ph->batch.count;) {
+        ph_group *g = &ph->groups[ph->batch.jobs[k].group];
+        lm_status s = ph_group_apply(ph, g, &ph->batch.jobs[k], st, err);
+        if (s != LM_OK)
+            return s;
+        k += g->photons;
+    }
+    return LM_OK;
+}
+
+/* 1 if group g fits in the current batch (a batch always takes at least one group). */
+static int batch_fits(const lm_photons *ph, uint32_t g)
+{
+    return ph->batch.count == 0 || ph->batch.count + ph->groups[g].photons <= PH_BATCH_PHOTONS;
+}
+
+static lm_status retrace_groups(lm_photons *ph, const uint32_t *list, uint32_t n, lm_photon_frame_stats *st,
+                                lm_error *err)
+{
+    uint32_t i = 0;
+    while (i < n) {
+        ph_batch_clear(&ph->batch);
+        for (; i < n && batch_fits(ph, list[i]); i++) {
+            const ph_group *g = &ph->groups[list[i]];
+            for (uint32_t m = 0; m < g->photons; m++)
+                if (!ph_batch_push(&ph->batch, list[i], m))
+                    return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
+            ph->groups[list[i]].retraces++;
+            st->groups_retraced++;
+            st->group_photons += g->photons;
+        }
+        lm_status s = ph_trace_batch(ph, err);
+        if (s == LM_OK)
+            s = apply_batch(ph, st, err);
+        if (s != LM_OK)
+            return s;
+    }
+    return LM_OK;
+}
+
+static void finish_stats(const lm_photons *ph, lm_photon_frame_stats *st, double t0)
+{
+    st->pending_groups = ph->queue_len;
+    st->seconds = lm_now() - t0;
+}
+
+lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)
+{
+    lm_photon_frame_stats local;
+    lm_photon_frame_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    double t0 = lm_now();
+    while (ph->queue_len)
+        pop_invalid(ph);
+    for (uint32_t g = 0; g < ph->group_count; g++)
+        ph->tmp_groups[g] = g;
+    lm_status s = retrace_groups(ph, ph->tmp_groups, ph->group_count, st, err);
+    finish_stats(ph, st, t0);
+    return s;
+}
+
+/* Round robin (section 2): k photons of every valid group are re-traced and compared with their
+ * stored paths; any difference marks the group invalid. */
+static lm_status round_robin(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
+{
+    ph_batch_clear(&ph->batch);
+    for (uint32_t i = 0; i < ph->group_count; i++) {
+        ph_group *g = &ph->groups[i];
+        if (g->invalid || g->photons == 0)
+            continue;
+        uint32_t k = ph->set.retrace_per_group < g->photons ? ph->set.retrace_per_group : g->photons;
+        for (uint32_t r = 0; r < k; r++)
+            if (!ph_batch_push(&ph->batch, i, (g->rr_next + r) % g->photons))
+                return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
+        g->rr_next = (g->rr_next + k) % g->photons;
+    }
+    st->rr_photons = ph->batch.count;
+    lm_status s = ph_trace_batch(ph, err);
+    if (s != LM_OK)
+        return s;
+    for (uint32_t k = 0; k < ph->batch.count; k++) {
+        const ph_job *j = &ph->batch.jobs[k];
+        ph_group *g = &ph->groups[j->group];
+        if (!ph_path_changed(ph, g, j->m, ph_job_vertices(&ph->batch, j), j->count))
+            continue;
+        st->paths_changed++;
+        if (!g->invalid) {
+            mark_invalid(ph, j->group);
+            g->invalidations++;
+            st->groups_invalidated++;
+        }
+    }
+    return LM_OK;
+}
+
+/* Re-traces up to group_budget invalid groups, oldest first. */
+static lm_status drain(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
+{
+    uint32_t n = ph->queue_len;
+    if (ph->set.group_budget && ph->set.group_budget < n)
+        n = ph->set.group_budget;
+    for (uint32_t i = 0; i < n; i++)
+        ph->tmp_groups[i] = pop_invalid(ph);
+    return retrace_groups(ph, ph->tmp_groups, n, st, err);
+}
+
+lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)
+{
+    lm_photon_frame_stats local;
+    lm_photon_frame_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    double t0 = lm_now();
+    lm_status s = round_robin(ph, st, err);
+    if (s == LM_OK)
+        s = drain(ph, st, err);
+    finish_stats(ph, st, t0);
+    return s;
+}
+
+/* ---- accessors ---- */
+
+const lm_photon_store *lm_photons_store(const lm_photons *ph) { return &ph->store; }
+uint32_t lm_photons_count(const lm_photons *ph) { return ph->photon_count; }
+uint32_t lm_photons_group_count(const lm_photons *ph) { return ph->group_count; }
+uint32_t lm_photons_groups_per_emitter(const lm_photons *ph) { return ph->G; }
+uint32_t lm_photons_stored_hits(const lm_photons *ph) { return ph->live_hits; }
+uint32_t lm_photons_pending_groups(const lm_photons *ph) { return ph->queue_len; }
+
+uint32_t lm_photons_emitter_photons(const lm_photons *ph, int e)
+{
+    if (e < 0 || (uint32_t)e >= ph->emitter_count)
+        return 0;
+    return ph->emitter_first[e + 1] - ph->emitter_first[e];
+}
+
+void lm_photons_group_info(const lm_photons *ph, uint32_t group, lm_photon_group_info *out)
+{
+    memset(out, 0, sizeof *out);
+    out->emitter = -1;
+    if (group >= ph->group_count)
+        return;
+    const ph_group *g = &ph->groups[group];
+    out->emitter = g->emitter;
+    out->index = g->index;
+    out->photons = g->photons;
+    out->invalid = g->invalid;
+    out->invalidations = g->invalidations;
+    out->retraces = g->retraces;
+}
+
+/* Emitter owning photon id (binary search over the first ids), or -1. */
+static int emitter_of(const lm_photons *ph, uint32_t photon)
+{
+    if (photon >= ph->photon_count)
+        return -1;
+    uint32_t lo = 0, hi = ph->emitter_count;
+    while (hi - lo > 1) {
+        uint32_t mid = (lo + hi) / 2;
+        if (ph->emitter_first[mid] <= photon)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return (int)lo;
+}
+
+uint32_t lm_photons_group_of(const lm_photons *ph, uint32_t photon)
+{
+    int e = emitter_of(ph, photon);
+    if (e < 0)
+        return LM_NONE;
+    return (uint32_t)e * ph->G + (photon - ph->emitter_first[e]) % ph->G;
+}
+
+uint32_t lm_photons_path(const lm_photons *ph, uint32_t photon, const lm_path_vertex **vertices)
+{
+    *vertices = NULL;
+    int e = emitter_of(ph, photon);
+    if (e < 0)
+        return 0;
+    uint32_t j = photon - ph->emitter_first[e];
+    const ph_group *g = &ph->groups[(uint32_t)e * ph->G + j % ph->G];
+    uint32_t m = j / ph->G;
+    *vertices = g->verts ? g->verts + g->offsets[m] : NULL;
+    return g->offsets[m + 1] - g->offsets[m];
+}
+
+void lm_photons_first_hit_flux(const lm_photons *ph, double *out)
+{
+    const lm_photon_store *ps = &ph->store;
+    for (int s = 0; s < ps->surface_count; s++) {
+        double sum[3] = {0, 0, 0};
+        for (uint32_t i = ps->surfaces[s].head; i != LM_NONE; i = ps->hits[i].next)
+            if (ps->hits[i].bounce == 0)
+                for (int c = 0; c < 3; c++)
+                    sum[c] += ps->hits[i].flux[c];
+        for (int c = 0; c < 3; c++)
+            out[3 * s + c] = sum[c];
+    }
+}
+
+void lm_photons_memory(const lm_photons *ph, lm_photon_memory *out)
+{
+    memset(out, 0, sizeof *out);
+    uint64_t verts = 0;
+    for (uint32_t i = 0; i < ph->group_count; i++) {
+        out->path_bytes += ph_group_bytes(&ph->groups[i]);
+        verts += ph->groups[i].offsets[ph->groups[i].photons];
+    }
+    out->store_bytes = (size_t)ph->store.capacity * lm_photon_store_bytes(&ph->store) +
+                       (size_t)ph->store.surface_count * sizeof *ph->store.surfaces;
+    size_t scratch = (size_t)ph->tmp_cap * sizeof *ph->tmp_verts + (size_t)ph->batch.cap * sizeof(ph_job);
+    for (int t = 0; t < ph->batch.buffer_count; t++)
+        scratch += ph->batch.buffers[t].cap * sizeof(ph_vertex);
+    out->other_bytes = sizeof *ph + (size_t)ph->group_count * (sizeof(ph_group) + 2 * sizeof(uint32_t)) +
+                       ((size_t)ph->emitter_count + 1) * sizeof(uint32_t) + scratch;
+    out->total_bytes = out->path_bytes + out->store_bytes + out->other_bytes;
+    double n = ph->photon_count ? ph->photon_count : 1;
+    out->per_photon = out->total_bytes / n;
+    out->mean_path_vertices = verts / n;
+    out->mean_hits = ph->live_hits / n;
+    out->live_per_photon = sizeof(uint32_t) + out->mean_path_vertices * sizeof(lm_path_vertex) +
+                           out->mean_hits * sizeof(lm_hit);
+}

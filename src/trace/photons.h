@@ -1,0 +1,127 @@
+/* The photon stage: selective photon emission and tracing (Larsen & Christensen 2004, section 2;
+ * DESIGN.md pipeline step 2; docs/photons.md).
+ *
+ * Each emitter owns a fixed set of photons, P_e = M_e x G, with fixed QMC (Halton) indices. Photon j of
+ * emitter e belongs to group j mod G of that emitter; G = 2^a 3^b, so a group's photons share one cell
+ * of the 2^a x 3^b stratification of Halton dims 0-1 and leave in similar directions. Every random
+ * decision along a path comes from the photon's own QMC dimensions, so an unchanged scene re-traces
+ * the identical path. Every photon's path is stored (its (node, triangle) vertices, hit points and the
+ * store slots of its hits), and every hit on a non-specular surface is linked into the lm_photon_store.
+ *
+ * Each frame, k photons per group are re-traced round robin and compared with their stored paths; a
+ * difference marks the whole group invalid. Invalid groups are re-traced oldest-invalid first under a
+ * per-frame group budget: their photons' old hits are removed and new ones added (photons whose path
+ * did not change cause no store change at all). Paths are traced in parallel (OpenMP) into per-photon
+ * buffers; store updates are applied serially in photon order, so results do not depend on threads.
+ *
+ * The scene, surfaces, BVH and emitters are borrowed: the caller keeps them alive and current (moves
+ * nodes with lm_rt_set_node_transform, calls lm_emitters_update after light edits). */
+#ifndef LM_PHOTONS_H
+#define LM_PHOTONS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../scene/scene.h"
+#include "lights.h"
+#include "photon_store.h"
+#include "rt_scene.h"
+
+typedef struct {
+    uint32_t total_photons;    /* photon budget over all emitters; 0 = per_group x groups x emitters */
+    uint32_t groups;           /* G, groups per emitter, must be 2^a 3^b (default 72 = 2^3 3^2) */
+    uint32_t per_group;        /* mean photons per group when total_photons is 0 (default 40) */
+    uint32_t retrace_per_group; /* k: photons per group re-traced each frame, round robin (default 1) */
+    uint32_t group_budget;     /* invalid groups re-traced per frame, oldest first (default 16; 0 = all) */
+    float epsilon;             /* a path vertex that moved more than this (world units) is a change;
+                                  <= 0: 1e-4 x scene size (default 0) */
+    uint32_t max_bounces;      /* most path vertices per photon, a safety net (default 32, at most 1024) */
+    uint32_t seed;             /* selects another, disjoint stretch of the Halton sequence (default 0) */
+} lm_photon_settings;
+
+void lm_photon_settings_default(lm_photon_settings *s);
+
+/* What one call of lm_photons_frame did. */
+typedef struct {
+    uint32_t rr_photons;        /* photons re-traced round robin to check their paths */
+    uint32_t paths_changed;     /* of those, how many differed from the stored path */
+    uint32_t groups_invalidated; /* groups newly marked invalid (round robin) this frame */
+    uint32_t groups_retraced;   /* invalid groups re-traced this frame */
+    uint32_t group_photons;     /* photons traced for those groups */
+    uint32_t photons_updated;   /* photons whose stored path and hits were replaced */
+    uint32_t hits_added, hits_removed;
+    uint32_t pending_groups;    /* invalid groups still waiting after this frame */
+    double seconds;
+} lm_photon_frame_stats;
+
+/* One group, for reports and tests. */
+typedef struct {
+    int emitter;
+    uint32_t index;             /* g in 0..G-1: photons j = g, g + G, ... of the emitter */
+    uint32_t photons;           /* M_e */
+    int invalid;                /* waiting in the re-trace queue */
+    uint32_t invalidations;     /* times the round robin found a changed path and marked it invalid */
+    uint32_t retraces;          /* times it was re-traced (lm_photons_trace_all included) */
+} lm_photon_group_info;
+
+typedef struct lm_photons lm_photons;
+
+/* Sets up photon counts, groups and the empty store; traces nothing. Emitters get photon counts in
+ * proportion to their luminance (at least one photon per group each), so photons carry about equal
+ * power. Fails on bad settings (G not 2^a 3^b, zero counts) naming the setting. */
+lm_status lm_photons_create(const lm_scene *s, const lm_surfaces *su, const lm_rt *rt, const lm_emitters *em,
+                            const lm_photon_settings *settings, lm_photons **out, lm_error *err);
+void lm_photons_free(lm_photons *ph);
+
+/* Traces every photon and stores its path and hits (initial full trace; also a full refresh: paths
+ * that did not change cause no store change). Clears the invalid queue. stats may be NULL. */
+lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);
+/* One frame: round-robin check of k photons per valid group, then re-trace of up to group_budget
+ * invalid groups, oldest first. stats may be NULL. Fails only when memory runs out. */
+lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);
+
+/* Marks all groups of emitter e invalid (after it moved or changed: call lm_emitters_update first).
+ * Groups already queued keep their place. Fails for an out-of-range emitter. */
+lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err);
+/* Marks every group invalid (e.g. after a material edit), in group order. */
+void lm_photons_invalidate_all(lm_photons *ph);
+
+const lm_photon_store *lm_photons_store(const lm_photons *ph);
+uint32_t lm_photons_count(const lm_photons *ph);         /* all photons */
+uint32_t lm_photons_group_count(const lm_photons *ph);   /* emitters x G */
+uint32_t lm_photons_groups_per_emitter(const lm_photons *ph);
+uint32_t lm_photons_emitter_photons(const lm_photons *ph, int e); /* P_e */
+uint32_t lm_photons_stored_hits(const lm_photons *ph);   /* live hits in the store */
+uint32_t lm_photons_pending_groups(const lm_photons *ph);
+void lm_photons_group_info(const lm_photons *ph, uint32_t group, lm_photon_group_info *out);
+/* Group of a photon id (lm_hit.photon), and the emitter that owns it. */
+uint32_t lm_photons_group_of(const lm_photons *ph, uint32_t photon);
+
+/* Memory: bytes held by paths (offsets and vertices), by the store (hit slots, spare ones included,
+ * and surface lists) and by the rest (groups, queue, trace scratch), summed in total;
+ * per_photon = total / photons. live_per_photon counts only what the photons use: 4 bytes of offset,
+ * sizeof(lm_path_vertex) per path vertex and sizeof(lm_hit) per stored hit. */
+typedef struct {
+    size_t path_bytes, store_bytes, other_bytes, total_bytes;
+    double per_photon, live_per_photon;
+    double mean_path_vertices;  /* stored vertices per photon */
+    double mean_hits;           /* stored hits per photon */
+} lm_photon_memory;
+void lm_photons_memory(const lm_photons *ph, lm_photon_memory *out);
+
+/* A photon's stored path: vertex count, and each vertex's node, triangle and world position. */
+typedef struct {
+    int node;
+    uint32_t tri;
+    float pos[3];
+    uint32_t slot;              /* its hit in the store, LM_NONE for a specular vertex */
+} lm_path_vertex;
+uint32_t lm_photons_path(const lm_photons *ph, uint32_t photon, const lm_path_vertex **vertices);
+
+/* Sum of the flux of stored first hits (bounce 0), per surface, into out[surface * 3 + c]
+ * (surface_count x 3 floats as doubles). */
+void lm_photons_first_hit_flux(const lm_photons *ph, double *out);
+
+#endif

@@ -1,0 +1,95 @@
+/* Inside the photon stage (photons.h), shared by photons.c, photon_trace.c and photon_paths.c. */
+#ifndef LM_PHOTONS_INTERNAL_H
+#define LM_PHOTONS_INTERNAL_H
+
+#include "photons.h"
+
+/* A group's photons m = 0..M-1 are emitter photons j = index + m G, ids first_id + m G. Their paths
+ * lie back to back in one slab: photon m's vertices are verts[offsets[m] .. offsets[m + 1]). */
+typedef struct {
+    int emitter;
+    uint32_t index, photons, first_id;
+    uint32_t rr_next;          /* next photon to check, round robin */
+    int invalid;               /* queued for re-trace */
+    uint32_t invalidations, retraces; /* counters for reports (lm_photon_group_info) */
+    uint32_t *offsets;         /* photons + 1 */
+    lm_path_vertex *verts;
+    uint32_t vert_cap;
+} ph_group;
+
+/* A freshly traced path vertex, before it is compared and stored. */
+typedef struct {
+    int32_t node;
+    uint32_t tri;
+    int32_t surface;           /* -1: nothing stored here (specular, or no surface) */
+    uint16_t bounce;
+    float pos[3], local[3], dir[3], flux[3];
+} ph_vertex;
+
+/* Per-thread growable vertex buffer. */
+typedef struct {
+    ph_vertex *v;
+    size_t len, cap;
+} ph_buffer;
+
+/* One photon to trace and where its vertices landed. */
+typedef struct {
+    uint32_t group, m;
+    uint32_t buffer;           /* thread buffer that holds its vertices */
+    uint32_t first, count;
+} ph_job;
+
+typedef struct {
+    ph_job *jobs;
+    uint32_t count, cap;
+    ph_buffer *buffers;
+    int buffer_count;
+} ph_batch;
+
+struct lm_photons {
+    const lm_scene *scene;
+    const lm_surfaces *surfaces;
+    const lm_rt *rt;
+    const lm_emitters *em;
+    lm_photon_settings set;
+    float epsilon;             /* resolved settings.epsilon */
+    float ray_offset;          /* origin offset along the normal when leaving a surface */
+    uint32_t G, emitter_count, group_count, photon_count;
+    uint32_t *emitter_first;   /* first photon id of each emitter, emitter_count + 1 entries */
+    ph_group *groups;          /* emitter e's group g is groups[e G + g] */
+    uint32_t *queue;           /* invalid groups, FIFO ring of group_count slots */
+    uint32_t queue_head, queue_len;
+    lm_photon_store store;
+    uint32_t live_hits;
+    uint64_t halton_base;      /* seed x photon_count: the seed's stretch of the sequence */
+    ph_batch batch;
+    /* Scratch for rebuilding one group's slab (ph_group_apply) and for lists of groups. */
+    lm_path_vertex *tmp_verts;
+    uint32_t tmp_cap, max_group_photons;
+    uint32_t *tmp_offsets;     /* max_group_photons + 1 */
+    uint8_t *tmp_changed;      /* max_group_photons */
+    uint32_t *tmp_groups;      /* group_count */
+};
+
+/* photon_trace.c: traces photon (group, m) and appends its vertices to buf. Returns 0 when memory
+ * ran out. Reads only ph's scene, BVH and emitters: safe from several threads. */
+int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count);
+/* Traces every job of the batch in parallel (OpenMP). */
+lm_status ph_trace_batch(lm_photons *ph, lm_error *err);
+void ph_batch_clear(ph_batch *b);
+int ph_batch_push(ph_batch *b, uint32_t group, uint32_t m);
+void ph_batch_free(ph_batch *b);
+
+/* photon_paths.c: path storage, comparison and store updates. */
+const ph_vertex *ph_job_vertices(const ph_batch *b, const ph_job *j);
+/* 1 if the traced path differs from photon m's stored one (photons.h: (node, tri) sequence, a vertex
+ * that moved more than epsilon in world or node-local space, or flux changed). */
+int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n);
+/* Rebuilds a group's slab from the batch jobs [first, first + M) (one per photon, in order): photons
+ * whose path changed get their old hits removed and new ones added; the others keep theirs. */
+lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_job *jobs, lm_photon_frame_stats *st,
+                         lm_error *err);
+void ph_group_free(ph_group *g);
+size_t ph_group_bytes(const ph_group *g);
+
+#endif

@@ -1,0 +1,163 @@
+/* photon_store: O(1) add and remove in per-surface lists, free-slot reuse, and the change
+ * accumulators (delta_f counts every hit, delta_i leaves out first hits from punctual lights). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <string.h>
+
+#include "../src/trace/photon_store.h"
+
+static lm_hit make_hit(int surface, uint32_t photon, float power, int bounce, int punctual)
+{
+    lm_hit h;
+    memset(&h, 0, sizeof h);
+    h.surface = surface;
+    h.photon = photon;
+    h.flux[0] = h.flux[1] = h.flux[2] = power; /* luminance = power */
+    h.bounce = (uint16_t)bounce;
+    h.from_punctual = (uint8_t)punctual;
+    return h;
+}
+
+/* Walks a surface's list forwards and backwards; returns the count and checks the links agree. */
+static uint32_t walk(const lm_photon_store *ps, int surface)
+{
+    uint32_t n = 0, last = LM_NONE;
+    for (uint32_t s = ps->surfaces[surface].head; s != LM_NONE; s = ps->hits[s].next) {
+        assert_int_equal(ps->hits[s].surface, surface);
+        assert_int_equal(ps->hits[s].prev, last);
+        last = s;
+        n++;
+    }
+    uint32_t back = 0;
+    for (uint32_t s = last; s != LM_NONE; s = ps->hits[s].prev)
+        back++;
+    assert_int_equal(back, n);
+    assert_int_equal(ps->surfaces[surface].count, n);
+    return n;
+}
+
+static void test_add_remove(void **state)
+{
+    (void)state;
+    lm_photon_store ps;
+    lm_error err;
+    assert_int_equal(lm_photon_store_init(&ps, 3, &err), LM_OK);
+    uint32_t slot[10];
+    for (int i = 0; i < 10; i++) {
+        lm_hit h = make_hit(i % 3, (uint32_t)i, 1.0f, 1, 0);
+        slot[i] = lm_photon_store_add(&ps, &h);
+        assert_int_not_equal(slot[i], LM_NONE);
+        assert_int_equal(ps.hits[slot[i]].photon, (uint32_t)i);
+    }
+    assert_int_equal(walk(&ps, 0), 4);
+    assert_int_equal(walk(&ps, 1), 3);
+    assert_int_equal(walk(&ps, 2), 3);
+    /* Remove the head, a middle and the tail of surface 0 (photons 9, 3, 0 / 6). */
+    lm_photon_store_remove(&ps, slot[9]);
+    lm_photon_store_remove(&ps, slot[3]);
+    lm_photon_store_remove(&ps, slot[0]);
+    assert_int_equal(walk(&ps, 0), 1);
+    assert_int_equal(ps.hits[ps.surfaces[0].head].photon, 6);
+    lm_photon_store_remove(&ps, slot[6]);
+    assert_int_equal(walk(&ps, 0), 0);
+    assert_int_equal(ps.surfaces[0].head, LM_NONE);
+    assert_int_equal(walk(&ps, 1), 3);
+    /* Removing a free or never-used slot changes nothing (the free list stays intact). */
+    double df = ps.surfaces[0].delta_f;
+    lm_photon_store_remove(&ps, slot[6]);
+    lm_photon_store_remove(&ps, 12345);
+    assert_float_equal(ps.surfaces[0].delta_f, df, 0.0);
+    uint32_t freed = 0;
+    for (uint32_t s = ps.free_head; s != LM_NONE; s = ps.hits[s].next)
+        freed++;
+    assert_int_equal(freed, 4);
+
+    /* Out-of-range surfaces are refused and leave the store as it was. */
+    lm_hit bad = make_hit(3, 99, 1.0f, 0, 0);
+    assert_int_equal(lm_photon_store_add(&ps, &bad), LM_NONE);
+    bad.surface = -1;
+    assert_int_equal(lm_photon_store_add(&ps, &bad), LM_NONE);
+    assert_int_equal(ps.used, 10);
+    lm_photon_store_free(&ps);
+}
+
+static void test_free_list_reuse(void **state)
+{
+    (void)state;
+    lm_photon_store ps;
+    lm_error err;
+    assert_int_equal(lm_photon_store_init(&ps, 2, &err), LM_OK);
+    uint32_t slot[2000];
+    for (int i = 0; i < 2000; i++) { /* more than the first allocation: the array grows */
+        lm_hit h = make_hit(i & 1, (uint32_t)i, 0.5f, 2, 0);
+        slot[i] = lm_photon_store_add(&ps, &h);
+    }
+    assert_int_equal(ps.used, 2000);
+    assert_true(ps.capacity >= 2000);
+    for (int i = 0; i < 2000; i += 2)
+        lm_photon_store_remove(&ps, slot[i]);
+    assert_int_equal(walk(&ps, 0), 0);
+    assert_int_equal(walk(&ps, 1), 1000);
+    uint32_t cap = ps.capacity;
+    for (int i = 0; i < 1000; i++) { /* freed slots are reused before the array grows */
+        lm_hit h = make_hit(0, 5000u + (uint32_t)i, 0.5f, 2, 0);
+        uint32_t s = lm_photon_store_add(&ps, &h);
+        assert_true(s < 2000);
+    }
+    assert_int_equal(ps.used, 2000);
+    assert_int_equal(ps.capacity, cap);
+    assert_int_equal(ps.free_head, LM_NONE);
+    assert_int_equal(walk(&ps, 0), 1000);
+    lm_hit h = make_hit(1, 9999, 0.5f, 2, 0);
+    assert_int_equal(lm_photon_store_add(&ps, &h), 2000);
+    lm_photon_store_free(&ps);
+}
+
+static void test_deltas(void **state)
+{
+    (void)state;
+    lm_photon_store ps;
+    lm_error err;
+    assert_int_equal(lm_photon_store_init(&ps, 2, &err), LM_OK);
+    lm_hit direct_punctual = make_hit(0, 0, 2.0f, 0, 1); /* per-pixel direct light: not in delta_i */
+    lm_hit bounced_punctual = make_hit(0, 1, 3.0f, 1, 1);
+    lm_hit direct_area = make_hit(0, 2, 5.0f, 0, 0);     /* emissive direct light is in the IIM */
+    uint32_t a = lm_photon_store_add(&ps, &direct_punctual);
+    uint32_t b = lm_photon_store_add(&ps, &bounced_punctual);
+    lm_photon_store_add(&ps, &direct_area);
+    assert_float_equal(ps.surfaces[0].delta_f, 10.0, 1e-9);
+    assert_float_equal(ps.surfaces[0].delta_i, 8.0, 1e-9);
+    assert_float_equal(ps.surfaces[1].delta_f, 0.0, 0.0);
+
+    lm_photon_store_reset_delta_f(&ps, 0);
+    assert_float_equal(ps.surfaces[0].delta_f, 0.0, 0.0);
+    assert_float_equal(ps.surfaces[0].delta_i, 8.0, 1e-9);
+    /* Removing counts as change too. */
+    lm_photon_store_remove(&ps, a);
+    lm_photon_store_remove(&ps, b);
+    assert_float_equal(ps.surfaces[0].delta_f, 5.0, 1e-9);
+    assert_float_equal(ps.surfaces[0].delta_i, 11.0, 1e-9);
+    lm_photon_store_reset_delta_i(&ps, 0);
+    assert_float_equal(ps.surfaces[0].delta_i, 0.0, 0.0);
+
+    lm_hit coloured = make_hit(1, 3, 0.0f, 1, 0);
+    coloured.flux[0] = 1.0f; /* luminance weights: red 0.2126 */
+    lm_photon_store_add(&ps, &coloured);
+    assert_float_equal(lm_hit_energy(&coloured), 0.2126, 1e-9);
+    assert_float_equal(ps.surfaces[1].delta_f, 0.2126, 1e-9);
+    assert_true(lm_photon_store_bytes(&ps) >= sizeof(lm_hit));
+    lm_photon_store_free(&ps);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_add_remove),
+        cmocka_unit_test(test_free_list_reuse),
+        cmocka_unit_test(test_deltas),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

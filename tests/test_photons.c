@@ -1,0 +1,582 @@
+/* photons: selective photon emission (Larsen & Christensen 2004, section 2). Deterministic traces,
+ * no invalidation in an unchanged scene, locality of invalidation (two rooms and a door), energy of
+ * first hits, emitter invalidation drained oldest first, and moving an object back restoring the hits. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/core/timing.h"
+#include "../src/trace/photons.h"
+#include "support.h"
+
+typedef struct {
+    lm_scene *s;
+    lm_surfaces su;
+    lm_rt *rt;
+    lm_emitters em;
+    lm_photons *ph;
+} world;
+
+static void world_load(world *w, const char *path)
+{
+    memset(w, 0, sizeof *w);
+    lm_error err;
+    lm_load_options lo = {0};
+    if (lm_scene_load_gltf(path, &lo, &w->s, &err) != LM_OK)
+        fail_msg("load: %s", err.msg);
+    lm_surface_options so;
+    lm_surface_options_default(&so);
+    assert_int_equal(lm_surfaces_build(w->s, &so, &w->su, &err), LM_OK);
+    assert_int_equal(lm_rt_build(w->s, &w->su, &w->rt, &err), LM_OK);
+    assert_int_equal(lm_emitters_build(w->s, &w->em, &err), LM_OK);
+}
+
+static void world_photons(world *w, const lm_photon_settings *set)
+{
+    lm_error err;
+    if (lm_photons_create(w->s, &w->su, w->rt, &w->em, set, &w->ph, &err) != LM_OK)
+        fail_msg("photons: %s", err.msg);
+    assert_int_equal(lm_photons_trace_all(w->ph, NULL, &err), LM_OK);
+}
+
+static void world_free(world *w)
+{
+    lm_photons_free(w->ph);
+    lm_emitters_free(&w->em);
+    lm_rt_free(w->rt);
+    lm_surfaces_free(&w->su);
+    lm_scene_free(w->s);
+}
+
+static int find_node(const lm_scene *s, const char *name)
+{
+    for (int i = 0; i < s->node_count; i++)
+        if (!strcmp(s->nodes[i].name, name))
+            return i;
+    fail_msg("no node '%s'", name);
+    return -1;
+}
+
+static int find_anim(const lm_scene *s, const char *name)
+{
+    for (int i = 0; i < s->animation_count; i++)
+        if (!strcmp(s->animations[i].name, name))
+            return i;
+    fail_msg("no animation '%s'", name);
+    return -1;
+}
+
+/* Sets animation `anim` to time t and moves the BVH along. */
+static void animate(world *w, int anim, float t)
+{
+    lm_error err;
+    lm_scene_eval_animation(w->s, anim, t);
+    assert_int_equal(lm_rt_sync_transforms(w->rt, w->s, &err), LM_OK);
+}
+
+static lm_photon_frame_stats frame(world *w)
+{
+    lm_photon_frame_stats st;
+    lm_error err;
+    if (lm_photons_frame(w->ph, &st, &err) != LM_OK)
+        fail_msg("frame: %s", err.msg);
+    return st;
+}
+
+/* ---- hit snapshots: every live hit, links cleared, sorted by (surface, photon, bounce) ---- */
+
+typedef struct {
+    lm_hit *h;
+    uint32_t n;
+} snapshot;
+
+static int hit_order(const void *pa, const void *pb)
+{
+    const lm_hit *a = pa, *b = pb;
+    if (a->surface != b->surface)
+        return a->surface < b->surface ? -1 : 1;
+    if (a->photon != b->photon)
+        return a->photon < b->photon ? -1 : 1;
+    return (a->bounce > b->bounce) - (a->bounce < b->bounce);
+}
+
+static snapshot take_snapshot(const lm_photons *ph)
+{
+    const lm_photon_store *ps = lm_photons_store(ph);
+    snapshot sn = {malloc(sizeof(lm_hit) * (lm_photons_stored_hits(ph) + 1)), 0};
+    assert_non_null(sn.h);
+    for (int s = 0; s < ps->surface_count; s++)
+        for (uint32_t i = ps->surfaces[s].head; i != LM_NONE; i = ps->hits[i].next) {
+            lm_hit h = ps->hits[i];
+            h.prev = h.next = 0;
+            sn.h[sn.n++] = h;
+        }
+    assert_int_equal(sn.n, lm_photons_stored_hits(ph));
+    qsort(sn.h, sn.n, sizeof *sn.h, hit_order);
+    return sn;
+}
+
+static void assert_same_snapshot(const snapshot *a, const snapshot *b)
+{
+    assert_int_equal(a->n, b->n);
+    assert_memory_equal(a->h, b->h, sizeof(lm_hit) * a->n);
+}
+
+/* ---- determinism ---- */
+
+static void test_deterministic(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world a, b;
+    world_load(&a, path);
+    world_photons(&a, &set);
+    int threads = omp_get_max_threads();
+    omp_set_num_threads(1); /* the second run single-threaded: results must not depend on threads */
+    world_load(&b, path);
+    world_photons(&b, &set);
+    omp_set_num_threads(threads);
+    assert_int_equal(lm_photons_count(a.ph), 72 * 40);
+    assert_true(lm_photons_stored_hits(a.ph) > lm_photons_count(a.ph)); /* a closed-ish box: > 1 hit each */
+    snapshot sa = take_snapshot(a.ph), sb = take_snapshot(b.ph);
+    assert_same_snapshot(&sa, &sb);
+
+    /* 1000 frames of an unchanged scene: nothing differs, nothing is invalidated, no store churn. */
+    uint32_t rr = 0;
+    double seconds = 0.0;
+    for (int f = 0; f < 1000; f++) {
+        lm_photon_frame_stats st = frame(&a);
+        seconds += st.seconds;
+        assert_int_equal(st.paths_changed, 0);
+        assert_int_equal(st.groups_invalidated, 0);
+        assert_int_equal(st.groups_retraced, 0);
+        assert_int_equal(st.hits_added + st.hits_removed, 0);
+        rr += st.rr_photons;
+    }
+    assert_int_equal(rr, 1000 * 72);
+    print_message("unchanged frame: %u photons checked in %.4f ms (mean of 1000)\n", rr / 1000, seconds);
+    snapshot sc = take_snapshot(a.ph);
+    assert_same_snapshot(&sa, &sc);
+    free(sa.h);
+    free(sb.h);
+    free(sc.h);
+    world_free(&a);
+    world_free(&b);
+}
+
+/* Each group's photons share one cell of the 8 x 9 stratification of the first two QMC coordinates:
+ * their first directions from a point light stay close (the cell spans 1/8 of cos theta, 40 degrees
+ * of phi), so first-hit points cluster. Checked on the group's first-vertex direction spread. */
+static void test_groups_are_coherent(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world w;
+    world_load(&w, path);
+    world_photons(&w, &set);
+    float lp[3];
+    memcpy(lp, &w.s->nodes[w.s->lights[0].node].world[12], sizeof lp);
+    double worst = 1.0;
+    for (uint32_t g = 0; g < lm_photons_group_count(w.ph); g++) {
+        float mean[3] = {0, 0, 0}, dirs[64][3];
+        uint32_t n = 0;
+        for (uint32_t m = 0; m < 40; m++) {
+            const lm_path_vertex *v;
+            if (lm_photons_path(w.ph, g + m * 72, &v) == 0)
+                continue;
+            float d[3] = {v[0].pos[0] - lp[0], v[0].pos[1] - lp[1], v[0].pos[2] - lp[2]};
+            float len = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            for (int k = 0; k < 3; k++) {
+                dirs[n][k] = d[k] / len;
+                mean[k] += dirs[n][k];
+            }
+            assert_int_equal(lm_photons_group_of(w.ph, g + m * 72), g);
+            n++;
+        }
+        float ml = sqrtf(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
+        for (uint32_t i = 0; i < n; i++) {
+            double c = (dirs[i][0] * mean[0] + dirs[i][1] * mean[1] + dirs[i][2] * mean[2]) / ml;
+            worst = c < worst ? c : worst;
+        }
+    }
+    print_message("widest group: %.1f degrees from its mean direction\n", acos(worst) * 180.0 / M_PI);
+    assert_true(worst > cos(60.0 * M_PI / 180.0));
+    world_free(&w);
+}
+
+/* ---- locality: two rooms and a door ---- */
+
+typedef struct {
+    uint32_t b_only_groups, b_only_invalidations;
+    uint32_t a_light_invalidations, b_light_invalidations;
+    uint32_t total_invalidations, frames, groups_retraced;
+    double seconds;
+} locality;
+
+/* 1 if every stored vertex of every photon of group g lies in room B (x > 0). */
+static int group_in_room_b(const lm_photons *ph, uint32_t g)
+{
+    uint32_t G = lm_photons_groups_per_emitter(ph);
+    lm_photon_group_info gi;
+    lm_photons_group_info(ph, g, &gi);
+    uint32_t first = 0;
+    for (int e = 0; e < gi.emitter; e++)
+        first += lm_photons_emitter_photons(ph, e);
+    for (uint32_t m = 0; m < gi.photons; m++) {
+        const lm_path_vertex *v;
+        uint32_t n = lm_photons_path(ph, first + gi.index + m * G, &v);
+        for (uint32_t i = 0; i < n; i++)
+            if (v[i].pos[0] <= 0.0f)
+                return 0;
+    }
+    return 1;
+}
+
+/* Door at door_t; the cube in room A follows its animation for 4 s while frames run. */
+static locality run_locality(const char *path, float door_t)
+{
+    world w;
+    world_load(&w, path);
+    animate(&w, find_anim(w.s, "door_swing"), door_t);
+    int cube_anim = find_anim(w.s, "cube_path");
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world_photons(&w, &set);
+    uint32_t groups = lm_photons_group_count(w.ph);
+    assert_int_equal(groups, 4 * 72);
+    uint8_t *b_only = malloc(groups), *b_light = malloc(groups);
+    assert_true(b_only && b_light);
+    locality r;
+    memset(&r, 0, sizeof r);
+    for (uint32_t g = 0; g < groups; g++) {
+        lm_photon_group_info gi;
+        lm_photons_group_info(w.ph, g, &gi);
+        b_only[g] = (uint8_t)group_in_room_b(w.ph, g);
+        b_light[g] = w.s->nodes[w.em.e[gi.emitter].node].world[12] > 0.0f;
+        r.b_only_groups += b_only[g];
+    }
+    for (int f = 1; f <= 200; f++, r.frames++) {
+        animate(&w, cube_anim, 0.02f * (float)f);
+        lm_photon_frame_stats st = frame(&w);
+        r.total_invalidations += st.groups_invalidated;
+        r.groups_retraced += st.groups_retraced;
+        r.seconds += st.seconds;
+    }
+    for (uint32_t g = 0; g < groups; g++) {
+        lm_photon_group_info gi;
+        lm_photons_group_info(w.ph, g, &gi);
+        if (b_only[g])
+            r.b_only_invalidations += gi.invalidations;
+        if (b_light[g])
+            r.b_light_invalidations += gi.invalidations;
+        else
+            r.a_light_invalidations += gi.invalidations;
+    }
+    free(b_only);
+    free(b_light);
+    world_free(&w);
+    return r;
+}
+
+static void test_locality_door_closed(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    locality r = run_locality(path, 0.0f);
+    print_message("door closed, %u frames: %u invalidations (room A lights %u, room B lights %u); "
+                  "%u groups entirely in room B, invalidated %u times; %u groups re-traced; %.2f ms/frame\n",
+                  r.frames, r.total_invalidations, r.a_light_invalidations, r.b_light_invalidations,
+                  r.b_only_groups, r.b_only_invalidations, r.groups_retraced, 1e3 * r.seconds / r.frames);
+    assert_true(r.b_only_groups >= 2 * 72 - 4); /* room B's lights' photons stay in room B */
+    assert_int_equal(r.b_only_invalidations, 0);
+    assert_int_equal(r.b_light_invalidations, 0);
+    assert_true(r.a_light_invalidations > 0);
+}
+
+static void test_locality_door_open(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    locality r = run_locality(path, 2.0f);
+    print_message("door open, %u frames: %u invalidations (room A lights %u, room B lights %u); "
+                  "%u groups entirely in room B, invalidated %u times; %u groups re-traced; %.2f ms/frame\n",
+                  r.frames, r.total_invalidations, r.a_light_invalidations, r.b_light_invalidations,
+                  r.b_only_groups, r.b_only_invalidations, r.groups_retraced, 1e3 * r.seconds / r.frames);
+    assert_int_equal(r.b_only_invalidations, 0);
+    assert_true(r.b_light_invalidations > 0); /* photons through the doorway meet the cube */
+    assert_true(r.a_light_invalidations > r.b_light_invalidations);
+}
+
+/* ---- energy: a point light in a closed box ---- */
+
+static void inward_box(lmt_mesh *m, float h)
+{
+    memset(m, 0, sizeof *m);
+    for (int axis = 0; axis < 3; axis++)
+        for (int sign = -1; sign <= 1; sign += 2) {
+            int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
+            float c[3], u[3] = {0, 0, 0}, v[3] = {0, 0, 0};
+            c[axis] = sign * h;
+            c[a1] = -h;
+            c[a2] = -h;
+            if (sign > 0) { /* edges swapped against lmt_mesh_cube: the normal points inwards */
+                v[a1] = 2 * h;
+                u[a2] = 2 * h;
+            } else {
+                v[a2] = 2 * h;
+                u[a1] = 2 * h;
+            }
+            lmt_mesh_quad(m, c, u, v);
+        }
+}
+
+static void test_energy_closed_box(void **state)
+{
+    (void)state;
+    static lmt_mesh box;
+    inward_box(&box, 1.0f);
+    const char *nodes = "[{\"name\": \"root\", \"children\": [1, 2]}, {\"name\": \"box\", \"mesh\": 0},"
+                        " {\"name\": \"lamp\", \"translation\": [0.2, 0.3, -0.1],"
+                        "  \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
+    const char *lights = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+                         " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\","
+                         " \"intensity\": 10, \"color\": [1, 0.5, 0.25]}]}},";
+    char path[512];
+    snprintf(path, sizeof path, "%s/box.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &box, 1, nodes, NULL, 0, lights), 0);
+    world w;
+    world_load(&w, path);
+    assert_int_equal(w.em.count, 1);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.total_photons = 20000;
+    world_photons(&w, &set);
+    uint32_t n = lm_photons_count(w.ph);
+    assert_true(n >= 19900 && n % 72 == 0);
+    int surfaces = lm_photons_store(w.ph)->surface_count;
+    assert_int_equal(surfaces, 6);
+    double *flux = calloc((size_t)surfaces * 3, sizeof *flux), sum[3] = {0, 0, 0};
+    assert_non_null(flux);
+    lm_photons_first_hit_flux(w.ph, flux);
+    for (int s = 0; s < surfaces; s++)
+        for (int c = 0; c < 3; c++)
+            sum[c] += flux[3 * s + c];
+    double power = 4.0 * M_PI * 10.0;
+    print_message("first-hit flux (%.4f %.4f %.4f), light power 4 pi I = (%.4f %.4f %.4f)\n", sum[0], sum[1],
+                  sum[2], power, power * 0.5, power * 0.25);
+    assert_float_equal(sum[0], power, 0.01 * power);
+    assert_float_equal(sum[1], 0.5 * power, 0.005 * power);
+    assert_float_equal(sum[2], 0.25 * power, 0.0025 * power);
+    /* Every photon's first hit was stored: bounce-0 hits = photons. */
+    lm_photon_memory mem;
+    lm_photons_memory(w.ph, &mem);
+    assert_true(mem.mean_hits > 1.0);
+    free(flux);
+    world_free(&w);
+}
+
+/* ---- emitter invalidation: every group queued, drained oldest first under the budget ---- */
+
+static void assert_emitter_pending(const lm_photons *ph, int e, uint32_t valid_groups)
+{
+    for (uint32_t g = 0; g < 72; g++) {
+        lm_photon_group_info gi;
+        lm_photons_group_info(ph, (uint32_t)e * 72 + g, &gi);
+        assert_int_equal(gi.emitter, e);
+        assert_int_equal(gi.invalid, g >= valid_groups);
+    }
+}
+
+static void test_invalidate_emitter(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.group_budget = 16;
+    world_photons(&w, &set);
+    lm_error err;
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 99, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "99"));
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 2, &err), LM_OK);
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 0, &err), LM_OK);
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 2, &err), LM_OK); /* already queued: no change */
+    assert_int_equal(lm_photons_pending_groups(w.ph), 144);
+    for (int f = 1; f <= 9; f++) {
+        lm_photon_frame_stats st = frame(&w);
+        assert_int_equal(st.groups_retraced, 16);
+        assert_int_equal(st.pending_groups, 144 - 16 * f);
+        assert_int_equal(st.hits_added + st.hits_removed + st.photons_updated, 0); /* nothing changed */
+        uint32_t done = 16u * (uint32_t)f;
+        assert_emitter_pending(w.ph, 2, done < 72 ? done : 72);
+        assert_emitter_pending(w.ph, 0, done > 72 ? done - 72 : 0);
+    }
+    assert_int_equal(frame(&w).groups_retraced, 0);
+
+    /* A brighter light: its groups re-trace with twice the flux on the same paths. */
+    int light = w.em.e[1].light;
+    double before = 0.0, after = 0.0;
+    snapshot s0 = take_snapshot(w.ph);
+    w.s->lights[light].intensity *= 2.0f;
+    lm_emitters_update(&w.em, w.s);
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 1, &err), LM_OK);
+    uint32_t updated = 0;
+    while (lm_photons_pending_groups(w.ph))
+        updated += frame(&w).photons_updated;
+    assert_int_equal(updated, lm_photons_emitter_photons(w.ph, 1));
+    snapshot s1 = take_snapshot(w.ph);
+    assert_int_equal(s0.n, s1.n);
+    for (uint32_t i = 0; i < s0.n; i++) {
+        if (lm_photons_group_of(w.ph, s0.h[i].photon) / 72 != 1) {
+            assert_memory_equal(&s0.h[i], &s1.h[i], sizeof(lm_hit));
+            continue;
+        }
+        before += s0.h[i].flux[1];
+        after += s1.h[i].flux[1];
+    }
+    assert_float_equal(after, 2.0 * before, 1e-4 * after);
+    free(s0.h);
+    free(s1.h);
+    world_free(&w);
+}
+
+/* ---- move a dynamic object and back: the original hits return exactly ---- */
+
+static uint32_t settle(world *w)
+{
+    uint32_t frames = 0, quiet = 0;
+    /* Every photon is checked within M = 40 frames; then drain what is left. */
+    while ((quiet < 41 || lm_photons_pending_groups(w->ph)) && frames < 2000) {
+        lm_photon_frame_stats st = frame(w);
+        quiet = st.groups_invalidated ? 0 : quiet + 1;
+        frames++;
+    }
+    return frames;
+}
+
+static void test_move_and_back(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world_photons(&w, &set);
+    snapshot s0 = take_snapshot(w.ph);
+    int cube = find_node(w.s, "dynamic_cube");
+    float home[16], moved[16];
+    memcpy(home, w.s->nodes[cube].world, sizeof home);
+    memcpy(moved, home, sizeof moved);
+    moved[12] -= 0.8f; /* 0.8 m along -x, still in room A */
+    moved[14] += 0.5f;
+    lm_error err;
+    memcpy(w.s->nodes[cube].world, moved, sizeof moved);
+    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, moved, &err), LM_OK);
+    uint32_t f1 = settle(&w);
+    snapshot s1 = take_snapshot(w.ph);
+    assert_true(s1.n != s0.n || memcmp(s1.h, s0.h, sizeof(lm_hit) * s0.n) != 0);
+
+    memcpy(w.s->nodes[cube].world, home, sizeof home);
+    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, home, &err), LM_OK);
+    uint32_t f2 = settle(&w);
+    print_message("settled in %u frames after the move, %u after moving back\n", f1, f2);
+    snapshot s2 = take_snapshot(w.ph);
+    assert_same_snapshot(&s0, &s2);
+    free(s0.h);
+    free(s1.h);
+    free(s2.h);
+    world_free(&w);
+}
+
+/* ---- settings and sizes ---- */
+
+static void test_settings(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    lm_error err;
+    set.groups = 70;
+    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &w.ph, &err), LM_ERR_INVALID);
+    assert_null(w.ph);
+    assert_non_null(strstr(err.msg, "groups"));
+    set.groups = 108;
+    set.max_bounces = 0;
+    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &w.ph, &err), LM_ERR_INVALID);
+    set.max_bounces = 8;
+    set.total_photons = 10000;
+    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &w.ph, &err), LM_OK);
+    /* Four equal lights: 10000 / 4 / 108 = 23.1 -> 23 per group. */
+    assert_int_equal(lm_photons_group_count(w.ph), 4 * 108);
+    for (int e = 0; e < 4; e++)
+        assert_int_equal(lm_photons_emitter_photons(w.ph, e), 23 * 108);
+    assert_int_equal(lm_photons_stored_hits(w.ph), 0);
+    assert_int_equal(lm_photons_trace_all(w.ph, NULL, &err), LM_OK);
+    for (uint32_t p = 0; p < lm_photons_count(w.ph); p++) {
+        const lm_path_vertex *v;
+        assert_true(lm_photons_path(w.ph, p, &v) <= 8);
+    }
+    world_free(&w);
+}
+
+/* Rough speed and memory on the Cornell box (printed, not asserted beyond sanity). */
+static void test_cornell_rate_and_memory(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.total_photons = 72 * 1400;
+    lm_error err;
+    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &w.ph, &err), LM_OK);
+    lm_photon_frame_stats st;
+    assert_int_equal(lm_photons_trace_all(w.ph, &st, &err), LM_OK);
+    lm_photon_memory mem;
+    lm_photons_memory(w.ph, &mem);
+    print_message("cornell: %u photons traced in %.3f s (%.0f photons/s, %d threads); %.2f path vertices and "
+                  "%.2f hits per photon; memory %.1f bytes/photon allocated, %.1f used "
+                  "(paths %zu, store %zu, other %zu bytes)\n",
+                  st.group_photons, st.seconds, st.group_photons / st.seconds, omp_get_max_threads(),
+                  mem.mean_path_vertices, mem.mean_hits, mem.per_photon, mem.live_per_photon, mem.path_bytes,
+                  mem.store_bytes, mem.other_bytes);
+    assert_int_equal(st.group_photons, lm_photons_count(w.ph));
+    assert_true(mem.mean_path_vertices >= mem.mean_hits && mem.mean_hits > 1.0);
+    assert_float_equal(mem.live_per_photon, 4.0 + 24.0 * mem.mean_path_vertices + 72.0 * mem.mean_hits, 1e-6);
+    assert_true(mem.per_photon >= mem.live_per_photon && mem.per_photon < 2.5 * mem.live_per_photon);
+    world_free(&w);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_groups_are_coherent),
+        cmocka_unit_test(test_locality_door_closed),
+        cmocka_unit_test(test_locality_door_open),
+        cmocka_unit_test(test_energy_closed_box),
+        cmocka_unit_test(test_invalidate_emitter),
+        cmocka_unit_test(test_move_and_back),
+        cmocka_unit_test(test_settings),
+        cmocka_unit_test(test_cornell_rate_and_memory),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
