@@ -1,0 +1,330 @@
+/* The reference solver's driver: adaptive passes, stopping rule, results and cache (reference.h). */
+#include "reference.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/log.h"
+#include "../core/timing.h"
+#include "ref_cache.h"
+#include "ref_paths.h"
+
+#define LM_REF_DARK_FLOOR 0.01    /* relative errors are taken against max(mean, 1% of the mean entry) */
+#define LM_REF_PROGRESS_SECONDS 3.0
+
+void lm_ref_settings_default(lm_ref_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    s->target_error = 0.02f;
+    s->samples = 64;
+    s->min_samples = 128;
+    s->max_samples = 65536;
+    s->seed = 1;
+    s->max_depth = 64;
+    s->rr_depth = 3;
+    s->use_cache = 1;
+    s->progress = 1;
+}
+
+static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+/* ---- per-entry statistics ---- */
+
+typedef struct {
+    uint32_t n;
+    double mean[2], m2[2];  /* Welford over the luminance of E_full [0] and E_iim [1] */
+    double sum[2][3];       /* RGB sums */
+} entry_stat;
+
+static void stat_add(entry_stat *st, const float full[3], const float iim[3])
+{
+    const float *v[2] = {full, iim};
+    st->n++;
+    for (int w = 0; w < 2; w++) {
+        double rgb[3] = {v[w][0], v[w][1], v[w][2]}, x = lum(rgb), d = x - st->mean[w];
+        st->mean[w] += d / st->n;
+        st->m2[w] += d * (x - st->mean[w]); /* Welford: M2 += (x - mean_old)(x - mean_new) */
+        for (int c = 0; c < 3; c++)
+            st->sum[w][c] += rgb[c];
+    }
+}
+
+/* Relative standard error of the mean: sqrt(M2 / (n - 1) / n) / max(mean, floor). */
+static double rel_se(const entry_stat *st, int w, double floor)
+{
+    if (st->n < 2)
+        return INFINITY;
+    double se = sqrt(fmax(0.0, st->m2[w]) / (st->n - 1.0) / st->n), d = fmax(st->mean[w], floor);
+    return d > 0.0 ? se / d : se > 0.0 ? INFINITY : 0.0;
+}
+
+static double entry_error(const entry_stat *st, int has_iim, double floor)
+{
+    double e = rel_se(st, 0, floor);
+    return has_iim ? fmax(e, rel_se(st, 1, floor)) : e;
+}
+
+/* ---- passes ---- */
+
+typedef struct {
+    const lm_ref_ctx *c;
+    const lm_ref_settings *set;
+    const lm_ref_frame *frames;  /* texels, else NULL */
+    const lm_ref_camera *cam;    /* pixels, else NULL */
+    uint32_t count;
+    entry_stat *st;
+} job;
+
+static void sample_entry(const job *j, uint32_t i, uint32_t k, float full[3], float iim[3])
+{
+    lm_ref_rng r;
+    lm_ref_rng_seed(&r, j->set->seed, i, k);
+    if (j->frames) {
+        lm_ref_texel_sample(j->c, &j->frames[i], &r, full, iim);
+        return;
+    }
+    lm_ref_pixel_sample(j->c, j->cam, (int)(i % (uint32_t)j->cam->width), (int)(i / (uint32_t)j->cam->width), &r, full);
+    memcpy(iim, full, 3 * sizeof(float));
+}
+
+/* Paths for an entry this pass: `samples`, growing to n / 4 for entries that keep sampling (a few
+ * dozen passes reach max_samples), never beyond max_samples. */
+static uint32_t batch_size(const lm_ref_settings *set, uint32_t n)
+{
+    uint32_t b = (uint32_t)set->samples, grow = n / 4, left = (uint32_t)set->max_samples - n;
+    b = grow > b ? grow : b;
+    return b < left ? b : left;
+}
+
+static void run_pass(const job *j, const uint32_t *active, uint32_t na)
+{
+#pragma omp parallel
+    {
+        lm_rt_thread_init();
+#pragma omp for schedule(dynamic, 4)
+        for (long a = 0; a < (long)na; a++) {
+            entry_stat *st = &j->st[active[a]];
+            uint32_t batch = batch_size(j->set, st->n);
+            for (uint32_t s = 0; s < batch; s++) {
+                float full[3], iim[3];
+                sample_entry(j, active[a], st->n, full, iim);
+                stat_add(st, full, iim);
+            }
+        }
+    }
+}
+
+/* 1% of the mean luminance of E_full over all entries (summed in entry order). */
+static double dark_floor(const job *j)
+{
+    double s = 0.0;
+    for (uint32_t i = 0; i < j->count; i++)
+        s += j->st[i].mean[0];
+    return j->count ? LM_REF_DARK_FLOOR * s / j->count : 0.0;
+}
+
+/* Entries that do not meet the stopping rule under the current floor. Every entry is checked, so one
+ * stopped under an earlier (higher) floor resumes, and the final report holds the same rule. */
+static uint32_t still_active(const job *j, uint32_t *active, double floor)
+{
+    uint32_t keep = 0, min = (uint32_t)j->set->min_samples;
+    for (uint32_t i = 0; i < j->count; i++) {
+        const entry_stat *st = &j->st[i];
+        int done = st->n >= (uint32_t)j->set->max_samples ||
+                   (st->n >= min && entry_error(st, j->frames != NULL, floor) <= j->set->target_error);
+        if (!done)
+            active[keep++] = i;
+    }
+    return keep;
+}
+
+static void adaptive(const job *j, uint32_t *active)
+{
+    uint32_t na = j->count;
+    for (uint32_t i = 0; i < na; i++)
+        active[i] = i;
+    double t0 = lm_now(), last = t0;
+    for (int pass = 1; na > 0; pass++) {
+        run_pass(j, active, na);
+        na = still_active(j, active, dark_floor(j));
+        if (j->set->progress && lm_now() - last >= LM_REF_PROGRESS_SECONDS) {
+            last = lm_now();
+            lm_info("reference: pass %d, %.0f s: %u of %u %s still sampling", pass, last - t0, na, j->count,
+                    j->frames ? "texels" : "pixels");
+        }
+    }
+}
+
+/* ---- results ---- */
+
+static lm_status alloc_result(lm_ref_result *r, uint32_t count, int texels, lm_error *err)
+{
+    size_t n = count ? count : 1;
+    r->count = count;
+    r->full = malloc(n * 3 * sizeof(float));
+    r->iim = texels ? malloc(n * 3 * sizeof(float)) : NULL;
+    r->radiance = texels ? malloc(n * 3 * sizeof(float)) : NULL;
+    r->samples = malloc(n * sizeof(uint32_t));
+    r->rel_se = malloc(n * sizeof(float));
+    if (!r->full || !r->samples || !r->rel_se || (texels && (!r->iim || !r->radiance)))
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for %u reference values", count);
+    return LM_OK;
+}
+
+static void finish(const job *j, lm_ref_result *r)
+{
+    double floor = dark_floor(j), sum_err = 0.0;
+    for (uint32_t i = 0; i < j->count; i++) {
+        const entry_stat *st = &j->st[i];
+        double inv = st->n ? 1.0 / st->n : 0.0, e = entry_error(st, j->frames != NULL, floor);
+        for (int c = 0; c < 3; c++) {
+            r->full[3 * i + c] = (float)(st->sum[0][c] * inv);
+            if (j->frames) {
+                r->iim[3 * i + c] = (float)(st->sum[1][c] * inv);
+                r->radiance[3 * i + c] = j->frames[i].albedo[c] / 3.14159265358979323846f * r->full[3 * i + c];
+            }
+        }
+        r->samples[i] = st->n;
+        r->rel_se[i] = (float)e;
+        r->total_samples += st->n;
+        r->converged += e <= j->set->target_error;
+        sum_err += e;
+        r->max_rel_se = fmax(r->max_rel_se, e);
+    }
+    r->mean_rel_se = j->count ? sum_err / j->count : 0.0;
+}
+
+static lm_status check_settings(const lm_ref_settings *set, lm_error *err)
+{
+    if (!(set->target_error > 0.0f) || !isfinite(set->target_error) || set->samples < 1 ||
+        set->max_samples < set->samples)
+        return lm_fail(err, LM_ERR_INVALID,
+                       "reference: invalid settings (target error %g, %d samples per pass, at most %d)",
+                       (double)set->target_error, set->samples, set->max_samples);
+    return LM_OK;
+}
+
+/* Runs the adaptive solver for a prepared job, with the cache around it. */
+static lm_status solve(job *j, uint32_t kind, uint64_t key, int width, int height, lm_ref_result *out, lm_error *err)
+{
+    char path[1200];
+    lm_ref_cache_path(path, sizeof path, j->set, kind, key);
+    if (j->set->use_cache && lm_ref_cache_load(path, kind, key, j->count, width, height, out)) {
+        lm_info("reference: %u %s from the cache (%s)", j->count, kind == LM_REF_KIND_TEXELS ? "texels" : "pixels", path);
+        return LM_OK;
+    }
+    memset(out, 0, sizeof *out);
+    out->width = width, out->height = height, out->key = key;
+    double t0 = lm_now();
+    j->st = calloc(j->count ? j->count : 1, sizeof *j->st);
+    uint32_t *active = malloc((j->count ? j->count : 1) * sizeof *active);
+    lm_status st = j->st && active ? alloc_result(out, j->count, kind == LM_REF_KIND_TEXELS, err)
+                                   : lm_fail(err, LM_ERR_NOMEM, "no memory for the reference solver");
+    if (st == LM_OK) {
+        adaptive(j, active);
+        finish(j, out);
+        out->seconds = lm_now() - t0;
+        if (j->set->use_cache)
+            lm_ref_cache_store(path, kind, out);
+    } else {
+        lm_ref_result_free(out);
+    }
+    free(active);
+    free(j->st);
+    j->st = NULL;
+    return st;
+}
+
+lm_status lm_reference_texels(const lm_scene *s, const lm_atlas *atlas, const lm_rt *rt, const lm_emitters *em,
+                              const lm_ref_settings *set, lm_ref_result *out, lm_error *err)
+{
+    memset(out, 0, sizeof *out);
+    lm_ref_settings fixed = *set;
+    fixed.min_samples = fixed.min_samples > fixed.samples ? fixed.min_samples : fixed.samples;
+    lm_status st = check_settings(&fixed, err);
+    if (st != LM_OK)
+        return st;
+    lm_ref_ctx c;
+    if ((st = lm_ref_ctx_init(&c, s, rt, em, &fixed, err)) != LM_OK)
+        return st;
+    lm_ref_frame *frames = malloc((atlas->texel_count ? atlas->texel_count : 1) * sizeof *frames);
+    if (!frames) {
+        lm_ref_ctx_free(&c);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %u reference texels", s->path, atlas->texel_count);
+    }
+    for (uint32_t i = 0; i < atlas->texel_count; i++)
+        lm_ref_texel_frame(&c, &atlas->texels[i], &frames[i]);
+    job j = {&c, &fixed, frames, NULL, atlas->texel_count, NULL};
+    st = solve(&j, LM_REF_KIND_TEXELS, lm_ref_key_texels(s, atlas, &fixed), atlas->width, atlas->height, out, err);
+    free(frames);
+    lm_ref_ctx_free(&c);
+    return st;
+}
+
+static lm_status check_camera(const lm_ref_camera *cam, lm_error *err)
+{
+    float f2 = cam->forward[0] * cam->forward[0] + cam->forward[1] * cam->forward[1] + cam->forward[2] * cam->forward[2];
+    int finite = isfinite(cam->eye[0]) && isfinite(cam->eye[1]) && isfinite(cam->eye[2]) && isfinite(f2) &&
+                 isfinite(cam->up[0]) && isfinite(cam->up[1]) && isfinite(cam->up[2]);
+    if (!finite || !(f2 > 0.0f) || cam->width < 1 || cam->height < 1 || !(cam->yfov > 0.0f) || !(cam->yfov < 3.1f))
+        return lm_fail(err, LM_ERR_INVALID, "reference: invalid camera (%d x %d, yfov %g)", cam->width, cam->height,
+                       (double)cam->yfov);
+    return LM_OK;
+}
+
+lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitters *em, const lm_ref_camera *cam,
+                              const lm_ref_settings *set, lm_ref_result *out, lm_error *err)
+{
+    memset(out, 0, sizeof *out);
+    lm_ref_settings fixed = *set;
+    fixed.min_samples = fixed.min_samples > fixed.samples ? fixed.min_samples : fixed.samples;
+    lm_status st = check_settings(&fixed, err);
+    if (st == LM_OK)
+        st = check_camera(cam, err);
+    if (st != LM_OK)
+        return st;
+    lm_ref_ctx c;
+    if ((st = lm_ref_ctx_init(&c, s, rt, em, &fixed, err)) != LM_OK)
+        return st;
+    job j = {&c, &fixed, NULL, cam, (uint32_t)cam->width * (uint32_t)cam->height, NULL};
+    st = solve(&j, LM_REF_KIND_PIXELS, lm_ref_key_pixels(s, cam, &fixed), cam->width, cam->height, out, err);
+    lm_ref_ctx_free(&c);
+    return st;
+}
+
+void lm_ref_result_free(lm_ref_result *r)
+{
+    free(r->full);
+    free(r->iim);
+    free(r->radiance);
+    free(r->samples);
+    free(r->rel_se);
+    memset(r, 0, sizeof *r);
+}
+
+void lm_ref_texels_to_image(const lm_atlas *a, const float *values, float *rgb)
+{
+    memset(rgb, 0, (size_t)a->width * (size_t)a->height * 3 * sizeof(float));
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        const lm_texel *t = &a->texels[i];
+        memcpy(rgb + 3 * ((size_t)t->y * (size_t)a->width + (size_t)t->x), values + 3 * (size_t)i, 3 * sizeof(float));
+    }
+}
+
+double lm_ref_relative_rmse(const float *est, const float *ref, const uint8_t *mask, size_t count, int channels)
+{
+    double num = 0.0, den = 0.0;
+    for (size_t i = 0; i < count; i++) {
+        if (mask && !mask[i])
+            continue;
+        for (int c = 0; c < channels; c++) {
+            double e = est[i * (size_t)channels + (size_t)c], r = ref[i * (size_t)channels + (size_t)c];
+            num += (e - r) * (e - r);
+            den += r * r;
+        }
+    }
+    if (den > 0.0)
+        return sqrt(num / den);
+    return num > 0.0 ? INFINITY : 0.0;
+}

@@ -1,0 +1,100 @@
+/* The reference solver: brute-force Monte Carlo path tracing (Embree), the ground truth for every
+ * error figure lmgi reports (docs/reference.md).
+ *
+ * Per lightmap texel it estimates
+ *   E_full  irradiance from all light arriving at the texel (W/m^2 in the scene's linear units);
+ *   E_iim   what an indirect illumination map holds (DESIGN.md): E_full minus the direct light of
+ *           point, spot and directional lights, i.e. all bounced light plus the direct light of
+ *           emissive surfaces;
+ *   L       the texel's outgoing radiance albedo / pi x E_full (what an AIM approximates).
+ * Per pixel of a camera it estimates the radiance arriving at the eye (direct light included).
+ *
+ * Estimator: from the texel's position lifted along its geometric normal by 1e-5 x the scene size,
+ * over the hemisphere of its shading normal: next-event estimation to every emitter (the punctual ones
+ * exactly, emissive surfaces with one light sample each, combined with BSDF sampling by multiple
+ * importance sampling, power heuristic), then one cosine-weighted ray continued as a path with NEE
+ * and MIS at every non-specular vertex, specular bounces through mirror and glass, and Russian
+ * roulette from bounce `rr_depth` on (survival lm_bsdf_survival).
+ *
+ * Adaptive sampling: passes of `samples` paths per active texel (pixel); per entry a running mean and
+ * variance (Welford) of the luminance; an entry stops when its relative standard error
+ * se / max(mean, floor) is at most `target_error` (for texels: for E_full and E_iim both), with
+ * floor = 1% of the mean luminance over all entries (so black texels stop too), after at least
+ * `min_samples`, or at `max_samples`.
+ *
+ * Determinism: the random numbers of sample k of entry i come from a counter-based generator seeded by
+ * (seed, i, k); each entry is summed by one thread in sample order, and the stopping rule reads sums
+ * in a fixed order, so results are bit-identical whatever the thread count.
+ *
+ * Cache: results are stored in `cache_dir` (default $LMGI_CACHE, else build/reference-cache) under a
+ * 64-bit FNV-1a key of the scene's geometry, materials, textures, lights and node matrices, the texel
+ * table (or the camera), and every setting. A file that does not match (key, kind, sizes, checksum) is
+ * ignored with a warning and recomputed. */
+#ifndef LM_REFERENCE_H
+#define LM_REFERENCE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../scene/scene.h"
+#include "lights.h"
+#include "rt_scene.h"
+
+typedef struct {
+    float target_error;    /* relative standard error per texel/pixel to stop at (default 0.02) */
+    int samples;           /* paths per entry per pass (default 64) */
+    int min_samples;       /* never stop an entry before this many (default 2 x samples) */
+    int max_samples;       /* cap per entry (default 65536) */
+    uint32_t seed;         /* default 1 */
+    int max_depth;         /* bounces at most (default 64) */
+    int rr_depth;          /* Russian roulette from this bounce on (default 3) */
+    const char *cache_dir; /* NULL: $LMGI_CACHE, else "build/reference-cache" */
+    int use_cache;         /* read and write the cache (default 1) */
+    int progress;          /* log progress through lm_info every few seconds (default 1) */
+} lm_ref_settings;
+
+void lm_ref_settings_default(lm_ref_settings *s);
+
+/* A pinhole camera: eye, unit forward and up (up need not be orthogonal to forward), vertical field of
+ * view in radians, picture size; the aspect ratio is width / height. */
+typedef struct {
+    float eye[3], forward[3], up[3];
+    float yfov;
+    int width, height;
+} lm_ref_camera;
+
+typedef struct {
+    uint32_t count;        /* entries: texels (the atlas's texel order) or pixels (row 0 at the top) */
+    int width, height;     /* atlas or picture size */
+    float *full;           /* 3 per entry: E_full for texels, radiance for pixels */
+    float *iim;            /* 3 per entry: E_iim (texels only, else NULL) */
+    float *radiance;       /* 3 per entry: albedo / pi x E_full (texels only, else NULL) */
+    uint32_t *samples;     /* paths per entry */
+    float *rel_se;         /* achieved relative standard error per entry (the larger of full and iim) */
+    uint64_t total_samples;
+    double mean_rel_se, max_rel_se;
+    uint32_t converged;    /* entries that reached target_error (the others hit max_samples) */
+    double seconds;        /* time spent computing (the original run's time when from the cache) */
+    int from_cache;
+    uint64_t key;          /* the cache key */
+} lm_ref_result;
+
+/* Texel references for every texel of `atlas` (built from s). */
+lm_status lm_reference_texels(const lm_scene *s, const lm_atlas *atlas, const lm_rt *rt, const lm_emitters *em,
+                              const lm_ref_settings *set, lm_ref_result *out, lm_error *err);
+/* Pixel radiance for a camera. */
+lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitters *em, const lm_ref_camera *cam,
+                              const lm_ref_settings *set, lm_ref_result *out, lm_error *err);
+void lm_ref_result_free(lm_ref_result *r);
+
+/* Spreads per-texel RGB values (3 per texel) into an atlas-sized RGB image (0 outside texels). */
+void lm_ref_texels_to_image(const lm_atlas *a, const float *values, float *rgb);
+
+/* Relative RMSE of est against ref over `count` entries of `channels` floats, where mask (NULL: all)
+ * is non-zero: sqrt(sum (est - ref)^2) / sqrt(sum ref^2). 0 when both are all zero (or nothing is
+ * selected), INFINITY when only ref is. */
+double lm_ref_relative_rmse(const float *est, const float *ref, const uint8_t *mask, size_t count, int channels);
+
+#endif

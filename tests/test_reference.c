@@ -1,0 +1,355 @@
+/* reference solver: analytic irradiance (point light over a plane, furnace box), determinism, cache,
+ * pixels, relative RMSE. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../src/core/log.h"
+#include "../src/core/timing.h"
+#include "../src/trace/reference.h"
+#include "support.h"
+
+#define PI 3.14159265358979323846
+
+/* The internal pipeline for one scene file. */
+typedef struct {
+    lm_scene *s;
+    lm_surfaces su;
+    lm_atlas atlas;
+    lm_rt *rt;
+    lm_emitters em;
+} pipeline;
+
+static void load(pipeline *p, const char *path, float texel_size)
+{
+    memset(p, 0, sizeof *p);
+    lm_error err;
+    lm_load_options lo = {0};
+    lm_surface_options so;
+    lm_atlas_options ao;
+    lm_surface_options_default(&so);
+    lm_atlas_options_default(&ao);
+    ao.texel_size = texel_size;
+    if (lm_scene_load_gltf(path, &lo, &p->s, &err) != LM_OK || lm_surfaces_build(p->s, &so, &p->su, &err) != LM_OK ||
+        lm_atlas_build(p->s, &p->su, &ao, &p->atlas, &err) != LM_OK || lm_rt_build(p->s, &p->su, &p->rt, &err) != LM_OK ||
+        lm_emitters_build(p->s, &p->em, &err) != LM_OK)
+        fail_msg("loading %s: %s", path, err.msg);
+}
+
+static void unload(pipeline *p)
+{
+    lm_emitters_free(&p->em);
+    lm_rt_free(p->rt);
+    lm_atlas_free(&p->atlas);
+    lm_surfaces_free(&p->su);
+    lm_scene_free(p->s);
+}
+
+/* Gives every primitive material 0 (lmt_write_gltf writes none) by rewriting the file's text. */
+static void use_material_0(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    static char in[1 << 16], out[1 << 17];
+    size_t n = fread(in, 1, sizeof in - 1, f);
+    fclose(f);
+    in[n] = '\0';
+    char *o = out;
+    for (const char *p = in; *p;) {
+        const char *q = strstr(p, "\"indices\": ");
+        if (!q) {
+            o += sprintf(o, "%s", p);
+            break;
+        }
+        const char *close = strchr(q, '}');
+        o += sprintf(o, "%.*s, \"material\": 0}", (int)(close - p), p);
+        p = close + 1;
+    }
+    f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(out, f);
+    fclose(f);
+}
+
+/* A 20 x 20 plane (y = 0, facing up, default 0.8 grey material) under a point light of intensity 10
+ * at height 2. */
+static const char *plane_scene(void)
+{
+    static char path[512];
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_quad(&m, (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    const char *nodes = "[{\"children\": [1, 2]}, {\"mesh\": 0},"
+                        " {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
+    const char *ext = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+                      " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}},";
+    snprintf(path, sizeof path, "%s/plane.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &m, 1, nodes, NULL, 0, ext), 0);
+    return path;
+}
+
+/* A closed box of half-size 1 seen from inside: every wall faces in, albedo 0.5, emits radiance 1. */
+static const char *furnace_scene(void)
+{
+    static char path[512];
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_cube(&m, 1.0f);
+    for (int t = 0; t < m.index_count; t += 3) { /* turn the winding inwards */
+        uint16_t k = m.idx[t + 1];
+        m.idx[t + 1] = m.idx[t + 2];
+        m.idx[t + 2] = k;
+    }
+    const char *mat = "\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1],"
+                      " \"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}],";
+    snprintf(path, sizeof path, "%s/furnace.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &m, 1, "[{\"mesh\": 0}]", NULL, 0, mat), 0);
+    use_material_0(path);
+    return path;
+}
+
+static lm_ref_settings quick_settings(float target, int samples)
+{
+    lm_ref_settings set;
+    lm_ref_settings_default(&set);
+    set.target_error = target;
+    set.samples = samples;
+    set.min_samples = samples;
+    set.use_cache = 0;
+    set.progress = 0;
+    return set;
+}
+
+static void test_point_light_over_plane(void **state)
+{
+    (void)state;
+    pipeline p;
+    load(&p, plane_scene(), 0.5f);
+    assert_true(p.atlas.texel_count >= 1000);
+    lm_ref_settings set = quick_settings(0.02f, 4);
+    lm_ref_result r;
+    lm_error err;
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &r, &err), LM_OK);
+    assert_int_equal(r.count, p.atlas.texel_count);
+    int checked = 0;
+    for (uint32_t i = 0; i < r.count; i++) {
+        const lm_texel *t = &p.atlas.texels[i];
+        assert_float_equal(r.iim[3 * i], 0.0, 0.0); /* nothing to bounce from: exactly 0 */
+        assert_float_equal(r.iim[3 * i + 2], 0.0, 0.0);
+        if (fabsf(t->pos[0]) > 8.0f || fabsf(t->pos[2]) > 8.0f)
+            continue;
+        double d2 = t->pos[0] * t->pos[0] + 4.0 + t->pos[2] * t->pos[2], e = 10.0 * (2.0 / sqrt(d2)) / d2;
+        assert_float_equal(r.full[3 * i + 1], e, 0.02 * e);
+        assert_float_equal(r.radiance[3 * i], 0.8 / PI * r.full[3 * i], 1e-6 * r.full[3 * i]);
+        checked++;
+    }
+    assert_true(checked > 500);
+    assert_int_equal(r.converged, r.count);
+    lm_ref_result_free(&r);
+    unload(&p);
+}
+
+/* Furnace: radiance Le / (1 - rho) everywhere, so E = pi Le / (1 - rho) = 2 pi; E_iim = E_full. */
+static void test_furnace(void **state)
+{
+    (void)state;
+    pipeline p;
+    load(&p, furnace_scene(), 0.25f);
+    assert_int_equal(p.em.count, 1);
+    lm_ref_settings set = quick_settings(0.006f, 64);
+    lm_ref_result r;
+    lm_error err;
+    double t0 = lm_now();
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &r, &err), LM_OK);
+    double expect = 2.0 * PI, worst = 0.0, mean = 0.0;
+    for (uint32_t i = 0; i < r.count; i++) {
+        for (int c = 0; c < 3; c++) {
+            assert_float_equal(r.full[3 * i + c], expect, 0.03 * expect);
+            assert_float_equal(r.iim[3 * i + c], r.full[3 * i + c], 0.0);
+        }
+        worst = fmax(worst, fabs(r.full[3 * i] / expect - 1.0));
+        mean += r.full[3 * i] / expect / r.count;
+    }
+    assert_float_equal(mean, 1.0, 0.002); /* unbiased: the average over texels is much tighter */
+    print_message("furnace: %u texels, %llu paths, error: mean %.4f max %.4f; mean E / expected %.5f, worst texel "
+                  "off by %.4f; %.2f s\n", r.count, (unsigned long long)r.total_samples, r.mean_rel_se, r.max_rel_se,
+                  mean, worst, lm_now() - t0);
+    assert_true(r.max_rel_se <= 0.006 || r.converged < r.count);
+    lm_ref_result_free(&r);
+    unload(&p);
+}
+
+static void test_deterministic_across_threads(void **state)
+{
+    (void)state;
+    pipeline p;
+    load(&p, furnace_scene(), 0.5f);
+    lm_ref_settings set = quick_settings(0.05f, 16);
+    lm_ref_result a, b;
+    lm_error err;
+    int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &a, &err), LM_OK);
+    omp_set_num_threads(threads > 1 ? threads : 2);
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &b, &err), LM_OK);
+    omp_set_num_threads(threads);
+    assert_int_equal(a.count, b.count);
+    assert_memory_equal(a.full, b.full, a.count * 3 * sizeof(float));
+    assert_memory_equal(a.iim, b.iim, a.count * 3 * sizeof(float));
+    assert_memory_equal(a.samples, b.samples, a.count * sizeof(uint32_t));
+    lm_ref_result_free(&a);
+    lm_ref_result_free(&b);
+    unload(&p);
+}
+
+static void corrupt(const char *path, long offset, int cut)
+{
+    FILE *f = fopen(path, "r+b");
+    assert_non_null(f);
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    fclose(f);
+    if (cut) {
+        assert_int_equal(truncate(path, size / 2), 0);
+        return;
+    }
+    f = fopen(path, "r+b");
+    fseek(f, offset < size ? offset : size / 2, SEEK_SET);
+    fputc(0x5a, f);
+    fputc(0xa5, f);
+    fclose(f);
+}
+
+static void test_cache_hit_and_corruption(void **state)
+{
+    (void)state;
+    pipeline p;
+    load(&p, furnace_scene(), 0.5f);
+    char dir[600];
+    snprintf(dir, sizeof dir, "%s/cache", lmt_tmpdir());
+    lm_ref_settings set = quick_settings(0.03f, 32);
+    set.use_cache = 1;
+    set.cache_dir = dir;
+    lm_ref_result a, b, c;
+    lm_error err;
+    double t0 = lm_now();
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &a, &err), LM_OK);
+    double t1 = lm_now();
+    assert_false(a.from_cache);
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &b, &err), LM_OK);
+    double t2 = lm_now();
+    assert_true(b.from_cache);
+    assert_true(t2 - t1 < t1 - t0);
+    assert_int_equal(a.key, b.key);
+    assert_memory_equal(a.full, b.full, a.count * 3 * sizeof(float));
+    assert_memory_equal(a.iim, b.iim, a.count * 3 * sizeof(float));
+    assert_memory_equal(a.radiance, b.radiance, a.count * 3 * sizeof(float));
+    assert_memory_equal(a.rel_se, b.rel_se, a.count * sizeof(float));
+    assert_int_equal(a.total_samples, b.total_samples);
+    lm_ref_result_free(&b);
+    /* a damaged file (a flipped byte, then a truncated one) is ignored with a warning and recomputed */
+    char file[1300];
+    snprintf(file, sizeof file, "%s/texels-%016llx.lmref", dir, (unsigned long long)a.key);
+    for (int k = 0; k < 2; k++) {
+        corrupt(file, 200, k);
+        int warnings = lm_log_warning_count();
+        assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &c, &err), LM_OK);
+        assert_false(c.from_cache);
+        assert_true(lm_log_warning_count() > warnings);
+        assert_memory_equal(a.full, c.full, a.count * 3 * sizeof(float));
+        lm_ref_result_free(&c);
+    }
+    /* another setting is another key */
+    set.seed = 7;
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &c, &err), LM_OK);
+    assert_false(c.from_cache);
+    assert_true(c.key != a.key);
+    lm_ref_result_free(&c);
+    lm_ref_result_free(&a);
+    unload(&p);
+}
+
+static void test_pixels_see_lit_plane(void **state)
+{
+    (void)state;
+    pipeline p;
+    load(&p, plane_scene(), 1.0f);
+    lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.2f, 16, 16};
+    lm_ref_settings set = quick_settings(0.01f, 16);
+    lm_ref_result r;
+    lm_error err;
+    assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &r, &err), LM_OK);
+    assert_int_equal(r.count, 256);
+    assert_null(r.iim);
+    /* pixels around the centre look at the origin: L = rho / pi x I / h^2 */
+    double expect = 0.8 / PI * 10.0 / 4.0;
+    for (int y = 7; y <= 8; y++)
+        for (int x = 7; x <= 8; x++)
+            assert_float_equal(r.full[3 * (y * 16 + x)], expect, 0.01 * expect);
+    lm_ref_result_free(&r);
+    cam.yfov = 0.0f;
+    assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &r, &err), LM_ERR_INVALID);
+    unload(&p);
+}
+
+static void test_invalid_settings(void **state)
+{
+    (void)state;
+    pipeline p;
+    load(&p, plane_scene(), 2.0f);
+    lm_ref_settings set = quick_settings(0.0f, 4);
+    lm_ref_result r;
+    lm_error err;
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &r, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "target error"));
+    unload(&p);
+}
+
+static void test_relative_rmse(void **state)
+{
+    (void)state;
+    const float ref[6] = {1, 2, 3, 4, 5, 6}, est[6] = {1, 2, 3, 4, 5, 9};
+    const uint8_t mask[2] = {1, 0};
+    assert_float_equal(lm_ref_relative_rmse(ref, ref, NULL, 2, 3), 0.0, 0.0);
+    assert_float_equal(lm_ref_relative_rmse(est, ref, NULL, 2, 3), 3.0 / sqrt(91.0), 1e-9);
+    assert_float_equal(lm_ref_relative_rmse(est, ref, mask, 2, 3), 0.0, 0.0);
+    const float zero[3] = {0, 0, 0};
+    assert_true(isinf(lm_ref_relative_rmse(ref, zero, NULL, 1, 3)));
+    assert_float_equal(lm_ref_relative_rmse(zero, zero, NULL, 1, 3), 0.0, 0.0);
+}
+
+static void test_texels_to_image(void **state)
+{
+    (void)state;
+    lm_texel tx[2] = {{.x = 1, .y = 0}, {.x = 0, .y = 1}};
+    lm_atlas a = {.width = 2, .height = 2, .texel_count = 2, .texels = tx};
+    const float v[6] = {1, 2, 3, 4, 5, 6};
+    float img[12];
+    lm_ref_texels_to_image(&a, v, img);
+    const float want[12] = {0, 0, 0, 1, 2, 3, 4, 5, 6, 0, 0, 0};
+    assert_memory_equal(img, want, sizeof want);
+}
+
+int main(void)
+{
+    lm_log_set_level(LM_LOG_ERROR);
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_point_light_over_plane),
+        cmocka_unit_test(test_furnace),
+        cmocka_unit_test(test_deterministic_across_threads),
+        cmocka_unit_test(test_cache_hit_and_corruption),
+        cmocka_unit_test(test_pixels_see_lit_plane),
+        cmocka_unit_test(test_invalid_settings),
+        cmocka_unit_test(test_relative_rmse),
+        cmocka_unit_test(test_texels_to_image),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
