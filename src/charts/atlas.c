@@ -9,7 +9,7 @@
 #include "charts_internal.h"
 
 /* Texels the default texel size aims at for the whole scene. */
-#define DEFAULT_TEXELS 262144.0
+#define DEFAULT_TEXELS 65536.0
 
 void lm_atlas_options_default(lm_atlas_options *o)
 {

@@ -91,7 +91,7 @@ typedef struct {
 } lm_atlas;
 
 void lm_atlas_options_default(lm_atlas_options *o);
-/* sqrt(total surface area / 2^18): about 256k texels for the whole scene. */
+/* sqrt(total surface area / 2^16): about 64k texels for the whole scene. */
 float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su);
 lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o,
                          lm_atlas *out, lm_error *err);

@@ -63,6 +63,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
     memset(a, 0, sizeof *a);
     lmgi_options_init(&a->options);
     a->repeats = 3;
+    a->camera = -1;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -83,6 +84,32 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_size(o, v, &a->width, &a->height);
         else if (!strcmp(o, "--repeats"))
             rc = parse_int(o, v, 1, 100, &a->repeats);
+        else if (!strcmp(o, "--frames"))
+            rc = parse_int(o, v, 1, 1000000, &a->frames);
+        else if (!strcmp(o, "--seed"))
+            rc = parse_int(o, v, 0, 2147483647, (int *)&a->seed);
+        else if (!strcmp(o, "--photons"))
+            rc = parse_int(o, v, 1, 100000000, &a->photons);
+        else if (!strcmp(o, "--groups"))
+            rc = parse_int(o, v, 1, 10000000, &a->groups);
+        else if (!strcmp(o, "--per-group"))
+            rc = parse_int(o, v, 1, 10000000, &a->per_group);
+        else if (!strcmp(o, "--retrace"))
+            rc = parse_int(o, v, 1, 1000000, &a->retrace);
+        else if (!strcmp(o, "--group-budget"))
+            rc = parse_int(o, v, 0, 10000000, &a->group_budget);
+        else if (!strcmp(o, "--nearest"))
+            rc = parse_int(o, v, 1, 100000, &a->nearest);
+        else if (!strcmp(o, "--surfaces-per-frame"))
+            rc = parse_int(o, v, 0, 10000000, &a->surface_budget);
+        else if (!strcmp(o, "--target-error"))
+            rc = parse_float(o, v, 1e-6f, &a->target_error);
+        else if (!strcmp(o, "--samples"))
+            rc = parse_int(o, v, 1, 100000000, &a->samples);
+        else if (!strcmp(o, "--cache"))
+            rc = v ? (a->cache_dir = v, 0) : bad(o, v, "a directory");
+        else if (!strcmp(o, "--camera"))
+            rc = parse_int(o, v, 0, 1000000, &a->camera);
         else if (!strcmp(o, "--scaling"))
             rc = v ? add_file(a->scaling, &a->scaling_count, v) : bad(o, v, "a scene file");
         else {
@@ -91,6 +118,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                 a->options.use_file_uv1 = 1;
             else if (!strcmp(o, "--strict"))
                 a->options.strict = 1;
+            else if (!strcmp(o, "--no-cache"))
+                a->no_cache = 1;
             else if (!strcmp(o, "-v") || !strcmp(o, "--verbose"))
                 a->verbose = 1;
             else if (!strcmp(o, "-q") || !strcmp(o, "--quiet"))

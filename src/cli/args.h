@@ -17,6 +17,21 @@ typedef struct {
     const char *files[LM_CLI_MAX_FILES];
     int scaling_count;
     const char *scaling[LM_CLI_MAX_FILES];
+    /* photon stage and reference solver (0 / NULL = the command's default) */
+    int frames;             /* --frames N */
+    unsigned seed;          /* --seed N */
+    int photons;            /* --photons N: total photon budget */
+    int groups;             /* --groups G */
+    int per_group;          /* --per-group M */
+    int retrace;            /* --retrace k: photons re-traced per group per frame */
+    int group_budget;       /* --group-budget B: invalid groups re-traced per frame */
+    int nearest;            /* --nearest N: photons per AIM estimate */
+    int surface_budget;     /* --surfaces-per-frame K: AIM refreshes per frame */
+    float target_error;     /* --target-error E: relative standard error per texel (reference) */
+    int samples;            /* --samples N: samples per texel/pixel per pass (reference) */
+    const char *cache_dir;  /* --cache DIR (reference) */
+    int no_cache;           /* --no-cache */
+    int camera;             /* --camera I (default: the file's first, else automatic) */
 } lm_cli_args;
 
 /* Parses argv[first..argc). Returns 0 on success, or prints what was wrong and returns 2. */

@@ -6,6 +6,8 @@
 
 #include "args.h"
 #include "bench.h"
+#include "photons_cmd.h"
+#include "reference_cmd.h"
 
 static void usage(FILE *f)
 {
@@ -22,7 +24,7 @@ static void usage(FILE *f)
             "  help                   this text\n"
             "\n"
             "options:\n"
-            "  --texel-size S   world units per lightmap texel (default: about 256k texels for the scene)\n"
+            "  --texel-size S   world units per lightmap texel (default: about 64k texels for the scene)\n"
             "  --gutter N       empty texels between charts (default 2)\n"
             "  --use-uv1        use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping\n"
             "  --cone DEG       max normal deviation inside one surface (default 30)\n"
@@ -99,6 +101,10 @@ int main(int argc, char **argv)
         return cmd_info(&a);
     if (!strcmp(cmd, "charts"))
         return cmd_charts(&a);
+    if (!strcmp(cmd, "photons"))
+        return lm_cli_photons(&a);
+    if (!strcmp(cmd, "reference"))
+        return lm_cli_reference(&a);
     if (!strcmp(cmd, "bench"))
         return lm_cli_bench(&a);
     fprintf(stderr, "lmgi: unknown command '%s'\n\n", cmd);

@@ -116,7 +116,10 @@ lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, con
     aim->surface_count = su->surface_count;
     aim->rgb = calloc((size_t)a->width * (size_t)a->height * 3, sizeof *aim->rgb);
     aim->refresh_count = calloc((size_t)su->surface_count + 1, sizeof *aim->refresh_count);
-    if (!aim->rgb || !aim->refresh_count)
+    aim->edge_d2 = malloc(((size_t)a->texel_count + 1) * sizeof *aim->edge_d2);
+    for (uint32_t i = 0; aim->edge_d2 && i < a->texel_count; i++)
+        aim->edge_d2[i] = -1.0f; /* unknown until the texel's first estimate walks the edges */
+    if (!aim->rgb || !aim->refresh_count || !aim->edge_d2)
         st = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for a %dx%d map", a->width, a->height);
     if (st == LM_OK)
         st = build_texel_lists(aim, a, err);
@@ -135,6 +138,7 @@ void lm_aim_free(lm_aim *aim)
     free(aim->edge_first);
     free(aim->edges);
     free(aim->refresh_count);
+    free(aim->edge_d2);
     memset(aim, 0, sizeof *aim);
 }
 
@@ -289,9 +293,22 @@ typedef struct {
     uint32_t first, end;  /* this surface's edges */
 } boundary;
 
+/* Squared distance from the origin to the segment ab (2-d). */
+static double segment_dist2(const double a[2], const double b[2])
+{
+    double d[2] = {b[0] - a[0], b[1] - a[1]}, len2 = d[0] * d[0] + d[1] * d[1];
+    double t = len2 > 0.0 ? -(a[0] * d[0] + a[1] * d[1]) / len2 : 0.0;
+    t = t < 0.0 ? 0.0 : t > 1.0 ? 1.0 : t;
+    double x = a[0] + t * d[0], y = a[1] + t * d[1];
+    return x * x + y * y;
+}
+
 /* Local-space (kernel-weighted) area of the disc of radius^2 r2 around q, in the tangent plane of normal
- * n, that lies on the surface: the full disc's plus the corrections of the boundary edges crossing it. */
-static double disc_area_on_surface(const boundary *bd, const float q[3], const double n[3], double r2, int kernel)
+ * n, that lies on the surface: the full disc's plus the corrections of the boundary edges crossing it.
+ * *edge_d2 gets the squared distance to the nearest boundary edge in that plane: a later disc smaller
+ * than that lies wholly on the surface and needs no edge walk. */
+static double disc_area_on_surface(const boundary *bd, const float q[3], const double n[3], double r2, int kernel,
+                                   double *edge_d2)
 {
     double t1[3], t2[3], h[3] = {fabs(n[0]) < 0.9 ? 1.0 : 0.0, fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
     t1[0] = h[1] * n[2] - h[2] * n[1];
@@ -303,7 +320,7 @@ static double disc_area_on_surface(const boundary *bd, const float q[3], const d
     t2[0] = n[1] * t1[2] - n[2] * t1[1]; /* t1 x t2 = n: counter-clockwise seen from the front */
     t2[1] = n[2] * t1[0] - n[0] * t1[2];
     t2[2] = n[0] * t1[1] - n[1] * t1[0];
-    double full = (kernel ? 0.5 : 1.0) * PI_D * r2, area = full;
+    double full = (kernel ? 0.5 : 1.0) * PI_D * r2, area = full, nearest = INFINITY;
     for (uint32_t e = bd->first; e < bd->end; e++) {
         double p[2][2];
         for (int k = 0; k < 2; k++) {
@@ -313,7 +330,9 @@ static double disc_area_on_surface(const boundary *bd, const float q[3], const d
             p[k][1] = rel[0] * t2[0] + rel[1] * t2[1] + rel[2] * t2[2];
         }
         area += edge_correction(p[0], p[1], r2, kernel);
+        nearest = fmin(nearest, segment_dist2(p[0], p[1]));
     }
+    *edge_d2 = nearest;
     return fmin(fmax(area, MIN_COVERAGE * full), full);
 }
 
@@ -362,7 +381,8 @@ static void texel_albedo(const lm_scene *s, const lm_texel *t, float rho[3])
 
 /* L = rho / pi * sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
  * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. */
-static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t *idx, float *d2, float out[3])
+static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t *idx, float *d2, float *edge_d2,
+                           float out[3])
 {
     out[0] = out[1] = out[2] = 0.0f;
     float r2 = 0.0f;
@@ -381,8 +401,12 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t *i
     else
         for (uint32_t i = 0; i < k; i++)
             add_flux(&f, idx[i], d2[i]);
-    double area = j->boundary_correction ? disc_area_on_surface(&j->bd, t->local, n, r2, j->kernel)
-                                         : (j->kernel ? 0.5 : 1.0) * PI_D * r2;
+    double area = (j->kernel ? 0.5 : 1.0) * PI_D * r2;
+    if (j->boundary_correction && !((double)r2 < *edge_d2)) {
+        double nearest;
+        area = disc_area_on_surface(&j->bd, t->local, n, r2, j->kernel, &nearest);
+        *edge_d2 = (float)nearest;
+    }
     float rho[3];
     texel_albedo(j->s, t, rho);
     for (int c = 0; c < 3; c++)
@@ -404,7 +428,7 @@ static void write_texels(lm_aim *aim, const estimate_job *j, uint32_t first, uin
             const lm_texel *t = &j->a->texels[aim->texel_list[i]];
             float *px = aim->rgb + 3 * ((size_t)t->y * (size_t)aim->width + (size_t)t->x);
             if (idx && d2)
-                estimate_texel(j, t, idx, d2, px);
+                estimate_texel(j, t, idx, d2, &aim->edge_d2[i], px);
         }
         free(idx);
         free(d2);

@@ -64,6 +64,8 @@ typedef struct {
     uint32_t *edge_first;    /* per surface (surface_count + 1 offsets) into edges */
     uint32_t *edges;         /* boundary edges, 2 scene vertex ids each, oriented with the surface on the left */
     uint32_t *refresh_count; /* per surface: how many times it was refreshed */
+    float *edge_d2;          /* per texel_list entry: squared distance to its surface's boundary in its
+                                tangent plane (-1 until first computed); a smaller disc skips the edges */
     float mean_hit_energy;   /* as of the last refresh call */
 } lm_aim;
 

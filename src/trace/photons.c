@@ -333,6 +333,7 @@ lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_erro
 /* ---- accessors ---- */
 
 const lm_photon_store *lm_photons_store(const lm_photons *ph) { return &ph->store; }
+lm_photon_store *lm_photons_store_mutable(lm_photons *ph) { return &ph->store; }
 uint32_t lm_photons_count(const lm_photons *ph) { return ph->photon_count; }
 uint32_t lm_photons_group_count(const lm_photons *ph) { return ph->group_count; }
 uint32_t lm_photons_groups_per_emitter(const lm_photons *ph) { return ph->G; }

@@ -89,6 +89,8 @@ lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err);
 void lm_photons_invalidate_all(lm_photons *ph);
 
 const lm_photon_store *lm_photons_store(const lm_photons *ph);
+/* The same store, writable: the AIM scheduler resets its surfaces' delta_f after a refresh. */
+lm_photon_store *lm_photons_store_mutable(lm_photons *ph);
 uint32_t lm_photons_count(const lm_photons *ph);         /* all photons */
 uint32_t lm_photons_group_count(const lm_photons *ph);   /* emitters x G */
 uint32_t lm_photons_groups_per_emitter(const lm_photons *ph);

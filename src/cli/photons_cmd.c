@@ -1,0 +1,182 @@
+/* lmgi photons: plays the scene's animations with the photon stage only (photons + AIMs) and writes
+ * the AIM atlas (EXR and PNG), a picture of the scene with its AIMs, and per-frame statistics (CSV). */
+#include "photons_cmd.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../charts/atlas_dilate.h"
+#include "../core/image.h"
+#include "../core/tonemap.h"
+#include "../gpu/camera.h"
+#include "../gpu/gl_context.h"
+#include "../gpu/lightmap_view.h"
+#include "../update/lmgi_scene.h"
+#include "../update/photon_stage.h"
+#include "progress.h"
+
+#define FRAME_RATE 30.0f /* frames are played at 30 per second of animation time */
+
+static void settings_from_args(const lm_cli_args *a, lm_photon_stage_settings *s)
+{
+    lm_photon_stage_settings_default(s);
+    if (a->photons)
+        s->photons.total_photons = (uint32_t)a->photons;
+    if (a->groups)
+        s->photons.groups = (uint32_t)a->groups;
+    if (a->per_group)
+        s->photons.per_group = (uint32_t)a->per_group;
+    if (a->retrace)
+        s->photons.retrace_per_group = (uint32_t)a->retrace;
+    if (a->group_budget)
+        s->photons.group_budget = (uint32_t)a->group_budget;
+    if (a->seed)
+        s->photons.seed = a->seed;
+    if (a->nearest)
+        s->aim.n_nearest = a->nearest;
+    if (a->surface_budget)
+        s->surfaces_per_frame = a->surface_budget;
+}
+
+static void csv_header(FILE *f)
+{
+    fprintf(f, "frame,time_s,emitters_moved,photons_retraced,paths_changed,groups_invalidated,groups_retraced,"
+               "group_photons,hits_added,hits_removed,groups_pending,surfaces_refreshed,surfaces_pending,"
+               "texels_written,animate_ms,photons_ms,aim_ms,frame_ms\n");
+}
+
+static void csv_row(FILE *f, const lm_photon_stage_frame *r)
+{
+    const lm_photon_frame_stats *p = &r->photons;
+    fprintf(f, "%d,%.4f,%d,%u,%u,%u,%u,%u,%u,%u,%u,%d,%d,%u,%.3f,%.3f,%.3f,%.3f\n", r->frame, (double)r->time,
+            r->emitters_moved, p->rr_photons, p->paths_changed, p->groups_invalidated, p->groups_retraced,
+            p->group_photons, p->hits_added, p->hits_removed, p->pending_groups, r->aim.surfaces_refreshed,
+            r->aim.surfaces_pending, r->aim.texels_written, 1e3 * r->t_animate, 1e3 * r->t_photons,
+            1e3 * r->t_aim, 1e3 * r->t_total);
+}
+
+/* DIR/aim.exr (linear), DIR/aim.png (tone-mapped) and DIR/view.png (the scene with its AIMs). */
+static lm_status write_pictures(const lmgi_scene *sc, const lm_aim *aim, const lm_cli_args *a, float *exposure,
+                                lm_error *err)
+{
+    const lm_atlas *at = &sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *rgb = malloc(n * 3 * sizeof *rgb);
+    uint8_t *img = malloc(n * 4);
+    int w = a->width ? a->width : 640, h = a->height ? a->height : 480;
+    uint8_t *view_img = malloc((size_t)w * h * 4);
+    char path[4096];
+    lm_status st = rgb && img && view_img ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory for the pictures");
+    if (st == LM_OK) {
+        memcpy(rgb, lm_aim_rgb(aim), n * 3 * sizeof *rgb);
+        snprintf(path, sizeof path, "%s/aim.exr", a->out_dir);
+        st = lm_write_exr(path, at->width, at->height, 3, rgb, err);
+    }
+    if (st == LM_OK) {
+        lm_atlas_dilate(at, rgb, 3, at->gutter);
+        *exposure = lm_auto_exposure(rgb, n, 3);
+        lm_tonemap_srgb8(rgb, n, 3, *exposure, img);
+        snprintf(path, sizeof path, "%s/aim.png", a->out_dir);
+        st = lm_write_png(path, at->width, at->height, img, err);
+    }
+    lm_gl_context *gl = NULL;
+    if (st == LM_OK)
+        st = lm_gl_context_create(&gl, err);
+    if (st == LM_OK) {
+        lm_view view;
+        lm_view_for_scene(sc->scene, a->camera, w, h, &view);
+        st = lm_render_lightmap(sc->scene, at, rgb, *exposure, &view, w, h, view_img, err);
+        snprintf(path, sizeof path, "%s/view.png", a->out_dir);
+        if (st == LM_OK)
+            st = lm_write_png(path, w, h, view_img, err);
+    }
+    lm_gl_context_destroy(gl);
+    free(rgb);
+    free(img);
+    free(view_img);
+    return st;
+}
+
+static lm_status play(lmgi_scene *sc, const lm_cli_args *a, lm_photon_stage *stage, FILE *csv, double *sum_ms,
+                      lm_error *err)
+{
+    int frames = a->frames ? a->frames : 60;
+    *sum_ms = 0.0;
+    for (int f = 0; f < frames; f++) {
+        lm_photon_stage_frame r;
+        lm_status st = lm_photon_stage_step(stage, (float)f / FRAME_RATE, &r, err);
+        if (st != LM_OK)
+            return st;
+        csv_row(csv, &r);
+        *sum_ms += 1e3 * r.t_total;
+        lm_progress("photons", f + 1, frames);
+    }
+    (void)sc;
+    return LM_OK;
+}
+
+static void summary(const lm_photon_stage *stage, const lm_photon_stage_frame *setup, int frames, double sum_ms,
+                    float exposure, const char *dir)
+{
+    const lm_photons *ph = lm_photon_stage_photons(stage);
+    lm_photon_memory mem;
+    lm_photons_memory(ph, &mem);
+    printf("photons     %u in %u groups (%u per emitter, %d emitters), %u hits stored\n", lm_photons_count(ph),
+           lm_photons_group_count(ph), lm_photons_groups_per_emitter(ph), lm_photon_stage_emitters(stage)->count,
+           lm_photons_stored_hits(ph));
+    printf("memory      %.0f bytes per photon (%.0f in use; %.2f path vertices, %.2f hits per photon)\n",
+           mem.per_photon, mem.live_per_photon, mem.mean_path_vertices, mem.mean_hits);
+    printf("setup       full trace %.1f ms, all AIMs %.1f ms\n", 1e3 * setup->t_photons, 1e3 * setup->t_aim);
+    printf("frames      %d, mean photon-stage frame %.3f ms\n", frames, frames ? sum_ms / frames : 0.0);
+    printf("wrote       %s/aim.exr, %s/aim.png, %s/view.png (exposure %.4g), %s/stats.csv\n", dir, dir, dir,
+           (double)exposure, dir);
+}
+
+int lm_cli_photons(const lm_cli_args *a)
+{
+    if (a->file_count != 1 || !a->out_dir) {
+        fprintf(stderr, "lmgi: photons needs one scene file and --out DIR\n");
+        return 2;
+    }
+    lmgi_scene *sc = NULL;
+    lmgi_error perr;
+    if (lmgi_load(a->files[0], &a->options, &sc, &perr) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", perr.message);
+        return 1;
+    }
+    lm_error err;
+    lm_error_clear(&err);
+    lm_photon_stage_settings set;
+    settings_from_args(a, &set);
+    lm_photon_stage *stage = NULL;
+    lm_photon_stage_frame setup;
+    memset(&setup, 0, sizeof setup);
+    char path[4096];
+    FILE *csv = NULL;
+    double sum_ms = 0.0;
+    float exposure = 1.0f;
+    lm_status st = lm_mkdir_p(a->out_dir, &err);
+    if (st == LM_OK) {
+        snprintf(path, sizeof path, "%s/stats.csv", a->out_dir);
+        csv = fopen(path, "w");
+        st = csv ? LM_OK : lm_fail(&err, LM_ERR_IO, "%s: cannot write", path);
+    }
+    if (st == LM_OK)
+        st = lm_photon_stage_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &stage, &setup, &err);
+    if (st == LM_OK) {
+        csv_header(csv);
+        st = play(sc, a, stage, csv, &sum_ms, &err);
+    }
+    if (csv && fclose(csv) != 0 && st == LM_OK)
+        st = lm_fail(&err, LM_ERR_IO, "%s/stats.csv: write failed", a->out_dir);
+    if (st == LM_OK)
+        st = write_pictures(sc, lm_photon_stage_aim(stage), a, &exposure, &err);
+    if (st == LM_OK && !a->quiet)
+        summary(stage, &setup, a->frames ? a->frames : 60, sum_ms, exposure, a->out_dir);
+    if (st != LM_OK)
+        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+    lm_photon_stage_free(stage);
+    lmgi_free(sc);
+    return st == LM_OK ? 0 : 1;
+}

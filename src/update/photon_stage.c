@@ -1,0 +1,162 @@
+#include "photon_stage.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/timing.h"
+
+/* What an emitter looked like when its photons were last traced: its node's world matrix and power. */
+typedef struct {
+    float world[16];
+    float power[3];
+} emitter_snapshot;
+
+struct lm_photon_stage {
+    lm_photon_stage_settings set;
+    lm_scene *scene;
+    const lm_surfaces *surfaces;
+    const lm_atlas *atlas;
+    lm_rt *rt;
+    lm_emitters emitters;
+    emitter_snapshot *snap;
+    lm_photons *photons;
+    lm_aim aim;
+    int have_emitters, have_aim;
+    int frame;
+};
+
+void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
+{
+    memset(s, 0, sizeof *s);
+    lm_photon_settings_default(&s->photons);
+    lm_aim_settings_default(&s->aim);
+    s->surfaces_per_frame = 4;
+}
+
+static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *out)
+{
+    const lm_emitter *em = &ps->emitters.e[e];
+    memset(out, 0, sizeof *out);
+    if (em->node >= 0 && em->node < ps->scene->node_count)
+        memcpy(out->world, ps->scene->nodes[em->node].world, sizeof out->world);
+    memcpy(out->power, em->power, sizeof out->power);
+}
+
+/* Invalidates the groups of every emitter whose placement or power changed since its last snapshot. */
+static lm_status check_emitters(lm_photon_stage *ps, int *moved, lm_error *err)
+{
+    *moved = 0;
+    for (int e = 0; e < ps->emitters.count; e++) {
+        emitter_snapshot now;
+        take_snapshot(ps, e, &now);
+        if (!memcmp(&now, &ps->snap[e], sizeof now))
+            continue;
+        ps->snap[e] = now;
+        (*moved)++;
+        lm_status st = lm_photons_invalidate_emitter(ps->photons, e, err);
+        if (st != LM_OK)
+            return st;
+    }
+    return LM_OK;
+}
+
+static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_error *err)
+{
+    double t0 = lm_now();
+    lm_status st = lm_emitters_build(ps->scene, &ps->emitters, err);
+    if (st != LM_OK)
+        return st;
+    ps->have_emitters = 1;
+    ps->snap = calloc((size_t)ps->emitters.count + 1, sizeof *ps->snap);
+    if (!ps->snap)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
+    for (int e = 0; e < ps->emitters.count; e++)
+        take_snapshot(ps, e, &ps->snap[e]);
+    st = lm_photons_create(ps->scene, ps->surfaces, ps->rt, &ps->emitters, &ps->set.photons, &ps->photons, err);
+    if (st == LM_OK)
+        st = lm_photons_trace_all(ps->photons, &first->photons, err);
+    double t1 = lm_now();
+    if (st == LM_OK)
+        st = lm_aim_init(&ps->aim, ps->scene, ps->surfaces, ps->atlas, &ps->set.aim, err);
+    ps->have_aim = st == LM_OK;
+    if (st == LM_OK)
+        st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
+                                lm_photons_store_mutable(ps->photons), &first->aim, err);
+    first->t_photons = t1 - t0;
+    first->t_aim = lm_now() - t1;
+    first->t_total = lm_now() - t0;
+    return st;
+}
+
+lm_status lm_photon_stage_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
+                                 const lm_photon_stage_settings *set, lm_photon_stage **out,
+                                 lm_photon_stage_frame *first, lm_error *err)
+{
+    *out = NULL;
+    lm_photon_stage *ps = calloc(1, sizeof *ps);
+    if (!ps)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", s->path);
+    if (set)
+        ps->set = *set;
+    else
+        lm_photon_stage_settings_default(&ps->set);
+    ps->scene = s;
+    ps->surfaces = su;
+    ps->atlas = a;
+    ps->rt = rt;
+    lm_photon_stage_frame scratch;
+    memset(&scratch, 0, sizeof scratch);
+    lm_status st = setup(ps, first ? first : &scratch, err);
+    if (st != LM_OK) {
+        lm_photon_stage_free(ps);
+        return st;
+    }
+    *out = ps;
+    return LM_OK;
+}
+
+void lm_photon_stage_free(lm_photon_stage *ps)
+{
+    if (!ps)
+        return;
+    if (ps->have_aim)
+        lm_aim_free(&ps->aim);
+    lm_photons_free(ps->photons);
+    if (ps->have_emitters)
+        lm_emitters_free(&ps->emitters);
+    free(ps->snap);
+    free(ps);
+}
+
+lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err)
+{
+    memset(out, 0, sizeof *out);
+    out->frame = ps->frame++;
+    out->time = t;
+    double t0 = lm_now();
+    if (ps->scene->animation_count > 0) {
+        lm_scene_eval_animation(ps->scene, -1, t);
+        lm_status st = lm_rt_sync_transforms(ps->rt, ps->scene, err);
+        if (st != LM_OK)
+            return st;
+    }
+    lm_emitters_update(&ps->emitters, ps->scene);
+    lm_status st = check_emitters(ps, &out->emitters_moved, err);
+    double t1 = lm_now();
+    if (st == LM_OK)
+        st = lm_photons_frame(ps->photons, &out->photons, err);
+    double t2 = lm_now();
+    if (st == LM_OK)
+        st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
+                            ps->set.surfaces_per_frame, &out->aim, err);
+    double t3 = lm_now();
+    out->t_animate = t1 - t0;
+    out->t_photons = t2 - t1;
+    out->t_aim = t3 - t2;
+    out->t_total = t3 - t0;
+    return st;
+}
+
+const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }
+const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }
+const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }

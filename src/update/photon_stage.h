@@ -1,0 +1,43 @@
+/* The photon stage of the frame loop (Larsen & Christensen sections 2-3): play the scene's animations,
+ * move instances, notice moved or changed lights, re-trace photons round robin and invalid groups
+ * under their budget, and refresh the AIMs of the surfaces that changed most, under theirs. */
+#ifndef LM_PHOTON_STAGE_H
+#define LM_PHOTON_STAGE_H
+
+#include "../photonmap/aim.h"
+#include "../trace/lights.h"
+#include "../trace/photons.h"
+
+typedef struct {
+    lm_photon_settings photons;
+    lm_aim_settings aim;
+    int surfaces_per_frame;  /* AIM refreshes per frame, largest delta_f/area first (default 4; < 0 all) */
+} lm_photon_stage_settings;
+
+typedef struct {
+    int frame;
+    float time;              /* animation time, seconds */
+    int emitters_moved;      /* emitters whose placement or power changed this frame */
+    lm_photon_frame_stats photons;
+    lm_aim_stats aim;
+    double t_animate, t_photons, t_aim, t_total; /* seconds */
+} lm_photon_stage_frame;
+
+typedef struct lm_photon_stage lm_photon_stage;
+
+void lm_photon_stage_settings_default(lm_photon_stage_settings *s);
+/* Builds emitters, traces every photon and fills every AIM (the first frame's state). `setup` (may be
+ * NULL) gets the time of that full trace and refresh. The scene, surfaces, atlas and BVH are borrowed
+ * and must outlive the stage; the stage moves the BVH's instances as animations play. */
+lm_status lm_photon_stage_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
+                                 const lm_photon_stage_settings *set, lm_photon_stage **out,
+                                 lm_photon_stage_frame *setup, lm_error *err);
+void lm_photon_stage_free(lm_photon_stage *ps);
+/* One frame at animation time t (every animation evaluated; t is clamped to each one's range). */
+lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
+
+const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
+const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps);
+const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
+
+#endif
