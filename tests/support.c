@@ -10,6 +10,11 @@
 #include <stdint.h>
 #include <unistd.h>
 
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
 static const char *existing(char *buf, size_t n, const char *base, const char *sub, const char *rel)
 {
     snprintf(buf, n, "%s/%s/%s", base, sub, rel);
@@ -206,4 +211,45 @@ int lmt_write_gltf(const char *path, const lmt_mesh *meshes, int mesh_count, con
     free(b64);
     free(buf);
     return fclose(f) == 0 ? 0 : -1;
+}
+
+void lmt_pipeline_load(lmt_pipeline *p, const char *path, float texel_size)
+{
+    memset(p, 0, sizeof *p);
+    lm_error err;
+    lm_load_options lo = {0};
+    lm_surface_options so;
+    lm_atlas_options ao;
+    lm_surface_options_default(&so);
+    lm_atlas_options_default(&ao);
+    ao.texel_size = texel_size;
+    if (lm_scene_load_gltf(path, &lo, &p->s, &err) != LM_OK || lm_surfaces_build(p->s, &so, &p->su, &err) != LM_OK ||
+        lm_atlas_build(p->s, &p->su, &ao, &p->atlas, &err) != LM_OK || lm_rt_build(p->s, &p->su, &p->rt, &err) != LM_OK ||
+        lm_emitters_build(p->s, &p->em, &err) != LM_OK)
+        fail_msg("loading %s: %s", path, err.msg);
+}
+
+void lmt_pipeline_free(lmt_pipeline *p)
+{
+    lm_emitters_free(&p->em);
+    lm_rt_free(p->rt);
+    lm_atlas_free(&p->atlas);
+    lm_surfaces_free(&p->su);
+    lm_scene_free(p->s);
+}
+
+const char *lmt_plane_scene(void)
+{
+    static char path[512];
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_quad(&m, (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    const char *nodes = "[{\"children\": [1, 2]}, {\"mesh\": 0},"
+                        " {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
+    const char *ext = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+                      " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}},";
+    snprintf(path, sizeof path, "%s/plane.gltf", lmt_tmpdir());
+    if (lmt_write_gltf(path, &m, 1, nodes, NULL, 0, ext) != 0)
+        fail_msg("cannot write %s", path);
+    return path;
 }

@@ -22,6 +22,28 @@ const char *lmt_tmpdir(void);
         }                                                                                       \
     } while (0)
 
+
+/* The internal pipeline for one scene file: scene, surfaces, atlas, BVH and emitters. */
+#include "../src/charts/charts.h"
+#include "../src/trace/lights.h"
+#include "../src/trace/rt_scene.h"
+
+typedef struct {
+    lm_scene *s;
+    lm_surfaces su;
+    lm_atlas atlas;
+    lm_rt *rt;
+    lm_emitters em;
+} lmt_pipeline;
+
+/* Loads `path` with default options but the given texel size (0 = default); fails the test on error. */
+void lmt_pipeline_load(lmt_pipeline *p, const char *path, float texel_size);
+void lmt_pipeline_free(lmt_pipeline *p);
+
+/* A 20 x 20 plane (y = 0, facing up, default 0.8 grey material) under a point light of intensity 10 at
+ * height 2, written to a fresh temporary directory; returns its path (static storage). */
+const char *lmt_plane_scene(void);
+
 #endif
 
 #include <stdint.h>

@@ -19,40 +19,6 @@
 
 #define PI 3.14159265358979323846
 
-/* The internal pipeline for one scene file. */
-typedef struct {
-    lm_scene *s;
-    lm_surfaces su;
-    lm_atlas atlas;
-    lm_rt *rt;
-    lm_emitters em;
-} pipeline;
-
-static void load(pipeline *p, const char *path, float texel_size)
-{
-    memset(p, 0, sizeof *p);
-    lm_error err;
-    lm_load_options lo = {0};
-    lm_surface_options so;
-    lm_atlas_options ao;
-    lm_surface_options_default(&so);
-    lm_atlas_options_default(&ao);
-    ao.texel_size = texel_size;
-    if (lm_scene_load_gltf(path, &lo, &p->s, &err) != LM_OK || lm_surfaces_build(p->s, &so, &p->su, &err) != LM_OK ||
-        lm_atlas_build(p->s, &p->su, &ao, &p->atlas, &err) != LM_OK || lm_rt_build(p->s, &p->su, &p->rt, &err) != LM_OK ||
-        lm_emitters_build(p->s, &p->em, &err) != LM_OK)
-        fail_msg("loading %s: %s", path, err.msg);
-}
-
-static void unload(pipeline *p)
-{
-    lm_emitters_free(&p->em);
-    lm_rt_free(p->rt);
-    lm_atlas_free(&p->atlas);
-    lm_surfaces_free(&p->su);
-    lm_scene_free(p->s);
-}
-
 /* Gives every primitive material 0 (lmt_write_gltf writes none) by rewriting the file's text. */
 static void use_material_0(const char *path)
 {
@@ -77,23 +43,6 @@ static void use_material_0(const char *path)
     assert_non_null(f);
     fputs(out, f);
     fclose(f);
-}
-
-/* A 20 x 20 plane (y = 0, facing up, default 0.8 grey material) under a point light of intensity 10
- * at height 2. */
-static const char *plane_scene(void)
-{
-    static char path[512];
-    static lmt_mesh m;
-    memset(&m, 0, sizeof m);
-    lmt_mesh_quad(&m, (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
-    const char *nodes = "[{\"children\": [1, 2]}, {\"mesh\": 0},"
-                        " {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
-    const char *ext = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
-                      " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}},";
-    snprintf(path, sizeof path, "%s/plane.gltf", lmt_tmpdir());
-    assert_int_equal(lmt_write_gltf(path, &m, 1, nodes, NULL, 0, ext), 0);
-    return path;
 }
 
 /* A closed box of half-size 1 seen from inside: every wall faces in, albedo 0.5, emits radiance 1. */
@@ -131,8 +80,8 @@ static lm_ref_settings quick_settings(float target, int samples)
 static void test_point_light_over_plane(void **state)
 {
     (void)state;
-    pipeline p;
-    load(&p, plane_scene(), 0.5f);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, lmt_plane_scene(), 0.5f);
     assert_true(p.atlas.texel_count >= 1000);
     lm_ref_settings set = quick_settings(0.02f, 4);
     lm_ref_result r;
@@ -154,15 +103,15 @@ static void test_point_light_over_plane(void **state)
     assert_true(checked > 500);
     assert_int_equal(r.converged, r.count);
     lm_ref_result_free(&r);
-    unload(&p);
+    lmt_pipeline_free(&p);
 }
 
 /* Furnace: radiance Le / (1 - rho) everywhere, so E = pi Le / (1 - rho) = 2 pi; E_iim = E_full. */
 static void test_furnace(void **state)
 {
     (void)state;
-    pipeline p;
-    load(&p, furnace_scene(), 0.25f);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, furnace_scene(), 0.25f);
     assert_int_equal(p.em.count, 1);
     lm_ref_settings set = quick_settings(0.006f, 64);
     lm_ref_result r;
@@ -184,14 +133,14 @@ static void test_furnace(void **state)
                   mean, worst, lm_now() - t0);
     assert_true(r.max_rel_se <= 0.006 || r.converged < r.count);
     lm_ref_result_free(&r);
-    unload(&p);
+    lmt_pipeline_free(&p);
 }
 
 static void test_deterministic_across_threads(void **state)
 {
     (void)state;
-    pipeline p;
-    load(&p, furnace_scene(), 0.5f);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, furnace_scene(), 0.5f);
     lm_ref_settings set = quick_settings(0.05f, 16);
     lm_ref_result a, b;
     lm_error err;
@@ -207,7 +156,7 @@ static void test_deterministic_across_threads(void **state)
     assert_memory_equal(a.samples, b.samples, a.count * sizeof(uint32_t));
     lm_ref_result_free(&a);
     lm_ref_result_free(&b);
-    unload(&p);
+    lmt_pipeline_free(&p);
 }
 
 static void corrupt(const char *path, long offset, int cut)
@@ -231,8 +180,8 @@ static void corrupt(const char *path, long offset, int cut)
 static void test_cache_hit_and_corruption(void **state)
 {
     (void)state;
-    pipeline p;
-    load(&p, furnace_scene(), 0.5f);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, furnace_scene(), 0.5f);
     char dir[600];
     snprintf(dir, sizeof dir, "%s/cache", lmt_tmpdir());
     lm_ref_settings set = quick_settings(0.03f, 32);
@@ -274,14 +223,14 @@ static void test_cache_hit_and_corruption(void **state)
     assert_true(c.key != a.key);
     lm_ref_result_free(&c);
     lm_ref_result_free(&a);
-    unload(&p);
+    lmt_pipeline_free(&p);
 }
 
 static void test_pixels_see_lit_plane(void **state)
 {
     (void)state;
-    pipeline p;
-    load(&p, plane_scene(), 1.0f);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, lmt_plane_scene(), 1.0f);
     lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.2f, 16, 16};
     lm_ref_settings set = quick_settings(0.01f, 16);
     lm_ref_result r;
@@ -297,20 +246,20 @@ static void test_pixels_see_lit_plane(void **state)
     lm_ref_result_free(&r);
     cam.yfov = 0.0f;
     assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &r, &err), LM_ERR_INVALID);
-    unload(&p);
+    lmt_pipeline_free(&p);
 }
 
 static void test_invalid_settings(void **state)
 {
     (void)state;
-    pipeline p;
-    load(&p, plane_scene(), 2.0f);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, lmt_plane_scene(), 2.0f);
     lm_ref_settings set = quick_settings(0.0f, 4);
     lm_ref_result r;
     lm_error err;
     assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &r, &err), LM_ERR_INVALID);
     assert_non_null(strstr(err.msg, "target error"));
-    unload(&p);
+    lmt_pipeline_free(&p);
 }
 
 static void test_relative_rmse(void **state)
