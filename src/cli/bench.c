@@ -1,4 +1,5 @@
 #include "bench.h"
+#include "bench_photons.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -169,5 +170,7 @@ int lm_cli_bench(const lm_cli_args *a)
     if (a->json_path)
         write_json(a->json_path, res, n, sr, sn);
     free(res);
+    if (a->file_count == 0)
+        lm_cli_bench_photons();
     return rc;
 }

@@ -121,10 +121,16 @@ double lm_halton(uint32_t dim, uint64_t index)
     lm_qmc_init();
     const qmc_dim *d = &g_dims[dim % LM_QMC_MAX_DIMS];
     double v = 0.0, scale = 1.0;
-    while (index != 0) {
-        v += d->table[index % d->chunk] * scale;
-        index /= d->chunk;
-        scale *= d->inv_chunk;
+    if (index <= UINT32_MAX) { /* 32-bit division is several times cheaper; photon indices fit */
+        for (uint32_t i = (uint32_t)index; i != 0; i /= d->chunk) {
+            v += d->table[i % d->chunk] * scale;
+            scale *= d->inv_chunk;
+        }
+    } else {
+        for (; index != 0; index /= d->chunk) {
+            v += d->table[index % d->chunk] * scale;
+            scale *= d->inv_chunk;
+        }
     }
     return v < 1.0 ? v : 0x1.fffffffffffffp-1;
 }

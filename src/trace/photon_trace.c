@@ -97,7 +97,8 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
     return 1;
 }
 
-int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count)
+int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count,
+                    uint32_t *rays)
 {
     const ph_group *g = &ph->groups[group];
     uint32_t id = g->first_id + m * ph->G;
@@ -112,10 +113,12 @@ int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer 
     memcpy(dir, emi.dir, sizeof dir);
     memcpy(flux, emi.flux, sizeof flux);
     *count = 0;
+    *rays = 0;
     if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) /* an emitter that emits nothing */
         return 1;
     for (uint32_t b = 0; b < ph->set.max_bounces; b++) {
         lm_rt_hit hit;
+        ++*rays;
         if (!lm_rt_intersect(ph->rt, org, dir, 0.0f, INFINITY, &hit))
             break;
         lm_shading sh;
@@ -192,7 +195,7 @@ lm_status ph_trace_batch(lm_photons *ph, lm_error *err)
             ph_job *j = &b->jobs[i];
             j->buffer = (uint32_t)t;
             j->first = (uint32_t)buf->len;
-            if (!ph_trace_photon(cph, j->group, j->m, buf, &j->count)) {
+            if (!ph_trace_photon(cph, j->group, j->m, buf, &j->count, &j->rays)) {
 #pragma omp atomic write
                 failed = 1;
             }
@@ -200,5 +203,8 @@ lm_status ph_trace_batch(lm_photons *ph, lm_error *err)
     }
     if (failed)
         return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of %u photons", b->count);
+    b->rays = 0;
+    for (uint32_t i = 0; i < b->count; i++)
+        b->rays += b->jobs[i].rays;
     return LM_OK;
 }

@@ -243,6 +243,7 @@ static lm_status retrace_groups(lm_photons *ph, const uint32_t *list, uint32_t n
             st->group_photons += g->photons;
         }
         lm_status s = ph_trace_batch(ph, err);
+        st->rays += ph->batch.rays;
         if (s == LM_OK)
             s = apply_batch(ph, st, err);
         if (s != LM_OK)
@@ -289,6 +290,7 @@ static lm_status round_robin(lm_photons *ph, lm_photon_frame_stats *st, lm_error
     }
     st->rr_photons = ph->batch.count;
     lm_status s = ph_trace_batch(ph, err);
+    st->rays += ph->batch.rays;
     if (s != LM_OK)
         return s;
     for (uint32_t k = 0; k < ph->batch.count; k++) {

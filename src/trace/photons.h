@@ -53,6 +53,7 @@ typedef struct {
     uint32_t photons_updated;   /* photons whose stored path and hits were replaced */
     uint32_t hits_added, hits_removed;
     uint32_t pending_groups;    /* invalid groups still waiting after this frame */
+    uint64_t rays;              /* rays cast (every path segment, a final miss included) */
     double seconds;
 } lm_photon_frame_stats;
 

@@ -37,6 +37,7 @@ typedef struct {
     uint32_t group, m;
     uint32_t buffer;           /* thread buffer that holds its vertices */
     uint32_t first, count;
+    uint32_t rays;             /* rays cast for it (a final miss included) */
 } ph_job;
 
 typedef struct {
@@ -44,6 +45,7 @@ typedef struct {
     uint32_t count, cap;
     ph_buffer *buffers;
     int buffer_count;
+    uint64_t rays;             /* rays cast by the last ph_trace_batch */
 } ph_batch;
 
 struct lm_photons {
@@ -73,7 +75,8 @@ struct lm_photons {
 
 /* photon_trace.c: traces photon (group, m) and appends its vertices to buf. Returns 0 when memory
  * ran out. Reads only ph's scene, BVH and emitters: safe from several threads. */
-int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count);
+int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count,
+                    uint32_t *rays);
 /* Traces every job of the batch in parallel (OpenMP). */
 lm_status ph_trace_batch(lm_photons *ph, lm_error *err);
 void ph_batch_clear(ph_batch *b);

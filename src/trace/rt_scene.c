@@ -1,6 +1,7 @@
 #include "rt_scene.h"
 
 #include <embree3/rtcore.h>
+#include <math.h>
 #include <pmmintrin.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -287,6 +288,25 @@ int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], floa
     setup_ray(&rh, org, dir, tnear, tfar);
     rtcOccluded1(rt->top, &ctx, &rh.ray);
     return rh.ray.tfar < 0.0f; /* Embree sets tfar to -inf on occlusion */
+}
+
+uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir, uint32_t n)
+{
+    uint64_t hits = 0;
+#pragma omp parallel reduction(+ : hits)
+    {
+        lm_rt_thread_init();
+        struct RTCIntersectContext ctx;
+        rtcInitIntersectContext(&ctx);
+#pragma omp for schedule(static)
+        for (int64_t i = 0; i < (int64_t)n; i++) {
+            struct RTCRayHit rh;
+            setup_ray(&rh, org + 3 * i, dir + 3 * i, 0.0f, INFINITY);
+            rtcIntersect1(rt->top, &ctx, &rh);
+            hits += rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+        }
+    }
+    return hits;
 }
 
 int lm_rt_instance_count(const lm_rt *rt) { return rt->instance_count; }

@@ -40,6 +40,10 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
 /* 1 if anything blocks the segment (tnear, tfar). */
 int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar);
 
+/* The benchmark's baseline: n closest-hit queries straight through rtcIntersect1 (no hit decoding),
+ * rays i = (org + 3i, dir + 3i), spread over the OpenMP threads. Returns the number of hits. */
+uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir, uint32_t n);
+
 /* Sets flush-to-zero and denormals-are-zero; Embree wants it in every thread that traces. */
 void lm_rt_thread_init(void);
 

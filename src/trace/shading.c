@@ -31,16 +31,12 @@ static void interp2(const float *attr, const uint32_t *idx, const float w[3], fl
 }
 
 /* Shading normal: interpolated vertex normals in world space, flipped to ng's side; ng where the
- * interpolation degenerates. */
-static lm_vec3 shading_normal(const lm_scene *s, const uint32_t *idx, const float w[3], lm_vec3 ng)
+ * interpolation degenerates. The normal transform is linear, so the local normals are interpolated
+ * first and transformed once. */
+static lm_vec3 shading_normal(const lm_scene *s, const lm_node *node, const uint32_t *idx, const float w[3],
+                              lm_vec3 ng)
 {
-    lm_vec3 n = lm_v3(0, 0, 0);
-    for (int k = 0; k < 3; k++) {
-        float nk[3];
-        lm_scene_normal_world(s, idx[k], nk);
-        n = lm_add(n, lm_scale(lm_v3_load(nk), w[k]));
-    }
-    n = lm_normalize(n);
+    lm_vec3 n = lm_mat4_normal(node->world, interp3(s->normals, idx, w));
     if (!lm_v3_finite(n) || lm_dot(n, n) < 0.5f)
         return ng;
     return lm_dot(n, ng) < 0.0f ? lm_scale(n, -1.0f) : n;
@@ -71,7 +67,7 @@ void lm_shading_from_hit(const lm_scene *s, const lm_rt_hit *hit, const float or
     lm_v3_store(sh->local, local);
     lm_vec3 ng = lm_v3_load(hit->ng);
     lm_v3_store(sh->ng, ng);
-    lm_v3_store(sh->ns, shading_normal(s, idx, w, ng));
+    lm_v3_store(sh->ns, shading_normal(s, node, idx, w, ng));
     interp2(s->uv0, idx, w, sh->uv0);
     sh->material_id = s->tri_material[hit->tri];
     sh->material = &s->materials[sh->material_id];

@@ -1,0 +1,194 @@
+/* lmgi bench, photon part: photon tracing against raw Embree on the same scene, the kd-tree next to
+ * the paper's Table 1, and the photon stage's frame time on the animated Cornell box. */
+#include "bench_photons.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <omp.h>
+#include <unistd.h>
+
+#include "../core/qmc.h"
+#include "../core/timing.h"
+#include "../core/vecmath.h"
+#include "../photonmap/kdtree.h"
+#include "../update/lmgi_scene.h"
+#include "../update/photon_stage.h"
+
+#define REPEATS 5
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* Rays leaving the emitters as photons do (emitter chosen in proportion to its luminance), for the
+ * raw-Embree baseline. */
+static void emitter_rays(const lmgi_scene *sc, const lm_emitters *em, uint32_t n, float *org, float *dir)
+{
+    for (uint32_t i = 0; i < n; i++) {
+        float u[4];
+        for (int k = 0; k < 4; k++)
+            u[k] = (float)lm_halton((uint32_t)k, i);
+        float pick = (float)lm_halton(4, i) * em->total_luminance, acc = 0.0f;
+        int e = 0;
+        while (e + 1 < em->count && (acc += em->e[e].luminance) < pick)
+            e++;
+        lm_emission out;
+        lm_emitter_emit(em, sc->scene, e, u, n, &out);
+        memcpy(org + 3 * (size_t)i, out.org, sizeof out.org);
+        memcpy(dir + 3 * (size_t)i, out.dir, sizeof out.dir);
+    }
+}
+
+/* The photons' own bounce segments (stored vertex i to vertex i + 1), appended to org/dir from slot
+ * `at`; returns the new count. With the emitter rays before them, the baseline casts what the photon
+ * tracer casts: coherent rays from the lights and incoherent bounce rays. */
+static uint32_t bounce_rays(const lm_photons *ph, float *org, float *dir, uint32_t at, uint32_t cap)
+{
+    for (uint32_t p = 0; p < lm_photons_count(ph); p++) {
+        const lm_path_vertex *v = NULL;
+        uint32_t n = lm_photons_path(ph, p, &v);
+        for (uint32_t i = 0; i + 1 < n && at < cap; i++, at++) {
+            lm_vec3 a = lm_v3_load(v[i].pos), d = lm_normalize(lm_sub(lm_v3_load(v[i + 1].pos), a));
+            lm_v3_store(org + 3 * (size_t)at, lm_add(a, lm_scale(d, 1e-4f)));
+            lm_v3_store(dir + 3 * (size_t)at, d);
+        }
+    }
+    return at;
+}
+
+/* Full traces of `photons` photons (fresh store each time) against raw rtcIntersect1 on the same rays:
+ * one from an emitter per photon, then the photons' bounce segments. */
+static void photon_throughput(const char *path, uint32_t photons)
+{
+    lmgi_scene *sc = NULL;
+    lmgi_error perr;
+    if (lmgi_load(path, NULL, &sc, &perr) != LMGI_OK) {
+        printf("%-26s skipped (%s)\n", path, perr.message);
+        return;
+    }
+    lm_error err;
+    lm_emitters em;
+    if (lm_emitters_build(sc->scene, &em, &err) != LM_OK || em.count == 0) {
+        printf("%-26s skipped (no emitters)\n", path);
+        lmgi_free(sc);
+        return;
+    }
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.total_photons = photons;
+    double t_ph[REPEATS], t_raw[REPEATS];
+    uint64_t rays = 0;
+    uint32_t traced = 0, raw = 0;
+    float *org = NULL, *dir = NULL;
+    for (int r = 0; r < REPEATS; r++) {
+        lm_photons *ph = NULL;
+        lm_photon_frame_stats st;
+        if (lm_photons_create(sc->scene, &sc->surfaces, sc->rt, &em, &set, &ph, &err) != LM_OK ||
+            lm_photons_trace_all(ph, &st, &err) != LM_OK) {
+            printf("%-26s failed: %s\n", path, err.msg);
+            lm_photons_free(ph);
+            lm_emitters_free(&em);
+            lmgi_free(sc);
+            return;
+        }
+        t_ph[r] = st.seconds;
+        rays = st.rays;
+        traced = lm_photons_count(ph);
+        if (r == 0) {
+            org = malloc(sizeof(float) * 3 * rays);
+            dir = malloc(sizeof(float) * 3 * rays);
+            if (org && dir) {
+                emitter_rays(sc, &em, traced, org, dir);
+                raw = bounce_rays(ph, org, dir, traced, (uint32_t)rays);
+            }
+        }
+        lm_photons_free(ph);
+    }
+    if (org && dir) {
+        for (int r = 0; r < REPEATS; r++) {
+            double t0 = lm_now();
+            lm_rt_raw_intersect(sc->rt, org, dir, raw);
+            t_raw[r] = lm_now() - t0;
+        }
+        double tp = median(t_ph, REPEATS), tr = median(t_raw, REPEATS);
+        const char *name = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
+        printf("%-26s %9u %8.1f %11.2f %11.2f %11.2f %7.0f%%\n", name, traced, 1e3 * tp, traced / tp / 1e6,
+               rays / tp / 1e6, raw / tr / 1e6, 100.0 * (rays / tp) / (raw / tr));
+    }
+    free(org);
+    free(dir);
+    lm_emitters_free(&em);
+    lmgi_free(sc);
+}
+
+/* The photon stage alone on the animated Cornell box: median frame time and its split. */
+static void photon_stage_frames(const char *path, int frames)
+{
+    lmgi_scene *sc = NULL;
+    lmgi_error perr;
+    if (lmgi_load(path, NULL, &sc, &perr) != LMGI_OK) {
+        printf("photon stage: skipped (%s)\n", perr.message);
+        return;
+    }
+    lm_error err;
+    lm_photon_stage *stage = NULL;
+    lm_photon_stage_frame setup;
+    if (lm_photon_stage_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, NULL, &stage, &setup, &err) != LM_OK) {
+        printf("photon stage: failed: %s\n", err.msg);
+        lmgi_free(sc);
+        return;
+    }
+    double *t[4];
+    for (int k = 0; k < 4; k++)
+        t[k] = malloc(sizeof(double) * (size_t)frames);
+    uint64_t retraced = 0, refreshed = 0;
+    for (int f = 0; f < frames && t[0] && t[1] && t[2] && t[3]; f++) {
+        lm_photon_stage_frame r;
+        if (lm_photon_stage_step(stage, (float)f / 30.0f, &r, &err) != LM_OK)
+            break;
+        t[0][f] = r.t_total;
+        t[1][f] = r.t_animate;
+        t[2][f] = r.t_photons;
+        t[3][f] = r.t_aim;
+        retraced += r.photons.rr_photons + r.photons.group_photons;
+        refreshed += (uint64_t)r.aim.surfaces_refreshed;
+    }
+    printf("photon stage on %s (%u photons, %u texels, %d frames at 30 fps of animation):\n", path,
+           lm_photons_count(lm_photon_stage_photons(stage)), sc->atlas.texel_count, frames);
+    printf("  setup: full trace %.1f ms, all AIMs %.1f ms\n", 1e3 * setup.t_photons, 1e3 * setup.t_aim);
+    printf("  median frame %.2f ms = animate + BVH %.2f, photons %.2f, AIMs %.2f "
+           "(%.1f photons re-traced, %.1f AIM surfaces refreshed per frame)\n",
+           1e3 * median(t[0], frames), 1e3 * median(t[1], frames), 1e3 * median(t[2], frames),
+           1e3 * median(t[3], frames), (double)retraced / frames, (double)refreshed / frames);
+    for (int k = 0; k < 4; k++)
+        free(t[k]);
+    lm_photon_stage_free(stage);
+    lmgi_free(sc);
+}
+
+void lm_cli_bench_photons(void)
+{
+    printf("\nphoton tracing vs raw Embree rtcIntersect1 on the same scene (medians of %d, %d threads):\n", REPEATS,
+           omp_get_max_threads());
+    printf("%-26s %9s %8s %11s %11s %11s %8s\n", "scene", "photons", "ms", "Mphotons/s", "Mrays/s", "raw Mrays/s",
+           "of raw");
+    const char *scenes[] = {"scenes/cornell.glb", "../shared/scenes/cornell-box/CornellBox.glb",
+                            "scenes/two_rooms.glb"};
+    for (size_t i = 0; i < sizeof scenes / sizeof *scenes; i++)
+        if (access(scenes[i], R_OK) == 0)
+            photon_throughput(scenes[i], 200000);
+    printf("\nkd-tree (build and 100-nearest query) next to Larsen & Christensen 2004, Table 1:\n");
+    lm_kdtree_bench(stdout);
+    printf("\n");
+    if (access("scenes/cornell.glb", R_OK) == 0)
+        photon_stage_frames("scenes/cornell.glb", 120);
+}
