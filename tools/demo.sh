@@ -13,4 +13,9 @@ for scene in scenes/cornell.glb scenes/two_rooms.glb ../shared/scenes/cornell-bo
     "$LMGI" info "$scene" | tee "demo/$name-info.txt"
     "$LMGI" charts "$scene" --out "demo/$name" --size 1024x768
 done
-echo "demo: pictures in demo/<scene>/atlas.png and demo/<scene>/surfaces.png"
+# The photon stage on the paper's scene: the cube and the mirror sphere move for 3 seconds.
+if [ -r scenes/cornell.glb ]; then
+    echo "== photons on scenes/cornell.glb"
+    "$LMGI" photons scenes/cornell.glb --frames 90 --photons 50000 --out demo/cornell-photons
+fi
+echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png and demo/cornell-photons/view.png"
