@@ -116,14 +116,30 @@ static void init_once(void)
 
 void lm_qmc_init(void) { pthread_once(&g_once, init_once); }
 
-double lm_halton(uint32_t dim, uint64_t index)
+/* Index i split as i = q chunk + r: q from the double reciprocal (several times cheaper than an
+ * integer division), then corrected by one where rounding left it off. Exact for every 32-bit i. */
+static uint32_t split(const qmc_dim *d, uint32_t i, uint32_t *r)
 {
-    lm_qmc_init();
-    const qmc_dim *d = &g_dims[dim % LM_QMC_MAX_DIMS];
+    uint32_t q = (uint32_t)((double)i * d->inv_chunk);
+    int64_t rest = (int64_t)i - (int64_t)q * d->chunk;
+    if (rest < 0) {
+        q--;
+        rest += d->chunk;
+    } else if (rest >= d->chunk) {
+        q++;
+        rest -= d->chunk;
+    }
+    *r = (uint32_t)rest;
+    return q;
+}
+
+static double radical(const qmc_dim *d, uint64_t index)
+{
     double v = 0.0, scale = 1.0;
-    if (index <= UINT32_MAX) { /* 32-bit division is several times cheaper; photon indices fit */
-        for (uint32_t i = (uint32_t)index; i != 0; i /= d->chunk) {
-            v += d->table[i % d->chunk] * scale;
+    if (index <= UINT32_MAX) { /* photon indices fit */
+        for (uint32_t i = (uint32_t)index, r; i != 0;) {
+            i = split(d, i, &r);
+            v += d->table[r] * scale;
             scale *= d->inv_chunk;
         }
     } else {
@@ -133,4 +149,17 @@ double lm_halton(uint32_t dim, uint64_t index)
         }
     }
     return v < 1.0 ? v : 0x1.fffffffffffffp-1;
+}
+
+double lm_halton(uint32_t dim, uint64_t index)
+{
+    lm_qmc_init();
+    return radical(&g_dims[dim % LM_QMC_MAX_DIMS], index);
+}
+
+void lm_halton_dims(uint32_t dim, uint32_t n, uint64_t index, double *out)
+{
+    lm_qmc_init();
+    for (uint32_t k = 0; k < n; k++)
+        out[k] = radical(&g_dims[(dim + k) % LM_QMC_MAX_DIMS], index);
 }

@@ -13,6 +13,9 @@
 
 /* Scrambled radical inverse, in [0, 1). dim < LM_QMC_MAX_DIMS. Thread-safe after lm_qmc_init. */
 double lm_halton(uint32_t dim, uint64_t index);
+/* lm_halton for the n dimensions dim .. dim + n - 1 of one point, into out[0 .. n - 1] (one
+ * initialization check for all of them: a photon needs several numbers at a time). */
+void lm_halton_dims(uint32_t dim, uint32_t n, uint64_t index, double *out);
 /* Builds the permutation tables (idempotent; called by lm_halton on first use in a single thread). */
 void lm_qmc_init(void);
 /* The d-th prime (d = 0 -> 2). */

@@ -129,32 +129,69 @@ static int replace_path(lm_photons *ph, const ph_group *g, uint32_t m, const ph_
 }
 
 /* Flags changed photons and sizes the new slab; reserves all memory before the store is touched. */
-static int prepare_apply(lm_photons *ph, ph_group *g, const ph_job *jobs, uint32_t *total)
+static int prepare_apply(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs, uint32_t *total)
 {
     *total = 0;
     for (uint32_t m = 0; m < g->photons; m++) {
         const ph_job *j = &jobs[m];
-        ph->tmp_changed[m] = (uint8_t)ph_path_changed(ph, g, m, ph_job_vertices(&ph->batch, j), j->count);
+        ph->tmp_changed[m] = (uint8_t)ph_path_changed(ph, g, m, ph_job_vertices(b, j), j->count);
         *total += j->count; /* an unchanged path has the same length */
     }
     return reserve_verts(&ph->tmp_verts, &ph->tmp_cap, *total, 0) &&
            reserve_verts(&g->verts, &g->vert_cap, *total, 1);
 }
 
-lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_job *jobs, lm_photon_frame_stats *st,
-                         lm_error *err)
+static lm_status fail_store(const ph_group *g, lm_error *err)
 {
+    return lm_fail(err, LM_ERR_NOMEM, "photons: no memory to store the hits of group %u of emitter %d",
+                   g->index, g->emitter);
+}
+
+static lm_status fail_paths(const ph_group *g, lm_error *err)
+{
+    return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of group %u of emitter %d", g->index,
+                   g->emitter);
+}
+
+/* A group that holds no vertices (never traced, or every path empty) has nothing to compare with and
+ * no hits to remove: every non-empty path is new (as ph_path_changed would say) and goes straight
+ * into the slab, with no scratch copy. */
+static lm_status apply_fresh(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs,
+                             lm_photon_frame_stats *st, lm_error *err)
+{
+    uint32_t total = 0;
+    for (uint32_t m = 0; m < g->photons; m++)
+        total += jobs[m].count;
+    if (!reserve_verts(&g->verts, &g->vert_cap, total, 1))
+        return fail_paths(g, err);
+    int ok = 1;
+    uint32_t at = 0;
+    for (uint32_t m = 0; m < g->photons; m++) {
+        const ph_job *j = &jobs[m];
+        g->offsets[m] = at;
+        if (j->count) /* replace_path reads only offsets[m .. m + 1], both still 0 */
+            ok &= replace_path(ph, g, m, ph_job_vertices(b, j), j->count, g->verts + at, st);
+        at += j->count;
+    }
+    g->offsets[g->photons] = at;
+    return ok ? LM_OK : fail_store(g, err);
+}
+
+lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs,
+                         lm_photon_frame_stats *st, lm_error *err)
+{
+    if (g->offsets[g->photons] == 0)
+        return apply_fresh(ph, g, b, jobs, st, err);
     uint32_t total;
-    if (!prepare_apply(ph, g, jobs, &total))
-        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of group %u of emitter %d",
-                       g->index, g->emitter);
+    if (!prepare_apply(ph, g, b, jobs, &total))
+        return fail_paths(g, err);
     int ok = 1;
     uint32_t at = 0;
     for (uint32_t m = 0; m < g->photons; m++) {
         ph->tmp_offsets[m] = at;
         const ph_job *j = &jobs[m];
         if (ph->tmp_changed[m])
-            ok &= replace_path(ph, g, m, ph_job_vertices(&ph->batch, j), j->count, ph->tmp_verts + at, st);
+            ok &= replace_path(ph, g, m, ph_job_vertices(b, j), j->count, ph->tmp_verts + at, st);
         else if (j->count) /* an empty path may have no slab at all */
             memcpy(ph->tmp_verts + at, g->verts + g->offsets[m], (size_t)j->count * sizeof *g->verts);
         at += j->count;
@@ -163,9 +200,23 @@ lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_job *jobs, lm_pho
     if (total)
         memcpy(g->verts, ph->tmp_verts, (size_t)total * sizeof *g->verts);
     memcpy(g->offsets, ph->tmp_offsets, ((size_t)g->photons + 1) * sizeof *g->offsets);
-    if (!ok)
-        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory to store the hits of group %u of emitter %d",
-                       g->index, g->emitter);
+    return ok ? LM_OK : fail_store(g, err);
+}
+
+lm_status ph_apply_batch(lm_photons *ph, const ph_batch *b, lm_photon_frame_stats *st, lm_error *err)
+{
+    uint64_t stored = 0;
+    for (uint32_t k = 0; k < b->count; k++)
+        stored += b->jobs[k].stored;
+    /* One growth for the whole batch instead of many doublings (if it fails, adds fail one by one). */
+    lm_photon_store_reserve(&ph->store, stored);
+    for (uint32_t k = 0; k < b->count;) {
+        ph_group *g = &ph->groups[b->jobs[k].group];
+        lm_status s = ph_group_apply(ph, g, b, &b->jobs[k], st, err);
+        if (s != LM_OK)
+            return s;
+        k += g->photons;
+    }
     return LM_OK;
 }
 

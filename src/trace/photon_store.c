@@ -42,6 +42,26 @@ static void account(lm_photon_store *ps, const lm_hit *h)
         sh->delta_i += e;
 }
 
+/* Grows the slot array to at least `need` slots, doubling so that one-by-one adds stay O(1). */
+static int grow(lm_photon_store *ps, uint64_t need)
+{
+    if (need <= ps->capacity)
+        return 1;
+    if (need > LM_NONE / 2) /* slot ids must stay below LM_NONE */
+        return 0;
+    uint64_t cap = ps->capacity ? ps->capacity : 1024;
+    while (cap < need)
+        cap *= 2;
+    lm_hit *grown = realloc(ps->hits, sizeof *grown * cap);
+    if (!grown)
+        return 0;
+    ps->hits = grown;
+    ps->capacity = (uint32_t)cap;
+    return 1;
+}
+
+int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n) { return grow(ps, ps->used + n); }
+
 static uint32_t take_slot(lm_photon_store *ps)
 {
     if (ps->free_head != LM_NONE) {
@@ -49,16 +69,8 @@ static uint32_t take_slot(lm_photon_store *ps)
         ps->free_head = ps->hits[slot].next;
         return slot;
     }
-    if (ps->used == ps->capacity) {
-        if (ps->capacity >= LM_NONE / 2) /* slot ids must stay below LM_NONE */
-            return LM_NONE;
-        uint32_t cap = ps->capacity ? ps->capacity * 2 : 1024;
-        lm_hit *grown = realloc(ps->hits, sizeof *grown * cap);
-        if (!grown)
-            return LM_NONE;
-        ps->hits = grown;
-        ps->capacity = cap;
-    }
+    if (ps->used == ps->capacity && !grow(ps, (uint64_t)ps->used + 1))
+        return LM_NONE;
     return ps->used++;
 }
 

@@ -46,6 +46,9 @@ void lm_photon_store_free(lm_photon_store *ps);
 /* Copies h into a free slot, links it into its surface's list and adds its energy to the surface's
  * deltas. Returns the slot, or LM_NONE when memory ran out (the store is unchanged then). */
 uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h);
+/* Makes room for n more adds without reallocation (free slots not counted), so a bulk update grows
+ * the array once. Returns 0 when memory ran out (the store is unchanged then). */
+int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n);
 /* Unlinks a stored hit, adds its energy to the deltas and frees the slot. A slot that holds no live
  * hit (already removed, or never used) is ignored. */
 void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot);

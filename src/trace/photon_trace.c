@@ -29,18 +29,21 @@ static uint64_t mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
-/* A uniform number in [0, 1) as float (never rounds up to 1). */
-static float photon_sample(const lm_photons *ph, uint32_t id, uint32_t dim)
+/* n uniform numbers in [0, 1) as floats (never rounded up to 1): dims dim .. dim + n - 1. */
+static void photon_samples(const lm_photons *ph, uint32_t id, uint32_t dim, uint32_t n, float *out)
 {
-    double u;
-    if (dim < LM_QMC_MAX_DIMS) {
-        u = lm_halton(dim, ph->halton_base + id);
-    } else {
-        uint64_t h = mix64(((uint64_t)ph->set.seed << 32 | id) + 0x9E3779B97F4A7C15ull * (dim + 1));
-        u = (double)(h >> 11) * 0x1.0p-53;
+    double u[PH_DIMS_PER_BOUNCE];
+    uint32_t q = dim < LM_QMC_MAX_DIMS ? LM_QMC_MAX_DIMS - dim : 0; /* how many are Halton dims */
+    q = q < n ? q : n;
+    lm_halton_dims(dim, q, ph->halton_base + id, u);
+    for (uint32_t k = q; k < n; k++) {
+        uint64_t h = mix64(((uint64_t)ph->set.seed << 32 | id) + 0x9E3779B97F4A7C15ull * (dim + k + 1));
+        u[k] = (double)(h >> 11) * 0x1.0p-53;
     }
-    float f = (float)u;
-    return f < 1.0f ? f : 0x1.fffffep-1f;
+    for (uint32_t k = 0; k < n; k++) {
+        float f = (float)u[k];
+        out[k] = f < 1.0f ? f : 0x1.fffffep-1f;
+    }
 }
 
 static int buffer_reserve(ph_buffer *buf)
@@ -78,10 +81,11 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
                    float dir[3], float flux[3])
 {
     uint32_t d = PH_EMIT_DIMS + PH_DIMS_PER_BOUNCE * b;
-    float p = lm_bsdf_survival(sh);
-    if (photon_sample(ph, id, d + 3) >= p)
+    float p = lm_bsdf_survival(sh), u[3];
+    photon_samples(ph, id, d + 3, 1, u);
+    if (u[0] >= p)
         return 0;
-    float u[3] = {photon_sample(ph, id, d), photon_sample(ph, id, d + 1), photon_sample(ph, id, d + 2)};
+    photon_samples(ph, id, d, 3, u);
     lm_bsdf_sample_t bs;
     if (!lm_bsdf_sample(sh, dir, u, &bs))
         return 0;
@@ -97,14 +101,12 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
     return 1;
 }
 
-int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count,
-                    uint32_t *rays)
+int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
 {
-    const ph_group *g = &ph->groups[group];
-    uint32_t id = g->first_id + m * ph->G;
+    const ph_group *g = &ph->groups[j->group];
+    uint32_t id = g->first_id + j->m * ph->G;
     float u[PH_EMIT_DIMS];
-    for (uint32_t k = 0; k < PH_EMIT_DIMS; k++)
-        u[k] = photon_sample(ph, id, k);
+    photon_samples(ph, id, 0, PH_EMIT_DIMS, u);
     uint32_t emitter_photons = ph->emitter_first[g->emitter + 1] - ph->emitter_first[g->emitter];
     lm_emission emi;
     lm_emitter_emit(ph->em, ph->scene, g->emitter, u, emitter_photons, &emi);
@@ -112,20 +114,20 @@ int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer 
     memcpy(org, emi.org, sizeof org);
     memcpy(dir, emi.dir, sizeof dir);
     memcpy(flux, emi.flux, sizeof flux);
-    *count = 0;
-    *rays = 0;
+    j->count = j->rays = j->stored = 0;
     if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) /* an emitter that emits nothing */
         return 1;
     for (uint32_t b = 0; b < ph->set.max_bounces; b++) {
         lm_rt_hit hit;
-        ++*rays;
+        j->rays++;
         if (!lm_rt_intersect(ph->rt, org, dir, 0.0f, INFINITY, &hit))
             break;
         lm_shading sh;
         lm_shading_from_hit(ph->scene, &hit, org, dir, &sh);
         if (!push_vertex(buf, &sh, dir, flux, b))
             return 0;
-        (*count)++;
+        j->count++;
+        j->stored += buf->v[buf->len - 1].surface >= 0;
         if (!scatter(ph, id, b, &sh, org, dir, flux))
             break;
     }
@@ -173,34 +175,44 @@ static int ensure_buffers(ph_batch *b, int threads)
     return 1;
 }
 
-/* Each job writes only its own record and its thread's buffer; what a job traces depends on the
+/* The jobs of b, shared out among the threads of the enclosing team (dynamic: path lengths vary).
+ * Each job writes only its own record and its thread's buffer; what a job traces depends on the
  * photon alone, so results are the same whatever thread ran it. */
-lm_status ph_trace_batch(lm_photons *ph, lm_error *err)
+static void trace_jobs(const lm_photons *ph, ph_batch *b, int *failed)
 {
-    ph_batch *b = &ph->batch;
+    ph_buffer *buf = &b->buffers[omp_get_thread_num()];
+#pragma omp for schedule(dynamic, 16)
+    for (long i = 0; i < (long)b->count; i++) {
+        ph_job *j = &b->jobs[i];
+        j->buffer = (uint32_t)omp_get_thread_num();
+        j->first = (uint32_t)buf->len;
+        if (!ph_trace_photon(ph, j, buf)) {
+#pragma omp atomic write
+            *failed = 1;
+        }
+    }
+}
+
+lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, const ph_batch *done, lm_photon_frame_stats *st,
+                         lm_error *err)
+{
     int threads = omp_get_max_threads();
     if (!ensure_buffers(b, threads))
         return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %d trace buffers", threads);
     for (int t = 0; t < b->buffer_count; t++)
         b->buffers[t].len = 0;
     int failed = 0;
-    const lm_photons *cph = ph;
+    lm_status applied = LM_OK;
 #pragma omp parallel num_threads(threads) if (b->count >= PH_PARALLEL_MIN_JOBS)
     {
         lm_rt_thread_init();
-        int t = omp_get_thread_num();
-        ph_buffer *buf = &b->buffers[t];
-#pragma omp for schedule(dynamic, 16)
-        for (long i = 0; i < (long)b->count; i++) {
-            ph_job *j = &b->jobs[i];
-            j->buffer = (uint32_t)t;
-            j->first = (uint32_t)buf->len;
-            if (!ph_trace_photon(cph, j->group, j->m, buf, &j->count, &j->rays)) {
-#pragma omp atomic write
-                failed = 1;
-            }
-        }
+#pragma omp master
+        if (done)
+            applied = ph_apply_batch(ph, done, st, err);
+        trace_jobs(ph, b, &failed);
     }
+    if (applied != LM_OK)
+        return applied;
     if (failed)
         return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of %u photons", b->count);
     b->rays = 0;

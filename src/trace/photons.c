@@ -165,7 +165,8 @@ void lm_photons_free(lm_photons *ph)
     free(ph->tmp_offsets);
     free(ph->tmp_changed);
     free(ph->tmp_groups);
-    ph_batch_free(&ph->batch);
+    ph_batch_free(&ph->batches[0]);
+    ph_batch_free(&ph->batches[1]);
     lm_photon_store_free(&ph->store);
     free(ph);
 }
@@ -209,45 +210,45 @@ void lm_photons_invalidate_all(lm_photons *ph)
 
 /* ---- re-tracing groups: trace in parallel, apply serially in group and photon order ---- */
 
-static lm_status apply_batch(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
+/* 1 if group g fits in batch b (a batch always takes at least one group). */
+static int batch_fits(const lm_photons *ph, const ph_batch *b, uint32_t g)
 {
-    for (uint32_t k = 0; k < ph->batch.count;) {
-        ph_group *g = &ph->groups[ph->batch.jobs[k].group];
-        lm_status s = ph_group_apply(ph, g, &ph->batch.jobs[k], st, err);
-        if (s != LM_OK)
-            return s;
-        k += g->photons;
+    return b->count == 0 || b->count + ph->groups[g].photons <= PH_BATCH_PHOTONS;
+}
+
+/* Fills b with whole groups from list[*i ...]; empty when the list is used up. */
+static lm_status fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, uint32_t n, uint32_t *i,
+                            lm_photon_frame_stats *st, lm_error *err)
+{
+    ph_batch_clear(b);
+    for (; *i < n && batch_fits(ph, b, list[*i]); ++*i) {
+        ph_group *g = &ph->groups[list[*i]];
+        for (uint32_t m = 0; m < g->photons; m++)
+            if (!ph_batch_push(b, list[*i], m))
+                return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
+        g->retraces++;
+        st->groups_retraced++;
+        st->group_photons += g->photons;
     }
     return LM_OK;
 }
 
-/* 1 if group g fits in the current batch (a batch always takes at least one group). */
-static int batch_fits(const lm_photons *ph, uint32_t g)
-{
-    return ph->batch.count == 0 || ph->batch.count + ph->groups[g].photons <= PH_BATCH_PHOTONS;
-}
-
+/* Batch k is applied while batch k + 1 is traced (the two alternate). Batches are applied in list
+ * order, so the store changes exactly as if each batch were traced and applied in turn. */
 static lm_status retrace_groups(lm_photons *ph, const uint32_t *list, uint32_t n, lm_photon_frame_stats *st,
                                 lm_error *err)
 {
+    const ph_batch *done = NULL;
     uint32_t i = 0;
-    while (i < n) {
-        ph_batch_clear(&ph->batch);
-        for (; i < n && batch_fits(ph, list[i]); i++) {
-            const ph_group *g = &ph->groups[list[i]];
-            for (uint32_t m = 0; m < g->photons; m++)
-                if (!ph_batch_push(&ph->batch, list[i], m))
-                    return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
-            ph->groups[list[i]].retraces++;
-            st->groups_retraced++;
-            st->group_photons += g->photons;
-        }
-        lm_status s = ph_trace_batch(ph, err);
-        st->rays += ph->batch.rays;
+    for (int k = 0; i < n || done; k ^= 1) {
+        ph_batch *b = &ph->batches[k];
+        lm_status s = fill_batch(ph, b, list, n, &i, st, err);
         if (s == LM_OK)
-            s = apply_batch(ph, st, err);
+            s = ph_trace_batch(ph, b, done, st, err);
         if (s != LM_OK)
             return s;
+        st->rays += b->rays;
+        done = b->count ? b : NULL;
     }
     return LM_OK;
 }
@@ -277,26 +278,27 @@ lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_
  * stored paths; any difference marks the group invalid. */
 static lm_status round_robin(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
 {
-    ph_batch_clear(&ph->batch);
+    ph_batch *b = &ph->batches[0];
+    ph_batch_clear(b);
     for (uint32_t i = 0; i < ph->group_count; i++) {
         ph_group *g = &ph->groups[i];
         if (g->invalid || g->photons == 0)
             continue;
         uint32_t k = ph->set.retrace_per_group < g->photons ? ph->set.retrace_per_group : g->photons;
         for (uint32_t r = 0; r < k; r++)
-            if (!ph_batch_push(&ph->batch, i, (g->rr_next + r) % g->photons))
+            if (!ph_batch_push(b, i, (g->rr_next + r) % g->photons))
                 return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
         g->rr_next = (g->rr_next + k) % g->photons;
     }
-    st->rr_photons = ph->batch.count;
-    lm_status s = ph_trace_batch(ph, err);
-    st->rays += ph->batch.rays;
+    st->rr_photons = b->count;
+    lm_status s = ph_trace_batch(ph, b, NULL, st, err);
+    st->rays += b->rays;
     if (s != LM_OK)
         return s;
-    for (uint32_t k = 0; k < ph->batch.count; k++) {
-        const ph_job *j = &ph->batch.jobs[k];
+    for (uint32_t k = 0; k < b->count; k++) {
+        const ph_job *j = &b->jobs[k];
         ph_group *g = &ph->groups[j->group];
-        if (!ph_path_changed(ph, g, j->m, ph_job_vertices(&ph->batch, j), j->count))
+        if (!ph_path_changed(ph, g, j->m, ph_job_vertices(b, j), j->count))
             continue;
         st->paths_changed++;
         if (!g->invalid) {
@@ -425,9 +427,13 @@ void lm_photons_memory(const lm_photons *ph, lm_photon_memory *out)
     }
     out->store_bytes = (size_t)ph->store.capacity * lm_photon_store_bytes(&ph->store) +
                        (size_t)ph->store.surface_count * sizeof *ph->store.surfaces;
-    size_t scratch = (size_t)ph->tmp_cap * sizeof *ph->tmp_verts + (size_t)ph->batch.cap * sizeof(ph_job);
-    for (int t = 0; t < ph->batch.buffer_count; t++)
-        scratch += ph->batch.buffers[t].cap * sizeof(ph_vertex);
+    size_t scratch = (size_t)ph->tmp_cap * sizeof *ph->tmp_verts;
+    for (int k = 0; k < 2; k++) {
+        const ph_batch *b = &ph->batches[k];
+        scratch += (size_t)b->cap * sizeof(ph_job);
+        for (int t = 0; t < b->buffer_count; t++)
+            scratch += b->buffers[t].cap * sizeof(ph_vertex);
+    }
     out->other_bytes = sizeof *ph + (size_t)ph->group_count * (sizeof(ph_group) + 2 * sizeof(uint32_t)) +
                        ((size_t)ph->emitter_count + 1) * sizeof(uint32_t) + scratch;
     out->total_bytes = out->path_bytes + out->store_bytes + out->other_bytes;

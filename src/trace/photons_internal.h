@@ -38,6 +38,7 @@ typedef struct {
     uint32_t buffer;           /* thread buffer that holds its vertices */
     uint32_t first, count;
     uint32_t rays;             /* rays cast for it (a final miss included) */
+    uint32_t stored;           /* of its vertices, those that store a hit */
 } ph_job;
 
 typedef struct {
@@ -64,7 +65,7 @@ struct lm_photons {
     lm_photon_store store;
     uint32_t live_hits;
     uint64_t halton_base;      /* seed x photon_count: the seed's stretch of the sequence */
-    ph_batch batch;
+    ph_batch batches[2];       /* a re-trace traces one while the other's results are applied */
     /* Scratch for rebuilding one group's slab (ph_group_apply) and for lists of groups. */
     lm_path_vertex *tmp_verts;
     uint32_t tmp_cap, max_group_photons;
@@ -73,12 +74,15 @@ struct lm_photons {
     uint32_t *tmp_groups;      /* group_count */
 };
 
-/* photon_trace.c: traces photon (group, m) and appends its vertices to buf. Returns 0 when memory
- * ran out. Reads only ph's scene, BVH and emitters: safe from several threads. */
-int ph_trace_photon(const lm_photons *ph, uint32_t group, uint32_t m, ph_buffer *buf, uint32_t *count,
-                    uint32_t *rays);
-/* Traces every job of the batch in parallel (OpenMP). */
-lm_status ph_trace_batch(lm_photons *ph, lm_error *err);
+/* photon_trace.c: traces job j's photon (group, m), appends its vertices to buf and fills j's count,
+ * rays and stored. Returns 0 when memory ran out. Reads only ph's settings, photon numbering, scene,
+ * BVH and emitters (never what applying writes): safe from several threads, and beside an apply. */
+int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf);
+/* Traces every job of batch b in parallel (OpenMP). If `done` is given, the calling thread first
+ * applies that already traced batch (ph_apply_batch, in batch order) and then joins the tracing, so
+ * applying one batch overlaps tracing the next. Returns the first failure (the apply's first). */
+lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, const ph_batch *done, lm_photon_frame_stats *st,
+                         lm_error *err);
 void ph_batch_clear(ph_batch *b);
 int ph_batch_push(ph_batch *b, uint32_t group, uint32_t m);
 void ph_batch_free(ph_batch *b);
@@ -88,10 +92,12 @@ const ph_vertex *ph_job_vertices(const ph_batch *b, const ph_job *j);
 /* 1 if the traced path differs from photon m's stored one (photons.h: (node, tri) sequence, a vertex
  * that moved more than epsilon in world or node-local space, or flux changed). */
 int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n);
-/* Rebuilds a group's slab from the batch jobs [first, first + M) (one per photon, in order): photons
- * whose path changed get their old hits removed and new ones added; the others keep theirs. */
-lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_job *jobs, lm_photon_frame_stats *st,
-                         lm_error *err);
+/* Rebuilds a group's slab from the jobs [first, first + M) of batch b (one per photon, in order):
+ * photons whose path changed get their old hits removed and new ones added; the others keep theirs. */
+lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs,
+                         lm_photon_frame_stats *st, lm_error *err);
+/* ph_group_apply for every group of a traced batch of whole groups, in batch order. */
+lm_status ph_apply_batch(lm_photons *ph, const ph_batch *b, lm_photon_frame_stats *st, lm_error *err);
 void ph_group_free(ph_group *g);
 size_t ph_group_bytes(const ph_group *g);
 
