@@ -239,6 +239,55 @@ static void test_uniform_borders_and_corners(void **state)
     run_uniform(2.0f, 0.05f);
 }
 
+/* The square of square_mesh(h) as a g x g grid of quads sharing their vertices (g <= 5). */
+static void grid_mesh(lmt_mesh *m, float h, int g)
+{
+    memset(m, 0, sizeof *m);
+    for (int j = 0; j <= g; j++)
+        for (int i = 0; i <= g; i++) {
+            float *p = m->pos + 3 * m->vertex_count++;
+            p[0] = -h + 2 * h * (float)i / (float)g;
+            p[1] = 0.0f;
+            p[2] = h - 2 * h * (float)j / (float)g;
+        }
+    for (int j = 0; j < g; j++)
+        for (int i = 0; i < g; i++) {
+            uint16_t a = (uint16_t)(j * (g + 1) + i), b = (uint16_t)(a + 1), c = (uint16_t)(b + g + 1),
+                     d = (uint16_t)(a + g + 1);
+            uint16_t t[6] = {a, b, c, a, c, d};
+            memcpy(m->idx + m->index_count, t, sizeof t);
+            m->index_count += 6;
+        }
+}
+
+/* A plane tessellated into a grid: its 16 collinear boundary edges are joined into the square's 4, and
+ * borders and corners still come out right. */
+static void test_collinear_edges_joined(void **state)
+{
+    (void)state;
+    lmt_mesh m;
+    grid_mesh(&m, 1.0f, 4);
+    tscene t;
+    ts_load(&t, &m, 1, "[{\"name\": \"plane\", \"mesh\": 0}]", 0.025f);
+    assert_int_equal(t.su.surface_count, 1);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 1, NULL), LM_OK);
+    const float E[1] = {2.0f}, above[3] = {0.0f, 5.0f, 0.0f};
+    g_rng = 7;
+    add_hits(&ps, &t, 0, -1.0f, -1.0f, 2.0f, 160, density_const, E, 1.0f, above);
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    set.n_nearest = 150;
+    lm_aim aim;
+    init_aim(&aim, &t, &set);
+    assert_int_equal(aim.edge_first[1] - aim.edge_first[0], 4);
+    assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+    uniform_check(&aim, &t, 1.0f, 0.6f / PI_F * E[0], 0.05);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
 /* Without the boundary correction the corner texels are visibly dark: the correction is what keeps them
  * in line (guards against it silently doing nothing). */
 static void test_boundary_correction_matters(void **state)
@@ -504,6 +553,36 @@ static void test_deterministic(void **state)
     ts_free(&t);
 }
 
+/* Refreshing every surface in one call (built and estimated together) gives the same map as refreshing
+ * them one at a time, in another order. */
+static void test_batch_matches_single(void **state)
+{
+    (void)state;
+    tscene t;
+    load_three(&t);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 3, NULL), LM_OK);
+    const float light[4] = {0.5f, 1.2f, 0.3f, 4.0f};
+    g_rng = 9;
+    for (int s = 0; s < 3; s++) {
+        float cx = t.s->nodes[t.su.surfaces[s].node].translation[0], h = sqrtf(t.su.surfaces[s].area) / 2;
+        add_hits(&ps, &t, s, cx - h, -h, 2 * h, 30 + 5 * s, density_point, light, 1.0f, light);
+    }
+    lm_aim a1, a2;
+    init_aim(&a1, &t, NULL);
+    init_aim(&a2, &t, NULL);
+    lm_aim_stats st;
+    assert_int_equal(lm_aim_refresh_all(&a1, t.s, &t.su, &t.a, &ps, &st, NULL), LM_OK);
+    assert_int_equal(st.surfaces_refreshed, 3);
+    for (int s = 2; s >= 0; s--)
+        assert_int_equal(lm_aim_refresh_surface(&a2, t.s, &t.su, &t.a, &ps, s, NULL, NULL), LM_OK);
+    assert_memory_equal(lm_aim_rgb(&a1), lm_aim_rgb(&a2), sizeof(float) * 3 * (size_t)a1.width * a1.height);
+    lm_aim_free(&a1);
+    lm_aim_free(&a2);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
 static void test_bad_settings(void **state)
 {
     (void)state;
@@ -531,9 +610,11 @@ int main(void)
         cmocka_unit_test(test_point_light_plane),
         cmocka_unit_test(test_uniform_borders_and_corners),
         cmocka_unit_test(test_boundary_correction_matters),
+        cmocka_unit_test(test_collinear_edges_joined),
         cmocka_unit_test(test_hard_cases),
         cmocka_unit_test(test_schedule),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_batch_matches_single),
         cmocka_unit_test(test_bad_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,5 +1,6 @@
 /* photonmap/kdtree: N-nearest and radius queries agree with brute force on random sets with many
- * duplicates, with N larger than the set, on empty and all-coincident sets; builds are deterministic. */
+ * duplicates, with N larger than the set, on empty and all-coincident sets; builds are deterministic;
+ * ties go to the lowest indices; bounded queries (lm_kdtree_nearest_within) match. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -227,6 +228,92 @@ static void test_deterministic_and_strided(void **state)
     free(wide);
 }
 
+/* N above the candidate buffer's limit (the heap mode) still matches brute force. */
+static void test_large_n(void **state)
+{
+    (void)state;
+    static const uint32_t ns[] = {257, 300, 600, 1999};
+    float *p = grid_points(2000, 30, 1, 21);
+    check_set(p, 2000, ns, 4, 5);
+    free(p);
+}
+
+/* Sorted copy of the first n indices. */
+static void sorted_indices(const uint32_t *idx, uint32_t n, uint32_t *out)
+{
+    memcpy(out, idx, sizeof *out * n);
+    for (uint32_t i = 1; i < n; i++)
+        for (uint32_t j = i; j > 0 && out[j - 1] > out[j]; j--) {
+            uint32_t t = out[j];
+            out[j] = out[j - 1];
+            out[j - 1] = t;
+        }
+}
+
+/* Ties at the n-th distance go to the lowest indices (so answers do not depend on the tree's shape). */
+static void test_ties_take_lowest_indices(void **state)
+{
+    (void)state;
+    enum { N = 300 };
+    float *p = grid_points(N, 3, 0, 8);
+    lm_kdtree t;
+    lm_kdtree_init(&t);
+    assert_int_equal(lm_kdtree_build(&t, p, 3, N, NULL), LM_OK);
+    static const uint32_t ns[] = {1, 10, 100, 299};
+    for (int k = 0; k < 4; k++) {
+        uint32_t n = ns[k], idx[N], got[N];
+        float d2[N], q[3] = {0.3f, 0.6f, 0.1f}, r2;
+        assert_int_equal(lm_kdtree_nearest(&t, q, n, idx, d2, &r2), n);
+        sorted_indices(idx, n, got);
+        uint32_t m = 0; /* brute force: every point below r2, then the lowest indices at r2 */
+        for (uint32_t i = 0; i < N; i++)
+            m += d2_of(p + 3 * i, q) < r2;
+        for (uint32_t i = 0, w = 0, at = 0; i < N; i++) {
+            float d = d2_of(p + 3 * i, q);
+            if (d < r2 || (d == r2 && at++ < n - m))
+                assert_int_equal(got[w++], i);
+        }
+    }
+    lm_kdtree_free(&t);
+    free(p);
+}
+
+/* lm_kdtree_nearest_within: with a bound that holds the n nearest, exactly lm_kdtree_nearest's answer;
+ * with a smaller one, every point within it. */
+static void test_nearest_within(void **state)
+{
+    (void)state;
+    enum { N = 1500, K = 100 };
+    float *p = grid_points(N, 40, 1, 31);
+    lm_kdtree t;
+    lm_kdtree_init(&t);
+    assert_int_equal(lm_kdtree_build(&t, p, 3, N, NULL), LM_OK);
+    uint64_t seed = 12;
+    for (int qi = 0; qi < 40; qi++) {
+        float q[3] = {(float)(rng_next(&seed) % 100) / 100.0f, 0.25f, (float)(rng_next(&seed) % 100) / 100.0f};
+        uint32_t ia[K], ib[K], sa[K], sb[K];
+        float da[K], db[K], ra, rb;
+        assert_int_equal(lm_kdtree_nearest(&t, q, K, ia, da, &ra), K);
+        float bound = ra * (1.0f + (float)(qi % 4));
+        assert_int_equal(lm_kdtree_nearest_within(&t, q, K, bound, ib, db, &rb), K);
+        assert_true(rb == ra);
+        sorted_indices(ia, K, sa);
+        sorted_indices(ib, K, sb);
+        assert_memory_equal(sa, sb, sizeof sa);
+        uint32_t inside = 0;
+        float small = ra * 0.5f;
+        for (uint32_t i = 0; i < N; i++)
+            inside += d2_of(p + 3 * i, q) <= small;
+        uint32_t got = lm_kdtree_nearest_within(&t, q, K, small, ib, db, &rb);
+        assert_int_equal(got, inside);
+        for (uint32_t i = 0; i < got; i++)
+            assert_true(db[i] <= small && db[i] == d2_of(p + 3 * ib[i], q));
+        assert_int_equal(lm_kdtree_nearest_within(&t, q, K, -1.0f, ib, db, &rb), 0);
+    }
+    lm_kdtree_free(&t);
+    free(p);
+}
+
 static void test_rejects_non_finite(void **state)
 {
     (void)state;
@@ -250,6 +337,9 @@ int main(void)
         cmocka_unit_test(test_radius_matches_brute_force),
         cmocka_unit_test(test_deterministic_and_strided),
         cmocka_unit_test(test_rejects_non_finite),
+        cmocka_unit_test(test_large_n),
+        cmocka_unit_test(test_ties_take_lowest_indices),
+        cmocka_unit_test(test_nearest_within),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -58,6 +58,108 @@ static int is_boundary(const lm_surfaces *su, uint32_t t, int k, int surface)
     return adj < 0 || su->tri_surface[adj] != surface;
 }
 
+/* ---------- joining collinear boundary edges ---------- */
+
+/* A boundary edge: scene vertex ids, from a to b. */
+typedef struct {
+    uint32_t a, b;
+} edge_ids;
+
+static int by_start(const void *x, const void *y)
+{
+    const edge_ids *p = x, *q = y;
+    if (p->a != q->a)
+        return (p->a > q->a) - (p->a < q->a);
+    return (p->b > q->b) - (p->b < q->b);
+}
+
+/* Whether b -> c continues a -> b in the same direction (within 1e-6 of a radian). */
+static int continues(const float *pos, uint32_t a, uint32_t b, uint32_t c)
+{
+    double d1[3], d2[3];
+    for (int k = 0; k < 3; k++) {
+        d1[k] = (double)pos[3 * (size_t)b + (size_t)k] - pos[3 * (size_t)a + (size_t)k];
+        d2[k] = (double)pos[3 * (size_t)c + (size_t)k] - pos[3 * (size_t)b + (size_t)k];
+    }
+    double x = d1[1] * d2[2] - d1[2] * d2[1], y = d1[2] * d2[0] - d1[0] * d2[2], z = d1[0] * d2[1] - d1[1] * d2[0];
+    double dot = d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2];
+    double l1 = d1[0] * d1[0] + d1[1] * d1[1] + d1[2] * d1[2], l2 = d2[0] * d2[0] + d2[1] * d2[1] + d2[2] * d2[2];
+    return dot > 0.0 && x * x + y * y + z * z <= 1e-12 * l1 * l2;
+}
+
+/* An unused edge of e[0, m) (sorted by start) leaving b along a -> b, or m. */
+static uint32_t next_edge(const float *pos, const edge_ids *e, const uint8_t *used, uint32_t m, uint32_t a,
+                          uint32_t b)
+{
+    uint32_t lo = 0, hi = m;
+    while (lo < hi) { /* first edge starting at b */
+        uint32_t mid = lo + (hi - lo) / 2;
+        if (e[mid].a < b)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    for (; lo < m && e[lo].a == b; lo++)
+        if (!used[lo] && continues(pos, a, b, e[lo].b))
+            return lo;
+    return m;
+}
+
+/* Rewrites one surface's m edges (in place, sorted by start) with chains of collinear ones joined:
+ * a -> b, b -> c becomes a -> c. The boundary is the same segments, so the disc's area on the surface
+ * is unchanged (up to rounding), with fewer edges to walk per texel. Chains start at edges nothing
+ * continues into; returns the new count. */
+static uint32_t join_collinear(const float *pos, edge_ids *e, uint32_t m, uint8_t *flags, edge_ids *out)
+{
+    uint8_t *used = flags, *inner = flags + m;
+    qsort(e, m, sizeof *e, by_start);
+    memset(flags, 0, 2 * (size_t)m);
+    for (uint32_t i = 0; i < m; i++) {
+        uint32_t j = next_edge(pos, e, inner, m, e[i].a, e[i].b);
+        if (j < m)
+            inner[j] = 1; /* continues edge i: not a chain start (unless a loop leaves no start) */
+    }
+    uint32_t w = 0;
+    for (int pass = 0; pass < 2; pass++)
+        for (uint32_t i = 0; i < m; i++) {
+            if (used[i] || (!pass && inner[i]))
+                continue;
+            used[i] = 1;
+            edge_ids c = e[i];
+            for (uint32_t j; (j = next_edge(pos, e, used, m, c.a, c.b)) < m; c.b = e[j].b)
+                used[j] = 1;
+            out[w++] = c;
+        }
+    memcpy(e, out, sizeof *e * w);
+    return w;
+}
+
+/* Joins each surface's collinear boundary edges and packs the edge lists. */
+static lm_status merge_edges(lm_aim *aim, const lm_scene *s, lm_error *err)
+{
+    uint32_t total = aim->edge_first[aim->surface_count], w = 0;
+    edge_ids *e = malloc(sizeof *e * (total ? total : 1)), *out = malloc(sizeof *out * (total ? total : 1));
+    uint8_t *flags = malloc(2 * (size_t)(total ? total : 1));
+    lm_status st = e && out && flags ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u edges", total);
+    for (uint32_t i = 0; st == LM_OK && i < total; i++)
+        e[i] = (edge_ids){aim->edges[2 * i], aim->edges[2 * i + 1]};
+    for (int sf = 0; st == LM_OK && sf < aim->surface_count; sf++) {
+        uint32_t first = aim->edge_first[sf], m = aim->edge_first[sf + 1] - first;
+        m = join_collinear(s->positions, e + first, m, flags, out);
+        aim->edge_first[sf] = w;
+        for (uint32_t i = 0; i < m; i++, w++) {
+            aim->edges[2 * w] = e[first + i].a;
+            aim->edges[2 * w + 1] = e[first + i].b;
+        }
+    }
+    if (st == LM_OK)
+        aim->edge_first[aim->surface_count] = w;
+    free(e);
+    free(out);
+    free(flags);
+    return st;
+}
+
 static lm_status build_edges(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, lm_error *err)
 {
     int ns = aim->surface_count;
@@ -84,7 +186,7 @@ static lm_status build_edges(lm_aim *aim, const lm_scene *s, const lm_surfaces *
         if (!pass && !(aim->edges = malloc(sizeof *aim->edges * 2 * (e ? e : 1))))
             return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u boundary edges", e);
     }
-    return LM_OK;
+    return merge_edges(aim, s, err);
 }
 
 static lm_status check_settings(const lm_aim_settings *o, lm_error *err)
@@ -303,36 +405,74 @@ static double segment_dist2(const double a[2], const double b[2])
     return x * x + y * y;
 }
 
-/* Local-space (kernel-weighted) area of the disc of radius^2 r2 around q, in the tangent plane of normal
- * n, that lies on the surface: the full disc's plus the corrections of the boundary edges crossing it.
- * *edge_d2 gets the squared distance to the nearest boundary edge in that plane: a later disc smaller
- * than that lies wholly on the surface and needs no edge walk. */
-static double disc_area_on_surface(const boundary *bd, const float q[3], const double n[3], double r2, int kernel,
-                                   double *edge_d2)
+/* Whether the segment ab lies wholly to one side of the square [-r, r]^2 (so it misses the disc). */
+static int beside_square(const double a[2], const double b[2], double r)
 {
-    double t1[3], t2[3], h[3] = {fabs(n[0]) < 0.9 ? 1.0 : 0.0, fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
+    return ((a[0] > r) & (b[0] > r)) | ((a[0] < -r) & (b[0] < -r)) | ((a[1] > r) & (b[1] > r)) |
+           ((a[1] < -r) & (b[1] < -r));
+}
+
+/* A tangent frame (t1, t2) of the unit normal n, with t1 x t2 = n: counter-clockwise seen from the front. */
+static void tangent_frame(const double n[3], double t1[3], double t2[3])
+{
+    double h[3] = {fabs(n[0]) < 0.9 ? 1.0 : 0.0, fabs(n[0]) < 0.9 ? 0.0 : 1.0, 0.0};
     t1[0] = h[1] * n[2] - h[2] * n[1];
     t1[1] = h[2] * n[0] - h[0] * n[2];
     t1[2] = h[0] * n[1] - h[1] * n[0];
     double l = sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
     for (int a = 0; a < 3; a++)
         t1[a] /= l;
-    t2[0] = n[1] * t1[2] - n[2] * t1[1]; /* t1 x t2 = n: counter-clockwise seen from the front */
+    t2[0] = n[1] * t1[2] - n[2] * t1[1];
     t2[1] = n[2] * t1[0] - n[0] * t1[2];
     t2[2] = n[0] * t1[1] - n[1] * t1[0];
-    double full = (kernel ? 0.5 : 1.0) * PI_D * r2, area = full, nearest = INFINITY;
-    for (uint32_t e = bd->first; e < bd->end; e++) {
-        double p[2][2];
+}
+
+/* One surface's boundary edges in the tangent frame of one normal: per edge the coordinates (a.t1, a.t2,
+ * b.t1, b.t2) of its ends. Each thread keeps one and reprojects only when the surface or the normal
+ * changes (texels of a flat surface share it). */
+typedef struct {
+    const boundary *bd;   /* what uv holds (NULL: nothing yet) */
+    double n[3], t1[3], t2[3];
+    double *uv;           /* 4 per edge, room for the most edges of a surface in the refresh */
+} edge_frame;
+
+static void project_edges(edge_frame *ef, const boundary *bd, const double n[3])
+{
+    if (ef->bd == bd && memcmp(ef->n, n, sizeof ef->n) == 0)
+        return;
+    ef->bd = bd;
+    memcpy(ef->n, n, sizeof ef->n);
+    tangent_frame(n, ef->t1, ef->t2);
+    for (uint32_t e = bd->first; e < bd->end; e++)
         for (int k = 0; k < 2; k++) {
             const float *v = bd->pos + 3 * (size_t)bd->edges[2 * e + (uint32_t)k];
-            double rel[3] = {(double)v[0] - q[0], (double)v[1] - q[1], (double)v[2] - q[2]};
-            p[k][0] = rel[0] * t1[0] + rel[1] * t1[1] + rel[2] * t1[2];
-            p[k][1] = rel[0] * t2[0] + rel[1] * t2[1] + rel[2] * t2[2];
+            double *o = ef->uv + 4 * (size_t)(e - bd->first) + 2 * k;
+            o[0] = v[0] * ef->t1[0] + v[1] * ef->t1[1] + v[2] * ef->t1[2];
+            o[1] = v[0] * ef->t2[0] + v[1] * ef->t2[1] + v[2] * ef->t2[2];
         }
+}
+
+/* Local-space (kernel-weighted) area of the disc of radius^2 r2 around q, in the tangent plane of normal
+ * n, that lies on the surface: the full disc's plus the corrections of the boundary edges crossing it.
+ * *edge_d2 gets a lower bound on the squared distance to the nearest boundary edge in that plane: a later
+ * disc smaller than that lies wholly on the surface and needs no edge walk. Edges beside the disc's
+ * bounding square are skipped. */
+static double disc_area_on_surface(edge_frame *ef, const boundary *bd, const float q[3], const double n[3],
+                                   double r2, int kernel, double *edge_d2)
+{
+    project_edges(ef, bd, n);
+    double qa = q[0] * ef->t1[0] + q[1] * ef->t1[1] + q[2] * ef->t1[2];
+    double qb = q[0] * ef->t2[0] + q[1] * ef->t2[1] + q[2] * ef->t2[2];
+    double full = (kernel ? 0.5 : 1.0) * PI_D * r2, area = full, nearest = r2, r = sqrt(r2);
+    for (uint32_t e = 0; e < bd->end - bd->first; e++) {
+        const double *o = ef->uv + 4 * (size_t)e;
+        double p[2][2] = {{o[0] - qa, o[1] - qb}, {o[2] - qa, o[3] - qb}};
+        if (beside_square(p[0], p[1], r))
+            continue; /* misses the disc: no correction, and farther than r */
         area += edge_correction(p[0], p[1], r2, kernel);
         nearest = fmin(nearest, segment_dist2(p[0], p[1]));
     }
-    *edge_d2 = nearest;
+    *edge_d2 = nearest; /* the nearest edge's distance, or r2 when every edge is farther (a lower bound) */
     return fmin(fmax(area, MIN_COVERAGE * full), full);
 }
 
@@ -366,6 +506,23 @@ static void add_flux(void *ctx, uint32_t index, float d2)
         f->sum[c] += w * f->flux[3 * (size_t)index + (size_t)c];
 }
 
+/* add_flux over the k found hits, in their order, with the sums kept in registers. */
+static void add_found(flux_sum *f, const uint32_t *idx, const float *d2, uint32_t k)
+{
+    double s0 = f->sum[0], s1 = f->sum[1], s2 = f->sum[2];
+    for (uint32_t i = 0; i < k; i++) {
+        double w = 1.0 - d2[i] * f->inv_r2;
+        w = w > 0.0 ? w : 0.0;
+        const float *phi = f->flux + 3 * (size_t)idx[i];
+        s0 += w * phi[0];
+        s1 += w * phi[1];
+        s2 += w * phi[2];
+    }
+    f->sum[0] = s0;
+    f->sum[1] = s1;
+    f->sum[2] = s2;
+}
+
 static void texel_albedo(const lm_scene *s, const lm_texel *t, float rho[3])
 {
     const lm_material *m = &s->materials[s->tri_material[t->tri]];
@@ -379,14 +536,48 @@ static void texel_albedo(const lm_scene *s, const lm_texel *t, float rho[3])
     lm_material_albedo(s, m, u, v, rho);
 }
 
+/* One thread's working memory for the estimates. */
+typedef struct texel_scratch texel_scratch;
+
+/* The last query of a run of texels: its position and N-th distance bound the next query's. */
+typedef struct {
+    int valid;
+    float q[3], r2;
+} nn_hint;
+
+/* The N nearest hits to q, searched first within the last query's radius plus the distance moved: by
+ * the triangle inequality the last query's N hits lie within that, so the answer is the same (a full
+ * search when rounding leaves it short). */
+static uint32_t find_nearest(const estimate_job *j, nn_hint *h, const float q[3], uint32_t *idx, float *d2,
+                             float *r2)
+{
+    uint32_t k = 0;
+    if (h->valid) {
+        double dx = (double)q[0] - h->q[0], dy = (double)q[1] - h->q[1], dz = (double)q[2] - h->q[2];
+        double r = sqrt((double)h->r2) + sqrt(dx * dx + dy * dy + dz * dz);
+        k = lm_kdtree_nearest_within(j->tree, q, j->n, (float)(r * r * (1.0 + 1e-5)), idx, d2, r2);
+    }
+    if (k < j->n)
+        k = lm_kdtree_nearest(j->tree, q, j->n, idx, d2, r2);
+    *h = (nn_hint){1, {q[0], q[1], q[2]}, *r2};
+    return k;
+}
+
+struct texel_scratch {
+    uint32_t *idx;  /* N found hits ... */
+    float *d2;      /* ... and their squared distances */
+    edge_frame ef;
+    nn_hint hint;
+};
+
 /* L = rho / pi * sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
  * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. */
-static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t *idx, float *d2, float *edge_d2,
+static void estimate_texel(const estimate_job *j, const lm_texel *t, texel_scratch *ts, float *edge_d2,
                            float out[3])
 {
     out[0] = out[1] = out[2] = 0.0f;
-    float r2 = 0.0f;
-    uint32_t k = lm_kdtree_nearest(j->tree, t->local, j->n, idx, d2, &r2);
+    float r2 = 0.0f, *d2 = ts->d2;
+    uint32_t *idx = ts->idx, k = find_nearest(j, &ts->hint, t->local, idx, d2, &r2);
     if (k == 0)
         return;
     double n[3];
@@ -399,40 +590,17 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t *i
     if (widened)
         lm_kdtree_radius(j->tree, t->local, r2, add_flux, &f);
     else
-        for (uint32_t i = 0; i < k; i++)
-            add_flux(&f, idx[i], d2[i]);
+        add_found(&f, idx, d2, k);
     double area = (j->kernel ? 0.5 : 1.0) * PI_D * r2;
     if (j->boundary_correction && !((double)r2 < *edge_d2)) {
         double nearest;
-        area = disc_area_on_surface(&j->bd, t->local, n, r2, j->kernel, &nearest);
+        area = disc_area_on_surface(&ts->ef, &j->bd, t->local, n, r2, j->kernel, &nearest);
         *edge_d2 = (float)nearest;
     }
     float rho[3];
     texel_albedo(j->s, t, rho);
     for (int c = 0; c < 3; c++)
         out[c] = (float)(rho[c] / PI_D * f.sum[c] / (area * factor));
-}
-
-static void write_texels(lm_aim *aim, const estimate_job *j, uint32_t first, uint32_t end, int *nomem)
-{
-#pragma omp parallel
-    {
-        uint32_t *idx = malloc(sizeof *idx * j->n);
-        float *d2 = malloc(sizeof *d2 * j->n);
-        if (!idx || !d2) {
-#pragma omp atomic write
-            *nomem = 1;
-        }
-#pragma omp for schedule(dynamic, 64)
-        for (int64_t i = first; i < (int64_t)end; i++) {
-            const lm_texel *t = &j->a->texels[aim->texel_list[i]];
-            float *px = aim->rgb + 3 * ((size_t)t->y * (size_t)aim->width + (size_t)t->x);
-            if (idx && d2)
-                estimate_texel(j, t, idx, d2, &aim->edge_d2[i], px);
-        }
-        free(idx);
-        free(d2);
-    }
 }
 
 static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_t end)
@@ -445,42 +613,141 @@ static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_
 
 /* ---------- refreshing ---------- */
 
-static lm_status compute_surface(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
-                                 const lm_photon_store *ps, int surface, lm_aim_stats *st, lm_error *err)
-{
-    const lm_surface *sf = &su->surfaces[surface];
-    const lm_material *m = &s->materials[sf->material];
-    linear_map L;
-    linear_map_of(s->nodes[sf->node].world, &L);
-    hit_set hits = {NULL, NULL, 0};
+/* One surface of a refresh: its hits, their kd-tree and the estimate's inputs. */
+typedef struct {
+    int surface;
+    hit_set hits;
     lm_kdtree tree;
-    lm_kdtree_init(&tree);
-    uint32_t first = aim->texel_first[surface], end = aim->texel_first[surface + 1];
-    lm_status rc = gather_hits(ps, surface, s, &L, aim->set.front_only && !m->double_sided && L.det != 0.0, &hits,
-                               err);
-    if (rc == LM_OK)
-        rc = lm_kdtree_build(&tree, hits.pos, 3, hits.count, err);
-    if (rc == LM_OK && hits.count == 0)
-        clear_texels(aim, a, first, end);
-    if (rc == LM_OK && hits.count > 0) {
-        uint32_t n = (uint32_t)aim->set.n_nearest < hits.count ? (uint32_t)aim->set.n_nearest : hits.count;
-        double rmin = (double)aim->set.min_radius_texels * a->texel_size;
-        estimate_job j = {s, a, &tree, &hits, &L, {s->positions, aim->edges, aim->edge_first[surface],
-                          aim->edge_first[surface + 1]}, n, rmin * rmin, aim->set.boundary_correction,
-                          aim->set.kernel};
-        int nomem = 0;
-        write_texels(aim, &j, first, end, &nomem);
-        if (nomem)
-            rc = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for N = %u lookups", n);
+    linear_map L;
+    estimate_job job;
+    lm_status rc;
+    lm_error err;
+} surface_job;
+
+/* Gathers the surface's hits and builds their kd-tree (independent of the other surfaces). */
+static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                            const lm_photon_store *ps, surface_job *sj)
+{
+    const lm_surface *sf = &su->surfaces[sj->surface];
+    const lm_material *m = &s->materials[sf->material];
+    linear_map_of(s->nodes[sf->node].world, &sj->L);
+    lm_kdtree_init(&sj->tree);
+    int front_only = aim->set.front_only && !m->double_sided && sj->L.det != 0.0;
+    sj->rc = gather_hits(ps, sj->surface, s, &sj->L, front_only, &sj->hits, &sj->err);
+    if (sj->rc == LM_OK)
+        sj->rc = lm_kdtree_build(&sj->tree, sj->hits.pos, 3, sj->hits.count, &sj->err);
+    uint32_t n = (uint32_t)aim->set.n_nearest < sj->hits.count ? (uint32_t)aim->set.n_nearest : sj->hits.count;
+    double rmin = (double)aim->set.min_radius_texels * a->texel_size;
+    sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {s->positions, aim->edges,
+                             aim->edge_first[sj->surface], aim->edge_first[sj->surface + 1]}, n, rmin * rmin,
+                             aim->set.boundary_correction, aim->set.kernel};
+}
+
+static void free_surface(surface_job *sj)
+{
+    lm_kdtree_free(&sj->tree);
+    free(sj->hits.pos);
+    free(sj->hits.flux);
+}
+
+static int scratch_init(texel_scratch *ts, uint32_t n_max, uint32_t edges_max)
+{
+    memset(ts, 0, sizeof *ts);
+    ts->idx = malloc(sizeof *ts->idx * (n_max ? n_max : 1));
+    ts->d2 = malloc(sizeof *ts->d2 * (n_max ? n_max : 1));
+    ts->ef.uv = malloc(sizeof *ts->ef.uv * 4 * (edges_max ? edges_max : 1));
+    return ts->idx && ts->d2 && ts->ef.uv;
+}
+
+static void scratch_free(texel_scratch *ts)
+{
+    free(ts->idx);
+    free(ts->d2);
+    free(ts->ef.uv);
+}
+
+/* Texels per work unit. A unit's texels run in order on one thread, and the search hints never cross
+ * units, so every texel's value is the same for any thread count. */
+#define TEXEL_CHUNK 64
+
+/* Estimates the texels of jobs[0, count) in one parallel region: each surface's texels are shared out
+ * in units and threads move on to the next surface without waiting. */
+static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32_t n_max, uint32_t edges_max,
+                         int *nomem)
+{
+#pragma omp parallel
+    {
+        texel_scratch ts;
+        int ok = scratch_init(&ts, n_max, edges_max);
+        if (!ok) {
+#pragma omp atomic write
+            *nomem = 1;
+        }
+        for (int j = 0; j < count; j++) {
+            const estimate_job *e = &jobs[j].job;
+            int64_t first = aim->texel_first[jobs[j].surface], end = aim->texel_first[jobs[j].surface + 1];
+            if (e->n == 0)
+                continue;
+#pragma omp for schedule(dynamic, TEXEL_CHUNK) nowait
+            for (int64_t i = first; i < end; i++) {
+                const lm_texel *t = &e->a->texels[aim->texel_list[i]];
+                float *px = aim->rgb + 3 * ((size_t)t->y * (size_t)aim->width + (size_t)t->x);
+                if ((i - first) % TEXEL_CHUNK == 0)
+                    ts.hint.valid = 0;
+                if (ok)
+                    estimate_texel(e, t, &ts, &aim->edge_d2[i], px);
+            }
+        }
+        scratch_free(&ts);
     }
-    if (rc == LM_OK && st) {
-        st->surfaces_refreshed++;
-        st->texels_written += end - first;
-        st->hits_used += hits.count;
+}
+
+/* Recomputes the texels of the given surfaces from their current hits (trees built in parallel, then all
+ * texels in one parallel pass), resets their delta_f and counts them in st. On an error, the surfaces
+ * before the failing one are still refreshed. */
+static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                  lm_photon_store *ps, const int *surfaces, int count, lm_aim_stats *st,
+                                  lm_error *err)
+{
+    surface_job *jobs = calloc((size_t)(count ? count : 1), sizeof *jobs);
+    if (!jobs)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory to refresh %d surfaces", count);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (int j = 0; j < count; j++) {
+        jobs[j].surface = surfaces[j];
+        prepare_surface(aim, s, su, a, ps, &jobs[j]);
     }
-    lm_kdtree_free(&tree);
-    free(hits.pos);
-    free(hits.flux);
+    int ok = 0;
+    uint32_t n_max = 0, edges_max = 0;
+    for (; ok < count && jobs[ok].rc == LM_OK; ok++) {
+        const boundary *bd = &jobs[ok].job.bd;
+        n_max = jobs[ok].job.n > n_max ? jobs[ok].job.n : n_max;
+        edges_max = bd->end - bd->first > edges_max ? bd->end - bd->first : edges_max;
+    }
+    lm_status rc = ok < count ? jobs[ok].rc : LM_OK;
+    if (rc != LM_OK && err)
+        *err = jobs[ok].err;
+    int nomem = 0;
+    write_texels(aim, jobs, ok, n_max, edges_max, &nomem);
+    if (nomem) {
+        ok = 0;
+        rc = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for N = %u lookups", n_max);
+    }
+    for (int j = 0; j < ok; j++) {
+        int sf = jobs[j].surface;
+        if (jobs[j].hits.count == 0)
+            clear_texels(aim, a, aim->texel_first[sf], aim->texel_first[sf + 1]);
+        lm_photon_store_reset_delta_f(ps, sf);
+        aim->refresh_count[sf]++;
+        if (st) {
+            st->surfaces_refreshed++;
+            st->texels_written += aim->texel_first[sf + 1] - aim->texel_first[sf];
+            st->hits_used += jobs[j].hits.count;
+        }
+    }
+    for (int j = 0; j < count; j++)
+        free_surface(&jobs[j]);
+    free(jobs);
     return rc;
 }
 
@@ -503,12 +770,7 @@ lm_status lm_aim_refresh_surface(lm_aim *aim, const lm_scene *s, const lm_surfac
         return rc;
     if (surface < 0 || surface >= aim->surface_count)
         return lm_fail(err, LM_ERR_INVALID, "AIM: surface %d out of range (0..%d)", surface, aim->surface_count - 1);
-    rc = compute_surface(aim, s, su, a, ps, surface, stats, err);
-    if (rc == LM_OK) {
-        lm_photon_store_reset_delta_f(ps, surface);
-        aim->refresh_count[surface]++;
-    }
-    return rc;
+    return refresh_surfaces(aim, s, su, a, ps, &surface, 1, stats, err);
 }
 
 /* Mean luminance of the stored hits (0 when there are none): the unit of the refresh threshold. */
@@ -555,10 +817,14 @@ static lm_status run_schedule(lm_aim *aim, const lm_scene *s, const lm_surfaces 
     }
     qsort(c, (size_t)count, sizeof *c, by_priority);
     int todo = budget < 0 || budget > count ? count : budget;
-    lm_status rc = LM_OK;
-    for (int i = 0; i < todo && rc == LM_OK; i++)
-        rc = lm_aim_refresh_surface(aim, s, su, a, ps, c[i].surface, st, err);
+    int *chosen = malloc(sizeof *chosen * (size_t)(todo ? todo : 1));
+    lm_status rc = chosen ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "AIM: no memory to schedule %d surfaces", todo);
+    for (int i = 0; chosen && i < todo; i++)
+        chosen[i] = c[i].surface;
+    if (rc == LM_OK)
+        rc = refresh_surfaces(aim, s, su, a, ps, chosen, todo, st, err);
     st->surfaces_pending = count - todo;
+    free(chosen);
     free(c);
     return rc;
 }

@@ -23,8 +23,9 @@
  * Scheduling (section 3): a surface's AIM is refreshed only when its delta_f (energy of hits added or
  * removed since its last refresh, kept by the photon store) exceeds a threshold; surfaces are taken in
  * order of delta_f / area, largest first, at most `budget` per call, and a refreshed surface's delta_f
- * is reset. Texels of a surface are computed in parallel (OpenMP); each texel's value depends only on
- * the store's contents, so results are identical for any thread count. */
+ * is reset. The surfaces of one call are prepared in parallel and their texels computed in one parallel
+ * pass (OpenMP, fixed units of texels); each texel's value depends only on the store's contents, so
+ * results are identical for any thread count. */
 #ifndef LM_AIM_H
 #define LM_AIM_H
 
@@ -62,7 +63,8 @@ typedef struct {
     uint32_t *texel_first;   /* per surface (surface_count + 1 offsets) into texel_list */
     uint32_t *texel_list;    /* atlas texel indices grouped by surface */
     uint32_t *edge_first;    /* per surface (surface_count + 1 offsets) into edges */
-    uint32_t *edges;         /* boundary edges, 2 scene vertex ids each, oriented with the surface on the left */
+    uint32_t *edges;         /* boundary edges, 2 scene vertex ids each, oriented with the surface on the left
+                                (collinear runs joined into one edge) */
     uint32_t *refresh_count; /* per surface: how many times it was refreshed */
     float *edge_d2;          /* per texel_list entry: squared distance to its surface's boundary in its
                                 tangent plane (-1 until first computed); a smaller disc skips the edges */

@@ -1,4 +1,5 @@
-/* Balanced kd-tree: in-place median build and N-nearest / radius queries (see kdtree.h). */
+/* Balanced kd-tree with bucket leaves: in-place median build and N-nearest / radius queries (see
+ * kdtree.h). */
 #include "kdtree.h"
 
 #include <math.h>
@@ -7,14 +8,18 @@
 
 #include "../core/timing.h"
 
-#define LEAF_AXIS 3u
 #define STACK_MAX 64
+#define LEAF LM_KDTREE_LEAF
 
 void lm_kdtree_init(lm_kdtree *t) { memset(t, 0, sizeof *t); }
 
 void lm_kdtree_free(lm_kdtree *t)
 {
     free(t->nodes);
+    free(t->x);
+    free(t->index);
+    free(t->split);
+    free(t->axis);
     memset(t, 0, sizeof *t);
 }
 
@@ -70,24 +75,62 @@ static int widest_axis(const float box[6])
     return e1 > e0 ? (e2 > e1 ? 2 : 1) : (e2 > e0 ? 2 : 0);
 }
 
-/* Builds [lo, hi) inside box; children get the box cut at the median (a conservative bound, O(1) per
- * node instead of a pass over the range). */
-static void build_range(lm_kd_node *nd, uint32_t lo, uint32_t hi, const float box[6])
+/* Splits [lo, hi) inside box at its median into [lo, mid) and [mid, hi) until the ranges are leaves;
+ * children get the box cut at the split (a conservative bound, O(1) per node). */
+static void build_range(lm_kdtree *t, uint32_t lo, uint32_t hi, const float box[6])
 {
     float b[6];
     memcpy(b, box, sizeof b);
-    while (hi - lo > LM_KDTREE_LEAF) {
+    while (hi - lo > LEAF) {
         int axis = widest_axis(b);
         uint32_t mid = lo + (hi - lo) / 2;
-        select_kth(nd, lo, hi, mid, axis);
-        nd[mid].meta = (nd[mid].meta & ~3u) | (uint32_t)axis;
+        select_kth(t->nodes, lo, hi, mid, axis);
+        float at = t->nodes[mid].p[axis];
+        t->split[mid] = at;
+        t->axis[mid] = (uint8_t)axis;
         float left[6];
         memcpy(left, b, sizeof left);
-        left[3 + axis] = nd[mid].p[axis];
-        build_range(nd, lo, mid, left);
-        b[axis] = nd[mid].p[axis];
-        lo = mid + 1;
+        left[3 + axis] = at;
+        build_range(t, lo, mid, left);
+        b[axis] = at;
+        lo = mid;
     }
+}
+
+/* Grows the arrays to hold count points (coordinates with LEAF slots of padding). */
+static lm_status reserve(lm_kdtree *t, uint32_t count, lm_error *err)
+{
+    if (count <= t->capacity && t->nodes)
+        return LM_OK;
+    lm_kdtree_free(t);
+    size_t slots = (size_t)count + LEAF;
+    t->nodes = malloc(sizeof *t->nodes * (count ? count : 1));
+    t->x = calloc(3 * slots, sizeof *t->x);
+    t->index = malloc(sizeof *t->index * (count ? count : 1));
+    t->split = malloc(sizeof *t->split * (count ? count : 1));
+    t->axis = malloc(count ? count : 1);
+    if (!t->nodes || !t->x || !t->index || !t->split || !t->axis) {
+        lm_kdtree_free(t);
+        return lm_fail(err, LM_ERR_NOMEM, "kd-tree: no memory for %u points", count);
+    }
+    t->y = t->x + slots;
+    t->z = t->y + slots;
+    t->capacity = count;
+    return LM_OK;
+}
+
+/* Copies the built order into the coordinate and index arrays the queries scan. */
+static void publish(lm_kdtree *t)
+{
+    for (uint32_t i = 0; i < t->count; i++) {
+        const lm_kd_node *n = &t->nodes[i];
+        t->x[i] = n->p[0];
+        t->y[i] = n->p[1];
+        t->z[i] = n->p[2];
+        t->index[i] = n->index;
+    }
+    for (uint32_t i = t->count; i < t->count + LEAF; i++) /* padding read by the fixed-width scans */
+        t->x[i] = t->y[i] = t->z[i] = 0.0f;
 }
 
 lm_status lm_kdtree_build(lm_kdtree *t, const float *points, size_t stride, uint32_t count, lm_error *err)
@@ -95,14 +138,10 @@ lm_status lm_kdtree_build(lm_kdtree *t, const float *points, size_t stride, uint
     if (count > LM_KDTREE_MAX_POINTS || stride < 3)
         return lm_fail(err, LM_ERR_INVALID, "kd-tree: %u points (max %u), stride %zu", count,
                        LM_KDTREE_MAX_POINTS, stride);
-    if (count > t->capacity) {
-        lm_kd_node *grown = realloc(t->nodes, sizeof *grown * count);
-        if (!grown)
-            return lm_fail(err, LM_ERR_NOMEM, "kd-tree: no memory for %u points", count);
-        t->nodes = grown;
-        t->capacity = count;
-    }
     t->count = 0;
+    lm_status st = reserve(t, count, err);
+    if (st != LM_OK)
+        return st;
     float box[6] = {INFINITY, INFINITY, INFINITY, -INFINITY, -INFINITY, -INFINITY};
     for (uint32_t i = 0; i < count; i++) {
         const float *p = points + stride * i;
@@ -114,217 +153,293 @@ lm_status lm_kdtree_build(lm_kdtree *t, const float *points, size_t stride, uint
             box[a] = p[a] < box[a] ? p[a] : box[a];
             box[3 + a] = p[a] > box[3 + a] ? p[a] : box[3 + a];
         }
-        n->meta = i << 2 | LEAF_AXIS;
+        n->index = i;
     }
     t->count = count;
     if (count)
-        build_range(t->nodes, 0, count, box);
+        build_range(t, 0, count, box);
+    publish(t);
     return LM_OK;
 }
 
-/* ---------- queries ---------- */
+/* ---------- traversal ---------- */
 
-/* The N-nearest collector. Small N (the common case, N <= KNN_BUFFER / 2) keeps candidates in an
- * unsorted buffer of 2N: once full, a selection keeps the N closest and their farthest becomes the
- * bound (amortised O(1) per candidate, few unpredictable branches). Larger N use a max-heap of N in the
- * caller's arrays (O(log N) per candidate, no allocation). */
-#define KNN_BUFFER 512
+/* A range still to visit, q's per-axis offsets to its cell (0 where q is inside the cell's slab) and
+ * the squared distance they make. */
+typedef struct {
+    uint32_t lo, hi;
+    float off[3], d2;
+} frame;
+
+/* Squared distance from q to a cell. The same operations as the point distance, so for any point p of
+ * the cell it is <= the computed |p - q|^2 exactly (rounding is monotone). */
+static inline float cell_d2(float ox, float oy, float oz) { return ox * ox + oy * oy + oz * oz; }
+
+/* Squared distances from q to the LEAF points from slot lo (the padding makes the fixed width safe). */
+static inline void leaf_d2(const lm_kdtree *t, uint32_t lo, const float q[3], float d2[LEAF])
+{
+    const float *x = t->x + lo, *y = t->y + lo, *z = t->z + lo;
+    float qx = q[0], qy = q[1], qz = q[2];
+    for (uint32_t i = 0; i < LEAF; i++) {
+        float dx = x[i] - qx, dy = y[i] - qy, dz = z[i] - qz;
+        d2[i] = dx * dx + dy * dy + dz * dz;
+    }
+}
+
+/* Steps the range f down to its child on q's side until it is a leaf; each farther child is pushed
+ * (without a branch) unless its cell is beyond bound. */
+static inline void descend(const lm_kdtree *t, const float q[3], frame *f, frame *stack, int *sp, float bound)
+{
+    uint32_t lo = f->lo, hi = f->hi;
+    float ox = f->off[0], oy = f->off[1], oz = f->off[2];
+    int n = *sp;
+    while (hi - lo > LEAF) {
+        uint32_t mid = lo + (hi - lo) / 2;
+        int a = t->axis[mid];
+        float diff = q[a] - t->split[mid];
+        float fx = a == 0 ? diff : ox, fy = a == 1 ? diff : oy, fz = a == 2 ? diff : oz;
+        float fd = cell_d2(fx, fy, fz);
+        int left = diff < 0.0f;
+        stack[n] = (frame){left ? mid : lo, left ? hi : mid, {fx, fy, fz}, fd};
+        n += !(fd > bound);
+        lo = left ? lo : mid;
+        hi = left ? mid : hi;
+    }
+    *sp = n;
+    f->lo = lo;
+    f->hi = hi;
+}
+
+/* ---------- N nearest ---------- */
+
+/* Candidates are keys (bits of d2 << 32 | index): d2 >= 0, so the keys order by distance, then index.
+ * N <= KNN_FAST (the common case) keeps them in an unsorted buffer: leaf points within the bound are
+ * appended without branches, and when 2N have gathered a selection (quickselect with branch-free
+ * partitioning) keeps the N smallest and the N-th becomes the bound. Larger N use a max-heap of N in
+ * the caller's arrays. */
+#define KNN_FAST 256u
+#define KNN_BUFFER (2 * KNN_FAST + LEAF)
 
 typedef struct {
-    float d2;
-    uint32_t idx;
-} cand;
-
-typedef struct {
-    uint32_t *idx;
+    uint64_t *buf;       /* buffered mode when non-NULL */
+    uint32_t *idx;       /* heap mode */
     float *d2;
-    cand *buf;     /* buffered mode when non-NULL */
     uint32_t count, n, cap;
-    float top;       /* candidates farther than this cannot be among the n nearest (+inf at first) */
-    uint32_t seen;   /* leaf points scanned while top was +inf ... */
-    float seen_max;  /* ... and the farthest of them: n of them bound the n-th distance */
+    uint32_t top_bits;   /* keys with more d2 bits cannot be among the n nearest (all ones at first) */
+    float top;           /* the same bound as a float, for cells (+inf at first) */
 } knn;
 
-/* Moves (idx, d2) down from slot i of the heap to where the max-heap order holds. */
-static void sift_down(knn *h, uint32_t i, uint32_t idx, float d2)
+static inline uint32_t float_bits(float f)
+{
+    uint32_t b;
+    memcpy(&b, &f, sizeof b);
+    return b;
+}
+
+static inline float bits_float(uint32_t b)
+{
+    float f;
+    memcpy(&f, &b, sizeof f);
+    return f;
+}
+
+static inline uint64_t make_key(float d2, uint32_t idx) { return (uint64_t)float_bits(d2) << 32 | idx; }
+
+static inline float key_d2(uint64_t key) { return bits_float((uint32_t)(key >> 32)); }
+
+static void set_bound(knn *k, uint64_t key)
+{
+    k->top_bits = (uint32_t)(key >> 32);
+    k->top = bits_float(k->top_bits);
+}
+
+/* Moves src[lo, hi - 1) apart around pivot (a key not among them) into dst[lo, hi), without branches:
+ * smaller keys to the front, larger to the back, and the pivot into the one slot left between them,
+ * whose index is returned. */
+static uint32_t split_keys(const uint64_t *src, uint64_t *dst, uint32_t lo, uint32_t hi, uint64_t pivot)
+{
+    uint32_t front = lo, back = hi - 1;
+    for (uint32_t i = lo; i < hi - 1; i++) {
+        uint64_t v = src[i];
+        uint32_t less = v < pivot;
+        dst[front] = v;
+        dst[back] = v;
+        front += less;
+        back -= 1u - less;
+    }
+    dst[front] = pivot;
+    return front;
+}
+
+/* Index (of lo, mid, hi) of the median of the three keys. */
+static uint32_t median3_at(const uint64_t *a, uint32_t lo, uint32_t mid, uint32_t hi)
+{
+    uint64_t x = a[lo], y = a[mid], z = a[hi];
+    if (x < y)
+        return y < z ? mid : x < z ? hi : lo;
+    return x < z ? lo : y < z ? hi : mid;
+}
+
+/* Rearranges the distinct keys a[0, count) so that a[0, n) are the n smallest (n < count). */
+static void select_smallest(uint64_t *a, uint32_t count, uint32_t n)
+{
+    uint64_t tmp[KNN_BUFFER];
+    uint32_t lo = 0, hi = count;
+    while (lo < n && n < hi) {
+        uint32_t p = median3_at(a, lo, lo + (hi - lo) / 2, hi - 1);
+        uint64_t pivot = a[p];
+        a[p] = a[hi - 1];
+        uint32_t j = split_keys(a, tmp, lo, hi, pivot);
+        memcpy(a + lo, tmp + lo, sizeof *a * (hi - lo));
+        if (n <= j)
+            hi = j;
+        else
+            lo = j + 1;
+    }
+}
+
+/* Largest key of a[0, count). */
+static uint64_t max_key(const uint64_t *a, uint32_t count)
+{
+    uint64_t m = 0;
+    for (uint32_t i = 0; i < count; i++)
+        m = a[i] > m ? a[i] : m;
+    return m;
+}
+
+/* Keeps the n nearest candidates; the farthest of them becomes the bound. */
+static void buffer_shrink(knn *k)
+{
+    select_smallest(k->buf, k->count, k->n);
+    k->count = k->n;
+    set_bound(k, max_key(k->buf, k->n));
+}
+
+static void buffer_leaf(knn *k, const float d2[LEAF], const uint32_t *idx, uint32_t m)
+{
+    uint64_t *buf = k->buf;
+    uint32_t c = k->count, top = k->top_bits;
+    for (uint32_t i = 0; i < m; i++) {
+        uint32_t b = float_bits(d2[i]);
+        buf[c] = (uint64_t)b << 32 | idx[i];
+        c += b <= top;
+    }
+    k->count = c;
+    if (c >= k->cap)
+        buffer_shrink(k);
+    else if (top == UINT32_MAX && c >= k->n) /* the first n points seen bound the n-th distance */
+        set_bound(k, max_key(buf, c));
+}
+
+/* Heap mode: a max-heap on keys in the caller's arrays. Moves key down from slot i to its place. */
+static void sift_down(knn *h, uint32_t i, uint64_t key)
 {
     uint32_t n = h->count;
     for (;;) {
         uint32_t c = 2 * i + 1;
         if (c >= n)
             break;
-        if (c + 1 < n && h->d2[c + 1] > h->d2[c])
-            c++;
-        if (h->d2[c] <= d2)
+        uint64_t kc = make_key(h->d2[c], h->idx[c]);
+        if (c + 1 < n) {
+            uint64_t k1 = make_key(h->d2[c + 1], h->idx[c + 1]);
+            if (k1 > kc) {
+                c++;
+                kc = k1;
+            }
+        }
+        if (kc <= key)
             break;
         h->d2[i] = h->d2[c];
         h->idx[i] = h->idx[c];
         i = c;
     }
-    h->d2[i] = d2;
-    h->idx[i] = idx;
+    h->d2[i] = key_d2(key);
+    h->idx[i] = (uint32_t)key;
 }
 
-/* Heap mode: the first n candidates are appended and heapified once; later ones replace the root. */
-static void heap_insert(knn *h, uint32_t idx, float d2)
+/* The first n keys are appended and heapified once; later ones replace the root when smaller. */
+static void heap_insert(knn *h, uint64_t key)
 {
     if (h->count < h->n) {
-        h->idx[h->count] = idx;
-        h->d2[h->count++] = d2;
+        h->idx[h->count] = (uint32_t)key;
+        h->d2[h->count++] = key_d2(key);
         if (h->count < h->n)
             return;
         for (uint32_t i = h->n / 2; i-- > 0;)
-            sift_down(h, i, h->idx[i], h->d2[i]);
-    } else if (d2 < h->d2[0]) {
-        sift_down(h, 0, idx, d2);
+            sift_down(h, i, make_key(h->d2[i], h->idx[i]));
+    } else if (key < make_key(h->d2[0], h->idx[0])) {
+        sift_down(h, 0, key);
     } else {
         return;
     }
-    if (h->d2[0] < h->top)
-        h->top = h->d2[0];
+    set_bound(h, make_key(h->d2[0], h->idx[0]));
 }
 
-/* Puts the k-th smallest candidate at k, smaller-or-equal before it (Hoare partitioning, as select_kth). */
-static void select_cand(cand *c, uint32_t count, uint32_t k)
+static void heap_leaf(knn *k, const float d2[LEAF], const uint32_t *idx, uint32_t m)
 {
-    uint32_t lo = 0, hi = count;
-    while (hi - lo > 1) {
-        float pivot = median3(c[lo].d2, c[lo + (hi - lo) / 2].d2, c[hi - 1].d2);
-        int64_t i = lo, j = (int64_t)hi - 1;
-        while (i <= j) {
-            while (c[i].d2 < pivot)
-                i++;
-            while (c[j].d2 > pivot)
-                j--;
-            if (i <= j) {
-                cand t = c[i];
-                c[i++] = c[j];
-                c[j--] = t;
-            }
-        }
-        if ((int64_t)k <= j)
-            hi = (uint32_t)(j + 1);
-        else if ((int64_t)k >= i)
-            lo = (uint32_t)i;
-        else
-            return;
-    }
+    for (uint32_t i = 0; i < m; i++)
+        if (float_bits(d2[i]) <= k->top_bits)
+            heap_insert(k, make_key(d2[i], idx[i]));
 }
 
-/* Buffered mode: keeps the n closest candidates; the n-th becomes the bound. */
-static void buffer_shrink(knn *k)
-{
-    select_cand(k->buf, k->count, k->n - 1);
-    k->count = k->n;
-    k->top = k->buf[k->n - 1].d2;
-}
-
-static inline float dist2(const float a[3], const float b[3])
-{
-    float dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
-    return dx * dx + dy * dy + dz * dz;
-}
-
-static inline void add(knn *k, uint32_t idx, float d2)
-{
-    if (!k->buf) {
-        heap_insert(k, idx, d2);
-        return;
-    }
-    k->buf[k->count++] = (cand){d2, idx};
-    if (k->count == k->cap)
-        buffer_shrink(k);
-}
-
-static inline void consider(knn *k, const lm_kd_node *nd, const float q[3])
-{
-    float d2 = dist2(nd->p, q);
-    if (d2 <= k->top)
-        add(k, nd->meta >> 2, d2);
-}
-
-/* A leaf range. Before any bound exists, the first n leaf points seen (the ones nearest q in the
- * near-first order, unlike the medians met on the way down) give one: their farthest distance. */
-static void scan_leaf(knn *k, const lm_kd_node *nd, uint32_t lo, uint32_t hi, const float q[3])
-{
-    if (k->top < INFINITY) {
-        for (uint32_t i = lo; i < hi; i++)
-            consider(k, &nd[i], q);
-        return;
-    }
-    for (uint32_t i = lo; i < hi; i++) {
-        float d2 = dist2(nd[i].p, q);
-        k->seen_max = d2 > k->seen_max ? d2 : k->seen_max;
-        add(k, nd[i].meta >> 2, d2);
-    }
-    k->seen += hi - lo;
-    if (k->seen >= k->n && k->seen_max < k->top)
-        k->top = k->seen_max;
-}
-
-typedef struct {
-    uint32_t lo, hi;
-    float d2; /* squared distance from q to the splitting plane that bounds this range */
-} frame;
-
-/* Depth-first, nearer side first; a range is skipped once its plane is no closer than the bound. */
+/* Depth-first, nearer side first; a cell is skipped once it is farther than the bound. */
 static void knn_search(const lm_kdtree *t, const float q[3], knn *k)
 {
     frame stack[STACK_MAX];
     int sp = 0;
-    stack[sp++] = (frame){0, t->count, 0.0f};
-    const lm_kd_node *nd = t->nodes;
+    stack[sp++] = (frame){0, t->count, {0.0f, 0.0f, 0.0f}, 0.0f};
+    float d2[LEAF];
     while (sp > 0) {
         frame f = stack[--sp];
-        if (f.d2 > k->top) /* every point beyond that plane is farther than the bound */
+        if (f.d2 > k->top)
             continue;
-        uint32_t lo = f.lo, hi = f.hi;
-        while (hi - lo > LM_KDTREE_LEAF) {
-            uint32_t mid = lo + (hi - lo) / 2;
-            const lm_kd_node *m = &nd[mid];
-            float diff = q[m->meta & 3u] - m->p[m->meta & 3u];
-            consider(k, m, q);
-            if (diff < 0.0f) {
-                stack[sp++] = (frame){mid + 1, hi, diff * diff};
-                hi = mid;
-            } else {
-                stack[sp++] = (frame){lo, mid, diff * diff};
-                lo = mid + 1;
-            }
-        }
-        scan_leaf(k, nd, lo, hi, q);
+        descend(t, q, &f, stack, &sp, k->top);
+        leaf_d2(t, f.lo, q, d2);
+        if (k->buf)
+            buffer_leaf(k, d2, t->index + f.lo, f.hi - f.lo);
+        else
+            heap_leaf(k, d2, t->index + f.lo, f.hi - f.lo);
     }
 }
 
-/* Index of the largest of d2[0..count). */
-static uint32_t argmax(const float *d2, uint32_t count)
+/* Largest of d2[0..count). */
+static float largest(const float *d2, uint32_t count)
 {
-    uint32_t best = 0;
+    float m = d2[0];
     for (uint32_t i = 1; i < count; i++)
-        if (d2[i] > d2[best])
-            best = i;
-    return best;
+        m = d2[i] > m ? d2[i] : m;
+    return m;
 }
 
 uint32_t lm_kdtree_nearest(const lm_kdtree *t, const float q[3], uint32_t n, uint32_t *out_index, float *out_d2,
                            float *r2)
 {
-    cand buf[KNN_BUFFER];
-    knn k = {out_index, out_d2, n <= KNN_BUFFER / 2 ? buf : NULL, 0, n, 2 * n, INFINITY, 0, 0.0f};
+    return lm_kdtree_nearest_within(t, q, n, INFINITY, out_index, out_d2, r2);
+}
+
+uint32_t lm_kdtree_nearest_within(const lm_kdtree *t, const float q[3], uint32_t n, float max_d2,
+                                  uint32_t *out_index, float *out_d2, float *r2)
+{
+    uint64_t buf[KNN_BUFFER];
+    uint32_t top = max_d2 < INFINITY ? float_bits(max_d2 > 0.0f ? max_d2 : 0.0f) : UINT32_MAX;
+    knn k = {n <= KNN_FAST ? buf : NULL, out_index, out_d2, 0, n, 2 * n, top, max_d2};
     if (n > 0 && t->count > 0)
         knn_search(t, q, &k);
     if (k.buf) {
         if (k.count > n)
-            buffer_shrink(&k);
+            select_smallest(buf, k.count, n);
+        k.count = k.count < n ? k.count : n;
         for (uint32_t i = 0; i < k.count; i++) {
-            out_index[i] = k.buf[i].idx;
-            out_d2[i] = k.buf[i].d2;
+            out_index[i] = (uint32_t)buf[i];
+            out_d2[i] = key_d2(buf[i]);
         }
     }
     if (r2)
-        *r2 = k.count ? out_d2[argmax(out_d2, k.count)] : 0.0f;
+        *r2 = k.count ? largest(out_d2, k.count) : 0.0f;
     return k.count;
 }
+
+/* ---------- radius ---------- */
 
 uint32_t lm_kdtree_radius(const lm_kdtree *t, const float q[3], float r2, lm_kdtree_visit visit, void *ctx)
 {
@@ -332,36 +447,17 @@ uint32_t lm_kdtree_radius(const lm_kdtree *t, const float q[3], float r2, lm_kdt
     int sp = 0;
     uint32_t found = 0;
     if (t->count > 0 && r2 >= 0.0f)
-        stack[sp++] = (frame){0, t->count, 0.0f};
-    const lm_kd_node *nd = t->nodes;
+        stack[sp++] = (frame){0, t->count, {0.0f, 0.0f, 0.0f}, 0.0f};
+    float d2[LEAF];
     while (sp > 0) {
         frame f = stack[--sp];
-        if (f.d2 > r2)
-            continue;
-        uint32_t lo = f.lo, hi = f.hi;
-        while (hi - lo > LM_KDTREE_LEAF) {
-            uint32_t mid = lo + (hi - lo) / 2;
-            const lm_kd_node *m = &nd[mid];
-            float diff = q[m->meta & 3u] - m->p[m->meta & 3u], d2 = dist2(m->p, q);
-            if (d2 <= r2) {
-                visit(ctx, m->meta >> 2, d2);
+        descend(t, q, &f, stack, &sp, r2);
+        leaf_d2(t, f.lo, q, d2);
+        for (uint32_t i = 0; i < f.hi - f.lo; i++)
+            if (d2[i] <= r2) {
+                visit(ctx, t->index[f.lo + i], d2[i]);
                 found++;
             }
-            if (diff < 0.0f) {
-                stack[sp++] = (frame){mid + 1, hi, diff * diff};
-                hi = mid;
-            } else {
-                stack[sp++] = (frame){lo, mid, diff * diff};
-                lo = mid + 1;
-            }
-        }
-        for (uint32_t i = lo; i < hi; i++) {
-            float d2 = dist2(nd[i].p, q);
-            if (d2 <= r2) {
-                visit(ctx, nd[i].meta >> 2, d2);
-                found++;
-            }
-        }
     }
     return found;
 }

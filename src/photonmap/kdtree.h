@@ -1,11 +1,13 @@
 /* A balanced 3-d kd-tree over points, for the per-surface photon maps of Larsen & Christensen
  * (section 3: "Kd-trees are fast for N-nearest neighbor queries").
  *
- * Layout: one array, no pointers. The subtree over the range [lo, hi) keeps its median (on the axis of
- * the range's largest extent) at mid = (lo + hi) / 2, the points below it in [lo, mid) and the points
- * above it in (mid, hi). Ranges of at most LM_KDTREE_LEAF points are left unsplit and scanned. Building
- * selects medians in place (three-way quickselect, linear in the range even when all keys are equal),
- * so it is O(n log n) and allocates only the node array (reused by later builds).
+ * Layout: arrays in tree order, no pointers. The subtree over the range [lo, hi) is split at
+ * mid = (lo + hi) / 2 on the axis of the range's largest extent: [lo, mid) holds keys <= the key of point
+ * mid, [mid, hi) keys >= it, so the splitting plane is point mid's coordinate. Ranges of at most
+ * LM_KDTREE_LEAF points are leaves ("buckets"); every point lies in one. Queries read the positions as
+ * three coordinate arrays (a leaf is a short run of each, scanned by a loop the compiler vectorises).
+ * Building selects medians in place (three-way quickselect, linear in the range even when all keys are
+ * equal), so it is O(n log n) and allocates only the arrays (reused by later builds).
  *
  * Queries are read-only and may run from several threads at once. Results are deterministic: the same
  * points in the same order give the same tree and the same answers. */
@@ -17,16 +19,20 @@
 
 #include "../core/error.h"
 
-#define LM_KDTREE_LEAF 8u         /* ranges this small are scanned, not split */
+#define LM_KDTREE_LEAF 16u         /* ranges this small are leaves, scanned, not split */
 #define LM_KDTREE_MAX_POINTS (1u << 30)
 
 typedef struct {
     float p[3];
-    uint32_t meta;                /* (caller's index << 2) | split axis (3 = leaf range, no split) */
+    uint32_t index;               /* the caller's index of the point */
 } lm_kd_node;
 
 typedef struct {
-    lm_kd_node *nodes;
+    lm_kd_node *nodes;            /* the points in tree order (built in place) */
+    float *x, *y, *z;             /* their coordinates, LM_KDTREE_LEAF zero slots of padding at the end */
+    uint32_t *index;              /* their caller's indices */
+    float *split;                 /* at mid of each split range: the splitting coordinate ... */
+    uint8_t *axis;                /* ... and its axis */
     uint32_t count, capacity;
 } lm_kdtree;
 
@@ -38,12 +44,18 @@ void lm_kdtree_free(lm_kdtree *t);
 lm_status lm_kdtree_build(lm_kdtree *t, const float *points, size_t stride, uint32_t count, lm_error *err);
 
 /* The n nearest points to q (Euclidean). Writes min(n, count) indices and their squared distances to
- * out_index / out_d2 (caller's arrays of n entries; they are used as a max-heap, so the order is not
- * sorted) and returns how many. *r2 (if non-NULL) receives the squared distance of the farthest one
- * returned (0 if none). Among points tied at the n-th distance, which ones are returned is unspecified
- * but deterministic. */
+ * out_index / out_d2 (caller's arrays of n entries, not in sorted order) and returns how many. *r2 (if
+ * non-NULL) receives the squared distance of the farthest one returned (0 if none). Among points tied
+ * at the n-th distance, the lower caller's indices are returned, so the answer does not depend on the
+ * tree's shape. No allocation. */
 uint32_t lm_kdtree_nearest(const lm_kdtree *t, const float q[3], uint32_t n, uint32_t *out_index, float *out_d2,
                            float *r2);
+
+/* The same among the points with squared distance <= max_d2 only (fewer than n when fewer lie there,
+ * and then all of them): a bound known in advance (from a nearby query) spares the search. When it
+ * returns n, the answer is exactly lm_kdtree_nearest's. */
+uint32_t lm_kdtree_nearest_within(const lm_kdtree *t, const float q[3], uint32_t n, float max_d2,
+                                  uint32_t *out_index, float *out_d2, float *r2);
 
 /* Calls visit(ctx, index, d2) for every point with squared distance d2 <= r2 from q, in a deterministic
  * order; returns how many. */
