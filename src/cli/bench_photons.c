@@ -67,6 +67,37 @@ static uint32_t bounce_rays(const lm_photons *ph, float *org, float *dir, uint32
 
 /* Full traces of `photons` photons (fresh store each time) against raw rtcIntersect1 on the same rays:
  * one from an emitter per photon, then the photons' bounce segments. */
+/* One full trace of a fresh photon set; returns its seconds (< 0 on failure) and, when org/dir are
+ * NULL, allocates and fills them with the rays to replay (*raw of them). */
+static double trace_once(const lmgi_scene *sc, const lm_emitters *em, const lm_photon_settings *set,
+                         uint64_t *rays, uint32_t *traced, float **org, float **dir, uint32_t *raw)
+{
+    lm_photons *ph = NULL;
+    lm_photon_frame_stats st;
+    lm_error err;
+    if (lm_photons_create(sc->scene, &sc->surfaces, sc->rt, em, set, &ph, &err) != LM_OK ||
+        lm_photons_trace_all(ph, &st, &err) != LM_OK) {
+        printf("failed: %s\n", err.msg);
+        lm_photons_free(ph);
+        return -1.0;
+    }
+    *rays = st.rays;
+    *traced = lm_photons_count(ph);
+    if (!*org) {
+        *org = malloc(sizeof(float) * 3 * st.rays);
+        *dir = malloc(sizeof(float) * 3 * st.rays);
+        if (*org && *dir) {
+            emitter_rays(sc, em, *traced, *org, *dir);
+            *raw = bounce_rays(ph, *org, *dir, *traced, (uint32_t)st.rays);
+        }
+    }
+    lm_photons_free(ph);
+    return st.seconds;
+}
+
+/* Full traces of `photons` photons (fresh store each time) against raw rtcIntersect1 on the same rays:
+ * one from an emitter per photon, then the photons' bounce segments. The two alternate, so load on
+ * the shared machine hits both alike; each figure is the median of REPEATS. */
 static void photon_throughput(const char *path, uint32_t photons)
 {
     lmgi_scene *sc = NULL;
@@ -89,36 +120,16 @@ static void photon_throughput(const char *path, uint32_t photons)
     uint64_t rays = 0;
     uint32_t traced = 0, raw = 0;
     float *org = NULL, *dir = NULL;
-    for (int r = 0; r < REPEATS; r++) {
-        lm_photons *ph = NULL;
-        lm_photon_frame_stats st;
-        if (lm_photons_create(sc->scene, &sc->surfaces, sc->rt, &em, &set, &ph, &err) != LM_OK ||
-            lm_photons_trace_all(ph, &st, &err) != LM_OK) {
-            printf("%-26s failed: %s\n", path, err.msg);
-            lm_photons_free(ph);
-            lm_emitters_free(&em);
-            lmgi_free(sc);
-            return;
-        }
-        t_ph[r] = st.seconds;
-        rays = st.rays;
-        traced = lm_photons_count(ph);
-        if (r == 0) {
-            org = malloc(sizeof(float) * 3 * rays);
-            dir = malloc(sizeof(float) * 3 * rays);
-            if (org && dir) {
-                emitter_rays(sc, &em, traced, org, dir);
-                raw = bounce_rays(ph, org, dir, traced, (uint32_t)rays);
-            }
-        }
-        lm_photons_free(ph);
-    }
-    if (org && dir) {
-        for (int r = 0; r < REPEATS; r++) {
-            double t0 = lm_now();
+    int ok = 1;
+    for (int r = 0; r < REPEATS && ok; r++) {
+        t_ph[r] = trace_once(sc, &em, &set, &rays, &traced, &org, &dir, &raw);
+        ok = t_ph[r] >= 0.0 && org && dir;
+        double t0 = lm_now();
+        if (ok)
             lm_rt_raw_intersect(sc->rt, org, dir, raw);
-            t_raw[r] = lm_now() - t0;
-        }
+        t_raw[r] = lm_now() - t0;
+    }
+    if (ok) {
         double tp = median(t_ph, REPEATS), tr = median(t_raw, REPEATS);
         const char *name = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
         printf("%-26s %9u %8.1f %11.2f %11.2f %11.2f %7.0f%%\n", name, traced, 1e3 * tp, traced / tp / 1e6,
