@@ -108,6 +108,16 @@ void lmt_mesh_cube(lmt_mesh *m, float h)
         }
 }
 
+void lmt_mesh_cube_inward(lmt_mesh *m, float h)
+{
+    lmt_mesh_cube(m, h);
+    for (int t = 0; t < m->index_count; t += 3) {
+        uint16_t k = m->idx[t + 1];
+        m->idx[t + 1] = m->idx[t + 2];
+        m->idx[t + 2] = k;
+    }
+}
+
 static char *base64(const uint8_t *d, size_t n)
 {
     static const char *A = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";

@@ -58,6 +58,8 @@ typedef struct {
 void lmt_mesh_quad(lmt_mesh *m, const float corner[3], const float edge_u[3], const float edge_v[3]);
 /* Axis-aligned cube of half-size h centred at the origin, 6 faces, outward winding. */
 void lmt_mesh_cube(lmt_mesh *m, float h);
+/* The same cube seen from inside: winding turned so every face points inwards (a closed room). */
+void lmt_mesh_cube_inward(lmt_mesh *m, float h);
 
 /* Writes a .gltf at `path` with one buffer (base64 data URI) holding the meshes, and one mesh per
  * entry. `nodes_json` is the JSON array of nodes (mesh i = meshes[i]); `extra_json` is inserted at the

@@ -320,32 +320,12 @@ static void test_locality_door_open(void **state)
 
 /* ---- energy: a point light in a closed box ---- */
 
-static void inward_box(lmt_mesh *m, float h)
-{
-    memset(m, 0, sizeof *m);
-    for (int axis = 0; axis < 3; axis++)
-        for (int sign = -1; sign <= 1; sign += 2) {
-            int a1 = (axis + 1) % 3, a2 = (axis + 2) % 3;
-            float c[3], u[3] = {0, 0, 0}, v[3] = {0, 0, 0};
-            c[axis] = sign * h;
-            c[a1] = -h;
-            c[a2] = -h;
-            if (sign > 0) { /* edges swapped against lmt_mesh_cube: the normal points inwards */
-                v[a1] = 2 * h;
-                u[a2] = 2 * h;
-            } else {
-                v[a2] = 2 * h;
-                u[a1] = 2 * h;
-            }
-            lmt_mesh_quad(m, c, u, v);
-        }
-}
-
 static void test_energy_closed_box(void **state)
 {
     (void)state;
     static lmt_mesh box;
-    inward_box(&box, 1.0f);
+    memset(&box, 0, sizeof box);
+    lmt_mesh_cube_inward(&box, 1.0f);
     const char *nodes = "[{\"name\": \"root\", \"children\": [1, 2]}, {\"name\": \"box\", \"mesh\": 0},"
                         " {\"name\": \"lamp\", \"translation\": [0.2, 0.3, -0.1],"
                         "  \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";

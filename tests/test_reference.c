@@ -51,12 +51,7 @@ static const char *furnace_scene(void)
     static char path[512];
     static lmt_mesh m;
     memset(&m, 0, sizeof m);
-    lmt_mesh_cube(&m, 1.0f);
-    for (int t = 0; t < m.index_count; t += 3) { /* turn the winding inwards */
-        uint16_t k = m.idx[t + 1];
-        m.idx[t + 1] = m.idx[t + 2];
-        m.idx[t + 2] = k;
-    }
+    lmt_mesh_cube_inward(&m, 1.0f);
     const char *mat = "\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1],"
                       " \"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}],";
     snprintf(path, sizeof path, "%s/furnace.gltf", lmt_tmpdir());

@@ -1,11 +1,13 @@
 #include "bench.h"
-#include "bench_photons.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+
+#include "../core/stats.h"
+#include "bench_photons.h"
 
 /* Scenes timed when none are named: ours first, then the shared ones (skipped when absent). */
 static const char *DEFAULT_SCENES[] = {
@@ -24,17 +26,6 @@ typedef struct {
     lmgi_info info;   /* counts of the last run, timings = medians */
 } result;
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* Loads `path` a->repeats times; fills r with the median of each stage. Returns 0 on success. */
 static int time_scene(const lm_cli_args *a, const char *path, result *r)
@@ -60,7 +51,7 @@ static int time_scene(const lm_cli_args *a, const char *path, result *r)
     lmgi_timings *m = &r->info.timings;
     double *fields[STAGES] = {&m->load, &m->surfaces, &m->unwrap, &m->pack, &m->texels, &m->atlas, &m->bvh, &m->total};
     for (int s = 0; s < STAGES; s++)
-        *fields[s] = median(t[s], a->repeats);
+        *fields[s] = lm_median(t[s], a->repeats);
     return 0;
 }
 

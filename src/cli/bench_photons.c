@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "../core/qmc.h"
+#include "../core/stats.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
 #include "../photonmap/kdtree.h"
@@ -17,17 +18,6 @@
 
 #define REPEATS 5
 
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* Rays leaving the emitters as photons do (emitter chosen in proportion to its luminance), for the
  * raw-Embree baseline. */
@@ -130,7 +120,7 @@ static void photon_throughput(const char *path, uint32_t photons)
         t_raw[r] = lm_now() - t0;
     }
     if (ok) {
-        double tp = median(t_ph, REPEATS), tr = median(t_raw, REPEATS);
+        double tp = lm_median(t_ph, REPEATS), tr = lm_median(t_raw, REPEATS);
         const char *name = strrchr(path, '/') ? strrchr(path, '/') + 1 : path;
         printf("%-26s %9u %8.1f %11.2f %11.2f %11.2f %7.0f%%\n", name, traced, 1e3 * tp, traced / tp / 1e6,
                rays / tp / 1e6, raw / tr / 1e6, 100.0 * (rays / tp) / (raw / tr));
@@ -178,8 +168,8 @@ static void photon_stage_frames(const char *path, int frames)
     printf("  setup: full trace %.1f ms, all AIMs %.1f ms\n", 1e3 * setup.t_photons, 1e3 * setup.t_aim);
     printf("  median frame %.2f ms = animate + BVH %.2f, photons %.2f, AIMs %.2f "
            "(%.1f photons re-traced, %.1f AIM surfaces refreshed per frame)\n",
-           1e3 * median(t[0], frames), 1e3 * median(t[1], frames), 1e3 * median(t[2], frames),
-           1e3 * median(t[3], frames), (double)retraced / frames, (double)refreshed / frames);
+           1e3 * lm_median(t[0], frames), 1e3 * lm_median(t[1], frames), 1e3 * lm_median(t[2], frames),
+           1e3 * lm_median(t[3], frames), (double)retraced / frames, (double)refreshed / frames);
     for (int k = 0; k < 4; k++)
         free(t[k]);
     lm_photon_stage_free(stage);

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 
 #include "../core/vecmath.h"
+#include "gl_mesh.h"
 #include "gl_shader.h"
 #include "offscreen.h"
 
@@ -77,16 +78,10 @@ lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *
         glDeleteProgram(prog);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap view", s->path);
     }
-    GLuint vao, vbo, tex = upload_atlas(a, rgb);
-    glGenVertexArrays(1, &vao);
-    glBindVertexArray(vao);
-    glGenBuffers(1, &vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 15 * (size_t)s->tri_count), verts, GL_STATIC_DRAW);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 5 * sizeof(float), (void *)0);
-    glVertexAttribPointer(1, 2, GL_FLOAT, GL_FALSE, 5 * sizeof(float), (void *)(3 * sizeof(float)));
-    glEnableVertexAttribArray(0);
-    glEnableVertexAttribArray(1);
+    GLuint tex = upload_atlas(a, rgb);
+    lm_gl_mesh mesh;
+    const int sizes[2] = {3, 2}; /* position, lightmap UV */
+    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
     free(verts);
 
     lm_offscreen target;
@@ -100,12 +95,11 @@ lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *
         glUniform1i(glGetUniformLocation(prog, "atlas"), 0);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, tex);
-        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * s->tri_count));
+        lm_gl_mesh_draw(&mesh);
         st = lm_offscreen_end(&target, rgba8, err);
     }
     glDeleteTextures(1, &tex);
-    glDeleteBuffers(1, &vbo);
-    glDeleteVertexArrays(1, &vao);
+    lm_gl_mesh_destroy(&mesh);
     glDeleteProgram(prog);
     return st;
 }

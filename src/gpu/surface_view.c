@@ -8,6 +8,7 @@
 
 #include "../core/palette.h"
 #include "../core/vecmath.h"
+#include "gl_mesh.h"
 #include "gl_shader.h"
 #include "offscreen.h"
 
@@ -55,16 +56,9 @@ lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const 
         glDeleteProgram(prog);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the surface view", s->path);
     }
-    GLuint vao, vbo;
-    glGenVertexArrays(1, &vao);
-    glBindVertexArray(vao);
-    glGenBuffers(1, &vbo);
-    glBindBuffer(GL_ARRAY_BUFFER, vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 18 * (size_t)s->tri_count), verts, GL_STATIC_DRAW);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), (void *)0);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), (void *)(3 * sizeof(float)));
-    glEnableVertexAttribArray(0);
-    glEnableVertexAttribArray(1);
+    lm_gl_mesh mesh;
+    const int sizes[2] = {3, 3}; /* position, colour */
+    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
     free(verts);
 
     lm_offscreen target;
@@ -74,11 +68,10 @@ lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const 
         lm_mat4_mul(vp, view->proj, view->view);
         glUseProgram(prog);
         glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
-        glDrawArrays(GL_TRIANGLES, 0, (GLsizei)(3 * s->tri_count));
+        lm_gl_mesh_draw(&mesh);
         st = lm_offscreen_end(&target, rgba8, err);
     }
-    glDeleteBuffers(1, &vbo);
-    glDeleteVertexArrays(1, &vao);
+    lm_gl_mesh_destroy(&mesh);
     glDeleteProgram(prog);
     return st;
 }

@@ -829,8 +829,9 @@ static lm_status run_schedule(lm_aim *aim, const lm_scene *s, const lm_surfaces 
     return rc;
 }
 
-lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
-                         lm_photon_store *ps, int budget, lm_aim_stats *stats, lm_error *err)
+/* One scheduled refresh: up to `budget` changed surfaces (budget < 0: no limit), or every one. */
+static lm_status refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                         lm_photon_store *ps, int budget, int all, lm_aim_stats *stats, lm_error *err)
 {
     lm_aim_stats local;
     lm_aim_stats *st = stats ? stats : &local;
@@ -838,21 +839,19 @@ lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, 
     double t0 = lm_now();
     lm_status rc = check_inputs(aim, su, a, ps, err);
     if (rc == LM_OK)
-        rc = run_schedule(aim, s, su, a, ps, budget, 0, st, err);
+        rc = run_schedule(aim, s, su, a, ps, budget, all, st, err);
     st->seconds = lm_now() - t0;
     return rc;
+}
+
+lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                         lm_photon_store *ps, int budget, lm_aim_stats *stats, lm_error *err)
+{
+    return refresh(aim, s, su, a, ps, budget, 0, stats, err);
 }
 
 lm_status lm_aim_refresh_all(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                              lm_photon_store *ps, lm_aim_stats *stats, lm_error *err)
 {
-    lm_aim_stats local;
-    lm_aim_stats *st = stats ? stats : &local;
-    memset(st, 0, sizeof *st);
-    double t0 = lm_now();
-    lm_status rc = check_inputs(aim, su, a, ps, err);
-    if (rc == LM_OK)
-        rc = run_schedule(aim, s, su, a, ps, -1, 1, st, err);
-    st->seconds = lm_now() - t0;
-    return rc;
+    return refresh(aim, s, su, a, ps, -1, 1, stats, err);
 }
