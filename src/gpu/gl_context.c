@@ -76,3 +76,5 @@ lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err)
 
 lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx) { return ctx->backend; }
 const char *lm_gl_context_description(const lm_gl_context *ctx) { return ctx->description; }
+
+lm_gl_proc lm_gl_get_proc(const char *name) { return (lm_gl_proc)OSMesaGetProcAddress(name); }

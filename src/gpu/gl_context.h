@@ -17,5 +17,8 @@ lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err);
 lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx);
 /* "4.5 (Core Profile) Mesa 22.3.6 / llvmpipe ..." */
 const char *lm_gl_context_description(const lm_gl_context *ctx);
+/* Entry point of a GL function the library does not export directly (e.g. glClipControl); NULL if none. */
+typedef void (*lm_gl_proc)(void);
+lm_gl_proc lm_gl_get_proc(const char *name);
 
 #endif

@@ -1,0 +1,87 @@
+/* Final gathering with a single-plane hemicube (Larsen & Christensen section 4; DESIGN.md step 4).
+ *
+ * From a texel's centre, the scene is rendered through one enlarged hemicube front plane: the square
+ * [-a, a]^2 at distance 1 along the texel's normal, R x R pixels. A pixel at plane position (x, y)
+ * carries the cosine-weighted solid angle it subtends, whose density is 1 / (pi (x^2 + y^2 + 1)^2) per
+ * unit plane area (DESIGN.md's weight dA / (pi (x^2 + y^2 + 1)^2) is its midpoint rule). lmgi uses the
+ * exact integral of that density over each pixel (closed form, lm_hemicube_pixel_weight), so the
+ * weights sum to F(a) = 4/pi * a/sqrt(1+a^2) * atan(a/sqrt(1+a^2)) exactly; the midpoint rule is off by
+ * 1.4e-4 at R = 32, a = 1. The part of the hemisphere outside the plane (1 - F(a): 17% at a = 2) is not
+ * seen and is assumed to look like the rest:
+ *
+ *     E = pi * sum(w L) / F(a)                (a uniform sky of radiance L gives exactly pi L)
+ *
+ * What the plane shows (DESIGN.md "What an IIM holds"): each surface at its AIM radiance (the AIM
+ * atlas, dilated into the gutters, sampled bilinearly with the lightmap UVs) plus its material's
+ * emitted radiance (an AIM holds only reflected light); mirror and glass triangles, which have no AIM,
+ * as black (they still occlude); the back of a single-sided surface as black; nothing hit as the sky
+ * radiance. Back faces (face normal . view direction > 0, single-sided materials only) are counted by
+ * weight: a texel whose back-face fraction is above backface_limit sees the inside of geometry and is
+ * invalid (the caller fills it from valid neighbours).
+ *
+ * GPU work: a batch of up to tiles^2 texels is rendered into one RGBA32F target, one R x R viewport
+ * tile per texel (rgb = radiance, a = 1 on back faces), with reversed float depth (no far plane). A
+ * compute shader then sums each tile with the weights in float, in a fixed order (deterministic), and
+ * writes (E, back-face fraction) with imageStore straight into the texel of an atlas-sized RGBA32F IIM
+ * texture. Nothing is read back in the gather; lm_iim_texture_read is for tests and output. */
+#ifndef LM_HEMICUBE_H
+#define LM_HEMICUBE_H
+
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../scene/scene.h"
+
+typedef struct {
+    int resolution;        /* R, pixels per side of the plane (default 32) */
+    float enlargement;     /* a, half-side of the plane at distance 1 (default 2: F = 0.831) */
+    float sky[3];          /* radiance where nothing is hit (default 0) */
+    float backface_limit;  /* back-face weight fraction above which a texel is invalid (default 0.1) */
+    float offset;          /* texel centre lifted along its normal by this x scene size (default 1e-4) */
+    int tiles;             /* tiles per side of the render target: tiles^2 texels per pass (default 16) */
+} lm_hemicube_settings;
+
+void lm_hemicube_settings_default(lm_hemicube_settings *s);
+
+/* F(a): the fraction of the cosine-weighted hemisphere the plane covers (closed form). */
+double lm_hemicube_coverage(double a);
+/* Exact weight of pixel (i, j) (i along x, 0 at x = -a) of an R x R plane of half-side a. */
+double lm_hemicube_pixel_weight(int R, double a, int i, int j);
+/* DESIGN.md's midpoint weight dA / (pi (x^2 + y^2 + 1)^2) at the pixel's centre. */
+double lm_hemicube_pixel_weight_midpoint(int R, double a, int i, int j);
+/* Sum of the exact (midpoint = 0) or midpoint (midpoint = 1) weights over all R^2 pixels. */
+double lm_hemicube_weight_sum(int R, double a, int midpoint);
+/* Form factor from a differential area at the origin facing +z to the rectangle [x0,x1] x [y0,y1] in the
+ * parallel plane at distance d (closed form; a coaxial square of half-side p: F = coverage(p / d)). */
+double lm_form_factor_rect(double x0, double x1, double y0, double y1, double d);
+
+typedef struct lm_gather lm_gather;
+
+typedef struct {
+    uint32_t texels;       /* texels gathered */
+    int passes;            /* render + reduce passes */
+    double seconds;        /* wall time including glFinish */
+} lm_gather_stats;
+
+/* Compiles the programs and makes the tiled target. Needs a current GL 4.5 context. */
+lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_error *err);
+void lm_gather_free(lm_gather *g);
+const lm_hemicube_settings *lm_gather_settings(const lm_gather *g);
+/* Uploads every triangle in world space under the current node matrices, with lightmap UVs, emitted
+ * radiance and face normals. Call again after nodes move. */
+lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err);
+/* Uploads the AIM (atlas-sized RGB radiance, width*height*3 floats), dilated into the gutters. */
+lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err);
+/* Gathers texels (indices into a->texels) into iim_tex (an RGBA32F texture of the atlas's size, from
+ * lm_iim_texture_create): rgb = indirect irradiance E, a = back-face fraction. stats may be NULL. */
+lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
+                           uint32_t count, unsigned iim_tex, lm_gather_stats *stats, lm_error *err);
+
+/* An atlas-sized RGBA32F texture, cleared to 0. Returns 0 on failure. */
+unsigned lm_iim_texture_create(int width, int height);
+void lm_iim_texture_free(unsigned tex);
+/* Reads the whole texture back: width*height*4 floats, row y at offset 4 * (y * width + x). */
+lm_status lm_iim_texture_read(unsigned tex, int width, int height, float *rgba, lm_error *err);
+
+#endif
