@@ -18,6 +18,9 @@ typedef struct {
 /* Samples an outgoing direction from three uniform numbers in [0,1). Returns 0 if the sample is
  * absorbed or invalid (below the surface for a reflective lobe). */
 int lm_bsdf_sample(const lm_shading *sh, const float wi[3], const float u[3], lm_bsdf_sample_t *out);
+/* How many of lm_bsdf_sample's numbers the material reads, u[0 .. n): 0 mirror, 1 glass, 2 diffuse
+ * and emitter, 3 glossy. The others may be left unset (a photon then skips computing them). */
+int lm_bsdf_sample_dims(const lm_shading *sh);
 /* f(wi -> wo) * |cos(ns, wo)| for the non-specular part (0 for mirror and glass). */
 void lm_bsdf_eval(const lm_shading *sh, const float wi[3], const float wo[3], float out[3]);
 /* Luminance of the albedo, the Russian-roulette survival probability before a bounce, in (0, 1]. */

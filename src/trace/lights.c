@@ -148,13 +148,18 @@ static lm_vec3 tri_world(const lm_scene *s, uint32_t t, lm_vec3 p[3])
     return lm_cross(lm_sub(p[1], p[0]), lm_sub(p[2], p[0]));
 }
 
-/* Flux of one emissive triangle: pi Le A per emitting side. */
-static void tri_flux(const lm_scene *s, uint32_t t, float out[3])
+/* Flux of one emissive triangle of world area `area`: pi Le A per emitting side. */
+static void tri_flux_of_area(const lm_scene *s, uint32_t t, float area, float out[3])
 {
     const lm_material *m = &s->materials[s->tri_material[t]];
-    float f = (float)LM_PI * lm_scene_tri_area_world(s, t) * (m->double_sided ? 2.0f : 1.0f);
+    float f = (float)LM_PI * area * (m->double_sided ? 2.0f : 1.0f);
     for (int c = 0; c < 3; c++)
         out[c] = m->emissive[c] * f;
+}
+
+static void tri_flux(const lm_scene *s, uint32_t t, float out[3])
+{
+    tri_flux_of_area(s, t, lm_scene_tri_area_world(s, t), out);
 }
 
 static void place_area(lm_emitter *e, const lm_scene *s)
@@ -239,7 +244,10 @@ static void emit_area(const lm_emitters *em, const lm_scene *s, const lm_emitter
     float rest, prob;
     uint32_t k = pick_tri(e, u[2], &rest, &prob);
     uint32_t t = e->tris[k];
-    lm_vec3 p[3], n = lm_normalize(tri_world(s, t, p));
+    /* The area comes from the same cross product as the normal (lm_scene_tri_area_world's formula):
+     * emission runs once per photon, and placing the vertices again was a sizeable share of it. */
+    lm_vec3 p[3], cr = tri_world(s, t, p), n = lm_normalize(cr);
+    float area = 0.5f * lm_length(cr);
     if (s->materials[s->tri_material[t]].double_sided) { /* leftover picks the side */
         int back = rest >= 0.5f;
         rest = back ? 2.0f * rest - 1.0f : 2.0f * rest;
@@ -251,7 +259,7 @@ static void emit_area(const lm_emitters *em, const lm_scene *s, const lm_emitter
     lm_v3_store(out->org, lm_add(x, lm_scale(n, LM_EMIT_LIFT * lm_scene_size(s))));
     lm_v3_store(out->dir, d);
     float f[3];
-    tri_flux(s, t, f);
+    tri_flux_of_area(s, t, area, f);
     for (int c = 0; c < 3; c++)
         out->flux[c] = prob > 0.0f ? f[c] / (prob * (float)count) : 0.0f;
 }

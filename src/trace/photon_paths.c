@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/prefault.h"
 #include "../core/vecmath.h"
 #include "photons_internal.h"
 
@@ -75,6 +76,7 @@ static int reserve_verts(lm_path_vertex **verts, uint32_t *cap, uint32_t need, i
     lm_path_vertex *v = realloc(*verts, (size_t)n * sizeof *v);
     if (!v)
         return 0;
+    lm_prefault(v + *cap, (size_t)(n - *cap) * sizeof *v); /* about to be written: map it in at once */
     *verts = v;
     *cap = n;
     return 1;

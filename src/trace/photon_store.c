@@ -3,6 +3,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/prefault.h"
+
 lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error *err)
 {
     memset(ps, 0, sizeof *ps);
@@ -60,7 +62,13 @@ static int grow(lm_photon_store *ps, uint64_t need)
     return 1;
 }
 
-int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n) { return grow(ps, ps->used + n); }
+int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n)
+{
+    if (!grow(ps, ps->used + n))
+        return 0;
+    lm_prefault(ps->hits + ps->used, sizeof *ps->hits * n); /* the batch's adds fill these next */
+    return 1;
+}
 
 static uint32_t take_slot(lm_photon_store *ps)
 {

@@ -10,6 +10,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/prefault.h"
 #include "../core/qmc.h"
 #include "../core/vecmath.h"
 #include "bsdf.h"
@@ -54,6 +55,7 @@ static int buffer_reserve(ph_buffer *buf)
     ph_vertex *v = realloc(buf->v, cap * sizeof *v);
     if (!v)
         return 0;
+    lm_prefault(v + buf->cap, (cap - buf->cap) * sizeof *v); /* a batch fills what it grew for */
     buf->v = v;
     buf->cap = cap;
     return 1;
@@ -81,11 +83,17 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
                    float dir[3], float flux[3])
 {
     uint32_t d = PH_EMIT_DIMS + PH_DIMS_PER_BOUNCE * b;
-    float p = lm_bsdf_survival(sh), u[3];
-    photon_samples(ph, id, d + 3, 1, u);
-    if (u[0] >= p)
-        return 0;
-    photon_samples(ph, id, d, 3, u);
+    float p = lm_bsdf_survival(sh), u[3] = {0.0f, 0.0f, 0.0f};
+    /* Only the numbers that decide something are computed (QMC is a large share of a trace): no
+     * roulette draw where survival is certain (u < 1 always), no BSDF number the material ignores. */
+    if (p < 1.0f) {
+        photon_samples(ph, id, d + 3, 1, u);
+        if (u[0] >= p)
+            return 0;
+    }
+    uint32_t n = (uint32_t)lm_bsdf_sample_dims(sh);
+    if (n)
+        photon_samples(ph, id, d, n, u);
     lm_bsdf_sample_t bs;
     if (!lm_bsdf_sample(sh, dir, u, &bs))
         return 0;
