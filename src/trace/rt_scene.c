@@ -15,7 +15,7 @@ struct lm_rt {
     RTCScene top;
     const lm_scene *scene;
     const int *tri_surface;     /* from surfaces, or NULL */
-    unsigned static_geom;       /* geomID of the static triangles in top, RTC_INVALID_GEOMETRY_ID if none */
+    unsigned static_inst;       /* instance geomID of the static scene in top, RTC_INVALID_GEOMETRY_ID if none */
     uint32_t static_count;
     uint32_t *static_tri;       /* static primID -> scene triangle */
     int instance_count;
@@ -78,7 +78,7 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
     for (int n = 0; n < s->node_count; n++)
         if (!s->nodes[n].dynamic)
             rt->static_count += s->nodes[n].tri_count;
-    rt->static_geom = RTC_INVALID_GEOMETRY_ID;
+    rt->static_inst = RTC_INVALID_GEOMETRY_ID;
     if (rt->static_count == 0)
         return LM_OK;
     rt->static_tri = malloc(sizeof(uint32_t) * rt->static_count);
@@ -92,8 +92,23 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
     RTCGeometry g = make_triangles(rt, s, rt->static_tri, rt->static_count, 1);
     if (!g)
         return fail_backend(rt, err, s->path);
-    rt->static_geom = rtcAttachGeometry(rt->top, g);
+    /* The static triangles get a scene of their own, placed once with the identity: a top-level
+     * commit after a dynamic node moves then rebuilds only the tree over the instances, never the
+     * static triangles' BVH. */
+    RTCScene world = rtcNewScene(rt->device);
+    rtcSetSceneFlags(world, RTC_SCENE_FLAG_ROBUST);
+    rtcAttachGeometry(world, g);
     rtcReleaseGeometry(g);
+    rtcCommitScene(world);
+    float identity[16];
+    lm_mat4_identity(identity);
+    RTCGeometry inst = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, world);
+    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, identity);
+    rtcCommitGeometry(inst);
+    rt->static_inst = rtcAttachGeometry(rt->top, inst);
+    rtcReleaseGeometry(inst);
+    rtcReleaseScene(world);
     return LM_OK;
 }
 
@@ -262,7 +277,7 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
         return 0;
     lm_vec3 ng = lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
     unsigned inst = rh.hit.instID[0];
-    if (inst != RTC_INVALID_GEOMETRY_ID) {
+    if (inst != rt->static_inst) {
         int node = rt->inst_node[inst];
         hit->node = node;
         hit->tri = rt->scene->nodes[node].first_tri + rh.hit.primID;

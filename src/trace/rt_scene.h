@@ -1,8 +1,9 @@
 /* The Embree scene used for every ray lmgi traces.
  *
- * Static nodes' triangles go, in world space, into one triangle geometry of the top-level scene.
- * Each dynamic node gets its own Embree scene in node-local space, placed in the top level as an
- * instance; moving the node is one transform update and one top-level commit (O(1) in the node's size).
+ * Static nodes' triangles go, in world space, into one Embree scene placed in the top level as an
+ * instance with the identity. Each dynamic node gets its own Embree scene in node-local space, placed
+ * in the top level as an instance; moving the node is one transform update and one top-level commit,
+ * which rebuilds only the small tree over the instances: O(1) in the scene's triangle count.
  * Hits report the node, the scene triangle id, its surface and a world-space geometric normal. */
 #ifndef LM_RT_SCENE_H
 #define LM_RT_SCENE_H
