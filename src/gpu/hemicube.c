@@ -18,6 +18,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->backface_limit = 0.1f;
     s->offset = 1e-4f;
     s->tiles = 16;
+    s->proxy_error = LM_PROXY_DEFAULT_ERROR;
 }
 
 /* Integral of 1 / (pi (1 + x^2 + y^2)^2) over [0, X] x [0, Y] (odd in X and in Y). */

@@ -15,7 +15,8 @@
  * atlas, dilated into the gutters, sampled bilinearly with the lightmap UVs) plus its material's
  * emitted radiance (an AIM holds only reflected light); mirror and glass triangles, which have no AIM,
  * as black (they still occlude); the back of a single-sided surface as black; nothing hit as the sky
- * radiance. Back faces (face normal . view direction > 0, single-sided materials only) are counted by
+ * radiance; the back of the texel's own surface is skipped (only a simplified copy of it can rise above
+ * the texel). Back faces (face normal . view direction > 0, single-sided materials only) are counted by
  * weight: a texel whose back-face fraction is above backface_limit sees the inside of geometry and is
  * invalid (the caller fills it from valid neighbours).
  *
@@ -23,13 +24,15 @@
  * tile per texel (rgb = radiance, a = 1 on back faces), with reversed float depth (no far plane). A
  * compute shader then sums each tile with the weights in float, in a fixed order (deterministic), and
  * writes (E, back-face fraction) with imageStore straight into the texel of an atlas-sized RGBA32F IIM
- * texture. Nothing is read back in the gather; lm_iim_texture_read is for tests and output. */
+ * texture. Nothing is read back in the gather; lm_iim_texture_read is for tests and output.
+ * With proxy_error > 0 the plane shows the gather proxy (charts/proxy.h) instead of every triangle. */
 #ifndef LM_HEMICUBE_H
 #define LM_HEMICUBE_H
 
 #include <stdint.h>
 
 #include "../charts/charts.h"
+#include "../charts/proxy.h"
 #include "../core/error.h"
 #include "../scene/scene.h"
 
@@ -40,6 +43,7 @@ typedef struct {
     float backface_limit;  /* back-face weight fraction above which a texel is invalid (default 0.1) */
     float offset;          /* texel centre lifted along its normal by this x scene size (default 1e-4) */
     int tiles;             /* tiles per side of the render target: tiles^2 texels per pass (default 16) */
+    float proxy_error;     /* gather proxy's error bound x scene size (default 0.005; 0: the full scene) */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);
@@ -69,8 +73,11 @@ lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_
 void lm_gather_free(lm_gather *g);
 const lm_hemicube_settings *lm_gather_settings(const lm_gather *g);
 /* Uploads every triangle in world space under the current node matrices, with lightmap UVs, emitted
- * radiance and face normals. Call again after nodes move. */
+ * radiance and face normals. Call again after nodes move. With proxy_error > 0 the triangles are those
+ * of the gather proxy (proxy.h), built on the first call for (s, a) and kept for later calls. */
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err);
+/* The proxy the gather draws; NULL when proxy_error is 0 or before lm_gather_set_scene. */
+const lm_proxy *lm_gather_proxy(const lm_gather *g);
 /* Uploads the AIM (atlas-sized RGB radiance, width*height*3 floats), dilated into the gutters. */
 lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err);
 /* Gathers texels (indices into a->texels) into iim_tex (an RGBA32F texture of the atlas's size, from

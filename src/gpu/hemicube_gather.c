@@ -16,8 +16,9 @@
 #include "gl_mesh.h"
 #include "gl_shader.h"
 
-/* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided. */
-#define VERTEX_FLOATS 12
+/* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided,
+ * surface (-1 when none). */
+#define VERTEX_FLOATS 13
 
 static const char *RENDER_VS =
     "#version 450 core\n"
@@ -26,21 +27,28 @@ static const char *RENDER_VS =
     "layout(location = 2) in vec3 emit;\n"
     "layout(location = 3) in vec3 face_n;\n"
     "layout(location = 4) in float one_sided;\n"
+    "layout(location = 5) in float surface;\n"
     "uniform mat4 view_proj;\n"
-    "out vec3 v_pos; out vec2 v_uv; flat out vec3 v_emit; flat out vec3 v_n; flat out float v_one;\n"
+    "out vec3 v_pos; out vec2 v_uv; flat out vec3 v_emit; flat out vec3 v_n; flat out float v_one, v_surf;\n"
     "void main() {\n"
-    "    v_pos = pos; v_uv = uv; v_emit = emit; v_n = face_n; v_one = one_sided;\n"
+    "    v_pos = pos; v_uv = uv; v_emit = emit; v_n = face_n; v_one = one_sided; v_surf = surface;\n"
     "    gl_Position = view_proj * vec4(pos, 1.0);\n"
     "}\n";
-/* rgb: what the plane sees; a: 1 on the back of a single-sided surface (counted, shown black). */
+/* rgb: what the plane sees; a: 1 on the back of a single-sided surface (counted, shown black). The back
+ * of the texel's own surface is skipped: a surface stays within a 30 degree cone, so only a simplified
+ * (proxy) copy of it can pass above the texel. */
 static const char *RENDER_FS =
     "#version 450 core\n"
-    "in vec3 v_pos; in vec2 v_uv; flat in vec3 v_emit; flat in vec3 v_n; flat in float v_one;\n"
+    "in vec3 v_pos; in vec2 v_uv; flat in vec3 v_emit; flat in vec3 v_n; flat in float v_one, v_surf;\n"
     "uniform sampler2D aim;\n"
     "uniform vec3 eye;\n"
+    "uniform float own_surface;\n"
     "out vec4 frag;\n"
     "void main() {\n"
-    "    if (v_one > 0.5 && dot(v_n, v_pos - eye) > 0.0) { frag = vec4(0.0, 0.0, 0.0, 1.0); return; }\n"
+    "    if (dot(v_n, v_pos - eye) > 0.0) {\n"
+    "        if (v_surf >= 0.0 && v_surf == own_surface) discard;\n"
+    "        if (v_one > 0.5) { frag = vec4(0.0, 0.0, 0.0, 1.0); return; }\n"
+    "    }\n"
     "    vec3 L = v_uv.x < 0.0 ? vec3(0.0) : texture(aim, v_uv).rgb;\n"
     "    frag = vec4(L + v_emit, 0.0);\n"
     "}\n";
@@ -81,6 +89,10 @@ struct lm_gather {
     int aim_w, aim_h;
     lm_gl_mesh mesh;
     int has_mesh;
+    lm_proxy proxy;        /* with has_proxy: built for proxy_scene, proxy_atlas */
+    int has_proxy;
+    const lm_scene *proxy_scene;
+    const lm_atlas *proxy_atlas;
     double coverage;
 };
 
@@ -132,6 +144,7 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
     GLint max_side = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_side);
     if (s->resolution < 2 || s->tiles < 1 || !(s->enlargement > 0.0f) || !(s->offset >= 0.0f) ||
+        !(s->proxy_error >= 0.0f && s->proxy_error < 1.0f) ||
         (long)s->resolution * s->tiles > max_side)
         return lm_fail(err, LM_ERR_INVALID, "hemicube settings out of range (resolution %d, tiles %d, a %g)",
                        s->resolution, s->tiles, (double)s->enlargement);
@@ -170,6 +183,8 @@ void lm_gather_free(lm_gather *g)
         return;
     if (g->has_mesh)
         lm_gl_mesh_destroy(&g->mesh);
+    if (g->has_proxy)
+        lm_proxy_free(&g->proxy);
     GLuint bufs[2] = {g->weights_buf, g->targets_buf};
     glDeleteBuffers(2, bufs);
     glDeleteTextures(1, &g->aim_tex);
@@ -183,40 +198,89 @@ void lm_gather_free(lm_gather *g)
 
 const lm_hemicube_settings *lm_gather_settings(const lm_gather *g) { return &g->set; }
 
-/* One triangle's three vertices (VERTEX_FLOATS each). */
-static void triangle_vertices(const lm_scene *s, const lm_atlas *a, uint32_t t, float *o)
+/* One triangle's three vertices (VERTEX_FLOATS each) from world positions, lightmap UVs (NULL: no
+ * AIM, drawn black: mirror, glass) and its material. */
+static void write_triangle(const float p[3][3], const float *uv[3], const lm_material *m, int surface, float *o)
 {
-    float p[3][3];
-    for (int k = 0; k < 3; k++)
-        lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], p[k]);
     lm_vec3 n = lm_cross(lm_sub(lm_v3_load(p[1]), lm_v3_load(p[0])), lm_sub(lm_v3_load(p[2]), lm_v3_load(p[0])));
     float len = lm_length(n);
     n = len > 0.0f ? lm_scale(n, 1.0f / len) : lm_v3(0, 0, 0);
-    const lm_material *m = &s->materials[s->tri_material[t]];
     for (int k = 0; k < 3; k++) {
         float *v = o + VERTEX_FLOATS * k;
-        const float *uv = a->corner_uv + 6 * (size_t)t + 2 * k;
-        int none = a->tri_chart[t] < 0 || !isfinite(uv[0]); /* mirror, glass: no AIM, black */
-        memcpy(v, p[k], sizeof p[k]);
-        v[3] = none ? -1.0f : uv[0];
-        v[4] = none ? -1.0f : uv[1];
+        memcpy(v, p[k], 3 * sizeof(float));
+        v[3] = uv[k] ? uv[k][0] : -1.0f;
+        v[4] = uv[k] ? uv[k][1] : -1.0f;
         memcpy(v + 5, m->emissive, 3 * sizeof(float));
         lm_v3_store(v + 8, n);
         v[11] = m->double_sided ? 0.0f : 1.0f;
+        v[12] = (float)surface;
     }
 }
 
+static void scene_triangle(const lm_scene *s, const lm_atlas *a, uint32_t t, float *o)
+{
+    float p[3][3];
+    const float *uv[3];
+    for (int k = 0; k < 3; k++) {
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], p[k]);
+        uv[k] = a->corner_uv + 6 * (size_t)t + 2 * k;
+        if (a->tri_chart[t] < 0 || !isfinite(uv[k][0]))
+            uv[k] = NULL;
+    }
+    int c = a->tri_chart[t];
+    write_triangle(p, uv, &s->materials[s->tri_material[t]], c < 0 ? -1 : a->charts[c].surface, o);
+}
+
+static void proxy_triangle(const lm_scene *s, const lm_atlas *a, const lm_proxy *px, uint32_t t, float *o)
+{
+    float p[3][3];
+    const float *uv[3];
+    for (int k = 0; k < 3; k++) {
+        uint32_t v = px->tris[3 * (size_t)t + k];
+        lm_proxy_vertex_world(s, px, px->tri_node[t], v, p[k]);
+        uv[k] = px->vertices[v].chart < 0 ? NULL : px->vertices[v].uv;
+    }
+    const lm_proxy_vertex *v0 = &px->vertices[px->tris[3 * (size_t)t]];
+    write_triangle(p, uv, &s->materials[v0->material], v0->chart < 0 ? -1 : a->charts[v0->chart].surface, o);
+}
+
+/* Builds the proxy once per (scene, atlas); proxy_error 0 drops it. */
+static lm_status ensure_proxy(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err)
+{
+    if (g->has_proxy && g->proxy_scene == s && g->proxy_atlas == a && g->proxy.source_tris == s->tri_count)
+        return LM_OK;
+    if (g->has_proxy)
+        lm_proxy_free(&g->proxy);
+    g->has_proxy = 0;
+    if (!(g->set.proxy_error > 0.0f))
+        return LM_OK;
+    lm_status st = lm_proxy_build(s, a, g->set.proxy_error, &g->proxy, err);
+    if (st == LM_OK)
+        g->has_proxy = 1, g->proxy_scene = s, g->proxy_atlas = a;
+    return st;
+}
+
+const lm_proxy *lm_gather_proxy(const lm_gather *g) { return g->has_proxy ? &g->proxy : NULL; }
+
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
-    float *v = malloc(sizeof(float) * 3 * VERTEX_FLOATS * (size_t)(s->tri_count ? s->tri_count : 1));
+    lm_status st = ensure_proxy(g, s, a, err);
+    if (st != LM_OK)
+        return st;
+    uint32_t count = g->has_proxy ? g->proxy.tri_count : s->tri_count;
+    float *v = malloc(sizeof(float) * 3 * VERTEX_FLOATS * (size_t)(count ? count : 1));
     if (!v)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the gather geometry", s->path);
-    for (uint32_t t = 0; t < s->tri_count; t++)
-        triangle_vertices(s, a, t, v + 3 * VERTEX_FLOATS * (size_t)t);
+    for (uint32_t t = 0; t < count; t++) {
+        if (g->has_proxy)
+            proxy_triangle(s, a, &g->proxy, t, v + 3 * VERTEX_FLOATS * (size_t)t);
+        else
+            scene_triangle(s, a, t, v + 3 * VERTEX_FLOATS * (size_t)t);
+    }
     if (g->has_mesh)
         lm_gl_mesh_destroy(&g->mesh);
-    const int sizes[5] = {3, 2, 3, 3, 1};
-    lm_gl_mesh_create(&g->mesh, v, (int)(3 * s->tri_count), sizes, 5);
+    const int sizes[6] = {3, 2, 3, 3, 1, 1};
+    lm_gl_mesh_create(&g->mesh, v, (int)(3 * count), sizes, 6);
     g->has_mesh = 1;
     free(v);
     return lm_gl_check("hemicube gather: scene upload", err);
@@ -297,6 +361,7 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
     GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
+    GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
     for (uint32_t i = 0; i < count; i++) {
         const lm_texel *tx = &a->texels[texels[i]];
         lm_vec3 p, n;
@@ -306,6 +371,7 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
         plane_view_proj(e, n, g->set.enlargement, near, m);
         glUniformMatrix4fv(vp_loc, 1, GL_FALSE, m);
         glUniform3f(eye_loc, e.x, e.y, e.z);
+        glUniform1f(own_loc, (float)tx->surface);
         glViewport((int)(i % (uint32_t)T) * R, (int)(i / (uint32_t)T) * R, R, R);
         lm_gl_mesh_draw(&g->mesh);
         xy[2 * i] = tx->x, xy[2 * i + 1] = tx->y;
