@@ -248,6 +248,18 @@ void lmt_pipeline_free(lmt_pipeline *p)
     lm_scene_free(p->s);
 }
 
+void lmt_reference_texels(const lmt_pipeline *p, float target_error, lm_ref_result *out)
+{
+    lm_ref_settings rs;
+    lm_ref_settings_default(&rs);
+    rs.target_error = target_error;
+    rs.use_cache = 0;
+    rs.progress = 0;
+    lm_error err;
+    if (lm_reference_texels(p->s, &p->atlas, p->rt, &p->em, &rs, out, &err) != LM_OK)
+        fail_msg("reference: %s", err.msg);
+}
+
 const char *lmt_plane_scene(void)
 {
     static char path[512];

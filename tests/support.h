@@ -40,6 +40,11 @@ typedef struct {
 void lmt_pipeline_load(lmt_pipeline *p, const char *path, float texel_size);
 void lmt_pipeline_free(lmt_pipeline *p);
 
+/* Reference texels for a loaded pipeline at a relative standard error target, uncached and quiet
+ * (a test must not depend on a cache a previous run left); fails the test on error. */
+#include "../src/trace/reference.h"
+void lmt_reference_texels(const lmt_pipeline *p, float target_error, lm_ref_result *out);
+
 /* A 20 x 20 plane (y = 0, facing up, default 0.8 grey material) under a point light of intensity 10 at
  * height 2, written to a fresh temporary directory; returns its path (static storage). */
 const char *lmt_plane_scene(void);

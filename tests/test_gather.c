@@ -407,16 +407,9 @@ static void test_cornell_box_against_reference(void **state)
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
     lmt_pipeline p;
     lmt_pipeline_load(&p, path, 40.0f);
-    lm_ref_settings rs;
-    lm_ref_settings_default(&rs);
-    rs.target_error = 0.05f;
-    rs.use_cache = 0;
-    rs.progress = 0;
     lm_ref_result ref;
-    lm_error err;
     double t0 = lm_now();
-    if (lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &rs, &ref, &err) != LM_OK)
-        fail_msg("%s", err.msg);
+    lmt_reference_texels(&p, 0.05f, &ref);
     double t_ref = lm_now() - t0;
     lm_photon_stage *st = stage_for(&p, 200000);
     uint32_t *texels = all_texels(&p.atlas);

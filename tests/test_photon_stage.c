@@ -114,15 +114,8 @@ static void test_cornell_box_aims_against_reference(void **state)
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
     lmt_pipeline p;
     lmt_pipeline_load(&p, path, 20.0f);
-    lm_ref_settings rs;
-    lm_ref_settings_default(&rs);
-    rs.target_error = 0.05f;
-    rs.use_cache = 0;
-    rs.progress = 0;
     lm_ref_result ref;
-    lm_error err;
-    if (lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &rs, &ref, &err) != LM_OK)
-        fail_msg("%s", err.msg);
+    lmt_reference_texels(&p, 0.05f, &ref);
     lm_photon_stage *st = stage_for(&p, 200000);
     const float *rgb = lm_aim_rgb(lm_photon_stage_aim(st));
     float *est = malloc(sizeof(float) * 3 * p.atlas.texel_count);
