@@ -1,0 +1,417 @@
+/* gpu/direct: direct light per pixel with shadow maps. A point light over a plane against
+ * rho/pi I cos/d^2, a box's shadow (umbra black, outside lit), a grazing directional light without
+ * acne (and with acne when the bias is off), a spot light's cone falloff against lm_spot_attenuation,
+ * a contact shadow, the glossy lobe against lm_bsdf_eval, the base colour texture against
+ * lm_material_albedo, and determinism. Orthographic camera looking straight down at a 4 x 4 patch of
+ * the plane, 64 x 64 pixels. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/core/vecmath.h"
+#include "../src/gpu/direct.h"
+#include "../src/gpu/gl_context.h"
+#include "../src/trace/bsdf.h"
+#include "../src/trace/lights.h"
+#include "support.h"
+
+#define PI 3.14159265358979323846
+#define W 64
+#define HALF 2.0f   /* the camera sees x, z in [-HALF, HALF] */
+#define RHO 0.8     /* the default material's albedo */
+
+static lm_gl_context *g_ctx;
+
+static int setup(void **state)
+{
+    (void)state;
+    lm_error err;
+    if (lm_gl_context_create(&g_ctx, &err) != LM_OK) {
+        fprintf(stderr, "GL context: %s\n", err.msg);
+        return -1;
+    }
+    return 0;
+}
+
+static int teardown(void **state)
+{
+    (void)state;
+    lm_gl_context_destroy(g_ctx);
+    return 0;
+}
+
+/* Looking down -Y from y = 5: image x = world x, image up = world -z. */
+static void top_view(lm_view *v)
+{
+    memset(v, 0, sizeof *v);
+    lm_mat4_look_at(v->view, lm_v3(0, 5, 0), lm_v3(0, 0, 0), lm_v3(0, 0, -1));
+    lm_mat4_identity(v->proj);
+    v->proj[0] = v->proj[5] = 1.0f / HALF;
+    v->proj[10] = -2.0f / 9.9f;
+    v->proj[14] = -10.1f / 9.9f; /* near 0.1, far 10 */
+    v->eye[1] = 5.0f;
+}
+
+/* World x, z of pixel (i, row r from the top). */
+static void pixel_xz(int i, int r, double *x, double *z)
+{
+    *x = (-1.0 + (2.0 * i + 1.0) / W) * HALF;
+    *z = (1.0 - (2.0 * r + 1.0) / W) * HALF * -1.0;
+}
+
+/* Changes the scene after loading (NULL: none). */
+typedef void (*scene_edit)(lm_scene *s);
+
+static float *render_edit(const char *path, const lm_direct_settings *set, scene_edit edit)
+{
+    lm_scene *s = NULL;
+    lm_emitters em;
+    lm_error err;
+    lm_load_options opt = {0};
+    assert_int_equal(lm_scene_load_gltf(path, &opt, &s, &err), LM_OK);
+    if (edit)
+        edit(s);
+    assert_int_equal(lm_emitters_build(s, &em, &err), LM_OK);
+    lm_emitters_update(&em, s);
+    lm_view v;
+    top_view(&v);
+    float *rgb = malloc(sizeof(float) * 3 * W * W);
+    assert_non_null(rgb);
+    lm_status st = lm_render_direct(s, &em, &v, W, W, set, rgb, &err);
+    if (st != LM_OK)
+        fail_msg("render: %s", err.msg);
+    lm_emitters_free(&em);
+    lm_scene_free(s);
+    return rgb;
+}
+
+static float *render_with(const char *path, const lm_direct_settings *set)
+{
+    return render_edit(path, set, NULL);
+}
+
+static float *render(const char *path) { return render_with(path, NULL); }
+
+static const char *scene_box_at(const char *name, int box, float box_y, const char *light_node,
+                                const char *light);
+
+/* The plane of lmt_plane_scene, an optional box and one light (node json, light json). */
+static const char *scene_with(const char *name, int box, const char *light_node, const char *light)
+{
+    return scene_box_at(name, box, 1.0f, light_node, light);
+}
+
+/* As scene_with, the box centred at (0.5, box_y, 0). */
+static const char *scene_box_at(const char *name, int box, float box_y, const char *light_node, const char *light)
+{
+    static char path[512];
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    lmt_mesh_cube(&m[1], 0.25f);
+    char nodes[1024], ext[512], box_node[128];
+    snprintf(box_node, sizeof box_node, ", {\"mesh\": 1, \"translation\": [0.5, %.6f, 0]}", box_y);
+    snprintf(nodes, sizeof nodes, "[{\"children\": [1, 2%s]}, {\"mesh\": 0}, %s%s]", box ? ", 3" : "", light_node,
+             box ? box_node : "");
+    snprintf(ext, sizeof ext,
+             "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+             " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [%s]}},", light);
+    snprintf(path, sizeof path, "%s/%s.gltf", lmt_tmpdir(), name);
+    if (lmt_write_gltf(path, m, box ? 2 : 1, nodes, NULL, 0, ext) != 0)
+        fail_msg("cannot write %s", path);
+    return path;
+}
+
+static double lum(const float *p) { return (p[0] + p[1] + p[2]) / 3.0; }
+
+static double rel(double got, double want) { return fabs(got - want) / want; }
+
+/* (a) rho/pi I h / d^3 under a point light of I = 10 at height 2. */
+static void test_point_plane(void **state)
+{
+    (void)state;
+    float *rgb = render(lmt_plane_scene());
+    double worst = 0.0, centre = 0.0;
+    for (int i = W / 2; i < W; i += 3) {
+        double x, z;
+        pixel_xz(i, W / 2, &x, &z);
+        double d2 = x * x + z * z + 4.0, want = RHO / PI * 10.0 * 2.0 / (d2 * sqrt(d2));
+        double e = rel(lum(rgb + 3 * (W / 2 * W + i)), want);
+        if (i == W / 2)
+            centre = e;
+        worst = fmax(worst, e);
+    }
+    print_message("point light: centre error %.2e, worst along the line %.2e\n", centre, worst);
+    assert_true(centre < 0.02);
+    assert_true(worst < 0.03);
+    free(rgb);
+}
+
+/* Does the segment from plane point (x, 0, z) to the light (0, 2, 0) pass through the box centred at
+ * (0.5, 1, 0) with half-size h? (slab test) */
+static int hits_box(double x, double z, double h)
+{
+    double o[3] = {x, 0, z}, d[3] = {-x, 2, -z}, c[3] = {0.5, 1, 0}, t0 = 0, t1 = 1;
+    for (int k = 0; k < 3; k++) {
+        if (fabs(d[k]) < 1e-12) {
+            if (fabs(o[k] - c[k]) > h)
+                return 0;
+            continue;
+        }
+        double a = (c[k] - h - o[k]) / d[k], b = (c[k] + h - o[k]) / d[k];
+        t0 = fmax(t0, fmin(a, b));
+        t1 = fmin(t1, fmax(a, b));
+    }
+    return t0 <= t1;
+}
+
+static const char *box_scene(void)
+{
+    return scene_with("box", 1, "{\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}",
+                      "{\"type\": \"point\", \"intensity\": 10}");
+}
+
+/* (b) The umbra of a box between the light and the plane; the box's own footprint (seen from above:
+ * its top) is skipped. */
+static void test_box_shadow(void **state)
+{
+    (void)state;
+    float *rgb = render(box_scene());
+    int umbra = 0, lit = 0;
+    double worst_umbra = 0.0, worst_lit = 0.0;
+    for (int r = 0; r < W; r++)
+        for (int i = 0; i < W; i++) {
+            double x, z;
+            pixel_xz(i, r, &x, &z);
+            if (fabs(x - 0.5) < 0.35 && fabs(z) < 0.35)
+                continue; /* the box top */
+            double d2 = x * x + z * z + 4.0, want = RHO / PI * 20.0 / (d2 * sqrt(d2));
+            double got = lum(rgb + 3 * (r * W + i));
+            if (hits_box(x, z, 0.2)) {
+                umbra++;
+                worst_umbra = fmax(worst_umbra, got / want);
+            } else if (!hits_box(x, z, 0.3)) {
+                lit++;
+                worst_lit = fmax(worst_lit, rel(got, want));
+            }
+        }
+    print_message("box shadow: %d umbra pixels, worst %.2e of lit; %d lit pixels, worst error %.2e\n", umbra,
+                  worst_umbra, lit, worst_lit);
+    assert_true(umbra > 50 && lit > 1000);
+    assert_true(worst_umbra <= 0.01);
+    assert_true(worst_lit < 0.03);
+    free(rgb);
+}
+
+/* The plane under a directional light at 80 degrees from its normal. */
+static const char *grazing_scene(void)
+{
+    /* Rotation about x by -10 degrees turns -Z into (0, -cos 80, -sin 80). */
+    char node[256];
+    snprintf(node, sizeof node,
+             "{\"rotation\": [%.9f, 0, 0, %.9f], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}",
+             sin(-5.0 * PI / 180.0), cos(-5.0 * PI / 180.0));
+    return scene_with("grazing", 0, node, "{\"type\": \"directional\", \"intensity\": 1}");
+}
+
+static double grazing_worst(const lm_direct_settings *set)
+{
+    float *rgb = render_with(grazing_scene(), set);
+    double want = RHO / PI * cos(80.0 * PI / 180.0), worst = 0.0;
+    for (int p = 0; p < W * W; p++)
+        worst = fmax(worst, rel(lum(rgb + 3 * p), want));
+    free(rgb);
+    return worst;
+}
+
+/* (c) Every pixel rho/pi E cos 80: no acne. Without the bias the same scene shows acne, so the test
+ * can see it. */
+static void test_grazing(void **state)
+{
+    (void)state;
+    lm_direct_settings none;
+    lm_direct_settings_default(&none);
+    none.normal_offset = none.slope_bias = none.const_bias = 0.0f;
+    double worst = grazing_worst(NULL), unbiased = grazing_worst(&none);
+    print_message("grazing directional light: worst pixel error %.2e (without bias: %.3f)\n", worst, unbiased);
+    assert_true(worst < 0.02);
+    assert_true(unbiased > 0.1);
+}
+
+/* (f) Contact: a box resting on the plane; the plane right beside it on the side away from the light
+ * (its shadow there spans x in [0.75, 1]) stays dark: the bias does not detach the shadow. */
+static void test_contact(void **state)
+{
+    (void)state;
+    float *rgb = render(scene_box_at("contact", 1, 0.25f,
+                                     "{\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}",
+                                     "{\"type\": \"point\", \"intensity\": 10}"));
+    double worst = 0.0;
+    int n = 0;
+    for (int r = 0; r < W; r++)
+        for (int i = 0; i < W; i++) {
+            double x, z;
+            pixel_xz(i, r, &x, &z);
+            if (x < 0.76 || x > 0.95 || fabs(z) > 0.15)
+                continue;
+            double d2 = x * x + z * z + 4.0, lit = RHO / PI * 20.0 / (d2 * sqrt(d2));
+            worst = fmax(worst, lum(rgb + 3 * (r * W + i)) / lit);
+            n++;
+        }
+    print_message("contact: %d pixels within 0.01..0.2 of the box, worst %.2e of lit\n", n, worst);
+    assert_true(n > 10 && worst <= 0.01);
+    free(rgb);
+}
+
+/* (d) A spot light pointing down from height 2: zero outside the outer cone, rho/pi I/d^2 on the axis,
+ * the glTF falloff (lm_spot_attenuation) in between. */
+static void test_spot(void **state)
+{
+    (void)state;
+    const char *node = "{\"translation\": [0, 2, 0], \"rotation\": [-0.70710678, 0, 0, 0.70710678],"
+                       " \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}";
+    float *rgb = render(scene_with("spot", 0, node,
+                                   "{\"type\": \"spot\", \"intensity\": 10,"
+                                   " \"spot\": {\"innerConeAngle\": 0.3, \"outerConeAngle\": 0.5}}"));
+    lm_light l = {.type = LM_LIGHT_SPOT, .inner_cone = 0.3f, .outer_cone = 0.5f};
+    double outside = 0.0, axis = 1.0, ramp = 0.0;
+    int ramp_n = 0;
+    for (int r = 0; r < W; r++)
+        for (int i = 0; i < W; i++) {
+            double x, z;
+            pixel_xz(i, r, &x, &z);
+            double d2 = x * x + z * z + 4.0, c = 2.0 / sqrt(d2), theta = acos(c);
+            double want = RHO / PI * 10.0 * c / d2 * lm_spot_attenuation(&l, (float)c);
+            double got = lum(rgb + 3 * (r * W + i));
+            if (theta > 0.51)
+                outside = fmax(outside, got);
+            else if (theta < 0.03)
+                axis = fmin(axis, rel(got, RHO / PI * 10.0 / d2) < 0.02 ? 0.0 : 1.0);
+            else if (theta > 0.32 && theta < 0.48) {
+                ramp = fmax(ramp, rel(got, want));
+                ramp_n++;
+            }
+        }
+    print_message("spot: max outside %.3g, axis %s, %d ramp pixels worst error %.2e\n", outside,
+                  axis == 0.0 ? "within 2%" : "off", ramp_n, ramp);
+    assert_true(outside == 0.0);
+    assert_true(axis == 0.0);
+    assert_true(ramp_n > 50 && ramp < 0.03);
+    free(rgb);
+}
+
+#define GLOSSY_BASE {0.9f, 0.6f, 0.3f, 1.0f}
+
+/* The plane's material becomes a rough metal: glossy, Phong exponent 30. */
+static void make_glossy(lm_scene *s)
+{
+    lm_material *m = &s->materials[s->tri_material[0]];
+    const float base[4] = GLOSSY_BASE;
+    memcpy(m->base_color, base, sizeof base);
+    m->metallic = 1.0f;
+    m->roughness = 0.5f;
+    assert_int_equal(lm_material_classify(m), LM_MAT_GLOSSY);
+}
+
+/* (g) The glossy lobe against bsdf.c: every pixel f(l -> v) I cos / d^2 with f from lm_bsdf_eval
+ * (reciprocal: eval(-v, l) = f cos(ns, l)). The camera is orthographic, v = +y everywhere. */
+static void test_glossy(void **state)
+{
+    (void)state;
+    float *rgb = render_edit(lmt_plane_scene(), NULL, make_glossy);
+    lm_material m = {.base_color = GLOSSY_BASE, .metallic = 1.0f, .roughness = 0.5f};
+    lm_material_classify(&m);
+    lm_shading sh = {.ng = {0, 1, 0}, .ns = {0, 1, 0}, .albedo = {0.9f, 0.6f, 0.3f}, .material = &m};
+    const float wi[3] = {0, -1, 0};
+    double worst = 0.0, peak = 0.0;
+    for (int r = 0; r < W; r++)
+        for (int i = 0; i < W; i++) {
+            double x, z;
+            pixel_xz(i, r, &x, &z);
+            double d2 = x * x + z * z + 4.0, d = sqrt(d2);
+            float l[3] = {(float)(-x / d), (float)(2.0 / d), (float)(-z / d)}, f[3];
+            lm_bsdf_eval(&sh, wi, l, f);
+            for (int c = 0; c < 3; c++) {
+                double want = f[c] * 10.0 / d2;
+                worst = fmax(worst, rel(rgb[3 * (r * W + i) + c], want));
+                peak = fmax(peak, want);
+            }
+        }
+    print_message("glossy (n = %.0f): worst pixel error %.2e against lm_bsdf_eval, peak radiance %.3f\n",
+                  lm_phong_exponent(0.5f), worst, peak);
+    assert_true(worst < 0.01);
+    free(rgb);
+}
+
+/* The plane's material gets a 2 x 2 base colour texture (rows differ) and a uv offset that puts the
+ * plane's uv (0, 0) at the centre of texel (0, 0), the top-left one. */
+static void add_texture(lm_scene *s)
+{
+    static const float texels[16] = {0.9f, 0.5f, 0.2f, 1, 0.1f, 0.1f, 0.1f, 1, 0.3f, 0.3f, 0.3f, 1, 0.2f, 0.2f, 0.2f, 1};
+    lm_texture *t = realloc(s->textures, sizeof *t * (size_t)(s->texture_count + 1));
+    assert_non_null(t);
+    s->textures = t;
+    t = &s->textures[s->texture_count];
+    t->width = t->height = 2;
+    t->rgba = malloc(sizeof texels);
+    assert_non_null(t->rgba);
+    memcpy(t->rgba, texels, sizeof texels);
+    lm_material *m = &s->materials[s->tri_material[0]];
+    m->base_color_tex = s->texture_count++;
+    m->base_color_uv = 0;
+    m->uv_offset[0] = m->uv_offset[1] = 0.25f;
+}
+
+/* (h) The base colour texture: the plane's albedo is factor x texel (0, 0), as lm_material_albedo. */
+static void test_texture(void **state)
+{
+    (void)state;
+    lm_scene *s = NULL;
+    lm_error err;
+    lm_load_options opt = {0};
+    assert_int_equal(lm_scene_load_gltf(lmt_plane_scene(), &opt, &s, &err), LM_OK);
+    add_texture(s);
+    float albedo[3];
+    lm_material_albedo(s, &s->materials[s->tri_material[0]], s->uv0[0], s->uv0[1], albedo);
+    lm_scene_free(s);
+    float *rgb = render_edit(lmt_plane_scene(), NULL, add_texture);
+    double worst = 0.0;
+    for (int c = 0; c < 3; c++) {
+        double x, z;
+        pixel_xz(W / 2, W / 2, &x, &z);
+        double d2 = x * x + z * z + 4.0, want = albedo[c] / PI * 20.0 / (d2 * sqrt(d2));
+        worst = fmax(worst, rel(rgb[3 * (W / 2 * W + W / 2) + c], want));
+    }
+    print_message("texture: albedo (%.3f, %.3f, %.3f), worst channel error %.2e\n", albedo[0], albedo[1],
+                  albedo[2], worst);
+    assert_true(fabs(albedo[0] - 0.8f * 0.9f) < 1e-5f); /* the CPU lookup hit texel (0, 0) */
+    assert_true(worst < 0.01);
+    free(rgb);
+}
+
+/* (e) Two renders are bit-identical. */
+static void test_deterministic(void **state)
+{
+    (void)state;
+    const char *path = box_scene();
+    float *a = render(path), *b = render(path);
+    assert_memory_equal(a, b, sizeof(float) * 3 * W * W);
+    free(a);
+    free(b);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_point_plane), cmocka_unit_test(test_box_shadow), cmocka_unit_test(test_grazing),
+        cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
+        cmocka_unit_test(test_deterministic),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
