@@ -275,3 +275,29 @@ const char *lmt_plane_scene(void)
         fail_msg("cannot write %s", path);
     return path;
 }
+
+/* Gives every primitive material 0 (lmt_write_gltf writes none) by rewriting the file's text. */
+void lmt_use_material_0(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    static char in[1 << 16], out[1 << 17];
+    size_t n = fread(in, 1, sizeof in - 1, f);
+    fclose(f);
+    in[n] = '\0';
+    char *o = out;
+    for (const char *p = in; *p;) {
+        const char *q = strstr(p, "\"indices\": ");
+        if (!q) {
+            o += sprintf(o, "%s", p);
+            break;
+        }
+        const char *close = strchr(q, '}');
+        o += sprintf(o, "%.*s, \"material\": 0}", (int)(close - p), p);
+        p = close + 1;
+    }
+    f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(out, f);
+    fclose(f);
+}

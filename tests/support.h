@@ -78,3 +78,5 @@ typedef struct {
 } lmt_accessor;
 int lmt_write_gltf(const char *path, const lmt_mesh *meshes, int mesh_count, const char *nodes_json,
                    const lmt_accessor *extra, int extra_count, const char *extra_json);
+/* Gives every primitive of a file lmt_write_gltf wrote material 0 (it writes none), rewriting its text. */
+void lmt_use_material_0(const char *path);

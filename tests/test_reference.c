@@ -19,32 +19,6 @@
 
 #define PI 3.14159265358979323846
 
-/* Gives every primitive material 0 (lmt_write_gltf writes none) by rewriting the file's text. */
-static void use_material_0(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    static char in[1 << 16], out[1 << 17];
-    size_t n = fread(in, 1, sizeof in - 1, f);
-    fclose(f);
-    in[n] = '\0';
-    char *o = out;
-    for (const char *p = in; *p;) {
-        const char *q = strstr(p, "\"indices\": ");
-        if (!q) {
-            o += sprintf(o, "%s", p);
-            break;
-        }
-        const char *close = strchr(q, '}');
-        o += sprintf(o, "%.*s, \"material\": 0}", (int)(close - p), p);
-        p = close + 1;
-    }
-    f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(out, f);
-    fclose(f);
-}
-
 /* A closed box of half-size 1 seen from inside: every wall faces in, albedo 0.5, emits radiance 1. */
 static const char *furnace_scene(void)
 {
@@ -56,7 +30,7 @@ static const char *furnace_scene(void)
                       " \"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}],";
     snprintf(path, sizeof path, "%s/furnace.gltf", lmt_tmpdir());
     assert_int_equal(lmt_write_gltf(path, &m, 1, "[{\"mesh\": 0}]", NULL, 0, mat), 0);
-    use_material_0(path);
+    lmt_use_material_0(path);
     return path;
 }
 

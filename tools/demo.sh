@@ -18,4 +18,10 @@ if [ -r scenes/cornell.glb ]; then
     echo "== photons on scenes/cornell.glb"
     "$LMGI" photons scenes/cornell.glb --frames 90 --photons 50000 --out demo/cornell-photons
 fi
-echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png and demo/cornell-photons/view.png"
+# The whole frame loop on the same scene: composited frames, final lightmap atlases, per-stage times.
+if [ -r scenes/cornell.glb ]; then
+    echo "== run on scenes/cornell.glb"
+    "$LMGI" run scenes/cornell.glb --frames 30 --size 512x512 --out demo/cornell-run
+fi
+echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png and"
+echo "      demo/cornell-run/frame_*.png"

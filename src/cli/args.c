@@ -110,6 +110,10 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = v ? (a->cache_dir = v, 0) : bad(o, v, "a directory");
         else if (!strcmp(o, "--camera"))
             rc = parse_int(o, v, 0, 1000000, &a->camera);
+        else if (!strcmp(o, "--texels-per-frame"))
+            rc = parse_int(o, v, 1, 100000000, &a->texels_per_frame);
+        else if (!strcmp(o, "--exr-every"))
+            rc = parse_int(o, v, 1, 1000000, &a->exr_every);
         else if (!strcmp(o, "--scaling"))
             rc = v ? add_file(a->scaling, &a->scaling_count, v) : bad(o, v, "a scene file");
         else {

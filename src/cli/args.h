@@ -32,6 +32,9 @@ typedef struct {
     const char *cache_dir;  /* --cache DIR (reference) */
     int no_cache;           /* --no-cache */
     int camera;             /* --camera I (default: the file's first, else automatic) */
+    /* lmgi run (0 = default) */
+    int texels_per_frame;   /* --texels-per-frame N: IIM gather budget per frame */
+    int exr_every;          /* --exr-every K: every K-th frame also as EXR */
 } lm_cli_args;
 
 /* Parses argv[first..argc). Returns 0 on success, or prints what was wrong and returns 2. */

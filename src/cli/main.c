@@ -8,6 +8,7 @@
 #include "bench.h"
 #include "photons_cmd.h"
 #include "reference_cmd.h"
+#include "run_cmd.h"
 
 static void usage(FILE *f)
 {
@@ -19,6 +20,9 @@ static void usage(FILE *f)
             "                         effects the scene calls for and why\n"
             "  charts SCENE --out DIR write DIR/atlas.png (charts coloured, gutters black) and DIR/surfaces.png\n"
             "                         (the scene from its camera, each surface a flat colour)\n"
+            "  run SCENE --out DIR    the whole frame loop over the scene's animations (photons, AIMs, IIM\n"
+            "                         gather, direct light, composite): DIR/frame_NNNN.png (every K-th also\n"
+            "                         .exr), iim.exr/png, aim.exr/png and frames.csv (work and ms per stage)\n"
             "  bench [SCENE...]       time load, surface split, atlas (unwrap, pack, texel table) and BVH build;\n"
             "                         --scaling FILE (repeatable) adds a growth table\n"
             "  help                   this text\n"
@@ -30,7 +34,10 @@ static void usage(FILE *f)
             "  --cone DEG       max normal deviation inside one surface (default 30)\n"
             "  --max-atlas N    largest atlas side; the texel size grows to fit (default 8192)\n"
             "  --strict         degenerate triangles and non-manifold edges are errors\n"
-            "  --size WxH       picture size for 'charts' (default 1024x768)\n"
+            "  --size WxH       picture size for 'charts' (default 1024x768) and 'run' (default 512x512)\n"
+            "  --frames N       'run': frames to play at 30 per second of animation (default 60)\n"
+            "  --texels-per-frame N  'run': IIM texels gathered per frame (default 20)\n"
+            "  --exr-every K    'run': every K-th frame also as linear EXR (default 10)\n"
             "  --repeats N      'bench': runs per scene, the median is reported (default 3)\n"
             "  --json FILE      'bench': also write the results as JSON\n"
             "  -v, -q           more / less on stderr\n");
@@ -105,6 +112,8 @@ int main(int argc, char **argv)
         return lm_cli_photons(&a);
     if (!strcmp(cmd, "reference"))
         return lm_cli_reference(&a);
+    if (!strcmp(cmd, "run"))
+        return lm_cli_run(&a);
     if (!strcmp(cmd, "bench"))
         return lm_cli_bench(&a);
     fprintf(stderr, "lmgi: unknown command '%s'\n\n", cmd);

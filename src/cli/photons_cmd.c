@@ -18,7 +18,7 @@
 
 #define FRAME_RATE 30.0f /* frames are played at 30 per second of animation time */
 
-static void settings_from_args(const lm_cli_args *a, lm_photon_stage_settings *s)
+void lm_cli_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
 {
     lm_photon_stage_settings_default(s);
     if (a->photons)
@@ -148,7 +148,7 @@ int lm_cli_photons(const lm_cli_args *a)
     lm_error err;
     lm_error_clear(&err);
     lm_photon_stage_settings set;
-    settings_from_args(a, &set);
+    lm_cli_photon_settings(a, &set);
     lm_photon_stage *stage = NULL;
     lm_photon_stage_frame setup;
     memset(&setup, 0, sizeof setup);

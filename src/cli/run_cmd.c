@@ -1,0 +1,212 @@
+/* lmgi run: plays the scene's animations through the whole frame loop (update/frame_loop.h) and writes
+ * DIR/frame_NNNN.png (every K-th also .exr), the final IIM and AIM atlases and DIR/frames.csv.
+ * The tone map's exposure is fixed from frame 0 so that the frames do not flicker. */
+#include "run_cmd.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../charts/atlas_dilate.h"
+#include "../core/image.h"
+#include "../core/tonemap.h"
+#include "../update/frame_loop.h"
+#include "../update/lmgi_scene.h"
+#include "photons_cmd.h"
+#include "progress.h"
+
+#define FRAME_RATE 30.0f /* frames are played at 30 per second of animation time */
+
+typedef struct {
+    const lm_cli_args *a;
+    lmgi_scene *sc;
+    lm_frame_loop *loop;
+    FILE *csv;
+    float exposure;        /* fixed from frame 0 */
+    uint8_t *png;          /* scratch, frame-sized RGBA8 */
+    double sum_ms[6];      /* photons, gather, blend, direct, composite, total */
+    uint32_t texels;
+} run_state;
+
+static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
+{
+    lm_frame_loop_settings_default(s);
+    lm_cli_photon_settings(a, &s->stage);
+    if (a->texels_per_frame)
+        s->iim.texels_per_frame = a->texels_per_frame;
+    if (a->width) {
+        s->width = a->width;
+        s->height = a->height;
+    }
+    s->camera = a->camera;
+}
+
+static void csv_header(FILE *f)
+{
+    fprintf(f, "frame,time_s,photons_retraced,groups_invalidated,groups_retraced,aim_surfaces_refreshed,"
+               "texels_gathered,animate_ms,trace_ms,aim_ms,photons_ms,gather_ms,blend_ms,direct_ms,composite_ms,"
+               "frame_ms\n");
+}
+
+static void csv_row(FILE *f, const lm_frame_stats *r)
+{
+    const lm_photon_stage_frame *s = &r->stage;
+    fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", s->frame, (double)s->time,
+            s->photons.rr_photons + s->photons.group_photons, s->photons.groups_invalidated,
+            s->photons.groups_retraced, s->aim.surfaces_refreshed, r->texels_gathered, 1e3 * s->t_animate,
+            1e3 * s->t_photons, 1e3 * s->t_aim, 1e3 * r->t_photons, 1e3 * r->t_gather, 1e3 * r->t_blend,
+            1e3 * r->t_direct, 1e3 * r->t_composite, 1e3 * r->t_total);
+}
+
+/* DIR/NAME.exr (linear) and DIR/NAME.png (tone-mapped with exposure k, or automatic when k <= 0). */
+static lm_status write_pair(const char *dir, const char *name, int w, int h, const float *rgb, float k, int exr,
+                            uint8_t *png, lm_error *err)
+{
+    char path[4096];
+    lm_status st = LM_OK;
+    if (exr) {
+        snprintf(path, sizeof path, "%s/%s.exr", dir, name);
+        st = lm_write_exr(path, w, h, 3, rgb, err);
+    }
+    size_t n = (size_t)w * h;
+    lm_tonemap_srgb8(rgb, n, 3, k > 0.0f ? k : lm_auto_exposure(rgb, n, 3), png);
+    snprintf(path, sizeof path, "%s/%s.png", dir, name);
+    return st == LM_OK ? lm_write_png(path, w, h, png, err) : st;
+}
+
+static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
+{
+    lm_frame_stats fs;
+    lm_status st = lm_frame_loop_step(r->loop, (float)f / FRAME_RATE, &fs, err);
+    if (st != LM_OK)
+        return st;
+    const float *img = lm_frame_loop_image(r->loop);
+    int w = lm_frame_loop_get_settings(r->loop)->width, h = lm_frame_loop_get_settings(r->loop)->height;
+    if (f == 0)
+        r->exposure = lm_auto_exposure(img, (size_t)w * h, 3);
+    char name[64];
+    snprintf(name, sizeof name, "frame_%04d", f);
+    st = write_pair(r->a->out_dir, name, w, h, img, r->exposure, f % every == 0, r->png, err);
+    csv_row(r->csv, &fs);
+    const double ms[6] = {fs.t_photons, fs.t_gather, fs.t_blend, fs.t_direct, fs.t_composite, fs.t_total};
+    for (int i = 0; i < 6; i++)
+        r->sum_ms[i] += 1e3 * ms[i];
+    r->texels += fs.texels_gathered;
+    return st;
+}
+
+/* Each IIM texel's E (invalid ones filled, gutters dilated) and each AIM texel's radiance. */
+static lm_status write_atlases(run_state *r, lm_error *err)
+{
+    const lm_atlas *at = &r->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *rgba = NULL, *rgb = malloc(n * 3 * sizeof *rgb);
+    uint8_t *png = malloc(n * 4);
+    lm_status st = rgb && png ? lm_frame_loop_read_iim(r->loop, &rgba, err)
+                              : lm_fail(err, LM_ERR_NOMEM, "no memory for the atlases");
+    if (st == LM_OK) {
+        lm_iim_fill_invalid(at, rgba, lm_frame_loop_get_settings(r->loop)->gather.backface_limit);
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
+        st = write_pair(r->a->out_dir, "iim", at->width, at->height, rgb, 0.0f, 1, png, err);
+    }
+    if (st == LM_OK) {
+        memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(r->loop))), n * 3 * sizeof *rgb);
+        lm_atlas_dilate(at, rgb, 3, at->gutter);
+        st = write_pair(r->a->out_dir, "aim", at->width, at->height, rgb, 0.0f, 1, png, err);
+    }
+    free(rgba);
+    free(rgb);
+    free(png);
+    return st;
+}
+
+static void summary(const run_state *r, int frames, const lm_photon_stage_frame *setup, double t_gather)
+{
+    const double *s = r->sum_ms;
+    printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", 1e3 * setup->t_photons,
+           1e3 * setup->t_aim, 1e3 * t_gather);
+    printf("frames      %d, %u texels gathered, exposure %.4g (from frame 0)\n", frames, r->texels,
+           (double)r->exposure);
+    printf("mean frame  %.2f ms (%.1f fps): photons %.2f, gather %.2f, blend %.2f, direct %.2f, composite %.2f\n",
+           s[5] / frames, s[5] > 0 ? 1e3 * frames / s[5] : 0.0, s[0] / frames, s[1] / frames, s[2] / frames,
+           s[3] / frames, s[4] / frames);
+    printf("wrote       %s/frame_*.png (.exr every %d), iim.exr/png, aim.exr/png, frames.csv\n", r->a->out_dir,
+           r->a->exr_every ? r->a->exr_every : 10);
+}
+
+static lm_status play(run_state *r, lm_error *err)
+{
+    int frames = r->a->frames ? r->a->frames : 60, every = r->a->exr_every ? r->a->exr_every : 10;
+    lm_status st = LM_OK;
+    csv_header(r->csv);
+    for (int f = 0; f < frames && st == LM_OK; f++) {
+        st = play_frame(r, f, every, err);
+        if (!r->a->quiet)
+            lm_progress("run", f + 1, frames);
+    }
+    return st;
+}
+
+static lm_status open_outputs(run_state *r, lm_error *err)
+{
+    char path[4096];
+    lm_status st = lm_mkdir_p(r->a->out_dir, err);
+    if (st != LM_OK)
+        return st;
+    snprintf(path, sizeof path, "%s/frames.csv", r->a->out_dir);
+    r->csv = fopen(path, "w");
+    return r->csv ? LM_OK : lm_fail(err, LM_ERR_IO, "%s: cannot write", path);
+}
+
+static lm_status run(run_state *r, lm_error *err)
+{
+    lm_frame_loop_settings set;
+    settings_from_args(r->a, &set);
+    r->png = malloc((size_t)set.width * set.height * 4);
+    if (!r->png)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the frames");
+    lm_photon_stage_frame setup;
+    memset(&setup, 0, sizeof setup);
+    double t_gather = 0.0;
+    lmgi_scene *sc = r->sc;
+    lm_status st = open_outputs(r, err);
+    if (st == LM_OK)
+        st = lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &r->loop, &setup, &t_gather,
+                                  err);
+    if (st == LM_OK)
+        st = play(r, err);
+    if (r->csv && fclose(r->csv) != 0 && st == LM_OK)
+        st = lm_fail(err, LM_ERR_IO, "%s/frames.csv: write failed", r->a->out_dir);
+    r->csv = NULL;
+    if (st == LM_OK)
+        st = write_atlases(r, err);
+    if (st == LM_OK && !r->a->quiet)
+        summary(r, r->a->frames ? r->a->frames : 60, &setup, t_gather);
+    return st;
+}
+
+int lm_cli_run(const lm_cli_args *a)
+{
+    if (a->file_count != 1 || !a->out_dir) {
+        fprintf(stderr, "lmgi: run needs one scene file and --out DIR\n");
+        return 2;
+    }
+    run_state r;
+    memset(&r, 0, sizeof r);
+    r.a = a;
+    lmgi_error perr;
+    if (lmgi_load(a->files[0], &a->options, &r.sc, &perr) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", perr.message);
+        return 1;
+    }
+    lm_error err;
+    lm_error_clear(&err);
+    lm_status st = run(&r, &err);
+    if (st != LM_OK)
+        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+    lm_frame_loop_free(r.loop);
+    free(r.png);
+    lmgi_free(r.sc);
+    return st == LM_OK ? 0 : 1;
+}

@@ -1,0 +1,194 @@
+#include "frame_loop.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/timing.h"
+#include "../gpu/composite.h"
+#include "../gpu/gl_context.h"
+
+struct lm_frame_loop {
+    lm_frame_loop_settings set;
+    lm_scene *scene;
+    const lm_atlas *atlas;
+    lm_gl_context *gl;
+    lm_photon_stage *stage;
+    lm_gather *gather;
+    lm_composite *comp;
+    lm_iim iim;
+    int have_iim;
+    uint32_t *texels;      /* scratch: this frame's scheduled texels (atlas texel_count) */
+    float *image, *direct, *indirect;
+    lm_view view;
+};
+
+void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
+{
+    lm_photon_stage_settings_default(&s->stage);
+    lm_hemicube_settings_default(&s->gather);
+    lm_iim_settings_default(&s->iim);
+    lm_direct_settings_default(&s->direct);
+    s->width = 512;
+    s->height = 512;
+    s->camera = -1;
+}
+
+/* The photon store's delta_i is the scheduler's input; the stage hands out its photons as const, but the
+ * loop owns the stage, so resetting delta_i through it is the loop's business. */
+static lm_photon_store *store_of(lm_frame_loop *fl)
+{
+    return lm_photons_store_mutable((lm_photons *)lm_photon_stage_photons(fl->stage));
+}
+
+/* Uploads the current scene and AIMs and gathers `count` scheduled texels into the fresh IIM. */
+static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
+{
+    if (count == 0)
+        return LM_OK;
+    lm_status st = lm_gather_set_scene(fl->gather, fl->scene, fl->atlas, err);
+    if (st == LM_OK)
+        st = lm_gather_set_aim(fl->gather, fl->atlas, lm_aim_rgb(lm_photon_stage_aim(fl->stage)), err);
+    if (st == LM_OK)
+        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels, count, fl->iim.fresh_tex, NULL, err);
+    return st;
+}
+
+static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
+{
+    size_t n = 3 * (size_t)fl->set.width * fl->set.height;
+    fl->texels = malloc(sizeof(uint32_t) * (fl->atlas->texel_count ? fl->atlas->texel_count : 1));
+    fl->image = malloc(n * sizeof(float));
+    fl->direct = calloc(n, sizeof(float));
+    fl->indirect = calloc(n, sizeof(float));
+    if (!fl->texels || !fl->image || !fl->direct || !fl->indirect)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", fl->scene->path);
+    return LM_OK;
+}
+
+/* GL context, gather, IIMs and composite; then every texel gathered and shown at once. */
+static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
+{
+    lm_status st = lm_gl_context_create(&fl->gl, err);
+    if (st == LM_OK)
+        st = lm_gather_create(&fl->set.gather, &fl->gather, err);
+    if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK)
+        fl->have_iim = 1;
+    if (st == LM_OK)
+        st = lm_composite_create(fl->scene, fl->atlas, fl->set.gather.backface_limit, &fl->comp, err);
+    double t0 = lm_now();
+    if (st == LM_OK)
+        st = gather(fl, lm_iim_schedule_all(&fl->iim, store_of(fl), fl->texels), err);
+    if (st == LM_OK)
+        st = lm_iim_blend(&fl->iim, 1, err);
+    if (t_gather)
+        *t_gather = lm_now() - t0;
+    return st;
+}
+
+lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
+                               const lm_frame_loop_settings *set, lm_frame_loop **out, lm_photon_stage_frame *setup,
+                               double *t_setup_gather, lm_error *err)
+{
+    *out = NULL;
+    lm_frame_loop *fl = calloc(1, sizeof *fl);
+    if (!fl)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", s->path);
+    fl->set = *set;
+    fl->scene = s;
+    fl->atlas = a;
+    lm_status st = alloc_buffers(fl, err);
+    if (st == LM_OK)
+        st = lm_photon_stage_create(s, su, a, rt, &set->stage, &fl->stage, setup, err);
+    if (st == LM_OK)
+        st = setup_gpu(fl, t_setup_gather, err);
+    if (st != LM_OK) {
+        lm_frame_loop_free(fl);
+        return st;
+    }
+    *out = fl;
+    return LM_OK;
+}
+
+void lm_frame_loop_free(lm_frame_loop *fl)
+{
+    if (!fl)
+        return;
+    lm_composite_free(fl->comp);
+    if (fl->have_iim)
+        lm_iim_free(&fl->iim);
+    lm_gather_free(fl->gather);
+    lm_gl_context_destroy(fl->gl);
+    lm_photon_stage_free(fl->stage);
+    free(fl->texels);
+    free(fl->image);
+    free(fl->direct);
+    free(fl->indirect);
+    free(fl);
+}
+
+/* Direct light, the indirect pass, and their sum. */
+static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
+{
+    int w = fl->set.width, h = fl->set.height;
+    lm_scene_update_bounds(fl->scene);
+    lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
+    double t0 = lm_now();
+    lm_status st = lm_render_direct(fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w, h,
+                                    &fl->set.direct, fl->direct, err);
+    double t1 = lm_now();
+    if (st == LM_OK)
+        st = lm_composite_indirect(fl->comp, fl->scene, fl->atlas, fl->iim.display_tex, &fl->view, w, h,
+                                   fl->indirect, err);
+    for (size_t i = 0, n = 3 * (size_t)w * h; st == LM_OK && i < n; i++)
+        fl->image[i] = fl->direct[i] + fl->indirect[i];
+    o->t_direct = t1 - t0;
+    o->t_composite = lm_now() - t1;
+    return st;
+}
+
+lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err)
+{
+    lm_frame_stats o;
+    memset(&o, 0, sizeof o);
+    double t0 = lm_now();
+    lm_status st = lm_photon_stage_step(fl->stage, t, &o.stage, err);
+    double t1 = lm_now();
+    if (st == LM_OK) {
+        o.texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
+        st = gather(fl, o.texels_gathered, err);
+    }
+    double t2 = lm_now();
+    if (st == LM_OK)
+        st = lm_iim_blend(&fl->iim, 0, err);
+    double t3 = lm_now();
+    if (st == LM_OK)
+        st = render(fl, &o, err);
+    o.t_photons = t1 - t0;
+    o.t_gather = t2 - t1;
+    o.t_blend = t3 - t2;
+    o.t_total = lm_now() - t0;
+    if (out)
+        *out = o;
+    return st;
+}
+
+const float *lm_frame_loop_image(const lm_frame_loop *fl) { return fl->image; }
+const float *lm_frame_loop_direct(const lm_frame_loop *fl) { return fl->direct; }
+const float *lm_frame_loop_indirect(const lm_frame_loop *fl) { return fl->indirect; }
+const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl->stage; }
+const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }
+const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }
+
+lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err)
+{
+    size_t n = 4 * (size_t)fl->atlas->width * fl->atlas->height;
+    *rgba = malloc(n * sizeof(float));
+    if (!*rgba)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the IIM read-back");
+    lm_status st = lm_iim_texture_read(fl->iim.display_tex, fl->atlas->width, fl->atlas->height, *rgba, err);
+    if (st != LM_OK) {
+        free(*rgba);
+        *rgba = NULL;
+    }
+    return st;
+}

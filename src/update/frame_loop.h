@@ -1,0 +1,62 @@
+/* The whole frame loop (Larsen & Christensen sections 2-7; docs/architecture.md "The frame loop").
+ *
+ * One frame at animation time t:
+ *   1. photon stage (photon_stage.h): animations, photons re-traced, AIMs refreshed;
+ *   2. IIMs (gpu/iim.h, gpu/hemicube.h): up to texels_per_frame texels scheduled by delta_i, gathered
+ *      over the current AIMs and node transforms into the fresh IIM, then blended into the display IIM;
+ *   3. direct light per pixel with shadows (gpu/direct.h);
+ *   4. composite in linear HDR: L = direct + albedo / pi * E_IIM (gpu/composite.h), mirror and glass black.
+ *
+ * Initial state (lm_frame_loop_create): a full photon trace, every AIM, and a full gather of every texel
+ * shown at once, so the first frame is already converged. The loop owns its GL context (current on the
+ * creating thread). */
+#ifndef LM_FRAME_LOOP_H
+#define LM_FRAME_LOOP_H
+
+#include "../gpu/camera.h"
+#include "../gpu/direct.h"
+#include "../gpu/hemicube.h"
+#include "../gpu/iim.h"
+#include "photon_stage.h"
+
+typedef struct {
+    lm_photon_stage_settings stage;
+    lm_hemicube_settings gather;
+    lm_iim_settings iim;
+    lm_direct_settings direct;
+    int width, height;     /* frame size (default 512 x 512) */
+    int camera;            /* lm_view_for_scene's camera (default -1) */
+} lm_frame_loop_settings;
+
+typedef struct {
+    lm_photon_stage_frame stage;
+    uint32_t texels_gathered;
+    /* seconds per stage: photon stage (animate + photons + AIMs), IIM gather (schedule, scene and AIM
+     * upload, hemicubes), blend, direct light, composite; and the whole frame */
+    double t_photons, t_gather, t_blend, t_direct, t_composite, t_total;
+} lm_frame_stats;
+
+typedef struct lm_frame_loop lm_frame_loop;
+
+void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
+/* The initial state. scene, surfaces, atlas and BVH are borrowed and must outlive the loop. setup (may
+ * be NULL) gets the photon stage's setup times; t_setup_gather (may be NULL) the full gather's. */
+lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
+                               const lm_frame_loop_settings *set, lm_frame_loop **out, lm_photon_stage_frame *setup,
+                               double *t_setup_gather, lm_error *err);
+void lm_frame_loop_free(lm_frame_loop *fl);
+/* One frame at animation time t; the picture is then in lm_frame_loop_image. */
+lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err);
+
+/* The last frame: composite, and its direct and indirect parts (width*height*3 linear floats, top row first). */
+const float *lm_frame_loop_image(const lm_frame_loop *fl);
+const float *lm_frame_loop_direct(const lm_frame_loop *fl);
+const float *lm_frame_loop_indirect(const lm_frame_loop *fl);
+const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);
+/* The displayed IIM read back (atlas-sized RGBA floats, a = back-face fraction); caller frees. */
+lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err);
+const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl);
+/* The view the frames are drawn from. */
+const lm_view *lm_frame_loop_view(const lm_frame_loop *fl);
+
+#endif

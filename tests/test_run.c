@@ -1,0 +1,180 @@
+/* lmgi run: the files it writes, one CSV row per frame, deterministic frames, bad arguments, and the
+ * composite in numbers on the furnace box (emission + albedo / pi * E_IIM = Le / (1 - rho)). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "../src/core/image.h"
+#include "support.h"
+
+static char output[65536];
+
+/* Runs `lmgi ARGS` and returns its exit status (output kept in `output`). */
+static int lmgi(const char *args)
+{
+    const char *build = getenv("LMGI_BUILD");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "%s/lmgi %s 2>&1", build ? build : "build", args);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(output, 1, sizeof output - 1, p);
+    output[n] = '\0';
+    int status = pclose(p);
+    assert_true(WIFEXITED(status));
+    return WEXITSTATUS(status);
+}
+
+/* A small, quick run of the Cornell box into DIR/NAME; returns the directory (static storage). */
+static const char *quick_run(const char *name)
+{
+    static char dir[1024];
+    char args[2048];
+    snprintf(dir, sizeof dir, "%s/%s", lmt_tmpdir(), name);
+    snprintf(args, sizeof args, "run scenes/cornell.glb --frames 3 --size 64x48 --texel-size 0.1 --photons 20000 "
+             "--exr-every 2 -q --out %s", dir);
+    if (lmgi(args) != 0)
+        fail_msg("lmgi run failed: %s", output);
+    return dir;
+}
+
+static int exists(const char *dir, const char *file)
+{
+    char path[2048];
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    return access(path, R_OK) == 0;
+}
+
+static int count_lines(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    int n = 0, c;
+    while ((c = fgetc(f)) != EOF)
+        n += c == '\n';
+    fclose(f);
+    return n;
+}
+
+static void test_writes_files(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    (void)scene;
+    const char *dir = quick_run("files");
+    const char *want[] = {"frame_0000.png", "frame_0001.png", "frame_0002.png", "frame_0000.exr", "frame_0002.exr",
+                          "iim.exr", "iim.png", "aim.exr", "aim.png", "frames.csv"};
+    for (size_t i = 0; i < sizeof want / sizeof *want; i++)
+        if (!exists(dir, want[i]))
+            fail_msg("missing %s/%s", dir, want[i]);
+    assert_false(exists(dir, "frame_0001.exr")); /* --exr-every 2 */
+    char path[2048];
+    snprintf(path, sizeof path, "%s/frames.csv", dir);
+    assert_int_equal(count_lines(path), 1 + 3); /* header + one row per frame */
+    int w, h;
+    float *px = NULL;
+    lm_error err;
+    snprintf(path, sizeof path, "%s/frame_0002.exr", dir);
+    assert_int_equal(lm_read_exr(path, &w, &h, &px, &err), LM_OK);
+    assert_int_equal(w, 64);
+    assert_int_equal(h, 48);
+    free(px);
+}
+
+static float *read_exr(const char *dir, const char *file, int *w, int *h)
+{
+    char path[2048];
+    float *px = NULL;
+    lm_error err;
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    if (lm_read_exr(path, w, h, &px, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    return px;
+}
+
+static void test_deterministic(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    (void)scene;
+    char a[1024];
+    snprintf(a, sizeof a, "%s", quick_run("a"));
+    const char *b = quick_run("b");
+    const char *frames[] = {"frame_0000.exr", "frame_0002.exr"};
+    for (int i = 0; i < 2; i++) {
+        int w, h, w2, h2;
+        float *x = read_exr(a, frames[i], &w, &h), *y = read_exr(b, frames[i], &w2, &h2);
+        assert_int_equal(w, w2);
+        assert_int_equal(h, h2);
+        assert_memory_equal(x, y, sizeof(float) * 4 * (size_t)w * h);
+        free(x);
+        free(y);
+    }
+}
+
+static void test_bad_args(void **state)
+{
+    (void)state;
+    assert_int_equal(lmgi("run scenes/cornell.glb --frames 2"), 2);
+    assert_non_null(strstr(output, "--out"));
+    assert_int_equal(lmgi("run --out /tmp/x"), 2);
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --texels-per-frame 0"), 2);
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --exr-every x"), 2);
+}
+
+/* Inside a closed box of albedo 0.5 whose walls all emit Le = 1: every wall pixel of a frame shows
+ * Le + rho / pi * E_IIM, which must reach Le / (1 - rho) = 2 within 3%. The camera sits inside. */
+static void test_furnace_composite(void **state)
+{
+    (void)state;
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_cube_inward(&m, 1.0f);
+    const char *extra = "\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1],"
+                        " \"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}],"
+                        " \"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 1.2, \"znear\": 0.01,"
+                        " \"aspectRatio\": 1}}],";
+    const char *nodes = "[{\"mesh\": 0}, {\"camera\": 0, \"translation\": [0.2, 0.1, 0.7]}]";
+    char tmp[1024], path[1100], args[4096], dir[1100];
+    snprintf(tmp, sizeof tmp, "%s", lmt_tmpdir());
+    snprintf(path, sizeof path, "%s/furnace.gltf", tmp);
+    snprintf(dir, sizeof dir, "%s/fout", tmp);
+    assert_int_equal(lmt_write_gltf(path, &m, 1, nodes, NULL, 0, extra), 0);
+    lmt_use_material_0(path);
+    snprintf(args, sizeof args, "run %s --frames 1 --size 64x64 --texel-size 0.2 --photons 100000 -q --out %s",
+             path, dir);
+    if (lmgi(args) != 0)
+        fail_msg("lmgi run failed: %s", output);
+    int w, h;
+    float *px = read_exr(dir, "frame_0000.exr", &w, &h);
+    double sum = 0.0, worst = 0.0;
+    for (int i = 0; i < w * h; i++) {
+        double L = px[4 * i + 1];
+        sum += L;
+        worst = fmax(worst, fabs(L / 2.0 - 1.0));
+    }
+    double mean = sum / (w * h);
+    print_message("furnace composite: %d pixels, mean radiance %.4f (want 2, %+.2f%%), worst pixel %.2f%%\n", w * h,
+                  mean, 100.0 * (mean / 2.0 - 1.0), 100.0 * worst);
+    assert_true(fabs(mean / 2.0 - 1.0) < 0.03);
+    assert_true(worst < 0.03); /* every pixel is a wall: the camera is inside */
+    free(px);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_writes_files),
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_bad_args),
+        cmocka_unit_test(test_furnace_composite),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
