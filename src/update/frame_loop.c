@@ -33,12 +33,8 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->camera = -1;
 }
 
-/* The photon store's delta_i is the scheduler's input; the stage hands out its photons as const, but the
- * loop owns the stage, so resetting delta_i through it is the loop's business. */
-static lm_photon_store *store_of(lm_frame_loop *fl)
-{
-    return lm_photons_store_mutable((lm_photons *)lm_photon_stage_photons(fl->stage));
-}
+/* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
+static lm_photon_store *store_of(lm_frame_loop *fl) { return lm_photon_stage_store(fl->stage); }
 
 /* Uploads the current scene and AIMs and gathers `count` scheduled texels into the fresh IIM. */
 static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)

@@ -158,5 +158,6 @@ lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_fra
 }
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }
+lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }

@@ -37,6 +37,8 @@ void lm_photon_stage_free(lm_photon_stage *ps);
 lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
+/* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */
+lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps);
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps);
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
 
