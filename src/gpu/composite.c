@@ -10,6 +10,8 @@
 #include "../core/vecmath.h"
 #include "gl_mesh.h"
 #include "gl_shader.h"
+#include "lightmap_view.h"
+#include "offscreen.h"
 
 struct lm_composite {
     int width, height;   /* atlas */
@@ -131,53 +133,6 @@ int lm_composite_albedo(const lm_composite *c, int x, int y, float out[3])
     return p[3] > 0.0f;
 }
 
-/* World position + lightmap UV per corner; UV (-1, -1) for triangles without texels. */
-static float *build_vertices(const lm_scene *s, const lm_atlas *a)
-{
-    float *v = malloc(sizeof(float) * 15 * (size_t)(s->tri_count ? s->tri_count : 1));
-    if (!v)
-        return NULL;
-    for (uint32_t t = 0; t < s->tri_count; t++)
-        for (int k = 0; k < 3; k++) {
-            float *o = v + 15 * (size_t)t + 5 * k;
-            lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], o);
-            const float *uv = a->corner_uv + 6 * (size_t)t + 2 * k;
-            int none = a->tri_chart[t] < 0 || !isfinite(uv[0]);
-            o[3] = none ? -1.0f : uv[0];
-            o[4] = none ? -1.0f : uv[1];
-        }
-    return v;
-}
-
-typedef struct {
-    GLuint fbo, color, depth;
-} target;
-
-static lm_status target_begin(target *t, int w, int h, lm_error *err)
-{
-    glGenFramebuffers(1, &t->fbo);
-    glGenRenderbuffers(1, &t->color);
-    glGenRenderbuffers(1, &t->depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, t->color);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, w, h);
-    glBindRenderbuffer(GL_RENDERBUFFER, t->depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t->color);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return lm_fail(err, LM_ERR_BACKEND, "composite: float target %dx%d is incomplete", w, h);
-    return LM_OK;
-}
-
-static void target_end(target *t)
-{
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteRenderbuffers(1, &t->color);
-    glDeleteRenderbuffers(1, &t->depth);
-    glDeleteFramebuffers(1, &t->fbo);
-}
-
 static void draw(const lm_composite *c, const lm_gl_mesh *mesh, unsigned iim_tex, const lm_view *view, int w, int h)
 {
     float vp[16];
@@ -206,22 +161,20 @@ static void draw(const lm_composite *c, const lm_gl_mesh *mesh, unsigned iim_tex
 lm_status lm_composite_indirect(lm_composite *c, const lm_scene *s, const lm_atlas *a, unsigned iim_tex,
                                 const lm_view *view, int width, int height, float *rgb, lm_error *err)
 {
-    float *verts = build_vertices(s, a);
+    float *verts = lm_lightmapped_vertices(s, a);
     if (!verts)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
     lm_gl_mesh mesh;
     const int sizes[2] = {3, 2};
     lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
     free(verts);
-    target t;
-    lm_status st = target_begin(&t, width, height, err);
+    lm_offscreen t;
+    lm_status st = lm_offscreen_begin_float(&t, width, height, err);
     if (st == LM_OK) {
         draw(c, &mesh, iim_tex, view, width, height);
-        glPixelStorei(GL_PACK_ALIGNMENT, 4);
-        for (int y = 0; y < height; y++)
-            glReadPixels(0, height - 1 - y, width, 1, GL_RGB, GL_FLOAT, rgb + 3 * (size_t)width * y);
+        lm_offscreen_read_rgb(&t, rgb);
+        lm_offscreen_release(&t);
     }
-    target_end(&t);
     lm_gl_mesh_destroy(&mesh);
     return st;
 }

@@ -13,6 +13,7 @@
 #include "direct_shader.h"
 #include "direct_mesh.h"
 #include "gl_shader.h"
+#include "offscreen.h"
 #include "shadow_maps.h"
 
 void lm_direct_settings_default(lm_direct_settings *s)
@@ -26,42 +27,6 @@ void lm_direct_settings_default(lm_direct_settings *s)
     s->const_bias = 0.5f;
 }
 
-typedef struct {
-    GLuint fbo, color, depth;
-} float_target;
-
-static lm_status target_begin(float_target *t, int w, int h, lm_error *err)
-{
-    glGenFramebuffers(1, &t->fbo);
-    glGenRenderbuffers(1, &t->color);
-    glGenRenderbuffers(1, &t->depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, t->color);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA32F, w, h);
-    glBindRenderbuffer(GL_RENDERBUFFER, t->depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, w, h);
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, t->color);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth);
-    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        return lm_fail(err, LM_ERR_BACKEND, "direct_light: float target %dx%d is incomplete", w, h);
-    return LM_OK;
-}
-
-static void target_end(float_target *t)
-{
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteRenderbuffers(1, &t->color);
-    glDeleteRenderbuffers(1, &t->depth);
-    glDeleteFramebuffers(1, &t->fbo);
-}
-
-/* Reads the target into rgb, top row first. */
-static void read_back(int w, int h, float *rgb)
-{
-    glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    for (int y = 0; y < h; y++)
-        glReadPixels(0, h - 1 - y, w, 1, GL_RGB, GL_FLOAT, rgb + 3 * (size_t)w * y);
-}
 
 static void set_light_uniforms(GLuint prog, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)
 {
@@ -126,7 +91,7 @@ static void emission_pass(GLuint prog, const lm_direct_mesh *mesh, int w, int h)
 
 /* One light: its shadow map, then an additive pass over the laid-down depth. */
 static lm_status light_pass(GLuint prog, const lm_scene *s, const lm_emitter *e, const lm_direct_mesh *mesh,
-                            const float_target *t, int w, int h,
+                            const lm_offscreen *t, int w, int h,
                             const lm_direct_settings *set, lm_error *err)
 {
     lm_shadow_map m;
@@ -155,8 +120,8 @@ static lm_status draw_all(GLuint prog, const lm_scene *s, const lm_emitters *em,
                           const lm_direct_mesh *mesh, int w, int h,
                           const lm_direct_settings *set, float *rgb, lm_error *err)
 {
-    float_target t = {0, 0, 0};
-    lm_status st = target_begin(&t, w, h, err);
+    lm_offscreen t;
+    lm_status st = lm_offscreen_begin_float(&t, w, h, err);
     if (st == LM_OK) {
         glUseProgram(prog);
         set_view_uniforms(prog, view, set);
@@ -166,11 +131,11 @@ static lm_status draw_all(GLuint prog, const lm_scene *s, const lm_emitters *em,
         if (em->e[i].kind != LM_EMIT_AREA)
             st = light_pass(prog, s, &em->e[i], mesh, &t, w, h, set, err);
     if (st == LM_OK) {
-        glBindFramebuffer(GL_FRAMEBUFFER, t.fbo);
-        read_back(w, h, rgb);
+        lm_offscreen_read_rgb(&t, rgb);
         st = lm_gl_check("direct_light: reading back", err);
     }
-    target_end(&t);
+    if (t.fbo)
+        lm_offscreen_release(&t);
     return st;
 }
 

@@ -34,8 +34,7 @@ static const char *FS =
     "    frag = vec4(srgb(exposure * texture(atlas, v_uv).rgb), 1.0);\n"
     "}\n";
 
-/* Position + lightmap UV per corner; UV (-1, -1) marks triangles without lightmap texels. */
-static float *build_vertices(const lm_scene *s, const lm_atlas *a)
+float *lm_lightmapped_vertices(const lm_scene *s, const lm_atlas *a)
 {
     float *v = malloc(sizeof(float) * 15 * (size_t)(s->tri_count ? s->tri_count : 1));
     if (!v)
@@ -73,7 +72,7 @@ lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *
     lm_status st = lm_gl_program("lightmap_view", VS, FS, &prog, err);
     if (st != LM_OK)
         return st;
-    float *verts = build_vertices(s, a);
+    float *verts = lm_lightmapped_vertices(s, a);
     if (!verts) {
         glDeleteProgram(prog);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap view", s->path);

@@ -8,7 +8,7 @@
 
 #include "gl_shader.h"
 
-static void release(lm_offscreen *o)
+void lm_offscreen_release(lm_offscreen *o)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteRenderbuffers(1, &o->color);
@@ -17,7 +17,7 @@ static void release(lm_offscreen *o)
     memset(o, 0, sizeof *o);
 }
 
-lm_status lm_offscreen_begin(lm_offscreen *o, int width, int height, lm_error *err)
+static lm_status begin(lm_offscreen *o, int width, int height, GLenum color_format, lm_error *err)
 {
     memset(o, 0, sizeof *o);
     o->width = width;
@@ -26,14 +26,14 @@ lm_status lm_offscreen_begin(lm_offscreen *o, int width, int height, lm_error *e
     glGenRenderbuffers(1, &o->color);
     glGenRenderbuffers(1, &o->depth);
     glBindRenderbuffer(GL_RENDERBUFFER, o->color);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+    glRenderbufferStorage(GL_RENDERBUFFER, color_format, width, height);
     glBindRenderbuffer(GL_RENDERBUFFER, o->depth);
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
     glBindFramebuffer(GL_FRAMEBUFFER, o->fbo);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, o->color);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, o->depth);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
-        release(o);
+        lm_offscreen_release(o);
         return lm_fail(err, LM_ERR_BACKEND, "offscreen target %dx%d is incomplete", width, height);
     }
     glViewport(0, 0, width, height);
@@ -44,13 +44,31 @@ lm_status lm_offscreen_begin(lm_offscreen *o, int width, int height, lm_error *e
     return LM_OK;
 }
 
+lm_status lm_offscreen_begin(lm_offscreen *o, int width, int height, lm_error *err)
+{
+    return begin(o, width, height, GL_RGBA8, err);
+}
+
+lm_status lm_offscreen_begin_float(lm_offscreen *o, int width, int height, lm_error *err)
+{
+    return begin(o, width, height, GL_RGBA32F, err);
+}
+
+void lm_offscreen_read_rgb(const lm_offscreen *o, float *rgb)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, o->fbo);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    for (int y = 0; y < o->height; y++) /* GL's rows start at the bottom */
+        glReadPixels(0, o->height - 1 - y, o->width, 1, GL_RGB, GL_FLOAT, rgb + 3 * (size_t)o->width * y);
+}
+
 lm_status lm_offscreen_end(lm_offscreen *o, uint8_t *rgba8, lm_error *err)
 {
     int w = o->width, h = o->height;
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_UNSIGNED_BYTE, rgba8);
     lm_status st = lm_gl_check("reading back the picture", err);
-    release(o);
+    lm_offscreen_release(o);
     /* GL's rows start at the bottom; images start at the top. */
     uint8_t *tmp = malloc((size_t)w * 4);
     if (!tmp)

@@ -1,4 +1,5 @@
-/* An offscreen render target (colour + depth) and reading it back as a top-down RGBA8 image. */
+/* An offscreen render target (colour + depth): RGBA8 read back as a top-down picture, or RGBA32F for
+ * linear HDR read back as top-down RGB floats. */
 #ifndef LM_OFFSCREEN_H
 #define LM_OFFSCREEN_H
 
@@ -15,5 +16,11 @@ typedef struct {
 lm_status lm_offscreen_begin(lm_offscreen *o, int width, int height, lm_error *err);
 /* Reads the picture back into rgba8 (row 0 at the top), unbinds and deletes the target. */
 lm_status lm_offscreen_end(lm_offscreen *o, uint8_t *rgba8, lm_error *err);
+/* The same with an RGBA32F colour buffer, for linear HDR passes. */
+lm_status lm_offscreen_begin_float(lm_offscreen *o, int width, int height, lm_error *err);
+/* Reads a float target's RGB into rgb (width*height*3, row 0 at the top); the target stays bound. */
+void lm_offscreen_read_rgb(const lm_offscreen *o, float *rgb);
+/* Unbinds and deletes a target (after lm_offscreen_read_rgb, or on an error path). */
+void lm_offscreen_release(lm_offscreen *o);
 
 #endif
