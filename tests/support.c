@@ -1,6 +1,8 @@
 #define _XOPEN_SOURCE 700
 #include "support.h"
 
+#include "../src/gpu/gl_context.h"
+
 #include <ftw.h>
 #include <sys/stat.h>
 
@@ -258,6 +260,27 @@ void lmt_reference_texels(const lmt_pipeline *p, float target_error, lm_ref_resu
     lm_error err;
     if (lm_reference_texels(p->s, &p->atlas, p->rt, &p->em, &rs, out, &err) != LM_OK)
         fail_msg("reference: %s", err.msg);
+}
+
+static lm_gl_context *g_gl;
+
+int lmt_gl_setup(void **state)
+{
+    (void)state;
+    lm_error err;
+    if (lm_gl_context_create(&g_gl, &err) != LM_OK) {
+        fprintf(stderr, "GL context: %s\n", err.msg);
+        return -1;
+    }
+    return 0;
+}
+
+int lmt_gl_teardown(void **state)
+{
+    (void)state;
+    lm_gl_context_destroy(g_gl);
+    g_gl = NULL;
+    return 0;
 }
 
 const char *lmt_plane_scene(void)

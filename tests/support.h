@@ -45,6 +45,10 @@ void lmt_pipeline_free(lmt_pipeline *p);
 #include "../src/trace/reference.h"
 void lmt_reference_texels(const lmt_pipeline *p, float target_error, lm_ref_result *out);
 
+/* cmocka group fixtures for tests that render: one GL context, current for the whole group. */
+int lmt_gl_setup(void **state);
+int lmt_gl_teardown(void **state);
+
 /* A 20 x 20 plane (y = 0, facing up, default 0.8 grey material) under a point light of intensity 10 at
  * height 2, written to a fresh temporary directory; returns its path (static storage). */
 const char *lmt_plane_scene(void);

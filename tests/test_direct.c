@@ -26,25 +26,6 @@
 #define HALF 2.0f   /* the camera sees x, z in [-HALF, HALF] */
 #define RHO 0.8     /* the default material's albedo */
 
-static lm_gl_context *g_ctx;
-
-static int setup(void **state)
-{
-    (void)state;
-    lm_error err;
-    if (lm_gl_context_create(&g_ctx, &err) != LM_OK) {
-        fprintf(stderr, "GL context: %s\n", err.msg);
-        return -1;
-    }
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lm_gl_context_destroy(g_ctx);
-    return 0;
-}
 
 /* Looking down -Y from y = 5: image x = world x, image up = world -z. */
 static void top_view(lm_view *v)
@@ -413,5 +394,5 @@ int main(void)
         cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
         cmocka_unit_test(test_deterministic),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

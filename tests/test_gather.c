@@ -32,25 +32,6 @@
  * reference's noise, not for a regression. */
 #define IIM_RMSE_BOUND 0.13
 
-static lm_gl_context *g_ctx;
-
-static int setup(void **state)
-{
-    (void)state;
-    lm_error err;
-    if (lm_gl_context_create(&g_ctx, &err) != LM_OK) {
-        fprintf(stderr, "GL context: %s\n", err.msg);
-        return -1;
-    }
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lm_gl_context_destroy(g_ctx);
-    return 0;
-}
 
 typedef struct {
     lm_scene *s;
@@ -640,5 +621,5 @@ int main(void)
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_box_against_reference),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

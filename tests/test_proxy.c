@@ -28,25 +28,6 @@
  * on the proxy and the original (either way) measured 1.83x the target. */
 #define PROXY_HAUSDORFF_FACTOR 2.0f
 
-static lm_gl_context *g_ctx;
-
-static int setup(void **state)
-{
-    (void)state;
-    lm_error err;
-    if (lm_gl_context_create(&g_ctx, &err) != LM_OK) {
-        fprintf(stderr, "GL context: %s\n", err.msg);
-        return -1;
-    }
-    return 0;
-}
-
-static int teardown(void **state)
-{
-    (void)state;
-    lm_gl_context_destroy(g_ctx);
-    return 0;
-}
 
 /* Distance from q to the segment [a, b]. */
 static float seg_dist(lm_vec3 q, lm_vec3 a, lm_vec3 b)
@@ -298,5 +279,5 @@ int main(void)
         cmocka_unit_test(test_cornell_proxy),
         cmocka_unit_test(test_cornell_gather_with_proxy),
     };
-    return cmocka_run_group_tests(tests, setup, teardown);
+    return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }
