@@ -6,9 +6,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "../src/gpu/gl_api.h"
 
 #include <math.h>
 #include <stdint.h>

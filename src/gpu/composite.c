@@ -1,9 +1,7 @@
 /* Indirect light of a frame (composite.h): one pass into an RGBA32F target with depth. */
 #include "composite.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 #include <math.h>
 #include <stdlib.h>
 

@@ -2,9 +2,7 @@
  * its shadow map and an additive pass (depth test LEQUAL, no depth writes) into an RGBA32F target. */
 #include "direct.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

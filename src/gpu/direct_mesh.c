@@ -1,8 +1,6 @@
 #include "direct_mesh.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,9 +1,7 @@
 #include "gl_context.h"
 
-#define GL_GLEXT_PROTOTYPES 1
 #include <GL/osmesa.h>
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 #include <stdio.h>
 #include <stdlib.h>
 

@@ -1,8 +1,6 @@
 #include "gl_shader.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 
 static lm_status compile(const char *name, const char *stage, GLenum type, const char *src, GLuint *out,
                          lm_error *err)

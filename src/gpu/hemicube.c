@@ -1,9 +1,7 @@
 /* Hemicube weights, F(a) and the IIM texture helpers (hemicube.h). */
 #include "hemicube.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 #include <math.h>
 
 #include "gl_shader.h"

@@ -2,9 +2,7 @@
  * reduction per tile that writes straight into the IIM texture (Larsen & Christensen section 4). */
 #include "hemicube.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,9 +1,7 @@
 /* IIM scheduling, double-buffered blending and invalid-texel filling (iim.h). */
 #include "iim.h"
 
-#define GL_GLEXT_PROTOTYPES 1
-#include <GL/gl.h>
-#include <GL/glext.h>
+#include "gl_api.h"
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
