@@ -1,12 +1,17 @@
-/* The OpenGL context lmgi renders with: headless OSMesa (Mesa llvmpipe) with a 4.5 core profile.
- * Rendering goes to framebuffer objects the caller makes; the context's own buffer is a 1x1 dummy.
- * The backend is chosen at run time: the interface leaves room for EGL on machines with a GPU. */
+/* The OpenGL context lmgi renders with: an OpenGL 4.5 core profile without a window. Rendering goes to
+ * framebuffer objects the caller makes.
+ *
+ * The backend is chosen at run time by the environment variable LMGI_GL:
+ *   auto (or unset)  EGL when it gives a hardware renderer (a GPU), else OSMesa;
+ *   egl              EGL only (an error if it fails);
+ *   osmesa           OSMesa only (Mesa llvmpipe; the tested path).
+ * GL functions are called through the current context's function table (gl_api.h). */
 #ifndef LM_GL_CONTEXT_H
 #define LM_GL_CONTEXT_H
 
 #include "../core/error.h"
 
-typedef enum { LM_GL_BACKEND_OSMESA = 0 } lm_gl_backend;
+typedef enum { LM_GL_BACKEND_OSMESA = 0, LM_GL_BACKEND_EGL = 1 } lm_gl_backend;
 
 typedef struct lm_gl_context lm_gl_context;
 
@@ -15,9 +20,13 @@ lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err);
 void lm_gl_context_destroy(lm_gl_context *ctx);
 lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err);
 lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx);
-/* "4.5 (Core Profile) Mesa 22.3.6 / llvmpipe ..." */
+/* "OSMesa" or "EGL". */
+const char *lm_gl_backend_name(lm_gl_backend backend);
+/* Version, renderer, backend and why: "4.5 (Core Profile) Mesa 22.3.6 / llvmpipe (LLVM 15.0.6, 256 bits)
+ * (OSMesa; EGL gave llvmpipe ...)" or "... (EGL, device /dev/dri/renderD128)". */
 const char *lm_gl_context_description(const lm_gl_context *ctx);
-/* Entry point of a GL function the library does not export directly (e.g. glClipControl); NULL if none. */
+/* Entry point of a GL function from the backend of the context current on the calling thread (e.g.
+ * glClipControl); NULL if none is current or the backend has no such function. */
 typedef void (*lm_gl_proc)(void);
 lm_gl_proc lm_gl_get_proc(const char *name);
 
