@@ -101,7 +101,9 @@ BENCH_ROOMS := 4 16 64
 bench: deps all $(BUILD)/gen_scenes
 	@mkdir -p $(BUILD)/bench
 	@for n in $(BENCH_ROOMS); do [ -f $(BUILD)/bench/rooms_$$n.glb ] || $(BUILD)/gen_scenes --rooms $$n $(BUILD)/bench/rooms_$$n.glb >/dev/null; done
-	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb)
+	@[ -f $(BUILD)/bench/cornell_255.glb ] || $(BUILD)/gen_scenes --cornell-cells 255 $(BUILD)/bench/cornell_255.glb >/dev/null
+	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb) \
+	  --gather-scene $(BUILD)/bench/cornell_255.glb
 
 scenes: $(BUILD)/gen_scenes
 	$(BUILD)/gen_scenes scenes

@@ -432,6 +432,60 @@ static void test_cornell_box_against_reference(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* The three ways of putting many texels into one pass give the same IIM: the shared Cornell box (AIMs
+ * from 20k photons, every texel) through viewports, instanced and (where the extension exists) layered.
+ * Measured: instanced worst texel 3.8e-3 of the mean E, rms 1.0e-4. */
+static void test_schemes_agree(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 40.0f);
+    lm_photon_stage *st = stage_for(&p, 20000);
+    uint32_t *texels = all_texels(&p.atlas);
+    float *iim[3] = {NULL, NULL, NULL};
+    for (int k = 0; k < 3; k++) {
+        lm_hemicube_settings set;
+        lm_hemicube_settings_default(&set);
+        set.scheme = (lm_gather_scheme)k;
+        lm_gather *g = NULL;
+        lm_error err;
+        if (lm_gather_create(&set, &g, &err) != LM_OK) {
+            assert_int_equal(k, LM_GATHER_LAYERED); /* only layered may be missing (an extension) */
+            print_message("layered scheme not tested: %s\n", err.msg);
+            continue;
+        }
+        lm_gather_free(g);
+        iim[k] = gather_aim(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), &set, texels, p.atlas.texel_count, NULL);
+    }
+    for (int k = 1; k < 3; k++) {
+        if (!iim[k])
+            continue;
+        double worst = 0.0, sum = 0.0, diff2 = 0.0;
+        for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
+            size_t at = 4 * ((size_t)p.atlas.texels[i].y * p.atlas.width + p.atlas.texels[i].x);
+            for (int c = 0; c < 3; c++) {
+                double d = fabs((double)iim[k][at + c] - iim[0][at + c]);
+                worst = fmax(worst, d);
+                diff2 += d * d;
+                sum += iim[0][at + c];
+            }
+            assert_true(fabsf(iim[k][at + 3] - iim[0][at + 3]) < 1e-3f);
+        }
+        double mean = sum / (3.0 * p.atlas.texel_count), rms = sqrt(diff2 / (3.0 * p.atlas.texel_count));
+        print_message("%s vs viewports: worst texel differs by %.2e of the mean E, rms %.2e\n",
+                      lm_gather_scheme_name((lm_gather_scheme)k), worst / mean, rms / mean);
+        /* the same up to pixels whose centre lies on a triangle edge, which the tile mappings round apart */
+        assert_true(worst < 1e-2 * mean);
+        assert_true(rms < 3e-4 * mean);
+    }
+    for (int k = 0; k < 3; k++)
+        free(iim[k]);
+    free(texels);
+    lm_photon_stage_free(st);
+    lmt_pipeline_free(&p);
+}
+
 /* Three squares (three surfaces) of 25, 16 and 9 texels at texel size 0.1. */
 static void three_surfaces(tscene *t)
 {
@@ -618,6 +672,7 @@ int main(void)
         cmocka_unit_test(test_fill_invalid),
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_cornell_box_against_reference),
+        cmocka_unit_test(test_schemes_agree),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

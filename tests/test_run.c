@@ -107,8 +107,8 @@ static void test_deterministic(void **state)
     char a[1024];
     snprintf(a, sizeof a, "%s", quick_run("a"));
     const char *b = quick_run("b");
-    const char *frames[] = {"frame_0000.exr", "frame_0002.exr"};
-    for (int i = 0; i < 2; i++) {
+    const char *frames[] = {"frame_0000.exr", "frame_0002.exr", "iim.exr", "aim.exr"};
+    for (int i = 0; i < 4; i++) {
         int w, h, w2, h2;
         float *x = read_exr(a, frames[i], &w, &h), *y = read_exr(b, frames[i], &w2, &h2);
         assert_int_equal(w, w2);

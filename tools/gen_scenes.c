@@ -3,6 +3,7 @@
  * Usage:
  *   gen_scenes DIR                 writes DIR/cornell.glb, DIR/two_rooms.glb, DIR/many_rooms.glb
  *   gen_scenes --rooms N OUTFILE   writes a many_rooms variant with N rooms to OUTFILE (benchmark sizes)
+ *   gen_scenes --cornell-cells N OUTFILE  writes cornell.glb with an N x N cell floor (benchmark sizes)
  *
  * Output is deterministic: a fixed pseudo-random seed, no clocks, fixed float formatting, so running it
  * twice gives identical bytes. Units are metres, +Y is up. lmgi conventions used here:
@@ -722,7 +723,9 @@ static void build_room(mesh parts[3], const room_desc *r)
 /* ------------------------------------------------------------------------------------------------ */
 /* (a) Cornell box with a bumpy floor                                                                */
 
-#define CB_CELLS 80
+/* Floor grid cells per side: 80 for scenes/cornell.glb (13,790 triangles); --cornell-cells for the
+ * gather benchmark's finer variants. */
+static int CB_CELLS = 80;
 
 /* Unscaled bump field; zero on the border (cos window), so the walls meet the floor at y = 0. */
 static double bump_raw(double x, double z)
@@ -1136,6 +1139,7 @@ static void usage(void)
     fprintf(stderr,
             "usage: gen_scenes DIR                 write DIR/cornell.glb, DIR/two_rooms.glb, DIR/many_rooms.glb\n"
             "       gen_scenes --rooms N OUTFILE   write a many_rooms variant with N rooms (1..100000) to OUTFILE\n"
+            "       gen_scenes --cornell-cells N OUTFILE  write cornell.glb with N x N floor cells (2..1000; default 80)\n"
             "The default many_rooms has 16 rooms (about 22,100 triangles each); the benchmark uses --rooms\n"
             "for smaller and larger variants.\n");
     exit(2);
@@ -1148,6 +1152,14 @@ int main(int argc, char **argv)
         long n = strtol(argv[2], &end, 10);
         if (*end || n < 1 || n > 100000) usage();
         gen_many_rooms(argv[3], (int)n);
+        return 0;
+    }
+    if (argc == 4 && strcmp(argv[1], "--cornell-cells") == 0) {
+        char *end;
+        long n = strtol(argv[2], &end, 10);
+        if (*end || n < 2 || n > 1000) usage();
+        CB_CELLS = (int)n;
+        gen_cornell(argv[3]);
         return 0;
     }
     if (argc != 2 || argv[1][0] == '-') usage();

@@ -58,12 +58,22 @@ static int add_file(const char **list, int *count, const char *f)
     return 0;
 }
 
+static int parse_scheme(const char *o, const char *v, int *out)
+{
+    static const char *names[] = {"viewports", "instanced", "layered"};
+    for (int k = 0; v && k < 3; k++)
+        if (!strcmp(v, names[k]))
+            return *out = k, 0;
+    return bad(o, v, "viewports, instanced or layered");
+}
+
 int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
 {
     memset(a, 0, sizeof *a);
     lmgi_options_init(&a->options);
     a->repeats = 3;
     a->camera = -1;
+    a->gather_scheme = -1;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -114,6 +124,14 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_int(o, v, 1, 100000000, &a->texels_per_frame);
         else if (!strcmp(o, "--exr-every"))
             rc = parse_int(o, v, 1, 1000000, &a->exr_every);
+        else if (!strcmp(o, "--hemicube"))
+            rc = parse_int(o, v, 2, 1024, &a->hemicube);
+        else if (!strcmp(o, "--enlargement"))
+            rc = parse_float(o, v, 1e-3f, &a->enlargement);
+        else if (!strcmp(o, "--gather-scheme"))
+            rc = parse_scheme(o, v, &a->gather_scheme);
+        else if (!strcmp(o, "--gather-scene"))
+            rc = v ? (a->gather_scene = v, 0) : bad(o, v, "a scene file");
         else if (!strcmp(o, "--scaling"))
             rc = v ? add_file(a->scaling, &a->scaling_count, v) : bad(o, v, "a scene file");
         else {

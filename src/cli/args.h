@@ -35,6 +35,10 @@ typedef struct {
     /* lmgi run (0 = default) */
     int texels_per_frame;   /* --texels-per-frame N: IIM gather budget per frame */
     int exr_every;          /* --exr-every K: every K-th frame also as EXR */
+    int hemicube;           /* --hemicube R: hemicube plane pixels per side */
+    float enlargement;      /* --enlargement a: hemicube plane half-side at distance 1 */
+    int gather_scheme;      /* --gather-scheme viewports|instanced|layered (-1 = default) */
+    const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
 } lm_cli_args;
 
 /* Parses argv[first..argc). Returns 0 on success, or prints what was wrong and returns 2. */

@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "../core/stats.h"
+#include "bench_gather.h"
 #include "bench_photons.h"
 
 /* Scenes timed when none are named: ours first, then the shared ones (skipped when absent). */
@@ -161,7 +162,9 @@ int lm_cli_bench(const lm_cli_args *a)
     if (a->json_path)
         write_json(a->json_path, res, n, sr, sn);
     free(res);
-    if (a->file_count == 0)
+    if (a->file_count == 0) {
         lm_cli_bench_photons();
+        lm_cli_bench_gather(a->gather_scene);
+    }
     return rc;
 }

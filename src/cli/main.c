@@ -37,9 +37,13 @@ static void usage(FILE *f)
             "  --size WxH       picture size for 'charts' (default 1024x768) and 'run' (default 512x512)\n"
             "  --frames N       'run': frames to play at 30 per second of animation (default 60)\n"
             "  --texels-per-frame N  'run': IIM texels gathered per frame (default 20)\n"
+            "  --hemicube R     'run': hemicube plane pixels per side (default 32)\n"
+            "  --enlargement A  'run': hemicube plane half-side a (default 2)\n"
+            "  --gather-scheme S 'run': viewports, instanced or layered (default: the fastest measured)\n"
             "  --exr-every K    'run': every K-th frame also as linear EXR (default 10)\n"
             "  --repeats N      'bench': runs per scene, the median is reported (default 3)\n"
             "  --json FILE      'bench': also write the results as JSON\n"
+            "  --gather-scene F 'bench': the ~133k-triangle Cornell box for the gather table (make bench makes it)\n"
             "  -v, -q           more / less on stderr\n");
 }
 

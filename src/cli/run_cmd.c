@@ -34,6 +34,12 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
     lm_cli_photon_settings(a, &s->stage);
     if (a->texels_per_frame)
         s->iim.texels_per_frame = a->texels_per_frame;
+    if (a->hemicube)
+        s->gather.resolution = a->hemicube;
+    if (a->enlargement > 0.0f)
+        s->gather.enlargement = a->enlargement;
+    if (a->gather_scheme >= 0)
+        s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
     if (a->width) {
         s->width = a->width;
         s->height = a->height;

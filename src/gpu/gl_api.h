@@ -40,6 +40,7 @@
     X(glClearColor, PFNGLCLEARCOLORPROC) \
     X(glClearDepth, PFNGLCLEARDEPTHPROC) \
     X(glClearTexImage, PFNGLCLEARTEXIMAGEPROC) \
+    X(glClearTexSubImage, PFNGLCLEARTEXSUBIMAGEPROC) \
     X(glClipControl, PFNGLCLIPCONTROLPROC) \
     X(glCompileShader, PFNGLCOMPILESHADERPROC) \
     X(glCreateProgram, PFNGLCREATEPROGRAMPROC) \
@@ -74,6 +75,7 @@
     X(glGetShaderInfoLog, PFNGLGETSHADERINFOLOGPROC) \
     X(glGetShaderiv, PFNGLGETSHADERIVPROC) \
     X(glGetString, PFNGLGETSTRINGPROC) \
+    X(glGetStringi, PFNGLGETSTRINGIPROC) \
     X(glGetTexImage, PFNGLGETTEXIMAGEPROC) \
     X(glGetUniformLocation, PFNGLGETUNIFORMLOCATIONPROC) \
     X(glLinkProgram, PFNGLLINKPROGRAMPROC) \
@@ -187,6 +189,7 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glClearColor (lm_gl_cur->glClearColor)
 #define glClearDepth (lm_gl_cur->glClearDepth)
 #define glClearTexImage (lm_gl_cur->glClearTexImage)
+#define glClearTexSubImage (lm_gl_cur->glClearTexSubImage)
 #define glClientWaitSync (lm_gl_cur->glClientWaitSync)
 #define glClipControl (lm_gl_cur->glClipControl)
 #define glColorMask (lm_gl_cur->glColorMask)
@@ -244,6 +247,7 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glGetShaderInfoLog (lm_gl_cur->glGetShaderInfoLog)
 #define glGetShaderiv (lm_gl_cur->glGetShaderiv)
 #define glGetString (lm_gl_cur->glGetString)
+#define glGetStringi (lm_gl_cur->glGetStringi)
 #define glGetTexImage (lm_gl_cur->glGetTexImage)
 #define glGetTexLevelParameteriv (lm_gl_cur->glGetTexLevelParameteriv)
 #define glGetUniformLocation (lm_gl_cur->glGetUniformLocation)

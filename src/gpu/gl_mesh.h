@@ -1,17 +1,22 @@
-/* Triangles for drawing: a vertex array and buffer of interleaved float attributes. */
+/* Triangles for drawing: a vertex array and buffer of interleaved float attributes, optionally indexed. */
 #ifndef LM_GL_MESH_H
 #define LM_GL_MESH_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 typedef struct {
-    unsigned vao, vbo;
-    int vertices;
+    unsigned vao, vbo, ibo;
+    int vertices;         /* vertices drawn: index count when indexed */
 } lm_gl_mesh;
 
 /* Uploads `vertices` vertices of interleaved floats; attribute i (location i) has sizes[i] floats. */
 void lm_gl_mesh_create(lm_gl_mesh *m, const float *data, int vertices, const int *sizes, int attributes);
+/* The same triangles with identical vertices shared through an index buffer (fewer vertex shader runs).
+ * Returns 0 when out of memory (nothing created). */
+int lm_gl_mesh_create_indexed(lm_gl_mesh *m, const float *data, int vertices, const int *sizes, int attributes);
 void lm_gl_mesh_draw(const lm_gl_mesh *m);
+void lm_gl_mesh_draw_instanced(const lm_gl_mesh *m, int instances);
 void lm_gl_mesh_destroy(lm_gl_mesh *m);
 
 #endif

@@ -17,6 +17,12 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->offset = 1e-4f;
     s->tiles = 16;
     s->proxy_error = LM_PROXY_DEFAULT_ERROR;
+    s->scheme = LM_GATHER_VIEWPORTS;
+}
+
+const char *lm_gather_scheme_name(lm_gather_scheme s)
+{
+    return s == LM_GATHER_VIEWPORTS ? "viewports" : s == LM_GATHER_INSTANCED ? "instanced" : "layered";
 }
 
 /* Integral of 1 / (pi (1 + x^2 + y^2)^2) over [0, X] x [0, Y] (odd in X and in Y). */

@@ -36,6 +36,17 @@
 #include "../core/error.h"
 #include "../scene/scene.h"
 
+/* How a pass puts many texels' planes into one render target (docs/gather.md, "Throughput"). */
+typedef enum {
+    LM_GATHER_VIEWPORTS = 0, /* one draw per texel into its own viewport tile */
+    LM_GATHER_INSTANCED = 1, /* one instanced draw per pass, each instance cut to its tile by clip distances */
+    LM_GATHER_LAYERED = 2    /* one instanced draw per pass into a layered target (needs
+                                GL_ARB_shader_viewport_layer_array) */
+} lm_gather_scheme;
+
+/* "viewports", "instanced", "layered" */
+const char *lm_gather_scheme_name(lm_gather_scheme s);
+
 typedef struct {
     int resolution;        /* R, pixels per side of the plane (default 32) */
     float enlargement;     /* a, half-side of the plane at distance 1 (default 2: F = 0.831) */
@@ -44,6 +55,7 @@ typedef struct {
     float offset;          /* texel centre lifted along its normal by this x scene size (default 1e-4) */
     int tiles;             /* tiles per side of the render target: tiles^2 texels per pass (default 16) */
     float proxy_error;     /* gather proxy's error bound x scene size (default 0.005; 0: the full scene) */
+    lm_gather_scheme scheme; /* default LM_GATHER_VIEWPORTS, the fastest measured (docs/gather.md) */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);

@@ -13,76 +13,19 @@
 #include "gl_context.h"
 #include "gl_mesh.h"
 #include "gl_shader.h"
+#include "hemicube_shaders.h"
 
 /* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided,
- * surface (-1 when none). */
+ * surface (-1 when none); a view: 4 vec4 (hemicube_shaders.c). */
 #define VERTEX_FLOATS 13
-
-static const char *RENDER_VS =
-    "#version 450 core\n"
-    "layout(location = 0) in vec3 pos;\n"
-    "layout(location = 1) in vec2 uv;\n"
-    "layout(location = 2) in vec3 emit;\n"
-    "layout(location = 3) in vec3 face_n;\n"
-    "layout(location = 4) in float one_sided;\n"
-    "layout(location = 5) in float surface;\n"
-    "uniform mat4 view_proj;\n"
-    "out vec3 v_pos; out vec2 v_uv; flat out vec3 v_emit; flat out vec3 v_n; flat out float v_one, v_surf;\n"
-    "void main() {\n"
-    "    v_pos = pos; v_uv = uv; v_emit = emit; v_n = face_n; v_one = one_sided; v_surf = surface;\n"
-    "    gl_Position = view_proj * vec4(pos, 1.0);\n"
-    "}\n";
-/* rgb: what the plane sees; a: 1 on the back of a single-sided surface (counted, shown black). The back
- * of the texel's own surface is skipped: a surface stays within a 30 degree cone, so only a simplified
- * (proxy) copy of it can pass above the texel. */
-static const char *RENDER_FS =
-    "#version 450 core\n"
-    "in vec3 v_pos; in vec2 v_uv; flat in vec3 v_emit; flat in vec3 v_n; flat in float v_one, v_surf;\n"
-    "uniform sampler2D aim;\n"
-    "uniform vec3 eye;\n"
-    "uniform float own_surface;\n"
-    "out vec4 frag;\n"
-    "void main() {\n"
-    "    if (dot(v_n, v_pos - eye) > 0.0) {\n"
-    "        if (v_surf >= 0.0 && v_surf == own_surface) discard;\n"
-    "        if (v_one > 0.5) { frag = vec4(0.0, 0.0, 0.0, 1.0); return; }\n"
-    "    }\n"
-    "    vec3 L = v_uv.x < 0.0 ? vec3(0.0) : texture(aim, v_uv).rgb;\n"
-    "    frag = vec4(L + v_emit, 0.0);\n"
-    "}\n";
-/* One work group per tile: weighted sums in a fixed order, then a fixed tree (deterministic). */
-static const char *REDUCE_CS =
-    "#version 450 core\n"
-    "layout(local_size_x = 64) in;\n"
-    "layout(binding = 0) uniform sampler2D tiles;\n"
-    "layout(binding = 0, rgba32f) uniform writeonly image2D iim;\n"
-    "layout(std430, binding = 0) readonly buffer Weights { float w[]; };\n"
-    "layout(std430, binding = 1) readonly buffer Targets { ivec2 xy[]; };\n"
-    "uniform int R;\n"
-    "uniform int tiles_x;\n"
-    "uniform float scale;   /* pi / F(a) */\n"
-    "uniform float inv_f;   /* 1 / F(a) */\n"
-    "shared vec4 part[64];\n"
-    "void main() {\n"
-    "    int tile = int(gl_WorkGroupID.x), lid = int(gl_LocalInvocationID.x);\n"
-    "    ivec2 origin = ivec2(tile % tiles_x, tile / tiles_x) * R;\n"
-    "    vec4 s = vec4(0.0);\n"
-    "    for (int p = lid; p < R * R; p += 64)\n"
-    "        s += w[p] * texelFetch(tiles, origin + ivec2(p % R, p / R), 0);\n"
-    "    part[lid] = s;\n"
-    "    barrier();\n"
-    "    for (int k = 32; k > 0; k >>= 1) {\n"
-    "        if (lid < k) part[lid] += part[lid + k];\n"
-    "        barrier();\n"
-    "    }\n"
-    "    if (lid == 0) imageStore(iim, xy[tile], vec4(scale * part[0].rgb, inv_f * part[0].a));\n"
-    "}\n";
+#define VIEW_FLOATS 16
 
 struct lm_gather {
     lm_hemicube_settings set;
     GLuint render_prog, reduce_prog;
     GLuint fbo, color, depth;
-    GLuint weights_buf, targets_buf;
+    GLuint weights_buf, targets_buf, views_buf;
+    float *views;          /* a pass's views (schemes 1, 2), tiles^2 * VIEW_FLOATS */
     GLuint aim_tex;
     int aim_w, aim_h;
     lm_gl_mesh mesh;
@@ -94,21 +37,29 @@ struct lm_gather {
     double coverage;
 };
 
+/* Schemes 0, 1: one (tiles R)^2 2D target; scheme 2: R x R x tiles^2 layers. */
 static lm_status make_target(lm_gather *g, lm_error *err)
 {
-    int side = g->set.tiles * g->set.resolution;
-    glGenTextures(1, &g->color);
-    glBindTexture(GL_TEXTURE_2D, g->color);
-    glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, side, side);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    glGenRenderbuffers(1, &g->depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, g->depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, side, side);
+    int R = g->set.resolution, side = g->set.tiles * R, layers = g->set.tiles * g->set.tiles;
+    int layered = g->set.scheme == LM_GATHER_LAYERED;
+    GLenum kind = layered ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D;
+    GLuint tex[2];
+    glGenTextures(2, tex);
+    g->color = tex[0], g->depth = tex[1];
+    for (int k = 0; k < 2; k++) {
+        GLenum format = k == 0 ? GL_RGBA32F : GL_DEPTH_COMPONENT32F;
+        glBindTexture(kind, tex[k]);
+        if (layered)
+            glTexStorage3D(kind, 1, format, R, R, layers);
+        else
+            glTexStorage2D(kind, 1, format, side, side);
+        glTexParameteri(kind, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(kind, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
     glGenFramebuffers(1, &g->fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, g->color, 0);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, g->depth);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, g->color, 0);
+    glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, g->depth, 0);
     GLenum fb = glCheckFramebufferStatus(GL_FRAMEBUFFER);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (fb != GL_FRAMEBUFFER_COMPLETE)
@@ -131,10 +82,26 @@ static lm_status upload_weights(lm_gather *g, lm_error *err)
     free(w);
     glGenBuffers(1, &g->targets_buf);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->targets_buf);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * 2 * (size_t)g->set.tiles * (size_t)g->set.tiles),
-                 NULL, GL_DYNAMIC_DRAW);
+    size_t per_pass = (size_t)g->set.tiles * (size_t)g->set.tiles;
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * 2 * per_pass), NULL, GL_DYNAMIC_DRAW);
+    glGenBuffers(1, &g->views_buf);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->views_buf);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * VIEW_FLOATS * per_pass), NULL, GL_DYNAMIC_DRAW);
+    g->views = malloc(sizeof(float) * VIEW_FLOATS * per_pass);
+    if (!g->views)
+        return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory for views");
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     return lm_gl_check("hemicube gather: weight buffers", err);
+}
+
+static int has_extension(const char *name)
+{
+    GLint n = 0;
+    glGetIntegerv(GL_NUM_EXTENSIONS, &n);
+    for (GLint i = 0; i < n; i++)
+        if (strcmp((const char *)glGetStringi(GL_EXTENSIONS, (GLuint)i), name) == 0)
+            return 1;
+    return 0;
 }
 
 static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
@@ -143,9 +110,17 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_side);
     if (s->resolution < 2 || s->tiles < 1 || !(s->enlargement > 0.0f) || !(s->offset >= 0.0f) ||
         !(s->proxy_error >= 0.0f && s->proxy_error < 1.0f) ||
-        (long)s->resolution * s->tiles > max_side)
+        (s->scheme != LM_GATHER_LAYERED && (long)s->resolution * s->tiles > max_side) ||
+        (unsigned)s->scheme > LM_GATHER_LAYERED)
         return lm_fail(err, LM_ERR_INVALID, "hemicube settings out of range (resolution %d, tiles %d, a %g)",
                        s->resolution, s->tiles, (double)s->enlargement);
+    GLint layers = 0;
+    glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &layers);
+    if (s->scheme == LM_GATHER_LAYERED && (!has_extension("GL_ARB_shader_viewport_layer_array") ||
+                                           (long)s->tiles * s->tiles > layers))
+        return lm_fail(err, LM_ERR_BACKEND, "hemicube gather: the layered scheme needs "
+                       "GL_ARB_shader_viewport_layer_array and %d array layers; use the instanced scheme",
+                       s->tiles * s->tiles);
     return LM_OK;
 }
 
@@ -160,9 +135,7 @@ lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the hemicube gather");
     g->set = *set;
     g->coverage = lm_hemicube_coverage(set->enlargement);
-    st = lm_gl_program("hemicube_render", RENDER_VS, RENDER_FS, &g->render_prog, err);
-    if (st == LM_OK)
-        st = lm_gl_compute_program("hemicube_reduce", REDUCE_CS, &g->reduce_prog, err);
+    st = lm_hemicube_programs(set->scheme, &g->render_prog, &g->reduce_prog, err);
     if (st == LM_OK)
         st = make_target(g, err);
     if (st == LM_OK)
@@ -183,11 +156,11 @@ void lm_gather_free(lm_gather *g)
         lm_gl_mesh_destroy(&g->mesh);
     if (g->has_proxy)
         lm_proxy_free(&g->proxy);
-    GLuint bufs[2] = {g->weights_buf, g->targets_buf};
-    glDeleteBuffers(2, bufs);
-    glDeleteTextures(1, &g->aim_tex);
-    glDeleteTextures(1, &g->color);
-    glDeleteRenderbuffers(1, &g->depth);
+    GLuint bufs[3] = {g->weights_buf, g->targets_buf, g->views_buf};
+    glDeleteBuffers(3, bufs);
+    free(g->views);
+    GLuint tex[3] = {g->aim_tex, g->color, g->depth};
+    glDeleteTextures(3, tex);
     glDeleteFramebuffers(1, &g->fbo);
     glDeleteProgram(g->render_prog);
     glDeleteProgram(g->reduce_prog);
@@ -278,9 +251,10 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
     if (g->has_mesh)
         lm_gl_mesh_destroy(&g->mesh);
     const int sizes[6] = {3, 2, 3, 3, 1, 1};
-    lm_gl_mesh_create(&g->mesh, v, (int)(3 * count), sizes, 6);
-    g->has_mesh = 1;
+    g->has_mesh = lm_gl_mesh_create_indexed(&g->mesh, v, (int)(3 * count), sizes, 6);
     free(v);
+    if (!g->has_mesh)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the gather geometry", s->path);
     return lm_gl_check("hemicube gather: scene upload", err);
 }
 
@@ -325,55 +299,130 @@ static void texel_frame(const lm_scene *s, const lm_texel *tx, lm_vec3 *pos, lm_
     *n = lm_length(nn) > 0.0f ? lm_normalize(nn) : lm_normalize(lm_v3_load(tx->normal));
 }
 
-/* Reversed-depth projection through the plane [-a, a]^2 at distance 1 along n, from eye e (column-major):
- * clip = (b.q / a, t.q / a, near, n.q) for q = p - e, so depth = near / distance, no far plane. */
-static void plane_view_proj(lm_vec3 e, lm_vec3 n, float a, float near, float m[16])
+/* The plane's axes scaled to clip space: b / a, t / a (x, y in [-w, w] on the plane) and n (w). */
+static void plane_axes(lm_vec3 n, float a, lm_vec3 axes[3])
 {
     lm_vec3 helper = fabsf(n.x) < 0.9f ? lm_v3(1, 0, 0) : lm_v3(0, 1, 0);
     lm_vec3 t = lm_normalize(lm_cross(helper, n)), b = lm_cross(n, t);
-    const lm_vec3 rows[3] = {lm_scale(b, 1.0f / a), lm_scale(t, 1.0f / a), n};
+    axes[0] = lm_scale(b, 1.0f / a), axes[1] = lm_scale(t, 1.0f / a), axes[2] = n;
+}
+
+/* Reversed-depth projection (column-major): clip = (b.q / a, t.q / a, near, n.q) for q = p - e, so
+ * depth = near / distance, no far plane. */
+static void plane_view_proj(lm_vec3 e, const lm_vec3 axes[3], float near, float m[16])
+{
     const int at[3] = {0, 1, 3};
     memset(m, 0, 16 * sizeof(float));
     for (int r = 0; r < 3; r++) {
-        m[0 + at[r]] = rows[r].x, m[4 + at[r]] = rows[r].y, m[8 + at[r]] = rows[r].z;
-        m[12 + at[r]] = -lm_dot(rows[r], e);
+        m[0 + at[r]] = axes[r].x, m[4 + at[r]] = axes[r].y, m[8 + at[r]] = axes[r].z;
+        m[12 + at[r]] = -lm_dot(axes[r], e);
     }
     m[12 + 2] = near;
+}
+
+typedef struct {
+    lm_vec3 eye, axes[3];
+    float surface;
+} texel_view;
+
+static texel_view view_of(const lm_gather *g, const lm_scene *s, const lm_texel *tx)
+{
+    lm_vec3 p, n;
+    texel_frame(s, tx, &p, &n);
+    texel_view v;
+    v.eye = lm_add(p, lm_scale(n, g->set.offset * lm_scene_size(s)));
+    plane_axes(n, g->set.enlargement, v.axes);
+    v.surface = (float)tx->surface;
+    return v;
+}
+
+static float near_plane(const lm_gather *g, const lm_scene *s)
+{
+    float near = 0.5f * g->set.offset * lm_scene_size(s);
+    return near > 0.0f ? near : 1e-6f;
+}
+
+/* Clears the part of the target `count` texels use: sky radiance, depth 0 (reversed). */
+static void clear_target(lm_gather *g, uint32_t count)
+{
+    int R = g->set.resolution, T = g->set.tiles;
+    const float sky[4] = {g->set.sky[0], g->set.sky[1], g->set.sky[2], 0.0f}, zero = 0.0f;
+    if (g->set.scheme == LM_GATHER_LAYERED) {
+        glClearTexSubImage(g->color, 0, 0, 0, 0, R, R, (GLsizei)count, GL_RGBA, GL_FLOAT, sky);
+        glClearTexSubImage(g->depth, 0, 0, 0, 0, R, R, (GLsizei)count, GL_DEPTH_COMPONENT, GL_FLOAT, &zero);
+        return;
+    }
+    int rows = (int)((count + (uint32_t)T - 1) / (uint32_t)T);
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(0, 0, T * R, rows * R);
+    glClearColor(sky[0], sky[1], sky[2], 0.0f);
+    glClearDepth(0.0);
+    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    glDisable(GL_SCISSOR_TEST);
+}
+
+/* Scheme 0: one draw per texel, its view in uniforms, its tile a viewport. */
+static void draw_viewports(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
+{
+    int R = g->set.resolution, T = g->set.tiles;
+    GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
+    GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
+    float near = near_plane(g, s);
+    for (uint32_t i = 0; i < count; i++) {
+        texel_view v = view_of(g, s, &a->texels[texels[i]]);
+        float m[16];
+        plane_view_proj(v.eye, v.axes, near, m);
+        glUniformMatrix4fv(vp_loc, 1, GL_FALSE, m);
+        glUniform3f(eye_loc, v.eye.x, v.eye.y, v.eye.z);
+        glUniform1f(own_loc, v.surface);
+        glViewport((int)(i % (uint32_t)T) * R, (int)(i / (uint32_t)T) * R, R, R);
+        lm_gl_mesh_draw(&g->mesh);
+    }
+}
+
+/* Schemes 1, 2: every texel's view into a buffer, then one instanced draw. */
+static void draw_instanced(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
+{
+    for (uint32_t i = 0; i < count; i++) {
+        texel_view v = view_of(g, s, &a->texels[texels[i]]);
+        float *o = g->views + VIEW_FLOATS * (size_t)i;
+        lm_v3_store(o, v.eye);
+        o[3] = v.surface;
+        for (int k = 0; k < 3; k++) {
+            lm_v3_store(o + 4 * (k + 1), v.axes[k]);
+            o[4 * (k + 1) + 3] = 0.0f;
+        }
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->views_buf);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * VIEW_FLOATS * count), g->views);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g->views_buf);
+    glUniform1i(glGetUniformLocation(g->render_prog, "tiles"), g->set.tiles);
+    glUniform1f(glGetUniformLocation(g->render_prog, "near"), near_plane(g, s));
+    int R = g->set.resolution, side = g->set.scheme == LM_GATHER_LAYERED ? R : g->set.tiles * R;
+    glViewport(0, 0, side, side);
+    int clip = g->set.scheme == LM_GATHER_INSTANCED;
+    for (int k = 0; clip && k < 4; k++)
+        glEnable(GL_CLIP_DISTANCE0 + k);
+    lm_gl_mesh_draw_instanced(&g->mesh, (int)count);
+    for (int k = 0; clip && k < 4; k++)
+        glDisable(GL_CLIP_DISTANCE0 + k);
 }
 
 static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count,
                          int *xy)
 {
-    int R = g->set.resolution, T = g->set.tiles;
-    float size = lm_scene_size(s), lift = g->set.offset * size, near = 0.5f * g->set.offset * size;
-    if (!(near > 0.0f))
-        near = 1e-6f;
     glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
-    glViewport(0, 0, T * R, T * R);
-    glDisable(GL_SCISSOR_TEST);
-    glClearColor(g->set.sky[0], g->set.sky[1], g->set.sky[2], 0.0f);
-    glClearDepth(0.0);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    clear_target(g, count);
     glUseProgram(g->render_prog);
     glUniform1i(glGetUniformLocation(g->render_prog, "aim"), 0);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
-    GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
-    GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
-    for (uint32_t i = 0; i < count; i++) {
-        const lm_texel *tx = &a->texels[texels[i]];
-        lm_vec3 p, n;
-        texel_frame(s, tx, &p, &n);
-        lm_vec3 e = lm_add(p, lm_scale(n, lift));
-        float m[16];
-        plane_view_proj(e, n, g->set.enlargement, near, m);
-        glUniformMatrix4fv(vp_loc, 1, GL_FALSE, m);
-        glUniform3f(eye_loc, e.x, e.y, e.z);
-        glUniform1f(own_loc, (float)tx->surface);
-        glViewport((int)(i % (uint32_t)T) * R, (int)(i / (uint32_t)T) * R, R, R);
-        lm_gl_mesh_draw(&g->mesh);
-        xy[2 * i] = tx->x, xy[2 * i + 1] = tx->y;
-    }
+    if (g->set.scheme == LM_GATHER_VIEWPORTS)
+        draw_viewports(g, s, a, texels, count);
+    else
+        draw_instanced(g, s, a, texels, count);
+    for (uint32_t i = 0; i < count; i++)
+        xy[2 * i] = a->texels[texels[i]].x, xy[2 * i + 1] = a->texels[texels[i]].y;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
@@ -387,11 +436,12 @@ static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t
     glUniform1f(glGetUniformLocation(g->reduce_prog, "scale"), (float)(3.14159265358979323846 / g->coverage));
     glUniform1f(glGetUniformLocation(g->reduce_prog, "inv_f"), (float)(1.0 / g->coverage));
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, g->color);
+    glBindTexture(g->set.scheme == LM_GATHER_LAYERED ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D, g->color);
     glBindImageTexture(0, iim_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->weights_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g->targets_buf);
-    glDispatchCompute(count, 1, 1);
+    glUniform1i(glGetUniformLocation(g->reduce_prog, "count"), (GLint)count);
+    glDispatchCompute((count + 7) / 8, 1, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 }
 

@@ -1,0 +1,275 @@
+/* lmgi bench, gather part (bench_gather.h). Each figure is the median over REPEATS alternating runs
+ * of one full pass (PASS texels spread over the atlas), glFinish included. */
+#include "bench_gather.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../charts/atlas_dilate.h"
+#include "../core/stats.h"
+#include "../core/timing.h"
+#include "../core/vecmath.h"
+#include "../gpu/gl_context.h"
+#include "../gpu/hemicube.h"
+#include "../photonmap/aim.h"
+#include "../update/lmgi_scene.h"
+#include "../update/photon_stage.h"
+
+#define REPEATS 5
+#define PASS 256
+#define RAYS_SIDE 32 /* 32 x 32 = 1,024 rays, the paper's ray-traced alternative */
+
+typedef struct {
+    const char *label;
+    int paper_row;         /* Table 2 row group: 34, 13,000, 133,000 polygons */
+    lmgi_scene *sc;
+    lm_photon_stage *stage;
+    float *aim;            /* dilated AIM (atlas RGB) */
+    uint32_t texels[PASS];
+    uint32_t count;
+} bench_scene;
+
+static int open_scene(const char *label, int paper_row, const char *path, bench_scene *b)
+{
+    memset(b, 0, sizeof *b);
+    b->label = label;
+    b->paper_row = paper_row;
+    lmgi_error perr;
+    if (access(path, R_OK) != 0 || lmgi_load(path, NULL, &b->sc, &perr) != LMGI_OK)
+        return 0;
+    lm_photon_stage_settings set;
+    lm_photon_stage_settings_default(&set);
+    lm_error err;
+    const lm_atlas *a = &b->sc->atlas;
+    if (lm_photon_stage_create(b->sc->scene, &b->sc->surfaces, a, b->sc->rt, &set, &b->stage, NULL, &err) != LM_OK) {
+        printf("%s: %s\n", label, err.msg);
+        return 0;
+    }
+    size_t n = 3 * (size_t)a->width * a->height;
+    b->aim = malloc(sizeof(float) * n);
+    if (!b->aim)
+        return 0;
+    memcpy(b->aim, lm_aim_rgb(lm_photon_stage_aim(b->stage)), sizeof(float) * n);
+    lm_atlas_dilate(a, b->aim, 3, a->gutter > 1 ? a->gutter : 1);
+    /* a pass of a ~100k-triangle scene without the proxy takes seconds: a quarter pass there */
+    uint32_t pass = b->sc->scene->tri_count > 50000 ? PASS / 4 : PASS;
+    b->count = a->texel_count < pass ? a->texel_count : pass;
+    for (uint32_t i = 0; i < b->count; i++) /* spread over the atlas */
+        b->texels[i] = (uint32_t)(((uint64_t)i * a->texel_count) / b->count);
+    return 1;
+}
+
+static void close_scene(bench_scene *b)
+{
+    lm_photon_stage_free(b->stage);
+    free(b->aim);
+    lmgi_free(b->sc);
+}
+
+/* A gather set up for one configuration (NULL on failure, with the reason printed). */
+static lm_gather *gather_for(const bench_scene *b, int R, int proxy, lm_gather_scheme scheme, int *tris)
+{
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    set.resolution = R;
+    set.scheme = scheme;
+    if (!proxy)
+        set.proxy_error = 0.0f;
+    lm_gather *g = NULL;
+    lm_error err;
+    if (lm_gather_create(&set, &g, &err) != LM_OK || lm_gather_set_scene(g, b->sc->scene, &b->sc->atlas, &err) != LM_OK ||
+        lm_gather_set_aim(g, &b->sc->atlas, lm_aim_rgb(lm_photon_stage_aim(b->stage)), &err) != LM_OK) {
+        printf("  %s: %s\n", b->label, err.msg);
+        lm_gather_free(g);
+        return NULL;
+    }
+    *tris = lm_gather_proxy(g) ? (int)lm_gather_proxy(g)->tri_count : (int)b->sc->scene->tri_count;
+    return g;
+}
+
+/* Seconds for one pass of b's texels. */
+static double time_pass(lm_gather *g, const bench_scene *b, unsigned iim)
+{
+    lm_gather_stats gs;
+    lm_error err;
+    if (lm_gather_texels(g, b->sc->scene, &b->sc->atlas, b->texels, b->count, iim, &gs, &err) != LM_OK) {
+        printf("  gather failed: %s\n", err.msg);
+        return NAN;
+    }
+    return gs.seconds;
+}
+
+/* Median ms per texel of each of n configurations, their runs alternating. */
+static void time_configs(lm_gather **g, int n, const bench_scene *b, double *ms_per_texel)
+{
+    unsigned iim = lm_iim_texture_create(b->sc->atlas.width, b->sc->atlas.height);
+    double runs[8][REPEATS];
+    for (int k = 0; k < n; k++)
+        if (g[k])
+            time_pass(g[k], b, iim); /* warm-up: shader variants, caches */
+    for (int r = 0; r < REPEATS; r++)
+        for (int k = 0; k < n; k++)
+            runs[k][r] = g[k] ? time_pass(g[k], b, iim) : NAN;
+    for (int k = 0; k < n; k++)
+        ms_per_texel[k] = g[k] ? 1e3 * lm_median(runs[k], REPEATS) / b->count : NAN;
+    lm_iim_texture_free(iim);
+}
+
+/* Bilinear AIM lookup at a lightmap UV (the dilated atlas, as the GPU samples it). */
+static lm_vec3 aim_at(const lm_atlas *a, const float *aim, float u, float v)
+{
+    float x = u * a->width - 0.5f, y = v * a->height - 0.5f;
+    int x0 = (int)floorf(x), y0 = (int)floorf(y);
+    float fx = x - x0, fy = y - y0;
+    lm_vec3 s = lm_v3(0, 0, 0);
+    for (int j = 0; j < 2; j++)
+        for (int i = 0; i < 2; i++) {
+            int xi = x0 + i < 0 ? 0 : x0 + i >= a->width ? a->width - 1 : x0 + i;
+            int yj = y0 + j < 0 ? 0 : y0 + j >= a->height ? a->height - 1 : y0 + j;
+            float w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
+            s = lm_add(s, lm_scale(lm_v3_load(aim + 3 * ((size_t)yj * a->width + xi)), w));
+        }
+    return s;
+}
+
+/* The paper's alternative: 1,024 stratified cosine-distributed rays from the texel, each hit's AIM
+ * radiance (plus emission) averaged: E = pi / N * sum L. Returns E's green channel (kept so the work
+ * is not optimized away). */
+static double ray_gather(const bench_scene *b, uint32_t texel)
+{
+    const lm_atlas *a = &b->sc->atlas;
+    const lm_scene *s = b->sc->scene;
+    const lm_texel *t = &a->texels[texel];
+    lm_vec3 n = lm_normalize(lm_v3_load(t->normal));
+    lm_vec3 helper = fabsf(n.x) < 0.9f ? lm_v3(1, 0, 0) : lm_v3(0, 1, 0);
+    lm_vec3 tx = lm_normalize(lm_cross(helper, n)), ty = lm_cross(n, tx);
+    lm_vec3 org = lm_add(lm_v3_load(t->pos), lm_scale(n, 1e-4f * lm_scene_size(s)));
+    double sum = 0.0;
+    for (int j = 0; j < RAYS_SIDE; j++)
+        for (int i = 0; i < RAYS_SIDE; i++) {
+            float u1 = (i + 0.5f) / RAYS_SIDE, u2 = (j + 0.5f) / RAYS_SIDE, r = sqrtf(u1), phi = 6.2831853f * u2;
+            lm_vec3 d = lm_add(lm_add(lm_scale(tx, r * cosf(phi)), lm_scale(ty, r * sinf(phi))),
+                               lm_scale(n, sqrtf(fmaxf(0.0f, 1.0f - u1))));
+            float o[3], dv[3];
+            lm_v3_store(o, org);
+            lm_v3_store(dv, d);
+            lm_rt_hit h;
+            if (!lm_rt_intersect(b->sc->rt, o, dv, 0.0f, INFINITY, &h))
+                continue;
+            const float *uv = a->corner_uv + 6 * (size_t)h.tri;
+            float w0 = 1.0f - h.u - h.v;
+            lm_vec3 L = lm_v3(0, 0, 0);
+            if (a->tri_chart[h.tri] >= 0)
+                L = aim_at(a, b->aim, w0 * uv[0] + h.u * uv[2] + h.v * uv[4], w0 * uv[1] + h.u * uv[3] + h.v * uv[5]);
+            sum += L.y + s->materials[s->tri_material[h.tri]].emissive[1];
+        }
+    return 3.14159265 * sum / (RAYS_SIDE * RAYS_SIDE);
+}
+
+/* ms per texel for the ray-cast gather of b's texels: one thread, and spread over the OpenMP threads. */
+static void time_rays(const bench_scene *b, double *one, double *all)
+{
+    double r1[REPEATS], r2[REPEATS], sink = 0.0;
+    for (int r = 0; r < REPEATS; r++) {
+        double t0 = lm_now();
+        for (uint32_t i = 0; i < b->count; i++)
+            sink += ray_gather(b, b->texels[i]);
+        double t1 = lm_now();
+#pragma omp parallel for reduction(+ : sink) schedule(dynamic, 8)
+        for (uint32_t i = 0; i < b->count; i++)
+            sink += ray_gather(b, b->texels[i]);
+        r1[r] = t1 - t0;
+        r2[r] = lm_now() - t1;
+    }
+    *one = 1e3 * lm_median(r1, REPEATS) / b->count;
+    *all = 1e3 * lm_median(r2, REPEATS) / b->count + 0.0 * sink;
+}
+
+static void print_table2(bench_scene *sc, int n)
+{
+    /* Larsen & Christensen 2004, Table 2 (ms per texel) for 34, 13,000, 133,000 polygons, R = 8, 16, 32 */
+    static const double PAPER[3][3] = {{0.75, 0.76, 0.78}, {0.90, 0.91, 0.97}, {1.55, 1.57, 1.59}};
+    printf("\nfinal gather, ms per texel (median of %d passes of %d texels, %d above 50k triangles; paper = "
+           "Larsen & Christensen 2004, Table 2):\n", REPEATS, PASS, PASS / 4);
+    printf("%-24s %9s %4s %12s %12s %10s %14s %9s\n", "scene", "triangles", "R", "full scene", "proxy",
+           "proxy tris", "proxy texels/s", "paper");
+    for (int s = 0; s < n; s++) {
+        for (int r = 0; r < 3; r++) {
+            int R = 8 << r, tris[2] = {0, 0};
+            lm_gather *g[2] = {gather_for(&sc[s], R, 0, LM_GATHER_VIEWPORTS, &tris[0]),
+                               gather_for(&sc[s], R, 1, LM_GATHER_VIEWPORTS, &tris[1])};
+            double ms[2];
+            time_configs(g, 2, &sc[s], ms);
+            printf("%-24s %9d %4d %12.3f %12.3f %10d %14.0f %9.2f\n", sc[s].label, tris[0], R, ms[0], ms[1], tris[1],
+                   1e3 / ms[1], PAPER[sc[s].paper_row][r]);
+            fflush(stdout);
+            lm_gather_free(g[0]);
+            lm_gather_free(g[1]);
+        }
+    }
+}
+
+static void print_schemes(bench_scene *sc, int n)
+{
+    printf("\npass schemes, R = 32 with the proxy, ms per texel (median of %d passes of %d texels):\n", REPEATS, PASS);
+    printf("%-24s %12s %12s %12s\n", "scene", "viewports", "instanced", "layered");
+    for (int s = 0; s < n; s++) {
+        lm_gather *g[3];
+        int tris;
+        for (int k = 0; k < 3; k++)
+            g[k] = gather_for(&sc[s], 32, 1, (lm_gather_scheme)k, &tris);
+        double ms[3];
+        time_configs(g, 3, &sc[s], ms);
+        printf("%-24s %12.3f %12.3f %12.3f\n", sc[s].label, ms[0], ms[1], ms[2]);
+        for (int k = 0; k < 3; k++)
+            lm_gather_free(g[k]);
+    }
+}
+
+static void print_rays(bench_scene *sc, int n)
+{
+    printf("\nEmbree ray-cast gather, %d rays per texel, ms per texel (paper: 16.7 ms for 1,024 rays, 8,000 "
+           "polygons):\n", RAYS_SIDE * RAYS_SIDE);
+    printf("%-24s %9s %12s %12s %14s\n", "scene", "triangles", "1 thread", "all threads", "GPU (proxy)");
+    for (int s = 0; s < n; s++) {
+        double one, all, gpu;
+        int tris;
+        lm_hemicube_settings def;
+        lm_hemicube_settings_default(&def);
+        lm_gather *g = gather_for(&sc[s], 32, 1, def.scheme, &tris);
+        time_configs(&g, 1, &sc[s], &gpu);
+        lm_gather_free(g);
+        time_rays(&sc[s], &one, &all);
+        printf("%-24s %9u %12.3f %12.3f %14.3f\n", sc[s].label, sc[s].sc->scene->tri_count, one, all, gpu);
+    }
+}
+
+void lm_cli_bench_gather(const char *big_cornell)
+{
+    lm_gl_context *gl = NULL;
+    lm_error err;
+    if (lm_gl_context_create(&gl, &err) != LM_OK) {
+        printf("\nfinal gather: skipped (%s)\n", err.msg);
+        return;
+    }
+    printf("\nfinal gather on %s\n", lm_gl_context_description(gl));
+    const char *paths[3] = {"../shared/scenes/cornell-box/CornellBox.glb", "scenes/cornell.glb", big_cornell};
+    const char *labels[3] = {"CornellBox.glb", "cornell.glb", "cornell (floor 255^2)"};
+    bench_scene sc[3];
+    int n = 0;
+    for (int i = 0; i < 3; i++) {
+        if (paths[i] && open_scene(labels[i], i, paths[i], &sc[n]))
+            n++;
+        else
+            printf("%s: skipped (not found: %s)\n", labels[i], paths[i] ? paths[i] : "no path");
+    }
+    print_schemes(sc, n);
+    print_table2(sc, n);
+    print_rays(sc, n);
+    for (int i = 0; i < n; i++)
+        close_scene(&sc[i]);
+    lm_gl_context_destroy(gl);
+}

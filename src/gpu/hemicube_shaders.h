@@ -1,0 +1,12 @@
+/* GLSL of the hemicube gather (hemicube_gather.c), one variant per way of putting many texels' planes
+ * into one pass (lm_gather_scheme). Internal to gpu/. */
+#ifndef LM_HEMICUBE_SHADERS_H
+#define LM_HEMICUBE_SHADERS_H
+
+#include "../core/error.h"
+#include "hemicube.h"
+
+/* Compiles and links the render program and the reduction program for `scheme`. */
+lm_status lm_hemicube_programs(lm_gather_scheme scheme, unsigned *render, unsigned *reduce, lm_error *err);
+
+#endif
