@@ -3,6 +3,7 @@
 #include "bench_gather.h"
 
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -188,6 +189,73 @@ static void time_rays(const bench_scene *b, double *one, double *all)
     *all = 1e3 * lm_median(r2, REPEATS) / b->count + 0.0 * sink;
 }
 
+/* A second GL context on a second thread: each of `threads` contexts gathers its share of the pass (the
+ * scene, AIM and IIM of its own), all at once. Seconds per repetition, median. */
+typedef struct {
+    const bench_scene *b;
+    uint32_t first, count;
+    double seconds[REPEATS];
+    int ok;
+} context_job;
+
+static void *context_worker(void *arg)
+{
+    context_job *j = arg;
+    lm_gl_context *gl = NULL;
+    lm_error err;
+    int tris;
+    if (lm_gl_context_create(&gl, &err) != LM_OK)
+        return NULL;
+    lm_hemicube_settings def;
+    lm_hemicube_settings_default(&def);
+    lm_gather *g = gather_for(j->b, 32, 1, def.scheme, &tris);
+    unsigned iim = lm_iim_texture_create(j->b->sc->atlas.width, j->b->sc->atlas.height);
+    lm_gather_stats gs;
+    for (int r = 0; g && r <= REPEATS; r++) { /* r = 0 warms up */
+        if (lm_gather_texels(g, j->b->sc->scene, &j->b->sc->atlas, j->b->texels + j->first, j->count, iim, &gs,
+                             &err) != LM_OK)
+            break;
+        if (r > 0)
+            j->seconds[r - 1] = gs.seconds;
+        j->ok = r == REPEATS;
+    }
+    lm_iim_texture_free(iim);
+    lm_gather_free(g);
+    lm_gl_context_destroy(gl);
+    return NULL;
+}
+
+/* Wall ms per texel with `threads` contexts splitting the pass (each thread's runs paired by index). */
+static double time_contexts(const bench_scene *b, int threads)
+{
+    context_job jobs[2];
+    pthread_t tid[2];
+    double wall[REPEATS];
+    for (int k = 0; k < threads; k++) {
+        memset(&jobs[k], 0, sizeof jobs[k]);
+        jobs[k].b = b;
+        jobs[k].first = b->count * (uint32_t)k / (uint32_t)threads;
+        jobs[k].count = b->count * (uint32_t)(k + 1) / (uint32_t)threads - jobs[k].first;
+        pthread_create(&tid[k], NULL, context_worker, &jobs[k]);
+    }
+    for (int k = 0; k < threads; k++)
+        pthread_join(tid[k], NULL);
+    for (int r = 0; r < REPEATS; r++) {
+        wall[r] = 0.0;
+        for (int k = 0; k < threads; k++)
+            wall[r] = jobs[k].ok && jobs[k].seconds[r] > wall[r] ? jobs[k].seconds[r] : (jobs[k].ok ? wall[r] : NAN);
+    }
+    return 1e3 * lm_median(wall, REPEATS) / b->count;
+}
+
+static void print_contexts(bench_scene *sc, int n)
+{
+    printf("\ncontexts, R = 32 with the proxy, default scheme, ms per texel of wall time (median of %d):\n", REPEATS);
+    printf("%-24s %12s %12s\n", "scene", "1 context", "2 contexts");
+    for (int s = 0; s < n; s++)
+        printf("%-24s %12.3f %12.3f\n", sc[s].label, time_contexts(&sc[s], 1), time_contexts(&sc[s], 2));
+}
+
 static void print_table2(bench_scene *sc, int n)
 {
     /* Larsen & Christensen 2004, Table 2 (ms per texel) for 34, 13,000, 133,000 polygons, R = 8, 16, 32 */
@@ -267,6 +335,7 @@ void lm_cli_bench_gather(const char *big_cornell)
             printf("%s: skipped (not found: %s)\n", labels[i], paths[i] ? paths[i] : "no path");
     }
     print_schemes(sc, n);
+    print_contexts(sc, n);
     print_table2(sc, n);
     print_rays(sc, n);
     for (int i = 0; i < n; i++)
