@@ -152,12 +152,59 @@ static void test_deltas(void **state)
     lm_photon_store_free(&ps);
 }
 
+/* lm_photon_store_clear keeps the slot array but nothing else: after churn (adds, removes, a free
+ * list), a cleared store hands out the same slots with the same contents as a fresh one. */
+static void test_clear_matches_fresh(void **state)
+{
+    (void)state;
+    lm_photon_store a, b;
+    lm_error err;
+    assert_int_equal(lm_photon_store_init(&a, 3, &err), LM_OK);
+    assert_int_equal(lm_photon_store_init(&b, 3, &err), LM_OK);
+    for (int i = 0; i < 3000; i++) {
+        lm_hit h = make_hit(i % 3, (uint32_t)i, 1.0f, i % 2, i % 5 == 0);
+        uint32_t slot = lm_photon_store_add(&a, &h);
+        if (i % 7 == 0)
+            lm_photon_store_remove(&a, slot);
+    }
+    lm_photon_store_remove(&a, 10);
+    lm_photon_store_remove(&a, 20);
+    assert_int_not_equal(a.free_head, LM_NONE);
+    uint32_t cap = a.capacity;
+    lm_hit *hits = a.hits;
+    lm_photon_store_clear(&a);
+    assert_int_equal(a.capacity, cap); /* memory kept */
+    assert_ptr_equal(a.hits, hits);
+    assert_int_equal(a.used, 0);
+    assert_int_equal(a.free_head, LM_NONE);
+    for (int s = 0; s < 3; s++) {
+        assert_int_equal(a.surfaces[s].head, LM_NONE);
+        assert_int_equal(walk(&a, s), 0);
+        assert_true(a.surfaces[s].delta_f == 0.0 && a.surfaces[s].delta_i == 0.0);
+    }
+    for (int i = 0; i < 500; i++) {
+        lm_hit h = make_hit((i * 7) % 3, (uint32_t)i, 0.5f, i % 3, i % 2);
+        assert_int_equal(lm_photon_store_add(&a, &h), lm_photon_store_add(&b, &h));
+        if (i % 11 == 0) {
+            lm_photon_store_remove(&a, (uint32_t)i / 2);
+            lm_photon_store_remove(&b, (uint32_t)i / 2);
+        }
+    }
+    assert_int_equal(a.used, b.used);
+    assert_int_equal(a.free_head, b.free_head);
+    assert_memory_equal(a.hits, b.hits, sizeof(lm_hit) * a.used);
+    assert_memory_equal(a.surfaces, b.surfaces, sizeof *a.surfaces * 3);
+    lm_photon_store_free(&a);
+    lm_photon_store_free(&b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_add_remove),
         cmocka_unit_test(test_free_list_reuse),
         cmocka_unit_test(test_deltas),
+        cmocka_unit_test(test_clear_matches_fresh),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -482,6 +482,67 @@ static void test_move_and_back(void **state)
     world_free(&w);
 }
 
+/* lm_photons_reset keeps the memory but forgets everything else: after some store churn (a move,
+ * settling, a move back), a reset and full trace on 3 threads gives the same store, slot for slot,
+ * and the same paths as a fresh photon set traced on 1 thread. */
+static void test_reset_matches_fresh(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world_photons(&w, &set);
+    int cube = find_node(w.s, "dynamic_cube");
+    float home[16], moved[16];
+    memcpy(home, w.s->nodes[cube].world, sizeof home);
+    memcpy(moved, home, sizeof moved);
+    moved[12] -= 0.8f;
+    lm_error err;
+    memcpy(w.s->nodes[cube].world, moved, sizeof moved);
+    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, moved, &err), LM_OK);
+    settle(&w);
+    memcpy(w.s->nodes[cube].world, home, sizeof home);
+    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, home, &err), LM_OK);
+    frame(&w); /* leaves groups pending and a non-empty free list behind */
+
+    int threads = omp_get_max_threads();
+    omp_set_num_threads(3);
+    lm_photons_reset(w.ph);
+    assert_int_equal(lm_photons_stored_hits(w.ph), 0);
+    assert_int_equal(lm_photons_pending_groups(w.ph), 0);
+    assert_int_equal(lm_photons_trace_all(w.ph, NULL, &err), LM_OK);
+    omp_set_num_threads(1);
+    lm_photons *fresh = NULL;
+    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &fresh, &err), LM_OK);
+    assert_int_equal(lm_photons_trace_all(fresh, NULL, &err), LM_OK);
+    omp_set_num_threads(threads);
+
+    const lm_photon_store *a = lm_photons_store(w.ph), *b = lm_photons_store(fresh);
+    assert_int_equal(a->used, b->used);
+    assert_int_equal(a->free_head, b->free_head);
+    assert_memory_equal(a->hits, b->hits, sizeof(lm_hit) * a->used);
+    assert_int_equal(a->surface_count, b->surface_count);
+    assert_memory_equal(a->surfaces, b->surfaces, sizeof *a->surfaces * (size_t)a->surface_count);
+    assert_int_equal(lm_photons_stored_hits(w.ph), lm_photons_stored_hits(fresh));
+    for (uint32_t p = 0; p < lm_photons_count(fresh); p++) {
+        const lm_path_vertex *va, *vb;
+        uint32_t na = lm_photons_path(w.ph, p, &va), nb = lm_photons_path(fresh, p, &vb);
+        assert_int_equal(na, nb);
+        if (na)
+            assert_memory_equal(va, vb, sizeof *va * na);
+    }
+    for (uint32_t g = 0; g < lm_photons_group_count(fresh); g++) {
+        lm_photon_group_info ga, gb;
+        lm_photons_group_info(w.ph, g, &ga);
+        lm_photons_group_info(fresh, g, &gb);
+        assert_memory_equal(&ga, &gb, sizeof ga);
+    }
+    lm_photons_free(fresh);
+    world_free(&w);
+}
+
 /* ---- settings and sizes ---- */
 
 static void test_settings(void **state)
@@ -555,6 +616,7 @@ int main(void)
         cmocka_unit_test(test_energy_closed_box),
         cmocka_unit_test(test_invalidate_emitter),
         cmocka_unit_test(test_move_and_back),
+        cmocka_unit_test(test_reset_matches_fresh),
         cmocka_unit_test(test_settings),
         cmocka_unit_test(test_cornell_rate_and_memory),
     };

@@ -9,10 +9,11 @@
  * plain Halton sequence. (Base 2 has no such permutation but the identity: dim 0 is van der Corput.)
  *
  * Speed: digits are processed in chunks of k digits (b^k <= LM_QMC_CHUNK_MAX), one table lookup per
- * chunk. */
+ * chunk; for 32-bit indices the chunk quotient is a multiply by a precomputed reciprocal (split). */
 #include "qmc.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 
 #define LM_QMC_CHUNK_MAX 4096u
 #define LM_QMC_SEED 0x6c6d6769514d4321ull /* fixed: sequences are identical on every run */
@@ -23,12 +24,14 @@ typedef struct {
     uint32_t base;
     uint32_t chunk;          /* b^k */
     double inv_chunk;        /* 1 / chunk */
+    uint64_t magic;          /* ceil(2^64 / chunk): exact 32-bit division by chunk (split) */
     double *table;           /* chunk entries: permuted radical inverse of k digits */
 } qmc_dim;
 
 static qmc_dim g_dims[LM_QMC_MAX_DIMS];
 static double g_storage[LM_QMC_TABLE_TOTAL];
 static pthread_once_t g_once = PTHREAD_ONCE_INIT;
+static _Atomic int g_ready; /* set once the tables are built: later calls skip pthread_once */
 
 static uint64_t splitmix64(uint64_t *state)
 {
@@ -106,43 +109,53 @@ static void init_once(void)
         d->base = n;
         chunk_shape(n, &d->chunk, &digits);
         d->inv_chunk = 1.0 / d->chunk;
+        d->magic = UINT64_MAX / d->chunk + 1;
         d->table = g_storage + at;
         at += d->chunk;
         make_permutation(i, n, perm);
         fill_table(d, digits, perm);
         i++;
     }
+    atomic_store_explicit(&g_ready, 1, memory_order_release);
 }
 
 void lm_qmc_init(void) { pthread_once(&g_once, init_once); }
 
-/* Index i split as i = q chunk + r: q from the double reciprocal (several times cheaper than an
- * integer division), then corrected by one where rounding left it off. Exact for every 32-bit i. */
-static uint32_t split(const qmc_dim *d, uint32_t i, uint32_t *r)
+/* lm_qmc_init for the per-number calls: one acquire load once the tables exist. */
+static inline void qmc_ready(void)
 {
-    uint32_t q = (uint32_t)((double)i * d->inv_chunk);
-    int64_t rest = (int64_t)i - (int64_t)q * d->chunk;
-    if (rest < 0) {
-        q--;
-        rest += d->chunk;
-    } else if (rest >= d->chunk) {
-        q++;
-        rest -= d->chunk;
-    }
-    *r = (uint32_t)rest;
+    if (!atomic_load_explicit(&g_ready, memory_order_acquire))
+        lm_qmc_init();
+}
+
+/* Index i split as i = q chunk + r with one 64 x 64 -> 128-bit multiply: q = floor(i magic / 2^64),
+ * magic = ceil(2^64 / chunk), which is exact for every 32-bit i and chunk < 2^32 (Lemire, Kaser and
+ * Kurz 2019, "Faster remainder by direct computation"). No division, no rounding correction. */
+static inline uint32_t split(const qmc_dim *d, uint32_t i, uint32_t *r)
+{
+    uint32_t q = (uint32_t)(((unsigned __int128)d->magic * i) >> 64);
+    *r = i - q * d->chunk;
     return q;
+}
+
+/* radical for a 32-bit index (the same operations in the same order: the same value bit for bit). */
+static inline double radical32(const qmc_dim *d, uint32_t i)
+{
+    double v = 0.0, scale = 1.0;
+    for (uint32_t r; i != 0;) {
+        i = split(d, i, &r);
+        v += d->table[r] * scale;
+        scale *= d->inv_chunk;
+    }
+    return v < 1.0 ? v : 0x1.fffffffffffffp-1;
 }
 
 static double radical(const qmc_dim *d, uint64_t index)
 {
     double v = 0.0, scale = 1.0;
-    if (index <= UINT32_MAX) { /* photon indices fit */
-        for (uint32_t i = (uint32_t)index, r; i != 0;) {
-            i = split(d, i, &r);
-            v += d->table[r] * scale;
-            scale *= d->inv_chunk;
-        }
-    } else {
+    if (index <= UINT32_MAX) /* photon indices fit */
+        return radical32(d, (uint32_t)index);
+    else {
         for (; index != 0; index /= d->chunk) {
             v += d->table[index % d->chunk] * scale;
             scale *= d->inv_chunk;
@@ -153,13 +166,23 @@ static double radical(const qmc_dim *d, uint64_t index)
 
 double lm_halton(uint32_t dim, uint64_t index)
 {
-    lm_qmc_init();
+    qmc_ready();
     return radical(&g_dims[dim % LM_QMC_MAX_DIMS], index);
 }
 
 void lm_halton_dims(uint32_t dim, uint32_t n, uint64_t index, double *out)
 {
-    lm_qmc_init();
+    qmc_ready();
     for (uint32_t k = 0; k < n; k++)
         out[k] = radical(&g_dims[(dim + k) % LM_QMC_MAX_DIMS], index);
+}
+
+void lm_halton_dims_float(uint32_t dim, uint32_t n, uint32_t index, float *out)
+{
+    qmc_ready();
+    const qmc_dim *d = &g_dims[dim];
+    for (uint32_t k = 0; k < n; k++) {
+        float f = (float)radical32(&d[k], index);
+        out[k] = f < 1.0f ? f : 0x1.fffffep-1f;
+    }
 }

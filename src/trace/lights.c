@@ -237,18 +237,40 @@ static lm_vec3 tri_point(const lm_vec3 p[3], float a, float c)
 
 /* ---- emission ---- */
 
-static void emit_area(const lm_emitters *em, const lm_scene *s, const lm_emitter *e, const float u[4],
+static void place_tri(const lm_scene *s, uint32_t t, float lift, lm_emit_tri *out)
+{
+    /* The area comes from the same cross product as the normal (lm_scene_tri_area_world's formula). */
+    lm_vec3 p[3], cr = tri_world(s, t, p);
+    for (int k = 0; k < 3; k++)
+        lm_v3_store(out->p[k], p[k]);
+    lm_v3_store(out->n, lm_normalize(cr));
+    tri_flux_of_area(s, t, 0.5f * lm_length(cr), out->flux);
+    out->lift = lift;
+    out->double_sided = s->materials[s->tri_material[t]].double_sided != 0;
+}
+
+void lm_emitter_place(const lm_emitters *em, const lm_scene *s, int e, lm_emit_tri *out)
+{
+    const lm_emitter *em_e = &em->e[e];
+    if (em_e->punctual)
+        return;
+    float lift = LM_EMIT_LIFT * lm_scene_size(s);
+    for (uint32_t k = 0; k < em_e->tri_count; k++)
+        place_tri(s, em_e->tris[k], lift, &out[k]);
+}
+
+static void emit_area(const lm_emitter *e, const lm_emit_tri *placed, const lm_scene *s, const float u[4],
                       uint32_t count, lm_emission *out)
 {
-    (void)em;
     float rest, prob;
     uint32_t k = pick_tri(e, u[2], &rest, &prob);
-    uint32_t t = e->tris[k];
-    /* The area comes from the same cross product as the normal (lm_scene_tri_area_world's formula):
-     * emission runs once per photon, and placing the vertices again was a sizeable share of it. */
-    lm_vec3 p[3], cr = tri_world(s, t, p), n = lm_normalize(cr);
-    float area = 0.5f * lm_length(cr);
-    if (s->materials[s->tri_material[t]].double_sided) { /* leftover picks the side */
+    lm_emit_tri own; /* placed here unless the caller placed them all (lm_emitter_place) */
+    const lm_emit_tri *tri = placed ? &placed[k] : &own;
+    if (!placed)
+        place_tri(s, e->tris[k], LM_EMIT_LIFT * lm_scene_size(s), &own);
+    lm_vec3 p[3] = {lm_v3_load(tri->p[0]), lm_v3_load(tri->p[1]), lm_v3_load(tri->p[2])};
+    lm_vec3 n = lm_v3_load(tri->n);
+    if (tri->double_sided) { /* leftover picks the side */
         int back = rest >= 0.5f;
         rest = back ? 2.0f * rest - 1.0f : 2.0f * rest;
         n = back ? lm_scale(n, -1.0f) : n;
@@ -256,12 +278,10 @@ static void emit_area(const lm_emitters *em, const lm_scene *s, const lm_emitter
     lm_vec3 x = tri_point(p, rest, u[3]);
     float r = sqrtf(u[0]), phi = (float)(2.0 * LM_PI) * u[1];
     lm_vec3 d = frame_dir(n, r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[0])));
-    lm_v3_store(out->org, lm_add(x, lm_scale(n, LM_EMIT_LIFT * lm_scene_size(s))));
+    lm_v3_store(out->org, lm_add(x, lm_scale(n, tri->lift)));
     lm_v3_store(out->dir, d);
-    float f[3];
-    tri_flux_of_area(s, t, area, f);
     for (int c = 0; c < 3; c++)
-        out->flux[c] = prob > 0.0f ? f[c] / (prob * (float)count) : 0.0f;
+        out->flux[c] = prob > 0.0f ? tri->flux[c] / (prob * (float)count) : 0.0f;
 }
 
 static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emitter *e, const float u[4],
@@ -292,8 +312,8 @@ static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emi
         out->flux[c] = e->radiant[c] * scale;
 }
 
-void lm_emitter_emit(const lm_emitters *em, const lm_scene *s, int e, const float u[4], uint32_t count,
-                     lm_emission *out)
+void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris,
+                            const float u[4], uint32_t count, lm_emission *out)
 {
     const lm_emitter *em_e = &em->e[e];
     memset(out, 0, sizeof *out);
@@ -302,7 +322,13 @@ void lm_emitter_emit(const lm_emitters *em, const lm_scene *s, int e, const floa
     if (em_e->punctual)
         emit_punctual(em, s, em_e, u, count, out);
     else if (em_e->tri_count > 0 && em_e->cdf[em_e->tri_count - 1] > 0.0f)
-        emit_area(em, s, em_e, u, count, out);
+        emit_area(em_e, tris, s, u, count, out);
+}
+
+void lm_emitter_emit(const lm_emitters *em, const lm_scene *s, int e, const float u[4], uint32_t count,
+                     lm_emission *out)
+{
+    lm_emitter_emit_placed(em, s, e, NULL, u, count, out);
 }
 
 /* ---- next-event estimation ---- */

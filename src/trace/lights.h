@@ -55,6 +55,22 @@ typedef struct {
 } lm_emission;
 void lm_emitter_emit(const lm_emitters *em, const lm_scene *s, int e, const float u[4], uint32_t count,
                      lm_emission *out);
+/* An area emitter's triangle placed in world space (current node matrices), with what emission
+ * derives from that placement. A caller that emits many photons while nothing moves (one photon
+ * batch) places each triangle once instead of once per photon. */
+typedef struct {
+    float p[3][3];        /* world corners */
+    float n[3];           /* unit geometric normal, front side */
+    float flux[3];        /* the triangle's flux (all emitting sides) */
+    float lift;           /* origin offset along the normal: 1e-5 x scene size */
+    int double_sided;
+} lm_emit_tri;
+/* Places emitter e's tri_count triangles into out[0 .. tri_count) (nothing for punctual lights). */
+void lm_emitter_place(const lm_emitters *em, const lm_scene *s, int e, lm_emit_tri *out);
+/* lm_emitter_emit from triangles that lm_emitter_place placed (tris may be NULL for punctual
+ * emitters): bit for bit the same emission while the scene has not changed since. */
+void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris,
+                            const float u[4], uint32_t count, lm_emission *out);
 
 /* Next-event estimation from point p: a sample on emitter e. dir is unit from p towards the light,
  * dist its distance (INFINITY for directional), radiance_weight the incident radiance times the

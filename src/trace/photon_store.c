@@ -13,12 +13,19 @@ lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error 
     ps->surfaces = malloc(sizeof *ps->surfaces * (size_t)(surface_count > 0 ? surface_count : 1));
     if (!ps->surfaces)
         return lm_fail(err, LM_ERR_NOMEM, "photon store: no memory for %d surfaces", surface_count);
-    for (int i = 0; i < surface_count; i++) {
+    lm_photon_store_clear(ps);
+    return LM_OK;
+}
+
+void lm_photon_store_clear(lm_photon_store *ps)
+{
+    ps->used = 0;
+    ps->free_head = LM_NONE;
+    for (int i = 0; i < ps->surface_count; i++) {
         ps->surfaces[i].head = LM_NONE;
         ps->surfaces[i].count = 0;
         ps->surfaces[i].delta_f = ps->surfaces[i].delta_i = 0.0;
     }
-    return LM_OK;
 }
 
 void lm_photon_store_free(lm_photon_store *ps)

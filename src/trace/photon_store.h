@@ -43,6 +43,10 @@ typedef struct {
 
 lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error *err);
 void lm_photon_store_free(lm_photon_store *ps);
+/* Empties the store and zeroes every surface's deltas but keeps the slot array (its capacity, and
+ * the memory already mapped in): afterwards it behaves exactly like a freshly initialized store of
+ * the same surface count, slot for slot, without growing or page-faulting again. */
+void lm_photon_store_clear(lm_photon_store *ps);
 /* Copies h into a free slot, links it into its surface's list and adds its energy to the surface's
  * deltas. Returns the slot, or LM_NONE when memory ran out (the store is unchanged then). */
 uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h);

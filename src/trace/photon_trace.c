@@ -33,10 +33,15 @@ static uint64_t mix64(uint64_t z)
 /* n uniform numbers in [0, 1) as floats (never rounded up to 1): dims dim .. dim + n - 1. */
 static void photon_samples(const lm_photons *ph, uint32_t id, uint32_t dim, uint32_t n, float *out)
 {
+    uint64_t index = ph->halton_base + id;
+    if (dim + n <= LM_QMC_MAX_DIMS && index <= UINT32_MAX) { /* every photon of seed 0 and most others */
+        lm_halton_dims_float(dim, n, (uint32_t)index, out);
+        return;
+    }
     double u[PH_DIMS_PER_BOUNCE];
     uint32_t q = dim < LM_QMC_MAX_DIMS ? LM_QMC_MAX_DIMS - dim : 0; /* how many are Halton dims */
     q = q < n ? q : n;
-    lm_halton_dims(dim, q, ph->halton_base + id, u);
+    lm_halton_dims(dim, q, index, u);
     for (uint32_t k = q; k < n; k++) {
         uint64_t h = mix64(((uint64_t)ph->set.seed << 32 | id) + 0x9E3779B97F4A7C15ull * (dim + k + 1));
         u[k] = (double)(h >> 11) * 0x1.0p-53;
@@ -117,7 +122,8 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
     photon_samples(ph, id, 0, PH_EMIT_DIMS, u);
     uint32_t emitter_photons = ph->emitter_first[g->emitter + 1] - ph->emitter_first[g->emitter];
     lm_emission emi;
-    lm_emitter_emit(ph->em, ph->scene, g->emitter, u, emitter_photons, &emi);
+    const lm_emit_tri *placed = ph->emit_placed ? ph->emit_placed + ph->emit_tri_first[g->emitter] : NULL;
+    lm_emitter_emit_placed(ph->em, ph->scene, g->emitter, placed, u, emitter_photons, &emi);
     float org[3], dir[3], flux[3];
     memcpy(org, emi.org, sizeof org);
     memcpy(dir, emi.dir, sizeof dir);
@@ -201,30 +207,105 @@ static void trace_jobs(const lm_photons *ph, ph_batch *b, int *failed)
     }
 }
 
-lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, const ph_batch *done, lm_photon_frame_stats *st,
-                         lm_error *err)
+/* Readies b for tracing by `threads` threads: one emptied vertex buffer each, and the emissive
+ * triangles placed once for the batch unless there are more of them than photons. 0: no memory. */
+static int batch_prepare(lm_photons *ph, ph_batch *b, int threads)
 {
-    int threads = omp_get_max_threads();
     if (!ensure_buffers(b, threads))
-        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %d trace buffers", threads);
+        return 0;
     for (int t = 0; t < b->buffer_count; t++)
         b->buffers[t].len = 0;
+    uint32_t etris = ph->emit_tri_first[ph->emitter_count];
+    ph->emit_placed = NULL;
+    if (etris && etris <= b->count) {
+        for (uint32_t e = 0; e < ph->emitter_count; e++)
+            lm_emitter_place(ph->em, ph->scene, (int)e, ph->emit_tris + ph->emit_tri_first[e]);
+        ph->emit_placed = ph->emit_tris;
+    }
+    return 1;
+}
+
+static void batch_rays(ph_batch *b)
+{
+    b->rays = 0;
+    for (uint32_t i = 0; i < b->count; i++)
+        b->rays += b->jobs[i].rays;
+}
+
+static lm_status fail_buffers(int threads, lm_error *err)
+{
+    return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %d trace buffers", threads);
+}
+
+static lm_status fail_traced(const ph_batch *b, lm_error *err)
+{
+    return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of %u photons", b->count);
+}
+
+lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, lm_error *err)
+{
+    int threads = omp_get_max_threads();
+    if (!batch_prepare(ph, b, threads))
+        return fail_buffers(threads, err);
     int failed = 0;
-    lm_status applied = LM_OK;
 #pragma omp parallel num_threads(threads) if (b->count >= PH_PARALLEL_MIN_JOBS)
     {
         lm_rt_thread_init();
-#pragma omp master
-        if (done)
-            applied = ph_apply_batch(ph, done, st, err);
         trace_jobs(ph, b, &failed);
+    }
+    if (failed)
+        return fail_traced(b, err);
+    batch_rays(b);
+    return LM_OK;
+}
+
+lm_status ph_trace_groups(lm_photons *ph, const uint32_t *list, uint32_t n, lm_photon_frame_stats *st,
+                          lm_error *err)
+{
+    int threads = omp_get_max_threads();
+    uint64_t total = 0;
+    for (uint32_t i = 0; i < n; i++)
+        total += ph->groups[list[i]].photons;
+    /* Shared by the team; written only inside `omp single` (or by the master's apply, which never
+     * runs beside a single), read by all after the single's barrier. */
+    ph_batch *b = NULL;
+    const ph_batch *done = NULL;
+    uint32_t next = 0;
+    int k = 0, failed = 0, stop = 0;
+    lm_status filled = LM_OK, applied = LM_OK;
+#pragma omp parallel num_threads(threads) if (total >= PH_PARALLEL_MIN_JOBS)
+    {
+        lm_rt_thread_init();
+        for (;;) {
+#pragma omp single
+            {
+                if (b) { /* the batch just traced is applied next, beside the tracing of the one after */
+                    batch_rays(b);
+                    st->rays += b->rays;
+                    done = b->count ? b : NULL;
+                    k ^= 1;
+                }
+                if (applied != LM_OK || failed || (next >= n && !done)) {
+                    stop = 1;
+                } else {
+                    b = &ph->batches[k];
+                    filled = ph_fill_batch(ph, b, list, n, &next, st, err);
+                    if (filled == LM_OK && !batch_prepare(ph, b, threads))
+                        filled = fail_buffers(threads, err);
+                    stop = filled != LM_OK;
+                }
+            }
+            if (stop)
+                break;
+#pragma omp master
+            if (done)
+                applied = ph_apply_batch(ph, done, st, err);
+            trace_jobs(ph, b, &failed);
+        }
     }
     if (applied != LM_OK)
         return applied;
     if (failed)
-        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the paths of %u photons", b->count);
-    b->rays = 0;
-    for (uint32_t i = 0; i < b->count; i++)
-        b->rays += b->jobs[i].rays;
-    return LM_OK;
+        return fail_traced(b, err);
+    return filled;
 }

@@ -77,6 +77,16 @@ static lm_status plan_counts(lm_photons *ph, lm_error *err)
         ph->emitter_first[e + 1] = (uint32_t)at;
     }
     ph->photon_count = (uint32_t)at;
+    ph->emit_tri_first = calloc((size_t)E + 1, sizeof *ph->emit_tri_first);
+    if (!ph->emit_tri_first)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u emitters", E);
+    for (uint32_t e = 0; e < E; e++)
+        ph->emit_tri_first[e + 1] = ph->emit_tri_first[e] + (ph->em->e[e].punctual ? 0 : ph->em->e[e].tri_count);
+    if (ph->emit_tri_first[E]) {
+        ph->emit_tris = malloc(ph->emit_tri_first[E] * sizeof *ph->emit_tris);
+        if (!ph->emit_tris)
+            return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u emissive triangles", ph->emit_tri_first[E]);
+    }
     return LM_OK;
 }
 
@@ -161,6 +171,8 @@ void lm_photons_free(lm_photons *ph)
     free(ph->groups);
     free(ph->queue);
     free(ph->emitter_first);
+    free(ph->emit_tri_first);
+    free(ph->emit_tris);
     free(ph->tmp_verts);
     free(ph->tmp_offsets);
     free(ph->tmp_changed);
@@ -169,6 +181,20 @@ void lm_photons_free(lm_photons *ph)
     ph_batch_free(&ph->batches[1]);
     lm_photon_store_free(&ph->store);
     free(ph);
+}
+
+void lm_photons_reset(lm_photons *ph)
+{
+    for (uint32_t i = 0; i < ph->group_count; i++) {
+        ph_group *g = &ph->groups[i];
+        memset(g->offsets, 0, ((size_t)g->photons + 1) * sizeof *g->offsets); /* slab kept: vert_cap */
+        g->rr_next = 0;
+        g->invalid = 0;
+        g->invalidations = g->retraces = 0;
+    }
+    ph->queue_head = ph->queue_len = 0;
+    lm_photon_store_clear(&ph->store);
+    ph->live_hits = 0;
 }
 
 /* ---- invalid-group queue: FIFO, each group at most once (oldest invalid first) ---- */
@@ -216,9 +242,8 @@ static int batch_fits(const lm_photons *ph, const ph_batch *b, uint32_t g)
     return b->count == 0 || b->count + ph->groups[g].photons <= PH_BATCH_PHOTONS;
 }
 
-/* Fills b with whole groups from list[*i ...]; empty when the list is used up. */
-static lm_status fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, uint32_t n, uint32_t *i,
-                            lm_photon_frame_stats *st, lm_error *err)
+lm_status ph_fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, uint32_t n, uint32_t *i,
+                        lm_photon_frame_stats *st, lm_error *err)
 {
     ph_batch_clear(b);
     for (; *i < n && batch_fits(ph, b, list[*i]); ++*i) {
@@ -229,26 +254,6 @@ static lm_status fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, u
         g->retraces++;
         st->groups_retraced++;
         st->group_photons += g->photons;
-    }
-    return LM_OK;
-}
-
-/* Batch k is applied while batch k + 1 is traced (the two alternate). Batches are applied in list
- * order, so the store changes exactly as if each batch were traced and applied in turn. */
-static lm_status retrace_groups(lm_photons *ph, const uint32_t *list, uint32_t n, lm_photon_frame_stats *st,
-                                lm_error *err)
-{
-    const ph_batch *done = NULL;
-    uint32_t i = 0;
-    for (int k = 0; i < n || done; k ^= 1) {
-        ph_batch *b = &ph->batches[k];
-        lm_status s = fill_batch(ph, b, list, n, &i, st, err);
-        if (s == LM_OK)
-            s = ph_trace_batch(ph, b, done, st, err);
-        if (s != LM_OK)
-            return s;
-        st->rays += b->rays;
-        done = b->count ? b : NULL;
     }
     return LM_OK;
 }
@@ -269,7 +274,7 @@ lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_
         pop_invalid(ph);
     for (uint32_t g = 0; g < ph->group_count; g++)
         ph->tmp_groups[g] = g;
-    lm_status s = retrace_groups(ph, ph->tmp_groups, ph->group_count, st, err);
+    lm_status s = ph_trace_groups(ph, ph->tmp_groups, ph->group_count, st, err);
     finish_stats(ph, st, t0);
     return s;
 }
@@ -291,7 +296,7 @@ static lm_status round_robin(lm_photons *ph, lm_photon_frame_stats *st, lm_error
         g->rr_next = (g->rr_next + k) % g->photons;
     }
     st->rr_photons = b->count;
-    lm_status s = ph_trace_batch(ph, b, NULL, st, err);
+    lm_status s = ph_trace_batch(ph, b, err);
     st->rays += b->rays;
     if (s != LM_OK)
         return s;
@@ -318,7 +323,7 @@ static lm_status drain(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
         n = ph->set.group_budget;
     for (uint32_t i = 0; i < n; i++)
         ph->tmp_groups[i] = pop_invalid(ph);
-    return retrace_groups(ph, ph->tmp_groups, n, st, err);
+    return ph_trace_groups(ph, ph->tmp_groups, n, st, err);
 }
 
 lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)

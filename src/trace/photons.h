@@ -75,6 +75,11 @@ typedef struct lm_photons lm_photons;
 lm_status lm_photons_create(const lm_scene *s, const lm_surfaces *su, const lm_rt *rt, const lm_emitters *em,
                             const lm_photon_settings *settings, lm_photons **out, lm_error *err);
 void lm_photons_free(lm_photons *ph);
+/* Forgets every path and hit (and the queue and the groups' counters) but keeps the memory: slabs,
+ * store slots and trace buffers stay allocated. The state is that of a fresh lm_photons_create with
+ * the same arguments, and a following lm_photons_trace_all gives bit-identical paths, hits and store
+ * slots, without the allocation and page faults of a first trace. */
+void lm_photons_reset(lm_photons *ph);
 
 /* Traces every photon and stores its path and hits (initial full trace; also a full refresh: paths
  * that did not change cause no store change). Clears the invalid queue. stats may be NULL. */

@@ -66,6 +66,12 @@ struct lm_photons {
     uint32_t live_hits;
     uint64_t halton_base;      /* seed x photon_count: the seed's stretch of the sequence */
     ph_batch batches[2];       /* a re-trace traces one while the other's results are applied */
+    /* Area emitters' triangles placed once per traced batch (lm_emitter_place): emitter e's are
+     * emit_tris[emit_tri_first[e] ..]. emit_placed is emit_tris while a batch is traced with them,
+     * NULL when the batch is too small to be worth it (each photon then places its own triangle). */
+    uint32_t *emit_tri_first;  /* emitter_count + 1 */
+    lm_emit_tri *emit_tris;
+    const lm_emit_tri *emit_placed;
     /* Scratch for rebuilding one group's slab (ph_group_apply) and for lists of groups. */
     lm_path_vertex *tmp_verts;
     uint32_t tmp_cap, max_group_photons;
@@ -78,14 +84,24 @@ struct lm_photons {
  * rays and stored. Returns 0 when memory ran out. Reads only ph's settings, photon numbering, scene,
  * BVH and emitters (never what applying writes): safe from several threads, and beside an apply. */
 int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf);
-/* Traces every job of batch b in parallel (OpenMP). If `done` is given, the calling thread first
- * applies that already traced batch (ph_apply_batch, in batch order) and then joins the tracing, so
- * applying one batch overlaps tracing the next. Returns the first failure (the apply's first). */
-lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, const ph_batch *done, lm_photon_frame_stats *st,
-                         lm_error *err);
+/* Traces every job of batch b in parallel (OpenMP; on the calling thread for fewer than 1024 jobs).
+ * Applies nothing (the round robin compares the paths itself). Fails only when memory runs out. */
+lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, lm_error *err);
+/* Traces and applies the whole groups list[0 .. n) in batches of whole groups (ph_fill_batch), all
+ * in one parallel region: batch k + 1 is traced by the team while the master first applies batch k,
+ * batches applied in list order (the store changes exactly as if each were traced and applied in
+ * turn). One region instead of one per batch: waking a thread team per batch cost milliseconds on a
+ * loaded machine. */
+lm_status ph_trace_groups(lm_photons *ph, const uint32_t *list, uint32_t n, lm_photon_frame_stats *st,
+                          lm_error *err);
 void ph_batch_clear(ph_batch *b);
 int ph_batch_push(ph_batch *b, uint32_t group, uint32_t m);
 void ph_batch_free(ph_batch *b);
+
+/* photons.c: fills b with whole groups from list[*i ...] (at least one group, up to a batch's photon
+ * bound); empty when the list is used up. Counts the groups' re-traces in g and st. */
+lm_status ph_fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, uint32_t n, uint32_t *i,
+                        lm_photon_frame_stats *st, lm_error *err);
 
 /* photon_paths.c: path storage, comparison and store updates. */
 const ph_vertex *ph_job_vertices(const ph_batch *b, const ph_job *j);
