@@ -2,7 +2,9 @@
  * rho/pi I cos/d^2, a box's shadow (umbra black, outside lit), a grazing directional light without
  * acne (and with acne when the bias is off), a spot light's cone falloff against lm_spot_attenuation,
  * a contact shadow, the glossy lobe against lm_bsdf_eval, the base colour texture against
- * lm_material_albedo, and determinism. Orthographic camera looking straight down at a 4 x 4 patch of
+ * lm_material_albedo, determinism, and the persistent lm_direct's caches (after a node, the light or
+ * its power changes, it renders what a fresh one-shot render of the same state renders; with nothing
+ * changed, nothing is re-rendered). Orthographic camera looking straight down at a 4 x 4 patch of
  * the plane, 64 x 64 pixels. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -387,12 +389,164 @@ static void test_deterministic(void **state)
     free(b);
 }
 
+/* A loaded scene with its emitters, for the cache tests: node 1 the plane, 2 the light, 3 the box. */
+typedef struct {
+    lm_scene *s;
+    lm_emitters em;
+    lm_view v;
+} live_scene;
+
+/* dynamic_node: the node marked dynamic (it and the other caster then sit in different layers). */
+static void live_load(live_scene *l, const char *path, int dynamic_node)
+{
+    lm_error err;
+    lm_load_options opt = {0};
+    assert_int_equal(lm_scene_load_gltf(path, &opt, &l->s, &err), LM_OK);
+    assert_int_equal(l->s->node_count, 4);
+    l->s->nodes[dynamic_node].dynamic = 1; /* the static / dynamic caster split is exercised */
+    assert_int_equal(lm_emitters_build(l->s, &l->em, &err), LM_OK);
+    lm_emitters_update(&l->em, l->s);
+    lm_scene_update_bounds(l->s);
+    top_view(&l->v);
+}
+
+/* After editing the scene: world matrices, bounds and emitters current, as the frame loop keeps them. */
+static void live_update(live_scene *l)
+{
+    lm_scene_update_world(l->s);
+    lm_scene_update_bounds(l->s);
+    lm_emitters_update(&l->em, l->s);
+}
+
+static void live_free(live_scene *l)
+{
+    lm_emitters_free(&l->em);
+    lm_scene_free(l->s);
+}
+
+/* The persistent object's render of the current state, checked against a fresh one-shot render. */
+static float *render_both(lm_direct *d, live_scene *l, const char *what)
+{
+    lm_error err;
+    float *a = malloc(sizeof(float) * 3 * W * W), *b = malloc(sizeof(float) * 3 * W * W);
+    assert_non_null(a);
+    assert_non_null(b);
+    if (lm_direct_render(d, l->s, &l->em, &l->v, W, W, a, &err) != LM_OK ||
+        lm_render_direct(l->s, &l->em, &l->v, W, W, NULL, b, &err) != LM_OK)
+        fail_msg("%s: %s", what, err.msg);
+    size_t differ = 0;
+    for (int i = 0; i < 3 * W * W; i++)
+        differ += a[i] != b[i];
+    if (differ)
+        fail_msg("%s: the persistent render differs from a fresh one in %zu values (a stale cache)", what, differ);
+    free(b);
+    return a;
+}
+
+static int differs(const float *a, const float *b)
+{
+    return memcmp(a, b, sizeof(float) * 3 * W * W) != 0;
+}
+
+/* (i) A persistent lm_direct after each change renders what a fresh render renders, and the change shows.
+ * dynamic_node 3: the box is dynamic; 1: the plane is, and the box is a static caster that moves without
+ * changing the scene bounds (so only the static-layer bookkeeping can notice). */
+static void check_cache_follows(const char *path, int dynamic_node)
+{
+    live_scene l;
+    live_load(&l, path, dynamic_node);
+    lm_direct *d = NULL;
+    lm_error err;
+    assert_int_equal(lm_direct_create(l.s, NULL, &d, &err), LM_OK);
+    float *first = render_both(d, &l, "first render");
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 1);
+
+    l.s->nodes[3].translation[0] -= 0.4f; /* the box moves: its shadow moves */
+    live_update(&l);
+    float *moved = render_both(d, &l, "box moved");
+    assert_true(differs(first, moved));
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 2);
+
+    l.s->nodes[2].translation[2] += 0.3f; /* the light moves */
+    live_update(&l);
+    float *light = render_both(d, &l, "light moved");
+    assert_true(differs(moved, light));
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 3);
+
+    for (int c = 0; c < 3; c++) /* more power: the image changes, the shadow map does not */
+        l.em.e[0].radiant[c] *= 2.0f;
+    float *power = render_both(d, &l, "power changed");
+    assert_true(differs(light, power));
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 3);
+
+    l.s->nodes[1].translation[1] -= 0.1f; /* the plane moves */
+    live_update(&l);
+    float *plane = render_both(d, &l, "plane moved");
+    assert_true(differs(power, plane));
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 4);
+
+    print_message("cache (%s, node %d dynamic): 4 changes, each identical to a fresh render; 4 maps rendered\n",
+                  path, dynamic_node);
+    lm_direct_free(d);
+    live_free(&l);
+    free(first);
+    free(moved);
+    free(light);
+    free(power);
+    free(plane);
+}
+
+static void test_cache_follows_changes(void **state)
+{
+    (void)state;
+    check_cache_follows(box_scene(), 3);
+    const char *spot = "{\"translation\": [0, 2, 0], \"rotation\": [-0.70710678, 0, 0, 0.70710678],"
+                       " \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}";
+    check_cache_follows(scene_with("spot_box", 1, spot,
+                                   "{\"type\": \"spot\", \"intensity\": 10,"
+                                   " \"spot\": {\"innerConeAngle\": 0.6, \"outerConeAngle\": 0.9}}"),
+                        1);
+}
+
+/* (j) Nothing changed: the second render is identical and renders no shadow map; nor does a point light
+ * that only turns. */
+static void test_cache_nothing_moved(void **state)
+{
+    (void)state;
+    live_scene l;
+    live_load(&l, box_scene(), 3);
+    lm_direct *d = NULL;
+    lm_error err;
+    assert_int_equal(lm_direct_create(l.s, NULL, &d, &err), LM_OK);
+    float *a = render_both(d, &l, "first render");
+    live_update(&l); /* recomputing the same matrices is not a change */
+    float *b = malloc(sizeof(float) * 3 * W * W);
+    assert_non_null(b);
+    assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, b, &err), LM_OK);
+    assert_memory_equal(a, b, sizeof(float) * 3 * W * W);
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 1);
+    l.s->nodes[2].rotation[0] = 0.6f; /* a point light turning changes neither its light nor its cube map */
+    l.s->nodes[2].rotation[3] = 0.8f;
+    live_update(&l);
+    float *turned = render_both(d, &l, "point light turned");
+    assert_memory_equal(a, turned, sizeof(float) * 3 * W * W);
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 1);
+    free(turned);
+    print_message("nothing moved (or a point light turned): renders identical, shadow maps rendered %ld\n",
+                  lm_direct_shadow_maps_rendered(d));
+    lm_direct_free(d);
+    live_free(&l);
+    free(a);
+    free(b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_plane), cmocka_unit_test(test_box_shadow), cmocka_unit_test(test_grazing),
         cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
-        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
+        cmocka_unit_test(test_cache_nothing_moved),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

@@ -1,9 +1,12 @@
-/* Indirect light of a frame (composite.h): one pass into an RGBA32F target with depth. */
+/* Indirect light of a frame and the final sum (composite.h): a premultiplied IIM x albedo atlas, then a
+ * full-screen pass over the direct pass's lightmap uvs adding the direct light (lm_composite_frame), or a
+ * geometry pass for the indirect part alone (lm_composite_indirect). Targets and programs persist. */
 #include "composite.h"
 
 #include "gl_api.h"
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "../core/vecmath.h"
 #include "gl_mesh.h"
@@ -14,8 +17,17 @@
 struct lm_composite {
     int width, height;   /* atlas */
     float *albedo;       /* atlas-sized RGBA: albedo / pi, a = 1 on covered texels */
-    GLuint albedo_tex, prog;
+    GLuint albedo_tex, prog, premult_prog, frame_prog, empty_vao;
     float limit;
+    GLint u_view_proj, u_lit, p_limit, p_albedo, p_iim, f_lit, f_direct, f_uv;
+    lm_float_target lit; /* atlas-sized, linear filter: (albedo / pi * E * w, w), w = covered and valid */
+    lm_gl_mesh mesh;      /* world position, lightmap uv; built on the first frame */
+    int node_count;
+    float *node_world;    /* per node: the world matrix its vertices were last uploaded with */
+    lm_float_target target;       /* the frame: sum (+ indirect) */
+    lm_float_target depth_target; /* lm_composite_indirect's geometry pass */
+    float *scratch;       /* read-back, width x height RGBA */
+    size_t scratch_px;
 };
 
 static const char *VS =
@@ -25,32 +37,49 @@ static const char *VS =
     "uniform mat4 view_proj;\n"
     "out vec2 v_uv;\n"
     "void main() { v_uv = uv; gl_Position = view_proj * vec4(pos, 1.0); }\n";
-/* Bilinear over the four nearest texels, each weighed by coverage x validity, renormalised. */
-static const char *FS =
+/* Per frame, per atlas texel: albedo / pi * E premultiplied by w = covered x valid (back-face fraction
+ * <= limit), and w; sampled with the texture unit's bilinear filter, rgb / a is then the bilinear filter
+ * over the four nearest texels that weighs only covered, valid ones, renormalised. */
+static const char *PREMULT_VS =
     "#version 450 core\n"
-    "in vec2 v_uv;\n"
+    "void main() {\n"
+    "    vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
+    "    gl_Position = vec4(p, 0.0, 1.0);\n"
+    "}\n";
+static const char *PREMULT_FS =
+    "#version 450 core\n"
     "uniform sampler2D albedo;\n"
     "uniform sampler2D iim;\n"
     "uniform float limit;\n"
     "out vec4 frag;\n"
     "void main() {\n"
-    "    if (v_uv.x < 0.0) { frag = vec4(0.0, 0.0, 0.0, 1.0); return; }\n"
-    "    ivec2 size = textureSize(albedo, 0);\n"
-    "    vec2 p = v_uv * vec2(size) - 0.5;\n"
-    "    ivec2 p0 = ivec2(floor(p));\n"
-    "    vec2 f = p - vec2(p0);\n"
-    "    vec3 sum = vec3(0.0);\n"
-    "    float wsum = 0.0;\n"
-    "    for (int j = 0; j < 2; j++)\n"
-    "        for (int i = 0; i < 2; i++) {\n"
-    "            ivec2 q = clamp(p0 + ivec2(i, j), ivec2(0), size - 1);\n"
-    "            vec4 al = texelFetch(albedo, q, 0), e = texelFetch(iim, q, 0);\n"
-    "            float w = (i == 1 ? f.x : 1.0 - f.x) * (j == 1 ? f.y : 1.0 - f.y);\n"
-    "            w *= al.a * (e.a <= limit ? 1.0 : 0.0);\n"
-    "            sum += w * al.rgb * e.rgb;\n"
-    "            wsum += w;\n"
-    "        }\n"
-    "    frag = vec4(wsum > 0.0 ? sum / wsum : vec3(0.0), 1.0);\n"
+    "    ivec2 q = ivec2(gl_FragCoord.xy);\n"
+    "    vec4 al = texelFetch(albedo, q, 0), e = texelFetch(iim, q, 0);\n"
+    "    float w = al.a * (e.a <= limit ? 1.0 : 0.0);\n"
+    "    frag = vec4(al.rgb * e.rgb * w, w);\n"
+    "}\n";
+static const char *FS =
+    "#version 450 core\n"
+    "in vec2 v_uv;\n"
+    "uniform sampler2D lit;\n"
+    "out vec4 frag;\n"
+    "void main() {\n"
+    "    vec4 t = textureLod(lit, v_uv, 0.0);\n"
+    "    frag = vec4(v_uv.x >= 0.0 && t.a > 0.0 ? t.rgb / t.a : vec3(0.0), 1.0);\n"
+    "}\n";
+/* The frame, full screen: direct + the indirect light at each pixel's lightmap uv. */
+static const char *FRAME_FS =
+    "#version 450 core\n"
+    "uniform sampler2D lit, direct, uvs;\n"
+    "layout(location = 0) out vec4 frag;\n"
+    "layout(location = 1) out vec4 indirect;\n"
+    "void main() {\n"
+    "    ivec2 q = ivec2(gl_FragCoord.xy);\n"
+    "    vec2 uv = texelFetch(uvs, q, 0).xy;\n"
+    "    vec4 t = textureLod(lit, uv, 0.0);\n"
+    "    vec3 e = uv.x >= 0.0 && t.a > 0.0 ? t.rgb / t.a : vec3(0.0);\n"
+    "    frag = vec4(texelFetch(direct, q, 0).rgb + e, 1.0);\n"
+    "    indirect = vec4(e, 1.0);\n"
     "}\n";
 
 /* albedo / pi at each covered texel's centre (its triangle's material, texture at the interpolated UV). */
@@ -107,6 +136,25 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
         return st;
     }
     c->albedo_tex = upload_rgba(a->width, a->height, c->albedo);
+    st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
+    if (st != LM_OK) {
+        lm_composite_free(c);
+        return st;
+    }
+    st = lm_gl_program("composite_frame", PREMULT_VS, FRAME_FS, &c->frame_prog, err);
+    if (st != LM_OK) {
+        lm_composite_free(c);
+        return st;
+    }
+    c->f_lit = glGetUniformLocation(c->frame_prog, "lit");
+    c->f_direct = glGetUniformLocation(c->frame_prog, "direct");
+    c->f_uv = glGetUniformLocation(c->frame_prog, "uvs");
+    glGenVertexArrays(1, &c->empty_vao);
+    c->u_view_proj = glGetUniformLocation(c->prog, "view_proj");
+    c->u_lit = glGetUniformLocation(c->prog, "lit");
+    c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
+    c->p_albedo = glGetUniformLocation(c->premult_prog, "albedo");
+    c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
     *out = c;
     return LM_OK;
 }
@@ -119,6 +167,19 @@ void lm_composite_free(lm_composite *c)
         glDeleteTextures(1, &c->albedo_tex);
     if (c->prog)
         glDeleteProgram(c->prog);
+    if (c->premult_prog)
+        glDeleteProgram(c->premult_prog);
+    if (c->frame_prog)
+        glDeleteProgram(c->frame_prog);
+    if (c->empty_vao)
+        glDeleteVertexArrays(1, &c->empty_vao);
+    if (c->mesh.vao)
+        lm_gl_mesh_destroy(&c->mesh);
+    lm_float_target_free(&c->target);
+    lm_float_target_free(&c->depth_target);
+    lm_float_target_free(&c->lit);
+    free(c->node_world);
+    free(c->scratch);
     free(c->albedo);
     free(c);
 }
@@ -131,7 +192,83 @@ int lm_composite_albedo(const lm_composite *c, int x, int y, float out[3])
     return p[3] > 0.0f;
 }
 
-static void draw(const lm_composite *c, const lm_gl_mesh *mesh, unsigned iim_tex, const lm_view *view, int w, int h)
+/* Position and lightmap uv of triangles [t0, t1) (5 floats a vertex), as lm_lightmapped_vertices. */
+static void fill_range(const lm_scene *s, const lm_atlas *a, uint32_t t0, uint32_t t1, float *v)
+{
+    for (uint32_t t = t0; t < t1; t++)
+        for (int k = 0; k < 3; k++) {
+            float *o = v + 15 * (size_t)(t - t0) + 5 * k;
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], o);
+            const float *uv = a->corner_uv + 6 * (size_t)t + 2 * k;
+            int none = a->tri_chart[t] < 0 || !isfinite(uv[0]);
+            o[3] = none ? -1.0f : uv[0];
+            o[4] = none ? -1.0f : uv[1];
+        }
+}
+
+/* Builds the vertex buffer on the first frame; later re-uploads only the nodes that moved. */
+static lm_status update_mesh(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err)
+{
+    if (!c->mesh.vao) {
+        float *verts = lm_lightmapped_vertices(s, a);
+        c->node_world = malloc(sizeof(float) * 16 * (size_t)(s->node_count ? s->node_count : 1));
+        if (!verts || !c->node_world) {
+            free(verts);
+            return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
+        }
+        const int sizes[2] = {3, 2};
+        lm_gl_mesh_create(&c->mesh, verts, (int)(3 * s->tri_count), sizes, 2);
+        free(verts);
+        c->node_count = s->node_count;
+        for (int i = 0; i < s->node_count; i++)
+            memcpy(c->node_world + 16 * (size_t)i, s->nodes[i].world, sizeof s->nodes[i].world);
+        return LM_OK;
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, c->mesh.vbo);
+    for (int i = 0; i < s->node_count && i < c->node_count; i++) {
+        const lm_node *nd = &s->nodes[i];
+        float *w = c->node_world + 16 * (size_t)i;
+        if (!memcmp(w, nd->world, sizeof nd->world))
+            continue;
+        memcpy(w, nd->world, sizeof nd->world);
+        if (!nd->tri_count)
+            continue;
+        float *v = malloc(sizeof(float) * 15 * nd->tri_count);
+        if (!v)
+            return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
+        fill_range(s, a, nd->first_tri, nd->first_tri + nd->tri_count, v);
+        glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)(sizeof(float) * 15 * (size_t)nd->first_tri),
+                        (GLsizeiptr)(sizeof(float) * 15 * nd->tri_count), v);
+        free(v);
+    }
+    return LM_OK;
+}
+
+/* The premultiplied atlas (c->lit, bound) from the display IIM. */
+static void premultiply(const lm_composite *c, unsigned iim_tex)
+{
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(c->premult_prog);
+    glUniform1f(c->p_limit, c->limit);
+    glUniform1i(c->p_albedo, 0);
+    glUniform1i(c->p_iim, 1);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, c->albedo_tex);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, iim_tex);
+    glBindVertexArray(c->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindTexture(GL_TEXTURE_2D, c->lit.color[0]); /* sampled with the bilinear filter */
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glActiveTexture(GL_TEXTURE0);
+}
+
+static void draw(const lm_composite *c, const lm_view *view, int w, int h)
 {
     float vp[16];
     lm_mat4_mul(vp, view->proj, view->view);
@@ -144,35 +281,82 @@ static void draw(const lm_composite *c, const lm_gl_mesh *mesh, unsigned iim_tex
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     glUseProgram(c->prog);
-    glUniformMatrix4fv(glGetUniformLocation(c->prog, "view_proj"), 1, GL_FALSE, vp);
-    glUniform1f(glGetUniformLocation(c->prog, "limit"), c->limit);
-    glUniform1i(glGetUniformLocation(c->prog, "albedo"), 0);
-    glUniform1i(glGetUniformLocation(c->prog, "iim"), 1);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, c->albedo_tex);
+    glUniformMatrix4fv(c->u_view_proj, 1, GL_FALSE, vp);
+    glUniform1i(c->u_lit, 1);
     glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, iim_tex);
-    lm_gl_mesh_draw(mesh);
+    glBindTexture(GL_TEXTURE_2D, c->lit.color[0]);
+    lm_gl_mesh_draw(&c->mesh);
     glActiveTexture(GL_TEXTURE0);
+}
+
+/* The scratch read-back buffer for width x height. */
+static lm_status scratch_for(lm_composite *c, int width, int height, lm_error *err)
+{
+    if (width <= 0 || height <= 0)
+        return lm_fail(err, LM_ERR_INVALID, "composite: bad size %dx%d", width, height);
+    size_t px = (size_t)width * (size_t)height;
+    if (px > c->scratch_px) {
+        free(c->scratch);
+        c->scratch = malloc(4 * px * sizeof(float));
+        c->scratch_px = c->scratch ? px : 0;
+        if (!c->scratch)
+            return lm_fail(err, LM_ERR_NOMEM, "composite: no memory to read back %dx%d", width, height);
+    }
+    return LM_OK;
+}
+
+lm_status lm_composite_frame(lm_composite *c, unsigned iim_tex, unsigned direct_tex, unsigned uv_tex, int width,
+                             int height, float *rgb, float *indirect, lm_error *err)
+{
+    lm_status st = scratch_for(c, width, height, err);
+    if (st == LM_OK)
+        st = lm_float_target_ensure(&c->lit, c->width, c->height, 1, err);
+    if (st != LM_OK)
+        return st;
+    premultiply(c, iim_tex);
+    /* two attachments once an indirect image was asked for: the target is not re-made back and forth */
+    int attachments = indirect || c->target.attachments == 2 ? 2 : 1;
+    st = lm_float_target_ensure(&c->target, width, height, attachments, err);
+    if (st != LM_OK)
+        return st;
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glUseProgram(c->frame_prog);
+    glUniform1i(c->f_lit, 1);
+    glUniform1i(c->f_direct, 3);
+    glUniform1i(c->f_uv, 4);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, c->lit.color[0]);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, direct_tex);
+    glActiveTexture(GL_TEXTURE4);
+    glBindTexture(GL_TEXTURE_2D, uv_tex);
+    glBindVertexArray(c->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glActiveTexture(GL_TEXTURE0);
+    lm_float_target_read_rgb(&c->target, 0, rgb, c->scratch);
+    if (indirect)
+        lm_float_target_read_rgb(&c->target, 1, indirect, c->scratch);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return lm_gl_check("composite", err);
 }
 
 lm_status lm_composite_indirect(lm_composite *c, const lm_scene *s, const lm_atlas *a, unsigned iim_tex,
                                 const lm_view *view, int width, int height, float *rgb, lm_error *err)
 {
-    float *verts = lm_lightmapped_vertices(s, a);
-    if (!verts)
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
-    lm_gl_mesh mesh;
-    const int sizes[2] = {3, 2};
-    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
-    free(verts);
-    lm_offscreen t;
-    lm_status st = lm_offscreen_begin_float(&t, width, height, err);
-    if (st == LM_OK) {
-        draw(c, &mesh, iim_tex, view, width, height);
-        lm_offscreen_read_rgb(&t, rgb);
-        lm_offscreen_release(&t);
-    }
-    lm_gl_mesh_destroy(&mesh);
-    return st;
+    lm_status st = scratch_for(c, width, height, err);
+    if (st == LM_OK)
+        st = update_mesh(c, s, a, err);
+    if (st == LM_OK)
+        st = lm_float_target_ensure(&c->lit, c->width, c->height, 1, err);
+    if (st != LM_OK)
+        return st;
+    premultiply(c, iim_tex);
+    st = lm_float_target_ensure(&c->depth_target, width, height, 1, err);
+    if (st != LM_OK)
+        return st;
+    draw(c, view, width, height);
+    lm_float_target_read_rgb(&c->depth_target, 0, rgb, c->scratch);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return lm_gl_check("composite", err);
 }

@@ -3,7 +3,8 @@
  * the texel's centre, fixed at creation); E_IIM is the displayed IIM texture. Both are sampled together
  * with a bilinear filter that only weighs covered, valid texels (back-face fraction <= the limit), so
  * gutters and invalid texels never darken a chart's border. Mirror and glass (no lightmap texels) and
- * the background are black. The caller adds the direct image. */
+ * the background are black. lm_composite_frame adds the direct image on the GPU. Programs, targets and
+ * (lm_composite_indirect) the lightmapped vertex buffer, only moved nodes re-uploaded, persist. */
 #ifndef LM_COMPOSITE_H
 #define LM_COMPOSITE_H
 
@@ -20,6 +21,13 @@ void lm_composite_free(lm_composite *c);
  * matrices into rgb (width*height*3 floats, row 0 at the top). */
 lm_status lm_composite_indirect(lm_composite *c, const lm_scene *s, const lm_atlas *a, unsigned iim_tex,
                                 const lm_view *view, int width, int height, float *rgb, lm_error *err);
+/* The frame: rgb = direct + albedo / pi * E, summed on the GPU by one full-screen pass and read back as
+ * one image. direct_tex and uv_tex: width x height RGBA32F textures of the direct light and of each
+ * pixel's lightmap uv ((-1, -1) where none) — lm_direct_texture and lm_direct_uv_texture — so the
+ * composite draws no geometry. When indirect is not NULL, the indirect part alone is read back into it
+ * too (a second colour attachment). */
+lm_status lm_composite_frame(lm_composite *c, unsigned iim_tex, unsigned direct_tex, unsigned uv_tex, int width,
+                             int height, float *rgb, float *indirect, lm_error *err);
 /* The albedo / pi of texel (x, y) (rgb) and whether it is covered (return 1). For tests. */
 int lm_composite_albedo(const lm_composite *c, int x, int y, float out[3]);
 

@@ -1,5 +1,6 @@
 /* Direct light per pixel (direct.h): an emission pass that also lays down depth, then per punctual light
- * its shadow map and an additive pass (depth test LEQUAL, no depth writes) into an RGBA32F target. */
+ * its shadow map (cached) and an additive pass (depth test LEQUAL, no depth writes) into an RGBA32F
+ * target. */
 #include "direct.h"
 
 #include "gl_api.h"
@@ -25,9 +26,49 @@ void lm_direct_settings_default(lm_direct_settings *s)
     s->const_bias = 0.5f;
 }
 
+typedef struct {
+    GLint pass_kind, kind, lpos, ldir, radiant, origin, cos_outer, spot_width, texel, map_size, light_vp;
+    GLint view_proj, eye, view_dir, ortho_view, pcf, normal_offset, slope_bias, max_slope, const_bias;
+    GLint map2d, mapcube, base_tex;
+} uniforms;
 
-static void set_light_uniforms(GLuint prog, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)
+/* One punctual light's map and the caster geometry versions it was rendered over. */
+typedef struct {
+    lm_shadow_map map;
+    unsigned long static_version, dynamic_version;
+} cached_map;
+
+struct lm_direct {
+    lm_direct_settings set;
+    GLuint prog, emission;  /* light program, emission program */
+    GLint e_view_proj, e_eye, e_view_dir, e_ortho_view;
+    uniforms u;
+    lm_direct_mesh mesh;
+    lm_shadow_renderer shadow;
+    lm_float_target target;
+    cached_map *maps;       /* per emitter index */
+    int map_count;
+    unsigned long static_version;  /* bumped whenever a static shadow-casting node moves (an edit) */
+    unsigned long dynamic_version; /* bumped whenever a dynamic shadow-casting node moves */
+    long maps_rendered;
+    int keep_uv;            /* the target has attachment 1: lightmap uv */
+    float *scratch;         /* read-back, width x height RGBA */
+    size_t scratch_px;
+};
+
+static void find_uniforms(GLuint p, uniforms *u)
 {
+#define LOC(name) u->name = glGetUniformLocation(p, #name)
+    LOC(pass_kind); LOC(kind); LOC(lpos); LOC(ldir); LOC(radiant); LOC(origin); LOC(cos_outer);
+    LOC(spot_width); LOC(texel); LOC(map_size); LOC(light_vp); LOC(view_proj); LOC(eye); LOC(view_dir);
+    LOC(ortho_view); LOC(pcf); LOC(normal_offset); LOC(slope_bias); LOC(max_slope); LOC(const_bias);
+    LOC(map2d); LOC(mapcube); LOC(base_tex);
+#undef LOC
+}
+
+static void set_light_uniforms(const lm_direct *d, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)
+{
+    const uniforms *u = &d->u;
     int kind = e->kind == LM_EMIT_POINT ? 0 : e->kind == LM_EMIT_SPOT ? 1 : 2;
     float cos_outer = -2.0f, width = 1.0f;
     if (kind == 1) { /* the same falloff as lm_spot_attenuation */
@@ -35,45 +76,52 @@ static void set_light_uniforms(GLuint prog, const lm_scene *s, const lm_emitter 
         cos_outer = cosf(l->outer_cone);
         width = fmaxf(1e-3f, cosf(l->inner_cone) - cos_outer);
     }
-    glUniform1i(glGetUniformLocation(prog, "pass_kind"), 1);
-    glUniform1i(glGetUniformLocation(prog, "kind"), kind);
-    glUniform3fv(glGetUniformLocation(prog, "lpos"), 1, e->pos);
-    glUniform3fv(glGetUniformLocation(prog, "ldir"), 1, m->dir);
-    glUniform3fv(glGetUniformLocation(prog, "radiant"), 1, e->radiant);
-    glUniform3fv(glGetUniformLocation(prog, "origin"), 1, m->origin);
-    glUniform1f(glGetUniformLocation(prog, "cos_outer"), cos_outer);
-    glUniform1f(glGetUniformLocation(prog, "spot_width"), width);
-    glUniform1f(glGetUniformLocation(prog, "texel"), m->texel);
-    glUniform1f(glGetUniformLocation(prog, "map_size"), (float)m->size);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "light_vp"), 1, GL_FALSE, m->light_vp);
-    glActiveTexture(m->cube ? GL_TEXTURE1 : GL_TEXTURE0);
-    glBindTexture(m->cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D, m->tex);
+    glUniform1i(u->pass_kind, 1);
+    glUniform1i(u->kind, kind);
+    glUniform3fv(u->lpos, 1, e->pos);
+    float ldir[3]; /* as the map's dir, which a cube map leaves 0 */
+    lm_v3_store(ldir, lm_normalize(lm_v3_load(e->dir)));
+    glUniform3fv(u->ldir, 1, ldir);
+    glUniform3fv(u->radiant, 1, e->radiant);
+    glUniform3fv(u->origin, 1, m->p.origin);
+    glUniform1f(u->cos_outer, cos_outer);
+    glUniform1f(u->spot_width, width);
+    glUniform1f(u->texel, m->p.texel);
+    glUniform1f(u->map_size, (float)m->p.size);
+    glUniformMatrix4fv(u->light_vp, 1, GL_FALSE, m->p.light_vp);
+    glActiveTexture(m->p.cube ? GL_TEXTURE1 : GL_TEXTURE0);
+    glBindTexture(m->p.cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D, m->tex);
 }
 
-static void set_view_uniforms(GLuint prog, const lm_view *view, const lm_direct_settings *set)
+static void set_view_uniforms(const lm_direct *d, const lm_view *view)
 {
+    const uniforms *u = &d->u;
+    const lm_direct_settings *set = &d->set;
     float vp[16];
     lm_mat4_mul(vp, view->proj, view->view);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
+    glUniformMatrix4fv(u->view_proj, 1, GL_FALSE, vp);
     /* orthographic views (no perspective divide) look along one direction: towards the eye is the
      * view matrix's third row */
     const float towards_eye[3] = {view->view[2], view->view[6], view->view[10]};
-    glUniform3fv(glGetUniformLocation(prog, "eye"), 1, view->eye);
-    glUniform3fv(glGetUniformLocation(prog, "view_dir"), 1, towards_eye);
-    glUniform1i(glGetUniformLocation(prog, "ortho_view"), view->proj[11] == 0.0f && view->proj[15] != 0.0f);
-    glUniform1i(glGetUniformLocation(prog, "pcf"), set->pcf_radius);
-    glUniform1f(glGetUniformLocation(prog, "normal_offset"), set->normal_offset);
-    glUniform1f(glGetUniformLocation(prog, "slope_bias"), set->slope_bias);
-    glUniform1f(glGetUniformLocation(prog, "max_slope"), set->max_slope);
-    glUniform1f(glGetUniformLocation(prog, "const_bias"), set->const_bias);
-    glUniform1i(glGetUniformLocation(prog, "map2d"), 0);
-    glUniform1i(glGetUniformLocation(prog, "mapcube"), 1);
-    glUniform1i(glGetUniformLocation(prog, "base_tex"), 2);
+    glUniform3fv(u->eye, 1, view->eye);
+    glUniform3fv(u->view_dir, 1, towards_eye);
+    glUniform1i(u->ortho_view, view->proj[11] == 0.0f && view->proj[15] != 0.0f);
+    glUniform1i(u->pcf, set->pcf_radius);
+    glUniform1f(u->normal_offset, set->normal_offset);
+    glUniform1f(u->slope_bias, set->slope_bias);
+    glUniform1f(u->max_slope, set->max_slope);
+    glUniform1f(u->const_bias, set->const_bias);
+    glUniform1i(u->map2d, 0);
+    glUniform1i(u->mapcube, 1);
+    glUniform1i(u->base_tex, 2);
 }
 
 /* Emission pass: clears, writes depth and the emitted radiance. */
-static void emission_pass(GLuint prog, const lm_direct_mesh *mesh, int w, int h)
+static void emission_pass(const lm_direct *d, const lm_view *view, int w, int h)
 {
+    float vp[16];
+    lm_mat4_mul(vp, view->proj, view->view);
+    const float towards_eye[3] = {view->view[2], view->view[6], view->view[10]};
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -82,80 +130,210 @@ static void emission_pass(GLuint prog, const lm_direct_mesh *mesh, int w, int h)
     glDisable(GL_BLEND);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glUseProgram(prog);
-    glUniform1i(glGetUniformLocation(prog, "pass_kind"), 0);
-    lm_direct_mesh_draw(mesh, prog);
+    if (d->keep_uv) {
+        const float none[4] = {-1.0f, -1.0f, 0.0f, 1.0f};
+        glClearBufferfv(GL_COLOR, 1, none);
+    }
+    glUseProgram(d->emission);
+    glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
+    glUniform3fv(d->e_eye, 1, view->eye);
+    glUniform3fv(d->e_view_dir, 1, towards_eye);
+    glUniform1i(d->e_ortho_view, view->proj[11] == 0.0f && view->proj[15] != 0.0f);
+    lm_direct_mesh_draw(&d->mesh, 0);
+}
+
+/* Emitter i's shadow map, re-rendered only when stale. */
+static lm_status shadow_map(lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, lm_error *err)
+{
+    cached_map *c = &d->maps[i];
+    lm_shadow_params p;
+    lm_shadow_params_compute(&p, s, e, e->kind == LM_EMIT_POINT ? d->set.cube_size : d->set.map_size);
+    int same = c->map.tex && !memcmp(&p, &c->map.p, sizeof p), static_ok = c->static_version == d->static_version;
+    if (same && static_ok && c->dynamic_version == d->dynamic_version)
+        return LM_OK;
+    lm_status st = lm_shadow_map_draw(&c->map, &p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_vertices,
+                                      !static_ok, err);
+    c->static_version = d->static_version;
+    c->dynamic_version = d->dynamic_version;
+    d->maps_rendered++;
+    return st;
 }
 
 /* One light: its shadow map, then an additive pass over the laid-down depth. */
-static lm_status light_pass(GLuint prog, const lm_scene *s, const lm_emitter *e, const lm_direct_mesh *mesh,
-                            const lm_offscreen *t, int w, int h,
-                            const lm_direct_settings *set, lm_error *err)
+static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, int w, int h,
+                            lm_error *err)
 {
-    lm_shadow_map m;
-    int size = e->kind == LM_EMIT_POINT ? set->cube_size : set->map_size;
-    lm_status st = lm_shadow_map_render(&m, s, e, &mesh->casters, size, err);
+    lm_status st = shadow_map(d, s, e, i, err);
     if (st != LM_OK)
         return st;
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
-    glUseProgram(prog);
-    set_light_uniforms(prog, s, e, &m);
-    lm_direct_mesh_draw(mesh, prog);
+    glUseProgram(d->prog);
+    set_light_uniforms(d, s, e, &d->maps[i].map);
+    lm_direct_mesh_draw(&d->mesh, d->prog);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
-    st = lm_gl_check("direct_light: light pass", err);
-    lm_shadow_map_free(&m);
+    return lm_gl_check("direct_light: light pass", err);
+}
+
+static int valid_settings(const lm_direct_settings *set)
+{
+    return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0;
+}
+
+lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings, lm_direct **out, lm_error *err)
+{
+    *out = NULL;
+    lm_direct *d = calloc(1, sizeof *d);
+    if (!d)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the direct light", s->path);
+    if (settings)
+        d->set = *settings;
+    else
+        lm_direct_settings_default(&d->set);
+    if (!valid_settings(&d->set)) {
+        lm_direct_settings bad = d->set;
+        free(d);
+        return lm_fail(err, LM_ERR_INVALID, "direct_light: bad settings (map %d, cube %d, pcf %d)", bad.map_size,
+                       bad.cube_size, bad.pcf_radius);
+    }
+    lm_status st = lm_gl_program("direct_light", lm_direct_vs, lm_direct_fs, &d->prog, err);
+    if (st == LM_OK) {
+        find_uniforms(d->prog, &d->u);
+        st = lm_gl_program("direct_emission", lm_direct_emission_vs, lm_direct_emission_fs, &d->emission, err);
+    }
+    if (st == LM_OK) {
+        d->e_view_proj = glGetUniformLocation(d->emission, "view_proj");
+        d->e_eye = glGetUniformLocation(d->emission, "eye");
+        d->e_view_dir = glGetUniformLocation(d->emission, "view_dir");
+        d->e_ortho_view = glGetUniformLocation(d->emission, "ortho_view");
+        st = lm_shadow_renderer_create(&d->shadow, err);
+    }
+    if (st == LM_OK)
+        st = lm_direct_mesh_build(&d->mesh, s, err);
+    if (st == LM_OK)
+        st = lm_gl_check("direct_light: setup", err);
+    if (st != LM_OK) {
+        lm_direct_free(d);
+        return st;
+    }
+    *out = d;
+    return LM_OK;
+}
+
+void lm_direct_free(lm_direct *d)
+{
+    if (!d)
+        return;
+    for (int i = 0; i < d->map_count; i++)
+        lm_shadow_map_free(&d->maps[i].map);
+    free(d->maps);
+    lm_float_target_free(&d->target);
+    if (d->mesh.first)
+        lm_direct_mesh_free(&d->mesh);
+    lm_shadow_renderer_free(&d->shadow);
+    if (d->prog)
+        glDeleteProgram(d->prog);
+    if (d->emission)
+        glDeleteProgram(d->emission);
+    free(d->scratch);
+    free(d);
+}
+
+/* One cached map per emitter index (the emitter list is fixed, but grow if it is not). */
+static lm_status ensure_maps(lm_direct *d, int count, lm_error *err)
+{
+    if (count <= d->map_count)
+        return LM_OK;
+    cached_map *m = realloc(d->maps, sizeof *m * (size_t)count);
+    if (!m)
+        return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory for %d shadow maps", count);
+    memset(m + d->map_count, 0, sizeof *m * (size_t)(count - d->map_count));
+    d->maps = m;
+    d->map_count = count;
+    return LM_OK;
+}
+
+lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
+                         int height, lm_error *err)
+{
+    if (width <= 0 || height <= 0)
+        return lm_fail(err, LM_ERR_INVALID, "direct_light: bad size %dx%d", width, height);
+    lm_status st = ensure_maps(d, em->count, err);
+    if (st != LM_OK)
+        return st;
+    int moved = lm_direct_mesh_update(&d->mesh, s);
+    d->static_version += (moved & LM_MESH_STATIC_CASTERS_MOVED) != 0;
+    d->dynamic_version += (moved & LM_MESH_DYNAMIC_CASTERS_MOVED) != 0;
+    st = lm_float_target_ensure(&d->target, width, height, d->keep_uv ? 2 : 1, err);
+    if (st != LM_OK)
+        return st;
+    emission_pass(d, view, width, height);
+    if (d->keep_uv) { /* the light passes add to attachment 0 only */
+        const GLenum light_only[2] = {GL_COLOR_ATTACHMENT0, GL_NONE};
+        glDrawBuffers(2, light_only);
+    }
+    glUseProgram(d->prog);
+    set_view_uniforms(d, view);
+    for (int i = 0; st == LM_OK && i < em->count; i++)
+        if (em->e[i].kind != LM_EMIT_AREA)
+            st = light_pass(d, s, &em->e[i], i, width, height, err);
+    if (d->keep_uv) {
+        static const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
+        glDrawBuffers(2, both);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return st;
 }
 
-static lm_status draw_all(GLuint prog, const lm_scene *s, const lm_emitters *em, const lm_view *view,
-                          const lm_direct_mesh *mesh, int w, int h,
-                          const lm_direct_settings *set, float *rgb, lm_error *err)
+unsigned lm_direct_texture(const lm_direct *d) { return d->target.color[0]; }
+
+unsigned lm_direct_uv_texture(const lm_direct *d) { return d->keep_uv ? d->target.color[1] : 0; }
+
+lm_status lm_direct_keep_lightmap_uv(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
-    lm_offscreen t;
-    lm_status st = lm_offscreen_begin_float(&t, w, h, err);
-    if (st == LM_OK) {
-        glUseProgram(prog);
-        set_view_uniforms(prog, view, set);
-        emission_pass(prog, mesh, w, h);
+    lm_status st = lm_direct_mesh_add_lightmap_uv(&d->mesh, s, a, err);
+    if (st == LM_OK)
+        d->keep_uv = 1;
+    return st == LM_OK ? lm_gl_check("direct_light: lightmap uvs", err) : st;
+}
+
+long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
+
+lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
+                           int height, float *rgb, lm_error *err)
+{
+    lm_status st = lm_direct_draw(d, s, em, view, width, height, err);
+    if (st != LM_OK)
+        return st;
+    size_t px = (size_t)width * (size_t)height;
+    if (px > d->scratch_px) {
+        free(d->scratch);
+        d->scratch = malloc(4 * px * sizeof(float));
+        d->scratch_px = d->scratch ? px : 0;
+        if (!d->scratch)
+            return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory to read back %dx%d", width, height);
     }
-    for (int i = 0; st == LM_OK && i < em->count; i++)
-        if (em->e[i].kind != LM_EMIT_AREA)
-            st = light_pass(prog, s, &em->e[i], mesh, &t, w, h, set, err);
-    if (st == LM_OK) {
-        lm_offscreen_read_rgb(&t, rgb);
-        st = lm_gl_check("direct_light: reading back", err);
-    }
-    if (t.fbo)
-        lm_offscreen_release(&t);
-    return st;
+    lm_float_target_read_rgb(&d->target, 0, rgb, d->scratch);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return lm_gl_check("direct_light: reading back", err);
 }
 
 lm_status lm_render_direct(const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                            int height, const lm_direct_settings *settings, float *rgb, lm_error *err)
 {
-    lm_direct_settings set;
-    if (settings)
-        set = *settings;
-    else
-        lm_direct_settings_default(&set);
-    if (width <= 0 || height <= 0 || set.map_size <= 0 || set.cube_size <= 0 || set.pcf_radius < 0)
+    if (width <= 0 || height <= 0)
         return lm_fail(err, LM_ERR_INVALID, "direct_light: bad size %dx%d or settings", width, height);
-    GLuint prog = 0;
-    lm_status st = lm_gl_program("direct_light", lm_direct_vs, lm_direct_fs, &prog, err);
-    if (st != LM_OK)
-        return st;
-    lm_direct_mesh mesh;
-    st = lm_direct_mesh_build(&mesh, s, err);
+    lm_direct *d = NULL;
+    lm_status st = lm_direct_create(s, settings, &d, err);
     if (st == LM_OK)
-        st = draw_all(prog, s, em, view, &mesh, width, height, &set, rgb, err);
-    lm_direct_mesh_free(&mesh);
-    glDeleteProgram(prog);
+        st = lm_direct_render(d, s, em, view, width, height, rgb, err);
+    lm_direct_free(d);
     return st;
 }

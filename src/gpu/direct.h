@@ -6,6 +6,7 @@
 #ifndef LM_DIRECT_H
 #define LM_DIRECT_H
 
+#include "../charts/charts.h"
 #include "../core/error.h"
 #include "../scene/scene.h"
 #include "../trace/lights.h"
@@ -23,7 +24,36 @@ typedef struct {
 
 void lm_direct_settings_default(lm_direct_settings *s);
 
-/* Renders width x height RGB floats into rgb (3 per pixel, row 0 at the top). em must be current
+/* A persistent direct-light renderer (docs/direct.md, "What is cached"): the program, the scene's vertex
+ * buffers and textures, the float target and one shadow map per punctual light, kept between renders.
+ * Each render re-uploads only the nodes whose world matrix changed and re-renders a light's shadow map
+ * only when its parameters (position, direction, cone, size, the scene bounds it is fitted to) or a
+ * shadow-casting node changed since that map was made. Everything else about the scene (materials,
+ * textures, the node set, which nodes cast shadows) is fixed at creation. Needs a current GL context. */
+typedef struct lm_direct lm_direct;
+
+/* settings NULL = defaults; they are fixed for the object's life. */
+lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings, lm_direct **out, lm_error *err);
+void lm_direct_free(lm_direct *d);
+/* Renders into the object's width x height RGBA32F target (no read-back); see lm_direct_texture. em and
+ * s->bounds current as for lm_render_direct. */
+lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
+                         int height, lm_error *err);
+/* The last lm_direct_draw's image: an RGBA32F texture (rgb = radiance, GL rows bottom-up). */
+unsigned lm_direct_texture(const lm_direct *d);
+/* lm_direct_draw, then the image read back as RGB floats (row 0 at the top). */
+lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
+                           int height, float *rgb, lm_error *err);
+/* From now on each render also keeps, per pixel, the visible surface's lightmap uv in atlas a ((-1, -1)
+ * where none: background, mirror, glass), for a composite that needs no geometry pass of its own. */
+lm_status lm_direct_keep_lightmap_uv(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err);
+/* That image of the last render: an RGBA32F texture (rg = uv), or 0 without lm_direct_keep_lightmap_uv. */
+unsigned lm_direct_uv_texture(const lm_direct *d);
+/* Shadow maps rendered since creation (each cube map counts once), for tests and statistics. */
+long lm_direct_shadow_maps_rendered(const lm_direct *d);
+
+/* One-shot: creates an lm_direct, renders, reads back and frees it.
+ * Renders width x height RGB floats into rgb (3 per pixel, row 0 at the top). em must be current
  * (lm_emitters_update) and s->bounds current (lm_scene_update_bounds) for the directional fit.
  * Needs a current GL context. settings NULL = defaults. */
 lm_status lm_render_direct(const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,

@@ -82,23 +82,35 @@ static void plan_groups(lm_direct_mesh *d, const lm_scene *s)
         d->tex[g - 1] = d->count[g] ? upload(&s->textures[g - 1]) : 0;
 }
 
-/* Fills the shading vertices (grouped) and the casters; returns the caster triangle count. */
-static int fill(const lm_direct_mesh *d, const lm_scene *s, float *v, float *c)
+/* Fills the shading vertices (grouped) and the casters, those of static nodes first; returns the caster
+ * triangle count. */
+static int fill(lm_direct_mesh *d, const lm_scene *s, float *v, float *c)
 {
-    int *next = calloc((size_t)d->groups, sizeof(int)), casters = 0;
+    int *next = calloc((size_t)d->groups, sizeof(int)), casters = 0, next_static = 0, next_dynamic = 0;
     if (!next)
         return -1;
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        const lm_node *nd = &s->nodes[s->tri_node[t]];
+        casters += nd->settings.shadows != 0;
+        next_dynamic += nd->settings.shadows && !nd->dynamic;
+    }
+    d->static_caster_vertices = 3 * next_dynamic;
     memcpy(next, d->first, sizeof(int) * (size_t)d->groups);
     for (uint32_t t = 0; t < s->tri_count; t++) {
         int g = group_of(s, t);
         float *o = v + (size_t)FLOATS * (size_t)next[g];
+        d->slot[t] = next[g];
         next[g] += 3;
         triangle_vertices(s, t, o);
-        if (!s->nodes[s->tri_node[t]].settings.shadows)
+        d->caster_slot[t] = -1;
+        const lm_node *nd = &s->nodes[s->tri_node[t]];
+        if (!nd->settings.shadows)
             continue;
+        int *at = nd->dynamic ? &next_dynamic : &next_static;
+        d->caster_slot[t] = 3 * *at;
         for (int k = 0; k < 3; k++)
-            memcpy(c + 9 * (size_t)casters + 3 * k, o + FLOATS * k, 3 * sizeof(float));
-        casters++;
+            memcpy(c + 9 * (size_t)*at + 3 * k, o + FLOATS * k, 3 * sizeof(float));
+        ++*at;
     }
     free(next);
     return casters;
@@ -112,9 +124,19 @@ lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, lm_error *e
     d->first = calloc((size_t)d->groups, sizeof(int));
     d->count = calloc((size_t)d->groups, sizeof(int));
     d->tex = calloc((size_t)d->groups, sizeof(unsigned));
+    d->slot = malloc(sizeof(int) * n);
+    d->caster_slot = malloc(sizeof(int) * n);
+    d->node_count = s->node_count;
+    d->node_world = malloc(sizeof(float) * 16 * (size_t)(s->node_count ? s->node_count : 1));
+    uint32_t most = 1;
+    for (int i = 0; i < s->node_count; i++)
+        most = s->nodes[i].tri_count > most ? s->nodes[i].tri_count : most;
+    d->scratch = malloc(sizeof(float) * (FLOATS * 3 + 9) * most);
     float *v = malloc(sizeof(float) * FLOATS * 3 * n), *c = malloc(sizeof(float) * 9 * n);
     int casters = -1;
-    if (d->first && d->count && d->tex && v && c) {
+    if (d->first && d->count && d->tex && d->slot && d->caster_slot && d->node_world && d->scratch && v && c) {
+        for (int i = 0; i < s->node_count; i++)
+            memcpy(d->node_world + 16 * (size_t)i, s->nodes[i].world, sizeof s->nodes[i].world);
         plan_groups(d, s);
         casters = fill(d, s, v, c);
     }
@@ -132,14 +154,94 @@ lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, lm_error *e
     return LM_OK;
 }
 
+/* Uploads `count` vertices of node-ordered data to buffer `vbo` at the slots given per triangle, one
+ * glBufferSubData per run of consecutive slots. stride: floats per vertex. data has room for the
+ * casters' packed positions after its n triangles. */
+static void upload_runs(unsigned vbo, const int *slot, uint32_t first, uint32_t n, float *data, int stride,
+                        int only_positions)
+{
+    glBindBuffer(GL_ARRAY_BUFFER, vbo);
+    size_t vbytes = sizeof(float) * (size_t)stride;
+    uint32_t i = 0;
+    while (i < n) {
+        if (slot[first + i] < 0) {
+            i++;
+            continue;
+        }
+        uint32_t j = i + 1;
+        while (j < n && slot[first + j] == slot[first + j - 1] + 3)
+            j++;
+        if (!only_positions)
+            glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)(vbytes * (size_t)slot[first + i]),
+                            (GLsizeiptr)(vbytes * 3 * (j - i)), data + (size_t)stride * 3 * i);
+        else { /* casters: 3 floats per vertex, the shading vertices' positions, packed after data */
+            float *p = data + (size_t)FLOATS * 3 * n;
+            for (uint32_t t = i; t < j; t++)
+                for (int k = 0; k < 3; k++)
+                    memcpy(p + 9 * (t - i) + 3 * k, data + (size_t)FLOATS * (3 * t + (uint32_t)k), 3 * sizeof(float));
+            glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)(sizeof(float) * 3 * (size_t)slot[first + i]),
+                            (GLsizeiptr)(sizeof(float) * 9 * (j - i)), p);
+        }
+        i = j;
+    }
+}
+
+int lm_direct_mesh_update(lm_direct_mesh *d, const lm_scene *s)
+{
+    int moved = 0;
+    for (int i = 0; i < s->node_count && i < d->node_count; i++) {
+        const lm_node *nd = &s->nodes[i];
+        float *w = d->node_world + 16 * (size_t)i;
+        if (!memcmp(w, nd->world, sizeof nd->world))
+            continue;
+        memcpy(w, nd->world, sizeof nd->world);
+        if (!nd->tri_count)
+            continue;
+        for (uint32_t t = 0; t < nd->tri_count; t++)
+            triangle_vertices(s, nd->first_tri + t, d->scratch + (size_t)FLOATS * 3 * t);
+        upload_runs(d->mesh.vbo, d->slot, nd->first_tri, nd->tri_count, d->scratch, FLOATS, 0);
+        moved |= LM_MESH_MOVED;
+        if (nd->settings.shadows) {
+            upload_runs(d->casters.vbo, d->caster_slot, nd->first_tri, nd->tri_count, d->scratch, FLOATS, 1);
+            moved |= nd->dynamic ? LM_MESH_DYNAMIC_CASTERS_MOVED : LM_MESH_STATIC_CASTERS_MOVED;
+        }
+    }
+    return moved;
+}
+
+lm_status lm_direct_mesh_add_lightmap_uv(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
+{
+    float *uv = malloc(sizeof(float) * 6 * (s->tri_count ? s->tri_count : 1));
+    if (!uv)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap uvs", s->path);
+    for (uint32_t t = 0; t < s->tri_count; t++)
+        for (int k = 0; k < 3; k++) { /* as lm_lightmapped_vertices */
+            const float *c = a->corner_uv + 6 * (size_t)t + 2 * k;
+            int none = a->tri_chart[t] < 0 || !isfinite(c[0]);
+            float *o = uv + 2 * ((size_t)d->slot[t] + (size_t)k);
+            o[0] = none ? -1.0f : c[0];
+            o[1] = none ? -1.0f : c[1];
+        }
+    if (!d->uv_vbo)
+        glGenBuffers(1, &d->uv_vbo);
+    glBindVertexArray(d->mesh.vao);
+    glBindBuffer(GL_ARRAY_BUFFER, d->uv_vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)(sizeof(float) * 6 * s->tri_count), uv, GL_STATIC_DRAW);
+    glVertexAttribPointer(7, 2, GL_FLOAT, GL_FALSE, 2 * sizeof(float), (void *)0);
+    glEnableVertexAttribArray(7);
+    free(uv);
+    return LM_OK;
+}
+
 void lm_direct_mesh_draw(const lm_direct_mesh *d, unsigned prog)
 {
-    GLint has_tex = glGetUniformLocation(prog, "has_tex");
+    GLint has_tex = prog ? glGetUniformLocation(prog, "has_tex") : -1;
     glBindVertexArray(d->mesh.vao);
     for (int g = 0; g < d->groups; g++) {
         if (!d->count[g])
             continue;
-        glUniform1i(has_tex, g > 0);
+        if (has_tex >= 0)
+            glUniform1i(has_tex, g > 0);
         glActiveTexture(GL_TEXTURE2);
         glBindTexture(GL_TEXTURE_2D, g > 0 ? d->tex[g - 1] : 0);
         glDrawArrays(GL_TRIANGLES, d->first[g], d->count[g]);
@@ -152,11 +254,17 @@ void lm_direct_mesh_free(lm_direct_mesh *d)
         lm_gl_mesh_destroy(&d->mesh);
     if (d->casters.vao)
         lm_gl_mesh_destroy(&d->casters);
+    if (d->uv_vbo)
+        glDeleteBuffers(1, &d->uv_vbo);
     for (int g = 0; d->tex && g + 1 < d->groups; g++)
         if (d->tex[g])
             glDeleteTextures(1, &d->tex[g]);
     free(d->first);
     free(d->count);
     free(d->tex);
+    free(d->slot);
+    free(d->caster_slot);
+    free(d->node_world);
+    free(d->scratch);
     memset(d, 0, sizeof *d);
 }

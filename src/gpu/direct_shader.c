@@ -115,3 +115,39 @@ const char *const lm_direct_fs =
     "    vec3 c = pass_kind == 0 ? v_em : light(v_pos, ns, ng, V);\n"
     "    frag = vec4(seen ? c : vec3(0.0), 1.0);\n"
     "}\n";
+
+/* The emission pass alone: depth, and Le on the front side (or both sides when double-sided); the same
+ * attributes and gl_Position as lm_direct_vs. Output 1 is the visible surface's lightmap uv (attribute 7)
+ * for the composite, when the target has that attachment. */
+const char *const lm_direct_emission_vs =
+    "#version 450 core\n"
+    "layout(location = 0) in vec3 pos;\n"
+    "layout(location = 2) in vec3 ng;\n"
+    "layout(location = 4) in vec4 par;\n"
+    "layout(location = 5) in vec3 em;\n"
+    "layout(location = 7) in vec2 lm_uv;\n"
+    "uniform mat4 view_proj;\n"
+    "out vec3 v_pos, v_ng, v_em;\n"
+    "out float v_two;\n"
+    "out vec2 v_lm;\n"
+    "invariant gl_Position;\n"
+    "void main() {\n"
+    "    v_pos = pos; v_ng = ng; v_em = em; v_two = par.y; v_lm = lm_uv;\n"
+    "    gl_Position = view_proj * vec4(pos, 1.0);\n"
+    "}\n";
+
+const char *const lm_direct_emission_fs =
+    "#version 450 core\n"
+    "in vec3 v_pos, v_ng, v_em;\n"
+    "in float v_two;\n"
+    "in vec2 v_lm;\n"
+    "uniform vec3 eye, view_dir;\n"
+    "uniform int ortho_view;\n"
+    "layout(location = 0) out vec4 frag;\n"
+    "layout(location = 1) out vec4 lightmap_uv;\n"
+    "void main() {\n"
+    "    vec3 V = ortho_view != 0 ? view_dir : normalize(eye - v_pos);\n"
+    "    bool back = dot(normalize(v_ng), V) < 0.0;\n"
+    "    frag = vec4(!back || v_two > 0.5 ? v_em : vec3(0.0), 1.0);\n"
+    "    lightmap_uv = vec4(v_lm, 0.0, 1.0);\n"
+    "}\n";

@@ -1,9 +1,13 @@
-/* GLSL of the direct-light pass (direct.c). One program draws both the emission pass (pass 0: depth
- * and emitted radiance) and one additive pass per light (pass 1), so the depths match exactly. */
+/* GLSL of the direct-light passes (direct.c): the light program (one additive pass per light; pass_kind 0
+ * still draws emission) and a small emission program for the pass that lays down depth and the emitted
+ * radiance. Both vertex shaders compute gl_Position with the same invariant expression, so their depths
+ * match exactly. */
 #ifndef LM_DIRECT_SHADER_H
 #define LM_DIRECT_SHADER_H
 
 extern const char *const lm_direct_vs;
 extern const char *const lm_direct_fs;
+extern const char *const lm_direct_emission_vs;
+extern const char *const lm_direct_emission_fs;
 
 #endif

@@ -80,3 +80,71 @@ lm_status lm_offscreen_end(lm_offscreen *o, uint8_t *rgba8, lm_error *err)
     free(tmp);
     return st;
 }
+
+void lm_float_target_free(lm_float_target *t)
+{
+    if (t->fbo) {
+        glDeleteFramebuffers(1, &t->fbo);
+        glDeleteRenderbuffers(1, &t->depth);
+        glDeleteTextures(t->attachments, t->color);
+    }
+    memset(t, 0, sizeof *t);
+}
+
+lm_status lm_float_target_ensure(lm_float_target *t, int width, int height, int attachments, lm_error *err)
+{
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    if (t->fbo && t->width == width && t->height == height && t->attachments == attachments) {
+        glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+        glViewport(0, 0, width, height);
+        return LM_OK;
+    }
+    lm_float_target_free(t);
+    t->width = width;
+    t->height = height;
+    t->attachments = attachments;
+    glGenFramebuffers(1, &t->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glGenTextures(attachments, t->color);
+    for (int i = 0; i < attachments; i++) {
+        glBindTexture(GL_TEXTURE_2D, t->color[i]);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, NULL);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, t->color[i], 0);
+    }
+    glGenRenderbuffers(1, &t->depth);
+    glBindRenderbuffer(GL_RENDERBUFFER, t->depth);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth);
+    glDrawBuffers(attachments, bufs);
+    if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        lm_float_target_free(t);
+        return lm_fail(err, LM_ERR_BACKEND, "float target %dx%d (%d attachments) is incomplete", width, height,
+                       attachments);
+    }
+    glViewport(0, 0, width, height);
+    return LM_OK;
+}
+
+void lm_float_target_read_rgb(const lm_float_target *t, int i, float *rgb, float *scratch)
+{
+    int w = t->width, h = t->height;
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);
+    glReadBuffer(GL_COLOR_ATTACHMENT0 + (GLenum)i);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    /* one RGBA read (the target's own layout: a plain copy in the driver), then flip and drop alpha */
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch);
+    for (int y = 0; y < h; y++) { /* GL's rows start at the bottom */
+        const float *src = scratch + 4 * (size_t)w * (size_t)(h - 1 - y);
+        float *dst = rgb + 3 * (size_t)w * (size_t)y;
+        for (int x = 0; x < w; x++) {
+            dst[3 * x] = src[4 * x];
+            dst[3 * x + 1] = src[4 * x + 1];
+            dst[3 * x + 2] = src[4 * x + 2];
+        }
+    }
+    glReadBuffer(GL_COLOR_ATTACHMENT0);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);
+}

@@ -23,4 +23,19 @@ void lm_offscreen_read_rgb(const lm_offscreen *o, float *rgb);
 /* Unbinds and deletes a target (after lm_offscreen_read_rgb, or on an error path). */
 void lm_offscreen_release(lm_offscreen *o);
 
+/* A persistent float target for per-frame passes: 1 or 2 RGBA32F colour textures (sampleable, e.g. by
+ * a later pass) and a 32-bit float depth renderbuffer, kept between frames and re-made only when the size
+ * or the attachment count changes. Zero-initialise before the first lm_float_target_ensure. */
+typedef struct {
+    unsigned fbo, color[2], depth;
+    int width, height, attachments;
+} lm_float_target;
+
+/* (Re)creates t when its size or attachment count differs and binds it (every attachment drawn to, the
+ * viewport set); does not clear. */
+lm_status lm_float_target_ensure(lm_float_target *t, int width, int height, int attachments, lm_error *err);
+/* Reads attachment i's RGB into rgb (width*height*3, row 0 at the top). scratch: width*height*4 floats. */
+void lm_float_target_read_rgb(const lm_float_target *t, int i, float *rgb, float *scratch);
+void lm_float_target_free(lm_float_target *t);
+
 #endif

@@ -54,16 +54,17 @@ static float far_corner(const lm_scene *s, lm_vec3 p, float floor_)
     return best;
 }
 
-static GLuint make_texture(GLenum target, int size)
+static GLuint make_texture(GLenum target, int size, GLenum format)
 {
+    GLenum ext = format == GL_R32F ? GL_RED : GL_DEPTH_COMPONENT;
     GLuint tex;
     glGenTextures(1, &tex);
     glBindTexture(target, tex);
     if (target == GL_TEXTURE_CUBE_MAP)
         for (int f = 0; f < 6; f++)
-            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_R32F, size, size, 0, GL_RED, GL_FLOAT, NULL);
+            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, (GLint)format, size, size, 0, ext, GL_FLOAT, NULL);
     else
-        glTexImage2D(target, 0, GL_R32F, size, size, 0, GL_RED, GL_FLOAT, NULL);
+        glTexImage2D(target, 0, (GLint)format, size, size, 0, ext, GL_FLOAT, NULL);
     glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -72,44 +73,70 @@ static GLuint make_texture(GLenum target, int size)
     return tex;
 }
 
-/* Draws the casters into one face (GL target `face` of m->tex) with view-projection vp. */
-static void draw_face(const lm_shadow_map *m, GLuint prog, GLenum face, const float vp[16],
-                      const lm_gl_mesh *casters)
+/* Which casters a face draws, and how it starts. */
+typedef struct {
+    int first, count;     /* vertex range of `casters` */
+    int from_layer;       /* 1: copy the static layer's face first (else clear) */
+    int into_layer;       /* 1: draw into the static layer instead of the map */
+} face_job;
+
+/* Draws one face (GL target `face`) with view-projection vp. */
+static void draw_face(const lm_shadow_map *m, const lm_shadow_renderer *r, GLenum face, const float vp[16],
+                      const lm_gl_mesh *casters, const face_job *job)
 {
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, m->tex, 0);
-    const float clear[4] = {NO_CASTER, 0, 0, 1};
-    glClearBufferfv(GL_COLOR, 0, clear);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    glUniformMatrix4fv(glGetUniformLocation(prog, "vp"), 1, GL_FALSE, vp);
-    lm_gl_mesh_draw(casters);
+    if (job->into_layer) {
+        glBindFramebuffer(GL_FRAMEBUFFER, m->layer_fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, m->layer_tex, 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, face, m->layer_depth, 0);
+    } else {
+        glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, m->tex, 0);
+    }
+    if (job->from_layer) {
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, m->layer_fbo);
+        glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, m->layer_tex, 0);
+        glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, face, m->layer_depth, 0);
+        int n = m->p.size;
+        glBlitFramebuffer(0, 0, n, n, 0, 0, n, n, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+        glBindFramebuffer(GL_READ_FRAMEBUFFER, m->fbo);
+    } else {
+        const float clear[4] = {NO_CASTER, 0, 0, 1};
+        glClearBufferfv(GL_COLOR, 0, clear);
+        glClear(GL_DEPTH_BUFFER_BIT);
+    }
+    if (job->count > 0) {
+        glUniformMatrix4fv(r->u_vp, 1, GL_FALSE, vp);
+        glBindVertexArray(casters->vao);
+        glDrawArrays(GL_TRIANGLES, job->first, job->count);
+    }
 }
 
-static void cube_faces(lm_shadow_map *m, GLuint prog, lm_vec3 p, float znear, float zfar,
-                       const lm_gl_mesh *casters)
+static void cube_faces(const lm_shadow_map *m, const lm_shadow_renderer *r, const lm_gl_mesh *casters,
+                       const face_job *job)
 {
     /* GL's cube map face order and orientation (+X, -X, +Y, -Y, +Z, -Z). */
     static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
     static const float ups[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
     float proj[16], view[16], vp[16];
-    lm_mat4_perspective(proj, (float)(M_PI / 2), 1.0f, znear, zfar);
+    lm_vec3 p = lm_v3_load(m->p.pos);
+    lm_mat4_perspective(proj, (float)(M_PI / 2), 1.0f, m->p.znear, m->p.zfar);
     for (int f = 0; f < 6; f++) {
         lm_mat4_look_at(view, p, lm_add(p, lm_v3_load(dirs[f])), lm_v3_load(ups[f]));
         lm_mat4_mul(vp, proj, view);
-        draw_face(m, prog, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, vp, casters);
+        draw_face(m, r, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, vp, casters, job);
     }
-    m->texel = 2.0f / (float)m->size;
 }
 
-static void spot_map(lm_shadow_map *m, const lm_light *l, lm_vec3 p, lm_vec3 d, float znear, float zfar)
+static void spot_map(lm_shadow_params *m, const lm_light *l, lm_vec3 p, lm_vec3 d)
 {
     float half = fminf(l->outer_cone, 1.48f) * 1.02f, view[16], proj[16];
     lm_mat4_look_at(view, p, lm_add(p, d), up_for(d));
-    lm_mat4_perspective(proj, 2.0f * half, 1.0f, znear, zfar);
+    lm_mat4_perspective(proj, 2.0f * half, 1.0f, m->znear, m->zfar);
     lm_mat4_mul(m->light_vp, proj, view);
     m->texel = 2.0f * tanf(half) / (float)m->size;
 }
 
-static void directional_map(lm_shadow_map *m, const lm_scene *s, lm_vec3 d)
+static void directional_map(lm_shadow_params *m, const lm_scene *s, lm_vec3 d)
 {
     lm_vec3 lo = lm_v3_load(s->bounds_min), hi = lm_v3_load(s->bounds_max);
     lm_vec3 c = lm_scale(lm_add(lo, hi), 0.5f);
@@ -122,56 +149,117 @@ static void directional_map(lm_shadow_map *m, const lm_scene *s, lm_vec3 d)
     m->texel = 2.0f * r / (float)m->size;
 }
 
-lm_status lm_shadow_map_render(lm_shadow_map *m, const lm_scene *s, const lm_emitter *e,
-                               const lm_gl_mesh *casters, int size, lm_error *err)
+void lm_shadow_params_compute(lm_shadow_params *m, const lm_scene *s, const lm_emitter *e, int size)
 {
     memset(m, 0, sizeof *m);
     m->size = size;
     m->cube = e->kind == LM_EMIT_POINT;
     m->ortho = e->kind == LM_EMIT_DIRECTIONAL;
     lm_vec3 p = lm_v3_load(e->pos), d = lm_normalize(lm_v3_load(e->dir));
+    lm_v3_store(m->pos, p);
     lm_v3_store(m->origin, p);
-    lm_v3_store(m->dir, d);
-    GLuint prog = 0;
-    lm_status st = lm_gl_program("shadow_map", VS, FS, &prog, err);
+    if (!m->cube) /* a cube map does not depend on where the point light faces: turning it redoes nothing */
+        lm_v3_store(m->dir, d);
+    float size_s = lm_scene_size(s) > 0.0f ? lm_scene_size(s) : 1.0f;
+    m->znear = 1e-4f * size_s;
+    m->zfar = 1.01f * far_corner(s, p, size_s) + m->znear;
+    m->range = m->ortho ? 2.02f * size_s : m->zfar;
+    if (m->cube)
+        m->texel = 2.0f / (float)size;
+    else if (m->ortho)
+        directional_map(m, s, d);
+    else
+        spot_map(m, &s->lights[e->light], p, d);
+}
+
+lm_status lm_shadow_renderer_create(lm_shadow_renderer *r, lm_error *err)
+{
+    memset(r, 0, sizeof *r);
+    lm_status st = lm_gl_program("shadow_map", VS, FS, &r->prog, err);
     if (st != LM_OK)
         return st;
-    m->tex = make_texture(m->cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D, size);
-    GLuint fbo, depth;
-    glGenFramebuffers(1, &fbo);
-    glGenRenderbuffers(1, &depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, size, size);
-    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
-    glViewport(0, 0, size, size);
+    r->u_vp = glGetUniformLocation(r->prog, "vp");
+    r->u_origin = glGetUniformLocation(r->prog, "origin");
+    r->u_dir = glGetUniformLocation(r->prog, "dir");
+    r->u_ortho = glGetUniformLocation(r->prog, "ortho");
+    r->u_range = glGetUniformLocation(r->prog, "range");
+    return LM_OK;
+}
+
+void lm_shadow_renderer_free(lm_shadow_renderer *r)
+{
+    if (r->prog)
+        glDeleteProgram(r->prog);
+    memset(r, 0, sizeof *r);
+}
+
+/* The texture, framebuffer and depth buffer for parameters p, kept when kind and size are unchanged; with
+ * `layer`, the static layer's too. */
+static void ensure_objects(lm_shadow_map *m, const lm_shadow_params *p, int layer)
+{
+    GLenum target = p->cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D;
+    if (m->tex && (m->p.cube != p->cube || m->p.size != p->size))
+        lm_shadow_map_free(m);
+    if (!m->tex) {
+        m->tex = make_texture(target, p->size, GL_R32F);
+        glGenFramebuffers(1, &m->fbo);
+        glGenRenderbuffers(1, &m->depth);
+        glBindRenderbuffer(GL_RENDERBUFFER, m->depth);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, p->size, p->size);
+        glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, m->depth);
+    }
+    if (layer && !m->layer_tex) {
+        m->layer_tex = make_texture(target, p->size, GL_R32F);
+        m->layer_depth = make_texture(target, p->size, GL_DEPTH_COMPONENT32F);
+        glGenFramebuffers(1, &m->layer_fbo);
+        m->layer_valid = 0;
+    }
+}
+
+/* Draws every face of the map (or of its layer) as `job` says. */
+static void draw_faces(const lm_shadow_map *m, const lm_shadow_renderer *r, const lm_gl_mesh *casters,
+                       const face_job *job)
+{
+    if (m->p.cube)
+        cube_faces(m, r, casters, job);
+    else
+        draw_face(m, r, GL_TEXTURE_2D, m->p.light_vp, casters, job);
+}
+
+lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const lm_shadow_renderer *r,
+                             const lm_gl_mesh *casters, int static_vertices, int redo_static, lm_error *err)
+{
+    int n = casters->vertices, split = static_vertices > 0 && static_vertices < n;
+    ensure_objects(m, p, split);
+    if (memcmp(&m->p, p, sizeof *p))
+        m->layer_valid = 0;
+    m->p = *p;
+    glViewport(0, 0, p->size, p->size);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glDisable(GL_CULL_FACE); /* both sides cast: open meshes too */
-    glUseProgram(prog);
-    glUniform3fv(glGetUniformLocation(prog, "dir"), 1, m->dir);
-    glUniform1i(glGetUniformLocation(prog, "ortho"), m->ortho);
-    float size_s = lm_scene_size(s) > 0.0f ? lm_scene_size(s) : 1.0f;
-    float znear = 1e-4f * size_s, zfar = 1.01f * far_corner(s, p, size_s) + znear;
-    glUniform1f(glGetUniformLocation(prog, "range"), m->ortho ? 2.02f * size_s : zfar);
-    if (m->cube) {
-        glUniform3fv(glGetUniformLocation(prog, "origin"), 1, m->origin);
-        cube_faces(m, prog, p, znear, zfar, casters);
+    glUseProgram(r->prog);
+    glUniform3fv(r->u_dir, 1, p->dir);
+    glUniform1i(r->u_ortho, p->ortho);
+    glUniform1f(r->u_range, p->range);
+    glUniform3fv(r->u_origin, 1, p->origin);
+    if (!split) {
+        const face_job all = {0, n, 0, 0};
+        draw_faces(m, r, casters, &all);
     } else {
-        if (m->ortho)
-            directional_map(m, s, d);
-        else
-            spot_map(m, &s->lights[e->light], p, d, znear, zfar);
-        glUniform3fv(glGetUniformLocation(prog, "origin"), 1, m->origin);
-        draw_face(m, prog, GL_TEXTURE_2D, m->light_vp, casters);
+        if (!m->layer_valid || redo_static) {
+            const face_job statics = {0, static_vertices, 0, 1};
+            draw_faces(m, r, casters, &statics);
+            m->layer_valid = 1;
+        }
+        const face_job dynamics = {static_vertices, n - static_vertices, 1, 0};
+        draw_faces(m, r, casters, &dynamics);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteRenderbuffers(1, &depth);
-    glDeleteFramebuffers(1, &fbo);
-    glDeleteProgram(prog);
-    st = lm_gl_check("shadow_map: rendering", err);
+    lm_status st = lm_gl_check("shadow_map: rendering", err);
     if (st != LM_OK)
         lm_shadow_map_free(m);
     return st;
@@ -179,6 +267,17 @@ lm_status lm_shadow_map_render(lm_shadow_map *m, const lm_scene *s, const lm_emi
 
 void lm_shadow_map_free(lm_shadow_map *m)
 {
-    glDeleteTextures(1, &m->tex);
-    m->tex = 0;
+    if (m->tex)
+        glDeleteTextures(1, &m->tex);
+    if (m->fbo)
+        glDeleteFramebuffers(1, &m->fbo);
+    if (m->depth)
+        glDeleteRenderbuffers(1, &m->depth);
+    if (m->layer_tex)
+        glDeleteTextures(1, &m->layer_tex);
+    if (m->layer_depth)
+        glDeleteTextures(1, &m->layer_depth);
+    if (m->layer_fbo)
+        glDeleteFramebuffers(1, &m->layer_fbo);
+    memset(m, 0, sizeof *m);
 }

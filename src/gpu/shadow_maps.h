@@ -10,21 +10,49 @@
 #include "../trace/lights.h"
 #include "gl_mesh.h"
 
+/* Everything a map is made from, apart from the casters' geometry: two maps with equal parameters
+ * (memcmp) over the same casters are identical. Computed without GL by lm_shadow_params_compute. */
 typedef struct {
     int cube;             /* 1: cube map (point light); 0: 2D map */
     int ortho;            /* 2D map: 1 orthographic (directional), 0 perspective (spot) */
-    unsigned tex;         /* GL_R32F texture (cube or 2D) */
     int size;             /* texels per side (per face for a cube) */
     float light_vp[16];   /* 2D map: world -> light clip space */
     float origin[3];      /* where the metric is measured from: the light, or the ortho box's near plane */
-    float dir[3];         /* directional: unit direction the light travels */
+    float dir[3];         /* spot, directional: unit direction the light travels (0 for a cube map) */
     float texel;          /* ortho: world size of a texel; perspective/cube: size per unit distance */
+    float pos[3];         /* the light's position (cube faces) */
+    float znear, zfar;    /* perspective and cube projections */
+    float range;          /* metric / range = the depth written */
+} lm_shadow_params;
+
+/* A map and its GL objects, kept between renders (zero-initialise; lm_shadow_map_free releases). When the
+ * casters are split into static and dynamic ones, the static casters' map (colour and depth) is kept as
+ * a layer: a render that only has to redo the dynamic casters copies the layer and draws them on top. */
+typedef struct {
+    lm_shadow_params p;   /* what the texture was last rendered from (valid when tex != 0) */
+    unsigned tex;         /* GL_R32F texture (cube or 2D) */
+    unsigned fbo, depth;  /* its framebuffer and DEPTH_COMPONENT32F renderbuffer */
+    unsigned layer_tex, layer_depth, layer_fbo; /* static layer: R32F and DEPTH_COMPONENT32F textures */
+    int layer_valid;      /* the layer holds the static casters under parameters p */
 } lm_shadow_map;
 
-/* Renders the map of punctual emitter e (pos/dir current) over the caster triangles `casters`
- * (attribute 0 = world position). Leaves the framebuffer binding at 0; the viewport is changed. */
-lm_status lm_shadow_map_render(lm_shadow_map *m, const lm_scene *s, const lm_emitter *e,
-                               const lm_gl_mesh *casters, int size, lm_error *err);
+/* The shadow-map program and its uniform locations. */
+typedef struct {
+    unsigned prog;
+    int u_vp, u_origin, u_dir, u_ortho, u_range;
+} lm_shadow_renderer;
+
+lm_status lm_shadow_renderer_create(lm_shadow_renderer *r, lm_error *err);
+void lm_shadow_renderer_free(lm_shadow_renderer *r);
+
+/* The parameters of punctual emitter e's map (pos/dir current, s->bounds current). */
+void lm_shadow_params_compute(lm_shadow_params *p, const lm_scene *s, const lm_emitter *e, int size);
+/* Renders map m with parameters p over the caster triangles `casters` (attribute 0 = world position),
+ * (re)allocating its textures when the kind or size changed. The first static_vertices vertices are
+ * static casters: when some follow them, the static ones are drawn into the layer, re-drawn only when p
+ * changed or redo_static is set, and each render copies the layer and draws the rest on top. Leaves the framebuffer binding at 0; the viewport is changed. */
+lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const lm_shadow_renderer *r,
+                             const lm_gl_mesh *casters, int static_vertices, int redo_static, lm_error *err);
 void lm_shadow_map_free(lm_shadow_map *m);
 
 #endif

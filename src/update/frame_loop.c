@@ -15,6 +15,7 @@ struct lm_frame_loop {
     lm_photon_stage *stage;
     lm_gather *gather;
     lm_composite *comp;
+    lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
     int have_iim;
     uint32_t *texels;      /* scratch: this frame's scheduled texels (atlas texel_count) */
@@ -71,6 +72,10 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         fl->have_iim = 1;
     if (st == LM_OK)
         st = lm_composite_create(fl->scene, fl->atlas, fl->set.gather.backface_limit, &fl->comp, err);
+    if (st == LM_OK)
+        st = lm_direct_create(fl->scene, &fl->set.direct, &fl->direct_light, err);
+    if (st == LM_OK)
+        st = lm_direct_keep_lightmap_uv(fl->direct_light, fl->scene, fl->atlas, err);
     double t0 = lm_now();
     if (st == LM_OK)
         st = gather(fl, lm_iim_schedule_all(&fl->iim, store_of(fl), fl->texels), err);
@@ -109,6 +114,7 @@ void lm_frame_loop_free(lm_frame_loop *fl)
 {
     if (!fl)
         return;
+    lm_direct_free(fl->direct_light);
     lm_composite_free(fl->comp);
     if (fl->have_iim)
         lm_iim_free(&fl->iim);
@@ -122,21 +128,21 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     free(fl);
 }
 
-/* Direct light, the indirect pass, and their sum. */
+/* Direct light into its persistent target (shadow maps re-rendered only when stale; each pixel's lightmap
+ * uv kept), then a full-screen composite adding albedo / pi * E_IIM on the GPU; the sum, the indirect
+ * part and the direct part are read back. */
 static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
     lm_scene_update_bounds(fl->scene);
     lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
     double t0 = lm_now();
-    lm_status st = lm_render_direct(fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w, h,
-                                    &fl->set.direct, fl->direct, err);
+    lm_status st = lm_direct_render(fl->direct_light, fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w,
+                                    h, fl->direct, err);
     double t1 = lm_now();
     if (st == LM_OK)
-        st = lm_composite_indirect(fl->comp, fl->scene, fl->atlas, fl->iim.display_tex, &fl->view, w, h,
-                                   fl->indirect, err);
-    for (size_t i = 0, n = 3 * (size_t)w * h; st == LM_OK && i < n; i++)
-        fl->image[i] = fl->direct[i] + fl->indirect[i];
+        st = lm_composite_frame(fl->comp, fl->iim.display_tex, lm_direct_texture(fl->direct_light),
+                                lm_direct_uv_texture(fl->direct_light), w, h, fl->image, fl->indirect, err);
     o->t_direct = t1 - t0;
     o->t_composite = lm_now() - t1;
     return st;
