@@ -213,13 +213,22 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     float *param = malloc(sizeof(float) * 2 * (size_t)(S + 1));
     if (!param)
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
+    int any_commit = 0, blending = 0;
     for (int s = 0; s < S; s++) {
         if (iim->commit[s])
             iim->blend_start[s] = instant ? NEVER : iim->frame;
         param[2 * s] = iim->commit[s] ? 1.0f : 0.0f;
         param[2 * s + 1] = lm_iim_blend_weight(iim, s);
+        any_commit |= iim->commit[s];
+        blending |= param[2 * s + 1] < 1.0f;
         iim->commit[s] = 0;
     }
+    if (!any_commit && iim->settled) { /* the last pass already wrote every final value */
+        free(param);
+        iim->frame++;
+        return LM_OK;
+    }
+    iim->settled = !blending;
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->params_buf);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * 2 * (size_t)S), param);
     free(param);

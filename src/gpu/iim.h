@@ -43,6 +43,7 @@ typedef struct {
     int *blend_start;      /* per surface: frame of its last commit (very negative: fully blended) */
     uint8_t *commit;       /* per surface: completed, to commit at the next lm_iim_blend */
     int frame;
+    int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */
     unsigned fresh_tex, old_tex, new_tex, display_tex;
     unsigned blend_prog, surface_buf, params_buf;

@@ -19,7 +19,8 @@ struct lm_frame_loop {
     lm_iim iim;
     int have_iim;
     uint32_t *texels;      /* scratch: this frame's scheduled texels (atlas texel_count) */
-    float *image, *direct, *indirect;
+    float *image;
+    int aim_stale;         /* the AIM changed since the gather last uploaded it */
     lm_view view;
 };
 
@@ -37,14 +38,17 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
 static lm_photon_store *store_of(lm_frame_loop *fl) { return lm_photon_stage_store(fl->stage); }
 
-/* Uploads the current scene and AIMs and gathers `count` scheduled texels into the fresh IIM. */
+/* Uploads the current scene (and the AIMs when they changed since the last upload) and gathers `count`
+ * scheduled texels into the fresh IIM. */
 static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
 {
     if (count == 0)
         return LM_OK;
     lm_status st = lm_gather_set_scene(fl->gather, fl->scene, fl->atlas, err);
-    if (st == LM_OK)
+    if (st == LM_OK && fl->aim_stale)
         st = lm_gather_set_aim(fl->gather, fl->atlas, lm_aim_rgb(lm_photon_stage_aim(fl->stage)), err);
+    if (st == LM_OK)
+        fl->aim_stale = 0;
     if (st == LM_OK)
         st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels, count, fl->iim.fresh_tex, NULL, err);
     return st;
@@ -55,9 +59,7 @@ static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
     size_t n = 3 * (size_t)fl->set.width * fl->set.height;
     fl->texels = malloc(sizeof(uint32_t) * (fl->atlas->texel_count ? fl->atlas->texel_count : 1));
     fl->image = malloc(n * sizeof(float));
-    fl->direct = calloc(n, sizeof(float));
-    fl->indirect = calloc(n, sizeof(float));
-    if (!fl->texels || !fl->image || !fl->direct || !fl->indirect)
+    if (!fl->texels || !fl->image)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", fl->scene->path);
     return LM_OK;
 }
@@ -77,6 +79,7 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     if (st == LM_OK)
         st = lm_direct_keep_lightmap_uv(fl->direct_light, fl->scene, fl->atlas, err);
     double t0 = lm_now();
+    fl->aim_stale = 1;
     if (st == LM_OK)
         st = gather(fl, lm_iim_schedule_all(&fl->iim, store_of(fl), fl->texels), err);
     if (st == LM_OK)
@@ -123,26 +126,23 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     lm_photon_stage_free(fl->stage);
     free(fl->texels);
     free(fl->image);
-    free(fl->direct);
-    free(fl->indirect);
     free(fl);
 }
 
 /* Direct light into its persistent target (shadow maps re-rendered only when stale; each pixel's lightmap
- * uv kept), then a full-screen composite adding albedo / pi * E_IIM on the GPU; the sum, the indirect
- * part and the direct part are read back. */
+ * uv kept), then a full-screen composite adding albedo / pi * E_IIM on the GPU; only the sum is read back. */
 static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
     lm_scene_update_bounds(fl->scene);
     lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
     double t0 = lm_now();
-    lm_status st = lm_direct_render(fl->direct_light, fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w,
-                                    h, fl->direct, err);
+    lm_status st = lm_direct_draw(fl->direct_light, fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w,
+                                  h, err);
     double t1 = lm_now();
     if (st == LM_OK)
         st = lm_composite_frame(fl->comp, fl->iim.display_tex, lm_direct_texture(fl->direct_light),
-                                lm_direct_uv_texture(fl->direct_light), w, h, fl->image, fl->indirect, err);
+                                lm_direct_uv_texture(fl->direct_light), w, h, fl->image, NULL, err);
     o->t_direct = t1 - t0;
     o->t_composite = lm_now() - t1;
     return st;
@@ -154,6 +154,8 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
     memset(&o, 0, sizeof o);
     double t0 = lm_now();
     lm_status st = lm_photon_stage_step(fl->stage, t, &o.stage, err);
+    if (o.stage.aim.surfaces_refreshed > 0)
+        fl->aim_stale = 1;
     double t1 = lm_now();
     if (st == LM_OK) {
         o.texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
@@ -175,8 +177,6 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
 }
 
 const float *lm_frame_loop_image(const lm_frame_loop *fl) { return fl->image; }
-const float *lm_frame_loop_direct(const lm_frame_loop *fl) { return fl->direct; }
-const float *lm_frame_loop_indirect(const lm_frame_loop *fl) { return fl->indirect; }
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl->stage; }
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }

@@ -48,10 +48,8 @@ void lm_frame_loop_free(lm_frame_loop *fl);
 /* One frame at animation time t; the picture is then in lm_frame_loop_image. */
 lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err);
 
-/* The last frame: composite, and its direct and indirect parts (width*height*3 linear floats, top row first). */
+/* The last frame, composited (width*height*3 linear floats, top row first); the only read-back of a frame. */
 const float *lm_frame_loop_image(const lm_frame_loop *fl);
-const float *lm_frame_loop_direct(const lm_frame_loop *fl);
-const float *lm_frame_loop_indirect(const lm_frame_loop *fl);
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);
 /* The displayed IIM read back (atlas-sized RGBA floats, a = back-face fraction); caller frees. */
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err);
