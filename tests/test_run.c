@@ -32,18 +32,21 @@ static int lmgi(const char *args)
     return WEXITSTATUS(status);
 }
 
-/* A small, quick run of the Cornell box into DIR/NAME; returns the directory (static storage). */
-static const char *quick_run(const char *name)
+/* A small, quick run of the Cornell box into DIR/NAME with extra options; returns the directory (static
+ * storage). */
+static const char *quick_run_with(const char *name, const char *extra)
 {
     static char dir[1024];
     char args[2048];
     snprintf(dir, sizeof dir, "%s/%s", lmt_tmpdir(), name);
     snprintf(args, sizeof args, "run scenes/cornell.glb --frames 3 --size 64x48 --texel-size 0.1 --photons 20000 "
-             "--exr-every 2 -q --out %s", dir);
+             "--exr-every 2 -q %s --out %s", extra, dir);
     if (lmgi(args) != 0)
         fail_msg("lmgi run failed: %s", output);
     return dir;
 }
+
+static const char *quick_run(const char *name) { return quick_run_with(name, ""); }
 
 static int exists(const char *dir, const char *file)
 {
@@ -119,6 +122,40 @@ static void test_deterministic(void **state)
     }
 }
 
+/* Mean |a - b| / mean |a| over the colour channels of two same-sized EXRs in dirs a and b. */
+static double exr_difference(const char *a, const char *b, const char *file)
+{
+    int w, h, w2, h2;
+    float *x = read_exr(a, file, &w, &h), *y = read_exr(b, file, &w2, &h2);
+    assert_int_equal(w, w2);
+    assert_int_equal(h, h2);
+    double d = 0.0, m = 0.0;
+    for (size_t i = 0; i < 4 * (size_t)w * h; i++)
+        if (i % 4 != 3)
+            d += fabs((double)x[i] - y[i]), m += fabs((double)x[i]);
+    free(x);
+    free(y);
+    return d / (m > 0.0 ? m : 1.0);
+}
+
+/* The gather options reach the gather: another scheme gives the same lightmap up to edge pixels, another
+ * hemicube resolution a different one. */
+static void test_gather_options(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    (void)scene;
+    char a[1024], b[1024];
+    snprintf(a, sizeof a, "%s", quick_run("default"));
+    snprintf(b, sizeof b, "%s", quick_run_with("instanced", "--gather-scheme instanced"));
+    double same = exr_difference(a, b, "iim.exr");
+    const char *c = quick_run_with("coarse", "--hemicube 8 --enlargement 1");
+    double other = exr_difference(a, c, "iim.exr");
+    print_message("IIM vs default: instanced %.2e, R = 8 and a = 1 %.2e (mean relative difference)\n", same, other);
+    assert_true(same < 1e-3);
+    assert_true(other > 1e-2);
+}
+
 static void test_bad_args(void **state)
 {
     (void)state;
@@ -127,6 +164,10 @@ static void test_bad_args(void **state)
     assert_int_equal(lmgi("run --out /tmp/x"), 2);
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --texels-per-frame 0"), 2);
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --exr-every x"), 2);
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --gather-scheme bogus"), 2);
+    assert_non_null(strstr(output, "viewports, instanced or layered"));
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --hemicube 1"), 2);
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --enlargement 0"), 2);
 }
 
 /* Inside a closed box of albedo 0.5 whose walls all emit Le = 1: every wall pixel of a frame shows
@@ -173,6 +214,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_writes_files),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_gather_options),
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_furnace_composite),
     };
