@@ -21,8 +21,7 @@ fi
 # The whole frame loop on the same scene: composited frames, final lightmap atlases, per-stage times.
 if [ -r scenes/cornell.glb ]; then
     echo "== run on scenes/cornell.glb"
-    # R = 64: at the default R = 32 the light's bright ceiling spot bands the walls (docs/gather.md)
-    "$LMGI" run scenes/cornell.glb --frames 30 --size 512x512 --hemicube 64 --out demo/cornell-run
+    "$LMGI" run scenes/cornell.glb --frames 30 --size 512x512 --out demo/cornell-run
 fi
 echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png and"
 echo "      demo/cornell-run/frame_*.png"

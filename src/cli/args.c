@@ -126,6 +126,9 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_int(o, v, 1, 1000000, &a->exr_every);
         else if (!strcmp(o, "--hemicube"))
             rc = parse_int(o, v, 2, 1024, &a->hemicube);
+        else if (!strcmp(o, "--hemicube-samples"))
+            rc = parse_int(o, v, 1, 4, &a->hemicube_samples) ? 2 : (a->hemicube_samples == 2 || a->hemicube_samples == 3
+                                                                       ? bad(o, v, "1 or 4") : 0);
         else if (!strcmp(o, "--enlargement"))
             rc = parse_float(o, v, 1e-3f, &a->enlargement);
         else if (!strcmp(o, "--gather-scheme"))

@@ -36,6 +36,8 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
         s->iim.texels_per_frame = a->texels_per_frame;
     if (a->hemicube)
         s->gather.resolution = a->hemicube;
+    if (a->hemicube_samples)
+        s->gather.samples = a->hemicube_samples;
     if (a->enlargement > 0.0f)
         s->gather.enlargement = a->enlargement;
     if (a->gather_scheme >= 0)

@@ -18,6 +18,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->tiles = 16;
     s->proxy_error = LM_PROXY_DEFAULT_ERROR;
     s->scheme = LM_GATHER_VIEWPORTS;
+    s->samples = 4;
 }
 
 const char *lm_gather_scheme_name(lm_gather_scheme s)

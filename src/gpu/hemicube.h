@@ -56,6 +56,7 @@ typedef struct {
     int tiles;             /* tiles per side of the render target: tiles^2 texels per pass (default 16) */
     float proxy_error;     /* gather proxy's error bound x scene size (default 0.005; 0: the full scene) */
     lm_gather_scheme scheme; /* default LM_GATHER_VIEWPORTS, the fastest measured (docs/gather.md) */
+    int samples;           /* AIM lookups per pixel, 1 or 4 (default 4: no banding from edge-on bright spots) */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);

@@ -16,8 +16,9 @@
 #include "hemicube_shaders.h"
 
 /* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided,
- * surface (-1 when none); a view: 4 vec4 (hemicube_shaders.c). */
-#define VERTEX_FLOATS 13
+ * surface (-1 when none), the UV's gradient (2 x vec3) and the chart's UV rectangle; a view: 4 vec4
+ * (hemicube_shaders.c). */
+#define VERTEX_FLOATS 23
 #define VIEW_FLOATS 16
 
 struct lm_gather {
@@ -111,9 +112,9 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
     if (s->resolution < 2 || s->tiles < 1 || !(s->enlargement > 0.0f) || !(s->offset >= 0.0f) ||
         !(s->proxy_error >= 0.0f && s->proxy_error < 1.0f) ||
         (s->scheme != LM_GATHER_LAYERED && (long)s->resolution * s->tiles > max_side) ||
-        (unsigned)s->scheme > LM_GATHER_LAYERED)
-        return lm_fail(err, LM_ERR_INVALID, "hemicube settings out of range (resolution %d, tiles %d, a %g)",
-                       s->resolution, s->tiles, (double)s->enlargement);
+        (unsigned)s->scheme > LM_GATHER_LAYERED || (s->samples != 1 && s->samples != 4))
+        return lm_fail(err, LM_ERR_INVALID, "hemicube settings out of range (resolution %d, tiles %d, a %g, "
+                       "samples %d: 1 or 4)", s->resolution, s->tiles, (double)s->enlargement, s->samples);
     GLint layers = 0;
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &layers);
     if (s->scheme == LM_GATHER_LAYERED && (!has_extension("GL_ARB_shader_viewport_layer_array") ||
@@ -135,7 +136,7 @@ lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the hemicube gather");
     g->set = *set;
     g->coverage = lm_hemicube_coverage(set->enlargement);
-    st = lm_hemicube_programs(set->scheme, &g->render_prog, &g->reduce_prog, err);
+    st = lm_hemicube_programs(set->scheme, set->samples, &g->render_prog, &g->reduce_prog, err);
     if (st == LM_OK)
         st = make_target(g, err);
     if (st == LM_OK)
@@ -169,13 +170,33 @@ void lm_gather_free(lm_gather *g)
 
 const lm_hemicube_settings *lm_gather_settings(const lm_gather *g) { return &g->set; }
 
+/* The lightmap UV's gradient over a triangle's plane: rows gu, gv with uv(p) = uv0 + (gu.(p - p0),
+ * gv.(p - p0)) (zero across the plane). Lets the fragment shader find the UV of nearby points on the
+ * plane exactly (hemicube_shaders.c, sub-samples). */
+static void uv_gradient(const float p[3][3], const float *uv[3], float gu[3], float gv[3])
+{
+    lm_vec3 e1 = lm_sub(lm_v3_load(p[1]), lm_v3_load(p[0])), e2 = lm_sub(lm_v3_load(p[2]), lm_v3_load(p[0]));
+    double a = lm_dot(e1, e1), b = lm_dot(e1, e2), c = lm_dot(e2, e2), det = a * c - b * b;
+    memset(gu, 0, 3 * sizeof(float));
+    memset(gv, 0, 3 * sizeof(float));
+    if (!uv[0] || !uv[1] || !uv[2] || !(det > 1e-30 * a * c))
+        return;
+    for (int r = 0; r < 2; r++) {
+        double d1 = uv[1][r] - uv[0][r], d2 = uv[2][r] - uv[0][r];
+        float al = (float)((c * d1 - b * d2) / det), be = (float)((a * d2 - b * d1) / det);
+        lm_v3_store(r ? gv : gu, lm_add(lm_scale(e1, al), lm_scale(e2, be)));
+    }
+}
+
 /* One triangle's three vertices (VERTEX_FLOATS each) from world positions, lightmap UVs (NULL: no
- * AIM, drawn black: mirror, glass) and its material. */
-static void write_triangle(const float p[3][3], const float *uv[3], const lm_material *m, int surface, float *o)
+ * AIM, drawn black: mirror, glass), its material and its chart (rectangle in UV, -1 when none). */
+static void write_triangle(const float p[3][3], const float *uv[3], const lm_material *m, int surface,
+                           const float rect[4], float *o)
 {
     lm_vec3 n = lm_cross(lm_sub(lm_v3_load(p[1]), lm_v3_load(p[0])), lm_sub(lm_v3_load(p[2]), lm_v3_load(p[0])));
-    float len = lm_length(n);
+    float len = lm_length(n), gu[3], gv[3];
     n = len > 0.0f ? lm_scale(n, 1.0f / len) : lm_v3(0, 0, 0);
+    uv_gradient(p, uv, gu, gv);
     for (int k = 0; k < 3; k++) {
         float *v = o + VERTEX_FLOATS * k;
         memcpy(v, p[k], 3 * sizeof(float));
@@ -185,12 +206,27 @@ static void write_triangle(const float p[3][3], const float *uv[3], const lm_mat
         lm_v3_store(v + 8, n);
         v[11] = m->double_sided ? 0.0f : 1.0f;
         v[12] = (float)surface;
+        memcpy(v + 13, gu, sizeof gu);
+        memcpy(v + 16, gv, sizeof gv);
+        memcpy(v + 19, rect, 4 * sizeof(float));
     }
+}
+
+/* Chart c's texels as a UV rectangle (what sub-samples stay inside); -1s when c < 0. */
+static void chart_rect(const lm_atlas *a, int c, float rect[4])
+{
+    if (c < 0) {
+        rect[0] = rect[1] = rect[2] = rect[3] = -1.0f;
+        return;
+    }
+    const lm_chart *ch = &a->charts[c];
+    rect[0] = (float)ch->x / (float)a->width, rect[1] = (float)ch->y / (float)a->height;
+    rect[2] = (float)(ch->x + ch->w) / (float)a->width, rect[3] = (float)(ch->y + ch->h) / (float)a->height;
 }
 
 static void scene_triangle(const lm_scene *s, const lm_atlas *a, uint32_t t, float *o)
 {
-    float p[3][3];
+    float p[3][3], rect[4];
     const float *uv[3];
     for (int k = 0; k < 3; k++) {
         lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], p[k]);
@@ -199,12 +235,13 @@ static void scene_triangle(const lm_scene *s, const lm_atlas *a, uint32_t t, flo
             uv[k] = NULL;
     }
     int c = a->tri_chart[t];
-    write_triangle(p, uv, &s->materials[s->tri_material[t]], c < 0 ? -1 : a->charts[c].surface, o);
+    chart_rect(a, uv[0] ? c : -1, rect);
+    write_triangle(p, uv, &s->materials[s->tri_material[t]], c < 0 ? -1 : a->charts[c].surface, rect, o);
 }
 
 static void proxy_triangle(const lm_scene *s, const lm_atlas *a, const lm_proxy *px, uint32_t t, float *o)
 {
-    float p[3][3];
+    float p[3][3], rect[4];
     const float *uv[3];
     for (int k = 0; k < 3; k++) {
         uint32_t v = px->tris[3 * (size_t)t + k];
@@ -212,7 +249,8 @@ static void proxy_triangle(const lm_scene *s, const lm_atlas *a, const lm_proxy 
         uv[k] = px->vertices[v].chart < 0 ? NULL : px->vertices[v].uv;
     }
     const lm_proxy_vertex *v0 = &px->vertices[px->tris[3 * (size_t)t]];
-    write_triangle(p, uv, &s->materials[v0->material], v0->chart < 0 ? -1 : a->charts[v0->chart].surface, o);
+    chart_rect(a, v0->chart, rect);
+    write_triangle(p, uv, &s->materials[v0->material], v0->chart < 0 ? -1 : a->charts[v0->chart].surface, rect, o);
 }
 
 /* Builds the proxy once per (scene, atlas); proxy_error 0 drops it. */
@@ -250,8 +288,8 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
     }
     if (g->has_mesh)
         lm_gl_mesh_destroy(&g->mesh);
-    const int sizes[6] = {3, 2, 3, 3, 1, 1};
-    g->has_mesh = lm_gl_mesh_create_indexed(&g->mesh, v, (int)(3 * count), sizes, 6);
+    const int sizes[9] = {3, 2, 3, 3, 1, 1, 3, 3, 4};
+    g->has_mesh = lm_gl_mesh_create_indexed(&g->mesh, v, (int)(3 * count), sizes, 9);
     free(v);
     if (!g->has_mesh)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the gather geometry", s->path);
@@ -367,6 +405,7 @@ static void draw_viewports(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     int R = g->set.resolution, T = g->set.tiles;
     GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
     GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
+    GLint ax_loc = glGetUniformLocation(g->render_prog, "axis_x"), ay_loc = glGetUniformLocation(g->render_prog, "axis_y");
     float near = near_plane(g, s);
     for (uint32_t i = 0; i < count; i++) {
         texel_view v = view_of(g, s, &a->texels[texels[i]]);
@@ -375,6 +414,10 @@ static void draw_viewports(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
         glUniformMatrix4fv(vp_loc, 1, GL_FALSE, m);
         glUniform3f(eye_loc, v.eye.x, v.eye.y, v.eye.z);
         glUniform1f(own_loc, v.surface);
+        for (int k = 0; k < 2; k++) { /* a b and a t: a clip-space step as a world direction per unit w */
+            lm_vec3 ax = lm_scale(v.axes[k], 1.0f / lm_dot(v.axes[k], v.axes[k]));
+            glUniform3f(k ? ay_loc : ax_loc, ax.x, ax.y, ax.z);
+        }
         glViewport((int)(i % (uint32_t)T) * R, (int)(i / (uint32_t)T) * R, R, R);
         lm_gl_mesh_draw(&g->mesh);
     }
@@ -415,6 +458,7 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     clear_target(g, count);
     glUseProgram(g->render_prog);
     glUniform1i(glGetUniformLocation(g->render_prog, "aim"), 0);
+    glUniform1f(glGetUniformLocation(g->render_prog, "pixel"), 2.0f / (float)g->set.resolution);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
     if (g->set.scheme == LM_GATHER_VIEWPORTS)

@@ -6,7 +6,8 @@
 #include "../core/error.h"
 #include "hemicube.h"
 
-/* Compiles and links the render program and the reduction program for `scheme`. */
-lm_status lm_hemicube_programs(lm_gather_scheme scheme, unsigned *render, unsigned *reduce, lm_error *err);
+/* Compiles and links the render program and the reduction program for `scheme`, with `samples` (1 or 4)
+ * AIM lookups per pixel. */
+lm_status lm_hemicube_programs(lm_gather_scheme scheme, int samples, unsigned *render, unsigned *reduce, lm_error *err);
 
 #endif
