@@ -26,12 +26,12 @@ const char *const lm_direct_vs =
  * size per unit distance (point, spot; divided by the cosine to the map's axis). The bias: the receiver
  * moves normal_offset texels along its normal, and its metric is lowered by
  * (const_bias + slope_bias (pcf + 1) min(tan theta, max_slope)) texels. */
-const char *const lm_direct_fs =
-    "#version 450 core\n"
+const char *const lm_direct_fs_body =
     "in vec3 v_pos, v_ns, v_ng, v_base, v_em;\n"
     "in vec4 v_par;\n"
     "in vec2 v_uv;\n"
-    "uniform int pass_kind, kind, pcf, has_tex;\n"
+    "uniform int pass_kind, has_tex;\n"
+    "const int kind = KIND, pcf = PCF; /* compiled per light kind and PCF radius: no branch on them */\n"
     "uniform sampler2D base_tex;\n"
     "uniform vec3 eye, view_dir, lpos, ldir, radiant, origin;\n"
     "uniform int ortho_view;\n"

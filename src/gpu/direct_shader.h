@@ -6,7 +6,9 @@
 #define LM_DIRECT_SHADER_H
 
 extern const char *const lm_direct_vs;
-extern const char *const lm_direct_fs;
+/* The light fragment shader without its first lines: "#version 450 core", then KIND (0 point, 1 spot,
+ * 2 directional) and PCF (the radius) defined, go before it (direct.c compiles one per kind). */
+extern const char *const lm_direct_fs_body;
 extern const char *const lm_direct_emission_vs;
 extern const char *const lm_direct_emission_fs;
 
