@@ -121,6 +121,34 @@ static void test_osmesa(void **state)
     unsetenv("LMGI_GL");
 }
 
+/* A shader that does not compile, and a program that does not link, fail with the shader's name, the
+ * stage and the driver's log. */
+static void test_shader_errors_name_the_shader(void **state)
+{
+    (void)state;
+    lm_gl_context *gl = create_with("osmesa");
+    static const char *VS = "#version 450 core\nvoid main() { gl_Position = vec4(0.0); }\n";
+    static const char *BAD_FS = "#version 450 core\nout vec4 c;\nvoid main() { c = undefined_thing; }\n";
+    static const char *UNLINKABLE_FS = "#version 450 core\nin vec3 never_written;\nout vec4 c;\n"
+                                       "void main() { c = vec4(never_written, 1.0); }\n";
+    unsigned prog = 0;
+    lm_error err;
+    assert_int_equal(lm_gl_program("my_broken_shader", VS, BAD_FS, &prog, &err), LM_ERR_BACKEND);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "my_broken_shader"));
+    assert_non_null(strstr(err.msg, "fragment"));
+    assert_non_null(strstr(err.msg, "undefined_thing")); /* the driver's log names the culprit */
+    assert_int_equal(lm_gl_program("my_unlinkable_program", VS, UNLINKABLE_FS, &prog, &err), LM_ERR_BACKEND);
+    print_message("%s\n", err.msg);
+    assert_non_null(strstr(err.msg, "my_unlinkable_program"));
+    assert_non_null(strstr(err.msg, "link"));
+    assert_int_equal(lm_gl_compute_program("my_compute", "#version 450 core\nlayout(local_size_x = 1) in;\n"
+                                           "void main() { nope(); }\n", &prog, &err), LM_ERR_BACKEND);
+    assert_non_null(strstr(err.msg, "my_compute"));
+    lm_gl_context_destroy(gl);
+    unsetenv("LMGI_GL");
+}
+
 static void test_egl_matches_osmesa(void **state)
 {
     (void)state;
@@ -229,6 +257,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_osmesa),
+        cmocka_unit_test(test_shader_errors_name_the_shader),
         cmocka_unit_test(test_egl_matches_osmesa),
         cmocka_unit_test(test_bad_value),
         cmocka_unit_test(test_auto),
