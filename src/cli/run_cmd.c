@@ -132,6 +132,7 @@ static lm_status write_atlases(run_state *r, lm_error *err)
 static void summary(const run_state *r, int frames, const lm_photon_stage_frame *setup, double t_gather)
 {
     const double *s = r->sum_ms;
+    printf("gl          %s\n", lm_frame_loop_gl_description(r->loop));
     printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", 1e3 * setup->t_photons,
            1e3 * setup->t_aim, 1e3 * t_gather);
     printf("frames      %d, %u texels gathered, exposure %.4g (from frame 0)\n", frames, r->texels,

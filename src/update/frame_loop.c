@@ -180,6 +180,7 @@ const float *lm_frame_loop_image(const lm_frame_loop *fl) { return fl->image; }
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl->stage; }
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }
+const char *lm_frame_loop_gl_description(const lm_frame_loop *fl) { return lm_gl_context_description(fl->gl); }
 
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err)
 {
