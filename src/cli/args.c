@@ -129,6 +129,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
         else if (!strcmp(o, "--hemicube-samples"))
             rc = parse_int(o, v, 1, 4, &a->hemicube_samples) ? 2 : (a->hemicube_samples == 2 || a->hemicube_samples == 3
                                                                        ? bad(o, v, "1 or 4") : 0);
+        else if (!strcmp(o, "--hemicube-coverage"))
+            rc = parse_int(o, v, 1, 16, &a->hemicube_coverage);
         else if (!strcmp(o, "--enlargement"))
             rc = parse_float(o, v, 1e-3f, &a->enlargement);
         else if (!strcmp(o, "--gather-scheme"))

@@ -37,6 +37,7 @@ typedef struct {
     int exr_every;          /* --exr-every K: every K-th frame also as EXR */
     int hemicube;           /* --hemicube R: hemicube plane pixels per side */
     int hemicube_samples;   /* --hemicube-samples N: AIM lookups per hemicube pixel (1 or 4) */
+    int hemicube_coverage;  /* --hemicube-coverage N: MSAA coverage samples per hemicube pixel (1 to 16) */
     float enlargement;      /* --enlargement a: hemicube plane half-side at distance 1 */
     int gather_scheme;      /* --gather-scheme viewports|instanced|layered (-1 = default) */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */

@@ -39,6 +39,8 @@ static void usage(FILE *f)
             "  --texels-per-frame N  'run': IIM texels gathered per frame (default 20)\n"
             "  --hemicube R     'run': hemicube plane pixels per side (default 32)\n"
             "  --hemicube-samples N 'run': AIM lookups per hemicube pixel, 1 or 4 (default 4: no banding)\n"
+            "  --hemicube-coverage N 'run': coverage samples per hemicube pixel, 1 to 16 (default 4: no plaid\n"
+            "                   from small emitters)\n"
             "  --enlargement A  'run': hemicube plane half-side a (default 2)\n"
             "  --gather-scheme S 'run': viewports, instanced or layered (default: the fastest measured)\n"
             "  --exr-every K    'run': every K-th frame also as linear EXR (default 10)\n"

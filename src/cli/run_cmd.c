@@ -38,6 +38,8 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
         s->gather.resolution = a->hemicube;
     if (a->hemicube_samples)
         s->gather.samples = a->hemicube_samples;
+    if (a->hemicube_coverage)
+        s->gather.coverage_samples = a->hemicube_coverage;
     if (a->enlargement > 0.0f)
         s->gather.enlargement = a->enlargement;
     if (a->gather_scheme >= 0)

@@ -138,6 +138,7 @@
     X(glTexImage3D, PFNGLTEXIMAGE3DPROC) \
     X(glTexParameterfv, PFNGLTEXPARAMETERFVPROC) \
     X(glTexStorage3D, PFNGLTEXSTORAGE3DPROC) \
+    X(glTexStorage2DMultisample, PFNGLTEXSTORAGE2DMULTISAMPLEPROC) \
     X(glTexSubImage3D, PFNGLTEXSUBIMAGE3DPROC) \
     X(glUniform1fv, PFNGLUNIFORM1FVPROC) \
     X(glUniform1iv, PFNGLUNIFORM1IVPROC) \
@@ -270,6 +271,7 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glTexParameteri (lm_gl_cur->glTexParameteri)
 #define glTexStorage2D (lm_gl_cur->glTexStorage2D)
 #define glTexStorage3D (lm_gl_cur->glTexStorage3D)
+#define glTexStorage2DMultisample (lm_gl_cur->glTexStorage2DMultisample)
 #define glTexSubImage2D (lm_gl_cur->glTexSubImage2D)
 #define glTexSubImage3D (lm_gl_cur->glTexSubImage3D)
 #define glUniform1f (lm_gl_cur->glUniform1f)

@@ -19,6 +19,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->proxy_error = LM_PROXY_DEFAULT_ERROR;
     s->scheme = LM_GATHER_VIEWPORTS;
     s->samples = 4;
+    s->coverage_samples = 4;
 }
 
 const char *lm_gather_scheme_name(lm_gather_scheme s)

@@ -57,6 +57,8 @@ typedef struct {
     float proxy_error;     /* gather proxy's error bound x scene size (default 0.005; 0: the full scene) */
     lm_gather_scheme scheme; /* default LM_GATHER_VIEWPORTS, the fastest measured (docs/gather.md) */
     int samples;           /* AIM lookups per pixel, 1 or 4 (default 4: no banding from edge-on bright spots) */
+    int coverage_samples;  /* coverage samples per pixel (MSAA, 1 to 16; default 4): a small emitter covering a
+                              few pixels adds a fraction per pixel instead of all or nothing (no plaid) */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);

@@ -25,6 +25,7 @@ struct lm_gather {
     lm_hemicube_settings set;
     GLuint render_prog, reduce_prog;
     GLuint fbo, color, depth;
+    GLuint ms_fbo, ms_color, ms_depth; /* with coverage_samples > 1: the multisampled target, resolved into color */
     GLuint weights_buf, targets_buf, views_buf;
     float *views;          /* a pass's views (schemes 1, 2), tiles^2 * VIEW_FLOATS */
     GLuint aim_tex;
@@ -62,6 +63,21 @@ static lm_status make_target(lm_gather *g, lm_error *err)
     glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, g->color, 0);
     glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, g->depth, 0);
     GLenum fb = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    if (fb == GL_FRAMEBUFFER_COMPLETE && g->set.coverage_samples > 1) {
+        GLuint ms[2];
+        glGenTextures(2, ms);
+        g->ms_color = ms[0], g->ms_depth = ms[1];
+        for (int k = 0; k < 2; k++) {
+            glBindTexture(GL_TEXTURE_2D_MULTISAMPLE, ms[k]);
+            glTexStorage2DMultisample(GL_TEXTURE_2D_MULTISAMPLE, g->set.coverage_samples,
+                                      k ? GL_DEPTH_COMPONENT32F : GL_RGBA32F, side, side, GL_TRUE);
+        }
+        glGenFramebuffers(1, &g->ms_fbo);
+        glBindFramebuffer(GL_FRAMEBUFFER, g->ms_fbo);
+        glFramebufferTexture(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, g->ms_color, 0);
+        glFramebufferTexture(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, g->ms_depth, 0);
+        fb = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     if (fb != GL_FRAMEBUFFER_COMPLETE)
         return lm_fail(err, LM_ERR_BACKEND, "hemicube gather: render target incomplete (0x%04x)", (unsigned)fb);
@@ -112,9 +128,12 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
     if (s->resolution < 2 || s->tiles < 1 || !(s->enlargement > 0.0f) || !(s->offset >= 0.0f) ||
         !(s->proxy_error >= 0.0f && s->proxy_error < 1.0f) ||
         (s->scheme != LM_GATHER_LAYERED && (long)s->resolution * s->tiles > max_side) ||
-        (unsigned)s->scheme > LM_GATHER_LAYERED || (s->samples != 1 && s->samples != 4))
+        (unsigned)s->scheme > LM_GATHER_LAYERED || (s->samples != 1 && s->samples != 4) ||
+        s->coverage_samples < 1 || s->coverage_samples > 16 ||
+        (s->coverage_samples > 1 && s->scheme == LM_GATHER_LAYERED))
         return lm_fail(err, LM_ERR_INVALID, "hemicube settings out of range (resolution %d, tiles %d, a %g, "
-                       "samples %d: 1 or 4)", s->resolution, s->tiles, (double)s->enlargement, s->samples);
+                       "samples %d: 1 or 4, coverage samples %d: 1 to 16, 1 with the layered scheme)",
+                       s->resolution, s->tiles, (double)s->enlargement, s->samples, s->coverage_samples);
     GLint layers = 0;
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &layers);
     if (s->scheme == LM_GATHER_LAYERED && (!has_extension("GL_ARB_shader_viewport_layer_array") ||
@@ -160,8 +179,9 @@ void lm_gather_free(lm_gather *g)
     GLuint bufs[3] = {g->weights_buf, g->targets_buf, g->views_buf};
     glDeleteBuffers(3, bufs);
     free(g->views);
-    GLuint tex[3] = {g->aim_tex, g->color, g->depth};
-    glDeleteTextures(3, tex);
+    GLuint tex[5] = {g->aim_tex, g->color, g->depth, g->ms_color, g->ms_depth};
+    glDeleteTextures(5, tex);
+    glDeleteFramebuffers(1, &g->ms_fbo);
     glDeleteFramebuffers(1, &g->fbo);
     glDeleteProgram(g->render_prog);
     glDeleteProgram(g->reduce_prog);
@@ -451,10 +471,19 @@ static void draw_instanced(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
         glDisable(GL_CLIP_DISTANCE0 + k);
 }
 
+/* The multisampled target's rows in use, averaged into the single-sampled one the reduction reads. */
+static void resolve(const lm_gather *g, uint32_t count)
+{
+    int R = g->set.resolution, T = g->set.tiles, rows = (int)((count + (uint32_t)T - 1) / (uint32_t)T);
+    glBindFramebuffer(GL_READ_FRAMEBUFFER, g->ms_fbo);
+    glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g->fbo);
+    glBlitFramebuffer(0, 0, T * R, rows * R, 0, 0, T * R, rows * R, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+}
+
 static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count,
                          int *xy)
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, g->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, g->ms_fbo ? g->ms_fbo : g->fbo);
     clear_target(g, count);
     glUseProgram(g->render_prog);
     glUniform1i(glGetUniformLocation(g->render_prog, "aim"), 0);
@@ -467,6 +496,8 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
         draw_instanced(g, s, a, texels, count);
     for (uint32_t i = 0; i < count; i++)
         xy[2 * i] = a->texels[texels[i]].x, xy[2 * i + 1] = a->texels[texels[i]].y;
+    if (g->ms_fbo)
+        resolve(g, count);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
