@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "../src/core/image.h"
+#include "../src/update/frame_loop.h"
 #include "support.h"
 
 static char output[65536];
@@ -158,6 +159,55 @@ static void test_gather_options(void **state)
     assert_true(other > 1e-2);
 }
 
+typedef struct {
+    int calls;
+    uint32_t last_done, total, monotonic;
+} progress_log;
+
+static void log_progress(void *user, uint32_t done, uint32_t total)
+{
+    progress_log *l = user;
+    l->monotonic &= done > l->last_done && done <= total;
+    l->calls++, l->last_done = done, l->total = total;
+}
+
+/* The first full gather reports progress in chunks, ending at the total, and chunking changes nothing. */
+static void test_setup_progress(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 0.1f);
+    float *iim[2];
+    progress_log log = {0, 0, 0, 1};
+    for (int k = 0; k < 2; k++) {
+        lm_frame_loop_settings set;
+        lm_frame_loop_settings_default(&set);
+        set.width = set.height = 32;
+        set.stage.photons.total_photons = 5000;
+        set.gather.tiles = 4; /* 16 texels per pass, chunks of 256 */
+        if (k) {
+            set.progress = log_progress;
+            set.progress_user = &log;
+        }
+        lm_frame_loop *fl = NULL;
+        lm_error err;
+        if (lm_frame_loop_create(p.s, &p.su, &p.atlas, p.rt, &set, &fl, NULL, NULL, &err) != LM_OK)
+            fail_msg("%s", err.msg);
+        assert_int_equal(lm_frame_loop_read_iim(fl, &iim[k], &err), LM_OK);
+        lm_frame_loop_free(fl);
+    }
+    print_message("%u texels gathered in %d chunks\n", log.total, log.calls);
+    assert_true(log.calls > 1);
+    assert_true(log.monotonic);
+    assert_int_equal(log.last_done, log.total);
+    assert_int_equal(log.total, p.atlas.texel_count);
+    assert_memory_equal(iim[0], iim[1], sizeof(float) * 4 * (size_t)p.atlas.width * p.atlas.height);
+    free(iim[0]);
+    free(iim[1]);
+    lmt_pipeline_free(&p);
+}
+
 static void test_bad_args(void **state)
 {
     (void)state;
@@ -218,6 +268,7 @@ int main(void)
         cmocka_unit_test(test_writes_files),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_gather_options),
+        cmocka_unit_test(test_setup_progress),
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_furnace_composite),
     };

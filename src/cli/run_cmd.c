@@ -28,6 +28,12 @@ typedef struct {
     uint32_t texels;
 } run_state;
 
+static void gather_progress(void *user, uint32_t done, uint32_t total)
+{
+    (void)user;
+    lm_progress("first full gather", (int)done, (int)total);
+}
+
 static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
 {
     lm_frame_loop_settings_default(s);
@@ -36,6 +42,8 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
         s->iim.texels_per_frame = a->texels_per_frame;
     if (a->hemicube)
         s->gather.resolution = a->hemicube;
+    if (!a->quiet)
+        s->progress = gather_progress;
     if (a->hemicube_samples)
         s->gather.samples = a->hemicube_samples;
     if (a->hemicube_coverage)

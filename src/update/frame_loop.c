@@ -33,6 +33,8 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->width = 512;
     s->height = 512;
     s->camera = -1;
+    s->progress = NULL;
+    s->progress_user = NULL;
 }
 
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
@@ -49,8 +51,14 @@ static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
         st = lm_gather_set_aim(fl->gather, fl->atlas, lm_aim_rgb(lm_photon_stage_aim(fl->stage)), err);
     if (st == LM_OK)
         fl->aim_stale = 0;
-    if (st == LM_OK)
-        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels, count, fl->iim.fresh_tex, NULL, err);
+    /* in chunks of 16 passes when someone watches (the first full gather), else all at once */
+    uint32_t chunk = fl->set.progress ? 16u * (uint32_t)(fl->set.gather.tiles * fl->set.gather.tiles) : count;
+    for (uint32_t done = 0; st == LM_OK && done < count; done += chunk) {
+        uint32_t n = count - done < chunk ? count - done : chunk;
+        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + done, n, fl->iim.fresh_tex, NULL, err);
+        if (fl->set.progress)
+            fl->set.progress(fl->set.progress_user, done + n, count);
+    }
     return st;
 }
 
@@ -82,6 +90,7 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     fl->aim_stale = 1;
     if (st == LM_OK)
         st = gather(fl, lm_iim_schedule_all(&fl->iim, store_of(fl), fl->texels), err);
+    fl->set.progress = NULL; /* per-frame gathers are small */
     if (st == LM_OK)
         st = lm_iim_blend(&fl->iim, 1, err);
     if (t_gather)

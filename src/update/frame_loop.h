@@ -26,6 +26,9 @@ typedef struct {
     lm_direct_settings direct;
     int width, height;     /* frame size (default 512 x 512) */
     int camera;            /* lm_view_for_scene's camera (default -1) */
+    /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
+    void (*progress)(void *user, uint32_t done, uint32_t total);
+    void *progress_user;
 } lm_frame_loop_settings;
 
 typedef struct {
