@@ -150,6 +150,14 @@ static void test_gather_options(void **state)
     snprintf(a, sizeof a, "%s", quick_run("default"));
     snprintf(b, sizeof b, "%s", quick_run_with("instanced", "-q --gather-scheme instanced"));
     double same = exr_difference(a, b, "iim.exr");
+    quick_run_with("layered", "-q --gather-scheme layered"); /* runs: coverage 1 is implied */
+    char args[2048], dir[1024];
+    snprintf(dir, sizeof dir, "%s/refused", lmt_tmpdir());
+    snprintf(args, sizeof args, "run scenes/cornell.glb --frames 1 --texel-size 0.1 -q --gather-scheme layered "
+             "--hemicube-coverage 4 --out %s", dir);
+    assert_int_equal(lmgi(args), 1);
+    assert_non_null(strstr(output, "1 with the layered scheme"));
+    assert_false(exists(dir, "frames.csv")); /* refused settings write nothing */
     const char *c = quick_run_with("coarse", "--hemicube 8 --enlargement 1 --hemicube-samples 1");
     /* not quiet: the summary names the GL backend it ran on */
     assert_true(strstr(output, "gl          ") && (strstr(output, "(OSMesa") || strstr(output, "(EGL")));

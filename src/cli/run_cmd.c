@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "../charts/atlas_dilate.h"
 #include "../core/image.h"
@@ -46,12 +47,14 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
         s->progress = gather_progress;
     if (a->hemicube_samples)
         s->gather.samples = a->hemicube_samples;
-    if (a->hemicube_coverage)
-        s->gather.coverage_samples = a->hemicube_coverage;
     if (a->enlargement > 0.0f)
         s->gather.enlargement = a->enlargement;
     if (a->gather_scheme >= 0)
         s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
+    if (a->hemicube_coverage)
+        s->gather.coverage_samples = a->hemicube_coverage;
+    else if (s->gather.scheme == LM_GATHER_LAYERED)
+        s->gather.coverage_samples = 1; /* the layered target is not multisampled */
     if (a->width) {
         s->width = a->width;
         s->height = a->height;
@@ -167,12 +170,19 @@ static lm_status play(run_state *r, lm_error *err)
     return st;
 }
 
+/* The output directory, made (or found writable) before the long setup, so a bad path fails at once. */
+static lm_status check_out_dir(const run_state *r, lm_error *err)
+{
+    lm_status st = lm_mkdir_p(r->a->out_dir, err);
+    if (st == LM_OK && access(r->a->out_dir, W_OK) != 0)
+        st = lm_fail(err, LM_ERR_IO, "%s: not writable", r->a->out_dir);
+    return st;
+}
+
+/* Files are created only once the frame loop exists: a run refused for its settings writes nothing. */
 static lm_status open_outputs(run_state *r, lm_error *err)
 {
     char path[4096];
-    lm_status st = lm_mkdir_p(r->a->out_dir, err);
-    if (st != LM_OK)
-        return st;
     snprintf(path, sizeof path, "%s/frames.csv", r->a->out_dir);
     r->csv = fopen(path, "w");
     return r->csv ? LM_OK : lm_fail(err, LM_ERR_IO, "%s: cannot write", path);
@@ -189,10 +199,12 @@ static lm_status run(run_state *r, lm_error *err)
     memset(&setup, 0, sizeof setup);
     double t_gather = 0.0;
     lmgi_scene *sc = r->sc;
-    lm_status st = open_outputs(r, err);
+    lm_status st = check_out_dir(r, err);
     if (st == LM_OK)
         st = lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &r->loop, &setup, &t_gather,
                                   err);
+    if (st == LM_OK)
+        st = open_outputs(r, err);
     if (st == LM_OK)
         st = play(r, err);
     if (r->csv && fclose(r->csv) != 0 && st == LM_OK)
