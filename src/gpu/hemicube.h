@@ -20,11 +20,14 @@
  * weight: a texel whose back-face fraction is above backface_limit sees the inside of geometry and is
  * invalid (the caller fills it from valid neighbours).
  *
- * GPU work: a batch of up to tiles^2 texels is rendered into one RGBA32F target, one R x R viewport
- * tile per texel (rgb = radiance, a = 1 on back faces), with reversed float depth (no far plane). A
- * compute shader then sums each tile with the weights in float, in a fixed order (deterministic), and
- * writes (E, back-face fraction) with imageStore straight into the texel of an atlas-sized RGBA32F IIM
- * texture. Nothing is read back in the gather; lm_iim_texture_read is for tests and output.
+ * GPU work: a batch of up to tiles^2 texels is rendered into one RGBA32F target, one R x R tile per
+ * texel (how the tiles are reached: lm_gather_scheme; rgb = radiance, a = 1 on back faces), with reversed
+ * float depth (no far plane), `samples` AIM lookups per pixel on the surface's plane and
+ * `coverage_samples` MSAA samples resolved before the sum (docs/gather.md: they remove banding and
+ * plaid). A compute shader then sums each tile with the weights in float, in a fixed order
+ * (deterministic), and writes (E, back-face fraction) with imageStore straight into the texel of an
+ * atlas-sized RGBA32F IIM texture. Nothing is read back in the gather; lm_iim_texture_read is for tests
+ * and output.
  * With proxy_error > 0 the plane shows the gather proxy (charts/proxy.h) instead of every triangle. */
 #ifndef LM_HEMICUBE_H
 #define LM_HEMICUBE_H
