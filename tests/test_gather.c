@@ -530,6 +530,7 @@ static void test_no_banding_under_the_ceiling(void **state)
             col[j] = col[j - 1], col[j - 1] = k;
         }
     assert_true(n > 20);
+    assert_int_equal(lm_gather_coverage_for(p.s), 1); /* a point light only: no coverage samples needed */
     double rough[2];
     float *e = malloc(sizeof(float) * n);
     assert_non_null(e);
@@ -593,6 +594,7 @@ static void test_no_plaid_from_small_emitters(void **state)
         rough[k] = column_roughness(e, n);
         free(rgba);
     }
+    assert_int_equal(lm_gather_coverage_for(p.s), 4); /* its light is an emissive quad */
     print_message("Cornell box back-wall row, %u texels: roughness %.4f with 1 coverage sample, %.4f with 4\n", n, rough[0],
                   rough[1]);
     /* measured: 0.114 with 1 coverage sample (neighbours step by up to 20%), 0.074 with 4 (steps of 5-10%

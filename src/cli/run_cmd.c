@@ -52,9 +52,7 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
     if (a->gather_scheme >= 0)
         s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
     if (a->hemicube_coverage)
-        s->gather.coverage_samples = a->hemicube_coverage;
-    else if (s->gather.scheme == LM_GATHER_LAYERED)
-        s->gather.coverage_samples = 1; /* the layered target is not multisampled */
+        s->gather.coverage_samples = a->hemicube_coverage; /* else chosen per scene by the frame loop */
     if (a->width) {
         s->width = a->width;
         s->height = a->height;

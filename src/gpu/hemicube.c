@@ -22,6 +22,16 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->coverage_samples = 4;
 }
 
+int lm_gather_coverage_for(const lm_scene *s)
+{
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        const float *e = s->materials[s->tri_material[t]].emissive;
+        if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f)
+            return 4;
+    }
+    return 1;
+}
+
 const char *lm_gather_scheme_name(lm_gather_scheme s)
 {
     return s == LM_GATHER_VIEWPORTS ? "viewports" : s == LM_GATHER_INSTANCED ? "instanced" : "layered";

@@ -61,10 +61,15 @@ typedef struct {
     lm_gather_scheme scheme; /* default LM_GATHER_VIEWPORTS, the fastest measured (docs/gather.md) */
     int samples;           /* AIM lookups per pixel, 1 or 4 (default 4: no banding from edge-on bright spots) */
     int coverage_samples;  /* coverage samples per pixel (MSAA, 1 to 16; default 4): a small emitter covering a
-                              few pixels adds a fraction per pixel instead of all or nothing (no plaid) */
+                              few pixels adds a fraction per pixel instead of all or nothing (no plaid).
+                              lm_gather_coverage_for picks it per scene */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);
+
+/* The coverage samples a scene calls for: 4 when a triangle is emissive (small emitters alias), else 1
+ * (the AIM's sub-samples handle everything else; coverage samples would only cost time). */
+int lm_gather_coverage_for(const lm_scene *s);
 
 /* F(a): the fraction of the cosine-weighted hemisphere the plane covers (closed form). */
 double lm_hemicube_coverage(double a);

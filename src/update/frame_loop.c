@@ -28,6 +28,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
 {
     lm_photon_stage_settings_default(&s->stage);
     lm_hemicube_settings_default(&s->gather);
+    s->gather.coverage_samples = 0; /* chosen per scene */
     lm_iim_settings_default(&s->iim);
     lm_direct_settings_default(&s->direct);
     s->width = 512;
@@ -76,6 +77,8 @@ static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
 static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
 {
     lm_status st = lm_gl_context_create(&fl->gl, err);
+    if (fl->set.gather.coverage_samples == 0)
+        fl->set.gather.coverage_samples = fl->set.gather.scheme == LM_GATHER_LAYERED ? 1 : lm_gather_coverage_for(fl->scene);
     if (st == LM_OK)
         st = lm_gather_create(&fl->set.gather, &fl->gather, err);
     if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK)

@@ -21,7 +21,7 @@
 
 typedef struct {
     lm_photon_stage_settings stage;
-    lm_hemicube_settings gather;
+    lm_hemicube_settings gather; /* coverage_samples 0 (the default here): lm_gather_coverage_for the scene */
     lm_iim_settings iim;
     lm_direct_settings direct;
     int width, height;     /* frame size (default 512 x 512) */
