@@ -505,6 +505,31 @@ static double column_roughness(const float *e, uint32_t n)
     return n > 2 ? sqrt(d2 / (n - 2)) / (sum / (n - 2)) : 0.0;
 }
 
+/* Sorts texel indices by their position along world axis `axis` (insertion sort: short lines). */
+static void sort_along(const lm_atlas *a, uint32_t *idx, uint32_t n, int axis)
+{
+    for (uint32_t i = 1; i < n; i++)
+        for (uint32_t j = i; j > 0 && a->texels[idx[j]].pos[axis] < a->texels[idx[j - 1]].pos[axis]; j--) {
+            uint32_t k = idx[j];
+            idx[j] = idx[j - 1], idx[j - 1] = k;
+        }
+}
+
+/* Roughness of the green irradiance along a sorted line of texels, gathered with `set`. */
+static double line_roughness(const lmt_pipeline *p, const lm_photon_stage *st, const uint32_t *line, uint32_t n,
+                             const lm_hemicube_settings *set)
+{
+    float *e = malloc(sizeof(float) * n);
+    assert_non_null(e);
+    float *rgba = gather_aim(p->s, &p->atlas, lm_aim_rgb(lm_photon_stage_aim(st)), set, line, n, NULL);
+    for (uint32_t i = 0; i < n; i++)
+        e[i] = texel_value_at(&p->atlas, rgba, line[i])[1];
+    double r = column_roughness(e, n);
+    free(rgba);
+    free(e);
+    return r;
+}
+
 /* Banding (docs/gather.md): on scenes/cornell.glb the light 10 cm under the ceiling makes a small, bright
  * AIM spot, seen nearly edge-on from the top of the back wall. One AIM sample per hemicube pixel makes a
  * column of those texels alternate; four sub-samples per pixel found on the surface's plane make it
@@ -524,33 +549,22 @@ static void test_no_banding_under_the_ceiling(void **state)
             t->pos[1] > 1.3f && t->pos[1] < 1.9f)
             col[n++] = i;
     }
-    for (uint32_t i = 1; i < n; i++) /* bottom to top */
-        for (uint32_t j = i; j > 0 && p.atlas.texels[col[j]].pos[1] < p.atlas.texels[col[j - 1]].pos[1]; j--) {
-            uint32_t k = col[j];
-            col[j] = col[j - 1], col[j - 1] = k;
-        }
+    sort_along(&p.atlas, col, n, 1); /* bottom to top */
     assert_true(n > 20);
     assert_int_equal(lm_gather_coverage_for(p.s), 1); /* a point light only: no coverage samples needed */
     double rough[2];
-    float *e = malloc(sizeof(float) * n);
-    assert_non_null(e);
     for (int k = 0; k < 2; k++) {
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
         set.samples = k ? 4 : 1;
         set.coverage_samples = 1; /* AIM sampling alone */
-        float *rgba = gather_aim(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), &set, col, n, NULL);
-        for (uint32_t i = 0; i < n; i++)
-            e[i] = texel_value_at(&p.atlas, rgba, col[i])[1];
-        rough[k] = column_roughness(e, n);
-        free(rgba);
+        rough[k] = line_roughness(&p, st, col, n, &set);
     }
     print_message("back wall under the ceiling, %u texels: roughness %.4f with 1 sample per pixel, %.4f with 4\n", n,
                   rough[0], rough[1]);
     /* measured: 0.147 with 1 sample, 0.024 with 4 (what is left is the AIM's photon noise) */
     assert_true(rough[1] < 0.04);
     assert_true(rough[0] > 3.0 * rough[1]); /* the test sees the banding it guards against */
-    free(e);
     free(col);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
@@ -575,24 +589,14 @@ static void test_no_plaid_from_small_emitters(void **state)
             t->pos[0] > -500.0f && t->pos[0] < -60.0f)
             row[n++] = i;
     }
-    for (uint32_t i = 1; i < n; i++)
-        for (uint32_t j = i; j > 0 && p.atlas.texels[row[j]].pos[0] < p.atlas.texels[row[j - 1]].pos[0]; j--) {
-            uint32_t k = row[j];
-            row[j] = row[j - 1], row[j - 1] = k;
-        }
+    sort_along(&p.atlas, row, n, 0);
     assert_true(n > 20);
     double rough[2];
-    float *e = malloc(sizeof(float) * n);
-    assert_non_null(e);
     for (int k = 0; k < 2; k++) {
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
         set.coverage_samples = k ? 4 : 1;
-        float *rgba = gather_aim(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), &set, row, n, NULL);
-        for (uint32_t i = 0; i < n; i++)
-            e[i] = texel_value_at(&p.atlas, rgba, row[i])[1];
-        rough[k] = column_roughness(e, n);
-        free(rgba);
+        rough[k] = line_roughness(&p, st, row, n, &set);
     }
     assert_int_equal(lm_gather_coverage_for(p.s), 4); /* its light is an emissive quad */
     print_message("Cornell box back-wall row, %u texels: roughness %.4f with 1 coverage sample, %.4f with 4\n", n, rough[0],
@@ -601,7 +605,6 @@ static void test_no_plaid_from_small_emitters(void **state)
      * remain: a quarter-pixel edge of a two-pixel emitter; docs/gather.md) */
     assert_true(rough[1] < 0.09);
     assert_true(rough[0] > 1.3 * rough[1]);
-    free(e);
     free(row);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);

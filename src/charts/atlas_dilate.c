@@ -44,3 +44,8 @@ void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
     free(filled);
     free(next);
 }
+
+void lm_atlas_dilate_gutters(const lm_atlas *a, float *data, int channels)
+{
+    lm_atlas_dilate(a, data, channels, a->gutter > 1 ? a->gutter : 1);
+}

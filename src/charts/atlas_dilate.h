@@ -9,5 +9,7 @@
  * that touches (8-neighbourhood) a texel filled so far the mean of those neighbours. Covered texels are
  * never changed. With passes >= gutter, every texel a bilinear lookup inside a chart can reach is set. */
 void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes);
+/* As many passes as the atlas's gutter (at least one): what bilinear sampling of a chart needs. */
+void lm_atlas_dilate_gutters(const lm_atlas *a, float *data, int channels);
 
 #endif

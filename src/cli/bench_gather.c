@@ -55,7 +55,7 @@ static int open_scene(const char *label, int paper_row, const char *path, bench_
     if (!b->aim)
         return 0;
     memcpy(b->aim, lm_aim_rgb(lm_photon_stage_aim(b->stage)), sizeof(float) * n);
-    lm_atlas_dilate(a, b->aim, 3, a->gutter > 1 ? a->gutter : 1);
+    lm_atlas_dilate_gutters(a, b->aim, 3);
     /* a pass of a ~100k-triangle scene without the proxy takes seconds: a quarter pass there */
     uint32_t pass = b->sc->scene->tri_count > 50000 ? PASS / 4 : PASS;
     b->count = a->texel_count < pass ? a->texel_count : pass;
@@ -149,8 +149,8 @@ static double ray_gather(const bench_scene *b, uint32_t texel)
     const lm_scene *s = b->sc->scene;
     const lm_texel *t = &a->texels[texel];
     lm_vec3 n = lm_normalize(lm_v3_load(t->normal));
-    lm_vec3 helper = fabsf(n.x) < 0.9f ? lm_v3(1, 0, 0) : lm_v3(0, 1, 0);
-    lm_vec3 tx = lm_normalize(lm_cross(helper, n)), ty = lm_cross(n, tx);
+    lm_vec3 tx, ty;
+    lm_tangents(n, &tx, &ty);
     lm_vec3 org = lm_add(lm_v3_load(t->pos), lm_scale(n, 1e-4f * lm_scene_size(s)));
     double sum = 0.0;
     for (int j = 0; j < RAYS_SIDE; j++)

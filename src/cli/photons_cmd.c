@@ -74,7 +74,7 @@ static lm_status write_pictures(const lmgi_scene *sc, const lm_aim *aim, const l
         st = lm_write_exr(path, at->width, at->height, 3, rgb, err);
     }
     if (st == LM_OK) {
-        lm_atlas_dilate(at, rgb, 3, at->gutter);
+        lm_atlas_dilate_gutters(at, rgb, 3);
         *exposure = lm_auto_exposure(rgb, n, 3);
         lm_tonemap_srgb8(rgb, n, 3, *exposure, img);
         snprintf(path, sizeof path, "%s/aim.png", a->out_dir);

@@ -131,7 +131,7 @@ static lm_status write_atlases(run_state *r, lm_error *err)
     }
     if (st == LM_OK) {
         memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(r->loop))), n * 3 * sizeof *rgb);
-        lm_atlas_dilate(at, rgb, 3, at->gutter);
+        lm_atlas_dilate_gutters(at, rgb, 3);
         st = write_pair(r->a->out_dir, "aim", at->width, at->height, rgb, 0.0f, 1, png, err);
     }
     free(rgba);

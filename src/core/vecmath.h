@@ -32,6 +32,13 @@ static inline lm_vec3 lm_vmax(lm_vec3 a, lm_vec3 b)
 {
     return lm_v3(fmaxf(a.x, b.x), fmaxf(a.y, b.y), fmaxf(a.z, b.z));
 }
+/* Unit t and b with (t, b, n) orthonormal for unit n, from a fixed helper axis (the hemicube's plane axes). */
+static inline void lm_tangents(lm_vec3 n, lm_vec3 *t, lm_vec3 *b)
+{
+    lm_vec3 helper = fabsf(n.x) < 0.9f ? lm_v3(1, 0, 0) : lm_v3(0, 1, 0);
+    *t = lm_normalize(lm_cross(helper, n));
+    *b = lm_cross(n, *t);
+}
 static inline int lm_v3_finite(lm_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 
 void lm_mat4_identity(float m[16]);

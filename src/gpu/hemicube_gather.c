@@ -323,7 +323,7 @@ lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rg
     if (!d)
         return lm_fail(err, LM_ERR_NOMEM, "no memory to dilate the AIM");
     memcpy(d, aim_rgb, sizeof(float) * n);
-    lm_atlas_dilate(a, d, 3, a->gutter > 1 ? a->gutter : 1); /* chart edges must not blend in black */
+    lm_atlas_dilate_gutters(a, d, 3); /* chart edges must not blend in black */
     if (!g->aim_tex || g->aim_w != a->width || g->aim_h != a->height) {
         glDeleteTextures(1, &g->aim_tex);
         glGenTextures(1, &g->aim_tex);
@@ -360,8 +360,8 @@ static void texel_frame(const lm_scene *s, const lm_texel *tx, lm_vec3 *pos, lm_
 /* The plane's axes scaled to clip space: b / a, t / a (x, y in [-w, w] on the plane) and n (w). */
 static void plane_axes(lm_vec3 n, float a, lm_vec3 axes[3])
 {
-    lm_vec3 helper = fabsf(n.x) < 0.9f ? lm_v3(1, 0, 0) : lm_v3(0, 1, 0);
-    lm_vec3 t = lm_normalize(lm_cross(helper, n)), b = lm_cross(n, t);
+    lm_vec3 t, b;
+    lm_tangents(n, &t, &b);
     axes[0] = lm_scale(b, 1.0f / a), axes[1] = lm_scale(t, 1.0f / a), axes[2] = n;
 }
 

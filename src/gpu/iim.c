@@ -298,6 +298,6 @@ uint32_t lm_iim_fill_invalid(const lm_atlas *a, float *rgba, float limit)
     }
     free(valid);
     free(next);
-    lm_atlas_dilate(a, rgba, 4, a->gutter > 1 ? a->gutter : 1);
+    lm_atlas_dilate_gutters(a, rgba, 4);
     return left;
 }
