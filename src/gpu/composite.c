@@ -1,6 +1,6 @@
 /* Indirect light of a frame and the final sum (composite.h): a premultiplied IIM x albedo atlas, then a
- * full-screen pass over the direct pass's lightmap uvs adding the direct light (lm_composite_frame), or a
- * geometry pass for the indirect part alone (lm_composite_indirect). Targets and programs persist. */
+ * full-screen pass over the direct pass's lightmap uvs adding the direct light. Targets and programs
+ * persist. */
 #include "composite.h"
 
 #include "gl_api.h"
@@ -8,35 +8,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../core/vecmath.h"
-#include "gl_mesh.h"
 #include "gl_shader.h"
-#include "lightmap_view.h"
 #include "offscreen.h"
 
 struct lm_composite {
     int width, height;   /* atlas */
     float *albedo;       /* atlas-sized RGBA: albedo / pi, a = 1 on covered texels */
-    GLuint albedo_tex, prog, premult_prog, frame_prog, empty_vao;
+    GLuint albedo_tex, premult_prog, frame_prog, empty_vao;
     float limit;
-    GLint u_view_proj, u_lit, p_limit, p_albedo, p_iim, f_lit, f_direct, f_uv;
+    GLint p_limit, p_albedo, p_iim, f_lit, f_direct, f_uv;
     lm_float_target lit; /* atlas-sized, linear filter: (albedo / pi * E * w, w), w = covered and valid */
-    lm_gl_mesh mesh;      /* world position, lightmap uv; built on the first frame */
-    int node_count;
-    float *node_world;    /* per node: the world matrix its vertices were last uploaded with */
-    lm_float_target target;       /* the frame: sum (+ indirect) */
-    lm_float_target depth_target; /* lm_composite_indirect's geometry pass */
+    lm_float_target target; /* the frame */
     float *scratch;       /* read-back, width x height RGBA */
     size_t scratch_px;
 };
 
-static const char *VS =
-    "#version 450 core\n"
-    "layout(location = 0) in vec3 pos;\n"
-    "layout(location = 1) in vec2 uv;\n"
-    "uniform mat4 view_proj;\n"
-    "out vec2 v_uv;\n"
-    "void main() { v_uv = uv; gl_Position = view_proj * vec4(pos, 1.0); }\n";
 /* Per frame, per atlas texel: albedo / pi * E premultiplied by w = covered x valid (back-face fraction
  * <= limit), and w; sampled with the texture unit's bilinear filter, rgb / a is then the bilinear filter
  * over the four nearest texels that weighs only covered, valid ones, renormalised. */
@@ -58,28 +44,17 @@ static const char *PREMULT_FS =
     "    float w = al.a * (e.a <= limit ? 1.0 : 0.0);\n"
     "    frag = vec4(al.rgb * e.rgb * w, w);\n"
     "}\n";
-static const char *FS =
-    "#version 450 core\n"
-    "in vec2 v_uv;\n"
-    "uniform sampler2D lit;\n"
-    "out vec4 frag;\n"
-    "void main() {\n"
-    "    vec4 t = textureLod(lit, v_uv, 0.0);\n"
-    "    frag = vec4(v_uv.x >= 0.0 && t.a > 0.0 ? t.rgb / t.a : vec3(0.0), 1.0);\n"
-    "}\n";
 /* The frame, full screen: direct + the indirect light at each pixel's lightmap uv. */
 static const char *FRAME_FS =
     "#version 450 core\n"
     "uniform sampler2D lit, direct, uvs;\n"
-    "layout(location = 0) out vec4 frag;\n"
-    "layout(location = 1) out vec4 indirect;\n"
+    "out vec4 frag;\n"
     "void main() {\n"
     "    ivec2 q = ivec2(gl_FragCoord.xy);\n"
     "    vec2 uv = texelFetch(uvs, q, 0).xy;\n"
     "    vec4 t = textureLod(lit, uv, 0.0);\n"
     "    vec3 e = uv.x >= 0.0 && t.a > 0.0 ? t.rgb / t.a : vec3(0.0);\n"
     "    frag = vec4(texelFetch(direct, q, 0).rgb + e, 1.0);\n"
-    "    indirect = vec4(e, 1.0);\n"
     "}\n";
 
 /* albedo / pi at each covered texel's centre (its triangle's material, texture at the interpolated UV). */
@@ -130,13 +105,8 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->height = a->height;
     c->limit = backface_limit;
     fill_albedo(s, a, c->albedo);
-    lm_status st = lm_gl_program("composite", VS, FS, &c->prog, err);
-    if (st != LM_OK) {
-        lm_composite_free(c);
-        return st;
-    }
     c->albedo_tex = upload_rgba(a->width, a->height, c->albedo);
-    st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
+    lm_status st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
     if (st != LM_OK) {
         lm_composite_free(c);
         return st;
@@ -150,8 +120,6 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->f_direct = glGetUniformLocation(c->frame_prog, "direct");
     c->f_uv = glGetUniformLocation(c->frame_prog, "uvs");
     glGenVertexArrays(1, &c->empty_vao);
-    c->u_view_proj = glGetUniformLocation(c->prog, "view_proj");
-    c->u_lit = glGetUniformLocation(c->prog, "lit");
     c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
     c->p_albedo = glGetUniformLocation(c->premult_prog, "albedo");
     c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
@@ -165,20 +133,14 @@ void lm_composite_free(lm_composite *c)
         return;
     if (c->albedo_tex)
         glDeleteTextures(1, &c->albedo_tex);
-    if (c->prog)
-        glDeleteProgram(c->prog);
     if (c->premult_prog)
         glDeleteProgram(c->premult_prog);
     if (c->frame_prog)
         glDeleteProgram(c->frame_prog);
     if (c->empty_vao)
         glDeleteVertexArrays(1, &c->empty_vao);
-    if (c->mesh.vao)
-        lm_gl_mesh_destroy(&c->mesh);
     lm_float_target_free(&c->target);
-    lm_float_target_free(&c->depth_target);
     lm_float_target_free(&c->lit);
-    free(c->node_world);
     free(c->scratch);
     free(c->albedo);
     free(c);
@@ -190,58 +152,6 @@ int lm_composite_albedo(const lm_composite *c, int x, int y, float out[3])
     for (int k = 0; k < 3; k++)
         out[k] = p[k];
     return p[3] > 0.0f;
-}
-
-/* Position and lightmap uv of triangles [t0, t1) (5 floats a vertex), as lm_lightmapped_vertices. */
-static void fill_range(const lm_scene *s, const lm_atlas *a, uint32_t t0, uint32_t t1, float *v)
-{
-    for (uint32_t t = t0; t < t1; t++)
-        for (int k = 0; k < 3; k++) {
-            float *o = v + 15 * (size_t)(t - t0) + 5 * k;
-            lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], o);
-            const float *uv = a->corner_uv + 6 * (size_t)t + 2 * k;
-            int none = a->tri_chart[t] < 0 || !isfinite(uv[0]);
-            o[3] = none ? -1.0f : uv[0];
-            o[4] = none ? -1.0f : uv[1];
-        }
-}
-
-/* Builds the vertex buffer on the first frame; later re-uploads only the nodes that moved. */
-static lm_status update_mesh(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err)
-{
-    if (!c->mesh.vao) {
-        float *verts = lm_lightmapped_vertices(s, a);
-        c->node_world = malloc(sizeof(float) * 16 * (size_t)(s->node_count ? s->node_count : 1));
-        if (!verts || !c->node_world) {
-            free(verts);
-            return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
-        }
-        const int sizes[2] = {3, 2};
-        lm_gl_mesh_create(&c->mesh, verts, (int)(3 * s->tri_count), sizes, 2);
-        free(verts);
-        c->node_count = s->node_count;
-        for (int i = 0; i < s->node_count; i++)
-            memcpy(c->node_world + 16 * (size_t)i, s->nodes[i].world, sizeof s->nodes[i].world);
-        return LM_OK;
-    }
-    glBindBuffer(GL_ARRAY_BUFFER, c->mesh.vbo);
-    for (int i = 0; i < s->node_count && i < c->node_count; i++) {
-        const lm_node *nd = &s->nodes[i];
-        float *w = c->node_world + 16 * (size_t)i;
-        if (!memcmp(w, nd->world, sizeof nd->world))
-            continue;
-        memcpy(w, nd->world, sizeof nd->world);
-        if (!nd->tri_count)
-            continue;
-        float *v = malloc(sizeof(float) * 15 * nd->tri_count);
-        if (!v)
-            return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
-        fill_range(s, a, nd->first_tri, nd->first_tri + nd->tri_count, v);
-        glBufferSubData(GL_ARRAY_BUFFER, (GLintptr)(sizeof(float) * 15 * (size_t)nd->first_tri),
-                        (GLsizeiptr)(sizeof(float) * 15 * nd->tri_count), v);
-        free(v);
-    }
-    return LM_OK;
 }
 
 /* The premultiplied atlas (c->lit, bound) from the display IIM. */
@@ -268,27 +178,6 @@ static void premultiply(const lm_composite *c, unsigned iim_tex)
     glActiveTexture(GL_TEXTURE0);
 }
 
-static void draw(const lm_composite *c, const lm_view *view, int w, int h)
-{
-    float vp[16];
-    lm_mat4_mul(vp, view->proj, view->view);
-    glViewport(0, 0, w, h);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_CULL_FACE);
-    glDisable(GL_BLEND);
-    glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glUseProgram(c->prog);
-    glUniformMatrix4fv(c->u_view_proj, 1, GL_FALSE, vp);
-    glUniform1i(c->u_lit, 1);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, c->lit.color[0]);
-    lm_gl_mesh_draw(&c->mesh);
-    glActiveTexture(GL_TEXTURE0);
-}
-
 /* The scratch read-back buffer for width x height. */
 static lm_status scratch_for(lm_composite *c, int width, int height, lm_error *err)
 {
@@ -306,7 +195,7 @@ static lm_status scratch_for(lm_composite *c, int width, int height, lm_error *e
 }
 
 lm_status lm_composite_frame(lm_composite *c, unsigned iim_tex, unsigned direct_tex, unsigned uv_tex, int width,
-                             int height, float *rgb, float *indirect, lm_error *err)
+                             int height, float *rgb, lm_error *err)
 {
     lm_status st = scratch_for(c, width, height, err);
     if (st == LM_OK)
@@ -314,9 +203,7 @@ lm_status lm_composite_frame(lm_composite *c, unsigned iim_tex, unsigned direct_
     if (st != LM_OK)
         return st;
     premultiply(c, iim_tex);
-    /* two attachments once an indirect image was asked for: the target is not re-made back and forth */
-    int attachments = indirect || c->target.attachments == 2 ? 2 : 1;
-    st = lm_float_target_ensure(&c->target, width, height, attachments, err);
+    st = lm_float_target_ensure(&c->target, width, height, 1, err);
     if (st != LM_OK)
         return st;
     glDisable(GL_DEPTH_TEST);
@@ -335,28 +222,6 @@ lm_status lm_composite_frame(lm_composite *c, unsigned iim_tex, unsigned direct_
     glDrawArrays(GL_TRIANGLES, 0, 3);
     glActiveTexture(GL_TEXTURE0);
     lm_float_target_read_rgb(&c->target, 0, rgb, c->scratch);
-    if (indirect)
-        lm_float_target_read_rgb(&c->target, 1, indirect, c->scratch);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    return lm_gl_check("composite", err);
-}
-
-lm_status lm_composite_indirect(lm_composite *c, const lm_scene *s, const lm_atlas *a, unsigned iim_tex,
-                                const lm_view *view, int width, int height, float *rgb, lm_error *err)
-{
-    lm_status st = scratch_for(c, width, height, err);
-    if (st == LM_OK)
-        st = update_mesh(c, s, a, err);
-    if (st == LM_OK)
-        st = lm_float_target_ensure(&c->lit, c->width, c->height, 1, err);
-    if (st != LM_OK)
-        return st;
-    premultiply(c, iim_tex);
-    st = lm_float_target_ensure(&c->depth_target, width, height, 1, err);
-    if (st != LM_OK)
-        return st;
-    draw(c, view, width, height);
-    lm_float_target_read_rgb(&c->depth_target, 0, rgb, c->scratch);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return lm_gl_check("composite", err);
 }

@@ -154,7 +154,7 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     double t1 = lm_now();
     if (st == LM_OK)
         st = lm_composite_frame(fl->comp, fl->iim.display_tex, lm_direct_texture(fl->direct_light),
-                                lm_direct_uv_texture(fl->direct_light), w, h, fl->image, NULL, err);
+                                lm_direct_uv_texture(fl->direct_light), w, h, fl->image, err);
     o->t_direct = t1 - t0;
     o->t_composite = lm_now() - t1;
     return st;
