@@ -244,10 +244,13 @@ static double time_contexts(const bench_scene *b, int threads)
     }
     for (int k = 0; k < threads; k++)
         pthread_join(tid[k], NULL);
+    int all_ok = 1;
+    for (int k = 0; k < threads; k++)
+        all_ok &= jobs[k].ok;
     for (int r = 0; r < REPEATS; r++) { /* the slower context sets the wall time; a failed one: none */
-        wall[r] = 0.0;
-        for (int k = 0; k < threads; k++)
-            wall[r] = jobs[k].ok ? fmax(wall[r], jobs[k].seconds[r]) : NAN;
+        wall[r] = all_ok ? 0.0 : NAN;
+        for (int k = 0; all_ok && k < threads; k++)
+            wall[r] = fmax(wall[r], jobs[k].seconds[r]);
     }
     return 1e3 * lm_median(wall, REPEATS) / b->count;
 }
