@@ -42,7 +42,7 @@ typedef struct {
 struct lm_direct {
     lm_direct_settings set;
     GLuint prog[3], emission; /* light programs per kind (point, spot, directional), emission program */
-    GLint e_view_proj, e_eye, e_view_dir, e_ortho_view;
+    GLint e_view_proj;
     uniforms u[3];
     lm_direct_mesh mesh;
     lm_shadow_renderer shadow;
@@ -122,7 +122,6 @@ static void emission_pass(const lm_direct *d, const lm_view *view, int w, int h)
 {
     float vp[16];
     lm_mat4_mul(vp, view->proj, view->view);
-    const float towards_eye[3] = {view->view[2], view->view[6], view->view[10]};
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -137,9 +136,6 @@ static void emission_pass(const lm_direct *d, const lm_view *view, int w, int h)
     }
     glUseProgram(d->emission);
     glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
-    glUniform3fv(d->e_eye, 1, view->eye);
-    glUniform3fv(d->e_view_dir, 1, towards_eye);
-    glUniform1i(d->e_ortho_view, view->proj[11] == 0.0f && view->proj[15] != 0.0f);
     lm_direct_mesh_draw(&d->mesh, 0);
 }
 
@@ -152,7 +148,7 @@ static lm_status shadow_map(lm_direct *d, const lm_scene *s, const lm_emitter *e
     int same = c->map.tex && !memcmp(&p, &c->map.p, sizeof p), static_ok = c->static_version == d->static_version;
     if (same && static_ok && c->dynamic_version == d->dynamic_version)
         return LM_OK;
-    lm_status st = lm_shadow_map_draw(&c->map, &p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_vertices,
+    lm_status st = lm_shadow_map_draw(&c->map, &p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_indices,
                                       !static_ok, err);
     c->static_version = d->static_version;
     c->dynamic_version = d->dynamic_version;
@@ -228,13 +224,10 @@ lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings
         st = lm_gl_program("direct_emission", lm_direct_emission_vs, lm_direct_emission_fs, &d->emission, err);
     if (st == LM_OK) {
         d->e_view_proj = glGetUniformLocation(d->emission, "view_proj");
-        d->e_eye = glGetUniformLocation(d->emission, "eye");
-        d->e_view_dir = glGetUniformLocation(d->emission, "view_dir");
-        d->e_ortho_view = glGetUniformLocation(d->emission, "ortho_view");
         st = lm_shadow_renderer_create(&d->shadow, err);
     }
     if (st == LM_OK)
-        st = lm_direct_mesh_build(&d->mesh, s, err);
+        st = lm_direct_mesh_build(&d->mesh, s, NULL, err);
     if (st == LM_OK)
         st = lm_gl_check("direct_light: setup", err);
     if (st != LM_OK) {
@@ -316,7 +309,8 @@ unsigned lm_direct_uv_texture(const lm_direct *d) { return d->keep_uv ? d->targe
 
 lm_status lm_direct_keep_lightmap_uv(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
-    lm_status st = lm_direct_mesh_add_lightmap_uv(&d->mesh, s, a, err);
+    lm_direct_mesh_free(&d->mesh); /* rebuilt: corners on different charts need their own vertices */
+    lm_status st = lm_direct_mesh_build(&d->mesh, s, a, err);
     if (st == LM_OK)
         d->keep_uv = 1;
     return st == LM_OK ? lm_gl_check("direct_light: lightmap uvs", err) : st;

@@ -1,24 +1,26 @@
 #include "direct_shader.h"
 
-/* Attributes (world space): position, shading normal, geometric normal, base colour factor,
- * (Phong exponent, double-sided, metallic, material class), emitted radiance, base colour texture uv
- * (KHR_texture_transform applied). */
+/* Attributes (world space): position, shading normal, base colour factor, (Phong exponent, double-sided,
+ * metallic, material class), emitted radiance, base colour texture uv (KHR_texture_transform applied).
+ * The per-material ones are flat (no interpolation: cheaper on llvmpipe). The geometric normal is the
+ * cross product of the position's screen derivatives, exact on a planar triangle, so vertices are shared
+ * between triangles; gl_FrontFacing says which side of the triangle (by its winding) is seen. */
 const char *const lm_direct_vs =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"
     "layout(location = 1) in vec3 ns;\n"
-    "layout(location = 2) in vec3 ng;\n"
-    "layout(location = 3) in vec3 base;\n"
-    "layout(location = 4) in vec4 par;\n"
-    "layout(location = 5) in vec3 em;\n"
-    "layout(location = 6) in vec2 uv;\n"
+    "layout(location = 2) in vec3 base;\n"
+    "layout(location = 3) in vec4 par;\n"
+    "layout(location = 4) in vec3 em;\n"
+    "layout(location = 5) in vec2 uv;\n"
     "uniform mat4 view_proj;\n"
-    "out vec3 v_pos, v_ns, v_ng, v_base, v_em;\n"
-    "out vec4 v_par;\n"
+    "out vec3 v_pos, v_ns;\n"
+    "flat out vec3 v_base, v_em;\n"
+    "flat out vec4 v_par;\n"
     "out vec2 v_uv;\n"
     "invariant gl_Position;\n"
     "void main() {\n"
-    "    v_pos = pos; v_ns = ns; v_ng = ng; v_base = base; v_par = par; v_em = em; v_uv = uv;\n"
+    "    v_pos = pos; v_ns = ns; v_base = base; v_par = par; v_em = em; v_uv = uv;\n"
     "    gl_Position = view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
@@ -27,8 +29,9 @@ const char *const lm_direct_vs =
  * moves normal_offset texels along its normal, and its metric is lowered by
  * (const_bias + slope_bias (pcf + 1) min(tan theta, max_slope)) texels. */
 const char *const lm_direct_fs_body =
-    "in vec3 v_pos, v_ns, v_ng, v_base, v_em;\n"
-    "in vec4 v_par;\n"
+    "in vec3 v_pos, v_ns;\n"
+    "flat in vec3 v_base, v_em;\n"
+    "flat in vec4 v_par;\n"
     "in vec2 v_uv;\n"
     "uniform int pass_kind, has_tex;\n"
     "const int kind = KIND, pcf = PCF; /* compiled per light kind and PCF radius: no branch on them */\n"
@@ -107,9 +110,10 @@ const char *const lm_direct_fs_body =
     "}\n"
     "void main() {\n"
     "    vec3 V = ortho_view != 0 ? view_dir : normalize(eye - v_pos);\n"
-    "    vec3 ng = normalize(v_ng), ns = normalize(v_ns);\n"
-    "    bool back = dot(ng, V) < 0.0;\n"
-    "    if (back) { ng = -ng; ns = -ns; }\n"
+    "    vec3 ng = normalize(cross(dFdx(v_pos), dFdy(v_pos))), ns = normalize(v_ns);\n"
+    "    if (dot(ng, V) < 0.0) ng = -ng; /* the side seen */\n"
+    "    bool back = !gl_FrontFacing;\n"
+    "    if (back) ns = -ns;\n"
     "    if (dot(ns, ng) < 0.0) ns = ng;\n"
     "    bool seen = !back || v_par.y > 0.5;\n"
     "    vec3 c = pass_kind == 0 ? v_em : light(v_pos, ns, ng, V);\n"
@@ -122,32 +126,27 @@ const char *const lm_direct_fs_body =
 const char *const lm_direct_emission_vs =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"
-    "layout(location = 2) in vec3 ng;\n"
-    "layout(location = 4) in vec4 par;\n"
-    "layout(location = 5) in vec3 em;\n"
+    "layout(location = 3) in vec4 par;\n"
+    "layout(location = 4) in vec3 em;\n"
     "layout(location = 7) in vec2 lm_uv;\n"
     "uniform mat4 view_proj;\n"
-    "out vec3 v_pos, v_ng, v_em;\n"
-    "out float v_two;\n"
+    "flat out vec3 v_em;\n"
+    "flat out float v_two;\n"
     "out vec2 v_lm;\n"
     "invariant gl_Position;\n"
     "void main() {\n"
-    "    v_pos = pos; v_ng = ng; v_em = em; v_two = par.y; v_lm = lm_uv;\n"
+    "    v_em = em; v_two = par.y; v_lm = lm_uv;\n"
     "    gl_Position = view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
 const char *const lm_direct_emission_fs =
     "#version 450 core\n"
-    "in vec3 v_pos, v_ng, v_em;\n"
-    "in float v_two;\n"
+    "flat in vec3 v_em;\n"
+    "flat in float v_two;\n"
     "in vec2 v_lm;\n"
-    "uniform vec3 eye, view_dir;\n"
-    "uniform int ortho_view;\n"
     "layout(location = 0) out vec4 frag;\n"
     "layout(location = 1) out vec4 lightmap_uv;\n"
     "void main() {\n"
-    "    vec3 V = ortho_view != 0 ? view_dir : normalize(eye - v_pos);\n"
-    "    bool back = dot(normalize(v_ng), V) < 0.0;\n"
-    "    frag = vec4(!back || v_two > 0.5 ? v_em : vec3(0.0), 1.0);\n"
+    "    frag = vec4(gl_FrontFacing || v_two > 0.5 ? v_em : vec3(0.0), 1.0);\n"
     "    lightmap_uv = vec4(v_lm, 0.0, 1.0);\n"
     "}\n";

@@ -73,6 +73,17 @@ static int dedupe(const float *data, int vertices, int stride, float *unique, ui
     return count;
 }
 
+void lm_gl_mesh_create_elements(lm_gl_mesh *m, const float *data, int vertices, const int *sizes, int attributes,
+                                const uint32_t *index, int indices)
+{
+    memset(m, 0, sizeof *m);
+    upload(m, data, vertices, sizes, attributes);
+    glGenBuffers(1, &m->ibo);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo); /* recorded in the VAO bound by upload */
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * (size_t)indices), index, GL_STATIC_DRAW);
+    m->vertices = indices;
+}
+
 int lm_gl_mesh_create_indexed(lm_gl_mesh *m, const float *data, int vertices, const int *sizes, int attributes)
 {
     memset(m, 0, sizeof *m);
@@ -80,14 +91,8 @@ int lm_gl_mesh_create_indexed(lm_gl_mesh *m, const float *data, int vertices, co
     float *unique = malloc(sizeof(float) * (size_t)stride * (size_t)(vertices ? vertices : 1));
     uint32_t *index = malloc(sizeof(uint32_t) * (size_t)(vertices ? vertices : 1));
     int count = unique && index ? dedupe(data, vertices, stride, unique, index) : -1;
-    if (count >= 0) {
-        upload(m, unique, count, sizes, attributes);
-        glGenBuffers(1, &m->ibo);
-        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, m->ibo); /* recorded in the VAO bound by upload */
-        glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)(sizeof(uint32_t) * (size_t)vertices), index,
-                     GL_STATIC_DRAW);
-        m->vertices = vertices;
-    }
+    if (count >= 0)
+        lm_gl_mesh_create_elements(m, unique, count, sizes, attributes, index, vertices);
     free(unique);
     free(index);
     return count >= 0;
@@ -100,6 +105,15 @@ void lm_gl_mesh_draw(const lm_gl_mesh *m)
         glDrawElements(GL_TRIANGLES, m->vertices, GL_UNSIGNED_INT, NULL);
     else
         glDrawArrays(GL_TRIANGLES, 0, m->vertices);
+}
+
+void lm_gl_mesh_draw_range(const lm_gl_mesh *m, int first, int count)
+{
+    glBindVertexArray(m->vao);
+    if (m->ibo)
+        glDrawElements(GL_TRIANGLES, count, GL_UNSIGNED_INT, (const void *)(sizeof(uint32_t) * (size_t)first));
+    else
+        glDrawArrays(GL_TRIANGLES, first, count);
 }
 
 void lm_gl_mesh_draw_instanced(const lm_gl_mesh *m, int instances)

@@ -12,10 +12,15 @@ typedef struct {
 
 /* Uploads `vertices` vertices of interleaved floats; attribute i (location i) has sizes[i] floats. */
 void lm_gl_mesh_create(lm_gl_mesh *m, const float *data, int vertices, const int *sizes, int attributes);
+/* Uploads `vertices` vertices as above and `indices` indices (3 per triangle) into them. */
+void lm_gl_mesh_create_elements(lm_gl_mesh *m, const float *data, int vertices, const int *sizes, int attributes,
+                                const uint32_t *index, int indices);
 /* The same triangles with identical vertices shared through an index buffer (fewer vertex shader runs).
  * Returns 0 when out of memory (nothing created). */
 int lm_gl_mesh_create_indexed(lm_gl_mesh *m, const float *data, int vertices, const int *sizes, int attributes);
 void lm_gl_mesh_draw(const lm_gl_mesh *m);
+/* Draws `count` vertices (indices when indexed) from the `first`-th. */
+void lm_gl_mesh_draw_range(const lm_gl_mesh *m, int first, int count);
 void lm_gl_mesh_draw_instanced(const lm_gl_mesh *m, int instances);
 void lm_gl_mesh_destroy(lm_gl_mesh *m);
 

@@ -75,7 +75,7 @@ static GLuint make_texture(GLenum target, int size, GLenum format)
 
 /* Which casters a face draws, and how it starts. */
 typedef struct {
-    int first, count;     /* vertex range of `casters` */
+    int first, count;     /* vertex (index) range of `casters` */
     int from_layer;       /* 1: copy the static layer's face first (else clear) */
     int into_layer;       /* 1: draw into the static layer instead of the map */
 } face_job;
@@ -106,8 +106,7 @@ static void draw_face(const lm_shadow_map *m, const lm_shadow_renderer *r, GLenu
     }
     if (job->count > 0) {
         glUniformMatrix4fv(r->u_vp, 1, GL_FALSE, vp);
-        glBindVertexArray(casters->vao);
-        glDrawArrays(GL_TRIANGLES, job->first, job->count);
+        lm_gl_mesh_draw_range(casters, job->first, job->count);
     }
 }
 
@@ -228,9 +227,9 @@ static void draw_faces(const lm_shadow_map *m, const lm_shadow_renderer *r, cons
 }
 
 lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const lm_shadow_renderer *r,
-                             const lm_gl_mesh *casters, int static_vertices, int redo_static, lm_error *err)
+                             const lm_gl_mesh *casters, int static_count, int redo_static, lm_error *err)
 {
-    int n = casters->vertices, split = static_vertices > 0 && static_vertices < n;
+    int n = casters->vertices, split = static_count > 0 && static_count < n;
     ensure_objects(m, p, split);
     if (memcmp(&m->p, p, sizeof *p))
         m->layer_valid = 0;
@@ -251,11 +250,11 @@ lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const 
         draw_faces(m, r, casters, &all);
     } else {
         if (!m->layer_valid || redo_static) {
-            const face_job statics = {0, static_vertices, 0, 1};
+            const face_job statics = {0, static_count, 0, 1};
             draw_faces(m, r, casters, &statics);
             m->layer_valid = 1;
         }
-        const face_job dynamics = {static_vertices, n - static_vertices, 1, 0};
+        const face_job dynamics = {static_count, n - static_count, 1, 0};
         draw_faces(m, r, casters, &dynamics);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -48,11 +48,12 @@ void lm_shadow_renderer_free(lm_shadow_renderer *r);
 /* The parameters of punctual emitter e's map (pos/dir current, s->bounds current). */
 void lm_shadow_params_compute(lm_shadow_params *p, const lm_scene *s, const lm_emitter *e, int size);
 /* Renders map m with parameters p over the caster triangles `casters` (attribute 0 = world position),
- * (re)allocating its textures when the kind or size changed. The first static_vertices vertices are
- * static casters: when some follow them, the static ones are drawn into the layer, re-drawn only when p
- * changed or redo_static is set, and each render copies the layer and draws the rest on top. Leaves the framebuffer binding at 0; the viewport is changed. */
+ * (re)allocating its textures when the kind or size changed. The first static_count vertices (indices
+ * when the mesh is indexed) are static casters: when some follow them, the static ones are drawn into
+ * the layer, re-drawn only when p changed or redo_static is set, and each render copies the layer and
+ * draws the rest on top. Leaves the framebuffer binding at 0; the viewport is changed. */
 lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const lm_shadow_renderer *r,
-                             const lm_gl_mesh *casters, int static_vertices, int redo_static, lm_error *err);
+                             const lm_gl_mesh *casters, int static_count, int redo_static, lm_error *err);
 void lm_shadow_map_free(lm_shadow_map *m);
 
 #endif
