@@ -324,3 +324,37 @@ void lmt_use_material_0(const char *path)
     fputs(out, f);
     fclose(f);
 }
+
+/* Writes the meshes with mesh i using material i (materials_json: the "materials" array's text). */
+const char *lmt_write_scene(const char *name, const lmt_mesh *meshes, int count, const char *nodes,
+                            const char *materials)
+{
+    static char path[512];
+    char extra[2048];
+    snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), name);
+    snprintf(extra, sizeof extra, "\"materials\": %s,", materials);
+    assert_int_equal(lmt_write_gltf(path, meshes, count, nodes, NULL, 0, extra), 0);
+    static char in[1 << 16], out[1 << 17];
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    size_t n = fread(in, 1, sizeof in - 1, f);
+    fclose(f);
+    in[n] = '\0';
+    char *o = out;
+    int prim = 0;
+    for (const char *p = in; *p;) { /* "indices": K}  ->  "indices": K, "material": prim} */
+        const char *q = strstr(p, "\"indices\": ");
+        if (!q) {
+            o += sprintf(o, "%s", p);
+            break;
+        }
+        const char *close = strchr(q, '}');
+        o += sprintf(o, "%.*s, \"material\": %d}", (int)(close - p), p, prim++);
+        p = close + 1;
+    }
+    f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(out, f);
+    fclose(f);
+    return path;
+}

@@ -82,5 +82,9 @@ typedef struct {
 } lmt_accessor;
 int lmt_write_gltf(const char *path, const lmt_mesh *meshes, int mesh_count, const char *nodes_json,
                    const lmt_accessor *extra, int extra_count, const char *extra_json);
+/* Writes meshes[0, count) to lmt_tmpdir()/name with mesh i using material i (materials: the JSON text of
+ * the "materials" array; nodes: of the "nodes" array); returns the path (static storage). */
+const char *lmt_write_scene(const char *name, const lmt_mesh *meshes, int count, const char *nodes,
+                            const char *materials);
 /* Gives every primitive of a file lmt_write_gltf wrote material 0 (it writes none), rewriting its text. */
 void lmt_use_material_0(const char *path);

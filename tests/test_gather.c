@@ -38,43 +38,10 @@ typedef struct {
     lm_atlas a;
 } tscene;
 
-/* Writes the meshes with mesh i using material i (materials_json: the "materials" array's text). */
-static const char *write_scene(const lmt_mesh *meshes, int count, const char *nodes, const char *materials)
-{
-    static char path[512];
-    char extra[2048];
-    snprintf(path, sizeof path, "%s/gather.gltf", lmt_tmpdir());
-    snprintf(extra, sizeof extra, "\"materials\": %s,", materials);
-    assert_int_equal(lmt_write_gltf(path, meshes, count, nodes, NULL, 0, extra), 0);
-    static char in[1 << 16], out[1 << 17];
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    size_t n = fread(in, 1, sizeof in - 1, f);
-    fclose(f);
-    in[n] = '\0';
-    char *o = out;
-    int prim = 0;
-    for (const char *p = in; *p;) { /* "indices": K}  ->  "indices": K, "material": prim} */
-        const char *q = strstr(p, "\"indices\": ");
-        if (!q) {
-            o += sprintf(o, "%s", p);
-            break;
-        }
-        const char *close = strchr(q, '}');
-        o += sprintf(o, "%.*s, \"material\": %d}", (int)(close - p), p, prim++);
-        p = close + 1;
-    }
-    f = fopen(path, "wb");
-    assert_non_null(f);
-    fputs(out, f);
-    fclose(f);
-    return path;
-}
-
 static void ts_load(tscene *t, const lmt_mesh *meshes, int count, const char *nodes, const char *materials,
                     float texel_size)
 {
-    const char *path = write_scene(meshes, count, nodes, materials);
+    const char *path = lmt_write_scene("gather.gltf", meshes, count, nodes, materials);
     lm_error err;
     lm_load_options lo = {0};
     if (lm_scene_load_gltf(path, &lo, &t->s, &err) != LM_OK)
@@ -125,6 +92,9 @@ static uint32_t texel_near(const tscene *t, uint32_t node, float x, float z)
 /* Gathers `count` texels with a zero AIM; rgba gets the whole IIM texture (caller frees). */
 static float *gather_aim(const lm_scene *sc, const lm_atlas *at, const float *aim_rgb,
                          const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count, lm_gather_stats *stats);
+static float *gather_with(const lm_scene *sc, const lm_atlas *at, const float *aim_rgb, const lm_emitter_light *el,
+                          const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count,
+                          lm_gather_stats *stats);
 
 static float *gather(const tscene *t, const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count,
                      lm_gather_stats *stats)
@@ -135,6 +105,14 @@ static float *gather(const tscene *t, const lm_hemicube_settings *set, const uin
 /* Gathers with the given AIM (NULL: black); returns the whole IIM texture read back (caller frees). */
 static float *gather_aim(const lm_scene *sc, const lm_atlas *at, const float *aim_rgb,
                          const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count, lm_gather_stats *stats)
+{
+    return gather_with(sc, at, aim_rgb, NULL, set, texels, count, stats);
+}
+
+/* The same with the emitters' light in closed form (el non-NULL) instead of drawn. */
+static float *gather_with(const lm_scene *sc, const lm_atlas *at, const float *aim_rgb, const lm_emitter_light *el,
+                          const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count,
+                          lm_gather_stats *stats)
 {
 
     lm_error err;
@@ -149,6 +127,7 @@ static float *gather_aim(const lm_scene *sc, const lm_atlas *at, const float *ai
     assert_non_null(rgba);
     unsigned tex = lm_iim_texture_create(at->width, at->height);
     assert_true(tex != 0);
+    lm_gather_set_emitter_light(g, el);
     assert_int_equal(lm_gather_set_scene(g, sc, at, &err), LM_OK);
     assert_int_equal(lm_gather_set_aim(g, at, aim, &err), LM_OK);
     if (lm_gather_texels(g, sc, at, texels, count, tex, stats, &err) != LM_OK)
@@ -349,14 +328,16 @@ static uint32_t *all_texels(const lm_atlas *a)
 }
 
 /* Furnace: a closed box, albedo 0.5, every wall emitting Le = 1. With photons, AIMs and a full gather,
- * each wall's outgoing radiance Le + rho / pi E_iim must reach Le / (1 - rho) = 2 within 3%. */
+ * each wall's outgoing radiance Le + rho / pi E_iim must reach Le / (1 - rho) = 2 within 3%: with the
+ * walls' emission drawn into the hemicubes, and with it in closed form (every wall an emitter seen
+ * whole: pi Le exactly, the hemicube adding only the reflected part). */
 static void test_furnace(void **state)
 {
     (void)state;
     lmt_mesh m;
     memset(&m, 0, sizeof m);
     lmt_mesh_cube_inward(&m, 1.0f);
-    const char *path = write_scene(&m, 1, "[{\"mesh\": 0}]",
+    const char *path = lmt_write_scene("gather.gltf", &m, 1, "[{\"mesh\": 0}]",
                                    "[{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1], "
                                    "\"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}]");
     lmt_pipeline p;
@@ -365,21 +346,29 @@ static void test_furnace(void **state)
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
     uint32_t *texels = all_texels(&p.atlas);
-    lm_gather_stats gs;
-    float *rgba = gather_aim(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), &set, texels, p.atlas.texel_count, &gs);
-    double sum = 0.0, worst = 0.0;
-    for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
-        const lm_texel *t = &p.atlas.texels[i];
-        double L = 1.0 + 0.5 / PI * rgba[4 * ((size_t)t->y * p.atlas.width + t->x)];
-        sum += L;
-        worst = fmax(worst, fabs(L / 2.0 - 1.0));
+    lm_emitter_light el;
+    lm_error err;
+    assert_true(lm_emitter_light_suits(p.s));
+    assert_int_equal(lm_emitter_light_init(&el, p.s, p.rt, 8, &err), LM_OK);
+    for (int closed = 0; closed < 2; closed++) {
+        lm_gather_stats gs;
+        float *rgba = gather_with(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), closed ? &el : NULL, &set,
+                                  texels, p.atlas.texel_count, &gs);
+        double sum = 0.0, worst = 0.0;
+        for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
+            const lm_texel *t = &p.atlas.texels[i];
+            double L = 1.0 + 0.5 / PI * rgba[4 * ((size_t)t->y * p.atlas.width + t->x)];
+            sum += L;
+            worst = fmax(worst, fabs(L / 2.0 - 1.0));
+        }
+        double mean = sum / p.atlas.texel_count;
+        print_message("furnace (emitters %s): %u texels, mean radiance %.4f (want 2, %+.2f%%), worst texel %.2f%%; "
+                      "%.3f ms per texel\n", closed ? "in closed form" : "drawn", p.atlas.texel_count, mean,
+                      100.0 * (mean / 2.0 - 1.0), 100.0 * worst, 1e3 * gs.seconds / p.atlas.texel_count);
+        assert_true(fabs(mean / 2.0 - 1.0) < 0.03);
+        free(rgba);
     }
-    double mean = sum / p.atlas.texel_count;
-    print_message("furnace: %u texels, mean radiance %.4f (want 2, %+.2f%%), worst texel %.2f%%; %.3f ms per "
-                  "texel\n", p.atlas.texel_count, mean, 100.0 * (mean / 2.0 - 1.0), 100.0 * worst,
-                  1e3 * gs.seconds / p.atlas.texel_count);
-    assert_true(fabs(mean / 2.0 - 1.0) < 0.03);
-    free(rgba);
+    lm_emitter_light_free(&el);
     free(texels);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
@@ -401,14 +390,19 @@ static void test_cornell_box_against_reference(void **state)
     float *est = malloc(sizeof(float) * 3 * p.atlas.texel_count);
     uint8_t *valid = malloc(p.atlas.texel_count);
     assert_true(est && valid);
-    for (int k = 0; k < 3; k++) {
-        const float as[3] = {1.0f, 2.0f, 3.0f};
+    lm_emitter_light el;
+    lm_error err;
+    assert_int_equal(lm_emitter_light_init(&el, p.s, p.rt, LM_EMITTER_LIGHT_DEFAULT_RAYS, &err), LM_OK);
+    for (int k = 0; k < 4; k++) { /* a = 1, 2, 3 with the emitter drawn; a = 2 with it in closed form */
+        const float as[4] = {1.0f, 2.0f, 3.0f, 2.0f};
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
         set.enlargement = as[k];
+        if (k == 3)
+            set.coverage_samples = 1; /* what the frame loop takes with the closed form */
         lm_gather_stats gs;
-        float *rgba = gather_aim(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), &set, texels,
-                                 p.atlas.texel_count, &gs);
+        float *rgba = gather_with(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), k == 3 ? &el : NULL, &set,
+                                  texels, p.atlas.texel_count, &gs);
         uint32_t invalid = 0;
         for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
             const float *v = rgba + 4 * ((size_t)p.atlas.texels[i].y * p.atlas.width + p.atlas.texels[i].x);
@@ -421,15 +415,16 @@ static void test_cornell_box_against_reference(void **state)
                    3 * sizeof(float));
         double rmse = lm_ref_relative_rmse(est, ref.iim, valid, p.atlas.texel_count, 3);
         double all = lm_ref_relative_rmse(est, ref.iim, NULL, p.atlas.texel_count, 3);
-        print_message("Cornell box IIM, a = %.0f: relative RMSE %.4f over valid texels, %.4f over all (%u texels, "
+        print_message("Cornell box IIM, a = %.0f%s: relative RMSE %.4f over valid texels, %.4f over all (%u texels, "
                       "%u invalid, %u unfilled; reference se %.3f, %.1f s%s); %.3f ms per texel (%d tris)\n",
-                      (double)set.enlargement, rmse, all, p.atlas.texel_count, invalid, unfilled, ref.mean_rel_se,
+                      (double)set.enlargement, k == 3 ? " (emitter in closed form)" : "", rmse, all, p.atlas.texel_count, invalid, unfilled, ref.mean_rel_se,
                       t_ref, ref.from_cache ? ", cached" : "", 1e3 * gs.seconds / p.atlas.texel_count,
                       (int)p.s->tri_count);
         if (set.enlargement == 2.0f)
             assert_true(rmse < IIM_RMSE_BOUND);
         free(rgba);
     }
+    lm_emitter_light_free(&el);
     free(est);
     free(valid);
     free(texels);
@@ -517,11 +512,11 @@ static void sort_along(const lm_atlas *a, uint32_t *idx, uint32_t n, int axis)
 
 /* Roughness of the green irradiance along a sorted line of texels, gathered with `set`. */
 static double line_roughness(const lmt_pipeline *p, const lm_photon_stage *st, const uint32_t *line, uint32_t n,
-                             const lm_hemicube_settings *set)
+                             const lm_emitter_light *el, const lm_hemicube_settings *set)
 {
     float *e = malloc(sizeof(float) * n);
     assert_non_null(e);
-    float *rgba = gather_aim(p->s, &p->atlas, lm_aim_rgb(lm_photon_stage_aim(st)), set, line, n, NULL);
+    float *rgba = gather_with(p->s, &p->atlas, lm_aim_rgb(lm_photon_stage_aim(st)), el, set, line, n, NULL);
     for (uint32_t i = 0; i < n; i++)
         e[i] = texel_value_at(&p->atlas, rgba, line[i])[1];
     double r = column_roughness(e, n);
@@ -551,14 +546,14 @@ static void test_no_banding_under_the_ceiling(void **state)
     }
     sort_along(&p.atlas, col, n, 1); /* bottom to top */
     assert_true(n > 20);
-    assert_int_equal(lm_gather_coverage_for(p.s), 1); /* a point light only: no coverage samples needed */
+    assert_int_equal(lm_gather_coverage_for(p.s, 0), 1); /* a point light only: no coverage samples needed */
     double rough[2];
     for (int k = 0; k < 2; k++) {
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
         set.samples = k ? 4 : 1;
         set.coverage_samples = 1; /* AIM sampling alone */
-        rough[k] = line_roughness(&p, st, col, n, &set);
+        rough[k] = line_roughness(&p, st, col, n, NULL, &set);
     }
     print_message("back wall under the ceiling, %u texels: roughness %.4f with 1 sample per pixel, %.4f with 4\n", n,
                   rough[0], rough[1]);
@@ -573,7 +568,8 @@ static void test_no_banding_under_the_ceiling(void **state)
 /* Plaid (docs/gather.md): the shared Cornell box's light is a small emissive quad that covers a few
  * hemicube pixels; with one coverage sample per pixel its share steps as its edges cross pixel centres
  * from texel to texel. Four coverage samples (MSAA) smooth a row of back-wall texels above the boxes
- * (nothing occludes the light there). */
+ * (nothing occludes the light there) but leave steps; the emitter's light in closed form
+ * (trace/emitter_light.h) removes them, with or without coverage samples. */
 static void test_no_plaid_from_small_emitters(void **state)
 {
     (void)state;
@@ -591,26 +587,34 @@ static void test_no_plaid_from_small_emitters(void **state)
     }
     sort_along(&p.atlas, row, n, 0);
     assert_true(n > 20);
-    double rough[2];
-    for (int k = 0; k < 2; k++) {
+    assert_true(lm_emitter_light_suits(p.s)); /* its light is an emissive quad: two triangles */
+    lm_emitter_light el;
+    lm_error err;
+    assert_int_equal(lm_emitter_light_init(&el, p.s, p.rt, LM_EMITTER_LIGHT_DEFAULT_RAYS, &err), LM_OK);
+    double rough[4]; /* drawn 1, drawn 4, closed form 1, closed form 4 coverage samples */
+    for (int k = 0; k < 4; k++) {
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
-        set.coverage_samples = k ? 4 : 1;
-        rough[k] = line_roughness(&p, st, row, n, &set);
+        set.coverage_samples = k % 2 ? 4 : 1;
+        rough[k] = line_roughness(&p, st, row, n, k >= 2 ? &el : NULL, &set);
     }
-    assert_int_equal(lm_gather_coverage_for(p.s), 4); /* its light is an emissive quad */
-    print_message("Cornell box back-wall row, %u texels: roughness %.4f with 1 coverage sample, %.4f with 4\n", n, rough[0],
-                  rough[1]);
-    /* measured: 0.114 with 1 coverage sample (neighbours step by up to 20%), 0.074 with 4 (steps of 5-10%
-     * remain: a quarter-pixel edge of a two-pixel emitter; docs/gather.md) */
+    assert_int_equal(lm_gather_coverage_for(p.s, 0), 4);
+    assert_int_equal(lm_gather_coverage_for(p.s, 1), 1);
+    print_message("Cornell box back-wall row, %u texels: roughness drawn %.4f (1 coverage sample), %.4f (4); "
+                  "closed form %.4f (1), %.4f (4)\n", n, rough[0], rough[1], rough[2], rough[3]);
+    /* measured: drawn 0.114 with 1 coverage sample (neighbours step by up to 20%), 0.074 with 4 (steps of
+     * 5-10% remain: a quarter-pixel edge of a two-pixel emitter; docs/gather.md); closed form 0.037 with 1,
+     * 0.022 with 4 (the AIM's photon noise, as under the ceiling) */
     assert_true(rough[1] < 0.09);
     assert_true(rough[0] > 1.3 * rough[1]);
+    assert_true(rough[2] < 0.6 * rough[1]); /* closed form, 1 coverage sample: smoother than drawn with 4 */
+    assert_true(rough[3] < 0.03);
+    lm_emitter_light_free(&el);
     free(row);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }
 
-/* Three squares (three surfaces) of 25, 16 and 9 texels at texel size 0.1. */
 static void three_surfaces(tscene *t)
 {
     lmt_mesh m[3];

@@ -58,6 +58,16 @@ static int add_file(const char **list, int *count, const char *f)
     return 0;
 }
 
+/* --emitter-light closed|drawn: 1 or 0 (unset: -1, the frame loop's choice per scene). */
+static int parse_emitter_light(const char *o, const char *v, int *out)
+{
+    if (v && !strcmp(v, "closed"))
+        return *out = 1, 0;
+    if (v && !strcmp(v, "drawn"))
+        return *out = 0, 0;
+    return bad(o, v, "closed or drawn");
+}
+
 static int parse_scheme(const char *o, const char *v, int *out)
 {
     static const char *names[] = {"viewports", "instanced", "layered"};
@@ -74,6 +84,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
     a->repeats = 3;
     a->camera = -1;
     a->gather_scheme = -1;
+    a->emitter_light = -1;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -135,6 +146,10 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_float(o, v, 1e-3f, &a->enlargement);
         else if (!strcmp(o, "--gather-scheme"))
             rc = parse_scheme(o, v, &a->gather_scheme);
+        else if (!strcmp(o, "--emitter-light"))
+            rc = parse_emitter_light(o, v, &a->emitter_light);
+        else if (!strcmp(o, "--emitter-rays"))
+            rc = parse_int(o, v, 1, 65536, &a->emitter_rays);
         else if (!strcmp(o, "--gather-scene"))
             rc = v ? (a->gather_scene = v, 0) : bad(o, v, "a scene file");
         else if (!strcmp(o, "--scaling"))

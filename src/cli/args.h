@@ -40,6 +40,8 @@ typedef struct {
     int hemicube_coverage;  /* --hemicube-coverage N: MSAA coverage samples per hemicube pixel (1 to 16) */
     float enlargement;      /* --enlargement a: hemicube plane half-side at distance 1 */
     int gather_scheme;      /* --gather-scheme viewports|instanced|layered (-1 = default) */
+    int emitter_light;      /* --emitter-light closed|drawn: 1, 0 (-1 = per scene) */
+    int emitter_rays;       /* --emitter-rays N: shadow rays per emissive triangle and texel */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
 } lm_cli_args;
 

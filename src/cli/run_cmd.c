@@ -51,6 +51,9 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
         s->gather.enlargement = a->enlargement;
     if (a->gather_scheme >= 0)
         s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
+    s->emitter_light = a->emitter_light;
+    if (a->emitter_rays)
+        s->emitter_rays = a->emitter_rays;
     if (a->hemicube_coverage)
         s->gather.coverage_samples = a->hemicube_coverage; /* else chosen per scene by the frame loop */
     if (a->width) {
@@ -144,6 +147,17 @@ static void summary(const run_state *r, int frames, const lm_photon_stage_frame 
 {
     const double *s = r->sum_ms;
     printf("gl          %s\n", lm_frame_loop_gl_description(r->loop));
+    const lm_frame_loop_settings *fs = lm_frame_loop_get_settings(r->loop);
+    uint32_t emissive = lm_emissive_triangle_count(r->sc->scene);
+    printf("gather      R %d, a %g, %d AIM lookups and %d coverage samples per pixel, %s scheme; ",
+           fs->gather.resolution, (double)fs->gather.enlargement, fs->gather.samples, fs->gather.coverage_samples,
+           lm_gather_scheme_name(fs->gather.scheme));
+    if (!emissive)
+        printf("no emissive triangles\n");
+    else if (fs->emitter_light)
+        printf("%u emissive triangles in closed form (%d shadow rays each)\n", emissive, fs->emitter_rays);
+    else
+        printf("%u emissive triangles drawn\n", emissive);
     printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", 1e3 * setup->t_photons,
            1e3 * setup->t_aim, 1e3 * t_gather);
     printf("frames      %d, %u texels gathered, exposure %.4g (from frame 0)\n", frames, r->texels,

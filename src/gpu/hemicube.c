@@ -22,8 +22,10 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->coverage_samples = 4;
 }
 
-int lm_gather_coverage_for(const lm_scene *s)
+int lm_gather_coverage_for(const lm_scene *s, int closed_form_emitters)
 {
+    if (closed_form_emitters)
+        return 1;
     for (uint32_t t = 0; t < s->tri_count; t++) {
         const float *e = s->materials[s->tri_material[t]].emissive;
         if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f)

@@ -38,6 +38,7 @@
 #include "../charts/proxy.h"
 #include "../core/error.h"
 #include "../scene/scene.h"
+#include "../trace/emitter_light.h"
 
 /* How a pass puts many texels' planes into one render target (docs/gather.md, "Throughput"). */
 typedef enum {
@@ -67,9 +68,11 @@ typedef struct {
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);
 
-/* The coverage samples a scene calls for: 4 when a triangle is emissive (small emitters alias), else 1
- * (the AIM's sub-samples handle everything else; coverage samples would only cost time). */
-int lm_gather_coverage_for(const lm_scene *s);
+/* The coverage samples a scene calls for: 4 when a triangle is emissive and its light is drawn into the
+ * hemicubes (small emitters alias), else 1: with the emitters' light in closed form (closed_form_emitters,
+ * lm_gather_set_emitter_light) or none, the AIM's sub-samples handle the rest and coverage samples would
+ * only cost time. */
+int lm_gather_coverage_for(const lm_scene *s, int closed_form_emitters);
 
 /* F(a): the fraction of the cosine-weighted hemisphere the plane covers (closed form). */
 double lm_hemicube_coverage(double a);
@@ -99,6 +102,11 @@ const lm_hemicube_settings *lm_gather_settings(const lm_gather *g);
  * radiance and face normals. Call again after nodes move. With proxy_error > 0 the triangles are those
  * of the gather proxy (proxy.h), built on the first call for (s, a) and kept for later calls. */
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err);
+/* With an emitter light (NULL: none, the default), emissive triangles are drawn without their emission
+ * (they still occlude) and each texel gets their irradiance in closed form with sampled visibility
+ * instead (trace/emitter_light.h: no plaid from small emitters, no coverage samples needed). Takes
+ * effect at the next lm_gather_set_scene; el is borrowed. */
+void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el);
 /* The proxy the gather draws; NULL when proxy_error is 0 or before lm_gather_set_scene. */
 const lm_proxy *lm_gather_proxy(const lm_gather *g);
 /* Uploads the AIM (atlas-sized RGB radiance, width*height*3 floats), dilated into the gutters. */

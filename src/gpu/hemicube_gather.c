@@ -14,6 +14,7 @@
 #include "gl_mesh.h"
 #include "gl_shader.h"
 #include "hemicube_shaders.h"
+#include "../trace/emitter_light.h"
 
 /* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided,
  * surface (-1 when none), the UV's gradient (2 x vec3) and the chart's UV rectangle; a view: 4 vec4
@@ -26,8 +27,10 @@ struct lm_gather {
     GLuint render_prog, reduce_prog;
     GLuint fbo, color, depth;
     GLuint ms_fbo, ms_color, ms_depth; /* with coverage_samples > 1: the multisampled target, resolved into color */
-    GLuint weights_buf, targets_buf, views_buf;
+    GLuint weights_buf, targets_buf, views_buf, emit_buf;
     float *views;          /* a pass's views (schemes 1, 2), tiles^2 * VIEW_FLOATS */
+    const lm_emitter_light *emitters; /* non-NULL: emitters' light in closed form, not drawn */
+    float *emit;           /* a pass's emitter irradiance per texel, tiles^2 * 4 */
     GLuint aim_tex;
     int aim_w, aim_h;
     lm_gl_mesh mesh;
@@ -105,8 +108,12 @@ static lm_status upload_weights(lm_gather *g, lm_error *err)
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->views_buf);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * VIEW_FLOATS * per_pass), NULL, GL_DYNAMIC_DRAW);
     g->views = malloc(sizeof(float) * VIEW_FLOATS * per_pass);
-    if (!g->views)
+    g->emit = calloc(4 * per_pass, sizeof(float));
+    if (!g->views || !g->emit)
         return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory for views");
+    glGenBuffers(1, &g->emit_buf); /* zeros until an emitter light is set */
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->emit_buf);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * 4 * per_pass), g->emit, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     return lm_gl_check("hemicube gather: weight buffers", err);
 }
@@ -176,9 +183,10 @@ void lm_gather_free(lm_gather *g)
         lm_gl_mesh_destroy(&g->mesh);
     if (g->has_proxy)
         lm_proxy_free(&g->proxy);
-    GLuint bufs[3] = {g->weights_buf, g->targets_buf, g->views_buf};
-    glDeleteBuffers(3, bufs);
+    GLuint bufs[4] = {g->weights_buf, g->targets_buf, g->views_buf, g->emit_buf};
+    glDeleteBuffers(4, bufs);
     free(g->views);
+    free(g->emit);
     GLuint tex[5] = {g->aim_tex, g->color, g->depth, g->ms_color, g->ms_depth};
     glDeleteTextures(5, tex);
     glDeleteFramebuffers(1, &g->ms_fbo);
@@ -211,7 +219,7 @@ static void uv_gradient(const float p[3][3], const float *uv[3], float gu[3], fl
 /* One triangle's three vertices (VERTEX_FLOATS each) from world positions, lightmap UVs (NULL: no
  * AIM, drawn black: mirror, glass), its material and its chart (rectangle in UV, -1 when none). */
 static void write_triangle(const float p[3][3], const float *uv[3], const lm_material *m, int surface,
-                           const float rect[4], float *o)
+                           const float rect[4], int draw_emission, float *o)
 {
     lm_vec3 n = lm_cross(lm_sub(lm_v3_load(p[1]), lm_v3_load(p[0])), lm_sub(lm_v3_load(p[2]), lm_v3_load(p[0])));
     float len = lm_length(n), gu[3], gv[3];
@@ -222,7 +230,8 @@ static void write_triangle(const float p[3][3], const float *uv[3], const lm_mat
         memcpy(v, p[k], 3 * sizeof(float));
         v[3] = uv[k] ? uv[k][0] : -1.0f;
         v[4] = uv[k] ? uv[k][1] : -1.0f;
-        memcpy(v + 5, m->emissive, 3 * sizeof(float));
+        for (int c = 0; c < 3; c++)
+            v[5 + c] = draw_emission ? m->emissive[c] : 0.0f;
         lm_v3_store(v + 8, n);
         v[11] = m->double_sided ? 0.0f : 1.0f;
         v[12] = (float)surface;
@@ -244,7 +253,7 @@ static void chart_rect(const lm_atlas *a, int c, float rect[4])
     rect[2] = (float)(ch->x + ch->w) / (float)a->width, rect[3] = (float)(ch->y + ch->h) / (float)a->height;
 }
 
-static void scene_triangle(const lm_scene *s, const lm_atlas *a, uint32_t t, float *o)
+static void scene_triangle(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t t, float *o)
 {
     float p[3][3], rect[4];
     const float *uv[3];
@@ -256,10 +265,12 @@ static void scene_triangle(const lm_scene *s, const lm_atlas *a, uint32_t t, flo
     }
     int c = a->tri_chart[t];
     chart_rect(a, uv[0] ? c : -1, rect);
-    write_triangle(p, uv, &s->materials[s->tri_material[t]], c < 0 ? -1 : a->charts[c].surface, rect, o);
+    write_triangle(p, uv, &s->materials[s->tri_material[t]], c < 0 ? -1 : a->charts[c].surface, rect,
+                   !g->emitters, o);
 }
 
-static void proxy_triangle(const lm_scene *s, const lm_atlas *a, const lm_proxy *px, uint32_t t, float *o)
+static void proxy_triangle(const lm_gather *g, const lm_scene *s, const lm_atlas *a, const lm_proxy *px, uint32_t t,
+                           float *o)
 {
     float p[3][3], rect[4];
     const float *uv[3];
@@ -270,7 +281,8 @@ static void proxy_triangle(const lm_scene *s, const lm_atlas *a, const lm_proxy 
     }
     const lm_proxy_vertex *v0 = &px->vertices[px->tris[3 * (size_t)t]];
     chart_rect(a, v0->chart, rect);
-    write_triangle(p, uv, &s->materials[v0->material], v0->chart < 0 ? -1 : a->charts[v0->chart].surface, rect, o);
+    write_triangle(p, uv, &s->materials[v0->material], v0->chart < 0 ? -1 : a->charts[v0->chart].surface, rect,
+                   !g->emitters, o);
 }
 
 /* Builds the proxy once per (scene, atlas); proxy_error 0 drops it. */
@@ -291,6 +303,8 @@ static lm_status ensure_proxy(lm_gather *g, const lm_scene *s, const lm_atlas *a
 
 const lm_proxy *lm_gather_proxy(const lm_gather *g) { return g->has_proxy ? &g->proxy : NULL; }
 
+void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el) { g->emitters = el; }
+
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
     lm_status st = ensure_proxy(g, s, a, err);
@@ -302,9 +316,9 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the gather geometry", s->path);
     for (uint32_t t = 0; t < count; t++) {
         if (g->has_proxy)
-            proxy_triangle(s, a, &g->proxy, t, v + 3 * VERTEX_FLOATS * (size_t)t);
+            proxy_triangle(g, s, a, &g->proxy, t, v + 3 * VERTEX_FLOATS * (size_t)t);
         else
-            scene_triangle(s, a, t, v + 3 * VERTEX_FLOATS * (size_t)t);
+            scene_triangle(g, s, a, t, v + 3 * VERTEX_FLOATS * (size_t)t);
     }
     if (g->has_mesh)
         lm_gl_mesh_destroy(&g->mesh);
@@ -501,6 +515,27 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
+/* The emitters' closed-form irradiance at each texel of a pass (from the plane's eye, along its
+ * normal), for the reduction to add; the sample pattern is seeded by the texel's index. */
+static void emitter_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
+                               uint32_t count)
+{
+#pragma omp parallel
+    {
+        lm_rt_thread_init();
+#pragma omp for schedule(dynamic, 4)
+        for (int64_t i = 0; i < (int64_t)count; i++) {
+            texel_view v = view_of(g, s, &a->texels[texels[i]]);
+            float eye[3], n[3];
+            lm_v3_store(eye, v.eye);
+            lm_v3_store(n, v.axes[2]);
+            lm_emitter_irradiance(g->emitters, eye, n, texels[i], g->emit + 4 * i);
+        }
+    }
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->emit_buf);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * 4 * count), g->emit);
+}
+
 static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t count)
 {
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->targets_buf);
@@ -515,6 +550,7 @@ static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t
     glBindImageTexture(0, iim_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->weights_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g->targets_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, g->emit_buf);
     glUniform1i(glGetUniformLocation(g->reduce_prog, "count"), (GLint)count);
     glDispatchCompute((count + 7) / 8, 1, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
@@ -543,6 +579,8 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     for (uint32_t first = 0; first < count; first += per_pass, passes++) {
         uint32_t n = count - first < per_pass ? count - first : per_pass;
         render_tiles(g, s, a, texels + first, n, xy);
+        if (g->emitters)
+            emitter_irradiance(g, s, a, texels + first, n);
         reduce_tiles(g, iim_tex, xy, n);
     }
     clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);

@@ -120,6 +120,7 @@ static const char *REDUCE_CS =
     "layout(binding = 0, rgba32f) uniform writeonly image2D iim;\n"
     "layout(std430, binding = 0) readonly buffer Weights { float w[]; };\n"
     "layout(std430, binding = 1) readonly buffer Targets { ivec2 xy[]; };\n"
+    "layout(std430, binding = 3) readonly buffer Emitters { vec4 emit[]; }; /* closed-form emitter E */\n"
     "uniform int R;\n"
     "uniform int tiles_x;\n"
     "uniform int count;\n"
@@ -139,7 +140,7 @@ static const char *REDUCE_CS =
     "        for (int x = 0; x < R; x++)\n"
     "            s += w[y * R + x] * texelFetch(tiles, origin + ivec2(x, y), 0);\n"
     "#endif\n"
-    "    imageStore(iim, xy[tile], vec4(scale * s.rgb, inv_f * s.a));\n"
+    "    imageStore(iim, xy[tile], vec4(scale * s.rgb + emit[tile].rgb, inv_f * s.a));\n"
     "}\n";
 
 /* "#version", the scheme's and sample count's defines and extension, then the body. Returns 0 if it

@@ -18,6 +18,9 @@ struct lm_frame_loop {
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
     int have_iim;
+    lm_rt *rt;
+    lm_emitter_light emitters; /* with have_emitters: the gather's closed-form emitter light */
+    int have_emitters;
     uint32_t *texels;      /* scratch: this frame's scheduled texels (atlas texel_count) */
     float *image;
     int aim_stale;         /* the AIM changed since the gather last uploaded it */
@@ -29,6 +32,8 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     lm_photon_stage_settings_default(&s->stage);
     lm_hemicube_settings_default(&s->gather);
     s->gather.coverage_samples = 0; /* chosen per scene */
+    s->emitter_light = -1;
+    s->emitter_rays = LM_EMITTER_LIGHT_DEFAULT_RAYS;
     lm_iim_settings_default(&s->iim);
     lm_direct_settings_default(&s->direct);
     s->width = 512;
@@ -73,14 +78,33 @@ static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
     return LM_OK;
 }
 
+/* The closed-form emitter light when the settings (or, on auto, the scene) call for it; the gather's
+ * coverage samples when on auto: none needed with it, else as the scene's emitters need. */
+static lm_status setup_emitters(lm_frame_loop *fl, lm_error *err)
+{
+    int closed_form = fl->set.emitter_light < 0 ? lm_emitter_light_suits(fl->scene) : fl->set.emitter_light;
+    closed_form = closed_form && lm_emissive_triangle_count(fl->scene) > 0;
+    if (fl->set.gather.coverage_samples == 0)
+        fl->set.gather.coverage_samples =
+            fl->set.gather.scheme == LM_GATHER_LAYERED ? 1 : lm_gather_coverage_for(fl->scene, closed_form);
+    fl->set.emitter_light = closed_form;
+    if (!closed_form)
+        return LM_OK;
+    lm_status st = lm_emitter_light_init(&fl->emitters, fl->scene, fl->rt, fl->set.emitter_rays, err);
+    fl->have_emitters = st == LM_OK;
+    return st;
+}
+
 /* GL context, gather, IIMs and composite; then every texel gathered and shown at once. */
 static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
 {
     lm_status st = lm_gl_context_create(&fl->gl, err);
-    if (fl->set.gather.coverage_samples == 0)
-        fl->set.gather.coverage_samples = fl->set.gather.scheme == LM_GATHER_LAYERED ? 1 : lm_gather_coverage_for(fl->scene);
+    if (st == LM_OK)
+        st = setup_emitters(fl, err);
     if (st == LM_OK)
         st = lm_gather_create(&fl->set.gather, &fl->gather, err);
+    if (st == LM_OK && fl->have_emitters)
+        lm_gather_set_emitter_light(fl->gather, &fl->emitters);
     if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK)
         fl->have_iim = 1;
     if (st == LM_OK)
@@ -112,6 +136,7 @@ lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atla
     fl->set = *set;
     fl->scene = s;
     fl->atlas = a;
+    fl->rt = rt;
     lm_status st = alloc_buffers(fl, err);
     if (st == LM_OK)
         st = lm_photon_stage_create(s, su, a, rt, &set->stage, &fl->stage, setup, err);
@@ -134,6 +159,8 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     if (fl->have_iim)
         lm_iim_free(&fl->iim);
     lm_gather_free(fl->gather);
+    if (fl->have_emitters)
+        lm_emitter_light_free(&fl->emitters);
     lm_gl_context_destroy(fl->gl);
     lm_photon_stage_free(fl->stage);
     free(fl->texels);

@@ -21,7 +21,12 @@
 
 typedef struct {
     lm_photon_stage_settings stage;
-    lm_hemicube_settings gather; /* coverage_samples 0 (the default here): lm_gather_coverage_for the scene */
+    lm_hemicube_settings gather; /* coverage_samples 0 (the default here): 1 with the closed-form emitter
+                                  * light, else lm_gather_coverage_for the scene */
+    int emitter_light;     /* emitters' light in the gather (trace/emitter_light.h): 1 closed form with sampled
+                            * visibility, 0 drawn into the hemicubes, -1 (default) closed form when
+                            * lm_emitter_light_suits the scene */
+    int emitter_rays;      /* shadow rays per emissive triangle and texel (default 32) */
     lm_iim_settings iim;
     lm_direct_settings direct;
     int width, height;     /* frame size (default 512 x 512) */
