@@ -1,6 +1,5 @@
-/* Indirect light of a frame and the final sum (composite.h): a premultiplied IIM x albedo atlas, then a
- * full-screen pass over the direct pass's lightmap uvs adding the direct light. Targets and programs
- * persist. */
+/* The indirect term of a frame's composite (composite.h): a premultiplied IIM x albedo atlas, rendered
+ * by one atlas-sized pass; the direct light's emission pass samples it. Target and program persist. */
 #include "composite.h"
 
 #include "gl_api.h"
@@ -13,14 +12,10 @@
 
 struct lm_composite {
     int width, height;   /* atlas */
-    float *albedo;       /* atlas-sized RGBA: albedo / pi, a = 1 on covered texels */
-    GLuint albedo_tex, premult_prog, frame_prog, empty_vao;
+    GLuint albedo_tex, premult_prog, empty_vao;
     float limit;
-    GLint p_limit, p_albedo, p_iim, f_lit, f_direct, f_uv;
+    GLint p_limit, p_albedo, p_iim;
     lm_float_target lit; /* atlas-sized, linear filter: (albedo / pi * E * w, w), w = covered and valid */
-    lm_float_target target; /* the frame */
-    float *scratch;       /* read-back, width x height RGBA */
-    size_t scratch_px;
 };
 
 /* Per frame, per atlas texel: albedo / pi * E premultiplied by w = covered x valid (back-face fraction
@@ -44,19 +39,6 @@ static const char *PREMULT_FS =
     "    float w = al.a * (e.a <= limit ? 1.0 : 0.0);\n"
     "    frag = vec4(al.rgb * e.rgb * w, w);\n"
     "}\n";
-/* The frame, full screen: direct + the indirect light at each pixel's lightmap uv. */
-static const char *FRAME_FS =
-    "#version 450 core\n"
-    "uniform sampler2D lit, direct, uvs;\n"
-    "out vec4 frag;\n"
-    "void main() {\n"
-    "    ivec2 q = ivec2(gl_FragCoord.xy);\n"
-    "    vec2 uv = texelFetch(uvs, q, 0).xy;\n"
-    "    vec4 t = textureLod(lit, uv, 0.0);\n"
-    "    vec3 e = uv.x >= 0.0 && t.a > 0.0 ? t.rgb / t.a : vec3(0.0);\n"
-    "    frag = vec4(texelFetch(direct, q, 0).rgb + e, 1.0);\n"
-    "}\n";
-
 /* albedo / pi at each covered texel's centre (its triangle's material, texture at the interpolated UV). */
 static void fill_albedo(const lm_scene *s, const lm_atlas *a, float *out)
 {
@@ -95,30 +77,23 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
 {
     *out = NULL;
     lm_composite *c = calloc(1, sizeof *c);
-    if (c)
-        c->albedo = calloc(4 * (size_t)a->width * a->height, sizeof(float));
-    if (!c || !c->albedo) {
+    float *albedo = calloc(4 * (size_t)a->width * a->height, sizeof(float)); /* albedo / pi, a = covered */
+    if (!c || !albedo) {
         free(c);
+        free(albedo);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the albedo atlas", s->path);
     }
     c->width = a->width;
     c->height = a->height;
     c->limit = backface_limit;
-    fill_albedo(s, a, c->albedo);
-    c->albedo_tex = upload_rgba(a->width, a->height, c->albedo);
+    fill_albedo(s, a, albedo);
+    c->albedo_tex = upload_rgba(a->width, a->height, albedo);
+    free(albedo);
     lm_status st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
     if (st != LM_OK) {
         lm_composite_free(c);
         return st;
     }
-    st = lm_gl_program("composite_frame", PREMULT_VS, FRAME_FS, &c->frame_prog, err);
-    if (st != LM_OK) {
-        lm_composite_free(c);
-        return st;
-    }
-    c->f_lit = glGetUniformLocation(c->frame_prog, "lit");
-    c->f_direct = glGetUniformLocation(c->frame_prog, "direct");
-    c->f_uv = glGetUniformLocation(c->frame_prog, "uvs");
     glGenVertexArrays(1, &c->empty_vao);
     c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
     c->p_albedo = glGetUniformLocation(c->premult_prog, "albedo");
@@ -135,23 +110,10 @@ void lm_composite_free(lm_composite *c)
         glDeleteTextures(1, &c->albedo_tex);
     if (c->premult_prog)
         glDeleteProgram(c->premult_prog);
-    if (c->frame_prog)
-        glDeleteProgram(c->frame_prog);
     if (c->empty_vao)
         glDeleteVertexArrays(1, &c->empty_vao);
-    lm_float_target_free(&c->target);
     lm_float_target_free(&c->lit);
-    free(c->scratch);
-    free(c->albedo);
     free(c);
-}
-
-int lm_composite_albedo(const lm_composite *c, int x, int y, float out[3])
-{
-    const float *p = c->albedo + 4 * ((size_t)y * c->width + x);
-    for (int k = 0; k < 3; k++)
-        out[k] = p[k];
-    return p[3] > 0.0f;
 }
 
 /* The premultiplied atlas (c->lit, bound) from the display IIM. */
@@ -178,50 +140,13 @@ static void premultiply(const lm_composite *c, unsigned iim_tex)
     glActiveTexture(GL_TEXTURE0);
 }
 
-/* The scratch read-back buffer for width x height. */
-static lm_status scratch_for(lm_composite *c, int width, int height, lm_error *err)
+lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit_tex, lm_error *err)
 {
-    if (width <= 0 || height <= 0)
-        return lm_fail(err, LM_ERR_INVALID, "composite: bad size %dx%d", width, height);
-    size_t px = (size_t)width * (size_t)height;
-    if (px > c->scratch_px) {
-        free(c->scratch);
-        c->scratch = malloc(4 * px * sizeof(float));
-        c->scratch_px = c->scratch ? px : 0;
-        if (!c->scratch)
-            return lm_fail(err, LM_ERR_NOMEM, "composite: no memory to read back %dx%d", width, height);
-    }
-    return LM_OK;
-}
-
-lm_status lm_composite_frame(lm_composite *c, unsigned iim_tex, unsigned direct_tex, unsigned uv_tex, int width,
-                             int height, float *rgb, lm_error *err)
-{
-    lm_status st = scratch_for(c, width, height, err);
-    if (st == LM_OK)
-        st = lm_float_target_ensure(&c->lit, c->width, c->height, 1, err);
+    lm_status st = lm_float_target_ensure(&c->lit, c->width, c->height, 1, err);
     if (st != LM_OK)
         return st;
     premultiply(c, iim_tex);
-    st = lm_float_target_ensure(&c->target, width, height, 1, err);
-    if (st != LM_OK)
-        return st;
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    glUseProgram(c->frame_prog);
-    glUniform1i(c->f_lit, 1);
-    glUniform1i(c->f_direct, 3);
-    glUniform1i(c->f_uv, 4);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, c->lit.color[0]);
-    glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D, direct_tex);
-    glActiveTexture(GL_TEXTURE4);
-    glBindTexture(GL_TEXTURE_2D, uv_tex);
-    glBindVertexArray(c->empty_vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    glActiveTexture(GL_TEXTURE0);
-    lm_float_target_read_rgb(&c->target, 0, rgb, c->scratch);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    return lm_gl_check("composite", err);
+    *lit_tex = c->lit.color[0];
+    return lm_gl_check("composite: indirect", err);
 }

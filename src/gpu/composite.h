@@ -1,9 +1,12 @@
 /* The frame's composite (DESIGN.md step 7): linear RGB = direct + albedo / pi * E_IIM. albedo is per
  * lightmap texel (base colour factor x texture at the texel's centre, fixed at creation); E_IIM is the
- * displayed IIM texture. Both are sampled together with a bilinear filter that only weighs covered, valid
- * texels (back-face fraction <= the limit), so gutters and invalid texels never darken a chart's border.
- * Mirror and glass (no lightmap texels) and the background get no indirect light. Programs and targets
- * persist. */
+ * displayed IIM texture. This module makes the indirect term's texture: an atlas-sized RGBA32F of
+ * (albedo / pi * E * w, w), w = 1 on covered, valid texels (back-face fraction <= the limit), else 0,
+ * with a bilinear filter; sampled at a visible point's lightmap uv, rgb / a is then the filter over the
+ * four nearest texels that weighs only covered, valid ones, so gutters and invalid texels never darken a
+ * chart's border. The direct light's emission pass adds it (gpu/direct.h, lm_direct_set_indirect): the
+ * sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
+ * light. Program and target persist. */
 #ifndef LM_COMPOSITE_H
 #define LM_COMPOSITE_H
 
@@ -15,14 +18,8 @@ typedef struct lm_composite lm_composite;
 lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
                               lm_error *err);
 void lm_composite_free(lm_composite *c);
-/* The frame: rgb = direct + albedo / pi * E (iim_tex: atlas-sized RGBA32F, a = back-face fraction),
- * summed on the GPU by one full-screen pass and read back as one image (width*height*3 floats, row 0 at
- * the top). direct_tex and uv_tex: width x height RGBA32F textures of the direct light and of each
- * pixel's lightmap uv ((-1, -1) where none) — lm_direct_texture and lm_direct_uv_texture — so the
- * composite draws no geometry. */
-lm_status lm_composite_frame(lm_composite *c, unsigned iim_tex, unsigned direct_tex, unsigned uv_tex, int width,
-                             int height, float *rgb, lm_error *err);
-/* The albedo / pi of texel (x, y) (rgb) and whether it is covered (return 1). For tests. */
-int lm_composite_albedo(const lm_composite *c, int x, int y, float out[3]);
+/* The indirect term from iim_tex (atlas-sized RGBA32F, a = back-face fraction) into *lit_tex (owned by c,
+ * valid until the next call). One atlas-sized pass. */
+lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit_tex, lm_error *err);
 
 #endif

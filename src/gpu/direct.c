@@ -42,7 +42,7 @@ typedef struct {
 struct lm_direct {
     lm_direct_settings set;
     GLuint prog[3], emission; /* light programs per kind (point, spot, directional), emission program */
-    GLint e_view_proj;
+    GLint e_view_proj, e_lit, e_use_lit;
     uniforms u[3];
     lm_direct_mesh mesh;
     lm_shadow_renderer shadow;
@@ -52,7 +52,8 @@ struct lm_direct {
     unsigned long static_version;  /* bumped whenever a static shadow-casting node moves (an edit) */
     unsigned long dynamic_version; /* bumped whenever a dynamic shadow-casting node moves */
     long maps_rendered;
-    int keep_uv;            /* the target has attachment 1: lightmap uv */
+    int has_lightmap;       /* the mesh carries lightmap uvs (lm_direct_use_lightmap) */
+    unsigned indirect_tex;  /* the indirect term the emission pass adds (0: none) */
     float *scratch;         /* read-back, width x height RGBA */
     size_t scratch_px;
 };
@@ -117,7 +118,8 @@ static void set_view_uniforms(const lm_direct *d, int kind, const lm_view *view)
     glUniform1i(u->base_tex, 2);
 }
 
-/* Emission pass: clears, writes depth and the emitted radiance. */
+/* Emission pass: clears, writes depth and the emitted radiance, plus the indirect term at each visible
+ * surface's lightmap uv when one is set. */
 static void emission_pass(const lm_direct *d, const lm_view *view, int w, int h)
 {
     float vp[16];
@@ -130,12 +132,14 @@ static void emission_pass(const lm_direct *d, const lm_view *view, int w, int h)
     glDisable(GL_BLEND);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    if (d->keep_uv) {
-        const float none[4] = {-1.0f, -1.0f, 0.0f, 1.0f};
-        glClearBufferfv(GL_COLOR, 1, none);
-    }
     glUseProgram(d->emission);
     glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
+    int use_lit = d->has_lightmap && d->indirect_tex;
+    glUniform1i(d->e_use_lit, use_lit);
+    glUniform1i(d->e_lit, 3);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, use_lit ? d->indirect_tex : 0);
+    glActiveTexture(GL_TEXTURE0);
     lm_direct_mesh_draw(&d->mesh, 0);
 }
 
@@ -224,6 +228,8 @@ lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings
         st = lm_gl_program("direct_emission", lm_direct_emission_vs, lm_direct_emission_fs, &d->emission, err);
     if (st == LM_OK) {
         d->e_view_proj = glGetUniformLocation(d->emission, "view_proj");
+        d->e_lit = glGetUniformLocation(d->emission, "lit");
+        d->e_use_lit = glGetUniformLocation(d->emission, "use_lit");
         st = lm_shadow_renderer_create(&d->shadow, err);
     }
     if (st == LM_OK)
@@ -283,38 +289,29 @@ lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em,
     int moved = lm_direct_mesh_update(&d->mesh, s);
     d->static_version += (moved & LM_MESH_STATIC_CASTERS_MOVED) != 0;
     d->dynamic_version += (moved & LM_MESH_DYNAMIC_CASTERS_MOVED) != 0;
-    st = lm_float_target_ensure(&d->target, width, height, d->keep_uv ? 2 : 1, err);
+    st = lm_float_target_ensure(&d->target, width, height, 1, err);
     if (st != LM_OK)
         return st;
     emission_pass(d, view, width, height);
-    if (d->keep_uv) { /* the light passes add to attachment 0 only */
-        const GLenum light_only[2] = {GL_COLOR_ATTACHMENT0, GL_NONE};
-        glDrawBuffers(2, light_only);
-    }
     for (int i = 0; st == LM_OK && i < em->count; i++)
         if (em->e[i].kind != LM_EMIT_AREA)
             st = light_pass(d, s, &em->e[i], i, view, width, height, err);
-    if (d->keep_uv) {
-        static const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-        glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
-        glDrawBuffers(2, both);
-    }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return st;
 }
 
 unsigned lm_direct_texture(const lm_direct *d) { return d->target.color[0]; }
 
-unsigned lm_direct_uv_texture(const lm_direct *d) { return d->keep_uv ? d->target.color[1] : 0; }
-
-lm_status lm_direct_keep_lightmap_uv(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
+lm_status lm_direct_use_lightmap(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
     lm_direct_mesh_free(&d->mesh); /* rebuilt: corners on different charts need their own vertices */
     lm_status st = lm_direct_mesh_build(&d->mesh, s, a, err);
     if (st == LM_OK)
-        d->keep_uv = 1;
+        d->has_lightmap = 1;
     return st == LM_OK ? lm_gl_check("direct_light: lightmap uvs", err) : st;
 }
+
+void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
 

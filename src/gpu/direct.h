@@ -44,11 +44,13 @@ unsigned lm_direct_texture(const lm_direct *d);
 /* lm_direct_draw, then the image read back as RGB floats (row 0 at the top). */
 lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                            int height, float *rgb, lm_error *err);
-/* From now on each render also keeps, per pixel, the visible surface's lightmap uv in atlas a ((-1, -1)
- * where none: background, mirror, glass), for a composite that needs no geometry pass of its own. */
-lm_status lm_direct_keep_lightmap_uv(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err);
-/* That image of the last render: an RGBA32F texture (rg = uv), or 0 without lm_direct_keep_lightmap_uv. */
-unsigned lm_direct_uv_texture(const lm_direct *d);
+/* From now on the vertices carry their lightmap uv in atlas a, so that the emission pass can add the
+ * frame's indirect light (lm_direct_set_indirect). */
+lm_status lm_direct_use_lightmap(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err);
+/* The indirect term the emission pass adds at each visible surface's lightmap uv: the premultiplied atlas
+ * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs
+ * lm_direct_use_lightmap; surfaces without a chart (mirror, glass) and the background get none. */
+void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);
 /* Shadow maps rendered since creation (each cube map counts once), for tests and statistics. */
 long lm_direct_shadow_maps_rendered(const lm_direct *d);
 

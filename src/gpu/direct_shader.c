@@ -121,8 +121,9 @@ const char *const lm_direct_fs_body =
     "}\n";
 
 /* The emission pass alone: depth, and Le on the front side (or both sides when double-sided); the same
- * attributes and gl_Position as lm_direct_vs. Output 1 is the visible surface's lightmap uv (attribute 7)
- * for the composite, when the target has that attachment. */
+ * attributes and gl_Position as lm_direct_vs. With use_lit, also the composite's indirect term
+ * albedo / pi * E_IIM: the premultiplied atlas `lit` (gpu/composite.h) at the lightmap uv (attribute 7,
+ * -1 without a chart), rgb / a over the covered, valid texels of its bilinear footprint. */
 const char *const lm_direct_emission_vs =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"
@@ -144,9 +145,14 @@ const char *const lm_direct_emission_fs =
     "flat in vec3 v_em;\n"
     "flat in float v_two;\n"
     "in vec2 v_lm;\n"
-    "layout(location = 0) out vec4 frag;\n"
-    "layout(location = 1) out vec4 lightmap_uv;\n"
+    "uniform sampler2D lit;\n"
+    "uniform int use_lit;\n"
+    "out vec4 frag;\n"
     "void main() {\n"
-    "    frag = vec4(gl_FrontFacing || v_two > 0.5 ? v_em : vec3(0.0), 1.0);\n"
-    "    lightmap_uv = vec4(v_lm, 0.0, 1.0);\n"
+    "    vec3 c = gl_FrontFacing || v_two > 0.5 ? v_em : vec3(0.0);\n"
+    "    if (use_lit != 0 && v_lm.x >= 0.0) {\n"
+    "        vec4 t = textureLod(lit, v_lm, 0.0);\n"
+    "        if (t.a > 0.0) c += t.rgb / t.a;\n"
+    "    }\n"
+    "    frag = vec4(c, 1.0);\n"
     "}\n";

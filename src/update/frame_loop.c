@@ -112,7 +112,7 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     if (st == LM_OK)
         st = lm_direct_create(fl->scene, &fl->set.direct, &fl->direct_light, err);
     if (st == LM_OK)
-        st = lm_direct_keep_lightmap_uv(fl->direct_light, fl->scene, fl->atlas, err);
+        st = lm_direct_use_lightmap(fl->direct_light, fl->scene, fl->atlas, err);
     double t0 = lm_now();
     fl->aim_stale = 1;
     if (st == LM_OK)
@@ -168,22 +168,24 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     free(fl);
 }
 
-/* Direct light into its persistent target (shadow maps re-rendered only when stale; each pixel's lightmap
- * uv kept), then a full-screen composite adding albedo / pi * E_IIM on the GPU; only the sum is read back. */
+/* The composite's indirect term (albedo / pi * E_IIM, premultiplied over the atlas), then the direct
+ * light, whose emission pass adds that term at each visible surface's lightmap uv (shadow maps
+ * re-rendered only when stale): one frame-sized read-back. */
 static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
     lm_scene_update_bounds(fl->scene);
     lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
     double t0 = lm_now();
-    lm_status st = lm_direct_draw(fl->direct_light, fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w,
-                                  h, err);
+    unsigned lit = 0;
+    lm_status st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
     double t1 = lm_now();
+    lm_direct_set_indirect(fl->direct_light, lit);
     if (st == LM_OK)
-        st = lm_composite_frame(fl->comp, fl->iim.display_tex, lm_direct_texture(fl->direct_light),
-                                lm_direct_uv_texture(fl->direct_light), w, h, fl->image, err);
-    o->t_direct = t1 - t0;
-    o->t_composite = lm_now() - t1;
+        st = lm_direct_render(fl->direct_light, fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w, h,
+                              fl->image, err);
+    o->t_composite = t1 - t0;
+    o->t_direct = lm_now() - t1;
     return st;
 }
 

@@ -4,8 +4,9 @@
  *   1. photon stage (photon_stage.h): animations, photons re-traced, AIMs refreshed;
  *   2. IIMs (gpu/iim.h, gpu/hemicube.h): up to texels_per_frame texels scheduled by delta_i, gathered
  *      over the current AIMs and node transforms into the fresh IIM, then blended into the display IIM;
- *   3. direct light per pixel with shadows (gpu/direct.h);
- *   4. composite in linear HDR: L = direct + albedo / pi * E_IIM (gpu/composite.h), mirror and glass black.
+ *   3. composite in linear HDR, L = direct + albedo / pi * E_IIM: the indirect term premultiplied over the
+ *      atlas (gpu/composite.h), added by the direct light's emission pass at each visible surface's
+ *      lightmap uv, then the direct light per pixel with shadows (gpu/direct.h); mirror and glass black.
  *
  * Initial state (lm_frame_loop_create): a full photon trace, every AIM, and a full gather of every texel
  * shown at once, so the first frame is already converged. The loop owns its GL context (current on the
@@ -40,7 +41,8 @@ typedef struct {
     lm_photon_stage_frame stage;
     uint32_t texels_gathered;
     /* seconds per stage: photon stage (animate + photons + AIMs), IIM gather (schedule, scene and AIM
-     * upload, hemicubes), blend, direct light, composite; and the whole frame */
+     * upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps, the frame's
+     * read-back), composite (the indirect term's atlas pass); and the whole frame */
     double t_photons, t_gather, t_blend, t_direct, t_composite, t_total;
 } lm_frame_stats;
 
