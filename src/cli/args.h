@@ -42,6 +42,7 @@ typedef struct {
     int gather_scheme;      /* --gather-scheme viewports|instanced|layered (-1 = default) */
     int emitter_light;      /* --emitter-light closed|drawn: 1, 0 (-1 = per scene) */
     int emitter_rays;       /* --emitter-rays N: shadow rays per emissive triangle and texel */
+    int in_order;           /* --in-order: photon stage before the gather, one thread (no overlap) */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
 } lm_cli_args;
 

@@ -52,6 +52,7 @@ static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
     if (a->gather_scheme >= 0)
         s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
     s->emitter_light = a->emitter_light;
+    s->overlap = !a->in_order;
     if (a->emitter_rays)
         s->emitter_rays = a->emitter_rays;
     if (a->hemicube_coverage)

@@ -6,6 +6,7 @@
 #include "../core/timing.h"
 #include "../gpu/composite.h"
 #include "../gpu/gl_context.h"
+#include "stage_worker.h"
 
 struct lm_frame_loop {
     lm_frame_loop_settings set;
@@ -13,6 +14,7 @@ struct lm_frame_loop {
     const lm_atlas *atlas;
     lm_gl_context *gl;
     lm_photon_stage *stage;
+    lm_stage_worker *worker; /* with settings.overlap: runs the stage's update beside the GL work */
     lm_gather *gather;
     lm_composite *comp;
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
@@ -33,6 +35,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     lm_hemicube_settings_default(&s->gather);
     s->gather.coverage_samples = 0; /* chosen per scene */
     s->emitter_light = -1;
+    s->overlap = 1;
     s->emitter_rays = LM_EMITTER_LIGHT_DEFAULT_RAYS;
     lm_iim_settings_default(&s->iim);
     lm_direct_settings_default(&s->direct);
@@ -46,17 +49,22 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
 static lm_photon_store *store_of(lm_frame_loop *fl) { return lm_photon_stage_store(fl->stage); }
 
-/* Uploads the current scene (and the AIMs when they changed since the last upload) and gathers `count`
- * scheduled texels into the fresh IIM. */
-static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
+/* Uploads the current scene and, when they changed since the last upload, the AIMs: all the gather reads
+ * of the photon stage, so that the stage may run on beside the gather once this returns. */
+static lm_status gather_prepare(lm_frame_loop *fl, lm_error *err)
 {
-    if (count == 0)
-        return LM_OK;
     lm_status st = lm_gather_set_scene(fl->gather, fl->scene, fl->atlas, err);
     if (st == LM_OK && fl->aim_stale)
         st = lm_gather_set_aim(fl->gather, fl->atlas, lm_aim_rgb(lm_photon_stage_aim(fl->stage)), err);
     if (st == LM_OK)
         fl->aim_stale = 0;
+    return st;
+}
+
+/* Gathers `count` scheduled texels into the fresh IIM. */
+static lm_status gather_run(lm_frame_loop *fl, uint32_t count, lm_error *err)
+{
+    lm_status st = LM_OK;
     /* in chunks of 16 passes when someone watches (the first full gather), else all at once */
     uint32_t chunk = fl->set.progress ? 16u * (uint32_t)(fl->set.gather.tiles * fl->set.gather.tiles) : count;
     for (uint32_t done = 0; st == LM_OK && done < count; done += chunk) {
@@ -66,6 +74,14 @@ static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
             fl->set.progress(fl->set.progress_user, done + n, count);
     }
     return st;
+}
+
+static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
+{
+    if (count == 0)
+        return LM_OK;
+    lm_status st = gather_prepare(fl, err);
+    return st == LM_OK ? gather_run(fl, count, err) : st;
 }
 
 static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
@@ -142,6 +158,8 @@ lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atla
         st = lm_photon_stage_create(s, su, a, rt, &set->stage, &fl->stage, setup, err);
     if (st == LM_OK)
         st = setup_gpu(fl, t_setup_gather, err);
+    if (st == LM_OK && fl->set.overlap)
+        st = lm_stage_worker_start(fl->stage, &fl->worker, err);
     if (st != LM_OK) {
         lm_frame_loop_free(fl);
         return st;
@@ -154,6 +172,7 @@ void lm_frame_loop_free(lm_frame_loop *fl)
 {
     if (!fl)
         return;
+    lm_stage_worker_stop(fl->worker);
     lm_direct_free(fl->direct_light);
     lm_composite_free(fl->comp);
     if (fl->have_iim)
@@ -189,28 +208,76 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     return st;
 }
 
-lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err)
+/* The paper's order: photon stage, then the gather over its fresh AIMs, blend, render. */
+static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
-    lm_frame_stats o;
-    memset(&o, 0, sizeof o);
     double t0 = lm_now();
-    lm_status st = lm_photon_stage_step(fl->stage, t, &o.stage, err);
-    if (o.stage.aim.surfaces_refreshed > 0)
+    lm_status st = lm_photon_stage_step(fl->stage, t, &o->stage, err);
+    if (o->stage.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
     double t1 = lm_now();
     if (st == LM_OK) {
-        o.texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
-        st = gather(fl, o.texels_gathered, err);
+        o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
+        st = gather(fl, o->texels_gathered, err);
     }
     double t2 = lm_now();
     if (st == LM_OK)
         st = lm_iim_blend(&fl->iim, 0, err);
     double t3 = lm_now();
     if (st == LM_OK)
-        st = render(fl, &o, err);
-    o.t_photons = t1 - t0;
-    o.t_gather = t2 - t1;
-    o.t_blend = t3 - t2;
+        st = render(fl, o, err);
+    o->t_photons = t1 - t0;
+    o->t_gather = t2 - t1;
+    o->t_blend = t3 - t2;
+    return st;
+}
+
+/* Overlapped: animate, schedule and upload what the gather needs, then the photon stage's tracing and
+ * AIM refresh run on the worker while this thread gathers, blends and renders. The gather therefore sees
+ * the AIMs and delta_i of the previous frame's stage (one frame later than in order; the IIM blends over
+ * several frames anyway). Every result depends only on that fixed order, not on timing. */
+static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
+{
+    double t0 = lm_now();
+    lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
+    if (st == LM_OK) {
+        o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
+        if (o->texels_gathered > 0)
+            st = gather_prepare(fl, err);
+    }
+    double t1 = lm_now();
+    if (st != LM_OK)
+        return st;
+    lm_stage_worker_begin(fl->worker, &o->stage);
+    st = gather_run(fl, o->texels_gathered, err);
+    double t2 = lm_now();
+    if (st == LM_OK)
+        st = lm_iim_blend(&fl->iim, 0, err);
+    double t3 = lm_now();
+    if (st == LM_OK)
+        st = render(fl, o, err);
+    double t4 = lm_now();
+    lm_error worker_err;
+    lm_status ws = lm_stage_worker_end(fl->worker, &worker_err);
+    if (ws != LM_OK && st == LM_OK) {
+        st = ws;
+        if (err)
+            *err = worker_err;
+    }
+    if (o->stage.aim.surfaces_refreshed > 0)
+        fl->aim_stale = 1;
+    o->t_photons = (t1 - t0) + (lm_now() - t4); /* what the frame spent on or waiting for the stage */
+    o->t_gather = t2 - t1;
+    o->t_blend = t3 - t2;
+    return st;
+}
+
+lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err)
+{
+    lm_frame_stats o;
+    memset(&o, 0, sizeof o);
+    double t0 = lm_now();
+    lm_status st = fl->worker ? step_overlapped(fl, t, &o, err) : step_in_order(fl, t, &o, err);
     o.t_total = lm_now() - t0;
     if (out)
         *out = o;

@@ -8,6 +8,9 @@
  *      atlas (gpu/composite.h), added by the direct light's emission pass at each visible surface's
  *      lightmap uv, then the direct light per pixel with shadows (gpu/direct.h); mirror and glass black.
  *
+ * With `overlap` (the default), step 1's tracing and AIM refresh run on a second thread while the calling
+ * thread does steps 2 and 3 over the previous frame's AIMs (docs/architecture.md).
+ *
  * Initial state (lm_frame_loop_create): a full photon trace, every AIM, and a full gather of every texel
  * shown at once, so the first frame is already converged. The loop owns its GL context (current on the
  * creating thread). */
@@ -28,6 +31,9 @@ typedef struct {
                             * visibility, 0 drawn into the hemicubes, -1 (default) closed form when
                             * lm_emitter_light_suits the scene */
     int emitter_rays;      /* shadow rays per emissive triangle and texel (default 32) */
+    int overlap;           /* 1 (default): the photon stage's tracing and AIM refresh run on a second thread
+                            * beside the gather and render, which then see the previous frame's AIMs and
+                            * delta_i; 0: the paper's order, all on the calling thread */
     lm_iim_settings iim;
     lm_direct_settings direct;
     int width, height;     /* frame size (default 512 x 512) */

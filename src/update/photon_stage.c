@@ -128,7 +128,7 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps);
 }
 
-lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err)
+lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err)
 {
     memset(out, 0, sizeof *out);
     out->frame = ps->frame++;
@@ -142,19 +142,30 @@ lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_fra
     }
     lm_emitters_update(&ps->emitters, ps->scene);
     lm_status st = check_emitters(ps, &out->emitters_moved, err);
+    out->t_animate = lm_now() - t0;
+    out->t_total = out->t_animate;
+    return st;
+}
+
+lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
+{
     double t1 = lm_now();
-    if (st == LM_OK)
-        st = lm_photons_frame(ps->photons, &out->photons, err);
+    lm_status st = lm_photons_frame(ps->photons, &out->photons, err);
     double t2 = lm_now();
     if (st == LM_OK)
         st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
                             ps->set.surfaces_per_frame, &out->aim, err);
     double t3 = lm_now();
-    out->t_animate = t1 - t0;
     out->t_photons = t2 - t1;
     out->t_aim = t3 - t2;
-    out->t_total = t3 - t0;
+    out->t_total = out->t_animate + (t3 - t1);
     return st;
+}
+
+lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err)
+{
+    lm_status st = lm_photon_stage_animate(ps, t, out, err);
+    return st == LM_OK ? lm_photon_stage_update(ps, out, err) : st;
 }
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }

@@ -33,8 +33,16 @@ lm_status lm_photon_stage_create(lm_scene *s, const lm_surfaces *su, const lm_at
                                  const lm_photon_stage_settings *set, lm_photon_stage **out,
                                  lm_photon_stage_frame *setup, lm_error *err);
 void lm_photon_stage_free(lm_photon_stage *ps);
-/* One frame at animation time t (every animation evaluated; t is clamped to each one's range). */
+/* One frame at animation time t (every animation evaluated; t is clamped to each one's range):
+ * lm_photon_stage_animate, then lm_photon_stage_update. */
 lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
+/* The first half: animations, node transforms (scene and BVH), emitters and the groups of moved lights
+ * marked invalid. */
+lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
+/* The second half: photons re-traced and AIMs refreshed (out: the frame lm_photon_stage_animate began).
+ * It reads the scene and BVH and writes only the stage's photons, store and AIM, so it may run on
+ * another thread beside rendering that only reads the scene (the frame loop's overlap). */
+lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err);
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */
