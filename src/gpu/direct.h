@@ -15,7 +15,8 @@
 typedef struct {
     int map_size;         /* 2D shadow maps (spot, directional), texels per side. Default 1024 */
     int cube_size;        /* point-light cube map, texels per face side. Default 512 */
-    int pcf_radius;       /* PCF taps: (2r+1)^2, 1 texel apart. Default 1 (3x3); 0 = hard shadows */
+    int pcf_radius;       /* PCF: (2r)^2 bilinear compare taps 1 texel apart (r = 0: one). Default 1: 4 taps over
+                           * 3 x 3 texels */
     float normal_offset;  /* receiver moved along its normal by this many texels. Default 1 */
     float slope_bias;     /* depth bias per texel and unit slope tan(theta), times (pcf_radius + 1). Default 1 */
     float max_slope;      /* tan(theta) is clamped here (theta near 90 degrees). Default 10 */

@@ -7,7 +7,6 @@
 #include "../core/vecmath.h"
 #include "gl_shader.h"
 
-#define NO_CASTER 1e30f /* metric where nothing occludes */
 
 static const char *VS =
     "#version 450 core\n"
@@ -16,19 +15,17 @@ static const char *VS =
     "out vec3 v_pos;\n"
     "void main() { v_pos = pos; gl_Position = vp * vec4(pos, 1.0); }\n";
 /* ortho: depth along dir from origin; else distance to origin. The depth test keeps the smallest
- * metric exactly (it is the depth), whatever the projection's depth precision. */
+ * metric exactly (it is the depth), whatever the projection's depth precision; there is no colour. */
 static const char *FS =
     "#version 450 core\n"
     "in vec3 v_pos;\n"
     "uniform vec3 origin, dir;\n"
     "uniform int ortho;\n"
     "uniform float range;\n"
-    "out vec4 frag;\n"
     "void main() {\n"
     "    vec3 d = v_pos - origin;\n"
     "    float m = ortho != 0 ? dot(d, dir) : length(d);\n"
     "    gl_FragDepth = clamp(m / range, 0.0, 1.0);\n"
-    "    frag = vec4(m, 0.0, 0.0, 1.0);\n"
     "}\n";
 
 static void ortho_proj(float m[16], float half, float zfar)
@@ -54,22 +51,29 @@ static float far_corner(const lm_scene *s, lm_vec3 p, float floor_)
     return best;
 }
 
-static GLuint make_texture(GLenum target, int size, GLenum format)
+/* A depth texture (cube or 2D). compare: sampled with hardware comparison and a linear filter (the map
+ * itself); else a plain copy source (the static layer). */
+static GLuint make_depth_texture(GLenum target, int size, int compare)
 {
-    GLenum ext = format == GL_R32F ? GL_RED : GL_DEPTH_COMPONENT;
     GLuint tex;
     glGenTextures(1, &tex);
     glBindTexture(target, tex);
     if (target == GL_TEXTURE_CUBE_MAP)
         for (int f = 0; f < 6; f++)
-            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, (GLint)format, size, size, 0, ext, GL_FLOAT, NULL);
+            glTexImage2D(GL_TEXTURE_CUBE_MAP_POSITIVE_X + f, 0, GL_DEPTH_COMPONENT32F, size, size, 0,
+                         GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
     else
-        glTexImage2D(target, 0, (GLint)format, size, size, 0, ext, GL_FLOAT, NULL);
-    glTexParameteri(target, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(target, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTexImage2D(target, 0, GL_DEPTH_COMPONENT32F, size, size, 0, GL_DEPTH_COMPONENT, GL_FLOAT, NULL);
+    GLint filter = compare ? GL_LINEAR : GL_NEAREST;
+    glTexParameteri(target, GL_TEXTURE_MIN_FILTER, filter);
+    glTexParameteri(target, GL_TEXTURE_MAG_FILTER, filter);
     glTexParameteri(target, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(target, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glTexParameteri(target, GL_TEXTURE_WRAP_R, GL_CLAMP_TO_EDGE);
+    if (compare) { /* lit where reference <= stored */
+        glTexParameteri(target, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        glTexParameteri(target, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+    }
     return tex;
 }
 
@@ -84,25 +88,16 @@ typedef struct {
 static void draw_face(const lm_shadow_map *m, const lm_shadow_renderer *r, GLenum face, const float vp[16],
                       const lm_gl_mesh *casters, const face_job *job)
 {
-    if (job->into_layer) {
-        glBindFramebuffer(GL_FRAMEBUFFER, m->layer_fbo);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, m->layer_tex, 0);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, face, m->layer_depth, 0);
-    } else {
-        glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, m->tex, 0);
-    }
+    glBindFramebuffer(GL_FRAMEBUFFER, job->into_layer ? m->layer_fbo : m->fbo);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, face, job->into_layer ? m->layer_tex : m->tex, 0);
     if (job->from_layer) {
         glBindFramebuffer(GL_READ_FRAMEBUFFER, m->layer_fbo);
-        glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, face, m->layer_tex, 0);
-        glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, face, m->layer_depth, 0);
+        glFramebufferTexture2D(GL_READ_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, face, m->layer_tex, 0);
         int n = m->p.size;
-        glBlitFramebuffer(0, 0, n, n, 0, 0, n, n, GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT, GL_NEAREST);
+        glBlitFramebuffer(0, 0, n, n, 0, 0, n, n, GL_DEPTH_BUFFER_BIT, GL_NEAREST);
         glBindFramebuffer(GL_READ_FRAMEBUFFER, m->fbo);
     } else {
-        const float clear[4] = {NO_CASTER, 0, 0, 1};
-        glClearBufferfv(GL_COLOR, 0, clear);
-        glClear(GL_DEPTH_BUFFER_BIT);
+        glClear(GL_DEPTH_BUFFER_BIT); /* depth 1: the range, where nothing occludes */
     }
     if (job->count > 0) {
         glUniformMatrix4fv(r->u_vp, 1, GL_FALSE, vp);
@@ -192,26 +187,31 @@ void lm_shadow_renderer_free(lm_shadow_renderer *r)
     memset(r, 0, sizeof *r);
 }
 
-/* The texture, framebuffer and depth buffer for parameters p, kept when kind and size are unchanged; with
- * `layer`, the static layer's too. */
+/* A depth-only framebuffer (no colour buffer is drawn or read). */
+static GLuint depth_only_fbo(void)
+{
+    GLuint fbo;
+    glGenFramebuffers(1, &fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glDrawBuffer(GL_NONE);
+    glReadBuffer(GL_NONE);
+    return fbo;
+}
+
+/* The texture and framebuffer for parameters p, kept when kind and size are unchanged; with `layer`, the
+ * static layer's too. */
 static void ensure_objects(lm_shadow_map *m, const lm_shadow_params *p, int layer)
 {
     GLenum target = p->cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D;
     if (m->tex && (m->p.cube != p->cube || m->p.size != p->size))
         lm_shadow_map_free(m);
     if (!m->tex) {
-        m->tex = make_texture(target, p->size, GL_R32F);
-        glGenFramebuffers(1, &m->fbo);
-        glGenRenderbuffers(1, &m->depth);
-        glBindRenderbuffer(GL_RENDERBUFFER, m->depth);
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, p->size, p->size);
-        glBindFramebuffer(GL_FRAMEBUFFER, m->fbo);
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, m->depth);
+        m->tex = make_depth_texture(target, p->size, 1);
+        m->fbo = depth_only_fbo();
     }
     if (layer && !m->layer_tex) {
-        m->layer_tex = make_texture(target, p->size, GL_R32F);
-        m->layer_depth = make_texture(target, p->size, GL_DEPTH_COMPONENT32F);
-        glGenFramebuffers(1, &m->layer_fbo);
+        m->layer_tex = make_depth_texture(target, p->size, 0);
+        m->layer_fbo = depth_only_fbo();
         m->layer_valid = 0;
     }
 }
@@ -270,12 +270,8 @@ void lm_shadow_map_free(lm_shadow_map *m)
         glDeleteTextures(1, &m->tex);
     if (m->fbo)
         glDeleteFramebuffers(1, &m->fbo);
-    if (m->depth)
-        glDeleteRenderbuffers(1, &m->depth);
     if (m->layer_tex)
         glDeleteTextures(1, &m->layer_tex);
-    if (m->layer_depth)
-        glDeleteTextures(1, &m->layer_depth);
     if (m->layer_fbo)
         glDeleteFramebuffers(1, &m->layer_fbo);
     memset(m, 0, sizeof *m);

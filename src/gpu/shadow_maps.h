@@ -1,7 +1,10 @@
 /* Shadow maps for the punctual lights (docs/direct.md): a cube map for a point light, a 2D perspective
  * map for a spot light (its cone = the outer angle) and an orthographic map fitted to the scene's bounds
- * for a directional light. Each texel holds a float distance metric of the nearest caster: the distance
- * to the light (point, spot) or the depth along the light's direction (directional). */
+ * for a directional light. Each texel holds a float distance metric of the nearest caster, divided by the
+ * map's range: the distance to the light (point, spot) or the depth along the light's direction
+ * (directional). The maps are DEPTH_COMPONENT32F textures with hardware comparison and a linear filter,
+ * so one lookup with a reference metric / range returns the lit fraction of the 2 x 2 texels around it
+ * (bilinear PCF). */
 #ifndef LM_SHADOW_MAPS_H
 #define LM_SHADOW_MAPS_H
 
@@ -26,13 +29,13 @@ typedef struct {
 } lm_shadow_params;
 
 /* A map and its GL objects, kept between renders (zero-initialise; lm_shadow_map_free releases). When the
- * casters are split into static and dynamic ones, the static casters' map (colour and depth) is kept as
- * a layer: a render that only has to redo the dynamic casters copies the layer and draws them on top. */
+ * casters are split into static and dynamic ones, the static casters' map is kept as a layer: a render
+ * that only has to redo the dynamic casters copies the layer and draws them on top. */
 typedef struct {
     lm_shadow_params p;   /* what the texture was last rendered from (valid when tex != 0) */
-    unsigned tex;         /* GL_R32F texture (cube or 2D) */
-    unsigned fbo, depth;  /* its framebuffer and DEPTH_COMPONENT32F renderbuffer */
-    unsigned layer_tex, layer_depth, layer_fbo; /* static layer: R32F and DEPTH_COMPONENT32F textures */
+    unsigned tex;         /* DEPTH_COMPONENT32F texture (cube or 2D), compare mode LEQUAL, linear */
+    unsigned fbo;         /* its framebuffer (depth only) */
+    unsigned layer_tex, layer_fbo; /* static layer: DEPTH_COMPONENT32F texture and framebuffer */
     int layer_valid;      /* the layer holds the static casters under parameters p */
 } lm_shadow_map;
 
