@@ -213,10 +213,12 @@ static inline void descend(const lm_kdtree *t, const float q[3], frame *f, frame
 /* ---------- N nearest ---------- */
 
 /* Candidates are keys (bits of d2 << 32 | index): d2 >= 0, so the keys order by distance, then index.
- * N <= KNN_FAST (the common case) keeps them in an unsorted buffer: leaf points within the bound are
- * appended without branches, and when 2N have gathered a selection (quickselect with branch-free
- * partitioning) keeps the N smallest and the N-th becomes the bound. Larger N use a max-heap of N in
- * the caller's arrays. */
+ * N <= KNN_FAST (the common case) keeps them in a buffer in the order the search meets them: leaf points
+ * within the bound are appended without branches, and when 2N have gathered, the N-th smallest is
+ * selected (quickselect with branch-free partitioning, on a copy) and becomes the bound, and the buffer
+ * keeps the keys up to it, in order. So the answer lists the N nearest in the search's leaf order (nearer
+ * side first), which depends only on the tree and the query, not on the bound the search started with.
+ * Larger N use a max-heap of N in the caller's arrays. */
 #define KNN_FAST 256u
 #define KNN_BUFFER (2 * KNN_FAST + LEAF)
 
@@ -280,22 +282,55 @@ static uint32_t median3_at(const uint64_t *a, uint32_t lo, uint32_t mid, uint32_
     return x < z ? lo : y < z ? hi : mid;
 }
 
-/* Rearranges the distinct keys a[0, count) so that a[0, n) are the n smallest (n < count). */
-static void select_smallest(uint64_t *a, uint32_t count, uint32_t n)
+/* The k-th smallest (from 0) of the distinct keys a[0, m), k < m; rearranges them, using tmp (room for m). */
+static uint64_t nth_key(uint64_t *a, uint64_t *tmp, uint32_t m, uint32_t k)
 {
-    uint64_t tmp[KNN_BUFFER];
-    uint32_t lo = 0, hi = count;
-    while (lo < n && n < hi) {
+    uint32_t lo = 0, hi = m;
+    while (hi - lo > 1) {
         uint32_t p = median3_at(a, lo, lo + (hi - lo) / 2, hi - 1);
         uint64_t pivot = a[p];
         a[p] = a[hi - 1];
         uint32_t j = split_keys(a, tmp, lo, hi, pivot);
         memcpy(a + lo, tmp + lo, sizeof *a * (hi - lo));
-        if (n <= j)
+        if (k == j)
+            return pivot;
+        if (k < j)
             hi = j;
         else
             lo = j + 1;
     }
+    return a[lo];
+}
+
+/* The n-th smallest of the distinct keys a[0, count) (n <= count), a left as it is. Keys with distances
+ * below lo (a guess: 0 when none) are only counted, and the n-th is selected among the others when the
+ * count shows it is one of them, else among all. */
+static uint64_t nth_smallest(const uint64_t *a, uint32_t count, uint32_t n, float lo)
+{
+    uint64_t sel[KNN_BUFFER], tmp[KNN_BUFFER], lo_key = make_key(lo, 0);
+    uint32_t below = 0, m = 0;
+    for (uint32_t i = 0; i < count; i++) { /* written without a branch, kept when not below */
+        sel[m] = a[i];
+        m += a[i] >= lo_key;
+        below += a[i] < lo_key;
+    }
+    if (below >= n) {
+        memcpy(sel, a, sizeof *a * count);
+        m = count;
+        below = 0;
+    }
+    return nth_key(sel, tmp, m, n - 1 - below);
+}
+
+/* Keeps the keys of a[0, count) up to max, in order; returns how many. */
+static uint32_t keep_up_to(uint64_t *a, uint32_t count, uint64_t max)
+{
+    uint32_t w = 0;
+    for (uint32_t i = 0; i < count; i++) {
+        a[w] = a[i];
+        w += a[i] <= max;
+    }
+    return w;
 }
 
 /* Largest key of a[0, count). */
@@ -307,12 +342,12 @@ static uint64_t max_key(const uint64_t *a, uint32_t count)
     return m;
 }
 
-/* Keeps the n nearest candidates; the farthest of them becomes the bound. */
+/* Keeps the n nearest candidates (in order); the farthest of them becomes the bound. */
 static void buffer_shrink(knn *k)
 {
-    select_smallest(k->buf, k->count, k->n);
-    k->count = k->n;
-    set_bound(k, max_key(k->buf, k->n));
+    uint64_t nth = nth_smallest(k->buf, k->count, k->n, 0.0f);
+    k->count = keep_up_to(k->buf, k->count, nth);
+    set_bound(k, nth);
 }
 
 static void buffer_leaf(knn *k, const float d2[LEAF], const uint32_t *idx, uint32_t m)
@@ -417,26 +452,61 @@ uint32_t lm_kdtree_nearest(const lm_kdtree *t, const float q[3], uint32_t n, uin
     return lm_kdtree_nearest_within(t, q, n, INFINITY, out_index, out_d2, r2);
 }
 
-uint32_t lm_kdtree_nearest_within(const lm_kdtree *t, const float q[3], uint32_t n, float max_d2,
-                                  uint32_t *out_index, float *out_d2, float *r2)
+/* The search with the candidates' bound at max_d2; lo_d2 is a guess at a squared distance below the n-th
+ * (0: none), which only speeds up the selection. */
+static uint32_t nearest_between(const lm_kdtree *t, const float q[3], uint32_t n, float lo_d2, float max_d2,
+                                uint32_t *out_index, float *out_d2, float *r2)
 {
     uint64_t buf[KNN_BUFFER];
     uint32_t top = max_d2 < INFINITY ? float_bits(max_d2 > 0.0f ? max_d2 : 0.0f) : UINT32_MAX;
     knn k = {n <= KNN_FAST ? buf : NULL, out_index, out_d2, 0, n, 2 * n, top, max_d2};
     if (n > 0 && t->count > 0)
         knn_search(t, q, &k);
+    float far = 0.0f;
     if (k.buf) {
-        if (k.count > n)
-            select_smallest(buf, k.count, n);
-        k.count = k.count < n ? k.count : n;
-        for (uint32_t i = 0; i < k.count; i++) {
-            out_index[i] = (uint32_t)buf[i];
-            out_d2[i] = key_d2(buf[i]);
+        uint64_t last = k.count > n ? nth_smallest(buf, k.count, n, lo_d2) : max_key(buf, k.count);
+        uint32_t w = 0;
+        for (uint32_t i = 0; i < k.count && w < n; i++) { /* written without a branch, kept up to the n-th */
+            out_index[w] = (uint32_t)buf[i];
+            out_d2[w] = key_d2(buf[i]);
+            w += buf[i] <= last;
         }
+        k.count = w;
+        far = key_d2(last);
+    } else if (k.count) {
+        far = largest(out_d2, k.count);
     }
     if (r2)
-        *r2 = k.count ? largest(out_d2, k.count) : 0.0f;
+        *r2 = k.count ? far : 0.0f;
     return k.count;
+}
+
+uint32_t lm_kdtree_nearest_within(const lm_kdtree *t, const float q[3], uint32_t n, float max_d2,
+                                  uint32_t *out_index, float *out_d2, float *r2)
+{
+    return nearest_between(t, q, n, 0.0f, max_d2, out_index, out_d2, r2);
+}
+
+#define HINT_SLACK 1e-5 /* relative margin over the rounding of computed distances (a few float ulps) */
+
+uint32_t lm_kdtree_nearest_hinted(const lm_kdtree *t, lm_kdtree_hint *h, const float q[3], uint32_t n,
+                                  uint32_t *out_index, float *out_d2, float *r2)
+{
+    uint32_t k = 0, want = n < t->count ? n : t->count;
+    float found = 0.0f;
+    if (h->valid) { /* q's n-th distance is within the step from the last query of the last n-th distance */
+        double dx = (double)q[0] - h->q[0], dy = (double)q[1] - h->q[1], dz = (double)q[2] - h->q[2];
+        double step = sqrt(dx * dx + dy * dy + dz * dz), r = sqrt((double)h->r2);
+        double lo = (r - step) * (1.0 - HINT_SLACK), hi = (r + step) * (1.0 + HINT_SLACK);
+        k = nearest_between(t, q, n, lo > 0.0 ? (float)(lo * lo) : 0.0f, (float)(hi * hi), out_index, out_d2,
+                            &found);
+    }
+    if (k < want) /* no hint, or rounding left the bound short */
+        k = lm_kdtree_nearest(t, q, n, out_index, out_d2, &found);
+    *h = (lm_kdtree_hint){1, {q[0], q[1], q[2]}, found};
+    if (r2)
+        *r2 = found;
+    return k;
 }
 
 /* ---------- radius ---------- */

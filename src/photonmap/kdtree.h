@@ -44,8 +44,9 @@ void lm_kdtree_free(lm_kdtree *t);
 lm_status lm_kdtree_build(lm_kdtree *t, const float *points, size_t stride, uint32_t count, lm_error *err);
 
 /* The n nearest points to q (Euclidean). Writes min(n, count) indices and their squared distances to
- * out_index / out_d2 (caller's arrays of n entries, not in sorted order) and returns how many. *r2 (if
- * non-NULL) receives the squared distance of the farthest one returned (0 if none). Among points tied
+ * out_index / out_d2 (caller's arrays of n entries, not in sorted order: for n <= 256 in the search's
+ * leaf order, a function of the tree and q) and returns how many. *r2 (if non-NULL) receives the
+ * squared distance of the farthest one returned (0 if none). Among points tied
  * at the n-th distance, the lower caller's indices are returned, so the answer does not depend on the
  * tree's shape. No allocation. */
 uint32_t lm_kdtree_nearest(const lm_kdtree *t, const float q[3], uint32_t n, uint32_t *out_index, float *out_d2,
@@ -55,6 +56,19 @@ uint32_t lm_kdtree_nearest(const lm_kdtree *t, const float q[3], uint32_t n, uin
  * and then all of them): a bound known in advance (from a nearby query) spares the search. When it
  * returns n, the answer is exactly lm_kdtree_nearest's. */
 uint32_t lm_kdtree_nearest_within(const lm_kdtree *t, const float q[3], uint32_t n, float max_d2,
+                                  uint32_t *out_index, float *out_d2, float *r2);
+
+/* Runs of nearby queries (a row of texels): the last query and its n-th squared distance bound the next
+ * query's search (its n-th distance is within the step between them of the last one). */
+typedef struct {
+    int valid;                    /* 0: no last query (the next one searches unbounded) */
+    float q[3], r2;
+} lm_kdtree_hint;
+
+/* lm_kdtree_nearest's answer, searched with the hint, which then holds this query. For n <= 256 the
+ * answer is listed in the same order whatever the hint (the search's leaf order), so that sums over it
+ * are the same for any run of queries. */
+uint32_t lm_kdtree_nearest_hinted(const lm_kdtree *t, lm_kdtree_hint *h, const float q[3], uint32_t n,
                                   uint32_t *out_index, float *out_d2, float *r2);
 
 /* Calls visit(ctx, index, d2) for every point with squared distance d2 <= r2 from q, in a deterministic
