@@ -1,5 +1,5 @@
 /* The indirect term of a frame's composite (composite.h): a premultiplied IIM x albedo atlas, rendered
- * by one atlas-sized pass; the direct light's emission pass samples it. Target and program persist. */
+ * by one atlas-sized pass; the direct light's first pass samples it. Target and program persist. */
 #include "composite.h"
 
 #include "gl_api.h"

@@ -4,7 +4,7 @@
  * (albedo / pi * E * w, w), w = 1 on covered, valid texels (back-face fraction <= the limit), else 0,
  * with a bilinear filter; sampled at a visible point's lightmap uv, rgb / a is then the filter over the
  * four nearest texels that weighs only covered, valid ones, so gutters and invalid texels never darken a
- * chart's border. The direct light's emission pass adds it (gpu/direct.h, lm_direct_set_indirect): the
+ * chart's border. The direct light's first pass adds it (gpu/direct.h, lm_direct_set_indirect): the
  * sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
  * light. Program and target persist. */
 #ifndef LM_COMPOSITE_H

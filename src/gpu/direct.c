@@ -1,6 +1,7 @@
-/* Direct light per pixel (direct.h): an emission pass that also lays down depth, then per punctual light
- * its shadow map (cached) and an additive pass (depth test LEQUAL, no depth writes) into an RGBA32F
- * target. */
+/* Direct light per pixel (direct.h): every punctual light's shadow map (cached), then a first pass that
+ * lays down depth and writes the emitted radiance, the indirect term and the first punctual light, then
+ * one additive pass (depth test LEQUAL, no depth writes) per further light, into an RGBA32F target. A
+ * scene without punctual lights gets an emission-only first pass. */
 #include "direct.h"
 
 #include "gl_api.h"
@@ -28,9 +29,9 @@ void lm_direct_settings_default(lm_direct_settings *s)
 }
 
 typedef struct {
-    GLint pass_kind, lpos, ldir, radiant, origin, cos_outer, spot_width, texel, map_size, light_vp;
+    GLint lpos, ldir, radiant, origin, cos_outer, spot_width, texel, map_size, light_vp;
     GLint view_proj, eye, view_dir, ortho_view, normal_offset, slope_bias, max_slope, const_bias, range;
-    GLint map2d, mapcube, base_tex;
+    GLint map2d, mapcube, base_tex, lit, use_lit;
 } uniforms;
 
 /* One punctual light's map and the caster geometry versions it was rendered over. */
@@ -41,9 +42,10 @@ typedef struct {
 
 struct lm_direct {
     lm_direct_settings set;
-    GLuint prog[3], emission; /* light programs per kind (point, spot, directional), emission program */
+    GLuint prog[3], first[3], emission; /* per light kind (point, spot, directional): additive light program,
+                                         * first-pass program; the emission-only program */
     GLint e_view_proj, e_lit, e_use_lit;
-    uniforms u[3];
+    uniforms u[3], uf[3];
     lm_direct_mesh mesh;
     lm_shadow_renderer shadow;
     lm_float_target target;
@@ -53,7 +55,7 @@ struct lm_direct {
     unsigned long dynamic_version; /* bumped whenever a dynamic shadow-casting node moves */
     long maps_rendered;
     int has_lightmap;       /* the mesh carries lightmap uvs (lm_direct_use_lightmap) */
-    unsigned indirect_tex;  /* the indirect term the emission pass adds (0: none) */
+    unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
     float *scratch;         /* read-back, width x height RGBA */
     size_t scratch_px;
 };
@@ -61,26 +63,24 @@ struct lm_direct {
 static void find_uniforms(GLuint p, uniforms *u)
 {
 #define LOC(name) u->name = glGetUniformLocation(p, #name)
-    LOC(pass_kind); LOC(lpos); LOC(ldir); LOC(radiant); LOC(origin); LOC(cos_outer);
+    LOC(lpos); LOC(ldir); LOC(radiant); LOC(origin); LOC(cos_outer);
     LOC(spot_width); LOC(texel); LOC(map_size); LOC(light_vp); LOC(view_proj); LOC(eye); LOC(view_dir);
     LOC(ortho_view); LOC(normal_offset); LOC(slope_bias); LOC(max_slope); LOC(const_bias); LOC(range);
-    LOC(map2d); LOC(mapcube); LOC(base_tex);
+    LOC(map2d); LOC(mapcube); LOC(base_tex); LOC(lit); LOC(use_lit);
 #undef LOC
 }
 
 static int kind_of(const lm_emitter *e) { return e->kind == LM_EMIT_POINT ? 0 : e->kind == LM_EMIT_SPOT ? 1 : 2; }
 
-static void set_light_uniforms(const lm_direct *d, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)
+static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)
 {
     int kind = kind_of(e);
-    const uniforms *u = &d->u[kind];
     float cos_outer = -2.0f, width = 1.0f;
     if (kind == 1) { /* the same falloff as lm_spot_attenuation */
         const lm_light *l = &s->lights[e->light];
         cos_outer = cosf(l->outer_cone);
         width = fmaxf(1e-3f, cosf(l->inner_cone) - cos_outer);
     }
-    glUniform1i(u->pass_kind, 1);
     glUniform3fv(u->lpos, 1, e->pos);
     float ldir[3]; /* as the map's dir, which a cube map leaves 0 */
     lm_v3_store(ldir, lm_normalize(lm_v3_load(e->dir)));
@@ -97,9 +97,8 @@ static void set_light_uniforms(const lm_direct *d, const lm_scene *s, const lm_e
     glBindTexture(m->p.cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D, m->tex);
 }
 
-static void set_view_uniforms(const lm_direct *d, int kind, const lm_view *view)
+static void set_view_uniforms(const lm_direct *d, const uniforms *u, const lm_view *view)
 {
-    const uniforms *u = &d->u[kind];
     const lm_direct_settings *set = &d->set;
     float vp[16];
     lm_mat4_mul(vp, view->proj, view->view);
@@ -119,12 +118,22 @@ static void set_view_uniforms(const lm_direct *d, int kind, const lm_view *view)
     glUniform1i(u->base_tex, 2);
 }
 
-/* Emission pass: clears, writes depth and the emitted radiance, plus the indirect term at each visible
- * surface's lightmap uv when one is set. */
-static void emission_pass(const lm_direct *d, const lm_view *view, int w, int h)
+/* The indirect term's texture on unit 3 for a first-pass program (lit, use_lit: its uniforms). */
+static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit)
 {
-    float vp[16];
-    lm_mat4_mul(vp, view->proj, view->view);
+    int on = d->has_lightmap && d->indirect_tex;
+    glUniform1i(use_lit, on);
+    glUniform1i(lit, 3);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, on ? d->indirect_tex : 0);
+    glActiveTexture(GL_TEXTURE0);
+}
+
+/* The first pass: clears, writes depth, the emitted radiance and the indirect term at each visible
+ * surface's lightmap uv, and punctual emitter `light` (-1: none, an emission-only pass). */
+static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters *em, int light, const lm_view *view,
+                       int w, int h)
+{
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
@@ -133,15 +142,23 @@ static void emission_pass(const lm_direct *d, const lm_view *view, int w, int h)
     glDisable(GL_BLEND);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    glUseProgram(d->emission);
-    glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
-    int use_lit = d->has_lightmap && d->indirect_tex;
-    glUniform1i(d->e_use_lit, use_lit);
-    glUniform1i(d->e_lit, 3);
-    glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D, use_lit ? d->indirect_tex : 0);
-    glActiveTexture(GL_TEXTURE0);
-    lm_direct_mesh_draw(&d->mesh, 0);
+    if (light < 0) {
+        float vp[16];
+        lm_mat4_mul(vp, view->proj, view->view);
+        glUseProgram(d->emission);
+        glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
+        bind_indirect(d, d->e_lit, d->e_use_lit);
+        lm_direct_mesh_draw(&d->mesh, 0);
+        return;
+    }
+    const lm_emitter *e = &em->e[light];
+    const uniforms *u = &d->uf[kind_of(e)];
+    GLuint prog = d->first[kind_of(e)];
+    glUseProgram(prog);
+    set_view_uniforms(d, u, view);
+    set_light_uniforms(u, s, e, &d->maps[light].map);
+    bind_indirect(d, u->lit, u->use_lit);
+    lm_direct_mesh_draw(&d->mesh, prog);
 }
 
 /* Emitter i's shadow map, re-rendered only when stale. */
@@ -161,13 +178,10 @@ static lm_status shadow_map(lm_direct *d, const lm_scene *s, const lm_emitter *e
     return st;
 }
 
-/* One light: its shadow map, then an additive pass over the laid-down depth. */
+/* A further light: an additive pass over the laid-down depth (its shadow map is ready). */
 static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, const lm_view *view,
                             int w, int h, lm_error *err)
 {
-    lm_status st = shadow_map(d, s, e, i, err);
-    if (st != LM_OK)
-        return st;
     glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
@@ -177,25 +191,29 @@ static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e
     glBlendFunc(GL_ONE, GL_ONE);
     GLuint prog = d->prog[kind_of(e)];
     glUseProgram(prog);
-    set_view_uniforms(d, kind_of(e), view);
-    set_light_uniforms(d, s, e, &d->maps[i].map);
+    set_view_uniforms(d, &d->u[kind_of(e)], view);
+    set_light_uniforms(&d->u[kind_of(e)], s, e, &d->maps[i].map);
     lm_direct_mesh_draw(&d->mesh, prog);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     return lm_gl_check("direct_light: light pass", err);
 }
 
-/* The light program for one kind (0 point, 1 spot, 2 directional) and PCF radius. Compiling the two as
- * constants takes the branches on them out of every pixel: about 20% of the light pass on llvmpipe. */
-static lm_status light_program(int kind, int pcf, GLuint *prog, lm_error *err)
+/* The light program for one kind (0 point, 1 spot, 2 directional), PCF radius and pass (first or
+ * additive). Compiling them as constants takes the branches on them out of every pixel: about 20% of
+ * the light pass on llvmpipe. */
+static lm_status light_program(int kind, int pcf, int first, GLuint *prog, lm_error *err)
 {
-    size_t n = strlen(lm_direct_fs_body) + 96;
+    size_t n = strlen(lm_direct_fs_body) + 128;
     char *fs = malloc(n);
     if (!fs)
         return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory for shader source");
-    snprintf(fs, n, "#version 450 core\n#define KIND %d\n#define PCF %d\n%s", kind, pcf, lm_direct_fs_body);
-    static const char *names[3] = {"direct_light (point)", "direct_light (spot)", "direct_light (directional)"};
-    lm_status st = lm_gl_program(names[kind], lm_direct_vs, fs, prog, err);
+    snprintf(fs, n, "#version 450 core\n#define KIND %d\n#define PCF %d\n#define FIRST %d\n%s", kind, pcf, first,
+             lm_direct_fs_body);
+    static const char *names[2][3] = {
+        {"direct_light (point)", "direct_light (spot)", "direct_light (directional)"},
+        {"direct_light (point, first pass)", "direct_light (spot, first pass)", "direct_light (directional, first pass)"}};
+    lm_status st = lm_gl_program(names[first][kind], lm_direct_vs, fs, prog, err);
     free(fs);
     return st;
 }
@@ -222,9 +240,12 @@ lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings
                        bad.cube_size, bad.pcf_radius);
     }
     lm_status st = LM_OK;
-    for (int k = 0; st == LM_OK && k < 3; k++)
-        if ((st = light_program(k, d->set.pcf_radius, &d->prog[k], err)) == LM_OK)
+    for (int k = 0; st == LM_OK && k < 3; k++) {
+        if ((st = light_program(k, d->set.pcf_radius, 0, &d->prog[k], err)) == LM_OK)
             find_uniforms(d->prog[k], &d->u[k]);
+        if (st == LM_OK && (st = light_program(k, d->set.pcf_radius, 1, &d->first[k], err)) == LM_OK)
+            find_uniforms(d->first[k], &d->uf[k]);
+    }
     if (st == LM_OK)
         st = lm_gl_program("direct_emission", lm_direct_emission_vs, lm_direct_emission_fs, &d->emission, err);
     if (st == LM_OK) {
@@ -256,9 +277,12 @@ void lm_direct_free(lm_direct *d)
     if (d->mesh.first)
         lm_direct_mesh_free(&d->mesh);
     lm_shadow_renderer_free(&d->shadow);
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; k < 3; k++) {
         if (d->prog[k])
             glDeleteProgram(d->prog[k]);
+        if (d->first[k])
+            glDeleteProgram(d->first[k]);
+    }
     if (d->emission)
         glDeleteProgram(d->emission);
     free(d->scratch);
@@ -293,8 +317,17 @@ lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em,
     st = lm_float_target_ensure(&d->target, width, height, 1, err);
     if (st != LM_OK)
         return st;
-    emission_pass(d, view, width, height);
+    int first = -1;
     for (int i = 0; st == LM_OK && i < em->count; i++)
+        if (em->e[i].kind != LM_EMIT_AREA) {
+            st = shadow_map(d, s, &em->e[i], i, err);
+            first = first < 0 ? i : first;
+        }
+    if (st != LM_OK)
+        return st;
+    glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
+    first_pass(d, s, em, first, view, width, height);
+    for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
         if (em->e[i].kind != LM_EMIT_AREA)
             st = light_pass(d, s, &em->e[i], i, view, width, height, err);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -45,10 +45,10 @@ unsigned lm_direct_texture(const lm_direct *d);
 /* lm_direct_draw, then the image read back as RGB floats (row 0 at the top). */
 lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                            int height, float *rgb, lm_error *err);
-/* From now on the vertices carry their lightmap uv in atlas a, so that the emission pass can add the
+/* From now on the vertices carry their lightmap uv in atlas a, so that the first pass can add the
  * frame's indirect light (lm_direct_set_indirect). */
 lm_status lm_direct_use_lightmap(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err);
-/* The indirect term the emission pass adds at each visible surface's lightmap uv: the premultiplied atlas
+/* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs
  * lm_direct_use_lightmap; surfaces without a chart (mirror, glass) and the background get none. */
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);

@@ -13,18 +13,21 @@ const char *const lm_direct_vs =
     "layout(location = 3) in vec4 par;\n"
     "layout(location = 4) in vec3 em;\n"
     "layout(location = 5) in vec2 uv;\n"
+    "layout(location = 7) in vec2 lm_uv;\n"
     "uniform mat4 view_proj;\n"
     "out vec3 v_pos, v_ns;\n"
     "flat out vec3 v_base, v_em;\n"
     "flat out vec4 v_par;\n"
-    "out vec2 v_uv;\n"
+    "out vec2 v_uv, v_lm;\n"
     "invariant gl_Position;\n"
     "void main() {\n"
-    "    v_pos = pos; v_ns = ns; v_base = base; v_par = par; v_em = em; v_uv = uv;\n"
+    "    v_pos = pos; v_ns = ns; v_base = base; v_par = par; v_em = em; v_uv = uv; v_lm = lm_uv;\n"
     "    gl_Position = view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
-/* kind: 0 point, 1 spot, 2 directional. texel: world size of a shadow-map texel (directional) or its
+/* kind: 0 point, 1 spot, 2 directional. FIRST 1: the frame's first pass, which also writes depth and adds
+ * the emitted radiance and the indirect term (as lm_direct_emission_fs); FIRST 0: a further light, added
+ * over the laid-down depth. texel: world size of a shadow-map texel (directional) or its
  * size per unit distance (point, spot; divided by the cosine to the map's axis). The bias: the receiver
  * moves normal_offset texels along its normal, and its metric is lowered by
  * (const_bias + slope_bias (pcf + 1) min(tan theta, max_slope)) texels. */
@@ -32,8 +35,9 @@ const char *const lm_direct_fs_body =
     "in vec3 v_pos, v_ns;\n"
     "flat in vec3 v_base, v_em;\n"
     "flat in vec4 v_par;\n"
-    "in vec2 v_uv;\n"
-    "uniform int pass_kind, has_tex;\n"
+    "in vec2 v_uv, v_lm;\n"
+    "uniform int has_tex, use_lit;\n"
+    "uniform sampler2D lit;\n"
     "const int kind = KIND, pcf = PCF; /* compiled per light kind and PCF radius: no branch on them */\n"
     /* taps per axis: bilinear compare taps half a texel either side of each texel boundary, so radius 1
      * (4 lookups) covers the 3 x 3 texels a nearest-texel 3 x 3 PCF read, with tent weights */
@@ -120,11 +124,21 @@ const char *const lm_direct_fs_body =
     "    if (back) ns = -ns;\n"
     "    if (dot(ns, ng) < 0.0) ns = ng;\n"
     "    bool seen = !back || v_par.y > 0.5;\n"
-    "    vec3 c = pass_kind == 0 ? v_em : light(v_pos, ns, ng, V);\n"
+    "    vec3 c = light(v_pos, ns, ng, V);\n"
+    "#if FIRST\n"
+    "    c += v_em;\n"
+    "    vec3 e = vec3(0.0);\n"
+    "    if (use_lit != 0 && v_lm.x >= 0.0) {\n"
+    "        vec4 t = textureLod(lit, v_lm, 0.0);\n"
+    "        if (t.a > 0.0) e = t.rgb / t.a;\n"
+    "    }\n"
+    "    frag = vec4((seen ? c : vec3(0.0)) + e, 1.0);\n"
+    "#else\n"
     "    frag = vec4(seen ? c : vec3(0.0), 1.0);\n"
+    "#endif\n"
     "}\n";
 
-/* The emission pass alone: depth, and Le on the front side (or both sides when double-sided); the same
+/* The emission-only first pass (a scene without punctual lights): depth, and Le on the front side (or both sides when double-sided); the same
  * attributes and gl_Position as lm_direct_vs. With use_lit, also the composite's indirect term
  * albedo / pi * E_IIM: the premultiplied atlas `lit` (gpu/composite.h) at the lightmap uv (attribute 7,
  * -1 without a chart), rgb / a over the covered, valid texels of its bilinear footprint. */

@@ -188,7 +188,7 @@ void lm_frame_loop_free(lm_frame_loop *fl)
 }
 
 /* The composite's indirect term (albedo / pi * E_IIM, premultiplied over the atlas), then the direct
- * light, whose emission pass adds that term at each visible surface's lightmap uv (shadow maps
+ * light, whose first pass adds that term at each visible surface's lightmap uv (shadow maps
  * re-rendered only when stale): one frame-sized read-back. */
 static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {

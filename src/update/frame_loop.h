@@ -5,7 +5,7 @@
  *   2. IIMs (gpu/iim.h, gpu/hemicube.h): up to texels_per_frame texels scheduled by delta_i, gathered
  *      over the current AIMs and node transforms into the fresh IIM, then blended into the display IIM;
  *   3. composite in linear HDR, L = direct + albedo / pi * E_IIM: the indirect term premultiplied over the
- *      atlas (gpu/composite.h), added by the direct light's emission pass at each visible surface's
+ *      atlas (gpu/composite.h), added by the direct light's first pass at each visible surface's
  *      lightmap uv, then the direct light per pixel with shadows (gpu/direct.h); mirror and glass black.
  *
  * With `overlap` (the default), step 1's tracing and AIM refresh run on a second thread while the calling
