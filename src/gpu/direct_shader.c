@@ -138,8 +138,9 @@ const char *const lm_direct_fs_body =
     "#endif\n"
     "}\n";
 
-/* The emission-only first pass (a scene without punctual lights): depth, and Le on the front side (or both sides when double-sided); the same
- * attributes and gl_Position as lm_direct_vs. With use_lit, also the composite's indirect term
+/* The emission-only first pass (a scene without punctual lights): depth, and Le on the front side (or
+ * both sides when double-sided); the same attributes and gl_Position as lm_direct_vs. With use_lit, also
+ * the composite's indirect term
  * albedo / pi * E_IIM: the premultiplied atlas `lit` (gpu/composite.h) at the lightmap uv (attribute 7,
  * -1 without a chart), rgb / a over the covered, valid texels of its bilinear footprint. */
 const char *const lm_direct_emission_vs =
