@@ -73,7 +73,14 @@ int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n)
 {
     if (!grow(ps, ps->used + n))
         return 0;
-    lm_prefault(ps->hits + ps->used, sizeof *ps->hits * n); /* the batch's adds fill these next */
+    /* The batch's adds fill these next: fault them in at once, but only those never touched yet
+     * (after lm_photon_store_clear the slots stay mapped, and asking the kernel again for pages it
+     * already has walks the page tables for nothing, once per batch of a warm re-trace). */
+    uint32_t from = ps->used > ps->mapped ? ps->used : ps->mapped, to = ps->used + (uint32_t)n;
+    if (to > from) {
+        lm_prefault(ps->hits + from, sizeof *ps->hits * (to - from));
+        ps->mapped = to;
+    }
     return 1;
 }
 

@@ -37,6 +37,7 @@ typedef struct {
     lm_hit *hits;
     uint32_t capacity, used; /* slots allocated / in use */
     uint32_t free_head;      /* first free slot (chain through next), LM_NONE if none */
+    uint32_t mapped;         /* slots [0, mapped) are known to be paged in (lm_photon_store_reserve) */
     int surface_count;
     lm_surface_hits *surfaces;
 } lm_photon_store;

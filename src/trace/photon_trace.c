@@ -131,39 +131,68 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
     j->count = j->rays = j->stored = 0;
     if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) /* an emitter that emits nothing */
         return 1;
+    /* Counted in locals, written once: j lies in the batch's job array, beside other threads' jobs. */
+    uint32_t rays = 0, count = 0, stored = 0;
+    int ok = 1;
     for (uint32_t b = 0; b < ph->set.max_bounces; b++) {
         lm_rt_hit hit;
-        j->rays++;
+        rays++;
         if (!lm_rt_intersect(ph->rt, org, dir, 0.0f, INFINITY, &hit))
             break;
         lm_shading sh;
         lm_shading_from_hit(ph->scene, &hit, org, dir, &sh);
-        if (!push_vertex(buf, &sh, dir, flux, b))
-            return 0;
-        j->count++;
-        j->stored += buf->v[buf->len - 1].surface >= 0;
+        if (!push_vertex(buf, &sh, dir, flux, b)) {
+            ok = 0;
+            break;
+        }
+        count++;
+        stored += buf->v[buf->len - 1].surface >= 0;
         if (!scatter(ph, id, b, &sh, org, dir, flux))
             break;
     }
-    return 1;
+    j->count = count;
+    j->rays = rays;
+    j->stored = stored;
+    return ok;
 }
 
 void ph_batch_clear(ph_batch *b) { b->count = 0; }
 
+/* Room for n more jobs. 0: no memory. */
+static int batch_reserve(ph_batch *b, uint32_t n)
+{
+    if (b->count + n <= b->cap)
+        return 1;
+    uint32_t cap = b->cap ? b->cap : 1024;
+    while (cap < b->count + n)
+        cap *= 2;
+    ph_job *jobs = realloc(b->jobs, cap * sizeof *jobs);
+    if (!jobs)
+        return 0;
+    b->jobs = jobs;
+    b->cap = cap;
+    return 1;
+}
+
+static inline void batch_append(ph_batch *b, uint32_t group, uint32_t m)
+{
+    b->jobs[b->count++] = (ph_job){.group = group, .m = m};
+}
+
 int ph_batch_push(ph_batch *b, uint32_t group, uint32_t m)
 {
-    if (b->count == b->cap) {
-        uint32_t cap = b->cap ? b->cap * 2 : 1024;
-        ph_job *jobs = realloc(b->jobs, cap * sizeof *jobs);
-        if (!jobs)
-            return 0;
-        b->jobs = jobs;
-        b->cap = cap;
-    }
-    ph_job *j = &b->jobs[b->count++];
-    memset(j, 0, sizeof *j);
-    j->group = group;
-    j->m = m;
+    if (!batch_reserve(b, 1))
+        return 0;
+    batch_append(b, group, m);
+    return 1;
+}
+
+int ph_batch_push_group(ph_batch *b, uint32_t group, uint32_t photons)
+{
+    if (!batch_reserve(b, photons))
+        return 0;
+    for (uint32_t m = 0; m < photons; m++)
+        batch_append(b, group, m);
     return 1;
 }
 
@@ -194,34 +223,44 @@ static int ensure_buffers(ph_batch *b, int threads)
  * photon alone, so results are the same whatever thread ran it. */
 static void trace_jobs(const lm_photons *ph, ph_batch *b, int *failed)
 {
-    ph_buffer *buf = &b->buffers[omp_get_thread_num()];
-#pragma omp for schedule(dynamic, 16)
+    /* The thread's buffer is worked on in a local copy: the buffers' headers lie side by side, and a
+     * length written back per vertex made the threads fight over one cache line (false sharing). */
+    int t = omp_get_thread_num();
+    ph_buffer buf = b->buffers[t];
+#pragma omp for schedule(dynamic, 16) nowait
     for (long i = 0; i < (long)b->count; i++) {
         ph_job *j = &b->jobs[i];
-        j->buffer = (uint32_t)omp_get_thread_num();
-        j->first = (uint32_t)buf->len;
-        if (!ph_trace_photon(ph, j, buf)) {
+        j->buffer = (uint32_t)t;
+        j->first = (uint32_t)buf.len;
+        if (!ph_trace_photon(ph, j, &buf)) {
 #pragma omp atomic write
             *failed = 1;
         }
     }
+    b->buffers[t] = buf; /* before the barrier: after it, the calling thread applies the batch */
+#pragma omp barrier
 }
 
-/* Readies b for tracing by `threads` threads: one emptied vertex buffer each, and the emissive
- * triangles placed once for the batch unless there are more of them than photons. 0: no memory. */
-static int batch_prepare(lm_photons *ph, ph_batch *b, int threads)
+/* Area emitters' triangles placed once for a trace of `photons` photons, unless there are more of
+ * them than photons (each photon then places its own: the same bits either way). */
+static void place_emitters(lm_photons *ph, uint64_t photons)
+{
+    uint32_t etris = ph->emit_tri_first[ph->emitter_count];
+    ph->emit_placed = NULL;
+    if (etris && etris <= photons) {
+        for (uint32_t e = 0; e < ph->emitter_count; e++)
+            lm_emitter_place(ph->em, ph->scene, (int)e, ph->emit_tris + ph->emit_tri_first[e]);
+        ph->emit_placed = ph->emit_tris;
+    }
+}
+
+/* One emptied vertex buffer for each of `threads` threads. 0: no memory. */
+static int batch_buffers(ph_batch *b, int threads)
 {
     if (!ensure_buffers(b, threads))
         return 0;
     for (int t = 0; t < b->buffer_count; t++)
         b->buffers[t].len = 0;
-    uint32_t etris = ph->emit_tri_first[ph->emitter_count];
-    ph->emit_placed = NULL;
-    if (etris && etris <= b->count) {
-        for (uint32_t e = 0; e < ph->emitter_count; e++)
-            lm_emitter_place(ph->em, ph->scene, (int)e, ph->emit_tris + ph->emit_tri_first[e]);
-        ph->emit_placed = ph->emit_tris;
-    }
     return 1;
 }
 
@@ -245,8 +284,9 @@ static lm_status fail_traced(const ph_batch *b, lm_error *err)
 lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, lm_error *err)
 {
     int threads = omp_get_max_threads();
-    if (!batch_prepare(ph, b, threads))
+    if (!batch_buffers(b, threads))
         return fail_buffers(threads, err);
+    place_emitters(ph, b->count);
     int failed = 0;
 #pragma omp parallel num_threads(threads) if (b->count >= PH_PARALLEL_MIN_JOBS)
     {
@@ -259,53 +299,77 @@ lm_status ph_trace_batch(lm_photons *ph, ph_batch *b, lm_error *err)
     return LM_OK;
 }
 
+/* A re-trace of a list of groups, batch by batch (ph_trace_groups). */
+typedef struct {
+    const uint32_t *list;
+    uint32_t n, next;          /* the groups, and the next one to put in a batch */
+    int threads;
+    lm_photon_frame_stats *st;
+    lm_error *err;
+    lm_status status;          /* the first failure to fill or apply a batch */
+    int failed;                /* a thread ran out of memory tracing (set by any thread) */
+    ph_batch *last;            /* the batch traced last, applied after the parallel region */
+} ph_pipe;
+
+static lm_status apply_traced(lm_photons *ph, ph_batch *b, lm_photon_frame_stats *st, lm_error *err)
+{
+    batch_rays(b);
+    st->rays += b->rays;
+    return ph_apply_batch(ph, b, st, err);
+}
+
+/* The calling thread's turn before it joins a batch's trace: applies `done` (the batch traced
+ * before, NULL for none), then fills `next` with the following groups. Stops the pipeline by
+ * leaving `next` empty: when the list is used up or anything failed. */
+static void pipe_turn(lm_photons *ph, ph_pipe *p, ph_batch *done, ph_batch *next)
+{
+    int failed;
+#pragma omp atomic read
+    failed = p->failed;
+    if (done && !failed && p->status == LM_OK)
+        p->status = apply_traced(ph, done, p->st, p->err);
+    ph_batch_clear(next);
+    if (failed || p->status != LM_OK || p->next >= p->n)
+        return;
+    p->status = ph_fill_batch(ph, next, p->list, p->n, &p->next, p->st, p->err);
+    if (p->status == LM_OK && !batch_buffers(next, p->threads))
+        p->status = fail_buffers(p->threads, p->err);
+    if (p->status != LM_OK)
+        ph_batch_clear(next);
+}
+
 lm_status ph_trace_groups(lm_photons *ph, const uint32_t *list, uint32_t n, lm_photon_frame_stats *st,
                           lm_error *err)
 {
-    int threads = omp_get_max_threads();
+    ph_pipe p = {.list = list, .n = n, .threads = omp_get_max_threads(), .st = st, .err = err, .status = LM_OK};
     uint64_t total = 0;
     for (uint32_t i = 0; i < n; i++)
         total += ph->groups[list[i]].photons;
-    /* Shared by the team; written only inside `omp single` (or by the master's apply, which never
-     * runs beside a single), read by all after the single's barrier. */
-    ph_batch *b = NULL;
-    const ph_batch *done = NULL;
-    uint32_t next = 0;
-    int k = 0, failed = 0, stop = 0;
-    lm_status filled = LM_OK, applied = LM_OK;
-#pragma omp parallel num_threads(threads) if (total >= PH_PARALLEL_MIN_JOBS)
+    place_emitters(ph, total); /* before the team starts: tracing only reads them */
+    pipe_turn(ph, &p, NULL, &ph->batches[0]);
+    /* Batch i is traced from batches[i & 1] while the calling thread first applies batch i - 1 and
+     * refills its slot with batch i + 1. One barrier per batch (the end of its trace): each is a
+     * scheduler tick of waiting when a thread of the team has lost its core on a loaded machine.
+     * Every thread reads batch i's count only after the barrier that follows its filling, and the
+     * slot is not refilled before the next barrier, so all threads leave the loop together. */
+#pragma omp parallel num_threads(p.threads) if (total >= PH_PARALLEL_MIN_JOBS)
     {
         lm_rt_thread_init();
-        for (;;) {
-#pragma omp single
-            {
-                if (b) { /* the batch just traced is applied next, beside the tracing of the one after */
-                    batch_rays(b);
-                    st->rays += b->rays;
-                    done = b->count ? b : NULL;
-                    k ^= 1;
-                }
-                if (applied != LM_OK || failed || (next >= n && !done)) {
-                    stop = 1;
-                } else {
-                    b = &ph->batches[k];
-                    filled = ph_fill_batch(ph, b, list, n, &next, st, err);
-                    if (filled == LM_OK && !batch_prepare(ph, b, threads))
-                        filled = fail_buffers(threads, err);
-                    stop = filled != LM_OK;
-                }
-            }
-            if (stop)
-                break;
+        for (uint32_t i = 0; ph->batches[i & 1].count; i++) {
+            ph_batch *cur = &ph->batches[i & 1], *other = &ph->batches[(i + 1) & 1];
 #pragma omp master
-            if (done)
-                applied = ph_apply_batch(ph, done, st, err);
-            trace_jobs(ph, b, &failed);
+            {
+                pipe_turn(ph, &p, i ? other : NULL, other);
+                p.last = cur;
+            }
+            trace_jobs(ph, cur, &p.failed);
         }
     }
-    if (applied != LM_OK)
-        return applied;
-    if (failed)
-        return fail_traced(b, err);
-    return filled;
+    if (p.last && !p.failed && p.status == LM_OK)
+        p.status = apply_traced(ph, p.last, st, err);
+    if (p.status != LM_OK)
+        return p.status;
+    if (p.failed)
+        return fail_traced(p.last, err);
+    return LM_OK;
 }

@@ -248,9 +248,8 @@ lm_status ph_fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, uint3
     ph_batch_clear(b);
     for (; *i < n && batch_fits(ph, b, list[*i]); ++*i) {
         ph_group *g = &ph->groups[list[*i]];
-        for (uint32_t m = 0; m < g->photons; m++)
-            if (!ph_batch_push(b, list[*i], m))
-                return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
+        if (!ph_batch_push_group(b, list[*i], g->photons))
+            return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
         g->retraces++;
         st->groups_retraced++;
         st->group_photons += g->photons;

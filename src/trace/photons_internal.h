@@ -96,6 +96,9 @@ lm_status ph_trace_groups(lm_photons *ph, const uint32_t *list, uint32_t n, lm_p
                           lm_error *err);
 void ph_batch_clear(ph_batch *b);
 int ph_batch_push(ph_batch *b, uint32_t group, uint32_t m);
+/* ph_batch_push of the group's photons m = 0 .. photons - 1, growing the list once (the calling
+ * thread fills a re-trace's batches on its own, between applying and tracing). */
+int ph_batch_push_group(ph_batch *b, uint32_t group, uint32_t photons);
 void ph_batch_free(ph_batch *b);
 
 /* photons.c: fills b with whole groups from list[*i ...] (at least one group, up to a batch's photon

@@ -65,6 +65,11 @@ static lm_vec3 shading_normal(const lm_scene *s, const lm_node *node, const uint
 static void fill_albedo(const lm_scene *s, const uint32_t *idx, const float w[3], lm_shading *sh)
 {
     const lm_material *m = sh->material;
+    if (m->base_color_tex < 0) { /* untextured (most hits): lm_material_albedo's factor, no call */
+        for (int c = 0; c < 3; c++)
+            sh->albedo[c] = m->base_color[c];
+        return;
+    }
     float uv[2] = {sh->uv0[0], sh->uv0[1]};
     if (m->base_color_uv == 1 && s->uv1)
         interp2(s->uv1, idx, w, uv);
