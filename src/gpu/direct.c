@@ -21,7 +21,7 @@ void lm_direct_settings_default(lm_direct_settings *s)
 {
     s->map_size = 1024;
     s->cube_size = 512;
-    s->pcf_radius = 1;
+    s->pcf_radius = 0;
     s->normal_offset = 1.0f;
     s->slope_bias = 1.0f;
     s->max_slope = 10.0f;
