@@ -508,6 +508,42 @@ static void test_cache_follows_changes(void **state)
                         1);
 }
 
+/* (k) A point light's cube map skips the faces its dynamic casters neither reach nor reached: the box
+ * leaves the face under the light (whose old shadow must then be cleared), stays out of it (the face is
+ * skipped) and comes back; each render equals a fresh one, which draws every face. */
+static void test_cube_faces_follow_casters(void **state)
+{
+    (void)state;
+    live_scene l;
+    live_load(&l, box_scene(), 3);
+    lm_direct *d = NULL;
+    lm_error err;
+    assert_int_equal(lm_direct_create(l.s, NULL, &d, &err), LM_OK);
+    float *under = render_both(d, &l, "box under the light");
+    const float xs[3] = {3.0f, 3.5f, 0.5f}; /* beside the light (+x face only), further, back under it */
+    const char *what[3] = {"box beside the light", "box further aside", "box back under the light"};
+    float *prev = NULL;
+    for (int k = 0; k < 3; k++) {
+        l.s->nodes[3].translation[0] = xs[k];
+        live_update(&l);
+        float *now = render_both(d, &l, what[k]);
+        if (k == 0)
+            assert_true(differs(under, now)); /* the shadow left the picture */
+        if (k == 1)
+            assert_memory_equal(prev, now, sizeof(float) * 3 * W * W);
+        if (k == 2)
+            assert_memory_equal(under, now, sizeof(float) * 3 * W * W);
+        free(prev);
+        prev = now;
+    }
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 4);
+    print_message("cube faces follow the dynamic casters: 3 moves, each identical to a fresh render\n");
+    free(prev);
+    free(under);
+    lm_direct_free(d);
+    live_free(&l);
+}
+
 /* (j) Nothing changed: the second render is identical and renders no shadow map; nor does a point light
  * that only turns. */
 static void test_cache_nothing_moved(void **state)
@@ -547,6 +583,7 @@ int main(void)
         cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
         cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
         cmocka_unit_test(test_cache_nothing_moved),
+        cmocka_unit_test(test_cube_faces_follow_casters),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

@@ -171,7 +171,7 @@ static lm_status shadow_map(lm_direct *d, const lm_scene *s, const lm_emitter *e
     if (same && static_ok && c->dynamic_version == d->dynamic_version)
         return LM_OK;
     lm_status st = lm_shadow_map_draw(&c->map, &p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_indices,
-                                      !static_ok, err);
+                                      !static_ok, d->mesh.dynamic_lo, d->mesh.dynamic_hi, err);
     c->static_version = d->static_version;
     c->dynamic_version = d->dynamic_version;
     d->maps_rendered++;

@@ -285,6 +285,23 @@ static void upload_meshes(lm_direct_mesh *d, const lm_scene *s, const built *b)
     glEnableVertexAttribArray(7);
 }
 
+/* The world bounds of the dynamic nodes' caster vertices under their current matrices (empty: lo > hi). */
+static void dynamic_bounds(lm_direct_mesh *d, const lm_scene *s)
+{
+    for (int k = 0; k < 3; k++)
+        d->dynamic_lo[k] = INFINITY, d->dynamic_hi[k] = -INFINITY;
+    for (int n = 0; n < s->node_count && n < d->node_count; n++) {
+        if (!s->nodes[n].dynamic)
+            continue;
+        for (int v = 0; v < d->caster_verts[n]; v++) {
+            float p[3];
+            lm_scene_vertex_world(s, d->caster_src[d->caster_first[n] + v], p);
+            for (int k = 0; k < 3; k++)
+                d->dynamic_lo[k] = fminf(d->dynamic_lo[k], p[k]), d->dynamic_hi[k] = fmaxf(d->dynamic_hi[k], p[k]);
+        }
+    }
+}
+
 lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
     memset(d, 0, sizeof *d);
@@ -299,6 +316,7 @@ lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_at
         for (int i = 0; i < s->node_count; i++)
             memcpy(d->node_world + 16 * (size_t)i, s->nodes[i].world, sizeof s->nodes[i].world);
         upload_meshes(d, s, &b);
+        dynamic_bounds(d, s);
     }
     built_free(&b);
     free(map.keys);
@@ -346,6 +364,8 @@ int lm_direct_mesh_update(lm_direct_mesh *d, const lm_scene *s)
         if (nd->settings.shadows)
             moved |= nd->dynamic ? LM_MESH_DYNAMIC_CASTERS_MOVED : LM_MESH_STATIC_CASTERS_MOVED;
     }
+    if (moved & LM_MESH_DYNAMIC_CASTERS_MOVED)
+        dynamic_bounds(d, s);
     return moved;
 }
 

@@ -28,6 +28,7 @@ typedef struct {
     float *node_world;    /* per node: the world matrix its vertices were last uploaded with */
     float *scratch;       /* vertices of the largest node (update) */
     unsigned uv_vbo;      /* lightmap uv per vertex (attribute 7), 0 without an atlas */
+    float dynamic_lo[3], dynamic_hi[3]; /* world bounds of the dynamic nodes' casters (after an update) */
 } lm_direct_mesh;
 
 /* Builds the meshes; with an atlas (may be NULL) also attribute 7: each vertex's lightmap uv, (-1, -1) on

@@ -82,6 +82,7 @@ typedef struct {
     int first, count;     /* vertex (index) range of `casters` */
     int from_layer;       /* 1: copy the static layer's face first (else clear) */
     int into_layer;       /* 1: draw into the static layer instead of the map */
+    const float *lo, *hi; /* with from_layer: the casters' world bounds (NULL: unknown, every face drawn) */
 } face_job;
 
 /* Draws one face (GL target `face`) with view-projection vp. */
@@ -105,8 +106,29 @@ static void draw_face(const lm_shadow_map *m, const lm_shadow_renderer *r, GLenu
     }
 }
 
-static void cube_faces(const lm_shadow_map *m, const lm_shadow_renderer *r, const lm_gl_mesh *casters,
-                       const face_job *job)
+/* Whether box [lo, hi] may reach cube face f (axis f / 2, sign + for even f) of a light at p: it is
+ * outside when all its corners lie behind one of the face frustum's four planes through p
+ * (|other coordinate| <= the axis coordinate). Conservative. */
+static int box_in_face(const float p[3], const float *lo, const float *hi, int f)
+{
+    int axis = f / 2;
+    float sign = f % 2 ? -1.0f : 1.0f;
+    for (int k = 1; k < 3; k++) {
+        int o = (axis + k) % 3;
+        for (int side = -1; side <= 1; side += 2) { /* plane: sign * a - side * b >= 0 */
+            int inside = 0;
+            for (int c = 0; c < 8 && !inside; c++) {
+                float a = ((c >> axis) & 1 ? hi : lo)[axis] - p[axis], b = ((c >> o) & 1 ? hi : lo)[o] - p[o];
+                inside = sign * a - (float)side * b >= 0.0f;
+            }
+            if (!inside)
+                return 0;
+        }
+    }
+    return 1;
+}
+
+static void cube_faces(lm_shadow_map *m, const lm_shadow_renderer *r, const lm_gl_mesh *casters, const face_job *job)
 {
     /* GL's cube map face order and orientation (+X, -X, +Y, -Y, +Z, -Z). */
     static const float dirs[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
@@ -115,6 +137,14 @@ static void cube_faces(const lm_shadow_map *m, const lm_shadow_renderer *r, cons
     lm_vec3 p = lm_v3_load(m->p.pos);
     lm_mat4_perspective(proj, (float)(M_PI / 2), 1.0f, m->p.znear, m->p.zfar);
     for (int f = 0; f < 6; f++) {
+        if (job->from_layer && job->lo) { /* skip a face that shows its layer and will again */
+            int now = box_in_face(m->p.pos, job->lo, job->hi, f);
+            if (!now && !m->face_dynamic[f])
+                continue;
+            m->face_dynamic[f] = (unsigned char)now;
+        } else if (job->from_layer) {
+            m->face_dynamic[f] = 1;
+        }
         lm_mat4_look_at(view, p, lm_add(p, lm_v3_load(dirs[f])), lm_v3_load(ups[f]));
         lm_mat4_mul(vp, proj, view);
         draw_face(m, r, GL_TEXTURE_CUBE_MAP_POSITIVE_X + (GLenum)f, vp, casters, job);
@@ -217,7 +247,7 @@ static void ensure_objects(lm_shadow_map *m, const lm_shadow_params *p, int laye
 }
 
 /* Draws every face of the map (or of its layer) as `job` says. */
-static void draw_faces(const lm_shadow_map *m, const lm_shadow_renderer *r, const lm_gl_mesh *casters,
+static void draw_faces(lm_shadow_map *m, const lm_shadow_renderer *r, const lm_gl_mesh *casters,
                        const face_job *job)
 {
     if (m->p.cube)
@@ -227,7 +257,8 @@ static void draw_faces(const lm_shadow_map *m, const lm_shadow_renderer *r, cons
 }
 
 lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const lm_shadow_renderer *r,
-                             const lm_gl_mesh *casters, int static_count, int redo_static, lm_error *err)
+                             const lm_gl_mesh *casters, int static_count, int redo_static, const float dynamic_lo[3],
+                             const float dynamic_hi[3], lm_error *err)
 {
     int n = casters->vertices, split = static_count > 0 && static_count < n;
     ensure_objects(m, p, split);
@@ -246,15 +277,17 @@ lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const 
     glUniform1f(r->u_range, p->range);
     glUniform3fv(r->u_origin, 1, p->origin);
     if (!split) {
-        const face_job all = {0, n, 0, 0};
+        const face_job all = {0, n, 0, 0, NULL, NULL};
         draw_faces(m, r, casters, &all);
     } else {
-        if (!m->layer_valid || redo_static) {
-            const face_job statics = {0, static_count, 0, 1};
+        int every_face = !m->layer_valid || redo_static; /* a new layer: every face copies it again */
+        if (every_face) {
+            const face_job statics = {0, static_count, 0, 1, NULL, NULL};
             draw_faces(m, r, casters, &statics);
             m->layer_valid = 1;
         }
-        const face_job dynamics = {static_count, n - static_count, 1, 0};
+        const face_job dynamics = {static_count, n - static_count, 1, 0, every_face ? NULL : dynamic_lo,
+                                   every_face ? NULL : dynamic_hi};
         draw_faces(m, r, casters, &dynamics);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

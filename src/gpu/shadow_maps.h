@@ -37,6 +37,7 @@ typedef struct {
     unsigned fbo;         /* its framebuffer (depth only) */
     unsigned layer_tex, layer_fbo; /* static layer: DEPTH_COMPONENT32F texture and framebuffer */
     int layer_valid;      /* the layer holds the static casters under parameters p */
+    unsigned char face_dynamic[6]; /* cube: the face holds dynamic casters drawn over the layer */
 } lm_shadow_map;
 
 /* The shadow-map program and its uniform locations. */
@@ -54,9 +55,12 @@ void lm_shadow_params_compute(lm_shadow_params *p, const lm_scene *s, const lm_e
  * (re)allocating its textures when the kind or size changed. The first static_count vertices (indices
  * when the mesh is indexed) are static casters: when some follow them, the static ones are drawn into
  * the layer, re-drawn only when p changed or redo_static is set, and each render copies the layer and
- * draws the rest on top. Leaves the framebuffer binding at 0; the viewport is changed. */
+ * draws the rest on top. With the dynamic casters' world bounds (dynamic_lo, dynamic_hi; NULL: unknown)
+ * a cube face whose frustum they miss now and at its last render already equals its layer and is
+ * skipped. Leaves the framebuffer binding at 0; the viewport is changed. */
 lm_status lm_shadow_map_draw(lm_shadow_map *m, const lm_shadow_params *p, const lm_shadow_renderer *r,
-                             const lm_gl_mesh *casters, int static_count, int redo_static, lm_error *err);
+                             const lm_gl_mesh *casters, int static_count, int redo_static, const float dynamic_lo[3],
+                             const float dynamic_hi[3], lm_error *err);
 void lm_shadow_map_free(lm_shadow_map *m);
 
 #endif
