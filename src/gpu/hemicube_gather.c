@@ -330,14 +330,8 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
     return lm_gl_check("hemicube gather: scene upload", err);
 }
 
-lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err)
+lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float *dilated_rgb, lm_error *err)
 {
-    size_t n = 3 * (size_t)a->width * (size_t)a->height;
-    float *d = malloc(sizeof(float) * n);
-    if (!d)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory to dilate the AIM");
-    memcpy(d, aim_rgb, sizeof(float) * n);
-    lm_atlas_dilate_gutters(a, d, 3); /* chart edges must not blend in black */
     if (!g->aim_tex || g->aim_w != a->width || g->aim_h != a->height) {
         glDeleteTextures(1, &g->aim_tex);
         glGenTextures(1, &g->aim_tex);
@@ -351,9 +345,21 @@ lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rg
     }
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a->width, a->height, GL_RGB, GL_FLOAT, d);
-    free(d);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a->width, a->height, GL_RGB, GL_FLOAT, dilated_rgb);
     return lm_gl_check("hemicube gather: AIM upload", err);
+}
+
+lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err)
+{
+    size_t n = 3 * (size_t)a->width * (size_t)a->height;
+    float *d = malloc(sizeof(float) * n);
+    if (!d)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory to dilate the AIM");
+    memcpy(d, aim_rgb, sizeof(float) * n);
+    lm_atlas_dilate_gutters(a, d, 3); /* chart edges must not blend in black */
+    lm_status st = lm_gather_set_aim_dilated(g, a, d, err);
+    free(d);
+    return st;
 }
 
 /* The texel's centre and normal under the current node matrices (barycentric on its triangle). */
@@ -576,16 +582,18 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     for (uint32_t first = 0; first < count; first += per_pass, passes++) {
         uint32_t n = count - first < per_pass ? count - first : per_pass;
         render_tiles(g, s, a, texels + first, n, xy);
-        if (g->emitters)
+        if (g->emitters) {
+            glFlush(); /* llvmpipe rasterizes the pass on its threads while this one computes */
             emitter_irradiance(g, s, a, texels + first, n);
+        }
         reduce_tiles(g, iim_tex, xy, n);
     }
     clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     glDepthFunc(GL_LESS);
     glClearDepth(1.0);
     free(xy);
-    glFinish();
-    if (stats) {
+    if (stats) { /* timed to the end of the GPU work; otherwise the caller's next commands queue behind it */
+        glFinish();
         stats->texels = count;
         stats->passes = passes;
         stats->seconds = lm_now() - t0;

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../charts/atlas_dilate.h"
 #include "../core/timing.h"
 
 #define PI_D 3.14159265358979323846
@@ -217,11 +218,12 @@ lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, con
     aim->height = a->height;
     aim->surface_count = su->surface_count;
     aim->rgb = calloc((size_t)a->width * (size_t)a->height * 3, sizeof *aim->rgb);
+    aim->dilated = calloc((size_t)a->width * (size_t)a->height * 3, sizeof *aim->dilated);
     aim->refresh_count = calloc((size_t)su->surface_count + 1, sizeof *aim->refresh_count);
     aim->edge_d2 = malloc(((size_t)a->texel_count + 1) * sizeof *aim->edge_d2);
     for (uint32_t i = 0; aim->edge_d2 && i < a->texel_count; i++)
         aim->edge_d2[i] = -1.0f; /* unknown until the texel's first estimate walks the edges */
-    if (!aim->rgb || !aim->refresh_count || !aim->edge_d2)
+    if (!aim->rgb || !aim->dilated || !aim->refresh_count || !aim->edge_d2)
         st = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for a %dx%d map", a->width, a->height);
     if (st == LM_OK)
         st = build_texel_lists(aim, a, err);
@@ -235,6 +237,7 @@ lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, con
 void lm_aim_free(lm_aim *aim)
 {
     free(aim->rgb);
+    free(aim->dilated);
     free(aim->texel_first);
     free(aim->texel_list);
     free(aim->edge_first);
@@ -245,6 +248,7 @@ void lm_aim_free(lm_aim *aim)
 }
 
 const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
+const float *lm_aim_dilated_rgb(const lm_aim *aim) { return aim->dilated; }
 
 /* ---------- the node's transform ---------- */
 
@@ -769,6 +773,10 @@ static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfa
     for (int j = 0; j < count; j++)
         free_surface(&jobs[j]);
     free(jobs);
+    if (ok > 0) {
+        memcpy(aim->dilated, aim->rgb, sizeof(float) * 3 * (size_t)aim->width * (size_t)aim->height);
+        lm_atlas_dilate_gutters(a, aim->dilated, 3);
+    }
     return rc;
 }
 
