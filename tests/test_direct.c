@@ -508,6 +508,16 @@ static void test_cache_follows_changes(void **state)
                         1);
 }
 
+/* The box scene (node 3, the box, dynamic) loaded live with a persistent lm_direct, and its first render
+ * checked against a fresh one (caller frees). */
+static float *live_start(live_scene *l, lm_direct **d)
+{
+    lm_error err;
+    live_load(l, box_scene(), 3);
+    assert_int_equal(lm_direct_create(l->s, NULL, d, &err), LM_OK);
+    return render_both(*d, l, "first render");
+}
+
 /* (k) A point light's cube map skips the faces its dynamic casters neither reach nor reached: the box
  * leaves the face under the light (whose old shadow must then be cleared), stays out of it (the face is
  * skipped) and comes back; each render equals a fresh one, which draws every face. */
@@ -515,11 +525,8 @@ static void test_cube_faces_follow_casters(void **state)
 {
     (void)state;
     live_scene l;
-    live_load(&l, box_scene(), 3);
     lm_direct *d = NULL;
-    lm_error err;
-    assert_int_equal(lm_direct_create(l.s, NULL, &d, &err), LM_OK);
-    float *under = render_both(d, &l, "box under the light");
+    float *under = live_start(&l, &d); /* the box under the light */
     const float xs[3] = {3.0f, 3.5f, 0.5f}; /* beside the light (+x face only), further, back under it */
     const char *what[3] = {"box beside the light", "box further aside", "box back under the light"};
     float *prev = NULL;
@@ -550,11 +557,9 @@ static void test_cache_nothing_moved(void **state)
 {
     (void)state;
     live_scene l;
-    live_load(&l, box_scene(), 3);
     lm_direct *d = NULL;
     lm_error err;
-    assert_int_equal(lm_direct_create(l.s, NULL, &d, &err), LM_OK);
-    float *a = render_both(d, &l, "first render");
+    float *a = live_start(&l, &d);
     live_update(&l); /* recomputing the same matrices is not a change */
     float *b = malloc(sizeof(float) * 3 * W * W);
     assert_non_null(b);

@@ -208,6 +208,15 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     return st;
 }
 
+/* Blend (timed into o), then render. */
+static lm_status blend_and_render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
+{
+    double t0 = lm_now();
+    lm_status st = lm_iim_blend(&fl->iim, 0, err);
+    o->t_blend = lm_now() - t0;
+    return st == LM_OK ? render(fl, o, err) : st;
+}
+
 /* The paper's order: photon stage, then the gather over its fresh AIMs, blend, render. */
 static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
@@ -220,16 +229,9 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
         o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
         st = gather(fl, o->texels_gathered, err);
     }
-    double t2 = lm_now();
-    if (st == LM_OK)
-        st = lm_iim_blend(&fl->iim, 0, err);
-    double t3 = lm_now();
-    if (st == LM_OK)
-        st = render(fl, o, err);
     o->t_photons = t1 - t0;
-    o->t_gather = t2 - t1;
-    o->t_blend = t3 - t2;
-    return st;
+    o->t_gather = lm_now() - t1;
+    return st == LM_OK ? blend_and_render(fl, o, err) : st;
 }
 
 /* Overlapped: animate, schedule and upload what the gather needs, then the photon stage's tracing and
@@ -250,12 +252,9 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
         return st;
     lm_stage_worker_begin(fl->worker, &o->stage);
     st = gather_run(fl, o->texels_gathered, err);
-    double t2 = lm_now();
+    o->t_gather = lm_now() - t1;
     if (st == LM_OK)
-        st = lm_iim_blend(&fl->iim, 0, err);
-    double t3 = lm_now();
-    if (st == LM_OK)
-        st = render(fl, o, err);
+        st = blend_and_render(fl, o, err);
     double t4 = lm_now();
     lm_error worker_err;
     lm_status ws = lm_stage_worker_end(fl->worker, &worker_err);
@@ -267,8 +266,6 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
     if (o->stage.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
     o->t_photons = (t1 - t0) + (lm_now() - t4); /* what the frame spent on or waiting for the stage */
-    o->t_gather = t2 - t1;
-    o->t_blend = t3 - t2;
     return st;
 }
 
