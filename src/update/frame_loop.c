@@ -193,7 +193,6 @@ void lm_frame_loop_free(lm_frame_loop *fl)
 static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
-    lm_scene_update_bounds(fl->scene);
     lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
     double t0 = lm_now();
     unsigned lit = 0;
@@ -217,11 +216,22 @@ static lm_status blend_and_render(lm_frame_loop *fl, lm_frame_stats *o, lm_error
     return st == LM_OK ? render(fl, o, err) : st;
 }
 
+/* Animations and the scene bounds that follow from them: written here, on the calling thread, before
+ * anything that reads them (the photon thread's update among them) starts. */
+static lm_status animate(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
+{
+    lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
+    lm_scene_update_bounds(fl->scene);
+    return st;
+}
+
 /* The paper's order: photon stage, then the gather over its fresh AIMs, blend, render. */
 static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
-    lm_status st = lm_photon_stage_step(fl->stage, t, &o->stage, err);
+    lm_status st = animate(fl, t, o, err);
+    if (st == LM_OK)
+        st = lm_photon_stage_update(fl->stage, &o->stage, err);
     if (o->stage.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
     double t1 = lm_now();
@@ -241,7 +251,7 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
 static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
-    lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
+    lm_status st = animate(fl, t, o, err);
     if (st == LM_OK) {
         o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
         if (o->texels_gathered > 0)
