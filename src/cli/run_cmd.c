@@ -150,9 +150,9 @@ static void summary(const run_state *r, int frames, const lm_photon_stage_frame 
     printf("gl          %s\n", lm_frame_loop_gl_description(r->loop));
     const lm_frame_loop_settings *fs = lm_frame_loop_get_settings(r->loop);
     uint32_t emissive = lm_emissive_triangle_count(r->sc->scene);
-    printf("gather      R %d, a %g, %d AIM lookups and %d coverage samples per pixel, %s scheme; ",
-           fs->gather.resolution, (double)fs->gather.enlargement, fs->gather.samples, fs->gather.coverage_samples,
-           lm_gather_scheme_name(fs->gather.scheme));
+    printf("gather      R %d, a %g, %d AIM lookup%s and %d coverage sample%s per pixel, %s scheme; ",
+           fs->gather.resolution, (double)fs->gather.enlargement, fs->gather.samples, fs->gather.samples > 1 ? "s" : "",
+           fs->gather.coverage_samples, fs->gather.coverage_samples > 1 ? "s" : "", lm_gather_scheme_name(fs->gather.scheme));
     if (!emissive)
         printf("no emissive triangles\n");
     else if (fs->emitter_light)
