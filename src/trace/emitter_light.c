@@ -149,10 +149,14 @@ typedef struct {
 } vis_sum;
 
 /* k stratified points on triangle (a, b, c) (relative to p), each weighed by cos cos' / r^2 and tested
- * with a shadow ray. face: the emitter's unit normal. */
+ * with a shadow ray, 8 rays to an Embree packet. face: the emitter's unit normal. */
 static void sample_triangle(const lm_emitter_light *el, dvec p, dvec nrm, dvec face, const dvec t[3], int k,
                             const double shift[2], vis_sum *vs)
 {
+    const float org[3] = {(float)p.x, (float)p.y, (float)p.z};
+    float dir[24], tfar[8];
+    double f[8];
+    int n = 0, blocked[8];
     for (int i = 0; i < k; i++) {
         double u = fmod((i + 0.5) / k + shift[0], 1.0), w = fmod(radical_inverse2((uint32_t)i) + shift[1], 1.0);
         double su = sqrt(u);
@@ -161,13 +165,24 @@ static void sample_triangle(const lm_emitter_light *el, dvec p, dvec nrm, dvec f
         if (!(r > 0.0))
             continue;
         dvec d = dscale(q, 1.0 / r);
-        double f = ddot(nrm, d) * fabs(ddot(face, d)) / (r * r);
-        if (!(f > 0.0))
+        double fi = ddot(nrm, d) * fabs(ddot(face, d)) / (r * r);
+        if (!(fi > 0.0))
             continue;
-        vs->f += f;
-        float org[3] = {(float)p.x, (float)p.y, (float)p.z}, dir[3] = {(float)d.x, (float)d.y, (float)d.z};
-        if (!lm_rt_occluded(el->rt, org, dir, 0.0f, (float)(r * (1.0 - 1e-4))))
-            vs->fv += f;
+        vs->f += fi;
+        f[n] = fi;
+        dir[3 * n] = (float)d.x, dir[3 * n + 1] = (float)d.y, dir[3 * n + 2] = (float)d.z;
+        tfar[n++] = (float)(r * (1.0 - 1e-4));
+        if (n == 8 || i == k - 1) {
+            lm_rt_occluded8(el->rt, org, dir, tfar, n, blocked);
+            for (int j = 0; j < n; j++)
+                vs->fv += blocked[j] ? 0.0 : f[j];
+            n = 0;
+        }
+    }
+    if (n > 0) { /* the last points were skipped after these */
+        lm_rt_occluded8(el->rt, org, dir, tfar, n, blocked);
+        for (int j = 0; j < n; j++)
+            vs->fv += blocked[j] ? 0.0 : f[j];
     }
 }
 

@@ -305,6 +305,29 @@ int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], floa
     return rh.ray.tfar < 0.0f; /* Embree sets tfar to -inf on occlusion */
 }
 
+void lm_rt_occluded8(const lm_rt *rt, const float org[3], const float *dir, const float *tfar, int n, int *blocked)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT; /* one origin: the rays fan out together */
+    _Alignas(32) struct RTCRay8 r;
+    _Alignas(32) int valid[8];
+    memset(&r, 0, sizeof r);
+    for (int i = 0; i < 8; i++) {
+        int on = i < n;
+        valid[i] = on ? -1 : 0;
+        r.org_x[i] = org[0], r.org_y[i] = org[1], r.org_z[i] = org[2];
+        r.dir_x[i] = on ? dir[3 * i] : 0.0f, r.dir_y[i] = on ? dir[3 * i + 1] : 0.0f;
+        r.dir_z[i] = on ? dir[3 * i + 2] : 1.0f;
+        r.tnear[i] = 0.0f;
+        r.tfar[i] = on ? tfar[i] : 0.0f;
+        r.mask[i] = 0xFFFFFFFFu;
+    }
+    rtcOccluded8(valid, rt->top, &ctx, &r);
+    for (int i = 0; i < n; i++)
+        blocked[i] = r.tfar[i] < 0.0f; /* Embree sets tfar to -inf on occlusion */
+}
+
 uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir, uint32_t n)
 {
     uint64_t hits = 0;

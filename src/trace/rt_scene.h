@@ -40,6 +40,9 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
                     lm_rt_hit *hit);
 /* 1 if anything blocks the segment (tnear, tfar). */
 int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar);
+/* Up to 8 segments from one origin as one Embree packet: blocked[i] = 1 if anything lies on
+ * org + t dir_i (dir: 3 floats each), t in (0, tfar[i]). n in 1..8. */
+void lm_rt_occluded8(const lm_rt *rt, const float org[3], const float *dir, const float *tfar, int n, int *blocked);
 
 /* The benchmark's baseline: n closest-hit queries straight through rtcIntersect1 (no hit decoding),
  * rays i = (org + 3i, dir + 3i), spread over the OpenMP threads. Returns the number of hits. */
