@@ -523,7 +523,7 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
 
 /* The emitters' closed-form irradiance at each texel of a pass (from the plane's eye, along its
  * normal), for the reduction to add; the sample pattern is seeded by the texel's index. On this thread,
- * while the GL threads rasterize the pass: about 10 us per texel for two emissive triangles, where an
+ * while the GL threads rasterize the pass: about 8 us per texel for two emissive triangles, where an
  * OpenMP team competing with the rasterizer's threads cost ten times that. */
 static void emitter_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
                                uint32_t count)
