@@ -435,6 +435,14 @@ static void test_invalidate_emitter(void **state)
 
 /* ---- move a dynamic object and back: the original hits return exactly ---- */
 
+/* Places node `node` at world matrix m, in the scene and the BVH, as an animation would. */
+static void move_node(world *w, int node, const float m[16])
+{
+    lm_error err;
+    memcpy(w->s->nodes[node].world, m, 16 * sizeof(float));
+    assert_int_equal(lm_rt_set_node_transform(w->rt, node, m, &err), LM_OK);
+}
+
 static uint32_t settle(world *w)
 {
     uint32_t frames = 0, quiet = 0;
@@ -463,15 +471,12 @@ static void test_move_and_back(void **state)
     memcpy(moved, home, sizeof moved);
     moved[12] -= 0.8f; /* 0.8 m along -x, still in room A */
     moved[14] += 0.5f;
-    lm_error err;
-    memcpy(w.s->nodes[cube].world, moved, sizeof moved);
-    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, moved, &err), LM_OK);
+    move_node(&w, cube, moved);
     uint32_t f1 = settle(&w);
     snapshot s1 = take_snapshot(w.ph);
     assert_true(s1.n != s0.n || memcmp(s1.h, s0.h, sizeof(lm_hit) * s0.n) != 0);
 
-    memcpy(w.s->nodes[cube].world, home, sizeof home);
-    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, home, &err), LM_OK);
+    move_node(&w, cube, home);
     uint32_t f2 = settle(&w);
     print_message("settled in %u frames after the move, %u after moving back\n", f1, f2);
     snapshot s2 = take_snapshot(w.ph);
@@ -499,16 +504,14 @@ static void test_reset_matches_fresh(void **state)
     memcpy(home, w.s->nodes[cube].world, sizeof home);
     memcpy(moved, home, sizeof moved);
     moved[12] -= 0.8f;
-    lm_error err;
-    memcpy(w.s->nodes[cube].world, moved, sizeof moved);
-    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, moved, &err), LM_OK);
+    move_node(&w, cube, moved);
     settle(&w);
-    memcpy(w.s->nodes[cube].world, home, sizeof home);
-    assert_int_equal(lm_rt_set_node_transform(w.rt, cube, home, &err), LM_OK);
+    move_node(&w, cube, home);
     frame(&w); /* leaves groups pending and a non-empty free list behind */
 
     int threads = omp_get_max_threads();
     omp_set_num_threads(3);
+    lm_error err;
     lm_photons_reset(w.ph);
     assert_int_equal(lm_photons_stored_hits(w.ph), 0);
     assert_int_equal(lm_photons_pending_groups(w.ph), 0);
