@@ -69,31 +69,11 @@ int lm_mat4_invert_affine(float out[16], const float m[16])
     return 1;
 }
 
-lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p)
-{
-    return lm_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
-                 m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
-                 m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
-}
-
 lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d)
 {
     return lm_v3(m[0] * d.x + m[4] * d.y + m[8] * d.z,
                  m[1] * d.x + m[5] * d.y + m[9] * d.z,
                  m[2] * d.x + m[6] * d.y + m[10] * d.z);
-}
-
-lm_vec3 lm_mat4_normal(const float m[16], lm_vec3 n)
-{
-    /* Cofactor matrix = det * inverse-transpose: the scale drops out on normalization, and flipping
-     * by the sign of det gives the true inverse-transpose for mirroring transforms too. */
-    lm_vec3 c0 = lm_v3(m[0], m[1], m[2]), c1 = lm_v3(m[4], m[5], m[6]), c2 = lm_v3(m[8], m[9], m[10]);
-    lm_vec3 r0 = lm_cross(c1, c2), r1 = lm_cross(c2, c0), r2 = lm_cross(c0, c1);
-    lm_vec3 out = lm_add(lm_add(lm_scale(r0, n.x), lm_scale(r1, n.y)), lm_scale(r2, n.z));
-    float det = lm_dot(c0, r0);
-    if (det < 0.0f)
-        out = lm_scale(out, -1.0f);
-    return lm_normalize(out);
 }
 
 int lm_mat4_finite(const float m[16])

@@ -47,10 +47,27 @@ void lm_mat4_mul(float out[16], const float a[16], const float b[16]); /* out = 
 void lm_mat4_from_trs(float m[16], const float t[3], const float q[4], const float s[3]);
 /* Inverse of a general affine matrix; returns 0 if singular. */
 int lm_mat4_invert_affine(float out[16], const float m[16]);
-lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p);
+/* Inline: photon shading transforms every hit with these two, without a call per hit. */
+static inline lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p)
+{
+    return lm_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
+                 m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
+                 m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
+}
 lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d);
-/* Normal transform: inverse-transpose of the upper 3x3, result normalized. */
-lm_vec3 lm_mat4_normal(const float m[16], lm_vec3 n);
+/* Normal transform: inverse-transpose of the upper 3x3, result normalized. The cofactor matrix is det
+ * times the inverse-transpose: the scale drops out on normalization, and flipping by the sign of det
+ * gives the true inverse-transpose for mirroring transforms too. */
+static inline lm_vec3 lm_mat4_normal(const float m[16], lm_vec3 n)
+{
+    lm_vec3 c0 = lm_v3(m[0], m[1], m[2]), c1 = lm_v3(m[4], m[5], m[6]), c2 = lm_v3(m[8], m[9], m[10]);
+    lm_vec3 r0 = lm_cross(c1, c2), r1 = lm_cross(c2, c0), r2 = lm_cross(c0, c1);
+    lm_vec3 out = lm_add(lm_add(lm_scale(r0, n.x), lm_scale(r1, n.y)), lm_scale(r2, n.z));
+    float det = lm_dot(c0, r0);
+    if (det < 0.0f)
+        out = lm_scale(out, -1.0f);
+    return lm_normalize(out);
+}
 int lm_mat4_finite(const float m[16]);
 void lm_mat4_perspective(float m[16], float yfov, float aspect, float znear, float zfar);
 void lm_mat4_look_at(float m[16], lm_vec3 eye, lm_vec3 target, lm_vec3 up);

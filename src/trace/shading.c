@@ -5,26 +5,6 @@
 
 #include "../core/vecmath.h"
 
-/* lm_mat4_point and lm_mat4_normal (vecmath.c), inlined here: the same operations in the same order,
- * so the same values bit for bit, without two calls per hit. */
-static inline __attribute__((always_inline)) lm_vec3 mat4_point(const float m[16], lm_vec3 p)
-{
-    return lm_v3(m[0] * p.x + m[4] * p.y + m[8] * p.z + m[12],
-                 m[1] * p.x + m[5] * p.y + m[9] * p.z + m[13],
-                 m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
-}
-
-static inline __attribute__((always_inline)) lm_vec3 mat4_normal(const float m[16], lm_vec3 n)
-{
-    lm_vec3 c0 = lm_v3(m[0], m[1], m[2]), c1 = lm_v3(m[4], m[5], m[6]), c2 = lm_v3(m[8], m[9], m[10]);
-    lm_vec3 r0 = lm_cross(c1, c2), r1 = lm_cross(c2, c0), r2 = lm_cross(c0, c1);
-    lm_vec3 out = lm_add(lm_add(lm_scale(r0, n.x), lm_scale(r1, n.y)), lm_scale(r2, n.z));
-    float det = lm_dot(c0, r0);
-    if (det < 0.0f)
-        out = lm_scale(out, -1.0f);
-    return lm_normalize(out);
-}
-
 /* Barycentric weights of Embree's (u, v): p = (1-u-v) v0 + u v1 + v v2. */
 static void hit_weights(const lm_rt_hit *hit, float w[3])
 {
@@ -56,7 +36,7 @@ static inline __attribute__((always_inline)) void interp2(const float *attr, con
 static lm_vec3 shading_normal(const lm_scene *s, const lm_node *node, const uint32_t *idx, const float w[3],
                               lm_vec3 ng)
 {
-    lm_vec3 n = mat4_normal(node->world, interp3(s->normals, idx, w));
+    lm_vec3 n = lm_mat4_normal(node->world, interp3(s->normals, idx, w));
     if (!lm_v3_finite(n) || lm_dot(n, n) < 0.5f)
         return ng;
     return lm_dot(n, ng) < 0.0f ? lm_scale(n, -1.0f) : n;
@@ -85,7 +65,7 @@ void lm_shading_from_hit(const lm_scene *s, const lm_rt_hit *hit, const float or
     hit_weights(hit, w);
     const lm_node *node = &s->nodes[hit->node];
     lm_vec3 local = interp3(s->positions, idx, w);
-    lm_vec3 pos = mat4_point(node->world, local);
+    lm_vec3 pos = lm_mat4_point(node->world, local);
     if (!lm_v3_finite(pos)) /* fall back to the ray's own parameter */
         pos = lm_add(lm_v3_load(org), lm_scale(lm_v3_load(dir), hit->t));
     lm_v3_store(sh->pos, pos);
