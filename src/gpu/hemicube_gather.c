@@ -439,32 +439,9 @@ static void clear_target(lm_gather *g, uint32_t count)
     glDisable(GL_SCISSOR_TEST);
 }
 
-/* Scheme 0: one draw per texel, its view in uniforms, its tile a viewport. */
-static void draw_viewports(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
-{
-    int R = g->set.resolution, T = g->set.tiles;
-    GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
-    GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
-    GLint ax_loc = glGetUniformLocation(g->render_prog, "axis_x"), ay_loc = glGetUniformLocation(g->render_prog, "axis_y");
-    float near = near_plane(g, s);
-    for (uint32_t i = 0; i < count; i++) {
-        texel_view v = view_of(g, s, &a->texels[texels[i]]);
-        float m[16];
-        plane_view_proj(v.eye, v.axes, near, m);
-        glUniformMatrix4fv(vp_loc, 1, GL_FALSE, m);
-        glUniform3f(eye_loc, v.eye.x, v.eye.y, v.eye.z);
-        glUniform1f(own_loc, v.surface);
-        for (int k = 0; k < 2; k++) { /* a b and a t: a clip-space step as a world direction per unit w */
-            lm_vec3 ax = lm_scale(v.axes[k], 1.0f / lm_dot(v.axes[k], v.axes[k]));
-            glUniform3f(k ? ay_loc : ax_loc, ax.x, ax.y, ax.z);
-        }
-        glViewport((int)(i % (uint32_t)T) * R, (int)(i / (uint32_t)T) * R, R, R);
-        lm_gl_mesh_draw(&g->mesh);
-    }
-}
-
-/* Schemes 1, 2: every texel's view into a buffer, then one instanced draw. */
-static void draw_instanced(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
+/* Every texel's view of a pass into g->views (VIEW_FLOATS each: eye and own surface, then the three
+ * axes), which every scheme draws from and the emitter light reads. */
+static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
 {
     for (uint32_t i = 0; i < count; i++) {
         texel_view v = view_of(g, s, &a->texels[texels[i]]);
@@ -476,6 +453,36 @@ static void draw_instanced(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
             o[4 * (k + 1) + 3] = 0.0f;
         }
     }
+}
+
+/* Scheme 0: one draw per texel, its view in uniforms, its tile a viewport. */
+static void draw_viewports(lm_gather *g, const lm_scene *s, uint32_t count)
+{
+    int R = g->set.resolution, T = g->set.tiles;
+    GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
+    GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
+    GLint ax_loc = glGetUniformLocation(g->render_prog, "axis_x"), ay_loc = glGetUniformLocation(g->render_prog, "axis_y");
+    float near = near_plane(g, s);
+    for (uint32_t i = 0; i < count; i++) {
+        const float *o = g->views + VIEW_FLOATS * (size_t)i;
+        lm_vec3 eye = lm_v3_load(o), axes[3] = {lm_v3_load(o + 4), lm_v3_load(o + 8), lm_v3_load(o + 12)};
+        float m[16];
+        plane_view_proj(eye, axes, near, m);
+        glUniformMatrix4fv(vp_loc, 1, GL_FALSE, m);
+        glUniform3f(eye_loc, eye.x, eye.y, eye.z);
+        glUniform1f(own_loc, o[3]);
+        for (int k = 0; k < 2; k++) { /* a b and a t: a clip-space step as a world direction per unit w */
+            lm_vec3 ax = lm_scale(axes[k], 1.0f / lm_dot(axes[k], axes[k]));
+            glUniform3f(k ? ay_loc : ax_loc, ax.x, ax.y, ax.z);
+        }
+        glViewport((int)(i % (uint32_t)T) * R, (int)(i / (uint32_t)T) * R, R, R);
+        lm_gl_mesh_draw(&g->mesh);
+    }
+}
+
+/* Schemes 1, 2: the views into a buffer, then one instanced draw. */
+static void draw_instanced(lm_gather *g, const lm_scene *s, uint32_t count)
+{
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->views_buf);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * VIEW_FLOATS * count), g->views);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g->views_buf);
@@ -510,10 +517,11 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     glUniform1f(glGetUniformLocation(g->render_prog, "pixel"), 2.0f / (float)g->set.resolution);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
+    fill_views(g, s, a, texels, count);
     if (g->set.scheme == LM_GATHER_VIEWPORTS)
-        draw_viewports(g, s, a, texels, count);
+        draw_viewports(g, s, count);
     else
-        draw_instanced(g, s, a, texels, count);
+        draw_instanced(g, s, count);
     for (uint32_t i = 0; i < count; i++)
         xy[2 * i] = a->texels[texels[i]].x, xy[2 * i + 1] = a->texels[texels[i]].y;
     if (g->ms_fbo)
@@ -521,19 +529,16 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-/* The emitters' closed-form irradiance at each texel of a pass (from the plane's eye, along its
- * normal), for the reduction to add; the sample pattern is seeded by the texel's index. On this thread,
+/* The emitters' closed-form irradiance at each texel of a pass (from its view's eye, along the view's
+ * normal: g->views, filled by render_tiles), for the reduction to add; the sample pattern is seeded by
+ * the texel's index. On this thread,
  * while the GL threads rasterize the pass: about 8 us per texel for two emissive triangles, where an
  * OpenMP team competing with the rasterizer's threads cost ten times that. */
-static void emitter_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
-                               uint32_t count)
+static void emitter_irradiance(lm_gather *g, const uint32_t *texels, uint32_t count)
 {
     for (uint32_t i = 0; i < count; i++) {
-        texel_view v = view_of(g, s, &a->texels[texels[i]]);
-        float eye[3], n[3];
-        lm_v3_store(eye, v.eye);
-        lm_v3_store(n, v.axes[2]);
-        lm_emitter_irradiance(g->emitters, eye, n, texels[i], g->emit + 4 * (size_t)i);
+        const float *o = g->views + VIEW_FLOATS * (size_t)i;
+        lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], g->emit + 4 * (size_t)i);
     }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->emit_buf);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * 4 * count), g->emit);
@@ -584,7 +589,7 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
         render_tiles(g, s, a, texels + first, n, xy);
         if (g->emitters) {
             glFlush(); /* llvmpipe rasterizes the pass on its threads while this one computes */
-            emitter_irradiance(g, s, a, texels + first, n);
+            emitter_irradiance(g, texels + first, n);
         }
         reduce_tiles(g, iim_tex, xy, n);
     }
