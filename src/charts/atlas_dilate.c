@@ -49,3 +49,15 @@ void lm_atlas_dilate_gutters(const lm_atlas *a, float *data, int channels)
 {
     lm_atlas_dilate(a, data, channels, a->gutter > 1 ? a->gutter : 1);
 }
+
+void lm_atlas_dilated_rgba(const lm_atlas *a, const float *rgb, float *rgba)
+{
+    size_t n = (size_t)a->width * (size_t)a->height;
+    for (size_t i = 0; i < n; i++) {
+        rgba[4 * i + 0] = rgb[3 * i + 0];
+        rgba[4 * i + 1] = rgb[3 * i + 1];
+        rgba[4 * i + 2] = rgb[3 * i + 2];
+        rgba[4 * i + 3] = 0.0f;
+    }
+    lm_atlas_dilate_gutters(a, rgba, 4);
+}

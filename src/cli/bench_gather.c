@@ -9,7 +9,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../charts/atlas_dilate.h"
 #include "../core/stats.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
@@ -29,7 +28,7 @@ typedef struct {
     int paper_row;         /* Table 2 row group: 34, 13,000, 133,000 polygons */
     lmgi_scene *sc;
     lm_photon_stage *stage;
-    float *aim;            /* dilated AIM (atlas RGB) */
+    const float *aim;      /* dilated AIM (atlas RGBA, the photon stage's) */
     lm_emitter_light el;   /* with has_el: the closed-form emitter light the frame loop would take */
     int has_el;
     uint32_t texels[PASS];
@@ -52,14 +51,9 @@ static int open_scene(const char *label, int paper_row, const char *path, bench_
         printf("%s: %s\n", label, err.msg);
         return 0;
     }
-    size_t n = 3 * (size_t)a->width * a->height;
-    b->aim = malloc(sizeof(float) * n);
-    if (!b->aim)
-        return 0;
-    memcpy(b->aim, lm_aim_rgb(lm_photon_stage_aim(b->stage)), sizeof(float) * n);
+    b->aim = lm_aim_dilated_rgba(lm_photon_stage_aim(b->stage));
     b->has_el = lm_emitter_light_suits(b->sc->scene) &&
                 lm_emitter_light_init(&b->el, b->sc->scene, b->sc->rt, LM_EMITTER_LIGHT_DEFAULT_RAYS, &err) == LM_OK;
-    lm_atlas_dilate_gutters(a, b->aim, 3);
     /* a pass of a ~100k-triangle scene without the proxy takes seconds: a quarter pass there */
     uint32_t pass = b->sc->scene->tri_count > 50000 ? PASS / 4 : PASS;
     b->count = a->texel_count < pass ? a->texel_count : pass;
@@ -73,7 +67,6 @@ static void close_scene(bench_scene *b)
     if (b->has_el)
         lm_emitter_light_free(&b->el);
     lm_photon_stage_free(b->stage);
-    free(b->aim);
     lmgi_free(b->sc);
 }
 
@@ -98,7 +91,7 @@ static lm_gather *gather_for(const bench_scene *b, int R, int proxy, lm_gather_s
     if (lm_gather_create(&set, &g, &err) == LM_OK && !single && b->has_el)
         lm_gather_set_emitter_light(g, &b->el);
     if (!g || lm_gather_set_scene(g, b->sc->scene, &b->sc->atlas, &err) != LM_OK ||
-        lm_gather_set_aim(g, &b->sc->atlas, lm_aim_rgb(lm_photon_stage_aim(b->stage)), &err) != LM_OK) {
+        lm_gather_set_aim_dilated(g, &b->sc->atlas, b->aim, &err) != LM_OK) {
         printf("  %s: %s\n", b->label, err.msg);
         lm_gather_free(g);
         return NULL;
@@ -147,7 +140,7 @@ static lm_vec3 aim_at(const lm_atlas *a, const float *aim, float u, float v)
             int xi = x0 + i < 0 ? 0 : x0 + i >= a->width ? a->width - 1 : x0 + i;
             int yj = y0 + j < 0 ? 0 : y0 + j >= a->height ? a->height - 1 : y0 + j;
             float w = (i ? fx : 1 - fx) * (j ? fy : 1 - fy);
-            s = lm_add(s, lm_scale(lm_v3_load(aim + 3 * ((size_t)yj * a->width + xi)), w));
+            s = lm_add(s, lm_scale(lm_v3_load(aim + 4 * ((size_t)yj * a->width + xi)), w));
         }
     return s;
 }

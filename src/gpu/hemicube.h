@@ -111,8 +111,8 @@ void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el);
 const lm_proxy *lm_gather_proxy(const lm_gather *g);
 /* Uploads the AIM (atlas-sized RGB radiance, width*height*3 floats), dilated into the gutters. */
 lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err);
-/* The same for an AIM already dilated (lm_aim_dilated_rgb): uploaded as it is. */
-lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float *dilated_rgb, lm_error *err);
+/* The same for an AIM already dilated as RGBA (lm_aim_dilated_rgba): uploaded as it is. */
+lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float *dilated_rgba, lm_error *err);
 /* Gathers texels (indices into a->texels) into iim_tex (an RGBA32F texture of the atlas's size, from
  * lm_iim_texture_create): rgb = indirect irradiance E, a = back-face fraction. stats may be NULL. */
 lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,

@@ -330,13 +330,13 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
     return lm_gl_check("hemicube gather: scene upload", err);
 }
 
-lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float *dilated_rgb, lm_error *err)
+lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float *dilated_rgba, lm_error *err)
 {
     if (!g->aim_tex || g->aim_w != a->width || g->aim_h != a->height) {
         glDeleteTextures(1, &g->aim_tex);
         glGenTextures(1, &g->aim_tex);
         glBindTexture(GL_TEXTURE_2D, g->aim_tex);
-        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGB32F, a->width, a->height);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, a->width, a->height);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
@@ -345,18 +345,16 @@ lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float
     }
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a->width, a->height, GL_RGB, GL_FLOAT, dilated_rgb);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a->width, a->height, GL_RGBA, GL_FLOAT, dilated_rgba);
     return lm_gl_check("hemicube gather: AIM upload", err);
 }
 
 lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err)
 {
-    size_t n = 3 * (size_t)a->width * (size_t)a->height;
-    float *d = malloc(sizeof(float) * n);
+    float *d = malloc(sizeof(float) * 4 * (size_t)a->width * (size_t)a->height);
     if (!d)
         return lm_fail(err, LM_ERR_NOMEM, "no memory to dilate the AIM");
-    memcpy(d, aim_rgb, sizeof(float) * n);
-    lm_atlas_dilate_gutters(a, d, 3); /* chart edges must not blend in black */
+    lm_atlas_dilated_rgba(a, aim_rgb, d); /* chart edges must not blend in black */
     lm_status st = lm_gather_set_aim_dilated(g, a, d, err);
     free(d);
     return st;

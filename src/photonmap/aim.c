@@ -218,7 +218,7 @@ lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, con
     aim->height = a->height;
     aim->surface_count = su->surface_count;
     aim->rgb = calloc((size_t)a->width * (size_t)a->height * 3, sizeof *aim->rgb);
-    aim->dilated = calloc((size_t)a->width * (size_t)a->height * 3, sizeof *aim->dilated);
+    aim->dilated = calloc((size_t)a->width * (size_t)a->height * 4, sizeof *aim->dilated);
     aim->refresh_count = calloc((size_t)su->surface_count + 1, sizeof *aim->refresh_count);
     aim->edge_d2 = malloc(((size_t)a->texel_count + 1) * sizeof *aim->edge_d2);
     for (uint32_t i = 0; aim->edge_d2 && i < a->texel_count; i++)
@@ -248,7 +248,7 @@ void lm_aim_free(lm_aim *aim)
 }
 
 const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
-const float *lm_aim_dilated_rgb(const lm_aim *aim) { return aim->dilated; }
+const float *lm_aim_dilated_rgba(const lm_aim *aim) { return aim->dilated; }
 
 /* ---------- the node's transform ---------- */
 
@@ -774,8 +774,7 @@ static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfa
         free_surface(&jobs[j]);
     free(jobs);
     if (ok > 0) {
-        memcpy(aim->dilated, aim->rgb, sizeof(float) * 3 * (size_t)aim->width * (size_t)aim->height);
-        lm_atlas_dilate_gutters(a, aim->dilated, 3);
+        lm_atlas_dilated_rgba(a, aim->rgb, aim->dilated);
     }
     return rc;
 }

@@ -60,7 +60,8 @@ typedef struct {
     lm_aim_settings set;
     int width, height, surface_count;
     float *rgb;              /* width * height * 3, radiance; 0 in gutters, uncovered texels, unlit surfaces */
-    float *dilated;          /* rgb with the charts' borders copied into the gutters (lm_aim_dilated_rgb) */
+    float *dilated;          /* rgb as RGBA (a = 0) with the charts' borders copied into the gutters
+                                (lm_aim_dilated_rgba) */
     uint32_t *texel_first;   /* per surface (surface_count + 1 offsets) into texel_list */
     uint32_t *texel_list;    /* atlas texel indices grouped by surface */
     uint32_t *edge_first;    /* per surface (surface_count + 1 offsets) into edges */
@@ -92,9 +93,10 @@ lm_status lm_aim_refresh_surface(lm_aim *aim, const lm_scene *s, const lm_surfac
 
 /* The RGB float map (width * height * 3, row y at offset 3 * (y * width + x)). */
 const float *lm_aim_rgb(const lm_aim *aim);
-/* The same with each chart's border texels copied out into its gutters (lm_atlas_dilate_gutters), what a
- * bilinear lookup near a chart's edge needs; kept up to date by every refresh, so that the frame loop's
- * photon thread, not its rendering thread, pays for it. */
-const float *lm_aim_dilated_rgb(const lm_aim *aim);
+/* The same as RGBA (alpha 0; four floats a texel are what a GPU texture holds and samples fastest) with
+ * each chart's border texels copied out into its gutters (lm_atlas_dilate_gutters), what a bilinear lookup
+ * near a chart's edge needs; kept up to date by every refresh, so that the frame loop's photon thread, not
+ * its rendering thread, pays for it. */
+const float *lm_aim_dilated_rgba(const lm_aim *aim);
 
 #endif

@@ -55,7 +55,7 @@ static lm_status gather_prepare(lm_frame_loop *fl, lm_error *err)
 {
     lm_status st = lm_gather_set_scene(fl->gather, fl->scene, fl->atlas, err);
     if (st == LM_OK && fl->aim_stale)
-        st = lm_gather_set_aim_dilated(fl->gather, fl->atlas, lm_aim_dilated_rgb(lm_photon_stage_aim(fl->stage)), err);
+        st = lm_gather_set_aim_dilated(fl->gather, fl->atlas, lm_aim_dilated_rgba(lm_photon_stage_aim(fl->stage)), err);
     if (st == LM_OK)
         fl->aim_stale = 0;
     return st;
