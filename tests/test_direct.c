@@ -1,5 +1,6 @@
 /* gpu/direct: direct light per pixel with shadow maps. A point light over a plane against
- * rho/pi I cos/d^2, a box's shadow (umbra black, outside lit), a grazing directional light without
+ * rho/pi I cos/d^2, a box's shadow (umbra black, outside lit; also beyond each of a point light's six
+ * cube faces, with PCF radius 0 and 1), a grazing directional light without
  * acne (and with acne when the bias is off), a spot light's cone falloff against lm_spot_attenuation,
  * a contact shadow, the glossy lobe against lm_bsdf_eval, the base colour texture against
  * lm_material_albedo, determinism, and the persistent lm_direct's caches (after a node, the light or
@@ -137,10 +138,10 @@ static void test_point_plane(void **state)
 }
 
 /* Does the segment from plane point (x, 0, z) to the light (0, 2, 0) pass through the box centred at
- * (0.5, 1, 0) with half-size h? (slab test) */
-static int hits_box(double x, double z, double h)
+ * (0.5, 1, box_z) with half-size h? (slab test) */
+static int hits_box(double x, double z, double box_z, double h)
 {
-    double o[3] = {x, 0, z}, d[3] = {-x, 2, -z}, c[3] = {0.5, 1, 0}, t0 = 0, t1 = 1;
+    double o[3] = {x, 0, z}, d[3] = {-x, 2, -z}, c[3] = {0.5, 1, box_z}, t0 = 0, t1 = 1;
     for (int k = 0; k < 3; k++) {
         if (fabs(d[k]) < 1e-12) {
             if (fabs(o[k] - c[k]) > h)
@@ -160,36 +161,89 @@ static const char *box_scene(void)
                       "{\"type\": \"point\", \"intensity\": 10}");
 }
 
-/* (b) The umbra of a box between the light and the plane; the box's own footprint (seen from above:
- * its top) is skipped. */
-static void test_box_shadow(void **state)
+/* The umbra of box_scene's box (centred at (0.5, 1, box_z)) in a top view of the plane: the umbra
+ * pixels' worst fraction of the unshadowed radiance and the lit pixels' worst error; the box's own
+ * footprint (seen from above: its top) is skipped. Asserts enough of each. */
+static void check_box_shadow(const char *what, const float *rgb, double box_z)
 {
-    (void)state;
-    float *rgb = render(box_scene());
     int umbra = 0, lit = 0;
     double worst_umbra = 0.0, worst_lit = 0.0;
     for (int r = 0; r < W; r++)
         for (int i = 0; i < W; i++) {
             double x, z;
             pixel_xz(i, r, &x, &z);
-            if (fabs(x - 0.5) < 0.35 && fabs(z) < 0.35)
+            if (fabs(x - 0.5) < 0.35 && fabs(z - box_z) < 0.35)
                 continue; /* the box top */
             double d2 = x * x + z * z + 4.0, want = RHO / PI * 20.0 / (d2 * sqrt(d2));
             double got = lum(rgb + 3 * (r * W + i));
-            if (hits_box(x, z, 0.2)) {
+            if (hits_box(x, z, box_z, 0.2)) {
                 umbra++;
                 worst_umbra = fmax(worst_umbra, got / want);
-            } else if (!hits_box(x, z, 0.3)) {
+            } else if (!hits_box(x, z, box_z, 0.3)) {
                 lit++;
                 worst_lit = fmax(worst_lit, rel(got, want));
             }
         }
-    print_message("box shadow: %d umbra pixels, worst %.2e of lit; %d lit pixels, worst error %.2e\n", umbra,
+    print_message("%s: %d umbra pixels, worst %.2e of lit; %d lit pixels, worst error %.2e\n", what, umbra,
                   worst_umbra, lit, worst_lit);
     assert_true(umbra > 50 && lit > 1000);
     assert_true(worst_umbra <= 0.01);
     assert_true(worst_lit < 0.03);
+}
+
+/* (b) The umbra of a box between the light and the plane. */
+static void test_box_shadow(void **state)
+{
+    (void)state;
+    float *rgb = render(box_scene());
+    check_box_shadow("box shadow", rgb, 0.0);
     free(rgb);
+}
+
+/* (b') The same light, box and plane turned as a whole so that the plane lies beyond each of the point
+ * light's six cube faces in turn, seen by a camera turned with them; the box is off the light's axis in
+ * both directions across the face, so a face whose image were mirrored, turned or taken from another
+ * tile would put the umbra elsewhere. With one bilinear tap and with PCF radius 1 (4 taps). */
+static void test_box_shadow_every_face(void **state)
+{
+    (void)state;
+    const float h = 0.70710678f; /* rotations taking local -Y (light to plane) to +X, -X, +Y, -Y, +Z, -Z */
+    static const float turns[6][4] = {{0, 0, h, h}, {0, 0, -h, h}, {1, 0, 0, 0}, {0, 0, 0, 1}, {-h, 0, 0, h}, {h, 0, 0, h}};
+    static const char *names[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+    const double box_z = 0.3;
+    lm_load_options opt = {0};
+    lm_error err;
+    lm_direct_settings set;
+    lm_direct_settings_default(&set);
+    for (int k = 0; k < 12; k++) {
+        int f = k % 6;
+        set.pcf_radius = k / 6;
+        lm_scene *s = NULL;
+        assert_int_equal(lm_scene_load_gltf(box_scene(), &opt, &s, &err), LM_OK);
+        memcpy(s->nodes[0].rotation, turns[f], sizeof turns[f]); /* the root: plane, light, box */
+        s->nodes[3].translation[2] = (float)box_z;
+        lm_scene_update_world(s);
+        lm_scene_update_bounds(s);
+        lm_emitters em;
+        assert_int_equal(lm_emitters_build(s, &em, &err), LM_OK);
+        lm_emitters_update(&em, s);
+        lm_view v;
+        top_view(&v);
+        float to_local[16], eye[3] = {0, 5, 0};
+        assert_true(lm_mat4_invert_affine(to_local, s->nodes[0].world));
+        lm_mat4_mul(v.view, v.view, to_local);
+        lm_v3_store(v.eye, lm_mat4_point(s->nodes[0].world, lm_v3_load(eye)));
+        float *rgb = malloc(sizeof(float) * 3 * W * W);
+        assert_non_null(rgb);
+        if (lm_render_direct(s, &em, &v, W, W, &set, rgb, &err) != LM_OK)
+            fail_msg("render: %s", err.msg);
+        char what[64];
+        snprintf(what, sizeof what, "box shadow beyond %s, PCF radius %d", names[f], set.pcf_radius);
+        check_box_shadow(what, rgb, box_z);
+        free(rgb);
+        lm_emitters_free(&em);
+        lm_scene_free(s);
+    }
 }
 
 /* The plane under a directional light at 80 degrees from its normal. */
@@ -584,7 +638,7 @@ static void test_cache_nothing_moved(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_point_plane), cmocka_unit_test(test_box_shadow), cmocka_unit_test(test_grazing),
+        cmocka_unit_test(test_point_plane), cmocka_unit_test(test_box_shadow), cmocka_unit_test(test_box_shadow_every_face), cmocka_unit_test(test_grazing),
         cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
         cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
         cmocka_unit_test(test_cache_nothing_moved),
