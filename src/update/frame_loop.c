@@ -244,10 +244,14 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     return st == LM_OK ? blend_and_render(fl, o, err) : st;
 }
 
-/* Overlapped: animate, schedule and upload what the gather needs, then the photon stage's tracing and
- * AIM refresh run on the worker while this thread gathers, blends and renders. The gather therefore sees
- * the AIMs and delta_i of the previous frame's stage (one frame later than in order; the IIM blends over
- * several frames anyway). Every result depends only on that fixed order, not on timing. */
+/* Overlapped: animate, schedule and upload what the gather needs, gather, then the photon stage's
+ * tracing and AIM refresh run on the worker while this thread blends and renders. The gather therefore
+ * sees the AIMs and delta_i of the previous frame's stage (one frame later than in order; the IIM blends
+ * over several frames anyway). Every result depends only on that fixed order, not on timing. The gather
+ * runs before the worker starts: its CPU work (the emitter light's shadow rays, llvmpipe's vertex work
+ * for one view per texel) is on the frame's critical path and took twice as long sharing the two cores
+ * with the stage, while the direct light, whose second rasterizer thread gains little, hides the
+ * stage as well alone (docs/bench.md: frame 41.4 -> 38.7 ms in alternating `lmgi run`s). */
 static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
@@ -260,9 +264,9 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
     double t1 = lm_now();
     if (st != LM_OK)
         return st;
-    lm_stage_worker_begin(fl->worker, &o->stage);
     st = gather_run(fl, o->texels_gathered, err);
     o->t_gather = lm_now() - t1;
+    lm_stage_worker_begin(fl->worker, &o->stage);
     if (st == LM_OK)
         st = blend_and_render(fl, o, err);
     double t4 = lm_now();

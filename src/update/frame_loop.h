@@ -32,8 +32,8 @@ typedef struct {
                             * lm_emitter_light_suits the scene */
     int emitter_rays;      /* shadow rays per emissive triangle and texel (default 32) */
     int overlap;           /* 1 (default): the photon stage's tracing and AIM refresh run on a second thread
-                            * beside the gather and render, which then see the previous frame's AIMs and
-                            * delta_i; 0: the paper's order, all on the calling thread */
+                            * beside the render, after the gather, which then sees the previous frame's
+                            * AIMs and delta_i; 0: the paper's order, all on the calling thread */
     lm_iim_settings iim;
     lm_direct_settings direct;
     int width, height;     /* frame size (default 512 x 512) */
