@@ -31,7 +31,10 @@ typedef struct {
 
 /* Settings for turning a scene file into surfaces, a lightmap atlas and a ray-tracing scene. */
 typedef struct {
-    float texel_size;       /* world units per lightmap texel; 0 = derived from the scene (~64k texels) */
+    float texel_size;       /* world units per lightmap texel; 0 = derived from the scene: about target_texels */
+    int target_texels;      /* texels the derived texel size aims at (0, the default: 65536).
+                             * 'lmgi run' aims at 90 x its texels per frame (docs/gather.md, "Atlas
+                             * density") */
     int gutter;             /* minimum empty texels between charts (default 2) */
     int use_file_uv1;       /* 1 = use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping */
     int strict;             /* 1 = degenerate triangles and non-manifold edges are errors, not warnings */

@@ -624,7 +624,21 @@ static void test_default_texel_size(void **state)
     lm_surfaces su;
     lm_error err = {0};
     assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
-    assert_float_equal(lm_atlas_default_texel_size(&t->s, &su), 4.0f / 256.0f, 1e-6f);
+    assert_float_equal(lm_atlas_default_texel_size(&t->s, &su, 0), 4.0f / 256.0f, 1e-6f);
+    assert_float_equal(lm_atlas_default_texel_size(&t->s, &su, 1600), 4.0f / 40.0f, 1e-6f);
+    /* the atlas options' target: the 4 x 4 quad at 0.1 units a texel is 40 x 40 covered texels */
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    assert_int_equal(o.target_texels, LM_ATLAS_DEFAULT_TEXELS);
+    o.target_texels = 1600;
+    lm_atlas a;
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    assert_float_equal(a.texel_size, 0.1f, 1e-6f);
+    assert_true(a.texel_count >= 1600 && a.texel_count <= 1700);
+    lm_atlas_free(&a);
+    o.target_texels = -1;
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "target_texels"));
     lm_surfaces_free(&su);
     ts_free(t);
 }

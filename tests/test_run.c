@@ -1,5 +1,6 @@
-/* lmgi run: the files it writes, one CSV row per frame, deterministic frames, bad arguments, and the
- * composite in numbers on the furnace box (emission + albedo / pi * E_IIM = Le / (1 - rho)). */
+/* lmgi run: the files it writes, one CSV row per frame, deterministic frames, its atlas sized for its texel
+ * budget, bad arguments, and the composite in numbers on the furnace box (emission + albedo / pi * E_IIM
+ * = Le / (1 - rho)). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -242,6 +243,49 @@ static void test_setup_progress(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* The texels `lmgi run` reports on its "atlas" line. */
+static unsigned atlas_texels(void)
+{
+    const char *line = strstr(output, "atlas ");
+    unsigned w, h, n;
+    if (!line || sscanf(line, "atlas %u x %u, %u texels", &w, &h, &n) != 3)
+        fail_msg("no atlas line in: %s", output);
+    return n;
+}
+
+/* Without a texel size, run sizes its atlas for its texel budget: about 90 frames' worth of texels
+ * (LM_FRAME_LOOP_REFRESH_FRAMES), so that the IIM is regathered in full every 3 s; --texels and
+ * --texel-size override it. */
+static void test_atlas_follows_budget(void **state)
+{
+    (void)state;
+    char dir[1024], args[2048];
+    snprintf(dir, sizeof dir, "%s/budget", lmt_tmpdir());
+    const int budgets[2] = {10, 40};
+    for (int k = 0; k < 2; k++) {
+        snprintf(args, sizeof args, "run scenes/cornell.glb --frames 1 --size 32x32 --photons 5000 "
+                 "--texels-per-frame %d --out %s", budgets[k], dir);
+        if (lmgi(args) != 0)
+            fail_msg("lmgi run failed: %s", output);
+        unsigned n = atlas_texels(), want = (unsigned)lm_frame_loop_atlas_texels(budgets[k]);
+        print_message("--texels-per-frame %d: %u atlas texels (aimed at %u)\n", budgets[k], n, want);
+        assert_int_equal(want, 90u * (unsigned)budgets[k]);
+        assert_true(n > 0.75 * want && n < 1.25 * want);
+    }
+    snprintf(args, sizeof args, "run scenes/cornell.glb --frames 1 --size 32x32 --photons 5000 --texels 3000 "
+             "--out %s", dir);
+    assert_int_equal(lmgi(args), 0);
+    assert_true(atlas_texels() > 2250 && atlas_texels() < 3750);
+    snprintf(args, sizeof args, "run scenes/cornell.glb --frames 1 --size 32x32 --photons 5000 --texel-size 0.1 "
+             "--out %s", dir);
+    assert_int_equal(lmgi(args), 0);
+    unsigned fixed = atlas_texels();
+    assert_int_equal(lmgi("info scenes/cornell.glb --texel-size 0.1"), 0);
+    char want[64];
+    snprintf(want, sizeof want, "%u texels", fixed);
+    assert_non_null(strstr(output, want));
+}
+
 static void test_bad_args(void **state)
 {
     (void)state;
@@ -258,6 +302,8 @@ static void test_bad_args(void **state)
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --emitter-light bogus"), 2);
     assert_non_null(strstr(output, "closed or drawn"));
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --emitter-rays 0"), 2);
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --texels 4"), 2);
+    assert_non_null(strstr(output, "--texels"));
 }
 
 /* Inside a closed box of albedo 0.5 whose walls all emit Le = 1: every wall pixel of a frame shows
@@ -314,6 +360,7 @@ int main(void)
         cmocka_unit_test(test_gather_options),
         cmocka_unit_test(test_overlap_against_order),
         cmocka_unit_test(test_setup_progress),
+        cmocka_unit_test(test_atlas_follows_budget),
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_furnace_composite),
     };

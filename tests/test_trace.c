@@ -13,6 +13,8 @@
 
 /* A static floor (y = 0, x and z in [-1, 1]) and back wall (z = -1), and a dynamic cube of half-size 0.25
  * at (0, 0.5, 0) that an animation slides to x = 0.5 at t = 1. */
+static char scene_path[512]; /* where load_test_scene wrote the scene */
+
 static lmgi_scene *load_test_scene(void **state)
 {
     (void)state;
@@ -30,8 +32,8 @@ static lmgi_scene *load_test_scene(void **state)
     lmt_accessor acc[2] = {{times, 2, "SCALAR"}, {moves, 2, "VEC3"}};
     const char *anim = "\"animations\": [{\"samplers\": [{\"input\": 6, \"output\": 7}],"
                        " \"channels\": [{\"sampler\": 0, \"target\": {\"node\": 3, \"path\": \"translation\"}}]}],";
-    char path[512];
-    snprintf(path, sizeof path, "%s/trace.gltf", lmt_tmpdir());
+    char *path = scene_path;
+    snprintf(scene_path, sizeof scene_path, "%s/trace.gltf", lmt_tmpdir());
     assert_int_equal(lmt_write_gltf(path, mesh, 3, nodes, acc, 2, anim), 0);
     lmgi_scene *sc = NULL;
     lmgi_error err;
@@ -132,12 +134,41 @@ static void test_bad_edits_are_refused(void **state)
     lmgi_free(sc);
 }
 
+/* lmgi_options.target_texels: with no texel size the atlas aims at that many texels (0: 65,536); a
+ * negative count is refused with a message naming it. */
+static void test_target_texels(void **state)
+{
+    lmgi_scene *sc = load_test_scene(state);
+    lmgi_free(sc);
+    const char *path = scene_path;
+    lmgi_options o;
+    lmgi_options_init(&o);
+    assert_int_equal(o.target_texels, 0);
+    const int targets[3] = {0, 500, 5000};
+    for (int k = 0; k < 3; k++) {
+        o.target_texels = targets[k];
+        lmgi_error err;
+        if (lmgi_load(path, &o, &sc, &err) != LMGI_OK)
+            fail_msg("load failed: %s", err.message);
+        double want = targets[k] ? targets[k] : 65536.0, got = lmgi_texel_count(sc);
+        print_message("target %d: %.0f texels\n", targets[k], got);
+        assert_true(got > 0.75 * want && got < 1.25 * want);
+        lmgi_free(sc);
+    }
+    o.target_texels = -3;
+    lmgi_error err;
+    assert_int_equal(lmgi_load(path, &o, &sc, &err), LMGI_ERR_INVALID);
+    assert_null(sc);
+    assert_non_null(strstr(err.message, "target texel count -3"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hits_expected_surfaces),
         cmocka_unit_test(test_dynamic_hits_follow_transform),
         cmocka_unit_test(test_bad_edits_are_refused),
+        cmocka_unit_test(test_target_texels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

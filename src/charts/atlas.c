@@ -8,24 +8,22 @@
 #include "../core/timing.h"
 #include "charts_internal.h"
 
-/* Texels the default texel size aims at for the whole scene. */
-#define DEFAULT_TEXELS 65536.0
-
 void lm_atlas_options_default(lm_atlas_options *o)
 {
     o->texel_size = 0.0f;
+    o->target_texels = LM_ATLAS_DEFAULT_TEXELS;
     o->gutter = 2;
     o->use_file_uv1 = 0;
     o->max_size = 8192;
 }
 
-float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su)
+float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su, int target)
 {
     double area = 0.0;
     for (int i = 0; i < su->surface_count; i++)
         area += su->surfaces[i].area;
     if (area > 0.0 && isfinite(area))
-        return (float)sqrt(area / DEFAULT_TEXELS);
+        return (float)sqrt(area / (target > 0 ? target : LM_ATLAS_DEFAULT_TEXELS));
     float size = 0.0f;
     float *pos = s && s->vertex_count ? lmc_world_positions(s, &size) : NULL;
     free(pos);
@@ -102,6 +100,9 @@ static lm_status check_options(const lm_scene *s, const lm_surfaces *su, const l
     if (!isfinite(o->texel_size) || o->gutter < 0 || o->gutter > 64)
         return lm_fail(err, LM_ERR_INVALID, "charts: texel_size %g must be finite and gutter %d in [0, 64]",
                        (double)o->texel_size, o->gutter);
+    if (o->target_texels < 0)
+        return lm_fail(err, LM_ERR_INVALID, "charts: target_texels %d must be >= 0 (0: %d)", o->target_texels,
+                       LM_ATLAS_DEFAULT_TEXELS);
     if (o->max_size < 4 * (o->gutter + 1) || o->max_size > 65536)
         return lm_fail(err, LM_ERR_INVALID, "charts: max_size %d must be in [%d, 65536]", o->max_size,
                        4 * (o->gutter + 1));
@@ -152,7 +153,7 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     lm_status st = check_options(s, su, o, err);
     if (st != LM_OK)
         return st;
-    float ts = o->texel_size > 0.0f ? o->texel_size : lm_atlas_default_texel_size(s, su), size;
+    float ts = o->texel_size > 0.0f ? o->texel_size : lm_atlas_default_texel_size(s, su, o->target_texels), size;
     double t0 = lm_now();
     float *pos = lmc_world_positions(s, &size);
     if (!pos)

@@ -47,8 +47,13 @@ void lm_surface_options_default(lm_surface_options *o);
 lm_status lm_surfaces_build(const lm_scene *s, const lm_surface_options *o, lm_surfaces *out, lm_error *err);
 void lm_surfaces_free(lm_surfaces *su);
 
+/* Texels the derived texel size aims at for the whole scene unless told otherwise. */
+#define LM_ATLAS_DEFAULT_TEXELS 65536
+
 typedef struct {
     float texel_size;      /* world units per texel; <= 0 derives it from the scene (lm_atlas_default_texel_size) */
+    int target_texels;     /* with texel_size <= 0: the texels the derived size aims at (default and 0:
+                            * LM_ATLAS_DEFAULT_TEXELS) */
     int gutter;            /* minimum empty texels between two charts (default 2) */
     int use_file_uv1;      /* take charts from the file's TEXCOORD_1 instead of unwrapping */
     int max_size;          /* largest atlas side allowed (default 8192); texel_size grows to fit */
@@ -91,8 +96,9 @@ typedef struct {
 } lm_atlas;
 
 void lm_atlas_options_default(lm_atlas_options *o);
-/* sqrt(total surface area / 2^16): about 64k texels for the whole scene. */
-float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su);
+/* sqrt(total surface area / target): about `target` texels for the whole scene (fewer where charts round
+ * down, a few more at their edges). */
+float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su, int target);
 lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o,
                          lm_atlas *out, lm_error *err);
 void lm_atlas_free(lm_atlas *a);

@@ -159,6 +159,11 @@ static void summary(const run_state *r, int frames, const lm_photon_stage_frame 
         printf("%u emissive triangles in closed form (%d shadow rays each)\n", emissive, fs->emitter_rays);
     else
         printf("%u emissive triangles drawn\n", emissive);
+    const lm_atlas *at = &r->sc->atlas;
+    int per_frame = fs->iim.texels_per_frame;
+    printf("atlas       %d x %d, %u texels of %.4g units: regathered in full every %u frames at %d a frame\n",
+           at->width, at->height, at->texel_count, (double)at->texel_size,
+           (at->texel_count + (uint32_t)per_frame - 1) / (uint32_t)per_frame, per_frame);
     printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", 1e3 * setup->t_photons,
            1e3 * setup->t_aim, 1e3 * t_gather);
     printf("frames      %d, %u texels gathered, exposure %.4g (from frame 0)\n", frames, r->texels,
@@ -240,7 +245,10 @@ int lm_cli_run(const lm_cli_args *a)
     memset(&r, 0, sizeof r);
     r.a = a;
     lmgi_error perr;
-    if (lmgi_load(a->files[0], &a->options, &r.sc, &perr) != LMGI_OK) {
+    lmgi_options o = a->options;
+    if (o.texel_size <= 0.0f && o.target_texels <= 0) /* a density the texel budget keeps up with */
+        o.target_texels = lm_frame_loop_atlas_texels(a->texels_per_frame ? a->texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME);
+    if (lmgi_load(a->files[0], &o, &r.sc, &perr) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", perr.message);
         return 1;
     }

@@ -39,7 +39,7 @@ static const char *BLEND_CS =
 
 void lm_iim_settings_default(lm_iim_settings *s)
 {
-    s->texels_per_frame = 20;
+    s->texels_per_frame = LM_IIM_DEFAULT_TEXELS_PER_FRAME;
     s->blend_frames = 8;
     s->delta_threshold = 0.0;
 }

@@ -27,8 +27,10 @@
 #include "../core/error.h"
 #include "../trace/photon_store.h"
 
+#define LM_IIM_DEFAULT_TEXELS_PER_FRAME 20 /* the paper's */
+
 typedef struct {
-    int texels_per_frame;  /* gather budget per frame (default 20, the paper's) */
+    int texels_per_frame;  /* gather budget per frame (default LM_IIM_DEFAULT_TEXELS_PER_FRAME) */
     int blend_frames;      /* frames an updated surface takes to blend from old to new (default 8; 0 = pop) */
     double delta_threshold; /* a surface is refreshed when its delta_i exceeds this (default 0) */
 } lm_iim_settings;

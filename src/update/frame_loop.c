@@ -29,6 +29,12 @@ struct lm_frame_loop {
     lm_view view;
 };
 
+int lm_frame_loop_atlas_texels(int texels_per_frame)
+{
+    long n = (long)texels_per_frame * LM_FRAME_LOOP_REFRESH_FRAMES;
+    return n < 256 ? 256 : n > 1L << 28 ? 1 << 28 : (int)n;
+}
+
 void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
 {
     lm_photon_stage_settings_default(&s->stage);

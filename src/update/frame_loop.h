@@ -54,6 +54,15 @@ typedef struct {
 
 typedef struct lm_frame_loop lm_frame_loop;
 
+/* Frames over which the IIM of a loop that gathers texels_per_frame texels a frame is refreshed in full,
+ * at the lightmap density 'lmgi run' derives when given no texel size: 3 s at 30 fps. The paper's box had
+ * 140 texels for 20 a frame (7 frames); at the 64k-texel default of a bake, 20 texels a frame take
+ * 3,300 frames, so indirect light could not follow anything that moves (docs/gather.md, "Atlas
+ * density"). */
+#define LM_FRAME_LOOP_REFRESH_FRAMES 90
+/* The atlas texels to aim at for that: texels_per_frame x LM_FRAME_LOOP_REFRESH_FRAMES, at least 256. */
+int lm_frame_loop_atlas_texels(int texels_per_frame);
+
 void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
 /* The initial state. scene, surfaces, atlas and BVH are borrowed and must outlive the loop. setup (may
  * be NULL) gets the photon stage's setup times; t_setup_gather (may be NULL) the full gather's. */

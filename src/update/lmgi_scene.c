@@ -21,6 +21,7 @@ void lmgi_options_init(lmgi_options *o)
     lm_atlas_options_default(&ao);
     memset(o, 0, sizeof *o);
     o->texel_size = ao.texel_size;
+    o->target_texels = 0; /* LM_ATLAS_DEFAULT_TEXELS, unless a caller (lmgi run) knows better */
     o->gutter = ao.gutter;
     o->use_file_uv1 = ao.use_file_uv1;
     o->strict = so.strict;
@@ -42,6 +43,9 @@ static lm_status check_options(const char *path, const lmgi_options *o, lm_error
     if (!(o->texel_size >= 0.0f) || !isfinite(o->texel_size))
         return lm_fail(err, LM_ERR_INVALID, "%s: texel size %g must be a finite number >= 0 (0 = automatic)",
                        path, (double)o->texel_size);
+    if (o->target_texels < 0)
+        return lm_fail(err, LM_ERR_INVALID, "%s: target texel count %d must be >= 0 (0 = %d)", path,
+                       o->target_texels, LM_ATLAS_DEFAULT_TEXELS);
     if (o->gutter < 1 || o->gutter > 64)
         return lm_fail(err, LM_ERR_INVALID, "%s: gutter %d must be between 1 and 64 texels", path, o->gutter);
     if (!(o->surface_cone_deg > 0.0f && o->surface_cone_deg < 90.0f))
@@ -74,6 +78,7 @@ static lm_status build(lmgi_scene *sc, const char *path, const lmgi_options *o, 
     lm_atlas_options ao;
     lm_atlas_options_default(&ao);
     ao.texel_size = o->texel_size;
+    ao.target_texels = o->target_texels;
     ao.gutter = o->gutter;
     ao.use_file_uv1 = o->use_file_uv1;
     ao.max_size = o->max_atlas_size;
