@@ -16,9 +16,11 @@ double lm_halton(uint32_t dim, uint64_t index);
 /* lm_halton for the n dimensions dim .. dim + n - 1 of one point, into out[0 .. n - 1] (one
  * initialization check for all of them: a photon needs several numbers at a time). */
 void lm_halton_dims(uint32_t dim, uint32_t n, uint64_t index, double *out);
-/* lm_halton_dims as floats for dims dim .. dim + n - 1 < LM_QMC_MAX_DIMS: out[k] = (float)lm_halton,
- * lowered to the largest float below 1 where rounding to float reached 1, so every value is in
- * [0, 1). The photon tracer's form (a photon takes its numbers 1 to 4 at a time). */
+/* lm_halton_dims as floats for dims dim .. dim + n - 1 < LM_QMC_MAX_DIMS: out[k] within one float ulp
+ * of (float)lm_halton (its own tables hold fewer digits per lookup, as floats, so that the ones a
+ * photon path touches stay in the L1 cache), lowered to the largest float below 1 where rounding
+ * reached 1, so every value is in [0, 1). The photon tracer's form (a photon takes its numbers 1 to 4
+ * at a time). */
 void lm_halton_dims_float(uint32_t dim, uint32_t n, uint32_t index, float *out);
 /* Builds the permutation tables (idempotent; called by lm_halton on first use in a single thread). */
 void lm_qmc_init(void);
