@@ -255,8 +255,9 @@ int lm_cli_run(const lm_cli_args *a)
     r.a = a;
     lmgi_error perr;
     lmgi_options o = a->options;
+    int per_frame = a->texels_per_frame ? a->texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME;
     if (o.texel_size <= 0.0f && o.target_texels <= 0) /* a density the texel budget keeps up with */
-        o.target_texels = lm_frame_loop_atlas_texels(a->texels_per_frame ? a->texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME);
+        o.target_texels = lm_frame_loop_atlas_texels(per_frame);
     if (lmgi_load(a->files[0], &o, &r.sc, &perr) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", perr.message);
         return 1;
