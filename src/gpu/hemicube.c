@@ -5,6 +5,7 @@
 #include <math.h>
 
 #include "gl_shader.h"
+#include "../trace/emitter_light.h"
 
 #define PI_D 3.14159265358979323846
 
@@ -24,14 +25,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
 
 int lm_gather_coverage_for(const lm_scene *s, int closed_form_emitters)
 {
-    if (closed_form_emitters)
-        return 1;
-    for (uint32_t t = 0; t < s->tri_count; t++) {
-        const float *e = s->materials[s->tri_material[t]].emissive;
-        if (e[0] > 0.0f || e[1] > 0.0f || e[2] > 0.0f)
-            return 4;
-    }
-    return 1;
+    return !closed_form_emitters && lm_emissive_triangle_count(s) > 0 ? 4 : 1;
 }
 
 const char *lm_gather_scheme_name(lm_gather_scheme s)

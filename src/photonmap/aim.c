@@ -498,18 +498,8 @@ typedef struct {
 typedef struct {
     const double *flux;
     double inv_r2;  /* 1 / r^2 with the Epanechnikov kernel, 0 for the box */
-    double sum[3];
+    double sum[4];  /* RGB and the flux's fourth channel, 0 */
 } flux_sum;
-
-/* Adds w(d) Phi_i. */
-static void add_flux(void *ctx, uint32_t index, float d2)
-{
-    flux_sum *f = ctx;
-    double w = 1.0 - d2 * f->inv_r2;
-    w = w > 0.0 ? w : 0.0;
-    for (int c = 0; c < 3; c++)
-        f->sum[c] += w * f->flux[4 * (size_t)index + (size_t)c];
-}
 
 /* Adds hit index's w(d) Phi to the partial sum s (the fourth channel is 0). */
 static inline void add_hit(double s[4], const flux_sum *f, uint32_t index, float d2)
@@ -519,6 +509,13 @@ static inline void add_hit(double s[4], const flux_sum *f, uint32_t index, float
     const double *phi = f->flux + 4 * (size_t)index;
     for (int c = 0; c < 4; c++)
         s[c] += w * phi[c];
+}
+
+/* Adds w(d) Phi_i (the radius search's visitor). */
+static void add_flux(void *ctx, uint32_t index, float d2)
+{
+    flux_sum *f = ctx;
+    add_hit(f->sum, f, index, d2);
 }
 
 /* add_flux over the k found hits: hit i goes to partial sum i % 4 (in order within each), and the four
@@ -610,7 +607,7 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, texel_scrat
     int widened = (double)r2 < rmin2;
     if (widened)
         r2 = (float)rmin2;
-    flux_sum f = {j->hits->flux, j->kernel ? 1.0 / r2 : 0.0, {0.0, 0.0, 0.0}};
+    flux_sum f = {j->hits->flux, j->kernel ? 1.0 / r2 : 0.0, {0.0, 0.0, 0.0, 0.0}};
     if (widened)
         lm_kdtree_radius(j->tree, t->local, r2, add_flux, &f);
     else
