@@ -511,7 +511,7 @@ static void check_cache_follows(const char *path, int dynamic_node)
     live_load(&l, path, dynamic_node);
     lm_direct *d = NULL;
     lm_error err;
-    assert_int_equal(lm_direct_create(l.s, NULL, &d, &err), LM_OK);
+    assert_int_equal(lm_direct_create(l.s, NULL, NULL, &d, &err), LM_OK);
     float *first = render_both(d, &l, "first render");
     assert_int_equal(lm_direct_shadow_maps_rendered(d), 1);
 
@@ -568,7 +568,7 @@ static float *live_start(live_scene *l, lm_direct **d)
 {
     lm_error err;
     live_load(l, box_scene(), 3);
-    assert_int_equal(lm_direct_create(l->s, NULL, d, &err), LM_OK);
+    assert_int_equal(lm_direct_create(l->s, NULL, NULL, d, &err), LM_OK);
     return render_both(*d, l, "first render");
 }
 

@@ -54,7 +54,7 @@ struct lm_direct {
     unsigned long static_version;  /* bumped whenever a static shadow-casting node moves (an edit) */
     unsigned long dynamic_version; /* bumped whenever a dynamic shadow-casting node moves */
     long maps_rendered;
-    int has_lightmap;       /* the mesh carries lightmap uvs (lm_direct_use_lightmap) */
+    int has_lightmap;       /* the mesh carries lightmap uvs (an atlas at lm_direct_create) */
     unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
     float *scratch;         /* read-back, width x height RGBA */
     size_t scratch_px;
@@ -223,7 +223,8 @@ static int valid_settings(const lm_direct_settings *set)
     return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0;
 }
 
-lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings, lm_direct **out, lm_error *err)
+lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct_settings *settings, lm_direct **out,
+                           lm_error *err)
 {
     *out = NULL;
     lm_direct *d = calloc(1, sizeof *d);
@@ -255,7 +256,8 @@ lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings
         st = lm_shadow_renderer_create(&d->shadow, err);
     }
     if (st == LM_OK)
-        st = lm_direct_mesh_build(&d->mesh, s, NULL, err);
+        st = lm_direct_mesh_build(&d->mesh, s, a, err);
+    d->has_lightmap = a != NULL;
     if (st == LM_OK)
         st = lm_gl_check("direct_light: setup", err);
     if (st != LM_OK) {
@@ -336,15 +338,6 @@ lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em,
 
 unsigned lm_direct_texture(const lm_direct *d) { return d->target.color[0]; }
 
-lm_status lm_direct_use_lightmap(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
-{
-    lm_direct_mesh_free(&d->mesh); /* rebuilt: corners on different charts need their own vertices */
-    lm_status st = lm_direct_mesh_build(&d->mesh, s, a, err);
-    if (st == LM_OK)
-        d->has_lightmap = 1;
-    return st == LM_OK ? lm_gl_check("direct_light: lightmap uvs", err) : st;
-}
-
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
@@ -374,7 +367,7 @@ lm_status lm_render_direct(const lm_scene *s, const lm_emitters *em, const lm_vi
     if (width <= 0 || height <= 0)
         return lm_fail(err, LM_ERR_INVALID, "direct_light: bad size %dx%d or settings", width, height);
     lm_direct *d = NULL;
-    lm_status st = lm_direct_create(s, settings, &d, err);
+    lm_status st = lm_direct_create(s, NULL, settings, &d, err);
     if (st == LM_OK)
         st = lm_direct_render(d, s, em, view, width, height, rgb, err);
     lm_direct_free(d);

@@ -34,8 +34,11 @@ void lm_direct_settings_default(lm_direct_settings *s);
  * textures, the node set, which nodes cast shadows) is fixed at creation. Needs a current GL context. */
 typedef struct lm_direct lm_direct;
 
-/* settings NULL = defaults; they are fixed for the object's life. */
-lm_status lm_direct_create(const lm_scene *s, const lm_direct_settings *settings, lm_direct **out, lm_error *err);
+/* settings NULL = defaults; they are fixed for the object's life. a (may be NULL): the lightmap atlas
+ * whose uvs the vertices carry, so that the first pass can add the frame's indirect light
+ * (lm_direct_set_indirect). */
+lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct_settings *settings, lm_direct **out,
+                           lm_error *err);
 void lm_direct_free(lm_direct *d);
 /* Renders into the object's width x height RGBA32F target (no read-back); see lm_direct_texture. em and
  * s->bounds current as for lm_render_direct. */
@@ -46,12 +49,9 @@ unsigned lm_direct_texture(const lm_direct *d);
 /* lm_direct_draw, then the image read back as RGB floats (row 0 at the top). */
 lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                            int height, float *rgb, lm_error *err);
-/* From now on the vertices carry their lightmap uv in atlas a, so that the first pass can add the
- * frame's indirect light (lm_direct_set_indirect). */
-lm_status lm_direct_use_lightmap(lm_direct *d, const lm_scene *s, const lm_atlas *a, lm_error *err);
 /* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
- * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs
- * lm_direct_use_lightmap; surfaces without a chart (mirror, glass) and the background get none. */
+ * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
+ * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);
 /* Shadow maps rendered since creation (each cube map counts once), for tests and statistics. */
 long lm_direct_shadow_maps_rendered(const lm_direct *d);

@@ -132,9 +132,7 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     if (st == LM_OK)
         st = lm_composite_create(fl->scene, fl->atlas, fl->set.gather.backface_limit, &fl->comp, err);
     if (st == LM_OK)
-        st = lm_direct_create(fl->scene, &fl->set.direct, &fl->direct_light, err);
-    if (st == LM_OK)
-        st = lm_direct_use_lightmap(fl->direct_light, fl->scene, fl->atlas, err);
+        st = lm_direct_create(fl->scene, fl->atlas, &fl->set.direct, &fl->direct_light, err);
     double t0 = lm_now();
     fl->aim_stale = 1;
     if (st == LM_OK)
