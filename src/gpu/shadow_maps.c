@@ -7,7 +7,6 @@
 #include "../core/vecmath.h"
 #include "gl_shader.h"
 
-
 static const char *VS =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"

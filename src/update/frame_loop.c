@@ -56,7 +56,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
 static lm_photon_store *store_of(lm_frame_loop *fl) { return lm_photon_stage_store(fl->stage); }
 
 /* Uploads the current scene and, when they changed since the last upload, the AIMs: all the gather reads
- * of the photon stage, so that the stage may run on beside the gather once this returns. */
+ * of the photon stage, so that the stage may run again once this returns. */
 static lm_status gather_prepare(lm_frame_loop *fl, lm_error *err)
 {
     lm_status st = lm_gather_set_scene(fl->gather, fl->scene, fl->atlas, err);
