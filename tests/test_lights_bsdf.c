@@ -317,11 +317,23 @@ static void test_shading_from_hit(void **state)
     assert_float_equal(sh.local[0], 0.25, 1e-5);
     assert_float_equal(sh.ng[1], 1.0, 1e-5);
     assert_float_equal(sh.ns[1], 1.0, 1e-5);
-    assert_float_equal(sh.uv0[0], 0.625, 1e-5); /* u = (x_local + 1) / 2 */
-    assert_float_equal(sh.uv0[1], 0.625, 1e-5);
     assert_float_equal(sh.albedo[0], 0.5, 1e-6);
     assert_ptr_equal(sh.material, &t.mat[0]);
     assert_int_equal(sh.node, 0);
+    /* A textured material: the albedo is the texture at the hit's interpolated uv, (0.625, 0.625)
+     * (u = (x_local + 1) / 2), and the 2 x 2 texture differs a quarter of a unit away. */
+    float texels[16] = {0.9f, 0.5f, 0.2f, 1, 0.1f, 0.1f, 0.1f, 1, 0.3f, 0.3f, 0.3f, 1, 0.2f, 0.2f, 0.2f, 1};
+    lm_texture tex = {.width = 2, .height = 2, .rgba = texels};
+    t.s.textures = &tex;
+    t.s.texture_count = 1;
+    t.mat[0].base_color_tex = 0;
+    lm_shading_from_hit(&t.s, &hit, org, dir, &sh);
+    float want[3], aside[3];
+    lm_material_albedo(&t.s, &t.mat[0], 0.625f, 0.625f, want);
+    lm_material_albedo(&t.s, &t.mat[0], 0.375f, 0.625f, aside);
+    for (int c = 0; c < 3; c++)
+        assert_float_equal(sh.albedo[c], want[c], 1e-5);
+    assert_true(fabsf(want[0] - aside[0]) > 0.01f);
     lm_rt_free(rt);
 }
 

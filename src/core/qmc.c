@@ -35,17 +35,12 @@ typedef struct {
 static qmc_dim g_dims[LM_QMC_MAX_DIMS];
 static double g_storage[LM_QMC_TABLE_TOTAL];
 
-/* The float path's tables (lm_halton_dims_float): chunks of at most LM_QMC_FCHUNK_MAX entries, stored as
- * floats, so that the tables a photon path touches (its first few dozen dimensions) stay in L1. */
+/* The float path's tables (lm_halton_float, qmc.h): chunks of at most LM_QMC_FCHUNK_MAX entries,
+ * stored as floats, so that the tables a photon path touches (its first few dozen dimensions) stay
+ * in L1. */
 #define LM_QMC_FCHUNK_MAX 256u
 #define LM_QMC_FTABLE_TOTAL 192677u /* sum of the 256 chunk sizes at FCHUNK_MAX */
-typedef struct {
-    uint32_t chunk;
-    double inv_chunk;
-    uint64_t magic;
-    float *table;
-} qmc_fdim;
-static qmc_fdim g_fdims[LM_QMC_MAX_DIMS];
+lm_qmc_fdim lm_qmc_fdims[LM_QMC_MAX_DIMS];
 static float g_fstorage[LM_QMC_FTABLE_TOTAL];
 static pthread_once_t g_once = PTHREAD_ONCE_INIT;
 static _Atomic int g_ready; /* set once the tables are built: later calls skip pthread_once */
@@ -119,7 +114,7 @@ static void init_once(void)
         if (!is_prime(n))
             continue;
         qmc_dim *d = &g_dims[i];
-        qmc_fdim *f = &g_fdims[i];
+        lm_qmc_fdim *f = &lm_qmc_fdims[i];
         uint32_t digits, fdigits;
         d->base = n;
         chunk_shape(n, LM_QMC_CHUNK_MAX, &d->chunk, &digits);
@@ -130,13 +125,14 @@ static void init_once(void)
         chunk_shape(n, LM_QMC_FCHUNK_MAX, &f->chunk, &fdigits);
         f->inv_chunk = 1.0 / f->chunk;
         f->magic = UINT64_MAX / f->chunk + 1;
-        f->table = g_fstorage + fat;
+        float *ftable = g_fstorage + fat;
+        f->table = ftable;
         fat += f->chunk;
         make_permutation(i, n, perm);
         for (uint32_t x = 0; x < d->chunk; x++)
             d->table[x] = chunk_value(x, n, digits, perm);
         for (uint32_t x = 0; x < f->chunk; x++)
-            f->table[x] = (float)chunk_value(x, n, fdigits, perm);
+            ftable[x] = (float)chunk_value(x, n, fdigits, perm);
         i++;
     }
     atomic_store_explicit(&g_ready, 1, memory_order_release);
@@ -209,26 +205,9 @@ void lm_halton_dims(uint32_t dim, uint32_t n, uint64_t index, double *out)
         out[k] = radical(&g_dims[(dim + k) % LM_QMC_MAX_DIMS], index);
 }
 
-/* radical32 from the float tables: more, smaller chunks, summed in double. */
-static inline double fradical32(const qmc_fdim *d, uint32_t i)
-{
-    uint32_t r;
-    i = split_by(d->magic, d->chunk, i, &r);
-    double v = d->table[r], scale = d->inv_chunk;
-    while (i != 0) {
-        i = split_by(d->magic, d->chunk, i, &r);
-        v += d->table[r] * scale;
-        scale *= d->inv_chunk;
-    }
-    return v;
-}
-
 void lm_halton_dims_float(uint32_t dim, uint32_t n, uint32_t index, float *out)
 {
     qmc_ready();
-    const qmc_fdim *d = &g_fdims[dim];
-    for (uint32_t k = 0; k < n; k++) {
-        float f = (float)fradical32(&d[k], index);
-        out[k] = f < 1.0f ? f : 0x1.fffffep-1f;
-    }
+    for (uint32_t k = 0; k < n; k++)
+        out[k] = lm_halton_float(dim + k, index);
 }

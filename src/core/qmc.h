@@ -24,6 +24,33 @@ void lm_halton_dims(uint32_t dim, uint32_t n, uint64_t index, double *out);
 void lm_halton_dims_float(uint32_t dim, uint32_t n, uint32_t index, float *out);
 /* Builds the permutation tables (idempotent; called by lm_halton on first use in a single thread). */
 void lm_qmc_init(void);
+
+/* The float path's tables, for lm_halton_float (inline: a photon bounce takes its numbers one or
+ * two at a time, and a call per number cost a third of the number). Built by lm_qmc_init. */
+typedef struct {
+    uint32_t chunk;       /* b^k <= 256 */
+    double inv_chunk;     /* 1 / chunk */
+    uint64_t magic;       /* ceil(2^64 / chunk): i / chunk as one multiply (qmc.c) */
+    const float *table;   /* chunk entries: permuted radical inverse of k digits */
+} lm_qmc_fdim;
+extern lm_qmc_fdim lm_qmc_fdims[LM_QMC_MAX_DIMS];
+
+/* One number of lm_halton_dims_float (the same value bit for bit), without the initialization
+ * check: call lm_qmc_init (or any other function here) once before. dim < LM_QMC_MAX_DIMS. */
+static inline float lm_halton_float(uint32_t dim, uint32_t index)
+{
+    const lm_qmc_fdim *d = &lm_qmc_fdims[dim];
+    uint32_t q = (uint32_t)(((unsigned __int128)d->magic * index) >> 64);
+    double v = d->table[index - q * d->chunk], scale = d->inv_chunk;
+    while (q != 0) {
+        uint32_t i = q;
+        q = (uint32_t)(((unsigned __int128)d->magic * i) >> 64);
+        v += d->table[i - q * d->chunk] * scale;
+        scale *= d->inv_chunk;
+    }
+    float f = (float)v;
+    return f < 1.0f ? f : 0x1.fffffep-1f;
+}
 /* The d-th prime (d = 0 -> 2). */
 uint32_t lm_qmc_prime(uint32_t dim);
 

@@ -40,6 +40,29 @@ static inline void lm_tangents(lm_vec3 n, lm_vec3 *t, lm_vec3 *b)
     *b = lm_cross(n, *t);
 }
 static inline int lm_v3_finite(lm_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
+/* Unit t and b with (t, b, n) orthonormal for unit n, without a branch or a square root (Duff et al.
+ * 2017, "Building an orthonormal basis, revisited"): the sampling frame of photons and BSDF lobes. */
+static inline void lm_onb(lm_vec3 n, lm_vec3 *t, lm_vec3 *b)
+{
+    float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), c = n.x * n.y * a;
+    *t = lm_v3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
+    *b = lm_v3(c, sign + n.y * n.y * a, -n.y);
+}
+/* sin and cos of the angle 2 pi u, u in [0, 1) (a sampled azimuth), within 1e-7 of the exact values:
+ * a quarter turn picked by rounding 4u, then Taylor polynomials to degree 9 and 8 on |r| <= pi / 4
+ * (truncation below 3e-8). Several times cheaper than sincosf, which must reduce any argument, and
+ * without branches: the quadrant is random for every photon. */
+static inline void lm_sincos_turn(float u, float *s, float *c)
+{
+    float y = 4.0f * u;
+    int q = (int)(y + 0.5f); /* nearest quarter turn, 0..4 */
+    float r = (y - (float)q) * 1.57079632679489662f, r2 = r * r;
+    float sn = r * (1.0f + r2 * (-1.0f / 6 + r2 * (1.0f / 120 + r2 * (-1.0f / 5040 + r2 * (1.0f / 362880)))));
+    float cs = 1.0f + r2 * (-0.5f + r2 * (1.0f / 24 + r2 * (-1.0f / 720 + r2 * (1.0f / 40320))));
+    float sa = q & 1 ? cs : sn, ca = q & 1 ? sn : cs; /* sin(r + q pi/2), cos(r + q pi/2) up to sign */
+    *s = q & 2 ? -sa : sa;
+    *c = (q + 1) & 2 ? -ca : ca;
+}
 
 void lm_mat4_identity(float m[16]);
 void lm_mat4_mul(float out[16], const float a[16], const float b[16]); /* out = a * b (out may alias) */
@@ -55,18 +78,31 @@ static inline lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p)
                  m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
 }
 lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d);
+/* The matrix that takes normals to world space under m: the cofactors of m's upper 3x3 (its inverse
+ * transpose times det), turned by det's sign so the normal keeps its side. Column-major 3x3. */
+static inline void lm_mat4_normal_matrix(const float m[16], float out[9])
+{
+    lm_vec3 c0 = lm_v3(m[0], m[1], m[2]), c1 = lm_v3(m[4], m[5], m[6]), c2 = lm_v3(m[8], m[9], m[10]);
+    lm_vec3 r0 = lm_cross(c1, c2), r1 = lm_cross(c2, c0), r2 = lm_cross(c0, c1);
+    float sign = lm_dot(c0, r0) < 0.0f ? -1.0f : 1.0f;
+    lm_v3_store(out, lm_scale(r0, sign));
+    lm_v3_store(out + 3, lm_scale(r1, sign));
+    lm_v3_store(out + 6, lm_scale(r2, sign));
+}
+/* A normal through a normal matrix (lm_mat4_normal_matrix), not normalized. */
+static inline lm_vec3 lm_mat3_normal(const float nm[9], lm_vec3 n)
+{
+    return lm_add(lm_add(lm_scale(lm_v3_load(nm), n.x), lm_scale(lm_v3_load(nm + 3), n.y)),
+                  lm_scale(lm_v3_load(nm + 6), n.z));
+}
 /* Normal transform: inverse-transpose of the upper 3x3, result normalized. The cofactor matrix is det
  * times the inverse-transpose: the scale drops out on normalization, and flipping by the sign of det
  * gives the true inverse-transpose for mirroring transforms too. */
 static inline lm_vec3 lm_mat4_normal(const float m[16], lm_vec3 n)
 {
-    lm_vec3 c0 = lm_v3(m[0], m[1], m[2]), c1 = lm_v3(m[4], m[5], m[6]), c2 = lm_v3(m[8], m[9], m[10]);
-    lm_vec3 r0 = lm_cross(c1, c2), r1 = lm_cross(c2, c0), r2 = lm_cross(c0, c1);
-    lm_vec3 out = lm_add(lm_add(lm_scale(r0, n.x), lm_scale(r1, n.y)), lm_scale(r2, n.z));
-    float det = lm_dot(c0, r0);
-    if (det < 0.0f)
-        out = lm_scale(out, -1.0f);
-    return lm_normalize(out);
+    float nm[9];
+    lm_mat4_normal_matrix(m, nm);
+    return lm_normalize(lm_mat3_normal(nm, n));
 }
 int lm_mat4_finite(const float m[16]);
 void lm_mat4_perspective(float m[16], float yfov, float aspect, float znear, float zfar);

@@ -29,35 +29,25 @@
 static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
 
-/* Orthonormal basis (t, b) around unit n (Duff et al. 2017, "Building an orthonormal basis, revisited"). */
-static void basis(lm_vec3 n, lm_vec3 *t, lm_vec3 *b)
-{
-    float sign = copysignf(1.0f, n.z);
-    float a = -1.0f / (sign + n.z), c = n.x * n.y * a;
-    *t = lm_v3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
-    *b = lm_v3(c, sign + n.y * n.y * a, -n.y);
-}
-
 static lm_vec3 from_local(lm_vec3 n, float x, float y, float z)
 {
     lm_vec3 t, b;
-    basis(n, &t, &b);
+    lm_onb(n, &t, &b);
     return lm_add(lm_add(lm_scale(t, x), lm_scale(b, y)), lm_scale(n, z));
 }
 
-/* Direction around n with density cos^e(angle) (e = 1: cosine-weighted, pdf cos / pi). */
+/* Direction around n with density cos^e(angle) (e = 1: cosine-weighted, pdf cos / pi). Unit up to
+ * rounding: (x, y, z) is unit and the frame orthonormal. */
 static lm_vec3 sample_power_cos(lm_vec3 n, float e, float u0, float u1)
 {
     /* e = 1 (every diffuse bounce): the root is a sqrtf, several times cheaper than powf. */
     float c = e == 1.0f ? sqrtf(1.0f - u0) : powf(1.0f - u0, 1.0f / (e + 1.0f));
-    float s = sqrtf(fmaxf(0.0f, 1.0f - c * c));
-    float phi = 2.0f * LM_PI * u1;
-    return lm_normalize(from_local(n, s * cosf(phi), s * sinf(phi), c));
+    float s = sqrtf(1.0f - c * c), sn, cs; /* c <= 1, so c * c <= 1 */
+    lm_sincos_turn(u1, &sn, &cs);
+    return from_local(n, s * cs, s * sn, c);
 }
 
 static lm_vec3 reflect(lm_vec3 d, lm_vec3 n) { return lm_sub(d, lm_scale(n, 2.0f * lm_dot(d, n))); }
-
-static int is_specular(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLASS; }
 
 /* Turns ng, ns towards the side wi comes from. Returns 0 for the back of a single-sided opaque surface. */
 static int orient(const lm_shading *sh, lm_vec3 wi, lm_vec3 *ng, lm_vec3 *ns)
@@ -200,13 +190,20 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], l
     if (sh->material->cls == LM_MAT_MIRROR)
         return sample_mirror(sh, ng, ns, wi, out);
     lm_vec3 wo;
-    if (sh->material->cls == LM_MAT_GLOSSY) {
-        glossy_params g;
-        glossy(sh, &g);
-        wo = u[2] < g.p_spec ? sample_power_cos(reflect(wi, ns), g.n, u[0], u[1]) : sample_power_cos(ns, 1.0f, u[0], u[1]);
-    } else {
+    if (sh->material->cls != LM_MAT_GLOSSY) {
+        /* Cosine-weighted: f cos / pdf = (albedo / pi) cos / (cos / pi) = albedo, so no evaluation,
+         * only eval_oriented's test that wo leaves above both normals. */
         wo = sample_power_cos(ns, 1.0f, u[0], u[1]);
+        if (lm_dot(ns, wo) <= 0.0f || lm_dot(ng, wo) <= 0.0f)
+            return 0;
+        lm_v3_store(out->wo, wo);
+        for (int c = 0; c < 3; c++)
+            out->weight[c] = sh->albedo[c];
+        return out->weight[0] > 0.0f || out->weight[1] > 0.0f || out->weight[2] > 0.0f;
     }
+    glossy_params g;
+    glossy(sh, &g);
+    wo = u[2] < g.p_spec ? sample_power_cos(reflect(wi, ns), g.n, u[0], u[1]) : sample_power_cos(ns, 1.0f, u[0], u[1]);
     float f[3], pdf;
     eval_oriented(sh, wi, wo, ng, ns, f, &pdf);
     if (!(pdf > 0.0f))
@@ -217,26 +214,12 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], l
     return out->weight[0] > 0.0f || out->weight[1] > 0.0f || out->weight[2] > 0.0f;
 }
 
-int lm_bsdf_sample_dims(const lm_shading *sh)
-{
-    switch (sh->material->cls) {
-    case LM_MAT_MIRROR:
-        return 0;
-    case LM_MAT_GLASS:
-        return 1;
-    case LM_MAT_GLOSSY:
-        return 3;
-    default:
-        return 2;
-    }
-}
-
 void lm_bsdf_eval(const lm_shading *sh, const float wi_[3], const float wo_[3], float out[3])
 {
     lm_vec3 wi = lm_v3_load(wi_), ng, ns;
     float pdf;
     out[0] = out[1] = out[2] = 0.0f;
-    if (is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
+    if (lm_material_is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
         return;
     eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, out, &pdf);
 }
@@ -245,20 +228,8 @@ float lm_bsdf_pdf(const lm_shading *sh, const float wi_[3], const float wo_[3])
 {
     lm_vec3 wi = lm_v3_load(wi_), ng, ns;
     float f[3], pdf = 0.0f;
-    if (is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
+    if (lm_material_is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
         return 0.0f;
     eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, f, &pdf);
     return pdf;
-}
-
-float lm_bsdf_survival(const lm_shading *sh)
-{
-    if (is_specular(sh->material->cls))
-        return 1.0f;
-    return clampf(lum(sh->albedo), 0.05f, 0.95f);
-}
-
-int lm_material_stores_hits(lm_material_class c)
-{
-    return c == LM_MAT_DIFFUSE || c == LM_MAT_GLOSSY || c == LM_MAT_EMITTER;
 }

@@ -18,15 +18,32 @@ typedef struct {
 /* Samples an outgoing direction from three uniform numbers in [0,1). Returns 0 if the sample is
  * absorbed or invalid (below the surface for a reflective lobe). */
 int lm_bsdf_sample(const lm_shading *sh, const float wi[3], const float u[3], lm_bsdf_sample_t *out);
-/* How many of lm_bsdf_sample's numbers the material reads, u[0 .. n): 0 mirror, 1 glass, 2 diffuse
- * and emitter, 3 glossy. The others may be left unset (a photon then skips computing them). */
-int lm_bsdf_sample_dims(const lm_shading *sh);
 /* f(wi -> wo) * |cos(ns, wo)| for the non-specular part (0 for mirror and glass). */
 void lm_bsdf_eval(const lm_shading *sh, const float wi[3], const float wo[3], float out[3]);
-/* Luminance of the albedo, the Russian-roulette survival probability before a bounce, in (0, 1]. */
-float lm_bsdf_survival(const lm_shading *sh);
+
+/* Inline, as every photon hit asks them (a call each cost more than the answer). */
+static inline int lm_material_is_specular(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLASS; }
+/* How many of lm_bsdf_sample's numbers the material reads, u[0 .. n): 0 mirror, 1 glass, 2 diffuse
+ * and emitter, 3 glossy. The others may be left unset (a photon then skips computing them). */
+static inline int lm_bsdf_sample_dims(const lm_shading *sh)
+{
+    lm_material_class c = sh->material->cls;
+    return c == LM_MAT_MIRROR ? 0 : c == LM_MAT_GLASS ? 1 : c == LM_MAT_GLOSSY ? 3 : 2;
+}
+/* Luminance of the albedo clamped to [0.05, 0.95], the Russian-roulette survival probability before a
+ * bounce; 1 for mirror and glass. */
+static inline float lm_bsdf_survival(const lm_shading *sh)
+{
+    if (lm_material_is_specular(sh->material->cls))
+        return 1.0f;
+    float l = 0.2126f * sh->albedo[0] + 0.7152f * sh->albedo[1] + 0.0722f * sh->albedo[2];
+    return l < 0.05f ? 0.05f : l > 0.95f ? 0.95f : l;
+}
 /* True for classes that store photon hits (diffuse, glossy, emitter). */
-int lm_material_stores_hits(lm_material_class c);
+static inline int lm_material_stores_hits(lm_material_class c)
+{
+    return c == LM_MAT_DIFFUSE || c == LM_MAT_GLOSSY || c == LM_MAT_EMITTER;
+}
 
 /* Additions used by the reference solver and the tests (bsdf.c documents the lobes):
  * lm_bsdf_pdf: solid-angle density with which lm_bsdf_sample picks wo for the non-specular part

@@ -203,16 +203,16 @@ void lm_emitters_update(lm_emitters *em, const lm_scene *s)
 
 /* ---- sampling helpers ---- */
 
+/* x t + y b + z n in the frame of unit n: unit for unit (x, y, z) up to rounding. */
 static lm_vec3 frame_dir(lm_vec3 n, float x, float y, float z)
 {
-    float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
-    lm_vec3 t = lm_v3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    lm_vec3 bt = lm_v3(b, sign + n.y * n.y * a, -n.y);
-    return lm_normalize(lm_add(lm_add(lm_scale(t, x), lm_scale(bt, y)), lm_scale(n, z)));
+    lm_vec3 t, b;
+    lm_onb(n, &t, &b);
+    return lm_add(lm_add(lm_scale(t, x), lm_scale(b, y)), lm_scale(n, z));
 }
 
 /* Index of the triangle u falls on in the CDF; *rest = u's position inside that triangle's interval. */
-static uint32_t pick_tri(const lm_emitter *e, float u, float *rest, float *prob)
+static inline uint32_t pick_tri(const lm_emitter *e, float u, float *rest, float *prob)
 {
     uint32_t lo = 0, hi = e->tri_count - 1;
     while (lo < hi) {
@@ -224,12 +224,13 @@ static uint32_t pick_tri(const lm_emitter *e, float u, float *rest, float *prob)
     }
     float a = lo ? e->cdf[lo - 1] : 0.0f, b = e->cdf[lo];
     *prob = b - a;
-    *rest = b > a ? fminf(fmaxf((u - a) / (b - a), 0.0f), 0.99999994f) : 0.5f;
+    float r = (u - a) / (b - a); /* clamped by comparisons: fminf and fmaxf are calls here */
+    *rest = b > a ? (r > 0.0f ? (r < 0.99999994f ? r : 0.99999994f) : 0.0f) : 0.5f;
     return lo;
 }
 
 /* Uniform point on the triangle from two numbers: b = (1 - sqrt a, sqrt a (1 - c), sqrt a c). */
-static lm_vec3 tri_point(const lm_vec3 p[3], float a, float c)
+static inline lm_vec3 tri_point(const lm_vec3 p[3], float a, float c)
 {
     float r = sqrtf(a);
     return lm_add(lm_add(lm_scale(p[0], 1.0f - r), lm_scale(p[1], r * (1.0f - c))), lm_scale(p[2], r * c));
@@ -243,7 +244,11 @@ static void place_tri(const lm_scene *s, uint32_t t, float lift, lm_emit_tri *ou
     lm_vec3 p[3], cr = tri_world(s, t, p);
     for (int k = 0; k < 3; k++)
         lm_v3_store(out->p[k], p[k]);
-    lm_v3_store(out->n, lm_normalize(cr));
+    lm_vec3 n = lm_normalize(cr), tan, bit;
+    lm_onb(n, &tan, &bit);
+    lm_v3_store(out->n, n);
+    lm_v3_store(out->t, tan);
+    lm_v3_store(out->b, bit);
     tri_flux_of_area(s, t, 0.5f * lm_length(cr), out->flux);
     out->lift = lift;
     out->double_sided = s->materials[s->tri_material[t]].double_sided != 0;
@@ -273,35 +278,39 @@ static void emit_area(const lm_emitter *e, const lm_emit_tri *placed, const lm_s
     if (tri->double_sided) { /* leftover picks the side */
         int back = rest >= 0.5f;
         rest = back ? 2.0f * rest - 1.0f : 2.0f * rest;
-        n = back ? lm_scale(n, -1.0f) : n;
+        n = back ? lm_scale(n, -1.0f) : n; /* (t, b, -n) is a frame as good as (t, b, n) */
     }
     lm_vec3 x = tri_point(p, rest, u[3]);
-    float r = sqrtf(u[0]), phi = (float)(2.0 * LM_PI) * u[1];
-    lm_vec3 d = frame_dir(n, r * cosf(phi), r * sinf(phi), sqrtf(fmaxf(0.0f, 1.0f - u[0])));
+    float r = sqrtf(u[0]), sn, cs;
+    lm_sincos_turn(u[1], &sn, &cs);
+    lm_vec3 d = lm_add(lm_add(lm_scale(lm_v3_load(tri->t), r * cs), lm_scale(lm_v3_load(tri->b), r * sn)),
+                       lm_scale(n, sqrtf(1.0f - u[0])));
     lm_v3_store(out->org, lm_add(x, lm_scale(n, tri->lift)));
     lm_v3_store(out->dir, d);
+    float w = prob > 0.0f ? 1.0f / (prob * (float)count) : 0.0f;
     for (int c = 0; c < 3; c++)
-        out->flux[c] = prob > 0.0f ? tri->flux[c] / (prob * (float)count) : 0.0f;
+        out->flux[c] = tri->flux[c] * w;
 }
 
 static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emitter *e, const float u[4],
                           uint32_t count, lm_emission *out)
 {
-    float phi = (float)(2.0 * LM_PI) * u[1], scale = 1.0f / (float)count;
+    float scale = 1.0f / (float)count, sn, cs;
+    lm_sincos_turn(u[1], &sn, &cs);
     lm_vec3 axis = lm_v3_load(e->dir), d, o = lm_v3_load(e->pos);
     if (e->kind == LM_EMIT_POINT) {
         float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        d = lm_v3(r * cosf(phi), r * sinf(phi), z);
+        d = lm_v3(r * cs, r * sn, z);
         scale *= (float)(4.0 * LM_PI);
     } else if (e->kind == LM_EMIT_SPOT) {
         const lm_light *l = &s->lights[e->light];
         float co = cosf(l->outer_cone), z = 1.0f - u[0] * (1.0f - co), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        d = frame_dir(axis, r * cosf(phi), r * sinf(phi), z);
+        d = frame_dir(axis, r * cs, r * sn, z);
         scale *= lm_spot_attenuation(l, z) * (float)(2.0 * LM_PI) * (1.0f - co);
     } else {
         float r = em->disk_radius * sqrtf(u[0]), back = 1.001f * em->disk_radius;
         lm_vec3 c = lm_sub(lm_v3_load(em->disk_center), lm_scale(axis, back));
-        lm_vec3 off = frame_dir(axis, cosf(phi), sinf(phi), 0.0f);
+        lm_vec3 off = frame_dir(axis, cs, sn, 0.0f);
         o = lm_add(c, lm_scale(off, r));
         d = axis;
         scale *= (float)LM_PI * em->disk_radius * em->disk_radius;

@@ -61,6 +61,7 @@ void lm_emitter_emit(const lm_emitters *em, const lm_scene *s, int e, const floa
 typedef struct {
     float p[3][3];        /* world corners */
     float n[3];           /* unit geometric normal, front side */
+    float t[3], b[3];     /* tangents: (t, b, n) orthonormal, the frame emitted directions are drawn in */
     float flux[3];        /* the triangle's flux (all emitting sides) */
     float lift;           /* origin offset along the normal: 1e-5 x scene size */
     int double_sided;

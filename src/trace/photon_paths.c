@@ -226,6 +226,8 @@ void ph_group_free(ph_group *g)
 {
     free(g->offsets);
     free(g->verts);
+    free(g->emit_u);
+    g->emit_u = NULL;
     g->offsets = NULL;
     g->verts = NULL;
     g->vert_cap = 0;
@@ -233,5 +235,6 @@ void ph_group_free(ph_group *g)
 
 size_t ph_group_bytes(const ph_group *g)
 {
-    return ((size_t)g->photons + 1) * sizeof *g->offsets + (size_t)g->vert_cap * sizeof *g->verts;
+    return ((size_t)g->photons + 1) * sizeof *g->offsets + (size_t)g->photons * 4 * sizeof *g->emit_u +
+           (size_t)g->vert_cap * sizeof *g->verts;
 }

@@ -36,16 +36,18 @@ void lm_photon_store_free(lm_photon_store *ps)
     ps->free_head = LM_NONE;
 }
 
-double lm_hit_energy(const lm_hit *h)
+static inline double hit_energy(const lm_hit *h)
 {
     return 0.2126 * h->flux[0] + 0.7152 * h->flux[1] + 0.0722 * h->flux[2];
 }
+
+double lm_hit_energy(const lm_hit *h) { return hit_energy(h); }
 
 /* Both deltas grow by the hit's energy, whether it arrives or leaves: they measure change. */
 static void account(lm_photon_store *ps, const lm_hit *h)
 {
     lm_surface_hits *sh = &ps->surfaces[h->surface];
-    double e = lm_hit_energy(h);
+    double e = hit_energy(h);
     sh->delta_f += e;
     if (!(h->bounce == 0 && h->from_punctual))
         sh->delta_i += e;

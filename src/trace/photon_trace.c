@@ -30,12 +30,14 @@ static uint64_t mix64(uint64_t z)
     return z ^ (z >> 31);
 }
 
-/* n uniform numbers in [0, 1) as floats (never rounded up to 1): dims dim .. dim + n - 1. */
-static void photon_samples(const lm_photons *ph, uint32_t id, uint32_t dim, uint32_t n, float *out)
+/* n uniform numbers in [0, 1) as floats (never rounded up to 1): dims dim .. dim + n - 1. The
+ * tables exist: lm_photons_create drew every photon's emission numbers through lm_halton_dims_float. */
+static inline void photon_samples(const lm_photons *ph, uint32_t id, uint32_t dim, uint32_t n, float *out)
 {
     uint64_t index = ph->halton_base + id;
     if (dim + n <= LM_QMC_MAX_DIMS && index <= UINT32_MAX) { /* every photon of seed 0 and most others */
-        lm_halton_dims_float(dim, n, (uint32_t)index, out);
+        for (uint32_t k = 0; k < n; k++)
+            out[k] = lm_halton_float(dim + k, (uint32_t)index);
         return;
     }
     double u[PH_DIMS_PER_BOUNCE];
@@ -114,12 +116,17 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
     return 1;
 }
 
+void ph_emission_samples(const lm_photons *ph, uint32_t id, float u[4])
+{
+    lm_qmc_init(); /* photon_samples reads the tables without a check */
+    photon_samples(ph, id, 0, PH_EMIT_DIMS, u);
+}
+
 int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
 {
     const ph_group *g = &ph->groups[j->group];
     uint32_t id = g->first_id + j->m * ph->G;
-    float u[PH_EMIT_DIMS];
-    photon_samples(ph, id, 0, PH_EMIT_DIMS, u);
+    const float *u = g->emit_u + PH_EMIT_DIMS * (size_t)j->m;
     uint32_t emitter_photons = ph->emitter_first[g->emitter + 1] - ph->emitter_first[g->emitter];
     lm_emission emi;
     const lm_emit_tri *placed = ph->emit_placed ? ph->emit_placed + ph->emit_tri_first[g->emitter] : NULL;

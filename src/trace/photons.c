@@ -106,8 +106,11 @@ static lm_status make_groups(lm_photons *ph, lm_error *err)
         g->photons = (ph->emitter_first[g->emitter + 1] - ph->emitter_first[g->emitter]) / ph->G;
         g->first_id = ph->emitter_first[g->emitter] + g->index;
         g->offsets = calloc((size_t)g->photons + 1, sizeof *g->offsets);
-        if (!g->offsets)
+        g->emit_u = malloc((size_t)g->photons * 4 * sizeof *g->emit_u); /* photons >= 1 */
+        if (!g->offsets || !g->emit_u)
             return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for group %u", i);
+        for (uint32_t m = 0; m < g->photons; m++)
+            ph_emission_samples(ph, g->first_id + m * ph->G, g->emit_u + 4 * (size_t)m);
         if (g->photons > ph->max_group_photons)
             ph->max_group_photons = g->photons;
     }
@@ -123,6 +126,7 @@ static lm_status setup(lm_photons *ph, lm_error *err)
     lm_status st = check_settings(&ph->set, err);
     if (st == LM_OK)
         st = plan_counts(ph, err);
+    ph->halton_base = (uint64_t)ph->set.seed * ph->photon_count; /* before make_groups draws from it */
     if (st == LM_OK)
         st = make_groups(ph, err);
     if (st == LM_OK)
@@ -132,7 +136,6 @@ static lm_status setup(lm_photons *ph, lm_error *err)
         size = 1.0f;
     ph->epsilon = ph->set.epsilon > 0.0f ? ph->set.epsilon : 1e-4f * size;
     ph->ray_offset = 1e-5f * size;
-    ph->halton_base = (uint64_t)ph->set.seed * ph->photon_count;
     return st;
 }
 

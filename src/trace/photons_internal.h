@@ -13,6 +13,8 @@ typedef struct {
     int invalid;               /* queued for re-trace */
     uint32_t invalidations, retraces; /* counters for reports (lm_photon_group_info) */
     uint32_t *offsets;         /* photons + 1 */
+    float *emit_u;             /* photons x 4: photon m's emission numbers (QMC dims 0-3), fixed for
+                                * its life, so a re-trace does not recompute them */
     lm_path_vertex *verts;
     uint32_t vert_cap;
 } ph_group;
@@ -80,7 +82,9 @@ struct lm_photons {
     uint32_t *tmp_groups;      /* group_count */
 };
 
-/* photon_trace.c: traces job j's photon (group, m), appends its vertices to buf and fills j's count,
+/* photon_trace.c: the 4 emission numbers of photon id (QMC dims 0-3), as ph_group.emit_u keeps them. */
+void ph_emission_samples(const lm_photons *ph, uint32_t id, float u[4]);
+/* Traces job j's photon (group, m), appends its vertices to buf and fills j's count,
  * rays and stored. Returns 0 when memory ran out. Reads only ph's settings, photon numbering, scene,
  * BVH and emitters (never what applying writes): safe from several threads, and beside an apply. */
 int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf);

@@ -71,9 +71,8 @@ static float power_heuristic(float a, float b) { return a * a / (a * a + b * b);
 
 static lm_vec3 cosine_dir(lm_vec3 n, float u0, float u1)
 {
-    float sign = copysignf(1.0f, n.z), a = -1.0f / (sign + n.z), b = n.x * n.y * a;
-    lm_vec3 t = lm_v3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    lm_vec3 bt = lm_v3(b, sign + n.y * n.y * a, -n.y);
+    lm_vec3 t, bt;
+    lm_onb(n, &t, &bt);
     float r = sqrtf(u0), phi = 2.0f * LM_PI_F * u1;
     lm_vec3 d = lm_add(lm_add(lm_scale(t, r * cosf(phi)), lm_scale(bt, r * sinf(phi))), lm_scale(n, sqrtf(1.0f - u0)));
     return lm_normalize(d);

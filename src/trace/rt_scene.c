@@ -22,6 +22,7 @@ struct lm_rt {
     int *inst_node;             /* instance geomID -> node */
     int *node_inst;             /* node -> instance geomID, -1 for static nodes */
     float (*inst_world)[16];    /* current world matrix of each instance */
+    float (*node_nmat)[9];      /* node -> normal matrix of its world matrix (kept with inst_world) */
     char device_error[256];
 };
 
@@ -142,6 +143,7 @@ static lm_status add_instance(lm_rt *rt, const lm_scene *s, int n, lm_error *err
     rt->inst_node[id] = n;
     rt->node_inst[n] = (int)id;
     memcpy(rt->inst_world[id], node->world, sizeof(float) * 16);
+    lm_mat4_normal_matrix(node->world, rt->node_nmat[n]);
     return LM_OK;
 }
 
@@ -167,14 +169,17 @@ lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_
     rt->inst_node = malloc(sizeof(int) * slots);
     rt->node_inst = malloc(sizeof(int) * (s->node_count ? s->node_count : 1));
     rt->inst_world = malloc(sizeof(float[16]) * slots);
-    if (!rt->inst_node || !rt->node_inst || !rt->inst_world) {
+    rt->node_nmat = malloc(sizeof(float[9]) * (s->node_count ? s->node_count : 1));
+    if (!rt->inst_node || !rt->node_inst || !rt->inst_world || !rt->node_nmat) {
         lm_rt_free(rt);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the ray-tracing scene", s->path);
     }
     for (size_t i = 0; i < slots; i++)
         rt->inst_node[i] = -1;
-    for (int n = 0; n < s->node_count; n++)
+    for (int n = 0; n < s->node_count; n++) {
         rt->node_inst[n] = -1;
+        lm_mat4_normal_matrix(s->nodes[n].world, rt->node_nmat[n]);
+    }
 
     lm_status st = add_static(rt, s, err);
     for (int n = 0; st == LM_OK && n < s->node_count; n++)
@@ -207,6 +212,7 @@ void lm_rt_free(lm_rt *rt)
     free(rt->inst_node);
     free(rt->node_inst);
     free(rt->inst_world);
+    free(rt->node_nmat);
     free(rt);
 }
 
@@ -225,6 +231,7 @@ static lm_status move_instance(lm_rt *rt, int node, const float world[16], lm_er
     rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, world);
     rtcCommitGeometry(inst);
     memcpy(rt->inst_world[id], world, sizeof(float) * 16);
+    lm_mat4_normal_matrix(world, rt->node_nmat[node]);
     return LM_OK;
 }
 
@@ -281,12 +288,13 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
         int node = rt->inst_node[inst];
         hit->node = node;
         hit->tri = rt->scene->nodes[node].first_tri + rh.hit.primID;
-        ng = lm_mat4_normal(rt->inst_world[inst], ng);
+        ng = lm_mat3_normal(rt->node_nmat[node], ng); /* Embree's Ng is in the instance's space */
     } else {
         hit->tri = rt->static_tri[rh.hit.primID];
         hit->node = (int)rt->scene->tri_node[hit->tri];
-        ng = lm_normalize(ng);
     }
+    ng = lm_normalize(ng);
+    hit->nmat = rt->node_nmat[hit->node];
     hit->t = rh.ray.tfar;
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;

@@ -23,6 +23,8 @@ typedef struct {
     int surface;       /* surface id, -1 for specular triangles */
     float u, v;        /* barycentrics of the hit on the triangle (Embree's: p = (1-u-v) v0 + u v1 + v v2) */
     float ng[3];       /* world-space geometric normal, unit length, as wound in the file */
+    const float *nmat; /* the hit node's normal matrix (lm_mat4_normal_matrix of its world matrix as
+                        * the BVH has it), valid until the node moves */
 } lm_rt_hit;
 
 /* Builds the BVHs from the scene's current node transforms. surfaces may be NULL (surface = -1). */

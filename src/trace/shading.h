@@ -1,5 +1,4 @@
-/* What a ray hit means for light transport: the hit point's position, normals, texture coordinates,
- * albedo and material, all in world space. Shared by the photon tracer and the reference solver. */
+/* What a ray hit means for light transport: the hit point's position, normals, albedo and material, all in world space. Shared by the photon tracer and the reference solver. */
 #ifndef LM_SHADING_H
 #define LM_SHADING_H
 
@@ -11,7 +10,6 @@ typedef struct {
     float local[3];      /* the same point in the hit node's local space */
     float ng[3];         /* geometric normal, unit, as wound */
     float ns[3];         /* shading normal, unit, flipped to the side of ng */
-    float uv0[2];
     float albedo[3];     /* base colour factor x texture at uv0, linear */
     const lm_material *material;
     int material_id;
