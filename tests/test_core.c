@@ -60,6 +60,48 @@ static void test_normal_transform_non_uniform_scale(void **state)
     assert_float_equal(n.z, 1.0f, 1e-6);
 }
 
+/* lm_sincos_turn against double-precision sin and cos of 2 pi u over a fine sweep of [0, 1) (every
+ * quadrant and its seams), and the values of its quarter turns exactly. */
+static void test_sincos_turn(void **state)
+{
+    (void)state;
+    double worst = 0.0;
+    for (int i = 0; i < 1 << 20; i++) {
+        float u = (float)i / (float)(1 << 20), s, c;
+        lm_sincos_turn(u, &s, &c);
+        double a = 2.0 * M_PI * (double)u;
+        worst = fmax(worst, fmax(fabs(s - sin(a)), fabs(c - cos(a))));
+    }
+    float s, c;
+    lm_sincos_turn(0x1.fffffep-1f, &s, &c); /* the largest u below 1 */
+    worst = fmax(worst, fmax(fabs(s - sin(2.0 * M_PI * 0x1.fffffep-1)), fabs(c - 1.0)));
+    assert_true(worst < 2e-7);
+    const float quarter[4][2] = {{0, 1}, {1, 0}, {0, -1}, {-1, 0}};
+    for (int q = 0; q < 4; q++) {
+        lm_sincos_turn(0.25f * (float)q, &s, &c);
+        assert_true(s == quarter[q][0] && c == quarter[q][1]);
+    }
+}
+
+/* lm_onb gives an orthonormal right-handed frame around unit normals all over the sphere, including
+ * both poles (its one seam is the sign of n.z). */
+static void test_onb(void **state)
+{
+    (void)state;
+    for (int i = 0; i <= 64; i++)
+        for (int j = 0; j < 64; j++) {
+            float th = (float)M_PI * (float)i / 64.0f, ph = 2.0f * (float)M_PI * (float)j / 64.0f;
+            lm_vec3 n = lm_v3(sinf(th) * cosf(ph), sinf(th) * sinf(ph), cosf(th)), t, b;
+            lm_onb(n, &t, &b);
+            assert_float_equal(lm_dot(t, t), 1.0f, 1e-5);
+            assert_float_equal(lm_dot(b, b), 1.0f, 1e-5);
+            assert_float_equal(lm_dot(t, b), 0.0f, 1e-5);
+            assert_float_equal(lm_dot(t, n), 0.0f, 1e-5);
+            assert_float_equal(lm_dot(b, n), 0.0f, 1e-5);
+            assert_float_equal(lm_dot(lm_cross(t, b), n), 1.0f, 1e-5);
+        }
+}
+
 static void test_slerp(void **state)
 {
     (void)state;
@@ -175,6 +217,8 @@ int main(void)
         cmocka_unit_test(test_trs_matches_composition),
         cmocka_unit_test(test_affine_inverse),
         cmocka_unit_test(test_normal_transform_non_uniform_scale),
+        cmocka_unit_test(test_sincos_turn),
+        cmocka_unit_test(test_onb),
         cmocka_unit_test(test_slerp),
         cmocka_unit_test(test_srgb_round_trip),
         cmocka_unit_test(test_exr_round_trip),

@@ -337,6 +337,44 @@ static void test_shading_from_hit(void **state)
     lm_rt_free(rt);
 }
 
+/* A dynamic node turned by a quarter turn about z after the BVH was built: the hit's geometric normal
+ * and the shading normal follow the new matrix (the normal matrix the BVH keeps for the node), and a
+ * mirroring matrix keeps the normals on the side the winding gives. */
+static void test_shading_moved_node(void **state)
+{
+    (void)state;
+    tscene t;
+    make_scene(&t, 1.0f, 0.5f, 1); /* the plane y = 0.5, facing +y */
+    t.nodes[0].dynamic = 1;
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(&t.s, NULL, &rt, &err), LM_OK);
+    float turn[16] = {0, 1, 0, 0, -1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; /* (x, y) -> (-y, x) */
+    assert_int_equal(lm_rt_set_node_transform(rt, 0, turn, &err), LM_OK);
+    memcpy(t.nodes[0].world, turn, sizeof turn);
+    float org[3] = {-2.0f, 0.25f, 0.1f}, dir[3] = {1, 0, 0}; /* the plane is now x = -0.5, facing -x */
+    lm_rt_hit hit;
+    assert_true(lm_rt_intersect(rt, org, dir, 0.0f, 1e30f, &hit));
+    lm_shading sh;
+    lm_shading_from_hit(&t.s, &hit, org, dir, &sh);
+    assert_float_equal(sh.pos[0], -0.5, 1e-5);
+    assert_float_equal(sh.ng[0], -1.0, 1e-5);
+    assert_float_equal(sh.ns[0], -1.0, 1e-5);
+    assert_float_equal(sh.ns[1], 0.0, 1e-5);
+    float mirror[16] = {1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}; /* y -> -y: plane y = -0.5 */
+    assert_int_equal(lm_rt_set_node_transform(rt, 0, mirror, &err), LM_OK);
+    memcpy(t.nodes[0].world, mirror, sizeof mirror);
+    float org2[3] = {0.1f, -2.0f, 0.2f}, up[3] = {0, 1, 0};
+    assert_true(lm_rt_intersect(rt, org2, up, 0.0f, 1e30f, &hit));
+    lm_shading_from_hit(&t.s, &hit, org2, up, &sh);
+    float want[3];
+    lm_v3_store(want, lm_mat4_normal(mirror, lm_v3(0, 1, 0)));
+    assert_float_equal(sh.pos[1], -0.5, 1e-5);
+    assert_float_equal(hit.ng[1], want[1], 1e-5);
+    assert_float_equal(sh.ns[1], want[1], 1e-5);
+    lm_rt_free(rt);
+}
+
 /* ---- BSDFs ---- */
 
 static lm_material g_mat;
@@ -516,6 +554,7 @@ int main(void)
         cmocka_unit_test(test_nee_point_light_irradiance),
         cmocka_unit_test(test_nee_area_light_irradiance),
         cmocka_unit_test(test_shading_from_hit),
+        cmocka_unit_test(test_shading_moved_node),
         cmocka_unit_test(test_diffuse_energy_and_cosine),
         cmocka_unit_test(test_single_sided_back_absorbs),
         cmocka_unit_test(test_glossy_energy_and_consistency),
