@@ -84,18 +84,21 @@ static int reserve_verts(lm_path_vertex **verts, uint32_t *cap, uint32_t need, i
 
 static uint32_t store_vertex(lm_photons *ph, const ph_vertex *v, uint32_t photon, int punctual)
 {
-    lm_hit h;
-    memset(&h, 0, sizeof h);
-    memcpy(h.pos, v->pos, sizeof h.pos);
-    memcpy(h.local, v->local, sizeof h.local);
-    memcpy(h.dir, v->dir, sizeof h.dir);
-    memcpy(h.flux, v->flux, sizeof h.flux);
-    h.photon = photon;
-    h.tri = v->tri;
-    h.surface = v->surface;
-    h.bounce = v->bounce;
-    h.from_punctual = (uint8_t)(punctual != 0);
-    return lm_photon_store_add(&ph->store, &h);
+    uint32_t slot;
+    lm_hit *h = lm_photon_store_claim(&ph->store, v->surface, &slot); /* filled in place */
+    if (!h)
+        return LM_NONE;
+    memcpy(h->pos, v->pos, sizeof h->pos);
+    memcpy(h->local, v->local, sizeof h->local);
+    memcpy(h->dir, v->dir, sizeof h->dir);
+    memcpy(h->flux, v->flux, sizeof h->flux);
+    h->photon = photon;
+    h->tri = v->tri;
+    h->bounce = v->bounce;
+    h->from_punctual = (uint8_t)(punctual != 0);
+    h->pad = 0;
+    lm_photon_store_link(&ph->store, slot);
+    return slot;
 }
 
 /* Removes photon m's old hits and writes its new path (with new hits) at out. Returns 0 if a hit

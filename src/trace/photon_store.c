@@ -98,16 +98,22 @@ static uint32_t take_slot(lm_photon_store *ps)
     return ps->used++;
 }
 
-uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h)
+lm_hit *lm_photon_store_claim(lm_photon_store *ps, int surface, uint32_t *slot)
 {
-    if (h->surface < 0 || h->surface >= ps->surface_count)
-        return LM_NONE;
-    uint32_t slot = take_slot(ps);
-    if (slot == LM_NONE)
-        return LM_NONE;
-    lm_surface_hits *sh = &ps->surfaces[h->surface];
+    if (surface < 0 || surface >= ps->surface_count)
+        return NULL;
+    *slot = take_slot(ps);
+    if (*slot == LM_NONE)
+        return NULL;
+    lm_hit *d = &ps->hits[*slot];
+    d->surface = surface;
+    return d;
+}
+
+void lm_photon_store_link(lm_photon_store *ps, uint32_t slot)
+{
     lm_hit *d = &ps->hits[slot];
-    *d = *h;
+    lm_surface_hits *sh = &ps->surfaces[d->surface];
     d->prev = LM_NONE;
     d->next = sh->head;
     if (sh->head != LM_NONE)
@@ -115,6 +121,16 @@ uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h)
     sh->head = slot;
     sh->count++;
     account(ps, d);
+}
+
+uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h)
+{
+    uint32_t slot;
+    lm_hit *d = lm_photon_store_claim(ps, h->surface, &slot);
+    if (!d)
+        return LM_NONE;
+    *d = *h;
+    lm_photon_store_link(ps, slot);
     return slot;
 }
 

@@ -51,6 +51,13 @@ void lm_photon_store_clear(lm_photon_store *ps);
 /* Copies h into a free slot, links it into its surface's list and adds its energy to the surface's
  * deltas. Returns the slot, or LM_NONE when memory ran out (the store is unchanged then). */
 uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h);
+/* lm_photon_store_add in two halves, for a caller that writes the hit straight into its slot (one
+ * copy less per stored photon hit): claim takes a free slot for a hit on `surface` and returns it
+ * to be filled (every field but prev and next; its surface is set), NULL when the surface is out of
+ * range or memory ran out (the store is unchanged then); link puts the filled hit in its surface's
+ * list and adds its energy to the deltas. */
+lm_hit *lm_photon_store_claim(lm_photon_store *ps, int surface, uint32_t *slot);
+void lm_photon_store_link(lm_photon_store *ps, uint32_t slot);
 /* Makes room for n more adds without reallocation (free slots not counted), so a bulk update grows
  * the array once. Returns 0 when memory ran out (the store is unchanged then). */
 int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n);
