@@ -42,7 +42,8 @@ static lm_vec3 sample_power_cos(lm_vec3 n, float e, float u0, float u1)
 {
     /* e = 1 (every diffuse bounce): the root is a sqrtf, several times cheaper than powf. */
     float c = e == 1.0f ? sqrtf(1.0f - u0) : powf(1.0f - u0, 1.0f / (e + 1.0f));
-    float s = sqrtf(1.0f - c * c), sn, cs; /* c <= 1, so c * c <= 1 */
+    /* sin: for e = 1 straight from u0 (no root chained after the first), else from c <= 1. */
+    float s = e == 1.0f ? sqrtf(u0) : sqrtf(1.0f - c * c), sn, cs;
     lm_sincos_turn(u1, &sn, &cs);
     return from_local(n, s * cs, s * sn, c);
 }
