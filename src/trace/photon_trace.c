@@ -234,9 +234,10 @@ static void trace_jobs(const lm_photons *ph, ph_batch *b, int *failed)
      * length written back per vertex made the threads fight over one cache line (false sharing). */
     int t = omp_get_thread_num();
     ph_buffer buf = b->buffers[t];
+    ph_job *jobs = b->jobs;
 #pragma omp for schedule(dynamic, 16) nowait
     for (long i = 0; i < (long)b->count; i++) {
-        ph_job *j = &b->jobs[i];
+        ph_job *j = &jobs[i];
         j->buffer = (uint32_t)t;
         j->first = (uint32_t)buf.len;
         if (!ph_trace_photon(ph, j, &buf)) {

@@ -145,9 +145,12 @@ lm_status lm_photons_create(const lm_scene *s, const lm_surfaces *su, const lm_r
     *out = NULL;
     if (!s || !rt || !em || !settings)
         return lm_fail(err, LM_ERR_INVALID, "photons: scene, BVH, emitters and settings are required");
-    lm_photons *ph = calloc(1, sizeof *ph);
+    /* Aligned as the struct's cache-line-aligned members ask (photons_internal.h); its size is a
+     * multiple of 64 because of them, as aligned_alloc wants. */
+    lm_photons *ph = aligned_alloc(_Alignof(lm_photons), sizeof *ph);
     if (!ph)
         return lm_fail(err, LM_ERR_NOMEM, "photons: no memory");
+    memset(ph, 0, sizeof *ph);
     ph->scene = s;
     ph->surfaces = su;
     ph->rt = rt;

@@ -43,8 +43,10 @@ typedef struct {
     uint32_t stored;           /* of its vertices, those that store a hit */
 } ph_job;
 
+/* On a cache line of its own: the calling thread fills one batch (count++ per photon) while the
+ * team reads the other's jobs and buffers. */
 typedef struct {
-    ph_job *jobs;
+    _Alignas(64) ph_job *jobs;
     uint32_t count, cap;
     ph_buffer *buffers;
     int buffer_count;
@@ -64,9 +66,12 @@ struct lm_photons {
     ph_group *groups;          /* emitter e's group g is groups[e G + g] */
     uint32_t *queue;           /* invalid groups, FIFO ring of group_count slots */
     uint32_t queue_head, queue_len;
-    lm_photon_store store;
-    uint32_t live_hits;
-    uint64_t halton_base;      /* seed x photon_count: the seed's stretch of the sequence */
+    /* The store and live_hits change with every applied hit while the other threads trace and read
+     * the fields around them: each on cache lines of its own (they shared one with halton_base, read
+     * for every QMC number, and the tracing threads kept losing it). */
+    _Alignas(64) lm_photon_store store;
+    _Alignas(64) uint32_t live_hits;
+    _Alignas(64) uint64_t halton_base; /* seed x photon_count: the seed's stretch of the sequence */
     ph_batch batches[2];       /* a re-trace traces one while the other's results are applied */
     /* Area emitters' triangles placed once per traced batch (lm_emitter_place): emitter e's are
      * emit_tris[emit_tri_first[e] ..]. emit_placed is emit_tris while a batch is traced with them,
