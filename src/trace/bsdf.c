@@ -29,21 +29,27 @@
 static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
 
-static lm_vec3 from_local(lm_vec3 n, float x, float y, float z)
+static inline lm_vec3 from_local(lm_vec3 n, float x, float y, float z)
 {
     lm_vec3 t, b;
     lm_onb(n, &t, &b);
     return lm_add(lm_add(lm_scale(t, x), lm_scale(b, y)), lm_scale(n, z));
 }
 
-/* Direction around n with density cos^e(angle) (e = 1: cosine-weighted, pdf cos / pi). Unit up to
- * rounding: (x, y, z) is unit and the frame orthonormal. */
+/* Cosine-weighted direction around n (pdf cos / pi): every diffuse bounce. Unit up to rounding: (x,
+ * y, z) is unit and the frame orthonormal. The sine of the polar angle comes straight from u0, so
+ * the two roots are independent. */
+static inline lm_vec3 sample_cosine(lm_vec3 n, float u0, float u1)
+{
+    float s = sqrtf(u0), sn, cs;
+    lm_sincos_turn(u1, &sn, &cs);
+    return from_local(n, s * cs, s * sn, sqrtf(1.0f - u0));
+}
+
+/* Direction around n with density cos^e(angle), e > 1 (the Phong lobe). */
 static lm_vec3 sample_power_cos(lm_vec3 n, float e, float u0, float u1)
 {
-    /* e = 1 (every diffuse bounce): the root is a sqrtf, several times cheaper than powf. */
-    float c = e == 1.0f ? sqrtf(1.0f - u0) : powf(1.0f - u0, 1.0f / (e + 1.0f));
-    /* sin: for e = 1 straight from u0 (no root chained after the first), else from c <= 1. */
-    float s = e == 1.0f ? sqrtf(u0) : sqrtf(1.0f - c * c), sn, cs;
+    float c = powf(1.0f - u0, 1.0f / (e + 1.0f)), s = sqrtf(1.0f - c * c), sn, cs; /* c <= 1 */
     lm_sincos_turn(u1, &sn, &cs);
     return from_local(n, s * cs, s * sn, c);
 }
@@ -194,7 +200,7 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], l
     if (sh->material->cls != LM_MAT_GLOSSY) {
         /* Cosine-weighted: f cos / pdf = (albedo / pi) cos / (cos / pi) = albedo, so no evaluation,
          * only eval_oriented's test that wo leaves above both normals. */
-        wo = sample_power_cos(ns, 1.0f, u[0], u[1]);
+        wo = sample_cosine(ns, u[0], u[1]);
         if (lm_dot(ns, wo) <= 0.0f || lm_dot(ng, wo) <= 0.0f)
             return 0;
         lm_v3_store(out->wo, wo);
@@ -204,7 +210,7 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], l
     }
     glossy_params g;
     glossy(sh, &g);
-    wo = u[2] < g.p_spec ? sample_power_cos(reflect(wi, ns), g.n, u[0], u[1]) : sample_power_cos(ns, 1.0f, u[0], u[1]);
+    wo = u[2] < g.p_spec ? sample_power_cos(reflect(wi, ns), g.n, u[0], u[1]) : sample_cosine(ns, u[0], u[1]);
     float f[3], pdf;
     eval_oriented(sh, wi, wo, ng, ns, f, &pdf);
     if (!(pdf > 0.0f))

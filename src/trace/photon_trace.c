@@ -104,11 +104,11 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
     lm_bsdf_sample_t bs;
     if (!lm_bsdf_sample(sh, dir, u, &bs))
         return 0;
-    for (int c = 0; c < 3; c++) {
-        flux[c] *= bs.weight[c] / p;
-        if (!isfinite(flux[c]))
-            return 0;
-    }
+    float inv_p = 1.0f / p;
+    for (int c = 0; c < 3; c++)
+        flux[c] *= bs.weight[c] * inv_p;
+    if (!lm_v3_finite(lm_v3_load(flux)))
+        return 0;
     lm_vec3 ng = lm_v3_load(sh->ng), wo = lm_v3_load(bs.wo);
     float side = lm_dot(ng, wo) >= 0.0f ? ph->ray_offset : -ph->ray_offset;
     lm_v3_store(org, lm_add(lm_v3_load(sh->pos), lm_scale(ng, side)));
