@@ -36,23 +36,6 @@ void lm_photon_store_free(lm_photon_store *ps)
     ps->free_head = LM_NONE;
 }
 
-static inline double hit_energy(const lm_hit *h)
-{
-    return 0.2126 * h->flux[0] + 0.7152 * h->flux[1] + 0.0722 * h->flux[2];
-}
-
-double lm_hit_energy(const lm_hit *h) { return hit_energy(h); }
-
-/* Both deltas grow by the hit's energy, whether it arrives or leaves: they measure change. */
-static void account(lm_photon_store *ps, const lm_hit *h)
-{
-    lm_surface_hits *sh = &ps->surfaces[h->surface];
-    double e = hit_energy(h);
-    sh->delta_f += e;
-    if (!(h->bounce == 0 && h->from_punctual))
-        sh->delta_i += e;
-}
-
 /* Grows the slot array to at least `need` slots, doubling so that one-by-one adds stay O(1). */
 static int grow(lm_photon_store *ps, uint64_t need)
 {
@@ -86,41 +69,11 @@ int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n)
     return 1;
 }
 
-static uint32_t take_slot(lm_photon_store *ps)
+uint32_t lm_photon_store_grow_slot(lm_photon_store *ps)
 {
-    if (ps->free_head != LM_NONE) {
-        uint32_t slot = ps->free_head;
-        ps->free_head = ps->hits[slot].next;
-        return slot;
-    }
-    if (ps->used == ps->capacity && !grow(ps, (uint64_t)ps->used + 1))
+    if (!grow(ps, (uint64_t)ps->used + 1))
         return LM_NONE;
     return ps->used++;
-}
-
-lm_hit *lm_photon_store_claim(lm_photon_store *ps, int surface, uint32_t *slot)
-{
-    if (surface < 0 || surface >= ps->surface_count)
-        return NULL;
-    *slot = take_slot(ps);
-    if (*slot == LM_NONE)
-        return NULL;
-    lm_hit *d = &ps->hits[*slot];
-    d->surface = surface;
-    return d;
-}
-
-void lm_photon_store_link(lm_photon_store *ps, uint32_t slot)
-{
-    lm_hit *d = &ps->hits[slot];
-    lm_surface_hits *sh = &ps->surfaces[d->surface];
-    d->prev = LM_NONE;
-    d->next = sh->head;
-    if (sh->head != LM_NONE)
-        ps->hits[sh->head].prev = slot;
-    sh->head = slot;
-    sh->count++;
-    account(ps, d);
 }
 
 uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h)
@@ -147,7 +100,7 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
     if (d->next != LM_NONE)
         ps->hits[d->next].prev = d->prev;
     sh->count--;
-    account(ps, d);
+    lm_photon_store_account(ps, d);
     d->surface = -1;
     d->prev = LM_NONE;
     d->next = ps->free_head;

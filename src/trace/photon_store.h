@@ -56,8 +56,8 @@ uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h);
  * to be filled (every field but prev and next; its surface is set), NULL when the surface is out of
  * range or memory ran out (the store is unchanged then); link puts the filled hit in its surface's
  * list and adds its energy to the deltas. */
-lm_hit *lm_photon_store_claim(lm_photon_store *ps, int surface, uint32_t *slot);
-void lm_photon_store_link(lm_photon_store *ps, uint32_t slot);
+static inline lm_hit *lm_photon_store_claim(lm_photon_store *ps, int surface, uint32_t *slot);
+static inline void lm_photon_store_link(lm_photon_store *ps, uint32_t slot);
 /* Makes room for n more adds without reallocation (free slots not counted), so a bulk update grows
  * the array once. Returns 0 when memory ran out (the store is unchanged then). */
 int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n);
@@ -65,11 +65,58 @@ int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n);
  * hit (already removed, or never used) is ignored. */
 void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot);
 /* Energy of a hit as the deltas count it. */
-double lm_hit_energy(const lm_hit *h);
+static inline double lm_hit_energy(const lm_hit *h)
+{
+    return 0.2126 * h->flux[0] + 0.7152 * h->flux[1] + 0.0722 * h->flux[2];
+}
 /* Sets a surface's delta_f (after its AIM refresh) or delta_i (after its IIM refresh) to zero. */
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface);
 void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface);
 /* Bytes held per stored hit slot (for the memory report). */
 size_t lm_photon_store_bytes(const lm_photon_store *ps);
+
+/* ---- inline: applying a traced batch claims and links every stored hit ---- */
+
+uint32_t lm_photon_store_grow_slot(lm_photon_store *ps); /* take_slot's rare path (photon_store.c) */
+
+static inline lm_hit *lm_photon_store_claim(lm_photon_store *ps, int surface, uint32_t *slot)
+{
+    if (surface < 0 || surface >= ps->surface_count)
+        return NULL;
+    if (ps->free_head != LM_NONE) {
+        *slot = ps->free_head;
+        ps->free_head = ps->hits[*slot].next;
+    } else if (ps->used < ps->capacity) {
+        *slot = ps->used++;
+    } else if ((*slot = lm_photon_store_grow_slot(ps)) == LM_NONE) {
+        return NULL;
+    }
+    lm_hit *d = &ps->hits[*slot];
+    d->surface = surface;
+    return d;
+}
+
+/* Both deltas of h's surface grow by its energy, whether it arrives or leaves: they measure change. */
+static inline void lm_photon_store_account(lm_photon_store *ps, const lm_hit *h)
+{
+    lm_surface_hits *sh = &ps->surfaces[h->surface];
+    double e = lm_hit_energy(h);
+    sh->delta_f += e;
+    if (!(h->bounce == 0 && h->from_punctual))
+        sh->delta_i += e;
+}
+
+static inline void lm_photon_store_link(lm_photon_store *ps, uint32_t slot)
+{
+    lm_hit *d = &ps->hits[slot];
+    lm_surface_hits *sh = &ps->surfaces[d->surface];
+    d->prev = LM_NONE;
+    d->next = sh->head;
+    if (sh->head != LM_NONE)
+        ps->hits[sh->head].prev = slot;
+    sh->head = slot;
+    sh->count++;
+    lm_photon_store_account(ps, d);
+}
 
 #endif
