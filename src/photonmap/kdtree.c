@@ -255,21 +255,25 @@ static void set_bound(knn *k, uint64_t key)
     k->top = bits_float(k->top_bits);
 }
 
-/* Moves src[lo, hi - 1) apart around pivot (a key not among them) into dst[lo, hi), without branches:
- * smaller keys to the front, larger to the back, and the pivot into the one slot left between them,
- * whose index is returned. */
-static uint32_t split_keys(const uint64_t *src, uint64_t *dst, uint32_t lo, uint32_t hi, uint64_t pivot)
+/* Moves in[lo, hi) but the pivot in[p] apart into out[lo, hi), without branches: smaller keys to the
+ * front, larger to the back (keys are distinct), and the pivot into the one slot left between them,
+ * whose index is returned. in is only read. */
+static uint32_t split_keys(const uint64_t *in, uint64_t *out, uint32_t lo, uint32_t hi, uint32_t p)
 {
+    uint64_t pivot = in[p];
     uint32_t front = lo, back = hi - 1;
-    for (uint32_t i = lo; i < hi - 1; i++) {
-        uint64_t v = src[i];
-        uint32_t less = v < pivot;
-        dst[front] = v;
-        dst[back] = v;
-        front += less;
-        back -= 1u - less;
+    for (uint32_t pass = 0; pass < 2; pass++) { /* [lo, p), then (p, hi): the pivot skipped without a test */
+        uint32_t from = pass ? p + 1 : lo, to = pass ? hi : p;
+        for (uint32_t i = from; i < to; i++) {
+            uint64_t v = in[i];
+            uint32_t less = v < pivot;
+            out[front] = v;
+            out[back] = v;
+            front += less;
+            back -= 1u - less;
+        }
     }
-    dst[front] = pivot;
+    out[front] = pivot;
     return front;
 }
 
@@ -282,24 +286,26 @@ static uint32_t median3_at(const uint64_t *a, uint32_t lo, uint32_t mid, uint32_
     return x < z ? lo : y < z ? hi : mid;
 }
 
-/* The k-th smallest (from 0) of the distinct keys a[0, m), k < m; rearranges them, using tmp (room for m). */
-static uint64_t nth_key(uint64_t *a, uint64_t *tmp, uint32_t m, uint32_t k)
+/* The k-th smallest (from 0) of the distinct keys src[0, m), k < m, src left as it is: quickselect whose
+ * partitions go back and forth between the scratch arrays x and y (room for m each) instead of being
+ * copied back after every step. */
+static uint64_t nth_key(const uint64_t *src, uint64_t *x, uint64_t *y, uint32_t m, uint32_t k)
 {
+    const uint64_t *in = src;
+    uint64_t *out = x;
     uint32_t lo = 0, hi = m;
     while (hi - lo > 1) {
-        uint32_t p = median3_at(a, lo, lo + (hi - lo) / 2, hi - 1);
-        uint64_t pivot = a[p];
-        a[p] = a[hi - 1];
-        uint32_t j = split_keys(a, tmp, lo, hi, pivot);
-        memcpy(a + lo, tmp + lo, sizeof *a * (hi - lo));
+        uint32_t j = split_keys(in, out, lo, hi, median3_at(in, lo, lo + (hi - lo) / 2, hi - 1));
         if (k == j)
-            return pivot;
+            return out[j];
         if (k < j)
             hi = j;
         else
             lo = j + 1;
+        in = out;
+        out = out == x ? y : x;
     }
-    return a[lo];
+    return in[lo];
 }
 
 /* The n-th smallest of the distinct keys a[0, count) (n <= count), a left as it is. Keys with distances
@@ -308,18 +314,17 @@ static uint64_t nth_key(uint64_t *a, uint64_t *tmp, uint32_t m, uint32_t k)
 static uint64_t nth_smallest(const uint64_t *a, uint32_t count, uint32_t n, float lo)
 {
     uint64_t sel[KNN_BUFFER], tmp[KNN_BUFFER], lo_key = make_key(lo, 0);
+    if (!(lo > 0.0f)) /* no guess: every key is a candidate */
+        return nth_key(a, sel, tmp, count, n - 1);
     uint32_t below = 0, m = 0;
     for (uint32_t i = 0; i < count; i++) { /* written without a branch, kept when not below */
         sel[m] = a[i];
         m += a[i] >= lo_key;
         below += a[i] < lo_key;
     }
-    if (below >= n) {
-        memcpy(sel, a, sizeof *a * count);
-        m = count;
-        below = 0;
-    }
-    return nth_key(sel, tmp, m, n - 1 - below);
+    if (below >= n)
+        return nth_key(a, sel, tmp, count, n - 1);
+    return nth_key(sel, tmp, sel, m, n - 1 - below); /* sel is read once before it is written */
 }
 
 /* Keeps the keys of a[0, count) up to max, in order; returns how many. */
