@@ -157,6 +157,24 @@ static void test_float_path(void **state)
     print_message("float path: %s\n", worst ? "some values one ulp from (float)lm_halton" : "all equal");
 }
 
+/* lm_halton_float_below answers lm_halton_float(d, i) < p exactly: for thresholds across [0, 1], and
+ * at the number itself and one float step either side (where the first lookup cannot decide), over all
+ * dimensions and indices of every size. */
+static void test_float_below(void **state)
+{
+    (void)state;
+    lm_qmc_init(); /* lm_halton_float reads the tables unchecked */
+    static const uint32_t big[] = {1u << 31, 4000000000u, UINT32_MAX - 1, UINT32_MAX};
+    for (uint32_t d = 0; d < LM_QMC_MAX_DIMS; d++)
+        for (uint32_t k = 0; k < 600 + 4; k++) {
+            uint32_t i = k < 600 ? k * 104729u : big[k - 600];
+            float f = lm_halton_float(d, i);
+            const float ps[] = {0.0f, 0.05f, 0.3f, 0.5f, 0.77f, 0.95f, 1.0f, f, nextafterf(f, 2.0f), nextafterf(f, -1.0f)};
+            for (size_t j = 0; j < sizeof ps / sizeof *ps; j++)
+                assert_int_equal(lm_halton_float_below(d, i, ps[j]), f < ps[j]);
+        }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -164,6 +182,7 @@ int main(void)
         cmocka_unit_test(test_distinct),        cmocka_unit_test(test_stratification),
         cmocka_unit_test(test_scrambled),       cmocka_unit_test(test_mean_and_spread),
         cmocka_unit_test(test_pairs),           cmocka_unit_test(test_float_path),
+        cmocka_unit_test(test_float_below),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -51,6 +51,21 @@ static inline float lm_halton_float(uint32_t dim, uint32_t index)
     float f = (float)v;
     return f < 1.0f ? f : 0x1.fffffep-1f;
 }
+
+/* lm_halton_float(dim, index) < p, exactly, mostly from the first table lookup alone: the digits after
+ * the first chunk add less than 1 / chunk, so unless p lies within that (widened by a float step) above
+ * the first chunk's value, the answer is known. A photon's Russian roulette asks only this. */
+static inline int lm_halton_float_below(uint32_t dim, uint32_t index, float p)
+{
+    const lm_qmc_fdim *d = &lm_qmc_fdims[dim];
+    uint32_t q = (uint32_t)(((unsigned __int128)d->magic * index) >> 64);
+    double v = d->table[index - q * d->chunk], margin = 1e-6; /* > a float step of values near 1 */
+    if (p > v + d->inv_chunk + margin)
+        return 1;
+    if (p <= v - margin)
+        return 0;
+    return lm_halton_float(dim, index) < p;
+}
 /* The d-th prime (d = 0 -> 2). */
 uint32_t lm_qmc_prime(uint32_t dim);
 

@@ -54,6 +54,18 @@ static inline void photon_samples(const lm_photons *ph, uint32_t id, uint32_t di
     }
 }
 
+/* Russian roulette: photon_samples(dim) < p, decided by lm_halton_float_below where the Halton tables
+ * serve the number (the same answer, mostly from one lookup). */
+static inline int survives(const lm_photons *ph, uint32_t id, uint32_t dim, float p)
+{
+    uint64_t index = ph->halton_base + id;
+    if (dim < LM_QMC_MAX_DIMS && index <= UINT32_MAX)
+        return lm_halton_float_below(dim, (uint32_t)index, p);
+    float u;
+    photon_samples(ph, id, dim, 1, &u);
+    return u < p;
+}
+
 static int buffer_reserve(ph_buffer *buf)
 {
     if (buf->len < buf->cap)
@@ -92,12 +104,10 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
     uint32_t d = PH_EMIT_DIMS + PH_DIMS_PER_BOUNCE * b;
     float p = lm_bsdf_survival(sh), u[3] = {0.0f, 0.0f, 0.0f};
     /* Only the numbers that decide something are computed (QMC is a large share of a trace): no
-     * roulette draw where survival is certain (u < 1 always), no BSDF number the material ignores. */
-    if (p < 1.0f) {
-        photon_samples(ph, id, d + 3, 1, u);
-        if (u[0] >= p)
-            return 0;
-    }
+     * roulette draw where survival is certain (u < 1 always), no BSDF number the material ignores,
+     * and the roulette's number only as far as it decides u < p. */
+    if (p < 1.0f && !survives(ph, id, d + 3, p))
+        return 0;
     uint32_t n = (uint32_t)lm_bsdf_sample_dims(sh);
     if (n)
         photon_samples(ph, id, d, n, u);
