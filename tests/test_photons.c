@@ -604,7 +604,7 @@ static void test_cornell_rate_and_memory(void **state)
                   mem.store_bytes, mem.other_bytes);
     assert_int_equal(st.group_photons, lm_photons_count(w.ph));
     assert_true(mem.mean_path_vertices >= mem.mean_hits && mem.mean_hits > 1.0);
-    assert_float_equal(mem.live_per_photon, 4.0 + 24.0 * mem.mean_path_vertices + 72.0 * mem.mean_hits, 1e-6);
+    assert_float_equal(mem.live_per_photon, 4.0 + 16.0 + 24.0 * mem.mean_path_vertices + 72.0 * mem.mean_hits, 1e-6);
     assert_true(mem.per_photon >= mem.live_per_photon && mem.per_photon < 2.5 * mem.live_per_photon);
     world_free(&w);
 }

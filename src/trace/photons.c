@@ -451,6 +451,6 @@ void lm_photons_memory(const lm_photons *ph, lm_photon_memory *out)
     out->per_photon = out->total_bytes / n;
     out->mean_path_vertices = verts / n;
     out->mean_hits = ph->live_hits / n;
-    out->live_per_photon = sizeof(uint32_t) + out->mean_path_vertices * sizeof(lm_path_vertex) +
-                           out->mean_hits * sizeof(lm_hit);
+    out->live_per_photon = sizeof(uint32_t) + 4 * sizeof(float) /* offset, emission numbers */ +
+                           out->mean_path_vertices * sizeof(lm_path_vertex) + out->mean_hits * sizeof(lm_hit);
 }

@@ -110,7 +110,7 @@ uint32_t lm_photons_group_of(const lm_photons *ph, uint32_t photon);
 /* Memory: bytes held by paths (offsets and vertices), by the store (hit slots, spare ones included,
  * and surface lists) and by the rest (groups, queue, trace scratch), summed in total;
  * per_photon = total / photons. live_per_photon counts only what the photons use: 4 bytes of offset,
- * sizeof(lm_path_vertex) per path vertex and sizeof(lm_hit) per stored hit. */
+ * 16 of emission numbers, sizeof(lm_path_vertex) per path vertex and sizeof(lm_hit) per stored hit. */
 typedef struct {
     size_t path_bytes, store_bytes, other_bytes, total_bytes;
     double per_photon, live_per_photon;
