@@ -337,6 +337,41 @@ static void test_shading_from_hit(void **state)
     lm_rt_free(rt);
 }
 
+/* The hit's geometric normal is the winding's, cross(v1 - v0, v2 - v0) of the world corners, on every
+ * triangle of the two-room scene (single-sided: a flipped normal makes photons die on the walls' fronts)
+ * static and dynamic (the door) alike: a ray from just off each triangle's centroid along that normal,
+ * turned back, must hit the triangle with ng along the same normal. */
+static void test_hit_normals_follow_winding(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 0.0f);
+    uint32_t checked = 0;
+    for (uint32_t t = 0; t < p.s->tri_count; t++) {
+        float v[3][3];
+        for (int k = 0; k < 3; k++)
+            lm_scene_vertex_world(p.s, p.s->tris[3 * (size_t)t + k], v[k]);
+        lm_vec3 a = lm_v3_load(v[0]), b = lm_v3_load(v[1]), c = lm_v3_load(v[2]);
+        lm_vec3 n = lm_cross(lm_sub(b, a), lm_sub(c, a));
+        if (!(lm_length(n) > 1e-6f))
+            continue;
+        n = lm_normalize(n);
+        lm_vec3 centre = lm_scale(lm_add(lm_add(a, b), c), 1.0f / 3.0f);
+        float org[3], dir[3];
+        lm_v3_store(org, lm_add(centre, lm_scale(n, 1e-3f)));
+        lm_v3_store(dir, lm_scale(n, -1.0f));
+        lm_rt_hit hit;
+        assert_true(lm_rt_intersect(p.rt, org, dir, 0.0f, 1e-2f, &hit));
+        if (hit.tri != t) /* a coplanar neighbour in front of it */
+            continue;
+        assert_true(lm_dot(lm_v3_load(hit.ng), n) > 0.999f);
+        checked++;
+    }
+    assert_true(checked >= p.s->tri_count / 2);
+    lmt_pipeline_free(&p);
+}
+
 /* A dynamic node turned by a quarter turn about z after the BVH was built: the hit's geometric normal
  * and the shading normal follow the new matrix (the normal matrix the BVH keeps for the node), and a
  * mirroring matrix keeps the normals on the side the winding gives. */
@@ -555,6 +590,7 @@ int main(void)
         cmocka_unit_test(test_nee_area_light_irradiance),
         cmocka_unit_test(test_shading_from_hit),
         cmocka_unit_test(test_shading_moved_node),
+        cmocka_unit_test(test_hit_normals_follow_winding),
         cmocka_unit_test(test_diffuse_energy_and_cosine),
         cmocka_unit_test(test_single_sided_back_absorbs),
         cmocka_unit_test(test_glossy_energy_and_consistency),

@@ -18,6 +18,8 @@ struct lm_rt {
     unsigned static_inst;       /* instance geomID of the static scene in top, RTC_INVALID_GEOMETRY_ID if none */
     uint32_t static_count;
     uint32_t *static_tri;       /* static primID -> scene triangle */
+    float (*static_ng)[3];      /* static primID -> its unit geometric normal (Embree's Ng, normalized
+                                 * once here instead of at every hit) */
     int instance_count;
     int *inst_node;             /* instance geomID -> node */
     int *node_inst;             /* node -> instance geomID, -1 for static nodes */
@@ -93,6 +95,17 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
     RTCGeometry g = make_triangles(rt, s, rt->static_tri, rt->static_count, 1);
     if (!g)
         return fail_backend(rt, err, s->path);
+    rt->static_ng = malloc(sizeof *rt->static_ng * rt->static_count);
+    if (!rt->static_ng) {
+        rtcReleaseGeometry(g);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %u static triangles", s->path, rt->static_count);
+    }
+    const float *vb = rtcGetGeometryBufferData(g, RTC_BUFFER_TYPE_VERTEX, 0);
+    for (uint32_t i = 0; i < rt->static_count; i++) { /* the direction of Embree's Ng */
+        lm_vec3 v0 = lm_v3_load(vb + 9 * (size_t)i), v1 = lm_v3_load(vb + 9 * (size_t)i + 3);
+        lm_vec3 v2 = lm_v3_load(vb + 9 * (size_t)i + 6);
+        lm_v3_store(rt->static_ng[i], lm_normalize(lm_cross(lm_sub(v1, v0), lm_sub(v2, v0))));
+    }
     /* The static triangles get a scene of their own, placed once with the identity: a top-level
      * commit after a dynamic node moves then rebuilds only the tree over the instances, never the
      * static triangles' BVH. */
@@ -209,6 +222,7 @@ void lm_rt_free(lm_rt *rt)
     if (rt->device)
         rtcReleaseDevice(rt->device);
     free(rt->static_tri);
+    free(rt->static_ng);
     free(rt->inst_node);
     free(rt->node_inst);
     free(rt->inst_world);
@@ -282,18 +296,19 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
     rtcIntersect1(rt->top, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
-    lm_vec3 ng = lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+    lm_vec3 ng;
     unsigned inst = rh.hit.instID[0];
     if (inst != rt->static_inst) {
         int node = rt->inst_node[inst];
         hit->node = node;
         hit->tri = rt->scene->nodes[node].first_tri + rh.hit.primID;
-        ng = lm_mat3_normal(rt->node_nmat[node], ng); /* Embree's Ng is in the instance's space */
+        /* Embree's Ng is in the instance's space */
+        ng = lm_normalize(lm_mat3_normal(rt->node_nmat[node], lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)));
     } else {
         hit->tri = rt->static_tri[rh.hit.primID];
         hit->node = (int)rt->scene->tri_node[hit->tri];
+        ng = lm_v3_load(rt->static_ng[rh.hit.primID]);
     }
-    ng = lm_normalize(ng);
     hit->nmat = rt->node_nmat[hit->node];
     hit->t = rh.ray.tfar;
     hit->u = rh.hit.u;
