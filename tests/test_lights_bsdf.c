@@ -337,6 +337,51 @@ static void test_shading_from_hit(void **state)
     lm_rt_free(rt);
 }
 
+/* Shading normals of a static triangle: a flat one's the BVH makes once and hands out with the hit
+ * (hit.ns) equals the one shading computes per hit for the same plane as a dynamic node; a smooth one
+ * (vertex normals tilted apart) is interpolated at the hit. */
+static void test_static_shading_normals(void **state)
+{
+    (void)state;
+    float org[3] = {0.3f, 2.0f, -0.2f}, dir[3] = {0, -1, 0}, ns[2][3];
+    for (int dynamic = 0; dynamic < 2; dynamic++) {
+        tscene t;
+        make_scene(&t, 1.0f, 0.5f, 1);
+        for (int v = 0; v < 4; v++) { /* flat, but not along the face: (0.6, 0.8, 0) */
+            t.nrm[3 * v] = 0.6f;
+            t.nrm[3 * v + 1] = 0.8f;
+        }
+        t.nodes[0].dynamic = dynamic;
+        lm_rt *rt = NULL;
+        lm_error err;
+        assert_int_equal(lm_rt_build(&t.s, NULL, &rt, &err), LM_OK);
+        lm_rt_hit hit;
+        assert_true(lm_rt_intersect(rt, org, dir, 0.0f, 1e30f, &hit));
+        assert_true(dynamic ? hit.ns == NULL : hit.ns != NULL);
+        lm_shading sh;
+        lm_shading_from_hit(&t.s, &hit, org, dir, &sh);
+        memcpy(ns[dynamic], sh.ns, sizeof sh.ns);
+        lm_rt_free(rt);
+    }
+    for (int c = 0; c < 3; c++)
+        assert_float_equal(ns[0][c], ns[1][c], 1e-6);
+    assert_float_equal(ns[0][0], 0.6, 1e-5);
+    tscene t;
+    make_scene(&t, 1.0f, 0.5f, 1);
+    t.nrm[0] = 1.0f, t.nrm[1] = 0.0f; /* vertex 0 tilted all the way to +x: not flat */
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(&t.s, NULL, &rt, &err), LM_OK);
+    float at[3] = {-0.9f, 2.0f, -0.9f}; /* near vertex 0 (-1, y, -1) */
+    lm_rt_hit hit;
+    assert_true(lm_rt_intersect(rt, at, dir, 0.0f, 1e30f, &hit));
+    assert_null(hit.ns);
+    lm_shading sh;
+    lm_shading_from_hit(&t.s, &hit, at, dir, &sh);
+    assert_true(sh.ns[0] > 0.5f && sh.ns[1] > 0.0f); /* leans far towards vertex 0's +x */
+    lm_rt_free(rt);
+}
+
 /* The hit's geometric normal is the winding's, cross(v1 - v0, v2 - v0) of the world corners, on every
  * triangle of the two-room scene (single-sided: a flipped normal makes photons die on the walls' fronts)
  * static and dynamic (the door) alike: a ray from just off each triangle's centroid along that normal,
@@ -591,6 +636,7 @@ int main(void)
         cmocka_unit_test(test_shading_from_hit),
         cmocka_unit_test(test_shading_moved_node),
         cmocka_unit_test(test_hit_normals_follow_winding),
+        cmocka_unit_test(test_static_shading_normals),
         cmocka_unit_test(test_diffuse_energy_and_cosine),
         cmocka_unit_test(test_single_sided_back_absorbs),
         cmocka_unit_test(test_glossy_energy_and_consistency),

@@ -95,6 +95,15 @@ static inline lm_vec3 lm_mat3_normal(const float nm[9], lm_vec3 n)
     return lm_add(lm_add(lm_scale(lm_v3_load(nm), n.x), lm_scale(lm_v3_load(nm + 3), n.y)),
                   lm_scale(lm_v3_load(nm + 6), n.z));
 }
+/* A shading normal: the local normal n through normal matrix nm, unit, turned to the side of the unit
+ * geometric normal ng; ng itself where n degenerates (zero, or not finite). */
+static inline lm_vec3 lm_shading_normal_of(const float nm[9], lm_vec3 n, lm_vec3 ng)
+{
+    lm_vec3 w = lm_normalize(lm_mat3_normal(nm, n));
+    if (!lm_v3_finite(w) || lm_dot(w, w) < 0.5f)
+        return ng;
+    return lm_dot(w, ng) < 0.0f ? lm_scale(w, -1.0f) : w;
+}
 /* Normal transform: inverse-transpose of the upper 3x3, result normalized. The cofactor matrix is det
  * times the inverse-transpose: the scale drops out on normalization, and flipping by the sign of det
  * gives the true inverse-transpose for mirroring transforms too. */

@@ -20,6 +20,7 @@ struct lm_rt {
     uint32_t *static_tri;       /* static primID -> scene triangle */
     float (*static_ng)[3];      /* static primID -> its unit geometric normal (Embree's Ng, normalized
                                  * once here instead of at every hit) */
+    float (*static_ns)[3];      /* static primID -> shading normal if the triangle is flat, else NaNs */
     int instance_count;
     int *inst_node;             /* instance geomID -> node */
     int *node_inst;             /* node -> instance geomID, -1 for static nodes */
@@ -96,7 +97,8 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
     if (!g)
         return fail_backend(rt, err, s->path);
     rt->static_ng = malloc(sizeof *rt->static_ng * rt->static_count);
-    if (!rt->static_ng) {
+    rt->static_ns = malloc(sizeof *rt->static_ns * rt->static_count);
+    if (!rt->static_ng || !rt->static_ns) {
         rtcReleaseGeometry(g);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %u static triangles", s->path, rt->static_count);
     }
@@ -104,7 +106,15 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
     for (uint32_t i = 0; i < rt->static_count; i++) { /* the direction of Embree's Ng */
         lm_vec3 v0 = lm_v3_load(vb + 9 * (size_t)i), v1 = lm_v3_load(vb + 9 * (size_t)i + 3);
         lm_vec3 v2 = lm_v3_load(vb + 9 * (size_t)i + 6);
-        lm_v3_store(rt->static_ng[i], lm_normalize(lm_cross(lm_sub(v1, v0), lm_sub(v2, v0))));
+        lm_vec3 ng = lm_normalize(lm_cross(lm_sub(v1, v0), lm_sub(v2, v0)));
+        lm_v3_store(rt->static_ng[i], ng);
+        const uint32_t *idx = s->tris + 3 * (size_t)rt->static_tri[i];
+        const float *n0 = s->normals + 3 * (size_t)idx[0];
+        int flat = !memcmp(n0, s->normals + 3 * (size_t)idx[1], 3 * sizeof(float)) &&
+                   !memcmp(n0, s->normals + 3 * (size_t)idx[2], 3 * sizeof(float));
+        lm_vec3 ns = flat ? lm_shading_normal_of(rt->node_nmat[s->tri_node[rt->static_tri[i]]], lm_v3_load(n0), ng)
+                          : lm_v3(NAN, NAN, NAN);
+        lm_v3_store(rt->static_ns[i], ns);
     }
     /* The static triangles get a scene of their own, placed once with the identity: a top-level
      * commit after a dynamic node moves then rebuilds only the tree over the instances, never the
@@ -223,6 +233,7 @@ void lm_rt_free(lm_rt *rt)
         rtcReleaseDevice(rt->device);
     free(rt->static_tri);
     free(rt->static_ng);
+    free(rt->static_ns);
     free(rt->inst_node);
     free(rt->node_inst);
     free(rt->inst_world);
@@ -304,10 +315,13 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
         hit->tri = rt->scene->nodes[node].first_tri + rh.hit.primID;
         /* Embree's Ng is in the instance's space */
         ng = lm_normalize(lm_mat3_normal(rt->node_nmat[node], lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)));
+        hit->ns = NULL;
     } else {
         hit->tri = rt->static_tri[rh.hit.primID];
         hit->node = (int)rt->scene->tri_node[hit->tri];
         ng = lm_v3_load(rt->static_ng[rh.hit.primID]);
+        const float *ns = rt->static_ns[rh.hit.primID];
+        hit->ns = isnan(ns[0]) ? NULL : ns;
     }
     hit->nmat = rt->node_nmat[hit->node];
     hit->t = rh.ray.tfar;

@@ -25,6 +25,8 @@ typedef struct {
     float ng[3];       /* world-space geometric normal, unit length, as wound in the file */
     const float *nmat; /* the hit node's normal matrix (lm_mat4_normal_matrix of its world matrix as
                         * the BVH has it), valid until the node moves */
+    const float *ns;   /* a flat static triangle's shading normal (its three vertex normals equal), as
+                        * lm_shading_normal_of makes it; NULL for the others */
 } lm_rt_hit;
 
 /* Builds the BVHs from the scene's current node transforms. surfaces may be NULL (surface = -1). */

@@ -32,14 +32,14 @@ static inline __attribute__((always_inline)) void interp2(const float *attr, con
 
 /* Shading normal: interpolated vertex normals in world space, flipped to ng's side; ng where the
  * interpolation degenerates. The normal transform is linear, so the local normals are interpolated
- * first and transformed once, by the node's normal matrix that the BVH keeps (no cofactors per hit). */
-static lm_vec3 shading_normal(const lm_scene *s, const float nmat[9], const uint32_t *idx, const float w[3],
+ * first and transformed once, by the node's normal matrix that the BVH keeps (no cofactors per hit).
+ * A flat static triangle's comes with the hit, made once by the BVH. */
+static lm_vec3 shading_normal(const lm_scene *s, const lm_rt_hit *hit, const uint32_t *idx, const float w[3],
                               lm_vec3 ng)
 {
-    lm_vec3 n = lm_normalize(lm_mat3_normal(nmat, interp3(s->normals, idx, w)));
-    if (!lm_v3_finite(n) || lm_dot(n, n) < 0.5f)
-        return ng;
-    return lm_dot(n, ng) < 0.0f ? lm_scale(n, -1.0f) : n;
+    if (hit->ns)
+        return lm_v3_load(hit->ns);
+    return lm_shading_normal_of(hit->nmat, interp3(s->normals, idx, w), ng);
 }
 
 static void fill_albedo(const lm_scene *s, const uint32_t *idx, const float w[3], lm_shading *sh)
@@ -71,7 +71,7 @@ void lm_shading_from_hit(const lm_scene *s, const lm_rt_hit *hit, const float or
     lm_v3_store(sh->local, local);
     lm_vec3 ng = lm_v3_load(hit->ng);
     lm_v3_store(sh->ng, ng);
-    lm_v3_store(sh->ns, shading_normal(s, hit->nmat, idx, w, ng));
+    lm_v3_store(sh->ns, shading_normal(s, hit, idx, w, ng));
     sh->material_id = s->tri_material[hit->tri];
     sh->material = &s->materials[sh->material_id];
     fill_albedo(s, idx, w, sh);
