@@ -141,10 +141,9 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
     lm_emission emi;
     const lm_emit_tri *placed = ph->emit_placed ? ph->emit_placed + ph->emit_tri_first[g->emitter] : NULL;
     lm_emitter_emit_placed(ph->em, ph->scene, g->emitter, placed, u, emitter_photons, &emi);
-    float org[3], dir[3], flux[3];
-    memcpy(org, emi.org, sizeof org);
-    memcpy(dir, emi.dir, sizeof dir);
-    memcpy(flux, emi.flux, sizeof flux);
+    /* The ray lives in emi itself: copying the values just stored there stalled on wide loads of
+     * narrow stores (no store-to-load forwarding). */
+    float *org = emi.org, *dir = emi.dir, *flux = emi.flux;
     j->count = j->rays = j->stored = 0;
     if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) /* an emitter that emits nothing */
         return 1;
@@ -158,13 +157,17 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
             break;
         lm_shading sh;
         lm_shading_from_hit(ph->scene, &hit, org, dir, &sh);
-        if (!push_vertex(buf, &sh, dir, flux, b)) {
+        /* The vertex is recorded after the scatter (with the direction and flux it arrived with): by
+         * then the shading's stores have left the store buffer, and copying them does not stall. */
+        float in_dir[3] = {dir[0], dir[1], dir[2]}, in_flux[3] = {flux[0], flux[1], flux[2]};
+        int scattered = scatter(ph, id, b, &sh, org, dir, flux);
+        if (!push_vertex(buf, &sh, in_dir, in_flux, b)) {
             ok = 0;
             break;
         }
         count++;
         stored += buf->v[buf->len - 1].surface >= 0;
-        if (!scatter(ph, id, b, &sh, org, dir, flux))
+        if (!scattered)
             break;
     }
     j->count = count;
