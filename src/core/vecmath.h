@@ -48,6 +48,19 @@ static inline void lm_onb(lm_vec3 n, lm_vec3 *t, lm_vec3 *b)
     *t = lm_v3(1.0f + sign * n.x * n.x * a, sign * c, -sign * n.x);
     *b = lm_v3(c, sign + n.y * n.y * a, -n.y);
 }
+/* x t + y b + z n: a direction given in the orthonormal frame (t, b, n), unit for unit (x, y, z) up to
+ * rounding. */
+static inline lm_vec3 lm_frame_dir(lm_vec3 t, lm_vec3 b, lm_vec3 n, float x, float y, float z)
+{
+    return lm_add(lm_add(lm_scale(t, x), lm_scale(b, y)), lm_scale(n, z));
+}
+/* lm_frame_dir in lm_onb's frame around unit n. */
+static inline lm_vec3 lm_onb_dir(lm_vec3 n, float x, float y, float z)
+{
+    lm_vec3 t, b;
+    lm_onb(n, &t, &b);
+    return lm_frame_dir(t, b, n, x, y, z);
+}
 /* sin and cos of the angle 2 pi u, u in [0, 1) (a sampled azimuth), within 1e-7 of the exact values:
  * a quarter turn picked by rounding 4u, then Taylor polynomials to degree 9 and 8 on |r| <= pi / 4
  * (truncation below 3e-8). Several times cheaper than sincosf, which must reduce any argument, and

@@ -29,13 +29,6 @@
 static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
 
-static inline lm_vec3 from_local(lm_vec3 n, float x, float y, float z)
-{
-    lm_vec3 t, b;
-    lm_onb(n, &t, &b);
-    return lm_add(lm_add(lm_scale(t, x), lm_scale(b, y)), lm_scale(n, z));
-}
-
 /* Cosine-weighted direction around n (pdf cos / pi): every diffuse bounce. Unit up to rounding: (x,
  * y, z) is unit and the frame orthonormal. The sine of the polar angle comes straight from u0, so
  * the two roots are independent. */
@@ -43,7 +36,7 @@ static inline lm_vec3 sample_cosine(lm_vec3 n, float u0, float u1)
 {
     float s = sqrtf(u0), sn, cs;
     lm_sincos_turn(u1, &sn, &cs);
-    return from_local(n, s * cs, s * sn, sqrtf(1.0f - u0));
+    return lm_onb_dir(n, s * cs, s * sn, sqrtf(1.0f - u0));
 }
 
 /* Direction around n with density cos^e(angle), e > 1 (the Phong lobe). */
@@ -51,7 +44,7 @@ static lm_vec3 sample_power_cos(lm_vec3 n, float e, float u0, float u1)
 {
     float c = powf(1.0f - u0, 1.0f / (e + 1.0f)), s = sqrtf(1.0f - c * c), sn, cs; /* c <= 1 */
     lm_sincos_turn(u1, &sn, &cs);
-    return from_local(n, s * cs, s * sn, c);
+    return lm_onb_dir(n, s * cs, s * sn, c);
 }
 
 static lm_vec3 reflect(lm_vec3 d, lm_vec3 n) { return lm_sub(d, lm_scale(n, 2.0f * lm_dot(d, n))); }

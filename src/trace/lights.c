@@ -203,14 +203,6 @@ void lm_emitters_update(lm_emitters *em, const lm_scene *s)
 
 /* ---- sampling helpers ---- */
 
-/* x t + y b + z n in the frame of unit n: unit for unit (x, y, z) up to rounding. */
-static lm_vec3 frame_dir(lm_vec3 n, float x, float y, float z)
-{
-    lm_vec3 t, b;
-    lm_onb(n, &t, &b);
-    return lm_add(lm_add(lm_scale(t, x), lm_scale(b, y)), lm_scale(n, z));
-}
-
 /* Index of the triangle u falls on in the CDF; *rest = u's position inside that triangle's interval. */
 static inline uint32_t pick_tri(const lm_emitter *e, float u, float *rest, float *prob)
 {
@@ -283,8 +275,7 @@ static void emit_area(const lm_emitter *e, const lm_emit_tri *placed, const lm_s
     lm_vec3 x = tri_point(p, rest, u[3]);
     float r = sqrtf(u[0]), sn, cs;
     lm_sincos_turn(u[1], &sn, &cs);
-    lm_vec3 d = lm_add(lm_add(lm_scale(lm_v3_load(tri->t), r * cs), lm_scale(lm_v3_load(tri->b), r * sn)),
-                       lm_scale(n, sqrtf(1.0f - u[0])));
+    lm_vec3 d = lm_frame_dir(lm_v3_load(tri->t), lm_v3_load(tri->b), n, r * cs, r * sn, sqrtf(1.0f - u[0]));
     lm_v3_store(out->org, lm_add(x, lm_scale(n, tri->lift)));
     lm_v3_store(out->dir, d);
     float w = prob > 0.0f ? 1.0f / (prob * (float)count) : 0.0f;
@@ -305,12 +296,12 @@ static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emi
     } else if (e->kind == LM_EMIT_SPOT) {
         const lm_light *l = &s->lights[e->light];
         float co = cosf(l->outer_cone), z = 1.0f - u[0] * (1.0f - co), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        d = frame_dir(axis, r * cs, r * sn, z);
+        d = lm_onb_dir(axis, r * cs, r * sn, z);
         scale *= lm_spot_attenuation(l, z) * (float)(2.0 * LM_PI) * (1.0f - co);
     } else {
         float r = em->disk_radius * sqrtf(u[0]), back = 1.001f * em->disk_radius;
         lm_vec3 c = lm_sub(lm_v3_load(em->disk_center), lm_scale(axis, back));
-        lm_vec3 off = frame_dir(axis, cs, sn, 0.0f);
+        lm_vec3 off = lm_onb_dir(axis, cs, sn, 0.0f);
         o = lm_add(c, lm_scale(off, r));
         d = axis;
         scale *= (float)LM_PI * em->disk_radius * em->disk_radius;

@@ -71,11 +71,8 @@ static float power_heuristic(float a, float b) { return a * a / (a * a + b * b);
 
 static lm_vec3 cosine_dir(lm_vec3 n, float u0, float u1)
 {
-    lm_vec3 t, bt;
-    lm_onb(n, &t, &bt);
     float r = sqrtf(u0), phi = 2.0f * LM_PI_F * u1;
-    lm_vec3 d = lm_add(lm_add(lm_scale(t, r * cosf(phi)), lm_scale(bt, r * sinf(phi))), lm_scale(n, sqrtf(1.0f - u0)));
-    return lm_normalize(d);
+    return lm_normalize(lm_onb_dir(n, r * cosf(phi), r * sinf(phi), sqrtf(1.0f - u0)));
 }
 
 /* Origin for a ray leaving a surface point towards d: lifted along ng to d's side. */
