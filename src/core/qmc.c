@@ -147,17 +147,7 @@ static inline void qmc_ready(void)
         lm_qmc_init();
 }
 
-/* Index i split as i = q chunk + r with one 64 x 64 -> 128-bit multiply: q = floor(i magic / 2^64),
- * magic = ceil(2^64 / chunk), which is exact for every 32-bit i and chunk < 2^32 (Lemire, Kaser and
- * Kurz 2019, "Faster remainder by direct computation"). No division, no rounding correction. */
-static inline uint32_t split_by(uint64_t magic, uint32_t chunk, uint32_t i, uint32_t *r)
-{
-    uint32_t q = (uint32_t)(((unsigned __int128)magic * i) >> 64);
-    *r = i - q * chunk;
-    return q;
-}
-
-static inline uint32_t split(const qmc_dim *d, uint32_t i, uint32_t *r) { return split_by(d->magic, d->chunk, i, r); }
+static inline uint32_t split(const qmc_dim *d, uint32_t i, uint32_t *r) { return lm_qmc_split(d->magic, d->chunk, i, r); }
 
 /* radical for a 32-bit index (the same operations in the same order: the same value bit for bit). */
 static inline double radical32(const qmc_dim *d, uint32_t i)

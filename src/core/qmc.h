@@ -35,17 +35,26 @@ typedef struct {
 } lm_qmc_fdim;
 extern lm_qmc_fdim lm_qmc_fdims[LM_QMC_MAX_DIMS];
 
+/* Index i split as i = q chunk + r with one 64 x 64 -> 128-bit multiply: q = floor(i magic / 2^64),
+ * magic = ceil(2^64 / chunk), which is exact for every 32-bit i and chunk < 2^32 (Lemire, Kaser and
+ * Kurz 2019, "Faster remainder by direct computation"). No division, no rounding correction. */
+static inline uint32_t lm_qmc_split(uint64_t magic, uint32_t chunk, uint32_t i, uint32_t *r)
+{
+    uint32_t q = (uint32_t)(((unsigned __int128)magic * i) >> 64);
+    *r = i - q * chunk;
+    return q;
+}
+
 /* One number of lm_halton_dims_float (the same value bit for bit), without the initialization
  * check: call lm_qmc_init (or any other function here) once before. dim < LM_QMC_MAX_DIMS. */
 static inline float lm_halton_float(uint32_t dim, uint32_t index)
 {
     const lm_qmc_fdim *d = &lm_qmc_fdims[dim];
-    uint32_t q = (uint32_t)(((unsigned __int128)d->magic * index) >> 64);
-    double v = d->table[index - q * d->chunk], scale = d->inv_chunk;
+    uint32_t r, q = lm_qmc_split(d->magic, d->chunk, index, &r);
+    double v = d->table[r], scale = d->inv_chunk;
     while (q != 0) {
-        uint32_t i = q;
-        q = (uint32_t)(((unsigned __int128)d->magic * i) >> 64);
-        v += d->table[i - q * d->chunk] * scale;
+        q = lm_qmc_split(d->magic, d->chunk, q, &r);
+        v += d->table[r] * scale;
         scale *= d->inv_chunk;
     }
     float f = (float)v;
@@ -58,8 +67,9 @@ static inline float lm_halton_float(uint32_t dim, uint32_t index)
 static inline int lm_halton_float_below(uint32_t dim, uint32_t index, float p)
 {
     const lm_qmc_fdim *d = &lm_qmc_fdims[dim];
-    uint32_t q = (uint32_t)(((unsigned __int128)d->magic * index) >> 64);
-    double v = d->table[index - q * d->chunk], margin = 1e-6; /* > a float step of values near 1 */
+    uint32_t r;
+    lm_qmc_split(d->magic, d->chunk, index, &r);
+    double v = d->table[r], margin = 1e-6; /* > a float step of values near 1 */
     if (p > v + d->inv_chunk + margin)
         return 1;
     if (p <= v - margin)

@@ -31,7 +31,7 @@ static uint64_t mix64(uint64_t z)
 }
 
 /* n uniform numbers in [0, 1) as floats (never rounded up to 1): dims dim .. dim + n - 1. The
- * tables exist: lm_photons_create drew every photon's emission numbers through lm_halton_dims_float. */
+ * tables exist: lm_photons_create built them (lm_qmc_init) before drawing the emission numbers. */
 static inline void photon_samples(const lm_photons *ph, uint32_t id, uint32_t dim, uint32_t n, float *out)
 {
     uint64_t index = ph->halton_base + id;
@@ -128,7 +128,6 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
 
 void ph_emission_samples(const lm_photons *ph, uint32_t id, float u[4])
 {
-    lm_qmc_init(); /* photon_samples reads the tables without a check */
     photon_samples(ph, id, 0, PH_EMIT_DIMS, u);
 }
 

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/qmc.h"
 #include "../core/timing.h"
 #include "photons_internal.h"
 
@@ -127,6 +128,7 @@ static lm_status setup(lm_photons *ph, lm_error *err)
     if (st == LM_OK)
         st = plan_counts(ph, err);
     ph->halton_base = (uint64_t)ph->set.seed * ph->photon_count; /* before make_groups draws from it */
+    lm_qmc_init(); /* once: the tracer reads the tables without a check */
     if (st == LM_OK)
         st = make_groups(ph, err);
     if (st == LM_OK)

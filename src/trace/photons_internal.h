@@ -87,7 +87,8 @@ struct lm_photons {
     uint32_t *tmp_groups;      /* group_count */
 };
 
-/* photon_trace.c: the 4 emission numbers of photon id (QMC dims 0-3), as ph_group.emit_u keeps them. */
+/* photon_trace.c: the 4 emission numbers of photon id (QMC dims 0-3), as ph_group.emit_u keeps them.
+ * The tracer reads the QMC tables unchecked: lm_qmc_init must have run (lm_photons_create's setup). */
 void ph_emission_samples(const lm_photons *ph, uint32_t id, float u[4]);
 /* Traces job j's photon (group, m), appends its vertices to buf and fills j's count,
  * rays and stored. Returns 0 when memory ran out. Reads only ph's settings, photon numbering, scene,
