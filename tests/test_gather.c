@@ -30,6 +30,7 @@
  * 0.035; with 1 sample of each: 0.168, 0.0996, 0.076). The bound leaves room for the reference's
  * noise, not for a regression. */
 #define IIM_RMSE_BOUND 0.12
+#define IIM_RMSE_BOUND_RIM 0.07
 
 
 typedef struct {
@@ -109,10 +110,11 @@ static float *gather_aim(const lm_scene *sc, const lm_atlas *at, const float *ai
     return gather_with(sc, at, aim_rgb, NULL, set, texels, count, stats);
 }
 
-/* The same with the emitters' light in closed form (el non-NULL) instead of drawn. */
-static float *gather_with(const lm_scene *sc, const lm_atlas *at, const float *aim_rgb, const lm_emitter_light *el,
-                          const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count,
-                          lm_gather_stats *stats)
+/* The same with the emitters' light in closed form (el non-NULL) instead of drawn, and with a tracer (rt
+ * non-NULL: the rim traced, covered texels invalid) as the frame loop gathers. */
+static float *gather_traced(const lm_scene *sc, const lm_atlas *at, const float *aim_rgb, const lm_emitter_light *el,
+                            const lm_rt *rt, const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count,
+                            lm_gather_stats *stats)
 {
 
     lm_error err;
@@ -128,6 +130,7 @@ static float *gather_with(const lm_scene *sc, const lm_atlas *at, const float *a
     unsigned tex = lm_iim_texture_create(at->width, at->height);
     assert_true(tex != 0);
     lm_gather_set_emitter_light(g, el);
+    lm_gather_set_tracer(g, rt);
     assert_int_equal(lm_gather_set_scene(g, sc, at, &err), LM_OK);
     assert_int_equal(lm_gather_set_aim(g, at, aim, &err), LM_OK);
     if (lm_gather_texels(g, sc, at, texels, count, tex, stats, &err) != LM_OK)
@@ -137,6 +140,13 @@ static float *gather_with(const lm_scene *sc, const lm_atlas *at, const float *a
     lm_gather_free(g);
     free(aim);
     return rgba;
+}
+
+static float *gather_with(const lm_scene *sc, const lm_atlas *at, const float *aim_rgb, const lm_emitter_light *el,
+                          const lm_hemicube_settings *set, const uint32_t *texels, uint32_t count,
+                          lm_gather_stats *stats)
+{
+    return gather_traced(sc, at, aim_rgb, el, NULL, set, texels, count, stats);
 }
 
 static const float *texel_value_at(const lm_atlas *a, const float *rgba, uint32_t texel)
@@ -257,6 +267,83 @@ static void test_parallel_square(void **state)
     check_square(2.2f, 1.0f); /* edges between pixel centres: rasterisation error */
 }
 
+/* The rim traced (hemicube_rim.h): a texel under a parallel emitting square gets pi Le F, whether the
+ * square fits inside the plane (side 2 at d = 1: 1 / F(a) reads 20% high) or reaches into the rim (side 8:
+ * 1 / F(a) reads pi Le, 5% high; side 40, nearly the whole hemisphere: the edge, 3 degrees above the
+ * horizon, falls inside one row of the 16 x 16 pattern, measured -1.1%). Within 2%, as the plane's own
+ * rasterization (check_square). */
+static void check_square_rim(float side, float d)
+{
+    lmt_mesh m[2];
+    square(&m[0], 0.05f, 0.0f, 1);
+    square(&m[1], side / 2, d, 0);
+    tscene t;
+    ts_load(&t, m, 2, "[{\"children\": [1, 2]}, {\"mesh\": 0}, {\"mesh\": 1}]",
+            "[{}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 0.5, 0.25]}]",
+            0.05f);
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    uint32_t texel = texel_near(&t, 1, 0.0f, 0.0f);
+    lm_gather_stats st;
+    float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, &texel, 1, &st);
+    const float *E = texel_value(&t, rgba, texel);
+    const lm_texel *tx = &t.a.texels[texel];
+    double h = side / 2.0, px = tx->pos[0], pz = tx->pos[2], dd = d - set.offset * lm_scene_size(t.s);
+    double F = lm_form_factor_rect(-h - px, h - px, -h - pz, h - pz, dd);
+    print_message("rim traced, square side %.1f at d %.1f: F = %.5f, E / (pi Le F) = %.4f (1 / F(a) would give "
+                  "%.4f)\n", (double)side, (double)d, F, E[0] / (PI * F),
+                  fmin(lm_hemicube_coverage(set.enlargement), F) / lm_hemicube_coverage(set.enlargement) / F);
+    const double Le[3] = {1.0, 0.5, 0.25};
+    for (int c = 0; c < 3; c++)
+        assert_true(fabs(E[c] / (PI * Le[c] * F) - 1.0) < 0.02);
+    assert_true(E[3] == 0.0f); /* nothing covers it */
+    free(rgba);
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
+static void test_rim_traced(void **state)
+{
+    (void)state;
+    check_square_rim(2.0f, 1.0f);
+    check_square_rim(8.0f, 1.0f);
+    check_square_rim(40.0f, 1.0f);
+}
+
+/* A texel with other geometry within a texel's width straight out from it (a floor under a lid 2 mm
+ * above it) or inside a closed mesh is covered: invalid with a tracer; one beside them is not. */
+static void test_covered_texels(void **state)
+{
+    (void)state;
+    lmt_mesh m[3];
+    square(&m[0], 2.0f, 0.0f, 1);
+    square(&m[1], 0.4f, 0.002f, 0); /* a lid facing the floor, 2 mm above it (texel 0.25) */
+    memset(&m[2], 0, sizeof m[2]);
+    lmt_mesh_cube(&m[2], 0.3f);
+    tscene t;
+    ts_load(&t, m, 3, "[{\"children\": [1, 2, 3]}, {\"mesh\": 0}, {\"mesh\": 1, \"translation\": [-1, 0, -1]}, "
+            "{\"mesh\": 2, \"translation\": [1, 0.3, 1]}]", "[{}, {}, {\"doubleSided\": true}]", 0.25f);
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    uint32_t texels[3] = {texel_near(&t, 1, -1.0f, -1.0f), texel_near(&t, 1, 1.0f, 1.0f),
+                          texel_near(&t, 1, 1.0f, -1.0f)};
+    assert_true(lm_texel_covered(rt, t.s, &t.a, &set, texels[0])); /* under the lid */
+    assert_true(lm_texel_covered(rt, t.s, &t.a, &set, texels[1])); /* inside the double-sided closed cube */
+    assert_false(lm_texel_covered(rt, t.s, &t.a, &set, texels[2])); /* in the open */
+    float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, texels, 3, NULL);
+    for (int k = 0; k < 3; k++)
+        assert_true((texel_value(&t, rgba, texels[k])[3] > set.backface_limit) == (k < 2));
+    free(rgba);
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
 /* (d) A floor texel inside a closed box sees only the box's back faces: invalid; one outside is valid. */
 static void test_box_backfaces(void **state)
 {
@@ -374,6 +461,34 @@ static void test_furnace(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* Each surface's mean E over its valid texels within `tol` of the reference's (of the scene's mean E for
+ * surfaces darker than that) for surfaces of at least 100 valid texels (walls, floor, ceiling), within
+ * `small_tol` for those of 20 to 99 (the boxes' faces, 5 x 5 texels: there the AIMs of the floor and walls
+ * they see are darkened within a gather radius of their edges, where the box hides part of the disc). */
+static void assert_surface_means(const lmt_pipeline *p, const float *est, const float *ref, const uint8_t *valid,
+                                 double tol, double small_tol)
+{
+    double all = 0.0;
+    uint32_t n_all = 0;
+    for (uint32_t i = 0; i < p->atlas.texel_count; i++)
+        if (valid[i])
+            all += ref[3 * i + 1], n_all++;
+    all /= n_all ? n_all : 1;
+    for (int sf = 0; sf < p->su.surface_count; sf++) {
+        double e = 0.0, r = 0.0;
+        uint32_t n = 0;
+        for (uint32_t i = 0; i < p->atlas.texel_count; i++)
+            if (valid[i] && p->atlas.texels[i].surface == sf)
+                e += est[3 * i + 1], r += ref[3 * i + 1], n++;
+        if (n < 20)
+            continue;
+        e /= n, r /= n;
+        print_message("  surface %2d (%s): %u texels, E %.4g, reference %.4g (%+.1f%%; scene mean %.4g)\n", sf,
+                      p->s->nodes[p->su.surfaces[sf].node].name, n, e, r, r > 0.0 ? 100.0 * (e / r - 1.0) : 0.0, all);
+        assert_true(fabs(e - r) <= (n >= 100 ? tol : small_tol) * fmax(r, all));
+    }
+}
+
 /* The shared Cornell box: a full gather over the AIMs against the reference solver's E_iim. */
 static void test_cornell_box_against_reference(void **state)
 {
@@ -393,20 +508,34 @@ static void test_cornell_box_against_reference(void **state)
     lm_emitter_light el;
     lm_error err;
     assert_int_equal(lm_emitter_light_init(&el, p.s, p.rt, LM_EMITTER_LIGHT_DEFAULT_RAYS, &err), LM_OK);
-    for (int k = 0; k < 4; k++) { /* a = 1, 2, 3 with the emitter drawn; a = 2 with it in closed form */
-        const float as[4] = {1.0f, 2.0f, 3.0f, 2.0f};
+    /* Texels nobody sees (the ceiling over the lamp, the lamp's top 0.9 mm under it, the floor under the
+     * boxes) are left out of every variant, as the frame loop's gather marks them invalid. */
+    lm_hemicube_settings defaults;
+    lm_hemicube_settings_default(&defaults);
+    uint8_t *hidden = malloc(p.atlas.texel_count);
+    assert_non_null(hidden);
+    for (uint32_t i = 0; i < p.atlas.texel_count; i++)
+        hidden[i] = (uint8_t)lm_texel_covered(p.rt, p.s, &p.atlas, &defaults, i);
+    /* a = 1, 2, 3 with the emitter drawn and the rim extrapolated by 1 / F(a) (the paper's gather, printed:
+     * at a = 2 the walls read 10-20% high, the 1 / F(a) bias of a bright source near the normal); then at
+     * a = 2: drawn with the rim traced, in closed form without and with the rim traced (the frame loop's
+     * gather for this scene), each asserted */
+    const float as[6] = {1.0f, 2.0f, 3.0f, 2.0f, 2.0f, 2.0f};
+    const int closed_form[6] = {0, 0, 0, 0, 1, 1}, traced[6] = {0, 0, 0, 1, 0, 1};
+    const double bound[6] = {0.0, 0.0, 0.0, IIM_RMSE_BOUND, IIM_RMSE_BOUND, IIM_RMSE_BOUND_RIM};
+    for (int k = 0; k < 6; k++) {
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
         set.enlargement = as[k];
-        if (k == 3)
+        if (closed_form[k])
             set.coverage_samples = 1; /* what the frame loop takes with the closed form */
         lm_gather_stats gs;
-        float *rgba = gather_with(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), k == 3 ? &el : NULL, &set,
-                                  texels, p.atlas.texel_count, &gs);
+        float *rgba = gather_traced(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), closed_form[k] ? &el : NULL,
+                                    traced[k] ? p.rt : NULL, &set, texels, p.atlas.texel_count, &gs);
         uint32_t invalid = 0;
         for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
             const float *v = rgba + 4 * ((size_t)p.atlas.texels[i].y * p.atlas.width + p.atlas.texels[i].x);
-            valid[i] = !(v[3] > set.backface_limit);
+            valid[i] = !(v[3] > set.backface_limit) && !hidden[i];
             invalid += !valid[i];
         }
         uint32_t unfilled = lm_iim_fill_invalid(&p.atlas, rgba, set.backface_limit);
@@ -417,14 +546,18 @@ static void test_cornell_box_against_reference(void **state)
         double all = lm_ref_relative_rmse(est, ref.iim, NULL, p.atlas.texel_count, 3);
         print_message("Cornell box IIM, a = %.0f%s: relative RMSE %.4f over valid texels, %.4f over all (%u texels, "
                       "%u invalid, %u unfilled; reference se %.3f, %.1f s%s); %.3f ms per texel (%d tris)\n",
-                      (double)set.enlargement, k == 3 ? " (emitter in closed form)" : "", rmse, all, p.atlas.texel_count, invalid, unfilled, ref.mean_rel_se,
+                      (double)set.enlargement, closed_form[k] ? (traced[k] ? " (emitter in closed form, rim traced)" :
+                      " (emitter in closed form)") : traced[k] ? " (rim traced)" : "", rmse, all, p.atlas.texel_count, invalid, unfilled, ref.mean_rel_se,
                       t_ref, ref.from_cache ? ", cached" : "", 1e3 * gs.seconds / p.atlas.texel_count,
                       (int)p.s->tri_count);
-        if (set.enlargement == 2.0f)
-            assert_true(rmse < IIM_RMSE_BOUND);
+        if (bound[k] > 0.0)
+            assert_true(rmse < bound[k]);
+        if (closed_form[k] && traced[k])
+            assert_surface_means(&p, est, ref.iim, valid, 0.03, 0.08);
         free(rgba);
     }
     lm_emitter_light_free(&el);
+    free(hidden);
     free(est);
     free(valid);
     free(texels);
@@ -434,8 +567,11 @@ static void test_cornell_box_against_reference(void **state)
 }
 
 /* The three ways of putting many texels into one pass give the same IIM: the shared Cornell box (AIMs
- * from 20k photons, every texel) through viewports, instanced and (where the extension exists) layered.
- * Measured: instanced worst texel 3.8e-3 of the mean E, rms 1.0e-4. */
+ * from 20k photons, every texel) through viewports, instanced and (where the extension exists) layered,
+ * with the lamp's light in closed form as the frame loop gathers this scene (drawn, the lamp's top seen
+ * edge-on through its 0.9 mm gap from the ceiling texels around it puts a 100-radiance sliver on pixel
+ * edges, which the tile mappings round apart: 1.7e-2 of the mean E there).
+ * Measured: instanced worst texel 2.0e-2 of the mean E, rms 4.1e-4; layered 6.0e-3, 1.2e-4. */
 static void test_schemes_agree(void **state)
 {
     (void)state;
@@ -445,6 +581,9 @@ static void test_schemes_agree(void **state)
     lm_photon_stage *st = stage_for(&p, 20000);
     uint32_t *texels = all_texels(&p.atlas);
     float *iim[3] = {NULL, NULL, NULL};
+    lm_emitter_light el;
+    lm_error eerr;
+    assert_int_equal(lm_emitter_light_init(&el, p.s, p.rt, LM_EMITTER_LIGHT_DEFAULT_RAYS, &eerr), LM_OK);
     for (int k = 0; k < 3; k++) {
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
@@ -458,13 +597,22 @@ static void test_schemes_agree(void **state)
             continue;
         }
         lm_gather_free(g);
-        iim[k] = gather_aim(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), &set, texels, p.atlas.texel_count, NULL);
+        iim[k] = gather_with(p.s, &p.atlas, lm_aim_rgb(lm_photon_stage_aim(st)), &el, &set, texels,
+                             p.atlas.texel_count, NULL);
     }
+    /* texels nobody sees (the ceiling over the lamp and the lamp's top, 0.9 mm apart) are left out: their
+     * E is a hundred times the room's, and the frame loop's gather marks them invalid */
+    lm_hemicube_settings defaults;
+    lm_hemicube_settings_default(&defaults);
     for (int k = 1; k < 3; k++) {
         if (!iim[k])
             continue;
         double worst = 0.0, sum = 0.0, diff2 = 0.0;
+        uint32_t compared = 0;
         for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
+            if (lm_texel_covered(p.rt, p.s, &p.atlas, &defaults, i))
+                continue;
+            compared++;
             size_t at = 4 * ((size_t)p.atlas.texels[i].y * p.atlas.width + p.atlas.texels[i].x);
             for (int c = 0; c < 3; c++) {
                 double d = fabs((double)iim[k][at + c] - iim[0][at + c]);
@@ -474,15 +622,19 @@ static void test_schemes_agree(void **state)
             }
             assert_true(fabsf(iim[k][at + 3] - iim[0][at + 3]) < 1e-3f);
         }
-        double mean = sum / (3.0 * p.atlas.texel_count), rms = sqrt(diff2 / (3.0 * p.atlas.texel_count));
+        double mean = sum / (3.0 * compared), rms = sqrt(diff2 / (3.0 * compared));
         print_message("%s vs viewports: worst texel differs by %.2e of the mean E, rms %.2e\n",
                       lm_gather_scheme_name((lm_gather_scheme)k), worst / mean, rms / mean);
-        /* the same up to pixels whose centre lies on a triangle edge, which the tile mappings round apart */
-        assert_true(worst < 1e-2 * mean);
-        assert_true(rms < 3e-4 * mean);
+        /* the same up to pixels whose centre lies on a triangle edge, which the tile mappings round apart;
+         * since the walls and the lamp have two sides, one ceiling texel 7 mm from the lamp's edge differs
+         * by 1.1% of its E (2e-2 of the mean) between viewports and instanced, every other texel by less
+         * than 0.4% */
+        assert_true(worst < 3e-2 * mean);
+        assert_true(rms < 5e-4 * mean);
     }
     for (int k = 0; k < 3; k++)
         free(iim[k]);
+    lm_emitter_light_free(&el);
     free(texels);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
@@ -793,6 +945,8 @@ int main(void)
         cmocka_unit_test(test_weights_sum_to_coverage),
         cmocka_unit_test(test_uniform_sky),
         cmocka_unit_test(test_parallel_square),
+        cmocka_unit_test(test_rim_traced),
+        cmocka_unit_test(test_covered_texels),
         cmocka_unit_test(test_box_backfaces),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_schedule_order_and_budget),

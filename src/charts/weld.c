@@ -59,7 +59,7 @@ float *lmc_world_normals(const lm_scene *s)
     return nrm;
 }
 
-/* Open-addressing table from (cell, node) to the first representative vertex in that cell; further
+/* Open-addressing table from (cell, node and side) to the first representative vertex in that cell; further
  * representatives of the cell are chained through next[]. */
 typedef struct {
     int64_t key[4];
@@ -143,6 +143,17 @@ uint32_t *lmc_weld(const lm_scene *s, const float *pos, float tol)
         rep = NULL;
         goto done;
     }
+    uint8_t *back = calloc((size_t)n + 1, 1);
+    if (!back) {
+        free(rep);
+        rep = NULL;
+        goto done;
+    }
+    /* the two sides of a split surface stay apart: each is its own single-sided sheet */
+    for (uint32_t t = 0; t < s->tri_count; t++)
+        if (lm_tri_is_back(s, t))
+            for (int k = 0; k < 3; k++)
+                back[s->tris[3 * (size_t)t + k]] = 1;
     for (size_t i = 0; i < cap; i++)
         g.slot[i].head = UINT32_MAX;
     tol = fmaxf(tol, FLT_MIN);
@@ -151,12 +162,14 @@ uint32_t *lmc_weld(const lm_scene *s, const float *pos, float tol)
         const float *p = pos + 3 * (size_t)v;
         uint32_t r = UINT32_MAX;
         if (isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2])) {
-            r = find_rep(&g, pos, p, s->vertex_node[v], inv_cell, tol);
+            uint32_t key = 2 * s->vertex_node[v] + back[v];
+            r = find_rep(&g, pos, p, key, inv_cell, tol);
             if (r == UINT32_MAX)
-                insert_rep(&g, p, v, s->vertex_node[v], inv_cell);
+                insert_rep(&g, p, v, key, inv_cell);
         }
         rep[v] = r == UINT32_MAX ? v : r;
     }
+    free(back);
 done:
     free(g.slot);
     free(g.next);

@@ -6,6 +6,7 @@
 
 #include "args.h"
 #include "bench.h"
+#include "check_cmd.h"
 #include "photons_cmd.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
@@ -23,6 +24,10 @@ static void usage(FILE *f)
             "  run SCENE --out DIR    the whole frame loop over the scene's animations (photons, AIMs, IIM\n"
             "                         gather, direct light, composite): DIR/frame_NNNN.png (every K-th also\n"
             "                         .exr), iim.exr/png, aim.exr/png and frames.csv (work and ms per stage)\n"
+            "  check SCENE            one frame of 'run' (same options) against the path-traced reference:\n"
+            "                         frame / reference per visible surface and over the frame, and the\n"
+            "                         relative RMSE (default --size 128x128; --out DIR: the two EXRs)\n"
+            "  reference SCENE --out DIR  path-traced ground truth per texel and per pixel\n"
             "  bench [SCENE...]       time load, surface split, atlas (unwrap, pack, texel table) and BVH build;\n"
             "                         --scaling FILE (repeatable) adds a growth table; with no SCENE also photon\n"
             "                         tracing vs raw Embree, kd-trees, the photon stage, the final gather and\n"
@@ -135,6 +140,8 @@ int main(int argc, char **argv)
         return lm_cli_reference(&a);
     if (!strcmp(cmd, "run"))
         return lm_cli_run(&a);
+    if (!strcmp(cmd, "check"))
+        return lm_cli_check(&a);
     if (!strcmp(cmd, "bench"))
         return lm_cli_bench(&a);
     fprintf(stderr, "lmgi: unknown command '%s'\n\n", cmd);

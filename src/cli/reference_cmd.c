@@ -25,7 +25,7 @@
 #define LM_CLI_REF_WIDTH 320
 #define LM_CLI_REF_HEIGHT 240
 
-static void settings_from_args(const lm_cli_args *a, lm_ref_settings *set)
+void lm_cli_ref_settings(const lm_cli_args *a, lm_ref_settings *set)
 {
     lm_ref_settings_default(set);
     if (a->target_error > 0.0f)
@@ -41,25 +41,6 @@ static void settings_from_args(const lm_cli_args *a, lm_ref_settings *set)
     set->cache_dir = a->cache_dir;
     set->use_cache = !a->no_cache;
     set->progress = !a->quiet;
-}
-
-/* The picture's camera from lm_view_for_scene: right, up and -forward are the view matrix's rows. */
-static int camera_from_view(const lm_scene *s, int camera, int w, int h, lm_ref_camera *cam)
-{
-    lm_view v;
-    lm_view_for_scene(s, camera, w, h, &v);
-    if (v.proj[11] != -1.0f) {
-        fprintf(stderr, "lmgi: reference: camera '%s' is orthographic; only perspective cameras are supported\n", v.name);
-        return 0;
-    }
-    memcpy(cam->eye, v.eye, sizeof cam->eye);
-    for (int k = 0; k < 3; k++) {
-        cam->up[k] = v.view[4 * k + 1];
-        cam->forward[k] = -v.view[4 * k + 2];
-    }
-    cam->yfov = 2.0f * atanf(1.0f / v.proj[5]);
-    cam->width = w, cam->height = h;
-    return 1;
 }
 
 static int write_atlas_exr(const char *dir, const char *name, const lm_atlas *atlas, const float *values)
@@ -139,10 +120,14 @@ static int run_pixels(const lm_cli_args *a, const lmgi_scene *sc, const lm_emitt
 {
     lm_ref_camera cam;
     int w = a->width > 0 ? a->width : LM_CLI_REF_WIDTH, h = a->height > 0 ? a->height : LM_CLI_REF_HEIGHT;
-    if (!camera_from_view(sc->scene, a->camera, w, h, &cam))
-        return 0;
-    lm_ref_result r;
+    lm_view view;
     lm_error err;
+    lm_view_for_scene(sc->scene, a->camera, w, h, &view);
+    if (lm_view_ref_camera(&view, w, h, &cam, &err) != LM_OK) {
+        fprintf(stderr, "lmgi: reference: %s\n", err.msg);
+        return 0;
+    }
+    lm_ref_result r;
     double t0 = lm_now();
     if (lm_reference_pixels(sc->scene, sc->rt, em, &cam, set, &r, &err) != LM_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.msg);
@@ -179,7 +164,7 @@ int lm_cli_reference(const lm_cli_args *a)
     if (!a->quiet && lm_log_get_level() < LM_LOG_INFO)
         lm_log_set_level(LM_LOG_INFO); /* progress lines */
     lm_ref_settings set;
-    settings_from_args(a, &set);
+    lm_cli_ref_settings(a, &set);
     ok = run_texels(a, sc, &em, &set) && run_pixels(a, sc, &em, &set);
     lm_emitters_free(&em);
     lmgi_free(sc);

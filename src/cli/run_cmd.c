@@ -37,7 +37,7 @@ static void gather_progress(void *user, uint32_t done, uint32_t total)
     lm_progress("first full gather", (int)done, (int)total);
 }
 
-static void settings_from_args(const lm_cli_args *a, lm_frame_loop_settings *s)
+void lm_cli_run_settings(const lm_cli_args *a, lm_frame_loop_settings *s)
 {
     lm_frame_loop_settings_default(s);
     lm_cli_photon_settings(a, &s->stage);
@@ -218,7 +218,7 @@ static lm_status open_outputs(run_state *r, lm_error *err)
 static lm_status run(run_state *r, lm_error *err)
 {
     lm_frame_loop_settings set;
-    settings_from_args(r->a, &set);
+    lm_cli_run_settings(r->a, &set);
     r->png = malloc((size_t)set.width * set.height * 4);
     if (!r->png)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the frames");
@@ -244,6 +244,20 @@ static lm_status run(run_state *r, lm_error *err)
     return st;
 }
 
+int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc)
+{
+    lmgi_error perr;
+    lmgi_options o = a->options;
+    int per_frame = a->texels_per_frame ? a->texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME;
+    if (o.texel_size <= 0.0f && o.target_texels <= 0) /* a density the texel budget keeps up with */
+        o.target_texels = lm_frame_loop_atlas_texels(per_frame);
+    if (lmgi_load(a->files[0], &o, sc, &perr) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", perr.message);
+        return 0;
+    }
+    return 1;
+}
+
 int lm_cli_run(const lm_cli_args *a)
 {
     if (a->file_count != 1 || !a->out_dir) {
@@ -253,15 +267,8 @@ int lm_cli_run(const lm_cli_args *a)
     run_state r;
     memset(&r, 0, sizeof r);
     r.a = a;
-    lmgi_error perr;
-    lmgi_options o = a->options;
-    int per_frame = a->texels_per_frame ? a->texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME;
-    if (o.texel_size <= 0.0f && o.target_texels <= 0) /* a density the texel budget keeps up with */
-        o.target_texels = lm_frame_loop_atlas_texels(per_frame);
-    if (lmgi_load(a->files[0], &o, &r.sc, &perr) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", perr.message);
+    if (!lm_cli_run_load(a, &r.sc))
         return 1;
-    }
     lm_error err;
     lm_error_clear(&err);
     lm_status st = run(&r, &err);

@@ -3,4 +3,12 @@
 #include "args.h"
 /* `lmgi run SCENE --frames N --size WxH --out DIR`: the whole frame loop over the scene's animations. */
 int lm_cli_run(const lm_cli_args *a);
+
+#include <lmgi.h>
+#include "../update/frame_loop.h"
+/* The frame loop's settings from the command line (defaults where not given). */
+void lm_cli_run_settings(const lm_cli_args *a, lm_frame_loop_settings *s);
+/* Loads a->files[0] as 'run' does: at the lightmap density its texel budget keeps up with unless told a
+ * texel size or count. 0 (after printing the error) on failure. */
+int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc);
 #endif

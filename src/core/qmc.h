@@ -79,4 +79,19 @@ static inline int lm_halton_float_below(uint32_t dim, uint32_t index, float p)
 /* The d-th prime (d = 0 -> 2). */
 uint32_t lm_qmc_prime(uint32_t dim);
 
+/* Two numbers in [0, 1) from a seed: a per-entry (texel) Cranley-Patterson shift of a fixed sample
+ * pattern, so an entry gets the same samples whenever it is computed and neighbours get different ones. */
+static inline void lm_seed_shift(uint32_t seed, double s[2])
+{
+    for (int k = 0; k < 2; k++) {
+        uint32_t h = seed * 0x9e3779b1u + (uint32_t)k * 0x85ebca77u;
+        h ^= h >> 16;
+        h *= 0x7feb352du;
+        h ^= h >> 15;
+        h *= 0x846ca68bu;
+        h ^= h >> 16;
+        s[k] = (double)h * (1.0 / 4294967296.0);
+    }
+}
+
 #endif

@@ -68,3 +68,18 @@ void lm_view_for_scene(const lm_scene *s, int camera, int width, int height, lm_
         automatic(s, aspect, out);
     }
 }
+
+lm_status lm_view_ref_camera(const lm_view *v, int width, int height, lm_ref_camera *cam, lm_error *err)
+{
+    if (v->proj[11] != -1.0f)
+        return lm_fail(err, LM_ERR_INVALID, "camera '%s' is orthographic; only perspective cameras are supported",
+                       v->name);
+    memcpy(cam->eye, v->eye, sizeof cam->eye);
+    for (int k = 0; k < 3; k++) {
+        cam->up[k] = v->view[4 * k + 1];
+        cam->forward[k] = -v->view[4 * k + 2];
+    }
+    cam->yfov = 2.0f * atanf(1.0f / v->proj[5]);
+    cam->width = width, cam->height = height;
+    return LM_OK;
+}

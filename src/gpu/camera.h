@@ -4,6 +4,7 @@
 #define LM_CAMERA_H
 
 #include "../scene/scene.h"
+#include "../trace/reference.h"
 
 typedef struct {
     float view[16], proj[16];
@@ -14,5 +15,9 @@ typedef struct {
 
 /* camera: index into s->cameras, or -1 for the first one if any, else automatic. */
 void lm_view_for_scene(const lm_scene *s, int camera, int width, int height, lm_view *out);
+
+/* The reference solver's camera for the same picture (right, up and -forward are the view matrix's rows),
+ * so that its pixels are the frame's. Fails for an orthographic view, which the solver does not take. */
+lm_status lm_view_ref_camera(const lm_view *v, int width, int height, lm_ref_camera *cam, lm_error *err);
 
 #endif

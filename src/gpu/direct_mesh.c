@@ -178,21 +178,25 @@ static int shading_vertices(lm_direct_mesh *d, const lm_scene *s, const lm_atlas
     return 1;
 }
 
-/* Indices grouped by texture (counting sort, triangle order within a group); 0 when out of memory. */
+/* Indices grouped by texture (counting sort, triangle order within a group), each group's split sides
+ * last (lm_direct_mesh.paired); 0 when out of memory. */
 static int shading_indices(lm_direct_mesh *d, const lm_scene *s, built *b)
 {
-    int *at = malloc(sizeof(int) * (size_t)d->groups);
+    int *at = malloc(sizeof(int) * 2 * (size_t)d->groups), *at_paired = at + d->groups;
     if (!at)
         return 0;
-    for (uint32_t t = 0; t < s->tri_count; t++)
+    for (uint32_t t = 0; t < s->tri_count; t++) {
         d->count[group_of(s, t)] += 3;
+        d->paired[group_of(s, t)] += s->materials[s->tri_material[t]].split_sides ? 3 : 0;
+    }
     for (int g = 1; g < d->groups; g++)
         d->first[g] = d->first[g - 1] + d->count[g - 1];
-    memcpy(at, d->first, sizeof(int) * (size_t)d->groups);
+    for (int g = 0; g < d->groups; g++)
+        at[g] = d->first[g], at_paired[g] = d->first[g] + d->count[g] - d->paired[g];
     for (uint32_t t = 0; t < s->tri_count; t++) {
-        int g = group_of(s, t);
-        memcpy(b->index + at[g], b->corner + 3 * (size_t)t, 3 * sizeof(uint32_t));
-        at[g] += 3;
+        int g = group_of(s, t), *o = s->materials[s->tri_material[t]].split_sides ? at_paired : at;
+        memcpy(b->index + o[g], b->corner + 3 * (size_t)t, 3 * sizeof(uint32_t));
+        o[g] += 3;
     }
     free(at);
     return 1;
@@ -246,6 +250,7 @@ static int allocate(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, bui
         most = s->nodes[i].tri_count > most ? s->nodes[i].tri_count : most;
     d->first = calloc((size_t)d->groups, sizeof(int));
     d->count = calloc((size_t)d->groups, sizeof(int));
+    d->paired = calloc((size_t)d->groups, sizeof(int));
     d->tex = calloc((size_t)d->groups, sizeof(unsigned));
     d->node_first = calloc(nodes, sizeof(int));
     d->node_verts = calloc(nodes, sizeof(int));
@@ -262,7 +267,7 @@ static int allocate(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, bui
     b->corner = malloc(sizeof(uint32_t) * corners);
     b->index = malloc(sizeof(uint32_t) * corners);
     b->caster_index = malloc(sizeof(uint32_t) * corners);
-    return d->first && d->count && d->tex && d->node_first && d->node_verts && d->caster_first &&
+    return d->first && d->count && d->paired && d->tex && d->node_first && d->node_verts && d->caster_first &&
            d->caster_verts && d->vert_src && d->vert_mat && d->caster_src && d->node_world && d->scratch &&
            b->vert && (b->lm_uv || !a) && b->caster_pos && b->corner && b->index && b->caster_index;
 }
@@ -379,7 +384,15 @@ void lm_direct_mesh_draw(const lm_direct_mesh *d, unsigned prog)
             glUniform1i(has_tex, g > 0);
         glActiveTexture(GL_TEXTURE2);
         glBindTexture(GL_TEXTURE_2D, g > 0 ? d->tex[g - 1] : 0);
-        lm_gl_mesh_draw_range(&d->mesh, d->first[g], d->count[g]);
+        int unpaired = d->count[g] - d->paired[g];
+        if (unpaired)
+            lm_gl_mesh_draw_range(&d->mesh, d->first[g], unpaired);
+        if (d->paired[g]) { /* both sides lie in one plane: only the one facing the eye is drawn */
+            glEnable(GL_CULL_FACE);
+            glCullFace(GL_BACK);
+            lm_gl_mesh_draw_range(&d->mesh, d->first[g] + unpaired, d->paired[g]);
+            glDisable(GL_CULL_FACE);
+        }
     }
 }
 
@@ -396,6 +409,7 @@ void lm_direct_mesh_free(lm_direct_mesh *d)
             glDeleteTextures(1, &d->tex[g]);
     free(d->first);
     free(d->count);
+    free(d->paired);
     free(d->tex);
     free(d->node_first);
     free(d->node_verts);

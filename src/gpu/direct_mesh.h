@@ -18,6 +18,8 @@ typedef struct {
     int static_caster_indices; /* indices of the static casters at the start of `casters` */
     int groups;           /* texture_count + 1: group 0 untextured, group g + 1 texture g */
     int *first, *count;   /* index range of each group */
+    int *paired;          /* of which the last `paired` are sides of split double-sided surfaces, drawn
+                           * with back faces culled (the twin on the same plane shows the other side) */
     unsigned *tex;        /* GL texture of group g + 1 (0 when the group is empty) */
     int node_count;
     int *node_first, *node_verts;     /* per node: its vertex range in `mesh` */

@@ -133,3 +133,20 @@ void lm_gl_mesh_destroy(lm_gl_mesh *m)
     glDeleteVertexArrays(1, &m->vao);
     m->vao = m->vbo = m->ibo = 0;
 }
+
+void lm_gl_mesh_draw_scene_sides(const lm_gl_mesh *m, const lm_scene *s)
+{
+    for (uint32_t t = 0; t < s->tri_count;) {
+        int split = s->materials[s->tri_material[t]].split_sides;
+        uint32_t end = t + 1;
+        while (end < s->tri_count && s->materials[s->tri_material[end]].split_sides == split)
+            end++;
+        if (split) {
+            glEnable(GL_CULL_FACE);
+            glCullFace(GL_BACK);
+        }
+        lm_gl_mesh_draw_range(m, (int)(3 * t), (int)(3 * (end - t)));
+        glDisable(GL_CULL_FACE);
+        t = end;
+    }
+}

@@ -5,6 +5,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "../scene/scene.h"
+
 typedef struct {
     unsigned vao, vbo, ibo;
     int vertices;         /* vertices drawn: index count when indexed */
@@ -21,6 +23,10 @@ int lm_gl_mesh_create_indexed(lm_gl_mesh *m, const float *data, int vertices, co
 void lm_gl_mesh_draw(const lm_gl_mesh *m);
 /* Draws `count` vertices (indices when indexed) from the `first`-th. */
 void lm_gl_mesh_draw_range(const lm_gl_mesh *m, int first, int count);
+/* Draws a mesh of unindexed triangles, one per scene triangle in the scene's order, with the back faces
+ * of split double-sided sides culled (lm_scene.tri_twin: the twin in the same plane shows that side),
+ * the others from both sides. */
+void lm_gl_mesh_draw_scene_sides(const lm_gl_mesh *m, const lm_scene *s);
 void lm_gl_mesh_draw_instanced(const lm_gl_mesh *m, int instances);
 void lm_gl_mesh_destroy(lm_gl_mesh *m);
 

@@ -39,6 +39,7 @@
 #include "../core/error.h"
 #include "../scene/scene.h"
 #include "../trace/emitter_light.h"
+#include "../trace/rt_scene.h"
 
 /* How a pass puts many texels' planes into one render target (docs/gather.md, "Throughput"). */
 typedef enum {
@@ -64,6 +65,9 @@ typedef struct {
     int coverage_samples;  /* coverage samples per pixel (MSAA, 1 to 16; default 4): a small emitter covering a
                               few pixels adds a fraction per pixel instead of all or nothing (no plaid).
                               lm_gather_coverage_for picks it per scene */
+    int rim_samples;       /* K, stratified directions over the hemisphere for the rim the plane misses
+                              (hemicube_rim.h; default 256, about 44 rays per texel at a = 2), with a tracer
+                              (lm_gather_set_tracer); 0 or no tracer: the paper's division by F(a) */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);
@@ -107,6 +111,15 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
  * instead (trace/emitter_light.h: no plaid from small emitters, no coverage samples needed). Takes
  * effect at the next lm_gather_set_scene; el is borrowed. */
 void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el);
+/* With a BVH (NULL: none, the default): the rim of the hemisphere outside the plane is traced
+ * (hemicube_rim.h, when rim_samples > 0) instead of extrapolated by 1 / F(a), and a covered texel
+ * (lm_texel_covered) is invalid (alpha 1), like a texel that sees back faces. rt is borrowed and must describe the scene the gather draws (the same node matrices). */
+void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt);
+/* Whether texel `texel` is covered as the gather with a tracer decides it: straight out from its centre
+ * (lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel
+ * lies inside a closed mesh) (docs/gather.md, "Covered texels"). */
+int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
+                     uint32_t texel);
 /* The proxy the gather draws; NULL when proxy_error is 0 or before lm_gather_set_scene. */
 const lm_proxy *lm_gather_proxy(const lm_gather *g);
 /* Uploads the AIM (atlas-sized RGB radiance, width*height*3 floats), dilated into the gutters. */

@@ -15,6 +15,7 @@
 #include "gl_shader.h"
 #include "hemicube_shaders.h"
 #include "../trace/emitter_light.h"
+#include "hemicube_rim.h"
 
 /* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided,
  * surface (-1 when none), the UV's gradient (2 x vec3) and the chart's UV rectangle; a view: 4 vec4
@@ -30,7 +31,9 @@ struct lm_gather {
     GLuint weights_buf, targets_buf, views_buf, emit_buf;
     float *views;          /* a pass's views (schemes 1, 2), tiles^2 * VIEW_FLOATS */
     const lm_emitter_light *emitters; /* non-NULL: emitters' light in closed form, not drawn */
-    float *emit;           /* a pass's emitter irradiance per texel, tiles^2 * 4 */
+    const lm_rt *rt;       /* non-NULL (and rim_samples > 0): the rim traced (hemicube_rim.h) */
+    float *aim_copy;       /* the dilated AIM as uploaded, for the rim's lookups (atlas-sized RGBA) */
+    float *emit;           /* a pass's irradiance from the CPU per texel (emitters, rim), tiles^2 * 4 */
     GLuint aim_tex;
     int aim_w, aim_h;
     lm_gl_mesh mesh;
@@ -137,10 +140,12 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
         (s->scheme != LM_GATHER_LAYERED && (long)s->resolution * s->tiles > max_side) ||
         (unsigned)s->scheme > LM_GATHER_LAYERED || (s->samples != 1 && s->samples != 4) ||
         s->coverage_samples < 1 || s->coverage_samples > 16 ||
-        (s->coverage_samples > 1 && s->scheme == LM_GATHER_LAYERED))
+        (s->coverage_samples > 1 && s->scheme == LM_GATHER_LAYERED) || s->rim_samples < 0 ||
+        s->rim_samples > 65536)
         return lm_fail(err, LM_ERR_INVALID, "hemicube settings out of range (resolution %d, tiles %d, a %g, "
-                       "samples %d: 1 or 4, coverage samples %d: 1 to 16, 1 with the layered scheme)",
-                       s->resolution, s->tiles, (double)s->enlargement, s->samples, s->coverage_samples);
+                       "samples %d: 1 or 4, coverage samples %d: 1 to 16, 1 with the layered scheme, rim samples %d: "
+                       "0 to 65536)", s->resolution, s->tiles, (double)s->enlargement, s->samples,
+                       s->coverage_samples, s->rim_samples);
     GLint layers = 0;
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &layers);
     if (s->scheme == LM_GATHER_LAYERED && (!has_extension("GL_ARB_shader_viewport_layer_array") ||
@@ -187,6 +192,7 @@ void lm_gather_free(lm_gather *g)
     glDeleteBuffers(4, bufs);
     free(g->views);
     free(g->emit);
+    free(g->aim_copy);
     GLuint tex[5] = {g->aim_tex, g->color, g->depth, g->ms_color, g->ms_depth};
     glDeleteTextures(5, tex);
     glDeleteFramebuffers(1, &g->ms_fbo);
@@ -233,7 +239,7 @@ static void write_triangle(const float p[3][3], const float *uv[3], const lm_mat
         for (int c = 0; c < 3; c++)
             v[5 + c] = draw_emission ? m->emissive[c] : 0.0f;
         lm_v3_store(v + 8, n);
-        v[11] = m->double_sided ? 0.0f : 1.0f;
+        v[11] = m->double_sided ? 0.0f : m->split_sides ? 2.0f : 1.0f;
         v[12] = (float)surface;
         memcpy(v + 13, gu, sizeof gu);
         memcpy(v + 16, gv, sizeof gv);
@@ -305,6 +311,10 @@ const lm_proxy *lm_gather_proxy(const lm_gather *g) { return g->has_proxy ? &g->
 
 void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el) { g->emitters = el; }
 
+void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt) { g->rt = rt; }
+
+static int traces_rim(const lm_gather *g) { return g->rt && g->set.rim_samples > 0; }
+
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
     lm_status st = ensure_proxy(g, s, a, err);
@@ -346,6 +356,13 @@ lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a->width, a->height, GL_RGBA, GL_FLOAT, dilated_rgba);
+    if (traces_rim(g)) { /* the caller may change its AIM while this gathers (the frame loop's overlap) */
+        size_t bytes = sizeof(float) * 4 * (size_t)a->width * (size_t)a->height;
+        float *copy = realloc(g->aim_copy, bytes);
+        if (!copy)
+            return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory for the AIM's copy");
+        g->aim_copy = memcpy(copy, dilated_rgba, bytes);
+    }
     return lm_gl_check("hemicube gather: AIM upload", err);
 }
 
@@ -410,6 +427,28 @@ static texel_view view_of(const lm_gather *g, const lm_scene *s, const lm_texel 
     plane_axes(n, g->set.enlargement, v.axes);
     v.surface = (float)tx->surface;
     return v;
+}
+
+/* Whether the texel at eye, normal n is covered (lm_texel_covered): straight out from it, other geometry
+ * within a texel's width, or the inside of a solid (the back of a triangle by its winding: the texel is
+ * inside a closed mesh, such as the floor under a box that stands on it). */
+static int covered_at(const lm_rt *rt, const lm_atlas *a, const float eye[3], const float n[3])
+{
+    lm_rt_hit h;
+    if (!lm_rt_intersect(rt, eye, n, 0.0f, INFINITY, &h))
+        return 0;
+    return h.t <= a->texel_size || lm_dot(lm_v3_load(h.ng), lm_v3_load(n)) > 0.0f;
+}
+
+int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
+                     uint32_t texel)
+{
+    lm_vec3 p, n;
+    texel_frame(s, &a->texels[texel], &p, &n);
+    float eye[3], dir[3];
+    lm_v3_store(eye, lm_add(p, lm_scale(n, set->offset * lm_scene_size(s))));
+    lm_v3_store(dir, n);
+    return covered_at(rt, a, eye, dir);
 }
 
 static float near_plane(const lm_gather *g, const lm_scene *s)
@@ -527,16 +566,32 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
-/* The emitters' closed-form irradiance at each texel of a pass (from its view's eye, along the view's
- * normal: g->views, filled by render_tiles), for the reduction to add; the sample pattern is seeded by
- * the texel's index. On this thread,
- * while the GL threads rasterize the pass: about 8 us per texel for two emissive triangles, where an
- * OpenMP team competing with the rasterizer's threads cost ten times that. */
-static void emitter_irradiance(lm_gather *g, const uint32_t *texels, uint32_t count)
+/* What each texel of a pass gets from the CPU, for the reduction to add: the emitters' closed-form
+ * irradiance and the rim's (from its view's eye and axes: g->views, filled by render_tiles); the sample
+ * patterns are seeded by the texel's index. On this thread, while the GL threads rasterize the pass:
+ * about 8 us per texel for two emissive triangles and 10 us for the rim, where an OpenMP team competing
+ * with the rasterizer's threads cost ten times that. */
+static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
+                           uint32_t count)
 {
+    lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]},
+                  g->set.enlargement, g->set.rim_samples};
     for (uint32_t i = 0; i < count; i++) {
         const float *o = g->views + VIEW_FLOATS * (size_t)i;
-        lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], g->emit + 4 * (size_t)i);
+        float *e = g->emit + 4 * (size_t)i;
+        e[0] = e[1] = e[2] = e[3] = 0.0f;
+        if (g->emitters)
+            lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], e);
+        if (g->rt && covered_at(g->rt, a, o, o + 12))
+            e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
+        if (traces_rim(g) && g->aim_copy) {
+            float b[3], t[3], r[3];
+            for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
+                b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
+            lm_rim_irradiance(&rim, o, b, t, o + 12, texels[i], r);
+            for (int k = 0; k < 3; k++)
+                e[k] += r[k];
+        }
     }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->emit_buf);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * 4 * count), g->emit);
@@ -549,7 +604,9 @@ static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t
     glUseProgram(g->reduce_prog);
     glUniform1i(glGetUniformLocation(g->reduce_prog, "R"), g->set.resolution);
     glUniform1i(glGetUniformLocation(g->reduce_prog, "tiles_x"), g->set.tiles);
-    glUniform1f(glGetUniformLocation(g->reduce_prog, "scale"), (float)(3.14159265358979323846 / g->coverage));
+    /* with the rim traced the plane's sum is not extrapolated to the whole hemisphere */
+    double scale = traces_rim(g) && g->aim_copy ? 1.0 : 1.0 / g->coverage;
+    glUniform1f(glGetUniformLocation(g->reduce_prog, "scale"), (float)(3.14159265358979323846 * scale));
     glUniform1f(glGetUniformLocation(g->reduce_prog, "inv_f"), (float)(1.0 / g->coverage));
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(g->set.scheme == LM_GATHER_LAYERED ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D, g->color);
@@ -585,9 +642,9 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     for (uint32_t first = 0; first < count; first += per_pass, passes++) {
         uint32_t n = count - first < per_pass ? count - first : per_pass;
         render_tiles(g, s, a, texels + first, n, xy);
-        if (g->emitters) {
+        if (g->emitters || g->rt) {
             glFlush(); /* llvmpipe rasterizes the pass on its threads while this one computes */
-            emitter_irradiance(g, texels + first, n);
+            cpu_irradiance(g, s, a, texels + first, n);
         }
         reduce_tiles(g, iim_tex, xy, n);
     }

@@ -10,8 +10,8 @@
 
 #include "gl_shader.h"
 
-/* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided,
- * surface (-1 when none). A view (schemes 1, 2) is 4 vec4: (eye, own surface), b / a, t / a, n. */
+/* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided (0
+ * double-sided, 1 single-sided, 2 one side of a split surface), surface (-1 when none). A view (schemes 1, 2) is 4 vec4: (eye, own surface), b / a, t / a, n. */
 static const char *RENDER_VS =
     "layout(location = 0) in vec3 pos;\n"
     "layout(location = 1) in vec2 uv;\n"
@@ -60,9 +60,10 @@ static const char *RENDER_VS =
     "#endif\n"
     "    gl_Position = c;\n"
     "#endif\n"
-    "    /* the back of the texel's own surface: every corner gets the same n.(p - eye) (a plane), so the\n"
-    "     * whole triangle moves outside the clip volume and is dropped before rasterization */\n"
-    "    if (surface >= 0.0 && surface == own && dot(face_n, pos - v_eye) > 0.0)\n"
+    "    /* the back of the texel's own surface, and the back of one side of a split double-sided surface\n"
+    "     * (its twin, on the same plane, shows that side): every corner gets the same n.(p - eye) (a plane),\n"
+    "     * so the whole triangle moves outside the clip volume and is dropped before rasterization */\n"
+    "    if ((surface >= 0.0 && surface == own || one_sided > 1.5) && dot(face_n, pos - v_eye) > 0.0)\n"
     "        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);\n"
     "}\n";
 /* rgb: what the plane sees; a: 1 on the back of a single-sided surface (counted, shown black). The back
@@ -120,11 +121,11 @@ static const char *REDUCE_CS =
     "layout(binding = 0, rgba32f) uniform writeonly image2D iim;\n"
     "layout(std430, binding = 0) readonly buffer Weights { float w[]; };\n"
     "layout(std430, binding = 1) readonly buffer Targets { ivec2 xy[]; };\n"
-    "layout(std430, binding = 3) readonly buffer Emitters { vec4 emit[]; }; /* closed-form emitter E */\n"
+    "layout(std430, binding = 3) readonly buffer Cpu { vec4 emit[]; }; /* emitter + rim E, 1 if covered */\n"
     "uniform int R;\n"
     "uniform int tiles_x;\n"
     "uniform int count;\n"
-    "uniform float scale;   /* pi / F(a) */\n"
+    "uniform float scale;   /* pi / F(a), or pi when the rim is traced */\n"
     "uniform float inv_f;   /* 1 / F(a) */\n"
     "void main() {\n"
     "    int tile = int(gl_GlobalInvocationID.x);\n"
@@ -140,7 +141,7 @@ static const char *REDUCE_CS =
     "        for (int x = 0; x < R; x++)\n"
     "            s += w[y * R + x] * texelFetch(tiles, origin + ivec2(x, y), 0);\n"
     "#endif\n"
-    "    imageStore(iim, xy[tile], vec4(scale * s.rgb + emit[tile].rgb, inv_f * s.a));\n"
+    "    imageStore(iim, xy[tile], vec4(scale * s.rgb + emit[tile].rgb, inv_f * s.a + emit[tile].a));\n"
     "}\n";
 
 /* "#version", the scheme's and sample count's defines and extension, then the body. Returns 0 if it

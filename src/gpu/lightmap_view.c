@@ -92,7 +92,7 @@ lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *
         glUniform1i(glGetUniformLocation(prog, "atlas"), 0);
         glActiveTexture(GL_TEXTURE0);
         glBindTexture(GL_TEXTURE_2D, tex);
-        lm_gl_mesh_draw(&mesh);
+        lm_gl_mesh_draw_scene_sides(&mesh, s);
         st = lm_offscreen_end(&target, rgba8, err);
     }
     glDeleteTextures(1, &tex);

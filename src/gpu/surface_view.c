@@ -23,15 +23,22 @@ static const char *FS =
     "out vec4 frag;\n"
     "void main() { frag = vec4(v_col, 1.0); }\n";
 
-/* Interleaved position + colour, three unshared corners per triangle, world space. */
-static float *build_vertices(const lm_scene *s, const lm_surfaces *su)
+/* The surface index as a colour: id + 2 in 24 bits (1: a specular triangle, 0: nothing drawn). */
+static void index_color(int id, uint8_t rgb[3])
+{
+    uint32_t v = (uint32_t)(id + 2);
+    rgb[0] = (uint8_t)(v & 255u), rgb[1] = (uint8_t)((v >> 8) & 255u), rgb[2] = (uint8_t)((v >> 16) & 255u);
+}
+
+/* Interleaved position + colour (color(surface id)), three unshared corners per triangle, world space. */
+static float *build_vertices(const lm_scene *s, const lm_surfaces *su, void (*color)(int, uint8_t[3]))
 {
     float *v = malloc(sizeof(float) * 18 * (size_t)(s->tri_count ? s->tri_count : 1));
     if (!v)
         return NULL;
     for (uint32_t t = 0; t < s->tri_count; t++) {
         uint8_t rgb[3];
-        lm_id_color(su->tri_surface[t], rgb);
+        color(su->tri_surface[t], rgb);
         for (int k = 0; k < 3; k++) {
             float *o = v + 18 * (size_t)t + 6 * k;
             lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], o);
@@ -42,14 +49,14 @@ static float *build_vertices(const lm_scene *s, const lm_surfaces *su)
     return v;
 }
 
-lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width,
-                                int height, uint8_t *rgba8, lm_error *err)
+static lm_status render(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width, int height,
+                        void (*color)(int, uint8_t[3]), uint8_t *rgba8, lm_error *err)
 {
     GLuint prog = 0;
     lm_status st = lm_gl_program("surface_ids", VS, FS, &prog, err);
     if (st != LM_OK)
         return st;
-    float *verts = build_vertices(s, su);
+    float *verts = build_vertices(s, su, color);
     if (!verts) {
         glDeleteProgram(prog);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the surface view", s->path);
@@ -66,10 +73,29 @@ lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const 
         lm_mat4_mul(vp, view->proj, view->view);
         glUseProgram(prog);
         glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
-        lm_gl_mesh_draw(&mesh);
+        lm_gl_mesh_draw_scene_sides(&mesh, s);
         st = lm_offscreen_end(&target, rgba8, err);
     }
     lm_gl_mesh_destroy(&mesh);
     glDeleteProgram(prog);
     return st;
+}
+
+lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width,
+                                int height, uint8_t *rgba8, lm_error *err)
+{
+    return render(s, su, view, width, height, lm_id_color, rgba8, err);
+}
+
+lm_status lm_render_surface_index(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width,
+                                  int height, int32_t *ids, lm_error *err)
+{
+    lm_status st = render(s, su, view, width, height, index_color, (uint8_t *)ids, err);
+    if (st != LM_OK)
+        return st;
+    for (size_t i = 0, n = (size_t)width * (size_t)height; i < n; i++) { /* in place: 4 bytes in, 4 out */
+        const uint8_t *c = (const uint8_t *)(ids + i);
+        ids[i] = (int32_t)((uint32_t)c[0] | (uint32_t)c[1] << 8 | (uint32_t)c[2] << 16) - 2;
+    }
+    return LM_OK;
 }

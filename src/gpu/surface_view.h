@@ -12,4 +12,10 @@
 lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width,
                                 int height, uint8_t *rgba8, lm_error *err);
 
+/* The same picture as surface indices (width*height, row 0 at the top): the surface seen at each pixel
+ * centre, -1 for a specular triangle, -2 for nothing. No blending or filtering: the colour channels carry
+ * the index exactly (up to 2^24 - 2 surfaces). Needs a current GL context. */
+lm_status lm_render_surface_index(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width,
+                                  int height, int32_t *ids, lm_error *err);
+
 #endif

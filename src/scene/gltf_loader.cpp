@@ -768,7 +768,7 @@ lm_status Loader::finish()
             return fail(LM_ERR_INVALID, "mesh \"%s\" (node %d) has %u degenerate triangles", mesh, i, bad);
         lm_warn("%s: mesh \"%s\" (node %d) has %u degenerate (zero-area) triangles", path_, mesh, i, bad);
     }
-    return LM_OK;
+    return lm_scene_split_sides(s_.get(), err_);
 }
 
 lm_status Loader::run(lm_scene **out)

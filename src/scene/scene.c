@@ -35,6 +35,7 @@ void lm_scene_free(lm_scene *s)
     free(s->tris);
     free(s->tri_material);
     free(s->tri_node);
+    free(s->tri_twin);
     free(s);
 }
 

@@ -42,7 +42,10 @@ typedef struct {
     int emissive_tex;      /* -1 if none */
     float transmission;    /* KHR_materials_transmission factor */
     float ior;             /* KHR_materials_ior (1.5 when absent) */
-    int double_sided;
+    int double_sided;      /* both sides lit alike by one triangle: after loading, only mirror and glass;
+                            * other double-sided materials have their sides split (split_sides) */
+    int split_sides;       /* double-sided in the file, not specular: each of its triangles has a twin
+                            * facing the other way (lm_scene.tri_twin), and both are single-sided */
     lm_material_class cls;
 } lm_material;
 
@@ -87,7 +90,9 @@ typedef struct {
     int camera, light;     /* -1 if none */
     int dynamic;           /* may move: extras dynamic, or targeted by an animation */
     lm_node_settings settings; /* resolved: inherited switches already applied (never -1 after load) */
-    uint32_t first_tri, tri_count; /* this node's triangles in lm_scene.tris */
+    uint32_t first_tri, tri_count; /* this node's triangles in lm_scene.tris: the file's first, then the
+                                    * twins of those with split sides (front_tri_count of them are the file's) */
+    uint32_t front_tri_count;
 } lm_node;
 
 typedef enum { LM_INTERP_LINEAR = 0, LM_INTERP_STEP, LM_INTERP_CUBIC } lm_interp;
@@ -140,6 +145,12 @@ typedef struct {
     uint32_t *tris;        /* 3 vertex indices per triangle */
     int *tri_material;     /* material index per triangle (a default material is appended when needed) */
     uint32_t *tri_node;    /* node index per triangle */
+    /* Two sides (DESIGN.md "Surfaces have two sides"): per triangle, the triangle on the same corners wound
+     * the other way, with its own vertices (normals negated) and the same material, or -1. A file's
+     * triangle comes before its twin. NULL when no material was split. Each side is then an ordinary
+     * single-sided triangle: its own surface, chart, photons, AIM and IIM, lit only from its front. */
+    int32_t *tri_twin;
+    uint32_t file_tri_count; /* triangles in the file (tri_count less the twins) */
 
     int mesh_count;        /* number of glTF meshes (for reporting) */
     float bounds_min[3], bounds_max[3]; /* world-space bounds at load time (all nodes) */
@@ -153,6 +164,14 @@ typedef struct {
  * file and the problem, and leaves *out NULL. Implemented in gltf_loader.cpp. */
 lm_status lm_scene_load_gltf(const char *path, const lm_load_options *opt, lm_scene **out, lm_error *err);
 void lm_scene_free(lm_scene *s);
+
+/* Gives every triangle of a double-sided, non-specular material a twin facing the other way and makes
+ * the material single-sided (split_sides): called once by the loader, after the nodes are finished. */
+lm_status lm_scene_split_sides(lm_scene *s, lm_error *err);
+/* A node's triangles as the file has them (its first ones; the rest are their twins). */
+static inline uint32_t lm_node_file_tris(const lm_scene *s, const lm_node *n) { return s->tri_twin ? n->front_tri_count : n->tri_count; }
+/* 1 when triangle t is the twin (the back side) of a file's triangle. */
+static inline int lm_tri_is_back(const lm_scene *s, uint32_t t) { return s->tri_twin && s->tri_twin[t] >= 0 && (uint32_t)s->tri_twin[t] < t; }
 
 /* Recomputes every node's world matrix from local transforms (parents before children). */
 void lm_scene_update_world(lm_scene *s);

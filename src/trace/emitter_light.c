@@ -1,6 +1,8 @@
 /* Closed-form emitter irradiance with sampled visibility (emitter_light.h). */
 #include "emitter_light.h"
 
+#include "../core/qmc.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -130,19 +132,6 @@ static double radical_inverse2(uint32_t i)
     return (double)i * (1.0 / 4294967296.0);
 }
 
-/* Two numbers in [0, 1) from a seed (the per-texel shift of the sample pattern). */
-static void seed_shift(uint32_t seed, double s[2])
-{
-    for (int k = 0; k < 2; k++) {
-        uint32_t h = seed * 0x9e3779b1u + (uint32_t)k * 0x85ebca77u;
-        h ^= h >> 16;
-        h *= 0x7feb352du;
-        h ^= h >> 15;
-        h *= 0x846ca68bu;
-        h ^= h >> 16;
-        s[k] = (double)h * (1.0 / 4294967296.0);
-    }
-}
 
 typedef struct {
     double f, fv; /* sums of the unoccluded integrand and of the visible part */
@@ -199,7 +188,7 @@ static double visibility(const lm_emitter_light *el, dvec p, dvec nrm, const dve
     int k1 = m == 4 ? (int)lround(el->rays * a1 / (a1 + a2)) : el->rays;
     k1 = k1 < 1 ? 1 : k1;
     double shift[2];
-    seed_shift(seed, shift);
+    lm_seed_shift(seed, shift);
     vis_sum vs = {0.0, 0.0};
     const dvec t1[3] = {q[0], q[1], q[2]};
     sample_triangle(el, p, nrm, face, t1, k1, shift, &vs);

@@ -80,14 +80,29 @@ static int buffer_reserve(ph_buffer *buf)
     return 1;
 }
 
-static int push_vertex(ph_buffer *buf, const lm_shading *sh, const float dir[3], const float flux[3], uint32_t b)
+/* Whether other geometry lies within cover_distance straight out from the side of the hit that dir
+ * arrived at (lm_photon_settings.cover_distance). */
+static int covered(const lm_photons *ph, const lm_shading *sh, const float dir[3])
+{
+    lm_vec3 n = lm_v3_load(sh->ng);
+    if (lm_dot(n, lm_v3_load(dir)) > 0.0f)
+        n = lm_scale(n, -1.0f);
+    float org[3], out[3];
+    lm_v3_store(org, lm_add(lm_v3_load(sh->pos), lm_scale(n, ph->ray_offset)));
+    lm_v3_store(out, n);
+    return lm_rt_occluded(ph->rt, org, out, 0.0f, ph->set.cover_distance);
+}
+
+static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *sh, const float dir[3],
+                       const float flux[3], uint32_t b)
 {
     if (!buffer_reserve(buf))
         return 0;
     ph_vertex *v = &buf->v[buf->len++];
     v->node = sh->node;
     v->tri = sh->tri;
-    v->surface = (sh->surface >= 0 && lm_material_stores_hits(sh->material->cls)) ? sh->surface : -1;
+    int store = sh->surface >= 0 && lm_material_stores_hits(sh->material->cls);
+    v->surface = store && !(ph->set.cover_distance > 0.0f && covered(ph, sh, dir)) ? sh->surface : -1;
     v->bounce = (uint16_t)b;
     memcpy(v->pos, sh->pos, sizeof v->pos);
     memcpy(v->local, sh->local, sizeof v->local);
@@ -160,7 +175,7 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
          * then the shading's stores have left the store buffer, and copying them does not stall. */
         float in_dir[3] = {dir[0], dir[1], dir[2]}, in_flux[3] = {flux[0], flux[1], flux[2]};
         int scattered = scatter(ph, id, b, &sh, org, dir, flux);
-        if (!push_vertex(buf, &sh, in_dir, in_flux, b)) {
+        if (!push_vertex(ph, buf, &sh, in_dir, in_flux, b)) {
             ok = 0;
             break;
         }

@@ -49,6 +49,8 @@ static lm_status check_settings(const lm_photon_settings *s, lm_error *err)
                        s->max_bounces);
     if (!isfinite(s->epsilon))
         return lm_fail(err, LM_ERR_INVALID, "photon settings: epsilon must be finite");
+    if (!isfinite(s->cover_distance))
+        return lm_fail(err, LM_ERR_INVALID, "photon settings: cover_distance must be finite");
     return LM_OK;
 }
 

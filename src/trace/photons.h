@@ -39,6 +39,12 @@ typedef struct {
                                   <= 0: 1e-4 x scene size (default 0) */
     uint32_t max_bounces;      /* most path vertices per photon, a safety net (default 32, at most 1024) */
     uint32_t seed;             /* selects another, disjoint stretch of the Halton sequence (default 0) */
+    float cover_distance;      /* a hit with other geometry closer than this (world units) straight out from
+                                * the side it arrived at is not stored (the photon still scatters): its light
+                                * lies where nothing sees it, a lamp millimetres under a ceiling or the floor
+                                * under a box, and the N-nearest estimate would spread it over the visible
+                                * texels around (docs/aim.md). <= 0 (default here): every hit is stored;
+                                * the photon stage makes it the atlas's texel size */
 } lm_photon_settings;
 
 void lm_photon_settings_default(lm_photon_settings *s);

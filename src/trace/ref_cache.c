@@ -40,6 +40,7 @@ static void hash_material(uint64_t *h, const lm_material *m)
     fnv_f(h, m->transmission);
     fnv_f(h, m->ior);
     fnv_u32(h, (uint32_t)m->double_sided);
+    fnv_u32(h, (uint32_t)m->split_sides);
     fnv_u32(h, (uint32_t)m->cls);
 }
 

@@ -81,7 +81,7 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
 {
     for (int n = 0; n < s->node_count; n++)
         if (!s->nodes[n].dynamic)
-            rt->static_count += s->nodes[n].tri_count;
+            rt->static_count += lm_node_file_tris(s, &s->nodes[n]);
     rt->static_inst = RTC_INVALID_GEOMETRY_ID;
     if (rt->static_count == 0)
         return LM_OK;
@@ -91,7 +91,7 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
     uint32_t k = 0;
     for (int n = 0; n < s->node_count; n++)
         if (!s->nodes[n].dynamic)
-            for (uint32_t i = 0; i < s->nodes[n].tri_count; i++)
+            for (uint32_t i = 0; i < lm_node_file_tris(s, &s->nodes[n]); i++)
                 rt->static_tri[k++] = s->nodes[n].first_tri + i;
     RTCGeometry g = make_triangles(rt, s, rt->static_tri, rt->static_count, 1);
     if (!g)
@@ -139,14 +139,15 @@ static lm_status add_static(lm_rt *rt, const lm_scene *s, lm_error *err)
 static lm_status add_instance(lm_rt *rt, const lm_scene *s, int n, lm_error *err)
 {
     const lm_node *node = &s->nodes[n];
-    uint32_t *ids = malloc(sizeof(uint32_t) * (node->tri_count ? node->tri_count : 1));
+    uint32_t count = lm_node_file_tris(s, node); /* twins are found through their file triangle's back */
+    uint32_t *ids = malloc(sizeof(uint32_t) * (count ? count : 1));
     if (!ids)
         return lm_fail(err, LM_ERR_NOMEM, "node '%s': no memory", node->name);
-    for (uint32_t i = 0; i < node->tri_count; i++)
+    for (uint32_t i = 0; i < count; i++)
         ids[i] = node->first_tri + i;
     RTCScene local = rtcNewScene(rt->device);
     rtcSetSceneFlags(local, RTC_SCENE_FLAG_ROBUST);
-    RTCGeometry tg = make_triangles(rt, s, ids, node->tri_count, 0);
+    RTCGeometry tg = make_triangles(rt, s, ids, count, 0);
     free(ids);
     if (!tg) {
         rtcReleaseScene(local);
@@ -327,6 +328,15 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
     hit->t = rh.ray.tfar;
     hit->u = rh.hit.u;
     hit->v = rh.hit.v;
+    const int32_t *twin = rt->scene->tri_twin;
+    if (twin && twin[hit->tri] >= 0 && lm_dot(ng, lm_v3(dir[0], dir[1], dir[2])) > 0.0f) {
+        /* the back of a split triangle is its twin: corners (0, 2, 1), so u and v swap */
+        hit->tri = (uint32_t)twin[hit->tri];
+        hit->u = rh.hit.v;
+        hit->v = rh.hit.u;
+        ng = lm_scale(ng, -1.0f);
+        hit->ns = NULL;
+    }
     hit->surface = rt->tri_surface ? rt->tri_surface[hit->tri] : -1;
     lm_v3_store(hit->ng, ng);
     return 1;

@@ -127,6 +127,8 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         st = lm_gather_create(&fl->set.gather, &fl->gather, err);
     if (st == LM_OK && fl->have_emitters)
         lm_gather_set_emitter_light(fl->gather, &fl->emitters);
+    if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (gpu/hemicube_rim.h) */
+        lm_gather_set_tracer(fl->gather, fl->rt);
     if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK)
         fl->have_iim = 1;
     if (st == LM_OK)

@@ -16,7 +16,8 @@ void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
 {
     const lm_scene *s = sc->scene;
     memset(in, 0, sizeof *in);
-    in->triangles = s->tri_count;
+    in->triangles = s->tri_twin ? s->file_tri_count : s->tri_count;
+    in->back_triangles = s->tri_count - in->triangles;
     in->vertices = s->vertex_count;
     in->nodes = s->node_count;
     for (int n = 0; n < s->node_count; n++)
@@ -101,7 +102,10 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     lmgi_info in;
     lmgi_get_info(sc, &in);
     fprintf(f, "scene       %s\n", s->path);
-    fprintf(f, "triangles   %u (%u vertices, %d meshes)\n", in.triangles, in.vertices, in.meshes);
+    fprintf(f, "triangles   %u (%u vertices, %d meshes)", in.triangles, in.vertices, in.meshes);
+    if (in.back_triangles)
+        fprintf(f, ", and %u back sides of double-sided surfaces", in.back_triangles);
+    fputc('\n', f);
     fprintf(f, "bounds      (%.4g %.4g %.4g) .. (%.4g %.4g %.4g)\n", (double)in.bounds_min[0],
             (double)in.bounds_min[1], (double)in.bounds_min[2], (double)in.bounds_max[0], (double)in.bounds_max[1],
             (double)in.bounds_max[2]);

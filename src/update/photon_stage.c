@@ -72,7 +72,10 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     for (int e = 0; e < ps->emitters.count; e++)
         take_snapshot(ps, e, &ps->snap[e]);
-    st = lm_photons_create(ps->scene, ps->surfaces, ps->rt, &ps->emitters, &ps->set.photons, &ps->photons, err);
+    lm_photon_settings photons = ps->set.photons;
+    if (photons.cover_distance == 0.0f && ps->atlas) /* light closer under something than a texel is hidden */
+        photons.cover_distance = ps->atlas->texel_size;
+    st = lm_photons_create(ps->scene, ps->surfaces, ps->rt, &ps->emitters, &photons, &ps->photons, err);
     if (st == LM_OK)
         st = lm_photons_trace_all(ps->photons, &first->photons, err);
     double t1 = lm_now();

@@ -9,7 +9,7 @@
 #include "../trace/photons.h"
 
 typedef struct {
-    lm_photon_settings photons;
+    lm_photon_settings photons; /* cover_distance 0 (default) is the atlas's texel size here; < 0: off */
     lm_aim_settings aim;
     int surfaces_per_frame;  /* AIM refreshes per frame, largest delta_f/area first (default 4; < 0 all) */
 } lm_photon_stage_settings;
