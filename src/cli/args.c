@@ -85,6 +85,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
     a->camera = -1;
     a->gather_scheme = -1;
     a->emitter_light = -1;
+    a->rim_samples = -1;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
         const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -144,6 +145,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                                                                        ? bad(o, v, "1 or 4") : 0);
         else if (!strcmp(o, "--hemicube-coverage"))
             rc = parse_int(o, v, 1, 16, &a->hemicube_coverage);
+        else if (!strcmp(o, "--rim-samples"))
+            rc = parse_int(o, v, 0, 65536, &a->rim_samples);
         else if (!strcmp(o, "--enlargement"))
             rc = parse_float(o, v, 1e-3f, &a->enlargement);
         else if (!strcmp(o, "--gather-scheme"))

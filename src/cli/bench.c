@@ -9,6 +9,7 @@
 #include "../core/stats.h"
 #include "bench_gather.h"
 #include "bench_photons.h"
+#include "bench_scenes.h"
 
 /* Scenes timed when none are named: ours first, then the shared ones (skipped when absent). */
 static const char *DEFAULT_SCENES[] = {
@@ -165,6 +166,7 @@ int lm_cli_bench(const lm_cli_args *a)
     if (a->file_count == 0) {
         lm_cli_bench_photons();
         lm_cli_bench_gather(a->gather_scene);
+        lm_cli_bench_scenes(files, count);
     }
     return rc;
 }

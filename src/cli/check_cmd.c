@@ -1,6 +1,7 @@
 /* lmgi check: `lmgi run`'s frame against the reference, per visible surface and over the frame. */
 #include "check_cmd.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -35,6 +36,23 @@ static void report(const lmgi_scene *sc, const lm_frame_check *c, const lm_ref_s
     printf("relative RMSE over those pixels %.4f\n", c->rel_rmse);
 }
 
+/* frame / reference per compared pixel as a colour: grey at 1, red where the frame is brighter, blue where
+ * it is darker, full at +-10%; black where nothing is compared. */
+static void ratio_picture(const lm_frame_check *c, uint8_t *rgba)
+{
+    size_t n = (size_t)c->width * (size_t)c->height;
+    for (size_t i = 0; i < n; i++) {
+        const float *f = c->frame + 3 * i, *r = c->ref + 3 * i;
+        double lf = f[0] + f[1] + f[2], lr = r[0] + r[1] + r[2];
+        double t = c->compared[i] && lr > 0.0 ? fmax(-1.0, fmin(1.0, (lf / lr - 1.0) / 0.1)) : 0.0;
+        uint8_t *o = rgba + 4 * i;
+        o[0] = (uint8_t)(c->compared[i] ? 128 + (t > 0 ? 127 * t : 0) - (t < 0 ? -100 * t : 0) : 0);
+        o[1] = (uint8_t)(c->compared[i] ? 128 - 100 * fabs(t) : 0);
+        o[2] = (uint8_t)(c->compared[i] ? 128 + (t < 0 ? -127 * t : 0) - (t > 0 ? 100 * t : 0) : 0);
+        o[3] = 255;
+    }
+}
+
 static int write_images(const char *dir, const lm_frame_check *c)
 {
     lm_error err;
@@ -48,6 +66,15 @@ static int write_images(const char *dir, const lm_frame_check *c)
         snprintf(path, sizeof path, "%s/check_reference.exr", dir);
         st = lm_write_exr(path, c->width, c->height, 3, c->ref, &err);
     }
+    uint8_t *rgba = st == LM_OK ? malloc((size_t)c->width * (size_t)c->height * 4) : NULL;
+    if (st == LM_OK && !rgba)
+        st = lm_fail(&err, LM_ERR_NOMEM, "no memory for the ratio picture");
+    if (st == LM_OK) {
+        ratio_picture(c, rgba);
+        snprintf(path, sizeof path, "%s/check_ratio.png", dir);
+        st = lm_write_png(path, c->width, c->height, rgba, &err);
+    }
+    free(rgba);
     if (st != LM_OK)
         fprintf(stderr, "lmgi: error: %s\n", err.msg);
     return st == LM_OK;

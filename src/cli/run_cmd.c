@@ -51,6 +51,8 @@ void lm_cli_run_settings(const lm_cli_args *a, lm_frame_loop_settings *s)
         s->gather.samples = a->hemicube_samples;
     if (a->enlargement > 0.0f)
         s->gather.enlargement = a->enlargement;
+    if (a->rim_samples >= 0)
+        s->gather.rim_samples = a->rim_samples;
     if (a->gather_scheme >= 0)
         s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
     s->emitter_light = a->emitter_light;

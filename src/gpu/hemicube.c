@@ -21,7 +21,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->scheme = LM_GATHER_VIEWPORTS;
     s->samples = 4;
     s->coverage_samples = 4;
-    s->rim_samples = 256;
+    s->rim_samples = 64;
 }
 
 int lm_gather_coverage_for(const lm_scene *s, int closed_form_emitters)

@@ -65,9 +65,10 @@ typedef struct {
     int coverage_samples;  /* coverage samples per pixel (MSAA, 1 to 16; default 4): a small emitter covering a
                               few pixels adds a fraction per pixel instead of all or nothing (no plaid).
                               lm_gather_coverage_for picks it per scene */
-    int rim_samples;       /* K, stratified directions over the hemisphere for the rim the plane misses
-                              (hemicube_rim.h; default 256, about 44 rays per texel at a = 2), with a tracer
-                              (lm_gather_set_tracer); 0 or no tracer: the paper's division by F(a) */
+    int rim_samples;       /* K, rays per texel into the rim the plane misses, each averaging the AIM over its
+                              footprint (hemicube_rim.h; default 64: fewer mottle surfaces that see a bright
+                              spot near their horizon), with a tracer (lm_gather_set_tracer); 0 or no
+                              tracer: the paper's division by F(a) */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);

@@ -204,24 +204,6 @@ void lm_gather_free(lm_gather *g)
 
 const lm_hemicube_settings *lm_gather_settings(const lm_gather *g) { return &g->set; }
 
-/* The lightmap UV's gradient over a triangle's plane: rows gu, gv with uv(p) = uv0 + (gu.(p - p0),
- * gv.(p - p0)) (zero across the plane). Lets the fragment shader find the UV of nearby points on the
- * plane exactly (hemicube_shaders.c, sub-samples). */
-static void uv_gradient(const float p[3][3], const float *uv[3], float gu[3], float gv[3])
-{
-    lm_vec3 e1 = lm_sub(lm_v3_load(p[1]), lm_v3_load(p[0])), e2 = lm_sub(lm_v3_load(p[2]), lm_v3_load(p[0]));
-    double a = lm_dot(e1, e1), b = lm_dot(e1, e2), c = lm_dot(e2, e2), det = a * c - b * b;
-    memset(gu, 0, 3 * sizeof(float));
-    memset(gv, 0, 3 * sizeof(float));
-    if (!uv[0] || !uv[1] || !uv[2] || !(det > 1e-30 * a * c))
-        return;
-    for (int r = 0; r < 2; r++) {
-        double d1 = uv[1][r] - uv[0][r], d2 = uv[2][r] - uv[0][r];
-        float al = (float)((c * d1 - b * d2) / det), be = (float)((a * d2 - b * d1) / det);
-        lm_v3_store(r ? gv : gu, lm_add(lm_scale(e1, al), lm_scale(e2, be)));
-    }
-}
-
 /* One triangle's three vertices (VERTEX_FLOATS each) from world positions, lightmap UVs (NULL: no
  * AIM, drawn black: mirror, glass), its material and its chart (rectangle in UV, -1 when none). */
 static void write_triangle(const float p[3][3], const float *uv[3], const lm_material *m, int surface,
@@ -230,7 +212,7 @@ static void write_triangle(const float p[3][3], const float *uv[3], const lm_mat
     lm_vec3 n = lm_cross(lm_sub(lm_v3_load(p[1]), lm_v3_load(p[0])), lm_sub(lm_v3_load(p[2]), lm_v3_load(p[0])));
     float len = lm_length(n), gu[3], gv[3];
     n = len > 0.0f ? lm_scale(n, 1.0f / len) : lm_v3(0, 0, 0);
-    uv_gradient(p, uv, gu, gv);
+    lm_uv_gradient(p, uv, gu, gv);
     for (int k = 0; k < 3; k++) {
         float *v = o + VERTEX_FLOATS * k;
         memcpy(v, p[k], 3 * sizeof(float));

@@ -23,26 +23,92 @@ static void sample_atlas(const lm_atlas *a, const float *rgba, float u, float v,
         out[c] = (1.0f - fy) * ((1.0f - fx) * p00[c] + fx * p10[c]) + fy * ((1.0f - fx) * p01[c] + fx * p11[c]);
 }
 
-/* What the hemicube would show along dir from eye. */
-static void radiance(const lm_rim *r, const float eye[3], const float dir[3], float L[3])
+/* The lightmap UV's gradient over a triangle's plane: rows gu, gv with uv(p) = uv0 + (gu.(p - p0),
+ * gv.(p - p0)) (zero across the plane). */
+void lm_uv_gradient(const float p[3][3], const float *uv[3], float gu[3], float gv[3])
 {
+    lm_vec3 e1 = lm_sub(lm_v3_load(p[1]), lm_v3_load(p[0])), e2 = lm_sub(lm_v3_load(p[2]), lm_v3_load(p[0]));
+    double a = lm_dot(e1, e1), b = lm_dot(e1, e2), c = lm_dot(e2, e2), det = a * c - b * b;
+    memset(gu, 0, 3 * sizeof(float));
+    memset(gv, 0, 3 * sizeof(float));
+    if (!uv[0] || !uv[1] || !uv[2] || !(det > 1e-30 * a * c))
+        return;
+    for (int r = 0; r < 2; r++) {
+        double d1 = uv[1][r] - uv[0][r], d2 = uv[2][r] - uv[0][r];
+        float al = (float)((c * d1 - b * d2) / det), be = (float)((a * d2 - b * d1) / det);
+        lm_v3_store(r ? gv : gu, lm_add(lm_scale(e1, al), lm_scale(e2, be)));
+    }
+}
+
+/* A direction of the rim in the texel's frame: azimuth phi (turns) and u in [0, 1) across the rim beyond
+ * the plane's edge in that azimuth; *weight is that azimuth's share of the rim, 1 - s_edge. */
+static lm_vec3 rim_dir(const lm_rim *r, lm_vec3 B, lm_vec3 T, lm_vec3 N, double phi, double u, double *weight)
+{
+    float sn, cs;
+    lm_sincos_turn((float)phi, &sn, &cs);
+    double m = fmax(fabs((double)cs), fabs((double)sn)), t2 = (double)r->enlargement * r->enlargement / (m * m);
+    double s_edge = t2 / (1.0 + t2), s = s_edge + (1.0 - s_edge) * u;
+    float st = (float)sqrt(s), z = (float)sqrt(fmax(0.0, 1.0 - s));
+    *weight = 1.0 - s_edge;
+    return lm_normalize(lm_add(lm_add(lm_scale(B, st * cs), lm_scale(T, st * sn)), lm_scale(N, z)));
+}
+
+#define SUB 4 /* sub-directions per side of a stratum: its footprint on the hit's plane */
+
+/* The stratum (phi0 + [0, dphi), u0 + [0, du)) of the rim: one ray through its middle and, on the plane
+ * of the triangle it hits, the AIM averaged over the stratum's footprint (SUB x SUB sub-directions met
+ * with that plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel
+ * averages its footprint: a small bright spot is then shared among the strata it overlaps instead of
+ * being all or nothing for one. Returns the weighted radiance sum (times SUB^2). */
+static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, lm_vec3 N, double phi0, double dphi,
+                    double u0, double du, double sum[3])
+{
+    double w;
+    float dir[3];
+    lm_v3_store(dir, rim_dir(r, B, T, N, phi0 + 0.5 * dphi, u0 + 0.5 * du, &w));
     lm_rt_hit h;
     if (!lm_rt_intersect(r->rt, eye, dir, 0.0f, INFINITY, &h)) {
-        memcpy(L, r->sky, 3 * sizeof(float));
+        for (int c = 0; c < 3; c++)
+            sum[c] += SUB * SUB * w * r->sky[c];
         return;
     }
-    memset(L, 0, 3 * sizeof(float));
     const lm_material *m = &r->scene->materials[r->scene->tri_material[h.tri]];
-    if (!m->double_sided && lm_dot(lm_v3_load(h.ng), lm_v3_load(dir)) > 0.0f)
+    lm_vec3 ng = lm_v3_load(h.ng), d = lm_v3_load(dir);
+    if (!m->double_sided && lm_dot(ng, d) > 0.0f)
         return; /* the back of a single-sided surface: black, as on the plane */
     const float *c = r->atlas->corner_uv + 6 * (size_t)h.tri;
-    if (r->atlas->tri_chart[h.tri] >= 0 && isfinite(c[0])) {
-        float w0 = 1.0f - h.u - h.v;
-        sample_atlas(r->atlas, r->aim, w0 * c[0] + h.u * c[2] + h.v * c[4], w0 * c[1] + h.u * c[3] + h.v * c[5], L);
+    int chart = r->atlas->tri_chart[h.tri];
+    lm_vec3 e = lm_v3_load(eye), P = lm_add(e, lm_scale(d, h.t));
+    if (chart >= 0 && isfinite(c[0])) {
+        float p[3][3], gu[3], gv[3], w0 = 1.0f - h.u - h.v;
+        const float *uv[3] = {c, c + 2, c + 4};
+        for (int k = 0; k < 3; k++)
+            lm_scene_vertex_world(r->scene, r->scene->tris[3 * (size_t)h.tri + k], p[k]);
+        lm_uv_gradient(p, uv, gu, gv);
+        float u = w0 * c[0] + h.u * c[2] + h.v * c[4], v = w0 * c[1] + h.u * c[3] + h.v * c[5];
+        const lm_chart *ch = &r->atlas->charts[chart];
+        float lo[2] = {(float)ch->x / r->atlas->width, (float)ch->y / r->atlas->height};
+        float hi[2] = {(float)(ch->x + ch->w) / r->atlas->width, (float)(ch->y + ch->h) / r->atlas->height};
+        double num = lm_dot(ng, lm_sub(P, e));
+        for (int i = 0; i < SUB; i++)
+            for (int j = 0; j < SUB; j++) {
+                double ws;
+                lm_vec3 ds = rim_dir(r, B, T, N, phi0 + (i + 0.5) / SUB * dphi, u0 + (j + 0.5) / SUB * du, &ws);
+                double den = lm_dot(ng, ds);
+                float su = u, sv = v, L[3];
+                if (num * den > 0.0) { /* meets the plane on the same side: its point's uv */
+                    lm_vec3 off = lm_sub(lm_add(e, lm_scale(ds, (float)(num / den))), P);
+                    su = fminf(fmaxf(u + lm_dot(lm_v3_load(gu), off), lo[0]), hi[0]);
+                    sv = fminf(fmaxf(v + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
+                }
+                sample_atlas(r->atlas, r->aim, su, sv, L);
+                for (int k = 0; k < 3; k++)
+                    sum[k] += ws * L[k];
+            }
     }
     if (r->emission)
         for (int k = 0; k < 3; k++)
-            L[k] += m->emissive[k];
+            sum[k] += SUB * SUB * w * m->emissive[k];
 }
 
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
@@ -50,24 +116,13 @@ void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], co
 {
     int side = (int)sqrtf((float)r->samples);
     double shift[2], sum[3] = {0.0, 0.0, 0.0};
-    lm_seed_shift(seed, shift);
+    lm_seed_shift(seed, shift); /* shift[1] unused: the footprints already cover each stratum */
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n);
-    for (int i = 0; i < side; i++)
-        for (int j = 0; j < side; j++) {
-            double u0 = fmod((i + shift[0]) / side, 1.0), u1 = fmod((j + shift[1]) / side, 1.0);
-            /* cosine-weighted: sin(theta) = sqrt(u0), so the plane hit is (x, y) / z */
-            float s = (float)sqrt(u0), z = (float)sqrt(1.0 - u0), sn, cs;
-            lm_sincos_turn((float)u1, &sn, &cs);
-            float x = s * cs, y = s * sn, lim = r->enlargement * z;
-            if (fabsf(x) <= lim && fabsf(y) <= lim)
-                continue; /* the plane sees this direction */
-            float dir[3], L[3];
-            lm_v3_store(dir, lm_normalize(lm_add(lm_add(lm_scale(B, x), lm_scale(T, y)), lm_scale(N, z))));
-            radiance(r, eye, dir, L);
-            for (int c = 0; c < 3; c++)
-                sum[c] += L[c];
-        }
+    double d = 1.0 / side;
+    for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
+        for (int j = 0; j < side; j++)
+            stratum(r, eye, B, T, N, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum);
     int K = side * side;
     for (int c = 0; c < 3; c++)
-        out[c] = K ? (float)(RIM_PI * sum[c] / K) : 0.0f;
+        out[c] = K ? (float)(RIM_PI * sum[c] / ((double)K * SUB * SUB)) : 0.0f;
 }

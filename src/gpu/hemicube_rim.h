@@ -4,21 +4,24 @@
  * paper divides the plane's sum by F(a), which assumes the rim looks like the rest; a bright source near
  * the horizon (the ceiling around a lamp, seen from a wall) or a dark one (the floor, seen from under a
  * table) makes that wrong by up to 30% per surface. Instead the rim's own irradiance is estimated with
- * rays:
+ * rays that all go into the rim:
  *
- *   E_rim = pi / K * sum over the K stratified cosine-weighted directions that miss the plane of L(hit)
+ *   E_rim = pi / K * sum over K directions of (1 - s_edge(phi)) L(hit)
  *
- * (K the samples over the whole hemisphere, so each direction that misses the plane stands for 1 / K of
- * it: an unbiased estimate of the rim's part, and E = pi sum(w L) + E_rim needs no division by F(a)).
+ * with the azimuth phi uniform and, for each, sin^2(theta) uniform between the plane's edge in that
+ * azimuth, s_edge = t^2 / (1 + t^2) with t = a / max(|cos phi|, |sin phi|), and 1: cosine-weighted
+ * directions restricted to the rim, each weighted by its azimuth's share of it. E_rim is unbiased, and
+ * E = pi sum(w L) + E_rim needs no division by F(a). The K directions are a sqrt(K) x sqrt(K)
+ * stratified grid in (phi, sin^2 theta), shifted per texel (its index seeds the shift), so a texel gets
+ * the same estimate whenever it is gathered.
  * L(hit) is what the hemicube would show there: the AIM at the hit's lightmap uv (bilinear, from the
  * gather's copy of the dilated AIM), plus the emitted radiance when emitters are drawn rather than in
  * closed form; 0 on the back of a single-sided surface, on mirror and glass; the sky where nothing is hit.
- * The K directions are an n x n stratified grid (K = n^2) shifted per texel (its index seeds the shift),
- * so a texel gets the same estimate whenever it is gathered.
  *
- * Cost: only the directions outside the plane are traced, 1 - F(a) of them (44 of K = 256 at a = 2),
- * about 10 us per texel on this machine, on the gather's calling thread while the GPU rasterizes.
- * Thread-safe (Embree queries and reads only). */
+ * Cost: K rays and AIM lookups per texel, on the gather's calling thread while the GPU rasterizes
+ * (docs/gather.md, "The rim", for the measured time). Noise: the rim is a band near the horizon; a
+ * small bright spot there (the ceiling over a point light, seen from a wall) is what the K rays must
+ * resolve, and too few mottle the IIM from texel to texel. Thread-safe (Embree queries and reads only). */
 #ifndef LM_HEMICUBE_RIM_H
 #define LM_HEMICUBE_RIM_H
 
@@ -42,5 +45,9 @@ typedef struct {
  * axes) and n. */
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
                        uint32_t seed, float out[3]);
+
+/* The lightmap uv's gradient over a triangle's plane (world corners p, uv per corner; NULL: none, zero
+ * gradient): rows gu, gv with uv(x) = uv0 + (gu.(x - p0), gv.(x - p0)). */
+void lm_uv_gradient(const float p[3][3], const float *uv[3], float gu[3], float gv[3]);
 
 #endif

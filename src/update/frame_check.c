@@ -18,6 +18,7 @@ void lm_frame_check_free(lm_frame_check *c)
     free(c->frame);
     free(c->ref);
     free(c->surface_at);
+    free(c->compared);
     free(c->surface);
     memset(c, 0, sizeof *c);
 }
@@ -60,6 +61,7 @@ static lm_status compare(const lmgi_scene *sc, lm_frame_check *c, lm_error *err)
         int s = c->surface_at[i];
         if (s < 0 || s >= c->surface_count || !interior(c, i))
             continue;
+        c->compared[i] = 1;
         add(&c->surface[s], c->frame + 3 * i, c->ref + 3 * i);
         if (!emissive_surface(sc, s)) {
             add(&c->lit, c->frame + 3 * i, c->ref + 3 * i);
@@ -124,8 +126,9 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
     out->frame = malloc(n * 3 * sizeof(float));
     out->ref = malloc(n * 3 * sizeof(float));
     out->surface_at = malloc(n * sizeof(int32_t));
+    out->compared = calloc(n, 1);
     out->surface = calloc((size_t)(out->surface_count ? out->surface_count : 1), sizeof *out->surface);
-    lm_status st = out->frame && out->ref && out->surface_at && out->surface
+    lm_status st = out->frame && out->ref && out->surface_at && out->compared && out->surface
                        ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
     lm_view view;
     if (st == LM_OK)

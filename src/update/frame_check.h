@@ -32,6 +32,7 @@ typedef struct {
     int width, height;
     float *frame, *ref;    /* 3 floats per pixel, linear radiance, row 0 at the top */
     int32_t *surface_at;   /* per pixel: surface index, -1 specular, -2 nothing */
+    uint8_t *compared;     /* per pixel: 1 where it counts in `surface` (an interior pixel of a surface) */
     int surface_count;
     lm_check_sum *surface; /* per surface */
     lm_check_sum lit;      /* every compared pixel of a non-emissive surface */
