@@ -23,5 +23,14 @@ if [ -r scenes/cornell.glb ]; then
     echo "== run on scenes/cornell.glb"
     "$LMGI" run scenes/cornell.glb --frames 30 --size 512x512 --out demo/cornell-run
 fi
-echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png and"
-echo "      demo/cornell-run/frame_*.png"
+# The shared Cornell box (its double-sided lamp 0.9 mm under the ceiling) as `lmgi run` renders it, and that
+# frame against the path-traced reference, per visible surface.
+if [ -r ../shared/scenes/cornell-box/CornellBox.glb ]; then
+    echo "== run and check on ../shared/scenes/cornell-box/CornellBox.glb"
+    "$LMGI" run ../shared/scenes/cornell-box/CornellBox.glb --frames 1 --size 512x512 --out demo/cornellbox-run
+    mkdir -p demo/cornellbox-check
+    "$LMGI" check ../shared/scenes/cornell-box/CornellBox.glb --out demo/cornellbox-check -q | tee demo/cornellbox-check/check.txt
+fi
+echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png,"
+echo "      demo/cornell-run/frame_*.png, demo/cornellbox-run/frame_0000.png and demo/cornellbox-check/"
+echo "      (check_ratio.png: frame / reference, red brighter, blue darker; check.txt per surface)"

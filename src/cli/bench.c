@@ -166,7 +166,7 @@ int lm_cli_bench(const lm_cli_args *a)
     if (a->file_count == 0) {
         lm_cli_bench_photons();
         lm_cli_bench_gather(a->gather_scene);
-        lm_cli_bench_scenes(files, count);
+        lm_cli_bench_scenes();
     }
     return rc;
 }

@@ -94,10 +94,13 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
             for (int j = 0; j < SUB; j++) {
                 double ws;
                 lm_vec3 ds = rim_dir(r, B, T, N, phi0 + (i + 0.5) / SUB * dphi, u0 + (j + 0.5) / SUB * du, &ws);
-                double den = lm_dot(ng, ds);
+                double den = lm_dot(ng, ds), ts = num / den;
                 float su = u, sv = v, L[3];
-                if (num * den > 0.0) { /* meets the plane on the same side: its point's uv */
-                    lm_vec3 off = lm_sub(lm_add(e, lm_scale(ds, (float)(num / den))), P);
+                /* meets the plane on the same side, not much further or nearer than the ray's own hit (at
+                 * grazing angles the stratum's far sub-directions would reach across the whole plane, past
+                 * whatever hides it): its point's uv; otherwise the ray's */
+                if (ts > 0.5 * h.t && ts < 2.0 * h.t) {
+                    lm_vec3 off = lm_sub(lm_add(e, lm_scale(ds, (float)ts)), P);
                     su = fminf(fmaxf(u + lm_dot(lm_v3_load(gu), off), lo[0]), hi[0]);
                     sv = fminf(fmaxf(v + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
                 }
