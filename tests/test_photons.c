@@ -609,6 +609,51 @@ static void test_cornell_rate_and_memory(void **state)
     world_free(&w);
 }
 
+/* Hidden light (docs/photons.md): a lamp facing up 2 mm under a ceiling, the lamp double-sided like the
+ * shared Cornell box's. Every photon its top sends into the gap lands within 2 mm of the lamp: with
+ * cover_distance 1 cm none of the hits in the gap (on the ceiling over the lamp, on the lamp's top) is
+ * stored (the photons still scatter), while the hits on the floor below, in the open, are all kept. */
+static void test_hidden_light(void **state)
+{
+    (void)state;
+    lmt_mesh m[3];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});     /* floor, up */
+    lmt_mesh_quad(&m[1], (float[3]){-2, 2, -2}, (float[3]){4, 0, 0}, (float[3]){0, 0, 4});     /* ceiling, down */
+    lmt_mesh_quad(&m[2], (float[3]){-0.3f, 1.998f, 0.3f}, (float[3]){0.6f, 0, 0}, (float[3]){0, 0, -0.6f}); /* lamp */
+    const char *path = lmt_write_scene("hidden.gltf", m, 3, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}]",
+                                       "[{}, {}, {\"doubleSided\": true, \"emissiveFactor\": [1, 1, 1]}]");
+    uint32_t floor_hits[2], gap_hits[2];
+    for (int k = 0; k < 2; k++) {
+        world w;
+        world_load(&w, path);
+        lm_photon_settings set;
+        lm_photon_settings_default(&set);
+        set.total_photons = 20000;
+        set.cover_distance = k ? 0.01f : 0.0f;
+        world_photons(&w, &set);
+        const lm_photon_store *ps = lm_photons_store(w.ph);
+        floor_hits[k] = gap_hits[k] = 0;
+        for (uint32_t h = 0; h < ps->used; h++) {
+            const lm_hit *x = &ps->hits[h];
+            if (x->surface < 0 || ps->surfaces[x->surface].count == 0)
+                continue;
+            int node = w.su.surfaces[x->surface].node;
+            int top = node == 2 && !lm_tri_is_back(w.s, x->tri); /* the file wound the lamp facing up */
+            int over = node == 1 && fabsf(x->pos[0]) < 0.29f && fabsf(x->pos[2]) < 0.29f;
+            floor_hits[k] += node == 0;
+            gap_hits[k] += top || over;
+        }
+        world_free(&w);
+    }
+    print_message("stored hits without / with cover: floor %u / %u, in the gap %u / %u\n", floor_hits[0],
+                  floor_hits[1], gap_hits[0], gap_hits[1]);
+    assert_true(gap_hits[0] > 1000); /* the gap fills with hits */
+    assert_int_equal(gap_hits[1], 0);
+    assert_int_equal(floor_hits[1], floor_hits[0]); /* the open floor keeps every hit */
+    assert_true(floor_hits[0] > 1000);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -622,6 +667,7 @@ int main(void)
         cmocka_unit_test(test_reset_matches_fresh),
         cmocka_unit_test(test_settings),
         cmocka_unit_test(test_cornell_rate_and_memory),
+        cmocka_unit_test(test_hidden_light),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -91,6 +91,27 @@ static void test_writes_files(void **state)
     assert_int_equal(w, 64);
     assert_int_equal(h, 48);
     free(px);
+    /* iim.exr's alpha says which texels are valid: 1 or 0, and both occur (the floor under the tall block,
+     * which stands on it, is covered) */
+    snprintf(path, sizeof path, "%s/iim.exr", dir);
+    assert_int_equal(lm_read_exr(path, &w, &h, &px, &err), LM_OK);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, scene, 0.1f); /* the quick run's atlas */
+    assert_int_equal(w, p.atlas.width);
+    assert_int_equal(h, p.atlas.height);
+    int ones = 0, invalid = 0;
+    for (size_t i = 0; i < (size_t)w * h; i++) {
+        assert_true(px[4 * i + 3] == 0.0f || px[4 * i + 3] == 1.0f);
+        ones += px[4 * i + 3] == 1.0f;
+        invalid += p.atlas.texel_index[i] >= 0 && px[4 * i + 3] == 0.0f;
+        if (p.atlas.texel_index[i] < 0)
+            assert_true(px[4 * i + 3] == 0.0f); /* gutters */
+    }
+    print_message("iim.exr: %d valid texels, %d invalid\n", ones, invalid);
+    assert_true(ones > 100);
+    assert_true(invalid > 0);
+    lmt_pipeline_free(&p);
+    free(px);
 }
 
 static float *read_exr(const char *dir, const char *file, int *w, int *h)

@@ -7,6 +7,7 @@
 #include <lmgi.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "support.h"
@@ -162,6 +163,66 @@ static void test_target_texels(void **state)
     assert_non_null(strstr(err.message, "target texel count -3"));
 }
 
+/* Two sides (docs/materials.md): an open double-sided quad gets a twin on the same corners wound the
+ * other way, normals negated, its material single-sided with split_sides; a closed double-sided cube
+ * keeps one sheet. A ray at the back of the quad hits the twin, facing the ray, at the same place. */
+static void test_two_sides(void **state)
+{
+    (void)state;
+    lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-1, 0, 1}, (float[3]){2, 0, 0}, (float[3]){0, 0, -2}); /* y = 0, facing +y */
+    lmt_mesh_cube(&m[1], 0.5f);
+    const char *path = lmt_write_scene("sides.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1, \"translation\": [3, 0.5, 0]}]",
+                                       "[{\"doubleSided\": true}, {\"doubleSided\": true}]");
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 0.25f);
+    const lm_scene *s = p.s;
+    assert_int_equal(s->file_tri_count, 2 + 12);
+    assert_int_equal(s->tri_count, 2 + 12 + 2);
+    assert_non_null(s->tri_twin);
+    assert_int_equal(s->materials[0].split_sides, 1);
+    assert_int_equal(s->materials[0].double_sided, 0);
+    assert_int_equal(s->materials[1].split_sides, 0); /* the closed cube */
+    assert_int_equal(s->materials[1].double_sided, 1);
+    const lm_node *quad = &s->nodes[0];
+    assert_int_equal(quad->front_tri_count, 2);
+    assert_int_equal(quad->tri_count, 4);
+    for (uint32_t t = quad->first_tri; t < quad->first_tri + 2; t++) {
+        uint32_t b = (uint32_t)s->tri_twin[t];
+        assert_int_equal(s->tri_twin[b], (int32_t)t);
+        assert_true(lm_tri_is_back(s, b) && !lm_tri_is_back(s, t));
+        const uint32_t *f = s->tris + 3 * (size_t)t, *k = s->tris + 3 * (size_t)b;
+        const int corner[3] = {0, 2, 1}; /* the twin's corner c is the front's corner[c] */
+        for (int c = 0; c < 3; c++) {
+            assert_true(k[c] != f[corner[c]]); /* its own vertices */
+            for (int a = 0; a < 3; a++) {
+                assert_float_equal(s->positions[3 * k[c] + a], s->positions[3 * f[corner[c]] + a], 0.0f);
+                assert_float_equal(s->normals[3 * k[c] + a], -s->normals[3 * f[corner[c]] + a], 0.0f);
+            }
+        }
+        assert_true(p.su.tri_surface[b] >= 0 && p.su.tri_surface[b] != p.su.tri_surface[t]);
+    }
+    for (uint32_t t = s->nodes[1].first_tri; t < s->nodes[1].first_tri + s->nodes[1].tri_count; t++)
+        assert_int_equal(s->tri_twin[t], -1);
+    /* from above: the file's triangle; from below: its twin, facing down, at the same point */
+    const float dirs[2][3] = {{0, -1, 0}, {0, 1, 0}}, orgs[2][3] = {{0.3f, 1, 0.2f}, {0.3f, -1, 0.2f}};
+    for (int k = 0; k < 2; k++) {
+        lm_rt_hit h;
+        assert_true(lm_rt_intersect(p.rt, orgs[k], dirs[k], 0.0f, INFINITY, &h));
+        assert_int_equal(lm_tri_is_back(s, h.tri), k);
+        assert_float_equal(h.ng[1], k ? -1.0f : 1.0f, 1e-6f);
+        assert_float_equal(h.t, 1.0f, 1e-5f);
+        float q[3] = {0, 0, 0}, w[3] = {1.0f - h.u - h.v, h.u, h.v};
+        for (int c = 0; c < 3; c++)
+            for (int a = 0; a < 3; a++)
+                q[a] += w[c] * s->positions[3 * s->tris[3 * (size_t)h.tri + c] + a];
+        assert_float_equal(q[0], 0.3f, 1e-5f);
+        assert_float_equal(q[2], 0.2f, 1e-5f);
+    }
+    lmt_pipeline_free(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -169,6 +230,7 @@ int main(void)
         cmocka_unit_test(test_dynamic_hits_follow_transform),
         cmocka_unit_test(test_bad_edits_are_refused),
         cmocka_unit_test(test_target_texels),
+        cmocka_unit_test(test_two_sides),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

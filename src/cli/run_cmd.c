@@ -133,10 +133,22 @@ static lm_status write_atlases(run_state *r, lm_error *err)
     lm_status st = rgb && png ? lm_frame_loop_read_iim(r->loop, &rgba, err)
                               : lm_fail(err, LM_ERR_NOMEM, "no memory for the atlases");
     if (st == LM_OK) {
-        lm_iim_fill_invalid(at, rgba, lm_frame_loop_get_settings(r->loop)->gather.backface_limit);
+        /* alpha: 1 on valid texels, 0 on invalid ones (inside or under geometry: filled from their
+         * neighbours so that bilinear filtering stays smooth, but not light anyone sees) and gutters */
+        float limit = lm_frame_loop_get_settings(r->loop)->gather.backface_limit;
+        uint8_t *valid = png; /* scratch until the pictures are written */
         for (size_t i = 0; i < n; i++)
+            valid[i] = at->texel_index[i] >= 0 && !(rgba[4 * i + 3] > limit);
+        lm_iim_fill_invalid(at, rgba, limit);
+        for (size_t i = 0; i < n; i++) {
             memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
-        st = write_pair(r->a->out_dir, "iim", at->width, at->height, rgb, 0.0f, 1, png, err);
+            rgba[4 * i + 3] = valid[i];
+        }
+        char path[4096];
+        snprintf(path, sizeof path, "%s/iim.exr", r->a->out_dir);
+        st = lm_write_exr(path, at->width, at->height, 4, rgba, err);
+        if (st == LM_OK)
+            st = write_pair(r->a->out_dir, "iim", at->width, at->height, rgb, 0.0f, 0, png, err);
     }
     if (st == LM_OK) {
         memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(r->loop))), n * 3 * sizeof *rgb);
