@@ -132,14 +132,15 @@ const char *const lm_direct_fs_body =
     "        vec4 t = textureLod(lit, v_lm, 0.0);\n"
     "        if (t.a > 0.0) e = t.rgb / t.a;\n"
     "    }\n"
-    "    frag = vec4((seen ? c : vec3(0.0)) + e, 1.0);\n"
+    "    frag = vec4(seen ? c + e : vec3(0.0), 1.0); /* the back of a single-sided surface: black */\n"
     "#else\n"
     "    frag = vec4(seen ? c : vec3(0.0), 1.0);\n"
     "#endif\n"
     "}\n";
 
 /* The emission-only first pass (a scene without punctual lights): depth, and Le on the front side (or
- * both sides when double-sided); the same attributes and gl_Position as lm_direct_vs. With use_lit, also
+ * both sides when double-sided; the back of a single-sided surface is black, lightmap and all, as the
+ * reference sees it); the same attributes and gl_Position as lm_direct_vs. With use_lit, also
  * the composite's indirect term
  * albedo / pi * E_IIM: the premultiplied atlas `lit` (gpu/composite.h) at the lightmap uv (attribute 7,
  * -1 without a chart), rgb / a over the covered, valid texels of its bilinear footprint. */
@@ -168,8 +169,9 @@ const char *const lm_direct_emission_fs =
     "uniform int use_lit;\n"
     "out vec4 frag;\n"
     "void main() {\n"
-    "    vec3 c = gl_FrontFacing || v_two > 0.5 ? v_em : vec3(0.0);\n"
-    "    if (use_lit != 0 && v_lm.x >= 0.0) {\n"
+    "    bool seen = gl_FrontFacing || v_two > 0.5; /* the back of a single-sided surface: black */\n"
+    "    vec3 c = seen ? v_em : vec3(0.0);\n"
+    "    if (seen && use_lit != 0 && v_lm.x >= 0.0) {\n"
     "        vec4 t = textureLod(lit, v_lm, 0.0);\n"
     "        if (t.a > 0.0) c += t.rgb / t.a;\n"
     "    }\n"
