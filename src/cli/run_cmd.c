@@ -150,10 +150,17 @@ static lm_status write_atlases(run_state *r, lm_error *err)
         if (st == LM_OK)
             st = write_pair(r->a->out_dir, "iim", at->width, at->height, rgb, 0.0f, 0, png, err);
     }
-    if (st == LM_OK) {
+    if (st == LM_OK) { /* the AIM with the IIM's validity as alpha: its texels under geometry hold only
+                        * the N-nearest estimate's spill from around them */
         memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(r->loop))), n * 3 * sizeof *rgb);
         lm_atlas_dilate_gutters(at, rgb, 3);
-        st = write_pair(r->a->out_dir, "aim", at->width, at->height, rgb, 0.0f, 1, png, err);
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgba + 4 * i, rgb + 3 * i, 3 * sizeof *rgb);
+        char path[4096];
+        snprintf(path, sizeof path, "%s/aim.exr", r->a->out_dir);
+        st = lm_write_exr(path, at->width, at->height, 4, rgba, err);
+        if (st == LM_OK)
+            st = write_pair(r->a->out_dir, "aim", at->width, at->height, rgb, 0.0f, 0, png, err);
     }
     free(rgba);
     free(rgb);
