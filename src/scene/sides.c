@@ -67,44 +67,68 @@ static int closed(const lm_scene *s, const uint32_t *tris, uint32_t n)
     return ok ? result : -1;
 }
 
+typedef struct {
+    uint32_t node, material, tri;
+} group_key;
+
+static int cmp_group(const void *a, const void *b)
+{
+    const group_key *x = a, *y = b;
+    if (x->node != y->node)
+        return x->node < y->node ? -1 : 1;
+    if (x->material != y->material)
+        return x->material < y->material ? -1 : 1;
+    return (x->tri > y->tri) - (x->tri < y->tri);
+}
+
 /* split[m] for every material: double-sided, not specular, and some node's triangles of it do not close
- * a surface. 0 when out of memory. */
+ * a surface. The candidates sorted by (node, material) make each node's triangles of one material a run:
+ * O(T log T) whatever the counts of nodes and materials. 0 when out of memory. */
 static int decide(const lm_scene *s, uint8_t *split)
 {
-    uint32_t *tris = malloc(sizeof *tris * (size_t)(s->tri_count ? s->tri_count : 1));
-    if (!tris)
-        return 0;
-    int ok = 1;
-    for (int i = 0; ok && i < s->node_count; i++) {
-        const lm_node *nd = &s->nodes[i];
-        for (int m = 0; ok && m < s->material_count; m++) {
-            if (!may_split(&s->materials[m]) || split[m])
-                continue;
-            uint32_t n = 0;
-            for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
-                if (s->tri_material[t] == m)
-                    tris[n++] = t;
-            int c = n ? closed(s, tris, n) : 1;
-            ok = c >= 0;
-            split[m] = (uint8_t)(c == 0);
-        }
+    uint32_t n = 0;
+    for (uint32_t t = 0; t < s->tri_count; t++)
+        n += (uint32_t)may_split(&s->materials[s->tri_material[t]]);
+    group_key *g = malloc(sizeof *g * (size_t)(n ? n : 1));
+    uint32_t *tris = malloc(sizeof *tris * (size_t)(n ? n : 1));
+    int ok = g && tris;
+    for (uint32_t t = 0, k = 0; ok && t < s->tri_count; t++)
+        if (may_split(&s->materials[s->tri_material[t]]))
+            g[k++] = (group_key){s->tri_node[t], (uint32_t)s->tri_material[t], t};
+    if (ok)
+        qsort(g, n, sizeof *g, cmp_group);
+    for (uint32_t a = 0, b; ok && a < n; a = b) {
+        for (b = a; b < n && g[b].node == g[a].node && g[b].material == g[a].material; b++)
+            tris[b - a] = g[b].tri;
+        if (split[g[a].material])
+            continue;
+        int c = closed(s, tris, b - a);
+        ok = c >= 0;
+        split[g[a].material] = (uint8_t)(c == 0);
     }
+    free(g);
     free(tris);
     return ok;
 }
 
-/* Node indices ordered by their first triangle (each node's triangles are contiguous). */
+/* Node indices ordered by their first triangle (each node's triangles are contiguous): (first_tri, node)
+ * pairs sorted as 64-bit keys. */
 static int *nodes_by_first_tri(const lm_scene *s)
 {
-    int *order = malloc(sizeof *order * (size_t)(s->node_count ? s->node_count : 1));
-    if (!order)
-        return NULL;
-    for (int i = 0; i < s->node_count; i++) {
-        int j = i;
-        for (; j > 0 && s->nodes[order[j - 1]].first_tri > s->nodes[i].first_tri; j--)
-            order[j] = order[j - 1];
-        order[j] = i;
+    size_t n = (size_t)s->node_count;
+    int *order = malloc(sizeof *order * (n ? n : 1));
+    uint64_t *key = malloc(sizeof *key * (n ? n : 1));
+    if (order && key) {
+        for (size_t i = 0; i < n; i++)
+            key[i] = (uint64_t)s->nodes[i].first_tri << 32 | (uint64_t)i;
+        qsort(key, n, sizeof *key, cmp_u64);
+        for (size_t i = 0; i < n; i++)
+            order[i] = (int)(key[i] & 0xFFFFFFFFu);
+    } else {
+        free(order);
+        order = NULL;
     }
+    free(key);
     return order;
 }
 
