@@ -46,6 +46,14 @@ static void test_usage_errors(void **state)
     assert_non_null(strstr(output, "--out"));
     assert_int_equal(run("help"), 0);
     assert_non_null(strstr(output, "charts SCENE --out DIR"));
+    /* a value is never taken from the next option, and is checked in full */
+    assert_int_equal(run("run scenes/cornell.glb --out -q"), 2);
+    assert_non_null(strstr(output, "--out (missing)"));
+    assert_int_equal(run("run scenes/cornell.glb --size 64x64abc --out x"), 2);
+    assert_non_null(strstr(output, "--size 64x64abc"));
+    assert_int_equal(run("run scenes/cornell.glb --groups 7 --out x"), 2);
+    assert_non_null(strstr(output, "--groups 7"));
+    assert_int_equal(run("info scenes/cornell.glb --groups 12 -q"), 0); /* 2^2 3 */
 }
 
 static void test_bad_scene_files(void **state)

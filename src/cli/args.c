@@ -43,9 +43,36 @@ static int parse_int(const char *opt, const char *v, int lo, int hi, int *out)
 
 static int parse_size(const char *opt, const char *v, int *w, int *h)
 {
-    if (!v || sscanf(v, "%dx%d", w, h) != 2 || *w < 16 || *h < 16 || *w > 16384 || *h > 16384)
+    int used = -1;
+    if (!v || sscanf(v, "%dx%d%n", w, h, &used) != 2 || used < 0 || v[used] || *w < 16 || *h < 16 || *w > 16384 ||
+        *h > 16384)
         return bad(opt, v, "WxH with 16 <= W, H <= 16384");
     return 0;
+}
+
+/* Photon groups: 2^a 3^b (their Halton strata, docs/photons.md), checked here so that a bad value is a bad
+ * command line (exit 2), not a scene that failed. */
+static int parse_groups(const char *opt, const char *v, int *out)
+{
+    int rc = parse_int(opt, v, 1, 1 << 20, out);
+    if (rc)
+        return rc;
+    int n = *out;
+    while (n % 2 == 0)
+        n /= 2;
+    while (n % 3 == 0)
+        n /= 3;
+    return n == 1 ? 0 : bad(opt, v, "2^a 3^b groups (1, 2, 3, 4, 6, 8, 9, 12, ..., 72, ...) up to 2^20");
+}
+
+/* The word after an option that takes a value, or NULL when there is none or it is another option ("-q",
+ * "--out"; a negative number is a value): `--out -q` must not make a directory named -q. */
+static const char *value_after(int argc, char **argv, int i)
+{
+    const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+    if (v && v[0] == '-' && v[1] && !(v[1] >= '0' && v[1] <= '9') && v[1] != '.')
+        return NULL;
+    return v;
 }
 
 static int add_file(const char **list, int *count, const char *f)
@@ -88,7 +115,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
     a->rim_samples = -1;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
-        const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
+        const char *o = argv[i], *v = value_after(argc, argv, i);
         int takes = 1;
         if (!strcmp(o, "--texel-size"))
             rc = parse_float(o, v, 0.0f, &a->options.texel_size);
@@ -115,7 +142,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
         else if (!strcmp(o, "--photons"))
             rc = parse_int(o, v, 1, 100000000, &a->photons);
         else if (!strcmp(o, "--groups"))
-            rc = parse_int(o, v, 1, 10000000, &a->groups);
+            rc = parse_groups(o, v, &a->groups);
         else if (!strcmp(o, "--per-group"))
             rc = parse_int(o, v, 1, 10000000, &a->per_group);
         else if (!strcmp(o, "--retrace"))
