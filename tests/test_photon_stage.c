@@ -191,7 +191,7 @@ static void test_photons_command(void **state)
     snprintf(args, sizeof args, "photons %s", path);
     assert_int_equal(run_lmgi(args), 2); /* no --out */
     snprintf(args, sizeof args, "photons %s --out %s/c --groups 70", path, dir);
-    assert_int_equal(run_lmgi(args), 1); /* G must be 2^a 3^b */
+    assert_int_equal(run_lmgi(args), 2); /* G must be 2^a 3^b: a bad command line (issue 16) */
 }
 
 int main(void)

@@ -13,6 +13,7 @@
 #include <stb/stb_image_write.h>
 
 #include "../src/core/log.h"
+#include "../src/core/timing.h"
 #include "../src/scene/scene.h"
 #include "support.h"
 
@@ -688,6 +689,40 @@ static void test_texture_transform_rotation(void **state)
     assert_float_equal(a[1], 2.0f, 1e-4);
 }
 
+/* A 50,000-node parent chain (issue 16: world matrices walked up each node's chain took 53 s, and the
+ * recursive resolution of node settings would overflow the stack on deeper chains): loads in well under
+ * a second now, the deepest node at the sum of the translations. The bound is 50x what it takes. */
+static void test_deep_hierarchy(void **state)
+{
+    (void)state;
+    enum { DEPTH = 50000 };
+    lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_quad(&m, (float[3]){0, 0, 0}, (float[3]){1, 0, 0}, (float[3]){0, 0, -1});
+    size_t cap = (size_t)DEPTH * 64 + 64;
+    char *nodes = malloc(cap);
+    assert_non_null(nodes);
+    size_t at = 0;
+    at += (size_t)snprintf(nodes + at, cap - at, "[");
+    for (int i = 0; i < DEPTH; i++) /* node i's child is i + 1; the last holds the mesh */
+        at += (size_t)(i + 1 < DEPTH ? snprintf(nodes + at, cap - at, "{\"children\": [%d], \"translation\": [0.001, 0, 0]},", i + 1)
+                                      : snprintf(nodes + at, cap - at, "{\"mesh\": 0, \"translation\": [0.001, 0, 0]}"));
+    snprintf(nodes + at, cap - at, "]");
+    char path[1024];
+    snprintf(path, sizeof path, "%s/deep.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &m, 1, nodes, NULL, 0, ""), 0); /* no material: the default */
+    free(nodes);
+    double t0 = lm_now();
+    lm_scene *s = load_ok(path, 0);
+    double seconds = lm_now() - t0;
+    print_message("%d-node chain loaded in %.3f s; deepest node at x = %.4f (want %.4f)\n", DEPTH, seconds,
+                  (double)s->nodes[DEPTH - 1].world[12], DEPTH * 0.001);
+    assert_int_equal(s->node_count, DEPTH);
+    assert_float_equal(s->nodes[DEPTH - 1].world[12], DEPTH * 0.001f, 0.05f);
+    assert_true(seconds < 10.0);
+    lm_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -705,6 +740,7 @@ int main(void)
         cmocka_unit_test(test_non_triangle_modes),
         cmocka_unit_test(test_material_and_texture),
         cmocka_unit_test(test_texture_transform_rotation),
+        cmocka_unit_test(test_deep_hierarchy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

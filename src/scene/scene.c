@@ -45,12 +45,58 @@ static void local_matrix(lm_node *n)
         lm_mat4_from_trs(n->matrix, n->translation, n->rotation, n->scale);
 }
 
-/* world = parent chain product, computed by walking up from each node: no ordering or scratch memory
- * needed, O(nodes x depth). The step bound keeps a corrupted (cyclic) hierarchy from looping. */
+int *lm_scene_parents_first(const lm_scene *s, int *cycle)
+{
+    size_t n = (size_t)(s->node_count > 0 ? s->node_count : 0);
+    int *order = malloc(sizeof(int) * (n + 1)), *stack = malloc(sizeof(int) * (n + 1));
+    unsigned char *state = calloc(n + 1, 1); /* 0 unseen, 1 on the walk under way, 2 placed */
+    *cycle = -1;
+    if (!order || !stack || !state) {
+        free(order), free(stack), free(state);
+        return NULL;
+    }
+    int placed = 0;
+    for (int i = 0; i < (int)n && *cycle < 0; i++) {
+        /* walk up to a placed ancestor (or the root), then place the walked nodes top down */
+        int top = 0, p = i;
+        while (p >= 0 && p < (int)n && state[p] == 0) {
+            state[p] = 1;
+            stack[top++] = p;
+            p = s->nodes[p].parent;
+        }
+        if (p >= 0 && p < (int)n && state[p] == 1)
+            *cycle = p;
+        while (top > 0) {
+            int k = stack[--top];
+            state[k] = 2;
+            order[placed++] = k;
+        }
+    }
+    free(stack);
+    free(state);
+    return order;
+}
+
+/* world = parent's world x local, parents first: O(nodes) whatever the depth. Without memory for the
+ * order (or on a cycle, which loading refuses), each node's chain is walked up instead, bounded. */
 void lm_scene_update_world(lm_scene *s)
 {
     for (int i = 0; i < s->node_count; i++)
         local_matrix(&s->nodes[i]);
+    int cycle;
+    int *order = lm_scene_parents_first(s, &cycle);
+    if (order && cycle < 0) {
+        for (int i = 0; i < s->node_count; i++) {
+            lm_node *n = &s->nodes[order[i]];
+            if (n->parent >= 0)
+                lm_mat4_mul(n->world, s->nodes[n->parent].world, n->matrix);
+            else
+                memcpy(n->world, n->matrix, sizeof n->matrix);
+        }
+        free(order);
+        return;
+    }
+    free(order);
     for (int i = 0; i < s->node_count; i++) {
         float *w = s->nodes[i].world;
         memcpy(w, s->nodes[i].matrix, sizeof s->nodes[i].matrix);

@@ -173,8 +173,11 @@ static inline uint32_t lm_node_file_tris(const lm_scene *s, const lm_node *n) { 
 /* 1 when triangle t is the twin (the back side) of a file's triangle. */
 static inline int lm_tri_is_back(const lm_scene *s, uint32_t t) { return s->tri_twin && s->tri_twin[t] >= 0 && (uint32_t)s->tri_twin[t] < t; }
 
-/* Recomputes every node's world matrix from local transforms (parents before children). */
+/* Recomputes every node's world matrix from local transforms (parents before children), O(nodes). */
 void lm_scene_update_world(lm_scene *s);
+/* Node indices with every parent before its children, O(nodes) whatever the depth (caller frees); NULL
+ * when out of memory. *cycle: -1, or a node on a cycle of the parent links (the order is then partial). */
+int *lm_scene_parents_first(const lm_scene *s, int *cycle);
 /* Sets the local TRS of every node that animation `anim` targets to its value at time t (seconds;
  * clamped to the animation's range), then updates world matrices. anim < 0 evaluates all animations. */
 void lm_scene_eval_animation(lm_scene *s, int anim, float t);

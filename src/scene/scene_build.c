@@ -195,20 +195,6 @@ void lm_copy_name(char *dst, const char *src)
 }
 
 /* Walking up from any node must reach a root within node_count steps. */
-static int find_cycle(const lm_scene *s)
-{
-    for (int i = 0; i < s->node_count; i++) {
-        int p = i, steps = 0;
-        while (p >= 0 && steps <= s->node_count) {
-            p = s->nodes[p].parent;
-            steps++;
-        }
-        if (p >= 0)
-            return i;
-    }
-    return -1;
-}
-
 /* Splits a local matrix into T, R, S (exact for matrices without shear). */
 static void decompose(lm_node *n)
 {
@@ -246,48 +232,45 @@ static void decompose(lm_node *n)
 
 static int resolve_switch(int own, int parent_value) { return own >= 0 ? own : parent_value; }
 
-/* Resolves node i after its ancestors (recursion depth is bounded: cycles were rejected). */
-static void resolve_node(lm_scene *s, int i, const unsigned char *animated, unsigned char *done)
+/* Resolves node i, whose parent is resolved already. */
+static void resolve_node(lm_scene *s, int i, const unsigned char *animated)
 {
-    if (done[i])
-        return;
     lm_node *n = &s->nodes[i];
-    const lm_node *p = NULL;
-    if (n->parent >= 0) {
-        resolve_node(s, n->parent, animated, done);
-        p = &s->nodes[n->parent];
-    }
+    const lm_node *p = n->parent >= 0 ? &s->nodes[n->parent] : NULL;
     /* A child of a moving node moves with it, whatever it says; otherwise its own flag or animation. */
     n->dynamic = (animated && animated[i]) || n->settings.dynamic == 1 || (p && p->dynamic);
     n->settings.dynamic = n->dynamic;
     n->settings.caustics = resolve_switch(n->settings.caustics, p ? p->settings.caustics : 1);
     n->settings.indirect = resolve_switch(n->settings.indirect, p ? p->settings.indirect : 1);
     n->settings.shadows = resolve_switch(n->settings.shadows, p ? p->settings.shadows : 1);
-    done[i] = 1;
 }
 
 lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_error *err)
 {
-    int c = find_cycle(s);
-    if (c >= 0)
+    int c;
+    int *order = lm_scene_parents_first(s, &c); /* iterative: a chain of any depth is fine */
+    if (!order)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: out of memory resolving nodes", s->path);
+    if (c >= 0) {
+        free(order);
         return lm_fail(err, LM_ERR_FORMAT, "%s: node %d (\"%s\") is part of a cycle in the node hierarchy",
                        s->path, c, s->nodes[c].name);
+    }
     for (int i = 0; i < s->node_count; i++) {
         lm_node *n = &s->nodes[i];
         if (n->has_matrix)
             decompose(n);
         else
             lm_mat4_from_trs(n->matrix, n->translation, n->rotation, n->scale);
-        if (!lm_mat4_finite(n->matrix))
+        if (!lm_mat4_finite(n->matrix)) {
+            free(order);
             return lm_fail(err, LM_ERR_INVALID, "%s: node %d (\"%s\") has a non-finite transform", s->path, i,
                            n->name);
+        }
     }
-    unsigned char *done = calloc((size_t)s->node_count + 1, 1);
-    if (!done)
-        return lm_fail(err, LM_ERR_NOMEM, "%s: out of memory resolving nodes", s->path);
     for (int i = 0; i < s->node_count; i++)
-        resolve_node(s, i, animated, done);
-    free(done);
+        resolve_node(s, order[i], animated);
+    free(order);
     lm_scene_update_world(s);
     lm_scene_update_bounds(s);
     return LM_OK;
