@@ -57,7 +57,7 @@ static int time_scene(const lm_cli_args *a, const char *path, result *r)
     return 0;
 }
 
-static const char *base_name(const char *p)
+const char *lm_cli_base_name(const char *p)
 {
     const char *s = strrchr(p, '/');
     return s ? s + 1 : p;
@@ -73,8 +73,8 @@ static void print_row(const result *r)
 {
     const lmgi_timings *t = &r->info.timings;
     printf("%-34s %9u %7.1fms %7.1fms %7.1fms %7.1fms %7.1fms %7.1fms %7.1fms %7.1fms %9u %6.1f\n",
-           base_name(r->path), r->info.triangles, 1e3 * t->load, 1e3 * t->surfaces, 1e3 * t->unwrap, 1e3 * t->pack,
-           1e3 * t->texels, 1e3 * t->atlas, 1e3 * t->bvh, 1e3 * t->total, r->info.texels,
+           lm_cli_base_name(r->path), r->info.triangles, 1e3 * t->load, 1e3 * t->surfaces, 1e3 * t->unwrap,
+           1e3 * t->pack, 1e3 * t->texels, 1e3 * t->atlas, 1e3 * t->bvh, 1e3 * t->total, r->info.texels,
            100.0 * (double)r->info.utilization);
 }
 
@@ -90,7 +90,7 @@ static void print_scaling(const result *r, int n)
         double norm = r[i].info.timings.total / (tri * log2(tri));
         if (i == 0)
             base = norm;
-        printf("%-34s %9u %8.3fs %8.2fus %8.2f\n", base_name(r[i].path), r[i].info.triangles,
+        printf("%-34s %9u %8.3fs %8.2fus %8.2f\n", lm_cli_base_name(r[i].path), r[i].info.triangles,
                r[i].info.timings.total, 1e6 * r[i].info.timings.total / tri, norm / base);
     }
 }
@@ -138,7 +138,7 @@ int lm_cli_bench(const lm_cli_args *a)
     print_header();
     for (int i = 0; i < count; i++) {
         if (access(files[i], R_OK) != 0) {
-            printf("%-34s skipped (not found: %s)\n", base_name(files[i]), files[i]);
+            printf("%-34s skipped (not found: %s)\n", lm_cli_base_name(files[i]), files[i]);
             continue;
         }
         if (time_scene(a, files[i], &res[n]) != 0) {

@@ -3,11 +3,11 @@
 
 #include <math.h>
 #include <stdio.h>
-#include <string.h>
 #include <unistd.h>
 
 #include "../core/timing.h"
 #include "../update/frame_check.h"
+#include "bench.h"
 
 /* scenes/many_rooms.glb is left out: its reference took over 10 minutes here. */
 static const char *SCENES[] = {
@@ -24,12 +24,6 @@ static const char *SCENES[] = {
 #define REF_ERROR 0.03f /* looser targets read rare bright paths short (docs/reference.md) */
 
 static double lum(const double c[3]) { return c[0] + c[1] + c[2]; }
-
-static const char *base_name(const char *p)
-{
-    const char *s = strrchr(p, '/');
-    return s ? s + 1 : p;
-}
 
 /* The surface of MIN pixels furthest from the reference, relative to max(its mean, the frame's). */
 static void worst_surface(const lmgi_scene *sc, const lm_frame_check *c, char *out, size_t size)
@@ -59,7 +53,7 @@ static void check_one(const char *path)
     lmgi_scene *sc = NULL;
     lmgi_error lerr;
     if (lmgi_load(path, &o, &sc, &lerr) != LMGI_OK) {
-        printf("%-34s error: %s\n", base_name(path), lerr.message);
+        printf("%-34s error: %s\n", lm_cli_base_name(path), lerr.message);
         return;
     }
     lm_frame_loop_settings ls;
@@ -73,14 +67,14 @@ static void check_one(const char *path)
     lm_error err;
     double t0 = lm_now();
     if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK) {
-        printf("%-34s error: %s\n", base_name(path), err.msg);
+        printf("%-34s error: %s\n", lm_cli_base_name(path), err.msg);
     } else if (lum(c.lit.ref) <= 0.0) {
-        printf("%-34s no light reaches the camera (the file has no light)\n", base_name(path));
+        printf("%-34s no light reaches the camera (the file has no light)\n", lm_cli_base_name(path));
         lm_frame_check_free(&c);
     } else {
         char worst[160];
         worst_surface(sc, &c, worst, sizeof worst);
-        printf("%-34s %6.3f %6.3f %6.3f %8.4f  %-36s %6.0f s\n", base_name(path), lm_check_ratio(&c.lit, 0),
+        printf("%-34s %6.3f %6.3f %6.3f %8.4f  %-36s %6.0f s\n", lm_cli_base_name(path), lm_check_ratio(&c.lit, 0),
                lm_check_ratio(&c.lit, 1), lm_check_ratio(&c.lit, 2), c.rel_rmse, worst, lm_now() - t0);
         lm_frame_check_free(&c);
     }
@@ -98,7 +92,7 @@ void lm_cli_bench_scenes(void)
            "time");
     for (int i = 0; i < count; i++) {
         if (access(files[i], R_OK) != 0)
-            printf("%-34s skipped (not found: %s)\n", base_name(files[i]), files[i]);
+            printf("%-34s skipped (not found: %s)\n", lm_cli_base_name(files[i]), files[i]);
         else
             check_one(files[i]);
     }

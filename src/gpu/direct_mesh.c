@@ -387,12 +387,8 @@ void lm_direct_mesh_draw(const lm_direct_mesh *d, unsigned prog)
         int unpaired = d->count[g] - d->paired[g];
         if (unpaired)
             lm_gl_mesh_draw_range(&d->mesh, d->first[g], unpaired);
-        if (d->paired[g]) { /* both sides lie in one plane: only the one facing the eye is drawn */
-            glEnable(GL_CULL_FACE);
-            glCullFace(GL_BACK);
-            lm_gl_mesh_draw_range(&d->mesh, d->first[g] + unpaired, d->paired[g]);
-            glDisable(GL_CULL_FACE);
-        }
+        if (d->paired[g]) /* both sides lie in one plane: only the one facing the eye is drawn */
+            lm_gl_mesh_draw_front_range(&d->mesh, d->first[g] + unpaired, d->paired[g]);
     }
 }
 

@@ -134,6 +134,14 @@ void lm_gl_mesh_destroy(lm_gl_mesh *m)
     m->vao = m->vbo = m->ibo = 0;
 }
 
+void lm_gl_mesh_draw_front_range(const lm_gl_mesh *m, int first, int count)
+{
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_BACK);
+    lm_gl_mesh_draw_range(m, first, count);
+    glDisable(GL_CULL_FACE);
+}
+
 void lm_gl_mesh_draw_scene_sides(const lm_gl_mesh *m, const lm_scene *s)
 {
     for (uint32_t t = 0; t < s->tri_count;) {
@@ -141,12 +149,7 @@ void lm_gl_mesh_draw_scene_sides(const lm_gl_mesh *m, const lm_scene *s)
         uint32_t end = t + 1;
         while (end < s->tri_count && s->materials[s->tri_material[end]].split_sides == split)
             end++;
-        if (split) {
-            glEnable(GL_CULL_FACE);
-            glCullFace(GL_BACK);
-        }
-        lm_gl_mesh_draw_range(m, (int)(3 * t), (int)(3 * (end - t)));
-        glDisable(GL_CULL_FACE);
+        (split ? lm_gl_mesh_draw_front_range : lm_gl_mesh_draw_range)(m, (int)(3 * t), (int)(3 * (end - t)));
         t = end;
     }
 }

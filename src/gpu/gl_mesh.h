@@ -23,6 +23,9 @@ int lm_gl_mesh_create_indexed(lm_gl_mesh *m, const float *data, int vertices, co
 void lm_gl_mesh_draw(const lm_gl_mesh *m);
 /* Draws `count` vertices (indices when indexed) from the `first`-th. */
 void lm_gl_mesh_draw_range(const lm_gl_mesh *m, int first, int count);
+/* The same with back faces culled (counter-clockwise fronts), for the sides of split double-sided
+ * surfaces: the twin in the same plane shows the other side. */
+void lm_gl_mesh_draw_front_range(const lm_gl_mesh *m, int first, int count);
 /* Draws a mesh of unindexed triangles, one per scene triangle in the scene's order, with the back faces
  * of split double-sided sides culled (lm_scene.tri_twin: the twin in the same plane shows that side),
  * the others from both sides. */

@@ -114,7 +114,8 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
 void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el);
 /* With a BVH (NULL: none, the default): the rim of the hemisphere outside the plane is traced
  * (hemicube_rim.h, when rim_samples > 0) instead of extrapolated by 1 / F(a), and a covered texel
- * (lm_texel_covered) is invalid (alpha 1), like a texel that sees back faces. rt is borrowed and must describe the scene the gather draws (the same node matrices). */
+ * (lm_texel_covered) is invalid (alpha 1), like a texel that sees back faces. rt is borrowed and must
+ * describe the scene the gather draws (the same node matrices). */
 void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt);
 /* Whether texel `texel` is covered as the gather with a tracer decides it: straight out from its centre
  * (lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel

@@ -296,6 +296,8 @@ void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el) { g->
 void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt) { g->rt = rt; }
 
 static int traces_rim(const lm_gather *g) { return g->rt && g->set.rim_samples > 0; }
+/* The rim is traced and the AIM's copy it looks up exists (lm_gather_set_aim after the tracer). */
+static int rim_ready(const lm_gather *g) { return traces_rim(g) && g->aim_copy; }
 
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
@@ -400,13 +402,13 @@ typedef struct {
     float surface;
 } texel_view;
 
-static texel_view view_of(const lm_gather *g, const lm_scene *s, const lm_texel *tx)
+static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, const lm_texel *tx)
 {
     lm_vec3 p, n;
     texel_frame(s, tx, &p, &n);
     texel_view v;
-    v.eye = lm_add(p, lm_scale(n, g->set.offset * lm_scene_size(s)));
-    plane_axes(n, g->set.enlargement, v.axes);
+    v.eye = lm_add(p, lm_scale(n, set->offset * lm_scene_size(s)));
+    plane_axes(n, set->enlargement, v.axes);
     v.surface = (float)tx->surface;
     return v;
 }
@@ -425,11 +427,10 @@ static int covered_at(const lm_rt *rt, const lm_atlas *a, const float eye[3], co
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
                      uint32_t texel)
 {
-    lm_vec3 p, n;
-    texel_frame(s, &a->texels[texel], &p, &n);
+    texel_view v = view_of(set, s, &a->texels[texel]);
     float eye[3], dir[3];
-    lm_v3_store(eye, lm_add(p, lm_scale(n, set->offset * lm_scene_size(s))));
-    lm_v3_store(dir, n);
+    lm_v3_store(eye, v.eye);
+    lm_v3_store(dir, v.axes[2]);
     return covered_at(rt, a, eye, dir);
 }
 
@@ -463,7 +464,7 @@ static void clear_target(lm_gather *g, uint32_t count)
 static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
 {
     for (uint32_t i = 0; i < count; i++) {
-        texel_view v = view_of(g, s, &a->texels[texels[i]]);
+        texel_view v = view_of(&g->set, s, &a->texels[texels[i]]);
         float *o = g->views + VIEW_FLOATS * (size_t)i;
         lm_v3_store(o, v.eye);
         o[3] = v.surface;
@@ -566,7 +567,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
             lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], e);
         if (g->rt && covered_at(g->rt, a, o, o + 12))
             e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
-        if (traces_rim(g) && g->aim_copy) {
+        if (rim_ready(g)) {
             float b[3], t[3], r[3];
             for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
                 b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
@@ -587,7 +588,7 @@ static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t
     glUniform1i(glGetUniformLocation(g->reduce_prog, "R"), g->set.resolution);
     glUniform1i(glGetUniformLocation(g->reduce_prog, "tiles_x"), g->set.tiles);
     /* with the rim traced the plane's sum is not extrapolated to the whole hemisphere */
-    double scale = traces_rim(g) && g->aim_copy ? 1.0 : 1.0 / g->coverage;
+    double scale = rim_ready(g) ? 1.0 : 1.0 / g->coverage;
     glUniform1f(glGetUniformLocation(g->reduce_prog, "scale"), (float)(3.14159265358979323846 * scale));
     glUniform1f(glGetUniformLocation(g->reduce_prog, "inv_f"), (float)(1.0 / g->coverage));
     glActiveTexture(GL_TEXTURE0);

@@ -11,7 +11,8 @@
 #include "gl_shader.h"
 
 /* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided (0
- * double-sided, 1 single-sided, 2 one side of a split surface), surface (-1 when none). A view (schemes 1, 2) is 4 vec4: (eye, own surface), b / a, t / a, n. */
+ * double-sided, 1 single-sided, 2 one side of a split surface), surface (-1 when none). A view (schemes
+ * 1, 2) is 4 vec4: (eye, own surface), b / a, t / a, n. */
 static const char *RENDER_VS =
     "layout(location = 0) in vec3 pos;\n"
     "layout(location = 1) in vec2 uv;\n"

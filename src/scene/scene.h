@@ -169,9 +169,15 @@ void lm_scene_free(lm_scene *s);
  * the material single-sided (split_sides): called once by the loader, after the nodes are finished. */
 lm_status lm_scene_split_sides(lm_scene *s, lm_error *err);
 /* A node's triangles as the file has them (its first ones; the rest are their twins). */
-static inline uint32_t lm_node_file_tris(const lm_scene *s, const lm_node *n) { return s->tri_twin ? n->front_tri_count : n->tri_count; }
+static inline uint32_t lm_node_file_tris(const lm_scene *s, const lm_node *n)
+{
+    return s->tri_twin ? n->front_tri_count : n->tri_count;
+}
 /* 1 when triangle t is the twin (the back side) of a file's triangle. */
-static inline int lm_tri_is_back(const lm_scene *s, uint32_t t) { return s->tri_twin && s->tri_twin[t] >= 0 && (uint32_t)s->tri_twin[t] < t; }
+static inline int lm_tri_is_back(const lm_scene *s, uint32_t t)
+{
+    return s->tri_twin && s->tri_twin[t] >= 0 && (uint32_t)s->tri_twin[t] < t;
+}
 
 /* Recomputes every node's world matrix from local transforms (parents before children), O(nodes). */
 void lm_scene_update_world(lm_scene *s);

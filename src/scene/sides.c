@@ -12,7 +12,10 @@
 
 #include "scene.h"
 
-static int may_split(const lm_material *m) { return m->double_sided && m->cls != LM_MAT_MIRROR && m->cls != LM_MAT_GLASS; }
+static int may_split(const lm_material *m)
+{
+    return m->double_sided && m->cls != LM_MAT_MIRROR && m->cls != LM_MAT_GLASS;
+}
 
 static int cmp_u64(const void *a, const void *b)
 {

@@ -129,7 +129,8 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
     out->compared = calloc(n, 1);
     out->surface = calloc((size_t)(out->surface_count ? out->surface_count : 1), sizeof *out->surface);
     lm_status st = out->frame && out->ref && out->surface_at && out->compared && out->surface
-                       ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
+                       ? LM_OK
+                       : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
     lm_view view;
     if (st == LM_OK)
         st = run_frames(sc, loop, frames, out, &view, err);
