@@ -314,6 +314,43 @@ static void test_rim_traced(void **state)
     check_square_rim(40.0f, 1.0f);
 }
 
+/* Shading normals tilted off the geometric one (a floor whose corner normals were averaged with the walls'):
+ * the plane and the rim reach below the floor, where the reference's texel sees nothing (the floor itself
+ * is in the way): under a uniform sky L the texel gets pi L (1 + cos t) / 2 for tilt t, whatever the
+ * floor's own AIM shows (here 10 L, which the plane would otherwise see from above). */
+static void test_tilted_normals(void **state)
+{
+    (void)state;
+    lmt_mesh m;
+    square(&m, 4.0f, 0.0f, 1);
+    tscene t;
+    ts_load(&t, &m, 1, "[{\"mesh\": 0}]", "[{}]", 0.25f);
+    const double tilt = PI / 4;
+    for (uint32_t v = 0; v < t.s->vertex_count; v++) {
+        float *n = t.s->normals + 3 * (size_t)v;
+        n[0] = (float)sin(tilt), n[1] = (float)cos(tilt), n[2] = 0.0f;
+    }
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    float *aim = malloc(3 * sizeof(float) * (size_t)t.a.width * (size_t)t.a.height);
+    assert_non_null(aim);
+    for (size_t i = 0; i < 3 * (size_t)t.a.width * (size_t)t.a.height; i++)
+        aim[i] = 10.0f;
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    set.sky[0] = set.sky[1] = set.sky[2] = 1.0f;
+    uint32_t texel = texel_near(&t, 0, 0.0f, 0.0f);
+    float *rgba = gather_traced(t.s, &t.a, aim, NULL, rt, &set, &texel, 1, NULL);
+    double E = texel_value(&t, rgba, texel)[0], want = PI * (1.0 + cos(tilt)) / 2.0;
+    print_message("tilted 45 degrees: E = %.4f, pi (1 + cos t) / 2 = %.4f\n", E, want);
+    assert_true(fabs(E / want - 1.0) < 0.01);
+    free(rgba);
+    free(aim);
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
 /* A texel with other geometry within a texel's width straight out from it (a floor under a lid 2 mm
  * above it) or inside a closed mesh is covered: invalid with a tracer; one beside them is not. */
 static void test_covered_texels(void **state)
@@ -1033,6 +1070,7 @@ int main(void)
         cmocka_unit_test(test_uniform_sky),
         cmocka_unit_test(test_parallel_square),
         cmocka_unit_test(test_rim_traced),
+        cmocka_unit_test(test_tilted_normals),
         cmocka_unit_test(test_covered_texels),
         cmocka_unit_test(test_box_backfaces),
         cmocka_unit_test(test_deterministic),

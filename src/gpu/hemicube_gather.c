@@ -361,19 +361,24 @@ lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rg
     return st;
 }
 
-/* The texel's centre and normal under the current node matrices (barycentric on its triangle). */
-static void texel_frame(const lm_scene *s, const lm_texel *tx, lm_vec3 *pos, lm_vec3 *n)
+/* The texel's centre, shading normal and geometric normal (its triangle's, turned to the shading
+ * normal's side) under the current node matrices (barycentric on its triangle). */
+static void texel_frame(const lm_scene *s, const lm_texel *tx, lm_vec3 *pos, lm_vec3 *n, lm_vec3 *ng)
 {
-    lm_vec3 p = lm_v3(0, 0, 0), nn = lm_v3(0, 0, 0);
+    lm_vec3 p = lm_v3(0, 0, 0), nn = lm_v3(0, 0, 0), c[3];
     for (int k = 0; k < 3; k++) {
         float v[3], vn[3];
         lm_scene_vertex_world(s, s->tris[3 * (size_t)tx->tri + k], v);
         lm_scene_normal_world(s, s->tris[3 * (size_t)tx->tri + k], vn);
-        p = lm_add(p, lm_scale(lm_v3_load(v), tx->bary[k]));
+        c[k] = lm_v3_load(v);
+        p = lm_add(p, lm_scale(c[k], tx->bary[k]));
         nn = lm_add(nn, lm_scale(lm_v3_load(vn), tx->bary[k]));
     }
     *pos = p;
     *n = lm_length(nn) > 0.0f ? lm_normalize(nn) : lm_normalize(lm_v3_load(tx->normal));
+    lm_vec3 g = lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0]));
+    g = lm_length(g) > 0.0f ? lm_normalize(g) : *n;
+    *ng = lm_dot(g, *n) < 0.0f ? lm_scale(g, -1.0f) : g;
 }
 
 /* The plane's axes scaled to clip space: b / a, t / a (x, y in [-w, w] on the plane) and n (w). */
@@ -399,14 +404,15 @@ static void plane_view_proj(lm_vec3 e, const lm_vec3 axes[3], float near, float 
 
 typedef struct {
     lm_vec3 eye, axes[3];
+    lm_vec3 ng; /* geometric normal: directions below its plane are blocked by the texel's own surface */
     float surface;
 } texel_view;
 
 static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, const lm_texel *tx)
 {
     lm_vec3 p, n;
-    texel_frame(s, tx, &p, &n);
     texel_view v;
+    texel_frame(s, tx, &p, &n, &v.ng);
     v.eye = lm_add(p, lm_scale(n, set->offset * lm_scene_size(s)));
     plane_axes(n, set->enlargement, v.axes);
     v.surface = (float)tx->surface;
@@ -460,7 +466,8 @@ static void clear_target(lm_gather *g, uint32_t count)
 }
 
 /* Every texel's view of a pass into g->views (VIEW_FLOATS each: eye and own surface, then the three
- * axes), which every scheme draws from and the emitter light reads. */
+ * axes, whose fourth components hold the geometric normal), which every scheme draws from and the
+ * emitter light and the rim read. */
 static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
 {
     for (uint32_t i = 0; i < count; i++) {
@@ -470,7 +477,7 @@ static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const
         o[3] = v.surface;
         for (int k = 0; k < 3; k++) {
             lm_v3_store(o + 4 * (k + 1), v.axes[k]);
-            o[4 * (k + 1) + 3] = 0.0f;
+            o[4 * (k + 1) + 3] = k == 0 ? v.ng.x : k == 1 ? v.ng.y : v.ng.z;
         }
     }
 }
@@ -482,6 +489,7 @@ static void draw_viewports(lm_gather *g, const lm_scene *s, uint32_t count)
     GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
     GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
     GLint ax_loc = glGetUniformLocation(g->render_prog, "axis_x"), ay_loc = glGetUniformLocation(g->render_prog, "axis_y");
+    GLint ng_loc = glGetUniformLocation(g->render_prog, "geo_n");
     float near = near_plane(g, s);
     for (uint32_t i = 0; i < count; i++) {
         const float *o = g->views + VIEW_FLOATS * (size_t)i;
@@ -491,6 +499,7 @@ static void draw_viewports(lm_gather *g, const lm_scene *s, uint32_t count)
         glUniformMatrix4fv(vp_loc, 1, GL_FALSE, m);
         glUniform3f(eye_loc, eye.x, eye.y, eye.z);
         glUniform1f(own_loc, o[3]);
+        glUniform3f(ng_loc, o[7], o[11], o[15]);
         for (int k = 0; k < 2; k++) { /* a b and a t: a clip-space step as a world direction per unit w */
             lm_vec3 ax = lm_scale(axes[k], 1.0f / lm_dot(axes[k], axes[k]));
             glUniform3f(k ? ay_loc : ax_loc, ax.x, ax.y, ax.z);
@@ -568,10 +577,10 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
         if (g->rt && covered_at(g->rt, a, o, o + 12))
             e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
         if (rim_ready(g)) {
-            float b[3], t[3], r[3];
+            float b[3], t[3], r[3], ng[3] = {o[7], o[11], o[15]};
             for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
                 b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
-            lm_rim_irradiance(&rim, o, b, t, o + 12, texels[i], r);
+            lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[i], r);
             for (int k = 0; k < 3; k++)
                 e[k] += r[k];
         }

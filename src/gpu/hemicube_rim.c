@@ -60,12 +60,14 @@ static lm_vec3 rim_dir(const lm_rim *r, lm_vec3 B, lm_vec3 T, lm_vec3 N, double 
  * with that plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel
  * averages its footprint: a small bright spot is then shared among the strata it overlaps instead of
  * being all or nothing for one. Returns the weighted radiance sum (times SUB^2). */
-static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, lm_vec3 N, double phi0, double dphi,
-                    double u0, double du, double sum[3])
+static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, lm_vec3 N, lm_vec3 G, double phi0,
+                    double dphi, double u0, double du, double sum[3])
 {
     double w;
     float dir[3];
     lm_v3_store(dir, rim_dir(r, B, T, N, phi0 + 0.5 * dphi, u0 + 0.5 * du, &w));
+    if (lm_dot(lm_v3_load(dir), G) <= 0.0f)
+        return; /* into the texel's own surface */
     lm_rt_hit h;
     if (!lm_rt_intersect(r->rt, eye, dir, 0.0f, INFINITY, &h)) {
         for (int c = 0; c < 3; c++)
@@ -94,6 +96,8 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
             for (int j = 0; j < SUB; j++) {
                 double ws;
                 lm_vec3 ds = rim_dir(r, B, T, N, phi0 + (i + 0.5) / SUB * dphi, u0 + (j + 0.5) / SUB * du, &ws);
+                if (lm_dot(ds, G) <= 0.0f)
+                    continue;
                 double den = lm_dot(ng, ds), ts = num / den;
                 float su = u, sv = v, L[3];
                 /* meets the plane on the same side, not much further or nearer than the ray's own hit (at
@@ -115,16 +119,16 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
 }
 
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
-                       uint32_t seed, float out[3])
+                       const float ng[3], uint32_t seed, float out[3])
 {
     int side = (int)sqrtf((float)r->samples);
     double shift[2], sum[3] = {0.0, 0.0, 0.0};
     lm_seed_shift(seed, shift); /* shift[1] unused: the footprints already cover each stratum */
-    lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n);
+    lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
     double d = 1.0 / side;
     for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
         for (int j = 0; j < side; j++)
-            stratum(r, eye, B, T, N, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum);
+            stratum(r, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum);
     int K = side * side;
     for (int c = 0; c < 3; c++)
         out[c] = K ? (float)(RIM_PI * sum[c] / ((double)K * SUB * SUB)) : 0.0f;

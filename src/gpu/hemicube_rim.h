@@ -42,8 +42,10 @@ typedef struct {
 } lm_rim;
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y
- * axes) and n. */
+ * axes) and n. Directions below the plane of ng, the texel's geometric normal, are blocked by its own
+ * surface and bring nothing (the rim of a shading normal tilted off the geometric one dips below it). */
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
+                       const float ng[3],
                        uint32_t seed, float out[3]);
 
 /* The lightmap uv's gradient over a triangle's plane (world corners p, uv per corner; NULL: none, zero

@@ -12,7 +12,8 @@
 
 /* Vertex: world position, lightmap UV (-1 when none), emitted radiance, face normal, single-sided (0
  * double-sided, 1 single-sided, 2 one side of a split surface), surface (-1 when none). A view (schemes
- * 1, 2) is 4 vec4: (eye, own surface), b / a, t / a, n. */
+ * 1, 2) is 4 vec4: (eye, own surface), b / a, t / a, n; the w of the last three is the texel's
+ * geometric normal. */
 static const char *RENDER_VS =
     "layout(location = 0) in vec3 pos;\n"
     "layout(location = 1) in vec2 uv;\n"
@@ -25,9 +26,9 @@ static const char *RENDER_VS =
     "layout(location = 8) in vec4 rect;\n"
     "out vec3 v_pos; out vec2 v_uv;\n"
     "flat out vec3 v_emit; flat out vec3 v_n; flat out float v_one; flat out vec3 v_eye;\n"
-    "flat out vec3 v_gu, v_gv, v_ax, v_ay; flat out vec4 v_rect;\n"
+    "flat out vec3 v_gu, v_gv, v_ax, v_ay; flat out vec4 v_rect; flat out vec3 v_ng;\n"
     "#if SCHEME == 0\n"
-    "uniform mat4 view_proj; uniform vec3 eye; uniform float own_surface; uniform vec3 axis_x, axis_y;\n"
+    "uniform mat4 view_proj; uniform vec3 eye; uniform float own_surface; uniform vec3 axis_x, axis_y, geo_n;\n"
     "#else\n"
     "layout(std430, binding = 2) readonly buffer Views { vec4 views[]; };\n"
     "uniform int tiles; uniform float near;\n"
@@ -40,7 +41,7 @@ static const char *RENDER_VS =
     "    v_gu = grad_u; v_gv = grad_v; v_rect = rect;\n"
     "    float own;\n"
     "#if SCHEME == 0\n"
-    "    v_eye = eye; own = own_surface; v_ax = axis_x; v_ay = axis_y;\n"
+    "    v_eye = eye; own = own_surface; v_ax = axis_x; v_ay = axis_y; v_ng = geo_n;\n"
     "    gl_Position = view_proj * vec4(pos, 1.0);\n"
     "#else\n"
     "    int i = gl_InstanceID;\n"
@@ -48,6 +49,7 @@ static const char *RENDER_VS =
     "    vec3 q = pos - e.xyz;\n"
     "    vec4 c = vec4(dot(views[4 * i + 1].xyz, q), dot(views[4 * i + 2].xyz, q), near, dot(views[4 * i + 3].xyz, q));\n"
     "    v_eye = e.xyz; own = e.w;\n"
+    "    v_ng = vec3(views[4 * i + 1].w, views[4 * i + 2].w, views[4 * i + 3].w);\n"
     "    vec3 B = views[4 * i + 1].xyz, T = views[4 * i + 2].xyz;\n"
     "    v_ax = B / dot(B, B); v_ay = T / dot(T, T);\n"
     "#if SCHEME == 1\n"
@@ -67,7 +69,10 @@ static const char *RENDER_VS =
     "    if ((surface >= 0.0 && surface == own || one_sided > 1.5) && dot(face_n, pos - v_eye) > 0.0)\n"
     "        gl_Position = vec4(2.0, 2.0, 2.0, 1.0);\n"
     "}\n";
-/* rgb: what the plane sees; a: 1 on the back of a single-sided surface (counted, shown black). The back
+/* rgb: what the plane sees; a: 1 on the back of a single-sided surface (counted, shown black). Below the
+ * plane of the texel's own triangle nothing is seen (black, not counted): where the shading normal
+ * tilts away from the geometric one (smoothed corners), the plane reaches below the surface and would
+ * otherwise see the texel's own surface from above, which light from there cannot reach. The back
  * of the texel's own surface is dropped in the vertex shader (a surface stays within a 30 degree cone, so
  * only a simplified (proxy) copy of it can pass above the texel); no discard here keeps the depth test
  * early.
@@ -80,7 +85,7 @@ static const char *RENDER_VS =
 static const char *RENDER_FS =
     "in vec3 v_pos; in vec2 v_uv;\n"
     "flat in vec3 v_emit; flat in vec3 v_n; flat in float v_one; flat in vec3 v_eye;\n"
-    "flat in vec3 v_gu, v_gv, v_ax, v_ay; flat in vec4 v_rect;\n"
+    "flat in vec3 v_gu, v_gv, v_ax, v_ay; flat in vec4 v_rect; flat in vec3 v_ng;\n"
     "uniform sampler2D aim;\n"
     "uniform float pixel;   /* a pixel's side in clip units, 2 / R */\n"
     "out vec4 frag;\n"
@@ -102,6 +107,7 @@ static const char *RENDER_FS =
     "    return 0.25 * L;\n"
     "}\n"
     "void main() {\n"
+    "    if (dot(v_ng, v_pos - v_eye) < 0.0) { frag = vec4(0.0); return; }\n"
     "    if (v_one > 0.5 && dot(v_n, v_pos - v_eye) > 0.0) { frag = vec4(0.0, 0.0, 0.0, 1.0); return; }\n"
     "#if SAMPLES == 4\n"
     "    vec3 L = v_uv.x < 0.0 ? vec3(0.0) : aim_radiance();\n"
