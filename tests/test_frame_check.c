@@ -27,7 +27,8 @@
 
 #define SIZE 96           /* frame side: about 100 to 1,800 compared pixels per surface */
 #define REF_ERROR 0.03f   /* the reference's target relative standard error per pixel */
-#define SURFACE_TOL 0.03  /* per surface: |frame - reference| <= SURFACE_TOL x max(reference, frame mean) */
+#define SURFACE_TOL 0.03  /* per surface: |frame - reference| <= tol x max(reference, frame mean), tol this
+                           * unless a scene says otherwise */
 #define MIN_PIXELS 100    /* surfaces with fewer compared pixels are reported, not asserted */
 
 /* A scene loaded as `lmgi run` loads it: the lightmap density its default texel budget keeps up with. */
@@ -57,6 +58,7 @@ static double lum(const double c[3]) { return c[0] + c[1] + c[2]; }
  * for surfaces darker than that: a dim face's few percent are a sliver of the picture), the frame within
  * `frame_tol` per channel, the relative RMSE under `rmse_bound`. */
 static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_check *c, double frame_tol,
+                         double surface_tol,
                          double rmse_bound)
 {
     double mean = lum(c->lit.ref) / (c->lit.pixels ? c->lit.pixels : 1);
@@ -74,7 +76,7 @@ static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_
                       sc->scene->materials[sc->surfaces.surfaces[s].material].name, sum->pixels, f, r,
                       r > 0.0 ? 100.0 * (f / r - 1.0) : 0.0, asserted ? "" : " (few pixels: not asserted)");
         if (asserted)
-            assert_true(fabs(f - r) <= SURFACE_TOL * fmax(r, mean));
+            assert_true(fabs(f - r) <= surface_tol * fmax(r, mean));
     }
     for (int k = 0; k < 3; k++)
         if (c->lit.ref[k] > 0.05 * fmax(c->lit.ref[0], fmax(c->lit.ref[1], c->lit.ref[2])))
@@ -82,7 +84,7 @@ static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_
     assert_true(c->rel_rmse < rmse_bound);
 }
 
-static void check_scene(const char *name, const char *path, double rmse_bound)
+static void check_scene_tol(const char *name, const char *path, double surface_tol, double rmse_bound)
 {
     lmgi_scene *sc = load_as_run(path, 0);
     lm_frame_loop_settings ls;
@@ -94,9 +96,14 @@ static void check_scene(const char *name, const char *path, double rmse_bound)
     lm_error err;
     if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
         fail_msg("%s: %s", name, err.msg);
-    assert_frame(name, sc, &c, 0.03, rmse_bound);
+    assert_frame(name, sc, &c, 0.03, surface_tol, rmse_bound);
     lm_frame_check_free(&c);
     lmgi_free(sc);
+}
+
+static void check_scene(const char *name, const char *path, double rmse_bound)
+{
+    check_scene_tol(name, path, SURFACE_TOL, rmse_bound);
 }
 
 /* Measured at 96 x 96 (frame / reference; relative RMSE, of which the reference's own noise is ~0.03):
@@ -124,6 +131,30 @@ static void test_two_rooms(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
     check_scene("two rooms", path, 0.05);
+}
+
+/* The depth-of-field scene's circuit board is a glossy metal (metallic 0.89, roughness 0.15): its lightmap
+ * carries only the diffuse lobe, kd / pi x E (docs/materials.md). With the whole albedo there, as before,
+ * the frame read 1.31 1.29 1.06 and the board 1.26 1.19 1.14 (the board seen by the hemicube as a
+ * diffuse reflector also lit the cubes' shadowed faces 4-7x). Measured at 128 x 128: frame 0.981 0.977
+ * 0.994, board 0.946 0.965 0.972: the missing 3-5% is the board's glossy reflection of its surroundings
+ * (lava spheres, lit cubes), which needs the reflection pass (issue 12); hence 6% per surface here. */
+static void test_depth_of_field(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_shared_scene("depth-of-field/DepthOfFieldExample.glb"));
+    check_scene_tol("depth of field", path, 0.06, 0.1);
+}
+
+/* cornell-suzanne: a loose box with averaged corner normals (the gather no longer sees below a texel's
+ * own plane: floor 1.071 -> 0.989) and a glossy Suzanne too small at this size to be asserted. Measured
+ * at 128 x 128: frame 0.992 0.991 0.986, relative RMSE 0.072; at 96 x 96 the ceiling reads -3.4% (its
+ * AIM around the lamp is dark), so 5% per surface here, the bound every scene is held to (issue 17). */
+static void test_cornell_suzanne(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf"));
+    check_scene_tol("cornell-suzanne", path, 0.05, 0.1);
 }
 
 /* The displayed IIM (what `lmgi run` exports as iim.exr, before invalid texels are filled) against the
@@ -218,6 +249,8 @@ int main(void)
         cmocka_unit_test(test_shared_cornell_box),
         cmocka_unit_test(test_generated_cornell_box),
         cmocka_unit_test(test_two_rooms),
+        cmocka_unit_test(test_depth_of_field),
+        cmocka_unit_test(test_cornell_suzanne),
         cmocka_unit_test(test_iim_run_density),
         cmocka_unit_test(test_iim_bake_density),
     };

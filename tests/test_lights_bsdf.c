@@ -551,6 +551,34 @@ static void test_glossy_energy_and_consistency(void **state)
     assert_float_equal(w, ref, 0.03 * ref);
 }
 
+/* What a lightmap turns irradiance into (kd / pi x E, docs/materials.md): the diffuse lobe of the BSDF the
+ * photons and the reference use. Away from a sharp glossy lobe f = kd / pi exactly; kd and ks follow the
+ * metallic mix; a diffuse surface's kd is its albedo, a mirror's nothing. */
+static void test_lobes_diffuse_part(void **state)
+{
+    (void)state;
+    lm_shading sh;
+    shading_up(&sh, LM_MAT_GLOSSY, 0.5f);
+    sh.albedo[1] = 0.6f, sh.albedo[2] = 0.7f;
+    g_mat.metallic = 0.89f, g_mat.roughness = 0.15f;
+    float kd[3], ks[3];
+    lm_material_lobes(&g_mat, sh.albedo, kd, ks);
+    for (int c = 0; c < 3; c++) {
+        assert_float_equal(ks[c], 0.04f * 0.11f + 0.89f * sh.albedo[c], 1e-6);
+        assert_float_equal(kd[c], sh.albedo[c] * 0.11f * (1.0f - ks[2]), 1e-6);
+    }
+    float wi[3] = {0.6f, -0.8f, 0.0f}, wo[3] = {0.0f, 0.6f, 0.8f}, f[3]; /* 64 degrees off the mirror */
+    lm_bsdf_eval(&sh, wi, wo, f);
+    for (int c = 0; c < 3; c++)
+        assert_float_equal(f[c] / 0.6f, kd[c] / PI, 1e-6);
+    g_mat.cls = LM_MAT_DIFFUSE;
+    lm_material_lobes(&g_mat, sh.albedo, kd, ks);
+    assert_true(kd[0] == 0.5f && kd[1] == 0.6f && kd[2] == 0.7f && ks[0] == 0.0f && ks[2] == 0.0f);
+    g_mat.cls = LM_MAT_MIRROR;
+    lm_material_lobes(&g_mat, sh.albedo, kd, ks);
+    assert_true(kd[0] == 0.0f && ks[0] == 0.0f);
+}
+
 static void test_mirror_reflects_exactly(void **state)
 {
     (void)state;
@@ -640,6 +668,7 @@ int main(void)
         cmocka_unit_test(test_diffuse_energy_and_cosine),
         cmocka_unit_test(test_single_sided_back_absorbs),
         cmocka_unit_test(test_glossy_energy_and_consistency),
+        cmocka_unit_test(test_lobes_diffuse_part),
         cmocka_unit_test(test_mirror_reflects_exactly),
         cmocka_unit_test(test_glass_fresnel_and_tir),
         cmocka_unit_test(test_phong_exponent),

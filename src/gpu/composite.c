@@ -47,12 +47,13 @@ static void fill_albedo(const lm_scene *s, const lm_atlas *a, float *out)
         const uint32_t *v = s->tris + 3 * (size_t)t->tri;
         const lm_material *m = &s->materials[s->tri_material[t->tri]];
         const float *uvs = m->base_color_uv == 1 && s->uv1 ? s->uv1 : s->uv0;
-        float uv[2] = {0.0f, 0.0f}, al[3];
+        float uv[2] = {0.0f, 0.0f}, albedo[3], al[3], ks[3];
         for (int k = 0; k < 3; k++) {
             uv[0] += t->bary[k] * uvs[2 * (size_t)v[k]];
             uv[1] += t->bary[k] * uvs[2 * (size_t)v[k] + 1];
         }
-        lm_material_albedo(s, m, uv[0], uv[1], al);
+        lm_material_albedo(s, m, uv[0], uv[1], albedo);
+        lm_material_lobes(m, albedo, al, ks);
         float *o = out + 4 * ((size_t)t->y * a->width + t->x);
         for (int c = 0; c < 3; c++)
             o[c] = al[c] / (float)M_PI;

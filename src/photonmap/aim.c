@@ -550,7 +550,9 @@ static void texel_albedo(const lm_scene *s, const lm_texel *t, float rho[3])
         u += t->bary[k] * uv[2 * (size_t)vi];
         v += t->bary[k] * uv[2 * (size_t)vi + 1];
     }
-    lm_material_albedo(s, m, u, v, rho);
+    float albedo[3], ks[3];
+    lm_material_albedo(s, m, u, v, albedo);
+    lm_material_lobes(m, albedo, rho, ks);
 }
 
 /* One thread's working memory for the estimates. */

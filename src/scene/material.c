@@ -77,6 +77,28 @@ static void sample_bilinear(const lm_texture *t, float u, float v, float out[3])
     }
 }
 
+#define LM_DIELECTRIC_F0 0.04f /* reflectance of a dielectric at normal incidence (index 1.5) */
+
+void lm_material_lobes(const lm_material *m, const float albedo[3], float kd[3], float ks[3])
+{
+    for (int c = 0; c < 3; c++)
+        kd[c] = ks[c] = 0.0f;
+    if (m->cls == LM_MAT_DIFFUSE || m->cls == LM_MAT_EMITTER) {
+        for (int c = 0; c < 3; c++)
+            kd[c] = albedo[c];
+        return;
+    }
+    if (m->cls != LM_MAT_GLOSSY)
+        return;
+    float metal = m->metallic < 0.0f ? 0.0f : m->metallic > 1.0f ? 1.0f : m->metallic, ksmax = 0.0f;
+    for (int c = 0; c < 3; c++) {
+        ks[c] = LM_DIELECTRIC_F0 * (1.0f - metal) + albedo[c] * metal;
+        ksmax = fmaxf(ksmax, ks[c]);
+    }
+    for (int c = 0; c < 3; c++)
+        kd[c] = albedo[c] * (1.0f - metal) * (1.0f - ksmax);
+}
+
 void lm_material_albedo(const lm_scene *s, const lm_material *m, float u, float v, float out[3])
 {
     for (int c = 0; c < 3; c++)

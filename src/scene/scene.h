@@ -205,6 +205,11 @@ lm_material_class lm_material_classify(lm_material *m);
 const char *lm_material_class_name(lm_material_class c);
 /* Albedo at texture coordinate (u, v) of the base colour texture (with its transform), times the factor. */
 void lm_material_albedo(const lm_scene *s, const lm_material *m, float u, float v, float out[3]);
+/* The two lobes of m's class for a given albedo (docs/materials.md, bsdf.c): kd the diffuse
+ * reflectance (the whole albedo for diffuse and emitters; albedo (1 - metallic)(1 - max ks) for glossy;
+ * 0 for mirror and glass) and ks the glossy lobe's (mix(0.04, albedo, metallic) for glossy, else 0).
+ * kd is what a lightmap's irradiance turns into view-independent radiance, kd / pi x E. */
+void lm_material_lobes(const lm_material *m, const float albedo[3], float kd[3], float ks[3]);
 
 const char *lm_light_type_name(lm_light_type t);
 

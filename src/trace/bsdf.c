@@ -24,7 +24,6 @@
 #include "../core/vecmath.h"
 
 #define LM_PI 3.14159265358979323846f
-#define LM_DIELECTRIC_F0 0.04f /* reflectance of a dielectric at normal incidence (index 1.5) */
 
 static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
@@ -91,13 +90,7 @@ typedef struct {
 
 static void glossy(const lm_shading *sh, glossy_params *g)
 {
-    float m = clampf(sh->material->metallic, 0.0f, 1.0f), ksmax = 0.0f;
-    for (int c = 0; c < 3; c++) {
-        g->ks[c] = LM_DIELECTRIC_F0 * (1.0f - m) + sh->albedo[c] * m;
-        ksmax = fmaxf(ksmax, g->ks[c]);
-    }
-    for (int c = 0; c < 3; c++)
-        g->kd[c] = sh->albedo[c] * (1.0f - m) * (1.0f - ksmax);
+    lm_material_lobes(sh->material, sh->albedo, g->kd, g->ks);
     g->n = lm_phong_exponent(sh->material->roughness);
     float ls = lum(g->ks), ld = lum(g->kd);
     g->p_spec = ls + ld > 0.0f ? ls / (ls + ld) : 0.5f;
