@@ -102,5 +102,8 @@ float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su, int 
 lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o,
                          lm_atlas *out, lm_error *err);
 void lm_atlas_free(lm_atlas *a);
+/* The diffuse lobe kd (lm_material_lobes) of the texel's material at its point: base colour x texture at
+ * the uv its barycentrics give on its triangle. What a lightmap's irradiance is turned into radiance with. */
+void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3]);
 
 #endif

@@ -258,3 +258,17 @@ done:
     free(nrm);
     return st;
 }
+
+void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3])
+{
+    const lm_material *m = &s->materials[s->tri_material[t->tri]];
+    const float *uvs = m->base_color_uv == 1 && s->uv1 ? s->uv1 : s->uv0;
+    float uv[2] = {0.0f, 0.0f}, albedo[3], ks[3];
+    for (int k = 0; k < 3; k++) {
+        uint32_t v = s->tris[3 * (size_t)t->tri + (size_t)k];
+        uv[0] += t->bary[k] * uvs[2 * (size_t)v];
+        uv[1] += t->bary[k] * uvs[2 * (size_t)v + 1];
+    }
+    lm_material_albedo(s, m, uv[0], uv[1], albedo);
+    lm_material_lobes(m, albedo, kd, ks);
+}

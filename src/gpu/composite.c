@@ -39,24 +39,16 @@ static const char *PREMULT_FS =
     "    float w = al.a * (e.a <= limit ? 1.0 : 0.0);\n"
     "    frag = vec4(al.rgb * e.rgb * w, w);\n"
     "}\n";
-/* albedo / pi at each covered texel's centre (its triangle's material, texture at the interpolated UV). */
+/* kd / pi at each covered texel's centre (its triangle's material, texture at the interpolated UV). */
 static void fill_albedo(const lm_scene *s, const lm_atlas *a, float *out)
 {
     for (uint32_t i = 0; i < a->texel_count; i++) {
         const lm_texel *t = &a->texels[i];
-        const uint32_t *v = s->tris + 3 * (size_t)t->tri;
-        const lm_material *m = &s->materials[s->tri_material[t->tri]];
-        const float *uvs = m->base_color_uv == 1 && s->uv1 ? s->uv1 : s->uv0;
-        float uv[2] = {0.0f, 0.0f}, albedo[3], al[3], ks[3];
-        for (int k = 0; k < 3; k++) {
-            uv[0] += t->bary[k] * uvs[2 * (size_t)v[k]];
-            uv[1] += t->bary[k] * uvs[2 * (size_t)v[k] + 1];
-        }
-        lm_material_albedo(s, m, uv[0], uv[1], albedo);
-        lm_material_lobes(m, albedo, al, ks);
+        float kd[3];
+        lm_texel_kd(s, t, kd);
         float *o = out + 4 * ((size_t)t->y * a->width + t->x);
         for (int c = 0; c < 3; c++)
-            o[c] = al[c] / (float)M_PI;
+            o[c] = kd[c] / (float)M_PI;
         o[3] = 1.0f;
     }
 }

@@ -540,21 +540,6 @@ static void add_found(flux_sum *f, const uint32_t *idx, const float *d2, uint32_
         f->sum[c] += (p0[c] + p1[c]) + (p2[c] + p3[c]);
 }
 
-static void texel_albedo(const lm_scene *s, const lm_texel *t, float rho[3])
-{
-    const lm_material *m = &s->materials[s->tri_material[t->tri]];
-    const float *uv = (m->base_color_uv == 1 && s->uv1) ? s->uv1 : s->uv0;
-    float u = 0.0f, v = 0.0f;
-    for (int k = 0; k < 3; k++) {
-        uint32_t vi = s->tris[3 * (size_t)t->tri + (size_t)k];
-        u += t->bary[k] * uv[2 * (size_t)vi];
-        v += t->bary[k] * uv[2 * (size_t)vi + 1];
-    }
-    float albedo[3], ks[3];
-    lm_material_albedo(s, m, u, v, albedo);
-    lm_material_lobes(m, albedo, rho, ks);
-}
-
 /* One thread's working memory for the estimates. */
 typedef struct texel_scratch texel_scratch;
 
@@ -621,7 +606,7 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, texel_scrat
         *edge_d2 = (float)nearest;
     }
     float rho[3];
-    texel_albedo(j->s, t, rho);
+    lm_texel_kd(j->s, t, rho);
     for (int c = 0; c < 3; c++)
         out[c] = (float)(rho[c] / PI_D * f.sum[c] / (area * factor));
 }
