@@ -32,6 +32,7 @@ static void test_generated_cornell(void **state)
     assert_true(e.on[LM_EFFECT_CAUSTICS]);
     assert_string_equal(e.reason[LM_EFFECT_CAUSTICS], "1 mirror material on node 'mirror_sphere'");
     assert_true(e.on[LM_EFFECT_REFLECTIONS]);
+    assert_string_equal(e.reason[LM_EFFECT_REFLECTIONS], "1 mirror material on node 'mirror_sphere'");
     assert_true(e.on[LM_EFFECT_PHOTON_UPDATES]);
     assert_non_null(strstr(e.reason[LM_EFFECT_PHOTON_UPDATES], "2 dynamic nodes"));
     lm_scene_free(s);
@@ -53,6 +54,20 @@ static void test_shared_cornell_box(void **state)
     assert_string_equal(e.reason[LM_EFFECT_CAUSTICS], "no specular material");
     assert_false(e.on[LM_EFFECT_REFLECTIONS]);
     assert_false(e.on[LM_EFFECT_PHOTON_UPDATES]);
+    lm_scene_free(s);
+}
+
+/* A glossy metal reflects (gpu/reflections.h) but focuses no caustic. */
+static void test_glossy_reflects(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_shared_scene("depth-of-field/DepthOfFieldExample.glb"));
+    lm_scene *s = load(path);
+    lm_effects e;
+    lm_effects_decide(s, &e);
+    assert_false(e.on[LM_EFFECT_CAUSTICS]);
+    assert_true(e.on[LM_EFFECT_REFLECTIONS]);
+    assert_string_equal(e.reason[LM_EFFECT_REFLECTIONS], "1 glossy material on node 'CircuitBoard'");
     lm_scene_free(s);
 }
 
@@ -100,6 +115,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_generated_cornell),
         cmocka_unit_test(test_shared_cornell_box),
+        cmocka_unit_test(test_glossy_reflects),
         cmocka_unit_test(test_switches_turn_effects_off),
         cmocka_unit_test(test_static_scene_traces_once),
     };

@@ -331,6 +331,8 @@ static void test_bad_args(void **state)
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --emitter-light bogus"), 2);
     assert_non_null(strstr(output, "closed or drawn"));
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --emitter-rays 0"), 2);
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --reflection-size -1"), 2);
+    assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --reflection-faces 0"), 2);
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --texels 4"), 2);
     assert_non_null(strstr(output, "--texels"));
 }
@@ -381,6 +383,54 @@ static void test_furnace_composite(void **state)
     }
 }
 
+/* Reflections (gpu/reflections.h): a cube at the centre of a closed room whose walls emit Le = 1 and
+ * reflect nothing, seen face on from inside; every pixel is the cube's front face reflecting the wall
+ * behind the camera. A mirror of albedo 0.8 shows 0.8 Le; a glossy metal (albedo 0.8, roughness 0.3:
+ * Phong n = 245, ks = 0.8, kd = 0) shows ks (n + 2) / (n + 1) (n.v) Le, 0.803 at the centre; with
+ * --reflection-size 0 the mirror is black. */
+static void check_reflection(const char *material, const char *opts, double want)
+{
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_cube_inward(&m[0], 10.0f);
+    lmt_mesh_cube(&m[1], 1.0f);
+    char materials[1024];
+    snprintf(materials, sizeof materials,
+             "[{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 1, 1]}, %s],"
+             " \"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.5, \"znear\": 0.01,"
+             " \"aspectRatio\": 1}}]",
+             material);
+    const char *path = lmt_write_scene("mirror.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"camera\": 0, "
+                                       "\"translation\": [0, 0, 4]}]", materials);
+    char args[4096], dir[1100];
+    snprintf(dir, sizeof dir, "%s/mirror_out", lmt_tmpdir());
+    snprintf(args, sizeof args, "run %s --frames 1 --size 32x32 --photons 20000 -q %s --out %s", path, opts, dir);
+    if (lmgi(args) != 0)
+        fail_msg("lmgi run failed: %s", output);
+    int w, h;
+    float *px = read_exr(dir, "frame_0000.exr", &w, &h);
+    double centre = px[4 * ((h / 2) * w + w / 2) + 1], worst = 0.0;
+    for (int i = 0; i < w * h; i++)
+        worst = fmax(worst, px[4 * i + 1]);
+    print_message("reflection (%s): centre %.4f (want %.4f), brightest %.4f\n", opts, centre, want, worst);
+    assert_true(fabs(centre - want) <= 0.02 * fmax(want, 0.05));
+    assert_true(worst <= fmax(want, 0.0) * 1.02 + 1e-6);
+    free(px);
+}
+
+static void test_reflections(void **state)
+{
+    (void)state;
+    const char *mirror = "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, 1], \"metallicFactor\": 1,"
+                         " \"roughnessFactor\": 0}}";
+    const char *glossy = "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, 1], \"metallicFactor\": 1,"
+                         " \"roughnessFactor\": 0.3}}";
+    check_reflection(mirror, "", 0.8);
+    double n = 2.0 / (0.3 * 0.3 * 0.3 * 0.3) - 2.0;
+    check_reflection(glossy, "", 0.8 * (n + 2.0) / (n + 1.0));
+    check_reflection(mirror, "--reflection-size 0", 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -392,6 +442,7 @@ int main(void)
         cmocka_unit_test(test_atlas_follows_budget),
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_furnace_composite),
+        cmocka_unit_test(test_reflections),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

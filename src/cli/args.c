@@ -113,6 +113,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
     a->gather_scheme = -1;
     a->emitter_light = -1;
     a->rim_samples = -1;
+    a->reflection_size = -1;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
         const char *o = argv[i], *v = value_after(argc, argv, i);
@@ -174,6 +175,10 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_int(o, v, 1, 16, &a->hemicube_coverage);
         else if (!strcmp(o, "--rim-samples"))
             rc = parse_int(o, v, 0, 65536, &a->rim_samples);
+        else if (!strcmp(o, "--reflection-size"))
+            rc = parse_int(o, v, 0, 4096, &a->reflection_size);
+        else if (!strcmp(o, "--reflection-faces"))
+            rc = parse_int(o, v, 1, 1 << 20, &a->reflection_faces);
         else if (!strcmp(o, "--enlargement"))
             rc = parse_float(o, v, 1e-3f, &a->enlargement);
         else if (!strcmp(o, "--gather-scheme"))

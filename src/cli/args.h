@@ -39,6 +39,8 @@ typedef struct {
     int hemicube_samples;   /* --hemicube-samples N: AIM lookups per hemicube pixel (1 or 4) */
     int hemicube_coverage;  /* --hemicube-coverage N: MSAA coverage samples per hemicube pixel (1 to 16) */
     int rim_samples;        /* --rim-samples K: directions for the rim outside the plane (0: 1 / F(a)); -1 unset */
+    int reflection_size;    /* --reflection-size N: environment map side (0: no reflections); -1 unset */
+    int reflection_faces;   /* --reflection-faces N: environment map faces re-rendered a frame; 0 unset */
     float enlargement;      /* --enlargement a: hemicube plane half-side at distance 1 */
     int gather_scheme;      /* --gather-scheme viewports|instanced|layered (-1 = default) */
     int emitter_light;      /* --emitter-light closed|drawn: 1, 0 (-1 = per scene) */

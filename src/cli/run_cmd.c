@@ -53,6 +53,10 @@ void lm_cli_run_settings(const lm_cli_args *a, lm_frame_loop_settings *s)
         s->gather.enlargement = a->enlargement;
     if (a->rim_samples >= 0)
         s->gather.rim_samples = a->rim_samples;
+    if (a->reflection_size >= 0)
+        s->reflection_size = a->reflection_size;
+    if (a->reflection_faces > 0)
+        s->reflection_faces = a->reflection_faces;
     if (a->gather_scheme >= 0)
         s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
     s->emitter_light = a->emitter_light;

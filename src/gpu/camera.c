@@ -54,6 +54,18 @@ static void automatic(const lm_scene *s, float aspect, lm_view *out)
     snprintf(out->name, sizeof out->name, "automatic");
 }
 
+void lm_view_cube_face(const float eye[3], int face, float znear, float zfar, lm_view *out)
+{
+    static const float fwd[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+    static const float up[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
+    memset(out, 0, sizeof *out);
+    lm_vec3 e = lm_v3_load(eye);
+    lm_mat4_look_at(out->view, e, lm_add(e, lm_v3_load(fwd[face])), lm_v3_load(up[face]));
+    lm_mat4_perspective(out->proj, 0.5f * 3.14159265358979f, 1.0f, znear, zfar);
+    lm_v3_store(out->eye, e);
+    snprintf(out->name, sizeof out->name, "cube face %d", face);
+}
+
 void lm_view_for_scene(const lm_scene *s, int camera, int width, int height, lm_view *out)
 {
     memset(out, 0, sizeof *out);

@@ -16,6 +16,11 @@ typedef struct {
 /* camera: index into s->cameras, or -1 for the first one if any, else automatic. */
 void lm_view_for_scene(const lm_scene *s, int camera, int width, int height, lm_view *out);
 
+/* Face f (0..5: +X, -X, +Y, -Y, +Z, -Z) of a cube map at eye: a 90-degree square view whose framebuffer
+ * pixel (x, y) is the face's texel (s, t) as GL samples a cube map (right and up of each face as the GL
+ * specification's major-axis table has them: +X looks with up -Y, right -Z, and so on). */
+void lm_view_cube_face(const float eye[3], int face, float znear, float zfar, lm_view *out);
+
 /* The reference solver's camera for the same picture (right, up and -forward are the view matrix's rows),
  * so that its pixels are the frame's. Fails for an orthographic view, which the solver does not take. */
 lm_status lm_view_ref_camera(const lm_view *v, int width, int height, lm_ref_camera *cam, lm_error *err);

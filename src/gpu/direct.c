@@ -49,6 +49,9 @@ struct lm_direct {
     lm_direct_mesh mesh;
     lm_shadow_renderer shadow;
     lm_float_target target;
+    lm_float_target probe;  /* environment map faces (lm_direct_draw_probe), apart from the frame's */
+    const lm_float_target *cur; /* the target of the draw in progress */
+    int drop[2];            /* vertices the draw in progress leaves out (lm_direct_draw_probe's node) */
     cached_map *maps;       /* per emitter index */
     int map_count;
     unsigned long static_version;  /* bumped whenever a static shadow-casting node moves (an edit) */
@@ -118,6 +121,15 @@ static void set_view_uniforms(const lm_direct *d, const uniforms *u, const lm_vi
     glUniform1i(u->base_tex, 2);
 }
 
+/* The vertex ranges of direct_shader.c for prog: keep (0, 0: all), drop. */
+static void set_ranges(GLuint prog, const int keep[2], const int drop[2])
+{
+    glUniform2i(glGetUniformLocation(prog, "keep"), keep[0], keep[1]);
+    glUniform2i(glGetUniformLocation(prog, "drop"), drop[0], drop[1]);
+}
+
+static const int ALL[2] = {0, 0};
+
 /* The indirect term's texture on unit 3 for a first-pass program (lit, use_lit: its uniforms). */
 static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit)
 {
@@ -146,6 +158,7 @@ static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters 
         float vp[16];
         lm_mat4_mul(vp, view->proj, view->view);
         glUseProgram(d->emission);
+        set_ranges(d->emission, ALL, d->drop);
         glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
         bind_indirect(d, d->e_lit, d->e_use_lit);
         lm_direct_mesh_draw(&d->mesh, 0);
@@ -155,6 +168,7 @@ static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters 
     const uniforms *u = &d->uf[kind_of(e)];
     GLuint prog = d->first[kind_of(e)];
     glUseProgram(prog);
+    set_ranges(prog, ALL, d->drop);
     set_view_uniforms(d, u, view);
     set_light_uniforms(u, s, e, &d->maps[light].map);
     bind_indirect(d, u->lit, u->use_lit);
@@ -182,7 +196,7 @@ static lm_status shadow_map(lm_direct *d, const lm_scene *s, const lm_emitter *e
 static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, const lm_view *view,
                             int w, int h, lm_error *err)
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, d->cur->fbo);
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
@@ -191,6 +205,7 @@ static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e
     glBlendFunc(GL_ONE, GL_ONE);
     GLuint prog = d->prog[kind_of(e)];
     glUseProgram(prog);
+    set_ranges(prog, ALL, d->drop);
     set_view_uniforms(d, &d->u[kind_of(e)], view);
     set_light_uniforms(&d->u[kind_of(e)], s, e, &d->maps[i].map);
     lm_direct_mesh_draw(&d->mesh, prog);
@@ -276,6 +291,7 @@ void lm_direct_free(lm_direct *d)
         lm_shadow_map_free(&d->maps[i].map);
     free(d->maps);
     lm_float_target_free(&d->target);
+    lm_float_target_free(&d->probe);
     if (d->mesh.first)
         lm_direct_mesh_free(&d->mesh);
     lm_shadow_renderer_free(&d->shadow);
@@ -305,8 +321,9 @@ static lm_status ensure_maps(lm_direct *d, int count, lm_error *err)
     return LM_OK;
 }
 
-lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
-                         int height, lm_error *err)
+/* The scene from view into target t (width x height), leaving out the vertices in d->drop. */
+static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, const lm_emitters *em,
+                           const lm_view *view, int width, int height, lm_error *err)
 {
     if (width <= 0 || height <= 0)
         return lm_fail(err, LM_ERR_INVALID, "direct_light: bad size %dx%d", width, height);
@@ -316,9 +333,10 @@ lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em,
     int moved = lm_direct_mesh_update(&d->mesh, s);
     d->static_version += (moved & LM_MESH_STATIC_CASTERS_MOVED) != 0;
     d->dynamic_version += (moved & LM_MESH_DYNAMIC_CASTERS_MOVED) != 0;
-    st = lm_float_target_ensure(&d->target, width, height, 1, err);
+    st = lm_float_target_ensure(t, width, height, 1, err);
     if (st != LM_OK)
         return st;
+    d->cur = t;
     int first = -1;
     for (int i = 0; st == LM_OK && i < em->count; i++)
         if (em->e[i].kind != LM_EMIT_AREA) {
@@ -327,7 +345,7 @@ lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em,
         }
     if (st != LM_OK)
         return st;
-    glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
     first_pass(d, s, em, first, view, width, height);
     for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
         if (em->e[i].kind != LM_EMIT_AREA)
@@ -336,29 +354,69 @@ lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em,
     return st;
 }
 
+lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
+                         int height, lm_error *err)
+{
+    d->drop[0] = d->drop[1] = 0;
+    return draw_into(d, &d->target, s, em, view, width, height, err);
+}
+
+lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
+                               int skip, lm_error *err)
+{
+    int ok = skip >= 0 && skip < d->mesh.node_count;
+    d->drop[0] = ok ? d->mesh.node_first[skip] : 0;
+    d->drop[1] = ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0;
+    lm_status st = draw_into(d, &d->probe, s, em, view, size, size, err);
+    d->drop[0] = d->drop[1] = 0;
+    return st;
+}
+
+unsigned lm_direct_probe_texture(const lm_direct *d) { return d->probe.color[0]; }
+
+void lm_direct_bind_target(const lm_direct *d)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
+    glViewport(0, 0, d->target.width, d->target.height);
+}
+
+void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
+{
+    if (node < 0 || node >= d->mesh.node_count || !d->mesh.node_verts[node])
+        return;
+    int keep[2] = {d->mesh.node_first[node], d->mesh.node_first[node] + d->mesh.node_verts[node]};
+    set_ranges(prog, keep, ALL);
+    lm_direct_mesh_draw(&d->mesh, prog);
+    set_ranges(prog, ALL, ALL);
+}
+
 unsigned lm_direct_texture(const lm_direct *d) { return d->target.color[0]; }
 
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
 
-lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
-                           int height, float *rgb, lm_error *err)
+lm_status lm_direct_read(lm_direct *d, float *rgb, lm_error *err)
 {
-    lm_status st = lm_direct_draw(d, s, em, view, width, height, err);
-    if (st != LM_OK)
-        return st;
-    size_t px = (size_t)width * (size_t)height;
+    size_t px = (size_t)d->target.width * (size_t)d->target.height;
     if (px > d->scratch_px) {
         free(d->scratch);
         d->scratch = malloc(4 * px * sizeof(float));
         d->scratch_px = d->scratch ? px : 0;
         if (!d->scratch)
-            return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory to read back %dx%d", width, height);
+            return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory to read back %dx%d", d->target.width,
+                           d->target.height);
     }
     lm_float_target_read_rgb(&d->target, 0, rgb, d->scratch);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return lm_gl_check("direct_light: reading back", err);
+}
+
+lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
+                           int height, float *rgb, lm_error *err)
+{
+    lm_status st = lm_direct_draw(d, s, em, view, width, height, err);
+    return st == LM_OK ? lm_direct_read(d, rgb, err) : st;
 }
 
 lm_status lm_render_direct(const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,

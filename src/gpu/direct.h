@@ -49,6 +49,21 @@ unsigned lm_direct_texture(const lm_direct *d);
 /* lm_direct_draw, then the image read back as RGB floats (row 0 at the top). */
 lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                            int height, float *rgb, lm_error *err);
+/* Reads the last lm_direct_draw's image (and what lm_direct_bind_target's passes added to it) back as RGB
+ * floats, row 0 at the top. */
+lm_status lm_direct_read(lm_direct *d, float *rgb, lm_error *err);
+/* Binds the frame's target (after lm_direct_draw) for a further pass to add to it (reflections.h). */
+void lm_direct_bind_target(const lm_direct *d);
+/* The scene from view into a second, size x size target kept apart from the frame's, node `skip`'s
+ * vertices left out (-1: none): one face of skip's environment map (reflections.h). The first pass's
+ * indirect term and the shadow maps are the frame's. */
+lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
+                               int skip, lm_error *err);
+/* The last lm_direct_draw_probe's image: an RGBA32F texture (GL rows bottom-up). */
+unsigned lm_direct_probe_texture(const lm_direct *d);
+/* Draws only node's triangles with prog, a program on lm_direct_vs (its uniforms set by the caller;
+ * has_tex and the base colour texture on unit 2 set here per texture group). */
+void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node);
 /* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
  * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */

@@ -5,6 +5,17 @@
  * The per-material ones are flat (no interpolation: cheaper on llvmpipe). The geometric normal is the
  * cross product of the position's screen derivatives, exact on a planar triangle, so vertices are shared
  * between triangles; gl_FrontFacing says which side of the triangle (by its winding) is seen. */
+/* Vertex ranges (a node's vertices are contiguous, direct_mesh.h): with keep.y > keep.x only the vertices
+ * in [keep.x, keep.y) are drawn (one node's reflections), and those in [drop.x, drop.y) never (a node's
+ * own environment map, drawn from inside it). Every corner of a dropped triangle leaves the clip volume
+ * on the same side, so it is cut before rasterization. Both 0 (the default): everything. */
+#define VERTEX_RANGES \
+    "uniform ivec2 keep, drop;\n" \
+    "bool dropped() {\n" \
+    "    int v = gl_VertexID;\n" \
+    "    return (keep.y > keep.x && (v < keep.x || v >= keep.y)) || (v >= drop.x && v < drop.y);\n" \
+    "}\n"
+
 const char *const lm_direct_vs =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"
@@ -20,9 +31,10 @@ const char *const lm_direct_vs =
     "flat out vec4 v_par;\n"
     "out vec2 v_uv, v_lm;\n"
     "invariant gl_Position;\n"
+    VERTEX_RANGES
     "void main() {\n"
     "    v_pos = pos; v_ns = ns; v_base = base; v_par = par; v_em = em; v_uv = uv; v_lm = lm_uv;\n"
-    "    gl_Position = view_proj * vec4(pos, 1.0);\n"
+    "    gl_Position = dropped() ? vec4(2.0, 2.0, 2.0, 1.0) : view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
 /* kind: 0 point, 1 spot, 2 directional. FIRST 1: the frame's first pass, which also writes depth and adds
@@ -155,9 +167,10 @@ const char *const lm_direct_emission_vs =
     "flat out float v_two;\n"
     "out vec2 v_lm;\n"
     "invariant gl_Position;\n"
+    VERTEX_RANGES
     "void main() {\n"
     "    v_em = em; v_two = par.y; v_lm = lm_uv;\n"
-    "    gl_Position = view_proj * vec4(pos, 1.0);\n"
+    "    gl_Position = dropped() ? vec4(2.0, 2.0, 2.0, 1.0) : view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
 const char *const lm_direct_emission_fs =

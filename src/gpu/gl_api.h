@@ -43,6 +43,7 @@
     X(glClearTexSubImage, PFNGLCLEARTEXSUBIMAGEPROC) \
     X(glClipControl, PFNGLCLIPCONTROLPROC) \
     X(glCompileShader, PFNGLCOMPILESHADERPROC) \
+    X(glCopyImageSubData, PFNGLCOPYIMAGESUBDATAPROC) \
     X(glCreateProgram, PFNGLCREATEPROGRAMPROC) \
     X(glCreateShader, PFNGLCREATESHADERPROC) \
     X(glDeleteBuffers, PFNGLDELETEBUFFERSPROC) \
@@ -195,6 +196,7 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glClipControl (lm_gl_cur->glClipControl)
 #define glColorMask (lm_gl_cur->glColorMask)
 #define glCompileShader (lm_gl_cur->glCompileShader)
+#define glCopyImageSubData (lm_gl_cur->glCopyImageSubData)
 #define glCreateProgram (lm_gl_cur->glCreateProgram)
 #define glCreateShader (lm_gl_cur->glCreateShader)
 #define glCullFace (lm_gl_cur->glCullFace)

@@ -134,11 +134,21 @@ static void decide_specular(const lm_scene *s, lm_effects *e)
     else
         snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "no specular material");
 
-    int any = on + off_count;
-    e->on[LM_EFFECT_REFLECTIONS] = any > 0;
-    snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s", any > 0 ? "mirror or glass material present" : "no specular material");
-    if (any > 0 && on > 0)
-        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s on node '%s'", what, s->nodes[node].name);
+    /* reflections (gpu/reflections.h): environment maps for mirror and glossy nodes */
+    usage glossy = count_usage(s, LM_MAT_GLOSSY, LM_EFFECT_REFLECTIONS);
+    int any = mirror.materials_on + mirror.materials_off, shiny = glossy.materials_on + glossy.materials_off;
+    e->on[LM_EFFECT_REFLECTIONS] = any + shiny > 0;
+    if (any > 0)
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%d mirror%s material%s on node '%s'",
+                 any, shiny ? " and glossy" : "", any + shiny == 1 ? "" : "s",
+                 s->nodes[mirror.first_node_on >= 0 ? mirror.first_node_on : mirror.first_node_off].name);
+    else if (shiny > 0)
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%d glossy material%s on node '%s'", shiny,
+                 shiny == 1 ? "" : "s",
+                 s->nodes[glossy.first_node_on >= 0 ? glossy.first_node_on : glossy.first_node_off].name);
+    else
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s", glass.materials_on + glass.materials_off > 0
+                 ? "glass only (refraction is not drawn yet)" : "no mirror or glossy material");
 }
 
 static void decide_updates(const lm_scene *s, lm_effects *e)

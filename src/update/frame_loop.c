@@ -5,6 +5,7 @@
 
 #include "../core/timing.h"
 #include "../gpu/composite.h"
+#include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
 #include "stage_worker.h"
 
@@ -17,6 +18,7 @@ struct lm_frame_loop {
     lm_stage_worker *worker; /* with settings.overlap: runs the stage's update beside the GL work */
     lm_gather *gather;
     lm_composite *comp;
+    lm_reflections *reflections; /* NULL: no mirror or glossy node, or switched off */
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
     int have_iim;
@@ -48,6 +50,8 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->width = 512;
     s->height = 512;
     s->camera = -1;
+    s->reflection_size = 128;
+    s->reflection_faces = 1;
     s->progress = NULL;
     s->progress_user = NULL;
 }
@@ -135,6 +139,10 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         st = lm_composite_create(fl->scene, fl->atlas, fl->set.gather.backface_limit, &fl->comp, err);
     if (st == LM_OK)
         st = lm_direct_create(fl->scene, fl->atlas, &fl->set.direct, &fl->direct_light, err);
+
+    if (st == LM_OK && fl->set.reflection_size > 0)
+        st = lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections,
+                                   err);
     double t0 = lm_now();
     fl->aim_stale = 1;
     if (st == LM_OK)
@@ -181,6 +189,7 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     lm_stage_worker_stop(fl->worker);
     lm_direct_free(fl->direct_light);
     lm_composite_free(fl->comp);
+    lm_reflections_free(fl->reflections);
     if (fl->have_iim)
         lm_iim_free(&fl->iim);
     lm_gather_free(fl->gather);
@@ -205,9 +214,20 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     lm_status st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
+    const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
+    double t2 = lm_now();
     if (st == LM_OK)
-        st = lm_direct_render(fl->direct_light, fl->scene, lm_photon_stage_emitters(fl->stage), &fl->view, w, h,
-                              fl->image, err);
+        st = lm_reflections_update(fl->reflections, fl->direct_light, fl->scene, em, err);
+    double t3 = lm_now();
+    if (st == LM_OK)
+        st = lm_direct_draw(fl->direct_light, fl->scene, em, &fl->view, w, h, err);
+    double t4 = lm_now();
+    if (st == LM_OK)
+        st = lm_reflections_draw(fl->reflections, fl->direct_light, &fl->view, err);
+    double t5 = lm_now();
+    if (st == LM_OK)
+        st = lm_direct_read(fl->direct_light, fl->image, err);
+    o->t_reflections = (t3 - t2) + (t5 - t4);
     o->t_composite = t1 - t0;
     o->t_direct = lm_now() - t1;
     return st;

@@ -38,6 +38,10 @@ typedef struct {
     lm_direct_settings direct;
     int width, height;     /* frame size (default 512 x 512) */
     int camera;            /* lm_view_for_scene's camera (default -1) */
+    int reflection_size;   /* texels per side of a mirror or glossy node's environment map (gpu/reflections.h;
+                            * default 128; 0: no reflections) */
+    int reflection_faces;  /* environment map faces re-rendered a frame, round robin, after all of them at the
+                            * first frame (default 1: a map refreshed in 6 frames) */
     /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;
@@ -48,8 +52,9 @@ typedef struct {
     uint32_t texels_gathered;
     /* seconds per stage: photon stage (animate + photons + AIMs), IIM gather (schedule, scene and AIM
      * upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps, the frame's
-     * read-back), composite (the indirect term's atlas pass); and the whole frame */
-    double t_photons, t_gather, t_blend, t_direct, t_composite, t_total;
+     * read-back), composite (the indirect term's atlas pass), reflections (environment map faces and the
+     * reflection pass, inside t_direct); and the whole frame */
+    double t_photons, t_gather, t_blend, t_direct, t_composite, t_reflections, t_total;
 } lm_frame_stats;
 
 typedef struct lm_frame_loop lm_frame_loop;
