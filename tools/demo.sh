@@ -31,6 +31,14 @@ if [ -r ../shared/scenes/cornell-box/CornellBox.glb ]; then
     mkdir -p demo/cornellbox-check
     "$LMGI" check ../shared/scenes/cornell-box/CornellBox.glb --out demo/cornellbox-check -q | tee demo/cornellbox-check/check.txt
 fi
+# A shared scene lit only by an emissive lamp, with a glossy Suzanne that reflects the room (its environment
+# map) and textured blocks whose indirect light takes the texture per pixel.
+if [ -r ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf ]; then
+    echo "== run on ../shared/scenes/cornell-suzanne"
+    "$LMGI" run ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf --frames 1 --size 512x512 \
+        --out demo/cornell-suzanne-run
+fi
 echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png,"
-echo "      demo/cornell-run/frame_*.png, demo/cornellbox-run/frame_0000.png and demo/cornellbox-check/"
+echo "      demo/cornell-run/frame_*.png, demo/cornellbox-run/frame_0000.png, demo/cornell-suzanne-run/"
+echo "      frame_0000.png and demo/cornellbox-check/"
 echo "      (check_ratio.png: frame / reference, red brighter, blue darker; check.txt per surface)"

@@ -1,5 +1,6 @@
-/* The indirect term of a frame's composite (composite.h): a premultiplied IIM x albedo atlas, rendered
- * by one atlas-sized pass; the direct light's first pass samples it. Target and program persist. */
+/* The indirect term of a frame's composite (composite.h): a premultiplied IIM / pi atlas, rendered by one
+ * atlas-sized pass; the direct light's first pass samples it and multiplies by kd. Target and program
+ * persist. */
 #include "composite.h"
 
 #include "gl_api.h"
@@ -12,13 +13,13 @@
 
 struct lm_composite {
     int width, height;   /* atlas */
-    GLuint albedo_tex, premult_prog, empty_vao;
+    GLuint covered_tex, premult_prog, empty_vao;
     float limit;
-    GLint p_limit, p_albedo, p_iim;
-    lm_float_target lit; /* atlas-sized, linear filter: (albedo / pi * E * w, w), w = covered and valid */
+    GLint p_limit, p_covered, p_iim;
+    lm_float_target lit; /* atlas-sized, linear filter: (E / pi * w, w), w = covered and valid */
 };
 
-/* Per frame, per atlas texel: albedo / pi * E premultiplied by w = covered x valid (back-face fraction
+/* Per frame, per atlas texel: E / pi premultiplied by w = covered x valid (back-face fraction
  * <= limit), and w; sampled with the texture unit's bilinear filter, rgb / a is then the bilinear filter
  * over the four nearest texels that weighs only covered, valid ones, renormalised. */
 static const char *PREMULT_VS =
@@ -29,28 +30,21 @@ static const char *PREMULT_VS =
     "}\n";
 static const char *PREMULT_FS =
     "#version 450 core\n"
-    "uniform sampler2D albedo;\n"
+    "uniform sampler2D covered;\n"
     "uniform sampler2D iim;\n"
     "uniform float limit;\n"
     "out vec4 frag;\n"
     "void main() {\n"
     "    ivec2 q = ivec2(gl_FragCoord.xy);\n"
-    "    vec4 al = texelFetch(albedo, q, 0), e = texelFetch(iim, q, 0);\n"
-    "    float w = al.a * (e.a <= limit ? 1.0 : 0.0);\n"
-    "    frag = vec4(al.rgb * e.rgb * w, w);\n"
+    "    vec4 e = texelFetch(iim, q, 0);\n"
+    "    float w = texelFetch(covered, q, 0).r * (e.a <= limit ? 1.0 : 0.0);\n"
+    "    frag = vec4(e.rgb * (w / 3.14159265358979), w);\n"
     "}\n";
-/* kd / pi at each covered texel's centre (its triangle's material, texture at the interpolated UV). */
-static void fill_albedo(const lm_scene *s, const lm_atlas *a, float *out)
+/* 1 at every texel of the texel table (covered by some triangle), 0 in gutters and unused corners. */
+static void fill_covered(const lm_atlas *a, float *out)
 {
-    for (uint32_t i = 0; i < a->texel_count; i++) {
-        const lm_texel *t = &a->texels[i];
-        float kd[3];
-        lm_texel_kd(s, t, kd);
-        float *o = out + 4 * ((size_t)t->y * a->width + t->x);
-        for (int c = 0; c < 3; c++)
-            o[c] = kd[c] / (float)M_PI;
-        o[3] = 1.0f;
-    }
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        out[4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x)] = 1.0f;
 }
 
 static GLuint upload_rgba(int w, int h, const float *rgba)
@@ -70,18 +64,18 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
 {
     *out = NULL;
     lm_composite *c = calloc(1, sizeof *c);
-    float *albedo = calloc(4 * (size_t)a->width * a->height, sizeof(float)); /* albedo / pi, a = covered */
-    if (!c || !albedo) {
+    float *covered = calloc(4 * (size_t)a->width * a->height, sizeof(float));
+    if (!c || !covered) {
         free(c);
-        free(albedo);
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the albedo atlas", s->path);
+        free(covered);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap coverage", s->path);
     }
     c->width = a->width;
     c->height = a->height;
     c->limit = backface_limit;
-    fill_albedo(s, a, albedo);
-    c->albedo_tex = upload_rgba(a->width, a->height, albedo);
-    free(albedo);
+    fill_covered(a, covered);
+    c->covered_tex = upload_rgba(a->width, a->height, covered);
+    free(covered);
     lm_status st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
     if (st != LM_OK) {
         lm_composite_free(c);
@@ -89,7 +83,7 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     }
     glGenVertexArrays(1, &c->empty_vao);
     c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
-    c->p_albedo = glGetUniformLocation(c->premult_prog, "albedo");
+    c->p_covered = glGetUniformLocation(c->premult_prog, "covered");
     c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
     *out = c;
     return LM_OK;
@@ -99,8 +93,8 @@ void lm_composite_free(lm_composite *c)
 {
     if (!c)
         return;
-    if (c->albedo_tex)
-        glDeleteTextures(1, &c->albedo_tex);
+    if (c->covered_tex)
+        glDeleteTextures(1, &c->covered_tex);
     if (c->premult_prog)
         glDeleteProgram(c->premult_prog);
     if (c->empty_vao)
@@ -117,10 +111,10 @@ static void premultiply(const lm_composite *c, unsigned iim_tex)
     glDisable(GL_CULL_FACE);
     glUseProgram(c->premult_prog);
     glUniform1f(c->p_limit, c->limit);
-    glUniform1i(c->p_albedo, 0);
+    glUniform1i(c->p_covered, 0);
     glUniform1i(c->p_iim, 1);
     glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, c->albedo_tex);
+    glBindTexture(GL_TEXTURE_2D, c->covered_tex);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, iim_tex);
     glBindVertexArray(c->empty_vao);

@@ -1,10 +1,10 @@
-/* The frame's composite (DESIGN.md step 7): linear RGB = direct + albedo / pi * E_IIM. albedo is per
- * lightmap texel (base colour factor x texture at the texel's centre, fixed at creation); E_IIM is the
- * displayed IIM texture. This module makes the indirect term's texture: an atlas-sized RGBA32F of
- * (albedo / pi * E * w, w), w = 1 on covered, valid texels (back-face fraction <= the limit), else 0,
+/* The frame's composite (DESIGN.md step 7): linear RGB = direct + kd / pi * E_IIM, kd the diffuse lobe
+ * per pixel (base colour factor x texture at the pixel, docs/materials.md); E_IIM is the displayed IIM
+ * texture. This module makes the indirect term's texture: an atlas-sized RGBA32F of
+ * (E / pi * w, w), w = 1 on covered, valid texels (back-face fraction <= the limit), else 0,
  * with a bilinear filter; sampled at a visible point's lightmap uv, rgb / a is then the filter over the
  * four nearest texels that weighs only covered, valid ones, so gutters and invalid texels never darken a
- * chart's border. The direct light's first pass adds it (gpu/direct.h, lm_direct_set_indirect): the
+ * chart's border. The direct light's first pass multiplies it by kd and adds it (gpu/direct.h, lm_direct_set_indirect): the
  * sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
  * light. Program and target persist. */
 #ifndef LM_COMPOSITE_H
@@ -14,7 +14,7 @@
 
 typedef struct lm_composite lm_composite;
 
-/* Builds the albedo/pi atlas texture and the program. Needs a current GL context. */
+/* Builds the coverage texture and the program. Needs a current GL context. */
 lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
                               lm_error *err);
 void lm_composite_free(lm_composite *c);

@@ -160,8 +160,9 @@ static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters 
         glUseProgram(d->emission);
         set_ranges(d->emission, ALL, d->drop);
         glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
+        glUniform1i(glGetUniformLocation(d->emission, "base_tex"), 2);
         bind_indirect(d, d->e_lit, d->e_use_lit);
-        lm_direct_mesh_draw(&d->mesh, 0);
+        lm_direct_mesh_draw(&d->mesh, d->emission);
         return;
     }
     const lm_emitter *e = &em->e[light];

@@ -16,6 +16,46 @@
     "    return (keep.y > keep.x && (v < keep.x || v >= keep.y)) || (v >= drop.x && v < drop.y);\n" \
     "}\n"
 
+/* bsdf.c's lobes (lm_material_lobes) per pixel, base colour texture included: diffuse and emitter kd =
+ * albedo; glossy ks = mix(0.04, albedo, metallic), kd = albedo (1 - metallic)(1 - max ks); mirror and
+ * glass none here.
+ * The albedo: a diffuse surface's light is linear in it, so its texture is read trilinearly, averaged
+ * over the pixel's footprint as the reference's many paths a pixel average it (a texture finer than the
+ * pixels, the cornell-suzanne block's checker, does not alias: its pixels' error 0.14 -> 0.05). A glossy
+ * lobe is not linear in it (kd = a (1 - m)(1 - max ks)): the lobe of the averaged texture is not the
+ * average of the lobes (the depth-of-field board, copper traces on green, read 1.79 1.16 1.06 so), so a
+ * glossy surface reads level 0 at the pixel's centre. Both lookups at the top of main(), in uniform
+ * control flow (a mipmapped lookup in a branch has no defined derivatives). */
+#define LOBES \
+    "vec3 albedo;\n" \
+    "void look_up_albedo() {\n" \
+    "    vec3 fine = textureLod(base_tex, v_uv, 0.0).rgb, filtered = texture(base_tex, v_uv).rgb;\n" \
+    "    albedo = v_base * (has_tex == 0 ? vec3(1.0) : int(v_par.w + 0.5) == 1 ? fine : filtered);\n" \
+    "}\n" \
+    "void lobes(out vec3 kd, out vec3 ks) {\n" \
+    "    vec3 a = albedo;\n" \
+    "    int cls = int(v_par.w + 0.5);\n" \
+    "    kd = vec3(0.0); ks = vec3(0.0);\n" \
+    "    if (cls == 0 || cls == 4) kd = a;\n" \
+    "    if (cls != 1) return;\n" \
+    "    ks = mix(vec3(0.04), a, v_par.z);\n" \
+    "    kd = a * (1.0 - v_par.z) * (1.0 - max(ks.r, max(ks.g, ks.b)));\n" \
+    "}\n"
+
+/* The indirect term at a pixel: kd / pi x E_IIM, E / pi from the premultiplied atlas `lit`
+ * (gpu/composite.h) at the lightmap uv (attribute 7, -1 without a chart), rgb / a over the covered, valid
+ * texels of its bilinear footprint, kd per pixel (the base colour texture at the pixel, not at the texel's
+ * centre: a texture finer than the lightmap stays sharp). */
+#define INDIRECT \
+    "vec3 indirect() {\n" \
+    "    if (use_lit == 0 || v_lm.x < 0.0) return vec3(0.0);\n" \
+    "    vec4 t = textureLod(lit, v_lm, 0.0);\n" \
+    "    if (t.a <= 0.0) return vec3(0.0);\n" \
+    "    vec3 kd, ks;\n" \
+    "    lobes(kd, ks);\n" \
+    "    return kd * t.rgb / t.a;\n" \
+    "}\n"
+
 const char *const lm_direct_vs =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"
@@ -99,17 +139,7 @@ const char *const lm_direct_fs_body =
     "    float lit = kind == 0 ? cube_shadow(q, m, T) : map_shadow(q, m);\n"
     "    return lit / float(taps * taps);\n"
     "}\n"
-    /* bsdf.c's lobes: diffuse and emitter kd = albedo; glossy ks = mix(0.04, albedo, metallic),
-     * kd = albedo (1 - metallic)(1 - max ks); mirror and glass black here. */
-    "void lobes(out vec3 kd, out vec3 ks) {\n"
-    "    vec3 a = v_base * (has_tex != 0 ? texture(base_tex, v_uv).rgb : vec3(1.0));\n"
-    "    int cls = int(v_par.w + 0.5);\n"
-    "    kd = vec3(0.0); ks = vec3(0.0);\n"
-    "    if (cls == 0 || cls == 4) kd = a;\n"
-    "    if (cls != 1) return;\n"
-    "    ks = mix(vec3(0.04), a, v_par.z);\n"
-    "    kd = a * (1.0 - v_par.z) * (1.0 - max(ks.r, max(ks.g, ks.b)));\n"
-    "}\n"
+    LOBES
     "vec3 light(vec3 p, vec3 ns, vec3 ng, vec3 V) {\n"
     "    vec3 L = -ldir, E = radiant;\n"
     "    float dist = 1.0;\n"
@@ -128,7 +158,9 @@ const char *const lm_direct_fs_body =
     "    vec3 f = kd / PI + ks * (n + 2.0) / (2.0 * PI) * lobe;\n"
     "    return f * E * max(dot(ns, L), 0.0) * shadow(p, ng, L, dist);\n"
     "}\n"
+    INDIRECT
     "void main() {\n"
+    "    look_up_albedo();\n"
     "    vec3 V = ortho_view != 0 ? view_dir : normalize(eye - v_pos);\n"
     "    vec3 ng = normalize(cross(dFdx(v_pos), dFdy(v_pos))), ns = normalize(v_ns);\n"
     "    if (dot(ng, V) < 0.0) ng = -ng; /* the side seen */\n"
@@ -139,12 +171,7 @@ const char *const lm_direct_fs_body =
     "    vec3 c = light(v_pos, ns, ng, V);\n"
     "#if FIRST\n"
     "    c += v_em;\n"
-    "    vec3 e = vec3(0.0);\n"
-    "    if (use_lit != 0 && v_lm.x >= 0.0) {\n"
-    "        vec4 t = textureLod(lit, v_lm, 0.0);\n"
-    "        if (t.a > 0.0) e = t.rgb / t.a;\n"
-    "    }\n"
-    "    frag = vec4(seen ? c + e : vec3(0.0), 1.0); /* the back of a single-sided surface: black */\n"
+    "    frag = vec4(seen ? c + indirect() : vec3(0.0), 1.0); /* the back of a single-sided surface: black */\n"
     "#else\n"
     "    frag = vec4(seen ? c : vec3(0.0), 1.0);\n"
     "#endif\n"
@@ -152,41 +179,39 @@ const char *const lm_direct_fs_body =
 
 /* The emission-only first pass (a scene without punctual lights): depth, and Le on the front side (or
  * both sides when double-sided; the back of a single-sided surface is black, lightmap and all, as the
- * reference sees it); the same attributes and gl_Position as lm_direct_vs. With use_lit, also
- * the composite's indirect term
- * albedo / pi * E_IIM: the premultiplied atlas `lit` (gpu/composite.h) at the lightmap uv (attribute 7,
- * -1 without a chart), rgb / a over the covered, valid texels of its bilinear footprint. */
+ * reference sees it), plus the indirect term (INDIRECT above); the same attributes and gl_Position as
+ * lm_direct_vs. */
 const char *const lm_direct_emission_vs =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"
+    "layout(location = 2) in vec3 base;\n"
     "layout(location = 3) in vec4 par;\n"
     "layout(location = 4) in vec3 em;\n"
+    "layout(location = 5) in vec2 uv;\n"
     "layout(location = 7) in vec2 lm_uv;\n"
     "uniform mat4 view_proj;\n"
-    "flat out vec3 v_em;\n"
-    "flat out float v_two;\n"
-    "out vec2 v_lm;\n"
+    "flat out vec3 v_em, v_base;\n"
+    "flat out vec4 v_par;\n"
+    "out vec2 v_uv, v_lm;\n"
     "invariant gl_Position;\n"
     VERTEX_RANGES
     "void main() {\n"
-    "    v_em = em; v_two = par.y; v_lm = lm_uv;\n"
+    "    v_em = em; v_base = base; v_par = par; v_uv = uv; v_lm = lm_uv;\n"
     "    gl_Position = dropped() ? vec4(2.0, 2.0, 2.0, 1.0) : view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
 const char *const lm_direct_emission_fs =
     "#version 450 core\n"
-    "flat in vec3 v_em;\n"
-    "flat in float v_two;\n"
-    "in vec2 v_lm;\n"
-    "uniform sampler2D lit;\n"
-    "uniform int use_lit;\n"
+    "flat in vec3 v_em, v_base;\n"
+    "flat in vec4 v_par;\n"
+    "in vec2 v_uv, v_lm;\n"
+    "uniform sampler2D lit, base_tex;\n"
+    "uniform int use_lit, has_tex;\n"
     "out vec4 frag;\n"
+    LOBES
+    INDIRECT
     "void main() {\n"
-    "    bool seen = gl_FrontFacing || v_two > 0.5; /* the back of a single-sided surface: black */\n"
-    "    vec3 c = seen ? v_em : vec3(0.0);\n"
-    "    if (seen && use_lit != 0 && v_lm.x >= 0.0) {\n"
-    "        vec4 t = textureLod(lit, v_lm, 0.0);\n"
-    "        if (t.a > 0.0) c += t.rgb / t.a;\n"
-    "    }\n"
-    "    frag = vec4(c, 1.0);\n"
+    "    look_up_albedo();\n"
+    "    bool seen = gl_FrontFacing || v_par.y > 0.5; /* the back of a single-sided surface: black */\n"
+    "    frag = vec4(seen ? v_em + indirect() : vec3(0.0), 1.0);\n"
     "}\n";
