@@ -85,7 +85,10 @@ static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_
     assert_true(c->rel_rmse < rmse_bound);
 }
 
-static void check_scene_tol(const char *name, const char *path, double surface_tol, double rmse_bound)
+/* One default frame of the scene at SIZE against the reference, asserted: frame within 3% per channel,
+ * surfaces within surface_tol, relative RMSE under rmse_bound. The caller frees c and the scene. */
+static lmgi_scene *run_check(const char *name, const char *path, double surface_tol, double rmse_bound,
+                             lm_frame_check *c)
 {
     lmgi_scene *sc = load_as_run(path, 0);
     lm_frame_loop_settings ls;
@@ -93,11 +96,17 @@ static void check_scene_tol(const char *name, const char *path, double surface_t
     ls.width = ls.height = SIZE;
     lm_ref_settings rs;
     ref_settings(&rs, REF_ERROR);
-    lm_frame_check c;
     lm_error err;
-    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
+    if (lm_frame_check_run(sc, &ls, &rs, 1, c, &err) != LM_OK)
         fail_msg("%s: %s", name, err.msg);
-    assert_frame(name, sc, &c, 0.03, surface_tol, rmse_bound);
+    assert_frame(name, sc, c, 0.03, surface_tol, rmse_bound);
+    return sc;
+}
+
+static void check_scene_tol(const char *name, const char *path, double surface_tol, double rmse_bound)
+{
+    lm_frame_check c;
+    lmgi_scene *sc = run_check(name, path, surface_tol, rmse_bound, &c);
     lm_frame_check_free(&c);
     lmgi_free(sc);
 }
@@ -175,17 +184,8 @@ static void test_cornell_suzanne(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf"));
-    lmgi_scene *sc = load_as_run(path, 0);
-    lm_frame_loop_settings ls;
-    lm_frame_loop_settings_default(&ls);
-    ls.width = ls.height = SIZE;
-    lm_ref_settings rs;
-    ref_settings(&rs, REF_ERROR);
     lm_frame_check c;
-    lm_error err;
-    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
-        fail_msg("cornell-suzanne: %s", err.msg);
-    assert_frame("cornell-suzanne", sc, &c, 0.03, 0.05, 0.1);
+    lmgi_scene *sc = run_check("cornell-suzanne", path, 0.05, 0.1, &c);
     double block = surface_rmse(&c, 0);
     print_message("  textured block: relative RMSE over its pixels %.4f\n", block);
     assert_true(block < BLOCK_RMSE);
