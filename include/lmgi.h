@@ -102,7 +102,10 @@ void lmgi_print_info(const lmgi_scene *scene, FILE *f);
 int lmgi_effect_count(const lmgi_scene *scene);
 void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
 
-/* Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major). */
+/* Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major); a
+ * matrix with NaN or infinite entries, or a singular one (a zero scale), is refused with
+ * LMGI_ERR_INVALID and changes nothing. (An animation may scale a node to zero: the node then leaves the
+ * rays until its scale returns.) */
 int lmgi_node_count(const lmgi_scene *scene);
 int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent */
 const char *lmgi_node_name(const lmgi_scene *scene, int node);
@@ -111,7 +114,8 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float wor
 /* Plays every glTF animation to time t (seconds) and moves the animated nodes. */
 lmgi_status lmgi_set_time(lmgi_scene *scene, float t, lmgi_error *err);
 
-/* Closest hit of the ray org + t dir, t in (0, tmax). */
+/* Closest hit of the ray org + t dir, t in (0, tmax). A ray with a NaN, infinite or huge (above 1.8e18)
+ * number, a zero direction or a NaN or negative tmax hits nothing (hit->hit = 0); tmax may be +inf. */
 void lmgi_intersect(const lmgi_scene *scene, const float org[3], const float dir[3], float tmax, lmgi_hit *hit);
 
 uint32_t lmgi_texel_count(const lmgi_scene *scene);

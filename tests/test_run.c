@@ -418,6 +418,42 @@ static void check_reflection(const char *material, const char *opts, double want
     free(px);
 }
 
+/* A node flattened by a zero scale (glTF allows it; animations hide nodes so): a static one makes zero-area
+ * triangles with NaN normals, whose photons must not hand Embree a NaN ray; a dynamic one an instance
+ * without an inverse, which Embree cannot take a ray into (it aborted the process): left out of the rays.
+ * The frame is finite either way. */
+static void test_flattened_node(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    lmt_mesh_cube(&m[1], 0.5f);
+    const char *materials = "[{}, {}], \"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": "
+                            "{\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}}";
+    for (int dynamic = 0; dynamic < 2; dynamic++) {
+    char nodes[512];
+    snprintf(nodes, sizeof nodes, "[{\"mesh\": 0}, {\"mesh\": 1, \"scale\": [1, 1, 0], \"translation\": [0, 0.5, 0]%s}, "
+             "{\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]",
+             dynamic ? ", \"extras\": {\"lmgi\": {\"dynamic\": true}}" : "");
+    const char *path = lmt_write_scene("flat.gltf", m, 2, nodes, materials);
+    char args[4096], dir[1100];
+    snprintf(dir, sizeof dir, "%s/flat_out", lmt_tmpdir());
+    snprintf(args, sizeof args, "run %s --frames 2 --size 32x32 --photons 20000 -q --out %s", path, dir);
+    if (lmgi(args) != 0)
+        fail_msg("lmgi run failed: %s", output);
+    int w, h;
+    float *px = read_exr(dir, "frame_0000.exr", &w, &h);
+    double sum = 0.0;
+    for (int i = 0; i < 4 * w * h; i++) {
+        assert_true(isfinite(px[i]));
+        sum += px[i];
+    }
+    assert_true(sum > 0.0);
+    free(px);
+    }
+}
+
 static void test_reflections(void **state)
 {
     (void)state;
@@ -443,6 +479,7 @@ int main(void)
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_furnace_composite),
         cmocka_unit_test(test_reflections),
+        cmocka_unit_test(test_flattened_node),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

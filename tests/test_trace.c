@@ -128,11 +128,61 @@ static void test_bad_edits_are_refused(void **state)
     m[5] = NAN;
     assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "cube"), m, &err), LMGI_ERR_INVALID);
     assert_non_null(strstr(err.message, "cube"));
+    m[5] = 0.0f; /* a zero scale: singular, which Embree's instance and every normal would choke on */
+    assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "cube"), m, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "singular"));
     assert_int_equal(lmgi_set_time(sc, INFINITY, &err), LMGI_ERR_INVALID);
     /* Refused edits left the cube where it was. */
     lmgi_hit h = shoot(sc, 0.1f, 2, 0.1f, 0, -1, 0);
     assert_float_equal(h.t, 1.25f, 1e-5);
     lmgi_free(sc);
+}
+
+/* Rays Embree would abort on (NaN, infinite or 1e20 numbers, a zero direction, a NaN or negative range)
+ * hit nothing instead: a library must not abort its host. */
+static void test_bad_rays_miss(void **state)
+{
+    lmgi_scene *sc = load_test_scene(state);
+    const float good_o[3] = {0.1f, 2, 0.1f}, good_d[3] = {0, -1, 0};
+    const float bad[][3] = {{NAN, 0, 0}, {INFINITY, 0, 0}, {0, -1e20f, 0}, {0, 0, 0}};
+    lmgi_hit h;
+    for (int i = 0; i < 4; i++) {
+        lmgi_intersect(sc, good_o, bad[i], 1e30f, &h);
+        assert_false(h.hit);
+        if (i < 3) {
+            lmgi_intersect(sc, bad[i], good_d, 1e30f, &h);
+            assert_false(h.hit);
+        }
+    }
+    lmgi_intersect(sc, good_o, good_d, NAN, &h);
+    assert_false(h.hit);
+    lmgi_intersect(sc, good_o, good_d, -1.0f, &h);
+    assert_false(h.hit);
+    lmgi_intersect(sc, good_o, good_d, INFINITY, &h); /* an open range is fine */
+    assert_true(h.hit);
+    lmgi_free(sc);
+}
+
+/* A vertex beyond LM_MAX_COORDINATE (1e20: Embree's rays stop at 1.8e18, and the texel size came out
+ * infinite) is a load error naming the node, not a scene that runs. */
+static void test_far_vertex_refused(void **state)
+{
+    (void)state;
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    float c[3] = {-1, 0, 1}, u[3] = {2, 0, 0}, v[3] = {0, 0, -2};
+    lmt_mesh_quad(&m, c, u, v);
+    m.pos[0] = 1e20f;
+    char path[600];
+    snprintf(path, sizeof path, "%s/far.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &m, 1, "[{\"name\": \"far_plate\", \"mesh\": 0}]", NULL, 0, NULL), 0);
+    lmgi_scene *sc = NULL;
+    lmgi_error err;
+    assert_int_equal(lmgi_load(path, NULL, &sc, &err), LMGI_ERR_INVALID);
+    assert_null(sc);
+    print_message("far vertex: %s\n", err.message);
+    assert_non_null(strstr(err.message, "far_plate"));
+    assert_non_null(strstr(err.message, "1e+20"));
 }
 
 /* lmgi_options.target_texels: with no texel size the atlas aims at that many texels (0: 65,536); a
@@ -229,6 +279,8 @@ int main(void)
         cmocka_unit_test(test_hits_expected_surfaces),
         cmocka_unit_test(test_dynamic_hits_follow_transform),
         cmocka_unit_test(test_bad_edits_are_refused),
+        cmocka_unit_test(test_bad_rays_miss),
+        cmocka_unit_test(test_far_vertex_refused),
         cmocka_unit_test(test_target_texels),
         cmocka_unit_test(test_two_sides),
     };

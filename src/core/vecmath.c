@@ -76,6 +76,13 @@ lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d)
                  m[2] * d.x + m[6] * d.y + m[10] * d.z);
 }
 
+int lm_mat4_singular(const float m[16])
+{
+    lm_vec3 a = lm_v3(m[0], m[1], m[2]), b = lm_v3(m[4], m[5], m[6]), c = lm_v3(m[8], m[9], m[10]);
+    double det = lm_dot(a, lm_cross(b, c)), scale = (double)lm_length(a) * lm_length(b) * lm_length(c);
+    return !(fabs(det) > 1e-6 * scale);
+}
+
 int lm_mat4_finite(const float m[16])
 {
     for (int i = 0; i < 16; i++)

@@ -190,6 +190,10 @@ void lm_scene_eval_animation(lm_scene *s, int anim, float t);
 /* Duration of the longest animation (0 if none). */
 float lm_scene_animation_duration(const lm_scene *s);
 
+/* The largest |coordinate| a vertex may have in world space after loading (a load error beyond it):
+ * rays must stay far inside Embree's limit of about 1.8e18, and texel sizes and scene sizes finite. */
+#define LM_MAX_COORDINATE 1e15f
+
 /* World-space position of a vertex / normal under the current node matrices. */
 void lm_scene_vertex_world(const lm_scene *s, uint32_t v, float out[3]);
 void lm_scene_normal_world(const lm_scene *s, uint32_t v, float out[3]);

@@ -160,6 +160,8 @@ static lm_status add_instance(lm_rt *rt, const lm_scene *s, int n, lm_error *err
     RTCGeometry inst = rtcNewGeometry(rt->device, RTC_GEOMETRY_TYPE_INSTANCE);
     rtcSetGeometryInstancedScene(inst, local);
     rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, node->world);
+    if (lm_mat4_singular(node->world))
+        rtcDisableGeometry(inst); /* as move_instance: no inverse, no rays */
     rtcCommitGeometry(inst);
     unsigned id = rtcAttachGeometry(rt->top, inst);
     rtcReleaseGeometry(inst);
@@ -254,6 +256,12 @@ static lm_status move_instance(lm_rt *rt, int node, const float world[16], lm_er
         return lm_fail(err, LM_ERR_INVALID, "node '%s': transform has NaN or Inf entries", s->nodes[node].name);
     unsigned id = (unsigned)rt->node_inst[node];
     RTCGeometry inst = rtcGetGeometry(rt->top, id);
+    /* A zero scale (an animation hiding a node) has no inverse, which Embree would need to take a ray into
+     * the instance: the node is left out of the rays until its transform is regular again. */
+    if (lm_mat4_singular(world))
+        rtcDisableGeometry(inst);
+    else
+        rtcEnableGeometry(inst);
     rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, world);
     rtcCommitGeometry(inst);
     memcpy(rt->inst_world[id], world, sizeof(float) * 16);
@@ -263,6 +271,9 @@ static lm_status move_instance(lm_rt *rt, int node, const float world[16], lm_er
 
 lm_status lm_rt_set_node_transform(lm_rt *rt, int node, const float world[16], lm_error *err)
 {
+    if (node >= 0 && node < rt->scene->node_count && lm_mat4_finite(world) && lm_mat4_singular(world))
+        return lm_fail(err, LM_ERR_INVALID, "node '%s': transform is singular (a zero scale flattens the node)",
+                       rt->scene->nodes[node].name);
     lm_status st = move_instance(rt, node, world, err);
     if (st == LM_OK)
         rtcCommitScene(rt->top);
@@ -298,9 +309,23 @@ static void setup_ray(struct RTCRayHit *rh, const float org[3], const float dir[
     rh->hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
 }
 
+/* Whether Embree may take the ray: finite origin and direction within its range (|x| <= 1.8e18, beyond
+ * which it asserts and aborts the process), a non-zero direction, 0 <= tnear <= tfar (tfar may be +inf).
+ * A ray that fails is answered as a miss: a library must not abort its host over one bad number. */
+static int ray_ok(const float org[3], const float dir[3], float tnear, float tfar)
+{
+    const float big = 1.8e18f;
+    for (int k = 0; k < 3; k++)
+        if (!(fabsf(org[k]) <= big) || !(fabsf(dir[k]) <= big))
+            return 0;
+    return (dir[0] != 0.0f || dir[1] != 0.0f || dir[2] != 0.0f) && tnear >= 0.0f && tnear <= big && tfar >= tnear;
+}
+
 int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,
                     lm_rt_hit *hit)
 {
+    if (!ray_ok(org, dir, tnear, tfar))
+        return 0;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
@@ -344,6 +369,8 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
 
 int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar)
 {
+    if (!ray_ok(org, dir, tnear, tfar))
+        return 0;
     struct RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
@@ -361,7 +388,7 @@ void lm_rt_occluded8(const lm_rt *rt, const float org[3], const float *dir, cons
     _Alignas(32) int valid[8];
     memset(&r, 0, sizeof r);
     for (int i = 0; i < 8; i++) {
-        int on = i < n;
+        int on = i < n && ray_ok(org, dir + 3 * i, 0.0f, tfar[i]);
         valid[i] = on ? -1 : 0;
         r.org_x[i] = org[0], r.org_y[i] = org[1], r.org_z[i] = org[2];
         r.dir_x[i] = on ? dir[3 * i] : 0.0f, r.dir_y[i] = on ? dir[3 * i + 1] : 0.0f;
