@@ -139,7 +139,6 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         st = lm_composite_create(fl->scene, fl->atlas, fl->set.gather.backface_limit, &fl->comp, err);
     if (st == LM_OK)
         st = lm_direct_create(fl->scene, fl->atlas, &fl->set.direct, &fl->direct_light, err);
-
     if (st == LM_OK && fl->set.reflection_size > 0)
         st = lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections,
                                    err);
@@ -202,9 +201,10 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     free(fl);
 }
 
-/* The composite's indirect term (albedo / pi * E_IIM, premultiplied over the atlas), then the direct
- * light, whose first pass adds that term at each visible surface's lightmap uv (shadow maps
- * re-rendered only when stale): one frame-sized read-back. */
+/* The composite's indirect term (E_IIM / pi, premultiplied over the atlas), the environment map faces
+ * due this frame, then the direct light, whose first pass adds kd x that term at each visible surface's
+ * lightmap uv (shadow maps re-rendered only when stale), the reflections over it: one frame-sized
+ * read-back. */
 static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
@@ -215,19 +215,14 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
     const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
-    double t2 = lm_now();
     if (st == LM_OK)
         st = lm_reflections_update(fl->reflections, fl->direct_light, fl->scene, em, err);
-    double t3 = lm_now();
     if (st == LM_OK)
         st = lm_direct_draw(fl->direct_light, fl->scene, em, &fl->view, w, h, err);
-    double t4 = lm_now();
     if (st == LM_OK)
         st = lm_reflections_draw(fl->reflections, fl->direct_light, &fl->view, err);
-    double t5 = lm_now();
     if (st == LM_OK)
         st = lm_direct_read(fl->direct_light, fl->image, err);
-    o->t_reflections = (t3 - t2) + (t5 - t4);
     o->t_composite = t1 - t0;
     o->t_direct = lm_now() - t1;
     return st;

@@ -52,9 +52,9 @@ typedef struct {
     uint32_t texels_gathered;
     /* seconds per stage: photon stage (animate + photons + AIMs), IIM gather (schedule, scene and AIM
      * upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps, the frame's
-     * read-back), composite (the indirect term's atlas pass), reflections (environment map faces and the
-     * reflection pass, inside t_direct); and the whole frame */
-    double t_photons, t_gather, t_blend, t_direct, t_composite, t_reflections, t_total;
+     * read-back; with reflections, their map faces and pass), composite (the indirect term's atlas pass);
+     * and the whole frame */
+    double t_photons, t_gather, t_blend, t_direct, t_composite, t_total;
 } lm_frame_stats;
 
 typedef struct lm_frame_loop lm_frame_loop;
