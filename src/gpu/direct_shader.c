@@ -42,6 +42,8 @@
     "    kd = a * (1.0 - v_par.z) * (1.0 - max(ks.r, max(ks.g, ks.b)));\n" \
     "}\n"
 
+const char *const lm_direct_lobes_glsl = LOBES;
+
 /* The indirect term at a pixel: kd / pi x E_IIM, E / pi from the premultiplied atlas `lit`
  * (gpu/composite.h) at the lightmap uv (attribute 7, -1 without a chart), rgb / a over the covered, valid
  * texels of its bilinear footprint, kd per pixel (the base colour texture at the pixel, not at the texel's

@@ -11,5 +11,9 @@ extern const char *const lm_direct_vs;
 extern const char *const lm_direct_fs_body;
 extern const char *const lm_direct_emission_vs;
 extern const char *const lm_direct_emission_fs;
+/* GLSL of the material's lobes per pixel, for other passes over lm_direct_vs's outputs: declares
+ * `vec3 albedo`, `look_up_albedo()` (call first in main(), in uniform control flow; needs uniforms
+ * has_tex and base_tex) and `lobes(out vec3 kd, out vec3 ks)`. */
+extern const char *const lm_direct_lobes_glsl;
 
 #endif

@@ -4,6 +4,7 @@
 
 #include "gl_api.h"
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,6 +17,7 @@ typedef struct {
     uint32_t *tris; /* the node's mirror and glossy triangles (their bounds place the map) */
     uint32_t tri_count;
     int glossy;     /* has glossy triangles: the map needs its blurred mip levels */
+    int mips_stale; /* a face was rendered since its mips were last built */
     GLuint cube;
 } reflector;
 
@@ -30,9 +32,10 @@ struct lm_reflections {
 };
 
 /* Mirror: albedo x env(r). Glossy: ks (n + 2) / (n + 1) max(n.r, 0) x env(r) at the mip level whose texel
- * is the lobe's width 1 / sqrt(n) (lod_base = log2(size / (pi / 2)), a face spanning pi / 2). The back of
- * a single-sided surface reflects nothing. Class numbers as in direct_shader.c (1 glossy, 2 mirror). */
-static const char *REFLECT_FS =
+ * is the lobe's width 1 / sqrt(n) (lod_base = log2(size / (pi / 2)), a face spanning pi / 2). albedo and
+ * ks from direct_shader.c's lobes (lm_direct_lobes_glsl), so both passes read a material alike. The back
+ * of a single-sided surface reflects nothing. Class numbers as there (1 glossy, 2 mirror). */
+static const char *REFLECT_HEAD =
     "#version 450 core\n"
     "in vec3 v_pos, v_ns;\n"
     "flat in vec3 v_base, v_em;\n"
@@ -43,18 +46,19 @@ static const char *REFLECT_FS =
     "uniform samplerCube env;\n"
     "uniform vec3 eye;\n"
     "uniform float lod_base;\n"
-    "out vec4 frag;\n"
+    "out vec4 frag;\n";
+static const char *REFLECT_MAIN =
     "void main() {\n"
-    "    vec3 a = v_base * (has_tex != 0 ? texture(base_tex, v_uv).rgb : vec3(1.0)); /* uniform flow */\n"
+    "    look_up_albedo();\n"
     "    bool two = v_par.y > 0.5;\n"
     "    if (!gl_FrontFacing && !two) { frag = vec4(0.0); return; }\n"
     "    vec3 n = normalize(gl_FrontFacing ? v_ns : -v_ns);\n"
     "    vec3 r = reflect(normalize(v_pos - eye), n);\n"
     "    int cls = int(v_par.w + 0.5);\n"
-    "    if (cls == 2) { frag = vec4(a * textureLod(env, r, 0.0).rgb, 0.0); return; }\n"
-    "    if (cls != 1) { frag = vec4(0.0); return; }\n"
+    "    if (cls == 2) { frag = vec4(albedo * textureLod(env, r, 0.0).rgb, 0.0); return; }\n"
+    "    vec3 kd, ks;\n"
+    "    lobes(kd, ks);\n"
     "    float e = v_par.x;\n"
-    "    vec3 ks = mix(vec3(0.04), a, v_par.z);\n"
     "    float lod = max(0.0, lod_base - 0.5 * log2(e));\n"
     "    float w = (e + 2.0) / (e + 1.0) * max(dot(n, r), 0.0);\n"
     "    frag = vec4(ks * w * textureLod(env, r, lod).rgb, 0.0);\n"
@@ -62,35 +66,30 @@ static const char *REFLECT_FS =
 
 static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY; }
 
-/* The nodes with mirror or glossy triangles, each with its list of them. */
+/* The nodes with mirror or glossy triangles, each with its list of them (from the node's own range). */
 static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error *err)
 {
-    int *count = calloc((size_t)s->node_count + 1, sizeof(int));
-    if (!count)
+    r->r = calloc((size_t)s->node_count + 1, sizeof *r->r);
+    if (!r->r)
         return lm_fail(err, LM_ERR_NOMEM, "reflections: no memory");
-    for (uint32_t t = 0; t < s->tri_count; t++)
-        if (reflects(s->materials[s->tri_material[t]].cls))
-            count[s->tri_node[t]]++;
-    for (int n = 0; n < s->node_count; n++)
-        r->count += count[n] > 0;
-    r->r = calloc((size_t)r->count + 1, sizeof *r->r);
-    lm_status st = r->r ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "reflections: no memory");
-    for (int n = 0, k = 0; st == LM_OK && n < s->node_count; n++) {
-        if (!count[n])
-            continue;
-        reflector *f = &r->r[k++];
-        f->node = n;
-        f->tris = malloc(sizeof(uint32_t) * (size_t)count[n]);
-        if (!f->tris)
-            st = lm_fail(err, LM_ERR_NOMEM, "reflections: no memory");
-        for (uint32_t t = 0; f->tris && t < s->tri_count; t++)
-            if ((int)s->tri_node[t] == n && reflects(s->materials[s->tri_material[t]].cls)) {
-                f->tris[f->tri_count++] = t;
-                f->glossy |= s->materials[s->tri_material[t]].cls == LM_MAT_GLOSSY;
-            }
+    for (int n = 0; n < s->node_count; n++) {
+        const lm_node *node = &s->nodes[n];
+        reflector *f = &r->r[r->count];
+        for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++) {
+            lm_material_class c = s->materials[s->tri_material[t]].cls;
+            if (!reflects(c))
+                continue;
+            if (!f->tris && !(f->tris = malloc(sizeof(uint32_t) * node->tri_count)))
+                return lm_fail(err, LM_ERR_NOMEM, "reflections: no memory");
+            f->tris[f->tri_count++] = t;
+            f->glossy |= c == LM_MAT_GLOSSY;
+        }
+        if (f->tri_count) {
+            f->node = n;
+            r->count++;
+        }
     }
-    free(count);
-    return st;
+    return LM_OK;
 }
 
 /* A mirror samples level 0 only: its map gets no mip levels to rebuild (on llvmpipe rebuilding a 128^2
@@ -127,8 +126,12 @@ lm_status lm_reflections_create(const lm_scene *s, int size, int faces_per_frame
         lm_reflections_free(r);
         return LM_OK;
     }
+    char fs[4096];
+    int len = snprintf(fs, sizeof fs, "%s%s%s", REFLECT_HEAD, lm_direct_lobes_glsl, REFLECT_MAIN);
+    if (st == LM_OK && (len < 0 || (size_t)len >= sizeof fs))
+        st = lm_fail(err, LM_ERR_BACKEND, "reflections: shader source buffer too small");
     if (st == LM_OK)
-        st = lm_gl_program("reflections", lm_direct_vs, REFLECT_FS, &r->prog, err);
+        st = lm_gl_program("reflections", lm_direct_vs, fs, &r->prog, err);
     for (int k = 0; st == LM_OK && k < r->count; k++)
         r->r[k].cube = cube_texture(size, r->r[k].glossy ? r->levels : 1);
     if (st == LM_OK)
@@ -186,6 +189,7 @@ static lm_status render_face(lm_reflections *r, int k, int face, lm_direct *d, c
         return st;
     glCopyImageSubData(lm_direct_probe_texture(d), GL_TEXTURE_2D, 0, 0, 0, 0, r->r[k].cube, GL_TEXTURE_CUBE_MAP, 0, 0,
                        0, face, r->size, r->size, 1);
+    r->r[k].mips_stale = r->r[k].glossy;
     r->faces++;
     return LM_OK;
 }
@@ -196,22 +200,17 @@ lm_status lm_reflections_update(lm_reflections *r, lm_direct *d, const lm_scene 
     if (!r)
         return LM_OK;
     int total = 6 * r->count, n = r->primed ? (r->faces_per_frame < total ? r->faces_per_frame : total) : total;
-    char *touched = calloc((size_t)r->count, 1);
-    if (!touched)
-        return lm_fail(err, LM_ERR_NOMEM, "reflections: no memory");
     lm_status st = LM_OK;
     for (int i = 0; st == LM_OK && i < n; i++) {
-        int k = r->next / 6, face = r->next % 6;
-        st = render_face(r, k, face, d, s, em, err);
-        touched[k] = 1;
+        st = render_face(r, r->next / 6, r->next % 6, d, s, em, err);
         r->next = (r->next + 1) % total;
     }
     for (int k = 0; st == LM_OK && k < r->count; k++)
-        if (touched[k] && r->r[k].glossy) {
+        if (r->r[k].mips_stale) {
             glBindTexture(GL_TEXTURE_CUBE_MAP, r->r[k].cube);
             glGenerateMipmap(GL_TEXTURE_CUBE_MAP);
+            r->r[k].mips_stale = 0;
         }
-    free(touched);
     r->primed = 1;
     return st == LM_OK ? lm_gl_check("reflections: maps", err) : st;
 }
