@@ -103,8 +103,9 @@ int lmgi_effect_count(const lmgi_scene *scene);
 void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
 
 /* Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major); a
- * matrix with NaN or infinite entries, or a singular one (a zero scale), is refused with
- * LMGI_ERR_INVALID and changes nothing. (An animation may scale a node to zero: the node then leaves the
+ * matrix with NaN or infinite entries, a singular one (a zero scale), or one that mirrors where the
+ * node's world matrix at load did not (or the other way round: a node's sides are fixed at load), is
+ * refused with LMGI_ERR_INVALID and changes nothing. (An animation may scale a node to zero: the node then leaves the
  * rays until its scale returns.) */
 int lmgi_node_count(const lmgi_scene *scene);
 int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent */

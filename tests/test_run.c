@@ -454,6 +454,58 @@ static void test_flattened_node(void **state)
     }
 }
 
+/* Mean of an EXR's colour channels. */
+static double frame_mean(const char *dir, const char *file)
+{
+    int w, h;
+    float *px = read_exr(dir, file, &w, &h);
+    double sum = 0.0;
+    for (int i = 0; i < 4 * w * h; i++)
+        if (i % 4 != 3)
+            sum += px[i];
+    free(px);
+    return sum / (3.0 * w * h);
+}
+
+/* glTF: a negative determinant turns a node's triangles over. A floor and a dynamic box, symmetric about
+ * x = 0, mirrored in x (static floor and the box's Embree instance alike), must light as they do unmirrored
+ * (before, the mirrored walls of the generated Cornell box rendered black). */
+static void test_mirrored_nodes(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    lmt_mesh_cube(&m[1], 0.5f);
+    const char *materials = "[{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}, "
+                            "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}], \"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": "
+                            "{\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}}, "
+                            "\"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 1.0, \"znear\": 0.01}}]";
+    double mean[2], iim[2];
+    for (int mirrored = 0; mirrored < 2; mirrored++) {
+        const char *s = mirrored ? "-1" : "1";
+        char nodes[512];
+        snprintf(nodes, sizeof nodes, "[{\"mesh\": 0, \"scale\": [%s, 1, 1]}, {\"mesh\": 1, \"scale\": [%s, 1, 1], "
+                 "\"translation\": [0, 0.5, 0], \"extras\": {\"lmgi\": {\"dynamic\": true}}}, "
+                 "{\"translation\": [0.3, 2, 0.2], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}, "
+                 "{\"translation\": [0, 1.5, 3], \"rotation\": [-0.2588, 0, 0, 0.9659], \"camera\": 0}]", s, s);
+        char name[64], dir[1100], args[4096];
+        snprintf(name, sizeof name, "mirror%d.gltf", mirrored);
+        const char *path = lmt_write_scene(name, m, 2, nodes, materials);
+        snprintf(dir, sizeof dir, "%s/mirror_out%d", lmt_tmpdir(), mirrored);
+        snprintf(args, sizeof args, "run %s --frames 2 --size 48x48 --photons 20000 --exr-every 1 -q --out %s", path, dir);
+        if (lmgi(args) != 0)
+            fail_msg("lmgi run failed: %s", output);
+        mean[mirrored] = frame_mean(dir, "frame_0001.exr");
+        iim[mirrored] = frame_mean(dir, "iim.exr");
+    }
+    print_message("mirrored nodes: frame mean %.4f unmirrored, %.4f mirrored; IIM %.4f, %.4f\n", mean[0],
+                  mean[1], iim[0], iim[1]);
+    assert_true(mean[0] > 0.05 && iim[0] > 0.01);
+    assert_float_equal(mean[1] / mean[0], 1.0, 0.03);
+    assert_float_equal(iim[1] / iim[0], 1.0, 0.03);
+}
+
 static void test_reflections(void **state)
 {
     (void)state;
@@ -480,6 +532,7 @@ int main(void)
         cmocka_unit_test(test_furnace_composite),
         cmocka_unit_test(test_reflections),
         cmocka_unit_test(test_flattened_node),
+        cmocka_unit_test(test_mirrored_nodes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

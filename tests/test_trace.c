@@ -131,6 +131,9 @@ static void test_bad_edits_are_refused(void **state)
     m[5] = 0.0f; /* a zero scale: singular, which Embree's instance and every normal would choke on */
     assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "cube"), m, &err), LMGI_ERR_INVALID);
     assert_non_null(strstr(err.message, "singular"));
+    m[5] = 1.0f, m[0] = -1.0f; /* a mirror: the cube's sides were decided at load by its sign then */
+    assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "cube"), m, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "mirrors"));
     assert_int_equal(lmgi_set_time(sc, INFINITY, &err), LMGI_ERR_INVALID);
     /* Refused edits left the cube where it was. */
     lmgi_hit h = shoot(sc, 0.1f, 2, 0.1f, 0, -1, 0);

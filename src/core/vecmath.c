@@ -83,6 +83,12 @@ int lm_mat4_singular(const float m[16])
     return !(fabs(det) > 1e-6 * scale);
 }
 
+int lm_mat4_mirrors(const float m[16])
+{
+    lm_vec3 a = lm_v3(m[0], m[1], m[2]), b = lm_v3(m[4], m[5], m[6]), c = lm_v3(m[8], m[9], m[10]);
+    return lm_dot(a, lm_cross(b, c)) < 0.0f;
+}
+
 int lm_mat4_finite(const float m[16])
 {
     for (int i = 0; i < 16; i++)

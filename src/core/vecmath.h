@@ -130,6 +130,8 @@ int lm_mat4_finite(const float m[16]);
 /* Whether the upper 3 x 3 is singular: |det| below 1e-6 of the product of its column lengths (a zero
  * scale, or columns so nearly parallel that normals and the inverse lose every digit). */
 int lm_mat4_singular(const float m[16]);
+/* Whether the upper 3 x 3 mirrors (a negative determinant: it turns a triangle's winding over). */
+int lm_mat4_mirrors(const float m[16]);
 void lm_mat4_perspective(float m[16], float yfov, float aspect, float znear, float zfar);
 void lm_mat4_look_at(float m[16], lm_vec3 eye, lm_vec3 target, lm_vec3 up);
 

@@ -93,6 +93,9 @@ typedef struct {
     uint32_t first_tri, tri_count; /* this node's triangles in lm_scene.tris: the file's first, then the
                                     * twins of those with split sides (front_tri_count of them are the file's) */
     uint32_t front_tri_count;
+    int mirrored;          /* its world matrix mirrors (negative determinant) at load: the loader reversed
+                            * its triangles' winding, as glTF asks, so that every later stage finds the
+                            * front where the file meant it. Edits keep the sign (lm_rt_set_node_transform) */
 } lm_node;
 
 typedef enum { LM_INTERP_LINEAR = 0, LM_INTERP_STEP, LM_INTERP_CUBIC } lm_interp;

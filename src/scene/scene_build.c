@@ -263,6 +263,45 @@ static void resolve_node(lm_scene *s, int i, const unsigned char *animated)
     n->settings.shadows = resolve_switch(n->settings.shadows, p ? p->settings.shadows : 1);
 }
 
+/* glTF: a node whose world matrix has a negative determinant shows its triangles' other side as the
+ * front. Reversing their winding once here makes the world winding say where the front is, for every
+ * stage that decides a side (surfaces, photon hits, hemicube, shadows, the frame's gl_FrontFacing). */
+static void reverse_mirrored(lm_scene *s)
+{
+    for (int i = 0; i < s->node_count; i++) {
+        lm_node *n = &s->nodes[i];
+        n->mirrored = lm_mat4_mirrors(n->world);
+        for (uint32_t t = n->first_tri; n->mirrored && t < n->first_tri + n->tri_count; t++) {
+            uint32_t *tri = s->tris + 3 * (size_t)t, v = tri[1];
+            tri[1] = tri[2], tri[2] = v;
+        }
+    }
+}
+
+/* An animation that scales a node through zero to a negative product turns it over while it plays:
+ * the winding stays as it was at load, so the node is then lit from behind. Said once per node. */
+static void warn_mirroring_animations(const lm_scene *s)
+{
+    for (int a = 0; a < s->animation_count; a++)
+        for (int c = 0; c < s->animations[a].channel_count; c++) {
+            const lm_anim_channel *ch = &s->animations[a].channels[c];
+            if (ch->path != LM_PATH_SCALE)
+                continue;
+            const lm_node *n = &s->nodes[ch->node];
+            float own = n->scale[0] * n->scale[1] * n->scale[2];
+            int per_key = ch->interp == LM_INTERP_CUBIC ? 3 : 1, value = ch->interp == LM_INTERP_CUBIC;
+            for (int k = 0; k < ch->key_count; k++) {
+                const float *v = ch->values + 3 * ((size_t)k * per_key + value);
+                if ((v[0] * v[1] * v[2] < 0.0f) != (own < 0.0f)) {
+                    lm_warn("%s: animation \"%s\" mirrors node \"%s\" (scale key %d); its sides stay those of "
+                            "its pose at load, so while mirrored it is lit from behind", s->path,
+                            s->animations[a].name, n->name, k);
+                    break;
+                }
+            }
+        }
+}
+
 lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_error *err)
 {
     int c;
@@ -291,5 +330,7 @@ lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_e
     free(order);
     lm_scene_update_world(s);
     lm_scene_update_bounds(s);
+    reverse_mirrored(s);
+    warn_mirroring_animations(s);
     return check_extent(s, err);
 }
