@@ -8,6 +8,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "../src/core/image.h"
 #include "../src/core/palette.h"
@@ -170,6 +175,63 @@ static void test_png_round_trip(void **state)
     remove(path);
 }
 
+/* In a child under a 4 KB file-size limit (as a full disk: writes fail part way), whether a PNG (png = 1)
+ * or EXR of noise fails with an error naming the file, leaves no NAME.partial and keeps what the file
+ * held before. Returns 0 when all three hold, else which one failed. */
+static int write_past_limit(const char *dir, int png)
+{
+    char path[600], partial[620];
+    snprintf(path, sizeof path, "%s/old.%s", dir, png ? "png" : "exr");
+    snprintf(partial, sizeof partial, "%s.partial", path);
+    FILE *f = fopen(path, "wb");
+    if (!f || fputs("earlier output", f) < 0 || fclose(f) != 0)
+        return 10;
+    enum { N = 64 };
+    static uint8_t px[N * N * 4];
+    static float fx[N * N * 3];
+    unsigned r = 12345u;
+    for (int i = 0; i < N * N * 4; i++)
+        r = r * 1664525u + 1013904223u, px[i] = (uint8_t)(r >> 24);
+    for (int i = 0; i < N * N * 3; i++)
+        fx[i] = (float)px[i] / 255.0f;
+    signal(SIGXFSZ, SIG_IGN);
+    struct rlimit lim = {4096, 4096};
+    if (setrlimit(RLIMIT_FSIZE, &lim) != 0)
+        return 11;
+    lm_error err;
+    lm_status st = png ? lm_write_png(path, N, N, px, &err) : lm_write_exr(path, N, N, 3, fx, &err);
+    if (st != LM_ERR_IO || !strstr(err.msg, path) || !strstr(err.msg, "write failed"))
+        return 1;
+    if (access(partial, F_OK) == 0)
+        return 2;
+    char back[32] = {0};
+    f = fopen(path, "rb");
+    if (!f || fread(back, 1, sizeof back - 1, f) != 14 || strcmp(back, "earlier output") != 0)
+        return 3;
+    fclose(f);
+    return 0;
+}
+
+/* A full disk wrote 133 zero-byte PNGs and 13 zero-byte EXRs without an error (stb's PNG writer does
+ * not check its writes): now every write is checked and a file is whole or absent. */
+static void test_write_past_limit(void **state)
+{
+    (void)state;
+    const char *dir = lmt_tmpdir();
+    for (int png = 0; png < 2; png++) {
+        fflush(NULL);
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0)
+            _exit(write_past_limit(dir, png));
+        int status;
+        assert_int_equal(waitpid(pid, &status, 0), pid);
+        assert_true(WIFEXITED(status));
+        if (WEXITSTATUS(status) != 0)
+            fail_msg("%s past the file-size limit: check %d failed", png ? "PNG" : "EXR", WEXITSTATUS(status));
+    }
+}
+
 static void test_palette_distinct(void **state)
 {
     (void)state;
@@ -223,6 +285,7 @@ int main(void)
         cmocka_unit_test(test_srgb_round_trip),
         cmocka_unit_test(test_exr_round_trip),
         cmocka_unit_test(test_png_round_trip),
+        cmocka_unit_test(test_write_past_limit),
         cmocka_unit_test(test_palette_distinct),
         cmocka_unit_test(test_mkdir_p),
         cmocka_unit_test(test_tonemap),

@@ -19,12 +19,12 @@
 
 static char output[65536];
 
-/* Runs `lmgi ARGS` and returns its exit status (output kept in `output`). */
-static int lmgi(const char *args)
+/* Runs `SHELL_PREFIX lmgi ARGS` and returns its exit status (output kept in `output`). */
+static int lmgi_after(const char *shell_prefix, const char *args)
 {
     const char *build = getenv("LMGI_BUILD");
     char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s/lmgi %s 2>&1", build ? build : "build", args);
+    snprintf(cmd, sizeof cmd, "%s%s/lmgi %s 2>&1", shell_prefix, build ? build : "build", args);
     FILE *p = popen(cmd, "r");
     assert_non_null(p);
     size_t n = fread(output, 1, sizeof output - 1, p);
@@ -33,6 +33,8 @@ static int lmgi(const char *args)
     assert_true(WIFEXITED(status));
     return WEXITSTATUS(status);
 }
+
+static int lmgi(const char *args) { return lmgi_after("", args); }
 
 /* A small, quick run of the Cornell box into DIR/NAME with extra options; returns the directory (static
  * storage). */
@@ -506,6 +508,45 @@ static void test_mirrored_nodes(void **state)
     assert_float_equal(iim[1] / iim[0], 1.0, 0.03);
 }
 
+/* --out: a directory holding someone else's files is refused (--force writes there), a second run
+ * replaces the first's frames without leaving the extra ones, and a run that cannot write (here past a
+ * file-size limit, as on a full disk) stops at the first file, names it and leaves nothing truncated. */
+static void test_output_dir(void **state)
+{
+    (void)state;
+    char dir[1024], args[2048], keep[1200];
+    snprintf(dir, sizeof dir, "%s/theirs", lmt_tmpdir());
+    snprintf(keep, sizeof keep, "%s/notes.txt", dir);
+    assert_int_equal(lm_mkdir_p(dir, &(lm_error){0}), LM_OK);
+    FILE *f = fopen(keep, "w");
+    assert_non_null(f);
+    fputs("mine", f);
+    fclose(f);
+    const char *quick = "run scenes/cornell.glb --size 32x32 --texel-size 0.1 --photons 5000 -q";
+    snprintf(args, sizeof args, "%s --frames 3 --out %s", quick, dir);
+    assert_int_equal(lmgi(args), 1);
+    assert_non_null(strstr(output, "notes.txt"));
+    assert_non_null(strstr(output, "--force"));
+    assert_false(exists(dir, "frame_0000.png"));
+    snprintf(args, sizeof args, "%s --frames 3 --out %s --force", quick, dir);
+    assert_int_equal(lmgi(args), 0);
+    assert_true(exists(dir, "frame_0002.png"));
+    snprintf(args, sizeof args, "%s --frames 1 --out %s", quick, dir); /* marked now: no --force needed */
+    assert_int_equal(lmgi(args), 0);
+    assert_true(exists(dir, "frame_0000.png") && exists(dir, "notes.txt"));
+    assert_false(exists(dir, "frame_0001.png") || exists(dir, "frame_0002.png"));
+
+    snprintf(dir, sizeof dir, "%s/full", lmt_tmpdir());
+    snprintf(args, sizeof args, "run scenes/cornell.glb --size 128x128 --texel-size 0.1 --photons 5000 -q "
+             "--frames 3 --out %s", dir);
+    assert_int_equal(lmgi_after("ulimit -f 100; ", args), 1); /* 50 or 100 KB: a frame's EXR does not fit */
+    print_message("past the file-size limit: %s", output);
+    assert_non_null(strstr(output, "frame_0000.exr"));
+    assert_non_null(strstr(output, "write failed"));
+    assert_false(exists(dir, "frame_0000.exr") || exists(dir, "frame_0000.exr.partial"));
+    assert_false(exists(dir, "frame_0001.png"));
+}
+
 static void test_reflections(void **state)
 {
     (void)state;
@@ -533,6 +574,7 @@ int main(void)
         cmocka_unit_test(test_reflections),
         cmocka_unit_test(test_flattened_node),
         cmocka_unit_test(test_mirrored_nodes),
+        cmocka_unit_test(test_output_dir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

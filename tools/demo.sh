@@ -3,6 +3,8 @@
 set -eu
 LMGI=${1:-build/lmgi}
 mkdir -p demo
+# demo/ is the demo's own (make clean removes it): --force lets a directory from before lmgi marked its
+# output directories (README, "Output directories") be written again.
 for scene in scenes/cornell.glb scenes/two_rooms.glb ../shared/scenes/cornell-box/CornellBox.glb; do
     name=$(basename "$scene" | sed 's/\.[^.]*$//')
     if [ ! -r "$scene" ]; then
@@ -11,34 +13,33 @@ for scene in scenes/cornell.glb scenes/two_rooms.glb ../shared/scenes/cornell-bo
     fi
     echo "== $scene"
     "$LMGI" info "$scene" | tee "demo/$name-info.txt"
-    "$LMGI" charts "$scene" --out "demo/$name" --size 1024x768
+    "$LMGI" charts "$scene" --out "demo/$name" --size 1024x768 --force
 done
 # The photon stage on the paper's scene: the cube and the mirror sphere move for 3 seconds.
 if [ -r scenes/cornell.glb ]; then
     echo "== photons on scenes/cornell.glb"
-    "$LMGI" photons scenes/cornell.glb --frames 90 --photons 50000 --out demo/cornell-photons
+    "$LMGI" photons scenes/cornell.glb --frames 90 --photons 50000 --out demo/cornell-photons --force
 fi
 # The whole frame loop on the same scene: composited frames, final lightmap atlases, per-stage times.
 if [ -r scenes/cornell.glb ]; then
     echo "== run on scenes/cornell.glb"
-    "$LMGI" run scenes/cornell.glb --frames 30 --size 512x512 --out demo/cornell-run
+    "$LMGI" run scenes/cornell.glb --frames 30 --size 512x512 --out demo/cornell-run --force
 fi
 # The shared Cornell box (its double-sided lamp 0.9 mm under the ceiling) as `lmgi run` renders it, and that
 # frame against the path-traced reference, per visible surface.
 if [ -r ../shared/scenes/cornell-box/CornellBox.glb ]; then
     echo "== run and check on ../shared/scenes/cornell-box/CornellBox.glb"
-    "$LMGI" run ../shared/scenes/cornell-box/CornellBox.glb --frames 1 --size 512x512 --out demo/cornellbox-run
-    mkdir -p demo/cornellbox-check
-    "$LMGI" check ../shared/scenes/cornell-box/CornellBox.glb --out demo/cornellbox-check -q | tee demo/cornellbox-check/check.txt
+    "$LMGI" run ../shared/scenes/cornell-box/CornellBox.glb --frames 1 --size 512x512 --out demo/cornellbox-run --force
+    "$LMGI" check ../shared/scenes/cornell-box/CornellBox.glb --out demo/cornellbox-check --force -q | tee demo/cornellbox-check.txt
 fi
 # A shared scene lit only by an emissive lamp, with a glossy Suzanne that reflects the room (its environment
 # map) and textured blocks whose indirect light takes the texture per pixel.
 if [ -r ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf ]; then
     echo "== run on ../shared/scenes/cornell-suzanne"
     "$LMGI" run ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf --frames 1 --size 512x512 \
-        --out demo/cornell-suzanne-run
+        --out demo/cornell-suzanne-run --force
 fi
 echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png,"
 echo "      demo/cornell-run/frame_*.png, demo/cornellbox-run/frame_0000.png, demo/cornell-suzanne-run/"
 echo "      frame_0000.png and demo/cornellbox-check/"
-echo "      (check_ratio.png: frame / reference, red brighter, blue darker; check.txt per surface)"
+echo "      (check_ratio.png: frame / reference, red brighter, blue darker; demo/cornellbox-check.txt per surface)"

@@ -46,6 +46,7 @@ typedef struct {
     int emitter_light;      /* --emitter-light closed|drawn: 1, 0 (-1 = per scene) */
     int emitter_rays;       /* --emitter-rays N: shadow rays per emissive triangle and texel */
     int in_order;           /* --in-order: photon stage before the gather, one thread (no overlap) */
+    int force;              /* --force: write into a non-empty --out directory lmgi did not make */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
 } lm_cli_args;
 

@@ -8,6 +8,7 @@
 #include "../core/image.h"
 #include "../core/log.h"
 #include "../update/frame_check.h"
+#include "out_dir.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
 
@@ -57,8 +58,8 @@ static int write_images(const char *dir, const lm_frame_check *c)
 {
     lm_error err;
     char path[4096];
-    lm_status st = lm_mkdir_p(dir, &err);
-    if (st == LM_OK) {
+    lm_status st = LM_OK;
+    {
         snprintf(path, sizeof path, "%s/check_frame.exr", dir);
         st = lm_write_exr(path, c->width, c->height, 3, c->frame, &err);
     }
@@ -87,6 +88,12 @@ int lm_cli_check(const lm_cli_args *a)
                         "       [--samples N] [--cache DIR] [--no-cache] [--out DIR]\n");
         return 2;
     }
+    static const char *const own[] = {"check_*.exr", "check_*.png", "*.partial", NULL};
+    lm_error err;
+    if (a->out_dir && lm_cli_claim_out_dir(a->out_dir, a->force, own, &err) != LM_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+        return 1;
+    }
     lmgi_scene *sc = NULL;
     if (!lm_cli_run_load(a, &sc))
         return 1;
@@ -100,7 +107,6 @@ int lm_cli_check(const lm_cli_args *a)
     if (!a->quiet && lm_log_get_level() < LM_LOG_INFO)
         lm_log_set_level(LM_LOG_INFO); /* the reference's progress lines */
     lm_frame_check c;
-    lm_error err;
     int rc = 0;
     if (lm_frame_check_run(sc, &ls, &rs, a->frames ? a->frames : 1, &c, &err) != LM_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.msg);

@@ -1,12 +1,14 @@
 /* The lmgi command. */
 #include <lmgi.h>
 
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 
 #include "args.h"
 #include "bench.h"
 #include "check_cmd.h"
+#include "out_dir.h"
 #include "photons_cmd.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
@@ -74,6 +76,8 @@ static void usage(FILE *f)
             "  --repeats N      'bench': runs per scene, the median is reported (default 3)\n"
             "  --json FILE      'bench': also write the results as JSON\n"
             "  --gather-scene F 'bench': the ~133k-triangle Cornell box for the gather table (make bench makes it)\n"
+            "  --force          write into a non-empty --out DIR that lmgi did not make (lmgi marks its\n"
+            "                   own with DIR/.lmgi and replaces only its own kind of file there)\n"
             "  -v, -q           more / less on stderr\n");
 }
 
@@ -108,6 +112,12 @@ static int cmd_charts(const lm_cli_args *a)
         fprintf(stderr, "lmgi: charts needs --out DIR\n");
         return 2;
     }
+    static const char *const own[] = {"atlas.png", "surfaces.png", "*.partial", NULL};
+    lm_error claim;
+    if (lm_cli_claim_out_dir(a->out_dir, a->force, own, &claim) != LM_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", claim.msg);
+        return 1;
+    }
     lmgi_scene *sc = NULL;
     int rc = load(a, &sc);
     if (rc)
@@ -136,6 +146,9 @@ int main(int argc, char **argv)
     lm_cli_args a;
     if (lm_cli_parse(argc, argv, 2, &a))
         return 2;
+    /* A file that outgrows the file-size limit (ulimit -f) is then a write error naming the file, as a
+     * full disk is, instead of a signal that kills the run. */
+    signal(SIGXFSZ, SIG_IGN);
     lmgi_set_verbosity(a.quiet ? 0 : a.verbose ? 2 : 1);
     const char *cmd = argv[1];
     if (!strcmp(cmd, "info"))

@@ -14,6 +14,7 @@
 #include "../gpu/lightmap_view.h"
 #include "../update/lmgi_scene.h"
 #include "../update/photon_stage.h"
+#include "out_dir.h"
 #include "progress.h"
 
 #define FRAME_RATE 30.0f /* frames are played at 30 per second of animation time */
@@ -156,7 +157,8 @@ int lm_cli_photons(const lm_cli_args *a)
     FILE *csv = NULL;
     double sum_ms = 0.0;
     float exposure = 1.0f;
-    lm_status st = lm_mkdir_p(a->out_dir, &err);
+    static const char *const own[] = {"aim.exr", "aim.png", "view.png", "stats.csv", "*.partial", NULL};
+    lm_status st = lm_cli_claim_out_dir(a->out_dir, a->force, own, &err);
     if (st == LM_OK) {
         snprintf(path, sizeof path, "%s/stats.csv", a->out_dir);
         csv = fopen(path, "w");

@@ -21,6 +21,7 @@
 #include "../gpu/camera.h"
 #include "../trace/reference.h"
 #include "../update/lmgi_scene.h"
+#include "out_dir.h"
 
 #define LM_CLI_REF_WIDTH 320
 #define LM_CLI_REF_HEIGHT 240
@@ -155,7 +156,9 @@ int lm_cli_reference(const lm_cli_args *a)
     }
     lm_error err;
     lm_emitters em;
-    int ok = lm_mkdir_p(a->out_dir, &err) == LM_OK && lm_emitters_build(sc->scene, &em, &err) == LM_OK;
+    static const char *const own[] = {"reference_*.exr", "reference_*.png", "*.partial", NULL};
+    int ok = lm_cli_claim_out_dir(a->out_dir, a->force, own, &err) == LM_OK &&
+             lm_emitters_build(sc->scene, &em, &err) == LM_OK;
     if (!ok) {
         fprintf(stderr, "lmgi: error: %s\n", err.msg);
         lmgi_free(sc);

@@ -3,6 +3,7 @@
  * The tone map's exposure is fixed from frame 0 so that the frames do not flicker. */
 #include "run_cmd.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -14,6 +15,7 @@
 #include "../core/tonemap.h"
 #include "../update/frame_loop.h"
 #include "../update/lmgi_scene.h"
+#include "out_dir.h"
 #include "photons_cmd.h"
 #include "progress.h"
 
@@ -79,7 +81,8 @@ static void csv_header(FILE *f)
                "frame_ms\n");
 }
 
-static void csv_row(FILE *f, const lm_frame_stats *r)
+/* Flushed row by row: a full disk stops the run at the row it hits, not after the last frame. */
+static int csv_row(FILE *f, const lm_frame_stats *r)
 {
     const lm_photon_stage_frame *s = &r->stage;
     fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", s->frame, (double)s->time,
@@ -87,6 +90,7 @@ static void csv_row(FILE *f, const lm_frame_stats *r)
             s->photons.groups_retraced, s->aim.surfaces_refreshed, r->texels_gathered, 1e3 * s->t_animate,
             1e3 * s->t_photons, 1e3 * s->t_aim, 1e3 * r->t_photons, 1e3 * r->t_gather, 1e3 * r->t_blend,
             1e3 * r->t_direct, 1e3 * r->t_composite, 1e3 * r->t_total);
+    return fflush(f) == 0 && !ferror(f);
 }
 
 /* DIR/NAME.exr (linear) and DIR/NAME.png (tone-mapped with exposure k, or automatic when k <= 0). */
@@ -118,7 +122,8 @@ static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
     char name[64];
     snprintf(name, sizeof name, "frame_%04d", f);
     st = write_pair(r->a->out_dir, name, w, h, img, r->exposure, f % every == 0, r->png, err);
-    csv_row(r->csv, &fs);
+    if (st == LM_OK && !csv_row(r->csv, &fs))
+        st = lm_fail(err, LM_ERR_IO, "%s/frames.csv: write failed (%s)", r->a->out_dir, strerror(errno));
     const double ms[6] = {fs.t_photons, fs.t_gather, fs.t_blend, fs.t_direct, fs.t_composite, fs.t_total};
     for (int i = 0; i < 6; i++)
         r->sum_ms[i] += 1e3 * ms[i];
@@ -222,13 +227,12 @@ static lm_status play(run_state *r, lm_error *err)
     return st;
 }
 
-/* The output directory, made (or found writable) before the long setup, so a bad path fails at once. */
+/* The output directory, claimed before the long setup, so a bad path fails at once. */
 static lm_status check_out_dir(const run_state *r, lm_error *err)
 {
-    lm_status st = lm_mkdir_p(r->a->out_dir, err);
-    if (st == LM_OK && access(r->a->out_dir, W_OK) != 0)
-        st = lm_fail(err, LM_ERR_IO, "%s: not writable", r->a->out_dir);
-    return st;
+    static const char *const own[] = {"frame_*.png", "frame_*.exr", "frames.csv", "iim.exr", "iim.png", "aim.exr",
+                                      "aim.png", "*.partial", NULL};
+    return lm_cli_claim_out_dir(r->a->out_dir, r->a->force, own, err);
 }
 
 /* Files are created only once the frame loop exists: a run refused for its settings writes nothing. */

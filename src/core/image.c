@@ -11,33 +11,115 @@
 #include <stb/stb_image_write.h>
 #include <tinyexr.h>
 
+/* A file appears whole or not at all: the bytes go to PATH.partial, every write and the close are
+ * checked (a full disk shows up at fclose, when the buffer is flushed), and only then does a rename put
+ * it in place. A failure removes the partial file and leaves whatever PATH held before. */
+lm_status lm_write_file(const char *path, const void *data, size_t size, lm_error *err)
+{
+    char tmp[4200];
+    if (snprintf(tmp, sizeof tmp, "%s.partial", path) >= (int)sizeof tmp)
+        return lm_fail(err, LM_ERR_INVALID, "%s: path too long", path);
+    FILE *f = fopen(tmp, "wb");
+    if (!f)
+        return lm_fail(err, LM_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    int ok = fwrite(data, 1, size, f) == size;
+    int e = errno;
+    ok = fflush(f) == 0 && ok;
+    e = ok ? 0 : (e ? e : errno);
+    if (fclose(f) != 0 && ok)
+        ok = 0, e = errno;
+    if (ok && rename(tmp, path) != 0)
+        ok = 0, e = errno;
+    if (!ok) {
+        remove(tmp);
+        return lm_fail(err, LM_ERR_IO, "%s: write failed (%s)", path, e ? strerror(e) : "short write");
+    }
+    return LM_OK;
+}
+
+typedef struct {
+    uint8_t *data;
+    size_t size, cap;
+    int failed;
+} byte_buffer;
+
+static void append_bytes(void *context, void *data, int size)
+{
+    byte_buffer *b = context;
+    if (b->failed || size <= 0)
+        return;
+    if (b->size + (size_t)size > b->cap) {
+        size_t cap = 2 * b->cap + (size_t)size;
+        uint8_t *grown = realloc(b->data, cap);
+        if (!grown) {
+            b->failed = 1;
+            return;
+        }
+        b->data = grown, b->cap = cap;
+    }
+    memcpy(b->data + b->size, data, (size_t)size);
+    b->size += (size_t)size;
+}
+
 lm_status lm_write_png(const char *path, int width, int height, const uint8_t *rgba8, lm_error *err)
 {
     if (width <= 0 || height <= 0 || !rgba8)
         return lm_fail(err, LM_ERR_INVALID, "%s: cannot write an empty %dx%d image", path, width, height);
-    if (!stbi_write_png(path, width, height, 4, rgba8, width * 4))
-        return lm_fail(err, LM_ERR_IO, "%s: cannot write PNG (%s)", path, strerror(errno));
-    return LM_OK;
+    byte_buffer b = {0};
+    int ok = stbi_write_png_to_func(append_bytes, &b, width, height, 4, rgba8, width * 4) && !b.failed;
+    lm_status st = ok ? lm_write_file(path, b.data, b.size, err)
+                      : lm_fail(err, LM_ERR_NOMEM, "%s: no memory to encode a %dx%d PNG", path, width, height);
+    free(b.data);
+    return st;
 }
 
+/* EXR in memory: one float plane per channel, in the (A)BGR order viewers expect, ZIP-compressed except
+ * for images under 16 x 16 (as tinyexr's SaveEXR does; written here so the file write can be checked). */
 lm_status lm_write_exr(const char *path, int width, int height, int channels, const float *data, lm_error *err)
 {
     if (width <= 0 || height <= 0 || !data || (channels != 1 && channels != 3 && channels != 4))
         return lm_fail(err, LM_ERR_INVALID, "%s: cannot write a %dx%d EXR with %d channels", path, width,
                        height, channels);
-    /* tinyexr leaks when it cannot open the file, so find that out first. */
-    FILE *probe = fopen(path, "wb");
-    if (!probe)
-        return lm_fail(err, LM_ERR_IO, "%s: cannot write EXR (%s)", path, strerror(errno));
-    fclose(probe);
-    const char *msg = NULL;
-    if (SaveEXR(data, width, height, channels, 0, path, &msg) < 0) {
-        lm_status st = lm_fail(err, LM_ERR_IO, "%s: cannot write EXR (%s)", path, msg ? msg : "unknown");
-        if (msg)
-            FreeEXRErrorMessage(msg);
-        return st;
+    size_t n = (size_t)width * height;
+    float *planes = malloc(sizeof *planes * n * (size_t)channels);
+    if (!planes)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory to encode a %dx%d EXR", path, width, height);
+    static const char *names[4][4] = {{"A"}, {0}, {"B", "G", "R"}, {"A", "B", "G", "R"}};
+    static const int source[4][4] = {{0}, {0}, {2, 1, 0}, {3, 2, 1, 0}}; /* data channel of each plane */
+    unsigned char *plane_ptr[4];
+    EXRChannelInfo info[4];
+    int types[4];
+    memset(info, 0, sizeof info);
+    for (int c = 0; c < channels; c++) {
+        float *plane = planes + (size_t)c * n;
+        for (size_t i = 0; i < n; i++)
+            plane[i] = data[(size_t)channels * i + (size_t)source[channels - 1][c]];
+        plane_ptr[c] = (unsigned char *)plane;
+        snprintf(info[c].name, sizeof info[c].name, "%s", names[channels - 1][c]);
+        types[c] = TINYEXR_PIXELTYPE_FLOAT;
     }
-    return LM_OK;
+    EXRHeader header;
+    InitEXRHeader(&header);
+    header.compression_type = width < 16 && height < 16 ? TINYEXR_COMPRESSIONTYPE_NONE : TINYEXR_COMPRESSIONTYPE_ZIP;
+    header.num_channels = channels;
+    header.channels = info;
+    header.pixel_types = types;
+    header.requested_pixel_types = types;
+    EXRImage image;
+    InitEXRImage(&image);
+    image.num_channels = channels;
+    image.images = plane_ptr;
+    image.width = width, image.height = height;
+    unsigned char *bytes = NULL;
+    const char *msg = NULL;
+    size_t size = SaveEXRImageToMemory(&image, &header, &bytes, &msg);
+    free(planes);
+    lm_status st = size ? lm_write_file(path, bytes, size, err)
+                        : lm_fail(err, LM_ERR_IO, "%s: cannot encode EXR (%s)", path, msg ? msg : "unknown");
+    if (msg)
+        FreeEXRErrorMessage(msg);
+    free(bytes);
+    return st;
 }
 
 lm_status lm_read_exr(const char *path, int *width, int *height, float **out, lm_error *err)

@@ -6,7 +6,10 @@
 
 #include "error.h"
 
-/* rgba8: width*height*4 bytes, row 0 at the top. */
+/* Writes size bytes to path through path.partial and a rename: the file is whole or absent, every write
+ * and the close checked; on failure the message names path and the reason, and path is as it was. */
+lm_status lm_write_file(const char *path, const void *data, size_t size, lm_error *err);
+/* rgba8: width*height*4 bytes, row 0 at the top. Both writers go through lm_write_file. */
 lm_status lm_write_png(const char *path, int width, int height, const uint8_t *rgba8, lm_error *err);
 /* rgb: width*height*channels floats (channels 1, 3 or 4), row 0 at the top. */
 lm_status lm_write_exr(const char *path, int width, int height, int channels, const float *data, lm_error *err);
