@@ -71,6 +71,32 @@ static void test_bad_scene_files(void **state)
     snprintf(args, sizeof args, "info %s", path);
     assert_int_equal(run(args), 1);
     assert_non_null(strstr(output, "bad.gltf"));
+
+    /* An empty scene: info says so (its bounds printed as +-3.4e38 before); run has nothing to light. */
+    snprintf(path, sizeof path, "%s/empty.gltf", lmt_tmpdir());
+    f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("{\"asset\": {\"version\": \"2.0\"}}", f);
+    fclose(f);
+    snprintf(args, sizeof args, "info %s", path);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "the scene is empty"));
+    snprintf(args, sizeof args, "run %s --out %s/out", path, lmt_tmpdir());
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "nothing to light"));
+
+    /* A material whose texture is missing: info says it uses its factor alone. */
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_quad(&m, (float[3]){0, 0, 0}, (float[3]){1, 0, 0}, (float[3]){0, 0, -1});
+    const char *textured = lmt_write_scene("textured.gltf", &m, 1, "[{\"mesh\": 0}]",
+                                           "[{\"name\": \"poster\", \"pbrMetallicRoughness\": "
+                                           "{\"baseColorTexture\": {\"index\": 0}}}], \"textures\": [{\"source\": 0}], "
+                                           "\"images\": [{\"uri\": \"gone.png\"}]");
+    snprintf(args, sizeof args, "info %s", textured);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "gone.png"));
+    assert_non_null(strstr(output, "texture is missing or undecodable"));
 }
 
 /* Degenerate triangles are a warning by default (the scene still loads) and an error with --strict. */

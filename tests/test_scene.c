@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+#include <sys/stat.h>
 
 #include <cmocka.h>
 #include <stb/stb_image_write.h>
@@ -551,6 +553,44 @@ static void test_bad_input(void **state)
     lm_log_set_level(LM_LOG_WARN);
 }
 
+/* Inputs that once gave an unclear message or none (issue 16): each is now an error naming what is wrong. */
+static void test_clear_errors(void **state)
+{
+    (void)state;
+    const char *dir = tri_setup();
+    char p[512];
+    tri_opts o = tri_defaults();
+
+    /* a buffer of byteLength 0 gave tinygltf's "vector::_M_range_check" */
+    static const char *empty_buffer =
+        "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"name\":\"geometry\",\"uri\":\"tri.bin\",\"byteLength\":0}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":6}]}";
+    write_text(dir, "zero-buffer.gltf", empty_buffer, p, sizeof p);
+    load_fails(p, 0, LM_ERR_FORMAT, "buffer 0 (\"geometry\"): byteLength 0");
+
+    /* a light of colour 1e38 overflowed its photon power to infinity and failed only in 'run' */
+    static const char *bright =
+        "{\"asset\":{\"version\":\"2.0\"},\"extensionsUsed\":[\"KHR_lights_punctual\"],"
+        "\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[{\"name\":\"sun\",\"type\":\"point\","
+        "\"color\":[1e38,1,1]}]}},\"nodes\":[{\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}]}";
+    write_text(dir, "bright.gltf", bright, p, sizeof p);
+    load_fails(p, 0, LM_ERR_INVALID, "light 0 (\"sun\"): colour x intensity 1e+38 exceeds");
+
+    o.ext = "\"extensionsUsed\":[\"KHR_materials_emissive_strength\"],";
+    o.material = "\"materials\":[{\"name\":\"lava\",\"emissiveFactor\":[1,1,1],\"extensions\":"
+                 "{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":1e30}}}],";
+    tri_case(dir, "emission.gltf", &o, p, sizeof p);
+    load_fails(p, 0, LM_ERR_INVALID, "material 0 (\"lava\"): emission 1e+30");
+
+    /* a directory read as "read error"; a device would be read forever */
+    snprintf(p, sizeof p, "%s/scene.gltf", dir);
+    assert_int_equal(mkdir(p, 0777), 0);
+    load_fails(p, 0, LM_ERR_IO, "is a directory");
+    if (access("/dev/zero", R_OK) == 0)
+        load_fails("/dev/zero", 0, LM_ERR_FORMAT, "device or pipe");
+    lm_log_set_level(LM_LOG_WARN);
+}
+
 static void test_non_triangle_modes(void **state)
 {
     (void)state;
@@ -737,6 +777,7 @@ int main(void)
         cmocka_unit_test(test_extras),
         cmocka_unit_test(test_world_transforms),
         cmocka_unit_test(test_bad_input),
+        cmocka_unit_test(test_clear_errors),
         cmocka_unit_test(test_non_triangle_modes),
         cmocka_unit_test(test_material_and_texture),
         cmocka_unit_test(test_texture_transform_rotation),

@@ -12,6 +12,7 @@
 #include "photons_cmd.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
+#include "scene_load.h"
 
 static void usage(FILE *f)
 {
@@ -87,12 +88,7 @@ static int load(const lm_cli_args *a, lmgi_scene **sc)
         fprintf(stderr, "lmgi: expected exactly one scene file, got %d (see 'lmgi help')\n", a->file_count);
         return 2;
     }
-    lmgi_error err;
-    if (lmgi_load(a->files[0], &a->options, sc, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        return 1;
-    }
-    return 0;
+    return lm_cli_load_scene(a->files[0], &a->options, 0, sc) ? 0 : 1;
 }
 
 static int cmd_info(const lm_cli_args *a)

@@ -16,6 +16,7 @@
 #include "../update/photon_stage.h"
 #include "out_dir.h"
 #include "progress.h"
+#include "scene_load.h"
 
 #define FRAME_RATE 30.0f /* frames are played at 30 per second of animation time */
 
@@ -141,11 +142,8 @@ int lm_cli_photons(const lm_cli_args *a)
         return 2;
     }
     lmgi_scene *sc = NULL;
-    lmgi_error perr;
-    if (lmgi_load(a->files[0], &a->options, &sc, &perr) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", perr.message);
+    if (!lm_cli_load_scene(a->files[0], &a->options, 1, &sc))
         return 1;
-    }
     lm_error err;
     lm_error_clear(&err);
     lm_photon_stage_settings set;

@@ -22,6 +22,7 @@
 #include "../trace/reference.h"
 #include "../update/lmgi_scene.h"
 #include "out_dir.h"
+#include "scene_load.h"
 
 #define LM_CLI_REF_WIDTH 320
 #define LM_CLI_REF_HEIGHT 240
@@ -149,11 +150,8 @@ int lm_cli_reference(const lm_cli_args *a)
         return 2;
     }
     lmgi_scene *sc = NULL;
-    lmgi_error lerr;
-    if (lmgi_load(a->files[0], &a->options, &sc, &lerr) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", lerr.message);
+    if (!lm_cli_load_scene(a->files[0], &a->options, 1, &sc))
         return 1;
-    }
     lm_error err;
     lm_emitters em;
     static const char *const own[] = {"reference_*.exr", "reference_*.png", "*.partial", NULL};

@@ -18,6 +18,7 @@
 #include "out_dir.h"
 #include "photons_cmd.h"
 #include "progress.h"
+#include "scene_load.h"
 
 #define FRAME_RATE 30.0f /* frames are played at 30 per second of animation time */
 
@@ -275,16 +276,11 @@ static lm_status run(run_state *r, lm_error *err)
 
 int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc)
 {
-    lmgi_error perr;
     lmgi_options o = a->options;
     int per_frame = a->texels_per_frame ? a->texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME;
     if (o.texel_size <= 0.0f && o.target_texels <= 0) /* a density the texel budget keeps up with */
         o.target_texels = lm_frame_loop_atlas_texels(per_frame);
-    if (lmgi_load(a->files[0], &o, sc, &perr) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", perr.message);
-        return 0;
-    }
-    return 1;
+    return lm_cli_load_scene(a->files[0], &o, 1, sc);
 }
 
 int lm_cli_run(const lm_cli_args *a)

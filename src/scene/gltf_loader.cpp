@@ -2,6 +2,7 @@
 // everything format-independent (decoding, triangulation, normals, node resolution) to scene_build.c.
 // Every check against the file's own numbers (indices, accessor spans, bufferViews) is done here:
 // tinygltf 2.7 parses the JSON but does not validate those. docs/loading.md lists what is accepted.
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 #include <stb_image.h>
 
@@ -10,6 +11,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <sys/stat.h>
 #include <memory>
 #include <new>
 #include <string>
@@ -151,6 +153,7 @@ class Loader {
     lm_status fail(lm_status st, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
     lm_status read_file(std::vector<unsigned char> &bytes);
     lm_status check_glb(const std::vector<unsigned char> &b);
+    lm_status check_buffers(const std::vector<unsigned char> &b, bool glb);
     lm_status parse(const std::vector<unsigned char> &bytes);
     lm_status check_extensions();
     lm_status locate(int acc, int type, const char *what, const std::string &ctx, Span &sp);
@@ -190,21 +193,38 @@ lm_status Loader::fail(lm_status st, const char *fmt, ...)
     return lm_fail(err_, st, "%s: %s", path_, msg);
 }
 
+// A regular file is read whole up to 4 GiB (tinygltf takes a 32-bit size); anything else (a pipe, a
+// device: /dev/zero never ends) up to k_max_stream_bytes, so no input reads forever.
+const uint64_t k_max_file_bytes = UINT32_MAX, k_max_stream_bytes = 256ull << 20;
+
 lm_status Loader::read_file(std::vector<unsigned char> &bytes)
 {
+    struct stat st;
+    if (stat(path_, &st) != 0)
+        return fail(LM_ERR_IO, "cannot open file: %s", strerror(errno));
+    if (S_ISDIR(st.st_mode))
+        return fail(LM_ERR_IO, "is a directory, not a .gltf or .glb file");
+    bool regular = S_ISREG(st.st_mode);
+    uint64_t cap = regular ? k_max_file_bytes : k_max_stream_bytes;
+    if (regular && uint64_t(st.st_size) > cap)
+        return fail(LM_ERR_FORMAT, "%llu bytes: larger than the 4 GiB a glTF file may have here",
+                    (unsigned long long)st.st_size);
     FILE *f = fopen(path_, "rb");
     if (!f)
         return fail(LM_ERR_IO, "cannot open file: %s", strerror(errno));
+    if (regular)
+        bytes.reserve(size_t(st.st_size));
     unsigned char buf[65536];
     size_t n;
-    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+    while (bytes.size() <= cap && (n = fread(buf, 1, sizeof buf, f)) > 0)
         bytes.insert(bytes.end(), buf, buf + n);
     bool bad = ferror(f);
     fclose(f);
     if (bad)
-        return fail(LM_ERR_IO, "read error");
-    if (bytes.size() > UINT32_MAX)
-        return fail(LM_ERR_FORMAT, "file larger than 4 GiB");
+        return fail(LM_ERR_IO, "read error: %s", strerror(errno));
+    if (bytes.size() > cap)
+        return fail(LM_ERR_FORMAT, "more than %llu MiB from a %s: not a scene file", (unsigned long long)(cap >> 20),
+                    regular ? "file" : "device or pipe");
     return LM_OK;
 }
 
@@ -238,14 +258,43 @@ lm_status Loader::check_glb(const std::vector<unsigned char> &b)
     return LM_OK;
 }
 
+// Buffers as glTF requires them (byteLength at least 1; the GLB's own buffer within its BIN chunk),
+// checked before tinygltf, which indexes an empty buffer unchecked ("vector::_M_range_check"). Malformed
+// JSON is left to tinygltf's parser and its message.
+lm_status Loader::check_buffers(const std::vector<unsigned char> &b, bool glb)
+{
+    size_t json_len = glb ? le32(&b[12]) : b.size(), json_at = glb ? 20 : 0;
+    nlohmann::json j = nlohmann::json::parse(b.begin() + long(json_at), b.begin() + long(json_at + json_len), nullptr,
+                                             false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("buffers") || !j["buffers"].is_array())
+        return LM_OK;
+    uint64_t bin_len = 0;
+    uint64_t bin = 20 + ((uint64_t(json_len) + 3) & ~3ull);
+    if (glb && bin + 8 <= le32(&b[8]))
+        bin_len = le32(&b[bin]);
+    const nlohmann::json &buffers = j["buffers"];
+    for (size_t i = 0; i < buffers.size(); i++) {
+        const nlohmann::json &buf = buffers[i];
+        std::string name = buf.is_object() && buf.contains("name") && buf["name"].is_string() ? buf["name"] : "";
+        const char *what = name.c_str();
+        if (!buf.is_object() || !buf.contains("byteLength") || !buf["byteLength"].is_number())
+            return fail(LM_ERR_FORMAT, "buffer %zu (\"%s\") has no byteLength", i, what);
+        double len = buf["byteLength"].get<double>();
+        if (!(len >= 1.0))
+            return fail(LM_ERR_FORMAT, "buffer %zu (\"%s\"): byteLength %g; glTF requires at least 1", i, what, len);
+        if (glb && i == 0 && !buf.contains("uri") && len > double(bin_len))
+            return fail(LM_ERR_FORMAT, "buffer 0 (\"%s\"): byteLength %g, but the .glb's BIN chunk holds %llu bytes",
+                        what, len, (unsigned long long)bin_len);
+    }
+    return LM_OK;
+}
+
 lm_status Loader::parse(const std::vector<unsigned char> &bytes)
 {
     bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
-    if (glb) {
-        lm_status st = check_glb(bytes);
-        if (st)
-            return st;
-    }
+    lm_status checked = glb ? check_glb(bytes) : LM_OK;
+    if (checked || (checked = check_buffers(bytes, glb)))
+        return checked;
     std::string p(path_), dir = ".";
     size_t slash = p.find_last_of('/');
     if (slash != std::string::npos)
@@ -390,6 +439,7 @@ lm_status Loader::materials()
         const tinygltf::PbrMetallicRoughness &pbr = m.pbrMetallicRoughness;
         vec_or(pbr.baseColorFactor, 4, one4, d.base_color);
         d.base_color_tex = texture(pbr.baseColorTexture.index, ctx);
+        d.missing_textures = pbr.baseColorTexture.index >= 0 && d.base_color_tex < 0;
         d.base_color_uv = pbr.baseColorTexture.texCoord == 1 ? 1 : 0;
         d.uv_scale[0] = d.uv_scale[1] = 1.0f;
         if (const tinygltf::Value *tt = ext_obj(pbr.baseColorTexture.extensions, "KHR_texture_transform")) {
@@ -411,6 +461,7 @@ lm_status Loader::materials()
         for (int k = 0; k < 3; k++)
             d.emissive[k] *= strength;
         d.emissive_tex = texture(m.emissiveTexture.index, ctx);
+        d.missing_textures += m.emissiveTexture.index >= 0 && d.emissive_tex < 0;
         d.transmission = float(num(ext_obj(m.extensions, "KHR_materials_transmission"), "transmissionFactor", 0.0));
         d.ior = float(num(ext_obj(m.extensions, "KHR_materials_ior"), "ior", 1.5));
         d.double_sided = m.doubleSided;
@@ -419,6 +470,11 @@ lm_status Loader::materials()
                              d.emissive[0], d.emissive[1], d.emissive[2], d.transmission, d.ior};
         if (!finite_all(all, sizeof all / sizeof all[0]))
             return fail(LM_ERR_INVALID, "%s has a non-finite parameter", ctx.c_str());
+        for (int k = 0; k < 3; k++)
+            if (!(std::fabs(d.emissive[k]) <= LM_MAX_EMISSION))
+                return fail(LM_ERR_INVALID, "%s: emission %g (emissiveFactor x emissiveStrength) exceeds %g: the "
+                            "photon powers it makes would overflow to infinity", ctx.c_str(), double(d.emissive[k]),
+                            LM_MAX_EMISSION);
         lm_material_classify(&d);
     }
     s_->material_count = int(n);
@@ -553,6 +609,11 @@ lm_status Loader::node_instances()
         const float all[] = {d.color[0], d.color[1], d.color[2], d.intensity, d.range, d.inner_cone, d.outer_cone};
         if (!finite_all(all, 7) || d.intensity < 0.0f)
             return fail(LM_ERR_INVALID, "light %d (\"%s\") has a non-finite or negative parameter", li, l.name.c_str());
+        for (int k = 0; k < 3; k++)
+            if (!(std::fabs(d.color[k] * d.intensity) <= LM_MAX_EMISSION))
+                return fail(LM_ERR_INVALID, "light %d (\"%s\"): colour x intensity %g exceeds %g: its photon powers "
+                            "would overflow to infinity", li, l.name.c_str(), double(d.color[k]) * d.intensity,
+                            LM_MAX_EMISSION);
         s_->nodes[i].light = int(lights.size());
         lights.push_back(d);
     }

@@ -40,6 +40,8 @@ typedef struct {
     float metallic, roughness;
     float emissive[3];     /* emissiveFactor x KHR_materials_emissive_strength: emitted radiance */
     int emissive_tex;      /* -1 if none */
+    int missing_textures;  /* textures the file names for it that could not be found or decoded (it uses
+                            * its factors instead; lmgi info says so) */
     float transmission;    /* KHR_materials_transmission factor */
     float ior;             /* KHR_materials_ior (1.5 when absent) */
     int double_sided;      /* both sides lit alike by one triangle: after loading, only mirror and glass;
@@ -196,6 +198,10 @@ float lm_scene_animation_duration(const lm_scene *s);
 /* The largest |coordinate| a vertex may have in world space after loading (a load error beyond it):
  * rays must stay far inside Embree's limit of about 1.8e18, and texel sizes and scene sizes finite. */
 #define LM_MAX_COORDINATE 1e15f
+/* The largest light colour x intensity or material emission (a load error beyond it): a photon's power is
+ * that times 4 pi or an area, summed over bounces and texels in float; 1e38 overflowed to infinity and
+ * asked for 77 billion photons. The brightest real light (the sun, about 1e5 lux) is far below. */
+#define LM_MAX_EMISSION 1e20
 
 /* World-space position of a vertex / normal under the current node matrices. */
 void lm_scene_vertex_world(const lm_scene *s, uint32_t v, float out[3]);

@@ -69,11 +69,13 @@ static void print_materials(const lm_scene *s, const lmgi_info *in, FILE *f)
         if (in->materials_by_class[c])
             fprintf(f, " %d %s", in->materials_by_class[c], lm_material_class_name((lm_material_class)c));
     fputc('\n', f);
-    for (int m = 0; m < s->material_count; m++)
-        fprintf(f, "  %-28s %-8s base (%.2f %.2f %.2f)%s\n", s->materials[m].name,
-                lm_material_class_name(s->materials[m].cls), (double)s->materials[m].base_color[0],
-                (double)s->materials[m].base_color[1], (double)s->materials[m].base_color[2],
-                s->materials[m].base_color_tex >= 0 ? " + texture" : "");
+    for (int m = 0; m < s->material_count; m++) {
+        const lm_material *mat = &s->materials[m];
+        fprintf(f, "  %-28s %-8s base (%.2f %.2f %.2f)%s%s\n", mat->name, lm_material_class_name(mat->cls),
+                (double)mat->base_color[0], (double)mat->base_color[1], (double)mat->base_color[2],
+                mat->base_color_tex >= 0 ? " + texture" : "",
+                mat->missing_textures ? " (a texture is missing or undecodable: its factor alone is used)" : "");
+    }
 }
 
 static void print_nodes(const lm_scene *s, const lmgi_info *in, FILE *f)
@@ -106,9 +108,12 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     if (in.back_triangles)
         fprintf(f, ", and %u back sides of double-sided surfaces", in.back_triangles);
     fputc('\n', f);
-    fprintf(f, "bounds      (%.4g %.4g %.4g) .. (%.4g %.4g %.4g)\n", (double)in.bounds_min[0],
-            (double)in.bounds_min[1], (double)in.bounds_min[2], (double)in.bounds_max[0], (double)in.bounds_max[1],
-            (double)in.bounds_max[2]);
+    if (in.triangles == 0)
+        fprintf(f, "bounds      none: the scene is empty (no triangles)\n");
+    else
+        fprintf(f, "bounds      (%.4g %.4g %.4g) .. (%.4g %.4g %.4g)\n", (double)in.bounds_min[0],
+                (double)in.bounds_min[1], (double)in.bounds_min[2], (double)in.bounds_max[0],
+                (double)in.bounds_max[1], (double)in.bounds_max[2]);
     print_nodes(s, &in, f);
     print_materials(s, &in, f);
     print_lights(s, &in, f);

@@ -1,0 +1,12 @@
+/* Loading the command's scene, with the command's message on failure. */
+#ifndef LM_CLI_SCENE_LOAD_H
+#define LM_CLI_SCENE_LOAD_H
+
+#include <lmgi.h>
+
+/* Loads path into *sc; prints "lmgi: error: ..." and returns 0 on failure. With lit = 1 a scene without
+ * triangles is refused too (nothing to light: 'run', 'photons' and 'reference' would only write black
+ * pictures), naming the file; 'info' and 'charts' take it. */
+int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_scene **sc);
+
+#endif
