@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "../src/core/image.h"
+#include "../src/core/memory.h"
 #include "../src/core/palette.h"
 #include "../src/core/tonemap.h"
 #include "../src/core/vecmath.h"
@@ -232,6 +233,20 @@ static void test_write_past_limit(void **state)
     }
 }
 
+/* A plan larger than the machine is refused naming what and the advice; a large one is allowed (warned). */
+static void test_memory_plan(void **state)
+{
+    (void)state;
+    double have = (double)lm_memory_physical();
+    assert_true(have > 0.0);
+    lm_error err;
+    assert_int_equal(lm_memory_plan("a test atlas", 2.0 * have, "use fewer texels", &err), LM_ERR_NOMEM);
+    assert_non_null(strstr(err.msg, "a test atlas"));
+    assert_non_null(strstr(err.msg, "use fewer texels"));
+    assert_int_equal(lm_memory_plan("a test atlas", 0.5 * have, "use fewer texels", &err), LM_OK);
+    assert_int_equal(lm_memory_plan("a test atlas", 1e6, "use fewer texels", &err), LM_OK);
+}
+
 static void test_palette_distinct(void **state)
 {
     (void)state;
@@ -286,6 +301,7 @@ int main(void)
         cmocka_unit_test(test_exr_round_trip),
         cmocka_unit_test(test_png_round_trip),
         cmocka_unit_test(test_write_past_limit),
+        cmocka_unit_test(test_memory_plan),
         cmocka_unit_test(test_palette_distinct),
         cmocka_unit_test(test_mkdir_p),
         cmocka_unit_test(test_tonemap),

@@ -547,6 +547,33 @@ static void test_output_dir(void **state)
     assert_false(exists(dir, "frame_0001.png"));
 }
 
+/* 1,000 point lights took 13.5 GB of shadow maps: all maps together now stay within a budget, each made
+ * smaller (and the run says so) when many lights share it. 30 point lights at 512 a face would take
+ * 360 MB: they get 256. */
+static void test_many_lights_share_shadow_maps(void **state)
+{
+    (void)state;
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_quad(&m, (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    const char *materials = "[{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}], \"extensionsUsed\": "
+                            "[\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": "
+                            "[{\"type\": \"point\", \"intensity\": 0.5}]}}";
+    char nodes[8192];
+    int at = snprintf(nodes, sizeof nodes, "[{\"mesh\": 0}");
+    for (int i = 0; i < 30; i++)
+        at += snprintf(nodes + at, sizeof nodes - (size_t)at, ", {\"translation\": [%g, 1.5, %g], \"extensions\": "
+                       "{\"KHR_lights_punctual\": {\"light\": 0}}}", -1.5 + 0.5 * (i % 6), -1.0 + 0.5 * (i / 6));
+    snprintf(nodes + at, sizeof nodes - (size_t)at, "]");
+    const char *path = lmt_write_scene("lights30.gltf", &m, 1, nodes, materials);
+    char dir[1100], args[4096];
+    snprintf(dir, sizeof dir, "%s/lights30", lmt_tmpdir());
+    snprintf(args, sizeof args, "run %s --frames 1 --size 32x32 --photons 20000 --exr-every 1 --out %s", path, dir);
+    assert_int_equal(lmgi(args), 0);
+    assert_non_null(strstr(output, "30 lights: shadow maps of 256 (cube faces)"));
+    assert_true(frame_mean(dir, "frame_0000.exr") > 0.0);
+}
+
 static void test_reflections(void **state)
 {
     (void)state;
@@ -575,6 +602,7 @@ int main(void)
         cmocka_unit_test(test_flattened_node),
         cmocka_unit_test(test_mirrored_nodes),
         cmocka_unit_test(test_output_dir),
+        cmocka_unit_test(test_many_lights_share_shadow_maps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -10,6 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/log.h"
+#include "../core/memory.h"
 #include "../core/vecmath.h"
 #include "direct_shader.h"
 #include "direct_mesh.h"
@@ -239,6 +241,40 @@ static int valid_settings(const lm_direct_settings *set)
     return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0;
 }
 
+/* Shadow-map texels for the scene's lights at the settings' sizes: a cube (6 faces) per point light, a
+ * 2D map per spot and directional light, each with its static layer (shadow_maps.h), 4 bytes a texel. */
+static double shadow_bytes(const lm_scene *s, int cube_size, int map_size)
+{
+    double bytes = 0.0;
+    for (int l = 0; l < s->light_count; l++)
+        bytes += s->lights[l].type == LM_LIGHT_POINT ? 6.0 * cube_size * cube_size : (double)map_size * map_size;
+    return 2.0 * 4.0 * bytes;
+}
+
+/* The shadow maps share LM_DIRECT_SHADOW_BUDGET: with many lights each map is made smaller (halved down to
+ * LM_DIRECT_SHADOW_MIN_SIZE, said once) instead of asking for 12 MB a point light (1,000 point lights took
+ * 13.5 GB and ended in "OpenGL error 0x0505"); a scene whose lights do not fit even then is refused. */
+static lm_status fit_shadow_budget(const lm_scene *s, lm_direct_settings *set, lm_error *err)
+{
+    int cube = set->cube_size, map = set->map_size;
+    while (shadow_bytes(s, cube, map) > LM_DIRECT_SHADOW_BUDGET &&
+           (cube > LM_DIRECT_SHADOW_MIN_SIZE || map > LM_DIRECT_SHADOW_MIN_SIZE)) {
+        cube = cube / 2 > LM_DIRECT_SHADOW_MIN_SIZE ? cube / 2 : LM_DIRECT_SHADOW_MIN_SIZE;
+        map = map / 2 > LM_DIRECT_SHADOW_MIN_SIZE ? map / 2 : LM_DIRECT_SHADOW_MIN_SIZE;
+    }
+    double mb = 1024.0 * 1024.0, need = shadow_bytes(s, cube, map);
+    if (need > LM_DIRECT_SHADOW_BUDGET)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: %d lights need %.0f MB of shadow maps even at %d texels a side, more "
+                       "than the %.0f MB they may take", s->path, s->light_count, need / mb, LM_DIRECT_SHADOW_MIN_SIZE,
+                       LM_DIRECT_SHADOW_BUDGET / mb);
+    if (cube != set->cube_size || map != set->map_size)
+        lm_warn("%s: %d lights: shadow maps of %d (cube faces) and %d texels a side instead of %d and %d, so that "
+                "they fit in %.0f MB; their shadows are softer", s->path, s->light_count, cube, map, set->cube_size,
+                set->map_size, LM_DIRECT_SHADOW_BUDGET / mb);
+    set->cube_size = cube, set->map_size = map;
+    return LM_OK;
+}
+
 lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct_settings *settings, lm_direct **out,
                            lm_error *err)
 {
@@ -256,7 +292,7 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
         return lm_fail(err, LM_ERR_INVALID, "direct_light: bad settings (map %d, cube %d, pcf %d)", bad.map_size,
                        bad.cube_size, bad.pcf_radius);
     }
-    lm_status st = LM_OK;
+    lm_status st = fit_shadow_budget(s, &d->set, err);
     for (int k = 0; st == LM_OK && k < 3; k++) {
         if ((st = light_program(k, d->set.pcf_radius, 0, &d->prog[k], err)) == LM_OK)
             find_uniforms(d->prog[k], &d->u[k]);

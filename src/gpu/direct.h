@@ -26,6 +26,11 @@ typedef struct {
 
 void lm_direct_settings_default(lm_direct_settings *s);
 
+/* What all shadow maps together may take, and the smallest side they are shrunk to to fit (direct.c,
+ * fit_shadow_budget): 256 MB holds 10 point lights at the default 512 a face, 1,365 at 64. */
+#define LM_DIRECT_SHADOW_BUDGET (256.0 * 1024.0 * 1024.0)
+#define LM_DIRECT_SHADOW_MIN_SIZE 64
+
 /* A persistent direct-light renderer (docs/direct.md, "What is cached"): the program, the scene's vertex
  * buffers and textures, the float target and one shadow map per punctual light, kept between renders.
  * Each render re-uploads only the nodes whose world matrix changed and re-renders a light's shadow map

@@ -1,8 +1,10 @@
 #include "frame_loop.h"
 
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/memory.h"
 #include "../core/timing.h"
 #include "../gpu/composite.h"
 #include "../gpu/reflections.h"
@@ -154,6 +156,10 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     return st;
 }
 
+/* What the frame loop adds per atlas texel to what lmgi_load holds (AIM, IIM double buffer, gather
+ * tables, their GL textures): about 250 bytes, measured from 66k to 1M texels (peak RSS of lmgi run). */
+#define FRAME_LOOP_BYTES_PER_TEXEL 250.0
+
 lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
                                const lm_frame_loop_settings *set, lm_frame_loop **out, lm_photon_stage_frame *setup,
                                double *t_setup_gather, lm_error *err)
@@ -166,7 +172,12 @@ lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atla
     fl->scene = s;
     fl->atlas = a;
     fl->rt = rt;
-    lm_status st = alloc_buffers(fl, err);
+    char what[128];
+    snprintf(what, sizeof what, "the lightmaps of %u texels (AIM, IIM, gather)", a->texel_count);
+    lm_status st = lm_memory_plan(what, (double)a->texel_count * FRAME_LOOP_BYTES_PER_TEXEL, "a larger texel "
+                                  "size (--texel-size) or fewer texels (--texels) makes it smaller", err);
+    if (st == LM_OK)
+        st = alloc_buffers(fl, err);
     if (st == LM_OK)
         st = lm_photon_stage_create(s, su, a, rt, &set->stage, &fl->stage, setup, err);
     if (st == LM_OK)
