@@ -574,6 +574,42 @@ static void test_many_lights_share_shadow_maps(void **state)
     assert_true(frame_mean(dir, "frame_0000.exr") > 0.0);
 }
 
+/* The same room 1e7 units from the origin renders as it does at the origin (it rendered black: float keeps
+ * 24 bits, so rays' offsets and depths there lost every digit; lmgi now works relative to the scene). */
+static void test_far_from_origin(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    lmt_mesh_cube(&m[1], 0.5f);
+    const char *materials = "[{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}, "
+                            "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}], \"extensionsUsed\": "
+                            "[\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": "
+                            "[{\"type\": \"point\", \"intensity\": 10}]}}, \"cameras\": [{\"type\": \"perspective\", "
+                            "\"perspective\": {\"yfov\": 1.0, \"znear\": 0.01}}]";
+    double mean[2];
+    for (int far = 0; far < 2; far++) {
+        char nodes[1024];
+        snprintf(nodes, sizeof nodes, "[{\"children\": [1, 2, 3, 4], \"translation\": [%s]}, {\"mesh\": 0}, "
+                 "{\"mesh\": 1, \"translation\": [0, 0.5, 0]}, {\"translation\": [0.3, 2, 0.2], \"extensions\": "
+                 "{\"KHR_lights_punctual\": {\"light\": 0}}}, {\"translation\": [0, 1.5, 3], "
+                 "\"rotation\": [-0.2588, 0, 0, 0.9659], \"camera\": 0}]", far ? "1e7, 1e7, -1e7" : "0, 0, 0");
+        char name[64], dir[1100], args[4096];
+        snprintf(name, sizeof name, "far%d.gltf", far);
+        const char *path = lmt_write_scene(name, m, 2, nodes, materials);
+        snprintf(dir, sizeof dir, "%s/far_out%d", lmt_tmpdir(), far);
+        snprintf(args, sizeof args, "run %s --frames 2 --size 48x48 --photons 20000 --exr-every 1 -q --out %s", path,
+                 dir);
+        if (lmgi(args) != 0)
+            fail_msg("lmgi run failed: %s", output);
+        mean[far] = frame_mean(dir, "frame_0001.exr");
+    }
+    print_message("far from the origin: frame mean %.4f at the origin, %.4f at 1e7\n", mean[0], mean[1]);
+    assert_true(mean[0] > 0.05);
+    assert_float_equal(mean[1] / mean[0], 1.0, 0.01);
+}
+
 static void test_reflections(void **state)
 {
     (void)state;
@@ -602,6 +638,7 @@ int main(void)
         cmocka_unit_test(test_flattened_node),
         cmocka_unit_test(test_mirrored_nodes),
         cmocka_unit_test(test_output_dir),
+        cmocka_unit_test(test_far_from_origin),
         cmocka_unit_test(test_many_lights_share_shadow_maps),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -16,9 +16,8 @@
  * at (0, 0.5, 0) that an animation slides to x = 0.5 at t = 1. */
 static char scene_path[512]; /* where load_test_scene wrote the scene */
 
-static lmgi_scene *load_test_scene(void **state)
+static lmgi_scene *load_test_scene_at(const char *root_translation)
 {
-    (void)state;
     static lmt_mesh mesh[3];
     memset(mesh, 0, sizeof mesh);
     float c0[3] = {-1, 0, 1}, u0[3] = {2, 0, 0}, v0[3] = {0, 0, -2};
@@ -26,9 +25,10 @@ static lmgi_scene *load_test_scene(void **state)
     float c1[3] = {-1, 0, -1}, u1[3] = {2, 0, 0}, v1[3] = {0, 2, 0};
     lmt_mesh_quad(&mesh[1], c1, u1, v1);
     lmt_mesh_cube(&mesh[2], 0.25f);
-    const char *nodes = "[{\"name\": \"root\", \"children\": [1, 2, 3]},"
-                        " {\"name\": \"floor\", \"mesh\": 0}, {\"name\": \"wall\", \"mesh\": 1},"
-                        " {\"name\": \"cube\", \"mesh\": 2, \"translation\": [0, 0.5, 0]}]";
+    char nodes[512];
+    snprintf(nodes, sizeof nodes, "[{\"name\": \"root\", \"children\": [1, 2, 3], \"translation\": [%s]},"
+             " {\"name\": \"floor\", \"mesh\": 0}, {\"name\": \"wall\", \"mesh\": 1},"
+             " {\"name\": \"cube\", \"mesh\": 2, \"translation\": [0, 0.5, 0]}]", root_translation);
     static const float times[2] = {0, 1}, moves[6] = {0, 0.5f, 0, 0.5f, 0.5f, 0};
     lmt_accessor acc[2] = {{times, 2, "SCALAR"}, {moves, 2, "VEC3"}};
     const char *anim = "\"animations\": [{\"samplers\": [{\"input\": 6, \"output\": 7}],"
@@ -44,6 +44,12 @@ static lmgi_scene *load_test_scene(void **state)
     if (lmgi_load(path, &o, &sc, &err) != LMGI_OK)
         fail_msg("load failed: %s", err.message);
     return sc;
+}
+
+static lmgi_scene *load_test_scene(void **state)
+{
+    (void)state;
+    return load_test_scene_at("0, 0, 0");
 }
 
 static lmgi_hit shoot(const lmgi_scene *sc, float x, float y, float z, float dx, float dy, float dz)
@@ -138,6 +144,91 @@ static void test_bad_edits_are_refused(void **state)
     /* Refused edits left the cube where it was. */
     lmgi_hit h = shoot(sc, 0.1f, 2, 0.1f, 0, -1, 0);
     assert_float_equal(h.t, 1.25f, 1e-5);
+    lmgi_free(sc);
+}
+
+/* A scene 10,000 units from the origin is worked on relative to its centre, and the API speaks the file's
+ * coordinates: rays, texel positions, bounds and node matrices are offset by 1e4 (where a float still
+ * resolves 0.001), the answers those of the scene at the origin. */
+static void test_far_from_origin(void **state)
+{
+    (void)state;
+    const float far = 1e4f;
+    lmgi_scene *sc = load_test_scene_at("10000, 10000, 10000");
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    assert_float_equal(in.bounds_min[0], far - 1.0f, 1e-3);
+    assert_float_equal(in.bounds_max[1], far + 2.0f, 1e-3);
+    lmgi_hit h = shoot(sc, far + 0.6f, far + 2, far + 0.6f, 0, -1, 0);
+    assert_int_equal(h.node, lmgi_find_node(sc, "floor"));
+    assert_float_equal(h.t, 2.0f, 2e-3);
+    lmgi_texel t;
+    lmgi_get_texel(sc, 0, &t);
+    assert_true(fabsf(t.position[0] - far) <= 1.01f && fabsf(t.position[2] - far) <= 1.01f);
+    float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, far + 0.5f, far + 0.5f, far + 0.5f, 1};
+    lmgi_error err;
+    assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "cube"), m, &err), LMGI_OK);
+    h = shoot(sc, far + 0.6f, far + 2, far + 0.6f, 0, -1, 0); /* the cube's top, now at y = 0.75 */
+    assert_int_equal(h.node, lmgi_find_node(sc, "cube"));
+    assert_float_equal(h.t, 1.25f, 2e-3);
+    lmgi_free(sc);
+}
+
+/* Every function of lmgi.h takes the NULLs it documents without a crash, and refuses the others. */
+static void test_null_arguments(void **state)
+{
+    lmgi_scene *sc = load_test_scene(state);
+    lmgi_error err;
+    lmgi_scene *out = (lmgi_scene *)1;
+    lmgi_options_init(NULL);
+    assert_int_equal(lmgi_load(NULL, NULL, &out, &err), LMGI_ERR_INVALID);
+    assert_null(out);
+    assert_int_equal(lmgi_load(scene_path, NULL, NULL, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "out"));
+    assert_int_equal(lmgi_load(NULL, NULL, &out, NULL), LMGI_ERR_INVALID);
+    lmgi_free(NULL);
+    lmgi_info in;
+    lmgi_get_info(NULL, &in);
+    assert_int_equal(in.triangles, 0u);
+    lmgi_get_info(sc, NULL);
+    lmgi_print_info(NULL, stdout);
+    lmgi_print_info(sc, NULL);
+    assert_int_equal(lmgi_effect_count(NULL), 0);
+    lmgi_effect e;
+    lmgi_get_effect(NULL, 0, &e);
+    assert_null(e.name);
+    lmgi_get_effect(sc, 0, NULL);
+    assert_int_equal(lmgi_node_count(NULL), 0);
+    assert_int_equal(lmgi_find_node(NULL, "cube"), -1);
+    assert_int_equal(lmgi_find_node(sc, NULL), -1);
+    assert_null(lmgi_node_name(NULL, 0));
+    assert_int_equal(lmgi_node_is_dynamic(NULL, 0), 0);
+    float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+    assert_int_equal(lmgi_set_node_transform(NULL, 0, m, &err), LMGI_ERR_INVALID);
+    assert_int_equal(lmgi_set_node_transform(sc, lmgi_find_node(sc, "cube"), NULL, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "matrix"));
+    assert_int_equal(lmgi_set_time(NULL, 0.0f, &err), LMGI_ERR_INVALID);
+    const float o[3] = {0.1f, 2, 0.1f}, d[3] = {0, -1, 0};
+    lmgi_hit h;
+    lmgi_intersect(NULL, o, d, 10.0f, &h);
+    assert_false(h.hit);
+    lmgi_intersect(sc, NULL, d, 10.0f, &h);
+    assert_false(h.hit);
+    lmgi_intersect(sc, o, NULL, 10.0f, &h);
+    assert_false(h.hit);
+    lmgi_intersect(sc, o, d, 10.0f, NULL);
+    assert_int_equal(lmgi_texel_count(NULL), 0u);
+    lmgi_texel t;
+    lmgi_get_texel(NULL, 0, &t);
+    assert_int_equal(t.surface, -1);
+    lmgi_get_texel(sc, 0, NULL);
+    float uv[6];
+    assert_int_equal(lmgi_triangle_lightmap_uv(NULL, 0, uv), 0);
+    assert_int_equal(lmgi_triangle_lightmap_uv(sc, 0, NULL), 0);
+    assert_int_equal(lmgi_write_charts(NULL, "/tmp", 0, 0, &err), LMGI_ERR_INVALID);
+    assert_int_equal(lmgi_write_charts(sc, NULL, 0, 0, &err), LMGI_ERR_INVALID);
+    assert_non_null(strstr(err.message, "directory"));
+    assert_non_null(lmgi_status_name(LMGI_ERR_INVALID));
     lmgi_free(sc);
 }
 
@@ -283,6 +374,8 @@ int main(void)
         cmocka_unit_test(test_dynamic_hits_follow_transform),
         cmocka_unit_test(test_bad_edits_are_refused),
         cmocka_unit_test(test_bad_rays_miss),
+        cmocka_unit_test(test_far_from_origin),
+        cmocka_unit_test(test_null_arguments),
         cmocka_unit_test(test_far_vertex_refused),
         cmocka_unit_test(test_target_texels),
         cmocka_unit_test(test_two_sides),

@@ -302,6 +302,40 @@ static void warn_mirroring_animations(const lm_scene *s)
         }
 }
 
+/* Float keeps 24 bits: a scene 1e6 units from the origin kept about 0.06 units of its positions (its
+ * frame came out at a ninth of its brightness, black at 1e7, from rays' offsets and depth buffers that
+ * lost their digits). A scene farther from the origin than its own size is moved to the origin by its
+ * root nodes, and their animated translations with them; the file's coordinates are origin + lmgi's. */
+static void rebase(lm_scene *s)
+{
+    float size = lm_scene_size(s);
+    lm_vec3 c = lm_scale(lm_add(lm_v3_load(s->bounds_min), lm_v3_load(s->bounds_max)), 0.5f);
+    if (!(size > 0.0f) || fmaxf(fabsf(c.x), fmaxf(fabsf(c.y), fabsf(c.z))) <= size)
+        return;
+    lm_v3_store(s->origin, c);
+    for (int i = 0; i < s->node_count; i++) {
+        lm_node *n = &s->nodes[i];
+        if (n->parent >= 0)
+            continue;
+        for (int k = 0; k < 3; k++)
+            n->translation[k] -= s->origin[k], n->matrix[12 + k] -= s->origin[k];
+    }
+    for (int a = 0; a < s->animation_count; a++)
+        for (int ci = 0; ci < s->animations[a].channel_count; ci++) {
+            lm_anim_channel *ch = &s->animations[a].channels[ci];
+            if (ch->path != LM_PATH_TRANSLATION || s->nodes[ch->node].parent >= 0)
+                continue;
+            int per_key = ch->interp == LM_INTERP_CUBIC ? 3 : 1, value = ch->interp == LM_INTERP_CUBIC;
+            for (int k = 0; k < ch->key_count; k++)
+                for (int j = 0; j < 3; j++)
+                    ch->values[3 * ((size_t)k * per_key + value) + j] -= s->origin[j];
+        }
+    lm_scene_update_world(s);
+    lm_scene_update_bounds(s);
+    lm_info("%s: the scene lies %g units from the origin; lmgi works relative to (%g %g %g)", s->path,
+            (double)lm_length(c), (double)c.x, (double)c.y, (double)c.z);
+}
+
 lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_error *err)
 {
     int c;
@@ -332,5 +366,8 @@ lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_e
     lm_scene_update_bounds(s);
     reverse_mirrored(s);
     warn_mirroring_animations(s);
-    return check_extent(s, err);
+    lm_status st = check_extent(s, err);
+    if (st == LM_OK)
+        rebase(s);
+    return st;
 }

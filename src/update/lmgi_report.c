@@ -14,8 +14,12 @@
 
 void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
 {
-    const lm_scene *s = sc->scene;
+    if (!in)
+        return;
     memset(in, 0, sizeof *in);
+    if (!sc)
+        return;
+    const lm_scene *s = sc->scene;
     in->triangles = s->tri_twin ? s->file_tri_count : s->tri_count;
     in->back_triangles = s->tri_count - in->triangles;
     in->vertices = s->vertex_count;
@@ -41,21 +45,22 @@ void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
     in->texels = sc->atlas.texel_count;
     in->texel_size = sc->atlas.texel_size;
     in->utilization = sc->atlas.utilization;
-    memcpy(in->bounds_min, s->bounds_min, sizeof in->bounds_min);
-    memcpy(in->bounds_max, s->bounds_max, sizeof in->bounds_max);
+    for (int k = 0; k < 3; k++) /* in the file's coordinates */
+        in->bounds_min[k] = s->bounds_min[k] + s->origin[k], in->bounds_max[k] = s->bounds_max[k] + s->origin[k];
     in->timings = sc->timings;
 }
 
 int lmgi_effect_count(const lmgi_scene *sc)
 {
-    (void)sc;
-    return LM_EFFECT_COUNT;
+    return sc ? LM_EFFECT_COUNT : 0;
 }
 
 void lmgi_get_effect(const lmgi_scene *sc, int i, lmgi_effect *out)
 {
+    if (!out)
+        return;
     memset(out, 0, sizeof *out);
-    if (i < 0 || i >= LM_EFFECT_COUNT)
+    if (!sc || i < 0 || i >= LM_EFFECT_COUNT)
         return;
     out->name = lm_effect_name((lm_effect_id)i);
     out->on = sc->effects.on[i];
@@ -100,6 +105,8 @@ static void print_lights(const lm_scene *s, const lmgi_info *in, FILE *f)
 
 void lmgi_print_info(const lmgi_scene *sc, FILE *f)
 {
+    if (!sc || !f)
+        return;
     const lm_scene *s = sc->scene;
     lmgi_info in;
     lmgi_get_info(sc, &in);
@@ -156,6 +163,10 @@ lmgi_status lmgi_write_charts(const lmgi_scene *sc, const char *dir, int width, 
 {
     lm_error e;
     lm_error_clear(&e);
+    if (!sc || !dir) {
+        lm_fail(&e, LM_ERR_INVALID, "lmgi_write_charts: %s is NULL", sc ? "the directory" : "the scene");
+        return lm_export_error(err, &e);
+    }
     if (width <= 0 || height <= 0) {
         width = 1024;
         height = 768;

@@ -15,6 +15,8 @@
 
 void lmgi_options_init(lmgi_options *o)
 {
+    if (!o)
+        return;
     lm_surface_options so;
     lm_atlas_options ao;
     lm_surface_options_default(&so);
@@ -109,6 +111,10 @@ lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out,
 {
     lm_error e;
     lm_error_clear(&e);
+    if (!out) {
+        lm_fail(&e, LM_ERR_INVALID, "lmgi_load: out is NULL (where the scene would go)");
+        return lm_export_error(err, &e);
+    }
     *out = NULL;
     lmgi_options defaults;
     if (!o) {
@@ -149,11 +155,11 @@ void lmgi_free(lmgi_scene *sc)
     free(sc);
 }
 
-int lmgi_node_count(const lmgi_scene *sc) { return sc->scene->node_count; }
+int lmgi_node_count(const lmgi_scene *sc) { return sc ? sc->scene->node_count : 0; }
 
 int lmgi_find_node(const lmgi_scene *sc, const char *name)
 {
-    for (int n = 0; name && n < sc->scene->node_count; n++)
+    for (int n = 0; sc && name && n < sc->scene->node_count; n++)
         if (strcmp(sc->scene->nodes[n].name, name) == 0)
             return n;
     return -1;
@@ -161,23 +167,31 @@ int lmgi_find_node(const lmgi_scene *sc, const char *name)
 
 const char *lmgi_node_name(const lmgi_scene *sc, int node)
 {
-    return node >= 0 && node < sc->scene->node_count ? sc->scene->nodes[node].name : NULL;
+    return sc && node >= 0 && node < sc->scene->node_count ? sc->scene->nodes[node].name : NULL;
 }
 
 int lmgi_node_is_dynamic(const lmgi_scene *sc, int node)
 {
-    return node >= 0 && node < sc->scene->node_count && sc->scene->nodes[node].dynamic;
+    return sc && node >= 0 && node < sc->scene->node_count && sc->scene->nodes[node].dynamic;
 }
 
 lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[16], lmgi_error *err)
 {
     lm_error e;
     lm_error_clear(&e);
-    lm_status st = lm_rt_set_node_transform(sc->rt, node, world, &e);
+    if (!sc || !world) {
+        lm_fail(&e, LM_ERR_INVALID, "lmgi_set_node_transform: %s is NULL", sc ? "the matrix" : "the scene");
+        return lm_export_error(err, &e);
+    }
+    float m[16]; /* from the file's world to lmgi's (lm_scene.origin) */
+    memcpy(m, world, sizeof m);
+    for (int k = 0; k < 3; k++)
+        m[12 + k] -= sc->scene->origin[k];
+    lm_status st = lm_rt_set_node_transform(sc->rt, node, m, &e);
     if (st != LM_OK)
         return lm_export_error(err, &e);
     /* The scene model follows, so lightmap and picture code see the same placement as the rays. */
-    memcpy(sc->scene->nodes[node].world, world, sizeof(float) * 16);
+    memcpy(sc->scene->nodes[node].world, m, sizeof m);
     return LMGI_OK;
 }
 
@@ -185,6 +199,10 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
 {
     lm_error e;
     lm_error_clear(&e);
+    if (!sc) {
+        lm_fail(&e, LM_ERR_INVALID, "lmgi_set_time: the scene is NULL");
+        return lm_export_error(err, &e);
+    }
     if (!isfinite(t)) {
         lm_fail(&e, LM_ERR_INVALID, "%s: animation time is not a finite number", sc->scene->path);
         return lm_export_error(err, &e);
@@ -197,10 +215,16 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
 
 void lmgi_intersect(const lmgi_scene *sc, const float org[3], const float dir[3], float tmax, lmgi_hit *hit)
 {
+    if (!hit)
+        return;
     lm_rt_hit h;
     memset(hit, 0, sizeof *hit);
     hit->node = hit->surface = -1;
-    if (!lm_rt_intersect(sc->rt, org, dir, 0.0f, tmax, &h))
+    if (!sc || !org || !dir)
+        return;
+    const float *o = sc->scene->origin;
+    const float local[3] = {org[0] - o[0], org[1] - o[1], org[2] - o[2]};
+    if (!lm_rt_intersect(sc->rt, local, dir, 0.0f, tmax, &h))
         return;
     hit->hit = 1;
     hit->t = h.t;
@@ -210,17 +234,20 @@ void lmgi_intersect(const lmgi_scene *sc, const float org[3], const float dir[3]
     memcpy(hit->normal, h.ng, sizeof hit->normal);
 }
 
-uint32_t lmgi_texel_count(const lmgi_scene *sc) { return sc->atlas.texel_count; }
+uint32_t lmgi_texel_count(const lmgi_scene *sc) { return sc ? sc->atlas.texel_count : 0; }
 
 void lmgi_get_texel(const lmgi_scene *sc, uint32_t i, lmgi_texel *out)
 {
+    if (!out)
+        return;
     memset(out, 0, sizeof *out);
-    if (i >= sc->atlas.texel_count) {
+    if (!sc || i >= sc->atlas.texel_count) {
         out->surface = -1;
         return;
     }
     const lm_texel *t = &sc->atlas.texels[i];
-    memcpy(out->position, t->pos, sizeof out->position);
+    for (int k = 0; k < 3; k++)
+        out->position[k] = t->pos[k] + sc->scene->origin[k];
     memcpy(out->normal, t->normal, sizeof out->normal);
     out->x = t->x;
     out->y = t->y;
@@ -231,7 +258,7 @@ void lmgi_get_texel(const lmgi_scene *sc, uint32_t i, lmgi_texel *out)
 
 int lmgi_triangle_lightmap_uv(const lmgi_scene *sc, uint32_t tri, float uv[6])
 {
-    if (tri >= sc->scene->tri_count || sc->atlas.tri_chart[tri] < 0)
+    if (!sc || !uv || tri >= sc->scene->tri_count || sc->atlas.tri_chart[tri] < 0)
         return 0;
     memcpy(uv, sc->atlas.corner_uv + 6 * (size_t)tri, 6 * sizeof(float));
     return 1;
