@@ -4,6 +4,7 @@
 #   make test       deps + build + every test (cmocka), including the loader fuzz test under ASan
 #   make test-asan  the whole suite built with AddressSanitizer + UndefinedBehaviorSanitizer
 #   make demo       deps + the main job on a generated scene; pictures in demo/
+#   make fuzz       100,000 structured inputs through load, photons and a frame under ASan + UBSan
 #   make bench      timings (never part of the tests)
 #   make scenes     regenerate scenes/ with tools/gen_scenes
 
@@ -42,7 +43,7 @@ TEST_C  := $(sort $(wildcard tests/test_*.c))
 TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o
 
-.PHONY: all deps test test-asan demo bench scenes clean
+.PHONY: all deps test test-asan demo bench scenes clean fuzz
 .PRECIOUS: $(BUILD)/obj/%.o
 .PHONY: FORCE
 all: $(BUILD)/lmgi $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
@@ -92,20 +93,29 @@ $(BUILD)/gen_scenes: tools/gen_scenes.c
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 -O2 $(WARN) -D_DEFAULT_SOURCE -o $@ $< -lm
 
-# The fuzz test always runs under ASan + UBSan, whatever the main build is.
+# The fuzz tests always run under ASan + UBSan, whatever the main build is: fuzz_loader (byte mutations
+# through the loader) and fuzz_pipeline (structured mutations through load, photons and one frame).
 FUZZ_BUILD := build/asan
-$(FUZZ_BUILD)/tests/fuzz_loader: FORCE
+FUZZ_TESTS := $(FUZZ_BUILD)/tests/fuzz_loader $(FUZZ_BUILD)/tests/fuzz_pipeline
+$(FUZZ_BUILD)/tests/fuzz_%: FORCE
 	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) OPT="-O1 -g" \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
 	  $(FUZZ_BUILD)/liblmgi.a $(FUZZ_BUILD)/obj/tests/support.o
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 -O1 -g $(WARN) -D_DEFAULT_SOURCE -Iinclude -fsanitize=address,undefined \
-	  -o $@ tests/fuzz_loader.c $(FUZZ_BUILD)/obj/tests/support.o $(FUZZ_BUILD)/liblmgi.a \
+	  -o $@ tests/fuzz_$*.c $(FUZZ_BUILD)/obj/tests/support.o $(FUZZ_BUILD)/liblmgi.a \
 	  -fsanitize=address,undefined -fopenmp $(LIBS) -lcmocka
 FORCE:
 
-test: deps all $(TESTS) $(if $(wildcard tests/fuzz_loader.c),$(FUZZ_BUILD)/tests/fuzz_loader)
-	@LMGI_BUILD=$(BUILD) sh tests/run_tests.sh $(TESTS) $(if $(wildcard tests/fuzz_loader.c),$(FUZZ_BUILD)/tests/fuzz_loader)
+test: deps all $(TESTS) $(FUZZ_TESTS)
+	@LMGI_BUILD=$(BUILD) sh tests/run_tests.sh $(TESTS) $(FUZZ_TESTS)
+
+# make fuzz: FUZZ_INPUTS structured inputs through the whole pipeline under ASan + UBSan, split over
+# FUZZ_JOBS processes with seeds 1..FUZZ_JOBS (each its own inputs); logs in build/fuzz/.
+FUZZ_INPUTS ?= 100000
+FUZZ_JOBS   ?= 2
+fuzz: deps $(FUZZ_BUILD)/tests/fuzz_pipeline
+	@sh tests/run_fuzz.sh $(FUZZ_BUILD)/tests/fuzz_pipeline $(FUZZ_INPUTS) $(FUZZ_JOBS) build/fuzz
 
 test-asan: deps
 	@$(MAKE) --no-print-directory BUILD=build/asan OPT="-O1 -g" \

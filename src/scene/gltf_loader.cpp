@@ -194,24 +194,32 @@ lm_status Loader::fail(lm_status st, const char *fmt, ...)
 }
 
 // A regular file is read whole up to 4 GiB (tinygltf takes a 32-bit size); anything else (a pipe, a
-// device: /dev/zero never ends) up to k_max_stream_bytes, so no input reads forever.
+// device: /dev/zero never ends) up to k_max_stream_bytes, so no input reads forever; a directory is not
+// read at all (an ifstream of one reports a size of 2^63, which tinygltf then allocated). The scene file
+// and every file it names (buffers, images: the tinygltf callback below) go through here. Returns an
+// empty string, or what was wrong; *format tells a malformed input from an unreadable one.
 const uint64_t k_max_file_bytes = UINT32_MAX, k_max_stream_bytes = 256ull << 20;
 
-lm_status Loader::read_file(std::vector<unsigned char> &bytes)
+std::string read_capped(const char *path, std::vector<unsigned char> &bytes, bool *format)
 {
+    *format = false;
     struct stat st;
-    if (stat(path_, &st) != 0)
-        return fail(LM_ERR_IO, "cannot open file: %s", strerror(errno));
+    if (stat(path, &st) != 0)
+        return std::string("cannot open file: ") + strerror(errno);
     if (S_ISDIR(st.st_mode))
-        return fail(LM_ERR_IO, "is a directory, not a .gltf or .glb file");
+        return "is a directory, not a file";
     bool regular = S_ISREG(st.st_mode);
     uint64_t cap = regular ? k_max_file_bytes : k_max_stream_bytes;
-    if (regular && uint64_t(st.st_size) > cap)
-        return fail(LM_ERR_FORMAT, "%llu bytes: larger than the 4 GiB a glTF file may have here",
-                    (unsigned long long)st.st_size);
-    FILE *f = fopen(path_, "rb");
+    char msg[160];
+    if (regular && uint64_t(st.st_size) > cap) {
+        *format = true;
+        snprintf(msg, sizeof msg, "%llu bytes: larger than the 4 GiB a file may have here",
+                 (unsigned long long)st.st_size);
+        return msg;
+    }
+    FILE *f = fopen(path, "rb");
     if (!f)
-        return fail(LM_ERR_IO, "cannot open file: %s", strerror(errno));
+        return std::string("cannot open file: ") + strerror(errno);
     if (regular)
         bytes.reserve(size_t(st.st_size));
     unsigned char buf[65536];
@@ -221,11 +229,33 @@ lm_status Loader::read_file(std::vector<unsigned char> &bytes)
     bool bad = ferror(f);
     fclose(f);
     if (bad)
-        return fail(LM_ERR_IO, "read error: %s", strerror(errno));
-    if (bytes.size() > cap)
-        return fail(LM_ERR_FORMAT, "more than %llu MiB from a %s: not a scene file", (unsigned long long)(cap >> 20),
-                    regular ? "file" : "device or pipe");
-    return LM_OK;
+        return std::string("read error: ") + strerror(errno);
+    if (bytes.size() > cap) {
+        *format = true;
+        snprintf(msg, sizeof msg, "more than %llu MiB from a %s: not a scene file", (unsigned long long)(cap >> 20),
+                 regular ? "file" : "device or pipe");
+        return msg;
+    }
+    return "";
+}
+
+bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+{
+    bool format = false;
+    out->clear();
+    std::string why = read_capped(path.c_str(), *out, &format);
+    if (!why.empty() && err)
+        *err += path + ": " + why + "\n";
+    return why.empty();
+}
+
+lm_status Loader::read_file(std::vector<unsigned char> &bytes)
+{
+    bool format = false;
+    std::string why = read_capped(path_, bytes, &format);
+    if (why == "is a directory, not a file")
+        why = "is a directory, not a .gltf or .glb file";
+    return why.empty() ? LM_OK : fail(format ? LM_ERR_FORMAT : LM_ERR_IO, "%s", why.c_str());
 }
 
 uint32_t le32(const unsigned char *p) { return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24; }
@@ -282,6 +312,9 @@ lm_status Loader::check_buffers(const std::vector<unsigned char> &b, bool glb)
         double len = buf["byteLength"].get<double>();
         if (!(len >= 1.0))
             return fail(LM_ERR_FORMAT, "buffer %zu (\"%s\"): byteLength %g; glTF requires at least 1", i, what, len);
+        if (len > double(k_max_file_bytes)) /* tinygltf would size a vector to it */
+            return fail(LM_ERR_FORMAT, "buffer %zu (\"%s\"): byteLength %g is more than the 4 GiB a file may have here",
+                        i, what, len);
         if (glb && i == 0 && !buf.contains("uri") && len > double(bin_len))
             return fail(LM_ERR_FORMAT, "buffer 0 (\"%s\"): byteLength %g, but the .glb's BIN chunk holds %llu bytes",
                         what, len, (unsigned long long)bin_len);
@@ -301,6 +334,9 @@ lm_status Loader::parse(const std::vector<unsigned char> &bytes)
         dir = slash == 0 ? "/" : p.substr(0, slash);
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(decode_image, &model_);
+    tinygltf::FsCallbacks fs = {&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_whole_file,
+                                &tinygltf::WriteWholeFile, nullptr};
+    gltf.SetFsCallbacks(fs);
     std::string terr, twarn;
     bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &terr, &twarn, bytes.data(), unsigned(bytes.size()), dir)
                   : gltf.LoadASCIIFromString(&model_, &terr, &twarn, reinterpret_cast<const char *>(bytes.data()),
@@ -470,6 +506,19 @@ lm_status Loader::materials()
                              d.emissive[0], d.emissive[1], d.emissive[2], d.transmission, d.ior};
         if (!finite_all(all, sizeof all / sizeof all[0]))
             return fail(LM_ERR_INVALID, "%s has a non-finite parameter", ctx.c_str());
+        /* glTF keeps these factors in [0, 1]; an albedo above 1 makes light (a base colour of 1e38 gave an
+         * infinite frame), a negative one takes it */
+        const float unit[] = {d.base_color[0], d.base_color[1], d.base_color[2], d.base_color[3], d.metallic,
+                              d.roughness, d.transmission};
+        static const char *const unit_name[] = {"baseColorFactor", "baseColorFactor", "baseColorFactor",
+                                                "baseColorFactor", "metallicFactor", "roughnessFactor",
+                                                "transmissionFactor"};
+        for (size_t k = 0; k < sizeof unit / sizeof unit[0]; k++)
+            if (!(unit[k] >= 0.0f && unit[k] <= 1.0f))
+                return fail(LM_ERR_INVALID, "%s: %s %g is outside [0, 1]", ctx.c_str(), unit_name[k], double(unit[k]));
+        for (int k = 0; k < 3; k++)
+            if (!(d.emissive[k] >= 0.0f))
+                return fail(LM_ERR_INVALID, "%s: emission %g is negative", ctx.c_str(), double(d.emissive[k]));
         for (int k = 0; k < 3; k++)
             if (!(std::fabs(d.emissive[k]) <= LM_MAX_EMISSION))
                 return fail(LM_ERR_INVALID, "%s: emission %g (emissiveFactor x emissiveStrength) exceeds %g: the "
