@@ -26,38 +26,18 @@ typedef struct {
 
 static uint32_t g_rng = FUZZ_SEED;
 
-static uint32_t rnd(void) /* xorshift32: fixed sequence for a fixed seed */
-{
-    g_rng ^= g_rng << 13;
-    g_rng ^= g_rng >> 17;
-    g_rng ^= g_rng << 5;
-    return g_rng;
-}
+static uint32_t rnd(void) { return lmt_xorshift(&g_rng); } /* fixed sequence for a fixed seed */
 
 static size_t rnd_below(size_t n) { return n ? rnd() % n : 0; }
 
 static blob read_file(const char *path)
 {
-    blob b = {NULL, 0};
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    b.size = (size_t)ftell(f);
-    fseek(f, 0, SEEK_SET);
-    b.data = malloc(b.size + 64);
-    assert_non_null(b.data);
-    assert_int_equal(fread(b.data, 1, b.size, f), b.size);
-    fclose(f);
+    blob b;
+    b.data = lmt_read_file(path, &b.size, 64);
     return b;
 }
 
-static void write_file(const char *path, const unsigned char *d, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(d, 1, n, f), n);
-    fclose(f);
-}
+static void write_file(const char *path, const unsigned char *d, size_t n) { lmt_write_file(path, d, n); }
 
 static void copy_file(const char *from, const char *dir, const char *name)
 {

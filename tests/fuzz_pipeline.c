@@ -40,39 +40,19 @@ typedef struct {
 
 static uint32_t g_rng;
 
-static uint32_t rnd(void) /* xorshift32 */
-{
-    g_rng ^= g_rng << 13;
-    g_rng ^= g_rng >> 17;
-    g_rng ^= g_rng << 5;
-    return g_rng;
-}
+static uint32_t rnd(void) { return lmt_xorshift(&g_rng); }
 
 static size_t rnd_below(size_t n) { return n ? rnd() % n : 0; }
 
 static blob read_blob(const char *path)
 {
-    blob b = {NULL, 0, 0};
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    fseek(f, 0, SEEK_END);
-    b.size = (size_t)ftell(f);
-    fseek(f, 0, SEEK_SET);
+    blob b;
+    b.data = lmt_read_file(path, &b.size, 4096);
     b.cap = b.size + 4096;
-    b.data = malloc(b.cap);
-    assert_non_null(b.data);
-    assert_int_equal(fread(b.data, 1, b.size, f), b.size);
-    fclose(f);
     return b;
 }
 
-static void write_blob(const char *path, const unsigned char *d, size_t n)
-{
-    FILE *f = fopen(path, "wb");
-    assert_non_null(f);
-    assert_int_equal(fwrite(d, 1, n, f), n);
-    fclose(f);
-}
+static void write_blob(const char *path, const unsigned char *d, size_t n) { lmt_write_file(path, d, n); }
 
 static uint32_t le32(const unsigned char *p) { return p[0] | p[1] << 8 | p[2] << 16 | (uint32_t)p[3] << 24; }
 static void put_le32(unsigned char *p, uint32_t v)

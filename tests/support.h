@@ -3,6 +3,7 @@
 #define LM_TEST_SUPPORT_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 /* Path of a file under ../shared/scenes (or $LMGI_SHARED/scenes); NULL if it does not exist.
  * The returned string is static storage, valid until the next call. */
@@ -11,6 +12,13 @@ const char *lmt_shared_scene(const char *relative);
 const char *lmt_project_scene(const char *relative);
 /* A fresh empty temporary directory for the calling test (static storage). */
 const char *lmt_tmpdir(void);
+/* The whole file in a malloc'd buffer with `extra` spare bytes after it (for mutations); *size its
+ * length. Fails the test when it cannot be read. */
+unsigned char *lmt_read_file(const char *path, size_t *size, size_t extra);
+/* xorshift32: the next number of the fixed sequence *state (non-zero) steps through. */
+uint32_t lmt_xorshift(uint32_t *state);
+/* Writes n bytes to path; fails the test when it cannot. */
+void lmt_write_file(const char *path, const void *data, size_t n);
 
 /* Use in a cmocka test: skips (and says so) when the scene is not there. */
 #define LMT_REQUIRE_SCENE(var, path_expr)                                                     \
@@ -55,7 +63,6 @@ const char *lmt_plane_scene(void);
 
 #endif
 
-#include <stdint.h>
 
 /* A tiny mesh for hand-written test scenes: positions (3 floats each) and u16 triangle indices. */
 typedef struct {

@@ -469,37 +469,47 @@ static double frame_mean(const char *dir, const char *file)
     return sum / (3.0 * w * h);
 }
 
+/* A floor (mesh 0) and a box (mesh 1), both diffuse, one point light (light 0) and a camera (camera 0),
+ * placed by `nodes`, written as NAME.gltf and run for 2 frames at 48 x 48: the second frame's mean and
+ * the IIM's. */
+static void run_floor_and_box(const char *name, const char *nodes, double *frame, double *iim)
+{
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    lmt_mesh_cube(&m[1], 0.5f);
+    const char *materials = "[{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}, "
+                            "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}], \"extensionsUsed\": "
+                            "[\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": "
+                            "[{\"type\": \"point\", \"intensity\": 10}]}}, \"cameras\": [{\"type\": \"perspective\", "
+                            "\"perspective\": {\"yfov\": 1.0, \"znear\": 0.01}}]";
+    char file[64], dir[1100], args[4096];
+    snprintf(file, sizeof file, "%s.gltf", name);
+    const char *path = lmt_write_scene(file, m, 2, nodes, materials);
+    snprintf(dir, sizeof dir, "%s/%s_out", lmt_tmpdir(), name);
+    snprintf(args, sizeof args, "run %s --frames 2 --size 48x48 --photons 20000 --exr-every 1 -q --out %s", path, dir);
+    if (lmgi(args) != 0)
+        fail_msg("lmgi run failed: %s", output);
+    *frame = frame_mean(dir, "frame_0001.exr");
+    *iim = frame_mean(dir, "iim.exr");
+}
+
 /* glTF: a negative determinant turns a node's triangles over. A floor and a dynamic box, symmetric about
  * x = 0, mirrored in x (static floor and the box's Embree instance alike), must light as they do unmirrored
  * (before, the mirrored walls of the generated Cornell box rendered black). */
 static void test_mirrored_nodes(void **state)
 {
     (void)state;
-    static lmt_mesh m[2];
-    memset(m, 0, sizeof m);
-    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
-    lmt_mesh_cube(&m[1], 0.5f);
-    const char *materials = "[{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}, "
-                            "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}], \"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": "
-                            "{\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}}, "
-                            "\"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 1.0, \"znear\": 0.01}}]";
     double mean[2], iim[2];
     for (int mirrored = 0; mirrored < 2; mirrored++) {
         const char *s = mirrored ? "-1" : "1";
-        char nodes[512];
+        char nodes[512], name[32];
         snprintf(nodes, sizeof nodes, "[{\"mesh\": 0, \"scale\": [%s, 1, 1]}, {\"mesh\": 1, \"scale\": [%s, 1, 1], "
                  "\"translation\": [0, 0.5, 0], \"extras\": {\"lmgi\": {\"dynamic\": true}}}, "
                  "{\"translation\": [0.3, 2, 0.2], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}, "
                  "{\"translation\": [0, 1.5, 3], \"rotation\": [-0.2588, 0, 0, 0.9659], \"camera\": 0}]", s, s);
-        char name[64], dir[1100], args[4096];
-        snprintf(name, sizeof name, "mirror%d.gltf", mirrored);
-        const char *path = lmt_write_scene(name, m, 2, nodes, materials);
-        snprintf(dir, sizeof dir, "%s/mirror_out%d", lmt_tmpdir(), mirrored);
-        snprintf(args, sizeof args, "run %s --frames 2 --size 48x48 --photons 20000 --exr-every 1 -q --out %s", path, dir);
-        if (lmgi(args) != 0)
-            fail_msg("lmgi run failed: %s", output);
-        mean[mirrored] = frame_mean(dir, "frame_0001.exr");
-        iim[mirrored] = frame_mean(dir, "iim.exr");
+        snprintf(name, sizeof name, "mirror%d", mirrored);
+        run_floor_and_box(name, nodes, &mean[mirrored], &iim[mirrored]);
     }
     print_message("mirrored nodes: frame mean %.4f unmirrored, %.4f mirrored; IIM %.4f, %.4f\n", mean[0],
                   mean[1], iim[0], iim[1]);
@@ -579,35 +589,21 @@ static void test_many_lights_share_shadow_maps(void **state)
 static void test_far_from_origin(void **state)
 {
     (void)state;
-    static lmt_mesh m[2];
-    memset(m, 0, sizeof m);
-    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
-    lmt_mesh_cube(&m[1], 0.5f);
-    const char *materials = "[{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}, "
-                            "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}}], \"extensionsUsed\": "
-                            "[\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": "
-                            "[{\"type\": \"point\", \"intensity\": 10}]}}, \"cameras\": [{\"type\": \"perspective\", "
-                            "\"perspective\": {\"yfov\": 1.0, \"znear\": 0.01}}]";
-    double mean[2];
+    double mean[2], iim[2];
     for (int far = 0; far < 2; far++) {
-        char nodes[1024];
+        char nodes[1024], name[32];
         snprintf(nodes, sizeof nodes, "[{\"children\": [1, 2, 3, 4], \"translation\": [%s]}, {\"mesh\": 0}, "
                  "{\"mesh\": 1, \"translation\": [0, 0.5, 0]}, {\"translation\": [0.3, 2, 0.2], \"extensions\": "
                  "{\"KHR_lights_punctual\": {\"light\": 0}}}, {\"translation\": [0, 1.5, 3], "
                  "\"rotation\": [-0.2588, 0, 0, 0.9659], \"camera\": 0}]", far ? "1e7, 1e7, -1e7" : "0, 0, 0");
-        char name[64], dir[1100], args[4096];
-        snprintf(name, sizeof name, "far%d.gltf", far);
-        const char *path = lmt_write_scene(name, m, 2, nodes, materials);
-        snprintf(dir, sizeof dir, "%s/far_out%d", lmt_tmpdir(), far);
-        snprintf(args, sizeof args, "run %s --frames 2 --size 48x48 --photons 20000 --exr-every 1 -q --out %s", path,
-                 dir);
-        if (lmgi(args) != 0)
-            fail_msg("lmgi run failed: %s", output);
-        mean[far] = frame_mean(dir, "frame_0001.exr");
+        snprintf(name, sizeof name, "far%d", far);
+        run_floor_and_box(name, nodes, &mean[far], &iim[far]);
     }
-    print_message("far from the origin: frame mean %.4f at the origin, %.4f at 1e7\n", mean[0], mean[1]);
+    print_message("far from the origin: frame mean %.4f at the origin, %.4f at 1e7; IIM %.4f, %.4f\n", mean[0],
+                  mean[1], iim[0], iim[1]);
     assert_true(mean[0] > 0.05);
     assert_float_equal(mean[1] / mean[0], 1.0, 0.01);
+    assert_float_equal(iim[1] / iim[0], 1.0, 0.01);
 }
 
 static void test_reflections(void **state)
