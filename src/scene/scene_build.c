@@ -304,13 +304,16 @@ static void warn_mirroring_animations(const lm_scene *s)
 
 /* Float keeps 24 bits: a scene 1e6 units from the origin kept about 0.06 units of its positions (its
  * frame came out at a ninth of its brightness, black at 1e7, from rays' offsets and depth buffers that
- * lost their digits). A scene farther from the origin than its own size is moved to the origin by its
- * root nodes, and their animated translations with them; the file's coordinates are origin + lmgi's. */
+ * lost their digits). A scene farther from the origin than LM_REBASE_RATIO times its own size (8 of its
+ * bits spent on the offset) is moved to the origin by its root nodes, and their animated translations
+ * with them; the file's coordinates are origin + lmgi's. Nearer, nothing changes. */
+#define LM_REBASE_RATIO 256.0f
+
 static void rebase(lm_scene *s)
 {
     float size = lm_scene_size(s);
     lm_vec3 c = lm_scale(lm_add(lm_v3_load(s->bounds_min), lm_v3_load(s->bounds_max)), 0.5f);
-    if (!(size > 0.0f) || fmaxf(fabsf(c.x), fmaxf(fabsf(c.y), fabsf(c.z))) <= size)
+    if (!(size > 0.0f) || fmaxf(fabsf(c.x), fmaxf(fabsf(c.y), fabsf(c.z))) <= LM_REBASE_RATIO * size)
         return;
     lm_v3_store(s->origin, c);
     for (int i = 0; i < s->node_count; i++) {

@@ -26,16 +26,16 @@ struct lm_rt {
     int *node_inst;             /* node -> instance geomID, -1 for static nodes */
     float (*inst_world)[16];    /* current world matrix of each instance */
     float (*node_nmat)[9];      /* node -> normal matrix of its world matrix (kept with inst_world) */
-    float *node_ng_sign;        /* node -> the sign of its world matrix's determinant: a geometric normal is
-                                 * the world triangle's winding, which a mirroring matrix turns over (the
-                                 * loader reversed a mirrored node's triangles so that it is the front) */
+    float *node_ng_sign;        /* node -> -1 where the loader reversed its winding (lm_node.mirrored), else 1:
+                                 * Embree's Ng follows the stored winding, and the front is the side its
+                                 * file normals face, through any later transform (nmat keeps that side) */
     char device_error[256];
 };
 
 static void set_node_normals(lm_rt *rt, int node, const float world[16])
 {
     lm_mat4_normal_matrix(world, rt->node_nmat[node]);
-    rt->node_ng_sign[node] = lm_mat4_mirrors(world) ? -1.0f : 1.0f;
+    rt->node_ng_sign[node] = rt->scene->nodes[node].mirrored ? -1.0f : 1.0f;
 }
 
 static void on_device_error(void *user, enum RTCError code, const char *str)
@@ -287,11 +287,6 @@ lm_status lm_rt_set_node_transform(lm_rt *rt, int node, const float world[16], l
         if (lm_mat4_singular(world))
             return lm_fail(err, LM_ERR_INVALID, "node '%s': transform is singular (a zero scale flattens the node)",
                            n->name);
-        /* its winding was set at load by the sign it had then (lm_node.mirrored) */
-        if (lm_mat4_mirrors(world) != n->mirrored)
-            return lm_fail(err, LM_ERR_INVALID, "node '%s': transform %s the node, which it %s at load; a node's "
-                           "sides are decided at load, so an edit keeps the sign of its determinant", n->name,
-                           n->mirrored ? "no longer mirrors" : "mirrors", n->mirrored ? "was mirrored" : "was not mirrored");
     }
     lm_status st = move_instance(rt, node, world, err);
     if (st == LM_OK)

@@ -183,6 +183,15 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
         lm_fail(&e, LM_ERR_INVALID, "lmgi_set_node_transform: %s is NULL", sc ? "the matrix" : "the scene");
         return lm_export_error(err, &e);
     }
+    const lm_node *n = node >= 0 && node < sc->scene->node_count ? &sc->scene->nodes[node] : NULL;
+    /* its winding was set at load by the sign it had then (lm_node.mirrored): the rays would follow a
+     * change (rt_scene.c), the rasterised sides and surfaces would not */
+    if (n && lm_mat4_finite(world) && !lm_mat4_singular(world) && lm_mat4_mirrors(world) != n->mirrored) {
+        lm_fail(&e, LM_ERR_INVALID, "node '%s': transform %s the node, which it %s at load; a node's sides are "
+                "decided at load, so an edit keeps the sign of its determinant", n->name,
+                n->mirrored ? "no longer mirrors" : "mirrors", n->mirrored ? "was mirrored" : "was not mirrored");
+        return lm_export_error(err, &e);
+    }
     float m[16]; /* from the file's world to lmgi's (lm_scene.origin) */
     memcpy(m, world, sizeof m);
     for (int k = 0; k < 3; k++)
