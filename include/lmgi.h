@@ -10,7 +10,7 @@
  * output zeroed, a hit with hit = 0), as each says. No function aborts its host.
  *
  * Coordinates: positions in and out (node matrices, rays, texel positions, bounds) are in the file's
- * world. A scene that lies farther from its origin than its own size is worked on relative to its centre
+ * world. A scene that lies farther from its origin than 256 times its size is worked on relative to its centre
  * (float keeps 24 bits: at 1e6 units the frame lost most of its light, at 1e7 all of it); the API converts,
  * so the caller never sees the difference. */
 #ifndef LMGI_H

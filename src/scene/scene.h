@@ -160,7 +160,7 @@ typedef struct {
     int mesh_count;        /* number of glTF meshes (for reporting) */
     float bounds_min[3], bounds_max[3]; /* world-space bounds at load time (all nodes) */
     float origin[3];       /* where lmgi's world origin lies in the file's world: a scene that sits farther
-                            * from the file's origin than its own size is rebased at load (its root nodes
+                            * from the file's origin than 256 times its size is rebased at load (its root nodes
                             * moved by -origin) so that float rays, matrices and depths keep their digits;
                             * the public API adds it back (positions out) and takes it off (positions in) */
 } lm_scene;
