@@ -250,7 +250,7 @@ static int run_pipeline(const char *path)
 {
     lmgi_options o;
     lmgi_options_init(&o);
-    o.target_texels = 256;
+    o.target_texels = 64;
     o.strict = (int)(rnd() & 1);
     lmgi_scene *sc = NULL;
     lmgi_error err;
@@ -268,14 +268,14 @@ static int run_pipeline(const char *path)
         lm_frame_loop_settings set;
         lm_frame_loop_settings_default(&set);
         set.width = set.height = 16;
-        set.stage.photons.total_photons = 2000;
+        set.stage.photons.total_photons = 500;
         set.iim.texels_per_frame = 20;
-        set.reflection_size = 8;
+        set.reflection_size = 4;
         set.overlap = 0;
-        set.gather.resolution = 8;
-        set.gather.rim_samples = 4;
-        set.emitter_rays = 4;
-        set.direct.cube_size = set.direct.map_size = 64;
+        set.gather.resolution = 4;
+        set.gather.rim_samples = 2;
+        set.emitter_rays = 2;
+        set.direct.cube_size = set.direct.map_size = 16;
         lm_frame_loop *fl = NULL;
         lm_error e;
         lm_status st = lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &fl, NULL, NULL, &e);
@@ -440,6 +440,9 @@ static void test_fuzz_pipeline(void **state)
         }
         free(m.data);
         free(b.data);
+        if ((it + 1) % 5000 == 0) /* progress for long runs (make fuzz logs) */
+            print_message("fuzz pipeline (seed %lu): %ld of %ld inputs, %ld rendered, %ld refused, %ld slow\n", seed,
+                          it + 1, inputs, rendered, refused, slow);
     }
     print_message("fuzz pipeline (seed %lu): %ld inputs, %ld rendered a finite frame, %ld refused with a message, "
                   "%ld over %.0f s (slowest %.2f s)\n", seed, inputs, rendered, refused, slow, SLOW_SECONDS, worst);

@@ -14,8 +14,8 @@ for seed in $(seq 1 "$jobs"); do
 done
 rc=0
 for p in $pids; do wait "$p" || rc=1; done
-grep -h "fuzz pipeline" "$dir"/seed-*.log
-grep -h "fuzz pipeline" "$dir"/seed-*.log | awk '{n+=$5; r+=$7; f+=$12; s+=$17} END {printf "fuzz: %d inputs, %d rendered, %d refused with a message, %d over 10 s\n", n, r, f, s}'
+grep -h "finite frame" "$dir"/seed-*.log
+grep -h "finite frame" "$dir"/seed-*.log | awk '{n+=$5; r+=$7; f+=$12; s+=$17} END {printf "fuzz: %d inputs, %d rendered, %d refused with a message, %d over 10 s\n", n, r, f, s}'
 grep -l "ERROR: AddressSanitizer\|ERROR: LeakSanitizer\|runtime error\|FAILED" "$dir"/seed-*.log && rc=1
 [ $rc -eq 0 ] && echo "fuzz: 0 aborts, 0 sanitizer reports" || echo "fuzz: FAILED (see $dir)"
 exit $rc
