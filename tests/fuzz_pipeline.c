@@ -12,7 +12,8 @@
  * naming the problem; never an abort, a sanitizer report, or more than 10 s.
  *
  * LMGI_FUZZ_INPUTS (default 240: the quick slice in make test, about a minute under ASan) and
- * LMGI_FUZZ_SEED (default 1) pick the inputs; make fuzz runs 100,000 over several seeds in parallel. */
+ * LMGI_FUZZ_SEED (default 1) pick the inputs; make fuzz runs 100,000 over several seeds in parallel.
+ * LMGI_FUZZ_ONLY=N (with the same seed and LMGI_FUZZ_INPUTS > N) runs input N alone, to reproduce it. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -375,6 +376,8 @@ static void test_fuzz_pipeline(void **state)
     const char *env = getenv("LMGI_FUZZ_INPUTS"), *seed_env = getenv("LMGI_FUZZ_SEED");
     long inputs = env ? strtol(env, NULL, 10) : 240;
     unsigned long seed = seed_env ? strtoul(seed_env, NULL, 10) : 1;
+    const char *only_env = getenv("LMGI_FUZZ_ONLY"); /* run input N alone (the others only drawn) */
+    long only = only_env ? strtol(only_env, NULL, 10) : -1;
     g_rng = 0x9e3779b9u ^ (uint32_t)(seed * 2654435761u);
     if (!g_rng)
         g_rng = 1;
@@ -426,6 +429,12 @@ static void test_fuzz_pipeline(void **state)
         write_blob(bin_path, b.data, b.size);
         if (getenv("LMGI_FUZZ_KEEP_ALL")) /* each input before it runs: the last one kept is the one that aborted */
             keep_input(path);
+        if (only >= 0 && it != only) { /* replaying to input `only`: the same random numbers, no work */
+            (void)rnd(); /* run_pipeline's strict flag */
+            free(m.data);
+            free(b.data);
+            continue;
+        }
         double t0 = lm_now();
         int r = run_pipeline(path);
         double dt = lm_now() - t0;
