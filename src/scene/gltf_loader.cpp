@@ -199,6 +199,7 @@ lm_status Loader::fail(lm_status st, const char *fmt, ...)
 // and every file it names (buffers, images: the tinygltf callback below) go through here. Returns an
 // empty string, or what was wrong; *format tells a malformed input from an unreadable one.
 const uint64_t k_max_file_bytes = UINT32_MAX, k_max_stream_bytes = 256ull << 20;
+const float k_max_uv = 1e6f;
 
 std::string read_capped(const char *path, std::vector<unsigned char> &bytes, bool *format)
 {
@@ -718,6 +719,12 @@ lm_status Loader::primitive(int node, int mesh, int prim)
             return fail(LM_ERR_FORMAT, "%s: %s accessor has %zu elements, POSITION %zu", ctx.c_str(), uv_names[k], c, vcount);
         if (!finite_all(uv[k].data(), uv[k].size()))
             return fail(LM_ERR_INVALID, "%s: non-finite %s", ctx.c_str(), uv_names[k]);
+        /* a texture repeats a million times at most: a coordinate of 3e38 (found by the fuzzer) overflows to
+         * inf and NaN when it is interpolated across a triangle, and the frame had a NaN pixel */
+        for (float v : uv[k])
+            if (!(std::fabs(v) <= k_max_uv))
+                return fail(LM_ERR_INVALID, "%s: %s value %g is beyond the %g a texture coordinate may reach",
+                            ctx.c_str(), uv_names[k], double(v), double(k_max_uv));
     }
     std::vector<uint32_t> idx;
     if (p.indices >= 0) {
