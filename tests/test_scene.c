@@ -582,6 +582,21 @@ static void test_clear_errors(void **state)
     tri_case(dir, "emission.gltf", &o, p, sizeof p);
     load_fails(p, 0, LM_ERR_INVALID, "material 0 (\"lava\"): emission 1e+30");
 
+    /* a texture coordinate of 3e38 (finite) overflowed when interpolated: the frame had a NaN pixel */
+    float uv_pos[9] = {0, 3e38f, 0, 1, 0, 0, 0, 1, 0};
+    char bin[600];
+    snprintf(bin, sizeof bin, "%s/uv.bin", dir);
+    write_tri_bin(bin, uv_pos, k_tri_idx);
+    static const char *huge_uv =
+        "{\"asset\":{\"version\":\"2.0\"},\"nodes\":[{\"mesh\":0}],\"meshes\":[{\"primitives\":[{\"attributes\":"
+        "{\"POSITION\":1,\"TEXCOORD_0\":2},\"indices\":0}]}],\"buffers\":[{\"uri\":\"uv.bin\",\"byteLength\":44}],"
+        "\"bufferViews\":[{\"buffer\":0,\"byteLength\":6},{\"buffer\":0,\"byteOffset\":8,\"byteLength\":36}],"
+        "\"accessors\":[{\"bufferView\":0,\"componentType\":5123,\"count\":3,\"type\":\"SCALAR\"},"
+        "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"},"
+        "{\"bufferView\":1,\"componentType\":5126,\"count\":3,\"type\":\"VEC2\"}]}";
+    write_text(dir, "huge-uv.gltf", huge_uv, p, sizeof p);
+    load_fails(p, 0, LM_ERR_INVALID, "TEXCOORD_0 value 3e+38");
+
     /* a directory read as "read error"; a device would be read forever */
     snprintf(p, sizeof p, "%s/scene.gltf", dir);
     assert_int_equal(mkdir(p, 0777), 0);
