@@ -58,11 +58,8 @@ static int write_images(const char *dir, const lm_frame_check *c)
 {
     lm_error err;
     char path[4096];
-    lm_status st = LM_OK;
-    {
-        snprintf(path, sizeof path, "%s/check_frame.exr", dir);
-        st = lm_write_exr(path, c->width, c->height, 3, c->frame, &err);
-    }
+    snprintf(path, sizeof path, "%s/check_frame.exr", dir);
+    lm_status st = lm_write_exr(path, c->width, c->height, 3, c->frame, &err);
     if (st == LM_OK) {
         snprintf(path, sizeof path, "%s/check_reference.exr", dir);
         st = lm_write_exr(path, c->width, c->height, 3, c->ref, &err);
@@ -88,7 +85,7 @@ int lm_cli_check(const lm_cli_args *a)
                         "       [--samples N] [--cache DIR] [--no-cache] [--out DIR]\n");
         return 2;
     }
-    static const char *const own[] = {"check_*.exr", "check_*.png", "*.partial", NULL};
+    static const char *const own[] = {"check_*.exr", "check_*.png", NULL};
     lm_error err;
     if (a->out_dir && lm_cli_claim_out_dir(a->out_dir, a->force, own, &err) != LM_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.msg);

@@ -108,7 +108,7 @@ static int cmd_charts(const lm_cli_args *a)
         fprintf(stderr, "lmgi: charts needs --out DIR\n");
         return 2;
     }
-    static const char *const own[] = {"atlas.png", "surfaces.png", "*.partial", NULL};
+    static const char *const own[] = {"atlas.png", "surfaces.png", NULL};
     lm_error claim;
     if (lm_cli_claim_out_dir(a->out_dir, a->force, own, &claim) != LM_OK) {
         fprintf(stderr, "lmgi: error: %s\n", claim.msg);

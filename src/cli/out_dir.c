@@ -11,8 +11,12 @@
 
 #define MARKER ".lmgi"
 
+/* A command's own kind of output, and the NAME.partial files lm_write_file leaves when a run is killed
+ * mid-write (every command's). */
 static int matches(const char *name, const char *const *own)
 {
+    if (fnmatch("*.partial", name, 0) == 0)
+        return 1;
     for (; *own; own++)
         if (fnmatch(*own, name, 0) == 0)
             return 1;
@@ -65,8 +69,8 @@ lm_status lm_cli_claim_out_dir(const char *dir, int force, const char *const *ow
         st = survey(dir, &marked, foreign, sizeof foreign, err);
     if (st == LM_OK && !marked && foreign[0] && !force)
         return lm_fail(err, LM_ERR_IO, "%s: not empty and not written by lmgi (it holds '%s'); give a new or "
-                       "empty directory, or --force to write there (lmgi then removes only files named like its own output)",
-                       dir, foreign);
+                       "empty directory, or --force to write there (lmgi then removes only files named like its "
+                       "own output)", dir, foreign);
     if (st == LM_OK)
         st = remove_own(dir, own, err);
     char marker[4200];

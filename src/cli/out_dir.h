@@ -4,7 +4,7 @@
  * A directory lmgi writes into holds a marker file, .lmgi. A command may write into a directory that is
  * new, empty, or has the marker; one that holds anything else is refused (exit 1, naming a file found
  * there) unless --force. Before writing, the command removes the files of its own kind of output (its
- * `own` name patterns, fnmatch(3)) and nothing else, so a run of 20 frames after one of 60 leaves 20
+ * `own` name patterns, fnmatch(3), and any NAME.partial lm_write_file left) and nothing else, so a run of 20 frames after one of 60 leaves 20
  * frames. Not thread-safe (one claim per command). */
 #ifndef LM_CLI_OUT_DIR_H
 #define LM_CLI_OUT_DIR_H

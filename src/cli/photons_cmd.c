@@ -155,7 +155,7 @@ int lm_cli_photons(const lm_cli_args *a)
     FILE *csv = NULL;
     double sum_ms = 0.0;
     float exposure = 1.0f;
-    static const char *const own[] = {"aim.exr", "aim.png", "view.png", "stats.csv", "*.partial", NULL};
+    static const char *const own[] = {"aim.exr", "aim.png", "view.png", "stats.csv", NULL};
     lm_status st = lm_cli_claim_out_dir(a->out_dir, a->force, own, &err);
     if (st == LM_OK) {
         snprintf(path, sizeof path, "%s/stats.csv", a->out_dir);

@@ -154,7 +154,7 @@ int lm_cli_reference(const lm_cli_args *a)
         return 1;
     lm_error err;
     lm_emitters em;
-    static const char *const own[] = {"reference_*.exr", "reference_*.png", "*.partial", NULL};
+    static const char *const own[] = {"reference_*.exr", "reference_*.png", NULL};
     int ok = lm_cli_claim_out_dir(a->out_dir, a->force, own, &err) == LM_OK &&
              lm_emitters_build(sc->scene, &em, &err) == LM_OK;
     if (!ok) {

@@ -232,7 +232,7 @@ static lm_status play(run_state *r, lm_error *err)
 static lm_status check_out_dir(const run_state *r, lm_error *err)
 {
     static const char *const own[] = {"frame_*.png", "frame_*.exr", "frames.csv", "iim.exr", "iim.png", "aim.exr",
-                                      "aim.png", "*.partial", NULL};
+                                      "aim.png", NULL};
     return lm_cli_claim_out_dir(r->a->out_dir, r->a->force, own, err);
 }
 

@@ -11,7 +11,6 @@
 #include <string.h>
 
 #include "../core/log.h"
-#include "../core/memory.h"
 #include "../core/vecmath.h"
 #include "direct_shader.h"
 #include "direct_mesh.h"

@@ -254,8 +254,6 @@ lm_status Loader::read_file(std::vector<unsigned char> &bytes)
 {
     bool format = false;
     std::string why = read_capped(path_, bytes, &format);
-    if (why == "is a directory, not a file")
-        why = "is a directory, not a .gltf or .glb file";
     return why.empty() ? LM_OK : fail(format ? LM_ERR_FORMAT : LM_ERR_IO, "%s", why.c_str());
 }
 

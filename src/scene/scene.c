@@ -122,8 +122,7 @@ static int find_key(const lm_anim_channel *c, float t)
     return lo;
 }
 
-/* Value (not tangent) of key k. */
-static const float *key_value(const lm_anim_channel *c, int k)
+float *lm_anim_key_value(const lm_anim_channel *c, int k)
 {
     int per_key = c->interp == LM_INTERP_CUBIC ? 3 : 1;
     return c->values + ((size_t)k * (size_t)per_key + (per_key == 3)) * (size_t)c->comps;
@@ -132,7 +131,7 @@ static const float *key_value(const lm_anim_channel *c, int k)
 /* glTF cubic Hermite spline between keys k and k+1 at fraction u, tangents scaled by the interval. */
 static void cubic(const lm_anim_channel *c, int k, float u, float dt, float *out)
 {
-    const float *p0 = key_value(c, k), *p1 = key_value(c, k + 1);
+    const float *p0 = lm_anim_key_value(c, k), *p1 = lm_anim_key_value(c, k + 1);
     const float *b0 = p0 + c->comps;     /* out-tangent of k */
     const float *a1 = p1 - c->comps;     /* in-tangent of k+1 */
     float u2 = u * u, u3 = u2 * u;
@@ -145,11 +144,11 @@ static void eval_channel(const lm_anim_channel *c, float t, float *out)
 {
     int n = c->key_count, k = find_key(c, t);
     if (t <= c->times[0] || k >= n - 1 || c->interp == LM_INTERP_STEP) {
-        memcpy(out, key_value(c, t <= c->times[0] ? 0 : k), (size_t)c->comps * sizeof(float));
+        memcpy(out, lm_anim_key_value(c, t <= c->times[0] ? 0 : k), (size_t)c->comps * sizeof(float));
     } else {
         float dt = c->times[k + 1] - c->times[k];
         float u = dt > 0.0f ? (t - c->times[k]) / dt : 0.0f;
-        const float *a = key_value(c, k), *b = key_value(c, k + 1);
+        const float *a = lm_anim_key_value(c, k), *b = lm_anim_key_value(c, k + 1);
         if (c->interp == LM_INTERP_CUBIC)
             cubic(c, k, u, dt, out);
         else if (c->path == LM_PATH_ROTATION)

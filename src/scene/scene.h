@@ -196,6 +196,8 @@ int *lm_scene_parents_first(const lm_scene *s, int *cycle);
 /* Sets the local TRS of every node that animation `anim` targets to its value at time t (seconds;
  * clamped to the animation's range), then updates world matrices. anim < 0 evaluates all animations. */
 void lm_scene_eval_animation(lm_scene *s, int anim, float t);
+/* The value (not a tangent) of key k of a channel: comps floats. */
+float *lm_anim_key_value(const lm_anim_channel *c, int k);
 /* Duration of the longest animation (0 if none). */
 float lm_scene_animation_duration(const lm_scene *s);
 

@@ -289,9 +289,8 @@ static void warn_mirroring_animations(const lm_scene *s)
                 continue;
             const lm_node *n = &s->nodes[ch->node];
             float own = n->scale[0] * n->scale[1] * n->scale[2];
-            int per_key = ch->interp == LM_INTERP_CUBIC ? 3 : 1, value = ch->interp == LM_INTERP_CUBIC;
             for (int k = 0; k < ch->key_count; k++) {
-                const float *v = ch->values + 3 * ((size_t)k * per_key + value);
+                const float *v = lm_anim_key_value(ch, k);
                 if ((v[0] * v[1] * v[2] < 0.0f) != (own < 0.0f)) {
                     lm_warn("%s: animation \"%s\" mirrors node \"%s\" (scale key %d); its sides stay those of "
                             "its pose at load, so while mirrored it is lit from behind", s->path,
@@ -328,10 +327,9 @@ static void rebase(lm_scene *s)
             lm_anim_channel *ch = &s->animations[a].channels[ci];
             if (ch->path != LM_PATH_TRANSLATION || s->nodes[ch->node].parent >= 0)
                 continue;
-            int per_key = ch->interp == LM_INTERP_CUBIC ? 3 : 1, value = ch->interp == LM_INTERP_CUBIC;
             for (int k = 0; k < ch->key_count; k++)
                 for (int j = 0; j < 3; j++)
-                    ch->values[3 * ((size_t)k * per_key + value) + j] -= s->origin[j];
+                    lm_anim_key_value(ch, k)[j] -= s->origin[j];
         }
     lm_scene_update_world(s);
     lm_scene_update_bounds(s);

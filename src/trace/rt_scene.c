@@ -26,17 +26,8 @@ struct lm_rt {
     int *node_inst;             /* node -> instance geomID, -1 for static nodes */
     float (*inst_world)[16];    /* current world matrix of each instance */
     float (*node_nmat)[9];      /* node -> normal matrix of its world matrix (kept with inst_world) */
-    float *node_ng_sign;        /* node -> -1 where the loader reversed its winding (lm_node.mirrored), else 1:
-                                 * Embree's Ng follows the stored winding, and the front is the side its
-                                 * file normals face, through any later transform (nmat keeps that side) */
     char device_error[256];
 };
-
-static void set_node_normals(lm_rt *rt, int node, const float world[16])
-{
-    lm_mat4_normal_matrix(world, rt->node_nmat[node]);
-    rt->node_ng_sign[node] = rt->scene->nodes[node].mirrored ? -1.0f : 1.0f;
-}
 
 static void on_device_error(void *user, enum RTCError code, const char *str)
 {
@@ -178,7 +169,7 @@ static lm_status add_instance(lm_rt *rt, const lm_scene *s, int n, lm_error *err
     rt->inst_node[id] = n;
     rt->node_inst[n] = (int)id;
     memcpy(rt->inst_world[id], node->world, sizeof(float) * 16);
-    set_node_normals(rt, n, node->world);
+    lm_mat4_normal_matrix(node->world, rt->node_nmat[n]);
     return LM_OK;
 }
 
@@ -205,8 +196,7 @@ lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_
     rt->node_inst = malloc(sizeof(int) * (s->node_count ? s->node_count : 1));
     rt->inst_world = malloc(sizeof(float[16]) * slots);
     rt->node_nmat = malloc(sizeof(float[9]) * (s->node_count ? s->node_count : 1));
-    rt->node_ng_sign = malloc(sizeof(float) * (s->node_count ? s->node_count : 1));
-    if (!rt->inst_node || !rt->node_inst || !rt->inst_world || !rt->node_nmat || !rt->node_ng_sign) {
+    if (!rt->inst_node || !rt->node_inst || !rt->inst_world || !rt->node_nmat) {
         lm_rt_free(rt);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the ray-tracing scene", s->path);
     }
@@ -214,7 +204,7 @@ lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_
         rt->inst_node[i] = -1;
     for (int n = 0; n < s->node_count; n++) {
         rt->node_inst[n] = -1;
-        set_node_normals(rt, n, s->nodes[n].world);
+        lm_mat4_normal_matrix(s->nodes[n].world, rt->node_nmat[n]);
     }
 
     lm_status st = add_static(rt, s, err);
@@ -251,7 +241,6 @@ void lm_rt_free(lm_rt *rt)
     free(rt->node_inst);
     free(rt->inst_world);
     free(rt->node_nmat);
-    free(rt->node_ng_sign);
     free(rt);
 }
 
@@ -276,18 +265,15 @@ static lm_status move_instance(lm_rt *rt, int node, const float world[16], lm_er
     rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT4X4_COLUMN_MAJOR, world);
     rtcCommitGeometry(inst);
     memcpy(rt->inst_world[id], world, sizeof(float) * 16);
-    set_node_normals(rt, node, world);
+    lm_mat4_normal_matrix(world, rt->node_nmat[node]);
     return LM_OK;
 }
 
 lm_status lm_rt_set_node_transform(lm_rt *rt, int node, const float world[16], lm_error *err)
 {
-    if (node >= 0 && node < rt->scene->node_count && lm_mat4_finite(world)) {
-        const lm_node *n = &rt->scene->nodes[node];
-        if (lm_mat4_singular(world))
-            return lm_fail(err, LM_ERR_INVALID, "node '%s': transform is singular (a zero scale flattens the node)",
-                           n->name);
-    }
+    if (node >= 0 && node < rt->scene->node_count && lm_mat4_finite(world) && lm_mat4_singular(world))
+        return lm_fail(err, LM_ERR_INVALID, "node '%s': transform is singular (a zero scale flattens the node)",
+                       rt->scene->nodes[node].name);
     lm_status st = move_instance(rt, node, world, err);
     if (st == LM_OK)
         rtcCommitScene(rt->top);
@@ -353,9 +339,11 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
         int node = rt->inst_node[inst];
         hit->node = node;
         hit->tri = rt->scene->nodes[node].first_tri + rh.hit.primID;
-        /* Embree's Ng is in the instance's space */
+        /* Embree's Ng is in the instance's space and follows the stored winding, which the loader reversed
+         * for a node mirrored at load (lm_node.mirrored): the front is the side its file normals face,
+         * through any later transform (nmat keeps that side) */
         ng = lm_normalize(lm_scale(lm_mat3_normal(rt->node_nmat[node], lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)),
-                                   rt->node_ng_sign[node]));
+                                   rt->scene->nodes[node].mirrored ? -1.0f : 1.0f));
         hit->ns = NULL;
     } else {
         hit->tri = rt->static_tri[rh.hit.primID];
