@@ -34,7 +34,7 @@ DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenm
                 libegl-dev libegl-mesa0
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
-                             src/gpu/*.c src/update/*.c))
+                             src/gpu/*.c src/update/*.c src/api/*.c))
 LIB_CXX := $(sort $(wildcard src/scene/*.cpp src/charts/*.cpp))
 CLI_C   := $(sort $(wildcard src/cli/*.c))
 LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o)

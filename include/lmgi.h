@@ -149,6 +149,171 @@ int lmgi_triangle_lightmap_uv(const lmgi_scene *scene, uint32_t triangle, float 
  * NULL scene or dir: LMGI_ERR_INVALID. */
 lmgi_status lmgi_write_charts(const lmgi_scene *scene, const char *dir, int width, int height, lmgi_error *err);
 
+/* ------------------------------------------------------------------------------------------------------
+ * Context: where messages go and the OpenGL context every updater made from it renders with.
+ *
+ * Thread-safety: a context, and every updater made from it, is used from one thread at a time (the
+ * GL context is made current on the calling thread at each call). Two contexts may be used on two
+ * threads at once; nothing is shared between them but read-only scenes. */
+typedef struct lmgi_context lmgi_context;
+
+typedef enum { LMGI_LOG_ERROR = 1, LMGI_LOG_WARN, LMGI_LOG_INFO, LMGI_LOG_DEBUG } lmgi_log_level;
+/* One message, without a prefix or newline; called on the thread that made the call (or, for the
+ * photon work an update runs beside rendering, on that update's worker thread while the call lasts). */
+typedef void (*lmgi_log_fn)(void *user, lmgi_log_level level, const char *message);
+
+/* Zero-initialised means the defaults. */
+typedef struct {
+    lmgi_log_fn log;          /* NULL: messages go to stderr as "lmgi: warning: ..." */
+    void *log_user;
+    lmgi_log_level log_level; /* the most detailed level passed on (0: LMGI_LOG_WARN) */
+    const char *gl_backend;   /* "auto", "egl" or "osmesa" (NULL: the LMGI_GL environment variable, else
+                               * auto: EGL when it gives a hardware renderer, else OSMesa) */
+} lmgi_context_desc;
+
+/* Creates the GL context (OpenGL 4.5 core, no window). NULL desc: the defaults; NULL out:
+ * LMGI_ERR_INVALID; no GL 4.5: LMGI_ERR_BACKEND naming what was tried. */
+lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **out, lmgi_error *err);
+/* Every updater made from it must be freed first. NULL: nothing. */
+void lmgi_context_free(lmgi_context *ctx);
+/* "4.5 (Core Profile) Mesa 22.3.6 / llvmpipe (...) (OSMesa; ...)"; "" for NULL. */
+const char *lmgi_context_gl_description(const lmgi_context *ctx);
+
+/* ------------------------------------------------------------------------------------------------------
+ * Updater: keeps a scene's lightmaps up to date as it changes (docs/architecture.md, "The frame loop").
+ * Creating one traces every photon, fills every AIM and gathers every texel (seconds on big atlases; the
+ * desc's progress callback follows it), so the first update already shows converged light. Each
+ * lmgi_update then plays animations to its time, re-traces the photons that changed, refreshes the AIMs
+ * of the surfaces whose photons changed most, and regathers IIM texels within a budget.
+ *
+ * The scene is borrowed and must outlive the updater; while an updater exists the scene's node edits and
+ * lmgi_set_time reach it at its next update. Thread-safety: as its context's (one thread at a time). */
+typedef struct lmgi_updater lmgi_updater;
+
+typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_DRAWN } lmgi_emitter_light;
+typedef enum { LMGI_GATHER_DEFAULT = 0, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_INSTANCED, LMGI_GATHER_LAYERED } lmgi_gather_scheme;
+
+/* Zero-initialised means the defaults (the same as `lmgi run`'s; docs/ says what each costs and buys). */
+typedef struct {
+    /* work per update */
+    int texels_per_frame;      /* IIM texels gathered per lmgi_update when its budget_ms is 0 (0: 20, the paper's) */
+    int blend_frames;          /* updates a regathered surface takes to fade in (0: 8; -1: at once) */
+    /* photons (docs/photons.md) */
+    uint32_t photons;          /* photon budget over all lights (0: groups x photons_per_group per light) */
+    uint32_t groups;           /* groups per light, 2^a 3^b (0: 72) */
+    uint32_t photons_per_group; /* (0: 160) */
+    uint32_t retrace_per_group; /* photons per group re-checked per update, round robin (0: 1) */
+    uint32_t group_budget;     /* invalid groups re-traced per update (0: 16; UINT32_MAX: all) */
+    uint32_t seed;             /* another, disjoint stretch of the Halton sequence (0: the default one) */
+    int photons_per_estimate;  /* N nearest photons per AIM estimate (0: docs/aim.md's default) */
+    int surfaces_per_frame;    /* AIM refreshes per update (0: 4; -1: all that changed) */
+    /* the gather (docs/gather.md) */
+    int hemicube_resolution;   /* R, plane pixels per side (0: 32) */
+    float enlargement;         /* a, the plane's half-side at distance 1 (0: 2) */
+    int hemicube_samples;      /* AIM lookups per hemicube pixel, 1 or 4 (0: 4) */
+    int hemicube_coverage;     /* MSAA samples per hemicube pixel, 1 to 16 (0: per scene) */
+    int rim_samples;           /* rays into the rim the plane misses (0: 64; -1: none, the paper's 1 / F(a)) */
+    lmgi_gather_scheme gather_scheme; /* how hemicubes are drawn (0: viewports, the fastest measured) */
+    lmgi_emitter_light emitter_light; /* emissive triangles' light in the gather (0: per scene) */
+    int emitter_rays;          /* shadow rays per emissive triangle and texel (0: 32) */
+    int in_order;              /* 1: the photon work before the gather on the calling thread (the paper's
+                                * order); 0: on a second thread beside rendering, one update behind */
+    /* the frame each lmgi_update composites (what `lmgi run` writes) */
+    int frame_width, frame_height; /* 0 x 0: none (lmgi_render draws on demand) */
+    int camera;                /* the file's camera for that frame (0: its first; -1, or 0 when it has none:
+                                * one framing the scene) */
+    int reflection_size;       /* environment map side of a mirror or glossy node (0: 128; -1: no reflections) */
+    int reflection_faces;      /* environment map faces re-rendered per update (0: 1) */
+    /* the first full gather: done and total texels (NULL: none) */
+    void (*progress)(void *user, uint32_t done, uint32_t total);
+    void *progress_user;
+} lmgi_updater_desc;
+
+/* What one lmgi_update did and what it cost (milliseconds). With the photon work on a second thread
+ * (in_order 0) its counts are those of the work that ran during this update. */
+typedef struct {
+    int frame;                 /* updates before this one */
+    float time;                /* animation time, seconds */
+    uint32_t photons_retraced, groups_invalidated, groups_retraced;
+    int aim_surfaces_refreshed;
+    uint32_t texels_gathered;  /* IIM texels regathered */
+    int texels_budget;         /* the texels this update was allowed (budget_ms > 0: from the measured cost) */
+    int surfaces_changed;      /* surfaces whose displayed lightmap changed (lmgi_surface_version moved) */
+    double ms_animate, ms_trace, ms_aim; /* the photon work's parts */
+    double ms_photons;         /* what the update spent on or waiting for the photon work */
+    double ms_gather, ms_blend, ms_direct, ms_composite, ms_total;
+} lmgi_update_stats;
+
+/* The atlas texel count `lmgi run` loads a scene at when given no texel size: what an updater gathering
+ * texels_per_frame texels an update (0: 20) regathers in full in 90 updates (3 s at 30 fps); pass it as
+ * lmgi_options.target_texels. Lightmaps much denser than their texel budget cannot follow what moves. */
+int lmgi_atlas_texels_for(int texels_per_frame);
+
+/* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative
+ * sizes, groups not 2^a 3^b, ...): LMGI_ERR_INVALID naming it; a scene without triangles: LMGI_ERR_INVALID. */
+lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *scene, const lmgi_updater_desc *desc,
+                                lmgi_updater **out, lmgi_error *err);
+void lmgi_updater_free(lmgi_updater *u); /* NULL: nothing */
+
+/* The settings an updater resolved (the desc's zeros and per-scene choices made) and its setup's cost. */
+typedef struct {
+    int texels_per_frame, hemicube_resolution, hemicube_samples, hemicube_coverage, rim_samples;
+    float enlargement;
+    const char *gather_scheme;  /* "viewports", "instanced" or "layered" */
+    uint32_t emissive_triangles;
+    int emitters_closed_form;   /* 1: their light in closed form with emitter_rays shadow rays, 0: drawn */
+    int emitter_rays;
+    uint32_t photons;           /* stored photon paths over all lights */
+    double ms_setup_trace, ms_setup_aim, ms_setup_gather; /* the full trace, every AIM, the full gather */
+} lmgi_updater_info;
+/* NULL u: info zeroed; NULL info: nothing. */
+void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info);
+
+/* One frame's work at animation time `time` (seconds; animations clamp to their range). budget_ms > 0:
+ * the texels regathered are chosen from the measured cost of the last updates so that the update takes
+ * about budget_ms (never fewer than 1 texel when there is work); 0: desc.texels_per_frame. stats may be
+ * NULL. NULL u, a time or budget that is not finite, or a negative budget: LMGI_ERR_INVALID. */
+lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err);
+
+/* The frame the last lmgi_update composited (frame_width x frame_height x 3 linear floats, top row
+ * first; valid until the next update or the free), NULL before the first update or without a frame. */
+const float *lmgi_frame(const lmgi_updater *u, int *width, int *height);
+
+/* A camera (column-major matrices, GL conventions: view space looks down -z, proj maps to clip space),
+ * in the file's world (see "Coordinates" above). */
+typedef struct {
+    float view[16], proj[16];
+} lmgi_camera;
+/* The scene's camera `index` (-1: the file's first, else one framing the scene) for a width x height
+ * picture. NULL scene or cam: LMGI_ERR_INVALID; index out of range: LMGI_ERR_INVALID. */
+lmgi_status lmgi_scene_camera(const lmgi_scene *scene, int index, int width, int height, lmgi_camera *cam,
+                              lmgi_error *err);
+/* Composites the current lighting (direct, shadows, reflections, indirect from the IIM) from `cam` into
+ * rgb (width * height * 3 linear floats, top row first). NULL argument, sizes outside 1..16384 or a view
+ * matrix that is not invertible: LMGI_ERR_INVALID. */
+lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb,
+                        lmgi_error *err);
+
+/* The lightmaps, atlas-sized (lmgi_info's atlas_width x atlas_height) RGBA floats, row 0 at v = 0:
+ *   LMGI_LIGHTMAP_IIM       irradiance E (rgb) as displayed, a = 1 on valid texels, 0 on gutters and on
+ *                           texels inside or under geometry (those filled from their neighbours and the
+ *                           gutters dilated, so bilinear filtering stays smooth);
+ *   LMGI_LIGHTMAP_AIM       the approximate illumination map (photon estimate of radiance leaving each
+ *                           texel, rgb; gutters dilated), a as above.
+ * A diffuse surface's indirect radiance is albedo / pi * E (docs/materials.md). */
+typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM } lmgi_lightmap;
+/* rgba must hold `floats` >= 4 * atlas_width * atlas_height floats. NULL u or rgba, too small, or an
+ * unknown kind: LMGI_ERR_INVALID. */
+lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err);
+
+int lmgi_surface_count(const lmgi_scene *scene); /* 0 for NULL */
+/* The atlas rectangle holding a surface's texels: rect = {x, y, width, height}; returns 0 (rect zeroed)
+ * for NULL or an id out of range. A surface's charts may share the rectangle with other surfaces. */
+int lmgi_surface_rect(const lmgi_scene *scene, int surface, int rect[4]);
+/* How many updates changed what surface's lightmap shows (1 after the updater's first gather): upload a
+ * surface's rectangle again only when this moved. 0 for NULL or an id out of range. */
+uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
+
 const char *lmgi_status_name(lmgi_status s);
 /* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */
 void lmgi_set_verbosity(int level);

@@ -29,7 +29,7 @@
 #include "../src/core/log.h"
 #include "../src/core/timing.h"
 #include "../src/update/frame_loop.h"
-#include "../src/update/lmgi_scene.h"
+#include "../src/api/lmgi_scene.h"
 #include "support.h"
 
 #define SLOW_SECONDS 10.0

@@ -1,5 +1,5 @@
 /* End to end, the way a user meets the lighting: `lmgi run`'s frame at its default settings against the
- * reference's pixels (update/frame_check.h), per visible surface and over the frame, on the shared Cornell
+ * reference's pixels (api/frame_check.h), per visible surface and over the frame, on the shared Cornell
  * box as shipped (its double-sided lamp 0.9 mm under the ceiling), the generated Cornell box and the
  * two-room scene; and the displayed IIM against the reference's E_iim per surface on the shared Cornell
  * box, at `lmgi run`'s lightmap density and at a bake's (64k texels).
@@ -22,7 +22,7 @@
 #include <string.h>
 
 #include "../src/gpu/iim.h"
-#include "../src/update/frame_check.h"
+#include "../src/api/frame_check.h"
 #include "support.h"
 
 #define SIZE 96           /* frame side: about 100 to 1,800 compared pixels per surface */

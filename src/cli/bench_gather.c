@@ -15,7 +15,7 @@
 #include "../gpu/gl_context.h"
 #include "../gpu/hemicube.h"
 #include "../photonmap/aim.h"
-#include "../update/lmgi_scene.h"
+#include "../api/lmgi_scene.h"
 #include "../update/frame_loop.h"
 #include "../update/photon_stage.h"
 

@@ -13,7 +13,7 @@
 #include "../core/timing.h"
 #include "../core/vecmath.h"
 #include "../photonmap/kdtree.h"
-#include "../update/lmgi_scene.h"
+#include "../api/lmgi_scene.h"
 #include "../update/photon_stage.h"
 
 #define REPEATS 5

@@ -6,7 +6,7 @@
 #include <unistd.h>
 
 #include "../core/timing.h"
-#include "../update/frame_check.h"
+#include "../api/frame_check.h"
 #include "bench.h"
 
 /* scenes/many_rooms.glb is left out: its reference took over 10 minutes here. */

@@ -7,7 +7,8 @@
 
 #include "../core/image.h"
 #include "../core/log.h"
-#include "../update/frame_check.h"
+#include "../api/frame_check.h"
+#include "../api/lmgi_updater.h"
 #include "out_dir.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
@@ -94,11 +95,17 @@ int lm_cli_check(const lm_cli_args *a)
     lmgi_scene *sc = NULL;
     if (!lm_cli_run_load(a, &sc))
         return 1;
-    lm_frame_loop_settings ls;
-    lm_cli_run_settings(a, &ls);
-    ls.progress = NULL;
+    lmgi_updater_desc d;
+    lm_cli_updater_desc(a, &d);
+    d.progress = NULL;
     if (!a->width)
-        ls.width = ls.height = CHECK_SIZE;
+        d.frame_width = d.frame_height = CHECK_SIZE;
+    lm_frame_loop_settings ls;
+    if (lm_updater_settings(sc->scene, &d, &ls, &err) != LM_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+        lmgi_free(sc);
+        return 1;
+    }
     lm_ref_settings rs;
     lm_cli_ref_settings(a, &rs);
     if (!a->quiet && lm_log_get_level() < LM_LOG_INFO)

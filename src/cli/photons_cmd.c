@@ -12,7 +12,7 @@
 #include "../gpu/camera.h"
 #include "../gpu/gl_context.h"
 #include "../gpu/lightmap_view.h"
-#include "../update/lmgi_scene.h"
+#include "../api/lmgi_scene.h"
 #include "../update/photon_stage.h"
 #include "out_dir.h"
 #include "progress.h"

@@ -20,7 +20,7 @@
 #include "../core/tonemap.h"
 #include "../gpu/camera.h"
 #include "../trace/reference.h"
-#include "../update/lmgi_scene.h"
+#include "../api/lmgi_scene.h"
 #include "out_dir.h"
 #include "scene_load.h"
 

@@ -1,4 +1,4 @@
-/* lmgi run: plays the scene's animations through the whole frame loop (update/frame_loop.h) and writes
+/* lmgi run: plays the scene's animations through the public updater (include/lmgi.h) and writes
  * DIR/frame_NNNN.png (every K-th also .exr), the final IIM and AIM atlases and DIR/frames.csv.
  * The tone map's exposure is fixed from frame 0 so that the frames do not flicker. */
 #include "run_cmd.h"
@@ -9,12 +9,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../charts/atlas_dilate.h"
 #include "../core/image.h"
 #include "../core/stats.h"
 #include "../core/tonemap.h"
-#include "../update/frame_loop.h"
-#include "../update/lmgi_scene.h"
 #include "out_dir.h"
 #include "photons_cmd.h"
 #include "progress.h"
@@ -25,7 +22,8 @@
 typedef struct {
     const lm_cli_args *a;
     lmgi_scene *sc;
-    lm_frame_loop *loop;
+    lmgi_context *ctx;
+    lmgi_updater *u;
     FILE *csv;
     float exposure;        /* fixed from frame 0 */
     uint8_t *png;          /* scratch, frame-sized RGBA8 */
@@ -40,39 +38,35 @@ static void gather_progress(void *user, uint32_t done, uint32_t total)
     lm_progress("first full gather", (int)done, (int)total);
 }
 
-void lm_cli_run_settings(const lm_cli_args *a, lm_frame_loop_settings *s)
+void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
 {
-    lm_frame_loop_settings_default(s);
-    lm_cli_photon_settings(a, &s->stage);
-    if (a->texels_per_frame)
-        s->iim.texels_per_frame = a->texels_per_frame;
-    if (a->hemicube)
-        s->gather.resolution = a->hemicube;
+    memset(d, 0, sizeof *d); /* 0: the defaults */
+    d->texels_per_frame = a->texels_per_frame;
+    d->photons = (uint32_t)a->photons;
+    d->groups = (uint32_t)a->groups;
+    d->photons_per_group = (uint32_t)a->per_group;
+    d->retrace_per_group = (uint32_t)a->retrace;
+    d->group_budget = a->group_budget < 0 ? 0 : a->group_budget == 0 ? UINT32_MAX : (uint32_t)a->group_budget;
+    d->seed = a->seed;
+    d->photons_per_estimate = a->nearest;
+    d->surfaces_per_frame = a->surface_budget;
+    d->hemicube_resolution = a->hemicube;
+    d->hemicube_samples = a->hemicube_samples;
+    d->hemicube_coverage = a->hemicube_coverage; /* 0: chosen per scene */
+    d->enlargement = a->enlargement > 0.0f ? a->enlargement : 0.0f;
+    d->rim_samples = a->rim_samples < 0 ? 0 : a->rim_samples == 0 ? -1 : a->rim_samples;
+    d->reflection_size = a->reflection_size < 0 ? 0 : a->reflection_size == 0 ? -1 : a->reflection_size;
+    d->reflection_faces = a->reflection_faces;
+    d->gather_scheme = a->gather_scheme < 0 ? LMGI_GATHER_DEFAULT : (lmgi_gather_scheme)(a->gather_scheme + 1);
+    d->emitter_light = a->emitter_light < 0 ? LMGI_EMITTERS_AUTO
+                       : a->emitter_light ? LMGI_EMITTERS_CLOSED_FORM : LMGI_EMITTERS_DRAWN;
+    d->emitter_rays = a->emitter_rays;
+    d->in_order = a->in_order;
+    d->frame_width = a->width ? a->width : LM_CLI_FRAME_SIZE;
+    d->frame_height = a->width ? a->height : LM_CLI_FRAME_SIZE;
+    d->camera = a->camera;
     if (!a->quiet)
-        s->progress = gather_progress;
-    if (a->hemicube_samples)
-        s->gather.samples = a->hemicube_samples;
-    if (a->enlargement > 0.0f)
-        s->gather.enlargement = a->enlargement;
-    if (a->rim_samples >= 0)
-        s->gather.rim_samples = a->rim_samples;
-    if (a->reflection_size >= 0)
-        s->reflection_size = a->reflection_size;
-    if (a->reflection_faces > 0)
-        s->reflection_faces = a->reflection_faces;
-    if (a->gather_scheme >= 0)
-        s->gather.scheme = (lm_gather_scheme)a->gather_scheme;
-    s->emitter_light = a->emitter_light;
-    s->overlap = !a->in_order;
-    if (a->emitter_rays)
-        s->emitter_rays = a->emitter_rays;
-    if (a->hemicube_coverage)
-        s->gather.coverage_samples = a->hemicube_coverage; /* else chosen per scene by the frame loop */
-    if (a->width) {
-        s->width = a->width;
-        s->height = a->height;
-    }
-    s->camera = a->camera;
+        d->progress = gather_progress;
 }
 
 static void csv_header(FILE *f)
@@ -83,14 +77,12 @@ static void csv_header(FILE *f)
 }
 
 /* Flushed row by row: a full disk stops the run at the row it hits, not after the last frame. */
-static int csv_row(FILE *f, const lm_frame_stats *r)
+static int csv_row(FILE *f, const lmgi_update_stats *s)
 {
-    const lm_photon_stage_frame *s = &r->stage;
     fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", s->frame, (double)s->time,
-            s->photons.rr_photons + s->photons.group_photons, s->photons.groups_invalidated,
-            s->photons.groups_retraced, s->aim.surfaces_refreshed, r->texels_gathered, 1e3 * s->t_animate,
-            1e3 * s->t_photons, 1e3 * s->t_aim, 1e3 * r->t_photons, 1e3 * r->t_gather, 1e3 * r->t_blend,
-            1e3 * r->t_direct, 1e3 * r->t_composite, 1e3 * r->t_total);
+            s->photons_retraced, s->groups_invalidated, s->groups_retraced, s->aim_surfaces_refreshed,
+            s->texels_gathered, s->ms_animate, s->ms_trace, s->ms_aim, s->ms_photons, s->ms_gather, s->ms_blend,
+            s->ms_direct, s->ms_composite, s->ms_total);
     return fflush(f) == 0 && !ferror(f);
 }
 
@@ -110,14 +102,21 @@ static lm_status write_pair(const char *dir, const char *name, int w, int h, con
     return st == LM_OK ? lm_write_png(path, w, h, png, err) : st;
 }
 
+/* An error from the public API as the CLI's. */
+static lm_status from_api(lm_error *err, const lmgi_error *e)
+{
+    return lm_fail(err, (lm_status)e->status, "%s", e->message);
+}
+
 static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
 {
-    lm_frame_stats fs;
-    lm_status st = lm_frame_loop_step(r->loop, (float)f / FRAME_RATE, &fs, err);
-    if (st != LM_OK)
-        return st;
-    const float *img = lm_frame_loop_image(r->loop);
-    int w = lm_frame_loop_get_settings(r->loop)->width, h = lm_frame_loop_get_settings(r->loop)->height;
+    lmgi_update_stats fs;
+    lmgi_error e;
+    if (lmgi_update(r->u, (float)f / FRAME_RATE, 0.0f, &fs, &e) != LMGI_OK)
+        return from_api(err, &e);
+    int w, h;
+    const float *img = lmgi_frame(r->u, &w, &h);
+    lm_status st;
     if (f == 0)
         r->exposure = lm_auto_exposure(img, (size_t)w * h, 3);
     char name[64];
@@ -125,52 +124,39 @@ static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
     st = write_pair(r->a->out_dir, name, w, h, img, r->exposure, f % every == 0, r->png, err);
     if (st == LM_OK && !csv_row(r->csv, &fs))
         st = lm_fail(err, LM_ERR_IO, "%s/frames.csv: write failed (%s)", r->a->out_dir, strerror(errno));
-    const double ms[6] = {fs.t_photons, fs.t_gather, fs.t_blend, fs.t_direct, fs.t_composite, fs.t_total};
+    const double ms[6] = {fs.ms_photons, fs.ms_gather, fs.ms_blend, fs.ms_direct, fs.ms_composite, fs.ms_total};
     for (int i = 0; i < 6; i++)
-        r->sum_ms[i] += 1e3 * ms[i];
-    r->frame_ms[f] = 1e3 * fs.t_total;
+        r->sum_ms[i] += ms[i];
+    r->frame_ms[f] = fs.ms_total;
     r->texels += fs.texels_gathered;
     return st;
 }
 
-/* Each IIM texel's E (invalid ones filled, gutters dilated) and each AIM texel's radiance. */
+/* The IIM's E (invalid texels filled, gutters dilated) and the AIM's radiance, each with validity as alpha
+ * (lmgi_get_lightmap). */
 static lm_status write_atlases(run_state *r, lm_error *err)
 {
-    const lm_atlas *at = &r->sc->atlas;
-    size_t n = (size_t)at->width * at->height;
-    float *rgba = NULL, *rgb = malloc(n * 3 * sizeof *rgb);
+    lmgi_info in;
+    lmgi_get_info(r->sc, &in);
+    size_t n = (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(n * 4 * sizeof *rgba), *rgb = malloc(n * 3 * sizeof *rgb);
     uint8_t *png = malloc(n * 4);
-    lm_status st = rgb && png ? lm_frame_loop_read_iim(r->loop, &rgba, err)
-                              : lm_fail(err, LM_ERR_NOMEM, "no memory for the atlases");
-    if (st == LM_OK) {
-        /* alpha: 1 on valid texels, 0 on invalid ones (inside or under geometry: filled from their
-         * neighbours so that bilinear filtering stays smooth, but not light anyone sees) and gutters */
-        float limit = lm_frame_loop_get_settings(r->loop)->gather.backface_limit;
-        uint8_t *valid = png; /* scratch until the pictures are written */
-        for (size_t i = 0; i < n; i++)
-            valid[i] = at->texel_index[i] >= 0 && !(rgba[4 * i + 3] > limit);
-        lm_iim_fill_invalid(at, rgba, limit);
-        for (size_t i = 0; i < n; i++) {
-            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
-            rgba[4 * i + 3] = valid[i];
+    lm_status st = rgba && rgb && png ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory for the atlases");
+    static const char *const names[2] = {"iim", "aim"};
+    static const lmgi_lightmap kinds[2] = {LMGI_LIGHTMAP_IIM, LMGI_LIGHTMAP_AIM};
+    for (int k = 0; k < 2 && st == LM_OK; k++) {
+        lmgi_error e;
+        if (lmgi_get_lightmap(r->u, kinds[k], rgba, n * 4, &e) != LMGI_OK) {
+            st = from_api(err, &e);
+            break;
         }
         char path[4096];
-        snprintf(path, sizeof path, "%s/iim.exr", r->a->out_dir);
-        st = lm_write_exr(path, at->width, at->height, 4, rgba, err);
-        if (st == LM_OK)
-            st = write_pair(r->a->out_dir, "iim", at->width, at->height, rgb, 0.0f, 0, png, err);
-    }
-    if (st == LM_OK) { /* the AIM with the IIM's validity as alpha: its texels under geometry hold only
-                        * the N-nearest estimate's spill from around them */
-        memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(r->loop))), n * 3 * sizeof *rgb);
-        lm_atlas_dilate_gutters(at, rgb, 3);
+        snprintf(path, sizeof path, "%s/%s.exr", r->a->out_dir, names[k]);
+        st = lm_write_exr(path, in.atlas_width, in.atlas_height, 4, rgba, err);
         for (size_t i = 0; i < n; i++)
-            memcpy(rgba + 4 * i, rgb + 3 * i, 3 * sizeof *rgb);
-        char path[4096];
-        snprintf(path, sizeof path, "%s/aim.exr", r->a->out_dir);
-        st = lm_write_exr(path, at->width, at->height, 4, rgba, err);
+            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
         if (st == LM_OK)
-            st = write_pair(r->a->out_dir, "aim", at->width, at->height, rgb, 0.0f, 0, png, err);
+            st = write_pair(r->a->out_dir, names[k], in.atlas_width, in.atlas_height, rgb, 0.0f, 0, png, err);
     }
     free(rgba);
     free(rgb);
@@ -178,28 +164,29 @@ static lm_status write_atlases(run_state *r, lm_error *err)
     return st;
 }
 
-static void summary(const run_state *r, int frames, const lm_photon_stage_frame *setup, double t_gather)
+static void summary(const run_state *r, int frames)
 {
     const double *s = r->sum_ms;
-    printf("gl          %s\n", lm_frame_loop_gl_description(r->loop));
-    const lm_frame_loop_settings *fs = lm_frame_loop_get_settings(r->loop);
-    uint32_t emissive = lm_emissive_triangle_count(r->sc->scene);
+    lmgi_updater_info ui;
+    lmgi_get_updater_info(r->u, &ui);
+    printf("gl          %s\n", lmgi_context_gl_description(r->ctx));
     printf("gather      R %d, a %g, %d AIM lookup%s and %d coverage sample%s per pixel, %s scheme; ",
-           fs->gather.resolution, (double)fs->gather.enlargement, fs->gather.samples, fs->gather.samples > 1 ? "s" : "",
-           fs->gather.coverage_samples, fs->gather.coverage_samples > 1 ? "s" : "", lm_gather_scheme_name(fs->gather.scheme));
-    if (!emissive)
+           ui.hemicube_resolution, (double)ui.enlargement, ui.hemicube_samples, ui.hemicube_samples > 1 ? "s" : "",
+           ui.hemicube_coverage, ui.hemicube_coverage > 1 ? "s" : "", ui.gather_scheme);
+    if (!ui.emissive_triangles)
         printf("no emissive triangles\n");
-    else if (fs->emitter_light)
-        printf("%u emissive triangles in closed form (%d shadow rays each)\n", emissive, fs->emitter_rays);
+    else if (ui.emitters_closed_form)
+        printf("%u emissive triangles in closed form (%d shadow rays each)\n", ui.emissive_triangles, ui.emitter_rays);
     else
-        printf("%u emissive triangles drawn\n", emissive);
-    const lm_atlas *at = &r->sc->atlas;
-    int per_frame = fs->iim.texels_per_frame;
+        printf("%u emissive triangles drawn\n", ui.emissive_triangles);
+    lmgi_info in;
+    lmgi_get_info(r->sc, &in);
+    int per_frame = ui.texels_per_frame;
     printf("atlas       %d x %d, %u texels of %.4g units: regathered in full every %u frames at %d a frame\n",
-           at->width, at->height, at->texel_count, (double)at->texel_size,
-           (at->texel_count + (uint32_t)per_frame - 1) / (uint32_t)per_frame, per_frame);
-    printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", 1e3 * setup->t_photons,
-           1e3 * setup->t_aim, 1e3 * t_gather);
+           in.atlas_width, in.atlas_height, in.texels, (double)in.texel_size,
+           (in.texels + (uint32_t)per_frame - 1) / (uint32_t)per_frame, per_frame);
+    printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", ui.ms_setup_trace,
+           ui.ms_setup_aim, ui.ms_setup_gather);
     printf("frames      %d, %u texels gathered, exposure %.4g (from frame 0)\n", frames, r->texels,
            (double)r->exposure);
     printf("mean frame  %.2f ms (%.1f fps): photons %.2f, gather %.2f, blend %.2f, direct %.2f, composite %.2f\n",
@@ -247,19 +234,17 @@ static lm_status open_outputs(run_state *r, lm_error *err)
 
 static lm_status run(run_state *r, lm_error *err)
 {
-    lm_frame_loop_settings set;
-    lm_cli_run_settings(r->a, &set);
-    r->png = malloc((size_t)set.width * set.height * 4);
+    lmgi_updater_desc desc;
+    lm_cli_updater_desc(r->a, &desc);
+    r->png = malloc((size_t)desc.frame_width * desc.frame_height * 4);
     if (!r->png)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the frames");
-    lm_photon_stage_frame setup;
-    memset(&setup, 0, sizeof setup);
-    double t_gather = 0.0;
-    lmgi_scene *sc = r->sc;
+    lmgi_error e;
     lm_status st = check_out_dir(r, err);
-    if (st == LM_OK)
-        st = lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &r->loop, &setup, &t_gather,
-                                  err);
+    if (st == LM_OK && lmgi_context_create(NULL, &r->ctx, &e) != LMGI_OK)
+        st = from_api(err, &e);
+    if (st == LM_OK && lmgi_updater_create(r->ctx, r->sc, &desc, &r->u, &e) != LMGI_OK)
+        st = from_api(err, &e);
     if (st == LM_OK)
         st = open_outputs(r, err);
     if (st == LM_OK)
@@ -270,16 +255,15 @@ static lm_status run(run_state *r, lm_error *err)
     if (st == LM_OK)
         st = write_atlases(r, err);
     if (st == LM_OK && !r->a->quiet)
-        summary(r, r->a->frames ? r->a->frames : 60, &setup, t_gather);
+        summary(r, r->a->frames ? r->a->frames : 60);
     return st;
 }
 
 int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc)
 {
     lmgi_options o = a->options;
-    int per_frame = a->texels_per_frame ? a->texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME;
     if (o.texel_size <= 0.0f && o.target_texels <= 0) /* a density the texel budget keeps up with */
-        o.target_texels = lm_frame_loop_atlas_texels(per_frame);
+        o.target_texels = lmgi_atlas_texels_for(a->texels_per_frame);
     return lm_cli_load_scene(a->files[0], &o, 1, sc);
 }
 
@@ -299,7 +283,8 @@ int lm_cli_run(const lm_cli_args *a)
     lm_status st = run(&r, &err);
     if (st != LM_OK)
         fprintf(stderr, "lmgi: error: %s\n", err.msg);
-    lm_frame_loop_free(r.loop);
+    lmgi_updater_free(r.u);
+    lmgi_context_free(r.ctx);
     free(r.frame_ms);
     free(r.png);
     lmgi_free(r.sc);

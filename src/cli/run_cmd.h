@@ -5,9 +5,9 @@
 int lm_cli_run(const lm_cli_args *a);
 
 #include <lmgi.h>
-#include "../update/frame_loop.h"
-/* The frame loop's settings from the command line (defaults where not given). */
-void lm_cli_run_settings(const lm_cli_args *a, lm_frame_loop_settings *s);
+#define LM_CLI_FRAME_SIZE 512 /* lmgi run's frame side when not given --size */
+/* The updater's desc from the command line (0, the defaults, where not given). */
+void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d);
 /* Loads a->files[0] as 'run' does: at the lightmap density its texel budget keeps up with unless told a
  * texel size or count. 0 (after printing the error) on failure. */
 int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc);

@@ -95,3 +95,17 @@ lm_status lm_view_ref_camera(const lm_view *v, int width, int height, lm_ref_cam
     cam->width = width, cam->height = height;
     return LM_OK;
 }
+
+int lm_view_from_matrices(const float view[16], const float proj[16], lm_view *out)
+{
+    float inv[16];
+    if (!lm_mat4_invert_affine(inv, view))
+        return 0;
+    memset(out, 0, sizeof *out);
+    memcpy(out->view, view, sizeof out->view);
+    memcpy(out->proj, proj, sizeof out->proj);
+    for (int i = 0; i < 3; i++)
+        out->eye[i] = inv[12 + i]; /* the camera's position: where view space's origin lies */
+    snprintf(out->name, sizeof out->name, "application camera");
+    return 1;
+}

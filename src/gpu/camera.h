@@ -16,6 +16,10 @@ typedef struct {
 /* camera: index into s->cameras, or -1 for the first one if any, else automatic. */
 void lm_view_for_scene(const lm_scene *s, int camera, int width, int height, lm_view *out);
 
+/* A view from an application's matrices (column-major, GL conventions: the camera looks down -z of view
+ * space, proj maps to GL clip space). Returns 0 (out untouched) when view is not an invertible affine map. */
+int lm_view_from_matrices(const float view[16], const float proj[16], lm_view *out);
+
 /* Face f (0..5: +X, -X, +Y, -Y, +Z, -Z) of a cube map at eye: a 90-degree square view whose framebuffer
  * pixel (x, y) is the face's texel (s, t) as GL samples a cube map (right and up of each face as the GL
  * specification's major-axis table has them: +X looks with up -Y, right -Z, and so on). */

@@ -147,15 +147,15 @@ static lm_status open_auto(lm_gl_context *ctx, char *why, size_t why_size, lm_er
     return open_backend(ctx, LM_GL_BACKEND_OSMESA, err);
 }
 
-lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err)
+lm_status lm_gl_context_create_backend(const char *backend, lm_gl_context **out, lm_error *err)
 {
     *out = NULL;
-    const char *choice = getenv("LMGI_GL");
+    const char *choice = backend && *backend ? backend : getenv("LMGI_GL");
     if (!choice || !*choice)
         choice = "auto";
     if (strcmp(choice, "auto") && strcmp(choice, "egl") && strcmp(choice, "osmesa"))
-        return lm_fail(err, LM_ERR_INVALID, "LMGI_GL=%s is not a GL backend; use auto (the default), egl or "
-                       "osmesa", choice);
+        return lm_fail(err, LM_ERR_INVALID, "%s%s is not a GL backend; use auto (the default), egl or osmesa",
+                       backend && *backend ? "" : "LMGI_GL=", choice);
     lm_gl_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for a GL context");
@@ -164,7 +164,7 @@ lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err)
     if (!strcmp(choice, "auto")) {
         st = open_auto(ctx, why, sizeof why, err);
     } else {
-        snprintf(why, sizeof why, "LMGI_GL=%s", choice);
+        snprintf(why, sizeof why, "%s%s", backend && *backend ? "asked for " : "LMGI_GL=", choice);
         st = open_backend(ctx, strcmp(choice, "egl") ? LM_GL_BACKEND_OSMESA : LM_GL_BACKEND_EGL, err);
     }
     if (st != LM_OK) {
@@ -180,6 +180,11 @@ lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err)
         snprintf(ctx->description, sizeof ctx->description, "%s / %s (OSMesa; %s)", version, renderer, why);
     *out = ctx;
     return LM_OK;
+}
+
+lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err)
+{
+    return lm_gl_context_create_backend(NULL, out, err);
 }
 
 void lm_gl_context_destroy(lm_gl_context *ctx)

@@ -17,6 +17,8 @@ typedef struct lm_gl_context lm_gl_context;
 
 /* Creates a GL >= 4.5 core context and makes it current on the calling thread. */
 lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err);
+/* The same with the backend named ("auto", "egl", "osmesa"; NULL or "": LMGI_GL decides). */
+lm_status lm_gl_context_create_backend(const char *backend, lm_gl_context **out, lm_error *err);
 void lm_gl_context_destroy(lm_gl_context *ctx);
 lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err);
 lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx);

@@ -103,7 +103,8 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
     iim->last_done = malloc(S * sizeof *iim->last_done);
     iim->blend_start = malloc(S * sizeof *iim->blend_start);
     iim->commit = calloc(S, 1);
-    if (!iim->cursor || !iim->last_done || !iim->blend_start || !iim->commit) {
+    iim->version = calloc(S, sizeof *iim->version);
+    if (!iim->cursor || !iim->last_done || !iim->blend_start || !iim->commit || !iim->version) {
         lm_iim_free(iim);
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
     }
@@ -133,6 +134,7 @@ void lm_iim_free(lm_iim *iim)
     free(iim->last_done);
     free(iim->blend_start);
     free(iim->commit);
+    free(iim->version);
     memset(iim, 0, sizeof *iim);
 }
 
@@ -215,6 +217,9 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
     int any_commit = 0, blending = 0;
     for (int s = 0; s < S; s++) {
+        /* shown differently from the last frame: committed now, or last frame's weight was below 1 */
+        if (iim->commit[s] || (double)iim->frame - 1 - iim->blend_start[s] < iim->set.blend_frames)
+            iim->version[s]++;
         if (iim->commit[s])
             iim->blend_start[s] = instant ? NEVER : iim->frame;
         param[2 * s] = iim->commit[s] ? 1.0f : 0.0f;

@@ -44,6 +44,8 @@ typedef struct {
     int *last_done;        /* per surface: frame its last refresh completed (-1: never) */
     int *blend_start;      /* per surface: frame of its last commit (very negative: fully blended) */
     uint8_t *commit;       /* per surface: completed, to commit at the next lm_iim_blend */
+    uint32_t *version;     /* per surface: blends that changed its displayed texels (a commit, or a blend
+                            * still under way) */
     int frame;
     int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */

@@ -16,6 +16,7 @@ struct lm_frame_loop {
     lm_scene *scene;
     const lm_atlas *atlas;
     lm_gl_context *gl;
+    int own_gl;              /* gl made here (else borrowed from the settings) */
     lm_photon_stage *stage;
     lm_stage_worker *worker; /* with settings.overlap: runs the stage's update beside the GL work */
     lm_gather *gather;
@@ -100,7 +101,7 @@ static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
 {
     size_t n = 3 * (size_t)fl->set.width * fl->set.height;
     fl->texels = malloc(sizeof(uint32_t) * (fl->atlas->texel_count ? fl->atlas->texel_count : 1));
-    fl->image = malloc(n * sizeof(float));
+    fl->image = malloc((n ? n : 1) * sizeof(float));
     if (!fl->texels || !fl->image)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", fl->scene->path);
     return LM_OK;
@@ -123,10 +124,37 @@ static lm_status setup_emitters(lm_frame_loop *fl, lm_error *err)
     return st;
 }
 
-/* GL context, gather, IIMs and composite; then every texel gathered and shown at once. */
+/* The passes that draw a frame (composite, direct light, reflections), made with the loop when it draws
+ * frames, else at the first lm_frame_loop_render. */
+static lm_status setup_render(lm_frame_loop *fl, lm_error *err)
+{
+    if (fl->direct_light)
+        return LM_OK;
+    lm_status st = lm_composite_create(fl->scene, fl->atlas, fl->set.gather.backface_limit, &fl->comp, err);
+    if (st == LM_OK)
+        st = lm_direct_create(fl->scene, fl->atlas, &fl->set.direct, &fl->direct_light, err);
+    if (st == LM_OK && fl->set.reflection_size > 0)
+        st = lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections,
+                                   err);
+    return st;
+}
+
+/* The settings' GL context made current, or one of the loop's own. */
+static lm_status setup_gl(lm_frame_loop *fl, lm_error *err)
+{
+    if (fl->set.gl) {
+        fl->gl = fl->set.gl;
+        return lm_gl_make_current(fl->gl, err);
+    }
+    lm_status st = lm_gl_context_create(&fl->gl, err);
+    fl->own_gl = st == LM_OK;
+    return st;
+}
+
+/* GL context, gather, IIMs and the render passes; then every texel gathered and shown at once. */
 static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
 {
-    lm_status st = lm_gl_context_create(&fl->gl, err);
+    lm_status st = setup_gl(fl, err);
     if (st == LM_OK)
         st = setup_emitters(fl, err);
     if (st == LM_OK)
@@ -137,13 +165,8 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         lm_gather_set_tracer(fl->gather, fl->rt);
     if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK)
         fl->have_iim = 1;
-    if (st == LM_OK)
-        st = lm_composite_create(fl->scene, fl->atlas, fl->set.gather.backface_limit, &fl->comp, err);
-    if (st == LM_OK)
-        st = lm_direct_create(fl->scene, fl->atlas, &fl->set.direct, &fl->direct_light, err);
-    if (st == LM_OK && fl->set.reflection_size > 0)
-        st = lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections,
-                                   err);
+    if (st == LM_OK && fl->set.width > 0)
+        st = setup_render(fl, err);
     double t0 = lm_now();
     fl->aim_stale = 1;
     if (st == LM_OK)
@@ -205,7 +228,8 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     lm_gather_free(fl->gather);
     if (fl->have_emitters)
         lm_emitter_light_free(&fl->emitters);
-    lm_gl_context_destroy(fl->gl);
+    if (fl->own_gl)
+        lm_gl_context_destroy(fl->gl);
     lm_photon_stage_free(fl->stage);
     free(fl->texels);
     free(fl->image);
@@ -216,27 +240,48 @@ void lm_frame_loop_free(lm_frame_loop *fl)
  * due this frame, then the direct light, whose first pass adds kd x that term at each visible surface's
  * lightmap uv (shadow maps re-rendered only when stale), the reflections over it: one frame-sized
  * read-back. */
-static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
+static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int h, float *rgb, int step,
+                             lm_frame_stats *o, lm_error *err)
 {
-    int w = fl->set.width, h = fl->set.height;
-    lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
     double t0 = lm_now();
     unsigned lit = 0;
     lm_status st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
     const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
-    if (st == LM_OK)
+    if (st == LM_OK && step) /* the faces due this step; an extra view shows the maps as they are */
         st = lm_reflections_update(fl->reflections, fl->direct_light, fl->scene, em, err);
     if (st == LM_OK)
-        st = lm_direct_draw(fl->direct_light, fl->scene, em, &fl->view, w, h, err);
+        st = lm_direct_draw(fl->direct_light, fl->scene, em, view, w, h, err);
     if (st == LM_OK)
-        st = lm_reflections_draw(fl->reflections, fl->direct_light, &fl->view, err);
+        st = lm_reflections_draw(fl->reflections, fl->direct_light, view, err);
     if (st == LM_OK)
-        st = lm_direct_read(fl->direct_light, fl->image, err);
+        st = lm_direct_read(fl->direct_light, rgb, err);
     o->t_composite = t1 - t0;
     o->t_direct = lm_now() - t1;
     return st;
+}
+
+/* The step's frame from the settings' camera, when the loop draws frames. */
+static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
+{
+    int w = fl->set.width, h = fl->set.height;
+    if (w <= 0)
+        return LM_OK;
+    lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
+    return render_view(fl, &fl->view, w, h, fl->image, 1, o, err);
+}
+
+lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width, int height, float *rgb,
+                               lm_error *err)
+{
+    lm_status st = lm_gl_make_current(fl->gl, err);
+    if (st == LM_OK)
+        st = setup_render(fl, err);
+    lm_frame_stats o;
+    /* the environment maps' faces due are refreshed by the steps' own frames; without those, here */
+    int refresh = fl->set.width <= 0;
+    return st == LM_OK ? render_view(fl, view, width, height, rgb, refresh, &o, err) : st;
 }
 
 /* Blend (timed into o), then render. */
@@ -320,7 +365,9 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
     lm_frame_stats o;
     memset(&o, 0, sizeof o);
     double t0 = lm_now();
-    lm_status st = fl->worker ? step_overlapped(fl, t, &o, err) : step_in_order(fl, t, &o, err);
+    lm_status st = lm_gl_make_current(fl->gl, err);
+    if (st == LM_OK)
+        st = fl->worker ? step_overlapped(fl, t, &o, err) : step_in_order(fl, t, &o, err);
     o.t_total = lm_now() - t0;
     if (out)
         *out = o;
@@ -328,6 +375,12 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
 }
 
 const float *lm_frame_loop_image(const lm_frame_loop *fl) { return fl->image; }
+const uint32_t *lm_frame_loop_surface_versions(const lm_frame_loop *fl) { return fl->iim.version; }
+
+void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels)
+{
+    fl->iim.set.texels_per_frame = texels > 0 ? texels : 0;
+}
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl->stage; }
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }
@@ -336,10 +389,14 @@ const char *lm_frame_loop_gl_description(const lm_frame_loop *fl) { return lm_gl
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err)
 {
     size_t n = 4 * (size_t)fl->atlas->width * fl->atlas->height;
+    *rgba = NULL;
+    lm_status st = lm_gl_make_current(fl->gl, err);
+    if (st != LM_OK)
+        return st;
     *rgba = malloc(n * sizeof(float));
     if (!*rgba)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the IIM read-back");
-    lm_status st = lm_iim_texture_read(fl->iim.display_tex, fl->atlas->width, fl->atlas->height, *rgba, err);
+    st = lm_iim_texture_read(fl->iim.display_tex, fl->atlas->width, fl->atlas->height, *rgba, err);
     if (st != LM_OK) {
         free(*rgba);
         *rgba = NULL;

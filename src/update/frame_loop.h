@@ -19,6 +19,7 @@
 
 #include "../gpu/camera.h"
 #include "../gpu/direct.h"
+#include "../gpu/gl_context.h"
 #include "../gpu/hemicube.h"
 #include "../gpu/iim.h"
 #include "photon_stage.h"
@@ -36,7 +37,8 @@ typedef struct {
                             * AIMs and delta_i; 0: the paper's order, all on the calling thread */
     lm_iim_settings iim;
     lm_direct_settings direct;
-    int width, height;     /* frame size (default 512 x 512) */
+    int width, height;     /* frame size (default 512 x 512; 0 x 0: lm_frame_loop_step composites no frame, and
+                            * the render passes are made at the first lm_frame_loop_render) */
     int camera;            /* lm_view_for_scene's camera (default -1) */
     int reflection_size;   /* texels per side of a mirror or glossy node's environment map (gpu/reflections.h;
                             * default 128; 0: no reflections) */
@@ -45,6 +47,8 @@ typedef struct {
     /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;
+    lm_gl_context *gl;     /* borrowed, made current at each call: the context to render with (NULL, the
+                            * default: the loop makes its own) */
 } lm_frame_loop_settings;
 
 typedef struct {
@@ -77,6 +81,18 @@ lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atla
 void lm_frame_loop_free(lm_frame_loop *fl);
 /* One frame at animation time t; the picture is then in lm_frame_loop_image. */
 lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err);
+
+/* The texels the next steps gather (at least 0; the settings' iim.texels_per_frame until set): the public
+ * updater's time budget turns into this. */
+void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels);
+/* Renders the composited frame from `view` at width x height into rgb (width*height*3 linear floats, top
+ * row first) with the lighting of the last step: lmgi_render's camera, beside the step's own frame. The
+ * environment maps' faces due are refreshed here only when the steps draw no frame (width 0). */
+lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width, int height, float *rgb,
+                               lm_error *err);
+/* Per surface, how many steps changed what the displayed IIM holds for it (the first full gather is 1):
+ * an engine uploads a surface's lightmap again only when this moved. */
+const uint32_t *lm_frame_loop_surface_versions(const lm_frame_loop *fl);
 
 /* The last frame, composited (width*height*3 linear floats, top row first); the only read-back of a frame. */
 const float *lm_frame_loop_image(const lm_frame_loop *fl);

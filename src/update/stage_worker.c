@@ -3,12 +3,15 @@
 #include <pthread.h>
 #include <stdlib.h>
 
+#include "../core/log.h"
+
 struct lm_stage_worker {
     lm_photon_stage *ps;
     pthread_t thread;
     pthread_mutex_t lock;
     pthread_cond_t wake, done_cond;
     lm_photon_stage_frame *frame; /* the job; NULL when none is waiting */
+    lm_log_target log;            /* the job's caller's message target, used for the job's messages */
     int busy, quit;
     lm_status status;
     lm_error err;
@@ -24,6 +27,7 @@ static void *run(void *arg)
         if (!w->frame)
             break;
         lm_photon_stage_frame *f = w->frame;
+        lm_log_swap_target(w->log);
         pthread_mutex_unlock(&w->lock);
         lm_error err;
         lm_status st = lm_photon_stage_update(w->ps, f, &err);
@@ -63,6 +67,7 @@ void lm_stage_worker_begin(lm_stage_worker *w, lm_photon_stage_frame *frame)
 {
     pthread_mutex_lock(&w->lock);
     w->frame = frame;
+    w->log = lm_log_get_target();
     w->busy = 1;
     pthread_cond_signal(&w->wake);
     pthread_mutex_unlock(&w->lock);

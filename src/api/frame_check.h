@@ -19,7 +19,7 @@
 #define LM_FRAME_CHECK_H
 
 #include "../trace/reference.h"
-#include "frame_loop.h"
+#include "../update/frame_loop.h"
 #include "lmgi_scene.h"
 
 /* Sums over a set of pixels: how many, and the frame's and the reference's radiance per channel. */

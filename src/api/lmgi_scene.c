@@ -10,7 +10,7 @@
 #include "../core/timing.h"
 #include "../core/vecmath.h"
 #include "../trace/rt_scene.h"
-#include "effects.h"
+#include "../update/effects.h"
 #include "lmgi_scene.h"
 
 void lmgi_options_init(lmgi_options *o)

@@ -6,7 +6,7 @@
 
 #include "../charts/charts.h"
 #include "../trace/rt_scene.h"
-#include "effects.h"
+#include "../update/effects.h"
 
 struct lmgi_scene {
     lmgi_options options;

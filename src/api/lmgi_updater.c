@@ -1,0 +1,463 @@
+/* The public API's updater: the frame loop (update/frame_loop.h) behind include/lmgi.h, with a time
+ * budget turned into a texel count, per-surface change counters and the lightmaps read back. */
+#include <lmgi.h>
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../charts/atlas_dilate.h"
+#include "../core/vecmath.h"
+#include "../update/frame_loop.h"
+#include "lmgi_context.h"
+#include "lmgi_scene.h"
+#include "lmgi_updater.h"
+
+struct lmgi_updater {
+    lmgi_context *ctx;
+    lmgi_scene *sc;
+    lm_frame_loop *loop;
+    int frames;                 /* updates done */
+    int has_frame;              /* the last update composited a frame */
+    uint32_t *seen;             /* per surface: lmgi_surface_version at the end of the last update */
+    double ms_per_texel;        /* the budget's cost model, smoothed over updates: gather ms per texel ... */
+    double ms_fixed;            /* ... and the rest of an update */
+    lm_photon_stage_frame setup;
+    double t_setup_gather;
+};
+
+static lmgi_status invalid(lmgi_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static lmgi_status invalid(lmgi_error *err, const char *fmt, ...)
+{
+    lm_error e;
+    e.status = LM_ERR_INVALID;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(e.msg, sizeof e.msg, fmt, ap);
+    va_end(ap);
+    return lm_export_error(err, &e);
+}
+
+/* A desc field: 0 keeps the default, a value in [lo, hi] replaces it, anything else is refused. */
+static int take(int v, int lo, int hi, int *dst)
+{
+    if (v == 0)
+        return 1;
+    if (v < lo || v > hi)
+        return 0;
+    *dst = v;
+    return 1;
+}
+
+#define TAKE(field, lo, hi, dst)                                                                                      \
+    do {                                                                                                              \
+        if (!take(d->field, lo, hi, dst))                                                                             \
+            return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: " #field " %d must be in %d..%d (0: the "       \
+                           "default)", (int)d->field, lo, hi);                                                        \
+    } while (0)
+
+/* The same for an unsigned field (photon counts). */
+#define TAKEU(field, lo, hi, dst)                                                                                     \
+    do {                                                                                                              \
+        int v_ = (int)*(dst);                                                                                         \
+        if (d->field > (uint32_t)(hi) || !take((int)d->field, lo, hi, &v_))                                           \
+            return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: " #field " %u must be in %d..%d (0: the "       \
+                           "default)", (unsigned)d->field, lo, hi);                                                   \
+        *(dst) = (uint32_t)v_;                                                                                        \
+    } while (0)
+
+/* The frame loop's settings from a desc, each field checked. */
+lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_frame_loop_settings *s,
+                              lm_error *err)
+{
+    lm_frame_loop_settings_default(s);
+    lm_photon_settings *ph = &s->stage.photons;
+    int v;
+    TAKE(texels_per_frame, 1, 100000000, &s->iim.texels_per_frame);
+    if (d->blend_frames == -1)
+        s->iim.blend_frames = 0;
+    else
+        TAKE(blend_frames, 1, 100000, &s->iim.blend_frames);
+    TAKEU(photons, 1, 100000000, &ph->total_photons);
+    TAKEU(groups, 1, 1 << 20, &ph->groups); /* 2^a 3^b: checked by photons */
+    TAKEU(photons_per_group, 1, 10000000, &ph->per_group);
+    TAKEU(retrace_per_group, 1, 1000000, &ph->retrace_per_group);
+    if (d->group_budget == UINT32_MAX)
+        ph->group_budget = 0; /* every invalid group at once */
+    else
+        TAKEU(group_budget, 1, 10000000, &ph->group_budget);
+    ph->seed = d->seed;
+    TAKE(photons_per_estimate, 1, 100000, &s->stage.aim.n_nearest);
+    if (d->surfaces_per_frame == -1)
+        s->stage.surfaces_per_frame = -1;
+    else
+        TAKE(surfaces_per_frame, 1, 10000000, &s->stage.surfaces_per_frame);
+    TAKE(hemicube_resolution, 2, 1024, &s->gather.resolution);
+    if (!(d->enlargement == 0.0f || (d->enlargement >= 1e-3f && d->enlargement <= 1e3f)))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: enlargement %g must be in [0.001, 1000] (0: "
+                       "the default)", (double)d->enlargement);
+    if (d->enlargement > 0.0f)
+        s->gather.enlargement = d->enlargement;
+    if (d->hemicube_samples != 0 && d->hemicube_samples != 1 && d->hemicube_samples != 4)
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: hemicube_samples %d must be 1 or 4 (0: the "
+                       "default)", d->hemicube_samples);
+    TAKE(hemicube_samples, 1, 4, &s->gather.samples);
+    TAKE(hemicube_coverage, 1, 16, &s->gather.coverage_samples);
+    if (d->rim_samples == -1)
+        s->gather.rim_samples = 0;
+    else
+        TAKE(rim_samples, 1, 65536, &s->gather.rim_samples);
+    v = 0;
+    TAKE(gather_scheme, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_LAYERED, &v);
+    if (v)
+        s->gather.scheme = (lm_gather_scheme)(v - 1);
+    v = 0;
+    TAKE(emitter_light, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_DRAWN, &v);
+    s->emitter_light = v == LMGI_EMITTERS_CLOSED_FORM ? 1 : v == LMGI_EMITTERS_DRAWN ? 0 : -1;
+    TAKE(emitter_rays, 1, 65536, &s->emitter_rays);
+    s->overlap = !d->in_order;
+    if (d->frame_width < 0 || d->frame_height < 0 || d->frame_width > 16384 || d->frame_height > 16384 ||
+        (d->frame_width == 0) != (d->frame_height == 0))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: frame %d x %d must be 0 x 0 (none) or sides in "
+                       "1..16384", d->frame_width, d->frame_height);
+    s->width = d->frame_width;
+    s->height = d->frame_height;
+    if (d->camera < -1 || (d->camera > 0 && d->camera >= scene->camera_count))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: camera %d: the scene has %d", d->camera,
+                       scene->camera_count);
+    s->camera = d->camera;
+    if (d->reflection_size == -1)
+        s->reflection_size = 0;
+    else
+        TAKE(reflection_size, 1, 4096, &s->reflection_size);
+    TAKE(reflection_faces, 1, 1 << 20, &s->reflection_faces);
+    s->progress = d->progress;
+    s->progress_user = d->progress_user;
+    return LM_OK;
+}
+
+int lmgi_atlas_texels_for(int texels_per_frame)
+{
+    return lm_frame_loop_atlas_texels(texels_per_frame > 0 ? texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME);
+}
+
+lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc, lmgi_updater **out,
+                                lmgi_error *err)
+{
+    if (!out)
+        return invalid(err, "lmgi_updater_create: out is NULL");
+    *out = NULL;
+    if (!ctx || !sc)
+        return invalid(err, "lmgi_updater_create: %s is NULL", ctx ? "scene" : "context");
+    if (sc->scene->tri_count == 0)
+        return invalid(err, "%s: the scene has no triangles to light", sc->scene->path);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc)
+        d = *desc;
+    lm_log_target saved = lm_api_enter(ctx);
+    lm_error e;
+    lm_frame_loop_settings set;
+    lm_status st = lm_updater_settings(sc->scene, &d, &set, &e);
+    set.gl = ctx->gl;
+    lmgi_updater *u = st == LM_OK ? calloc(1, sizeof *u) : NULL;
+    if (st == LM_OK && !u)
+        st = lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");
+    if (st == LM_OK) {
+        u->ctx = ctx;
+        u->sc = sc;
+        u->seen = calloc((size_t)(sc->atlas.surface_count > 0 ? sc->atlas.surface_count : 1), sizeof *u->seen);
+        st = u->seen ? lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &u->loop, &u->setup,
+                                            &u->t_setup_gather, &e)
+                     : lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");
+    }
+    lm_api_leave(saved);
+    if (st != LM_OK) {
+        if (u)
+            free(u->seen);
+        free(u);
+        return lm_export_error(err, &e);
+    }
+    const uint32_t *ver = lm_frame_loop_surface_versions(u->loop);
+    memcpy(u->seen, ver, sizeof *u->seen * (size_t)sc->atlas.surface_count);
+    /* the budget's first guess: the full gather's cost per texel (small per-frame batches cost more per
+     * texel; the model corrects itself from the first update on) */
+    u->ms_per_texel = sc->atlas.texel_count ? 1e3 * u->t_setup_gather / sc->atlas.texel_count : 0.01;
+    ctx->updaters++;
+    *out = u;
+    return LMGI_OK;
+}
+
+void lmgi_updater_free(lmgi_updater *u)
+{
+    if (!u)
+        return;
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_gl_make_current(u->ctx->gl, NULL); /* the loop's GL objects are deleted in its context */
+    lm_frame_loop_free(u->loop);
+    lm_api_leave(saved);
+    u->ctx->updaters--;
+    free(u->seen);
+    free(u);
+}
+
+void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
+{
+    if (!info)
+        return;
+    memset(info, 0, sizeof *info);
+    if (!u)
+        return;
+    const lm_frame_loop_settings *s = lm_frame_loop_get_settings(u->loop);
+    info->texels_per_frame = s->iim.texels_per_frame;
+    info->hemicube_resolution = s->gather.resolution;
+    info->hemicube_samples = s->gather.samples;
+    info->hemicube_coverage = s->gather.coverage_samples;
+    info->rim_samples = s->gather.rim_samples;
+    info->enlargement = s->gather.enlargement;
+    info->gather_scheme = lm_gather_scheme_name(s->gather.scheme);
+    info->emissive_triangles = lm_emissive_triangle_count(u->sc->scene);
+    info->emitters_closed_form = s->emitter_light;
+    info->emitter_rays = s->emitter_rays;
+    info->photons = lm_photons_count(lm_photon_stage_photons(lm_frame_loop_stage(u->loop)));
+    info->ms_setup_trace = 1e3 * u->setup.t_photons;
+    info->ms_setup_aim = 1e3 * u->setup.t_aim;
+    info->ms_setup_gather = 1e3 * u->t_setup_gather;
+}
+
+/* Texels that fit in budget_ms by the cost model: never fewer than one, never more than the atlas. */
+static int texels_for_budget(const lmgi_updater *u, float budget_ms)
+{
+    double n = ((double)budget_ms - u->ms_fixed) / (u->ms_per_texel > 1e-6 ? u->ms_per_texel : 1e-6);
+    double most = u->sc->atlas.texel_count > 0 ? u->sc->atlas.texel_count : 1;
+    return n < 1.0 ? 1 : n > most ? (int)most : (int)n;
+}
+
+/* The cost model follows each update: an exponential average of the gather's cost per texel and of the
+ * rest. Choosing n = (budget - rest) / (gather / n) converges to the n whose gather fills what the rest
+ * leaves, the gather's fixed cost per pass included. */
+static void learn_cost(lmgi_updater *u, const lm_frame_stats *fs)
+{
+    const double keep = 0.7;
+    double rest = 1e3 * (fs->t_total - fs->t_gather);
+    u->ms_fixed = u->frames == 0 ? rest : keep * u->ms_fixed + (1.0 - keep) * rest;
+    if (fs->texels_gathered > 0) {
+        double per = 1e3 * fs->t_gather / fs->texels_gathered;
+        u->ms_per_texel = keep * u->ms_per_texel + (1.0 - keep) * per;
+    }
+}
+
+static int count_changed(lmgi_updater *u)
+{
+    const uint32_t *ver = lm_frame_loop_surface_versions(u->loop);
+    int changed = 0;
+    for (int s = 0; s < u->sc->atlas.surface_count; s++) {
+        changed += ver[s] != u->seen[s];
+        u->seen[s] = ver[s];
+    }
+    return changed;
+}
+
+static void export_stats(const lm_frame_stats *fs, int budget, int changed, lmgi_update_stats *o)
+{
+    const lm_photon_stage_frame *st = &fs->stage;
+    memset(o, 0, sizeof *o);
+    o->frame = st->frame;
+    o->time = st->time;
+    o->photons_retraced = st->photons.rr_photons + st->photons.group_photons;
+    o->groups_invalidated = st->photons.groups_invalidated;
+    o->groups_retraced = st->photons.groups_retraced;
+    o->aim_surfaces_refreshed = st->aim.surfaces_refreshed;
+    o->texels_gathered = fs->texels_gathered;
+    o->texels_budget = budget;
+    o->surfaces_changed = changed;
+    o->ms_animate = 1e3 * st->t_animate;
+    o->ms_trace = 1e3 * st->t_photons;
+    o->ms_aim = 1e3 * st->t_aim;
+    o->ms_photons = 1e3 * fs->t_photons;
+    o->ms_gather = 1e3 * fs->t_gather;
+    o->ms_blend = 1e3 * fs->t_blend;
+    o->ms_direct = 1e3 * fs->t_direct;
+    o->ms_composite = 1e3 * fs->t_composite;
+    o->ms_total = 1e3 * fs->t_total;
+}
+
+lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)
+{
+    if (!u)
+        return invalid(err, "lmgi_update: updater is NULL");
+    if (!isfinite(time))
+        return invalid(err, "lmgi_update: time %g is not a finite number", (double)time);
+    if (!(budget_ms >= 0.0f) || !isfinite(budget_ms))
+        return invalid(err, "lmgi_update: budget %g ms must be a finite number >= 0 (0: texels_per_frame)",
+                       (double)budget_ms);
+    int budget = budget_ms > 0.0f ? texels_for_budget(u, budget_ms)
+                                   : lm_frame_loop_get_settings(u->loop)->iim.texels_per_frame;
+    lm_frame_loop_set_texels_per_frame(u->loop, budget);
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_frame_stats fs;
+    lm_error e;
+    lm_status st = lm_frame_loop_step(u->loop, time, &fs, &e);
+    lm_api_leave(saved);
+    if (st != LM_OK)
+        return lm_export_error(err, &e);
+    learn_cost(u, &fs);
+    u->frames++;
+    u->has_frame = lm_frame_loop_get_settings(u->loop)->width > 0;
+    if (stats)
+        export_stats(&fs, budget, count_changed(u), stats);
+    else
+        count_changed(u);
+    return LMGI_OK;
+}
+
+const float *lmgi_frame(const lmgi_updater *u, int *width, int *height)
+{
+    int w = 0, h = 0;
+    const float *img = NULL;
+    if (u && u->has_frame) {
+        w = lm_frame_loop_get_settings(u->loop)->width;
+        h = lm_frame_loop_get_settings(u->loop)->height;
+        img = lm_frame_loop_image(u->loop);
+    }
+    if (width)
+        *width = w;
+    if (height)
+        *height = h;
+    return img;
+}
+
+lmgi_status lmgi_scene_camera(const lmgi_scene *sc, int index, int width, int height, lmgi_camera *cam,
+                              lmgi_error *err)
+{
+    if (!sc || !cam)
+        return invalid(err, "lmgi_scene_camera: %s is NULL", sc ? "cam" : "scene");
+    if (index < -1 || index >= sc->scene->camera_count)
+        return invalid(err, "lmgi_scene_camera: camera %d: the scene has %d", index, sc->scene->camera_count);
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        return invalid(err, "lmgi_scene_camera: picture %d x %d must have sides in 1..16384", width, height);
+    lm_view v;
+    lm_view_for_scene(sc->scene, index, width, height, &v);
+    float to_file[16]; /* lmgi's world to the file's: the view matrix takes file positions */
+    lm_mat4_identity(to_file);
+    for (int k = 0; k < 3; k++)
+        to_file[12 + k] = -sc->scene->origin[k];
+    lm_mat4_mul(cam->view, v.view, to_file);
+    memcpy(cam->proj, v.proj, sizeof cam->proj);
+    return LMGI_OK;
+}
+
+lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb, lmgi_error *err)
+{
+    if (!u || !cam || !rgb)
+        return invalid(err, "lmgi_render: %s is NULL", !u ? "updater" : !cam ? "cam" : "rgb");
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        return invalid(err, "lmgi_render: picture %d x %d must have sides in 1..16384", width, height);
+    for (int i = 0; i < 16; i++)
+        if (!isfinite(cam->view[i]) || !isfinite(cam->proj[i]))
+            return invalid(err, "lmgi_render: camera matrix entry %d is not a finite number", i);
+    float from_file[16], view[16]; /* the camera takes file positions; lmgi's are origin-relative */
+    lm_mat4_identity(from_file);
+    for (int k = 0; k < 3; k++)
+        from_file[12 + k] = u->sc->scene->origin[k];
+    lm_mat4_mul(view, cam->view, from_file);
+    lm_view v;
+    if (!lm_view_from_matrices(view, cam->proj, &v))
+        return invalid(err, "lmgi_render: the view matrix is not invertible");
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_error e;
+    lm_status st = lm_frame_loop_render(u->loop, &v, width, height, rgb, &e);
+    lm_api_leave(saved);
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+/* The displayed IIM: alpha 1 on valid texels, 0 on invalid ones (inside or under geometry: filled from
+ * their neighbours so that bilinear filtering stays smooth, but not light anyone sees) and gutters. */
+static lm_status read_iim(const lmgi_updater *u, float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *raw = NULL;
+    lm_status st = lm_frame_loop_read_iim(u->loop, &raw, err);
+    if (st != LM_OK)
+        return st;
+    float limit = lm_frame_loop_get_settings(u->loop)->gather.backface_limit;
+    for (size_t i = 0; i < n; i++) /* validity, kept in the output's alpha until the fill is done */
+        rgba[4 * i + 3] = at->texel_index[i] >= 0 && !(raw[4 * i + 3] > limit);
+    lm_iim_fill_invalid(at, raw, limit);
+    for (size_t i = 0; i < n; i++)
+        memcpy(rgba + 4 * i, raw + 4 * i, 3 * sizeof *rgba);
+    free(raw);
+    return LM_OK;
+}
+
+/* The AIM's radiance, gutters dilated, with the IIM's validity as alpha: its texels under geometry hold
+ * only the N-nearest estimate's spill from around them. */
+static lm_status read_aim(const lmgi_updater *u, float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *rgb = malloc(n * 3 * sizeof *rgb);
+    if (!rgb)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the AIM read-back");
+    lm_status st = read_iim(u, rgba, err);
+    if (st == LM_OK) {
+        memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(u->loop))), n * 3 * sizeof *rgb);
+        lm_atlas_dilate_gutters(at, rgb, 3);
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgba + 4 * i, rgb + 3 * i, 3 * sizeof *rgb);
+    }
+    free(rgb);
+    return st;
+}
+
+lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
+{
+    if (!u || !rgba)
+        return invalid(err, "lmgi_get_lightmap: %s is NULL", u ? "rgba" : "updater");
+    const lm_atlas *at = &u->sc->atlas;
+    size_t need = 4 * (size_t)at->width * at->height;
+    if (floats < need)
+        return invalid(err, "lmgi_get_lightmap: the buffer holds %zu floats; the %d x %d atlas needs %zu", floats,
+                       at->width, at->height, need);
+    if (kind != LMGI_LIGHTMAP_IIM && kind != LMGI_LIGHTMAP_AIM)
+        return invalid(err, "lmgi_get_lightmap: %d is not a lightmap kind", (int)kind);
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_error e;
+    lm_status st = kind == LMGI_LIGHTMAP_IIM ? read_iim(u, rgba, &e) : read_aim(u, rgba, &e);
+    lm_api_leave(saved);
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+int lmgi_surface_count(const lmgi_scene *sc) { return sc ? sc->atlas.surface_count : 0; }
+
+int lmgi_surface_rect(const lmgi_scene *sc, int surface, int rect[4])
+{
+    if (!rect)
+        return 0;
+    memset(rect, 0, 4 * sizeof *rect);
+    if (!sc || surface < 0 || surface >= sc->atlas.surface_count)
+        return 0;
+    const lm_atlas *at = &sc->atlas;
+    int x0 = at->width, y0 = at->height, x1 = -1, y1 = -1;
+    for (uint32_t i = 0; i < at->texel_count; i++) {
+        const lm_texel *t = &at->texels[i];
+        if (t->surface != surface)
+            continue;
+        x0 = t->x < x0 ? t->x : x0, x1 = t->x > x1 ? t->x : x1;
+        y0 = t->y < y0 ? t->y : y0, y1 = t->y > y1 ? t->y : y1;
+    }
+    if (x1 < 0)
+        return 0;
+    rect[0] = x0, rect[1] = y0, rect[2] = x1 - x0 + 1, rect[3] = y1 - y0 + 1;
+    return 1;
+}
+
+uint32_t lmgi_surface_version(const lmgi_updater *u, int surface)
+{
+    if (!u || surface < 0 || surface >= u->sc->atlas.surface_count)
+        return 0;
+    return lm_frame_loop_surface_versions(u->loop)[surface];
+}

@@ -1,0 +1,14 @@
+/* What the public updater shares with the rest of the API: its desc turned into frame loop settings. */
+#ifndef LM_LMGI_UPDATER_H
+#define LM_LMGI_UPDATER_H
+
+#include <lmgi.h>
+
+#include "../update/frame_loop.h"
+
+/* The frame loop's settings for a desc (its zeros the defaults), each field checked: LM_ERR_INVALID naming
+ * the field and its range. s->gl and s->progress are the caller's to set beyond the desc's. */
+lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_frame_loop_settings *s,
+                              lm_error *err);
+
+#endif
