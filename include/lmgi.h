@@ -186,8 +186,9 @@ const char *lmgi_context_gl_description(const lmgi_context *ctx);
  * lmgi_update then plays animations to its time, re-traces the photons that changed, refreshes the AIMs
  * of the surfaces whose photons changed most, and regathers IIM texels within a budget.
  *
- * The scene is borrowed and must outlive the updater; while an updater exists the scene's node edits and
- * lmgi_set_time reach it at its next update. Thread-safety: as its context's (one thread at a time). */
+ * The scene is borrowed and must outlive the updater (lmgi_free refuses, with a message, a scene that has
+ * one); a scene has at most one updater, since updates move its nodes. Node edits made while an updater
+ * exists reach it at its next update. Thread-safety: as its context's (one thread at a time). */
 typedef struct lmgi_updater lmgi_updater;
 
 typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_DRAWN } lmgi_emitter_light;
@@ -250,7 +251,8 @@ typedef struct {
 int lmgi_atlas_texels_for(int texels_per_frame);
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative
- * sizes, groups not 2^a 3^b, ...): LMGI_ERR_INVALID naming it; a scene without triangles: LMGI_ERR_INVALID. */
+ * sizes, groups not 2^a 3^b, ...): LMGI_ERR_INVALID naming it; a scene without triangles, or one that
+ * already has an updater: LMGI_ERR_INVALID. */
 lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *scene, const lmgi_updater_desc *desc,
                                 lmgi_updater **out, lmgi_error *err);
 void lmgi_updater_free(lmgi_updater *u); /* NULL: nothing */

@@ -146,6 +146,10 @@ void lmgi_free(lmgi_scene *sc)
 {
     if (!sc)
         return;
+    if (sc->updater) { /* its updater reads it: leak it rather than crash later */
+        lm_log(LM_LOG_ERROR, "lmgi_free: %s still has an updater; free that first (scene kept)", sc->scene->path);
+        return;
+    }
     lm_rt_free(sc->rt);
     if (sc->have_atlas)
         lm_atlas_free(&sc->atlas);

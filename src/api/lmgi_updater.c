@@ -153,6 +153,9 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
         return invalid(err, "lmgi_updater_create: %s is NULL", ctx ? "scene" : "context");
     if (sc->scene->tri_count == 0)
         return invalid(err, "%s: the scene has no triangles to light", sc->scene->path);
+    if (sc->updater)
+        return invalid(err, "%s: the scene already has an updater (it moves the scene's nodes: one at a time)",
+                       sc->scene->path);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     if (desc)
@@ -173,6 +176,10 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
                                             &u->t_setup_gather, &e)
                      : lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");
     }
+    if (st == LM_OK)
+        lm_info("%s: updater ready: %u photons, %u texels gathered in %.0f ms", sc->scene->path,
+                lm_photons_count(lm_photon_stage_photons(lm_frame_loop_stage(u->loop))), sc->atlas.texel_count,
+                1e3 * u->t_setup_gather);
     lm_api_leave(saved);
     if (st != LM_OK) {
         if (u)
@@ -186,6 +193,7 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
      * texel; the model corrects itself from the first update on) */
     u->ms_per_texel = sc->atlas.texel_count ? 1e3 * u->t_setup_gather / sc->atlas.texel_count : 0.01;
     ctx->updaters++;
+    sc->updater = 1;
     *out = u;
     return LMGI_OK;
 }
@@ -199,6 +207,7 @@ void lmgi_updater_free(lmgi_updater *u)
     lm_frame_loop_free(u->loop);
     lm_api_leave(saved);
     u->ctx->updaters--;
+    u->sc->updater = 0;
     free(u->seen);
     free(u);
 }

@@ -57,6 +57,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->reflection_faces = 1;
     s->progress = NULL;
     s->progress_user = NULL;
+    s->gl = NULL;
 }
 
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */

@@ -1,0 +1,376 @@
+/* The public updater API through include/lmgi.h alone: contexts and their logs, updaters on one or two
+ * contexts giving the same frames, lmgi_render against the update's own frame, the lightmaps and their
+ * change counters, the time budget, and every bad argument refused without changing anything. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <lmgi.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+
+#define SIDE 40
+
+static lmgi_scene *load_cornell(void)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 1500;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
+static void small_desc(lmgi_updater_desc *d)
+{
+    memset(d, 0, sizeof *d);
+    d->photons = 6000;
+    d->hemicube_resolution = 16;
+    d->rim_samples = 8;
+    d->emitter_rays = 4;
+    d->reflection_size = 16;
+    d->frame_width = d->frame_height = SIDE;
+}
+
+static lmgi_updater *make_updater(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *d)
+{
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
+static void update(lmgi_updater *u, float t, float budget, lmgi_update_stats *st)
+{
+    lmgi_error e;
+    if (lmgi_update(u, t, budget, st, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+}
+
+typedef struct {
+    int count[5];
+    char last[256];
+} log_record;
+
+static void record(void *user, lmgi_log_level level, const char *message)
+{
+    log_record *r = user;
+    r->count[level]++;
+    snprintf(r->last, sizeof r->last, "%s", message);
+}
+
+static void test_context(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    assert_true(strstr(lmgi_context_gl_description(ctx), "4.") != NULL); /* a GL 4.x context */
+    lmgi_context_free(ctx);
+    lmgi_context_free(NULL);
+    assert_string_equal(lmgi_context_gl_description(NULL), "");
+    assert_int_equal(lmgi_context_create(NULL, NULL, &e), LMGI_ERR_INVALID);
+    lmgi_context_desc d = {.gl_backend = "vulkan"};
+    ctx = (lmgi_context *)&d; /* must be reset to NULL on failure */
+    assert_int_equal(lmgi_context_create(&d, &ctx, &e), LMGI_ERR_INVALID);
+    assert_null(ctx);
+    assert_non_null(strstr(e.message, "vulkan"));
+    d = (lmgi_context_desc){.log_level = 9};
+    assert_int_equal(lmgi_context_create(&d, &ctx, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "log level 9"));
+}
+
+/* A context's messages reach its callback, at its level and no other's. */
+static void test_log_callback(void **state)
+{
+    (void)state;
+    log_record info, quiet;
+    memset(&info, 0, sizeof info);
+    memset(&quiet, 0, sizeof quiet);
+    lmgi_context_desc d = {.log = record, .log_user = &info, .log_level = LMGI_LOG_INFO};
+    lmgi_context_desc q = {.log = record, .log_user = &quiet, .log_level = LMGI_LOG_WARN};
+    lmgi_context *a = NULL, *b = NULL;
+    assert_int_equal(lmgi_context_create(&d, &a, NULL), LMGI_OK);
+    assert_int_equal(lmgi_context_create(&q, &b, NULL), LMGI_OK);
+    lmgi_scene *s1 = load_cornell(), *s2 = load_cornell();
+    lmgi_updater_desc ud;
+    small_desc(&ud);
+    lmgi_updater *u1 = make_updater(a, s1, &ud), *u2 = make_updater(b, s2, &ud);
+    assert_int_equal(info.count[LMGI_LOG_INFO], 1);
+    assert_non_null(strstr(info.last, "updater ready"));
+    assert_int_equal(quiet.count[LMGI_LOG_INFO], 0); /* below its level */
+    lmgi_updater_free(u1);
+    lmgi_updater_free(u2);
+    lmgi_free(s1);
+    lmgi_free(s2);
+    lmgi_context_free(a);
+    lmgi_context_free(b);
+}
+
+static double max_diff(const float *a, const float *b, size_t n)
+{
+    double m = 0.0;
+    for (size_t i = 0; i < n; i++)
+        m = fmax(m, fabs((double)a[i] - b[i]));
+    return m;
+}
+
+/* Two updaters, each on its own context, updated in turn on one thread give the frames one alone gives:
+ * every call makes its own GL context current. And lmgi_render from the same camera repeats the frame. */
+static void test_two_contexts_one_thread(void **state)
+{
+    (void)state;
+    lmgi_context *a = NULL, *b = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &a, NULL), LMGI_OK);
+    assert_int_equal(lmgi_context_create(NULL, &b, NULL), LMGI_OK);
+    lmgi_scene *s1 = load_cornell(), *s2 = load_cornell();
+    lmgi_updater_desc d;
+    small_desc(&d);
+    lmgi_updater *u1 = make_updater(a, s1, &d);
+    lmgi_updater *u2 = make_updater(b, s2, &d);
+    size_t n = 3 * SIDE * SIDE;
+    float *f1 = malloc(n * sizeof *f1), *again = malloc(n * sizeof *again);
+    for (int f = 0; f < 3; f++) {
+        float t = 0.2f * (float)f;
+        update(u1, t, 0.0f, NULL);
+        memcpy(f1, lmgi_frame(u1, NULL, NULL), n * sizeof *f1);
+        update(u2, t, 0.0f, NULL);
+        int w = 0, h = 0;
+        const float *f2 = lmgi_frame(u2, &w, &h);
+        assert_int_equal(w, SIDE);
+        assert_int_equal(h, SIDE);
+        assert_true(max_diff(f1, f2, n) == 0.0);
+    }
+    lmgi_camera cam;
+    assert_int_equal(lmgi_scene_camera(s1, -1, SIDE, SIDE, &cam, NULL), LMGI_OK);
+    lmgi_error e;
+    assert_int_equal(lmgi_render(u1, &cam, SIDE, SIDE, again, &e), LMGI_OK);
+    double mean = 0.0;
+    for (size_t i = 0; i < n; i++)
+        mean += f1[i] / (double)n;
+    assert_true(mean > 0.05);
+    assert_true(max_diff(f1, again, n) <= 1e-4 * mean);
+    free(f1);
+    free(again);
+    lmgi_updater_free(u1);
+    lmgi_updater_free(u2);
+    lmgi_free(s1);
+    lmgi_free(s2);
+    lmgi_context_free(a);
+    lmgi_context_free(b);
+}
+
+/* The lightmaps: validity 0 or 1 as alpha, finite light on every valid texel and some on most; each
+ * surface's rectangle holds its texels; change counters at 1 after the first gather, still while
+ * nothing moves once the fade is over, moving when the cube does. */
+static void test_lightmaps_and_versions(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_scene *sc = load_cornell();
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.frame_width = d.frame_height = 0; /* no frame: the game draws its own */
+    d.texels_per_frame = 200;
+    lmgi_updater *u = make_updater(ctx, sc, &d);
+    assert_null(lmgi_frame(u, NULL, NULL));
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = (size_t)in.atlas_width * in.atlas_height;
+    float *iim = malloc(4 * n * sizeof *iim), *aim = malloc(4 * n * sizeof *aim);
+    lmgi_error e;
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim, 4 * n, &e), LMGI_OK);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim, 4 * n, &e), LMGI_OK);
+    size_t valid = 0, lit = 0;
+    for (size_t i = 0; i < n; i++) {
+        assert_true(iim[4 * i + 3] == 0.0f || iim[4 * i + 3] == 1.0f);
+        assert_true(aim[4 * i + 3] == iim[4 * i + 3]);
+        for (int c = 0; c < 3; c++)
+            assert_true(isfinite(iim[4 * i + c]) && iim[4 * i + c] >= 0.0f && isfinite(aim[4 * i + c]));
+        valid += iim[4 * i + 3] == 1.0f;
+        lit += iim[4 * i + 3] == 1.0f && iim[4 * i] + iim[4 * i + 1] + iim[4 * i + 2] > 0.0f;
+    }
+    assert_true(valid > in.texels / 2 && valid <= in.texels);
+    assert_true(lit > valid * 9 / 10);
+
+    int surfaces = lmgi_surface_count(sc);
+    assert_int_equal(surfaces, in.surfaces);
+    for (int s = 0; s < surfaces; s++)
+        assert_int_equal(lmgi_surface_version(u, s), 1);
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        int r[4];
+        assert_true(lmgi_surface_rect(sc, t.surface, r));
+        assert_true(t.x >= r[0] && t.x < r[0] + r[2] && t.y >= r[1] && t.y < r[1] + r[3]);
+    }
+    /* the scene at rest (time 0 throughout): after the first updates' re-traces settle and the fades end,
+     * no surface changes */
+    lmgi_update_stats st;
+    int quiet_run = 0;
+    for (int f = 0; f < 60 && quiet_run < 10; f++) {
+        update(u, 0.0f, 0.0f, &st);
+        quiet_run = st.surfaces_changed == 0 ? quiet_run + 1 : 0;
+    }
+    assert_int_equal(quiet_run, 10);
+    uint32_t before = 0;
+    for (int s = 0; s < surfaces; s++)
+        before += lmgi_surface_version(u, s);
+    int changed = 0;
+    for (int f = 1; f <= 10; f++) { /* the cube moves: some surfaces change, and their counters with them */
+        update(u, 0.1f * (float)f, 0.0f, &st);
+        changed += st.surfaces_changed;
+    }
+    uint32_t after = 0;
+    for (int s = 0; s < surfaces; s++)
+        after += lmgi_surface_version(u, s);
+    assert_true(changed > 0);
+    assert_int_equal(after - before, (uint32_t)changed);
+    free(iim);
+    free(aim);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A time budget turns into texels from the measured cost: a generous one allows many, a tiny one one. */
+static void test_budget_sets_texels(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_scene *sc = load_cornell();
+    lmgi_updater_desc d;
+    small_desc(&d);
+    lmgi_updater *u = make_updater(ctx, sc, &d);
+    lmgi_update_stats st;
+    update(u, 0.0f, 0.0f, &st);
+    assert_int_equal(st.texels_budget, 20); /* texels_per_frame's default */
+    update(u, 0.1f, 0.001f, &st);
+    assert_int_equal(st.texels_budget, 1);
+    update(u, 0.2f, 5000.0f, &st);
+    assert_true(st.texels_budget > 200);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+static void expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
+{
+    assert_int_equal(st, LMGI_ERR_INVALID);
+    if (!strstr(e->message, words))
+        fail_msg("'%s' does not name '%s'", e->message, words);
+}
+
+/* Every bad argument: LMGI_ERR_INVALID with a message, and nothing changed. */
+static void test_bad_arguments(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_scene *sc = load_cornell();
+    lmgi_updater *u = (lmgi_updater *)sc;
+    lmgi_error e;
+    lmgi_updater_desc d;
+    static const char *const named[] = {"hemicube_samples 3", "frame 10 x 0", "camera 7", "blend_frames -5",
+                                        "enlargement", "groups"};
+    for (int k = 0; k < 6; k++) {
+        small_desc(&d);
+        if (k == 0)
+            d.hemicube_samples = 3;
+        if (k == 1)
+            d.frame_width = 10, d.frame_height = 0;
+        if (k == 2)
+            d.camera = 7;
+        if (k == 3)
+            d.blend_frames = -5;
+        if (k == 4)
+            d.enlargement = NAN;
+        if (k == 5)
+            d.groups = 5; /* not 2^a 3^b */
+        u = (lmgi_updater *)sc;
+        expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, named[k]);
+        assert_null(u);
+    }
+    expect_invalid(lmgi_updater_create(NULL, sc, NULL, &u, &e), &e, "context is NULL");
+    expect_invalid(lmgi_updater_create(ctx, NULL, NULL, &u, &e), &e, "scene is NULL");
+    expect_invalid(lmgi_updater_create(ctx, sc, NULL, NULL, &e), &e, "out is NULL");
+
+    small_desc(&d);
+    u = make_updater(ctx, sc, &d);
+    lmgi_updater *second = NULL;
+    expect_invalid(lmgi_updater_create(ctx, sc, &d, &second, &e), &e, "already has an updater");
+    lmgi_update_stats st, untouched;
+    update(u, 0.0f, 0.0f, &st);
+    memset(&untouched, 0x5a, sizeof untouched);
+    st = untouched;
+    expect_invalid(lmgi_update(u, NAN, 0.0f, &st, &e), &e, "time");
+    expect_invalid(lmgi_update(u, INFINITY, 0.0f, &st, &e), &e, "time");
+    expect_invalid(lmgi_update(u, 0.1f, -1.0f, &st, &e), &e, "budget");
+    expect_invalid(lmgi_update(u, 0.1f, NAN, &st, &e), &e, "budget");
+    expect_invalid(lmgi_update(NULL, 0.1f, 0.0f, &st, &e), &e, "updater is NULL");
+    assert_memory_equal(&st, &untouched, sizeof st);
+    update(u, 0.1f, 0.0f, &st);
+    assert_int_equal(st.frame, 1); /* the refused calls did no update */
+
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *buf = malloc(n * sizeof *buf);
+    expect_invalid(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, buf, n - 1, &e), &e, "needs");
+    expect_invalid(lmgi_get_lightmap(u, (lmgi_lightmap)7, buf, n, &e), &e, "not a lightmap kind");
+    expect_invalid(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, NULL, n, &e), &e, "rgba is NULL");
+    expect_invalid(lmgi_get_lightmap(NULL, LMGI_LIGHTMAP_IIM, buf, n, &e), &e, "updater is NULL");
+
+    lmgi_camera cam;
+    expect_invalid(lmgi_scene_camera(sc, 5, 8, 8, &cam, &e), &e, "camera 5");
+    expect_invalid(lmgi_scene_camera(sc, -1, 0, 8, &cam, &e), &e, "0 x 8");
+    assert_int_equal(lmgi_scene_camera(sc, -1, 8, 8, &cam, &e), LMGI_OK);
+    expect_invalid(lmgi_render(u, &cam, 8, 99999, buf, &e), &e, "8 x 99999");
+    expect_invalid(lmgi_render(u, NULL, 8, 8, buf, &e), &e, "cam is NULL");
+    lmgi_camera flat = cam;
+    memset(flat.view, 0, sizeof flat.view);
+    expect_invalid(lmgi_render(u, &flat, 8, 8, buf, &e), &e, "not invertible");
+    flat = cam;
+    flat.proj[5] = NAN;
+    expect_invalid(lmgi_render(u, &flat, 8, 8, buf, &e), &e, "not a finite number");
+
+    int r[4] = {1, 2, 3, 4};
+    assert_int_equal(lmgi_surface_rect(sc, in.surfaces, r), 0);
+    assert_int_equal(r[0] | r[1] | r[2] | r[3], 0);
+    assert_int_equal(lmgi_surface_version(u, -1), 0);
+    assert_int_equal(lmgi_surface_version(NULL, 0), 0);
+    assert_int_equal(lmgi_surface_count(NULL), 0);
+
+    lmgi_free(sc); /* refused while the updater works on it: the scene stays usable */
+    update(u, 0.2f, 0.0f, &st);
+    assert_int_equal(st.frame, 2);
+    lmgi_context_free(ctx); /* refused too while an updater is alive */
+    update(u, 0.3f, 0.0f, &st);
+    free(buf);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_context),
+        cmocka_unit_test(test_log_callback),
+        cmocka_unit_test(test_two_contexts_one_thread),
+        cmocka_unit_test(test_lightmaps_and_versions),
+        cmocka_unit_test(test_budget_sets_texels),
+        cmocka_unit_test(test_bad_arguments),
+    };
+    lmgi_set_verbosity(0); /* the refusals below log errors on purpose */
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
