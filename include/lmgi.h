@@ -24,6 +24,13 @@
 extern "C" {
 #endif
 
+/* What liblmgi.so exports: these functions only (it is built with hidden visibility). */
+#if defined(__GNUC__) || defined(__clang__)
+#define LMGI_API __attribute__((visibility("default")))
+#else
+#define LMGI_API
+#endif
+
 typedef enum {
     LMGI_OK = 0,
     LMGI_ERR_IO,          /* a file is missing, unreadable or unwritable */
@@ -101,53 +108,63 @@ typedef struct {
 } lmgi_texel;
 
 /* The defaults (NULL o: nothing). */
-void lmgi_options_init(lmgi_options *o);
+LMGI_API void lmgi_options_init(lmgi_options *o);
 
 /* Loads a .gltf/.glb file and builds surfaces, the lightmap atlas, the texel table and the BVHs.
  * NULL path or out: LMGI_ERR_INVALID. A plan larger than the machine's memory (a tiny texel size) is
  * LMGI_ERR_NOMEM before the work, one above 1 GiB a warning with its estimate. */
-lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out, lmgi_error *err);
-void lmgi_free(lmgi_scene *scene); /* NULL: nothing */
+LMGI_API lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out, lmgi_error *err);
+LMGI_API void lmgi_free(lmgi_scene *scene); /* NULL: nothing */
 
 /* NULL scene: info zeroed; NULL info: nothing. */
-void lmgi_get_info(const lmgi_scene *scene, lmgi_info *info);
+LMGI_API void lmgi_get_info(const lmgi_scene *scene, lmgi_info *info);
 /* Writes the human-readable summary `lmgi info` prints (NULL scene or f: nothing). */
-void lmgi_print_info(const lmgi_scene *scene, FILE *f);
-int lmgi_effect_count(const lmgi_scene *scene); /* 0 for NULL */
+LMGI_API void lmgi_print_info(const lmgi_scene *scene, FILE *f);
+LMGI_API int lmgi_effect_count(const lmgi_scene *scene); /* 0 for NULL */
 /* NULL scene or i out of range: out zeroed (name NULL); NULL out: nothing. */
-void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
+LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
 
-/* Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major); a
- * matrix with NaN or infinite entries, a singular one (a zero scale), or one that mirrors where the
- * node's world matrix at load did not (or the other way round: a node's sides are fixed at load), is
- * refused with LMGI_ERR_INVALID and changes nothing. (An animation may scale a node to zero: the node then leaves the
- * rays until its scale returns.) */
-int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
-int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
-const char *lmgi_node_name(const lmgi_scene *scene, int node); /* NULL for NULL or an id out of range */
-int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);   /* 0 for NULL or an id out of range */
+/* Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major) and
+ * its children with it; a static node, a matrix with NaN or infinite entries, a singular one (a zero
+ * scale), or one that mirrors where the node's world matrix at load did not (or the other way round: a
+ * node's sides are fixed at load), is refused with LMGI_ERR_INVALID and changes nothing. (An animation
+ * may scale a node to zero: the node then leaves the rays until its scale returns.)
+ * The rule between edits and animations: an edit wins. A moved node's own animation channels stop
+ * driving it (lmgi_set_time and updates play the others), until lmgi_node_resume_animation hands it
+ * back; its children's channels still play, relative to where it now is. An updater sees an edit at
+ * its next lmgi_update, as it sees an animation's move. */
+LMGI_API int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
+LMGI_API int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
+LMGI_API const char *lmgi_node_name(const lmgi_scene *scene, int node); /* NULL for NULL or an id out of range */
+LMGI_API int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);   /* 0 for NULL or an id out of range */
+/* A node's world matrix now (column-major; in the file's world). Returns 0 (world untouched) for a NULL
+ * argument or an id out of range. */
+LMGI_API int lmgi_get_node_transform(const lmgi_scene *scene, int node, float world[16]);
 /* NULL scene or world: LMGI_ERR_INVALID. */
-lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
+LMGI_API lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
+/* Hands an edited node back to its animations from the next lmgi_set_time or update on. NULL scene or
+ * an id out of range: LMGI_ERR_INVALID. */
+LMGI_API lmgi_status lmgi_node_resume_animation(lmgi_scene *scene, int node, lmgi_error *err);
 /* Plays every glTF animation to time t (seconds) and moves the animated nodes. NULL scene or a t that
  * is not finite: LMGI_ERR_INVALID. */
-lmgi_status lmgi_set_time(lmgi_scene *scene, float t, lmgi_error *err);
+LMGI_API lmgi_status lmgi_set_time(lmgi_scene *scene, float t, lmgi_error *err);
 
 /* Closest hit of the ray org + t dir, t in (0, tmax). A ray with a NaN, infinite or huge (above 1.8e18)
  * number, a zero direction or a NaN or negative tmax hits nothing (hit->hit = 0); tmax may be +inf.
  * NULL scene, org or dir: no hit; NULL hit: nothing. */
-void lmgi_intersect(const lmgi_scene *scene, const float org[3], const float dir[3], float tmax, lmgi_hit *hit);
+LMGI_API void lmgi_intersect(const lmgi_scene *scene, const float org[3], const float dir[3], float tmax, lmgi_hit *hit);
 
-uint32_t lmgi_texel_count(const lmgi_scene *scene); /* 0 for NULL */
+LMGI_API uint32_t lmgi_texel_count(const lmgi_scene *scene); /* 0 for NULL */
 /* NULL scene or i out of range: out zeroed with surface -1; NULL out: nothing. */
-void lmgi_get_texel(const lmgi_scene *scene, uint32_t i, lmgi_texel *out);
+LMGI_API void lmgi_get_texel(const lmgi_scene *scene, uint32_t i, lmgi_texel *out);
 /* The lightmap UVs of a triangle's three corners (6 floats in [0,1]); returns 0 if it has none (or
  * scene or uv is NULL). */
-int lmgi_triangle_lightmap_uv(const lmgi_scene *scene, uint32_t triangle, float uv[6]);
+LMGI_API int lmgi_triangle_lightmap_uv(const lmgi_scene *scene, uint32_t triangle, float uv[6]);
 
 /* Writes DIR/atlas.png (each chart its own colour, gutters black) and DIR/surfaces.png (the scene from
  * its camera, or an automatic one, each surface in a flat colour) at width x height (0 = 1024x768).
  * NULL scene or dir: LMGI_ERR_INVALID. */
-lmgi_status lmgi_write_charts(const lmgi_scene *scene, const char *dir, int width, int height, lmgi_error *err);
+LMGI_API lmgi_status lmgi_write_charts(const lmgi_scene *scene, const char *dir, int width, int height, lmgi_error *err);
 
 /* ------------------------------------------------------------------------------------------------------
  * Context: where messages go and the OpenGL context every updater made from it renders with.
@@ -173,11 +190,11 @@ typedef struct {
 
 /* Creates the GL context (OpenGL 4.5 core, no window). NULL desc: the defaults; NULL out:
  * LMGI_ERR_INVALID; no GL 4.5: LMGI_ERR_BACKEND naming what was tried. */
-lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **out, lmgi_error *err);
+LMGI_API lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **out, lmgi_error *err);
 /* Every updater made from it must be freed first. NULL: nothing. */
-void lmgi_context_free(lmgi_context *ctx);
+LMGI_API void lmgi_context_free(lmgi_context *ctx);
 /* "4.5 (Core Profile) Mesa 22.3.6 / llvmpipe (...) (OSMesa; ...)"; "" for NULL. */
-const char *lmgi_context_gl_description(const lmgi_context *ctx);
+LMGI_API const char *lmgi_context_gl_description(const lmgi_context *ctx);
 
 /* ------------------------------------------------------------------------------------------------------
  * Updater: keeps a scene's lightmaps up to date as it changes (docs/architecture.md, "The frame loop").
@@ -248,14 +265,14 @@ typedef struct {
 /* The atlas texel count `lmgi run` loads a scene at when given no texel size: what an updater gathering
  * texels_per_frame texels an update (0: 20) regathers in full in 90 updates (3 s at 30 fps); pass it as
  * lmgi_options.target_texels. Lightmaps much denser than their texel budget cannot follow what moves. */
-int lmgi_atlas_texels_for(int texels_per_frame);
+LMGI_API int lmgi_atlas_texels_for(int texels_per_frame);
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative
  * sizes, groups not 2^a 3^b, ...): LMGI_ERR_INVALID naming it; a scene without triangles, or one that
  * already has an updater: LMGI_ERR_INVALID. */
-lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *scene, const lmgi_updater_desc *desc,
+LMGI_API lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *scene, const lmgi_updater_desc *desc,
                                 lmgi_updater **out, lmgi_error *err);
-void lmgi_updater_free(lmgi_updater *u); /* NULL: nothing */
+LMGI_API void lmgi_updater_free(lmgi_updater *u); /* NULL: nothing */
 
 /* The settings an updater resolved (the desc's zeros and per-scene choices made) and its setup's cost. */
 typedef struct {
@@ -269,17 +286,17 @@ typedef struct {
     double ms_setup_trace, ms_setup_aim, ms_setup_gather; /* the full trace, every AIM, the full gather */
 } lmgi_updater_info;
 /* NULL u: info zeroed; NULL info: nothing. */
-void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info);
+LMGI_API void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info);
 
 /* One frame's work at animation time `time` (seconds; animations clamp to their range). budget_ms > 0:
  * the texels regathered are chosen from the measured cost of the last updates so that the update takes
  * about budget_ms (never fewer than 1 texel when there is work); 0: desc.texels_per_frame. stats may be
  * NULL. NULL u, a time or budget that is not finite, or a negative budget: LMGI_ERR_INVALID. */
-lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err);
+LMGI_API lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err);
 
 /* The frame the last lmgi_update composited (frame_width x frame_height x 3 linear floats, top row
  * first; valid until the next update or the free), NULL before the first update or without a frame. */
-const float *lmgi_frame(const lmgi_updater *u, int *width, int *height);
+LMGI_API const float *lmgi_frame(const lmgi_updater *u, int *width, int *height);
 
 /* A camera (column-major matrices, GL conventions: view space looks down -z, proj maps to clip space),
  * in the file's world (see "Coordinates" above). */
@@ -288,12 +305,12 @@ typedef struct {
 } lmgi_camera;
 /* The scene's camera `index` (-1: the file's first, else one framing the scene) for a width x height
  * picture. NULL scene or cam: LMGI_ERR_INVALID; index out of range: LMGI_ERR_INVALID. */
-lmgi_status lmgi_scene_camera(const lmgi_scene *scene, int index, int width, int height, lmgi_camera *cam,
+LMGI_API lmgi_status lmgi_scene_camera(const lmgi_scene *scene, int index, int width, int height, lmgi_camera *cam,
                               lmgi_error *err);
 /* Composites the current lighting (direct, shadows, reflections, indirect from the IIM) from `cam` into
  * rgb (width * height * 3 linear floats, top row first). NULL argument, sizes outside 1..16384 or a view
  * matrix that is not invertible: LMGI_ERR_INVALID. */
-lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb,
+LMGI_API lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb,
                         lmgi_error *err);
 
 /* The lightmaps, atlas-sized (lmgi_info's atlas_width x atlas_height) RGBA floats, row 0 at v = 0:
@@ -306,19 +323,19 @@ lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int 
 typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM } lmgi_lightmap;
 /* rgba must hold `floats` >= 4 * atlas_width * atlas_height floats. NULL u or rgba, too small, or an
  * unknown kind: LMGI_ERR_INVALID. */
-lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err);
+LMGI_API lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err);
 
-int lmgi_surface_count(const lmgi_scene *scene); /* 0 for NULL */
+LMGI_API int lmgi_surface_count(const lmgi_scene *scene); /* 0 for NULL */
 /* The atlas rectangle holding a surface's texels: rect = {x, y, width, height}; returns 0 (rect zeroed)
  * for NULL or an id out of range. A surface's charts may share the rectangle with other surfaces. */
-int lmgi_surface_rect(const lmgi_scene *scene, int surface, int rect[4]);
+LMGI_API int lmgi_surface_rect(const lmgi_scene *scene, int surface, int rect[4]);
 /* How many updates changed what surface's lightmap shows (1 after the updater's first gather): upload a
  * surface's rectangle again only when this moved. 0 for NULL or an id out of range. */
-uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
+LMGI_API uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
 
-const char *lmgi_status_name(lmgi_status s);
+LMGI_API const char *lmgi_status_name(lmgi_status s);
 /* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */
-void lmgi_set_verbosity(int level);
+LMGI_API void lmgi_set_verbosity(int level);
 
 #ifdef __cplusplus
 }

@@ -241,6 +241,48 @@ static void test_lightmaps_and_versions(void **state)
     lmgi_context_free(ctx);
 }
 
+/* An edit reaches the updater at its next update, relights what it touches, and playing time does not
+ * take it back. */
+static void test_edit_reaches_updater(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_scene *sc = load_cornell();
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.frame_width = d.frame_height = 0;
+    d.texels_per_frame = 200;
+    lmgi_updater *u = make_updater(ctx, sc, &d);
+    lmgi_update_stats st;
+    for (int f = 0; f < 40; f++) /* at rest at time 0 */
+        update(u, 0.0f, 0.0f, &st);
+    assert_int_equal(st.surfaces_changed, 0);
+    int cube = lmgi_find_node(sc, "dynamic_cube");
+    float m[16];
+    assert_true(lmgi_get_node_transform(sc, cube, m));
+    m[12] = -0.6f, m[14] = 0.6f; /* to the floor's front left corner */
+    lmgi_error e;
+    assert_int_equal(lmgi_set_node_transform(sc, cube, m, &e), LMGI_OK);
+    int changed = 0;
+    for (int f = 1; f <= 20; f++) { /* time runs on: the cube's animation must not take it back */
+        update(u, 0.05f * (float)f, 0.0f, &st);
+        changed += st.surfaces_changed;
+    }
+    assert_true(changed > 0);
+    float now[16];
+    assert_true(lmgi_get_node_transform(sc, cube, now));
+    assert_memory_equal(now, m, sizeof m);
+    const float org[3] = {-0.6f, 1.9f, 0.6f}, down[3] = {0, -1, 0};
+    lmgi_hit h;
+    lmgi_intersect(sc, org, down, INFINITY, &h);
+    assert_true(h.hit);
+    assert_int_equal(h.node, cube);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* A time budget turns into texels from the measured cost: a generous one allows many, a tiny one one. */
 static void test_budget_sets_texels(void **state)
 {
@@ -368,6 +410,7 @@ int main(void)
         cmocka_unit_test(test_log_callback),
         cmocka_unit_test(test_two_contexts_one_thread),
         cmocka_unit_test(test_lightmaps_and_versions),
+        cmocka_unit_test(test_edit_reaches_updater),
         cmocka_unit_test(test_budget_sets_texels),
         cmocka_unit_test(test_bad_arguments),
     };

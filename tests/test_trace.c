@@ -112,13 +112,50 @@ static void test_dynamic_hits_follow_transform(void **state)
     assert_int_equal(h.node, lmgi_find_node(sc, "floor"));
     assert_float_equal(h.t, 2.0f, 1e-5);
 
-    /* The animation puts it at x = 0.25 (half way) at t = 0.5, original size. */
+    /* An edit wins over the animation: playing time leaves the cube where it was put ... */
+    assert_int_equal(lmgi_set_time(sc, 0.5f, &err), LMGI_OK);
+    h = shoot(sc, 0.1f, 2, 0.1f, 0, -1, 0);
+    assert_int_equal(h.node, cube);
+    assert_float_equal(h.t, 1.0f, 1e-5);
+    /* ... until it is handed back: the animation puts it at x = 0.25 (half way) at t = 0.5, original size. */
+    assert_int_equal(lmgi_node_resume_animation(sc, cube, &err), LMGI_OK);
     assert_int_equal(lmgi_set_time(sc, 0.5f, &err), LMGI_OK);
     h = shoot(sc, 0.45f, 2, 0.0f, 0, -1, 0);
     assert_int_equal(h.node, cube);
     assert_float_equal(h.t, 1.25f, 1e-5);
     h = shoot(sc, -0.05f, 2, 0.0f, 0, -1, 0); /* x = -0.05 is left of the cube at [0, 0.5] */
     assert_int_equal(h.node, lmgi_find_node(sc, "floor"));
+    lmgi_free(sc);
+}
+
+/* An edit moves a node's children with it: a carrier without a mesh, a cube under it. */
+static void test_children_follow_an_edit(void **state)
+{
+    (void)state;
+    static lmt_mesh mesh[2];
+    memset(mesh, 0, sizeof mesh);
+    float c0[3] = {-1, 0, 1}, u0[3] = {2, 0, 0}, v0[3] = {0, 0, -2};
+    lmt_mesh_quad(&mesh[0], c0, u0, v0);
+    lmt_mesh_cube(&mesh[1], 0.25f);
+    const char *nodes = "[{\"name\": \"floor\", \"mesh\": 0},"
+                        " {\"name\": \"carrier\", \"children\": [2], \"extras\": {\"lmgi\": {\"dynamic\": true}}},"
+                        " {\"name\": \"cube\", \"mesh\": 1, \"translation\": [0, 0.5, 0]}]";
+    char path[600];
+    snprintf(path, sizeof path, "%s/carrier.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, mesh, 2, nodes, NULL, 0, ""), 0);
+    lmgi_scene *sc = NULL;
+    lmgi_error err;
+    if (lmgi_load(path, NULL, &sc, &err) != LMGI_OK)
+        fail_msg("%s", err.message);
+    int carrier = lmgi_find_node(sc, "carrier"), cube = lmgi_find_node(sc, "cube");
+    assert_true(lmgi_node_is_dynamic(sc, cube)); /* under a dynamic node */
+    lmgi_hit h = shoot(sc, 0.6f, 2, 0.0f, 0, -1, 0);
+    assert_int_equal(h.node, lmgi_find_node(sc, "floor"));
+    const float m[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.5f, 0, 0, 1};
+    assert_int_equal(lmgi_set_node_transform(sc, carrier, m, &err), LMGI_OK);
+    h = shoot(sc, 0.6f, 2, 0.0f, 0, -1, 0); /* the cube now spans x in [0.25, 0.75] */
+    assert_int_equal(h.node, cube);
+    assert_float_equal(h.t, 1.25f, 1e-5);
     lmgi_free(sc);
 }
 
@@ -372,6 +409,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hits_expected_surfaces),
         cmocka_unit_test(test_dynamic_hits_follow_transform),
+        cmocka_unit_test(test_children_follow_an_edit),
         cmocka_unit_test(test_bad_edits_are_refused),
         cmocka_unit_test(test_bad_rays_miss),
         cmocka_unit_test(test_far_from_origin),

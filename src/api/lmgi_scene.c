@@ -200,11 +200,53 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
     memcpy(m, world, sizeof m);
     for (int k = 0; k < 3; k++)
         m[12 + k] -= sc->scene->origin[k];
-    lm_status st = lm_rt_set_node_transform(sc->rt, node, m, &e);
-    if (st != LM_OK)
+    if (!n) {
+        lm_fail(&e, LM_ERR_INVALID, "node id %d is out of range (scene has %d nodes)", node, sc->scene->node_count);
         return lm_export_error(err, &e);
-    /* The scene model follows, so lightmap and picture code see the same placement as the rays. */
-    memcpy(sc->scene->nodes[node].world, m, sizeof m);
+    }
+    if (!n->dynamic) {
+        lm_fail(&e, LM_ERR_INVALID, "node '%s' is static and cannot be moved; mark it dynamic with extras "
+                "{\"lmgi\": {\"dynamic\": true}}", n->name);
+        return lm_export_error(err, &e);
+    }
+    if (!lm_mat4_finite(m) || lm_mat4_singular(m)) {
+        lm_fail(&e, LM_ERR_INVALID, "node '%s': transform %s", n->name, lm_mat4_finite(m) ? "is singular (a zero "
+                "scale flattens the node)" : "has NaN or Inf entries");
+        return lm_export_error(err, &e);
+    }
+    /* The scene model first (children follow through their local matrices), then the rays from it; on a
+     * failure the node's earlier placement comes back. */
+    lm_node saved = *n;
+    lm_status st = lm_scene_set_node_world(sc->scene, node, m)
+                       ? lm_rt_sync_transforms(sc->rt, sc->scene, &e)
+                       : lm_fail(&e, LM_ERR_INVALID, "node '%s': its parent's transform has no inverse", n->name);
+    if (st != LM_OK) {
+        sc->scene->nodes[node] = saved;
+        lm_scene_update_world(sc->scene);
+        lm_rt_sync_transforms(sc->rt, sc->scene, NULL);
+        return lm_export_error(err, &e);
+    }
+    return LMGI_OK;
+}
+
+int lmgi_get_node_transform(const lmgi_scene *sc, int node, float world[16])
+{
+    if (!sc || !world || node < 0 || node >= sc->scene->node_count)
+        return 0;
+    memcpy(world, sc->scene->nodes[node].world, 16 * sizeof *world);
+    for (int k = 0; k < 3; k++) /* lmgi's world to the file's */
+        world[12 + k] += sc->scene->origin[k];
+    return 1;
+}
+
+lmgi_status lmgi_node_resume_animation(lmgi_scene *sc, int node, lmgi_error *err)
+{
+    lm_error e;
+    if (!sc || node < 0 || node >= sc->scene->node_count) {
+        lm_fail(&e, LM_ERR_INVALID, "lmgi_node_resume_animation: %s", sc ? "node id out of range" : "the scene is NULL");
+        return lm_export_error(err, &e);
+    }
+    lm_scene_release_node(sc->scene, node);
     return LMGI_OK;
 }
 

@@ -166,6 +166,8 @@ static void apply_channel(lm_scene *s, const lm_anim_channel *c, float t)
     if (c->node < 0 || c->node >= s->node_count || c->key_count < 1)
         return;
     lm_node *n = &s->nodes[c->node];
+    if (n->edited)
+        return;
     float v[4];
     eval_channel(c, t, v);
     float *dst = c->path == LM_PATH_TRANSLATION ? n->translation : c->path == LM_PATH_ROTATION ? n->rotation : n->scale;
@@ -186,6 +188,27 @@ void lm_scene_eval_animation(lm_scene *s, int anim, float t)
     }
     lm_scene_update_world(s);
 }
+
+int lm_scene_set_node_world(lm_scene *s, int node, const float world[16])
+{
+    lm_node *n = &s->nodes[node];
+    float local[16];
+    if (n->parent >= 0) {
+        float inv[16];
+        if (!lm_mat4_invert_affine(inv, s->nodes[n->parent].world))
+            return 0;
+        lm_mat4_mul(local, inv, world);
+    } else {
+        memcpy(local, world, sizeof local);
+    }
+    memcpy(n->matrix, local, sizeof local);
+    n->has_matrix = 1;
+    n->edited = 1;
+    lm_scene_update_world(s);
+    return 1;
+}
+
+void lm_scene_release_node(lm_scene *s, int node) { s->nodes[node].edited = 0; }
 
 float lm_scene_animation_duration(const lm_scene *s)
 {

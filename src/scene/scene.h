@@ -98,6 +98,8 @@ typedef struct {
     int mirrored;          /* its world matrix mirrors (negative determinant) at load: the loader reversed
                             * its triangles' winding, as glTF asks, so that every later stage finds the
                             * front where the file meant it. Edits keep the sign (lm_rt_set_node_transform) */
+    int edited;            /* placed by an edit (lm_scene_set_node_world): its animation channels no longer
+                            * drive it, so that playing time does not undo what a user did */
 } lm_node;
 
 typedef enum { LM_INTERP_LINEAR = 0, LM_INTERP_STEP, LM_INTERP_CUBIC } lm_interp;
@@ -196,6 +198,12 @@ int *lm_scene_parents_first(const lm_scene *s, int *cycle);
 /* Sets the local TRS of every node that animation `anim` targets to its value at time t (seconds;
  * clamped to the animation's range), then updates world matrices. anim < 0 evaluates all animations. */
 void lm_scene_eval_animation(lm_scene *s, int anim, float t);
+/* An edit: places `node` at `world` (its local matrix becomes the parent's inverse times world, so its
+ * children follow) and marks it edited, so animations leave it alone until lm_scene_release_node. Returns
+ * 0, changing nothing, when the parent's world matrix has no inverse. */
+int lm_scene_set_node_world(lm_scene *s, int node, const float world[16]);
+/* Hands an edited node back to its animations (from the next lm_scene_eval_animation on). */
+void lm_scene_release_node(lm_scene *s, int node);
 /* The value (not a tangent) of key k of a channel: comps floats. */
 float *lm_anim_key_value(const lm_anim_channel *c, int k);
 /* Duration of the longest animation (0 if none). */
