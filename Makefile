@@ -6,6 +6,7 @@
 #   make demo       deps + the main job on a generated scene; pictures in demo/
 #   make fuzz       100,000 structured inputs through load, photons and a frame under ASan + UBSan
 #   make bench      timings (never part of the tests)
+#   make install    PREFIX=DIR (default /usr/local): lmgi.h, liblmgi.a/.so, lmgi, lmgi.pc
 #   make scenes     regenerate scenes/ with tools/gen_scenes
 
 CC      ?= gcc
@@ -24,8 +25,12 @@ WARN    := -Wall -Wextra -Werror
 # Its square roots are single instructions, without the test for a negative argument that would set
 # errno (nothing reads it).
 TRACE_FP := -ffp-contract=fast -fno-math-errno
-CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)
-CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC -fopenmp -Iinclude -I/usr/include/stb $(SAN) $(CXXFLAGS)
+# Hidden visibility: liblmgi.so exports only what include/lmgi.h marks LMGI_API (the static library and
+# the programs linked with it are unaffected).
+VIS          := -fvisibility=hidden
+CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)
+CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fvisibility-inlines-hidden -fopenmp -Iinclude \
+                -I/usr/include/stb $(SAN) $(CXXFLAGS)
 LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lOSMesa -lEGL -lgomp -lstdc++ -lm -lpthread
 LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
 
@@ -43,7 +48,7 @@ TEST_C  := $(sort $(wildcard tests/test_*.c))
 TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o
 
-.PHONY: all deps test test-asan demo bench scenes clean fuzz
+.PHONY: all deps test test-asan demo bench scenes clean fuzz install
 .PRECIOUS: $(BUILD)/obj/%.o
 .PHONY: FORCE
 all: $(BUILD)/lmgi $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
@@ -79,8 +84,21 @@ $(BUILD)/liblmgi.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-$(BUILD)/liblmgi.so: $(LIB_OBJ)
-	$(CC) -shared -o $@ $^ $(LDFLAGS_ALL) $(LIBS)
+SONAME := liblmgi.so.0
+$(BUILD)/liblmgi.so: $(LIB_OBJ) src/api/lmgi.map
+	$(CC) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=src/api/lmgi.map -o $@ $(LIB_OBJ) $(LDFLAGS_ALL) $(LIBS)
+
+# make install PREFIX=DIR: the header, both libraries, the lmgi command and lmgi.pc for pkg-config
+# (`cc app.c $$(pkg-config --cflags --libs lmgi)`; add --static for liblmgi.a and its dependencies).
+PREFIX ?= /usr/local
+install: all
+	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/bin
+	install -m 644 include/lmgi.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 $(BUILD)/liblmgi.a $(DESTDIR)$(PREFIX)/lib/
+	install -m 755 $(BUILD)/liblmgi.so $(DESTDIR)$(PREFIX)/lib/$(SONAME)
+	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/liblmgi.so
+	install -m 755 $(BUILD)/lmgi $(DESTDIR)$(PREFIX)/bin/
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
 
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
 	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS)

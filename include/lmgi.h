@@ -333,6 +333,25 @@ LMGI_API int lmgi_surface_rect(const lmgi_scene *scene, int surface, int rect[4]
  * surface's rectangle again only when this moved. 0 for NULL or an id out of range. */
 LMGI_API uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
 
+/* ------------------------------------------------------------------------------------------------------
+ * Pictures. EXR keeps the linear numbers; PNG is for people: exposure, a tone map, then sRGB.
+ *   LMGI_TONEMAP_NEUTRAL (the default): Khronos PBR Neutral. Colours below 0.76 pass unchanged, brighter
+ *     ones are compressed smoothly towards white and desaturated with it, so a bright lit floor keeps its
+ *     shading. Automatic exposure meters like a camera: the median lit luminance goes to 0.18.
+ *   LMGI_TONEMAP_CLAMP: min(1, k c), the linear look; automatic exposure puts the 99th percentile lit
+ *     luminance at 0.9, so large bright areas clip to flat white. */
+typedef enum { LMGI_TONEMAP_NEUTRAL = 0, LMGI_TONEMAP_CLAMP } lmgi_tonemap;
+
+/* The exposure `op` picks for `pixels` RGB values (3 floats each); 1 when none is lit or rgb is NULL. */
+LMGI_API float lmgi_auto_exposure(lmgi_tonemap op, const float *rgb, size_t pixels);
+/* Writes width x height pixels of `channels` floats (1, 3 or 4; rows top first) to path: ".exr" linear
+ * floats as given, ".png" RGB tone-mapped by op at `exposure` (0: automatic), alpha dropped. The file
+ * appears whole or not at all (written to PATH.partial, then renamed). NULL arguments, sizes outside
+ * 1..65536, other channel counts or another extension: LMGI_ERR_INVALID; a failed write: LMGI_ERR_IO
+ * naming the file. */
+LMGI_API lmgi_status lmgi_write_image(const char *path, int width, int height, int channels, const float *pixels,
+                                      lmgi_tonemap op, float exposure, lmgi_error *err);
+
 LMGI_API const char *lmgi_status_name(lmgi_status s);
 /* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */
 LMGI_API void lmgi_set_verbosity(int level);

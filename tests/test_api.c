@@ -8,6 +8,7 @@
 
 #include <lmgi.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -403,6 +404,70 @@ static void test_bad_arguments(void **state)
     lmgi_context_free(ctx);
 }
 
+/* lmgi_write_image: EXR and PNG written whole, every bad argument named. */
+static void test_write_image(void **state)
+{
+    (void)state;
+    float px[4 * 6 * 4];
+    for (int i = 0; i < 4 * 6 * 4; i++)
+        px[i] = 0.1f * (float)(i % 7);
+    char path[1024];
+    lmgi_error e;
+    const char *names[2] = {"picture.exr", "picture.png"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), names[k]);
+        assert_int_equal(lmgi_write_image(path, 6, 4, 4, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e), LMGI_OK);
+        size_t size = 0;
+        unsigned char *data = lmt_read_file(path, &size, 0);
+        assert_true(size > 40);
+        assert_memory_equal(data + (k ? 1 : 0), k ? "PNG" : "\x76\x2f\x31\x01", k ? 3 : 4); /* the formats' magic */
+        free(data);
+    }
+    expect_invalid(lmgi_write_image(path, 6, 4, 2, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e), &e, "2 channels");
+    expect_invalid(lmgi_write_image(path, 0, 4, 3, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e), &e, "0 x 4");
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, (lmgi_tonemap)5, 0.0f, &e), &e, "not a tone map");
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, LMGI_TONEMAP_CLAMP, NAN, &e), &e, "exposure");
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, NULL, LMGI_TONEMAP_CLAMP, 0.0f, &e), &e, "pixels is NULL");
+    snprintf(path, sizeof path, "%s/picture.jpg", lmt_tmpdir());
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, LMGI_TONEMAP_CLAMP, 0.0f, &e), &e, ".exr or .png");
+    assert_int_equal(lmgi_write_image("/proc/lmgi-nowhere/a.png", 6, 4, 3, px, LMGI_TONEMAP_CLAMP, 1.0f, &e),
+                     LMGI_ERR_IO);
+    assert_non_null(strstr(e.message, "/proc/lmgi-nowhere/a.png"));
+    assert_float_equal(lmgi_auto_exposure(LMGI_TONEMAP_NEUTRAL, NULL, 3), 1.0f, 0.0);
+}
+
+/* liblmgi.so exports exactly the functions lmgi.h marks LMGI_API: nothing internal, nothing missing. */
+static void test_exported_symbols(void **state)
+{
+    (void)state;
+    const char *build = getenv("LMGI_BUILD");
+    char cmd[1024];
+    snprintf(cmd, sizeof cmd, "nm -D --defined-only %s/liblmgi.so", build ? build : "build");
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    char line[1024];
+    int exported = 0;
+    while (fgets(line, sizeof line, p)) {
+        char type[8], name[900];
+        if (sscanf(line, "%*s %7s %899s", type, name) != 2)
+            continue;
+        if (strncmp(name, "lmgi_", 5) != 0)
+            fail_msg("liblmgi.so exports %s, which is not in lmgi.h", name);
+        exported++;
+    }
+    assert_int_equal(pclose(p), 0);
+    size_t size = 0;
+    char *header = (char *)lmt_read_file("include/lmgi.h", &size, 1);
+    header[size] = '\0';
+    int declared = 0;
+    for (const char *q = header; (q = strstr(q, "\nLMGI_API ")) != NULL; q++)
+        declared++;
+    free(header);
+    print_message("liblmgi.so exports %d symbols, lmgi.h declares %d\n", exported, declared);
+    assert_true(declared > 30);
+    assert_int_equal(exported, declared);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -413,6 +478,8 @@ int main(void)
         cmocka_unit_test(test_edit_reaches_updater),
         cmocka_unit_test(test_budget_sets_texels),
         cmocka_unit_test(test_bad_arguments),
+        cmocka_unit_test(test_write_image),
+        cmocka_unit_test(test_exported_symbols),
     };
     lmgi_set_verbosity(0); /* the refusals below log errors on purpose */
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -288,6 +288,31 @@ static void test_tonemap(void **state)
     assert_float_equal(lm_auto_exposure(zero, 1, 3), 1.0f, 0.0); /* nothing lit: no scaling */
 }
 
+/* Khronos PBR Neutral against its formula worked by hand: grey 0.5 loses the 0.04 offset and is
+ * otherwise untouched (below the 0.76 shoulder); grey 2 compresses to 1 - 0.24^2 / 1.44 = 0.96 exactly
+ * (the desaturation mixes grey with grey); colours keep their order; nothing passes 1. Automatic
+ * exposure puts the median lit luminance at 0.18. */
+static void test_tonemap_neutral(void **state)
+{
+    (void)state;
+    float rgb[6 * 3] = {0.5f, 0.5f, 0.5f, 2.0f, 2.0f, 2.0f, 0.6f, 0.3f, 0.1f, 1e6f, 1e6f, 1e6f, 0, 0, 0, 40, 2, 1};
+    uint8_t out[6 * 4];
+    lm_tonemap(LM_TONEMAP_NEUTRAL, rgb, 6, 3, 1.0f, out);
+    assert_int_equal(out[0], (int)(255.0f * lm_linear_to_srgb(0.46f) + 0.5f));
+    assert_int_equal(out[4], (int)(255.0f * lm_linear_to_srgb(0.96f) + 0.5f));
+    assert_int_equal(out[4], out[6]);
+    assert_int_equal(out[8], (int)(255.0f * lm_linear_to_srgb(0.56f) + 0.5f)); /* 0.6 - 0.04 */
+    assert_int_equal(out[9], (int)(255.0f * lm_linear_to_srgb(0.26f) + 0.5f));
+    assert_int_equal(out[12], 255); /* a hot pixel goes to white, not past it */
+    assert_int_equal(out[16], 0);
+    assert_true(out[20] == 255 && out[21] < out[20] && out[22] <= out[21]); /* a bright red stays reddish */
+    float grey[5 * 3];
+    for (int i = 0; i < 5; i++) /* lit luminances 1, 2, 3, 4 and one unlit: median 2 (the unlit left out) */
+        grey[3 * i] = grey[3 * i + 1] = grey[3 * i + 2] = (float)i;
+    assert_float_equal(lm_tonemap_exposure(LM_TONEMAP_NEUTRAL, grey, 5, 3), 0.18f / 2.0f, 1e-6);
+    assert_float_equal(lm_tonemap_exposure(LM_TONEMAP_CLAMP, grey, 5, 3), lm_auto_exposure(grey, 5, 3), 0.0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -305,6 +330,7 @@ int main(void)
         cmocka_unit_test(test_palette_distinct),
         cmocka_unit_test(test_mkdir_p),
         cmocka_unit_test(test_tonemap),
+        cmocka_unit_test(test_tonemap_neutral),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -95,6 +95,15 @@ static int parse_emitter_light(const char *o, const char *v, int *out)
     return bad(o, v, "closed or drawn");
 }
 
+static int parse_tonemap(const char *o, const char *v, int *out)
+{
+    if (v && !strcmp(v, "neutral"))
+        return *out = LMGI_TONEMAP_NEUTRAL, 0;
+    if (v && !strcmp(v, "clamp"))
+        return *out = LMGI_TONEMAP_CLAMP, 0;
+    return bad(o, v, "neutral or clamp");
+}
+
 static int parse_scheme(const char *o, const char *v, int *out)
 {
     static const char *names[] = {"viewports", "instanced", "layered"};
@@ -185,6 +194,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_scheme(o, v, &a->gather_scheme);
         else if (!strcmp(o, "--emitter-light"))
             rc = parse_emitter_light(o, v, &a->emitter_light);
+        else if (!strcmp(o, "--tonemap"))
+            rc = parse_tonemap(o, v, &a->tonemap);
         else if (!strcmp(o, "--emitter-rays"))
             rc = parse_int(o, v, 1, 65536, &a->emitter_rays);
         else if (!strcmp(o, "--gather-scene"))

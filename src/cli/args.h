@@ -47,6 +47,7 @@ typedef struct {
     int emitter_rays;       /* --emitter-rays N: shadow rays per emissive triangle and texel */
     int in_order;           /* --in-order: photon stage before the gather, one thread (no overlap) */
     int force;              /* --force: write into a non-empty --out directory lmgi did not make */
+    int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
 } lm_cli_args;
 

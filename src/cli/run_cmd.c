@@ -9,9 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../core/image.h"
 #include "../core/stats.h"
-#include "../core/tonemap.h"
 #include "out_dir.h"
 #include "photons_cmd.h"
 #include "progress.h"
@@ -26,7 +24,6 @@ typedef struct {
     lmgi_updater *u;
     FILE *csv;
     float exposure;        /* fixed from frame 0 */
-    uint8_t *png;          /* scratch, frame-sized RGBA8 */
     double sum_ms[6];      /* photons, gather, blend, direct, composite, total */
     double *frame_ms;      /* each frame's total, for the median */
     uint32_t texels;
@@ -86,26 +83,27 @@ static int csv_row(FILE *f, const lmgi_update_stats *s)
     return fflush(f) == 0 && !ferror(f);
 }
 
-/* DIR/NAME.exr (linear) and DIR/NAME.png (tone-mapped with exposure k, or automatic when k <= 0). */
-static lm_status write_pair(const char *dir, const char *name, int w, int h, const float *rgb, float k, int exr,
-                            uint8_t *png, lm_error *err)
-{
-    char path[4096];
-    lm_status st = LM_OK;
-    if (exr) {
-        snprintf(path, sizeof path, "%s/%s.exr", dir, name);
-        st = lm_write_exr(path, w, h, 3, rgb, err);
-    }
-    size_t n = (size_t)w * h;
-    lm_tonemap_srgb8(rgb, n, 3, k > 0.0f ? k : lm_auto_exposure(rgb, n, 3), png);
-    snprintf(path, sizeof path, "%s/%s.png", dir, name);
-    return st == LM_OK ? lm_write_png(path, w, h, png, err) : st;
-}
-
 /* An error from the public API as the CLI's. */
 static lm_status from_api(lm_error *err, const lmgi_error *e)
 {
     return lm_fail(err, (lm_status)e->status, "%s", e->message);
+}
+
+/* DIR/NAME.exr (linear) and DIR/NAME.png (tone-mapped with exposure k, or automatic when k <= 0). */
+static lm_status write_pair(const run_state *r, const char *name, int w, int h, int channels, const float *px,
+                            float k, int exr, lm_error *err)
+{
+    char path[4096];
+    lmgi_error e;
+    if (exr) {
+        snprintf(path, sizeof path, "%s/%s.exr", r->a->out_dir, name);
+        if (lmgi_write_image(path, w, h, channels, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e) != LMGI_OK)
+            return from_api(err, &e);
+    }
+    snprintf(path, sizeof path, "%s/%s.png", r->a->out_dir, name);
+    if (lmgi_write_image(path, w, h, channels, px, (lmgi_tonemap)r->a->tonemap, k > 0.0f ? k : 0.0f, &e) != LMGI_OK)
+        return from_api(err, &e);
+    return LM_OK;
 }
 
 static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
@@ -118,10 +116,10 @@ static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
     const float *img = lmgi_frame(r->u, &w, &h);
     lm_status st;
     if (f == 0)
-        r->exposure = lm_auto_exposure(img, (size_t)w * h, 3);
+        r->exposure = lmgi_auto_exposure((lmgi_tonemap)r->a->tonemap, img, (size_t)w * h);
     char name[64];
     snprintf(name, sizeof name, "frame_%04d", f);
-    st = write_pair(r->a->out_dir, name, w, h, img, r->exposure, f % every == 0, r->png, err);
+    st = write_pair(r, name, w, h, 3, img, r->exposure, f % every == 0, err);
     if (st == LM_OK && !csv_row(r->csv, &fs))
         st = lm_fail(err, LM_ERR_IO, "%s/frames.csv: write failed (%s)", r->a->out_dir, strerror(errno));
     const double ms[6] = {fs.ms_photons, fs.ms_gather, fs.ms_blend, fs.ms_direct, fs.ms_composite, fs.ms_total};
@@ -139,28 +137,17 @@ static lm_status write_atlases(run_state *r, lm_error *err)
     lmgi_info in;
     lmgi_get_info(r->sc, &in);
     size_t n = (size_t)in.atlas_width * in.atlas_height;
-    float *rgba = malloc(n * 4 * sizeof *rgba), *rgb = malloc(n * 3 * sizeof *rgb);
-    uint8_t *png = malloc(n * 4);
-    lm_status st = rgba && rgb && png ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory for the atlases");
+    float *rgba = malloc(n * 4 * sizeof *rgba);
+    lm_status st = rgba ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory for the atlases");
     static const char *const names[2] = {"iim", "aim"};
     static const lmgi_lightmap kinds[2] = {LMGI_LIGHTMAP_IIM, LMGI_LIGHTMAP_AIM};
     for (int k = 0; k < 2 && st == LM_OK; k++) {
         lmgi_error e;
-        if (lmgi_get_lightmap(r->u, kinds[k], rgba, n * 4, &e) != LMGI_OK) {
-            st = from_api(err, &e);
-            break;
-        }
-        char path[4096];
-        snprintf(path, sizeof path, "%s/%s.exr", r->a->out_dir, names[k]);
-        st = lm_write_exr(path, in.atlas_width, in.atlas_height, 4, rgba, err);
-        for (size_t i = 0; i < n; i++)
-            memcpy(rgb + 3 * i, rgba + 4 * i, 3 * sizeof *rgb);
-        if (st == LM_OK)
-            st = write_pair(r->a->out_dir, names[k], in.atlas_width, in.atlas_height, rgb, 0.0f, 0, png, err);
+        st = lmgi_get_lightmap(r->u, kinds[k], rgba, n * 4, &e) == LMGI_OK
+                 ? write_pair(r, names[k], in.atlas_width, in.atlas_height, 4, rgba, 0.0f, 1, err)
+                 : from_api(err, &e);
     }
     free(rgba);
-    free(rgb);
-    free(png);
     return st;
 }
 
@@ -236,9 +223,6 @@ static lm_status run(run_state *r, lm_error *err)
 {
     lmgi_updater_desc desc;
     lm_cli_updater_desc(r->a, &desc);
-    r->png = malloc((size_t)desc.frame_width * desc.frame_height * 4);
-    if (!r->png)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory for the frames");
     lmgi_error e;
     lm_status st = check_out_dir(r, err);
     if (st == LM_OK && lmgi_context_create(NULL, &r->ctx, &e) != LMGI_OK)
@@ -286,7 +270,6 @@ int lm_cli_run(const lm_cli_args *a)
     lmgi_updater_free(r.u);
     lmgi_context_free(r.ctx);
     free(r.frame_ms);
-    free(r.png);
     lmgi_free(r.sc);
     return st == LM_OK ? 0 : 1;
 }

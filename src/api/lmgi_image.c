@@ -1,0 +1,62 @@
+/* The public API's pictures: EXR as the numbers, PNG tone-mapped (core/tonemap.h). */
+#include <lmgi.h>
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/image.h"
+#include "../core/tonemap.h"
+#include "lmgi_scene.h"
+
+float lmgi_auto_exposure(lmgi_tonemap op, const float *rgb, size_t pixels)
+{
+    return rgb ? lm_tonemap_exposure((lm_tonemap_op)op, rgb, pixels, 3) : 1.0f;
+}
+
+static int ends_with(const char *s, const char *tail)
+{
+    size_t n = strlen(s), m = strlen(tail);
+    return n > m && strcmp(s + n - m, tail) == 0;
+}
+
+lmgi_status lmgi_write_image(const char *path, int width, int height, int channels, const float *pixels,
+                             lmgi_tonemap op, float exposure, lmgi_error *err)
+{
+    lm_error e;
+    lm_status st = LM_OK;
+    if (!path || !pixels)
+        st = lm_fail(&e, LM_ERR_INVALID, "lmgi_write_image: %s is NULL", path ? "pixels" : "path");
+    else if (width < 1 || height < 1 || width > 65536 || height > 65536)
+        st = lm_fail(&e, LM_ERR_INVALID, "%s: picture %d x %d must have sides in 1..65536", path, width, height);
+    else if (channels != 1 && channels != 3 && channels != 4)
+        st = lm_fail(&e, LM_ERR_INVALID, "%s: %d channels; pictures have 1, 3 or 4", path, channels);
+    else if (op != LMGI_TONEMAP_NEUTRAL && op != LMGI_TONEMAP_CLAMP)
+        st = lm_fail(&e, LM_ERR_INVALID, "%s: %d is not a tone map", path, (int)op);
+    else if (!(exposure >= 0.0f) || exposure > 1e30f)
+        st = lm_fail(&e, LM_ERR_INVALID, "%s: exposure %g must be a finite number >= 0 (0: automatic)", path,
+                     (double)exposure);
+    if (st != LM_OK)
+        return lm_export_error(err, &e);
+    if (ends_with(path, ".exr"))
+        st = lm_write_exr(path, width, height, channels, pixels, &e);
+    else if (!ends_with(path, ".png"))
+        st = lm_fail(&e, LM_ERR_INVALID, "%s: the name must end in .exr or .png", path);
+    else {
+        size_t n = (size_t)width * height;
+        float *rgb = malloc(n * 3 * sizeof *rgb);
+        uint8_t *png = malloc(n * 4);
+        if (!rgb || !png)
+            st = lm_fail(&e, LM_ERR_NOMEM, "%s: no memory for a %d x %d picture", path, width, height);
+        for (size_t i = 0; st == LM_OK && i < n; i++)
+            for (int c = 0; c < 3; c++) /* grey from one channel; RGB from the first three */
+                rgb[3 * i + c] = pixels[(size_t)channels * i + (channels == 1 ? 0 : c)];
+        if (st == LM_OK) {
+            float k = exposure > 0.0f ? exposure : lm_tonemap_exposure((lm_tonemap_op)op, rgb, n, 3);
+            lm_tonemap((lm_tonemap_op)op, rgb, n, 3, k, png);
+            st = lm_write_png(path, width, height, png, &e);
+        }
+        free(rgb);
+        free(png);
+    }
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
