@@ -48,7 +48,7 @@ TEST_C  := $(sort $(wildcard tests/test_*.c))
 TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o
 
-.PHONY: all deps test test-asan demo bench scenes clean fuzz install
+.PHONY: all deps test test-asan demo bench scenes clean fuzz install install-files
 .PRECIOUS: $(BUILD)/obj/%.o
 .PHONY: FORCE
 all: $(BUILD)/lmgi $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
@@ -91,7 +91,9 @@ $(BUILD)/liblmgi.so: $(LIB_OBJ) src/api/lmgi.map
 # make install PREFIX=DIR: the header, both libraries, the lmgi command and lmgi.pc for pkg-config
 # (`cc app.c $$(pkg-config --cflags --libs lmgi)`; add --static for liblmgi.a and its dependencies).
 PREFIX ?= /usr/local
-install: all
+install: all install-files
+# the copying alone, of what BUILD holds (test_examples installs each build's own libraries this way)
+install-files:
 	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/bin
 	install -m 644 include/lmgi.h $(DESTDIR)$(PREFIX)/include/
 	install -m 644 $(BUILD)/liblmgi.a $(DESTDIR)$(PREFIX)/lib/

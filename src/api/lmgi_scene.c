@@ -12,6 +12,7 @@
 #include "../trace/rt_scene.h"
 #include "../update/effects.h"
 #include "lmgi_scene.h"
+#include "lmgi_updater.h"
 
 void lmgi_options_init(lmgi_options *o)
 {
@@ -216,6 +217,8 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
     }
     /* The scene model first (children follow through their local matrices), then the rays from it; on a
      * failure the node's earlier placement comes back. */
+    if (sc->updater) /* its photon work may still be reading the scene and BVH */
+        lm_updater_sync(sc->updater);
     lm_node saved = *n;
     lm_status st = lm_scene_set_node_world(sc->scene, node, m)
                        ? lm_rt_sync_transforms(sc->rt, sc->scene, &e)
@@ -246,6 +249,8 @@ lmgi_status lmgi_node_resume_animation(lmgi_scene *sc, int node, lmgi_error *err
         lm_fail(&e, LM_ERR_INVALID, "lmgi_node_resume_animation: %s", sc ? "node id out of range" : "the scene is NULL");
         return lm_export_error(err, &e);
     }
+    if (sc->updater)
+        lm_updater_sync(sc->updater);
     lm_scene_release_node(sc->scene, node);
     return LMGI_OK;
 }
@@ -262,6 +267,8 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
         lm_fail(&e, LM_ERR_INVALID, "%s: animation time is not a finite number", sc->scene->path);
         return lm_export_error(err, &e);
     }
+    if (sc->updater)
+        lm_updater_sync(sc->updater);
     lm_scene_eval_animation(sc->scene, -1, t);
     if (lm_rt_sync_transforms(sc->rt, sc->scene, &e) != LM_OK)
         return lm_export_error(err, &e);

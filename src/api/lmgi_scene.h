@@ -17,7 +17,7 @@ struct lmgi_scene {
     lm_rt *rt;
     lm_effects effects;
     lmgi_timings timings;
-    int updater;            /* an updater works on it (it moves nodes and the BVH: one at a time) */
+    lmgi_updater *updater;  /* the one updater working on it (it moves nodes and the BVH), or NULL */
 };
 
 /* Copies an internal error into the public one and returns its status. */

@@ -193,9 +193,18 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
      * texel; the model corrects itself from the first update on) */
     u->ms_per_texel = sc->atlas.texel_count ? 1e3 * u->t_setup_gather / sc->atlas.texel_count : 0.01;
     ctx->updaters++;
-    sc->updater = 1;
+    sc->updater = u;
     *out = u;
     return LMGI_OK;
+}
+
+void lm_updater_sync(lmgi_updater *u)
+{
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_error e;
+    if (lm_frame_loop_sync(u->loop, &e) != LM_OK) /* reported again by the next update's own work */
+        lm_log(LM_LOG_ERROR, "%s", e.msg);
+    lm_api_leave(saved);
 }
 
 void lmgi_updater_free(lmgi_updater *u)
@@ -207,7 +216,7 @@ void lmgi_updater_free(lmgi_updater *u)
     lm_frame_loop_free(u->loop);
     lm_api_leave(saved);
     u->ctx->updaters--;
-    u->sc->updater = 0;
+    u->sc->updater = NULL;
     free(u->seen);
     free(u);
 }
@@ -411,7 +420,9 @@ static lm_status read_aim(const lmgi_updater *u, float *rgba, lm_error *err)
     float *rgb = malloc(n * 3 * sizeof *rgb);
     if (!rgb)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the AIM read-back");
-    lm_status st = read_iim(u, rgba, err);
+    lm_status st = lm_frame_loop_sync(u->loop, err); /* the AIM is the photon work's */
+    if (st == LM_OK)
+        st = read_iim(u, rgba, err);
     if (st == LM_OK) {
         memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(u->loop))), n * 3 * sizeof *rgb);
         lm_atlas_dilate_gutters(at, rgb, 3);

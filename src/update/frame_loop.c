@@ -19,6 +19,8 @@ struct lm_frame_loop {
     int own_gl;              /* gl made here (else borrowed from the settings) */
     lm_photon_stage *stage;
     lm_stage_worker *worker; /* with settings.overlap: runs the stage's update beside the GL work */
+    lm_photon_stage_frame pending; /* detached: the stage's job begun by the last step, not yet joined */
+    int pending_busy;
     lm_gather *gather;
     lm_composite *comp;
     lm_reflections *reflections; /* NULL: no mirror or glossy node, or switched off */
@@ -220,6 +222,7 @@ void lm_frame_loop_free(lm_frame_loop *fl)
 {
     if (!fl)
         return;
+    lm_frame_loop_sync(fl, NULL);
     lm_stage_worker_stop(fl->worker);
     lm_direct_free(fl->direct_light);
     lm_composite_free(fl->comp);
@@ -361,6 +364,59 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
     return st;
 }
 
+/* Waits for the stage's job a detached step left running; `done` (may be NULL) gets its counts. */
+static lm_status join_stage(lm_frame_loop *fl, lm_photon_stage_frame *done, lm_error *err)
+{
+    if (!fl->pending_busy)
+        return LM_OK;
+    lm_status st = lm_stage_worker_end(fl->worker, err);
+    fl->pending_busy = 0;
+    if (fl->pending.aim.surfaces_refreshed > 0)
+        fl->aim_stale = 1;
+    if (done)
+        *done = fl->pending;
+    return st;
+}
+
+lm_status lm_frame_loop_sync(lm_frame_loop *fl, lm_error *err) { return join_stage(fl, NULL, err); }
+
+/* Detached (overlap without a frame of its own: a game draws between steps): the stage's job begun by
+ * the last step is joined first, then animate, schedule, gather and blend as overlapped, and the next
+ * job begins last and runs until the next step, the caller's own frame hiding it. The gather sees the
+ * same AIMs and delta_i as overlapped (the previous step's stage), so the lightmaps are the same. */
+static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
+{
+    double t0 = lm_now();
+    lm_photon_stage_frame done;
+    memset(&done, 0, sizeof done);
+    lm_status st = join_stage(fl, &done, err);
+    if (st == LM_OK)
+        st = animate(fl, t, o, err);
+    /* the counts and times of the stage's work that finished in this step (begun by the last one) */
+    o->stage.photons = done.photons;
+    o->stage.aim = done.aim;
+    o->stage.t_photons = done.t_photons;
+    o->stage.t_aim = done.t_aim;
+    if (st == LM_OK) {
+        o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
+        if (o->texels_gathered > 0)
+            st = gather_prepare(fl, err);
+    }
+    double t1 = lm_now();
+    o->t_photons = t1 - t0;
+    if (st == LM_OK)
+        st = gather_run(fl, o->texels_gathered, err);
+    o->t_gather = lm_now() - t1;
+    if (st == LM_OK)
+        st = blend_and_render(fl, o, err); /* no frame: the blend alone */
+    if (st == LM_OK) {
+        fl->pending = o->stage;
+        fl->pending_busy = 1;
+        lm_stage_worker_begin(fl->worker, &fl->pending);
+    }
+    return st;
+}
+
 lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err)
 {
     lm_frame_stats o;
@@ -368,7 +424,8 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
     double t0 = lm_now();
     lm_status st = lm_gl_make_current(fl->gl, err);
     if (st == LM_OK)
-        st = fl->worker ? step_overlapped(fl, t, &o, err) : step_in_order(fl, t, &o, err);
+        st = !fl->worker ? step_in_order(fl, t, &o, err)
+             : fl->set.width > 0 ? step_overlapped(fl, t, &o, err) : step_detached(fl, t, &o, err);
     o.t_total = lm_now() - t0;
     if (out)
         *out = o;

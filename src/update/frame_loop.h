@@ -9,7 +9,9 @@
  *      lightmap uv, then the direct light per pixel with shadows (gpu/direct.h); mirror and glass black.
  *
  * With `overlap` (the default), step 1's tracing and AIM refresh run on a second thread while the calling
- * thread does steps 2 and 3 over the previous frame's AIMs (docs/architecture.md).
+ * thread does steps 2 and 3 over the previous frame's AIMs (docs/architecture.md). A loop that draws no
+ * frame (width 0: the application renders) lets that thread run on past the step until the next one
+ * (lm_frame_loop_sync), so the photon work hides behind the application's own frame.
  *
  * Initial state (lm_frame_loop_create): a full photon trace, every AIM, and a full gather of every texel
  * shown at once, so the first frame is already converged. The loop owns its GL context (current on the
@@ -82,6 +84,10 @@ void lm_frame_loop_free(lm_frame_loop *fl);
 /* One frame at animation time t; the picture is then in lm_frame_loop_image. */
 lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err);
 
+/* Waits for photon work a step left running (a loop that draws no frame of its own, with overlap, lets
+ * the stage's tracing and AIM refresh run on past the step, beside whatever the caller does next). Call
+ * it before anything that writes the scene or BVH (an edit) or reads the AIM or photons. */
+lm_status lm_frame_loop_sync(lm_frame_loop *fl, lm_error *err);
 /* The texels the next steps gather (at least 0; the settings' iim.texels_per_frame until set): the public
  * updater's time budget turns into this. */
 void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels);
