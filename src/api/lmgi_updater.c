@@ -15,6 +15,8 @@
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
+#define COST_WINDOW 32
+
 struct lmgi_updater {
     lmgi_context *ctx;
     lmgi_scene *sc;
@@ -22,8 +24,9 @@ struct lmgi_updater {
     int frames;                 /* updates done */
     int has_frame;              /* the last update composited a frame */
     uint32_t *seen;             /* per surface: lmgi_surface_version at the end of the last update */
-    double ms_per_texel;        /* the budget's cost model, smoothed over updates: gather ms per texel ... */
-    double ms_fixed;            /* ... and the rest of an update */
+    /* the budget's cost model: the last COST_WINDOW updates' gather ms per texel, and the rest of each */
+    double per_texel[COST_WINDOW], rest[COST_WINDOW];
+    int costs;                  /* samples taken (the window holds the last min(costs, COST_WINDOW)) */
     lm_photon_stage_frame setup;
     double t_setup_gather;
 };
@@ -191,7 +194,9 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
     memcpy(u->seen, ver, sizeof *u->seen * (size_t)sc->atlas.surface_count);
     /* the budget's first guess: the full gather's cost per texel (small per-frame batches cost more per
      * texel; the model corrects itself from the first update on) */
-    u->ms_per_texel = sc->atlas.texel_count ? 1e3 * u->t_setup_gather / sc->atlas.texel_count : 0.01;
+    u->per_texel[0] = sc->atlas.texel_count ? 1e3 * u->t_setup_gather / sc->atlas.texel_count : 0.01;
+    u->rest[0] = 0.0;
+    u->costs = 1;
     ctx->updaters++;
     sc->updater = u;
     *out = u;
@@ -245,26 +250,44 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     info->ms_setup_gather = 1e3 * u->t_setup_gather;
 }
 
-/* Texels that fit in budget_ms by the cost model: never fewer than one, never more than the atlas. */
-static int texels_for_budget(const lmgi_updater *u, float budget_ms)
+/* The 95th percentile of the window's first n samples. */
+static double p95(const double *v, int n)
 {
-    double n = ((double)budget_ms - u->ms_fixed) / (u->ms_per_texel > 1e-6 ? u->ms_per_texel : 1e-6);
-    double most = u->sc->atlas.texel_count > 0 ? u->sc->atlas.texel_count : 1;
-    return n < 1.0 ? 1 : n > most ? (int)most : (int)n;
+    double sorted[COST_WINDOW];
+    memcpy(sorted, v, sizeof *v * (size_t)n);
+    for (int i = 1; i < n; i++) /* insertion sort: 32 values */
+        for (int j = i; j > 0 && sorted[j - 1] > sorted[j]; j--) {
+            double t = sorted[j];
+            sorted[j] = sorted[j - 1], sorted[j - 1] = t;
+        }
+    return sorted[(int)(0.95 * (n - 1))];
 }
 
-/* The cost model follows each update: an exponential average of the gather's cost per texel and of the
- * rest. Choosing n = (budget - rest) / (gather / n) converges to the n whose gather fills what the rest
- * leaves, the gather's fixed cost per pass included. */
+/* Texels that fit in budget_ms: the budget less the 95th percentile of the rest of recent updates, over
+ * the 95th percentile of their gather cost per texel, so that the 95th percentile update keeps within it
+ * (a mean would let half of them run over: a gather's cost per texel varies by a third with the surfaces
+ * it draws; docs/bench.md has the figures). Never fewer than one texel, never more than the atlas. */
+static int texels_for_budget(const lmgi_updater *u, float budget_ms)
+{
+    int n = u->costs < COST_WINDOW ? u->costs : COST_WINDOW;
+    double per = p95(u->per_texel, n), rest = p95(u->rest, n);
+    double texels = ((double)budget_ms - rest) / (per > 1e-6 ? per : 1e-6);
+    double most = u->sc->atlas.texel_count > 0 ? u->sc->atlas.texel_count : 1;
+    return texels < 1.0 ? 1 : texels > most ? (int)most : (int)texels;
+}
+
+/* Each update's costs go into the window (the first one, which uploads everything, is left out). The gather
+ * cost per texel includes its per-pass and upload costs, so a small batch looks dearer per texel; choosing
+ * n = (budget - rest) / (gather / n) still settles where the gather fills what the rest leaves. */
 static void learn_cost(lmgi_updater *u, const lm_frame_stats *fs)
 {
-    const double keep = 0.7;
-    double rest = 1e3 * (fs->t_total - fs->t_gather);
-    u->ms_fixed = u->frames == 0 ? rest : keep * u->ms_fixed + (1.0 - keep) * rest;
-    if (fs->texels_gathered > 0) {
-        double per = 1e3 * fs->t_gather / fs->texels_gathered;
-        u->ms_per_texel = keep * u->ms_per_texel + (1.0 - keep) * per;
-    }
+    if (u->frames == 0)
+        return;
+    int i = u->costs % COST_WINDOW;
+    u->rest[i] = 1e3 * (fs->t_total - fs->t_gather);
+    u->per_texel[i] = fs->texels_gathered > 0 ? 1e3 * fs->t_gather / fs->texels_gathered
+                                               : u->per_texel[(u->costs - 1) % COST_WINDOW];
+    u->costs++;
 }
 
 static int count_changed(lmgi_updater *u)

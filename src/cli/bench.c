@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include "../core/stats.h"
+#include "bench_budget.h"
 #include "bench_gather.h"
 #include "bench_photons.h"
 #include "bench_scenes.h"
@@ -166,6 +167,7 @@ int lm_cli_bench(const lm_cli_args *a)
     if (a->file_count == 0) {
         lm_cli_bench_photons();
         lm_cli_bench_gather(a->gather_scene);
+        lm_cli_bench_budget();
         lm_cli_bench_scenes();
     }
     return rc;
