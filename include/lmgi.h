@@ -142,6 +142,28 @@ LMGI_API int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);   /* 0 for
 LMGI_API int lmgi_get_node_transform(const lmgi_scene *scene, int node, float world[16]);
 /* NULL scene or world: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
+/* Lights (KHR_lights_punctual). A light shines from its node (lmgi_set_node_transform moves it; a node
+ * with no triangles in or under it may be moved even when static). Edits reach an updater at its next
+ * update: the light's photon groups are re-traced (no other light's), its shadow map is redrawn, and
+ * the surfaces its photons reach are refreshed. */
+typedef enum { LMGI_LIGHT_POINT = 0, LMGI_LIGHT_SPOT, LMGI_LIGHT_DIRECTIONAL } lmgi_light_type;
+typedef struct {
+    lmgi_light_type type;     /* fixed at load (lmgi_set_light refuses a change) */
+    int node;                 /* the node placing it (read only) */
+    float color[3];           /* linear RGB, each in [0, 1000] */
+    float intensity;          /* candela (point, spot) or lux (directional), >= 0 */
+    float range;              /* 0: infinite */
+    float inner_cone, outer_cone; /* spot: radians, 0 <= inner < outer <= pi/2 */
+    int enabled;              /* 0: switched off (emits nothing; colour and intensity kept) */
+} lmgi_light;
+LMGI_API int lmgi_light_count(const lmgi_scene *scene); /* 0 for NULL */
+/* NULL argument or an id out of range: LMGI_ERR_INVALID (out zeroed when given). */
+LMGI_API lmgi_status lmgi_get_light(const lmgi_scene *scene, int light, lmgi_light *out, lmgi_error *err);
+/* Recolours, dims, brightens, switches on or off, or reshapes (range, cones) a light. A NaN, a value out
+ * of range, a type or node other than the light's, or an id out of range: LMGI_ERR_INVALID, nothing
+ * changed. */
+LMGI_API lmgi_status lmgi_set_light(lmgi_scene *scene, int light, const lmgi_light *l, lmgi_error *err);
+
 /* Hands an edited node back to its animations from the next lmgi_set_time or update on. NULL scene or
  * an id out of range: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_node_resume_animation(lmgi_scene *scene, int node, lmgi_error *err);

@@ -55,6 +55,13 @@ static void update(lmgi_updater *u, float t, float budget, lmgi_update_stats *st
         fail_msg("%s", e.message);
 }
 
+static void expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
+{
+    assert_int_equal(st, LMGI_ERR_INVALID);
+    if (!strstr(e->message, words))
+        fail_msg("'%s' does not name '%s'", e->message, words);
+}
+
 typedef struct {
     int count[5];
     char last[256];
@@ -284,6 +291,110 @@ static void test_edit_reaches_updater(void **state)
     lmgi_context_free(ctx);
 }
 
+/* Dimming a light in room A of the two rooms with the door closed relights room A and leaves room B's
+ * surfaces, IIM and AIM untouched to the bit (the paper's Fig. 5: an edit costs only what it reaches). */
+static void test_light_edit_stays_in_its_room(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 3000;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.frame_width = d.frame_height = 0;
+    d.texels_per_frame = 400;
+    lmgi_updater *u = make_updater(ctx, sc, &d);
+    lmgi_update_stats st;
+    int quiet = 0;
+    for (int f = 0; f < 80 && quiet < 10; f++) { /* the door closed at time 0 */
+        update(u, 0.0f, 0.0f, &st);
+        quiet = st.surfaces_changed == 0 ? quiet + 1 : 0;
+    }
+    assert_int_equal(quiet, 10);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *iim0 = malloc(n * sizeof *iim0), *aim0 = malloc(n * sizeof *aim0);
+    float *iim1 = malloc(n * sizeof *iim1), *aim1 = malloc(n * sizeof *aim1);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim0, n, &e), LMGI_OK);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim0, n, &e), LMGI_OK);
+    int surfaces = lmgi_surface_count(sc);
+    uint32_t *ver0 = calloc((size_t)surfaces, sizeof *ver0);
+    for (int s = 0; s < surfaces; s++)
+        ver0[s] = lmgi_surface_version(u, s);
+
+    int a1 = -1;
+    for (int l = 0; l < lmgi_light_count(sc); l++) {
+        lmgi_light li;
+        assert_int_equal(lmgi_get_light(sc, l, &li, &e), LMGI_OK);
+        if (!strcmp(lmgi_node_name(sc, li.node), "light_a1"))
+            a1 = l;
+    }
+    assert_true(a1 >= 0);
+    lmgi_light li;
+    assert_int_equal(lmgi_get_light(sc, a1, &li, &e), LMGI_OK);
+    assert_true(li.enabled && li.intensity > 0.0f);
+    li.intensity *= 0.25f;
+    assert_int_equal(lmgi_set_light(sc, a1, &li, &e), LMGI_OK);
+    for (int f = 0; f < 40; f++)
+        update(u, 0.0f, 0.0f, &st);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim1, n, &e), LMGI_OK);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim1, n, &e), LMGI_OK);
+    int a_changed = 0, b_texels = 0;
+    double a_before = 0.0, a_after = 0.0;
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        size_t k = 4 * ((size_t)t.y * in.atlas_width + t.x);
+        if (t.position[0] > 0.2f) { /* room B, well clear of the wall and door */
+            b_texels++;
+            assert_memory_equal(iim0 + k, iim1 + k, 4 * sizeof *iim0);
+            assert_memory_equal(aim0 + k, aim1 + k, 4 * sizeof *aim0);
+            assert_int_equal(lmgi_surface_version(u, t.surface), ver0[t.surface]);
+        } else if (t.position[0] < -0.2f) {
+            a_before += iim0[k] + iim0[k + 1] + iim0[k + 2];
+            a_after += iim1[k] + iim1[k + 1] + iim1[k + 2];
+            a_changed += lmgi_surface_version(u, t.surface) != ver0[t.surface];
+        }
+    }
+    print_message("light_a1 at a quarter: room A's indirect light %.3g -> %.3g; %d room B texels unchanged\n",
+                  a_before, a_after, b_texels);
+    assert_true(b_texels > 100 && a_changed > 100);
+    assert_true(a_after < 0.9 * a_before); /* one of room A's two lights at a quarter */
+
+    li.enabled = 0; /* off, then on again: back to the quarter */
+    assert_int_equal(lmgi_set_light(sc, a1, &li, &e), LMGI_OK);
+    update(u, 0.0f, 0.0f, &st);
+    lmgi_light back;
+    assert_int_equal(lmgi_get_light(sc, a1, &back, &e), LMGI_OK);
+    assert_true(!back.enabled && back.intensity == li.intensity);
+
+    lmgi_light bad = li;
+    bad.color[1] = NAN;
+    expect_invalid(lmgi_set_light(sc, a1, &bad, &e), &e, "colour");
+    bad = li;
+    bad.intensity = -1.0f;
+    expect_invalid(lmgi_set_light(sc, a1, &bad, &e), &e, "intensity");
+    bad = li;
+    bad.type = LMGI_LIGHT_SPOT;
+    expect_invalid(lmgi_set_light(sc, a1, &bad, &e), &e, "fixed at load");
+    expect_invalid(lmgi_set_light(sc, 99, &li, &e), &e, "out of range");
+    expect_invalid(lmgi_get_light(sc, -1, &back, &e), &e, "out of range");
+    expect_invalid(lmgi_set_light(NULL, 0, &li, &e), &e, "NULL");
+    assert_int_equal(lmgi_get_light(sc, a1, &back, &e), LMGI_OK);
+    assert_true(!back.enabled); /* the refused edits changed nothing */
+    free(iim0), free(aim0), free(iim1), free(aim1), free(ver0);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* A time budget turns into texels from the measured cost: a generous one allows many, a tiny one one. */
 static void test_budget_sets_texels(void **state)
 {
@@ -306,12 +417,6 @@ static void test_budget_sets_texels(void **state)
     lmgi_context_free(ctx);
 }
 
-static void expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
-{
-    assert_int_equal(st, LMGI_ERR_INVALID);
-    if (!strstr(e->message, words))
-        fail_msg("'%s' does not name '%s'", e->message, words);
-}
 
 /* Every bad argument: LMGI_ERR_INVALID with a message, and nothing changed. */
 static void test_bad_arguments(void **state)
@@ -476,6 +581,7 @@ int main(void)
         cmocka_unit_test(test_two_contexts_one_thread),
         cmocka_unit_test(test_lightmaps_and_versions),
         cmocka_unit_test(test_edit_reaches_updater),
+        cmocka_unit_test(test_light_edit_stays_in_its_room),
         cmocka_unit_test(test_budget_sets_texels),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_write_image),

@@ -180,6 +180,20 @@ int lmgi_node_is_dynamic(const lmgi_scene *sc, int node)
     return sc && node >= 0 && node < sc->scene->node_count && sc->scene->nodes[node].dynamic;
 }
 
+/* Whether a node or one under it has triangles (a static one of those is in the static BVH, which does not
+ * move; a light's or camera's node without any may move freely). */
+static int carries_triangles(const lm_scene *s, int node)
+{
+    for (int i = 0; i < s->node_count; i++) {
+        if (s->nodes[i].tri_count == 0)
+            continue;
+        for (int p = i, steps = 0; p >= 0 && steps <= s->node_count; p = s->nodes[p].parent, steps++)
+            if (p == node)
+                return 1;
+    }
+    return 0;
+}
+
 lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[16], lmgi_error *err)
 {
     lm_error e;
@@ -205,7 +219,7 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
         lm_fail(&e, LM_ERR_INVALID, "node id %d is out of range (scene has %d nodes)", node, sc->scene->node_count);
         return lm_export_error(err, &e);
     }
-    if (!n->dynamic) {
+    if (!n->dynamic && carries_triangles(sc->scene, node)) {
         lm_fail(&e, LM_ERR_INVALID, "node '%s' is static and cannot be moved; mark it dynamic with extras "
                 "{\"lmgi\": {\"dynamic\": true}}", n->name);
         return lm_export_error(err, &e);

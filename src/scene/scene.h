@@ -61,6 +61,7 @@ typedef struct {
     float range;           /* 0 = infinite */
     float inner_cone, outer_cone; /* spot only, radians */
     int node;              /* node that places it; light shines down the node's local -Z */
+    int off;               /* switched off by an edit: emits nothing, keeps its colour and intensity */
 } lm_light;
 
 typedef struct {

@@ -132,7 +132,7 @@ static void place_punctual(lm_emitter *e, const lm_scene *s, float disk_radius)
                 : e->kind == LM_EMIT_SPOT  ? lm_spot_solid_angle(l)
                                            : (float)LM_PI * disk_radius * disk_radius;
     for (int c = 0; c < 3; c++) {
-        e->radiant[c] = l->color[c] * l->intensity;
+        e->radiant[c] = l->off ? 0.0f : l->color[c] * l->intensity;
         e->power[c] = e->radiant[c] * scale;
     }
 }

@@ -48,7 +48,7 @@ static void hash_light(uint64_t *h, const lm_light *l)
 {
     fnv_u32(h, (uint32_t)l->type);
     fnv(h, l->color, sizeof l->color);
-    fnv_f(h, l->intensity);
+    fnv_f(h, l->off ? 0.0f : l->intensity);
     fnv_f(h, l->range);
     fnv_f(h, l->inner_cone);
     fnv_f(h, l->outer_cone);

@@ -1,0 +1,77 @@
+/* The public API's light edits: recolour, dim, switch off, reshape. The photon stage notices a light
+ * whose power or placement changed (its emitter snapshot) and re-traces that light's groups alone. */
+#include <lmgi.h>
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "lmgi_scene.h"
+#include "lmgi_updater.h"
+
+static lmgi_status refuse(lmgi_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static lmgi_status refuse(lmgi_error *err, const char *fmt, ...)
+{
+    lm_error e;
+    e.status = LM_ERR_INVALID;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(e.msg, sizeof e.msg, fmt, ap);
+    va_end(ap);
+    return lm_export_error(err, &e);
+}
+
+int lmgi_light_count(const lmgi_scene *sc) { return sc ? sc->scene->light_count : 0; }
+
+lmgi_status lmgi_get_light(const lmgi_scene *sc, int light, lmgi_light *out, lmgi_error *err)
+{
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (!sc || !out)
+        return refuse(err, "lmgi_get_light: %s is NULL", sc ? "out" : "the scene");
+    if (light < 0 || light >= sc->scene->light_count)
+        return refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
+    const lm_light *l = &sc->scene->lights[light];
+    out->type = (lmgi_light_type)l->type;
+    out->node = l->node;
+    memcpy(out->color, l->color, sizeof out->color);
+    out->intensity = l->intensity;
+    out->range = l->range;
+    out->inner_cone = l->inner_cone;
+    out->outer_cone = l->outer_cone;
+    out->enabled = !l->off;
+    return LMGI_OK;
+}
+
+static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; } /* false for NaN */
+
+lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi_error *err)
+{
+    if (!sc || !in)
+        return refuse(err, "lmgi_set_light: %s is NULL", sc ? "the light" : "the scene");
+    if (light < 0 || light >= sc->scene->light_count)
+        return refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
+    lm_light *l = &sc->scene->lights[light];
+    if ((int)in->type != (int)l->type || in->node != l->node)
+        return refuse(err, "light '%s': its type and node are fixed at load", l->name);
+    for (int c = 0; c < 3; c++)
+        if (!in_range(in->color[c], 0.0f, 1000.0f))
+            return refuse(err, "light '%s': colour %g must be in [0, 1000]", l->name, (double)in->color[c]);
+    if (!in_range(in->intensity, 0.0f, 1e15f) || !in_range(in->range, 0.0f, 1e15f))
+        return refuse(err, "light '%s': intensity %g and range %g must be finite numbers >= 0", l->name,
+                      (double)in->intensity, (double)in->range);
+    if (l->type == LM_LIGHT_SPOT && !(in_range(in->inner_cone, 0.0f, (float)M_PI_2) &&
+                                      in_range(in->outer_cone, 0.0f, (float)M_PI_2) && in->inner_cone < in->outer_cone))
+        return refuse(err, "light '%s': cones %g and %g must satisfy 0 <= inner < outer <= pi/2", l->name,
+                      (double)in->inner_cone, (double)in->outer_cone);
+    if (sc->updater) /* its photon work reads the lights */
+        lm_updater_sync(sc->updater);
+    memcpy(l->color, in->color, sizeof l->color);
+    l->intensity = in->intensity;
+    l->range = in->range;
+    if (l->type == LM_LIGHT_SPOT)
+        l->inner_cone = in->inner_cone, l->outer_cone = in->outer_cone;
+    l->off = !in->enabled;
+    return LMGI_OK;
+}
