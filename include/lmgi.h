@@ -38,7 +38,8 @@ typedef enum {
     LMGI_ERR_INVALID,     /* an invalid argument or value (NaN, out-of-range id, degenerate data in strict mode) */
     LMGI_ERR_UNSUPPORTED, /* a required glTF extension or feature lmgi does not implement */
     LMGI_ERR_NOMEM,
-    LMGI_ERR_BACKEND      /* Embree or OpenGL failed */
+    LMGI_ERR_BACKEND,     /* Embree or OpenGL failed */
+    LMGI_ERR_CANCELLED    /* a cancel flag stopped the work (nothing half done is shown) */
 } lmgi_status;
 
 typedef struct {
@@ -231,6 +232,8 @@ LMGI_API const char *lmgi_context_gl_description(const lmgi_context *ctx);
 typedef struct lmgi_updater lmgi_updater;
 
 typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_DRAWN } lmgi_emitter_light;
+/* Progress of long work: fraction 0 to 1 and the stage under way ("photons", "gather", "done"). */
+typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
 typedef enum { LMGI_GATHER_DEFAULT = 0, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_INSTANCED, LMGI_GATHER_LAYERED } lmgi_gather_scheme;
 
 /* Zero-initialised means the defaults (the same as `lmgi run`'s; docs/ says what each costs and buys). */
@@ -264,9 +267,11 @@ typedef struct {
                                 * one framing the scene) */
     int reflection_size;       /* environment map side of a mirror or glossy node (0: 128; -1: no reflections) */
     int reflection_faces;      /* environment map faces re-rendered per update (0: 1) */
-    /* the first full gather: done and total texels (NULL: none) */
-    void (*progress)(void *user, uint32_t done, uint32_t total);
+    /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
+     * that, set non-zero (from any thread), stops it between gather passes: LMGI_ERR_CANCELLED */
+    lmgi_progress_fn progress;
     void *progress_user;
+    const volatile int *cancel;
 } lmgi_updater_desc;
 
 /* What one lmgi_update did and what it cost (milliseconds). With the photon work on a second thread
@@ -309,6 +314,31 @@ typedef struct {
 } lmgi_updater_info;
 /* NULL u: info zeroed; NULL info: nothing. */
 LMGI_API void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info);
+
+/* Baking: the lightmaps brought to the converged state of the scene as it is now, for an editor. An
+ * updater's creation is the first bake (every photon, AIM and texel); lmgi_bake after edits re-traces
+ * every photon (a path the edits did not change changes nothing), refreshes the AIMs of the surfaces
+ * whose photons changed and regathers every texel of the surfaces whose light changed, then shows them
+ * at once, and reports how much that was. The quality is the updater's desc (photons, N, R, ...).
+ * The bake works on the updater (not the scene) because the updater holds the solution it refines. */
+typedef struct {
+    lmgi_progress_fn progress;  /* NULL: none */
+    void *progress_user;
+    const volatile int *cancel; /* set non-zero (from any thread) to stop within about 100 ms (between
+                                 * gather passes): LMGI_ERR_CANCELLED, the lightmaps as before the bake
+                                 * and what it did not finish left to the next bake or update */
+    float time;                 /* animation time to bake at (seconds) */
+} lmgi_bake_desc;
+typedef struct {
+    uint32_t photons_traced, photons_changed; /* re-traced, and of those the paths the edits changed */
+    int aim_surfaces_refreshed;
+    uint32_t texels_gathered;   /* texels regathered (the atlas has lmgi_info.texels) */
+    int surfaces_changed;       /* surfaces whose lightmap changed */
+    double ms_photons, ms_gather, ms_total;
+} lmgi_bake_report;
+/* NULL u or a non-finite time: LMGI_ERR_INVALID; NULL desc: the defaults; report may be NULL. */
+LMGI_API lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_report *report,
+                               lmgi_error *err);
 
 /* One frame's work at animation time `time` (seconds; animations clamp to their range). budget_ms > 0:
  * the texels regathered are chosen from the measured cost of the last updates so that the update takes

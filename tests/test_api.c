@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "support.h"
 
@@ -395,6 +396,126 @@ static void test_light_edit_stays_in_its_room(void **state)
     lmgi_context_free(ctx);
 }
 
+typedef struct {
+    volatile int cancel;
+    float at;            /* set the flag once the gather has passed this fraction */
+    double set_time;     /* when it was set */
+    int calls;
+} canceller;
+
+static double seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void cancel_at(void *user, float fraction, const char *stage)
+{
+    canceller *c = user;
+    c->calls++;
+    assert_non_null(stage);
+    if (!c->cancel && fraction >= c->at)
+        c->cancel = 1, c->set_time = seconds();
+}
+
+/* Bakes: the updater's creation is converged, so a bake without edits does nothing; after dimming a light
+ * in room A a bake regathers room A's surfaces only, shows them at once and says so; a cancelled creation
+ * or bake stops soon after the flag and leaves the lightmaps as they were. */
+static void test_bake(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 3000;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.frame_width = d.frame_height = 0;
+    canceller c = {0, 0.5f, 0.0, 0};
+    d.progress = cancel_at;
+    d.progress_user = &c;
+    d.cancel = &c.cancel;
+    lmgi_updater *u = NULL;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_CANCELLED);
+    double late = seconds() - c.set_time;
+    print_message("creation cancelled %.0f ms after the flag (%d progress calls)\n", 1e3 * late, c.calls);
+    assert_null(u);
+    assert_true(late < 0.5);
+    d.progress = NULL;
+    d.cancel = NULL;
+    u = make_updater(ctx, sc, &d); /* the scene is free for another updater after the cancel */
+
+    lmgi_bake_report r;
+    assert_int_equal(lmgi_bake(u, NULL, &r, &e), LMGI_OK);
+    assert_true(r.photons_traced > 0);
+    assert_int_equal(r.photons_changed, 0);
+    assert_int_equal(r.texels_gathered, 0);
+    assert_int_equal(r.surfaces_changed, 0);
+
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *before = malloc(n * sizeof *before), *after = malloc(n * sizeof *after);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, before, n, &e), LMGI_OK);
+    int a1 = lmgi_find_node(sc, "light_a1"), light = -1;
+    lmgi_light li;
+    for (int l = 0; l < lmgi_light_count(sc); l++)
+        if (lmgi_get_light(sc, l, &li, &e) == LMGI_OK && li.node == a1)
+            light = l;
+    assert_int_equal(lmgi_get_light(sc, light, &li, &e), LMGI_OK);
+    li.intensity *= 0.25f;
+    assert_int_equal(lmgi_set_light(sc, light, &li, &e), LMGI_OK);
+
+    canceller early = {1, 0.0f, 0.0, 0}; /* already set: the bake stops after its photons */
+    lmgi_bake_desc bd = {.cancel = &early.cancel};
+    assert_int_equal(lmgi_bake(u, &bd, &r, &e), LMGI_ERR_CANCELLED);
+    print_message("bake cancelled after its photons: %u of %u photon paths changed (light_a1's), %d AIM surfaces\n",
+                  r.photons_changed, r.photons_traced, r.aim_surfaces_refreshed);
+    assert_true(r.photons_changed > 0 && r.photons_changed < r.photons_traced / 2); /* one light of four */
+    assert_true(r.aim_surfaces_refreshed > 0);
+    assert_int_equal(r.texels_gathered, 0);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, after, n, &e), LMGI_OK);
+    assert_memory_equal(before, after, n * sizeof *before); /* nothing half done shown */
+
+    canceller watch = {0, 2.0f, 0.0, 0}; /* never cancels; counts the progress calls */
+    bd = (lmgi_bake_desc){.progress = cancel_at, .progress_user = &watch};
+    assert_int_equal(lmgi_bake(u, &bd, &r, &e), LMGI_OK);
+    print_message("the bake after it: %u of %u texels regathered, %d surfaces changed, %.0f ms\n",
+                  r.texels_gathered, in.texels, r.surfaces_changed, r.ms_total);
+    assert_true(watch.calls >= 3);
+    assert_true(r.texels_gathered > 0 && r.texels_gathered < in.texels * 3 / 4);
+    assert_true(r.surfaces_changed > 0);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, after, n, &e), LMGI_OK);
+    int b_same = 1, a_darker = 0;
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        size_t k = 4 * ((size_t)t.y * in.atlas_width + t.x);
+        if (t.position[0] > 0.2f)
+            b_same &= !memcmp(before + k, after + k, 4 * sizeof *before);
+        else if (t.position[0] < -0.2f)
+            a_darker += after[k + 1] < before[k + 1];
+    }
+    assert_true(b_same);
+    assert_true(a_darker > 100);
+    assert_int_equal(lmgi_bake(u, NULL, &r, &e), LMGI_OK); /* done: nothing left */
+    assert_int_equal(r.texels_gathered, 0);
+    lmgi_bake_desc nan_time = {.time = NAN};
+    expect_invalid(lmgi_bake(u, &nan_time, &r, &e), &e, "time");
+    expect_invalid(lmgi_bake(NULL, NULL, &r, &e), &e, "NULL");
+    free(before);
+    free(after);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* A time budget turns into texels from the measured cost: a generous one allows many, a tiny one one. */
 static void test_budget_sets_texels(void **state)
 {
@@ -582,6 +703,7 @@ int main(void)
         cmocka_unit_test(test_lightmaps_and_versions),
         cmocka_unit_test(test_edit_reaches_updater),
         cmocka_unit_test(test_light_edit_stays_in_its_room),
+        cmocka_unit_test(test_bake),
         cmocka_unit_test(test_budget_sets_texels),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_write_image),

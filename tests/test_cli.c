@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include "../src/core/image.h"
 #include "../src/core/memory.h"
@@ -202,6 +203,37 @@ static void test_charts_pictures(void **state)
     assert_non_null(strstr(output, "/proc/lmgi-not-writable"));
 }
 
+/* lmgi bake writes the lightmap, its preview and the AIM; Ctrl-C stops it soon, writing nothing. */
+static void test_bake_command(void **state)
+{
+    (void)state;
+    char args[2048], path[1200], dir[256];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir()); /* a fresh directory at each call */
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --out %s/bake", dir);
+    if (run(args) != 0)
+        fail_msg("%s: %s", args, output);
+    assert_non_null(strstr(output, "baked"));
+    static const char *const files[] = {"lightmap.exr", "lightmap.png", "aim.exr"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/bake/%s", dir, files[k]);
+        assert_int_equal(access(path, R_OK), 0);
+    }
+    /* the default density of the two rooms takes seconds to gather: interrupted after 1 s */
+    const char *build = getenv("LMGI_BUILD");
+    snprintf(args, sizeof args, "timeout --preserve-status -s INT 1 %s/lmgi bake scenes/two_rooms.glb --out %s/interrupted 2>&1",
+             build ? build : "build", dir);
+    FILE *p = popen(args, "r");
+    assert_non_null(p);
+    size_t n = fread(output, 1, sizeof output - 1, p);
+    output[n] = '\0';
+    int status = pclose(p);
+    assert_true(WIFEXITED(status));
+    if (WEXITSTATUS(status) != 130 || !strstr(output, "bake cancelled"))
+        fail_msg("interrupted bake: exit %d, %s", WEXITSTATUS(status), output);
+    snprintf(path, sizeof path, "%s/interrupted/lightmap.exr", dir);
+    assert_int_not_equal(access(path, F_OK), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -210,6 +242,7 @@ int main(void)
         cmocka_unit_test(test_strict_refuses_degenerate_triangles),
         cmocka_unit_test(test_info_on_generated_cornell),
         cmocka_unit_test(test_charts_pictures),
+        cmocka_unit_test(test_bake_command),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

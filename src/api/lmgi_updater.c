@@ -136,14 +136,20 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     else
         TAKE(reflection_size, 1, 4096, &s->reflection_size);
     TAKE(reflection_faces, 1, 1 << 20, &s->reflection_faces);
-    s->progress = d->progress;
-    s->progress_user = d->progress_user;
+    s->cancel = d->cancel;
     return LM_OK;
 }
 
 int lmgi_atlas_texels_for(int texels_per_frame)
 {
     return lm_frame_loop_atlas_texels(texels_per_frame > 0 ? texels_per_frame : LM_IIM_DEFAULT_TEXELS_PER_FRAME);
+}
+
+/* The frame loop's progress (texels of the first gather) as the public one (a fraction and a stage). */
+static void gather_progress(void *user, uint32_t done, uint32_t total)
+{
+    const lmgi_updater_desc *d = user;
+    d->progress(d->progress_user, total ? (float)done / (float)total : 1.0f, "gather");
 }
 
 lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc, lmgi_updater **out,
@@ -168,6 +174,10 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
     lm_frame_loop_settings set;
     lm_status st = lm_updater_settings(sc->scene, &d, &set, &e);
     set.gl = ctx->gl;
+    if (d.progress) {
+        set.progress = gather_progress;
+        set.progress_user = &d;
+    }
     lmgi_updater *u = st == LM_OK ? calloc(1, sizeof *u) : NULL;
     if (st == LM_OK && !u)
         st = lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");
@@ -323,6 +333,47 @@ static void export_stats(const lm_frame_stats *fs, int budget, int changed, lmgi
     o->ms_direct = 1e3 * fs->t_direct;
     o->ms_composite = 1e3 * fs->t_composite;
     o->ms_total = 1e3 * fs->t_total;
+}
+
+static void bake_progress(void *user, double fraction, const char *stage)
+{
+    const lmgi_bake_desc *d = user;
+    d->progress(d->progress_user, (float)fraction, stage);
+}
+
+lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_report *report, lmgi_error *err)
+{
+    lmgi_bake_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc)
+        d = *desc;
+    if (report)
+        memset(report, 0, sizeof *report);
+    if (!u)
+        return invalid(err, "lmgi_bake: updater is NULL");
+    if (!isfinite(d.time))
+        return invalid(err, "lmgi_bake: time %g is not a finite number", (double)d.time);
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_bake_stats bs;
+    lm_error e;
+    lm_status st = lm_frame_loop_bake(u->loop, d.time, d.progress ? bake_progress : NULL, &d, d.cancel, &bs, &e);
+    if (st == LM_OK)
+        lm_info("%s: bake: %u of %u photon paths changed, %d AIM surfaces, %u texels, %d surfaces changed",
+                u->sc->scene->path, bs.photons_changed, bs.photons_traced, bs.aim_surfaces_refreshed,
+                bs.texels_gathered, bs.surfaces_changed);
+    lm_api_leave(saved);
+    count_changed(u); /* the bake's changes are not the next update's */
+    if (report) {
+        report->photons_traced = bs.photons_traced;
+        report->photons_changed = bs.photons_changed;
+        report->aim_surfaces_refreshed = bs.aim_surfaces_refreshed;
+        report->texels_gathered = bs.texels_gathered;
+        report->surfaces_changed = bs.surfaces_changed;
+        report->ms_photons = 1e3 * bs.t_photons;
+        report->ms_gather = 1e3 * bs.t_gather;
+        report->ms_total = report->ms_photons + report->ms_gather;
+    }
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }
 
 lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "args.h"
+#include "bake_cmd.h"
 #include "bench.h"
 #include "check_cmd.h"
 #include "out_dir.h"
@@ -27,6 +28,9 @@ static void usage(FILE *f)
             "  run SCENE --out DIR    the whole frame loop over the scene's animations (photons, AIMs, IIM\n"
             "                         gather, direct light, composite): DIR/frame_NNNN.png (every K-th also\n"
             "                         .exr), iim.exr/png, aim.exr/png and frames.csv (work and ms per stage)\n"
+            "  bake SCENE --out DIR   the full solution for the scene as it is (every photon, AIM and texel),\n"
+            "                         with a progress bar and the time left (Ctrl-C cancels): DIR/lightmap.exr\n"
+            "                         (irradiance, alpha = valid), lightmap.png (a preview), aim.exr\n"
             "  check SCENE            one frame of 'run' (same options) against the path-traced reference:\n"
             "                         frame / reference per visible surface and over the frame, and the\n"
             "                         relative RMSE (default --size 128x128; --out DIR: the two EXRs)\n"
@@ -160,6 +164,8 @@ int main(int argc, char **argv)
         return lm_cli_reference(&a);
     if (!strcmp(cmd, "run"))
         return lm_cli_run(&a);
+    if (!strcmp(cmd, "bake"))
+        return lm_cli_bake(&a);
     if (!strcmp(cmd, "check"))
         return lm_cli_check(&a);
     if (!strcmp(cmd, "bench"))

@@ -29,10 +29,9 @@ typedef struct {
     uint32_t texels;
 } run_state;
 
-static void gather_progress(void *user, uint32_t done, uint32_t total)
+static void gather_progress(void *user, float fraction, const char *stage)
 {
-    (void)user;
-    lm_progress("first full gather", (int)done, (int)total);
+    lm_progress_fraction("first full solution", fraction, stage, *(const double *)user);
 }
 
 void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
@@ -62,8 +61,12 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
     d->frame_width = a->width ? a->width : LM_CLI_FRAME_SIZE;
     d->frame_height = a->width ? a->height : LM_CLI_FRAME_SIZE;
     d->camera = a->camera;
-    if (!a->quiet)
+    if (!a->quiet) {
+        static double started;
+        started = lm_cli_now();
         d->progress = gather_progress;
+        d->progress_user = &started;
+    }
 }
 
 static void csv_header(FILE *f)

@@ -33,6 +33,7 @@ const char *lm_status_name(lm_status s)
     case LM_ERR_UNSUPPORTED: return "unsupported";
     case LM_ERR_NOMEM: return "out of memory";
     case LM_ERR_BACKEND: return "backend error";
+    case LM_ERR_CANCELLED: return "cancelled";
     }
     return "unknown error";
 }

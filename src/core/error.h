@@ -12,7 +12,8 @@ typedef enum {
     LM_ERR_INVALID,     /* invalid value: NaN/Inf, degenerate geometry in strict mode, bad argument */
     LM_ERR_UNSUPPORTED, /* a required extension or feature lmgi does not implement */
     LM_ERR_NOMEM,
-    LM_ERR_BACKEND      /* Embree or OpenGL failed */
+    LM_ERR_BACKEND,     /* Embree or OpenGL failed */
+    LM_ERR_CANCELLED    /* the caller's cancel flag stopped the work */
 } lm_status;
 
 typedef struct {

@@ -81,9 +81,14 @@ static lm_status gather_prepare(lm_frame_loop *fl, lm_error *err)
 static lm_status gather_run(lm_frame_loop *fl, uint32_t count, lm_error *err)
 {
     lm_status st = LM_OK;
-    /* in chunks of 16 passes when someone watches (the first full gather), else all at once */
-    uint32_t chunk = fl->set.progress ? 16u * (uint32_t)(fl->set.gather.tiles * fl->set.gather.tiles) : count;
+    /* a pass at a time when someone watches or may cancel (the first full gather, a bake: tens of ms a
+     * pass, so a cancel is heard within 100 ms), else all at once */
+    int watched = fl->set.progress || fl->set.cancel;
+    uint32_t chunk = watched ? (uint32_t)(fl->set.gather.tiles * fl->set.gather.tiles) : count;
     for (uint32_t done = 0; st == LM_OK && done < count; done += chunk) {
+        if (fl->set.cancel && *fl->set.cancel)
+            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u texels", fl->scene->path, done,
+                           count);
         uint32_t n = count - done < chunk ? count - done : chunk;
         st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + done, n, fl->iim.fresh_tex, NULL, err);
         if (fl->set.progress)
@@ -175,6 +180,7 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     if (st == LM_OK)
         st = gather(fl, lm_iim_schedule_all(&fl->iim, store_of(fl), fl->texels), err);
     fl->set.progress = NULL; /* per-frame gathers are small */
+    fl->set.cancel = NULL;
     if (st == LM_OK)
         st = lm_iim_blend(&fl->iim, 1, err);
     if (t_gather)
@@ -429,6 +435,96 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
     o.t_total = lm_now() - t0;
     if (out)
         *out = o;
+    return st;
+}
+
+/* The bake's gather reports through the loop's progress hook as a fraction of the whole bake. */
+typedef struct {
+    lm_bake_progress fn;
+    void *user;
+} bake_watch;
+
+static void bake_gather_progress(void *user, uint32_t done, uint32_t total)
+{
+    const bake_watch *w = user;
+    w->fn(w->user, 0.3 + 0.7 * (double)done / (total ? total : 1), "gather");
+}
+
+/* Schedules every texel of every surface whose light changed (the whole atlas as the budget), gathers
+ * them a pass at a time and commits them at once. On a cancel the scheduled surfaces get their delta_i
+ * back and stay uncommitted, so what shows is the last complete state and a later bake or step redoes
+ * them. */
+static lm_status bake_gather(lm_frame_loop *fl, lm_bake_progress progress, void *user, const volatile int *cancel,
+                             lm_bake_stats *out, lm_error *err)
+{
+    lm_photon_store *ps = store_of(fl);
+    int S = fl->iim.surface_count;
+    double *saved = malloc(sizeof *saved * (size_t)(S ? S : 1));
+    if (!saved)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", fl->scene->path);
+    for (int s = 0; s < S; s++)
+        saved[s] = ps->surfaces[s].delta_i;
+    int budget = fl->iim.set.texels_per_frame;
+    fl->iim.set.texels_per_frame = (int)fl->atlas->texel_count;
+    uint32_t n = lm_iim_schedule(&fl->iim, ps, fl->texels);
+    fl->iim.set.texels_per_frame = budget;
+    bake_watch w = {progress, user};
+    fl->set.progress = progress ? bake_gather_progress : NULL;
+    fl->set.progress_user = &w;
+    fl->set.cancel = cancel;
+    lm_status st = gather(fl, n, err);
+    fl->set.progress = NULL;
+    fl->set.cancel = NULL;
+    if (st != LM_OK) {
+        for (int s = 0; s < S; s++)
+            if (fl->iim.commit[s])
+                fl->iim.commit[s] = 0, ps->surfaces[s].delta_i = saved[s];
+    } else {
+        uint32_t before = 0, after = 0;
+        for (int s = 0; s < S; s++)
+            before += fl->iim.version[s];
+        st = lm_iim_blend(&fl->iim, 1, err);
+        for (int s = 0; s < S; s++)
+            after += fl->iim.version[s];
+        out->texels_gathered = n;
+        out->surfaces_changed = (int)(after - before);
+    }
+    free(saved);
+    return st;
+}
+
+lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progress, void *user,
+                             const volatile int *cancel, lm_bake_stats *out, lm_error *err)
+{
+    memset(out, 0, sizeof *out);
+    lm_status st = lm_frame_loop_sync(fl, err);
+    if (st == LM_OK)
+        st = lm_gl_make_current(fl->gl, err);
+    if (st != LM_OK)
+        return st;
+    if (progress)
+        progress(user, 0.0, "photons");
+    double t0 = lm_now();
+    lm_photon_stage_frame f;
+    st = lm_photon_stage_converge(fl->stage, t, &f, err);
+    lm_scene_update_bounds(fl->scene);
+    out->photons_traced = f.photons.group_photons;
+    out->photons_changed = f.photons.photons_updated;
+    out->aim_surfaces_refreshed = f.aim.surfaces_refreshed;
+    if (f.aim.surfaces_refreshed > 0)
+        fl->aim_stale = 1;
+    double t1 = lm_now();
+    out->t_photons = t1 - t0;
+    if (st == LM_OK && cancel && *cancel)
+        st = lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after the photons", fl->scene->path);
+    if (st == LM_OK) {
+        if (progress)
+            progress(user, 0.3, "gather");
+        st = bake_gather(fl, progress, user, cancel, out, err);
+    }
+    out->t_gather = lm_now() - t1;
+    if (st == LM_OK && progress)
+        progress(user, 1.0, "done");
     return st;
 }
 

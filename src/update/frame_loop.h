@@ -49,6 +49,7 @@ typedef struct {
     /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;
+    const volatile int *cancel; /* non-zero stops the first full gather between passes: LM_ERR_CANCELLED */
     lm_gl_context *gl;     /* borrowed, made current at each call: the context to render with (NULL, the
                             * default: the loop makes its own) */
 } lm_frame_loop_settings;
@@ -88,6 +89,25 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
  * the stage's tracing and AIM refresh run on past the step, beside whatever the caller does next). Call
  * it before anything that writes the scene or BVH (an edit) or reads the AIM or photons. */
 lm_status lm_frame_loop_sync(lm_frame_loop *fl, lm_error *err);
+/* What a bake did: photon paths that changed (of all, re-traced), AIM surfaces refreshed, IIM texels
+ * regathered, surfaces whose displayed lightmap changed. */
+typedef struct {
+    uint32_t photons_traced, photons_changed;
+    int aim_surfaces_refreshed;
+    uint32_t texels_gathered;
+    int surfaces_changed;
+    double t_photons, t_gather;
+} lm_bake_stats;
+typedef void (*lm_bake_progress)(void *user, double fraction, const char *stage);
+/* Brings the lightmaps to the converged state of the scene as it is now (animation time t): every photon
+ * re-traced, the AIM of every surface whose photons changed refreshed, every texel of every surface whose
+ * light changed regathered, and shown at once (no blend). What the scene's edits did not touch costs
+ * only the photons' re-trace. progress (may be NULL) hears fractions 0 to 1 and the stage ("photons",
+ * "gather"); *cancel (may be NULL) set non-zero stops it between gather passes with LM_ERR_CANCELLED,
+ * nothing of the unfinished gather shown and those surfaces left to the next bake or step. */
+lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progress, void *user,
+                             const volatile int *cancel, lm_bake_stats *out, lm_error *err);
+
 /* The texels the next steps gather (at least 0; the settings' iim.texels_per_frame until set): the public
  * updater's time budget turns into this. */
 void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels);

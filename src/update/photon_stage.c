@@ -171,6 +171,22 @@ lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_fra
     return st == LM_OK ? lm_photon_stage_update(ps, out, err) : st;
 }
 
+lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err)
+{
+    lm_status st = lm_photon_stage_animate(ps, t, out, err);
+    double t1 = lm_now();
+    if (st == LM_OK)
+        st = lm_photons_trace_all(ps->photons, &out->photons, err);
+    double t2 = lm_now();
+    if (st == LM_OK)
+        st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons), -1,
+                            &out->aim, err);
+    out->t_photons = t2 - t1;
+    out->t_aim = lm_now() - t2;
+    out->t_total = out->t_animate + out->t_photons + out->t_aim;
+    return st;
+}
+
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }

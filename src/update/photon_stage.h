@@ -44,6 +44,10 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
  * another thread beside rendering that only reads the scene (the frame loop's overlap). */
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err);
 
+/* A full refresh at time t, for a bake: animate, then every photon re-traced (a path that did not change
+ * changes nothing in the store) and the AIM of every surface whose photons changed refreshed. */
+lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
+
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps);

@@ -1,0 +1,104 @@
+/* lmgi bake: through the public API only. */
+#include "bake_cmd.h"
+
+#include <lmgi.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "out_dir.h"
+#include "progress.h"
+#include "run_cmd.h"
+#include "scene_load.h"
+
+static volatile sig_atomic_t g_interrupted;
+static volatile int g_cancel; /* what the library polls; set from the signal handler */
+
+static void on_interrupt(int sig)
+{
+    (void)sig;
+    g_interrupted = 1;
+    g_cancel = 1;
+}
+
+static void show(void *user, float fraction, const char *stage)
+{
+    lm_progress_fraction("bake", fraction, stage, *(const double *)user);
+}
+
+static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(n * sizeof *rgba);
+    lmgi_error e;
+    char path[4096];
+    int rc = 0;
+    static const char *const files[3] = {"lightmap.exr", "lightmap.png", "aim.exr"};
+    for (int k = 0; k < 3 && rc == 0; k++) {
+        lmgi_lightmap kind = k < 2 ? LMGI_LIGHTMAP_IIM : LMGI_LIGHTMAP_AIM;
+        snprintf(path, sizeof path, "%s/%s", dir, files[k]);
+        if (!rgba)
+            rc = 1, fprintf(stderr, "lmgi: error: no memory for the %d x %d lightmap\n", in.atlas_width, in.atlas_height);
+        else if ((k != 1 && lmgi_get_lightmap(u, kind, rgba, n, &e) != LMGI_OK) ||
+                 lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, rgba, LMGI_TONEMAP_NEUTRAL, 0.0f, &e))
+            rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
+    }
+    free(rgba);
+    return rc;
+}
+
+int lm_cli_bake(const lm_cli_args *a)
+{
+    if (a->file_count != 1 || !a->out_dir) {
+        fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
+        return 2;
+    }
+    static const char *const own[] = {"lightmap.exr", "lightmap.png", "aim.exr", NULL};
+    lm_error claim;
+    if (lm_cli_claim_out_dir(a->out_dir, a->force, own, &claim) != LM_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", claim.msg);
+        return 1;
+    }
+    lmgi_scene *sc = NULL;
+    lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
+    if (!lm_cli_load_scene(a->files[0], &o, 1, &sc))
+        return 1;
+    lmgi_updater_desc d;
+    lm_cli_updater_desc(a, &d);
+    d.frame_width = d.frame_height = 0;
+    double started = lm_cli_now();
+    d.progress = a->quiet ? NULL : show;
+    d.progress_user = &started;
+    d.cancel = &g_cancel;
+    signal(SIGINT, on_interrupt);
+    lmgi_context *ctx = NULL;
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    int rc = 0;
+    if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK || lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK) {
+        if (e.status == LMGI_ERR_CANCELLED)
+            fprintf(stderr, "\nlmgi: bake cancelled after %.1f s; nothing written\n", lm_cli_now() - started);
+        else
+            fprintf(stderr, "lmgi: error: %s\n", e.message);
+        rc = e.status == LMGI_ERR_CANCELLED ? 130 : 1;
+    }
+    signal(SIGINT, SIG_DFL);
+    if (rc == 0)
+        rc = write_maps(sc, u, a->out_dir);
+    if (rc == 0 && !a->quiet) {
+        lmgi_info in;
+        lmgi_updater_info ui;
+        lmgi_get_info(sc, &in);
+        lmgi_get_updater_info(u, &ui);
+        printf("baked       %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather "
+               "%.0f ms)\nwrote       %s/lightmap.exr (irradiance, alpha = valid), lightmap.png, aim.exr\n",
+               in.texels, in.atlas_width, in.atlas_height, ui.photons, lm_cli_now() - started, ui.ms_setup_trace,
+               ui.ms_setup_aim, ui.ms_setup_gather, a->out_dir);
+    }
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+    return rc;
+}
