@@ -165,6 +165,28 @@ LMGI_API lmgi_status lmgi_get_light(const lmgi_scene *scene, int light, lmgi_lig
  * changed. */
 LMGI_API lmgi_status lmgi_set_light(lmgi_scene *scene, int light, const lmgi_light *l, lmgi_error *err);
 
+/* Materials. An edit of colour or emission reaches an updater at its next update: the photons that
+ * touch the material are re-traced (no others), the AIMs of its surfaces refreshed, and the frame's
+ * direct light and indirect term use the new colour at once. The class (diffuse, glossy, mirror, glass,
+ * emitter) is fixed at load. */
+typedef enum { LMGI_MATERIAL_DIFFUSE = 0, LMGI_MATERIAL_GLOSSY, LMGI_MATERIAL_MIRROR, LMGI_MATERIAL_GLASS,
+               LMGI_MATERIAL_EMITTER } lmgi_material_class;
+typedef struct {
+    lmgi_material_class cls;  /* read only */
+    float base_color[4];      /* linear RGBA factor, each in [0, 1] (a base colour texture multiplies it) */
+    float emissive[3];        /* emitted radiance (emissiveFactor x strength), >= 0; non-zero only for a
+                               * material that was emissive at load (its triangles are the emitters) */
+    float metallic, roughness; /* read only */
+} lmgi_material;
+LMGI_API int lmgi_material_count(const lmgi_scene *scene); /* 0 for NULL */
+LMGI_API const char *lmgi_material_name(const lmgi_scene *scene, int material); /* NULL when out of range */
+/* NULL argument or an id out of range: LMGI_ERR_INVALID (out zeroed when given). */
+LMGI_API lmgi_status lmgi_get_material(const lmgi_scene *scene, int material, lmgi_material *out, lmgi_error *err);
+/* Recolours a material or changes its emission. NaN, values out of range, emission on a material that
+ * was not emissive at load, a class other than its own, or an id out of range: LMGI_ERR_INVALID, nothing
+ * changed. */
+LMGI_API lmgi_status lmgi_set_material(lmgi_scene *scene, int material, const lmgi_material *m, lmgi_error *err);
+
 /* Hands an edited node back to its animations from the next lmgi_set_time or update on. NULL scene or
  * an id out of range: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_node_resume_animation(lmgi_scene *scene, int node, lmgi_error *err);

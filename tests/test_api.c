@@ -492,17 +492,24 @@ static void test_bake(void **state)
     assert_true(r.texels_gathered > 0 && r.texels_gathered < in.texels * 3 / 4);
     assert_true(r.surfaces_changed > 0);
     assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, after, n, &e), LMGI_OK);
-    int b_same = 1, a_darker = 0;
+    /* Room B's floor and walls include their halves of the doorway's reveal, which lie on room A's side of
+     * the door: seeing room A's dimmed surfaces, they are regathered, and their texels deep in room B
+     * change by no more than the gather's rounding (a texel drawn in another tile of a pass) and what the
+     * door's thin edges, lit from both rooms, pass on: under 0.1%. */
+    int a_darker = 0;
+    double b_worst = 0.0;
     for (uint32_t i = 0; i < in.texels; i++) {
         lmgi_texel t;
         lmgi_get_texel(sc, i, &t);
         size_t k = 4 * ((size_t)t.y * in.atlas_width + t.x);
         if (t.position[0] > 0.2f)
-            b_same &= !memcmp(before + k, after + k, 4 * sizeof *before);
+            for (int c = 0; c < 3; c++)
+                b_worst = fmax(b_worst, fabs((double)after[k + c] - before[k + c]) / (fabs((double)before[k + c]) + 1e-3));
         else if (t.position[0] < -0.2f)
             a_darker += after[k + 1] < before[k + 1];
     }
-    assert_true(b_same);
+    print_message("room B (x > 0.2): largest relative change %.1e\n", b_worst);
+    assert_true(b_worst < 1e-3);
     assert_true(a_darker > 100);
     assert_int_equal(lmgi_bake(u, NULL, &r, &e), LMGI_OK); /* done: nothing left */
     assert_int_equal(r.texels_gathered, 0);
@@ -513,6 +520,83 @@ static void test_bake(void **state)
     free(after);
     lmgi_updater_free(u);
     lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* Recolouring the red wall blue, then a bake, gives the lightmap of a scene whose wall was blue from the
+ * start (the same photons, the same gather): the edit reaches every photon and AIM it should. Bad
+ * material edits are refused. */
+static void test_recolour_material(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_scene *edited = load_cornell(), *blue = load_cornell();
+    int red = -1;
+    for (int m = 0; m < lmgi_material_count(edited); m++)
+        if (!strcmp(lmgi_material_name(edited, m), "red"))
+            red = m;
+    assert_true(red >= 0);
+    lmgi_material mat;
+    lmgi_error e;
+    assert_int_equal(lmgi_get_material(edited, red, &mat, &e), LMGI_OK);
+    assert_int_equal(mat.cls, LMGI_MATERIAL_DIFFUSE);
+    lmgi_material recoloured = mat;
+    recoloured.base_color[0] = 0.05f, recoloured.base_color[1] = 0.06f, recoloured.base_color[2] = 0.63f;
+    assert_int_equal(lmgi_set_material(blue, red, &recoloured, &e), LMGI_OK); /* blue from the start */
+
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.frame_width = d.frame_height = 0;
+    lmgi_updater *u = make_updater(ctx, edited, &d), *truth = make_updater(ctx, blue, &d);
+    assert_int_equal(lmgi_set_material(edited, red, &recoloured, &e), LMGI_OK);
+    lmgi_bake_report r;
+    lmgi_bake_report rt;
+    assert_int_equal(lmgi_bake(truth, NULL, &rt, &e), LMGI_OK); /* both at the animations' time 0 (the file's */
+    assert_int_equal(lmgi_bake(u, NULL, &r, &e), LMGI_OK);      /* rest pose differs) */
+    print_message("red wall recoloured blue: %u of %u photon paths changed, %d AIM surfaces, %u texels regathered\n",
+                  r.photons_changed, r.photons_traced, r.aim_surfaces_refreshed, r.texels_gathered);
+    assert_true(r.photons_changed > 0 && r.photons_changed < r.photons_traced);
+    assert_true(r.aim_surfaces_refreshed > 0 && r.texels_gathered > 0);
+
+    lmgi_info in;
+    lmgi_get_info(edited, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *a = malloc(n * sizeof *a), *b = malloc(n * sizeof *b);
+    for (int k = 0; k < 2; k++) {
+        lmgi_lightmap kind = k ? LMGI_LIGHTMAP_AIM : LMGI_LIGHTMAP_IIM;
+        assert_int_equal(lmgi_get_lightmap(u, kind, a, n, &e), LMGI_OK);
+        assert_int_equal(lmgi_get_lightmap(truth, kind, b, n, &e), LMGI_OK);
+        double diff = 0.0, sum = 0.0;
+        for (size_t i = 0; i < n; i++)
+            if (i % 4 != 3)
+                diff += fabs((double)a[i] - b[i]), sum += fabs((double)b[i]);
+        print_message("%s after the edit and a bake against blue from the start: mean relative difference %.2e\n",
+                      k ? "AIM" : "IIM", diff / sum);
+        assert_true(diff / sum < 1e-4);
+    }
+    lmgi_material bad = recoloured;
+    bad.base_color[2] = 1.5f;
+    expect_invalid(lmgi_set_material(edited, red, &bad, &e), &e, "base colour");
+    bad = recoloured;
+    bad.emissive[0] = 1.0f;
+    expect_invalid(lmgi_set_material(edited, red, &bad, &e), &e, "not emissive at load");
+    bad = recoloured;
+    bad.cls = LMGI_MATERIAL_MIRROR;
+    expect_invalid(lmgi_set_material(edited, red, &bad, &e), &e, "class");
+    bad = recoloured;
+    bad.base_color[0] = NAN;
+    expect_invalid(lmgi_set_material(edited, red, &bad, &e), &e, "base colour");
+    expect_invalid(lmgi_set_material(edited, 99, &recoloured, &e), &e, "out of range");
+    assert_null(lmgi_material_name(edited, 99));
+    assert_int_equal(lmgi_get_material(edited, red, &mat, &e), LMGI_OK);
+    assert_memory_equal(mat.base_color, recoloured.base_color, sizeof mat.base_color); /* refusals changed nothing */
+    free(a);
+    free(b);
+    lmgi_updater_free(u);
+    lmgi_updater_free(truth);
+    lmgi_free(edited);
+    lmgi_free(blue);
     lmgi_context_free(ctx);
 }
 
@@ -704,6 +788,7 @@ int main(void)
         cmocka_unit_test(test_edit_reaches_updater),
         cmocka_unit_test(test_light_edit_stays_in_its_room),
         cmocka_unit_test(test_bake),
+        cmocka_unit_test(test_recolour_material),
         cmocka_unit_test(test_budget_sets_texels),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_write_image),

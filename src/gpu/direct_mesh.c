@@ -312,6 +312,7 @@ static void dynamic_bounds(lm_direct_mesh *d, const lm_scene *s)
 lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
     memset(d, 0, sizeof *d);
+    d->material_version = s->material_version;
     d->groups = s->texture_count + 1;
     d->node_count = s->node_count;
     built b;
@@ -357,10 +358,13 @@ static void upload_node(lm_direct_mesh *d, const lm_scene *s, int n)
 
 int lm_direct_mesh_update(lm_direct_mesh *d, const lm_scene *s)
 {
-    int moved = 0;
+    int moved = 0, recolour = d->material_version != s->material_version;
+    d->material_version = s->material_version;
     for (int i = 0; i < s->node_count && i < d->node_count; i++) {
         const lm_node *nd = &s->nodes[i];
         float *w = d->node_world + 16 * (size_t)i;
+        if (recolour && nd->tri_count) /* the same places, new colours: no shadow is stale */
+            upload_node(d, s, i);
         if (!memcmp(w, nd->world, sizeof nd->world))
             continue;
         memcpy(w, nd->world, sizeof nd->world);

@@ -31,12 +31,14 @@ typedef struct {
     float *scratch;       /* vertices of the largest node (update) */
     unsigned uv_vbo;      /* lightmap uv per vertex (attribute 7), 0 without an atlas */
     float dynamic_lo[3], dynamic_hi[3]; /* world bounds of the dynamic nodes' casters (after an update) */
+    uint32_t material_version; /* the scene's when the vertices (which carry their material) were uploaded */
 } lm_direct_mesh;
 
 /* Builds the meshes; with an atlas (may be NULL) also attribute 7: each vertex's lightmap uv, (-1, -1) on
  * triangles without a chart (uvs are fixed: they do not move with their node). */
 lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, lm_error *err);
-/* Re-uploads the vertices of every node whose world matrix changed since they were uploaded. Returns
+/* Re-uploads the vertices of every node whose world matrix changed since they were uploaded, and of
+ * every node after a material edit (lm_scene.material_version). Returns
  * LM_MESH_MOVED when some node moved, | LM_MESH_DYNAMIC_CASTERS_MOVED or LM_MESH_STATIC_CASTERS_MOVED
  * when one of them casts shadows (a static node only moves when the caller edits it). */
 enum { LM_MESH_MOVED = 1, LM_MESH_DYNAMIC_CASTERS_MOVED = 2, LM_MESH_STATIC_CASTERS_MOVED = 4 };

@@ -130,6 +130,7 @@ typedef struct {
     lm_node *nodes;
     int material_count;
     lm_material *materials;
+    uint32_t material_version; /* counts material edits: what copied materials (the GPU's) compare with */
     int texture_count;
     lm_texture *textures;
     int light_count;

@@ -259,6 +259,22 @@ void lm_photons_invalidate_all(lm_photons *ph)
         mark_invalid(ph, g);
 }
 
+uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *materials)
+{
+    uint32_t n = 0;
+    for (uint32_t gi = 0; gi < ph->group_count; gi++) {
+        const ph_group *g = &ph->groups[gi];
+        uint32_t end = g->photons && g->offsets ? g->offsets[g->photons] : 0;
+        for (uint32_t i = 0; i < end; i++)
+            if (materials[ph->scene->tri_material[g->verts[i].tri]]) {
+                mark_invalid(ph, gi);
+                n++;
+                break;
+            }
+    }
+    return n;
+}
+
 /* ---- re-tracing groups: trace in parallel, apply serially in group and photon order ---- */
 
 /* 1 if group g fits in batch b (a batch always takes at least one group). */

@@ -6,6 +6,7 @@
 
 #include "../core/memory.h"
 #include "../core/timing.h"
+#include "../core/vecmath.h"
 #include "../gpu/composite.h"
 #include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
@@ -450,6 +451,63 @@ static void bake_gather_progress(void *user, uint32_t done, uint32_t total)
     w->fn(w->user, 0.3 + 0.7 * (double)done / (total ? total : 1), "gather");
 }
 
+/* A texel's position now (its node may have moved since load). */
+static lm_vec3 texel_now(const lm_frame_loop *fl, uint32_t texel)
+{
+    const lm_texel *t = &fl->atlas->texels[texel];
+    const float *w = fl->scene->nodes[fl->scene->tri_node[t->tri]].world;
+    return lm_mat4_point(w, lm_v3_load(t->local));
+}
+
+#define SEE_PAIRS 16 /* texel pairs tried between two surfaces */
+
+/* Whether surface a sees surface b: one of SEE_PAIRS texel pairs, spread over both, joined by an
+ * unoccluded segment. False negatives are possible for surfaces that see each other through a gap
+ * narrower than the pairs' spacing; no false positives, beyond surfaces seen edge-on. */
+static int sees(const lm_frame_loop *fl, int a, int b, float lift)
+{
+    const lm_iim *iim = &fl->iim;
+    uint32_t na = iim->surf_first[a + 1] - iim->surf_first[a], nb = iim->surf_first[b + 1] - iim->surf_first[b];
+    if (!na || !nb)
+        return 0;
+    for (uint32_t k = 0; k < SEE_PAIRS; k++) {
+        uint32_t ta = iim->surf_texels[iim->surf_first[a] + (uint32_t)((uint64_t)k * na / SEE_PAIRS)];
+        uint32_t tb = iim->surf_texels[iim->surf_first[b] + (uint32_t)((uint64_t)((k * 7 + 3) % SEE_PAIRS) * nb / SEE_PAIRS)];
+        lm_vec3 p = texel_now(fl, ta), q = texel_now(fl, tb), d = lm_sub(q, p);
+        float len = lm_length(d);
+        if (!(len > 2.0f * lift))
+            continue;
+        d = lm_scale(d, 1.0f / len);
+        float org[3], dir[3];
+        lm_v3_store(org, lm_add(p, lm_scale(d, lift)));
+        lm_v3_store(dir, d);
+        if (!lm_rt_occluded(fl->rt, org, dir, 0.0f, len - 2.0f * lift))
+            return 1;
+    }
+    return 0;
+}
+
+/* A surface whose own photons did not change may still see one whose AIM the bake refreshed (the cube
+ * beside a recoloured wall that no changed photon reached): its hemicube would show the old light, so it
+ * is regathered too. Marks those surfaces' delta_i; returns how many. */
+static int widen_to_viewers(lm_frame_loop *fl, lm_photon_store *ps)
+{
+    const uint8_t *refreshed = lm_photon_stage_refreshed(fl->stage);
+    int S = fl->iim.surface_count, n = 0;
+    float lift = 1e-3f * lm_scene_size(fl->scene);
+    for (int a = 0; a < S; a++) {
+        if (ps->surfaces[a].delta_i > fl->iim.set.delta_threshold)
+            continue;
+        for (int b = 0; b < S; b++)
+            if (b != a && refreshed[b] && sees(fl, a, b, lift)) {
+                ps->surfaces[a].delta_i = fl->iim.set.delta_threshold + 1e-30;
+                n++;
+                break;
+            }
+    }
+    return n;
+}
+
 /* Schedules every texel of every surface whose light changed (the whole atlas as the budget), gathers
  * them a pass at a time and commits them at once. On a cancel the scheduled surfaces get their delta_i
  * back and stay uncommitted, so what shows is the last complete state and a later bake or step redoes
@@ -513,6 +571,8 @@ lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progre
     out->aim_surfaces_refreshed = f.aim.surfaces_refreshed;
     if (f.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
+    if (st == LM_OK) /* before a cancel can stop the bake: a later one must still regather them */
+        out->surfaces_seeing = widen_to_viewers(fl, store_of(fl));
     double t1 = lm_now();
     out->t_photons = t1 - t0;
     if (st == LM_OK && cancel && *cancel)

@@ -95,6 +95,7 @@ typedef struct {
     uint32_t photons_traced, photons_changed;
     int aim_surfaces_refreshed;
     uint32_t texels_gathered;
+    int surfaces_seeing;   /* of the surfaces regathered, those only because they see a refreshed AIM */
     int surfaces_changed;
     double t_photons, t_gather;
 } lm_bake_stats;

@@ -11,6 +11,17 @@ typedef struct {
     float power[3];
 } emitter_snapshot;
 
+/* What photons and AIMs read of a material: its colour and emission. */
+typedef struct {
+    float base_color[4], emissive[3];
+} material_snapshot;
+
+static void take_material(const lm_material *m, material_snapshot *out)
+{
+    memcpy(out->base_color, m->base_color, sizeof out->base_color);
+    memcpy(out->emissive, m->emissive, sizeof out->emissive);
+}
+
 struct lm_photon_stage {
     lm_photon_stage_settings set;
     lm_scene *scene;
@@ -19,6 +30,8 @@ struct lm_photon_stage {
     lm_rt *rt;
     lm_emitters emitters;
     emitter_snapshot *snap;
+    material_snapshot *mat_snap; /* per material, as its photons were last traced and AIMs refreshed */
+    uint8_t *refreshed;          /* per surface: its AIM refreshed by the last lm_photon_stage_converge */
     lm_photons *photons;
     lm_aim aim;
     int have_emitters, have_aim;
@@ -40,6 +53,36 @@ static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *ou
     if (em->node >= 0 && em->node < ps->scene->node_count)
         memcpy(out->world, ps->scene->nodes[em->node].world, sizeof out->world);
     memcpy(out->power, em->power, sizeof out->power);
+}
+
+/* A material edit (colour, emission) reaches the photons that touch the material, which are re-traced,
+ * and the AIMs of its surfaces, whose albedo the estimate multiplies in: those are marked for a refresh.
+ * The surfaces its light reaches follow from the re-traced photons' hits. Returns the edited materials. */
+static int check_materials(lm_photon_stage *ps)
+{
+    const lm_scene *s = ps->scene;
+    uint8_t *changed = NULL;
+    int n = 0;
+    for (int m = 0; m < s->material_count; m++) {
+        material_snapshot now;
+        take_material(&s->materials[m], &now);
+        if (!memcmp(&now, &ps->mat_snap[m], sizeof now))
+            continue;
+        if (!changed && !(changed = calloc((size_t)s->material_count, 1)))
+            return 0; /* out of memory: seen at the next frame */
+        ps->mat_snap[m] = now;
+        changed[m] = 1;
+        n++;
+    }
+    if (!n)
+        return 0;
+    lm_photons_invalidate_materials(ps->photons, changed);
+    lm_photon_store *store = lm_photons_store_mutable(ps->photons);
+    for (int k = 0; k < ps->surfaces->surface_count; k++)
+        if (changed[ps->surfaces->surfaces[k].material]) /* over any threshold: first in line for a refresh */
+            store->surfaces[k].delta_f = 1e30;
+    free(changed);
+    return n;
 }
 
 /* Invalidates the groups of every emitter whose placement or power changed since its last snapshot. */
@@ -72,6 +115,11 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     for (int e = 0; e < ps->emitters.count; e++)
         take_snapshot(ps, e, &ps->snap[e]);
+    ps->mat_snap = malloc(sizeof *ps->mat_snap * (size_t)(ps->scene->material_count + 1));
+    if (!ps->mat_snap)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
+    for (int m = 0; m < ps->scene->material_count; m++)
+        take_material(&ps->scene->materials[m], &ps->mat_snap[m]);
     lm_photon_settings photons = ps->set.photons;
     if (photons.cover_distance == 0.0f && ps->atlas) /* light closer under something than a texel is hidden */
         photons.cover_distance = ps->atlas->texel_size;
@@ -128,6 +176,8 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     if (ps->have_emitters)
         lm_emitters_free(&ps->emitters);
     free(ps->snap);
+    free(ps->mat_snap);
+    free(ps->refreshed);
     free(ps);
 }
 
@@ -145,6 +195,7 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
     }
     lm_emitters_update(&ps->emitters, ps->scene);
     lm_status st = check_emitters(ps, &out->emitters_moved, err);
+    out->materials_changed = check_materials(ps);
     out->t_animate = lm_now() - t0;
     out->t_total = out->t_animate;
     return st;
@@ -178,14 +229,25 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage
     if (st == LM_OK)
         st = lm_photons_trace_all(ps->photons, &out->photons, err);
     double t2 = lm_now();
+    float threshold = ps->aim.set.delta_threshold; /* a bake refreshes every surface whose photons changed */
+    ps->aim.set.delta_threshold = 0.0f;
+    int S = ps->surfaces->surface_count;
+    if (!ps->refreshed && !(ps->refreshed = malloc((size_t)(S ? S : 1))))
+        st = st == LM_OK ? lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", ps->scene->path) : st;
+    const lm_photon_store *store = lm_photons_store(ps->photons);
+    for (int k = 0; st == LM_OK && k < S; k++)
+        ps->refreshed[k] = store->surfaces[k].delta_f > 0.0;
     if (st == LM_OK)
         st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons), -1,
                             &out->aim, err);
+    ps->aim.set.delta_threshold = threshold;
     out->t_photons = t2 - t1;
     out->t_aim = lm_now() - t2;
     out->t_total = out->t_animate + out->t_photons + out->t_aim;
     return st;
 }
+
+const uint8_t *lm_photon_stage_refreshed(const lm_photon_stage *ps) { return ps->refreshed; }
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }

@@ -18,6 +18,7 @@ typedef struct {
     int frame;
     float time;              /* animation time, seconds */
     int emitters_moved;      /* emitters whose placement or power changed this frame */
+    int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
     lm_photon_frame_stats photons;
     lm_aim_stats aim;
     double t_animate, t_photons, t_aim, t_total; /* seconds */
@@ -47,6 +48,8 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
 /* A full refresh at time t, for a bake: animate, then every photon re-traced (a path that did not change
  * changes nothing in the store) and the AIM of every surface whose photons changed refreshed. */
 lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
+/* After lm_photon_stage_converge: per surface, 1 if its AIM was refreshed (valid until the next call). */
+const uint8_t *lm_photon_stage_refreshed(const lm_photon_stage *ps);
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */

@@ -1,5 +1,6 @@
-/* The public API's light edits: recolour, dim, switch off, reshape. The photon stage notices a light
- * whose power or placement changed (its emitter snapshot) and re-traces that light's groups alone. */
+/* The public API's light and material edits. The photon stage notices a light whose power or placement
+ * changed (its emitter snapshot) and re-traces that light's groups alone, and a material whose colour or
+ * emission changed (its material snapshot) and re-traces the groups that touch it. */
 #include <lmgi.h>
 
 #include <math.h>
@@ -73,5 +74,59 @@ lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi
     if (l->type == LM_LIGHT_SPOT)
         l->inner_cone = in->inner_cone, l->outer_cone = in->outer_cone;
     l->off = !in->enabled;
+    return LMGI_OK;
+}
+
+int lmgi_material_count(const lmgi_scene *sc) { return sc ? sc->scene->material_count : 0; }
+
+const char *lmgi_material_name(const lmgi_scene *sc, int m)
+{
+    return sc && m >= 0 && m < sc->scene->material_count ? sc->scene->materials[m].name : NULL;
+}
+
+lmgi_status lmgi_get_material(const lmgi_scene *sc, int material, lmgi_material *out, lmgi_error *err)
+{
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (!sc || !out)
+        return refuse(err, "lmgi_get_material: %s is NULL", sc ? "out" : "the scene");
+    if (material < 0 || material >= sc->scene->material_count)
+        return refuse(err, "material id %d is out of range (scene has %d materials)", material,
+                      sc->scene->material_count);
+    const lm_material *m = &sc->scene->materials[material];
+    out->cls = (lmgi_material_class)m->cls;
+    memcpy(out->base_color, m->base_color, sizeof out->base_color);
+    memcpy(out->emissive, m->emissive, sizeof out->emissive);
+    out->metallic = m->metallic;
+    out->roughness = m->roughness;
+    return LMGI_OK;
+}
+
+lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material *in, lmgi_error *err)
+{
+    if (!sc || !in)
+        return refuse(err, "lmgi_set_material: %s is NULL", sc ? "the material" : "the scene");
+    if (material < 0 || material >= sc->scene->material_count)
+        return refuse(err, "material id %d is out of range (scene has %d materials)", material,
+                      sc->scene->material_count);
+    lm_material *m = &sc->scene->materials[material];
+    if ((int)in->cls != (int)m->cls)
+        return refuse(err, "material '%s': its class is fixed at load", m->name);
+    for (int c = 0; c < 4; c++)
+        if (!in_range(in->base_color[c], 0.0f, 1.0f))
+            return refuse(err, "material '%s': base colour %g must be in [0, 1]", m->name, (double)in->base_color[c]);
+    for (int c = 0; c < 3; c++) {
+        if (!in_range(in->emissive[c], 0.0f, 1e20f))
+            return refuse(err, "material '%s': emission %g must be a finite number >= 0", m->name,
+                          (double)in->emissive[c]);
+        if (in->emissive[c] > 0.0f && m->cls != LM_MAT_EMITTER)
+            return refuse(err, "material '%s' was not emissive at load: its triangles are not emitters, so it "
+                          "cannot start to emit", m->name);
+    }
+    if (sc->updater) /* its photon work reads the materials */
+        lm_updater_sync(sc->updater);
+    memcpy(m->base_color, in->base_color, sizeof m->base_color);
+    memcpy(m->emissive, in->emissive, sizeof m->emissive);
+    sc->scene->material_version++;
     return LMGI_OK;
 }
