@@ -575,6 +575,19 @@ static void test_recolour_material(void **state)
                       k ? "AIM" : "IIM", diff / sum);
         assert_true(diff / sum < 1e-4);
     }
+    /* the frame shows it: the left wall (red in the file) is blue now */
+    lmgi_camera cam;
+    float *px = malloc(3 * SIDE * SIDE * sizeof *px);
+    assert_int_equal(lmgi_scene_camera(edited, -1, SIDE, SIDE, &cam, &e), LMGI_OK);
+    assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, px, &e), LMGI_OK);
+    double wall[3] = {0, 0, 0};
+    for (int y = SIDE / 3; y < 2 * SIDE / 3; y++)
+        for (int x = 1; x < SIDE / 10; x++)
+            for (int c = 0; c < 3; c++)
+                wall[c] += px[3 * (y * SIDE + x) + c];
+    print_message("left wall in the frame: %.3g %.3g %.3g\n", wall[0], wall[1], wall[2]);
+    assert_true(wall[2] > 3.0 * wall[0]);
+    free(px);
     lmgi_material bad = recoloured;
     bad.base_color[2] = 1.5f;
     expect_invalid(lmgi_set_material(edited, red, &bad, &e), &e, "base colour");

@@ -101,8 +101,42 @@ static void test_runtime_loop(void **state)
     assert_non_null(strstr(output, "no node 'no_such_node'"));
 }
 
+/* The editor's session on the two rooms: a first bake, the blue cube in room A recoloured and a light
+ * of room B moved, each re-bake touching part of the scene and saying so, every lightmap written. */
+static void test_editor_session(void **state)
+{
+    (void)state;
+    const char *prog = install_and_compile("editor_session");
+    char cmd[4096], dir[1024];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    snprintf(cmd, sizeof cmd, "(%s scenes/two_rooms.glb %s --material blue --light light_b2 --texels 3000 2>/dev/null)",
+             prog, dir); /* stdout only: the report, not the progress bars */
+    if (sh(cmd) != 0)
+        fail_msg("%s: %s", cmd, output);
+    print_message("%s", output);
+    unsigned changed = 0, traced = 0, texels = 0;
+    const char *line = strstr(output, "recolour ");
+    assert_non_null(line);
+    assert_int_equal(sscanf(line, "recolour %u of %u photon paths changed, %*d AIM surfaces refreshed, %u texels",
+                            &changed, &traced, &texels), 3);
+    assert_true(changed > 0 && changed < traced / 10); /* the cube's photons, not the rooms' */
+    assert_true(texels > 0 && texels < 3300);
+    line = strstr(output, "move ");
+    assert_non_null(line);
+    assert_int_equal(sscanf(line, "move %u of %u photon paths changed", &changed, &traced), 2);
+    assert_int_equal(changed, traced / 4); /* light_b2's own photons: one light of four */
+    static const char *const files[] = {"lightmap.exr", "lightmap_recoloured.exr", "lightmap_moved.exr", "view.png"};
+    for (int k = 0; k < 4; k++) {
+        snprintf(cmd, sizeof cmd, "%s/%s", dir, files[k]);
+        assert_true(file_size(cmd) > 1000);
+    }
+    snprintf(cmd, sizeof cmd, "%s scenes/two_rooms.glb %s --material nothing --texels 500", prog, dir);
+    assert_int_equal(sh(cmd), 1);
+    assert_non_null(strstr(output, "no material 'nothing'"));
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_runtime_loop)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_runtime_loop), cmocka_unit_test(test_editor_session)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
