@@ -152,6 +152,7 @@ bench: deps all $(BUILD)/gen_scenes
 	@[ -f $(BUILD)/bench/cornell_255.glb ] || $(BUILD)/gen_scenes --cornell-cells 255 $(BUILD)/bench/cornell_255.glb >/dev/null
 	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb) \
 	  --gather-scene $(BUILD)/bench/cornell_255.glb
+	$(BUILD)/lmgi bench --edits bench/two_rooms_edits.json scenes/two_rooms.glb --json $(BUILD)/bench/edits.json
 
 scenes: $(BUILD)/gen_scenes
 	$(BUILD)/gen_scenes scenes

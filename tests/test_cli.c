@@ -234,6 +234,48 @@ static void test_bake_command(void **state)
     assert_int_not_equal(access(path, F_OK), 0);
 }
 
+/* lmgi bench --edits: the lag table and the JSON from a small script; bad scripts named where they fail. */
+static void test_bench_edits(void **state)
+{
+    (void)state;
+    char dir[256], path[512], args[2048];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    snprintf(path, sizeof path, "%s/edits.json", dir);
+    const char *script = "{\"frames\": 12, \"budget_ms\": 0, \"fps\": 0, \"texels\": 600,\n"
+                         " \"edits\": [{\"frame\": 2, \"light\": \"light_a1\", \"intensity\": 2}]}\n";
+    lmt_write_file(path, script, strlen(script));
+    snprintf(args, sizeof args, "bench --edits %s scenes/two_rooms.glb --json %s/out.json", path, dir);
+    if (run(args) != 0)
+        fail_msg("%s: %s", args, output);
+    const char *row = strstr(output, "light light_a1");
+    assert_non_null(row);
+    int frame = -1;
+    double error = -1.0;
+    assert_int_equal(sscanf(row, "light light_a1 %d %lf%%", &frame, &error), 2);
+    assert_int_equal(frame, 2);
+    assert_true(error > 5.0); /* one of room A's two lights at a tenth: far from the converged state at first */
+    assert_non_null(strstr(output, "updates: median"));
+    snprintf(path, sizeof path, "%s/out.json", dir);
+    size_t n = 0;
+    char *json = (char *)lmt_read_file(path, &n, 1);
+    json[n] = '\0';
+    assert_non_null(strstr(json, "\"frames_to_5\""));
+    free(json);
+
+    snprintf(path, sizeof path, "%s/broken.json", dir);
+    const char *broken = "{\"edits\": [\n  {\"frame\": 1,, }]}";
+    lmt_write_file(path, broken, strlen(broken));
+    snprintf(args, sizeof args, "bench --edits %s scenes/two_rooms.glb", path);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "line 2, column"));
+    snprintf(path, sizeof path, "%s/unknown.json", dir);
+    const char *unknown = "{\"frames\": 5, \"texels\": 300, \"edits\": [{\"frame\": 1, \"light\": \"nope\"}]}";
+    lmt_write_file(path, unknown, strlen(unknown));
+    snprintf(args, sizeof args, "bench --edits %s scenes/two_rooms.glb", path);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "edit 0: no light on that node"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -243,6 +285,7 @@ int main(void)
         cmocka_unit_test(test_info_on_generated_cornell),
         cmocka_unit_test(test_charts_pictures),
         cmocka_unit_test(test_bake_command),
+        cmocka_unit_test(test_bench_edits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

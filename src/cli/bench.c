@@ -8,6 +8,7 @@
 
 #include "../core/stats.h"
 #include "bench_budget.h"
+#include "bench_edits.h"
 #include "bench_gather.h"
 #include "bench_photons.h"
 #include "bench_scenes.h"
@@ -125,6 +126,8 @@ static void write_json(const char *path, const result *r, int n, const result *s
 
 int lm_cli_bench(const lm_cli_args *a)
 {
+    if (a->edits_path)
+        return lm_cli_bench_edits(a);
     const char *const *files = a->files;
     int count = a->file_count;
     if (count == 0) {

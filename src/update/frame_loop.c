@@ -32,6 +32,7 @@ struct lm_frame_loop {
     lm_emitter_light emitters; /* with have_emitters: the gather's closed-form emitter light */
     int have_emitters;
     uint32_t *texels;      /* scratch: this frame's scheduled texels (atlas texel_count) */
+    uint8_t *refreshed;    /* scratch: per surface, its AIM refreshed since the last schedule */
     float *image;
     int aim_stale;         /* the AIM changed since the gather last uploaded it */
     lm_view view;
@@ -45,6 +46,7 @@ int lm_frame_loop_atlas_texels(int texels_per_frame)
 
 void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
 {
+    memset(s, 0, sizeof *s); /* a field added later is 0, NULL, off, not stack garbage */
     lm_photon_stage_settings_default(&s->stage);
     lm_hemicube_settings_default(&s->gather);
     s->gather.coverage_samples = 0; /* chosen per scene */
@@ -58,13 +60,70 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->camera = -1;
     s->reflection_size = 128;
     s->reflection_faces = 1;
-    s->progress = NULL;
-    s->progress_user = NULL;
-    s->gl = NULL;
 }
 
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
 static lm_photon_store *store_of(lm_frame_loop *fl) { return lm_photon_stage_store(fl->stage); }
+
+/* A texel's position now (its node may have moved since load). */
+static lm_vec3 texel_now(const lm_frame_loop *fl, uint32_t texel)
+{
+    const lm_texel *t = &fl->atlas->texels[texel];
+    const float *w = fl->scene->nodes[fl->scene->tri_node[t->tri]].world;
+    return lm_mat4_point(w, lm_v3_load(t->local));
+}
+
+#define SEE_PAIRS 16 /* texel pairs tried between two surfaces */
+
+/* Whether surface a sees surface b: one of SEE_PAIRS texel pairs, spread over both, joined by an
+ * unoccluded segment. False negatives are possible for surfaces that see each other through a gap
+ * narrower than the pairs' spacing; no false positives, beyond surfaces seen edge-on. */
+static int sees(const lm_frame_loop *fl, int a, int b, float lift)
+{
+    const lm_iim *iim = &fl->iim;
+    uint32_t na = iim->surf_first[a + 1] - iim->surf_first[a], nb = iim->surf_first[b + 1] - iim->surf_first[b];
+    if (!na || !nb)
+        return 0;
+    for (uint32_t k = 0; k < SEE_PAIRS; k++) {
+        uint32_t ta = iim->surf_texels[iim->surf_first[a] + (uint32_t)((uint64_t)k * na / SEE_PAIRS)];
+        uint32_t tb = iim->surf_texels[iim->surf_first[b] + (uint32_t)((uint64_t)((k * 7 + 3) % SEE_PAIRS) * nb / SEE_PAIRS)];
+        lm_vec3 p = texel_now(fl, ta), q = texel_now(fl, tb), d = lm_sub(q, p);
+        float len = lm_length(d);
+        if (!(len > 2.0f * lift))
+            continue;
+        d = lm_scale(d, 1.0f / len);
+        float org[3], dir[3];
+        lm_v3_store(org, lm_add(p, lm_scale(d, lift)));
+        lm_v3_store(dir, d);
+        if (!lm_rt_occluded(fl->rt, org, dir, 0.0f, len - 2.0f * lift))
+            return 1;
+    }
+    return 0;
+}
+
+/* A surface whose own photons did not change may still see one whose AIM was refreshed (the cube beside
+ * a recoloured wall that no changed photon reached): its hemicube would show the old light, so it is
+ * regathered too. Marks those surfaces' delta_i; returns how many. Called when the stage's work is done
+ * (not running on the worker), before the IIM schedule. */
+static int widen_to_viewers(lm_frame_loop *fl, lm_photon_store *ps)
+{
+    uint8_t *refreshed = fl->refreshed;
+    if (!lm_photon_stage_take_refreshed(fl->stage, refreshed))
+        return 0;
+    int S = fl->iim.surface_count, n = 0;
+    float lift = 1e-3f * lm_scene_size(fl->scene);
+    for (int a = 0; a < S; a++) {
+        if (ps->surfaces[a].delta_i > fl->iim.set.delta_threshold)
+            continue;
+        for (int b = 0; b < S; b++)
+            if (b != a && refreshed[b] && sees(fl, a, b, lift)) {
+                ps->surfaces[a].delta_i = fl->iim.set.delta_threshold + 1e-30;
+                n++;
+                break;
+            }
+    }
+    return n;
+}
 
 /* Uploads the current scene and, when they changed since the last upload, the AIMs: all the gather reads
  * of the photon stage, so that the stage may run again once this returns. */
@@ -111,7 +170,8 @@ static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
     size_t n = 3 * (size_t)fl->set.width * fl->set.height;
     fl->texels = malloc(sizeof(uint32_t) * (fl->atlas->texel_count ? fl->atlas->texel_count : 1));
     fl->image = malloc((n ? n : 1) * sizeof(float));
-    if (!fl->texels || !fl->image)
+    fl->refreshed = malloc((size_t)fl->atlas->surface_count + 1);
+    if (!fl->texels || !fl->image || !fl->refreshed)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", fl->scene->path);
     return LM_OK;
 }
@@ -244,6 +304,7 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     lm_photon_stage_free(fl->stage);
     free(fl->texels);
     free(fl->image);
+    free(fl->refreshed);
     free(fl);
 }
 
@@ -324,6 +385,7 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
         fl->aim_stale = 1;
     double t1 = lm_now();
     if (st == LM_OK) {
+        widen_to_viewers(fl, store_of(fl));
         o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
         st = gather(fl, o->texels_gathered, err);
     }
@@ -345,6 +407,7 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
     double t0 = lm_now();
     lm_status st = animate(fl, t, o, err);
     if (st == LM_OK) {
+        widen_to_viewers(fl, store_of(fl));
         o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
         if (o->texels_gathered > 0)
             st = gather_prepare(fl, err);
@@ -405,6 +468,7 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     o->stage.t_photons = done.t_photons;
     o->stage.t_aim = done.t_aim;
     if (st == LM_OK) {
+        widen_to_viewers(fl, store_of(fl));
         o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
         if (o->texels_gathered > 0)
             st = gather_prepare(fl, err);
@@ -449,63 +513,6 @@ static void bake_gather_progress(void *user, uint32_t done, uint32_t total)
 {
     const bake_watch *w = user;
     w->fn(w->user, 0.3 + 0.7 * (double)done / (total ? total : 1), "gather");
-}
-
-/* A texel's position now (its node may have moved since load). */
-static lm_vec3 texel_now(const lm_frame_loop *fl, uint32_t texel)
-{
-    const lm_texel *t = &fl->atlas->texels[texel];
-    const float *w = fl->scene->nodes[fl->scene->tri_node[t->tri]].world;
-    return lm_mat4_point(w, lm_v3_load(t->local));
-}
-
-#define SEE_PAIRS 16 /* texel pairs tried between two surfaces */
-
-/* Whether surface a sees surface b: one of SEE_PAIRS texel pairs, spread over both, joined by an
- * unoccluded segment. False negatives are possible for surfaces that see each other through a gap
- * narrower than the pairs' spacing; no false positives, beyond surfaces seen edge-on. */
-static int sees(const lm_frame_loop *fl, int a, int b, float lift)
-{
-    const lm_iim *iim = &fl->iim;
-    uint32_t na = iim->surf_first[a + 1] - iim->surf_first[a], nb = iim->surf_first[b + 1] - iim->surf_first[b];
-    if (!na || !nb)
-        return 0;
-    for (uint32_t k = 0; k < SEE_PAIRS; k++) {
-        uint32_t ta = iim->surf_texels[iim->surf_first[a] + (uint32_t)((uint64_t)k * na / SEE_PAIRS)];
-        uint32_t tb = iim->surf_texels[iim->surf_first[b] + (uint32_t)((uint64_t)((k * 7 + 3) % SEE_PAIRS) * nb / SEE_PAIRS)];
-        lm_vec3 p = texel_now(fl, ta), q = texel_now(fl, tb), d = lm_sub(q, p);
-        float len = lm_length(d);
-        if (!(len > 2.0f * lift))
-            continue;
-        d = lm_scale(d, 1.0f / len);
-        float org[3], dir[3];
-        lm_v3_store(org, lm_add(p, lm_scale(d, lift)));
-        lm_v3_store(dir, d);
-        if (!lm_rt_occluded(fl->rt, org, dir, 0.0f, len - 2.0f * lift))
-            return 1;
-    }
-    return 0;
-}
-
-/* A surface whose own photons did not change may still see one whose AIM the bake refreshed (the cube
- * beside a recoloured wall that no changed photon reached): its hemicube would show the old light, so it
- * is regathered too. Marks those surfaces' delta_i; returns how many. */
-static int widen_to_viewers(lm_frame_loop *fl, lm_photon_store *ps)
-{
-    const uint8_t *refreshed = lm_photon_stage_refreshed(fl->stage);
-    int S = fl->iim.surface_count, n = 0;
-    float lift = 1e-3f * lm_scene_size(fl->scene);
-    for (int a = 0; a < S; a++) {
-        if (ps->surfaces[a].delta_i > fl->iim.set.delta_threshold)
-            continue;
-        for (int b = 0; b < S; b++)
-            if (b != a && refreshed[b] && sees(fl, a, b, lift)) {
-                ps->surfaces[a].delta_i = fl->iim.set.delta_threshold + 1e-30;
-                n++;
-                break;
-            }
-    }
-    return n;
 }
 
 /* Schedules every texel of every surface whose light changed (the whole atlas as the budget), gathers

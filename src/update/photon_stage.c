@@ -31,7 +31,8 @@ struct lm_photon_stage {
     lm_emitters emitters;
     emitter_snapshot *snap;
     material_snapshot *mat_snap; /* per material, as its photons were last traced and AIMs refreshed */
-    uint8_t *refreshed;          /* per surface: its AIM refreshed by the last lm_photon_stage_converge */
+    uint8_t *refreshed;          /* per surface: its AIM refreshed since lm_photon_stage_take_refreshed */
+    uint8_t *had_delta;          /* scratch: per surface, delta_f > 0 before a refresh */
     lm_photons *photons;
     lm_aim aim;
     int have_emitters, have_aim;
@@ -116,7 +117,10 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     for (int e = 0; e < ps->emitters.count; e++)
         take_snapshot(ps, e, &ps->snap[e]);
     ps->mat_snap = malloc(sizeof *ps->mat_snap * (size_t)(ps->scene->material_count + 1));
-    if (!ps->mat_snap)
+    size_t S = (size_t)ps->surfaces->surface_count + 1;
+    ps->refreshed = calloc(S, 1);
+    ps->had_delta = calloc(S, 1);
+    if (!ps->mat_snap || !ps->refreshed || !ps->had_delta)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     for (int m = 0; m < ps->scene->material_count; m++)
         take_material(&ps->scene->materials[m], &ps->mat_snap[m]);
@@ -178,6 +182,7 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->snap);
     free(ps->mat_snap);
     free(ps->refreshed);
+    free(ps->had_delta);
     free(ps);
 }
 
@@ -201,14 +206,26 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
     return st;
 }
 
+/* lm_aim_refresh, noting which surfaces it refreshed (their delta_f went to 0). */
+static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out, lm_error *err)
+{
+    lm_photon_store *store = lm_photons_store_mutable(ps->photons);
+    int S = ps->surfaces->surface_count;
+    for (int k = 0; k < S; k++)
+        ps->had_delta[k] = store->surfaces[k].delta_f > 0.0;
+    lm_status st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, store, budget, out, err);
+    for (int k = 0; k < S; k++)
+        ps->refreshed[k] |= ps->had_delta[k] && !(store->surfaces[k].delta_f > 0.0);
+    return st;
+}
+
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
     double t1 = lm_now();
     lm_status st = lm_photons_frame(ps->photons, &out->photons, err);
     double t2 = lm_now();
     if (st == LM_OK)
-        st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
-                            ps->set.surfaces_per_frame, &out->aim, err);
+        st = refresh_aims(ps, ps->set.surfaces_per_frame, &out->aim, err);
     double t3 = lm_now();
     out->t_photons = t2 - t1;
     out->t_aim = t3 - t2;
@@ -231,15 +248,8 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage
     double t2 = lm_now();
     float threshold = ps->aim.set.delta_threshold; /* a bake refreshes every surface whose photons changed */
     ps->aim.set.delta_threshold = 0.0f;
-    int S = ps->surfaces->surface_count;
-    if (!ps->refreshed && !(ps->refreshed = malloc((size_t)(S ? S : 1))))
-        st = st == LM_OK ? lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", ps->scene->path) : st;
-    const lm_photon_store *store = lm_photons_store(ps->photons);
-    for (int k = 0; st == LM_OK && k < S; k++)
-        ps->refreshed[k] = store->surfaces[k].delta_f > 0.0;
     if (st == LM_OK)
-        st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons), -1,
-                            &out->aim, err);
+        st = refresh_aims(ps, -1, &out->aim, err);
     ps->aim.set.delta_threshold = threshold;
     out->t_photons = t2 - t1;
     out->t_aim = lm_now() - t2;
@@ -247,7 +257,15 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage
     return st;
 }
 
-const uint8_t *lm_photon_stage_refreshed(const lm_photon_stage *ps) { return ps->refreshed; }
+int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out)
+{
+    int n = 0;
+    for (int k = 0; k < ps->surfaces->surface_count; k++) {
+        n += out[k] = ps->refreshed[k];
+        ps->refreshed[k] = 0;
+    }
+    return n;
+}
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }

@@ -48,8 +48,10 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
 /* A full refresh at time t, for a bake: animate, then every photon re-traced (a path that did not change
  * changes nothing in the store) and the AIM of every surface whose photons changed refreshed. */
 lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
-/* After lm_photon_stage_converge: per surface, 1 if its AIM was refreshed (valid until the next call). */
-const uint8_t *lm_photon_stage_refreshed(const lm_photon_stage *ps);
+/* Per surface, 1 if its AIM was refreshed since the last call (by updates or a converge), into out
+ * (surface_count bytes); clears the record. Returns how many. Not while an update runs on another
+ * thread. */
+int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */
