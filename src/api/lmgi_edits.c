@@ -8,6 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "../core/vecmath.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
@@ -62,8 +63,8 @@ lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi
     if (!in_range(in->intensity, 0.0f, 1e15f) || !in_range(in->range, 0.0f, 1e15f))
         return refuse(err, "light '%s': intensity %g and range %g must be finite numbers >= 0", l->name,
                       (double)in->intensity, (double)in->range);
-    if (l->type == LM_LIGHT_SPOT && !(in_range(in->inner_cone, 0.0f, (float)M_PI_2) &&
-                                      in_range(in->outer_cone, 0.0f, (float)M_PI_2) && in->inner_cone < in->outer_cone))
+    if (l->type == LM_LIGHT_SPOT && !(in_range(in->inner_cone, 0.0f, (float)(LM_PI / 2)) &&
+                                      in_range(in->outer_cone, 0.0f, (float)(LM_PI / 2)) && in->inner_cone < in->outer_cone))
         return refuse(err, "light '%s': cones %g and %g must satisfy 0 <= inner < outer <= pi/2", l->name,
                       (double)in->inner_cone, (double)in->outer_cone);
     if (sc->updater) /* its photon work reads the lights */

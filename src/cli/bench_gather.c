@@ -176,7 +176,7 @@ static double ray_gather(const bench_scene *b, uint32_t texel)
                 L = aim_at(a, b->aim, w0 * uv[0] + h.u * uv[2] + h.v * uv[4], w0 * uv[1] + h.u * uv[3] + h.v * uv[5]);
             sum += L.y + s->materials[s->tri_material[h.tri]].emissive[1];
         }
-    return 3.14159265 * sum / (RAYS_SIDE * RAYS_SIDE);
+    return LM_PI * sum / (RAYS_SIDE * RAYS_SIDE);
 }
 
 /* ms per texel for the ray-cast gather of b's texels: one thread, and spread over the OpenMP threads. */

@@ -5,6 +5,11 @@
 
 #include <math.h>
 
+/* pi, once for every layer: double, and float for arithmetic that must stay in float. */
+#define LM_PI 3.14159265358979323846
+#define LM_PI_F 3.14159265358979323846f
+#define LM_PI_GLSL "3.14159265358979" /* the same in shader source */
+
 typedef struct { float x, y, z; } lm_vec3;
 
 static inline lm_vec3 lm_v3(float x, float y, float z) { lm_vec3 v = {x, y, z}; return v; }

@@ -61,7 +61,7 @@ void lm_view_cube_face(const float eye[3], int face, float znear, float zfar, lm
     memset(out, 0, sizeof *out);
     lm_vec3 e = lm_v3_load(eye);
     lm_mat4_look_at(out->view, e, lm_add(e, lm_v3_load(fwd[face])), lm_v3_load(up[face]));
-    lm_mat4_perspective(out->proj, 0.5f * 3.14159265358979f, 1.0f, znear, zfar);
+    lm_mat4_perspective(out->proj, 0.5f * LM_PI_F, 1.0f, znear, zfar);
     lm_v3_store(out->eye, e);
     snprintf(out->name, sizeof out->name, "cube face %d", face);
 }

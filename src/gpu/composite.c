@@ -3,6 +3,7 @@
  * persist. */
 #include "composite.h"
 
+#include "../core/vecmath.h"
 #include "gl_api.h"
 #include <math.h>
 #include <stdlib.h>
@@ -38,7 +39,7 @@ static const char *PREMULT_FS =
     "    ivec2 q = ivec2(gl_FragCoord.xy);\n"
     "    vec4 e = texelFetch(iim, q, 0);\n"
     "    float w = texelFetch(covered, q, 0).r * (e.a <= limit ? 1.0 : 0.0);\n"
-    "    frag = vec4(e.rgb * (w / 3.14159265358979), w);\n"
+    "    frag = vec4(e.rgb * (w / " LM_PI_GLSL "), w);\n"
     "}\n";
 /* 1 at every texel of the texel table (covered by some triangle), 0 in gutters and unused corners. */
 static void fill_covered(const lm_atlas *a, float *out)

@@ -1,5 +1,7 @@
 #include "direct_shader.h"
 
+#include "../core/vecmath.h"
+
 /* Attributes (world space): position, shading normal, base colour factor, (Phong exponent, double-sided,
  * metallic, material class), emitted radiance, base colour texture uv (KHR_texture_transform applied).
  * The per-material ones are flat (no interpolation: cheaper on llvmpipe). The geometric normal is the
@@ -106,7 +108,7 @@ const char *const lm_direct_fs_body =
     "uniform sampler2DShadow map2d;   /* metric / range, compared in the sampler (bilinear PCF) */\n"
     "uniform samplerCubeShadow mapcube;\n"
     "out vec4 frag;\n"
-    "const float PI = 3.14159265358979;\n"
+    "const float PI = " LM_PI_GLSL ";\n"
     "float cube_shadow(vec3 q, float m, float T) {\n"
     "    vec3 d = q - lpos, a = abs(d);\n"
     "    vec3 t = normalize(cross(d, a.x < a.y ? vec3(1, 0, 0) : vec3(0, 1, 0)));\n"

@@ -1,13 +1,13 @@
 /* Hemicube weights, F(a) and the IIM texture helpers (hemicube.h). */
 #include "hemicube.h"
 
+#include "../core/vecmath.h"
 #include "gl_api.h"
 #include <math.h>
 
 #include "gl_shader.h"
 #include "../trace/emitter_light.h"
 
-#define PI_D 3.14159265358979323846
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s)
 {
@@ -38,7 +38,7 @@ const char *lm_gather_scheme_name(lm_gather_scheme s)
 static double corner(double X, double Y)
 {
     double sx = sqrt(1.0 + X * X), sy = sqrt(1.0 + Y * Y);
-    return (X / sx * atan(Y / sx) + Y / sy * atan(X / sy)) / (2.0 * PI_D);
+    return (X / sx * atan(Y / sx) + Y / sy * atan(X / sy)) / (2.0 * LM_PI);
 }
 
 double lm_form_factor_rect(double x0, double x1, double y0, double y1, double d)
@@ -50,7 +50,7 @@ double lm_form_factor_rect(double x0, double x1, double y0, double y1, double d)
 double lm_hemicube_coverage(double a)
 {
     double b = a / sqrt(1.0 + a * a);
-    return 4.0 / PI_D * b * atan(b);
+    return 4.0 / LM_PI * b * atan(b);
 }
 
 double lm_hemicube_pixel_weight(int R, double a, int i, int j)
@@ -62,7 +62,7 @@ double lm_hemicube_pixel_weight(int R, double a, int i, int j)
 double lm_hemicube_pixel_weight_midpoint(int R, double a, int i, int j)
 {
     double h = 2.0 * a / R, x = -a + (i + 0.5) * h, y = -a + (j + 0.5) * h, q = x * x + y * y + 1.0;
-    return h * h / (PI_D * q * q);
+    return h * h / (LM_PI * q * q);
 }
 
 double lm_hemicube_weight_sum(int R, double a, int midpoint)

@@ -102,7 +102,6 @@ typedef struct {
 /* Compiles the programs and makes the tiled target. Needs a current GL 4.5 context. */
 lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_error *err);
 void lm_gather_free(lm_gather *g);
-const lm_hemicube_settings *lm_gather_settings(const lm_gather *g);
 /* Uploads every triangle in world space under the current node matrices, with lightmap UVs, emitted
  * radiance and face normals. Call again after nodes move. With proxy_error > 0 the triangles are those
  * of the gather proxy (proxy.h), built on the first call for (s, a) and kept for later calls. */

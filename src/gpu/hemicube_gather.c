@@ -202,7 +202,6 @@ void lm_gather_free(lm_gather *g)
     free(g);
 }
 
-const lm_hemicube_settings *lm_gather_settings(const lm_gather *g) { return &g->set; }
 
 /* One triangle's three vertices (VERTEX_FLOATS each) from world positions, lightmap UVs (NULL: no
  * AIM, drawn black: mirror, glass), its material and its chart (rectangle in UV, -1 when none). */
@@ -598,7 +597,7 @@ static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t
     glUniform1i(glGetUniformLocation(g->reduce_prog, "tiles_x"), g->set.tiles);
     /* with the rim traced the plane's sum is not extrapolated to the whole hemisphere */
     double scale = rim_ready(g) ? 1.0 : 1.0 / g->coverage;
-    glUniform1f(glGetUniformLocation(g->reduce_prog, "scale"), (float)(3.14159265358979323846 * scale));
+    glUniform1f(glGetUniformLocation(g->reduce_prog, "scale"), (float)(LM_PI * scale));
     glUniform1f(glGetUniformLocation(g->reduce_prog, "inv_f"), (float)(1.0 / g->coverage));
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(g->set.scheme == LM_GATHER_LAYERED ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D, g->color);

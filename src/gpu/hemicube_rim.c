@@ -7,7 +7,6 @@
 #include "../core/qmc.h"
 #include "../core/vecmath.h"
 
-#define RIM_PI 3.14159265358979323846
 
 /* Bilinear RGBA lookup at uv in [0, 1]^2 (texel (x, y) spans [x, x + 1] / width), clamped to the edge. */
 static void sample_atlas(const lm_atlas *a, const float *rgba, float u, float v, float out[3])
@@ -131,5 +130,5 @@ void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], co
             stratum(r, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum);
     int K = side * side;
     for (int c = 0; c < 3; c++)
-        out[c] = K ? (float)(RIM_PI * sum[c] / ((double)K * SUB * SUB)) : 0.0f;
+        out[c] = K ? (float)(LM_PI * sum[c] / ((double)K * SUB * SUB)) : 0.0f;
 }

@@ -27,7 +27,6 @@ struct lm_reflections {
     int count;
     int next;          /* the next face to refresh: reflector next / 6, face next % 6 */
     int primed;        /* every face rendered once */
-    long faces;
     GLuint prog;
 };
 
@@ -159,9 +158,7 @@ void lm_reflections_free(lm_reflections *r)
     free(r);
 }
 
-int lm_reflections_count(const lm_reflections *r) { return r ? r->count : 0; }
 
-long lm_reflections_faces_rendered(const lm_reflections *r) { return r ? r->faces : 0; }
 
 /* The centre of the reflector's triangles' world bounds, where its map is seen from. */
 static void centre(const lm_scene *s, const reflector *f, float c[3])
@@ -190,7 +187,6 @@ static lm_status render_face(lm_reflections *r, int k, int face, lm_direct *d, c
     glCopyImageSubData(lm_direct_probe_texture(d), GL_TEXTURE_2D, 0, 0, 0, 0, r->r[k].cube, GL_TEXTURE_CUBE_MAP, 0, 0,
                        0, face, r->size, r->size, 1);
     r->r[k].mips_stale = r->r[k].glossy;
-    r->faces++;
     return LM_OK;
 }
 
@@ -232,7 +228,7 @@ lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const
     lm_mat4_mul(vp, view->proj, view->view);
     glUniformMatrix4fv(glGetUniformLocation(r->prog, "view_proj"), 1, GL_FALSE, vp);
     glUniform3fv(glGetUniformLocation(r->prog, "eye"), 1, view->eye);
-    glUniform1f(glGetUniformLocation(r->prog, "lod_base"), (float)log2(r->size / (0.5 * 3.14159265358979)));
+    glUniform1f(glGetUniformLocation(r->prog, "lod_base"), (float)log2(r->size / (0.5 * LM_PI)));
     glUniform1i(glGetUniformLocation(r->prog, "base_tex"), 2);
     glUniform1i(glGetUniformLocation(r->prog, "env"), 4);
     for (int k = 0; k < r->count; k++) {

@@ -34,14 +34,11 @@ typedef struct lm_reflections lm_reflections;
 lm_status lm_reflections_create(const lm_scene *s, int size, int faces_per_frame, lm_reflections **out,
                                 lm_error *err);
 void lm_reflections_free(lm_reflections *r);
-int lm_reflections_count(const lm_reflections *r);
 /* Re-renders faces of the maps with d's direct pass (after lm_direct_set_indirect for this frame): every
  * face on the first call, then faces_per_frame of them, round robin. */
 lm_status lm_reflections_update(lm_reflections *r, lm_direct *d, const lm_scene *s, const lm_emitters *em,
                                 lm_error *err);
 /* Adds the reflections to the frame d just drew from view (lm_direct_draw; depth test against its depth). */
 lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const lm_view *view, lm_error *err);
-/* Faces rendered since creation (tests, statistics). */
-long lm_reflections_faces_rendered(const lm_reflections *r);
 
 #endif

@@ -134,7 +134,7 @@ static void cube_faces(lm_shadow_map *m, const lm_shadow_renderer *r, const lm_g
     static const float ups[6][3] = {{0, -1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}, {0, -1, 0}, {0, -1, 0}};
     float proj[16], view[16], vp[16];
     lm_vec3 p = lm_v3_load(m->p.pos);
-    lm_mat4_perspective(proj, (float)(M_PI / 2), 1.0f, m->p.znear, m->p.zfar);
+    lm_mat4_perspective(proj, (float)(LM_PI / 2), 1.0f, m->p.znear, m->p.zfar);
     for (int f = 0; f < 6; f++) {
         if (job->from_layer && job->lo) { /* skip a face that shows its layer and will again */
             int now = box_in_face(m->p.pos, job->lo, job->hi, f);

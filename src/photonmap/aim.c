@@ -9,8 +9,8 @@
 
 #include "../charts/atlas_dilate.h"
 #include "../core/timing.h"
+#include "../core/vecmath.h"
 
-#define PI_D 3.14159265358979323846
 #define MIN_COVERAGE 0.0625 /* the disc's part on the surface is never taken below 1/16 of it */
 
 void lm_aim_settings_default(lm_aim_settings *o)
@@ -468,7 +468,7 @@ static double disc_area_on_surface(edge_frame *ef, const boundary *bd, const flo
     project_edges(ef, bd, n);
     double qa = q[0] * ef->t1[0] + q[1] * ef->t1[1] + q[2] * ef->t1[2];
     double qb = q[0] * ef->t2[0] + q[1] * ef->t2[1] + q[2] * ef->t2[2];
-    double full = (kernel ? 0.5 : 1.0) * PI_D * r2, area = full, nearest = r2, r = sqrt(r2);
+    double full = (kernel ? 0.5 : 1.0) * LM_PI * r2, area = full, nearest = r2, r = sqrt(r2);
     for (uint32_t e = 0; e < bd->end - bd->first; e++) {
         const double *o = ef->uv + 4 * (size_t)e;
         double p[2][2] = {{o[0] - qa, o[1] - qb}, {o[2] - qa, o[3] - qb}};
@@ -599,7 +599,7 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, texel_scrat
         lm_kdtree_radius(j->tree, t->local, r2, add_flux, &f);
     else
         add_found(&f, idx, d2, k);
-    double area = (j->kernel ? 0.5 : 1.0) * PI_D * r2;
+    double area = (j->kernel ? 0.5 : 1.0) * LM_PI * r2;
     if (j->boundary_correction && !((double)r2 < *edge_d2)) {
         double nearest;
         area = disc_area_on_surface(&ts->ef, &j->bd, t->local, n, r2, j->kernel, &nearest);
@@ -608,7 +608,7 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, texel_scrat
     float rho[3];
     lm_texel_kd(j->s, t, rho);
     for (int c = 0; c < 3; c++)
-        out[c] = (float)(rho[c] / PI_D * f.sum[c] / (area * factor));
+        out[c] = (float)(rho[c] / LM_PI * f.sum[c] / (area * factor));
 }
 
 static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_t end)

@@ -23,7 +23,6 @@
 
 #include "../core/vecmath.h"
 
-#define LM_PI 3.14159265358979323846f
 
 static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
@@ -114,16 +113,16 @@ static void eval_oriented(const lm_shading *sh, lm_vec3 wi, lm_vec3 wo, lm_vec3 
         return;
     if (sh->material->cls != LM_MAT_GLOSSY) {
         for (int c = 0; c < 3; c++)
-            f[c] = sh->albedo[c] / LM_PI * cos_o;
-        *pdf = cos_o / LM_PI;
+            f[c] = sh->albedo[c] / LM_PI_F * cos_o;
+        *pdf = cos_o / LM_PI_F;
         return;
     }
     glossy_params g;
     glossy(sh, &g);
     float lobe = phong(reflect(wi, ns), wo, g.n);
     for (int c = 0; c < 3; c++)
-        f[c] = (g.kd[c] / LM_PI + g.ks[c] * (g.n + 2.0f) / (2.0f * LM_PI) * lobe) * cos_o;
-    *pdf = (1.0f - g.p_spec) * cos_o / LM_PI + g.p_spec * (g.n + 1.0f) / (2.0f * LM_PI) * lobe;
+        f[c] = (g.kd[c] / LM_PI_F + g.ks[c] * (g.n + 2.0f) / (2.0f * LM_PI_F) * lobe) * cos_o;
+    *pdf = (1.0f - g.p_spec) * cos_o / LM_PI_F + g.p_spec * (g.n + 1.0f) / (2.0f * LM_PI_F) * lobe;
 }
 
 static int sample_glass(const lm_shading *sh, lm_vec3 wi, const float u[3], lm_bsdf_sample_t *out)

@@ -2,12 +2,12 @@
 #include "emitter_light.h"
 
 #include "../core/qmc.h"
+#include "../core/vecmath.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define PI_D 3.14159265358979323846
 
 typedef struct {
     double x, y, z;

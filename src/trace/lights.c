@@ -25,7 +25,6 @@
 
 #include "../core/vecmath.h"
 
-#define LM_PI 3.14159265358979323846
 #define LM_SPOT_MIN_WIDTH 1e-3f   /* the extension's max(0.001, cos inner - cos outer) */
 #define LM_EMIT_LIFT 1e-5f        /* area photon origins are lifted by this x scene size */
 

@@ -253,12 +253,6 @@ lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err)
     return LM_OK;
 }
 
-void lm_photons_invalidate_all(lm_photons *ph)
-{
-    for (uint32_t g = 0; g < ph->group_count; g++)
-        mark_invalid(ph, g);
-}
-
 uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *materials)
 {
     uint32_t n = 0;

@@ -97,8 +97,6 @@ lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_erro
 /* Marks all groups of emitter e invalid (after it moved or changed: call lm_emitters_update first).
  * Groups already queued keep their place. Fails for an out-of-range emitter. */
 lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err);
-/* Marks every group invalid, in group order. */
-void lm_photons_invalidate_all(lm_photons *ph);
 /* Marks invalid every group with a stored path vertex on a triangle whose material is flagged in
  * `materials` (per scene material): what a material edit reaches. Returns how many groups. */
 uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *materials);

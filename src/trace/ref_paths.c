@@ -14,7 +14,6 @@
 #include "bsdf.h"
 #include "shading.h"
 
-#define LM_PI_F 3.14159265358979323846f
 #define LM_REF_EPS_REL 1e-5f /* ray offsets, relative to the scene size */
 
 /* ---- random numbers ---- */

@@ -7,6 +7,7 @@
 
 #include "../core/log.h"
 #include "../core/timing.h"
+#include "../core/vecmath.h"
 #include "ref_cache.h"
 #include "ref_paths.h"
 
@@ -182,7 +183,7 @@ static void finish(const job *j, lm_ref_result *r)
             r->full[3 * i + c] = (float)(st->sum[0][c] * inv);
             if (j->frames) {
                 r->iim[3 * i + c] = (float)(st->sum[1][c] * inv);
-                r->radiance[3 * i + c] = j->frames[i].albedo[c] / 3.14159265358979323846f * r->full[3 * i + c];
+                r->radiance[3 * i + c] = j->frames[i].albedo[c] / LM_PI_F * r->full[3 * i + c];
             }
         }
         r->samples[i] = st->n;

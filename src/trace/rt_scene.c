@@ -424,5 +424,4 @@ uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir
     return hits;
 }
 
-int lm_rt_instance_count(const lm_rt *rt) { return rt->instance_count; }
 uint32_t lm_rt_static_triangle_count(const lm_rt *rt) { return rt->static_count; }

@@ -56,7 +56,6 @@ uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir
 void lm_rt_thread_init(void);
 
 /* Counts, for reports. */
-int lm_rt_instance_count(const lm_rt *rt);
 uint32_t lm_rt_static_triangle_count(const lm_rt *rt);
 
 #endif

@@ -65,19 +65,28 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
 static lm_photon_store *store_of(lm_frame_loop *fl) { return lm_photon_stage_store(fl->stage); }
 
-/* A texel's position now (its node may have moved since load). */
-static lm_vec3 texel_now(const lm_frame_loop *fl, uint32_t texel)
+/* A texel's position now (its node may have moved since load) and its triangle's geometric normal now
+ * (the side its light leaves from). */
+static lm_vec3 texel_now(const lm_frame_loop *fl, uint32_t texel, lm_vec3 *normal)
 {
     const lm_texel *t = &fl->atlas->texels[texel];
     const float *w = fl->scene->nodes[fl->scene->tri_node[t->tri]].world;
+    lm_vec3 c[3];
+    for (int k = 0; k < 3; k++) {
+        float v[3];
+        lm_scene_vertex_world(fl->scene, fl->scene->tris[3 * (size_t)t->tri + (size_t)k], v);
+        c[k] = lm_v3_load(v);
+    }
+    *normal = lm_normalize(lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0])));
     return lm_mat4_point(w, lm_v3_load(t->local));
 }
 
 #define SEE_PAIRS 16 /* texel pairs tried between two surfaces */
 
-/* Whether surface a sees surface b: one of SEE_PAIRS texel pairs, spread over both, joined by an
- * unoccluded segment. False negatives are possible for surfaces that see each other through a gap
- * narrower than the pairs' spacing; no false positives, beyond surfaces seen edge-on. */
+/* Whether surface a sees surface b: one of SEE_PAIRS texel pairs, spread over both, that face each other
+ * and are joined by an unoccluded segment (each end lifted off its surface along its normal). False
+ * negatives are possible for surfaces that see each other through a gap narrower than the pairs'
+ * spacing. */
 static int sees(const lm_frame_loop *fl, int a, int b, float lift)
 {
     const lm_iim *iim = &fl->iim;
@@ -87,15 +96,21 @@ static int sees(const lm_frame_loop *fl, int a, int b, float lift)
     for (uint32_t k = 0; k < SEE_PAIRS; k++) {
         uint32_t ta = iim->surf_texels[iim->surf_first[a] + (uint32_t)((uint64_t)k * na / SEE_PAIRS)];
         uint32_t tb = iim->surf_texels[iim->surf_first[b] + (uint32_t)((uint64_t)((k * 7 + 3) % SEE_PAIRS) * nb / SEE_PAIRS)];
-        lm_vec3 p = texel_now(fl, ta), q = texel_now(fl, tb), d = lm_sub(q, p);
+        lm_vec3 na3, nb3;
+        lm_vec3 p = texel_now(fl, ta, &na3), q = texel_now(fl, tb, &nb3);
+        p = lm_add(p, lm_scale(na3, lift));
+        q = lm_add(q, lm_scale(nb3, lift));
+        lm_vec3 d = lm_sub(q, p);
         float len = lm_length(d);
-        if (!(len > 2.0f * lift))
+        if (!(len > lift))
             continue;
         d = lm_scale(d, 1.0f / len);
+        if (!(lm_dot(na3, d) > 0.01f && lm_dot(nb3, d) < -0.01f)) /* not facing each other */
+            continue;
         float org[3], dir[3];
-        lm_v3_store(org, lm_add(p, lm_scale(d, lift)));
+        lm_v3_store(org, p);
         lm_v3_store(dir, d);
-        if (!lm_rt_occluded(fl->rt, org, dir, 0.0f, len - 2.0f * lift))
+        if (!lm_rt_occluded(fl->rt, org, dir, 0.0f, len))
             return 1;
     }
     return 0;
@@ -605,7 +620,6 @@ void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels)
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl->stage; }
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }
-const char *lm_frame_loop_gl_description(const lm_frame_loop *fl) { return lm_gl_context_description(fl->gl); }
 
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err)
 {

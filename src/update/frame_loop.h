@@ -127,8 +127,6 @@ const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);
 /* The displayed IIM read back (atlas-sized RGBA floats, a = back-face fraction); caller frees. */
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err);
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl);
-/* The GL context's renderer and backend ("4.5 (Core Profile) Mesa ... (OSMesa; ...)"). */
-const char *lm_frame_loop_gl_description(const lm_frame_loop *fl);
 /* The view the frames are drawn from. */
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl);
 

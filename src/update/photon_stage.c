@@ -32,7 +32,7 @@ struct lm_photon_stage {
     emitter_snapshot *snap;
     material_snapshot *mat_snap; /* per material, as its photons were last traced and AIMs refreshed */
     uint8_t *refreshed;          /* per surface: its AIM refreshed since lm_photon_stage_take_refreshed */
-    uint8_t *had_delta;          /* scratch: per surface, delta_f > 0 before a refresh */
+    double *delta_before;        /* scratch: per surface, delta_f before a refresh */
     lm_photons *photons;
     lm_aim aim;
     int have_emitters, have_aim;
@@ -119,8 +119,8 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     ps->mat_snap = malloc(sizeof *ps->mat_snap * (size_t)(ps->scene->material_count + 1));
     size_t S = (size_t)ps->surfaces->surface_count + 1;
     ps->refreshed = calloc(S, 1);
-    ps->had_delta = calloc(S, 1);
-    if (!ps->mat_snap || !ps->refreshed || !ps->had_delta)
+    ps->delta_before = calloc(S, sizeof *ps->delta_before);
+    if (!ps->mat_snap || !ps->refreshed || !ps->delta_before)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     for (int m = 0; m < ps->scene->material_count; m++)
         take_material(&ps->scene->materials[m], &ps->mat_snap[m]);
@@ -182,7 +182,7 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->snap);
     free(ps->mat_snap);
     free(ps->refreshed);
-    free(ps->had_delta);
+    free(ps->delta_before);
     free(ps);
 }
 
@@ -206,16 +206,26 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
     return st;
 }
 
-/* lm_aim_refresh, noting which surfaces it refreshed (their delta_f went to 0). */
+/* A refreshed AIM whose change is at least this fraction of all the energy stored in hits counts for the
+ * surfaces that see it (lm_photon_stage_take_refreshed); smaller changes, such as the few photons that
+ * reach the edges of a closed door from the far room, are not worth regathering everything that sees
+ * them. */
+#define SEEN_CHANGE 1e-3
+
+/* lm_aim_refresh, noting which surfaces it refreshed (their delta_f went to 0) by a change worth seeing. */
 static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out, lm_error *err)
 {
     lm_photon_store *store = lm_photons_store_mutable(ps->photons);
     int S = ps->surfaces->surface_count;
-    for (int k = 0; k < S; k++)
-        ps->had_delta[k] = store->surfaces[k].delta_f > 0.0;
+    uint64_t hits = 0;
+    for (int k = 0; k < S; k++) {
+        ps->delta_before[k] = store->surfaces[k].delta_f;
+        hits += store->surfaces[k].count;
+    }
     lm_status st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, store, budget, out, err);
+    double seen = SEEN_CHANGE * ps->aim.mean_hit_energy * (double)hits;
     for (int k = 0; k < S; k++)
-        ps->refreshed[k] |= ps->had_delta[k] && !(store->surfaces[k].delta_f > 0.0);
+        ps->refreshed[k] |= ps->delta_before[k] > seen && !(store->surfaces[k].delta_f > 0.0);
     return st;
 }
 

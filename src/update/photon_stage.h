@@ -48,7 +48,8 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
 /* A full refresh at time t, for a bake: animate, then every photon re-traced (a path that did not change
  * changes nothing in the store) and the AIM of every surface whose photons changed refreshed. */
 lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
-/* Per surface, 1 if its AIM was refreshed since the last call (by updates or a converge), into out
+/* Per surface, 1 if its AIM was refreshed since the last call (by updates or a converge) for a change of
+ * at least a thousandth of the energy stored in hits, into out
  * (surface_count bytes); clears the record. Returns how many. Not while an update runs on another
  * thread. */
 int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
