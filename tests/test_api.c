@@ -17,6 +17,23 @@
 
 #define SIDE 40
 
+static lmgi_context *new_context(void)
+{
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return ctx;
+}
+
+/* Frees what a test made, in the order the API asks: the updater before its scene and context. */
+static void close_all(lmgi_updater *u, lmgi_scene *sc, lmgi_context *ctx)
+{
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 static lmgi_scene *load_cornell(void)
 {
     lmgi_options o;
@@ -182,8 +199,7 @@ static void test_two_contexts_one_thread(void **state)
 static void test_lightmaps_and_versions(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_cornell();
     lmgi_updater_desc d;
     small_desc(&d);
@@ -245,9 +261,7 @@ static void test_lightmaps_and_versions(void **state)
     assert_int_equal(after - before, (uint32_t)changed);
     free(iim);
     free(aim);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    close_all(u, sc, ctx);
 }
 
 /* An edit reaches the updater at its next update, relights what it touches, and playing time does not
@@ -255,8 +269,7 @@ static void test_lightmaps_and_versions(void **state)
 static void test_edit_reaches_updater(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_cornell();
     lmgi_updater_desc d;
     small_desc(&d);
@@ -287,9 +300,7 @@ static void test_edit_reaches_updater(void **state)
     lmgi_intersect(sc, org, down, INFINITY, &h);
     assert_true(h.hit);
     assert_int_equal(h.node, cube);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    close_all(u, sc, ctx);
 }
 
 /* Dimming a light in room A of the two rooms with the door closed relights room A and leaves room B's
@@ -297,8 +308,7 @@ static void test_edit_reaches_updater(void **state)
 static void test_light_edit_stays_in_its_room(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_context *ctx = new_context();
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = 3000;
@@ -406,9 +416,7 @@ static void test_light_edit_stays_in_its_room(void **state)
     assert_int_equal(lmgi_get_light(sc, a1, &back, &e), LMGI_OK);
     assert_true(!back.enabled); /* the refused edits changed nothing */
     free(iim0), free(aim0), free(iim1), free(aim1), free(ver0);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    close_all(u, sc, ctx);
 }
 
 typedef struct {
@@ -440,8 +448,7 @@ static void cancel_at(void *user, float fraction, const char *stage)
 static void test_bake(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_context *ctx = new_context();
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = 3000;
@@ -532,9 +539,7 @@ static void test_bake(void **state)
     expect_invalid(lmgi_bake(NULL, NULL, &r, &e), &e, "NULL");
     free(before);
     free(after);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    close_all(u, sc, ctx);
 }
 
 /* Recolouring the red wall blue, then a bake, gives the lightmap of a scene whose wall was blue from the
@@ -543,8 +548,7 @@ static void test_bake(void **state)
 static void test_recolour_material(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_context *ctx = new_context();
     lmgi_scene *edited = load_cornell(), *blue = load_cornell();
     int red = -1;
     for (int m = 0; m < lmgi_material_count(edited); m++)
@@ -631,8 +635,7 @@ static void test_recolour_material(void **state)
 static void test_budget_sets_texels(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_cornell();
     lmgi_updater_desc d;
     small_desc(&d);
@@ -644,9 +647,7 @@ static void test_budget_sets_texels(void **state)
     assert_int_equal(st.texels_budget, 1);
     update(u, 0.2f, 5000.0f, &st);
     assert_true(st.texels_budget > 200);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    close_all(u, sc, ctx);
 }
 
 
@@ -654,8 +655,7 @@ static void test_budget_sets_texels(void **state)
 static void test_bad_arguments(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, NULL), LMGI_OK);
+    lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_cornell();
     lmgi_updater *u = (lmgi_updater *)sc;
     lmgi_error e;
@@ -736,9 +736,7 @@ static void test_bad_arguments(void **state)
     lmgi_context_free(ctx); /* refused too while an updater is alive */
     update(u, 0.3f, 0.0f, &st);
     free(buf);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    close_all(u, sc, ctx);
 }
 
 /* lmgi_write_image: EXR and PNG written whole, every bad argument named. */

@@ -4,7 +4,6 @@
 #include <lmgi.h>
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -12,17 +11,6 @@
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
-static lmgi_status refuse(lmgi_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static lmgi_status refuse(lmgi_error *err, const char *fmt, ...)
-{
-    lm_error e;
-    e.status = LM_ERR_INVALID;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(e.msg, sizeof e.msg, fmt, ap);
-    va_end(ap);
-    return lm_export_error(err, &e);
-}
 
 int lmgi_light_count(const lmgi_scene *sc) { return sc ? sc->scene->light_count : 0; }
 
@@ -31,9 +19,9 @@ lmgi_status lmgi_get_light(const lmgi_scene *sc, int light, lmgi_light *out, lmg
     if (out)
         memset(out, 0, sizeof *out);
     if (!sc || !out)
-        return refuse(err, "lmgi_get_light: %s is NULL", sc ? "out" : "the scene");
+        return lm_api_refuse(err, "lmgi_get_light: %s is NULL", sc ? "out" : "the scene");
     if (light < 0 || light >= sc->scene->light_count)
-        return refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
+        return lm_api_refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
     const lm_light *l = &sc->scene->lights[light];
     out->type = (lmgi_light_type)l->type;
     out->node = l->node;
@@ -51,21 +39,21 @@ static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; } 
 lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi_error *err)
 {
     if (!sc || !in)
-        return refuse(err, "lmgi_set_light: %s is NULL", sc ? "the light" : "the scene");
+        return lm_api_refuse(err, "lmgi_set_light: %s is NULL", sc ? "the light" : "the scene");
     if (light < 0 || light >= sc->scene->light_count)
-        return refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
+        return lm_api_refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
     lm_light *l = &sc->scene->lights[light];
     if ((int)in->type != (int)l->type || in->node != l->node)
-        return refuse(err, "light '%s': its type and node are fixed at load", l->name);
+        return lm_api_refuse(err, "light '%s': its type and node are fixed at load", l->name);
     for (int c = 0; c < 3; c++)
         if (!in_range(in->color[c], 0.0f, 1000.0f))
-            return refuse(err, "light '%s': colour %g must be in [0, 1000]", l->name, (double)in->color[c]);
+            return lm_api_refuse(err, "light '%s': colour %g must be in [0, 1000]", l->name, (double)in->color[c]);
     if (!in_range(in->intensity, 0.0f, 1e15f) || !in_range(in->range, 0.0f, 1e15f))
-        return refuse(err, "light '%s': intensity %g and range %g must be finite numbers >= 0", l->name,
+        return lm_api_refuse(err, "light '%s': intensity %g and range %g must be finite numbers >= 0", l->name,
                       (double)in->intensity, (double)in->range);
     if (l->type == LM_LIGHT_SPOT && !(in_range(in->inner_cone, 0.0f, (float)(LM_PI / 2)) &&
                                       in_range(in->outer_cone, 0.0f, (float)(LM_PI / 2)) && in->inner_cone < in->outer_cone))
-        return refuse(err, "light '%s': cones %g and %g must satisfy 0 <= inner < outer <= pi/2", l->name,
+        return lm_api_refuse(err, "light '%s': cones %g and %g must satisfy 0 <= inner < outer <= pi/2", l->name,
                       (double)in->inner_cone, (double)in->outer_cone);
     if (sc->updater) /* its photon work reads the lights */
         lm_updater_sync(sc->updater);
@@ -90,9 +78,9 @@ lmgi_status lmgi_get_material(const lmgi_scene *sc, int material, lmgi_material 
     if (out)
         memset(out, 0, sizeof *out);
     if (!sc || !out)
-        return refuse(err, "lmgi_get_material: %s is NULL", sc ? "out" : "the scene");
+        return lm_api_refuse(err, "lmgi_get_material: %s is NULL", sc ? "out" : "the scene");
     if (material < 0 || material >= sc->scene->material_count)
-        return refuse(err, "material id %d is out of range (scene has %d materials)", material,
+        return lm_api_refuse(err, "material id %d is out of range (scene has %d materials)", material,
                       sc->scene->material_count);
     const lm_material *m = &sc->scene->materials[material];
     out->cls = (lmgi_material_class)m->cls;
@@ -106,22 +94,22 @@ lmgi_status lmgi_get_material(const lmgi_scene *sc, int material, lmgi_material 
 lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material *in, lmgi_error *err)
 {
     if (!sc || !in)
-        return refuse(err, "lmgi_set_material: %s is NULL", sc ? "the material" : "the scene");
+        return lm_api_refuse(err, "lmgi_set_material: %s is NULL", sc ? "the material" : "the scene");
     if (material < 0 || material >= sc->scene->material_count)
-        return refuse(err, "material id %d is out of range (scene has %d materials)", material,
+        return lm_api_refuse(err, "material id %d is out of range (scene has %d materials)", material,
                       sc->scene->material_count);
     lm_material *m = &sc->scene->materials[material];
     if ((int)in->cls != (int)m->cls)
-        return refuse(err, "material '%s': its class is fixed at load", m->name);
+        return lm_api_refuse(err, "material '%s': its class is fixed at load", m->name);
     for (int c = 0; c < 4; c++)
         if (!in_range(in->base_color[c], 0.0f, 1.0f))
-            return refuse(err, "material '%s': base colour %g must be in [0, 1]", m->name, (double)in->base_color[c]);
+            return lm_api_refuse(err, "material '%s': base colour %g must be in [0, 1]", m->name, (double)in->base_color[c]);
     for (int c = 0; c < 3; c++) {
         if (!in_range(in->emissive[c], 0.0f, 1e20f))
-            return refuse(err, "material '%s': emission %g must be a finite number >= 0", m->name,
+            return lm_api_refuse(err, "material '%s': emission %g must be a finite number >= 0", m->name,
                           (double)in->emissive[c]);
         if (in->emissive[c] > 0.0f && m->cls != LM_MAT_EMITTER)
-            return refuse(err, "material '%s' was not emissive at load: its triangles are not emitters, so it "
+            return lm_api_refuse(err, "material '%s' was not emissive at load: its triangles are not emitters, so it "
                           "cannot start to emit", m->name);
     }
     if (sc->updater) /* its photon work reads the materials */

@@ -2,6 +2,8 @@
  * ray-tracing BVHs, plus the effects it calls for. */
 #include <lmgi.h>
 
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -39,6 +41,17 @@ lmgi_status lm_export_error(lmgi_error *out, const lm_error *in)
         memcpy(out->message, in->msg, sizeof out->message);
     }
     return (lmgi_status)in->status;
+}
+
+lmgi_status lm_api_refuse(lmgi_error *err, const char *fmt, ...)
+{
+    lm_error e;
+    e.status = LM_ERR_INVALID;
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(e.msg, sizeof e.msg, fmt, ap);
+    va_end(ap);
+    return lm_export_error(err, &e);
 }
 
 static lm_status check_options(const char *path, const lmgi_options *o, lm_error *err)

@@ -22,5 +22,7 @@ struct lmgi_scene {
 
 /* Copies an internal error into the public one and returns its status. */
 lmgi_status lm_export_error(lmgi_error *out, const lm_error *in);
+/* Fills err with LMGI_ERR_INVALID and the formatted message, and returns LMGI_ERR_INVALID. */
+lmgi_status lm_api_refuse(lmgi_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 
 #endif

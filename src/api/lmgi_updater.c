@@ -3,7 +3,6 @@
 #include <lmgi.h>
 
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,17 +30,6 @@ struct lmgi_updater {
     double t_setup_gather;
 };
 
-static lmgi_status invalid(lmgi_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
-static lmgi_status invalid(lmgi_error *err, const char *fmt, ...)
-{
-    lm_error e;
-    e.status = LM_ERR_INVALID;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(e.msg, sizeof e.msg, fmt, ap);
-    va_end(ap);
-    return lm_export_error(err, &e);
-}
 
 /* A desc field: 0 keeps the default, a value in [lo, hi] replaces it, anything else is refused. */
 static int take(int v, int lo, int hi, int *dst)
@@ -156,14 +144,14 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
                                 lmgi_error *err)
 {
     if (!out)
-        return invalid(err, "lmgi_updater_create: out is NULL");
+        return lm_api_refuse(err, "lmgi_updater_create: out is NULL");
     *out = NULL;
     if (!ctx || !sc)
-        return invalid(err, "lmgi_updater_create: %s is NULL", ctx ? "scene" : "context");
+        return lm_api_refuse(err, "lmgi_updater_create: %s is NULL", ctx ? "scene" : "context");
     if (sc->scene->tri_count == 0)
-        return invalid(err, "%s: the scene has no triangles to light", sc->scene->path);
+        return lm_api_refuse(err, "%s: the scene has no triangles to light", sc->scene->path);
     if (sc->updater)
-        return invalid(err, "%s: the scene already has an updater (it moves the scene's nodes: one at a time)",
+        return lm_api_refuse(err, "%s: the scene already has an updater (it moves the scene's nodes: one at a time)",
                        sc->scene->path);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
@@ -350,9 +338,9 @@ lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_rep
     if (report)
         memset(report, 0, sizeof *report);
     if (!u)
-        return invalid(err, "lmgi_bake: updater is NULL");
+        return lm_api_refuse(err, "lmgi_bake: updater is NULL");
     if (!isfinite(d.time))
-        return invalid(err, "lmgi_bake: time %g is not a finite number", (double)d.time);
+        return lm_api_refuse(err, "lmgi_bake: time %g is not a finite number", (double)d.time);
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_bake_stats bs;
     lm_error e;
@@ -379,11 +367,11 @@ lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_rep
 lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)
 {
     if (!u)
-        return invalid(err, "lmgi_update: updater is NULL");
+        return lm_api_refuse(err, "lmgi_update: updater is NULL");
     if (!isfinite(time))
-        return invalid(err, "lmgi_update: time %g is not a finite number", (double)time);
+        return lm_api_refuse(err, "lmgi_update: time %g is not a finite number", (double)time);
     if (!(budget_ms >= 0.0f) || !isfinite(budget_ms))
-        return invalid(err, "lmgi_update: budget %g ms must be a finite number >= 0 (0: texels_per_frame)",
+        return lm_api_refuse(err, "lmgi_update: budget %g ms must be a finite number >= 0 (0: texels_per_frame)",
                        (double)budget_ms);
     int budget = budget_ms > 0.0f ? texels_for_budget(u, budget_ms)
                                    : lm_frame_loop_get_settings(u->loop)->iim.texels_per_frame;
@@ -425,11 +413,11 @@ lmgi_status lmgi_scene_camera(const lmgi_scene *sc, int index, int width, int he
                               lmgi_error *err)
 {
     if (!sc || !cam)
-        return invalid(err, "lmgi_scene_camera: %s is NULL", sc ? "cam" : "scene");
+        return lm_api_refuse(err, "lmgi_scene_camera: %s is NULL", sc ? "cam" : "scene");
     if (index < -1 || index >= sc->scene->camera_count)
-        return invalid(err, "lmgi_scene_camera: camera %d: the scene has %d", index, sc->scene->camera_count);
+        return lm_api_refuse(err, "lmgi_scene_camera: camera %d: the scene has %d", index, sc->scene->camera_count);
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        return invalid(err, "lmgi_scene_camera: picture %d x %d must have sides in 1..16384", width, height);
+        return lm_api_refuse(err, "lmgi_scene_camera: picture %d x %d must have sides in 1..16384", width, height);
     lm_view v;
     lm_view_for_scene(sc->scene, index, width, height, &v);
     float to_file[16]; /* lmgi's world to the file's: the view matrix takes file positions */
@@ -444,12 +432,12 @@ lmgi_status lmgi_scene_camera(const lmgi_scene *sc, int index, int width, int he
 lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb, lmgi_error *err)
 {
     if (!u || !cam || !rgb)
-        return invalid(err, "lmgi_render: %s is NULL", !u ? "updater" : !cam ? "cam" : "rgb");
+        return lm_api_refuse(err, "lmgi_render: %s is NULL", !u ? "updater" : !cam ? "cam" : "rgb");
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        return invalid(err, "lmgi_render: picture %d x %d must have sides in 1..16384", width, height);
+        return lm_api_refuse(err, "lmgi_render: picture %d x %d must have sides in 1..16384", width, height);
     for (int i = 0; i < 16; i++)
         if (!isfinite(cam->view[i]) || !isfinite(cam->proj[i]))
-            return invalid(err, "lmgi_render: camera matrix entry %d is not a finite number", i);
+            return lm_api_refuse(err, "lmgi_render: camera matrix entry %d is not a finite number", i);
     float from_file[16], view[16]; /* the camera takes file positions; lmgi's are origin-relative */
     lm_mat4_identity(from_file);
     for (int k = 0; k < 3; k++)
@@ -457,7 +445,7 @@ lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int 
     lm_mat4_mul(view, cam->view, from_file);
     lm_view v;
     if (!lm_view_from_matrices(view, cam->proj, &v))
-        return invalid(err, "lmgi_render: the view matrix is not invertible");
+        return lm_api_refuse(err, "lmgi_render: the view matrix is not invertible");
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
     lm_status st = lm_frame_loop_render(u->loop, &v, width, height, rgb, &e);
@@ -510,14 +498,14 @@ static lm_status read_aim(const lmgi_updater *u, float *rgba, lm_error *err)
 lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
 {
     if (!u || !rgba)
-        return invalid(err, "lmgi_get_lightmap: %s is NULL", u ? "rgba" : "updater");
+        return lm_api_refuse(err, "lmgi_get_lightmap: %s is NULL", u ? "rgba" : "updater");
     const lm_atlas *at = &u->sc->atlas;
     size_t need = 4 * (size_t)at->width * at->height;
     if (floats < need)
-        return invalid(err, "lmgi_get_lightmap: the buffer holds %zu floats; the %d x %d atlas needs %zu", floats,
+        return lm_api_refuse(err, "lmgi_get_lightmap: the buffer holds %zu floats; the %d x %d atlas needs %zu", floats,
                        at->width, at->height, need);
     if (kind != LMGI_LIGHTMAP_IIM && kind != LMGI_LIGHTMAP_AIM)
-        return invalid(err, "lmgi_get_lightmap: %d is not a lightmap kind", (int)kind);
+        return lm_api_refuse(err, "lmgi_get_lightmap: %d is not a lightmap kind", (int)kind);
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
     lm_status st = kind == LMGI_LIGHTMAP_IIM ? read_iim(u, rgba, &e) : read_aim(u, rgba, &e);

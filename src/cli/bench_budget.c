@@ -7,21 +7,11 @@
 #include <string.h>
 #include <time.h>
 
+#include "../core/stats.h"
+#include "progress.h"
+
 #define UPDATES 160
 #define SETTLE 10
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
 
 /* One budget: UPDATES paced updates, the cube sliding; ms[] gets each update's time after SETTLE. */
 static int play(lmgi_context *ctx, lmgi_scene *sc, float budget, double *ms, double *texels)
@@ -39,7 +29,7 @@ static int play(lmgi_context *ctx, lmgi_scene *sc, float budget, double *ms, dou
     *texels = 0.0;
     int rc = 0;
     for (int f = 0; f < UPDATES && rc == 0; f++) {
-        double t0 = now_ms();
+        double t0 = 1e3 * lm_cli_now();
         memcpy(m, start, sizeof m);
         m[12] += 0.3f * sinf(0.1f * (float)f);
         lmgi_update_stats st;
@@ -49,7 +39,7 @@ static int play(lmgi_context *ctx, lmgi_scene *sc, float budget, double *ms, dou
             ms[f - SETTLE] = st.ms_total;
             *texels += st.texels_gathered;
         }
-        struct timespec rest = {0, (long)(1e6 * fmax(0.0, 1e3 / 60.0 - (now_ms() - t0)))};
+        struct timespec rest = {0, (long)(1e6 * fmax(0.0, 1e3 / 60.0 - (1e3 * lm_cli_now() - t0)))};
         nanosleep(&rest, NULL);
     }
     lmgi_set_node_transform(sc, cube, start, NULL);
@@ -79,8 +69,7 @@ void lm_cli_bench_budget(void)
     for (size_t b = 0; b < sizeof budgets / sizeof *budgets; b++) {
         if (play(ctx, sc, budgets[b], ms, &texels) != 0)
             break;
-        qsort(ms, (size_t)n, sizeof *ms, cmp_double);
-        double p95 = ms[(int)(0.95 * (n - 1))];
+        double p95 = lm_quantile(ms, n, 0.95); /* sorts ms */
         printf("%8.1fms %8.2fms %8.2fms %8.2fms %10.2f %12.1f\n", (double)budgets[b], ms[n / 2], p95, ms[n - 1],
                p95 / budgets[b], texels / n);
         fflush(stdout);

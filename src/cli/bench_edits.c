@@ -10,7 +10,9 @@
 #include <string.h>
 #include <time.h>
 
+#include "../core/stats.h"
 #include "json.h"
+#include "progress.h"
 
 #define MAX_EDITS 256
 
@@ -164,19 +166,6 @@ static double distance(const float *a, const float *b, size_t texels)
     return sum > 0.0 ? d / sum : 0.0;
 }
 
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return 1e3 * (double)ts.tv_sec + 1e-6 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 typedef struct {
     lmgi_context *ctx;
     lmgi_scene *sc, *twin;
@@ -237,7 +226,7 @@ static int play(const lm_cli_args *a, const script *s, bench *b, frame_row *rows
     if (!converge(b))
         return 0;
     for (int f = 0; f < s->frames; f++) {
-        double start = now_ms();
+        double start = 1e3 * lm_cli_now();
         int edited = 0;
         for (; next < s->edit_count && s->edits[next].frame == f; next++, edited = 1)
             if (!apply(path, next, s->edits[next].v, b->sc) || !apply(path, next, s->edits[next].v, b->twin))
@@ -250,7 +239,7 @@ static int play(const lm_cli_args *a, const script *s, bench *b, frame_row *rows
         }
         rows[f] = (frame_row){st.ms_total, st.ms_photons, st.ms_gather, st.ms_blend, st.texels_gathered,
                               st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0};
-        double spent = now_ms() - start;
+        double spent = 1e3 * lm_cli_now() - start;
         if (s->fps > 0 && spent < 1e3 / s->fps) { /* the game's own frame, with the photon work beside it */
             double left = 1e3 / s->fps - spent;
             struct timespec ts = {(time_t)(left / 1e3), (long)(fmod(left, 1e3) * 1e6)};
@@ -324,9 +313,9 @@ static void report(const lm_cli_args *a, const script *s, const frame_row *rows)
         texels += rows[f].texels;
     }
     if (ms) {
-        qsort(ms, (size_t)s->frames, sizeof *ms, cmp_double);
+        double p95 = lm_quantile(ms, s->frames, 0.95); /* sorts ms */
         printf("updates: median %.2f ms, 95th percentile %.2f ms, worst %.2f ms; %d of %d over the budget by more "
-               "than 10%%; %.1f texels an update\n", ms[s->frames / 2], ms[(int)(0.95 * (s->frames - 1))],
+               "than 10%%; %.1f texels an update\n", ms[s->frames / 2], p95,
                ms[s->frames - 1], over, s->frames, texels / s->frames);
     }
     if (json) {

@@ -8,6 +8,12 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+double lm_quantile(double *v, int n, double q)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return v[(int)(q * (n - 1))];
+}
+
 double lm_median(double *v, int n)
 {
     qsort(v, (size_t)n, sizeof *v, cmp_double);

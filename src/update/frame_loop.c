@@ -371,6 +371,14 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
     return st == LM_OK ? render_view(fl, view, width, height, rgb, refresh, &o, err) : st;
 }
 
+/* This frame's texels (after adding the viewers of refreshed AIMs), and the uploads the gather needs. */
+static lm_status schedule(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
+{
+    widen_to_viewers(fl, store_of(fl));
+    o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
+    return o->texels_gathered > 0 ? gather_prepare(fl, err) : LM_OK;
+}
+
 /* Blend (timed into o), then render. */
 static lm_status blend_and_render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
@@ -399,11 +407,10 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     if (o->stage.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
     double t1 = lm_now();
-    if (st == LM_OK) {
-        widen_to_viewers(fl, store_of(fl));
-        o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
-        st = gather(fl, o->texels_gathered, err);
-    }
+    if (st == LM_OK)
+        st = schedule(fl, o, err);
+    if (st == LM_OK)
+        st = gather_run(fl, o->texels_gathered, err);
     o->t_photons = t1 - t0;
     o->t_gather = lm_now() - t1;
     return st == LM_OK ? blend_and_render(fl, o, err) : st;
@@ -421,12 +428,8 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
 {
     double t0 = lm_now();
     lm_status st = animate(fl, t, o, err);
-    if (st == LM_OK) {
-        widen_to_viewers(fl, store_of(fl));
-        o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
-        if (o->texels_gathered > 0)
-            st = gather_prepare(fl, err);
-    }
+    if (st == LM_OK)
+        st = schedule(fl, o, err);
     double t1 = lm_now();
     if (st != LM_OK)
         return st;
@@ -482,12 +485,8 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     o->stage.aim = done.aim;
     o->stage.t_photons = done.t_photons;
     o->stage.t_aim = done.t_aim;
-    if (st == LM_OK) {
-        widen_to_viewers(fl, store_of(fl));
-        o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
-        if (o->texels_gathered > 0)
-            st = gather_prepare(fl, err);
-    }
+    if (st == LM_OK)
+        st = schedule(fl, o, err);
     double t1 = lm_now();
     o->t_photons = t1 - t0;
     if (st == LM_OK)
