@@ -908,12 +908,12 @@ static int texel_surface(const tscene *t, uint32_t texel) { return t->a.texels[t
 static uint32_t schedule_frame(lm_iim *iim, lm_photon_store *ps, const tscene *t, int counts[3])
 {
     uint32_t out[64];
-    uint32_t n = lm_iim_schedule(iim, ps, out);
-    assert_true(n <= (uint32_t)iim->set.texels_per_frame);
+    uint32_t n = lm_iim_sched_pick(&iim->sched, ps, out);
+    assert_true(n <= (uint32_t)iim->sched.texels_per_frame);
     counts[0] = counts[1] = counts[2] = 0;
     for (uint32_t i = 0; i < n; i++)
         counts[texel_surface(t, out[i])]++;
-    iim->frame++; /* lm_iim_blend advances it on the GPU path */
+    lm_iim_sched_end_frame(&iim->sched); /* lm_iim_blend advances it on the GPU path */
     return n;
 }
 
@@ -930,7 +930,7 @@ static void test_schedule_order_and_budget(void **state)
     lm_error err;
     assert_int_equal(lm_iim_init(&iim, &t.a, &set, 0, &err), LM_OK);
     for (int s = 0; s < 3; s++)
-        sizes[s] = iim.surf_first[s + 1] - iim.surf_first[s];
+        sizes[s] = iim.sched.surf_first[s + 1] - iim.sched.surf_first[s];
     lm_photon_store ps;
     assert_int_equal(lm_photon_store_init(&ps, 3, &err), LM_OK);
     int c[3];
@@ -1007,12 +1007,12 @@ static void test_blend_stays_between(void **state)
     uint32_t *all = malloc(sizeof(uint32_t) * t.a.texel_count);
     assert_true(old && nw && d && all);
     set_fresh(&iim, 1.0f); /* first full gather: shown at once */
-    lm_iim_schedule_all(&iim, &ps, all);
+    lm_iim_sched_pick_all(&iim.sched, &ps, all);
     assert_int_equal(lm_iim_blend(&iim, 1, &err), LM_OK);
     assert_int_equal(lm_iim_texture_read(iim.display_tex, t.a.width, t.a.height, old, &err), LM_OK);
     set_fresh(&iim, 3.0f);
     assert_int_equal(lm_iim_texture_read(iim.fresh_tex, t.a.width, t.a.height, nw, &err), LM_OK);
-    lm_iim_schedule_all(&iim, &ps, all);
+    lm_iim_sched_pick_all(&iim.sched, &ps, all);
     float prev = -1.0f;
     const lm_texel *t0 = &t.a.texels[0];
     size_t k0 = 4 * ((size_t)t0->y * (size_t)t.a.width + (size_t)t0->x);
@@ -1021,7 +1021,7 @@ static void test_blend_stays_between(void **state)
             memcpy(old, d, sizeof(float) * n);
             set_fresh(&iim, 0.5f);
             assert_int_equal(lm_iim_texture_read(iim.fresh_tex, t.a.width, t.a.height, nw, &err), LM_OK);
-            lm_iim_schedule_all(&iim, &ps, all);
+            lm_iim_sched_pick_all(&iim.sched, &ps, all);
             prev = 1e9f;
         }
         assert_int_equal(lm_iim_blend(&iim, 0, &err), LM_OK);

@@ -44,26 +44,6 @@ void lm_iim_settings_default(lm_iim_settings *s)
     s->delta_threshold = 0.0;
 }
 
-static lm_status group_texels(lm_iim *iim, const lm_atlas *a, lm_error *err)
-{
-    int S = iim->surface_count;
-    iim->surf_first = calloc((size_t)S + 1, sizeof *iim->surf_first);
-    iim->surf_texels = malloc(sizeof *iim->surf_texels * (a->texel_count ? a->texel_count : 1));
-    if (!iim->surf_first || !iim->surf_texels)
-        return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for texel lists");
-    for (uint32_t i = 0; i < a->texel_count; i++)
-        iim->surf_first[a->texels[i].surface + 1]++;
-    for (int s = 0; s < S; s++)
-        iim->surf_first[s + 1] += iim->surf_first[s];
-    uint32_t *fill = iim->cursor; /* borrowed as a write position, zeroed after */
-    for (uint32_t i = 0; i < a->texel_count; i++) {
-        int s = a->texels[i].surface;
-        iim->surf_texels[iim->surf_first[s] + fill[s]++] = i;
-    }
-    memset(iim->cursor, 0, sizeof *iim->cursor * (size_t)(S ? S : 1));
-    return LM_OK;
-}
-
 static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
 {
     unsigned *tex[4] = {&iim->fresh_tex, &iim->old_tex, &iim->new_tex, &iim->display_tex};
@@ -85,7 +65,7 @@ static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * n), surf, GL_STATIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * 2 * (size_t)(iim->surface_count + 1)), NULL,
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * 2 * (size_t)(iim->sched.surface_count + 1)), NULL,
                  GL_DYNAMIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     free(surf);
@@ -97,20 +77,14 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
     memset(iim, 0, sizeof *iim);
     iim->set = *set;
     iim->width = a->width, iim->height = a->height;
-    iim->surface_count = a->surface_count;
     size_t S = (size_t)(a->surface_count ? a->surface_count : 1);
-    iim->cursor = calloc(S, sizeof *iim->cursor);
-    iim->last_done = malloc(S * sizeof *iim->last_done);
     iim->blend_start = malloc(S * sizeof *iim->blend_start);
-    iim->commit = calloc(S, 1);
     iim->version = calloc(S, sizeof *iim->version);
-    if (!iim->cursor || !iim->last_done || !iim->blend_start || !iim->commit || !iim->version) {
-        lm_iim_free(iim);
-        return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
-    }
-    for (size_t s = 0; s < S; s++)
-        iim->last_done[s] = -1, iim->blend_start[s] = NEVER;
-    lm_status st = group_texels(iim, a, err);
+    lm_status st = iim->blend_start && iim->version
+                       ? lm_iim_sched_init(&iim->sched, a, set->texels_per_frame, set->delta_threshold, err)
+                       : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
+    for (size_t k = 0; st == LM_OK && k < S; k++)
+        iim->blend_start[k] = NEVER;
     if (st == LM_OK && with_gl)
         st = init_gl(iim, a, err);
     if (st != LM_OK)
@@ -128,109 +102,43 @@ void lm_iim_free(lm_iim *iim)
         glDeleteBuffers(2, bufs);
         glDeleteProgram(iim->blend_prog);
     }
-    free(iim->surf_first);
-    free(iim->surf_texels);
-    free(iim->cursor);
-    free(iim->last_done);
+    lm_iim_sched_free(&iim->sched);
     free(iim->blend_start);
-    free(iim->commit);
     free(iim->version);
     memset(iim, 0, sizeof *iim);
-}
-
-/* Order: larger delta_i first, then older (never refreshed counts as oldest), then lower id. */
-static int before(const lm_iim *iim, const lm_photon_store *ps, int s, int t)
-{
-    double ds = ps->surfaces[s].delta_i, dt = ps->surfaces[t].delta_i;
-    if (ds != dt)
-        return ds > dt;
-    long as = iim->last_done[s] < 0 ? LONG_MAX : (long)iim->frame - iim->last_done[s];
-    long at = iim->last_done[t] < 0 ? LONG_MAX : (long)iim->frame - iim->last_done[t];
-    if (as != at)
-        return as > at;
-    return s < t;
-}
-
-static void complete_surface(lm_iim *iim, lm_photon_store *ps, int s)
-{
-    iim->cursor[s] = 0;
-    iim->last_done[s] = iim->frame;
-    iim->commit[s] = 1;
-    lm_photon_store_reset_delta_i(ps, s);
-}
-
-/* Hands out texels of surface s from its cursor; completes it when its last texel is out. */
-static uint32_t take_texels(lm_iim *iim, lm_photon_store *ps, int s, uint32_t *out, uint32_t room)
-{
-    uint32_t first = iim->surf_first[s], count = iim->surf_first[s + 1] - first, n = 0;
-    while (iim->cursor[s] < count && n < room)
-        out[n++] = iim->surf_texels[first + iim->cursor[s]++];
-    if (iim->cursor[s] == count)
-        complete_surface(iim, ps, s);
-    return n;
-}
-
-uint32_t lm_iim_schedule(lm_iim *iim, lm_photon_store *ps, uint32_t *out)
-{
-    int *cand = malloc(sizeof(int) * (size_t)(iim->surface_count ? iim->surface_count : 1));
-    if (!cand)
-        return 0;
-    int nc = 0;
-    for (int s = 0; s < iim->surface_count; s++) {
-        if (iim->cursor[s] == 0 && !(ps->surfaces[s].delta_i > iim->set.delta_threshold))
-            continue;
-        int k = nc++; /* insertion sort: surface counts are small */
-        while (k > 0 && before(iim, ps, s, cand[k - 1]))
-            cand[k] = cand[k - 1], k--;
-        cand[k] = s;
-    }
-    uint32_t budget = iim->set.texels_per_frame > 0 ? (uint32_t)iim->set.texels_per_frame : 0, n = 0;
-    for (int i = 0; i < nc && n < budget; i++)
-        n += take_texels(iim, ps, cand[i], out + n, budget - n);
-    free(cand);
-    return n;
-}
-
-uint32_t lm_iim_schedule_all(lm_iim *iim, lm_photon_store *ps, uint32_t *out)
-{
-    uint32_t n = 0;
-    for (int s = 0; s < iim->surface_count; s++) {
-        iim->cursor[s] = 0;
-        n += take_texels(iim, ps, s, out + n, UINT32_MAX);
-    }
-    return n;
 }
 
 float lm_iim_blend_weight(const lm_iim *iim, int surface)
 {
     if (iim->set.blend_frames <= 0)
         return 1.0f;
-    float t = (float)((double)iim->frame - iim->blend_start[surface]) / (float)iim->set.blend_frames;
+    float t = (float)((double)iim->sched.frame - iim->blend_start[surface]) / (float)iim->set.blend_frames;
     return t < 1.0f ? t : 1.0f;
 }
 
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
 {
-    int S = iim->surface_count;
+    int S = iim->sched.surface_count;
+    uint8_t *commit = iim->sched.commit;
     float *param = malloc(sizeof(float) * 2 * (size_t)(S + 1));
     if (!param)
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
     int any_commit = 0, blending = 0;
     for (int s = 0; s < S; s++) {
         /* shown differently from the last frame: committed now, or last frame's weight was below 1 */
-        if (iim->commit[s] || (double)iim->frame - 1 - iim->blend_start[s] < iim->set.blend_frames)
+        if (commit[s] || (double)iim->sched.frame - 1 - iim->blend_start[s] < iim->set.blend_frames)
             iim->version[s]++;
-        if (iim->commit[s])
-            iim->blend_start[s] = instant ? NEVER : iim->frame;
-        param[2 * s] = iim->commit[s] ? 1.0f : 0.0f;
+        if (commit[s])
+            iim->blend_start[s] = instant ? NEVER : iim->sched.frame;
+        param[2 * s] = commit[s] ? 1.0f : 0.0f;
         param[2 * s + 1] = lm_iim_blend_weight(iim, s);
-        any_commit |= iim->commit[s];
+        any_commit |= commit[s];
         blending |= param[2 * s + 1] < 1.0f;
-        iim->commit[s] = 0;
+        commit[s] = 0;
     }
     if (!any_commit && iim->settled) { /* the last pass already wrote every final value */
         free(param);
-        iim->frame++;
+        lm_iim_sched_end_frame(&iim->sched);
         return LM_OK;
     }
     iim->settled = !blending;
@@ -246,7 +154,7 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->params_buf);
     glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
-    iim->frame++;
+    lm_iim_sched_end_frame(&iim->sched);
     return lm_gl_check("IIM blend (iim_blend)", err);
 }
 

@@ -1,14 +1,7 @@
-/* Indirect illumination maps (IIMs): scheduling of texel refreshes and double-buffered blending
- * (Larsen & Christensen section 4; DESIGN.md step 4).
- *
- * Scheduling: each frame at most texels_per_frame texels (the paper's 20) are handed to the gather.
- * Surfaces are taken in order of their delta_i (photon store: energy of hits added or removed since
- * the surface's IIM was refreshed, first hits of punctual lights left out), largest first, then by
- * age (frames since the surface's last completed refresh, oldest first), then by id. Only surfaces
- * with delta_i > delta_threshold, or with a refresh under way, are candidates: nothing changed means no
- * IIM work. A surface's texels are refreshed in atlas order from a cursor that survives across frames;
- * when the last one is handed out the surface's refresh is complete: its delta_i is reset
- * (lm_photon_store_reset_delta_i) and it is committed at the next lm_iim_blend.
+/* Indirect illumination maps (IIMs): double-buffered textures and blending (Larsen & Christensen
+ * section 4; DESIGN.md step 4). Which texels are regathered and when a surface is complete is the
+ * scheduler's (photonmap/iim_schedule.h, `sched` below), which alone writes the photon store's delta_i;
+ * this module only reads its commit flags (and clears them) and its frame counter.
  *
  * Double buffering (GPU, no read-back): the gather writes into `fresh`. Committing a surface copies,
  * for its texels, the currently displayed value into `old` and `fresh` into `new`; from then on
@@ -25,7 +18,7 @@
 
 #include "../charts/charts.h"
 #include "../core/error.h"
-#include "../trace/photon_store.h"
+#include "../photonmap/iim_schedule.h"
 
 #define LM_IIM_DEFAULT_TEXELS_PER_FRAME 20 /* the paper's */
 
@@ -36,17 +29,12 @@ typedef struct {
 } lm_iim_settings;
 
 typedef struct {
-    lm_iim_settings set;
-    int width, height, surface_count;
-    uint32_t *surf_first;  /* surface_count + 1 offsets into surf_texels */
-    uint32_t *surf_texels; /* texel indices (into lm_atlas.texels) grouped by surface, atlas order */
-    uint32_t *cursor;      /* per surface: next texel of a refresh under way (0: none under way) */
-    int *last_done;        /* per surface: frame its last refresh completed (-1: never) */
+    lm_iim_settings set;   /* blend_frames used here; texels_per_frame and delta_threshold are sched's */
+    lm_iim_sched sched;    /* which texels to regather; its frame counter is the blend's clock */
+    int width, height;
     int *blend_start;      /* per surface: frame of its last commit (very negative: fully blended) */
-    uint8_t *commit;       /* per surface: completed, to commit at the next lm_iim_blend */
     uint32_t *version;     /* per surface: blends that changed its displayed texels (a commit, or a blend
                             * still under way) */
-    int frame;
     int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */
     unsigned fresh_tex, old_tex, new_tex, display_tex;
@@ -58,16 +46,10 @@ void lm_iim_settings_default(lm_iim_settings *s);
 lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set, int with_gl, lm_error *err);
 void lm_iim_free(lm_iim *iim);
 
-/* Picks this frame's texels (at most texels_per_frame, written to out) and resets delta_i of surfaces
- * whose refresh completes. Returns how many. */
-uint32_t lm_iim_schedule(lm_iim *iim, lm_photon_store *ps, uint32_t *out);
-/* Every texel of every surface, for the first full gather; marks every surface completed. Returns the
- * count (out must hold a->texel_count). */
-uint32_t lm_iim_schedule_all(lm_iim *iim, lm_photon_store *ps, uint32_t *out);
 /* Blend weight of a surface this frame. */
 float lm_iim_blend_weight(const lm_iim *iim, int surface);
-/* Ends the frame on the GPU: commits completed surfaces, writes display = mix(old, new, t), then
- * advances the frame counter. instant: committed surfaces show new at once (after the first gather). */
+/* Ends the frame on the GPU: commits the surfaces the scheduler completed (clearing their flags),
+ * writes display = mix(old, new, t), then advances the scheduler's frame counter. instant: committed surfaces show new at once (after the first gather). */
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
 
 /* CPU: texels (rgba, atlas-sized, a = back-face fraction) with a > limit take the mean of valid

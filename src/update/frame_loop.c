@@ -89,7 +89,7 @@ static lm_vec3 texel_now(const lm_frame_loop *fl, uint32_t texel, lm_vec3 *norma
  * spacing. */
 static int sees(const lm_frame_loop *fl, int a, int b, float lift)
 {
-    const lm_iim *iim = &fl->iim;
+    const lm_iim_sched *iim = &fl->iim.sched;
     uint32_t na = iim->surf_first[a + 1] - iim->surf_first[a], nb = iim->surf_first[b + 1] - iim->surf_first[b];
     if (!na || !nb)
         return 0;
@@ -125,14 +125,14 @@ static int widen_to_viewers(lm_frame_loop *fl, lm_photon_store *ps)
     uint8_t *refreshed = fl->refreshed;
     if (!lm_photon_stage_take_refreshed(fl->stage, refreshed))
         return 0;
-    int S = fl->iim.surface_count, n = 0;
+    int S = fl->iim.sched.surface_count, n = 0;
     float lift = 1e-3f * lm_scene_size(fl->scene);
     for (int a = 0; a < S; a++) {
-        if (ps->surfaces[a].delta_i > fl->iim.set.delta_threshold)
+        if (ps->surfaces[a].delta_i > fl->iim.sched.delta_threshold)
             continue;
         for (int b = 0; b < S; b++)
             if (b != a && refreshed[b] && sees(fl, a, b, lift)) {
-                ps->surfaces[a].delta_i = fl->iim.set.delta_threshold + 1e-30;
+                ps->surfaces[a].delta_i = fl->iim.sched.delta_threshold + 1e-30;
                 n++;
                 break;
             }
@@ -254,7 +254,7 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     double t0 = lm_now();
     fl->aim_stale = 1;
     if (st == LM_OK)
-        st = gather(fl, lm_iim_schedule_all(&fl->iim, store_of(fl), fl->texels), err);
+        st = gather(fl, lm_iim_sched_pick_all(&fl->iim.sched, store_of(fl), fl->texels), err);
     fl->set.progress = NULL; /* per-frame gathers are small */
     fl->set.cancel = NULL;
     if (st == LM_OK)
@@ -375,7 +375,7 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
 static lm_status schedule(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     widen_to_viewers(fl, store_of(fl));
-    o->texels_gathered = lm_iim_schedule(&fl->iim, store_of(fl), fl->texels);
+    o->texels_gathered = lm_iim_sched_pick(&fl->iim.sched, store_of(fl), fl->texels);
     return o->texels_gathered > 0 ? gather_prepare(fl, err) : LM_OK;
 }
 
@@ -537,16 +537,16 @@ static lm_status bake_gather(lm_frame_loop *fl, lm_bake_progress progress, void 
                              lm_bake_stats *out, lm_error *err)
 {
     lm_photon_store *ps = store_of(fl);
-    int S = fl->iim.surface_count;
+    int S = fl->iim.sched.surface_count;
     double *saved = malloc(sizeof *saved * (size_t)(S ? S : 1));
     if (!saved)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", fl->scene->path);
     for (int s = 0; s < S; s++)
         saved[s] = ps->surfaces[s].delta_i;
-    int budget = fl->iim.set.texels_per_frame;
-    fl->iim.set.texels_per_frame = (int)fl->atlas->texel_count;
-    uint32_t n = lm_iim_schedule(&fl->iim, ps, fl->texels);
-    fl->iim.set.texels_per_frame = budget;
+    int budget = fl->iim.sched.texels_per_frame;
+    fl->iim.sched.texels_per_frame = (int)fl->atlas->texel_count;
+    uint32_t n = lm_iim_sched_pick(&fl->iim.sched, ps, fl->texels);
+    fl->iim.sched.texels_per_frame = budget;
     bake_watch w = {progress, user};
     fl->set.progress = progress ? bake_gather_progress : NULL;
     fl->set.progress_user = &w;
@@ -556,8 +556,8 @@ static lm_status bake_gather(lm_frame_loop *fl, lm_bake_progress progress, void 
     fl->set.cancel = NULL;
     if (st != LM_OK) {
         for (int s = 0; s < S; s++)
-            if (fl->iim.commit[s])
-                fl->iim.commit[s] = 0, ps->surfaces[s].delta_i = saved[s];
+            if (fl->iim.sched.commit[s])
+                fl->iim.sched.commit[s] = 0, ps->surfaces[s].delta_i = saved[s];
     } else {
         uint32_t before = 0, after = 0;
         for (int s = 0; s < S; s++)
@@ -614,7 +614,7 @@ const uint32_t *lm_frame_loop_surface_versions(const lm_frame_loop *fl) { return
 
 void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels)
 {
-    fl->iim.set.texels_per_frame = texels > 0 ? texels : 0;
+    fl->iim.sched.texels_per_frame = texels > 0 ? texels : 0;
 }
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl->stage; }
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }

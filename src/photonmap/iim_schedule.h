@@ -1,0 +1,47 @@
+/* Which IIM texels to regather, and when a surface's refresh is complete (Larsen & Christensen section 4;
+ * the IIMs themselves, their GPU textures and blending, are gpu/iim.h).
+ *
+ * Each frame at most texels_per_frame texels are handed to the gather. Surfaces are taken in order of
+ * their delta_i (photon store: energy of hits added or removed since the surface's IIM was refreshed,
+ * first hits of punctual lights left out), largest first, then by age (frames since the surface's last
+ * completed refresh, oldest first), then by id. Only surfaces with delta_i > delta_threshold, or with a
+ * refresh under way, are candidates: nothing changed means no IIM work. A surface's texels are handed out
+ * in atlas order from a cursor that survives across frames; when the last one is out the refresh is
+ * complete: the surface's delta_i is reset (the scheduler is what writes it, beside the AIM scheduler's
+ * delta_f) and its commit flag is raised for the blend to consume.
+ *
+ * Cost: O(surfaces^2) per frame for the ordering (insertion sort; surface counts are small) plus the
+ * texels handed out. Not thread-safe; the photon store must not be updated meanwhile. */
+#ifndef LM_IIM_SCHEDULE_H
+#define LM_IIM_SCHEDULE_H
+
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../trace/photon_store.h"
+
+typedef struct {
+    int texels_per_frame;  /* gather budget per frame (>= 0) */
+    double delta_threshold; /* a surface is refreshed when its delta_i exceeds this */
+    int surface_count;
+    uint32_t *surf_first;  /* surface_count + 1 offsets into surf_texels */
+    uint32_t *surf_texels; /* texel indices (into lm_atlas.texels) grouped by surface, atlas order */
+    uint32_t *cursor;      /* per surface: next texel of a refresh under way (0: none under way) */
+    int *last_done;        /* per surface: frame its last refresh completed (-1: never) */
+    uint8_t *commit;       /* per surface: refresh completed, for the blend to commit (and clear) */
+    int frame;             /* advanced once a frame by lm_iim_sched_end_frame */
+} lm_iim_sched;
+
+lm_status lm_iim_sched_init(lm_iim_sched *s, const lm_atlas *a, int texels_per_frame, double delta_threshold,
+                            lm_error *err);
+void lm_iim_sched_free(lm_iim_sched *s);
+/* Picks this frame's texels (at most texels_per_frame, written to out) and resets delta_i of surfaces
+ * whose refresh completes. Returns how many. */
+uint32_t lm_iim_sched_pick(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);
+/* Every texel of every surface, for the first full gather; completes every surface. Returns the count
+ * (out must hold the atlas's texel_count). */
+uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);
+void lm_iim_sched_end_frame(lm_iim_sched *s);
+
+#endif
