@@ -49,7 +49,7 @@ static int save(lmgi_scene *sc, lmgi_updater *u, const char *dir, const char *na
     if (!rgba)
         rc = 1;
     else if (lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, n, &e) != LMGI_OK ||
-             lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, rgba, LMGI_TONEMAP_NEUTRAL, 0.0f, &e))
+             lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, rgba, NULL, &e))
         rc = fail(path, &e);
     free(rgba);
     return rc;
@@ -135,7 +135,7 @@ static int session(lmgi_context *ctx, lmgi_scene *sc, const char *out, const cha
     snprintf(path, sizeof path, "%s/view.png", out);
     if (!rc && (!frame || lmgi_scene_camera(sc, -1, 320, 240, &cam, &e) != LMGI_OK ||
                 lmgi_render(u, &cam, 320, 240, frame, &e) != LMGI_OK ||
-                lmgi_write_image(path, 320, 240, 3, frame, LMGI_TONEMAP_NEUTRAL, 0.0f, &e) != LMGI_OK))
+                lmgi_write_image(path, 320, 240, 3, frame, NULL, &e) != LMGI_OK))
         rc = fail("view", &e);
     free(frame);
     lmgi_updater_free(u);

@@ -117,13 +117,13 @@ static int write_results(lmgi_scene *sc, lmgi_updater *u, const char *out)
     else if (lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim, n, &e) != LMGI_OK)
         rc = fail("lightmap", &e);
     else if (snprintf(path, sizeof path, "%s/iim.exr", out),
-             lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, iim, LMGI_TONEMAP_NEUTRAL, 0.0f, &e))
+             lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, iim, NULL, &e))
         rc = fail("write", &e);
     else if (lmgi_scene_camera(sc, -1, 256, 256, &cam, &e) != LMGI_OK ||
              lmgi_render(u, &cam, 256, 256, frame, &e) != LMGI_OK)
         rc = fail("render", &e);
     else if (snprintf(path, sizeof path, "%s/frame.png", out),
-             lmgi_write_image(path, 256, 256, 3, frame, LMGI_TONEMAP_NEUTRAL, 0.0f, &e))
+             lmgi_write_image(path, 256, 256, 3, frame, NULL, &e))
         rc = fail("write", &e);
     free(iim);
     free(frame);

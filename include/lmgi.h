@@ -418,13 +418,18 @@ typedef enum { LMGI_TONEMAP_NEUTRAL = 0, LMGI_TONEMAP_CLAMP } lmgi_tonemap;
 
 /* The exposure `op` picks for `pixels` RGB values (3 floats each); 1 when none is lit or rgb is NULL. */
 LMGI_API float lmgi_auto_exposure(lmgi_tonemap op, const float *rgb, size_t pixels);
+/* How lmgi_write_image writes; zero-initialised (or NULL) means the defaults. */
+typedef struct {
+    lmgi_tonemap tonemap;  /* PNG: the tone map (default neutral) */
+    float exposure;        /* PNG: the exposure (0: automatic) */
+    int half;              /* EXR: 16-bit half floats (half the size, 11 bits, values up to 65504); 0: 32-bit */
+} lmgi_image_desc;
 /* Writes width x height pixels of `channels` floats (1, 3 or 4; rows top first) to path: ".exr" linear
- * floats as given, ".png" RGB tone-mapped by op at `exposure` (0: automatic), alpha dropped. The file
- * appears whole or not at all (written to PATH.partial, then renamed). NULL arguments, sizes outside
- * 1..65536, other channel counts or another extension: LMGI_ERR_INVALID; a failed write: LMGI_ERR_IO
- * naming the file. */
+ * as given, ".png" RGB tone-mapped, alpha dropped. The file appears whole or not at all (written to
+ * PATH.partial, then renamed). NULL path or pixels, sizes outside 1..65536, other channel counts, a bad
+ * desc or another extension: LMGI_ERR_INVALID; a failed write: LMGI_ERR_IO naming the file. */
 LMGI_API lmgi_status lmgi_write_image(const char *path, int width, int height, int channels, const float *pixels,
-                                      lmgi_tonemap op, float exposure, lmgi_error *err);
+                                      const lmgi_image_desc *desc, lmgi_error *err);
 
 LMGI_API const char *lmgi_status_name(lmgi_status s);
 /* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */

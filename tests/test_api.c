@@ -751,21 +751,21 @@ static void test_write_image(void **state)
     const char *names[2] = {"picture.exr", "picture.png"};
     for (int k = 0; k < 2; k++) {
         snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), names[k]);
-        assert_int_equal(lmgi_write_image(path, 6, 4, 4, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e), LMGI_OK);
+        assert_int_equal(lmgi_write_image(path, 6, 4, 4, px, NULL, &e), LMGI_OK);
         size_t size = 0;
         unsigned char *data = lmt_read_file(path, &size, 0);
         assert_true(size > 40);
         assert_memory_equal(data + (k ? 1 : 0), k ? "PNG" : "\x76\x2f\x31\x01", k ? 3 : 4); /* the formats' magic */
         free(data);
     }
-    expect_invalid(lmgi_write_image(path, 6, 4, 2, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e), &e, "2 channels");
-    expect_invalid(lmgi_write_image(path, 0, 4, 3, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e), &e, "0 x 4");
-    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, (lmgi_tonemap)5, 0.0f, &e), &e, "not a tone map");
-    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, LMGI_TONEMAP_CLAMP, NAN, &e), &e, "exposure");
-    expect_invalid(lmgi_write_image(path, 6, 4, 3, NULL, LMGI_TONEMAP_CLAMP, 0.0f, &e), &e, "pixels is NULL");
+    expect_invalid(lmgi_write_image(path, 6, 4, 2, px, NULL, &e), &e, "2 channels");
+    expect_invalid(lmgi_write_image(path, 0, 4, 3, px, NULL, &e), &e, "0 x 4");
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, &(lmgi_image_desc){.tonemap = (lmgi_tonemap)5}, &e), &e, "not a tone map");
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, &(lmgi_image_desc){.exposure = NAN}, &e), &e, "exposure");
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, NULL, NULL, &e), &e, "pixels is NULL");
     snprintf(path, sizeof path, "%s/picture.jpg", lmt_tmpdir());
-    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, LMGI_TONEMAP_CLAMP, 0.0f, &e), &e, ".exr or .png");
-    assert_int_equal(lmgi_write_image("/proc/lmgi-nowhere/a.png", 6, 4, 3, px, LMGI_TONEMAP_CLAMP, 1.0f, &e),
+    expect_invalid(lmgi_write_image(path, 6, 4, 3, px, NULL, &e), &e, ".exr or .png");
+    assert_int_equal(lmgi_write_image("/proc/lmgi-nowhere/a.png", 6, 4, 3, px, &(lmgi_image_desc){LMGI_TONEMAP_CLAMP, 1.0f, 0}, &e),
                      LMGI_ERR_IO);
     assert_non_null(strstr(e.message, "/proc/lmgi-nowhere/a.png"));
     assert_float_equal(lmgi_auto_exposure(LMGI_TONEMAP_NEUTRAL, NULL, 3), 1.0f, 0.0);

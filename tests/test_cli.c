@@ -4,6 +4,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -218,6 +219,32 @@ static void test_bake_command(void **state)
         snprintf(path, sizeof path, "%s/bake/%s", dir, files[k]);
         assert_int_equal(access(path, R_OK), 0);
     }
+    /* --half: the same lightmap in 16-bit floats, under half the size */
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --half --out %s/half", dir);
+    if (run(args) != 0)
+        fail_msg("%s: %s", args, output);
+    char full_path[1200];
+    snprintf(full_path, sizeof full_path, "%s/bake/lightmap.exr", dir);
+    snprintf(path, sizeof path, "%s/half/lightmap.exr", dir);
+    int w = 0, h = 0, w2 = 0, h2 = 0;
+    float *full = NULL, *half = NULL;
+    lm_error err;
+    assert_int_equal(lm_read_exr(full_path, &w, &h, &full, &err), LM_OK);
+    assert_int_equal(lm_read_exr(path, &w2, &h2, &half, &err), LM_OK);
+    assert_true(w == w2 && h == h2);
+    double worst = 0.0;
+    for (size_t i = 0; i < 4 * (size_t)w * h; i++)
+        worst = fmax(worst, fabs((double)half[i] - full[i]) / (fabs((double)full[i]) + 1e-6));
+    print_message("lightmap.exr in half floats: largest relative difference %.1e\n", worst);
+    assert_true(worst < 1e-3); /* 11 bits */
+    free(full);
+    free(half);
+    FILE *fa = fopen(full_path, "rb"), *fb = fopen(path, "rb");
+    assert_true(fa && fb);
+    fseek(fa, 0, SEEK_END), fseek(fb, 0, SEEK_END);
+    assert_true(ftell(fb) < ftell(fa) / 2 + 1024);
+    fclose(fa), fclose(fb);
+
     /* the default density of the two rooms takes seconds to gather: interrupted after 1 s */
     const char *build = getenv("LMGI_BUILD");
     snprintf(args, sizeof args, "timeout --preserve-status -s INT 1 %s/lmgi bake scenes/two_rooms.glb --out %s/interrupted 2>&1",

@@ -20,8 +20,14 @@ static int ends_with(const char *s, const char *tail)
 }
 
 lmgi_status lmgi_write_image(const char *path, int width, int height, int channels, const float *pixels,
-                             lmgi_tonemap op, float exposure, lmgi_error *err)
+                             const lmgi_image_desc *desc, lmgi_error *err)
 {
+    lmgi_image_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc)
+        d = *desc;
+    lmgi_tonemap op = d.tonemap;
+    float exposure = d.exposure;
     lm_error e;
     lm_status st = LM_OK;
     if (!path || !pixels)
@@ -38,7 +44,7 @@ lmgi_status lmgi_write_image(const char *path, int width, int height, int channe
     if (st != LM_OK)
         return lm_export_error(err, &e);
     if (ends_with(path, ".exr"))
-        st = lm_write_exr(path, width, height, channels, pixels, &e);
+        st = lm_write_exr_as(path, width, height, channels, pixels, d.half != 0, &e);
     else if (!ends_with(path, ".png"))
         st = lm_fail(&e, LM_ERR_INVALID, "%s: the name must end in .exr or .png", path);
     else {

@@ -212,6 +212,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                 a->options.strict = 1;
             else if (!strcmp(o, "--in-order"))
                 a->in_order = 1;
+            else if (!strcmp(o, "--half"))
+                a->half = 1;
             else if (!strcmp(o, "--force"))
                 a->force = 1;
             else if (!strcmp(o, "--no-cache"))

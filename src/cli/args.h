@@ -48,6 +48,7 @@ typedef struct {
     int in_order;           /* --in-order: photon stage before the gather, one thread (no overlap) */
     int force;              /* --force: write into a non-empty --out directory lmgi did not make */
     int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
+    int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
 } lm_cli_args;

@@ -26,8 +26,9 @@ static void show(void *user, float fraction, const char *stage)
     lm_progress_fraction("bake", fraction, stage, *(const double *)user);
 }
 
-static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir)
+static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half)
 {
+    const lmgi_image_desc exr = {.half = half};
     lmgi_info in;
     lmgi_get_info(sc, &in);
     size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
@@ -42,7 +43,7 @@ static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir)
         if (!rgba)
             rc = 1, fprintf(stderr, "lmgi: error: no memory for the %d x %d lightmap\n", in.atlas_width, in.atlas_height);
         else if ((k != 1 && lmgi_get_lightmap(u, kind, rgba, n, &e) != LMGI_OK) ||
-                 lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, rgba, LMGI_TONEMAP_NEUTRAL, 0.0f, &e))
+                 lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, rgba, &exr, &e))
             rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
     }
     free(rgba);
@@ -86,7 +87,7 @@ int lm_cli_bake(const lm_cli_args *a)
     }
     signal(SIGINT, SIG_DFL);
     if (rc == 0)
-        rc = write_maps(sc, u, a->out_dir);
+        rc = write_maps(sc, u, a->out_dir, a->half);
     if (rc == 0 && !a->quiet) {
         lmgi_info in;
         lmgi_updater_info ui;

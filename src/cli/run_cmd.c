@@ -100,11 +100,12 @@ static lm_status write_pair(const run_state *r, const char *name, int w, int h, 
     lmgi_error e;
     if (exr) {
         snprintf(path, sizeof path, "%s/%s.exr", r->a->out_dir, name);
-        if (lmgi_write_image(path, w, h, channels, px, LMGI_TONEMAP_NEUTRAL, 0.0f, &e) != LMGI_OK)
+        if (lmgi_write_image(path, w, h, channels, px, NULL, &e) != LMGI_OK)
             return from_api(err, &e);
     }
     snprintf(path, sizeof path, "%s/%s.png", r->a->out_dir, name);
-    if (lmgi_write_image(path, w, h, channels, px, (lmgi_tonemap)r->a->tonemap, k > 0.0f ? k : 0.0f, &e) != LMGI_OK)
+    lmgi_image_desc png = {(lmgi_tonemap)r->a->tonemap, k > 0.0f ? k : 0.0f, 0};
+    if (lmgi_write_image(path, w, h, channels, px, &png, &e) != LMGI_OK)
         return from_api(err, &e);
     return LM_OK;
 }

@@ -77,6 +77,12 @@ lm_status lm_write_png(const char *path, int width, int height, const uint8_t *r
  * for images under 16 x 16 (as tinyexr's SaveEXR does; written here so the file write can be checked). */
 lm_status lm_write_exr(const char *path, int width, int height, int channels, const float *data, lm_error *err)
 {
+    return lm_write_exr_as(path, width, height, channels, data, 0, err);
+}
+
+lm_status lm_write_exr_as(const char *path, int width, int height, int channels, const float *data, int half,
+                          lm_error *err)
+{
     if (width <= 0 || height <= 0 || !data || (channels != 1 && channels != 3 && channels != 4))
         return lm_fail(err, LM_ERR_INVALID, "%s: cannot write a %dx%d EXR with %d channels", path, width,
                        height, channels);
@@ -88,7 +94,7 @@ lm_status lm_write_exr(const char *path, int width, int height, int channels, co
     static const int source[4][4] = {{0}, {0}, {2, 1, 0}, {3, 2, 1, 0}}; /* data channel of each plane */
     unsigned char *plane_ptr[4];
     EXRChannelInfo info[4];
-    int types[4];
+    int types[4], stored[4];
     memset(info, 0, sizeof info);
     for (int c = 0; c < channels; c++) {
         float *plane = planes + (size_t)c * n;
@@ -97,6 +103,7 @@ lm_status lm_write_exr(const char *path, int width, int height, int channels, co
         plane_ptr[c] = (unsigned char *)plane;
         snprintf(info[c].name, sizeof info[c].name, "%s", names[channels - 1][c]);
         types[c] = TINYEXR_PIXELTYPE_FLOAT;
+        stored[c] = half ? TINYEXR_PIXELTYPE_HALF : TINYEXR_PIXELTYPE_FLOAT;
     }
     EXRHeader header;
     InitEXRHeader(&header);
@@ -104,7 +111,7 @@ lm_status lm_write_exr(const char *path, int width, int height, int channels, co
     header.num_channels = channels;
     header.channels = info;
     header.pixel_types = types;
-    header.requested_pixel_types = types;
+    header.requested_pixel_types = stored;
     EXRImage image;
     InitEXRImage(&image);
     image.num_channels = channels;

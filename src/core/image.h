@@ -13,6 +13,10 @@ lm_status lm_write_file(const char *path, const void *data, size_t size, lm_erro
 lm_status lm_write_png(const char *path, int width, int height, const uint8_t *rgba8, lm_error *err);
 /* rgb: width*height*channels floats (channels 1, 3 or 4), row 0 at the top. */
 lm_status lm_write_exr(const char *path, int width, int height, int channels, const float *data, lm_error *err);
+/* The same stored as 16-bit half floats when `half` (half the size; 11 bits of precision, values up to
+ * 65504). */
+lm_status lm_write_exr_as(const char *path, int width, int height, int channels, const float *data, int half,
+                          lm_error *err);
 /* Reads an EXR as RGBA floats (caller frees *out with free()). */
 lm_status lm_read_exr(const char *path, int *width, int *height, float **out, lm_error *err);
 /* Reads a PNG/JPEG as RGBA8 (caller frees *out with free()). */
