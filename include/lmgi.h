@@ -116,6 +116,11 @@ LMGI_API void lmgi_options_init(lmgi_options *o);
  * LMGI_ERR_NOMEM before the work, one above 1 GiB a warning with its estimate. */
 LMGI_API lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out, lmgi_error *err);
 LMGI_API void lmgi_free(lmgi_scene *scene); /* NULL: nothing */
+/* The same from a .gltf or .glb held in memory (size bytes; `name`, may be NULL, names it in messages).
+ * It may not name external files: its buffers and images are the .glb's own or data: URIs. NULL data or
+ * size 0: LMGI_ERR_INVALID. The bytes are not kept. */
+LMGI_API lmgi_status lmgi_load_memory(const void *data, size_t size, const char *name, const lmgi_options *o,
+                                      lmgi_scene **out, lmgi_error *err);
 
 /* NULL scene: info zeroed; NULL info: nothing. */
 LMGI_API void lmgi_get_info(const lmgi_scene *scene, lmgi_info *info);
@@ -164,6 +169,53 @@ LMGI_API lmgi_status lmgi_get_light(const lmgi_scene *scene, int light, lmgi_lig
  * of range, a type or node other than the light's, or an id out of range: LMGI_ERR_INVALID, nothing
  * changed. */
 LMGI_API lmgi_status lmgi_set_light(lmgi_scene *scene, int light, const lmgi_light *l, lmgi_error *err);
+
+/* An application's own level, handed over without a file: meshes (vertex and index arrays placed by a
+ * matrix), materials and lights. lmgi_load_desc writes them into a .glb in memory and loads that, so they
+ * are checked, classified and lit exactly as a file would be (docs/loading.md). Zero means the default:
+ * a zero transform is the identity, a zero base colour white, a zero light colour white. */
+typedef struct {
+    const char *name;          /* the node's name (lmgi_find_node); NULL: "mesh" */
+    const float *positions;    /* 3 floats per vertex, in the node's space */
+    const float *normals;      /* 3 per vertex, or NULL: from the faces */
+    const float *uvs;          /* 2 per vertex (base colour texture coordinates), or NULL */
+    uint32_t vertex_count;
+    const uint32_t *indices;   /* 3 per triangle, counter-clockwise seen from the front */
+    uint32_t triangle_count;
+    int material;              /* index into the desc's materials */
+    float transform[16];       /* the node's matrix, column-major (all 0: identity) */
+    int dynamic;               /* 1: may move (lmgi_set_node_transform) */
+} lmgi_mesh_desc;
+typedef struct {
+    const char *name;
+    float base_color[4];       /* linear RGBA in [0, 1] (all 0: white) */
+    float metallic, roughness; /* roughness 0: 1 */
+    float emissive[3];         /* emitted radiance (any size) */
+    float transmission, ior;   /* glass: transmission 1, ior e.g. 1.5 (0: none) */
+    int double_sided;
+} lmgi_material_desc;
+typedef struct {
+    const char *name;          /* its node's name */
+    int type;                  /* lmgi_light_type: LMGI_LIGHT_POINT (0), _SPOT, _DIRECTIONAL */
+    float color[3];            /* all 0: white */
+    float intensity;           /* candela (point, spot) or lux (directional) */
+    float range;               /* 0: infinite */
+    float inner_cone, outer_cone; /* spot, radians (outer 0: pi/4) */
+    float position[3], direction[3]; /* direction 0: down -z */
+} lmgi_light_desc;
+typedef struct {
+    const char *name;          /* names the scene in messages; NULL: "(scene desc)" */
+    const lmgi_mesh_desc *meshes;
+    int mesh_count;
+    const lmgi_material_desc *materials;
+    int material_count;
+    const lmgi_light_desc *lights;
+    int light_count;
+} lmgi_scene_desc;
+/* Builds a scene from a desc. No meshes, an index past its mesh's vertices, a material out of range,
+ * NaN or infinite numbers: LMGI_ERR_INVALID naming the mesh or light; otherwise as lmgi_load. */
+LMGI_API lmgi_status lmgi_load_desc(const lmgi_scene_desc *desc, const lmgi_options *o, lmgi_scene **out,
+                                    lmgi_error *err);
 
 /* Materials. An edit of colour or emission reaches an updater at its next update: the photons that
  * touch the material are re-traced (no others), the AIMs of its surfaces refreshed, and the frame's

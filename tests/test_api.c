@@ -771,6 +771,114 @@ static void test_write_image(void **state)
     assert_float_equal(lmgi_auto_exposure(LMGI_TONEMAP_NEUTRAL, NULL, 3), 1.0f, 0.0);
 }
 
+/* A level from arrays (lmgi_load_desc): a floor, a dynamic box on it and a point light above, loaded,
+ * hit where the arrays put them, lit by an updater, and every bad desc refused naming the mesh. */
+static void test_scene_from_arrays(void **state)
+{
+    (void)state;
+    static const float floor_pos[12] = {-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2};
+    static const uint32_t floor_idx[6] = {0, 1, 2, 0, 2, 3};
+    float box_pos[24];
+    for (int v = 0; v < 8; v++) /* corners of [-0.25, 0.25] x [0, 0.5] x [-0.25, 0.25] */
+        box_pos[3 * v] = v & 1 ? 0.25f : -0.25f, box_pos[3 * v + 1] = v & 2 ? 0.5f : 0.0f,
+        box_pos[3 * v + 2] = v & 4 ? 0.25f : -0.25f;
+    static const uint32_t box_idx[36] = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+                                         2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
+    lmgi_mesh_desc meshes[2];
+    memset(meshes, 0, sizeof meshes);
+    meshes[0] = (lmgi_mesh_desc){.name = "floor", .positions = floor_pos, .vertex_count = 4, .indices = floor_idx,
+                                 .triangle_count = 2, .material = 0};
+    meshes[1] = (lmgi_mesh_desc){.name = "box", .positions = box_pos, .vertex_count = 8, .indices = box_idx,
+                                 .triangle_count = 12, .material = 1, .dynamic = 1};
+    meshes[1].transform[0] = meshes[1].transform[5] = meshes[1].transform[10] = meshes[1].transform[15] = 1.0f;
+    meshes[1].transform[12] = 0.5f; /* moved along x */
+    lmgi_material_desc mats[2] = {{.name = "grey", .base_color = {0.7f, 0.7f, 0.7f, 1.0f}},
+                                  {.name = "orange", .base_color = {0.8f, 0.4f, 0.1f, 1.0f}}};
+    lmgi_light_desc light = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 10.0f, .position = {0, 2, 0}};
+    lmgi_scene_desc d = {.name = "arrays", .meshes = meshes, .mesh_count = 2, .materials = mats, .material_count = 2,
+                         .lights = &light, .light_count = 1};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 1000;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    assert_int_equal(in.triangles, 14);
+    assert_int_equal(in.lights, 1);
+    assert_int_equal(in.materials, 2);
+    assert_int_equal(in.dynamic_nodes, 1);
+    int box = lmgi_find_node(sc, "box");
+    assert_true(box >= 0 && lmgi_node_is_dynamic(sc, box));
+    const float org[3] = {0.6f, 5.0f, 0.1f}, down[3] = {0, -1, 0};
+    lmgi_hit h;
+    lmgi_intersect(sc, org, down, INFINITY, &h);
+    assert_true(h.hit && h.node == box);
+    assert_float_equal(h.t, 4.5f, 1e-5); /* the box's top at y = 0.5 */
+    const float beside[3] = {-1.0f, 5.0f, 1.0f};
+    lmgi_intersect(sc, beside, down, INFINITY, &h);
+    assert_true(h.hit && h.node == lmgi_find_node(sc, "floor"));
+    assert_float_equal(h.t, 5.0f, 1e-5);
+
+    lmgi_context *ctx = new_context();
+    lmgi_updater_desc ud;
+    small_desc(&ud);
+    ud.frame_width = ud.frame_height = 0;
+    lmgi_updater *u = make_updater(ctx, sc, &ud);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *iim = malloc(n * sizeof *iim);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim, n, &e), LMGI_OK);
+    double lit = 0.0;
+    for (size_t i = 0; i < n; i += 4)
+        lit += iim[i + 3] > 0.5f ? iim[i] + iim[i + 1] + iim[i + 2] : 0.0;
+    assert_true(lit > 0.0); /* the box's light bounced onto the floor and the floor's onto the box */
+    free(iim);
+    close_all(u, sc, ctx);
+
+    uint32_t bad_idx[6] = {0, 1, 2, 0, 2, 9};
+    meshes[0].indices = bad_idx;
+    expect_invalid(lmgi_load_desc(&d, &o, &sc, &e), &e, "mesh 0: index 5 is 9");
+    assert_null(sc);
+    meshes[0].indices = floor_idx;
+    meshes[1].material = 5;
+    expect_invalid(lmgi_load_desc(&d, &o, &sc, &e), &e, "mesh 1: material 5");
+    meshes[1].material = 1;
+    meshes[1].transform[13] = NAN;
+    expect_invalid(lmgi_load_desc(&d, &o, &sc, &e), &e, "mesh 1: its transform");
+    meshes[1].transform[13] = 0.0f;
+    float nan_floor[12];
+    memcpy(nan_floor, floor_pos, sizeof nan_floor);
+    nan_floor[4] = NAN;
+    meshes[0].positions = nan_floor;
+    assert_int_not_equal(lmgi_load_desc(&d, &o, &sc, &e), LMGI_OK); /* the loader's own check */
+    print_message("a NaN vertex in a desc: %s\n", e.message);
+    meshes[0].positions = floor_pos;
+    d.mesh_count = 0;
+    expect_invalid(lmgi_load_desc(&d, &o, &sc, &e), &e, "no meshes");
+    expect_invalid(lmgi_load_desc(NULL, &o, &sc, &e), &e, "NULL");
+    expect_invalid(lmgi_load_memory(NULL, 10, "x", &o, &sc, &e), &e, "data is NULL");
+
+    /* a .glb from memory is the file's scene; one naming an external file is refused, saying why */
+    size_t size = 0;
+    unsigned char *bytes = lmt_read_file(lmt_project_scene("two_rooms.glb"), &size, 0);
+    lmgi_scene *from_file = NULL;
+    assert_int_equal(lmgi_load_memory(bytes, size, "two rooms in memory", &o, &sc, &e), LMGI_OK);
+    assert_int_equal(lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &from_file, &e), LMGI_OK);
+    lmgi_info a, b;
+    lmgi_get_info(sc, &a);
+    lmgi_get_info(from_file, &b);
+    assert_true(a.triangles == b.triangles && a.texels == b.texels && a.lights == b.lights);
+    lmgi_free(sc);
+    lmgi_free(from_file);
+    free(bytes);
+    const char *external = "{\"asset\":{\"version\":\"2.0\"},\"buffers\":[{\"uri\":\"geometry.bin\",\"byteLength\":36}]}";
+    assert_int_not_equal(lmgi_load_memory(external, strlen(external), "external", &o, &sc, &e), LMGI_OK);
+    print_message("a scene in memory naming geometry.bin: %s\n", e.message);
+    assert_non_null(strstr(e.message, "geometry.bin: a scene from memory cannot name external files"));
+}
+
 /* liblmgi.so exports exactly the functions lmgi.h marks LMGI_API: nothing internal, nothing missing. */
 static void test_exported_symbols(void **state)
 {
@@ -817,6 +925,7 @@ int main(void)
         cmocka_unit_test(test_budget_sets_texels),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_write_image),
+        cmocka_unit_test(test_scene_from_arrays),
         cmocka_unit_test(test_exported_symbols),
     };
     lmgi_set_verbosity(0); /* the refusals below log errors on purpose */

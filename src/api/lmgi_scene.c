@@ -72,10 +72,11 @@ static lm_status check_options(const char *path, const lmgi_options *o, lm_error
     return LM_OK;
 }
 
-static lm_status build(lmgi_scene *sc, const char *path, const lmgi_options *o, lm_error *err)
+static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_t size, const lmgi_options *o,
+                       lm_error *err)
 {
     double t0 = lm_now();
-    lm_load_options lo = {.strict = o->strict};
+    lm_load_options lo = {.strict = o->strict, .data = data, .size = size};
     lm_status st = lm_scene_load_gltf(path, &lo, &sc->scene, err);
     if (st != LM_OK)
         return st;
@@ -121,7 +122,9 @@ static lm_status build(lmgi_scene *sc, const char *path, const lmgi_options *o, 
     return LM_OK;
 }
 
-lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out, lmgi_error *err)
+/* lmgi_load and lmgi_load_memory: the file's bytes from disk, or data (when non-NULL) named `path`. */
+static lmgi_status load(const char *path, const void *data, size_t size, const lmgi_options *o, lmgi_scene **out,
+                        lmgi_error *err)
 {
     lm_error e;
     lm_error_clear(&e);
@@ -147,13 +150,29 @@ lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out,
     sc->options = *o;
     lm_status st = check_options(path, o, &e);
     if (st == LM_OK)
-        st = build(sc, path, o, &e);
+        st = build(sc, path, data, size, o, &e);
     if (st != LM_OK) {
         lmgi_free(sc);
         return lm_export_error(err, &e);
     }
     *out = sc;
     return LMGI_OK;
+}
+
+lmgi_status lmgi_load(const char *path, const lmgi_options *o, lmgi_scene **out, lmgi_error *err)
+{
+    return load(path, NULL, 0, o, out, err);
+}
+
+lmgi_status lmgi_load_memory(const void *data, size_t size, const char *name, const lmgi_options *o,
+                             lmgi_scene **out, lmgi_error *err)
+{
+    if (!data || size == 0) {
+        if (out)
+            *out = NULL;
+        return lm_api_refuse(err, "lmgi_load_memory: %s", data ? "size is 0" : "data is NULL");
+    }
+    return load(name ? name : "(memory)", data, size, o, out, err);
 }
 
 void lmgi_free(lmgi_scene *sc)

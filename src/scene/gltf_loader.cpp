@@ -139,6 +139,10 @@ class Loader {
     Loader(const char *path, const lm_load_options *opt, lm_error *err) : path_(path), err_(err)
     {
         strict_ = opt && opt->strict;
+        if (opt && opt->data) {
+            mem_ = static_cast<const unsigned char *>(opt->data);
+            mem_size_ = opt->size;
+        }
     }
     ~Loader()
     {
@@ -169,6 +173,8 @@ class Loader {
     lm_status finish();
 
     const char *path_;
+    const unsigned char *mem_ = nullptr; // the scene's bytes when it comes from memory
+    size_t mem_size_ = 0;
     lm_error *err_;
     bool strict_ = false;
     tinygltf::Model model_;
@@ -250,8 +256,27 @@ bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const st
     return why.empty();
 }
 
+// A scene from memory has no directory to find other files in: every file it names "exists", so that
+// reading it is refused with the reason rather than reported missing.
+bool any_file_exists(const std::string &, void *) { return true; }
+
+bool refuse_external_file(std::vector<unsigned char> *, std::string *err, const std::string &path, void *)
+{
+    if (err)
+        *err += path + ": a scene from memory cannot name external files; embed them (a .glb's buffer or "
+                       "data: URIs)\n";
+    return false;
+}
+
 lm_status Loader::read_file(std::vector<unsigned char> &bytes)
 {
+    if (mem_) {
+        if (mem_size_ > k_max_file_bytes)
+            return fail(LM_ERR_FORMAT, "%llu bytes is more than the 4 GiB a scene may have here",
+                        (unsigned long long)mem_size_);
+        bytes.assign(mem_, mem_ + mem_size_);
+        return LM_OK;
+    }
     bool format = false;
     std::string why = read_capped(path_, bytes, &format);
     return why.empty() ? LM_OK : fail(format ? LM_ERR_FORMAT : LM_ERR_IO, "%s", why.c_str());
@@ -333,8 +358,8 @@ lm_status Loader::parse(const std::vector<unsigned char> &bytes)
         dir = slash == 0 ? "/" : p.substr(0, slash);
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(decode_image, &model_);
-    tinygltf::FsCallbacks fs = {&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_whole_file,
-                                &tinygltf::WriteWholeFile, nullptr};
+    tinygltf::FsCallbacks fs = {mem_ ? &any_file_exists : &tinygltf::FileExists, &tinygltf::ExpandFilePath,
+                                mem_ ? &refuse_external_file : &read_whole_file, &tinygltf::WriteWholeFile, nullptr};
     gltf.SetFsCallbacks(fs);
     std::string terr, twarn;
     bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &terr, &twarn, bytes.data(), unsigned(bytes.size()), dir)

@@ -171,6 +171,10 @@ typedef struct {
 
 typedef struct {
     int strict;            /* degenerate triangles and non-finite data become errors, not warnings */
+    const void *data;      /* non-NULL: the .gltf or .glb's bytes in memory (`path` then only names it in
+                            * messages, and the scene may not name external files: data: URIs or the GLB's
+                            * own buffer only) */
+    size_t size;
 } lm_load_options;
 
 /* Loads a .gltf or .glb file. On failure returns the status, fills err with a message that names the
