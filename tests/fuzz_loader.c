@@ -184,7 +184,7 @@ static void test_fuzz_loader(void **state)
         write_file(path, m.data, m.size);
         lm_scene *scene = NULL;
         lm_error err;
-        lm_load_options opt = {(int)(rnd() & 1)};
+        lm_load_options opt = {.strict = (int)(rnd() & 1)};
         if (lm_scene_load_gltf(path, &opt, &scene, &err) == LM_OK) {
             assert_non_null(scene);
             ok++;

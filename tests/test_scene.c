@@ -41,7 +41,7 @@ static lm_scene *load_ok(const char *path, int strict)
 {
     lm_scene *s = NULL;
     lm_error err;
-    lm_load_options opt = {strict};
+    lm_load_options opt = {.strict = strict};
     lm_status st = lm_scene_load_gltf(path, &opt, &s, &err);
     if (st != LM_OK)
         print_error("load failed: %s\n", err.msg);
@@ -55,7 +55,7 @@ static void load_fails(const char *path, int strict, lm_status want, const char 
 {
     lm_scene *s = (lm_scene *)1;
     lm_error err;
-    lm_load_options opt = {strict};
+    lm_load_options opt = {.strict = strict};
     lm_status st = lm_scene_load_gltf(path, &opt, &s, &err);
     if (st != want || !strstr(err.msg, path) || !strstr(err.msg, word))
         print_error("status %d (want %d), message: %s\n", st, want, err.msg);
