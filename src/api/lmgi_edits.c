@@ -11,7 +11,6 @@
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
-
 int lmgi_light_count(const lmgi_scene *sc) { return sc ? sc->scene->light_count : 0; }
 
 lmgi_status lmgi_get_light(const lmgi_scene *sc, int light, lmgi_light *out, lmgi_error *err)

@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "../charts/atlas_dilate.h"
+#include "../core/stats.h"
 #include "../core/vecmath.h"
 #include "../update/frame_loop.h"
 #include "lmgi_context.h"
@@ -21,7 +22,6 @@ struct lmgi_updater {
     lmgi_scene *sc;
     lm_frame_loop *loop;
     int frames;                 /* updates done */
-    int has_frame;              /* the last update composited a frame */
     uint32_t *seen;             /* per surface: lmgi_surface_version at the end of the last update */
     /* the budget's cost model: the last COST_WINDOW updates' gather ms per texel, and the rest of each */
     double per_texel[COST_WINDOW], rest[COST_WINDOW];
@@ -29,7 +29,6 @@ struct lmgi_updater {
     lm_photon_stage_frame setup;
     double t_setup_gather;
 };
-
 
 /* A desc field: 0 keeps the default, a value in [lo, hi] replaces it, anything else is refused. */
 static int take(int v, int lo, int hi, int *dst)
@@ -248,17 +247,12 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     info->ms_setup_gather = 1e3 * u->t_setup_gather;
 }
 
-/* The 95th percentile of the window's first n samples. */
+/* The 95th percentile of the window's first n samples (sorting a copy). */
 static double p95(const double *v, int n)
 {
     double sorted[COST_WINDOW];
     memcpy(sorted, v, sizeof *v * (size_t)n);
-    for (int i = 1; i < n; i++) /* insertion sort: 32 values */
-        for (int j = i; j > 0 && sorted[j - 1] > sorted[j]; j--) {
-            double t = sorted[j];
-            sorted[j] = sorted[j - 1], sorted[j - 1] = t;
-        }
-    return sorted[(int)(0.95 * (n - 1))];
+    return lm_quantile(sorted, n, 0.95);
 }
 
 /* Texels that fit in budget_ms: the budget less the 95th percentile of the rest of recent updates, over
@@ -385,7 +379,6 @@ lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_updat
         return lm_export_error(err, &e);
     learn_cost(u, &fs);
     u->frames++;
-    u->has_frame = lm_frame_loop_get_settings(u->loop)->width > 0;
     if (stats)
         export_stats(&fs, budget, count_changed(u), stats);
     else
@@ -397,7 +390,7 @@ const float *lmgi_frame(const lmgi_updater *u, int *width, int *height)
 {
     int w = 0, h = 0;
     const float *img = NULL;
-    if (u && u->has_frame) {
+    if (u && u->frames > 0 && lm_frame_loop_get_settings(u->loop)->width > 0) { /* a frame composited */
         w = lm_frame_loop_get_settings(u->loop)->width;
         h = lm_frame_loop_get_settings(u->loop)->height;
         img = lm_frame_loop_image(u->loop);
@@ -407,6 +400,15 @@ const float *lmgi_frame(const lmgi_updater *u, int *width, int *height)
     if (height)
         *height = h;
     return img;
+}
+
+/* The translation by sign x the scene's origin (lm_scene.origin: where lmgi's world origin lies in the
+ * file's): +1 takes lmgi's positions to the file's, -1 the file's to lmgi's. */
+static void origin_shift(const lm_scene *s, float sign, float m[16])
+{
+    lm_mat4_identity(m);
+    for (int k = 0; k < 3; k++)
+        m[12 + k] = sign * s->origin[k];
 }
 
 lmgi_status lmgi_scene_camera(const lmgi_scene *sc, int index, int width, int height, lmgi_camera *cam,
@@ -421,9 +423,7 @@ lmgi_status lmgi_scene_camera(const lmgi_scene *sc, int index, int width, int he
     lm_view v;
     lm_view_for_scene(sc->scene, index, width, height, &v);
     float to_file[16]; /* lmgi's world to the file's: the view matrix takes file positions */
-    lm_mat4_identity(to_file);
-    for (int k = 0; k < 3; k++)
-        to_file[12 + k] = -sc->scene->origin[k];
+    origin_shift(sc->scene, -1.0f, to_file);
     lm_mat4_mul(cam->view, v.view, to_file);
     memcpy(cam->proj, v.proj, sizeof cam->proj);
     return LMGI_OK;
@@ -439,9 +439,7 @@ lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int 
         if (!isfinite(cam->view[i]) || !isfinite(cam->proj[i]))
             return lm_api_refuse(err, "lmgi_render: camera matrix entry %d is not a finite number", i);
     float from_file[16], view[16]; /* the camera takes file positions; lmgi's are origin-relative */
-    lm_mat4_identity(from_file);
-    for (int k = 0; k < 3; k++)
-        from_file[12 + k] = u->sc->scene->origin[k];
+    origin_shift(u->sc->scene, 1.0f, from_file);
     lm_mat4_mul(view, cam->view, from_file);
     lm_view v;
     if (!lm_view_from_matrices(view, cam->proj, &v))
@@ -453,20 +451,30 @@ lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int 
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }
 
-/* The displayed IIM: alpha 1 on valid texels, 0 on invalid ones (inside or under geometry: filled from
- * their neighbours so that bilinear filtering stays smooth, but not light anyone sees) and gutters. */
+/* The displayed IIM read back into *raw (the caller frees it), and each texel's validity into rgba's
+ * alpha: 1 on valid texels, 0 on gutters and on texels inside or under geometry (back-face fraction over
+ * the limit: filled from their neighbours for filtering, but not light anyone sees). */
+static lm_status read_raw_iim(const lmgi_updater *u, float **raw, float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    lm_status st = lm_frame_loop_read_iim(u->loop, raw, err);
+    float limit = lm_frame_loop_get_settings(u->loop)->gather.backface_limit;
+    for (size_t i = 0; st == LM_OK && i < n; i++)
+        rgba[4 * i + 3] = at->texel_index[i] >= 0 && !((*raw)[4 * i + 3] > limit);
+    return st;
+}
+
+/* The displayed IIM, invalid texels filled and gutters dilated, with validity as alpha. */
 static lm_status read_iim(const lmgi_updater *u, float *rgba, lm_error *err)
 {
     const lm_atlas *at = &u->sc->atlas;
     size_t n = (size_t)at->width * at->height;
     float *raw = NULL;
-    lm_status st = lm_frame_loop_read_iim(u->loop, &raw, err);
+    lm_status st = read_raw_iim(u, &raw, rgba, err);
     if (st != LM_OK)
         return st;
-    float limit = lm_frame_loop_get_settings(u->loop)->gather.backface_limit;
-    for (size_t i = 0; i < n; i++) /* validity, kept in the output's alpha until the fill is done */
-        rgba[4 * i + 3] = at->texel_index[i] >= 0 && !(raw[4 * i + 3] > limit);
-    lm_iim_fill_invalid(at, raw, limit);
+    lm_iim_fill_invalid(at, raw, lm_frame_loop_get_settings(u->loop)->gather.backface_limit);
     for (size_t i = 0; i < n; i++)
         memcpy(rgba + 4 * i, raw + 4 * i, 3 * sizeof *rgba);
     free(raw);
@@ -479,12 +487,13 @@ static lm_status read_aim(const lmgi_updater *u, float *rgba, lm_error *err)
 {
     const lm_atlas *at = &u->sc->atlas;
     size_t n = (size_t)at->width * at->height;
-    float *rgb = malloc(n * 3 * sizeof *rgb);
+    float *rgb = malloc(n * 3 * sizeof *rgb), *raw = NULL;
     if (!rgb)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the AIM read-back");
     lm_status st = lm_frame_loop_sync(u->loop, err); /* the AIM is the photon work's */
     if (st == LM_OK)
-        st = read_iim(u, rgba, err);
+        st = read_raw_iim(u, &raw, rgba, err); /* for the validity alone: no fill */
+    free(raw);
     if (st == LM_OK) {
         memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(u->loop))), n * 3 * sizeof *rgb);
         lm_atlas_dilate_gutters(at, rgb, 3);
