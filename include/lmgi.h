@@ -407,6 +407,7 @@ typedef struct {
     uint32_t photons_traced, photons_changed; /* re-traced, and of those the paths the edits changed */
     int aim_surfaces_refreshed;
     uint32_t texels_gathered;   /* texels regathered (the atlas has lmgi_info.texels) */
+    int surfaces_seeing;        /* of the surfaces regathered, those only because they see a refreshed AIM */
     int surfaces_changed;       /* surfaces whose lightmap changed */
     double ms_photons, ms_gather, ms_total;
 } lmgi_bake_report;

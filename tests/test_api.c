@@ -572,8 +572,10 @@ static void test_recolour_material(void **state)
     lmgi_bake_report rt;
     assert_int_equal(lmgi_bake(truth, NULL, &rt, &e), LMGI_OK); /* both at the animations' time 0 (the file's */
     assert_int_equal(lmgi_bake(u, NULL, &r, &e), LMGI_OK);      /* rest pose differs) */
-    print_message("red wall recoloured blue: %u of %u photon paths changed, %d AIM surfaces, %u texels regathered\n",
-                  r.photons_changed, r.photons_traced, r.aim_surfaces_refreshed, r.texels_gathered);
+    print_message("red wall recoloured blue: %u of %u photon paths changed, %d AIM surfaces, %u texels regathered "
+                  "(%d surfaces for what they see)\n", r.photons_changed, r.photons_traced, r.aim_surfaces_refreshed,
+                  r.texels_gathered, r.surfaces_seeing);
+    assert_true(r.surfaces_seeing > 0); /* the cube's faces, which no changed photon reached */
     assert_true(r.photons_changed > 0 && r.photons_changed < r.photons_traced);
     assert_true(r.aim_surfaces_refreshed > 0 && r.texels_gathered > 0);
 

@@ -340,9 +340,9 @@ lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_rep
     lm_error e;
     lm_status st = lm_frame_loop_bake(u->loop, d.time, d.progress ? bake_progress : NULL, &d, d.cancel, &bs, &e);
     if (st == LM_OK)
-        lm_info("%s: bake: %u of %u photon paths changed, %d AIM surfaces, %u texels, %d surfaces changed",
-                u->sc->scene->path, bs.photons_changed, bs.photons_traced, bs.aim_surfaces_refreshed,
-                bs.texels_gathered, bs.surfaces_changed);
+        lm_info("%s: bake: %u of %u photon paths changed, %d AIM surfaces, %u texels (%d surfaces for what they "
+                "see), %d surfaces changed", u->sc->scene->path, bs.photons_changed, bs.photons_traced,
+                bs.aim_surfaces_refreshed, bs.texels_gathered, bs.surfaces_seeing, bs.surfaces_changed);
     lm_api_leave(saved);
     count_changed(u); /* the bake's changes are not the next update's */
     if (report) {
@@ -350,6 +350,7 @@ lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_rep
         report->photons_changed = bs.photons_changed;
         report->aim_surfaces_refreshed = bs.aim_surfaces_refreshed;
         report->texels_gathered = bs.texels_gathered;
+        report->surfaces_seeing = bs.surfaces_seeing;
         report->surfaces_changed = bs.surfaces_changed;
         report->ms_photons = 1e3 * bs.t_photons;
         report->ms_gather = 1e3 * bs.t_gather;

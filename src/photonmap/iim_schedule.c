@@ -89,6 +89,11 @@ static uint32_t take_texels(lm_iim_sched *s, lm_photon_store *ps, int k, uint32_
 
 uint32_t lm_iim_sched_pick(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out)
 {
+    return lm_iim_sched_pick_up_to(s, ps, s->texels_per_frame > 0 ? (uint32_t)s->texels_per_frame : 0, out);
+}
+
+uint32_t lm_iim_sched_pick_up_to(lm_iim_sched *s, lm_photon_store *ps, uint32_t budget, uint32_t *out)
+{
     int *cand = malloc(sizeof(int) * (size_t)(s->surface_count ? s->surface_count : 1));
     if (!cand)
         return 0;
@@ -101,7 +106,7 @@ uint32_t lm_iim_sched_pick(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out)
             cand[i] = cand[i - 1], i--;
         cand[i] = k;
     }
-    uint32_t budget = s->texels_per_frame > 0 ? (uint32_t)s->texels_per_frame : 0, n = 0;
+    uint32_t n = 0;
     for (int i = 0; i < nc && n < budget; i++)
         n += take_texels(s, ps, cand[i], out + n, budget - n);
     free(cand);

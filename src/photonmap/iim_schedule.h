@@ -39,6 +39,8 @@ void lm_iim_sched_free(lm_iim_sched *s);
 /* Picks this frame's texels (at most texels_per_frame, written to out) and resets delta_i of surfaces
  * whose refresh completes. Returns how many. */
 uint32_t lm_iim_sched_pick(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);
+/* The same with `budget` texels in place of texels_per_frame (a bake: the whole atlas). */
+uint32_t lm_iim_sched_pick_up_to(lm_iim_sched *s, lm_photon_store *ps, uint32_t budget, uint32_t *out);
 /* Every texel of every surface, for the first full gather; completes every surface. Returns the count
  * (out must hold the atlas's texel_count). */
 uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);

@@ -1,5 +1,6 @@
 #include "frame_loop.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -132,7 +133,10 @@ static int widen_to_viewers(lm_frame_loop *fl, lm_photon_store *ps)
             continue;
         for (int b = 0; b < S; b++)
             if (b != a && refreshed[b] && sees(fl, a, b, lift)) {
-                ps->surfaces[a].delta_i = fl->iim.sched.delta_threshold + 1e-30;
+                /* just over the threshold, whatever its size (a fixed 1e-30 vanishes beside 1; nextafter's
+                 * denormal beside 0 reads as 0 on the threads that trace, which flush denormals) */
+                double th = fl->iim.sched.delta_threshold;
+                ps->surfaces[a].delta_i = th + fmax(1e-30, 1e-9 * th);
                 n++;
                 break;
             }
@@ -543,10 +547,7 @@ static lm_status bake_gather(lm_frame_loop *fl, lm_bake_progress progress, void 
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", fl->scene->path);
     for (int s = 0; s < S; s++)
         saved[s] = ps->surfaces[s].delta_i;
-    int budget = fl->iim.sched.texels_per_frame;
-    fl->iim.sched.texels_per_frame = (int)fl->atlas->texel_count;
-    uint32_t n = lm_iim_sched_pick(&fl->iim.sched, ps, fl->texels);
-    fl->iim.sched.texels_per_frame = budget;
+    uint32_t n = lm_iim_sched_pick_up_to(&fl->iim.sched, ps, fl->atlas->texel_count, fl->texels);
     bake_watch w = {progress, user};
     fl->set.progress = progress ? bake_gather_progress : NULL;
     fl->set.progress_user = &w;
