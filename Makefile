@@ -44,6 +44,10 @@ LIB_CXX := $(sort $(wildcard src/scene/*.cpp src/charts/*.cpp))
 CLI_C   := $(sort $(wildcard src/cli/*.c))
 LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o)
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
+# lmgi-dev: the developer's commands that look inside the library (tools/dev/main.c), on the CLI's
+# option parser and helpers
+DEV_C   := $(sort $(wildcard tools/dev/*.c))
+DEV_OBJ := $(DEV_C:%.c=$(BUILD)/obj/%.o) $(filter-out %/main.o,$(CLI_OBJ))
 TEST_C  := $(sort $(wildcard tests/test_*.c))
 TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o
@@ -51,7 +55,7 @@ TEST_SUPPORT := $(BUILD)/obj/tests/support.o
 .PHONY: all deps test test-asan demo bench scenes clean fuzz install install-files
 .PRECIOUS: $(BUILD)/obj/%.o
 .PHONY: FORCE
-all: $(BUILD)/lmgi $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
+all: $(BUILD)/lmgi $(BUILD)/lmgi-dev $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
 
 deps:
 	@missing=""; for p in $(DEB_PACKAGES); do \
@@ -105,6 +109,9 @@ install-files:
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
 	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS)
 
+$(BUILD)/lmgi-dev: $(DEV_OBJ) $(BUILD)/liblmgi.a
+	$(CC) -o $@ $(DEV_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS)
+
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
 	@mkdir -p $(dir $@)
 	$(CC) -o $@ $< $(TEST_SUPPORT) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) -lcmocka
@@ -150,8 +157,8 @@ bench: deps all $(BUILD)/gen_scenes
 	@mkdir -p $(BUILD)/bench
 	@for n in $(BENCH_ROOMS); do [ -f $(BUILD)/bench/rooms_$$n.glb ] || $(BUILD)/gen_scenes --rooms $$n $(BUILD)/bench/rooms_$$n.glb >/dev/null; done
 	@[ -f $(BUILD)/bench/cornell_255.glb ] || $(BUILD)/gen_scenes --cornell-cells 255 $(BUILD)/bench/cornell_255.glb >/dev/null
-	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb) \
-	  --gather-scene $(BUILD)/bench/cornell_255.glb
+	$(BUILD)/lmgi-dev bench --gather-scene $(BUILD)/bench/cornell_255.glb
+	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb)
 	$(BUILD)/lmgi bench --edits bench/two_rooms_edits.json scenes/two_rooms.glb --json $(BUILD)/bench/edits.json
 
 scenes: $(BUILD)/gen_scenes

@@ -461,6 +461,78 @@ LMGI_API int lmgi_surface_rect(const lmgi_scene *scene, int surface, int rect[4]
 LMGI_API uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
 
 /* ------------------------------------------------------------------------------------------------------
+ * Reference: the converged answer every error figure is measured against (docs/reference.md): Monte
+ * Carlo path tracing, per lightmap texel and per pixel, each entry sampled until its relative standard
+ * error reaches the target. Deterministic for a scene, desc and camera; results are cached on disk under
+ * a key of all of them, so asking again costs a file read. Cost: seconds (small atlases, a 96 x 96
+ * picture) to minutes. Progress lines go to stderr at verbosity 2. Thread-safety: one call at a time per
+ * scene (other scenes' calls may run beside it); it uses every core. */
+typedef struct {
+    float target_error;     /* relative standard error per entry to stop at (0: 0.02) */
+    int samples;            /* paths per entry per pass (0: 64; entries take at least two passes) */
+    uint32_t seed;          /* (0: 1) */
+    const char *cache_dir;  /* NULL: $LMGI_CACHE, else build/reference-cache */
+    int no_cache;           /* 1: neither read nor write the cache */
+} lmgi_reference_desc;
+
+/* A reference solution as images, width x height x 3 linear floats, top row first for pixels, row 0 at
+ * v = 0 for texels (the lightmaps' layout; 0 outside texels). */
+typedef struct {
+    int width, height;
+    float *full;            /* texels: irradiance E from all light; pixels: radiance reaching the eye */
+    float *iim;             /* texels: E without the punctual lights' direct part (what the IIM holds); pixels: NULL */
+    float *radiance;        /* texels: albedo / pi x E (what the AIM approximates); pixels: NULL */
+    uint32_t entries, converged; /* texels or pixels, and how many reached the target (the rest hit the cap) */
+    uint64_t samples;       /* paths traced over all entries */
+    double mean_rel_se, max_rel_se; /* achieved relative standard error per entry */
+    double seconds;         /* computing time (the first computation's when it came from the cache) */
+    int from_cache;
+} lmgi_reference;
+
+/* Every texel of the scene's atlas. NULL scene or out: LMGI_ERR_INVALID; NULL desc: the defaults; a
+ * target_error or samples out of range: LMGI_ERR_INVALID naming it. out is zeroed on failure. */
+LMGI_API lmgi_status lmgi_reference_texels(const lmgi_scene *scene, const lmgi_reference_desc *desc,
+                                           lmgi_reference *out, lmgi_error *err);
+/* The picture a perspective camera sees (lmgi_scene_camera, or the application's). An orthographic or
+ * non-invertible camera, sides outside 1..16384: LMGI_ERR_INVALID. */
+LMGI_API lmgi_status lmgi_reference_pixels(const lmgi_scene *scene, const lmgi_reference_desc *desc,
+                                           const lmgi_camera *cam, int width, int height, lmgi_reference *out,
+                                           lmgi_error *err);
+LMGI_API void lmgi_reference_free(lmgi_reference *r); /* NULL: nothing; the struct is zeroed */
+
+/* Check: an updater's composited frame against the reference's pixels of the same camera, the way a user
+ * meets the lighting (docs/reference.md, "Frame against reference"). Compared are the pixels whose
+ * centre and four neighbours see one surface (edges alias, which is not lighting); mirror and glass
+ * pixels and the background are left out, and the frame's totals leave out emissive surfaces too (each
+ * still has its row). */
+typedef struct {
+    int node, material;     /* the surface's node and material ids */
+    uint32_t pixels;        /* compared pixels (0: not seen) */
+    double frame_mean[3], reference_mean[3]; /* mean radiance over them per channel */
+    double ratio[3];        /* frame / reference per channel (1 when both are 0, INFINITY when only the frame is not) */
+} lmgi_check_surface;
+typedef struct {
+    int width, height;
+    float *frame, *reference; /* width x height x 3 linear floats, top row first */
+    unsigned char *compared; /* per pixel: 1 where it counts */
+    int surface_count;      /* lmgi_surface_count */
+    lmgi_check_surface *surfaces;
+    uint32_t pixels;        /* compared pixels of non-emissive surfaces */
+    double frame_mean[3], reference_mean[3], ratio[3]; /* over those pixels */
+    double rel_rmse;        /* relative RMSE of the frame over those pixels */
+    double reference_rel_se, reference_seconds; /* the reference's own noise and cost */
+} lmgi_check_result;
+/* Creates an updater on ctx for scene with desc (frame_width x frame_height: the picture, 0 x 0 is
+ * 128 x 128; camera: the view), runs `frames` updates (at least 1, 30 per second of animation), compares
+ * the last frame with lmgi_reference_pixels at the same camera and frees the updater. NULL ctx, scene or
+ * out, a scene that has an updater, frames < 1: LMGI_ERR_INVALID; else the updater's and reference's
+ * errors. out is zeroed on failure. */
+LMGI_API lmgi_status lmgi_check(lmgi_context *ctx, lmgi_scene *scene, const lmgi_updater_desc *desc,
+                                const lmgi_reference_desc *ref, int frames, lmgi_check_result *out,
+                                lmgi_error *err);
+LMGI_API void lmgi_check_free(lmgi_check_result *c); /* NULL: nothing; the struct is zeroed */
+
+/* ------------------------------------------------------------------------------------------------------
  * Pictures. EXR keeps the linear numbers; PNG is for people: exposure, a tone map, then sRGB.
  *   LMGI_TONEMAP_NEUTRAL (the default): Khronos PBR Neutral. Colours below 0.76 pass unchanged, brighter
  *     ones are compressed smoothly towards white and desaturated with it, so a bright lit floor keeps its
@@ -483,6 +555,15 @@ typedef struct {
  * desc or another extension: LMGI_ERR_INVALID; a failed write: LMGI_ERR_IO naming the file. */
 LMGI_API lmgi_status lmgi_write_image(const char *path, int width, int height, int channels, const float *pixels,
                                       const lmgi_image_desc *desc, lmgi_error *err);
+
+/* Output directories, claimed before any work so that nothing a user put there is lost and no stale file
+ * of an earlier, longer run is left beside the new ones (README, "Output directories"). A directory lmgi
+ * writes into holds a marker file, .lmgi. The claim makes `dir` (and its parents) if needed and refuses,
+ * with LMGI_ERR_IO naming a file found there, one that holds anything but lmgi's marker unless force is
+ * non-zero; then it removes the files named like the caller's own output (`own`: NULL-terminated
+ * fnmatch(3) patterns, NULL for none) and any NAME.partial an interrupted write left, and nothing else,
+ * and writes the marker. NULL dir: LMGI_ERR_INVALID. Not thread-safe for one directory. */
+LMGI_API lmgi_status lmgi_claim_output_dir(const char *dir, int force, const char *const *own, lmgi_error *err);
 
 LMGI_API const char *lmgi_status_name(lmgi_status s);
 /* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */

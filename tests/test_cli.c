@@ -4,6 +4,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -303,6 +304,89 @@ static void test_bench_edits(void **state)
     assert_non_null(strstr(output, "edit 0: no light on that node"));
 }
 
+/* `lmgi reference` writes the atlas-sized texel images and the picture, and `lmgi check` compares a frame
+ * with the reference: the frame within 10% of it over the lit pixels at these small settings. */
+static void test_reference_and_check_commands(void **state)
+{
+    (void)state;
+    const char *dir = lmt_tmpdir();
+    char args[2048], path[1100];
+    snprintf(args, sizeof args, "info scenes/cornell.glb --texels 800");
+    assert_int_equal(run(args), 0);
+    int aw = 0, ah = 0;
+    const char *atlas = strstr(output, "\natlas ");
+    assert_non_null(atlas);
+    assert_int_equal(sscanf(strpbrk(atlas, "0123456789"), "%d x %d", &aw, &ah), 2);
+    snprintf(args, sizeof args, "reference scenes/cornell.glb --texels 800 --size 24x20 --target-error 0.1 "
+             "--no-cache --out %s/ref", dir);
+    assert_int_equal(run(args), 0);
+    static const char *const atlas_images[] = {"reference_full.exr", "reference_iim.exr", "reference_radiance.exr"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/ref/%s", dir, atlas_images[k]);
+        int w, h;
+        float *img = NULL;
+        lm_error err;
+        assert_int_equal(lm_read_exr(path, &w, &h, &img, &err), LM_OK);
+        assert_int_equal(w, aw);
+        assert_int_equal(h, ah);
+        double sum = 0.0;
+        for (size_t i = 0; i < (size_t)w * h * 4; i++)
+            sum += img[i];
+        assert_true(sum > 0.0); /* lit */
+        free(img);
+    }
+    snprintf(path, sizeof path, "%s/ref/reference_pixels.png", dir);
+    assert_int_equal(access(path, R_OK), 0);
+    snprintf(args, sizeof args, "check scenes/cornell.glb --texels 800 --size 32x32 --photons 6000 --hemicube 16 "
+             "--target-error 0.1 --no-cache --out %s/check -q", dir);
+    assert_int_equal(run(args), 0);
+    const char *row = strstr(output, "frame (not emitters)");
+    assert_non_null(row);
+    unsigned pixels;
+    double r, g, b;
+    assert_int_equal(sscanf(row + strlen("frame (not emitters)"), "%u %lf %lf %lf", &pixels, &r, &g, &b), 4);
+    print_message("lmgi check at 32 x 32: %u pixels, frame / reference %.3f %.3f %.3f\n", pixels, r, g, b);
+    assert_true(pixels > 100);
+    assert_true(fabs(r - 1.0) < 0.1 && fabs(g - 1.0) < 0.1 && fabs(b - 1.0) < 0.1);
+    static const char *const check_files[] = {"check_frame.exr", "check_reference.exr", "check_ratio.png"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/check/%s", dir, check_files[k]);
+        assert_int_equal(access(path, R_OK), 0);
+    }
+}
+
+/* The lmgi command is the public API's first user: no file of src/cli/ includes anything of the library
+ * but include/lmgi.h (src/cli's own headers, by plain name). */
+static void test_cli_sees_only_the_public_header(void **state)
+{
+    (void)state;
+    DIR *d = opendir("src/cli");
+    assert_non_null(d);
+    int files = 0;
+    for (struct dirent *e; (e = readdir(d));) {
+        size_t n = strlen(e->d_name);
+        if (n < 3 || (strcmp(e->d_name + n - 2, ".c") && strcmp(e->d_name + n - 2, ".h")))
+            continue;
+        char path[600], line[1024];
+        snprintf(path, sizeof path, "src/cli/%s", e->d_name);
+        FILE *f = fopen(path, "r");
+        assert_non_null(f);
+        while (fgets(line, sizeof line, f)) {
+            char name[512];
+            if (sscanf(line, " # include \"%511[^\"]\"", name) != 1)
+                continue;
+            snprintf(path, sizeof path, "src/cli/%s", name);
+            if (strchr(name, '/') || access(path, R_OK) != 0)
+                fail_msg("src/cli/%s includes \"%s\": the command may use include/lmgi.h and its own files only",
+                         e->d_name, name);
+        }
+        fclose(f);
+        files++;
+    }
+    closedir(d);
+    assert_true(files > 20);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -313,6 +397,8 @@ int main(void)
         cmocka_unit_test(test_charts_pictures),
         cmocka_unit_test(test_bake_command),
         cmocka_unit_test(test_bench_edits),
+        cmocka_unit_test(test_reference_and_check_commands),
+        cmocka_unit_test(test_cli_sees_only_the_public_header),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

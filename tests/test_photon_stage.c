@@ -1,5 +1,5 @@
 /* The photon stage end to end: photons traced through the scene, AIMs estimated from them, compared
- * with an analytic answer and with the reference solver; and the `lmgi photons` command. */
+ * with an analytic answer and with the reference solver; and the `lmgi-dev photons` command. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -146,11 +146,11 @@ static void test_cornell_box_aims_against_reference(void **state)
     lmt_pipeline_free(&p);
 }
 
-static int run_lmgi(const char *args)
+static int run_lmgi_dev(const char *args)
 {
     const char *build = getenv("LMGI_BUILD");
     char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s/lmgi %s > /dev/null 2>&1", build ? build : "build", args);
+    snprintf(cmd, sizeof cmd, "%s/lmgi-dev %s > /dev/null 2>&1", build ? build : "build", args);
     int status = system(cmd);
     assert_true(WIFEXITED(status));
     return WEXITSTATUS(status);
@@ -175,7 +175,7 @@ static void test_photons_command(void **state)
     const char *dir = lmt_tmpdir();
     char args[2048], file[1024];
     snprintf(args, sizeof args, "photons %s --frames 12 --size 160x120 --out %s/a", path, dir);
-    assert_int_equal(run_lmgi(args), 0);
+    assert_int_equal(run_lmgi_dev(args), 0);
     const char *outputs[] = {"aim.exr", "aim.png", "view.png"};
     for (int i = 0; i < 3; i++) {
         snprintf(file, sizeof file, "%s/a/%s", dir, outputs[i]);
@@ -185,13 +185,13 @@ static void test_photons_command(void **state)
     assert_int_equal(count_lines(file), 13); /* header + one row per frame */
     /* Same scene, same frames, same seed: the same AIM, byte for byte. */
     snprintf(args, sizeof args, "photons %s --frames 12 --size 160x120 --out %s/b -q", path, dir);
-    assert_int_equal(run_lmgi(args), 0);
+    assert_int_equal(run_lmgi_dev(args), 0);
     snprintf(args, sizeof args, "cmp -s %s/a/aim.exr %s/b/aim.exr", dir, dir);
     assert_int_equal(system(args), 0);
     snprintf(args, sizeof args, "photons %s", path);
-    assert_int_equal(run_lmgi(args), 2); /* no --out */
+    assert_int_equal(run_lmgi_dev(args), 2); /* no --out */
     snprintf(args, sizeof args, "photons %s --out %s/c --groups 70", path, dir);
-    assert_int_equal(run_lmgi(args), 2); /* G must be 2^a 3^b: a bad command line (issue 16) */
+    assert_int_equal(run_lmgi_dev(args), 2); /* G must be 2^a 3^b: a bad command line (issue 16) */
 }
 
 int main(void)

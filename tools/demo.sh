@@ -2,6 +2,7 @@
 # make demo: the main job on our scenes, leaving pictures in demo/ (named in the README).
 set -eu
 LMGI=${1:-build/lmgi}
+LMGI_DEV=$(dirname "$LMGI")/lmgi-dev # the developer's commands (tools/dev)
 mkdir -p demo
 # demo/ is the demo's own (make clean removes it): --force lets a directory from before lmgi marked its
 # output directories (README, "Output directories") be written again.
@@ -18,7 +19,7 @@ done
 # The photon stage on the paper's scene: the cube and the mirror sphere move for 3 seconds.
 if [ -r scenes/cornell.glb ]; then
     echo "== photons on scenes/cornell.glb"
-    "$LMGI" photons scenes/cornell.glb --frames 90 --photons 50000 --out demo/cornell-photons --force
+    "$LMGI_DEV" photons scenes/cornell.glb --frames 90 --photons 50000 --out demo/cornell-photons --force
 fi
 # The whole frame loop on the same scene: composited frames, final lightmap atlases, per-stage times.
 if [ -r scenes/cornell.glb ]; then

@@ -9,8 +9,8 @@
 
 #include "../charts/atlas_dilate.h"
 #include "../core/stats.h"
-#include "../core/vecmath.h"
 #include "../update/frame_loop.h"
+#include "lmgi_camera.h"
 #include "lmgi_context.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
@@ -403,48 +403,15 @@ const float *lmgi_frame(const lmgi_updater *u, int *width, int *height)
     return img;
 }
 
-/* The translation by sign x the scene's origin (lm_scene.origin: where lmgi's world origin lies in the
- * file's): +1 takes lmgi's positions to the file's, -1 the file's to lmgi's. */
-static void origin_shift(const lm_scene *s, float sign, float m[16])
-{
-    lm_mat4_identity(m);
-    for (int k = 0; k < 3; k++)
-        m[12 + k] = sign * s->origin[k];
-}
-
-lmgi_status lmgi_scene_camera(const lmgi_scene *sc, int index, int width, int height, lmgi_camera *cam,
-                              lmgi_error *err)
-{
-    if (!sc || !cam)
-        return lm_api_refuse(err, "lmgi_scene_camera: %s is NULL", sc ? "cam" : "scene");
-    if (index < -1 || index >= sc->scene->camera_count)
-        return lm_api_refuse(err, "lmgi_scene_camera: camera %d: the scene has %d", index, sc->scene->camera_count);
-    if (width < 1 || height < 1 || width > 16384 || height > 16384)
-        return lm_api_refuse(err, "lmgi_scene_camera: picture %d x %d must have sides in 1..16384", width, height);
-    lm_view v;
-    lm_view_for_scene(sc->scene, index, width, height, &v);
-    float to_file[16]; /* lmgi's world to the file's: the view matrix takes file positions */
-    origin_shift(sc->scene, -1.0f, to_file);
-    lm_mat4_mul(cam->view, v.view, to_file);
-    memcpy(cam->proj, v.proj, sizeof cam->proj);
-    return LMGI_OK;
-}
-
 lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb, lmgi_error *err)
 {
     if (!u || !cam || !rgb)
         return lm_api_refuse(err, "lmgi_render: %s is NULL", !u ? "updater" : !cam ? "cam" : "rgb");
     if (width < 1 || height < 1 || width > 16384 || height > 16384)
         return lm_api_refuse(err, "lmgi_render: picture %d x %d must have sides in 1..16384", width, height);
-    for (int i = 0; i < 16; i++)
-        if (!isfinite(cam->view[i]) || !isfinite(cam->proj[i]))
-            return lm_api_refuse(err, "lmgi_render: camera matrix entry %d is not a finite number", i);
-    float from_file[16], view[16]; /* the camera takes file positions; lmgi's are origin-relative */
-    origin_shift(u->sc->scene, 1.0f, from_file);
-    lm_mat4_mul(view, cam->view, from_file);
     lm_view v;
-    if (!lm_view_from_matrices(view, cam->proj, &v))
-        return lm_api_refuse(err, "lmgi_render: the view matrix is not invertible");
+    if (lm_api_view(u->sc, cam, "lmgi_render", &v, err) != LMGI_OK)
+        return LMGI_ERR_INVALID;
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
     lm_status st = lm_frame_loop_render(u->loop, &v, width, height, rgb, &e);

@@ -57,11 +57,8 @@ int lm_cli_bake(const lm_cli_args *a)
         return 2;
     }
     static const char *const own[] = {"lightmap.exr", "lightmap.png", "aim.exr", NULL};
-    lm_error claim;
-    if (lm_cli_claim_out_dir(a->out_dir, a->force, own, &claim) != LM_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", claim.msg);
+    if (!lm_cli_claim_out_dir(a, own))
         return 1;
-    }
     lmgi_scene *sc = NULL;
     lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
     if (!lm_cli_load_scene(a->files[0], &o, 1, &sc))

@@ -6,11 +6,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../core/stats.h"
+#include "order_stats.h"
 #include "bench_budget.h"
 #include "bench_edits.h"
-#include "bench_gather.h"
-#include "bench_photons.h"
 #include "bench_scenes.h"
 
 /* Scenes timed when none are named: ours first, then the shared ones (skipped when absent). */
@@ -55,7 +53,7 @@ static int time_scene(const lm_cli_args *a, const char *path, result *r)
     lmgi_timings *m = &r->info.timings;
     double *fields[STAGES] = {&m->load, &m->surfaces, &m->unwrap, &m->pack, &m->texels, &m->atlas, &m->bvh, &m->total};
     for (int s = 0; s < STAGES; s++)
-        *fields[s] = lm_median(t[s], a->repeats);
+        *fields[s] = lm_cli_median(t[s], a->repeats);
     return 0;
 }
 
@@ -168,8 +166,6 @@ int lm_cli_bench(const lm_cli_args *a)
         write_json(a->json_path, res, n, sr, sn);
     free(res);
     if (a->file_count == 0) {
-        lm_cli_bench_photons();
-        lm_cli_bench_gather(a->gather_scene);
         lm_cli_bench_budget();
         lm_cli_bench_scenes();
     }

@@ -7,7 +7,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "../core/stats.h"
+#include "order_stats.h"
 #include "progress.h"
 
 #define UPDATES 160
@@ -69,7 +69,7 @@ void lm_cli_bench_budget(void)
     for (size_t b = 0; b < sizeof budgets / sizeof *budgets; b++) {
         if (play(ctx, sc, budgets[b], ms, &texels) != 0)
             break;
-        double p95 = lm_quantile(ms, n, 0.95); /* sorts ms */
+        double p95 = lm_cli_quantile(ms, n, 0.95); /* sorts ms */
         printf("%8.1fms %8.2fms %8.2fms %8.2fms %10.2f %12.1f\n", (double)budgets[b], ms[n / 2], p95, ms[n - 1],
                p95 / budgets[b], texels / n);
         fflush(stdout);

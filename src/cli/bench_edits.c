@@ -10,7 +10,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "../core/stats.h"
+#include "order_stats.h"
 #include "json.h"
 #include "progress.h"
 
@@ -313,7 +313,7 @@ static void report(const lm_cli_args *a, const script *s, const frame_row *rows)
         texels += rows[f].texels;
     }
     if (ms) {
-        double p95 = lm_quantile(ms, s->frames, 0.95); /* sorts ms */
+        double p95 = lm_cli_quantile(ms, s->frames, 0.95); /* sorts ms */
         printf("updates: median %.2f ms, 95th percentile %.2f ms, worst %.2f ms; %d of %d over the budget by more "
                "than 10%%; %.1f texels an update\n", ms[s->frames / 2], p95,
                ms[s->frames - 1], over, s->frames, texels / s->frames);

@@ -1,13 +1,13 @@
-/* Every scene against the reference (bench_scenes.h). */
+/* Every scene against the reference (bench_scenes.h), through lmgi_check. */
 #include "bench_scenes.h"
 
 #include <math.h>
 #include <stdio.h>
+#include <string.h>
 #include <unistd.h>
 
-#include "../core/timing.h"
-#include "../api/frame_check.h"
 #include "bench.h"
+#include "progress.h"
 
 /* scenes/many_rooms.glb is left out: its reference took over 10 minutes here. */
 static const char *SCENES[] = {
@@ -25,58 +25,55 @@ static const char *SCENES[] = {
 
 static double lum(const double c[3]) { return c[0] + c[1] + c[2]; }
 
-/* The surface of MIN pixels furthest from the reference, relative to max(its mean, the frame's). */
-static void worst_surface(const lmgi_scene *sc, const lm_frame_check *c, char *out, size_t size)
+/* The surface of at least 100 pixels furthest from the reference, relative to max(its mean, the frame's). */
+static void worst_surface(const lmgi_scene *sc, const lmgi_check_result *c, char *out, size_t size)
 {
-    double mean = lum(c->lit.ref) / (c->lit.pixels ? c->lit.pixels : 1), worst = -1.0;
+    double mean = lum(c->reference_mean), worst = -1.0;
     snprintf(out, size, "-");
     for (int s = 0; s < c->surface_count; s++) {
-        const lm_check_sum *sum = &c->surface[s];
-        if (sum->pixels < 100)
+        const lmgi_check_surface *f = &c->surfaces[s];
+        if (f->pixels < 100)
             continue;
-        double f = lum(sum->frame) / sum->pixels, r = lum(sum->ref) / sum->pixels;
-        double d = fabs(f - r) / fmax(fmax(r, mean), 1e-30);
+        double fr = lum(f->frame_mean), r = lum(f->reference_mean);
+        double d = fabs(fr - r) / fmax(fmax(r, mean), 1e-30);
         if (d > worst) {
             worst = d;
-            snprintf(out, size, "%+.1f%% %s/%s", r > 0.0 ? 100.0 * (f / r - 1.0) : 0.0,
-                     sc->scene->nodes[sc->surfaces.surfaces[s].node].name,
-                     sc->scene->materials[sc->surfaces.surfaces[s].material].name);
+            snprintf(out, size, "%+.1f%% %s/%s", r > 0.0 ? 100.0 * (fr / r - 1.0) : 0.0, lmgi_node_name(sc, f->node),
+                     lmgi_material_name(sc, f->material));
         }
     }
 }
 
-static void check_one(const char *path)
+static void check_one(lmgi_context *ctx, const char *path)
 {
     lmgi_options o;
     lmgi_options_init(&o);
-    o.target_texels = lm_frame_loop_atlas_texels(LM_IIM_DEFAULT_TEXELS_PER_FRAME);
+    o.target_texels = lmgi_atlas_texels_for(0);
     lmgi_scene *sc = NULL;
-    lmgi_error lerr;
-    if (lmgi_load(path, &o, &sc, &lerr) != LMGI_OK) {
-        printf("%-34s error: %s\n", lm_cli_base_name(path), lerr.message);
+    lmgi_error err;
+    if (lmgi_load(path, &o, &sc, &err) != LMGI_OK) {
+        printf("%-34s error: %s\n", lm_cli_base_name(path), err.message);
         return;
     }
-    lm_frame_loop_settings ls;
-    lm_frame_loop_settings_default(&ls);
-    ls.width = ls.height = SIZE;
-    lm_ref_settings rs;
-    lm_ref_settings_default(&rs);
-    rs.target_error = REF_ERROR;
-    rs.progress = 0;
-    lm_frame_check c;
-    lm_error err;
-    double t0 = lm_now();
-    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK) {
-        printf("%-34s error: %s\n", lm_cli_base_name(path), err.msg);
-    } else if (lum(c.lit.ref) <= 0.0) {
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.frame_width = d.frame_height = SIZE;
+    lmgi_reference_desc rd;
+    memset(&rd, 0, sizeof rd);
+    rd.target_error = REF_ERROR;
+    lmgi_check_result c;
+    double t0 = lm_cli_now();
+    if (lmgi_check(ctx, sc, &d, &rd, 1, &c, &err) != LMGI_OK) {
+        printf("%-34s error: %s\n", lm_cli_base_name(path), err.message);
+    } else if (lum(c.reference_mean) <= 0.0) {
         printf("%-34s no light reaches the camera (the file has no light)\n", lm_cli_base_name(path));
-        lm_frame_check_free(&c);
+        lmgi_check_free(&c);
     } else {
         char worst[160];
         worst_surface(sc, &c, worst, sizeof worst);
-        printf("%-34s %6.3f %6.3f %6.3f %8.4f  %-36s %6.0f s\n", lm_cli_base_name(path), lm_check_ratio(&c.lit, 0),
-               lm_check_ratio(&c.lit, 1), lm_check_ratio(&c.lit, 2), c.rel_rmse, worst, lm_now() - t0);
-        lm_frame_check_free(&c);
+        printf("%-34s %6.3f %6.3f %6.3f %8.4f  %-36s %6.0f s\n", lm_cli_base_name(path), c.ratio[0], c.ratio[1],
+               c.ratio[2], c.rel_rmse, worst, lm_cli_now() - t0);
+        lmgi_check_free(&c);
     }
     fflush(stdout);
     lmgi_free(sc);
@@ -90,10 +87,17 @@ void lm_cli_bench_scenes(void)
            "(cached; lmgi check SCENE for the per-surface table)\n", SIZE, SIZE, (double)REF_ERROR);
     printf("%-34s %-20s %8s  %-36s %8s\n", "scene", "frame / ref (R G B)", "rel RMSE", "surface furthest off",
            "time");
+    lmgi_context *ctx = NULL;
+    lmgi_error err;
+    if (lmgi_context_create(NULL, &ctx, &err) != LMGI_OK) {
+        printf("error: %s\n", err.message);
+        return;
+    }
     for (int i = 0; i < count; i++) {
         if (access(files[i], R_OK) != 0)
             printf("%-34s skipped (not found: %s)\n", lm_cli_base_name(files[i]), files[i]);
         else
-            check_one(files[i]);
+            check_one(ctx, files[i]);
     }
+    lmgi_context_free(ctx);
 }

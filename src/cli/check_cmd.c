@@ -1,82 +1,82 @@
-/* lmgi check: `lmgi run`'s frame against the reference, per visible surface and over the frame. */
+/* lmgi check: `lmgi run`'s frame against the reference, per visible surface and over the frame
+ * (lmgi_check). */
 #include "check_cmd.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "../core/image.h"
-#include "../core/log.h"
-#include "../api/frame_check.h"
-#include "../api/lmgi_updater.h"
 #include "out_dir.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
 
-#define CHECK_SIZE 128 /* default picture side: the reference's pixels take seconds, not minutes */
-
-static void print_row(const char *name, const char *material, const lm_check_sum *c)
+static void print_row(const char *name, const char *material, uint32_t pixels, const double ratio[3])
 {
-    printf("  %-24s %-24s %7u   %6.3f %6.3f %6.3f\n", name, material, c->pixels, lm_check_ratio(c, 0),
-           lm_check_ratio(c, 1), lm_check_ratio(c, 2));
+    printf("  %-24s %-24s %7u   %6.3f %6.3f %6.3f\n", name, material, pixels, ratio[0], ratio[1], ratio[2]);
 }
 
-static void report(const lmgi_scene *sc, const lm_frame_check *c, const lm_ref_settings *rs)
+static void report(const lmgi_scene *sc, const lmgi_check_result *c, const lmgi_reference_desc *rd)
 {
     printf("frame %dx%d against the reference (target error %.3g: mean relative standard error per pixel %.3f, "
-           "%.1f s)\n", c->width, c->height, (double)rs->target_error, c->ref_rel_se, c->ref_seconds);
+           "%.1f s)\n", c->width, c->height, rd->target_error > 0.0f ? (double)rd->target_error : 0.02,
+           c->reference_rel_se, c->reference_seconds);
     printf("  %-24s %-24s %7s   frame / reference (R G B)\n", "surface (node)", "material", "pixels");
     for (int s = 0; s < c->surface_count; s++) {
-        if (!c->surface[s].pixels)
+        const lmgi_check_surface *f = &c->surfaces[s];
+        if (!f->pixels)
             continue;
-        const lm_surface *sf = &sc->surfaces.surfaces[s];
         char name[96];
-        snprintf(name, sizeof name, "%d (%.14s)", s, sc->scene->nodes[sf->node].name);
-        print_row(name, sc->scene->materials[sf->material].name, &c->surface[s]);
+        snprintf(name, sizeof name, "%d (%.14s)", s, lmgi_node_name(sc, f->node));
+        print_row(name, lmgi_material_name(sc, f->material), f->pixels, f->ratio);
     }
-    print_row("frame (not emitters)", "", &c->lit);
+    print_row("frame (not emitters)", "", c->pixels, c->ratio);
     printf("relative RMSE over those pixels %.4f\n", c->rel_rmse);
 }
 
 /* frame / reference per compared pixel as a colour: grey at 1, red where the frame is brighter, blue where
- * it is darker, full at +-10%; black where nothing is compared. */
-static void ratio_picture(const lm_frame_check *c, uint8_t *rgba)
+ * it is darker, full at +-10%; black where nothing is compared. Written as linear values that the clamp
+ * tone map at exposure 1 turns into these sRGB levels. */
+static void ratio_picture(const lmgi_check_result *c, float *rgb)
 {
     size_t n = (size_t)c->width * (size_t)c->height;
     for (size_t i = 0; i < n; i++) {
-        const float *f = c->frame + 3 * i, *r = c->ref + 3 * i;
+        const float *f = c->frame + 3 * i, *r = c->reference + 3 * i;
         double lf = f[0] + f[1] + f[2], lr = r[0] + r[1] + r[2];
         double t = c->compared[i] && lr > 0.0 ? fmax(-1.0, fmin(1.0, (lf / lr - 1.0) / 0.1)) : 0.0;
-        uint8_t *o = rgba + 4 * i;
-        o[0] = (uint8_t)(c->compared[i] ? 128 + (t > 0 ? 127 * t : 0) - (t < 0 ? -100 * t : 0) : 0);
-        o[1] = (uint8_t)(c->compared[i] ? 128 - 100 * fabs(t) : 0);
-        o[2] = (uint8_t)(c->compared[i] ? 128 + (t < 0 ? -127 * t : 0) - (t > 0 ? 100 * t : 0) : 0);
-        o[3] = 255;
+        double srgb[3] = {128 + (t > 0 ? 127 * t : 0) - (t < 0 ? -100 * t : 0), 128 - 100 * fabs(t),
+                          128 + (t < 0 ? -127 * t : 0) - (t > 0 ? 100 * t : 0)};
+        for (int k = 0; k < 3; k++) {
+            double v = c->compared[i] ? srgb[k] / 255.0 : 0.0;
+            rgb[3 * i + k] = (float)(v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4));
+        }
     }
 }
 
-static int write_images(const char *dir, const lm_frame_check *c)
+static int write_images(const char *dir, const lmgi_check_result *c)
 {
-    lm_error err;
     char path[4096];
+    lmgi_error err;
     snprintf(path, sizeof path, "%s/check_frame.exr", dir);
-    lm_status st = lm_write_exr(path, c->width, c->height, 3, c->frame, &err);
-    if (st == LM_OK) {
+    lmgi_status st = lmgi_write_image(path, c->width, c->height, 3, c->frame, NULL, &err);
+    if (st == LMGI_OK) {
         snprintf(path, sizeof path, "%s/check_reference.exr", dir);
-        st = lm_write_exr(path, c->width, c->height, 3, c->ref, &err);
+        st = lmgi_write_image(path, c->width, c->height, 3, c->reference, NULL, &err);
     }
-    uint8_t *rgba = st == LM_OK ? malloc((size_t)c->width * (size_t)c->height * 4) : NULL;
-    if (st == LM_OK && !rgba)
-        st = lm_fail(&err, LM_ERR_NOMEM, "no memory for the ratio picture");
-    if (st == LM_OK) {
-        ratio_picture(c, rgba);
+    float *rgb = st == LMGI_OK ? malloc((size_t)c->width * (size_t)c->height * 3 * sizeof *rgb) : NULL;
+    if (st == LMGI_OK && !rgb) {
+        fprintf(stderr, "lmgi: error: no memory for the ratio picture\n");
+        return 0;
+    }
+    if (st == LMGI_OK) {
+        ratio_picture(c, rgb);
         snprintf(path, sizeof path, "%s/check_ratio.png", dir);
-        st = lm_write_png(path, c->width, c->height, rgba, &err);
+        lmgi_image_desc as_is = {LMGI_TONEMAP_CLAMP, 1.0f, 0};
+        st = lmgi_write_image(path, c->width, c->height, 3, rgb, &as_is, &err);
     }
-    free(rgba);
-    if (st != LM_OK)
-        fprintf(stderr, "lmgi: error: %s\n", err.msg);
-    return st == LM_OK;
+    free(rgb);
+    if (st != LMGI_OK)
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+    return st == LMGI_OK;
 }
 
 int lm_cli_check(const lm_cli_args *a)
@@ -87,11 +87,8 @@ int lm_cli_check(const lm_cli_args *a)
         return 2;
     }
     static const char *const own[] = {"check_*.exr", "check_*.png", NULL};
-    lm_error err;
-    if (a->out_dir && lm_cli_claim_out_dir(a->out_dir, a->force, own, &err) != LM_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+    if (a->out_dir && !lm_cli_claim_out_dir(a, own))
         return 1;
-    }
     lmgi_scene *sc = NULL;
     if (!lm_cli_run_load(a, &sc))
         return 1;
@@ -99,28 +96,24 @@ int lm_cli_check(const lm_cli_args *a)
     lm_cli_updater_desc(a, &d);
     d.progress = NULL;
     if (!a->width)
-        d.frame_width = d.frame_height = CHECK_SIZE;
-    lm_frame_loop_settings ls;
-    if (lm_updater_settings(sc->scene, &d, &ls, &err) != LM_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.msg);
-        lmgi_free(sc);
-        return 1;
-    }
-    lm_ref_settings rs;
-    lm_cli_ref_settings(a, &rs);
-    if (!a->quiet && lm_log_get_level() < LM_LOG_INFO)
-        lm_log_set_level(LM_LOG_INFO); /* the reference's progress lines */
-    lm_frame_check c;
+        d.frame_width = d.frame_height = 0; /* lmgi_check's picture: the reference's pixels take seconds */
+    lmgi_reference_desc rd;
+    lm_cli_reference_desc(a, &rd);
+    lmgi_context *ctx = NULL;
+    lmgi_check_result c;
+    lmgi_error err;
     int rc = 0;
-    if (lm_frame_check_run(sc, &ls, &rs, a->frames ? a->frames : 1, &c, &err) != LM_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+    if (lmgi_context_create(NULL, &ctx, &err) != LMGI_OK ||
+        lmgi_check(ctx, sc, &d, &rd, a->frames ? a->frames : 1, &c, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
         rc = 1;
     } else {
-        report(sc, &c, &rs);
+        report(sc, &c, &rd);
         if (a->out_dir && !write_images(a->out_dir, &c))
             rc = 1;
-        lm_frame_check_free(&c);
+        lmgi_check_free(&c);
     }
+    lmgi_context_free(ctx);
     lmgi_free(sc);
     return rc;
 }

@@ -10,7 +10,6 @@
 #include "bench.h"
 #include "check_cmd.h"
 #include "out_dir.h"
-#include "photons_cmd.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
 #include "scene_load.h"
@@ -36,10 +35,9 @@ static void usage(FILE *f)
             "                         relative RMSE (default --size 128x128; --out DIR: the two EXRs)\n"
             "  reference SCENE --out DIR  path-traced ground truth per texel and per pixel\n"
             "  bench [SCENE...]       time load, surface split, atlas (unwrap, pack, texel table) and BVH build;\n"
-            "                         --scaling FILE (repeatable) adds a growth table; with no SCENE also photon\n"
-            "                         tracing vs raw Embree, kd-trees, the photon stage, the final gather,\n"
-            "                         the whole frame, the update time budget and every scene's default frame\n"
-            "                         against the reference\n"
+            "                         --scaling FILE (repeatable) adds a growth table; with no SCENE also the\n"
+            "                         update time budget and every scene's default frame against the\n"
+            "                         reference (photon tracing and the gather: lmgi-dev bench, make bench)\n"
             "  bench --edits SCRIPT.json SCENE  a scripted edit sequence through the updater: per-update times,\n"
             "                         budget overruns and each edit's update lag (docs/bench.md; --json FILE)\n"
             "  help                   this text\n"
@@ -86,7 +84,6 @@ static void usage(FILE *f)
             "  --exr-every K    'run': every K-th frame also as linear EXR (default 10)\n"
             "  --repeats N      'bench': runs per scene, the median is reported (default 3)\n"
             "  --json FILE      'bench': also write the results as JSON\n"
-            "  --gather-scene F 'bench': the ~133k-triangle Cornell box for the gather table (make bench makes it)\n"
             "  --force          write into a non-empty --out DIR that lmgi did not make (lmgi marks its\n"
             "                   own with DIR/.lmgi and replaces only its own kind of file there)\n"
             "  -v, -q           more / less on stderr\n");
@@ -119,11 +116,8 @@ static int cmd_charts(const lm_cli_args *a)
         return 2;
     }
     static const char *const own[] = {"atlas.png", "surfaces.png", NULL};
-    lm_error claim;
-    if (lm_cli_claim_out_dir(a->out_dir, a->force, own, &claim) != LM_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", claim.msg);
+    if (!lm_cli_claim_out_dir(a, own))
         return 1;
-    }
     lmgi_scene *sc = NULL;
     int rc = load(a, &sc);
     if (rc)
@@ -161,8 +155,6 @@ int main(int argc, char **argv)
         return cmd_info(&a);
     if (!strcmp(cmd, "charts"))
         return cmd_charts(&a);
-    if (!strcmp(cmd, "photons"))
-        return lm_cli_photons(&a);
     if (!strcmp(cmd, "reference"))
         return lm_cli_reference(&a);
     if (!strcmp(cmd, "run"))

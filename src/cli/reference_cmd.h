@@ -5,8 +5,7 @@
  * E_full, E_iim and radiance as atlas-sized EXRs, and the camera's picture as EXR and tone-mapped PNG. */
 int lm_cli_reference(const lm_cli_args *a);
 
-#include "../trace/reference.h"
-/* The reference solver's settings from the command line (--target-error, --samples, --seed, --cache,
- * --no-cache, -q). */
-void lm_cli_ref_settings(const lm_cli_args *a, lm_ref_settings *set);
+/* The reference's desc from the command line (--target-error, --samples, --seed, --cache, --no-cache),
+ * and, unless -q, its progress lines shown. */
+void lm_cli_reference_desc(const lm_cli_args *a, lmgi_reference_desc *d);
 #endif

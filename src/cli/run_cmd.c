@@ -9,9 +9,8 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../core/stats.h"
-#include "out_dir.h"
-#include "photons_cmd.h"
+#include "order_stats.h"
+#include "fail.h"
 #include "progress.h"
 #include "scene_load.h"
 
@@ -86,46 +85,36 @@ static int csv_row(FILE *f, const lmgi_update_stats *s)
     return fflush(f) == 0 && !ferror(f);
 }
 
-/* An error from the public API as the CLI's. */
-static lm_status from_api(lm_error *err, const lmgi_error *e)
-{
-    return lm_fail(err, (lm_status)e->status, "%s", e->message);
-}
-
 /* DIR/NAME.exr (linear) and DIR/NAME.png (tone-mapped with exposure k, or automatic when k <= 0). */
-static lm_status write_pair(const run_state *r, const char *name, int w, int h, int channels, const float *px,
-                            float k, int exr, lm_error *err)
+static lmgi_status write_pair(const run_state *r, const char *name, int w, int h, int channels, const float *px,
+                            float k, int exr, lmgi_error *err)
 {
     char path[4096];
-    lmgi_error e;
     if (exr) {
         snprintf(path, sizeof path, "%s/%s.exr", r->a->out_dir, name);
-        if (lmgi_write_image(path, w, h, channels, px, NULL, &e) != LMGI_OK)
-            return from_api(err, &e);
+        if (lmgi_write_image(path, w, h, channels, px, NULL, err) != LMGI_OK)
+            return err->status;
     }
     snprintf(path, sizeof path, "%s/%s.png", r->a->out_dir, name);
     lmgi_image_desc png = {(lmgi_tonemap)r->a->tonemap, k > 0.0f ? k : 0.0f, 0};
-    if (lmgi_write_image(path, w, h, channels, px, &png, &e) != LMGI_OK)
-        return from_api(err, &e);
-    return LM_OK;
+    return lmgi_write_image(path, w, h, channels, px, &png, err);
 }
 
-static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
+static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
 {
     lmgi_update_stats fs;
-    lmgi_error e;
-    if (lmgi_update(r->u, (float)f / FRAME_RATE, 0.0f, &fs, &e) != LMGI_OK)
-        return from_api(err, &e);
+    if (lmgi_update(r->u, (float)f / FRAME_RATE, 0.0f, &fs, err) != LMGI_OK)
+        return err->status;
     int w, h;
     const float *img = lmgi_frame(r->u, &w, &h);
-    lm_status st;
+    lmgi_status st;
     if (f == 0)
         r->exposure = lmgi_auto_exposure((lmgi_tonemap)r->a->tonemap, img, (size_t)w * h);
     char name[64];
     snprintf(name, sizeof name, "frame_%04d", f);
     st = write_pair(r, name, w, h, 3, img, r->exposure, f % every == 0, err);
-    if (st == LM_OK && !csv_row(r->csv, &fs))
-        st = lm_fail(err, LM_ERR_IO, "%s/frames.csv: write failed (%s)", r->a->out_dir, strerror(errno));
+    if (st == LMGI_OK && !csv_row(r->csv, &fs))
+        st = lm_cli_fail(err, LMGI_ERR_IO, "%s/frames.csv: write failed (%s)", r->a->out_dir, strerror(errno));
     const double ms[6] = {fs.ms_photons, fs.ms_gather, fs.ms_blend, fs.ms_direct, fs.ms_composite, fs.ms_total};
     for (int i = 0; i < 6; i++)
         r->sum_ms[i] += ms[i];
@@ -136,20 +125,19 @@ static lm_status play_frame(run_state *r, int f, int every, lm_error *err)
 
 /* The IIM's E (invalid texels filled, gutters dilated) and the AIM's radiance, each with validity as alpha
  * (lmgi_get_lightmap). */
-static lm_status write_atlases(run_state *r, lm_error *err)
+static lmgi_status write_atlases(run_state *r, lmgi_error *err)
 {
     lmgi_info in;
     lmgi_get_info(r->sc, &in);
     size_t n = (size_t)in.atlas_width * in.atlas_height;
     float *rgba = malloc(n * 4 * sizeof *rgba);
-    lm_status st = rgba ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory for the atlases");
+    lmgi_status st = rgba ? LMGI_OK : lm_cli_fail(err, LMGI_ERR_NOMEM, "no memory for the atlases");
     static const char *const names[2] = {"iim", "aim"};
     static const lmgi_lightmap kinds[2] = {LMGI_LIGHTMAP_IIM, LMGI_LIGHTMAP_AIM};
-    for (int k = 0; k < 2 && st == LM_OK; k++) {
-        lmgi_error e;
-        st = lmgi_get_lightmap(r->u, kinds[k], rgba, n * 4, &e) == LMGI_OK
-                 ? write_pair(r, names[k], in.atlas_width, in.atlas_height, 4, rgba, 0.0f, 1, err)
-                 : from_api(err, &e);
+    for (int k = 0; k < 2 && st == LMGI_OK; k++) {
+        st = lmgi_get_lightmap(r->u, kinds[k], rgba, n * 4, err);
+        if (st == LMGI_OK)
+            st = write_pair(r, names[k], in.atlas_width, in.atlas_height, 4, rgba, 0.0f, 1, err);
     }
     free(rgba);
     return st;
@@ -183,22 +171,22 @@ static void summary(const run_state *r, int frames)
     printf("mean frame  %.2f ms (%.1f fps): photons %.2f, gather %.2f, blend %.2f, direct %.2f, composite %.2f\n",
            s[5] / frames, s[5] > 0 ? 1e3 * frames / s[5] : 0.0, s[0] / frames, s[1] / frames, s[2] / frames,
            s[3] / frames, s[4] / frames);
-    double median = lm_median(r->frame_ms, frames);
+    double median = lm_cli_median(r->frame_ms, frames);
     printf("median      %.2f ms (%.1f fps; the mean includes frame 0, which uploads everything)\n", median,
            median > 0.0 ? 1e3 / median : 0.0);
     printf("wrote       %s/frame_*.png (.exr every %d), iim.exr/png, aim.exr/png, frames.csv\n", r->a->out_dir,
            r->a->exr_every ? r->a->exr_every : 10);
 }
 
-static lm_status play(run_state *r, lm_error *err)
+static lmgi_status play(run_state *r, lmgi_error *err)
 {
     int frames = r->a->frames ? r->a->frames : 60, every = r->a->exr_every ? r->a->exr_every : 10;
     r->frame_ms = malloc(sizeof *r->frame_ms * (size_t)frames);
     if (!r->frame_ms)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory for %d frame times", frames);
-    lm_status st = LM_OK;
+        return lm_cli_fail(err, LMGI_ERR_NOMEM, "no memory for %d frame times", frames);
+    lmgi_status st = LMGI_OK;
     csv_header(r->csv);
-    for (int f = 0; f < frames && st == LM_OK; f++) {
+    for (int f = 0; f < frames && st == LMGI_OK; f++) {
         st = play_frame(r, f, every, err);
         if (!r->a->quiet)
             lm_progress("run", f + 1, frames);
@@ -206,43 +194,37 @@ static lm_status play(run_state *r, lm_error *err)
     return st;
 }
 
-/* The output directory, claimed before the long setup, so a bad path fails at once. */
-static lm_status check_out_dir(const run_state *r, lm_error *err)
-{
-    static const char *const own[] = {"frame_*.png", "frame_*.exr", "frames.csv", "iim.exr", "iim.png", "aim.exr",
-                                      "aim.png", NULL};
-    return lm_cli_claim_out_dir(r->a->out_dir, r->a->force, own, err);
-}
-
 /* Files are created only once the frame loop exists: a run refused for its settings writes nothing. */
-static lm_status open_outputs(run_state *r, lm_error *err)
+static lmgi_status open_outputs(run_state *r, lmgi_error *err)
 {
     char path[4096];
     snprintf(path, sizeof path, "%s/frames.csv", r->a->out_dir);
     r->csv = fopen(path, "w");
-    return r->csv ? LM_OK : lm_fail(err, LM_ERR_IO, "%s: cannot write", path);
+    return r->csv ? LMGI_OK : lm_cli_fail(err, LMGI_ERR_IO, "%s: cannot write", path);
 }
 
-static lm_status run(run_state *r, lm_error *err)
+static lmgi_status run(run_state *r, lmgi_error *err)
 {
     lmgi_updater_desc desc;
     lm_cli_updater_desc(r->a, &desc);
-    lmgi_error e;
-    lm_status st = check_out_dir(r, err);
-    if (st == LM_OK && lmgi_context_create(NULL, &r->ctx, &e) != LMGI_OK)
-        st = from_api(err, &e);
-    if (st == LM_OK && lmgi_updater_create(r->ctx, r->sc, &desc, &r->u, &e) != LMGI_OK)
-        st = from_api(err, &e);
-    if (st == LM_OK)
+    /* the output directory, claimed before the long setup, so a bad path fails at once */
+    static const char *const own[] = {"frame_*.png", "frame_*.exr", "frames.csv", "iim.exr", "iim.png", "aim.exr",
+                                      "aim.png", NULL};
+    lmgi_status st = lmgi_claim_output_dir(r->a->out_dir, r->a->force, own, err);
+    if (st == LMGI_OK)
+        st = lmgi_context_create(NULL, &r->ctx, err);
+    if (st == LMGI_OK)
+        st = lmgi_updater_create(r->ctx, r->sc, &desc, &r->u, err);
+    if (st == LMGI_OK)
         st = open_outputs(r, err);
-    if (st == LM_OK)
+    if (st == LMGI_OK)
         st = play(r, err);
-    if (r->csv && fclose(r->csv) != 0 && st == LM_OK)
-        st = lm_fail(err, LM_ERR_IO, "%s/frames.csv: write failed", r->a->out_dir);
+    if (r->csv && fclose(r->csv) != 0 && st == LMGI_OK)
+        st = lm_cli_fail(err, LMGI_ERR_IO, "%s/frames.csv: write failed", r->a->out_dir);
     r->csv = NULL;
-    if (st == LM_OK)
+    if (st == LMGI_OK)
         st = write_atlases(r, err);
-    if (st == LM_OK && !r->a->quiet)
+    if (st == LMGI_OK && !r->a->quiet)
         summary(r, r->a->frames ? r->a->frames : 60);
     return st;
 }
@@ -266,14 +248,13 @@ int lm_cli_run(const lm_cli_args *a)
     r.a = a;
     if (!lm_cli_run_load(a, &r.sc))
         return 1;
-    lm_error err;
-    lm_error_clear(&err);
-    lm_status st = run(&r, &err);
-    if (st != LM_OK)
-        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+    lmgi_error err;
+    lmgi_status st = run(&r, &err);
+    if (st != LMGI_OK)
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
     lmgi_updater_free(r.u);
     lmgi_context_free(r.ctx);
     free(r.frame_ms);
     lmgi_free(r.sc);
-    return st == LM_OK ? 0 : 1;
+    return st == LMGI_OK ? 0 : 1;
 }

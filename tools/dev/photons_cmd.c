@@ -1,4 +1,4 @@
-/* lmgi photons: plays the scene's animations with the photon stage only (photons + AIMs) and writes
+/* lmgi-dev photons: plays the scene's animations with the photon stage only (photons + AIMs) and writes
  * the AIM atlas (EXR and PNG), a picture of the scene with its AIMs, and per-frame statistics (CSV). */
 #include "photons_cmd.h"
 
@@ -6,21 +6,21 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../charts/atlas_dilate.h"
-#include "../core/image.h"
-#include "../core/tonemap.h"
-#include "../gpu/camera.h"
-#include "../gpu/gl_context.h"
-#include "../gpu/lightmap_view.h"
-#include "../api/lmgi_scene.h"
-#include "../update/photon_stage.h"
-#include "out_dir.h"
-#include "progress.h"
-#include "scene_load.h"
+#include "../../src/charts/atlas_dilate.h"
+#include "../../src/core/image.h"
+#include "../../src/core/tonemap.h"
+#include "../../src/gpu/camera.h"
+#include "../../src/gpu/gl_context.h"
+#include "../../src/gpu/lightmap_view.h"
+#include "../../src/api/lmgi_scene.h"
+#include "../../src/update/photon_stage.h"
+#include "../../src/cli/out_dir.h"
+#include "../../src/cli/progress.h"
+#include "../../src/cli/scene_load.h"
 
 #define FRAME_RATE 30.0f /* frames are played at 30 per second of animation time */
 
-void lm_cli_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
+void lm_dev_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
 {
     lm_photon_stage_settings_default(s);
     if (a->photons)
@@ -135,10 +135,10 @@ static void summary(const lm_photon_stage *stage, const lm_photon_stage_frame *s
            (double)exposure, dir);
 }
 
-int lm_cli_photons(const lm_cli_args *a)
+int lm_dev_photons(const lm_cli_args *a)
 {
     if (a->file_count != 1 || !a->out_dir) {
-        fprintf(stderr, "lmgi: photons needs one scene file and --out DIR\n");
+        fprintf(stderr, "lmgi-dev: photons needs one scene file and --out DIR\n");
         return 2;
     }
     lmgi_scene *sc = NULL;
@@ -147,7 +147,7 @@ int lm_cli_photons(const lm_cli_args *a)
     lm_error err;
     lm_error_clear(&err);
     lm_photon_stage_settings set;
-    lm_cli_photon_settings(a, &set);
+    lm_dev_photon_settings(a, &set);
     lm_photon_stage *stage = NULL;
     lm_photon_stage_frame setup;
     memset(&setup, 0, sizeof setup);
@@ -156,12 +156,13 @@ int lm_cli_photons(const lm_cli_args *a)
     double sum_ms = 0.0;
     float exposure = 1.0f;
     static const char *const own[] = {"aim.exr", "aim.png", "view.png", "stats.csv", NULL};
-    lm_status st = lm_cli_claim_out_dir(a->out_dir, a->force, own, &err);
-    if (st == LM_OK) {
-        snprintf(path, sizeof path, "%s/stats.csv", a->out_dir);
-        csv = fopen(path, "w");
-        st = csv ? LM_OK : lm_fail(&err, LM_ERR_IO, "%s: cannot write", path);
+    if (!lm_cli_claim_out_dir(a, own)) {
+        lmgi_free(sc);
+        return 1;
     }
+    snprintf(path, sizeof path, "%s/stats.csv", a->out_dir);
+    csv = fopen(path, "w");
+    lm_status st = csv ? LM_OK : lm_fail(&err, LM_ERR_IO, "%s: cannot write", path);
     if (st == LM_OK)
         st = lm_photon_stage_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &stage, &setup, &err);
     if (st == LM_OK) {
@@ -175,7 +176,7 @@ int lm_cli_photons(const lm_cli_args *a)
     if (st == LM_OK && !a->quiet)
         summary(stage, &setup, a->frames ? a->frames : 60, sum_ms, exposure, a->out_dir);
     if (st != LM_OK)
-        fprintf(stderr, "lmgi: error: %s\n", err.msg);
+        fprintf(stderr, "lmgi-dev: error: %s\n", err.msg);
     lm_photon_stage_free(stage);
     lmgi_free(sc);
     return st == LM_OK ? 0 : 1;

@@ -1,4 +1,4 @@
-/* lmgi bench, photon part: photon tracing against raw Embree on the same scene, the kd-tree next to
+/* lmgi-dev bench, photon part: photon tracing against raw Embree on the same scene, the kd-tree next to
  * the paper's Table 1, and the photon stage's frame time on the animated Cornell box. */
 #include "bench_photons.h"
 
@@ -8,13 +8,13 @@
 #include <omp.h>
 #include <unistd.h>
 
-#include "../core/qmc.h"
-#include "../core/stats.h"
-#include "../core/timing.h"
-#include "../core/vecmath.h"
-#include "../photonmap/kdtree.h"
-#include "../api/lmgi_scene.h"
-#include "../update/photon_stage.h"
+#include "../../src/core/qmc.h"
+#include "../../src/core/stats.h"
+#include "../../src/core/timing.h"
+#include "../../src/core/vecmath.h"
+#include "../../src/photonmap/kdtree.h"
+#include "../../src/api/lmgi_scene.h"
+#include "../../src/update/photon_stage.h"
 
 #define REPEATS 5
 
@@ -231,7 +231,7 @@ static void node_moves(const char *path)
     lmgi_free(sc);
 }
 
-void lm_cli_bench_photons(void)
+void lm_dev_bench_photons(void)
 {
     printf("\nmoving a dynamic node (instance transform + top-level commit), mean of 1000:\n");
     const char *moving[] = {"scenes/cornell.glb", "scenes/two_rooms.glb"};

@@ -1,4 +1,4 @@
-/* lmgi bench, gather part (bench_gather.h). Each figure is the median over REPEATS alternating runs
+/* lmgi-dev bench, gather part (bench_gather.h). Each figure is the median over REPEATS alternating runs
  * of one full pass (PASS texels spread over the atlas), glFinish included. */
 #include "bench_gather.h"
 
@@ -9,15 +9,15 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../core/stats.h"
-#include "../core/timing.h"
-#include "../core/vecmath.h"
-#include "../gpu/gl_context.h"
-#include "../gpu/hemicube.h"
-#include "../photonmap/aim.h"
-#include "../api/lmgi_scene.h"
-#include "../update/frame_loop.h"
-#include "../update/photon_stage.h"
+#include "../../src/core/stats.h"
+#include "../../src/core/timing.h"
+#include "../../src/core/vecmath.h"
+#include "../../src/gpu/gl_context.h"
+#include "../../src/gpu/hemicube.h"
+#include "../../src/photonmap/aim.h"
+#include "../../src/api/lmgi_scene.h"
+#include "../../src/update/frame_loop.h"
+#include "../../src/update/photon_stage.h"
 
 #define REPEATS 5
 #define PASS 256
@@ -397,7 +397,7 @@ static void print_frame(void)
     }
 }
 
-void lm_cli_bench_gather(const char *big_cornell)
+void lm_dev_bench_gather(const char *big_cornell)
 {
     lm_gl_context *gl = NULL;
     lm_error err;

@@ -1,0 +1,289 @@
+/* The public reference, check and output-directory calls through include/lmgi.h alone: texels and pixels
+ * against the analytic irradiance of a point light over a plane, determinism and the cache, a frame
+ * checked against the reference, and every bad argument refused. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <lmgi.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "support.h"
+
+#define PI 3.14159265358979323846
+#define INTENSITY 10.0f /* candela, 2 units over the floor */
+#define HEIGHT 2.0f
+#define ALBEDO 0.8f
+
+/* A 16 x 16 floor of albedo 0.8 at y = 0 under a point light: nothing else, so nothing bounces. */
+static lmgi_scene *lamp_over_floor(void)
+{
+    static const float pos[12] = {-8, 0, 8, 8, 0, 8, 8, 0, -8, -8, 0, -8};
+    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    lmgi_mesh_desc floor = {.name = "floor", .positions = pos, .vertex_count = 4, .indices = idx, .triangle_count = 2};
+    lmgi_material_desc grey = {.name = "grey", .base_color = {ALBEDO, ALBEDO, ALBEDO, 1.0f}};
+    lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = INTENSITY,
+                            .position = {0, HEIGHT, 0}};
+    lmgi_scene_desc d = {.name = "lamp over floor", .meshes = &floor, .mesh_count = 1, .materials = &grey,
+                         .material_count = 1, .lights = &lamp, .light_count = 1};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 1500;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
+static void expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
+{
+    assert_int_equal(st, LMGI_ERR_INVALID);
+    if (!strstr(e->message, words))
+        fail_msg("'%s' does not name '%s'", e->message, words);
+}
+
+static lmgi_reference_desc quick(void)
+{
+    lmgi_reference_desc d;
+    memset(&d, 0, sizeof d);
+    d.target_error = 0.02f;
+    d.samples = 4;
+    d.no_cache = 1;
+    return d;
+}
+
+/* E = I cos(theta) / d^2 at every texel (the images hold it at the texel's atlas position), E_iim exactly 0
+ * (no surface to bounce from), radiance = albedo / pi x E; the same again, bit for bit; and from the cache. */
+static void test_reference_texels(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = lamp_over_floor();
+    lmgi_reference_desc d = quick();
+    lmgi_reference r, again;
+    lmgi_error e;
+    assert_int_equal(lmgi_reference_texels(sc, &d, &r, &e), LMGI_OK);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    assert_int_equal(r.width, in.atlas_width);
+    assert_int_equal(r.height, in.atlas_height);
+    assert_int_equal(r.entries, lmgi_texel_count(sc));
+    assert_int_equal(r.converged, r.entries);
+    assert_false(r.from_cache);
+    int checked = 0;
+    for (uint32_t i = 0; i < r.entries; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        size_t at = 3 * ((size_t)t.y * (size_t)r.width + (size_t)t.x);
+        assert_float_equal(r.iim[at], 0.0, 0.0);
+        double x = t.position[0], z = t.position[2], d2 = x * x + HEIGHT * HEIGHT + z * z;
+        double expect = INTENSITY * (HEIGHT / sqrt(d2)) / d2;
+        assert_float_equal(r.full[at + 1], expect, 0.03 * expect);
+        assert_float_equal(r.radiance[at], ALBEDO / PI * r.full[at], 1e-5 * r.full[at]);
+        checked++;
+    }
+    assert_true(checked > 1000);
+    assert_int_equal(lmgi_reference_texels(sc, &d, &again, &e), LMGI_OK);
+    size_t bytes = (size_t)r.width * (size_t)r.height * 3 * sizeof(float);
+    assert_memory_equal(r.full, again.full, bytes); /* deterministic */
+    lmgi_reference_free(&again);
+    char cache[1024];
+    snprintf(cache, sizeof cache, "%s/ref-cache", lmt_tmpdir()); /* a new directory: nothing cached yet */
+    d.no_cache = 0;
+    d.cache_dir = cache;
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(lmgi_reference_texels(sc, &d, &again, &e), LMGI_OK);
+        assert_int_equal(again.from_cache, k); /* computed, then read back */
+        assert_memory_equal(r.iim, again.iim, bytes);
+        assert_memory_equal(r.full, again.full, bytes);
+        lmgi_reference_free(&again);
+    }
+    assert_null(again.full);
+    lmgi_reference_free(&r);
+    lmgi_free(sc);
+}
+
+/* The picture: every pixel that sees the floor shows albedo / pi x E of the point it sees; the check's
+ * frame (direct light, no indirect to add) within a few percent of it over the floor. */
+static void test_reference_pixels_and_check(void **state)
+{
+    (void)state;
+    enum { SIDE = 48 };
+    lmgi_scene *sc = lamp_over_floor();
+    lmgi_camera cam;
+    lmgi_error e;
+    assert_int_equal(lmgi_scene_camera(sc, -1, SIDE, SIDE, &cam, &e), LMGI_OK);
+    lmgi_reference_desc d = quick();
+    lmgi_reference px;
+    assert_int_equal(lmgi_reference_pixels(sc, &d, &cam, SIDE, SIDE, &px, &e), LMGI_OK);
+    assert_int_equal(px.width, SIDE);
+    assert_int_equal(px.entries, SIDE * SIDE);
+    assert_null(px.iim);
+    double sum_ref = 0.0;
+    int seen = 0;
+    for (int i = 0; i < SIDE * SIDE; i++)
+        if (px.full[3 * i] > 0.0f)
+            sum_ref += px.full[3 * i], seen++;
+    assert_true(seen > SIDE * SIDE / 8); /* the automatic camera looks down at the lit floor */
+
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater_desc ud;
+    memset(&ud, 0, sizeof ud);
+    ud.photons = 4000;
+    ud.hemicube_resolution = 16;
+    ud.frame_width = ud.frame_height = SIDE;
+    lmgi_check_result c;
+    assert_int_equal(lmgi_check(ctx, sc, &ud, &d, 1, &c, &e), LMGI_OK);
+    assert_int_equal(c.width, SIDE);
+    assert_int_equal(c.surface_count, lmgi_surface_count(sc));
+    assert_true(c.pixels > (uint32_t)seen / 2); /* the floor's interior pixels */
+    double sum_check = 0.0;
+    for (int i = 0; i < SIDE * SIDE; i++)
+        sum_check += c.reference[3 * i] > 0.0f ? c.reference[3 * i] : 0.0;
+    print_message("lamp over floor: frame / reference %.4f %.4f %.4f over %u pixels, relative RMSE %.4f; "
+                  "the check's reference / lmgi_reference_pixels %.4f\n", c.ratio[0], c.ratio[1], c.ratio[2],
+                  c.pixels, c.rel_rmse, sum_check / sum_ref);
+    assert_float_equal(sum_check / sum_ref, 1.0, 0.01); /* the same camera, the same picture */
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(c.ratio[k], 1.0, 0.03);
+        assert_float_equal(c.ratio[k], c.frame_mean[k] / c.reference_mean[k], 1e-9);
+    }
+    int floor_row = -1;
+    for (int s = 0; s < c.surface_count; s++)
+        if (c.surfaces[s].pixels)
+            floor_row = s;
+    assert_true(floor_row >= 0);
+    assert_int_equal(c.surfaces[floor_row].node, lmgi_find_node(sc, "floor"));
+    assert_int_equal(c.surfaces[floor_row].pixels, c.pixels); /* the only surface, not emissive */
+    lmgi_check_free(&c);
+    assert_null(c.frame);
+    lmgi_reference_free(&px);
+    lmgi_context_free(ctx);
+    lmgi_free(sc);
+}
+
+static void test_bad_arguments(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = lamp_over_floor();
+    lmgi_reference_desc d = quick();
+    lmgi_reference r;
+    lmgi_error e;
+    memset(&r, 0x5a, sizeof r);
+    expect_invalid(lmgi_reference_texels(NULL, &d, &r, &e), &e, "scene is NULL");
+    assert_null(r.full); /* zeroed */
+    expect_invalid(lmgi_reference_texels(sc, &d, NULL, &e), &e, "out is NULL");
+    d.target_error = NAN;
+    expect_invalid(lmgi_reference_texels(sc, &d, &r, &e), &e, "target_error");
+    d.target_error = 2.0f;
+    expect_invalid(lmgi_reference_texels(sc, &d, &r, &e), &e, "target_error 2");
+    d = quick();
+    d.samples = -3;
+    expect_invalid(lmgi_reference_texels(sc, &d, &r, &e), &e, "samples -3");
+    d = quick();
+    lmgi_camera cam;
+    assert_int_equal(lmgi_scene_camera(sc, -1, 8, 8, &cam, &e), LMGI_OK);
+    expect_invalid(lmgi_reference_pixels(sc, &d, NULL, 8, 8, &r, &e), &e, "cam is NULL");
+    expect_invalid(lmgi_reference_pixels(sc, &d, &cam, 0, 8, &r, &e), &e, "0 x 8");
+    lmgi_camera flat = cam;
+    memset(flat.view, 0, sizeof flat.view);
+    expect_invalid(lmgi_reference_pixels(sc, &d, &flat, 8, 8, &r, &e), &e, "not invertible");
+    flat = cam; /* an orthographic projection: the solver takes pinhole cameras only */
+    memset(flat.proj, 0, sizeof flat.proj);
+    flat.proj[0] = flat.proj[5] = flat.proj[15] = 1.0f, flat.proj[10] = -1.0f;
+    expect_invalid(lmgi_reference_pixels(sc, &d, &flat, 8, 8, &r, &e), &e, "orthographic");
+    lmgi_reference_free(NULL);
+
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_check_result c;
+    expect_invalid(lmgi_check(NULL, sc, NULL, &d, 1, &c, &e), &e, "context is NULL");
+    expect_invalid(lmgi_check(ctx, NULL, NULL, &d, 1, &c, &e), &e, "scene is NULL");
+    expect_invalid(lmgi_check(ctx, sc, NULL, &d, 1, NULL, &e), &e, "out is NULL");
+    expect_invalid(lmgi_check(ctx, sc, NULL, &d, 0, &c, &e), &e, "0 frames");
+    lmgi_updater_desc ud;
+    memset(&ud, 0, sizeof ud);
+    ud.hemicube_samples = 3;
+    expect_invalid(lmgi_check(ctx, sc, &ud, &d, 1, &c, &e), &e, "hemicube_samples 3");
+    d.target_error = -1.0f;
+    expect_invalid(lmgi_check(ctx, sc, NULL, &d, 1, &c, &e), &e, "target_error");
+    d = quick();
+    ud.hemicube_samples = 0;
+    ud.photons = 2000;
+    ud.hemicube_resolution = 8;
+    ud.frame_width = ud.frame_height = 0;
+    lmgi_updater *u = NULL;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &ud, &u, &e), LMGI_OK);
+    expect_invalid(lmgi_check(ctx, sc, NULL, &d, 1, &c, &e), &e, "has an updater");
+    lmgi_updater_free(u);
+    lmgi_check_free(NULL);
+    lmgi_context_free(ctx);
+    lmgi_free(sc);
+}
+
+static int exists(const char *dir, const char *name)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return access(path, F_OK) == 0;
+}
+
+static void touch(const char *dir, const char *name)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    lmt_write_file(path, "x", 1);
+}
+
+/* A new directory is made and marked; one holding a user's file is refused and left as it was; force
+ * writes there, removing only what is named like the caller's output (and interrupted writes). */
+static void test_claim_output_dir(void **state)
+{
+    (void)state;
+    static const char *const own[] = {"frame_*.png", NULL};
+    char dir[1024], user[1024];
+    const char *tmp = lmt_tmpdir();
+    lmgi_error e;
+    snprintf(dir, sizeof dir, "%s/new/deeper", tmp);
+    assert_int_equal(lmgi_claim_output_dir(dir, 0, own, &e), LMGI_OK);
+    assert_true(exists(dir, ".lmgi"));
+    touch(dir, "frame_0001.png");
+    touch(dir, "notes.txt");
+    assert_int_equal(lmgi_claim_output_dir(dir, 0, own, &e), LMGI_OK); /* marked: lmgi's own */
+    assert_false(exists(dir, "frame_0001.png"));
+    assert_true(exists(dir, "notes.txt"));
+
+    snprintf(user, sizeof user, "%s/users", tmp);
+    mkdir(user, 0755);
+    touch(user, "frame_0007.png");
+    touch(user, "thesis.tex");
+    assert_int_equal(lmgi_claim_output_dir(user, 0, own, &e), LMGI_ERR_IO);
+    assert_non_null(strstr(e.message, "not written by lmgi"));
+    assert_true(exists(user, "frame_0007.png") && exists(user, "thesis.tex") && !exists(user, ".lmgi"));
+    touch(user, "frame_0008.png.partial");
+    assert_int_equal(lmgi_claim_output_dir(user, 1, NULL, &e), LMGI_OK); /* forced, no own kind */
+    assert_true(exists(user, "frame_0007.png") && exists(user, "thesis.tex") && exists(user, ".lmgi"));
+    assert_false(exists(user, "frame_0008.png.partial"));
+    expect_invalid(lmgi_claim_output_dir(NULL, 0, own, &e), &e, "dir is NULL");
+    char file[1200];
+    snprintf(file, sizeof file, "%s/thesis.tex", user);
+    assert_int_equal(lmgi_claim_output_dir(file, 1, own, &e), LMGI_ERR_IO); /* a file, not a directory */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_reference_texels),
+        cmocka_unit_test(test_reference_pixels_and_check),
+        cmocka_unit_test(test_bad_arguments),
+        cmocka_unit_test(test_claim_output_dir),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

@@ -1,0 +1,44 @@
+/* lmgi-dev: the developer's commands that look inside the library (they include src/ headers, which the
+ * lmgi command may not): the photon stage alone, and the photon and gather benchmarks measured against
+ * raw Embree and the paper's tables. Options as the lmgi command's (src/cli/args.h). */
+#include <lmgi.h>
+
+#include <stdio.h>
+#include <string.h>
+
+#include "../../src/cli/args.h"
+#include "bench_gather.h"
+#include "bench_photons.h"
+#include "photons_cmd.h"
+
+static void usage(FILE *f)
+{
+    fprintf(f, "usage: lmgi-dev photons SCENE --out DIR [--frames N] [photon options]\n"
+               "         the photon stage alone over the scene's animations: AIM atlas, a view with AIMs, stats.csv\n"
+               "       lmgi-dev bench [--gather-scene FILE]\n"
+               "         photon tracing against raw Embree and the final gather against the paper's Table 2\n"
+               "         (FILE: the ~133k-triangle Cornell box of `build/gen_scenes --cornell-cells 255`)\n"
+               "options and their meaning: `lmgi help`\n");
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    lm_cli_args a;
+    if (lm_cli_parse(argc, argv, 2, &a))
+        return 2;
+    lmgi_set_verbosity(a.quiet ? 0 : a.verbose ? 2 : 1);
+    if (!strcmp(argv[1], "photons"))
+        return lm_dev_photons(&a);
+    if (!strcmp(argv[1], "bench")) {
+        lm_dev_bench_photons();
+        lm_dev_bench_gather(a.gather_scene);
+        return 0;
+    }
+    fprintf(stderr, "lmgi-dev: unknown command '%s'\n\n", argv[1]);
+    usage(stderr);
+    return 2;
+}
