@@ -2,8 +2,9 @@
  *
  * Loads a scene and bakes it with a progress bar (the updater's creation is the first bake), then does
  * what an artist does: recolours a wall, moves a light, and re-bakes after each edit; each re-bake redoes
- * only what the edit reached and says how much. Writes the lightmap after each bake and a picture from
- * the scene's camera at the end.
+ * only what the edit reached and says how much. Writes the lightmap after each bake, a picture from
+ * the scene's camera at the end, and exports the edited level for an engine: OUT_DIR/level.gltf with
+ * the lightmap's UVs as TEXCOORD_1 and level_lightmap.exr beside it.
  *
  *   editor_session SCENE OUT_DIR [--material NAME] [--light NODE] [--texels N]
  *
@@ -138,6 +139,11 @@ static int session(lmgi_context *ctx, lmgi_scene *sc, const char *out, const cha
                 lmgi_write_image(path, 320, 240, 3, frame, NULL, &e) != LMGI_OK))
         rc = fail("view", &e);
     free(frame);
+    lmgi_export_desc x = {.name = "level"};
+    if (!rc && lmgi_export_gltf(u, out, &x, &e) != LMGI_OK)
+        rc = fail("export", &e);
+    if (!rc)
+        printf("exported %s/level.gltf with level_lightmap.exr\n", out);
     lmgi_updater_free(u);
     return rc;
 }
@@ -168,6 +174,10 @@ int main(int argc, char **argv)
     lmgi_context *ctx = NULL;
     lmgi_scene *sc = NULL;
     lmgi_error e;
+    /* the output directory claimed first: an artist's files there are never overwritten */
+    static const char *const own[] = {"lightmap*.exr", "view.png", NULL};
+    if (lmgi_claim_output_dir(out, 0, own, &e) != LMGI_OK)
+        return fail("output", &e);
     if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK)
         return fail("context", &e);
     int rc = lmgi_load(scene, &o, &sc, &e) == LMGI_OK ? session(ctx, sc, out, material, light) : fail(scene, &e);

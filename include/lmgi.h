@@ -452,6 +452,26 @@ typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM } lmgi_lightmap;
  * unknown kind: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err);
 
+/* Export for engines (docs/api.md, "Exporting to engines"): the scene as lmgi lit it, written to
+ * DIR/NAME.gltf (+ NAME.bin, NAME_texN.png for its textures) with TEXCOORD_1 on every triangle set to its
+ * lightmap UVs, and the lightmap itself beside it: NAME_lightmap.exr (the displayed IIM as
+ * lmgi_get_lightmap gives it: irradiance, alpha = valid; linear float or half) and NAME_lightmap.png (a
+ * tone-mapped preview). Every node is a root placed by its world matrix at the time of the export (the
+ * baked pose; animations are not written); each node with lightmap texels names the lightmap in its
+ * extras ({"lightmap": {"uri": "NAME_lightmap.exr", "texCoord": 1}}, beside {"lmgi": {...}}, its
+ * settings), and the document's extras say what the lightmap holds. The copy loads back into lmgi with
+ * lmgi_options.use_file_uv1 (`--use-uv1`) and lights the same. */
+typedef struct {
+    const char *name;   /* the files' base name (NULL: "scene"): letters, digits, - _ . */
+    int half;           /* the EXR in 16-bit half floats */
+    int force;          /* write into a directory that holds files lmgi did not write (lmgi_claim_output_dir) */
+} lmgi_export_desc;
+/* NULL u or dir, a name that is not plain: LMGI_ERR_INVALID; a name that would replace the scene's own
+ * file: LMGI_ERR_INVALID, nothing written; a directory lmgi may not write into, a failed write:
+ * LMGI_ERR_IO naming the file. NULL desc: the defaults. Thread-safety: as the updater's. */
+LMGI_API lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export_desc *desc,
+                                      lmgi_error *err);
+
 LMGI_API int lmgi_surface_count(const lmgi_scene *scene); /* 0 for NULL */
 /* The atlas rectangle holding a surface's texels: rect = {x, y, width, height}; returns 0 (rect zeroed)
  * for NULL or an id out of range. A surface's charts may share the rectangle with other surfaces. */

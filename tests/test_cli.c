@@ -220,8 +220,9 @@ static void test_bake_command(void **state)
         snprintf(path, sizeof path, "%s/bake/%s", dir, files[k]);
         assert_int_equal(access(path, R_OK), 0);
     }
-    /* --half: the same lightmap in 16-bit floats, under half the size */
-    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --half --out %s/half", dir);
+    /* --half: the same lightmap in 16-bit floats, under half the size; --gltf: the copy for engines, whose
+     * lightmap is the bake's */
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --half --gltf --out %s/half", dir);
     if (run(args) != 0)
         fail_msg("%s: %s", args, output);
     char full_path[1200];
@@ -238,6 +239,17 @@ static void test_bake_command(void **state)
         worst = fmax(worst, fabs((double)half[i] - full[i]) / (fabs((double)full[i]) + 1e-6));
     print_message("lightmap.exr in half floats: largest relative difference %.1e\n", worst);
     assert_true(worst < 1e-3); /* 11 bits */
+    snprintf(path, sizeof path, "%s/half/cornell_lightmap.exr", dir);
+    float *exported = NULL;
+    assert_int_equal(lm_read_exr(path, &w2, &h2, &exported, &err), LM_OK);
+    assert_memory_equal(exported, half, 4 * sizeof(float) * (size_t)w * h);
+    free(exported);
+    static const char *const gltf_files[] = {"cornell.gltf", "cornell.bin", "cornell_lightmap.png"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(path, sizeof path, "%s/half/%s", dir, gltf_files[k]);
+        assert_int_equal(access(path, R_OK), 0);
+    }
+    snprintf(path, sizeof path, "%s/half/lightmap.exr", dir);
     free(full);
     free(half);
     FILE *fa = fopen(full_path, "rb"), *fb = fopen(path, "rb");

@@ -102,7 +102,8 @@ static void test_runtime_loop(void **state)
 }
 
 /* The editor's session on the two rooms: a first bake, the blue cube in room A recoloured and a light
- * of room B moved, each re-bake touching part of the scene and saying so, every lightmap written. */
+ * of room B moved, each re-bake touching part of the scene and saying so, every lightmap written and the
+ * level exported. */
 static void test_editor_session(void **state)
 {
     (void)state;
@@ -125,8 +126,9 @@ static void test_editor_session(void **state)
     assert_non_null(line);
     assert_int_equal(sscanf(line, "move %u of %u photon paths changed", &changed, &traced), 2);
     assert_int_equal(changed, traced / 4); /* light_b2's own photons: one light of four */
-    static const char *const files[] = {"lightmap.exr", "lightmap_recoloured.exr", "lightmap_moved.exr", "view.png"};
-    for (int k = 0; k < 4; k++) {
+    static const char *const files[] = {"lightmap.exr", "lightmap_recoloured.exr", "lightmap_moved.exr", "view.png",
+                                        "level.gltf", "level.bin", "level_lightmap.exr"};
+    for (int k = 0; k < 7; k++) {
         snprintf(cmd, sizeof cmd, "%s/%s", dir, files[k]);
         assert_true(file_size(cmd) > 1000);
     }

@@ -71,8 +71,8 @@ static lm_status claim(const char *dir, int force, const char *const *own, lm_er
         st = survey(dir, &marked, foreign, sizeof foreign, err);
     if (st == LM_OK && !marked && foreign[0] && !force)
         return lm_fail(err, LM_ERR_IO, "%s: not empty and not written by lmgi (it holds '%s'); give a new or "
-                       "empty directory, or --force to write there (lmgi then removes only files named like its "
-                       "own output)", dir, foreign);
+                       "empty directory, or force the write (lmgi's --force; lmgi then removes only files named "
+                       "like its own output)", dir, foreign);
     if (st == LM_OK)
         st = remove_own(dir, own, err);
     char marker[4200];

@@ -200,6 +200,8 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
     return LMGI_OK;
 }
 
+const lmgi_scene *lm_updater_scene(const lmgi_updater *u) { return u->sc; }
+
 void lm_updater_sync(lmgi_updater *u)
 {
     lm_log_target saved = lm_api_enter(u->ctx);

@@ -214,6 +214,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                 a->in_order = 1;
             else if (!strcmp(o, "--half"))
                 a->half = 1;
+            else if (!strcmp(o, "--gltf"))
+                a->gltf = 1;
             else if (!strcmp(o, "--force"))
                 a->force = 1;
             else if (!strcmp(o, "--no-cache"))

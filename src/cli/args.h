@@ -49,6 +49,7 @@ typedef struct {
     int force;              /* --force: write into a non-empty --out directory lmgi did not make */
     int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
+    int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
 } lm_cli_args;

@@ -2,9 +2,11 @@
 #include "bake_cmd.h"
 
 #include <lmgi.h>
+#include <ctype.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "out_dir.h"
 #include "progress.h"
@@ -50,6 +52,26 @@ static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half
     return rc;
 }
 
+/* DIR/NAME.gltf and its lightmap, NAME the scene file's name without its extension (other characters
+ * than a-z A-Z 0-9 - _ made '_'). */
+static int write_gltf(const lm_cli_args *a, lmgi_updater *u, char *name, size_t size)
+{
+    const char *base = strrchr(a->files[0], '/');
+    snprintf(name, size, "%s", base ? base + 1 : a->files[0]);
+    char *dot = strrchr(name, '.');
+    if (dot && dot != name)
+        *dot = '\0';
+    for (char *c = name; *c; c++)
+        if (!isalnum((unsigned char)*c) && *c != '-' && *c != '_')
+            *c = '_';
+    lmgi_export_desc d = {.name = name, .half = a->half};
+    lmgi_error e;
+    if (lmgi_export_gltf(u, a->out_dir, &d, &e) == LMGI_OK)
+        return 0;
+    fprintf(stderr, "lmgi: error: %s\n", e.message);
+    return 1;
+}
+
 int lm_cli_bake(const lm_cli_args *a)
 {
     if (a->file_count != 1 || !a->out_dir) {
@@ -85,6 +107,9 @@ int lm_cli_bake(const lm_cli_args *a)
     signal(SIGINT, SIG_DFL);
     if (rc == 0)
         rc = write_maps(sc, u, a->out_dir, a->half);
+    char name[256] = "";
+    if (rc == 0 && a->gltf)
+        rc = write_gltf(a, u, name, sizeof name);
     if (rc == 0 && !a->quiet) {
         lmgi_info in;
         lmgi_updater_info ui;
@@ -94,6 +119,9 @@ int lm_cli_bake(const lm_cli_args *a)
                "%.0f ms)\nwrote       %s/lightmap.exr (irradiance, alpha = valid), lightmap.png, aim.exr\n",
                in.texels, in.atlas_width, in.atlas_height, ui.photons, lm_cli_now() - started, ui.ms_setup_trace,
                ui.ms_setup_aim, ui.ms_setup_gather, a->out_dir);
+        if (a->gltf)
+            printf("            %s/%s.gltf (TEXCOORD_1: the lightmap's UVs) with %s_lightmap.exr and .png\n", a->out_dir,
+                   name, name);
     }
     lmgi_updater_free(u);
     lmgi_free(sc);

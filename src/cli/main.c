@@ -29,7 +29,8 @@ static void usage(FILE *f)
             "                         .exr), iim.exr/png, aim.exr/png and frames.csv (work and ms per stage)\n"
             "  bake SCENE --out DIR   the full solution for the scene as it is (every photon, AIM and texel),\n"
             "                         with a progress bar and the time left (Ctrl-C cancels): DIR/lightmap.exr\n"
-            "                         (irradiance, alpha = valid), lightmap.png (a preview), aim.exr\n"
+            "                         (irradiance, alpha = valid), lightmap.png (a preview), aim.exr; --gltf:\n"
+            "                         also NAME.gltf, the scene for engines with TEXCOORD_1 = lightmap UVs\n"
             "  check SCENE            one frame of 'run' (same options) against the path-traced reference:\n"
             "                         frame / reference per visible surface and over the frame, and the\n"
             "                         relative RMSE (default --size 128x128; --out DIR: the two EXRs)\n"
@@ -84,6 +85,8 @@ static void usage(FILE *f)
             "  --exr-every K    'run': every K-th frame also as linear EXR (default 10)\n"
             "  --repeats N      'bench': runs per scene, the median is reported (default 3)\n"
             "  --json FILE      'bench': also write the results as JSON\n"
+            "  --half           'bake': EXR lightmaps in 16-bit half floats\n"
+            "  --gltf           'bake': also a glTF copy of the scene with the lightmap (docs/api.md)\n"
             "  --force          write into a non-empty --out DIR that lmgi did not make (lmgi marks its\n"
             "                   own with DIR/.lmgi and replaces only its own kind of file there)\n"
             "  -v, -q           more / less on stderr\n");

@@ -1,0 +1,522 @@
+/* The public API's glTF export (lmgi_export_gltf): the scene as lmgi lit it, with the lightmap's UVs as
+ * TEXCOORD_1 and the lightmap beside it (docs/api.md, "Exporting to engines").
+ *
+ * Every node becomes a root node placed by its world matrix (the file's world: lmgi's origin added back),
+ * so what an engine draws is where lmgi baked it. Each node's triangles are written with their own three
+ * vertices per triangle (the lightmap's charts cut the mesh wherever they like; sharing vertices would
+ * need their UVs to agree), one primitive per material. Twins of double-sided surfaces are written as
+ * the single-sided triangles they are in lmgi, each with its own lightmap texels, so their material is
+ * single-sided in the copy. A mirrored node's triangles get the file's winding back: glTF readers reverse
+ * it again for the negative determinant, as lmgi's loader did. */
+#include <lmgi.h>
+
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/image.h"
+#include "../core/vecmath.h"
+#include "lmgi_scene.h"
+#include "lmgi_updater.h"
+
+typedef struct {
+    const lm_scene *s;
+    const lm_atlas *atlas;
+    const char *name;
+    FILE *json, *bin;      /* open_memstream'd */
+    char *json_text, *bin_data;
+    size_t json_size, bin_stream_size; /* the streams' own sizes (set when flushed) */
+    size_t bin_size;       /* bytes appended to bin so far */
+    int accessors, views;  /* written so far */
+    int first;             /* the next JSON array element is the first */
+} writer;
+
+static void sep(writer *w)
+{
+    if (!w->first)
+        fputc(',', w->json);
+    w->first = 0;
+}
+
+/* A name as a JSON string (quotes, backslashes and control characters escaped). */
+static void json_string(FILE *f, const char *s)
+{
+    fputc('"', f);
+    for (; *s; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            fprintf(f, "\\%c", c);
+        else if (c < 0x20)
+            fprintf(f, "\\u%04x", c);
+        else
+            fputc(c, f);
+    }
+    fputc('"', f);
+}
+
+static void json_floats(FILE *f, const float *v, int n)
+{
+    fputc('[', f);
+    for (int i = 0; i < n; i++)
+        fprintf(f, "%s%.9g", i ? "," : "", (double)v[i]);
+    fputc(']', f);
+}
+
+/* One buffer view holding `bytes` of data appended to the binary buffer (4-byte aligned). */
+static int add_view(writer *w, FILE *views, const void *data, size_t bytes, int target)
+{
+    while (w->bin_size % 4) {
+        fputc(0, w->bin);
+        w->bin_size++;
+    }
+    fprintf(views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu", w->views ? "," : "", w->bin_size, bytes);
+    if (target)
+        fprintf(views, ",\"target\":%d", target);
+    fputc('}', views);
+    fwrite(data, 1, bytes, w->bin);
+    w->bin_size += bytes;
+    return w->views++;
+}
+
+/* An accessor over a new view: count elements of `comps` floats (or uint32 indices when comps is 0). */
+static int add_accessor(writer *w, FILE *views, FILE *accessors, const void *data, uint32_t count, int comps)
+{
+    static const char *const types[] = {"SCALAR", "SCALAR", "VEC2", "VEC3"};
+    size_t bytes = (size_t)count * (comps ? (size_t)comps * sizeof(float) : sizeof(uint32_t));
+    int view = add_view(w, views, data, bytes, comps ? 34962 : 34963);
+    fprintf(accessors, "%s{\"bufferView\":%d,\"componentType\":%d,\"count\":%u,\"type\":\"%s\"", w->accessors ? "," : "",
+            view, comps ? 5126 : 5125, count, types[comps]);
+    if (comps == 3) { /* POSITION needs its bounds */
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        const float *p = data;
+        for (uint32_t i = 0; i < count; i++)
+            for (int k = 0; k < 3; k++)
+                lo[k] = fminf(lo[k], p[3 * i + k]), hi[k] = fmaxf(hi[k], p[3 * i + k]);
+        fprintf(accessors, ",\"min\":");
+        json_floats(accessors, lo, 3);
+        fprintf(accessors, ",\"max\":");
+        json_floats(accessors, hi, 3);
+    }
+    fputc('}', accessors);
+    return w->accessors++;
+}
+
+/* Which uv set a material's textures read: 0, or 2 where the file's base colour texture used TEXCOORD_1
+ * (TEXCOORD_1 now holds the lightmap's). */
+static int texture_uv(const lm_material *m) { return m->base_color_uv == 1 ? 2 : 0; }
+
+/* The vertices of the triangles [first, first + count) of `node` using `material`, three per triangle,
+ * written as one primitive. */
+static lm_status write_primitive(writer *w, FILE *views, FILE *accessors, const lm_node *nd, int material,
+                                 lm_error *err)
+{
+    const lm_scene *s = w->s;
+    uint32_t n = 0;
+    for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
+        n += s->tri_material[t] == material;
+    float *pos = malloc((size_t)n * 3 * 3 * sizeof(float)), *nrm = malloc((size_t)n * 3 * 3 * sizeof(float));
+    float *uv0 = malloc((size_t)n * 3 * 2 * sizeof(float)), *uvl = malloc((size_t)n * 3 * 2 * sizeof(float));
+    float *uvf = malloc((size_t)n * 3 * 2 * sizeof(float));
+    uint32_t *idx = malloc((size_t)n * 3 * sizeof(uint32_t));
+    if (!pos || !nrm || !uv0 || !uvl || !uvf || !idx) {
+        free(pos), free(nrm), free(uv0), free(uvl), free(uvf), free(idx);
+        return lm_fail(err, LM_ERR_NOMEM, "export: no memory for node '%s'", nd->name);
+    }
+    static const int file_order[3] = {0, 2, 1}, same[3] = {0, 1, 2};
+    const int *order = nd->mirrored ? file_order : same;
+    uint32_t v = 0;
+    for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++) {
+        if (s->tri_material[t] != material)
+            continue;
+        for (int c = 0; c < 3; c++, v++) {
+            int k = order[c];
+            uint32_t sv = s->tris[3 * t + k];
+            memcpy(pos + 3 * v, s->positions + 3 * (size_t)sv, 3 * sizeof(float));
+            memcpy(nrm + 3 * v, s->normals + 3 * (size_t)sv, 3 * sizeof(float));
+            memcpy(uv0 + 2 * v, s->uv0 + 2 * (size_t)sv, 2 * sizeof(float));
+            if (s->uv1)
+                memcpy(uvf + 2 * v, s->uv1 + 2 * (size_t)sv, 2 * sizeof(float));
+            else
+                uvf[2 * v] = uvf[2 * v + 1] = 0.0f;
+            const float *l = w->atlas->corner_uv + 6 * (size_t)t + 2 * k; /* NaN: no surface (mirror, glass) */
+            uvl[2 * v] = isfinite(l[0]) ? l[0] : 0.0f;
+            uvl[2 * v + 1] = isfinite(l[1]) ? l[1] : 0.0f;
+            idx[v] = v;
+        }
+    }
+    int a_pos = add_accessor(w, views, accessors, pos, 3 * n, 3);
+    int a_nrm = add_accessor(w, views, accessors, nrm, 3 * n, 3);
+    int a_uv0 = add_accessor(w, views, accessors, uv0, 3 * n, 2);
+    int a_uvl = add_accessor(w, views, accessors, uvl, 3 * n, 2);
+    int a_uvf = texture_uv(&s->materials[material]) == 2 ? add_accessor(w, views, accessors, uvf, 3 * n, 2) : -1;
+    int a_idx = add_accessor(w, views, accessors, idx, 3 * n, 0);
+    sep(w);
+    fprintf(w->json, "{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d,\"TEXCOORD_1\":%d", a_pos, a_nrm,
+            a_uv0, a_uvl);
+    if (a_uvf >= 0)
+        fprintf(w->json, ",\"TEXCOORD_2\":%d", a_uvf);
+    fprintf(w->json, "},\"indices\":%d,\"material\":%d}", a_idx, material);
+    free(pos), free(nrm), free(uv0), free(uvl), free(uvf), free(idx);
+    return LM_OK;
+}
+
+/* Meshes: one per node with triangles (mesh_of[node], else -1), a primitive per material it uses. */
+static lm_status write_meshes(writer *w, FILE *views, FILE *accessors, int *mesh_of, lm_error *err)
+{
+    const lm_scene *s = w->s;
+    int meshes = 0;
+    lm_status st = LM_OK;
+    fprintf(w->json, ",\"meshes\":[");
+    for (int i = 0; i < s->node_count && st == LM_OK; i++) {
+        const lm_node *nd = &s->nodes[i];
+        mesh_of[i] = -1;
+        if (!nd->tri_count)
+            continue;
+        mesh_of[i] = meshes++;
+        fprintf(w->json, "%s{\"name\":", mesh_of[i] ? "," : "");
+        json_string(w->json, nd->name);
+        fprintf(w->json, ",\"primitives\":[");
+        w->first = 1;
+        for (int m = 0; m < s->material_count && st == LM_OK; m++)
+            for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
+                if (s->tri_material[t] == m) {
+                    st = write_primitive(w, views, accessors, nd, m, err);
+                    break;
+                }
+        fprintf(w->json, "]}");
+    }
+    fputc(']', w->json);
+    return st;
+}
+
+/* Whether any of the node's triangles has lightmap texels (mirror and glass have none). */
+static int has_lightmap(const lm_atlas *a, const lm_node *nd)
+{
+    for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
+        if (a->tri_chart[t] >= 0)
+            return 1;
+    return 0;
+}
+
+static void write_nodes(writer *w, const int *mesh_of)
+{
+    const lm_scene *s = w->s;
+    fprintf(w->json, ",\"scene\":0,\"scenes\":[{\"nodes\":[");
+    for (int i = 0; i < s->node_count; i++)
+        fprintf(w->json, "%s%d", i ? "," : "", i);
+    fprintf(w->json, "]}],\"nodes\":[");
+    for (int i = 0; i < s->node_count; i++) {
+        const lm_node *nd = &s->nodes[i];
+        float m[16];
+        memcpy(m, nd->world, sizeof m);
+        for (int k = 0; k < 3; k++) /* the file's world: lmgi's origin added back */
+            m[12 + k] += s->origin[k] * m[15];
+        fprintf(w->json, "%s{\"name\":", i ? "," : "");
+        json_string(w->json, nd->name);
+        fprintf(w->json, ",\"matrix\":");
+        json_floats(w->json, m, 16);
+        if (mesh_of[i] >= 0)
+            fprintf(w->json, ",\"mesh\":%d", mesh_of[i]);
+        if (nd->camera >= 0)
+            fprintf(w->json, ",\"camera\":%d", nd->camera);
+        if (nd->light >= 0)
+            fprintf(w->json, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", nd->light);
+        /* lmgi's own node settings (as resolved: a reload needs no inheritance), then the lightmap */
+        const lm_node_settings *ns = &nd->settings;
+        fprintf(w->json, ",\"extras\":{\"lmgi\":{\"dynamic\":%s,\"caustics\":%s,\"indirect\":%s,\"shadows\":%s}",
+                nd->dynamic ? "true" : "false", ns->caustics ? "true" : "false", ns->indirect ? "true" : "false",
+                ns->shadows ? "true" : "false");
+        if (has_lightmap(w->atlas, nd))
+            fprintf(w->json, ",\"lightmap\":{\"uri\":\"%s_lightmap.exr\",\"texCoord\":1}", w->name);
+        fprintf(w->json, "}}");
+    }
+    fputc(']', w->json);
+}
+
+/* Textures: each of the scene's decoded images as NAME_texN.png (8-bit sRGB), one sampler. */
+static lm_status write_textures(writer *w, const char *dir, lm_error *err)
+{
+    const lm_scene *s = w->s;
+    if (!s->texture_count)
+        return LM_OK;
+    lm_status st = LM_OK;
+    fprintf(w->json, ",\"samplers\":[{}],\"images\":[");
+    for (int i = 0; i < s->texture_count; i++) {
+        fprintf(w->json, "%s{\"uri\":\"%s_tex%d.png\"}", i ? "," : "", w->name, i); /* name checked to be plain */
+        const lm_texture *t = &s->textures[i];
+        size_t n = (size_t)t->width * (size_t)t->height;
+        uint8_t *px = st == LM_OK ? malloc(n * 4) : NULL;
+        if (st == LM_OK && !px)
+            st = lm_fail(err, LM_ERR_NOMEM, "export: no memory for texture %d", i);
+        for (size_t p = 0; px && p < n; p++)
+            for (int c = 0; c < 4; c++) {
+                float v = t->rgba[4 * p + c];
+                v = c < 3 ? lm_linear_to_srgb(v) : v;
+                px[4 * p + c] = (uint8_t)lroundf(255.0f * fminf(1.0f, fmaxf(0.0f, v)));
+            }
+        if (px) {
+            char path[4200];
+            snprintf(path, sizeof path, "%s/%s_tex%d.png", dir, w->name, i);
+            st = lm_write_png(path, t->width, t->height, px, err);
+        }
+        free(px);
+    }
+    fprintf(w->json, "],\"textures\":[");
+    for (int i = 0; i < s->texture_count; i++)
+        fprintf(w->json, "%s{\"source\":%d,\"sampler\":0}", i ? "," : "", i);
+    fputc(']', w->json);
+    return st;
+}
+
+static void write_texture_ref(FILE *f, const lm_material *m, int texture)
+{
+    fprintf(f, "{\"index\":%d,\"texCoord\":%d", texture, texture_uv(m));
+    if (m->uv_offset[0] != 0.0f || m->uv_offset[1] != 0.0f || m->uv_scale[0] != 1.0f || m->uv_scale[1] != 1.0f ||
+        m->uv_rotation != 0.0f)
+        fprintf(f, ",\"extensions\":{\"KHR_texture_transform\":{\"offset\":[%.9g,%.9g],\"scale\":[%.9g,%.9g],"
+                   "\"rotation\":%.9g}}", (double)m->uv_offset[0], (double)m->uv_offset[1], (double)m->uv_scale[0],
+                (double)m->uv_scale[1], (double)m->uv_rotation);
+    fputc('}', f);
+}
+
+static void write_materials(writer *w)
+{
+    const lm_scene *s = w->s;
+    fprintf(w->json, ",\"materials\":[");
+    for (int i = 0; i < s->material_count; i++) {
+        const lm_material *m = &s->materials[i];
+        fprintf(w->json, "%s{\"name\":", i ? "," : "");
+        json_string(w->json, m->name);
+        fprintf(w->json, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
+        json_floats(w->json, m->base_color, 4);
+        fprintf(w->json, ",\"metallicFactor\":%.9g,\"roughnessFactor\":%.9g", (double)m->metallic, (double)m->roughness);
+        if (m->base_color_tex >= 0) {
+            fprintf(w->json, ",\"baseColorTexture\":");
+            write_texture_ref(w->json, m, m->base_color_tex);
+        }
+        fputc('}', w->json);
+        float strength = fmaxf(m->emissive[0], fmaxf(m->emissive[1], m->emissive[2]));
+        if (strength > 0.0f) { /* the factor is at most 1; the rest is KHR_materials_emissive_strength */
+            float f[3] = {m->emissive[0] / strength, m->emissive[1] / strength, m->emissive[2] / strength};
+            fprintf(w->json, ",\"emissiveFactor\":");
+            json_floats(w->json, f, 3);
+        }
+        if (m->emissive_tex >= 0) {
+            fprintf(w->json, ",\"emissiveTexture\":");
+            write_texture_ref(w->json, m, m->emissive_tex);
+        }
+        /* split sides are two single-sided triangles here, each with its own lightmap texels */
+        fprintf(w->json, ",\"doubleSided\":%s,\"extensions\":{\"KHR_materials_ior\":{\"ior\":%.9g}",
+                m->double_sided ? "true" : "false", (double)m->ior);
+        if (strength > 1.0f)
+            fprintf(w->json, ",\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}", (double)strength);
+        if (m->transmission > 0.0f)
+            fprintf(w->json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
+        fprintf(w->json, "}}");
+    }
+    fputc(']', w->json);
+}
+
+static void write_lights_and_cameras(writer *w)
+{
+    const lm_scene *s = w->s;
+    static const char *const types[] = {"point", "spot", "directional"};
+    if (s->light_count) {
+        fprintf(w->json, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
+        for (int i = 0; i < s->light_count; i++) {
+            const lm_light *l = &s->lights[i];
+            fprintf(w->json, "%s{\"name\":", i ? "," : "");
+            json_string(w->json, l->name);
+            fprintf(w->json, ",\"type\":\"%s\",\"color\":", types[l->type]);
+            json_floats(w->json, l->color, 3);
+            fprintf(w->json, ",\"intensity\":%.9g", l->off ? 0.0 : (double)l->intensity); /* as baked */
+            if (l->range > 0.0f && l->type != LM_LIGHT_DIRECTIONAL)
+                fprintf(w->json, ",\"range\":%.9g", (double)l->range);
+            if (l->type == LM_LIGHT_SPOT)
+                fprintf(w->json, ",\"spot\":{\"innerConeAngle\":%.9g,\"outerConeAngle\":%.9g}", (double)l->inner_cone,
+                        (double)l->outer_cone);
+            fputc('}', w->json);
+        }
+        fprintf(w->json, "]}}");
+    }
+    if (!s->camera_count)
+        return;
+    fprintf(w->json, ",\"cameras\":[");
+    for (int i = 0; i < s->camera_count; i++) {
+        const lm_camera *c = &s->cameras[i];
+        fprintf(w->json, "%s{\"name\":", i ? "," : "");
+        json_string(w->json, c->name);
+        if (c->perspective) {
+            fprintf(w->json, ",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g", (double)c->yfov,
+                    (double)c->znear);
+            if (c->aspect > 0.0f)
+                fprintf(w->json, ",\"aspectRatio\":%.9g", (double)c->aspect);
+        } else {
+            fprintf(w->json, ",\"type\":\"orthographic\",\"orthographic\":{\"xmag\":%.9g,\"ymag\":%.9g,\"znear\":%.9g",
+                    (double)c->xmag, (double)c->ymag, (double)c->znear);
+        }
+        if (c->zfar > 0.0f || !c->perspective)
+            fprintf(w->json, ",\"zfar\":%.9g", (double)(c->zfar > 0.0f ? c->zfar : 1e6f));
+        fprintf(w->json, "}}");
+    }
+    fputc(']', w->json);
+}
+
+/* The lightmap: the displayed IIM (irradiance, alpha = valid) as EXR, and a tone-mapped PNG preview. */
+static lmgi_status write_lightmap(lmgi_updater *u, const writer *w, const char *dir, int half, lmgi_error *err)
+{
+    size_t n = 4 * (size_t)w->atlas->width * (size_t)w->atlas->height;
+    float *rgba = malloc(n * sizeof *rgba);
+    if (!rgba)
+        return lm_api_refuse(err, "lmgi_export_gltf: no memory for the %d x %d lightmap", w->atlas->width,
+                             w->atlas->height);
+    lmgi_status st = lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, n, err);
+    char path[4200];
+    lmgi_image_desc d = {LMGI_TONEMAP_NEUTRAL, 0.0f, half};
+    snprintf(path, sizeof path, "%s/%s_lightmap.exr", dir, w->name);
+    if (st == LMGI_OK)
+        st = lmgi_write_image(path, w->atlas->width, w->atlas->height, 4, rgba, &d, err);
+    snprintf(path, sizeof path, "%s/%s_lightmap.png", dir, w->name);
+    if (st == LMGI_OK)
+        st = lmgi_write_image(path, w->atlas->width, w->atlas->height, 4, rgba, &d, err);
+    free(rgba);
+    return st;
+}
+
+/* The extensions the document uses (KHR_materials_ior always: every material states its IOR). */
+static void write_extensions_used(writer *w)
+{
+    const lm_scene *s = w->s;
+    int strength = 0, transmission = 0, transform = 0;
+    for (int i = 0; i < s->material_count; i++) {
+        const lm_material *m = &s->materials[i];
+        strength |= fmaxf(m->emissive[0], fmaxf(m->emissive[1], m->emissive[2])) > 1.0f;
+        transmission |= m->transmission > 0.0f;
+        transform |= (m->base_color_tex >= 0 || m->emissive_tex >= 0) &&
+                     (m->uv_offset[0] != 0.0f || m->uv_offset[1] != 0.0f || m->uv_scale[0] != 1.0f ||
+                      m->uv_scale[1] != 1.0f || m->uv_rotation != 0.0f);
+    }
+    fprintf(w->json, ",\"extensionsUsed\":[\"KHR_materials_ior\"%s%s%s%s]",
+            s->light_count ? ",\"KHR_lights_punctual\"" : "", strength ? ",\"KHR_materials_emissive_strength\"" : "",
+            transmission ? ",\"KHR_materials_transmission\"" : "", transform ? ",\"KHR_texture_transform\"" : "");
+}
+
+/* Everything but the images into w's JSON and binary streams. */
+static lm_status write_document(writer *w, const char *dir, lm_error *err)
+{
+    const lm_scene *s = w->s;
+    FILE *views = NULL, *accessors = NULL;
+    char *views_text = NULL, *accessors_text = NULL;
+    size_t views_size = 0, accessors_size = 0;
+    int *mesh_of = malloc(sizeof *mesh_of * (size_t)(s->node_count ? s->node_count : 1));
+    views = open_memstream(&views_text, &views_size);
+    accessors = open_memstream(&accessors_text, &accessors_size);
+    lm_status st = mesh_of && views && accessors ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "export: no memory");
+    if (st == LM_OK) {
+        fprintf(w->json, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"lmgi\"}");
+        write_extensions_used(w);
+        st = write_meshes(w, views, accessors, mesh_of, err);
+    }
+    if (st == LM_OK) {
+        write_nodes(w, mesh_of);
+        write_materials(w);
+        write_lights_and_cameras(w);
+        st = write_textures(w, dir, err);
+    }
+    if (views)
+        fclose(views);
+    if (accessors)
+        fclose(accessors);
+    if (st == LM_OK) {
+        fflush(w->bin);
+        fprintf(w->json, ",\"buffers\":[{\"uri\":\"%s.bin\",\"byteLength\":%zu}],\"bufferViews\":[%s],"
+                         "\"accessors\":[%s],\"extras\":{\"lmgi\":{\"lightmap\":\"%s_lightmap.exr\","
+                         "\"preview\":\"%s_lightmap.png\",\"texCoord\":1,\"size\":[%d,%d],"
+                         "\"holds\":\"irradiance E of indirect light and emissive surfaces (not the punctual "
+                         "lights' direct light); diffuse radiance = baseColor / pi x E; alpha 1 on valid texels\"}}}",
+                w->name, w->bin_size, views_text ? views_text : "", accessors_text ? accessors_text : "", w->name,
+                w->name, w->atlas->width, w->atlas->height);
+    }
+    free(views_text);
+    free(accessors_text);
+    free(mesh_of);
+    return st;
+}
+
+/* The export's file name: letters, digits, '-', '_' and '.', so it is a plain relative URI. */
+static int plain_name(const char *name)
+{
+    if (!name[0] || strlen(name) > 200 || name[0] == '.')
+        return 0;
+    for (const char *c = name; *c; c++)
+        if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') || *c == '-' ||
+              *c == '_' || *c == '.'))
+            return 0;
+    return 1;
+}
+
+/* Whether writing NAME's files into dir would replace the scene's own file. */
+static int would_replace_input(const lm_scene *s, const char *dir, const char *name)
+{
+    char in[PATH_MAX], out_dir[PATH_MAX];
+    if (!realpath(s->path, in) || !realpath(dir, out_dir))
+        return 0;
+    const char *slash = strrchr(in, '/');
+    size_t n = (size_t)(slash - in);
+    return strlen(out_dir) == n && strncmp(in, out_dir, n) == 0 && strncmp(slash + 1, name, strlen(name)) == 0;
+}
+
+lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export_desc *desc, lmgi_error *err)
+{
+    static const char fn[] = "lmgi_export_gltf";
+    if (!u || !dir)
+        return lm_api_refuse(err, "%s: %s is NULL", fn, u ? "dir" : "updater");
+    lmgi_export_desc d;
+    memset(&d, 0, sizeof d);
+    if (desc)
+        d = *desc;
+    const char *name = d.name ? d.name : "scene";
+    if (!plain_name(name))
+        return lm_api_refuse(err, "%s: name '%s' must be 1 to 200 of a-z A-Z 0-9 - _ . and not start with '.'", fn,
+                             name);
+    const lmgi_scene *sc = lm_updater_scene(u);
+    if (would_replace_input(sc->scene, dir, name))
+        return lm_api_refuse(err, "%s: %s/%s.* would replace the scene's own file %s; choose another name or "
+                             "directory", fn, dir, name, sc->scene->path);
+    char own[4][260];
+    snprintf(own[0], sizeof own[0], "%s.gltf", name);
+    snprintf(own[1], sizeof own[1], "%s.bin", name);
+    snprintf(own[2], sizeof own[2], "%s_lightmap.*", name);
+    snprintf(own[3], sizeof own[3], "%s_tex*.png", name);
+    const char *const patterns[] = {own[0], own[1], own[2], own[3], NULL};
+    lmgi_status st = lmgi_claim_output_dir(dir, d.force, patterns, err);
+    if (st != LMGI_OK)
+        return st;
+    writer w;
+    memset(&w, 0, sizeof w);
+    w.s = sc->scene, w.atlas = &sc->atlas, w.name = name;
+    w.json = open_memstream(&w.json_text, &w.json_size);
+    w.bin = open_memstream(&w.bin_data, &w.bin_stream_size);
+    lm_error e;
+    lm_status ls = w.json && w.bin ? write_document(&w, dir, &e) : lm_fail(&e, LM_ERR_NOMEM, "export: no memory");
+    if (w.json)
+        fclose(w.json);
+    if (w.bin)
+        fclose(w.bin);
+    char path[4200];
+    if (ls == LM_OK) {
+        snprintf(path, sizeof path, "%s/%s.bin", dir, name);
+        ls = lm_write_file(path, w.bin_data, w.bin_stream_size, &e);
+    }
+    if (ls == LM_OK) {
+        snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
+        ls = lm_write_file(path, w.json_text, w.json_size, &e);
+    }
+    free(w.json_text);
+    free(w.bin_data);
+    if (ls != LM_OK)
+        return lm_export_error(err, &e);
+    return write_lightmap(u, &w, dir, d.half, err);
+}

@@ -1,0 +1,228 @@
+/* lmgi_export_gltf: the glTF copy an engine loads. Every exported triangle's TEXCOORD_1 leads to lightmap
+ * texels of its own surface at its own place, the lightmap file holds what lmgi_get_lightmap gives, the
+ * copy re-loads with --use-uv1 and lights the same, and bad exports are refused without writing. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <lmgi.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "../src/api/lmgi_scene.h"
+#include "../src/core/image.h"
+#include "../src/core/vecmath.h"
+#include "support.h"
+
+static lmgi_scene *load(const char *path, int use_uv1)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 2000;
+    o.use_file_uv1 = use_uv1;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
+static lmgi_updater *bake(lmgi_context *ctx, lmgi_scene *sc)
+{
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.photons = 20000;
+    d.hemicube_resolution = 16;
+    d.rim_samples = 16;
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
+/* Per node (by name), the mean of the lightmap's valid texels' irradiance (R + G + B), and their count. */
+static void node_means(const lmgi_scene *sc, const float *rgba, const char *name, double *mean, int *count)
+{
+    const lm_scene *s = sc->scene;
+    int node = lmgi_find_node(sc, name);
+    double sum = 0.0;
+    *count = 0;
+    for (uint32_t i = 0; i < sc->atlas.texel_count; i++) {
+        const lm_texel *t = &sc->atlas.texels[i];
+        const float *p = rgba + 4 * ((size_t)t->y * (size_t)sc->atlas.width + (size_t)t->x);
+        if ((int)s->tri_node[t->tri] != node || p[3] < 0.5f)
+            continue;
+        sum += p[0] + p[1] + p[2];
+        ++*count;
+    }
+    *mean = *count ? sum / *count : 0.0;
+}
+
+static float *lightmap(lmgi_updater *u, const lmgi_scene *sc)
+{
+    size_t n = 4 * (size_t)sc->atlas.width * (size_t)sc->atlas.height;
+    float *rgba = malloc(n * sizeof *rgba);
+    lmgi_error e;
+    assert_non_null(rgba);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, n, &e), LMGI_OK);
+    return rgba;
+}
+
+/* Each re-loaded triangle's TEXCOORD_1 centroid falls on a texel of the original atlas that belongs to a
+ * surface of the same node and lies on the triangle (within its size and two texels): the UVs, their v
+ * direction and the node matrices all agree with the lightmap file. Returns the share that does. */
+static double uv1_hits(const lmgi_scene *orig, const lm_scene *copy)
+{
+    const lm_atlas *a = &orig->atlas;
+    int hits = 0, total = 0;
+    for (uint32_t t = 0; t < copy->tri_count; t++) {
+        const lm_node *nd = &copy->nodes[copy->tri_node[t]];
+        int on = lmgi_find_node(orig, nd->name);
+        const uint32_t *v = copy->tris + 3 * t;
+        float u = 0, w = 0;
+        lm_vec3 c = {0, 0, 0}, p[3];
+        for (int k = 0; k < 3; k++) {
+            u += copy->uv1[2 * v[k]] / 3, w += copy->uv1[2 * v[k] + 1] / 3;
+            const float *q = copy->positions + 3 * v[k];
+            p[k] = lm_mat4_point(nd->world, lm_v3(q[0], q[1], q[2]));
+            c = lm_add(c, lm_scale(p[k], 1.0f / 3));
+        }
+        if (u == 0.0f && w == 0.0f)
+            continue; /* mirror and glass: no lightmap */
+        total++;
+        int x = (int)(u * a->width), y = (int)(w * a->height);
+        if (x < 0 || y < 0 || x >= a->width || y >= a->height)
+            continue;
+        int ti = a->texel_index[(size_t)y * a->width + x];
+        if (ti < 0 || (int)orig->scene->tri_node[a->texels[ti].tri] != on)
+            continue;
+        float reach = 2.0f * a->texel_size;
+        for (int k = 0; k < 3; k++)
+            reach = fmaxf(reach, lm_length(lm_sub(p[k], c)) + 2.0f * a->texel_size);
+        const float *tp = a->texels[ti].pos;
+        hits += lm_length(lm_sub(lm_v3(tp[0], tp[1], tp[2]), c)) <= reach;
+    }
+    assert_true(total > 1000);
+    return (double)hits / total;
+}
+
+static void test_export_and_reload(void **state)
+{
+    (void)state;
+    const char *dir = lmt_tmpdir();
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_scene *sc = load(lmt_project_scene("cornell.glb"), 0);
+    lmgi_updater *u = bake(ctx, sc);
+    lmgi_export_desc d = {.name = "box"};
+    assert_int_equal(lmgi_export_gltf(u, dir, &d, &e), LMGI_OK);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/box_lightmap.png", dir);
+    assert_int_equal(access(path, R_OK), 0);
+
+    float *mine = lightmap(u, sc), *file = NULL; /* the file holds what the updater shows */
+    int w, h;
+    lm_error le;
+    snprintf(path, sizeof path, "%s/box_lightmap.exr", dir);
+    assert_int_equal(lm_read_exr(path, &w, &h, &file, &le), LM_OK);
+    assert_int_equal(w, sc->atlas.width);
+    assert_int_equal(h, sc->atlas.height);
+    assert_memory_equal(mine, file, 4 * sizeof(float) * (size_t)w * h);
+    free(file);
+
+    snprintf(path, sizeof path, "%s/box.gltf", dir);
+    lm_load_options lo = {.strict = 0};
+    lm_scene *copy = NULL;
+    assert_int_equal(lm_scene_load_gltf(path, &lo, &copy, &le), LM_OK);
+    assert_int_equal(copy->tri_count, sc->scene->tri_count);
+    assert_int_equal(copy->light_count, 1);
+    assert_int_equal(copy->camera_count, sc->scene->camera_count);
+    for (int i = 0; i < sc->scene->node_count; i++) {
+        const lm_node *a = &sc->scene->nodes[i], *b = &copy->nodes[i];
+        assert_string_equal(a->name, b->name);
+        assert_int_equal(a->dynamic, b->dynamic); /* kept in the node's lmgi extras */
+        for (int k = 0; k < 16; k++)
+            assert_float_equal(a->world[k], b->world[k], 1e-6);
+    }
+    double share = uv1_hits(sc, copy);
+    print_message("export: %.2f%% of the copy's triangles find their own texels through TEXCOORD_1\n", 100.0 * share);
+    assert_true(share > 0.97);
+    lm_scene_free(copy);
+
+    /* The copy, charted from its TEXCOORD_1, lit again: each node as bright as in the original. */
+    lmgi_scene *again = load(path, 1);
+    lmgi_updater *u2 = bake(ctx, again);
+    float *theirs = lightmap(u2, again);
+    static const char *const nodes[] = {"cornell_box", "tall_block", "dynamic_cube"};
+    for (int k = 0; k < 3; k++) {
+        double m1, m2;
+        int n1, n2;
+        node_means(sc, mine, nodes[k], &m1, &n1);
+        node_means(again, theirs, nodes[k], &m2, &n2);
+        print_message("  %-12s mean E %.4f over %d texels, re-loaded %.4f over %d (%.2f%%)\n", nodes[k], m1, n1, m2, n2,
+                      100.0 * (m2 / m1 - 1.0));
+        assert_true(n1 > 20 && n2 > 20);
+        assert_float_equal(m2, m1, 0.05 * m1);
+    }
+    free(mine);
+    free(theirs);
+    lmgi_updater_free(u2);
+    lmgi_free(again);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A name that is not a plain file name, or one that would replace the scene's own file, writes nothing. */
+static void test_bad_exports(void **state)
+{
+    (void)state;
+    const char *dir = lmt_tmpdir();
+    char scene[1200];
+    snprintf(scene, sizeof scene, "%s/room.glb", dir);
+    size_t size = 0;
+    unsigned char *bytes = lmt_read_file(lmt_project_scene("cornell.glb"), &size, 0);
+    lmt_write_file(scene, bytes, size);
+    free(bytes);
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_scene *sc = load(scene, 0);
+    lmgi_updater *u = bake(ctx, sc);
+    lmgi_export_desc d = {.name = "../up"};
+    assert_int_equal(lmgi_export_gltf(u, dir, &d, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "name '../up'"));
+    d.name = "room";
+    d.force = 1;
+    assert_int_equal(lmgi_export_gltf(u, dir, &d, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "would replace the scene's own file"));
+    assert_int_equal(lmgi_export_gltf(NULL, dir, &d, &e), LMGI_ERR_INVALID);
+    assert_int_equal(lmgi_export_gltf(u, NULL, &d, &e), LMGI_ERR_INVALID);
+    d.name = "copy";
+    d.force = 0;
+    assert_int_equal(lmgi_export_gltf(u, dir, &d, &e), LMGI_ERR_IO); /* the directory holds the user's room.glb */
+    char path[1300];
+    snprintf(path, sizeof path, "%s/copy.gltf", dir);
+    assert_int_not_equal(access(path, F_OK), 0);
+    bytes = lmt_read_file(scene, &size, 0);
+    assert_true(size > 1000); /* untouched */
+    free(bytes);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_export_and_reload),
+        cmocka_unit_test(test_bad_exports),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
