@@ -29,6 +29,7 @@
 
 #include "../src/core/log.h"
 #include "../src/core/timing.h"
+#include "../src/gpu/gl_context.h"
 #include "../src/update/frame_loop.h"
 #include "../src/api/lmgi_scene.h"
 #include "support.h"
@@ -41,6 +42,8 @@ typedef struct {
 } blob;
 
 static uint32_t g_rng;
+static lm_gl_context *g_gl; /* one GL context for every input's frame loop (a context per input cost most of
+                             * an input's time: llvmpipe sets up megabytes for each) */
 
 static uint32_t rnd(void) { return lmt_xorshift(&g_rng); }
 
@@ -278,6 +281,7 @@ static int run_pipeline(const char *path)
         set.gather.rim_samples = 2;
         set.emitter_rays = 2;
         set.direct.cube_size = set.direct.map_size = 16;
+        set.gl = g_gl;
         lm_frame_loop *fl = NULL;
         lm_error e;
         lm_status st = lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &fl, NULL, NULL, &e);
@@ -408,6 +412,9 @@ static void test_fuzz_pipeline(void **state)
                            : sources[k].project ? lmt_project_scene(sources[k].project)
                                                 : path);
     lm_log_set_level(LM_LOG_ERROR); /* warnings from thousands of broken files are noise here */
+    lm_error gl_err;
+    if (lm_gl_context_create(&g_gl, &gl_err) != LM_OK)
+        fail_msg("%s", gl_err.msg);
     for (int k = 0; k < SOURCES; k++) { /* unmutated, every source renders (else the fuzzing proves little) */
         snprintf(path, sizeof path, "%s/%s", dir, sources[k].name);
         write_blob(path, src[k].data, src[k].size);
@@ -462,6 +469,7 @@ static void test_fuzz_pipeline(void **state)
     for (int k = 0; k < SOURCES; k++)
         free(src[k].data);
     free(bin.data);
+    lm_gl_context_destroy(g_gl);
     lm_log_set_level(LM_LOG_WARN);
 }
 
