@@ -445,9 +445,15 @@ LMGI_API lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int wi
  *                           texels inside or under geometry (those filled from their neighbours and the
  *                           gutters dilated, so bilinear filtering stays smooth);
  *   LMGI_LIGHTMAP_AIM       the approximate illumination map (photon estimate of radiance leaving each
- *                           texel, rgb; gutters dilated), a as above.
+ *                           texel, rgb; gutters dilated), a as above;
+ *   LMGI_LIGHTMAP_ERROR     how far the displayed IIM may still be from the lighting as it is now,
+ *                           relative to the texel's irradiance (r = g = b): what a refresh under way or
+ *                           a blend has still to bring in, and, where the surface's photons changed since
+ *                           its last refresh, that change relative to their energy (an upper bound;
+ *                           docs/api.md, "The error atlas"). 0 everywhere once the lightmap has caught
+ *                           up: an editor shows what is not yet final, a game can wait for it. a as above.
  * A diffuse surface's indirect radiance is albedo / pi * E (docs/materials.md). */
-typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM } lmgi_lightmap;
+typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM, LMGI_LIGHTMAP_ERROR } lmgi_lightmap;
 /* rgba must hold `floats` >= 4 * atlas_width * atlas_height floats. NULL u or rgba, too small, or an
  * unknown kind: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err);

@@ -351,10 +351,15 @@ static void test_light_edit_stays_in_its_room(void **state)
     lmgi_light li;
     assert_int_equal(lmgi_get_light(sc, a1, &li, &e), LMGI_OK);
     assert_true(li.enabled && li.intensity > 0.0f);
+    float *err0 = malloc(n * sizeof *err0), *err1 = malloc(n * sizeof *err1), *err40 = malloc(n * sizeof *err40);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_ERROR, err0, n, &e), LMGI_OK);
     li.intensity *= 0.25f;
     assert_int_equal(lmgi_set_light(sc, a1, &li, &e), LMGI_OK);
-    for (int f = 0; f < 40; f++)
+    update(u, 0.0f, 0.0f, &st);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_ERROR, err1, n, &e), LMGI_OK);
+    for (int f = 1; f < 40; f++)
         update(u, 0.0f, 0.0f, &st);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_ERROR, err40, n, &e), LMGI_OK);
     assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim1, n, &e), LMGI_OK);
     assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim1, n, &e), LMGI_OK);
     /* surfaces wholly in room B, and those reaching into the doorway's reveal, on room A's side of the
@@ -365,14 +370,16 @@ static void test_light_edit_stays_in_its_room(void **state)
         lmgi_get_texel(sc, i, &t);
         reaches_a[t.surface] |= t.position[0] < 0.2f;
     }
-    int a_changed = 0, b_texels = 0, b_untouched = 0;
-    double a_before = 0.0, a_after = 0.0, b_worst = 0.0;
+    int a_changed = 0, b_texels = 0, b_untouched = 0, a_texels = 0;
+    double a_before = 0.0, a_after = 0.0, b_worst = 0.0, settled = 0.0, a_err1 = 0.0, a_err40 = 0.0;
     for (uint32_t i = 0; i < in.texels; i++) {
         lmgi_texel t;
         lmgi_get_texel(sc, i, &t);
         size_t k = 4 * ((size_t)t.y * in.atlas_width + t.x);
+        settled = fmax(settled, err0[k]);
         if (t.position[0] > 0.2f && !reaches_a[t.surface]) { /* room B alone: no work, not a bit changed */
             b_untouched++;
+            assert_true(err1[k] == 0.0f && err40[k] == 0.0f); /* nothing to catch up on */
             assert_memory_equal(iim0 + k, iim1 + k, 4 * sizeof *iim0);
             assert_memory_equal(aim0 + k, aim1 + k, 4 * sizeof *aim0);
             assert_int_equal(lmgi_surface_version(u, t.surface), ver0[t.surface]);
@@ -385,8 +392,16 @@ static void test_light_edit_stays_in_its_room(void **state)
             a_before += iim0[k] + iim0[k + 1] + iim0[k + 2];
             a_after += iim1[k] + iim1[k + 1] + iim1[k + 2];
             a_changed += lmgi_surface_version(u, t.surface) != ver0[t.surface];
+            a_err1 += err1[k], a_err40 += err40[k], a_texels++;
         }
     }
+    a_err1 /= a_texels, a_err40 /= a_texels;
+    print_message("room A's indirect light changed by %.3f relative\n", fabs(a_after / a_before - 1.0));
+    print_message("error atlas: settled at most %.2e; room A's mean after the edit's first update %.3f, after 40 "
+                  "%.2e\n", settled, a_err1, a_err40);
+    assert_true(settled < 0.02);   /* converged before the edit */
+    assert_true(a_err1 > 0.05);    /* a light at a quarter: room A is far from its new light */
+    assert_true(a_err40 < 0.5 * a_err1); /* and catches up */
     free(reaches_a);
     print_message("light_a1 at a quarter: room A's indirect light %.3g -> %.3g; %d texels of surfaces wholly in room "
                   "B unchanged, %d more within %.1e\n", a_before, a_after, b_untouched, b_texels, b_worst);
@@ -415,7 +430,7 @@ static void test_light_edit_stays_in_its_room(void **state)
     expect_invalid(lmgi_set_light(NULL, 0, &li, &e), &e, "NULL");
     assert_int_equal(lmgi_get_light(sc, a1, &back, &e), LMGI_OK);
     assert_true(!back.enabled); /* the refused edits changed nothing */
-    free(iim0), free(aim0), free(iim1), free(aim1), free(ver0);
+    free(iim0), free(aim0), free(iim1), free(aim1), free(ver0), free(err0), free(err1), free(err40);
     close_all(u, sc, ctx);
 }
 

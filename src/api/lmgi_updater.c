@@ -474,6 +474,28 @@ static lm_status read_aim(const lmgi_updater *u, float *rgba, lm_error *err)
     return st;
 }
 
+/* The error estimate (lm_frame_loop_iim_error) in rgb, gutters dilated, with the IIM's validity as alpha. */
+static lm_status read_error(const lmgi_updater *u, float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *e = malloc(n * sizeof *e), *rgb = malloc(n * 3 * sizeof *rgb), *raw = NULL;
+    lm_status st = e && rgb ? lm_frame_loop_iim_error(u->loop, e, err) : lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
+    if (st == LM_OK)
+        st = read_raw_iim(u, &raw, rgba, err); /* for the validity */
+    free(raw);
+    if (st == LM_OK) {
+        for (size_t i = 0; i < n; i++)
+            rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = e[i];
+        lm_atlas_dilate_gutters(at, rgb, 3);
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgba + 4 * i, rgb + 3 * i, 3 * sizeof *rgb);
+    }
+    free(e);
+    free(rgb);
+    return st;
+}
+
 lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
 {
     if (!u || !rgba)
@@ -483,11 +505,13 @@ lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, 
     if (floats < need)
         return lm_api_refuse(err, "lmgi_get_lightmap: the buffer holds %zu floats; the %d x %d atlas needs %zu", floats,
                        at->width, at->height, need);
-    if (kind != LMGI_LIGHTMAP_IIM && kind != LMGI_LIGHTMAP_AIM)
+    if (kind != LMGI_LIGHTMAP_IIM && kind != LMGI_LIGHTMAP_AIM && kind != LMGI_LIGHTMAP_ERROR)
         return lm_api_refuse(err, "lmgi_get_lightmap: %d is not a lightmap kind", (int)kind);
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
-    lm_status st = kind == LMGI_LIGHTMAP_IIM ? read_iim(u, rgba, &e) : read_aim(u, rgba, &e);
+    lm_status st = kind == LMGI_LIGHTMAP_IIM ? read_iim(u, rgba, &e)
+                   : kind == LMGI_LIGHTMAP_AIM ? read_aim(u, rgba, &e)
+                                               : read_error(u, rgba, &e);
     lm_api_leave(saved);
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }

@@ -110,3 +110,12 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_f = 0.0; }
 void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_i = 0.0; }
 size_t lm_photon_store_bytes(const lm_photon_store *ps) { (void)ps; return sizeof(lm_hit); }
+
+double lm_photon_store_iim_energy(const lm_photon_store *ps, int surface)
+{
+    double e = 0.0;
+    for (uint32_t h = ps->surfaces[surface].head; h != LM_NONE; h = ps->hits[h].next)
+        if (!(ps->hits[h].bounce == 0 && ps->hits[h].from_punctual))
+            e += lm_hit_energy(&ps->hits[h]);
+    return e;
+}

@@ -69,6 +69,9 @@ static inline double lm_hit_energy(const lm_hit *h)
 {
     return 0.2126 * h->flux[0] + 0.7152 * h->flux[1] + 0.0722 * h->flux[2];
 }
+/* The energy of a surface's stored hits that an IIM holds (first hits of punctual lights left out, as
+ * delta_i leaves them out): what delta_i is measured against. O(hits on the surface). */
+double lm_photon_store_iim_energy(const lm_photon_store *ps, int surface);
 /* Sets a surface's delta_f (after its AIM refresh) or delta_i (after its IIM refresh) to zero. */
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface);
 void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface);

@@ -638,3 +638,44 @@ lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error
     }
     return st;
 }
+
+static double lum(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, float *error, lm_error *err)
+{
+    const lm_atlas *a = fl->atlas;
+    size_t n = (size_t)a->width * a->height;
+    float *shown = NULL, *fresh = malloc(4 * n * sizeof *fresh);
+    double *pending = calloc((size_t)(a->surface_count > 0 ? a->surface_count : 1), sizeof *pending);
+    lm_status st = fresh && pending ? lm_frame_loop_sync(fl, err) : lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
+    if (st == LM_OK)
+        st = lm_frame_loop_read_iim(fl, &shown, err);
+    if (st == LM_OK)
+        st = lm_iim_texture_read(fl->iim.fresh_tex, a->width, a->height, fresh, err);
+    if (st == LM_OK) {
+        const lm_photon_store *ps = lm_photons_store(lm_photon_stage_photons(fl->stage));
+        for (int s = 0; s < a->surface_count; s++) {
+            double e = lm_photon_store_iim_energy(ps, s), d = ps->surfaces[s].delta_i;
+            pending[s] = d <= 0.0 ? 0.0 : e > 0.0 ? d / e : 1.0;
+        }
+        float limit = fl->set.gather.backface_limit;
+        double sum = 0.0;
+        uint32_t valid = 0;
+        for (uint32_t i = 0; i < a->texel_count; i++) {
+            const float *p = shown + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
+            if (!(p[3] > limit))
+                sum += lum(p), valid++;
+        }
+        double floor = 0.01 * (valid ? sum / valid : 0.0) + 1e-30;
+        memset(error, 0, n * sizeof *error);
+        for (uint32_t i = 0; i < a->texel_count; i++) {
+            size_t at = (size_t)a->texels[i].y * a->width + a->texels[i].x;
+            double f = lum(fresh + 4 * at), blend = fabs(f - lum(shown + 4 * at)) / fmax(fabs(f), floor);
+            error[at] = (float)fmax(blend, pending[a->texels[i].surface]);
+        }
+    }
+    free(shown);
+    free(fresh);
+    free(pending);
+    return st;
+}

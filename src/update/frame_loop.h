@@ -126,6 +126,17 @@ const float *lm_frame_loop_image(const lm_frame_loop *fl);
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);
 /* The displayed IIM read back (atlas-sized RGBA floats, a = back-face fraction); caller frees. */
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err);
+/* Per atlas pixel (width*height floats, 0 outside texels), how far the displayed IIM may be from the
+ * lighting as it is now, relative to the texel's irradiance: the larger of
+ *   - what the display has still to blend in: |fresh - displayed| / max(|fresh|, floor), fresh being
+ *     the latest gathered value (a refresh under way, or a committed one still fading in), luminance,
+ *     floor 1% of the mean displayed luminance of valid texels;
+ *   - what is not gathered yet: the surface's delta_i (photon energy added or removed since its IIM was
+ *     last refreshed, the scheduler's own measure) over its stored IIM energy, an upper bound of the
+ *     relative change of the light its photons bring.
+ * 0 everywhere once every refresh is complete and blended and no photon changed since. Joins photon work
+ * under way first. */
+lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, float *error, lm_error *err);
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl);
 /* The view the frames are drawn from. */
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl);
