@@ -284,7 +284,7 @@ static int run_pipeline(const char *path)
         set.gl = g_gl;
         lm_frame_loop *fl = NULL;
         lm_error e;
-        lm_status st = lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &fl, NULL, NULL, &e);
+        lm_status st = lm_frame_loop_create(&sc->world, &set, &fl, NULL, NULL, &e);
         if (st == LM_OK) {
             lm_frame_stats fs;
             st = lm_frame_loop_step(fl, 0.25f, &fs, &e);

@@ -35,6 +35,7 @@ void lmt_write_file(const char *path, const void *data, size_t n);
 #include "../src/charts/charts.h"
 #include "../src/trace/lights.h"
 #include "../src/trace/rt_scene.h"
+#include "../src/update/world.h"
 
 typedef struct {
     lm_scene *s;
@@ -42,6 +43,7 @@ typedef struct {
     lm_atlas atlas;
     lm_rt *rt;
     lm_emitters em;
+    lm_world w;    /* s, su, atlas and rt for the runtime */
 } lmt_pipeline;
 
 /* Loads `path` with default options but the given texel size (0 = default); fails the test on error. */

@@ -203,7 +203,7 @@ static void check_iim(const char *path, int target_texels, float ref_error, uint
     ls.width = ls.height = 16; /* no picture is looked at */
     lm_frame_loop *fl = NULL;
     lm_error err;
-    if (lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &ls, &fl, NULL, NULL, &err) != LM_OK)
+    if (lm_frame_loop_create(&sc->world, &ls, &fl, NULL, NULL, &err) != LM_OK)
         fail_msg("%s", err.msg);
     float *rgba = NULL;
     assert_int_equal(lm_frame_loop_read_iim(fl, &rgba, &err), LM_OK);

@@ -438,7 +438,7 @@ static lm_photon_stage *stage_for(lmt_pipeline *p, uint32_t photons)
     set.photons.total_photons = photons;
     lm_photon_stage *st = NULL;
     lm_error err;
-    if (lm_photon_stage_create(p->s, &p->su, &p->atlas, p->rt, &set, &st, NULL, &err) != LM_OK)
+    if (lm_photon_stage_create(&p->w, &set, &st, NULL, &err) != LM_OK)
         fail_msg("%s", err.msg);
     return st;
 }
@@ -804,7 +804,7 @@ static void test_rim_smooth(void **state)
     lm_photon_stage_settings_default(&ps);
     lm_photon_stage *st = NULL;
     lm_error err;
-    if (lm_photon_stage_create(p.s, &p.su, &p.atlas, p.rt, &ps, &st, NULL, &err) != LM_OK)
+    if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK)
         fail_msg("%s", err.msg);
     /* the tall block's face towards the camera (+z), texels 0.2 m to 1.2 m high */
     uint32_t *face = malloc(sizeof(uint32_t) * p.atlas.texel_count), n = 0;

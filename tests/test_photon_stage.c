@@ -29,7 +29,7 @@ static lm_photon_stage *stage_for(lmt_pipeline *p, uint32_t photons)
     set.photons.total_photons = photons;
     lm_photon_stage *st = NULL;
     lm_error err;
-    if (lm_photon_stage_create(p->s, &p->su, &p->atlas, p->rt, &set, &st, NULL, &err) != LM_OK)
+    if (lm_photon_stage_create(&p->w, &set, &st, NULL, &err) != LM_OK)
         fail_msg("%s", err.msg);
     return st;
 }

@@ -244,7 +244,7 @@ static void test_cornell_gather_with_proxy(void **state)
     ss.photons.total_photons = 100000;
     lm_photon_stage *st = NULL;
     lm_error err;
-    if (lm_photon_stage_create(p.s, &p.su, &p.atlas, p.rt, &ss, &st, NULL, &err) != LM_OK)
+    if (lm_photon_stage_create(&p.w, &ss, &st, NULL, &err) != LM_OK)
         fail_msg("%s", err.msg);
     enum { N = 1024 };
     uint32_t texels[N];

@@ -258,7 +258,7 @@ static void test_setup_progress(void **state)
         }
         lm_frame_loop *fl = NULL;
         lm_error err;
-        if (lm_frame_loop_create(p.s, &p.su, &p.atlas, p.rt, &set, &fl, NULL, NULL, &err) != LM_OK)
+        if (lm_frame_loop_create(&p.w, &set, &fl, NULL, NULL, &err) != LM_OK)
             fail_msg("%s", err.msg);
         assert_int_equal(lm_frame_loop_read_iim(fl, &iim[k], &err), LM_OK);
         lm_frame_loop_free(fl);

@@ -78,7 +78,7 @@ static lm_status run_frames(lmgi_scene *sc, const lm_frame_loop_settings *set, i
                             lm_view *view, lm_error *err)
 {
     lm_frame_loop *fl = NULL;
-    lm_status st = lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, set, &fl, NULL, NULL, err);
+    lm_status st = lm_frame_loop_create(&sc->world, set, &fl, NULL, NULL, err);
     for (int f = 0; st == LM_OK && f < (frames > 0 ? frames : 1); f++) {
         lm_frame_stats fs;
         st = lm_frame_loop_step(fl, (float)f / 30.0f, &fs, err);

@@ -110,6 +110,7 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
         return st;
     double t4 = lm_now();
 
+    sc->world = (lm_world){sc->scene, &sc->surfaces, &sc->atlas, sc->rt};
     lm_effects_decide(sc->scene, &sc->effects);
     sc->timings.load = t1 - t0;
     sc->timings.surfaces = t2 - t1;

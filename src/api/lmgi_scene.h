@@ -7,6 +7,7 @@
 #include "../charts/charts.h"
 #include "../trace/rt_scene.h"
 #include "../update/effects.h"
+#include "../update/world.h"
 
 struct lmgi_scene {
     lmgi_options options;
@@ -15,6 +16,7 @@ struct lmgi_scene {
     lm_atlas atlas;
     int have_surfaces, have_atlas;
     lm_rt *rt;
+    lm_world world;         /* the four above, for the runtime (set once they are built) */
     lm_effects effects;
     lmgi_timings timings;
     lmgi_updater *updater;  /* the one updater working on it (it moves nodes and the BVH), or NULL */

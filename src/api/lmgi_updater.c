@@ -172,7 +172,7 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
         u->ctx = ctx;
         u->sc = sc;
         u->seen = calloc((size_t)(sc->atlas.surface_count > 0 ? sc->atlas.surface_count : 1), sizeof *u->seen);
-        st = u->seen ? lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &u->loop, &u->setup,
+        st = u->seen ? lm_frame_loop_create(&sc->world, &set, &u->loop, &u->setup,
                                             &u->t_setup_gather, &e)
                      : lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");
     }

@@ -272,18 +272,18 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
  * tables, their GL textures): about 250 bytes, measured from 66k to 1M texels (peak RSS of lmgi run). */
 #define FRAME_LOOP_BYTES_PER_TEXEL 250.0
 
-lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
-                               const lm_frame_loop_settings *set, lm_frame_loop **out, lm_photon_stage_frame *setup,
-                               double *t_setup_gather, lm_error *err)
+lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *set, lm_frame_loop **out,
+                               lm_photon_stage_frame *setup, double *t_setup_gather, lm_error *err)
 {
     *out = NULL;
+    const lm_atlas *a = w->atlas;
     lm_frame_loop *fl = calloc(1, sizeof *fl);
     if (!fl)
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", s->path);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
     fl->set = *set;
-    fl->scene = s;
+    fl->scene = w->scene;
     fl->atlas = a;
-    fl->rt = rt;
+    fl->rt = w->rt;
     char what[128];
     snprintf(what, sizeof what, "the lightmaps of %u texels (AIM, IIM, gather)", a->texel_count);
     lm_status st = lm_memory_plan(what, (double)a->texel_count * FRAME_LOOP_BYTES_PER_TEXEL, "a larger texel "
@@ -291,7 +291,7 @@ lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atla
     if (st == LM_OK)
         st = alloc_buffers(fl, err);
     if (st == LM_OK)
-        st = lm_photon_stage_create(s, su, a, rt, &set->stage, &fl->stage, setup, err);
+        st = lm_photon_stage_create(w, &set->stage, &fl->stage, setup, err);
     if (st == LM_OK)
         st = setup_gpu(fl, t_setup_gather, err);
     if (st == LM_OK && fl->set.overlap)

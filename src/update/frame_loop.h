@@ -76,11 +76,10 @@ typedef struct lm_frame_loop lm_frame_loop;
 int lm_frame_loop_atlas_texels(int texels_per_frame);
 
 void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
-/* The initial state. scene, surfaces, atlas and BVH are borrowed and must outlive the loop. setup (may
- * be NULL) gets the photon stage's setup times; t_setup_gather (may be NULL) the full gather's. */
-lm_status lm_frame_loop_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
-                               const lm_frame_loop_settings *set, lm_frame_loop **out, lm_photon_stage_frame *setup,
-                               double *t_setup_gather, lm_error *err);
+/* The initial state. The world (update/world.h) is borrowed and must outlive the loop. setup (may be
+ * NULL) gets the photon stage's setup times; t_setup_gather (may be NULL) the full gather's. */
+lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *set, lm_frame_loop **out,
+                               lm_photon_stage_frame *setup, double *t_setup_gather, lm_error *err);
 void lm_frame_loop_free(lm_frame_loop *fl);
 /* One frame at animation time t; the picture is then in lm_frame_loop_image. */
 lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err);

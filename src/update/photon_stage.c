@@ -143,22 +143,21 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     return st;
 }
 
-lm_status lm_photon_stage_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
-                                 const lm_photon_stage_settings *set, lm_photon_stage **out,
+lm_status lm_photon_stage_create(const lm_world *w, const lm_photon_stage_settings *set, lm_photon_stage **out,
                                  lm_photon_stage_frame *first, lm_error *err)
 {
     *out = NULL;
     lm_photon_stage *ps = calloc(1, sizeof *ps);
     if (!ps)
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", s->path);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", w->scene->path);
     if (set)
         ps->set = *set;
     else
         lm_photon_stage_settings_default(&ps->set);
-    ps->scene = s;
-    ps->surfaces = su;
-    ps->atlas = a;
-    ps->rt = rt;
+    ps->scene = w->scene;
+    ps->surfaces = w->surfaces;
+    ps->atlas = w->atlas;
+    ps->rt = w->rt;
     lm_photon_stage_frame scratch;
     memset(&scratch, 0, sizeof scratch);
     lm_status st = setup(ps, first ? first : &scratch, err);

@@ -7,6 +7,7 @@
 #include "../photonmap/aim.h"
 #include "../trace/lights.h"
 #include "../trace/photons.h"
+#include "world.h"
 
 typedef struct {
     lm_photon_settings photons; /* cover_distance 0 (default) is the atlas's texel size here; < 0: off */
@@ -28,10 +29,9 @@ typedef struct lm_photon_stage lm_photon_stage;
 
 void lm_photon_stage_settings_default(lm_photon_stage_settings *s);
 /* Builds emitters, traces every photon and fills every AIM (the first frame's state). `setup` (may be
- * NULL) gets the time of that full trace and refresh. The scene, surfaces, atlas and BVH are borrowed
- * and must outlive the stage; the stage moves the BVH's instances as animations play. */
-lm_status lm_photon_stage_create(lm_scene *s, const lm_surfaces *su, const lm_atlas *a, lm_rt *rt,
-                                 const lm_photon_stage_settings *set, lm_photon_stage **out,
+ * NULL) gets the time of that full trace and refresh. The world (update/world.h) is borrowed and must
+ * outlive the stage; the stage moves the BVH's instances as animations play. */
+lm_status lm_photon_stage_create(const lm_world *w, const lm_photon_stage_settings *set, lm_photon_stage **out,
                                  lm_photon_stage_frame *setup, lm_error *err);
 void lm_photon_stage_free(lm_photon_stage *ps);
 /* One frame at animation time t (every animation evaluated; t is clamped to each one's range):

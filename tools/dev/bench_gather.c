@@ -47,7 +47,7 @@ static int open_scene(const char *label, int paper_row, const char *path, bench_
     lm_photon_stage_settings_default(&set);
     lm_error err;
     const lm_atlas *a = &b->sc->atlas;
-    if (lm_photon_stage_create(b->sc->scene, &b->sc->surfaces, a, b->sc->rt, &set, &b->stage, NULL, &err) != LM_OK) {
+    if (lm_photon_stage_create(&b->sc->world, &set, &b->stage, NULL, &err) != LM_OK) {
         printf("%s: %s\n", label, err.msg);
         return 0;
     }
@@ -344,7 +344,7 @@ static void print_frame_mode(lmgi_scene *sc, const char *path, int overlap)
     lm_frame_loop *fl = NULL;
     lm_error err;
     double t_setup = 0.0;
-    if (lm_frame_loop_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &fl, NULL, &t_setup, &err) != LM_OK) {
+    if (lm_frame_loop_create(&sc->world, &set, &fl, NULL, &t_setup, &err) != LM_OK) {
         printf("\nframe loop: %s\n", err.msg);
         return;
     }

@@ -171,7 +171,7 @@ static void photon_stage_frames(const char *path, int frames)
     lm_error err;
     lm_photon_stage *stage = NULL;
     lm_photon_stage_frame setup;
-    if (lm_photon_stage_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, NULL, &stage, &setup, &err) != LM_OK) {
+    if (lm_photon_stage_create(&sc->world, NULL, &stage, &setup, &err) != LM_OK) {
         printf("photon stage: failed: %s\n", err.msg);
         lmgi_free(sc);
         return;

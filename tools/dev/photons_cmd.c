@@ -164,7 +164,7 @@ int lm_dev_photons(const lm_cli_args *a)
     csv = fopen(path, "w");
     lm_status st = csv ? LM_OK : lm_fail(&err, LM_ERR_IO, "%s: cannot write", path);
     if (st == LM_OK)
-        st = lm_photon_stage_create(sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &set, &stage, &setup, &err);
+        st = lm_photon_stage_create(&sc->world, &set, &stage, &setup, &err);
     if (st == LM_OK) {
         csv_header(csv);
         st = play(sc, a, stage, csv, &sum_ms, &err);
