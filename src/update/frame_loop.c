@@ -425,9 +425,9 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
  * sees the AIMs and delta_i of the previous frame's stage (one frame later than in order; the IIM blends
  * over several frames anyway). Every result depends only on that fixed order, not on timing. The gather
  * runs before the worker starts: its CPU work (the emitter light's shadow rays, llvmpipe's vertex work
- * for one view per texel) is on the frame's critical path and took twice as long sharing the two cores
- * with the stage, while the direct light, whose second rasterizer thread gains little, hides the
- * stage as well alone (docs/bench.md: frame 41.4 -> 38.7 ms in alternating `lmgi run`s). */
+ * for one view per texel) is on the frame's critical path and slows down sharing the cores with the
+ * stage, while the direct light, whose second rasterizer thread gains little, hides the stage as well
+ * alone (docs/bench.md has the figures). */
 static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
