@@ -426,7 +426,6 @@ void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
     set_ranges(prog, ALL, ALL);
 }
 
-unsigned lm_direct_texture(const lm_direct *d) { return d->target.color[0]; }
 
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 

@@ -45,12 +45,10 @@ typedef struct lm_direct lm_direct;
 lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct_settings *settings, lm_direct **out,
                            lm_error *err);
 void lm_direct_free(lm_direct *d);
-/* Renders into the object's width x height RGBA32F target (no read-back); see lm_direct_texture. em and
- * s->bounds current as for lm_render_direct. */
+/* Renders into the object's width x height RGBA32F target (no read-back; rgb = radiance, GL rows
+ * bottom-up), where reflections draw over it before lm_direct_read. em and s->bounds current as for lm_render_direct. */
 lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                          int height, lm_error *err);
-/* The last lm_direct_draw's image: an RGBA32F texture (rgb = radiance, GL rows bottom-up). */
-unsigned lm_direct_texture(const lm_direct *d);
 /* lm_direct_draw, then the image read back as RGB floats (row 0 at the top). */
 lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                            int height, float *rgb, lm_error *err);
