@@ -234,3 +234,15 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
     }
     return rc;
 }
+
+int lm_cli_start(int argc, char **argv, void (*usage)(FILE *), lm_cli_args *a)
+{
+    if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
+        usage(argc < 2 ? stderr : stdout);
+        return argc < 2 ? 2 : 0;
+    }
+    if (lm_cli_parse(argc, argv, 2, a))
+        return 2;
+    lmgi_set_verbosity(a->quiet ? 0 : a->verbose ? 2 : 1);
+    return -1;
+}

@@ -3,6 +3,7 @@
 #define LM_CLI_ARGS_H
 
 #include <lmgi.h>
+#include <stdio.h>
 
 #define LM_CLI_MAX_FILES 64
 
@@ -56,5 +57,9 @@ typedef struct {
 
 /* Parses argv[first..argc). Returns 0 on success, or prints what was wrong and returns 2. */
 int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a);
+/* The start a program of commands shares (`PROGRAM COMMAND [options]`): no command prints usage on
+ * stderr (exit 2), help on stdout (exit 0); then argv[2..] is parsed (exit 2 when bad) and the library's
+ * verbosity set from -q / -v. Returns -1 to go on with argv[1], else the exit code. */
+int lm_cli_start(int argc, char **argv, void (*usage)(FILE *), lm_cli_args *a);
 
 #endif

@@ -142,17 +142,13 @@ static int cmd_charts(const lm_cli_args *a)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
-        usage(argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
-    }
     lm_cli_args a;
-    if (lm_cli_parse(argc, argv, 2, &a))
-        return 2;
+    int rc = lm_cli_start(argc, argv, usage, &a);
+    if (rc >= 0)
+        return rc;
     /* A file that outgrows the file-size limit (ulimit -f) is then a write error naming the file, as a
      * full disk is, instead of a signal that kills the run. */
     signal(SIGXFSZ, SIG_IGN);
-    lmgi_set_verbosity(a.quiet ? 0 : a.verbose ? 2 : 1);
     const char *cmd = argv[1];
     if (!strcmp(cmd, "info"))
         return cmd_info(&a);

@@ -23,14 +23,10 @@ static void usage(FILE *f)
 
 int main(int argc, char **argv)
 {
-    if (argc < 2 || !strcmp(argv[1], "help") || !strcmp(argv[1], "--help") || !strcmp(argv[1], "-h")) {
-        usage(argc < 2 ? stderr : stdout);
-        return argc < 2 ? 2 : 0;
-    }
     lm_cli_args a;
-    if (lm_cli_parse(argc, argv, 2, &a))
-        return 2;
-    lmgi_set_verbosity(a.quiet ? 0 : a.verbose ? 2 : 1);
+    int rc = lm_cli_start(argc, argv, usage, &a);
+    if (rc >= 0)
+        return rc;
     if (!strcmp(argv[1], "photons"))
         return lm_dev_photons(&a);
     if (!strcmp(argv[1], "bench")) {
