@@ -508,6 +508,7 @@ typedef struct {
     float *full;            /* texels: irradiance E from all light; pixels: radiance reaching the eye */
     float *iim;             /* texels: E without the punctual lights' direct part (what the IIM holds); pixels: NULL */
     float *radiance;        /* texels: albedo / pi x E (what the AIM approximates); pixels: NULL */
+    float target_error;     /* the relative standard error it sampled to (the desc's, or the default) */
     uint32_t entries, converged; /* texels or pixels, and how many reached the target (the rest hit the cap) */
     uint64_t samples;       /* paths traced over all entries */
     double mean_rel_se, max_rel_se; /* achieved relative standard error per entry */
@@ -546,6 +547,7 @@ typedef struct {
     uint32_t pixels;        /* compared pixels of non-emissive surfaces */
     double frame_mean[3], reference_mean[3], ratio[3]; /* over those pixels */
     double rel_rmse;        /* relative RMSE of the frame over those pixels */
+    float reference_target_error; /* the reference's target relative standard error */
     double reference_rel_se, reference_seconds; /* the reference's own noise and cost */
 } lmgi_check_result;
 /* Creates an updater on ctx for scene with desc (frame_width x frame_height: the picture, 0 x 0 is

@@ -75,6 +75,7 @@ static void test_reference_texels(void **state)
     assert_int_equal(r.height, in.atlas_height);
     assert_int_equal(r.entries, lmgi_texel_count(sc));
     assert_int_equal(r.converged, r.entries);
+    assert_float_equal(r.target_error, 0.02f, 0.0f); /* the desc's */
     assert_false(r.from_cache);
     int checked = 0;
     for (uint32_t i = 0; i < r.entries; i++) {
@@ -142,6 +143,7 @@ static void test_reference_pixels_and_check(void **state)
     lmgi_check_result c;
     assert_int_equal(lmgi_check(ctx, sc, &ud, &d, 1, &c, &e), LMGI_OK);
     assert_int_equal(c.width, SIDE);
+    assert_float_equal(c.reference_target_error, 0.02f, 0.0f);
     assert_int_equal(c.surface_count, lmgi_surface_count(sc));
     assert_true(c.pixels > (uint32_t)seen / 2); /* the floor's interior pixels */
     double sum_check = 0.0;

@@ -23,7 +23,8 @@ static void export_sum(const lm_check_sum *sum, uint32_t *pixels, double frame[3
 }
 
 /* The internal check's figures and arrays moved into the public result. */
-static lm_status export_check(lm_frame_check *c, const lmgi_scene *sc, lmgi_check_result *out, lm_error *err)
+static lm_status export_check(lm_frame_check *c, const lmgi_scene *sc, float target, lmgi_check_result *out,
+                              lm_error *err)
 {
     out->width = c->width, out->height = c->height;
     out->frame = c->frame, out->reference = c->ref, out->compared = c->compared;
@@ -41,6 +42,7 @@ static lm_status export_check(lm_frame_check *c, const lmgi_scene *sc, lmgi_chec
     }
     export_sum(&c->lit, &out->pixels, out->frame_mean, out->reference_mean, out->ratio);
     out->rel_rmse = c->rel_rmse;
+    out->reference_target_error = target;
     out->reference_rel_se = c->ref_rel_se;
     out->reference_seconds = c->ref_seconds;
     return LM_OK;
@@ -81,7 +83,7 @@ lmgi_status lmgi_check(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_des
     if (st == LM_OK)
         st = lm_frame_check_run(sc, &ls, &rs, frames, &c, &e);
     if (st == LM_OK)
-        st = export_check(&c, sc, out, &e);
+        st = export_check(&c, sc, rs.target_error, out, &e);
     lm_frame_check_free(&c);
     lm_api_leave(saved);
     if (st == LM_OK)

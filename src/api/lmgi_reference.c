@@ -39,8 +39,10 @@ lmgi_status lm_api_ref_settings(const lmgi_reference_desc *desc, const char *fn,
 
 /* Moves the internal result's arrays and figures into the public one (texel values spread into an
  * atlas-sized image when atlas is given). */
-static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, lmgi_reference *out, lm_error *err)
+static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float target, lmgi_reference *out,
+                               lm_error *err)
 {
+    out->target_error = target;
     out->width = r->width, out->height = r->height;
     out->entries = r->count, out->converged = r->converged;
     out->samples = r->total_samples;
@@ -79,7 +81,7 @@ static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const
         lm_emitters_free(&em);
     }
     if (st == LM_OK)
-        st = export_result(&r, cam ? NULL : &sc->atlas, out, &e);
+        st = export_result(&r, cam ? NULL : &sc->atlas, set->target_error, out, &e);
     lm_ref_result_free(&r);
     if (st == LM_OK)
         return LMGI_OK;

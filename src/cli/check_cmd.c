@@ -15,10 +15,10 @@ static void print_row(const char *name, const char *material, uint32_t pixels, c
     printf("  %-24s %-24s %7u   %6.3f %6.3f %6.3f\n", name, material, pixels, ratio[0], ratio[1], ratio[2]);
 }
 
-static void report(const lmgi_scene *sc, const lmgi_check_result *c, const lmgi_reference_desc *rd)
+static void report(const lmgi_scene *sc, const lmgi_check_result *c)
 {
     printf("frame %dx%d against the reference (target error %.3g: mean relative standard error per pixel %.3f, "
-           "%.1f s)\n", c->width, c->height, rd->target_error > 0.0f ? (double)rd->target_error : 0.02,
+           "%.1f s)\n", c->width, c->height, (double)c->reference_target_error,
            c->reference_rel_se, c->reference_seconds);
     printf("  %-24s %-24s %7s   frame / reference (R G B)\n", "surface (node)", "material", "pixels");
     for (int s = 0; s < c->surface_count; s++) {
@@ -108,7 +108,7 @@ int lm_cli_check(const lm_cli_args *a)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         rc = 1;
     } else {
-        report(sc, &c, &rd);
+        report(sc, &c);
         if (a->out_dir && !write_images(a->out_dir, &c))
             rc = 1;
         lmgi_check_free(&c);

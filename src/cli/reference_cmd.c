@@ -43,12 +43,12 @@ static int write(const lm_cli_args *a, const char *name, int w, int h, const flo
     return 0;
 }
 
-static void report(const char *what, const lmgi_reference *r, const lmgi_reference_desc *d, double wall)
+static void report(const char *what, const lmgi_reference *r, double wall)
 {
     printf("%s: %u, %llu samples (%.0f per entry), target error %.4g: reached by %u (%.2f%%), "
            "relative standard error mean %.4f max %.4f, %.1f s%s\n",
            what, r->entries, (unsigned long long)r->samples, r->entries ? (double)r->samples / r->entries : 0.0,
-           d->target_error > 0.0f ? (double)d->target_error : 0.02, r->converged,
+           (double)r->target_error, r->converged,
            r->entries ? 100.0 * r->converged / r->entries : 100.0, r->mean_rel_se, r->max_rel_se,
            r->from_cache ? wall : r->seconds, r->from_cache ? " (from the cache)" : "");
     if (r->from_cache)
@@ -71,7 +71,7 @@ static int run_texels(const lm_cli_args *a, const lmgi_scene *sc, const lmgi_ref
         lmgi_info in;
         lmgi_get_info(sc, &in);
         printf("atlas %d x %d, texel size %g\n", in.atlas_width, in.atlas_height, (double)in.texel_size);
-        report("texels", &r, d, lm_cli_now() - t0);
+        report("texels", &r, lm_cli_now() - t0);
     }
     lmgi_reference_free(&r);
     return ok;
@@ -91,7 +91,7 @@ static int run_pixels(const lm_cli_args *a, const lmgi_scene *sc, const lmgi_ref
     }
     int ok = write(a, "reference_pixels.exr", w, h, r.full) && write(a, "reference_pixels.png", w, h, r.full);
     if (ok && !a->quiet)
-        report("pixels", &r, d, lm_cli_now() - t0);
+        report("pixels", &r, lm_cli_now() - t0);
     lmgi_reference_free(&r);
     return ok;
 }
