@@ -218,11 +218,79 @@ static void test_bad_exports(void **state)
     lmgi_context_free(ctx);
 }
 
+/* What the copy says of materials and lights is what lmgi had: emission below 1 and above it (factor and
+ * KHR_materials_emissive_strength), base colours, a coloured spot light's colour, intensity and cones. */
+static void test_materials_and_lights_round_trip(void **state)
+{
+    (void)state;
+    static const float floor_pos[12] = {-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2};
+    static const float dim_pos[12] = {-2, 1, -2, -1, 1, -2, -1, 2, -2, -2, 2, -2};
+    static const float hot_pos[12] = {1, 1, -2, 2, 1, -2, 2, 2, -2, 1, 2, -2};
+    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    lmgi_mesh_desc meshes[3] = {
+        {.name = "floor", .positions = floor_pos, .vertex_count = 4, .indices = idx, .triangle_count = 2, .material = 0},
+        {.name = "dim", .positions = dim_pos, .vertex_count = 4, .indices = idx, .triangle_count = 2, .material = 1},
+        {.name = "hot", .positions = hot_pos, .vertex_count = 4, .indices = idx, .triangle_count = 2, .material = 2}};
+    lmgi_material_desc mats[3] = {{.name = "grey", .base_color = {0.6f, 0.5f, 0.4f, 1.0f}},
+                                  {.name = "dim", .emissive = {0.2f, 0.1f, 0.05f}},
+                                  {.name = "hot", .emissive = {5.0f, 2.5f, 1.0f}}};
+    lmgi_light_desc spot = {.name = "spot", .type = LMGI_LIGHT_SPOT, .color = {1.0f, 0.5f, 0.25f}, .intensity = 7.0f,
+                            .inner_cone = 0.3f, .outer_cone = 0.6f, .position = {0, 3, 0}, .direction = {0, -1, 0}};
+    lmgi_scene_desc sd = {.name = "emitters", .meshes = meshes, .mesh_count = 3, .materials = mats,
+                          .material_count = 3, .lights = &spot, .light_count = 1};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 800;
+    lmgi_scene *sc = NULL;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_load_desc(&sd, &o, &sc, &e), LMGI_OK);
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater *u = bake(ctx, sc);
+    const char *dir = lmt_tmpdir();
+    lmgi_export_desc d = {.name = "emitters"};
+    assert_int_equal(lmgi_export_gltf(u, dir, &d, &e), LMGI_OK);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/emitters.gltf", dir);
+    lm_load_options lo = {.strict = 0};
+    lm_scene *copy = NULL;
+    lm_error le;
+    assert_int_equal(lm_scene_load_gltf(path, &lo, &copy, &le), LM_OK);
+    const lm_scene *s = sc->scene;
+    for (int m = 0; m < s->material_count; m++) {
+        const lm_material *a = &s->materials[m], *b = NULL;
+        for (int k = 0; k < copy->material_count; k++)
+            if (!strcmp(copy->materials[k].name, a->name))
+                b = &copy->materials[k];
+        assert_non_null(b);
+        for (int k = 0; k < 3; k++) /* the desc's emission, through lmgi_load_desc's glTF */
+            for (int c = 0; c < 3 && !strcmp(mats[k].name, a->name); c++)
+                assert_float_equal(a->emissive[c], mats[k].emissive[c], 1e-6 * (1.0 + mats[k].emissive[c]));
+        for (int c = 0; c < 3; c++) {
+            assert_float_equal(b->emissive[c], a->emissive[c], 1e-6 * (1.0 + a->emissive[c]));
+            assert_float_equal(b->base_color[c], a->base_color[c], 1e-6);
+        }
+        assert_int_equal(b->cls, a->cls);
+    }
+    assert_int_equal(copy->light_count, 1);
+    const lm_light *la = &s->lights[0], *lb = &copy->lights[0];
+    assert_int_equal(lb->type, la->type);
+    assert_float_equal(lb->intensity, la->intensity, 1e-6);
+    assert_float_equal(lb->outer_cone, la->outer_cone, 1e-6);
+    for (int c = 0; c < 3; c++)
+        assert_float_equal(lb->color[c], la->color[c], 1e-6);
+    lm_scene_free(copy);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_export_and_reload),
         cmocka_unit_test(test_bad_exports),
+        cmocka_unit_test(test_materials_and_lights_round_trip),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

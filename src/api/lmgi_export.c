@@ -17,7 +17,7 @@
 #include <string.h>
 
 #include "../core/image.h"
-#include "../core/vecmath.h"
+#include "gltf_write.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
@@ -25,92 +25,16 @@ typedef struct {
     const lm_scene *s;
     const lm_atlas *atlas;
     const char *name;
-    FILE *json, *bin;      /* open_memstream'd */
-    char *json_text, *bin_data;
-    size_t json_size, bin_stream_size; /* the streams' own sizes (set when flushed) */
-    size_t bin_size;       /* bytes appended to bin so far */
-    int accessors, views;  /* written so far */
-    int first;             /* the next JSON array element is the first */
+    lm_gltf_doc doc;
 } writer;
-
-static void sep(writer *w)
-{
-    if (!w->first)
-        fputc(',', w->json);
-    w->first = 0;
-}
-
-/* A name as a JSON string (quotes, backslashes and control characters escaped). */
-static void json_string(FILE *f, const char *s)
-{
-    fputc('"', f);
-    for (; *s; s++) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            fprintf(f, "\\%c", c);
-        else if (c < 0x20)
-            fprintf(f, "\\u%04x", c);
-        else
-            fputc(c, f);
-    }
-    fputc('"', f);
-}
-
-static void json_floats(FILE *f, const float *v, int n)
-{
-    fputc('[', f);
-    for (int i = 0; i < n; i++)
-        fprintf(f, "%s%.9g", i ? "," : "", (double)v[i]);
-    fputc(']', f);
-}
-
-/* One buffer view holding `bytes` of data appended to the binary buffer (4-byte aligned). */
-static int add_view(writer *w, FILE *views, const void *data, size_t bytes, int target)
-{
-    while (w->bin_size % 4) {
-        fputc(0, w->bin);
-        w->bin_size++;
-    }
-    fprintf(views, "%s{\"buffer\":0,\"byteOffset\":%zu,\"byteLength\":%zu", w->views ? "," : "", w->bin_size, bytes);
-    if (target)
-        fprintf(views, ",\"target\":%d", target);
-    fputc('}', views);
-    fwrite(data, 1, bytes, w->bin);
-    w->bin_size += bytes;
-    return w->views++;
-}
-
-/* An accessor over a new view: count elements of `comps` floats (or uint32 indices when comps is 0). */
-static int add_accessor(writer *w, FILE *views, FILE *accessors, const void *data, uint32_t count, int comps)
-{
-    static const char *const types[] = {"SCALAR", "SCALAR", "VEC2", "VEC3"};
-    size_t bytes = (size_t)count * (comps ? (size_t)comps * sizeof(float) : sizeof(uint32_t));
-    int view = add_view(w, views, data, bytes, comps ? 34962 : 34963);
-    fprintf(accessors, "%s{\"bufferView\":%d,\"componentType\":%d,\"count\":%u,\"type\":\"%s\"", w->accessors ? "," : "",
-            view, comps ? 5126 : 5125, count, types[comps]);
-    if (comps == 3) { /* POSITION needs its bounds */
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        const float *p = data;
-        for (uint32_t i = 0; i < count; i++)
-            for (int k = 0; k < 3; k++)
-                lo[k] = fminf(lo[k], p[3 * i + k]), hi[k] = fmaxf(hi[k], p[3 * i + k]);
-        fprintf(accessors, ",\"min\":");
-        json_floats(accessors, lo, 3);
-        fprintf(accessors, ",\"max\":");
-        json_floats(accessors, hi, 3);
-    }
-    fputc('}', accessors);
-    return w->accessors++;
-}
 
 /* Which uv set a material's textures read: 0, or 2 where the file's base colour texture used TEXCOORD_1
  * (TEXCOORD_1 now holds the lightmap's). */
 static int texture_uv(const lm_material *m) { return m->base_color_uv == 1 ? 2 : 0; }
 
-/* The vertices of the triangles [first, first + count) of `node` using `material`, three per triangle,
- * written as one primitive. */
-static lm_status write_primitive(writer *w, FILE *views, FILE *accessors, const lm_node *nd, int material,
-                                 lm_error *err)
+/* The vertices of node nd's triangles of `material`, three per triangle, written as one primitive (the
+ * node's first when `first`). */
+static lm_status write_primitive(writer *w, const lm_node *nd, int material, int first, lm_error *err)
 {
     const lm_scene *s = w->s;
     uint32_t n = 0;
@@ -118,9 +42,10 @@ static lm_status write_primitive(writer *w, FILE *views, FILE *accessors, const 
         n += s->tri_material[t] == material;
     float *pos = malloc((size_t)n * 3 * 3 * sizeof(float)), *nrm = malloc((size_t)n * 3 * 3 * sizeof(float));
     float *uv0 = malloc((size_t)n * 3 * 2 * sizeof(float)), *uvl = malloc((size_t)n * 3 * 2 * sizeof(float));
-    float *uvf = malloc((size_t)n * 3 * 2 * sizeof(float));
+    int file_uv1 = texture_uv(&s->materials[material]) == 2;
+    float *uvf = file_uv1 ? malloc((size_t)n * 3 * 2 * sizeof(float)) : NULL;
     uint32_t *idx = malloc((size_t)n * 3 * sizeof(uint32_t));
-    if (!pos || !nrm || !uv0 || !uvl || !uvf || !idx) {
+    if (!pos || !nrm || !uv0 || !uvl || (file_uv1 && !uvf) || !idx) {
         free(pos), free(nrm), free(uv0), free(uvl), free(uvf), free(idx);
         return lm_fail(err, LM_ERR_NOMEM, "export: no memory for node '%s'", nd->name);
     }
@@ -136,58 +61,55 @@ static lm_status write_primitive(writer *w, FILE *views, FILE *accessors, const 
             memcpy(pos + 3 * v, s->positions + 3 * (size_t)sv, 3 * sizeof(float));
             memcpy(nrm + 3 * v, s->normals + 3 * (size_t)sv, 3 * sizeof(float));
             memcpy(uv0 + 2 * v, s->uv0 + 2 * (size_t)sv, 2 * sizeof(float));
-            if (s->uv1)
+            if (uvf)
                 memcpy(uvf + 2 * v, s->uv1 + 2 * (size_t)sv, 2 * sizeof(float));
-            else
-                uvf[2 * v] = uvf[2 * v + 1] = 0.0f;
             const float *l = w->atlas->corner_uv + 6 * (size_t)t + 2 * k; /* NaN: no surface (mirror, glass) */
             uvl[2 * v] = isfinite(l[0]) ? l[0] : 0.0f;
             uvl[2 * v + 1] = isfinite(l[1]) ? l[1] : 0.0f;
             idx[v] = v;
         }
     }
-    int a_pos = add_accessor(w, views, accessors, pos, 3 * n, 3);
-    int a_nrm = add_accessor(w, views, accessors, nrm, 3 * n, 3);
-    int a_uv0 = add_accessor(w, views, accessors, uv0, 3 * n, 2);
-    int a_uvl = add_accessor(w, views, accessors, uvl, 3 * n, 2);
-    int a_uvf = texture_uv(&s->materials[material]) == 2 ? add_accessor(w, views, accessors, uvf, 3 * n, 2) : -1;
-    int a_idx = add_accessor(w, views, accessors, idx, 3 * n, 0);
-    sep(w);
-    fprintf(w->json, "{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d,\"TEXCOORD_1\":%d", a_pos, a_nrm,
-            a_uv0, a_uvl);
+    int a_pos = lm_gltf_accessor(&w->doc, pos, 3 * n, 3, 1);
+    int a_nrm = lm_gltf_accessor(&w->doc, nrm, 3 * n, 3, 0);
+    int a_uv0 = lm_gltf_accessor(&w->doc, uv0, 3 * n, 2, 0);
+    int a_uvl = lm_gltf_accessor(&w->doc, uvl, 3 * n, 2, 0);
+    int a_uvf = uvf ? lm_gltf_accessor(&w->doc, uvf, 3 * n, 2, 0) : -1;
+    int a_idx = lm_gltf_accessor(&w->doc, idx, 3 * n, 0, 0);
+    fprintf(w->doc.json, "%s{\"attributes\":{\"POSITION\":%d,\"NORMAL\":%d,\"TEXCOORD_0\":%d,\"TEXCOORD_1\":%d",
+            first ? "" : ",", a_pos, a_nrm, a_uv0, a_uvl);
     if (a_uvf >= 0)
-        fprintf(w->json, ",\"TEXCOORD_2\":%d", a_uvf);
-    fprintf(w->json, "},\"indices\":%d,\"material\":%d}", a_idx, material);
+        fprintf(w->doc.json, ",\"TEXCOORD_2\":%d", a_uvf);
+    fprintf(w->doc.json, "},\"indices\":%d,\"material\":%d}", a_idx, material);
     free(pos), free(nrm), free(uv0), free(uvl), free(uvf), free(idx);
     return LM_OK;
 }
 
 /* Meshes: one per node with triangles (mesh_of[node], else -1), a primitive per material it uses. */
-static lm_status write_meshes(writer *w, FILE *views, FILE *accessors, int *mesh_of, lm_error *err)
+static lm_status write_meshes(writer *w, int *mesh_of, lm_error *err)
 {
     const lm_scene *s = w->s;
     int meshes = 0;
     lm_status st = LM_OK;
-    fprintf(w->json, ",\"meshes\":[");
+    fprintf(w->doc.json, ",\"meshes\":[");
     for (int i = 0; i < s->node_count && st == LM_OK; i++) {
         const lm_node *nd = &s->nodes[i];
         mesh_of[i] = -1;
         if (!nd->tri_count)
             continue;
         mesh_of[i] = meshes++;
-        fprintf(w->json, "%s{\"name\":", mesh_of[i] ? "," : "");
-        json_string(w->json, nd->name);
-        fprintf(w->json, ",\"primitives\":[");
-        w->first = 1;
+        fprintf(w->doc.json, "%s{\"name\":", mesh_of[i] ? "," : "");
+        lm_gltf_string(w->doc.json, nd->name);
+        fprintf(w->doc.json, ",\"primitives\":[");
+        int written = 0;
         for (int m = 0; m < s->material_count && st == LM_OK; m++)
             for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
                 if (s->tri_material[t] == m) {
-                    st = write_primitive(w, views, accessors, nd, m, err);
+                    st = write_primitive(w, nd, m, !written++, err);
                     break;
                 }
-        fprintf(w->json, "]}");
+        fprintf(w->doc.json, "]}");
     }
-    fputc(']', w->json);
+    fputc(']', w->doc.json);
     return st;
 }
 
@@ -203,36 +125,36 @@ static int has_lightmap(const lm_atlas *a, const lm_node *nd)
 static void write_nodes(writer *w, const int *mesh_of)
 {
     const lm_scene *s = w->s;
-    fprintf(w->json, ",\"scene\":0,\"scenes\":[{\"nodes\":[");
+    fprintf(w->doc.json, ",\"scene\":0,\"scenes\":[{\"nodes\":[");
     for (int i = 0; i < s->node_count; i++)
-        fprintf(w->json, "%s%d", i ? "," : "", i);
-    fprintf(w->json, "]}],\"nodes\":[");
+        fprintf(w->doc.json, "%s%d", i ? "," : "", i);
+    fprintf(w->doc.json, "]}],\"nodes\":[");
     for (int i = 0; i < s->node_count; i++) {
         const lm_node *nd = &s->nodes[i];
         float m[16];
         memcpy(m, nd->world, sizeof m);
         for (int k = 0; k < 3; k++) /* the file's world: lmgi's origin added back */
             m[12 + k] += s->origin[k] * m[15];
-        fprintf(w->json, "%s{\"name\":", i ? "," : "");
-        json_string(w->json, nd->name);
-        fprintf(w->json, ",\"matrix\":");
-        json_floats(w->json, m, 16);
+        fprintf(w->doc.json, "%s{\"name\":", i ? "," : "");
+        lm_gltf_string(w->doc.json, nd->name);
+        fprintf(w->doc.json, ",\"matrix\":");
+        lm_gltf_floats(w->doc.json, m, 16);
         if (mesh_of[i] >= 0)
-            fprintf(w->json, ",\"mesh\":%d", mesh_of[i]);
+            fprintf(w->doc.json, ",\"mesh\":%d", mesh_of[i]);
         if (nd->camera >= 0)
-            fprintf(w->json, ",\"camera\":%d", nd->camera);
+            fprintf(w->doc.json, ",\"camera\":%d", nd->camera);
         if (nd->light >= 0)
-            fprintf(w->json, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", nd->light);
+            fprintf(w->doc.json, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", nd->light);
         /* lmgi's own node settings (as resolved: a reload needs no inheritance), then the lightmap */
         const lm_node_settings *ns = &nd->settings;
-        fprintf(w->json, ",\"extras\":{\"lmgi\":{\"dynamic\":%s,\"caustics\":%s,\"indirect\":%s,\"shadows\":%s}",
+        fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"dynamic\":%s,\"caustics\":%s,\"indirect\":%s,\"shadows\":%s}",
                 nd->dynamic ? "true" : "false", ns->caustics ? "true" : "false", ns->indirect ? "true" : "false",
                 ns->shadows ? "true" : "false");
         if (has_lightmap(w->atlas, nd))
-            fprintf(w->json, ",\"lightmap\":{\"uri\":\"%s_lightmap.exr\",\"texCoord\":1}", w->name);
-        fprintf(w->json, "}}");
+            fprintf(w->doc.json, ",\"lightmap\":{\"uri\":\"%s_lightmap.exr\",\"texCoord\":1}", w->name);
+        fprintf(w->doc.json, "}}");
     }
-    fputc(']', w->json);
+    fputc(']', w->doc.json);
 }
 
 /* Textures: each of the scene's decoded images as NAME_texN.png (8-bit sRGB), one sampler. */
@@ -242,9 +164,9 @@ static lm_status write_textures(writer *w, const char *dir, lm_error *err)
     if (!s->texture_count)
         return LM_OK;
     lm_status st = LM_OK;
-    fprintf(w->json, ",\"samplers\":[{}],\"images\":[");
+    fprintf(w->doc.json, ",\"samplers\":[{}],\"images\":[");
     for (int i = 0; i < s->texture_count; i++) {
-        fprintf(w->json, "%s{\"uri\":\"%s_tex%d.png\"}", i ? "," : "", w->name, i); /* name checked to be plain */
+        fprintf(w->doc.json, "%s{\"uri\":\"%s_tex%d.png\"}", i ? "," : "", w->name, i); /* name checked to be plain */
         const lm_texture *t = &s->textures[i];
         size_t n = (size_t)t->width * (size_t)t->height;
         uint8_t *px = st == LM_OK ? malloc(n * 4) : NULL;
@@ -263,10 +185,10 @@ static lm_status write_textures(writer *w, const char *dir, lm_error *err)
         }
         free(px);
     }
-    fprintf(w->json, "],\"textures\":[");
+    fprintf(w->doc.json, "],\"textures\":[");
     for (int i = 0; i < s->texture_count; i++)
-        fprintf(w->json, "%s{\"source\":%d,\"sampler\":0}", i ? "," : "", i);
-    fputc(']', w->json);
+        fprintf(w->doc.json, "%s{\"source\":%d,\"sampler\":0}", i ? "," : "", i);
+    fputc(']', w->doc.json);
     return st;
 }
 
@@ -284,84 +206,70 @@ static void write_texture_ref(FILE *f, const lm_material *m, int texture)
 static void write_materials(writer *w)
 {
     const lm_scene *s = w->s;
-    fprintf(w->json, ",\"materials\":[");
+    fprintf(w->doc.json, ",\"materials\":[");
     for (int i = 0; i < s->material_count; i++) {
         const lm_material *m = &s->materials[i];
-        fprintf(w->json, "%s{\"name\":", i ? "," : "");
-        json_string(w->json, m->name);
-        fprintf(w->json, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
-        json_floats(w->json, m->base_color, 4);
-        fprintf(w->json, ",\"metallicFactor\":%.9g,\"roughnessFactor\":%.9g", (double)m->metallic, (double)m->roughness);
+        fprintf(w->doc.json, "%s{\"name\":", i ? "," : "");
+        lm_gltf_string(w->doc.json, m->name);
+        fprintf(w->doc.json, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
+        lm_gltf_floats(w->doc.json, m->base_color, 4);
+        fprintf(w->doc.json, ",\"metallicFactor\":%.9g,\"roughnessFactor\":%.9g", (double)m->metallic, (double)m->roughness);
         if (m->base_color_tex >= 0) {
-            fprintf(w->json, ",\"baseColorTexture\":");
-            write_texture_ref(w->json, m, m->base_color_tex);
+            fprintf(w->doc.json, ",\"baseColorTexture\":");
+            write_texture_ref(w->doc.json, m, m->base_color_tex);
         }
-        fputc('}', w->json);
-        float strength = fmaxf(m->emissive[0], fmaxf(m->emissive[1], m->emissive[2]));
-        if (strength > 0.0f) { /* the factor is at most 1; the rest is KHR_materials_emissive_strength */
-            float f[3] = {m->emissive[0] / strength, m->emissive[1] / strength, m->emissive[2] / strength};
-            fprintf(w->json, ",\"emissiveFactor\":");
-            json_floats(w->json, f, 3);
-        }
+        fputc('}', w->doc.json);
+        float strength = lm_gltf_emissive(w->doc.json, m->emissive);
         if (m->emissive_tex >= 0) {
-            fprintf(w->json, ",\"emissiveTexture\":");
-            write_texture_ref(w->json, m, m->emissive_tex);
+            fprintf(w->doc.json, ",\"emissiveTexture\":");
+            write_texture_ref(w->doc.json, m, m->emissive_tex);
         }
         /* split sides are two single-sided triangles here, each with its own lightmap texels */
-        fprintf(w->json, ",\"doubleSided\":%s,\"extensions\":{\"KHR_materials_ior\":{\"ior\":%.9g}",
+        fprintf(w->doc.json, ",\"doubleSided\":%s,\"extensions\":{\"KHR_materials_ior\":{\"ior\":%.9g}",
                 m->double_sided ? "true" : "false", (double)m->ior);
-        if (strength > 1.0f)
-            fprintf(w->json, ",\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}", (double)strength);
+        if (strength > 0.0f)
+            fprintf(w->doc.json, ",\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}", (double)strength);
         if (m->transmission > 0.0f)
-            fprintf(w->json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
-        fprintf(w->json, "}}");
+            fprintf(w->doc.json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
+        fprintf(w->doc.json, "}}");
     }
-    fputc(']', w->json);
+    fputc(']', w->doc.json);
 }
 
 static void write_lights_and_cameras(writer *w)
 {
     const lm_scene *s = w->s;
-    static const char *const types[] = {"point", "spot", "directional"};
     if (s->light_count) {
-        fprintf(w->json, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
+        fprintf(w->doc.json, ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[");
         for (int i = 0; i < s->light_count; i++) {
             const lm_light *l = &s->lights[i];
-            fprintf(w->json, "%s{\"name\":", i ? "," : "");
-            json_string(w->json, l->name);
-            fprintf(w->json, ",\"type\":\"%s\",\"color\":", types[l->type]);
-            json_floats(w->json, l->color, 3);
-            fprintf(w->json, ",\"intensity\":%.9g", l->off ? 0.0 : (double)l->intensity); /* as baked */
-            if (l->range > 0.0f && l->type != LM_LIGHT_DIRECTIONAL)
-                fprintf(w->json, ",\"range\":%.9g", (double)l->range);
-            if (l->type == LM_LIGHT_SPOT)
-                fprintf(w->json, ",\"spot\":{\"innerConeAngle\":%.9g,\"outerConeAngle\":%.9g}", (double)l->inner_cone,
-                        (double)l->outer_cone);
-            fputc('}', w->json);
+            fprintf(w->doc.json, "%s", i ? "," : "");
+            lm_gltf_light(w->doc.json, l->name, (int)l->type, l->color, l->off ? 0.0f : l->intensity, /* as baked */
+                          l->range, l->inner_cone, l->outer_cone);
         }
-        fprintf(w->json, "]}}");
+        fprintf(w->doc.json, "]}}");
     }
     if (!s->camera_count)
         return;
-    fprintf(w->json, ",\"cameras\":[");
+    fprintf(w->doc.json, ",\"cameras\":[");
     for (int i = 0; i < s->camera_count; i++) {
         const lm_camera *c = &s->cameras[i];
-        fprintf(w->json, "%s{\"name\":", i ? "," : "");
-        json_string(w->json, c->name);
+        fprintf(w->doc.json, "%s{\"name\":", i ? "," : "");
+        lm_gltf_string(w->doc.json, c->name);
         if (c->perspective) {
-            fprintf(w->json, ",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g", (double)c->yfov,
+            fprintf(w->doc.json, ",\"type\":\"perspective\",\"perspective\":{\"yfov\":%.9g,\"znear\":%.9g", (double)c->yfov,
                     (double)c->znear);
             if (c->aspect > 0.0f)
-                fprintf(w->json, ",\"aspectRatio\":%.9g", (double)c->aspect);
+                fprintf(w->doc.json, ",\"aspectRatio\":%.9g", (double)c->aspect);
         } else {
-            fprintf(w->json, ",\"type\":\"orthographic\",\"orthographic\":{\"xmag\":%.9g,\"ymag\":%.9g,\"znear\":%.9g",
+            fprintf(w->doc.json, ",\"type\":\"orthographic\",\"orthographic\":{\"xmag\":%.9g,\"ymag\":%.9g,\"znear\":%.9g",
                     (double)c->xmag, (double)c->ymag, (double)c->znear);
         }
         if (c->zfar > 0.0f || !c->perspective)
-            fprintf(w->json, ",\"zfar\":%.9g", (double)(c->zfar > 0.0f ? c->zfar : 1e6f));
-        fprintf(w->json, "}}");
+            fprintf(w->doc.json, ",\"zfar\":%.9g", (double)(c->zfar > 0.0f ? c->zfar : 1e6f));
+        fprintf(w->doc.json, "}}");
     }
-    fputc(']', w->json);
+    fputc(']', w->doc.json);
 }
 
 /* The lightmap: the displayed IIM (irradiance, alpha = valid) as EXR, and a tone-mapped PNG preview. */
@@ -398,51 +306,38 @@ static void write_extensions_used(writer *w)
                      (m->uv_offset[0] != 0.0f || m->uv_offset[1] != 0.0f || m->uv_scale[0] != 1.0f ||
                       m->uv_scale[1] != 1.0f || m->uv_rotation != 0.0f);
     }
-    fprintf(w->json, ",\"extensionsUsed\":[\"KHR_materials_ior\"%s%s%s%s]",
+    fprintf(w->doc.json, ",\"extensionsUsed\":[\"KHR_materials_ior\"%s%s%s%s]",
             s->light_count ? ",\"KHR_lights_punctual\"" : "", strength ? ",\"KHR_materials_emissive_strength\"" : "",
             transmission ? ",\"KHR_materials_transmission\"" : "", transform ? ",\"KHR_texture_transform\"" : "");
 }
 
-/* Everything but the images into w's JSON and binary streams. */
+/* Everything but the images into w's document. */
 static lm_status write_document(writer *w, const char *dir, lm_error *err)
 {
     const lm_scene *s = w->s;
-    FILE *views = NULL, *accessors = NULL;
-    char *views_text = NULL, *accessors_text = NULL;
-    size_t views_size = 0, accessors_size = 0;
     int *mesh_of = malloc(sizeof *mesh_of * (size_t)(s->node_count ? s->node_count : 1));
-    views = open_memstream(&views_text, &views_size);
-    accessors = open_memstream(&accessors_text, &accessors_size);
-    lm_status st = mesh_of && views && accessors ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "export: no memory");
-    if (st == LM_OK) {
-        fprintf(w->json, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"lmgi\"}");
-        write_extensions_used(w);
-        st = write_meshes(w, views, accessors, mesh_of, err);
-    }
+    if (!mesh_of)
+        return lm_fail(err, LM_ERR_NOMEM, "export: no memory");
+    fprintf(w->doc.json, "{\"asset\":{\"version\":\"2.0\",\"generator\":\"lmgi\"}");
+    write_extensions_used(w);
+    lm_status st = write_meshes(w, mesh_of, err);
     if (st == LM_OK) {
         write_nodes(w, mesh_of);
         write_materials(w);
         write_lights_and_cameras(w);
         st = write_textures(w, dir, err);
     }
-    if (views)
-        fclose(views);
-    if (accessors)
-        fclose(accessors);
-    if (st == LM_OK) {
-        fflush(w->bin);
-        fprintf(w->json, ",\"buffers\":[{\"uri\":\"%s.bin\",\"byteLength\":%zu}],\"bufferViews\":[%s],"
-                         "\"accessors\":[%s],\"extras\":{\"lmgi\":{\"lightmap\":\"%s_lightmap.exr\","
-                         "\"preview\":\"%s_lightmap.png\",\"texCoord\":1,\"size\":[%d,%d],"
-                         "\"holds\":\"irradiance E of indirect light and emissive surfaces (not the punctual "
-                         "lights' direct light); diffuse radiance = baseColor / pi x E; alpha 1 on valid texels\"}}}",
-                w->name, w->bin_size, views_text ? views_text : "", accessors_text ? accessors_text : "", w->name,
-                w->name, w->atlas->width, w->atlas->height);
-    }
-    free(views_text);
-    free(accessors_text);
     free(mesh_of);
-    return st;
+    if (st != LM_OK)
+        return st;
+    char bin_uri[260];
+    snprintf(bin_uri, sizeof bin_uri, "%s.bin", w->name);
+    lm_gltf_finish(&w->doc, bin_uri);
+    fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"lightmap\":\"%s_lightmap.exr\",\"preview\":\"%s_lightmap.png\","
+                     "\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of indirect light and emissive surfaces "
+                     "(not the punctual lights' direct light); diffuse radiance = baseColor / pi x E; alpha 1 on valid "
+                     "texels\"}}}", w->name, w->name, w->atlas->width, w->atlas->height);
+    return LM_OK;
 }
 
 /* The export's file name: letters, digits, '-', '_' and '.', so it is a plain relative URI. */
@@ -494,28 +389,26 @@ lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export
     lmgi_status st = lmgi_claim_output_dir(dir, d.force, patterns, err);
     if (st != LMGI_OK)
         return st;
-    writer w;
-    memset(&w, 0, sizeof w);
-    w.s = sc->scene, w.atlas = &sc->atlas, w.name = name;
-    w.json = open_memstream(&w.json_text, &w.json_size);
-    w.bin = open_memstream(&w.bin_data, &w.bin_stream_size);
+    writer w = {.s = sc->scene, .atlas = &sc->atlas, .name = name};
     lm_error e;
-    lm_status ls = w.json && w.bin ? write_document(&w, dir, &e) : lm_fail(&e, LM_ERR_NOMEM, "export: no memory");
-    if (w.json)
-        fclose(w.json);
-    if (w.bin)
-        fclose(w.bin);
+    lm_status ls = lm_gltf_open(&w.doc) ? LM_OK : lm_fail(&e, LM_ERR_NOMEM, "export: no memory");
+    if (ls == LM_OK)
+        ls = write_document(&w, dir, &e);
+    size_t json_len = 0, bin_len = 0;
+    const char *json = ls == LM_OK ? lm_gltf_text(&w.doc, &json_len) : NULL;
+    const void *bin = ls == LM_OK ? lm_gltf_bin(&w.doc, &bin_len) : NULL;
+    if (ls == LM_OK && (!json || !bin))
+        ls = lm_fail(&e, LM_ERR_NOMEM, "export: no memory for the document");
     char path[4200];
     if (ls == LM_OK) {
         snprintf(path, sizeof path, "%s/%s.bin", dir, name);
-        ls = lm_write_file(path, w.bin_data, w.bin_stream_size, &e);
+        ls = lm_write_file(path, bin, bin_len, &e);
     }
     if (ls == LM_OK) {
         snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
-        ls = lm_write_file(path, w.json_text, w.json_size, &e);
+        ls = lm_write_file(path, json, json_len, &e);
     }
-    free(w.json_text);
-    free(w.bin_data);
+    lm_gltf_close(&w.doc);
     if (ls != LM_OK)
         return lm_export_error(err, &e);
     return write_lightmap(u, &w, dir, d.half, err);
