@@ -479,20 +479,19 @@ static lm_status read_error(const lmgi_updater *u, float *rgba, lm_error *err)
 {
     const lm_atlas *at = &u->sc->atlas;
     size_t n = (size_t)at->width * at->height;
-    float *e = malloc(n * sizeof *e), *rgb = malloc(n * 3 * sizeof *rgb), *raw = NULL;
-    lm_status st = e && rgb ? lm_frame_loop_iim_error(u->loop, e, err) : lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
+    float *e = malloc(n * sizeof *e), *raw = NULL;
+    if (!e)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
+    lm_status st = read_raw_iim(u, &raw, rgba, err); /* the validity, and what the estimate compares */
     if (st == LM_OK)
-        st = read_raw_iim(u, &raw, rgba, err); /* for the validity */
-    free(raw);
+        st = lm_frame_loop_iim_error(u->loop, raw, e, err);
     if (st == LM_OK) {
+        lm_atlas_dilate_gutters(at, e, 1);
         for (size_t i = 0; i < n; i++)
-            rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = e[i];
-        lm_atlas_dilate_gutters(at, rgb, 3);
-        for (size_t i = 0; i < n; i++)
-            memcpy(rgba + 4 * i, rgb + 3 * i, 3 * sizeof *rgb);
+            rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = e[i];
     }
+    free(raw);
     free(e);
-    free(rgb);
     return st;
 }
 

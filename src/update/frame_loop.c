@@ -641,15 +641,13 @@ lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error
 
 static double lum(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
 
-lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, float *error, lm_error *err)
+lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *error, lm_error *err)
 {
     const lm_atlas *a = fl->atlas;
     size_t n = (size_t)a->width * a->height;
-    float *shown = NULL, *fresh = malloc(4 * n * sizeof *fresh);
+    float *fresh = malloc(4 * n * sizeof *fresh);
     double *pending = calloc((size_t)(a->surface_count > 0 ? a->surface_count : 1), sizeof *pending);
     lm_status st = fresh && pending ? lm_frame_loop_sync(fl, err) : lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
-    if (st == LM_OK)
-        st = lm_frame_loop_read_iim(fl, &shown, err);
     if (st == LM_OK)
         st = lm_iim_texture_read(fl->iim.fresh_tex, a->width, a->height, fresh, err);
     if (st == LM_OK) {
@@ -674,7 +672,6 @@ lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, float *error, lm_error *err
             error[at] = (float)fmax(blend, pending[a->texels[i].surface]);
         }
     }
-    free(shown);
     free(fresh);
     free(pending);
     return st;

@@ -133,9 +133,9 @@ lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error
  *   - what is not gathered yet: the surface's delta_i (photon energy added or removed since its IIM was
  *     last refreshed, the scheduler's own measure) over its stored IIM energy, an upper bound of the
  *     relative change of the light its photons bring.
- * 0 everywhere once every refresh is complete and blended and no photon changed since. Joins photon work
- * under way first. */
-lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, float *error, lm_error *err);
+ * 0 everywhere once every refresh is complete and blended and no photon changed since. `shown` is the
+ * displayed IIM as lm_frame_loop_read_iim gives it. Joins photon work under way first. */
+lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *error, lm_error *err);
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl);
 /* The view the frames are drawn from. */
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl);
