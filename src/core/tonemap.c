@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "image.h"
+#include "vecmath.h"
 
 static int cmp_float(const void *a, const void *b)
 {
@@ -11,7 +12,6 @@ static int cmp_float(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-static float luminance(const float *c) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
 /* The q-quantile of the finite luminances > 0; 0 if there are none. */
 static float lit_quantile(const float *rgb, size_t n, int stride, double q)
@@ -21,7 +21,7 @@ static float lit_quantile(const float *rgb, size_t n, int stride, double q)
         return 0.0f;
     size_t m = 0;
     for (size_t i = 0; i < n; i++) {
-        float l = luminance(rgb + i * (size_t)stride);
+        float l = lm_luminance(rgb + i * (size_t)stride);
         if (l > 0.0f && isfinite(l))
             lum[m++] = l;
     }

@@ -44,6 +44,8 @@ static inline void lm_tangents(lm_vec3 n, lm_vec3 *t, lm_vec3 *b)
     *t = lm_normalize(lm_cross(helper, n));
     *b = lm_cross(n, *t);
 }
+/* Relative luminance of linear Rec. 709 RGB (the weights every brightness figure of lmgi uses). */
+static inline float lm_luminance(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 static inline int lm_v3_finite(lm_vec3 a) { return isfinite(a.x) && isfinite(a.y) && isfinite(a.z); }
 /* Unit t and b with (t, b, n) orthonormal for unit n, without a branch or a square root (Duff et al.
  * 2017, "Building an orthonormal basis, revisited"): the sampling frame of photons and BSDF lobes. */

@@ -4,6 +4,8 @@
 
 #include <math.h>
 
+#include "../core/vecmath.h"
+
 /* Class thresholds (docs/materials.md). */
 #define LM_EMITTER_MIN_LUMINANCE 0.0f  /* emissive luminance above this makes an emitter */
 #define LM_GLASS_MIN_TRANSMISSION 0.5f /* transmission at or above this is glass */
@@ -11,12 +13,11 @@
 #define LM_MIRROR_MAX_ROUGHNESS 0.1f   /* metals smoother than this are mirrors */
 #define LM_GLOSSY_MAX_ROUGHNESS 0.2f   /* dielectrics smoother than this are glossy */
 
-static float luminance(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
 lm_material_class lm_material_classify(lm_material *m)
 {
     lm_material_class c;
-    if (luminance(m->emissive) > LM_EMITTER_MIN_LUMINANCE)
+    if (lm_luminance(m->emissive) > LM_EMITTER_MIN_LUMINANCE)
         c = LM_MAT_EMITTER;
     else if (m->transmission >= LM_GLASS_MIN_TRANSMISSION)
         c = LM_MAT_GLASS;

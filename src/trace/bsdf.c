@@ -24,7 +24,6 @@
 #include "../core/vecmath.h"
 
 
-static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
 
 /* Cosine-weighted direction around n (pdf cos / pi): every diffuse bounce. Unit up to rounding: (x,
@@ -91,7 +90,7 @@ static void glossy(const lm_shading *sh, glossy_params *g)
 {
     lm_material_lobes(sh->material, sh->albedo, g->kd, g->ks);
     g->n = lm_phong_exponent(sh->material->roughness);
-    float ls = lum(g->ks), ld = lum(g->kd);
+    float ls = lm_luminance(g->ks), ld = lm_luminance(g->kd);
     g->p_spec = ls + ld > 0.0f ? ls / (ls + ld) : 0.5f;
 }
 

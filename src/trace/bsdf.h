@@ -6,6 +6,7 @@
 #ifndef LM_BSDF_H
 #define LM_BSDF_H
 
+#include "../core/vecmath.h"
 #include "shading.h"
 
 typedef struct {
@@ -36,7 +37,7 @@ static inline float lm_bsdf_survival(const lm_shading *sh)
 {
     if (lm_material_is_specular(sh->material->cls))
         return 1.0f;
-    float l = 0.2126f * sh->albedo[0] + 0.7152f * sh->albedo[1] + 0.0722f * sh->albedo[2];
+    float l = lm_luminance(sh->albedo);
     return l < 0.05f ? 0.05f : l > 0.95f ? 0.95f : l;
 }
 /* True for classes that store photon hits (diffuse, glossy, emitter). */

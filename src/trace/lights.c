@@ -28,7 +28,6 @@
 #define LM_SPOT_MIN_WIDTH 1e-3f   /* the extension's max(0.001, cos inner - cos outer) */
 #define LM_EMIT_LIFT 1e-5f        /* area photon origins are lifted by this x scene size */
 
-static float lum(const float c[3]) { return 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2]; }
 
 /* ---- spot falloff ---- */
 
@@ -170,7 +169,7 @@ static void place_area(lm_emitter *e, const lm_scene *s)
         for (int c = 0; c < 3; c++)
             pw[c] += f[c];
         area += lm_scene_tri_area_world(s, e->tris[k]);
-        acc += lum(f);
+        acc += lm_luminance(f);
         e->cdf[k] = (float)acc;
     }
     for (uint32_t k = 0; k < e->tri_count; k++) /* normalize; a flux-less emitter picks nothing */
@@ -195,7 +194,7 @@ void lm_emitters_update(lm_emitters *em, const lm_scene *s)
             place_punctual(e, s, em->disk_radius);
         else
             place_area(e, s);
-        e->luminance = lum(e->power);
+        e->luminance = lm_luminance(e->power);
         em->total_luminance += e->luminance;
     }
 }

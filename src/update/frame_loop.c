@@ -639,8 +639,6 @@ lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error
     return st;
 }
 
-static double lum(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-
 lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *error, lm_error *err)
 {
     const lm_atlas *a = fl->atlas;
@@ -662,13 +660,13 @@ lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *
         for (uint32_t i = 0; i < a->texel_count; i++) {
             const float *p = shown + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
             if (!(p[3] > limit))
-                sum += lum(p), valid++;
+                sum += lm_luminance(p), valid++;
         }
         double floor = 0.01 * (valid ? sum / valid : 0.0) + 1e-30;
         memset(error, 0, n * sizeof *error);
         for (uint32_t i = 0; i < a->texel_count; i++) {
             size_t at = (size_t)a->texels[i].y * a->width + a->texels[i].x;
-            double f = lum(fresh + 4 * at), blend = fabs(f - lum(shown + 4 * at)) / fmax(fabs(f), floor);
+            double f = lm_luminance(fresh + 4 * at), blend = fabs(f - lm_luminance(shown + 4 * at)) / fmax(fabs(f), floor);
             error[at] = (float)fmax(blend, pending[a->texels[i].surface]);
         }
     }
