@@ -36,16 +36,14 @@ static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half
     size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
     float *rgba = malloc(n * sizeof *rgba);
     lmgi_error e;
-    char path[4096];
     int rc = 0;
     static const char *const files[3] = {"lightmap.exr", "lightmap.png", "aim.exr"};
     for (int k = 0; k < 3 && rc == 0; k++) {
         lmgi_lightmap kind = k < 2 ? LMGI_LIGHTMAP_IIM : LMGI_LIGHTMAP_AIM;
-        snprintf(path, sizeof path, "%s/%s", dir, files[k]);
         if (!rgba)
             rc = 1, fprintf(stderr, "lmgi: error: no memory for the %d x %d lightmap\n", in.atlas_width, in.atlas_height);
         else if ((k != 1 && lmgi_get_lightmap(u, kind, rgba, n, &e) != LMGI_OK) ||
-                 lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, rgba, &exr, &e))
+                 lm_cli_write_image(dir, files[k], in.atlas_width, in.atlas_height, 4, rgba, &exr, &e))
             rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
     }
     free(rgba);

@@ -54,14 +54,10 @@ static void ratio_picture(const lmgi_check_result *c, float *rgb)
 
 static int write_images(const char *dir, const lmgi_check_result *c)
 {
-    char path[4096];
     lmgi_error err;
-    snprintf(path, sizeof path, "%s/check_frame.exr", dir);
-    lmgi_status st = lmgi_write_image(path, c->width, c->height, 3, c->frame, NULL, &err);
-    if (st == LMGI_OK) {
-        snprintf(path, sizeof path, "%s/check_reference.exr", dir);
-        st = lmgi_write_image(path, c->width, c->height, 3, c->reference, NULL, &err);
-    }
+    lmgi_status st = lm_cli_write_image(dir, "check_frame.exr", c->width, c->height, 3, c->frame, NULL, &err);
+    if (st == LMGI_OK)
+        st = lm_cli_write_image(dir, "check_reference.exr", c->width, c->height, 3, c->reference, NULL, &err);
     float *rgb = st == LMGI_OK ? malloc((size_t)c->width * (size_t)c->height * 3 * sizeof *rgb) : NULL;
     if (st == LMGI_OK && !rgb) {
         fprintf(stderr, "lmgi: error: no memory for the ratio picture\n");
@@ -69,9 +65,8 @@ static int write_images(const char *dir, const lmgi_check_result *c)
     }
     if (st == LMGI_OK) {
         ratio_picture(c, rgb);
-        snprintf(path, sizeof path, "%s/check_ratio.png", dir);
         lmgi_image_desc as_is = {LMGI_TONEMAP_CLAMP, 1.0f, 0};
-        st = lmgi_write_image(path, c->width, c->height, 3, rgb, &as_is, &err);
+        st = lm_cli_write_image(dir, "check_ratio.png", c->width, c->height, 3, rgb, &as_is, &err);
     }
     free(rgb);
     if (st != LMGI_OK)

@@ -33,11 +33,9 @@ void lm_cli_reference_desc(const lm_cli_args *a, lmgi_reference_desc *d)
 /* DIR/NAME written from pixels, or the error printed. */
 static int write(const lm_cli_args *a, const char *name, int w, int h, const float *px)
 {
-    char path[4200];
-    snprintf(path, sizeof path, "%s/%s", a->out_dir, name);
     lmgi_image_desc d = {(lmgi_tonemap)a->tonemap, 0.0f, 0};
     lmgi_error err;
-    if (lmgi_write_image(path, w, h, 3, px, &d, &err) == LMGI_OK)
+    if (lm_cli_write_image(a->out_dir, name, w, h, 3, px, &d, &err) == LMGI_OK)
         return 1;
     fprintf(stderr, "lmgi: error: %s\n", err.message);
     return 0;

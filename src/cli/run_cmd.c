@@ -11,6 +11,7 @@
 
 #include "order_stats.h"
 #include "fail.h"
+#include "out_dir.h"
 #include "progress.h"
 #include "scene_load.h"
 
@@ -89,15 +90,13 @@ static int csv_row(FILE *f, const lmgi_update_stats *s)
 static lmgi_status write_pair(const run_state *r, const char *name, int w, int h, int channels, const float *px,
                             float k, int exr, lmgi_error *err)
 {
-    char path[4096];
-    if (exr) {
-        snprintf(path, sizeof path, "%s/%s.exr", r->a->out_dir, name);
-        if (lmgi_write_image(path, w, h, channels, px, NULL, err) != LMGI_OK)
-            return err->status;
-    }
-    snprintf(path, sizeof path, "%s/%s.png", r->a->out_dir, name);
+    char file[80];
+    snprintf(file, sizeof file, "%s.exr", name);
+    if (exr && lm_cli_write_image(r->a->out_dir, file, w, h, channels, px, NULL, err) != LMGI_OK)
+        return err->status;
+    snprintf(file, sizeof file, "%s.png", name);
     lmgi_image_desc png = {(lmgi_tonemap)r->a->tonemap, k > 0.0f ? k : 0.0f, 0};
-    return lmgi_write_image(path, w, h, channels, px, &png, err);
+    return lm_cli_write_image(r->a->out_dir, file, w, h, channels, px, &png, err);
 }
 
 static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
