@@ -148,27 +148,47 @@ LMGI_API int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);   /* 0 for
 LMGI_API int lmgi_get_node_transform(const lmgi_scene *scene, int node, float world[16]);
 /* NULL scene or world: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
-/* Lights (KHR_lights_punctual). A light shines from its node (lmgi_set_node_transform moves it; a node
- * with no triangles in or under it may be moved even when static). Edits reach an updater at its next
- * update: the light's photon groups are re-traced (no other light's), its shadow map is redrawn, and
- * the surfaces its photons reach are refreshed. */
+/* Lights (KHR_lights_punctual). A light of the file shines from its node (lmgi_set_node_transform moves
+ * it; a node with no triangles in or under it may be moved even when static); a light added by
+ * lmgi_add_light has no node and is placed by its own position and direction. Edits reach an updater at
+ * its next update: the light's photon groups are traced (no other light's), its shadow map is redrawn,
+ * and the surfaces its photons reach are refreshed.
+ * Ids: a light keeps its id for the scene's life; a removed light's id is not given to another, and
+ * lmgi_light_count counts it (lmgi_light_is_removed tells). */
 typedef enum { LMGI_LIGHT_POINT = 0, LMGI_LIGHT_SPOT, LMGI_LIGHT_DIRECTIONAL } lmgi_light_type;
 typedef struct {
-    lmgi_light_type type;     /* fixed at load (lmgi_set_light refuses a change) */
-    int node;                 /* the node placing it (read only) */
+    lmgi_light_type type;     /* fixed once the light exists (lmgi_set_light refuses a change) */
+    int node;                 /* the node placing it, -1 for an added light (read only) */
     float color[3];           /* linear RGB, each in [0, 1000] */
     float intensity;          /* candela (point, spot) or lux (directional), >= 0 */
     float range;              /* 0: infinite */
     float inner_cone, outer_cone; /* spot: radians, 0 <= inner < outer <= pi/2 */
     int enabled;              /* 0: switched off (emits nothing; colour and intensity kept) */
+    float position[3];        /* world position (point, spot), in the file's world */
+    float direction[3];       /* unit direction it shines (spot, directional; unused for point lights).
+                               * Both read only for a light with a node (its node places it); for an
+                               * added light lmgi_set_light moves it (any length but 0: normalised) */
 } lmgi_light;
-LMGI_API int lmgi_light_count(const lmgi_scene *scene); /* 0 for NULL */
-/* NULL argument or an id out of range: LMGI_ERR_INVALID (out zeroed when given). */
+LMGI_API int lmgi_light_count(const lmgi_scene *scene); /* ids 0 .. count - 1, removed ones included; 0 for NULL */
+/* 1 for a removed light; 0 otherwise (a NULL scene or an id out of range included). */
+LMGI_API int lmgi_light_is_removed(const lmgi_scene *scene, int light);
+/* NULL argument, an id out of range or a removed light's: LMGI_ERR_INVALID (out zeroed when given). */
 LMGI_API lmgi_status lmgi_get_light(const lmgi_scene *scene, int light, lmgi_light *out, lmgi_error *err);
-/* Recolours, dims, brightens, switches on or off, or reshapes (range, cones) a light. A NaN, a value out
- * of range, a type or node other than the light's, or an id out of range: LMGI_ERR_INVALID, nothing
- * changed. */
+/* Recolours, dims, brightens, switches on or off, or reshapes (range, cones) a light, and moves an
+ * added one. A NaN, a value out of range, a type or node other than the light's, or an id out of range or
+ * removed: LMGI_ERR_INVALID, nothing changed. */
 LMGI_API lmgi_status lmgi_set_light(lmgi_scene *scene, int light, const lmgi_light *l, lmgi_error *err);
+/* Adds a light of any type, placed by l's position and direction (l->node is ignored), and returns its
+ * id in *id (the next one; -1 on failure). An updater traces its photons from its next update on: as
+ * many per unit of power as the scene's lights at the updater's creation got (the mean light's count for
+ * a light added dark), in its own groups under the group budget, so the frames that follow catch up on
+ * it like after a light's move; no other light's photons change. The values as lmgi_set_light checks
+ * them, plus a spot or directional light's direction not 0: LMGI_ERR_INVALID, nothing added. */
+LMGI_API lmgi_status lmgi_add_light(lmgi_scene *scene, const lmgi_light *l, int *id, lmgi_error *err);
+/* Removes a light (the file's or an added one): from the next update on it emits nothing, its photons'
+ * hits leave the lightmaps (its groups re-traced: no other light's) and it casts no light in the frame.
+ * An id out of range or already removed: LMGI_ERR_INVALID. */
+LMGI_API lmgi_status lmgi_remove_light(lmgi_scene *scene, int light, lmgi_error *err);
 
 /* An application's own level, handed over without a file: meshes (vertex and index arrays placed by a
  * matrix), materials and lights. lmgi_load_desc writes them into a .glb in memory and loads that, so they

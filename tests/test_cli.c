@@ -282,7 +282,9 @@ static void test_bench_edits(void **state)
     snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
     snprintf(path, sizeof path, "%s/edits.json", dir);
     const char *script = "{\"frames\": 12, \"budget_ms\": 0, \"fps\": 0, \"texels\": 600,\n"
-                         " \"edits\": [{\"frame\": 2, \"light\": \"light_a1\", \"intensity\": 2}]}\n";
+                         " \"edits\": [{\"frame\": 2, \"light\": \"light_a1\", \"intensity\": 2},\n"
+                         "  {\"frame\": 5, \"add_light\": \"point\", \"position\": [2, 2.2, 0], \"intensity\": 15},\n"
+                         "  {\"frame\": 8, \"remove_light\": \"light_b2\"}]}\n";
     lmt_write_file(path, script, strlen(script));
     snprintf(args, sizeof args, "bench --edits %s scenes/two_rooms.glb --json %s/out.json", path, dir);
     if (run(args) != 0)
@@ -295,6 +297,14 @@ static void test_bench_edits(void **state)
     assert_int_equal(frame, 2);
     assert_true(error > 5.0); /* one of room A's two lights at a tenth: far from the converged state at first */
     assert_non_null(strstr(output, "updates: median"));
+    double added = -1.0, removed = -1.0; /* a lamp added in room B, then one of its lights removed */
+    assert_non_null(row = strstr(output, "add_light point"));
+    assert_int_equal(sscanf(row, "add_light point %d %lf%%", &frame, &added), 2);
+    assert_int_equal(frame, 5);
+    assert_non_null(row = strstr(output, "remove_light light_b2"));
+    assert_int_equal(sscanf(row, "remove_light light_b2 %d %lf%%", &frame, &removed), 2);
+    assert_int_equal(frame, 8);
+    assert_true(added > 5.0 && removed > 5.0);
     snprintf(path, sizeof path, "%s/out.json", dir);
     size_t n = 0;
     char *json = (char *)lmt_read_file(path, &n, 1);

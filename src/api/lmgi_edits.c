@@ -5,13 +5,35 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "../core/vecmath.h"
+#include "../update/effects.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
 int lmgi_light_count(const lmgi_scene *sc) { return sc ? sc->scene->light_count : 0; }
+
+int lmgi_light_is_removed(const lmgi_scene *sc, int light)
+{
+    return sc && light >= 0 && light < sc->scene->light_count && sc->scene->lights[light].removed;
+}
+
+/* The light `light` names, or NULL with err filled (an id out of range, or of a removed light). */
+static lm_light *live_light(const lmgi_scene *sc, int light, lmgi_error *err)
+{
+    if (light < 0 || light >= sc->scene->light_count) {
+        lm_api_refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
+        return NULL;
+    }
+    lm_light *l = &sc->scene->lights[light];
+    if (l->removed) {
+        lm_api_refuse(err, "light %d ('%s') was removed", light, l->name);
+        return NULL;
+    }
+    return l;
+}
 
 lmgi_status lmgi_get_light(const lmgi_scene *sc, int light, lmgi_light *out, lmgi_error *err)
 {
@@ -19,9 +41,9 @@ lmgi_status lmgi_get_light(const lmgi_scene *sc, int light, lmgi_light *out, lmg
         memset(out, 0, sizeof *out);
     if (!sc || !out)
         return lm_api_refuse(err, "lmgi_get_light: %s is NULL", sc ? "out" : "the scene");
-    if (light < 0 || light >= sc->scene->light_count)
-        return lm_api_refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
-    const lm_light *l = &sc->scene->lights[light];
+    const lm_light *l = live_light(sc, light, err);
+    if (!l)
+        return LMGI_ERR_INVALID;
     out->type = (lmgi_light_type)l->type;
     out->node = l->node;
     memcpy(out->color, l->color, sizeof out->color);
@@ -30,38 +52,133 @@ lmgi_status lmgi_get_light(const lmgi_scene *sc, int light, lmgi_light *out, lmg
     out->inner_cone = l->inner_cone;
     out->outer_cone = l->outer_cone;
     out->enabled = !l->off;
+    lm_vec3 p = lm_v3_load(l->pos), d = lm_v3_load(l->dir);
+    if (l->node >= 0) { /* where its node puts it: the node's origin, shining down its -z */
+        const float *w = sc->scene->nodes[l->node].world;
+        p = lm_v3(w[12], w[13], w[14]);
+        d = lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1)));
+    }
+    lm_v3_store(out->position, lm_add(p, lm_v3_load(sc->scene->origin)));
+    lm_v3_store(out->direction, d);
     return LMGI_OK;
 }
 
 static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; } /* false for NaN */
 
-lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi_error *err)
+/* What lmgi_set_light and lmgi_add_light accept of in for a light of type `type` named `name`; the
+ * placement (position, direction) too when `placed`. */
+static lmgi_status check_light(const lmgi_light *in, lm_light_type type, const char *name, int placed,
+                               lmgi_error *err)
 {
-    if (!sc || !in)
-        return lm_api_refuse(err, "lmgi_set_light: %s is NULL", sc ? "the light" : "the scene");
-    if (light < 0 || light >= sc->scene->light_count)
-        return lm_api_refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
-    lm_light *l = &sc->scene->lights[light];
-    if ((int)in->type != (int)l->type || in->node != l->node)
-        return lm_api_refuse(err, "light '%s': its type and node are fixed at load", l->name);
     for (int c = 0; c < 3; c++)
         if (!in_range(in->color[c], 0.0f, 1000.0f))
-            return lm_api_refuse(err, "light '%s': colour %g must be in [0, 1000]", l->name, (double)in->color[c]);
+            return lm_api_refuse(err, "light '%s': colour %g must be in [0, 1000]", name, (double)in->color[c]);
     if (!in_range(in->intensity, 0.0f, 1e15f) || !in_range(in->range, 0.0f, 1e15f))
-        return lm_api_refuse(err, "light '%s': intensity %g and range %g must be finite numbers >= 0", l->name,
-                      (double)in->intensity, (double)in->range);
-    if (l->type == LM_LIGHT_SPOT && !(in_range(in->inner_cone, 0.0f, (float)(LM_PI / 2)) &&
-                                      in_range(in->outer_cone, 0.0f, (float)(LM_PI / 2)) && in->inner_cone < in->outer_cone))
-        return lm_api_refuse(err, "light '%s': cones %g and %g must satisfy 0 <= inner < outer <= pi/2", l->name,
-                      (double)in->inner_cone, (double)in->outer_cone);
-    if (sc->updater) /* its photon work reads the lights */
-        lm_updater_sync(sc->updater);
+        return lm_api_refuse(err, "light '%s': intensity %g and range %g must be finite numbers >= 0", name,
+                             (double)in->intensity, (double)in->range);
+    if (type == LM_LIGHT_SPOT && !(in_range(in->inner_cone, 0.0f, (float)(LM_PI / 2)) &&
+                                   in_range(in->outer_cone, 0.0f, (float)(LM_PI / 2)) && in->inner_cone < in->outer_cone))
+        return lm_api_refuse(err, "light '%s': cones %g and %g must satisfy 0 <= inner < outer <= pi/2", name,
+                             (double)in->inner_cone, (double)in->outer_cone);
+    if (!placed)
+        return LMGI_OK;
+    for (int k = 0; k < 3; k++)
+        if (!in_range(in->position[k], -LM_MAX_COORDINATE, LM_MAX_COORDINATE) || !isfinite(in->direction[k]))
+            return lm_api_refuse(err, "light '%s': position (%g %g %g) and direction must be finite, the position "
+                                 "within %g of the origin", name, (double)in->position[0], (double)in->position[1],
+                                 (double)in->position[2], (double)LM_MAX_COORDINATE);
+    lm_vec3 d = lm_v3_load(in->direction);
+    if (type != LM_LIGHT_POINT && !(lm_dot(d, d) > 1e-30f))
+        return lm_api_refuse(err, "light '%s': a %s light needs a direction (it is 0)", name,
+                             lm_light_type_name(type));
+    return LMGI_OK;
+}
+
+/* The edit in takes effect on l (checked): colour, intensity, range, cones, on or off, and an added
+ * light's place. */
+static void apply_light(lmgi_scene *sc, lm_light *l, const lmgi_light *in)
+{
     memcpy(l->color, in->color, sizeof l->color);
     l->intensity = in->intensity;
     l->range = in->range;
     if (l->type == LM_LIGHT_SPOT)
         l->inner_cone = in->inner_cone, l->outer_cone = in->outer_cone;
     l->off = !in->enabled;
+    if (l->node < 0) {
+        lm_vec3 d = lm_v3_load(in->direction);
+        lm_v3_store(l->pos, lm_sub(lm_v3_load(in->position), lm_v3_load(sc->scene->origin)));
+        lm_v3_store(l->dir, lm_dot(d, d) > 1e-30f ? lm_normalize(d) : lm_v3(0, 0, -1));
+    }
+}
+
+lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi_error *err)
+{
+    if (!sc || !in)
+        return lm_api_refuse(err, "lmgi_set_light: %s is NULL", sc ? "the light" : "the scene");
+    lm_light *l = live_light(sc, light, err);
+    if (!l)
+        return LMGI_ERR_INVALID;
+    if ((int)in->type != (int)l->type || in->node != l->node)
+        return lm_api_refuse(err, "light '%s': its type and node are fixed at load", l->name);
+    lmgi_status st = check_light(in, l->type, l->name, l->node < 0, err);
+    if (st != LMGI_OK)
+        return st;
+    if (sc->updater) /* its photon work reads the lights */
+        lm_updater_sync(sc->updater);
+    apply_light(sc, l, in);
+    return LMGI_OK;
+}
+
+lmgi_status lmgi_add_light(lmgi_scene *sc, const lmgi_light *in, int *id, lmgi_error *err)
+{
+    if (id)
+        *id = -1;
+    if (!sc || !in || !id)
+        return lm_api_refuse(err, "lmgi_add_light: %s is NULL", !sc ? "the scene" : !in ? "the light" : "id");
+    if ((int)in->type < LMGI_LIGHT_POINT || (int)in->type > LMGI_LIGHT_DIRECTIONAL)
+        return lm_api_refuse(err, "lmgi_add_light: type %d is not a light type (0 point, 1 spot, 2 directional)",
+                             (int)in->type);
+    lm_scene *s = sc->scene;
+    char name[LM_NAME_MAX];
+    snprintf(name, sizeof name, "added light %d", s->light_count);
+    lmgi_status st = check_light(in, (lm_light_type)in->type, name, 1, err);
+    if (st != LMGI_OK)
+        return st;
+    if (s->light_count >= 1 << 20)
+        return lm_api_refuse(err, "lmgi_add_light: the scene has %d lights, the most it may have", s->light_count);
+    if (sc->updater)
+        lm_updater_sync(sc->updater);
+    lm_light *lights = realloc(s->lights, sizeof *lights * ((size_t)s->light_count + 1));
+    if (!lights) {
+        lm_error e;
+        lm_fail(&e, LM_ERR_NOMEM, "lmgi_add_light: no memory for another light");
+        return lm_export_error(err, &e);
+    }
+    s->lights = lights;
+    lm_light *l = &s->lights[s->light_count];
+    memset(l, 0, sizeof *l);
+    memcpy(l->name, name, sizeof l->name);
+    l->type = (lm_light_type)in->type;
+    l->node = -1;
+    l->added = 1;
+    l->inner_cone = 0.0f, l->outer_cone = (float)(LM_PI / 4);
+    apply_light(sc, l, in);
+    *id = s->light_count++;
+    lm_effects_decide(s, &sc->effects); /* lmgi info: what the scene now calls for */
+    return LMGI_OK;
+}
+
+lmgi_status lmgi_remove_light(lmgi_scene *sc, int light, lmgi_error *err)
+{
+    if (!sc)
+        return lm_api_refuse(err, "lmgi_remove_light: the scene is NULL");
+    lm_light *l = live_light(sc, light, err);
+    if (!l)
+        return LMGI_ERR_INVALID;
+    if (sc->updater)
+        lm_updater_sync(sc->updater);
+    l->removed = 1;
+    lm_effects_decide(sc->scene, &sc->effects);
     return LMGI_OK;
 }
 

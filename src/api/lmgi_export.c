@@ -17,6 +17,7 @@
 #include <string.h>
 
 #include "../core/image.h"
+#include "../core/vecmath.h"
 #include "gltf_write.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
@@ -122,11 +123,36 @@ static int has_lightmap(const lm_atlas *a, const lm_node *nd)
     return 0;
 }
 
+/* A node for each light added by an edit, at its position with its local -z along its direction. */
+static void write_added_lights(writer *w)
+{
+    const lm_scene *s = w->s;
+    for (int l = 0; l < s->light_count; l++) {
+        const lm_light *li = &s->lights[l];
+        if (li->node >= 0 || li->removed)
+            continue;
+        lm_vec3 z = lm_scale(lm_normalize(lm_v3_load(li->dir)), -1.0f);
+        lm_vec3 up = fabsf(z.y) < 0.9f ? lm_v3(0, 1, 0) : lm_v3(1, 0, 0);
+        lm_vec3 x = lm_normalize(lm_cross(up, z)), y = lm_cross(z, x);
+        float m[16] = {x.x, x.y, x.z, 0, y.x, y.y, y.z, 0, z.x, z.y, z.z, 0, 0, 0, 0, 1};
+        for (int k = 0; k < 3; k++)
+            m[12 + k] = li->pos[k] + s->origin[k];
+        fprintf(w->doc.json, ",{\"name\":");
+        lm_gltf_string(w->doc.json, li->name);
+        fprintf(w->doc.json, ",\"matrix\":");
+        lm_gltf_floats(w->doc.json, m, 16);
+        fprintf(w->doc.json, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}}", l);
+    }
+}
+
 static void write_nodes(writer *w, const int *mesh_of)
 {
     const lm_scene *s = w->s;
+    int added = 0; /* lights added by edits: a node each, after the scene's */
+    for (int l = 0; l < s->light_count; l++)
+        added += s->lights[l].node < 0 && !s->lights[l].removed;
     fprintf(w->doc.json, ",\"scene\":0,\"scenes\":[{\"nodes\":[");
-    for (int i = 0; i < s->node_count; i++)
+    for (int i = 0; i < s->node_count + added; i++)
         fprintf(w->doc.json, "%s%d", i ? "," : "", i);
     fprintf(w->doc.json, "]}],\"nodes\":[");
     for (int i = 0; i < s->node_count; i++) {
@@ -143,7 +169,7 @@ static void write_nodes(writer *w, const int *mesh_of)
             fprintf(w->doc.json, ",\"mesh\":%d", mesh_of[i]);
         if (nd->camera >= 0)
             fprintf(w->doc.json, ",\"camera\":%d", nd->camera);
-        if (nd->light >= 0)
+        if (nd->light >= 0 && !s->lights[nd->light].removed)
             fprintf(w->doc.json, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", nd->light);
         /* lmgi's own node settings (as resolved: a reload needs no inheritance), then the lightmap */
         const lm_node_settings *ns = &nd->settings;
@@ -154,6 +180,7 @@ static void write_nodes(writer *w, const int *mesh_of)
             fprintf(w->doc.json, ",\"lightmap\":{\"uri\":\"%s_lightmap.exr\",\"texCoord\":1}", w->name);
         fprintf(w->doc.json, "}}");
     }
+    write_added_lights(w);
     fputc(']', w->doc.json);
 }
 
@@ -233,6 +260,7 @@ static void write_materials(writer *w)
             fprintf(w->doc.json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
         fprintf(w->doc.json, "}}");
     }
+    write_added_lights(w);
     fputc(']', w->doc.json);
 }
 
@@ -269,6 +297,7 @@ static void write_lights_and_cameras(writer *w)
             fprintf(w->doc.json, ",\"zfar\":%.9g", (double)(c->zfar > 0.0f ? c->zfar : 1e6f));
         fprintf(w->doc.json, "}}");
     }
+    write_added_lights(w);
     fputc(']', w->doc.json);
 }
 

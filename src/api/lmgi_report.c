@@ -31,9 +31,9 @@ void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
     for (int m = 0; m < s->material_count; m++)
         in->materials_by_class[s->materials[m].cls]++;
     in->textures = s->texture_count;
-    in->lights = s->light_count;
     for (int l = 0; l < s->light_count; l++)
-        in->lights_by_type[s->lights[l].type]++;
+        if (!s->lights[l].removed)
+            in->lights++, in->lights_by_type[s->lights[l].type]++;
     in->cameras = s->camera_count;
     in->animations = s->animation_count;
     in->surfaces = sc->surfaces.surface_count;
@@ -98,6 +98,8 @@ static void print_lights(const lm_scene *s, const lmgi_info *in, FILE *f)
             in->lights_by_type[1], in->lights_by_type[2]);
     for (int l = 0; l < s->light_count; l++) {
         const lm_light *li = &s->lights[l];
+        if (li->removed)
+            continue;
         fprintf(f, "  %-12s '%s' intensity %g colour (%.2f %.2f %.2f)\n", lm_light_type_name(li->type), li->name,
                 (double)li->intensity, (double)li->color[0], (double)li->color[1], (double)li->color[2]);
     }

@@ -170,7 +170,7 @@ static void write_nodes(const lmgi_scene_desc *d, FILE *f)
             if (!is_zero(l->color, 3))
                 memcpy(color, l->color, sizeof color);
             fprintf(f, "%s", i ? "," : "");
-            lm_gltf_light(f, NULL, l->type, color, l->intensity, l->range, l->inner_cone,
+            lm_gltf_light(f, l->name, l->type, color, l->intensity, l->range, l->inner_cone,
                           l->outer_cone > 0.0f ? l->outer_cone : 0.785398163f);
         }
         fprintf(f, "]}}");

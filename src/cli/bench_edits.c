@@ -149,8 +149,33 @@ static int apply(const char *path, int i, const json_value *e, lmgi_scene *sc)
         if ((v = json_get(e, "emissive")) && !floats(v, mm.emissive, 3))
             return bad(path, i, "\"emissive\" must be 3 numbers");
         st = lmgi_set_material(sc, m, &mm, &err);
+    } else if ((light = json_get(e, "add_light")) && light->type == JSON_STRING) {
+        static const char *const types[3] = {"point", "spot", "directional"};
+        lmgi_light li = {.color = {1, 1, 1}, .intensity = 1.0f, .enabled = 1, .direction = {0, -1, 0},
+                         .inner_cone = 0.0f, .outer_cone = 0.785398f};
+        li.type = (lmgi_light_type)3;
+        for (int t = 0; t < 3; t++)
+            if (!strcmp(light->string, types[t]))
+                li.type = (lmgi_light_type)t;
+        const json_value *v;
+        if ((int)li.type == 3 || !floats(json_get(e, "position"), li.position, 3))
+            return bad(path, i, "\"add_light\" is \"point\", \"spot\" or \"directional\", with a \"position\"");
+        if ((v = json_get(e, "direction")) && !floats(v, li.direction, 3))
+            return bad(path, i, "\"direction\" must be 3 numbers");
+        if ((v = json_get(e, "color")) && !floats(v, li.color, 3))
+            return bad(path, i, "\"color\" must be 3 numbers");
+        if ((v = json_get(e, "intensity")) && v->type == JSON_NUMBER)
+            li.intensity = (float)v->number;
+        int id;
+        st = lmgi_add_light(sc, &li, &id, &err);
+    } else if ((light = json_get(e, "remove_light")) && light->type == JSON_STRING) {
+        int l = light_of_node(sc, light->string);
+        if (l < 0)
+            return bad(path, i, "no light on that node");
+        st = lmgi_remove_light(sc, l, &err);
     } else {
-        return bad(path, i, "an edit names a \"light\" (its node), a \"node\" or a \"material\"");
+        return bad(path, i, "an edit names a \"light\" (its node), a \"node\", a \"material\", \"add_light\" or "
+                   "\"remove_light\"");
     }
     return st == LMGI_OK ? 1 : bad(path, i, err.message);
 }
@@ -272,9 +297,15 @@ static void lag(const frame_row *rows, int from, int to, double limit, int *fram
 
 static void describe(const json_value *e, char *out, size_t n)
 {
-    const json_value *l = json_get(e, "light"), *nd = json_get(e, "node"), *m = json_get(e, "material");
-    snprintf(out, n, "%s %s", l ? "light" : nd ? "node" : "material",
-             l && l->string ? l->string : nd && nd->string ? nd->string : m && m->string ? m->string : "?");
+    static const char *const kinds[5] = {"light", "node", "material", "add_light", "remove_light"};
+    for (int k = 0; k < 5; k++) {
+        const json_value *v = json_get(e, kinds[k]);
+        if (v && v->string) {
+            snprintf(out, n, "%s %s", kinds[k], v->string);
+            return;
+        }
+    }
+    snprintf(out, n, "?");
 }
 
 static void report(const lm_cli_args *a, const script *s, const frame_row *rows)

@@ -60,8 +60,14 @@ typedef struct {
     float intensity;       /* candela (point/spot) or lux (directional), as in the file */
     float range;           /* 0 = infinite */
     float inner_cone, outer_cone; /* spot only, radians */
-    int node;              /* node that places it; light shines down the node's local -Z */
+    int node;              /* node that places it; light shines down the node's local -Z. -1 for a light
+                            * added after load (added): pos and dir place it */
+    float pos[3], dir[3];  /* an added light's world position and unit direction (unused otherwise) */
     int off;               /* switched off by an edit: emits nothing, keeps its colour and intensity */
+    int added;             /* added by an edit after load: its emitter follows the area emitters, so that
+                            * the photon ids of the lights before it do not move (lights.c) */
+    int removed;           /* removed by an edit: emits nothing and is never on again; its id stays taken
+                            * (ids are not reused, so a caller's handle to another light stays good) */
 } lm_light;
 
 typedef struct {

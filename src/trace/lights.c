@@ -80,6 +80,18 @@ static lm_status add_area(const lm_scene *s, int node, lm_emitter *e, lm_error *
     return LM_OK;
 }
 
+static void set_punctual(const lm_scene *s, int light, lm_emitter *e)
+{
+    memset(e, 0, sizeof *e);
+    lm_light_type t = s->lights[light].type;
+    e->kind = t == LM_LIGHT_POINT ? LM_EMIT_POINT : t == LM_LIGHT_SPOT ? LM_EMIT_SPOT : LM_EMIT_DIRECTIONAL;
+    e->light = light;
+    e->node = s->lights[light].node;
+    e->punctual = 1;
+}
+
+/* Order: the file's lights, the emissive nodes, then the lights added by edits in the order they came,
+ * the order lm_emitters_add_light gives an emitter list built before the edits. */
 lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -89,14 +101,9 @@ lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
     out->e = calloc(n > 0 ? (size_t)n : 1, sizeof *out->e);
     if (!out->e)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %d emitters", s->path, n);
-    for (int i = 0; i < s->light_count; i++) {
-        lm_emitter *e = &out->e[out->count++];
-        lm_light_type t = s->lights[i].type;
-        e->kind = t == LM_LIGHT_POINT ? LM_EMIT_POINT : t == LM_LIGHT_SPOT ? LM_EMIT_SPOT : LM_EMIT_DIRECTIONAL;
-        e->light = i;
-        e->node = s->lights[i].node;
-        e->punctual = 1;
-    }
+    for (int i = 0; i < s->light_count; i++)
+        if (!s->lights[i].added)
+            set_punctual(s, i, &out->e[out->count++]);
     for (int i = 0; i < s->node_count; i++) {
         if (count_emissive(s, &s->nodes[i]) == 0)
             continue;
@@ -106,8 +113,30 @@ lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
             return st;
         }
     }
+    for (int i = 0; i < s->light_count; i++)
+        if (s->lights[i].added)
+            set_punctual(s, i, &out->e[out->count++]);
     lm_emitters_update(out, s);
     return LM_OK;
+}
+
+lm_status lm_emitters_add_light(lm_emitters *em, const lm_scene *s, int light, lm_error *err)
+{
+    lm_emitter *e = realloc(em->e, sizeof *e * ((size_t)em->count + 1));
+    if (!e)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for light '%s'", s->path, s->lights[light].name);
+    em->e = e;
+    set_punctual(s, light, &em->e[em->count++]);
+    lm_emitters_update(em, s);
+    return LM_OK;
+}
+
+int lm_emitters_light_count(const lm_emitters *em)
+{
+    int n = 0;
+    for (int i = 0; i < em->count; i++)
+        n += em->e[i].punctual;
+    return n;
 }
 
 void lm_emitters_free(lm_emitters *em)
@@ -123,14 +152,20 @@ void lm_emitters_free(lm_emitters *em)
 static void place_punctual(lm_emitter *e, const lm_scene *s, float disk_radius)
 {
     const lm_light *l = &s->lights[e->light];
-    const float *w = s->nodes[e->node].world;
-    lm_v3_store(e->pos, lm_v3(w[12], w[13], w[14]));
-    lm_v3_store(e->dir, lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1))));
+    if (e->node >= 0) {
+        const float *w = s->nodes[e->node].world;
+        lm_v3_store(e->pos, lm_v3(w[12], w[13], w[14]));
+        lm_v3_store(e->dir, lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1))));
+    } else {
+        memcpy(e->pos, l->pos, sizeof e->pos);
+        lm_v3_store(e->dir, lm_normalize(lm_v3_load(l->dir)));
+    }
+    int dark = l->off || l->removed;
     float scale = e->kind == LM_EMIT_POINT ? (float)(4.0 * LM_PI)
                 : e->kind == LM_EMIT_SPOT  ? lm_spot_solid_angle(l)
                                            : (float)LM_PI * disk_radius * disk_radius;
     for (int c = 0; c < 3; c++) {
-        e->radiant[c] = l->off ? 0.0f : l->color[c] * l->intensity;
+        e->radiant[c] = dark ? 0.0f : l->color[c] * l->intensity;
         e->power[c] = e->radiant[c] * scale;
     }
 }
@@ -317,7 +352,7 @@ void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, con
     memset(out, 0, sizeof *out);
     if (count == 0)
         return;
-    if (em_e->punctual)
+    if (em_e->punctual && em_e->luminance > 0.0f) /* a light switched off or removed: no photon */
         emit_punctual(em, s, em_e, u, count, out);
     else if (em_e->tri_count > 0 && em_e->cdf[em_e->tri_count - 1] > 0.0f)
         emit_area(em_e, tris, s, u, count, out);

@@ -43,6 +43,11 @@ typedef struct {
 
 lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err);
 void lm_emitters_free(lm_emitters *em);
+/* Appends the emitter of scene light `light`, added by an edit after em was built, and places every
+ * emitter (lm_emitters_update). */
+lm_status lm_emitters_add_light(lm_emitters *em, const lm_scene *s, int light, lm_error *err);
+/* Point, spot and directional emitters in em (the lights it knows). */
+int lm_emitters_light_count(const lm_emitters *em);
 /* Re-reads emitter placement and flux after node moves or light edits (world matrices, bounds). */
 void lm_emitters_update(lm_emitters *em, const lm_scene *s);
 

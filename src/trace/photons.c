@@ -89,6 +89,7 @@ static lm_status plan_counts(lm_photons *ph, lm_error *err)
         ph->emitter_first[e + 1] = (uint32_t)at;
     }
     ph->photon_count = (uint32_t)at;
+    ph->per_luminance = ph->em->total_luminance > 0.0f ? (double)at / ph->em->total_luminance : 0.0;
     char what[128];
     snprintf(what, sizeof what, "%llu photons over %u lights", (unsigned long long)at, E);
     lm_status st = lm_memory_plan(what, (double)at * PH_BYTES_PER_PHOTON, "fewer photons (--photons, or "
@@ -108,16 +109,10 @@ static lm_status plan_counts(lm_photons *ph, lm_error *err)
     return LM_OK;
 }
 
-static lm_status make_groups(lm_photons *ph, lm_error *err)
+/* Groups [from, to), of the emitters emitter_first plans: their photons' fixed emission numbers. */
+static lm_status init_groups(lm_photons *ph, uint32_t from, uint32_t to, lm_error *err)
 {
-    ph->group_count = ph->emitter_count * ph->G;
-    size_t n = ph->group_count ? ph->group_count : 1;
-    ph->groups = calloc(n, sizeof *ph->groups);
-    ph->queue = malloc(n * sizeof *ph->queue);
-    ph->tmp_groups = malloc(n * sizeof *ph->tmp_groups);
-    if (!ph->groups || !ph->queue || !ph->tmp_groups)
-        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u groups", ph->group_count);
-    for (uint32_t i = 0; i < ph->group_count; i++) {
+    for (uint32_t i = from; i < to; i++) {
         ph_group *g = &ph->groups[i];
         g->emitter = (int)(i / ph->G);
         g->index = i % ph->G;
@@ -129,14 +124,41 @@ static lm_status make_groups(lm_photons *ph, lm_error *err)
             return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for group %u", i);
         for (uint32_t m = 0; m < g->photons; m++)
             ph_emission_samples(ph, g->first_id + m * ph->G, g->emit_u + 4 * (size_t)m);
-        if (g->photons > ph->max_group_photons)
-            ph->max_group_photons = g->photons;
     }
-    ph->tmp_offsets = malloc(((size_t)ph->max_group_photons + 1) * sizeof *ph->tmp_offsets);
-    ph->tmp_changed = malloc((size_t)ph->max_group_photons + 1);
-    if (!ph->tmp_offsets || !ph->tmp_changed)
-        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for group scratch");
     return LM_OK;
+}
+
+/* Scratch for rebuilding the largest group's slab. */
+static lm_status size_scratch(lm_photons *ph, lm_error *err)
+{
+    uint32_t most = 0;
+    for (uint32_t i = 0; i < ph->group_count; i++)
+        most = ph->groups[i].photons > most ? ph->groups[i].photons : most;
+    if (ph->tmp_offsets && most <= ph->max_group_photons)
+        return LM_OK;
+    uint32_t *offsets = realloc(ph->tmp_offsets, ((size_t)most + 1) * sizeof *offsets);
+    if (offsets)
+        ph->tmp_offsets = offsets;
+    uint8_t *changed = realloc(ph->tmp_changed, (size_t)most + 1);
+    if (changed)
+        ph->tmp_changed = changed;
+    if (!offsets || !changed)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for group scratch");
+    ph->max_group_photons = most;
+    return LM_OK;
+}
+
+static lm_status make_groups(lm_photons *ph, lm_error *err)
+{
+    ph->group_count = ph->emitter_count * ph->G;
+    size_t n = ph->group_count ? ph->group_count : 1;
+    ph->groups = calloc(n, sizeof *ph->groups);
+    ph->queue = malloc(n * sizeof *ph->queue);
+    ph->tmp_groups = malloc(n * sizeof *ph->tmp_groups);
+    if (!ph->groups || !ph->queue || !ph->tmp_groups)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u groups", ph->group_count);
+    lm_status st = init_groups(ph, 0, ph->group_count, err);
+    return st == LM_OK ? size_scratch(ph, err) : st;
 }
 
 static lm_status setup(lm_photons *ph, lm_error *err)
@@ -251,6 +273,67 @@ lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err)
     for (uint32_t g = 0; g < ph->G; g++)
         mark_invalid(ph, (uint32_t)e * ph->G + g);
     return LM_OK;
+}
+
+/* M_e of an emitter added after creation: the photons per unit of luminance the others got, so that
+ * its photons carry about their power; a light added dark (or to a scene with none lit) gets the mean
+ * emitter's count. */
+static uint32_t added_per_group(const lm_photons *ph, const lm_emitter *e)
+{
+    double m = e->luminance > 0.0f && ph->per_luminance > 0.0 ? floor(e->luminance * ph->per_luminance / ph->G + 0.5)
+             : ph->emitter_count ? (double)ph->photon_count / ph->emitter_count / ph->G
+             : ph->set.total_photons ? (double)ph->set.total_photons / ph->G
+                                     : (double)ph->set.per_group;
+    return m < 1.0 ? 1u : (uint32_t)fmin(m, (double)PH_MAX_PHOTONS);
+}
+
+lm_status lm_photons_add_emitter(lm_photons *ph, lm_error *err)
+{
+    uint32_t E = ph->emitter_count, G = ph->G, old = ph->group_count;
+    if (ph->em->count != (int)E + 1 || !ph->em->e[E].punctual)
+        return lm_fail(err, LM_ERR_INVALID, "photons: expected one light appended to the %u emitters (have %d)", E,
+                       ph->em->count);
+    uint64_t at = ph->photon_count + (uint64_t)added_per_group(ph, &ph->em->e[E]) * G;
+    if (at > PH_MAX_PHOTONS)
+        return lm_fail(err, LM_ERR_INVALID, "photons: another light would make %llu photons, over %u",
+                       (unsigned long long)at, PH_MAX_PHOTONS);
+    uint32_t *first = realloc(ph->emitter_first, ((size_t)E + 2) * sizeof *first);
+    if (first)
+        ph->emitter_first = first;
+    uint32_t *tri_first = realloc(ph->emit_tri_first, ((size_t)E + 2) * sizeof *tri_first);
+    if (tri_first)
+        ph->emit_tri_first = tri_first;
+    ph_group *groups = realloc(ph->groups, ((size_t)old + G) * sizeof *groups);
+    if (groups)
+        ph->groups = groups;
+    uint32_t *tmp = realloc(ph->tmp_groups, ((size_t)old + G) * sizeof *tmp);
+    if (tmp)
+        ph->tmp_groups = tmp;
+    uint32_t *queue = malloc(((size_t)old + G) * sizeof *queue);
+    if (!first || !tri_first || !groups || !tmp || !queue) {
+        free(queue);
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for another light's %u groups", G);
+    }
+    for (uint32_t i = 0; i < ph->queue_len; i++) /* the ring laid out afresh for its new length */
+        queue[i] = ph->queue[(ph->queue_head + i) % old];
+    free(ph->queue);
+    ph->queue = queue;
+    ph->queue_head = 0;
+    memset(ph->groups + old, 0, G * sizeof *ph->groups);
+    ph->emitter_first[E + 1] = (uint32_t)at;
+    ph->emit_tri_first[E + 1] = ph->emit_tri_first[E];
+    ph->emitter_count = E + 1;
+    ph->group_count = old + G;
+    ph->photon_count = (uint32_t)at;
+    lm_status st = init_groups(ph, old, old + G, err);
+    if (st == LM_OK)
+        st = size_scratch(ph, err);
+    if (st != LM_OK) { /* the new groups trace nothing: no photons */
+        for (uint32_t i = old; i < old + G; i++)
+            ph->groups[i].photons = 0;
+        return st;
+    }
+    return lm_photons_invalidate_emitter(ph, (int)E, err);
 }
 
 uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *materials)

@@ -97,6 +97,12 @@ lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_erro
 /* Marks all groups of emitter e invalid (after it moved or changed: call lm_emitters_update first).
  * Groups already queued keep their place. Fails for an out-of-range emitter. */
 lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err);
+/* Takes on the light that lm_emitters_add_light appended to the emitter list (the last one): its
+ * photons get the ids after all others (no other photon's numbers change) and a count from the photons
+ * per unit of luminance at creation (the mean emitter's when it is dark), and its groups are queued for
+ * tracing. Fails when the list did not grow by one light (nothing changed), or when memory runs out
+ * (the light then has no photons). */
+lm_status lm_photons_add_emitter(lm_photons *ph, lm_error *err);
 /* Marks invalid every group with a stored path vertex on a triangle whose material is flagged in
  * `materials` (per scene material): what a material edit reaches. Returns how many groups. */
 uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *materials);

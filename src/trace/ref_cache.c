@@ -48,11 +48,15 @@ static void hash_light(uint64_t *h, const lm_light *l)
 {
     fnv_u32(h, (uint32_t)l->type);
     fnv(h, l->color, sizeof l->color);
-    fnv_f(h, l->off ? 0.0f : l->intensity);
+    fnv_f(h, l->off || l->removed ? 0.0f : l->intensity);
     fnv_f(h, l->range);
     fnv_f(h, l->inner_cone);
     fnv_f(h, l->outer_cone);
     fnv_u32(h, (uint32_t)l->node);
+    if (l->node < 0) { /* an added light: its own place */
+        fnv(h, l->pos, sizeof l->pos);
+        fnv(h, l->dir, sizeof l->dir);
+    }
 }
 
 static void hash_scene(uint64_t *h, const lm_scene *s)

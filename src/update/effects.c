@@ -48,11 +48,12 @@ static usage count_usage(const lm_scene *s, lm_material_class cls, lm_effect_id 
     return u;
 }
 
+/* Lights of a type (-1: any) that have not been removed. */
 static int count_lights(const lm_scene *s, int type)
 {
     int n = 0;
     for (int i = 0; i < s->light_count; i++)
-        n += (int)s->lights[i].type == type;
+        n += !s->lights[i].removed && (type < 0 || (int)s->lights[i].type == type);
     return n;
 }
 
@@ -60,21 +61,21 @@ static void describe_lights(const lm_scene *s, char *buf, size_t n)
 {
     int p = count_lights(s, LM_LIGHT_POINT), sp = count_lights(s, LM_LIGHT_SPOT);
     int d = count_lights(s, LM_LIGHT_DIRECTIONAL);
-    snprintf(buf, n, "%d point, %d spot, %d directional light%s", p, sp, d, s->light_count == 1 ? "" : "s");
+    snprintf(buf, n, "%d point, %d spot, %d directional light%s", p, sp, d, count_lights(s, -1) == 1 ? "" : "s");
 }
 
 static void decide_direct(const lm_scene *s, lm_effects *e)
 {
     char lights[128];
     describe_lights(s, lights, sizeof lights);
-    e->on[LM_EFFECT_DIRECT] = s->light_count > 0;
-    snprintf(e->reason[LM_EFFECT_DIRECT], 256, "%s", s->light_count > 0 ? lights : "no point, spot or directional light");
+    e->on[LM_EFFECT_DIRECT] = count_lights(s, -1) > 0;
+    snprintf(e->reason[LM_EFFECT_DIRECT], 256, "%s", count_lights(s, -1) > 0 ? lights : "no point, spot or directional light");
 
     int casting = 0;
     for (int n = 0; n < s->node_count; n++)
         casting += s->nodes[n].tri_count > 0 && s->nodes[n].settings.shadows;
-    e->on[LM_EFFECT_SHADOWS] = s->light_count > 0 && casting > 0;
-    if (s->light_count == 0)
+    e->on[LM_EFFECT_SHADOWS] = count_lights(s, -1) > 0 && casting > 0;
+    if (count_lights(s, -1) == 0)
         snprintf(e->reason[LM_EFFECT_SHADOWS], 256, "no point, spot or directional light");
     else if (casting == 0)
         snprintf(e->reason[LM_EFFECT_SHADOWS], 256, "every node has extras shadows: false");
@@ -92,17 +93,17 @@ static void decide_indirect(const lm_scene *s, lm_effects *e)
     int emitters = emit.materials_on + emit.materials_off;
     int first_emitter = emit.first_node_on >= 0 ? emit.first_node_on : emit.first_node_off;
     char *r = e->reason[LM_EFFECT_INDIRECT];
-    e->on[LM_EFFECT_INDIRECT] = (s->light_count > 0 || emitters > 0) && receivers > 0;
-    if (s->light_count == 0 && emitters == 0)
+    e->on[LM_EFFECT_INDIRECT] = (count_lights(s, -1) > 0 || emitters > 0) && receivers > 0;
+    if (count_lights(s, -1) == 0 && emitters == 0)
         snprintf(r, 256, "no light and no emissive material");
     else if (receivers == 0)
         snprintf(r, 256, "every node has extras indirect: false");
     else if (emitters == 0)
-        snprintf(r, 256, "%d light%s bounce off %d node%s", s->light_count, s->light_count == 1 ? "" : "s",
+        snprintf(r, 256, "%d light%s bounce off %d node%s", count_lights(s, -1), count_lights(s, -1) == 1 ? "" : "s",
                  receivers, receivers == 1 ? "" : "s");
     else
         snprintf(r, 256, "%d light%s and %d emissive material%s (first on node '%s') bounce off %d node%s",
-                 s->light_count, s->light_count == 1 ? "" : "s", emitters, emitters == 1 ? "" : "s",
+                 count_lights(s, -1), count_lights(s, -1) == 1 ? "" : "s", emitters, emitters == 1 ? "" : "s",
                  s->nodes[first_emitter].name, receivers, receivers == 1 ? "" : "s");
 }
 
@@ -121,7 +122,7 @@ static void decide_specular(const lm_scene *s, lm_effects *e)
         snprintf(what, sizeof what, "%d %s material%s", on, glass.materials_on ? "glass" : "mirror",
                  on == 1 ? "" : "s");
     usage emit = count_usage(s, LM_MAT_EMITTER, LM_EFFECT_CAUSTICS);
-    int lit = s->light_count > 0 || emit.materials_on + emit.materials_off > 0;
+    int lit = count_lights(s, -1) > 0 || emit.materials_on + emit.materials_off > 0;
 
     e->on[LM_EFFECT_CAUSTICS] = on > 0 && lit;
     if (on > 0 && lit)

@@ -5,10 +5,11 @@
 
 #include "../core/timing.h"
 
-/* What an emitter looked like when its photons were last traced: its node's world matrix and power. */
+/* What an emitter looked like when its photons were last traced: its node's world matrix, its place and
+ * its power. */
 typedef struct {
     float world[16];
-    float power[3];
+    float pos[3], dir[3], power[3];
 } emitter_snapshot;
 
 /* What photons and AIMs read of a material: its colour and emission. */
@@ -53,7 +54,33 @@ static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *ou
     memset(out, 0, sizeof *out);
     if (em->node >= 0 && em->node < ps->scene->node_count)
         memcpy(out->world, ps->scene->nodes[em->node].world, sizeof out->world);
+    if (em->punctual) {
+        memcpy(out->pos, em->pos, sizeof out->pos);
+        memcpy(out->dir, em->dir, sizeof out->dir);
+    }
     memcpy(out->power, em->power, sizeof out->power);
+}
+
+/* Lights added to the scene since the emitter list was built (they come last, in id order) join it and
+ * the photons, which queue their groups for tracing. Returns how many. */
+static lm_status take_new_lights(lm_photon_stage *ps, int *added, lm_error *err)
+{
+    *added = 0;
+    for (int l = lm_emitters_light_count(&ps->emitters); l < ps->scene->light_count; l++) {
+        emitter_snapshot *snap = realloc(ps->snap, sizeof *snap * ((size_t)ps->emitters.count + 2));
+        if (!snap)
+            return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for light '%s'", ps->scene->path,
+                           ps->scene->lights[l].name);
+        ps->snap = snap;
+        lm_status st = lm_emitters_add_light(&ps->emitters, ps->scene, l, err);
+        if (st == LM_OK)
+            st = lm_photons_add_emitter(ps->photons, err);
+        if (st != LM_OK)
+            return st;
+        take_snapshot(ps, ps->emitters.count - 1, &ps->snap[ps->emitters.count - 1]);
+        ++*added;
+    }
+    return LM_OK;
 }
 
 /* A material edit (colour, emission) reaches the photons that touch the material, which are re-traced,
@@ -197,8 +224,12 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
         if (st != LM_OK)
             return st;
     }
+    int added = 0;
+    lm_status st = take_new_lights(ps, &added, err);
     lm_emitters_update(&ps->emitters, ps->scene);
-    lm_status st = check_emitters(ps, &out->emitters_moved, err);
+    if (st == LM_OK)
+        st = check_emitters(ps, &out->emitters_moved, err);
+    out->emitters_moved += added;
     out->materials_changed = check_materials(ps);
     out->t_animate = lm_now() - t0;
     out->t_total = out->t_animate;

@@ -18,7 +18,7 @@ typedef struct {
 typedef struct {
     int frame;
     float time;              /* animation time, seconds */
-    int emitters_moved;      /* emitters whose placement or power changed this frame */
+    int emitters_moved;      /* emitters whose placement or power changed this frame, or that were added */
     int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
     lm_photon_frame_stats photons;
     lm_aim_stats aim;

@@ -1,0 +1,438 @@
+/* Lights added and removed through the public API (lmgi_add_light, lmgi_remove_light): an added light
+ * lights the room as the same light loaded from the level does, only its own photons are traced,
+ * removing it gives back the lightmap from before, removing every light leaves the room dark, the same
+ * edits give the same lightmaps, an added light in one room of the two-room scene leaves the other
+ * untouched, and bad lights are refused naming what is wrong. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <lmgi.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "support.h"
+
+#define SIDE 48
+
+static const lmgi_light_desc LAMP = {.name = "lamp", .type = LMGI_LIGHT_POINT, .color = {1.0f, 0.9f, 0.8f},
+                                     .intensity = 4.0f, .position = {-1.0f, 2.5f, -1.0f}};
+static const lmgi_light_desc SPOT = {.name = "spot", .type = LMGI_LIGHT_SPOT, .color = {0.3f, 0.6f, 1.0f},
+                                     .intensity = 12.0f, .inner_cone = 0.3f, .outer_cone = 0.7f,
+                                     .position = {1.0f, 2.8f, 1.0f}, .direction = {-0.2f, -1.0f, 0.1f}};
+
+/* A closed room 4 x 3 x 4 (seen from inside) with a block in it, lit by `lights`. */
+static lmgi_scene *load_room(const lmgi_light_desc *lights, int light_count)
+{
+    float room[24], block[24];
+    for (int v = 0; v < 8; v++) {
+        room[3 * v] = v & 1 ? 2.0f : -2.0f, room[3 * v + 1] = v & 2 ? 3.0f : 0.0f, room[3 * v + 2] = v & 4 ? 2.0f : -2.0f;
+        block[3 * v] = v & 1 ? 0.9f : 0.1f, block[3 * v + 1] = v & 2 ? 1.0f : 0.0f,
+        block[3 * v + 2] = v & 4 ? -0.1f : -0.9f;
+    }
+    static const uint32_t inward[36] = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
+                                         2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
+    uint32_t outward[36];
+    for (int t = 0; t < 12; t++) /* the same faces wound the other way: their fronts face out */
+        outward[3 * t] = inward[3 * t], outward[3 * t + 1] = inward[3 * t + 2], outward[3 * t + 2] = inward[3 * t + 1];
+    lmgi_mesh_desc meshes[2] = {
+        {.name = "room", .positions = room, .vertex_count = 8, .indices = inward, .triangle_count = 12},
+        {.name = "block", .positions = block, .vertex_count = 8, .indices = outward, .triangle_count = 12,
+         .material = 1}};
+    lmgi_material_desc mats[2] = {{.name = "plaster", .base_color = {0.7f, 0.7f, 0.7f, 1.0f}},
+                                  {.name = "red", .base_color = {0.8f, 0.2f, 0.1f, 1.0f}}};
+    lmgi_scene_desc d = {.name = "room", .meshes = meshes, .mesh_count = 2, .materials = mats, .material_count = 2,
+                         .lights = lights, .light_count = light_count};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 1500;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
+static lmgi_updater *make_updater(lmgi_context *ctx, lmgi_scene *sc)
+{
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.photons_per_group = 100;
+    d.hemicube_resolution = 16;
+    d.rim_samples = 16;
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
+static float *get_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    *n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(*n * sizeof *rgba);
+    lmgi_error e;
+    assert_non_null(rgba);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, *n, &e), LMGI_OK);
+    return rgba;
+}
+
+static void bake(lmgi_updater *u, lmgi_bake_report *r)
+{
+    lmgi_error e;
+    if (lmgi_bake(u, NULL, r, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+}
+
+/* Mean irradiance (R + G + B) of the valid texels of `node`. */
+static double node_mean(const lmgi_scene *sc, const float *iim, const char *node)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    int want = lmgi_find_node(sc, node);
+    double sum = 0.0;
+    int n = 0;
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        const float *p = iim + 4 * ((size_t)t.y * in.atlas_width + t.x);
+        lmgi_hit h;
+        float org[3], dir[3];
+        for (int k = 0; k < 3; k++)
+            org[k] = t.position[k] + 1e-3f * t.normal[k], dir[k] = -t.normal[k];
+        lmgi_intersect(sc, org, dir, 1e-2f, &h);
+        if (p[3] < 0.5f || !h.hit || h.node != want)
+            continue;
+        sum += p[0] + p[1] + p[2];
+        n++;
+    }
+    assert_true(n > 20);
+    return sum / n;
+}
+
+/* A camera in the room's corner at (1.9, 2, 1.9) looking at (-1, 0.5, -1), 90 degrees wide. */
+static void corner_camera(lmgi_camera *cam)
+{
+    float eye[3] = {1.9f, 2.0f, 1.9f}, at[3] = {-1.0f, 0.5f, -1.0f}, f[3], r[3], up[3], l = 0.0f, m = 0.0f;
+    for (int k = 0; k < 3; k++)
+        f[k] = at[k] - eye[k], l += f[k] * f[k];
+    for (int k = 0; k < 3; k++)
+        f[k] /= sqrtf(l);
+    r[0] = -f[2], r[1] = 0.0f, r[2] = f[0]; /* f x (0, 1, 0) */
+    m = sqrtf(r[0] * r[0] + r[2] * r[2]);
+    r[0] /= m, r[2] /= m;
+    up[0] = r[1] * f[2] - r[2] * f[1], up[1] = r[2] * f[0] - r[0] * f[2], up[2] = r[0] * f[1] - r[1] * f[0];
+    memset(cam, 0, sizeof *cam);
+    for (int k = 0; k < 3; k++) {
+        cam->view[4 * k] = r[k], cam->view[4 * k + 1] = up[k], cam->view[4 * k + 2] = -f[k];
+        cam->view[12] -= r[k] * eye[k], cam->view[13] -= up[k] * eye[k], cam->view[14] += f[k] * eye[k];
+    }
+    cam->view[15] = 1.0f;
+    float n = 0.05f, fa = 20.0f; /* tan(45 deg) = 1 */
+    cam->proj[0] = cam->proj[5] = 1.0f;
+    cam->proj[10] = -(fa + n) / (fa - n), cam->proj[11] = -1.0f, cam->proj[14] = -2.0f * fa * n / (fa - n);
+}
+
+/* The frame's mean (R + G + B) from the room's corner. */
+static double frame_mean(lmgi_updater *u, const lmgi_scene *sc)
+{
+    (void)sc;
+    lmgi_camera cam;
+    lmgi_error e;
+    corner_camera(&cam);
+    float *rgb = malloc(3 * SIDE * SIDE * sizeof *rgb);
+    assert_non_null(rgb);
+    assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, rgb, &e), LMGI_OK);
+    double sum = 0.0;
+    for (int i = 0; i < 3 * SIDE * SIDE; i++)
+        sum += rgb[i];
+    free(rgb);
+    return sum / (SIDE * SIDE);
+}
+
+static lmgi_light light_of(const lmgi_light_desc *d)
+{
+    lmgi_light l;
+    memset(&l, 0, sizeof l);
+    l.type = (lmgi_light_type)d->type;
+    memcpy(l.color, d->color, sizeof l.color);
+    l.intensity = d->intensity;
+    l.inner_cone = d->inner_cone, l.outer_cone = d->outer_cone;
+    l.enabled = 1;
+    memcpy(l.position, d->position, sizeof l.position);
+    memcpy(l.direction, d->direction, sizeof l.direction);
+    return l;
+}
+
+static void expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
+{
+    assert_int_equal(st, LMGI_ERR_INVALID);
+    if (!strstr(e->message, words))
+        fail_msg("'%s' does not name '%s'", e->message, words);
+}
+
+static void test_add_and_remove(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    const lmgi_light_desc both[2] = {LAMP, SPOT};
+    lmgi_scene *loaded = load_room(both, 2);
+    lmgi_updater *ul = make_updater(ctx, loaded);
+    size_t n;
+    float *want = get_iim(ul, loaded, &n);
+    double want_frame = frame_mean(ul, loaded);
+
+    lmgi_scene *sc = load_room(&LAMP, 1);
+    lmgi_updater *u = make_updater(ctx, sc);
+    float *before = get_iim(u, sc, &n);
+    lmgi_updater_info info0, info1;
+    lmgi_get_updater_info(u, &info0);
+
+    lmgi_light spot = light_of(&SPOT);
+    int id = -2;
+    assert_int_equal(lmgi_add_light(sc, &spot, &id, &e), LMGI_OK);
+    assert_int_equal(id, 1);
+    assert_int_equal(lmgi_light_count(sc), 2);
+    lmgi_light got;
+    assert_int_equal(lmgi_get_light(sc, id, &got, &e), LMGI_OK);
+    float len = sqrtf(SPOT.direction[0] * SPOT.direction[0] + SPOT.direction[1] * SPOT.direction[1] +
+                      SPOT.direction[2] * SPOT.direction[2]);
+    assert_int_equal(got.node, -1);
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(got.position[k], SPOT.position[k], 1e-6);
+        assert_float_equal(got.direction[k], SPOT.direction[k] / len, 1e-6);
+    }
+    lmgi_bake_report r;
+    bake(u, &r);
+    lmgi_get_updater_info(u, &info1);
+    uint32_t added = info1.photons - info0.photons;
+    print_message("the added spot: %u photons (the lamp has %u), %u paths changed of %u traced, %d surfaces\n",
+                  added, info0.photons, r.photons_changed, r.photons_traced, r.surfaces_changed);
+    assert_true(added > 0);
+    assert_true(r.photons_changed <= added && r.photons_changed > added / 2); /* its photons, no other's */
+    float *with = get_iim(u, sc, &n);
+    const char *nodes[2] = {"room", "block"};
+    for (int k = 0; k < 2; k++) {
+        double a = node_mean(sc, with, nodes[k]), b = node_mean(loaded, want, nodes[k]);
+        print_message("%s: added %.4f, loaded %.4f (%+.1f%%), before %.4f\n", nodes[k], a, b, 100.0 * (a / b - 1.0),
+                      node_mean(sc, before, nodes[k]));
+        assert_true(fabs(a / b - 1.0) < 0.03);
+    }
+    double frame = frame_mean(u, sc);
+    print_message("frame: added %.4f, loaded %.4f\n", frame, want_frame);
+    assert_true(fabs(frame / want_frame - 1.0) < 0.02);
+
+    /* the same edits on the same scene: the same lightmap, to the bit */
+    lmgi_scene *again = load_room(&LAMP, 1);
+    lmgi_updater_free(ul);
+    lmgi_free(loaded);
+    ul = make_updater(ctx, again);
+    assert_int_equal(lmgi_add_light(again, &spot, &id, &e), LMGI_OK);
+    bake(ul, &r);
+    float *same = get_iim(ul, again, &n);
+    assert_memory_equal(same, with, n * sizeof *same);
+
+    /* exported for an engine: the added spot comes back as a light of its own node, where it was put */
+    lmgi_export_desc x = {.name = "room", .force = 1};
+    char dir[64], path[1200];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    assert_int_equal(lmgi_export_gltf(u, dir, &x, &e), LMGI_OK);
+    snprintf(path, sizeof path, "%s/room.gltf", dir);
+    lmgi_scene *copy = NULL;
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.use_file_uv1 = 1;
+    if (lmgi_load(path, &o, &copy, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    assert_int_equal(lmgi_light_count(copy), 2);
+    lmgi_light back;
+    assert_int_equal(lmgi_get_light(copy, 1, &back, &e), LMGI_OK);
+    assert_int_equal(back.type, LMGI_LIGHT_SPOT);
+    assert_true(back.node >= 0);
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(back.position[k], got.position[k], 1e-5);
+        assert_float_equal(back.direction[k], got.direction[k], 1e-5);
+        assert_float_equal(back.color[k], got.color[k], 1e-6);
+    }
+    assert_float_equal(back.outer_cone, got.outer_cone, 1e-6);
+    lmgi_free(copy);
+
+    /* moved: only its photons are traced again */
+    assert_int_equal(lmgi_get_light(sc, 1, &got, &e), LMGI_OK);
+    got.position[0] = -0.5f;
+    assert_int_equal(lmgi_set_light(sc, 1, &got, &e), LMGI_OK);
+    bake(u, &r);
+    assert_true(r.photons_changed <= added && r.photons_changed > 0);
+    assert_int_equal(lmgi_get_light(sc, 1, &got, &e), LMGI_OK);
+    assert_float_equal(got.position[0], -0.5f, 1e-6);
+
+    /* removed: the lightmap from before it came, but for the order of sums and the texels that see a change
+     * below the one a bake regathers for (a thousandth of the stored energy: update/photon_stage.c) */
+    assert_int_equal(lmgi_remove_light(sc, 1, &e), LMGI_OK);
+    assert_true(lmgi_light_is_removed(sc, 1) && !lmgi_light_is_removed(sc, 0));
+    bake(u, &r);
+    assert_true(r.photons_changed <= added);
+    float *after = get_iim(u, sc, &n);
+    double worst = 0.0;
+    int valid = 0, off = 0;
+    for (size_t i = 0; i < n; i += 4) {
+        if (before[i + 3] < 0.5f)
+            continue;
+        double d = 0.0;
+        for (int c = 0; c < 3; c++)
+            d = fmax(d, fabs((double)after[i + c] - before[i + c]) / (fabs((double)before[i + c]) + 1e-3));
+        worst = fmax(worst, d);
+        valid++;
+        off += d > 1e-4;
+    }
+    print_message("removed again: %d of %d texels more than 1e-4 from the lightmap before the add, the worst by %.2e\n",
+                  off, valid, worst);
+    assert_true(off <= valid / 100 && worst < 0.05);
+    for (int k = 0; k < 2; k++)
+        assert_float_equal(node_mean(sc, after, nodes[k]), node_mean(sc, before, nodes[k]),
+                           1e-3 * node_mean(sc, before, nodes[k]));
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    assert_int_equal(in.lights, 1);
+    assert_int_equal(lmgi_light_count(sc), 2); /* its id stays taken */
+
+    /* the file's own light removed: dark */
+    assert_int_equal(lmgi_remove_light(sc, 0, &e), LMGI_OK);
+    bake(u, &r);
+    float *dark = get_iim(u, sc, &n);
+    double most = 0.0;
+    for (size_t i = 0; i < n; i++)
+        most = fmax(most, fabs((double)dark[i] * (i % 4 != 3)));
+    assert_true(most == 0.0);
+    assert_true(frame_mean(u, sc) == 0.0);
+    assert_int_equal(lmgi_export_gltf(u, dir, &x, &e), LMGI_OK); /* no light left to export */
+    if (lmgi_load(path, &o, &copy, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_get_info(copy, &in);
+    assert_int_equal(in.lights, 0);
+    lmgi_free(copy);
+
+    /* bad lights and ids */
+    lmgi_light bad = light_of(&SPOT);
+    expect_invalid(lmgi_get_light(sc, 1, &got, &e), &e, "was removed");
+    expect_invalid(lmgi_set_light(sc, 1, &bad, &e), &e, "was removed");
+    expect_invalid(lmgi_remove_light(sc, 0, &e), &e, "was removed");
+    expect_invalid(lmgi_remove_light(sc, 7, &e), &e, "out of range");
+    bad.position[1] = NAN;
+    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "position");
+    assert_int_equal(id, -1);
+    bad = light_of(&SPOT);
+    memset(bad.direction, 0, sizeof bad.direction);
+    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "direction");
+    bad.type = LMGI_LIGHT_POINT; /* a point light needs none */
+    assert_int_equal(lmgi_add_light(sc, &bad, &id, &e), LMGI_OK);
+    assert_int_equal(id, 2);
+    expect_invalid(lmgi_set_light(sc, 2, &bad, &e), &e, "fixed"); /* bad.node 0: not its node, -1 */
+    bad = light_of(&SPOT);
+    bad.type = (lmgi_light_type)3;
+    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "type 3");
+    bad = light_of(&SPOT);
+    bad.outer_cone = 0.1f;
+    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "cones");
+    expect_invalid(lmgi_add_light(sc, &bad, NULL, &e), &e, "NULL");
+    expect_invalid(lmgi_add_light(NULL, &bad, &id, &e), &e, "NULL");
+    assert_int_equal(lmgi_light_count(sc), 3); /* nothing added by the refused calls */
+
+    free(want), free(before), free(with), free(same), free(after), free(dark);
+    lmgi_updater_free(ul);
+    lmgi_free(again);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A light added in room A of the two rooms, door closed, and removed again: room B's lightmap and its
+ * surfaces' versions stay as they were, to the bit (an edit costs only what it reaches). */
+static void test_added_light_stays_in_its_room(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 3000;
+    lmgi_scene *sc = NULL;
+    if (lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_updater *u = make_updater(ctx, sc);
+    size_t n;
+    float *iim0 = get_iim(u, sc, &n);
+    int surfaces = lmgi_surface_count(sc);
+    uint32_t *ver0 = calloc((size_t)surfaces, sizeof *ver0);
+    for (int s = 0; s < surfaces; s++)
+        ver0[s] = lmgi_surface_version(u, s);
+    lmgi_light a1;
+    int id = -1;
+    for (int l = 0; l < lmgi_light_count(sc); l++)
+        if (lmgi_get_light(sc, l, &a1, &e) == LMGI_OK && !strcmp(lmgi_node_name(sc, a1.node), "light_a1"))
+            id = l;
+    assert_int_equal(lmgi_get_light(sc, id, &a1, &e), LMGI_OK);
+    lmgi_light lamp = {.type = LMGI_LIGHT_POINT, .color = {1.0f, 0.5f, 0.2f}, .intensity = 2.0f * a1.intensity,
+                       .enabled = 1, .position = {a1.position[0] + 0.5f, a1.position[1] - 0.5f, a1.position[2]}};
+    assert_true(lamp.position[0] < -0.5f); /* in room A */
+    assert_int_equal(lmgi_add_light(sc, &lamp, &id, &e), LMGI_OK);
+    lmgi_bake_report r;
+    bake(u, &r);
+    float *iim1 = get_iim(u, sc, &n);
+    assert_int_equal(lmgi_remove_light(sc, id, &e), LMGI_OK);
+    lmgi_bake_report r2;
+    bake(u, &r2);
+    float *iim2 = get_iim(u, sc, &n);
+
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    uint8_t *reaches_a = calloc((size_t)surfaces, 1); /* room B's surfaces reaching into the doorway */
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        reaches_a[t.surface] |= t.position[0] < 0.2f;
+    }
+    int b_texels = 0;
+    double a_before = 0.0, a_with = 0.0;
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        size_t k = 4 * ((size_t)t.y * in.atlas_width + t.x);
+        if (t.position[0] > 0.2f && !reaches_a[t.surface]) {
+            b_texels++;
+            assert_memory_equal(iim0 + k, iim1 + k, 4 * sizeof *iim0);
+            assert_memory_equal(iim0 + k, iim2 + k, 4 * sizeof *iim0);
+            assert_int_equal(lmgi_surface_version(u, t.surface), ver0[t.surface]);
+        } else if (t.position[0] < -0.2f) {
+            a_before += iim0[k] + iim0[k + 1] + iim0[k + 2];
+            a_with += iim1[k] + iim1[k + 1] + iim1[k + 2];
+        }
+    }
+    print_message("a lamp added in room A: its indirect light x%.3f, %u texels regathered (%d surfaces changed); "
+                  "%d texels of room B untouched; removed: %u texels regathered\n", a_with / a_before,
+                  r.texels_gathered, r.surfaces_changed, b_texels, r2.texels_gathered);
+    assert_true(b_texels > 100);
+    assert_true(a_with > 1.1 * a_before);
+    assert_true(r.texels_gathered > 0 && r.texels_gathered < in.texels * 3 / 4);
+    free(iim0), free(iim1), free(iim2), free(ver0), free(reaches_a);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_add_and_remove),
+        cmocka_unit_test(test_added_light_stays_in_its_room),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
