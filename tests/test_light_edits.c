@@ -353,6 +353,44 @@ static void test_add_and_remove(void **state)
     lmgi_context_free(ctx);
 }
 
+/* A level that starts without any light (an editor's empty level) is lit by the first light added, with
+ * the desc's photons per group, and shows it in the frame. */
+static void test_first_light(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_scene *sc = load_room(NULL, 0);
+    lmgi_updater *u = make_updater(ctx, sc);
+    size_t n;
+    float *dark = get_iim(u, sc, &n);
+    assert_true(node_mean(sc, dark, "room") == 0.0);
+    lmgi_light lamp = light_of(&LAMP);
+    int id = -1;
+    assert_int_equal(lmgi_add_light(sc, &lamp, &id, &e), LMGI_OK);
+    assert_int_equal(id, 0);
+    lmgi_bake_report r;
+    bake(u, &r);
+    lmgi_updater_info info;
+    lmgi_get_updater_info(u, &info);
+    assert_int_equal(info.photons, 72 * 100); /* photons_per_group x the default 72 groups */
+    float *lit = get_iim(u, sc, &n);
+    lmgi_scene *loaded = load_room(&LAMP, 1);
+    lmgi_updater *ul = make_updater(ctx, loaded);
+    float *want = get_iim(ul, loaded, &n);
+    double a = node_mean(sc, lit, "room"), b = node_mean(loaded, want, "room");
+    print_message("the first light of an empty room: %.4f, loaded with it %.4f\n", a, b);
+    assert_true(fabs(a / b - 1.0) < 1e-3); /* the same photons, in another order of sums */
+    assert_true(frame_mean(u, sc) > 0.5 * frame_mean(ul, loaded));
+    free(dark), free(lit), free(want);
+    lmgi_updater_free(ul);
+    lmgi_free(loaded);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* A light added in room A of the two rooms, door closed, and removed again: room B's lightmap and its
  * surfaces' versions stay as they were, to the bit (an edit costs only what it reaches). */
 static void test_added_light_stays_in_its_room(void **state)
@@ -432,6 +470,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_add_and_remove),
+        cmocka_unit_test(test_first_light),
         cmocka_unit_test(test_added_light_stays_in_its_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
