@@ -148,6 +148,14 @@ LMGI_API int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);   /* 0 for
 LMGI_API int lmgi_get_node_transform(const lmgi_scene *scene, int node, float world[16]);
 /* NULL scene or world: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
+/* Switches a node and every node under it between static (0: in the static BVH, shadows cached) and
+ * dynamic (1: lmgi_set_node_transform may move it), where they are now. The ray-tracing BVH is rebuilt at
+ * once (as at load: milliseconds for thousands of triangles) and the direct pass's casters at the next
+ * frame; no photon, AIM or IIM work follows, since nothing moved. A node under a dynamic parent, or one
+ * with an animation driving it or a node under it, stays dynamic: LMGI_ERR_INVALID naming it; so is a
+ * dynamic other than 0 or 1 or an id out of range. Asking for what the nodes already are: LMGI_OK, nothing
+ * done. */
+LMGI_API lmgi_status lmgi_set_node_dynamic(lmgi_scene *scene, int node, int dynamic, lmgi_error *err);
 /* Lights (KHR_lights_punctual). A light of the file shines from its node (lmgi_set_node_transform moves
  * it; a node with no triangles in or under it may be moved even when static); a light added by
  * lmgi_add_light has no node and is placed by its own position and direction. Edits reach an updater at

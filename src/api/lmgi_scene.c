@@ -217,14 +217,42 @@ int lmgi_node_is_dynamic(const lmgi_scene *sc, int node)
  * move; a light's or camera's node without any may move freely). */
 static int carries_triangles(const lm_scene *s, int node)
 {
-    for (int i = 0; i < s->node_count; i++) {
-        if (s->nodes[i].tri_count == 0)
-            continue;
-        for (int p = i, steps = 0; p >= 0 && steps <= s->node_count; p = s->nodes[p].parent, steps++)
-            if (p == node)
-                return 1;
-    }
+    for (int i = 0; i < s->node_count; i++)
+        if (s->nodes[i].tri_count > 0 && lm_node_under(s, i, node))
+            return 1;
     return 0;
+}
+
+lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_error *err)
+{
+    if (!sc)
+        return lm_api_refuse(err, "lmgi_set_node_dynamic: the scene is NULL");
+    lm_scene *s = sc->scene;
+    if (node < 0 || node >= s->node_count)
+        return lm_api_refuse(err, "node id %d is out of range (scene has %d nodes)", node, s->node_count);
+    const lm_node *n = &s->nodes[node];
+    if (dynamic != 0 && dynamic != 1)
+        return lm_api_refuse(err, "node '%s': dynamic is 0 or 1, not %d", n->name, dynamic);
+    int same = 1;
+    for (int i = 0; i < s->node_count; i++)
+        same &= !lm_node_under(s, i, node) || s->nodes[i].dynamic == dynamic;
+    if (same)
+        return LMGI_OK; /* nothing to rebuild */
+    if (!dynamic && n->parent >= 0 && s->nodes[n->parent].dynamic)
+        return lm_api_refuse(err, "node '%s' lies under dynamic node '%s', which moves it: it stays dynamic", n->name,
+                             s->nodes[n->parent].name);
+    if (!dynamic && lm_node_animated_under(s, node))
+        return lm_api_refuse(err, "node '%s' (or a node under it) is animated: it stays dynamic", n->name);
+    if (sc->updater) /* its photon work traces rays in the BVH about to be rebuilt */
+        lm_updater_sync(sc->updater);
+    lm_scene_set_dynamic(s, node, dynamic);
+    lm_error e;
+    if (lm_rt_rebuild(sc->rt, &e) != LM_OK) {
+        lm_scene_set_dynamic(s, node, !dynamic); /* the old BVH is still in place */
+        return lm_export_error(err, &e);
+    }
+    lm_effects_decide(s, &sc->effects);
+    return LMGI_OK;
 }
 
 lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[16], lmgi_error *err)

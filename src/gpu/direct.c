@@ -59,6 +59,7 @@ struct lm_direct {
     unsigned long dynamic_version; /* bumped whenever a dynamic shadow-casting node moves */
     long maps_rendered;
     int has_lightmap;       /* the mesh carries lightmap uvs (an atlas at lm_direct_create) */
+    const lm_atlas *atlas;  /* that atlas (borrowed), for a rebuild of the mesh */
     unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
     float *scratch;         /* read-back, width x height RGBA */
     size_t scratch_px;
@@ -309,6 +310,7 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
     if (st == LM_OK)
         st = lm_direct_mesh_build(&d->mesh, s, a, err);
     d->has_lightmap = a != NULL;
+    d->atlas = a;
     if (st == LM_OK)
         st = lm_gl_check("direct_light: setup", err);
     if (st != LM_OK) {
@@ -364,6 +366,15 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     if (width <= 0 || height <= 0)
         return lm_fail(err, LM_ERR_INVALID, "direct_light: bad size %dx%d", width, height);
     lm_status st = ensure_maps(d, em->count, err);
+    if (st == LM_OK && d->mesh.motion_version != s->motion_version) {
+        /* nodes switched between static and dynamic: the casters split again, every shadow redrawn */
+        lm_direct_mesh fresh;
+        if ((st = lm_direct_mesh_build(&fresh, s, d->atlas, err)) == LM_OK) {
+            lm_direct_mesh_free(&d->mesh);
+            d->mesh = fresh;
+            d->static_version++, d->dynamic_version++;
+        }
+    }
     if (st != LM_OK)
         return st;
     int moved = lm_direct_mesh_update(&d->mesh, s);

@@ -271,3 +271,30 @@ const char *lm_light_type_name(lm_light_type t)
     }
     return "unknown";
 }
+
+int lm_node_under(const lm_scene *s, int node, int ancestor)
+{
+    for (int steps = 0; node >= 0 && node < s->node_count && steps <= s->node_count; steps++) {
+        if (node == ancestor)
+            return 1;
+        node = s->nodes[node].parent; /* steps bound a cycle, which the loader refuses anyway */
+    }
+    return 0;
+}
+
+int lm_node_animated_under(const lm_scene *s, int node)
+{
+    for (int a = 0; a < s->animation_count; a++)
+        for (int c = 0; c < s->animations[a].channel_count; c++)
+            if (lm_node_under(s, s->animations[a].channels[c].node, node))
+                return 1;
+    return 0;
+}
+
+void lm_scene_set_dynamic(lm_scene *s, int node, int dynamic)
+{
+    for (int n = 0; n < s->node_count; n++)
+        if (lm_node_under(s, n, node))
+            s->nodes[n].dynamic = s->nodes[n].settings.dynamic = dynamic;
+    s->motion_version++;
+}

@@ -137,6 +137,8 @@ typedef struct {
     int material_count;
     lm_material *materials;
     uint32_t material_version; /* counts material edits: what copied materials (the GPU's) compare with */
+    uint32_t motion_version; /* counts switches of nodes between static and dynamic: what the structures
+                              * built on that split (the direct pass's casters) compare with */
     int texture_count;
     lm_texture *textures;
     int light_count;
@@ -214,6 +216,14 @@ void lm_scene_eval_animation(lm_scene *s, int anim, float t);
  * children follow) and marks it edited, so animations leave it alone until lm_scene_release_node. Returns
  * 0, changing nothing, when the parent's world matrix has no inverse. */
 int lm_scene_set_node_world(lm_scene *s, int node, const float world[16]);
+/* 1 when `node` is `ancestor` or lies under it. */
+int lm_node_under(const lm_scene *s, int node, int ancestor);
+/* 1 when an animation channel drives `node` or a node under it. */
+int lm_node_animated_under(const lm_scene *s, int node);
+/* Makes `node` and every node under it dynamic (1) or static (0), where they are now, and counts the
+ * switch in motion_version. The caller checks that it may (no animated node goes static, no node under a
+ * dynamic parent) and rebuilds what is built on the split (lm_rt_rebuild). */
+void lm_scene_set_dynamic(lm_scene *s, int node, int dynamic);
 /* Hands an edited node back to its animations (from the next lm_scene_eval_animation on). */
 void lm_scene_release_node(lm_scene *s, int node);
 /* The value (not a tangent) of key k of a channel: comps floats. */

@@ -173,7 +173,7 @@ static lm_status add_instance(lm_rt *rt, const lm_scene *s, int n, lm_error *err
     return LM_OK;
 }
 
-lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_error *err)
+static lm_status build(const lm_scene *s, const int *tri_surface, lm_rt **out, lm_error *err)
 {
     *out = NULL;
     lm_rt_thread_init();
@@ -181,7 +181,7 @@ lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_
     if (!rt)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the ray-tracing scene", s->path);
     rt->scene = s;
-    rt->tri_surface = su ? su->tri_surface : NULL;
+    rt->tri_surface = tri_surface;
     rt->device = rtcNewDevice(NULL);
     if (!rt->device) {
         free(rt);
@@ -223,6 +223,25 @@ lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_
         return st;
     }
     *out = rt;
+    return LM_OK;
+}
+
+lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_error *err)
+{
+    return build(s, su ? su->tri_surface : NULL, out, err);
+}
+
+lm_status lm_rt_rebuild(lm_rt *rt, lm_error *err)
+{
+    lm_rt *fresh = NULL;
+    lm_status st = build(rt->scene, rt->tri_surface, &fresh, err);
+    if (st != LM_OK)
+        return st;
+    lm_rt old = *rt; /* the new BVH moves into rt (whose address its users hold), the old one is freed */
+    *rt = *fresh;
+    *fresh = old;
+    rtcSetDeviceErrorFunction(rt->device, on_device_error, rt);
+    lm_rt_free(fresh);
     return LM_OK;
 }
 

@@ -32,6 +32,10 @@ typedef struct {
 /* Builds the BVHs from the scene's current node transforms. surfaces may be NULL (surface = -1). */
 lm_status lm_rt_build(const lm_scene *s, const lm_surfaces *su, lm_rt **out, lm_error *err);
 void lm_rt_free(lm_rt *rt);
+/* Builds the BVHs again from the scene as it is now, in place (rt's address stays, so whoever holds it
+ * keeps it): after nodes switched between static and dynamic. As lm_rt_build's cost; on a failure rt is
+ * as it was. Not while another thread traces rays in rt. */
+lm_status lm_rt_rebuild(lm_rt *rt, lm_error *err);
 
 /* Moves dynamic node `node` to world matrix `world` and commits the top level. Fails for a static
  * node, an out-of-range id or a non-finite matrix, naming the node. */
