@@ -50,7 +50,7 @@ DEV_C   := $(sort $(wildcard tools/dev/*.c))
 DEV_OBJ := $(DEV_C:%.c=$(BUILD)/obj/%.o) $(filter-out %/main.o,$(CLI_OBJ))
 TEST_C  := $(sort $(wildcard tests/test_*.c))
 TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
-TEST_SUPPORT := $(BUILD)/obj/tests/support.o
+TEST_SUPPORT := $(BUILD)/obj/tests/support.o $(BUILD)/obj/tests/edit_room.o
 
 .PHONY: all deps test test-asan demo bench scenes clean fuzz install install-files
 .PRECIOUS: $(BUILD)/obj/%.o

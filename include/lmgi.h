@@ -245,26 +245,33 @@ typedef struct {
 LMGI_API lmgi_status lmgi_load_desc(const lmgi_scene_desc *desc, const lmgi_options *o, lmgi_scene **out,
                                     lmgi_error *err);
 
-/* Materials. An edit of colour or emission reaches an updater at its next update: the photons that
- * touch the material are re-traced (no others), the AIMs of its surfaces refreshed, and the frame's
- * direct light and indirect term use the new colour at once. The class (diffuse, glossy, mirror, glass,
- * emitter) is fixed at load. */
+/* Materials. An edit reaches an updater at its next update: the photons that touch the material are
+ * re-traced (no others), the AIMs of its surfaces refreshed, and the frame's direct light and indirect
+ * term use the new material at once. The class (diffuse, glossy, mirror, glass, emitter) follows from
+ * metallic, roughness and transmission by the rule loading applies (docs/materials.md), so changing those
+ * may change it: a diffuse or glossy material may become any of the four (a mirror's or glass's
+ * triangles keep their lightmap texels, unused, so it may come back); one that was mirror or glass at
+ * load has no texels and stays mirror or glass; an emitter (emissive at load) stays an emitter. */
 typedef enum { LMGI_MATERIAL_DIFFUSE = 0, LMGI_MATERIAL_GLOSSY, LMGI_MATERIAL_MIRROR, LMGI_MATERIAL_GLASS,
                LMGI_MATERIAL_EMITTER } lmgi_material_class;
 typedef struct {
-    lmgi_material_class cls;  /* read only */
+    lmgi_material_class cls;  /* read only: what the parameters make (lmgi_set_material accepts the old
+                               * class or the new one here, and refuses any other) */
     float base_color[4];      /* linear RGBA factor, each in [0, 1] (a base colour texture multiplies it) */
     float emissive[3];        /* emitted radiance (emissiveFactor x strength), >= 0; non-zero only for a
                                * material that was emissive at load (its triangles are the emitters) */
-    float metallic, roughness; /* read only */
+    float metallic, roughness; /* each in [0, 1] (fixed for an emitter) */
+    float transmission;       /* KHR_materials_transmission, in [0, 1] (0.5 and above: glass) */
+    float ior;                /* KHR_materials_ior, in [1, 10] */
 } lmgi_material;
 LMGI_API int lmgi_material_count(const lmgi_scene *scene); /* 0 for NULL */
 LMGI_API const char *lmgi_material_name(const lmgi_scene *scene, int material); /* NULL when out of range */
 /* NULL argument or an id out of range: LMGI_ERR_INVALID (out zeroed when given). */
 LMGI_API lmgi_status lmgi_get_material(const lmgi_scene *scene, int material, lmgi_material *out, lmgi_error *err);
-/* Recolours a material or changes its emission. NaN, values out of range, emission on a material that
- * was not emissive at load, a class other than its own, or an id out of range: LMGI_ERR_INVALID, nothing
- * changed. */
+/* Recolours a material, changes its emission, or its class through metallic, roughness, transmission and
+ * ior. NaN or values out of range, emission on a material that was not emissive at load, a class the
+ * material cannot take (above), a cls that is neither its class nor the parameters', or an id out of
+ * range: LMGI_ERR_INVALID naming it, nothing changed. */
 LMGI_API lmgi_status lmgi_set_material(lmgi_scene *scene, int material, const lmgi_material *m, lmgi_error *err);
 
 /* Hands an edited node back to its animations from the next lmgi_set_time or update on. NULL scene or

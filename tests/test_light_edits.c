@@ -14,9 +14,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "edit_room.h"
 #include "support.h"
-
-#define SIDE 48
 
 static const lmgi_light_desc LAMP = {.name = "lamp", .type = LMGI_LIGHT_POINT, .color = {1.0f, 0.9f, 0.8f},
                                      .intensity = 4.0f, .position = {-1.0f, 2.5f, -1.0f}};
@@ -24,135 +23,22 @@ static const lmgi_light_desc SPOT = {.name = "spot", .type = LMGI_LIGHT_SPOT, .c
                                      .intensity = 12.0f, .inner_cone = 0.3f, .outer_cone = 0.7f,
                                      .position = {1.0f, 2.8f, 1.0f}, .direction = {-0.2f, -1.0f, 0.1f}};
 
-/* A closed room 4 x 3 x 4 (seen from inside) with a block in it, lit by `lights`. */
+/* The edit room (edit_room.h) with its block off centre, lit by `lights`. */
 static lmgi_scene *load_room(const lmgi_light_desc *lights, int light_count)
 {
-    float room[24], block[24];
-    for (int v = 0; v < 8; v++) {
-        room[3 * v] = v & 1 ? 2.0f : -2.0f, room[3 * v + 1] = v & 2 ? 3.0f : 0.0f, room[3 * v + 2] = v & 4 ? 2.0f : -2.0f;
-        block[3 * v] = v & 1 ? 0.9f : 0.1f, block[3 * v + 1] = v & 2 ? 1.0f : 0.0f,
-        block[3 * v + 2] = v & 4 ? -0.1f : -0.9f;
-    }
-    static const uint32_t inward[36] = {0, 1, 3, 0, 3, 2, 4, 6, 7, 4, 7, 5, 0, 4, 5, 0, 5, 1,
-                                         2, 3, 7, 2, 7, 6, 0, 2, 6, 0, 6, 4, 1, 5, 7, 1, 7, 3};
-    uint32_t outward[36];
-    for (int t = 0; t < 12; t++) /* the same faces wound the other way: their fronts face out */
-        outward[3 * t] = inward[3 * t], outward[3 * t + 1] = inward[3 * t + 2], outward[3 * t + 2] = inward[3 * t + 1];
-    lmgi_mesh_desc meshes[2] = {
-        {.name = "room", .positions = room, .vertex_count = 8, .indices = inward, .triangle_count = 12},
-        {.name = "block", .positions = block, .vertex_count = 8, .indices = outward, .triangle_count = 12,
-         .material = 1}};
-    lmgi_material_desc mats[2] = {{.name = "plaster", .base_color = {0.7f, 0.7f, 0.7f, 1.0f}},
-                                  {.name = "red", .base_color = {0.8f, 0.2f, 0.1f, 1.0f}}};
-    lmgi_scene_desc d = {.name = "room", .meshes = meshes, .mesh_count = 2, .materials = mats, .material_count = 2,
-                         .lights = lights, .light_count = light_count};
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 1500;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
+    lmt_room_spec spec = {.lights = lights, .light_count = light_count, .block_lo = {0.1f, 0.0f, -0.9f},
+                          .block_hi = {0.9f, 1.0f, -0.1f}};
+    return lmt_room(&spec);
 }
 
-static lmgi_updater *make_updater(lmgi_context *ctx, lmgi_scene *sc)
+static double frame_mean(lmgi_updater *u)
 {
-    lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
-    d.photons_per_group = 100;
-    d.hemicube_resolution = 16;
-    d.rim_samples = 16;
-    lmgi_updater *u = NULL;
-    lmgi_error e;
-    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return u;
-}
-
-static float *get_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n)
-{
-    lmgi_info in;
-    lmgi_get_info(sc, &in);
-    *n = 4 * (size_t)in.atlas_width * in.atlas_height;
-    float *rgba = malloc(*n * sizeof *rgba);
-    lmgi_error e;
-    assert_non_null(rgba);
-    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, *n, &e), LMGI_OK);
-    return rgba;
-}
-
-static void bake(lmgi_updater *u, lmgi_bake_report *r)
-{
-    lmgi_error e;
-    if (lmgi_bake(u, NULL, r, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-}
-
-/* Mean irradiance (R + G + B) of the valid texels of `node`. */
-static double node_mean(const lmgi_scene *sc, const float *iim, const char *node)
-{
-    lmgi_info in;
-    lmgi_get_info(sc, &in);
-    int want = lmgi_find_node(sc, node);
+    float *rgb = lmt_corner_frame(u);
     double sum = 0.0;
-    int n = 0;
-    for (uint32_t i = 0; i < in.texels; i++) {
-        lmgi_texel t;
-        lmgi_get_texel(sc, i, &t);
-        const float *p = iim + 4 * ((size_t)t.y * in.atlas_width + t.x);
-        lmgi_hit h;
-        float org[3], dir[3];
-        for (int k = 0; k < 3; k++)
-            org[k] = t.position[k] + 1e-3f * t.normal[k], dir[k] = -t.normal[k];
-        lmgi_intersect(sc, org, dir, 1e-2f, &h);
-        if (p[3] < 0.5f || !h.hit || h.node != want)
-            continue;
-        sum += p[0] + p[1] + p[2];
-        n++;
-    }
-    assert_true(n > 20);
-    return sum / n;
-}
-
-/* A camera in the room's corner at (1.9, 2, 1.9) looking at (-1, 0.5, -1), 90 degrees wide. */
-static void corner_camera(lmgi_camera *cam)
-{
-    float eye[3] = {1.9f, 2.0f, 1.9f}, at[3] = {-1.0f, 0.5f, -1.0f}, f[3], r[3], up[3], l = 0.0f, m = 0.0f;
-    for (int k = 0; k < 3; k++)
-        f[k] = at[k] - eye[k], l += f[k] * f[k];
-    for (int k = 0; k < 3; k++)
-        f[k] /= sqrtf(l);
-    r[0] = -f[2], r[1] = 0.0f, r[2] = f[0]; /* f x (0, 1, 0) */
-    m = sqrtf(r[0] * r[0] + r[2] * r[2]);
-    r[0] /= m, r[2] /= m;
-    up[0] = r[1] * f[2] - r[2] * f[1], up[1] = r[2] * f[0] - r[0] * f[2], up[2] = r[0] * f[1] - r[1] * f[0];
-    memset(cam, 0, sizeof *cam);
-    for (int k = 0; k < 3; k++) {
-        cam->view[4 * k] = r[k], cam->view[4 * k + 1] = up[k], cam->view[4 * k + 2] = -f[k];
-        cam->view[12] -= r[k] * eye[k], cam->view[13] -= up[k] * eye[k], cam->view[14] += f[k] * eye[k];
-    }
-    cam->view[15] = 1.0f;
-    float n = 0.05f, fa = 20.0f; /* tan(45 deg) = 1 */
-    cam->proj[0] = cam->proj[5] = 1.0f;
-    cam->proj[10] = -(fa + n) / (fa - n), cam->proj[11] = -1.0f, cam->proj[14] = -2.0f * fa * n / (fa - n);
-}
-
-/* The frame's mean (R + G + B) from the room's corner. */
-static double frame_mean(lmgi_updater *u, const lmgi_scene *sc)
-{
-    (void)sc;
-    lmgi_camera cam;
-    lmgi_error e;
-    corner_camera(&cam);
-    float *rgb = malloc(3 * SIDE * SIDE * sizeof *rgb);
-    assert_non_null(rgb);
-    assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, rgb, &e), LMGI_OK);
-    double sum = 0.0;
-    for (int i = 0; i < 3 * SIDE * SIDE; i++)
+    for (int i = 0; i < 3 * LMT_SIDE * LMT_SIDE; i++)
         sum += rgb[i];
     free(rgb);
-    return sum / (SIDE * SIDE);
+    return sum / (LMT_SIDE * LMT_SIDE);
 }
 
 static lmgi_light light_of(const lmgi_light_desc *d)
@@ -169,12 +55,6 @@ static lmgi_light light_of(const lmgi_light_desc *d)
     return l;
 }
 
-static void expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
-{
-    assert_int_equal(st, LMGI_ERR_INVALID);
-    if (!strstr(e->message, words))
-        fail_msg("'%s' does not name '%s'", e->message, words);
-}
 
 static void test_add_and_remove(void **state)
 {
@@ -184,14 +64,14 @@ static void test_add_and_remove(void **state)
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     const lmgi_light_desc both[2] = {LAMP, SPOT};
     lmgi_scene *loaded = load_room(both, 2);
-    lmgi_updater *ul = make_updater(ctx, loaded);
+    lmgi_updater *ul = lmt_room_updater(ctx, loaded);
     size_t n;
-    float *want = get_iim(ul, loaded, &n);
-    double want_frame = frame_mean(ul, loaded);
+    float *want = lmt_iim(ul, loaded, &n);
+    double want_frame = frame_mean(ul);
 
     lmgi_scene *sc = load_room(&LAMP, 1);
-    lmgi_updater *u = make_updater(ctx, sc);
-    float *before = get_iim(u, sc, &n);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    float *before = lmt_iim(u, sc, &n);
     lmgi_updater_info info0, info1;
     lmgi_get_updater_info(u, &info0);
 
@@ -210,22 +90,22 @@ static void test_add_and_remove(void **state)
         assert_float_equal(got.direction[k], SPOT.direction[k] / len, 1e-6);
     }
     lmgi_bake_report r;
-    bake(u, &r);
+    lmt_bake(u, &r);
     lmgi_get_updater_info(u, &info1);
     uint32_t added = info1.photons - info0.photons;
     print_message("the added spot: %u photons (the lamp has %u), %u paths changed of %u traced, %d surfaces\n",
                   added, info0.photons, r.photons_changed, r.photons_traced, r.surfaces_changed);
     assert_true(added > 0);
     assert_true(r.photons_changed <= added && r.photons_changed > added / 2); /* its photons, no other's */
-    float *with = get_iim(u, sc, &n);
+    float *with = lmt_iim(u, sc, &n);
     const char *nodes[2] = {"room", "block"};
     for (int k = 0; k < 2; k++) {
-        double a = node_mean(sc, with, nodes[k]), b = node_mean(loaded, want, nodes[k]);
+        double a = lmt_node_mean(sc, with, nodes[k]), b = lmt_node_mean(loaded, want, nodes[k]);
         print_message("%s: added %.4f, loaded %.4f (%+.1f%%), before %.4f\n", nodes[k], a, b, 100.0 * (a / b - 1.0),
-                      node_mean(sc, before, nodes[k]));
+                      lmt_node_mean(sc, before, nodes[k]));
         assert_true(fabs(a / b - 1.0) < 0.03);
     }
-    double frame = frame_mean(u, sc);
+    double frame = frame_mean(u);
     print_message("frame: added %.4f, loaded %.4f\n", frame, want_frame);
     assert_true(fabs(frame / want_frame - 1.0) < 0.02);
 
@@ -233,10 +113,10 @@ static void test_add_and_remove(void **state)
     lmgi_scene *again = load_room(&LAMP, 1);
     lmgi_updater_free(ul);
     lmgi_free(loaded);
-    ul = make_updater(ctx, again);
+    ul = lmt_room_updater(ctx, again);
     assert_int_equal(lmgi_add_light(again, &spot, &id, &e), LMGI_OK);
-    bake(ul, &r);
-    float *same = get_iim(ul, again, &n);
+    lmt_bake(ul, &r);
+    float *same = lmt_iim(ul, again, &n);
     assert_memory_equal(same, with, n * sizeof *same);
 
     /* exported for an engine: the added spot comes back as a light of its own node, where it was put */
@@ -268,7 +148,7 @@ static void test_add_and_remove(void **state)
     assert_int_equal(lmgi_get_light(sc, 1, &got, &e), LMGI_OK);
     got.position[0] = -0.5f;
     assert_int_equal(lmgi_set_light(sc, 1, &got, &e), LMGI_OK);
-    bake(u, &r);
+    lmt_bake(u, &r);
     assert_true(r.photons_changed <= added && r.photons_changed > 0);
     assert_int_equal(lmgi_get_light(sc, 1, &got, &e), LMGI_OK);
     assert_float_equal(got.position[0], -0.5f, 1e-6);
@@ -277,9 +157,9 @@ static void test_add_and_remove(void **state)
      * below the one a bake regathers for (a thousandth of the stored energy: update/photon_stage.c) */
     assert_int_equal(lmgi_remove_light(sc, 1, &e), LMGI_OK);
     assert_true(lmgi_light_is_removed(sc, 1) && !lmgi_light_is_removed(sc, 0));
-    bake(u, &r);
+    lmt_bake(u, &r);
     assert_true(r.photons_changed <= added);
-    float *after = get_iim(u, sc, &n);
+    float *after = lmt_iim(u, sc, &n);
     double worst = 0.0;
     int valid = 0, off = 0;
     for (size_t i = 0; i < n; i += 4) {
@@ -296,8 +176,8 @@ static void test_add_and_remove(void **state)
                   off, valid, worst);
     assert_true(off <= valid / 100 && worst < 0.05);
     for (int k = 0; k < 2; k++)
-        assert_float_equal(node_mean(sc, after, nodes[k]), node_mean(sc, before, nodes[k]),
-                           1e-3 * node_mean(sc, before, nodes[k]));
+        assert_float_equal(lmt_node_mean(sc, after, nodes[k]), lmt_node_mean(sc, before, nodes[k]),
+                           1e-3 * lmt_node_mean(sc, before, nodes[k]));
     lmgi_info in;
     lmgi_get_info(sc, &in);
     assert_int_equal(in.lights, 1);
@@ -305,13 +185,13 @@ static void test_add_and_remove(void **state)
 
     /* the file's own light removed: dark */
     assert_int_equal(lmgi_remove_light(sc, 0, &e), LMGI_OK);
-    bake(u, &r);
-    float *dark = get_iim(u, sc, &n);
+    lmt_bake(u, &r);
+    float *dark = lmt_iim(u, sc, &n);
     double most = 0.0;
     for (size_t i = 0; i < n; i++)
         most = fmax(most, fabs((double)dark[i] * (i % 4 != 3)));
     assert_true(most == 0.0);
-    assert_true(frame_mean(u, sc) == 0.0);
+    assert_true(frame_mean(u) == 0.0);
     assert_int_equal(lmgi_export_gltf(u, dir, &x, &e), LMGI_OK); /* no light left to export */
     if (lmgi_load(path, &o, &copy, &e) != LMGI_OK)
         fail_msg("%s", e.message);
@@ -321,28 +201,28 @@ static void test_add_and_remove(void **state)
 
     /* bad lights and ids */
     lmgi_light bad = light_of(&SPOT);
-    expect_invalid(lmgi_get_light(sc, 1, &got, &e), &e, "was removed");
-    expect_invalid(lmgi_set_light(sc, 1, &bad, &e), &e, "was removed");
-    expect_invalid(lmgi_remove_light(sc, 0, &e), &e, "was removed");
-    expect_invalid(lmgi_remove_light(sc, 7, &e), &e, "out of range");
+    lmt_expect_invalid(lmgi_get_light(sc, 1, &got, &e), &e, "was removed");
+    lmt_expect_invalid(lmgi_set_light(sc, 1, &bad, &e), &e, "was removed");
+    lmt_expect_invalid(lmgi_remove_light(sc, 0, &e), &e, "was removed");
+    lmt_expect_invalid(lmgi_remove_light(sc, 7, &e), &e, "out of range");
     bad.position[1] = NAN;
-    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "position");
+    lmt_expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "position");
     assert_int_equal(id, -1);
     bad = light_of(&SPOT);
     memset(bad.direction, 0, sizeof bad.direction);
-    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "direction");
+    lmt_expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "direction");
     bad.type = LMGI_LIGHT_POINT; /* a point light needs none */
     assert_int_equal(lmgi_add_light(sc, &bad, &id, &e), LMGI_OK);
     assert_int_equal(id, 2);
-    expect_invalid(lmgi_set_light(sc, 2, &bad, &e), &e, "fixed"); /* bad.node 0: not its node, -1 */
+    lmt_expect_invalid(lmgi_set_light(sc, 2, &bad, &e), &e, "fixed"); /* bad.node 0: not its node, -1 */
     bad = light_of(&SPOT);
     bad.type = (lmgi_light_type)3;
-    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "type 3");
+    lmt_expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "type 3");
     bad = light_of(&SPOT);
     bad.outer_cone = 0.1f;
-    expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "cones");
-    expect_invalid(lmgi_add_light(sc, &bad, NULL, &e), &e, "NULL");
-    expect_invalid(lmgi_add_light(NULL, &bad, &id, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "cones");
+    lmt_expect_invalid(lmgi_add_light(sc, &bad, NULL, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_add_light(NULL, &bad, &id, &e), &e, "NULL");
     assert_int_equal(lmgi_light_count(sc), 3); /* nothing added by the refused calls */
 
     free(want), free(before), free(with), free(same), free(after), free(dark);
@@ -362,27 +242,27 @@ static void test_first_light(void **state)
     lmgi_error e;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_scene *sc = load_room(NULL, 0);
-    lmgi_updater *u = make_updater(ctx, sc);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
     size_t n;
-    float *dark = get_iim(u, sc, &n);
-    assert_true(node_mean(sc, dark, "room") == 0.0);
+    float *dark = lmt_iim(u, sc, &n);
+    assert_true(lmt_node_mean(sc, dark, "room") == 0.0);
     lmgi_light lamp = light_of(&LAMP);
     int id = -1;
     assert_int_equal(lmgi_add_light(sc, &lamp, &id, &e), LMGI_OK);
     assert_int_equal(id, 0);
     lmgi_bake_report r;
-    bake(u, &r);
+    lmt_bake(u, &r);
     lmgi_updater_info info;
     lmgi_get_updater_info(u, &info);
     assert_int_equal(info.photons, 72 * 100); /* photons_per_group x the default 72 groups */
-    float *lit = get_iim(u, sc, &n);
+    float *lit = lmt_iim(u, sc, &n);
     lmgi_scene *loaded = load_room(&LAMP, 1);
-    lmgi_updater *ul = make_updater(ctx, loaded);
-    float *want = get_iim(ul, loaded, &n);
-    double a = node_mean(sc, lit, "room"), b = node_mean(loaded, want, "room");
+    lmgi_updater *ul = lmt_room_updater(ctx, loaded);
+    float *want = lmt_iim(ul, loaded, &n);
+    double a = lmt_node_mean(sc, lit, "room"), b = lmt_node_mean(loaded, want, "room");
     print_message("the first light of an empty room: %.4f, loaded with it %.4f\n", a, b);
     assert_true(fabs(a / b - 1.0) < 1e-3); /* the same photons, in another order of sums */
-    assert_true(frame_mean(u, sc) > 0.5 * frame_mean(ul, loaded));
+    assert_true(frame_mean(u) > 0.5 * frame_mean(ul));
     free(dark), free(lit), free(want);
     lmgi_updater_free(ul);
     lmgi_free(loaded);
@@ -405,9 +285,9 @@ static void test_added_light_stays_in_its_room(void **state)
     lmgi_scene *sc = NULL;
     if (lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &sc, &e) != LMGI_OK)
         fail_msg("%s", e.message);
-    lmgi_updater *u = make_updater(ctx, sc);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
     size_t n;
-    float *iim0 = get_iim(u, sc, &n);
+    float *iim0 = lmt_iim(u, sc, &n);
     int surfaces = lmgi_surface_count(sc);
     uint32_t *ver0 = calloc((size_t)surfaces, sizeof *ver0);
     for (int s = 0; s < surfaces; s++)
@@ -423,12 +303,12 @@ static void test_added_light_stays_in_its_room(void **state)
     assert_true(lamp.position[0] < -0.5f); /* in room A */
     assert_int_equal(lmgi_add_light(sc, &lamp, &id, &e), LMGI_OK);
     lmgi_bake_report r;
-    bake(u, &r);
-    float *iim1 = get_iim(u, sc, &n);
+    lmt_bake(u, &r);
+    float *iim1 = lmt_iim(u, sc, &n);
     assert_int_equal(lmgi_remove_light(sc, id, &e), LMGI_OK);
     lmgi_bake_report r2;
-    bake(u, &r2);
-    float *iim2 = get_iim(u, sc, &n);
+    lmt_bake(u, &r2);
+    float *iim2 = lmt_iim(u, sc, &n);
 
     lmgi_info in;
     lmgi_get_info(sc, &in);

@@ -204,6 +204,35 @@ lmgi_status lmgi_get_material(const lmgi_scene *sc, int material, lmgi_material 
     memcpy(out->emissive, m->emissive, sizeof out->emissive);
     out->metallic = m->metallic;
     out->roughness = m->roughness;
+    out->transmission = m->transmission;
+    out->ior = m->ior;
+    return LMGI_OK;
+}
+
+/* The class in's parameters give m by the load's rule (docs/materials.md), or why m cannot take them. */
+static lmgi_status new_class(const lm_material *m, const lmgi_material *in, lm_material_class *out, lmgi_error *err)
+{
+    int same = in->metallic == m->metallic && in->roughness == m->roughness &&
+               in->transmission == m->transmission && in->ior == m->ior;
+    if (m->cls == LM_MAT_EMITTER) { /* its triangles are the emitters: only its emission and colour change */
+        *out = LM_MAT_EMITTER;
+        return same ? LMGI_OK : lm_api_refuse(err, "material '%s' is an emitter: its triangles emit, and its class "
+                                              "(metallic, roughness, transmission, ior) is fixed", m->name);
+    }
+    lm_material probe = *m;
+    probe.metallic = in->metallic, probe.roughness = in->roughness;
+    probe.transmission = in->transmission, probe.ior = in->ior;
+    memset(probe.emissive, 0, sizeof probe.emissive);
+    *out = lm_material_classify(&probe);
+    int lightmap = *out != LM_MAT_MIRROR && *out != LM_MAT_GLASS;
+    if (lightmap && !m->lightmapped)
+        return lm_api_refuse(err, "material '%s' was %s at load, so its triangles have no lightmap texels and it "
+                             "cannot become %s (mirror and glass it may; load the scene with the new material)",
+                             m->name, lm_material_class_name(m->cls), lm_material_class_name(*out));
+    if ((int)in->cls != (int)m->cls && (int)in->cls != (int)*out)
+        return lm_api_refuse(err, "material '%s': its class is read only (cls): metallic %g, roughness %g and transmission %g "
+                             "make it %s (docs/materials.md)", m->name, (double)in->metallic, (double)in->roughness,
+                             (double)in->transmission, lm_material_class_name(*out));
     return LMGI_OK;
 }
 
@@ -215,8 +244,6 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
         return lm_api_refuse(err, "material id %d is out of range (scene has %d materials)", material,
                       sc->scene->material_count);
     lm_material *m = &sc->scene->materials[material];
-    if ((int)in->cls != (int)m->cls)
-        return lm_api_refuse(err, "material '%s': its class is fixed at load", m->name);
     for (int c = 0; c < 4; c++)
         if (!in_range(in->base_color[c], 0.0f, 1.0f))
             return lm_api_refuse(err, "material '%s': base colour %g must be in [0, 1]", m->name, (double)in->base_color[c]);
@@ -228,10 +255,26 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
             return lm_api_refuse(err, "material '%s' was not emissive at load: its triangles are not emitters, so it "
                           "cannot start to emit", m->name);
     }
+    if (!in_range(in->metallic, 0.0f, 1.0f) || !in_range(in->roughness, 0.0f, 1.0f) ||
+        !in_range(in->transmission, 0.0f, 1.0f) || !(in_range(in->ior, 1.0f, 10.0f) || in->ior == m->ior))
+        return lm_api_refuse(err, "material '%s': metallic %g, roughness %g and transmission %g must be in [0, 1], "
+                             "ior %g in [1, 10]", m->name, (double)in->metallic, (double)in->roughness,
+                             (double)in->transmission, (double)in->ior);
+    lm_material_class cls;
+    lmgi_status st = new_class(m, in, &cls, err);
+    if (st != LMGI_OK)
+        return st;
     if (sc->updater) /* its photon work reads the materials */
         lm_updater_sync(sc->updater);
     memcpy(m->base_color, in->base_color, sizeof m->base_color);
     memcpy(m->emissive, in->emissive, sizeof m->emissive);
+    m->metallic = in->metallic, m->roughness = in->roughness;
+    m->transmission = in->transmission, m->ior = in->ior;
     sc->scene->material_version++;
+    if (cls != m->cls) {
+        m->cls = cls;
+        sc->scene->class_version++;
+        lm_effects_decide(sc->scene, &sc->effects);
+    }
     return LMGI_OK;
 }

@@ -49,6 +49,8 @@ typedef struct {
     int split_sides;       /* double-sided in the file, not specular: each of its triangles has a twin
                             * facing the other way (lm_scene.tri_twin), and both are single-sided */
     lm_material_class cls;
+    int lightmapped;       /* its triangles got lightmap texels at load (it was not mirror or glass then):
+                            * what an edit of its class may rely on */
 } lm_material;
 
 typedef enum { LM_LIGHT_POINT = 0, LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL } lm_light_type;
@@ -137,6 +139,8 @@ typedef struct {
     int material_count;
     lm_material *materials;
     uint32_t material_version; /* counts material edits: what copied materials (the GPU's) compare with */
+    uint32_t class_version;  /* counts material class changes: what the structures built per class (the
+                              * reflection pass's nodes) compare with */
     uint32_t motion_version; /* counts switches of nodes between static and dynamic: what the structures
                               * built on that split (the direct pass's casters) compare with */
     int texture_count;

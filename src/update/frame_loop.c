@@ -26,6 +26,7 @@ struct lm_frame_loop {
     lm_gather *gather;
     lm_composite *comp;
     lm_reflections *reflections; /* NULL: no mirror or glossy node, or switched off */
+    uint32_t reflect_classes;    /* the scene's class_version the reflections were made for */
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
     int have_iim;
@@ -224,7 +225,19 @@ static lm_status setup_render(lm_frame_loop *fl, lm_error *err)
     if (st == LM_OK && fl->set.reflection_size > 0)
         st = lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections,
                                    err);
+    fl->reflect_classes = fl->scene->class_version;
     return st;
+}
+
+/* After a material changed class the nodes that reflect are others: their maps are made again. */
+static lm_status follow_classes(lm_frame_loop *fl, lm_error *err)
+{
+    if (fl->reflect_classes == fl->scene->class_version || fl->set.reflection_size <= 0)
+        return LM_OK;
+    lm_reflections_free(fl->reflections);
+    fl->reflections = NULL;
+    fl->reflect_classes = fl->scene->class_version;
+    return lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections, err);
 }
 
 /* The settings' GL context made current, or one of the loop's own. */
@@ -336,7 +349,9 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
 {
     double t0 = lm_now();
     unsigned lit = 0;
-    lm_status st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
+    lm_status st = follow_classes(fl, err);
+    if (st == LM_OK)
+        st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
     const lm_emitters *em = lm_photon_stage_emitters(fl->stage);

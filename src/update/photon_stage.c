@@ -12,15 +12,20 @@ typedef struct {
     float pos[3], dir[3], power[3];
 } emitter_snapshot;
 
-/* What photons and AIMs read of a material: its colour and emission. */
+/* What photons and AIMs read of a material: its colour, emission and what makes its class. */
 typedef struct {
-    float base_color[4], emissive[3];
+    float base_color[4], emissive[3], metallic, roughness, transmission, ior;
+    int cls;
 } material_snapshot;
 
 static void take_material(const lm_material *m, material_snapshot *out)
 {
+    memset(out, 0, sizeof *out);
     memcpy(out->base_color, m->base_color, sizeof out->base_color);
     memcpy(out->emissive, m->emissive, sizeof out->emissive);
+    out->metallic = m->metallic, out->roughness = m->roughness;
+    out->transmission = m->transmission, out->ior = m->ior;
+    out->cls = (int)m->cls;
 }
 
 struct lm_photon_stage {
@@ -83,7 +88,7 @@ static lm_status take_new_lights(lm_photon_stage *ps, int *added, lm_error *err)
     return LM_OK;
 }
 
-/* A material edit (colour, emission) reaches the photons that touch the material, which are re-traced,
+/* A material edit (colour, emission, class) reaches the photons that touch the material, which are re-traced,
  * and the AIMs of its surfaces, whose albedo the estimate multiplies in: those are marked for a refresh.
  * The surfaces its light reaches follow from the re-traced photons' hits. Returns the edited materials. */
 static int check_materials(lm_photon_stage *ps)

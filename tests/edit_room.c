@@ -1,0 +1,167 @@
+/* The edit tests' room (edit_room.h). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include "edit_room.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int all_zero(const float *v, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (v[i] != 0.0f)
+            return 0;
+    return 1;
+}
+
+lmgi_scene *lmt_room(const lmt_room_spec *spec)
+{
+    static const float default_lo[3] = {-0.4f, 0.0f, -0.4f}, default_hi[3] = {0.4f, 1.0f, 0.4f};
+    const float *lo = spec->block_lo, *hi = spec->block_hi;
+    if (all_zero(lo, 3) && all_zero(hi, 3))
+        lo = default_lo, hi = default_hi;
+    float room[24], block[24], stool[24];
+    for (int v = 0; v < 8; v++)
+        for (int k = 0; k < 3; k++) {
+            int up = (v >> k) & 1;
+            room[3 * v + k] = k == 1 ? (up ? 3.0f : 0.0f) : (up ? 2.0f : -2.0f);
+            block[3 * v + k] = up ? hi[k] : lo[k];
+            stool[3 * v + k] = k == 1 ? (up ? 0.3f : 0.0f) : k == 0 ? (up ? 1.9f : 1.6f) : (up ? -1.6f : -1.9f);
+        }
+    /* corners of each face (bit k of a corner index: the upper end along axis k), wound so the face
+     * looks out of the box; each face has vertices of its own, so its normals are the face's */
+    static const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    float room_v[72], block_v[72], stool_v[72];
+    uint32_t outward[36], inward[36];
+    for (int f = 0; f < 6; f++) {
+        for (int c = 0; c < 4; c++)
+            for (int k = 0; k < 3; k++) {
+                int at = 3 * (4 * f + c) + k, corner = 3 * faces[f][c] + k;
+                room_v[at] = room[corner], block_v[at] = block[corner], stool_v[at] = stool[corner];
+            }
+        const uint32_t q = 4 * (uint32_t)f, out[6] = {q, q + 1, q + 2, q, q + 2, q + 3};
+        for (int i = 0; i < 6; i++)
+            outward[6 * f + i] = out[i], inward[6 * f + i] = out[i % 3 == 1 ? i + 1 : i % 3 == 2 ? i - 1 : i];
+    }
+    lmgi_mesh_desc meshes[3] = {
+        {.name = "room", .positions = room_v, .vertex_count = 24, .indices = inward, .triangle_count = 12},
+        {.name = "block", .positions = block_v, .vertex_count = 24, .indices = outward, .triangle_count = 12,
+         .material = 1, .dynamic = spec->block_dynamic},
+        {.name = "stool", .positions = stool_v, .vertex_count = 24, .indices = outward, .triangle_count = 12,
+         .dynamic = 1}};
+    lmgi_material_desc mats[2] = {{.name = "plaster", .base_color = {0.7f, 0.7f, 0.7f, 1.0f}},
+                                  {.name = "red", .base_color = {0.8f, 0.2f, 0.1f, 1.0f}}};
+    if (spec->block)
+        mats[1] = *spec->block;
+    lmgi_scene_desc d = {.name = "room", .meshes = meshes, .mesh_count = spec->stool ? 3 : 2, .materials = mats,
+                         .material_count = 2, .lights = spec->lights, .light_count = spec->light_count};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 1500;
+    o.texel_size = spec->texel_size;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
+lmgi_updater *lmt_room_updater(lmgi_context *ctx, lmgi_scene *sc)
+{
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.photons_per_group = 100;
+    d.hemicube_resolution = 16;
+    d.rim_samples = 16;
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
+float *lmt_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    *n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(*n * sizeof *rgba);
+    lmgi_error e;
+    assert_non_null(rgba);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, *n, &e), LMGI_OK);
+    return rgba;
+}
+
+void lmt_bake(lmgi_updater *u, lmgi_bake_report *r)
+{
+    lmgi_error e;
+    if (lmgi_bake(u, NULL, r, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+}
+
+float *lmt_corner_frame(lmgi_updater *u)
+{
+    const float eye[3] = {1.9f, 2.0f, 1.9f}, at[3] = {-1.0f, 0.5f, -1.0f};
+    float f[3], l = 0.0f;
+    for (int k = 0; k < 3; k++)
+        f[k] = at[k] - eye[k], l += f[k] * f[k];
+    for (int k = 0; k < 3; k++)
+        f[k] /= sqrtf(l);
+    float r[3] = {-f[2], 0.0f, f[0]}, m = sqrtf(f[0] * f[0] + f[2] * f[2]); /* f x (0, 1, 0) */
+    r[0] /= m, r[2] /= m;
+    float up[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    lmgi_camera cam;
+    memset(&cam, 0, sizeof cam);
+    for (int k = 0; k < 3; k++) {
+        cam.view[4 * k] = r[k], cam.view[4 * k + 1] = up[k], cam.view[4 * k + 2] = -f[k];
+        cam.view[12] -= r[k] * eye[k], cam.view[13] -= up[k] * eye[k], cam.view[14] += f[k] * eye[k];
+    }
+    cam.view[15] = 1.0f;
+    const float n = 0.05f, fa = 20.0f; /* tan(45 degrees) = 1 */
+    cam.proj[0] = cam.proj[5] = 1.0f;
+    cam.proj[10] = -(fa + n) / (fa - n), cam.proj[11] = -1.0f, cam.proj[14] = -2.0f * fa * n / (fa - n);
+    float *rgb = malloc(3 * LMT_SIDE * LMT_SIDE * sizeof *rgb);
+    lmgi_error e;
+    assert_non_null(rgb);
+    assert_int_equal(lmgi_render(u, &cam, LMT_SIDE, LMT_SIDE, rgb, &e), LMGI_OK);
+    return rgb;
+}
+
+double lmt_relative_l1(const float *a, const float *b, size_t n)
+{
+    double d = 0.0, s = 0.0;
+    for (size_t i = 0; i < n; i++)
+        d += fabs((double)a[i] - b[i]), s += fabs((double)b[i]);
+    return s > 0.0 ? d / s : d;
+}
+
+double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node)
+{
+    static const char *const names[3] = {"room", "block", "stool"}; /* 12 triangles each, in this order */
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    double sum = 0.0;
+    int n = 0;
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        const float *p = iim + 4 * ((size_t)t.y * in.atlas_width + t.x);
+        if (p[3] < 0.5f || t.triangle >= 36 || strcmp(names[t.triangle / 12], node))
+            continue;
+        sum += p[0] + p[1] + p[2];
+        n++;
+    }
+    assert_true(n > 20);
+    return sum / n;
+}
+
+void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
+{
+    assert_int_equal(st, LMGI_ERR_INVALID);
+    if (!strstr(e->message, words))
+        fail_msg("'%s' does not name '%s'", e->message, words);
+}

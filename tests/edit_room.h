@@ -1,0 +1,40 @@
+/* A small test level for the edit tests (lights, node motion, material classes), built through the public
+ * API: a closed room 4 x 3 x 4 seen from inside (plaster, 0.7 grey) with a block on its floor, optionally
+ * a dynamic stool in a corner, lit as the spec says; and the few steps those tests repeat on it. Each
+ * helper fails the calling cmocka test on an error. */
+#ifndef LMT_EDIT_ROOM_H
+#define LMT_EDIT_ROOM_H
+
+#include <lmgi.h>
+#include <stddef.h>
+
+typedef struct {
+    const lmgi_light_desc *lights;      /* may be NULL (a level without lights) */
+    int light_count;
+    const lmgi_material_desc *block;    /* the block's material (NULL: diffuse red 0.8 0.2 0.1) */
+    float block_lo[3], block_hi[3];     /* its box (all 0: [-0.4, 0.4] x [0, 1] x [-0.4, 0.4]) */
+    int block_dynamic;
+    int stool;                          /* 1: a dynamic 0.3 x 0.3 x 0.3 stool at x, z in [1.6, 1.9] x [-1.9, -1.6] */
+    float texel_size;                   /* world units per lightmap texel (0: about 1,500 texels) */
+} lmt_room_spec;
+
+/* The room as a scene; its nodes are "room", "block" and "stool". */
+lmgi_scene *lmt_room(const lmt_room_spec *spec);
+/* An updater for the edit tests: 100 photons a group, hemicube 16, 16 rim rays, no frame of its own. */
+lmgi_updater *lmt_room_updater(lmgi_context *ctx, lmgi_scene *sc);
+/* The displayed IIM (malloc'd, atlas-sized RGBA; *n floats). */
+float *lmt_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n);
+void lmt_bake(lmgi_updater *u, lmgi_bake_report *r);
+/* The frame (malloc'd, LMT_SIDE x LMT_SIDE x 3) from the room's corner at (1.9, 2, 1.9), looking at
+ * (-1, 0.5, -1) with a 90 degree field of view. */
+#define LMT_SIDE 48
+float *lmt_corner_frame(lmgi_updater *u);
+/* Relative L1 distance of a from b over n floats. */
+double lmt_relative_l1(const float *a, const float *b, size_t n);
+/* Mean irradiance (R + G + B) of the valid texels of node `node` ("room", "block", "stool") in an IIM of
+ * a room. */
+double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node);
+/* Asserts that st is LMGI_ERR_INVALID with a message naming `words`. */
+void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words);
+
+#endif
