@@ -156,6 +156,22 @@ LMGI_API lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const 
  * dynamic other than 0 or 1 or an id out of range. Asking for what the nodes already are: LMGI_OK, nothing
  * done. */
 LMGI_API lmgi_status lmgi_set_node_dynamic(lmgi_scene *scene, int node, int dynamic, lmgi_error *err);
+/* A node's effect switches (1 on, 0 off), as its glTF extras {"lmgi": {...}} set them at load (unset:
+ * its parent's; on at the roots):
+ *   shadows      its triangles cast shadows of the point, spot and directional lights;
+ *   indirect     its lightmap is gathered and the frame shows it (the light of emissive triangles, which
+ *                the lightmap carries, included); off: no gather work at all for it, and the frame shows
+ *                its direct light alone; it still blocks and reflects light for the others;
+ *   reflections  a mirror or glossy node gets an environment map (off: no map, no cost; mirrors black).
+ * lmgi_set_node_effects sets them on the node and every node under it; an updater follows at its next
+ * update (the casters and the maps are made again; a node whose indirect comes back on is regathered in
+ * full). NULL argument, an id out of range, a switch other than 0 or 1: LMGI_ERR_INVALID, nothing
+ * changed. (extras "caustics" waits for the caustic pass.) */
+typedef struct {
+    int shadows, indirect, reflections;
+} lmgi_node_effects;
+LMGI_API lmgi_status lmgi_get_node_effects(const lmgi_scene *scene, int node, lmgi_node_effects *out, lmgi_error *err);
+LMGI_API lmgi_status lmgi_set_node_effects(lmgi_scene *scene, int node, const lmgi_node_effects *e, lmgi_error *err);
 /* Lights (KHR_lights_punctual). A light of the file shines from its node (lmgi_set_node_transform moves
  * it; a node with no triangles in or under it may be moved even when static); a light added by
  * lmgi_add_light has no node and is placed by its own position and direction. Edits reach an updater at

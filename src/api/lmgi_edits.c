@@ -273,7 +273,7 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
     sc->scene->material_version++;
     if (cls != m->cls) {
         m->cls = cls;
-        sc->scene->class_version++;
+        sc->scene->pass_version++;
         lm_effects_decide(sc->scene, &sc->effects);
     }
     return LMGI_OK;

@@ -173,9 +173,9 @@ static void write_nodes(writer *w, const int *mesh_of)
             fprintf(w->doc.json, ",\"extensions\":{\"KHR_lights_punctual\":{\"light\":%d}}", nd->light);
         /* lmgi's own node settings (as resolved: a reload needs no inheritance), then the lightmap */
         const lm_node_settings *ns = &nd->settings;
-        fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"dynamic\":%s,\"caustics\":%s,\"indirect\":%s,\"shadows\":%s}",
-                nd->dynamic ? "true" : "false", ns->caustics ? "true" : "false", ns->indirect ? "true" : "false",
-                ns->shadows ? "true" : "false");
+        fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"dynamic\":%s,\"caustics\":%s,\"indirect\":%s,\"shadows\":%s,"
+                "\"reflections\":%s}", nd->dynamic ? "true" : "false", ns->caustics ? "true" : "false",
+                ns->indirect ? "true" : "false", ns->shadows ? "true" : "false", ns->reflections ? "true" : "false");
         if (has_lightmap(w->atlas, nd))
             fprintf(w->doc.json, ",\"lightmap\":{\"uri\":\"%s_lightmap.exr\",\"texCoord\":1}", w->name);
         fprintf(w->doc.json, "}}");

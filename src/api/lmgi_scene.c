@@ -223,6 +223,45 @@ static int carries_triangles(const lm_scene *s, int node)
     return 0;
 }
 
+lmgi_status lmgi_get_node_effects(const lmgi_scene *sc, int node, lmgi_node_effects *out, lmgi_error *err)
+{
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (!sc || !out)
+        return lm_api_refuse(err, "lmgi_get_node_effects: %s is NULL", sc ? "out" : "the scene");
+    if (node < 0 || node >= sc->scene->node_count)
+        return lm_api_refuse(err, "node id %d is out of range (scene has %d nodes)", node, sc->scene->node_count);
+    const lm_node_settings *st = &sc->scene->nodes[node].settings;
+    out->shadows = st->shadows;
+    out->indirect = st->indirect;
+    out->reflections = st->reflections;
+    return LMGI_OK;
+}
+
+lmgi_status lmgi_set_node_effects(lmgi_scene *sc, int node, const lmgi_node_effects *in, lmgi_error *err)
+{
+    if (!sc || !in)
+        return lm_api_refuse(err, "lmgi_set_node_effects: %s is NULL", sc ? "the effects" : "the scene");
+    lm_scene *s = sc->scene;
+    if (node < 0 || node >= s->node_count)
+        return lm_api_refuse(err, "node id %d is out of range (scene has %d nodes)", node, s->node_count);
+    const int v[3] = {in->shadows, in->indirect, in->reflections};
+    static const char *const names[3] = {"shadows", "indirect", "reflections"};
+    for (int k = 0; k < 3; k++)
+        if (v[k] != 0 && v[k] != 1)
+            return lm_api_refuse(err, "node '%s': %s is 0 or 1, not %d", s->nodes[node].name, names[k], v[k]);
+    if (sc->updater) /* its photon work reads the store the gather's switches write */
+        lm_updater_sync(sc->updater);
+    for (int n = 0; n < s->node_count; n++)
+        if (lm_node_under(s, n, node)) { /* as extras inherit: the node and everything under it */
+            lm_node_settings *st = &s->nodes[n].settings;
+            st->shadows = in->shadows, st->indirect = in->indirect, st->reflections = in->reflections;
+        }
+    s->pass_version++;
+    lm_effects_decide(s, &sc->effects);
+    return LMGI_OK;
+}
+
 lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_error *err)
 {
     if (!sc)

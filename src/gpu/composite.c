@@ -41,11 +41,13 @@ static const char *PREMULT_FS =
     "    float w = texelFetch(covered, q, 0).r * (e.a <= limit ? 1.0 : 0.0);\n"
     "    frag = vec4(e.rgb * (w / " LM_PI_GLSL "), w);\n"
     "}\n";
-/* 1 at every texel of the texel table (covered by some triangle), 0 in gutters and unused corners. */
-static void fill_covered(const lm_atlas *a, float *out)
+/* 1 at every texel of the texel table (covered by some triangle) whose node takes indirect light, 0 in
+ * gutters, unused corners and on nodes with indirect light switched off. */
+static void fill_covered(const lm_scene *s, const lm_atlas *a, float *out)
 {
     for (uint32_t i = 0; i < a->texel_count; i++)
-        out[4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x)] = 1.0f;
+        out[4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x)] =
+            s->nodes[s->tri_node[a->texels[i].tri]].settings.indirect ? 1.0f : 0.0f;
 }
 
 static GLuint upload_rgba(int w, int h, const float *rgba)
@@ -74,7 +76,7 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->width = a->width;
     c->height = a->height;
     c->limit = backface_limit;
-    fill_covered(a, covered);
+    fill_covered(s, a, covered);
     c->covered_tex = upload_rgba(a->width, a->height, covered);
     free(covered);
     lm_status st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
@@ -87,6 +89,19 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->p_covered = glGetUniformLocation(c->premult_prog, "covered");
     c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
     *out = c;
+    return LM_OK;
+}
+
+lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err)
+{
+    float *covered = calloc(4 * (size_t)a->width * a->height, sizeof(float));
+    if (!covered)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap coverage", s->path);
+    fill_covered(s, a, covered);
+    glBindTexture(GL_TEXTURE_2D, c->covered_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a->width, a->height, GL_RGBA, GL_FLOAT, covered);
+    free(covered);
     return LM_OK;
 }
 

@@ -6,7 +6,8 @@
  * four nearest texels that weighs only covered, valid ones, so gutters and invalid texels never darken a
  * chart's border. The direct light's first pass multiplies it by kd and adds it (gpu/direct.h, lm_direct_set_indirect): the
  * sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
- * light. Program and target persist. */
+ * light, nor do nodes whose indirect light is switched off (extras "indirect": false, lmgi_set_node_effects).
+ * Program and target persist. */
 #ifndef LM_COMPOSITE_H
 #define LM_COMPOSITE_H
 
@@ -18,6 +19,8 @@ typedef struct lm_composite lm_composite;
 lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
                               lm_error *err);
 void lm_composite_free(lm_composite *c);
+/* Builds the coverage again after nodes switched their indirect light on or off (lm_node_settings). */
+lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err);
 /* The indirect term from iim_tex (atlas-sized RGBA32F, a = back-face fraction) into *lit_tex (owned by c,
  * valid until the next call). One atlas-sized pass. */
 lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit_tex, lm_error *err);

@@ -366,8 +366,9 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     if (width <= 0 || height <= 0)
         return lm_fail(err, LM_ERR_INVALID, "direct_light: bad size %dx%d", width, height);
     lm_status st = ensure_maps(d, em->count, err);
-    if (st == LM_OK && d->mesh.motion_version != s->motion_version) {
-        /* nodes switched between static and dynamic: the casters split again, every shadow redrawn */
+    if (st == LM_OK && d->mesh.pass_version != s->pass_version) {
+        /* nodes switched between static and dynamic, or shadows on or off: the casters chosen and split
+         * again, every shadow redrawn */
         lm_direct_mesh fresh;
         if ((st = lm_direct_mesh_build(&fresh, s, d->atlas, err)) == LM_OK) {
             lm_direct_mesh_free(&d->mesh);

@@ -313,7 +313,7 @@ lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_at
 {
     memset(d, 0, sizeof *d);
     d->material_version = s->material_version;
-    d->motion_version = s->motion_version;
+    d->pass_version = s->pass_version;
     d->groups = s->texture_count + 1;
     d->node_count = s->node_count;
     built b;

@@ -32,7 +32,7 @@ typedef struct {
     unsigned uv_vbo;      /* lightmap uv per vertex (attribute 7), 0 without an atlas */
     float dynamic_lo[3], dynamic_hi[3]; /* world bounds of the dynamic nodes' casters (after an update) */
     uint32_t material_version; /* the scene's when the vertices (which carry their material) were uploaded */
-    uint32_t motion_version;   /* the scene's when the casters were split into static and dynamic */
+    uint32_t pass_version;     /* the scene's when the casters were chosen and split into static and dynamic */
 } lm_direct_mesh;
 
 /* Builds the meshes; with an atlas (may be NULL) also attribute 7: each vertex's lightmap uv, (-1, -1) on

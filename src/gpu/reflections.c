@@ -74,6 +74,8 @@ static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error 
     for (int n = 0; n < s->node_count; n++) {
         const lm_node *node = &s->nodes[n];
         reflector *f = &r->r[r->count];
+        if (!node->settings.reflections) /* switched off (extras, lmgi_set_node_effects): drawn black */
+            continue;
         for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++) {
             lm_material_class c = s->materials[s->tri_material[t]].cls;
             if (!reflects(c))

@@ -35,7 +35,8 @@ lm_status lm_iim_sched_init(lm_iim_sched *s, const lm_atlas *a, int texels_per_f
     s->cursor = calloc(S, sizeof *s->cursor);
     s->last_done = malloc(S * sizeof *s->last_done);
     s->commit = calloc(S, 1);
-    lm_status st = s->cursor && s->last_done && s->commit
+    s->off = calloc(S, 1);
+    lm_status st = s->cursor && s->last_done && s->commit && s->off
                        ? group_texels(s, a, err)
                        : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
     for (size_t k = 0; st == LM_OK && k < S; k++)
@@ -52,6 +53,7 @@ void lm_iim_sched_free(lm_iim_sched *s)
     free(s->cursor);
     free(s->last_done);
     free(s->commit);
+    free(s->off);
     memset(s, 0, sizeof *s);
 }
 
@@ -99,7 +101,7 @@ uint32_t lm_iim_sched_pick_up_to(lm_iim_sched *s, lm_photon_store *ps, uint32_t 
         return 0;
     int nc = 0;
     for (int k = 0; k < s->surface_count; k++) {
-        if (s->cursor[k] == 0 && !(ps->surfaces[k].delta_i > s->delta_threshold))
+        if (s->off[k] || (s->cursor[k] == 0 && !(ps->surfaces[k].delta_i > s->delta_threshold)))
             continue;
         int i = nc++; /* insertion sort: surface counts are small */
         while (i > 0 && before(s, ps, k, cand[i - 1]))
@@ -118,9 +120,19 @@ uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *o
     uint32_t n = 0;
     for (int k = 0; k < s->surface_count; k++) {
         s->cursor[k] = 0;
-        n += take_texels(s, ps, k, out + n, UINT32_MAX);
+        if (!s->off[k])
+            n += take_texels(s, ps, k, out + n, UINT32_MAX);
     }
     return n;
 }
 
 void lm_iim_sched_end_frame(lm_iim_sched *s) { s->frame++; }
+
+void lm_iim_sched_set_off(lm_iim_sched *s, lm_photon_store *ps, int k, int off)
+{
+    if (!off && s->off[k])
+        ps->surfaces[k].delta_i = 1e30;
+    s->off[k] = (uint8_t)(off != 0);
+    if (off)
+        s->cursor[k] = 0;
+}

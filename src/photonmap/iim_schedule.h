@@ -30,6 +30,7 @@ typedef struct {
     uint32_t *cursor;      /* per surface: next texel of a refresh under way (0: none under way) */
     int *last_done;        /* per surface: frame its last refresh completed (-1: never) */
     uint8_t *commit;       /* per surface: refresh completed, for the blend to commit (and clear) */
+    uint8_t *off;          /* per surface: not gathered at all (its node's indirect switched off) */
     int frame;             /* advanced once a frame by lm_iim_sched_end_frame */
 } lm_iim_sched;
 
@@ -45,5 +46,8 @@ uint32_t lm_iim_sched_pick_up_to(lm_iim_sched *s, lm_photon_store *ps, uint32_t 
  * (out must hold the atlas's texel_count). */
 uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);
 void lm_iim_sched_end_frame(lm_iim_sched *s);
+/* Switches surface k's gather off (a refresh under way is dropped) or on again; a surface switched on is
+ * refreshed in full next, as if all its light had changed (its delta_i set over any threshold). */
+void lm_iim_sched_set_off(lm_iim_sched *s, lm_photon_store *ps, int k, int off);
 
 #endif

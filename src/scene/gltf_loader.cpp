@@ -561,7 +561,7 @@ lm_status Loader::materials()
 // Reads the lmgi extras of a node: -1 unset, 0/1 set.
 void read_settings(const tinygltf::Value &extras, lm_node_settings &st, const char *path, const std::string &ctx)
 {
-    st.dynamic = st.caustics = st.indirect = st.shadows = -1;
+    st.dynamic = st.caustics = st.indirect = st.shadows = st.reflections = -1;
     if (!extras.IsObject() || !extras.Has("lmgi"))
         return;
     const tinygltf::Value &l = extras.Get("lmgi");
@@ -570,7 +570,8 @@ void read_settings(const tinygltf::Value &extras, lm_node_settings &st, const ch
         return;
     }
     struct { const char *key; int *dst; } keys[] = {
-        {"dynamic", &st.dynamic}, {"caustics", &st.caustics}, {"indirect", &st.indirect}, {"shadows", &st.shadows}};
+        {"dynamic", &st.dynamic}, {"caustics", &st.caustics}, {"indirect", &st.indirect}, {"shadows", &st.shadows},
+        {"reflections", &st.reflections}};
     for (const std::string &k : l.Keys()) {
         bool found = false;
         for (auto &e : keys) {

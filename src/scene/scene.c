@@ -296,5 +296,5 @@ void lm_scene_set_dynamic(lm_scene *s, int node, int dynamic)
     for (int n = 0; n < s->node_count; n++)
         if (lm_node_under(s, n, node))
             s->nodes[n].dynamic = s->nodes[n].settings.dynamic = dynamic;
-    s->motion_version++;
+    s->pass_version++;
 }

@@ -88,6 +88,7 @@ typedef struct {
     int caustics;          /* extras "caustics" */
     int indirect;          /* extras "indirect" */
     int shadows;           /* extras "shadows" */
+    int reflections;       /* extras "reflections": a mirror or glossy node gets an environment map */
 } lm_node_settings;
 
 typedef struct {
@@ -139,10 +140,10 @@ typedef struct {
     int material_count;
     lm_material *materials;
     uint32_t material_version; /* counts material edits: what copied materials (the GPU's) compare with */
-    uint32_t class_version;  /* counts material class changes: what the structures built per class (the
-                              * reflection pass's nodes) compare with */
-    uint32_t motion_version; /* counts switches of nodes between static and dynamic: what the structures
-                              * built on that split (the direct pass's casters) compare with */
+    uint32_t pass_version;   /* counts edits that change which passes a node takes part in and how (static
+                              * or dynamic, a material's class, a node's effect switches): what the render
+                              * passes built on them (the direct pass's casters, the reflection maps)
+                              * compare with */
     int texture_count;
     lm_texture *textures;
     int light_count;
@@ -225,7 +226,7 @@ int lm_node_under(const lm_scene *s, int node, int ancestor);
 /* 1 when an animation channel drives `node` or a node under it. */
 int lm_node_animated_under(const lm_scene *s, int node);
 /* Makes `node` and every node under it dynamic (1) or static (0), where they are now, and counts the
- * switch in motion_version. The caller checks that it may (no animated node goes static, no node under a
+ * switch in pass_version. The caller checks that it may (no animated node goes static, no node under a
  * dynamic parent) and rebuilds what is built on the split (lm_rt_rebuild). */
 void lm_scene_set_dynamic(lm_scene *s, int node, int dynamic);
 /* Hands an edited node back to its animations (from the next lm_scene_eval_animation on). */

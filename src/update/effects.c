@@ -14,7 +14,9 @@ const char *lm_effect_name(lm_effect_id e)
 /* The per-node extras switch that governs an effect. */
 static int node_switch(const lm_node *node, lm_effect_id effect)
 {
-    return effect == LM_EFFECT_INDIRECT ? node->settings.indirect : node->settings.caustics;
+    return effect == LM_EFFECT_INDIRECT      ? node->settings.indirect
+         : effect == LM_EFFECT_REFLECTIONS ? node->settings.reflections
+                                           : node->settings.caustics;
 }
 
 /* Materials of class `cls` used by triangles of nodes where the effect's switch is on, and where off. */
@@ -137,16 +139,20 @@ static void decide_specular(const lm_scene *s, lm_effects *e)
 
     /* reflections (gpu/reflections.h): environment maps for mirror and glossy nodes */
     usage glossy = count_usage(s, LM_MAT_GLOSSY, LM_EFFECT_REFLECTIONS);
-    int any = mirror.materials_on + mirror.materials_off, shiny = glossy.materials_on + glossy.materials_off;
+    usage mirrors = count_usage(s, LM_MAT_MIRROR, LM_EFFECT_REFLECTIONS);
+    int any = mirrors.materials_on, shiny = glossy.materials_on;
+    int switched = mirrors.materials_off + glossy.materials_off;
     e->on[LM_EFFECT_REFLECTIONS] = any + shiny > 0;
     if (any > 0)
         snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%d mirror%s material%s on node '%s'",
-                 any, shiny ? " and glossy" : "", any + shiny == 1 ? "" : "s",
-                 s->nodes[mirror.first_node_on >= 0 ? mirror.first_node_on : mirror.first_node_off].name);
+                 any, shiny ? " and glossy" : "", any + shiny == 1 ? "" : "s", s->nodes[mirrors.first_node_on].name);
     else if (shiny > 0)
         snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%d glossy material%s on node '%s'", shiny,
-                 shiny == 1 ? "" : "s",
-                 s->nodes[glossy.first_node_on >= 0 ? glossy.first_node_on : glossy.first_node_off].name);
+                 shiny == 1 ? "" : "s", s->nodes[glossy.first_node_on].name);
+    else if (switched > 0)
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "mirror and glossy materials only on nodes with "
+                 "reflections switched off (first: '%s')",
+                 s->nodes[mirrors.first_node_off >= 0 ? mirrors.first_node_off : glossy.first_node_off].name);
     else
         snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s", glass.materials_on + glass.materials_off > 0
                  ? "glass only (refraction is not drawn yet)" : "no mirror or glossy material");

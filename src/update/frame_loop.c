@@ -26,7 +26,9 @@ struct lm_frame_loop {
     lm_gather *gather;
     lm_composite *comp;
     lm_reflections *reflections; /* NULL: no mirror or glossy node, or switched off */
-    uint32_t reflect_classes;    /* the scene's class_version the reflections were made for */
+    uint32_t reflect_version;    /* the scene's pass_version the reflection maps were made for */
+    uint32_t switch_version;     /* the scene's pass_version the gather's and composite's switches follow */
+    const lm_surfaces *surfaces;
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
     int have_iim;
@@ -225,18 +227,39 @@ static lm_status setup_render(lm_frame_loop *fl, lm_error *err)
     if (st == LM_OK && fl->set.reflection_size > 0)
         st = lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections,
                                    err);
-    fl->reflect_classes = fl->scene->class_version;
+    fl->reflect_version = fl->scene->pass_version;
     return st;
 }
 
-/* After a material changed class the nodes that reflect are others: their maps are made again. */
-static lm_status follow_classes(lm_frame_loop *fl, lm_error *err)
+/* Per surface, whether its node takes indirect light (extras "indirect", lmgi_set_node_effects): the
+ * scheduler gathers only those (one switched on again is regathered in full). */
+static void sync_gather_switches(lm_frame_loop *fl)
 {
-    if (fl->reflect_classes == fl->scene->class_version || fl->set.reflection_size <= 0)
-        return LM_OK;
+    for (int k = 0; k < fl->surfaces->surface_count; k++) {
+        int off = !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
+        if (off != fl->iim.sched.off[k])
+            lm_iim_sched_set_off(&fl->iim.sched, store_of(fl), k, off);
+    }
+}
+
+/* After edits that change which passes a node takes part in (lm_scene.pass_version: a material's class,
+ * a node's effect switches): the gather's and the composite's surfaces, and the nodes that reflect,
+ * whose maps are made again. */
+static lm_status follow_pass_edits(lm_frame_loop *fl, lm_error *err)
+{
+    uint32_t v = fl->scene->pass_version;
+    lm_status st = LM_OK;
+    if (fl->switch_version != v) {
+        sync_gather_switches(fl);
+        if (fl->comp)
+            st = lm_composite_update_coverage(fl->comp, fl->scene, fl->atlas, err);
+        fl->switch_version = v;
+    }
+    if (st != LM_OK || fl->reflect_version == v || fl->set.reflection_size <= 0 || !fl->direct_light)
+        return st;
     lm_reflections_free(fl->reflections);
     fl->reflections = NULL;
-    fl->reflect_classes = fl->scene->class_version;
+    fl->reflect_version = v;
     return lm_reflections_create(fl->scene, fl->set.reflection_size, fl->set.reflection_faces, &fl->reflections, err);
 }
 
@@ -264,8 +287,11 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         lm_gather_set_emitter_light(fl->gather, &fl->emitters);
     if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (gpu/hemicube_rim.h) */
         lm_gather_set_tracer(fl->gather, fl->rt);
-    if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK)
+    if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK) {
         fl->have_iim = 1;
+        sync_gather_switches(fl); /* nodes without indirect light are not gathered at all */
+        fl->switch_version = fl->scene->pass_version;
+    }
     if (st == LM_OK && fl->set.width > 0)
         st = setup_render(fl, err);
     double t0 = lm_now();
@@ -295,6 +321,7 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
     fl->set = *set;
     fl->scene = w->scene;
+    fl->surfaces = w->surfaces;
     fl->atlas = a;
     fl->rt = w->rt;
     char what[128];
@@ -349,7 +376,7 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
 {
     double t0 = lm_now();
     unsigned lit = 0;
-    lm_status st = follow_classes(fl, err);
+    lm_status st = follow_pass_edits(fl, err);
     if (st == LM_OK)
         st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
     double t1 = lm_now();
@@ -528,6 +555,8 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
     double t0 = lm_now();
     lm_status st = lm_gl_make_current(fl->gl, err);
     if (st == LM_OK)
+        st = follow_pass_edits(fl, err);
+    if (st == LM_OK)
         st = !fl->worker ? step_in_order(fl, t, &o, err)
              : fl->set.width > 0 ? step_overlapped(fl, t, &o, err) : step_detached(fl, t, &o, err);
     o.t_total = lm_now() - t0;
@@ -595,6 +624,8 @@ lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progre
     lm_status st = lm_frame_loop_sync(fl, err);
     if (st == LM_OK)
         st = lm_gl_make_current(fl->gl, err);
+    if (st == LM_OK)
+        st = follow_pass_edits(fl, err);
     if (st != LM_OK)
         return st;
     if (progress)
@@ -682,7 +713,8 @@ lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *
         for (uint32_t i = 0; i < a->texel_count; i++) {
             size_t at = (size_t)a->texels[i].y * a->width + a->texels[i].x;
             double f = lm_luminance(fresh + 4 * at), blend = fabs(f - lm_luminance(shown + 4 * at)) / fmax(fabs(f), floor);
-            error[at] = (float)fmax(blend, pending[a->texels[i].surface]);
+            int k = a->texels[i].surface;
+            error[at] = fl->iim.sched.off[k] ? 0.0f : (float)fmax(blend, pending[k]); /* off: nothing to show */
         }
     }
     free(fresh);
