@@ -366,6 +366,54 @@ static void test_energy_closed_box(void **state)
     world_free(&w);
 }
 
+/* Russian roulette by the albedo's largest channel: no channel of a photon's flux grows at a bounce, so
+ * in a closed box of saturated red (0.8 0.2 0.1) no stored hit carries more, per channel, than the
+ * photon left the lamp with. (With the luminance, 0.32, as the survival the red channel grew 2.5x a
+ * bounce: hits of 100 times a photon's red.) The mean of the stored red flux per bounce falls by the
+ * albedo, as it should. */
+static void test_no_channel_grows(void **state)
+{
+    (void)state;
+    static lmt_mesh box;
+    memset(&box, 0, sizeof box);
+    lmt_mesh_cube_inward(&box, 1.0f);
+    const char *nodes = "[{\"name\": \"box\", \"mesh\": 0},"
+                        " {\"name\": \"lamp\", \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
+    const char *materials = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+                            " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}},"
+                            " \"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.2, 0.1, 1],"
+                            " \"metallicFactor\": 0}}],";
+    char path[512];
+    snprintf(path, sizeof path, "%s/red.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &box, 1, nodes, NULL, 0, materials), 0);
+    lmt_use_material_0(path);
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.total_photons = 20000;
+    world_photons(&w, &set);
+    double emitted = 4.0 * M_PI * 10.0 / lm_photons_count(w.ph), worst[3] = {0, 0, 0}, red[8] = {0};
+    uint32_t count[8] = {0};
+    const lm_photon_store *ps = lm_photons_store(w.ph);
+    for (int k = 0; k < ps->surface_count; k++)
+        for (uint32_t h = ps->surfaces[k].head; h != LM_NONE; h = ps->hits[h].next) {
+            const lm_hit *x = &ps->hits[h];
+            for (int c = 0; c < 3; c++)
+                worst[c] = fmax(worst[c], x->flux[c] / emitted);
+            if (x->bounce < 8)
+                red[x->bounce] += x->flux[0], count[x->bounce]++;
+        }
+    print_message("largest stored flux over a photon's: %.3f %.3f %.3f; mean red per hit by bounce: %.3f %.3f %.3f\n",
+                  worst[0], worst[1], worst[2], red[0] / count[0] / emitted, red[1] / count[1] / emitted,
+                  red[2] / count[2] / emitted);
+    for (int c = 0; c < 3; c++)
+        assert_true(worst[c] <= 1.0 + 1e-5);
+    /* survivors keep the red (0.8 / 0.8): each bounce's stored red is the one before times the albedo */
+    assert_float_equal(red[1] / emitted, 0.8 * red[0] / emitted, 0.03 * red[0] / emitted);
+    world_free(&w);
+}
+
 /* ---- emitter invalidation: every group queued, drained oldest first under the budget ---- */
 
 static void assert_emitter_pending(const lm_photons *ph, int e, uint32_t valid_groups)
@@ -662,6 +710,7 @@ int main(void)
         cmocka_unit_test(test_locality_door_closed),
         cmocka_unit_test(test_locality_door_open),
         cmocka_unit_test(test_energy_closed_box),
+        cmocka_unit_test(test_no_channel_grows),
         cmocka_unit_test(test_invalidate_emitter),
         cmocka_unit_test(test_move_and_back),
         cmocka_unit_test(test_reset_matches_fresh),

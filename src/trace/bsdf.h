@@ -40,6 +40,21 @@ static inline float lm_bsdf_survival(const lm_shading *sh)
     float l = lm_luminance(sh->albedo);
     return l < 0.05f ? 0.05f : l > 0.95f ? 0.95f : l;
 }
+/* A photon's survival probability before a bounce: the albedo's largest channel, clamped to [0.05, 0.95];
+ * 1 for mirror and glass. Not the luminance (lm_bsdf_survival): a photon's flux is multiplied by
+ * albedo / p per channel, which the largest channel keeps at most 1 (but for the clamp); with the
+ * luminance a saturated red (0.8 0.2 0.1, luminance 0.32) gave the red channel 2.5x a bounce, and the
+ * few photons that survived many bounces near it carried a thousand times a photon's power into the
+ * AIMs (docs/photons.md, "Russian roulette"). */
+static inline float lm_bsdf_photon_survival(const lm_shading *sh)
+{
+    if (lm_material_is_specular(sh->material->cls))
+        return 1.0f;
+    const float *a = sh->albedo;
+    float m = a[0] > a[1] ? a[0] : a[1];
+    m = m > a[2] ? m : a[2];
+    return m < 0.05f ? 0.05f : m > 0.95f ? 0.95f : m;
+}
 /* True for classes that store photon hits (diffuse, glossy, emitter). */
 static inline int lm_material_stores_hits(lm_material_class c)
 {

@@ -117,7 +117,7 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
                    float dir[3], float flux[3])
 {
     uint32_t d = PH_EMIT_DIMS + PH_DIMS_PER_BOUNCE * b;
-    float p = lm_bsdf_survival(sh), u[3] = {0.0f, 0.0f, 0.0f};
+    float p = lm_bsdf_photon_survival(sh), u[3] = {0.0f, 0.0f, 0.0f};
     /* Only the numbers that decide something are computed (QMC is a large share of a trace): no
      * roulette draw where survival is certain (u < 1 always), no BSDF number the material ignores,
      * and the roulette's number only as far as it decides u < p. */
