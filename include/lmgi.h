@@ -361,6 +361,8 @@ typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_
 typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
 typedef enum { LMGI_GATHER_DEFAULT = 0, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_INSTANCED, LMGI_GATHER_LAYERED } lmgi_gather_scheme;
 
+enum { LMGI_EFFECT_SHADOWS = 1, LMGI_EFFECT_INDIRECT = 2, LMGI_EFFECT_REFLECTIONS = 4 };
+
 /* Zero-initialised means the defaults (the same as `lmgi run`'s; docs/ says what each costs and buys). */
 typedef struct {
     /* work per update */
@@ -392,6 +394,11 @@ typedef struct {
                                 * one framing the scene) */
     int reflection_size;       /* environment map side of a mirror or glossy node (0: 128; -1: no reflections) */
     int reflection_faces;      /* environment map faces re-rendered per update (0: 1) */
+    /* effects this updater leaves out whatever the scene calls for (0: none), LMGI_EFFECT_* bits:
+     * SHADOWS no shadow maps (lights reach everything), INDIRECT no photon, AIM or gather work at all
+     * (the lightmaps stay 0; the frame shows direct light, emission and reflections), REFLECTIONS no
+     * environment maps (as reflection_size -1). Per node: lmgi_set_node_effects */
+    unsigned effects_off;
     /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
      * that, set non-zero (from any thread), stops it between gather passes: LMGI_ERR_CANCELLED */
     lmgi_progress_fn progress;

@@ -22,6 +22,8 @@ typedef struct {
 lmgi_scene *lmt_room(const lmt_room_spec *spec);
 /* An updater for the edit tests: 100 photons a group, hemicube 16, 16 rim rays, no frame of its own. */
 lmgi_updater *lmt_room_updater(lmgi_context *ctx, lmgi_scene *sc);
+/* The same leaving out the effects in effects_off (lmgi_updater_desc). */
+lmgi_updater *lmt_room_updater_without(lmgi_context *ctx, lmgi_scene *sc, unsigned effects_off);
 /* The displayed IIM (malloc'd, atlas-sized RGBA; *n floats). */
 float *lmt_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n);
 void lmt_bake(lmgi_updater *u, lmgi_bake_report *r);

@@ -191,11 +191,78 @@ static void test_reflections(void **state)
     lmgi_context_free(ctx);
 }
 
+/* Every root of the room (room, block, stool, lamp) with the switches fx. */
+static void switch_all(lmgi_scene *sc, const lmgi_node_effects *fx)
+{
+    lmgi_error e;
+    for (int n = 0; n < lmgi_node_count(sc); n++)
+        assert_int_equal(lmgi_set_node_effects(sc, n, fx, &e), LMGI_OK);
+}
+
+/* The run's switches (lmgi_updater_desc.effects_off) give the frame of the same scene with every node's
+ * switch off, and a run without indirect light does no photon, AIM or gather work at all. */
+static void test_run_effects(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    const lmgi_material_desc chrome = {.name = "chrome", .base_color = {0.9f, 0.9f, 0.9f, 1.0f}, .metallic = 1.0f,
+                                       .roughness = 0.05f};
+    static const unsigned bits[3] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS};
+    static const char *const names[3] = {"shadows", "indirect", "reflections"};
+    for (int k = 0; k < 3; k++) {
+        lmgi_scene *run = load_room(&chrome), *nodes = load_room(&chrome);
+        lmgi_updater *u = lmt_room_updater_without(ctx, run, bits[k]);
+        lmgi_node_effects fx = {1, 1, 1};
+        *(k == 0 ? &fx.shadows : k == 1 ? &fx.indirect : &fx.reflections) = 0;
+        switch_all(nodes, &fx);
+        lmgi_updater *un = lmt_room_updater(ctx, nodes);
+        lmgi_update_stats st, stn;
+        uint32_t work = 0;
+        for (int f = 0; f < 3; f++) {
+            assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+            assert_int_equal(lmgi_update(un, 0.0f, 0.0f, &stn, &e), LMGI_OK);
+            work += st.photons_retraced + st.texels_gathered + (uint32_t)st.aim_surfaces_refreshed;
+        }
+        float *a = lmt_corner_frame(u), *b = lmt_corner_frame(un);
+        double d = lmt_relative_l1(a, b, PIXELS);
+        lmgi_updater_info info;
+        lmgi_get_updater_info(u, &info);
+        print_message("-%s: frame %.1e from every node's %s off; photons %u, photon and gather work in 3 updates "
+                      "%u\n", names[k], d, names[k], info.photons, work);
+        assert_true(d < 1e-6);
+        if (bits[k] == LMGI_EFFECT_INDIRECT) {
+            assert_int_equal(info.photons, 0);
+            assert_int_equal(work, 0);
+            size_t n;
+            float *iim = lmt_iim(u, run, &n);
+            for (size_t i = 0; i < n; i += 4)
+                assert_true(iim[i] == 0.0f && iim[i + 1] == 0.0f && iim[i + 2] == 0.0f);
+            free(iim);
+        }
+        free(a), free(b);
+        lmgi_updater_free(u);
+        lmgi_updater_free(un);
+        lmgi_free(run);
+        lmgi_free(nodes);
+    }
+    lmgi_scene *sc = load_room(NULL);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.effects_off = 8;
+    lmgi_updater *u = NULL;
+    lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, "effects_off");
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shadows_and_indirect),
         cmocka_unit_test(test_reflections),
+        cmocka_unit_test(test_run_effects),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

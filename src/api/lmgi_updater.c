@@ -123,6 +123,14 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     else
         TAKE(reflection_size, 1, 4096, &s->reflection_size);
     TAKE(reflection_faces, 1, 1 << 20, &s->reflection_faces);
+    const unsigned all = LMGI_EFFECT_SHADOWS | LMGI_EFFECT_INDIRECT | LMGI_EFFECT_REFLECTIONS;
+    if (d->effects_off & ~all)
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: effects_off 0x%x has bits other than "
+                       "LMGI_EFFECT_SHADOWS, _INDIRECT and _REFLECTIONS", d->effects_off);
+    s->direct.shadows = !(d->effects_off & LMGI_EFFECT_SHADOWS);
+    s->indirect = !(d->effects_off & LMGI_EFFECT_INDIRECT);
+    if (d->effects_off & LMGI_EFFECT_REFLECTIONS)
+        s->reflection_size = 0;
     s->cancel = d->cancel;
     return LM_OK;
 }
@@ -243,7 +251,8 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     info->emissive_triangles = lm_emissive_triangle_count(u->sc->scene);
     info->emitters_closed_form = s->emitter_light;
     info->emitter_rays = s->emitter_rays;
-    info->photons = lm_photons_count(lm_photon_stage_photons(lm_frame_loop_stage(u->loop)));
+    info->photons = lm_frame_loop_get_settings(u->loop)->indirect /* else one untraced photon a light */
+                        ? lm_photons_count(lm_photon_stage_photons(lm_frame_loop_stage(u->loop))) : 0;
     info->ms_setup_trace = 1e3 * u->setup.t_photons;
     info->ms_setup_aim = 1e3 * u->setup.t_aim;
     info->ms_setup_gather = 1e3 * u->t_setup_gather;

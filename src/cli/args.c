@@ -104,6 +104,27 @@ static int parse_tonemap(const char *o, const char *v, int *out)
     return bad(o, v, "neutral or clamp");
 }
 
+/* A comma-separated list of -effect (left out) or +effect (kept), effect one of shadows, indirect,
+ * reflections: the effects_off bits of lmgi_updater_desc. */
+static int parse_effects(const char *o, const char *v, unsigned *off)
+{
+    static const char *names[3] = {"shadows", "indirect", "reflections"};
+    static const unsigned bits[3] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS};
+    const char *p = v;
+    while (p && *p) {
+        size_t n = strcspn(p, ",");
+        int k = 0;
+        while (k < 3 && !(n == strlen(names[k]) + 1 && !strncmp(p + 1, names[k], n - 1)))
+            k++;
+        if (k == 3 || (*p != '-' && *p != '+'))
+            return bad(o, v, "a list such as -shadows,-indirect,+reflections (each of shadows, indirect, "
+                             "reflections with - to leave it out or + to keep it)");
+        *off = *p == '-' ? *off | bits[k] : *off & ~bits[k];
+        p += n + (p[n] == ',');
+    }
+    return v && *v ? 0 : bad(o, v, "a list such as -shadows,-indirect");
+}
+
 static int parse_scheme(const char *o, const char *v, int *out)
 {
     static const char *names[] = {"viewports", "instanced", "layered"};
@@ -194,6 +215,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_scheme(o, v, &a->gather_scheme);
         else if (!strcmp(o, "--emitter-light"))
             rc = parse_emitter_light(o, v, &a->emitter_light);
+        else if (!strcmp(o, "--effects")) /* its list starts with - or +: the word after it, whatever it is */
+            rc = parse_effects(o, i + 1 < argc ? argv[i + 1] : NULL, &a->effects_off);
         else if (!strcmp(o, "--tonemap"))
             rc = parse_tonemap(o, v, &a->tonemap);
         else if (!strcmp(o, "--emitter-rays"))

@@ -27,6 +27,7 @@ void lm_direct_settings_default(lm_direct_settings *s)
     s->slope_bias = 1.0f;
     s->max_slope = 10.0f;
     s->const_bias = 0.5f;
+    s->shadows = 1;
 }
 
 typedef struct {
@@ -308,7 +309,7 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
         st = lm_shadow_renderer_create(&d->shadow, err);
     }
     if (st == LM_OK)
-        st = lm_direct_mesh_build(&d->mesh, s, a, err);
+        st = lm_direct_mesh_build(&d->mesh, s, a, d->set.shadows, err);
     d->has_lightmap = a != NULL;
     d->atlas = a;
     if (st == LM_OK)
@@ -370,7 +371,7 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
         /* nodes switched between static and dynamic, or shadows on or off: the casters chosen and split
          * again, every shadow redrawn */
         lm_direct_mesh fresh;
-        if ((st = lm_direct_mesh_build(&fresh, s, d->atlas, err)) == LM_OK) {
+        if ((st = lm_direct_mesh_build(&fresh, s, d->atlas, d->set.shadows, err)) == LM_OK) {
             lm_direct_mesh_free(&d->mesh);
             d->mesh = fresh;
             d->static_version++, d->dynamic_version++;

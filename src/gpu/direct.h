@@ -22,6 +22,8 @@ typedef struct {
     float slope_bias;     /* depth bias per texel and unit slope tan(theta), times (pcf_radius + 1). Default 1 */
     float max_slope;      /* tan(theta) is clamped here (theta near 90 degrees). Default 10 */
     float const_bias;     /* constant depth bias in texels. Default 0.5 */
+    int shadows;          /* 0: no node casts shadows (the run's switch; a node's own is lm_node_settings).
+                           * Default 1 */
 } lm_direct_settings;
 
 void lm_direct_settings_default(lm_direct_settings *s);

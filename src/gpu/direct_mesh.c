@@ -228,12 +228,12 @@ static int node_casters(lm_direct_mesh *d, const lm_scene *s, int n, corner_map 
 }
 
 /* The casters: static nodes' first, then the dynamic ones'. */
-static int caster_geometry(lm_direct_mesh *d, const lm_scene *s, corner_map *map, built *b)
+static int caster_geometry(lm_direct_mesh *d, const lm_scene *s, int shadows, corner_map *map, built *b)
 {
     for (int pass = 0; pass < 2; pass++) {
         for (int n = 0; n < s->node_count; n++) {
             const lm_node *nd = &s->nodes[n];
-            if (!nd->settings.shadows || (nd->dynamic != 0) != (pass == 1))
+            if (!shadows || !nd->settings.shadows || (nd->dynamic != 0) != (pass == 1))
                 continue;
             if (!node_casters(d, s, n, map, b))
                 return 0;
@@ -309,7 +309,7 @@ static void dynamic_bounds(lm_direct_mesh *d, const lm_scene *s)
     }
 }
 
-lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, lm_error *err)
+lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, int shadows, lm_error *err)
 {
     memset(d, 0, sizeof *d);
     d->material_version = s->material_version;
@@ -320,7 +320,7 @@ lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_at
     memset(&b, 0, sizeof b);
     corner_map map = {NULL, NULL, 0};
     int ok = allocate(d, s, a, &b) && shading_vertices(d, s, a, &map, &b) && shading_indices(d, s, &b) &&
-             caster_geometry(d, s, &map, &b);
+             caster_geometry(d, s, shadows, &map, &b);
     if (ok) {
         for (int i = 0; i < s->node_count; i++)
             memcpy(d->node_world + 16 * (size_t)i, s->nodes[i].world, sizeof s->nodes[i].world);

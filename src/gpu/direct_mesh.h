@@ -36,8 +36,9 @@ typedef struct {
 } lm_direct_mesh;
 
 /* Builds the meshes; with an atlas (may be NULL) also attribute 7: each vertex's lightmap uv, (-1, -1) on
- * triangles without a chart (uvs are fixed: they do not move with their node). */
-lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, lm_error *err);
+ * triangles without a chart (uvs are fixed: they do not move with their node). shadows 0: no casters at
+ * all (the run's switch), else the nodes whose own switch is on. */
+lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, int shadows, lm_error *err);
 /* Re-uploads the vertices of every node whose world matrix changed since they were uploaded, and of
  * every node after a material edit (lm_scene.material_version). Returns
  * LM_MESH_MOVED when some node moved, | LM_MESH_DYNAMIC_CASTERS_MOVED or LM_MESH_STATIC_CASTERS_MOVED

@@ -64,6 +64,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->camera = -1;
     s->reflection_size = 128;
     s->reflection_faces = 1;
+    s->indirect = 1;
 }
 
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
@@ -208,7 +209,7 @@ static lm_status setup_emitters(lm_frame_loop *fl, lm_error *err)
         fl->set.gather.coverage_samples =
             fl->set.gather.scheme == LM_GATHER_LAYERED ? 1 : lm_gather_coverage_for(fl->scene, closed_form);
     fl->set.emitter_light = closed_form;
-    if (!closed_form)
+    if (!closed_form || !fl->set.indirect) /* without indirect light nothing is gathered */
         return LM_OK;
     lm_status st = lm_emitter_light_init(&fl->emitters, fl->scene, fl->rt, fl->set.emitter_rays, err);
     fl->have_emitters = st == LM_OK;
@@ -236,7 +237,7 @@ static lm_status setup_render(lm_frame_loop *fl, lm_error *err)
 static void sync_gather_switches(lm_frame_loop *fl)
 {
     for (int k = 0; k < fl->surfaces->surface_count; k++) {
-        int off = !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
+        int off = !fl->set.indirect || !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
         if (off != fl->iim.sched.off[k])
             lm_iim_sched_set_off(&fl->iim.sched, store_of(fl), k, off);
     }
@@ -320,6 +321,7 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
     if (!fl)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
     fl->set = *set;
+    fl->set.stage.trace = fl->set.stage.trace && fl->set.indirect;
     fl->scene = w->scene;
     fl->surfaces = w->surfaces;
     fl->atlas = a;
@@ -331,7 +333,7 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
     if (st == LM_OK)
         st = alloc_buffers(fl, err);
     if (st == LM_OK)
-        st = lm_photon_stage_create(w, &set->stage, &fl->stage, setup, err);
+        st = lm_photon_stage_create(w, &fl->set.stage, &fl->stage, setup, err);
     if (st == LM_OK)
         st = setup_gpu(fl, t_setup_gather, err);
     if (st == LM_OK && fl->set.overlap)
@@ -377,7 +379,7 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
     double t0 = lm_now();
     unsigned lit = 0;
     lm_status st = follow_pass_edits(fl, err);
-    if (st == LM_OK)
+    if (st == LM_OK && fl->set.indirect) /* else the first pass adds no indirect term */
         st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);

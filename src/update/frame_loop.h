@@ -46,6 +46,8 @@ typedef struct {
                             * default 128; 0: no reflections) */
     int reflection_faces;  /* environment map faces re-rendered a frame, round robin, after all of them at the
                             * first frame (default 1: a map refreshed in 6 frames) */
+    int indirect;          /* 0: no indirect light at all (no photon, AIM or gather work; the frame shows direct
+                            * light, emission and reflections); default 1. stage.trace follows it */
     /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;

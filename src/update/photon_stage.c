@@ -51,6 +51,7 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     lm_photon_settings_default(&s->photons);
     lm_aim_settings_default(&s->aim);
     s->surfaces_per_frame = 4;
+    s->trace = 1;
 }
 
 static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *out)
@@ -159,14 +160,16 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     lm_photon_settings photons = ps->set.photons;
     if (photons.cover_distance == 0.0f && ps->atlas) /* light closer under something than a texel is hidden */
         photons.cover_distance = ps->atlas->texel_size;
+    if (!ps->set.trace) /* one photon a light, never traced: the emitters' bookkeeping without the cost */
+        photons.total_photons = 0, photons.groups = 1, photons.per_group = 1;
     st = lm_photons_create(ps->scene, ps->surfaces, ps->rt, &ps->emitters, &photons, &ps->photons, err);
-    if (st == LM_OK)
+    if (st == LM_OK && ps->set.trace)
         st = lm_photons_trace_all(ps->photons, &first->photons, err);
     double t1 = lm_now();
     if (st == LM_OK)
         st = lm_aim_init(&ps->aim, ps->scene, ps->surfaces, ps->atlas, &ps->set.aim, err);
     ps->have_aim = st == LM_OK;
-    if (st == LM_OK)
+    if (st == LM_OK && ps->set.trace)
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);
     first->t_photons = t1 - t0;
@@ -266,6 +269,8 @@ static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out
 
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
+    if (!ps->set.trace)
+        return LM_OK;
     double t1 = lm_now();
     lm_status st = lm_photons_frame(ps->photons, &out->photons, err);
     double t2 = lm_now();
@@ -287,6 +292,8 @@ lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_fra
 lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err)
 {
     lm_status st = lm_photon_stage_animate(ps, t, out, err);
+    if (st != LM_OK || !ps->set.trace)
+        return st;
     double t1 = lm_now();
     if (st == LM_OK)
         st = lm_photons_trace_all(ps->photons, &out->photons, err);
