@@ -18,6 +18,15 @@ static int all_zero(const float *v, int n)
     return 1;
 }
 
+lmgi_context *lmt_context(void)
+{
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return ctx;
+}
+
 lmgi_scene *lmt_room(const lmt_room_spec *spec)
 {
     static const float default_lo[3] = {-0.4f, 0.0f, -0.4f}, default_hi[3] = {0.4f, 1.0f, 0.4f};

@@ -18,6 +18,8 @@ typedef struct {
     float texel_size;                   /* world units per lightmap texel (0: about 1,500 texels) */
 } lmt_room_spec;
 
+/* A context with the default GL backend. */
+lmgi_context *lmt_context(void);
 /* The room as a scene; its nodes are "room", "block" and "stool". */
 lmgi_scene *lmt_room(const lmt_room_spec *spec);
 /* An updater for the edit tests: 100 photons a group, hemicube 16, 16 rim rays, no frame of its own. */

@@ -59,9 +59,8 @@ static lmgi_light light_of(const lmgi_light_desc *d)
 static void test_add_and_remove(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     const lmgi_light_desc both[2] = {LAMP, SPOT};
     lmgi_scene *loaded = load_room(both, 2);
     lmgi_updater *ul = lmt_room_updater(ctx, loaded);
@@ -238,9 +237,8 @@ static void test_add_and_remove(void **state)
 static void test_first_light(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_scene *sc = load_room(NULL, 0);
     lmgi_updater *u = lmt_room_updater(ctx, sc);
     size_t n;
@@ -276,9 +274,8 @@ static void test_first_light(void **state)
 static void test_added_light_stays_in_its_room(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = 3000;

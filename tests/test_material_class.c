@@ -39,9 +39,8 @@ static int material_named(const lmgi_scene *sc, const char *name)
 static void test_diffuse_to_mirror_and_back(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     const lmgi_material_desc chrome = {.name = "red", .base_color = {0.8f, 0.2f, 0.1f, 1.0f}, .metallic = 1.0f,
                                        .roughness = 0.05f};
     lmgi_scene *sc = load_room(NULL, 0.0f);

@@ -52,9 +52,8 @@ static uint32_t node_texels(const lmgi_scene *sc, int first_tri)
 static void test_shadows_and_indirect(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_scene *sc = load_room(NULL), *twin = load_room(NULL);
     lmgi_updater *u = lmt_room_updater(ctx, sc), *ut = lmt_room_updater(ctx, twin);
     int block = lmgi_find_node(sc, "block"), lamp = lmgi_find_node(sc, "lamp");
@@ -156,9 +155,8 @@ static lmgi_effect effect(const lmgi_scene *sc, const char *name)
 static void test_reflections(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     const lmgi_material_desc chrome = {.name = "chrome", .base_color = {0.9f, 0.9f, 0.9f, 1.0f}, .metallic = 1.0f,
                                        .roughness = 0.05f};
     lmgi_scene *sc = load_room(&chrome);
@@ -204,9 +202,8 @@ static void switch_all(lmgi_scene *sc, const lmgi_node_effects *fx)
 static void test_run_effects(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     const lmgi_material_desc chrome = {.name = "chrome", .base_color = {0.9f, 0.9f, 0.9f, 1.0f}, .metallic = 1.0f,
                                        .roughness = 0.05f};
     static const unsigned bits[3] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS};

@@ -38,9 +38,8 @@ static double iim_sum(const float *iim, size_t n)
 static void test_static_block_made_dynamic(void **state)
 {
     (void)state;
-    lmgi_context *ctx = NULL;
+    lmgi_context *ctx = lmt_context();
     lmgi_error e;
-    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_scene *sc = load_room(0), *twin = load_room(1);
     lmgi_updater *u = lmt_room_updater(ctx, sc), *ut = lmt_room_updater(ctx, twin);
     int block = lmgi_find_node(sc, "block");
