@@ -1,8 +1,8 @@
 /* A level editor's session, through include/lmgi.h alone.
  *
  * Loads a scene and bakes it with a progress bar (the updater's creation is the first bake), then does
- * what an artist does: recolours a wall, moves a light, and re-bakes after each edit; each re-bake redoes
- * only what the edit reached and says how much. Writes the lightmap after each bake, a picture from
+ * what an artist does: recolours a wall, moves a light, adds a lamp below it, and re-bakes after each
+ * edit; each re-bake redoes only what the edit reached and says how much. Writes the lightmap after each bake, a picture from
  * the scene's camera at the end, and exports the edited level for an engine: OUT_DIR/level.gltf with
  * the lightmap's UVs as TEXCOORD_1 and level_lightmap.exr beside it.
  *
@@ -119,7 +119,16 @@ static int edit(lmgi_scene *sc, lmgi_updater *u, const char *out, const char *ma
     if (lmgi_set_node_transform(sc, li.node, world, &e) != LMGI_OK)
         return fail("move light", &e);
     printf("moved light '%s' by 0.25 along x\n", lmgi_node_name(sc, li.node));
-    return rebake(u, "move") || save(sc, u, out, "lightmap_moved.exr");
+    if (rebake(u, "move") || save(sc, u, out, "lightmap_moved.exr"))
+        return 1;
+
+    lmgi_get_light(sc, l, &li, NULL); /* a second lamp like it, half a unit below it */
+    li.position[1] -= 0.5f;
+    int lamp;
+    if (lmgi_add_light(sc, &li, &lamp, &e) != LMGI_OK)
+        return fail("add a lamp", &e);
+    printf("added light %d below '%s'\n", lamp, lmgi_node_name(sc, li.node));
+    return rebake(u, "lamp") || save(sc, u, out, "lightmap_lamp.exr");
 }
 
 static int session(lmgi_context *ctx, lmgi_scene *sc, const char *out, const char *material, const char *light)

@@ -126,9 +126,14 @@ static void test_editor_session(void **state)
     assert_non_null(line);
     assert_int_equal(sscanf(line, "move %u of %u photon paths changed", &changed, &traced), 2);
     assert_int_equal(changed, traced / 4); /* light_b2's own photons: one light of four */
-    static const char *const files[] = {"lightmap.exr", "lightmap_recoloured.exr", "lightmap_moved.exr", "view.png",
-                                        "level.gltf", "level.bin", "level_lightmap.exr"};
-    for (int k = 0; k < 7; k++) {
+    line = strstr(output, "lamp ");
+    assert_non_null(line);
+    assert_int_equal(sscanf(line, "lamp %u of %u photon paths changed", &changed, &traced), 2);
+    assert_int_equal(changed, traced / 5); /* the added lamp's, as many as its twin light_b2 has */
+    static const char *const files[] = {"lightmap.exr", "lightmap_recoloured.exr", "lightmap_moved.exr",
+                                        "lightmap_lamp.exr", "view.png", "level.gltf", "level.bin",
+                                        "level_lightmap.exr"};
+    for (int k = 0; k < 8; k++) {
         snprintf(cmd, sizeof cmd, "%s/%s", dir, files[k]);
         assert_true(file_size(cmd) > 1000);
     }
