@@ -362,6 +362,12 @@ typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
 typedef enum { LMGI_GATHER_DEFAULT = 0, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_INSTANCED, LMGI_GATHER_LAYERED } lmgi_gather_scheme;
 
 enum { LMGI_EFFECT_SHADOWS = 1, LMGI_EFFECT_INDIRECT = 2, LMGI_EFFECT_REFLECTIONS = 4 };
+/* How frames get their indirect light (docs/gather.md): LMGI_INDIRECT_LIGHTMAP, the paper's AIMs,
+ * hemicube gather and IIM (the lightmaps); LMGI_INDIRECT_BRUTEFORCE, every visible pixel gathers the
+ * photon hits themselves (Mara et al. 2013, every photon against every pixel: the ground truth of
+ * photon gathers, for small scenes and frames; no AIM or IIM, so the lightmaps stay 0 and environment
+ * maps show direct light only). */
+typedef enum { LMGI_INDIRECT_LIGHTMAP = 0, LMGI_INDIRECT_BRUTEFORCE } lmgi_indirect_path;
 
 /* Zero-initialised means the defaults (the same as `lmgi run`'s; docs/ says what each costs and buys). */
 typedef struct {
@@ -399,6 +405,7 @@ typedef struct {
      * (the lightmaps stay 0; the frame shows direct light, emission and reflections), REFLECTIONS no
      * environment maps (as reflection_size -1). Per node: lmgi_set_node_effects */
     unsigned effects_off;
+    lmgi_indirect_path indirect; /* (0: LMGI_INDIRECT_LIGHTMAP) */
     /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
      * that, set non-zero (from any thread), stops it between gather passes: LMGI_ERR_CANCELLED */
     lmgi_progress_fn progress;

@@ -115,7 +115,7 @@ void lmt_bake(lmgi_updater *u, lmgi_bake_report *r)
         fail_msg("%s", e.message);
 }
 
-float *lmt_corner_frame(lmgi_updater *u)
+void lmt_corner_camera(lmgi_camera *out)
 {
     const float eye[3] = {1.9f, 2.0f, 1.9f}, at[3] = {-1.0f, 0.5f, -1.0f};
     float f[3], l = 0.0f;
@@ -136,6 +136,13 @@ float *lmt_corner_frame(lmgi_updater *u)
     const float n = 0.05f, fa = 20.0f; /* tan(45 degrees) = 1 */
     cam.proj[0] = cam.proj[5] = 1.0f;
     cam.proj[10] = -(fa + n) / (fa - n), cam.proj[11] = -1.0f, cam.proj[14] = -2.0f * fa * n / (fa - n);
+    *out = cam;
+}
+
+float *lmt_corner_frame(lmgi_updater *u)
+{
+    lmgi_camera cam;
+    lmt_corner_camera(&cam);
     float *rgb = malloc(3 * LMT_SIDE * LMT_SIDE * sizeof *rgb);
     lmgi_error e;
     assert_non_null(rgb);

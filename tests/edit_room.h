@@ -33,6 +33,7 @@ void lmt_bake(lmgi_updater *u, lmgi_bake_report *r);
  * (-1, 0.5, -1) with a 90 degree field of view. */
 #define LMT_SIDE 48
 float *lmt_corner_frame(lmgi_updater *u);
+void lmt_corner_camera(lmgi_camera *cam);
 /* Relative L1 distance of a from b over n floats. */
 double lmt_relative_l1(const float *a, const float *b, size_t n);
 /* Mean irradiance (R + G + B) of the valid texels of node `node` ("room", "block", "stool") in an IIM of

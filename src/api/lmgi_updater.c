@@ -127,6 +127,10 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     if (d->effects_off & ~all)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: effects_off 0x%x has bits other than "
                        "LMGI_EFFECT_SHADOWS, _INDIRECT and _REFLECTIONS", d->effects_off);
+    if ((int)d->indirect < LMGI_INDIRECT_LIGHTMAP || (int)d->indirect > LMGI_INDIRECT_BRUTEFORCE)
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: indirect %d is not an indirect path "
+                       "(LMGI_INDIRECT_LIGHTMAP, LMGI_INDIRECT_BRUTEFORCE)", (int)d->indirect);
+    s->indirect_path = d->indirect == LMGI_INDIRECT_BRUTEFORCE ? LM_INDIRECT_BRUTEFORCE : LM_INDIRECT_LIGHTMAP;
     s->direct.shadows = !(d->effects_off & LMGI_EFFECT_SHADOWS);
     s->indirect = !(d->effects_off & LMGI_EFFECT_INDIRECT);
     if (d->effects_off & LMGI_EFFECT_REFLECTIONS)

@@ -125,6 +125,15 @@ static int parse_effects(const char *o, const char *v, unsigned *off)
     return v && *v ? 0 : bad(o, v, "a list such as -shadows,-indirect");
 }
 
+static int parse_indirect(const char *o, const char *v, int *out)
+{
+    if (v && !strcmp(v, "lightmap"))
+        return *out = LMGI_INDIRECT_LIGHTMAP, 0;
+    if (v && !strcmp(v, "bruteforce"))
+        return *out = LMGI_INDIRECT_BRUTEFORCE, 0;
+    return bad(o, v, "lightmap or bruteforce");
+}
+
 static int parse_scheme(const char *o, const char *v, int *out)
 {
     static const char *names[] = {"viewports", "instanced", "layered"};
@@ -217,6 +226,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_emitter_light(o, v, &a->emitter_light);
         else if (!strcmp(o, "--effects")) /* its list starts with - or +: the word after it, whatever it is */
             rc = parse_effects(o, i + 1 < argc ? argv[i + 1] : NULL, &a->effects_off);
+        else if (!strcmp(o, "--indirect"))
+            rc = parse_indirect(o, v, &a->indirect);
         else if (!strcmp(o, "--tonemap"))
             rc = parse_tonemap(o, v, &a->tonemap);
         else if (!strcmp(o, "--emitter-rays"))

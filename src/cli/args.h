@@ -50,6 +50,7 @@ typedef struct {
     int force;              /* --force: write into a non-empty --out directory lmgi did not make */
     int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
     unsigned effects_off;   /* --effects -shadows,-indirect,-reflections: lmgi_updater_desc.effects_off */
+    int indirect;           /* --indirect lightmap|bruteforce: lmgi_updater_desc.indirect (default lightmap) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */

@@ -54,6 +54,7 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
     d->reflection_size = a->reflection_size < 0 ? 0 : a->reflection_size == 0 ? -1 : a->reflection_size;
     d->reflection_faces = a->reflection_faces;
     d->effects_off = a->effects_off;
+    d->indirect = (lmgi_indirect_path)a->indirect;
     d->gather_scheme = a->gather_scheme < 0 ? LMGI_GATHER_DEFAULT : (lmgi_gather_scheme)(a->gather_scheme + 1);
     d->emitter_light = a->emitter_light < 0 ? LMGI_EMITTERS_AUTO
                        : a->emitter_light ? LMGI_EMITTERS_CLOSED_FORM : LMGI_EMITTERS_DRAWN;

@@ -19,6 +19,7 @@ lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error 
 
 void lm_photon_store_clear(lm_photon_store *ps)
 {
+    ps->version++;
     ps->used = 0;
     ps->free_head = LM_NONE;
     for (int i = 0; i < ps->surface_count; i++) {

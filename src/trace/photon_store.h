@@ -40,6 +40,8 @@ typedef struct {
     uint32_t mapped;         /* slots [0, mapped) are known to be paged in (lm_photon_store_reserve) */
     int surface_count;
     lm_surface_hits *surfaces;
+    uint64_t version;        /* counts hits linked and removed, and clears: what a copy of the store's
+                              * contents (the brute-force gather's picture) compares with */
 } lm_photon_store;
 
 lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error *err);
@@ -104,6 +106,7 @@ static inline void lm_photon_store_account(lm_photon_store *ps, const lm_hit *h)
 {
     lm_surface_hits *sh = &ps->surfaces[h->surface];
     double e = lm_hit_energy(h);
+    ps->version++;
     sh->delta_f += e;
     if (!(h->bounce == 0 && h->from_punctual))
         sh->delta_i += e;

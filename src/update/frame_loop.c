@@ -9,6 +9,7 @@
 #include "../core/timing.h"
 #include "../core/vecmath.h"
 #include "../gpu/composite.h"
+#include "../photonmap/pixel_gather.h"
 #include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
 #include "stage_worker.h"
@@ -28,6 +29,12 @@ struct lm_frame_loop {
     lm_reflections *reflections; /* NULL: no mirror or glossy node, or switched off */
     uint32_t reflect_version;    /* the scene's pass_version the reflection maps were made for */
     uint32_t switch_version;     /* the scene's pass_version the gather's and composite's switches follow */
+    /* the brute-force path: the indirect radiance of one view's pixels, and what it was computed for */
+    lm_gbuffer gbuf;
+    float *photon_rgb;
+    lm_view photon_view;
+    int photon_w, photon_h;
+    uint64_t photon_version, photon_world; /* the store's version and a hash of the node matrices */
     const lm_surfaces *surfaces;
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
@@ -65,6 +72,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->reflection_size = 128;
     s->reflection_faces = 1;
     s->indirect = 1;
+    s->indirect_path = LM_INDIRECT_LIGHTMAP;
 }
 
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
@@ -237,7 +245,8 @@ static lm_status setup_render(lm_frame_loop *fl, lm_error *err)
 static void sync_gather_switches(lm_frame_loop *fl)
 {
     for (int k = 0; k < fl->surfaces->surface_count; k++) {
-        int off = !fl->set.indirect || !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
+        int off = !fl->set.indirect || fl->set.indirect_path != LM_INDIRECT_LIGHTMAP ||
+                  !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
         if (off != fl->iim.sched.off[k])
             lm_iim_sched_set_off(&fl->iim.sched, store_of(fl), k, off);
     }
@@ -322,6 +331,7 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
     fl->set = *set;
     fl->set.stage.trace = fl->set.stage.trace && fl->set.indirect;
+    fl->set.stage.aims = fl->set.stage.aims && fl->set.indirect_path == LM_INDIRECT_LIGHTMAP;
     fl->scene = w->scene;
     fl->surfaces = w->surfaces;
     fl->atlas = a;
@@ -355,6 +365,8 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     lm_direct_free(fl->direct_light);
     lm_composite_free(fl->comp);
     lm_reflections_free(fl->reflections);
+    lm_gbuffer_free(&fl->gbuf);
+    free(fl->photon_rgb);
     if (fl->have_iim)
         lm_iim_free(&fl->iim);
     lm_gather_free(fl->gather);
@@ -369,6 +381,73 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     free(fl);
 }
 
+/* A hash of every node's world matrix: the brute-force picture is made again when something moved. */
+static uint64_t world_hash(const lm_scene *s)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (int n = 0; n < s->node_count; n++) {
+        const unsigned char *b = (const unsigned char *)s->nodes[n].world;
+        for (size_t k = 0; k < sizeof s->nodes[n].world; k++)
+            h = (h ^ b[k]) * 1099511628211ull;
+    }
+    return h;
+}
+
+/* The brute-force path's indirect radiance for view at w x h into fl->photon_rgb, unless it is there
+ * already for the same view, photons and node matrices. Reads the photon store: never while the stage's
+ * worker runs (the steps call it before they start it). */
+static lm_status photon_indirect(lm_frame_loop *fl, const lm_view *view, int w, int h, lm_error *err)
+{
+    const lm_photon_store *ps = lm_photons_store(lm_photon_stage_photons(fl->stage));
+    uint64_t world = world_hash(fl->scene);
+    if (fl->photon_rgb && fl->photon_w == w && fl->photon_h == h && fl->photon_version == ps->version &&
+        fl->photon_world == world && !memcmp(fl->photon_view.view, view->view, sizeof view->view) &&
+        !memcmp(fl->photon_view.proj, view->proj, sizeof view->proj))
+        return LM_OK;
+    lm_ref_camera cam;
+    lm_status st = lm_view_ref_camera(view, w, h, &cam, err);
+    if (st == LM_OK)
+        st = lm_gbuffer_trace(&fl->gbuf, fl->scene, fl->rt, &cam, err);
+    float *rgb = st == LM_OK ? realloc(fl->photon_rgb, 3 * (size_t)w * (size_t)h * sizeof *rgb) : NULL;
+    if (st == LM_OK && !rgb)
+        st = lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon gather's picture", fl->scene->path);
+    if (st != LM_OK)
+        return st;
+    fl->photon_rgb = rgb;
+    float r = lm_pixel_gather_radius(ps, fl->surfaces, fl->set.stage.aim.n_nearest);
+    lm_pixel_gather_bruteforce(&fl->gbuf, ps, r, rgb);
+    fl->photon_view = *view, fl->photon_w = w, fl->photon_h = h;
+    fl->photon_version = ps->version, fl->photon_world = world;
+    return LM_OK;
+}
+
+/* Adds the brute-force path's indirect radiance, made beforehand for this view (photon_indirect), to the
+ * frame rgb (top row first, as the picture). */
+static lm_status add_photon_indirect(lm_frame_loop *fl, const lm_view *view, int w, int h, float *rgb,
+                                     lm_error *err)
+{
+    if (!fl->photon_rgb || fl->photon_w != w || fl->photon_h != h ||
+        memcmp(fl->photon_view.view, view->view, sizeof view->view))
+        return lm_fail(err, LM_ERR_INVALID, "%s: the photon gather's picture was not made for this view",
+                       fl->scene->path);
+    for (size_t i = 0; i < 3 * (size_t)w * (size_t)h; i++)
+        rgb[i] += fl->photon_rgb[i];
+    return LM_OK;
+}
+
+/* The step's own frame's view, and with the brute-force path its photon picture, made while the store is
+ * quiet (before the stage's worker starts: the frame shows the photons as the last stage left them). */
+static lm_status prepare_frame(lm_frame_loop *fl, lm_error *err)
+{
+    int w = fl->set.width, h = fl->set.height;
+    if (w <= 0)
+        return LM_OK;
+    lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
+    if (!fl->set.indirect || fl->set.indirect_path != LM_INDIRECT_BRUTEFORCE)
+        return LM_OK;
+    return photon_indirect(fl, &fl->view, w, h, err);
+}
+
 /* The composite's indirect term (E_IIM / pi, premultiplied over the atlas), the environment map faces
  * due this frame, then the direct light, whose first pass adds kd x that term at each visible surface's
  * lightmap uv (shadow maps re-rendered only when stale), the reflections over it: one frame-sized
@@ -379,8 +458,8 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
     double t0 = lm_now();
     unsigned lit = 0;
     lm_status st = follow_pass_edits(fl, err);
-    if (st == LM_OK && fl->set.indirect) /* else the first pass adds no indirect term */
-        st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err);
+    if (st == LM_OK && fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_LIGHTMAP)
+        st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err); /* else the first pass adds none */
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
     const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
@@ -392,6 +471,8 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
         st = lm_reflections_draw(fl->reflections, fl->direct_light, view, err);
     if (st == LM_OK)
         st = lm_direct_read(fl->direct_light, rgb, err);
+    if (st == LM_OK && fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_BRUTEFORCE)
+        st = add_photon_indirect(fl, view, w, h, rgb, err);
     o->t_composite = t1 - t0;
     o->t_direct = lm_now() - t1;
     return st;
@@ -403,8 +484,7 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     int w = fl->set.width, h = fl->set.height;
     if (w <= 0)
         return LM_OK;
-    lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
-    return render_view(fl, &fl->view, w, h, fl->image, 1, o, err);
+    return render_view(fl, &fl->view, w, h, fl->image, 1, o, err); /* fl->view: prepare_frame's */
 }
 
 lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width, int height, float *rgb,
@@ -413,6 +493,9 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
     lm_status st = lm_gl_make_current(fl->gl, err);
     if (st == LM_OK)
         st = setup_render(fl, err);
+    if (st == LM_OK && fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_BRUTEFORCE &&
+        (st = lm_frame_loop_sync(fl, err)) == LM_OK) /* the gather reads the store the worker writes */
+        st = photon_indirect(fl, view, width, height, err);
     lm_frame_stats o;
     /* the environment maps' faces due are refreshed by the steps' own frames; without those, here */
     int refresh = fl->set.width <= 0;
@@ -454,6 +537,8 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
         st = lm_photon_stage_update(fl->stage, &o->stage, err);
     if (o->stage.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
+    if (st == LM_OK)
+        st = prepare_frame(fl, err);
     double t1 = lm_now();
     if (st == LM_OK)
         st = schedule(fl, o, err);
@@ -479,6 +564,8 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
     if (st == LM_OK)
         st = schedule(fl, o, err);
     double t1 = lm_now();
+    if (st == LM_OK)
+        st = prepare_frame(fl, err);
     if (st != LM_OK)
         return st;
     st = gather_run(fl, o->texels_gathered, err);

@@ -26,6 +26,8 @@
 #include "../gpu/iim.h"
 #include "photon_stage.h"
 
+enum { LM_INDIRECT_LIGHTMAP = 0, LM_INDIRECT_BRUTEFORCE = 1 };
+
 typedef struct {
     lm_photon_stage_settings stage;
     lm_hemicube_settings gather; /* coverage_samples 0 (the default here): 1 with the closed-form emitter
@@ -48,6 +50,10 @@ typedef struct {
                             * first frame (default 1: a map refreshed in 6 frames) */
     int indirect;          /* 0: no indirect light at all (no photon, AIM or gather work; the frame shows direct
                             * light, emission and reflections); default 1. stage.trace follows it */
+    int indirect_path;     /* how the frame gets its indirect light: LM_INDIRECT_LIGHTMAP (default: AIMs, the
+                            * hemicube gather into the IIM, the composite) or LM_INDIRECT_BRUTEFORCE (straight
+                            * from the photon hits at the visible pixels, photonmap/pixel_gather.h: no AIM, no
+                            * IIM; the lightmaps stay 0 and environment maps hold direct light only) */
     /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;

@@ -52,6 +52,7 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     lm_aim_settings_default(&s->aim);
     s->surfaces_per_frame = 4;
     s->trace = 1;
+    s->aims = 1;
 }
 
 static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *out)
@@ -169,7 +170,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     if (st == LM_OK)
         st = lm_aim_init(&ps->aim, ps->scene, ps->surfaces, ps->atlas, &ps->set.aim, err);
     ps->have_aim = st == LM_OK;
-    if (st == LM_OK && ps->set.trace)
+    if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);
     first->t_photons = t1 - t0;
@@ -274,7 +275,7 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
     double t1 = lm_now();
     lm_status st = lm_photons_frame(ps->photons, &out->photons, err);
     double t2 = lm_now();
-    if (st == LM_OK)
+    if (st == LM_OK && ps->set.aims)
         st = refresh_aims(ps, ps->set.surfaces_per_frame, &out->aim, err);
     double t3 = lm_now();
     out->t_photons = t2 - t1;
@@ -300,7 +301,7 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage
     double t2 = lm_now();
     float threshold = ps->aim.set.delta_threshold; /* a bake refreshes every surface whose photons changed */
     ps->aim.set.delta_threshold = 0.0f;
-    if (st == LM_OK)
+    if (st == LM_OK && ps->set.aims)
         st = refresh_aims(ps, -1, &out->aim, err);
     ps->aim.set.delta_threshold = threshold;
     out->t_photons = t2 - t1;

@@ -15,6 +15,8 @@ typedef struct {
     int surfaces_per_frame;  /* AIM refreshes per frame, largest delta_f/area first (default 4; < 0 all) */
     int trace;               /* 0: no photon is traced and no AIM filled, at setup or after (a run without
                               * indirect light: the stage keeps only the emitters and the animations) */
+    int aims;                /* 0: photons traced, no AIM filled (an indirect path that gathers from the
+                              * photons themselves) */
 } lm_photon_stage_settings;
 
 typedef struct {

@@ -1,0 +1,53 @@
+/* Indirect light for the visible picture straight from the photons, without AIMs or a hemicube: the
+ * photon density estimate of Mara, McGuire, Nowrouzezahrai & Luebke (2013), eq. 1, at each pixel's
+ * visible point X,
+ *
+ *     L(X) = kd(X) / pi * sum_P Phi_P kappa(|Y_P - X|) / (pi c (1 - c + c^2 / 3) r^2)
+ *
+ * over the stored photon hits P (position Y_P, flux Phi_P) within r of X that arrive at X's front, with
+ * the paper's kernel kappa(s) = min(c, 1 - s / r), c = 1/5 (eq. 2; the denominator is its integral over
+ * the disc, eq. 3), the diffuse BSDF kd / pi (kd the diffuse lobe, docs/materials.md) and one radius r
+ * for every photon (the paper's constant-radius case, in which every gather order gives the same
+ * picture). The hits are those an IIM holds: every stored hit but the punctual lights' first ones,
+ * whose light the direct pass draws per pixel.
+ *
+ * r: the radius of a disc that holds n photons on average, r = sqrt(n A / (pi H)), A the surfaces' world
+ * area and H the hits gathered (the N of the AIM's N-nearest estimate, so that both paths blur alike on
+ * average; docs/gather.md, "The brute-force gather").
+ *
+ * This is the brute-force iteration (every photon against every pixel: O(pixels x hits), seconds at
+ * 512 x 512 and tens of thousands of hits, on the calling thread's OpenMP team), the ground truth for
+ * faster gathers. The visible points come from primary rays through the pixel centres (lm_gbuffer).
+ * Deterministic: each pixel sums its hits in store order. Not thread-safe against store updates. */
+#ifndef LM_PIXEL_GATHER_H
+#define LM_PIXEL_GATHER_H
+
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../scene/scene.h"
+#include "../trace/photon_store.h"
+#include "../trace/reference.h"
+#include "../trace/rt_scene.h"
+
+/* What each pixel sees: its visible point, the shading normal on the eye's side, and kd there (0 for
+ * mirror, glass, the back of a single-sided surface and the background, which take no indirect term). */
+typedef struct {
+    int width, height;
+    float *pos, *normal, *kd; /* 3 floats per pixel each, row 0 at the top */
+} lm_gbuffer;
+
+/* Casts one ray through each pixel's centre of cam (the reference's pinhole, lm_ref_camera). Grows g's
+ * arrays as the size asks (g zero-initialised the first time). */
+lm_status lm_gbuffer_trace(lm_gbuffer *g, const lm_scene *s, const lm_rt *rt, const lm_ref_camera *cam, lm_error *err);
+void lm_gbuffer_free(lm_gbuffer *g);
+
+/* r = sqrt(n A / (pi H)) over the store's hits that the gather takes (H) and the surfaces' area (A);
+ * 0 when there are none. */
+float lm_pixel_gather_radius(const lm_photon_store *ps, const lm_surfaces *su, int n);
+/* out (3 floats per pixel): L(X) above for every pixel of g, every gathered hit tested against every
+ * pixel. */
+void lm_pixel_gather_bruteforce(const lm_gbuffer *g, const lm_photon_store *ps, float radius, float *out);
+
+#endif
