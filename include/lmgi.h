@@ -130,7 +130,13 @@ LMGI_API int lmgi_effect_count(const lmgi_scene *scene); /* 0 for NULL */
 /* NULL scene or i out of range: out zeroed (name NULL); NULL out: nothing. */
 LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
 
-/* Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major) and
+/* Edits (node transforms, static or dynamic, effect switches, lights, materials) are made between an
+ * updater's calls, on the thread that uses it (a scene with an updater follows its context's one thread
+ * at a time); each first waits for photon work the last update left running, then changes the scene,
+ * and the updater takes it in at its next update or bake. Without an updater a scene may be edited from
+ * any one thread at a time.
+ *
+ * Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major) and
  * its children with it; a static node, a matrix with NaN or infinite entries, a singular one (a zero
  * scale), or one that mirrors where the node's world matrix at load did not (or the other way round: a
  * node's sides are fixed at load), is refused with LMGI_ERR_INVALID and changes nothing. (An animation
