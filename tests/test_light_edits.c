@@ -222,6 +222,11 @@ static void test_add_and_remove(void **state)
     lmt_expect_invalid(lmgi_add_light(sc, &bad, &id, &e), &e, "cones");
     lmt_expect_invalid(lmgi_add_light(sc, &bad, NULL, &e), &e, "NULL");
     lmt_expect_invalid(lmgi_add_light(NULL, &bad, &id, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_add_light(sc, NULL, &id, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_remove_light(NULL, 0, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_remove_light(sc, -1, &e), &e, "out of range");
+    assert_false(lmgi_light_is_removed(NULL, 1));
+    assert_false(lmgi_light_is_removed(sc, 99));
     assert_int_equal(lmgi_light_count(sc), 3); /* nothing added by the refused calls */
 
     free(want), free(before), free(with), free(same), free(after), free(dark);

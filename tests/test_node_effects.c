@@ -126,6 +126,9 @@ static void test_shadows_and_indirect(void **state)
     lmt_expect_invalid(lmgi_set_node_effects(sc, block, &bad, &e), &e, "indirect is 0 or 1");
     lmt_expect_invalid(lmgi_set_node_effects(sc, 99, &fx, &e), &e, "out of range");
     lmt_expect_invalid(lmgi_set_node_effects(sc, block, NULL, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_set_node_effects(NULL, block, &fx, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_get_node_effects(NULL, block, &bad, &e), &e, "NULL");
+    lmt_expect_invalid(lmgi_get_node_effects(sc, block, NULL, &e), &e, "NULL");
     lmt_expect_invalid(lmgi_get_node_effects(sc, -1, &bad, &e), &e, "out of range");
     assert_int_equal(lmgi_get_node_effects(sc, block, &bad, &e), LMGI_OK);
     assert_true(bad.shadows && bad.indirect && bad.reflections);
