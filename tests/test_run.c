@@ -388,7 +388,9 @@ static void test_furnace_composite(void **state)
 /* Reflections (gpu/reflections.h): a cube at the centre of a closed room whose walls emit Le = 1 and
  * reflect nothing, seen face on from inside; every pixel is the cube's front face reflecting the wall
  * behind the camera. A mirror of albedo 0.8 shows 0.8 Le; a glossy metal (albedo 0.8, roughness 0.3:
- * Phong n = 245, ks = 0.8, kd = 0) shows ks (n + 2) / (n + 1) (n.v) Le, 0.803 at the centre; with
+ * Phong n = 245, ks = 0.8, kd = 0) shows ks (n + 2) / (n + 1) (n.v) Le, 0.803 at the centre; a glass cube
+ * (ior 1.5, tint 0.5 0.8 1) F Le + (1 - F) 0.8 Le in green, F = 0.04 face on: 0.808, and a clear one Le
+ * (what it reflects and what it lets through add up: nothing lost, nothing gained); with
  * --reflection-size 0 the mirror is black. */
 static void check_reflection(const char *material, const char *opts, double want)
 {
@@ -400,7 +402,7 @@ static void check_reflection(const char *material, const char *opts, double want
     snprintf(materials, sizeof materials,
              "[{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 1, 1]}, %s],"
              " \"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.5, \"znear\": 0.01,"
-             " \"aspectRatio\": 1}}]",
+             " \"aspectRatio\": 1}}], \"extensionsUsed\": [\"KHR_materials_transmission\", \"KHR_materials_ior\"]",
              material);
     const char *path = lmt_write_scene("mirror.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"camera\": 0, "
                                        "\"translation\": [0, 0, 4]}]", materials);
@@ -617,6 +619,13 @@ static void test_reflections(void **state)
     double n = 2.0 / (0.3 * 0.3 * 0.3 * 0.3) - 2.0;
     check_reflection(glossy, "", 0.8 * (n + 2.0) / (n + 1.0));
     check_reflection(mirror, "--reflection-size 0", 0.0);
+    const char *glass = "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.8, 1, 1], \"metallicFactor\": 0},"
+                        " \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1},"
+                        " \"KHR_materials_ior\": {\"ior\": 1.5}}}";
+    const char *clear = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0},"
+                        " \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1}}}";
+    check_reflection(glass, "", 0.04 + 0.96 * 0.8);
+    check_reflection(clear, "", 1.0);
 }
 
 int main(void)

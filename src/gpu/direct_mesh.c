@@ -8,7 +8,7 @@
 #include "../core/vecmath.h"
 #include "../trace/bsdf.h"
 
-#define FLOATS 18 /* pos, ns, base colour, (n, double-sided, metallic, class), emission, uv */
+#define FLOATS 18 /* pos, ns, base colour, (n or glass's ior, double-sided, metallic, class), emission, uv */
 
 /* Group of triangle t: 0 without a base colour texture, else texture index + 1. */
 static int group_of(const lm_scene *s, uint32_t t)
@@ -38,7 +38,7 @@ static void vertex_attributes(const lm_scene *s, uint32_t vi, int mi, float *v)
     lm_scene_vertex_world(s, vi, v);
     lm_scene_normal_world(s, vi, v + 3);
     memcpy(v + 6, m->base_color, 3 * sizeof(float));
-    v[9] = m->cls == LM_MAT_GLOSSY ? lm_phong_exponent(m->roughness) : 1.0f;
+    v[9] = m->cls == LM_MAT_GLOSSY ? lm_phong_exponent(m->roughness) : m->cls == LM_MAT_GLASS ? m->ior : 1.0f;
     v[10] = (float)m->double_sided;
     v[11] = fminf(fmaxf(m->metallic, 0.0f), 1.0f);
     v[12] = (float)m->cls;

@@ -31,9 +31,13 @@ struct lm_reflections {
 };
 
 /* Mirror: albedo x env(r). Glossy: ks (n + 2) / (n + 1) max(n.r, 0) x env(r) at the mip level whose texel
- * is the lobe's width 1 / sqrt(n) (lod_base = log2(size / (pi / 2)), a face spanning pi / 2). albedo and
- * ks from direct_shader.c's lobes (lm_direct_lobes_glsl), so both passes read a material alike. The back
- * of a single-sided surface reflects nothing. Class numbers as there (1 glossy, 2 mirror). */
+ * is the lobe's width 1 / sqrt(n) (lod_base = log2(size / (pi / 2)), a face spanning pi / 2). Glass (ior
+ * in the vertex's n): F env(r) + (1 - F) albedo env(t), F the dielectric Fresnel reflectance at the eye
+ * ray's angle (Schlick's approximation to it), t the ray refracted into the glass at this first surface
+ * (1 under total internal reflection, leaving the inside), looked up as if it left unbent: the glass's
+ * far side and the parallax of what lies behind are not modelled. albedo and ks from direct_shader.c's
+ * lobes (lm_direct_lobes_glsl), so both passes read a material alike. The back of a single-sided surface
+ * reflects nothing. Class numbers as there (1 glossy, 2 mirror, 3 glass). */
 static const char *REFLECT_HEAD =
     "#version 450 core\n"
     "in vec3 v_pos, v_ns;\n"
@@ -55,6 +59,16 @@ static const char *REFLECT_MAIN =
     "    vec3 r = reflect(normalize(v_pos - eye), n);\n"
     "    int cls = int(v_par.w + 0.5);\n"
     "    if (cls == 2) { frag = vec4(albedo * textureLod(env, r, 0.0).rgb, 0.0); return; }\n"
+    "    if (cls == 3) {\n"
+    "        vec3 d = normalize(v_pos - eye);\n"
+    "        float eta = gl_FrontFacing ? 1.0 / v_par.x : v_par.x, c = clamp(-dot(d, n), 0.0, 1.0);\n"
+    "        vec3 t = refract(d, n, eta);\n"
+    "        float f0 = (1.0 - v_par.x) / (1.0 + v_par.x), F = f0 * f0 + (1.0 - f0 * f0) * pow(1.0 - c, 5.0);\n"
+    "        if (dot(t, t) == 0.0) F = 1.0;\n"
+    "        vec3 through = dot(t, t) > 0.0 ? albedo * textureLod(env, t, 0.0).rgb : vec3(0.0);\n"
+    "        frag = vec4(F * textureLod(env, r, 0.0).rgb + (1.0 - F) * through, 0.0);\n"
+    "        return;\n"
+    "    }\n"
     "    vec3 kd, ks;\n"
     "    lobes(kd, ks);\n"
     "    float e = v_par.x;\n"
@@ -63,7 +77,7 @@ static const char *REFLECT_MAIN =
     "    frag = vec4(ks * w * textureLod(env, r, lod).rgb, 0.0);\n"
     "}\n";
 
-static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY; }
+static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY || c == LM_MAT_GLASS; }
 
 /* The nodes with mirror or glossy triangles, each with its list of them (from the node's own range). */
 static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error *err)

@@ -1,10 +1,11 @@
-/* Reflections (the paper's section 6): a dynamic environment cube map per node that holds mirror or
- * glossy triangles, rendered from the centre of the node's world bounds with the frame's own direct
+/* Reflections (the paper's section 6): a dynamic environment cube map per node that holds mirror, glossy
+ * or glass triangles, rendered from the centre of the node's world bounds with the frame's own direct
  * pass (direct light, shadows, emission and the IIM's indirect term; the node itself left out), and an
  * additive pass that adds to the frame what those triangles reflect of it:
  *
  *   mirror   albedo x env(r)
  *   glossy   ks (n + 2) / (n + 1) max(n.r, 0) x env(r, blurred to the lobe)
+ *   glass    F env(r) + (1 - F) albedo env(t), F Schlick's Fresnel, t refracted at the near surface
  *
  * r the eye ray reflected about the shading normal, ks and n the Phong lobe of bsdf.c (the normalized
  * lobe integrated against an environment that is constant across it). The glossy lobe is the cube map's
@@ -14,8 +15,9 @@
  * nothing is counted twice (docs/materials.md, "What each class gets from where").
  *
  * Approximations: the map is seen from one point, so a reflection of something near a large reflector is
- * displaced (parallax); reflectors see each other without their reflections (one bounce); glass gets
- * nothing here yet. Cost: 6 direct passes of size^2 pixels per map, at creation of the object's first
+ * displaced (parallax); reflectors see each other without their reflections (one bounce); glass bends the
+ * ray at its near surface only and looks it up unbent by the far one (no image through a lens), and the
+ * light it focuses is the caustics' (issue 12). Cost: 6 direct passes of size^2 pixels per map, at creation of the object's first
  * update and then `faces_per_frame` faces a frame, round robin over all maps (docs/direct.md,
  * "Reflections"). Needs a current GL context; not thread-safe. */
 #ifndef LM_REFLECTIONS_H

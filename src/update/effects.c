@@ -140,22 +140,28 @@ static void decide_specular(const lm_scene *s, lm_effects *e)
     /* reflections (gpu/reflections.h): environment maps for mirror and glossy nodes */
     usage glossy = count_usage(s, LM_MAT_GLOSSY, LM_EFFECT_REFLECTIONS);
     usage mirrors = count_usage(s, LM_MAT_MIRROR, LM_EFFECT_REFLECTIONS);
-    int any = mirrors.materials_on, shiny = glossy.materials_on;
-    int switched = mirrors.materials_off + glossy.materials_off;
-    e->on[LM_EFFECT_REFLECTIONS] = any + shiny > 0;
-    if (any > 0)
-        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%d mirror%s material%s on node '%s'",
-                 any, shiny ? " and glossy" : "", any + shiny == 1 ? "" : "s", s->nodes[mirrors.first_node_on].name);
-    else if (shiny > 0)
-        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%d glossy material%s on node '%s'", shiny,
-                 shiny == 1 ? "" : "s", s->nodes[glossy.first_node_on].name);
-    else if (switched > 0)
-        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "mirror and glossy materials only on nodes with "
+    usage glasses = count_usage(s, LM_MAT_GLASS, LM_EFFECT_REFLECTIONS);
+    int on_count = mirrors.materials_on + glossy.materials_on + glasses.materials_on;
+    int switched = mirrors.materials_off + glossy.materials_off + glasses.materials_off;
+    const usage *first = mirrors.first_node_on >= 0 ? &mirrors : glossy.first_node_on >= 0 ? &glossy : &glasses;
+    e->on[LM_EFFECT_REFLECTIONS] = on_count > 0;
+    if (on_count > 0) { /* "1 mirror and 2 glass materials on node '...'" */
+        char what[160] = "";
+        const int counts[3] = {mirrors.materials_on, glossy.materials_on, glasses.materials_on};
+        static const char *const kinds[3] = {"mirror", "glossy", "glass"};
+        for (int k = 0; k < 3; k++)
+            if (counts[k])
+                snprintf(what + strlen(what), sizeof what - strlen(what), "%s%d %s", what[0] ? " and " : "",
+                         counts[k], kinds[k]);
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s material%s on node '%s'", what, on_count == 1 ? "" : "s",
+                 s->nodes[first->first_node_on].name);
+    } else if (switched > 0)
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "mirror, glossy and glass materials only on nodes with "
                  "reflections switched off (first: '%s')",
-                 s->nodes[mirrors.first_node_off >= 0 ? mirrors.first_node_off : glossy.first_node_off].name);
+                 s->nodes[mirrors.first_node_off >= 0 ? mirrors.first_node_off
+                          : glossy.first_node_off >= 0 ? glossy.first_node_off : glasses.first_node_off].name);
     else
-        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s", glass.materials_on + glass.materials_off > 0
-                 ? "glass only (refraction is not drawn yet)" : "no mirror or glossy material");
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "no mirror, glossy or glass material");
 }
 
 static void decide_updates(const lm_scene *s, lm_effects *e)
