@@ -52,14 +52,9 @@ lmgi_status lmgi_get_light(const lmgi_scene *sc, int light, lmgi_light *out, lmg
     out->inner_cone = l->inner_cone;
     out->outer_cone = l->outer_cone;
     out->enabled = !l->off;
-    lm_vec3 p = lm_v3_load(l->pos), d = lm_v3_load(l->dir);
-    if (l->node >= 0) { /* where its node puts it: the node's origin, shining down its -z */
-        const float *w = sc->scene->nodes[l->node].world;
-        p = lm_v3(w[12], w[13], w[14]);
-        d = lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1)));
-    }
-    lm_v3_store(out->position, lm_add(p, lm_v3_load(sc->scene->origin)));
-    lm_v3_store(out->direction, d);
+    lm_light_place(sc->scene, l, out->position, out->direction);
+    for (int k = 0; k < 3; k++) /* lmgi's world to the file's */
+        out->position[k] += sc->scene->origin[k];
     return LMGI_OK;
 }
 
@@ -224,8 +219,7 @@ static lmgi_status new_class(const lm_material *m, const lmgi_material *in, lm_m
     probe.transmission = in->transmission, probe.ior = in->ior;
     memset(probe.emissive, 0, sizeof probe.emissive);
     *out = lm_material_classify(&probe);
-    int lightmap = *out != LM_MAT_MIRROR && *out != LM_MAT_GLASS;
-    if (lightmap && !m->lightmapped)
+    if (!lm_material_is_specular(*out) && !m->lightmapped)
         return lm_api_refuse(err, "material '%s' was %s at load, so its triangles have no lightmap texels and it "
                              "cannot become %s (mirror and glass it may; load the scene with the new material)",
                              m->name, lm_material_class_name(m->cls), lm_material_class_name(*out));

@@ -59,7 +59,7 @@ double lmc_tri_area(const lm_scene *s, const float *pos, uint32_t t, double n[3]
 static int is_specular(const lm_scene *s, uint32_t t)
 {
     lm_material_class c = s->materials[s->tri_material[t]].cls;
-    return c == LM_MAT_MIRROR || c == LM_MAT_GLASS;
+    return lm_material_is_specular(c);
 }
 
 /* Warns about (or, strict, fails on) per-node counts of a geometry problem. */

@@ -50,46 +50,17 @@ static void fill_covered(const lm_scene *s, const lm_atlas *a, float *out)
             s->nodes[s->tri_node[a->texels[i].tri]].settings.indirect ? 1.0f : 0.0f;
 }
 
-static GLuint upload_rgba(int w, int h, const float *rgba)
+/* An atlas-sized RGBA32F texture, nearest filtered, its texels left to lm_composite_update_coverage. */
+static GLuint coverage_texture(int w, int h)
 {
     GLuint tex;
     glGenTextures(1, &tex);
     glBindTexture(GL_TEXTURE_2D, tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, rgba);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     return tex;
-}
-
-lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
-                              lm_error *err)
-{
-    *out = NULL;
-    lm_composite *c = calloc(1, sizeof *c);
-    float *covered = calloc(4 * (size_t)a->width * a->height, sizeof(float));
-    if (!c || !covered) {
-        free(c);
-        free(covered);
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap coverage", s->path);
-    }
-    c->width = a->width;
-    c->height = a->height;
-    c->limit = backface_limit;
-    fill_covered(s, a, covered);
-    c->covered_tex = upload_rgba(a->width, a->height, covered);
-    free(covered);
-    lm_status st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
-    if (st != LM_OK) {
-        lm_composite_free(c);
-        return st;
-    }
-    glGenVertexArrays(1, &c->empty_vao);
-    c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
-    c->p_covered = glGetUniformLocation(c->premult_prog, "covered");
-    c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
-    *out = c;
-    return LM_OK;
 }
 
 lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err)
@@ -104,6 +75,33 @@ lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const
     free(covered);
     return LM_OK;
 }
+
+lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
+                              lm_error *err)
+{
+    *out = NULL;
+    lm_composite *c = calloc(1, sizeof *c);
+    if (!c)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
+    c->width = a->width;
+    c->height = a->height;
+    c->limit = backface_limit;
+    c->covered_tex = coverage_texture(a->width, a->height);
+    lm_status st = lm_composite_update_coverage(c, s, a, err);
+    if (st == LM_OK)
+        st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
+    if (st != LM_OK) {
+        lm_composite_free(c);
+        return st;
+    }
+    glGenVertexArrays(1, &c->empty_vao);
+    c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
+    c->p_covered = glGetUniformLocation(c->premult_prog, "covered");
+    c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
+    *out = c;
+    return LM_OK;
+}
+
 
 void lm_composite_free(lm_composite *c)
 {

@@ -549,7 +549,7 @@ lm_status Loader::materials()
                             "photon powers it makes would overflow to infinity", ctx.c_str(), double(d.emissive[k]),
                             LM_MAX_EMISSION);
         lm_material_classify(&d);
-        d.lightmapped = d.cls != LM_MAT_MIRROR && d.cls != LM_MAT_GLASS;
+        d.lightmapped = !lm_material_is_specular(d.cls);
     }
     s_->material_count = int(n);
     s_->textures = copy_out(textures_);
@@ -826,7 +826,7 @@ lm_status Loader::geometry()
         d.uv_scale[0] = d.uv_scale[1] = 1.0f;
         d.roughness = 1.0f, d.ior = 1.5f;
         lm_material_classify(&d);
-        d.lightmapped = d.cls != LM_MAT_MIRROR && d.cls != LM_MAT_GLASS;
+        d.lightmapped = !lm_material_is_specular(d.cls);
     }
     s_->vertex_count = uint32_t(pos_.size() / 3);
     s_->positions = copy_out(pos_), s_->normals = copy_out(nrm_), s_->uv0 = copy_out(uv0_);

@@ -298,3 +298,15 @@ void lm_scene_set_dynamic(lm_scene *s, int node, int dynamic)
             s->nodes[n].dynamic = s->nodes[n].settings.dynamic = dynamic;
     s->pass_version++;
 }
+
+void lm_light_place(const lm_scene *s, const lm_light *l, float pos[3], float dir[3])
+{
+    if (l->node < 0) {
+        memcpy(pos, l->pos, 3 * sizeof *pos);
+        lm_v3_store(dir, lm_normalize(lm_v3_load(l->dir)));
+        return;
+    }
+    const float *w = s->nodes[l->node].world;
+    lm_v3_store(pos, lm_v3(w[12], w[13], w[14]));
+    lm_v3_store(dir, lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1))));
+}

@@ -254,6 +254,8 @@ float lm_scene_size(const lm_scene *s);
 /* Recomputes bounds_min/max from the current world matrices. */
 void lm_scene_update_bounds(lm_scene *s);
 
+/* Mirror and glass: light leaves them in one direction; they store no photon and get no lightmap texels. */
+static inline int lm_material_is_specular(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLASS; }
 /* Applies the material class rule to m's parameters (sets m->cls and returns it). */
 lm_material_class lm_material_classify(lm_material *m);
 const char *lm_material_class_name(lm_material_class c);
@@ -266,5 +268,8 @@ void lm_material_albedo(const lm_scene *s, const lm_material *m, float u, float 
 void lm_material_lobes(const lm_material *m, const float albedo[3], float kd[3], float ks[3]);
 
 const char *lm_light_type_name(lm_light_type t);
+/* Where a light is now (lmgi's world) and the unit direction it shines: its node's origin and -Z under
+ * the node's world matrix, or an added light's own pos and dir. */
+void lm_light_place(const lm_scene *s, const lm_light *l, float pos[3], float dir[3]);
 
 #endif

@@ -14,7 +14,7 @@
 
 static int may_split(const lm_material *m)
 {
-    return m->double_sided && m->cls != LM_MAT_MIRROR && m->cls != LM_MAT_GLASS;
+    return m->double_sided && !lm_material_is_specular(m->cls);
 }
 
 static int cmp_u64(const void *a, const void *b)

@@ -23,7 +23,6 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi[3], const float u[3], lm
 void lm_bsdf_eval(const lm_shading *sh, const float wi[3], const float wo[3], float out[3]);
 
 /* Inline, as every photon hit asks them (a call each cost more than the answer). */
-static inline int lm_material_is_specular(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLASS; }
 /* How many of lm_bsdf_sample's numbers the material reads, u[0 .. n): 0 mirror, 1 glass, 2 diffuse
  * and emitter, 3 glossy. The others may be left unset (a photon then skips computing them). */
 static inline int lm_bsdf_sample_dims(const lm_shading *sh)
@@ -31,29 +30,26 @@ static inline int lm_bsdf_sample_dims(const lm_shading *sh)
     lm_material_class c = sh->material->cls;
     return c == LM_MAT_MIRROR ? 0 : c == LM_MAT_GLASS ? 1 : c == LM_MAT_GLOSSY ? 3 : 2;
 }
-/* Luminance of the albedo clamped to [0.05, 0.95], the Russian-roulette survival probability before a
- * bounce; 1 for mirror and glass. */
-static inline float lm_bsdf_survival(const lm_shading *sh)
+/* A Russian-roulette survival probability p for a bounce off sh: 1 for mirror and glass, else p clamped
+ * to [0.05, 0.95], so that no path is certain to end nor to go on. */
+static inline float lm_bsdf_roulette(const lm_shading *sh, float p)
 {
     if (lm_material_is_specular(sh->material->cls))
         return 1.0f;
-    float l = lm_luminance(sh->albedo);
-    return l < 0.05f ? 0.05f : l > 0.95f ? 0.95f : l;
+    return p < 0.05f ? 0.05f : p > 0.95f ? 0.95f : p;
 }
-/* A photon's survival probability before a bounce: the albedo's largest channel, clamped to [0.05, 0.95];
- * 1 for mirror and glass. Not the luminance (lm_bsdf_survival): a photon's flux is multiplied by
- * albedo / p per channel, which the largest channel keeps at most 1 (but for the clamp); with the
- * luminance a saturated red (0.8 0.2 0.1, luminance 0.32) gave the red channel 2.5x a bounce, and the
- * few photons that survived many bounces near it carried a thousand times a photon's power into the
- * AIMs (docs/photons.md, "Russian roulette"). */
+/* The reference's survival before a bounce: the albedo's luminance (lm_bsdf_roulette). */
+static inline float lm_bsdf_survival(const lm_shading *sh) { return lm_bsdf_roulette(sh, lm_luminance(sh->albedo)); }
+/* A photon's survival before a bounce: the albedo's largest channel (lm_bsdf_roulette). Not the
+ * luminance: a photon's flux is multiplied by albedo / p per channel, which the largest channel keeps at
+ * most 1 (but for the clamp); with the luminance a saturated red (0.8 0.2 0.1, luminance 0.32) gave the
+ * red channel 2.5x a bounce, and the few photons that survived many bounces carried thousands of times a
+ * photon's power into the AIMs, in a closed red box 2e12 times (docs/photons.md, "Russian roulette"). */
 static inline float lm_bsdf_photon_survival(const lm_shading *sh)
 {
-    if (lm_material_is_specular(sh->material->cls))
-        return 1.0f;
-    const float *a = sh->albedo;
+    const float *a = sh->albedo; /* by comparisons: fmaxf may be a call, and this is asked every bounce */
     float m = a[0] > a[1] ? a[0] : a[1];
-    m = m > a[2] ? m : a[2];
-    return m < 0.05f ? 0.05f : m > 0.95f ? 0.95f : m;
+    return lm_bsdf_roulette(sh, m > a[2] ? m : a[2]);
 }
 /* True for classes that store photon hits (diffuse, glossy, emitter). */
 static inline int lm_material_stores_hits(lm_material_class c)

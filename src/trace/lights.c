@@ -152,14 +152,7 @@ void lm_emitters_free(lm_emitters *em)
 static void place_punctual(lm_emitter *e, const lm_scene *s, float disk_radius)
 {
     const lm_light *l = &s->lights[e->light];
-    if (e->node >= 0) {
-        const float *w = s->nodes[e->node].world;
-        lm_v3_store(e->pos, lm_v3(w[12], w[13], w[14]));
-        lm_v3_store(e->dir, lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1))));
-    } else {
-        memcpy(e->pos, l->pos, sizeof e->pos);
-        lm_v3_store(e->dir, lm_normalize(lm_v3_load(l->dir)));
-    }
+    lm_light_place(s, l, e->pos, e->dir);
     int dark = l->off || l->removed;
     float scale = e->kind == LM_EMIT_POINT ? (float)(4.0 * LM_PI)
                 : e->kind == LM_EMIT_SPOT  ? lm_spot_solid_angle(l)

@@ -150,7 +150,7 @@ static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, 
             float pl = prev_pdf > 0.0f ? light_pdf(c, sh.tri, org, lm_v3_load(sh.pos)) : 0.0f;
             add_scaled(out, beta, le, prev_pdf > 0.0f ? power_heuristic(prev_pdf, pl) : 1.0f);
         }
-        int specular = sh.material->cls == LM_MAT_MIRROR || sh.material->cls == LM_MAT_GLASS;
+        int specular = lm_material_is_specular(sh.material->cls);
         if (!specular) {
             float d[3] = {0, 0, 0};
             direct_at_vertex(c, &sh, df, r, d);

@@ -75,6 +75,17 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->indirect_path = LM_INDIRECT_LIGHTMAP;
 }
 
+/* Which indirect path the frames take, if any: the lightmaps (AIMs, gather, IIM) or the photon gather at
+ * the pixels. */
+static int lightmap_path(const lm_frame_loop *fl)
+{
+    return fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_LIGHTMAP;
+}
+static int photon_path(const lm_frame_loop *fl)
+{
+    return fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_BRUTEFORCE;
+}
+
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
 static lm_photon_store *store_of(lm_frame_loop *fl) { return lm_photon_stage_store(fl->stage); }
 
@@ -217,7 +228,7 @@ static lm_status setup_emitters(lm_frame_loop *fl, lm_error *err)
         fl->set.gather.coverage_samples =
             fl->set.gather.scheme == LM_GATHER_LAYERED ? 1 : lm_gather_coverage_for(fl->scene, closed_form);
     fl->set.emitter_light = closed_form;
-    if (!closed_form || !fl->set.indirect) /* without indirect light nothing is gathered */
+    if (!closed_form || !lightmap_path(fl)) /* the gather's alone */
         return LM_OK;
     lm_status st = lm_emitter_light_init(&fl->emitters, fl->scene, fl->rt, fl->set.emitter_rays, err);
     fl->have_emitters = st == LM_OK;
@@ -245,8 +256,7 @@ static lm_status setup_render(lm_frame_loop *fl, lm_error *err)
 static void sync_gather_switches(lm_frame_loop *fl)
 {
     for (int k = 0; k < fl->surfaces->surface_count; k++) {
-        int off = !fl->set.indirect || fl->set.indirect_path != LM_INDIRECT_LIGHTMAP ||
-                  !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
+        int off = !lightmap_path(fl) || !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
         if (off != fl->iim.sched.off[k])
             lm_iim_sched_set_off(&fl->iim.sched, store_of(fl), k, off);
     }
@@ -331,7 +341,7 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
     fl->set = *set;
     fl->set.stage.trace = fl->set.stage.trace && fl->set.indirect;
-    fl->set.stage.aims = fl->set.stage.aims && fl->set.indirect_path == LM_INDIRECT_LIGHTMAP;
+    fl->set.stage.aims = fl->set.stage.aims && lightmap_path(fl);
     fl->scene = w->scene;
     fl->surfaces = w->surfaces;
     fl->atlas = a;
@@ -443,7 +453,7 @@ static lm_status prepare_frame(lm_frame_loop *fl, lm_error *err)
     if (w <= 0)
         return LM_OK;
     lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
-    if (!fl->set.indirect || fl->set.indirect_path != LM_INDIRECT_BRUTEFORCE)
+    if (!photon_path(fl))
         return LM_OK;
     return photon_indirect(fl, &fl->view, w, h, err);
 }
@@ -458,7 +468,7 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
     double t0 = lm_now();
     unsigned lit = 0;
     lm_status st = follow_pass_edits(fl, err);
-    if (st == LM_OK && fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_LIGHTMAP)
+    if (st == LM_OK && lightmap_path(fl))
         st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err); /* else the first pass adds none */
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
@@ -471,7 +481,7 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
         st = lm_reflections_draw(fl->reflections, fl->direct_light, view, err);
     if (st == LM_OK)
         st = lm_direct_read(fl->direct_light, rgb, err);
-    if (st == LM_OK && fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_BRUTEFORCE)
+    if (st == LM_OK && photon_path(fl))
         st = add_photon_indirect(fl, view, w, h, rgb, err);
     o->t_composite = t1 - t0;
     o->t_direct = lm_now() - t1;
@@ -493,7 +503,7 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
     lm_status st = lm_gl_make_current(fl->gl, err);
     if (st == LM_OK)
         st = setup_render(fl, err);
-    if (st == LM_OK && fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_BRUTEFORCE &&
+    if (st == LM_OK && photon_path(fl) &&
         (st = lm_frame_loop_sync(fl, err)) == LM_OK) /* the gather reads the store the worker writes */
         st = photon_indirect(fl, view, width, height, err);
     lm_frame_stats o;
