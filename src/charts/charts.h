@@ -102,6 +102,11 @@ float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su, int 
 lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o,
                          lm_atlas *out, lm_error *err);
 void lm_atlas_free(lm_atlas *a);
+/* Texel t's overlap with its own triangle cut by a k x k grid of the texel (k >= 1): for each of the k^2
+ * squares that overlaps the triangle, the centroid of that overlap in the node's local space (local[i])
+ * and its share of the texel's overlap area (share[i], summing to 1). Returns how many (at most k^2; 0
+ * for a degenerate triangle). What a quantity that varies within a texel is averaged over. */
+int lm_texel_parts(const lm_scene *s, const lm_atlas *a, const lm_texel *t, int k, float local[][3], float share[]);
 /* The diffuse lobe kd (lm_material_lobes) of the texel's material at its point: base colour x texture at
  * the uv its barycentrics give on its triangle. What a lightmap's irradiance is turned into radiance with. */
 void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3]);

@@ -34,14 +34,14 @@ static int clip_half(const pt *in, int n, pt a, pt b, pt *out)
     return m;
 }
 
-/* Area and centroid of the unit square at (ix, iy) clipped to the counter-clockwise triangle t. */
-static double clip_texel(const pt t[3], int ix, int iy, pt *centroid)
+/* Area and centroid of the square of side `side` at (x0, y0) clipped to the counter-clockwise triangle t. */
+static double clip_square(const pt t[3], double x0, double y0, double side, pt *centroid)
 {
     pt a[16], b[16];
-    a[0] = (pt){ix, iy};
-    a[1] = (pt){ix + 1.0, iy};
-    a[2] = (pt){ix + 1.0, iy + 1.0};
-    a[3] = (pt){ix, iy + 1.0};
+    a[0] = (pt){x0, y0};
+    a[1] = (pt){x0 + side, y0};
+    a[2] = (pt){x0 + side, y0 + side};
+    a[3] = (pt){x0, y0 + side};
     int n = 4;
     n = clip_half(a, n, t[0], t[1], b);
     n = clip_half(b, n, t[1], t[2], a);
@@ -59,6 +59,12 @@ static double clip_texel(const pt t[3], int ix, int iy, pt *centroid)
     centroid->x = cx / (3.0 * area2);
     centroid->y = cy / (3.0 * area2);
     return 0.5 * area2;
+}
+
+/* The unit square at (ix, iy): a texel. */
+static double clip_texel(const pt t[3], int ix, int iy, pt *centroid)
+{
+    return clip_square(t, ix, iy, 1.0, centroid);
 }
 
 typedef struct {
@@ -257,6 +263,47 @@ done:
     free(count);
     free(nrm);
     return st;
+}
+
+int lm_texel_parts(const lm_scene *s, const lm_atlas *a, const lm_texel *t, int k, float local[][3], float share[])
+{
+    pt c[3];
+    const float *uv = a->corner_uv + 6 * (size_t)t->tri;
+    for (int i = 0; i < 3; i++)
+        c[i] = (pt){(double)uv[2 * i] * a->width, (double)uv[2 * i + 1] * a->height};
+    int order[3] = {0, 1, 2};
+    double d = (c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y);
+    if (!(fabs(d) > 0.0) || k < 1)
+        return 0;
+    if (d < 0.0) { /* clip_square wants the corners counter-clockwise */
+        pt tmp = c[1];
+        c[1] = c[2], c[2] = tmp;
+        order[1] = 2, order[2] = 1;
+        d = -d;
+    }
+    int n = 0;
+    double total = 0.0;
+    for (int j = 0; j < k; j++)
+        for (int i = 0; i < k; i++) {
+            pt m;
+            double ov = clip_square(c, t->x + (double)i / k, t->y + (double)j / k, 1.0 / k, &m);
+            if (!(ov > 0.0))
+                continue;
+            double b1 = ((m.x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (m.y - c[0].y)) / d;
+            double b2 = ((c[1].x - c[0].x) * (m.y - c[0].y) - (m.x - c[0].x) * (c[1].y - c[0].y)) / d;
+            double w[3] = {1.0 - b1 - b2, b1, b2};
+            for (int axis = 0; axis < 3; axis++) {
+                double v = 0.0;
+                for (int q = 0; q < 3; q++)
+                    v += w[q] * s->positions[3 * (size_t)s->tris[3 * (size_t)t->tri + (size_t)order[q]] + (size_t)axis];
+                local[n][axis] = (float)v;
+            }
+            share[n++] = (float)ov;
+            total += ov;
+        }
+    for (int i = 0; i < n; i++)
+        share[i] = (float)(share[i] / total);
+    return n;
 }
 
 void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3])

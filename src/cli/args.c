@@ -134,6 +134,17 @@ static int parse_indirect(const char *o, const char *v, int *out)
     return bad(o, v, "lightmap or bruteforce");
 }
 
+static int parse_aim_direct(const char *o, const char *v, int *out)
+{
+    if (v && !strcmp(v, "emitters"))
+        return *out = LMGI_AIM_DIRECT_EMITTERS, 0;
+    if (v && !strcmp(v, "photons"))
+        return *out = LMGI_AIM_DIRECT_PHOTONS, 0;
+    if (v && !strcmp(v, "all"))
+        return *out = LMGI_AIM_DIRECT_ALL, 0;
+    return bad(o, v, "emitters, photons or all");
+}
+
 static int parse_scheme(const char *o, const char *v, int *out)
 {
     static const char *names[] = {"viewports", "instanced", "layered"};
@@ -228,6 +239,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_effects(o, i + 1 < argc ? argv[i + 1] : NULL, &a->effects_off);
         else if (!strcmp(o, "--indirect"))
             rc = parse_indirect(o, v, &a->indirect);
+        else if (!strcmp(o, "--aim-direct"))
+            rc = parse_aim_direct(o, v, &a->aim_direct);
         else if (!strcmp(o, "--tonemap"))
             rc = parse_tonemap(o, v, &a->tonemap);
         else if (!strcmp(o, "--emitter-rays"))

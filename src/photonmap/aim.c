@@ -247,6 +247,8 @@ void lm_aim_free(lm_aim *aim)
     memset(aim, 0, sizeof *aim);
 }
 
+void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d) { aim->direct = d; }
+
 const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
 const float *lm_aim_dilated_rgba(const lm_aim *aim) { return aim->dilated; }
 
@@ -328,8 +330,10 @@ static int arrives_front(const linear_map *L, const lm_scene *s, const lm_hit *h
     return L->det * d < 0.0;
 }
 
+/* The surface's hits that the estimate sums: from the front only (front_only), and without those whose
+ * light is computed directly (direct, may be NULL). */
 static lm_status gather_hits(const lm_photon_store *ps, int surface, const lm_scene *s, const linear_map *L,
-                             int front_only, hit_set *out, lm_error *err)
+                             int front_only, const lm_direct_light *direct, hit_set *out, lm_error *err)
 {
     uint32_t n = ps->surfaces[surface].count;
     out->count = 0;
@@ -339,7 +343,7 @@ static lm_status gather_hits(const lm_photon_store *ps, int surface, const lm_sc
         return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u hits of surface %d", n, surface);
     for (uint32_t h = ps->surfaces[surface].head; h != LM_NONE && out->count < n; h = ps->hits[h].next) {
         const lm_hit *hit = &ps->hits[h];
-        if (front_only && !arrives_front(L, s, hit))
+        if ((front_only && !arrives_front(L, s, hit)) || (direct && lm_direct_covers_hit(direct, hit)))
             continue;
         memcpy(out->pos + 3 * out->count, hit->local, sizeof hit->local);
         for (int c = 0; c < 4; c++)
@@ -493,6 +497,9 @@ typedef struct {
     uint32_t n;           /* N, clamped to the hit count */
     double rmin2_world;   /* squared smallest radius, world units */
     int boundary_correction, kernel;
+    const lm_direct_light *direct; /* NULL: no direct light added */
+    const float *world;   /* the node's world matrix (texel positions for the direct light) */
+    int two_sided;        /* double-sided material: direct light on both sides */
 } estimate_job;
 
 typedef struct {
@@ -557,6 +564,7 @@ typedef struct {
     const estimate_job *job; /* NULL: nothing kept yet */
     uint32_t tri;
     double n[3], factor;
+    float n_world[3];        /* unit world normal of the front side */
 } tri_frame;
 
 static const tri_frame *triangle_frame(const estimate_job *j, uint32_t tri, tri_frame *tf)
@@ -566,6 +574,14 @@ static const tri_frame *triangle_frame(const estimate_job *j, uint32_t tri, tri_
         tf->tri = tri;
         local_face_normal(j->s, tri, tf->n);
         tf->factor = area_factor(j->L, tf->n);
+        double w[3], len = 0.0; /* det(M) M^-T n, as arrives_front */
+        for (int c = 0; c < 3; c++) {
+            w[c] = j->L->inv[0][c] * tf->n[0] + j->L->inv[1][c] * tf->n[1] + j->L->inv[2][c] * tf->n[2];
+            len += w[c] * w[c];
+        }
+        len = sqrt(len) * (j->L->det < 0.0 ? -1.0 : 1.0);
+        for (int c = 0; c < 3; c++)
+            tf->n_world[c] = len != 0.0 ? (float)(w[c] / len) : (float)tf->n[c];
     }
     return tf;
 }
@@ -578,12 +594,14 @@ struct texel_scratch {
     lm_kdtree_hint hint;
 };
 
-/* L = rho / pi * sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
- * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. */
-static void estimate_texel(const estimate_job *j, const lm_texel *t, texel_scratch *ts, float *edge_d2,
-                           float out[3])
+/* E = sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
+ * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. 0 without hits. */
+static void photon_irradiance(const estimate_job *j, const lm_texel *t, texel_scratch *ts, float *edge_d2,
+                              double out[3])
 {
-    out[0] = out[1] = out[2] = 0.0f;
+    out[0] = out[1] = out[2] = 0.0;
+    if (j->n == 0)
+        return;
     float r2 = 0.0f, *d2 = ts->d2;
     uint32_t *idx = ts->idx, k = find_nearest(j, &ts->hint, t->local, idx, d2, &r2);
     if (k == 0)
@@ -605,10 +623,52 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, texel_scrat
         area = disc_area_on_surface(&ts->ef, &j->bd, t->local, n, r2, j->kernel, &nearest);
         *edge_d2 = (float)nearest;
     }
+    for (int c = 0; c < 3; c++)
+        out[c] = f.sum[c] / (area * factor);
+}
+
+
+/* E_direct averaged over the texel's parts at their current world positions (seeded by the atlas index,
+ * so the same every refresh), added to e. Covered parts (under a box standing on the floor) are left out
+ * of the average, not counted dark: the texel's value is what its visible part receives, as the photon
+ * estimate, which has no hits under the box either, gives it. */
+static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts, double e[3])
+{
+    float local[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS][3], share[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS];
+    int n = lm_texel_parts(j->s, j->a, t, LM_AIM_DIRECT_PARTS, local, share);
+    if (n == 0) { /* a degenerate triangle: its centroid */
+        memcpy(local[0], t->local, sizeof local[0]);
+        share[0] = 1.0f;
+        n = 1;
+    }
+    const tri_frame *tf = triangle_frame(j, t->tri, &ts->tri);
+    double sum[3] = {0.0, 0.0, 0.0}, seen = 0.0;
+    for (int i = 0; i < n; i++) {
+        float p[3], d[3];
+        lm_v3_store(p, lm_mat4_point(j->world, lm_v3_load(local[i])));
+        uint32_t seed = index * (LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS) + (uint32_t)i;
+        if (!lm_direct_irradiance(j->direct, p, tf->n_world, j->two_sided, seed, d))
+            continue;
+        seen += share[i];
+        for (int c = 0; c < 3; c++)
+            sum[c] += (double)share[i] * d[c];
+    }
+    for (int c = 0; seen > 0.0 && c < 3; c++)
+        e[c] += sum[c] / seen;
+}
+
+/* L = rho / pi (E_photons + E_direct). */
+static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts,
+                           float *edge_d2, float out[3])
+{
+    double e[3];
+    photon_irradiance(j, t, ts, edge_d2, e);
+    if (j->direct)
+        add_direct(j, t, index, ts, e);
     float rho[3];
     lm_texel_kd(j->s, t, rho);
     for (int c = 0; c < 3; c++)
-        out[c] = (float)(rho[c] / LM_PI * f.sum[c] / (area * factor));
+        out[c] = (float)(rho[c] / LM_PI * e[c]);
 }
 
 static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_t end)
@@ -641,14 +701,15 @@ static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfa
     linear_map_of(s->nodes[sf->node].world, &sj->L);
     lm_kdtree_init(&sj->tree);
     int front_only = aim->set.front_only && !m->double_sided && sj->L.det != 0.0;
-    sj->rc = gather_hits(ps, sj->surface, s, &sj->L, front_only, &sj->hits, &sj->err);
+    sj->rc = gather_hits(ps, sj->surface, s, &sj->L, front_only, aim->direct, &sj->hits, &sj->err);
     if (sj->rc == LM_OK)
         sj->rc = lm_kdtree_build(&sj->tree, sj->hits.pos, 3, sj->hits.count, &sj->err);
     uint32_t n = (uint32_t)aim->set.n_nearest < sj->hits.count ? (uint32_t)aim->set.n_nearest : sj->hits.count;
     double rmin = (double)aim->set.min_radius_texels * a->texel_size;
     sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {s->positions, aim->edges,
                              aim->edge_first[sj->surface], aim->edge_first[sj->surface + 1]}, n, rmin * rmin,
-                             aim->set.boundary_correction, aim->set.kernel};
+                             aim->set.boundary_correction, aim->set.kernel, aim->direct,
+                             s->nodes[sf->node].world, m->double_sided};
 }
 
 static void free_surface(surface_job *sj)
@@ -695,7 +756,7 @@ static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32
         for (int j = 0; j < count; j++) {
             const estimate_job *e = &jobs[j].job;
             int64_t first = aim->texel_first[jobs[j].surface], end = aim->texel_first[jobs[j].surface + 1];
-            if (e->n == 0)
+            if (e->n == 0 && !e->direct)
                 continue;
 #pragma omp for schedule(dynamic, TEXEL_CHUNK) nowait
             for (int64_t i = first; i < end; i++) {
@@ -704,7 +765,7 @@ static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32
                 if ((i - first) % TEXEL_CHUNK == 0)
                     ts.hint.valid = 0;
                 if (ok)
-                    estimate_texel(e, t, &ts, &aim->edge_d2[i], px);
+                    estimate_texel(e, t, aim->texel_list[i], &ts, &aim->edge_d2[i], px);
             }
         }
         scratch_free(&ts);
@@ -744,7 +805,7 @@ static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfa
     }
     for (int j = 0; j < ok; j++) {
         int sf = jobs[j].surface;
-        if (jobs[j].hits.count == 0)
+        if (jobs[j].hits.count == 0 && !aim->direct)
             clear_texels(aim, a, aim->texel_first[sf], aim->texel_first[sf + 1]);
         lm_photon_store_reset_delta_f(ps, sf);
         aim->refresh_count[sf]++;

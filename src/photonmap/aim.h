@@ -34,6 +34,7 @@
 #include "../charts/charts.h"
 #include "../core/error.h"
 #include "../scene/scene.h"
+#include "../trace/direct_irradiance.h"
 #include "../trace/photon_store.h"
 #include "kdtree.h"
 
@@ -71,6 +72,8 @@ typedef struct {
     float *edge_d2;          /* per texel_list entry: squared distance to its surface's boundary in its
                                 tangent plane (-1 until first computed); a smaller disc skips the edges */
     float mean_hit_energy;   /* as of the last refresh call */
+    const lm_direct_light *direct; /* NULL (default): photons carry all light, the paper's form; else
+                                      lm_aim_set_direct */
 } lm_aim;
 
 void lm_aim_settings_default(lm_aim_settings *o);
@@ -79,6 +82,18 @@ void lm_aim_settings_default(lm_aim_settings *o);
 lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                       const lm_aim_settings *set, lm_error *err);
 void lm_aim_free(lm_aim *aim);
+
+/* From the next refresh on, each texel's direct light is computed (trace/direct_irradiance.h: averaged
+ * over the texel's parts at their current world positions, geometric normal, both sides for a
+ * double-sided material, seeded by the atlas texel index) and the photon hits it covers (lm_direct_covers_hit) are left out of the
+ * estimate: L = rho / pi (E_direct + sum(w_i Phi_i) / A_w over the other hits). A surface with no
+ * other hits gets its direct light alone. NULL: back to photons for everything. d is borrowed. The
+ * caller refreshes every surface after a change (lm_aim_refresh_all) if the maps must agree at once. */
+void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
+/* The direct light is averaged over this many squared parts of a texel (lm_texel_parts; covered parts
+ * left out): near a lamp it falls off within a texel, and the centroid's value alone lost energy the
+ * hemicube should see (4.8% of the suzanne Cornell box's ceiling, docs/aim.md). */
+#define LM_AIM_DIRECT_PARTS 2
 
 /* Refreshes up to `budget` surfaces (budget < 0: no limit) whose delta_f is over the threshold, in
  * order of delta_f / area (ties: lower surface id first), and resets their delta_f. stats may be NULL. */

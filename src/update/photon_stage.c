@@ -1,9 +1,14 @@
 #include "photon_stage.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../core/timing.h"
+
+/* Shadow rays per emissive triangle and point (trace/emitter_light.h): an AIM texel takes 4 points (its
+ * 2 x 2 parts), 16 rays in all; only penumbrae are sampled. */
+#define AIM_EMITTER_RAYS 4
 
 /* What an emitter looked like when its photons were last traced: its node's world matrix, its place and
  * its power. */
@@ -41,7 +46,9 @@ struct lm_photon_stage {
     double *delta_before;        /* scratch: per surface, delta_f before a refresh */
     lm_photons *photons;
     lm_aim aim;
-    int have_emitters, have_aim;
+    lm_emitter_light area;       /* with have_area: the emissive triangles' closed form, for the AIMs */
+    lm_direct_light direct;      /* the AIMs' direct light (set.exact_direct) */
+    int have_emitters, have_aim, have_area;
     int frame;
 };
 
@@ -53,6 +60,27 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     s->surfaces_per_frame = 4;
     s->trace = 1;
     s->aims = 1;
+    s->exact_direct = 1;
+}
+
+/* The AIMs take direct light from trace/direct_irradiance.h: punctual lights always, emissive triangles
+ * where their closed form suits the scene; nothing where the photons' cover distance hides a side. */
+static lm_status setup_direct(lm_photon_stage *ps, float cover, lm_error *err)
+{
+    if (!(ps->set.exact_direct == 2) && !lm_emitter_light_suits(ps->scene))
+        return LM_OK; /* nothing to compute: photons bring all light, as in the paper */
+    if (lm_emitter_light_suits(ps->scene)) {
+        lm_status st = lm_emitter_light_init(&ps->area, ps->scene, ps->rt, AIM_EMITTER_RAYS, err);
+        if (st != LM_OK)
+            return st;
+        ps->have_area = 1;
+    }
+    float size = lm_scene_size(ps->scene);
+    ps->direct = (lm_direct_light){ps->scene, ps->rt, &ps->emitters, ps->have_area ? &ps->area : NULL,
+                                   ps->set.exact_direct == 2, 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f),
+                                   cover};
+    lm_aim_set_direct(&ps->aim, &ps->direct);
+    return LM_OK;
 }
 
 static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *out)
@@ -170,6 +198,8 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     if (st == LM_OK)
         st = lm_aim_init(&ps->aim, ps->scene, ps->surfaces, ps->atlas, &ps->set.aim, err);
     ps->have_aim = st == LM_OK;
+    if (st == LM_OK && ps->set.exact_direct)
+        st = setup_direct(ps, photons.cover_distance, err);
     if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);
@@ -211,6 +241,8 @@ void lm_photon_stage_free(lm_photon_stage *ps)
         return;
     if (ps->have_aim)
         lm_aim_free(&ps->aim);
+    if (ps->have_area)
+        lm_emitter_light_free(&ps->area);
     lm_photons_free(ps->photons);
     if (ps->have_emitters)
         lm_emitters_free(&ps->emitters);

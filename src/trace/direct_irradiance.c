@@ -1,0 +1,74 @@
+/* Direct irradiance at a surface point (direct_irradiance.h). */
+#include "direct_irradiance.h"
+
+#include "../core/vecmath.h"
+
+#include <math.h>
+
+/* 1 when other geometry lies within d->cover straight out from p on the side of normal n. */
+static int covered(const lm_direct_light *d, lm_vec3 p, lm_vec3 n)
+{
+    if (!(d->cover > 0.0f))
+        return 0;
+    float org[3], dir[3];
+    lm_v3_store(org, lm_add(p, lm_scale(n, d->lift)));
+    lm_v3_store(dir, n);
+    return lm_rt_occluded(d->rt, org, dir, 0.0f, d->cover);
+}
+
+/* Every punctual light's E = weight cos, where a shadow ray from p (lifted to the side the light is on)
+ * reaches it; sides: bit 0 the front (n), bit 1 the back. */
+static void punctual(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, int sides, double e[3])
+{
+    const float none[3] = {0.0f, 0.0f, 0.0f};
+    for (int k = 0; k < d->em->count; k++) {
+        const lm_emitter *em = &d->em->e[k];
+        if (!em->punctual || (em->radiant[0] == 0.0f && em->radiant[1] == 0.0f && em->radiant[2] == 0.0f))
+            continue;
+        float at[3];
+        lm_v3_store(at, p);
+        lm_light_sample ls;
+        if (!lm_emitter_sample_toward(d->em, d->scene, k, at, none, &ls))
+            continue;
+        float c = lm_dot(n, lm_v3_load(ls.dir));
+        int front = c >= 0.0f;
+        c = fabsf(c);
+        if (!(sides & (front ? 1 : 2)) || !(c > 0.0f))
+            continue;
+        float org[3];
+        lm_v3_store(org, lm_add(p, lm_scale(n, front ? d->lift : -d->lift)));
+        float far = isinf(ls.dist) ? INFINITY : ls.dist * (1.0f - 1e-4f);
+        if (lm_rt_occluded(d->rt, org, ls.dir, 0.0f, far))
+            continue;
+        for (int ch = 0; ch < 3; ch++)
+            e[ch] += (double)ls.weight[ch] * c;
+    }
+}
+
+/* The emissive triangles' light on the side of normal n, from p lifted to that side. */
+static void area(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, uint32_t seed, double e[3])
+{
+    float at[3], nrm[3], out[3];
+    lm_v3_store(at, lm_add(p, lm_scale(n, d->lift)));
+    lm_v3_store(nrm, n);
+    lm_emitter_irradiance(d->area, at, nrm, seed, out);
+    for (int c = 0; c < 3; c++)
+        e[c] += out[c];
+}
+
+int lm_direct_irradiance(const lm_direct_light *d, const float p[3], const float n[3], int two_sided,
+                          uint32_t seed, float out[3])
+{
+    double e[3] = {0.0, 0.0, 0.0};
+    lm_vec3 pv = lm_v3_load(p), nv = lm_v3_load(n), back = lm_scale(nv, -1.0f);
+    int sides = (covered(d, pv, nv) ? 0 : 1) | (two_sided && !covered(d, pv, back) ? 2 : 0);
+    if (d->punctual)
+        punctual(d, pv, nv, sides, e);
+    if (d->area && (sides & 1))
+        area(d, pv, nv, seed, e);
+    if (d->area && (sides & 2))
+        area(d, pv, back, seed ^ 0x9e3779b9u, e);
+    for (int c = 0; c < 3; c++)
+        out[c] = (float)e[c];
+    return sides != 0;
+}
