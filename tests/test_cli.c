@@ -58,6 +58,9 @@ static void test_usage_errors(void **state)
     assert_int_equal(run("run scenes/cornell.glb --groups 7 --out x"), 2);
     assert_non_null(strstr(output, "--groups 7"));
     assert_int_equal(run("info scenes/cornell.glb --groups 12 -q"), 0); /* 2^2 3 */
+    assert_int_equal(run("run scenes/cornell.glb --aim-direct exact --out x"), 2);
+    assert_non_null(strstr(output, "--aim-direct exact"));
+    assert_non_null(strstr(output, "emitters, photons or all"));
 }
 
 static void test_bad_scene_files(void **state)
