@@ -374,11 +374,11 @@ enum { LMGI_EFFECT_SHADOWS = 1, LMGI_EFFECT_INDIRECT = 2, LMGI_EFFECT_REFLECTION
  * photon gathers, for small scenes and frames; no AIM or IIM, so the lightmaps stay 0 and environment
  * maps show direct light only). */
 typedef enum { LMGI_INDIRECT_LIGHTMAP = 0, LMGI_INDIRECT_BRUTEFORCE } lmgi_indirect_path;
-/* Where the approximate illumination maps (docs/aim.md) get direct light. EMITTERS: emissive triangles' light
- * computed per texel (closed form, sampled shadows) where the gather's closed form suits the scene, photons
- * bringing the rest; ALL: punctual lights' too (one shadow ray each); PHOTONS: photon first hits bring it
- * all (the paper's form: blurred across shadow edges by the photon estimate's radius). */
-typedef enum { LMGI_AIM_DIRECT_EMITTERS = 0, LMGI_AIM_DIRECT_PHOTONS, LMGI_AIM_DIRECT_ALL } lmgi_aim_direct;
+/* Where the approximate illumination maps (docs/aim.md) get direct light. PHOTONS: photon first hits bring it
+ * all (the paper's form: blurred across shadow edges by the photon estimate's radius); EMITTERS: emissive
+ * triangles' light computed per texel (closed form, sampled shadows) where the gather's closed form suits
+ * the scene, photons bringing the rest (sharp contact shadows); ALL: punctual lights' too. */
+typedef enum { LMGI_AIM_DIRECT_PHOTONS = 0, LMGI_AIM_DIRECT_EMITTERS, LMGI_AIM_DIRECT_ALL } lmgi_aim_direct;
 
 /* Zero-initialised means the defaults (the same as `lmgi run`'s; docs/ says what each costs and buys). */
 typedef struct {
@@ -394,7 +394,7 @@ typedef struct {
     uint32_t seed;             /* another, disjoint stretch of the Halton sequence (0: the default one) */
     int photons_per_estimate;  /* N nearest photons per AIM estimate (0: docs/aim.md's default) */
     int surfaces_per_frame;    /* AIM refreshes per update (0: 4; -1: all that changed) */
-    lmgi_aim_direct aim_direct; /* (0: LMGI_AIM_DIRECT_EMITTERS) */
+    lmgi_aim_direct aim_direct; /* (0: LMGI_AIM_DIRECT_PHOTONS) */
     /* the gather (docs/gather.md) */
     int hemicube_resolution;   /* R, plane pixels per side (0: 32) */
     float enlargement;         /* a, the plane's half-side at distance 1 (0: 2) */

@@ -239,9 +239,10 @@ static void test_lamp_under_ceiling(void **state)
     lmt_pipeline_free(&p);
 }
 
-/* The updater's choice (lmgi_updater_desc.aim_direct) on the edit room, lit by a point light only: the
- * default computes emissive triangles' light, and the room has none, so its AIM is the paper's to the
- * bit; ALL computes the lamp's light too, and the AIM changes; a value out of range is refused. */
+/* The updater's choice (lmgi_updater_desc.aim_direct) on the edit room, lit by a point light only:
+ * EMITTERS computes emissive triangles' light, and the room has none, so its AIM is the default's (the
+ * paper's) to the bit; ALL computes the lamp's light too, and the AIM changes; a value out of range is
+ * refused. */
 static float *room_aim(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, size_t *n)
 {
     lmgi_updater_desc d;

@@ -117,23 +117,34 @@ static void check_scene(const char *name, const char *path, double rmse_bound)
 }
 
 /* Measured at 96 x 96 (frame / reference; relative RMSE, of which the reference's own noise is ~0.03):
- * shared Cornell box 1.001 1.001 1.000, 0.039 (0.997 0.999 0.998 with the AIMs' direct light computed; before two sides, the hidden light and the traced rim:
+ * shared Cornell box 1.001 1.001 1.000, 0.039 (0.994 0.997 0.998 with the emitters' light computed in the AIMs; before two sides, the hidden light and the traced rim:
  * 2.45 3.06 2.98 over every pixel of a surface at 128 x 128, the outside of the box lit with the inside's
  * lightmap; 1.64 over the pixels both light); generated Cornell box 0.994 1.000 0.999, 0.052; two rooms
  * 0.990 0.992 0.994, 0.033 (its door -4.1%, the run density's 32 texels a face: -2% at 20k texels).
  * The RMSE bounds leave room for the reference's noise. */
 /* The small box's faces, relative to their own reference (they are dim: SURFACE_TOL measures them against
- * the frame's mean): the face towards the camera (133 pixels) read +21..34% per channel while the AIMs
- * took direct light from photon first hits, whose estimate blurs the floor's contact shadow at the box's
- * foot into the light; with it computed (docs/aim.md), +6..15%. CONTACT_TOL is on the sum of the
- * channels: 1.28 then, 1.11 now. */
+ * the frame's mean): the face towards the camera (133 pixels) reads +21..34% per channel with the AIMs'
+ * direct light from photon first hits (the default), whose estimate blurs the floor's contact shadow at
+ * the box's foot into the light; with it computed (--aim-direct emitters, docs/aim.md), +6..15%.
+ * CONTACT_TOL is on the sum of the channels: 1.28 then, 1.11 now. */
 #define CONTACT_TOL 0.2
 static void test_shared_cornell_box(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
+    check_scene("shared Cornell box", path, 0.06);
+    lmgi_scene *sc = load_as_run(path, 0);
+    lm_frame_loop_settings ls;
+    lm_frame_loop_settings_default(&ls);
+    ls.width = ls.height = SIZE;
+    ls.stage.exact_direct = 1;
+    lm_ref_settings rs;
+    ref_settings(&rs, REF_ERROR);
     lm_frame_check c;
-    lmgi_scene *sc = run_check("shared Cornell box", path, SURFACE_TOL, 0.06, &c);
+    lm_error err;
+    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    assert_frame("shared Cornell box, emitters' light computed in the AIMs", sc, &c, 0.03, SURFACE_TOL, 0.06);
     int faces = 0;
     for (int s = 0; s < c.surface_count; s++) {
         const lm_check_sum *sum = &c.surface[s];
@@ -297,8 +308,7 @@ static void test_iim_run_density(void **state)
 
 /* At 66,816 texels, with the photon count `lmgi run` takes (11,520): walls, floor and ceiling within 2%,
  * relative RMSE 0.053; the boxes' faces (529 to 1,035 texels) read -6% to +10%, the AIM's photon noise
- * where they meet the floor (within 2% with 200k photons), so they are reported, not asserted (-2.1% to
- * +6.7% with the AIMs' direct light computed). The
+ * where they meet the floor (within 2% with 200k photons), so they are reported, not asserted. The
  * reference's 0.05 is enough for means over thousands of texels (this scene has no rare bright paths:
  * its light is an area light). */
 static void test_iim_bake_density(void **state)

@@ -80,9 +80,9 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
         TAKEU(group_budget, 1, 10000000, &ph->group_budget);
     ph->seed = d->seed;
     TAKE(photons_per_estimate, 1, 100000, &s->stage.aim.n_nearest);
-    if ((int)d->aim_direct < LMGI_AIM_DIRECT_EMITTERS || (int)d->aim_direct > LMGI_AIM_DIRECT_ALL)
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: aim_direct %d is not LMGI_AIM_DIRECT_EMITTERS, "
-                       "_PHOTONS or _ALL", (int)d->aim_direct);
+    if ((int)d->aim_direct < LMGI_AIM_DIRECT_PHOTONS || (int)d->aim_direct > LMGI_AIM_DIRECT_ALL)
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: aim_direct %d is not LMGI_AIM_DIRECT_PHOTONS, "
+                       "_EMITTERS or _ALL", (int)d->aim_direct);
     s->stage.exact_direct = d->aim_direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : d->aim_direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
     if (d->surfaces_per_frame == -1)
         s->stage.surfaces_per_frame = -1;

@@ -51,7 +51,7 @@ typedef struct {
     int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
     unsigned effects_off;   /* --effects -shadows,-indirect,-reflections: lmgi_updater_desc.effects_off */
     int indirect;           /* --indirect lightmap|bruteforce: lmgi_updater_desc.indirect (default lightmap) */
-    int aim_direct;         /* --aim-direct emitters|photons|all: lmgi_updater_desc.aim_direct (default emitters) */
+    int aim_direct;         /* --aim-direct emitters|photons|all: lmgi_updater_desc.aim_direct (default photons) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */

@@ -60,7 +60,6 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     s->surfaces_per_frame = 4;
     s->trace = 1;
     s->aims = 1;
-    s->exact_direct = 1;
 }
 
 /* The AIMs take direct light from trace/direct_irradiance.h: punctual lights always, emissive triangles

@@ -18,7 +18,7 @@ typedef struct {
     int aims;                /* 0: photons traced, no AIM filled (an indirect path that gathers from the
                               * photons themselves) */
     int exact_direct;        /* AIM texels compute direct light (trace/direct_irradiance.h), photons bring the
-                              * rest: 1 (default) from emissive triangles, 2 from punctual lights too; 0:
+                              * rest: 1 from emissive triangles, 2 from punctual lights too; 0 (default):
                               * photons bring all of it (the paper's form) */
 } lm_photon_stage_settings;
 

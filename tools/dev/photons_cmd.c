@@ -39,7 +39,7 @@ void lm_dev_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
         s->aim.n_nearest = a->nearest;
     if (a->surface_budget)
         s->surfaces_per_frame = a->surface_budget;
-    s->exact_direct = a->aim_direct == LMGI_AIM_DIRECT_PHOTONS ? 0 : a->aim_direct == LMGI_AIM_DIRECT_ALL ? 2 : 1;
+    s->exact_direct = a->aim_direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : a->aim_direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
 }
 
 static void csv_header(FILE *f)
