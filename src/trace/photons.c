@@ -26,7 +26,7 @@ void lm_photon_settings_default(lm_photon_settings *s)
     s->per_group = 160;
     s->retrace_per_group = 1;
     s->group_budget = 16;
-    s->max_bounces = 32;
+    s->max_bounces = 1024;
 }
 
 static int is_2a3b(uint32_t n)
@@ -59,12 +59,33 @@ static lm_status check_settings(const lm_photon_settings *s, lm_error *err)
     return LM_OK;
 }
 
-/* M_e: photons per group of emitter e, in proportion to its luminance, at least 1. */
-static uint32_t emitter_per_group(const lm_photons *ph, int e, uint64_t total)
+/* An emitter's weight in the photon budget: its luminance, but for a lit emitter at least half the mean
+ * lit emitter's. In proportion to luminance alone, photons carry equal power, and a lamp a million times
+ * dimmer than the sun got one photon a group: where the lamp is all the light (a room the sun does not
+ * reach) its lightmap was those 72 photons' noise, 21% off (docs/hard-cases.md). The floor costs the
+ * brightest emitters a share of their photons only where others are far dimmer. Dark emitters weigh 0. */
+static double emitter_weight(const lm_photons *ph, float luminance)
+{
+    return luminance > 0.0f ? fmax((double)luminance, ph->weight_floor) : 0.0;
+}
+
+static void plan_weights(lm_photons *ph, double *sum)
 {
     const lm_emitters *em = ph->em;
-    double share = em->total_luminance > 0.0f ? em->e[e].luminance / (double)em->total_luminance
-                                               : 1.0 / em->count;
+    int lit = 0;
+    for (int e = 0; e < em->count; e++)
+        lit += em->e[e].luminance > 0.0f;
+    ph->weight_floor = lit ? 0.5 * em->total_luminance / lit : 0.0;
+    *sum = 0.0;
+    for (int e = 0; e < em->count; e++)
+        *sum += emitter_weight(ph, em->e[e].luminance);
+}
+
+/* M_e: photons per group of emitter e, in proportion to its weight, at least 1. */
+static uint32_t emitter_per_group(const lm_photons *ph, int e, uint64_t total, double weights)
+{
+    const lm_emitters *em = ph->em;
+    double share = weights > 0.0 ? emitter_weight(ph, em->e[e].luminance) / weights : 1.0 / em->count;
     double m = floor((double)total * share / ph->G + 0.5);
     return m < 1.0 ? 1u : (uint32_t)fmin(m, (double)PH_MAX_PHOTONS);
 }
@@ -80,16 +101,18 @@ static lm_status plan_counts(lm_photons *ph, lm_error *err)
     ph->emitter_first = calloc((size_t)E + 1, sizeof *ph->emitter_first);
     if (!ph->emitter_first)
         return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u emitters", E);
+    double weights;
+    plan_weights(ph, &weights);
     uint64_t at = 0;
     for (uint32_t e = 0; e < E; e++) {
-        at += (uint64_t)emitter_per_group(ph, (int)e, total) * ph->G;
+        at += (uint64_t)emitter_per_group(ph, (int)e, total, weights) * ph->G;
         if (at > PH_MAX_PHOTONS)
             return lm_fail(err, LM_ERR_INVALID, "photons: %llu photons over %u emitters exceed %u",
                            (unsigned long long)at, E, PH_MAX_PHOTONS);
         ph->emitter_first[e + 1] = (uint32_t)at;
     }
     ph->photon_count = (uint32_t)at;
-    ph->per_luminance = ph->em->total_luminance > 0.0f ? (double)at / ph->em->total_luminance : 0.0;
+    ph->per_luminance = weights > 0.0 ? (double)at / weights : 0.0;
     char what[128];
     snprintf(what, sizeof what, "%llu photons over %u lights", (unsigned long long)at, E);
     lm_status st = lm_memory_plan(what, (double)at * PH_BYTES_PER_PHOTON, "fewer photons (--photons, or "
@@ -275,12 +298,13 @@ lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err)
     return LM_OK;
 }
 
-/* M_e of an emitter added after creation: the photons per unit of luminance the others got, so that
- * its photons carry about their power; a light added dark (or to a scene with none lit) gets the mean
- * emitter's count. */
+/* M_e of an emitter added after creation: the photons per unit of weight the others got (emitter_weight,
+ * with the floor of creation), so that its photons carry about their power; a light added dark (or to a
+ * scene with none lit) gets the mean emitter's count. */
 static uint32_t added_per_group(const lm_photons *ph, const lm_emitter *e)
 {
-    double m = e->luminance > 0.0f && ph->per_luminance > 0.0 ? floor(e->luminance * ph->per_luminance / ph->G + 0.5)
+    double m = e->luminance > 0.0f && ph->per_luminance > 0.0
+                   ? floor(emitter_weight(ph, e->luminance) * ph->per_luminance / ph->G + 0.5)
              : ph->emitter_count ? (double)ph->photon_count / ph->emitter_count / ph->G
              : ph->set.total_photons ? (double)ph->set.total_photons / ph->G
                                      : (double)ph->set.per_group;

@@ -37,7 +37,8 @@ typedef struct {
     uint32_t group_budget;     /* invalid groups re-traced per frame, oldest first (default 16; 0 = all) */
     float epsilon;             /* a path vertex that moved more than this (world units) is a change;
                                   <= 0: 1e-4 x scene size (default 0) */
-    uint32_t max_bounces;      /* most path vertices per photon, a safety net (default 32, at most 1024) */
+    uint32_t max_bounces;      /* most path vertices per photon, a safety net (default and at most 1024:
+                                  Russian roulette ends paths; a white room needs hundreds of bounces) */
     uint32_t seed;             /* selects another, disjoint stretch of the Halton sequence (default 0) */
     float cover_distance;      /* a hit with other geometry closer than this (world units) straight out from
                                 * the side it arrived at is not stored (the photon still scatters): its light
@@ -76,8 +77,9 @@ typedef struct {
 typedef struct lm_photons lm_photons;
 
 /* Sets up photon counts, groups and the empty store; traces nothing. Emitters get photon counts in
- * proportion to their luminance (at least one photon per group each), so photons carry about equal
- * power. Fails on bad settings (G not 2^a 3^b, zero counts) naming the setting. */
+ * proportion to their luminance, a lit one's taken as at least half the mean lit emitter's (a lamp beside
+ * the sun still gets enough to light its room), at least one photon per group each; so photons carry
+ * about equal power where lights are alike. Fails on bad settings (G not 2^a 3^b, zero counts) naming the setting. */
 lm_status lm_photons_create(const lm_scene *s, const lm_surfaces *su, const lm_rt *rt, const lm_emitters *em,
                             const lm_photon_settings *settings, lm_photons **out, lm_error *err);
 void lm_photons_free(lm_photons *ph);
@@ -99,7 +101,7 @@ lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_erro
 lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err);
 /* Takes on the light that lm_emitters_add_light appended to the emitter list (the last one): its
  * photons get the ids after all others (no other photon's numbers change) and a count from the photons
- * per unit of luminance at creation (the mean emitter's when it is dark), and its groups are queued for
+ * per unit of weight at creation (the mean emitter's when it is dark), and its groups are queued for
  * tracing. Fails when the list did not grow by one light (nothing changed), or when memory runs out
  * (the light then has no photons). */
 lm_status lm_photons_add_emitter(lm_photons *ph, lm_error *err);

@@ -63,7 +63,8 @@ struct lm_photons {
     float ray_offset;          /* origin offset along the normal when leaving a surface */
     uint32_t G, emitter_count, group_count, photon_count;
     uint32_t *emitter_first;   /* first photon id of each emitter, emitter_count + 1 entries */
-    double per_luminance;      /* photons per unit of emitter luminance at creation (lights added later) */
+    double per_luminance;      /* photons per unit of emitter weight at creation (lights added later) */
+    double weight_floor;       /* the least weight of a lit emitter (emitter_weight), fixed at creation */
     ph_group *groups;          /* emitter e's group g is groups[e G + g] */
     uint32_t *queue;           /* invalid groups, FIFO ring of group_count slots */
     uint32_t queue_head, queue_len;

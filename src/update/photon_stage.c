@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../core/timing.h"
+#include "../trace/sealed_lights.h"
 
 /* Shadow rays per emissive triangle and point (trace/emitter_light.h): an AIM texel takes 4 points (its
  * 2 x 2 parts), 16 rays in all; only penumbrae are sampled. */
@@ -172,6 +173,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     if (st != LM_OK)
         return st;
     ps->have_emitters = 1;
+    lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
     ps->snap = calloc((size_t)ps->emitters.count + 1, sizeof *ps->snap);
     if (!ps->snap)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
@@ -267,6 +269,7 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
     int added = 0;
     lm_status st = take_new_lights(ps, &added, err);
     lm_emitters_update(&ps->emitters, ps->scene);
+    lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
     if (st == LM_OK)
         st = check_emitters(ps, &out->emitters_moved, err);
     out->emitters_moved += added;
