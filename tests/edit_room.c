@@ -81,14 +81,19 @@ lmgi_scene *lmt_room(const lmt_room_spec *spec)
 
 lmgi_updater *lmt_room_updater(lmgi_context *ctx, lmgi_scene *sc) { return lmt_room_updater_without(ctx, sc, 0); }
 
+void lmt_room_desc(lmgi_updater_desc *d)
+{
+    memset(d, 0, sizeof *d);
+    d->photons_per_group = 100;
+    d->hemicube_resolution = 16;
+    d->rim_samples = 16;
+}
+
 lmgi_updater *lmt_room_updater_without(lmgi_context *ctx, lmgi_scene *sc, unsigned effects_off)
 {
     lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
+    lmt_room_desc(&d);
     d.effects_off = effects_off;
-    d.photons_per_group = 100;
-    d.hemicube_resolution = 16;
-    d.rim_samples = 16;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)

@@ -22,7 +22,9 @@ typedef struct {
 lmgi_context *lmt_context(void);
 /* The room as a scene; its nodes are "room", "block" and "stool". */
 lmgi_scene *lmt_room(const lmt_room_spec *spec);
-/* An updater for the edit tests: 100 photons a group, hemicube 16, 16 rim rays, no frame of its own. */
+/* The edit tests' updater settings: 100 photons a group, hemicube 16, 16 rim rays, no frame of its own. */
+void lmt_room_desc(lmgi_updater_desc *d);
+/* An updater with them (lmt_room_desc). */
 lmgi_updater *lmt_room_updater(lmgi_context *ctx, lmgi_scene *sc);
 /* The same leaving out the effects in effects_off (lmgi_updater_desc). */
 lmgi_updater *lmt_room_updater_without(lmgi_context *ctx, lmgi_scene *sc, unsigned effects_off);

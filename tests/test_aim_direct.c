@@ -246,9 +246,7 @@ static void test_lamp_under_ceiling(void **state)
 static float *room_aim(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, size_t *n)
 {
     lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
-    d.photons_per_group = 100;
-    d.hemicube_resolution = 16;
+    lmt_room_desc(&d);
     d.aim_direct = mode;
     lmgi_updater *u = NULL;
     lmgi_error e;

@@ -57,20 +57,36 @@ static lmgi_scene *load(const lmgi_scene_desc *d, float texel_size)
     return sc;
 }
 
+/* ---------- the room with a lamp, and an updater on it ---------- */
+
+/* The edit room (edit_room.h) lit by a 4 cd point lamp. */
+static lmgi_scene *lamp_room(void)
+{
+    static const lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 4.0f,
+                                         .position = {-1.2f, 2.5f, -1.0f}};
+    lmt_room_spec spec = {.lights = &lamp, .light_count = 1};
+    return lmt_room(&spec);
+}
+
+static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *d)
+{
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
 /* A converged bake of sc (cheap settings: 100 photons a group, hemicube 16; defaults with `defaults`) and
  * its IIM (malloc'd RGBA, *n floats). */
 static float *bake_with(lmgi_context *ctx, lmgi_scene *sc, int defaults, size_t *n)
 {
-    lmgi_updater *u = NULL;
-    if (defaults) {
-        lmgi_updater_desc d;
+    lmgi_updater_desc d;
+    if (defaults)
         memset(&d, 0, sizeof d);
-        lmgi_error e;
-        if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
-            fail_msg("%s", e.message);
-    } else {
-        u = lmt_room_updater(ctx, sc);
-    }
+    else
+        lmt_room_desc(&d);
+    lmgi_updater *u = updater(ctx, sc, &d);
     lmgi_bake_report r;
     lmt_bake(u, &r);
     float *iim = lmt_iim(u, sc, n);
@@ -290,22 +306,13 @@ static void test_n_beyond_the_hits(void **state)
 {
     (void)state;
     lmgi_context *ctx = lmt_context();
-    const lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 4.0f,
-                                  .position = {-1.2f, 2.5f, -1.0f}};
-    lmt_room_spec spec = {.lights = &lamp, .light_count = 1};
-    lmgi_scene *sc = lmt_room(&spec);
+    lmgi_scene *sc = lamp_room();
     size_t n;
     float *usual = baked_iim(ctx, sc, &n);
     lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
-    d.photons_per_group = 100;
-    d.hemicube_resolution = 16;
-    d.rim_samples = 16;
+    lmt_room_desc(&d);
     d.photons_per_estimate = 100000;
-    lmgi_updater *u = NULL;
-    lmgi_error e;
-    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
+    lmgi_updater *u = updater(ctx, sc, &d);
     lmgi_bake_report r;
     lmt_bake(u, &r);
     float *all = lmt_iim(u, sc, &n);
@@ -332,10 +339,7 @@ static void test_blend_under_constant_edits(void **state)
 {
     (void)state;
     lmgi_context *ctx = lmt_context();
-    const lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 4.0f,
-                                  .position = {-1.2f, 2.5f, -1.0f}};
-    lmt_room_spec spec = {.lights = &lamp, .light_count = 1};
-    lmgi_scene *sc = lmt_room(&spec);
+    lmgi_scene *sc = lamp_room();
     size_t n;
     float *lo = baked_iim(ctx, sc, &n);
     lmgi_light l;
@@ -348,14 +352,9 @@ static void test_blend_under_constant_edits(void **state)
     assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
 
     lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
-    d.photons_per_group = 100;
-    d.hemicube_resolution = 16;
-    d.rim_samples = 16;
+    lmt_room_desc(&d);
     d.in_order = 1;
-    lmgi_updater *u = NULL;
-    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
+    lmgi_updater *u = updater(ctx, sc, &d);
     float *now = malloc(n * sizeof *now);
     assert_non_null(now);
     double worst = 0.0, moved = 0.0; /* how far any texel went from the lamp at 4 towards 8 */
