@@ -309,6 +309,34 @@ static void emit_area(const lm_emitter *e, const lm_emit_tri *placed, const lm_s
         out->flux[c] = tri->flux[c] * w;
 }
 
+int lm_emitter_area_point(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris, const float u[2],
+                          float pos[3], float n[3], float weight[3])
+{
+    const lm_emitter *em_e = &em->e[e];
+    if (em_e->punctual || !em_e->tri_count || !(em_e->luminance > 0.0f))
+        return 0;
+    float rest, prob;
+    uint32_t k = pick_tri(em_e, u[0], &rest, &prob);
+    lm_emit_tri own;
+    const lm_emit_tri *tri = tris ? &tris[k] : &own;
+    if (!tris)
+        place_tri(s, em_e->tris[k], LM_EMIT_LIFT * lm_scene_size(s), &own);
+    lm_vec3 p[3] = {lm_v3_load(tri->p[0]), lm_v3_load(tri->p[1]), lm_v3_load(tri->p[2])}, nn = lm_v3_load(tri->n);
+    if (tri->double_sided) {
+        int back = rest >= 0.5f;
+        rest = back ? 2.0f * rest - 1.0f : 2.0f * rest;
+        nn = back ? lm_scale(nn, -1.0f) : nn;
+    }
+    if (!(prob > 0.0f))
+        return 0;
+    lm_v3_store(pos, lm_add(tri_point(p, rest, u[1]), lm_scale(nn, tri->lift)));
+    lm_v3_store(n, nn);
+    /* Le / pdf = Le A sides / prob, and the triangle's flux is pi Le A sides */
+    for (int c = 0; c < 3; c++)
+        weight[c] = tri->flux[c] / ((float)LM_PI * prob);
+    return 1;
+}
+
 static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emitter *e, const float u[4],
                           uint32_t count, lm_emission *out)
 {

@@ -78,6 +78,16 @@ void lm_emitter_place(const lm_emitters *em, const lm_scene *s, int e, lm_emit_t
 void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris,
                             const float u[4], uint32_t count, lm_emission *out);
 
+/* A point on area emitter e as emission picks one (u[0]: the triangle by flux, its leftover the side of a
+ * double-sided one; u[1] with that leftover: uniform on the triangle), for an emitter that then picks
+ * its own direction (the caustic photons, trace/caustics.h): pos lifted off the surface as an emitted
+ * photon's origin, n the unit normal of the emitting side, and weight = Le / pdf (pdf per unit area over
+ * all sides of all the emitter's triangles), so that a photon leaving along w with density p_w (solid
+ * angle) carries weight x cos(n, w) / p_w. Returns 0 for a punctual or flux-less emitter. tris: as
+ * lm_emitter_place made them, or NULL. */
+int lm_emitter_area_point(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris, const float u[2],
+                          float pos[3], float n[3], float weight[3]);
+
 /* Next-event estimation from point p: a sample on emitter e. dir is unit from p towards the light,
  * dist its distance (INFINITY for directional), radiance_weight the incident radiance times the
  * inverse pdf (so that E += radiance_weight * cos for one sample). Returns 0 if p gets nothing. */

@@ -1,0 +1,615 @@
+/* Caustic photons: emission towards the generators, specular paths, the per-pair photon lists and
+ * their updates (caustics.h). */
+#include "caustics.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/qmc.h"
+#include "../core/timing.h"
+#include "../core/vecmath.h"
+#include "bsdf.h"
+#include "shading.h"
+
+#define CAUSTIC_EMIT_DIMS 4u
+#define CAUSTIC_RAY_OFFSET 1e-5f /* x scene size, as the photon stage's */
+/* Fewer photons than this are traced on the calling thread (a thread team costs more). */
+#define CAUSTIC_PARALLEL_MIN 512u
+
+void lm_caustic_settings_default(lm_caustic_settings *s)
+{
+    s->photons = 16384;
+    s->retrace = 0.25f;
+    s->max_bounces = 32;
+    s->seed = 0;
+}
+
+/* ---- emission ---- */
+
+/* A direction uniform in the cone of half-angle acos(cos_max) about unit axis a (cos_max -1: the whole
+ * sphere); returns the cone's solid angle. */
+static float cone_dir(lm_vec3 a, float cos_max, float u0, float u1, lm_vec3 *d)
+{
+    float z = 1.0f - u0 * (1.0f - cos_max), r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
+    lm_sincos_turn(u1, &sn, &cs);
+    *d = lm_normalize(lm_onb_dir(a, r * cs, r * sn, z));
+    return (float)(2.0 * LM_PI) * (1.0f - cos_max);
+}
+
+/* The cone from point o around sphere g: its unit axis and the cosine of its half-angle (-1 when o is
+ * inside the sphere: every direction may reach it). */
+static void cone_to(const lm_caustic_generator *g, lm_vec3 o, lm_vec3 *axis, float *cos_max)
+{
+    lm_vec3 to = lm_sub(lm_v3_load(g->centre), o);
+    float d = lm_length(to);
+    if (!(d > g->radius * 1.0001f)) {
+        *axis = lm_v3(0, 0, 1);
+        *cos_max = -1.0f;
+        return;
+    }
+    *axis = lm_scale(to, 1.0f / d);
+    float s = g->radius / d;
+    *cos_max = sqrtf(fmaxf(0.0f, 1.0f - s * s));
+}
+
+static int set_flux(float flux[3], const float radiant[3], float scale)
+{
+    for (int c = 0; c < 3; c++)
+        flux[c] = radiant[c] * scale;
+    return scale > 0.0f && (radiant[0] > 0.0f || radiant[1] > 0.0f || radiant[2] > 0.0f);
+}
+
+int lm_caustic_emit(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris,
+                    const lm_caustic_generator *g, const float u[4], uint32_t count, float org[3], float dir[3],
+                    float flux[3])
+{
+    const lm_emitter *em_e = &em->e[e];
+    memset(flux, 0, 3 * sizeof *flux);
+    if (!(g->radius > 0.0f) || count == 0)
+        return 0;
+    float inv = 1.0f / (float)count;
+    lm_vec3 axis, d;
+    float cos_max;
+    if (em_e->kind == LM_EMIT_DIRECTIONAL) {
+        lm_vec3 L = lm_normalize(lm_v3_load(em_e->dir)), c = lm_v3_load(g->centre), t, b;
+        lm_tangents(L, &t, &b);
+        float r = g->radius * sqrtf(u[0]), sn, cs;
+        lm_sincos_turn(u[1], &sn, &cs);
+        /* started upstream of everything: past the scene's bounding sphere and the generator's */
+        float back = lm_length(lm_sub(c, lm_v3_load(em->disk_center))) + 1.001f * em->disk_radius + g->radius;
+        lm_vec3 o = lm_add(c, lm_add(lm_scale(t, r * cs), lm_scale(b, r * sn)));
+        lm_v3_store(org, lm_sub(o, lm_scale(L, back)));
+        lm_v3_store(dir, L);
+        return set_flux(flux, em_e->radiant, (float)LM_PI * g->radius * g->radius * inv);
+    }
+    if (em_e->kind == LM_EMIT_AREA) {
+        float n[3], w[3];
+        if (!lm_emitter_area_point(em, s, e, tris, u + 2, org, n, w))
+            return 0;
+        cone_to(g, lm_v3_load(org), &axis, &cos_max);
+        float omega = cone_dir(axis, cos_max, u[0], u[1], &d);
+        float cos_e = lm_dot(lm_v3_load(n), d);
+        lm_v3_store(dir, d);
+        return cos_e > 0.0f && set_flux(flux, w, cos_e * omega * inv);
+    }
+    lm_vec3 o = lm_v3_load(em_e->pos);
+    cone_to(g, o, &axis, &cos_max);
+    float omega = cone_dir(axis, cos_max, u[0], u[1], &d), att = 1.0f;
+    if (em_e->kind == LM_EMIT_SPOT)
+        att = lm_spot_attenuation(&s->lights[em_e->light], lm_dot(d, lm_normalize(lm_v3_load(em_e->dir))));
+    lm_v3_store(org, o);
+    lm_v3_store(dir, d);
+    return set_flux(flux, em_e->radiant, att * omega * inv);
+}
+
+/* ---- paths ---- */
+
+lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, int generator, const float org_[3],
+                                  const float dir_[3], const float flux_[3], uint32_t max_bounces,
+                                  lm_caustic_numbers next, void *user, lm_caustic_hit *hit, uint32_t *rays)
+{
+    float org[3], dir[3], flux[3];
+    memcpy(org, org_, sizeof org);
+    memcpy(dir, dir_, sizeof dir);
+    memcpy(flux, flux_, sizeof flux);
+    float offset = CAUSTIC_RAY_OFFSET * lm_scene_size(s);
+    uint32_t n = 0;
+    lm_caustic_fate fate = LM_CAUSTIC_CAPPED;
+    for (uint32_t b = 0; b <= max_bounces; b++) {
+        lm_rt_hit h;
+        n++;
+        if (!lm_rt_intersect(rt, org, dir, 0.0f, INFINITY, &h)) {
+            fate = b == 0 ? LM_CAUSTIC_MISSED : LM_CAUSTIC_ESCAPED;
+            break;
+        }
+        lm_shading sh;
+        lm_shading_from_hit(s, &h, org, dir, &sh);
+        int specular = lm_material_is_specular(sh.material->cls);
+        if (b == 0 && (!specular || (generator >= 0 && sh.node != generator))) {
+            fate = LM_CAUSTIC_MISSED;
+            break;
+        }
+        if (!specular) {
+            lm_vec3 ng = lm_v3_load(sh.ng);
+            if (lm_dot(ng, lm_v3_load(dir)) > 0.0f)
+                ng = lm_scale(ng, -1.0f);
+            memcpy(hit->pos, sh.pos, sizeof hit->pos);
+            lm_v3_store(hit->ng, ng);
+            memcpy(hit->flux, flux, sizeof hit->flux);
+            memcpy(hit->dir, dir, sizeof hit->dir);
+            hit->node = sh.node;
+            hit->tri = sh.tri;
+            hit->bounces = (uint16_t)b;
+            fate = LM_CAUSTIC_LANDED;
+            break;
+        }
+        if (b == max_bounces) /* one more specular bounce than allowed */
+            break;
+        float u[3] = {next(user, b), 0.0f, 0.0f};
+        lm_bsdf_sample_t bs;
+        if (!lm_bsdf_sample(&sh, dir, u, &bs)) {
+            fate = LM_CAUSTIC_ABSORBED;
+            break;
+        }
+        for (int c = 0; c < 3; c++)
+            flux[c] *= bs.weight[c];
+        if (!lm_v3_finite(lm_v3_load(flux))) {
+            fate = LM_CAUSTIC_ABSORBED;
+            break;
+        }
+        lm_vec3 ng = lm_v3_load(sh.ng), wo = lm_v3_load(bs.wo);
+        float side = lm_dot(ng, wo) >= 0.0f ? offset : -offset;
+        lm_v3_store(org, lm_add(lm_v3_load(sh.pos), lm_scale(ng, side)));
+        memcpy(dir, bs.wo, sizeof dir);
+    }
+    if (rays)
+        *rays = n;
+    return fate;
+}
+
+/* ---- generators ---- */
+
+/* The sphere around node n's specular triangles' world bounds; radius 0 when they have no extent. */
+static void generator_sphere(const lm_scene *s, int n, lm_caustic_generator *g)
+{
+    const lm_node *node = &s->nodes[n];
+    lm_vec3 lo = lm_v3(INFINITY, INFINITY, INFINITY), hi = lm_scale(lo, -1.0f);
+    for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++) {
+        if (!lm_material_is_specular(s->materials[s->tri_material[t]].cls))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            float p[3];
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)t + (size_t)k], p);
+            lo = lm_vmin(lo, lm_v3_load(p));
+            hi = lm_vmax(hi, lm_v3_load(p));
+        }
+    }
+    g->node = n;
+    lm_vec3 c = lm_scale(lm_add(lo, hi), 0.5f);
+    float r = 0.5f * lm_length(lm_sub(hi, lo));
+    int ok = lm_v3_finite(c) && isfinite(r) && r > 0.0f;
+    lm_v3_store(g->centre, ok ? c : lm_v3(0, 0, 0));
+    g->radius = ok ? r : 0.0f;
+}
+
+static int has_specular(const lm_scene *s, int n)
+{
+    const lm_node *node = &s->nodes[n];
+    for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++)
+        if (lm_material_is_specular(s->materials[s->tri_material[t]].cls))
+            return 1;
+    return 0;
+}
+
+lm_status lm_caustic_generators(const lm_scene *s, lm_caustic_generator **out, int *count, lm_error *err)
+{
+    *out = NULL;
+    *count = 0;
+    int n = 0;
+    for (int i = 0; i < s->node_count; i++)
+        n += s->nodes[i].settings.caustics && has_specular(s, i);
+    if (!n)
+        return LM_OK;
+    lm_caustic_generator *g = calloc((size_t)n, sizeof *g);
+    if (!g)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the caustic generators", s->path);
+    int k = 0;
+    for (int i = 0; i < s->node_count; i++)
+        if (s->nodes[i].settings.caustics && has_specular(s, i)) {
+            generator_sphere(s, i, &g[k]);
+            k += g[k].radius > 0.0f; /* no extent: nothing to aim at */
+        }
+    if (!k) {
+        free(g);
+        return LM_OK;
+    }
+    *out = g;
+    *count = k;
+    return LM_OK;
+}
+
+/* ---- the photon lists ---- */
+
+typedef struct {
+    int emitter, generator;
+    uint32_t first;        /* first slot */
+    uint32_t cursor;       /* next photon of the round robin */
+    uint32_t remaining;    /* photons still to re-trace in the round robin's current turn */
+    int whole;             /* re-trace every photon at the next frame */
+} pair;
+
+/* What an emitter's placement was when its photons were last traced: a change re-traces its pairs. */
+typedef struct {
+    float pos[3], dir[3], radiant[3], power[3];
+    float world[16];
+} emitter_state;
+
+struct lm_caustics {
+    const lm_scene *scene;
+    const lm_rt *rt;
+    const lm_emitters *em;
+    lm_caustic_settings set;
+    lm_caustic_generator *gen;
+    float (*gen_world)[16];  /* generator node matrices when their spheres were made */
+    int gen_count;
+    emitter_state *em_state;
+    int em_count;
+    pair *pairs;
+    int pair_count;
+    uint32_t slots;
+    lm_caustic_hit *hits;
+    double *emitted;         /* 3 per slot: a photon's emitted flux when it reached its generator, else 0 */
+    uint32_t landed;
+    uint64_t version;
+    uint64_t world_hash;     /* of every node matrix: a change starts a round-robin turn */
+    /* scratch: the frame's jobs (slot numbers) and their fates */
+    uint32_t *jobs;
+    uint8_t *fates;
+    uint32_t *job_rays;
+    lm_emit_tri *tris;       /* area emitters' placed triangles: em_tri_first[e] .. */
+    uint32_t *em_tri_first;
+};
+
+static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t i = 0; i < n; i++)
+        h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+
+static uint64_t world_hash(const lm_scene *s)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (int n = 0; n < s->node_count; n++)
+        h = hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
+    return h;
+}
+
+static void emitter_snapshot(const lm_caustics *c, int e, emitter_state *out)
+{
+    const lm_emitter *em = &c->em->e[e];
+    memset(out, 0, sizeof *out);
+    memcpy(out->pos, em->pos, sizeof out->pos);
+    memcpy(out->dir, em->dir, sizeof out->dir);
+    memcpy(out->radiant, em->radiant, sizeof out->radiant);
+    memcpy(out->power, em->power, sizeof out->power);
+    if (em->node >= 0 && em->node < c->scene->node_count)
+        memcpy(out->world, c->scene->nodes[em->node].world, sizeof out->world);
+}
+
+/* QMC number for slot `slot`'s photon, dimension dim (a pure function of the photon). */
+static float caustic_number(const lm_caustics *c, uint32_t slot, uint32_t dim)
+{
+    uint64_t index = (uint64_t)c->set.seed * c->slots + slot;
+    if (dim < LM_QMC_MAX_DIMS && index <= UINT32_MAX)
+        return lm_halton_float(dim, (uint32_t)index);
+    uint64_t h = index * 0x9E3779B97F4A7C15ull + (uint64_t)(dim + 1) * 0xBF58476D1CE4E5B9ull;
+    h ^= h >> 31;
+    h *= 0x94D049BB133111EBull;
+    h ^= h >> 29;
+    return (float)(h >> 40) * (1.0f / 16777216.0f);
+}
+
+typedef struct {
+    const lm_caustics *c;
+    uint32_t slot;
+} numbers_user;
+
+static float bounce_number(void *user, uint32_t bounce)
+{
+    const numbers_user *n = user;
+    return caustic_number(n->c, n->slot, CAUSTIC_EMIT_DIMS + bounce);
+}
+
+static const pair *pair_of(const lm_caustics *c, uint32_t slot)
+{
+    return &c->pairs[slot / c->set.photons];
+}
+
+/* Traces the photon of `slot` into its hit slot; returns its fate, *rays the rays cast. */
+static lm_caustic_fate trace_slot(const lm_caustics *c, uint32_t slot, lm_caustic_hit *hit, double emitted[3],
+                                  uint32_t *rays)
+{
+    const pair *p = pair_of(c, slot);
+    float u[4], org[3], dir[3], flux[3];
+    for (uint32_t k = 0; k < CAUSTIC_EMIT_DIMS; k++)
+        u[k] = caustic_number(c, slot, k);
+    memset(hit, 0, sizeof *hit);
+    emitted[0] = emitted[1] = emitted[2] = 0.0;
+    *rays = 0;
+    const lm_emit_tri *tris = c->em->e[p->emitter].punctual ? NULL : c->tris + c->em_tri_first[p->emitter];
+    if (!lm_caustic_emit(c->em, c->scene, p->emitter, tris, &c->gen[p->generator], u, c->set.photons, org, dir,
+                         flux))
+        return LM_CAUSTIC_MISSED;
+    numbers_user nu = {c, slot};
+    lm_caustic_fate f = lm_caustic_follow(c->scene, c->rt, c->gen[p->generator].node, org, dir, flux,
+                                          c->set.max_bounces, bounce_number, &nu, hit, rays);
+    if (f != LM_CAUSTIC_MISSED)
+        for (int k = 0; k < 3; k++)
+            emitted[k] = flux[k];
+    hit->emitter = (uint16_t)p->emitter;
+    if (f != LM_CAUSTIC_LANDED)
+        memset(hit, 0, sizeof *hit);
+    return f;
+}
+
+/* Places the area emitters' triangles for this frame's traces. */
+static void place_emitters(lm_caustics *c)
+{
+    for (int e = 0; e < c->em_count; e++)
+        if (!c->em->e[e].punctual)
+            lm_emitter_place(c->em, c->scene, e, c->tris + c->em_tri_first[e]);
+}
+
+/* Traces jobs[0 .. n) (slots), in parallel, then counts. */
+static void trace_jobs(lm_caustics *c, uint32_t n, lm_caustic_frame_stats *st)
+{
+    if (!n)
+        return;
+    place_emitters(c);
+    const lm_caustics *cc = c;
+#pragma omp parallel if (n >= CAUSTIC_PARALLEL_MIN)
+    {
+        lm_rt_thread_init();
+#pragma omp for schedule(dynamic, 64)
+        for (long i = 0; i < (long)n; i++) {
+            uint32_t slot = c->jobs[i];
+            lm_caustic_hit h;
+            double em[3];
+            uint32_t rays;
+            c->fates[i] = (uint8_t)trace_slot(cc, slot, &h, em, &rays);
+            c->job_rays[i] = rays;
+            c->hits[slot] = h;
+            memcpy(c->emitted + 3 * (size_t)slot, em, sizeof em);
+        }
+    }
+    uint32_t *fate_count[5] = {&st->landed, &st->missed, &st->escaped, &st->absorbed, &st->capped};
+    for (uint32_t i = 0; i < n; i++) {
+        (*fate_count[c->fates[i]])++;
+        st->rays += c->job_rays[i];
+    }
+    st->traced += n;
+    uint32_t landed = 0;
+    for (uint32_t s = 0; s < c->slots; s++)
+        landed += c->hits[s].flux[0] != 0.0f || c->hits[s].flux[1] != 0.0f || c->hits[s].flux[2] != 0.0f;
+    c->landed = landed;
+    c->version++;
+}
+
+static lm_status alloc_lists(lm_caustics *c, lm_error *err)
+{
+    c->pair_count = c->gen_count * c->em_count;
+    c->pairs = calloc((size_t)(c->pair_count ? c->pair_count : 1), sizeof *c->pairs);
+    c->gen_world = calloc((size_t)(c->gen_count ? c->gen_count : 1), sizeof *c->gen_world);
+    c->em_state = calloc((size_t)(c->em_count ? c->em_count : 1), sizeof *c->em_state);
+    c->em_tri_first = calloc((size_t)c->em_count + 1, sizeof *c->em_tri_first);
+    uint64_t slots = (uint64_t)c->pair_count * c->set.photons;
+    if (slots > UINT32_MAX / 2)
+        return lm_fail(err, LM_ERR_INVALID, "%s: %d caustic pairs of %u photons are too many", c->scene->path,
+                       c->pair_count, c->set.photons);
+    c->slots = (uint32_t)slots;
+    size_t n = slots ? (size_t)slots : 1;
+    c->hits = calloc(n, sizeof *c->hits);
+    c->emitted = calloc(3 * n, sizeof *c->emitted);
+    c->jobs = malloc(n * sizeof *c->jobs);
+    c->fates = malloc(n);
+    c->job_rays = malloc(n * sizeof *c->job_rays);
+    if (!c->pairs || !c->gen_world || !c->em_state || !c->em_tri_first || !c->hits || !c->emitted || !c->jobs ||
+        !c->fates || !c->job_rays)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %llu caustic photons", c->scene->path,
+                       (unsigned long long)slots);
+    for (int e = 0; e < c->em_count; e++)
+        c->em_tri_first[e + 1] = c->em_tri_first[e] + (c->em->e[e].punctual ? 0 : c->em->e[e].tri_count);
+    c->tris = malloc(sizeof *c->tris * (c->em_tri_first[c->em_count] ? c->em_tri_first[c->em_count] : 1));
+    if (!c->tris)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the caustic emitters", c->scene->path);
+    for (int g = 0; g < c->gen_count; g++)
+        for (int e = 0; e < c->em_count; e++) {
+            pair *p = &c->pairs[g * c->em_count + e];
+            p->emitter = e;
+            p->generator = g;
+            p->first = (uint32_t)(g * c->em_count + e) * c->set.photons;
+        }
+    return LM_OK;
+}
+
+static lm_status check_settings(const lm_scene *s, const lm_caustic_settings *set, lm_error *err)
+{
+    if (set->photons < 1 || set->photons > (1u << 24))
+        return lm_fail(err, LM_ERR_INVALID, "%s: caustic photons per pair must be 1 to 16777216, not %u", s->path,
+                       set->photons);
+    if (!(set->retrace > 0.0f && set->retrace <= 1.0f))
+        return lm_fail(err, LM_ERR_INVALID, "%s: the caustic re-trace fraction must be in (0, 1], not %g", s->path,
+                       (double)set->retrace);
+    if (set->max_bounces < 1 || set->max_bounces > 1024)
+        return lm_fail(err, LM_ERR_INVALID, "%s: caustic bounces must be 1 to 1024, not %u", s->path,
+                       set->max_bounces);
+    return LM_OK;
+}
+
+static void snapshot_all(lm_caustics *c)
+{
+    for (int g = 0; g < c->gen_count; g++)
+        memcpy(c->gen_world[g], c->scene->nodes[c->gen[g].node].world, sizeof c->gen_world[g]);
+    for (int e = 0; e < c->em_count; e++)
+        emitter_snapshot(c, e, &c->em_state[e]);
+    c->world_hash = world_hash(c->scene);
+}
+
+lm_status lm_caustics_trace_all(lm_caustics *c, lm_caustic_frame_stats *stats, lm_error *err)
+{
+    (void)err;
+    lm_caustic_frame_stats st;
+    memset(&st, 0, sizeof st);
+    double t0 = lm_now();
+    for (int g = 0; g < c->gen_count; g++) /* spheres as the scene is now */
+        generator_sphere(c->scene, c->gen[g].node, &c->gen[g]);
+    snapshot_all(c);
+    for (uint32_t s = 0; s < c->slots; s++)
+        c->jobs[s] = s;
+    for (int p = 0; p < c->pair_count; p++)
+        c->pairs[p].remaining = 0, c->pairs[p].whole = 0;
+    trace_jobs(c, c->slots, &st);
+    st.seconds = lm_now() - t0;
+    if (stats)
+        *stats = st;
+    return LM_OK;
+}
+
+lm_status lm_caustics_create(const lm_scene *s, const lm_rt *rt, const lm_emitters *em,
+                             const lm_caustic_settings *set, lm_caustics **out, lm_caustic_frame_stats *stats,
+                             lm_error *err)
+{
+    *out = NULL;
+    lm_caustic_settings def;
+    if (!set) {
+        lm_caustic_settings_default(&def);
+        set = &def;
+    }
+    lm_status st = check_settings(s, set, err);
+    if (st != LM_OK)
+        return st;
+    lm_caustics *c = calloc(1, sizeof *c);
+    if (!c)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the caustic photons", s->path);
+    c->scene = s, c->rt = rt, c->em = em, c->set = *set;
+    c->em_count = em->count;
+    lm_qmc_init();
+    st = lm_caustic_generators(s, &c->gen, &c->gen_count, err);
+    if (st == LM_OK)
+        st = alloc_lists(c, err);
+    if (st == LM_OK)
+        st = lm_caustics_trace_all(c, stats, err);
+    if (st != LM_OK) {
+        lm_caustics_free(c);
+        return st;
+    }
+    *out = c;
+    return LM_OK;
+}
+
+void lm_caustics_free(lm_caustics *c)
+{
+    if (!c)
+        return;
+    free(c->gen);
+    free(c->gen_world);
+    free(c->em_state);
+    free(c->pairs);
+    free(c->hits);
+    free(c->emitted);
+    free(c->jobs);
+    free(c->fates);
+    free(c->job_rays);
+    free(c->tris);
+    free(c->em_tri_first);
+    free(c);
+}
+
+/* Marks whole the pairs whose generator moved or whose emitter changed; returns how many. */
+static uint32_t mark_moved(lm_caustics *c)
+{
+    uint32_t n = 0;
+    for (int g = 0; g < c->gen_count; g++) {
+        const float *w = c->scene->nodes[c->gen[g].node].world;
+        if (!memcmp(w, c->gen_world[g], sizeof c->gen_world[g]))
+            continue;
+        memcpy(c->gen_world[g], w, sizeof c->gen_world[g]);
+        generator_sphere(c->scene, c->gen[g].node, &c->gen[g]);
+        for (int e = 0; e < c->em_count; e++)
+            c->pairs[g * c->em_count + e].whole = 1;
+    }
+    for (int e = 0; e < c->em_count; e++) {
+        emitter_state now;
+        emitter_snapshot(c, e, &now);
+        if (!memcmp(&now, &c->em_state[e], sizeof now))
+            continue;
+        c->em_state[e] = now;
+        for (int g = 0; g < c->gen_count; g++)
+            c->pairs[g * c->em_count + e].whole = 1;
+    }
+    for (int p = 0; p < c->pair_count; p++)
+        n += c->pairs[p].whole;
+    return n;
+}
+
+lm_status lm_caustics_frame(lm_caustics *c, lm_caustic_frame_stats *stats, lm_error *err)
+{
+    (void)err;
+    lm_caustic_frame_stats st;
+    memset(&st, 0, sizeof st);
+    double t0 = lm_now();
+    if (c->pair_count) {
+        st.pairs_moved = mark_moved(c);
+        uint64_t h = world_hash(c->scene);
+        int moved = h != c->world_hash;
+        c->world_hash = h;
+        uint32_t N = c->set.photons, per_frame = (uint32_t)ceil((double)c->set.retrace * N), n = 0;
+        per_frame = per_frame < 1 ? 1 : per_frame > N ? N : per_frame;
+        for (int i = 0; i < c->pair_count; i++) {
+            pair *p = &c->pairs[i];
+            if (p->whole) {
+                for (uint32_t k = 0; k < N; k++)
+                    c->jobs[n++] = p->first + k;
+                p->whole = 0;
+                p->remaining = moved ? N : 0; /* the turn begins again after the scene moved */
+                continue;
+            }
+            if (moved)
+                p->remaining = N;
+            uint32_t take = p->remaining < per_frame ? p->remaining : per_frame;
+            for (uint32_t k = 0; k < take; k++) {
+                c->jobs[n++] = p->first + p->cursor;
+                p->cursor = (p->cursor + 1) % N;
+            }
+            p->remaining -= take;
+        }
+        trace_jobs(c, n, &st);
+    }
+    st.seconds = lm_now() - t0;
+    if (stats)
+        *stats = st;
+    return LM_OK;
+}
+
+int lm_caustics_pair_count(const lm_caustics *c) { return c->pair_count; }
+int lm_caustics_generator_count(const lm_caustics *c) { return c->gen_count; }
+const lm_caustic_generator *lm_caustics_generator(const lm_caustics *c, int i) { return &c->gen[i]; }
+uint32_t lm_caustics_photon_count(const lm_caustics *c) { return c->slots; }
+const lm_caustic_hit *lm_caustics_hits(const lm_caustics *c) { return c->hits; }
+uint32_t lm_caustics_landed(const lm_caustics *c) { return c->landed; }
+uint64_t lm_caustics_version(const lm_caustics *c) { return c->version; }
+
+void lm_caustics_flux(const lm_caustics *c, double stored[3], double emitted[3])
+{
+    for (int k = 0; k < 3; k++)
+        stored[k] = emitted[k] = 0.0;
+    for (uint32_t s = 0; s < c->slots; s++)
+        for (int k = 0; k < 3; k++) {
+            stored[k] += c->hits[s].flux[k];
+            emitted[k] += c->emitted[3 * (size_t)s + k];
+        }
+}

@@ -1,0 +1,390 @@
+/* Caustic photons (trace/caustics.h): where they land against the analytic image of a light in a mirror,
+ * energy through mirrors and glass, what moves re-traces what, bad geometry, switches, determinism. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/trace/caustics.h"
+#include "support.h"
+
+#define LIGHTS(json) \
+    "\"extensionsUsed\": [\"KHR_lights_punctual\", \"KHR_materials_transmission\", \"KHR_materials_ior\"], " \
+    "\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [" json "]}}"
+#define DIFFUSE(g) "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [" #g ", " #g ", " #g ", 1], \"metallicFactor\": 0}}"
+#define MIRROR(r) "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [" #r ", " #r ", " #r ", 1], \"metallicFactor\": 1, " \
+                  "\"roughnessFactor\": 0}}"
+#define GLASS "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": " \
+              "{\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 1.5}}}"
+
+static lm_caustics *make(const lmt_pipeline *p, uint32_t photons, lm_caustic_frame_stats *st)
+{
+    lm_caustic_settings set;
+    lm_caustic_settings_default(&set);
+    set.photons = photons;
+    lm_caustics *c = NULL;
+    lm_error err;
+    if (lm_caustics_create(p->s, p->rt, &p->em, &set, &c, st, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    return c;
+}
+
+/* An 8 x 8 m diffuse floor (y = 0), a vertical 0.5 m square mirror at x = 1 facing -x (y in [0.75, 1.25],
+ * z in [-0.25, 0.25]), a point light of 10 cd at (0, 2, 0); `cube_extras`: a 0.2 m diffuse cube at
+ * (-2, 0.2, -2) with these node extras (NULL: no cube); `mirror_extras` on the mirror. */
+static const char *mirror_scene(const char *name, const char *mirror_extras, const char *cube_extras)
+{
+    static lmt_mesh m[3];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-4, 0, 4}, (float[3]){8, 0, 0}, (float[3]){0, 0, -8});
+    lmt_mesh_quad(&m[1], (float[3]){1, 0.75f, -0.25f}, (float[3]){0, 0, 0.5f}, (float[3]){0, 0.5f, 0});
+    lmt_mesh_cube(&m[2], 0.2f);
+    char nodes[1024];
+    snprintf(nodes, sizeof nodes,
+             "[{\"mesh\": 0}, {\"mesh\": 1%s%s}, {\"translation\": [0, 2, 0], \"extensions\": "
+             "{\"KHR_lights_punctual\": {\"light\": 0}}}%s%s%s]",
+             mirror_extras ? ", \"extras\": " : "", mirror_extras ? mirror_extras : "",
+             cube_extras ? ", {\"mesh\": 2, \"translation\": [-2, 0.2, -2], \"extras\": " : "",
+             cube_extras ? cube_extras : "", cube_extras ? "}" : "");
+    return lmt_write_scene(name, m, cube_extras ? 3 : 2, nodes,
+                           "[" DIFFUSE(0.8) ", " MIRROR(0.9) ", " DIFFUSE(0.5) "], " LIGHTS("{\"type\": \"point\", \"intensity\": 10}"));
+}
+
+/* The image of the light in the mirror: irradiance rho I cos / d^2 from the virtual light V = (2, 2, 0) at a
+ * floor point (x, 0, z); 0 where the line to V misses the mirror. */
+static double mirror_image(double x, double z, int *inside)
+{
+    double t = 1.0 / (2.0 - x), y = 2.0 - 2.0 * t, zz = z * t; /* where the line to V crosses x = 1 */
+    *inside = x < 2.0 && y >= 0.75 && y <= 1.25 && fabs(zz) <= 0.25;
+    double d = sqrt((2.0 - x) * (2.0 - x) + 4.0 + z * z);
+    return 0.9 * 10.0 * 2.0 / (d * d * d);
+}
+
+/* The photons binned in 0.1 m cells of the floor: cells well inside the lit patch read the image of the
+ * light within 10%, cells well outside nothing. */
+static void test_mirror_image(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, mirror_scene("mirror.gltf", NULL, NULL), 0.2f);
+    lm_caustic_frame_stats st;
+    lm_caustics *c = make(&p, 1u << 16, &st);
+    assert_int_equal(lm_caustics_generator_count(c), 1);
+    assert_int_equal(lm_caustics_pair_count(c), 1);
+    enum { N = 80 };
+    const double cell = 0.1, lo = -4.0;
+    static double bins[N][N];
+    memset(bins, 0, sizeof bins);
+    const lm_caustic_hit *h = lm_caustics_hits(c);
+    for (uint32_t i = 0; i < lm_caustics_photon_count(c); i++) {
+        if (h[i].flux[1] == 0.0f)
+            continue;
+        assert_int_equal(h[i].node, 0);
+        assert_true(h[i].ng[1] > 0.99f);
+        int bx = (int)floor((h[i].pos[0] - lo) / cell), bz = (int)floor((h[i].pos[2] - lo) / cell);
+        if (bx >= 0 && bx < N && bz >= 0 && bz < N)
+            bins[bx][bz] += h[i].flux[1];
+    }
+    double worst_in = 0.0, sum_in = 0.0, want_in = 0.0, out_flux = 0.0, in_flux = 0.0;
+    int inside_cells = 0;
+    for (int i = 0; i < N; i++)
+        for (int k = 0; k < N; k++) {
+            double x0 = lo + i * cell, z0 = lo + k * cell, E = bins[i][k] / (cell * cell);
+            int all_in = 1, all_out = 1;
+            for (int cx = -1; cx <= 2; cx++) /* the cell and a margin of half a cell */
+                for (int cz = -1; cz <= 2; cz++) {
+                    int in;
+                    mirror_image(x0 + cx * 0.5 * cell, z0 + cz * 0.5 * cell, &in);
+                    all_in &= in, all_out &= !in;
+                }
+            int in;
+            double want = mirror_image(x0 + 0.5 * cell, z0 + 0.5 * cell, &in);
+            if (all_in) {
+                worst_in = fmax(worst_in, fabs(E / want - 1.0));
+                sum_in += E, want_in += want, inside_cells++;
+                in_flux += bins[i][k];
+            } else if (all_out) {
+                out_flux += bins[i][k];
+            }
+        }
+    print_message("mirror image: %d cells inside, mean %.4f of rho I cos / d^2, worst cell %.3f; flux outside %.2e of "
+                  "inside; %u landed, %u missed of %u\n", inside_cells, sum_in / want_in, worst_in, out_flux / in_flux,
+                  st.landed, st.missed, st.traced);
+    assert_true(inside_cells > 40);
+    assert_true(fabs(sum_in / want_in - 1.0) < 0.02);
+    assert_true(worst_in < 0.10);
+    assert_true(out_flux == 0.0);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
+/* A mirror of albedo 0.9 stores exactly 0.9 of what it received; received, the light's intensity times
+ * the mirror's solid angle from the light (a rectangle seen off its axis: the difference of four on-axis
+ * corner rectangles, Omega(a, b, h) = atan(a b / (h sqrt(a^2 + b^2 + h^2)))). */
+static double rect_solid_angle(double a, double b, double h) { return atan(a * b / (h * sqrt(a * a + b * b + h * h))); }
+
+static void test_mirror_energy(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, mirror_scene("mirror_energy.gltf", NULL, NULL), 0.2f);
+    lm_caustics *c = make(&p, 1u << 16, NULL);
+    double stored[3], emitted[3];
+    lm_caustics_flux(c, stored, emitted);
+    /* from (0, 2, 0) the mirror plane x = 1 lies at h = 1; the mirror spans y - 2 in [-1.25, -0.75], z in
+     * [-0.25, 0.25] */
+    double omega = 2.0 * (rect_solid_angle(1.25, 0.25, 1.0) - rect_solid_angle(0.75, 0.25, 1.0));
+    print_message("mirror energy: stored %.6f, 0.9 x received %.6f; received %.5f, I x Omega %.5f\n", stored[1],
+                  0.9 * emitted[1], emitted[1], 10.0 * omega);
+    assert_true(fabs(stored[1] - 0.9 * emitted[1]) <= 1e-5 * stored[1]);
+    assert_true(fabs(emitted[1] / (10.0 * omega) - 1.0) < 0.005);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
+/* A closed diffuse room (half-size 3) with a light and a generator cube (half-size 0.3) at its centre. */
+static const char *room_scene(const char *name, const char *generator, const char *light_json, float light_y,
+                              float cube_size)
+{
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_cube_inward(&m[0], 3.0f);
+    lmt_mesh_cube(&m[1], cube_size);
+    char nodes[512], materials[2048];
+    snprintf(nodes, sizeof nodes,
+             "[{\"mesh\": 0}, {\"mesh\": 1}, {\"translation\": [0, %g, 0.01], \"extensions\": "
+             "{\"KHR_lights_punctual\": {\"light\": 0}}}]", (double)light_y);
+    snprintf(materials, sizeof materials, "[" DIFFUSE(0.5) ", %s], " LIGHTS("%s"), generator, light_json);
+    return lmt_write_scene(name, m, 2, nodes, materials);
+}
+
+/* Clear glass passes every photon on (Fresnel picks reflection or refraction, weight 1): what lands is what
+ * the cube received, less what total internal reflection kept past the bounce cap. A light inside a glass
+ * cube: the whole sphere of directions, every photon through the glass. */
+static void test_glass_energy(void **state)
+{
+    (void)state;
+    const char *point = "{\"type\": \"point\", \"intensity\": 10}";
+    for (int inside = 0; inside < 2; inside++) {
+        lmt_pipeline p;
+        lmt_pipeline_load(&p, room_scene("glass.gltf", GLASS, point, inside ? 0.0f : 2.0f, 0.3f), 0.5f);
+        lm_caustic_frame_stats st;
+        lm_caustics *c = make(&p, 1u << 14, &st);
+        double stored[3], emitted[3];
+        lm_caustics_flux(c, stored, emitted);
+        print_message("glass (light %s): stored %.5f of received %.5f; %u landed, %u capped, %u absorbed, %u escaped, "
+                      "%u missed\n", inside ? "inside" : "outside", stored[1], emitted[1], st.landed, st.capped,
+                      st.absorbed, st.escaped, st.missed);
+        assert_int_equal(st.escaped, 0); /* a closed room */
+        assert_true(stored[1] <= emitted[1] * (1.0 + 1e-6));
+        assert_true(stored[1] >= emitted[1] * (1.0 - 1e-6) - (double)(st.capped + st.absorbed) * emitted[1] / st.landed * 2.0);
+        if (inside) { /* every direction reaches the glass */
+            assert_int_equal(st.missed, 0);
+            assert_true(fabs(emitted[1] / (4.0 * M_PI * 10.0) - 1.0) < 1e-3);
+        }
+        lm_caustics_free(c);
+        lmt_pipeline_free(&p);
+    }
+}
+
+/* Light caught in a mirror box (every face a perfect mirror, the light inside): every photon bounces
+ * until the cap, is counted and dropped; nothing hangs. */
+static void test_bounce_cap(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, room_scene("mirror_box.gltf", "{\"pbrMetallicRoughness\": {\"metallicFactor\": 1, "
+                      "\"roughnessFactor\": 0}, \"doubleSided\": true}", "{\"type\": \"point\", \"intensity\": 1}", 0.0f, 1.0f),
+                      0.5f);
+    lm_caustic_frame_stats st;
+    lm_caustics *c = make(&p, 4096, &st);
+    print_message("mirror box: %u capped, %u landed of %u, %llu rays\n", st.capped, st.landed, st.traced,
+                  (unsigned long long)st.rays);
+    assert_int_equal(st.capped, st.traced - st.missed - st.absorbed);
+    assert_true(st.capped > 3000);
+    assert_int_equal(st.landed, 0);
+    assert_int_equal(lm_caustics_landed(c), 0);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
+static void move(lmt_pipeline *p, int node, float dx)
+{
+    float w[16];
+    memcpy(w, p->s->nodes[node].world, sizeof w);
+    w[12] += dx;
+    lm_error err;
+    assert_true(lm_scene_set_node_world(p->s, node, w));
+    if (lm_rt_set_node_transform(p->rt, node, w, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    lm_emitters_update(&p->em, p->s);
+}
+
+/* A still scene traces nothing; another node moving re-traces a quarter of each pair a frame for one
+ * turn; the generator moving re-traces its pair whole at once. */
+static void test_what_moves(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, mirror_scene("moves.gltf", "{\"lmgi\": {\"dynamic\": true}}", "{\"lmgi\": {\"dynamic\": true}}"),
+                      0.2f);
+    const uint32_t N = 4096;
+    lm_caustics *c = make(&p, N, NULL);
+    lm_caustic_frame_stats st;
+    lm_error err;
+    assert_int_equal(lm_caustics_frame(c, &st, &err), LM_OK);
+    assert_int_equal(st.traced, 0);
+    move(&p, 3, 0.1f); /* the cube */
+    uint32_t traced[6];
+    for (int f = 0; f < 6; f++) {
+        assert_int_equal(lm_caustics_frame(c, &st, &err), LM_OK);
+        traced[f] = st.traced;
+    }
+    print_message("cube moved: %u %u %u %u %u %u photons re-traced\n", traced[0], traced[1], traced[2], traced[3],
+                  traced[4], traced[5]);
+    for (int f = 0; f < 4; f++)
+        assert_int_equal(traced[f], N / 4);
+    assert_int_equal(traced[4], 0);
+    uint64_t v = lm_caustics_version(c);
+    move(&p, 1, 0.05f); /* the mirror */
+    assert_int_equal(lm_caustics_frame(c, &st, &err), LM_OK);
+    assert_int_equal(st.pairs_moved, 1);
+    assert_true(st.traced >= N);
+    assert_true(lm_caustics_version(c) > v);
+    assert_float_equal(lm_caustics_generator(c, 0)->centre[0], 1.05, 1e-5);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
+/* Extras "caustics": false makes a mirror no generator; a spot aimed away from the mirror lands nothing;
+ * a scene with no specular material has no pairs and costs nothing. */
+static void test_switches_and_empty(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, mirror_scene("off.gltf", "{\"lmgi\": {\"caustics\": false}}", NULL), 0.2f);
+    lm_caustic_frame_stats st;
+    lm_caustics *c = make(&p, 1024, &st);
+    assert_int_equal(lm_caustics_pair_count(c), 0);
+    assert_int_equal(lm_caustics_photon_count(c), 0);
+    assert_int_equal(st.traced, 0);
+    lm_error err;
+    assert_int_equal(lm_caustics_frame(c, &st, &err), LM_OK);
+    assert_int_equal(st.traced, 0);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+
+    /* a spot at (0, 2, 0) pointing -x (away from the mirror at +x) */
+    const char *spot = "{\"type\": \"spot\", \"intensity\": 10, \"spot\": {\"outerConeAngle\": 0.5}}";
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-4, 0, 4}, (float[3]){8, 0, 0}, (float[3]){0, 0, -8});
+    lmt_mesh_quad(&m[1], (float[3]){1, 0.75f, -0.25f}, (float[3]){0, 0, 0.5f}, (float[3]){0, 0.5f, 0});
+    /* a node's light shines down its -Z: rotated +90 degrees about y, -Z becomes -x */
+    const char *path = lmt_write_scene("spot.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"translation\": [0, 2, 0], "
+                                       "\"rotation\": [0, 0.7071068, 0, 0.7071068], \"extensions\": "
+                                       "{\"KHR_lights_punctual\": {\"light\": 0}}}]",
+                                       "[" DIFFUSE(0.8) ", " MIRROR(0.9) "], " LIGHTS("{\"type\": \"spot\", \"intensity\": 10, "
+                                       "\"spot\": {\"outerConeAngle\": 0.5}}"));
+    (void)spot;
+    lmt_pipeline_load(&p, path, 0.2f);
+    c = make(&p, 1024, &st);
+    assert_int_equal(lm_caustics_pair_count(c), 1);
+    assert_int_equal(lm_caustics_landed(c), 0);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
+/* The sun on the mirror: received = E x area x cos, stored = 0.9 of it. */
+static void test_directional(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-4, 0, 4}, (float[3]){8, 0, 0}, (float[3]){0, 0, -8});
+    lmt_mesh_quad(&m[1], (float[3]){1, 0.75f, -0.25f}, (float[3]){0, 0, 0.5f}, (float[3]){0, 0.5f, 0});
+    /* the node's -Z turned to (1, -1, 0) / sqrt 2: columns x' = (0, 0, 1), y' = (1, 1, 0) / sqrt 2,
+     * z' = (-1, 1, 0) / sqrt 2 */
+    const char *path = lmt_write_scene("sun.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"matrix\": "
+                                       "[0, 0, 1, 0, 0.7071068, 0.7071068, 0, 0, -0.7071068, 0.7071068, 0, 0, 0, 0, 0, 1], "
+                                       "\"extensions\": "
+                                       "{\"KHR_lights_punctual\": {\"light\": 0}}}]",
+                                       "[" DIFFUSE(0.8) ", " MIRROR(0.9) "], " LIGHTS("{\"type\": \"directional\", \"intensity\": 3}"));
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 0.2f);
+    const float *d = p.em.e[0].dir;
+    lm_caustics *c = make(&p, 1u << 14, NULL);
+    double stored[3], emitted[3];
+    lm_caustics_flux(c, stored, emitted);
+    double cos = d[0] / sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]), want = 3.0 * 0.25 * cos;
+    print_message("sun: direction (%.3f %.3f %.3f), received %.5f of E A cos %.5f, stored %.5f\n", (double)d[0],
+                  (double)d[1], (double)d[2], emitted[1], want, stored[1]);
+    assert_true(cos > 0.6);
+    assert_true(fabs(emitted[1] / want - 1.0) < 0.01);
+    assert_true(fabs(stored[1] - 0.9 * emitted[1]) <= 1e-5 * stored[1]);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
+/* One thread or two: the same photons, bit for bit. */
+static void test_deterministic(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, room_scene("det.gltf", GLASS, "{\"type\": \"point\", \"intensity\": 10}", 2.0f, 0.3f), 0.5f);
+    int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    lm_caustics *a = make(&p, 8192, NULL);
+    omp_set_num_threads(threads > 1 ? threads : 2);
+    lm_caustics *b = make(&p, 8192, NULL);
+    omp_set_num_threads(threads);
+    assert_int_equal(lm_caustics_photon_count(a), lm_caustics_photon_count(b));
+    assert_memory_equal(lm_caustics_hits(a), lm_caustics_hits(b), sizeof(lm_caustic_hit) * lm_caustics_photon_count(a));
+    lm_caustics_free(a);
+    lm_caustics_free(b);
+    lmt_pipeline_free(&p);
+}
+
+/* Bad settings are refused naming them. */
+static void test_bad_settings(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, mirror_scene("bad.gltf", NULL, NULL), 0.2f);
+    lm_caustic_settings set;
+    lm_caustics *c = NULL;
+    lm_error err;
+    lm_caustic_settings_default(&set);
+    set.retrace = 0.0f;
+    assert_int_equal(lm_caustics_create(p.s, p.rt, &p.em, &set, &c, NULL, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "re-trace"));
+    set.retrace = NAN;
+    assert_int_equal(lm_caustics_create(p.s, p.rt, &p.em, &set, &c, NULL, &err), LM_ERR_INVALID);
+    lm_caustic_settings_default(&set);
+    set.photons = 0;
+    assert_int_equal(lm_caustics_create(p.s, p.rt, &p.em, &set, &c, NULL, &err), LM_ERR_INVALID);
+    assert_null(c);
+    lmt_pipeline_free(&p);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_mirror_image),
+        cmocka_unit_test(test_mirror_energy),
+        cmocka_unit_test(test_glass_energy),
+        cmocka_unit_test(test_bounce_cap),
+        cmocka_unit_test(test_what_moves),
+        cmocka_unit_test(test_switches_and_empty),
+        cmocka_unit_test(test_directional),
+        cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_bad_settings),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
