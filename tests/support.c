@@ -4,6 +4,7 @@
 #include "../src/gpu/gl_context.h"
 
 #include <ftw.h>
+#include <math.h>
 #include <sys/stat.h>
 
 #include <stdio.h>
@@ -388,4 +389,31 @@ const char *lmt_write_scene(const char *name, const lmt_mesh *meshes, int count,
     fputs(out, f);
     fclose(f);
     return path;
+}
+
+const char *lmt_mirror_scene(const char *name, const char *mirror_extras, const char *cube_extras)
+{
+    static lmt_mesh m[3];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-4, 0, 4}, (float[3]){8, 0, 0}, (float[3]){0, 0, -8});
+    lmt_mesh_quad(&m[1], (float[3]){1, 0.75f, -0.25f}, (float[3]){0, 0, 0.5f}, (float[3]){0, 0.5f, 0});
+    lmt_mesh_cube(&m[2], 0.2f);
+    char nodes[1024];
+    snprintf(nodes, sizeof nodes,
+             "[{\"mesh\": 0}, {\"mesh\": 1%s%s}, {\"translation\": [0, 2, 0], \"extensions\": "
+             "{\"KHR_lights_punctual\": {\"light\": 0}}}%s%s%s]",
+             mirror_extras ? ", \"extras\": " : "", mirror_extras ? mirror_extras : "",
+             cube_extras ? ", {\"mesh\": 2, \"translation\": [-2, 0.2, -2], \"extras\": " : "",
+             cube_extras ? cube_extras : "", cube_extras ? "}" : "");
+    return lmt_write_scene(name, m, cube_extras ? 3 : 2, nodes,
+                           "[" LMT_DIFFUSE(0.8) ", " LMT_MIRROR(0.9) ", " LMT_DIFFUSE(0.5) "], "
+                           LMT_LIGHTS("{\"type\": \"point\", \"intensity\": 10}"));
+}
+
+double lmt_mirror_image(double x, double z, int *inside)
+{
+    double t = 1.0 / (2.0 - x), y = 2.0 - 2.0 * t, zz = z * t; /* where the line to it crosses x = 1 */
+    *inside = x < 2.0 && y >= 0.75 && y <= 1.25 && fabs(zz) <= 0.25;
+    double d = sqrt((2.0 - x) * (2.0 - x) + 4.0 + z * z);
+    return 0.9 * 10.0 * 2.0 / (d * d * d);
 }

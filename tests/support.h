@@ -63,6 +63,28 @@ int lmt_gl_teardown(void **state);
  * height 2, written to a fresh temporary directory; returns its path (static storage). */
 const char *lmt_plane_scene(void);
 
+
+/* Material and light JSON for lmt_write_scene's materials text: a grey diffuse material, a mirror of albedo
+ * r, clear glass (ior 1.5), and the extensions' declarations with a list of KHR_lights_punctual lights
+ * (each a JSON object). */
+#define LMT_LIGHTS(json) \
+    "\"extensionsUsed\": [\"KHR_lights_punctual\", \"KHR_materials_transmission\", \"KHR_materials_ior\"], " \
+    "\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [" json "]}}"
+#define LMT_DIFFUSE(g) "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [" #g ", " #g ", " #g ", 1], \"metallicFactor\": 0}}"
+#define LMT_MIRROR(r) "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [" #r ", " #r ", " #r ", 1], \"metallicFactor\": 1, " \
+                      "\"roughnessFactor\": 0}}"
+#define LMT_GLASS "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": " \
+                  "{\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 1.5}}}"
+
+/* The caustic tests' mirror scene: an 8 x 8 m diffuse floor (y = 0, albedo 0.8), a vertical 0.5 m square
+ * mirror (albedo 0.9) at x = 1 facing -x (y in [0.75, 1.25], z in [-0.25, 0.25]), a point light of 10 cd
+ * at (0, 2, 0); `cube_extras`: a 0.2 m diffuse cube at (-2, 0.2, -2) with these node extras (NULL: no
+ * cube); `mirror_extras` on the mirror's node. Written to lmt_tmpdir()/name; returns its path. */
+const char *lmt_mirror_scene(const char *name, const char *mirror_extras, const char *cube_extras);
+/* The image of that light in that mirror: the irradiance rho I cos / d^2 from the virtual light (2, 2, 0)
+ * at floor point (x, 0, z), and whether the line to it passes through the mirror (*inside). */
+double lmt_mirror_image(double x, double z, int *inside);
+
 #endif
 
 

@@ -14,15 +14,6 @@
 #include "../src/trace/caustics.h"
 #include "support.h"
 
-#define LIGHTS(json) \
-    "\"extensionsUsed\": [\"KHR_lights_punctual\", \"KHR_materials_transmission\", \"KHR_materials_ior\"], " \
-    "\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [" json "]}}"
-#define DIFFUSE(g) "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [" #g ", " #g ", " #g ", 1], \"metallicFactor\": 0}}"
-#define MIRROR(r) "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [" #r ", " #r ", " #r ", 1], \"metallicFactor\": 1, " \
-                  "\"roughnessFactor\": 0}}"
-#define GLASS "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": " \
-              "{\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 1.5}}}"
-
 static lm_caustics *make(const lmt_pipeline *p, uint32_t photons, lm_caustic_frame_stats *st)
 {
     lm_caustic_settings set;
@@ -35,44 +26,13 @@ static lm_caustics *make(const lmt_pipeline *p, uint32_t photons, lm_caustic_fra
     return c;
 }
 
-/* An 8 x 8 m diffuse floor (y = 0), a vertical 0.5 m square mirror at x = 1 facing -x (y in [0.75, 1.25],
- * z in [-0.25, 0.25]), a point light of 10 cd at (0, 2, 0); `cube_extras`: a 0.2 m diffuse cube at
- * (-2, 0.2, -2) with these node extras (NULL: no cube); `mirror_extras` on the mirror. */
-static const char *mirror_scene(const char *name, const char *mirror_extras, const char *cube_extras)
-{
-    static lmt_mesh m[3];
-    memset(m, 0, sizeof m);
-    lmt_mesh_quad(&m[0], (float[3]){-4, 0, 4}, (float[3]){8, 0, 0}, (float[3]){0, 0, -8});
-    lmt_mesh_quad(&m[1], (float[3]){1, 0.75f, -0.25f}, (float[3]){0, 0, 0.5f}, (float[3]){0, 0.5f, 0});
-    lmt_mesh_cube(&m[2], 0.2f);
-    char nodes[1024];
-    snprintf(nodes, sizeof nodes,
-             "[{\"mesh\": 0}, {\"mesh\": 1%s%s}, {\"translation\": [0, 2, 0], \"extensions\": "
-             "{\"KHR_lights_punctual\": {\"light\": 0}}}%s%s%s]",
-             mirror_extras ? ", \"extras\": " : "", mirror_extras ? mirror_extras : "",
-             cube_extras ? ", {\"mesh\": 2, \"translation\": [-2, 0.2, -2], \"extras\": " : "",
-             cube_extras ? cube_extras : "", cube_extras ? "}" : "");
-    return lmt_write_scene(name, m, cube_extras ? 3 : 2, nodes,
-                           "[" DIFFUSE(0.8) ", " MIRROR(0.9) ", " DIFFUSE(0.5) "], " LIGHTS("{\"type\": \"point\", \"intensity\": 10}"));
-}
-
-/* The image of the light in the mirror: irradiance rho I cos / d^2 from the virtual light V = (2, 2, 0) at a
- * floor point (x, 0, z); 0 where the line to V misses the mirror. */
-static double mirror_image(double x, double z, int *inside)
-{
-    double t = 1.0 / (2.0 - x), y = 2.0 - 2.0 * t, zz = z * t; /* where the line to V crosses x = 1 */
-    *inside = x < 2.0 && y >= 0.75 && y <= 1.25 && fabs(zz) <= 0.25;
-    double d = sqrt((2.0 - x) * (2.0 - x) + 4.0 + z * z);
-    return 0.9 * 10.0 * 2.0 / (d * d * d);
-}
-
 /* The photons binned in 0.1 m cells of the floor: cells well inside the lit patch read the image of the
  * light within 10%, cells well outside nothing. */
 static void test_mirror_image(void **state)
 {
     (void)state;
     lmt_pipeline p;
-    lmt_pipeline_load(&p, mirror_scene("mirror.gltf", NULL, NULL), 0.2f);
+    lmt_pipeline_load(&p, lmt_mirror_scene("mirror.gltf", NULL, NULL), 0.2f);
     lm_caustic_frame_stats st;
     lm_caustics *c = make(&p, 1u << 16, &st);
     assert_int_equal(lm_caustics_generator_count(c), 1);
@@ -100,11 +60,11 @@ static void test_mirror_image(void **state)
             for (int cx = -1; cx <= 2; cx++) /* the cell and a margin of half a cell */
                 for (int cz = -1; cz <= 2; cz++) {
                     int in;
-                    mirror_image(x0 + cx * 0.5 * cell, z0 + cz * 0.5 * cell, &in);
+                    lmt_mirror_image(x0 + cx * 0.5 * cell, z0 + cz * 0.5 * cell, &in);
                     all_in &= in, all_out &= !in;
                 }
             int in;
-            double want = mirror_image(x0 + 0.5 * cell, z0 + 0.5 * cell, &in);
+            double want = lmt_mirror_image(x0 + 0.5 * cell, z0 + 0.5 * cell, &in);
             if (all_in) {
                 worst_in = fmax(worst_in, fabs(E / want - 1.0));
                 sum_in += E, want_in += want, inside_cells++;
@@ -133,7 +93,7 @@ static void test_mirror_energy(void **state)
 {
     (void)state;
     lmt_pipeline p;
-    lmt_pipeline_load(&p, mirror_scene("mirror_energy.gltf", NULL, NULL), 0.2f);
+    lmt_pipeline_load(&p, lmt_mirror_scene("mirror_energy.gltf", NULL, NULL), 0.2f);
     lm_caustics *c = make(&p, 1u << 16, NULL);
     double stored[3], emitted[3];
     lm_caustics_flux(c, stored, emitted);
@@ -160,7 +120,7 @@ static const char *room_scene(const char *name, const char *generator, const cha
     snprintf(nodes, sizeof nodes,
              "[{\"mesh\": 0}, {\"mesh\": 1}, {\"translation\": [0, %g, 0.01], \"extensions\": "
              "{\"KHR_lights_punctual\": {\"light\": 0}}}]", (double)light_y);
-    snprintf(materials, sizeof materials, "[" DIFFUSE(0.5) ", %s], " LIGHTS("%s"), generator, light_json);
+    snprintf(materials, sizeof materials, "[" LMT_DIFFUSE(0.5) ", %s], " LMT_LIGHTS("%s"), generator, light_json);
     return lmt_write_scene(name, m, 2, nodes, materials);
 }
 
@@ -173,7 +133,7 @@ static void test_glass_energy(void **state)
     const char *point = "{\"type\": \"point\", \"intensity\": 10}";
     for (int inside = 0; inside < 2; inside++) {
         lmt_pipeline p;
-        lmt_pipeline_load(&p, room_scene("glass.gltf", GLASS, point, inside ? 0.0f : 2.0f, 0.3f), 0.5f);
+        lmt_pipeline_load(&p, room_scene("glass.gltf", LMT_GLASS, point, inside ? 0.0f : 2.0f, 0.3f), 0.5f);
         lm_caustic_frame_stats st;
         lm_caustics *c = make(&p, 1u << 14, &st);
         double stored[3], emitted[3];
@@ -232,7 +192,7 @@ static void test_what_moves(void **state)
 {
     (void)state;
     lmt_pipeline p;
-    lmt_pipeline_load(&p, mirror_scene("moves.gltf", "{\"lmgi\": {\"dynamic\": true}}", "{\"lmgi\": {\"dynamic\": true}}"),
+    lmt_pipeline_load(&p, lmt_mirror_scene("moves.gltf", "{\"lmgi\": {\"dynamic\": true}}", "{\"lmgi\": {\"dynamic\": true}}"),
                       0.2f);
     const uint32_t N = 4096;
     lm_caustics *c = make(&p, N, NULL);
@@ -268,7 +228,7 @@ static void test_switches_and_empty(void **state)
 {
     (void)state;
     lmt_pipeline p;
-    lmt_pipeline_load(&p, mirror_scene("off.gltf", "{\"lmgi\": {\"caustics\": false}}", NULL), 0.2f);
+    lmt_pipeline_load(&p, lmt_mirror_scene("off.gltf", "{\"lmgi\": {\"caustics\": false}}", NULL), 0.2f);
     lm_caustic_frame_stats st;
     lm_caustics *c = make(&p, 1024, &st);
     assert_int_equal(lm_caustics_pair_count(c), 0);
@@ -290,7 +250,7 @@ static void test_switches_and_empty(void **state)
     const char *path = lmt_write_scene("spot.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"translation\": [0, 2, 0], "
                                        "\"rotation\": [0, 0.7071068, 0, 0.7071068], \"extensions\": "
                                        "{\"KHR_lights_punctual\": {\"light\": 0}}}]",
-                                       "[" DIFFUSE(0.8) ", " MIRROR(0.9) "], " LIGHTS("{\"type\": \"spot\", \"intensity\": 10, "
+                                       "[" LMT_DIFFUSE(0.8) ", " LMT_MIRROR(0.9) "], " LMT_LIGHTS("{\"type\": \"spot\", \"intensity\": 10, "
                                        "\"spot\": {\"outerConeAngle\": 0.5}}"));
     (void)spot;
     lmt_pipeline_load(&p, path, 0.2f);
@@ -315,7 +275,7 @@ static void test_directional(void **state)
                                        "[0, 0, 1, 0, 0.7071068, 0.7071068, 0, 0, -0.7071068, 0.7071068, 0, 0, 0, 0, 0, 1], "
                                        "\"extensions\": "
                                        "{\"KHR_lights_punctual\": {\"light\": 0}}}]",
-                                       "[" DIFFUSE(0.8) ", " MIRROR(0.9) "], " LIGHTS("{\"type\": \"directional\", \"intensity\": 3}"));
+                                       "[" LMT_DIFFUSE(0.8) ", " LMT_MIRROR(0.9) "], " LMT_LIGHTS("{\"type\": \"directional\", \"intensity\": 3}"));
     lmt_pipeline p;
     lmt_pipeline_load(&p, path, 0.2f);
     const float *d = p.em.e[0].dir;
@@ -337,7 +297,7 @@ static void test_deterministic(void **state)
 {
     (void)state;
     lmt_pipeline p;
-    lmt_pipeline_load(&p, room_scene("det.gltf", GLASS, "{\"type\": \"point\", \"intensity\": 10}", 2.0f, 0.3f), 0.5f);
+    lmt_pipeline_load(&p, room_scene("det.gltf", LMT_GLASS, "{\"type\": \"point\", \"intensity\": 10}", 2.0f, 0.3f), 0.5f);
     int threads = omp_get_max_threads();
     omp_set_num_threads(1);
     lm_caustics *a = make(&p, 8192, NULL);
@@ -356,7 +316,7 @@ static void test_bad_settings(void **state)
 {
     (void)state;
     lmt_pipeline p;
-    lmt_pipeline_load(&p, mirror_scene("bad.gltf", NULL, NULL), 0.2f);
+    lmt_pipeline_load(&p, lmt_mirror_scene("bad.gltf", NULL, NULL), 0.2f);
     lm_caustic_settings set;
     lm_caustics *c = NULL;
     lm_error err;

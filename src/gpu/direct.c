@@ -440,6 +440,23 @@ void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
 }
 
 
+void lm_direct_draw_scene(const lm_direct *d, unsigned prog, int skip)
+{
+    int ok = skip >= 0 && skip < d->mesh.node_count;
+    int drop[2] = {ok ? d->mesh.node_first[skip] : 0, ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0};
+    set_ranges(prog, ALL, drop);
+    lm_direct_mesh_draw(&d->mesh, prog);
+    set_ranges(prog, ALL, ALL);
+}
+
+void lm_direct_bind_probe(const lm_direct *d)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, d->probe.fbo);
+    glViewport(0, 0, d->probe.width, d->probe.height);
+}
+
+unsigned lm_direct_depth_texture(const lm_direct *d, int probe) { return probe ? d->probe.depth : d->target.depth; }
+
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }

@@ -69,6 +69,13 @@ unsigned lm_direct_probe_texture(const lm_direct *d);
 /* Draws only node's triangles with prog, a program on lm_direct_vs (its uniforms set by the caller;
  * has_tex and the base colour texture on unit 2 set here per texture group). */
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node);
+/* Draws every node's triangles but node skip's (-1: none) with prog, as lm_direct_draw_node draws one: a
+ * further pass over the frame or a probe face (the caustics' composite). */
+void lm_direct_draw_scene(const lm_direct *d, unsigned prog, int skip);
+/* Binds the probe's target (after lm_direct_draw_probe) for a further pass to add to it. */
+void lm_direct_bind_probe(const lm_direct *d);
+/* The depth texture of the frame's target (probe 0) or of the probe's (1): 24-bit, GL window depth. */
+unsigned lm_direct_depth_texture(const lm_direct *d, int probe);
 /* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
  * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */

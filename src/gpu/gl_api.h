@@ -24,6 +24,7 @@
 #define LM_GL_FUNCTIONS(X) \
     X(glActiveTexture, PFNGLACTIVETEXTUREPROC) \
     X(glAttachShader, PFNGLATTACHSHADERPROC) \
+    X(glBeginQuery, PFNGLBEGINQUERYPROC) \
     X(glBindBuffer, PFNGLBINDBUFFERPROC) \
     X(glBindBufferBase, PFNGLBINDBUFFERBASEPROC) \
     X(glBindFramebuffer, PFNGLBINDFRAMEBUFFERPROC) \
@@ -37,11 +38,13 @@
     X(glCheckFramebufferStatus, PFNGLCHECKFRAMEBUFFERSTATUSPROC) \
     X(glClear, PFNGLCLEARPROC) \
     X(glClearBufferfv, PFNGLCLEARBUFFERFVPROC) \
+    X(glClearBufferiv, PFNGLCLEARBUFFERIVPROC) \
     X(glClearColor, PFNGLCLEARCOLORPROC) \
     X(glClearDepth, PFNGLCLEARDEPTHPROC) \
     X(glClearTexImage, PFNGLCLEARTEXIMAGEPROC) \
     X(glClearTexSubImage, PFNGLCLEARTEXSUBIMAGEPROC) \
     X(glClipControl, PFNGLCLIPCONTROLPROC) \
+    X(glColorMask, PFNGLCOLORMASKPROC) \
     X(glCompileShader, PFNGLCOMPILESHADERPROC) \
     X(glCopyImageSubData, PFNGLCOPYIMAGESUBDATAPROC) \
     X(glCreateProgram, PFNGLCREATEPROGRAMPROC) \
@@ -49,6 +52,7 @@
     X(glDeleteBuffers, PFNGLDELETEBUFFERSPROC) \
     X(glDeleteFramebuffers, PFNGLDELETEFRAMEBUFFERSPROC) \
     X(glDeleteProgram, PFNGLDELETEPROGRAMPROC) \
+    X(glDeleteQueries, PFNGLDELETEQUERIESPROC) \
     X(glDeleteRenderbuffers, PFNGLDELETERENDERBUFFERSPROC) \
     X(glDeleteShader, PFNGLDELETESHADERPROC) \
     X(glDeleteTextures, PFNGLDELETETEXTURESPROC) \
@@ -60,19 +64,22 @@
     X(glDrawArrays, PFNGLDRAWARRAYSPROC) \
     X(glEnable, PFNGLENABLEPROC) \
     X(glEnableVertexAttribArray, PFNGLENABLEVERTEXATTRIBARRAYPROC) \
+    X(glEndQuery, PFNGLENDQUERYPROC) \
     X(glFinish, PFNGLFINISHPROC) \
     X(glFramebufferRenderbuffer, PFNGLFRAMEBUFFERRENDERBUFFERPROC) \
     X(glFramebufferTexture2D, PFNGLFRAMEBUFFERTEXTURE2DPROC) \
     X(glGenBuffers, PFNGLGENBUFFERSPROC) \
+    X(glGenerateMipmap, PFNGLGENERATEMIPMAPPROC) \
     X(glGenFramebuffers, PFNGLGENFRAMEBUFFERSPROC) \
+    X(glGenQueries, PFNGLGENQUERIESPROC) \
     X(glGenRenderbuffers, PFNGLGENRENDERBUFFERSPROC) \
     X(glGenTextures, PFNGLGENTEXTURESPROC) \
     X(glGenVertexArrays, PFNGLGENVERTEXARRAYSPROC) \
-    X(glGenerateMipmap, PFNGLGENERATEMIPMAPPROC) \
     X(glGetError, PFNGLGETERRORPROC) \
     X(glGetIntegerv, PFNGLGETINTEGERVPROC) \
     X(glGetProgramInfoLog, PFNGLGETPROGRAMINFOLOGPROC) \
     X(glGetProgramiv, PFNGLGETPROGRAMIVPROC) \
+    X(glGetQueryObjectui64v, PFNGLGETQUERYOBJECTUI64VPROC) \
     X(glGetShaderInfoLog, PFNGLGETSHADERINFOLOGPROC) \
     X(glGetShaderiv, PFNGLGETSHADERIVPROC) \
     X(glGetString, PFNGLGETSTRINGPROC) \
@@ -84,7 +91,11 @@
     X(glPixelStorei, PFNGLPIXELSTOREIPROC) \
     X(glReadPixels, PFNGLREADPIXELSPROC) \
     X(glRenderbufferStorage, PFNGLRENDERBUFFERSTORAGEPROC) \
+    X(glScissor, PFNGLSCISSORPROC) \
     X(glShaderSource, PFNGLSHADERSOURCEPROC) \
+    X(glStencilFunc, PFNGLSTENCILFUNCPROC) \
+    X(glStencilMask, PFNGLSTENCILMASKPROC) \
+    X(glStencilOp, PFNGLSTENCILOPPROC) \
     X(glTexImage2D, PFNGLTEXIMAGE2DPROC) \
     X(glTexParameterf, PFNGLTEXPARAMETERFPROC) \
     X(glTexParameteri, PFNGLTEXPARAMETERIPROC) \
@@ -100,16 +111,12 @@
     X(glVertexAttribPointer, PFNGLVERTEXATTRIBPOINTERPROC) \
     X(glViewport, PFNGLVIEWPORTPROC) \
     /* not called yet, kept ready: */ \
-    X(glBeginQuery, PFNGLBEGINQUERYPROC) \
     X(glBindBufferRange, PFNGLBINDBUFFERRANGEPROC) \
     X(glBlendEquation, PFNGLBLENDEQUATIONPROC) \
     X(glBlendFuncSeparate, PFNGLBLENDFUNCSEPARATEPROC) \
     X(glBlitFramebuffer, PFNGLBLITFRAMEBUFFERPROC) \
-    X(glClearBufferiv, PFNGLCLEARBUFFERIVPROC) \
     X(glClientWaitSync, PFNGLCLIENTWAITSYNCPROC) \
-    X(glColorMask, PFNGLCOLORMASKPROC) \
     X(glCullFace, PFNGLCULLFACEPROC) \
-    X(glDeleteQueries, PFNGLDELETEQUERIESPROC) \
     X(glDeleteSync, PFNGLDELETESYNCPROC) \
     X(glDepthRange, PFNGLDEPTHRANGEPROC) \
     X(glDisableVertexAttribArray, PFNGLDISABLEVERTEXATTRIBARRAYPROC) \
@@ -118,28 +125,24 @@
     X(glDrawBuffers, PFNGLDRAWBUFFERSPROC) \
     X(glDrawElements, PFNGLDRAWELEMENTSPROC) \
     X(glDrawElementsInstanced, PFNGLDRAWELEMENTSINSTANCEDPROC) \
-    X(glEndQuery, PFNGLENDQUERYPROC) \
     X(glFenceSync, PFNGLFENCESYNCPROC) \
     X(glFlush, PFNGLFLUSHPROC) \
     X(glFramebufferTexture, PFNGLFRAMEBUFFERTEXTUREPROC) \
     X(glFramebufferTextureLayer, PFNGLFRAMEBUFFERTEXTURELAYERPROC) \
     X(glFrontFace, PFNGLFRONTFACEPROC) \
-    X(glGenQueries, PFNGLGENQUERIESPROC) \
     X(glGetBufferSubData, PFNGLGETBUFFERSUBDATAPROC) \
     X(glGetFloatv, PFNGLGETFLOATVPROC) \
     X(glGetIntegeri_v, PFNGLGETINTEGERI_VPROC) \
-    X(glGetQueryObjectui64v, PFNGLGETQUERYOBJECTUI64VPROC) \
     X(glGetTexLevelParameteriv, PFNGLGETTEXLEVELPARAMETERIVPROC) \
     X(glIsEnabled, PFNGLISENABLEDPROC) \
     X(glMapBufferRange, PFNGLMAPBUFFERRANGEPROC) \
     X(glPolygonOffset, PFNGLPOLYGONOFFSETPROC) \
     X(glQueryCounter, PFNGLQUERYCOUNTERPROC) \
     X(glReadBuffer, PFNGLREADBUFFERPROC) \
-    X(glScissor, PFNGLSCISSORPROC) \
     X(glTexImage3D, PFNGLTEXIMAGE3DPROC) \
     X(glTexParameterfv, PFNGLTEXPARAMETERFVPROC) \
-    X(glTexStorage3D, PFNGLTEXSTORAGE3DPROC) \
     X(glTexStorage2DMultisample, PFNGLTEXSTORAGE2DMULTISAMPLEPROC) \
+    X(glTexStorage3D, PFNGLTEXSTORAGE3DPROC) \
     X(glTexSubImage3D, PFNGLTEXSUBIMAGE3DPROC) \
     X(glUniform1fv, PFNGLUNIFORM1FVPROC) \
     X(glUniform1iv, PFNGLUNIFORM1IVPROC) \
@@ -266,6 +269,9 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glRenderbufferStorage (lm_gl_cur->glRenderbufferStorage)
 #define glScissor (lm_gl_cur->glScissor)
 #define glShaderSource (lm_gl_cur->glShaderSource)
+#define glStencilFunc (lm_gl_cur->glStencilFunc)
+#define glStencilMask (lm_gl_cur->glStencilMask)
+#define glStencilOp (lm_gl_cur->glStencilOp)
 #define glTexImage2D (lm_gl_cur->glTexImage2D)
 #define glTexImage3D (lm_gl_cur->glTexImage3D)
 #define glTexParameterf (lm_gl_cur->glTexParameterf)

@@ -85,7 +85,7 @@ void lm_float_target_free(lm_float_target *t)
 {
     if (t->fbo) {
         glDeleteFramebuffers(1, &t->fbo);
-        glDeleteRenderbuffers(1, &t->depth);
+        glDeleteTextures(1, &t->depth);
         glDeleteTextures(t->attachments, t->color);
     }
     memset(t, 0, sizeof *t);
@@ -113,10 +113,13 @@ lm_status lm_float_target_ensure(lm_float_target *t, int width, int height, int 
         glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, t->color[i], 0);
     }
-    glGenRenderbuffers(1, &t->depth);
-    glBindRenderbuffer(GL_RENDERBUFFER, t->depth);
-    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
-    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, t->depth);
+    /* depth as a texture: the caustic pass reads the frame's depth (gpu/caustic_pass.h) */
+    glGenTextures(1, &t->depth);
+    glBindTexture(GL_TEXTURE_2D, t->depth);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT24, width, height, 0, GL_DEPTH_COMPONENT, GL_UNSIGNED_INT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, t->depth, 0);
     glDrawBuffers(attachments, bufs);
     if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
         glBindFramebuffer(GL_FRAMEBUFFER, 0);

@@ -24,8 +24,8 @@ void lm_offscreen_read_rgb(const lm_offscreen *o, float *rgb);
 void lm_offscreen_release(lm_offscreen *o);
 
 /* A persistent float target for per-frame passes: 1 or 2 RGBA32F colour textures (sampleable, e.g. by
- * a later pass) and a 32-bit float depth renderbuffer, kept between frames and re-made only when the size
- * or the attachment count changes. Zero-initialise before the first lm_float_target_ensure. */
+ * a later pass) and a 24-bit depth texture (sampleable: the caustic pass reads it), kept between frames
+ * and re-made only when the size or the attachment count changes. Zero-initialise before the first lm_float_target_ensure. */
 typedef struct {
     unsigned fbo, color[2], depth;
     int width, height, attachments;

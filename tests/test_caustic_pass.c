@@ -1,0 +1,210 @@
+/* The screen-space caustic pass (gpu/caustic_pass.h): the caustic a mirror throws on the floor, as the
+ * pass filters it on screen, against the analytic image of the light; the tiles the occlusion queries
+ * find against a count of the splatted photons; the power on screen against the photons'; both filters. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/core/vecmath.h"
+#include "../src/gpu/caustic_pass.h"
+#include "support.h"
+
+#define W 256
+#define H 256
+
+typedef struct {
+    lmt_pipeline p;
+    lm_caustics *c;
+    lm_direct *d;
+    lm_view view;
+} fixture;
+
+/* The mirror scene (support.h) seen from 4 m straight above (-0.15, 0, 0), 60 degrees. */
+static void setup(fixture *f, uint32_t photons)
+{
+    lmt_pipeline_load(&f->p, lmt_mirror_scene("pass.gltf", NULL, NULL), 0.25f);
+    lm_caustic_settings cs;
+    lm_caustic_settings_default(&cs);
+    cs.photons = photons;
+    lm_error err;
+    if (lm_caustics_create(f->p.s, f->p.rt, &f->p.em, &cs, &f->c, NULL, &err) != LM_OK ||
+        lm_direct_create(f->p.s, &f->p.atlas, NULL, &f->d, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    float view[16], proj[16];
+    lm_mat4_look_at(view, lm_v3(-0.15f, 4.0f, 0.0f), lm_v3(-0.15f, 0.0f, 0.0f), lm_v3(0.0f, 0.0f, -1.0f));
+    lm_mat4_perspective(proj, (float)(M_PI / 3.0), 1.0f, 0.1f, 20.0f);
+    assert_true(lm_view_from_matrices(view, proj, &f->view));
+    if (lm_direct_draw(f->d, f->p.s, &f->p.em, &f->view, W, H, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+}
+
+static void teardown(fixture *f)
+{
+    lm_direct_free(f->d);
+    lm_caustics_free(f->c);
+    lmt_pipeline_free(&f->p);
+}
+
+static lm_caustic_pass *run(fixture *f, const lm_caustic_pass_settings *set, lm_caustic_pass_stats *st)
+{
+    lm_caustic_pass *cp = NULL;
+    lm_error err;
+    if (lm_caustic_pass_create(set, &cp, &err) != LM_OK ||
+        lm_caustic_pass_set_photons(cp, lm_caustics_hits(f->c), lm_caustics_photon_count(f->c), &err) != LM_OK ||
+        lm_caustic_pass_run(cp, 0, &f->view, lm_direct_depth_texture(f->d, 0), W, H, NULL, -1, st, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    return cp;
+}
+
+/* The floor point pixel (x, y) (row 0 at the top) sees: the camera looks straight down from y = 4. */
+static void floor_point(int x, int y, double *wx, double *wz)
+{
+    double t = tan(M_PI / 6.0), sx = (2.0 * (x + 0.5) / W - 1.0) * t, sy = (1.0 - 2.0 * (y + 0.5) / H) * t;
+    /* right = forward x up = (0, -1, 0) x (0, 0, -1) = (1, 0, 0); up on screen is -z */
+    *wx = -0.15 + 4.0 * sx;
+    *wz = -4.0 * sy;
+}
+
+/* Pixels whose filter footprint (k pixels and a margin) lies inside the lit patch read the analytic image
+ * within 10% each (their mean within 2%); those whose footprint lies outside read 0. */
+static void check_image(const float *E, int k, const char *what)
+{
+    double sum = 0.0, want = 0.0, worst = 0.0, outside = 0.0;
+    int n_in = 0, n_out = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            int all_in = 1, all_out = 1, in;
+            for (int dy = -k - 1; dy <= k + 1; dy += k + 1)
+                for (int dx = -k - 1; dx <= k + 1; dx += k + 1) {
+                    double wx, wz;
+                    floor_point(x + dx, y + dy, &wx, &wz);
+                    lmt_mirror_image(wx, wz, &in);
+                    all_in &= in, all_out &= !in;
+                }
+            double wx, wz, e = E[3 * (y * W + x) + 1];
+            floor_point(x, y, &wx, &wz);
+            double a = lmt_mirror_image(wx, wz, &in);
+            if (all_in) {
+                sum += e, want += a, n_in++;
+                worst = fmax(worst, fabs(e / a - 1.0));
+            } else if (all_out) {
+                outside = fmax(outside, e), n_out++;
+            }
+        }
+    print_message("%s: %d pixels inside, mean %.4f of the image, worst pixel %.3f; %d outside, brightest %.3g\n", what,
+                  n_in, sum / want, worst, n_out, outside);
+    assert_true(n_in > 1000);
+    assert_true(fabs(sum / want - 1.0) < 0.02);
+    assert_true(worst < 0.10);
+    assert_true(outside == 0.0);
+}
+
+static void test_mirror_caustic(void **state)
+{
+    (void)state;
+    fixture f;
+    setup(&f, 1u << 16);
+    lm_caustic_pass_settings set;
+    lm_caustic_pass_settings_default(&set);
+    for (int world = 0; world < 2; world++) {
+        set.world_space = world;
+        lm_caustic_pass_stats st;
+        lm_caustic_pass *cp = run(&f, &set, &st);
+        static float E[3 * W * H];
+        lm_error err;
+        assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
+        print_message("%s filter: %u photons, %llu splatted, %d of %d tiles lit, %llu pixels filtered\n",
+                      world ? "world" : "screen", st.photons, (unsigned long long)st.splatted, st.tiles_lit, st.tiles,
+                      (unsigned long long)st.pixels_filtered);
+        check_image(E, set.filter_k, world ? "world-space filter" : "screen-space filter");
+        lm_caustic_pass_free(cp);
+    }
+    teardown(&f);
+}
+
+/* The tiles the queries call lit are exactly those a count of the splat's photons finds. */
+static void test_tiles_match_splat(void **state)
+{
+    (void)state;
+    fixture f;
+    setup(&f, 1u << 14);
+    lm_caustic_pass_settings set;
+    lm_caustic_pass_settings_default(&set);
+    for (int tile = 8; tile <= 64; tile *= 2) {
+        set.tile = tile;
+        lm_caustic_pass_stats st;
+        lm_caustic_pass *cp = run(&f, &set, &st);
+        static float splat[4 * W * H];
+        lm_error err;
+        assert_int_equal(lm_caustic_pass_read_splat(cp, 0, splat, &err), LM_OK);
+        int tx, ty;
+        const uint8_t *lit = lm_caustic_pass_tiles(cp, 0, &tx, &ty);
+        assert_int_equal(tx, (W + tile - 1) / tile);
+        int n_lit = 0, mismatched = 0;
+        double photons = 0.0;
+        for (int j = 0; j < ty; j++)
+            for (int i = 0; i < tx; i++) {
+                double count = 0.0;
+                for (int y = j * tile; y < (j + 1) * tile && y < H; y++)
+                    for (int x = i * tile; x < (i + 1) * tile && x < W; x++)
+                        count += splat[4 * (y * W + x) + 3];
+                photons += count;
+                mismatched += (count > 0.0) != (lit[j * tx + i] != 0);
+                n_lit += lit[j * tx + i] != 0;
+            }
+        print_message("tile %d: %d of %d lit, %d mismatched; %.0f photons counted, %llu splatted\n", tile, n_lit, tx * ty,
+                      mismatched, photons, (unsigned long long)st.splatted);
+        assert_int_equal(mismatched, 0);
+        assert_int_equal(n_lit, st.tiles_lit);
+        assert_true(n_lit > 0 && n_lit < tx * ty / 2);
+        assert_true(fabs(photons - (double)st.splatted) < 0.5);
+        lm_caustic_pass_free(cp);
+    }
+    teardown(&f);
+}
+
+/* Without photons nothing is drawn and the irradiance is 0; bad settings are refused naming them. */
+static void test_empty_and_bad(void **state)
+{
+    (void)state;
+    fixture f;
+    setup(&f, 256);
+    lm_caustic_pass *cp = NULL;
+    lm_error err;
+    lm_caustic_pass_settings set;
+    lm_caustic_pass_settings_default(&set);
+    assert_int_equal(lm_caustic_pass_create(&set, &cp, &err), LM_OK);
+    lm_caustic_pass_stats st;
+    assert_int_equal(lm_caustic_pass_run(cp, 0, &f.view, lm_direct_depth_texture(f.d, 0), W, H, f.d, -1, &st, &err), LM_OK);
+    assert_int_equal(st.photons, 0);
+    assert_int_equal(st.tiles_lit, 0);
+    static float E[3 * W * H];
+    assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
+    for (int i = 0; i < 3 * W * H; i++)
+        assert_true(E[i] == 0.0f);
+    lm_caustic_pass_free(cp);
+    set.filter_k = 9;
+    assert_int_equal(lm_caustic_pass_create(&set, &cp, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "k must be"));
+    lm_caustic_pass_settings_default(&set);
+    set.tile = 2;
+    assert_int_equal(lm_caustic_pass_create(&set, &cp, &err), LM_ERR_INVALID);
+    assert_null(cp);
+    teardown(&f);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_mirror_caustic),
+        cmocka_unit_test(test_tiles_match_splat),
+        cmocka_unit_test(test_empty_and_bad),
+    };
+    return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
+}
