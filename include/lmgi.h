@@ -168,13 +168,15 @@ LMGI_API lmgi_status lmgi_set_node_dynamic(lmgi_scene *scene, int node, int dyna
  *   indirect     its lightmap is gathered and the frame shows it (the light of emissive triangles, which
  *                the lightmap carries, included); off: no gather work at all for it, and the frame shows
  *                its direct light alone; it still blocks and reflects light for the others;
- *   reflections  a mirror or glossy node gets an environment map (off: no map, no cost; mirrors black).
+ *   reflections  a mirror, glossy or glass node gets an environment map (off: no map, no cost; mirrors
+ *                black);
+ *   caustics     a mirror or glass node focuses light: caustic photons are shot at it (off: none, no cost).
  * lmgi_set_node_effects sets them on the node and every node under it; an updater follows at its next
- * update (the casters and the maps are made again; a node whose indirect comes back on is regathered in
- * full). NULL argument, an id out of range, a switch other than 0 or 1: LMGI_ERR_INVALID, nothing
- * changed. (extras "caustics" waits for the caustic pass.) */
+ * update (the casters, the maps and the caustic photons are made again; a node whose indirect comes back
+ * on is regathered in full). NULL argument, an id out of range, a switch other than 0 or 1:
+ * LMGI_ERR_INVALID, nothing changed. The extras' names are these ("casts_shadows" also for shadows). */
 typedef struct {
-    int shadows, indirect, reflections;
+    int shadows, indirect, reflections, caustics;
 } lmgi_node_effects;
 LMGI_API lmgi_status lmgi_get_node_effects(const lmgi_scene *scene, int node, lmgi_node_effects *out, lmgi_error *err);
 LMGI_API lmgi_status lmgi_set_node_effects(lmgi_scene *scene, int node, const lmgi_node_effects *e, lmgi_error *err);
@@ -367,7 +369,7 @@ typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_
 typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
 typedef enum { LMGI_GATHER_DEFAULT = 0, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_INSTANCED, LMGI_GATHER_LAYERED } lmgi_gather_scheme;
 
-enum { LMGI_EFFECT_SHADOWS = 1, LMGI_EFFECT_INDIRECT = 2, LMGI_EFFECT_REFLECTIONS = 4 };
+enum { LMGI_EFFECT_SHADOWS = 1, LMGI_EFFECT_INDIRECT = 2, LMGI_EFFECT_REFLECTIONS = 4, LMGI_EFFECT_CAUSTICS = 8 };
 /* How frames get their indirect light (docs/gather.md): LMGI_INDIRECT_LIGHTMAP, the paper's AIMs,
  * hemicube gather and IIM (the lightmaps); LMGI_INDIRECT_BRUTEFORCE, every visible pixel gathers the
  * photon hits themselves (Mara et al. 2013, every photon against every pixel: the ground truth of
@@ -410,12 +412,23 @@ typedef struct {
     int frame_width, frame_height; /* 0 x 0: none (lmgi_render draws on demand) */
     int camera;                /* the file's camera for that frame (0: its first; -1, or 0 when it has none:
                                 * one framing the scene) */
-    int reflection_size;       /* environment map side of a mirror or glossy node (0: 128; -1: no reflections) */
-    int reflection_faces;      /* environment map faces re-rendered per update (0: 1) */
+    int reflection_size;       /* environment map side of a mirror, glossy or glass node (0: 128; -1: no
+                                * reflections) */
+    int reflection_faces;      /* most environment map faces re-rendered per update, those whose view changed
+                                * longest ago first (0: 1; a still scene renders none) */
+    /* caustics (docs/caustics.md): photons shot from every light towards every mirror or glass node,
+     * filtered on screen */
+    uint32_t caustic_photons;  /* per light and mirror or glass node (0: 16384) */
+    float caustic_retrace;     /* share of them re-traced per update while anything moves, in (0, 1] (0: 0.25);
+                                * a moved light or mirror/glass node re-traces its own at once */
+    int caustic_filter;        /* k of the (2k + 1)^2 cone filter, 1 to 8 (0: 3; -1: k = 0, no filter) */
+    int caustic_tile;          /* screen tile side in pixels of the occlusion queries, 4 to 256 (0: 32) */
+    int caustic_world_filter;  /* 1: filter by world distance from the depth (0: the paper's screen-space one) */
     /* effects this updater leaves out whatever the scene calls for (0: none), LMGI_EFFECT_* bits:
      * SHADOWS no shadow maps (lights reach everything), INDIRECT no photon, AIM or gather work at all
-     * (the lightmaps stay 0; the frame shows direct light, emission and reflections), REFLECTIONS no
-     * environment maps (as reflection_size -1). Per node: lmgi_set_node_effects */
+     * (the lightmaps stay 0; the frame shows direct light, emission, caustics and reflections), REFLECTIONS
+     * no environment maps (as reflection_size -1), CAUSTICS no caustic photons and no caustic pass. Per
+     * node: lmgi_set_node_effects */
     unsigned effects_off;
     lmgi_indirect_path indirect; /* (0: LMGI_INDIRECT_LIGHTMAP) */
     /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
@@ -435,9 +448,13 @@ typedef struct {
     uint32_t texels_gathered;  /* IIM texels regathered */
     int texels_budget;         /* the texels this update was allowed (budget_ms > 0: from the measured cost) */
     int surfaces_changed;      /* surfaces whose displayed lightmap changed (lmgi_surface_version moved) */
-    double ms_animate, ms_trace, ms_aim; /* the photon work's parts */
+    uint32_t caustic_photons_retraced; /* caustic photons traced (a moved light or mirror/glass node: all its) */
+    int caustic_tiles, caustic_tiles_lit; /* screen tiles queried, and those found holding caustic photons */
+    uint64_t caustic_pixels_filtered; /* pixels the caustic filter ran on (the lit tiles grown by k) */
+    int cube_faces_rendered;   /* environment map faces rendered */
+    double ms_animate, ms_trace, ms_aim, ms_caustic_trace; /* the photon work's parts */
     double ms_photons;         /* what the update spent on or waiting for the photon work */
-    double ms_gather, ms_blend, ms_direct, ms_composite, ms_total;
+    double ms_gather, ms_blend, ms_direct, ms_caustics, ms_reflections, ms_composite, ms_total;
 } lmgi_update_stats;
 
 /* The atlas texel count `lmgi run` loads a scene at when given no texel size: what an updater gathering
@@ -531,6 +548,14 @@ LMGI_API lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int wi
  *                           up: an editor shows what is not yet final, a game can wait for it. a as above.
  * A diffuse surface's indirect radiance is albedo / pi * E (docs/materials.md). */
 typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM, LMGI_LIGHTMAP_ERROR } lmgi_lightmap;
+/* The caustics of the last picture the updater drew, an update's own frame or lmgi_render's
+ * (docs/caustics.md): the irradiance E the screen-space caustic pass filtered at each pixel, width x height
+ * x 3 linear floats, top row first (the picture added kd / pi x E there); 0 where no caustic photon's
+ * filter reached, and everywhere in a scene without caustics. *width and *height (each may be NULL) get
+ * the picture's size, 0 x 0 before any; rgb must hold `floats` >= 3 x width x height. NULL u or rgb, too
+ * small, or no picture yet: LMGI_ERR_INVALID (the size still given). */
+LMGI_API lmgi_status lmgi_get_caustics(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height,
+                                       lmgi_error *err);
 /* rgba must hold `floats` >= 4 * atlas_width * atlas_height floats. NULL u or rgba, too small, or an
  * unknown kind: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err);
@@ -566,35 +591,64 @@ LMGI_API uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
 /* ------------------------------------------------------------------------------------------------------
  * Reference: the converged answer every error figure is measured against (docs/reference.md): Monte
  * Carlo path tracing, per lightmap texel and per pixel, each entry sampled until its relative standard
- * error reaches the target. Deterministic for a scene, desc and camera; results are cached on disk under
- * a key of all of them, so asking again costs a file read. Cost: seconds (small atlases, a 96 x 96
- * picture) to minutes. Progress lines go to stderr at verbosity 2. Thread-safety: one call at a time per
- * scene (other scenes' calls may run beside it); it uses every core. */
+ * error reaches the target, and light tracing for the caustics. Deterministic for a scene, desc and
+ * camera; results are cached on disk under a key of all of them, so asking again costs a file read.
+ * Cost: seconds (small atlases, a 96 x 96 picture) to minutes; the caustic part adds caustic_photons
+ * photons per (light, mirror or glass node) pair. Progress lines go to stderr at verbosity 2.
+ * Thread-safety: one call at a time per scene (other scenes' calls may run beside it); it uses every
+ * core.
+ *
+ * The light is split by the path it came along (docs/reference.md, "Which part carries which light"),
+ * so that every pass is checked against its own part. Mirror and glass are specular; the receiver is
+ * the texel, or the first surface an eye ray meets when that is not mirror or glass:
+ *   direct       point, spot and directional lights straight at the receiver;
+ *   caustic      light from any emitter that reached the receiver off mirrors and glass only (light
+ *                tracing: the paths a path tracer cannot find from point lights);
+ *   lost         light seen by the receiver in mirrors and glass that last came off an ordinary
+ *                surface: the runtime's gather sees mirrors black, so no pass carries it;
+ *   iim          (texels) the rest: emissive surfaces seen directly and everything whose first bounce
+ *                from the receiver is off an ordinary surface;
+ *   pixels add   emission (the surface's own), indirect (the iim-like rest, shaded) and reflections
+ *                (everything seen where the eye ray first meets mirror or glass).
+ * full is the sum of the parts: direct + iim + caustic + lost for texels, emission + direct + indirect +
+ * caustic + lost + reflections for pixels (to float rounding). */
 typedef struct {
     float target_error;     /* relative standard error per entry to stop at (0: 0.02) */
     int samples;            /* paths per entry per pass (0: 64; entries take at least two passes) */
     uint32_t seed;          /* (0: 1) */
     const char *cache_dir;  /* NULL: $LMGI_CACHE, else build/reference-cache */
     int no_cache;           /* 1: neither read nor write the cache */
+    int caustic_photons;    /* light-traced photons per (emitter, mirror or glass node) pair, 1..16777216
+                             * (0: 1048576) */
 } lmgi_reference_desc;
 
 /* A reference solution as images, width x height x 3 linear floats, top row first for pixels, row 0 at
- * v = 0 for texels (the lightmaps' layout; 0 outside texels). */
+ * v = 0 for texels (the lightmaps' layout; 0 outside texels). Texels hold irradiance, pixels radiance. */
 typedef struct {
     int width, height;
     float *full;            /* texels: irradiance E from all light; pixels: radiance reaching the eye */
-    float *iim;             /* texels: E without the punctual lights' direct part (what the IIM holds); pixels: NULL */
+    float *iim;             /* texels: the iim part (what the IIM holds); pixels: NULL */
     float *radiance;        /* texels: albedo / pi x E (what the AIM approximates); pixels: NULL */
+    float *direct;          /* point, spot and directional lights straight at the receiver (pixels: as it
+                             * reflects them towards the eye) */
+    float *caustic;         /* light off mirrors and glass only, straight from an emitter */
+    float *lost;            /* light seen in mirrors and glass that last came off an ordinary surface */
+    float *emission;        /* pixels: the surface's own emission; texels: NULL */
+    float *indirect;        /* pixels: the iim-like rest as the surface reflects it; texels: NULL */
+    float *reflections;     /* pixels: everything seen where the eye ray first meets mirror or glass; texels: NULL */
     float target_error;     /* the relative standard error it sampled to (the desc's, or the default) */
     uint32_t entries, converged; /* texels or pixels, and how many reached the target (the rest hit the cap) */
     uint64_t samples;       /* paths traced over all entries */
-    double mean_rel_se, max_rel_se; /* achieved relative standard error per entry */
+    double mean_rel_se, max_rel_se; /* achieved relative standard error per entry (of the path-traced parts) */
     double seconds;         /* computing time (the first computation's when it came from the cache) */
+    uint64_t caustic_photons; /* photons the caustic part traced (0: the scene has no mirror, glass or light) */
+    double caustic_seconds; /* its share of seconds */
     int from_cache;
 } lmgi_reference;
 
 /* Every texel of the scene's atlas. NULL scene or out: LMGI_ERR_INVALID; NULL desc: the defaults; a
- * target_error or samples out of range: LMGI_ERR_INVALID naming it. out is zeroed on failure. */
+ * target_error, samples or caustic_photons out of range: LMGI_ERR_INVALID naming it. out is zeroed on
+ * failure. */
 LMGI_API lmgi_status lmgi_reference_texels(const lmgi_scene *scene, const lmgi_reference_desc *desc,
                                            lmgi_reference *out, lmgi_error *err);
 /* The picture a perspective camera sees (lmgi_scene_camera, or the application's). An orthographic or

@@ -401,12 +401,15 @@ const char *lmt_mirror_scene(const char *name, const char *mirror_extras, const 
     char nodes[1024];
     snprintf(nodes, sizeof nodes,
              "[{\"mesh\": 0}, {\"mesh\": 1%s%s}, {\"translation\": [0, 2, 0], \"extensions\": "
-             "{\"KHR_lights_punctual\": {\"light\": 0}}}%s%s%s]",
+             "{\"KHR_lights_punctual\": {\"light\": 0}}}%s%s%s, {\"camera\": 0, \"translation\": [-0.15, 4, 0], "
+             "\"rotation\": [-0.7071068, 0, 0, 0.7071068]}]",
              mirror_extras ? ", \"extras\": " : "", mirror_extras ? mirror_extras : "",
-             cube_extras ? ", {\"mesh\": 2, \"translation\": [-2, 0.2, -2], \"extras\": " : "",
+             cube_extras ? ", {\"name\": \"cube\", \"mesh\": 2, \"translation\": [-2, 0.2, -2], \"extras\": " : "",
              cube_extras ? cube_extras : "", cube_extras ? "}" : "");
     return lmt_write_scene(name, m, cube_extras ? 3 : 2, nodes,
                            "[" LMT_DIFFUSE(0.8) ", " LMT_MIRROR(0.9) ", " LMT_DIFFUSE(0.5) "], "
+                           "\"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 1.0472, "
+                           "\"znear\": 0.1, \"aspectRatio\": 1}}], "
                            LMT_LIGHTS("{\"type\": \"point\", \"intensity\": 10}"));
 }
 

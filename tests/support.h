@@ -79,7 +79,8 @@ const char *lmt_plane_scene(void);
 /* The caustic tests' mirror scene: an 8 x 8 m diffuse floor (y = 0, albedo 0.8), a vertical 0.5 m square
  * mirror (albedo 0.9) at x = 1 facing -x (y in [0.75, 1.25], z in [-0.25, 0.25]), a point light of 10 cd
  * at (0, 2, 0); `cube_extras`: a 0.2 m diffuse cube at (-2, 0.2, -2) with these node extras (NULL: no
- * cube); `mirror_extras` on the mirror's node. Written to lmt_tmpdir()/name; returns its path. */
+ * cube; it is named "cube"); `mirror_extras` on the mirror's node; last, a camera 4 m above (-0.15, 0, 0) looking straight down
+ * (60 degrees). Written to lmt_tmpdir()/name; returns its path. */
 const char *lmt_mirror_scene(const char *name, const char *mirror_extras, const char *cube_extras);
 /* The image of that light in that mirror: the irradiance rho I cos / d^2 from the virtual light (2, 2, 0)
  * at floor point (x, 0, z), and whether the line to it passes through the mirror (*inside). */

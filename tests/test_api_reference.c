@@ -1,6 +1,6 @@
 /* The public reference, check and output-directory calls through include/lmgi.h alone: texels and pixels
- * against the analytic irradiance of a point light over a plane, determinism and the cache, a frame
- * checked against the reference, and every bad argument refused. */
+ * against the analytic irradiance of a point light over a plane, its parts (and a mirror's caustic),
+ * determinism and the cache, a frame checked against the reference, and every bad argument refused. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -90,8 +90,14 @@ static void test_reference_texels(void **state)
         checked++;
     }
     assert_true(checked > 1000);
-    assert_int_equal(lmgi_reference_texels(sc, &d, &again, &e), LMGI_OK);
     size_t bytes = (size_t)r.width * (size_t)r.height * 3 * sizeof(float);
+    /* no mirror or glass: all of it is direct light, no caustic, nothing lost; no pixel parts */
+    assert_memory_equal(r.full, r.direct, bytes);
+    for (size_t i = 0; i < bytes / sizeof(float); i++)
+        assert_true(r.caustic[i] == 0.0f && r.lost[i] == 0.0f);
+    assert_true(!r.emission && !r.indirect && !r.reflections);
+    assert_int_equal(r.caustic_photons, 0);
+    assert_int_equal(lmgi_reference_texels(sc, &d, &again, &e), LMGI_OK);
     assert_memory_equal(r.full, again.full, bytes); /* deterministic */
     lmgi_reference_free(&again);
     char cache[1024];
@@ -103,6 +109,8 @@ static void test_reference_texels(void **state)
         assert_int_equal(again.from_cache, k); /* computed, then read back */
         assert_memory_equal(r.iim, again.iim, bytes);
         assert_memory_equal(r.full, again.full, bytes);
+        assert_memory_equal(r.direct, again.direct, bytes);
+        assert_memory_equal(r.lost, again.lost, bytes);
         lmgi_reference_free(&again);
     }
     assert_null(again.full);
@@ -126,6 +134,12 @@ static void test_reference_pixels_and_check(void **state)
     assert_int_equal(px.width, SIDE);
     assert_int_equal(px.entries, SIDE * SIDE);
     assert_null(px.iim);
+    assert_null(px.radiance);
+    for (int i = 0; i < 3 * SIDE * SIDE; i++) { /* all of it is the floor's direct light */
+        assert_true(px.emission[i] == 0.0f && px.indirect[i] == 0.0f && px.caustic[i] == 0.0f);
+        assert_true(px.reflections[i] == 0.0f && px.lost[i] == 0.0f);
+        assert_float_equal(px.direct[i], px.full[i], 0.0);
+    }
     double sum_ref = 0.0;
     int seen = 0;
     for (int i = 0; i < SIDE * SIDE; i++)
@@ -171,6 +185,67 @@ static void test_reference_pixels_and_check(void **state)
     lmgi_free(sc);
 }
 
+/* The lamp over the floor with a 1.5 x 1.5 mirror 1 unit above it, facing down: the floor (the only
+ * surface with texels) gets the light's image, E = rho I cos / d^2 from the virtual light at (0, 4, 0),
+ * over the mirror scaled 4 times from it (|x|, |z| < 3); the pixel parts add up to the picture. */
+static void test_reference_parts_with_mirror(void **state)
+{
+    (void)state;
+    static const float floor_pos[12] = {-8, 0, 8, 8, 0, 8, 8, 0, -8, -8, 0, -8};
+    static const float mirror_pos[12] = {-0.75f, 3, -0.75f, 0.75f, 3, -0.75f, 0.75f, 3, 0.75f, -0.75f, 3, 0.75f};
+    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    lmgi_mesh_desc meshes[2] = {
+        {.name = "floor", .positions = floor_pos, .vertex_count = 4, .indices = idx, .triangle_count = 2},
+        {.name = "mirror", .positions = mirror_pos, .vertex_count = 4, .indices = idx, .triangle_count = 2,
+         .material = 1}};
+    lmgi_material_desc mats[2] = {{.name = "grey", .base_color = {ALBEDO, ALBEDO, ALBEDO, 1.0f}},
+                                  {.name = "mirror", .base_color = {0.9f, 0.9f, 0.9f, 1.0f}, .metallic = 1.0f,
+                                   .roughness = 0.01f}};
+    lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = INTENSITY,
+                            .position = {0, HEIGHT, 0}};
+    lmgi_scene_desc sd = {.name = "lamp, mirror and floor", .meshes = meshes, .mesh_count = 2, .materials = mats,
+                          .material_count = 2, .lights = &lamp, .light_count = 1};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 1500;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&sd, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_reference_desc d = quick();
+    d.target_error = 0.2f;
+    d.caustic_photons = 1 << 18;
+    lmgi_reference r;
+    assert_int_equal(lmgi_reference_texels(sc, &d, &r, &e), LMGI_OK);
+    assert_int_equal(r.caustic_photons, 1 << 18);
+    double got = 0.0, want = 0.0;
+    for (uint32_t i = 0; i < r.entries; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        double x = t.position[0], z = t.position[2], d2 = x * x + 16.0 + z * z;
+        if (fabs(x) > 2.5 || fabs(z) > 2.5)
+            continue;
+        got += r.caustic[3 * ((size_t)t.y * (size_t)r.width + (size_t)t.x)];
+        want += 0.9 * INTENSITY * (4.0 / sqrt(d2)) / d2;
+    }
+    print_message("mirror over the lamp: texels' caustic / analytic %.4f\n", got / want);
+    assert_float_equal(got / want, 1.0, 0.05);
+    lmgi_reference_free(&r);
+    enum { SIDE = 24 };
+    lmgi_camera cam;
+    assert_int_equal(lmgi_scene_camera(sc, -1, SIDE, SIDE, &cam, &e), LMGI_OK);
+    assert_int_equal(lmgi_reference_pixels(sc, &d, &cam, SIDE, SIDE, &r, &e), LMGI_OK);
+    double caustic = 0.0;
+    for (int i = 0; i < 3 * SIDE * SIDE; i++) {
+        double sum = (double)r.emission[i] + r.direct[i] + r.indirect[i] + r.caustic[i] + r.reflections[i] + r.lost[i];
+        assert_float_equal(sum, r.full[i], 1e-5 * fmax(r.full[i], 1e-6));
+        caustic += r.caustic[i];
+    }
+    assert_true(caustic > 0.0);
+    lmgi_reference_free(&r);
+    lmgi_free(sc);
+}
+
 static void test_bad_arguments(void **state)
 {
     (void)state;
@@ -189,6 +264,11 @@ static void test_bad_arguments(void **state)
     d = quick();
     d.samples = -3;
     expect_invalid(lmgi_reference_texels(sc, &d, &r, &e), &e, "samples -3");
+    d = quick();
+    d.caustic_photons = -1;
+    expect_invalid(lmgi_reference_texels(sc, &d, &r, &e), &e, "caustic_photons -1");
+    d.caustic_photons = (1 << 24) + 1;
+    expect_invalid(lmgi_reference_texels(sc, &d, &r, &e), &e, "caustic_photons 16777217");
     d = quick();
     lmgi_camera cam;
     assert_int_equal(lmgi_scene_camera(sc, -1, 8, 8, &cam, &e), LMGI_OK);
@@ -284,6 +364,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reference_texels),
         cmocka_unit_test(test_reference_pixels_and_check),
+        cmocka_unit_test(test_reference_parts_with_mirror),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_claim_output_dir),
     };

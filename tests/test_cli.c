@@ -149,7 +149,7 @@ static void test_info_on_generated_cornell(void **state)
     snprintf(args, sizeof args, "info %s", path);
     assert_int_equal(run(args), 0);
     assert_non_null(strstr(output, "surfaces    16 "));
-    assert_non_null(strstr(output, "caustics: on — 1 mirror material on node 'mirror_sphere'"));
+    assert_non_null(strstr(output, "caustics: on — 1 mirror and 1 glass materials (the first on node 'mirror_sphere')"));
     assert_non_null(strstr(output, "1 point, 0 spot, 0 directional"));
 }
 

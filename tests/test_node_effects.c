@@ -209,13 +209,14 @@ static void test_run_effects(void **state)
     lmgi_error e;
     const lmgi_material_desc chrome = {.name = "chrome", .base_color = {0.9f, 0.9f, 0.9f, 1.0f}, .metallic = 1.0f,
                                        .roughness = 0.05f};
-    static const unsigned bits[3] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS};
-    static const char *const names[3] = {"shadows", "indirect", "reflections"};
-    for (int k = 0; k < 3; k++) {
+    static const unsigned bits[4] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS,
+                                     LMGI_EFFECT_CAUSTICS};
+    static const char *const names[4] = {"shadows", "indirect", "reflections", "caustics"};
+    for (int k = 0; k < 4; k++) {
         lmgi_scene *run = load_room(&chrome), *nodes = load_room(&chrome);
         lmgi_updater *u = lmt_room_updater_without(ctx, run, bits[k]);
-        lmgi_node_effects fx = {1, 1, 1};
-        *(k == 0 ? &fx.shadows : k == 1 ? &fx.indirect : &fx.reflections) = 0;
+        lmgi_node_effects fx = {1, 1, 1, 1};
+        *(k == 0 ? &fx.shadows : k == 1 ? &fx.indirect : k == 2 ? &fx.reflections : &fx.caustics) = 0;
         switch_all(nodes, &fx);
         lmgi_updater *un = lmt_room_updater(ctx, nodes);
         lmgi_update_stats st, stn;
@@ -250,7 +251,7 @@ static void test_run_effects(void **state)
     lmgi_scene *sc = load_room(NULL);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.effects_off = 8;
+    d.effects_off = 16;
     lmgi_updater *u = NULL;
     lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, "effects_off");
     lmgi_free(sc);

@@ -1,5 +1,5 @@
-/* reference solver: analytic irradiance (point light over a plane, furnace box), determinism, cache,
- * pixels, relative RMSE. */
+/* reference solver: analytic irradiance (point light over a plane, furnace box), the furnace's pixel
+ * parts, determinism, cache, pixels, relative RMSE (the split by light path: test_reference_split.c). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -105,6 +105,28 @@ static void test_furnace(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* The furnace from inside: every pixel sees radiance 2, its own emission 1 exactly (the receiver's part)
+ * and 1 more from the walls it lights (the indirect part); no direct, caustic, lost or reflected light. */
+static void test_furnace_pixel_parts(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, furnace_scene(), 0.5f);
+    lm_ref_camera cam = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 1.0f, 8, 8};
+    lm_ref_settings set = quick_settings(0.01f, 64);
+    lm_ref_result r;
+    lm_error err;
+    assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &r, &err), LM_OK);
+    for (uint32_t i = 0; i < 3 * r.count; i++) {
+        assert_float_equal(r.emission[i], 1.0, 0.0);
+        assert_float_equal(r.indirect[i], 1.0, 0.05);
+        assert_float_equal(r.full[i], r.emission[i] + r.indirect[i], 1e-6);
+        assert_true(r.direct[i] == 0.0f && r.caustic[i] == 0.0f && r.lost[i] == 0.0f && r.reflections[i] == 0.0f);
+    }
+    lm_ref_result_free(&r);
+    lmt_pipeline_free(&p);
+}
+
 static void test_deterministic_across_threads(void **state)
 {
     (void)state;
@@ -122,6 +144,7 @@ static void test_deterministic_across_threads(void **state)
     assert_int_equal(a.count, b.count);
     assert_memory_equal(a.full, b.full, a.count * 3 * sizeof(float));
     assert_memory_equal(a.iim, b.iim, a.count * 3 * sizeof(float));
+    assert_memory_equal(a.lost, b.lost, a.count * 3 * sizeof(float));
     assert_memory_equal(a.samples, b.samples, a.count * sizeof(uint32_t));
     lm_ref_result_free(&a);
     lm_ref_result_free(&b);
@@ -262,6 +285,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_over_plane),
         cmocka_unit_test(test_furnace),
+        cmocka_unit_test(test_furnace_pixel_parts),
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_cache_hit_and_corruption),
         cmocka_unit_test(test_pixels_see_lit_plane),

@@ -764,6 +764,7 @@ static void gen_cornell(const char *path)
     int green = gl_material(&g, "green", 0.14, 0.45, 0.091, 0, 1, 0);
     int cube_mat = gl_material(&g, "cube", 0.75, 0.6, 0.25, 0, 1, 0);
     int mirror = gl_material(&g, "mirror", 0.95, 0.95, 0.95, 1, 0, 0);
+    int glass = gl_material(&g, "glass", 1, 1, 1, 0, 0, 1);
 
     /* Room: white part (bumpy floor, ceiling, back wall), red left wall, green right wall; interior
      * x, z in [-1, 1], y in [0, 2], open towards +Z where the camera is. */
@@ -863,9 +864,31 @@ static void gen_cornell(const char *path)
     gl_anim_channel(&g, sphere_node, "translation", INTERP_CUBIC, st, 5, sv, 3);
     gl_anim_end(&g, "sphere_bob");
 
+    /* Dynamic glass sphere, r = 0.12 m, centre 0.22 m up: a ball lens that focuses the ceiling light near the
+     * floor (a spot about 0.1 m across). It goes round the cube's ellipse half a turn behind the cube, so
+     * the two never meet (0.4 m apart at least: the cube's half diagonal and the radius). Made after the
+     * light and camera, so that the nodes before it keep their ids. */
+    float gtr[17 * 3];
+    for (int k = 0; k <= 16; k++) {
+        double th = 2 * PI * k / 16 + PI;
+        gtr[3 * k] = (float)(0.55 * cos(th));
+        gtr[3 * k + 1] = 0.22f;
+        gtr[3 * k + 2] = (float)(0.5 + 0.2 * sin(th));
+    }
+    mesh lens = {0};
+    mesh_sphere(&lens, V(0, 0, 0), 0.12, 32, 16);
+    d = node_none();
+    d.mesh = gl_mesh(&g, "glass_sphere", &lens, &glass, 1);
+    d.t = V(gtr[0], gtr[1], gtr[2]);
+    d.dynamic = 1;
+    int lens_node = gl_node(&g, "glass_sphere", &d);
+
+    gl_anim_channel(&g, lens_node, "translation", INTERP_LINEAR, times, 17, gtr, 3);
+    gl_anim_end(&g, "glass_path");
+
     gl_write(&g, path);
     for (int i = 0; i < 3; i++) mesh_free(&room[i]);
-    mesh_free(&block); mesh_free(&cube); mesh_free(&sph);
+    mesh_free(&block); mesh_free(&cube); mesh_free(&sph); mesh_free(&lens);
 }
 
 /* ------------------------------------------------------------------------------------------------ */

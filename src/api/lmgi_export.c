@@ -176,6 +176,12 @@ static void write_nodes(writer *w, const int *mesh_of)
         fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"dynamic\":%s,\"caustics\":%s,\"indirect\":%s,\"shadows\":%s,"
                 "\"reflections\":%s}", nd->dynamic ? "true" : "false", ns->caustics ? "true" : "false",
                 ns->indirect ? "true" : "false", ns->shadows ? "true" : "false", ns->reflections ? "true" : "false");
+        if (ns->has_reflection_box) { /* in the file's world, as it was read */
+            fprintf(w->doc.json, ",\"reflection_box\":[");
+            for (int k = 0; k < 6; k++)
+                fprintf(w->doc.json, "%s%.9g", k ? "," : "", (double)(ns->reflection_box[k] + s->origin[k % 3]));
+            fputc(']', w->doc.json);
+        }
         if (has_lightmap(w->atlas, nd))
             fprintf(w->doc.json, ",\"lightmap\":{\"uri\":\"%s_lightmap.exr\",\"texCoord\":1}", w->name);
         fprintf(w->doc.json, "}}");

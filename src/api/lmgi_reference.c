@@ -22,6 +22,9 @@ lmgi_status lm_api_ref_settings(const lmgi_reference_desc *desc, const char *fn,
         return lm_api_refuse(err, "%s: target_error %g must be in (0, 1] (0: the default)", fn, (double)d.target_error);
     if (d.samples < 0 || d.samples > 65536)
         return lm_api_refuse(err, "%s: samples %d must be in 1..65536 (0: the default)", fn, d.samples);
+    if (d.caustic_photons < 0 || d.caustic_photons > (1 << 24))
+        return lm_api_refuse(err, "%s: caustic_photons %d must be in 1..16777216 (0: the default)", fn,
+                             d.caustic_photons);
     if (d.target_error > 0.0f)
         s->target_error = d.target_error;
     if (d.samples > 0) {
@@ -32,13 +35,15 @@ lmgi_status lm_api_ref_settings(const lmgi_reference_desc *desc, const char *fn,
     }
     if (d.seed)
         s->seed = d.seed;
+    if (d.caustic_photons > 0)
+        s->caustic_photons = (uint32_t)d.caustic_photons;
     s->cache_dir = d.cache_dir;
     s->use_cache = !d.no_cache;
     return LMGI_OK;
 }
 
-/* Moves the internal result's arrays and figures into the public one (texel values spread into an
- * atlas-sized image when atlas is given). */
+/* Moves the internal result's arrays and figures into the public one (texel values spread into
+ * atlas-sized images when atlas is given). */
 static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float target, lmgi_reference *out,
                                lm_error *err)
 {
@@ -48,18 +53,24 @@ static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float ta
     out->samples = r->total_samples;
     out->mean_rel_se = r->mean_rel_se, out->max_rel_se = r->max_rel_se;
     out->seconds = r->seconds, out->from_cache = r->from_cache;
-    if (!atlas) {
-        out->full = r->full;
-        r->full = NULL;
-        return LM_OK;
-    }
-    size_t bytes = (size_t)atlas->width * (size_t)atlas->height * 3 * sizeof(float);
-    float **dst[3] = {&out->full, &out->iim, &out->radiance};
-    const float *src[3] = {r->full, r->iim, r->radiance};
-    for (int k = 0; k < 3; k++) {
+    out->caustic_photons = r->caustic_photons, out->caustic_seconds = r->caustic_seconds;
+    /* the same parts in the same order; NULL where the kind has none */
+    float **src[] = {&r->full, &r->iim, &r->radiance, &r->direct, &r->caustic, &r->lost, &r->emission,
+                     &r->indirect, &r->reflections};
+    float **dst[] = {&out->full, &out->iim, &out->radiance, &out->direct, &out->caustic, &out->lost,
+                     &out->emission, &out->indirect, &out->reflections};
+    size_t bytes = atlas ? (size_t)atlas->width * (size_t)atlas->height * 3 * sizeof(float) : 0;
+    for (size_t k = 0; k < sizeof src / sizeof *src; k++) {
+        if (!*src[k])
+            continue;
+        if (!atlas) { /* pixels: the arrays are the images */
+            *dst[k] = *src[k];
+            *src[k] = NULL;
+            continue;
+        }
         if (!(*dst[k] = malloc(bytes)))
             return lm_fail(err, LM_ERR_NOMEM, "no memory for a %d x %d reference image", atlas->width, atlas->height);
-        lm_ref_texels_to_image(atlas, src[k], *dst[k]);
+        lm_ref_texels_to_image(atlas, *src[k], *dst[k]);
     }
     return LM_OK;
 }
@@ -127,8 +138,9 @@ void lmgi_reference_free(lmgi_reference *r)
 {
     if (!r)
         return;
-    free(r->full);
-    free(r->iim);
-    free(r->radiance);
+    float *images[9] = {r->full, r->iim, r->radiance, r->direct, r->caustic, r->lost, r->emission, r->indirect,
+                        r->reflections};
+    for (size_t k = 0; k < sizeof images / sizeof *images; k++)
+        free(images[k]);
     memset(r, 0, sizeof *r);
 }

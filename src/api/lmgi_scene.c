@@ -235,6 +235,7 @@ lmgi_status lmgi_get_node_effects(const lmgi_scene *sc, int node, lmgi_node_effe
     out->shadows = st->shadows;
     out->indirect = st->indirect;
     out->reflections = st->reflections;
+    out->caustics = st->caustics;
     return LMGI_OK;
 }
 
@@ -245,9 +246,9 @@ lmgi_status lmgi_set_node_effects(lmgi_scene *sc, int node, const lmgi_node_effe
     lm_scene *s = sc->scene;
     if (node < 0 || node >= s->node_count)
         return lm_api_refuse(err, "node id %d is out of range (scene has %d nodes)", node, s->node_count);
-    const int v[3] = {in->shadows, in->indirect, in->reflections};
-    static const char *const names[3] = {"shadows", "indirect", "reflections"};
-    for (int k = 0; k < 3; k++)
+    const int v[4] = {in->shadows, in->indirect, in->reflections, in->caustics};
+    static const char *const names[4] = {"shadows", "indirect", "reflections", "caustics"};
+    for (int k = 0; k < 4; k++)
         if (v[k] != 0 && v[k] != 1)
             return lm_api_refuse(err, "node '%s': %s is 0 or 1, not %d", s->nodes[node].name, names[k], v[k]);
     if (sc->updater) /* its photon work reads the store the gather's switches write */
@@ -256,6 +257,7 @@ lmgi_status lmgi_set_node_effects(lmgi_scene *sc, int node, const lmgi_node_effe
         if (lm_node_under(s, n, node)) { /* as extras inherit: the node and everything under it */
             lm_node_settings *st = &s->nodes[n].settings;
             st->shadows = in->shadows, st->indirect = in->indirect, st->reflections = in->reflections;
+            st->caustics = in->caustics;
         }
     s->pass_version++;
     lm_effects_decide(s, &sc->effects);

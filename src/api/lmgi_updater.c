@@ -127,10 +127,25 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     else
         TAKE(reflection_size, 1, 4096, &s->reflection_size);
     TAKE(reflection_faces, 1, 1 << 20, &s->reflection_faces);
-    const unsigned all = LMGI_EFFECT_SHADOWS | LMGI_EFFECT_INDIRECT | LMGI_EFFECT_REFLECTIONS;
+    TAKEU(caustic_photons, 1, 1 << 24, &s->stage.caustic.photons);
+    if (!(d->caustic_retrace == 0.0f || (d->caustic_retrace > 0.0f && d->caustic_retrace <= 1.0f)))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: caustic_retrace %g must be in (0, 1] (0: the "
+                       "default)", (double)d->caustic_retrace);
+    if (d->caustic_retrace > 0.0f)
+        s->stage.caustic.retrace = d->caustic_retrace;
+    if (d->caustic_filter == -1)
+        s->caustic_pass.filter_k = 0;
+    else
+        TAKE(caustic_filter, 1, 8, &s->caustic_pass.filter_k);
+    TAKE(caustic_tile, 4, 256, &s->caustic_pass.tile);
+    if (d->caustic_world_filter != 0 && d->caustic_world_filter != 1)
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: caustic_world_filter %d must be 0 or 1",
+                       d->caustic_world_filter);
+    s->caustic_pass.world_space = d->caustic_world_filter;
+    const unsigned all = LMGI_EFFECT_SHADOWS | LMGI_EFFECT_INDIRECT | LMGI_EFFECT_REFLECTIONS | LMGI_EFFECT_CAUSTICS;
     if (d->effects_off & ~all)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: effects_off 0x%x has bits other than "
-                       "LMGI_EFFECT_SHADOWS, _INDIRECT and _REFLECTIONS", d->effects_off);
+                       "LMGI_EFFECT_SHADOWS, _INDIRECT, _REFLECTIONS and _CAUSTICS", d->effects_off);
     if ((int)d->indirect < LMGI_INDIRECT_LIGHTMAP || (int)d->indirect > LMGI_INDIRECT_BRUTEFORCE)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: indirect %d is not an indirect path "
                        "(LMGI_INDIRECT_LIGHTMAP, LMGI_INDIRECT_BRUTEFORCE)", (int)d->indirect);
@@ -139,6 +154,7 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     s->indirect = !(d->effects_off & LMGI_EFFECT_INDIRECT);
     if (d->effects_off & LMGI_EFFECT_REFLECTIONS)
         s->reflection_size = 0;
+    s->caustics = !(d->effects_off & LMGI_EFFECT_CAUSTICS);
     s->cancel = d->cancel;
     return LM_OK;
 }
@@ -325,13 +341,21 @@ static void export_stats(const lm_frame_stats *fs, int budget, int changed, lmgi
     o->texels_gathered = fs->texels_gathered;
     o->texels_budget = budget;
     o->surfaces_changed = changed;
+    o->caustic_photons_retraced = st->caustics.traced;
+    o->caustic_tiles = fs->caustic.tiles;
+    o->caustic_tiles_lit = fs->caustic.tiles_lit;
+    o->caustic_pixels_filtered = fs->caustic.pixels_filtered;
+    o->cube_faces_rendered = fs->cube_faces;
     o->ms_animate = 1e3 * st->t_animate;
     o->ms_trace = 1e3 * st->t_photons;
     o->ms_aim = 1e3 * st->t_aim;
+    o->ms_caustic_trace = 1e3 * st->t_caustics;
     o->ms_photons = 1e3 * fs->t_photons;
     o->ms_gather = 1e3 * fs->t_gather;
     o->ms_blend = 1e3 * fs->t_blend;
     o->ms_direct = 1e3 * fs->t_direct;
+    o->ms_caustics = 1e3 * fs->t_caustics;
+    o->ms_reflections = 1e3 * fs->t_reflections;
     o->ms_composite = 1e3 * fs->t_composite;
     o->ms_total = 1e3 * fs->t_total;
 }
@@ -420,6 +444,30 @@ const float *lmgi_frame(const lmgi_updater *u, int *width, int *height)
     if (height)
         *height = h;
     return img;
+}
+
+lmgi_status lmgi_get_caustics(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height, lmgi_error *err)
+{
+    int w = 0, h = 0;
+    if (u)
+        lm_frame_loop_caustics_size(u->loop, &w, &h);
+    if (width)
+        *width = w;
+    if (height)
+        *height = h;
+    if (!u || !rgb)
+        return lm_api_refuse(err, "lmgi_get_caustics: %s is NULL", !u ? "updater" : "rgb");
+    size_t need = 3 * (size_t)w * (size_t)h;
+    if (!w)
+        return lm_api_refuse(err, "lmgi_get_caustics: the updater has drawn no picture yet");
+    if (floats < need)
+        return lm_api_refuse(err, "lmgi_get_caustics: %zu floats given, the %d x %d picture's caustics need %zu",
+                             floats, w, h, need);
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_error e;
+    lm_status st = lm_frame_loop_read_caustics(u->loop, rgb, &e);
+    lm_api_leave(saved);
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }
 
 lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb, lmgi_error *err)

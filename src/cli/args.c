@@ -105,24 +105,34 @@ static int parse_tonemap(const char *o, const char *v, int *out)
 }
 
 /* A comma-separated list of -effect (left out) or +effect (kept), effect one of shadows, indirect,
- * reflections: the effects_off bits of lmgi_updater_desc. */
+ * reflections, caustics: the effects_off bits of lmgi_updater_desc. */
 static int parse_effects(const char *o, const char *v, unsigned *off)
 {
-    static const char *names[3] = {"shadows", "indirect", "reflections"};
-    static const unsigned bits[3] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS};
+    static const char *names[4] = {"shadows", "indirect", "reflections", "caustics"};
+    static const unsigned bits[4] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS,
+                                     LMGI_EFFECT_CAUSTICS};
     const char *p = v;
     while (p && *p) {
         size_t n = strcspn(p, ",");
         int k = 0;
-        while (k < 3 && !(n == strlen(names[k]) + 1 && !strncmp(p + 1, names[k], n - 1)))
+        while (k < 4 && !(n == strlen(names[k]) + 1 && !strncmp(p + 1, names[k], n - 1)))
             k++;
-        if (k == 3 || (*p != '-' && *p != '+'))
-            return bad(o, v, "a list such as -shadows,-indirect,+reflections (each of shadows, indirect, "
-                             "reflections with - to leave it out or + to keep it)");
+        if (k == 4 || (*p != '-' && *p != '+'))
+            return bad(o, v, "a list such as -shadows,-caustics,+reflections (each of shadows, indirect, "
+                             "reflections, caustics with - to leave it out or + to keep it)");
         *off = *p == '-' ? *off | bits[k] : *off & ~bits[k];
         p += n + (p[n] == ',');
     }
     return v && *v ? 0 : bad(o, v, "a list such as -shadows,-indirect");
+}
+
+static int parse_caustic_space(const char *o, const char *v, int *out)
+{
+    if (v && !strcmp(v, "screen"))
+        return *out = 0, 0;
+    if (v && !strcmp(v, "world"))
+        return *out = 1, 0;
+    return bad(o, v, "screen or world");
 }
 
 static int parse_indirect(const char *o, const char *v, int *out)
@@ -164,6 +174,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
     a->emitter_light = -1;
     a->rim_samples = -1;
     a->reflection_size = -1;
+    a->caustic_filter = -1;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
         const char *o = argv[i], *v = value_after(argc, argv, i);
@@ -208,6 +219,19 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_float(o, v, 1e-6f, &a->target_error);
         else if (!strcmp(o, "--samples"))
             rc = parse_int(o, v, 1, 100000000, &a->samples);
+        else if (!strcmp(o, "--caustic-photons"))
+            rc = parse_int(o, v, 1, 1 << 24, &a->caustic_photons);
+        else if (!strcmp(o, "--reference-caustic-photons"))
+            rc = parse_int(o, v, 1, 1 << 24, &a->ref_caustic_photons);
+        else if (!strcmp(o, "--caustic-retrace"))
+            rc = parse_float(o, v, 0.0f, &a->caustic_retrace) ? 2 : a->caustic_retrace > 0.0f && a->caustic_retrace <= 1.0f
+                     ? 0 : bad(o, v, "a share of the caustic photons in (0, 1]");
+        else if (!strcmp(o, "--caustic-filter"))
+            rc = parse_int(o, v, 0, 8, &a->caustic_filter);
+        else if (!strcmp(o, "--caustic-space"))
+            rc = parse_caustic_space(o, v, &a->caustic_world);
+        else if (!strcmp(o, "--caustic-tile"))
+            rc = parse_int(o, v, 4, 256, &a->caustic_tile);
         else if (!strcmp(o, "--cache"))
             rc = v ? (a->cache_dir = v, 0) : bad(o, v, "a directory");
         else if (!strcmp(o, "--camera"))

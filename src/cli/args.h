@@ -30,6 +30,9 @@ typedef struct {
     int surface_budget;     /* --surfaces-per-frame K: AIM refreshes per frame */
     float target_error;     /* --target-error E: relative standard error per texel (reference) */
     int samples;            /* --samples N: samples per texel/pixel per pass (reference) */
+    int caustic_photons;    /* --caustic-photons N: caustic photons per light and mirror/glass node (a run's, or
+                             * the reference command's light-traced ones) */
+    int ref_caustic_photons; /* --reference-caustic-photons N: the reference's light-traced ones (check) */
     const char *cache_dir;  /* --cache DIR (reference) */
     int no_cache;           /* --no-cache */
     int camera;             /* --camera I (default: the file's first, else automatic) */
@@ -42,6 +45,10 @@ typedef struct {
     int rim_samples;        /* --rim-samples K: directions for the rim outside the plane (0: 1 / F(a)); -1 unset */
     int reflection_size;    /* --reflection-size N: environment map side (0: no reflections); -1 unset */
     int reflection_faces;   /* --reflection-faces N: environment map faces re-rendered a frame; 0 unset */
+    float caustic_retrace;  /* --caustic-retrace F: share of the caustic photons re-traced a frame; 0 unset */
+    int caustic_filter;     /* --caustic-filter K: k of the caustics' (2k + 1)^2 filter; -1 unset */
+    int caustic_world;      /* --caustic-space screen|world: 1 filters by world distance */
+    int caustic_tile;       /* --caustic-tile N: tile side of the caustics' occlusion queries; 0 unset */
     float enlargement;      /* --enlargement a: hemicube plane half-side at distance 1 */
     int gather_scheme;      /* --gather-scheme viewports|instanced|layered (-1 = default) */
     int emitter_light;      /* --emitter-light closed|drawn: 1, 0 (-1 = per scene) */
@@ -49,7 +56,7 @@ typedef struct {
     int in_order;           /* --in-order: photon stage before the gather, one thread (no overlap) */
     int force;              /* --force: write into a non-empty --out directory lmgi did not make */
     int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
-    unsigned effects_off;   /* --effects -shadows,-indirect,-reflections: lmgi_updater_desc.effects_off */
+    unsigned effects_off;   /* --effects -shadows,-indirect,-reflections,-caustics: lmgi_updater_desc.effects_off */
     int indirect;           /* --indirect lightmap|bruteforce: lmgi_updater_desc.indirect (default lightmap) */
     int aim_direct;         /* --aim-direct emitters|photons|all: lmgi_updater_desc.aim_direct (default photons) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */

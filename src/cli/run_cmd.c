@@ -24,7 +24,9 @@ typedef struct {
     lmgi_updater *u;
     FILE *csv;
     float exposure;        /* fixed from frame 0 */
-    double sum_ms[6];      /* photons, gather, blend, direct, composite, total */
+    double sum_ms[8];      /* photons, gather, blend, direct, caustics, reflections, composite, total */
+    uint64_t caustic_photons, cube_faces; /* over all frames */
+    int caustic_frames;    /* frames that had caustic photons to draw */
     double *frame_ms;      /* each frame's total, for the median */
     uint32_t texels;
 } run_state;
@@ -53,6 +55,11 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
     d->rim_samples = a->rim_samples < 0 ? 0 : a->rim_samples == 0 ? -1 : a->rim_samples;
     d->reflection_size = a->reflection_size < 0 ? 0 : a->reflection_size == 0 ? -1 : a->reflection_size;
     d->reflection_faces = a->reflection_faces;
+    d->caustic_photons = (uint32_t)a->caustic_photons;
+    d->caustic_retrace = a->caustic_retrace;
+    d->caustic_filter = a->caustic_filter < 0 ? 0 : a->caustic_filter == 0 ? -1 : a->caustic_filter;
+    d->caustic_tile = a->caustic_tile;
+    d->caustic_world_filter = a->caustic_world;
     d->effects_off = a->effects_off;
     d->indirect = (lmgi_indirect_path)a->indirect;
     d->aim_direct = (lmgi_aim_direct)a->aim_direct;
@@ -72,20 +79,26 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
     }
 }
 
+/* Every pass's work and milliseconds: the photon work (and its parts), the gather, the blend, the direct
+ * light, the caustics (photons traced, tiles queried and lit, pixels filtered), the reflections (cube
+ * faces rendered), the composite. */
 static void csv_header(FILE *f)
 {
     fprintf(f, "frame,time_s,photons_retraced,groups_invalidated,groups_retraced,aim_surfaces_refreshed,"
-               "texels_gathered,animate_ms,trace_ms,aim_ms,photons_ms,gather_ms,blend_ms,direct_ms,composite_ms,"
-               "frame_ms\n");
+               "texels_gathered,caustic_photons_retraced,caustic_tiles,caustic_tiles_lit,caustic_pixels_filtered,"
+               "cube_faces_rendered,animate_ms,trace_ms,aim_ms,caustic_trace_ms,photons_ms,gather_ms,blend_ms,"
+               "direct_ms,caustics_ms,reflections_ms,composite_ms,frame_ms\n");
 }
 
 /* Flushed row by row: a full disk stops the run at the row it hits, not after the last frame. */
 static int csv_row(FILE *f, const lmgi_update_stats *s)
 {
-    fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", s->frame, (double)s->time,
-            s->photons_retraced, s->groups_invalidated, s->groups_retraced, s->aim_surfaces_refreshed,
-            s->texels_gathered, s->ms_animate, s->ms_trace, s->ms_aim, s->ms_photons, s->ms_gather, s->ms_blend,
-            s->ms_direct, s->ms_composite, s->ms_total);
+    fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%u,%d,%d,%llu,%d,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+            s->frame, (double)s->time, s->photons_retraced, s->groups_invalidated, s->groups_retraced,
+            s->aim_surfaces_refreshed, s->texels_gathered, s->caustic_photons_retraced, s->caustic_tiles,
+            s->caustic_tiles_lit, (unsigned long long)s->caustic_pixels_filtered, s->cube_faces_rendered,
+            s->ms_animate, s->ms_trace, s->ms_aim, s->ms_caustic_trace, s->ms_photons, s->ms_gather, s->ms_blend,
+            s->ms_direct, s->ms_caustics, s->ms_reflections, s->ms_composite, s->ms_total);
     return fflush(f) == 0 && !ferror(f);
 }
 
@@ -117,9 +130,13 @@ static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
     st = write_pair(r, name, w, h, 3, img, r->exposure, f % every == 0, err);
     if (st == LMGI_OK && !csv_row(r->csv, &fs))
         st = lm_cli_fail(err, LMGI_ERR_IO, "%s/frames.csv: write failed (%s)", r->a->out_dir, strerror(errno));
-    const double ms[6] = {fs.ms_photons, fs.ms_gather, fs.ms_blend, fs.ms_direct, fs.ms_composite, fs.ms_total};
-    for (int i = 0; i < 6; i++)
+    const double ms[8] = {fs.ms_photons, fs.ms_gather, fs.ms_blend, fs.ms_direct, fs.ms_caustics, fs.ms_reflections,
+                          fs.ms_composite, fs.ms_total};
+    for (int i = 0; i < 8; i++)
         r->sum_ms[i] += ms[i];
+    r->caustic_photons += fs.caustic_photons_retraced;
+    r->caustic_frames += fs.caustic_tiles > 0;
+    r->cube_faces += (uint64_t)fs.cube_faces_rendered;
     r->frame_ms[f] = fs.ms_total;
     r->texels += fs.texels_gathered;
     return st;
@@ -145,12 +162,49 @@ static lmgi_status write_atlases(run_state *r, lmgi_error *err)
     return st;
 }
 
+/* What the scene calls for and why, with what this run left out (--effects). */
+static void print_effects(const run_state *r)
+{
+    static const struct { const char *name; unsigned bit; } run_off[4] = {
+        {"shadows", LMGI_EFFECT_SHADOWS}, {"indirect", LMGI_EFFECT_INDIRECT}, {"reflections", LMGI_EFFECT_REFLECTIONS},
+        {"caustics", LMGI_EFFECT_CAUSTICS}};
+    for (int i = 0; i < lmgi_effect_count(r->sc); i++) {
+        lmgi_effect e;
+        lmgi_get_effect(r->sc, i, &e);
+        int off = 0;
+        for (int k = 0; k < 4; k++)
+            off |= !strcmp(e.name, run_off[k].name) && (r->a->effects_off & run_off[k].bit);
+        printf("%-11s %s: %s\n", i ? "" : "effects", e.name, off ? "off (left out by --effects)" : e.on ? "on" : "off");
+        if (!off)
+            printf("%-11s   %s\n", "", e.reason);
+    }
+}
+
+/* The last frame's caustic irradiance (lmgi_get_caustics), when the run drew caustics: caustics.exr and
+ * caustics.png (its own exposure). */
+static lmgi_status write_caustics(run_state *r, lmgi_error *err)
+{
+    if (!r->caustic_frames)
+        return LMGI_OK;
+    int w, h;
+    lmgi_frame(r->u, &w, &h);
+    size_t n = 3 * (size_t)w * (size_t)h;
+    float *rgb = malloc((n ? n : 1) * sizeof *rgb);
+    lmgi_status st = rgb ? lmgi_get_caustics(r->u, rgb, n, NULL, NULL, err)
+                         : lm_cli_fail(err, LMGI_ERR_NOMEM, "no memory for the caustics");
+    if (st == LMGI_OK)
+        st = write_pair(r, "caustics", w, h, 3, rgb, 0.0f, 1, err);
+    free(rgb);
+    return st;
+}
+
 static void summary(const run_state *r, int frames)
 {
     const double *s = r->sum_ms;
     lmgi_updater_info ui;
     lmgi_get_updater_info(r->u, &ui);
     printf("gl          %s\n", lmgi_context_gl_description(r->ctx));
+    print_effects(r);
     printf("gather      R %d, a %g, %d AIM lookup%s and %d coverage sample%s per pixel, %s scheme; ",
            ui.hemicube_resolution, (double)ui.enlargement, ui.hemicube_samples, ui.hemicube_samples > 1 ? "s" : "",
            ui.hemicube_coverage, ui.hemicube_coverage > 1 ? "s" : "", ui.gather_scheme);
@@ -170,14 +224,16 @@ static void summary(const run_state *r, int frames)
            ui.ms_setup_aim, ui.ms_setup_gather);
     printf("frames      %d, %u texels gathered, exposure %.4g (from frame 0)\n", frames, r->texels,
            (double)r->exposure);
-    printf("mean frame  %.2f ms (%.1f fps): photons %.2f, gather %.2f, blend %.2f, direct %.2f, composite %.2f\n",
-           s[5] / frames, s[5] > 0 ? 1e3 * frames / s[5] : 0.0, s[0] / frames, s[1] / frames, s[2] / frames,
-           s[3] / frames, s[4] / frames);
+    printf("mean frame  %.2f ms (%.1f fps): photons %.2f, gather %.2f, blend %.2f, direct %.2f, caustics %.2f, "
+           "reflections %.2f, composite %.2f\n", s[7] / frames, s[7] > 0 ? 1e3 * frames / s[7] : 0.0, s[0] / frames,
+           s[1] / frames, s[2] / frames, s[3] / frames, s[4] / frames, s[5] / frames, s[6] / frames);
+    printf("work        %llu caustic photons traced, %llu environment map faces rendered\n",
+           (unsigned long long)r->caustic_photons, (unsigned long long)r->cube_faces);
     double median = lm_cli_median(r->frame_ms, frames);
     printf("median      %.2f ms (%.1f fps; the mean includes frame 0, which uploads everything)\n", median,
            median > 0.0 ? 1e3 / median : 0.0);
-    printf("wrote       %s/frame_*.png (.exr every %d), iim.exr/png, aim.exr/png, frames.csv\n", r->a->out_dir,
-           r->a->exr_every ? r->a->exr_every : 10);
+    printf("wrote       %s/frame_*.png (.exr every %d), iim.exr/png, aim.exr/png, %sframes.csv\n", r->a->out_dir,
+           r->a->exr_every ? r->a->exr_every : 10, r->caustic_frames ? "caustics.exr/png (the last frame's), " : "");
 }
 
 static lmgi_status play(run_state *r, lmgi_error *err)
@@ -211,7 +267,7 @@ static lmgi_status run(run_state *r, lmgi_error *err)
     lm_cli_updater_desc(r->a, &desc);
     /* the output directory, claimed before the long setup, so a bad path fails at once */
     static const char *const own[] = {"frame_*.png", "frame_*.exr", "frames.csv", "iim.exr", "iim.png", "aim.exr",
-                                      "aim.png", NULL};
+                                      "aim.png", "caustics.exr", "caustics.png", NULL};
     lmgi_status st = lmgi_claim_output_dir(r->a->out_dir, r->a->force, own, err);
     if (st == LMGI_OK)
         st = lmgi_context_create(NULL, &r->ctx, err);
@@ -226,6 +282,8 @@ static lmgi_status run(run_state *r, lmgi_error *err)
     r->csv = NULL;
     if (st == LMGI_OK)
         st = write_atlases(r, err);
+    if (st == LMGI_OK)
+        st = write_caustics(r, err);
     if (st == LMGI_OK && !r->a->quiet)
         summary(r, r->a->frames ? r->a->frames : 60);
     return st;

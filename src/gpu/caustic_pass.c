@@ -166,14 +166,17 @@ typedef struct {
     int tiles_x, tiles_y;
     uint8_t *lit;
     GLuint *queries;
+    int lit_count, box[4];  /* the last run's lit tiles and the box of their grown squares */
 } slot_targets;
 
 struct lm_caustic_pass {
     lm_caustic_pass_settings set;
     GLuint splat_prog, query_prog, filter_prog, composite_prog;
-    GLuint vao, photon_vbo, empty_vao, rect_vbo;
+    GLuint vao, photon_vbo, index_buf, empty_vao, rect_vbo;
     uint32_t photons;
-    slot_targets slots[2];
+    float *pos;             /* the photons' positions (3 floats each), for the frustum test of each run */
+    uint32_t *visible;      /* scratch: the indices of the photons in a run's view frustum */
+    slot_targets slots[LM_CAUSTIC_SLOTS];
     float *rects;           /* scratch: 12 floats per grown tile */
 };
 
@@ -291,8 +294,10 @@ lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic
         glGenVertexArrays(1, &cp->vao);
         glGenVertexArrays(1, &cp->empty_vao);
         glGenBuffers(1, &cp->photon_vbo);
+        glGenBuffers(1, &cp->index_buf);
         glGenBuffers(1, &cp->rect_vbo);
         glBindVertexArray(cp->vao);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, cp->index_buf); /* the VAO keeps it */
         glBindBuffer(GL_ARRAY_BUFFER, cp->photon_vbo);
         for (int a = 0; a < 3; a++) {
             glEnableVertexAttribArray((GLuint)a);
@@ -314,7 +319,7 @@ void lm_caustic_pass_free(lm_caustic_pass *cp)
 {
     if (!cp)
         return;
-    for (int i = 0; i < 2; i++)
+    for (int i = 0; i < LM_CAUSTIC_SLOTS; i++)
         free_slot(&cp->slots[i]);
     GLuint progs[4] = {cp->splat_prog, cp->query_prog, cp->filter_prog, cp->composite_prog};
     for (int i = 0; i < 4; i++)
@@ -324,9 +329,12 @@ void lm_caustic_pass_free(lm_caustic_pass *cp)
         glDeleteVertexArrays(1, &cp->vao);
         glDeleteVertexArrays(1, &cp->empty_vao);
         glDeleteBuffers(1, &cp->photon_vbo);
+        glDeleteBuffers(1, &cp->index_buf);
         glDeleteBuffers(1, &cp->rect_vbo);
     }
     free(cp->rects);
+    free(cp->pos);
+    free(cp->visible);
     free(cp);
 }
 
@@ -336,13 +344,22 @@ lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit 
     for (uint32_t i = 0; i < count; i++)
         n += hits[i].flux[0] != 0.0f || hits[i].flux[1] != 0.0f || hits[i].flux[2] != 0.0f;
     float *v = malloc((size_t)(n ? n : 1) * PHOTON_FLOATS * sizeof *v);
-    if (!v)
+    float *pos = realloc(cp->pos, (size_t)(n ? n : 1) * 3 * sizeof *pos);
+    uint32_t *vis = pos ? realloc(cp->visible, (size_t)(n ? n : 1) * sizeof *vis) : NULL;
+    cp->pos = pos ? pos : cp->pos;
+    cp->visible = vis ? vis : cp->visible;
+    if (!v || !pos || !vis) {
+        free(v);
+        cp->photons = 0;
         return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %u photons", n);
+    }
     float *p = v;
     for (uint32_t i = 0; i < count; i++) {
         const lm_caustic_hit *h = &hits[i];
         if (h->flux[0] == 0.0f && h->flux[1] == 0.0f && h->flux[2] == 0.0f)
             continue;
+        memcpy(pos, h->pos, 3 * sizeof *pos);
+        pos += 3;
         memcpy(p, h->pos, 3 * sizeof *p);
         memcpy(p + 3, h->ng, 3 * sizeof *p);
         memcpy(p + 6, h->flux, 3 * sizeof *p);
@@ -408,6 +425,23 @@ static int view_constants(const lm_view *v, int w, int h, view_consts *c)
 
 static void set_size(GLuint prog, int w, int h) { glUniform2f(glGetUniformLocation(prog, "size"), (float)w, (float)h); }
 
+/* The photons inside the view's frustum (clip space, |x|, |y|, |z| <= w, w > 0) into cp->visible: the
+ * vertex stage, which llvmpipe runs on one thread, then sees only those (a sixth of them for a cube map's
+ * face). Returns how many. */
+static uint32_t visible_photons(lm_caustic_pass *cp, const float m[16])
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < cp->photons; i++) {
+        const float *p = cp->pos + 3 * (size_t)i;
+        float c[4];
+        for (int r = 0; r < 4; r++)
+            c[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+        if (c[3] > 0.0f && fabsf(c[0]) <= c[3] && fabsf(c[1]) <= c[3] && fabsf(c[2]) <= c[3])
+            cp->visible[n++] = i;
+    }
+    return n;
+}
+
 static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view, const view_consts *vc, GLuint depth,
                        lm_caustic_pass_stats *st)
 {
@@ -439,18 +473,21 @@ static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, depth);
     glUniform1i(glGetUniformLocation(p, "depth"), 0);
+    uint32_t n = visible_photons(cp, vc->view_proj);
+    glBindVertexArray(cp->vao);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)(n ? n : 1) * sizeof *cp->visible), cp->visible,
+                 GL_STREAM_DRAW);
     GLuint q;
     glGenQueries(1, &q);
     glBeginQuery(GL_SAMPLES_PASSED, q);
-    glBindVertexArray(cp->vao);
-    glDrawArrays(GL_POINTS, 0, (GLsizei)cp->photons);
+    glDrawElements(GL_POINTS, (GLsizei)n, GL_UNSIGNED_INT, NULL);
     glEndQuery(GL_SAMPLES_PASSED);
-    GLuint64 n = 0;
-    glGetQueryObjectui64v(q, GL_QUERY_RESULT, &n);
+    GLuint64 splatted = 0;
+    glGetQueryObjectui64v(q, GL_QUERY_RESULT, &splatted);
     glDeleteQueries(1, &q);
     glDisable(GL_BLEND);
-    st->photons = cp->photons;
-    st->splatted = n;
+    st->photons = n;
+    st->splatted = splatted;
     return LM_OK;
 }
 
@@ -551,7 +588,7 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
 static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_view *view, const lm_direct *d, int slot,
                       int skip, const int box[4])
 {
-    if (slot)
+    if (slot == LM_CAUSTIC_SLOT_PROBE)
         lm_direct_bind_probe(d);
     else
         lm_direct_bind_target(d);
@@ -585,7 +622,7 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
 {
     lm_caustic_pass_stats st;
     memset(&st, 0, sizeof st);
-    if (slot < 0 || slot > 1 || width <= 0 || height <= 0)
+    if (slot < 0 || slot >= LM_CAUSTIC_SLOTS || width <= 0 || height <= 0)
         return lm_fail(err, LM_ERR_INVALID, "caustic pass: bad slot %d or size %dx%d", slot, width, height);
     view_consts vc;
     if (!view_constants(view, width, height, &vc))
@@ -604,6 +641,7 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
             *stats = st;
         return s;
     }
+    glFinish(); /* the times below are the pass's own, not the frame's work before it */
     double t0 = lm_now();
     splat(cp, t, view, &vc, depth, &st); /* its query's result waits for the splat */
     double t1 = lm_now();
@@ -616,6 +654,8 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
         glFinish();
     }
     double t3 = lm_now();
+    t->lit_count = st.tiles_lit;
+    memcpy(t->box, box, sizeof box);
     if (s == LM_OK && d && st.tiles_lit) {
         composite(cp, t, view, d, slot, skip, box);
         glFinish();
@@ -628,11 +668,37 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
     return s == LM_OK ? lm_gl_check("caustic pass", err) : s;
 }
 
-unsigned lm_caustic_pass_irradiance(const lm_caustic_pass *cp, int slot) { return cp->slots[slot & 1].irr_tex; }
+/* The slot asked for, the frame's when out of range. */
+static const slot_targets *slot_of(const lm_caustic_pass *cp, int slot)
+{
+    return &cp->slots[slot >= 0 && slot < LM_CAUSTIC_SLOTS ? slot : LM_CAUSTIC_SLOT_FRAME];
+}
+
+unsigned lm_caustic_pass_irradiance(const lm_caustic_pass *cp, int slot) { return slot_of(cp, slot)->irr_tex; }
+
+lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_view *view, const lm_direct *d, int skip,
+                                    lm_caustic_pass_stats *stats, lm_error *err)
+{
+    if (slot < 0 || slot >= LM_CAUSTIC_SLOTS || !cp->slots[slot].irr_fbo)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: slot %d has no irradiance to composite", slot);
+    slot_targets *t = &cp->slots[slot];
+    lm_caustic_pass_stats st;
+    memset(&st, 0, sizeof st);
+    double t0 = lm_now();
+    if (t->lit_count && cp->photons) {
+        composite(cp, t, view, d, slot, skip, t->box);
+        glFinish();
+    }
+    glBindVertexArray(0);
+    st.t_composite = lm_now() - t0;
+    if (stats)
+        *stats = st;
+    return lm_gl_check("caustic pass: composite", err);
+}
 
 const uint8_t *lm_caustic_pass_tiles(const lm_caustic_pass *cp, int slot, int *tiles_x, int *tiles_y)
 {
-    const slot_targets *t = &cp->slots[slot & 1];
+    const slot_targets *t = slot_of(cp, slot);
     *tiles_x = t->tiles_x;
     *tiles_y = t->tiles_y;
     return t->lit;
@@ -651,13 +717,13 @@ static lm_status read_texture(GLuint tex, int w, int h, float *rgba, lm_error *e
 
 lm_status lm_caustic_pass_read_splat(const lm_caustic_pass *cp, int slot, float *rgba, lm_error *err)
 {
-    const slot_targets *t = &cp->slots[slot & 1];
+    const slot_targets *t = slot_of(cp, slot);
     return read_texture(t->splat_tex[0], t->width, t->height, rgba, err);
 }
 
 lm_status lm_caustic_pass_read_irradiance(const lm_caustic_pass *cp, int slot, float *rgb, lm_error *err)
 {
-    const slot_targets *t = &cp->slots[slot & 1];
+    const slot_targets *t = slot_of(cp, slot);
     size_t n = (size_t)t->width * (size_t)t->height;
     float *rgba = malloc((n ? n : 1) * 4 * sizeof *rgba);
     if (!rgba)

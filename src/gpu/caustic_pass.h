@@ -27,7 +27,9 @@
  *            adding kd / pi x E (kd the diffuse lobe at the pixel, gpu/direct_shader.c's lobes), inside the
  *            box of the grown tiles.
  *
- * Two slots of targets (the frame's, and the environment maps' faces), each re-made when its size changes.
+ * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
+ * environment maps' faces (_PROBE, composited into lm_direct's probe target) and other views an application
+ * renders (_VIEW).
  * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel, one
  * draw of the scene clipped to the lit tiles' box (docs/bench.md has the figures). Needs a current GL
  * context; not thread-safe. */
@@ -58,6 +60,7 @@ typedef struct {
 } lm_caustic_pass_stats;
 
 typedef struct lm_caustic_pass lm_caustic_pass;
+enum { LM_CAUSTIC_SLOT_FRAME = 0, LM_CAUSTIC_SLOT_PROBE = 1, LM_CAUSTIC_SLOT_VIEW = 2, LM_CAUSTIC_SLOTS = 3 };
 
 lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic_pass **out, lm_error *err);
 void lm_caustic_pass_free(lm_caustic_pass *cp);
@@ -65,11 +68,15 @@ void lm_caustic_pass_free(lm_caustic_pass *cp);
 lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit *hits, uint32_t count, lm_error *err);
 uint32_t lm_caustic_pass_photon_count(const lm_caustic_pass *cp);
 /* Splat, tiles and filter for `view` over the depth texture `depth` (width x height, lm_direct_depth_texture)
- * into slot `slot`'s irradiance; then, unless d is NULL, the composite into d's frame (slot 0) or probe
- * (slot 1) target, leaving node `skip` out (-1: none). Nothing at all is drawn without photons. stats may
- * be NULL. */
+ * into slot `slot`'s irradiance; then, unless d is NULL, the composite into d's probe target (the probe
+ * slot) or its frame's (the others), leaving node `skip` out (-1: none). Nothing at all is drawn without
+ * photons. stats may be NULL. */
 lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,
                               int height, const lm_direct *d, int skip, lm_caustic_pass_stats *stats, lm_error *err);
+/* The composite alone, over slot's irradiance as its last run left it: for a picture whose photons, view
+ * and depth are those of that run (nothing moved), which need no splat, query or filter again. */
+lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_view *view, const lm_direct *d, int skip,
+                                    lm_caustic_pass_stats *stats, lm_error *err);
 /* After a run of slot: the irradiance E (RGBA32F texture, rgb), the tiles whose queries found photons
  * (tiles_x x tiles_y flags, row 0 at the bottom as GL's), and the splat read back (width x height x 4
  * floats, GL rows bottom-up: rgb = sum Phi / A_pix, a = photons) for tests. */

@@ -530,6 +530,10 @@ lm_status Loader::materials()
                              d.emissive[0], d.emissive[1], d.emissive[2], d.transmission, d.ior};
         if (!finite_all(all, sizeof all / sizeof all[0]))
             return fail(LM_ERR_INVALID, "%s has a non-finite parameter", ctx.c_str());
+        /* KHR_materials_ior: 1 or more, or 0 (a Fresnel term of 1 at every angle: all reflected) */
+        if (!(d.ior >= 1.0f || d.ior == 0.0f))
+            return fail(LM_ERR_INVALID, "%s: KHR_materials_ior ior %g must be at least 1 (or 0: all reflected)",
+                        ctx.c_str(), double(d.ior));
         /* glTF keeps these factors in [0, 1]; an albedo above 1 makes light (a base colour of 1e38 gave an
          * infinite frame), a negative one takes it */
         const float unit[] = {d.base_color[0], d.base_color[1], d.base_color[2], d.base_color[3], d.metallic,
@@ -558,6 +562,29 @@ lm_status Loader::materials()
     return LM_OK;
 }
 
+// extras.lmgi.reflection_box: [min x, y, z, max x, y, z] in world space, the proxy of what a reflector's
+// environment map sees (gpu/reflections.h); anything else is warned about and ignored.
+static void read_reflection_box(const tinygltf::Value &v, lm_node_settings &st, const char *path,
+                                const std::string &ctx)
+{
+    float b[6];
+    bool ok = v.IsArray() && v.ArrayLen() == 6;
+    for (int k = 0; ok && k < 6; k++) {
+        ok = v.Get(k).IsNumber();
+        b[k] = ok ? float(v.Get(k).GetNumberAsDouble()) : 0.0f;
+        ok = ok && std::isfinite(b[k]);
+    }
+    for (int k = 0; ok && k < 3; k++)
+        ok = b[k] < b[k + 3];
+    if (!ok) {
+        lm_warn("%s: %s: extras.lmgi.reflection_box is not [min x, y, z, max x, y, z] with min < max; ignored",
+                path, ctx.c_str());
+        return;
+    }
+    memcpy(st.reflection_box, b, sizeof b);
+    st.has_reflection_box = 1;
+}
+
 // Reads the lmgi extras of a node: -1 unset, 0/1 set.
 void read_settings(const tinygltf::Value &extras, lm_node_settings &st, const char *path, const std::string &ctx)
 {
@@ -571,9 +598,13 @@ void read_settings(const tinygltf::Value &extras, lm_node_settings &st, const ch
     }
     struct { const char *key; int *dst; } keys[] = {
         {"dynamic", &st.dynamic}, {"caustics", &st.caustics}, {"indirect", &st.indirect}, {"shadows", &st.shadows},
-        {"reflections", &st.reflections}};
+        {"casts_shadows", &st.shadows}, {"reflections", &st.reflections}};
     for (const std::string &k : l.Keys()) {
         bool found = false;
+        if (k == "reflection_box") {
+            read_reflection_box(l.Get(k), st, path, ctx);
+            continue;
+        }
         for (auto &e : keys) {
             if (k != e.key)
                 continue;

@@ -87,8 +87,10 @@ typedef struct {
     int dynamic;           /* extras "dynamic": true */
     int caustics;          /* extras "caustics" */
     int indirect;          /* extras "indirect" */
-    int shadows;           /* extras "shadows" */
+    int shadows;           /* extras "shadows" (or "casts_shadows") */
     int reflections;       /* extras "reflections": a mirror or glossy node gets an environment map */
+    int has_reflection_box; /* extras "reflection_box": its environment map is looked up box-projected */
+    float reflection_box[6]; /* that box, world space: min x, y, z, max x, y, z (not inherited) */
 } lm_node_settings;
 
 typedef struct {

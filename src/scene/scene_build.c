@@ -318,6 +318,8 @@ static void rebase(lm_scene *s)
     lm_v3_store(s->origin, c);
     for (int i = 0; i < s->node_count; i++) {
         lm_node *n = &s->nodes[i];
+        for (int k = 0; k < 6 && n->settings.has_reflection_box; k++) /* world space, as the file gave it */
+            n->settings.reflection_box[k] -= s->origin[k % 3];
         if (n->parent >= 0)
             continue;
         for (int k = 0; k < 3; k++)

@@ -128,7 +128,8 @@ static int sample_glass(const lm_shading *sh, lm_vec3 wi, const float u[3], lm_b
 {
     lm_vec3 ng = lm_v3_load(sh->ng), ns = lm_v3_load(sh->ns);
     int entering = lm_dot(wi, ng) < 0.0f;
-    float eta_i = entering ? 1.0f : sh->material->ior, eta_t = entering ? sh->material->ior : 1.0f;
+    float ior = sh->material->ior == 0.0f ? 1.0f : sh->material->ior; /* 0: reflects all, below */
+    float eta_i = entering ? 1.0f : ior, eta_t = entering ? ior : 1.0f;
     if (!(eta_i > 0.0f) || !(eta_t > 0.0f))
         return 0;
     if (lm_dot(wi, ns) > 0.0f) /* normals against wi */
@@ -136,6 +137,8 @@ static int sample_glass(const lm_shading *sh, lm_vec3 wi, const float u[3], lm_b
     if (!entering)
         ng = lm_scale(ng, -1.0f);
     float cos_i = -lm_dot(wi, ns), F = lm_fresnel_dielectric(cos_i, eta_i, eta_t);
+    if (sh->material->ior == 0.0f) /* KHR_materials_ior's 0: the Fresnel term is 1, everything reflected */
+        F = 1.0f;
     out->specular = 1;
     if (u[0] < F) { /* Fresnel-weighted reflection (also total internal reflection) */
         lm_vec3 r = reflect(wi, ns);

@@ -171,24 +171,52 @@ lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, int genera
 
 /* ---- generators ---- */
 
-/* The sphere around node n's specular triangles' world bounds; radius 0 when they have no extent. */
-static void generator_sphere(const lm_scene *s, int n, lm_caustic_generator *g)
+/* Calls fn for every world corner of node n's specular triangles. */
+static void specular_corners(const lm_scene *s, int n, void (*fn)(void *, lm_vec3), void *user)
 {
     const lm_node *node = &s->nodes[n];
-    lm_vec3 lo = lm_v3(INFINITY, INFINITY, INFINITY), hi = lm_scale(lo, -1.0f);
     for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++) {
         if (!lm_material_is_specular(s->materials[s->tri_material[t]].cls))
             continue;
         for (int k = 0; k < 3; k++) {
             float p[3];
             lm_scene_vertex_world(s, s->tris[3 * (size_t)t + (size_t)k], p);
-            lo = lm_vmin(lo, lm_v3_load(p));
-            hi = lm_vmax(hi, lm_v3_load(p));
+            fn(user, lm_v3_load(p));
         }
     }
+}
+
+typedef struct {
+    lm_vec3 lo, hi, c;
+    float r2;
+} sphere_fit;
+
+static void grow_box(void *user, lm_vec3 p)
+{
+    sphere_fit *f = user;
+    f->lo = lm_vmin(f->lo, p);
+    f->hi = lm_vmax(f->hi, p);
+}
+
+static void grow_radius(void *user, lm_vec3 p)
+{
+    sphere_fit *f = user;
+    lm_vec3 d = lm_sub(p, f->c);
+    f->r2 = fmaxf(f->r2, lm_dot(d, d));
+}
+
+/* The sphere about the centre of node n's specular triangles' world bounds through their farthest corner
+ * (a sphere's own for a sphere; the box's half diagonal would aim 3^(3/2) times the photons at it);
+ * radius 0 when they have no extent. */
+static void generator_sphere(const lm_scene *s, int n, lm_caustic_generator *g)
+{
+    sphere_fit f = {lm_v3(INFINITY, INFINITY, INFINITY), lm_v3(-INFINITY, -INFINITY, -INFINITY), lm_v3(0, 0, 0), 0.0f};
+    specular_corners(s, n, grow_box, &f);
+    f.c = lm_scale(lm_add(f.lo, f.hi), 0.5f);
+    specular_corners(s, n, grow_radius, &f);
     g->node = n;
-    lm_vec3 c = lm_scale(lm_add(lo, hi), 0.5f);
-    float r = 0.5f * lm_length(lm_sub(hi, lo));
+    lm_vec3 c = f.c;
+    float r = sqrtf(f.r2);
     int ok = lm_v3_finite(c) && isfinite(r) && r > 0.0f;
     lm_v3_store(g->centre, ok ? c : lm_v3(0, 0, 0));
     g->radius = ok ? r : 0.0f;
@@ -266,7 +294,8 @@ struct lm_caustics {
     uint64_t world_hash;     /* of every node matrix: a change starts a round-robin turn */
     /* scratch: the frame's jobs (slot numbers) and their fates */
     uint32_t *jobs;
-    uint8_t *fates;
+    uint8_t *fates;            /* per job its fate, and whether its hit differs from the slot's before */
+    uint8_t *changed;
     uint32_t *job_rays;
     lm_emit_tri *tris;       /* area emitters' placed triangles: em_tri_first[e] .. */
     uint32_t *em_tri_first;
@@ -382,21 +411,24 @@ static void trace_jobs(lm_caustics *c, uint32_t n, lm_caustic_frame_stats *st)
             uint32_t rays;
             c->fates[i] = (uint8_t)trace_slot(cc, slot, &h, em, &rays);
             c->job_rays[i] = rays;
+            c->changed[i] = memcmp(&c->hits[slot], &h, sizeof h) != 0;
             c->hits[slot] = h;
             memcpy(c->emitted + 3 * (size_t)slot, em, sizeof em);
         }
     }
     uint32_t *fate_count[5] = {&st->landed, &st->missed, &st->escaped, &st->absorbed, &st->capped};
+    int changed = 0;
     for (uint32_t i = 0; i < n; i++) {
         (*fate_count[c->fates[i]])++;
         st->rays += c->job_rays[i];
+        changed |= c->changed[i];
     }
     st->traced += n;
     uint32_t landed = 0;
     for (uint32_t s = 0; s < c->slots; s++)
         landed += c->hits[s].flux[0] != 0.0f || c->hits[s].flux[1] != 0.0f || c->hits[s].flux[2] != 0.0f;
     c->landed = landed;
-    c->version++;
+    c->version += changed; /* a re-trace that found every path as it was changes nothing downstream */
 }
 
 static lm_status alloc_lists(lm_caustics *c, lm_error *err)
@@ -416,9 +448,10 @@ static lm_status alloc_lists(lm_caustics *c, lm_error *err)
     c->emitted = calloc(3 * n, sizeof *c->emitted);
     c->jobs = malloc(n * sizeof *c->jobs);
     c->fates = malloc(n);
+    c->changed = malloc(n);
     c->job_rays = malloc(n * sizeof *c->job_rays);
     if (!c->pairs || !c->gen_world || !c->em_state || !c->em_tri_first || !c->hits || !c->emitted || !c->jobs ||
-        !c->fates || !c->job_rays)
+        !c->fates || !c->changed || !c->job_rays)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %llu caustic photons", c->scene->path,
                        (unsigned long long)slots);
     for (int e = 0; e < c->em_count; e++)
@@ -523,6 +556,7 @@ void lm_caustics_free(lm_caustics *c)
     free(c->emitted);
     free(c->jobs);
     free(c->fates);
+    free(c->changed);
     free(c->job_rays);
     free(c->tris);
     free(c->em_tri_first);

@@ -129,7 +129,8 @@ const lm_caustic_generator *lm_caustics_generator(const lm_caustics *c, int i);
 uint32_t lm_caustics_photon_count(const lm_caustics *c); /* slots: pairs x photons */
 /* Every slot, pair by pair (a slot whose flux is 0 holds no photon). */
 const lm_caustic_hit *lm_caustics_hits(const lm_caustics *c);
-/* Landed photons now, and a counter of changes to the slots (a copy compares it to know it is stale). */
+/* Landed photons now, and a counter of changes to the slots: it moves when a trace changed a slot (a copy
+ * compares it to know it is stale; a round robin that finds every path as it was leaves it). */
 uint32_t lm_caustics_landed(const lm_caustics *c);
 uint64_t lm_caustics_version(const lm_caustics *c);
 /* The total flux stored per channel (doubles), and the flux the generators received from the emitters,

@@ -10,7 +10,7 @@
 #include "../core/log.h"
 
 #define LM_REF_MAGIC "LMGIREF1"
-#define LM_REF_VERSION 1u
+#define LM_REF_VERSION 2u /* 2: the split by light path (caustic, lost, pixel parts) */
 #define LM_FNV_OFFSET 0xcbf29ce484222325ull
 #define LM_FNV_PRIME 0x100000001b3ull
 
@@ -99,6 +99,7 @@ static void hash_settings(uint64_t *h, const lm_ref_settings *set)
     fnv_u32(h, set->seed);
     fnv_u32(h, (uint32_t)set->max_depth);
     fnv_u32(h, (uint32_t)set->rr_depth);
+    fnv_u32(h, set->caustic_photons);
 }
 
 uint64_t lm_ref_key_texels(const lm_scene *s, const lm_atlas *a, const lm_ref_settings *set)
@@ -161,6 +162,8 @@ typedef struct {
     uint32_t has_texel_arrays, converged;
     uint64_t total_samples;
     double mean_rel_se, max_rel_se, seconds;
+    uint64_t caustic_photons;
+    double caustic_seconds;
 } file_header;
 
 /* Writes or reads the header fields one by one (no struct padding in the file). */
@@ -203,17 +206,17 @@ static void get(buffer *b, void *d, size_t n)
         op(b, &(h)->version, 4), op(b, &(h)->kind, 4), op(b, &(h)->key, 8), op(b, &(h)->count, 4);              \
         op(b, &(h)->width, 4), op(b, &(h)->height, 4), op(b, &(h)->has_texel_arrays, 4);                        \
         op(b, &(h)->converged, 4), op(b, &(h)->total_samples, 8), op(b, &(h)->mean_rel_se, 8);                  \
-        op(b, &(h)->max_rel_se, 8), op(b, &(h)->seconds, 8);                                                    \
+        op(b, &(h)->max_rel_se, 8), op(b, &(h)->seconds, 8), op(b, &(h)->caustic_photons, 8);                   \
+        op(b, &(h)->caustic_seconds, 8);                                                                        \
     } while (0)
 
-static void put_arrays(buffer *b, const lm_ref_result *r, int texel_arrays)
+static void put_arrays(buffer *b, const lm_ref_result *r, int texels)
 {
-    size_t n3 = (size_t)r->count * 3 * sizeof(float);
-    put(b, r->full, n3);
-    if (texel_arrays) {
-        put(b, r->iim, n3);
-        put(b, r->radiance, n3);
-    }
+    lm_ref_result view = *r; /* the list points at a result's fields, which it may fill: read through a copy */
+    float **arrays[LM_REF_MAX_ARRAYS];
+    int n = lm_ref_result_arrays(&view, texels, arrays);
+    for (int i = 0; i < n; i++)
+        put(b, *arrays[i], (size_t)r->count * 3 * sizeof(float));
     put(b, r->samples, (size_t)r->count * sizeof(uint32_t));
     put(b, r->rel_se, (size_t)r->count * sizeof(float));
 }
@@ -232,7 +235,8 @@ void lm_ref_cache_store(const char *path, uint32_t kind, const lm_ref_result *r)
         }
     }
     file_header h = {LM_REF_VERSION, kind, r->key, r->count, r->width, r->height, r->iim != NULL, r->converged,
-                     r->total_samples, r->mean_rel_se, r->max_rel_se, r->seconds};
+                     r->total_samples, r->mean_rel_se, r->max_rel_se, r->seconds, r->caustic_photons,
+                     r->caustic_seconds};
     buffer b = {0};
     put(&b, LM_REF_MAGIC, 8);
     XFER_FIELDS(put, &b, &h);
@@ -273,17 +277,6 @@ static int read_all(const char *path, buffer *b)
     return ok ? 1 : -1;
 }
 
-static int alloc_result(lm_ref_result *r, int texel_arrays)
-{
-    size_t n = r->count ? r->count : 1;
-    r->full = malloc(n * 3 * sizeof(float));
-    r->iim = texel_arrays ? malloc(n * 3 * sizeof(float)) : NULL;
-    r->radiance = texel_arrays ? malloc(n * 3 * sizeof(float)) : NULL;
-    r->samples = malloc(n * sizeof(uint32_t));
-    r->rel_se = malloc(n * sizeof(float));
-    return r->full && r->samples && r->rel_se && (!texel_arrays || (r->iim && r->radiance));
-}
-
 static int parse(buffer *b, uint32_t kind, uint64_t key, uint32_t count, int width, int height, lm_ref_result *out,
                  const char **why)
 {
@@ -306,20 +299,19 @@ static int parse(buffer *b, uint32_t kind, uint64_t key, uint32_t count, int wid
         return *why = "key or sizes do not match", 0;
     memset(out, 0, sizeof *out);
     out->count = count, out->width = width, out->height = height, out->key = key;
-    if (!alloc_result(out, (int)h.has_texel_arrays))
+    if (!lm_ref_result_alloc(out, count, (int)h.has_texel_arrays))
         return *why = "out of memory", 0;
-    size_t n3 = (size_t)count * 3 * sizeof(float);
-    get(b, out->full, n3);
-    if (h.has_texel_arrays) {
-        get(b, out->iim, n3);
-        get(b, out->radiance, n3);
-    }
+    float **arrays[LM_REF_MAX_ARRAYS];
+    int n = lm_ref_result_arrays(out, (int)h.has_texel_arrays, arrays);
+    for (int i = 0; i < n; i++)
+        get(b, *arrays[i], (size_t)count * 3 * sizeof(float));
     get(b, out->samples, (size_t)count * sizeof(uint32_t));
     get(b, out->rel_se, (size_t)count * sizeof(float));
     if (b->bad || b->pos != b->len)
         return *why = "wrong length", 0;
     out->converged = h.converged, out->total_samples = h.total_samples;
     out->mean_rel_se = h.mean_rel_se, out->max_rel_se = h.max_rel_se, out->seconds = h.seconds;
+    out->caustic_photons = h.caustic_photons, out->caustic_seconds = h.caustic_seconds;
     out->from_cache = 1;
     return 1;
 }

@@ -1,9 +1,12 @@
 /* The reference solver's disk cache (reference.h): keys and files. Internal to src/trace.
  *
- * Key: 64-bit FNV-1a over the scene's vertices, triangles, materials, textures, lights, node world
- * matrices and bounds, then the texel table (or the camera), then every setting that changes the
- * numbers. File: "LMGIREF1", version, kind, key, count, width, height, summary, the arrays, and an
- * FNV-1a checksum of everything before it; written to a temporary name and renamed into place. */
+ * Key: 64-bit FNV-1a over the file version, the scene's vertices, triangles, materials, textures,
+ * lights, node world matrices and bounds, then the texel table (or the camera), then every setting that
+ * changes the numbers (caustic_photons included). File: "LMGIREF1", version (2: the split by light
+ * path), kind, key, count, width, height, summary (the caustic part's photons and time included), the
+ * float arrays in lm_ref_result_arrays' order, samples, rel_se, and an FNV-1a checksum of everything
+ * before it; written to a temporary name and renamed into place. A file of another version is ignored
+ * with a warning and recomputed. */
 #ifndef LM_REF_CACHE_H
 #define LM_REF_CACHE_H
 
@@ -13,6 +16,15 @@
 #include "reference.h"
 
 enum { LM_REF_KIND_TEXELS = 1, LM_REF_KIND_PIXELS = 2 };
+
+/* The float arrays (3 per entry) a result of the kind holds, as pointers to r's fields, in a fixed order
+ * (the file's): full, direct, caustic, lost, then iim, radiance (texels) or emission, indirect,
+ * reflections (pixels). Returns how many. Shared by the solver (reference.c) and the cache. */
+#define LM_REF_MAX_ARRAYS 8
+int lm_ref_result_arrays(lm_ref_result *r, int texels, float **arrays[LM_REF_MAX_ARRAYS]);
+/* Allocates those arrays, samples and rel_se for count entries into a zeroed r; 0 when memory ran out
+ * (what was allocated stays for lm_ref_result_free). */
+int lm_ref_result_alloc(lm_ref_result *r, uint32_t count, int texels);
 
 uint64_t lm_ref_key_texels(const lm_scene *s, const lm_atlas *a, const lm_ref_settings *set);
 uint64_t lm_ref_key_pixels(const lm_scene *s, const lm_ref_camera *cam, const lm_ref_settings *set);

@@ -3,7 +3,12 @@
  * A path carries throughput beta. At each hit: emitted radiance Le (MIS-weighted against the light
  * sample the previous vertex took, unless that vertex was specular or the camera); at a non-specular
  * vertex, next-event estimation to every emitter (area lights MIS-weighted, power heuristic); then a
- * BSDF sample, beta *= f cos / pdf; Russian roulette from rr_depth on, beta /= survival. */
+ * BSDF sample, beta *= f cos / pdf; Russian roulette from rr_depth on, beta /= survival.
+ *
+ * Each contribution goes to the part the path's route so far says (docs/reference.md, "Which part
+ * carries which light"); the route only sorts, it draws no numbers, so the paths and their sum are
+ * those of the solver before the split. Emission met after a chain of only specular vertices from the
+ * receiver is dropped: the light tracer's caustic part carries it, for every kind of emitter alike. */
 #include "ref_paths.h"
 
 #include <math.h>
@@ -108,9 +113,10 @@ static float light_pdf(const lm_ref_ctx *c, uint32_t tri, lm_vec3 o, lm_vec3 x)
     return lm_emitter_pdf(c->em, c->s, e, tri, of, xf);
 }
 
-/* NEE at a surface vertex: sum over emitters of f cos x Le / pdf, MIS-weighted for area lights. */
+/* NEE at a surface vertex: sum over emitters of f cos x Le / pdf, MIS-weighted for area lights, into
+ * `all` (in emitter order, as the sum of every part) and split into `punct` and `area`. */
 static void direct_at_vertex(const lm_ref_ctx *c, const lm_shading *sh, const float wi[3], lm_ref_rng *r,
-                             float out[3])
+                             float all[3], float punct[3], float area[3])
 {
     lm_vec3 p = lm_v3_load(sh->pos), ng = lm_v3_load(sh->ng);
     for (int e = 0; e < c->em->count; e++) {
@@ -124,18 +130,100 @@ static void direct_at_vertex(const lm_ref_ctx *c, const lm_shading *sh, const fl
         if (!visible(c, lift(c, p, ng, lm_v3_load(ls.dir)), &ls))
             continue;
         float w = ls.pdf > 0.0f ? power_heuristic(ls.pdf, lm_bsdf_pdf(sh, wi, ls.dir)) : 1.0f;
-        add_scaled(out, f, ls.weight, w);
+        add_scaled(all, f, ls.weight, w);
+        add_scaled(c->em->e[e].punctual ? punct : area, f, ls.weight, w);
     }
+}
+
+/* ---- routes: which part a contribution belongs to ---- */
+
+typedef enum {
+    ROUTE_EYE,        /* a camera ray before its first hit */
+    ROUTE_RECEIVER,   /* at the receiver (a pixel's first hit, not specular) */
+    ROUTE_LEFT,       /* just left the receiver: the next hit decides */
+    ROUTE_CHAIN,      /* only mirror and glass since the receiver */
+    ROUTE_SETTLED     /* everything from here on goes to one part */
+} route_state;
+
+typedef struct {
+    route_state state;
+    int part;         /* ROUTE_SETTLED: the part */
+} route;
+
+#define DROPPED (-1)  /* emission the caustic part carries */
+
+static int settle(route *rt, int part)
+{
+    rt->state = ROUTE_SETTLED;
+    rt->part = part;
+    return part;
+}
+
+/* Moves the route past a hit (specular or not); returns the part the hit's emission belongs to. */
+static int route_hit(route *rt, int specular)
+{
+    switch (rt->state) {
+    case ROUTE_EYE:
+        if (specular)
+            return settle(rt, LM_REF_REFLECTIONS);
+        rt->state = ROUTE_RECEIVER;
+        return LM_REF_EMISSION;
+    case ROUTE_LEFT:
+        if (specular) {
+            rt->state = ROUTE_CHAIN;
+            return DROPPED;
+        }
+        return settle(rt, LM_REF_INDIRECT);
+    case ROUTE_CHAIN: /* an emitter at the chain's end is a caustic; what gathers past it is lost */
+        if (!specular)
+            settle(rt, LM_REF_LOST);
+        return DROPPED;
+    case ROUTE_RECEIVER: /* the bounce leaves it: never met at a hit */
+    case ROUTE_SETTLED:
+        break;
+    }
+    return rt->part;
+}
+
+/* What one path gathers: every kept contribution in path order, and the same by part. */
+typedef struct {
+    float total[3];
+    float part[LM_REF_BACKWARD_PARTS][3];
+} tally;
+
+static void tally_add(tally *t, int part, const float beta[3], const float v[3], float w)
+{
+    add_scaled(t->total, beta, v, w);
+    add_scaled(t->part[part], beta, v, w);
+}
+
+/* NEE at a non-specular vertex: at the receiver the punctual lights are the direct part and emissive
+ * surfaces the indirect one; elsewhere all of it goes to the route's part. */
+static void tally_direct(const lm_ref_ctx *c, const route *rt, const lm_shading *sh, const float wi[3], lm_ref_rng *r,
+                         const float beta[3], tally *t)
+{
+    float all[3] = {0, 0, 0}, punct[3] = {0, 0, 0}, area[3] = {0, 0, 0};
+    direct_at_vertex(c, sh, wi, r, all, punct, area);
+    add_scaled(t->total, beta, all, 1.0f);
+    if (rt->state != ROUTE_RECEIVER) {
+        add_scaled(t->part[rt->part], beta, all, 1.0f);
+        return;
+    }
+    add_scaled(t->part[LM_REF_DIRECT], beta, punct, 1.0f);
+    add_scaled(t->part[LM_REF_INDIRECT], beta, area, 1.0f);
 }
 
 /* ---- paths ---- */
 
-/* Radiance arriving at org from direction dir. prev_pdf: solid-angle density dir was sampled with at a
- * vertex that also took light samples (0: camera or specular, no MIS). */
-static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, float prev_pdf, float out[3])
+/* Radiance arriving at org from direction dir, tallied by part from route state `from` (ROUTE_EYE for a
+ * camera ray, ROUTE_LEFT for a ray leaving a texel). prev_pdf: solid-angle density dir was sampled with
+ * at a vertex that also took light samples (0: camera or specular, no MIS). */
+static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, float prev_pdf, route_state from,
+                  tally *out)
 {
     float beta[3] = {1, 1, 1};
-    out[0] = out[1] = out[2] = 0.0f;
+    route rt = {from, LM_REF_INDIRECT};
+    memset(out, 0, sizeof *out);
     for (int depth = 0; depth < c->max_depth; depth++) {
         lm_rt_hit hit;
         float of[3], df[3];
@@ -145,17 +233,16 @@ static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, 
             return;
         lm_shading sh;
         lm_shading_from_hit(c->s, &hit, of, df, &sh);
+        int specular = lm_material_is_specular(sh.material->cls), part = route_hit(&rt, specular);
         float wo_back[3] = {-df[0], -df[1], -df[2]}, le[3];
-        if (lm_emitted_radiance(sh.material, sh.ng, wo_back, le)) {
+        if (part != DROPPED && lm_emitted_radiance(sh.material, sh.ng, wo_back, le)) {
             float pl = prev_pdf > 0.0f ? light_pdf(c, sh.tri, org, lm_v3_load(sh.pos)) : 0.0f;
-            add_scaled(out, beta, le, prev_pdf > 0.0f ? power_heuristic(prev_pdf, pl) : 1.0f);
+            tally_add(out, part, beta, le, prev_pdf > 0.0f ? power_heuristic(prev_pdf, pl) : 1.0f);
         }
-        int specular = lm_material_is_specular(sh.material->cls);
-        if (!specular) {
-            float d[3] = {0, 0, 0};
-            direct_at_vertex(c, &sh, df, r, d);
-            add_scaled(out, beta, d, 1.0f);
-        }
+        if (!specular)
+            tally_direct(c, &rt, &sh, df, r, beta, out);
+        if (rt.state == ROUTE_RECEIVER)
+            rt.state = ROUTE_LEFT;
         float u[3] = {lm_ref_rng_float(r), lm_ref_rng_float(r), lm_ref_rng_float(r)};
         lm_bsdf_sample_t bs;
         if (!lm_bsdf_sample(&sh, df, u, &bs))
@@ -225,24 +312,31 @@ static void texel_direct(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng 
     }
 }
 
-void lm_ref_texel_sample(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng *r, float full[3], float iim[3])
+void lm_ref_texel_sample(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng *r, lm_ref_sample *out)
 {
-    float punct[3] = {0, 0, 0}, area[3] = {0, 0, 0}, li[3] = {0, 0, 0};
+    float punct[3] = {0, 0, 0}, area[3] = {0, 0, 0};
+    tally li;
+    memset(&li, 0, sizeof li);
     texel_direct(c, f, r, punct, area);
     float u0 = lm_ref_rng_float(r), u1 = lm_ref_rng_float(r);
     lm_vec3 n = lm_v3_load(f->n), d = cosine_dir(n, u0, u1);
     float cos = lm_dot(n, d);
     if (lm_dot(d, lm_v3_load(f->ng)) > 0.0f && cos > 0.0f)
-        trace(c, r, lm_v3_load(f->org), d, cos / LM_PI_F, li); /* E += L cos / (cos / pi) = pi L */
+        trace(c, r, lm_v3_load(f->org), d, cos / LM_PI_F, ROUTE_LEFT, &li); /* E += L cos / (cos / pi) = pi L */
+    memset(out, 0, sizeof *out);
     for (int k = 0; k < 3; k++) {
-        iim[k] = area[k] + LM_PI_F * li[k];
-        full[k] = iim[k] + punct[k];
+        float all = area[k] + LM_PI_F * li.total[k]; /* the old E_iim expression: full stays bit for bit */
+        out->full[k] = all + punct[k];
+        out->part[LM_REF_DIRECT][k] = punct[k];
+        out->part[LM_REF_INDIRECT][k] = area[k] + LM_PI_F * li.part[LM_REF_INDIRECT][k];
+        out->part[LM_REF_LOST][k] = LM_PI_F * li.part[LM_REF_LOST][k];
     }
 }
 
 /* ---- pixels ---- */
 
-void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, int y, lm_ref_rng *r, float out[3])
+void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, int y, lm_ref_rng *r,
+                         lm_ref_sample *out)
 {
     lm_vec3 fwd = lm_normalize(lm_v3_load(cam->forward));
     lm_vec3 right = lm_normalize(lm_cross(fwd, lm_v3_load(cam->up)));
@@ -251,5 +345,8 @@ void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, i
     float sx = (2.0f * ((float)x + lm_ref_rng_float(r)) / (float)cam->width - 1.0f) * th * aspect;
     float sy = (1.0f - 2.0f * ((float)y + lm_ref_rng_float(r)) / (float)cam->height) * th;
     lm_vec3 d = lm_normalize(lm_add(fwd, lm_add(lm_scale(right, sx), lm_scale(up, sy))));
-    trace(c, r, lm_v3_load(cam->eye), d, 0.0f, out);
+    tally t;
+    trace(c, r, lm_v3_load(cam->eye), d, 0.0f, ROUTE_EYE, &t);
+    memcpy(out->full, t.total, sizeof out->full);
+    memcpy(out->part, t.part, sizeof out->part);
 }

@@ -1,5 +1,6 @@
 /* The reference solver's estimators: one path-traced sample of a texel's irradiance or of a pixel's
- * radiance (reference.h says what they estimate). Internal to src/trace. */
+ * radiance, split by light path into the parts reference.h and docs/reference.md ("Which part carries
+ * which light") define. Internal to src/trace. */
 #ifndef LM_REF_PATHS_H
 #define LM_REF_PATHS_H
 
@@ -35,10 +36,31 @@ typedef struct {
     float albedo[3];
 } lm_ref_frame;
 
+/* The parts the backward tracer estimates (the caustic part is the light tracer's, ref_caustic.h). A
+ * texel sample fills DIRECT, INDIRECT (E_iim) and LOST; a pixel sample any of them. */
+enum {
+    LM_REF_EMISSION = 0,   /* the receiver's own emission towards the eye (pixels) */
+    LM_REF_DIRECT,         /* point, spot and directional lights straight at the receiver */
+    LM_REF_INDIRECT,       /* emitters seen directly, and all light whose first vertex past the receiver is
+                            * not specular: E_iim for texels */
+    LM_REF_REFLECTIONS,    /* all light along a camera ray whose first hit is mirror or glass (pixels) */
+    LM_REF_LOST,           /* light gathered past a specular chain that leaves the receiver (L..D S+ receiver) */
+    LM_REF_BACKWARD_PARTS
+};
+
+/* One sample. full is every contribution the path tracer keeps, summed in path order (in a scene
+ * without mirror or glass bit for bit what the solver gave before the split); the parts add up to it
+ * to float rounding. */
+typedef struct {
+    float full[3];
+    float part[LM_REF_BACKWARD_PARTS][3];
+} lm_ref_sample;
+
 void lm_ref_texel_frame(const lm_ref_ctx *c, const lm_texel *t, lm_ref_frame *f);
-/* One sample of E_full and E_iim at a texel. */
-void lm_ref_texel_sample(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng *r, float full[3], float iim[3]);
+/* One sample of a texel's irradiance. */
+void lm_ref_texel_sample(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng *r, lm_ref_sample *out);
 /* One sample of the radiance through pixel (x, y), jittered inside the pixel. */
-void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, int y, lm_ref_rng *r, float out[3]);
+void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, int y, lm_ref_rng *r,
+                         lm_ref_sample *out);
 
 #endif

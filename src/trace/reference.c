@@ -9,6 +9,7 @@
 #include "../core/timing.h"
 #include "../core/vecmath.h"
 #include "ref_cache.h"
+#include "ref_caustic.h"
 #include "ref_paths.h"
 
 #define LM_REF_DARK_FLOOR 0.01    /* relative errors are taken against max(mean, 1% of the mean entry) */
@@ -24,6 +25,7 @@ void lm_ref_settings_default(lm_ref_settings *s)
     s->seed = 1;
     s->max_depth = 64;
     s->rr_depth = 3;
+    s->caustic_photons = LM_REF_CAUSTIC_PHOTONS;
     s->use_cache = 1;
     s->progress = 1;
 }
@@ -34,20 +36,24 @@ static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.
 
 typedef struct {
     uint32_t n;
-    double mean[2], m2[2];  /* Welford over the luminance of E_full [0] and E_iim [1] */
-    double sum[2][3];       /* RGB sums */
+    double mean[2], m2[2];  /* Welford over the luminance of E_full [0] and E_iim [1] (texels) */
+    double full[3];         /* RGB sums */
+    double part[LM_REF_BACKWARD_PARTS][3];
 } entry_stat;
 
-static void stat_add(entry_stat *st, const float full[3], const float iim[3])
+static void stat_add(entry_stat *st, const lm_ref_sample *smp)
 {
-    const float *v[2] = {full, iim};
+    const float *v[2] = {smp->full, smp->part[LM_REF_INDIRECT]};
     st->n++;
     for (int w = 0; w < 2; w++) {
         double rgb[3] = {v[w][0], v[w][1], v[w][2]}, x = lum(rgb), d = x - st->mean[w];
         st->mean[w] += d / st->n;
         st->m2[w] += d * (x - st->mean[w]); /* Welford: M2 += (x - mean_old)(x - mean_new) */
-        for (int c = 0; c < 3; c++)
-            st->sum[w][c] += rgb[c];
+    }
+    for (int c = 0; c < 3; c++) {
+        st->full[c] += smp->full[c];
+        for (int p = 0; p < LM_REF_BACKWARD_PARTS; p++)
+            st->part[p][c] += smp->part[p][c];
     }
 }
 
@@ -72,21 +78,21 @@ typedef struct {
     const lm_ref_ctx *c;
     const lm_ref_settings *set;
     const lm_ref_frame *frames;  /* texels, else NULL */
+    const lm_atlas *atlas;       /* texels, else NULL */
     const lm_ref_camera *cam;    /* pixels, else NULL */
     uint32_t count;
     entry_stat *st;
 } job;
 
-static void sample_entry(const job *j, uint32_t i, uint32_t k, float full[3], float iim[3])
+static void sample_entry(const job *j, uint32_t i, uint32_t k, lm_ref_sample *out)
 {
     lm_ref_rng r;
     lm_ref_rng_seed(&r, j->set->seed, i, k);
-    if (j->frames) {
-        lm_ref_texel_sample(j->c, &j->frames[i], &r, full, iim);
-        return;
-    }
-    lm_ref_pixel_sample(j->c, j->cam, (int)(i % (uint32_t)j->cam->width), (int)(i / (uint32_t)j->cam->width), &r, full);
-    memcpy(iim, full, 3 * sizeof(float));
+    if (j->frames)
+        lm_ref_texel_sample(j->c, &j->frames[i], &r, out);
+    else
+        lm_ref_pixel_sample(j->c, j->cam, (int)(i % (uint32_t)j->cam->width), (int)(i / (uint32_t)j->cam->width), &r,
+                            out);
 }
 
 /* Paths for an entry this pass: `samples`, growing to n / 4 for entries that keep sampling (a few
@@ -108,9 +114,9 @@ static void run_pass(const job *j, const uint32_t *active, uint32_t na)
             entry_stat *st = &j->st[active[a]];
             uint32_t batch = batch_size(j->set, st->n);
             for (uint32_t s = 0; s < batch; s++) {
-                float full[3], iim[3];
-                sample_entry(j, active[a], st->n, full, iim);
-                stat_add(st, full, iim);
+                lm_ref_sample smp;
+                sample_entry(j, active[a], st->n, &smp);
+                stat_add(st, &smp);
             }
         }
     }
@@ -159,33 +165,35 @@ static void adaptive(const job *j, uint32_t *active)
 
 /* ---- results ---- */
 
-static lm_status alloc_result(lm_ref_result *r, uint32_t count, int texels, lm_error *err)
+/* An entry's parts: the path tracer's means, and the light tracer's caustic, which full takes in. */
+static void entry_result(const job *j, uint32_t i, const float *caustic, lm_ref_result *r)
 {
-    size_t n = count ? count : 1;
-    r->count = count;
-    r->full = malloc(n * 3 * sizeof(float));
-    r->iim = texels ? malloc(n * 3 * sizeof(float)) : NULL;
-    r->radiance = texels ? malloc(n * 3 * sizeof(float)) : NULL;
-    r->samples = malloc(n * sizeof(uint32_t));
-    r->rel_se = malloc(n * sizeof(float));
-    if (!r->full || !r->samples || !r->rel_se || (texels && (!r->iim || !r->radiance)))
-        return lm_fail(err, LM_ERR_NOMEM, "no memory for %u reference values", count);
-    return LM_OK;
+    const entry_stat *st = &j->st[i];
+    double inv = st->n ? 1.0 / st->n : 0.0;
+    size_t at = 3 * (size_t)i;
+    for (int c = 0; c < 3; c++) {
+        r->full[at + c] = (float)(st->full[c] * inv + (double)caustic[at + c]);
+        r->caustic[at + c] = caustic[at + c];
+        r->direct[at + c] = (float)(st->part[LM_REF_DIRECT][c] * inv);
+        r->lost[at + c] = (float)(st->part[LM_REF_LOST][c] * inv);
+        if (j->frames) {
+            r->iim[at + c] = (float)(st->part[LM_REF_INDIRECT][c] * inv);
+            r->radiance[at + c] = j->frames[i].albedo[c] / LM_PI_F * r->full[at + c];
+        } else {
+            r->emission[at + c] = (float)(st->part[LM_REF_EMISSION][c] * inv);
+            r->indirect[at + c] = (float)(st->part[LM_REF_INDIRECT][c] * inv);
+            r->reflections[at + c] = (float)(st->part[LM_REF_REFLECTIONS][c] * inv);
+        }
+    }
 }
 
-static void finish(const job *j, lm_ref_result *r)
+static void finish(const job *j, const float *caustic, lm_ref_result *r)
 {
     double floor = dark_floor(j), sum_err = 0.0;
     for (uint32_t i = 0; i < j->count; i++) {
         const entry_stat *st = &j->st[i];
-        double inv = st->n ? 1.0 / st->n : 0.0, e = entry_error(st, j->frames != NULL, floor);
-        for (int c = 0; c < 3; c++) {
-            r->full[3 * i + c] = (float)(st->sum[0][c] * inv);
-            if (j->frames) {
-                r->iim[3 * i + c] = (float)(st->sum[1][c] * inv);
-                r->radiance[3 * i + c] = j->frames[i].albedo[c] / LM_PI_F * r->full[3 * i + c];
-            }
-        }
+        double e = entry_error(st, j->frames != NULL, floor);
+        entry_result(j, i, caustic, r);
         r->samples[i] = st->n;
         r->rel_se[i] = (float)e;
         r->total_samples += st->n;
@@ -203,10 +211,25 @@ static lm_status check_settings(const lm_ref_settings *set, lm_error *err)
         return lm_fail(err, LM_ERR_INVALID,
                        "reference: invalid settings (target error %g, %d samples per pass, at most %d)",
                        (double)set->target_error, set->samples, set->max_samples);
+    if (set->caustic_photons < 1 || set->caustic_photons > (1u << 24))
+        return lm_fail(err, LM_ERR_INVALID, "reference: caustic photons per pair must be 1 to 16777216, not %u",
+                       set->caustic_photons);
     return LM_OK;
 }
 
-/* Runs the adaptive solver for a prepared job, with the cache around it. */
+/* The light tracer's caustic part of every entry into caustic (3 per entry). */
+static lm_status caustic_part(const job *j, float *caustic, lm_ref_result *r, lm_error *err)
+{
+    double t0 = lm_now();
+    lm_status st = j->frames ? lm_ref_caustic_texels(j->c, j->atlas, j->set, caustic, &r->caustic_photons, err)
+                             : lm_ref_caustic_pixels(j->c, j->cam, j->set, caustic, &r->caustic_photons, err);
+    r->caustic_seconds = lm_now() - t0;
+    if (st == LM_OK && r->caustic_photons && j->set->progress)
+        lm_info("reference: %llu caustic photons, %.1f s", (unsigned long long)r->caustic_photons, r->caustic_seconds);
+    return st;
+}
+
+/* Runs the adaptive solver for a prepared job, then the caustic part, with the cache around them. */
 static lm_status solve(job *j, uint32_t kind, uint64_t key, int width, int height, lm_ref_result *out, lm_error *err)
 {
     char path[1200];
@@ -218,19 +241,26 @@ static lm_status solve(job *j, uint32_t kind, uint64_t key, int width, int heigh
     memset(out, 0, sizeof *out);
     out->width = width, out->height = height, out->key = key;
     double t0 = lm_now();
-    j->st = calloc(j->count ? j->count : 1, sizeof *j->st);
-    uint32_t *active = malloc((j->count ? j->count : 1) * sizeof *active);
-    lm_status st = j->st && active ? alloc_result(out, j->count, kind == LM_REF_KIND_TEXELS, err)
-                                   : lm_fail(err, LM_ERR_NOMEM, "no memory for the reference solver");
+    size_t n = j->count ? j->count : 1;
+    j->st = calloc(n, sizeof *j->st);
+    uint32_t *active = malloc(n * sizeof *active);
+    float *caustic = malloc(n * 3 * sizeof *caustic);
+    lm_status st = j->st && active && caustic && lm_ref_result_alloc(out, j->count, kind == LM_REF_KIND_TEXELS)
+                       ? LM_OK
+                       : lm_fail(err, LM_ERR_NOMEM, "no memory for %u reference values", j->count);
     if (st == LM_OK) {
         adaptive(j, active);
-        finish(j, out);
+        st = caustic_part(j, caustic, out, err);
+    }
+    if (st == LM_OK) {
+        finish(j, caustic, out);
         out->seconds = lm_now() - t0;
         if (j->set->use_cache)
             lm_ref_cache_store(path, kind, out);
     } else {
         lm_ref_result_free(out);
     }
+    free(caustic);
     free(active);
     free(j->st);
     j->st = NULL;
@@ -256,7 +286,7 @@ lm_status lm_reference_texels(const lm_scene *s, const lm_atlas *atlas, const lm
     }
     for (uint32_t i = 0; i < atlas->texel_count; i++)
         lm_ref_texel_frame(&c, &atlas->texels[i], &frames[i]);
-    job j = {&c, &fixed, frames, NULL, atlas->texel_count, NULL};
+    job j = {&c, &fixed, frames, atlas, NULL, atlas->texel_count, NULL};
     st = solve(&j, LM_REF_KIND_TEXELS, lm_ref_key_texels(s, atlas, &fixed), atlas->width, atlas->height, out, err);
     free(frames);
     lm_ref_ctx_free(&c);
@@ -288,17 +318,53 @@ lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitt
     lm_ref_ctx c;
     if ((st = lm_ref_ctx_init(&c, s, rt, em, &fixed, err)) != LM_OK)
         return st;
-    job j = {&c, &fixed, NULL, cam, (uint32_t)cam->width * (uint32_t)cam->height, NULL};
+    job j = {&c, &fixed, NULL, NULL, cam, (uint32_t)cam->width * (uint32_t)cam->height, NULL};
     st = solve(&j, LM_REF_KIND_PIXELS, lm_ref_key_pixels(s, cam, &fixed), cam->width, cam->height, out, err);
     lm_ref_ctx_free(&c);
     return st;
 }
 
+int lm_ref_result_arrays(lm_ref_result *r, int texels, float **arrays[LM_REF_MAX_ARRAYS])
+{
+    int n = 0;
+    arrays[n++] = &r->full;
+    arrays[n++] = &r->direct;
+    arrays[n++] = &r->caustic;
+    arrays[n++] = &r->lost;
+    if (texels) {
+        arrays[n++] = &r->iim;
+        arrays[n++] = &r->radiance;
+    } else {
+        arrays[n++] = &r->emission;
+        arrays[n++] = &r->indirect;
+        arrays[n++] = &r->reflections;
+    }
+    return n;
+}
+
+int lm_ref_result_alloc(lm_ref_result *r, uint32_t count, int texels)
+{
+    size_t n = count ? count : 1;
+    float **arrays[LM_REF_MAX_ARRAYS];
+    int k = lm_ref_result_arrays(r, texels, arrays), ok = 1;
+    r->count = count;
+    for (int i = 0; i < k; i++)
+        ok &= (*arrays[i] = malloc(n * 3 * sizeof(float))) != NULL;
+    r->samples = malloc(n * sizeof(uint32_t));
+    r->rel_se = malloc(n * sizeof(float));
+    return ok && r->samples && r->rel_se;
+}
+
 void lm_ref_result_free(lm_ref_result *r)
 {
-    free(r->full);
-    free(r->iim);
-    free(r->radiance);
+    float **arrays[LM_REF_MAX_ARRAYS];
+    for (int k = 0; k < 2; k++) { /* a result of either kind: every array it may hold */
+        int n = lm_ref_result_arrays(r, k, arrays);
+        for (int i = 0; i < n; i++) {
+            free(*arrays[i]);
+            *arrays[i] = NULL;
+        }
+    }
     free(r->samples);
     free(r->rel_se);
     memset(r, 0, sizeof *r);

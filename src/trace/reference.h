@@ -1,30 +1,49 @@
 /* The reference solver: brute-force Monte Carlo path tracing (Embree), the ground truth for every
  * error figure lmgi reports (docs/reference.md).
  *
- * Per lightmap texel it estimates
- *   E_full  irradiance from all light arriving at the texel (W/m^2 in the scene's linear units);
- *   E_iim   what an indirect illumination map holds (DESIGN.md): E_full minus the direct light of
- *           point, spot and directional lights, i.e. all bounced light plus the direct light of
- *           emissive surfaces;
- *   L       the texel's outgoing radiance albedo / pi x E_full (what an AIM approximates).
- * Per pixel of a camera it estimates the radiance arriving at the eye (direct light included).
+ * The light at a receiver is split by the path it came along, so that every pass of the runtime is
+ * checked against its own part (docs/reference.md, "Which part carries which light"). A vertex is
+ * specular when its material is mirror or glass. The receiver is the texel's point, or for a pixel the
+ * first non-specular vertex the eye ray reaches with no specular vertex before it.
+ *   direct       point, spot and directional lights straight at the receiver;
+ *   caustic      light that left an emitter (any kind), met only specular vertices and reached the
+ *                receiver (L S+ D); estimated only by light tracing (ref_caustic.h), the path tracer
+ *                drops these paths;
+ *   lost         light that reaches the receiver through one or more specular vertices whose chain
+ *                starts at a non-specular vertex v: everything gathered at v and beyond (v's own
+ *                emission is the caustic part's). The runtime carries it in no pass (its hemicubes draw
+ *                mirror and glass black); reported so that its size is known;
+ *   iim          (texels) the rest: emitters seen straight from the receiver, and all light whose first
+ *                vertex past the receiver is not specular, however it got there;
+ *   pixels       emission (the receiver's own, towards the eye), direct and indirect (the iim-like rest)
+ *                times the receiver's BSDF, caustic, lost, and reflections: all the light along an eye
+ *                ray whose first hit is specular (path-traced; a point light's caustic seen in a mirror
+ *                is a path of probability 0 both ways and is missing).
+ * Per texel: E_full = direct + iim + caustic + lost (W/m^2 in the scene's linear units), E_iim = the iim
+ * part (what an indirect illumination map holds), L = albedo / pi x E_full (what an AIM approximates).
+ * Per pixel: full = the sum of its six parts (radiance).
  *
  * Estimator: from the texel's position lifted along its geometric normal by 1e-5 x the scene size,
  * over the hemisphere of its shading normal: next-event estimation to every emitter (the punctual ones
  * exactly, emissive surfaces with one light sample each, combined with BSDF sampling by multiple
  * importance sampling, power heuristic), then one cosine-weighted ray continued as a path with NEE
  * and MIS at every non-specular vertex, specular bounces through mirror and glass, and Russian
- * roulette from bounce `rr_depth` on (survival lm_bsdf_survival).
+ * roulette from bounce `rr_depth` on (survival lm_bsdf_survival). Each contribution goes to the part the
+ * path's route says; the route draws no numbers, so in a scene without mirror or glass every path and
+ * E_full, E_iim and the pixels are bit for bit what the solver gave before the split. The caustic part:
+ * `caustic_photons` photons per (emitter, specular node) pair, traced forward (ref_caustic.h).
  *
  * Adaptive sampling: passes of `samples` paths per active texel (pixel); per entry a running mean and
  * variance (Welford) of the luminance; an entry stops when its relative standard error
  * se / max(mean, floor) is at most `target_error` (for texels: for E_full and E_iim both), with
  * floor = 1% of the mean luminance over all entries (so black texels stop too), after at least
- * `min_samples`, or at `max_samples`.
+ * `min_samples`, or at `max_samples`. The rule reads the path tracer's part of E_full (the caustic
+ * part has a fixed photon count and is added after).
  *
  * Determinism: the random numbers of sample k of entry i come from a counter-based generator seeded by
- * (seed, i, k); each entry is summed by one thread in sample order, and the stopping rule reads sums
- * in a fixed order, so results are bit-identical whatever the thread count.
+ * (seed, i, k), those of caustic photon k of pair p by (seed, LM_REF_CAUSTIC_STREAM + p, k); each entry
+ * is summed by one thread in sample order, photons are added up in photon order, and the stopping rule
+ * reads sums in a fixed order, so results are bit-identical whatever the thread count.
  *
  * Cache: results are stored in `cache_dir` (default $LMGI_CACHE, else build/reference-cache) under a
  * 64-bit FNV-1a key of the scene's geometry, materials, textures, lights and node matrices, the texel
@@ -50,10 +69,16 @@ typedef struct {
     uint32_t seed;         /* default 1 */
     int max_depth;         /* bounces at most (default 64) */
     int rr_depth;          /* Russian roulette from this bounce on (default 3) */
+    uint32_t caustic_photons; /* light-traced photons per (emitter, specular node) pair, 1 to 2^24
+                               * (default LM_REF_CAUSTIC_PHOTONS) */
     const char *cache_dir; /* NULL: $LMGI_CACHE, else "build/reference-cache" */
     int use_cache;         /* read and write the cache (default 1) */
     int progress;          /* log progress through lm_info every few seconds (default 1) */
 } lm_ref_settings;
+
+/* The caustic part's default photons per pair: scenes/cornell.glb's one pair in about a second on two
+ * cores, its texels' caustic within a few percent (docs/reference.md, "Settings and their cost"). */
+#define LM_REF_CAUSTIC_PHOTONS (1u << 20)
 
 void lm_ref_settings_default(lm_ref_settings *s);
 
@@ -68,15 +93,24 @@ typedef struct {
 typedef struct {
     uint32_t count;        /* entries: texels (the atlas's texel order) or pixels (row 0 at the top) */
     int width, height;     /* atlas or picture size */
-    float *full;           /* 3 per entry: E_full for texels, radiance for pixels */
-    float *iim;            /* 3 per entry: E_iim (texels only, else NULL) */
-    float *radiance;       /* 3 per entry: albedo / pi x E_full (texels only, else NULL) */
+    /* 3 floats per entry each; texels irradiance, pixels radiance. NULL where the kind has no such part. */
+    float *full;           /* everything: the sum of the parts below (E_full for texels) */
+    float *iim;            /* texels: E_iim, the iim part; pixels: NULL */
+    float *radiance;       /* texels: albedo / pi x E_full; pixels: NULL */
+    float *direct;         /* punctual lights straight at the receiver (pixels: times its BSDF) */
+    float *caustic;        /* L S+ D, light-traced */
+    float *lost;           /* past a specular chain that starts at a non-specular vertex */
+    float *emission;       /* pixels: the receiver's own emission; texels: NULL */
+    float *indirect;       /* pixels: the iim-like rest times the BSDF; texels: NULL (iim is it) */
+    float *reflections;    /* pixels: all light along eye rays whose first hit is mirror or glass; texels: NULL */
     uint32_t *samples;     /* paths per entry */
     float *rel_se;         /* achieved relative standard error per entry (the larger of full and iim) */
     uint64_t total_samples;
     double mean_rel_se, max_rel_se;
     uint32_t converged;    /* entries that reached target_error (the others hit max_samples) */
-    double seconds;        /* time spent computing (the original run's time when from the cache) */
+    double seconds;        /* time spent computing, caustic part included (the original run's when cached) */
+    uint64_t caustic_photons; /* photons the caustic part traced (pairs x caustic_photons; 0 without pairs) */
+    double caustic_seconds;   /* its share of `seconds` */
     int from_cache;
     uint64_t key;          /* the cache key */
 } lm_ref_result;

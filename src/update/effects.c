@@ -109,58 +109,68 @@ static void decide_indirect(const lm_scene *s, lm_effects *e)
                  s->nodes[first_emitter].name, receivers, receivers == 1 ? "" : "s");
 }
 
-/* Caustics and reflections both come from mirror and glass materials. */
+/* "1 mirror material on node 'x'", "1 mirror and 2 glass materials (the first on node 'x')": the classes'
+ * materials where an effect is on; returns their count. */
+static int describe_materials(const lm_scene *s, const usage *u, const char *const *kinds, int n, char *out,
+                              size_t size)
+{
+    char what[160] = "";
+    int total = 0, first = -1;
+    for (int k = 0; k < n; k++) {
+        if (!u[k].materials_on)
+            continue;
+        snprintf(what + strlen(what), sizeof what - strlen(what), "%s%d %s", what[0] ? " and " : "",
+                 u[k].materials_on, kinds[k]);
+        total += u[k].materials_on;
+        first = first < 0 ? u[k].first_node_on : first;
+    }
+    if (total == 1)
+        snprintf(out, size, "%s material on node '%s'", what, s->nodes[first].name);
+    else if (total)
+        snprintf(out, size, "%s materials (the first on node '%s')", what, s->nodes[first].name);
+    return total;
+}
+
+/* The first node of the classes' materials where an effect is switched off (-1: none). */
+static int first_off(const usage *u, int n)
+{
+    for (int k = 0; k < n; k++)
+        if (u[k].first_node_off >= 0)
+            return u[k].first_node_off;
+    return -1;
+}
+
+/* Caustics come from mirror and glass materials that a light reaches, reflections from mirror, glossy and
+ * glass ones. */
 static void decide_specular(const lm_scene *s, lm_effects *e)
 {
-    usage glass = count_usage(s, LM_MAT_GLASS, LM_EFFECT_CAUSTICS);
-    usage mirror = count_usage(s, LM_MAT_MIRROR, LM_EFFECT_CAUSTICS);
-    int on = glass.materials_on + mirror.materials_on, off_count = glass.materials_off + mirror.materials_off;
-    int node = glass.first_node_on >= 0 ? glass.first_node_on : mirror.first_node_on;
-    char what[160] = "";
-    if (glass.materials_on && mirror.materials_on)
-        snprintf(what, sizeof what, "%d glass and %d mirror material%s", glass.materials_on, mirror.materials_on,
-                 mirror.materials_on == 1 ? "" : "s");
-    else if (on)
-        snprintf(what, sizeof what, "%d %s material%s", on, glass.materials_on ? "glass" : "mirror",
-                 on == 1 ? "" : "s");
+    static const char *const kinds[3] = {"mirror", "glass", "glossy"};
+    const usage c[2] = {count_usage(s, LM_MAT_MIRROR, LM_EFFECT_CAUSTICS), count_usage(s, LM_MAT_GLASS, LM_EFFECT_CAUSTICS)};
     usage emit = count_usage(s, LM_MAT_EMITTER, LM_EFFECT_CAUSTICS);
     int lit = count_lights(s, -1) > 0 || emit.materials_on + emit.materials_off > 0;
-
+    char what[200];
+    int on = describe_materials(s, c, kinds, 2, what, sizeof what), off = first_off(c, 2);
     e->on[LM_EFFECT_CAUSTICS] = on > 0 && lit;
     if (on > 0 && lit)
-        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "%s on node '%s'", what, s->nodes[node].name);
+        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "%s", what);
     else if (on > 0)
         snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "no light to focus (%s)", what);
-    else if (off_count > 0)
-        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "specular material only on nodes with extras caustics: false "
-                 "(first: '%s')", s->nodes[glass.first_node_off >= 0 ? glass.first_node_off : mirror.first_node_off].name);
+    else if (off >= 0)
+        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "mirror and glass materials only on nodes with caustics "
+                 "switched off (first: '%s')", s->nodes[off].name);
     else
-        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "no specular material");
+        snprintf(e->reason[LM_EFFECT_CAUSTICS], 256, "no mirror or glass material");
 
-    /* reflections (gpu/reflections.h): environment maps for mirror and glossy nodes */
-    usage glossy = count_usage(s, LM_MAT_GLOSSY, LM_EFFECT_REFLECTIONS);
-    usage mirrors = count_usage(s, LM_MAT_MIRROR, LM_EFFECT_REFLECTIONS);
-    usage glasses = count_usage(s, LM_MAT_GLASS, LM_EFFECT_REFLECTIONS);
-    int on_count = mirrors.materials_on + glossy.materials_on + glasses.materials_on;
-    int switched = mirrors.materials_off + glossy.materials_off + glasses.materials_off;
-    const usage *first = mirrors.first_node_on >= 0 ? &mirrors : glossy.first_node_on >= 0 ? &glossy : &glasses;
-    e->on[LM_EFFECT_REFLECTIONS] = on_count > 0;
-    if (on_count > 0) { /* "1 mirror and 2 glass materials on node '...'" */
-        char what[160] = "";
-        const int counts[3] = {mirrors.materials_on, glossy.materials_on, glasses.materials_on};
-        static const char *const kinds[3] = {"mirror", "glossy", "glass"};
-        for (int k = 0; k < 3; k++)
-            if (counts[k])
-                snprintf(what + strlen(what), sizeof what - strlen(what), "%s%d %s", what[0] ? " and " : "",
-                         counts[k], kinds[k]);
-        snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "%s material%s on node '%s'", what, on_count == 1 ? "" : "s",
-                 s->nodes[first->first_node_on].name);
-    } else if (switched > 0)
+    const usage r[3] = {count_usage(s, LM_MAT_MIRROR, LM_EFFECT_REFLECTIONS),
+                        count_usage(s, LM_MAT_GLASS, LM_EFFECT_REFLECTIONS),
+                        count_usage(s, LM_MAT_GLOSSY, LM_EFFECT_REFLECTIONS)};
+    on = describe_materials(s, r, kinds, 3, e->reason[LM_EFFECT_REFLECTIONS], 256);
+    off = first_off(r, 3);
+    e->on[LM_EFFECT_REFLECTIONS] = on > 0;
+    if (!on && off >= 0)
         snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "mirror, glossy and glass materials only on nodes with "
-                 "reflections switched off (first: '%s')",
-                 s->nodes[mirrors.first_node_off >= 0 ? mirrors.first_node_off
-                          : glossy.first_node_off >= 0 ? glossy.first_node_off : glasses.first_node_off].name);
-    else
+                 "reflections switched off (first: '%s')", s->nodes[off].name);
+    else if (!on)
         snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "no mirror, glossy or glass material");
 }
 

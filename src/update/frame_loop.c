@@ -24,9 +24,17 @@ struct lm_frame_loop {
     lm_stage_worker *worker; /* with settings.overlap: runs the stage's update beside the GL work */
     lm_photon_stage_frame pending; /* detached: the stage's job begun by the last step, not yet joined */
     int pending_busy;
+    int pending_joined;            /* a sync joined it: its counts wait for the next step's report */
     lm_gather *gather;
     lm_composite *comp;
     lm_reflections *reflections; /* NULL: no mirror or glossy node, or switched off */
+    lm_caustic_pass *caustic_pass; /* made when the first caustic photons land */
+    uint64_t caustic_version;    /* the stage's caustic photons the pass holds (lm_caustics_version) */
+    int caustic_slot, caustic_w, caustic_h; /* the last picture drawn: its caustics' slot and size (w 0: none yet) */
+    uint64_t caustic_key[LM_CAUSTIC_SLOTS]; /* what each slot's last run was made for (draw_caustics) */
+    int caustic_keyed[LM_CAUSTIC_SLOTS];
+    int generators;              /* the scene has caustic generators (mirror or glass nodes, caustics on) ... */
+    uint32_t generators_version; /* ... as of this pass_version (+1: 0 is never a count yet) */
     uint32_t reflect_version;    /* the scene's pass_version the reflection maps were made for */
     uint32_t switch_version;     /* the scene's pass_version the gather's and composite's switches follow */
     /* the brute-force path: the indirect radiance of one view's pixels, and what it was computed for */
@@ -71,6 +79,8 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->camera = -1;
     s->reflection_size = 128;
     s->reflection_faces = 1;
+    s->caustics = 1;
+    lm_caustic_pass_settings_default(&s->caustic_pass);
     s->indirect = 1;
     s->indirect_path = LM_INDIRECT_LIGHTMAP;
 }
@@ -341,6 +351,7 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
     fl->set = *set;
     fl->set.stage.trace = fl->set.stage.trace && fl->set.indirect;
+    fl->set.stage.caustics = fl->set.caustics;
     fl->set.stage.aims = fl->set.stage.aims && lightmap_path(fl);
     fl->scene = w->scene;
     fl->surfaces = w->surfaces;
@@ -375,6 +386,7 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     lm_direct_free(fl->direct_light);
     lm_composite_free(fl->comp);
     lm_reflections_free(fl->reflections);
+    lm_caustic_pass_free(fl->caustic_pass);
     lm_gbuffer_free(&fl->gbuf);
     free(fl->photon_rgb);
     if (fl->have_iim)
@@ -391,15 +403,20 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     free(fl);
 }
 
+static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
+{
+    const unsigned char *b = p;
+    for (size_t k = 0; k < n; k++)
+        h = (h ^ b[k]) * 1099511628211ull;
+    return h;
+}
+
 /* A hash of every node's world matrix: the brute-force picture is made again when something moved. */
 static uint64_t world_hash(const lm_scene *s)
 {
     uint64_t h = 1469598103934665603ull;
-    for (int n = 0; n < s->node_count; n++) {
-        const unsigned char *b = (const unsigned char *)s->nodes[n].world;
-        for (size_t k = 0; k < sizeof s->nodes[n].world; k++)
-            h = (h ^ b[k]) * 1099511628211ull;
-    }
+    for (int n = 0; n < s->node_count; n++)
+        h = hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
     return h;
 }
 
@@ -445,24 +462,101 @@ static lm_status add_photon_indirect(lm_frame_loop *fl, const lm_view *view, int
     return LM_OK;
 }
 
-/* The step's own frame's view, and with the brute-force path its photon picture, made while the store is
- * quiet (before the stage's worker starts: the frame shows the photons as the last stage left them). */
+/* Whether the scene has caustic generators now (from the scene, which the stage's worker does not write:
+ * its caustic photons may be made again on the worker meanwhile). */
+static int has_generators(lm_frame_loop *fl)
+{
+    if (!fl->set.caustics)
+        return 0;
+    if (fl->generators_version != fl->scene->pass_version + 1) {
+        lm_caustic_generator *g = NULL;
+        lm_error err;
+        int n = 1; /* out of memory: taken as there being some (a sync too many, never one too few) */
+        if (lm_caustic_generators(fl->scene, &g, &n, &err) == LM_OK)
+            free(g);
+        fl->generators = n > 0;
+        fl->generators_version = fl->scene->pass_version + 1;
+    }
+    return fl->generators;
+}
+
+/* The stage's caustic photons into the caustic pass when they changed since, the pass made when the first
+ * ones land. Reads the stage's photons: while its worker is quiet. */
+static lm_status upload_caustics(lm_frame_loop *fl, lm_error *err)
+{
+    const lm_caustics *c = lm_photon_stage_caustics(fl->stage);
+    if (!c || lm_caustics_version(c) == fl->caustic_version || (!fl->caustic_pass && !lm_caustics_landed(c)))
+        return LM_OK;
+    lm_status st = fl->caustic_pass ? LM_OK : lm_caustic_pass_create(&fl->set.caustic_pass, &fl->caustic_pass, err);
+    if (st == LM_OK)
+        st = lm_caustic_pass_set_photons(fl->caustic_pass, lm_caustics_hits(c), lm_caustics_photon_count(c), err);
+    if (st == LM_OK)
+        fl->caustic_version = lm_caustics_version(c);
+    return st;
+}
+
+/* The step's own frame's view, its caustic photons, and with the brute-force path its photon picture, made
+ * while the store is quiet (before the stage's worker starts: the frame shows the photons as the last
+ * stage left them). */
 static lm_status prepare_frame(lm_frame_loop *fl, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
     if (w <= 0)
         return LM_OK;
+    lm_status st = upload_caustics(fl, err);
+    if (st != LM_OK)
+        return st;
     lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
     if (!photon_path(fl))
         return LM_OK;
     return photon_indirect(fl, &fl->view, w, h, err);
 }
 
+/* What lights the scene besides the lightmaps, as the environment maps' dirty tracking compares it: the
+ * emitters' placement and power, the materials' edits, the caustic photons. */
+static uint64_t lighting_hash(const lm_frame_loop *fl)
+{
+    const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
+    uint64_t h = 1469598103934665603ull;
+    for (int e = 0; e < em->count; e++) {
+        const lm_emitter *x = &em->e[e];
+        const float *parts[4] = {x->pos, x->dir, x->radiant, x->power};
+        for (int k = 0; k < 4; k++)
+            h = hash_bytes(h, parts[k], 3 * sizeof(float));
+    }
+    h = hash_bytes(h, &fl->scene->material_version, sizeof fl->scene->material_version);
+    return hash_bytes(h, &fl->caustic_version, sizeof fl->caustic_version);
+}
+
+/* The caustics of a picture drawn by lm_direct_draw (the step's own frame keeps its caustics apart, for
+ * lm_frame_loop_read_caustics). The splat, queries and filter are skipped, the composite alone drawn
+ * again, when the photons, the view and every node are as for the slot's last run: nothing it depends on
+ * changed. */
+static lm_status draw_caustics(lm_frame_loop *fl, lm_caustic_pass *cp, int own, const lm_view *view, int w, int h,
+                               lm_frame_stats *o, lm_error *err)
+{
+    int slot = own ? LM_CAUSTIC_SLOT_FRAME : LM_CAUSTIC_SLOT_VIEW;
+    uint64_t key = world_hash(fl->scene);
+    key = hash_bytes(key, view->view, sizeof view->view);
+    key = hash_bytes(key, view->proj, sizeof view->proj);
+    key = hash_bytes(key, &fl->caustic_version, sizeof fl->caustic_version);
+    const int size[2] = {w, h};
+    key = hash_bytes(key, size, sizeof size);
+    if (fl->caustic_key[slot] == key && fl->caustic_keyed[slot])
+        return lm_caustic_pass_composite(cp, slot, view, fl->direct_light, -1, &o->caustic, err);
+    lm_status st = lm_caustic_pass_run(cp, slot, view, lm_direct_depth_texture(fl->direct_light, 0), w, h,
+                                       fl->direct_light, -1, &o->caustic, err);
+    fl->caustic_key[slot] = key;
+    fl->caustic_keyed[slot] = st == LM_OK;
+    return st;
+}
+
 /* The composite's indirect term (E_IIM / pi, premultiplied over the atlas), the environment map faces
- * due this frame, then the direct light, whose first pass adds kd x that term at each visible surface's
- * lightmap uv (shadow maps re-rendered only when stale), the reflections over it: one frame-sized
- * read-back. */
-static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int h, float *rgb, int step,
+ * due this frame (when `step`), then the direct light, whose first pass adds kd x that term at each
+ * visible surface's lightmap uv (shadow maps re-rendered only when stale), the caustics over its depth,
+ * the reflections over it: one frame-sized read-back. `own`: the step's own frame (its caustics are kept
+ * for lm_frame_loop_read_caustics), else another view. */
+static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int h, float *rgb, int own, int step,
                              lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
@@ -473,18 +567,33 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
     const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
-    if (st == LM_OK && step) /* the faces due this step; an extra view shows the maps as they are */
-        st = lm_reflections_update(fl->reflections, fl->direct_light, fl->scene, em, err);
+    lm_caustic_pass *caustics = fl->caustic_pass && lm_caustic_pass_photon_count(fl->caustic_pass) ? fl->caustic_pass
+                                                                                                  : NULL;
+    if (st == LM_OK && step) { /* the faces due this step; an extra view shows the maps as they are */
+        lm_reflection_inputs in = {fl->surfaces, lightmap_path(fl) ? fl->iim.version : NULL, lighting_hash(fl),
+                                   caustics};
+        st = lm_reflections_update(fl->reflections, fl->direct_light, fl->scene, em, &in, &o->cube_faces, err);
+    }
+    double t2 = lm_now();
     if (st == LM_OK)
         st = lm_direct_draw(fl->direct_light, fl->scene, em, view, w, h, err);
+    double t3 = lm_now();
+    if (st == LM_OK && caustics)
+        st = draw_caustics(fl, caustics, own, view, w, h, o, err);
+    fl->caustic_slot = own ? LM_CAUSTIC_SLOT_FRAME : LM_CAUSTIC_SLOT_VIEW;
+    fl->caustic_w = w, fl->caustic_h = h;
+    double t4 = lm_now();
     if (st == LM_OK)
-        st = lm_reflections_draw(fl->reflections, fl->direct_light, view, err);
+        st = lm_reflections_draw(fl->reflections, fl->direct_light, fl->scene, view, err);
+    double t5 = lm_now();
     if (st == LM_OK)
         st = lm_direct_read(fl->direct_light, rgb, err);
     if (st == LM_OK && photon_path(fl))
         st = add_photon_indirect(fl, view, w, h, rgb, err);
     o->t_composite = t1 - t0;
-    o->t_direct = lm_now() - t1;
+    o->t_caustics = t4 - t3;
+    o->t_reflections = (t2 - t1) + (t5 - t4);
+    o->t_direct = (t3 - t2) + (lm_now() - t5);
     return st;
 }
 
@@ -494,7 +603,7 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     int w = fl->set.width, h = fl->set.height;
     if (w <= 0)
         return LM_OK;
-    return render_view(fl, &fl->view, w, h, fl->image, 1, o, err); /* fl->view: prepare_frame's */
+    return render_view(fl, &fl->view, w, h, fl->image, 1, 1, o, err); /* fl->view: prepare_frame's */
 }
 
 lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width, int height, float *rgb,
@@ -503,13 +612,20 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
     lm_status st = lm_gl_make_current(fl->gl, err);
     if (st == LM_OK)
         st = setup_render(fl, err);
-    if (st == LM_OK && photon_path(fl) &&
-        (st = lm_frame_loop_sync(fl, err)) == LM_OK) /* the gather reads the store the worker writes */
+    /* the photon gather and the caustic photons read what the worker writes. A loop that draws frames of
+     * its own shows the caustic photons its last frame showed (the step's lighting); one that draws none
+     * takes the newest, waiting for the work that traces them */
+    int newest = fl->set.width <= 0 && has_generators(fl);
+    if (st == LM_OK && (photon_path(fl) || newest))
+        st = lm_frame_loop_sync(fl, err);
+    if (st == LM_OK && newest)
+        st = upload_caustics(fl, err);
+    if (st == LM_OK && photon_path(fl))
         st = photon_indirect(fl, view, width, height, err);
     lm_frame_stats o;
     /* the environment maps' faces due are refreshed by the steps' own frames; without those, here */
     int refresh = fl->set.width <= 0;
-    return st == LM_OK ? render_view(fl, view, width, height, rgb, refresh, &o, err) : st;
+    return st == LM_OK ? render_view(fl, view, width, height, rgb, 0, refresh, &o, err) : st;
 }
 
 /* This frame's texels (after adding the viewers of refreshed AIMs), and the uploads the gather needs. */
@@ -597,13 +713,19 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
     return st;
 }
 
-/* Waits for the stage's job a detached step left running; `done` (may be NULL) gets its counts. */
+/* Waits for the stage's job a detached step left running; `done` (may be NULL) gets its counts, or, when
+ * a sync joined it before (lm_frame_loop_sync), that job's counts, which the step reports. */
 static lm_status join_stage(lm_frame_loop *fl, lm_photon_stage_frame *done, lm_error *err)
 {
-    if (!fl->pending_busy)
+    if (!fl->pending_busy) {
+        if (done && fl->pending_joined)
+            *done = fl->pending;
+        fl->pending_joined = fl->pending_joined && !done;
         return LM_OK;
+    }
     lm_status st = lm_stage_worker_end(fl->worker, err);
     fl->pending_busy = 0;
+    fl->pending_joined = !done;
     if (fl->pending.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
     if (done)
@@ -628,8 +750,10 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     /* the counts and times of the stage's work that finished in this step (begun by the last one) */
     o->stage.photons = done.photons;
     o->stage.aim = done.aim;
+    o->stage.caustics = done.caustics;
     o->stage.t_photons = done.t_photons;
     o->stage.t_aim = done.t_aim;
+    o->stage.t_caustics = done.t_caustics;
     if (st == LM_OK)
         st = schedule(fl, o, err);
     double t1 = lm_now();
@@ -819,4 +943,23 @@ lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *
     free(fresh);
     free(pending);
     return st;
+}
+
+void lm_frame_loop_caustics_size(const lm_frame_loop *fl, int *width, int *height)
+{
+    *width = fl->caustic_w;
+    *height = fl->caustic_h;
+}
+
+lm_status lm_frame_loop_read_caustics(lm_frame_loop *fl, float *rgb, lm_error *err)
+{
+    size_t n = 3 * (size_t)fl->caustic_w * (size_t)fl->caustic_h;
+    lm_status st = lm_gl_make_current(fl->gl, err);
+    if (st != LM_OK)
+        return st;
+    if (!fl->caustic_pass || !lm_caustic_pass_photon_count(fl->caustic_pass)) { /* none drawn: none */
+        memset(rgb, 0, n * sizeof *rgb);
+        return LM_OK;
+    }
+    return lm_caustic_pass_read_irradiance(fl->caustic_pass, fl->caustic_slot, rgb, err);
 }

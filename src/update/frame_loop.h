@@ -4,9 +4,11 @@
  *   1. photon stage (photon_stage.h): animations, photons re-traced, AIMs refreshed;
  *   2. IIMs (gpu/iim.h, gpu/hemicube.h): up to texels_per_frame texels scheduled by delta_i, gathered
  *      over the current AIMs and node transforms into the fresh IIM, then blended into the display IIM;
- *   3. composite in linear HDR, L = direct + albedo / pi * E_IIM: the indirect term premultiplied over the
- *      atlas (gpu/composite.h), added by the direct light's first pass at each visible surface's
- *      lightmap uv, then the direct light per pixel with shadows (gpu/direct.h); mirror and glass black.
+ *   3. composite in linear HDR, the paper's Eq. 6, L = L_indirect + L_caustics + L_specular + sum L_direct
+ *      shadow: the indirect term kd / pi E_IIM premultiplied over the atlas (gpu/composite.h) and added by
+ *      the direct light's first pass at each visible surface's lightmap uv, the direct light per pixel
+ *      with shadows (gpu/direct.h), the caustics filtered on screen over its depth (gpu/caustic_pass.h),
+ *      then what mirror, glass and glossy nodes reflect of their environment maps (gpu/reflections.h).
  *
  * With `overlap` (the default), step 1's tracing and AIM refresh run on a second thread while the calling
  * thread does steps 2 and 3 over the previous frame's AIMs (docs/architecture.md). A loop that draws no
@@ -20,6 +22,7 @@
 #define LM_FRAME_LOOP_H
 
 #include "../gpu/camera.h"
+#include "../gpu/caustic_pass.h"
 #include "../gpu/direct.h"
 #include "../gpu/gl_context.h"
 #include "../gpu/hemicube.h"
@@ -48,6 +51,9 @@ typedef struct {
                             * default 128; 0: no reflections) */
     int reflection_faces;  /* environment map faces re-rendered a frame, round robin, after all of them at the
                             * first frame (default 1: a map refreshed in 6 frames) */
+    int caustics;          /* 1 (default): caustic photons (stage.caustic) and the screen-space caustic pass, which
+                            * cost nothing while no mirror or glass node has its caustics switched on; 0: none */
+    lm_caustic_pass_settings caustic_pass;
     int indirect;          /* 0: no indirect light at all (no photon, AIM or gather work; the frame shows direct
                             * light, emission and reflections); default 1. stage.trace follows it */
     int indirect_path;     /* how the frame gets its indirect light: LM_INDIRECT_LIGHTMAP (default: AIMs, the
@@ -65,11 +71,13 @@ typedef struct {
 typedef struct {
     lm_photon_stage_frame stage;
     uint32_t texels_gathered;
-    /* seconds per stage: photon stage (animate + photons + AIMs), IIM gather (schedule, scene and AIM
-     * upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps, the frame's
-     * read-back; with reflections, their map faces and pass), composite (the indirect term's atlas pass);
-     * and the whole frame */
-    double t_photons, t_gather, t_blend, t_direct, t_composite, t_total;
+    lm_caustic_pass_stats caustic; /* the frame's caustic pass */
+    int cube_faces;        /* environment map faces rendered */
+    /* seconds per stage: photon stage (animate + photons + AIMs + caustic photons), IIM gather (schedule,
+     * scene and AIM upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps,
+     * the frame's read-back), caustics (the screen-space pass), reflections (map faces and their pass),
+     * composite (the indirect term's atlas pass); and the whole frame */
+    double t_photons, t_gather, t_blend, t_direct, t_caustics, t_reflections, t_composite, t_total;
 } lm_frame_stats;
 
 typedef struct lm_frame_loop lm_frame_loop;
@@ -120,14 +128,21 @@ lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progre
  * updater's time budget turns into this. */
 void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels);
 /* Renders the composited frame from `view` at width x height into rgb (width*height*3 linear floats, top
- * row first) with the lighting of the last step: lmgi_render's camera, beside the step's own frame. The
- * environment maps' faces due are refreshed here only when the steps draw no frame (width 0). */
+ * row first) with the lighting of the last step: lmgi_render's camera, beside the step's own frame. When
+ * the steps draw no frame (width 0), the environment maps' faces due are refreshed here, and the caustics
+ * are the newest photons' (the photon work the last step left running is waited for); else both are as
+ * the step's own frame showed them. */
 lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width, int height, float *rgb,
                                lm_error *err);
 /* Per surface, how many steps changed what the displayed IIM holds for it (the first full gather is 1):
  * an engine uploads a surface's lightmap again only when this moved. */
 const uint32_t *lm_frame_loop_surface_versions(const lm_frame_loop *fl);
 
+/* The caustic irradiance E of the last picture drawn (a step's own frame or lm_frame_loop_render's), its
+ * size from lm_frame_loop_caustics_size (0 x 0 before any), width*height*3 linear floats, top row first; 0
+ * where no caustic photon's filter reached, and everywhere without caustics: the picture added kd / pi x E. */
+void lm_frame_loop_caustics_size(const lm_frame_loop *fl, int *width, int *height);
+lm_status lm_frame_loop_read_caustics(lm_frame_loop *fl, float *rgb, lm_error *err);
 /* The last frame, composited (width*height*3 linear floats, top row first); the only read-back of a frame. */
 const float *lm_frame_loop_image(const lm_frame_loop *fl);
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);

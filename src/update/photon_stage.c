@@ -49,6 +49,10 @@ struct lm_photon_stage {
     lm_aim aim;
     lm_emitter_light area;       /* with have_area: the emissive triangles' closed form, for the AIMs */
     lm_direct_light direct;      /* the AIMs' direct light (set.exact_direct) */
+    lm_caustics *caustics;       /* with set.caustics */
+    uint32_t caustic_version;    /* the scene's pass_version they were made for */
+    int caustic_emitters;        /* the emitters they were made for */
+    int caustics_stale;          /* a material was edited: made again at the next update */
     int have_emitters, have_aim, have_area;
     int frame;
 };
@@ -61,6 +65,7 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     s->surfaces_per_frame = 4;
     s->trace = 1;
     s->aims = 1;
+    lm_caustic_settings_default(&s->caustic);
 }
 
 /* The AIMs take direct light from trace/direct_irradiance.h: punctual lights always, emissive triangles
@@ -139,6 +144,7 @@ static int check_materials(lm_photon_stage *ps)
     }
     if (!n)
         return 0;
+    ps->caustics_stale = 1;
     lm_photons_invalidate_materials(ps->photons, changed);
     lm_photon_store *store = lm_photons_store_mutable(ps->photons);
     for (int k = 0; k < ps->surfaces->surface_count; k++)
@@ -164,6 +170,42 @@ static lm_status check_emitters(lm_photon_stage *ps, int *moved, lm_error *err)
             return st;
     }
     return LM_OK;
+}
+
+/* The caustic photons for the scene as it is now (made again after edits that change the generators or
+ * the emitters: every photon traced). */
+static lm_status make_caustics(lm_photon_stage *ps, lm_caustic_frame_stats *st, lm_error *err)
+{
+    lm_caustics_free(ps->caustics);
+    ps->caustics = NULL;
+    ps->caustic_version = ps->scene->pass_version;
+    ps->caustic_emitters = ps->emitters.count;
+    ps->caustics_stale = 0;
+    return lm_caustics_create(ps->scene, ps->rt, &ps->emitters, &ps->set.caustic, &ps->caustics, st, err);
+}
+
+/* Whether edits changed what the caustic photons are made of: a class or switch (pass_version), an added
+ * light, an edited material. */
+static int caustics_outdated(const lm_photon_stage *ps)
+{
+    return ps->caustics_stale || ps->caustic_version != ps->scene->pass_version ||
+           ps->caustic_emitters != ps->emitters.count;
+}
+
+/* One frame of the caustic photons: made again after edits that change what they are made of, else their
+ * round robin and the pairs whose generator or emitter moved. */
+static lm_status update_caustics(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
+{
+    if (!ps->set.caustics)
+        return LM_OK;
+    double t0 = lm_now();
+    lm_status st;
+    if (caustics_outdated(ps))
+        st = make_caustics(ps, &out->caustics, err);
+    else
+        st = lm_caustics_frame(ps->caustics, &out->caustics, err);
+    out->t_caustics = lm_now() - t0;
+    return st;
 }
 
 static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_error *err)
@@ -204,8 +246,12 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);
+    double t2 = lm_now();
+    if (st == LM_OK && ps->set.caustics)
+        st = make_caustics(ps, &first->caustics, err);
     first->t_photons = t1 - t0;
-    first->t_aim = lm_now() - t1;
+    first->t_aim = t2 - t1;
+    first->t_caustics = lm_now() - t2;
     first->t_total = lm_now() - t0;
     return st;
 }
@@ -240,6 +286,7 @@ void lm_photon_stage_free(lm_photon_stage *ps)
 {
     if (!ps)
         return;
+    lm_caustics_free(ps->caustics);
     if (ps->have_aim)
         lm_aim_free(&ps->aim);
     if (ps->have_area)
@@ -304,17 +351,17 @@ static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out
 
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
-    if (!ps->set.trace)
-        return LM_OK;
     double t1 = lm_now();
-    lm_status st = lm_photons_frame(ps->photons, &out->photons, err);
+    lm_status st = ps->set.trace ? lm_photons_frame(ps->photons, &out->photons, err) : LM_OK;
     double t2 = lm_now();
-    if (st == LM_OK && ps->set.aims)
+    if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = refresh_aims(ps, ps->set.surfaces_per_frame, &out->aim, err);
     double t3 = lm_now();
+    if (st == LM_OK)
+        st = update_caustics(ps, out, err);
     out->t_photons = t2 - t1;
     out->t_aim = t3 - t2;
-    out->t_total = out->t_animate + (t3 - t1);
+    out->t_total = out->t_animate + (lm_now() - t1);
     return st;
 }
 
@@ -327,6 +374,12 @@ lm_status lm_photon_stage_step(lm_photon_stage *ps, float t, lm_photon_stage_fra
 lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err)
 {
     lm_status st = lm_photon_stage_animate(ps, t, out, err);
+    if (st == LM_OK && ps->set.caustics) { /* every caustic photon traced again */
+        double t0 = lm_now();
+        st = caustics_outdated(ps) ? make_caustics(ps, &out->caustics, err)
+                                   : lm_caustics_trace_all(ps->caustics, &out->caustics, err);
+        out->t_caustics = lm_now() - t0;
+    }
     if (st != LM_OK || !ps->set.trace)
         return st;
     double t1 = lm_now();
@@ -340,7 +393,7 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage
     ps->aim.set.delta_threshold = threshold;
     out->t_photons = t2 - t1;
     out->t_aim = lm_now() - t2;
-    out->t_total = out->t_animate + out->t_photons + out->t_aim;
+    out->t_total = out->t_animate + out->t_photons + out->t_aim + out->t_caustics;
     return st;
 }
 
@@ -358,3 +411,4 @@ const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }
+const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps) { return ps->caustics; }

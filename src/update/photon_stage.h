@@ -1,10 +1,12 @@
-/* The photon stage of the frame loop (Larsen & Christensen sections 2-3): play the scene's animations,
- * move instances, notice moved or changed lights, re-trace photons round robin and invalid groups
- * under their budget, and refresh the AIMs of the surfaces that changed most, under theirs. */
+/* The photon stage of the frame loop (Larsen & Christensen sections 2-3 and 5): play the scene's
+ * animations, move instances, notice moved or changed lights, re-trace photons round robin and invalid
+ * groups under their budget, refresh the AIMs of the surfaces that changed most, under theirs, and keep
+ * the caustic photons current (trace/caustics.h). */
 #ifndef LM_PHOTON_STAGE_H
 #define LM_PHOTON_STAGE_H
 
 #include "../photonmap/aim.h"
+#include "../trace/caustics.h"
 #include "../trace/lights.h"
 #include "../trace/photons.h"
 #include "world.h"
@@ -20,6 +22,9 @@ typedef struct {
     int exact_direct;        /* AIM texels compute direct light (trace/direct_irradiance.h), photons bring the
                               * rest: 1 from emissive triangles, 2 from punctual lights too; 0 (default):
                               * photons bring all of it (the paper's form) */
+    int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
+                              * them: no work at all). Default 0; the frame loop follows the scene's effects */
+    lm_caustic_settings caustic;
 } lm_photon_stage_settings;
 
 typedef struct {
@@ -29,7 +34,8 @@ typedef struct {
     int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
     lm_photon_frame_stats photons;
     lm_aim_stats aim;
-    double t_animate, t_photons, t_aim, t_total; /* seconds */
+    lm_caustic_frame_stats caustics; /* its seconds are t_caustics */
+    double t_animate, t_photons, t_aim, t_caustics, t_total; /* seconds */
 } lm_photon_stage_frame;
 
 typedef struct lm_photon_stage lm_photon_stage;
@@ -66,5 +72,8 @@ const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps);
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps);
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
+/* The caustic photons; NULL when the settings have none. A class or switch edit (lm_scene.pass_version), an
+ * added light or an edited material makes them again at the next update (a full trace). */
+const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps);
 
 #endif

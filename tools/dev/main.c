@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "../../src/cli/args.h"
+#include "bench_caustics.h"
 #include "bench_gather.h"
 #include "bench_photons.h"
 #include "photons_cmd.h"
@@ -16,7 +17,10 @@ static void usage(FILE *f)
     fprintf(f, "usage: lmgi-dev photons SCENE --out DIR [--frames N] [photon options]\n"
                "         the photon stage alone over the scene's animations: AIM atlas, a view with AIMs, stats.csv\n"
                "       lmgi-dev bench [--gather-scene FILE]\n"
-               "         photon tracing against raw Embree and the final gather against the paper's Table 2\n"
+               "         photon tracing against raw Embree, the final gather against the paper's Table 2, the\n"
+               "         caustic pass and reflections against the paper's section 5 figures\n"
+               "       lmgi-dev bench-caustics\n"
+               "         the caustics and reflections part alone\n"
                "         (FILE: the ~133k-triangle Cornell box of `build/gen_scenes --cornell-cells 255`)\n"
                "options and their meaning: `lmgi help`\n");
 }
@@ -32,6 +36,11 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "bench")) {
         lm_dev_bench_photons();
         lm_dev_bench_gather(a.gather_scene);
+        lm_dev_bench_caustics();
+        return 0;
+    }
+    if (!strcmp(argv[1], "bench-caustics")) {
+        lm_dev_bench_caustics();
         return 0;
     }
     fprintf(stderr, "lmgi-dev: unknown command '%s'\n\n", argv[1]);

@@ -1,0 +1,292 @@
+/* The specular passes against the reference solver's own parts (docs/caustics.md, docs/reference.md,
+ * "Which part carries which light"): a glass ball's focal spot against the light-traced caustic part, a
+ * mirror sphere's pixels and a wall mirror's (plain and box-projected cube map) against the reference's
+ * radiance. Small scenes, 64 x 64 pictures, references at a loose target: a few seconds each. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "edit_room.h"
+#include "support.h"
+
+#define SIDE 64
+#define PIXELS (SIDE * SIDE)
+
+/* A perspective camera at eye looking at `at` (y up), vertical field of view fov radians, square. */
+static void look_at(const float eye[3], const float at[3], float fov, lmgi_camera *cam)
+{
+    float f[3], l = 0.0f;
+    for (int k = 0; k < 3; k++)
+        f[k] = at[k] - eye[k], l += f[k] * f[k];
+    for (int k = 0; k < 3; k++)
+        f[k] /= sqrtf(l);
+    float r[3] = {-f[2], 0.0f, f[0]}, m = sqrtf(f[0] * f[0] + f[2] * f[2]); /* f x (0, 1, 0) */
+    r[0] /= m, r[2] /= m;
+    float up[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
+    memset(cam, 0, sizeof *cam);
+    for (int k = 0; k < 3; k++) {
+        cam->view[4 * k] = r[k], cam->view[4 * k + 1] = up[k], cam->view[4 * k + 2] = -f[k];
+        cam->view[12] -= r[k] * eye[k], cam->view[13] -= up[k] * eye[k], cam->view[14] += f[k] * eye[k];
+    }
+    cam->view[15] = 1.0f;
+    const float n = 0.05f, fa = 30.0f, t = 1.0f / tanf(0.5f * fov);
+    cam->proj[0] = cam->proj[5] = t;
+    cam->proj[10] = -(fa + n) / (fa - n), cam->proj[11] = -1.0f, cam->proj[14] = -2.0f * fa * n / (fa - n);
+}
+
+static lmgi_scene *load(const char *path, int texels)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = texels;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
+static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, uint32_t caustic_photons)
+{
+    lmgi_updater_desc d;
+    lmt_room_desc(&d);
+    d.caustic_photons = caustic_photons;
+    d.reflection_size = 128;
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_update_stats st;
+    if (lmgi_update(u, 0.0f, 0.0f, &st, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
+static void reference(lmgi_scene *sc, const lmgi_camera *cam, float target, lmgi_reference *ref)
+{
+    lmgi_reference_desc d = {.target_error = target, .no_cache = 1};
+    lmgi_error e;
+    if (lmgi_reference_pixels(sc, &d, cam, SIDE, SIDE, ref, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+}
+
+/* A glass ball (r 0.3, ior 1.5) 0.5 m over a white floor (0.8) under a 10 cd lamp at (-1, 3, 0): its focal
+ * spot near (0.2, 0, 0), seen from the side. The runtime's caustic there (kd / pi x the caustic pass's
+ * E) against the reference's light-traced caustic part over the spot: total power within 10%, centroid
+ * within 2 pixels. */
+static void test_glass_focal_spot(void **state)
+{
+    (void)state;
+    enum { SEG = 48, RINGS = 24 };
+    static float pos[3 * (SEG + 1) * (RINGS + 1)], nrm[3 * (SEG + 1) * (RINGS + 1)];
+    static uint32_t idx[6 * SEG * RINGS];
+    int v = 0, t = 0;
+    for (int j = 0; j <= RINGS; j++)
+        for (int i = 0; i <= SEG; i++, v++) {
+            double th = M_PI * j / RINGS, ph = 2 * M_PI * i / SEG;
+            double n[3] = {sin(th) * cos(ph), cos(th), sin(th) * sin(ph)};
+            for (int k = 0; k < 3; k++)
+                nrm[3 * v + k] = (float)n[k], pos[3 * v + k] = (k == 1 ? 0.5f : 0.0f) + 0.3f * (float)n[k];
+        }
+    for (int j = 0; j < RINGS; j++)
+        for (int i = 0; i < SEG; i++) {
+            uint32_t a = (uint32_t)(j * (SEG + 1) + i), b = a + 1, c = a + SEG + 1, d = c + 1;
+            const uint32_t q[6] = {a, b, d, a, d, c};
+            if (j > 0)
+                memcpy(idx + 3 * t++, q, 3 * sizeof *q);
+            if (j < RINGS - 1)
+                memcpy(idx + 3 * t++, q + 3, 3 * sizeof *q);
+        }
+    const float floor_pos[12] = {-4, 0, 4, 4, 0, 4, 4, 0, -4, -4, 0, -4};
+    const uint32_t floor_idx[6] = {0, 1, 2, 0, 2, 3};
+    lmgi_mesh_desc meshes[2] = {
+        {.name = "floor", .positions = floor_pos, .vertex_count = 4, .indices = floor_idx, .triangle_count = 2},
+        {.name = "ball", .positions = pos, .normals = nrm, .vertex_count = (uint32_t)v, .indices = idx,
+         .triangle_count = (uint32_t)t, .material = 1}};
+    lmgi_material_desc mats[2] = {{.name = "white", .base_color = {0.8f, 0.8f, 0.8f, 1}},
+                                  {.name = "glass", .base_color = {1, 1, 1, 1}, .transmission = 1.0f, .ior = 1.5f}};
+    lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 10.0f, .position = {-1, 3, 0}};
+    lmgi_scene_desc d = {.name = "glass ball", .meshes = meshes, .mesh_count = 2, .materials = mats,
+                         .material_count = 2, .lights = &lamp, .light_count = 1};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 800;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_camera cam;
+    look_at((const float[3]){1.4f, 1.3f, 0.9f}, (const float[3]){0.2f, 0.0f, 0.0f}, 0.6f, &cam);
+    lmgi_context *ctx = lmt_context();
+    lmgi_updater *u = updater(ctx, sc, 1u << 16);
+    static float frame[3 * PIXELS], E[3 * PIXELS];
+    int w, h;
+    assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, frame, &e), LMGI_OK);
+    assert_int_equal(lmgi_get_caustics(u, E, 3 * PIXELS, &w, &h, &e), LMGI_OK);
+    lmgi_reference ref;
+    reference(sc, &cam, 0.2f, &ref);
+    /* the spot: pixels where the reference's caustic exceeds a tenth of its brightest, grown by 4 pixels */
+    double peak = 0.0;
+    for (int i = 0; i < PIXELS; i++)
+        peak = fmax(peak, ref.caustic[3 * i + 1]);
+    static unsigned char spot[PIXELS];
+    memset(spot, 0, sizeof spot);
+    for (int y = 0; y < SIDE; y++)
+        for (int x = 0; x < SIDE; x++)
+            if (ref.caustic[3 * (y * SIDE + x) + 1] > 0.1 * peak)
+                for (int dy = -4; dy <= 4; dy++)
+                    for (int dx = -4; dx <= 4; dx++)
+                        if (x + dx >= 0 && x + dx < SIDE && y + dy >= 0 && y + dy < SIDE)
+                            spot[(y + dy) * SIDE + x + dx] = 1;
+    double run = 0.0, want = 0.0, cx[2] = {0, 0}, cy[2] = {0, 0};
+    int n = 0;
+    for (int y = 0; y < SIDE; y++)
+        for (int x = 0; x < SIDE; x++) {
+            int i = y * SIDE + x;
+            if (!spot[i])
+                continue;
+            double a = 0.8 / M_PI * E[3 * i + 1], b = ref.caustic[3 * i + 1];
+            run += a, want += b, n++;
+            cx[0] += a * x, cy[0] += a * y, cx[1] += b * x, cy[1] += b * y;
+        }
+    double dist = hypot(cx[0] / run - cx[1] / want, cy[0] / run - cy[1] / want);
+    print_message("glass ball: focal spot over %d pixels: power %.4f of the reference's caustic part (%.4g), centroid "
+                  "%.2f pixels off ((%.1f, %.1f) against (%.1f, %.1f)); reference caustic %.2f s\n", n, run / want, want,
+                  dist, cx[0] / run, cy[0] / run, cx[1] / want, cy[1] / want, ref.caustic_seconds);
+    assert_true(n > 20 && n < PIXELS / 2);
+    assert_true(fabs(run / want - 1.0) < 0.10);
+    assert_true(dist < 2.0);
+    lmgi_reference_free(&ref);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A room (half-size 2) with coloured panels on three walls, a lamp, and `specular`: a mirror sphere (r 0.5)
+ * at its centre, or a 2 x 2 m mirror on the wall x = -2 (with a reflection_box of the room when `box`). */
+static const char *mirror_room(const char *name, int sphere, int box)
+{
+    static lmt_mesh m[5];
+    memset(m, 0, sizeof m);
+    lmt_mesh_cube_inward(&m[0], 2.0f);
+    lmt_mesh_quad(&m[1], (float[3]){1.99f, -1.5f, 1.0f}, (float[3]){0, 2.5f, 0}, (float[3]){0, 0, -2.0f}); /* red, x = 2 */
+    lmt_mesh_quad(&m[2], (float[3]){-1.0f, -1.5f, -1.99f}, (float[3]){2.0f, 0, 0}, (float[3]){0, 2.5f, 0}); /* blue, z = -2 */
+    lmt_mesh_quad(&m[3], (float[3]){-1.0f, -1.99f, 1.0f}, (float[3]){2.0f, 0, 0}, (float[3]){0, 0, -2.0f}); /* green floor */
+    if (sphere)
+        lmt_mesh_cube(&m[4], 0.35f); /* a box mirror: its flat faces make the test a planar-mirror test too */
+    else
+        lmt_mesh_quad(&m[4], (float[3]){-1.99f, -1.0f, 1.0f}, (float[3]){0, 0, -2.0f}, (float[3]){0, 2.0f, 0});
+    char nodes[512];
+    snprintf(nodes, sizeof nodes,
+             "[{\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}, {\"mesh\": 3}, {\"mesh\": 4%s}, {\"translation\": [0.3, 1.2, "
+             "0.4], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]",
+             box ? ", \"extras\": {\"lmgi\": {\"reflection_box\": [-2, -2, -2, 2, 2, 2]}}" : "");
+    return lmt_write_scene(name, m, 5, nodes,
+                           "[" LMT_DIFFUSE(0.7) ", {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.1, 0.1, 1], "
+                           "\"metallicFactor\": 0}}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.1, 0.2, 0.8, 1], "
+                           "\"metallicFactor\": 0}}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.2, 0.7, 0.2, 1], "
+                           "\"metallicFactor\": 0}}, " LMT_MIRROR(0.9) "], "
+                           LMT_LIGHTS("{\"type\": \"point\", \"intensity\": 8}"));
+}
+
+/* Relative RMSE and mean ratio of a against b over the pixels whose eye ray (and its 4 neighbours') meets the
+ * mirror first: the reference's reflections part is what they show. */
+static void compare_mirror(const float *frame, const lmgi_reference *ref, double *rmse, double *ratio, int *count)
+{
+    double d2 = 0.0, r2 = 0.0, sa = 0.0, sb = 0.0;
+    int n = 0;
+    for (int y = 1; y < SIDE - 1; y++)
+        for (int x = 1; x < SIDE - 1; x++) {
+            int i = y * SIDE + x, inside = 1;
+            const int nb[5] = {i, i - 1, i + 1, i - SIDE, i + SIDE};
+            for (int k = 0; k < 5; k++)
+                inside &= ref->reflections[3 * nb[k] + 1] > 0.0f && ref->full[3 * nb[k] + 1] == ref->reflections[3 * nb[k] + 1];
+            if (!inside)
+                continue;
+            for (int c = 0; c < 3; c++) {
+                double a = frame[3 * i + c], b = ref->reflections[3 * i + c];
+                d2 += (a - b) * (a - b), r2 += b * b, sa += a, sb += b;
+            }
+            n++;
+        }
+    *rmse = sqrt(d2 / r2);
+    *ratio = sa / sb;
+    *count = n;
+}
+
+/* A mirror box (albedo 0.9) in the middle of a room with coloured walls: its pixels against the
+ * reference's radiance. Its flat faces see the walls from where they are, the cube map from the box's
+ * centre: the map's parallax is its error here. */
+static void test_mirror_pixels(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = load(mirror_room("mirror_box.gltf", 1, 0), 1500);
+    lmgi_camera cam;
+    look_at((const float[3]){1.2f, 0.6f, 1.5f}, (const float[3]){0, 0, 0}, 0.7f, &cam);
+    lmgi_context *ctx = lmt_context();
+    lmgi_updater *u = updater(ctx, sc, 0);
+    static float frame[3 * PIXELS];
+    lmgi_error e;
+    assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, frame, &e), LMGI_OK);
+    lmgi_reference ref;
+    reference(sc, &cam, 0.05f, &ref);
+    double rmse, ratio;
+    int n;
+    compare_mirror(frame, &ref, &rmse, &ratio, &n);
+    print_message("mirror box: %d pixels, frame / reference %.4f, relative RMSE %.3f\n", n, ratio, rmse);
+    assert_true(n > 200);
+    assert_true(fabs(ratio - 1.0) < 0.10);
+    assert_true(rmse < 0.35);
+    lmgi_reference_free(&ref);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A 2 x 2 m mirror on a wall, seen from across the room: the plain cube map (seen from the mirror's
+ * centre) shows the room displaced; box-projected onto the room's box it shows it where it is. */
+static void test_wall_mirror_box_projection(void **state)
+{
+    (void)state;
+    double rmse[2], ratio[2];
+    int n[2];
+    for (int box = 0; box < 2; box++) {
+        lmgi_scene *sc = load(mirror_room(box ? "wall_box.gltf" : "wall_plain.gltf", 0, box), 1500);
+        lmgi_camera cam;
+        look_at((const float[3]){1.5f, 0.3f, 1.2f}, (const float[3]){-2.0f, 0.0f, 0.0f}, 0.9f, &cam);
+        lmgi_context *ctx = lmt_context();
+        lmgi_updater *u = updater(ctx, sc, 0);
+        static float frame[3 * PIXELS];
+        lmgi_error e;
+        assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, frame, &e), LMGI_OK);
+        lmgi_reference ref;
+        reference(sc, &cam, 0.05f, &ref);
+        compare_mirror(frame, &ref, &rmse[box], &ratio[box], &n[box]);
+        lmgi_reference_free(&ref);
+        lmgi_updater_free(u);
+        lmgi_free(sc);
+        lmgi_context_free(ctx);
+    }
+    print_message("wall mirror (%d pixels): plain cube map relative RMSE %.3f (mean %.3f of the reference), "
+                  "box-projected %.3f (mean %.3f)\n", n[0], rmse[0], ratio[0], rmse[1], ratio[1]);
+    assert_true(n[0] > 300 && n[0] == n[1]);
+    assert_true(rmse[1] < 0.5 * rmse[0]);
+    assert_true(rmse[1] < 0.25);
+    assert_true(fabs(ratio[1] - 1.0) < 0.10);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_glass_focal_spot),
+        cmocka_unit_test(test_mirror_pixels),
+        cmocka_unit_test(test_wall_mirror_box_projection),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
