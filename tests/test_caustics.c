@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "../src/trace/caustics.h"
+#include "../src/trace/photons.h"
 #include "support.h"
 
 static lm_caustics *make(const lmt_pipeline *p, uint32_t photons, lm_caustic_frame_stats *st)
@@ -311,6 +312,126 @@ static void test_deterministic(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* The photon stage's own photons mark the hits that came off mirrors and glass only (L S+ D): exactly those
+ * whose path before them is all specular. Their light is the caustic pass's: the IIM's energy and delta_i
+ * leave them out. */
+static void test_regular_photons_mark_caustic_hits(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, room_scene("marks.gltf", LMT_MIRROR(0.9), "{\"type\": \"point\", \"intensity\": 10}", 2.0f,
+                                     0.5f), 0.5f);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.per_group = 100;
+    lm_photons *ph = NULL;
+    lm_error err;
+    if (lm_photons_create(p.s, &p.su, p.rt, &p.em, &set, &ph, &err) != LM_OK ||
+        lm_photons_trace_all(ph, NULL, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    const lm_photon_store *ps = lm_photons_store(ph);
+    uint32_t marked = 0, wrong = 0;
+    double caustic_energy = 0.0, all = 0.0, iim = 0.0;
+    for (uint32_t id = 0; id < lm_photons_count(ph); id++) {
+        const lm_path_vertex *v = NULL;
+        uint32_t n = lm_photons_path(ph, id, &v);
+        int specular_before = 1;
+        for (uint32_t i = 0; i < n; i++) {
+            if (v[i].slot != LM_NONE) {
+                const lm_hit *h = &ps->hits[v[i].slot];
+                int want = i > 0 && specular_before;
+                wrong += h->caustic != want;
+                marked += h->caustic;
+                caustic_energy += h->caustic ? lm_hit_energy(h) : 0.0;
+            }
+            specular_before = specular_before && lm_material_is_specular(p.s->materials[p.s->tri_material[v[i].tri]].cls);
+        }
+    }
+    for (int k = 0; k < ps->surface_count; k++) {
+        iim += lm_photon_store_iim_energy(ps, k);
+        for (uint32_t h = ps->surfaces[k].head; h != LM_NONE; h = ps->hits[h].next)
+            all += lm_hit_energy(&ps->hits[h]) * !(ps->hits[h].bounce == 0 && ps->hits[h].from_punctual);
+    }
+    print_message("%u caustic hits marked (%.4f of the energy), %u marked wrong; IIM energy %.4f = all but first "
+                  "punctual hits %.4f less caustic %.4f\n", marked, caustic_energy, wrong, iim, all, caustic_energy);
+    assert_true(marked > 100);
+    assert_true(iim > 0.5 * all); /* a closed room: most bounced light is not caustic */
+    assert_int_equal(wrong, 0);
+    assert_true(fabs(iim - (all - caustic_energy)) <= 1e-6 * all);
+    lm_photons_free(ph);
+    lmt_pipeline_free(&p);
+}
+
+/* KHR_materials_ior: 0 is the extension's "everything reflected" (the glass acts as a mirror: every
+ * photon off it after one bounce, all its power); 1 bends nothing (every photon goes straight through,
+ * in twice, out once: two bounces, its direction kept); 0.5 is refused naming the material. A mirror
+ * whose triangles have no extent is no generator. */
+static void test_odd_glass(void **state)
+{
+    (void)state;
+    const char *point = "{\"type\": \"point\", \"intensity\": 10}";
+    const char *ior0 = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": "
+                       "{\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 0}}}";
+    const char *ior1 = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0}, \"extensions\": {\"KHR_materials_transmission\": "
+                       "{\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 1}}}";
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, room_scene("ior0.gltf", ior0, point, 2.0f, 0.3f), 0.5f);
+    lm_caustic_frame_stats st;
+    lm_caustics *c = make(&p, 4096, &st);
+    double stored[3], emitted[3];
+    lm_caustics_flux(c, stored, emitted);
+    uint32_t one = 0;
+    for (uint32_t i = 0; i < lm_caustics_photon_count(c); i++)
+        one += lm_caustics_hits(c)[i].flux[1] != 0.0f && lm_caustics_hits(c)[i].bounces == 1;
+    print_message("ior 0: %u of %u landed after one bounce, stored %.5f of received %.5f\n", one, st.landed, stored[1],
+                  emitted[1]);
+    assert_true(st.landed > 1000);
+    assert_int_equal(one, st.landed);
+    assert_true(fabs(stored[1] - emitted[1]) <= 1e-5 * emitted[1]);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+
+    lmt_pipeline_load(&p, room_scene("ior1.gltf", ior1, point, 2.0f, 0.3f), 0.5f);
+    c = make(&p, 4096, &st);
+    uint32_t straight = 0;
+    for (uint32_t i = 0; i < lm_caustics_photon_count(c); i++) {
+        const lm_caustic_hit *h = &lm_caustics_hits(c)[i];
+        float to[3] = {h->pos[0], h->pos[1] - 2.0f, h->pos[2] - 0.01f}; /* from the light (0, 2, 0.01) */
+        float l = sqrtf(to[0] * to[0] + to[1] * to[1] + to[2] * to[2]);
+        straight += h->flux[1] != 0.0f && h->bounces == 2 && fabsf(to[0] / l - h->dir[0]) < 1e-3f &&
+                    fabsf(to[1] / l - h->dir[1]) < 1e-3f && fabsf(to[2] / l - h->dir[2]) < 1e-3f;
+    }
+    print_message("ior 1: %u of %u landed straight on after two bounces\n", straight, st.landed);
+    assert_true(st.landed > 1000);
+    assert_int_equal(straight, st.landed);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+
+    lm_scene *s = NULL;
+    lm_load_options lo = {0};
+    lm_error err;
+    const char *bad = "{\"name\": \"thin glass\", \"pbrMetallicRoughness\": {\"metallicFactor\": 0}, \"extensions\": "
+                      "{\"KHR_materials_transmission\": {\"transmissionFactor\": 1}, \"KHR_materials_ior\": {\"ior\": 0.5}}}";
+    assert_int_equal(lm_scene_load_gltf(room_scene("ior05.gltf", bad, point, 2.0f, 0.3f), &lo, &s, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "thin glass"));
+    assert_non_null(strstr(err.msg, "ior"));
+    assert_null(s);
+
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_cube_inward(&m[0], 3.0f);
+    lmt_mesh_quad(&m[1], (float[3]){0, 1, 0}, (float[3]){0, 0, 0}, (float[3]){0, 0, 0});
+    lmt_pipeline_load(&p, lmt_write_scene("flat.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"translation\": [0, 2, 0], "
+                                          "\"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]",
+                                          "[" LMT_DIFFUSE(0.5) ", " LMT_MIRROR(0.9) "], " LMT_LIGHTS("{\"type\": \"point\", \"intensity\": 10}")),
+                      0.5f);
+    c = make(&p, 1024, &st);
+    assert_int_equal(lm_caustics_generator_count(c), 0);
+    assert_int_equal(st.traced, 0);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
 /* Bad settings are refused naming them. */
 static void test_bad_settings(void **state)
 {
@@ -344,6 +465,8 @@ int main(void)
         cmocka_unit_test(test_switches_and_empty),
         cmocka_unit_test(test_directional),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_regular_photons_mark_caustic_hits),
+        cmocka_unit_test(test_odd_glass),
         cmocka_unit_test(test_bad_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

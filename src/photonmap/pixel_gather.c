@@ -57,8 +57,9 @@ void lm_gbuffer_free(lm_gbuffer *g)
     memset(g, 0, sizeof *g);
 }
 
-/* The hits the gather takes: all but the punctual lights' first ones (their light is the direct pass's). */
-static int gathered(const lm_hit *h) { return !(h->bounce == 0 && h->from_punctual); }
+/* The hits the gather takes: all but the punctual lights' first ones (their light is the direct pass's) and
+ * the caustic ones (the caustic pass's; with it left out, nobody's). */
+static int gathered(const lm_hit *h) { return lm_hit_in_iim(h); }
 
 float lm_pixel_gather_radius(const lm_photon_store *ps, const lm_surfaces *su, int n)
 {

@@ -8,8 +8,9 @@
  * the paper's kernel kappa(s) = min(c, 1 - s / r), c = 1/5 (eq. 2; the denominator is its integral over
  * the disc, eq. 3), the diffuse BSDF kd / pi (kd the diffuse lobe, docs/materials.md) and one radius r
  * for every photon (the paper's constant-radius case, in which every gather order gives the same
- * picture). The hits are those an IIM holds: every stored hit but the punctual lights' first ones,
- * whose light the direct pass draws per pixel.
+ * picture). The hits are those an IIM holds (lm_hit_in_iim): every stored hit but the punctual lights'
+ * first ones, whose light the direct pass draws per pixel, and the caustic ones (off mirrors and glass
+ * only), whose light the caustic pass draws.
  *
  * r: the radius of a disc that holds n photons on average, r = sqrt(n A / (pi H)), A the surfaces' world
  * area and H the hits gathered (the N of the AIM's N-nearest estimate, so that both paths blur alike on

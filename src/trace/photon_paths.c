@@ -96,7 +96,7 @@ static uint32_t store_vertex(lm_photons *ph, const ph_vertex *v, uint32_t photon
     h->tri = v->tri;
     h->bounce = v->bounce;
     h->from_punctual = (uint8_t)(punctual != 0);
-    h->pad = 0;
+    h->caustic = v->caustic;
     lm_photon_store_link(&ph->store, slot);
     return slot;
 }

@@ -116,7 +116,7 @@ double lm_photon_store_iim_energy(const lm_photon_store *ps, int surface)
 {
     double e = 0.0;
     for (uint32_t h = ps->surfaces[surface].head; h != LM_NONE; h = ps->hits[h].next)
-        if (!(ps->hits[h].bounce == 0 && ps->hits[h].from_punctual))
+        if (lm_hit_in_iim(&ps->hits[h]))
             e += lm_hit_energy(&ps->hits[h]);
     return e;
 }

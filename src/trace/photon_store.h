@@ -1,8 +1,8 @@
 /* Stored photon hits, linked into per-surface lists so that adding and removing a hit is O(1), with
  * the change accumulators the update scheduler reads (Larsen & Christensen, section 2-3):
  *   delta_f: energy of every hit added or removed since the surface's AIM was last refreshed;
- *   delta_i: the same, leaving out first hits from punctual lights (an IIM holds everything but the
- *            punctual lights' direct light, DESIGN.md), since the surface's IIM was last refreshed.
+ *   delta_i: the same, leaving out first hits from punctual lights and caustic hits (an IIM holds neither:
+ *            DESIGN.md, docs/caustics.md), since the surface's IIM was last refreshed.
  * Energy of a hit is the luminance of its flux. */
 #ifndef LM_PHOTON_STORE_H
 #define LM_PHOTON_STORE_H
@@ -23,7 +23,8 @@ typedef struct {
     int32_t surface;
     uint16_t bounce;       /* 0 = first hit after leaving the emitter */
     uint8_t from_punctual; /* the photon came from a point, spot or directional light */
-    uint8_t pad;
+    uint8_t caustic;       /* it came off mirrors and glass only, straight from its emitter (L S+ D): light
+                            * the caustic pass carries, not the receiver's IIM (docs/caustics.md) */
     uint32_t prev, next;   /* links in the surface's hit list (LM_NONE at the ends); next also links free slots */
 } lm_hit;
 
@@ -66,13 +67,16 @@ int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n);
 /* Unlinks a stored hit, adds its energy to the deltas and frees the slot. A slot that holds no live
  * hit (already removed, or never used) is ignored. */
 void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot);
+/* Whether a hit's light is what the receiver's IIM holds: not a punctual light's first hit (the direct
+ * pass's), not a caustic hit (the caustic pass's). */
+static inline int lm_hit_in_iim(const lm_hit *h) { return !(h->bounce == 0 && h->from_punctual) && !h->caustic; }
 /* Energy of a hit as the deltas count it. */
 static inline double lm_hit_energy(const lm_hit *h)
 {
     return 0.2126 * h->flux[0] + 0.7152 * h->flux[1] + 0.0722 * h->flux[2];
 }
-/* The energy of a surface's stored hits that an IIM holds (first hits of punctual lights left out, as
- * delta_i leaves them out): what delta_i is measured against. O(hits on the surface). */
+/* The energy of a surface's stored hits that an IIM holds (lm_hit_in_iim, as delta_i counts them): what
+ * delta_i is measured against. O(hits on the surface). */
 double lm_photon_store_iim_energy(const lm_photon_store *ps, int surface);
 /* Sets a surface's delta_f (after its AIM refresh) or delta_i (after its IIM refresh) to zero. */
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface);
@@ -108,7 +112,7 @@ static inline void lm_photon_store_account(lm_photon_store *ps, const lm_hit *h)
     double e = lm_hit_energy(h);
     ps->version++;
     sh->delta_f += e;
-    if (!(h->bounce == 0 && h->from_punctual))
+    if (lm_hit_in_iim(h))
         sh->delta_i += e;
 }
 

@@ -94,7 +94,7 @@ static int covered(const lm_photons *ph, const lm_shading *sh, const float dir[3
 }
 
 static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *sh, const float dir[3],
-                       const float flux[3], uint32_t b)
+                       const float flux[3], uint32_t b, int caustic)
 {
     if (!buffer_reserve(buf))
         return 0;
@@ -104,6 +104,7 @@ static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *s
     int store = sh->surface >= 0 && lm_material_stores_hits(sh->material->cls);
     v->surface = store && !(ph->set.cover_distance > 0.0f && covered(ph, sh, dir)) ? sh->surface : -1;
     v->bounce = (uint16_t)b;
+    v->caustic = (uint8_t)caustic;
     memcpy(v->pos, sh->pos, sizeof v->pos);
     memcpy(v->local, sh->local, sizeof v->local);
     memcpy(v->dir, dir, sizeof v->dir);
@@ -163,7 +164,7 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
         return 1;
     /* Counted in locals, written once: j lies in the batch's job array, beside other threads' jobs. */
     uint32_t rays = 0, count = 0, stored = 0;
-    int ok = 1;
+    int ok = 1, specular_so_far = 1; /* every vertex before this one was mirror or glass */
     for (uint32_t b = 0; b < ph->set.max_bounces; b++) {
         lm_rt_hit hit;
         rays++;
@@ -175,10 +176,11 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
          * then the shading's stores have left the store buffer, and copying them does not stall. */
         float in_dir[3] = {dir[0], dir[1], dir[2]}, in_flux[3] = {flux[0], flux[1], flux[2]};
         int scattered = scatter(ph, id, b, &sh, org, dir, flux);
-        if (!push_vertex(ph, buf, &sh, in_dir, in_flux, b)) {
+        if (!push_vertex(ph, buf, &sh, in_dir, in_flux, b, b > 0 && specular_so_far)) {
             ok = 0;
             break;
         }
+        specular_so_far = specular_so_far && lm_material_is_specular(sh.material->cls);
         count++;
         stored += buf->v[buf->len - 1].surface >= 0;
         if (!scattered)

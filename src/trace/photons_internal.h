@@ -25,6 +25,7 @@ typedef struct {
     uint32_t tri;
     int32_t surface;           /* -1: nothing stored here (specular, or no surface) */
     uint16_t bounce;
+    uint8_t caustic;           /* every vertex before it was mirror or glass (L S+ D: lm_hit.caustic) */
     float pos[3], local[3], dir[3], flux[3];
 } ph_vertex;
 
