@@ -641,8 +641,10 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
             *stats = st;
         return s;
     }
+    double tw = lm_now();
     glFinish(); /* the times below are the pass's own, not the frame's work before it */
     double t0 = lm_now();
+    st.t_wait = t0 - tw;
     splat(cp, t, view, &vc, depth, &st); /* its query's result waits for the splat */
     double t1 = lm_now();
     query_tiles(cp, t, &st);

@@ -57,6 +57,8 @@ typedef struct {
     int tiles, tiles_lit;  /* tiles of the screen, and those whose query found photons */
     uint64_t pixels_filtered; /* pixels of the grown lit tiles (shared pixels counted once per tile) */
     double t_splat, t_query, t_filter, t_composite; /* seconds (each ends with the GPU's work done) */
+    double t_wait;         /* seconds waited first for the GPU work before the pass (the frame's direct
+                            * light, which runs asynchronously): not the pass's own */
 } lm_caustic_pass_stats;
 
 typedef struct lm_caustic_pass lm_caustic_pass;

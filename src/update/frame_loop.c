@@ -591,9 +591,10 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
     if (st == LM_OK && photon_path(fl))
         st = add_photon_indirect(fl, view, w, h, rgb, err);
     o->t_composite = t1 - t0;
-    o->t_caustics = t4 - t3;
+    /* the caustic pass first waits for the direct light's GPU work: that wait is the direct light's */
+    o->t_caustics = t4 - t3 - o->caustic.t_wait;
     o->t_reflections = (t2 - t1) + (t5 - t4);
-    o->t_direct = (t3 - t2) + (lm_now() - t5);
+    o->t_direct = (t3 - t2) + o->caustic.t_wait + (lm_now() - t5);
     return st;
 }
 

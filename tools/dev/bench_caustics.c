@@ -215,7 +215,7 @@ static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflection
         printf("frame loop: %s\n", err.msg);
         return;
     }
-    static double t[P_COUNT][FRAMES], per_face[FRAMES];
+    static double t[P_COUNT][FRAMES], per_face[FRAMES], parts[5][FRAMES];
     int faced = 0;
     uint64_t traced = 0;
     for (int n = 0; n < FRAMES; n++) {
@@ -229,6 +229,10 @@ static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflection
                                    o.t_composite, o.t_total};
         for (int k = 0; k < P_COUNT; k++)
             t[k][n] = 1e3 * v[k];
+        const double cp[5] = {o.caustic.t_splat, o.caustic.t_query, o.caustic.t_filter, o.caustic.t_composite,
+                              (double)o.caustic.tiles_lit};
+        for (int k = 0; k < 5; k++)
+            parts[k][n] = k < 4 ? 1e3 * cp[k] : cp[k];
         if (o.cube_faces > 0 && n > 0)
             per_face[faced++] = 1e3 * o.t_reflections / o.cube_faces;
         traced += o.stage.caustics.traced;
@@ -242,6 +246,10 @@ static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflection
     if (faced)
         printf("   %d faces a frame: %.2f ms a face", faces, lm_median(per_face, faced));
     printf(caustics ? "   %.0f caustic photons a frame\n" : "\n", (double)traced / FRAMES);
+    if (caustics)
+        printf("%-34s caustic pass: splat %.2f, queries %.2f, filter %.2f, composite %.2f ms; %.0f tiles lit\n", "",
+               lm_median(parts[0], FRAMES), lm_median(parts[1], FRAMES), lm_median(parts[2], FRAMES),
+               lm_median(parts[3], FRAMES), lm_median(parts[4], FRAMES));
     lm_frame_loop_free(fl);
 }
 
