@@ -21,10 +21,12 @@ if [ -r scenes/cornell.glb ]; then
     echo "== photons on scenes/cornell.glb"
     "$LMGI_DEV" photons scenes/cornell.glb --frames 90 --photons 50000 --out demo/cornell-photons --force
 fi
-# The whole frame loop on the same scene: composited frames, final lightmap atlases, per-stage times.
+# The whole frame loop on the same scene: composited frames (the mirror sphere reflecting the box, the glass
+# sphere's caustic following it round the floor), the last frame's caustics alone (caustics.png), final
+# lightmap atlases, per-stage times. 90 frames: 3 s of the animation.
 if [ -r scenes/cornell.glb ]; then
     echo "== run on scenes/cornell.glb"
-    "$LMGI" run scenes/cornell.glb --frames 30 --size 512x512 --out demo/cornell-run --force
+    "$LMGI" run scenes/cornell.glb --frames 90 --exr-every 30 --size 512x512 --out demo/cornell-run --force
 fi
 # The shared Cornell box (its double-sided lamp 0.9 mm under the ceiling) as `lmgi run` renders it, and that
 # frame against the path-traced reference, per visible surface.
@@ -41,6 +43,6 @@ if [ -r ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf ]; then
         --out demo/cornell-suzanne-run --force
 fi
 echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png,"
-echo "      demo/cornell-run/frame_*.png, demo/cornellbox-run/frame_0000.png, demo/cornell-suzanne-run/"
+echo "      demo/cornell-run/frame_*.png and caustics.png, demo/cornellbox-run/frame_0000.png, demo/cornell-suzanne-run/"
 echo "      frame_0000.png and demo/cornellbox-check/"
 echo "      (check_ratio.png: frame / reference, red brighter, blue darker; demo/cornellbox-check.txt per surface)"
