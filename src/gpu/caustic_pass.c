@@ -167,7 +167,44 @@ typedef struct {
     uint8_t *lit;
     GLuint *queries;
     int lit_count, box[4];  /* the last run's lit tiles and the box of their grown squares */
+    /* where the splat and the irradiance may hold anything but 0 (x0, y0, x1, y1): what the next run
+     * clears, the last run's lit tiles (the whole target when new) */
+    int splat_held[4], irr_held[4];
 } slot_targets;
+
+/* The pixel box of the lit tiles (grown by `grow` pixels, clamped to the target); empty (x1 <= x0) when none. */
+static void lit_box(const slot_targets *t, int tile, int grow, int box[4])
+{
+    box[0] = t->width, box[1] = t->height, box[2] = box[3] = 0;
+    for (int ty = 0; ty < t->tiles_y; ty++)
+        for (int tx = 0; tx < t->tiles_x; tx++)
+            if (t->lit[ty * t->tiles_x + tx]) {
+                int x0 = tx * tile - grow, y0 = ty * tile - grow, x1 = (tx + 1) * tile + grow, y1 = (ty + 1) * tile + grow;
+                box[0] = x0 < box[0] ? x0 : box[0], box[1] = y0 < box[1] ? y0 : box[1];
+                box[2] = x1 > box[2] ? x1 : box[2], box[3] = y1 > box[3] ? y1 : box[3];
+            }
+    box[0] = box[0] < 0 ? 0 : box[0], box[1] = box[1] < 0 ? 0 : box[1];
+    box[2] = box[2] > t->width ? t->width : box[2], box[3] = box[3] > t->height ? t->height : box[3];
+}
+
+/* Clears the bound framebuffer's colour attachments [0, colours) (and its stencil) inside box only: a pass
+ * clears what its last run wrote, not the whole screen. */
+static void clear_box(const int box[4], int colours, int stencil)
+{
+    if (box[2] <= box[0] || box[3] <= box[1])
+        return;
+    static const float zero[4] = {0, 0, 0, 0};
+    static const GLint zero_stencil = 0;
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(box[0], box[1], box[2] - box[0], box[3] - box[1]);
+    for (int i = 0; i < colours; i++)
+        glClearBufferfv(GL_COLOR, i, zero);
+    if (stencil) {
+        glStencilMask(0xFF);
+        glClearBufferiv(GL_STENCIL, 0, &zero_stencil);
+    }
+    glDisable(GL_SCISSOR_TEST);
+}
 
 struct lm_caustic_pass {
     lm_caustic_pass_settings set;
@@ -235,6 +272,9 @@ static lm_status make_slot(lm_caustic_pass *cp, slot_targets *t, int w, int h, l
     glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, w, h);
     glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, t->stencil);
     glDrawBuffers(2, bufs);
+    const int all[4] = {0, 0, w, h}; /* new textures hold anything */
+    memcpy(t->splat_held, all, sizeof all);
+    memcpy(t->irr_held, all, sizeof all);
     int ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     glGenFramebuffers(1, &t->irr_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
@@ -447,12 +487,7 @@ static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view
 {
     glBindFramebuffer(GL_FRAMEBUFFER, t->splat_fbo);
     glViewport(0, 0, t->width, t->height);
-    static const float zero[4] = {0, 0, 0, 0};
-    static const GLint zero_stencil = 0;
-    glClearBufferfv(GL_COLOR, 0, zero);
-    glClearBufferfv(GL_COLOR, 1, zero);
-    glStencilMask(0xFF);
-    glClearBufferiv(GL_STENCIL, 0, &zero_stencil);
+    clear_box(t->splat_held, 2, 1);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glEnable(GL_BLEND);
@@ -521,6 +556,7 @@ static void query_tiles(lm_caustic_pass *cp, slot_targets *t, lm_caustic_pass_st
     }
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDisable(GL_STENCIL_TEST);
+    lit_box(t, cp->set.tile, 0, t->splat_held); /* photons landed in lit tiles only */
     st->tiles = t->tiles_x * t->tiles_y;
     st->tiles_lit = lit;
 }
@@ -557,8 +593,8 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
 {
     glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
     glViewport(0, 0, t->width, t->height);
-    static const float zero[4] = {0, 0, 0, 0};
-    glClearBufferfv(GL_COLOR, 0, zero);
+    clear_box(t->irr_held, 1, 0);
+    lit_box(t, cp->set.tile, cp->set.filter_k, t->irr_held);
     if (!count)
         return;
     GLuint p = cp->filter_prog;
@@ -632,9 +668,10 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
     if (s != LM_OK || !cp->photons) {
         if (s == LM_OK && t->irr_fbo) { /* nothing lights the slot: its irradiance is 0 */
             memset(t->lit, 0, (size_t)(t->tiles_x * t->tiles_y));
+            t->lit_count = 0;
             glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
-            static const float zero[4] = {0, 0, 0, 0};
-            glClearBufferfv(GL_COLOR, 0, zero);
+            clear_box(t->irr_held, 1, 0);
+            memset(t->irr_held, 0, sizeof t->irr_held);
             glBindFramebuffer(GL_FRAMEBUFFER, 0);
         }
         if (stats)
