@@ -27,35 +27,30 @@ lmgi_context *lmt_context(void)
     return ctx;
 }
 
+static lmgi_scene *load_desc(const lmgi_scene_desc *d, int target_texels, float texel_size)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = target_texels;
+    o.texel_size = texel_size;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(d, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
 lmgi_scene *lmt_room(const lmt_room_spec *spec)
 {
     static const float default_lo[3] = {-0.4f, 0.0f, -0.4f}, default_hi[3] = {0.4f, 1.0f, 0.4f};
     const float *lo = spec->block_lo, *hi = spec->block_hi;
     if (all_zero(lo, 3) && all_zero(hi, 3))
         lo = default_lo, hi = default_hi;
-    float room[24], block[24], stool[24];
-    for (int v = 0; v < 8; v++)
-        for (int k = 0; k < 3; k++) {
-            int up = (v >> k) & 1;
-            room[3 * v + k] = k == 1 ? (up ? 3.0f : 0.0f) : (up ? 2.0f : -2.0f);
-            block[3 * v + k] = up ? hi[k] : lo[k];
-            stool[3 * v + k] = k == 1 ? (up ? 0.3f : 0.0f) : k == 0 ? (up ? 1.9f : 1.6f) : (up ? -1.6f : -1.9f);
-        }
-    /* corners of each face (bit k of a corner index: the upper end along axis k), wound so the face
-     * looks out of the box; each face has vertices of its own, so its normals are the face's */
-    static const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
     float room_v[72], block_v[72], stool_v[72];
     uint32_t outward[36], inward[36];
-    for (int f = 0; f < 6; f++) {
-        for (int c = 0; c < 4; c++)
-            for (int k = 0; k < 3; k++) {
-                int at = 3 * (4 * f + c) + k, corner = 3 * faces[f][c] + k;
-                room_v[at] = room[corner], block_v[at] = block[corner], stool_v[at] = stool[corner];
-            }
-        const uint32_t q = 4 * (uint32_t)f, out[6] = {q, q + 1, q + 2, q, q + 2, q + 3};
-        for (int i = 0; i < 6; i++)
-            outward[6 * f + i] = out[i], inward[6 * f + i] = out[i % 3 == 1 ? i + 1 : i % 3 == 2 ? i - 1 : i];
-    }
+    lmt_box((const float[3]){-2, 0, -2}, (const float[3]){2, 3, 2}, 1, room_v, inward);
+    lmt_box(lo, hi, 0, block_v, outward);
+    lmt_box((const float[3]){1.6f, 0, -1.9f}, (const float[3]){1.9f, 0.3f, -1.6f}, 0, stool_v, outward);
     lmgi_mesh_desc meshes[3] = {
         {.name = "room", .positions = room_v, .vertex_count = 24, .indices = inward, .triangle_count = 12},
         {.name = "block", .positions = block_v, .vertex_count = 24, .indices = outward, .triangle_count = 12,
@@ -68,15 +63,62 @@ lmgi_scene *lmt_room(const lmt_room_spec *spec)
         mats[1] = *spec->block;
     lmgi_scene_desc d = {.name = "room", .meshes = meshes, .mesh_count = spec->stool ? 3 : 2, .materials = mats,
                          .material_count = 2, .lights = spec->lights, .light_count = spec->light_count};
+    return load_desc(&d, 1500, spec->texel_size);
+}
+
+void lmt_box(const float lo[3], const float hi[3], int inward, float *pos, uint32_t *idx)
+{
+    /* corners of each face (bit k of a corner index: the upper end along axis k), wound to look out */
+    static const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+    for (int f = 0; f < 6; f++) {
+        for (int c = 0; c < 4; c++)
+            for (int k = 0; k < 3; k++)
+                pos[3 * (4 * f + c) + k] = (faces[f][c] >> k) & 1 ? hi[k] : lo[k];
+        const uint32_t q = 4 * (uint32_t)f, out[6] = {q, q + 1, q + 2, q, q + 2, q + 3};
+        for (int i = 0; i < 6; i++)
+            idx[6 * f + i] = inward ? out[i % 3 == 1 ? i + 1 : i % 3 == 2 ? i - 1 : i] : out[i];
+    }
+}
+
+lmgi_scene *lmt_load_desc(const lmgi_scene_desc *d, int target_texels, float texel_size)
+{
+    return load_desc(d, target_texels, texel_size);
+}
+
+lmgi_scene *lmt_load(const char *path, int target_texels)
+{
     lmgi_options o;
     lmgi_options_init(&o);
-    o.target_texels = 1500;
-    o.texel_size = spec->texel_size;
+    o.target_texels = target_texels;
     lmgi_scene *sc = NULL;
     lmgi_error e;
-    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     return sc;
+}
+
+uint32_t lmt_uv_sphere(float r, const float c[3], int seg, int rings, float *pos, float *nrm, uint32_t *idx,
+                       uint32_t *vertices)
+{
+    uint32_t v = 0, t = 0;
+    for (int j = 0; j <= rings; j++)
+        for (int i = 0; i <= seg; i++, v++) {
+            double th = M_PI * j / rings, ph = 2 * M_PI * i / seg;
+            double n[3] = {sin(th) * cos(ph), cos(th), sin(th) * sin(ph)};
+            for (int k = 0; k < 3; k++)
+                nrm[3 * v + k] = (float)n[k], pos[3 * v + k] = c[k] + r * (float)n[k];
+        }
+    for (int j = 0; j < rings; j++)
+        for (int i = 0; i < seg; i++) {
+            uint32_t a = (uint32_t)(j * (seg + 1) + i), b = a + 1, cc = a + (uint32_t)seg + 1, d = cc + 1;
+            const uint32_t q[6] = {a, b, d, a, d, cc};
+            if (j > 0)
+                memcpy(idx + 3 * t++, q, 3 * sizeof *q);
+            if (j < rings - 1)
+                memcpy(idx + 3 * t++, q + 3, 3 * sizeof *q);
+        }
+    *vertices = v;
+    return t;
 }
 
 lmgi_updater *lmt_room_updater(lmgi_context *ctx, lmgi_scene *sc) { return lmt_room_updater_without(ctx, sc, 0); }
@@ -120,9 +162,8 @@ void lmt_bake(lmgi_updater *u, lmgi_bake_report *r)
         fail_msg("%s", e.message);
 }
 
-void lmt_corner_camera(lmgi_camera *out)
+void lmt_look_at(const float eye[3], const float at[3], float fov, lmgi_camera *cam)
 {
-    const float eye[3] = {1.9f, 2.0f, 1.9f}, at[3] = {-1.0f, 0.5f, -1.0f};
     float f[3], l = 0.0f;
     for (int k = 0; k < 3; k++)
         f[k] = at[k] - eye[k], l += f[k] * f[k];
@@ -131,17 +172,21 @@ void lmt_corner_camera(lmgi_camera *out)
     float r[3] = {-f[2], 0.0f, f[0]}, m = sqrtf(f[0] * f[0] + f[2] * f[2]); /* f x (0, 1, 0) */
     r[0] /= m, r[2] /= m;
     float up[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
-    lmgi_camera cam;
-    memset(&cam, 0, sizeof cam);
+    memset(cam, 0, sizeof *cam);
     for (int k = 0; k < 3; k++) {
-        cam.view[4 * k] = r[k], cam.view[4 * k + 1] = up[k], cam.view[4 * k + 2] = -f[k];
-        cam.view[12] -= r[k] * eye[k], cam.view[13] -= up[k] * eye[k], cam.view[14] += f[k] * eye[k];
+        cam->view[4 * k] = r[k], cam->view[4 * k + 1] = up[k], cam->view[4 * k + 2] = -f[k];
+        cam->view[12] -= r[k] * eye[k], cam->view[13] -= up[k] * eye[k], cam->view[14] += f[k] * eye[k];
     }
-    cam.view[15] = 1.0f;
-    const float n = 0.05f, fa = 20.0f; /* tan(45 degrees) = 1 */
-    cam.proj[0] = cam.proj[5] = 1.0f;
-    cam.proj[10] = -(fa + n) / (fa - n), cam.proj[11] = -1.0f, cam.proj[14] = -2.0f * fa * n / (fa - n);
-    *out = cam;
+    cam->view[15] = 1.0f;
+    const float n = 0.05f, fa = 30.0f, t = 1.0f / tanf(0.5f * fov);
+    cam->proj[0] = cam->proj[5] = t;
+    cam->proj[10] = -(fa + n) / (fa - n), cam->proj[11] = -1.0f, cam->proj[14] = -2.0f * fa * n / (fa - n);
+}
+
+void lmt_corner_camera(lmgi_camera *out)
+{
+    const float eye[3] = {1.9f, 2.0f, 1.9f}, at[3] = {-1.0f, 0.5f, -1.0f};
+    lmt_look_at(eye, at, 0.5f * (float)M_PI, out);
 }
 
 float *lmt_corner_frame(lmgi_updater *u)

@@ -7,6 +7,7 @@
 
 #include <lmgi.h>
 #include <stddef.h>
+#include <stdint.h>
 
 typedef struct {
     const lmgi_light_desc *lights;      /* may be NULL (a level without lights) */
@@ -18,6 +19,21 @@ typedef struct {
     float texel_size;                   /* world units per lightmap texel (0: about 1,500 texels) */
 } lmt_room_spec;
 
+/* lmgi_load_desc / lmgi_load at about target_texels texels (0: the default), or texels of texel_size world
+ * units (0: derived); fails the test on an error. */
+lmgi_scene *lmt_load_desc(const lmgi_scene_desc *d, int target_texels, float texel_size);
+lmgi_scene *lmt_load(const char *path, int target_texels);
+/* A perspective camera at eye looking at `at` (y up), square, vertical field of view fov radians, near 0.05,
+ * far 30. */
+void lmt_look_at(const float eye[3], const float at[3], float fov, lmgi_camera *cam);
+/* A UV sphere of radius r at c, seg segments around and rings pole to pole (the poles' rings one triangle a
+ * segment, no zero-area ones): positions and normals ((seg + 1)(rings + 1) x 3 floats each) and indices
+ * (at most 6 seg rings); returns the triangles, *vertices the vertices. */
+uint32_t lmt_uv_sphere(float r, const float c[3], int seg, int rings, float *pos, float *nrm, uint32_t *idx,
+                       uint32_t *vertices);
+/* An axis-aligned box [lo, hi]: 24 vertices (4 a face, so its normals are the faces') into pos (72 floats)
+ * and 12 triangles into idx (36), wound to face out of it, or into it with `inward`. */
+void lmt_box(const float lo[3], const float hi[3], int inward, float *pos, uint32_t *idx);
 /* A context with the default GL backend. */
 lmgi_context *lmt_context(void);
 /* The room as a scene; its nodes are "room", "block" and "stool". */

@@ -14,6 +14,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "edit_room.h"
 #include "support.h"
 
 #define PI 3.14159265358979323846
@@ -32,14 +33,7 @@ static lmgi_scene *lamp_over_floor(void)
                             .position = {0, HEIGHT, 0}};
     lmgi_scene_desc d = {.name = "lamp over floor", .meshes = &floor, .mesh_count = 1, .materials = &grey,
                          .material_count = 1, .lights = &lamp, .light_count = 1};
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 1500;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
+    return lmt_load_desc(&d, 1500, 0.0f);
 }
 
 static void expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
@@ -205,13 +199,8 @@ static void test_reference_parts_with_mirror(void **state)
                             .position = {0, HEIGHT, 0}};
     lmgi_scene_desc sd = {.name = "lamp, mirror and floor", .meshes = meshes, .mesh_count = 2, .materials = mats,
                           .material_count = 2, .lights = &lamp, .light_count = 1};
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 1500;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = lmt_load_desc(&sd, 1500, 0.0f);
     lmgi_error e;
-    if (lmgi_load_desc(&sd, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     lmgi_reference_desc d = quick();
     d.target_error = 0.2f;
     d.caustic_photons = 1 << 18;

@@ -122,13 +122,8 @@ static void test_still_frame_reuses_caustics(void **state)
 {
     (void)state;
     lmgi_context *ctx = lmt_context();
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 800;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = lmt_load(lmt_mirror_scene("still.gltf", NULL, "{\"lmgi\": {\"dynamic\": true}}"), 800);
     lmgi_error e;
-    if (lmgi_load(lmt_mirror_scene("still.gltf", NULL, "{\"lmgi\": {\"dynamic\": true}}"), &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     lmgi_updater_desc d;
     lmt_room_desc(&d);
     d.frame_width = d.frame_height = SIDE;
@@ -302,31 +297,6 @@ static void test_dirty_faces(void **state)
     lmgi_context_free(ctx);
 }
 
-/* A UV sphere of radius r at c: positions, normals and indices (seg around, rings pole to pole; the
- * poles' rings get one triangle a segment, not a zero-area one besides); returns its triangles. */
-static int sphere(float r, const float c[3], int seg, int rings, float *pos, float *nrm, uint32_t *idx)
-{
-    int v = 0;
-    for (int j = 0; j <= rings; j++)
-        for (int i = 0; i <= seg; i++, v++) {
-            double th = M_PI * j / rings, ph = 2 * M_PI * i / seg;
-            double n[3] = {sin(th) * cos(ph), cos(th), sin(th) * sin(ph)};
-            for (int k = 0; k < 3; k++)
-                nrm[3 * v + k] = (float)n[k], pos[3 * v + k] = c[k] + r * (float)n[k];
-        }
-    int t = 0;
-    for (int j = 0; j < rings; j++)
-        for (int i = 0; i < seg; i++) {
-            uint32_t a = (uint32_t)(j * (seg + 1) + i), b = a + 1, cc = a + (uint32_t)seg + 1, d = cc + 1;
-            const uint32_t q[6] = {a, b, d, a, d, cc};
-            if (j > 0)
-                memcpy(idx + 3 * t++, q, 3 * sizeof *q);
-            if (j < rings - 1)
-                memcpy(idx + 3 * t++, q + 3, 3 * sizeof *q);
-        }
-    return t;
-}
-
 /* A mirror sphere (albedo 0.8) inside a closed box whose walls emit radiance 1 shows 0.8 at every pixel
  * of it (what it reflects is the same everywhere). */
 static void test_mirror_sphere_in_uniform_box(void **state)
@@ -335,31 +305,20 @@ static void test_mirror_sphere_in_uniform_box(void **state)
     enum { SEG = 32, RINGS = 16, SV = (SEG + 1) * (RINGS + 1), ST = 2 * SEG * RINGS };
     static float spos[3 * SV], snrm[3 * SV], box[72];
     static uint32_t sidx[3 * ST], bidx[36];
-    int tris = sphere(0.5f, (const float[3]){0, 0, 0}, SEG, RINGS, spos, snrm, sidx);
-    static const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (int f = 0; f < 6; f++) {
-        for (int c = 0; c < 4; c++)
-            for (int k = 0; k < 3; k++)
-                box[3 * (4 * f + c) + k] = (faces[f][c] >> k) & 1 ? 3.0f : -3.0f;
-        const uint32_t q = 4 * (uint32_t)f, in[6] = {q, q + 2, q + 1, q, q + 3, q + 2}; /* wound to face in */
-        memcpy(bidx + 6 * f, in, sizeof in);
-    }
+    uint32_t sv;
+    uint32_t tris = lmt_uv_sphere(0.5f, (const float[3]){0, 0, 0}, SEG, RINGS, spos, snrm, sidx, &sv);
+    lmt_box((const float[3]){-3, -3, -3}, (const float[3]){3, 3, 3}, 1, box, bidx);
     lmgi_mesh_desc meshes[2] = {
         {.name = "box", .positions = box, .vertex_count = 24, .indices = bidx, .triangle_count = 12},
-        {.name = "ball", .positions = spos, .normals = snrm, .vertex_count = SV, .indices = sidx, .triangle_count = (uint32_t)tris,
+        {.name = "ball", .positions = spos, .normals = snrm, .vertex_count = sv, .indices = sidx, .triangle_count = tris,
          .material = 1}};
     lmgi_material_desc mats[2] = {{.name = "glow", .base_color = {0, 0, 0, 1}, .emissive = {1, 1, 1}},
                                   {.name = "chrome", .base_color = {0.8f, 0.8f, 0.8f, 1}, .metallic = 1.0f,
                                    .roughness = 0.01f}};
     lmgi_scene_desc d = {.name = "uniform box", .meshes = meshes, .mesh_count = 2, .materials = mats,
                          .material_count = 2};
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 600;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = lmt_load_desc(&d, 600, 0.0f);
     lmgi_error e;
-    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     lmgi_context *ctx = lmt_context();
     lmgi_updater_desc ud;
     lmt_room_desc(&ud);
@@ -371,12 +330,8 @@ static void test_mirror_sphere_in_uniform_box(void **state)
     update(u, &st);
     /* from (0, 0, 2.5) towards the ball, 40 degrees: it fills the middle of the picture */
     lmgi_camera cam;
-    memset(&cam, 0, sizeof cam);
-    cam.view[0] = cam.view[5] = cam.view[10] = cam.view[15] = 1.0f;
-    cam.view[14] = -2.5f;
-    float t = 1.0f / tanf(0.35f), n = 0.05f, fa = 20.0f;
-    cam.proj[0] = cam.proj[5] = t;
-    cam.proj[10] = -(fa + n) / (fa - n), cam.proj[11] = -1.0f, cam.proj[14] = -2.0f * fa * n / (fa - n);
+    lmt_look_at((const float[3]){0, 0, 2.5f}, (const float[3]){0, 0, 0}, 0.7f, &cam);
+    float t = cam.proj[5];
     static float rgb[PIXELS];
     assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, rgb, &e), LMGI_OK);
     double worst = 0.0, sum = 0.0;

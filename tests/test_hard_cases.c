@@ -15,25 +15,13 @@
 
 #define PI 3.14159265358979323846
 
-/* An axis-aligned box [lo, hi], 24 vertices (4 a face, so its normals are the faces'), 12 triangles
- * wound to face out of it (inward = 0) or into it. */
+/* A box's vertices and triangles (lmt_box). */
 typedef struct {
     float v[72];
     uint32_t idx[36];
 } box_mesh;
 
-static void make_box(box_mesh *b, const float lo[3], const float hi[3], int inward)
-{
-    static const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (int f = 0; f < 6; f++) {
-        for (int c = 0; c < 4; c++)
-            for (int k = 0; k < 3; k++)
-                b->v[3 * (4 * f + c) + k] = (faces[f][c] >> k) & 1 ? hi[k] : lo[k];
-        const uint32_t q = 4 * (uint32_t)f, out[6] = {q, q + 1, q + 2, q, q + 2, q + 3};
-        for (int i = 0; i < 6; i++)
-            b->idx[6 * f + i] = inward ? out[i % 3 == 1 ? i + 1 : i % 3 == 2 ? i - 1 : i] : out[i];
-    }
-}
+static void make_box(box_mesh *b, const float lo[3], const float hi[3], int inward) { lmt_box(lo, hi, inward, b->v, b->idx); }
 
 /* The matrix x -> s x + t, column-major. */
 static void scale_translate(float m[16], float s, const float t[3])
@@ -44,18 +32,7 @@ static void scale_translate(float m[16], float s, const float t[3])
     m[15] = 1.0f;
 }
 
-static lmgi_scene *load(const lmgi_scene_desc *d, float texel_size)
-{
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 1500;
-    o.texel_size = texel_size;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load_desc(d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
-}
+static lmgi_scene *load(const lmgi_scene_desc *d, float texel_size) { return lmt_load_desc(d, 1500, texel_size); }
 
 /* ---------- the room with a lamp, and an updater on it ---------- */
 

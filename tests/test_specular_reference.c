@@ -18,40 +18,6 @@
 #define SIDE 64
 #define PIXELS (SIDE * SIDE)
 
-/* A perspective camera at eye looking at `at` (y up), vertical field of view fov radians, square. */
-static void look_at(const float eye[3], const float at[3], float fov, lmgi_camera *cam)
-{
-    float f[3], l = 0.0f;
-    for (int k = 0; k < 3; k++)
-        f[k] = at[k] - eye[k], l += f[k] * f[k];
-    for (int k = 0; k < 3; k++)
-        f[k] /= sqrtf(l);
-    float r[3] = {-f[2], 0.0f, f[0]}, m = sqrtf(f[0] * f[0] + f[2] * f[2]); /* f x (0, 1, 0) */
-    r[0] /= m, r[2] /= m;
-    float up[3] = {r[1] * f[2] - r[2] * f[1], r[2] * f[0] - r[0] * f[2], r[0] * f[1] - r[1] * f[0]};
-    memset(cam, 0, sizeof *cam);
-    for (int k = 0; k < 3; k++) {
-        cam->view[4 * k] = r[k], cam->view[4 * k + 1] = up[k], cam->view[4 * k + 2] = -f[k];
-        cam->view[12] -= r[k] * eye[k], cam->view[13] -= up[k] * eye[k], cam->view[14] += f[k] * eye[k];
-    }
-    cam->view[15] = 1.0f;
-    const float n = 0.05f, fa = 30.0f, t = 1.0f / tanf(0.5f * fov);
-    cam->proj[0] = cam->proj[5] = t;
-    cam->proj[10] = -(fa + n) / (fa - n), cam->proj[11] = -1.0f, cam->proj[14] = -2.0f * fa * n / (fa - n);
-}
-
-static lmgi_scene *load(const char *path, int texels)
-{
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = texels;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
-}
-
 /* An updater at the edit tests' cheap settings (lmt_room_desc), or the defaults (`full`). */
 static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, uint32_t caustic_photons, int world_filter, int full)
 {
@@ -80,32 +46,6 @@ static void reference(lmgi_scene *sc, const lmgi_camera *cam, float target, lmgi
         fail_msg("%s", e.message);
 }
 
-/* A UV sphere of radius r at c, seg segments around and rings pole to pole (the poles' rings one triangle a
- * segment): positions, normals, indices; returns the triangles, *vertices the vertices. */
-static uint32_t uv_sphere(float r, const float c[3], int seg, int rings, float *pos, float *nrm, uint32_t *idx,
-                          uint32_t *vertices)
-{
-    uint32_t v = 0, t = 0;
-    for (int j = 0; j <= rings; j++)
-        for (int i = 0; i <= seg; i++, v++) {
-            double th = M_PI * j / rings, ph = 2 * M_PI * i / seg;
-            double n[3] = {sin(th) * cos(ph), cos(th), sin(th) * sin(ph)};
-            for (int k = 0; k < 3; k++)
-                nrm[3 * v + k] = (float)n[k], pos[3 * v + k] = c[k] + r * (float)n[k];
-        }
-    for (int j = 0; j < rings; j++)
-        for (int i = 0; i < seg; i++) {
-            uint32_t a = (uint32_t)(j * (seg + 1) + i), b = a + 1, cc = a + (uint32_t)seg + 1, d = cc + 1;
-            const uint32_t q[6] = {a, b, d, a, d, cc};
-            if (j > 0)
-                memcpy(idx + 3 * t++, q, 3 * sizeof *q);
-            if (j < rings - 1)
-                memcpy(idx + 3 * t++, q + 3, 3 * sizeof *q);
-        }
-    *vertices = v;
-    return t;
-}
-
 /* A glass ball (r 0.3, ior 1.5) 0.5 m over a white floor (0.8) under a 10 cd lamp at (-1, 3, 0): its focal
  * spot near (0.2, 0, 0), seen from the side. The runtime's caustic there (kd / pi x the caustic pass's
  * E), screen-space filter and world-space, against the reference's light-traced caustic part over the
@@ -117,7 +57,7 @@ static void test_glass_focal_spot(void **state)
     enum { SEG = 48, RINGS = 24 };
     static float pos[3 * (SEG + 1) * (RINGS + 1)], nrm[3 * (SEG + 1) * (RINGS + 1)];
     static uint32_t idx[6 * SEG * RINGS];
-    uint32_t v, t = uv_sphere(0.3f, (const float[3]){0, 0.5f, 0}, SEG, RINGS, pos, nrm, idx, &v);
+    uint32_t v, t = lmt_uv_sphere(0.3f, (const float[3]){0, 0.5f, 0}, SEG, RINGS, pos, nrm, idx, &v);
     const float floor_pos[12] = {-4, 0, 4, 4, 0, 4, 4, 0, -4, -4, 0, -4};
     const uint32_t floor_idx[6] = {0, 1, 2, 0, 2, 3};
     lmgi_mesh_desc meshes[2] = {
@@ -129,15 +69,10 @@ static void test_glass_focal_spot(void **state)
     lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 10.0f, .position = {-1, 3, 0}};
     lmgi_scene_desc d = {.name = "glass ball", .meshes = meshes, .mesh_count = 2, .materials = mats,
                          .material_count = 2, .lights = &lamp, .light_count = 1};
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 800;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = lmt_load_desc(&d, 800, 0.0f);
     lmgi_error e;
-    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     lmgi_camera cam;
-    look_at((const float[3]){1.4f, 1.3f, 0.9f}, (const float[3]){0.2f, 0.0f, 0.0f}, 0.6f, &cam);
+    lmt_look_at((const float[3]){1.4f, 1.3f, 0.9f}, (const float[3]){0.2f, 0.0f, 0.0f}, 0.6f, &cam);
     lmgi_context *ctx = lmt_context();
     lmgi_reference ref;
     reference(sc, &cam, 0.2f, &ref);
@@ -236,21 +171,6 @@ static void compare_mirror(const float *frame, const lmgi_reference *ref, double
     *count = n;
 }
 
-/* An axis-aligned box [lo, hi] as 24 vertices (4 a face) and 12 triangles, wound to face out of it or, with
- * `inward`, into it. */
-static void box(const float lo[3], const float hi[3], int inward, float *pos, uint32_t *idx)
-{
-    static const int faces[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-    for (int f = 0; f < 6; f++) {
-        for (int c = 0; c < 4; c++)
-            for (int k = 0; k < 3; k++)
-                pos[3 * (4 * f + c) + k] = (faces[f][c] >> k) & 1 ? hi[k] : lo[k];
-        const uint32_t q = 4 * (uint32_t)f, out[6] = {q, q + 1, q + 2, q, q + 2, q + 3};
-        for (int i = 0; i < 6; i++)
-            idx[6 * f + i] = inward ? out[i % 3 == 1 ? i + 1 : i % 3 == 2 ? i - 1 : i] : out[i];
-    }
-}
-
 /* A mirror sphere (r 0.5, albedo 0.9) in the middle of a room (half-size 2) with a red, a blue and a green
  * block against its walls and a lamp: its pixels against the reference's radiance (its reflections part).
  * Measured 0.92 of it, relative RMSE 0.19; the walls themselves read 0.96 in the frame, and the top of the
@@ -262,11 +182,11 @@ static void test_mirror_sphere_pixels(void **state)
     enum { SEG = 48, RINGS = 24 };
     static float spos[3 * (SEG + 1) * (RINGS + 1)], snrm[3 * (SEG + 1) * (RINGS + 1)], b[4][72];
     static uint32_t sidx[6 * SEG * RINGS], bidx[4][36];
-    uint32_t sv, st = uv_sphere(0.5f, (const float[3]){0, 0, 0}, SEG, RINGS, spos, snrm, sidx, &sv);
-    box((const float[3]){-2, -2, -2}, (const float[3]){2, 2, 2}, 1, b[0], bidx[0]);
-    box((const float[3]){1.4f, -2, -1}, (const float[3]){2, 0.5f, 1}, 0, b[1], bidx[1]);    /* red, at x = 2 */
-    box((const float[3]){-1, -2, -2}, (const float[3]){1, 0, -1.4f}, 0, b[2], bidx[2]);     /* blue, at z = -2 */
-    box((const float[3]){-2, -2, -1}, (const float[3]){-1.2f, -1, 1}, 0, b[3], bidx[3]);    /* green, at x = -2 */
+    uint32_t sv, st = lmt_uv_sphere(0.5f, (const float[3]){0, 0, 0}, SEG, RINGS, spos, snrm, sidx, &sv);
+    lmt_box((const float[3]){-2, -2, -2}, (const float[3]){2, 2, 2}, 1, b[0], bidx[0]);
+    lmt_box((const float[3]){1.4f, -2, -1}, (const float[3]){2, 0.5f, 1}, 0, b[1], bidx[1]);    /* red, at x = 2 */
+    lmt_box((const float[3]){-1, -2, -2}, (const float[3]){1, 0, -1.4f}, 0, b[2], bidx[2]);     /* blue, at z = -2 */
+    lmt_box((const float[3]){-2, -2, -1}, (const float[3]){-1.2f, -1, 1}, 0, b[3], bidx[3]);    /* green, at x = -2 */
     lmgi_mesh_desc meshes[5];
     static const char *const names[4] = {"room", "red", "blue", "green"};
     for (int k = 0; k < 4; k++)
@@ -283,15 +203,10 @@ static void test_mirror_sphere_pixels(void **state)
     lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 8.0f, .position = {0.3f, 1.2f, 0.9f}};
     lmgi_scene_desc d = {.name = "mirror sphere room", .meshes = meshes, .mesh_count = 5, .materials = mats,
                          .material_count = 5, .lights = &lamp, .light_count = 1};
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 1500;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = lmt_load_desc(&d, 1500, 0.0f);
     lmgi_error e;
-    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     lmgi_camera cam;
-    look_at((const float[3]){0.8f, 0.5f, 1.7f}, (const float[3]){0, 0, 0}, 0.6f, &cam);
+    lmt_look_at((const float[3]){0.8f, 0.5f, 1.7f}, (const float[3]){0, 0, 0}, 0.6f, &cam);
     lmgi_context *ctx = lmt_context();
     lmgi_updater *u = updater(ctx, sc, 0, 0, 1);
     static float frame[3 * PIXELS];
@@ -319,9 +234,9 @@ static void test_wall_mirror_box_projection(void **state)
     double rmse[2], ratio[2];
     int n[2];
     for (int box = 0; box < 2; box++) {
-        lmgi_scene *sc = load(mirror_room(box ? "wall_box.gltf" : "wall_plain.gltf", box), 1500);
+        lmgi_scene *sc = lmt_load(mirror_room(box ? "wall_box.gltf" : "wall_plain.gltf", box), 1500);
         lmgi_camera cam;
-        look_at((const float[3]){1.5f, 0.3f, 1.2f}, (const float[3]){-2.0f, 0.0f, 0.0f}, 0.9f, &cam);
+        lmt_look_at((const float[3]){1.5f, 0.3f, 1.2f}, (const float[3]){-2.0f, 0.0f, 0.0f}, 0.9f, &cam);
         lmgi_context *ctx = lmt_context();
         lmgi_updater *u = updater(ctx, sc, 0, 0, 0);
         static float frame[3 * PIXELS];

@@ -1,6 +1,8 @@
 /* The scene model: freeing, world transforms, animation evaluation and geometric queries. */
 #include "scene.h"
 
+#include "../core/hash.h"
+
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -309,4 +311,12 @@ void lm_light_place(const lm_scene *s, const lm_light *l, float pos[3], float di
     const float *w = s->nodes[l->node].world;
     lm_v3_store(pos, lm_v3(w[12], w[13], w[14]));
     lm_v3_store(dir, lm_normalize(lm_mat4_dir(w, lm_v3(0, 0, -1))));
+}
+
+uint64_t lm_scene_world_hash(const lm_scene *s)
+{
+    uint64_t h = LM_HASH_SEED;
+    for (int n = 0; n < s->node_count; n++)
+        h = lm_hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
+    return h;
 }

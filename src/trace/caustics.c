@@ -301,22 +301,6 @@ struct lm_caustics {
     uint32_t *em_tri_first;
 };
 
-static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t i = 0; i < n; i++)
-        h = (h ^ b[i]) * 1099511628211ull;
-    return h;
-}
-
-static uint64_t world_hash(const lm_scene *s)
-{
-    uint64_t h = 1469598103934665603ull;
-    for (int n = 0; n < s->node_count; n++)
-        h = hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
-    return h;
-}
-
 static void emitter_snapshot(const lm_caustics *c, int e, emitter_state *out)
 {
     const lm_emitter *em = &c->em->e[e];
@@ -489,7 +473,7 @@ static void snapshot_all(lm_caustics *c)
         memcpy(c->gen_world[g], c->scene->nodes[c->gen[g].node].world, sizeof c->gen_world[g]);
     for (int e = 0; e < c->em_count; e++)
         emitter_snapshot(c, e, &c->em_state[e]);
-    c->world_hash = world_hash(c->scene);
+    c->world_hash = lm_scene_world_hash(c->scene);
 }
 
 lm_status lm_caustics_trace_all(lm_caustics *c, lm_caustic_frame_stats *stats, lm_error *err)
@@ -598,7 +582,7 @@ lm_status lm_caustics_frame(lm_caustics *c, lm_caustic_frame_stats *stats, lm_er
     double t0 = lm_now();
     if (c->pair_count) {
         st.pairs_moved = mark_moved(c);
-        uint64_t h = world_hash(c->scene);
+        uint64_t h = lm_scene_world_hash(c->scene);
         int moved = h != c->world_hash;
         c->world_hash = h;
         uint32_t N = c->set.photons, per_frame = (uint32_t)ceil((double)c->set.retrace * N), n = 0;

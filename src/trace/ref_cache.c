@@ -1,6 +1,8 @@
 /* Cache keys and files for the reference solver (ref_cache.h). */
 #include "ref_cache.h"
 
+#include "../core/hash.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,17 +13,11 @@
 
 #define LM_REF_MAGIC "LMGIREF1"
 #define LM_REF_VERSION 2u /* 2: the split by light path (caustic, lost, pixel parts) */
-#define LM_FNV_OFFSET 0xcbf29ce484222325ull
-#define LM_FNV_PRIME 0x100000001b3ull
+#define LM_FNV_OFFSET LM_HASH_SEED
 
 /* ---- FNV-1a ---- */
 
-static void fnv(uint64_t *h, const void *data, size_t n)
-{
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; i++)
-        *h = (*h ^ p[i]) * LM_FNV_PRIME;
-}
+static void fnv(uint64_t *h, const void *data, size_t n) { *h = lm_hash_bytes(*h, data, n); }
 
 static void fnv_u32(uint64_t *h, uint32_t v) { fnv(h, &v, sizeof v); }
 static void fnv_f(uint64_t *h, float v) { fnv(h, &v, sizeof v); }

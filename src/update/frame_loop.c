@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/hash.h"
 #include "../core/memory.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
@@ -403,30 +404,13 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     free(fl);
 }
 
-static uint64_t hash_bytes(uint64_t h, const void *p, size_t n)
-{
-    const unsigned char *b = p;
-    for (size_t k = 0; k < n; k++)
-        h = (h ^ b[k]) * 1099511628211ull;
-    return h;
-}
-
-/* A hash of every node's world matrix: the brute-force picture is made again when something moved. */
-static uint64_t world_hash(const lm_scene *s)
-{
-    uint64_t h = 1469598103934665603ull;
-    for (int n = 0; n < s->node_count; n++)
-        h = hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
-    return h;
-}
-
 /* The brute-force path's indirect radiance for view at w x h into fl->photon_rgb, unless it is there
  * already for the same view, photons and node matrices. Reads the photon store: never while the stage's
  * worker runs (the steps call it before they start it). */
 static lm_status photon_indirect(lm_frame_loop *fl, const lm_view *view, int w, int h, lm_error *err)
 {
     const lm_photon_store *ps = lm_photons_store(lm_photon_stage_photons(fl->stage));
-    uint64_t world = world_hash(fl->scene);
+    uint64_t world = lm_scene_world_hash(fl->scene);
     if (fl->photon_rgb && fl->photon_w == w && fl->photon_h == h && fl->photon_version == ps->version &&
         fl->photon_world == world && !memcmp(fl->photon_view.view, view->view, sizeof view->view) &&
         !memcmp(fl->photon_view.proj, view->proj, sizeof view->proj))
@@ -517,15 +501,15 @@ static lm_status prepare_frame(lm_frame_loop *fl, lm_error *err)
 static uint64_t lighting_hash(const lm_frame_loop *fl)
 {
     const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
-    uint64_t h = 1469598103934665603ull;
+    uint64_t h = LM_HASH_SEED;
     for (int e = 0; e < em->count; e++) {
         const lm_emitter *x = &em->e[e];
         const float *parts[4] = {x->pos, x->dir, x->radiant, x->power};
         for (int k = 0; k < 4; k++)
-            h = hash_bytes(h, parts[k], 3 * sizeof(float));
+            h = lm_hash_bytes(h, parts[k], 3 * sizeof(float));
     }
-    h = hash_bytes(h, &fl->scene->material_version, sizeof fl->scene->material_version);
-    return hash_bytes(h, &fl->caustic_version, sizeof fl->caustic_version);
+    h = lm_hash_bytes(h, &fl->scene->material_version, sizeof fl->scene->material_version);
+    return lm_hash_bytes(h, &fl->caustic_version, sizeof fl->caustic_version);
 }
 
 /* The caustics of a picture drawn by lm_direct_draw (the step's own frame keeps its caustics apart, for
@@ -536,12 +520,12 @@ static lm_status draw_caustics(lm_frame_loop *fl, lm_caustic_pass *cp, int own, 
                                lm_frame_stats *o, lm_error *err)
 {
     int slot = own ? LM_CAUSTIC_SLOT_FRAME : LM_CAUSTIC_SLOT_VIEW;
-    uint64_t key = world_hash(fl->scene);
-    key = hash_bytes(key, view->view, sizeof view->view);
-    key = hash_bytes(key, view->proj, sizeof view->proj);
-    key = hash_bytes(key, &fl->caustic_version, sizeof fl->caustic_version);
+    uint64_t key = lm_scene_world_hash(fl->scene);
+    key = lm_hash_bytes(key, view->view, sizeof view->view);
+    key = lm_hash_bytes(key, view->proj, sizeof view->proj);
+    key = lm_hash_bytes(key, &fl->caustic_version, sizeof fl->caustic_version);
     const int size[2] = {w, h};
-    key = hash_bytes(key, size, sizeof size);
+    key = lm_hash_bytes(key, size, sizeof size);
     if (fl->caustic_key[slot] == key && fl->caustic_keyed[slot])
         return lm_caustic_pass_composite(cp, slot, view, fl->direct_light, -1, &o->caustic, err);
     lm_status st = lm_caustic_pass_run(cp, slot, view, lm_direct_depth_texture(fl->direct_light, 0), w, h,
