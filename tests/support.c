@@ -418,5 +418,9 @@ double lmt_mirror_image(double x, double z, int *inside)
     double t = 1.0 / (2.0 - x), y = 2.0 - 2.0 * t, zz = z * t; /* where the line to it crosses x = 1 */
     *inside = x < 2.0 && y >= 0.75 && y <= 1.25 && fabs(zz) <= 0.25;
     double d = sqrt((2.0 - x) * (2.0 - x) + 4.0 + z * z);
-    return 0.9 * 10.0 * 2.0 / (d * d * d);
+    /* the light arrives at the mirror from (0, 2, 0) at cos = 1 / |(1, y - 2, zz)| */
+    double cos_i = 1.0 / sqrt(1.0 + (y - 2.0) * (y - 2.0) + zz * zz), m = 1.0 - cos_i;
+    return lmt_mirror_fresnel(0.9, m) * 10.0 * 2.0 / (d * d * d);
 }
+
+double lmt_mirror_fresnel(double albedo, double one_minus_cos) { return albedo + (1.0 - albedo) * pow(one_minus_cos, 5.0); }

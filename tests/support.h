@@ -82,9 +82,12 @@ const char *lmt_plane_scene(void);
  * cube; it is named "cube"); `mirror_extras` on the mirror's node; last, a camera 4 m above (-0.15, 0, 0) looking straight down
  * (60 degrees). Written to lmt_tmpdir()/name; returns its path. */
 const char *lmt_mirror_scene(const char *name, const char *mirror_extras, const char *cube_extras);
-/* The image of that light in that mirror: the irradiance rho I cos / d^2 from the virtual light (2, 2, 0)
- * at floor point (x, 0, z), and whether the line to it passes through the mirror (*inside). */
+/* The image of that light in that mirror: the irradiance F I cos / d^2 from the virtual light (2, 2, 0) at
+ * floor point (x, 0, z), F the mirror's reflectance where that light meets it, and whether the line to it
+ * passes through the mirror (*inside). */
 double lmt_mirror_image(double x, double z, int *inside);
+/* A metal's Fresnel reflectance (Schlick's, F0 the albedo) at 1 - cos. */
+double lmt_mirror_fresnel(double albedo, double one_minus_cos);
 
 #endif
 

@@ -592,7 +592,15 @@ static void test_mirror_reflects_exactly(void **state)
     assert_float_equal(bs.wo[0], 0.6, 1e-6);
     assert_float_equal(bs.wo[1], 0.8, 1e-6);
     assert_float_equal(bs.wo[2], 0.0, 1e-6);
-    assert_float_equal(bs.weight[1], 0.8, 1e-6);
+    /* a metal's Fresnel (Schlick's, F0 the albedo): cos 0.8, 0.8 + 0.2 (1 - 0.8)^5 */
+    assert_float_equal(bs.weight[1], 0.8 + 0.2 * 0.00032, 1e-6);
+    float grazing[3], face_on[3], albedo[3] = {0.8f, 0.5f, 0.2f};
+    lm_mirror_fresnel(albedo, 0.0f, grazing);
+    lm_mirror_fresnel(albedo, -1.0f, face_on);
+    for (int c = 0; c < 3; c++) {
+        assert_float_equal(grazing[c], 1.0, 1e-6);
+        assert_float_equal(face_on[c], albedo[c], 1e-6);
+    }
     float f[3];
     lm_bsdf_eval(&sh, wi, bs.wo, f);
     assert_float_equal(f[0], 0.0, 0.0);

@@ -94,12 +94,13 @@ static int in_patch(v3 p, double margin)
     return fabs(s) > HALF + margin || fabs(t) > HALF + margin ? -1 : 0;
 }
 
-/* E = rho I cos(theta) / d^2 from the virtual light at floor point p. */
+/* E = F I cos(theta) / d^2 from the virtual light at floor point p, F the mirror's reflectance (a metal's
+ * Fresnel, Schlick's with F0 = rho) at the angle the ray through p meets it. */
 static double caustic_irradiance(v3 p)
 {
     v3 to = v3_sub(virtual_light(), p);
-    double d2 = v3_dot(to, to);
-    return RHO_MIRROR * INTENSITY * (to.y / sqrt(d2)) / d2;
+    double d2 = v3_dot(to, to), cos_i = fabs(v3_dot(to, mirror_normal())) / sqrt(d2);
+    return lmt_mirror_fresnel(RHO_MIRROR, 1.0 - cos_i) * INTENSITY * (to.y / sqrt(d2)) / d2;
 }
 
 static lm_ref_settings quick_settings(uint32_t caustic_photons)

@@ -38,7 +38,7 @@ struct lm_reflections {
     GLuint prog;
 };
 
-/* Mirror: albedo x env(r). Glossy: ks (n + 2) / (n + 1) max(n.r, 0) x env(r) at the mip level whose texel
+/* Mirror: F x env(r), F the metal's Fresnel (Schlick's, the albedo as F0: lm_mirror_fresnel). Glossy: ks (n + 2) / (n + 1) max(n.r, 0) x env(r) at the mip level whose texel
  * is the lobe's width 1 / sqrt(n) (lod_base = log2(size / (pi / 2)), a face spanning pi / 2). Glass (ior
  * in the vertex's n): F env(r) + (1 - F) albedo env(t), F the dielectric Fresnel reflectance at the eye
  * ray's angle (Schlick's approximation to it; 1 for KHR_materials_ior's 0), t the ray refracted into the
@@ -75,7 +75,12 @@ static const char *REFLECT_MAIN =
     "    vec3 n = normalize(gl_FrontFacing ? v_ns : -v_ns);\n"
     "    vec3 r = reflect(normalize(v_pos - eye), n);\n"
     "    int cls = int(v_par.w + 0.5);\n"
-    "    if (cls == 2) { frag = vec4(albedo * textureLod(env, parallax(r), 0.0).rgb, 0.0); return; }\n"
+    "    if (cls == 2) { /* a metal's Fresnel, Schlick's with the albedo as F0 (bsdf.c's lm_mirror_fresnel) */\n"
+    "        float m = 1.0 - clamp(abs(dot(normalize(v_pos - eye), n)), 0.0, 1.0);\n"
+    "        vec3 F = albedo + (1.0 - albedo) * (m * m * m * m * m);\n"
+    "        frag = vec4(F * textureLod(env, parallax(r), 0.0).rgb, 0.0);\n"
+    "        return;\n"
+    "    }\n"
     "    if (cls == 3) {\n"
     "        vec3 d = normalize(v_pos - eye);\n"
     "        if (v_par.x == 0.0) { frag = vec4(textureLod(env, parallax(r), 0.0).rgb, 0.0); return; } /* ior 0 */\n"

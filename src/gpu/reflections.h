@@ -4,7 +4,7 @@
  * given; the node itself left out), and an additive pass that adds to the frame what those triangles
  * reflect of it:
  *
- *   mirror   albedo x env(r)
+ *   mirror   F x env(r), F = albedo + (1 - albedo)(1 - cos)^5 (a metal's Fresnel, Schlick's)
  *   glossy   ks (n + 2) / (n + 1) max(n.r, 0) x env(r, blurred to the lobe)
  *   glass    F env(r) + (1 - F) albedo env(t), F Schlick's Fresnel, t refracted at the near surface
  *

@@ -13,7 +13,9 @@
  *                      kd + ks <= 1; n = lm_phong_exponent(roughness). Sampled as a mixture of the
  *                      cosine lobe and the Phong lobe (pdf (n + 1) / (2 pi) cos^n alpha), picked by
  *                      the luminances of kd and ks; the weight uses the mixture's pdf.
- *   mirror             wo = reflect(wi, ns), weight = albedo.
+ *   mirror             wo = reflect(wi, ns), weight = the metal's Fresnel reflectance, Schlick's
+ *                      approximation with the albedo as F0 (glTF's metallic model): albedo face on,
+ *                      rising to 1 at grazing angles (lm_mirror_fresnel).
  *   glass              exact dielectric Fresnel F; reflect with probability F (weight 1), else refract
  *                      by Snell's law (weight = albedo, the glass tint); total internal reflection
  *                      reflects always. Inside/outside from the sign of dot(wi, ng). */
@@ -167,10 +169,16 @@ static int sample_mirror(const lm_shading *sh, lm_vec3 ng, lm_vec3 ns, lm_vec3 w
     if (lm_dot(r, ng) <= 0.0f)
         return 0;
     lm_v3_store(out->wo, r);
-    for (int c = 0; c < 3; c++)
-        out->weight[c] = sh->albedo[c];
+    lm_mirror_fresnel(sh->albedo, -lm_dot(wi, ns), out->weight);
     out->specular = 1;
     return 1;
+}
+
+void lm_mirror_fresnel(const float albedo[3], float cos_i, float out[3])
+{
+    float c = cos_i < 0.0f ? -cos_i : cos_i, m = 1.0f - (c > 1.0f ? 1.0f : c), m5 = m * m * m * m * m;
+    for (int k = 0; k < 3; k++)
+        out[k] = albedo[k] + (1.0f - albedo[k]) * m5;
 }
 
 int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], lm_bsdf_sample_t *out)

@@ -68,6 +68,10 @@ static inline int lm_material_stores_hits(lm_material_class c)
  * lm_phong_exponent: the glossy lobe's exponent for a roughness, n = 2 / r^4 - 2 clamped to [1, 1e4]. */
 float lm_bsdf_pdf(const lm_shading *sh, const float wi[3], const float wo[3]);
 float lm_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
+/* A mirror's reflectance at cos_i (the cosine between the incoming direction and the normal, either sign):
+ * Schlick's F0 + (1 - F0)(1 - cos)^5 per channel, F0 the albedo. The reflection pass's shader computes
+ * the same. */
+void lm_mirror_fresnel(const float albedo[3], float cos_i, float out[3]);
 float lm_phong_exponent(float roughness);
 
 #endif
