@@ -57,7 +57,7 @@ static lm_caustic_pass *run(fixture *f, const lm_caustic_pass_settings *set, lm_
     lm_error err;
     if (lm_caustic_pass_create(set, &cp, &err) != LM_OK ||
         lm_caustic_pass_set_photons(cp, lm_caustics_hits(f->c), lm_caustics_photon_count(f->c), &err) != LM_OK ||
-        lm_caustic_pass_run(cp, 0, &f->view, lm_direct_depth_texture(f->d, 0), W, H, NULL, -1, st, &err) != LM_OK)
+        lm_caustic_pass_run(cp, 0, &f->view, lm_direct_depth_texture(f->d, 0), W, H, NULL, st, &err) != LM_OK)
         fail_msg("%s", err.msg);
     return cp;
 }
@@ -181,7 +181,7 @@ static void test_empty_and_bad(void **state)
     lm_caustic_pass_settings_default(&set);
     assert_int_equal(lm_caustic_pass_create(&set, &cp, &err), LM_OK);
     lm_caustic_pass_stats st;
-    assert_int_equal(lm_caustic_pass_run(cp, 0, &f.view, lm_direct_depth_texture(f.d, 0), W, H, f.d, -1, &st, &err), LM_OK);
+    assert_int_equal(lm_caustic_pass_run(cp, 0, &f.view, lm_direct_depth_texture(f.d, 0), W, H, f.d, &st, &err), LM_OK);
     assert_int_equal(st.photons, 0);
     assert_int_equal(st.tiles_lit, 0);
     static float E[3 * W * H];

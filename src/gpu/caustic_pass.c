@@ -9,7 +9,6 @@
 
 #include "../core/timing.h"
 #include "../core/vecmath.h"
-#include "direct_shader.h"
 #include "gl_shader.h"
 
 void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
@@ -138,24 +137,16 @@ static const char *FILTER_WORLD =
     "        }\n"
     "    frag = vec4(e / (PI * R * R / 3.0), 1.0);\n"
     "}\n";
-/* kd / pi x E at every visible non-specular pixel (mirror and glass have no diffuse lobe). */
-static const char *COMPOSITE_HEAD =
+/* kd / pi x E at every pixel, kd as the direct light's first pass found it (0 on mirror, glass and the
+ * back of single-sided surfaces). */
+static const char *COMPOSITE_FS =
     "#version 450 core\n"
-    "in vec3 v_pos, v_ns;\n"
-    "flat in vec3 v_base, v_em;\n"
-    "flat in vec4 v_par;\n"
-    "in vec2 v_uv, v_lm;\n"
-    "uniform int has_tex;\n"
-    "uniform sampler2D base_tex, irr;\n"
+    "uniform sampler2D irr, kd;\n"
     "out vec4 frag;\n"
-    "const float PI = " LM_PI_GLSL ";\n";
-static const char *COMPOSITE_MAIN =
+    "const float PI = " LM_PI_GLSL ";\n"
     "void main() {\n"
-    "    look_up_albedo();\n"
-    "    if (!gl_FrontFacing && v_par.y < 0.5) { frag = vec4(0.0); return; }\n"
-    "    vec3 kd, ks;\n"
-    "    lobes(kd, ks);\n"
-    "    frag = vec4(kd / PI * texelFetch(irr, ivec2(gl_FragCoord.xy), 0).rgb, 0.0);\n"
+    "    ivec2 p = ivec2(gl_FragCoord.xy);\n"
+    "    frag = vec4(texelFetch(kd, p, 0).rgb / PI * texelFetch(irr, p, 0).rgb, 0.0);\n"
     "}\n";
 
 /* One slot's targets: the splat (two RGBA32F + depth-stencil), the irradiance, the tiles' flags. */
@@ -305,11 +296,8 @@ static lm_status build_programs(lm_caustic_pass *cp, lm_error *err)
         memcpy(k, digits, 8);
         st = lm_gl_program("caustic filter", FILTER_VS, fs, &cp->filter_prog, err);
     }
-    len = snprintf(fs, sizeof fs, "%s%s%s", COMPOSITE_HEAD, lm_direct_lobes_glsl, COMPOSITE_MAIN);
-    if (st == LM_OK && (len < 0 || (size_t)len >= sizeof fs))
-        st = lm_fail(err, LM_ERR_BACKEND, "caustic pass: shader source buffer too small");
     if (st == LM_OK)
-        st = lm_gl_program("caustic composite", lm_direct_vs, fs, &cp->composite_prog, err);
+        st = lm_gl_program("caustic composite", RECT_VS, COMPOSITE_FS, &cp->composite_prog, err);
     return st;
 }
 
@@ -621,40 +609,38 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
     glActiveTexture(GL_TEXTURE0);
 }
 
-static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_view *view, const lm_direct *d, int slot,
-                      int skip, const int box[4])
+/* kd / pi x E added over the box of the grown lit tiles (outside them E is 0), into d's probe target (the
+ * probe slot) or its frame's. One quad: no geometry drawn again. */
+static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_direct *d, int slot, const int box[4])
 {
     if (slot == LM_CAUSTIC_SLOT_PROBE)
         lm_direct_bind_probe(d);
     else
         lm_direct_bind_target(d);
-    glEnable(GL_SCISSOR_TEST);
-    glScissor(box[0], box[1], box[2] - box[0], box[3] - box[1]);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LEQUAL);
-    glDepthMask(GL_FALSE);
+    glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     GLuint p = cp->composite_prog;
     glUseProgram(p);
-    float vp[16];
-    lm_mat4_mul(vp, view->proj, view->view);
-    glUniformMatrix4fv(glGetUniformLocation(p, "view_proj"), 1, GL_FALSE, vp);
-    glUniform1i(glGetUniformLocation(p, "base_tex"), 2);
-    glActiveTexture(GL_TEXTURE5);
-    glBindTexture(GL_TEXTURE_2D, t->irr_tex);
-    glUniform1i(glGetUniformLocation(p, "irr"), 5);
-    lm_direct_draw_scene(d, p, skip);
+    set_size(p, t->width, t->height);
+    glUniform4f(glGetUniformLocation(p, "rect"), (float)box[0], (float)box[1], (float)box[2], (float)box[3]);
+    const GLuint tex[2] = {t->irr_tex, lm_direct_kd_texture(d, slot == LM_CAUSTIC_SLOT_PROBE)};
+    const char *names[2] = {"irr", "kd"};
+    for (int i = 0; i < 2; i++) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, tex[i]);
+        glUniform1i(glGetUniformLocation(p, names[i]), i);
+    }
+    glBindVertexArray(cp->empty_vao);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
     glActiveTexture(GL_TEXTURE0);
     glDisable(GL_BLEND);
-    glDisable(GL_SCISSOR_TEST);
-    glDepthMask(GL_TRUE);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
 lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,
-                              int height, const lm_direct *d, int skip, lm_caustic_pass_stats *stats, lm_error *err)
+                              int height, const lm_direct *d, lm_caustic_pass_stats *stats, lm_error *err)
 {
     lm_caustic_pass_stats st;
     memset(&st, 0, sizeof st);
@@ -696,7 +682,7 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
     t->lit_count = st.tiles_lit;
     memcpy(t->box, box, sizeof box);
     if (s == LM_OK && d && st.tiles_lit) {
-        composite(cp, t, view, d, slot, skip, box);
+        composite(cp, t, d, slot, box);
         glFinish();
     }
     glBindVertexArray(0);
@@ -715,8 +701,8 @@ static const slot_targets *slot_of(const lm_caustic_pass *cp, int slot)
 
 unsigned lm_caustic_pass_irradiance(const lm_caustic_pass *cp, int slot) { return slot_of(cp, slot)->irr_tex; }
 
-lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_view *view, const lm_direct *d, int skip,
-                                    lm_caustic_pass_stats *stats, lm_error *err)
+lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_direct *d, lm_caustic_pass_stats *stats,
+                                    lm_error *err)
 {
     if (slot < 0 || slot >= LM_CAUSTIC_SLOTS || !cp->slots[slot].irr_fbo)
         return lm_fail(err, LM_ERR_INVALID, "caustic pass: slot %d has no irradiance to composite", slot);
@@ -725,7 +711,7 @@ lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_view
     memset(&st, 0, sizeof st);
     double t0 = lm_now();
     if (t->lit_count && cp->photons) {
-        composite(cp, t, view, d, slot, skip, t->box);
+        composite(cp, t, d, slot, t->box);
         glFinish();
     }
     glBindVertexArray(0);

@@ -23,15 +23,14 @@
  *                world radius R = k pixel footprints at x, E(x) = sum_j Phi_j max(0, 1 - |P_j - P_x| / R)
  *                / (pi R^2 / 3): photons on another surface than x's (a depth step) do not leak.
  *            Elsewhere E is 0.
- *   composite  the scene drawn again over the frame's depth (depth test LEQUAL, additive), each pixel
- *            adding kd / pi x E (kd the diffuse lobe at the pixel, gpu/direct_shader.c's lobes), inside the
- *            box of the grown tiles.
+ *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
+ *            lobe the direct light's first pass wrote there: lm_direct_kd_texture).
  *
  * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
  * environment maps' faces (_PROBE, composited into lm_direct's probe target) and other views an application
  * renders (_VIEW).
- * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel, one
- * draw of the scene clipped to the lit tiles' box (docs/bench.md has the figures). Needs a current GL
+ * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel, two
+ * per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a current GL
  * context; not thread-safe. */
 #ifndef LM_CAUSTIC_PASS_H
 #define LM_CAUSTIC_PASS_H
@@ -71,14 +70,14 @@ lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit 
 uint32_t lm_caustic_pass_photon_count(const lm_caustic_pass *cp);
 /* Splat, tiles and filter for `view` over the depth texture `depth` (width x height, lm_direct_depth_texture)
  * into slot `slot`'s irradiance; then, unless d is NULL, the composite into d's probe target (the probe
- * slot) or its frame's (the others), leaving node `skip` out (-1: none). Nothing at all is drawn without
+ * slot) or its frame's (the others), whose first pass drew the same view. Nothing at all is drawn without
  * photons. stats may be NULL. */
 lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,
-                              int height, const lm_direct *d, int skip, lm_caustic_pass_stats *stats, lm_error *err);
+                              int height, const lm_direct *d, lm_caustic_pass_stats *stats, lm_error *err);
 /* The composite alone, over slot's irradiance as its last run left it: for a picture whose photons, view
  * and depth are those of that run (nothing moved), which need no splat, query or filter again. */
-lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_view *view, const lm_direct *d, int skip,
-                                    lm_caustic_pass_stats *stats, lm_error *err);
+lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_direct *d, lm_caustic_pass_stats *stats,
+                                    lm_error *err);
 /* After a run of slot: the irradiance E (RGBA32F texture, rgb), the tiles whose queries found photons
  * (tiles_x x tiles_y flags, row 0 at the bottom as GL's), and the splat read back (width x height x 4
  * floats, GL rows bottom-up: rgb = sum Phi / A_pix, a = photons) for tests. */

@@ -382,7 +382,7 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     int moved = lm_direct_mesh_update(&d->mesh, s);
     d->static_version += (moved & LM_MESH_STATIC_CASTERS_MOVED) != 0;
     d->dynamic_version += (moved & LM_MESH_DYNAMIC_CASTERS_MOVED) != 0;
-    st = lm_float_target_ensure(t, width, height, 1, err);
+    st = lm_float_target_ensure(t, width, height, 2, err); /* radiance, and the first pass's kd */
     if (st != LM_OK)
         return st;
     d->cur = t;
@@ -395,7 +395,10 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     if (st != LM_OK)
         return st;
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    static const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glDrawBuffers(2, both);
     first_pass(d, s, em, first, view, width, height);
+    glDrawBuffers(1, both); /* the additive passes after it add radiance only */
     for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
         if (em->e[i].kind != LM_EMIT_AREA)
             st = light_pass(d, s, &em->e[i], i, view, width, height, err);
@@ -423,11 +426,16 @@ lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitter
 
 unsigned lm_direct_probe_texture(const lm_direct *d) { return d->probe.color[0]; }
 
-void lm_direct_bind_target(const lm_direct *d)
+/* Binds a target for a pass that adds radiance (attachment 0; the kd attachment stays as it is). */
+static void bind_radiance(const lm_float_target *t)
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, d->target.fbo);
-    glViewport(0, 0, d->target.width, d->target.height);
+    static const GLenum radiance = GL_COLOR_ATTACHMENT0;
+    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glDrawBuffers(1, &radiance);
+    glViewport(0, 0, t->width, t->height);
 }
+
+void lm_direct_bind_target(const lm_direct *d) { bind_radiance(&d->target); }
 
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
 {
@@ -440,22 +448,10 @@ void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
 }
 
 
-void lm_direct_draw_scene(const lm_direct *d, unsigned prog, int skip)
-{
-    int ok = skip >= 0 && skip < d->mesh.node_count;
-    int drop[2] = {ok ? d->mesh.node_first[skip] : 0, ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0};
-    set_ranges(prog, ALL, drop);
-    lm_direct_mesh_draw(&d->mesh, prog);
-    set_ranges(prog, ALL, ALL);
-}
-
-void lm_direct_bind_probe(const lm_direct *d)
-{
-    glBindFramebuffer(GL_FRAMEBUFFER, d->probe.fbo);
-    glViewport(0, 0, d->probe.width, d->probe.height);
-}
+void lm_direct_bind_probe(const lm_direct *d) { bind_radiance(&d->probe); }
 
 unsigned lm_direct_depth_texture(const lm_direct *d, int probe) { return probe ? d->probe.depth : d->target.depth; }
+unsigned lm_direct_kd_texture(const lm_direct *d, int probe) { return probe ? d->probe.color[1] : d->target.color[1]; }
 
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 

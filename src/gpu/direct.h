@@ -57,7 +57,7 @@ lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *e
 /* Reads the last lm_direct_draw's image (and what lm_direct_bind_target's passes added to it) back as RGB
  * floats, row 0 at the top. */
 lm_status lm_direct_read(lm_direct *d, float *rgb, lm_error *err);
-/* Binds the frame's target (after lm_direct_draw) for a further pass to add to it (reflections.h). */
+/* Binds the frame's target (after lm_direct_draw) for a further pass to add radiance to it (reflections.h). */
 void lm_direct_bind_target(const lm_direct *d);
 /* The scene from view into a second, size x size target kept apart from the frame's, node `skip`'s
  * vertices left out (-1: none): one face of skip's environment map (reflections.h). The first pass's
@@ -69,13 +69,14 @@ unsigned lm_direct_probe_texture(const lm_direct *d);
 /* Draws only node's triangles with prog, a program on lm_direct_vs (its uniforms set by the caller;
  * has_tex and the base colour texture on unit 2 set here per texture group). */
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node);
-/* Draws every node's triangles but node skip's (-1: none) with prog, as lm_direct_draw_node draws one: a
- * further pass over the frame or a probe face (the caustics' composite). */
-void lm_direct_draw_scene(const lm_direct *d, unsigned prog, int skip);
 /* Binds the probe's target (after lm_direct_draw_probe) for a further pass to add to it. */
 void lm_direct_bind_probe(const lm_direct *d);
 /* The depth texture of the frame's target (probe 0) or of the probe's (1): 24-bit, GL window depth. */
 unsigned lm_direct_depth_texture(const lm_direct *d, int probe);
+/* The diffuse lobe kd the first pass found at each pixel of the frame (probe 0) or the probe (1): an
+ * RGBA32F texture (rgb; 0 where nothing, the back of a single-sided surface, mirror and glass), for a
+ * later pass that adds kd / pi x an irradiance per pixel (the caustics). */
+unsigned lm_direct_kd_texture(const lm_direct *d, int probe);
 /* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
  * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */

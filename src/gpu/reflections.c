@@ -251,7 +251,7 @@ static lm_status render_face(lm_reflections *r, int k, int face, lm_direct *d, c
     lm_status st = lm_direct_draw_probe(d, s, em, &v, r->size, f->node, err);
     if (st == LM_OK && caustics) /* the face's caustics, over its own depth */
         st = lm_caustic_pass_run(caustics, LM_CAUSTIC_SLOT_PROBE, &v, lm_direct_depth_texture(d, 1), r->size, r->size,
-                                 d, f->node, NULL, err);
+                                 d, NULL, err);
     if (st != LM_OK)
         return st;
     glCopyImageSubData(lm_direct_probe_texture(d), GL_TEXTURE_2D, 0, 0, 0, 0, f->cube, GL_TEXTURE_CUBE_MAP, 0, 0, 0,

@@ -527,9 +527,9 @@ static lm_status draw_caustics(lm_frame_loop *fl, lm_caustic_pass *cp, int own, 
     const int size[2] = {w, h};
     key = lm_hash_bytes(key, size, sizeof size);
     if (fl->caustic_key[slot] == key && fl->caustic_keyed[slot])
-        return lm_caustic_pass_composite(cp, slot, view, fl->direct_light, -1, &o->caustic, err);
+        return lm_caustic_pass_composite(cp, slot, fl->direct_light, &o->caustic, err);
     lm_status st = lm_caustic_pass_run(cp, slot, view, lm_direct_depth_texture(fl->direct_light, 0), w, h,
-                                       fl->direct_light, -1, &o->caustic, err);
+                                       fl->direct_light, &o->caustic, err);
     fl->caustic_key[slot] = key;
     fl->caustic_keyed[slot] = st == LM_OK;
     return st;

@@ -64,7 +64,7 @@ static int time_pass(lm_caustic_pass *cp, const lm_view *v, const lm_direct *d, 
     lm_caustic_pass_stats st;
     lm_error err;
     for (int r = 0; r < REPEATS; r++) {
-        if (lm_caustic_pass_run(cp, LM_CAUSTIC_SLOT_FRAME, v, depth, SIZE, SIZE, d, -1, &st, &err) != LM_OK) {
+        if (lm_caustic_pass_run(cp, LM_CAUSTIC_SLOT_FRAME, v, depth, SIZE, SIZE, d, &st, &err) != LM_OK) {
             printf("caustic pass: %s\n", err.msg);
             return 0;
         }
