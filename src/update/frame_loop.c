@@ -30,7 +30,7 @@ struct lm_frame_loop {
     lm_composite *comp;
     lm_reflections *reflections; /* NULL: no mirror or glossy node, or switched off */
     lm_caustic_pass *caustic_pass; /* made when the first caustic photons land */
-    uint64_t caustic_version;    /* the stage's caustic photons the pass holds (lm_caustics_version) */
+    uint64_t caustic_version;    /* the stage's caustic photons the pass holds (lm_photon_stage_caustics_version) */
     int caustic_slot, caustic_w, caustic_h; /* the last picture drawn: its caustics' slot and size (w 0: none yet) */
     uint64_t caustic_key[LM_CAUSTIC_SLOTS]; /* what each slot's last run was made for (draw_caustics) */
     int caustic_keyed[LM_CAUSTIC_SLOTS];
@@ -469,13 +469,14 @@ static int has_generators(lm_frame_loop *fl)
 static lm_status upload_caustics(lm_frame_loop *fl, lm_error *err)
 {
     const lm_caustics *c = lm_photon_stage_caustics(fl->stage);
-    if (!c || lm_caustics_version(c) == fl->caustic_version || (!fl->caustic_pass && !lm_caustics_landed(c)))
+    uint64_t version = lm_photon_stage_caustics_version(fl->stage);
+    if (!c || version == fl->caustic_version || (!fl->caustic_pass && !lm_caustics_landed(c)))
         return LM_OK;
     lm_status st = fl->caustic_pass ? LM_OK : lm_caustic_pass_create(&fl->set.caustic_pass, &fl->caustic_pass, err);
     if (st == LM_OK)
         st = lm_caustic_pass_set_photons(fl->caustic_pass, lm_caustics_hits(c), lm_caustics_photon_count(c), err);
     if (st == LM_OK)
-        fl->caustic_version = lm_caustics_version(c);
+        fl->caustic_version = version;
     return st;
 }
 
@@ -600,7 +601,8 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
     /* the photon gather and the caustic photons read what the worker writes. A loop that draws frames of
      * its own shows the caustic photons its last frame showed (the step's lighting); one that draws none
      * takes the newest, waiting for the work that traces them */
-    int newest = fl->set.width <= 0 && has_generators(fl);
+    int newest = fl->set.width <= 0 && (has_generators(fl) || (fl->caustic_pass &&
+                                                                  lm_caustic_pass_photon_count(fl->caustic_pass)));
     if (st == LM_OK && (photon_path(fl) || newest))
         st = lm_frame_loop_sync(fl, err);
     if (st == LM_OK && newest)

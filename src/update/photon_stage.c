@@ -53,6 +53,7 @@ struct lm_photon_stage {
     uint32_t caustic_version;    /* the scene's pass_version they were made for */
     int caustic_emitters;        /* the emitters they were made for */
     int caustics_stale;          /* a material was edited: made again at the next update */
+    uint64_t caustic_made;       /* times they were made (lm_photon_stage_caustics_version) */
     int have_emitters, have_aim, have_area;
     int frame;
 };
@@ -181,6 +182,7 @@ static lm_status make_caustics(lm_photon_stage *ps, lm_caustic_frame_stats *st, 
     ps->caustic_version = ps->scene->pass_version;
     ps->caustic_emitters = ps->emitters.count;
     ps->caustics_stale = 0;
+    ps->caustic_made++;
     return lm_caustics_create(ps->scene, ps->rt, &ps->emitters, &ps->set.caustic, &ps->caustics, st, err);
 }
 
@@ -412,3 +414,8 @@ lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }
 const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps) { return ps->caustics; }
+
+uint64_t lm_photon_stage_caustics_version(const lm_photon_stage *ps)
+{
+    return ps->caustic_made << 40 | (ps->caustics ? lm_caustics_version(ps->caustics) : 0);
+}

@@ -75,5 +75,8 @@ const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
 /* The caustic photons; NULL when the settings have none. A class or switch edit (lm_scene.pass_version), an
  * added light or an edited material makes them again at the next update (a full trace). */
 const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps);
+/* A counter that moves whenever the caustic photons changed, across their being made again (which
+ * lm_caustics_version alone does not see: a new set counts from 0 again). */
+uint64_t lm_photon_stage_caustics_version(const lm_photon_stage *ps);
 
 #endif
