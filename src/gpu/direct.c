@@ -163,6 +163,10 @@ static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters 
         glUseProgram(d->emission);
         set_ranges(d->emission, ALL, d->drop);
         glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
+        const float towards_eye[3] = {view->view[2], view->view[6], view->view[10]}; /* as set_view_uniforms */
+        glUniform3fv(glGetUniformLocation(d->emission, "eye"), 1, view->eye);
+        glUniform3fv(glGetUniformLocation(d->emission, "view_dir"), 1, towards_eye);
+        glUniform1i(glGetUniformLocation(d->emission, "ortho_view"), view->proj[11] == 0.0f && view->proj[15] != 0.0f);
         glUniform1i(glGetUniformLocation(d->emission, "base_tex"), 2);
         bind_indirect(d, d->e_lit, d->e_use_lit);
         lm_direct_mesh_draw(&d->mesh, d->emission);
@@ -382,7 +386,7 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     int moved = lm_direct_mesh_update(&d->mesh, s);
     d->static_version += (moved & LM_MESH_STATIC_CASTERS_MOVED) != 0;
     d->dynamic_version += (moved & LM_MESH_DYNAMIC_CASTERS_MOVED) != 0;
-    st = lm_float_target_ensure(t, width, height, 2, err); /* radiance, and the first pass's kd */
+    st = lm_float_target_ensure(t, width, height, 3, err); /* radiance; the first pass's kd and G-buffer */
     if (st != LM_OK)
         return st;
     d->cur = t;
@@ -395,10 +399,10 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     if (st != LM_OK)
         return st;
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
-    static const GLenum both[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
-    glDrawBuffers(2, both);
+    static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+    glDrawBuffers(3, all);
     first_pass(d, s, em, first, view, width, height);
-    glDrawBuffers(1, both); /* the additive passes after it add radiance only */
+    glDrawBuffers(1, all); /* the additive passes after it add radiance only */
     for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
         if (em->e[i].kind != LM_EMIT_AREA)
             st = light_pass(d, s, &em->e[i], i, view, width, height, err);
@@ -452,6 +456,8 @@ void lm_direct_bind_probe(const lm_direct *d) { bind_radiance(&d->probe); }
 
 unsigned lm_direct_depth_texture(const lm_direct *d, int probe) { return probe ? d->probe.depth : d->target.depth; }
 unsigned lm_direct_kd_texture(const lm_direct *d, int probe) { return probe ? d->probe.color[1] : d->target.color[1]; }
+unsigned lm_direct_gbuffer_texture(const lm_direct *d) { return d->target.color[2]; }
+unsigned lm_direct_radiance_texture(const lm_direct *d) { return d->target.color[0]; }
 
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 

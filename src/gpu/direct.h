@@ -77,6 +77,13 @@ unsigned lm_direct_depth_texture(const lm_direct *d, int probe);
  * RGBA32F texture (rgb; 0 where nothing, the back of a single-sided surface, mirror and glass), for a
  * later pass that adds kd / pi x an irradiance per pixel (the caustics). */
 unsigned lm_direct_kd_texture(const lm_direct *d, int probe);
+/* The frame's G-buffer from the first pass (after lm_direct_draw): an RGBA32F texture, rgb the visible
+ * point's world position, a the eye-side shading normal packed (0: nothing, or the back of a single-sided
+ * surface; lm_direct_gbuffer_glsl unpacks it), for the per-pixel photon gathers (gpu/photon_gather.h). */
+unsigned lm_direct_gbuffer_texture(const lm_direct *d);
+/* The frame's radiance (after lm_direct_draw): the RGBA32F texture lm_direct_read reads, for a compute pass
+ * that adds to it (the photon gathers' composite). */
+unsigned lm_direct_radiance_texture(const lm_direct *d);
 /* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
  * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */

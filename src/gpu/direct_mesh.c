@@ -125,11 +125,12 @@ static corner_key key_of(const lm_scene *s, const lm_atlas *a, uint32_t t, int k
     memset(&key, 0, sizeof key);
     key.vi = s->tris[3 * (size_t)t + k];
     key.mat = (int32_t)s->tri_material[t];
-    if (a) { /* as lm_lightmapped_vertices */
+    if (a) { /* as lm_lightmapped_vertices; -2: the node's indirect light is switched off (the photon
+              * gathers read it from the G-buffer, direct_shader.c) */
         const float *c = a->corner_uv + 6 * (size_t)t + 2 * k;
-        int none = a->tri_chart[t] < 0 || !isfinite(c[0]);
-        key.lm[0] = none ? -1.0f : c[0];
-        key.lm[1] = none ? -1.0f : c[1];
+        int none = a->tri_chart[t] < 0 || !isfinite(c[0]), off = !s->nodes[s->tri_node[t]].settings.indirect;
+        key.lm[0] = off ? -2.0f : none ? -1.0f : c[0];
+        key.lm[1] = off ? -2.0f : none ? -1.0f : c[1];
     }
     return key;
 }

@@ -46,6 +46,32 @@
 
 const char *const lm_direct_lobes_glsl = LOBES;
 
+/* The first pass's G-buffer (attachment 2, for the per-pixel photon gathers, gpu/photon_gather.h): the
+ * visible point's world position, and its shading normal on the eye's side octahedron-mapped to 12 bits
+ * a coordinate, packed into one float as the integer 1 + 4096 x + y (exact: under 2^24); 0 where nothing
+ * or the back of a single-sided surface is seen, or a node whose indirect light is switched off (its
+ * lightmap uv -2, direct_mesh.c). lm_direct_gbuffer_glsl unpacks it. */
+#define GBUFFER \
+    "vec4 gbuffer(vec3 p, vec3 n, bool seen) {\n" \
+    "    vec2 o = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));\n" \
+    "    if (n.z < 0.0) o = (1.0 - abs(o.yx)) * vec2(o.x >= 0.0 ? 1.0 : -1.0, o.y >= 0.0 ? 1.0 : -1.0);\n" \
+    "    vec2 q = round(clamp(o * 0.5 + 0.5, 0.0, 1.0) * 4095.0);\n" \
+    "    return vec4(p, seen && v_lm.x > -1.5 ? 1.0 + q.x * 4096.0 + q.y : 0.0);\n" \
+    "}\n"
+
+const char *const lm_direct_gbuffer_glsl =
+    "bool gbuffer_normal(float a, out vec3 n) {\n"
+    "    n = vec3(0.0);\n"
+    "    if (a < 1.0) return false;\n"
+    "    float c = a - 1.0, qx = floor(c / 4096.0), qy = c - qx * 4096.0;\n"
+    "    vec2 o = vec2(qx, qy) / 4095.0 * 2.0 - 1.0;\n"
+    "    n = vec3(o, 1.0 - abs(o.x) - abs(o.y));\n"
+    "    if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);\n"
+    "    n = normalize(n);\n"
+    "    return true;\n"
+    "}\n";
+
+
 /* The indirect term at a pixel: kd / pi x E_IIM, E / pi from the premultiplied atlas `lit`
  * (gpu/composite.h) at the lightmap uv (attribute 7, -1 without a chart), rgb / a over the covered, valid
  * texels of its bilinear footprint, kd per pixel (the base colour texture at the pixel, not at the texel's
@@ -110,6 +136,7 @@ const char *const lm_direct_fs_body =
     "#if FIRST\n"
     "layout(location = 0) out vec4 frag;\n"
     "layout(location = 1) out vec4 kd_out; /* the diffuse lobe at the pixel, for later passes */\n"
+    "layout(location = 2) out vec4 g_out;  /* position and normal (GBUFFER) */\n"
     "#else\n"
     "out vec4 frag;\n"
     "#endif\n"
@@ -168,6 +195,7 @@ const char *const lm_direct_fs_body =
     "    return f * E * max(dot(ns, L), 0.0) * shadow(p, ng, L, dist);\n"
     "}\n"
     INDIRECT
+    GBUFFER
     "void main() {\n"
     "    look_up_albedo();\n"
     "    vec3 V = ortho_view != 0 ? view_dir : normalize(eye - v_pos);\n"
@@ -184,6 +212,7 @@ const char *const lm_direct_fs_body =
     "    vec3 kd, ks;\n"
     "    lobes(kd, ks);\n"
     "    kd_out = vec4(seen ? kd : vec3(0.0), 1.0);\n"
+    "    g_out = gbuffer(v_pos, ns, seen);\n"
     "#else\n"
     "    frag = vec4(seen ? c : vec3(0.0), 1.0);\n"
     "#endif\n"
@@ -196,38 +225,51 @@ const char *const lm_direct_fs_body =
 const char *const lm_direct_emission_vs =
     "#version 450 core\n"
     "layout(location = 0) in vec3 pos;\n"
+    "layout(location = 1) in vec3 ns;\n"
     "layout(location = 2) in vec3 base;\n"
     "layout(location = 3) in vec4 par;\n"
     "layout(location = 4) in vec3 em;\n"
     "layout(location = 5) in vec2 uv;\n"
     "layout(location = 7) in vec2 lm_uv;\n"
     "uniform mat4 view_proj;\n"
+    "out vec3 v_pos, v_ns;\n"
     "flat out vec3 v_em, v_base;\n"
     "flat out vec4 v_par;\n"
     "out vec2 v_uv, v_lm;\n"
     "invariant gl_Position;\n"
     VERTEX_RANGES
     "void main() {\n"
-    "    v_em = em; v_base = base; v_par = par; v_uv = uv; v_lm = lm_uv;\n"
+    "    v_pos = pos; v_ns = ns; v_em = em; v_base = base; v_par = par; v_uv = uv; v_lm = lm_uv;\n"
     "    gl_Position = dropped() ? vec4(2.0, 2.0, 2.0, 1.0) : view_proj * vec4(pos, 1.0);\n"
     "}\n";
 
 const char *const lm_direct_emission_fs =
     "#version 450 core\n"
+    "in vec3 v_pos, v_ns;\n"
     "flat in vec3 v_em, v_base;\n"
     "flat in vec4 v_par;\n"
     "in vec2 v_uv, v_lm;\n"
     "uniform sampler2D lit, base_tex;\n"
     "uniform int use_lit, has_tex;\n"
+    "uniform vec3 eye, view_dir;\n"
+    "uniform int ortho_view;\n"
     "layout(location = 0) out vec4 frag;\n"
     "layout(location = 1) out vec4 kd_out;\n"
+    "layout(location = 2) out vec4 g_out;\n"
     LOBES
     INDIRECT
+    GBUFFER
     "void main() {\n"
     "    look_up_albedo();\n"
     "    bool seen = gl_FrontFacing || v_par.y > 0.5; /* the back of a single-sided surface: black */\n"
+    "    vec3 V = ortho_view != 0 ? view_dir : normalize(eye - v_pos);\n"
+    "    vec3 ng = normalize(cross(dFdx(v_pos), dFdy(v_pos))), ns = normalize(v_ns);\n"
+    "    if (dot(ng, V) < 0.0) ng = -ng;\n"
+    "    if (!gl_FrontFacing) ns = -ns;\n"
+    "    if (dot(ns, ng) < 0.0) ns = ng;\n"
     "    frag = vec4(seen ? v_em + indirect() : vec3(0.0), 1.0);\n"
     "    vec3 kd, ks;\n"
     "    lobes(kd, ks);\n"
     "    kd_out = vec4(seen ? kd : vec3(0.0), 1.0);\n"
+    "    g_out = gbuffer(v_pos, ns, seen);\n"
     "}\n";

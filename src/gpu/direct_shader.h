@@ -15,5 +15,8 @@ extern const char *const lm_direct_emission_fs;
  * `vec3 albedo`, `look_up_albedo()` (call first in main(), in uniform control flow; needs uniforms
  * has_tex and base_tex) and `lobes(out vec3 kd, out vec3 ks)`. */
 extern const char *const lm_direct_lobes_glsl;
+/* GLSL that unpacks the G-buffer's a (lm_direct_gbuffer_texture): `bool gbuffer_normal(float a, out vec3 n)`,
+ * false where the pixel has no visible front. */
+extern const char *const lm_direct_gbuffer_glsl;
 
 #endif

@@ -37,6 +37,7 @@
     X(glBufferSubData, PFNGLBUFFERSUBDATAPROC) \
     X(glCheckFramebufferStatus, PFNGLCHECKFRAMEBUFFERSTATUSPROC) \
     X(glClear, PFNGLCLEARPROC) \
+    X(glClearBufferData, PFNGLCLEARBUFFERDATAPROC) \
     X(glClearBufferfv, PFNGLCLEARBUFFERFVPROC) \
     X(glClearBufferiv, PFNGLCLEARBUFFERIVPROC) \
     X(glClearColor, PFNGLCLEARCOLORPROC) \
@@ -187,6 +188,7 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glBlitFramebuffer (lm_gl_cur->glBlitFramebuffer)
 #define glBufferData (lm_gl_cur->glBufferData)
 #define glBufferSubData (lm_gl_cur->glBufferSubData)
+#define glClearBufferData (lm_gl_cur->glClearBufferData)
 #define glCheckFramebufferStatus (lm_gl_cur->glCheckFramebufferStatus)
 #define glClear (lm_gl_cur->glClear)
 #define glClearBufferfv (lm_gl_cur->glClearBufferfv)

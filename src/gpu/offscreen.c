@@ -93,7 +93,7 @@ void lm_float_target_free(lm_float_target *t)
 
 lm_status lm_float_target_ensure(lm_float_target *t, int width, int height, int attachments, lm_error *err)
 {
-    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    static const GLenum bufs[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     if (t->fbo && t->width == width && t->height == height && t->attachments == attachments) {
         glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
         glViewport(0, 0, width, height);

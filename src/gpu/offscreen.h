@@ -23,11 +23,11 @@ void lm_offscreen_read_rgb(const lm_offscreen *o, float *rgb);
 /* Unbinds and deletes a target (after lm_offscreen_read_rgb, or on an error path). */
 void lm_offscreen_release(lm_offscreen *o);
 
-/* A persistent float target for per-frame passes: 1 or 2 RGBA32F colour textures (sampleable, e.g. by
+/* A persistent float target for per-frame passes: 1 to 3 RGBA32F colour textures (sampleable, e.g. by
  * a later pass) and a 24-bit depth texture (sampleable: the caustic pass reads it), kept between frames
  * and re-made only when the size or the attachment count changes. Zero-initialise before the first lm_float_target_ensure. */
 typedef struct {
-    unsigned fbo, color[2], depth;
+    unsigned fbo, color[3], depth;
     int width, height, attachments;
 } lm_float_target;
 
