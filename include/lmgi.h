@@ -370,12 +370,18 @@ typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
 typedef enum { LMGI_GATHER_DEFAULT = 0, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_INSTANCED, LMGI_GATHER_LAYERED } lmgi_gather_scheme;
 
 enum { LMGI_EFFECT_SHADOWS = 1, LMGI_EFFECT_INDIRECT = 2, LMGI_EFFECT_REFLECTIONS = 4, LMGI_EFFECT_CAUSTICS = 8 };
-/* How frames get their indirect light (docs/gather.md): LMGI_INDIRECT_LIGHTMAP, the paper's AIMs,
- * hemicube gather and IIM (the lightmaps); LMGI_INDIRECT_BRUTEFORCE, every visible pixel gathers the
- * photon hits themselves (Mara et al. 2013, every photon against every pixel: the ground truth of
- * photon gathers, for small scenes and frames; no AIM or IIM, so the lightmaps stay 0 and environment
- * maps show direct light only). */
-typedef enum { LMGI_INDIRECT_LIGHTMAP = 0, LMGI_INDIRECT_BRUTEFORCE } lmgi_indirect_path;
+/* How frames get their indirect light (docs/gather.md, docs/tiled.md): LMGI_INDIRECT_LIGHTMAP, the
+ * paper's AIMs, hemicube gather and IIM (the lightmaps); the others gather the photon hits themselves at
+ * every visible pixel on the GPU (Mara et al. 2013; no AIM or IIM, so the lightmaps stay 0 and environment
+ * maps show direct light only): TILED per screen tile from shared memory (the fast one), HASHGRID per
+ * pixel from a hash grid of cells, BRUTEFORCE every photon against every pixel (the ground truth the
+ * others equal, for small frames). */
+typedef enum {
+    LMGI_INDIRECT_LIGHTMAP = 0,
+    LMGI_INDIRECT_BRUTEFORCE,
+    LMGI_INDIRECT_TILED,
+    LMGI_INDIRECT_HASHGRID
+} lmgi_indirect_path;
 /* Where the approximate illumination maps (docs/aim.md) get direct light. PHOTONS: photon first hits bring it
  * all (the paper's form: blurred across shadow edges by the photon estimate's radius); EMITTERS: emissive
  * triangles' light computed per texel (closed form, sampled shadows) where the gather's closed form suits
@@ -431,6 +437,13 @@ typedef struct {
      * node: lmgi_set_node_effects */
     unsigned effects_off;
     lmgi_indirect_path indirect; /* (0: LMGI_INDIRECT_LIGHTMAP) */
+    /* the per-pixel photon gathers (indirect TILED, HASHGRID, BRUTEFORCE; docs/tiled.md) */
+    int photon_tile;           /* TILED: screen tile side in pixels, 4, 8, 16 or 32 (0: 16) */
+    int photon_chunk;          /* TILED: photons per shared-memory load, 64 to 1024 (0: 256) */
+    int photon_stochastic;     /* TILED: k, each pixel reads 1/k^2 of its tile's photons, then an edge-aware
+                                * k x k reconstruction, 1 to 4 (0: 1, all of them) */
+    float photon_radius;       /* the kernel radius in scene units (0: the disc that holds
+                                * photons_per_estimate photons on average) */
     /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
      * that, set non-zero (from any thread), stops it between gather passes: LMGI_ERR_CANCELLED */
     lmgi_progress_fn progress;
@@ -452,6 +465,11 @@ typedef struct {
     int caustic_tiles, caustic_tiles_lit; /* screen tiles queried, and those found holding caustic photons */
     uint64_t caustic_pixels_filtered; /* pixels the caustic filter ran on (the lit tiles grown by k) */
     int cube_faces_rendered;   /* environment map faces rendered */
+    int photon_gathers;        /* per-pixel photon gathers run (indirect TILED, HASHGRID, BRUTEFORCE): 0 when
+                                * the photons, the view and the scene were as for the last one (its picture
+                                * is shown again; the gather's time is in ms_gather) */
+    uint64_t photon_entries;   /* the tile or hash-cell list entries of those gathers */
+    uint32_t photon_pages_uploaded; /* pages of 1,024 photon records sent to the GPU (only those that changed) */
     double ms_animate, ms_trace, ms_aim, ms_caustic_trace; /* the photon work's parts */
     double ms_photons;         /* what the update spent on or waiting for the photon work */
     double ms_gather, ms_blend, ms_direct, ms_caustics, ms_reflections, ms_composite, ms_total;

@@ -146,10 +146,25 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     if (d->effects_off & ~all)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: effects_off 0x%x has bits other than "
                        "LMGI_EFFECT_SHADOWS, _INDIRECT, _REFLECTIONS and _CAUSTICS", d->effects_off);
-    if ((int)d->indirect < LMGI_INDIRECT_LIGHTMAP || (int)d->indirect > LMGI_INDIRECT_BRUTEFORCE)
+    if ((int)d->indirect < LMGI_INDIRECT_LIGHTMAP || (int)d->indirect > LMGI_INDIRECT_HASHGRID)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: indirect %d is not an indirect path "
-                       "(LMGI_INDIRECT_LIGHTMAP, LMGI_INDIRECT_BRUTEFORCE)", (int)d->indirect);
-    s->indirect_path = d->indirect == LMGI_INDIRECT_BRUTEFORCE ? LM_INDIRECT_BRUTEFORCE : LM_INDIRECT_LIGHTMAP;
+                       "(LMGI_INDIRECT_LIGHTMAP, _BRUTEFORCE, _TILED, _HASHGRID)", (int)d->indirect);
+    static const int paths[4] = {LM_INDIRECT_LIGHTMAP, LM_INDIRECT_BRUTEFORCE, LM_INDIRECT_TILED, LM_INDIRECT_HASHGRID};
+    s->indirect_path = paths[d->indirect];
+    if (d->photon_tile)
+        s->photon_gather.tile = d->photon_tile;
+    if (d->photon_chunk)
+        s->photon_gather.chunk = d->photon_chunk;
+    if (d->photon_stochastic)
+        s->photon_gather.stochastic = d->photon_stochastic;
+    lm_error why;
+    if (!lm_photon_gather_settings_check(&s->photon_gather, &why))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: %s (photon_tile, photon_chunk, "
+                       "photon_stochastic; 0: the defaults)", why.msg);
+    if (!(d->photon_radius >= 0.0f) || !isfinite(d->photon_radius))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: photon_radius %g must be positive (0: from "
+                       "photons_per_estimate)", (double)d->photon_radius);
+    s->photon_radius = d->photon_radius;
     s->direct.shadows = !(d->effects_off & LMGI_EFFECT_SHADOWS);
     s->indirect = !(d->effects_off & LMGI_EFFECT_INDIRECT);
     if (d->effects_off & LMGI_EFFECT_REFLECTIONS)
@@ -346,6 +361,9 @@ static void export_stats(const lm_frame_stats *fs, int budget, int changed, lmgi
     o->caustic_tiles_lit = fs->caustic.tiles_lit;
     o->caustic_pixels_filtered = fs->caustic.pixels_filtered;
     o->cube_faces_rendered = fs->cube_faces;
+    o->photon_gathers = fs->photon_gathers;
+    o->photon_entries = fs->photon_gathers ? fs->photon_gather.entries : 0;
+    o->photon_pages_uploaded = fs->photon_gather.pages_uploaded;
     o->ms_animate = 1e3 * st->t_animate;
     o->ms_trace = 1e3 * st->t_photons;
     o->ms_aim = 1e3 * st->t_aim;

@@ -141,7 +141,11 @@ static int parse_indirect(const char *o, const char *v, int *out)
         return *out = LMGI_INDIRECT_LIGHTMAP, 0;
     if (v && !strcmp(v, "bruteforce"))
         return *out = LMGI_INDIRECT_BRUTEFORCE, 0;
-    return bad(o, v, "lightmap or bruteforce");
+    if (v && !strcmp(v, "tiled"))
+        return *out = LMGI_INDIRECT_TILED, 0;
+    if (v && !strcmp(v, "hashgrid"))
+        return *out = LMGI_INDIRECT_HASHGRID, 0;
+    return bad(o, v, "lightmap, tiled, hashgrid or bruteforce");
 }
 
 static int parse_aim_direct(const char *o, const char *v, int *out)
@@ -232,6 +236,16 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_caustic_space(o, v, &a->caustic_world);
         else if (!strcmp(o, "--caustic-tile"))
             rc = parse_int(o, v, 4, 256, &a->caustic_tile);
+        else if (!strcmp(o, "--photon-tile"))
+            rc = parse_int(o, v, 4, 32, &a->photon_tile) ? 2 : (a->photon_tile & (a->photon_tile - 1)) == 0
+                     ? 0 : bad(o, v, "4, 8, 16 or 32 pixels");
+        else if (!strcmp(o, "--photon-chunk"))
+            rc = parse_int(o, v, 64, 1024, &a->photon_chunk);
+        else if (!strcmp(o, "--photon-stochastic"))
+            rc = parse_int(o, v, 1, 4, &a->photon_stochastic);
+        else if (!strcmp(o, "--photon-radius"))
+            rc = parse_float(o, v, 0.0f, &a->photon_radius) ? 2 : a->photon_radius > 0.0f
+                     ? 0 : bad(o, v, "a radius in scene units, above 0");
         else if (!strcmp(o, "--cache"))
             rc = v ? (a->cache_dir = v, 0) : bad(o, v, "a directory");
         else if (!strcmp(o, "--camera"))

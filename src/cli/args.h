@@ -57,7 +57,9 @@ typedef struct {
     int force;              /* --force: write into a non-empty --out directory lmgi did not make */
     int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
     unsigned effects_off;   /* --effects -shadows,-indirect,-reflections,-caustics: lmgi_updater_desc.effects_off */
-    int indirect;           /* --indirect lightmap|bruteforce: lmgi_updater_desc.indirect (default lightmap) */
+    int indirect;           /* --indirect lightmap|tiled|hashgrid|bruteforce: lmgi_updater_desc.indirect */
+    int photon_tile, photon_chunk, photon_stochastic; /* --photon-tile/-chunk/-stochastic; 0 unset */
+    float photon_radius;    /* --photon-radius R; 0 unset */
     int aim_direct;         /* --aim-direct emitters|photons|all: lmgi_updater_desc.aim_direct (default photons) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */

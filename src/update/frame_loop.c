@@ -38,12 +38,13 @@ struct lm_frame_loop {
     uint32_t generators_version; /* ... as of this pass_version (+1: 0 is never a count yet) */
     uint32_t reflect_version;    /* the scene's pass_version the reflection maps were made for */
     uint32_t switch_version;     /* the scene's pass_version the gather's and composite's switches follow */
-    /* the brute-force path: the indirect radiance of one view's pixels, and what it was computed for */
-    lm_gbuffer gbuf;
-    float *photon_rgb;
-    lm_view photon_view;
-    int photon_w, photon_h;
-    uint64_t photon_version, photon_world; /* the store's version and a hash of the node matrices */
+    /* the photon paths: the store's hits as GPU records, the gather, and what its picture was made for */
+    lm_photon_records records;
+    lm_photon_gather *photon_gather;
+    float photon_radius;         /* the kernel radius for the records held */
+    uint64_t photon_key;         /* a hash of the records, view, size, radius and scene the last gather saw */
+    int photon_keyed;
+    unsigned photon_runs;        /* gathers run: turns the stochastic gather's classes */
     const lm_surfaces *surfaces;
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
@@ -84,6 +85,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     lm_caustic_pass_settings_default(&s->caustic_pass);
     s->indirect = 1;
     s->indirect_path = LM_INDIRECT_LIGHTMAP;
+    lm_photon_gather_settings_default(&s->photon_gather);
 }
 
 /* Which indirect path the frames take, if any: the lightmaps (AIMs, gather, IIM) or the photon gather at
@@ -94,7 +96,7 @@ static int lightmap_path(const lm_frame_loop *fl)
 }
 static int photon_path(const lm_frame_loop *fl)
 {
-    return fl->set.indirect && fl->set.indirect_path == LM_INDIRECT_BRUTEFORCE;
+    return fl->set.indirect && fl->set.indirect_path != LM_INDIRECT_LIGHTMAP;
 }
 
 /* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
@@ -388,8 +390,8 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     lm_composite_free(fl->comp);
     lm_reflections_free(fl->reflections);
     lm_caustic_pass_free(fl->caustic_pass);
-    lm_gbuffer_free(&fl->gbuf);
-    free(fl->photon_rgb);
+    lm_photon_gather_free(fl->photon_gather);
+    lm_photon_records_free(&fl->records);
     if (fl->have_iim)
         lm_iim_free(&fl->iim);
     lm_gather_free(fl->gather);
@@ -404,46 +406,61 @@ void lm_frame_loop_free(lm_frame_loop *fl)
     free(fl);
 }
 
-/* The brute-force path's indirect radiance for view at w x h into fl->photon_rgb, unless it is there
- * already for the same view, photons and node matrices. Reads the photon store: never while the stage's
- * worker runs (the steps call it before they start it). */
-static lm_status photon_indirect(lm_frame_loop *fl, const lm_view *view, int w, int h, lm_error *err)
+/* The photon paths' records: the store's hits packed, the pages that changed sent to the GPU, and the
+ * kernel radius for them. Reads the photon store: never while the stage's worker runs (the steps call it
+ * before they start it). */
+static lm_status photon_records(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     const lm_photon_store *ps = lm_photons_store(lm_photon_stage_photons(fl->stage));
-    uint64_t world = lm_scene_world_hash(fl->scene);
-    if (fl->photon_rgb && fl->photon_w == w && fl->photon_h == h && fl->photon_version == ps->version &&
-        fl->photon_world == world && !memcmp(fl->photon_view.view, view->view, sizeof view->view) &&
-        !memcmp(fl->photon_view.proj, view->proj, sizeof view->proj))
-        return LM_OK;
-    lm_ref_camera cam;
-    lm_status st = lm_view_ref_camera(view, w, h, &cam, err);
-    if (st == LM_OK)
-        st = lm_gbuffer_trace(&fl->gbuf, fl->scene, fl->rt, &cam, err);
-    float *rgb = st == LM_OK ? realloc(fl->photon_rgb, 3 * (size_t)w * (size_t)h * sizeof *rgb) : NULL;
-    if (st == LM_OK && !rgb)
-        st = lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon gather's picture", fl->scene->path);
-    if (st != LM_OK)
-        return st;
-    fl->photon_rgb = rgb;
-    float r = lm_pixel_gather_radius(ps, fl->surfaces, fl->set.stage.aim.n_nearest);
-    lm_pixel_gather_bruteforce(&fl->gbuf, ps, r, rgb);
-    fl->photon_view = *view, fl->photon_w = w, fl->photon_h = h;
-    fl->photon_version = ps->version, fl->photon_world = world;
-    return LM_OK;
+    lm_status st = LM_OK;
+    if (!fl->photon_gather) {
+        lm_photon_gather_settings set = fl->set.photon_gather;
+        set.kind = fl->set.indirect_path == LM_INDIRECT_HASHGRID     ? LM_PHOTON_GATHER_HASHGRID
+                   : fl->set.indirect_path == LM_INDIRECT_BRUTEFORCE ? LM_PHOTON_GATHER_BRUTEFORCE
+                                                                     : LM_PHOTON_GATHER_TILED;
+        st = lm_photon_gather_create(&set, &fl->photon_gather, err);
+    }
+    int fresh = !fl->records.rec || fl->records.store_version != ps->version;
+    if (st == LM_OK && fresh)
+        st = lm_photon_records_update(&fl->records, ps, err);
+    if (st == LM_OK && fresh)
+        st = lm_photon_gather_set_records(fl->photon_gather, &fl->records, o ? &o->photon_gather : NULL, err);
+    if (st == LM_OK && (fresh || !(fl->photon_radius > 0.0f)))
+        fl->photon_radius = fl->set.photon_radius > 0.0f
+                                ? fl->set.photon_radius
+                                : lm_pixel_gather_radius(ps, fl->surfaces, fl->set.stage.aim.n_nearest);
+    return st;
 }
 
-/* Adds the brute-force path's indirect radiance, made beforehand for this view (photon_indirect), to the
- * frame rgb (top row first, as the picture). */
-static lm_status add_photon_indirect(lm_frame_loop *fl, const lm_view *view, int w, int h, float *rgb,
-                                     lm_error *err)
+/* The photon paths' indirect light added to the picture lm_direct_draw drew for view: the gather runs
+ * again only when its records, the view, the size, the radius or the scene (node matrices, materials,
+ * effect switches) changed since its last picture; else that picture is added again. */
+static lm_status draw_photon_indirect(lm_frame_loop *fl, const lm_view *view, int w, int h, lm_frame_stats *o,
+                                      lm_error *err)
 {
-    if (!fl->photon_rgb || fl->photon_w != w || fl->photon_h != h ||
-        memcmp(fl->photon_view.view, view->view, sizeof view->view))
-        return lm_fail(err, LM_ERR_INVALID, "%s: the photon gather's picture was not made for this view",
-                       fl->scene->path);
-    for (size_t i = 0; i < 3 * (size_t)w * (size_t)h; i++)
-        rgb[i] += fl->photon_rgb[i];
-    return LM_OK;
+    if (!(fl->photon_radius > 0.0f)) /* no photon the gather takes: no indirect light */
+        return LM_OK;
+    uint64_t key = lm_scene_world_hash(fl->scene);
+    key = lm_hash_bytes(key, view->view, sizeof view->view);
+    key = lm_hash_bytes(key, view->proj, sizeof view->proj);
+    const int size[2] = {w, h};
+    key = lm_hash_bytes(key, size, sizeof size);
+    key = lm_hash_bytes(key, &fl->records.store_version, sizeof fl->records.store_version);
+    key = lm_hash_bytes(key, &fl->photon_radius, sizeof fl->photon_radius);
+    key = lm_hash_bytes(key, &fl->scene->material_version, sizeof fl->scene->material_version);
+    key = lm_hash_bytes(key, &fl->scene->pass_version, sizeof fl->scene->pass_version);
+    unsigned kd = lm_direct_kd_texture(fl->direct_light, 0), gbuf = lm_direct_gbuffer_texture(fl->direct_light);
+    lm_status st = LM_OK;
+    if (!fl->photon_keyed || key != fl->photon_key) {
+        st = lm_photon_gather_run(fl->photon_gather, view, w, h, kd, gbuf, fl->photon_radius, fl->photon_runs++,
+                                  &o->photon_gather, err);
+        o->photon_gathers++;
+        fl->photon_key = key;
+        fl->photon_keyed = st == LM_OK;
+    }
+    if (st == LM_OK)
+        st = lm_photon_gather_composite(fl->photon_gather, lm_direct_radiance_texture(fl->direct_light), kd, gbuf, err);
+    return st;
 }
 
 /* Whether the scene has caustic generators now (from the scene, which the stage's worker does not write:
@@ -483,7 +500,7 @@ static lm_status upload_caustics(lm_frame_loop *fl, lm_error *err)
 /* The step's own frame's view, its caustic photons, and with the brute-force path its photon picture, made
  * while the store is quiet (before the stage's worker starts: the frame shows the photons as the last
  * stage left them). */
-static lm_status prepare_frame(lm_frame_loop *fl, lm_error *err)
+static lm_status prepare_frame(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
     if (w <= 0)
@@ -492,9 +509,7 @@ static lm_status prepare_frame(lm_frame_loop *fl, lm_error *err)
     if (st != LM_OK)
         return st;
     lm_view_for_scene(fl->scene, fl->set.camera, w, h, &fl->view);
-    if (!photon_path(fl))
-        return LM_OK;
-    return photon_indirect(fl, &fl->view, w, h, err);
+    return photon_path(fl) ? photon_records(fl, o, err) : LM_OK;
 }
 
 /* What lights the scene besides the lightmaps, as the environment maps' dirty tracking compares it: the
@@ -563,6 +578,10 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
     if (st == LM_OK)
         st = lm_direct_draw(fl->direct_light, fl->scene, em, view, w, h, err);
     double t3 = lm_now();
+    o->photon_gather.t_wait = 0.0;
+    if (st == LM_OK && photon_path(fl))
+        st = draw_photon_indirect(fl, view, w, h, o, err);
+    double t3p = lm_now();
     if (st == LM_OK && caustics)
         st = draw_caustics(fl, caustics, own, view, w, h, o, err);
     fl->caustic_slot = own ? LM_CAUSTIC_SLOT_FRAME : LM_CAUSTIC_SLOT_VIEW;
@@ -573,13 +592,13 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
     double t5 = lm_now();
     if (st == LM_OK)
         st = lm_direct_read(fl->direct_light, rgb, err);
-    if (st == LM_OK && photon_path(fl))
-        st = add_photon_indirect(fl, view, w, h, rgb, err);
     o->t_composite = t1 - t0;
-    /* the caustic pass first waits for the direct light's GPU work: that wait is the direct light's */
-    o->t_caustics = t4 - t3 - o->caustic.t_wait;
+    /* the caustic pass and the photon gather first wait for the direct light's GPU work: that wait is
+     * the direct light's */
+    o->t_caustics = t4 - t3p - o->caustic.t_wait;
+    o->t_gather += t3p - t3 - o->photon_gather.t_wait;
     o->t_reflections = (t2 - t1) + (t5 - t4);
-    o->t_direct = (t3 - t2) + o->caustic.t_wait + (lm_now() - t5);
+    o->t_direct = (t3 - t2) + o->caustic.t_wait + o->photon_gather.t_wait + (lm_now() - t5);
     return st;
 }
 
@@ -607,9 +626,10 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
         st = lm_frame_loop_sync(fl, err);
     if (st == LM_OK && newest)
         st = upload_caustics(fl, err);
-    if (st == LM_OK && photon_path(fl))
-        st = photon_indirect(fl, view, width, height, err);
     lm_frame_stats o;
+    memset(&o, 0, sizeof o);
+    if (st == LM_OK && photon_path(fl))
+        st = photon_records(fl, &o, err);
     /* the environment maps' faces due are refreshed by the steps' own frames; without those, here */
     int refresh = fl->set.width <= 0;
     return st == LM_OK ? render_view(fl, view, width, height, rgb, 0, refresh, &o, err) : st;
@@ -651,7 +671,7 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     if (o->stage.aim.surfaces_refreshed > 0)
         fl->aim_stale = 1;
     if (st == LM_OK)
-        st = prepare_frame(fl, err);
+        st = prepare_frame(fl, o, err);
     double t1 = lm_now();
     if (st == LM_OK)
         st = schedule(fl, o, err);
@@ -678,7 +698,7 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
         st = schedule(fl, o, err);
     double t1 = lm_now();
     if (st == LM_OK)
-        st = prepare_frame(fl, err);
+        st = prepare_frame(fl, o, err);
     if (st != LM_OK)
         return st;
     st = gather_run(fl, o->texels_gathered, err);

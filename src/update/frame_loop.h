@@ -27,9 +27,10 @@
 #include "../gpu/gl_context.h"
 #include "../gpu/hemicube.h"
 #include "../gpu/iim.h"
+#include "../gpu/photon_gather.h"
 #include "photon_stage.h"
 
-enum { LM_INDIRECT_LIGHTMAP = 0, LM_INDIRECT_BRUTEFORCE = 1 };
+enum { LM_INDIRECT_LIGHTMAP = 0, LM_INDIRECT_BRUTEFORCE = 1, LM_INDIRECT_TILED = 2, LM_INDIRECT_HASHGRID = 3 };
 
 typedef struct {
     lm_photon_stage_settings stage;
@@ -57,9 +58,14 @@ typedef struct {
     int indirect;          /* 0: no indirect light at all (no photon, AIM or gather work; the frame shows direct
                             * light, emission and reflections); default 1. stage.trace follows it */
     int indirect_path;     /* how the frame gets its indirect light: LM_INDIRECT_LIGHTMAP (default: AIMs, the
-                            * hemicube gather into the IIM, the composite) or LM_INDIRECT_BRUTEFORCE (straight
-                            * from the photon hits at the visible pixels, photonmap/pixel_gather.h: no AIM, no
-                            * IIM; the lightmaps stay 0 and environment maps hold direct light only) */
+                            * hemicube gather into the IIM, the composite) or LM_INDIRECT_TILED, _HASHGRID or
+                            * _BRUTEFORCE (straight from the photon hits at the visible pixels on the GPU,
+                            * gpu/photon_gather.h: no AIM, no IIM; the lightmaps stay 0 and environment maps
+                            * hold direct light only) */
+    lm_photon_gather_settings photon_gather; /* those three paths' tile, chunk and stochastic k (the kind
+                                              * follows indirect_path) */
+    float photon_radius;   /* their kernel radius (0, the default: the disc that holds stage.aim.n_nearest hits
+                            * on average, lm_pixel_gather_radius) */
     /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;
@@ -73,6 +79,8 @@ typedef struct {
     uint32_t texels_gathered;
     lm_caustic_pass_stats caustic; /* the frame's caustic pass */
     int cube_faces;        /* environment map faces rendered */
+    lm_photon_gather_stats photon_gather; /* the photon paths' gather (its times are in t_gather) */
+    int photon_gathers;    /* gathers run: 0 when the records, view and G-buffer were as for the last one */
     /* seconds per stage: photon stage (animate + photons + AIMs + caustic photons), IIM gather (schedule,
      * scene and AIM upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps,
      * the frame's read-back), caustics (the screen-space pass), reflections (map faces and their pass),
