@@ -51,7 +51,7 @@ static void setup(fixture *f, const char *path, float texel, int w, int h)
     f->w = w, f->h = h;
     lm_view_for_scene(f->p.s, -1, w, h, &f->view);
     if (lm_direct_draw(f->d, f->p.s, lm_photon_stage_emitters(f->stage), &f->view, w, h, &err) != LM_OK ||
-        lm_photon_records_update(&f->rec, f->store, &err) != LM_OK)
+        lm_photon_records_update(&f->rec, f->store, f->p.s, &err) != LM_OK)
         fail_msg("%s", err.msg);
     f->radius = lm_pixel_gather_radius(f->store, &f->p.su, 128);
 }
@@ -128,8 +128,10 @@ static void test_records(void **state)
             h.flux[c] = ldexpf((float)lmt_xorshift(&seed) / 4294967296.0f, e);
         lm_vec3 d = lm_normalize(lm_v3_load(h.dir));
         lm_v3_store(h.dir, d);
+        float side[3];
+        lm_hit_side_normal(NULL, &h, side); /* no scene: the arrival direction */
         lm_photon_record r;
-        lm_photon_record_encode(&h, &r);
+        lm_photon_record_encode(&h, side, &r);
         float pos[3], from[3], flux[3];
         assert_true(lm_photon_record_decode(&r, pos, from, flux));
         assert_memory_equal(pos, h.pos, sizeof pos);
@@ -139,7 +141,7 @@ static void test_records(void **state)
         double cosang = -(from[0] * d.x + from[1] * d.y + from[2] * d.z);
         worst_angle = fmax(worst_angle, acos(fmin(1.0, cosang)) * 180.0 / M_PI);
     }
-    print_message("20,000 random hits: flux within %.3g of the brightest channel, direction within %.3f degrees\n",
+    print_message("20,000 random hits: flux within %.3g of the brightest channel, side normal within %.3f degrees\n",
                   worst_flux, worst_angle);
     assert_true(worst_flux <= 1.0 / 8192.0 + 1e-9);
     assert_true(worst_angle < 1.0);
@@ -149,18 +151,18 @@ static void test_records(void **state)
     h.flux[0] = h.flux[1] = h.flux[2] = 1.0f;
     h.dir[1] = -1.0f;
     lm_photon_record r;
-    float pos[3], from[3], flux[3];
+    float pos[3], from[3], flux[3], up[3] = {0.0f, 1.0f, 0.0f};
     h.from_punctual = 1; /* a punctual light's first hit: the direct pass's */
-    lm_photon_record_encode(&h, &r);
+    lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
     h.from_punctual = 0, h.caustic = 1; /* the caustic pass's */
-    lm_photon_record_encode(&h, &r);
+    lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
     h.caustic = 0, h.surface = -1; /* a free slot */
-    lm_photon_record_encode(&h, &r);
+    lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
     h.surface = 0, h.flux[0] = h.flux[1] = h.flux[2] = 0.0f;
-    lm_photon_record_encode(&h, &r);
+    lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
 }
 
@@ -182,14 +184,14 @@ static void test_records_dirty_pages(void **state)
     }
     lm_photon_records r;
     memset(&r, 0, sizeof r);
-    assert_int_equal(lm_photon_records_update(&r, &ps, &err), LM_OK);
+    assert_int_equal(lm_photon_records_update(&r, &ps, NULL, &err), LM_OK);
     assert_int_equal(r.count, 5000);
     assert_int_equal(r.live, 5000);
     assert_int_equal(r.dirty_pages, 5);
-    assert_int_equal(lm_photon_records_update(&r, &ps, &err), LM_OK);
+    assert_int_equal(lm_photon_records_update(&r, &ps, NULL, &err), LM_OK);
     assert_int_equal(r.dirty_pages, 0);
     lm_photon_store_remove(&ps, 2500);
-    assert_int_equal(lm_photon_records_update(&r, &ps, &err), LM_OK);
+    assert_int_equal(lm_photon_records_update(&r, &ps, NULL, &err), LM_OK);
     assert_int_equal(r.dirty_pages, 1);
     assert_true(r.dirty[2500 / LM_RECORD_PAGE]);
     assert_int_equal(r.live, 4999);
@@ -245,7 +247,7 @@ static void test_gathers_agree(void **state)
         lm_gbuffer_trace(&g, f.p.s, f.p.rt, &cam, &err) != LM_OK)
         fail_msg("%s", err.msg);
     float *cpu = malloc(n * sizeof *cpu);
-    lm_pixel_gather_bruteforce(&g, f.store, f.radius, cpu);
+    lm_pixel_gather_bruteforce(&g, f.store, f.p.s, f.radius, cpu);
     /* the GPU's radiance kd / pi x E at the pixels where both G-buffers see a diffuse point */
     double sum_gpu = 0.0, sum_cpu = 0.0, worst = 0.0;
     int same = 0;
@@ -307,7 +309,7 @@ static void set_hits(fixture *f, const float *x, const float *z, int n)
         assert_true(lm_photon_store_add(&ps, &h) != LM_NONE);
     }
     lm_photon_records_free(&f->rec);
-    assert_int_equal(lm_photon_records_update(&f->rec, &ps, &err), LM_OK);
+    assert_int_equal(lm_photon_records_update(&f->rec, &ps, f->p.s, &err), LM_OK);
     lm_photon_store_free(&ps);
 }
 

@@ -49,7 +49,7 @@ static void test_uniform_field(void **state)
                    (float)M_PI, (float)M_PI};
     lm_gbuffer g = {3, 1, pos, normal, kd};
     float out[9];
-    lm_pixel_gather_bruteforce(&g, &ps, 0.1f, out);
+    lm_pixel_gather_bruteforce(&g, &ps, NULL, 0.1f, out); /* no scene: arrival directions stand in */
     print_message("uniform field of irradiance 1: %.4f %.4f %.4f | %.4f %.4f %.4f | from behind %g\n", out[0], out[1],
                   out[2], out[3], out[4], out[5], out[6]);
     for (int c = 0; c < 3; c++)

@@ -62,6 +62,7 @@ struct lm_direct {
     int has_lightmap;       /* the mesh carries lightmap uvs (an atlas at lm_direct_create) */
     const lm_atlas *atlas;  /* that atlas (borrowed), for a rebuild of the mesh */
     unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
+    unsigned coverage_tex;  /* else the photon gathers' kernel coverage it writes to kd's alpha (0: none) */
     float *scratch;         /* read-back, width x height RGBA */
     size_t scratch_px;
 };
@@ -136,11 +137,11 @@ static const int ALL[2] = {0, 0};
 /* The indirect term's texture on unit 3 for a first-pass program (lit, use_lit: its uniforms). */
 static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit)
 {
-    int on = d->has_lightmap && d->indirect_tex;
-    glUniform1i(use_lit, on);
+    unsigned tex = !d->has_lightmap ? 0 : d->indirect_tex ? d->indirect_tex : d->coverage_tex;
+    glUniform1i(use_lit, !tex ? 0 : d->indirect_tex ? 1 : 2);
     glUniform1i(lit, 3);
     glActiveTexture(GL_TEXTURE3);
-    glBindTexture(GL_TEXTURE_2D, on ? d->indirect_tex : 0);
+    glBindTexture(GL_TEXTURE_2D, tex);
     glActiveTexture(GL_TEXTURE0);
 }
 
@@ -335,6 +336,8 @@ void lm_direct_free(lm_direct *d)
     free(d->maps);
     lm_float_target_free(&d->target);
     lm_float_target_free(&d->probe);
+    if (d->coverage_tex)
+        glDeleteTextures(1, &d->coverage_tex);
     if (d->mesh.first)
         lm_direct_mesh_free(&d->mesh);
     lm_shadow_renderer_free(&d->shadow);
@@ -460,6 +463,37 @@ unsigned lm_direct_gbuffer_texture(const lm_direct *d) { return d->target.color[
 unsigned lm_direct_radiance_texture(const lm_direct *d) { return d->target.color[0]; }
 
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
+lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *err)
+{
+    if (!coverage || !d->has_lightmap) {
+        if (d->coverage_tex)
+            glDeleteTextures(1, &d->coverage_tex);
+        d->coverage_tex = 0;
+        return LM_OK;
+    }
+    const lm_atlas *a = d->atlas;
+    float *rgba = calloc(4 * (size_t)a->width * (size_t)a->height, sizeof *rgba);
+    if (!rgba)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for a %d x %d coverage atlas", a->width, a->height);
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        float *p = rgba + 4 * ((size_t)a->texels[i].y * (size_t)a->width + (size_t)a->texels[i].x);
+        p[0] = coverage[i] > 0.0f ? 1.0f / coverage[i] : 1.0f;
+        p[3] = 1.0f;
+    }
+    if (!d->coverage_tex) {
+        glGenTextures(1, &d->coverage_tex);
+        glBindTexture(GL_TEXTURE_2D, d->coverage_tex);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    }
+    glBindTexture(GL_TEXTURE_2D, d->coverage_tex);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, a->width, a->height, 0, GL_RGBA, GL_FLOAT, rgba);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    free(rgba);
+    return LM_OK;
+}
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
 

@@ -74,8 +74,9 @@ void lm_direct_bind_probe(const lm_direct *d);
 /* The depth texture of the frame's target (probe 0) or of the probe's (1): 24-bit, GL window depth. */
 unsigned lm_direct_depth_texture(const lm_direct *d, int probe);
 /* The diffuse lobe kd the first pass found at each pixel of the frame (probe 0) or the probe (1): an
- * RGBA32F texture (rgb; 0 where nothing, the back of a single-sided surface, mirror and glass), for a
- * later pass that adds kd / pi x an irradiance per pixel (the caustics). */
+ * RGBA32F texture (rgb; 0 where nothing, the back of a single-sided surface, mirror and glass; a: 1, or
+ * lm_direct_set_coverage's 1 / c), for a later pass that adds kd / pi x an irradiance per pixel (the
+ * caustics, the photon gathers). */
 unsigned lm_direct_kd_texture(const lm_direct *d, int probe);
 /* The frame's G-buffer from the first pass (after lm_direct_draw): an RGBA32F texture, rgb the visible
  * point's world position, a the eye-side shading normal packed (0: nothing, or the back of a single-sided
@@ -88,6 +89,12 @@ unsigned lm_direct_radiance_texture(const lm_direct *d);
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
  * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);
+/* For the per-pixel photon gathers, with no indirect term set: coverage (one float per atlas texel, NULL:
+ * none) is the part of the gathers' kernel on each texel's surface, c (photonmap/aim.h
+ * lm_aim_kernel_coverage). The first pass then writes 1 / c, taken over the valid texels of the pixel's
+ * bilinear footprint, into the kd texture's alpha (1 where no texel is, or without coverage). Copied to
+ * a texture the object owns. Needs an atlas at lm_direct_create (else ignored). Errors: out of memory. */
+lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *err);
 /* Shadow maps rendered since creation (each cube map counts once), for tests and statistics. */
 long lm_direct_shadow_maps_rendered(const lm_direct *d);
 

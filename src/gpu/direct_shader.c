@@ -78,12 +78,22 @@ const char *const lm_direct_gbuffer_glsl =
  * centre: a texture finer than the lightmap stays sharp). */
 #define INDIRECT \
     "vec3 indirect() {\n" \
-    "    if (use_lit == 0 || v_lm.x < 0.0) return vec3(0.0);\n" \
+    "    if (use_lit != 1 || v_lm.x < 0.0) return vec3(0.0);\n" \
     "    vec4 t = textureLod(lit, v_lm, 0.0);\n" \
     "    if (t.a <= 0.0) return vec3(0.0);\n" \
     "    vec3 kd, ks;\n" \
     "    lobes(kd, ks);\n" \
     "    return kd * t.rgb / t.a;\n" \
+    "}\n"
+
+/* With use_lit 2, `lit` holds the photon gathers' kernel coverage instead (lm_direct_set_coverage,
+ * premultiplied: r / a = 1 / coverage over the valid texels of the footprint), which the first pass writes
+ * into the kd attachment's alpha (1 without it) for the gathers' resolve. */
+#define COVERAGE \
+    "float inv_coverage() {\n" \
+    "    if (use_lit != 2 || v_lm.x < 0.0) return 1.0;\n" \
+    "    vec4 t = textureLod(lit, v_lm, 0.0);\n" \
+    "    return t.a > 0.0 ? t.r / t.a : 1.0;\n" \
     "}\n"
 
 const char *const lm_direct_vs =
@@ -195,6 +205,7 @@ const char *const lm_direct_fs_body =
     "    return f * E * max(dot(ns, L), 0.0) * shadow(p, ng, L, dist);\n"
     "}\n"
     INDIRECT
+    COVERAGE
     GBUFFER
     "void main() {\n"
     "    look_up_albedo();\n"
@@ -211,7 +222,7 @@ const char *const lm_direct_fs_body =
     "    frag = vec4(seen ? c + indirect() : vec3(0.0), 1.0); /* the back of a single-sided surface: black */\n"
     "    vec3 kd, ks;\n"
     "    lobes(kd, ks);\n"
-    "    kd_out = vec4(seen ? kd : vec3(0.0), 1.0);\n"
+    "    kd_out = vec4(seen ? kd : vec3(0.0), inv_coverage());\n"
     "    g_out = gbuffer(v_pos, ns, seen);\n"
     "#else\n"
     "    frag = vec4(seen ? c : vec3(0.0), 1.0);\n"
@@ -258,6 +269,7 @@ const char *const lm_direct_emission_fs =
     "layout(location = 2) out vec4 g_out;\n"
     LOBES
     INDIRECT
+    COVERAGE
     GBUFFER
     "void main() {\n"
     "    look_up_albedo();\n"
@@ -270,6 +282,6 @@ const char *const lm_direct_emission_fs =
     "    frag = vec4(seen ? v_em + indirect() : vec3(0.0), 1.0);\n"
     "    vec3 kd, ks;\n"
     "    lobes(kd, ks);\n"
-    "    kd_out = vec4(seen ? kd : vec3(0.0), 1.0);\n"
+    "    kd_out = vec4(seen ? kd : vec3(0.0), inv_coverage());\n"
     "    g_out = gbuffer(v_pos, ns, seen);\n"
     "}\n";

@@ -4,7 +4,8 @@
 
 /* The density estimate of Mara et al. (2013) eq. 1 with the kernel of eq. 2 (kappa = min(c, 1 - s / r),
  * c = 1/5), as photonmap/pixel_gather.c computes it on the CPU: a record within r of the visible point x
- * that arrives at x's front adds flux x kappa. The sums are 64-bit fixed point (two words with carry,
+ * on x's surface or on one that continues it smoothly (pixel_gather.h: never the other side of a thin
+ * wall, nor the wall across a corner) adds flux x kappa. The sums are 64-bit fixed point (two words with carry,
  * 2^-40 of the brightest possible term a unit: to_fixed), so they are exact whatever order the records
  * come in: the tile and cell lists are filled by atomics in no fixed order, and the picture is the same
  * on every run and for every gather (tiled, hash grid and brute force give equal sums). The terms are
@@ -19,12 +20,12 @@ const char *const lm_pg_common_glsl =
     "    uvec3 q = uvec3((w3 >> 11) & 8191u, ((w3 & 2047u) << 2) | (w4 >> 30), (w4 >> 17) & 8191u);\n"
     "    return ldexp(vec3(q), ivec3(e - 13));\n"
     "}\n"
-    /* the octahedron's unfolding, not normalised: only the sign of a dot product is wanted */
-    "vec3 record_from(uint w4) {\n"
+    /* the side normal: the octahedron's unfolding, normalised */
+    "vec3 record_side(uint w4) {\n"
     "    precise vec2 o = vec2(float((w4 >> 8) & 255u), float(w4 & 255u)) / 255.0 * 2.0 - 1.0;\n"
     "    precise vec3 d = vec3(o, 1.0 - abs(o.x) - abs(o.y));\n"
     "    if (d.z < 0.0) d.xy = (1.0 - abs(d.yx)) * vec2(d.x >= 0.0 ? 1.0 : -1.0, d.y >= 0.0 ? 1.0 : -1.0);\n"
-    "    return d;\n"
+    "    return d * inversesqrt(dot(d, d));\n"
     "}\n"
     "void add_fixed(inout uvec2 a, float v) {\n"
     "    float hi = floor(v * (1.0 / 4294967296.0));\n"
@@ -33,12 +34,13 @@ const char *const lm_pg_common_glsl =
     "    a.y += uint(hi) + carry;\n"
     "}\n"
     "float fixed_value(uvec2 a) { return (float(a.y) * 4294967296.0 + float(a.x)) / to_fixed; }\n"
-    /* one decoded photon (position, the direction it came from, flux) at the visible point x, normal n */
-    "void gather_photon(vec3 p, vec3 from, vec3 flux, vec3 x, vec3 n, inout uvec2 s[3]) {\n"
+    /* one decoded photon (position, side normal, flux) at the visible point x, normal n */
+    "void gather_photon(vec3 p, vec3 side, vec3 flux, vec3 x, vec3 n, inout uvec2 s[3]) {\n"
     "    precise vec3 d = p - x;\n"
     "    precise float d2 = dot(d, d);\n"
     "    if (d2 >= radius2) return;\n"
-    "    if (dot(from, n) <= 0.0) return;\n"
+    "    precise float facing = dot(side, n), h = abs(dot(d, n));\n"
+    "    if (facing < 0.5 || h > 0.5 * radius) return;\n"
     "    precise float kappa = min(KERNEL_C, 1.0 - sqrt(d2) / radius);\n"
     "    precise vec3 v = flux * (kappa * to_fixed);\n"
     "    add_fixed(s[0], v.x);\n"
@@ -48,7 +50,7 @@ const char *const lm_pg_common_glsl =
     "vec3 record_pos(uint i) { return uintBitsToFloat(uvec3(rec[5u * i], rec[5u * i + 1u], rec[5u * i + 2u])); }\n"
     "void gather_stored(uint i, vec3 x, vec3 n, inout uvec2 s[3]) {\n"
     "    uint w3 = rec[5u * i + 3u], w4 = rec[5u * i + 4u];\n"
-    "    if (w3 != 0u) gather_photon(record_pos(i), record_from(w4), record_flux(w3, w4), x, n, s);\n"
+    "    if (w3 != 0u) gather_photon(record_pos(i), record_side(w4), record_flux(w3, w4), x, n, s);\n"
     "}\n"
     /* a pixel that takes indirect light: a visible front with a diffuse lobe */
     "bool visible_point(ivec2 p, out vec3 x, out vec3 n) {\n"
@@ -231,7 +233,7 @@ const char *const lm_pg_gather_tiles_cs =
     "uniform ivec2 size;\n"
     "uniform int tiles_x, k, frame;\n"
     "uniform uint round0, round_count;\n"
-    "shared vec3 sh_pos[CHUNK], sh_from[CHUNK], sh_flux[CHUNK]; /* decoded once a tile, read by every pixel */\n"
+    "shared vec3 sh_pos[CHUNK], sh_side[CHUNK], sh_flux[CHUNK]; /* decoded once a tile, read by every pixel */\n"
     "void main() {\n"
     "    ivec2 p = ivec2(gl_GlobalInvocationID.xy);\n"
     "    uint classes = uint(k * k), part = uint(CHUNK) / classes, lid = gl_LocalInvocationIndex;\n"
@@ -254,13 +256,13 @@ const char *const lm_pg_gather_tiles_cs =
     "            if (at < offsets[first + c + 1u] - from) {\n"
     "                uint i = list[from + at], w3 = rec[5u * i + 3u], w4 = rec[5u * i + 4u];\n"
     "                sh_pos[slot] = record_pos(i);\n"
-    "                sh_from[slot] = record_from(w4);\n"
+    "                sh_side[slot] = record_side(w4);\n"
     "                sh_flux[slot] = record_flux(w3, w4);\n"
     "            }\n"
     "        }\n"
     "        barrier();\n"
     "        uint done = r * part, m = live && mine > done ? min(part, mine - done) : 0u;\n"
-    "        for (uint j = cls * part; j < cls * part + m; j++) gather_photon(sh_pos[j], sh_from[j], sh_flux[j], x, n, s);\n"
+    "        for (uint j = cls * part; j < cls * part + m; j++) gather_photon(sh_pos[j], sh_side[j], sh_flux[j], x, n, s);\n"
     "        barrier();\n"
     "    }\n"
     "    if (live) store_sums(pixel, s);\n"
@@ -332,7 +334,8 @@ const char *const lm_pg_finish_cs =
     "    imageStore(e_out, p, irradiance(s, live));\n"
     "}\n";
 
-/* radiance += kd / pi x E. With k > 1, E is first averaged over the k x k pixels around (one of each
+/* radiance += kd / pi x E / c, c the kernel's part on the pixel's surface (the kd texture's alpha holds
+ * 1 / c: lm_direct_set_coverage), as the AIM divides by the disc's part on the surface. With k > 1, E is first averaged over the k x k pixels around (one of each
  * class), each weighted by how alike its visible point is: its distance off the pixel's tangent plane
  * (a Gaussian of width r / 2) and its normal (cosine to the 8th), so that the average stays on the
  * surface the pixel sees (the reconstruction after the stochastic gather; the kd is the pixel's own, so
@@ -364,6 +367,6 @@ const char *const lm_pg_resolve_cs =
     "            }\n"
     "        e.rgb /= max(e.a, 1e-30);\n"
     "    }\n"
-    "    vec3 kd = texelFetch(kd_tex, p, 0).rgb;\n"
-    "    imageStore(radiance_img, p, imageLoad(radiance_img, p) + vec4(kd / PI * e.rgb, 0.0));\n"
+    "    vec4 kd = texelFetch(kd_tex, p, 0); /* a: 1 / the kernel's part on the surface (gpu/direct.h) */\n"
+    "    imageStore(radiance_img, p, imageLoad(radiance_img, p) + vec4(kd.rgb / PI * e.rgb * kd.a, 0.0));\n"
     "}\n";

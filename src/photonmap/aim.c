@@ -679,6 +679,44 @@ static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_
     }
 }
 
+/* ---------- the per-pixel gathers' kernel on the surface ---------- */
+
+lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                 float radius, float *out, lm_error *err)
+{
+    static const double GX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834}, GW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+    const double c = 0.2; /* the kernel's clamp (pixel_gather.h) */
+    uint32_t edges_max = 0;
+    for (int k = 0; k < su->surface_count; k++)
+        edges_max = aim->edge_first[k + 1] - aim->edge_first[k] > edges_max ? aim->edge_first[k + 1] - aim->edge_first[k]
+                                                                          : edges_max;
+    edge_frame ef = {NULL, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, malloc(sizeof(double) * 4 * (edges_max ? edges_max : 1))};
+    if (!ef.uv)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the boundary edges of %d surfaces", su->surface_count);
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        out[i] = 1.0f;
+    for (int k = 0; k < su->surface_count; k++) {
+        linear_map L;
+        linear_map_of(s->nodes[su->surfaces[k].node].world, &L);
+        boundary bd = {s->positions, aim->edges, aim->edge_first[k], aim->edge_first[k + 1]};
+        ef.bd = NULL;
+        for (uint32_t i = aim->texel_first[k]; i < aim->texel_first[k + 1]; i++) {
+            const lm_texel *t = &a->texels[aim->texel_list[i]];
+            double n[3];
+            local_face_normal(s, t->tri, n);
+            double r = (double)radius / sqrt(area_factor(&L, n)), on = 0.0, full = 0.0, nearest;
+            for (int g = 0; g < 3; g++) {
+                double x = r * (1.0 - 0.5 * c + 0.5 * c * GX[g]);
+                on += GW[g] * disc_area_on_surface(&ef, &bd, t->local, n, x * x, 0, &nearest);
+                full += GW[g] * LM_PI * x * x;
+            }
+            out[aim->texel_list[i]] = full > 0.0 ? (float)fmin(fmax(on / full, MIN_COVERAGE), 1.0) : 1.0f;
+        }
+    }
+    free(ef.uv);
+    return LM_OK;
+}
+
 /* ---------- refreshing ---------- */
 
 /* One surface of a refresh: its hits, their kd-tree and the estimate's inputs. */

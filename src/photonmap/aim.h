@@ -95,6 +95,16 @@ void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
  * hemicube should see (4.8% of the suzanne Cornell box's ceiling, docs/aim.md). */
 #define LM_AIM_DIRECT_PARTS 2
 
+/* For the per-pixel photon gathers (pixel_gather.h, gpu/photon_gather.h), which sum one constant radius r
+ * (world units) with the kernel min(c, 1 - s / r), c = 1/5: per atlas texel, the part of that kernel's
+ * weight that lies on the texel's surface, in [1/16, 1] (1 away from its boundary, about 1/2 at an edge,
+ * 1/4 in a corner), from the same exact disc-on-surface areas as the AIM's boundary correction, in the
+ * texel's tangent plane at its node's current scale. The kernel is the integral of box discs of radius t
+ * over t in [(1 - c) r, r], weight 1 / r, taken with 3-point Gauss-Legendre (exact for the full disc).
+ * out: a->texel_count floats. Cost: O(texels x boundary edges within r). Errors: out of memory. */
+lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                 float radius, float *out, lm_error *err);
+
 /* Refreshes up to `budget` surfaces (budget < 0: no limit) whose delta_f is over the threshold, in
  * order of delta_f / area (ties: lower surface id first), and resets their delta_f. stats may be NULL. */
 lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,

@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/vecmath.h"
+
 #define MANTISSA_BITS 13
 #define MANTISSA_MAX ((1u << MANTISSA_BITS) - 1u)
 
@@ -36,7 +38,24 @@ static void decode_direction(uint32_t bits, float d[3])
     d[0] = x / n, d[1] = y / n, d[2] = z / n;
 }
 
-void lm_photon_record_encode(const lm_hit *h, lm_photon_record *r)
+void lm_hit_side_normal(const lm_scene *s, const lm_hit *h, float n[3])
+{
+    lm_vec3 from = lm_scale(lm_v3_load(h->dir), -1.0f), ng = from;
+    if (s && h->tri < s->tri_count) {
+        const uint32_t *t = s->tris + 3 * (size_t)h->tri;
+        const float *m = s->nodes[s->tri_node[h->tri]].world;
+        lm_vec3 a = lm_mat4_point(m, lm_v3_load(s->positions + 3 * (size_t)t[0]));
+        lm_vec3 b = lm_mat4_point(m, lm_v3_load(s->positions + 3 * (size_t)t[1]));
+        lm_vec3 c = lm_mat4_point(m, lm_v3_load(s->positions + 3 * (size_t)t[2]));
+        lm_vec3 x = lm_cross(lm_sub(b, a), lm_sub(c, a));
+        float len = sqrtf(lm_dot(x, x));
+        if (len > 0.0f && isfinite(len))
+            ng = lm_scale(x, lm_dot(x, from) < 0.0f ? -1.0f / len : 1.0f / len);
+    }
+    lm_v3_store(n, ng);
+}
+
+void lm_photon_record_encode(const lm_hit *h, const float side[3], lm_photon_record *r)
 {
     memset(r, 0, sizeof *r);
     if (!h || h->surface < 0 || !lm_hit_in_iim(h))
@@ -57,14 +76,13 @@ void lm_photon_record_encode(const lm_hit *h, lm_photon_record *r)
     }
     memcpy(r->w, h->pos, 3 * sizeof(float));
     r->w[3] = (uint32_t)(e + 128) << 24 | q[0] << 11 | q[1] >> 2;
-    const float from[3] = {-h->dir[0], -h->dir[1], -h->dir[2]};
-    r->w[4] = (q[1] & 3u) << 30 | q[2] << 17 | encode_direction(from);
+    r->w[4] = (q[1] & 3u) << 30 | q[2] << 17 | encode_direction(side);
 }
 
-int lm_photon_record_decode(const lm_photon_record *r, float pos[3], float from[3], float flux[3])
+int lm_photon_record_decode(const lm_photon_record *r, float pos[3], float side[3], float flux[3])
 {
     memset(pos, 0, 3 * sizeof *pos);
-    memset(from, 0, 3 * sizeof *from);
+    memset(side, 0, 3 * sizeof *side);
     memset(flux, 0, 3 * sizeof *flux);
     if (!r->w[3])
         return 0;
@@ -73,7 +91,7 @@ int lm_photon_record_decode(const lm_photon_record *r, float pos[3], float from[
     uint32_t q[3] = {r->w[3] >> 11 & MANTISSA_MAX, (r->w[3] & 0x7FFu) << 2 | r->w[4] >> 30, r->w[4] >> 17 & MANTISSA_MAX};
     for (int c = 0; c < 3; c++)
         flux[c] = ldexpf((float)q[c], e - MANTISSA_BITS);
-    decode_direction(r->w[4] & 0xFFFFu, from);
+    decode_direction(r->w[4] & 0xFFFFu, side);
     return 1;
 }
 
@@ -95,7 +113,8 @@ static int reserve(lm_photon_records *r, uint32_t n)
     return 1;
 }
 
-lm_status lm_photon_records_update(lm_photon_records *r, const lm_photon_store *ps, lm_error *err)
+lm_status lm_photon_records_update(lm_photon_records *r, const lm_photon_store *ps, const lm_scene *s,
+                                   lm_error *err)
 {
     if (r->rec && r->store_version == ps->version) {
         r->dirty_pages = 0;
@@ -113,7 +132,10 @@ lm_status lm_photon_records_update(lm_photon_records *r, const lm_photon_store *
     r->live = 0;
     for (uint32_t i = 0; i < n; i++) {
         lm_photon_record x;
-        lm_photon_record_encode(&ps->hits[i], &x);
+        float side[3] = {0.0f, 0.0f, 0.0f};
+        if (ps->hits[i].surface >= 0)
+            lm_hit_side_normal(s, &ps->hits[i], side);
+        lm_photon_record_encode(&ps->hits[i], side, &x);
         r->live += x.w[3] != 0;
         if (resized || memcmp(&x, &r->rec[i], sizeof x)) {
             r->rec[i] = x;

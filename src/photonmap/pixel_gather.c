@@ -7,6 +7,7 @@
 
 #include "../core/vecmath.h"
 #include "../trace/shading.h"
+#include "photon_records.h"
 
 #define KERNEL_C 0.2f /* the paper's cone clamped to a fifth of its height (eq. 2) */
 
@@ -72,22 +73,22 @@ float lm_pixel_gather_radius(const lm_photon_store *ps, const lm_surfaces *su, i
     return hits > 0.0 ? (float)sqrt((double)n * area / (LM_PI * hits)) : 0.0f;
 }
 
-/* The gathered hits packed for the inner loop: position, the direction they arrive from, flux. */
+/* The gathered hits packed for the inner loop: position, side normal (lm_hit_side_normal), flux. */
 typedef struct {
-    float *p, *from, *flux;
+    float *p, *side, *flux;
     uint32_t count;
 } packed_hits;
 
-static int pack(const lm_photon_store *ps, packed_hits *out)
+static int pack(const lm_photon_store *ps, const lm_scene *s, packed_hits *out)
 {
     uint32_t n = 0;
     for (int k = 0; k < ps->surface_count; k++)
         n += ps->surfaces[k].count;
     out->p = malloc(3 * (size_t)(n ? n : 1) * sizeof(float));
-    out->from = malloc(3 * (size_t)(n ? n : 1) * sizeof(float));
+    out->side = malloc(3 * (size_t)(n ? n : 1) * sizeof(float));
     out->flux = malloc(3 * (size_t)(n ? n : 1) * sizeof(float));
     out->count = 0;
-    if (!out->p || !out->from || !out->flux)
+    if (!out->p || !out->side || !out->flux)
         return 0;
     for (int k = 0; k < ps->surface_count; k++)
         for (uint32_t h = ps->surfaces[k].head; h != LM_NONE; h = ps->hits[h].next) {
@@ -96,20 +97,29 @@ static int pack(const lm_photon_store *ps, packed_hits *out)
                 continue;
             size_t at = 3 * (size_t)out->count++;
             memcpy(out->p + at, x->pos, 3 * sizeof(float));
-            lm_v3_store(out->from + at, lm_scale(lm_v3_load(x->dir), -1.0f));
+            lm_hit_side_normal(s, x, out->side + at);
             memcpy(out->flux + at, x->flux, 3 * sizeof(float));
         }
     return 1;
 }
 
-void lm_pixel_gather_bruteforce(const lm_gbuffer *g, const lm_photon_store *ps, float radius, float *out)
+/* Whether a photon at offset d from X (side normal np) lights X (normal nx): it lies on a surface that
+ * continues X's smoothly, normals within 60 degrees and within r / 2 of X's tangent plane (a sphere of
+ * radius r still counts). */
+static int same_side(lm_vec3 d, lm_vec3 np, lm_vec3 nx, float radius)
+{
+    return lm_dot(np, nx) >= 0.5f && fabsf(lm_dot(d, nx)) <= 0.5f * radius;
+}
+
+void lm_pixel_gather_bruteforce(const lm_gbuffer *g, const lm_photon_store *ps, const lm_scene *s, float radius,
+                                float *out)
 {
     size_t n = (size_t)g->width * (size_t)g->height;
     memset(out, 0, 3 * n * sizeof *out);
     packed_hits h;
-    if (!(radius > 0.0f) || !pack(ps, &h)) {
+    if (!(radius > 0.0f) || !pack(ps, s, &h)) {
         if (radius > 0.0f)
-            free(h.p), free(h.from), free(h.flux);
+            free(h.p), free(h.side), free(h.flux);
         return;
     }
     const float r2 = radius * radius, inv_r = 1.0f / radius;
@@ -124,7 +134,7 @@ void lm_pixel_gather_bruteforce(const lm_gbuffer *g, const lm_photon_store *ps, 
         for (uint32_t k = 0; k < h.count; k++) {
             lm_vec3 d = lm_sub(lm_v3_load(h.p + 3 * (size_t)k), x);
             float d2 = lm_dot(d, d);
-            if (d2 >= r2 || lm_dot(lm_v3_load(h.from + 3 * (size_t)k), nx) <= 0.0f)
+            if (d2 >= r2 || !same_side(d, lm_v3_load(h.side + 3 * (size_t)k), nx, radius))
                 continue;
             float kappa = fminf(KERNEL_C, 1.0f - sqrtf(d2) * inv_r);
             for (int c = 0; c < 3; c++)
@@ -133,5 +143,5 @@ void lm_pixel_gather_bruteforce(const lm_gbuffer *g, const lm_photon_store *ps, 
         for (int c = 0; c < 3; c++)
             out[3 * i + c] = (float)(kd[c] / LM_PI * sum[c] / norm);
     }
-    free(h.p), free(h.from), free(h.flux);
+    free(h.p), free(h.side), free(h.flux);
 }

@@ -4,11 +4,17 @@
  *
  *     L(X) = kd(X) / pi * sum_P Phi_P kappa(|Y_P - X|) / (pi c (1 - c + c^2 / 3) r^2)
  *
- * over the stored photon hits P (position Y_P, flux Phi_P) within r of X that arrive at X's front, with
- * the paper's kernel kappa(s) = min(c, 1 - s / r), c = 1/5 (eq. 2; the denominator is its integral over
+ * over the stored photon hits P (position Y_P, flux Phi_P) within r of X that lie on X's surface or on one
+ * that continues it smoothly (P's side normal, lm_hit_side_normal, within 60 degrees of X's normal, P
+ * within r / 2 of X's tangent plane), with the paper's kernel kappa(s) = min(c, 1 - s / r), c = 1/5 (eq. 2; the denominator is its integral over
  * the disc, eq. 3), the diffuse BSDF kd / pi (kd the diffuse lobe, docs/materials.md) and one radius r
  * for every photon (the paper's constant-radius case, in which every gather order gives the same
- * picture). The hits are those an IIM holds (lm_hit_in_iim): every stored hit but the punctual lights'
+ * picture). The paper's sphere alone lets a photon light the other side of a thin wall and the wall
+ * across a corner: the outside of the shared Cornell box's ceiling, lit by nothing, read as bright as its
+ * inside. The side test keeps each photon to its own surface and those that continue it, as the lightmap
+ * path's per-surface photon maps do; where the disc crosses the surface's edge the frame divides by the
+ * part of it on the surface (lm_aim_pixel_coverage), as the AIM does (docs/tiled.md).
+ * The hits are those an IIM holds (lm_hit_in_iim): every stored hit but the punctual lights'
  * first ones, whose light the direct pass draws per pixel, and the caustic ones (off mirrors and glass
  * only), whose light the caustic pass draws.
  *
@@ -48,7 +54,8 @@ void lm_gbuffer_free(lm_gbuffer *g);
  * 0 when there are none. */
 float lm_pixel_gather_radius(const lm_photon_store *ps, const lm_surfaces *su, int n);
 /* out (3 floats per pixel): L(X) above for every pixel of g, every gathered hit tested against every
- * pixel. */
-void lm_pixel_gather_bruteforce(const lm_gbuffer *g, const lm_photon_store *ps, float radius, float *out);
+ * pixel. s: the scene the hits lie on (lm_hit_side_normal; NULL: their arrival directions stand in). */
+void lm_pixel_gather_bruteforce(const lm_gbuffer *g, const lm_photon_store *ps, const lm_scene *s, float radius,
+                                float *out);
 
 #endif

@@ -45,6 +45,7 @@ struct lm_frame_loop {
     uint64_t photon_key;         /* a hash of the records, view, size, radius and scene the last gather saw */
     int photon_keyed;
     unsigned photon_runs;        /* gathers run: turns the stochastic gather's classes */
+    uint64_t coverage_key;       /* the radius and node scales the direct pass's kernel coverage is for (0: none) */
     const lm_surfaces *surfaces;
     lm_direct *direct_light; /* persistent: program, buffers, target and shadow maps */
     lm_iim iim;
@@ -422,13 +423,39 @@ static lm_status photon_records(lm_frame_loop *fl, lm_frame_stats *o, lm_error *
     }
     int fresh = !fl->records.rec || fl->records.store_version != ps->version;
     if (st == LM_OK && fresh)
-        st = lm_photon_records_update(&fl->records, ps, err);
+        st = lm_photon_records_update(&fl->records, ps, fl->scene, err);
     if (st == LM_OK && fresh)
         st = lm_photon_gather_set_records(fl->photon_gather, &fl->records, o ? &o->photon_gather : NULL, err);
     if (st == LM_OK && (fresh || !(fl->photon_radius > 0.0f)))
         fl->photon_radius = fl->set.photon_radius > 0.0f
                                 ? fl->set.photon_radius
                                 : lm_pixel_gather_radius(ps, fl->surfaces, fl->set.stage.aim.n_nearest);
+    return st;
+}
+
+/* The photon paths' kernel coverage (lm_aim_kernel_coverage) for the direct pass to write beside kd: made
+ * again when the radius or a node's scale (its matrix's column lengths) changed. */
+static lm_status update_coverage(lm_frame_loop *fl, lm_error *err)
+{
+    uint64_t key = lm_hash_bytes(0x9e3779b97f4a7c15ull, &fl->photon_radius, sizeof fl->photon_radius);
+    for (int i = 0; i < fl->scene->node_count; i++) {
+        const float *m = fl->scene->nodes[i].world;
+        float len2[3];
+        for (int c = 0; c < 3; c++)
+            len2[c] = m[4 * c] * m[4 * c] + m[4 * c + 1] * m[4 * c + 1] + m[4 * c + 2] * m[4 * c + 2];
+        key = lm_hash_bytes(key, len2, sizeof len2);
+    }
+    if (key == fl->coverage_key || !(fl->photon_radius > 0.0f))
+        return LM_OK;
+    float *c = malloc((size_t)(fl->atlas->texel_count ? fl->atlas->texel_count : 1) * sizeof *c);
+    if (!c)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the coverage of %u texels", fl->atlas->texel_count);
+    lm_status st = lm_aim_kernel_coverage(lm_photon_stage_aim(fl->stage), fl->scene, fl->surfaces, fl->atlas,
+                                          fl->photon_radius, c, err);
+    if (st == LM_OK)
+        st = lm_direct_set_coverage(fl->direct_light, c, err);
+    free(c);
+    fl->coverage_key = st == LM_OK ? key : 0;
     return st;
 }
 
@@ -566,6 +593,8 @@ static lm_status render_view(lm_frame_loop *fl, const lm_view *view, int w, int 
         st = lm_composite_indirect(fl->comp, fl->iim.display_tex, &lit, err); /* else the first pass adds none */
     double t1 = lm_now();
     lm_direct_set_indirect(fl->direct_light, lit);
+    if (st == LM_OK && photon_path(fl))
+        st = update_coverage(fl, err);
     const lm_emitters *em = lm_photon_stage_emitters(fl->stage);
     lm_caustic_pass *caustics = fl->caustic_pass && lm_caustic_pass_photon_count(fl->caustic_pass) ? fl->caustic_pass
                                                                                                   : NULL;
