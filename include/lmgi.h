@@ -497,6 +497,9 @@ typedef struct {
     int emitter_rays;
     uint32_t photons;           /* stored photon paths over all lights */
     double ms_setup_trace, ms_setup_aim, ms_setup_gather; /* the full trace, every AIM, the full gather */
+    const char *indirect;       /* "lightmap", "tiled", "hashgrid" or "bruteforce" */
+    int photon_tile, photon_chunk, photon_stochastic; /* the per-pixel gathers' knobs (docs/tiled.md) */
+    float photon_radius;        /* their kernel radius in scene units (0 before the first frame, or none) */
 } lmgi_updater_info;
 /* NULL u: info zeroed; NULL info: nothing. */
 LMGI_API void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info);

@@ -61,6 +61,54 @@ static void test_usage_errors(void **state)
     assert_int_equal(run("run scenes/cornell.glb --aim-direct exact --out x"), 2);
     assert_non_null(strstr(output, "--aim-direct exact"));
     assert_non_null(strstr(output, "emitters, photons or all"));
+    /* the indirect paths and their knobs (docs/tiled.md) */
+    assert_int_equal(run("run scenes/cornell.glb --indirect photons --out x"), 2);
+    assert_non_null(strstr(output, "--indirect photons"));
+    assert_non_null(strstr(output, "tiled"));
+    assert_int_equal(run("run scenes/cornell.glb --photon-tile 12 --out x"), 2);
+    assert_non_null(strstr(output, "--photon-tile 12"));
+    assert_int_equal(run("run scenes/cornell.glb --photon-stochastic 5 --out x"), 2);
+    assert_non_null(strstr(output, "--photon-stochastic 5"));
+    assert_int_equal(run("run scenes/cornell.glb --photon-chunk 32 --out x"), 2);
+    assert_non_null(strstr(output, "--photon-chunk 32"));
+    assert_int_equal(run("run scenes/cornell.glb --photon-radius 0 --out x"), 2);
+    assert_non_null(strstr(output, "--photon-radius 0"));
+    assert_int_equal(run("run scenes/cornell.glb --photon-radius nan --out x"), 2);
+}
+
+/* `lmgi run --indirect tiled` writes its frames, and frames.csv counts the gathers: one at the first frame,
+ * then one a frame while the animated cube moves. */
+static void test_tiled_run(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    char args[2048], path[2048];
+    const char *dir = lmt_tmpdir();
+    snprintf(args, sizeof args, "run %s --indirect tiled --photon-stochastic 2 --frames 3 --size 48x48 "
+             "--texels 800 --photons 6000 --out %s/tiled", scene, dir);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "tiled photon gather per pixel: radius"));
+    snprintf(path, sizeof path, "%s/tiled/frames.csv", dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char line[8192];
+    assert_non_null(fgets(line, sizeof line, f));
+    int col = 0, at = -1;
+    for (char *tok = strtok(line, ",\n"); tok; tok = strtok(NULL, ",\n"), col++)
+        if (!strcmp(tok, "photon_gathers"))
+            at = col;
+    assert_true(at >= 0);
+    int rows = 0, gathers = 0;
+    while (fgets(line, sizeof line, f)) {
+        col = 0;
+        for (char *tok = strtok(line, ",\n"); tok; tok = strtok(NULL, ",\n"), col++)
+            if (col == at)
+                gathers += atoi(tok);
+        rows++;
+    }
+    fclose(f);
+    assert_int_equal(rows, 3);
+    assert_int_equal(gathers, 3);
 }
 
 static void test_bad_scene_files(void **state)
@@ -416,6 +464,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_usage_errors),
+        cmocka_unit_test(test_tiled_run),
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_strict_refuses_degenerate_triangles),
         cmocka_unit_test(test_info_on_generated_cornell),

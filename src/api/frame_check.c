@@ -17,6 +17,7 @@ void lm_frame_check_free(lm_frame_check *c)
 {
     free(c->frame);
     free(c->ref);
+    free(c->ref_indirect);
     free(c->surface_at);
     free(c->compared);
     free(c->surface);
@@ -110,10 +111,27 @@ static lm_status reference_pixels(const lmgi_scene *sc, const lm_view *view, con
     if (st != LM_OK)
         return st;
     memcpy(c->ref, r.full, (size_t)r.count * 3 * sizeof(float));
+    memcpy(c->ref_indirect, r.indirect, (size_t)r.count * 3 * sizeof(float));
     c->ref_rel_se = r.mean_rel_se;
     c->ref_seconds = r.seconds;
     lm_ref_result_free(&r);
     return LM_OK;
+}
+
+lm_status lm_frame_check_frame(lmgi_scene *sc, const lm_frame_loop_settings *loop, int frames, float *rgb,
+                               lm_error *err)
+{
+    lm_frame_check c;
+    memset(&c, 0, sizeof c);
+    c.width = loop->width, c.height = loop->height;
+    c.frame = rgb;
+    c.surface_at = malloc((size_t)c.width * (size_t)c.height * sizeof(int32_t));
+    if (!c.surface_at)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", c.width, c.height);
+    lm_view view;
+    lm_status st = run_frames(sc, loop, frames, &c, &view, err);
+    free(c.surface_at);
+    return st;
 }
 
 lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop, const lm_ref_settings *ref,
@@ -125,10 +143,11 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
     out->surface_count = sc->surfaces.surface_count;
     out->frame = malloc(n * 3 * sizeof(float));
     out->ref = malloc(n * 3 * sizeof(float));
+    out->ref_indirect = malloc(n * 3 * sizeof(float));
     out->surface_at = malloc(n * sizeof(int32_t));
     out->compared = calloc(n, 1);
     out->surface = calloc((size_t)(out->surface_count ? out->surface_count : 1), sizeof *out->surface);
-    lm_status st = out->frame && out->ref && out->surface_at && out->compared && out->surface
+    lm_status st = out->frame && out->ref && out->ref_indirect && out->surface_at && out->compared && out->surface
                        ? LM_OK
                        : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
     lm_view view;

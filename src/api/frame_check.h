@@ -31,6 +31,7 @@ typedef struct {
 typedef struct {
     int width, height;
     float *frame, *ref;    /* 3 floats per pixel, linear radiance, row 0 at the top */
+    float *ref_indirect;   /* the reference's indirect part (trace/reference.h: the iim-like rest, shaded) */
     int32_t *surface_at;   /* per pixel: surface index, -1 specular, -2 nothing */
     uint8_t *compared;     /* per pixel: 1 where it counts in `surface` (an interior pixel of a surface) */
     int surface_count;
@@ -50,5 +51,9 @@ double lm_check_ratio(const lm_check_sum *c, int channel);
 lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop, const lm_ref_settings *ref,
                              int frames, lm_frame_check *out, lm_error *err);
 void lm_frame_check_free(lm_frame_check *c);
+/* The frame alone (what lm_frame_check_run compares): the loop's picture after `frames` frames into rgb
+ * (loop->width x loop->height x 3 floats). */
+lm_status lm_frame_check_frame(lmgi_scene *sc, const lm_frame_loop_settings *loop, int frames, float *rgb,
+                               lm_error *err);
 
 #endif

@@ -295,6 +295,12 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     info->ms_setup_trace = 1e3 * u->setup.t_photons;
     info->ms_setup_aim = 1e3 * u->setup.t_aim;
     info->ms_setup_gather = 1e3 * u->t_setup_gather;
+    static const char *const paths[4] = {"lightmap", "bruteforce", "tiled", "hashgrid"};
+    info->indirect = s->indirect_path >= 0 && s->indirect_path < 4 ? paths[s->indirect_path] : "lightmap";
+    info->photon_tile = s->photon_gather.tile;
+    info->photon_chunk = s->photon_gather.chunk;
+    info->photon_stochastic = s->photon_gather.stochastic;
+    info->photon_radius = lm_frame_loop_photon_radius(u->loop);
 }
 
 /* The 95th percentile of the window's first n samples (sorting a copy). */

@@ -26,6 +26,7 @@ typedef struct {
     float exposure;        /* fixed from frame 0 */
     double sum_ms[8];      /* photons, gather, blend, direct, caustics, reflections, composite, total */
     uint64_t caustic_photons, cube_faces; /* over all frames */
+    uint64_t photon_gathers, photon_entries;
     int caustic_frames;    /* frames that had caustic photons to draw */
     double *frame_ms;      /* each frame's total, for the median */
     uint32_t texels;
@@ -141,6 +142,8 @@ static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
     r->caustic_photons += fs.caustic_photons_retraced;
     r->caustic_frames += fs.caustic_tiles > 0;
     r->cube_faces += (uint64_t)fs.cube_faces_rendered;
+    r->photon_gathers += (uint64_t)fs.photon_gathers;
+    r->photon_entries += fs.photon_entries;
     r->frame_ms[f] = fs.ms_total;
     r->texels += fs.texels_gathered;
     return st;
@@ -221,6 +224,10 @@ static void summary(const run_state *r, int frames)
     lmgi_info in;
     lmgi_get_info(r->sc, &in);
     int per_frame = ui.texels_per_frame;
+    if (strcmp(ui.indirect, "lightmap"))
+        printf("indirect    %s photon gather per pixel: radius %.4g, tile %d, chunk %d, k %d; %llu gathers, "
+               "%llu list entries\n", ui.indirect, (double)ui.photon_radius, ui.photon_tile, ui.photon_chunk,
+               ui.photon_stochastic, (unsigned long long)r->photon_gathers, (unsigned long long)r->photon_entries);
     printf("atlas       %d x %d, %u texels of %.4g units: regathered in full every %u frames at %d a frame\n",
            in.atlas_width, in.atlas_height, in.texels, (double)in.texel_size,
            (in.texels + (uint32_t)per_frame - 1) / (uint32_t)per_frame, per_frame);

@@ -433,6 +433,8 @@ static lm_status photon_records(lm_frame_loop *fl, lm_frame_stats *o, lm_error *
     return st;
 }
 
+float lm_frame_loop_photon_radius(const lm_frame_loop *fl) { return photon_path(fl) ? fl->photon_radius : 0.0f; }
+
 /* The photon paths' kernel coverage (lm_aim_kernel_coverage) for the direct pass to write beside kd: made
  * again when the radius or a node's scale (its matrix's column lengths) changed. */
 static lm_status update_coverage(lm_frame_loop *fl, lm_error *err)

@@ -100,6 +100,9 @@ typedef struct lm_frame_loop lm_frame_loop;
 int lm_frame_loop_atlas_texels(int texels_per_frame);
 
 void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
+/* The photon paths' kernel radius in use (0 before their first frame, on the lightmap path, or with no
+ * photon to gather). */
+float lm_frame_loop_photon_radius(const lm_frame_loop *fl);
 /* The initial state. The world (update/world.h) is borrowed and must outlive the loop. setup (may be
  * NULL) gets the photon stage's setup times; t_setup_gather (may be NULL) the full gather's. */
 lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *set, lm_frame_loop **out,
