@@ -439,7 +439,7 @@ typedef struct {
     lmgi_indirect_path indirect; /* (0: LMGI_INDIRECT_LIGHTMAP) */
     /* the per-pixel photon gathers (indirect TILED, HASHGRID, BRUTEFORCE; docs/tiled.md) */
     int photon_tile;           /* TILED: screen tile side in pixels, 4, 8, 16 or 32 (0: 16) */
-    int photon_chunk;          /* TILED: photons per shared-memory load, 64 to 1024 (0: 256) */
+    int photon_chunk;          /* TILED: photons per shared-memory load, 64 to 512 (0: 256) */
     int photon_stochastic;     /* TILED: k, each pixel reads 1/k^2 of its tile's photons, then an edge-aware
                                 * k x k reconstruction, 1 to 4 (0: 1, all of them) */
     float photon_radius;       /* the kernel radius in scene units (0: the disc that holds

@@ -240,7 +240,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_int(o, v, 4, 32, &a->photon_tile) ? 2 : (a->photon_tile & (a->photon_tile - 1)) == 0
                      ? 0 : bad(o, v, "4, 8, 16 or 32 pixels");
         else if (!strcmp(o, "--photon-chunk"))
-            rc = parse_int(o, v, 64, 1024, &a->photon_chunk);
+            rc = parse_int(o, v, 64, 512, &a->photon_chunk);
         else if (!strcmp(o, "--photon-stochastic"))
             rc = parse_int(o, v, 1, 4, &a->photon_stochastic);
         else if (!strcmp(o, "--photon-radius"))

@@ -88,7 +88,7 @@ static void usage(FILE *f)
             "                   every pixel: the ground truth, small frames only)\n"
             "  --photon-tile N, --photon-chunk N, --photon-stochastic K, --photon-radius R  'run', 'check'\n"
             "                   with --indirect tiled: tile side (4, 8, 16 or 32; default 16), photons per\n"
-            "                   shared-memory load (64 to 1024; default 256), k: each pixel reads 1/k^2 of\n"
+            "                   shared-memory load (64 to 512; default 256), k: each pixel reads 1/k^2 of\n"
             "                   its tile's photons, then an edge-aware k x k average (1 to 4; default 1: all);\n"
             "                   the kernel radius (default: the disc of --nearest photons)\n"
             "  --effects LIST   'run', 'check', 'bake': effects left out (-) or kept (+) whatever the scene\n"

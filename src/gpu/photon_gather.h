@@ -48,7 +48,7 @@ typedef enum { LM_PHOTON_GATHER_TILED = 0, LM_PHOTON_GATHER_HASHGRID, LM_PHOTON_
 typedef struct {
     int kind;       /* lm_photon_gather_kind. Default TILED */
     int tile;       /* tiled: tile side in pixels, 4, 8, 16 or 32. Default 16 */
-    int chunk;      /* tiled: records per shared-memory load, 64 to 2048. Default 256 */
+    int chunk;      /* tiled: records per shared-memory load, 64 to 512 (3 vec3 a record: 18 KB). Default 256 */
     int stochastic; /* tiled: k, each pixel reads 1/k^2 of its tile's records (1: all), 1 to 4. Default 1 */
 } lm_photon_gather_settings;
 

@@ -10,6 +10,7 @@
 #include "bench_caustics.h"
 #include "bench_gather.h"
 #include "bench_photons.h"
+#include "bench_tiled.h"
 #include "photons_cmd.h"
 
 static void usage(FILE *f)
@@ -18,10 +19,13 @@ static void usage(FILE *f)
                "         the photon stage alone over the scene's animations: AIM atlas, a view with AIMs, stats.csv\n"
                "       lmgi-dev bench [--gather-scene FILE]\n"
                "         photon tracing against raw Embree, the final gather against the paper's Table 2, the\n"
-               "         caustic pass and reflections against the paper's section 5 figures\n"
+               "         caustic pass and reflections against the paper's section 5 figures, the per-pixel\n"
+               "         photon gathers against Mara et al.'s (2013)\n"
+               "         (FILE: the ~133k-triangle Cornell box of `build/gen_scenes --cornell-cells 255`)\n"
                "       lmgi-dev bench-caustics\n"
                "         the caustics and reflections part alone\n"
-               "         (FILE: the ~133k-triangle Cornell box of `build/gen_scenes --cornell-cells 255`)\n"
+               "       lmgi-dev bench-tiled\n"
+               "         the per-pixel photon gathers alone (tiled, stochastic, hash grid, brute force)\n"
                "options and their meaning: `lmgi help`\n");
 }
 
@@ -37,10 +41,15 @@ int main(int argc, char **argv)
         lm_dev_bench_photons();
         lm_dev_bench_gather(a.gather_scene);
         lm_dev_bench_caustics();
+        lm_dev_bench_tiled();
         return 0;
     }
     if (!strcmp(argv[1], "bench-caustics")) {
         lm_dev_bench_caustics();
+        return 0;
+    }
+    if (!strcmp(argv[1], "bench-tiled")) {
+        lm_dev_bench_tiled();
         return 0;
     }
     fprintf(stderr, "lmgi-dev: unknown command '%s'\n\n", argv[1]);
