@@ -35,6 +35,15 @@ if [ -r ../shared/scenes/cornell-box/CornellBox.glb ]; then
     "$LMGI" run ../shared/scenes/cornell-box/CornellBox.glb --frames 1 --size 512x512 --out demo/cornellbox-run --force
     "$LMGI" check ../shared/scenes/cornell-box/CornellBox.glb --out demo/cornellbox-check --force -q | tee demo/cornellbox-check.txt
 fi
+# The same box with its indirect light gathered per pixel straight from the photons (--indirect tiled,
+# docs/tiled.md) beside the lightmap path above, and that frame against the same reference.
+if [ -r ../shared/scenes/cornell-box/CornellBox.glb ]; then
+    echo "== run and check with --indirect tiled on ../shared/scenes/cornell-box/CornellBox.glb"
+    "$LMGI" run ../shared/scenes/cornell-box/CornellBox.glb --indirect tiled --frames 1 --size 512x512 \
+        --out demo/cornellbox-tiled-run --force
+    "$LMGI" check ../shared/scenes/cornell-box/CornellBox.glb --indirect tiled --out demo/cornellbox-check-tiled \
+        --force -q | tee demo/cornellbox-check-tiled.txt
+fi
 # A shared scene lit only by an emissive lamp, with a glossy Suzanne that reflects the room (its environment
 # map) and textured blocks whose indirect light takes the texture per pixel.
 if [ -r ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf ]; then
@@ -43,6 +52,7 @@ if [ -r ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf ]; then
         --out demo/cornell-suzanne-run --force
 fi
 echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png,"
-echo "      demo/cornell-run/frame_*.png and caustics.png, demo/cornellbox-run/frame_0000.png, demo/cornell-suzanne-run/"
-echo "      frame_0000.png and demo/cornellbox-check/"
-echo "      (check_ratio.png: frame / reference, red brighter, blue darker; demo/cornellbox-check.txt per surface)"
+echo "      demo/cornell-run/frame_*.png and caustics.png, demo/cornellbox-run/frame_0000.png beside"
+echo "      demo/cornellbox-tiled-run/frame_0000.png (--indirect tiled), demo/cornell-suzanne-run/frame_0000.png,"
+echo "      demo/cornellbox-check/ and demo/cornellbox-check-tiled/ (check_ratio.png: frame / reference, red"
+echo "      brighter, blue darker; demo/cornellbox-check.txt and -check-tiled.txt per surface)"

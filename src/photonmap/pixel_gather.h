@@ -20,7 +20,7 @@
  *
  * r: the radius of a disc that holds n photons on average, r = sqrt(n A / (pi H)), A the surfaces' world
  * area and H the hits gathered (the N of the AIM's N-nearest estimate, so that both paths blur alike on
- * average; docs/gather.md, "The brute-force gather").
+ * average; docs/tiled.md, "The estimate").
  *
  * This is the brute-force iteration (every photon against every pixel: O(pixels x hits), seconds at
  * 512 x 512 and tens of thousands of hits, on the calling thread's OpenMP team), the ground truth for
