@@ -4,10 +4,13 @@
  *
  *     E(x) = sum_P Phi_P kappa(|Y_P - x|) / (pi c (1 - c + c^2 / 3) r^2)
  *
- * over the photon records (photonmap/photon_records.h) within r of its visible point that arrive at its
- * front (eq. 1-3, kappa = min(c, 1 - s / r), c = 1/5, one radius r for all: the paper's constant-radius
- * case, in which every gather gives the same picture), and lm_photon_gather_composite adds kd / pi x E to
- * the frame, in place of the lightmaps' albedo / pi x E_IIM.
+ * over the photon records (photonmap/photon_records.h) within r of its visible point that lie on its
+ * surface or one that continues it (side normals within 60 degrees, within r / 2 of its tangent plane;
+ * photonmap/pixel_gather.h) (eq. 1-3, kappa = min(c, 1 - s / r), c = 1/5, one radius r for all: the
+ * paper's constant-radius case, in which every gather gives the same picture), and
+ * lm_photon_gather_composite adds kd / pi x E / c_x to the frame, c_x the kernel's part on the pixel's
+ * surface (the kd texture's alpha holds 1 / c_x: gpu/direct.h lm_direct_set_coverage), in place of the
+ * lightmaps' albedo / pi x E_IIM.
  *
  * The gathers, all compute shaders (GL 4.5) over the frame's G-buffer (gpu/direct.h: kd, position and
  * normal from the direct light's first pass):
@@ -78,8 +81,8 @@ lm_status lm_photon_gather_set_records(lm_photon_gather *g, const lm_photon_reco
  * classes; E goes to the object's w x h texture. */
 lm_status lm_photon_gather_run(lm_photon_gather *g, const lm_view *view, int w, int h, unsigned kd_tex,
                                unsigned g_tex, float radius, unsigned frame, lm_photon_gather_stats *st, lm_error *err);
-/* radiance_tex (w x h RGBA32F, the frame's: lm_direct_radiance_texture) += kd / pi x E of the last run
- * (reconstructed when stochastic), over the same G-buffer. */
+/* radiance_tex (w x h RGBA32F, the frame's: lm_direct_radiance_texture) += kd / pi x E / c_x of the last
+ * run (reconstructed when stochastic), over the same G-buffer (kd_tex's alpha: 1 / c_x). */
 lm_status lm_photon_gather_composite(lm_photon_gather *g, unsigned radiance_tex, unsigned kd_tex, unsigned g_tex,
                                      lm_error *err);
 /* The last run's E (3 floats a pixel, row 0 at the top; before any reconstruction), for tests. */
