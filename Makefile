@@ -160,6 +160,7 @@ bench: deps all $(BUILD)/gen_scenes
 	$(BUILD)/lmgi-dev bench --gather-scene $(BUILD)/bench/cornell_255.glb
 	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb)
 	$(BUILD)/lmgi bench --edits bench/two_rooms_edits.json scenes/two_rooms.glb --json $(BUILD)/bench/edits.json
+	$(BUILD)/lmgi bench --soak 100000 scenes/cornell.glb --size 32x32
 
 scenes: $(BUILD)/gen_scenes
 	$(BUILD)/gen_scenes scenes

@@ -72,6 +72,7 @@ typedef struct {
     uint32_t back_triangles; /* the second sides of double-sided surfaces (one per triangle, facing the
                               * other way), beside `triangles`, the file's own; docs/materials.md */
     int nodes, dynamic_nodes, meshes, materials, textures, lights, cameras, animations;
+    float animation_seconds;    /* the longest animation's last key time (0: none) */
     int materials_by_class[5];  /* diffuse, glossy, mirror, glass, emitter */
     int lights_by_type[3];      /* point, spot, directional */
     int surfaces, charts;

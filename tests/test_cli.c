@@ -76,6 +76,26 @@ static void test_usage_errors(void **state)
     assert_int_equal(run("run scenes/cornell.glb --photon-radius nan --out x"), 2);
 }
 
+/* `lmgi bench --soak N`: N updates of the looped animation, memory and time per block, no non-finite
+ * value; a bad count is a usage error. `lmgi info` says how long the animation is. */
+static void test_soak(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    char args[2048];
+    snprintf(args, sizeof args, "info %s", scene);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "animations 3 (8 s)"));
+    snprintf(args, sizeof args, "bench --soak 40 %s --size 16x16 --texels 800 --photons 4000 --caustic-photons 1024",
+             scene);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "40 updates at 16 x 16, the animation (8 s) looped"));
+    assert_non_null(strstr(output, "non-finite frame values: 0"));
+    assert_non_null(strstr(output, "resident MB"));
+    assert_int_equal(run("bench --soak 0"), 2);
+    assert_non_null(strstr(output, "--soak 0"));
+}
+
 /* `lmgi run --indirect tiled` writes its frames, and frames.csv counts the gathers: one at the first frame,
  * then one a frame while the animated cube moves. */
 static void test_tiled_run(void **state)
@@ -465,6 +485,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_usage_errors),
         cmocka_unit_test(test_tiled_run),
+        cmocka_unit_test(test_soak),
         cmocka_unit_test(test_bad_scene_files),
         cmocka_unit_test(test_strict_refuses_degenerate_triangles),
         cmocka_unit_test(test_info_on_generated_cornell),

@@ -36,6 +36,9 @@ void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
             in->lights++, in->lights_by_type[s->lights[l].type]++;
     in->cameras = s->camera_count;
     in->animations = s->animation_count;
+    for (int a = 0; a < s->animation_count; a++)
+        in->animation_seconds = in->animation_seconds > s->animations[a].duration ? in->animation_seconds
+                                                                                : s->animations[a].duration;
     in->surfaces = sc->surfaces.surface_count;
     in->charts = sc->atlas.chart_count;
     in->degenerate_triangles = sc->surfaces.degenerate_tris;
@@ -126,7 +129,10 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     print_nodes(s, &in, f);
     print_materials(s, &in, f);
     print_lights(s, &in, f);
-    fprintf(f, "cameras     %d, animations %d, textures %d\n", in.cameras, in.animations, in.textures);
+    fprintf(f, "cameras     %d, animations %d", in.cameras, in.animations);
+    if (in.animations)
+        fprintf(f, " (%.3g s)", (double)in.animation_seconds);
+    fprintf(f, ", textures %d\n", in.textures);
     fprintf(f, "surfaces    %d (%u degenerate triangles dropped, %u non-manifold edges)\n", in.surfaces,
             in.degenerate_triangles, in.nonmanifold_edges);
     fprintf(f, "charts      %d\n", in.charts);

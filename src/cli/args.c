@@ -283,6 +283,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_tonemap(o, v, &a->tonemap);
         else if (!strcmp(o, "--emitter-rays"))
             rc = parse_int(o, v, 1, 65536, &a->emitter_rays);
+        else if (!strcmp(o, "--soak"))
+            rc = parse_int(o, v, 1, 100000000, &a->soak);
         else if (!strcmp(o, "--edits"))
             rc = v ? (a->edits_path = v, 0) : bad(o, v, "an edit script (JSON)");
         else if (!strcmp(o, "--gather-scene"))

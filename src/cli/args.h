@@ -65,6 +65,7 @@ typedef struct {
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
+    int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */
 } lm_cli_args;
 
 /* Parses argv[first..argc). Returns 0 on success, or prints what was wrong and returns 2. */

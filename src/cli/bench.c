@@ -9,6 +9,7 @@
 #include "order_stats.h"
 #include "bench_budget.h"
 #include "bench_edits.h"
+#include "bench_soak.h"
 #include "bench_scenes.h"
 
 /* Scenes timed when none are named: ours first, then the shared ones (skipped when absent). */
@@ -126,6 +127,8 @@ int lm_cli_bench(const lm_cli_args *a)
 {
     if (a->edits_path)
         return lm_cli_bench_edits(a);
+    if (a->soak)
+        return lm_cli_bench_soak(a);
     const char *const *files = a->files;
     int count = a->file_count;
     if (count == 0) {

@@ -43,6 +43,8 @@ static void usage(FILE *f)
             "                         reference (photon tracing and the gather: lmgi-dev bench, make bench)\n"
             "  bench --edits SCRIPT.json SCENE  a scripted edit sequence through the updater: per-update times,\n"
             "                         budget overruns and each edit's update lag (docs/bench.md; --json FILE)\n"
+            "  bench --soak N [SCENE]  N updates of the looped animation (default scenes/cornell.glb, 32 x 32):\n"
+            "                         resident memory, update times and non-finite frame values per block\n"
             "  help                   this text\n"
             "\n"
             "options:\n"
