@@ -42,6 +42,7 @@ struct lm_frame_loop {
     lm_photon_records records;
     lm_photon_gather *photon_gather;
     float photon_radius;         /* the kernel radius for the records held */
+    uint32_t radius_live;        /* the live records it was derived from */
     uint64_t photon_key;         /* a hash of the records, view, size, radius and scene the last gather saw */
     int photon_keyed;
     unsigned photon_runs;        /* gathers run: turns the stochastic gather's classes */
@@ -426,10 +427,17 @@ static lm_status photon_records(lm_frame_loop *fl, lm_frame_stats *o, lm_error *
         st = lm_photon_records_update(&fl->records, ps, fl->scene, err);
     if (st == LM_OK && fresh)
         st = lm_photon_gather_set_records(fl->photon_gather, &fl->records, o ? &o->photon_gather : NULL, err);
-    if (st == LM_OK && (fresh || !(fl->photon_radius > 0.0f)))
+    /* The derived radius is kept until the gathered hits change by a tenth (its square root: 5%): a radius
+     * that followed every re-traced photon would change the kernel, and so the picture and the coverage
+     * atlas, every frame. */
+    uint32_t live = fl->records.live, was = fl->radius_live;
+    int drifted = live > was + was / 10 || was > live + live / 10;
+    if (st == LM_OK && (!(fl->photon_radius > 0.0f) || (fresh && drifted))) {
         fl->photon_radius = fl->set.photon_radius > 0.0f
                                 ? fl->set.photon_radius
                                 : lm_pixel_gather_radius(ps, fl->surfaces, fl->set.stage.aim.n_nearest);
+        fl->radius_live = live;
+    }
     return st;
 }
 
