@@ -212,19 +212,24 @@ static void summary(const run_state *r, int frames)
     lmgi_get_updater_info(r->u, &ui);
     printf("gl          %s\n", lmgi_context_gl_description(r->ctx));
     print_effects(r);
-    printf("gather      R %d, a %g, %d AIM lookup%s and %d coverage sample%s per pixel, %s scheme; ",
-           ui.hemicube_resolution, (double)ui.enlargement, ui.hemicube_samples, ui.hemicube_samples > 1 ? "s" : "",
-           ui.hemicube_coverage, ui.hemicube_coverage > 1 ? "s" : "", ui.gather_scheme);
-    if (!ui.emissive_triangles)
-        printf("no emissive triangles\n");
-    else if (ui.emitters_closed_form)
-        printf("%u emissive triangles in closed form (%d shadow rays each)\n", ui.emissive_triangles, ui.emitter_rays);
-    else
-        printf("%u emissive triangles drawn\n", ui.emissive_triangles);
+    int lightmap = !strcmp(ui.indirect, "lightmap");
+    if (lightmap) { /* the hemicube gather's settings; the photon paths have none */
+        printf("gather      R %d, a %g, %d AIM lookup%s and %d coverage sample%s per pixel, %s scheme; ",
+               ui.hemicube_resolution, (double)ui.enlargement, ui.hemicube_samples,
+               ui.hemicube_samples > 1 ? "s" : "", ui.hemicube_coverage, ui.hemicube_coverage > 1 ? "s" : "",
+               ui.gather_scheme);
+        if (!ui.emissive_triangles)
+            printf("no emissive triangles\n");
+        else if (ui.emitters_closed_form)
+            printf("%u emissive triangles in closed form (%d shadow rays each)\n", ui.emissive_triangles,
+                   ui.emitter_rays);
+        else
+            printf("%u emissive triangles drawn\n", ui.emissive_triangles);
+    }
     lmgi_info in;
     lmgi_get_info(r->sc, &in);
     int per_frame = ui.texels_per_frame;
-    if (strcmp(ui.indirect, "lightmap"))
+    if (!lightmap)
         printf("indirect    %s photon gather per pixel: radius %.4g, tile %d, chunk %d, k %d; %llu gathers, "
                "%llu list entries\n", ui.indirect, (double)ui.photon_radius, ui.photon_tile, ui.photon_chunk,
                ui.photon_stochastic, (unsigned long long)r->photon_gathers, (unsigned long long)r->photon_entries);
