@@ -131,6 +131,19 @@ lm_status lm_float_target_ensure(lm_float_target *t, int width, int height, int 
     return LM_OK;
 }
 
+void lm_rgba_to_rgb_top_down(const float *rgba, int w, int h, float *rgb)
+{
+    for (int y = 0; y < h; y++) { /* GL's rows start at the bottom */
+        const float *src = rgba + 4 * (size_t)w * (size_t)(h - 1 - y);
+        float *dst = rgb + 3 * (size_t)w * (size_t)y;
+        for (int x = 0; x < w; x++) {
+            dst[3 * x] = src[4 * x];
+            dst[3 * x + 1] = src[4 * x + 1];
+            dst[3 * x + 2] = src[4 * x + 2];
+        }
+    }
+}
+
 void lm_float_target_read_rgb(const lm_float_target *t, int i, float *rgb, float *scratch)
 {
     int w = t->width, h = t->height;
@@ -139,15 +152,7 @@ void lm_float_target_read_rgb(const lm_float_target *t, int i, float *rgb, float
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     /* one RGBA read (the target's own layout: a plain copy in the driver), then flip and drop alpha */
     glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, scratch);
-    for (int y = 0; y < h; y++) { /* GL's rows start at the bottom */
-        const float *src = scratch + 4 * (size_t)w * (size_t)(h - 1 - y);
-        float *dst = rgb + 3 * (size_t)w * (size_t)y;
-        for (int x = 0; x < w; x++) {
-            dst[3 * x] = src[4 * x];
-            dst[3 * x + 1] = src[4 * x + 1];
-            dst[3 * x + 2] = src[4 * x + 2];
-        }
-    }
+    lm_rgba_to_rgb_top_down(scratch, w, h, rgb);
     glReadBuffer(GL_COLOR_ATTACHMENT0);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, t->fbo);
 }

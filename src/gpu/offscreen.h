@@ -36,6 +36,8 @@ typedef struct {
 lm_status lm_float_target_ensure(lm_float_target *t, int width, int height, int attachments, lm_error *err);
 /* Reads attachment i's RGB into rgb (width*height*3, row 0 at the top). scratch: width*height*4 floats. */
 void lm_float_target_read_rgb(const lm_float_target *t, int i, float *rgb, float *scratch);
+/* A w x h RGBA float picture as GL reads it (row 0 at the bottom) into rgb (w*h*3, row 0 at the top). */
+void lm_rgba_to_rgb_top_down(const float *rgba, int w, int h, float *rgb);
 void lm_float_target_free(lm_float_target *t);
 
 #endif

@@ -11,6 +11,7 @@
 #include "direct_shader.h"
 #include "gl_api.h"
 #include "gl_shader.h"
+#include "offscreen.h"
 #include "photon_gather_shaders.h"
 
 enum {
@@ -178,10 +179,7 @@ lm_status lm_photon_gather_set_records(lm_photon_gather *g, const lm_photon_reco
     }
     g->records = r->count;
     g->live = r->live;
-    g->top_exponent = -1000;
-    for (uint32_t i = 0; i < r->count; i++)
-        if (r->rec[i].w[3] && (int)(r->rec[i].w[3] >> 24) - 128 > g->top_exponent)
-            g->top_exponent = (int)(r->rec[i].w[3] >> 24) - 128;
+    g->top_exponent = r->top_exponent;
     if (st) {
         st->records = g->records, st->records_live = g->live;
         st->pages_uploaded = pages;
@@ -191,15 +189,15 @@ lm_status lm_photon_gather_set_records(lm_photon_gather *g, const lm_photon_reco
 }
 
 /* The uniforms every gather program shares (photon_gather_shaders.c's common part). */
-static void common_uniforms(const lm_photon_gather *g, GLuint p, float radius, float share)
+static void common_uniforms(const lm_photon_gather *g, GLuint p)
 {
+    float radius = g->radius;
     /* the largest term is the brightest channel (under 2^top) times kappa (at most c = 1/5) */
     double top = ldexp(1.0, g->top_exponent) * 0.2;
     glUseProgram(p);
     glUniform1f(glGetUniformLocation(p, "radius"), radius);
     glUniform1f(glGetUniformLocation(p, "radius2"), radius * radius);
     glUniform1f(glGetUniformLocation(p, "to_fixed"), g->top_exponent > -1000 ? (float)(FIXED_UNIT / top) : 1.0f);
-    glUniform1f(glGetUniformLocation(p, "share"), share);
     glUniform1i(glGetUniformLocation(p, "kd_tex"), 0);
     glUniform1i(glGetUniformLocation(p, "g_tex"), 1);
 }
@@ -302,14 +300,14 @@ static lm_status run_tiled(lm_photon_gather *g, const lm_view *view, unsigned fr
     const float vrow2[4] = {view->view[2], view->view[6], view->view[10], view->view[14]};
     ensure(g, B_BOUNDS, 8 * (size_t)tx * (size_t)ty);
     GLuint p = g->prog[P_BOUNDS];
-    common_uniforms(g, p, g->radius, 1.0f);
+    common_uniforms(g, p);
     glUniform4fv(glGetUniformLocation(p, "vrow2"), 1, vrow2);
     glUniform2i(glGetUniformLocation(p, "size"), g->width, g->height);
     glUniform1i(glGetUniformLocation(p, "tiles_x"), tx);
     glDispatchCompute((GLuint)tx, (GLuint)ty, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
     p = g->prog[P_INSERT_TILES];
-    common_uniforms(g, p, g->radius, 1.0f);
+    common_uniforms(g, p);
     glUniformMatrix4fv(glGetUniformLocation(p, "vp"), 1, GL_FALSE, vp);
     glUniform4fv(glGetUniformLocation(p, "vrow2"), 1, vrow2);
     glUniform2i(glGetUniformLocation(p, "size"), g->width, g->height);
@@ -338,7 +336,7 @@ static lm_status run_tiled(lm_photon_gather *g, const lm_view *view, unsigned fr
     const uint32_t per_round = 1 + part + (uint32_t)(g->set.chunk + T * T - 1) / (uint32_t)(T * T);
     const uint32_t window = WINDOW_ITERATIONS / per_round > 0 ? WINDOW_ITERATIONS / per_round : 1;
     p = g->prog[P_GATHER_TILES];
-    common_uniforms(g, p, g->radius, 1.0f);
+    common_uniforms(g, p);
     glUniform2i(glGetUniformLocation(p, "size"), g->width, g->height);
     glUniform1i(glGetUniformLocation(p, "tiles_x"), tx);
     glUniform1i(glGetUniformLocation(p, "k"), k);
@@ -358,7 +356,7 @@ static lm_status run_cells(lm_photon_gather *g, double *t_mid, lm_photon_gather_
     while (buckets < 2 * g->live && buckets < (1u << 26))
         buckets *= 2;
     GLuint p = g->prog[P_INSERT_CELLS];
-    common_uniforms(g, p, g->radius, 1.0f);
+    common_uniforms(g, p);
     glUniform1f(glGetUniformLocation(p, "cell"), 2.0f * g->radius);
     glUniform1ui(glGetUniformLocation(p, "buckets"), buckets);
     uint32_t longest = 0;
@@ -368,7 +366,7 @@ static lm_status run_cells(lm_photon_gather *g, double *t_mid, lm_photon_gather_
     *t_mid = lm_now();
     const uint32_t window = WINDOW_ITERATIONS / 8 - 64; /* each of up to 8 buckets, and their loops */
     p = g->prog[P_GATHER_CELLS];
-    common_uniforms(g, p, g->radius, 1.0f);
+    common_uniforms(g, p);
     glUniform1f(glGetUniformLocation(p, "cell"), 2.0f * g->radius);
     glUniform1ui(glGetUniformLocation(p, "buckets"), buckets);
     glUniform2i(glGetUniformLocation(p, "size"), g->width, g->height);
@@ -384,7 +382,7 @@ static lm_status run_cells(lm_photon_gather *g, double *t_mid, lm_photon_gather_
 static void run_all(lm_photon_gather *g, double *t_mid)
 {
     GLuint p = g->prog[P_GATHER_ALL];
-    common_uniforms(g, p, g->radius, 1.0f);
+    common_uniforms(g, p);
     glUniform2i(glGetUniformLocation(p, "size"), g->width, g->height);
     *t_mid = lm_now();
     for (uint32_t first = 0; first < g->records; first += WINDOW_ITERATIONS) {
@@ -431,7 +429,8 @@ lm_status lm_photon_gather_run(lm_photon_gather *g, const lm_view *view, int w, 
         run_all(g, &t_mid);
     if (s == LM_OK) {
         GLuint p = g->prog[P_FINISH];
-        common_uniforms(g, p, g->radius, g->k > 1 ? (float)(g->k * g->k) : 1.0f);
+        common_uniforms(g, p);
+        glUniform1f(glGetUniformLocation(p, "share"), (float)(g->k * g->k)); /* a pixel read 1/k^2 of them */
         glUniform2i(glGetUniformLocation(p, "size"), w, h);
         glBindImageTexture(0, g->e_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glDispatchCompute((GLuint)(w + 7) / 8, (GLuint)(h + 7) / 8, 1);
@@ -455,7 +454,7 @@ lm_status lm_photon_gather_composite(lm_photon_gather *g, unsigned radiance_tex,
         return lm_fail(err, LM_ERR_INVALID, "photon gather: composite before any run");
     GLuint p = g->prog[P_RESOLVE];
     bind_gbuffer(kd_tex, g_tex);
-    common_uniforms(g, p, g->radius, 1.0f);
+    common_uniforms(g, p);
     glUniform2i(glGetUniformLocation(p, "size"), g->width, g->height);
     glUniform1i(glGetUniformLocation(p, "k"), g->k);
     glBindImageTexture(0, g->e_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
@@ -475,11 +474,7 @@ lm_status lm_photon_gather_read(lm_photon_gather *g, float *rgb, lm_error *err)
     glBindTexture(GL_TEXTURE_2D, g->e_tex);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, rgba);
-    for (int y = 0; y < h; y++)
-        for (int x = 0; x < w; x++)
-            for (int c = 0; c < 3; c++)
-                rgb[3 * ((size_t)y * (size_t)w + (size_t)x) + (size_t)c] =
-                    rgba[4 * ((size_t)(h - 1 - y) * (size_t)w + (size_t)x) + (size_t)c];
+    lm_rgba_to_rgb_top_down(rgba, w, h, rgb);
     free(rgba);
     return lm_gl_check("photon gather: read", err);
 }

@@ -42,12 +42,11 @@ void lm_hit_side_normal(const lm_scene *s, const lm_hit *h, float n[3])
 {
     lm_vec3 from = lm_scale(lm_v3_load(h->dir), -1.0f), ng = from;
     if (s && h->tri < s->tri_count) {
-        const uint32_t *t = s->tris + 3 * (size_t)h->tri;
-        const float *m = s->nodes[s->tri_node[h->tri]].world;
-        lm_vec3 a = lm_mat4_point(m, lm_v3_load(s->positions + 3 * (size_t)t[0]));
-        lm_vec3 b = lm_mat4_point(m, lm_v3_load(s->positions + 3 * (size_t)t[1]));
-        lm_vec3 c = lm_mat4_point(m, lm_v3_load(s->positions + 3 * (size_t)t[2]));
-        lm_vec3 x = lm_cross(lm_sub(b, a), lm_sub(c, a));
+        float p[3][3];
+        for (int k = 0; k < 3; k++)
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)h->tri + (size_t)k], p[k]);
+        lm_vec3 a = lm_v3_load(p[0]);
+        lm_vec3 x = lm_cross(lm_sub(lm_v3_load(p[1]), a), lm_sub(lm_v3_load(p[2]), a));
         float len = sqrtf(lm_dot(x, x));
         if (len > 0.0f && isfinite(len))
             ng = lm_scale(x, lm_dot(x, from) < 0.0f ? -1.0f / len : 1.0f / len);
@@ -130,6 +129,7 @@ lm_status lm_photon_records_update(lm_photon_records *r, const lm_photon_store *
     r->pages = (n + LM_RECORD_PAGE - 1) / LM_RECORD_PAGE;
     memset(r->dirty, resized, r->pages);
     r->live = 0;
+    r->top_exponent = -1000;
     for (uint32_t i = 0; i < n; i++) {
         lm_photon_record x;
         float side[3] = {0.0f, 0.0f, 0.0f};
@@ -137,6 +137,8 @@ lm_status lm_photon_records_update(lm_photon_records *r, const lm_photon_store *
             lm_hit_side_normal(s, &ps->hits[i], side);
         lm_photon_record_encode(&ps->hits[i], side, &x);
         r->live += x.w[3] != 0;
+        if (x.w[3] && (int)(x.w[3] >> 24) - 128 > r->top_exponent)
+            r->top_exponent = (int)(x.w[3] >> 24) - 128;
         if (resized || memcmp(&x, &r->rec[i], sizeof x)) {
             r->rec[i] = x;
             r->dirty[i / LM_RECORD_PAGE] = 1;

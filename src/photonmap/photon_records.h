@@ -41,6 +41,7 @@ typedef struct {
     lm_photon_record *rec;   /* rec[slot] for slot in [0, count) */
     uint32_t count, capacity;
     uint32_t live;           /* records that are not empty */
+    int top_exponent;        /* the largest shared exponent e of a record that is not empty (-1000: none) */
     uint8_t *dirty;          /* per page: changed by the last update (pages = ceil(count / LM_RECORD_PAGE)) */
     uint32_t pages, dirty_pages;
     uint64_t store_version;  /* the store's version the records hold */
