@@ -74,9 +74,10 @@ static lm_status compare(const lmgi_scene *sc, lm_frame_check *c, lm_error *err)
     return LM_OK;
 }
 
-/* The frame loop's picture after `frames` frames, and the surface index of each of its pixels. */
-static lm_status run_frames(lmgi_scene *sc, const lm_frame_loop_settings *set, int frames, lm_frame_check *c,
-                            lm_view *view, lm_error *err)
+/* The frame loop's picture after `frames` frames into rgb, and (surface_at not NULL) the surface index of
+ * each of its pixels. */
+static lm_status run_frames(lmgi_scene *sc, const lm_frame_loop_settings *set, int frames, float *rgb,
+                            int32_t *surface_at, lm_view *view, lm_error *err)
 {
     lm_frame_loop *fl = NULL;
     lm_status st = lm_frame_loop_create(&sc->world, set, &fl, NULL, NULL, err);
@@ -85,12 +86,11 @@ static lm_status run_frames(lmgi_scene *sc, const lm_frame_loop_settings *set, i
         st = lm_frame_loop_step(fl, (float)f / 30.0f, &fs, err);
     }
     if (st == LM_OK) {
-        size_t bytes = (size_t)c->width * (size_t)c->height * 3 * sizeof(float);
-        memcpy(c->frame, lm_frame_loop_image(fl), bytes);
+        memcpy(rgb, lm_frame_loop_image(fl), (size_t)set->width * (size_t)set->height * 3 * sizeof(float));
         *view = *lm_frame_loop_view(fl);
-        /* drawn with the loop's context still current (it has no other) */
-        st = lm_render_surface_index(sc->scene, &sc->surfaces, view, c->width, c->height, c->surface_at, err);
     }
+    if (st == LM_OK && surface_at) /* drawn with the loop's context still current (it has no other) */
+        st = lm_render_surface_index(sc->scene, &sc->surfaces, view, set->width, set->height, surface_at, err);
     lm_frame_loop_free(fl);
     return st;
 }
@@ -121,17 +121,8 @@ static lm_status reference_pixels(const lmgi_scene *sc, const lm_view *view, con
 lm_status lm_frame_check_frame(lmgi_scene *sc, const lm_frame_loop_settings *loop, int frames, float *rgb,
                                lm_error *err)
 {
-    lm_frame_check c;
-    memset(&c, 0, sizeof c);
-    c.width = loop->width, c.height = loop->height;
-    c.frame = rgb;
-    c.surface_at = malloc((size_t)c.width * (size_t)c.height * sizeof(int32_t));
-    if (!c.surface_at)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", c.width, c.height);
     lm_view view;
-    lm_status st = run_frames(sc, loop, frames, &c, &view, err);
-    free(c.surface_at);
-    return st;
+    return run_frames(sc, loop, frames, rgb, NULL, &view, err);
 }
 
 lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop, const lm_ref_settings *ref,
@@ -152,7 +143,7 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
                        : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
     lm_view view;
     if (st == LM_OK)
-        st = run_frames(sc, loop, frames, out, &view, err);
+        st = run_frames(sc, loop, frames, out->frame, out->surface_at, &view, err);
     if (st == LM_OK)
         st = reference_pixels(sc, &view, ref, out, err);
     if (st == LM_OK)
