@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "../../src/api/lmgi_scene.h"
 #include "../../src/core/qmc.h"
@@ -17,6 +16,7 @@
 #include "../../src/gpu/gl_context.h"
 #include "../../src/trace/caustics.h"
 #include "../../src/update/frame_loop.h"
+#include "dev_scene.h"
 
 #define REPEATS 5
 #define SIZE 512
@@ -264,12 +264,8 @@ void lm_dev_bench_caustics(void)
     lm_qmc_init();
     print_filter();
     const char *path = "scenes/cornell.glb";
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = lm_frame_loop_atlas_texels(LM_IIM_DEFAULT_TEXELS_PER_FRAME);
-    lmgi_scene *sc = NULL;
-    lmgi_error perr;
-    if (access(path, R_OK) == 0 && lmgi_load(path, &o, &sc, &perr) == LMGI_OK) {
+    lmgi_scene *sc = lm_dev_load(path, lmgi_atlas_texels_for(0));
+    if (sc) {
         print_tracing(sc);
         printf("\nframe loop on %s at %d x %d (mirror and glass spheres and the cube moving), ms, median of %d "
                "frames:\n", path, SIZE, SIZE, FRAMES);

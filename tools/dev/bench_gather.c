@@ -7,7 +7,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "../../src/core/stats.h"
 #include "../../src/core/timing.h"
@@ -18,6 +17,7 @@
 #include "../../src/api/lmgi_scene.h"
 #include "../../src/update/frame_loop.h"
 #include "../../src/update/photon_stage.h"
+#include "dev_scene.h"
 
 #define REPEATS 5
 #define PASS 256
@@ -40,8 +40,7 @@ static int open_scene(const char *label, int paper_row, const char *path, bench_
     memset(b, 0, sizeof *b);
     b->label = label;
     b->paper_row = paper_row;
-    lmgi_error perr;
-    if (access(path, R_OK) != 0 || lmgi_load(path, NULL, &b->sc, &perr) != LMGI_OK)
+    if (!(b->sc = lm_dev_load(path, 0)))
         return 0;
     lm_photon_stage_settings set;
     lm_photon_stage_settings_default(&set);
@@ -381,12 +380,8 @@ static void print_frame(void)
     /* lmgi run's atlas (its texel budget regathers it in full every 3 s), then a bake's 64k texels */
     const int targets[2] = {lm_frame_loop_atlas_texels(LM_IIM_DEFAULT_TEXELS_PER_FRAME), 0};
     for (int k = 0; k < 2; k++) {
-        lmgi_options o;
-        lmgi_options_init(&o);
-        o.target_texels = targets[k];
-        lmgi_scene *sc = NULL;
-        lmgi_error perr;
-        if (access(path, R_OK) != 0 || lmgi_load(path, &o, &sc, &perr) != LMGI_OK) {
+        lmgi_scene *sc = lm_dev_load(path, targets[k]);
+        if (!sc) {
             printf("\nframe loop: skipped (%s not loaded)\n", path);
             return;
         }

@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "../../src/api/lmgi_scene.h"
 #include "../../src/core/qmc.h"
@@ -15,8 +14,8 @@
 #include "../../src/gpu/gl_context.h"
 #include "../../src/gpu/photon_gather.h"
 #include "../../src/photonmap/pixel_gather.h"
-#include "../../src/update/frame_loop.h"
 #include "../../src/update/photon_stage.h"
+#include "dev_scene.h"
 
 #define REPEATS 3
 #define BIG_PHOTONS 200000u /* photons traced for the large set (it stores more hits than that) */
@@ -164,12 +163,8 @@ void lm_dev_bench_tiled(void)
     }
     lm_qmc_init();
     const char *path = "scenes/cornell.glb";
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = lm_frame_loop_atlas_texels(LM_IIM_DEFAULT_TEXELS_PER_FRAME);
-    lmgi_scene *sc = NULL;
-    lmgi_error perr;
-    if (access(path, R_OK) == 0 && lmgi_load(path, &o, &sc, &perr) == LMGI_OK) {
+    lmgi_scene *sc = lm_dev_load(path, lmgi_atlas_texels_for(0));
+    if (sc) {
         printf("\nper-pixel photon gathers (docs/tiled.md) on %s, the scene's own camera; the paper: Mara et al. "
                "2013, GTX 670\n", lm_gl_context_description(gl));
         print_scene(sc, path, 0);
