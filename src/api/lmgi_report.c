@@ -1,6 +1,7 @@
 /* What the public API reports about a loaded scene: counts, effects, and the charts pictures. */
 #include <lmgi.h>
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -37,8 +38,7 @@ void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
     in->cameras = s->camera_count;
     in->animations = s->animation_count;
     for (int a = 0; a < s->animation_count; a++)
-        in->animation_seconds = in->animation_seconds > s->animations[a].duration ? in->animation_seconds
-                                                                                : s->animations[a].duration;
+        in->animation_seconds = fmaxf(in->animation_seconds, s->animations[a].duration);
     in->surfaces = sc->surfaces.surface_count;
     in->charts = sc->atlas.chart_count;
     in->degenerate_triangles = sc->surfaces.degenerate_tris;

@@ -91,19 +91,20 @@ static void csv_header(FILE *f)
 {
     fprintf(f, "frame,time_s,photons_retraced,groups_invalidated,groups_retraced,aim_surfaces_refreshed,"
                "texels_gathered,caustic_photons_retraced,caustic_tiles,caustic_tiles_lit,caustic_pixels_filtered,"
-               "cube_faces_rendered,photon_gathers,photon_entries,photon_pages_uploaded,animate_ms,trace_ms,aim_ms,caustic_trace_ms,photons_ms,gather_ms,blend_ms,"
-               "direct_ms,caustics_ms,reflections_ms,composite_ms,frame_ms\n");
+               "cube_faces_rendered,photon_gathers,photon_entries,photon_pages_uploaded,animate_ms,trace_ms,aim_ms,"
+               "caustic_trace_ms,photons_ms,gather_ms,blend_ms,direct_ms,caustics_ms,reflections_ms,composite_ms,frame_ms\n");
 }
 
 /* Flushed row by row: a full disk stops the run at the row it hits, not after the last frame. */
 static int csv_row(FILE *f, const lmgi_update_stats *s)
 {
-    fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%u,%d,%d,%llu,%d,%d,%llu,%u,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+    fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%u,%d,%d,%llu,%d,%d,%llu,%u,"
+               "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n",
             s->frame, (double)s->time, s->photons_retraced, s->groups_invalidated, s->groups_retraced,
             s->aim_surfaces_refreshed, s->texels_gathered, s->caustic_photons_retraced, s->caustic_tiles,
             s->caustic_tiles_lit, (unsigned long long)s->caustic_pixels_filtered, s->cube_faces_rendered,
-            s->photon_gathers, (unsigned long long)s->photon_entries, s->photon_pages_uploaded, s->ms_animate, s->ms_trace, s->ms_aim, s->ms_caustic_trace, s->ms_photons, s->ms_gather, s->ms_blend,
-            s->ms_direct, s->ms_caustics, s->ms_reflections, s->ms_composite, s->ms_total);
+            s->photon_gathers, (unsigned long long)s->photon_entries, s->photon_pages_uploaded, s->ms_animate,
+            s->ms_trace, s->ms_aim, s->ms_caustic_trace, s->ms_photons, s->ms_gather, s->ms_blend, s->ms_direct, s->ms_caustics, s->ms_reflections, s->ms_composite, s->ms_total);
     return fflush(f) == 0 && !ferror(f);
 }
 

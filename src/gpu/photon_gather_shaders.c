@@ -335,8 +335,8 @@ const char *const lm_pg_finish_cs =
     "}\n";
 
 /* radiance += kd / pi x E / c, c the kernel's part on the pixel's surface (the kd texture's alpha holds
- * 1 / c: lm_direct_set_coverage), as the AIM divides by the disc's part on the surface. With k > 1, E is first averaged over the k x k pixels around (one of each
- * class), each weighted by how alike its visible point is: its distance off the pixel's tangent plane
+ * 1 / c: lm_direct_set_coverage), as the AIM divides by the disc's part on the surface. With k > 1, E is
+ * first averaged over the k x k pixels around (one of each class), each weighted by how alike its visible point is: its distance off the pixel's tangent plane
  * (a Gaussian of width r / 2) and its normal (cosine to the 8th), so that the average stays on the
  * surface the pixel sees (the reconstruction after the stochastic gather; the kd is the pixel's own, so
  * texture detail stays sharp). */

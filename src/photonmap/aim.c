@@ -686,11 +686,14 @@ lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_
 {
     static const double GX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834}, GW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
     const double c = 0.2; /* the kernel's clamp (pixel_gather.h) */
-    uint32_t edges_max = 0;
-    for (int k = 0; k < su->surface_count; k++)
-        edges_max = aim->edge_first[k + 1] - aim->edge_first[k] > edges_max ? aim->edge_first[k + 1] - aim->edge_first[k]
-                                                                          : edges_max;
-    edge_frame ef = {NULL, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, malloc(sizeof(double) * 4 * (edges_max ? edges_max : 1))};
+    uint32_t edges_max = 1;
+    for (int k = 0; k < su->surface_count; k++) {
+        uint32_t m = aim->edge_first[k + 1] - aim->edge_first[k];
+        edges_max = m > edges_max ? m : edges_max;
+    }
+    edge_frame ef;
+    memset(&ef, 0, sizeof ef);
+    ef.uv = malloc(sizeof *ef.uv * 4 * edges_max);
     if (!ef.uv)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the boundary edges of %d surfaces", su->surface_count);
     for (uint32_t i = 0; i < a->texel_count; i++)
@@ -699,7 +702,7 @@ lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_
         linear_map L;
         linear_map_of(s->nodes[su->surfaces[k].node].world, &L);
         boundary bd = {s->positions, aim->edges, aim->edge_first[k], aim->edge_first[k + 1]};
-        ef.bd = NULL;
+        ef.bd = NULL; /* bd's address is the same for every surface: reproject */
         for (uint32_t i = aim->texel_first[k]; i < aim->texel_first[k + 1]; i++) {
             const lm_texel *t = &a->texels[aim->texel_list[i]];
             double n[3];

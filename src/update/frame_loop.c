@@ -534,9 +534,9 @@ static lm_status upload_caustics(lm_frame_loop *fl, lm_error *err)
     return st;
 }
 
-/* The step's own frame's view, its caustic photons, and with the brute-force path its photon picture, made
- * while the store is quiet (before the stage's worker starts: the frame shows the photons as the last
- * stage left them). */
+/* The step's own frame's view, its caustic photons, and on the photon paths their records, made while the
+ * store is quiet (before the stage's worker starts: the frame shows the photons as the last stage left
+ * them). */
 static lm_status prepare_frame(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     int w = fl->set.width, h = fl->set.height;
