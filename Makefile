@@ -6,6 +6,8 @@
 #   make demo       deps + the main job on a generated scene; pictures in demo/
 #   make fuzz       100,000 structured inputs through load, photons and a frame under ASan + UBSan
 #   make bench      timings (never part of the tests)
+#   make tradeoff   what accuracy costs in time: the quick knob sweep on the generated Cornell box,
+#                   build/tradeoff/report.html (TRADEOFF_SCENES, TRADEOFF_FLAGS: the full sweep)
 #   make install    PREFIX=DIR (default /usr/local): lmgi.h, liblmgi.a/.so, lmgi, lmgi.pc
 #   make scenes     regenerate scenes/ with tools/gen_scenes
 
@@ -36,7 +38,7 @@ LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
 
 DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
                 nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libcmocka-dev \
-                libegl-dev libegl-mesa0
+                libegl-dev libegl-mesa0 python3-matplotlib
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
                              src/gpu/*.c src/update/*.c src/api/*.c))
@@ -52,7 +54,7 @@ TEST_C  := $(sort $(wildcard tests/test_*.c))
 TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o $(BUILD)/obj/tests/edit_room.o
 
-.PHONY: all deps test test-asan demo bench scenes clean fuzz install install-files
+.PHONY: all deps test test-asan demo bench tradeoff scenes clean fuzz install install-files
 .PRECIOUS: $(BUILD)/obj/%.o
 .PHONY: FORCE
 all: $(BUILD)/lmgi $(BUILD)/lmgi-dev $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
@@ -104,6 +106,8 @@ install-files:
 	install -m 755 $(BUILD)/liblmgi.so $(DESTDIR)$(PREFIX)/lib/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/liblmgi.so
 	install -m 755 $(BUILD)/lmgi $(DESTDIR)$(PREFIX)/bin/
+	install -d $(DESTDIR)$(PREFIX)/share/lmgi
+	install -m 644 tools/tradeoff_report.py $(DESTDIR)$(PREFIX)/share/lmgi/
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
 
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
@@ -161,6 +165,13 @@ bench: deps all $(BUILD)/gen_scenes
 	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb)
 	$(BUILD)/lmgi bench --edits bench/two_rooms_edits.json scenes/two_rooms.glb --json $(BUILD)/bench/edits.json
 	$(BUILD)/lmgi bench --soak 100000 scenes/cornell.glb --size 32x32
+
+# The full sweep of docs/tradeoff.md: make tradeoff TRADEOFF_FLAGS= TRADEOFF_SCENES="scenes/cornell.glb
+# ../shared/scenes/cornell-box/CornellBox.glb scenes/two_rooms.glb"
+TRADEOFF_SCENES ?= scenes/cornell.glb
+TRADEOFF_FLAGS  ?= --quick
+tradeoff: deps all
+	$(BUILD)/lmgi tradeoff $(TRADEOFF_SCENES) $(TRADEOFF_FLAGS) --out $(BUILD)/tradeoff
 
 scenes: $(BUILD)/gen_scenes
 	$(BUILD)/gen_scenes scenes

@@ -448,6 +448,99 @@ static void test_reference_and_check_commands(void **state)
     }
 }
 
+/* Column `name` of a CSV header line, -1 if absent. */
+static int csv_column(const char *header, const char *name)
+{
+    int col = 0;
+    for (const char *p = header; *p; col++) {
+        size_t len = strcspn(p, ",\n");
+        if (len == strlen(name) && !strncmp(p, name, len))
+            return col;
+        p += len + (p[len] == ',');
+        if (p[-1] != ',')
+            break;
+    }
+    return -1;
+}
+
+/* Field `col` of a CSV line (no commas inside fields; quotes stripped) into out. */
+static void csv_field(const char *line, int col, char *out, size_t size)
+{
+    const char *p = line;
+    for (int c = 0; c < col && p; c++)
+        p = strchr(p, ',') ? strchr(p, ',') + 1 : NULL;
+    assert_non_null(p);
+    size_t len = strcspn(p, ",\n");
+    if (len >= 2 && p[0] == '"')
+        p++, len -= 2;
+    snprintf(out, size, "%.*s", (int)len, p);
+}
+
+/* `lmgi tradeoff` on one knob: a row per value with the photons it asked for, its stage times and its
+ * errors against the reference; 16 times the photons leave the AIM closer to the reference; the error
+ * maps and the report beside them. Bad knobs and a missing --out are refused. */
+static void test_tradeoff(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    const char *dir = lmt_tmpdir();
+    char args[2048], path[2048];
+    snprintf(args, sizeof args, "tradeoff %s --knobs photons_per_group,bogus --out %s/bad", scene, dir);
+    assert_int_equal(run(args), 2);
+    assert_non_null(strstr(output, "unknown knob 'bogus'"));
+    snprintf(args, sizeof args, "tradeoff %s --quick", scene);
+    assert_int_equal(run(args), 2);
+    snprintf(args, sizeof args, "tradeoff %s --quick --knobs photons_per_group --repeats 1 --size 32x32 --texels 800 "
+             "--target-error 0.05 --cache %s/cache --out %s/tradeoff -q", scene, dir, dir);
+    assert_int_equal(run(args), 0);
+    snprintf(path, sizeof path, "%s/tradeoff/tradeoff.csv", dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char header[4096], line[4096], v[64];
+    assert_non_null(fgets(header, sizeof header, f));
+    static const char *const names[] = {"knob", "value", "default", "photons", "solution_ms", "update_ms",
+                                        "aim_rmse", "iim_rmse", "frame_rmse", "frame_r"};
+    int col[10];
+    for (int k = 0; k < 10; k++)
+        assert_true((col[k] = csv_column(header, names[k])) >= 0);
+    double aim[3] = {0.0, 0.0, 0.0};
+    int rows = 0;
+    for (; fgets(line, sizeof line, f); rows++) {
+        assert_true(rows < 3);
+        static const int per_group[3] = {40, 160, 640};
+        csv_field(line, col[0], v, sizeof v);
+        assert_string_equal(v, "photons_per_group");
+        csv_field(line, col[1], v, sizeof v);
+        assert_int_equal(atoi(v), per_group[rows]);
+        csv_field(line, col[2], v, sizeof v);
+        assert_int_equal(atoi(v), per_group[rows] == 160); /* the default */
+        csv_field(line, col[3], v, sizeof v);
+        assert_int_equal(atoi(v), 72 * per_group[rows]); /* one light, 72 groups */
+        double x[6];
+        for (int k = 0; k < 6; k++) {
+            csv_field(line, col[4 + k], v, sizeof v);
+            x[k] = atof(v);
+            assert_true(isfinite(x[k]) && x[k] > 0.0);
+        }
+        aim[rows] = x[2];
+        print_message("tradeoff: %d photons per group: solution %.1f ms, update %.1f ms, relative RMSE AIM %.4f "
+                      "IIM %.4f frame %.4f (frame / reference R %.3f)\n", per_group[rows], x[0], x[1], x[2], x[3],
+                      x[4], x[5]);
+        assert_true(x[3] < 0.2);
+        assert_true(fabs(x[5] - 1.0) < 0.1);
+    }
+    fclose(f);
+    assert_int_equal(rows, 3);
+    assert_true(aim[2] < aim[0]);
+    static const char *const files[] = {"tradeoff.json", "map_cornell_default_iim.npy", "map_cornell_default_frame.npy",
+                                        "plot_cornell_front.png", "plot_cornell_knobs.png", "plot_cornell_maps.png",
+                                        "report.html"};
+    for (int k = 0; k < 7; k++) {
+        snprintf(path, sizeof path, "%s/tradeoff/%s", dir, files[k]);
+        assert_int_equal(access(path, R_OK), 0);
+    }
+}
+
 /* The lmgi command is the public API's first user: no file of src/cli/ includes anything of the library
  * but include/lmgi.h (src/cli's own headers, by plain name). */
 static void test_cli_sees_only_the_public_header(void **state)
@@ -493,6 +586,7 @@ int main(void)
         cmocka_unit_test(test_bake_command),
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),
+        cmocka_unit_test(test_tradeoff),
         cmocka_unit_test(test_cli_sees_only_the_public_header),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -285,6 +285,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_int(o, v, 1, 65536, &a->emitter_rays);
         else if (!strcmp(o, "--soak"))
             rc = parse_int(o, v, 1, 100000000, &a->soak);
+        else if (!strcmp(o, "--knobs"))
+            rc = v ? (a->knobs = v, 0) : bad(o, v, "a comma-separated list of knobs");
         else if (!strcmp(o, "--edits"))
             rc = v ? (a->edits_path = v, 0) : bad(o, v, "an edit script (JSON)");
         else if (!strcmp(o, "--gather-scene"))
@@ -305,6 +307,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                 a->gltf = 1;
             else if (!strcmp(o, "--force"))
                 a->force = 1;
+            else if (!strcmp(o, "--quick"))
+                a->quick = 1;
             else if (!strcmp(o, "--no-cache"))
                 a->no_cache = 1;
             else if (!strcmp(o, "-v") || !strcmp(o, "--verbose"))

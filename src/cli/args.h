@@ -66,6 +66,8 @@ typedef struct {
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
     int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */
+    int quick;                /* --quick (tradeoff): fewer values per knob, looser references */
+    const char *knobs;        /* --knobs LIST (tradeoff): the knobs to sweep (NULL: all) */
 } lm_cli_args;
 
 /* Parses argv[first..argc). Returns 0 on success, or prints what was wrong and returns 2. */

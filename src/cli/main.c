@@ -13,6 +13,7 @@
 #include "reference_cmd.h"
 #include "run_cmd.h"
 #include "scene_load.h"
+#include "tradeoff_cmd.h"
 
 static void usage(FILE *f)
 {
@@ -45,6 +46,11 @@ static void usage(FILE *f)
             "                         budget overruns and each edit's update lag (docs/bench.md; --json FILE)\n"
             "  bench --soak N [SCENE]  N updates of the looped animation (default scenes/cornell.glb, 32 x 32):\n"
             "                         resident memory, update times and non-finite frame values per block\n"
+            "  tradeoff SCENE... --out DIR  what accuracy costs in time: every knob that trades one for the\n"
+            "                         other swept around the defaults (--quick: fewer values; --knobs LIST:\n"
+            "                         only those), each setting's stage times (medians of --repeats) and the\n"
+            "                         error of its AIM, IIM and frame against the reference: DIR/report.html\n"
+            "                         (plots, the Pareto front), tradeoff.csv/.json (docs/tradeoff.md)\n"
             "  help                   this text\n"
             "\n"
             "options:\n"
@@ -195,6 +201,8 @@ int main(int argc, char **argv)
         return lm_cli_check(&a);
     if (!strcmp(cmd, "bench"))
         return lm_cli_bench(&a);
+    if (!strcmp(cmd, "tradeoff"))
+        return lm_cli_tradeoff(&a);
     fprintf(stderr, "lmgi: unknown command '%s'\n\n", cmd);
     usage(stderr);
     return 2;

@@ -1,0 +1,386 @@
+/* lmgi tradeoff: every knob setting measured for time and error (tradeoff_cmd.h, docs/tradeoff.md). */
+#include "tradeoff_cmd.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "order_stats.h"
+#include "out_dir.h"
+#include "reference_cmd.h"
+#include "run_cmd.h"
+#include "scene_load.h"
+#include "tradeoff_knobs.h"
+#include "tradeoff_write.h"
+
+/* Updates timed after each creation (the first, which uploads everything, is not counted). */
+#define UPDATES_QUICK 3
+#define UPDATES_FULL 6
+
+/* One setting on one scene's atlas: its scene, texel reference and what it measured. */
+typedef struct {
+    lmgi_scene *sc;
+    lmgi_reference texels;
+    int target_texels;
+} atlas_state;
+
+static void free_atlas(atlas_state *s)
+{
+    lmgi_reference_free(&s->texels);
+    lmgi_free(s->sc);
+    memset(s, 0, sizeof *s);
+}
+
+static int load_atlas(const lm_cli_args *a, const char *path, int target_texels, const lmgi_reference_desc *rd,
+                      atlas_state *s)
+{
+    memset(s, 0, sizeof *s);
+    lmgi_options o = a->options;
+    o.texel_size = 0.0f;
+    o.target_texels = target_texels;
+    if (!lm_cli_load_scene(path, &o, 1, &s->sc))
+        return 0;
+    lmgi_error err;
+    if (lmgi_reference_texels(s->sc, rd, &s->texels, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        free_atlas(s);
+        return 0;
+    }
+    s->target_texels = target_texels;
+    return 1;
+}
+
+/* Error of est (stride `stride` floats a texel or pixel) against ref (3 a texel) over the entries where
+ * mask is set, on the sum of the channels: relative RMSE (RMSE over the mean reference), and each entry's
+ * |est - ref| / max(ref, 5% of the mean reference) at the 99th percentile and worst. signed_err (may be
+ * NULL) gets est / ref - 1 per entry with the same floor, NAN where not compared. */
+static lm_tradeoff_error error_of(const float *est, int stride, const float *ref, const unsigned char *mask,
+                                  size_t n, float *signed_err)
+{
+    lm_tradeoff_error e = {NAN, NAN, NAN, 0};
+    double sum_r = 0.0, se = 0.0;
+    uint32_t m = 0;
+    for (size_t i = 0; i < n; i++)
+        if (mask[i]) {
+            double f = est[stride * i] + est[stride * i + 1] + est[stride * i + 2];
+            double r = ref[3 * i] + ref[3 * i + 1] + ref[3 * i + 2];
+            sum_r += r, se += (f - r) * (f - r), m++;
+        }
+    for (size_t i = 0; signed_err && i < n; i++)
+        signed_err[i] = NAN;
+    if (m == 0 || !(sum_r > 0.0))
+        return e;
+    double mean = sum_r / m, floor = 0.05 * mean;
+    double *rel = malloc(sizeof *rel * m);
+    if (!rel)
+        return e;
+    uint32_t k = 0;
+    for (size_t i = 0; i < n; i++)
+        if (mask[i]) {
+            double f = est[stride * i] + est[stride * i + 1] + est[stride * i + 2];
+            double r = ref[3 * i] + ref[3 * i + 1] + ref[3 * i + 2];
+            double d = (f - r) / fmax(r, floor);
+            rel[k++] = fabs(d);
+            if (signed_err)
+                signed_err[i] = (float)d;
+        }
+    e.rmse = sqrt(se / m) / mean;
+    e.p99 = lm_cli_quantile(rel, (int)m, 0.99);
+    e.worst = rel[m - 1]; /* sorted by the quantile */
+    e.count = m;
+    free(rel);
+    return e;
+}
+
+/* The AIM and IIM of a new updater (the converged solution at time 0) against the texel reference, over
+ * the texels the IIM marks valid. The IIM's signed error map goes to m->iim_map. */
+static int lightmap_errors(lmgi_updater *u, const atlas_state *as, lm_tradeoff_row *m, lmgi_error *err)
+{
+    size_t n = (size_t)as->texels.width * (size_t)as->texels.height;
+    float *iim = malloc(sizeof *iim * 4 * n), *aim = malloc(sizeof *aim * 4 * n);
+    unsigned char *valid = malloc(n);
+    m->iim_map = malloc(sizeof *m->iim_map * n);
+    int ok = iim && aim && valid && m->iim_map;
+    if (!ok)
+        fprintf(stderr, "lmgi: error: no memory for the lightmaps' errors\n");
+    ok = ok && lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim, 4 * n, err) == LMGI_OK &&
+         lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim, 4 * n, err) == LMGI_OK;
+    if (ok) {
+        for (size_t i = 0; i < n; i++)
+            valid[i] = iim[4 * i + 3] > 0.5f;
+        m->map_width = as->texels.width, m->map_height = as->texels.height;
+        m->iim = error_of(iim, 4, as->texels.iim, valid, n, m->iim_map);
+        m->aim = error_of(aim, 4, as->texels.radiance, valid, n, NULL);
+    }
+    free(iim);
+    free(aim);
+    free(valid);
+    return ok;
+}
+
+/* Per visible surface (not emitters), |frame mean / reference mean - 1| on the sum of the channels: the
+ * pixel-weighted RMS over surfaces of 20 or more compared pixels, and the worst of those with 100 or more
+ * (issue 17's bound). Means over a surface's pixels average the reference's own noise away, which the
+ * per-pixel RMSE keeps (about its target error). */
+static void surface_errors(const lmgi_scene *sc, const lmgi_check_result *c, lm_tradeoff_row *m)
+{
+    double se = 0.0, w = 0.0;
+    m->frame_surface_worst = 0.0;
+    for (int s = 0; s < c->surface_count; s++) {
+        const lmgi_check_surface *f = &c->surfaces[s];
+        lmgi_material mat;
+        lmgi_error err;
+        if (f->pixels < 20 || lmgi_get_material(sc, f->material, &mat, &err) != LMGI_OK ||
+            mat.cls == LMGI_MATERIAL_EMITTER)
+            continue;
+        double fr = f->frame_mean[0] + f->frame_mean[1] + f->frame_mean[2];
+        double rf = f->reference_mean[0] + f->reference_mean[1] + f->reference_mean[2];
+        if (!(rf > 0.0))
+            continue;
+        double d = fabs(fr / rf - 1.0);
+        se += f->pixels * d * d, w += f->pixels;
+        if (f->pixels >= 100)
+            m->frame_surface_worst = fmax(m->frame_surface_worst, d);
+    }
+    m->frame_surface_rms = w > 0.0 ? sqrt(se / w) : NAN;
+}
+
+/* The frame the way `lmgi check` compares it (lmgi_check: one update at time 0 against the reference
+ * pixels of the same camera). */
+static int frame_errors(lmgi_context *ctx, const atlas_state *as, const lmgi_updater_desc *d,
+                        const lmgi_reference_desc *rd, lm_tradeoff_row *m, lmgi_error *err)
+{
+    lmgi_check_result c;
+    if (lmgi_set_time(as->sc, 0.0f, err) != LMGI_OK || lmgi_check(ctx, as->sc, d, rd, 1, &c, err) != LMGI_OK)
+        return 0;
+    size_t n = (size_t)c.width * (size_t)c.height;
+    m->frame_map = malloc(sizeof *m->frame_map * n);
+    int ok = m->frame_map != NULL;
+    if (ok) {
+        m->frame = error_of(c.frame, 3, c.reference, c.compared, n, m->frame_map);
+        m->frame.rmse = c.rel_rmse; /* the library's figure, emitters left out as `lmgi check` does */
+        m->frame_width = c.width, m->frame_height = c.height;
+        m->frame_bias = 0.0;
+        for (int k = 0; k < 3; k++) {
+            m->frame_ratio[k] = c.ratio[k];
+            m->frame_bias = fmax(m->frame_bias, fabs(c.ratio[k] - 1.0));
+        }
+        m->reference_rel_se = c.reference_rel_se;
+        surface_errors(as->sc, &c, m);
+    } else
+        fprintf(stderr, "lmgi: error: no memory for the frame's error\n");
+    lmgi_check_free(&c);
+    return ok;
+}
+
+/* Stage times: `repeats` updaters created at time 0 (the full solution: trace, AIMs, gather), each then
+ * updated `updates` + 1 times at 30 per second; medians. The first updater's lightmaps give the AIM and
+ * IIM errors. */
+static int time_and_lightmaps(lmgi_context *ctx, const atlas_state *as, const lm_tradeoff_setting *s,
+                              int repeats, int updates, int width, int height, lm_tradeoff_row *m,
+                              lmgi_error *err)
+{
+    lmgi_updater_desc d = s->desc;
+    d.frame_width = width, d.frame_height = height;
+    int nu = repeats * updates;
+    double *v = malloc(sizeof *v * (size_t)(12 * (repeats + nu)));
+    if (!v) {
+        fprintf(stderr, "lmgi: error: no memory for the timings\n");
+        return 0;
+    }
+    double *trace = v, *aim = trace + repeats, *gather = aim + repeats, *solution = gather + repeats;
+    double *up[8];
+    for (int k = 0; k < 8; k++)
+        up[k] = solution + repeats + (size_t)k * nu;
+    int ok = 1;
+    for (int r = 0; r < repeats && ok; r++) {
+        lmgi_updater *u = NULL;
+        ok = lmgi_set_time(as->sc, 0.0f, err) == LMGI_OK && lmgi_updater_create(ctx, as->sc, &d, &u, err) == LMGI_OK;
+        if (!ok)
+            break;
+        lmgi_updater_info info;
+        lmgi_get_updater_info(u, &info);
+        trace[r] = info.ms_setup_trace, aim[r] = info.ms_setup_aim, gather[r] = info.ms_setup_gather;
+        solution[r] = trace[r] + aim[r] + gather[r];
+        m->photons = info.photons;
+        m->coverage = info.hemicube_coverage;
+        if (r == 0 && s->desc.indirect == LMGI_INDIRECT_LIGHTMAP)
+            ok = lightmap_errors(u, as, m, err);
+        for (int f = 0; f <= updates && ok; f++) {
+            lmgi_update_stats st;
+            ok = lmgi_update(u, (float)f / 30.0f, 0.0f, &st, err) == LMGI_OK;
+            if (!ok || f == 0)
+                continue;
+            int i = r * updates + f - 1;
+            up[0][i] = st.ms_total, up[1][i] = st.ms_photons, up[2][i] = st.ms_gather, up[3][i] = st.ms_direct;
+            up[4][i] = st.ms_caustics, up[5][i] = st.ms_reflections, up[6][i] = st.ms_composite;
+            up[7][i] = st.ms_blend;
+        }
+        if (ok && r == 0) {
+            lmgi_get_updater_info(u, &info);
+            m->photon_radius = info.photon_radius;
+        }
+        lmgi_updater_free(u);
+    }
+    if (ok) {
+        m->ms_trace = lm_cli_median(trace, repeats), m->ms_aim = lm_cli_median(aim, repeats);
+        m->ms_gather = lm_cli_median(gather, repeats), m->ms_solution = lm_cli_median(solution, repeats);
+        for (int k = 0; k < 8; k++)
+            m->ms_update[k] = updates ? lm_cli_median(up[k], nu) : 0.0;
+    }
+    free(v);
+    return ok;
+}
+
+static int measure(lmgi_context *ctx, const atlas_state *as, const lm_tradeoff_setting *s,
+                   const lmgi_reference_desc *rd, int repeats, int updates, int width, int height,
+                   lm_tradeoff_row *m)
+{
+    m->aim = m->iim = m->frame = (lm_tradeoff_error){NAN, NAN, NAN, 0};
+    lmgi_error err;
+    lmgi_updater_desc d = s->desc;
+    d.frame_width = width, d.frame_height = height;
+    if (!time_and_lightmaps(ctx, as, s, repeats, updates, width, height, m, &err) ||
+        !frame_errors(ctx, as, &d, rd, m, &err)) {
+        fprintf(stderr, "lmgi: error: %s = %s: %s\n", s->knob, s->value, err.message);
+        return 0;
+    }
+    return 1;
+}
+
+/* The tiled gather's default radius on this scene: what an updater resolves at its first frame. */
+static float tiled_radius(lmgi_context *ctx, lmgi_scene *sc, int width, int height)
+{
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.indirect = LMGI_INDIRECT_TILED;
+    d.frame_width = width, d.frame_height = height;
+    lmgi_updater *u = NULL;
+    lmgi_error err;
+    float r = 0.0f;
+    if (lmgi_set_time(sc, 0.0f, &err) == LMGI_OK && lmgi_updater_create(ctx, sc, &d, &u, &err) == LMGI_OK &&
+        lmgi_update(u, 0.0f, 0.0f, NULL, &err) == LMGI_OK) {
+        lmgi_updater_info info;
+        lmgi_get_updater_info(u, &info);
+        r = info.photon_radius;
+    }
+    lmgi_updater_free(u);
+    return r;
+}
+
+static int scene_calls_for(const lmgi_scene *sc, const char *effect)
+{
+    for (int i = 0; i < lmgi_effect_count(sc); i++) {
+        lmgi_effect e;
+        lmgi_get_effect(sc, i, &e);
+        if (e.name && !strcmp(e.name, effect))
+            return e.on;
+    }
+    return 0;
+}
+
+/* Every setting of one scene, measured; rows (one per setting) into sr. */
+static int sweep_scene(const lm_cli_args *a, lmgi_context *ctx, const char *path, const lmgi_reference_desc *rd,
+                       lm_tradeoff_scene *sr)
+{
+    int quick = a->quick, width = a->width ? a->width : 96;
+    int height = a->height ? a->height : width;
+    int texels = a->options.target_texels > 0 ? a->options.target_texels : lmgi_atlas_texels_for(0);
+    lm_tradeoff_plan plan = {quick, texels, 0, 0.0f, a->knobs};
+    atlas_state def;
+    if (!load_atlas(a, path, plan.default_texels, rd, &def))
+        return 0;
+    if (!a->verbose) /* each updater's "ready" line and the cached references' would bury the progress */
+        lmgi_set_verbosity(0);
+    plan.caustics = scene_calls_for(def.sc, "caustics");
+    plan.photon_radius = scene_calls_for(def.sc, "indirect") ? tiled_radius(ctx, def.sc, width, height) : 0.0f;
+    sr->reference_texels_seconds = def.texels.seconds;
+    sr->reference_texels_rel_se = def.texels.mean_rel_se;
+    lm_tradeoff_setting *set = NULL;
+    int n = 0, ok = lm_tradeoff_settings(&plan, &set, &n);
+    sr->rows = ok ? calloc((size_t)(n ? n : 1), sizeof *sr->rows) : NULL;
+    if (!sr->rows) {
+        fprintf(stderr, "lmgi: error: no memory for the settings\n");
+        free(set);
+        free_atlas(&def);
+        return 0;
+    }
+    int updates = quick ? UPDATES_QUICK : UPDATES_FULL;
+    for (int i = 0; i < n && ok; i++) {
+        lm_tradeoff_row *m = &sr->rows[i];
+        m->setting = set[i];
+        m->is_default = set[i].target_texels == plan.default_texels &&
+                        !memcmp(&set[i].desc, &(lmgi_updater_desc){0}, sizeof set[i].desc);
+        int same = -1;
+        for (int j = 0; j < i && same < 0; j++)
+            if (lm_tradeoff_same(&set[j], &set[i]))
+                same = j;
+        if (same >= 0) {
+            lm_tradeoff_row_copy(m, &sr->rows[same]);
+        } else if (set[i].target_texels == def.target_texels) {
+            ok = measure(ctx, &def, &set[i], rd, a->repeats, updates, width, height, m);
+        } else {
+            atlas_state other;
+            ok = load_atlas(a, path, set[i].target_texels, rd, &other) &&
+                 measure(ctx, &other, &set[i], rd, a->repeats, updates, width, height, m);
+            if (other.sc)
+                free_atlas(&other);
+        }
+        sr->count = i + 1;
+        if (ok && !a->quiet)
+            fprintf(stderr, "lmgi: tradeoff %s [%d/%d] %s = %s%s: solution %.1f ms, update %.1f ms; relative RMSE "
+                    "AIM %.4f, IIM %.4f, frame %.4f (per surface %.4f)\n", sr->name, i + 1, n, set[i].knob,
+                    set[i].value, same >= 0 ? " (measured above)" : "", m->ms_solution, m->ms_update[0], m->aim.rmse,
+                    m->iim.rmse, m->frame.rmse, m->frame_surface_rms);
+    }
+    free(set);
+    free_atlas(&def);
+    lmgi_set_verbosity(a->quiet ? 0 : a->verbose ? 2 : 1);
+    return ok;
+}
+
+int lm_cli_tradeoff(const lm_cli_args *a)
+{
+    if (a->file_count < 1 || !a->out_dir) {
+        fprintf(stderr, "lmgi: usage: lmgi tradeoff SCENE... --out DIR [--quick] [--knobs LIST] [--size WxH]\n"
+                        "       [--repeats N] [--target-error E]\n");
+        return 2;
+    }
+    char bad[64];
+    if (a->knobs && !lm_tradeoff_knobs_known(a->knobs, bad, sizeof bad)) {
+        fprintf(stderr, "lmgi: --knobs: unknown knob '%s' (knobs: %s)\n", bad, lm_tradeoff_knob_keys());
+        return 2;
+    }
+    if (!lm_cli_claim_out_dir(a, lm_tradeoff_own_files()))
+        return 1;
+    lmgi_reference_desc rd;
+    lm_cli_reference_desc(a, &rd);
+    if (!(a->target_error > 0.0f)) /* looser, and the generated Cornell box's rare bright paths read as a
+                                    * frame error of 0.21 where 0.03 reads 0.05 */
+        rd.target_error = 0.03f;
+    lmgi_context *ctx = NULL;
+    lmgi_error err;
+    if (lmgi_context_create(NULL, &ctx, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        return 1;
+    }
+    lm_tradeoff_scene *scenes = calloc((size_t)a->file_count, sizeof *scenes);
+    int ok = scenes != NULL, done = 0;
+    for (int i = 0; i < a->file_count && ok; i++) {
+        scenes[i].path = a->files[i];
+        lm_tradeoff_scene_name(a->files[i], scenes[i].name, sizeof scenes[i].name);
+        ok = sweep_scene(a, ctx, a->files[i], &rd, &scenes[i]);
+        done = i + 1;
+    }
+    lm_tradeoff_run run = {a->quick, a->repeats, rd.target_error, scenes, done};
+    /* what was measured is written even when a later scene failed */
+    int wrote = scenes && lm_tradeoff_write(a->out_dir, &run);
+    int reported = wrote && ok && lm_tradeoff_report(a->out_dir, a->quiet);
+    for (int i = 0; i < done; i++)
+        lm_tradeoff_scene_free(&scenes[i]);
+    free(scenes);
+    lmgi_context_free(ctx);
+    return reported ? 0 : 1;
+}

@@ -1,0 +1,62 @@
+/* What `lmgi tradeoff` measured, and how it is written: DIR/tradeoff.csv (one row per scene and setting),
+ * DIR/tradeoff.json (the same, with the run's settings and which error maps are which), the maps as
+ * DIR/map_SCENE_WHICH_{iim,frame}.npy (float32, rows top first for the frame, v = 0 first for the
+ * atlas; the signed relative error est / ref - 1 with the floor of error_of, NaN where not compared), and
+ * the report (tools/tradeoff_report.py) that turns them into DIR/report.html and DIR/plot_*.png. */
+#ifndef LM_CLI_TRADEOFF_WRITE_H
+#define LM_CLI_TRADEOFF_WRITE_H
+
+#include <stdint.h>
+
+#include "tradeoff_knobs.h"
+
+typedef struct {
+    double rmse, p99, worst; /* relative RMSE; 99th percentile and worst relative error; NAN: no such map */
+    uint32_t count;          /* texels or pixels compared */
+} lm_tradeoff_error;
+
+typedef struct {
+    lm_tradeoff_setting setting;
+    int is_default;          /* every knob at its default */
+    uint32_t photons;        /* stored photon paths */
+    int coverage;            /* coverage samples as resolved */
+    float photon_radius;     /* the tiled gather's radius as resolved (0: not that path) */
+    double ms_trace, ms_aim, ms_gather, ms_solution; /* the full solution's stages and sum, medians */
+    double ms_update[8];     /* medians per update: total, photons, gather, direct, caustics, reflections,
+                              * composite, blend */
+    lm_tradeoff_error aim, iim, frame;
+    double frame_ratio[3], frame_bias; /* frame / reference per channel; max |ratio - 1| */
+    double frame_surface_rms, frame_surface_worst; /* per visible surface (tradeoff_cmd.c surface_errors) */
+    double reference_rel_se; /* the pixel reference's own relative standard error */
+    float *iim_map, *frame_map;
+    int map_width, map_height, frame_width, frame_height;
+} lm_tradeoff_row;
+
+typedef struct {
+    const char *path;
+    char name[64];           /* the file's base name, letters, digits, - and _ */
+    double reference_texels_seconds, reference_texels_rel_se;
+    lm_tradeoff_row *rows;
+    int count;
+} lm_tradeoff_scene;
+
+typedef struct {
+    int quick, repeats;
+    float target_error;      /* the references' */
+    const lm_tradeoff_scene *scenes;
+    int count;
+} lm_tradeoff_run;
+
+/* The fnmatch patterns of the files the command writes (for lmgi_claim_output_dir). */
+const char *const *lm_tradeoff_own_files(void);
+void lm_tradeoff_scene_name(const char *path, char *name, size_t size);
+/* dst = src with its own copies of the maps (a setting measured once, listed under two knobs). */
+void lm_tradeoff_row_copy(lm_tradeoff_row *dst, const lm_tradeoff_row *src);
+void lm_tradeoff_scene_free(lm_tradeoff_scene *s);
+/* The CSV, the JSON and the maps. 0 (after printing the error) when a file cannot be written. */
+int lm_tradeoff_write(const char *dir, const lm_tradeoff_run *run);
+/* Runs tools/tradeoff_report.py DIR (found beside the executable: ../tools or ../share/lmgi). 0 (after
+ * saying why and how to run it) when it is not found or fails. */
+int lm_tradeoff_report(const char *dir, int quiet);
+
+#endif

@@ -1,0 +1,268 @@
+#!/usr/bin/env python3
+"""The report of `lmgi tradeoff` (docs/tradeoff.md): reads DIR/tradeoff.json and the error maps the command
+wrote beside it, draws the plots with matplotlib and writes DIR/report.html, which opens in any browser
+without a network (its pictures are the PNG files beside it).
+
+usage: tradeoff_report.py DIR [-q]
+"""
+import html
+import json
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
+import numpy as np  # noqa: E402
+
+# Knobs whose cost is paid every update rather than in the full solution (trace, AIMs, gather).
+UPDATE_COST = {"texels_per_frame", "caustic_photons", "caustic_filter", "tiled_k", "tiled_radius"}
+# Knobs that change the frame but not the lightmaps: judged by the frame's error.
+FRAME_ONLY = {"caustic_photons", "caustic_filter", "tiled_k", "tiled_radius", "texels_per_frame"}
+
+
+def finite(v):
+    return v is not None and isinstance(v, (int, float)) and math.isfinite(v)
+
+
+def cost_of(row):
+    return row["ms"]["update"] if row["knob"] in UPDATE_COST else row["ms"]["solution"]
+
+
+def frame_error(row):
+    """The frame's error per visible surface: the per-pixel RMSE keeps the reference's own noise (about its
+    target error), the surfaces' means average it away."""
+    return row.get("frame_surface_rms")
+
+
+def error_of(row):
+    """The error a knob is judged by: the IIM's where the knob changes the lightmaps, else the frame's."""
+    if row["knob"] not in FRAME_ONLY and finite(row["iim"]["rmse"]):
+        return row["iim"]["rmse"]
+    return frame_error(row)
+
+
+def pareto(points):
+    """Indices of the points (cost, error) no other point beats in both (ties kept once)."""
+    order = sorted(range(len(points)), key=lambda i: (points[i][0], points[i][1]))
+    front, best = [], math.inf
+    for i in order:
+        if points[i][1] < best:
+            front.append(i)
+            best = points[i][1]
+    return front
+
+
+def log_axes(ax, xs, ys):
+    xs = [x for x in xs if finite(x) and x > 0]
+    ys = [y for y in ys if finite(y) and y > 0]
+    if xs and max(xs) / min(xs) > 4:
+        ax.set_xscale("log")
+    if ys and max(ys) / min(ys) > 4:
+        ax.set_yscale("log")
+
+
+def knob_plots(scene, out_dir):
+    """One panel per knob: its error against its cost, each point labelled with its value, the default
+    starred."""
+    knobs = []
+    for r in scene["rows"]:
+        if r["knob"] != "grid" and r["knob"] not in knobs:
+            knobs.append(r["knob"])
+    if not knobs:
+        return None
+    cols = 3
+    rows_n = (len(knobs) + cols - 1) // cols
+    fig, axes = plt.subplots(rows_n, cols, figsize=(4.6 * cols, 3.5 * rows_n), squeeze=False)
+    for k, knob in enumerate(knobs):
+        ax = axes[k // cols][k % cols]
+        rs = sorted((r for r in scene["rows"] if r["knob"] == knob), key=lambda r: r["x"] if finite(r["x"]) else 0)
+        xs = [cost_of(r) for r in rs]
+        for metric, style in (("iim", "o-"), ("frame", "s--")):
+            ys = [r["iim"]["rmse"] if metric == "iim" else frame_error(r) for r in rs]
+            if not any(finite(y) for y in ys):
+                continue
+            ax.plot(xs, ys, style, label="IIM per texel" if metric == "iim" else "frame per surface", markersize=4)
+            for r, x, y in zip(rs, xs, ys):
+                if finite(y):
+                    ax.annotate(r["value"], (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7)
+                    if r["default"]:
+                        ax.plot([x], [y], "*", color="black", markersize=11, zorder=5)
+        log_axes(ax, xs, [frame_error(r) for r in rs] + [r["iim"]["rmse"] for r in rs])
+        ax.set_title(rs[0]["label"], fontsize=9)
+        ax.set_xlabel("ms per update" if knob in UPDATE_COST else "ms for the full solution", fontsize=8)
+        ax.set_ylabel("relative error (RMS)", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    for k in range(len(knobs), rows_n * cols):
+        axes[k // cols][k % cols].axis("off")
+    fig.suptitle(f"{scene['name']}: error against time per knob (star: the default)", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    name = f"plot_{scene['name']}_knobs.png"
+    fig.savefig(os.path.join(out_dir, name), dpi=90)
+    plt.close(fig)
+    return name
+
+
+def front_plot(scene, out_dir):
+    """Every lightmap setting's frame and IIM error against the full solution's time, the Pareto front
+    drawn through the ones nothing beats, the default starred."""
+    rs = [r for r in scene["rows"] if r["knob"] not in UPDATE_COST and finite(r["iim"]["rmse"])]
+    if not rs:
+        return None, []
+    fig, axes = plt.subplots(1, 2, figsize=(12, 4.6))
+    fronts = {}
+    for ax, metric in zip(axes, ("iim", "frame")):
+        pts = [(r["ms"]["solution"], r["iim"]["rmse"] if metric == "iim" else frame_error(r)) for r in rs]
+        ax.scatter([p[0] for p in pts], [p[1] for p in pts], s=14, color="tab:blue", alpha=0.7, label="settings")
+        front = pareto(pts)
+        fronts[metric] = front
+        ax.plot([pts[i][0] for i in front], [pts[i][1] for i in front], "-o", color="tab:red", markersize=4,
+                label="Pareto front")
+        for i in front:
+            ax.annotate(f"{rs[i]['knob']} {rs[i]['value']}", pts[i], textcoords="offset points", xytext=(3, 3),
+                        fontsize=6)
+        for r, p in zip(rs, pts):
+            if r["default"]:
+                ax.plot([p[0]], [p[1]], "*", color="black", markersize=13, zorder=5, label="default")
+                break
+        log_axes(ax, [p[0] for p in pts], [p[1] for p in pts])
+        ax.set_xlabel("ms for the full solution (trace + AIMs + gather)")
+        ax.set_ylabel("IIM relative RMSE per texel" if metric == "iim" else "frame relative error per surface (RMS)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(f"{scene['name']}: every setting, error against time", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    name = f"plot_{scene['name']}_front.png"
+    fig.savefig(os.path.join(out_dir, name), dpi=90)
+    plt.close(fig)
+    return name, [rs[i] for i in fronts["frame"]]
+
+
+def map_plots(scene, out_dir):
+    """The signed relative error (estimate / reference - 1) per texel and per pixel, for the default, the
+    fastest and the most accurate setting."""
+    maps = scene.get("maps", {})
+    which = [w for w in ("default", "fastest", "most_accurate") if w in maps]
+    if not which:
+        return None
+    fig, axes = plt.subplots(2, len(which), figsize=(4.4 * len(which), 8), squeeze=False)
+    cmap = plt.get_cmap("coolwarm").copy()
+    cmap.set_bad("#c8c8c8")
+    for c, w in enumerate(which):
+        row = scene["rows"][maps[w]["row"]]
+        for r, kind in enumerate(("iim", "frame")):
+            ax = axes[r][c]
+            m = np.load(os.path.join(out_dir, maps[w][kind]))
+            img = ax.imshow(m, cmap=cmap, vmin=-0.3, vmax=0.3, origin="lower" if kind == "iim" else "upper",
+                            interpolation="nearest")
+            ax.set_title(f"{w.replace('_', ' ')}: {row['knob']} {row['value']}\n"
+                         f"{'IIM per texel' if kind == 'iim' else 'frame per pixel'}, RMSE {row[kind]['rmse']:.3f}",
+                         fontsize=8)
+            ax.set_xticks([])
+            ax.set_yticks([])
+            fig.colorbar(img, ax=ax, fraction=0.046, pad=0.04).ax.tick_params(labelsize=7)
+    fig.suptitle(f"{scene['name']}: relative error (estimate / reference - 1; grey: not compared)", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.97))
+    name = f"plot_{scene['name']}_maps.png"
+    fig.savefig(os.path.join(out_dir, name), dpi=90)
+    plt.close(fig)
+    return name
+
+
+def suggestions(scene):
+    """Per knob: the cheapest value whose error is within 1% of the best the sweep reached (docs/tradeoff.md,
+    "Defaults from the front")."""
+    out = []
+    knobs = []
+    for r in scene["rows"]:
+        if r["knob"] != "grid" and r["knob"] not in knobs:
+            knobs.append(r["knob"])
+    for knob in knobs:
+        rs = [r for r in scene["rows"] if r["knob"] == knob and finite(error_of(r))]
+        if not rs:
+            continue
+        best = min(error_of(r) for r in rs)
+        ok = [r for r in rs if error_of(r) <= best * 1.01]
+        pick = min(ok, key=cost_of)
+        default = next((r for r in rs if r["default"]), None)
+        out.append((knob, rs[0]["label"], default, pick, best))
+    return out
+
+
+def fmt(v, digits=4):
+    return f"{v:.{digits}f}" if finite(v) else ""
+
+
+def scene_html(scene, out_dir):
+    parts = [f"<h2>{html.escape(scene['name'])}</h2>",
+             f"<p>{html.escape(scene['path'])}: {len(scene['rows'])} settings; texel reference "
+             f"{scene['reference_texels_seconds']:.1f} s (relative standard error {scene['reference_texels_rel_se']:.3f})."
+             "</p>"]
+    front_png, front = front_plot(scene, out_dir)
+    if front_png:
+        parts.append(f'<img src="{front_png}" alt="error against time, every setting">')
+        parts.append("<p>On the frame's front: " + ", ".join(
+            html.escape(f"{r['knob']} {r['value']} ({r['ms']['solution']:.0f} ms, {frame_error(r):.4f})")
+            for r in front) + ".</p>")
+    knobs_png = knob_plots(scene, out_dir)
+    if knobs_png:
+        parts.append(f'<img src="{knobs_png}" alt="error against time per knob">')
+    parts.append("<h3>Defaults against the front</h3><table><tr><th>knob</th><th>default</th><th>its error</th>"
+                 "<th>cheapest within 1% of the best</th><th>its error</th><th>its cost (ms)</th><th>default's cost</th></tr>")
+    for knob, label, default, pick, best in suggestions(scene):
+        parts.append("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>".format(
+            html.escape(label), html.escape(default["value"]) if default else "(per scene)",
+            fmt(error_of(default)) if default else "", html.escape(pick["value"]), fmt(error_of(pick)),
+            fmt(cost_of(pick), 1), fmt(cost_of(default), 1) if default else ""))
+    parts.append("</table>")
+    maps_png = map_plots(scene, out_dir)
+    if maps_png:
+        parts.append(f'<img src="{maps_png}" alt="error maps">')
+    cols = ["knob", "value", "solution ms", "trace", "AIMs", "gather", "update ms", "AIM RMSE", "IIM RMSE", "IIM p99",
+            "IIM worst", "frame RMSE", "frame p99", "frame worst", "frame bias", "per surface", "worst surface"]
+    parts.append("<h3>Every setting</h3><table><tr>" + "".join(f"<th>{c}</th>" for c in cols) + "</tr>")
+    for r in scene["rows"]:
+        cells = [r["knob"], r["value"] + (" (default)" if r["default"] else ""), fmt(r["ms"]["solution"], 1),
+                 fmt(r["ms"]["trace"], 1), fmt(r["ms"]["aim"], 1), fmt(r["ms"]["gather"], 1),
+                 fmt(r["ms"]["update"], 2), fmt(r["aim"]["rmse"]), fmt(r["iim"]["rmse"]), fmt(r["iim"]["p99"]),
+                 fmt(r["iim"]["worst"]), fmt(r["frame"]["rmse"]), fmt(r["frame"]["p99"]), fmt(r["frame"]["worst"]),
+                 fmt(r["frame_bias"]), fmt(r.get("frame_surface_rms")), fmt(r.get("frame_surface_worst"))]
+        parts.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
+    parts.append("</table>")
+    return "\n".join(parts)
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    out_dir, quiet = argv[1], "-q" in argv[2:]
+    with open(os.path.join(out_dir, "tradeoff.json")) as f:
+        run = json.load(f)
+    body = [scene_html(s, out_dir) for s in run["scenes"]]
+    page = f"""<!DOCTYPE html>
+<html><head><meta charset="utf-8"><title>lmgi tradeoff</title>
+<style>body{{font-family:sans-serif;max-width:1300px;margin:2em auto;}} img{{max-width:100%;}}
+table{{border-collapse:collapse;font-size:12px;margin:1em 0;}} td,th{{border:1px solid #ccc;padding:2px 6px;text-align:right;}}
+th{{background:#eee;}}</style></head><body>
+<h1>What accuracy costs in time</h1>
+<p>{'Quick sweep' if run['quick'] else 'Full sweep'}; times are medians of {run['repeats']} runs; errors against the
+path-traced reference (relative standard error {run['reference_target_error']:g} per entry, which is also about
+the smallest relative RMSE a setting can show). AIM and IIM over the valid texels, the frame over the pixels
+<code>lmgi check</code> compares. docs/tradeoff.md says what each knob buys and costs.</p>
+{''.join(body)}
+</body></html>
+"""
+    with open(os.path.join(out_dir, "report.html"), "w") as f:
+        f.write(page)
+    if not quiet:
+        print(f"wrote {os.path.join(out_dir, 'report.html')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))
