@@ -408,7 +408,8 @@ typedef struct {
     int hemicube_resolution;   /* R, plane pixels per side (0: 32) */
     float enlargement;         /* a, the plane's half-side at distance 1 (0: 2) */
     int hemicube_samples;      /* AIM lookups per hemicube pixel, 1 or 4 (0: 4) */
-    int hemicube_coverage;     /* MSAA samples per hemicube pixel, 1 to 16 (0: per scene) */
+    int hemicube_coverage;     /* MSAA samples per hemicube pixel, 1 to 16 and at most what the GL renders into
+                                * float targets (llvmpipe: 4; more: LMGI_ERR_INVALID naming it) (0: per scene) */
     int rim_samples;           /* rays into the rim the plane misses (0: 64; -1: none, the paper's 1 / F(a)) */
     lmgi_gather_scheme gather_scheme; /* how hemicubes are drawn (0: viewports, the fastest measured) */
     lmgi_emitter_light emitter_light; /* emissive triangles' light in the gather (0: per scene) */

@@ -146,6 +146,14 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
                        "samples %d: 1 or 4, coverage samples %d: 1 to 16, 1 with the layered scheme, rim samples %d: "
                        "0 to 65536)", s->resolution, s->tiles, (double)s->enlargement, s->samples,
                        s->coverage_samples, s->rim_samples);
+    /* the multisampled target holds float colour and float depth: both limits bind (llvmpipe: 8) */
+    GLint max_color = 0, max_depth = 0;
+    glGetIntegerv(GL_MAX_COLOR_TEXTURE_SAMPLES, &max_color);
+    glGetIntegerv(GL_MAX_DEPTH_TEXTURE_SAMPLES, &max_depth);
+    int max_coverage = max_color < max_depth ? max_color : max_depth;
+    if (s->coverage_samples > 1 && s->coverage_samples > max_coverage)
+        return lm_fail(err, LM_ERR_INVALID, "hemicube coverage samples %d: this GL renders at most %d samples per "
+                       "pixel into float targets", s->coverage_samples, max_coverage);
     GLint layers = 0;
     glGetIntegerv(GL_MAX_ARRAY_TEXTURE_LAYERS, &layers);
     if (s->scheme == LM_GATHER_LAYERED && (!has_extension("GL_ARB_shader_viewport_layer_array") ||
