@@ -166,10 +166,11 @@ bench: deps all $(BUILD)/gen_scenes
 	$(BUILD)/lmgi bench --edits bench/two_rooms_edits.json scenes/two_rooms.glb --json $(BUILD)/bench/edits.json
 	$(BUILD)/lmgi bench --soak 100000 scenes/cornell.glb --size 32x32
 
-# The full sweep of docs/tradeoff.md: make tradeoff TRADEOFF_FLAGS= TRADEOFF_SCENES="scenes/cornell.glb
+# The full sweep of docs/tradeoff.md: make tradeoff TRADEOFF_SCENES="scenes/cornell.glb
 # ../shared/scenes/cornell-box/CornellBox.glb scenes/two_rooms.glb"
+# TRADEOFF_FLAGS="--edits bench/cornell_edits.json,bench/two_rooms_lag.json"
 TRADEOFF_SCENES ?= scenes/cornell.glb
-TRADEOFF_FLAGS  ?= --quick
+TRADEOFF_FLAGS  ?= --quick --edits bench/cornell_edits.json
 tradeoff: deps all
 	$(BUILD)/lmgi tradeoff $(TRADEOFF_SCENES) $(TRADEOFF_FLAGS) --out $(BUILD)/tradeoff
 

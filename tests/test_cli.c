@@ -541,6 +541,61 @@ static void test_tradeoff(void **state)
     }
 }
 
+/* The update-lag part of `lmgi tradeoff`: an edit script played once per update budget. Moving the cube
+ * moves some surface's light; 80 texels an update bring the worst surface within 5% in fewer updates than
+ * 5 do (6 and 33 when written); a script for a scene not on the command line is refused. */
+static void test_tradeoff_update_lag(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    const char *dir = lmt_tmpdir();
+    char args[4096], path[2048];
+    snprintf(path, sizeof path, "%s/lag_script.json", dir);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fprintf(f, "{\"scene\": \"cornell.glb\", \"frames\": 60, \"fps\": 0, \"budget_ms\": 0, \"texels\": 800,\n"
+               " \"edits\": [{\"frame\": 2, \"node\": \"dynamic_cube\", \"translate\": [-1.1, 0, 0]}]}\n");
+    fclose(f);
+    snprintf(args, sizeof args, "tradeoff two_rooms.glb --edits %s --out %s/lagbad", path, dir);
+    assert_int_equal(run(args), 2);
+    assert_non_null(strstr(output, "its \"scene\" is not on the command line"));
+    snprintf(args, sizeof args, "tradeoff %s --quick --knobs hemicube_samples --repeats 1 --size 32x32 --texels 800 "
+             "--target-error 0.05 --cache %s/cache --edits %s --out %s/lag -q", scene, dir, path, dir);
+    assert_int_equal(run(args), 0);
+    snprintf(path, sizeof path, "%s/lag/lag.csv", dir);
+    f = fopen(path, "r");
+    assert_non_null(f);
+    char header[1024], line[1024], v[64];
+    assert_non_null(fgets(header, sizeof header, f));
+    int knob = csv_column(header, "knob"), value = csv_column(header, "value"), error = csv_column(header, "error");
+    int to5 = csv_column(header, "frames_to_5");
+    assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0);
+    int plays = 0, lag5 = -2, lag80 = -2;
+    while (fgets(line, sizeof line, f)) {
+        plays++;
+        csv_field(line, error, v, sizeof v);
+        double e = atof(v);
+        assert_true(e > 0.02); /* the edit moved some surface's light (5.8% when written) */
+        char name[64];
+        csv_field(line, knob, name, sizeof name);
+        int is_texels = !strcmp(name, "texels_per_frame");
+        csv_field(line, value, v, sizeof v);
+        int n = atoi(v);
+        csv_field(line, to5, v, sizeof v);
+        print_message("lag: %s %d: distance at the edit %.3f, within 5%% after %s updates\n", name, n, e, v);
+        if (is_texels && n == 5)
+            lag5 = atoi(v);
+        if (is_texels && n == 80)
+            lag80 = atoi(v);
+    }
+    fclose(f);
+    assert_int_equal(plays, 7); /* the defaults and two values of each of three budgets */
+    assert_true(lag80 > 0);
+    assert_true(lag5 == -1 || lag5 > lag80);
+    snprintf(path, sizeof path, "%s/lag/plot_cornell_lag.png", dir);
+    assert_int_equal(access(path, R_OK), 0);
+}
+
 /* The lmgi command is the public API's first user: no file of src/cli/ includes anything of the library
  * but include/lmgi.h (src/cli's own headers, by plain name). */
 static void test_cli_sees_only_the_public_header(void **state)
@@ -587,6 +642,7 @@ int main(void)
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),
         cmocka_unit_test(test_tradeoff),
+        cmocka_unit_test(test_tradeoff_update_lag),
         cmocka_unit_test(test_cli_sees_only_the_public_header),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -27,8 +27,13 @@ def finite(v):
     return v is not None and isinstance(v, (int, float)) and math.isfinite(v)
 
 
+def num(v):
+    """A JSON number, NaN for null (a setting the library refused has no numbers)."""
+    return float(v) if finite(v) else math.nan
+
+
 def cost_of(row):
-    return row["ms"]["update"] if row["knob"] in UPDATE_COST else row["ms"]["solution"]
+    return num(row["ms"]["update"] if row["knob"] in UPDATE_COST else row["ms"]["solution"])
 
 
 def frame_error(row):
@@ -64,6 +69,25 @@ def log_axes(ax, xs, ys):
         ax.set_yscale("log")
 
 
+def style(ax, xlabel, ylabel, legend_size=7):
+    ax.set_xlabel(xlabel, fontsize=8)
+    ax.set_ylabel(ylabel, fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+    if legend_size:
+        ax.legend(fontsize=legend_size)
+
+
+def save(fig, scene, kind, title, out_dir, top=0.97):
+    """Titles, lays out and writes the figure as DIR/plot_SCENE_KIND.png; returns the file's name."""
+    fig.suptitle(f"{scene['name']}: {title}", fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, top))
+    name = f"plot_{scene['name']}_{kind}.png"
+    fig.savefig(os.path.join(out_dir, name), dpi=90)
+    plt.close(fig)
+    return name
+
+
 def knob_plots(scene, out_dir):
     """One panel per knob: its error against its cost, each point labelled with its value, the default
     starred."""
@@ -80,11 +104,11 @@ def knob_plots(scene, out_dir):
         ax = axes[k // cols][k % cols]
         rs = sorted((r for r in scene["rows"] if r["knob"] == knob), key=lambda r: r["x"] if finite(r["x"]) else 0)
         xs = [cost_of(r) for r in rs]
-        for metric, style in (("iim", "o-"), ("frame", "s--")):
-            ys = [r["iim"]["rmse"] if metric == "iim" else frame_error(r) for r in rs]
+        for metric, line in (("iim", "o-"), ("frame", "s--")):
+            ys = [num(r["iim"]["rmse"] if metric == "iim" else frame_error(r)) for r in rs]
             if not any(finite(y) for y in ys):
                 continue
-            ax.plot(xs, ys, style, label="IIM per texel" if metric == "iim" else "frame per surface", markersize=4)
+            ax.plot(xs, ys, line, label="IIM per texel" if metric == "iim" else "frame per surface", markersize=4)
             for r, x, y in zip(rs, xs, ys):
                 if finite(y):
                     ax.annotate(r["value"], (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7)
@@ -92,19 +116,10 @@ def knob_plots(scene, out_dir):
                         ax.plot([x], [y], "*", color="black", markersize=11, zorder=5)
         log_axes(ax, xs, [frame_error(r) for r in rs] + [r["iim"]["rmse"] for r in rs])
         ax.set_title(rs[0]["label"], fontsize=9)
-        ax.set_xlabel("ms per update" if knob in UPDATE_COST else "ms for the full solution", fontsize=8)
-        ax.set_ylabel("relative error (RMS)", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=7)
+        style(ax, "ms per update" if knob in UPDATE_COST else "ms for the full solution", "relative error (RMS)")
     for k in range(len(knobs), rows_n * cols):
         axes[k // cols][k % cols].axis("off")
-    fig.suptitle(f"{scene['name']}: error against time per knob (star: the default)", fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
-    name = f"plot_{scene['name']}_knobs.png"
-    fig.savefig(os.path.join(out_dir, name), dpi=90)
-    plt.close(fig)
-    return name
+    return save(fig, scene, "knobs", "error against time per knob (star: the default)", out_dir)
 
 
 def front_plot(scene, out_dir):
@@ -130,15 +145,9 @@ def front_plot(scene, out_dir):
                 ax.plot([p[0]], [p[1]], "*", color="black", markersize=13, zorder=5, label="default")
                 break
         log_axes(ax, [p[0] for p in pts], [p[1] for p in pts])
-        ax.set_xlabel("ms for the full solution (trace + AIMs + gather)")
-        ax.set_ylabel("IIM relative RMSE per texel" if metric == "iim" else "frame relative error per surface (RMS)")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.suptitle(f"{scene['name']}: every setting, error against time", fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
-    name = f"plot_{scene['name']}_front.png"
-    fig.savefig(os.path.join(out_dir, name), dpi=90)
-    plt.close(fig)
+        style(ax, "ms for the full solution (trace + AIMs + gather)",
+              "IIM relative RMSE per texel" if metric == "iim" else "frame relative error per surface (RMS)", 8)
+    name = save(fig, scene, "front", "every setting, error against time", out_dir)
     return name, [rs[i] for i in fronts["frame"]]
 
 
@@ -165,12 +174,61 @@ def map_plots(scene, out_dir):
             ax.set_xticks([])
             ax.set_yticks([])
             fig.colorbar(img, ax=ax, fraction=0.046, pad=0.04).ax.tick_params(labelsize=7)
-    fig.suptitle(f"{scene['name']}: relative error (estimate / reference - 1; grey: not compared)", fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.97))
-    name = f"plot_{scene['name']}_maps.png"
-    fig.savefig(os.path.join(out_dir, name), dpi=90)
-    plt.close(fig)
-    return name
+    return save(fig, scene, "maps", "relative error (estimate / reference - 1; grey: not compared)", out_dir)
+
+
+def lag_plot(scene, out_dir):
+    """After each edit, the lightmap's distance from the converged one against the update time spent since,
+    one curve per update budget."""
+    plays = [p for p in scene.get("plays", []) if p["frames"]]
+    if not plays:
+        return None
+    edits = plays[0]["edits"]
+    fig, axes = plt.subplots(1, len(edits), figsize=(4.4 * len(edits), 3.8), squeeze=False)
+    frames = scene["script_frames"]
+    for e, edit in enumerate(edits):
+        ax = axes[0][e]
+        start = edit["frame"]
+        end = edits[e + 1]["frame"] if e + 1 < len(edits) else frames
+        for p in plays:
+            ms, xs, ys = 0.0, [], []
+            for err, t, _whole in p["frames"][start:end]:
+                ms += t
+                xs.append(ms)
+                ys.append(max(err, 1e-4))
+            ax.plot(xs, ys, "-" if p["default"] else "--", linewidth=2.2 if p["default"] else 1.2,
+                    label="defaults" if p["default"] else f"{p['knob']} {p['value']}")
+        ax.axhline(0.05, color="grey", linewidth=0.8)
+        ax.axhline(0.02, color="grey", linewidth=0.8, linestyle=":")
+        ax.set_yscale("log")
+        ax.set_title(f"{edit['edit']} (update {start})", fontsize=9)
+        style(ax, "update ms since the edit", "worst surface's distance from converged", 6 if e == 0 else 0)
+    return save(fig, scene, "lag", "update lag after each edit (lines at 5% and 2%)", out_dir, 0.93)
+
+
+def lag_html(scene, out_dir):
+    plays = [p for p in scene.get("plays", []) if p["frames"]]
+    if not plays:
+        return ""
+    parts = [f"<h3>Update lag ({html.escape(scene['script'])})</h3>"]
+    png = lag_plot(scene, out_dir)
+    if png:
+        parts.append(f'<img src="{png}" alt="update lag">')
+
+    def cell(f, ms):
+        return f"{f} ({ms:.0f} ms)" if f >= 0 else f"not in {ms:.0f} ms"
+    parts.append("<p>The distance is the relative L1 distance of the IIM from the converged IIM of the edited scene "
+                 "on the surface furthest from it (surfaces of 16 valid texels or more).</p>")
+    parts.append("<table><tr><th>edit</th><th>budget</th><th>distance at the edit</th><th>within 5%: updates "
+                 "(ms)</th><th>within 2%</th></tr>")
+    for e in range(len(plays[0]["edits"])):
+        for p in plays:
+            ed = p["edits"][e]
+            parts.append("<tr><td>{}</td><td>{}</td><td>{:.1f}%</td><td>{}</td><td>{}</td></tr>".format(
+                html.escape(ed["edit"]), "defaults" if p["default"] else html.escape(f"{p['knob']} {p['value']}"),
+                100 * ed["error"], cell(ed["frames_to_5"], ed["ms_to_5"]), cell(ed["frames_to_2"], ed["ms_to_2"])))
+    parts.append("</table>")
+    return "\n".join(parts)
 
 
 def suggestions(scene):
@@ -222,6 +280,7 @@ def scene_html(scene, out_dir):
     maps_png = map_plots(scene, out_dir)
     if maps_png:
         parts.append(f'<img src="{maps_png}" alt="error maps">')
+    parts.append(lag_html(scene, out_dir))
     cols = ["knob", "value", "solution ms", "trace", "AIMs", "gather", "update ms", "AIM RMSE", "IIM RMSE", "IIM p99",
             "IIM worst", "frame RMSE", "frame p99", "frame worst", "frame bias", "per surface", "worst surface"]
     parts.append("<h3>Every setting</h3><table><tr>" + "".join(f"<th>{c}</th>" for c in cols) + "</tr>")

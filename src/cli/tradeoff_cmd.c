@@ -11,6 +11,7 @@
 #include "out_dir.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
+#include "edit_script.h"
 #include "scene_load.h"
 #include "tradeoff_knobs.h"
 #include "tradeoff_write.h"
@@ -234,6 +235,17 @@ static int time_and_lightmaps(lmgi_context *ctx, const atlas_state *as, const lm
     return ok;
 }
 
+static void fail_row(lm_tradeoff_row *m)
+{
+    m->aim = m->iim = m->frame = (lm_tradeoff_error){NAN, NAN, NAN, 0};
+    m->ms_trace = m->ms_aim = m->ms_gather = m->ms_solution = NAN;
+    for (int k = 0; k < 8; k++)
+        m->ms_update[k] = NAN;
+    m->frame_bias = m->frame_surface_rms = m->frame_surface_worst = NAN;
+    free(m->iim_map), free(m->frame_map);
+    m->iim_map = m->frame_map = NULL;
+}
+
 static int measure(lmgi_context *ctx, const atlas_state *as, const lm_tradeoff_setting *s,
                    const lmgi_reference_desc *rd, int repeats, int updates, int width, int height,
                    lm_tradeoff_row *m)
@@ -281,6 +293,60 @@ static int scene_calls_for(const lmgi_scene *sc, const char *effect)
     return 0;
 }
 
+/* The update budgets the lag study moves, one at a time around their defaults. lmgi_update runs with
+ * budget_ms 0, so that texels_per_frame is what each update gathers. */
+static const struct {
+    const char *knob;
+    int values[3], def;
+} BUDGETS[3] = {{"texels_per_frame", {5, 20, 80}, 20},
+                {"group_budget", {4, 16, 64}, 16},
+                {"surfaces_per_frame", {1, 4, 16}, 4}};
+
+/* The scene's edit script played once per budget setting (the default once); plays into sr. A play the
+ * library refuses counts as a failed setting. */
+static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_script *script, lm_tradeoff_scene *sr)
+{
+    sr->script = script;
+    sr->plays = calloc(7, sizeof *sr->plays);
+    if (!sr->plays)
+        return fprintf(stderr, "lmgi: error: no memory for the plays\n"), 0;
+    for (int b = 0; b < 3; b++)
+        for (int k = 0; k < 3; k++) {
+            int v = BUDGETS[b].values[k], is_default = v == BUDGETS[b].def;
+            if (is_default && b > 0)
+                continue; /* the default is played once, with the first budget */
+            lm_tradeoff_play *p = &sr->plays[sr->play_count++];
+            p->knob = BUDGETS[b].knob, p->value = v, p->is_default = is_default;
+            lmgi_updater_desc d;
+            memset(&d, 0, sizeof d);
+            if (!is_default) {
+                if (b == 0)
+                    d.texels_per_frame = v;
+                else if (b == 1)
+                    d.group_budget = (uint32_t)v;
+                else
+                    d.surfaces_per_frame = v;
+            }
+            p->frames = calloc((size_t)script->frames, sizeof *p->frames);
+            if (!p->frames || !lm_edit_script_play(script, path, &d, 0.0f, p->frames)) {
+                free(p->frames);
+                p->frames = NULL;
+                sr->failed++;
+                continue;
+            }
+            if (!a->quiet) {
+                int from, to, f5;
+                double ms5;
+                lm_edit_span(script, 0, &from, &to);
+                lm_edit_lag(p->frames, from, to, 0.05, 1, &f5, &ms5);
+                fprintf(stderr, "lmgi: tradeoff %s update lag [%d/7] %s = %d: the first edit's worst surface %s %d "
+                        "updates (%.0f ms)\n", sr->name, sr->play_count, p->knob, v,
+                        f5 < 0 ? "still 5% off after" : "within 5% after", f5 < 0 ? to - from : f5, ms5);
+            }
+        }
+    return 1;
+}
+
 /* Every setting of one scene, measured; rows (one per setting) into sr. */
 static int sweep_scene(const lm_cli_args *a, lmgi_context *ctx, const char *path, const lmgi_reference_desc *rd,
                        lm_tradeoff_scene *sr)
@@ -317,19 +383,24 @@ static int sweep_scene(const lm_cli_args *a, lmgi_context *ctx, const char *path
         for (int j = 0; j < i && same < 0; j++)
             if (lm_tradeoff_same(&set[j], &set[i]))
                 same = j;
+        int measured = 1;
         if (same >= 0) {
             lm_tradeoff_row_copy(m, &sr->rows[same]);
         } else if (set[i].target_texels == def.target_texels) {
-            ok = measure(ctx, &def, &set[i], rd, a->repeats, updates, width, height, m);
+            measured = measure(ctx, &def, &set[i], rd, a->repeats, updates, width, height, m);
         } else {
             atlas_state other;
-            ok = load_atlas(a, path, set[i].target_texels, rd, &other) &&
-                 measure(ctx, &other, &set[i], rd, a->repeats, updates, width, height, m);
+            ok = load_atlas(a, path, set[i].target_texels, rd, &other);
+            measured = ok && measure(ctx, &other, &set[i], rd, a->repeats, updates, width, height, m);
             if (other.sc)
                 free_atlas(&other);
         }
         sr->count = i + 1;
-        if (ok && !a->quiet)
+        /* a setting the library refuses (a limit of this GL) is a row without numbers; the sweep goes on
+         * and the command ends with exit status 1 */
+        if (!measured)
+            fail_row(m), sr->failed++;
+        if (measured && !a->quiet)
             fprintf(stderr, "lmgi: tradeoff %s [%d/%d] %s = %s%s: solution %.1f ms, update %.1f ms; relative RMSE "
                     "AIM %.4f, IIM %.4f, frame %.4f (per surface %.4f)\n", sr->name, i + 1, n, set[i].knob,
                     set[i].value, same >= 0 ? " (measured above)" : "", m->ms_solution, m->ms_update[0], m->aim.rmse,
@@ -339,6 +410,56 @@ static int sweep_scene(const lm_cli_args *a, lmgi_context *ctx, const char *path
     free_atlas(&def);
     lmgi_set_verbosity(a->quiet ? 0 : a->verbose ? 2 : 1);
     return ok;
+}
+
+/* --edits LIST: up to 8 edit scripts, each for the scene on the command line its "scene" key names (by
+ * file name), or for the only scene when it names none. */
+#define MAX_SCRIPTS 8
+typedef struct {
+    char paths[4096];      /* --edits, split in place: the scripts' paths point into it */
+    lm_edit_script s[MAX_SCRIPTS];
+    int count;
+    const lm_edit_script *of_scene[LM_CLI_MAX_FILES];
+} edit_scripts;
+
+static void free_scripts(edit_scripts *e)
+{
+    for (int i = 0; i < e->count; i++)
+        lm_edit_script_free(&e->s[i]);
+    e->count = 0;
+}
+
+static const char *base_name(const char *path)
+{
+    const char *b = strrchr(path, '/');
+    return b ? b + 1 : path;
+}
+
+static int read_scripts(const lm_cli_args *a, edit_scripts *e)
+{
+    memset(e, 0, sizeof *e);
+    snprintf(e->paths, sizeof e->paths, "%s", a->edits_path ? a->edits_path : "");
+    for (char *save = NULL, *p = strtok_r(e->paths, ",", &save); p; p = strtok_r(NULL, ",", &save)) {
+        if (e->count == MAX_SCRIPTS)
+            return fprintf(stderr, "lmgi: --edits: at most %d scripts\n", MAX_SCRIPTS), free_scripts(e), 0;
+        lm_edit_script *s = &e->s[e->count];
+        if (!lm_edit_script_read(p, s))
+            return free_scripts(e), 0;
+        e->count++;
+        int found = -1;
+        for (int i = 0; i < a->file_count && found < 0; i++)
+            if (s->scene ? !strcmp(base_name(s->scene), base_name(a->files[i])) : a->file_count == 1)
+                found = i;
+        if (found < 0 || e->of_scene[found]) {
+            fprintf(stderr, "lmgi: --edits %s: %s\n", p,
+                    found >= 0 ? "a second script for the same scene"
+                    : s->scene ? "its \"scene\" is not on the command line"
+                               : "names no \"scene\" (the file it edits), and there are several scenes");
+            return free_scripts(e), 0;
+        }
+        e->of_scene[found] = s;
+    }
+    return 1;
 }
 
 int lm_cli_tradeoff(const lm_cli_args *a)
@@ -353,8 +474,13 @@ int lm_cli_tradeoff(const lm_cli_args *a)
         fprintf(stderr, "lmgi: --knobs: unknown knob '%s' (knobs: %s)\n", bad, lm_tradeoff_knob_keys());
         return 2;
     }
-    if (!lm_cli_claim_out_dir(a, lm_tradeoff_own_files()))
+    edit_scripts scripts;
+    if (!read_scripts(a, &scripts))
+        return 2;
+    if (!lm_cli_claim_out_dir(a, lm_tradeoff_own_files())) {
+        free_scripts(&scripts);
         return 1;
+    }
     lmgi_reference_desc rd;
     lm_cli_reference_desc(a, &rd);
     if (!(a->target_error > 0.0f)) /* looser, and the generated Cornell box's rare bright paths read as a
@@ -364,6 +490,7 @@ int lm_cli_tradeoff(const lm_cli_args *a)
     lmgi_error err;
     if (lmgi_context_create(NULL, &ctx, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
+        free_scripts(&scripts);
         return 1;
     }
     lm_tradeoff_scene *scenes = calloc((size_t)a->file_count, sizeof *scenes);
@@ -372,6 +499,8 @@ int lm_cli_tradeoff(const lm_cli_args *a)
         scenes[i].path = a->files[i];
         lm_tradeoff_scene_name(a->files[i], scenes[i].name, sizeof scenes[i].name);
         ok = sweep_scene(a, ctx, a->files[i], &rd, &scenes[i]);
+        if (ok && scripts.of_scene[i])
+            ok = lag_sweep(a, a->files[i], scripts.of_scene[i], &scenes[i]);
         done = i + 1;
     }
     lm_tradeoff_run run = {a->quick, a->repeats, rd.target_error, scenes, done};
@@ -379,8 +508,15 @@ int lm_cli_tradeoff(const lm_cli_args *a)
     int wrote = scenes && lm_tradeoff_write(a->out_dir, &run);
     int reported = wrote && ok && lm_tradeoff_report(a->out_dir, a->quiet);
     for (int i = 0; i < done; i++)
+        if (scenes[i].failed) {
+            fprintf(stderr, "lmgi: tradeoff: %d setting(s) of %s could not be measured (above); their rows are "
+                    "empty\n", scenes[i].failed, scenes[i].name);
+            reported = 0;
+        }
+    for (int i = 0; i < done; i++)
         lm_tradeoff_scene_free(&scenes[i]);
     free(scenes);
+    free_scripts(&scripts);
     lmgi_context_free(ctx);
     return reported ? 0 : 1;
 }

@@ -114,7 +114,7 @@ static const knob KNOBS[] = {
     {"hemicube", "hemicube resolution R", {16, 24, 32, 48, 64}, 5, {16, 32, 64}, 3, 32, set_hemicube, 0},
     {"enlargement", "hemicube enlargement a", {1, 1.5, 2, 3}, 4, {1, 2, 3}, 3, 2, set_enlargement, 0},
     {"hemicube_samples", "AIM lookups per hemicube pixel", {1, 4}, 2, {1, 4}, 2, 4, set_samples, 0},
-    {"coverage", "coverage samples per hemicube pixel", {1, 4, 16}, 3, {1, 4}, 2, NAN, set_coverage, 0},
+    {"coverage", "coverage samples per hemicube pixel", {1, 2, 4}, 3, {1, 4}, 2, NAN, set_coverage, 0},
     {"rim_samples", "rim rays per texel (0: 1 / F(a))", {0, 16, 64, 256}, 4, {0, 64}, 2, 64, set_rim, 0},
     {"aim_direct", "AIM direct light (0 photons, 1 emitters)", {0, 1}, 2, {0, 1}, 2, 0, set_aim_direct, 0},
     {"texels_per_frame", "IIM texels gathered per update", {5, 20, 80}, 3, {0}, 0, 20, set_texels_per_frame, 0},

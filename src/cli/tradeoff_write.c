@@ -12,8 +12,8 @@
 
 const char *const *lm_tradeoff_own_files(void)
 {
-    static const char *const own[] = {"tradeoff.csv", "tradeoff.json", "map_*.npy", "plot_*.png", "report.html",
-                                      NULL};
+    static const char *const own[] = {"tradeoff.csv", "tradeoff.json", "lag.csv", "map_*.npy", "plot_*.png",
+                                      "report.html", NULL};
     return own;
 }
 
@@ -51,6 +51,11 @@ void lm_tradeoff_row_copy(lm_tradeoff_row *dst, const lm_tradeoff_row *src)
 
 void lm_tradeoff_scene_free(lm_tradeoff_scene *s)
 {
+    for (int i = 0; i < s->play_count; i++)
+        free(s->plays[i].frames);
+    free(s->plays);
+    s->plays = NULL;
+    s->play_count = 0;
     for (int i = 0; i < s->count; i++) {
         free(s->rows[i].iim_map);
         free(s->rows[i].frame_map);
@@ -229,6 +234,79 @@ static void json_row(FILE *f, const lm_tradeoff_row *r)
             r->frame_ratio[1], r->frame_ratio[2], r->reference_rel_se);
 }
 
+/* ---------- update lag ---------- */
+
+typedef struct {
+    char what[128];
+    int frame, frames_to[2];
+    double error, ms_to[2];
+} edit_lag;
+
+/* Edit i's lag in play p, by the worst surface's distance; 0 when a later edit shares its frame (that one
+ * reports). */
+static int lag_of(const lm_edit_script *s, const lm_tradeoff_play *p, int i, edit_lag *l)
+{
+    int from, to;
+    if (!lm_edit_span(s, i, &from, &to))
+        return 0;
+    lm_edit_describe(s->edits[i].v, l->what, sizeof l->what);
+    l->frame = from;
+    l->error = p->frames[from].worst_surface;
+    lm_edit_lag(p->frames, from, to, 0.05, 1, &l->frames_to[0], &l->ms_to[0]);
+    lm_edit_lag(p->frames, from, to, 0.02, 1, &l->frames_to[1], &l->ms_to[1]);
+    return 1;
+}
+
+static int write_lag_csv(const char *path, const lm_tradeoff_run *run)
+{
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return 0;
+    fprintf(f, "scene,knob,value,default,edit,frame,error,frames_to_5,ms_to_5,frames_to_2,ms_to_2\n");
+    for (int i = 0; i < run->count; i++) {
+        const lm_tradeoff_scene *s = &run->scenes[i];
+        for (int p = 0; p < s->play_count; p++)
+            for (int e = 0; s->plays[p].frames && e < s->script->edit_count; e++) {
+                edit_lag l;
+                if (lag_of(s->script, &s->plays[p], e, &l))
+                    fprintf(f, "%s,%s,%d,%d,\"%s\",%d,%.5f,%d,%.2f,%d,%.2f\n", s->name, s->plays[p].knob,
+                            s->plays[p].value, s->plays[p].is_default, l.what, l.frame, l.error, l.frames_to[0],
+                            l.ms_to[0], l.frames_to[1], l.ms_to[1]);
+            }
+    }
+    return fclose(f) == 0;
+}
+
+static void json_plays(FILE *f, const lm_tradeoff_scene *s)
+{
+    fprintf(f, ",\n   \"script\": ");
+    json_string(f, s->script->path);
+    fprintf(f, ", \"script_frames\": %d, \"plays\": [\n", s->script->frames);
+    for (int p = 0; p < s->play_count; p++) {
+        const lm_tradeoff_play *pl = &s->plays[p];
+        fprintf(f, "    {\"knob\": \"%s\", \"value\": %d, \"default\": %s, \"frames\": [", pl->knob, pl->value,
+                pl->is_default ? "true" : "false");
+        for (int k = 0; pl->frames && k < s->script->frames; k++)
+            fprintf(f, "%s[%.5f, %.3f, %.5f]", k ? ", " : "", pl->frames[k].worst_surface, pl->frames[k].ms_total,
+                    pl->frames[k].error);
+        fprintf(f, "], \"edits\": [");
+        int first = 1;
+        for (int e = 0; pl->frames && e < s->script->edit_count; e++) {
+            edit_lag l;
+            if (!lag_of(s->script, pl, e, &l))
+                continue;
+            fprintf(f, "%s{\"edit\": ", first ? "" : ", ");
+            json_string(f, l.what);
+            fprintf(f, ", \"frame\": %d, \"error\": %.5f, \"frames_to_5\": %d, \"ms_to_5\": %.2f, "
+                    "\"frames_to_2\": %d, \"ms_to_2\": %.2f}", l.frame, l.error, l.frames_to[0], l.ms_to[0],
+                    l.frames_to[1], l.ms_to[1]);
+            first = 0;
+        }
+        fprintf(f, "]}%s\n", p + 1 < s->play_count ? "," : "");
+    }
+    fprintf(f, "   ]");
+}
+
 static int write_json(const char *path, const lm_tradeoff_run *run, int (*picks)[3])
 {
     FILE *f = fopen(path, "w");
@@ -260,7 +338,10 @@ static int write_json(const char *path, const lm_tradeoff_run *run, int (*picks)
             json_row(f, &s->rows[j]);
             fprintf(f, "%s\n", j + 1 < s->count ? "," : "");
         }
-        fprintf(f, "  ]}%s\n", i + 1 < run->count ? "," : "");
+        fprintf(f, "  ]");
+        if (s->script)
+            json_plays(f, s);
+        fprintf(f, "}%s\n", i + 1 < run->count ? "," : "");
     }
     fprintf(f, "]}\n");
     return fclose(f) == 0;
@@ -279,6 +360,9 @@ int lm_tradeoff_write(const char *dir, const lm_tradeoff_run *run)
     char path[PATH_MAX];
     snprintf(path, sizeof path, "%s/tradeoff.csv", dir);
     if (ok && !write_csv(path, run))
+        ok = 0, fprintf(stderr, "lmgi: error: cannot write %s: %s\n", path, strerror(errno));
+    snprintf(path, sizeof path, "%s/lag.csv", dir);
+    if (ok && !write_lag_csv(path, run))
         ok = 0, fprintf(stderr, "lmgi: error: cannot write %s: %s\n", path, strerror(errno));
     snprintf(path, sizeof path, "%s/tradeoff.json", dir);
     if (ok && !write_json(path, run, picks))

@@ -8,6 +8,7 @@
 
 #include <stdint.h>
 
+#include "edit_script.h"
 #include "tradeoff_knobs.h"
 
 typedef struct {
@@ -32,12 +33,24 @@ typedef struct {
     int map_width, map_height, frame_width, frame_height;
 } lm_tradeoff_row;
 
+/* One play of a scene's edit script at one update budget (the update-lag study). */
+typedef struct {
+    const char *knob;        /* "texels_per_frame", "group_budget" or "surfaces_per_frame" */
+    int value;
+    int is_default;          /* every budget at its default */
+    lm_edit_frame *frames;   /* the script's frames, one per update (NULL: the play failed) */
+} lm_tradeoff_play;
+
 typedef struct {
     const char *path;
-    char name[64];           /* the file's base name, letters, digits, - and _ */
+    char name[64];
+    const lm_edit_script *script; /* the edit script played on it (NULL: none) */
+    lm_tradeoff_play *plays;
+    int play_count;           /* the file's base name, letters, digits, - and _ */
     double reference_texels_seconds, reference_texels_rel_se;
     lm_tradeoff_row *rows;
     int count;
+    int failed;              /* settings the library refused (their rows hold NAN) */
 } lm_tradeoff_scene;
 
 typedef struct {
@@ -53,7 +66,9 @@ void lm_tradeoff_scene_name(const char *path, char *name, size_t size);
 /* dst = src with its own copies of the maps (a setting measured once, listed under two knobs). */
 void lm_tradeoff_row_copy(lm_tradeoff_row *dst, const lm_tradeoff_row *src);
 void lm_tradeoff_scene_free(lm_tradeoff_scene *s);
-/* The CSV, the JSON and the maps. 0 (after printing the error) when a file cannot be written. */
+/* The CSV, the JSON (with the plays: per update the lightmap's distance from the converged one and the
+ * update's time, and per edit the updates and milliseconds until it is within 5% and 2%), lag.csv and
+ * the maps. 0 (after printing the error) when a file cannot be written. */
 int lm_tradeoff_write(const char *dir, const lm_tradeoff_run *run);
 /* Runs tools/tradeoff_report.py DIR (found beside the executable: ../tools or ../share/lmgi). 0 (after
  * saying why and how to run it) when it is not found or fails. */

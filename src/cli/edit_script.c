@@ -1,0 +1,383 @@
+/* Edit scripts: reading, applying and playing them (edit_script.h). */
+#include "edit_script.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "progress.h"
+
+static int bad(const char *path, int i, const char *what)
+{
+    if (i >= 0)
+        fprintf(stderr, "lmgi: %s: edit %d: %s\n", path, i, what);
+    else
+        fprintf(stderr, "lmgi: %s: %s\n", path, what);
+    return 0;
+}
+
+static double number_or(const json_value *root, const char *key, double fallback)
+{
+    const json_value *v = json_get(root, key);
+    return v && v->type == JSON_NUMBER ? v->number : fallback;
+}
+
+static int parse_script(const char *path, const json_value *root, lm_edit_script *s)
+{
+    if (root->type != JSON_OBJECT)
+        return bad(path, -1, "the script must be a JSON object with an \"edits\" array");
+    s->frames = (int)number_or(root, "frames", 120);
+    s->fps = (int)number_or(root, "fps", 60);
+    s->texels = (int)number_or(root, "texels", 3000);
+    s->budget_ms = (float)number_or(root, "budget_ms", 8.0);
+    const json_value *scene = json_get(root, "scene");
+    s->scene = scene && scene->type == JSON_STRING ? scene->string : NULL;
+    if (s->frames < 1 || s->frames > 100000 || s->fps < 0 || s->fps > 1000 || s->texels < 64 ||
+        !(s->budget_ms >= 0.0f && s->budget_ms < 1e4f))
+        return bad(path, -1, "frames (1..100000), fps (0..1000), texels (>= 64) or budget_ms (>= 0) out of range");
+    const json_value *edits = json_get(root, "edits");
+    if (!edits || edits->type != JSON_ARRAY || edits->count > LM_EDIT_MAX)
+        return bad(path, -1, "\"edits\" must be an array of at most 256 edits");
+    s->edit_count = (int)edits->count;
+    for (int i = 0; i < s->edit_count; i++) {
+        const json_value *e = &edits->items[i];
+        const json_value *f = json_get(e, "frame");
+        if (!f || f->type != JSON_NUMBER || f->number < 0 || f->number >= s->frames)
+            return bad(path, i, "needs a \"frame\" within the script's frames");
+        if (i > 0 && f->number < s->edits[i - 1].frame)
+            return bad(path, i, "edits must come in frame order");
+        s->edits[i] = (lm_edit){(int)f->number, e};
+    }
+    return 1;
+}
+
+/* n floats from a JSON array, each finite. */
+static int floats(const json_value *v, float *out, size_t n)
+{
+    if (!v || v->type != JSON_ARRAY || v->count != n)
+        return 0;
+    for (size_t i = 0; i < n; i++) {
+        if (v->items[i].type != JSON_NUMBER || !isfinite(v->items[i].number))
+            return 0;
+        out[i] = (float)v->items[i].number;
+    }
+    return 1;
+}
+
+static int light_of_node(const lmgi_scene *sc, const char *name)
+{
+    for (int l = 0; l < lmgi_light_count(sc); l++) {
+        lmgi_light li;
+        if (lmgi_get_light(sc, l, &li, NULL) == LMGI_OK && !strcmp(lmgi_node_name(sc, li.node), name))
+            return l;
+    }
+    return -1;
+}
+
+static int material_named(const lmgi_scene *sc, const char *name)
+{
+    for (int m = 0; m < lmgi_material_count(sc); m++)
+        if (!strcmp(lmgi_material_name(sc, m), name))
+            return m;
+    return -1;
+}
+
+/* Applies one edit to a scene; 0 (after saying why) when the script asks for something the scene lacks
+ * or lmgi refuses. */
+static int apply(const char *path, int i, const json_value *e, lmgi_scene *sc)
+{
+    lmgi_error err;
+    const json_value *light = json_get(e, "light"), *node = json_get(e, "node"), *mat = json_get(e, "material");
+    lmgi_status st = LMGI_OK;
+    if (light && light->type == JSON_STRING) {
+        int l = light_of_node(sc, light->string);
+        lmgi_light li;
+        if (l < 0 || lmgi_get_light(sc, l, &li, &err) != LMGI_OK)
+            return bad(path, i, "no light on that node");
+        const json_value *v;
+        if ((v = json_get(e, "intensity")) && v->type == JSON_NUMBER)
+            li.intensity = (float)v->number;
+        if ((v = json_get(e, "enabled")) && v->type == JSON_BOOL)
+            li.enabled = v->number != 0.0;
+        if ((v = json_get(e, "color")) && !floats(v, li.color, 3))
+            return bad(path, i, "\"color\" must be 3 numbers");
+        st = lmgi_set_light(sc, l, &li, &err);
+    } else if (node && node->type == JSON_STRING) {
+        int n = lmgi_find_node(sc, node->string);
+        float world[16], move[3];
+        if (n < 0 || !lmgi_get_node_transform(sc, n, world))
+            return bad(path, i, "no node of that name");
+        if (!floats(json_get(e, "translate"), move, 3))
+            return bad(path, i, "a node edit needs \"translate\": [x, y, z]");
+        for (int k = 0; k < 3; k++)
+            world[12 + k] += move[k];
+        st = lmgi_set_node_transform(sc, n, world, &err);
+    } else if (mat && mat->type == JSON_STRING) {
+        int m = material_named(sc, mat->string);
+        lmgi_material mm;
+        if (m < 0 || lmgi_get_material(sc, m, &mm, &err) != LMGI_OK)
+            return bad(path, i, "no material of that name");
+        const json_value *v;
+        if ((v = json_get(e, "base_color")) && !floats(v, mm.base_color, 3))
+            return bad(path, i, "\"base_color\" must be 3 numbers");
+        if ((v = json_get(e, "emissive")) && !floats(v, mm.emissive, 3))
+            return bad(path, i, "\"emissive\" must be 3 numbers");
+        st = lmgi_set_material(sc, m, &mm, &err);
+    } else if ((light = json_get(e, "add_light")) && light->type == JSON_STRING) {
+        static const char *const types[3] = {"point", "spot", "directional"};
+        lmgi_light li = {.color = {1, 1, 1}, .intensity = 1.0f, .enabled = 1, .direction = {0, -1, 0},
+                         .inner_cone = 0.0f, .outer_cone = 0.785398f};
+        li.type = (lmgi_light_type)3;
+        for (int t = 0; t < 3; t++)
+            if (!strcmp(light->string, types[t]))
+                li.type = (lmgi_light_type)t;
+        const json_value *v;
+        if ((int)li.type == 3 || !floats(json_get(e, "position"), li.position, 3))
+            return bad(path, i, "\"add_light\" is \"point\", \"spot\" or \"directional\", with a \"position\"");
+        if ((v = json_get(e, "direction")) && !floats(v, li.direction, 3))
+            return bad(path, i, "\"direction\" must be 3 numbers");
+        if ((v = json_get(e, "color")) && !floats(v, li.color, 3))
+            return bad(path, i, "\"color\" must be 3 numbers");
+        if ((v = json_get(e, "intensity")) && v->type == JSON_NUMBER)
+            li.intensity = (float)v->number;
+        int id;
+        st = lmgi_add_light(sc, &li, &id, &err);
+    } else if ((light = json_get(e, "remove_light")) && light->type == JSON_STRING) {
+        int l = light_of_node(sc, light->string);
+        if (l < 0)
+            return bad(path, i, "no light on that node");
+        st = lmgi_remove_light(sc, l, &err);
+    } else {
+        return bad(path, i, "an edit names a \"light\" (its node), a \"node\", a \"material\", \"add_light\" or "
+                   "\"remove_light\"");
+    }
+    return st == LMGI_OK ? 1 : bad(path, i, err.message);
+}
+
+/* Relative L1 distance of a from b over valid texels (b's alpha). */
+static double distance(const float *a, const float *b, size_t texels)
+{
+    double d = 0.0, sum = 0.0;
+    for (size_t i = 0; i < texels; i++)
+        if (b[4 * i + 3] > 0.5f)
+            for (int c = 0; c < 3; c++)
+                d += fabs((double)a[4 * i + c] - b[4 * i + c]), sum += fabs((double)b[4 * i + c]);
+    return sum > 0.0 ? d / sum : 0.0;
+}
+
+/* The largest relative L1 distance of one surface's valid texels (MIN_SURFACE_TEXELS or more): an edit
+ * whose light stays near it (a moved cube's shadow) moves the whole atlas's distance by a fraction of a
+ * percent while the surfaces around it are far off. surface_of: the surface of each atlas pixel, -1 for
+ * none; sums: 2 x surfaces doubles of scratch. */
+#define MIN_SURFACE_TEXELS 16
+static double worst_surface(const float *a, const float *b, size_t texels, const int *surface_of, int surfaces,
+                            double *sums)
+{
+    memset(sums, 0, sizeof *sums * 3 * (size_t)surfaces);
+    for (size_t i = 0; i < texels; i++) {
+        int s = surface_of[i];
+        if (s < 0 || !(b[4 * i + 3] > 0.5f))
+            continue;
+        for (int c = 0; c < 3; c++)
+            sums[3 * s] += fabs((double)a[4 * i + c] - b[4 * i + c]), sums[3 * s + 1] += fabs((double)b[4 * i + c]);
+        sums[3 * s + 2] += 1.0;
+    }
+    double worst = 0.0;
+    for (int s = 0; s < surfaces; s++)
+        if (sums[3 * s + 2] >= MIN_SURFACE_TEXELS && sums[3 * s + 1] > 0.0)
+            worst = fmax(worst, sums[3 * s] / sums[3 * s + 1]);
+    return worst;
+}
+
+typedef struct {
+    lmgi_context *ctx;
+    lmgi_scene *sc, *twin;
+    lmgi_updater *u, *ref;
+    float *iim, *converged;
+    size_t texels;
+    int *surface_of, surfaces;
+    double *sums;
+} bench;
+
+static int setup(const char *scene_path, const lm_edit_script *s, const lmgi_updater_desc *d, bench *b)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = s->texels;
+    lmgi_error e;
+    lmgi_updater_desc dd = {0};
+    if (d)
+        dd = *d;
+    if (lmgi_context_create(NULL, &b->ctx, &e) != LMGI_OK || lmgi_load(scene_path, &o, &b->sc, &e) != LMGI_OK ||
+        lmgi_load(scene_path, &o, &b->twin, &e) != LMGI_OK ||
+        lmgi_updater_create(b->ctx, b->sc, &dd, &b->u, &e) != LMGI_OK ||
+        lmgi_updater_create(b->ctx, b->twin, &dd, &b->ref, &e) != LMGI_OK) {
+        fprintf(stderr, "lmgi: %s: %s\n", scene_path, e.message);
+        return 0;
+    }
+    lmgi_info in;
+    lmgi_get_info(b->sc, &in);
+    b->texels = (size_t)in.atlas_width * in.atlas_height;
+    b->iim = malloc(4 * b->texels * sizeof *b->iim);
+    b->converged = malloc(4 * b->texels * sizeof *b->converged);
+    b->surfaces = lmgi_surface_count(b->sc);
+    b->surface_of = malloc(b->texels * sizeof *b->surface_of);
+    b->sums = malloc(3 * (size_t)(b->surfaces ? b->surfaces : 1) * sizeof *b->sums);
+    if (!b->iim || !b->converged || !b->surface_of || !b->sums)
+        return fprintf(stderr, "lmgi: no memory for the lightmaps\n"), 0;
+    for (size_t i = 0; i < b->texels; i++)
+        b->surface_of[i] = -1;
+    for (uint32_t t = 0; t < lmgi_texel_count(b->sc); t++) {
+        lmgi_texel tx;
+        lmgi_get_texel(b->sc, t, &tx);
+        b->surface_of[(size_t)tx.y * in.atlas_width + tx.x] = tx.surface;
+    }
+    return 1;
+}
+
+static void teardown(bench *b)
+{
+    free(b->iim);
+    free(b->converged);
+    free(b->surface_of);
+    free(b->sums);
+    lmgi_updater_free(b->u);
+    lmgi_updater_free(b->ref);
+    lmgi_free(b->sc);
+    lmgi_free(b->twin);
+    lmgi_context_free(b->ctx);
+}
+
+/* The converged lightmap of the twin, edited alike: a bake. */
+static int converge(bench *b)
+{
+    lmgi_error e;
+    if (lmgi_bake(b->ref, NULL, NULL, &e) != LMGI_OK ||
+        lmgi_get_lightmap(b->ref, LMGI_LIGHTMAP_IIM, b->converged, 4 * b->texels, &e) != LMGI_OK) {
+        fprintf(stderr, "lmgi: %s\n", e.message);
+        return 0;
+    }
+    return 1;
+}
+
+static int play(const lm_edit_script *s, float budget_ms, bench *b, lm_edit_frame *rows)
+{
+    const char *path = s->path;
+    int next = 0;
+    if (!converge(b))
+        return 0;
+    for (int f = 0; f < s->frames; f++) {
+        double start = 1e3 * lm_cli_now();
+        int edited = 0;
+        for (; next < s->edit_count && s->edits[next].frame == f; next++, edited = 1)
+            if (!apply(path, next, s->edits[next].v, b->sc) || !apply(path, next, s->edits[next].v, b->twin))
+                return 0;
+        lmgi_update_stats st;
+        lmgi_error e;
+        if (lmgi_update(b->u, 0.0f, budget_ms, &st, &e) != LMGI_OK) {
+            fprintf(stderr, "lmgi: %s\n", e.message);
+            return 0;
+        }
+        rows[f] = (lm_edit_frame){st.ms_total, st.ms_photons, st.ms_gather, st.ms_blend, st.texels_gathered,
+                              st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0};
+        double spent = 1e3 * lm_cli_now() - start;
+        if (s->fps > 0 && spent < 1e3 / s->fps) { /* the game's own frame, with the photon work beside it */
+            double left = 1e3 / s->fps - spent;
+            struct timespec ts = {(time_t)(left / 1e3), (long)(fmod(left, 1e3) * 1e6)};
+            nanosleep(&ts, NULL);
+        }
+        /* measured outside the update's time: the converged state after this frame's edits, and the
+         * distance of the updater's lightmap from it */
+        if (edited && !converge(b))
+            return 0;
+        if (lmgi_get_lightmap(b->u, LMGI_LIGHTMAP_IIM, b->iim, 4 * b->texels, &e) != LMGI_OK)
+            return fprintf(stderr, "lmgi: %s\n", e.message), 0;
+        rows[f].error = distance(b->iim, b->converged, b->texels);
+        rows[f].worst_surface = worst_surface(b->iim, b->converged, b->texels, b->surface_of, b->surfaces, b->sums);
+    }
+    return 1;
+}
+
+void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, int worst, int *frames, double *ms)
+{
+    double sum = 0.0;
+    for (int f = from; f < to; f++) {
+        sum += rows[f].ms_total;
+        if ((worst ? rows[f].worst_surface : rows[f].error) < limit) {
+            *frames = f - from + 1, *ms = sum;
+            return;
+        }
+    }
+    *frames = -1, *ms = sum;
+}
+
+void lm_edit_describe(const json_value *e, char *out, size_t n)
+{
+    static const char *const kinds[5] = {"light", "node", "material", "add_light", "remove_light"};
+    for (int k = 0; k < 5; k++) {
+        const json_value *v = json_get(e, kinds[k]);
+        if (v && v->string) {
+            snprintf(out, n, "%s %s", kinds[k], v->string);
+            return;
+        }
+    }
+    snprintf(out, n, "?");
+}
+
+static json_value *read_script(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "lmgi: %s: cannot read the edit script\n", path);
+        return NULL;
+    }
+    char *text = malloc(1 << 20);
+    size_t n = text ? fread(text, 1, 1 << 20, f) : 0;
+    int too_big = text && n == 1 << 20;
+    fclose(f);
+    char err[512];
+    json_value *root = text && !too_big ? json_parse(text, n, err, sizeof err) : NULL;
+    if (!root)
+        fprintf(stderr, "lmgi: %s: %s\n", path, !text ? "out of memory" : too_big ? "larger than 1 MiB" : err);
+    free(text);
+    return root;
+}
+
+
+int lm_edit_script_read(const char *path, lm_edit_script *s)
+{
+    memset(s, 0, sizeof *s);
+    s->path = path;
+    s->root = read_script(path);
+    if (!s->root || !parse_script(path, s->root, s)) {
+        lm_edit_script_free(s);
+        return 0;
+    }
+    return 1;
+}
+
+void lm_edit_script_free(lm_edit_script *s)
+{
+    json_free(s->root);
+    s->root = NULL;
+    s->edit_count = 0;
+}
+
+int lm_edit_script_play(const lm_edit_script *s, const char *scene_path, const lmgi_updater_desc *d,
+                        float budget_ms, lm_edit_frame *rows)
+{
+    bench b;
+    memset(&b, 0, sizeof b);
+    int ok = setup(scene_path, s, d, &b) && play(s, budget_ms, &b, rows);
+    teardown(&b);
+    return ok;
+}
+
+int lm_edit_span(const lm_edit_script *s, int i, int *from, int *to)
+{
+    *from = s->edits[i].frame;
+    *to = i + 1 < s->edit_count ? s->edits[i + 1].frame : s->frames;
+    return !(i + 1 < s->edit_count && *to == *from);
+}

@@ -1,0 +1,57 @@
+/* Edit scripts (docs/bench.md, "Edit scripts and update lag"): a JSON list of edits made at given updates
+ * (lights, nodes, materials, lights added and removed), played through the public updater with each
+ * update's time and work, and after each edit the distance of the updater's lightmap from the converged
+ * lightmap of the edited scene (a twin scene given the same edits and baked). `lmgi bench --edits` reports
+ * one play; `lmgi tradeoff --edits` plays a script once per update budget for the update-lag curves. */
+#ifndef LM_CLI_EDIT_SCRIPT_H
+#define LM_CLI_EDIT_SCRIPT_H
+
+#include <lmgi.h>
+
+#include "json.h"
+
+#define LM_EDIT_MAX 256
+
+typedef struct {
+    int frame;             /* the update before which the edit is made */
+    const json_value *v;   /* the edit's object in the script */
+} lm_edit;
+
+typedef struct {
+    const char *path;
+    json_value *root;
+    int frames, fps, texels;
+    float budget_ms;
+    const char *scene;     /* the "scene" key: the file name the script was written for (NULL: not said) */
+    int edit_count;
+    lm_edit edits[LM_EDIT_MAX];
+} lm_edit_script;
+
+/* One update of a play. */
+typedef struct {
+    double ms_total, ms_photons, ms_gather, ms_blend;
+    uint32_t texels, photons;
+    int aim, changed;
+    double error;          /* relative L1 distance of the IIM from the converged one, over valid texels */
+    double worst_surface;  /* the same per surface of 16 or more valid texels, the largest */
+} lm_edit_frame;
+
+/* Reads and checks the script (1 MiB at most). 0, after printing what is wrong (file, edit, key), when
+ * it cannot be read, is not valid JSON or is out of range. */
+int lm_edit_script_read(const char *path, lm_edit_script *s);
+void lm_edit_script_free(lm_edit_script *s);
+/* Plays s on scene_path loaded at the script's texels, with desc d (NULL: the defaults) and lmgi_update's
+ * budget budget_ms (the script's, or 0 for d's texels_per_frame): rows[0 .. s->frames). 0 after printing
+ * the error (an edit the scene cannot take names the edit). */
+int lm_edit_script_play(const lm_edit_script *s, const char *scene_path, const lmgi_updater_desc *d,
+                        float budget_ms, lm_edit_frame *rows);
+/* The updates edit i's effect is measured over, [*from, *to): from its frame to the next edit's (or the
+ * end). 0 when a later edit shares its frame (the last of a frame's edits reports). */
+int lm_edit_span(const lm_edit_script *s, int i, int *from, int *to);
+/* Updates and update milliseconds from `from` until the error (worst: the worst surface's, else the whole
+ * atlas's) is under `limit` (*frames -1: not in [from, to); *ms is then the time of all of them). */
+void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, int worst, int *frames, double *ms);
+/* "light light_b2", "node door", ...: what edit e does, for tables. */
+void lm_edit_describe(const json_value *e, char *out, size_t n);
+
+#endif
