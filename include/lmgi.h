@@ -395,13 +395,15 @@ typedef struct {
     int texels_per_frame;      /* IIM texels gathered per lmgi_update when its budget_ms is 0 (0: 20, the paper's) */
     int blend_frames;          /* updates a regathered surface takes to fade in (0: 8; -1: at once) */
     /* photons (docs/photons.md) */
-    uint32_t photons;          /* photon budget over all lights (0: groups x photons_per_group per light) */
+    uint32_t photons;          /* photon budget over all lights (0: groups x photons_per_group per light, and at
+                                * least 46,080 over the scene unless photons_per_group is given: a scene with
+                                * one light gets 640 a group; docs/tradeoff.md, "Defaults against the front") */
     uint32_t groups;           /* groups per light, 2^a 3^b (0: 72) */
     uint32_t photons_per_group; /* (0: 160) */
     uint32_t retrace_per_group; /* photons per group re-checked per update, round robin (0: 1) */
     uint32_t group_budget;     /* invalid groups re-traced per update (0: 16; UINT32_MAX: all) */
     uint32_t seed;             /* another, disjoint stretch of the Halton sequence (0: the default one) */
-    int photons_per_estimate;  /* N nearest photons per AIM estimate (0: docs/aim.md's default) */
+    int photons_per_estimate;  /* N nearest photons per AIM estimate (0: 32, docs/aim.md) */
     int surfaces_per_frame;    /* AIM refreshes per update (0: 4; -1: all that changed) */
     lmgi_aim_direct aim_direct; /* (0: LMGI_AIM_DIRECT_PHOTONS) */
     /* the gather (docs/gather.md) */
@@ -444,8 +446,8 @@ typedef struct {
     int photon_chunk;          /* TILED: photons per shared-memory load, 64 to 512 (0: 256) */
     int photon_stochastic;     /* TILED: k, each pixel reads 1/k^2 of its tile's photons, then an edge-aware
                                 * k x k reconstruction, 1 to 4 (0: 1, all of them) */
-    float photon_radius;       /* the kernel radius in scene units (0: the disc that holds
-                                * photons_per_estimate photons on average) */
+    float photon_radius;       /* the kernel radius in scene units (0: the disc that holds 128 photons on
+                                * average) */
     /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
      * that, set non-zero (from any thread), stops it between gather passes: LMGI_ERR_CANCELLED */
     lmgi_progress_fn progress;

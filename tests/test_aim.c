@@ -126,11 +126,10 @@ static void init_aim(lm_aim *aim, const tscene *t, const lm_aim_settings *set)
         fail_msg("aim init: %s", err.msg);
 }
 
-/* (a) A point light over a large plane: the AIM's radiance is rho / pi * E(x) within 5% away from the
- * plane's edges. */
-static void test_point_light_plane(void **state)
+/* (a) A point light over a large plane: the AIM's radiance is rho / pi * E(x) within `worst_bound` away
+ * from the plane's edges, `mean_bound` on average, with N = n (0: the default). */
+static void point_light_plane(int n, double worst_bound, double mean_bound)
 {
-    (void)state;
     lmt_mesh m;
     square_mesh(&m, 2.0f);
     tscene t;
@@ -144,6 +143,8 @@ static void test_point_light_plane(void **state)
     lm_aim aim;
     lm_aim_settings set;
     lm_aim_settings_default(&set);
+    if (n)
+        set.n_nearest = n;
     init_aim(&aim, &t, &set);
     lm_aim_stats st;
     assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, &st, NULL), LM_OK);
@@ -165,16 +166,25 @@ static void test_point_light_plane(void **state)
         }
         checked++;
     }
-    print_message("point light: %d texels, mean error %.2f%%, worst %.2f%% (refresh of %u texels from %llu hits: "
-                  "%.1f ms)\n", checked, 100.0 * sum / (3 * checked), 100.0 * worst, st.texels_written,
+    print_message("point light, N = %d: %d texels, mean error %.2f%%, worst %.2f%% (refresh of %u texels from %llu hits: "
+                  "%.1f ms)\n", set.n_nearest, checked, 100.0 * sum / (3 * checked), 100.0 * worst, st.texels_written,
                   (unsigned long long)st.hits_used, 1e3 * st.seconds);
     assert_true(checked > 4000);
-    assert_true(worst < 0.05);
-    assert_true(sum / (3 * checked) < 0.015);
+    assert_true(worst < worst_bound);
+    assert_true(sum / (3 * checked) < mean_bound);
     assert_true(ps.surfaces[0].delta_f == 0.0);
     lm_aim_free(&aim);
     lm_photon_store_free(&ps);
     ts_free(&t);
+}
+
+/* N = 128 (the default until issue 15) within 5% everywhere; the default N = 32 has the noise of a quarter
+ * of the hits (worst 11.5%, mean 2.4% when written), which the hemicube gather averages over many texels. */
+static void test_point_light_plane(void **state)
+{
+    (void)state;
+    point_light_plane(128, 0.05, 0.015);
+    point_light_plane(0, 0.15, 0.03);
 }
 
 /* Interior mean and the worst deviation of any texel (edges and corners included) from it. */

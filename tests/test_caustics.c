@@ -341,6 +341,7 @@ static void test_regular_photons_mark_caustic_hits(void **state)
     lm_photon_settings set;
     lm_photon_settings_default(&set);
     set.per_group = 100;
+    set.min_total = 0;
     lm_photons *ph = NULL;
     lm_error err;
     if (lm_photons_create(p.s, &p.su, p.rt, &p.em, &set, &ph, &err) != LM_OK ||

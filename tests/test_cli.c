@@ -476,9 +476,10 @@ static void csv_field(const char *line, int col, char *out, size_t size)
     snprintf(out, size, "%.*s", (int)len, p);
 }
 
-/* `lmgi tradeoff` on one knob: a row per value with the photons it asked for, its stage times and its
- * errors against the reference; 16 times the photons leave the AIM closer to the reference; the error
- * maps and the report beside them. Bad knobs and a missing --out are refused. */
+/* `lmgi tradeoff` on one knob: a row per value with the photons it asked for (exactly: a given number per
+ * group is not raised to the scene's floor), its stage times and its errors against the reference; 16
+ * times the photons leave the AIM closer to the reference; the error maps and the report beside them.
+ * Bad knobs and a missing --out are refused. */
 static void test_tradeoff(void **state)
 {
     (void)state;
@@ -490,7 +491,8 @@ static void test_tradeoff(void **state)
     assert_non_null(strstr(output, "unknown knob 'bogus'"));
     snprintf(args, sizeof args, "tradeoff %s --quick", scene);
     assert_int_equal(run(args), 2);
-    snprintf(args, sizeof args, "tradeoff %s --quick --knobs photons_per_group --repeats 1 --size 32x32 --texels 800 "
+    snprintf(args, sizeof args, "tradeoff %s --quick --knobs photons_per_group,aim_direct --repeats 1 --size 32x32 "
+             "--texels 800 "
              "--target-error 0.05 --cache %s/cache --out %s/tradeoff -q", scene, dir, dir);
     assert_int_equal(run(args), 0);
     snprintf(path, sizeof path, "%s/tradeoff/tradeoff.csv", dir);
@@ -504,16 +506,21 @@ static void test_tradeoff(void **state)
     for (int k = 0; k < 10; k++)
         assert_true((col[k] = csv_column(header, names[k])) >= 0);
     double aim[3] = {0.0, 0.0, 0.0};
-    int rows = 0;
-    for (; fgets(line, sizeof line, f); rows++) {
+    int rows = 0, defaults = 0;
+    while (fgets(line, sizeof line, f)) {
+        csv_field(line, col[0], v, sizeof v);
+        if (!strcmp(v, "aim_direct")) { /* its photons-from-first-hits row is the default desc */
+            csv_field(line, col[2], v, sizeof v);
+            defaults += atoi(v);
+            continue;
+        }
         assert_true(rows < 3);
         static const int per_group[3] = {40, 160, 640};
-        csv_field(line, col[0], v, sizeof v);
         assert_string_equal(v, "photons_per_group");
         csv_field(line, col[1], v, sizeof v);
         assert_int_equal(atoi(v), per_group[rows]);
         csv_field(line, col[2], v, sizeof v);
-        assert_int_equal(atoi(v), per_group[rows] == 160); /* the default */
+        assert_int_equal(atoi(v), 0); /* photons per group given: none is the default, which is the scene's floor */
         csv_field(line, col[3], v, sizeof v);
         assert_int_equal(atoi(v), 72 * per_group[rows]); /* one light, 72 groups */
         double x[6];
@@ -528,9 +535,11 @@ static void test_tradeoff(void **state)
                       x[4], x[5]);
         assert_true(x[3] < 0.2);
         assert_true(fabs(x[5] - 1.0) < 0.1);
+        rows++;
     }
     fclose(f);
     assert_int_equal(rows, 3);
+    assert_int_equal(defaults, 1);
     assert_true(aim[2] < aim[0]);
     static const char *const files[] = {"tradeoff.json", "map_cornell_default_iim.npy", "map_cornell_default_frame.npy",
                                         "plot_cornell_front.png", "plot_cornell_knobs.png", "plot_cornell_maps.png",

@@ -153,7 +153,8 @@ static void test_add_and_remove(void **state)
     assert_float_equal(got.position[0], -0.5f, 1e-6);
 
     /* removed: the lightmap from before it came, but for the order of sums and the texels that see a change
-     * below the one a bake regathers for (a thousandth of the stored energy: update/photon_stage.c) */
+     * below the one a bake regathers for (a thousandth of the stored energy: update/photon_stage.c). Those
+     * are under 2% of the texels (measured 1.2% at N = 32), each off by under 1e-3 (measured 3.8e-4). */
     assert_int_equal(lmgi_remove_light(sc, 1, &e), LMGI_OK);
     assert_true(lmgi_light_is_removed(sc, 1) && !lmgi_light_is_removed(sc, 0));
     lmt_bake(u, &r);
@@ -173,7 +174,7 @@ static void test_add_and_remove(void **state)
     }
     print_message("removed again: %d of %d texels more than 1e-4 from the lightmap before the add, the worst by %.2e\n",
                   off, valid, worst);
-    assert_true(off <= valid / 100 && worst < 0.05);
+    assert_true(off <= valid / 50 && worst < 1e-3);
     for (int k = 0; k < 2; k++)
         assert_float_equal(lmt_node_mean(sc, after, nodes[k]), lmt_node_mean(sc, before, nodes[k]),
                            1e-3 * lmt_node_mean(sc, before, nodes[k]));

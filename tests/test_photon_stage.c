@@ -18,15 +18,18 @@
 #include "support.h"
 
 #define PI 3.14159265358979323846
-/* Measured 0.0765 (reference standard error 0.035, 200k photons, N = 128): the bound leaves room for
- * the reference's own noise, not for a regression in the photon stage. */
+/* Measured 0.0879 (reference standard error 0.025, 200k photons, the default N = 32; 0.0765 at N = 128):
+ * the bound leaves room for the reference's own noise, not for a regression in the photon stage. */
 #define AIM_RMSE_BOUND 0.10
 
-static lm_photon_stage *stage_for(lmt_pipeline *p, uint32_t photons)
+/* n_nearest 0: the default N */
+static lm_photon_stage *stage_for(lmt_pipeline *p, uint32_t photons, int n_nearest)
 {
     lm_photon_stage_settings set;
     lm_photon_stage_settings_default(&set);
     set.photons.total_photons = photons;
+    if (n_nearest)
+        set.aim.n_nearest = n_nearest;
     lm_photon_stage *st = NULL;
     lm_error err;
     if (lm_photon_stage_create(&p->w, &set, &st, NULL, &err) != LM_OK)
@@ -34,14 +37,13 @@ static lm_photon_stage *stage_for(lmt_pipeline *p, uint32_t photons)
     return st;
 }
 
-/* Point light (I = 10) 2 above a 20 x 20 plane of albedo 0.8: L = rho/pi * I h / d^3. Away from the
- * plane's edges the AIM built from traced photons must match it within 5%. */
-static void test_aim_point_light_over_plane(void **state)
+/* Point light (I = 10) 2 above a 20 x 20 plane of albedo 0.8: L = rho/pi * I h / d^3, away from the
+ * plane's edges, against the AIM built from 400k traced photons with N nearest. */
+static void aim_point_light_over_plane(int n_nearest, double rmse_bound, double worst_bound)
 {
-    (void)state;
     lmt_pipeline p;
     lmt_pipeline_load(&p, lmt_plane_scene(), 0.1f);
-    lm_photon_stage *st = stage_for(&p, 400000);
+    lm_photon_stage *st = stage_for(&p, 400000, n_nearest);
     const float *rgb = lm_aim_rgb(lm_photon_stage_aim(st));
     double err2 = 0.0, ref2 = 0.0, worst = 0.0, bias = 0.0;
     int n = 0;
@@ -59,14 +61,23 @@ static void test_aim_point_light_over_plane(void **state)
         n++;
     }
     double rmse = sqrt(err2 / ref2);
-    print_message("AIM vs analytic over %d texels: relative RMSE %.4f, mean bias %+.4f, worst %.4f\n", n, rmse,
-                  bias / n, worst);
+    print_message("N %s: AIM vs analytic over %d texels: relative RMSE %.4f, mean bias %+.4f, worst %.4f\n",
+                  n_nearest ? "128" : "default", n, rmse, bias / n, worst);
     assert_true(n > 5000);
-    assert_true(rmse < 0.05);
+    assert_true(rmse < rmse_bound);
     assert_true(fabs(bias / n) < 0.02);
-    assert_true(worst < 0.15);
+    assert_true(worst < worst_bound);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
+}
+
+/* N = 128 within 5% everywhere; the default N = 32 averages a quarter of the photons, so single texels
+ * stray further (measured worst 0.186) while the mean error stays (measured RMSE 0.017). */
+static void test_aim_point_light_over_plane(void **state)
+{
+    (void)state;
+    aim_point_light_over_plane(128, 0.05, 0.15);
+    aim_point_light_over_plane(0, 0.03, 0.25);
 }
 
 /* 1 if the texel's normal runs into an emitter within 1% of the scene size: the ceiling patch hidden
@@ -116,7 +127,7 @@ static void test_cornell_box_aims_against_reference(void **state)
     lmt_pipeline_load(&p, path, 20.0f);
     lm_ref_result ref;
     lmt_reference_texels(&p, 0.05f, &ref);
-    lm_photon_stage *st = stage_for(&p, 200000);
+    lm_photon_stage *st = stage_for(&p, 200000, 0);
     const float *rgb = lm_aim_rgb(lm_photon_stage_aim(st));
     float *est = malloc(sizeof(float) * 3 * p.atlas.texel_count);
     uint8_t *mask = malloc(p.atlas.texel_count), *visible = malloc(p.atlas.texel_count);

@@ -73,6 +73,8 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     TAKEU(photons, 1, 100000000, &ph->total_photons);
     TAKEU(groups, 1, 1 << 20, &ph->groups); /* 2^a 3^b: checked by photons */
     TAKEU(photons_per_group, 1, 10000000, &ph->per_group);
+    if (d->photons_per_group)
+        ph->min_total = 0; /* photons per group as asked, without the scene's floor */
     TAKEU(retrace_per_group, 1, 1000000, &ph->retrace_per_group);
     if (d->group_budget == UINT32_MAX)
         ph->group_budget = 0; /* every invalid group at once */

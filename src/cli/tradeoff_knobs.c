@@ -105,11 +105,12 @@ static void set_tiled_radius(lmgi_updater_desc *d, int *t, double v, const lm_tr
 }
 
 /* The defaults are the values the zero desc resolves to (lmgi.h), so each sweep's default point is the
- * default desc itself. */
+ * default desc itself; NAN where the default depends on the scene (photons per group: 160, or more up to
+ * the scene's floor of 46,080 photons; coverage) and for the tiled gather's own sweeps. */
 static const knob KNOBS[] = {
-    {"photons_per_group", "photons per group", {40, 80, 160, 320, 640}, 5, {40, 160, 640}, 3, 160, set_per_group, 0},
+    {"photons_per_group", "photons per group", {40, 80, 160, 320, 640}, 5, {40, 160, 640}, 3, NAN, set_per_group, 0},
     {"groups", "groups per light", {18, 36, 72, 144, 288}, 5, {18, 72, 288}, 3, 72, set_groups, 0},
-    {"nearest", "photons per AIM estimate N", {32, 64, 128, 256}, 4, {32, 128, 256}, 3, 128, set_nearest, 0},
+    {"nearest", "photons per AIM estimate N", {16, 32, 64, 128, 256}, 5, {16, 32, 128}, 3, 32, set_nearest, 0},
     {"texels", "atlas texels (x the default)", {0.25, 0.5, 1, 2, 4}, 5, {0.5, 1, 2}, 3, 1, set_texels, 0},
     {"hemicube", "hemicube resolution R", {16, 24, 32, 48, 64}, 5, {16, 32, 64}, 3, 32, set_hemicube, 0},
     {"enlargement", "hemicube enlargement a", {1, 1.5, 2, 3}, 4, {1, 2, 3}, 3, 2, set_enlargement, 0},

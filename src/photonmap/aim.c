@@ -15,7 +15,7 @@
 
 void lm_aim_settings_default(lm_aim_settings *o)
 {
-    o->n_nearest = 128;
+    o->n_nearest = 32;
     o->min_radius_texels = 1.0f;
     o->delta_threshold = 0.01f;
     o->front_only = 1;

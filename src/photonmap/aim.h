@@ -39,7 +39,7 @@
 #include "kdtree.h"
 
 typedef struct {
-    int n_nearest;           /* N hits per estimate (default 128; clamped to the surface's hit count) */
+    int n_nearest;           /* N hits per estimate (default 32; clamped to the surface's hit count) */
     float min_radius_texels; /* smallest gather radius, in texels of the atlas (default 1) */
     float delta_threshold;   /* refresh when delta_f > this x the mean stored hit energy (default 0.01) */
     int front_only;          /* single-sided materials count only hits arriving from the front (default 1) */

@@ -50,6 +50,11 @@ typedef struct {
 lm_status lm_gbuffer_trace(lm_gbuffer *g, const lm_scene *s, const lm_rt *rt, const lm_ref_camera *cam, lm_error *err);
 void lm_gbuffer_free(lm_gbuffer *g);
 
+/* The hits the per-pixel gathers' default radius holds on average: the AIMs' N of 128 they were measured
+ * with (docs/tiled.md), kept when the AIMs' default went to 32 (a quarter of those photons per pixel is
+ * a quarter of the samples, where an AIM texel's estimate is averaged again by the hemicube). */
+#define LM_PIXEL_GATHER_HITS 128
+
 /* r = sqrt(n A / (pi H)) over the store's hits that the gather takes (H) and the surfaces' area (A);
  * 0 when there are none. */
 float lm_pixel_gather_radius(const lm_photon_store *ps, const lm_surfaces *su, int n);

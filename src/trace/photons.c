@@ -24,6 +24,7 @@ void lm_photon_settings_default(lm_photon_settings *s)
      * shared scenes 3-4% off the reference at default settings, at 160 within 2% (docs/photons.md,
      * "Photon budget"), for about twice the stage's own work per frame */
     s->per_group = 160;
+    s->min_total = LM_PHOTONS_MIN_TOTAL;
     s->retrace_per_group = 1;
     s->group_budget = 16;
     s->max_bounces = 1024;
@@ -98,6 +99,8 @@ static lm_status plan_counts(lm_photons *ph, lm_error *err)
 {
     uint32_t E = ph->emitter_count;
     uint64_t total = ph->set.total_photons ? ph->set.total_photons : (uint64_t)ph->set.per_group * ph->G * E;
+    if (!ph->set.total_photons && total < ph->set.min_total)
+        total = ph->set.min_total;
     ph->emitter_first = calloc((size_t)E + 1, sizeof *ph->emitter_first);
     if (!ph->emitter_first)
         return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u emitters", E);

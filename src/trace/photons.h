@@ -33,6 +33,9 @@ typedef struct {
     uint32_t total_photons;    /* photon budget over all emitters; 0 = per_group x groups x emitters */
     uint32_t groups;           /* G, groups per emitter, must be 2^a 3^b (default 72 = 2^3 3^2) */
     uint32_t per_group;        /* mean photons per group when total_photons is 0 (default 160) */
+    uint32_t min_total;        /* with total_photons 0, at least this many photons over all emitters
+                                * (default LM_PHOTONS_MIN_TOTAL; 0: none). Set per_group and this to 0 for
+                                * exactly per_group x groups x emitters */
     uint32_t retrace_per_group; /* k: photons per group re-traced each frame, round robin (default 1) */
     uint32_t group_budget;     /* invalid groups re-traced per frame, oldest first (default 16; 0 = all) */
     float epsilon;             /* a path vertex that moved more than this (world units) is a change;
@@ -47,6 +50,12 @@ typedef struct {
                                 * texels around (docs/aim.md). <= 0 (default here): every hit is stored;
                                 * the photon stage makes it the atlas's texel size */
 } lm_photon_settings;
+
+/* The scene's default photon floor, 72 groups of 640: one light's photons when the scene has one, 160 a
+ * group per light from four lights on. A single light at 160 a group left the shared Cornell box's small
+ * box 21-34% too bright (its faces see the floor's contact shadow blurred by the estimate's radius);
+ * at 640 with N = 32 they are within 3% (docs/tradeoff.md, "Defaults against the front"). */
+#define LM_PHOTONS_MIN_TOTAL 46080u
 
 void lm_photon_settings_default(lm_photon_settings *s);
 

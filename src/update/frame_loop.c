@@ -435,7 +435,7 @@ static lm_status photon_records(lm_frame_loop *fl, lm_frame_stats *o, lm_error *
     if (st == LM_OK && (!(fl->photon_radius > 0.0f) || (fresh && drifted))) {
         fl->photon_radius = fl->set.photon_radius > 0.0f
                                 ? fl->set.photon_radius
-                                : lm_pixel_gather_radius(ps, fl->surfaces, fl->set.stage.aim.n_nearest);
+                                : lm_pixel_gather_radius(ps, fl->surfaces, LM_PIXEL_GATHER_HITS);
         fl->radius_live = live;
     }
     return st;

@@ -64,8 +64,8 @@ typedef struct {
                             * hold direct light only) */
     lm_photon_gather_settings photon_gather; /* those three paths' tile, chunk and stochastic k (the kind
                                               * follows indirect_path) */
-    float photon_radius;   /* their kernel radius (0, the default: the disc that holds stage.aim.n_nearest hits
-                            * on average, lm_pixel_gather_radius) */
+    float photon_radius;   /* their kernel radius (0, the default: the disc that holds LM_PIXEL_GATHER_HITS
+                            * hits on average, lm_pixel_gather_radius) */
     /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;

@@ -28,7 +28,7 @@ void lm_dev_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
     if (a->groups)
         s->photons.groups = (uint32_t)a->groups;
     if (a->per_group)
-        s->photons.per_group = (uint32_t)a->per_group;
+        s->photons.per_group = (uint32_t)a->per_group, s->photons.min_total = 0;
     if (a->retrace)
         s->photons.retrace_per_group = (uint32_t)a->retrace;
     if (a->group_budget)
