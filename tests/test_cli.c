@@ -383,6 +383,46 @@ static void test_bench_edits(void **state)
     assert_non_null(strstr(json, "\"frames_to_5\""));
     free(json);
 
+    /* the work outside an edit's reach, the door closed: a light in room A, then one in room B, each caught
+     * up on before the next (200 texels an update); the other room's surfaces are never rewritten */
+    snprintf(path, sizeof path, "%s/reach.json", dir);
+    const char *reach = "{\"frames\": 40, \"budget_ms\": 0, \"fps\": 0, \"texels\": 600,\n"
+                        " \"edits\": [{\"frame\": 2, \"light\": \"light_a1\", \"intensity\": 2},\n"
+                        "  {\"frame\": 20, \"light\": \"light_b2\", \"enabled\": false}]}\n";
+    lmt_write_file(path, reach, strlen(reach));
+    snprintf(args, sizeof args, "bench --edits %s scenes/two_rooms.glb --texels-per-frame 200 --json %s/reach_out.json",
+             path, dir);
+    if (run(args) != 0)
+        fail_msg("%s: %s", args, output);
+    snprintf(path, sizeof path, "%s/reach_out.json", dir);
+    json = (char *)lmt_read_file(path, &n, 1);
+    json[n] = '\0';
+    static const char *const lights[2] = {"\"light light_a1\"", "\"light light_b2\""};
+    int reaches[2];
+    for (int k = 0; k < 2; k++) {
+        int reach = -1, rewrites = -1, outside = -1;
+        unsigned outside_texels = 1;
+        assert_non_null(row = strstr(json, lights[k]));
+        assert_non_null(row = strstr(row, "\"reach_surfaces\""));
+        assert_int_equal(sscanf(row, "\"reach_surfaces\": %d, \"rewritten_in_reach\": %d, \"outside_surfaces\": %d, "
+                                "\"outside_texels\": %u", &reach, &rewrites, &outside, &outside_texels), 4);
+        print_message("%s: %d surfaces in its reach, %d surface rewrites there, %d outside (%u texels)\n", lights[k],
+                      reach, rewrites, outside, outside_texels);
+        reaches[k] = reach;
+        assert_true(rewrites > 10);
+        assert_int_equal(outside, 0);
+        assert_int_equal(outside_texels, 0);
+    }
+    /* each light reaches its own room (and the door's two sides), not the other: together fewer surfaces
+     * than the scene's, each some */
+    free(json);
+    int surfaces = 0;
+    assert_int_equal(run("info scenes/two_rooms.glb --texels 600"), 0);
+    assert_non_null(row = strstr(output, "surfaces "));
+    assert_int_equal(sscanf(row, "surfaces %d", &surfaces), 1);
+    print_message("%d surfaces in all\n", surfaces);
+    assert_true(reaches[0] > 10 && reaches[1] > 10 && reaches[0] + reaches[1] < surfaces + 10);
+
     snprintf(path, sizeof path, "%s/broken.json", dir);
     const char *broken = "{\"edits\": [\n  {\"frame\": 1,, }]}";
     lmt_write_file(path, broken, strlen(broken));

@@ -9,12 +9,14 @@
 
 #include "edit_script.h"
 #include "order_stats.h"
+#include "run_cmd.h"
 
 static void report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_frame *rows)
 {
     printf("lmgi bench --edits %s %s: %d updates, budget %.1f ms, %d fps, %d texels\n", a->edits_path, a->files[0],
            s->frames, (double)s->budget_ms, s->fps, s->texels);
-    printf("%-28s %6s %10s %14s %14s\n", "edit", "frame", "error", "to 5%", "to 2%");
+    printf("%-28s %6s %10s %14s %14s %14s %20s\n", "edit", "frame", "error", "to 5%", "to 2%", "rewrites",
+           "outside its reach");
     FILE *json = a->json_path ? fopen(a->json_path, "w") : NULL;
     if (json)
         fprintf(json, "{\n  \"script\": \"%s\", \"scene\": \"%s\", \"budget_ms\": %g,\n  \"edits\": [\n",
@@ -31,11 +33,19 @@ static void report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_
         lm_edit_describe(s->edits[i].v, what, sizeof what);
         snprintf(l5, sizeof l5, f5 < 0 ? "not in %d fr" : "%d fr %.0f ms", f5 < 0 ? to - from : f5, ms5);
         snprintf(l2, sizeof l2, f2 < 0 ? "not in %d fr" : "%d fr %.0f ms", f2 < 0 ? to - from : f2, ms2);
-        printf("%-28s %6d %9.1f%% %14s %14s\n", what, from, 100.0 * rows[from].error, l5, l2);
+        int reached = 0, outside = 0; /* surface rewrites in its reach, and where its light does not reach */
+        uint32_t outside_texels = 0;
+        for (int f = from; f < to; f++)
+            reached += rows[f].reached, outside += rows[f].outside, outside_texels += rows[f].outside_texels;
+        char in[32], out[48];
+        snprintf(in, sizeof in, "%d surf", reached);
+        snprintf(out, sizeof out, "%d surf, %u tx", outside, outside_texels);
+        printf("%-28s %6d %9.1f%% %14s %14s %14s %20s\n", what, from, 100.0 * rows[from].error, l5, l2, in, out);
         if (json)
             fprintf(json, "    {\"edit\": \"%s\", \"frame\": %d, \"error\": %.5f, \"frames_to_5\": %d, \"ms_to_5\": %.2f, "
-                    "\"frames_to_2\": %d, \"ms_to_2\": %.2f}%s\n", what, from, rows[from].error, f5, ms5, f2, ms2,
-                    i + 1 < s->edit_count ? "," : "");
+                    "\"frames_to_2\": %d, \"ms_to_2\": %.2f, \"reach_surfaces\": %d, \"rewritten_in_reach\": %d, "
+                    "\"outside_surfaces\": %d, \"outside_texels\": %u}%s\n", what, from, rows[from].error, f5, ms5, f2,
+                    ms2, rows[from].reach, reached, outside, outside_texels, i + 1 < s->edit_count ? "," : "");
     }
     double *ms = malloc(sizeof *ms * (size_t)s->frames);
     int over = 0;
@@ -76,7 +86,12 @@ int lm_cli_bench_edits(const lm_cli_args *a)
     if (!lm_edit_script_read(a->edits_path, &s))
         return 1;
     lm_edit_frame *rows = calloc((size_t)s.frames, sizeof *rows);
-    int ok = rows && lm_edit_script_play(&s, a->files[0], NULL, s.budget_ms, rows);
+    lmgi_updater_desc d; /* the photon and gather options given; the frame and progress as the zero desc's */
+    lm_cli_updater_desc(a, &d);
+    d.frame_width = d.frame_height = 0;
+    d.progress = NULL;
+    d.progress_user = NULL;
+    int ok = rows && lm_edit_script_play(&s, a->files[0], &d, s.budget_ms, rows);
     if (ok)
         report(a, &s, rows);
     free(rows);

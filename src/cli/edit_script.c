@@ -195,10 +195,14 @@ typedef struct {
     lmgi_context *ctx;
     lmgi_scene *sc, *twin;
     lmgi_updater *u, *ref;
-    float *iim, *converged;
+    float *iim, *converged, *before; /* before: the converged lightmap before the last edit */
     size_t texels;
     int *surface_of, surfaces;
     double *sums;
+    uint8_t *reach;        /* per surface: 1 in the last edit's reach (all of them before the first edit), 0
+                            * not, 2 nothing to judge by (mark_reach): its rewrites are not counted */
+    uint32_t *version;     /* per surface: lmgi_surface_version after the last update */
+    uint32_t *surface_texels;
 } bench;
 
 static int setup(const char *scene_path, const lm_edit_script *s, const lmgi_updater_desc *d, bench *b)
@@ -224,15 +228,23 @@ static int setup(const char *scene_path, const lm_edit_script *s, const lmgi_upd
     b->converged = malloc(4 * b->texels * sizeof *b->converged);
     b->surfaces = lmgi_surface_count(b->sc);
     b->surface_of = malloc(b->texels * sizeof *b->surface_of);
-    b->sums = malloc(3 * (size_t)(b->surfaces ? b->surfaces : 1) * sizeof *b->sums);
-    if (!b->iim || !b->converged || !b->surface_of || !b->sums)
+    size_t ns = (size_t)(b->surfaces ? b->surfaces : 1);
+    b->sums = malloc(3 * ns * sizeof *b->sums);
+    b->before = malloc(4 * b->texels * sizeof *b->before);
+    b->reach = malloc(ns);
+    b->version = calloc(ns, sizeof *b->version);
+    b->surface_texels = calloc(ns, sizeof *b->surface_texels);
+    if (!b->iim || !b->converged || !b->surface_of || !b->sums || !b->before || !b->reach || !b->version ||
+        !b->surface_texels)
         return fprintf(stderr, "lmgi: no memory for the lightmaps\n"), 0;
+    memset(b->reach, 1, ns);
     for (size_t i = 0; i < b->texels; i++)
         b->surface_of[i] = -1;
     for (uint32_t t = 0; t < lmgi_texel_count(b->sc); t++) {
         lmgi_texel tx;
         lmgi_get_texel(b->sc, t, &tx);
         b->surface_of[(size_t)tx.y * in.atlas_width + tx.x] = tx.surface;
+        b->surface_texels[tx.surface]++;
     }
     return 1;
 }
@@ -241,8 +253,12 @@ static void teardown(bench *b)
 {
     free(b->iim);
     free(b->converged);
+    free(b->before);
     free(b->surface_of);
     free(b->sums);
+    free(b->reach);
+    free(b->version);
+    free(b->surface_texels);
     lmgi_updater_free(b->u);
     lmgi_updater_free(b->ref);
     lmgi_free(b->sc);
@@ -260,6 +276,43 @@ static int converge(bench *b)
         return 0;
     }
     return 1;
+}
+
+/* Which surfaces the last edit reached: those whose converged lightmap (b->converged, now the edited
+ * scene's) moved from b->before by more than LM_EDIT_REACH, and those an earlier edit reached that have
+ * not caught up with it (more than LM_EDIT_CAUGHT_UP from its converged lightmap at the update before:
+ * worst_surface's per-surface sums, still in b->sums), whose work goes on. */
+static void mark_reach(bench *b)
+{
+    for (int s = 0; s < b->surfaces; s++)
+        b->reach[s] = b->reach[s] == 1 && b->sums[3 * s] > LM_EDIT_CAUGHT_UP * b->sums[3 * s + 1];
+    double *moved = b->sums; /* 2 per surface from here */
+    memset(moved, 0, sizeof *moved * 2 * (size_t)b->surfaces);
+    for (size_t i = 0; i < b->texels; i++) {
+        int s = b->surface_of[i];
+        if (s < 0 || !(b->converged[4 * i + 3] > 0.5f || b->before[4 * i + 3] > 0.5f))
+            continue;
+        for (int c = 0; c < 4; c++) /* alpha too: a texel that turned valid or invalid is reached */
+            moved[2 * s] += fabs((double)b->converged[4 * i + c] - b->before[4 * i + c]),
+                moved[2 * s + 1] += fabs((double)b->before[4 * i + c]);
+    }
+    for (int s = 0; s < b->surfaces; s++) /* 2: no valid texel, or dark before and after: nothing to judge */
+        b->reach[s] = moved[2 * s + 1] == 0.0 && moved[2 * s] == 0.0 ? 2
+                      : b->reach[s] || moved[2 * s] > LM_EDIT_REACH * moved[2 * s + 1];
+}
+
+/* The surfaces in and outside the last edit's reach whose displayed lightmap this update rewrote. */
+static void count_rewritten(bench *b, lm_edit_frame *row)
+{
+    for (int s = 0; s < b->surfaces; s++) {
+        uint32_t v = lmgi_surface_version(b->u, s);
+        row->reach += b->reach[s] == 1;
+        if (v != b->version[s] && b->reach[s] == 1)
+            row->reached++;
+        else if (v != b->version[s] && b->reach[s] == 0)
+            row->outside++, row->outside_texels += b->surface_texels[s];
+        b->version[s] = v;
+    }
 }
 
 static int play(const lm_edit_script *s, float budget_ms, bench *b, lm_edit_frame *rows)
@@ -281,7 +334,7 @@ static int play(const lm_edit_script *s, float budget_ms, bench *b, lm_edit_fram
             return 0;
         }
         rows[f] = (lm_edit_frame){st.ms_total, st.ms_photons, st.ms_gather, st.ms_blend, st.texels_gathered,
-                              st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0};
+                              st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0, 0, 0, 0, 0};
         double spent = 1e3 * lm_cli_now() - start;
         if (s->fps > 0 && spent < 1e3 / s->fps) { /* the game's own frame, with the photon work beside it */
             double left = 1e3 / s->fps - spent;
@@ -290,8 +343,13 @@ static int play(const lm_edit_script *s, float budget_ms, bench *b, lm_edit_fram
         }
         /* measured outside the update's time: the converged state after this frame's edits, and the
          * distance of the updater's lightmap from it */
-        if (edited && !converge(b))
-            return 0;
+        if (edited) {
+            memcpy(b->before, b->converged, 4 * b->texels * sizeof *b->before);
+            if (!converge(b))
+                return 0;
+            mark_reach(b);
+        }
+        count_rewritten(b, &rows[f]);
         if (lmgi_get_lightmap(b->u, LMGI_LIGHTMAP_IIM, b->iim, 4 * b->texels, &e) != LMGI_OK)
             return fprintf(stderr, "lmgi: %s\n", e.message), 0;
         rows[f].error = distance(b->iim, b->converged, b->texels);

@@ -34,7 +34,19 @@ typedef struct {
     int aim, changed;
     double error;          /* relative L1 distance of the IIM from the converged one, over valid texels */
     double worst_surface;  /* the same per surface of 16 or more valid texels, the largest */
+    int outside;           /* surfaces outside the last edit's reach (their converged lightmap did not move:
+                            * LM_EDIT_REACH) whose displayed lightmap this update rewrote */
+    uint32_t outside_texels; /* their texels */
+    int reached;           /* the surfaces in its reach this update rewrote */
+    int reach;             /* the surfaces in its reach, of those with something to judge by */
 } lm_edit_frame;
+
+/* A surface is in an edit's reach when its converged lightmap moved by more than this (relative L1 over
+ * its valid texels) with the edit (a bake leaves the others' texels as they were, to the bit), or when an
+ * earlier edit reached it and its lightmap is still further than LM_EDIT_CAUGHT_UP from that edit's
+ * converged one: the work under way is the earlier edit's. */
+#define LM_EDIT_REACH 1e-4
+#define LM_EDIT_CAUGHT_UP 0.02
 
 /* Reads and checks the script (1 MiB at most). 0, after printing what is wrong (file, edit, key), when
  * it cannot be read, is not valid JSON or is out of range. */
