@@ -406,6 +406,9 @@ typedef struct {
     int photons_per_estimate;  /* N nearest photons per AIM estimate (0: 32, docs/aim.md) */
     int surfaces_per_frame;    /* AIM refreshes per update (0: 4; -1: all that changed) */
     lmgi_aim_direct aim_direct; /* (0: LMGI_AIM_DIRECT_PHOTONS) */
+    int error_estimate;        /* 1: the AIMs keep their estimates' error, for LMGI_LIGHTMAP_ACCURACY (0: off,
+                                * the default: it walks each estimate's photons twice; docs/gather.md, "Error
+                                * estimate") */
     /* the gather (docs/gather.md) */
     int hemicube_resolution;   /* R, plane pixels per side (0: 32) */
     float enlargement;         /* a, the plane's half-side at distance 1 (0: 2) */
@@ -571,8 +574,13 @@ LMGI_API lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int wi
  *                           its last refresh, that change relative to their energy (an upper bound;
  *                           docs/api.md, "The error atlas"). 0 everywhere once the lightmap has caught
  *                           up: an editor shows what is not yet final, a game can wait for it. a as above.
+ *   LMGI_LIGHTMAP_ACCURACY  the lightmaps' estimate of their own accuracy (needs desc.error_estimate): r the
+ *                           IIM texel's relative standard error from the photon noise of the AIMs its
+ *                           hemicube sees, g the AIM texel's own, b the share of its hemicube on back faces
+ *                           (light it cannot know); a as above. Noise, not bias: docs/gather.md, "Error
+ *                           estimate", says what it ranks and what it misses. Costs 64 rays a texel a call.
  * A diffuse surface's indirect radiance is albedo / pi * E (docs/materials.md). */
-typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM, LMGI_LIGHTMAP_ERROR } lmgi_lightmap;
+typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM, LMGI_LIGHTMAP_ERROR, LMGI_LIGHTMAP_ACCURACY } lmgi_lightmap;
 /* The caustics of the last picture the updater drew, an update's own frame or lmgi_render's
  * (docs/caustics.md): the irradiance E the screen-space caustic pass filtered at each pixel, width x height
  * x 3 linear floats, top row first (the picture added kd / pi x E there); 0 where no caustic photon's

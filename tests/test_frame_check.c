@@ -315,9 +315,10 @@ static void test_iim_run_density(void **state)
     check_iim(path, 0, REF_ERROR, 100);
 }
 
-/* At 66,816 texels, with the photon count `lmgi run` takes (11,520): walls, floor and ceiling within 2%,
- * relative RMSE 0.053; the boxes' faces (529 to 1,035 texels) read -6% to +10%, the AIM's photon noise
- * where they meet the floor (within 2% with 200k photons), so they are reported, not asserted. The
+/* At 66,816 texels, with the photon count `lmgi run` took before the scene's floor (11,520): walls, floor
+ * and ceiling within 2%, relative RMSE 0.053; the boxes' faces (529 to 1,035 texels) read -6% to +10%,
+ * the AIM's photon noise where they meet the floor (within 2% with 200k photons), so they are reported,
+ * not asserted. With the floor (46,080) and N = 32: relative RMSE 0.051. The
  * reference's 0.05 is enough for means over thousands of texels (this scene has no rare bright paths:
  * its light is an area light). */
 static void test_iim_bake_density(void **state)

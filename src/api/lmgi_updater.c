@@ -86,6 +86,9 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: aim_direct %d is not LMGI_AIM_DIRECT_PHOTONS, "
                        "_EMITTERS or _ALL", (int)d->aim_direct);
     s->stage.exact_direct = d->aim_direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : d->aim_direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
+    if (d->error_estimate != 0 && d->error_estimate != 1)
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: error_estimate %d must be 0 or 1", d->error_estimate);
+    s->stage.aim.error_estimate = d->error_estimate;
     if (d->surfaces_per_frame == -1)
         s->stage.surfaces_per_frame = -1;
     else
@@ -586,6 +589,27 @@ static lm_status read_error(const lmgi_updater *u, float *rgba, lm_error *err)
     return st;
 }
 
+/* The accuracy estimate (lm_frame_loop_accuracy), gutters dilated, with the IIM's validity as alpha. */
+static lm_status read_accuracy(const lmgi_updater *u, float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *raw = NULL, *est = malloc(4 * n * sizeof *est);
+    if (!est)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the accuracy estimate");
+    lm_status st = read_raw_iim(u, &raw, rgba, err); /* the validity, and the IIM the estimate is relative to */
+    if (st == LM_OK)
+        st = lm_frame_loop_accuracy(u->loop, raw, est, err);
+    if (st == LM_OK) {
+        lm_atlas_dilate_gutters(at, est, 4);
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgba + 4 * i, est + 4 * i, 3 * sizeof *rgba);
+    }
+    free(raw);
+    free(est);
+    return st;
+}
+
 lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
 {
     if (!u || !rgba)
@@ -595,13 +619,17 @@ lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, 
     if (floats < need)
         return lm_api_refuse(err, "lmgi_get_lightmap: the buffer holds %zu floats; the %d x %d atlas needs %zu", floats,
                        at->width, at->height, need);
-    if (kind != LMGI_LIGHTMAP_IIM && kind != LMGI_LIGHTMAP_AIM && kind != LMGI_LIGHTMAP_ERROR)
+    if (kind < LMGI_LIGHTMAP_IIM || kind > LMGI_LIGHTMAP_ACCURACY)
         return lm_api_refuse(err, "lmgi_get_lightmap: %d is not a lightmap kind", (int)kind);
+    if (kind == LMGI_LIGHTMAP_ACCURACY && !lm_photon_stage_aim(lm_frame_loop_stage(u->loop))->error)
+        return lm_api_refuse(err, "lmgi_get_lightmap: the accuracy estimate needs the updater made with "
+                             "desc.error_estimate 1");
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
-    lm_status st = kind == LMGI_LIGHTMAP_IIM ? read_iim(u, rgba, &e)
+    lm_status st = kind == LMGI_LIGHTMAP_IIM   ? read_iim(u, rgba, &e)
                    : kind == LMGI_LIGHTMAP_AIM ? read_aim(u, rgba, &e)
-                                               : read_error(u, rgba, &e);
+                   : kind == LMGI_LIGHTMAP_ERROR ? read_error(u, rgba, &e)
+                                               : read_accuracy(u, rgba, &e);
     lm_api_leave(saved);
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }

@@ -63,6 +63,7 @@ typedef struct {
     int aim_direct;         /* --aim-direct emitters|photons|all: lmgi_updater_desc.aim_direct (default photons) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
+    int accuracy;           /* --accuracy (bake): also the lightmaps' estimate of their own error */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
     int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */

@@ -3,6 +3,7 @@
 
 #include <lmgi.h>
 #include <ctype.h>
+#include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -50,6 +51,82 @@ static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half
     return rc;
 }
 
+static int by_value(const void *a, const void *b)
+{
+    float x = *(const float *)a, y = *(const float *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The picture of the lightmap's estimated error: 0 dark blue, ACCURACY_SCALE / 2 red, ACCURACY_SCALE and
+ * over yellow; black where the texel is invalid or unlit. */
+#define ACCURACY_SCALE 0.1f
+static void heat(float v, float rgb[3])
+{
+    static const float stops[3][3] = {{0.0f, 0.0f, 0.3f}, {0.9f, 0.1f, 0.1f}, {1.0f, 1.0f, 0.2f}};
+    float x = fminf(fmaxf(v / ACCURACY_SCALE, 0.0f), 1.0f) * 2.0f;
+    int k = x < 1.0f ? 0 : 1;
+    float f = x - (float)k;
+    for (int c = 0; c < 3; c++)
+        rgb[c] = (1.0f - f) * stops[k][c] + f * stops[k + 1][c];
+}
+
+/* --accuracy: DIR/accuracy.exr (LMGI_LIGHTMAP_ACCURACY), accuracy.png (its lightmap channel as a heat map)
+ * and the estimate's median and 95th percentile over the valid texels that receive indirect light,
+ * printed. */
+static int write_accuracy(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half, int quiet)
+{
+    const lmgi_image_desc exr = {.half = half};
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(4 * n * sizeof *rgba), *lit = malloc(4 * n * sizeof *lit);
+    float *iim = malloc(n * sizeof *iim), *aim = malloc(n * sizeof *aim);
+    lmgi_error e;
+    int rc = 0;
+    double started = lm_cli_now();
+    if (!rgba || !lit || !iim || !aim)
+        rc = 1, fprintf(stderr, "lmgi: error: no memory for the %d x %d accuracy map\n", in.atlas_width,
+                        in.atlas_height);
+    else if (lmgi_get_lightmap(u, LMGI_LIGHTMAP_ACCURACY, rgba, 4 * n, &e) != LMGI_OK)
+        rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
+    double seconds = lm_cli_now() - started;
+    if (rc == 0 && (lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, lit, 4 * n, &e) != LMGI_OK ||
+                    lm_cli_write_image(dir, "accuracy.exr", in.atlas_width, in.atlas_height, 4, rgba, &exr, &e)))
+        rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
+    size_t m = 0;
+    for (uint32_t t = 0; rc == 0 && t < in.texels; t++) {
+        lmgi_texel tx;
+        lmgi_get_texel(sc, t, &tx);
+        size_t at = 4 * ((size_t)tx.y * in.atlas_width + tx.x);
+        if (rgba[at + 3] > 0.5f && lit[at] + lit[at + 1] + lit[at + 2] > 0.0f)
+            iim[m] = rgba[at], aim[m++] = rgba[at + 1];
+    }
+    if (rc == 0) { /* the picture, in the IIM read's buffer: black but where a lit texel is */
+        for (size_t i = 0; i < n; i++) {
+            int shown = rgba[4 * i + 3] > 0.5f && lit[4 * i] + lit[4 * i + 1] + lit[4 * i + 2] > 0.0f;
+            if (shown)
+                heat(rgba[4 * i], lit + 3 * i);
+            else
+                lit[3 * i] = lit[3 * i + 1] = lit[3 * i + 2] = 0.0f;
+        }
+        const lmgi_image_desc png = {LMGI_TONEMAP_CLAMP, 1.0f, 0};
+        if (lm_cli_write_image(dir, "accuracy.png", in.atlas_width, in.atlas_height, 3, lit, &png, &e))
+            rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
+    }
+    if (rc == 0 && m && !quiet) {
+        qsort(iim, m, sizeof *iim, by_value);
+        qsort(aim, m, sizeof *aim, by_value);
+        printf("accuracy    estimated relative standard error over %zu lit texels: lightmap median %.3f, 95th "
+               "percentile %.3f; AIM median %.3f (photon noise only: docs/gather.md, \"Error estimate\"; %.1f s)\n",
+               m, (double)iim[m / 2], (double)iim[m * 95 / 100], (double)aim[m / 2], seconds);
+    }
+    free(rgba);
+    free(lit);
+    free(iim);
+    free(aim);
+    return rc;
+}
+
 /* DIR/NAME.gltf and its lightmap, NAME the scene file's name without its extension (other characters
  * than a-z A-Z 0-9 - _ made '_'). */
 static int write_gltf(const lm_cli_args *a, lmgi_updater *u, char *name, size_t size)
@@ -76,7 +153,7 @@ int lm_cli_bake(const lm_cli_args *a)
         fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
         return 2;
     }
-    static const char *const own[] = {"lightmap.exr", "lightmap.png", "aim.exr", NULL};
+    static const char *const own[] = {"lightmap.exr", "lightmap.png", "aim.exr", "accuracy.exr", "accuracy.png", NULL};
     if (!lm_cli_claim_out_dir(a, own))
         return 1;
     lmgi_scene *sc = NULL;
@@ -86,6 +163,7 @@ int lm_cli_bake(const lm_cli_args *a)
     lmgi_updater_desc d;
     lm_cli_updater_desc(a, &d);
     d.frame_width = d.frame_height = 0;
+    d.error_estimate = a->accuracy;
     double started = lm_cli_now();
     d.progress = a->quiet ? NULL : show;
     d.progress_user = &started;
@@ -105,6 +183,8 @@ int lm_cli_bake(const lm_cli_args *a)
     signal(SIGINT, SIG_DFL);
     if (rc == 0)
         rc = write_maps(sc, u, a->out_dir, a->half);
+    if (rc == 0 && a->accuracy)
+        rc = write_accuracy(sc, u, a->out_dir, a->half, a->quiet);
     char name[256] = "";
     if (rc == 0 && a->gltf)
         rc = write_gltf(a, u, name, sizeof name);

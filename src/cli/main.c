@@ -43,7 +43,8 @@ static void usage(FILE *f)
             "                         update time budget and every scene's default frame against the\n"
             "                         reference (photon tracing and the gather: lmgi-dev bench, make bench)\n"
             "  bench --edits SCRIPT.json SCENE  a scripted edit sequence through the updater: per-update times,\n"
-            "                         budget overruns and each edit's update lag (docs/bench.md; --json FILE)\n"
+            "                         budget overruns, each edit's update lag and the surfaces it rewrote in\n"
+            "                         its reach and outside it (docs/bench.md; --json FILE)\n"
             "  bench --soak N [SCENE]  N updates of the looped animation (default scenes/cornell.glb, 32 x 32):\n"
             "                         resident memory, update times and non-finite frame values per block\n"
             "  tradeoff SCENE... --out DIR  what accuracy costs in time: every knob that trades one for the\n"
@@ -124,6 +125,8 @@ static void usage(FILE *f)
             "  --json FILE      'bench': also write the results as JSON\n"
             "  --half           'bake': EXR lightmaps in 16-bit half floats\n"
             "  --gltf           'bake': also a glTF copy of the scene with the lightmap (docs/api.md)\n"
+            "  --accuracy       'bake': also DIR/accuracy.exr, the lightmaps' estimate of their own error (r: the\n"
+            "                   lightmap's relative standard error, g: the AIM's, b: back-face share)\n"
             "  --force          write into a non-empty --out DIR that lmgi did not make (lmgi marks its\n"
             "                   own with DIR/.lmgi and replaces only its own kind of file there)\n"
             "  -v, -q           more / less on stderr\n");

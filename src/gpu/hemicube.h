@@ -121,6 +121,11 @@ void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt);
  * lies inside a closed mesh) (docs/gather.md, "Covered texels"). */
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
                      uint32_t texel);
+/* Where texel `texel` gathers from: its centre lifted along the shading normal by set->offset x the scene
+ * size (eye), the unit shading normal n the plane faces, and the geometric normal ng turned to n's side
+ * (directions below its plane are blocked by the texel's own surface), under the current node matrices. */
+void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, uint32_t texel,
+                           float eye[3], float n[3], float ng[3]);
 /* The proxy the gather draws; NULL when proxy_error is 0 or before lm_gather_set_scene. */
 const lm_proxy *lm_gather_proxy(const lm_gather *g);
 /* Uploads the AIM (atlas-sized RGB radiance, width*height*3 floats), dilated into the gutters. */

@@ -426,6 +426,15 @@ static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, co
     return v;
 }
 
+void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, uint32_t texel,
+                           float eye[3], float n[3], float ng[3])
+{
+    texel_view v = view_of(set, s, &a->texels[texel]);
+    lm_v3_store(eye, v.eye);
+    lm_v3_store(n, v.axes[2]);
+    lm_v3_store(ng, v.ng);
+}
+
 /* Whether the texel at eye, normal n is covered (lm_texel_covered): straight out from it, other geometry
  * within a texel's width, or the inside of a solid (the back of a triangle by its winding: the texel is
  * inside a closed mesh, such as the floor under a box that stands on it). */

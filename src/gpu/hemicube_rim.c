@@ -8,8 +8,7 @@
 #include "../core/vecmath.h"
 
 
-/* Bilinear RGBA lookup at uv in [0, 1]^2 (texel (x, y) spans [x, x + 1] / width), clamped to the edge. */
-static void sample_atlas(const lm_atlas *a, const float *rgba, float u, float v, float out[3])
+void lm_atlas_sample_rgb(const lm_atlas *a, const float *rgba, float u, float v, float out[3])
 {
     float x = u * (float)a->width - 0.5f, y = v * (float)a->height - 0.5f;
     x = fminf(fmaxf(x, 0.0f), (float)(a->width - 1));
@@ -107,7 +106,7 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
                     su = fminf(fmaxf(u + lm_dot(lm_v3_load(gu), off), lo[0]), hi[0]);
                     sv = fminf(fmaxf(v + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
                 }
-                sample_atlas(r->atlas, r->aim, su, sv, L);
+                lm_atlas_sample_rgb(r->atlas, r->aim, su, sv, L);
                 for (int k = 0; k < 3; k++)
                     sum[k] += ws * L[k];
             }

@@ -48,6 +48,10 @@ void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], co
                        const float ng[3],
                        uint32_t seed, float out[3]);
 
+/* Bilinear lookup of an atlas-sized RGBA map's rgb at lightmap uv in [0, 1]^2 (texel (x, y) spans
+ * [x, x + 1] / width), clamped to the atlas's edge. */
+void lm_atlas_sample_rgb(const lm_atlas *a, const float *rgba, float u, float v, float out[3]);
+
 /* The lightmap uv's gradient over a triangle's plane (world corners p, uv per corner; NULL: none, zero
  * gradient): rows gu, gv with uv(x) = uv0 + (gu.(x - p0), gv.(x - p0)). */
 void lm_uv_gradient(const float p[3][3], const float *uv[3], float gu[3], float gv[3]);

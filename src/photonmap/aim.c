@@ -21,6 +21,7 @@ void lm_aim_settings_default(lm_aim_settings *o)
     o->front_only = 1;
     o->boundary_correction = 1;
     o->kernel = 1;
+    o->error_estimate = 0;
 }
 
 /* ---------- init: per-surface texel lists and boundary edges ---------- */
@@ -223,7 +224,10 @@ lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, con
     aim->edge_d2 = malloc(((size_t)a->texel_count + 1) * sizeof *aim->edge_d2);
     for (uint32_t i = 0; aim->edge_d2 && i < a->texel_count; i++)
         aim->edge_d2[i] = -1.0f; /* unknown until the texel's first estimate walks the edges */
-    if (!aim->rgb || !aim->dilated || !aim->refresh_count || !aim->edge_d2)
+    if (aim->set.error_estimate)
+        aim->error = calloc((size_t)a->width * (size_t)a->height * 2, sizeof *aim->error);
+    if (!aim->rgb || !aim->dilated || !aim->refresh_count || !aim->edge_d2 ||
+        (aim->set.error_estimate && !aim->error))
         st = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for a %dx%d map", a->width, a->height);
     if (st == LM_OK)
         st = build_texel_lists(aim, a, err);
@@ -238,6 +242,7 @@ void lm_aim_free(lm_aim *aim)
 {
     free(aim->rgb);
     free(aim->dilated);
+    free(aim->error);
     free(aim->texel_first);
     free(aim->texel_list);
     free(aim->edge_first);
@@ -594,10 +599,33 @@ struct texel_scratch {
     lm_kdtree_hint hint;
 };
 
+/* For the error estimate (lm_aim.error): sum((w_i Y_i)^2), Y_i = y . Phi_i. */
+typedef struct {
+    const double *flux;
+    double inv_r2, y[3], sum;
+} square_sum;
+
+static void add_square(void *ctx, uint32_t index, float d2)
+{
+    square_sum *q = ctx;
+    double w = fmax(1.0 - d2 * q->inv_r2, 0.0);
+    const double *phi = q->flux + 4 * (size_t)index;
+    double v = w * (q->y[0] * phi[0] + q->y[1] * phi[1] + q->y[2] * phi[2]);
+    q->sum += v * v;
+}
+
+/* What the error estimate keeps of one texel's photon estimate: the variance of y . E, as a sum of
+ * independently placed hits, and the radius^2 in world units. */
+typedef struct {
+    int on;
+    double y[3];   /* luminance weights times rho / pi: the variance is the radiance's */
+    double var, r2_world;
+} estimate_error;
+
 /* E = sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
  * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. 0 without hits. */
 static void photon_irradiance(const estimate_job *j, const lm_texel *t, texel_scratch *ts, float *edge_d2,
-                              double out[3])
+                              double out[3], estimate_error *ee)
 {
     out[0] = out[1] = out[2] = 0.0;
     if (j->n == 0)
@@ -625,6 +653,16 @@ static void photon_irradiance(const estimate_job *j, const lm_texel *t, texel_sc
     }
     for (int c = 0; c < 3; c++)
         out[c] = f.sum[c] / (area * factor);
+    if (ee->on) { /* only when asked: a second walk over the same hits */
+        square_sum q = {j->hits->flux, f.inv_r2, {ee->y[0], ee->y[1], ee->y[2]}, 0.0};
+        if (widened)
+            lm_kdtree_radius(j->tree, t->local, r2, add_square, &q);
+        else
+            for (uint32_t i = 0; i < k; i++)
+                add_square(&q, idx[i], d2[i]);
+        ee->var = q.sum / (area * factor * area * factor);
+        ee->r2_world = (double)r2 * factor;
+    }
 }
 
 
@@ -657,25 +695,37 @@ static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index,
         e[c] += sum[c] / seen;
 }
 
-/* L = rho / pi (E_photons + E_direct). */
+/* L = rho / pi (E_photons + E_direct); with error (NULL: not kept) the texel's relative standard error and
+ * radius (lm_aim.error). */
 static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts,
-                           float *edge_d2, float out[3])
+                           float *edge_d2, float out[3], float *error)
 {
-    double e[3];
-    photon_irradiance(j, t, ts, edge_d2, e);
-    if (j->direct)
-        add_direct(j, t, index, ts, e);
     float rho[3];
     lm_texel_kd(j->s, t, rho);
+    static const double lum[3] = {0.2126, 0.7152, 0.0722};
+    estimate_error ee = {error != NULL, {lum[0] * rho[0] / LM_PI, lum[1] * rho[1] / LM_PI, lum[2] * rho[2] / LM_PI},
+                         0.0, 0.0};
+    double e[3];
+    photon_irradiance(j, t, ts, edge_d2, e, &ee);
+    if (j->direct)
+        add_direct(j, t, index, ts, e);
     for (int c = 0; c < 3; c++)
         out[c] = (float)(rho[c] / LM_PI * e[c]);
+    if (error) {
+        double y = ee.y[0] * e[0] + ee.y[1] * e[1] + ee.y[2] * e[2];
+        error[0] = y > 0.0 ? (float)(sqrt(ee.var) / y) : 0.0f;
+        error[1] = y > 0.0 ? (float)sqrt(ee.r2_world) : 0.0f;
+    }
 }
 
 static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_t end)
 {
     for (uint32_t i = first; i < end; i++) {
         const lm_texel *t = &a->texels[aim->texel_list[i]];
-        memset(aim->rgb + 3 * ((size_t)t->y * (size_t)aim->width + (size_t)t->x), 0, 3 * sizeof(float));
+        size_t at = (size_t)t->y * (size_t)aim->width + (size_t)t->x;
+        memset(aim->rgb + 3 * at, 0, 3 * sizeof(float));
+        if (aim->error)
+            memset(aim->error + 2 * at, 0, 2 * sizeof(float));
     }
 }
 
@@ -802,11 +852,12 @@ static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32
 #pragma omp for schedule(dynamic, TEXEL_CHUNK) nowait
             for (int64_t i = first; i < end; i++) {
                 const lm_texel *t = &e->a->texels[aim->texel_list[i]];
-                float *px = aim->rgb + 3 * ((size_t)t->y * (size_t)aim->width + (size_t)t->x);
+                size_t at = (size_t)t->y * (size_t)aim->width + (size_t)t->x;
                 if ((i - first) % TEXEL_CHUNK == 0)
                     ts.hint.valid = 0;
                 if (ok)
-                    estimate_texel(e, t, aim->texel_list[i], &ts, &aim->edge_d2[i], px);
+                    estimate_texel(e, t, aim->texel_list[i], &ts, &aim->edge_d2[i], aim->rgb + 3 * at,
+                                   aim->error ? aim->error + 2 * at : NULL);
             }
         }
         scratch_free(&ts);

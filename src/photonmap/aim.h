@@ -47,6 +47,7 @@ typedef struct {
     int kernel;              /* 0: box, the paper's sum(Phi) / (pi r^2); 1: Epanechnikov weights
                                 w = 1 - d^2 / r^2, sum(w Phi) / (pi r^2 / 2): same mean, far less noise
                                 (default 1) */
+    int error_estimate;      /* keep each texel's estimate error (lm_aim.error; default 0: off, no cost) */
 } lm_aim_settings;
 
 typedef struct {
@@ -71,6 +72,12 @@ typedef struct {
     uint32_t *refresh_count; /* per surface: how many times it was refreshed */
     float *edge_d2;          /* per texel_list entry: squared distance to its surface's boundary in its
                                 tangent plane (-1 until first computed); a smaller disc skips the edges */
+    float *error;            /* with set.error_estimate, per atlas texel (width * height * 2): the relative
+                                standard error of the texel's radiance (luminance) as a sum of independently
+                                placed hits, sqrt(sum (w_i Y_i)^2) / sum(w_i Y_i) with Y_i the luminance of
+                                rho / pi Phi_i, over the whole value (direct light computed, not estimated,
+                                has none); and the estimate's radius in world units, over which neighbouring
+                                texels share hits. 0 and 0 where the AIM is 0. NULL when off */
     float mean_hit_energy;   /* as of the last refresh call */
     const lm_direct_light *direct; /* NULL (default): photons carry all light, the paper's form; else
                                       lm_aim_set_direct */

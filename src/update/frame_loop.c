@@ -10,6 +10,7 @@
 #include "../core/timing.h"
 #include "../core/vecmath.h"
 #include "../gpu/composite.h"
+#include "../gpu/gather_error.h"
 #include "../photonmap/pixel_gather.h"
 #include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
@@ -988,6 +989,25 @@ lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *
     }
     free(fresh);
     free(pending);
+    return st;
+}
+
+lm_status lm_frame_loop_accuracy(lm_frame_loop *fl, const float *shown, float *out, lm_error *err)
+{
+    const lm_atlas *a = fl->atlas;
+    lm_status st = lm_frame_loop_sync(fl, err); /* the AIM and its error are the photon work's */
+    const lm_aim *aim = lm_photon_stage_aim(fl->stage);
+    if (st == LM_OK && !aim->error)
+        st = lm_fail(err, LM_ERR_INVALID, "the error estimate needs the AIMs' own (stage.aim.error_estimate)");
+    float *source = st == LM_OK ? malloc(4 * (size_t)a->width * a->height * sizeof *source) : NULL;
+    if (st == LM_OK && !source)
+        st = lm_fail(err, LM_ERR_NOMEM, "no memory for the error estimate");
+    if (st == LM_OK) {
+        lm_gather_error_source(a, aim->rgb, aim->error, source);
+        lm_gather_error(&fl->set.gather, fl->scene, a, fl->rt, source, aim->error, aim->set.kernel, shown,
+                        LM_GATHER_ERROR_RAYS, out);
+    }
+    free(source);
     return st;
 }
 

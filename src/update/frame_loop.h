@@ -170,6 +170,11 @@ lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error
  * 0 everywhere once every refresh is complete and blended and no photon changed since. `shown` is the
  * displayed IIM as lm_frame_loop_read_iim gives it. Joins photon work under way first. */
 lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *error, lm_error *err);
+/* The lightmaps' estimate of their own accuracy (gpu/gather_error.h), atlas-sized RGBA: the IIM's relative
+ * standard error from the AIMs' photon noise, the AIM texel's own, the hemicube's back-face fraction, 0;
+ * with LM_GATHER_ERROR_RAYS rays a texel. `shown` as for lm_frame_loop_iim_error. Needs the AIMs' error
+ * (stage.aim.error_estimate), else LM_ERR_INVALID. Joins photon work under way first. */
+lm_status lm_frame_loop_accuracy(lm_frame_loop *fl, const float *shown, float *out, lm_error *err);
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl);
 /* The view the frames are drawn from. */
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl);
