@@ -722,6 +722,13 @@ typedef struct {
 LMGI_API lmgi_status lmgi_check(lmgi_context *ctx, lmgi_scene *scene, const lmgi_updater_desc *desc,
                                 const lmgi_reference_desc *ref, int frames, lmgi_check_result *out,
                                 lmgi_error *err);
+/* The same for an updater as it is now, between its updates: its picture from cam at width x height, drawn
+ * as lmgi_render draws it, against lmgi_reference_pixels of the scene as it is now (its edits included:
+ * the reference cache keys on nodes, lights and materials). What an editor's user sees while the
+ * lightmaps catch up with an edit (docs/tradeoff.md, "The frame's lag"). NULL u, cam or out, sides outside
+ * 1..16384: LMGI_ERR_INVALID; else the render's and reference's errors. out is zeroed on failure. */
+LMGI_API lmgi_status lmgi_check_updater(lmgi_updater *u, const lmgi_camera *cam, int width, int height,
+                                        const lmgi_reference_desc *ref, lmgi_check_result *out, lmgi_error *err);
 LMGI_API void lmgi_check_free(lmgi_check_result *c); /* NULL: nothing; the struct is zeroed */
 
 /* ------------------------------------------------------------------------------------------------------

@@ -172,6 +172,29 @@ static void test_reference_pixels_and_check(void **state)
     assert_true(floor_row >= 0);
     assert_int_equal(c.surfaces[floor_row].node, lmgi_find_node(sc, "floor"));
     assert_int_equal(c.surfaces[floor_row].pixels, c.pixels); /* the only surface, not emissive */
+
+    /* an updater of the same desc, one update in: lmgi_check_updater draws its lighting from the same
+     * camera and compares it with the same reference (from the cache) */
+    ud.frame_width = ud.frame_height = 0;
+    lmgi_updater *u = NULL;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &ud, &u, &e), LMGI_OK);
+    assert_int_equal(lmgi_update(u, 0.0f, 0.0f, NULL, &e), LMGI_OK);
+    lmgi_check_result cu;
+    assert_int_equal(lmgi_check_updater(u, &cam, SIDE, SIDE, &d, &cu, &e), LMGI_OK);
+    print_message("the updater's check: frame / reference %.4f %.4f %.4f over %u pixels (lmgi_check's %.4f)\n",
+                  cu.ratio[0], cu.ratio[1], cu.ratio[2], cu.pixels, c.ratio[0]);
+    assert_int_equal(cu.pixels, c.pixels);
+    double sum_updater = 0.0; /* the same view, to float rounding: the same picture */
+    for (int i = 0; i < SIDE * SIDE; i++)
+        sum_updater += cu.reference[3 * i] > 0.0f ? cu.reference[3 * i] : 0.0;
+    assert_float_equal(sum_updater / sum_check, 1.0, 0.01);
+    for (int k = 0; k < 3; k++)
+        assert_float_equal(cu.ratio[k], c.ratio[k], 1e-3);
+    lmgi_check_free(&cu);
+    expect_invalid(lmgi_check_updater(NULL, &cam, SIDE, SIDE, &d, &cu, &e), &e, "updater is NULL");
+    expect_invalid(lmgi_check_updater(u, NULL, SIDE, SIDE, &d, &cu, &e), &e, "cam is NULL");
+    expect_invalid(lmgi_check_updater(u, &cam, 0, SIDE, &d, &cu, &e), &e, "0 x");
+    lmgi_updater_free(u);
     lmgi_check_free(&c);
     assert_null(c.frame);
     lmgi_reference_free(&px);

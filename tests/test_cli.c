@@ -609,7 +609,7 @@ static void test_tradeoff_update_lag(void **state)
     assert_int_equal(run(args), 2);
     assert_non_null(strstr(output, "its \"scene\" is not on the command line"));
     snprintf(args, sizeof args, "tradeoff %s --quick --knobs hemicube_samples --repeats 1 --size 32x32 --texels 800 "
-             "--target-error 0.05 --cache %s/cache --edits %s --out %s/lag -q", scene, dir, path, dir);
+             "--target-error 0.05 --cache %s/cache --edits %s --out %s/lag --frame-lag -q", scene, dir, path, dir);
     assert_int_equal(run(args), 0);
     snprintf(path, sizeof path, "%s/lag/lag.csv", dir);
     f = fopen(path, "r");
@@ -617,14 +617,27 @@ static void test_tradeoff_update_lag(void **state)
     char header[1024], line[1024], v[64];
     assert_non_null(fgets(header, sizeof header, f));
     int knob = csv_column(header, "knob"), value = csv_column(header, "value"), error = csv_column(header, "error");
-    int to5 = csv_column(header, "frames_to_5");
-    assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0);
+    int to5 = csv_column(header, "frames_to_5"), def = csv_column(header, "default");
+    int frame_error = csv_column(header, "frame_error"), frame_end = csv_column(header, "frame_end");
+    assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0 && def >= 0 && frame_error >= 0 && frame_end >= 0);
     int plays = 0, lag5 = -2, lag80 = -2;
     while (fgets(line, sizeof line, f)) {
         plays++;
         csv_field(line, error, v, sizeof v);
         double e = atof(v);
         assert_true(e > 0.02); /* the edit moved some surface's light (5.8% when written) */
+        /* --frame-lag: the default play's frame against the reference of the edited scene, per surface,
+         * at the edit and at the end (2.2% and 2.3% when written: the direct light is the frame's own) */
+        char fe[64], fend[64];
+        csv_field(line, def, v, sizeof v);
+        csv_field(line, frame_error, fe, sizeof fe);
+        csv_field(line, frame_end, fend, sizeof fend);
+        if (atoi(v)) {
+            print_message("frame against the reference: %s at the edit, %s at the end\n", fe, fend);
+            assert_true(atof(fe) > 0.0 && atof(fe) < 0.1 && atof(fend) > 0.0 && atof(fend) < 0.1);
+        } else {
+            assert_string_equal(fe, ""); /* only the default play is checked */
+        }
         char name[64];
         csv_field(line, knob, name, sizeof name);
         int is_texels = !strcmp(name, "texels_per_frame");

@@ -125,11 +125,11 @@ lm_status lm_frame_check_frame(lmgi_scene *sc, const lm_frame_loop_settings *loo
     return run_frames(sc, loop, frames, rgb, NULL, &view, err);
 }
 
-lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop, const lm_ref_settings *ref,
-                             int frames, lm_frame_check *out, lm_error *err)
+/* out's arrays for a width x height picture. */
+static lm_status alloc_check(const lmgi_scene *sc, int width, int height, lm_frame_check *out, lm_error *err)
 {
     memset(out, 0, sizeof *out);
-    out->width = loop->width, out->height = loop->height;
+    out->width = width, out->height = height;
     size_t n = (size_t)out->width * (size_t)out->height;
     out->surface_count = sc->surfaces.surface_count;
     out->frame = malloc(n * 3 * sizeof(float));
@@ -138,14 +138,37 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
     out->surface_at = malloc(n * sizeof(int32_t));
     out->compared = calloc(n, 1);
     out->surface = calloc((size_t)(out->surface_count ? out->surface_count : 1), sizeof *out->surface);
-    lm_status st = out->frame && out->ref && out->ref_indirect && out->surface_at && out->compared && out->surface
-                       ? LM_OK
-                       : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
+    return out->frame && out->ref && out->ref_indirect && out->surface_at && out->compared && out->surface
+               ? LM_OK
+               : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
+}
+
+lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop, const lm_ref_settings *ref,
+                             int frames, lm_frame_check *out, lm_error *err)
+{
+    lm_status st = alloc_check(sc, loop->width, loop->height, out, err);
     lm_view view;
     if (st == LM_OK)
         st = run_frames(sc, loop, frames, out->frame, out->surface_at, &view, err);
     if (st == LM_OK)
         st = reference_pixels(sc, &view, ref, out, err);
+    if (st == LM_OK)
+        st = compare(sc, out, err);
+    if (st != LM_OK)
+        lm_frame_check_free(out);
+    return st;
+}
+
+lm_status lm_frame_check_picture(const lmgi_scene *sc, const lm_view *view, const float *rgb, int width, int height,
+                                 const lm_ref_settings *ref, lm_frame_check *out, lm_error *err)
+{
+    lm_status st = alloc_check(sc, width, height, out, err);
+    if (st == LM_OK) {
+        memcpy(out->frame, rgb, (size_t)width * (size_t)height * 3 * sizeof(float));
+        st = lm_render_surface_index(sc->scene, &sc->surfaces, view, width, height, out->surface_at, err);
+    }
+    if (st == LM_OK)
+        st = reference_pixels(sc, view, ref, out, err);
     if (st == LM_OK)
         st = compare(sc, out, err);
     if (st != LM_OK)

@@ -51,6 +51,11 @@ double lm_check_ratio(const lm_check_sum *c, int channel);
 lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop, const lm_ref_settings *ref,
                              int frames, lm_frame_check *out, lm_error *err);
 void lm_frame_check_free(lm_frame_check *c);
+/* The same comparison for a picture already drawn: rgb (width x height x 3, top row first) from `view` of sc
+ * as its nodes, lights and materials are now, against the reference's pixels of that view (the cache keys
+ * on all of those). The surface index picture is drawn on the current GL context. */
+lm_status lm_frame_check_picture(const lmgi_scene *sc, const lm_view *view, const float *rgb, int width, int height,
+                                 const lm_ref_settings *ref, lm_frame_check *out, lm_error *err);
 /* The frame alone (what lm_frame_check_run compares): the loop's picture after `frames` frames into rgb
  * (loop->width x loop->height x 3 floats). */
 lm_status lm_frame_check_frame(lmgi_scene *sc, const lm_frame_loop_settings *loop, int frames, float *rgb,

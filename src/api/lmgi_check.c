@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "frame_check.h"
+#include "lmgi_camera.h"
 #include "lmgi_context.h"
 #include "lmgi_reference.h"
 #include "lmgi_scene.h"
@@ -85,6 +86,46 @@ lmgi_status lmgi_check(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_des
     if (st == LM_OK)
         st = export_check(&c, sc, rs.target_error, out, &e);
     lm_frame_check_free(&c);
+    lm_api_leave(saved);
+    if (st == LM_OK)
+        return LMGI_OK;
+    lmgi_check_free(out);
+    return lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_check_updater(lmgi_updater *u, const lmgi_camera *cam, int width, int height,
+                               const lmgi_reference_desc *ref, lmgi_check_result *out, lmgi_error *err)
+{
+    static const char fn[] = "lmgi_check_updater";
+    if (out)
+        memset(out, 0, sizeof *out);
+    if (!u || !cam || !out)
+        return lm_api_refuse(err, "%s: %s is NULL", fn, !u ? "updater" : !cam ? "cam" : "out");
+    if (width < 1 || height < 1 || width > 16384 || height > 16384)
+        return lm_api_refuse(err, "%s: picture %d x %d must have sides in 1..16384", fn, width, height);
+    const lmgi_scene *sc = lm_updater_scene(u);
+    lm_view v;
+    lm_ref_settings rs;
+    if (lm_api_view(sc, cam, fn, &v, err) != LMGI_OK || lm_api_ref_settings(ref, fn, &rs, err) != LMGI_OK)
+        return LMGI_ERR_INVALID;
+    float *rgb = malloc((size_t)width * (size_t)height * 3 * sizeof *rgb);
+    if (!rgb)
+        return lm_export_error(err, &(lm_error){LM_ERR_NOMEM, "lmgi_check_updater: no memory for the picture"});
+    lmgi_status rc = lmgi_render(u, cam, width, height, rgb, err);
+    if (rc != LMGI_OK)
+        return free(rgb), rc;
+    lmgi_context *ctx = lm_updater_context(u);
+    lm_log_target saved = lm_api_enter(ctx);
+    lm_error e;
+    lm_frame_check c;
+    memset(&c, 0, sizeof c);
+    lm_status st = lm_gl_make_current(ctx->gl, &e); /* the surface index picture is drawn on it */
+    if (st == LM_OK)
+        st = lm_frame_check_picture(sc, &v, rgb, width, height, &rs, &c, &e);
+    if (st == LM_OK)
+        st = export_check(&c, sc, rs.target_error, out, &e);
+    lm_frame_check_free(&c);
+    free(rgb);
     lm_api_leave(saved);
     if (st == LM_OK)
         return LMGI_OK;

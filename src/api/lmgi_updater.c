@@ -263,6 +263,8 @@ void lm_updater_sync(lmgi_updater *u)
     lm_api_leave(saved);
 }
 
+lmgi_context *lm_updater_context(const lmgi_updater *u) { return u->ctx; }
+
 void lmgi_updater_free(lmgi_updater *u)
 {
     if (!u)

@@ -11,8 +11,9 @@
 lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_frame_loop_settings *s,
                               lm_error *err);
 
-/* The scene u works on. */
+/* The scene u works on, and the context it was made on. */
 const lmgi_scene *lm_updater_scene(const lmgi_updater *u);
+lmgi_context *lm_updater_context(const lmgi_updater *u);
 
 /* Waits for the photon work an update left running, before the scene is changed under it. */
 void lm_updater_sync(lmgi_updater *u);

@@ -307,6 +307,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                 a->gltf = 1;
             else if (!strcmp(o, "--accuracy"))
                 a->accuracy = 1;
+            else if (!strcmp(o, "--frame-lag"))
+                a->frame_lag = 1;
             else if (!strcmp(o, "--force"))
                 a->force = 1;
             else if (!strcmp(o, "--quick"))

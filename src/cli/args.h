@@ -64,6 +64,7 @@ typedef struct {
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     int accuracy;           /* --accuracy (bake): also the lightmaps' estimate of their own error */
+    int frame_lag;          /* --frame-lag (tradeoff --edits): the frame's lag against the reference too */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
     int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */

@@ -27,8 +27,8 @@ static void report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_
             continue; /* several edits in one frame: the last one reports */
         int f5, f2;
         double ms5, ms2;
-        lm_edit_lag(rows, from, to, 0.05, 0, &f5, &ms5);
-        lm_edit_lag(rows, from, to, 0.02, 0, &f2, &ms2);
+        lm_edit_lag(rows, from, to, 0.05, LM_LAG_ATLAS, &f5, &ms5);
+        lm_edit_lag(rows, from, to, 0.02, LM_LAG_ATLAS, &f2, &ms2);
         char what[128], l5[48], l2[48];
         lm_edit_describe(s->edits[i].v, what, sizeof what);
         snprintf(l5, sizeof l5, f5 < 0 ? "not in %d fr" : "%d fr %.0f ms", f5 < 0 ? to - from : f5, ms5);
@@ -91,7 +91,7 @@ int lm_cli_bench_edits(const lm_cli_args *a)
     d.frame_width = d.frame_height = 0;
     d.progress = NULL;
     d.progress_user = NULL;
-    int ok = rows && lm_edit_script_play(&s, a->files[0], &d, s.budget_ms, rows);
+    int ok = rows && lm_edit_script_play(&s, a->files[0], &d, s.budget_ms, NULL, rows);
     if (ok)
         report(a, &s, rows);
     free(rows);

@@ -8,6 +8,7 @@
 #include <time.h>
 
 #include "progress.h"
+#include "surface_error.h"
 
 static int bad(const char *path, int i, const char *what)
 {
@@ -315,7 +316,23 @@ static void count_rewritten(bench *b, lm_edit_frame *row)
     }
 }
 
-static int play(const lm_edit_script *s, float budget_ms, bench *b, lm_edit_frame *rows)
+/* The frame's error per surface against the reference of the scene as it is now (fc's check). */
+static int frame_error(bench *b, const lm_edit_frame_check *fc, double *out)
+{
+    lmgi_camera cam;
+    lmgi_check_result c;
+    lmgi_error e;
+    if (lmgi_scene_camera(b->sc, -1, fc->width, fc->height, &cam, &e) != LMGI_OK ||
+        lmgi_check_updater(b->u, &cam, fc->width, fc->height, fc->ref, &c, &e) != LMGI_OK)
+        return fprintf(stderr, "lmgi: frame check: %s\n", e.message), 0;
+    double worst;
+    *out = lm_cli_surface_error(b->sc, &c, &worst);
+    lmgi_check_free(&c);
+    return 1;
+}
+
+static int play(const lm_edit_script *s, float budget_ms, const lm_edit_frame_check *fc, bench *b,
+                lm_edit_frame *rows)
 {
     const char *path = s->path;
     int next = 0;
@@ -334,7 +351,8 @@ static int play(const lm_edit_script *s, float budget_ms, bench *b, lm_edit_fram
             return 0;
         }
         rows[f] = (lm_edit_frame){st.ms_total, st.ms_photons, st.ms_gather, st.ms_blend, st.texels_gathered,
-                              st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0, 0, 0, 0, 0};
+                              st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0, 0, 0, 0, 0,
+                              NAN};
         double spent = 1e3 * lm_cli_now() - start;
         if (s->fps > 0 && spent < 1e3 / s->fps) { /* the game's own frame, with the photon work beside it */
             double left = 1e3 / s->fps - spent;
@@ -352,18 +370,24 @@ static int play(const lm_edit_script *s, float budget_ms, bench *b, lm_edit_fram
         count_rewritten(b, &rows[f]);
         if (lmgi_get_lightmap(b->u, LMGI_LIGHTMAP_IIM, b->iim, 4 * b->texels, &e) != LMGI_OK)
             return fprintf(stderr, "lmgi: %s\n", e.message), 0;
+        if (fc && next > 0 && !frame_error(b, fc, &rows[f].frame_error))
+            return 0;
         rows[f].error = distance(b->iim, b->converged, b->texels);
         rows[f].worst_surface = worst_surface(b->iim, b->converged, b->texels, b->surface_of, b->surfaces, b->sums);
     }
     return 1;
 }
 
-void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, int worst, int *frames, double *ms)
+void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, lm_lag_metric by, int *frames,
+                 double *ms)
 {
     double sum = 0.0;
     for (int f = from; f < to; f++) {
         sum += rows[f].ms_total;
-        if ((worst ? rows[f].worst_surface : rows[f].error) < limit) {
+        double e = by == LM_LAG_FRAME ? rows[f].frame_error
+                   : by == LM_LAG_WORST_SURFACE ? rows[f].worst_surface
+                                                : rows[f].error;
+        if (e < limit) {
             *frames = f - from + 1, *ms = sum;
             return;
         }
@@ -424,11 +448,11 @@ void lm_edit_script_free(lm_edit_script *s)
 }
 
 int lm_edit_script_play(const lm_edit_script *s, const char *scene_path, const lmgi_updater_desc *d,
-                        float budget_ms, lm_edit_frame *rows)
+                        float budget_ms, const lm_edit_frame_check *fc, lm_edit_frame *rows)
 {
     bench b;
     memset(&b, 0, sizeof b);
-    int ok = setup(scene_path, s, d, &b) && play(s, budget_ms, &b, rows);
+    int ok = setup(scene_path, s, d, &b) && play(s, budget_ms, fc, &b, rows);
     teardown(&b);
     return ok;
 }

@@ -39,7 +39,21 @@ typedef struct {
     uint32_t outside_texels; /* their texels */
     int reached;           /* the surfaces in its reach this update rewrote */
     int reach;             /* the surfaces in its reach, of those with something to judge by */
+    double frame_error;    /* with a frame check: the frame's error per surface (surface_error.h) against the
+                            * path-traced reference of the scene as edited so far; NAN before the first
+                            * edit and without one */
 } lm_edit_frame;
+
+/* A play's frame check: after every update from the first edit on, the updater's picture from the scene's
+ * camera at width x height against the reference (lmgi_check_updater; ref's cache makes each edited
+ * state's reference once). */
+typedef struct {
+    const lmgi_reference_desc *ref;
+    int width, height;
+} lm_edit_frame_check;
+
+/* What lm_edit_lag measures the lag by. */
+typedef enum { LM_LAG_ATLAS = 0, LM_LAG_WORST_SURFACE = 1, LM_LAG_FRAME = 2 } lm_lag_metric;
 
 /* A surface is in an edit's reach when its converged lightmap moved by more than this (relative L1 over
  * its valid texels) with the edit (a bake leaves the others' texels as they were, to the bit), or when an
@@ -53,16 +67,18 @@ typedef struct {
 int lm_edit_script_read(const char *path, lm_edit_script *s);
 void lm_edit_script_free(lm_edit_script *s);
 /* Plays s on scene_path loaded at the script's texels, with desc d (NULL: the defaults) and lmgi_update's
- * budget budget_ms (the script's, or 0 for d's texels_per_frame): rows[0 .. s->frames). 0 after printing
- * the error (an edit the scene cannot take names the edit). */
+ * budget budget_ms (the script's, or 0 for d's texels_per_frame): rows[0 .. s->frames); fc: the frame
+ * check (NULL: none). 0 after printing the error (an edit the scene cannot take names the edit). */
 int lm_edit_script_play(const lm_edit_script *s, const char *scene_path, const lmgi_updater_desc *d,
-                        float budget_ms, lm_edit_frame *rows);
+                        float budget_ms, const lm_edit_frame_check *fc, lm_edit_frame *rows);
 /* The updates edit i's effect is measured over, [*from, *to): from its frame to the next edit's (or the
  * end). 0 when a later edit shares its frame (the last of a frame's edits reports). */
 int lm_edit_span(const lm_edit_script *s, int i, int *from, int *to);
-/* Updates and update milliseconds from `from` until the error (worst: the worst surface's, else the whole
- * atlas's) is under `limit` (*frames -1: not in [from, to); *ms is then the time of all of them). */
-void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, int worst, int *frames, double *ms);
+/* Updates and update milliseconds from `from` until the error `by` measures (the whole atlas's distance,
+ * the worst surface's, or the frame's) is under `limit` (*frames -1: not in [from, to); *ms is then the
+ * time of all of them). */
+void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, lm_lag_metric by, int *frames,
+                 double *ms);
 /* "light light_b2", "node door", ...: what edit e does, for tables. */
 void lm_edit_describe(const json_value *e, char *out, size_t n);
 

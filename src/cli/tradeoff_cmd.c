@@ -12,6 +12,7 @@
 #include "reference_cmd.h"
 #include "run_cmd.h"
 #include "edit_script.h"
+#include "surface_error.h"
 #include "scene_load.h"
 #include "tradeoff_knobs.h"
 #include "tradeoff_write.h"
@@ -121,31 +122,10 @@ static int lightmap_errors(lmgi_updater *u, const atlas_state *as, lm_tradeoff_r
     return ok;
 }
 
-/* Per visible surface (not emitters), |frame mean / reference mean - 1| on the sum of the channels: the
- * pixel-weighted RMS over surfaces of 20 or more compared pixels, and the worst of those with 100 or more
- * (issue 17's bound). Means over a surface's pixels average the reference's own noise away, which the
- * per-pixel RMSE keeps (about its target error). */
+/* The frame's error per surface (surface_error.h) into m. */
 static void surface_errors(const lmgi_scene *sc, const lmgi_check_result *c, lm_tradeoff_row *m)
 {
-    double se = 0.0, w = 0.0;
-    m->frame_surface_worst = 0.0;
-    for (int s = 0; s < c->surface_count; s++) {
-        const lmgi_check_surface *f = &c->surfaces[s];
-        lmgi_material mat;
-        lmgi_error err;
-        if (f->pixels < 20 || lmgi_get_material(sc, f->material, &mat, &err) != LMGI_OK ||
-            mat.cls == LMGI_MATERIAL_EMITTER)
-            continue;
-        double fr = f->frame_mean[0] + f->frame_mean[1] + f->frame_mean[2];
-        double rf = f->reference_mean[0] + f->reference_mean[1] + f->reference_mean[2];
-        if (!(rf > 0.0))
-            continue;
-        double d = fabs(fr / rf - 1.0);
-        se += f->pixels * d * d, w += f->pixels;
-        if (f->pixels >= 100)
-            m->frame_surface_worst = fmax(m->frame_surface_worst, d);
-    }
-    m->frame_surface_rms = w > 0.0 ? sqrt(se / w) : NAN;
+    m->frame_surface_rms = lm_cli_surface_error(sc, c, &m->frame_surface_worst);
 }
 
 /* The frame the way `lmgi check` compares it (lmgi_check: one update at time 0 against the reference
@@ -304,8 +284,12 @@ static const struct {
 
 /* The scene's edit script played once per budget setting (the default once); plays into sr. A play the
  * library refuses counts as a failed setting. */
-static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_script *script, lm_tradeoff_scene *sr)
+static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_script *script,
+                     const lmgi_reference_desc *rd, lm_tradeoff_scene *sr)
 {
+    /* --frame-lag: the default play's frame against the path-traced reference after every update, at 64 x 64
+     * (a reference per edited state: 64^2 costs under half of 96^2, and per-surface means need few pixels) */
+    lm_edit_frame_check fc = {rd, LM_TRADEOFF_LAG_SIDE, LM_TRADEOFF_LAG_SIDE};
     sr->script = script;
     sr->plays = calloc(7, sizeof *sr->plays);
     if (!sr->plays)
@@ -328,7 +312,8 @@ static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_scrip
                     d.surfaces_per_frame = v;
             }
             p->frames = calloc((size_t)script->frames, sizeof *p->frames);
-            if (!p->frames || !lm_edit_script_play(script, path, &d, 0.0f, p->frames)) {
+            p->frame_lag = is_default && a->frame_lag;
+            if (!p->frames || !lm_edit_script_play(script, path, &d, 0.0f, p->frame_lag ? &fc : NULL, p->frames)) {
                 free(p->frames);
                 p->frames = NULL;
                 sr->failed++;
@@ -338,7 +323,7 @@ static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_scrip
                 int from, to, f5;
                 double ms5;
                 lm_edit_span(script, 0, &from, &to);
-                lm_edit_lag(p->frames, from, to, 0.05, 1, &f5, &ms5);
+                lm_edit_lag(p->frames, from, to, 0.05, LM_LAG_WORST_SURFACE, &f5, &ms5);
                 fprintf(stderr, "lmgi: tradeoff %s update lag [%d/7] %s = %d: the first edit's worst surface %s %d "
                         "updates (%.0f ms)\n", sr->name, sr->play_count, p->knob, v,
                         f5 < 0 ? "still 5% off after" : "within 5% after", f5 < 0 ? to - from : f5, ms5);
@@ -500,7 +485,7 @@ int lm_cli_tradeoff(const lm_cli_args *a)
         lm_tradeoff_scene_name(a->files[i], scenes[i].name, sizeof scenes[i].name);
         ok = sweep_scene(a, ctx, a->files[i], &rd, &scenes[i]);
         if (ok && scripts.of_scene[i])
-            ok = lag_sweep(a, a->files[i], scripts.of_scene[i], &scenes[i]);
+            ok = lag_sweep(a, a->files[i], scripts.of_scene[i], &rd, &scenes[i]);
         done = i + 1;
     }
     lm_tradeoff_run run = {a->quick, a->repeats, rd.target_error, scenes, done};

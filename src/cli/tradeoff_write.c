@@ -238,12 +238,13 @@ static void json_row(FILE *f, const lm_tradeoff_row *r)
 
 typedef struct {
     char what[128];
-    int frame, frames_to[2];
-    double error, ms_to[2];
+    int frame, frames_to[2], frame_to[2]; /* frame_to: by the frame's error (-1 also when not measured) */
+    double error, ms_to[2], frame_error, frame_end, frame_ms[2]; /* frame_*: NAN when not measured */
 } edit_lag;
 
-/* Edit i's lag in play p, by the worst surface's distance; 0 when a later edit shares its frame (that one
- * reports). */
+/* Edit i's lag in play p, by the worst surface's distance and (--frame-lag) by the frame's error against
+ * the reference, that error at the edit and at the end of its span; 0 when a later edit shares its frame
+ * (that one reports). */
 static int lag_of(const lm_edit_script *s, const lm_tradeoff_play *p, int i, edit_lag *l)
 {
     int from, to;
@@ -252,26 +253,43 @@ static int lag_of(const lm_edit_script *s, const lm_tradeoff_play *p, int i, edi
     lm_edit_describe(s->edits[i].v, l->what, sizeof l->what);
     l->frame = from;
     l->error = p->frames[from].worst_surface;
-    lm_edit_lag(p->frames, from, to, 0.05, 1, &l->frames_to[0], &l->ms_to[0]);
-    lm_edit_lag(p->frames, from, to, 0.02, 1, &l->frames_to[1], &l->ms_to[1]);
+    lm_edit_lag(p->frames, from, to, 0.05, LM_LAG_WORST_SURFACE, &l->frames_to[0], &l->ms_to[0]);
+    lm_edit_lag(p->frames, from, to, 0.02, LM_LAG_WORST_SURFACE, &l->frames_to[1], &l->ms_to[1]);
+    lm_edit_lag(p->frames, from, to, 0.05, LM_LAG_FRAME, &l->frame_to[0], &l->frame_ms[0]);
+    lm_edit_lag(p->frames, from, to, 0.02, LM_LAG_FRAME, &l->frame_to[1], &l->frame_ms[1]);
+    l->frame_error = p->frames[from].frame_error;
+    l->frame_end = p->frames[to - 1].frame_error;
+    if (!p->frame_lag)
+        l->frame_ms[0] = l->frame_ms[1] = NAN;
     return 1;
 }
+
 
 static int write_lag_csv(const char *path, const lm_tradeoff_run *run)
 {
     FILE *f = fopen(path, "w");
     if (!f)
         return 0;
-    fprintf(f, "scene,knob,value,default,edit,frame,error,frames_to_5,ms_to_5,frames_to_2,ms_to_2\n");
+    fprintf(f, "scene,knob,value,default,edit,frame,error,frames_to_5,ms_to_5,frames_to_2,ms_to_2,frame_error,"
+            "frame_to_5,frame_ms_to_5,frame_to_2,frame_ms_to_2,frame_end\n");
     for (int i = 0; i < run->count; i++) {
         const lm_tradeoff_scene *s = &run->scenes[i];
         for (int p = 0; p < s->play_count; p++)
             for (int e = 0; s->plays[p].frames && e < s->script->edit_count; e++) {
                 edit_lag l;
-                if (lag_of(s->script, &s->plays[p], e, &l))
-                    fprintf(f, "%s,%s,%d,%d,\"%s\",%d,%.5f,%d,%.2f,%d,%.2f\n", s->name, s->plays[p].knob,
+                if (lag_of(s->script, &s->plays[p], e, &l)) {
+                    fprintf(f, "%s,%s,%d,%d,\"%s\",%d,%.5f,%d,%.2f,%d,%.2f,", s->name, s->plays[p].knob,
                             s->plays[p].value, s->plays[p].is_default, l.what, l.frame, l.error, l.frames_to[0],
                             l.ms_to[0], l.frames_to[1], l.ms_to[1]);
+                    num(f, l.frame_error, 0); /* the frame's columns empty where it was not checked */
+                    fprintf(f, ",%d,", l.frame_to[0]);
+                    num(f, l.frame_ms[0], 0);
+                    fprintf(f, ",%d,", l.frame_to[1]);
+                    num(f, l.frame_ms[1], 0);
+                    fputc(',', f);
+                    num(f, l.frame_end, 0);
+                    fputc('\n', f);
+                }
             }
     }
     return fclose(f) == 0;
@@ -286,9 +304,12 @@ static void json_plays(FILE *f, const lm_tradeoff_scene *s)
         const lm_tradeoff_play *pl = &s->plays[p];
         fprintf(f, "    {\"knob\": \"%s\", \"value\": %d, \"default\": %s, \"frames\": [", pl->knob, pl->value,
                 pl->is_default ? "true" : "false");
-        for (int k = 0; pl->frames && k < s->script->frames; k++)
-            fprintf(f, "%s[%.5f, %.3f, %.5f]", k ? ", " : "", pl->frames[k].worst_surface, pl->frames[k].ms_total,
+        for (int k = 0; pl->frames && k < s->script->frames; k++) {
+            fprintf(f, "%s[%.5f, %.3f, %.5f, ", k ? ", " : "", pl->frames[k].worst_surface, pl->frames[k].ms_total,
                     pl->frames[k].error);
+            num(f, pl->frames[k].frame_error, 1);
+            fprintf(f, "]");
+        }
         fprintf(f, "], \"edits\": [");
         int first = 1;
         for (int e = 0; pl->frames && e < s->script->edit_count; e++) {
@@ -298,8 +319,17 @@ static void json_plays(FILE *f, const lm_tradeoff_scene *s)
             fprintf(f, "%s{\"edit\": ", first ? "" : ", ");
             json_string(f, l.what);
             fprintf(f, ", \"frame\": %d, \"error\": %.5f, \"frames_to_5\": %d, \"ms_to_5\": %.2f, "
-                    "\"frames_to_2\": %d, \"ms_to_2\": %.2f}", l.frame, l.error, l.frames_to[0], l.ms_to[0],
-                    l.frames_to[1], l.ms_to[1]);
+                    "\"frames_to_2\": %d, \"ms_to_2\": %.2f, \"frame_to_5\": %d, \"frame_to_2\": %d, \"frame_ms_to_5\": ",
+                    l.frame, l.error, l.frames_to[0], l.ms_to[0], l.frames_to[1], l.ms_to[1], l.frame_to[0],
+                    l.frame_to[1]);
+            num(f, l.frame_ms[0], 1);
+            fprintf(f, ", \"frame_ms_to_2\": ");
+            num(f, l.frame_ms[1], 1);
+            fprintf(f, ", \"frame_error\": ");
+            num(f, l.frame_error, 1);
+            fprintf(f, ", \"frame_end\": ");
+            num(f, l.frame_end, 1);
+            fprintf(f, "}");
             first = 0;
         }
         fprintf(f, "]}%s\n", p + 1 < s->play_count ? "," : "");

@@ -39,7 +39,11 @@ typedef struct {
     int value;
     int is_default;          /* every budget at its default */
     lm_edit_frame *frames;   /* the script's frames, one per update (NULL: the play failed) */
+    int frame_lag;           /* its frames' frame_error measured (--frame-lag, the default play) */
 } lm_tradeoff_play;
+
+/* The side of the frame --frame-lag checks after every update. */
+#define LM_TRADEOFF_LAG_SIDE 64
 
 typedef struct {
     const char *path;
