@@ -403,7 +403,8 @@ int lm_tradeoff_write(const char *dir, const lm_tradeoff_run *run)
 
 /* ---------- the report ---------- */
 
-/* tools/tradeoff_report.py beside the executable: ../tools (a build tree) or ../share/lmgi (an install). */
+/* tools/tradeoff_report.py beside the executable: ../tools (build/lmgi), ../../tools (a build tree one
+ * level deeper: build/asan/lmgi, make test-asan's) or ../share/lmgi (an install). */
 static int find_script(char *out, size_t size)
 {
     char exe[PATH_MAX];
@@ -415,8 +416,9 @@ static int find_script(char *out, size_t size)
     if (!slash)
         return 0;
     *slash = '\0';
-    static const char *const rel[] = {"../tools/tradeoff_report.py", "../share/lmgi/tradeoff_report.py"};
-    for (int i = 0; i < 2; i++) {
+    static const char *const rel[] = {"../tools/tradeoff_report.py", "../../tools/tradeoff_report.py",
+                                      "../share/lmgi/tradeoff_report.py"};
+    for (int i = 0; i < 3; i++) {
         snprintf(out, size, "%s/%s", exe, rel[i]);
         if (access(out, R_OK) == 0)
             return 1;
