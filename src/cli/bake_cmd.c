@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "order_stats.h"
 #include "out_dir.h"
 #include "progress.h"
 #include "run_cmd.h"
@@ -51,12 +52,6 @@ static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half
     return rc;
 }
 
-static int by_value(const void *a, const void *b)
-{
-    float x = *(const float *)a, y = *(const float *)b;
-    return x < y ? -1 : x > y;
-}
-
 /* The picture of the lightmap's estimated error: 0 dark blue, ACCURACY_SCALE / 2 red, ACCURACY_SCALE and
  * over yellow; black where the texel is invalid or unlit. */
 #define ACCURACY_SCALE 0.1f
@@ -80,7 +75,7 @@ static int write_accuracy(lmgi_scene *sc, lmgi_updater *u, const char *dir, int 
     lmgi_get_info(sc, &in);
     size_t n = (size_t)in.atlas_width * in.atlas_height;
     float *rgba = malloc(4 * n * sizeof *rgba), *lit = malloc(4 * n * sizeof *lit);
-    float *iim = malloc(n * sizeof *iim), *aim = malloc(n * sizeof *aim);
+    double *iim = malloc(n * sizeof *iim), *aim = malloc(n * sizeof *aim);
     lmgi_error e;
     int rc = 0;
     double started = lm_cli_now();
@@ -114,11 +109,10 @@ static int write_accuracy(lmgi_scene *sc, lmgi_updater *u, const char *dir, int 
             rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
     }
     if (rc == 0 && m && !quiet) {
-        qsort(iim, m, sizeof *iim, by_value);
-        qsort(aim, m, sizeof *aim, by_value);
+        double median = lm_cli_median(iim, (int)m), p95 = lm_cli_quantile(iim, (int)m, 0.95);
         printf("accuracy    estimated relative standard error over %zu lit texels: lightmap median %.3f, 95th "
                "percentile %.3f; AIM median %.3f (photon noise only: docs/gather.md, \"Error estimate\"; %.1f s)\n",
-               m, (double)iim[m / 2], (double)iim[m * 95 / 100], (double)aim[m / 2], seconds);
+               m, median, p95, lm_cli_median(aim, (int)m), seconds);
     }
     free(rgba);
     free(lit);

@@ -122,11 +122,6 @@ static int lightmap_errors(lmgi_updater *u, const atlas_state *as, lm_tradeoff_r
     return ok;
 }
 
-/* The frame's error per surface (surface_error.h) into m. */
-static void surface_errors(const lmgi_scene *sc, const lmgi_check_result *c, lm_tradeoff_row *m)
-{
-    m->frame_surface_rms = lm_cli_surface_error(sc, c, &m->frame_surface_worst);
-}
 
 /* The frame the way `lmgi check` compares it (lmgi_check: one update at time 0 against the reference
  * pixels of the same camera). */
@@ -149,7 +144,7 @@ static int frame_errors(lmgi_context *ctx, const atlas_state *as, const lmgi_upd
             m->frame_bias = fmax(m->frame_bias, fabs(c.ratio[k] - 1.0));
         }
         m->reference_rel_se = c.reference_rel_se;
-        surface_errors(as->sc, &c, m);
+        m->frame_surface_rms = lm_cli_surface_error(as->sc, &c, &m->frame_surface_worst);
     } else
         fprintf(stderr, "lmgi: error: no memory for the frame's error\n");
     lmgi_check_free(&c);

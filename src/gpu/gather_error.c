@@ -2,7 +2,6 @@
 #include "gather_error.h"
 
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #include "../charts/atlas_dilate.h"
@@ -13,29 +12,12 @@
 void lm_gather_error_source(const lm_atlas *a, const float *aim_rgb, const float *aim_error, float *out)
 {
     size_t n = (size_t)a->width * a->height;
-    float *rgb = out; /* (s Y, r, Y) packed in the front, then spread to RGBA from the back */
     for (size_t i = 0; i < n; i++) {
         float y = lm_luminance(aim_rgb + 3 * i);
-        rgb[3 * i] = aim_error[2 * i] * y, rgb[3 * i + 1] = aim_error[2 * i + 1], rgb[3 * i + 2] = y;
-    }
-    for (size_t i = n; i-- > 0;) {
-        float v[3] = {rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]};
-        memcpy(out + 4 * i, v, sizeof v);
+        out[4 * i] = aim_error[2 * i] * y, out[4 * i + 1] = aim_error[2 * i + 1], out[4 * i + 2] = y;
         out[4 * i + 3] = 0.0f;
     }
     lm_atlas_dilate_gutters(a, out, 4);
-}
-
-/* The lightmap uv where a ray hit triangle tri at barycentrics (u, v); 0 for a triangle with no chart. */
-static int hit_uv(const lm_atlas *a, const lm_rt_hit *h, float uv[2])
-{
-    const float *c = a->corner_uv + 6 * (size_t)h->tri;
-    if (a->tri_chart[h->tri] < 0 || !isfinite(c[0]))
-        return 0;
-    float w0 = 1.0f - h->u - h->v;
-    uv[0] = w0 * c[0] + h->u * c[2] + h->v * c[4];
-    uv[1] = w0 * c[1] + h->u * c[3] + h->v * c[5];
-    return 1;
 }
 
 /* Var(E) and the fully correlated sum for one texel (gather_error.h), luminance, with side^2 rays. */
@@ -60,7 +42,7 @@ static void texel_variance(const lm_hemicube_settings *set, const lm_scene *s, c
             float dir[3], uv[2], src[3];
             lm_v3_store(dir, d);
             lm_rt_hit h;
-            if (!lm_rt_intersect(rt, eye, dir, 0.0f, INFINITY, &h) || !hit_uv(a, &h, uv))
+            if (!lm_rt_intersect(rt, eye, dir, 0.0f, INFINITY, &h) || !lm_atlas_hit_uv(a, &h, uv))
                 continue; /* the sky, a mirror or glass: no photon estimate, no noise */
             const lm_material *m = &s->materials[s->tri_material[h.tri]];
             double cos_h = -lm_dot(lm_v3_load(h.ng), d);

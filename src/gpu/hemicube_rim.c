@@ -21,6 +21,17 @@ void lm_atlas_sample_rgb(const lm_atlas *a, const float *rgba, float u, float v,
         out[c] = (1.0f - fy) * ((1.0f - fx) * p00[c] + fx * p10[c]) + fy * ((1.0f - fx) * p01[c] + fx * p11[c]);
 }
 
+int lm_atlas_hit_uv(const lm_atlas *a, const lm_rt_hit *h, float uv[2])
+{
+    const float *c = a->corner_uv + 6 * (size_t)h->tri;
+    if (a->tri_chart[h->tri] < 0 || !isfinite(c[0]))
+        return 0;
+    float w0 = 1.0f - h->u - h->v;
+    uv[0] = w0 * c[0] + h->u * c[2] + h->v * c[4];
+    uv[1] = w0 * c[1] + h->u * c[3] + h->v * c[5];
+    return 1;
+}
+
 /* The lightmap UV's gradient over a triangle's plane: rows gu, gv with uv(p) = uv0 + (gu.(p - p0),
  * gv.(p - p0)) (zero across the plane). */
 void lm_uv_gradient(const float p[3][3], const float *uv[3], float gu[3], float gv[3])
@@ -77,16 +88,16 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
     if (!m->double_sided && lm_dot(ng, d) > 0.0f)
         return; /* the back of a single-sided surface: black, as on the plane */
     const float *c = r->atlas->corner_uv + 6 * (size_t)h.tri;
-    int chart = r->atlas->tri_chart[h.tri];
     lm_vec3 e = lm_v3_load(eye), P = lm_add(e, lm_scale(d, h.t));
-    if (chart >= 0 && isfinite(c[0])) {
-        float p[3][3], gu[3], gv[3], w0 = 1.0f - h.u - h.v;
+    float hit[2];
+    if (lm_atlas_hit_uv(r->atlas, &h, hit)) {
+        float p[3][3], gu[3], gv[3];
         const float *uv[3] = {c, c + 2, c + 4};
         for (int k = 0; k < 3; k++)
             lm_scene_vertex_world(r->scene, r->scene->tris[3 * (size_t)h.tri + k], p[k]);
         lm_uv_gradient(p, uv, gu, gv);
-        float u = w0 * c[0] + h.u * c[2] + h.v * c[4], v = w0 * c[1] + h.u * c[3] + h.v * c[5];
-        const lm_chart *ch = &r->atlas->charts[chart];
+        float u = hit[0], v = hit[1];
+        const lm_chart *ch = &r->atlas->charts[r->atlas->tri_chart[h.tri]];
         float lo[2] = {(float)ch->x / r->atlas->width, (float)ch->y / r->atlas->height};
         float hi[2] = {(float)(ch->x + ch->w) / r->atlas->width, (float)(ch->y + ch->h) / r->atlas->height};
         double num = lm_dot(ng, lm_sub(P, e));

@@ -51,6 +51,9 @@ void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], co
 /* Bilinear lookup of an atlas-sized RGBA map's rgb at lightmap uv in [0, 1]^2 (texel (x, y) spans
  * [x, x + 1] / width), clamped to the atlas's edge. */
 void lm_atlas_sample_rgb(const lm_atlas *a, const float *rgba, float u, float v, float out[3]);
+/* The lightmap uv where ray hit h met its triangle (barycentric on the corners' uvs); 0 for a triangle with
+ * no chart (mirror, glass). */
+int lm_atlas_hit_uv(const lm_atlas *a, const lm_rt_hit *h, float uv[2]);
 
 /* The lightmap uv's gradient over a triangle's plane (world corners p, uv per corner; NULL: none, zero
  * gradient): rows gu, gv with uv(x) = uv0 + (gu.(x - p0), gv.(x - p0)). */

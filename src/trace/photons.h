@@ -34,8 +34,8 @@ typedef struct {
     uint32_t groups;           /* G, groups per emitter, must be 2^a 3^b (default 72 = 2^3 3^2) */
     uint32_t per_group;        /* mean photons per group when total_photons is 0 (default 160) */
     uint32_t min_total;        /* with total_photons 0, at least this many photons over all emitters
-                                * (default LM_PHOTONS_MIN_TOTAL; 0: none). Set per_group and this to 0 for
-                                * exactly per_group x groups x emitters */
+                                * (default LM_PHOTONS_MIN_TOTAL; 0: none, exactly per_group x groups x
+                                * emitters) */
     uint32_t retrace_per_group; /* k: photons per group re-traced each frame, round robin (default 1) */
     uint32_t group_budget;     /* invalid groups re-traced per frame, oldest first (default 16; 0 = all) */
     float epsilon;             /* a path vertex that moved more than this (world units) is a change;
