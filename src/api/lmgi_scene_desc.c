@@ -86,7 +86,9 @@ static void write_meshes(const lmgi_scene_desc *d, lm_gltf_doc *doc)
     fprintf(f, ",\"meshes\":[");
     for (int i = 0; i < d->mesh_count; i++) {
         const lmgi_mesh_desc *m = &d->meshes[i];
-        fprintf(f, "%s{\"name\":\"mesh %d\",\"primitives\":[{\"attributes\":{\"POSITION\":%d", i ? "," : "", i,
+        fprintf(f, "%s{\"name\":", i ? "," : ""); /* the node's name: the loader's warnings name the mesh */
+        lm_gltf_string(f, m->name ? m->name : "mesh");
+        fprintf(f, ",\"primitives\":[{\"attributes\":{\"POSITION\":%d",
                 lm_gltf_accessor(doc, m->positions, m->vertex_count, 3, 1));
         if (m->normals)
             fprintf(f, ",\"NORMAL\":%d", lm_gltf_accessor(doc, m->normals, m->vertex_count, 3, 0));
