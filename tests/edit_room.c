@@ -209,24 +209,39 @@ double lmt_relative_l1(const float *a, const float *b, size_t n)
     return s > 0.0 ? d / s : d;
 }
 
-double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node)
+void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first, uint32_t count, double *mean,
+                         double *top)
 {
-    static const char *const names[3] = {"room", "block", "stool"}; /* 12 triangles each, in this order */
     lmgi_info in;
     lmgi_get_info(sc, &in);
     double sum = 0.0;
     int n = 0;
+    *top = 0.0;
     for (uint32_t i = 0; i < in.texels; i++) {
         lmgi_texel t;
         lmgi_get_texel(sc, i, &t);
         const float *p = iim + 4 * ((size_t)t.y * in.atlas_width + t.x);
-        if (p[3] < 0.5f || t.triangle >= 36 || strcmp(names[t.triangle / 12], node))
+        if (p[3] < 0.5f || t.triangle < first || t.triangle >= first + count)
             continue;
-        sum += p[0] + p[1] + p[2];
-        n++;
+        double e = (double)p[0] + p[1] + p[2];
+        sum += e, n++;
+        *top = e > *top ? e : *top;
     }
     assert_true(n > 20);
-    return sum / n;
+    *mean = sum / n;
+}
+
+double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node)
+{
+    static const char *const names[3] = {"room", "block", "stool"}; /* 12 triangles each, in this order */
+    for (uint32_t k = 0; k < 3; k++)
+        if (!strcmp(names[k], node)) {
+            double mean, top;
+            lmt_triangles_stats(sc, iim, 12 * k, 12, &mean, &top);
+            return mean;
+        }
+    fail_msg("no node '%s' in the room", node);
+    return 0.0;
 }
 
 void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)

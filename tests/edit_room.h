@@ -54,8 +54,11 @@ float *lmt_corner_frame(lmgi_updater *u);
 void lmt_corner_camera(lmgi_camera *cam);
 /* Relative L1 distance of a from b over n floats. */
 double lmt_relative_l1(const float *a, const float *b, size_t n);
-/* Mean irradiance (R + G + B) of the valid texels of node `node` ("room", "block", "stool") in an IIM of
- * a room. */
+/* Mean and largest irradiance (R + G + B) over the valid texels of triangles [first, first + count) in an
+ * IIM (more than 20 of them, or the test fails). */
+void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first, uint32_t count, double *mean,
+                         double *top);
+/* The mean over node `node` ("room", "block", "stool") in an IIM of a room. */
 double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node);
 /* Asserts that st is LMGI_ERR_INVALID with a message naming `words`. */
 void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words);

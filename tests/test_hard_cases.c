@@ -54,9 +54,17 @@ static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updat
     return u;
 }
 
-/* A converged bake of sc (cheap settings: 100 photons a group, hemicube 16; defaults with `defaults`) and
- * its IIM (malloc'd RGBA, *n floats). */
-static float *bake_with(lmgi_context *ctx, lmgi_scene *sc, int defaults, size_t *n)
+static int all_finite(const float *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i]))
+            return 0;
+    return 1;
+}
+
+/* An updater on sc (cheap settings: 100 photons a group, hemicube 16; the defaults with `defaults`),
+ * baked to convergence, and its IIM (malloc'd RGBA, *n floats), every value of it finite. */
+static lmgi_updater *baked(lmgi_context *ctx, lmgi_scene *sc, int defaults, float **iim, size_t *n)
 {
     lmgi_updater_desc d;
     if (defaults)
@@ -66,20 +74,19 @@ static float *bake_with(lmgi_context *ctx, lmgi_scene *sc, int defaults, size_t 
     lmgi_updater *u = updater(ctx, sc, &d);
     lmgi_bake_report r;
     lmt_bake(u, &r);
-    float *iim = lmt_iim(u, sc, n);
-    lmgi_updater_free(u);
+    *iim = lmt_iim(u, sc, n);
+    assert_true(all_finite(*iim, *n));
+    return u;
+}
+
+static float *bake_with(lmgi_context *ctx, lmgi_scene *sc, int defaults, size_t *n)
+{
+    float *iim;
+    lmgi_updater_free(baked(ctx, sc, defaults, &iim, n));
     return iim;
 }
 
 static float *baked_iim(lmgi_context *ctx, lmgi_scene *sc, size_t *n) { return bake_with(ctx, sc, 0, n); }
-
-static int all_finite(const float *v, size_t n)
-{
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(v[i]))
-            return 0;
-    return 1;
-}
 
 /* ---------- scale and distance from the origin ---------- */
 
@@ -308,29 +315,6 @@ static void test_n_beyond_the_hits(void **state)
 
 /* ---------- thin walls and inner corners ---------- */
 
-/* Mean and largest irradiance (R + G + B) of the valid IIM texels of triangles [first, first + count). */
-static void tri_range_stats(const lmgi_scene *sc, const float *iim, uint32_t first, uint32_t count, double *mean,
-                            double *top)
-{
-    lmgi_info in;
-    lmgi_get_info(sc, &in);
-    double sum = 0.0;
-    int n = 0;
-    *top = 0.0;
-    for (uint32_t i = 0; i < in.texels; i++) {
-        lmgi_texel t;
-        lmgi_get_texel(sc, i, &t);
-        const float *p = iim + 4 * ((size_t)t.y * in.atlas_width + t.x);
-        if (p[3] < 0.5f || t.triangle < first || t.triangle >= first + count)
-            continue;
-        double e = (double)p[0] + p[1] + p[2];
-        sum += e, n++;
-        *top = fmax(*top, e);
-    }
-    assert_true(n > 20);
-    *mean = sum / n;
-}
-
 static double frame_mean(const float *rgb, int pixels)
 {
     double sum = 0.0;
@@ -363,17 +347,12 @@ static void test_thin_wall_and_corners(void **state)
                          .material_count = 1, .lights = &lamp, .light_count = 1};
     lmgi_scene *sc = load(&d, 0.0f);
     lmgi_context *ctx = lmt_context();
-    lmgi_updater_desc ud;
-    memset(&ud, 0, sizeof ud);
-    lmgi_updater *u = updater(ctx, sc, &ud);
-    lmgi_bake_report r;
-    lmt_bake(u, &r);
     size_t n;
-    float *iim = lmt_iim(u, sc, &n);
-    assert_true(all_finite(iim, n));
+    float *iim;
+    lmgi_updater *u = baked(ctx, sc, 1, &iim, &n);
     double lit_mean, lit_top, dark_mean, dark_top;
-    tri_range_stats(sc, iim, 0, 12, &lit_mean, &lit_top);
-    tri_range_stats(sc, iim, 12, 12, &dark_mean, &dark_top);
+    lmt_triangles_stats(sc, iim, 0, 12, &lit_mean, &lit_top);
+    lmt_triangles_stats(sc, iim, 12, 12, &dark_mean, &dark_top);
     print_message("thin wall (1e-4): lit room IIM mean %.4g (largest %.4g), dark room mean %.3g, largest %.3g "
                   "(%.2g%% of the lit mean)\n", lit_mean, lit_top, dark_mean, dark_top, 100.0 * dark_top / lit_mean);
     assert_true(lit_mean > 0.0);
@@ -425,14 +404,9 @@ static void test_grazing_light(void **state)
                          .lights = &light, .light_count = 1};
     lmgi_scene *sc = load(&d, 0.0f);
     lmgi_context *ctx = lmt_context();
-    lmgi_updater_desc ud;
-    memset(&ud, 0, sizeof ud);
-    lmgi_updater *u = updater(ctx, sc, &ud);
-    lmgi_bake_report r;
-    lmt_bake(u, &r);
     size_t n;
-    float *iim = lmt_iim(u, sc, &n);
-    assert_true(all_finite(iim, n));
+    float *iim;
+    lmgi_updater *u = baked(ctx, sc, 1, &iim, &n);
     lmgi_error e;
     float *aim = malloc(n * sizeof *aim);
     assert_non_null(aim);
@@ -499,10 +473,10 @@ static void test_slivers_and_zero_area(void **state)
     float *want = bake_with(ctx, a, 1, &n), *got = bake_with(ctx, b, 1, &m);
     assert_true(all_finite(got, m));
     double w_room, w_carpet, g_room, g_carpet, top;
-    tri_range_stats(a, want, 0, 12, &w_room, &top);
-    tri_range_stats(a, want, 12, 2, &w_carpet, &top);
-    tri_range_stats(b, got, 0, 12, &g_room, &top);
-    tri_range_stats(b, got, 12, 6, &g_carpet, &top);
+    lmt_triangles_stats(a, want, 0, 12, &w_room, &top);
+    lmt_triangles_stats(a, want, 12, 2, &w_carpet, &top);
+    lmt_triangles_stats(b, got, 0, 12, &g_room, &top);
+    lmt_triangles_stats(b, got, 12, 6, &g_carpet, &top);
     print_message("sliver and zero-area triangles: carpet %.4f (clean %.4f, %+.2f%%), room %.4f (%+.2f%%)\n", g_carpet,
                   w_carpet, 100.0 * (g_carpet / w_carpet - 1.0), g_room, 100.0 * (g_room / w_room - 1.0));
     assert_true(fabs(g_carpet / w_carpet - 1.0) < 0.01);
@@ -516,16 +490,11 @@ static void test_slivers_and_zero_area(void **state)
  * every value finite, the picture lit. Returns the room's IIM mean before the move. */
 static double bake_move_and_draw(lmgi_context *ctx, lmgi_scene *sc)
 {
-    lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
-    lmgi_updater *u = updater(ctx, sc, &d);
-    lmgi_bake_report r;
-    lmt_bake(u, &r);
     size_t n;
-    float *iim = lmt_iim(u, sc, &n);
-    assert_true(all_finite(iim, n));
+    float *iim;
+    lmgi_updater *u = baked(ctx, sc, 1, &iim, &n);
     double room, top;
-    tri_range_stats(sc, iim, 0, 12, &room, &top);
+    lmt_triangles_stats(sc, iim, 0, 12, &room, &top);
     free(iim);
     lmgi_error e;
     float moved[16];
@@ -661,19 +630,16 @@ static void test_photons_on_a_vertex_and_seams(void **state)
     double energy[2], room[2], top;
     for (int k = 0; k < 2; k++) {
         lmgi_scene *sc = plate_under_spot(k);
-        lmgi_updater_desc d;
-        memset(&d, 0, sizeof d);
-        lmgi_updater *u = updater(ctx, sc, &d);
-        lmgi_bake_report r;
-        lmt_bake(u, &r);
         size_t n;
-        float *iim = lmt_iim(u, sc, &n), *aim = malloc(n * sizeof *aim);
+        float *iim;
+        lmgi_updater *u = baked(ctx, sc, 1, &iim, &n);
+        float *aim = malloc(n * sizeof *aim);
         assert_non_null(aim);
         lmgi_error e;
         assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim, n, &e), LMGI_OK);
-        assert_true(all_finite(iim, n) && all_finite(aim, n));
+        assert_true(all_finite(aim, n));
         energy[k] = plate_energy(sc, aim);
-        tri_range_stats(sc, iim, 0, 12, &room[k], &top);
+        lmt_triangles_stats(sc, iim, 0, 12, &room[k], &top);
         free(iim), free(aim);
         lmgi_updater_free(u);
         lmgi_free(sc);
