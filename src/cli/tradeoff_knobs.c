@@ -111,7 +111,7 @@ static const knob KNOBS[] = {
     {"photons_per_group", "photons per group", {40, 80, 160, 320, 640}, 5, {40, 160, 640}, 3, NAN, set_per_group, 0},
     {"groups", "groups per light", {18, 36, 72, 144, 288}, 5, {18, 72, 288}, 3, 72, set_groups, 0},
     {"nearest", "photons per AIM estimate N", {16, 32, 64, 128, 256}, 5, {16, 32, 128}, 3, 32, set_nearest, 0},
-    {"texels", "atlas texels (x the default)", {0.25, 0.5, 1, 2, 4}, 5, {0.5, 1, 2}, 3, 1, set_texels, 0},
+    {"texels", "atlas texels (x the default)", {0.25, 0.5, 1, 2, 4}, 5, {0.5, 1}, 2, 1, set_texels, 0},
     {"hemicube", "hemicube resolution R", {16, 24, 32, 48, 64}, 5, {16, 32, 64}, 3, 32, set_hemicube, 0},
     {"enlargement", "hemicube enlargement a", {1, 1.5, 2, 3}, 4, {1, 2, 3}, 3, 2, set_enlargement, 0},
     {"hemicube_samples", "AIM lookups per hemicube pixel", {1, 4}, 2, {1, 4}, 2, 4, set_samples, 0},
