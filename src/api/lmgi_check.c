@@ -111,15 +111,14 @@ lmgi_status lmgi_check_updater(lmgi_updater *u, const lmgi_camera *cam, int widt
     float *rgb = malloc((size_t)width * (size_t)height * 3 * sizeof *rgb);
     if (!rgb)
         return lm_export_error(err, &(lm_error){LM_ERR_NOMEM, "lmgi_check_updater: no memory for the picture"});
-    lmgi_status rc = lmgi_render(u, cam, width, height, rgb, err);
-    if (rc != LMGI_OK)
-        return free(rgb), rc;
     lmgi_context *ctx = lm_updater_context(u);
     lm_log_target saved = lm_api_enter(ctx);
     lm_error e;
     lm_frame_check c;
     memset(&c, 0, sizeof c);
-    lm_status st = lm_gl_make_current(ctx->gl, &e); /* the surface index picture is drawn on it */
+    lm_status st = lm_updater_render(u, &v, width, height, rgb, &e); /* as lmgi_render draws it */
+    if (st == LM_OK)
+        st = lm_gl_make_current(ctx->gl, &e); /* the surface index picture is drawn on it */
     if (st == LM_OK)
         st = lm_frame_check_picture(sc, &v, rgb, width, height, &rs, &c, &e);
     if (st == LM_OK)

@@ -512,9 +512,14 @@ lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int 
         return LMGI_ERR_INVALID;
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
-    lm_status st = lm_frame_loop_render(u->loop, &v, width, height, rgb, &e);
+    lm_status st = lm_updater_render(u, &v, width, height, rgb, &e);
     lm_api_leave(saved);
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+lm_status lm_updater_render(lmgi_updater *u, const lm_view *v, int width, int height, float *rgb, lm_error *err)
+{
+    return lm_frame_loop_render(u->loop, v, width, height, rgb, err);
 }
 
 /* The displayed IIM read back into *raw (the caller frees it), and each texel's validity into rgba's

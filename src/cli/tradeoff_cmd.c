@@ -133,7 +133,6 @@ static int lightmap_errors(lmgi_updater *u, const atlas_state *as, lm_tradeoff_r
     return ok;
 }
 
-
 /* The frame the way `lmgi check` compares it (lmgi_check: one update at time 0 against the reference
  * pixels of the same camera). */
 static int frame_errors(lmgi_context *ctx, const atlas_state *as, const lmgi_updater_desc *d,

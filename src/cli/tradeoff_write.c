@@ -264,7 +264,6 @@ static int lag_of(const lm_edit_script *s, const lm_tradeoff_play *p, int i, edi
     return 1;
 }
 
-
 static int write_lag_csv(const char *path, const lm_tradeoff_run *run)
 {
     FILE *f = fopen(path, "w");

@@ -96,7 +96,6 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
         for (int k = 0; k < 3; k++)
             lm_scene_vertex_world(r->scene, r->scene->tris[3 * (size_t)h.tri + k], p[k]);
         lm_uv_gradient(p, uv, gu, gv);
-        float u = hit[0], v = hit[1];
         const lm_chart *ch = &r->atlas->charts[r->atlas->tri_chart[h.tri]];
         float lo[2] = {(float)ch->x / r->atlas->width, (float)ch->y / r->atlas->height};
         float hi[2] = {(float)(ch->x + ch->w) / r->atlas->width, (float)(ch->y + ch->h) / r->atlas->height};
@@ -108,14 +107,14 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
                 if (lm_dot(ds, G) <= 0.0f)
                     continue;
                 double den = lm_dot(ng, ds), ts = num / den;
-                float su = u, sv = v, L[3];
+                float su = hit[0], sv = hit[1], L[3];
                 /* meets the plane on the same side, not much further or nearer than the ray's own hit (at
                  * grazing angles the stratum's far sub-directions would reach across the whole plane, past
                  * whatever hides it): its point's uv; otherwise the ray's */
                 if (ts > 0.5 * h.t && ts < 2.0 * h.t) {
                     lm_vec3 off = lm_sub(lm_add(e, lm_scale(ds, (float)ts)), P);
-                    su = fminf(fmaxf(u + lm_dot(lm_v3_load(gu), off), lo[0]), hi[0]);
-                    sv = fminf(fmaxf(v + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
+                    su = fminf(fmaxf(hit[0] + lm_dot(lm_v3_load(gu), off), lo[0]), hi[0]);
+                    sv = fminf(fmaxf(hit[1] + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
                 }
                 lm_atlas_sample_rgb(r->atlas, r->aim, su, sv, L);
                 for (int k = 0; k < 3; k++)
