@@ -33,11 +33,11 @@ VIS          := -fvisibility=hidden
 CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)
 CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fvisibility-inlines-hidden -fopenmp -Iinclude \
                 -I/usr/include/stb $(SAN) $(CXXFLAGS)
-LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lOSMesa -lEGL -lgomp -lstdc++ -lm -lpthread
+LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lwebp -lOSMesa -lEGL -lgomp -lstdc++ -lm -lpthread
 LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
 
 DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
-                nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libcmocka-dev \
+                nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libwebp-dev libcmocka-dev \
                 libegl-dev libegl-mesa0 python3-matplotlib
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \

@@ -4,7 +4,6 @@
 // tinygltf 2.7 parses the JSON but does not validate those. docs/loading.md lists what is accepted.
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
-#include <stb_image.h>
 
 #include <cerrno>
 #include <cmath>
@@ -21,6 +20,7 @@ extern "C" {
 #include "../core/error.h"
 #include "../core/log.h"
 #include "scene.h"
+#include "image_decode.h"
 #include "scene_build.h"
 }
 
@@ -28,8 +28,7 @@ namespace {
 
 const char *const k_supported_required[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_transmission", "KHR_materials_ior",
-                                            "KHR_texture_transform"};
-const long long k_max_texels = 1LL << 26;        // larger images are skipped with a warning
+                                            "KHR_texture_transform", "EXT_texture_webp"};
 const size_t k_max_unbacked_elems = 1u << 24;    // accessors without a bufferView (all zeros)
 const uint32_t k_glb_json = 0x4E4F534Au, k_glb_bin = 0x004E4942u;
 
@@ -95,11 +94,12 @@ void vec_or(const std::vector<double> &v, size_t n, const float *def, float *out
 
 bool finite_all(const float *v, size_t n) { return lm_first_nonfinite(v, n) < 0; }
 
-// stb_image decoding for tinygltf, to 8-bit RGBA. An undecodable or oversized image is a warning (the
-// material keeps its factor), and an image whose bufferView lies outside its buffer is an error:
-// tinygltf hands us a pointer it never checked.
-bool decode_image(tinygltf::Image *img, const int idx, std::string *err, std::string *warn, int, int,
-                  const unsigned char *bytes, int size, void *user)
+// tinygltf's image callback: keeps the encoded bytes (img->as_is) for Loader::decode, which decodes only
+// the images a material uses, at the size lmgi needs (image_decode.h); decoding every image here held
+// them all at full size at once. An image whose bufferView lies outside its buffer is an error: tinygltf
+// hands us a pointer it never checked.
+bool keep_image_bytes(tinygltf::Image *img, const int idx, std::string *err, std::string *, int, int,
+                      const unsigned char *bytes, int size, void *user)
 {
     const tinygltf::Model *model = static_cast<const tinygltf::Model *>(user);
     if (img->bufferView >= 0) {
@@ -111,20 +111,9 @@ bool decode_image(tinygltf::Image *img, const int idx, std::string *err, std::st
             return false;
         }
     }
-    int w = 0, h = 0, comp = 0;
-    bool ok = size > 0 && stbi_info_from_memory(bytes, size, &w, &h, &comp) && w > 0 && h > 0 &&
-              (long long)w * h <= k_max_texels;
-    unsigned char *px = ok ? stbi_load_from_memory(bytes, size, &w, &h, &comp, 4) : nullptr;
-    img->image.clear();
+    img->image.assign(bytes, bytes + (size > 0 ? size : 0));
+    img->as_is = true;
     img->width = img->height = 0;
-    if (!px) {
-        *warn += "image " + std::to_string(idx) + " (\"" + img->name + "\") could not be decoded; ignored\n";
-        return true;
-    }
-    img->image.assign(px, px + size_t(w) * size_t(h) * 4);
-    stbi_image_free(px);
-    img->width = w, img->height = h, img->component = 4, img->bits = 8;
-    img->pixel_type = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE;
     return true;
 }
 
@@ -163,7 +152,10 @@ class Loader {
     lm_status locate(int acc, int type, const char *what, const std::string &ctx, Span &sp);
     lm_status read_floats(int acc, int type, bool force_norm, const char *what, const std::string &ctx,
                           std::vector<float> &out, size_t &count);
+    int image_of(int tex_index) const;
+    bool decode(int img, bool srgb, std::vector<uint8_t> &rgba, int &w, int &h);
     int texture(int tex_index, const std::string &ctx);
+    void metal_rough_from_texture(const tinygltf::PbrMetallicRoughness &pbr, lm_material &d);
     lm_status materials();
     lm_status nodes();
     lm_status node_instances();
@@ -179,7 +171,7 @@ class Loader {
     bool strict_ = false;
     tinygltf::Model model_;
     ScenePtr s_;
-    std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted)
+    std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet decoded, -2 undecodable)
     std::vector<lm_texture> textures_;
     std::vector<unsigned char> animated_;
     bool need_default_material_ = false;
@@ -357,7 +349,7 @@ lm_status Loader::parse(const std::vector<unsigned char> &bytes)
     if (slash != std::string::npos)
         dir = slash == 0 ? "/" : p.substr(0, slash);
     tinygltf::TinyGLTF gltf;
-    gltf.SetImageLoader(decode_image, &model_);
+    gltf.SetImageLoader(keep_image_bytes, &model_);
     tinygltf::FsCallbacks fs = {mem_ ? &any_file_exists : &tinygltf::FileExists, &tinygltf::ExpandFilePath,
                                 mem_ ? &refuse_external_file : &read_whole_file, &tinygltf::WriteWholeFile, nullptr};
     gltf.SetFsCallbacks(fs);
@@ -461,28 +453,82 @@ lm_status Loader::read_floats(int acc, int type, bool force_norm, const char *wh
     return LM_OK;
 }
 
+// The glTF image that texture `tex_index` shows: EXT_texture_webp's source where the texture has one (the
+// extension's own image; `source` is then a fallback for readers without WebP), else `source`; -1 if
+// none names an image.
+int Loader::image_of(int tex_index) const
+{
+    if (tex_index < 0 || size_t(tex_index) >= model_.textures.size())
+        return -1;
+    const tinygltf::Texture &t = model_.textures[size_t(tex_index)];
+    int img = int_prop(ext_obj(t.extensions, "EXT_texture_webp"), "source", t.source);
+    return img >= 0 && size_t(img) < model_.images.size() ? img : -1;
+}
+
+// Decodes image `img` to 8-bit RGBA at LM_TEXTURE_MAX_SIDE; false (with a warning naming the image) when
+// it cannot be.
+bool Loader::decode(int img, bool srgb, std::vector<uint8_t> &rgba, int &w, int &h)
+{
+    const tinygltf::Image &im = model_.images[size_t(img)];
+    if (im.image.empty())
+        return false; // unreadable file: tinygltf said so as it parsed
+    uint8_t *px = nullptr;
+    const char *why = "";
+    lm_status st = lm_image_decode(im.image.data(), im.image.size(), LM_TEXTURE_MAX_SIDE, srgb, &px, &w, &h, &why);
+    if (st == LM_ERR_NOMEM)
+        throw std::bad_alloc();
+    if (st) {
+        const std::string &label = im.name.empty() ? im.uri : im.name;
+        lm_warn("%s: image %d (\"%.200s\"): %s; ignored", path_, img, label.c_str(), why);
+        return false;
+    }
+    rgba.assign(px, px + size_t(w) * size_t(h) * 4);
+    free(px);
+    return true;
+}
+
 // lm texture index for glTF texture `tex_index` (-1 if none or undecodable); colour textures are sRGB.
 int Loader::texture(int tex_index, const std::string &ctx)
 {
     if (tex_index < 0)
         return -1;
-    if (size_t(tex_index) >= model_.textures.size() || model_.textures[size_t(tex_index)].source < 0 ||
-        size_t(model_.textures[size_t(tex_index)].source) >= model_.images.size()) {
+    int img = image_of(tex_index);
+    if (img < 0) {
         lm_warn("%s: %s: texture %d is missing; using the factor alone", path_, ctx.c_str(), tex_index);
         return -1;
     }
-    size_t img = size_t(model_.textures[size_t(tex_index)].source);
-    if (image_tex_[img] >= 0)
-        return image_tex_[img];
-    const tinygltf::Image &im = model_.images[img];
-    if (im.width <= 0 || im.height <= 0 || im.image.size() != size_t(im.width) * size_t(im.height) * 4)
-        return -1; // decode failure, already warned
+    if (image_tex_[size_t(img)] != -1)
+        return image_tex_[size_t(img)] < 0 ? -1 : image_tex_[size_t(img)];
+    std::vector<uint8_t> rgba;
+    int w = 0, h = 0;
+    if (!decode(img, true, rgba, w, h)) {
+        image_tex_[size_t(img)] = -2; // warned once
+        return -1;
+    }
     lm_texture t = {0, 0, nullptr};
-    if (!lm_texture_from_rgba8(&t, im.image.data(), im.width, im.height, 1))
+    if (!lm_texture_from_rgba8(&t, rgba.data(), w, h, 1))
         throw std::bad_alloc();
     textures_.push_back(t);
-    image_tex_[img] = int(textures_.size() - 1);
-    return image_tex_[img];
+    image_tex_[size_t(img)] = int(textures_.size() - 1);
+    return image_tex_[size_t(img)];
+}
+
+// metallicRoughnessTexture (glTF: roughness in G, metalness in B, linear): the factors become factor x the
+// texture's mean, so a material is metal as far as its texels are. UnityGLTF, for one, leaves
+// metallicFactor at its default 1 and puts the metalness in this texture alone.
+void Loader::metal_rough_from_texture(const tinygltf::PbrMetallicRoughness &pbr, lm_material &d)
+{
+    int img = image_of(pbr.metallicRoughnessTexture.index);
+    std::vector<uint8_t> px;
+    int w = 0, h = 0;
+    if (img < 0 || !decode(img, false, px, w, h))
+        return;
+    double g = 0.0, b = 0.0;
+    size_t n = size_t(w) * size_t(h);
+    for (size_t i = 0; i < n; i++)
+        g += px[4 * i + 1], b += px[4 * i + 2];
+    d.roughness *= float(g / (255.0 * double(n)));
+    d.metallic *= float(b / (255.0 * double(n)));
 }
 
 lm_status Loader::materials()
@@ -516,6 +562,8 @@ lm_status Loader::materials()
         }
         d.metallic = float(pbr.metallicFactor);
         d.roughness = float(pbr.roughnessFactor);
+        if (pbr.metallicRoughnessTexture.index >= 0)
+            metal_rough_from_texture(pbr, d);
         vec_or(m.emissiveFactor, 3, zero3, d.emissive);
         float strength = float(num(ext_obj(m.extensions, "KHR_materials_emissive_strength"), "emissiveStrength", 1.0));
         for (int k = 0; k < 3; k++)
