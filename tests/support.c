@@ -315,7 +315,9 @@ int lmt_gl_teardown(void **state)
     return 0;
 }
 
-const char *lmt_plane_scene(void)
+const char *lmt_plane_scene(void) { return lmt_plane_scene_with("{\"type\": \"point\", \"intensity\": 10}"); }
+
+const char *lmt_plane_scene_with(const char *light)
 {
     static char path[512];
     static lmt_mesh m;
@@ -323,8 +325,10 @@ const char *lmt_plane_scene(void)
     lmt_mesh_quad(&m, (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
     const char *nodes = "[{\"children\": [1, 2]}, {\"mesh\": 0},"
                         " {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
-    const char *ext = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
-                      " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}},";
+    char ext[512];
+    snprintf(ext, sizeof ext,
+             "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [%s]}},",
+             light);
     snprintf(path, sizeof path, "%s/plane.gltf", lmt_tmpdir());
     if (lmt_write_gltf(path, &m, 1, nodes, NULL, 0, ext) != 0)
         fail_msg("cannot write %s", path);

@@ -62,6 +62,9 @@ int lmt_gl_teardown(void **state);
 /* A 20 x 20 plane (y = 0, facing up, default 0.8 grey material) under a point light of intensity 10 at
  * height 2, written to a fresh temporary directory; returns its path (static storage). */
 const char *lmt_plane_scene(void);
+/* The same plane under one light at (0, 2, 0) given as KHR_lights_punctual JSON (its node turns nothing:
+ * a spot shines down -Z). */
+const char *lmt_plane_scene_with(const char *light);
 
 
 /* Material and light JSON for lmt_write_scene's materials text: a grey diffuse material, a mirror of albedo

@@ -137,6 +137,30 @@ static void test_point_plane(void **state)
     free(rgb);
 }
 
+/* KHR_lights_punctual range 3 on the same light: rho/pi I h / d^3 x clamp(1 - (d / 3)^4, 0, 1) over the
+ * whole picture; the corners (d = 3.46) get no light at all. */
+static void test_point_plane_range(void **state)
+{
+    (void)state;
+    float *rgb = render(lmt_plane_scene_with("{\"type\": \"point\", \"intensity\": 10, \"range\": 3}"));
+    double worst = 0.0, dark = 0.0;
+    for (int r = 0; r < W; r++)
+        for (int i = 0; i < W; i++) {
+            double x, z;
+            pixel_xz(i, r, &x, &z);
+            double d2 = x * x + z * z + 4.0, q = d2 / 9.0, window = fmax(0.0, 1.0 - q * q);
+            double want = RHO / PI * 10.0 * 2.0 / (d2 * sqrt(d2)) * window, got = lum(rgb + 3 * (r * W + i));
+            if (window == 0.0)
+                dark = fmax(dark, got);
+            else if (window > 0.1)
+                worst = fmax(worst, rel(got, want));
+        }
+    print_message("point light, range 3: worst where lit %.2e, brightest beyond the range %.2e\n", worst, dark);
+    assert_true(worst < 0.03);
+    assert_true(dark == 0.0);
+    free(rgb);
+}
+
 /* Does the segment from plane point (x, 0, z) to the light (0, 2, 0) pass through the box centred at
  * (0.5, 1, box_z) with half-size h? (slab test) */
 static int hits_box(double x, double z, double box_z, double h)
@@ -638,7 +662,7 @@ static void test_cache_nothing_moved(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_point_plane), cmocka_unit_test(test_box_shadow), cmocka_unit_test(test_box_shadow_every_face), cmocka_unit_test(test_grazing),
+        cmocka_unit_test(test_point_plane), cmocka_unit_test(test_point_plane_range), cmocka_unit_test(test_box_shadow), cmocka_unit_test(test_box_shadow_every_face), cmocka_unit_test(test_grazing),
         cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
         cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
         cmocka_unit_test(test_cache_nothing_moved),

@@ -263,6 +263,35 @@ static void test_nee_point_light_irradiance(void **state)
     lm_emitters_free(&em);
 }
 
+/* KHR_lights_punctual range 1.5 on that light: its inverse square times clamp(1 - (d / range)^4, 0, 1), the
+ * extension's recommended window; no light at all from 1.5 on; directional lights have no range. */
+static void test_nee_point_light_range(void **state)
+{
+    (void)state;
+    tscene t;
+    make_scene(&t, 1.0f, 0.0f, 1);
+    add_light(&t, LM_LIGHT_POINT, 2.0f, (float[3]){0, 1, 0});
+    t.lights[0].range = 1.5f;
+    lm_emitters em;
+    lm_error err;
+    assert_int_equal(lm_emitters_build(&t.s, &em, &err), LM_OK);
+    for (int i = 0; i < 8; i++) {
+        float x = 0.25f * (float)i, p[3] = {x, 0, 0};
+        double d2 = x * x + 1.0, r = sqrt(d2) / 1.5, window = fmax(0.0, 1.0 - r * r * r * r);
+        lm_light_sample ls;
+        int lit = lm_emitter_sample_toward(&em, &t.s, 0, p, (float[3]){0.5f, 0.5f, 0.5f}, &ls);
+        assert_int_equal(lit, window > 0.0);
+        if (lit)
+            assert_float_equal(ls.weight[0], 2.0 * window / d2, 1e-5);
+    }
+    assert_float_equal(lm_light_range_window(&t.lights[0], 0.0f), 1.0f, 0.0f);
+    t.lights[0].type = LM_LIGHT_DIRECTIONAL;
+    assert_float_equal(lm_light_range_window(&t.lights[0], 100.0f), 1.0f, 0.0f);
+    t.lights[0].type = LM_LIGHT_POINT, t.lights[0].range = 0.0f; /* absent: no window */
+    assert_float_equal(lm_light_range_window(&t.lights[0], 1e6f), 1.0f, 0.0f);
+    lm_emitters_free(&em);
+}
+
 /* Irradiance under a square Lambertian emitter: E = pi Le F, F the point-to-rectangle form factor
  * summed over the four corner rectangles (a x a at height h):
  * F = 1/(2 pi) [X/sqrt(1+X^2) atan(Y/sqrt(1+X^2)) + Y/sqrt(1+Y^2) atan(X/sqrt(1+Y^2))], X = Y = a/h. */
@@ -668,6 +697,7 @@ int main(void)
         cmocka_unit_test(test_area_flux_and_emission),
         cmocka_unit_test(test_directional_flux),
         cmocka_unit_test(test_nee_point_light_irradiance),
+        cmocka_unit_test(test_nee_point_light_range),
         cmocka_unit_test(test_nee_area_light_irradiance),
         cmocka_unit_test(test_shading_from_hit),
         cmocka_unit_test(test_shading_moved_node),

@@ -80,6 +80,40 @@ static void test_aim_point_light_over_plane(void **state)
     aim_point_light_over_plane(0, 0.03, 0.25);
 }
 
+/* KHR_lights_punctual range 3 on that light: photons carry the window from their first hit, so the AIM
+ * follows rho/pi I h / d^3 x clamp(1 - (d / 3)^4, 0, 1) and holds nothing beyond d = 3 but what the
+ * estimate's radius blurs across (less than 1% of the light within it). */
+static void test_aim_point_light_range(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, lmt_plane_scene_with("{\"type\": \"point\", \"intensity\": 10, \"range\": 3}"), 0.1f);
+    lm_photon_stage *st = stage_for(&p, 400000, 0);
+    const float *rgb = lm_aim_rgb(lm_photon_stage_aim(st));
+    double err2 = 0.0, ref2 = 0.0, inside = 0.0, beyond = 0.0;
+    for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
+        const lm_texel *t = &p.atlas.texels[i];
+        double d2 = t->pos[0] * t->pos[0] + t->pos[2] * t->pos[2] + 4.0, q = d2 / 9.0;
+        double want = 0.8 / PI * 10.0 * 2.0 / (d2 * sqrt(d2)) * fmax(0.0, 1.0 - q * q);
+        double got = rgb[3 * ((size_t)t->y * p.atlas.width + t->x)];
+        if (d2 >= 9.0 + 1.0) /* a metre past the cut-off: beyond the estimate's radius */
+            beyond += got;
+        else if (d2 < 9.0)
+            inside += got;
+        if (d2 < 8.0) {
+            err2 += (got - want) * (got - want);
+            ref2 += want * want;
+        }
+    }
+    double rmse = sqrt(err2 / ref2);
+    print_message("range 3: AIM vs analytic relative RMSE %.4f; beyond the range %.2e of the light within it\n", rmse,
+                  beyond / inside);
+    assert_true(rmse < 0.05);
+    assert_true(beyond / inside < 0.01);
+    lm_photon_stage_free(st);
+    lmt_pipeline_free(&p);
+}
+
 /* 1 if the texel's normal runs into an emitter within 1% of the scene size: the ceiling patch hidden
  * right behind the shared Cornell box's lamp, which the lamp's back side lights from 0.1 mm away. No
  * one can see it, and no N-nearest estimate resolves a spike that narrow. */
@@ -209,6 +243,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_aim_point_light_over_plane),
+        cmocka_unit_test(test_aim_point_light_range),
         cmocka_unit_test(test_cornell_box_aims_against_reference),
         cmocka_unit_test(test_photons_command),
     };

@@ -32,7 +32,7 @@ void lm_direct_settings_default(lm_direct_settings *s)
 
 typedef struct {
     GLint lpos, ldir, radiant, origin, cos_outer, spot_width, texel, map_size, light_vp;
-    GLint view_proj, eye, view_dir, ortho_view, normal_offset, slope_bias, max_slope, const_bias, range;
+    GLint view_proj, eye, view_dir, ortho_view, normal_offset, slope_bias, max_slope, const_bias, range, light_range;
     GLint map2d, mapcube, base_tex, lit, use_lit;
 } uniforms;
 
@@ -72,7 +72,7 @@ static void find_uniforms(GLuint p, uniforms *u)
 #define LOC(name) u->name = glGetUniformLocation(p, #name)
     LOC(lpos); LOC(ldir); LOC(radiant); LOC(origin); LOC(cos_outer);
     LOC(spot_width); LOC(texel); LOC(map_size); LOC(light_vp); LOC(view_proj); LOC(eye); LOC(view_dir);
-    LOC(ortho_view); LOC(normal_offset); LOC(slope_bias); LOC(max_slope); LOC(const_bias); LOC(range);
+    LOC(ortho_view); LOC(normal_offset); LOC(slope_bias); LOC(max_slope); LOC(const_bias); LOC(range); LOC(light_range);
     LOC(map2d); LOC(mapcube); LOC(base_tex); LOC(lit); LOC(use_lit);
 #undef LOC
 }
@@ -99,6 +99,7 @@ static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_em
     glUniform1f(u->texel, m->p.texel);
     glUniform1f(u->map_size, (float)m->p.size);
     glUniform1f(u->range, m->p.range);
+    glUniform1f(u->light_range, kind == 2 ? 0.0f : s->lights[e->light].range); /* lm_light_range_window's */
     glUniformMatrix4fv(u->light_vp, 1, GL_FALSE, m->p.light_vp);
     glActiveTexture(m->p.cube ? GL_TEXTURE1 : GL_TEXTURE0);
     glBindTexture(m->p.cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D, m->tex);

@@ -106,8 +106,8 @@ int lm_caustic_emit(const lm_emitters *em, const lm_scene *s, int e, const lm_em
 
 /* ---- paths ---- */
 
-lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, int generator, const float org_[3],
-                                  const float dir_[3], const float flux_[3], uint32_t max_bounces,
+lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, const lm_emitter *source, int generator,
+                                  const float org_[3], const float dir_[3], const float flux_[3], uint32_t max_bounces,
                                   lm_caustic_numbers next, void *user, lm_caustic_hit *hit, uint32_t *rays)
 {
     float org[3], dir[3], flux[3];
@@ -123,6 +123,10 @@ lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, int genera
         if (!lm_rt_intersect(rt, org, dir, 0.0f, INFINITY, &h)) {
             fate = b == 0 ? LM_CAUSTIC_MISSED : LM_CAUSTIC_ESCAPED;
             break;
+        }
+        if (b == 0) {
+            float w = lm_emitter_range_window(s, source, h.t);
+            flux[0] *= w, flux[1] *= w, flux[2] *= w;
         }
         lm_shading sh;
         lm_shading_from_hit(s, &h, org, dir, &sh);
@@ -358,8 +362,8 @@ static lm_caustic_fate trace_slot(const lm_caustics *c, uint32_t slot, lm_causti
                          flux))
         return LM_CAUSTIC_MISSED;
     numbers_user nu = {c, slot};
-    lm_caustic_fate f = lm_caustic_follow(c->scene, c->rt, c->gen[p->generator].node, org, dir, flux,
-                                          c->set.max_bounces, bounce_number, &nu, hit, rays);
+    lm_caustic_fate f = lm_caustic_follow(c->scene, c->rt, &c->em->e[p->emitter], c->gen[p->generator].node, org,
+                                          dir, flux, c->set.max_bounces, bounce_number, &nu, hit, rays);
     if (f != LM_CAUSTIC_MISSED)
         for (int k = 0; k < 3; k++)
             emitted[k] = flux[k];

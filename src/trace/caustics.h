@@ -90,10 +90,11 @@ typedef enum {
 /* Follows a photon from org along dir: its first hit must be a specular triangle of node `generator`
  * (-1: any specular triangle), then specular bounces with the numbers next(user, bounce) gives (one per
  * bounce: glass's reflect-or-refract), until it lands (hit filled, flux included) or ends. *rays
- * (may be NULL) gets the rays cast. Reads the scene and BVH only: thread-safe. */
+ * (may be NULL) gets the rays cast. source: the emitter (its range windows the flux at the first hit,
+ * lm_emitter_range_window). Reads the scene and BVH only: thread-safe. */
 typedef float (*lm_caustic_numbers)(void *user, uint32_t bounce);
-lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, int generator, const float org[3],
-                                  const float dir[3], const float flux[3], uint32_t max_bounces,
+lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, const lm_emitter *source, int generator,
+                                  const float org[3], const float dir[3], const float flux[3], uint32_t max_bounces,
                                   lm_caustic_numbers next, void *user, lm_caustic_hit *hit, uint32_t *rays);
 
 /* The generators of s as they are now (world bounds of their specular triangles), nodes whose switch is

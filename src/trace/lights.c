@@ -15,8 +15,8 @@
  *                surface by 1e-5 x the scene size.
  * Next-event estimation (lm_emitter_sample_toward): the delta lights are evaluated exactly (weight =
  * I att / d^2, or E for directional); an area emitter gets a point chosen by u[0] (triangle, by flux)
- * and u[1], u[2] (uniform on it), weight = Le cos_l / (d^2 pdf_area). The glTF `range` is ignored
- * (physical inverse-square falloff everywhere), as are emissive textures. */
+ * and u[1], u[2] (uniform on it), weight = Le cos_l / (d^2 pdf_area). A point or spot light's glTF
+ * `range` windows its inverse square (lm_light_range_window); emissive textures are not used. */
 #include "lights.h"
 
 #include <math.h>
@@ -49,6 +49,23 @@ float lm_spot_solid_angle(const lm_light *l)
     double co = cos((double)l->outer_cone), w = (double)spot_width(l), up = fmin(1.0, co + w);
     double ramp = (up - co) * (up - co) * (up - co) / (3.0 * w * w);
     return (float)(2.0 * LM_PI * (ramp + (1.0 - up)));
+}
+
+/* The window KHR_lights_punctual recommends for `range` (its reference implementation's
+ * attenuation is clamp(1 - (d / range)^4, 0, 1) / d^2): smooth, 1 near the light, 0 from range on.
+ * Range 0 (absent in the file) is no window. */
+float lm_light_range_window(const lm_light *l, float dist)
+{
+    if (!(l->range > 0.0f) || l->type == LM_LIGHT_DIRECTIONAL)
+        return 1.0f;
+    float r = dist / l->range, r2 = r * r;
+    return fminf(fmaxf(1.0f - r2 * r2, 0.0f), 1.0f);
+}
+
+float lm_emitter_range_window(const lm_scene *s, const lm_emitter *e, float dist)
+{
+    return e->kind == LM_EMIT_POINT || e->kind == LM_EMIT_SPOT ? lm_light_range_window(&s->lights[e->light], dist)
+                                                               : 1.0f;
 }
 
 /* ---- building and placement ---- */
@@ -415,6 +432,7 @@ static int toward_punctual(const lm_scene *s, const lm_emitter *e, lm_vec3 p, lm
     lm_vec3 dir = lm_scale(d, 1.0f / dist);
     if (e->kind == LM_EMIT_SPOT)
         att = lm_spot_attenuation(&s->lights[e->light], -lm_dot(dir, lm_v3_load(e->dir)));
+    att *= lm_light_range_window(&s->lights[e->light], dist);
     lm_v3_store(out->dir, dir);
     out->dist = dist;
     for (int c = 0; c < 3; c++)

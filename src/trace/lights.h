@@ -111,6 +111,12 @@ int lm_emitter_sample_toward(const lm_emitters *em, const lm_scene *s, int e, co
  * leaving the surface): the material's emissive for an emitter on an emitting side, else 0; returns
  * whether it is non-zero. Emissive textures are not used (the emissive factor is). */
 float lm_spot_attenuation(const lm_light *l, float cos_angle);
+/* KHR_lights_punctual `range` (lights.c): the factor on a point or spot light's inverse square at
+ * distance dist, clamp(1 - (dist / range)^4, 0, 1); 1 without a range and for directional lights.
+ * lm_emitter_range_window: the same for emitter e (1 for area emitters). Photons carry it from their
+ * first hit on (photon_trace.c, caustics.c), so photon maps, the gather and the reference agree. */
+float lm_light_range_window(const lm_light *l, float dist);
+float lm_emitter_range_window(const lm_scene *s, const lm_emitter *e, float dist);
 float lm_spot_solid_angle(const lm_light *l);
 float lm_emitter_pdf(const lm_emitters *em, const lm_scene *s, int e, uint32_t tri, const float p[3],
                      const float x[3]);

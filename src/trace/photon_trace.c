@@ -170,6 +170,10 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
         rays++;
         if (!lm_rt_intersect(ph->rt, org, dir, 0.0f, INFINITY, &hit))
             break;
+        if (b == 0) { /* a point or spot light's range: its light at the first hit, carried on from there */
+            float w = lm_emitter_range_window(ph->scene, &ph->em->e[g->emitter], hit.t);
+            flux[0] *= w, flux[1] *= w, flux[2] *= w;
+        }
         lm_shading sh;
         lm_shading_from_hit(ph->scene, &hit, org, dir, &sh);
         /* The vertex is recorded after the scatter (with the direction and flux it arrived with): by
