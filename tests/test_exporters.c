@@ -17,6 +17,7 @@
 #include <webp/encode.h>
 
 #include "../src/core/log.h"
+#include "../src/core/timing.h"
 #include "../src/scene/image_decode.h"
 #include "../src/scene/scene.h"
 #include "support.h"
@@ -205,6 +206,118 @@ static void test_metal_rough_texture(void **state)
     lm_scene_free(s);
 }
 
+/* Appends printf-formatted text to a growing buffer. */
+static void put(char **buf, size_t *len, size_t *cap, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    char piece[512];
+    int n = vsnprintf(piece, sizeof piece, fmt, ap);
+    va_end(ap);
+    assert_true(n >= 0 && (size_t)n < sizeof piece);
+    if (*len + (size_t)n + 1 > *cap) {
+        *cap = 2 * (*cap + (size_t)n + 1);
+        *buf = realloc(*buf, *cap);
+        assert_non_null(*buf);
+    }
+    memcpy(*buf + *len, piece, (size_t)n + 1);
+    *len += (size_t)n;
+}
+
+/* UnityGLTF's apartment block in small: 2,000 materials over 2,000 quads, their base colour from 300
+ * textures (each a 1024 x 1024 PNG). Every texture is reduced to 512 on decode, and `lmgi info` fits the
+ * scene on a screen: the totals, the first materials and lights, and how many more there are. */
+static void test_many_materials_and_textures(void **state)
+{
+    (void)state;
+    enum { MATERIALS = 2000, TEXTURES = 300, SIDE = 1024, PER_ROW = 50 };
+    const char *dir = lmt_tmpdir();
+    uint8_t *px = malloc((size_t)SIDE * SIDE * 4);
+    assert_non_null(px);
+    for (int i = 0; i < SIDE * SIDE; i++)
+        px[4 * i] = (uint8_t)(i % SIDE / 4), px[4 * i + 1] = (uint8_t)(i / SIDE / 4), px[4 * i + 2] = 128,
+                 px[4 * i + 3] = 255;
+    char path[700];
+    snprintf(path, sizeof path, "%s/wall.png", dir);
+    assert_true(stbi_write_png(path, SIDE, SIDE, 4, px, SIDE * 4) != 0);
+    free(px);
+    const uint16_t idx[6] = {0, 1, 2, 0, 2, 3};
+    const float pos[12] = {0, 0, 0, 1, 0, 0, 1, 0, -1, 0, 0, -1};
+    uint8_t bin[60];
+    memcpy(bin, idx, 12);
+    memcpy(bin + 12, pos, 48);
+    snprintf(path, sizeof path, "%s/quad.bin", dir);
+    lmt_write_file(path, bin, sizeof bin);
+    char *j = NULL;
+    size_t len = 0, cap = 0;
+    put(&j, &len, &cap, "{\"asset\": {\"version\": \"2.0\"}, \"buffers\": [{\"uri\": \"quad.bin\", \"byteLength\": 60}], "
+        "\"bufferViews\": [{\"buffer\": 0, \"byteLength\": 12}, {\"buffer\": 0, \"byteOffset\": 12, \"byteLength\": 48}], "
+        "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5123, \"count\": 6, \"type\": \"SCALAR\"}, "
+        "{\"bufferView\": 1, \"componentType\": 5126, \"count\": 4, \"type\": \"VEC3\", \"min\": [0, 0, -1], \"max\": [1, 0, 0]}], "
+        "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [");
+    for (int l = 0; l < 40; l++)
+        put(&j, &len, &cap, "%s{\"type\": \"point\", \"intensity\": 5, \"range\": 4}", l ? ", " : "");
+    put(&j, &len, &cap, "]}}, \"nodes\": [");
+    for (int i = 0; i < MATERIALS + 40; i++) {
+        float x = 1.5f * (float)(i % PER_ROW), z = -1.5f * (float)(i / PER_ROW % PER_ROW);
+        if (i < MATERIALS)
+            put(&j, &len, &cap, "%s{\"mesh\": %d, \"translation\": [%g, 0, %g]}", i ? ", " : "", i, x, z);
+        else
+            put(&j, &len, &cap, ", {\"translation\": [%g, 2, %g], \"extensions\": {\"KHR_lights_punctual\": {\"light\": %d}}}",
+                4.0f * (float)(i - MATERIALS), -20.0f, i - MATERIALS);
+    }
+    put(&j, &len, &cap, "], \"meshes\": [");
+    for (int i = 0; i < MATERIALS; i++)
+        put(&j, &len, &cap, "%s{\"primitives\": [{\"attributes\": {\"POSITION\": 1}, \"indices\": 0, \"material\": %d}]}",
+            i ? ", " : "", i);
+    put(&j, &len, &cap, "], \"materials\": [");
+    for (int i = 0; i < MATERIALS; i++)
+        put(&j, &len, &cap, "%s{\"name\": \"material_%04d\", \"pbrMetallicRoughness\": {\"baseColorTexture\": "
+            "{\"index\": %d}, \"metallicFactor\": 0}}", i ? ", " : "", i, i % TEXTURES);
+    put(&j, &len, &cap, "], \"textures\": [");
+    for (int i = 0; i < TEXTURES; i++)
+        put(&j, &len, &cap, "%s{\"source\": %d}", i ? ", " : "", i);
+    put(&j, &len, &cap, "], \"images\": [");
+    for (int i = 0; i < TEXTURES; i++) /* one file, named by every image: each image is decoded on its own */
+        put(&j, &len, &cap, "%s{\"uri\": \"wall.png\"}", i ? ", " : "");
+    put(&j, &len, &cap, "]}");
+    snprintf(path, sizeof path, "%s/apartments.gltf", dir);
+    lmt_write_file(path, j, len);
+    free(j);
+
+    double t0 = lm_now();
+    lm_scene *s = load(path);
+    double seconds = lm_now() - t0, bytes = 0.0;
+    assert_int_equal(s->material_count, MATERIALS);
+    assert_int_equal(s->texture_count, TEXTURES);
+    for (int i = 0; i < s->texture_count; i++) {
+        assert_int_equal(s->textures[i].width, LM_TEXTURE_MAX_SIDE);
+        bytes += 16.0 * s->textures[i].width * s->textures[i].height;
+    }
+    print_message("%d materials, %d textures of %d x %d: loaded in %.2f s; textures %.0f MiB as lmgi keeps them "
+                  "(%.0f MiB at full size)\n", MATERIALS, TEXTURES, SIDE, SIDE, seconds, bytes / 1048576.0,
+                  16.0 * SIDE * SIDE * TEXTURES / 1048576.0);
+    assert_true(bytes <= 16.0 * LM_TEXTURE_MAX_SIDE * LM_TEXTURE_MAX_SIDE * TEXTURES);
+    lm_scene_free(s);
+
+    const char *build = getenv("LMGI_BUILD");
+    char cmd[1024], line[1024];
+    snprintf(cmd, sizeof cmd, "%s/lmgi info %s --texels 20000 2>&1", build ? build : "build", path);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    int lines = 0, more_materials = 0, more_lights = 0;
+    while (fgets(line, sizeof line, p)) {
+        lines++;
+        more_materials += strstr(line, "... and 1988 more materials") != NULL;
+        more_lights += strstr(line, "... and 28 more lights") != NULL;
+    }
+    assert_int_equal(pclose(p), 0);
+    print_message("lmgi info: %d lines\n", lines);
+    assert_true(lines <= 50);
+    assert_int_equal(more_materials, 1);
+    assert_int_equal(more_lights, 1);
+}
+
 /* ../shared/scenes/truck-town: Godot 4's export (required EXT_texture_webp, percent-encoded URIs into
  * textures/, OMI physics extensions) loads with both its WebP textures, reduced to 512 on their longer
  * side, and its sun. */
@@ -236,7 +349,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_webp_percent_encoded), cmocka_unit_test(test_webp_corrupt),
         cmocka_unit_test(test_reduced_on_decode),    cmocka_unit_test(test_metal_rough_texture),
-        cmocka_unit_test(test_truck_town_loads),
+        cmocka_unit_test(test_many_materials_and_textures), cmocka_unit_test(test_truck_town_loads),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

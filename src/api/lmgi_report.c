@@ -70,42 +70,76 @@ void lmgi_get_effect(const lmgi_scene *sc, int i, lmgi_effect *out)
     snprintf(out->reason, sizeof out->reason, "%s", sc->effects.reason[i]);
 }
 
+/* A level's thousands of materials, lights and moving nodes would fill pages: each list shows its first
+ * LIST_MAX entries in the order that matters (for materials, the classes that switch effects on first)
+ * and says how many more there are; the totals above each list count them all. */
+#define LIST_MAX 12
+
+static void print_more(FILE *f, int more, const char *what)
+{
+    if (more > 0)
+        fprintf(f, "  ... and %d more %s\n", more, what);
+}
+
 static void print_materials(const lm_scene *s, const lmgi_info *in, FILE *f)
 {
+    static const lm_material_class order[] = {LM_MAT_EMITTER, LM_MAT_GLASS, LM_MAT_MIRROR, LM_MAT_GLOSSY,
+                                              LM_MAT_DIFFUSE};
     fprintf(f, "materials   %d:", in->materials);
     for (int c = 0; c < LM_MAT_CLASS_COUNT; c++)
         if (in->materials_by_class[c])
             fprintf(f, " %d %s", in->materials_by_class[c], lm_material_class_name((lm_material_class)c));
+    int missing = 0;
+    for (int m = 0; m < s->material_count; m++)
+        missing += s->materials[m].missing_textures > 0;
+    if (missing)
+        fprintf(f, "; %d with a texture missing or undecodable (their factors alone are used)", missing);
     fputc('\n', f);
-    for (int m = 0; m < s->material_count; m++) {
-        const lm_material *mat = &s->materials[m];
-        fprintf(f, "  %-28s %-8s base (%.2f %.2f %.2f)%s%s\n", mat->name, lm_material_class_name(mat->cls),
-                (double)mat->base_color[0], (double)mat->base_color[1], (double)mat->base_color[2],
-                mat->base_color_tex >= 0 ? " + texture" : "",
-                mat->missing_textures ? " (a texture is missing or undecodable: its factor alone is used)" : "");
-    }
+    int shown = 0;
+    for (size_t k = 0; k < sizeof order / sizeof order[0]; k++)
+        for (int m = 0; m < s->material_count && shown < LIST_MAX; m++) {
+            const lm_material *mat = &s->materials[m];
+            if (mat->cls != order[k])
+                continue;
+            fprintf(f, "  %-28s %-8s base (%.2f %.2f %.2f)%s%s\n", mat->name, lm_material_class_name(mat->cls),
+                    (double)mat->base_color[0], (double)mat->base_color[1], (double)mat->base_color[2],
+                    mat->base_color_tex >= 0 ? " + texture" : "",
+                    mat->missing_textures ? " (a texture is missing or undecodable: its factor alone is used)" : "");
+            shown++;
+        }
+    print_more(f, s->material_count - shown, "materials");
 }
 
 static void print_nodes(const lm_scene *s, const lmgi_info *in, FILE *f)
 {
     fprintf(f, "nodes       %d (%d static, %d dynamic)\n", in->nodes, in->nodes - in->dynamic_nodes,
             in->dynamic_nodes);
-    for (int n = 0; n < s->node_count; n++)
-        if (s->nodes[n].dynamic)
+    int shown = 0;
+    for (int n = 0; n < s->node_count && shown < LIST_MAX; n++)
+        if (s->nodes[n].dynamic) {
             fprintf(f, "  dynamic: '%s' (%u triangles)\n", s->nodes[n].name, s->nodes[n].tri_count);
+            shown++;
+        }
+    print_more(f, in->dynamic_nodes - shown, "dynamic nodes");
 }
 
 static void print_lights(const lm_scene *s, const lmgi_info *in, FILE *f)
 {
     fprintf(f, "lights      %d (%d point, %d spot, %d directional)\n", in->lights, in->lights_by_type[0],
             in->lights_by_type[1], in->lights_by_type[2]);
-    for (int l = 0; l < s->light_count; l++) {
+    int shown = 0;
+    for (int l = 0; l < s->light_count && shown < LIST_MAX; l++) {
         const lm_light *li = &s->lights[l];
         if (li->removed)
             continue;
-        fprintf(f, "  %-12s '%s' intensity %g colour (%.2f %.2f %.2f)\n", lm_light_type_name(li->type), li->name,
+        fprintf(f, "  %-12s '%s' intensity %g colour (%.2f %.2f %.2f)", lm_light_type_name(li->type), li->name,
                 (double)li->intensity, (double)li->color[0], (double)li->color[1], (double)li->color[2]);
+        if (li->range > 0.0f && li->type != LM_LIGHT_DIRECTIONAL)
+            fprintf(f, " range %g", (double)li->range);
+        fputc('\n', f);
+        shown++;
     }
+    print_more(f, in->lights - shown, "lights");
 }
 
 void lmgi_print_info(const lmgi_scene *sc, FILE *f)

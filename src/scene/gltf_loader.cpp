@@ -94,7 +94,7 @@ void vec_or(const std::vector<double> &v, size_t n, const float *def, float *out
 
 bool finite_all(const float *v, size_t n) { return lm_first_nonfinite(v, n) < 0; }
 
-// tinygltf's image callback: keeps the encoded bytes (img->as_is) for Loader::decode, which decodes only
+// tinygltf's image callback: keeps the encoded bytes (img->as_is) for Loader::decode_used_images, which decodes only
 // the images a material uses, at the size lmgi needs (image_decode.h); decoding every image here held
 // them all at full size at once. An image whose bufferView lies outside its buffer is an error: tinygltf
 // hands us a pointer it never checked.
@@ -153,7 +153,7 @@ class Loader {
     lm_status read_floats(int acc, int type, bool force_norm, const char *what, const std::string &ctx,
                           std::vector<float> &out, size_t &count);
     int image_of(int tex_index) const;
-    bool decode(int img, bool srgb, std::vector<uint8_t> &rgba, int &w, int &h);
+    void decode_used_images();
     int texture(int tex_index, const std::string &ctx);
     void metal_rough_from_texture(const tinygltf::PbrMetallicRoughness &pbr, lm_material &d);
     lm_status materials();
@@ -171,7 +171,14 @@ class Loader {
     bool strict_ = false;
     tinygltf::Model model_;
     ScenePtr s_;
-    std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet decoded, -2 undecodable)
+    std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted, -2 undecodable)
+    struct Decoded {                         // an image as decode_used_images left it
+        std::vector<uint8_t> rgba;           // 8-bit RGBA; empty: unused or undecodable
+        int w = 0, h = 0;
+        lm_status status = LM_OK;
+        const char *why = "";
+    };
+    std::vector<Decoded> decoded_;
     std::vector<lm_texture> textures_;
     std::vector<unsigned char> animated_;
     bool need_default_material_ = false;
@@ -465,26 +472,54 @@ int Loader::image_of(int tex_index) const
     return img >= 0 && size_t(img) < model_.images.size() ? img : -1;
 }
 
-// Decodes image `img` to 8-bit RGBA at LM_TEXTURE_MAX_SIDE; false (with a warning naming the image) when
-// it cannot be.
-bool Loader::decode(int img, bool srgb, std::vector<uint8_t> &rgba, int &w, int &h)
+// Decodes every image a material uses, in parallel (decoding is most of a textured level's load: 300
+// JPEG or PNG textures of 1024 x 1024 took 8 s on one core), each as colour (sRGB) or data as its use
+// says. An image used both ways is decoded as its first use in material order says. The warnings for
+// undecodable images follow, in image order, so the log is the same on any number of threads.
+void Loader::decode_used_images()
 {
-    const tinygltf::Image &im = model_.images[size_t(img)];
-    if (im.image.empty())
-        return false; // unreadable file: tinygltf said so as it parsed
-    uint8_t *px = nullptr;
-    const char *why = "";
-    lm_status st = lm_image_decode(im.image.data(), im.image.size(), LM_TEXTURE_MAX_SIDE, srgb, &px, &w, &h, &why);
-    if (st == LM_ERR_NOMEM)
-        throw std::bad_alloc();
-    if (st) {
-        const std::string &label = im.name.empty() ? im.uri : im.name;
-        lm_warn("%s: image %d (\"%.200s\"): %s; ignored", path_, img, label.c_str(), why);
-        return false;
+    size_t n = model_.images.size();
+    decoded_.assign(n, Decoded());
+    std::vector<signed char> use(n, -1); // -1 unused, 1 colour, 0 data
+    auto mark = [&](int tex, int srgb) {
+        int img = image_of(tex);
+        if (img >= 0 && use[size_t(img)] < 0)
+            use[size_t(img)] = (signed char)srgb;
+    };
+    for (const tinygltf::Material &m : model_.materials) {
+        mark(m.pbrMetallicRoughness.baseColorTexture.index, 1);
+        mark(m.emissiveTexture.index, 1);
+        mark(m.pbrMetallicRoughness.metallicRoughnessTexture.index, 0);
     }
-    rgba.assign(px, px + size_t(w) * size_t(h) * 4);
-    free(px);
-    return true;
+    long count = long(n);
+#pragma omp parallel for schedule(dynamic)
+    for (long i = 0; i < count; i++) {
+        const tinygltf::Image &im = model_.images[size_t(i)];
+        Decoded &d = decoded_[size_t(i)];
+        if (use[size_t(i)] < 0 || im.image.empty()) // unused, or unreadable (tinygltf said so as it parsed)
+            continue;
+        uint8_t *px = nullptr;
+        d.status = lm_image_decode(im.image.data(), im.image.size(), LM_TEXTURE_MAX_SIDE, use[size_t(i)], &px, &d.w,
+                                   &d.h, &d.why);
+        if (px) {
+            try {
+                d.rgba.assign(px, px + size_t(d.w) * size_t(d.h) * 4);
+            } catch (const std::bad_alloc &) {
+                d.status = LM_ERR_NOMEM;
+            }
+            free(px);
+        }
+    }
+    for (size_t i = 0; i < n; i++) {
+        const tinygltf::Image &im = model_.images[i];
+        model_.images[i].image.clear(); // the encoded bytes are done with
+        model_.images[i].image.shrink_to_fit();
+        if (decoded_[i].status == LM_ERR_NOMEM)
+            throw std::bad_alloc();
+        if (decoded_[i].status)
+            lm_warn("%s: image %zu (\"%.200s\"): %s; ignored", path_, i, (im.name.empty() ? im.uri : im.name).c_str(),
+                    decoded_[i].why);
+    }
 }
 
 // lm texture index for glTF texture `tex_index` (-1 if none or undecodable); colour textures are sRGB.
@@ -499,14 +534,13 @@ int Loader::texture(int tex_index, const std::string &ctx)
     }
     if (image_tex_[size_t(img)] != -1)
         return image_tex_[size_t(img)] < 0 ? -1 : image_tex_[size_t(img)];
-    std::vector<uint8_t> rgba;
-    int w = 0, h = 0;
-    if (!decode(img, true, rgba, w, h)) {
-        image_tex_[size_t(img)] = -2; // warned once
+    const Decoded &d = decoded_[size_t(img)];
+    if (d.rgba.empty()) {
+        image_tex_[size_t(img)] = -2;
         return -1;
     }
     lm_texture t = {0, 0, nullptr};
-    if (!lm_texture_from_rgba8(&t, rgba.data(), w, h, 1))
+    if (!lm_texture_from_rgba8(&t, d.rgba.data(), d.w, d.h, 1))
         throw std::bad_alloc();
     textures_.push_back(t);
     image_tex_[size_t(img)] = int(textures_.size() - 1);
@@ -519,12 +553,11 @@ int Loader::texture(int tex_index, const std::string &ctx)
 void Loader::metal_rough_from_texture(const tinygltf::PbrMetallicRoughness &pbr, lm_material &d)
 {
     int img = image_of(pbr.metallicRoughnessTexture.index);
-    std::vector<uint8_t> px;
-    int w = 0, h = 0;
-    if (img < 0 || !decode(img, false, px, w, h))
+    if (img < 0 || decoded_[size_t(img)].rgba.empty())
         return;
+    const uint8_t *px = decoded_[size_t(img)].rgba.data();
     double g = 0.0, b = 0.0;
-    size_t n = size_t(w) * size_t(h);
+    size_t n = size_t(decoded_[size_t(img)].w) * size_t(decoded_[size_t(img)].h);
     for (size_t i = 0; i < n; i++)
         g += px[4 * i + 1], b += px[4 * i + 2];
     d.roughness *= float(g / (255.0 * double(n)));
@@ -536,6 +569,7 @@ lm_status Loader::materials()
     size_t n = model_.materials.size();
     s_->materials = calloc_n<lm_material>(n + 1); // room for the default material
     image_tex_.assign(model_.images.size(), -1);
+    decode_used_images();
     static const float one4[4] = {1, 1, 1, 1}, zero3[3] = {0, 0, 0};
     for (size_t i = 0; i < n; i++) {
         const tinygltf::Material &m = model_.materials[i];

@@ -28,7 +28,7 @@
 extern "C" {
 #endif
 
-#define LM_TEXTURE_MAX_SIDE 512
+#define LM_TEXTURE_MAX_SIDE 256
 #define LM_IMAGE_MAX_PIXELS (1LL << 26)
 
 /* 1 if the bytes start as a WebP file does. */
