@@ -277,6 +277,26 @@ static void test_charts_pictures(void **state)
 }
 
 /* lmgi bake writes the lightmap, its preview and the AIM; Ctrl-C stops it soon, writing nothing. */
+/* LMGI_PROGRESS_SECONDS=0: a line for every step of the gather, each with its stage, share and time
+ * left; -q: none. */
+static void test_progress_lines(void **state)
+{
+    (void)state;
+    char args[2048];
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --out %s/bake", lmt_tmpdir());
+    setenv("LMGI_PROGRESS_SECONDS", "0", 1);
+    assert_int_equal(run(args), 0);
+    int lines = 0;
+    for (const char *p = output; (p = strstr(p, "bake: gather ")); p++)
+        lines += strstr(p, "s left)\n") != NULL;
+    print_message("%d gather progress lines\n", lines);
+    assert_true(lines >= 3);
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 -q --out %s/quiet", lmt_tmpdir());
+    assert_int_equal(run(args), 0);
+    assert_null(strstr(output, "bake: "));
+    unsetenv("LMGI_PROGRESS_SECONDS");
+}
+
 static void test_bake_command(void **state)
 {
     (void)state;
@@ -286,6 +306,10 @@ static void test_bake_command(void **state)
     if (run(args) != 0)
         fail_msg("%s: %s", args, output);
     assert_non_null(strstr(output, "baked"));
+    /* stderr is a pipe here, not a terminal: progress comes as whole lines, the first and the last at least */
+    assert_non_null(strstr(output, "bake: gather"));
+    assert_non_null(strstr(output, "bake: done in"));
+    assert_null(strstr(output, "\r"));
     static const char *const files[] = {"lightmap.exr", "lightmap.png", "aim.exr"};
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/bake/%s", dir, files[k]);
@@ -701,6 +725,7 @@ int main(void)
         cmocka_unit_test(test_info_on_generated_cornell),
         cmocka_unit_test(test_charts_pictures),
         cmocka_unit_test(test_bake_command),
+        cmocka_unit_test(test_progress_lines),
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),
         cmocka_unit_test(test_tradeoff),

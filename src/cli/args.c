@@ -1,4 +1,5 @@
 #include "args.h"
+#include "progress.h"
 
 #include <errno.h>
 #include <math.h>
@@ -339,5 +340,6 @@ int lm_cli_start(int argc, char **argv, void (*usage)(FILE *), lm_cli_args *a)
     if (lm_cli_parse(argc, argv, 2, a))
         return 2;
     lmgi_set_verbosity(a->quiet ? 0 : a->verbose ? 2 : 1);
+    lm_progress_quiet(a->quiet);
     return -1;
 }

@@ -146,6 +146,25 @@ static uint32_t still_active(const job *j, uint32_t *active, double floor)
     return keep;
 }
 
+/* Seconds left, estimated: an entry's standard error falls as 1 / sqrt(samples), so one at error e over
+ * the target t needs about n (e / t)^2 samples in all (within max_samples); the samples still needed at
+ * the rate so far. Rough while the errors themselves are noisy, it settles after the first passes. */
+static double seconds_left(const job *j, const uint32_t *active, uint32_t na, double floor, double spent)
+{
+    double done = 0.0, needed = 0.0, t = j->set->target_error;
+    for (uint32_t i = 0; i < j->count; i++)
+        done += j->st[i].n;
+    for (uint32_t a = 0; a < na; a++) {
+        const entry_stat *st = &j->st[active[a]];
+        double e = entry_error(st, j->frames != NULL, floor), want = st->n * (e / t) * (e / t);
+        if (!(want <= j->set->max_samples)) /* also an error not yet finite */
+            want = j->set->max_samples;
+        want = fmax(want, j->set->min_samples);
+        needed += fmax(0.0, want - st->n);
+    }
+    return done > 0.0 ? needed * spent / done : 0.0;
+}
+
 static void adaptive(const job *j, uint32_t *active)
 {
     uint32_t na = j->count;
@@ -154,11 +173,12 @@ static void adaptive(const job *j, uint32_t *active)
     double t0 = lm_now(), last = t0;
     for (int pass = 1; na > 0; pass++) {
         run_pass(j, active, na);
-        na = still_active(j, active, dark_floor(j));
-        if (j->set->progress && lm_now() - last >= LM_REF_PROGRESS_SECONDS) {
+        double floor = dark_floor(j);
+        na = still_active(j, active, floor);
+        if (j->set->progress && na > 0 && lm_now() - last >= LM_REF_PROGRESS_SECONDS) {
             last = lm_now();
-            lm_info("reference: pass %d, %.0f s: %u of %u %s still sampling", pass, last - t0, na, j->count,
-                    j->frames ? "texels" : "pixels");
+            lm_info("reference: pass %d, %.0f s: %u of %u %s still sampling, about %.0f s left", pass, last - t0, na,
+                    j->count, j->frames ? "texels" : "pixels", seconds_left(j, active, na, floor, last - t0));
         }
     }
 }
