@@ -456,6 +456,15 @@ typedef struct {
     lmgi_progress_fn progress;
     void *progress_user;
     const volatile int *cancel;
+    /* the first full solution's checkpoint (docs/levels.md, "Long bakes"): a file (NULL: none) that its
+     * gather writes what it has finished to, between passes at most every checkpoint_seconds (0: 10) and
+     * when cancelled, so that a killed or cancelled bake keeps its work; resume non-zero: the gather starts
+     * from that file and ends with the same bits as a bake that never stopped. A resume without the file,
+     * or from one of another scene or other settings, is LMGI_ERR_INVALID naming it; nothing is written
+     * over it then. The caller removes the file when it no longer wants it. */
+    const char *checkpoint;
+    double checkpoint_seconds;
+    int resume;
 } lmgi_updater_desc;
 
 /* What one lmgi_update did and what it cost (milliseconds). With the photon work on a second thread

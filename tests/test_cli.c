@@ -9,6 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -295,6 +297,90 @@ static void test_progress_lines(void **state)
     assert_int_equal(run(args), 0);
     assert_null(strstr(output, "bake: "));
     unsetenv("LMGI_PROGRESS_SECONDS");
+}
+
+/* 1 if the two files hold the same bytes. */
+static int same_bytes(const char *a, const char *b)
+{
+    size_t na = 0, nb = 0;
+    unsigned char *x = lmt_read_file(a, &na, 0), *y = lmt_read_file(b, &nb, 0);
+    int same = na == nb && memcmp(x, y, na) == 0;
+    free(x);
+    free(y);
+    return same;
+}
+
+/* A bake killed (SIGKILL: nothing of its own runs) keeps what its gather finished in DIR/bake.checkpoint;
+ * --resume gathers only the rest and writes the same bytes as a bake that never stopped. A resume of
+ * another scene's checkpoint is refused, naming it, with nothing overwritten, and a bake that fails
+ * leaves the last good lightmaps in place. */
+static void test_bake_killed_and_resumed(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("two_rooms.glb"));
+    char dir[256], args[2048], a_path[600], b_path[600], ck[800];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    snprintf(args, sizeof args, "bake %s --texels 20000 --out %s/whole -q", scene, dir);
+    assert_int_equal(run(args), 0);
+    snprintf(ck, sizeof ck, "%s/part/bake.checkpoint", dir);
+    const char *build = getenv("LMGI_BUILD");
+    char exe[512];
+    snprintf(exe, sizeof exe, "%s/lmgi", build ? build : "build");
+    char out_dir[600];
+    snprintf(out_dir, sizeof out_dir, "%s/part", dir);
+    pid_t pid = fork();
+    assert_true(pid >= 0);
+    if (pid == 0) {
+        freopen("/dev/null", "w", stderr);
+        execl(exe, exe, "bake", scene, "--texels", "20000", "--checkpoint-seconds", "0.05", "--out", out_dir,
+              (char *)NULL);
+        _exit(127);
+    }
+    int waited = 0;
+    while (access(ck, R_OK) != 0 && waited < 60000) { /* the first checkpoint, then a little more */
+        usleep(10000);
+        waited += 10;
+    }
+    usleep(300000);
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    assert_true(WIFSIGNALED(status)); /* killed before it finished */
+    assert_int_equal(access(ck, R_OK), 0);
+    char saved[700];
+    snprintf(saved, sizeof saved, "%s/saved.checkpoint", dir);
+    assert_int_equal(link(ck, saved), 0);
+
+    snprintf(args, sizeof args, "bake %s --texels 20000 --out %s/part --resume -v", scene, dir);
+    assert_int_equal(run(args), 0);
+    const char *at = strstr(output, "resuming the gather at texel ");
+    assert_non_null(at);
+    unsigned from = 0, of = 0;
+    assert_int_equal(sscanf(at, "resuming the gather at texel %u of %u", &from, &of), 2);
+    print_message("killed and resumed at texel %u of %u\n", from, of);
+    assert_true(from > 0 && from < of);
+    snprintf(a_path, sizeof a_path, "%s/whole/lightmap.exr", dir);
+    snprintf(b_path, sizeof b_path, "%s/part/lightmap.exr", dir);
+    assert_true(same_bytes(a_path, b_path));
+    assert_int_equal(access(ck, F_OK), -1); /* done with */
+
+    /* another scene's checkpoint: refused, named, kept */
+    char other[400];
+    snprintf(other, sizeof other, "%s/other", dir);
+    assert_int_equal(mkdir(other, 0755), 0);
+    snprintf(ck, sizeof ck, "%s/bake.checkpoint", other);
+    assert_int_equal(link(saved, ck), 0);
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --out %s --resume --force", other);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "a checkpoint of another scene or other settings"));
+    assert_non_null(strstr(output, "other/bake.checkpoint"));
+    assert_true(same_bytes(saved, ck));
+
+    /* a bake that fails keeps the last good lightmaps */
+    snprintf(args, sizeof args, "bake %s/missing.glb --out %s/whole", dir, dir);
+    assert_int_equal(run(args), 1);
+    snprintf(b_path, sizeof b_path, "%s/part/lightmap.exr", dir);
+    assert_true(same_bytes(a_path, b_path));
 }
 
 static void test_bake_command(void **state)
@@ -726,6 +812,7 @@ int main(void)
         cmocka_unit_test(test_charts_pictures),
         cmocka_unit_test(test_bake_command),
         cmocka_unit_test(test_progress_lines),
+        cmocka_unit_test(test_bake_killed_and_resumed),
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),
         cmocka_unit_test(test_tradeoff),

@@ -217,6 +217,12 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
         set.progress = gather_progress;
         set.progress_user = &d;
     }
+    set.checkpoint = d.checkpoint;
+    set.checkpoint_seconds = d.checkpoint_seconds;
+    set.resume = d.resume;
+    if (st == LM_OK && (!(d.checkpoint_seconds >= 0.0) || (d.resume && !d.checkpoint)))
+        st = lm_fail(&e, LM_ERR_INVALID, "lmgi_updater_create: %s", d.resume ? "resume without a checkpoint file"
+                                                                               : "checkpoint_seconds is negative or NaN");
     lmgi_updater *u = st == LM_OK ? calloc(1, sizeof *u) : NULL;
     if (st == LM_OK && !u)
         st = lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");

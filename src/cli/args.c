@@ -228,6 +228,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_int(o, v, 1, 1 << 24, &a->caustic_photons);
         else if (!strcmp(o, "--reference-caustic-photons"))
             rc = parse_int(o, v, 1, 1 << 24, &a->ref_caustic_photons);
+        else if (!strcmp(o, "--checkpoint-seconds"))
+            rc = parse_float(o, v, 0.0f, &a->checkpoint_seconds);
         else if (!strcmp(o, "--caustic-retrace"))
             rc = parse_float(o, v, 0.0f, &a->caustic_retrace) ? 2 : a->caustic_retrace > 0.0f && a->caustic_retrace <= 1.0f
                      ? 0 : bad(o, v, "a share of the caustic photons in (0, 1]");
@@ -308,6 +310,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                 a->gltf = 1;
             else if (!strcmp(o, "--accuracy"))
                 a->accuracy = 1;
+            else if (!strcmp(o, "--resume"))
+                a->resume = 1;
             else if (!strcmp(o, "--frame-lag"))
                 a->frame_lag = 1;
             else if (!strcmp(o, "--force"))

@@ -64,6 +64,8 @@ typedef struct {
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     int accuracy;           /* --accuracy (bake): also the lightmaps' estimate of their own error */
+    int resume;             /* --resume (bake): continue from DIR/bake.checkpoint */
+    float checkpoint_seconds; /* --checkpoint-seconds S (bake): at most one checkpoint every S (0: 10) */
     int frame_lag;          /* --frame-lag (tradeoff --edits): the frame's lag against the reference too */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */

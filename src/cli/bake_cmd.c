@@ -147,8 +147,9 @@ int lm_cli_bake(const lm_cli_args *a)
         fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
         return 2;
     }
-    static const char *const own[] = {"lightmap.exr", "lightmap.png", "aim.exr", "accuracy.exr", "accuracy.png", NULL};
-    if (!lm_cli_claim_out_dir(a, own))
+    /* Nothing of an earlier bake is removed before this one has succeeded: a mistyped scene, a cancel or a
+     * kill leaves the last good lightmaps (each file is replaced whole, lm_cli_write_image). */
+    if (!lm_cli_claim_out_dir(a, NULL))
         return 1;
     lmgi_scene *sc = NULL;
     lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
@@ -162,21 +163,41 @@ int lm_cli_bake(const lm_cli_args *a)
     d.progress = a->quiet ? NULL : show;
     d.progress_user = &started;
     d.cancel = &g_cancel;
+    /* what the gather finished survives a cancel, a kill or a failure (docs/levels.md, "Long bakes") */
+    char checkpoint[4200];
+    snprintf(checkpoint, sizeof checkpoint, "%s/bake.checkpoint", a->out_dir);
+    d.checkpoint = checkpoint;
+    d.checkpoint_seconds = a->checkpoint_seconds;
+    d.resume = a->resume;
     signal(SIGINT, on_interrupt);
+    signal(SIGTERM, on_interrupt); /* a scheduler's stop, as Ctrl-C */
     lmgi_context *ctx = NULL;
     lmgi_updater *u = NULL;
     lmgi_error e;
     int rc = 0;
     if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK || lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK) {
         if (e.status == LMGI_ERR_CANCELLED)
-            fprintf(stderr, "\nlmgi: bake cancelled after %.1f s; nothing written\n", lm_cli_now() - started);
+            fprintf(stderr, "\nlmgi: bake cancelled after %.1f s (%s); no lightmap written; the same command with "
+                    "--resume continues it\n", lm_cli_now() - started, e.message);
         else
             fprintf(stderr, "lmgi: error: %s\n", e.message);
         rc = e.status == LMGI_ERR_CANCELLED ? 130 : 1;
     }
     signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
     if (rc == 0)
         rc = write_maps(sc, u, a->out_dir, a->half);
+    if (rc == 0) {
+        remove(checkpoint); /* the lightmaps hold all it held */
+        if (!a->accuracy) { /* an earlier bake's estimate would no longer describe these lightmaps */
+            static const char *const stale[] = {"accuracy.exr", "accuracy.png"};
+            for (int k = 0; k < 2; k++) {
+                char path[4200];
+                snprintf(path, sizeof path, "%s/%s", a->out_dir, stale[k]);
+                remove(path);
+            }
+        }
+    }
     if (rc == 0 && a->accuracy)
         rc = write_accuracy(sc, u, a->out_dir, a->half, a->quiet);
     char name[256] = "";

@@ -103,3 +103,12 @@ lm_status lm_iim_texture_read(unsigned tex, int width, int height, float *rgba, 
     glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, rgba);
     return lm_gl_check("reading the IIM texture", err);
 }
+
+lm_status lm_iim_texture_write(unsigned tex, int width, int height, const float *rgba, lm_error *err)
+{
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, width, height, GL_RGBA, GL_FLOAT, rgba);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+    return lm_gl_check("writing the IIM texture", err);
+}

@@ -8,12 +8,14 @@
 #include "../core/hash.h"
 #include "../core/memory.h"
 #include "../core/timing.h"
+#include "../core/log.h"
 #include "../core/vecmath.h"
 #include "../gpu/composite.h"
 #include "../gpu/gather_error.h"
 #include "../photonmap/pixel_gather.h"
 #include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
+#include "bake_checkpoint.h"
 #include "stage_worker.h"
 
 struct lm_frame_loop {
@@ -195,20 +197,42 @@ static lm_status gather_prepare(lm_frame_loop *fl, lm_error *err)
     return st;
 }
 
-/* Gathers `count` scheduled texels into the fresh IIM. */
-static lm_status gather_run(lm_frame_loop *fl, uint32_t count, lm_error *err)
+/* The first full gather's checkpoint while it runs (bake_checkpoint.h); NULL in gather_run: none. */
+typedef struct {
+    const char *path;
+    uint64_t key;
+    double seconds, last;  /* at most one write a `seconds`, the last at `last` */
+    float *rgba;           /* the fresh IIM read back */
+} checkpointing;
+
+static lm_status checkpoint_save(lm_frame_loop *fl, checkpointing *ck, uint32_t done, uint32_t count, lm_error *err)
+{
+    lm_status st = lm_iim_texture_read(fl->iim.fresh_tex, fl->atlas->width, fl->atlas->height, ck->rgba, err);
+    if (st == LM_OK)
+        st = lm_checkpoint_write(ck->path, ck->key, fl->atlas, count, done, ck->rgba, err);
+    ck->last = lm_now();
+    return st;
+}
+
+/* Gathers scheduled texels [start, count) into the fresh IIM. */
+static lm_status gather_run(lm_frame_loop *fl, uint32_t start, uint32_t count, checkpointing *ck, lm_error *err)
 {
     lm_status st = LM_OK;
     /* a pass at a time when someone watches or may cancel (the first full gather, a bake: tens of ms a
      * pass, so a cancel is heard within 100 ms), else all at once */
-    int watched = fl->set.progress || fl->set.cancel;
+    int watched = fl->set.progress || fl->set.cancel || ck;
     uint32_t chunk = watched ? (uint32_t)(fl->set.gather.tiles * fl->set.gather.tiles) : count;
-    for (uint32_t done = 0; st == LM_OK && done < count; done += chunk) {
-        if (fl->set.cancel && *fl->set.cancel)
-            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u texels", fl->scene->path, done,
-                           count);
+    for (uint32_t done = start; st == LM_OK && done < count; done += chunk) {
+        if (fl->set.cancel && *fl->set.cancel) {
+            if (ck && (st = checkpoint_save(fl, ck, done, count, err)) != LM_OK)
+                return st;
+            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u texels%s%s", fl->scene->path, done,
+                           count, ck ? ", kept in " : "", ck ? ck->path : "");
+        }
         uint32_t n = count - done < chunk ? count - done : chunk;
         st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + done, n, fl->iim.fresh_tex, NULL, err);
+        if (st == LM_OK && ck && done + n < count && lm_now() - ck->last >= ck->seconds)
+            st = checkpoint_save(fl, ck, done + n, count, err);
         if (fl->set.progress)
             fl->set.progress(fl->set.progress_user, done + n, count);
     }
@@ -220,7 +244,38 @@ static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
     if (count == 0)
         return LM_OK;
     lm_status st = gather_prepare(fl, err);
-    return st == LM_OK ? gather_run(fl, count, err) : st;
+    return st == LM_OK ? gather_run(fl, 0, count, NULL, err) : st;
+}
+
+/* The first full gather of every texel, checkpointed to set.checkpoint when one is named (and resumed
+ * from it when set.resume says so). */
+static lm_status first_gather(lm_frame_loop *fl, lm_error *err)
+{
+    uint32_t count = lm_iim_sched_pick_all(&fl->iim.sched, store_of(fl), fl->texels);
+    if (!fl->set.checkpoint || count == 0)
+        return gather(fl, count, err);
+    lm_status st = gather_prepare(fl, err);
+    if (st != LM_OK)
+        return st;
+    checkpointing ck = {fl->set.checkpoint, 0,
+                        fl->set.checkpoint_seconds > 0.0 ? fl->set.checkpoint_seconds : LM_CHECKPOINT_DEFAULT_SECONDS,
+                        lm_now(), malloc(4 * sizeof(float) * (size_t)fl->atlas->width * (size_t)fl->atlas->height)};
+    if (!ck.rgba)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the bake's checkpoint");
+    ck.key = lm_checkpoint_key(fl->scene, fl->atlas, &fl->set.gather, fl->texels, count,
+                               lm_aim_dilated_rgba(lm_photon_stage_aim(fl->stage)));
+    uint32_t start = 0;
+    if (fl->set.resume) {
+        st = lm_checkpoint_read(ck.path, ck.key, fl->atlas, count, ck.rgba, &start, err);
+        if (st == LM_OK)
+            st = lm_iim_texture_write(fl->iim.fresh_tex, fl->atlas->width, fl->atlas->height, ck.rgba, err);
+        if (st == LM_OK)
+            lm_info("%s: resuming the gather at texel %u of %u from %s", fl->scene->path, start, count, ck.path);
+    }
+    if (st == LM_OK)
+        st = gather_run(fl, start, count, &ck, err);
+    free(ck.rgba);
+    return st;
 }
 
 static lm_status alloc_buffers(lm_frame_loop *fl, lm_error *err)
@@ -333,9 +388,10 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
     double t0 = lm_now();
     fl->aim_stale = 1;
     if (st == LM_OK)
-        st = gather(fl, lm_iim_sched_pick_all(&fl->iim.sched, store_of(fl), fl->texels), err);
+        st = first_gather(fl, err);
     fl->set.progress = NULL; /* per-frame gathers are small */
     fl->set.cancel = NULL;
+    fl->set.checkpoint = NULL;
     if (st == LM_OK)
         st = lm_iim_blend(&fl->iim, 1, err);
     if (t_gather)
@@ -716,7 +772,7 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     if (st == LM_OK)
         st = schedule(fl, o, err);
     if (st == LM_OK)
-        st = gather_run(fl, o->texels_gathered, err);
+        st = gather_run(fl, 0, o->texels_gathered, NULL, err);
     o->t_photons = t1 - t0;
     o->t_gather = lm_now() - t1;
     return st == LM_OK ? blend_and_render(fl, o, err) : st;
@@ -741,7 +797,7 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
         st = prepare_frame(fl, o, err);
     if (st != LM_OK)
         return st;
-    st = gather_run(fl, o->texels_gathered, err);
+    st = gather_run(fl, 0, o->texels_gathered, NULL, err);
     o->t_gather = lm_now() - t1;
     lm_stage_worker_begin(fl->worker, &o->stage);
     if (st == LM_OK)
@@ -806,7 +862,7 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     double t1 = lm_now();
     o->t_photons = t1 - t0;
     if (st == LM_OK)
-        st = gather_run(fl, o->texels_gathered, err);
+        st = gather_run(fl, 0, o->texels_gathered, NULL, err);
     o->t_gather = lm_now() - t1;
     if (st == LM_OK)
         st = blend_and_render(fl, o, err); /* no frame: the blend alone */

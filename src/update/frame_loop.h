@@ -70,6 +70,12 @@ typedef struct {
     void (*progress)(void *user, uint32_t done, uint32_t total);
     void *progress_user;
     const volatile int *cancel; /* non-zero stops the first full gather between passes: LM_ERR_CANCELLED */
+    /* the first full gather's checkpoint file (bake_checkpoint.h; NULL: none): written at most every
+     * checkpoint_seconds (0: LM_CHECKPOINT_DEFAULT_SECONDS) between passes and on a cancel; resume
+     * non-zero: the gather starts from it (it must exist and match, else LM_ERR_INVALID) */
+    const char *checkpoint;
+    double checkpoint_seconds;
+    int resume;
     lm_gl_context *gl;     /* borrowed, made current at each call: the context to render with (NULL, the
                             * default: the loop makes its own) */
 } lm_frame_loop_settings;

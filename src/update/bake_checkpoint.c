@@ -1,0 +1,88 @@
+/* The first full gather's checkpoint file (bake_checkpoint.h). */
+#include "bake_checkpoint.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/hash.h"
+
+static const char k_magic[8] = {'L', 'M', 'G', 'I', 'C', 'K', 'P', '1'};
+
+uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *gather,
+                           const uint32_t *order, uint32_t count, const float *aim_dilated_rgba)
+{
+    uint64_t h = LM_HASH_SEED;
+    h = lm_hash_bytes(h, s->positions, 3 * sizeof(float) * s->vertex_count);
+    h = lm_hash_bytes(h, s->tris, 3 * sizeof(uint32_t) * s->tri_count);
+    h = lm_hash_bytes(h, s->materials, sizeof *s->materials * (size_t)s->material_count);
+    for (int n = 0; n < s->node_count; n++)
+        h = lm_hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
+    h = lm_hash_bytes(h, &a->width, sizeof a->width);
+    h = lm_hash_bytes(h, &a->height, sizeof a->height);
+    h = lm_hash_bytes(h, a->texels, sizeof *a->texels * a->texel_count);
+    h = lm_hash_bytes(h, gather, sizeof *gather);
+    h = lm_hash_bytes(h, &count, sizeof count);
+    h = lm_hash_bytes(h, order, sizeof *order * count);
+    return lm_hash_bytes(h, aim_dilated_rgba, 4 * sizeof(float) * (size_t)a->width * (size_t)a->height);
+}
+
+typedef struct {
+    char magic[8];
+    uint64_t key;
+    uint32_t count, done;
+    int32_t width, height;
+} header;
+
+lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, uint32_t done,
+                              const float *rgba, lm_error *err)
+{
+    header hd;
+    memset(&hd, 0, sizeof hd);
+    memcpy(hd.magic, k_magic, sizeof hd.magic);
+    hd.key = key, hd.count = count, hd.done = done, hd.width = a->width, hd.height = a->height;
+    size_t n = 4 * sizeof(float) * (size_t)a->width * (size_t)a->height;
+    uint64_t sum = lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n);
+    char tmp[4200];
+    if (snprintf(tmp, sizeof tmp, "%s.partial", path) >= (int)sizeof tmp)
+        return lm_fail(err, LM_ERR_INVALID, "checkpoint path too long: %s", path);
+    FILE *f = fopen(tmp, "wb");
+    if (!f)
+        return lm_fail(err, LM_ERR_IO, "%s: cannot write the bake's checkpoint: %s", tmp, strerror(errno));
+    int ok = fwrite(&hd, sizeof hd, 1, f) == 1 && fwrite(rgba, 1, n, f) == n && fwrite(&sum, sizeof sum, 1, f) == 1;
+    ok = fclose(f) == 0 && ok;
+    if (!ok || rename(tmp, path) != 0) {
+        int e = errno;
+        remove(tmp);
+        return lm_fail(err, LM_ERR_IO, "%s: cannot write the bake's checkpoint: %s", path, strerror(e));
+    }
+    return LM_OK;
+}
+
+lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, float *rgba,
+                             uint32_t *done, lm_error *err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return lm_fail(err, errno == ENOENT ? LM_ERR_INVALID : LM_ERR_IO, "%s: no checkpoint to resume: %s", path,
+                       strerror(errno));
+    header hd;
+    size_t n = 4 * sizeof(float) * (size_t)a->width * (size_t)a->height;
+    uint64_t sum = 0;
+    int ok = fread(&hd, sizeof hd, 1, f) == 1 && memcmp(hd.magic, k_magic, sizeof hd.magic) == 0;
+    if (ok && (hd.key != key || hd.count != count || hd.width != a->width || hd.height != a->height)) {
+        fclose(f);
+        return lm_fail(err, LM_ERR_INVALID,
+                       "%s: a checkpoint of another scene or other settings (its key %016llx, this bake's %016llx); "
+                       "bake without --resume to start again", path, (unsigned long long)hd.key,
+                       (unsigned long long)key);
+    }
+    ok = ok && hd.done <= count && fread(rgba, 1, n, f) == n && fread(&sum, sizeof sum, 1, f) == 1 &&
+         fgetc(f) == EOF && sum == lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n);
+    fclose(f);
+    if (!ok)
+        return lm_fail(err, LM_ERR_INVALID, "%s: not an lmgi bake checkpoint, or damaged", path);
+    *done = hd.done;
+    return LM_OK;
+}

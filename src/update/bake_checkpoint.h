@@ -1,0 +1,43 @@
+/* The first full gather's checkpoint: what a bake had gathered when it was cancelled, failed or killed,
+ * so that a resumed bake gathers only the rest and ends with the same bits as one that never stopped.
+ *
+ * Why it can: the gather writes each texel from the AIMs and the scene alone, and the first full gather
+ * takes the texels in a fixed order in passes of a fixed size; a checkpoint is written only between passes.
+ * So the fresh IIM after `done` texels, plus the passes from `done` on, is the uninterrupted gather.
+ *
+ * File (little-endian, as the machine writes it): "LMGICKP1", key (u64), texel count (u32), done (u32),
+ * atlas width, height (i32), width x height x 4 floats (the fresh IIM as the passes left it), and an FNV-1a
+ * checksum of all before it. Written to NAME.partial and renamed over NAME, so a kill leaves the previous
+ * checkpoint or the new one, never half of one.
+ *
+ * Key: FNV-1a over the scene's vertices, triangles, materials and node matrices, the texel table, the
+ * order the texels are gathered in, the gather's settings and the dilated AIM it reads (which carries
+ * the photons, lights and estimate settings). A checkpoint of another scene or other settings does not
+ * match and is refused, naming the file.
+ *
+ * Cost: one read-back of the IIM (16 bytes a texel) and its write per checkpoint; the key hashes about
+ * 50 bytes a texel and a triangle once. Errors: LM_ERR_IO (cannot read or write, naming the file),
+ * LM_ERR_INVALID (no checkpoint to resume, another bake's, or damaged). Not thread-safe. */
+#ifndef LM_BAKE_CHECKPOINT_H
+#define LM_BAKE_CHECKPOINT_H
+
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../gpu/hemicube.h"
+#include "../scene/scene.h"
+
+#define LM_CHECKPOINT_DEFAULT_SECONDS 10.0
+
+uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *gather,
+                           const uint32_t *order, uint32_t count, const float *aim_dilated_rgba);
+
+/* Reads the checkpoint at path into rgba (width x height x 4 floats of a) and *done; LM_ERR_INVALID when
+ * there is none, or it is of another key or atlas, or damaged. */
+lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, float *rgba,
+                             uint32_t *done, lm_error *err);
+lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, uint32_t done,
+                              const float *rgba, lm_error *err);
+
+#endif
