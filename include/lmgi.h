@@ -223,6 +223,17 @@ LMGI_API lmgi_status lmgi_add_light(lmgi_scene *scene, const lmgi_light *l, int 
  * An id out of range or already removed: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_remove_light(lmgi_scene *scene, int light, lmgi_error *err);
 
+/* The sky: an environment of uniform radiance (linear RGB, the units of an emissive surface's radiance)
+ * around the scene, for outdoor levels and the windows of interiors (docs/levels.md, "Sky"). It lights
+ * through photons, the gather (what a texel's hemisphere sees of it), the frame's background and
+ * reflections, and the reference; an edit (a darker or bluer sky) is taken up like a light's: its photons
+ * re-traced at the next updates. Set it before lmgi_updater_create when the scene has no other light (an
+ * updater made for a scene with nothing to light does no indirect work). A NaN, a negative or a value
+ * above 1e20: LMGI_ERR_INVALID, nothing changed. Thread-safety: as lmgi_set_light. */
+LMGI_API lmgi_status lmgi_set_environment(lmgi_scene *scene, const float radiance[3], lmgi_error *err);
+/* 1 and the radiance in out when the scene has a sky (0 and out zeroed otherwise, NULL scene included). */
+LMGI_API int lmgi_get_environment(const lmgi_scene *scene, float out[3]);
+
 /* An application's own level, handed over without a file: meshes (vertex and index arrays placed by a
  * matrix), materials and lights. lmgi_load_desc writes them into a .glb in memory and loads that, so they
  * are checked, classified and lit exactly as a file would be (docs/loading.md). Zero means the default:

@@ -89,7 +89,7 @@ static void add_hit(lm_photon_store *ps, const lmt_pipeline *p, int surface, flo
     h.surface = surface;
     h.tri = p->su.surfaces[surface].tris[0];
     h.bounce = (uint16_t)bounce;
-    h.from_punctual = bounce == 0;
+    h.source = bounce == 0 ? LM_HIT_FROM_PUNCTUAL : LM_HIT_FROM_AREA;
     assert_true(lm_photon_store_add(ps, &h) != LM_NONE);
 }
 

@@ -60,6 +60,18 @@ static void test_usage_errors(void **state)
     assert_int_equal(run("run scenes/cornell.glb --groups 7 --out x"), 2);
     assert_non_null(strstr(output, "--groups 7"));
     assert_int_equal(run("info scenes/cornell.glb --groups 12 -q"), 0); /* 2^2 3 */
+    /* --sky: one radiance or three, finite and >= 0; info says what it got */
+    static const char *const bad_sky[] = {"nan", "-1", "1,2", "1,2,3,4", "1,,2", "1e30", "inf", "0.5,x,1"};
+    for (int k = 0; k < 8; k++) {
+        char args[256];
+        snprintf(args, sizeof args, "info scenes/cornell.glb --sky %s", bad_sky[k]);
+        assert_int_equal(run(args), 2);
+        assert_non_null(strstr(output, "--sky"));
+    }
+    assert_int_equal(run("info scenes/cornell.glb --sky 0.5,0.25,1"), 0);
+    assert_non_null(strstr(output, "sky         uniform radiance (0.5 0.25 1)"));
+    assert_int_equal(run("info scenes/cornell.glb --sky 2"), 0);
+    assert_non_null(strstr(output, "sky         uniform radiance (2 2 2)"));
     assert_int_equal(run("run scenes/cornell.glb --aim-direct exact --out x"), 2);
     assert_non_null(strstr(output, "--aim-direct exact"));
     assert_non_null(strstr(output, "emitters, photons or all"));

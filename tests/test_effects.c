@@ -91,7 +91,7 @@ static void test_switches_turn_effects_off(void **state)
     assert_false(e.on[LM_EFFECT_DIRECT]);
     assert_false(e.on[LM_EFFECT_INDIRECT]);
     assert_false(e.on[LM_EFFECT_PHOTON_UPDATES]);
-    assert_string_equal(e.reason[LM_EFFECT_INDIRECT], "no light and no emissive material");
+    assert_string_equal(e.reason[LM_EFFECT_INDIRECT], "no light, no emissive material and no sky (--sky)");
     lm_scene_free(s);
 }
 

@@ -152,10 +152,10 @@ static void test_records(void **state)
     h.dir[1] = -1.0f;
     lm_photon_record r;
     float pos[3], from[3], flux[3], up[3] = {0.0f, 1.0f, 0.0f};
-    h.from_punctual = 1; /* a punctual light's first hit: the direct pass's */
+    h.source = LM_HIT_FROM_PUNCTUAL; /* a punctual light's first hit: the direct pass's */
     lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
-    h.from_punctual = 0, h.caustic = 1; /* the caustic pass's */
+    h.source = LM_HIT_FROM_AREA, h.caustic = 1; /* the caustic pass's */
     lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
     h.caustic = 0, h.surface = -1; /* a free slot */

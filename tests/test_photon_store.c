@@ -17,7 +17,7 @@ static lm_hit make_hit(int surface, uint32_t photon, float power, int bounce, in
     h.photon = photon;
     h.flux[0] = h.flux[1] = h.flux[2] = power; /* luminance = power */
     h.bounce = (uint16_t)bounce;
-    h.from_punctual = (uint8_t)punctual;
+    h.source = punctual ? LM_HIT_FROM_PUNCTUAL : LM_HIT_FROM_AREA;
     return h;
 }
 

@@ -41,7 +41,7 @@ static void test_uniform_field(void **state)
     memset(&lamp, 0, sizeof lamp);
     lamp.dir[1] = -1.0f;
     lamp.flux[0] = lamp.flux[1] = lamp.flux[2] = 100.0f;
-    lamp.from_punctual = 1;
+    lamp.source = LM_HIT_FROM_PUNCTUAL;
     assert_true(lm_photon_store_add(&ps, &lamp) != LM_NONE);
 
     float pos[9] = {0, 0, 0, 0.5f, 0, -0.3f, 0, 0, 0}, normal[9] = {0, 1, 0, 0, 1, 0, 0, -1, 0};

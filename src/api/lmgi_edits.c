@@ -272,3 +272,28 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
     }
     return LMGI_OK;
 }
+
+lmgi_status lmgi_set_environment(lmgi_scene *sc, const float radiance[3], lmgi_error *err)
+{
+    if (!sc || !radiance)
+        return lm_api_refuse(err, "lmgi_set_environment: %s is NULL", sc ? "the radiance" : "the scene");
+    for (int c = 0; c < 3; c++)
+        if (!in_range(radiance[c], 0.0f, (float)LM_MAX_EMISSION))
+            return lm_api_refuse(err, "sky radiance (%g %g %g) must be finite numbers in [0, %g]", (double)radiance[0],
+                                 (double)radiance[1], (double)radiance[2], LM_MAX_EMISSION);
+    if (sc->updater) /* its photon work reads the sky */
+        lm_updater_sync(sc->updater);
+    lm_scene *s = sc->scene;
+    memcpy(s->sky, radiance, sizeof s->sky);
+    s->has_sky = 1;
+    lm_effects_decide(s, &sc->effects);
+    return LMGI_OK;
+}
+
+int lmgi_get_environment(const lmgi_scene *sc, float out[3])
+{
+    int has = sc && sc->scene->has_sky;
+    for (int c = 0; out && c < 3; c++)
+        out[c] = has ? sc->scene->sky[c] : 0.0f;
+    return has;
+}

@@ -369,9 +369,12 @@ static lm_status write_document(writer *w, const char *dir, lm_error *err)
     snprintf(bin_uri, sizeof bin_uri, "%s.bin", w->name);
     lm_gltf_finish(&w->doc, bin_uri);
     fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"lightmap\":\"%s_lightmap.exr\",\"preview\":\"%s_lightmap.png\","
-                     "\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of indirect light and emissive surfaces "
-                     "(not the punctual lights' direct light); diffuse radiance = baseColor / pi x E; alpha 1 on valid "
-                     "texels\"}}}", w->name, w->name, w->atlas->width, w->atlas->height);
+                     "\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of indirect light, emissive surfaces "
+                     "and the sky (not the punctual lights' direct light); diffuse radiance = baseColor / pi x E; alpha "
+                     "1 on valid texels\"", w->name, w->name, w->atlas->width, w->atlas->height);
+    if (s->has_sky) /* read back by the loader (docs/levels.md, "Sky") */
+        fprintf(w->doc.json, ",\"sky\":[%.9g,%.9g,%.9g]", (double)s->sky[0], (double)s->sky[1], (double)s->sky[2]);
+    fputs("}}}", w->doc.json);
     return LM_OK;
 }
 

@@ -163,6 +163,9 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     print_nodes(s, &in, f);
     print_materials(s, &in, f);
     print_lights(s, &in, f);
+    if (s->has_sky)
+        fprintf(f, "sky         uniform radiance (%.4g %.4g %.4g)\n", (double)s->sky[0], (double)s->sky[1],
+                (double)s->sky[2]);
     fprintf(f, "cameras     %d, animations %d", in.cameras, in.animations);
     if (in.animations)
         fprintf(f, " (%.3g s)", (double)in.animation_seconds);

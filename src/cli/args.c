@@ -1,5 +1,6 @@
 #include "args.h"
 #include "progress.h"
+#include "scene_load.h"
 
 #include <errno.h>
 #include <math.h>
@@ -23,6 +24,33 @@ static int parse_float(const char *opt, const char *v, float lo, float *out)
     if (errno || end == v || *end || !isfinite(d) || d < lo)
         return bad(opt, v, "a finite number");
     *out = (float)d;
+    return 0;
+}
+
+/* --sky L or R,G,B: a uniform sky's radiance, finite and >= 0. */
+static int parse_sky(const char *opt, const char *v)
+{
+    float rgb[3];
+    char *end = NULL;
+    if (!v)
+        return bad(opt, v, "a radiance L or R,G,B");
+    const char *p = v;
+    int n = 0;
+    for (; n < 3; n++) {
+        errno = 0;
+        double d = strtod(p, &end);
+        if (errno || end == p || !isfinite(d) || d < 0.0 || d > 1e20)
+            return bad(opt, v, "a radiance L or R,G,B of finite numbers in [0, 1e20]");
+        rgb[n] = (float)d;
+        if (*end != ',')
+            break;
+        p = end + 1;
+    }
+    if (*end || (n != 0 && n != 2))
+        return bad(opt, v, "a radiance L or R,G,B of finite numbers in [0, 1e20]");
+    if (n == 0)
+        rgb[1] = rgb[2] = rgb[0];
+    lm_cli_set_sky(rgb);
     return 0;
 }
 
@@ -228,6 +256,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
             rc = parse_int(o, v, 1, 1 << 24, &a->caustic_photons);
         else if (!strcmp(o, "--reference-caustic-photons"))
             rc = parse_int(o, v, 1, 1 << 24, &a->ref_caustic_photons);
+        else if (!strcmp(o, "--sky"))
+            rc = parse_sky(o, v);
         else if (!strcmp(o, "--checkpoint-seconds"))
             rc = parse_float(o, v, 0.0f, &a->checkpoint_seconds);
         else if (!strcmp(o, "--caustic-retrace"))

@@ -29,7 +29,9 @@ static void usage(FILE *f)
             "                         gather, direct light, composite): DIR/frame_NNNN.png (every K-th also\n"
             "                         .exr), iim.exr/png, aim.exr/png and frames.csv (work and ms per stage)\n"
             "  bake SCENE --out DIR   the full solution for the scene as it is (every photon, AIM and texel),\n"
-            "                         with a progress bar and the time left (Ctrl-C cancels): DIR/lightmap.exr\n"
+            "                         with a progress bar and the time left (Ctrl-C or SIGTERM cancels, keeping\n"
+            "                         what it finished for --resume; a failed bake leaves the last lightmaps):\n"
+            "                         DIR/lightmap.exr\n"
             "                         (irradiance, alpha = valid), lightmap.png (a preview), aim.exr; --gltf:\n"
             "                         also NAME.gltf, the scene for engines with TEXCOORD_1 = lightmap UVs\n"
             "  check SCENE            one frame of 'run' (same options) against the path-traced reference:\n"
@@ -132,9 +134,16 @@ static void usage(FILE *f)
             "  --gltf           'bake': also a glTF copy of the scene with the lightmap (docs/api.md)\n"
             "  --accuracy       'bake': also DIR/accuracy.exr, the lightmaps' estimate of their own error (r: the\n"
             "                   lightmap's relative standard error, g: the AIM's, b: back-face share)\n"
+            "  --resume         'bake': continue the bake that was cancelled or killed from DIR/bake.checkpoint\n"
+            "                   (what its gather had finished), to the same lightmaps as one that never stopped\n"
+            "  --checkpoint-seconds S 'bake': at most one checkpoint every S seconds (default 10)\n"
+            "  --sky L | R,G,B  every command: a uniform sky of that radiance around the scene (linear, the units\n"
+            "                   of an emissive surface; docs/levels.md): lights through photons, the gather,\n"
+            "                   the background and reflections; a file's extras.lmgi.sky gives one too\n"
             "  --force          write into a non-empty --out DIR that lmgi did not make (lmgi marks its\n"
             "                   own with DIR/.lmgi and replaces only its own kind of file there)\n"
-            "  -v, -q           more / less on stderr\n");
+            "  -v, -q           more / less on stderr; where stderr is not a terminal, progress comes as a\n"
+            "                   line every 5 s (LMGI_PROGRESS_SECONDS)\n");
 }
 
 static int load(const lm_cli_args *a, lmgi_scene **sc)

@@ -8,5 +8,7 @@
  * triangles is refused too (nothing to light: 'run', 'photons' and 'reference' would only write black
  * pictures), naming the file; 'info' and 'charts' take it. */
 int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_scene **sc);
+/* --sky: every scene lm_cli_load_scene loads from now on gets this sky (lmgi_set_environment). */
+void lm_cli_set_sky(const float sky[3]);
 
 #endif

@@ -159,6 +159,8 @@ static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters 
     glDisable(GL_BLEND);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    const float sky[4] = {s->sky[0], s->sky[1], s->sky[2], 1.0f}; /* the background, in frames and reflections */
+    glClearBufferfv(GL_COLOR, 0, sky);
     if (light < 0) {
         float vp[16];
         lm_mat4_mul(vp, view->proj, view->view);
@@ -396,7 +398,7 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     d->cur = t;
     int first = -1;
     for (int i = 0; st == LM_OK && i < em->count; i++)
-        if (em->e[i].kind != LM_EMIT_AREA) {
+        if (em->e[i].punctual) {
             st = shadow_map(d, s, &em->e[i], i, err);
             first = first < 0 ? i : first;
         }
@@ -408,7 +410,7 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     first_pass(d, s, em, first, view, width, height);
     glDrawBuffers(1, all); /* the additive passes after it add radiance only */
     for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
-        if (em->e[i].kind != LM_EMIT_AREA)
+        if (em->e[i].punctual)
             st = light_pass(d, s, &em->e[i], i, view, width, height, err);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return st;

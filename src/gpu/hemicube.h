@@ -142,6 +142,9 @@ unsigned lm_iim_texture_create(int width, int height);
 void lm_iim_texture_free(unsigned tex);
 /* Reads the whole texture back: width*height*4 floats, row y at offset 4 * (y * width + x). */
 lm_status lm_iim_texture_read(unsigned tex, int width, int height, float *rgba, lm_error *err);
+/* The radiance a hemicube sees where nothing is hit (settings.sky): the scene's sky, set before each
+ * gather by the frame loop, so that a sky edit reaches the next gather. */
+void lm_gather_set_sky(lm_gather *g, const float sky[3]);
 /* Replaces the whole texture's contents with rgba (as lm_iim_texture_read gives it): a resumed bake's
  * checkpoint (update/bake_checkpoint.h). */
 lm_status lm_iim_texture_write(unsigned tex, int width, int height, const float *rgba, lm_error *err);

@@ -462,6 +462,11 @@ static float near_plane(const lm_gather *g, const lm_scene *s)
     return near > 0.0f ? near : 1e-6f;
 }
 
+void lm_gather_set_sky(lm_gather *g, const float sky[3])
+{
+    memcpy(g->set.sky, sky, sizeof g->set.sky);
+}
+
 /* Clears the part of the target `count` texels use: sky radiance, depth 0 (reversed). */
 static void clear_target(lm_gather *g, uint32_t count)
 {

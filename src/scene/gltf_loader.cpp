@@ -163,6 +163,7 @@ class Loader {
     lm_status primitive(int node, int mesh, int prim);
     lm_status animations();
     lm_status finish();
+    lm_status sky();
 
     const char *path_;
     const unsigned char *mem_ = nullptr; // the scene's bytes when it comes from memory
@@ -1027,6 +1028,28 @@ lm_status Loader::finish()
     return lm_scene_split_sides(s_.get(), err_);
 }
 
+// The file's sky: the root's extras {"lmgi": {"sky": [r, g, b]}}, a uniform radiance (lm_scene.sky). A
+// malformed one is an error (it is light, and a scene lit wrongly is worse than one refused).
+lm_status Loader::sky()
+{
+    const tinygltf::Value &x = model_.extras;
+    if (!x.IsObject() || !x.Has("lmgi") || !x.Get("lmgi").IsObject() || !x.Get("lmgi").Has("sky"))
+        return LM_OK;
+    const tinygltf::Value &v = x.Get("lmgi").Get("sky");
+    bool ok = v.IsArray() && v.ArrayLen() == 3;
+    for (int k = 0; ok && k < 3; k++) {
+        ok = v.Get(k).IsNumber();
+        double d = ok ? v.Get(k).GetNumberAsDouble() : -1.0;
+        ok = ok && d >= 0.0 && d <= LM_MAX_EMISSION;
+        s_->sky[k] = float(d);
+    }
+    if (!ok)
+        return fail(LM_ERR_INVALID, "extras.lmgi.sky must be [r, g, b], a radiance of finite numbers in [0, %g]",
+                    LM_MAX_EMISSION);
+    s_->has_sky = 1;
+    return LM_OK;
+}
+
 lm_status Loader::run(lm_scene **out)
 {
     std::vector<unsigned char> bytes;
@@ -1036,7 +1059,8 @@ lm_status Loader::run(lm_scene **out)
     bytes = std::vector<unsigned char>(); // tinygltf has copied what it needs
     s_.reset(calloc_n<lm_scene>(1));
     snprintf(s_->path, sizeof s_->path, "%s", path_);
-    if ((st = materials()) || (st = nodes()) || (st = animations()) || (st = geometry()) || (st = finish()))
+    if ((st = materials()) || (st = nodes()) || (st = animations()) || (st = geometry()) || (st = finish()) ||
+        (st = sky()))
         return st;
     *out = s_.release();
     return LM_OK;

@@ -176,6 +176,14 @@ typedef struct {
     int32_t *tri_twin;
     uint32_t file_tri_count; /* triangles in the file (tri_count less the twins) */
 
+    /* The sky: an environment of uniform radiance around the scene, linear RGB (docs/levels.md, "Sky").
+     * It lights through photons (lm_emitters' SKY emitter), the gather (what a texel's hemisphere sees of
+     * it), the frame's background and reflections, and the reference (rays that leave the scene).
+     * has_sky: the scene has one, even if it is dark now (set once: the emitter then stays, so a sky
+     * dimmed to 0 and back is an edit like a light's). */
+    float sky[3];
+    int has_sky;
+
     int mesh_count;        /* number of glTF meshes (for reporting) */
     float bounds_min[3], bounds_max[3]; /* world-space bounds at load time (all nodes) */
     float origin[3];       /* where lmgi's world origin lies in the file's world: a scene that sits farther

@@ -67,7 +67,7 @@ int lm_caustic_emit(const lm_emitters *em, const lm_scene *s, int e, const lm_em
 {
     const lm_emitter *em_e = &em->e[e];
     memset(flux, 0, 3 * sizeof *flux);
-    if (!(g->radius > 0.0f) || count == 0)
+    if (!(g->radius > 0.0f) || count == 0 || em_e->kind == LM_EMIT_SKY) /* the sky throws no caustic photons */
         return 0;
     float inv = 1.0f / (float)count;
     lm_vec3 axis, d;

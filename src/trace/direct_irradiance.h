@@ -47,10 +47,12 @@ int lm_direct_irradiance(const lm_direct_light *d, const float p[3], const float
                           uint32_t seed, float out[3]);
 
 /* 1 when hit h carries light that lm_direct_irradiance computes (a first hit of a punctual light, or of
- * an emissive triangle when d->area is set): an estimate that adds lm_direct_irradiance leaves it out. */
+ * an emissive triangle when d->area is set; never the sky's): an estimate that adds lm_direct_irradiance
+ * leaves it out. */
 static inline int lm_direct_covers_hit(const lm_direct_light *d, const lm_hit *h)
 {
-    return h->bounce == 0 && (h->from_punctual ? d->punctual : d->area != NULL);
+    return h->bounce == 0 && (h->source == LM_HIT_FROM_PUNCTUAL ? d->punctual
+                              : h->source == LM_HIT_FROM_AREA && d->area != NULL);
 }
 
 #endif

@@ -107,12 +107,19 @@ static void set_punctual(const lm_scene *s, int light, lm_emitter *e)
     e->punctual = 1;
 }
 
+static void set_sky(lm_emitter *e)
+{
+    memset(e, 0, sizeof *e);
+    e->kind = LM_EMIT_SKY;
+    e->light = e->node = -1;
+}
+
 /* Order: the file's lights, the emissive nodes, then the lights added by edits in the order they came,
  * the order lm_emitters_add_light gives an emitter list built before the edits. */
 lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
 {
     memset(out, 0, sizeof *out);
-    int n = s->light_count;
+    int n = s->light_count + (s->has_sky != 0);
     for (int i = 0; i < s->node_count; i++)
         n += count_emissive(s, &s->nodes[i]) > 0;
     out->e = calloc(n > 0 ? (size_t)n : 1, sizeof *out->e);
@@ -133,8 +140,29 @@ lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
     for (int i = 0; i < s->light_count; i++)
         if (s->lights[i].added)
             set_punctual(s, i, &out->e[out->count++]);
+    if (s->has_sky)
+        set_sky(&out->e[out->count++]);
     lm_emitters_update(out, s);
     return LM_OK;
+}
+
+lm_status lm_emitters_add_sky(lm_emitters *em, const lm_scene *s, lm_error *err)
+{
+    lm_emitter *e = realloc(em->e, sizeof *e * ((size_t)em->count + 1));
+    if (!e)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the sky", s->path);
+    em->e = e;
+    set_sky(&em->e[em->count++]);
+    lm_emitters_update(em, s);
+    return LM_OK;
+}
+
+int lm_emitters_sky(const lm_emitters *em)
+{
+    for (int i = 0; i < em->count; i++)
+        if (em->e[i].kind == LM_EMIT_SKY)
+            return i;
+    return -1;
 }
 
 lm_status lm_emitters_add_light(lm_emitters *em, const lm_scene *s, int light, lm_error *err)
@@ -177,6 +205,15 @@ static void place_punctual(lm_emitter *e, const lm_scene *s, float disk_radius)
     for (int c = 0; c < 3; c++) {
         e->radiant[c] = dark ? 0.0f : l->color[c] * l->intensity;
         e->power[c] = e->radiant[c] * scale;
+    }
+}
+
+/* Radiance L from every direction through a disk of radius R facing it: L pi R^2 per steradian, 4 pi of them. */
+static void place_sky(lm_emitter *e, const lm_scene *s, float disk_radius)
+{
+    for (int c = 0; c < 3; c++) {
+        e->radiant[c] = s->sky[c];
+        e->power[c] = s->sky[c] * (float)(4.0 * LM_PI * LM_PI) * disk_radius * disk_radius;
     }
 }
 
@@ -237,6 +274,8 @@ void lm_emitters_update(lm_emitters *em, const lm_scene *s)
         lm_emitter *e = &em->e[i];
         if (e->punctual)
             place_punctual(e, s, em->disk_radius);
+        else if (e->kind == LM_EMIT_SKY)
+            place_sky(e, s, em->disk_radius);
         else
             place_area(e, s);
         e->luminance = lm_luminance(e->power);
@@ -383,6 +422,24 @@ static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emi
         out->flux[c] = e->radiant[c] * scale;
 }
 
+/* A sky photon: its direction of travel uniform on the sphere (u[0], u[1]: similar directions for QMC
+ * strata of those two), its origin uniform on the disk (u[2] radius, u[3] angle) of the scene's bounding
+ * sphere across that direction, moved back outside the sphere; flux L 4 pi pi R^2 / count. */
+static void emit_sky(const lm_emitters *em, const lm_emitter *e, const float u[4], uint32_t count, lm_emission *out)
+{
+    float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
+    lm_sincos_turn(u[1], &sn, &cs);
+    lm_vec3 d = lm_v3(r * cs, r * sn, z);
+    float rad = em->disk_radius * sqrtf(u[2]), back = 1.001f * em->disk_radius;
+    lm_sincos_turn(u[3], &sn, &cs);
+    lm_vec3 o = lm_add(lm_sub(lm_v3_load(em->disk_center), lm_scale(d, back)), lm_onb_dir(d, rad * cs, rad * sn, 0.0f));
+    lm_v3_store(out->org, o);
+    lm_v3_store(out->dir, d);
+    float scale = (float)(4.0 * LM_PI * LM_PI) * em->disk_radius * em->disk_radius / (float)count;
+    for (int c = 0; c < 3; c++)
+        out->flux[c] = e->radiant[c] * scale;
+}
+
 void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris,
                             const float u[4], uint32_t count, lm_emission *out)
 {
@@ -392,6 +449,8 @@ void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, con
         return;
     if (em_e->punctual && em_e->luminance > 0.0f) /* a light switched off or removed: no photon */
         emit_punctual(em, s, em_e, u, count, out);
+    else if (em_e->kind == LM_EMIT_SKY && em_e->luminance > 0.0f)
+        emit_sky(em, em_e, u, count, out);
     else if (em_e->tri_count > 0 && em_e->cdf[em_e->tri_count - 1] > 0.0f)
         emit_area(em_e, tris, s, u, count, out);
 }
@@ -487,6 +546,8 @@ int lm_emitter_sample_toward(const lm_emitters *em, const lm_scene *s, int e, co
     const lm_emitter *em_e = &em->e[e];
     if (em_e->punctual)
         return toward_punctual(s, em_e, lm_v3_load(p), out);
+    if (em_e->kind == LM_EMIT_SKY) /* found by the rays that leave the scene instead */
+        return 0;
     return toward_area(s, em_e, lm_v3_load(p), u, out);
 }
 

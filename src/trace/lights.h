@@ -5,7 +5,11 @@
  * Point: intensity I -> flux 4 pi I. Spot: I -> I times the solid angle of its cone (with the glTF
  * smooth falloff between inner and outer angles integrated). Directional: illuminance E -> flux E times
  * the area of a disk that covers the scene's bounds, perpendicular to the light. Emissive: radiance
- * L = emissive x strength, flux pi L A per emitting side (double-sided materials emit on both sides). */
+ * L = emissive x strength, flux pi L A per emitting side (double-sided materials emit on both sides).
+ * Sky (lm_scene.sky, uniform radiance L from every direction): photons leave the disk that covers the
+ * scene's bounds perpendicular to a direction drawn uniformly on the sphere, flux L 4 pi x pi R^2 in
+ * all; it has no next-event estimation (the reference meets it where rays leave the scene) and no
+ * caustic photons. It is the last emitter; node and light are -1. */
 #ifndef LM_LIGHTS_H
 #define LM_LIGHTS_H
 
@@ -14,7 +18,7 @@
 #include "../core/error.h"
 #include "../scene/scene.h"
 
-typedef enum { LM_EMIT_POINT = 0, LM_EMIT_SPOT, LM_EMIT_DIRECTIONAL, LM_EMIT_AREA } lm_emitter_kind;
+typedef enum { LM_EMIT_POINT = 0, LM_EMIT_SPOT, LM_EMIT_DIRECTIONAL, LM_EMIT_AREA, LM_EMIT_SKY } lm_emitter_kind;
 
 typedef struct {
     lm_emitter_kind kind;
@@ -46,6 +50,10 @@ void lm_emitters_free(lm_emitters *em);
 /* Appends the emitter of scene light `light`, added by an edit after em was built, and places every
  * emitter (lm_emitters_update). */
 lm_status lm_emitters_add_light(lm_emitters *em, const lm_scene *s, int light, lm_error *err);
+/* Appends the sky emitter, for a scene given a sky (lm_scene.has_sky) after em was built; and the index of
+ * em's sky emitter, -1 without one. */
+lm_status lm_emitters_add_sky(lm_emitters *em, const lm_scene *s, lm_error *err);
+int lm_emitters_sky(const lm_emitters *em);
 /* Point, spot and directional emitters in em (the lights it knows). */
 int lm_emitters_light_count(const lm_emitters *em);
 /* Re-reads emitter placement and flux after node moves or light edits (world matrices, bounds). */

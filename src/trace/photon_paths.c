@@ -82,7 +82,7 @@ static int reserve_verts(lm_path_vertex **verts, uint32_t *cap, uint32_t need, i
     return 1;
 }
 
-static uint32_t store_vertex(lm_photons *ph, const ph_vertex *v, uint32_t photon, int punctual)
+static uint32_t store_vertex(lm_photons *ph, const ph_vertex *v, uint32_t photon, int source)
 {
     uint32_t slot;
     lm_hit *h = lm_photon_store_claim(&ph->store, v->surface, &slot); /* filled in place */
@@ -95,7 +95,7 @@ static uint32_t store_vertex(lm_photons *ph, const ph_vertex *v, uint32_t photon
     h->photon = photon;
     h->tri = v->tri;
     h->bounce = v->bounce;
-    h->from_punctual = (uint8_t)(punctual != 0);
+    h->source = (uint8_t)source;
     h->caustic = v->caustic;
     lm_photon_store_link(&ph->store, slot);
     return slot;
@@ -113,7 +113,8 @@ static int replace_path(lm_photons *ph, const ph_group *g, uint32_t m, const ph_
             st->hits_removed++;
         }
     uint32_t photon = g->first_id + m * ph->G;
-    int punctual = ph->em->e[g->emitter].punctual, ok = 1;
+    const lm_emitter *em = &ph->em->e[g->emitter];
+    int source = em->punctual ? LM_HIT_FROM_PUNCTUAL : em->kind == LM_EMIT_SKY ? LM_HIT_FROM_SKY : LM_HIT_FROM_AREA, ok = 1;
     for (uint32_t i = 0; i < n; i++) {
         out[i].node = v[i].node;
         out[i].tri = v[i].tri;
@@ -121,7 +122,7 @@ static int replace_path(lm_photons *ph, const ph_group *g, uint32_t m, const ph_
         out[i].slot = LM_NONE;
         if (v[i].surface < 0)
             continue;
-        out[i].slot = store_vertex(ph, &v[i], photon, punctual);
+        out[i].slot = store_vertex(ph, &v[i], photon, source);
         if (out[i].slot == LM_NONE) {
             ok = 0;
             continue;

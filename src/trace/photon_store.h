@@ -13,6 +13,8 @@
 
 #define LM_NONE 0xFFFFFFFFu
 
+enum { LM_HIT_FROM_AREA = 0, LM_HIT_FROM_PUNCTUAL = 1, LM_HIT_FROM_SKY = 2 };
+
 typedef struct {
     float pos[3];          /* world position when stored */
     float local[3];        /* position in the hit node's local space (AIM lookups match texel.local) */
@@ -22,7 +24,8 @@ typedef struct {
     uint32_t tri;
     int32_t surface;
     uint16_t bounce;       /* 0 = first hit after leaving the emitter */
-    uint8_t from_punctual; /* the photon came from a point, spot or directional light */
+    uint8_t source;        /* what the photon came from: LM_HIT_FROM_AREA (emissive triangles), _PUNCTUAL
+                            * (a point, spot or directional light) or _SKY */
     uint8_t caustic;       /* it came off mirrors and glass only, straight from its emitter (L S+ D): light
                             * the caustic pass carries, not the receiver's IIM (docs/caustics.md) */
     uint32_t prev, next;   /* links in the surface's hit list (LM_NONE at the ends); next also links free slots */
@@ -69,7 +72,10 @@ int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n);
 void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot);
 /* Whether a hit's light is what the receiver's IIM holds: not a punctual light's first hit (the direct
  * pass's), not a caustic hit (the caustic pass's). */
-static inline int lm_hit_in_iim(const lm_hit *h) { return !(h->bounce == 0 && h->from_punctual) && !h->caustic; }
+static inline int lm_hit_in_iim(const lm_hit *h)
+{
+    return !(h->bounce == 0 && h->source == LM_HIT_FROM_PUNCTUAL) && !h->caustic;
+}
 /* Energy of a hit as the deltas count it. */
 static inline double lm_hit_energy(const lm_hit *h)
 {

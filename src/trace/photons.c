@@ -317,8 +317,8 @@ static uint32_t added_per_group(const lm_photons *ph, const lm_emitter *e)
 lm_status lm_photons_add_emitter(lm_photons *ph, lm_error *err)
 {
     uint32_t E = ph->emitter_count, G = ph->G, old = ph->group_count;
-    if (ph->em->count != (int)E + 1 || !ph->em->e[E].punctual)
-        return lm_fail(err, LM_ERR_INVALID, "photons: expected one light appended to the %u emitters (have %d)", E,
+    if (ph->em->count != (int)E + 1 || !(ph->em->e[E].punctual || ph->em->e[E].kind == LM_EMIT_SKY))
+        return lm_fail(err, LM_ERR_INVALID, "photons: expected one light or the sky appended to the %u emitters (have %d)", E,
                        ph->em->count);
     uint64_t at = ph->photon_count + (uint64_t)added_per_group(ph, &ph->em->e[E]) * G;
     if (at > PH_MAX_PHOTONS)

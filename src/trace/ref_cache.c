@@ -57,6 +57,8 @@ static void hash_light(uint64_t *h, const lm_light *l)
 
 static void hash_scene(uint64_t *h, const lm_scene *s)
 {
+    fnv(h, s->sky, sizeof s->sky);
+    fnv_u32(h, (uint32_t)s->has_sky);
     size_t nv = s->vertex_count;
     fnv_u32(h, s->vertex_count);
     fnv(h, s->positions, nv * 3 * sizeof(float));

@@ -8,7 +8,9 @@
  * Each contribution goes to the part the path's route so far says (docs/reference.md, "Which part
  * carries which light"); the route only sorts, it draws no numbers, so the paths and their sum are
  * those of the solver before the split. Emission met after a chain of only specular vertices from the
- * receiver is dropped: the light tracer's caustic part carries it, for every kind of emitter alike. */
+ * receiver is dropped: the light tracer's caustic part carries it, for every kind of emitter alike (the
+ * sky's, which the light tracer does not emit, is then left out of both). A ray that leaves the scene
+ * meets the sky (lm_scene.sky). */
 #include "ref_paths.h"
 
 #include <math.h>
@@ -229,8 +231,14 @@ static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, 
         float of[3], df[3];
         lm_v3_store(of, org);
         lm_v3_store(df, dir);
-        if (!lm_rt_intersect(c->rt, of, df, 0.0f, INFINITY, &hit))
+        if (!lm_rt_intersect(c->rt, of, df, 0.0f, INFINITY, &hit)) {
+            /* the sky where the ray leaves: met like an emitter (no light sample of it to weigh against),
+             * seen from the receiver it is the IIM's part, from the eye the background's */
+            int part = route_hit(&rt, 0);
+            if (part != DROPPED && c->s->has_sky)
+                tally_add(out, part, beta, c->s->sky, 1.0f);
             return;
+        }
         lm_shading sh;
         lm_shading_from_hit(c->s, &hit, of, df, &sh);
         int specular = lm_material_is_specular(sh.material->cls), part = route_hit(&rt, specular);

@@ -95,18 +95,20 @@ static void decide_indirect(const lm_scene *s, lm_effects *e)
     int emitters = emit.materials_on + emit.materials_off;
     int first_emitter = emit.first_node_on >= 0 ? emit.first_node_on : emit.first_node_off;
     char *r = e->reason[LM_EFFECT_INDIRECT];
-    e->on[LM_EFFECT_INDIRECT] = (count_lights(s, -1) > 0 || emitters > 0) && receivers > 0;
-    if (count_lights(s, -1) == 0 && emitters == 0)
-        snprintf(r, 256, "no light and no emissive material");
+    e->on[LM_EFFECT_INDIRECT] = (count_lights(s, -1) > 0 || emitters > 0 || s->has_sky) && receivers > 0;
+    if (count_lights(s, -1) == 0 && emitters == 0 && !s->has_sky)
+        snprintf(r, 256, "no light, no emissive material and no sky (--sky)");
     else if (receivers == 0)
         snprintf(r, 256, "every node has extras indirect: false");
+    else if (count_lights(s, -1) == 0 && emitters == 0)
+        snprintf(r, 256, "the sky lights %d node%s", receivers, receivers == 1 ? "" : "s");
     else if (emitters == 0)
-        snprintf(r, 256, "%d light%s bounce off %d node%s", count_lights(s, -1), count_lights(s, -1) == 1 ? "" : "s",
-                 receivers, receivers == 1 ? "" : "s");
+        snprintf(r, 256, "%d light%s%s bounce off %d node%s", count_lights(s, -1), count_lights(s, -1) == 1 ? "" : "s",
+                 s->has_sky ? " and the sky" : "", receivers, receivers == 1 ? "" : "s");
     else
-        snprintf(r, 256, "%d light%s and %d emissive material%s (first on node '%s') bounce off %d node%s",
-                 count_lights(s, -1), count_lights(s, -1) == 1 ? "" : "s", emitters, emitters == 1 ? "" : "s",
-                 s->nodes[first_emitter].name, receivers, receivers == 1 ? "" : "s");
+        snprintf(r, 256, "%d light%s%s and %d emissive material%s (first on node '%s') bounce off %d node%s",
+                 count_lights(s, -1), count_lights(s, -1) == 1 ? "" : "s", s->has_sky ? ", the sky" : "", emitters,
+                 emitters == 1 ? "" : "s", s->nodes[first_emitter].name, receivers, receivers == 1 ? "" : "s");
 }
 
 /* "1 mirror material on node 'x'", "1 mirror and 2 glass materials (the first on node 'x')": the classes'

@@ -190,6 +190,8 @@ static int widen_to_viewers(lm_frame_loop *fl, lm_photon_store *ps)
 static lm_status gather_prepare(lm_frame_loop *fl, lm_error *err)
 {
     lm_status st = lm_gather_set_scene(fl->gather, fl->scene, fl->atlas, err);
+    if (fl->scene->has_sky)
+        lm_gather_set_sky(fl->gather, fl->scene->sky);
     if (st == LM_OK && fl->aim_stale)
         st = lm_gather_set_aim_dilated(fl->gather, fl->atlas, lm_aim_dilated_rgba(lm_photon_stage_aim(fl->stage)), err);
     if (st == LM_OK)

@@ -124,6 +124,25 @@ static lm_status take_new_lights(lm_photon_stage *ps, int *added, lm_error *err)
     return LM_OK;
 }
 
+/* A sky given to the scene after the emitter list was built joins it last, as a light added by an edit. */
+static lm_status take_new_sky(lm_photon_stage *ps, int *added, lm_error *err)
+{
+    if (!ps->scene->has_sky || lm_emitters_sky(&ps->emitters) >= 0)
+        return LM_OK;
+    emitter_snapshot *snap = realloc(ps->snap, sizeof *snap * ((size_t)ps->emitters.count + 2));
+    if (!snap)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the sky", ps->scene->path);
+    ps->snap = snap;
+    lm_status st = lm_emitters_add_sky(&ps->emitters, ps->scene, err);
+    if (st == LM_OK)
+        st = lm_photons_add_emitter(ps->photons, err);
+    if (st == LM_OK) {
+        take_snapshot(ps, ps->emitters.count - 1, &ps->snap[ps->emitters.count - 1]);
+        ++*added;
+    }
+    return st;
+}
+
 /* A material edit (colour, emission, class) reaches the photons that touch the material, which are re-traced,
  * and the AIMs of its surfaces, whose albedo the estimate multiplies in: those are marked for a refresh.
  * The surfaces its light reaches follow from the re-traced photons' hits. Returns the edited materials. */
@@ -317,6 +336,8 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
     }
     int added = 0;
     lm_status st = take_new_lights(ps, &added, err);
+    if (st == LM_OK)
+        st = take_new_sky(ps, &added, err);
     lm_emitters_update(&ps->emitters, ps->scene);
     lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
     if (st == LM_OK)

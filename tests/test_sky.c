@@ -1,0 +1,276 @@
+/* The sky (issue 30, item 3): a uniform environment of radiance L. Under it an open plane receives
+ * E = pi L (every direction of its hemisphere sees the sky) and leaves rho L; the reference, the gather
+ * and the photons must each give that, a box open to the sky must match the reference, an edit of the
+ * sky (darker, or given after the updater was made) must reach the lightmaps, and a file's or the API's
+ * bad sky must be refused. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+#include <lmgi.h>
+
+#include "support.h"
+
+#define PI 3.14159265358979323846
+#define RHO 0.8 /* lmt_write_gltf's scenes use the default material: 0.8 grey */
+
+static const float k_sky[3] = {1.0f, 0.5f, 0.25f};
+
+/* A 20 x 20 plane facing up; `sky`: the file's extras.lmgi.sky JSON (NULL: none); `light`: one point light
+ * 2 above it (KHR_lights_punctual JSON, NULL: none). */
+static const char *plane_scene(const char *name, const char *sky, const char *light)
+{
+    static char path[512];
+    lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_quad(&m, (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    char extra[1024] = "", nodes[512];
+    size_t at = 0;
+    if (sky)
+        at += (size_t)snprintf(extra + at, sizeof extra - at, "\"extras\": {\"lmgi\": {\"sky\": %s}}, ", sky);
+    if (light)
+        snprintf(extra + at, sizeof extra - at,
+                 "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [%s]}},",
+                 light);
+    snprintf(nodes, sizeof nodes, "[{\"mesh\": 0}%s]",
+             light ? ", {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}" : "");
+    snprintf(path, sizeof path, "%s/%s.gltf", lmt_tmpdir(), name);
+    assert_int_equal(lmt_write_gltf(path, &m, 1, nodes, NULL, 0, extra), 0);
+    return path;
+}
+
+static lmgi_scene *load(const char *path, int texels)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = texels;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
+/* Mean of channel c of the valid texels of a lightmap whose texel centres lie within `inner` of the plane's
+ * middle (x and z), from the atlas's texel positions. */
+typedef struct {
+    double mean[3];
+    int n;
+} texel_mean;
+
+static texel_mean lightmap_mean(lmgi_updater *u, lmgi_scene *sc, lmgi_lightmap kind)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(n * sizeof *rgba);
+    assert_non_null(rgba);
+    lmgi_error e;
+    assert_int_equal(lmgi_get_lightmap(u, kind, rgba, n, &e), LMGI_OK);
+    texel_mean m = {{0, 0, 0}, 0};
+    for (size_t i = 0; i < n / 4; i++) {
+        if (!(rgba[4 * i + 3] > 0.0f))
+            continue;
+        for (int c = 0; c < 3; c++)
+            m.mean[c] += rgba[4 * i + c];
+        m.n++;
+    }
+    for (int c = 0; c < 3; c++)
+        m.mean[c] /= m.n > 0 ? m.n : 1;
+    free(rgba);
+    return m;
+}
+
+static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc)
+{
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
+/* The plane under the sky alone: the reference's texels E = pi L to its noise (every path escapes at
+ * once), the gather's IIM pi L (the hemicube sees nothing but sky: exact), and the photon estimate
+ * (AIM) rho L within 3% on average. */
+static void test_open_plane(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = load(plane_scene("open", "[1, 0.5, 0.25]", NULL), 4000);
+    float sky[3];
+    assert_int_equal(lmgi_get_environment(sc, sky), 1);
+    assert_float_equal(sky[1], 0.5f, 0.0f);
+
+    lmgi_error e;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater *u = updater(ctx, sc);
+    texel_mean iim = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM), aim = lightmap_mean(u, sc, LMGI_LIGHTMAP_AIM);
+
+    lmgi_reference_desc rd;
+    memset(&rd, 0, sizeof rd);
+    rd.target_error = 0.02f;
+    rd.no_cache = 1;
+    lmgi_reference r;
+    assert_int_equal(lmgi_reference_texels(sc, &rd, &r, &e), LMGI_OK);
+    double ref[3] = {0, 0, 0};
+    int texels = 0;
+    for (int i = 0; i < r.width * r.height; i++) { /* the atlas's texels: 0 in its gutters */
+        if (r.full[3 * i] == 0.0f && r.full[3 * i + 1] == 0.0f)
+            continue;
+        for (int c = 0; c < 3; c++)
+            ref[c] += r.full[3 * i + c];
+        texels++;
+    }
+    assert_int_equal(texels, iim.n);
+    for (int c = 0; c < 3; c++)
+        ref[c] /= texels;
+    lmgi_reference_free(&r);
+
+    for (int c = 0; c < 3; c++) {
+        double want = PI * k_sky[c];
+        print_message("channel %d: pi L %.4f, reference %.4f, IIM %.4f; rho L %.4f, AIM %.4f\n", c, want, ref[c],
+                      iim.mean[c], RHO * k_sky[c], aim.mean[c]);
+        assert_float_equal(ref[c] / want, 1.0, 0.005);
+        assert_float_equal(iim.mean[c] / want, 1.0, 0.01);
+        assert_float_equal(aim.mean[c] / (RHO * k_sky[c]), 1.0, 0.03);
+    }
+    /* the export carries the sky, and loads back with it */
+    const char *dir = lmt_tmpdir();
+    lmgi_export_desc xd = {.name = "open", .force = 1};
+    assert_int_equal(lmgi_export_gltf(u, dir, &xd, &e), LMGI_OK);
+    char path[600];
+    snprintf(path, sizeof path, "%s/open.gltf", dir);
+    lmgi_scene *back = load(path, 1000);
+    float sky_back[3];
+    assert_int_equal(lmgi_get_environment(back, sky_back), 1);
+    for (int c = 0; c < 3; c++)
+        assert_float_equal(sky_back[c], k_sky[c], 0.0f);
+    lmgi_free(back);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* An edit of the sky is taken up like a light's: twice the sky, twice the lightmap after a bake; a sky
+ * given to a scene lit by a lamp after its updater was made adds pi L to every texel's IIM. */
+static void test_sky_edits(void **state)
+{
+    (void)state;
+    lmgi_error e;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_scene *sc = load(plane_scene("edit", "[1, 0.5, 0.25]", NULL), 4000);
+    lmgi_updater *u = updater(ctx, sc);
+    texel_mean before = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
+    const float twice[3] = {2.0f, 1.0f, 0.5f};
+    assert_int_equal(lmgi_set_environment(sc, twice, &e), LMGI_OK);
+    assert_int_equal(lmgi_bake(u, NULL, NULL, &e), LMGI_OK);
+    texel_mean after = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
+    for (int c = 0; c < 3; c++)
+        assert_float_equal(after.mean[c] / before.mean[c], 2.0, 0.02);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+
+    /* the lamp's plane sees nothing of it (no other surface): its IIM is 0 until the sky comes */
+    sc = load(plane_scene("lamp", NULL, "{\"type\": \"point\", \"intensity\": 10}"), 4000);
+    assert_int_equal(lmgi_get_environment(sc, NULL), 0);
+    u = updater(ctx, sc);
+    before = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
+    assert_int_equal(lmgi_set_environment(sc, k_sky, &e), LMGI_OK);
+    assert_int_equal(lmgi_bake(u, NULL, NULL, &e), LMGI_OK);
+    after = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
+    for (int c = 0; c < 3; c++) {
+        print_message("channel %d: IIM %.4f before the sky, %.4f after (pi L = %.4f)\n", c, before.mean[c],
+                      after.mean[c], PI * k_sky[c]);
+        assert_true(before.mean[c] == 0.0);
+        assert_float_equal(after.mean[c] / (PI * k_sky[c]), 1.0, 0.01);
+    }
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A box open at the top (floor and four walls of 2 m, the camera above looking in) under the sky alone:
+ * the frame against the reference, over the frame within 5%: the sky through the opening, bounced. */
+static void test_open_box_against_reference(void **state)
+{
+    (void)state;
+    lmt_mesh m[5];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-1, 0, 1}, (float[3]){2, 0, 0}, (float[3]){0, 0, -2});   /* floor, up */
+    lmt_mesh_quad(&m[1], (float[3]){-1, 0, -1}, (float[3]){2, 0, 0}, (float[3]){0, 2, 0});   /* back, +z */
+    lmt_mesh_quad(&m[2], (float[3]){1, 0, 1}, (float[3]){-2, 0, 0}, (float[3]){0, 2, 0});    /* front, -z */
+    lmt_mesh_quad(&m[3], (float[3]){-1, 0, 1}, (float[3]){0, 0, -2}, (float[3]){0, 2, 0});   /* left, +x */
+    lmt_mesh_quad(&m[4], (float[3]){1, 0, -1}, (float[3]){0, 0, 2}, (float[3]){0, 2, 0});    /* right, -x */
+    char path[512];
+    snprintf(path, sizeof path, "%s/box.gltf", lmt_tmpdir());
+    const char *nodes = "[{\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}, {\"mesh\": 3}, {\"mesh\": 4}, "
+                        "{\"camera\": 0, \"translation\": [0, 3.2, 0.9], \"rotation\": [-0.6427876, 0, 0, 0.7660444]}]";
+    assert_int_equal(lmt_write_gltf(path, m, 5, nodes, NULL, 0,
+                                    "\"extras\": {\"lmgi\": {\"sky\": [1, 0.5, 0.25]}}, \"cameras\": [{\"type\": "
+                                    "\"perspective\", \"perspective\": {\"yfov\": 1.0, \"znear\": 0.05}}],"),
+                     0);
+    lmgi_scene *sc = load(path, 6000);
+    lmgi_error e;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater_desc ud;
+    memset(&ud, 0, sizeof ud);
+    ud.frame_width = ud.frame_height = 64;
+    lmgi_reference_desc rd;
+    memset(&rd, 0, sizeof rd);
+    rd.target_error = 0.03f;
+    rd.no_cache = 1;
+    lmgi_check_result c;
+    assert_int_equal(lmgi_check(ctx, sc, &ud, &rd, 1, &c, &e), LMGI_OK);
+    print_message("open box under the sky: frame / reference %.4f %.4f %.4f over %u pixels, relative RMSE %.4f\n",
+                  c.ratio[0], c.ratio[1], c.ratio[2], c.pixels, c.rel_rmse);
+    assert_true(c.pixels > 64 * 64 / 2);
+    for (int k = 0; k < 3; k++)
+        assert_float_equal(c.ratio[k], 1.0, 0.05);
+    lmgi_check_free(&c);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A sky of NaN, a negative one, or a malformed one in the file: refused, naming it, nothing changed. */
+static void test_bad_sky(void **state)
+{
+    (void)state;
+    lmgi_error e;
+    lmgi_scene *sc = NULL;
+    const char *bad[] = {"[1, 2]", "[1, -1, 0]", "[1, \"a\", 0]", "[1e30, 0, 0]"};
+    for (int k = 0; k < 4; k++) {
+        assert_int_equal(lmgi_load(plane_scene("bad", bad[k], NULL), NULL, &sc, &e), LMGI_ERR_INVALID);
+        assert_non_null(strstr(e.message, "extras.lmgi.sky"));
+        assert_null(sc);
+    }
+    sc = load(plane_scene("good", NULL, NULL), 1000);
+    const float nan_sky[3] = {NAN, 0, 0}, negative[3] = {0, -1, 0};
+    assert_int_equal(lmgi_set_environment(sc, nan_sky, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "sky radiance"));
+    assert_int_equal(lmgi_set_environment(sc, negative, &e), LMGI_ERR_INVALID);
+    assert_int_equal(lmgi_set_environment(sc, NULL, &e), LMGI_ERR_INVALID);
+    assert_int_equal(lmgi_get_environment(sc, NULL), 0); /* nothing changed */
+    lmgi_free(sc);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_open_plane),
+        cmocka_unit_test(test_sky_edits),
+        cmocka_unit_test(test_open_box_against_reference),
+        cmocka_unit_test(test_bad_sky),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
