@@ -157,6 +157,27 @@ static lm_status plan_memory(const lm_atlas *a, lm_error *err)
                           "texels (--texels) makes it smaller", err);
 }
 
+/* A texel budget (target_texels) is met within LM_BUDGET_WARN: a count farther off is packed again, in
+ * at most LM_BUDGET_PASSES passes, until within LM_BUDGET_SLACK; a count still beyond LM_BUDGET_WARN is
+ * warned about. */
+#define LM_BUDGET_SLACK 0.1
+#define LM_BUDGET_WARN 0.15
+#define LM_BUDGET_PASSES 6
+
+/* The charts packed at texel size ts, their triangles copied and their texels made, into out. */
+static lm_status lay_out(const lm_scene *s, const lmc_charts *c, const float *pos, float ts,
+                         const lm_atlas_options *o, lm_atlas *out, lm_error *err)
+{
+    lm_status st = lmc_pack(c, ts, o->gutter, o->max_size, out, err);
+    if (st == LM_OK)
+        st = plan_memory(out, err);
+    if (st == LM_OK)
+        st = copy_chart_tris(c, out, err);
+    if (st == LM_OK)
+        st = lmc_texels(s, c, pos, out, err);
+    return st;
+}
+
 lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atlas_options *o, lm_atlas *out,
                          lm_error *err)
 {
@@ -178,14 +199,33 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     st = o->use_file_uv1 ? lmc_charts_from_uv1(s, su, pos, &c, err) : lmc_unwrap(s, su, pos, &c, err);
     double t1 = lm_now(), t2 = t1;
     if (st == LM_OK) {
-        st = lmc_pack(&c, ts, o->gutter, o->max_size, out, err);
+        st = lay_out(s, &c, pos, ts, o, out, err);
         t2 = lm_now();
-        if (st == LM_OK)
-            st = plan_memory(out, err);
-        if (st == LM_OK)
-            st = copy_chart_tris(&c, out, err);
-        if (st == LM_OK)
-            st = lmc_texels(s, &c, pos, out, err);
+        /* A texel budget is met by the texel size, but charts round up to whole texels: a level of many small
+         * charts got 10x the texels it asked for (scenes/many_rooms.glb at 2,000). The texel size is scaled
+         * by the square root of what came over what was asked; a budget below what the charts need at their
+         * smallest stays over it (warned). */
+        double target = o->target_texels > 0 ? o->target_texels : LM_ATLAS_DEFAULT_TEXELS;
+        double ratio = out->texel_count / target, best = fabs(ratio - 1.0);
+        float best_ts = ts, last_ts = ts;
+        for (int pass = 0; st == LM_OK && o->texel_size <= 0.0f && pass < LM_BUDGET_PASSES &&
+                           best > (pass ? LM_BUDGET_SLACK : LM_BUDGET_WARN);
+             pass++) {
+            last_ts = best_ts * (float)sqrt(ratio);
+            lm_atlas_free(out);
+            st = lay_out(s, &c, pos, last_ts, o, out, err);
+            double r = out->texel_count / target;
+            if (st != LM_OK || !(fabs(r - 1.0) < best - 0.01))
+                break; /* no nearer: the charts are at their fewest texels (or their most) */
+            best = fabs(r - 1.0), best_ts = last_ts, ratio = r;
+        }
+        if (st == LM_OK && last_ts != best_ts) {
+            lm_atlas_free(out);
+            st = lay_out(s, &c, pos, best_ts, o, out, err);
+        }
+        if (st == LM_OK && o->texel_size <= 0.0f && best > LM_BUDGET_WARN)
+            lm_warn("%s: %d charts need %u texels at the least; the budget of %.0f texels cannot be met "
+                    "(docs/levels.md, \"Atlas\")", s->path, c.count, out->texel_count, target);
         lmc_charts_free(&c);
     }
     free(pos);
