@@ -379,7 +379,15 @@ typedef struct lmgi_updater lmgi_updater;
 typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_DRAWN } lmgi_emitter_light;
 /* Progress of long work: fraction 0 to 1 and the stage under way ("photons", "gather", "done"). */
 typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
-typedef enum { LMGI_GATHER_DEFAULT = 0, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_INSTANCED, LMGI_GATHER_LAYERED } lmgi_gather_scheme;
+typedef enum {
+    LMGI_GATHER_DEFAULT = 0, /* the hemicube, or rays for a scene of over LMGI_RAYS_ABOVE_TRIANGLES where the GL
+                              * rasterizes in software (docs/gather.md, "Rays") */
+    LMGI_GATHER_VIEWPORTS,   /* hemicubes, one draw per texel */
+    LMGI_GATHER_INSTANCED,   /* hemicubes, one instanced draw per pass */
+    LMGI_GATHER_LAYERED,     /* hemicubes, into a layered target */
+    LMGI_GATHER_RAYS         /* no hemicube: Embree rays over each texel's hemisphere on every core */
+} lmgi_gather_scheme;
+#define LMGI_RAYS_ABOVE_TRIANGLES 20000
 
 enum { LMGI_EFFECT_SHADOWS = 1, LMGI_EFFECT_INDIRECT = 2, LMGI_EFFECT_REFLECTIONS = 4, LMGI_EFFECT_CAUSTICS = 8 };
 /* How frames get their indirect light (docs/gather.md, docs/tiled.md): LMGI_INDIRECT_LIGHTMAP, the
@@ -518,7 +526,7 @@ LMGI_API void lmgi_updater_free(lmgi_updater *u); /* NULL: nothing */
 typedef struct {
     int texels_per_frame, hemicube_resolution, hemicube_samples, hemicube_coverage, rim_samples;
     float enlargement;
-    const char *gather_scheme;  /* "viewports", "instanced" or "layered" */
+    const char *gather_scheme;  /* "viewports", "instanced", "layered" or "rays" */
     uint32_t emissive_triangles;
     int emitters_closed_form;   /* 1: their light in closed form with emitter_rays shadow rays, 0: drawn */
     int emitter_rays;

@@ -558,13 +558,16 @@ static void test_cornell_box_against_reference(void **state)
      * at a = 2 the walls read 10-20% high, the 1 / F(a) bias of a bright source near the normal); then at
      * a = 2: drawn with the rim traced, in closed form without and with the rim traced (the frame loop's
      * gather for this scene), each asserted */
-    const float as[6] = {1.0f, 2.0f, 3.0f, 2.0f, 2.0f, 2.0f};
-    const int closed_form[6] = {0, 0, 0, 0, 1, 1}, traced[6] = {0, 0, 0, 1, 0, 1};
-    const double bound[6] = {0.0, 0.0, 0.0, IIM_RMSE_BOUND, IIM_RMSE_BOUND, IIM_RMSE_BOUND_RIM};
-    for (int k = 0; k < 6; k++) {
+    /* last, the rays scheme (no hemicube, the whole hemisphere traced) with the emitter in closed form: held
+     * to the frame loop's gather's bounds */
+    const float as[7] = {1.0f, 2.0f, 3.0f, 2.0f, 2.0f, 2.0f, 2.0f};
+    const int closed_form[7] = {0, 0, 0, 0, 1, 1, 1}, traced[7] = {0, 0, 0, 1, 0, 1, 1};
+    const double bound[7] = {0.0, 0.0, 0.0, IIM_RMSE_BOUND, IIM_RMSE_BOUND, IIM_RMSE_BOUND_RIM, IIM_RMSE_BOUND_RIM};
+    for (int k = 0; k < 7; k++) {
         lm_hemicube_settings set;
         lm_hemicube_settings_default(&set);
         set.enlargement = as[k];
+        set.scheme = k == 6 ? LM_GATHER_RAYS : set.scheme;
         if (closed_form[k])
             set.coverage_samples = 1; /* what the frame loop takes with the closed form */
         lm_gather_stats gs;
@@ -582,9 +585,9 @@ static void test_cornell_box_against_reference(void **state)
                    3 * sizeof(float));
         double rmse = lm_ref_relative_rmse(est, ref.iim, valid, p.atlas.texel_count, 3);
         double all = lm_ref_relative_rmse(est, ref.iim, NULL, p.atlas.texel_count, 3);
-        print_message("Cornell box IIM, a = %.0f%s: relative RMSE %.4f over valid texels, %.4f over all (%u texels, "
+        print_message("Cornell box IIM, %s a = %.0f%s: relative RMSE %.4f over valid texels, %.4f over all (%u texels, "
                       "%u invalid, %u unfilled; reference se %.3f, %.1f s%s); %.3f ms per texel (%d tris)\n",
-                      (double)set.enlargement, closed_form[k] ? (traced[k] ? " (emitter in closed form, rim traced)" :
+                      k == 6 ? "rays," : "hemicube,", (double)set.enlargement, closed_form[k] ? (traced[k] ? " (emitter in closed form, rim traced)" :
                       " (emitter in closed form)") : traced[k] ? " (rim traced)" : "", rmse, all, p.atlas.texel_count, invalid, unfilled, ref.mean_rel_se,
                       t_ref, ref.from_cache ? ", cached" : "", 1e3 * gs.seconds / p.atlas.texel_count,
                       (int)p.s->tri_count);

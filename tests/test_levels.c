@@ -2,7 +2,8 @@
  * triangles, a sun and a point light with a range) and Godot 4's truck-town export (WebP textures behind
  * a required extension, percent-encoded URIs, 2 km of ground). Each loads, keeps its texel budget, bakes
  * at a small budget under a sky with no valid texel exactly 0, and its frame matches the path-traced
- * reference within 5% over the frame. Skipped, saying so, where ../shared is absent. */
+ * reference within 5% over the frame (with the gather this machine picks for them: rays on a software
+ * GL). Skipped, saying so, where ../shared is absent. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -84,6 +85,9 @@ static void bake_and_check(const char *path, int texels, const lmgi_camera *cam)
         fail_msg("%s", e.message);
     lmgi_info in;
     lmgi_get_info(sc, &in);
+    lmgi_updater_info ui;
+    lmgi_get_updater_info(u, &ui);
+    print_message("%s: %s gather, %.1f s\n", path, ui.gather_scheme, 1e-3 * ui.ms_setup_gather);
     size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
     float *rgba = malloc(n * sizeof *rgba);
     assert_non_null(rgba);

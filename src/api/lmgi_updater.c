@@ -109,7 +109,7 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     else
         TAKE(rim_samples, 1, 65536, &s->gather.rim_samples);
     v = 0;
-    TAKE(gather_scheme, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_LAYERED, &v);
+    TAKE(gather_scheme, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_RAYS, &v);
     if (v)
         s->gather.scheme = (lm_gather_scheme)(v - 1);
     v = 0;
@@ -213,6 +213,11 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
     lm_frame_loop_settings set;
     lm_status st = lm_updater_settings(sc->scene, &d, &set, &e);
     set.gl = ctx->gl;
+    /* a software rasterizer's hemicube costs what the gather proxy's triangles cost; rays, the log of the
+     * level's (docs/gather.md, "Rays") */
+    if (d.gather_scheme == LMGI_GATHER_DEFAULT && sc->scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES &&
+        lm_gl_context_is_software(ctx->gl))
+        set.gather.scheme = LM_GATHER_RAYS;
     if (d.progress) {
         set.progress = gather_progress;
         set.progress_user = &d;

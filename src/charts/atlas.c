@@ -215,8 +215,12 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
             lm_atlas_free(out);
             st = lay_out(s, &c, pos, last_ts, o, out, err);
             double r = out->texel_count / target;
-            if (st != LM_OK || !(fabs(r - 1.0) < best - 0.01))
-                break; /* no nearer: the charts are at their fewest texels (or their most) */
+            lm_debug("charts: texel size %g: %u texels (budget %.0f)", (double)last_ts, out->texel_count, target);
+            /* kept only if nearer, and if the count answered the texel size at least a quarter as much as the
+             * area says (1 / ratio): charts already at their fewest texels would otherwise take texels of
+             * hundreds of metres for a few texels fewer (truck-town at run's 1,800) */
+            if (st != LM_OK || !(fabs(r - 1.0) < best - 0.01) || (ratio > 1.0 && r > 0.75 * ratio + 0.25))
+                break;
             best = fabs(r - 1.0), best_ts = last_ts, ratio = r;
         }
         if (st == LM_OK && last_ts != best_ts) {

@@ -190,11 +190,11 @@ static int parse_aim_direct(const char *o, const char *v, int *out)
 
 static int parse_scheme(const char *o, const char *v, int *out)
 {
-    static const char *names[] = {"viewports", "instanced", "layered"};
-    for (int k = 0; v && k < 3; k++)
+    static const char *names[] = {"viewports", "instanced", "layered", "rays"};
+    for (int k = 0; v && k < 4; k++)
         if (!strcmp(v, names[k]))
             return *out = k, 0;
-    return bad(o, v, "viewports, instanced or layered");
+    return bad(o, v, "viewports, instanced, layered or rays");
 }
 
 int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)

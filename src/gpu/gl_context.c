@@ -218,3 +218,8 @@ lm_gl_proc lm_gl_get_proc(const char *name)
         return NULL;
     return t_current->backend == LM_GL_BACKEND_EGL ? lm_gl_egl_get_proc(name) : lm_gl_osmesa_get_proc(name);
 }
+
+int lm_gl_context_is_software(const lm_gl_context *ctx)
+{
+    return ctx && is_software_renderer(lm_gl_context_description(ctx));
+}

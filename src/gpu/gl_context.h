@@ -24,6 +24,8 @@ lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err);
 lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx);
 /* "OSMesa" or "EGL". */
 const char *lm_gl_backend_name(lm_gl_backend backend);
+/* 1 when the context's GL rasterizes on the CPU (llvmpipe and its kind). */
+int lm_gl_context_is_software(const lm_gl_context *ctx);
 /* Version, renderer, backend and why: "4.5 (Core Profile) Mesa 22.3.6 / llvmpipe (LLVM 15.0.6, 256 bits)
  * (OSMesa; EGL gave llvmpipe ...)" or "... (EGL, device /dev/dri/renderD128)". */
 const char *lm_gl_context_description(const lm_gl_context *ctx);

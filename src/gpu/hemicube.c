@@ -22,6 +22,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->samples = 4;
     s->coverage_samples = 4;
     s->rim_samples = 64;
+    s->ray_samples = 400;
 }
 
 int lm_gather_coverage_for(const lm_scene *s, int closed_form_emitters)
@@ -31,7 +32,9 @@ int lm_gather_coverage_for(const lm_scene *s, int closed_form_emitters)
 
 const char *lm_gather_scheme_name(lm_gather_scheme s)
 {
-    return s == LM_GATHER_VIEWPORTS ? "viewports" : s == LM_GATHER_INSTANCED ? "instanced" : "layered";
+    return s == LM_GATHER_VIEWPORTS ? "viewports" : s == LM_GATHER_INSTANCED ? "instanced"
+         : s == LM_GATHER_LAYERED   ? "layered"
+                                    : "rays";
 }
 
 /* Integral of 1 / (pi (1 + x^2 + y^2)^2) over [0, X] x [0, Y] (odd in X and in Y). */

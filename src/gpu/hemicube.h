@@ -45,8 +45,13 @@
 typedef enum {
     LM_GATHER_VIEWPORTS = 0, /* one draw per texel into its own viewport tile */
     LM_GATHER_INSTANCED = 1, /* one instanced draw per pass, each instance cut to its tile by clip distances */
-    LM_GATHER_LAYERED = 2    /* one instanced draw per pass into a layered target (needs
+    LM_GATHER_LAYERED = 2,   /* one instanced draw per pass into a layered target (needs
                                 GL_ARB_shader_viewport_layer_array) */
+    LM_GATHER_RAYS = 3       /* no hemicube: ray_samples cosine-weighted strata of the whole hemisphere traced
+                                with Embree on every core, the AIM averaged over each stratum's footprint
+                                where it meets what it hits (hemicube_rim.h with enlargement 0). Its cost
+                                grows with the log of the level's triangles, the raster's with the proxy's:
+                                the choice where the GL rasterizes in software (docs/gather.md, "Rays") */
 } lm_gather_scheme;
 
 /* "viewports", "instanced", "layered" */
@@ -69,6 +74,7 @@ typedef struct {
                               footprint (hemicube_rim.h; default 64: fewer mottle surfaces that see a bright
                               spot near their horizon), with a tracer (lm_gather_set_tracer); 0 or no
                               tracer: the paper's division by F(a) */
+    int ray_samples;       /* LM_GATHER_RAYS: strata per texel, rounded down to a square (default 400) */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);

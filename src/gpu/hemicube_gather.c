@@ -138,7 +138,8 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
     if (s->resolution < 2 || s->tiles < 1 || !(s->enlargement > 0.0f) || !(s->offset >= 0.0f) ||
         !(s->proxy_error >= 0.0f && s->proxy_error < 1.0f) ||
         (s->scheme != LM_GATHER_LAYERED && (long)s->resolution * s->tiles > max_side) ||
-        (unsigned)s->scheme > LM_GATHER_LAYERED || (s->samples != 1 && s->samples != 4) ||
+        (unsigned)s->scheme > LM_GATHER_RAYS || (s->samples != 1 && s->samples != 4) ||
+        (s->scheme == LM_GATHER_RAYS && (s->ray_samples < 1 || s->ray_samples > 65536)) ||
         s->coverage_samples < 1 || s->coverage_samples > 16 ||
         (s->coverage_samples > 1 && s->scheme == LM_GATHER_LAYERED) || s->rim_samples < 0 ||
         s->rim_samples > 65536)
@@ -175,7 +176,8 @@ lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the hemicube gather");
     g->set = *set;
     g->coverage = lm_hemicube_coverage(set->enlargement);
-    st = lm_hemicube_programs(set->scheme, set->samples, &g->render_prog, &g->reduce_prog, err);
+    st = lm_hemicube_programs(set->scheme == LM_GATHER_RAYS ? LM_GATHER_VIEWPORTS : set->scheme, set->samples,
+                              &g->render_prog, &g->reduce_prog, err);
     if (st == LM_OK)
         st = make_target(g, err);
     if (st == LM_OK)
@@ -302,7 +304,10 @@ void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el) { g->
 
 void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt) { g->rt = rt; }
 
-static int traces_rim(const lm_gather *g) { return g->rt && g->set.rim_samples > 0; }
+static int traces_rim(const lm_gather *g)
+{
+    return g->rt && (g->set.rim_samples > 0 || g->set.scheme == LM_GATHER_RAYS);
+}
 /* The rim is traced and the AIM's copy it looks up exists (lm_gather_set_aim after the tracer). */
 static int rim_ready(const lm_gather *g) { return traces_rim(g) && g->aim_copy; }
 
@@ -601,7 +606,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
             float b[3], t[3], r[3], ng[3] = {o[7], o[11], o[15]};
             for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
                 b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
-            lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[i], r);
+            lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[i], r, NULL);
             for (int k = 0; k < 3; k++)
                 e[k] += r[k];
         }
@@ -632,11 +637,66 @@ static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
 }
 
+/* LM_GATHER_RAYS: each texel's whole hemisphere by rays, in parallel (what the hemicube and its rim
+ * together see: the AIM where a ray meets a surface, the back of a single-sided one black and counted
+ * into the back-face share, the sky where nothing is met, the emitters in closed form or as met), a pass
+ * of tiles^2 texels at a time, each written into the IIM texture at its texel. */
+static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
+                             uint32_t count, unsigned iim_tex, lm_error *err)
+{
+    if (!rim_ready(g))
+        return lm_fail(err, LM_ERR_INVALID, "ray gather: it needs the scene's tracer (lm_gather_set_tracer)");
+    lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]}, 0.0f,
+                  g->set.ray_samples};
+    uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
+    glBindTexture(GL_TEXTURE_2D, iim_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    for (uint32_t first = 0; first < count; first += per_pass) {
+        uint32_t n = count - first < per_pass ? count - first : per_pass;
+        fill_views(g, s, a, texels + first, n);
+#pragma omp parallel
+        {
+            lm_rt_thread_init();
+#pragma omp for schedule(dynamic, 4)
+            for (long i = 0; i < (long)n; i++) {
+                const float *o = g->views + VIEW_FLOATS * (size_t)i;
+                float *e = g->emit + 4 * (size_t)i, r[3], back = 0.0f;
+                float b[3], t[3], ng[3] = {o[7], o[11], o[15]};
+                e[0] = e[1] = e[2] = e[3] = 0.0f;
+                if (g->emitters)
+                    lm_emitter_irradiance(g->emitters, o, o + 12, texels[first + (uint32_t)i], e);
+                for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
+                    b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
+                lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[first + (uint32_t)i], r, &back);
+                for (int k = 0; k < 3; k++)
+                    e[k] += r[k];
+                e[3] = covered_at(g->rt, a, o, o + 12) ? 1.0f : back;
+            }
+        }
+        for (uint32_t i = 0; i < n; i++) {
+            const lm_texel *tx = &a->texels[texels[first + i]];
+            glTexSubImage2D(GL_TEXTURE_2D, 0, tx->x, tx->y, 1, 1, GL_RGBA, GL_FLOAT, g->emit + 4 * (size_t)i);
+        }
+    }
+    return lm_gl_check("ray gather", err);
+}
+
 lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
                            uint32_t count, unsigned iim_tex, lm_gather_stats *stats, lm_error *err)
 {
     if (!g->has_mesh || !g->aim_tex)
         return lm_fail(err, LM_ERR_INVALID, "hemicube gather: set the scene and the AIM first");
+    if (g->set.scheme == LM_GATHER_RAYS) {
+        double t0 = lm_now();
+        lm_status st = gather_rays(g, s, a, texels, count, iim_tex, err);
+        if (stats) {
+            glFinish();
+            stats->texels = count, stats->passes = (int)((count + (uint32_t)(g->set.tiles * g->set.tiles) - 1) /
+                                                         (uint32_t)(g->set.tiles * g->set.tiles));
+            stats->seconds = lm_now() - t0;
+        }
+        return st;
+    }
     double t0 = lm_now();
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
     int *xy = malloc(sizeof(int) * 2 * per_pass);

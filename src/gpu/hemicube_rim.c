@@ -70,7 +70,7 @@ static lm_vec3 rim_dir(const lm_rim *r, lm_vec3 B, lm_vec3 T, lm_vec3 N, double 
  * averages its footprint: a small bright spot is then shared among the strata it overlaps instead of
  * being all or nothing for one. Returns the weighted radiance sum (times SUB^2). */
 static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, lm_vec3 N, lm_vec3 G, double phi0,
-                    double dphi, double u0, double du, double sum[3])
+                    double dphi, double u0, double du, double sum[3], double *back)
 {
     double w;
     float dir[3];
@@ -85,8 +85,10 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
     }
     const lm_material *m = &r->scene->materials[r->scene->tri_material[h.tri]];
     lm_vec3 ng = lm_v3_load(h.ng), d = lm_v3_load(dir);
-    if (!m->double_sided && lm_dot(ng, d) > 0.0f)
-        return; /* the back of a single-sided surface: black, as on the plane */
+    if (!m->double_sided && lm_dot(ng, d) > 0.0f) {
+        *back += w; /* the back of a single-sided surface: black, as on the plane */
+        return;
+    }
     const float *c = r->atlas->corner_uv + 6 * (size_t)h.tri;
     lm_vec3 e = lm_v3_load(eye), P = lm_add(e, lm_scale(d, h.t));
     float hit[2];
@@ -127,17 +129,19 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
 }
 
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
-                       const float ng[3], uint32_t seed, float out[3])
+                       const float ng[3], uint32_t seed, float out[3], float *back)
 {
     int side = (int)sqrtf((float)r->samples);
-    double shift[2], sum[3] = {0.0, 0.0, 0.0};
+    double shift[2], sum[3] = {0.0, 0.0, 0.0}, back_w = 0.0;
     lm_seed_shift(seed, shift); /* shift[1] unused: the footprints already cover each stratum */
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
     double d = 1.0 / side;
     for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
         for (int j = 0; j < side; j++)
-            stratum(r, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum);
+            stratum(r, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum, &back_w);
     int K = side * side;
     for (int c = 0; c < 3; c++)
         out[c] = K ? (float)(LM_PI * sum[c] / ((double)K * SUB * SUB)) : 0.0f;
+    if (back)
+        *back = K ? (float)(back_w / K) : 0.0f;
 }

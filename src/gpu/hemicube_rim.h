@@ -43,10 +43,12 @@ typedef struct {
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y
  * axes) and n. Directions below the plane of ng, the texel's geometric normal, are blocked by its own
- * surface and bring nothing (the rim of a shading normal tilted off the geometric one dips below it). */
+ * surface and bring nothing (the rim of a shading normal tilted off the geometric one dips below it).
+ * back (may be NULL): the share of the directions, weighted as the irradiance is, that met the back of a
+ * single-sided surface. With enlargement 0 the "rim" is the whole hemisphere: the ray gather
+ * (LM_GATHER_RAYS, hemicube.h). */
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
-                       const float ng[3],
-                       uint32_t seed, float out[3]);
+                       const float ng[3], uint32_t seed, float out[3], float *back);
 
 /* Bilinear lookup of an atlas-sized RGBA map's rgb at lightmap uv in [0, 1]^2 (texel (x, y) spans
  * [x, x + 1] / width), clamped to the atlas's edge. */

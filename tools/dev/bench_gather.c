@@ -20,6 +20,7 @@
 #include "dev_scene.h"
 
 #define REPEATS 5
+#define LM_DEV_RAY_STRATA 400 /* lm_hemicube_settings_default's ray_samples */
 #define PASS 256
 #define RAYS_SIDE 32 /* 32 x 32 = 1,024 rays, the paper's ray-traced alternative */
 
@@ -73,7 +74,17 @@ static void close_scene(bench_scene *b)
  * lookup and one coverage sample per pixel, emitters drawn (the paper's hemicube), else what the frame
  * loop takes for the scene: 4 AIM lookups, the emitters' light in closed form where it suits the scene
  * and then 1 coverage sample, else as lm_gather_coverage_for says. */
+static lm_gather *gather_traced(const bench_scene *b, int R, int proxy, lm_gather_scheme scheme, int single,
+                                int traced, int *tris);
 static lm_gather *gather_for(const bench_scene *b, int R, int proxy, lm_gather_scheme scheme, int single, int *tris)
+{
+    return gather_traced(b, R, proxy, scheme, single, scheme == LM_GATHER_RAYS, tris);
+}
+
+/* As gather_for; traced: the rim (and the rays scheme) traced with the scene's Embree scene, as the frame
+ * loop does. */
+static lm_gather *gather_traced(const bench_scene *b, int R, int proxy, lm_gather_scheme scheme, int single,
+                                int traced, int *tris)
 {
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
@@ -89,6 +100,8 @@ static lm_gather *gather_for(const bench_scene *b, int R, int proxy, lm_gather_s
     lm_error err;
     if (lm_gather_create(&set, &g, &err) == LM_OK && !single && b->has_el)
         lm_gather_set_emitter_light(g, &b->el);
+    if (g && traced)
+        lm_gather_set_tracer(g, b->sc->rt);
     if (!g || lm_gather_set_scene(g, b->sc->scene, &b->sc->atlas, &err) != LM_OK ||
         lm_gather_set_aim_dilated(g, &b->sc->atlas, b->aim, &err) != LM_OK) {
         printf("  %s: %s\n", b->label, err.msg);
@@ -419,4 +432,43 @@ void lm_dev_bench_gather(const char *big_cornell)
         close_scene(&sc[i]);
     lm_gl_context_destroy(gl);
     print_frame();
+}
+
+void lm_dev_bench_levels(const char *const *paths, int count)
+{
+    lm_gl_context *gl = NULL;
+    lm_error err;
+    if (lm_gl_context_create(&gl, &err) != LM_OK) {
+        printf("\ngather on levels: skipped (%s)\n", err.msg);
+        return;
+    }
+    printf("\ngather on levels, the frame loop's defaults (R = 32 with the proxy and the rim traced; rays: %d strata), "
+           "ms per texel of "
+           "wall time (median of %d passes of up to %d texels spread over the atlas; x first: against the first "
+           "scene's hemicube) on %s:\n", LM_DEV_RAY_STRATA, REPEATS, PASS, lm_gl_context_description(gl));
+    printf("%-24s %10s %11s %10s %8s %10s %8s\n", "scene", "triangles", "proxy tris", "hemicube", "x first", "rays",
+           "x first");
+    double first = NAN;
+    for (int i = 0; i < count; i++) {
+        const char *label = strrchr(paths[i], '/') ? strrchr(paths[i], '/') + 1 : paths[i];
+        bench_scene b;
+        if (!open_scene(label, 0, paths[i], &b)) {
+            printf("%-24s skipped (cannot load %s)\n", label, paths[i]);
+            continue;
+        }
+        int tris = 0, ray_tris = 0;
+        lm_gather *g[2] = {gather_traced(&b, 32, 1, LM_GATHER_VIEWPORTS, 0, 1, &tris),
+                           gather_traced(&b, 32, 1, LM_GATHER_RAYS, 0, 1, &ray_tris)};
+        double ms[2] = {NAN, NAN};
+        time_configs(g, 2, &b, ms);
+        if (isnan(first))
+            first = ms[0];
+        printf("%-24s %10u %11d %10.3f %8.2f %10.3f %8.2f\n", label, b.sc->scene->tri_count, tris, ms[0],
+               ms[0] / first, ms[1], ms[1] / first);
+        fflush(stdout);
+        lm_gather_free(g[0]);
+        lm_gather_free(g[1]);
+        close_scene(&b);
+    }
+    lm_gl_context_destroy(gl);
 }

@@ -24,6 +24,8 @@ static void usage(FILE *f)
                "         (FILE: the ~133k-triangle Cornell box of `build/gen_scenes --cornell-cells 255`)\n"
                "       lmgi-dev bench-caustics\n"
                "         the caustics and reflections part alone\n"
+               "       lmgi-dev bench-levels SCENE...\n"
+               "         the gather's ms per texel on each scene against the first (triangles, proxy triangles)\n"
                "       lmgi-dev bench-tiled\n"
                "         the per-pixel photon gathers alone (tiled, stochastic, hash grid, brute force)\n"
                "options and their meaning: `lmgi help`\n");
@@ -46,6 +48,10 @@ int main(int argc, char **argv)
     }
     if (!strcmp(argv[1], "bench-caustics")) {
         lm_dev_bench_caustics();
+        return 0;
+    }
+    if (!strcmp(argv[1], "bench-levels")) {
+        lm_dev_bench_levels(a.files, a.file_count);
         return 0;
     }
     if (!strcmp(argv[1], "bench-tiled")) {
