@@ -155,13 +155,19 @@ test-asan: deps
 demo: deps all
 	@sh tools/demo.sh $(BUILD)/lmgi
 
-# The scaling rows use many-room scenes of 4, 16 and 64 rooms (about 89k, 354k and 1.4M triangles).
+# The scaling rows use many-room scenes of 4, 16 and 64 rooms (about 89k, 354k and 1.4M triangles); the
+# levels' gather table and the level bake 12 and 45 rooms (265k and 994k triangles).
 BENCH_ROOMS := 4 16 64
 bench: deps all $(BUILD)/gen_scenes
 	@mkdir -p $(BUILD)/bench
 	@for n in $(BENCH_ROOMS); do [ -f $(BUILD)/bench/rooms_$$n.glb ] || $(BUILD)/gen_scenes --rooms $$n $(BUILD)/bench/rooms_$$n.glb >/dev/null; done
 	@[ -f $(BUILD)/bench/cornell_255.glb ] || $(BUILD)/gen_scenes --cornell-cells 255 $(BUILD)/bench/cornell_255.glb >/dev/null
+	@for n in 12 45; do [ -f $(BUILD)/bench/rooms_$$n.glb ] || $(BUILD)/gen_scenes --rooms $$n $(BUILD)/bench/rooms_$$n.glb >/dev/null; done
 	$(BUILD)/lmgi-dev bench --gather-scene $(BUILD)/bench/cornell_255.glb
+	$(BUILD)/lmgi-dev bench-levels scenes/cornell.glb $(wildcard ../shared/scenes/occlusion-room/room_lit.glb \
+	  ../shared/scenes/truck-town/town_lit.gltf) $(BUILD)/bench/rooms_12.glb $(BUILD)/bench/rooms_45.glb
+	@echo "a generated level of 265,072 triangles (gen_scenes --rooms 12), baked at the defaults:"
+	$(BUILD)/lmgi bake $(BUILD)/bench/rooms_12.glb --out $(BUILD)/bench/bake_rooms_12 --force 2>/dev/null
 	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb)
 	$(BUILD)/lmgi bench --edits bench/two_rooms_edits.json scenes/two_rooms.glb --json $(BUILD)/bench/edits.json
 	$(BUILD)/lmgi bench --soak 100000 scenes/cornell.glb --size 32x32
