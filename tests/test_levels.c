@@ -16,26 +16,15 @@
 #include <cmocka.h>
 #include <lmgi.h>
 
+#include "edit_room.h"
 #include "support.h"
 
 static const float k_sky[3] = {0.2f, 0.25f, 0.35f}; /* a pale blue sky, a tenth of the room's lamp-lit walls */
 
-static lmgi_scene *load(const char *path, int texels)
-{
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = texels;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
-}
-
 /* The budget met within 15%, and the atlas at least `utilization` full. */
 static void atlas_within(const char *path, int texels, double utilization)
 {
-    lmgi_scene *sc = load(path, texels);
+    lmgi_scene *sc = lmt_load(path, texels);
     lmgi_info in;
     lmgi_get_info(sc, &in);
     print_message("%s at %d texels: %u texels, utilization %.1f%%\n", path, texels, in.texels,
@@ -73,7 +62,7 @@ static void look_at(const float eye[3], const float at[3], lmgi_camera *c)
  * cam (NULL: the file's camera) against the reference at 64 x 64, within 5% per channel over the frame. */
 static void bake_and_check(const char *path, int texels, const lmgi_camera *cam)
 {
-    lmgi_scene *sc = load(path, texels);
+    lmgi_scene *sc = lmt_load(path, texels);
     lmgi_error e;
     assert_int_equal(lmgi_set_environment(sc, k_sky, &e), LMGI_OK);
     lmgi_context *ctx = NULL;

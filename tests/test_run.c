@@ -326,7 +326,7 @@ static void test_bad_args(void **state)
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --texels-per-frame 0"), 2);
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --exr-every x"), 2);
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --gather-scheme bogus"), 2);
-    assert_non_null(strstr(output, "viewports, instanced or layered"));
+    assert_non_null(strstr(output, "viewports, instanced, layered or rays"));
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --hemicube 1"), 2);
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --hemicube-samples 2"), 2);
     assert_int_equal(lmgi("run scenes/cornell.glb --out /tmp/x --enlargement 0"), 2);

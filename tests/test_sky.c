@@ -15,6 +15,7 @@
 #include <cmocka.h>
 #include <lmgi.h>
 
+#include "edit_room.h"
 #include "support.h"
 
 #define PI 3.14159265358979323846
@@ -43,18 +44,6 @@ static const char *plane_scene(const char *name, const char *sky, const char *li
     snprintf(path, sizeof path, "%s/%s.gltf", lmt_tmpdir(), name);
     assert_int_equal(lmt_write_gltf(path, &m, 1, nodes, NULL, 0, extra), 0);
     return path;
-}
-
-static lmgi_scene *load(const char *path, int texels)
-{
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = texels;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
 }
 
 /* Mean of channel c of the valid texels of a lightmap whose texel centres lie within `inner` of the plane's
@@ -104,7 +93,7 @@ static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc)
 static void test_open_plane(void **state)
 {
     (void)state;
-    lmgi_scene *sc = load(plane_scene("open", "[1, 0.5, 0.25]", NULL), 4000);
+    lmgi_scene *sc = lmt_load(plane_scene("open", "[1, 0.5, 0.25]", NULL), 4000);
     float sky[3];
     assert_int_equal(lmgi_get_environment(sc, sky), 1);
     assert_float_equal(sky[1], 0.5f, 0.0f);
@@ -149,7 +138,7 @@ static void test_open_plane(void **state)
     assert_int_equal(lmgi_export_gltf(u, dir, &xd, &e), LMGI_OK);
     char path[600];
     snprintf(path, sizeof path, "%s/open.gltf", dir);
-    lmgi_scene *back = load(path, 1000);
+    lmgi_scene *back = lmt_load(path, 1000);
     float sky_back[3];
     assert_int_equal(lmgi_get_environment(back, sky_back), 1);
     for (int c = 0; c < 3; c++)
@@ -168,7 +157,7 @@ static void test_sky_edits(void **state)
     lmgi_error e;
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
-    lmgi_scene *sc = load(plane_scene("edit", "[1, 0.5, 0.25]", NULL), 4000);
+    lmgi_scene *sc = lmt_load(plane_scene("edit", "[1, 0.5, 0.25]", NULL), 4000);
     lmgi_updater *u = updater(ctx, sc);
     texel_mean before = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
     const float twice[3] = {2.0f, 1.0f, 0.5f};
@@ -181,7 +170,7 @@ static void test_sky_edits(void **state)
     lmgi_free(sc);
 
     /* the lamp's plane sees nothing of it (no other surface): its IIM is 0 until the sky comes */
-    sc = load(plane_scene("lamp", NULL, "{\"type\": \"point\", \"intensity\": 10}"), 4000);
+    sc = lmt_load(plane_scene("lamp", NULL, "{\"type\": \"point\", \"intensity\": 10}"), 4000);
     assert_int_equal(lmgi_get_environment(sc, NULL), 0);
     u = updater(ctx, sc);
     before = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
@@ -219,7 +208,7 @@ static void test_open_box_against_reference(void **state)
                                     "\"extras\": {\"lmgi\": {\"sky\": [1, 0.5, 0.25]}}, \"cameras\": [{\"type\": "
                                     "\"perspective\", \"perspective\": {\"yfov\": 1.0, \"znear\": 0.05}}],"),
                      0);
-    lmgi_scene *sc = load(path, 6000);
+    lmgi_scene *sc = lmt_load(path, 6000);
     lmgi_error e;
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
@@ -254,7 +243,7 @@ static void test_bad_sky(void **state)
         assert_non_null(strstr(e.message, "extras.lmgi.sky"));
         assert_null(sc);
     }
-    sc = load(plane_scene("good", NULL, NULL), 1000);
+    sc = lmt_load(plane_scene("good", NULL, NULL), 1000);
     const float nan_sky[3] = {NAN, 0, 0}, negative[3] = {0, -1, 0};
     assert_int_equal(lmgi_set_environment(sc, nan_sky, &e), LMGI_ERR_INVALID);
     assert_non_null(strstr(e.message, "sky radiance"));

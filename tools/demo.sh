@@ -51,8 +51,18 @@ if [ -r ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf ]; then
     "$LMGI" run ../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf --frames 1 --size 512x512 \
         --out demo/cornell-suzanne-run --force
 fi
+# A real level (docs/levels.md): Godot 4's truck-town export (WebP textures), under its sun and a pale sky,
+# baked at a texel budget the level can hold and then run for a frame at 1024 x 512.
+if [ -r ../shared/scenes/truck-town/town_lit.gltf ]; then
+    echo "== bake and run on ../shared/scenes/truck-town/town_lit.gltf under a sky"
+    "$LMGI" bake ../shared/scenes/truck-town/town_lit.gltf --sky 0.2,0.25,0.35 --texels 65536 \
+        --out demo/truck-town-bake --force -q
+    "$LMGI" run ../shared/scenes/truck-town/town_lit.gltf --sky 0.2,0.25,0.35 --texels 65536 --frames 1 \
+        --size 1024x512 --out demo/truck-town-run --force -q
+fi
 echo "demo: pictures in demo/<scene>/atlas.png, demo/<scene>/surfaces.png, demo/cornell-photons/view.png,"
 echo "      demo/cornell-run/frame_*.png and caustics.png, demo/cornellbox-run/frame_0000.png beside"
 echo "      demo/cornellbox-tiled-run/frame_0000.png (--indirect tiled), demo/cornell-suzanne-run/frame_0000.png,"
 echo "      demo/cornellbox-check/ and demo/cornellbox-check-tiled/ (check_ratio.png: frame / reference, red"
-echo "      brighter, blue darker; demo/cornellbox-check.txt and -check-tiled.txt per surface)"
+echo "      brighter, blue darker; demo/cornellbox-check.txt and -check-tiled.txt per surface),"
+echo "      demo/truck-town-bake/lightmap.png and demo/truck-town-run/frame_0000.png (a real level under a sky)"
