@@ -231,8 +231,19 @@ LMGI_API lmgi_status lmgi_remove_light(lmgi_scene *scene, int light, lmgi_error 
  * updater made for a scene with nothing to light does no indirect work). A NaN, a negative or a value
  * above 1e20: LMGI_ERR_INVALID, nothing changed. Thread-safety: as lmgi_set_light. */
 LMGI_API lmgi_status lmgi_set_environment(lmgi_scene *scene, const float radiance[3], lmgi_error *err);
-/* 1 and the radiance in out when the scene has a sky (0 and out zeroed otherwise, NULL scene included). */
+/* 1 and the radiance in out when the scene has a sky (0 and out zeroed otherwise, NULL scene included): the
+ * uniform sky's, the gradient's at the zenith, the image's scale. */
 LMGI_API int lmgi_get_environment(const lmgi_scene *scene, float out[3]);
+/* A two-colour sky: zenith overhead, horizon at and below the horizon, in between linear in the height of
+ * the direction (L = horizon + (zenith - horizon) max(y, 0)). An HDR equirectangular image (Radiance .hdr or
+ * OpenEXR .exr; row 0 at the zenith, column 0 towards -z) times scale. Either is gathered by rays (a
+ * hemicube clears to one colour): an updater made with a hemicube scheme refuses them (LMGI_ERR_INVALID;
+ * give the sky before lmgi_updater_create, whose default then takes rays), and the frame's background and
+ * reflections show the sky's mean. Bad values as lmgi_set_environment; an image that cannot be read or is
+ * not HDR: LMGI_ERR_IO or LMGI_ERR_FORMAT naming it; nothing changed on any error. */
+LMGI_API lmgi_status lmgi_set_environment_gradient(lmgi_scene *scene, const float zenith[3], const float horizon[3],
+                                                   lmgi_error *err);
+LMGI_API lmgi_status lmgi_set_environment_image(lmgi_scene *scene, const char *path, float scale, lmgi_error *err);
 
 /* An application's own level, handed over without a file: meshes (vertex and index arrays placed by a
  * matrix), materials and lights. lmgi_load_desc writes them into a .glb in memory and loads that, so they

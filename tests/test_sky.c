@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 #include <lmgi.h>
+#include <stb/stb_image_write.h>
 
 #include "edit_room.h"
 #include "support.h"
@@ -231,6 +232,134 @@ static void test_open_box_against_reference(void **state)
     lmgi_context_free(ctx);
 }
 
+/* The gradient sky L(d) = H + (Z - H) max(d.y, 0) over an open plane: E = pi H + 2 pi (Z - H) / 3. */
+static const float k_zenith[3] = {1.0f, 0.5f, 0.25f}, k_horizon[3] = {0.2f, 0.3f, 0.4f};
+
+static double gradient_e(int c) { return PI * k_horizon[c] + 2.0 * PI * (k_zenith[c] - k_horizon[c]) / 3.0; }
+
+/* An open plane under `sc`'s sky: the reference's texels, the IIM and the AIM (rho / pi E) against
+ * scale x gradient_e within the given tolerances; the updater's gather is the rays scheme. */
+static void plane_against(lmgi_scene *sc, double scale, double ref_tol, double iim_tol, double aim_tol)
+{
+    lmgi_error e;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater *u = updater(ctx, sc);
+    lmgi_updater_info ui;
+    lmgi_get_updater_info(u, &ui);
+    assert_string_equal(ui.gather_scheme, "rays");
+    texel_mean iim = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM), aim = lightmap_mean(u, sc, LMGI_LIGHTMAP_AIM);
+    lmgi_reference_desc rd;
+    memset(&rd, 0, sizeof rd);
+    rd.target_error = 0.02f;
+    rd.no_cache = 1;
+    lmgi_reference r;
+    assert_int_equal(lmgi_reference_texels(sc, &rd, &r, &e), LMGI_OK);
+    double ref[3] = {0, 0, 0};
+    int texels = 0;
+    for (int i = 0; i < r.width * r.height; i++) {
+        if (r.full[3 * i] == 0.0f && r.full[3 * i + 1] == 0.0f)
+            continue;
+        for (int c = 0; c < 3; c++)
+            ref[c] += r.full[3 * i + c];
+        texels++;
+    }
+    lmgi_reference_free(&r);
+    for (int c = 0; c < 3; c++) {
+        double want = scale * gradient_e(c);
+        ref[c] /= texels;
+        print_message("channel %d: E %.4f, reference %.4f, IIM %.4f; rho / pi E %.4f, AIM %.4f\n", c, want, ref[c],
+                      iim.mean[c], RHO / PI * want, aim.mean[c]);
+        assert_float_equal(ref[c] / want, 1.0, ref_tol);
+        assert_float_equal(iim.mean[c] / want, 1.0, iim_tol);
+        assert_float_equal(aim.mean[c] / (RHO / PI * want), 1.0, aim_tol);
+    }
+    lmgi_updater_free(u);
+    lmgi_context_free(ctx);
+}
+
+/* A gradient sky from the file; its export loads back with it. An updater told to draw hemicubes refuses
+ * it, and so does such an updater when the sky turns into one afterwards. */
+static void test_gradient_sky(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = lmt_load(plane_scene("gradient", "{\"zenith\": [1, 0.5, 0.25], \"horizon\": [0.2, 0.3, 0.4]}",
+                                          NULL), 4000);
+    plane_against(sc, 1.0, 0.01, 0.01, 0.04);
+    lmgi_error e;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.gather_scheme = LMGI_GATHER_VIEWPORTS;
+    lmgi_updater *u = NULL;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "rays gather"));
+    assert_int_equal(lmgi_set_environment(sc, k_sky, &e), LMGI_OK); /* uniform again: hemicubes may show it */
+    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_OK);
+    assert_int_equal(lmgi_set_environment_gradient(sc, k_zenith, k_horizon, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "rays gather"));
+    float now[3];
+    assert_int_equal(lmgi_get_environment(sc, now), 1);
+    assert_float_equal(now[1], k_sky[1], 0.0f); /* nothing changed */
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* An equirectangular HDR image of the same gradient (64 x 32 pixels: each row's mean direction's height),
+ * as Radiance .hdr from the file's extras with a scale of 2, and as OpenEXR through the API: the plane gets
+ * twice, then once, the gradient's E (within the image's rows' resolution). A PNG named .hdr, a negative
+ * pixel, a missing file: refused, naming the file. */
+static void test_image_sky(void **state)
+{
+    (void)state;
+    enum { W = 64, H = 32 };
+    float *px = malloc(sizeof(float) * 3 * W * H);
+    assert_non_null(px);
+    for (int y = 0; y < H; y++) {
+        /* the row's mean of max(cos theta, 0) over its band of theta, weighted by sin theta: exact for the
+         * bilinear lookup's piecewise linearity to first order */
+        double t0 = PI * y / H, t1 = PI * (y + 1) / H, c0 = cos(t0), c1 = cos(t1);
+        double up = c0 > 0.0 ? (c0 * c0 - fmax(c1, 0.0) * fmax(c1, 0.0)) / 2.0 : 0.0, band = c0 - c1;
+        for (int x = 0; x < W; x++)
+            for (int c = 0; c < 3; c++)
+                px[3 * (y * W + x) + c] = (float)(k_horizon[c] + (k_zenith[c] - k_horizon[c]) * up / band);
+    }
+    const char *scene = plane_scene("image", "{\"image\": \"sky.hdr\", \"scale\": 2}", NULL);
+    char dir[512], path[600];
+    snprintf(dir, sizeof dir, "%s", scene);
+    *strrchr(dir, '/') = '\0';
+    snprintf(path, sizeof path, "%s/sky.hdr", dir);
+    assert_true(stbi_write_hdr(path, W, H, 3, px) != 0);
+    lmgi_scene *sc = lmt_load(scene, 4000);
+    plane_against(sc, 2.0, 0.02, 0.02, 0.05);
+    lmgi_error e;
+    snprintf(path, sizeof path, "%s/sky.exr", dir);
+    assert_int_equal(lmgi_write_image(path, W, H, 3, px, NULL, &e), LMGI_OK);
+    assert_int_equal(lmgi_set_environment_image(sc, path, 1.0f, &e), LMGI_OK);
+    plane_against(sc, 1.0, 0.02, 0.02, 0.05);
+
+    /* not an HDR image, a negative pixel, no file: refused, named, the sky as it was */
+    snprintf(path, sizeof path, "%s/fake.hdr", dir);
+    const unsigned char png[] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n', 0, 0, 0, 0};
+    lmt_write_file(path, png, sizeof png);
+    assert_int_equal(lmgi_set_environment_image(sc, path, 1.0f, &e), LMGI_ERR_FORMAT);
+    assert_non_null(strstr(e.message, "fake.hdr"));
+    px[7] = -1.0f;
+    snprintf(path, sizeof path, "%s/negative.exr", dir);
+    assert_int_equal(lmgi_write_image(path, W, H, 3, px, NULL, &e), LMGI_OK);
+    assert_int_equal(lmgi_set_environment_image(sc, path, 1.0f, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "negative"));
+    assert_int_equal(lmgi_set_environment_image(sc, "/nonexistent/sky.hdr", 1.0f, &e), LMGI_ERR_IO);
+    assert_int_equal(lmgi_set_environment_image(sc, path, NAN, &e), LMGI_ERR_INVALID);
+    float now[3];
+    assert_int_equal(lmgi_get_environment(sc, now), 1);
+    assert_float_equal(now[0], 1.0f, 0.0f); /* the EXR sky's scale */
+    free(px);
+    lmgi_free(sc);
+}
+
 /* A sky of NaN, a negative one, or a malformed one in the file: refused, naming it, nothing changed. */
 static void test_bad_sky(void **state)
 {
@@ -259,6 +388,8 @@ int main(void)
         cmocka_unit_test(test_open_plane),
         cmocka_unit_test(test_sky_edits),
         cmocka_unit_test(test_open_box_against_reference),
+        cmocka_unit_test(test_gradient_sky),
+        cmocka_unit_test(test_image_sky),
         cmocka_unit_test(test_bad_sky),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
+#include "../scene/sky.h"
 #include "../update/effects.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
@@ -273,20 +274,84 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
     return LMGI_OK;
 }
 
+/* A sky's radiance, refused unless finite and in [0, LM_MAX_EMISSION]. */
+static lmgi_status check_sky(const float *rgb, const char *what, lmgi_error *err)
+{
+    for (int c = 0; c < 3; c++)
+        if (!in_range(rgb[c], 0.0f, (float)LM_MAX_EMISSION))
+            return lm_api_refuse(err, "sky radiance %s(%g %g %g) must be finite numbers in [0, %g]", what,
+                                 (double)rgb[0], (double)rgb[1], (double)rgb[2], LM_MAX_EMISSION);
+    return LMGI_OK;
+}
+
+/* Before a sky edit: the updater's photon work reads the sky; one that gathers by hemicube cannot show a sky
+ * that is not uniform. */
+static lmgi_status sky_edit_allowed(lmgi_scene *sc, int uniform, lmgi_error *err)
+{
+    if (!sc->updater)
+        return LMGI_OK;
+    lmgi_updater_info ui;
+    lmgi_get_updater_info(sc->updater, &ui);
+    if (!uniform && ui.gather_scheme && strcmp(ui.gather_scheme, "rays") != 0)
+        return lm_api_refuse(err, "%s: a gradient or image sky needs the rays gather, and this updater draws "
+                             "hemicubes (%s): give the sky before lmgi_updater_create, or ask for rays",
+                             sc->scene->path, ui.gather_scheme);
+    lm_updater_sync(sc->updater);
+    return LMGI_OK;
+}
+
+/* The sky is set: what the scene calls for follows. */
+static lmgi_status sky_set(lmgi_scene *sc, lm_sky_kind kind, const float sky[3], const float *horizon)
+{
+    lm_scene *s = sc->scene;
+    memcpy(s->sky, sky, sizeof s->sky);
+    if (horizon)
+        memcpy(s->sky_horizon, horizon, sizeof s->sky_horizon);
+    if (kind != LM_SKY_IMAGE) {
+        free(s->sky_image);
+        s->sky_image = NULL, s->sky_width = s->sky_height = 0;
+    }
+    s->sky_kind = kind;
+    s->has_sky = 1;
+    lm_effects_decide(s, &sc->effects);
+    return LMGI_OK;
+}
+
 lmgi_status lmgi_set_environment(lmgi_scene *sc, const float radiance[3], lmgi_error *err)
 {
     if (!sc || !radiance)
         return lm_api_refuse(err, "lmgi_set_environment: %s is NULL", sc ? "the radiance" : "the scene");
-    for (int c = 0; c < 3; c++)
-        if (!in_range(radiance[c], 0.0f, (float)LM_MAX_EMISSION))
-            return lm_api_refuse(err, "sky radiance (%g %g %g) must be finite numbers in [0, %g]", (double)radiance[0],
-                                 (double)radiance[1], (double)radiance[2], LM_MAX_EMISSION);
-    if (sc->updater) /* its photon work reads the sky */
-        lm_updater_sync(sc->updater);
-    lm_scene *s = sc->scene;
-    memcpy(s->sky, radiance, sizeof s->sky);
-    s->has_sky = 1;
-    lm_effects_decide(s, &sc->effects);
+    lmgi_status st = check_sky(radiance, "", err);
+    if (st == LMGI_OK)
+        st = sky_edit_allowed(sc, 1, err);
+    return st == LMGI_OK ? sky_set(sc, LM_SKY_UNIFORM, radiance, NULL) : st;
+}
+
+lmgi_status lmgi_set_environment_gradient(lmgi_scene *sc, const float zenith[3], const float horizon[3],
+                                          lmgi_error *err)
+{
+    if (!sc || !zenith || !horizon)
+        return lm_api_refuse(err, "lmgi_set_environment_gradient: %s is NULL", sc ? "a colour" : "the scene");
+    lmgi_status st = check_sky(zenith, "at the zenith ", err);
+    if (st == LMGI_OK)
+        st = check_sky(horizon, "at the horizon ", err);
+    if (st == LMGI_OK)
+        st = sky_edit_allowed(sc, 0, err);
+    return st == LMGI_OK ? sky_set(sc, LM_SKY_GRADIENT, zenith, horizon) : st;
+}
+
+lmgi_status lmgi_set_environment_image(lmgi_scene *sc, const char *path, float scale, lmgi_error *err)
+{
+    if (!sc || !path)
+        return lm_api_refuse(err, "lmgi_set_environment_image: %s is NULL", sc ? "the path" : "the scene");
+    lmgi_status st = sky_edit_allowed(sc, 0, err);
+    if (st != LMGI_OK)
+        return st;
+    lm_error e;
+    const float k[3] = {scale, scale, scale};
+    if (lm_sky_load_image(sc->scene, path, k, &e) != LM_OK)
+        return lm_export_error(err, &e);
+    lm_effects_decide(sc->scene, &sc->effects);
     return LMGI_OK;
 }
 

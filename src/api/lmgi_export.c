@@ -346,6 +346,29 @@ static void write_extensions_used(writer *w)
             transmission ? ",\"KHR_materials_transmission\"" : "", transform ? ",\"KHR_texture_transform\"" : "");
 }
 
+/* The sky into the document's extras as the loader reads it back (docs/levels.md, "Sky"); an image sky's
+ * image beside the document as NAME_sky.exr. */
+static lm_status write_sky(writer *w, const char *dir, lm_error *err)
+{
+    const lm_scene *s = w->s;
+    if (!s->has_sky)
+        return LM_OK;
+    if (s->sky_kind == LM_SKY_GRADIENT) {
+        fprintf(w->doc.json, ",\"sky\":{\"zenith\":[%.9g,%.9g,%.9g],\"horizon\":[%.9g,%.9g,%.9g]}", (double)s->sky[0],
+                (double)s->sky[1], (double)s->sky[2], (double)s->sky_horizon[0], (double)s->sky_horizon[1],
+                (double)s->sky_horizon[2]);
+        return LM_OK;
+    }
+    if (s->sky_kind == LM_SKY_IMAGE && s->sky_image) { /* one scale for all channels: the API's */
+        char path[4200];
+        snprintf(path, sizeof path, "%s/%s_sky.exr", dir, w->name);
+        fprintf(w->doc.json, ",\"sky\":{\"image\":\"%s_sky.exr\",\"scale\":%.9g}", w->name, (double)s->sky[0]);
+        return lm_write_exr(path, s->sky_width, s->sky_height, 3, s->sky_image, err);
+    }
+    fprintf(w->doc.json, ",\"sky\":[%.9g,%.9g,%.9g]", (double)s->sky[0], (double)s->sky[1], (double)s->sky[2]);
+    return LM_OK;
+}
+
 /* Everything but the images into w's document. */
 static lm_status write_document(writer *w, const char *dir, lm_error *err)
 {
@@ -372,10 +395,9 @@ static lm_status write_document(writer *w, const char *dir, lm_error *err)
                      "\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of indirect light, emissive surfaces "
                      "and the sky (not the punctual lights' direct light); diffuse radiance = baseColor / pi x E; alpha "
                      "1 on valid texels\"", w->name, w->name, w->atlas->width, w->atlas->height);
-    if (s->has_sky) /* read back by the loader (docs/levels.md, "Sky") */
-        fprintf(w->doc.json, ",\"sky\":[%.9g,%.9g,%.9g]", (double)s->sky[0], (double)s->sky[1], (double)s->sky[2]);
+    st = write_sky(w, dir, err);
     fputs("}}}", w->doc.json);
-    return LM_OK;
+    return st;
 }
 
 /* The export's file name: letters, digits, '-', '_' and '.', so it is a plain relative URI. */

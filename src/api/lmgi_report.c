@@ -163,7 +163,13 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     print_nodes(s, &in, f);
     print_materials(s, &in, f);
     print_lights(s, &in, f);
-    if (s->has_sky)
+    if (s->has_sky && s->sky_kind == LM_SKY_GRADIENT)
+        fprintf(f, "sky         gradient, radiance (%.4g %.4g %.4g) at the zenith, (%.4g %.4g %.4g) at the horizon\n",
+                (double)s->sky[0], (double)s->sky[1], (double)s->sky[2], (double)s->sky_horizon[0],
+                (double)s->sky_horizon[1], (double)s->sky_horizon[2]);
+    else if (s->has_sky && s->sky_kind == LM_SKY_IMAGE)
+        fprintf(f, "sky         HDR image, %d x %d, scale %.4g\n", s->sky_width, s->sky_height, (double)s->sky[0]);
+    else if (s->has_sky)
         fprintf(f, "sky         uniform radiance (%.4g %.4g %.4g)\n", (double)s->sky[0], (double)s->sky[1],
                 (double)s->sky[2]);
     fprintf(f, "cameras     %d, animations %d", in.cameras, in.animations);

@@ -9,6 +9,7 @@
 
 #include "../charts/atlas_dilate.h"
 #include "../core/stats.h"
+#include "../scene/sky.h"
 #include "../update/frame_loop.h"
 #include "lmgi_camera.h"
 #include "lmgi_context.h"
@@ -215,9 +216,13 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
     set.gl = ctx->gl;
     /* a software rasterizer's hemicube costs what the gather proxy's triangles cost; rays, the log of the
      * level's (docs/gather.md, "Rays") */
-    if (d.gather_scheme == LMGI_GATHER_DEFAULT && sc->scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES &&
-        lm_gl_context_is_software(ctx->gl))
+    if (d.gather_scheme == LMGI_GATHER_DEFAULT &&
+        ((sc->scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES && lm_gl_context_is_software(ctx->gl)) ||
+         !lm_sky_is_uniform(sc->scene))) /* a hemicube clears to one colour */
         set.gather.scheme = LM_GATHER_RAYS;
+    if (st == LM_OK && set.gather.scheme != LM_GATHER_RAYS && !lm_sky_is_uniform(sc->scene))
+        st = lm_fail(&e, LM_ERR_INVALID, "%s: a gradient or image sky needs the rays gather (--gather-scheme rays), "
+                     "not hemicubes (%s)", sc->scene->path, lm_gather_scheme_name(set.gather.scheme));
     if (d.progress) {
         set.progress = gather_progress;
         set.progress_user = &d;

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 
 static int bad(const char *opt, const char *value, const char *want)
 {
@@ -27,30 +28,54 @@ static int parse_float(const char *opt, const char *v, float lo, float *out)
     return 0;
 }
 
-/* --sky L or R,G,B: a uniform sky's radiance, finite and >= 0. */
-static int parse_sky(const char *opt, const char *v)
+/* One radiance, L or R,G,B (finite, in [0, 1e20]), from p into rgb; the end of what it read in *end, NULL if
+ * it is not one. */
+static const char *parse_radiance(const char *p, float rgb[3])
 {
-    float rgb[3];
-    char *end = NULL;
-    if (!v)
-        return bad(opt, v, "a radiance L or R,G,B");
-    const char *p = v;
     int n = 0;
-    for (; n < 3; n++) {
+    char *end = NULL;
+    for (;; n++) {
         errno = 0;
         double d = strtod(p, &end);
-        if (errno || end == p || !isfinite(d) || d < 0.0 || d > 1e20)
-            return bad(opt, v, "a radiance L or R,G,B of finite numbers in [0, 1e20]");
+        if (errno || end == p || !isfinite(d) || d < 0.0 || d > 1e20 || n > 2)
+            return NULL;
         rgb[n] = (float)d;
         if (*end != ',')
             break;
         p = end + 1;
     }
-    if (*end || (n != 0 && n != 2))
-        return bad(opt, v, "a radiance L or R,G,B of finite numbers in [0, 1e20]");
+    if (n != 0 && n != 2)
+        return NULL;
     if (n == 0)
         rgb[1] = rgb[2] = rgb[0];
-    lm_cli_set_sky(rgb);
+    return end;
+}
+
+/* --sky L | R,G,B (uniform) | R,G,B/R,G,B (zenith/horizon: a gradient) | FILE.hdr or FILE.exr (an
+ * equirectangular HDR image). */
+static int parse_sky(const char *opt, const char *v)
+{
+    static const char want[] = "a radiance L or R,G,B, a gradient ZENITH/HORIZON of two, or an HDR image "
+                               "(.hdr, .exr); radiances finite numbers in [0, 1e20]";
+    if (!v)
+        return bad(opt, v, want);
+    size_t len = strlen(v);
+    if (len > 4 && (!strcasecmp(v + len - 4, ".hdr") || !strcasecmp(v + len - 4, ".exr"))) {
+        lm_cli_set_sky(LM_CLI_SKY_IMAGE, NULL, NULL, v);
+        return 0;
+    }
+    float zenith[3], horizon[3];
+    const char *end = parse_radiance(v, zenith);
+    if (end && *end == '/') {
+        end = parse_radiance(end + 1, horizon);
+        if (!end || *end)
+            return bad(opt, v, want);
+        lm_cli_set_sky(LM_CLI_SKY_GRADIENT, zenith, horizon, NULL);
+        return 0;
+    }
+    if (!end || *end)
+        return bad(opt, v, want);
+    lm_cli_set_sky(LM_CLI_SKY_UNIFORM, zenith, NULL, NULL);
     return 0;
 }
 

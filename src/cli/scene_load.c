@@ -2,13 +2,34 @@
 
 #include <string.h>
 
-static float g_sky[3];
-static int g_has_sky;
+static struct {
+    lm_cli_sky kind; /* LM_CLI_SKY_NONE: no --sky */
+    float zenith[3], horizon[3];
+    const char *image;
+} g_sky;
 
-void lm_cli_set_sky(const float sky[3])
+void lm_cli_set_sky(lm_cli_sky kind, const float zenith[3], const float horizon[3], const char *image)
 {
-    memcpy(g_sky, sky, sizeof g_sky);
-    g_has_sky = 1;
+    g_sky.kind = kind;
+    if (zenith)
+        memcpy(g_sky.zenith, zenith, sizeof g_sky.zenith);
+    if (horizon)
+        memcpy(g_sky.horizon, horizon, sizeof g_sky.horizon);
+    g_sky.image = image;
+}
+
+static lmgi_status set_sky(lmgi_scene *sc, lmgi_error *err)
+{
+    switch (g_sky.kind) {
+    case LM_CLI_SKY_UNIFORM:
+        return lmgi_set_environment(sc, g_sky.zenith, err);
+    case LM_CLI_SKY_GRADIENT:
+        return lmgi_set_environment_gradient(sc, g_sky.zenith, g_sky.horizon, err);
+    case LM_CLI_SKY_IMAGE:
+        return lmgi_set_environment_image(sc, g_sky.image, 1.0f, err);
+    default:
+        return LMGI_OK;
+    }
 }
 
 int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_scene **sc)
@@ -18,7 +39,7 @@ int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_sce
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
-    if (g_has_sky && lmgi_set_environment(*sc, g_sky, &err) != LMGI_OK) {
+    if (set_sky(*sc, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: --sky: %s\n", err.message);
         lmgi_free(*sc);
         *sc = NULL;

@@ -8,7 +8,9 @@
  * triangles is refused too (nothing to light: 'run', 'photons' and 'reference' would only write black
  * pictures), naming the file; 'info' and 'charts' take it. */
 int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_scene **sc);
-/* --sky: every scene lm_cli_load_scene loads from now on gets this sky (lmgi_set_environment). */
-void lm_cli_set_sky(const float sky[3]);
+/* --sky: every scene lm_cli_load_scene loads from now on gets this sky (lmgi_set_environment and its
+ * gradient and image forms; the arrays are copied, the image's path kept). */
+typedef enum { LM_CLI_SKY_NONE = 0, LM_CLI_SKY_UNIFORM, LM_CLI_SKY_GRADIENT, LM_CLI_SKY_IMAGE } lm_cli_sky;
+void lm_cli_set_sky(lm_cli_sky kind, const float zenith[3], const float horizon[3], const char *image);
 
 #endif

@@ -12,6 +12,7 @@
 
 #include "../core/log.h"
 #include "../core/vecmath.h"
+#include "../scene/sky.h"
 #include "direct_shader.h"
 #include "direct_mesh.h"
 #include "gl_shader.h"
@@ -159,7 +160,8 @@ static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters 
     glDisable(GL_BLEND);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    const float sky[4] = {s->sky[0], s->sky[1], s->sky[2], 1.0f}; /* the background, in frames and reflections */
+    float sky[4] = {0.0f, 0.0f, 0.0f, 1.0f}; /* the background, in frames and reflections: the sky's mean */
+    lm_sky_mean(s, sky);
     glClearBufferfv(GL_COLOR, 0, sky);
     if (light < 0) {
         float vp[16];

@@ -6,6 +6,7 @@
 
 #include "../core/qmc.h"
 #include "../core/vecmath.h"
+#include "../scene/sky.h"
 
 
 void lm_atlas_sample_rgb(const lm_atlas *a, const float *rgba, float u, float v, float out[3])
@@ -79,8 +80,11 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
         return; /* into the texel's own surface */
     lm_rt_hit h;
     if (!lm_rt_intersect(r->rt, eye, dir, 0.0f, INFINITY, &h)) {
+        float sky[3] = {r->sky[0], r->sky[1], r->sky[2]};
+        if (r->scene->has_sky) /* the scene's own, which may differ by direction */
+            lm_sky_radiance(r->scene, dir, sky);
         for (int c = 0; c < 3; c++)
-            sum[c] += SUB * SUB * w * r->sky[c];
+            sum[c] += SUB * SUB * w * sky[c];
         return;
     }
     const lm_material *m = &r->scene->materials[r->scene->tri_material[h.tri]];

@@ -22,6 +22,7 @@ extern "C" {
 #include "scene.h"
 #include "image_decode.h"
 #include "scene_build.h"
+#include "sky.h"
 }
 
 namespace {
@@ -1028,24 +1029,55 @@ lm_status Loader::finish()
     return lm_scene_split_sides(s_.get(), err_);
 }
 
-// The file's sky: the root's extras {"lmgi": {"sky": [r, g, b]}}, a uniform radiance (lm_scene.sky). A
-// malformed one is an error (it is light, and a scene lit wrongly is worse than one refused).
+// A radiance [r, g, b] of finite numbers in [0, LM_MAX_EMISSION] into out; false if v is not one.
+static bool radiance(const tinygltf::Value &v, float out[3])
+{
+    bool ok = v.IsArray() && v.ArrayLen() == 3;
+    for (int k = 0; ok && k < 3; k++) {
+        ok = v.Get(k).IsNumber();
+        double d = ok ? v.Get(k).GetNumberAsDouble() : -1.0;
+        ok = ok && d >= 0.0 && d <= LM_MAX_EMISSION;
+        out[k] = float(d);
+    }
+    return ok;
+}
+
+// The file's sky, in the root's extras (docs/levels.md, "Sky"): {"lmgi": {"sky": [r, g, b]}} a uniform
+// radiance, {"sky": {"zenith": [r, g, b], "horizon": [r, g, b]}} a gradient, {"sky": {"image": URI,
+// "scale": k}} an equirectangular HDR image beside the scene (.hdr, .exr). A malformed one is an error: it is
+// light, and a scene lit wrongly is worse than one refused.
 lm_status Loader::sky()
 {
     const tinygltf::Value &x = model_.extras;
     if (!x.IsObject() || !x.Has("lmgi") || !x.Get("lmgi").IsObject() || !x.Get("lmgi").Has("sky"))
         return LM_OK;
     const tinygltf::Value &v = x.Get("lmgi").Get("sky");
-    bool ok = v.IsArray() && v.ArrayLen() == 3;
-    for (int k = 0; ok && k < 3; k++) {
-        ok = v.Get(k).IsNumber();
-        double d = ok ? v.Get(k).GetNumberAsDouble() : -1.0;
-        ok = ok && d >= 0.0 && d <= LM_MAX_EMISSION;
-        s_->sky[k] = float(d);
+    if (v.IsArray()) {
+        if (!radiance(v, s_->sky))
+            return fail(LM_ERR_INVALID, "extras.lmgi.sky must be [r, g, b], a radiance of finite numbers in [0, %g]",
+                        LM_MAX_EMISSION);
+        s_->sky_kind = LM_SKY_UNIFORM;
+    } else if (v.IsObject() && v.Has("zenith")) {
+        if (!radiance(v.Get("zenith"), s_->sky) || !v.Has("horizon") || !radiance(v.Get("horizon"), s_->sky_horizon))
+            return fail(LM_ERR_INVALID, "extras.lmgi.sky: zenith and horizon must each be [r, g, b], finite numbers "
+                        "in [0, %g]", LM_MAX_EMISSION);
+        s_->sky_kind = LM_SKY_GRADIENT;
+    } else if (v.IsObject() && v.Has("image") && v.Get("image").IsString()) {
+        if (mem_)
+            return fail(LM_ERR_INVALID, "extras.lmgi.sky.image: a scene from memory cannot name external files");
+        double k = num(&v, "scale", 1.0);
+        const float scale[3] = {float(k), float(k), float(k)};
+        std::string p(path_), uri = v.Get("image").Get<std::string>();
+        size_t slash = p.find_last_of('/');
+        std::string file = uri.size() && uri[0] == '/' ? uri : (slash == std::string::npos ? "" : p.substr(0, slash + 1)) + uri;
+        lm_error e;
+        if (lm_sky_load_image(s_.get(), file.c_str(), scale, &e) != LM_OK)
+            return fail(e.status, "extras.lmgi.sky.image: %s", e.msg);
+        return LM_OK;
+    } else {
+        return fail(LM_ERR_INVALID, "extras.lmgi.sky must be [r, g, b], {\"zenith\": [r, g, b], \"horizon\": "
+                    "[r, g, b]} or {\"image\": URI, \"scale\": k}");
     }
-    if (!ok)
-        return fail(LM_ERR_INVALID, "extras.lmgi.sky must be [r, g, b], a radiance of finite numbers in [0, %g]",
-                    LM_MAX_EMISSION);
     s_->has_sky = 1;
     return LM_OK;
 }

@@ -55,6 +55,8 @@ typedef struct {
 
 typedef enum { LM_LIGHT_POINT = 0, LM_LIGHT_SPOT, LM_LIGHT_DIRECTIONAL } lm_light_type;
 
+typedef enum { LM_SKY_UNIFORM = 0, LM_SKY_GRADIENT, LM_SKY_IMAGE } lm_sky_kind;
+
 typedef struct {
     char name[LM_NAME_MAX];
     lm_light_type type;
@@ -176,13 +178,19 @@ typedef struct {
     int32_t *tri_twin;
     uint32_t file_tri_count; /* triangles in the file (tri_count less the twins) */
 
-    /* The sky: an environment of uniform radiance around the scene, linear RGB (docs/levels.md, "Sky").
-     * It lights through photons (lm_emitters' SKY emitter), the gather (what a texel's hemisphere sees of
-     * it), the frame's background and reflections, and the reference (rays that leave the scene).
+    /* The sky: the environment around the scene, radiance by direction in linear RGB (docs/levels.md,
+     * "Sky"; sky.h). It lights through photons (lm_emitters' SKY emitter), the gather (what a texel's
+     * hemisphere sees of it), the frame's background and reflections, and the reference (rays that leave
+     * the scene). sky: the uniform sky's radiance, the gradient's at the zenith, the image's scale.
      * has_sky: the scene has one, even if it is dark now (set once: the emitter then stays, so a sky
      * dimmed to 0 and back is an edit like a light's). */
     float sky[3];
     int has_sky;
+    lm_sky_kind sky_kind;
+    float sky_horizon[3];  /* LM_SKY_GRADIENT: the radiance at and below the horizon */
+    int sky_width, sky_height; /* LM_SKY_IMAGE: an equirectangular image, row 0 at the zenith, column 0
+                                * towards -z, x increasing eastwards (+x at a quarter) */
+    float *sky_image;      /* sky_width x sky_height x 3 floats, times sky[] */
 
     int mesh_count;        /* number of glTF meshes (for reporting) */
     float bounds_min[3], bounds_max[3]; /* world-space bounds at load time (all nodes) */

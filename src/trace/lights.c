@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
+#include "../scene/sky.h"
 
 #define LM_SPOT_MIN_WIDTH 1e-3f   /* the extension's max(0.001, cos inner - cos outer) */
 #define LM_EMIT_LIFT 1e-5f        /* area photon origins are lifted by this x scene size */
@@ -208,13 +209,13 @@ static void place_punctual(lm_emitter *e, const lm_scene *s, float disk_radius)
     }
 }
 
-/* Radiance L from every direction through a disk of radius R facing it: L pi R^2 per steradian, 4 pi of them. */
+/* Radiance L from every direction through a disk of radius R facing it: L pi R^2 per steradian, 4 pi of them
+ * (L the sky's mean over the sphere; radiant keeps it). */
 static void place_sky(lm_emitter *e, const lm_scene *s, float disk_radius)
 {
-    for (int c = 0; c < 3; c++) {
-        e->radiant[c] = s->sky[c];
-        e->power[c] = s->sky[c] * (float)(4.0 * LM_PI * LM_PI) * disk_radius * disk_radius;
-    }
+    lm_sky_mean(s, e->radiant);
+    for (int c = 0; c < 3; c++)
+        e->power[c] = e->radiant[c] * (float)(4.0 * LM_PI * LM_PI) * disk_radius * disk_radius;
 }
 
 /* Triangle corners and (unnormalized) geometric normal in world space. */
@@ -424,8 +425,9 @@ static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emi
 
 /* A sky photon: its direction of travel uniform on the sphere (u[0], u[1]: similar directions for QMC
  * strata of those two), its origin uniform on the disk (u[2] radius, u[3] angle) of the scene's bounding
- * sphere across that direction, moved back outside the sphere; flux L 4 pi pi R^2 / count. */
-static void emit_sky(const lm_emitters *em, const lm_emitter *e, const float u[4], uint32_t count, lm_emission *out)
+ * sphere across that direction, moved back outside the sphere; flux L(-d) 4 pi pi R^2 / count, L the sky's
+ * radiance from where it comes (lm_sky_radiance). */
+static void emit_sky(const lm_emitters *em, const lm_scene *s, const float u[4], uint32_t count, lm_emission *out)
 {
     float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
     lm_sincos_turn(u[1], &sn, &cs);
@@ -435,9 +437,11 @@ static void emit_sky(const lm_emitters *em, const lm_emitter *e, const float u[4
     lm_vec3 o = lm_add(lm_sub(lm_v3_load(em->disk_center), lm_scale(d, back)), lm_onb_dir(d, rad * cs, rad * sn, 0.0f));
     lm_v3_store(out->org, o);
     lm_v3_store(out->dir, d);
-    float scale = (float)(4.0 * LM_PI * LM_PI) * em->disk_radius * em->disk_radius / (float)count;
+    float scale = (float)(4.0 * LM_PI * LM_PI) * em->disk_radius * em->disk_radius / (float)count, from[3], L[3];
+    lm_v3_store(from, lm_scale(d, -1.0f));
+    lm_sky_radiance(s, from, L);
     for (int c = 0; c < 3; c++)
-        out->flux[c] = e->radiant[c] * scale;
+        out->flux[c] = L[c] * scale;
 }
 
 void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris,
@@ -450,7 +454,7 @@ void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, con
     if (em_e->punctual && em_e->luminance > 0.0f) /* a light switched off or removed: no photon */
         emit_punctual(em, s, em_e, u, count, out);
     else if (em_e->kind == LM_EMIT_SKY && em_e->luminance > 0.0f)
-        emit_sky(em, em_e, u, count, out);
+        emit_sky(em, s, u, count, out);
     else if (em_e->tri_count > 0 && em_e->cdf[em_e->tri_count - 1] > 0.0f)
         emit_area(em_e, tris, s, u, count, out);
 }

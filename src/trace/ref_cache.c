@@ -59,6 +59,10 @@ static void hash_scene(uint64_t *h, const lm_scene *s)
 {
     fnv(h, s->sky, sizeof s->sky);
     fnv_u32(h, (uint32_t)s->has_sky);
+    fnv_u32(h, (uint32_t)s->sky_kind);
+    fnv(h, s->sky_horizon, sizeof s->sky_horizon);
+    if (s->sky_image)
+        fnv(h, s->sky_image, 3 * sizeof(float) * (size_t)s->sky_width * (size_t)s->sky_height);
     size_t nv = s->vertex_count;
     fnv_u32(h, s->vertex_count);
     fnv(h, s->positions, nv * 3 * sizeof(float));

@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
+#include "../scene/sky.h"
 #include "bsdf.h"
 #include "shading.h"
 
@@ -235,8 +236,10 @@ static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, 
             /* the sky where the ray leaves: met like an emitter (no light sample of it to weigh against),
              * seen from the receiver it is the IIM's part, from the eye the background's */
             int part = route_hit(&rt, 0);
+            float sky[3];
+            lm_sky_radiance(c->s, df, sky);
             if (part != DROPPED && c->s->has_sky)
-                tally_add(out, part, beta, c->s->sky, 1.0f);
+                tally_add(out, part, beta, sky, 1.0f);
             return;
         }
         lm_shading sh;

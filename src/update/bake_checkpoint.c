@@ -18,6 +18,10 @@ uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicu
     h = lm_hash_bytes(h, s->tris, 3 * sizeof(uint32_t) * s->tri_count);
     h = lm_hash_bytes(h, s->materials, sizeof *s->materials * (size_t)s->material_count);
     h = lm_hash_bytes(h, s->sky, sizeof s->sky);
+    h = lm_hash_bytes(h, &s->sky_kind, sizeof s->sky_kind);
+    h = lm_hash_bytes(h, s->sky_horizon, sizeof s->sky_horizon);
+    if (s->sky_image)
+        h = lm_hash_bytes(h, s->sky_image, 3 * sizeof(float) * (size_t)s->sky_width * (size_t)s->sky_height);
     for (int n = 0; n < s->node_count; n++)
         h = lm_hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
     h = lm_hash_bytes(h, &a->width, sizeof a->width);

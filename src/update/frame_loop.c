@@ -15,6 +15,7 @@
 #include "../photonmap/pixel_gather.h"
 #include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
+#include "../scene/sky.h"
 #include "bake_checkpoint.h"
 #include "stage_worker.h"
 
@@ -190,8 +191,11 @@ static int widen_to_viewers(lm_frame_loop *fl, lm_photon_store *ps)
 static lm_status gather_prepare(lm_frame_loop *fl, lm_error *err)
 {
     lm_status st = lm_gather_set_scene(fl->gather, fl->scene, fl->atlas, err);
-    if (fl->scene->has_sky)
-        lm_gather_set_sky(fl->gather, fl->scene->sky);
+    if (fl->scene->has_sky) { /* a hemicube clears to one colour: a sky that is not uniform wants the rays scheme */
+        float mean[3];
+        lm_sky_mean(fl->scene, mean);
+        lm_gather_set_sky(fl->gather, mean);
+    }
     if (st == LM_OK && fl->aim_stale)
         st = lm_gather_set_aim_dilated(fl->gather, fl->atlas, lm_aim_dilated_rgba(lm_photon_stage_aim(fl->stage)), err);
     if (st == LM_OK)

@@ -1,0 +1,29 @@
+/* The sky's radiance by direction (lm_scene.sky*): one function every pass asks, so that photons, rays, the
+ * gather and the reference see the same sky.
+ *
+ *   uniform   L(d) = sky
+ *   gradient  L(d) = horizon + (sky - horizon) max(d.y, 0): the zenith's radiance overhead, the horizon's
+ *             at and below the horizon (an overcast or clear sky over a ground the scene does not model)
+ *   image     L(d) = sky x the equirectangular image at d (bilinear; row 0 at the zenith, column 0 towards
+ *             -z, +x a quarter round): an HDR capture (.hdr, .exr)
+ *
+ * d is a unit direction towards the sky (away from the scene), +y up. lm_sky_mean is L's mean over the
+ * sphere (its power's share: flux = 4 pi x mean x pi R^2 through the scene's disk); for the image it is the
+ * solid-angle-weighted mean of its pixels. Reads only: thread-safe. */
+#ifndef LM_SKY_H
+#define LM_SKY_H
+
+#include "scene.h"
+
+void lm_sky_radiance(const lm_scene *s, const float d[3], float out[3]);
+void lm_sky_mean(const lm_scene *s, float out[3]);
+/* 1 when the sky looks the same every way (a uniform one): the hemicube may clear to it. */
+int lm_sky_is_uniform(const lm_scene *s);
+/* Reads an equirectangular HDR image (Radiance .hdr through stb_image, OpenEXR .exr through tinyexr) as the
+ * scene's sky image, times scale: rgb finite and >= 0 everywhere, at most LM_SKY_MAX_PIXELS. On failure
+ * nothing of s changes; LM_ERR_IO (cannot read), LM_ERR_FORMAT (not an HDR image lmgi reads),
+ * LM_ERR_INVALID (a negative or non-finite pixel, too large, a bad scale), naming the file. */
+#define LM_SKY_MAX_PIXELS (1 << 24)
+lm_status lm_sky_load_image(lm_scene *s, const char *path, const float scale[3], lm_error *err);
+
+#endif
