@@ -289,10 +289,20 @@ static void test_gradient_sky(void **state)
     lmgi_error e;
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater *u = updater(ctx, sc); /* its export carries the gradient: reloaded, the same E */
+    const char *dir = lmt_tmpdir();
+    lmgi_export_desc xd = {.name = "gradient", .force = 1};
+    assert_int_equal(lmgi_export_gltf(u, dir, &xd, &e), LMGI_OK);
+    lmgi_updater_free(u);
+    char path[600];
+    snprintf(path, sizeof path, "%s/gradient.gltf", dir);
+    lmgi_scene *back = lmt_load(path, 4000);
+    plane_against(back, 1.0, 0.01, 0.01, 0.04);
+    lmgi_free(back);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     d.gather_scheme = LMGI_GATHER_VIEWPORTS;
-    lmgi_updater *u = NULL;
+    u = NULL;
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID);
     assert_non_null(strstr(e.message, "rays gather"));
     assert_int_equal(lmgi_set_environment(sc, k_sky, &e), LMGI_OK); /* uniform again: hemicubes may show it */
