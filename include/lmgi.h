@@ -238,8 +238,8 @@ LMGI_API int lmgi_get_environment(const lmgi_scene *scene, float out[3]);
  * the direction (L = horizon + (zenith - horizon) max(y, 0)). An HDR equirectangular image (Radiance .hdr or
  * OpenEXR .exr; row 0 at the zenith, column 0 towards -z) times scale. Either is gathered by rays (a
  * hemicube clears to one colour): an updater made with a hemicube scheme refuses them (LMGI_ERR_INVALID;
- * give the sky before lmgi_updater_create, whose default then takes rays), and the frame's background and
- * reflections show the sky's mean. Bad values as lmgi_set_environment; an image that cannot be read or is
+ * give the sky before lmgi_updater_create, whose default then takes rays); the frame's background and
+ * reflections show it by direction. Bad values as lmgi_set_environment; an image that cannot be read or is
  * not HDR: LMGI_ERR_IO or LMGI_ERR_FORMAT naming it; nothing changed on any error. */
 LMGI_API lmgi_status lmgi_set_environment_gradient(lmgi_scene *scene, const float zenith[3], const float horizon[3],
                                                    lmgi_error *err);

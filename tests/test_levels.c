@@ -34,30 +34,6 @@ static void atlas_within(const char *path, int texels, double utilization)
     lmgi_free(sc);
 }
 
-/* A camera at eye looking at `at` (y up), 63 degrees across, for a square picture. */
-static void look_at(const float eye[3], const float at[3], lmgi_camera *c)
-{
-    float f[3], s[3], u[3], l = 0.0f;
-    for (int k = 0; k < 3; k++)
-        f[k] = at[k] - eye[k], l += f[k] * f[k];
-    for (int k = 0; k < 3; k++)
-        f[k] /= sqrtf(l);
-    s[0] = -f[2], s[1] = 0.0f, s[2] = f[0]; /* f x (0, 1, 0) */
-    l = sqrtf(s[0] * s[0] + s[2] * s[2]);
-    s[0] /= l, s[2] /= l;
-    u[0] = s[1] * f[2] - s[2] * f[1], u[1] = s[2] * f[0] - s[0] * f[2], u[2] = s[0] * f[1] - s[1] * f[0];
-    memset(c, 0, sizeof *c);
-    for (int k = 0; k < 3; k++)
-        c->view[4 * k] = s[k], c->view[4 * k + 1] = u[k], c->view[4 * k + 2] = -f[k];
-    c->view[12] = -(s[0] * eye[0] + s[1] * eye[1] + s[2] * eye[2]);
-    c->view[13] = -(u[0] * eye[0] + u[1] * eye[1] + u[2] * eye[2]);
-    c->view[14] = f[0] * eye[0] + f[1] * eye[1] + f[2] * eye[2];
-    c->view[15] = 1.0f;
-    float t = 1.0f / tanf(0.55f), n = 0.05f, far = 500.0f;
-    c->proj[0] = c->proj[5] = t;
-    c->proj[10] = (far + n) / (n - far), c->proj[11] = -1.0f, c->proj[14] = 2.0f * far * n / (n - far);
-}
-
 /* Bakes the level at `texels` under the sky: no valid texel of the lightmap exactly 0; then its frame from
  * cam (NULL: the file's camera) against the reference at 64 x 64, within 5% per channel over the frame. */
 static void bake_and_check(const char *path, int texels, const lmgi_camera *cam)
@@ -124,7 +100,7 @@ static void test_occlusion_room(void **state)
     atlas_within(path, 20000, 0.6);
     atlas_within(path, 65536, 0.6);
     lmgi_camera cam;
-    look_at((const float[3]){4.0f, 2.5f, 4.0f}, (const float[3]){-2.0f, 1.5f, -2.0f}, &cam);
+    lmt_look_at((const float[3]){4.0f, 2.5f, 4.0f}, (const float[3]){-2.0f, 1.5f, -2.0f}, 1.1f, &cam);
     bake_and_check(path, 8000, &cam);
 }
 

@@ -370,6 +370,35 @@ static void test_image_sky(void **state)
     lmgi_free(sc);
 }
 
+/* The frame's background is the sky as it is by direction: the middle pixel of a frame looking at the
+ * horizon shows the horizon's radiance, one looking 45 degrees up H + (Z - H) sin 45 (the sky pass, to
+ * float precision); a uniform sky is its one colour. */
+static void test_sky_behind_everything(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = lmt_load(plane_scene("behind", "{\"zenith\": [1, 0.5, 0.25], \"horizon\": [0.2, 0.3, 0.4]}",
+                                          NULL), 2000);
+    lmgi_error e;
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_updater *u = updater(ctx, sc);
+    enum { SIDE = 33 };
+    float rgb[3 * SIDE * SIDE];
+    const float eye[3] = {0, 1, 0}, level[3] = {1, 1, 0}, up[3] = {1, 2, 0};
+    const double rise[2] = {0.0, sqrt(0.5)};
+    for (int k = 0; k < 2; k++) {
+        lmgi_camera cam;
+        lmt_look_at(eye, k ? up : level, 1.0f, &cam);
+        assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, rgb, &e), LMGI_OK);
+        const float *mid = rgb + 3 * (SIDE / 2 * SIDE + SIDE / 2);
+        for (int c = 0; c < 3; c++)
+            assert_float_equal(mid[c], k_horizon[c] + (k_zenith[c] - k_horizon[c]) * rise[k], 1e-4);
+    }
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* A sky of NaN, a negative one, or a malformed one in the file: refused, naming it, nothing changed. */
 static void test_bad_sky(void **state)
 {
@@ -400,6 +429,7 @@ int main(void)
         cmocka_unit_test(test_open_box_against_reference),
         cmocka_unit_test(test_gradient_sky),
         cmocka_unit_test(test_image_sky),
+        cmocka_unit_test(test_sky_behind_everything),
         cmocka_unit_test(test_bad_sky),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

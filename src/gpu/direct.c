@@ -18,6 +18,7 @@
 #include "gl_shader.h"
 #include "offscreen.h"
 #include "shadow_maps.h"
+#include "sky_pass.h"
 
 void lm_direct_settings_default(lm_direct_settings *s)
 {
@@ -50,6 +51,7 @@ struct lm_direct {
     GLint e_view_proj, e_lit, e_use_lit;
     uniforms u[3], uf[3];
     lm_direct_mesh mesh;
+    lm_sky_pass sky;        /* a gradient or image sky behind everything */
     lm_shadow_renderer shadow;
     lm_float_target target;
     lm_float_target probe;  /* environment map faces (lm_direct_draw_probe), apart from the frame's */
@@ -149,7 +151,7 @@ static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit)
 
 /* The first pass: clears, writes depth, the emitted radiance and the indirect term at each visible
  * surface's lightmap uv, and punctual emitter `light` (-1: none, an emission-only pass). */
-static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters *em, int light, const lm_view *view,
+static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, int light, const lm_view *view,
                        int w, int h)
 {
     glViewport(0, 0, w, h);
@@ -160,9 +162,10 @@ static void first_pass(const lm_direct *d, const lm_scene *s, const lm_emitters 
     glDisable(GL_BLEND);
     glClearColor(0.0f, 0.0f, 0.0f, 1.0f);
     glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
-    float sky[4] = {0.0f, 0.0f, 0.0f, 1.0f}; /* the background, in frames and reflections: the sky's mean */
+    float sky[4] = {0.0f, 0.0f, 0.0f, 1.0f}; /* the background, in frames and reflections */
     lm_sky_mean(s, sky);
     glClearBufferfv(GL_COLOR, 0, sky);
+    lm_sky_pass_draw(&d->sky, s, view->view, view->proj); /* by direction, where it varies */
     if (light < 0) {
         float vp[16];
         lm_mat4_mul(vp, view->proj, view->view);
@@ -312,6 +315,8 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
     }
     if (st == LM_OK)
         st = lm_gl_program("direct_emission", lm_direct_emission_vs, lm_direct_emission_fs, &d->emission, err);
+    if (st == LM_OK)
+        st = lm_sky_pass_init(&d->sky, err);
     if (st == LM_OK) {
         d->e_view_proj = glGetUniformLocation(d->emission, "view_proj");
         d->e_lit = glGetUniformLocation(d->emission, "lit");
@@ -354,6 +359,7 @@ void lm_direct_free(lm_direct *d)
     }
     if (d->emission)
         glDeleteProgram(d->emission);
+    lm_sky_pass_free(&d->sky);
     free(d->scratch);
     free(d);
 }

@@ -46,6 +46,7 @@
     X(glClearTexSubImage, PFNGLCLEARTEXSUBIMAGEPROC) \
     X(glClipControl, PFNGLCLIPCONTROLPROC) \
     X(glColorMask, PFNGLCOLORMASKPROC) \
+    X(glColorMaski, PFNGLCOLORMASKIPROC) \
     X(glCompileShader, PFNGLCOMPILESHADERPROC) \
     X(glCopyImageSubData, PFNGLCOPYIMAGESUBDATAPROC) \
     X(glCreateProgram, PFNGLCREATEPROGRAMPROC) \
@@ -200,6 +201,7 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glClientWaitSync (lm_gl_cur->glClientWaitSync)
 #define glClipControl (lm_gl_cur->glClipControl)
 #define glColorMask (lm_gl_cur->glColorMask)
+#define glColorMaski (lm_gl_cur->glColorMaski)
 #define glCompileShader (lm_gl_cur->glCompileShader)
 #define glCopyImageSubData (lm_gl_cur->glCopyImageSubData)
 #define glCreateProgram (lm_gl_cur->glCreateProgram)
