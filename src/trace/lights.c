@@ -5,9 +5,12 @@
  *   spot         cos uniform in [cos outer, 1] (uniform over the outer cone's solid angle 2 pi (1 - cos
  *                outer)); flux = I att(cos) 2 pi (1 - cos outer) / count, so its mean is I x the
  *                attenuation-weighted solid angle.
- *   directional  origin uniform on the disk (u[0] radius, u[1] angle) of radius R = half the bounds'
- *                diagonal, centred on the bounds' centre and moved back by 1.001 R against the light's
- *                direction (outside the bounding sphere); flux = E pi R^2 / count.
+ *   directional  origin uniform (u[0], u[1]) on the rectangle across the light's direction that covers
+ *                the scene's bounds box as the light sees it (the box's corners projected on the plane
+ *                across the light: fitted, where the bounding sphere's disk sent a third to a half of
+ *                a flat level's sun photons past it), moved back by 1.001 R (R half the bounds'
+ *                diagonal) against the light's direction from the bounds' centre: outside the bounding
+ *                sphere; flux = E area / count.
  *   area         u[2] picks a triangle by its flux (CDF), its leftover the side (double-sided
  *                materials) and then one barycentric coordinate, u[3] the other (uniform on the
  *                triangle); u[0], u[1] a cosine-weighted direction about the emitting side's normal;
@@ -195,14 +198,36 @@ void lm_emitters_free(lm_emitters *em)
     memset(em, 0, sizeof *em);
 }
 
-static void place_punctual(lm_emitter *e, const lm_scene *s, float disk_radius)
+/* A directional light's rectangle (lm_emitter.rect): the bounds' 8 corners projected on the plane across
+ * the light, their extent there, upstream by 1.001 R; returns its area. */
+static float fit_rectangle(lm_emitter *e, const lm_emitters *em, const lm_scene *s)
+{
+    lm_vec3 axis = lm_normalize(lm_v3_load(e->dir)), t, b, c = lm_v3_load(em->disk_center);
+    lm_tangents(axis, &t, &b);
+    float lo[2] = {0.0f, 0.0f}, hi[2] = {0.0f, 0.0f};
+    for (int k = 0; em->disk_radius > 0.0f && k < 8; k++) {
+        lm_vec3 p = lm_v3(k & 1 ? s->bounds_max[0] : s->bounds_min[0], k & 2 ? s->bounds_max[1] : s->bounds_min[1],
+                          k & 4 ? s->bounds_max[2] : s->bounds_min[2]);
+        lm_vec3 d = lm_sub(p, c);
+        float x = lm_dot(d, t), y = lm_dot(d, b);
+        lo[0] = fminf(lo[0], x), hi[0] = fmaxf(hi[0], x), lo[1] = fminf(lo[1], y), hi[1] = fmaxf(hi[1], y);
+    }
+    lm_vec3 corner = lm_add(lm_sub(c, lm_scale(axis, 1.001f * em->disk_radius)),
+                            lm_add(lm_scale(t, lo[0]), lm_scale(b, lo[1])));
+    lm_v3_store(e->rect[0], corner);
+    lm_v3_store(e->rect[1], lm_scale(t, hi[0] - lo[0]));
+    lm_v3_store(e->rect[2], lm_scale(b, hi[1] - lo[1]));
+    return (hi[0] - lo[0]) * (hi[1] - lo[1]);
+}
+
+static void place_punctual(lm_emitter *e, const lm_emitters *em, const lm_scene *s)
 {
     const lm_light *l = &s->lights[e->light];
     lm_light_place(s, l, e->pos, e->dir);
     int dark = l->off || l->removed;
     float scale = e->kind == LM_EMIT_POINT ? (float)(4.0 * LM_PI)
                 : e->kind == LM_EMIT_SPOT  ? lm_spot_solid_angle(l)
-                                           : (float)LM_PI * disk_radius * disk_radius;
+                                           : fit_rectangle(e, em, s);
     for (int c = 0; c < 3; c++) {
         e->radiant[c] = dark ? 0.0f : l->color[c] * l->intensity;
         e->power[c] = e->radiant[c] * scale;
@@ -274,7 +299,7 @@ void lm_emitters_update(lm_emitters *em, const lm_scene *s)
     for (int i = 0; i < em->count; i++) {
         lm_emitter *e = &em->e[i];
         if (e->punctual)
-            place_punctual(e, s, em->disk_radius);
+            place_punctual(e, em, s);
         else if (e->kind == LM_EMIT_SKY)
             place_sky(e, s, em->disk_radius);
         else
@@ -394,7 +419,7 @@ int lm_emitter_area_point(const lm_emitters *em, const lm_scene *s, int e, const
     return 1;
 }
 
-static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emitter *e, const float u[4],
+static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[4],
                           uint32_t count, lm_emission *out)
 {
     float scale = 1.0f / (float)count, sn, cs;
@@ -409,13 +434,11 @@ static void emit_punctual(const lm_emitters *em, const lm_scene *s, const lm_emi
         float co = cosf(l->outer_cone), z = 1.0f - u[0] * (1.0f - co), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
         d = lm_onb_dir(axis, r * cs, r * sn, z);
         scale *= lm_spot_attenuation(l, z) * (float)(2.0 * LM_PI) * (1.0f - co);
-    } else {
-        float r = em->disk_radius * sqrtf(u[0]), back = 1.001f * em->disk_radius;
-        lm_vec3 c = lm_sub(lm_v3_load(em->disk_center), lm_scale(axis, back));
-        lm_vec3 off = lm_onb_dir(axis, cs, sn, 0.0f);
-        o = lm_add(c, lm_scale(off, r));
+    } else { /* the fitted rectangle (fit_rectangle), its area the power's */
+        lm_vec3 eu = lm_v3_load(e->rect[1]), ev = lm_v3_load(e->rect[2]);
+        o = lm_add(lm_v3_load(e->rect[0]), lm_add(lm_scale(eu, u[0]), lm_scale(ev, u[1])));
         d = axis;
-        scale *= (float)LM_PI * em->disk_radius * em->disk_radius;
+        scale *= lm_length(eu) * lm_length(ev);
     }
     lm_v3_store(out->org, o);
     lm_v3_store(out->dir, d);
@@ -452,7 +475,7 @@ void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, con
     if (count == 0)
         return;
     if (em_e->punctual && em_e->luminance > 0.0f) /* a light switched off or removed: no photon */
-        emit_punctual(em, s, em_e, u, count, out);
+        emit_punctual(s, em_e, u, count, out);
     else if (em_e->kind == LM_EMIT_SKY && em_e->luminance > 0.0f)
         emit_sky(em, s, u, count, out);
     else if (em_e->tri_count > 0 && em_e->cdf[em_e->tri_count - 1] > 0.0f)

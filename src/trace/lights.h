@@ -4,7 +4,7 @@
  * Units (docs/materials.md): glTF intensities are used as linear RGB radiometric quantities.
  * Point: intensity I -> flux 4 pi I. Spot: I -> I times the solid angle of its cone (with the glTF
  * smooth falloff between inner and outer angles integrated). Directional: illuminance E -> flux E times
- * the area of a disk that covers the scene's bounds, perpendicular to the light. Emissive: radiance
+ * the area of the rectangle across the light that covers the scene's bounds as the light sees them. Emissive: radiance
  * L = emissive x strength, flux pi L A per emitting side (double-sided materials emit on both sides).
  * Sky (lm_scene.sky, uniform radiance L from every direction): photons leave the disk that covers the
  * scene's bounds perpendicular to a direction drawn uniformly on the sphere, flux L 4 pi x pi R^2 in
@@ -36,6 +36,8 @@ typedef struct {
     float pos[3];         /* point/spot: world position (node world translation) */
     float dir[3];         /* point/spot/directional: unit direction the light shines (node world -Z) */
     float radiant[3];     /* point/spot: intensity x colour; directional: illuminance x colour */
+    float rect[3][3];     /* directional: the rectangle its photons leave from, across its direction and
+                           * upstream of the scene: a corner and its two edges (lights.c, "fitted") */
 } lm_emitter;
 
 typedef struct {
