@@ -290,12 +290,11 @@ static lmgi_status sky_edit_allowed(lmgi_scene *sc, int uniform, lmgi_error *err
 {
     if (!sc->updater)
         return LMGI_OK;
-    lmgi_updater_info ui;
-    lmgi_get_updater_info(sc->updater, &ui);
-    if (!uniform && ui.gather_scheme && strcmp(ui.gather_scheme, "rays") != 0)
+    lm_gather_scheme scheme = lm_updater_gather_scheme(sc->updater);
+    if (!uniform && scheme != LM_GATHER_RAYS)
         return lm_api_refuse(err, "%s: a gradient or image sky needs the rays gather, and this updater draws "
                              "hemicubes (%s): give the sky before lmgi_updater_create, or ask for rays",
-                             sc->scene->path, ui.gather_scheme);
+                             sc->scene->path, lm_gather_scheme_name(scheme));
     lm_updater_sync(sc->updater);
     return LMGI_OK;
 }

@@ -295,6 +295,11 @@ void lmgi_updater_free(lmgi_updater *u)
     free(u);
 }
 
+lm_gather_scheme lm_updater_gather_scheme(const lmgi_updater *u)
+{
+    return lm_frame_loop_get_settings(u->loop)->gather.scheme;
+}
+
 void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
 {
     if (!info)

@@ -19,5 +19,7 @@ lm_status lm_updater_render(lmgi_updater *u, const lm_view *v, int width, int he
 
 /* Waits for the photon work an update left running, before the scene is changed under it. */
 void lm_updater_sync(lmgi_updater *u);
+/* How u gathers (the frame loop's settings): a gradient or image sky needs LM_GATHER_RAYS. */
+lm_gather_scheme lm_updater_gather_scheme(const lmgi_updater *u);
 
 #endif

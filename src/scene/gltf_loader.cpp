@@ -165,6 +165,7 @@ class Loader {
     lm_status animations();
     lm_status finish();
     lm_status sky();
+    std::string scene_dir() const;
 
     const char *path_;
     const unsigned char *mem_ = nullptr; // the scene's bytes when it comes from memory
@@ -173,7 +174,7 @@ class Loader {
     bool strict_ = false;
     tinygltf::Model model_;
     ScenePtr s_;
-    std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted, -2 undecodable)
+    std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted)
     struct Decoded {                         // an image as decode_used_images left it
         std::vector<uint8_t> rgba;           // 8-bit RGBA; empty: unused or undecodable
         int w = 0, h = 0;
@@ -347,16 +348,21 @@ lm_status Loader::check_buffers(const std::vector<unsigned char> &b, bool glb)
     return LM_OK;
 }
 
+// The folder of the scene file, which the files it names are relative to.
+std::string Loader::scene_dir() const
+{
+    std::string p(path_);
+    size_t slash = p.find_last_of('/');
+    return slash == std::string::npos ? "." : slash == 0 ? "/" : p.substr(0, slash);
+}
+
 lm_status Loader::parse(const std::vector<unsigned char> &bytes)
 {
     bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
     lm_status checked = glb ? check_glb(bytes) : LM_OK;
     if (checked || (checked = check_buffers(bytes, glb)))
         return checked;
-    std::string p(path_), dir = ".";
-    size_t slash = p.find_last_of('/');
-    if (slash != std::string::npos)
-        dir = slash == 0 ? "/" : p.substr(0, slash);
+    std::string dir = scene_dir();
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(keep_image_bytes, &model_);
     tinygltf::FsCallbacks fs = {mem_ ? &any_file_exists : &tinygltf::FileExists, &tinygltf::ExpandFilePath,
@@ -534,13 +540,11 @@ int Loader::texture(int tex_index, const std::string &ctx)
         lm_warn("%s: %s: texture %d is missing; using the factor alone", path_, ctx.c_str(), tex_index);
         return -1;
     }
-    if (image_tex_[size_t(img)] != -1)
-        return image_tex_[size_t(img)] < 0 ? -1 : image_tex_[size_t(img)];
+    if (image_tex_[size_t(img)] >= 0)
+        return image_tex_[size_t(img)];
     const Decoded &d = decoded_[size_t(img)];
-    if (d.rgba.empty()) {
-        image_tex_[size_t(img)] = -2;
+    if (d.rgba.empty()) // undecodable, already warned
         return -1;
-    }
     lm_texture t = {0, 0, nullptr};
     if (!lm_texture_from_rgba8(&t, d.rgba.data(), d.w, d.h, 1))
         throw std::bad_alloc();
@@ -1067,9 +1071,8 @@ lm_status Loader::sky()
             return fail(LM_ERR_INVALID, "extras.lmgi.sky.image: a scene from memory cannot name external files");
         double k = num(&v, "scale", 1.0);
         const float scale[3] = {float(k), float(k), float(k)};
-        std::string p(path_), uri = v.Get("image").Get<std::string>();
-        size_t slash = p.find_last_of('/');
-        std::string file = uri.size() && uri[0] == '/' ? uri : (slash == std::string::npos ? "" : p.substr(0, slash + 1)) + uri;
+        std::string uri = v.Get("image").Get<std::string>();
+        std::string file = uri.size() && uri[0] == '/' ? uri : scene_dir() + "/" + uri;
         lm_error e;
         if (lm_sky_load_image(s_.get(), file.c_str(), scale, &e) != LM_OK)
             return fail(e.status, "extras.lmgi.sky.image: %s", e.msg);

@@ -191,6 +191,7 @@ typedef struct {
     int sky_width, sky_height; /* LM_SKY_IMAGE: an equirectangular image, row 0 at the zenith, column 0
                                 * towards -z, x increasing eastwards (+x at a quarter) */
     float *sky_image;      /* sky_width x sky_height x 3 floats, times sky[] */
+    float sky_image_mean[3]; /* its mean over the sphere (solid-angle weighted), made as it is loaded */
 
     int mesh_count;        /* number of glTF meshes (for reporting) */
     float bounds_min[3], bounds_max[3]; /* world-space bounds at load time (all nodes) */

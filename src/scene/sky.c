@@ -9,6 +9,7 @@
 
 #include <stb/stb_image.h>
 
+#include "../core/hash.h"
 #include "../core/image.h"
 
 #include "../core/vecmath.h"
@@ -66,16 +67,35 @@ void lm_sky_mean(const lm_scene *s, float out[3])
             out[c] = s->sky_horizon[c] + 0.25f * (s->sky[c] - s->sky_horizon[c]);
         return;
     }
+    for (int c = 0; c < 3; c++)
+        out[c] = s->sky_image_mean[c] * s->sky[c];
+}
+
+uint64_t lm_sky_hash(uint64_t h, const lm_scene *s)
+{
+    uint32_t has = (uint32_t)s->has_sky, kind = (uint32_t)s->sky_kind;
+    h = lm_hash_bytes(h, s->sky, sizeof s->sky);
+    h = lm_hash_bytes(h, &has, sizeof has);
+    h = lm_hash_bytes(h, &kind, sizeof kind);
+    h = lm_hash_bytes(h, s->sky_horizon, sizeof s->sky_horizon);
+    if (s->sky_image)
+        h = lm_hash_bytes(h, s->sky_image, 3 * sizeof(float) * (size_t)s->sky_width * (size_t)s->sky_height);
+    return h;
+}
+
+/* The image's mean over the sphere: a row's solid angle goes as sin(theta). */
+static void image_mean(const float *rgb, int w, int h, float out[3])
+{
     double sum[3] = {0, 0, 0}, weight = 0.0;
-    for (int y = 0; s->sky_image && y < s->sky_height; y++) { /* a row's solid angle goes as sin(theta) */
-        double w = sin(LM_PI * (y + 0.5) / s->sky_height);
-        for (int x = 0; x < s->sky_width; x++)
+    for (int y = 0; y < h; y++) {
+        double wt = sin(LM_PI * (y + 0.5) / h);
+        for (int x = 0; x < w; x++)
             for (int c = 0; c < 3; c++)
-                sum[c] += w * s->sky_image[3 * ((size_t)y * s->sky_width + x) + c];
-        weight += w * s->sky_width;
+                sum[c] += wt * rgb[3 * ((size_t)y * w + x) + c];
+        weight += wt * w;
     }
     for (int c = 0; c < 3; c++)
-        out[c] = weight > 0.0 ? (float)(sum[c] / weight) * s->sky[c] : 0.0f;
+        out[c] = weight > 0.0 ? (float)(sum[c] / weight) : 0.0f;
 }
 
 /* RGB floats of the file, from .hdr (stb_image) or .exr (tinyexr), by its content. */
@@ -135,6 +155,7 @@ lm_status lm_sky_load_image(lm_scene *s, const char *path, const float scale[3],
         }
     free(s->sky_image);
     s->sky_image = rgb, s->sky_width = w, s->sky_height = h;
+    image_mean(rgb, w, h, s->sky_image_mean);
     s->sky_kind = LM_SKY_IMAGE;
     memcpy(s->sky, scale, sizeof s->sky);
     s->has_sky = 1;

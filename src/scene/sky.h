@@ -9,14 +9,19 @@
  *
  * d is a unit direction towards the sky (away from the scene), +y up. lm_sky_mean is L's mean over the
  * sphere (its power's share: flux = 4 pi x mean x pi R^2 through the scene's disk); for the image it is the
- * solid-angle-weighted mean of its pixels. Reads only: thread-safe. */
+ * solid-angle-weighted mean of its pixels, made once as the image is loaded (the photon stage and the
+ * frame ask for it every frame). lm_sky_hash extends an FNV-1a hash by everything the sky is (the
+ * reference's cache and the bake's checkpoint key on it). Reads only: thread-safe. */
 #ifndef LM_SKY_H
 #define LM_SKY_H
+
+#include <stdint.h>
 
 #include "scene.h"
 
 void lm_sky_radiance(const lm_scene *s, const float d[3], float out[3]);
 void lm_sky_mean(const lm_scene *s, float out[3]);
+uint64_t lm_sky_hash(uint64_t h, const lm_scene *s);
 /* 1 when the sky looks the same every way (a uniform one): the hemicube may clear to it. */
 int lm_sky_is_uniform(const lm_scene *s);
 /* Reads an equirectangular HDR image (Radiance .hdr through stb_image, OpenEXR .exr through tinyexr) as the

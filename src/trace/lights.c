@@ -150,13 +150,22 @@ lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
     return LM_OK;
 }
 
-lm_status lm_emitters_add_sky(lm_emitters *em, const lm_scene *s, lm_error *err)
+/* Room for one more emitter at the end of em: its slot, or NULL when memory ran out. */
+static lm_emitter *append(lm_emitters *em)
 {
     lm_emitter *e = realloc(em->e, sizeof *e * ((size_t)em->count + 1));
     if (!e)
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the sky", s->path);
+        return NULL;
     em->e = e;
-    set_sky(&em->e[em->count++]);
+    return &em->e[em->count++];
+}
+
+lm_status lm_emitters_add_sky(lm_emitters *em, const lm_scene *s, lm_error *err)
+{
+    lm_emitter *e = append(em);
+    if (!e)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the sky", s->path);
+    set_sky(e);
     lm_emitters_update(em, s);
     return LM_OK;
 }
@@ -171,11 +180,10 @@ int lm_emitters_sky(const lm_emitters *em)
 
 lm_status lm_emitters_add_light(lm_emitters *em, const lm_scene *s, int light, lm_error *err)
 {
-    lm_emitter *e = realloc(em->e, sizeof *e * ((size_t)em->count + 1));
+    lm_emitter *e = append(em);
     if (!e)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for light '%s'", s->path, s->lights[light].name);
-    em->e = e;
-    set_punctual(s, light, &em->e[em->count++]);
+    set_punctual(s, light, e);
     lm_emitters_update(em, s);
     return LM_OK;
 }

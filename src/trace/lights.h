@@ -4,12 +4,13 @@
  * Units (docs/materials.md): glTF intensities are used as linear RGB radiometric quantities.
  * Point: intensity I -> flux 4 pi I. Spot: I -> I times the solid angle of its cone (with the glTF
  * smooth falloff between inner and outer angles integrated). Directional: illuminance E -> flux E times
- * the area of the rectangle across the light that covers the scene's bounds as the light sees them. Emissive: radiance
- * L = emissive x strength, flux pi L A per emitting side (double-sided materials emit on both sides).
- * Sky (lm_scene.sky, uniform radiance L from every direction): photons leave the disk that covers the
- * scene's bounds perpendicular to a direction drawn uniformly on the sphere, flux L 4 pi x pi R^2 in
- * all; it has no next-event estimation (the reference meets it where rays leave the scene) and no
- * caustic photons. It is the last emitter; node and light are -1. */
+ * the area of the rectangle across the light that covers the scene's bounds as the light sees them.
+ * Emissive: radiance L = emissive x strength, flux pi L A per emitting side (double-sided materials emit
+ * on both sides). Sky (lm_scene.sky*, radiance L(d) by direction, scene/sky.h): photons leave the disk
+ * that covers the scene's bounds across a direction drawn uniformly on the sphere, each with the radiance
+ * from where it comes, flux 4 pi mean(L) x pi R^2 in all; it has no next-event estimation (the reference
+ * meets it where rays leave the scene) and no caustic photons. It is the last emitter of a list built with
+ * it; node and light are -1. */
 #ifndef LM_LIGHTS_H
 #define LM_LIGHTS_H
 

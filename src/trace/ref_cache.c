@@ -10,6 +10,7 @@
 
 #include "../core/image.h"
 #include "../core/log.h"
+#include "../scene/sky.h"
 
 #define LM_REF_MAGIC "LMGIREF1"
 #define LM_REF_VERSION 2u /* 2: the split by light path (caustic, lost, pixel parts) */
@@ -57,12 +58,7 @@ static void hash_light(uint64_t *h, const lm_light *l)
 
 static void hash_scene(uint64_t *h, const lm_scene *s)
 {
-    fnv(h, s->sky, sizeof s->sky);
-    fnv_u32(h, (uint32_t)s->has_sky);
-    fnv_u32(h, (uint32_t)s->sky_kind);
-    fnv(h, s->sky_horizon, sizeof s->sky_horizon);
-    if (s->sky_image)
-        fnv(h, s->sky_image, 3 * sizeof(float) * (size_t)s->sky_width * (size_t)s->sky_height);
+    *h = lm_sky_hash(*h, s);
     size_t nv = s->vertex_count;
     fnv_u32(h, s->vertex_count);
     fnv(h, s->positions, nv * 3 * sizeof(float));

@@ -7,6 +7,8 @@
 #include <string.h>
 
 #include "../core/hash.h"
+#include "../core/image.h"
+#include "../scene/sky.h"
 
 static const char k_magic[8] = {'L', 'M', 'G', 'I', 'C', 'K', 'P', '1'};
 
@@ -17,11 +19,7 @@ uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicu
     h = lm_hash_bytes(h, s->positions, 3 * sizeof(float) * s->vertex_count);
     h = lm_hash_bytes(h, s->tris, 3 * sizeof(uint32_t) * s->tri_count);
     h = lm_hash_bytes(h, s->materials, sizeof *s->materials * (size_t)s->material_count);
-    h = lm_hash_bytes(h, s->sky, sizeof s->sky);
-    h = lm_hash_bytes(h, &s->sky_kind, sizeof s->sky_kind);
-    h = lm_hash_bytes(h, s->sky_horizon, sizeof s->sky_horizon);
-    if (s->sky_image)
-        h = lm_hash_bytes(h, s->sky_image, 3 * sizeof(float) * (size_t)s->sky_width * (size_t)s->sky_height);
+    h = lm_sky_hash(h, s);
     for (int n = 0; n < s->node_count; n++)
         h = lm_hash_bytes(h, s->nodes[n].world, sizeof s->nodes[n].world);
     h = lm_hash_bytes(h, &a->width, sizeof a->width);
@@ -48,21 +46,16 @@ lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a,
     memcpy(hd.magic, k_magic, sizeof hd.magic);
     hd.key = key, hd.count = count, hd.done = done, hd.width = a->width, hd.height = a->height;
     size_t n = 4 * sizeof(float) * (size_t)a->width * (size_t)a->height;
-    uint64_t sum = lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n);
-    char tmp[4200];
-    if (snprintf(tmp, sizeof tmp, "%s.partial", path) >= (int)sizeof tmp)
-        return lm_fail(err, LM_ERR_INVALID, "checkpoint path too long: %s", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
-        return lm_fail(err, LM_ERR_IO, "%s: cannot write the bake's checkpoint: %s", tmp, strerror(errno));
-    int ok = fwrite(&hd, sizeof hd, 1, f) == 1 && fwrite(rgba, 1, n, f) == n && fwrite(&sum, sizeof sum, 1, f) == 1;
-    ok = fclose(f) == 0 && ok;
-    if (!ok || rename(tmp, path) != 0) {
-        int e = errno;
-        remove(tmp);
-        return lm_fail(err, LM_ERR_IO, "%s: cannot write the bake's checkpoint: %s", path, strerror(e));
-    }
-    return LM_OK;
+    unsigned char *file = malloc(sizeof hd + n + sizeof(uint64_t));
+    if (!file)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake's checkpoint", path);
+    memcpy(file, &hd, sizeof hd);
+    memcpy(file + sizeof hd, rgba, n);
+    uint64_t sum = lm_hash_bytes(LM_HASH_SEED, file, sizeof hd + n);
+    memcpy(file + sizeof hd + n, &sum, sizeof sum);
+    lm_status st = lm_write_file(path, file, sizeof hd + n + sizeof sum, err); /* whole or not at all */
+    free(file);
+    return st;
 }
 
 lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, float *rgba,

@@ -7,8 +7,8 @@
  *
  * File (little-endian, as the machine writes it): "LMGICKP1", key (u64), texel count (u32), done (u32),
  * atlas width, height (i32), width x height x 4 floats (the fresh IIM as the passes left it), and an FNV-1a
- * checksum of all before it. Written to NAME.partial and renamed over NAME, so a kill leaves the previous
- * checkpoint or the new one, never half of one.
+ * checksum of all before it. Written whole or not at all (lm_write_file: NAME.partial renamed over NAME),
+ * so a kill leaves the previous checkpoint or the new one, never half of one.
  *
  * Key: FNV-1a over the scene's vertices, triangles, materials and node matrices, the texel table, the
  * order the texels are gathered in, the gather's settings and the dilated AIM it reads (which carries

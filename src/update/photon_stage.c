@@ -102,44 +102,37 @@ static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *ou
     memcpy(out->power, em->power, sizeof out->power);
 }
 
-/* Lights added to the scene since the emitter list was built (they come last, in id order) join it and
- * the photons, which queue their groups for tracing. Returns how many. */
-static lm_status take_new_lights(lm_photon_stage *ps, int *added, lm_error *err)
+/* Scene light `light` (-1: the sky), come after the emitter list was built, joins it last and the photons,
+ * which queue its groups for tracing; *added counts it. */
+static lm_status join_emitter(lm_photon_stage *ps, int light, int *added, lm_error *err)
 {
-    *added = 0;
-    for (int l = lm_emitters_light_count(&ps->emitters); l < ps->scene->light_count; l++) {
-        emitter_snapshot *snap = realloc(ps->snap, sizeof *snap * ((size_t)ps->emitters.count + 2));
-        if (!snap)
-            return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for light '%s'", ps->scene->path,
-                           ps->scene->lights[l].name);
-        ps->snap = snap;
-        lm_status st = lm_emitters_add_light(&ps->emitters, ps->scene, l, err);
-        if (st == LM_OK)
-            st = lm_photons_add_emitter(ps->photons, err);
-        if (st != LM_OK)
-            return st;
-        take_snapshot(ps, ps->emitters.count - 1, &ps->snap[ps->emitters.count - 1]);
-        ++*added;
-    }
+    emitter_snapshot *snap = realloc(ps->snap, sizeof *snap * ((size_t)ps->emitters.count + 2));
+    if (!snap && light < 0)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the sky", ps->scene->path);
+    if (!snap)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for light '%s'", ps->scene->path, ps->scene->lights[light].name);
+    ps->snap = snap;
+    lm_status st = light < 0 ? lm_emitters_add_sky(&ps->emitters, ps->scene, err)
+                             : lm_emitters_add_light(&ps->emitters, ps->scene, light, err);
+    if (st == LM_OK)
+        st = lm_photons_add_emitter(ps->photons, err);
+    if (st != LM_OK)
+        return st;
+    take_snapshot(ps, ps->emitters.count - 1, &ps->snap[ps->emitters.count - 1]);
+    ++*added;
     return LM_OK;
 }
 
-/* A sky given to the scene after the emitter list was built joins it last, as a light added by an edit. */
-static lm_status take_new_sky(lm_photon_stage *ps, int *added, lm_error *err)
+/* Lights added to the scene since the emitter list was built (they come last, in id order), and a sky
+ * given to it since, join the emitters as join_emitter says. Returns how many. */
+static lm_status take_new_emitters(lm_photon_stage *ps, int *added, lm_error *err)
 {
-    if (!ps->scene->has_sky || lm_emitters_sky(&ps->emitters) >= 0)
-        return LM_OK;
-    emitter_snapshot *snap = realloc(ps->snap, sizeof *snap * ((size_t)ps->emitters.count + 2));
-    if (!snap)
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the sky", ps->scene->path);
-    ps->snap = snap;
-    lm_status st = lm_emitters_add_sky(&ps->emitters, ps->scene, err);
-    if (st == LM_OK)
-        st = lm_photons_add_emitter(ps->photons, err);
-    if (st == LM_OK) {
-        take_snapshot(ps, ps->emitters.count - 1, &ps->snap[ps->emitters.count - 1]);
-        ++*added;
-    }
+    *added = 0;
+    lm_status st = LM_OK;
+    for (int l = lm_emitters_light_count(&ps->emitters); st == LM_OK && l < ps->scene->light_count; l++)
+        st = join_emitter(ps, l, added, err);
+    if (st == LM_OK && ps->scene->has_sky && lm_emitters_sky(&ps->emitters) < 0)
+        st = join_emitter(ps, -1, added, err);
     return st;
 }
 
@@ -335,9 +328,7 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
             return st;
     }
     int added = 0;
-    lm_status st = take_new_lights(ps, &added, err);
-    if (st == LM_OK)
-        st = take_new_sky(ps, &added, err);
+    lm_status st = take_new_emitters(ps, &added, err);
     lm_emitters_update(&ps->emitters, ps->scene);
     lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
     if (st == LM_OK)
