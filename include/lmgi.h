@@ -53,11 +53,15 @@ typedef struct {
     int target_texels;      /* texels the derived texel size aims at (0, the default: 65536).
                              * 'lmgi run' aims at 90 x its texels per frame (docs/gather.md, "Atlas
                              * density") */
-    int gutter;             /* minimum empty texels between charts (default 2) */
+    int gutter;             /* empty texels between charts (default 0; more for engines that mipmap lightmaps) */
     int use_file_uv1;       /* 1 = use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping */
     int strict;             /* 1 = degenerate triangles and non-manifold edges are errors, not warnings */
     float surface_cone_deg; /* max normal deviation within one surface, degrees (default 30) */
     int max_atlas_size;     /* largest atlas side; texel size grows to fit (default 8192) */
+    int wall_texels;        /* with a derived texel size: each surface of at least 2 m^2 (a wall, a floor)
+                             * gets at least about this many texels, at a finer texel size than the rest
+                             * where needed, on top of target_texels; 0, the default: one texel size for
+                             * all ('lmgi run': 16; docs/levels.md, "Density") */
 } lmgi_options;
 
 typedef struct lmgi_scene lmgi_scene;

@@ -275,8 +275,14 @@ static void check_corners(const lm_scene *s, const lm_surfaces *su, const lm_atl
         const lm_chart *r = &a->charts[c];
         for (int k = 0; k < 3; k++) {
             double x = a->corner_uv[6 * t + 2 * k] * (double)a->width, y = a->corner_uv[6 * t + 2 * k + 1] * (double)a->height;
-            assert_true(x >= r->x - 1e-3 && x <= r->x + r->w + 1e-3);
-            assert_true(y >= r->y - 1e-3 && y <= r->y + r->h + 1e-3);
+            double cx = a->coverage_uv[6 * t + 2 * k] * (double)a->width, cy = a->coverage_uv[6 * t + 2 * k + 1] * (double)a->height;
+            double in = 0.5 - r->pad; /* a lookup reaches no further than half a texel into the border */
+            assert_true(x >= r->x + in - 1e-3 && x <= r->x + r->w - in + 1e-3);
+            assert_true(y >= r->y + in - 1e-3 && y <= r->y + r->h - in + 1e-3);
+            assert_true(cx >= r->x - 1e-3 && cx <= r->x + r->w + 1e-3);
+            assert_true(cy >= r->y - 1e-3 && cy <= r->y + r->h + 1e-3);
+            if (r->w > 1 && r->h > 1) /* one texel: its corners all at its centre */
+                assert_true(x == cx && y == cy);
         }
     }
 }
@@ -643,9 +649,10 @@ static void test_default_texel_size(void **state)
     ts_free(t);
 }
 
-/* Dilating chart ids into the gutters never mixes two charts: every texel a bilinear lookup inside
- * a chart can touch (within one texel of its covered texels) ends up with exactly that chart's id. */
-static void check_dilation(const lm_atlas *a)
+/* Bilinear lookups never mix two charts, though rects touch: every lookup at a point of a triangle
+ * (its corner_uv) reads four texels of its own rect and border, and after lm_atlas_dilate_gutters each of
+ * them holds that chart's id, covered or not. */
+static void check_dilation(const lm_scene *s, const lm_atlas *a)
 {
     size_t n = (size_t)a->width * a->height;
     float *data = calloc(n, sizeof *data);
@@ -653,22 +660,29 @@ static void check_dilation(const lm_atlas *a)
     for (size_t i = 0; i < n; i++)
         if (a->texel_index[i] >= 0)
             data[i] = (float)(a->tri_chart[a->texels[a->texel_index[i]].tri] + 1);
-    lm_atlas_dilate(a, data, 1, a->gutter);
-    for (int y = 0; y < a->height; y++)
-        for (int x = 0; x < a->width; x++) {
-            int ti = a->texel_index[(size_t)y * a->width + x];
-            if (ti < 0)
-                continue;
-            float id = (float)(a->tri_chart[a->texels[ti].tri] + 1);
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dx = -1; dx <= 1; dx++) {
-                    int xx = x + dx, yy = y + dy;
-                    if (xx >= 0 && yy >= 0 && xx < a->width && yy < a->height &&
-                        data[(size_t)yy * a->width + xx] != id)
-                        fail_msg("texel (%d,%d) next to chart %g holds %g", xx, yy, (double)id,
+    lm_atlas_dilate_gutters(a, data, 1);
+    static const double bary[][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.5, 0.5, 0}, {0, 0.5, 0.5},
+                                     {0.5, 0, 0.5}, {1.0 / 3, 1.0 / 3, 1.0 / 3}, {0.8, 0.1, 0.1}};
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        int c = a->tri_chart[t];
+        if (c < 0)
+            continue;
+        const float *uv = a->corner_uv + 6 * (size_t)t;
+        const lm_chart *r = &a->charts[c];
+        for (size_t b = 0; b < sizeof bary / sizeof *bary; b++) {
+            double x = (bary[b][0] * uv[0] + bary[b][1] * uv[2] + bary[b][2] * uv[4]) * a->width - 0.5;
+            double y = (bary[b][0] * uv[1] + bary[b][1] * uv[3] + bary[b][2] * uv[5]) * a->height - 0.5;
+            int x0 = (int)floor(x + 1e-4), y0 = (int)floor(y + 1e-4);
+            int x1 = x - x0 > 1e-4 ? x0 + 1 : x0, y1 = y - y0 > 1e-4 ? y0 + 1 : y0; /* weight 0: not read */
+            if (x0 < r->x - r->pad || y0 < r->y - r->pad || x1 >= r->x + r->w + r->pad || y1 >= r->y + r->h + r->pad)
+                fail_msg("triangle %u: a lookup at (%g, %g) reads outside its chart %d's rect", t, x, y, c);
+            for (int yy = y0; yy <= y1; yy++)
+                for (int xx = x0; xx <= x1; xx++)
+                    if (data[(size_t)yy * a->width + xx] != (float)(c + 1))
+                        fail_msg("texel (%d,%d) read by chart %d holds %g", xx, yy, c + 1,
                                  (double)data[(size_t)yy * a->width + xx]);
-                }
         }
+    }
     free(data);
 }
 
@@ -691,7 +705,7 @@ static void shared_scene(const char *rel, int expect_surfaces, int uv1)
                   a.chart_count, a.width, a.height, (double)a.utilization);
     if (expect_surfaces >= 0)
         assert_int_equal(n, expect_surfaces);
-    check_dilation(&a);
+    check_dilation(s, &a);
     lm_atlas_free(&a);
     if (uv1) {
         lm_atlas_options o;

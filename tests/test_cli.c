@@ -45,7 +45,7 @@ static void test_usage_errors(void **state)
     assert_int_equal(run("info"), 2);
     assert_int_equal(run("info a.glb --texel-size abc"), 2);
     assert_non_null(strstr(output, "--texel-size abc"));
-    assert_int_equal(run("info a.glb --gutter 0"), 2);
+    assert_int_equal(run("info a.glb --gutter -1"), 2);
     assert_int_equal(run("info a.glb --wat"), 2);
     assert_non_null(strstr(output, "'--wat'"));
     assert_int_equal(run("charts scenes/cornell.glb"), 2);

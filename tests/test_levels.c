@@ -34,6 +34,55 @@ static void atlas_within(const char *path, int texels, double utilization)
     lmgi_free(sc);
 }
 
+/* The budgets item 2 of issue 30 names, from 2,000 to 1,000,000 texels: each met within 15%, the atlas at
+ * least 60% used (measured: 66-99%, docs/levels.md, "Atlas"). */
+static void atlas_every_budget(const char *path)
+{
+    static const int budgets[] = {2000, 20000, 200000, 1000000};
+    for (size_t i = 0; i < sizeof budgets / sizeof *budgets; i++)
+        atlas_within(path, budgets[i], 0.6);
+}
+
+/* At `lmgi run`'s density (1,800 texels and lmgi_options.wall_texels 16): every surface of 2 m^2 or more
+ * gets at least `least` texels (one texel of 50 m each before, on the town), and the texels the walls add
+ * stay within `most` in all. */
+static void walls_at_run_density(const char *path, uint32_t least, uint32_t most)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = lmgi_atlas_texels_for(0);
+    o.wall_texels = 16;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    int n = lmgi_surface_count(sc);
+    uint32_t *count = calloc((size_t)n, sizeof *count), fewest = UINT32_MAX;
+    double *area = calloc((size_t)n, sizeof *area);
+    assert_non_null(count);
+    assert_non_null(area);
+    for (uint32_t i = 0; i < lmgi_texel_count(sc); i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        count[t.surface]++;
+        area[t.surface] += t.area;
+    }
+    int walls = 0;
+    for (int f = 0; f < n; f++)
+        if (area[f] >= 2.0) {
+            walls++;
+            fewest = count[f] < fewest ? count[f] : fewest;
+        }
+    print_message("%s at run's density: %u texels, %d surfaces of 2 m^2 or more, the fewest texels of one %u\n",
+                  path, lmgi_texel_count(sc), walls, fewest);
+    assert_true(walls > 0);
+    assert_true(fewest >= least);
+    assert_true(lmgi_texel_count(sc) <= most);
+    free(count);
+    free(area);
+    lmgi_free(sc);
+}
+
 /* Bakes the level at `texels` under the sky: no valid texel of the lightmap exactly 0; then its frame from
  * cam (NULL: the file's camera) against the reference at 64 x 64, within 5% per channel over the frame. */
 static void bake_and_check(const char *path, int texels, const lmgi_camera *cam)
@@ -97,8 +146,8 @@ static void test_occlusion_room(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("occlusion-room/room_lit.glb"));
-    atlas_within(path, 20000, 0.6);
-    atlas_within(path, 65536, 0.6);
+    atlas_every_budget(path);
+    walls_at_run_density(path, 12, 4000);
     lmgi_camera cam;
     lmt_look_at((const float[3]){4.0f, 2.5f, 4.0f}, (const float[3]){-2.0f, 1.5f, -2.0f}, 1.1f, &cam);
     bake_and_check(path, 8000, &cam);
@@ -111,8 +160,17 @@ static void test_truck_town(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("truck-town/town_lit.gltf"));
-    atlas_within(path, 65536, 0.6);
+    atlas_every_budget(path);
+    walls_at_run_density(path, 12, 8000);
     bake_and_check(path, 20000, NULL);
+}
+
+/* The generated level of many rooms (354,112 triangles, 13,246 surfaces at the fragment merge): at 2,000
+ * texels its small surfaces merge (docs/levels.md, "Atlas"), at 1,000,000 its 19,220 charts pack. */
+static void test_many_rooms(void **state)
+{
+    (void)state;
+    atlas_every_budget("scenes/many_rooms.glb");
 }
 
 int main(void)
@@ -120,6 +178,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_occlusion_room),
         cmocka_unit_test(test_truck_town),
+        cmocka_unit_test(test_many_rooms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

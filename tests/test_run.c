@@ -471,6 +471,21 @@ static double frame_mean(const char *dir, const char *file)
     return sum / (3.0 * w * h);
 }
 
+/* The mean of a lightmap's valid texels (alpha 1): not of its free space, which depends on the layout. */
+static double lightmap_mean(const char *dir, const char *file)
+{
+    int w, h;
+    float *px = read_exr(dir, file, &w, &h);
+    double sum = 0.0, n = 0.0;
+    for (int i = 0; i < w * h; i++)
+        if (px[4 * i + 3] > 0.0f) {
+            sum += px[4 * i] + px[4 * i + 1] + px[4 * i + 2];
+            n += 3.0;
+        }
+    free(px);
+    return n > 0.0 ? sum / n : 0.0;
+}
+
 /* A floor (mesh 0) and a box (mesh 1), both diffuse, one point light (light 0) and a camera (camera 0),
  * placed by `nodes`, written as NAME.gltf and run for 2 frames at 48 x 48: the second frame's mean and
  * the IIM's. */
@@ -493,7 +508,7 @@ static void run_floor_and_box(const char *name, const char *nodes, double *frame
     if (lmgi(args) != 0)
         fail_msg("lmgi run failed: %s", output);
     *frame = frame_mean(dir, "frame_0001.exr");
-    *iim = frame_mean(dir, "iim.exr");
+    *iim = lightmap_mean(dir, "iim.exr");
 }
 
 /* glTF: a negative determinant turns a node's triangles over. A floor and a dynamic box, symmetric about

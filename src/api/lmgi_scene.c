@@ -62,11 +62,13 @@ static lm_status check_options(const char *path, const lmgi_options *o, lm_error
     if (o->target_texels < 0)
         return lm_fail(err, LM_ERR_INVALID, "%s: target texel count %d must be >= 0 (0 = %d)", path,
                        o->target_texels, LM_ATLAS_DEFAULT_TEXELS);
-    if (o->gutter < 1 || o->gutter > 64)
-        return lm_fail(err, LM_ERR_INVALID, "%s: gutter %d must be between 1 and 64 texels", path, o->gutter);
+    if (o->gutter < 0 || o->gutter > 64)
+        return lm_fail(err, LM_ERR_INVALID, "%s: gutter %d must be between 0 and 64 texels", path, o->gutter);
     if (!(o->surface_cone_deg > 0.0f && o->surface_cone_deg < 90.0f))
         return lm_fail(err, LM_ERR_INVALID, "%s: surface cone %g must be in (0, 90) degrees", path,
                        (double)o->surface_cone_deg);
+    if (o->wall_texels < 0 || o->wall_texels > 65536)
+        return lm_fail(err, LM_ERR_INVALID, "%s: wall_texels %d must be in [0, 65536]", path, o->wall_texels);
     if (o->max_atlas_size < 64 || o->max_atlas_size > 32768)
         return lm_fail(err, LM_ERR_INVALID, "%s: max atlas size %d must be in [64, 32768]", path, o->max_atlas_size);
     return LM_OK;
@@ -87,6 +89,12 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     so.cone_deg = o->surface_cone_deg;
     so.strict = o->strict;
     st = lm_surfaces_build(sc->scene, &so, &sc->surfaces, err);
+    int target = o->target_texels > 0 ? o->target_texels : LM_ATLAS_DEFAULT_TEXELS;
+    if (st == LM_OK && o->texel_size <= 0.0f && !o->use_file_uv1 &&
+        (so.min_surface_area = lm_surface_area_for_budget(&sc->surfaces, target)) > 0.0f) {
+        lm_surfaces_free(&sc->surfaces); /* the small surfaces merged, so that the budget can be met */
+        st = lm_surfaces_build(sc->scene, &so, &sc->surfaces, err);
+    }
     if (st != LM_OK)
         return st;
     sc->have_surfaces = 1;
@@ -95,7 +103,8 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     lm_atlas_options ao;
     lm_atlas_options_default(&ao);
     ao.texel_size = o->texel_size;
-    ao.target_texels = o->target_texels;
+    ao.target_texels = target;
+    ao.wall_texels = o->texel_size <= 0.0f ? o->wall_texels : 0;
     ao.gutter = o->gutter;
     ao.use_file_uv1 = o->use_file_uv1;
     ao.max_size = o->max_atlas_size;

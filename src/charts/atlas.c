@@ -14,9 +14,10 @@ void lm_atlas_options_default(lm_atlas_options *o)
 {
     o->texel_size = 0.0f;
     o->target_texels = LM_ATLAS_DEFAULT_TEXELS;
-    o->gutter = 2;
+    o->gutter = 0;
     o->use_file_uv1 = 0;
     o->max_size = 8192;
+    o->wall_texels = 0;
 }
 
 float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su, int target)
@@ -105,6 +106,8 @@ static lm_status check_options(const lm_scene *s, const lm_surfaces *su, const l
     if (o->target_texels < 0)
         return lm_fail(err, LM_ERR_INVALID, "charts: target_texels %d must be >= 0 (0: %d)", o->target_texels,
                        LM_ATLAS_DEFAULT_TEXELS);
+    if (o->wall_texels < 0 || o->wall_texels > 65536)
+        return lm_fail(err, LM_ERR_INVALID, "charts: wall_texels %d must be in [0, 65536]", o->wall_texels);
     if (o->max_size < 4 * (o->gutter + 1) || o->max_size > 65536)
         return lm_fail(err, LM_ERR_INVALID, "charts: max_size %d must be in [%d, 65536]", o->max_size,
                        4 * (o->gutter + 1));
@@ -164,17 +167,103 @@ static lm_status plan_memory(const lm_atlas *a, lm_error *err)
 #define LM_BUDGET_WARN 0.15
 #define LM_BUDGET_PASSES 6
 
-/* The charts packed at texel size ts, their triangles copied and their texels made, into out. */
-static lm_status lay_out(const lm_scene *s, const lmc_charts *c, const float *pos, float ts,
-                         const lm_atlas_options *o, lm_atlas *out, lm_error *err)
+/* A chart extent that takes one texel at texel size ts (as lmc_pack rounds). */
+static int one_texel(const lmc_chart *ch, float ts)
 {
-    lm_status st = lmc_pack(c, ts, o->gutter, o->max_size, out, err);
+    return lmc_chart_texels(ch, 0, ts) + 0.01 < 1.0 && lmc_chart_texels(ch, 1, ts) + 0.01 < 1.0;
+}
+
+/* A surface's texel size over the atlas's ts: 1, or less where a wall-sized surface would get fewer than
+ * wall_texels texels (lm_atlas_options.wall_texels). */
+static double texel_scale(const lm_surface *f, float ts, int wall_texels)
+{
+    if (wall_texels <= 0 || !(f->area >= LM_WALL_AREA))
+        return 1.0;
+    double own = sqrt((double)f->area / wall_texels);
+    return own < ts ? own / ts : 1.0;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* Frees what collapse_small made (its tri_uv is c's). */
+static void free_view(lmc_charts *v)
+{
+    for (int i = 0; v->charts && i < v->count; i++)
+        free(v->charts[i].tris);
+    free(v->charts);
+    memset(v, 0, sizeof *v);
+}
+
+/* The charts of c at texel size ts, each surface whose charts would all take one texel made one chart:
+ * a small object unwrapped into several charts (a sphere's caps and sides) needs no more than one texel
+ * when it is smaller than one, and a level of thousands of them could otherwise never meet a small
+ * budget. The one chart's triangles overlap inside its texel, which then holds their summed area. */
+static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, float ts, int wall_texels,
+                                lmc_charts *v, lm_error *err)
+{
+    memset(v, 0, sizeof *v);
+    v->tri_uv = c->tri_uv;
+    v->charts = calloc((size_t)c->count + 1, sizeof *v->charts);
+    if (!v->charts)
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    for (int i = 0, end; i < c->count; i = end) {
+        int small = 1;
+        uint32_t tris = 0;
+        double scale = texel_scale(&su->surfaces[c->charts[i].surface], ts, wall_texels);
+        for (end = i; end < c->count && c->charts[end].surface == c->charts[i].surface; end++) {
+            lmc_chart probe = c->charts[end];
+            probe.texel_scale = scale;
+            small &= one_texel(&probe, ts);
+            tris += c->charts[end].tri_count;
+        }
+        for (int k = i; k < end; k += small ? end - i : 1) {
+            lmc_chart *d = &v->charts[v->count++];
+            *d = c->charts[k];
+            d->texel_scale = scale;
+            d->tri_count = small ? tris : c->charts[k].tri_count;
+            d->tris = malloc(((size_t)d->tri_count + 1) * sizeof *d->tris);
+            if (!d->tris) {
+                free_view(v);
+                return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+            }
+            uint32_t n = 0;
+            for (int m = k; m < (small ? end : k + 1); m++) {
+                memcpy(d->tris + n, c->charts[m].tris, (size_t)c->charts[m].tri_count * sizeof *d->tris);
+                n += c->charts[m].tri_count;
+                d->ext[0] = fmax(d->ext[0], c->charts[m].ext[0]);
+                d->ext[1] = fmax(d->ext[1], c->charts[m].ext[1]);
+            }
+            if (small)
+                qsort(d->tris, n, sizeof *d->tris, cmp_u32);
+        }
+    }
+    return LM_OK;
+}
+
+/* The charts packed at texel size ts, their triangles copied and their texels made, into out. */
+static lm_status lay_out(const lm_scene *s, const lm_surfaces *su, const lmc_charts *all, const float *pos,
+                         float ts, const lm_atlas_options *o, lm_atlas *out, double *budgeted, lm_error *err)
+{
+    lmc_charts c;
+    lm_status st = collapse_small(all, su, ts, o->wall_texels, &c, err);
+    if (st != LM_OK)
+        return st;
+    st = lmc_pack(&c, ts, o->gutter, o->max_size, out, err);
     if (st == LM_OK)
         st = plan_memory(out, err);
     if (st == LM_OK)
-        st = copy_chart_tris(c, out, err);
+        st = copy_chart_tris(&c, out, err);
     if (st == LM_OK)
-        st = lmc_texels(s, c, pos, out, err);
+        st = lmc_texels(s, &c, pos, out, err);
+    /* what counts against the budget: the walls' extra texels come on top of it */
+    *budgeted = out->texel_count;
+    for (uint32_t i = 0; st == LM_OK && i < out->texel_count; i++)
+        *budgeted -= c.charts[out->tri_chart[out->texels[i].tri]].texel_scale < 1.0;
+    free_view(&c);
     return st;
 }
 
@@ -199,22 +288,23 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     st = o->use_file_uv1 ? lmc_charts_from_uv1(s, su, pos, &c, err) : lmc_unwrap(s, su, pos, &c, err);
     double t1 = lm_now(), t2 = t1;
     if (st == LM_OK) {
-        st = lay_out(s, &c, pos, ts, o, out, err);
+        double count = 0.0;
+        st = lay_out(s, su, &c, pos, ts, o, out, &count, err);
         t2 = lm_now();
         /* A texel budget is met by the texel size, but charts round up to whole texels: a level of many small
          * charts got 10x the texels it asked for (scenes/many_rooms.glb at 2,000). The texel size is scaled
          * by the square root of what came over what was asked; a budget below what the charts need at their
          * smallest stays over it (warned). */
         double target = o->target_texels > 0 ? o->target_texels : LM_ATLAS_DEFAULT_TEXELS;
-        double ratio = out->texel_count / target, best = fabs(ratio - 1.0);
+        double ratio = count / target, best = fabs(ratio - 1.0);
         float best_ts = ts, last_ts = ts;
         for (int pass = 0; st == LM_OK && o->texel_size <= 0.0f && pass < LM_BUDGET_PASSES &&
                            best > (pass ? LM_BUDGET_SLACK : LM_BUDGET_WARN);
              pass++) {
             last_ts = best_ts * (float)sqrt(ratio);
             lm_atlas_free(out);
-            st = lay_out(s, &c, pos, last_ts, o, out, err);
-            double r = out->texel_count / target;
+            st = lay_out(s, su, &c, pos, last_ts, o, out, &count, err);
+            double r = count / target;
             lm_debug("charts: texel size %g: %u texels (budget %.0f)", (double)last_ts, out->texel_count, target);
             /* kept only if nearer, and if the count answered the texel size at least a quarter as much as the
              * area says (1 / ratio): charts already at their fewest texels would otherwise take texels of
@@ -225,11 +315,11 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
         }
         if (st == LM_OK && last_ts != best_ts) {
             lm_atlas_free(out);
-            st = lay_out(s, &c, pos, best_ts, o, out, err);
+            st = lay_out(s, su, &c, pos, best_ts, o, out, &count, err);
         }
-        if (st == LM_OK && o->texel_size <= 0.0f && best > LM_BUDGET_WARN)
-            lm_warn("%s: %d charts need %u texels at the least; the budget of %.0f texels cannot be met "
-                    "(docs/levels.md, \"Atlas\")", s->path, c.count, out->texel_count, target);
+        if (st == LM_OK && o->texel_size <= 0.0f && best > LM_BUDGET_WARN && c.count > 0)
+            lm_warn("%s: %d charts need %.0f texels at the least; the budget of %.0f texels cannot be met "
+                    "(docs/levels.md, \"Atlas\")", s->path, c.count, count, target);
         lmc_charts_free(&c);
     }
     free(pos);
@@ -256,6 +346,8 @@ void lm_atlas_free(lm_atlas *a)
         free(a->charts[i].tris);
     free(a->charts);
     free(a->corner_uv);
+    free(a->coverage_uv);
+    free(a->chart_owner);
     free(a->tri_chart);
     free(a->texels);
     free(a->texel_index);

@@ -27,7 +27,13 @@ void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
                 for (int dy = -1; dy <= 1; dy++)
                     for (int dx = -1; dx <= 1; dx++) {
                         int xx = x + dx, yy = y + dy;
-                        if (xx < 0 || yy < 0 || xx >= w || yy >= h || !filled[(size_t)yy * w + xx])
+                        if (xx < 0 || yy < 0 || xx >= w || yy >= h)
+                            continue;
+                        size_t j = (size_t)yy * w + xx;
+                        if (!filled[j])
+                            continue;
+                        /* inside a chart's rect only from the same chart: rects touch (no gutter) */
+                        if (a->chart_owner && a->chart_owner[i] >= 0 && a->chart_owner[j] != a->chart_owner[i])
                             continue;
                         for (int c = 0; c < channels && c < 4; c++)
                             sum[c] += data[((size_t)yy * w + xx) * channels + c];
@@ -47,7 +53,7 @@ void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
 
 void lm_atlas_dilate_gutters(const lm_atlas *a, float *data, int channels)
 {
-    lm_atlas_dilate(a, data, channels, a->gutter > 1 ? a->gutter : 1);
+    lm_atlas_dilate(a, data, channels, a->gutter > 2 ? a->gutter : 2);
 }
 
 void lm_atlas_dilated_rgba(const lm_atlas *a, const float *rgb, float *rgba)

@@ -6,7 +6,7 @@
  * (tri_surface = -1) and no lightmap texels.
  *
  * Each surface is unwrapped into one or more charts (planar projection, split where the projection
- * would fold or overlap); charts are packed into one atlas with gutters. The texel table lists every
+ * would fold or overlap); charts are packed into one atlas. The texel table lists every
  * covered texel with its world position, normal, surface, triangle and world-space area. */
 #ifndef LM_CHARTS_H
 #define LM_CHARTS_H
@@ -19,6 +19,8 @@
 typedef struct {
     float cone_deg;        /* max angle between a triangle's normal and its surface's seed normal (default 30) */
     float min_fragment_area; /* surfaces smaller than this fraction of the node's area are merged (default 1e-3) */
+    float min_surface_area; /* and those smaller than this world area (default 0; a texel's area at a budget too
+                             * small for one texel per surface, lm_surface_area_for_budget) */
     int strict;            /* non-manifold edges and degenerate triangles are errors */
 } lm_surface_options;
 
@@ -46,6 +48,11 @@ typedef struct {
 void lm_surface_options_default(lm_surface_options *o);
 lm_status lm_surfaces_build(const lm_scene *s, const lm_surface_options *o, lm_surfaces *out, lm_error *err);
 void lm_surfaces_free(lm_surfaces *su);
+/* The min_surface_area a texel budget needs: 0 when the surfaces (after the fragment merge) are few
+ * enough for one texel each, otherwise the area of one texel at the budget's texel size. A surface takes
+ * at least one texel, and a level of thousands of small ones (a sphere's 30-degree facets, a chair's
+ * bevels) could never meet a small budget. */
+float lm_surface_area_for_budget(const lm_surfaces *su, int target_texels);
 
 /* Texels the derived texel size aims at for the whole scene unless told otherwise. */
 #define LM_ATLAS_DEFAULT_TEXELS 65536
@@ -54,14 +61,23 @@ typedef struct {
     float texel_size;      /* world units per texel; <= 0 derives it from the scene (lm_atlas_default_texel_size) */
     int target_texels;     /* with texel_size <= 0: the texels the derived size aims at (default and 0:
                             * LM_ATLAS_DEFAULT_TEXELS) */
-    int gutter;            /* minimum empty texels between two charts (default 2) */
+    int gutter;            /* empty texels between two charts (default 0: corner_uv keeps bilinear lookups
+                            * inside each chart; more for engines that mipmap the lightmap) */
     int use_file_uv1;      /* take charts from the file's TEXCOORD_1 instead of unwrapping */
     int max_size;          /* largest atlas side allowed (default 8192); texel_size grows to fit */
+    int wall_texels;       /* each surface of at least LM_WALL_AREA gets about this many texels at least: its
+                            * charts a finer texel size than the atlas's where needed, those texels on top
+                            * of target_texels (default 0: off) */
 } lm_atlas_options;
+
+/* A wall's or floor's area in world units: 2 m^2 in glTF's metres (a door's area). */
+#define LM_WALL_AREA 2.0f
 
 typedef struct {
     int surface;
     int x, y, w, h;        /* rectangle in the atlas, texels, gutters excluded */
+    int pad;               /* texels of border of its own around it (0 or 1): what its lookups reach beyond
+                            * the rect (corner_uv) */
     uint32_t tri_count;
     uint32_t *tris;
 } lm_chart;
@@ -83,8 +99,16 @@ typedef struct {
     int gutter;
     int chart_count;
     lm_chart *charts;
-    float *corner_uv;      /* lightmap UV per triangle corner, 6 floats per scene triangle, in [0,1]
-                              (texel (x, y) spans [x, x+1]/width); NaN for triangles with no surface */
+    float *corner_uv;      /* lightmap UV per triangle corner, 6 floats per scene triangle, in [0,1], for
+                              sampling: a bilinear lookup inside a triangle reads only its chart's rect and
+                              border (the chart's extent lies between its rect's first and last texel
+                              centres, or reaches at most half a texel into its border), so charts need no
+                              gutter; NaN for triangles with no surface */
+    float *coverage_uv;    /* the corners as the texel table was made (texel (x, y) is the square
+                              [x, x+1]/width): which texel a point of a triangle lies in; corner_uv but for
+                              charts of one texel (all of whose corners are that texel's centre) */
+    int *chart_owner;      /* width*height: the chart whose rect or border holds the texel, -1 in gutters
+                              and free space */
     int *tri_chart;        /* chart per triangle, -1 if none */
     uint32_t texel_count;
     lm_texel *texels;

@@ -27,17 +27,23 @@ static int cmp_rect(const void *a, const void *b)
 
 static int round4(double v) { return 4 * (int)ceil(v / 4.0); }
 
-/* Texels a chart extent needs: its covered texels stay strictly inside (see lmc_chart_offset). */
-static int texels_for(double ext, float texel_size)
+/* Texels a chart extent of t texels needs, and the border of its own (*pad) it keeps around them. One
+ * texel below a texel (all of it shown as that texel). Below LMC_PAD_MIN, enough that the extent, centred
+ * (lmc_chart_offset), lies between the first and last texel centres, where a bilinear lookup reads
+ * nothing outside the rect: no border. A wider chart keeps the texels its extent covers and a border of
+ * one texel, which its lookups reach and its own light fills (lm_atlas_dilate): the texel more would
+ * place its texels half a texel apart from where they sit at every other size. */
+static int texels_for(double t, int *pad)
 {
-    double t = ext / (double)texel_size;
-    return (int)floor(t + 0.01) + 1;
+    int covered = (int)floor(t + 0.01) + 1;
+    *pad = t + 0.01 >= 1.0 && covered >= LMC_PAD_MIN;
+    return t + 0.01 < 1.0 ? 1 : *pad ? covered : (int)ceil(t - 1e-6) + 1;
 }
 
 void lmc_chart_offset(const lmc_chart *c, const lm_chart *r, float texel_size, double off[2])
 {
-    off[0] = 0.5 * ((double)r->w - c->ext[0] / (double)texel_size);
-    off[1] = 0.5 * ((double)r->h - c->ext[1] / (double)texel_size);
+    off[0] = 0.5 * ((double)r->w - lmc_chart_texels(c, 0, texel_size));
+    off[1] = 0.5 * ((double)r->h - lmc_chart_texels(c, 1, texel_size));
 }
 
 /* Shelf-packs the sorted rects into width W (gutter g around every rect and the border); returns the
@@ -51,8 +57,8 @@ static long shelf_pack(const rect_key *k, int n, int W, int g, lm_chart *ch)
             x = g;
             shelf = 0;
         }
-        ch[k[i].id].x = (int)x;
-        ch[k[i].id].y = (int)y;
+        ch[k[i].id].x = (int)x + ch[k[i].id].pad; /* the rect inside its border */
+        ch[k[i].id].y = (int)y + ch[k[i].id].pad;
         x += k[i].w + g;
         if (k[i].h > shelf)
             shelf = k[i].h;
@@ -66,14 +72,16 @@ static double try_pack(const lmc_charts *c, rect_key *k, float ts, int g, int ma
     double area = 0.0, widest = 0.0;
     for (int i = 0; i < c->count; i++) {
         lm_chart *r = &out->charts[i];
-        double ew = c->charts[i].ext[0] / (double)ts, eh = c->charts[i].ext[1] / (double)ts;
+        double ew = lmc_chart_texels(&c->charts[i], 0, ts), eh = lmc_chart_texels(&c->charts[i], 1, ts);
         if (!(ew < max_size && eh < max_size))
             return fmax(ew, eh) + 2.0 * g + 1.0;
-        r->w = texels_for(c->charts[i].ext[0], ts);
-        r->h = texels_for(c->charts[i].ext[1], ts);
-        k[i] = (rect_key){r->w, r->h, i};
-        area += (double)(r->w + g) * (double)(r->h + g);
-        widest = fmax(widest, r->w);
+        int px, py;
+        r->w = texels_for(ew, &px);
+        r->h = texels_for(eh, &py);
+        r->pad = px | py;
+        k[i] = (rect_key){r->w + 2 * r->pad, r->h + 2 * r->pad, i};
+        area += (double)(k[i].w + g) * (double)(k[i].h + g);
+        widest = fmax(widest, k[i].w);
     }
     qsort(k, (size_t)c->count, sizeof *k, cmp_rect);
     /* A few widths around the square root of the area; the smallest atlas that fits wins. */
@@ -81,7 +89,7 @@ static double try_pack(const lmc_charts *c, rect_key *k, float ts, int g, int ma
     int best_w = 0, best_h = 0;
     double need = DBL_MAX;
     for (size_t i = 0; i < sizeof slack / sizeof *slack; i++) {
-        int W = round4(fmax(sqrt(area) * slack[i] + g, widest + 2.0 * g));
+        int W = round4(fmax(fmax(sqrt(area) * slack[i] + g, widest + 2.0 * g), 4.0)); /* 4: no charts at all */
         int H = round4((double)shelf_pack(k, c->count, W, g, out->charts));
         if (W <= max_size && H <= max_size) {
             if (!best_w || (double)W * H < (double)best_w * best_h) {

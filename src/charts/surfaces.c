@@ -41,6 +41,7 @@ void lm_surface_options_default(lm_surface_options *o)
 {
     o->cone_deg = 30.0f;
     o->min_fragment_area = 1e-3f;
+    o->min_surface_area = 0.0f;
     o->strict = 0;
 }
 
@@ -323,7 +324,7 @@ static int uf_find(int *parent, int r)
 static int fragment_kind(const seg_ctx *c, int r, int tri_count, uint32_t node)
 {
     double limit = (double)c->o->min_fragment_area * c->node_area[node];
-    if (c->r_area[r] < limit)
+    if (c->r_area[r] < limit || c->r_area[r] < (double)c->o->min_surface_area)
         return 1;
     return tri_count <= FEW_TRIS && c->r_area[r] < FEW_TRIS_AREA_FACTOR * limit ? 2 : 0;
 }
@@ -372,6 +373,101 @@ static int cmp_frag(const void *a, const void *b)
     return (x->r > y->r) - (x->r < y->r);
 }
 
+typedef struct {
+    uint32_t node, material, morton;
+    int root;
+} scatter_key;
+
+static int cmp_scatter(const void *a, const void *b)
+{
+    const scatter_key *x = a, *y = b;
+    if (x->node != y->node)
+        return x->node < y->node ? -1 : 1;
+    if (x->material != y->material)
+        return x->material < y->material ? -1 : 1;
+    if (x->morton != y->morton)
+        return x->morton < y->morton ? -1 : 1;
+    return (x->root > y->root) - (x->root < y->root);
+}
+
+/* Bits of v (10 used) spread to every third bit. */
+static uint32_t spread3(uint32_t v)
+{
+    v &= 0x3ff;
+    v = (v | (v << 16)) & 0x030000ff;
+    v = (v | (v << 8)) & 0x0300f00f;
+    v = (v | (v << 4)) & 0x030c30c3;
+    return (v | (v << 2)) & 0x09249249;
+}
+
+static void unite(seg_ctx *c, int *parent, int from, int to)
+{
+    parent[from] = to;
+    c->r_area[to] += c->r_area[from];
+    for (int k = 0; k < 3; k++)
+        c->r_sum[3 * to + k] += c->r_sum[3 * from + k];
+}
+
+/* Regions still below min_surface_area after the merge across edges have no neighbour of their node and
+ * material (a table's separate legs, a bookshelf's books): they are merged with the nearby ones of the
+ * same node and material, walking them in Morton order of their centroids, until each group reaches the
+ * area. Such a surface is no longer connected; its charts are still split by connectivity. */
+static lm_status merge_scattered(seg_ctx *c, int *parent, lm_error *err)
+{
+    int n = c->region_count, m = 0;
+    double *cen = calloc(3 * (size_t)n + 1, sizeof *cen), lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    scatter_key *k = malloc((size_t)n * sizeof *k + 1);
+    if (!cen || !k) {
+        free(cen);
+        free(k);
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    }
+    for (int r = 0; r < n; r++) /* area-weighted centroids, per root */
+        for (int i = c->r_first[r], root = uf_find(parent, r); i < c->r_first[r + 1]; i++) {
+            const uint32_t *v = c->s->tris + 3 * (size_t)c->r_tris[i];
+            for (int a = 0; a < 3; a++)
+                cen[3 * root + a] += c->area[c->r_tris[i]] / 3.0 *
+                                     ((double)c->pos[3 * v[0] + a] + c->pos[3 * v[1] + a] + c->pos[3 * v[2] + a]);
+        }
+    for (int r = 0; r < n; r++) {
+        if (uf_find(parent, r) != r || !(c->r_area[r] < (double)c->o->min_surface_area) || !(c->r_area[r] > 0.0))
+            continue;
+        uint32_t t = (uint32_t)c->r_tris[c->r_first[r]];
+        k[m++] = (scatter_key){c->s->tri_node[t], c->s->tri_material[t], 0, r};
+        for (int a = 0; a < 3; a++) {
+            cen[3 * r + a] /= c->r_area[r];
+            lo[a] = fmin(lo[a], cen[3 * r + a]);
+            hi[a] = fmax(hi[a], cen[3 * r + a]);
+        }
+    }
+    for (int i = 0; i < m; i++) {
+        uint32_t code = 0;
+        for (int a = 0; a < 3; a++) {
+            double f = hi[a] > lo[a] ? (cen[3 * k[i].root + a] - lo[a]) / (hi[a] - lo[a]) : 0.0;
+            code |= spread3((uint32_t)fmin(fmax(f * 1023.0, 0.0), 1023.0)) << a;
+        }
+        k[i].morton = code;
+    }
+    qsort(k, (size_t)m, sizeof *k, cmp_scatter);
+    for (int i = 0, cur = -1, done = -1; i < m; i++) {
+        int same = i > 0 && k[i].node == k[i - 1].node && k[i].material == k[i - 1].material;
+        if (!same)
+            cur = done = -1;
+        if (cur >= 0)
+            unite(c, parent, k[i].root, cur);
+        else
+            cur = k[i].root;
+        int last = i + 1 == m || k[i + 1].node != k[i].node || k[i + 1].material != k[i].material;
+        if (c->r_area[cur] >= (double)c->o->min_surface_area)
+            done = cur, cur = -1;
+        else if (last && done >= 0) /* the group's remainder joins its last full one */
+            unite(c, parent, cur, done);
+    }
+    free(cen);
+    free(k);
+    return LM_OK;
+}
+
 /* Merges fragments, smallest first, into the adjacent region with the most similar normal. */
 static lm_status merge_fragments(seg_ctx *c, lm_error *err)
 {
@@ -400,17 +496,15 @@ static lm_status merge_fragments(seg_ctx *c, lm_error *err)
         int to = best_neighbour(c, parent, r, root);
         if (to < 0 || (kind == 2 && mean_dot(c, root, to) < few_cos))
             continue;
-        parent[root] = to;
-        c->r_area[to] += c->r_area[root];
-        for (int k = 0; k < 3; k++)
-            c->r_sum[3 * to + k] += c->r_sum[3 * root + k];
+        unite(c, parent, root, to);
     }
+    lm_status st = c->o->min_surface_area > 0.0f ? merge_scattered(c, parent, err) : LM_OK;
     for (uint32_t t = 0; t < c->s->tri_count; t++)
         if (c->label[t] >= 0)
             c->label[t] = uf_find(parent, c->label[t]);
     free(parent);
     free(frag);
-    return LM_OK;
+    return st;
 }
 
 /* Numbers the merged regions by their first triangle and fills the surface array. */
@@ -519,9 +613,11 @@ lm_status lm_surfaces_build(const lm_scene *s, const lm_surface_options *o, lm_s
     lm_status st = lmc_check_scene(s, err);
     if (st != LM_OK)
         return st;
-    if (!(o->cone_deg > 0.0f && o->cone_deg <= 180.0f) || !(o->min_fragment_area >= 0.0f))
-        return lm_fail(err, LM_ERR_INVALID, "charts: cone_deg %g must be in (0, 180] and min_fragment_area %g >= 0",
-                       (double)o->cone_deg, (double)o->min_fragment_area);
+    if (!(o->cone_deg > 0.0f && o->cone_deg <= 180.0f) || !(o->min_fragment_area >= 0.0f) ||
+        !(o->min_surface_area >= 0.0f) || !isfinite(o->min_surface_area))
+        return lm_fail(err, LM_ERR_INVALID,
+                       "charts: cone_deg %g must be in (0, 180], min_fragment_area %g and min_surface_area %g >= 0",
+                       (double)o->cone_deg, (double)o->min_fragment_area, (double)o->min_surface_area);
     seg_ctx c = {.s = s, .o = o};
     st = alloc_ctx(&c, err);
     if (st == LM_OK)
@@ -559,4 +655,15 @@ void lm_surfaces_free(lm_surfaces *su)
     free(su->vertex_weld);
     free(su->tri_adj);
     memset(su, 0, sizeof *su);
+}
+
+float lm_surface_area_for_budget(const lm_surfaces *su, int target_texels)
+{
+    double target = target_texels > 0 ? target_texels : LM_ATLAS_DEFAULT_TEXELS, area = 0.0;
+    for (int i = 0; i < su->surface_count; i++)
+        area += su->surfaces[i].area;
+    /* a surface's charts round up to whole texels: past half the budget in surfaces, their count rules */
+    if (su->surface_count <= 0.5 * target || !(area > 0.0) || !isfinite(area))
+        return 0.0f;
+    return (float)(area / target);
 }

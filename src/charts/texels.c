@@ -79,7 +79,8 @@ static double chart_corners(const texel_job *j, int ci, uint32_t t, pt out[3], i
 {
     double off[2];
     lmc_chart_offset(&j->c->charts[ci], &j->a->charts[ci], j->a->texel_size, off);
-    const double *uv = j->c->tri_uv + 6 * (size_t)t, inv = 1.0 / (double)j->a->texel_size;
+    const double *uv = j->c->tri_uv + 6 * (size_t)t;
+    double inv = 1.0 / ((double)j->a->texel_size * j->c->charts[ci].texel_scale);
     for (int k = 0; k < 3; k++)
         out[k] = (pt){off[0] + uv[2 * k] * inv, off[1] + uv[2 * k + 1] * inv};
     double sa = 0.5 * ((out[1].x - out[0].x) * (out[2].y - out[0].y) - (out[2].x - out[0].x) * (out[1].y - out[0].y));
@@ -163,6 +164,13 @@ static void texel_point(const texel_job *j, int ci, uint32_t t, double px, doubl
     }
 }
 
+/* Chart-local coordinate q as a bilinear lookup takes it: itself (lmc_pack sized the rect so that lookups
+ * stay in it and its border), or the centre of a chart of one texel. */
+static double lookup_coord(double q, int w)
+{
+    return w <= 1 ? 0.5 : q;
+}
+
 /* Fills this chart's corner UVs and returns its texels (row-major), or NULL when memory ran out. */
 static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
 {
@@ -179,8 +187,11 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
         int ord[3];
         double uv_area = chart_corners(j, ci, t, c, ord), n[3], world = lmc_tri_area(j->s, j->pos, t, n);
         for (int k = 0; k < 3; k++) {
-            j->a->corner_uv[6 * (size_t)t + 2 * ord[k]] = (float)((r->x + c[k].x) / j->a->width);
-            j->a->corner_uv[6 * (size_t)t + 2 * ord[k] + 1] = (float)((r->y + c[k].y) / j->a->height);
+            float *cov = j->a->coverage_uv + 6 * (size_t)t + 2 * ord[k], *uv = j->a->corner_uv + 6 * (size_t)t + 2 * ord[k];
+            cov[0] = (float)((r->x + c[k].x) / j->a->width);
+            cov[1] = (float)((r->y + c[k].y) / j->a->height);
+            uv[0] = (float)((r->x + lookup_coord(c[k].x, r->w)) / j->a->width);
+            uv[1] = (float)((r->y + lookup_coord(c[k].y, r->h)) / j->a->height);
         }
         j->a->tri_chart[t] = ci;
         accumulate(acc, r, t, c, uv_area > 0.0 ? world / uv_area : 0.0, world);
@@ -232,22 +243,31 @@ lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, l
 {
     size_t np = (size_t)a->width * a->height;
     a->corner_uv = malloc(6 * (size_t)s->tri_count * sizeof *a->corner_uv + 1);
+    a->coverage_uv = malloc(6 * (size_t)s->tri_count * sizeof *a->coverage_uv + 1);
+    a->chart_owner = malloc(np * sizeof *a->chart_owner + 1);
     a->tri_chart = malloc((size_t)s->tri_count * sizeof *a->tri_chart + 1);
     a->texel_index = malloc(np * sizeof *a->texel_index + 1);
     lm_texel **per = calloc((size_t)a->chart_count + 1, sizeof *per);
     uint32_t *count = calloc((size_t)a->chart_count + 1, sizeof *count);
     float *nrm = lmc_world_normals(s);
     lm_status st = LM_OK;
-    if (!a->corner_uv || !a->tri_chart || !a->texel_index || !per || !count || !nrm) {
+    if (!a->corner_uv || !a->coverage_uv || !a->chart_owner || !a->tri_chart || !a->texel_index || !per || !count ||
+        !nrm) {
         st = lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for the texel table");
         goto done;
     }
     for (size_t i = 0; i < 6 * (size_t)s->tri_count; i++)
-        a->corner_uv[i] = NAN;
+        a->corner_uv[i] = a->coverage_uv[i] = NAN;
     for (uint32_t t = 0; t < s->tri_count; t++)
         a->tri_chart[t] = -1;
     for (size_t i = 0; i < np; i++)
-        a->texel_index[i] = -1;
+        a->texel_index[i] = a->chart_owner[i] = -1;
+    for (int i = 0; i < a->chart_count; i++) {
+        const lm_chart *r = &a->charts[i];
+        for (int y = r->y - r->pad; y < r->y + r->h + r->pad; y++)
+            for (int x = r->x - r->pad; x < r->x + r->w + r->pad; x++)
+                a->chart_owner[(size_t)y * a->width + x] = i;
+    }
     texel_job j = {s, c, pos, nrm, a};
     int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
@@ -268,7 +288,7 @@ done:
 int lm_texel_parts(const lm_scene *s, const lm_atlas *a, const lm_texel *t, int k, float local[][3], float share[])
 {
     pt c[3];
-    const float *uv = a->corner_uv + 6 * (size_t)t->tri;
+    const float *uv = a->coverage_uv + 6 * (size_t)t->tri;
     for (int i = 0; i < 3; i++)
         c[i] = (pt){(double)uv[2 * i] * a->width, (double)uv[2 * i + 1] * a->height};
     int order[3] = {0, 1, 2};

@@ -242,7 +242,7 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
         else if (!strcmp(o, "--texels"))
             rc = parse_int(o, v, 16, 1 << 28, &a->options.target_texels);
         else if (!strcmp(o, "--gutter"))
-            rc = parse_int(o, v, 1, 64, &a->options.gutter);
+            rc = parse_int(o, v, 0, 64, &a->options.gutter);
         else if (!strcmp(o, "--cone"))
             rc = parse_float(o, v, 0.0f, &a->options.surface_cone_deg);
         else if (!strcmp(o, "--max-atlas"))

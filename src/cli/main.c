@@ -65,7 +65,7 @@ static void usage(FILE *f)
             "  --texel-size S   world units per lightmap texel (default: from --texels)\n"
             "  --texels N       texels the derived texel size aims at (default 65536; 'run': 90 x\n"
             "                   --texels-per-frame, so that its IIM is refreshed in full every 3 s)\n"
-            "  --gutter N       empty texels between charts (default 2)\n"
+            "  --gutter N       empty texels between charts (default 0)\n"
             "  --use-uv1        use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping\n"
             "  --cone DEG       max normal deviation inside one surface (default 30)\n"
             "  --max-atlas N    largest atlas side; the texel size grows to fit (default 8192)\n"

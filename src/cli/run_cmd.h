@@ -6,6 +6,8 @@ int lm_cli_run(const lm_cli_args *a);
 
 #include <lmgi.h>
 #define LM_CLI_FRAME_SIZE 512 /* lmgi run's frame side when not given --size */
+/* Texels each wall or floor gets at least at run's density (lmgi_options.wall_texels) */
+#define LM_CLI_RUN_WALL_TEXELS 16
 /* The updater's desc from the command line (0, the defaults, where not given). */
 void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d);
 /* Loads a->files[0] as 'run' does: at the lightmap density its texel budget keeps up with unless told a

@@ -238,7 +238,7 @@ static void write_triangle(const float p[3][3], const float *uv[3], const lm_mat
     }
 }
 
-/* Chart c's texels as a UV rectangle (what sub-samples stay inside); -1s when c < 0. */
+/* Chart c's texel centres as a UV rectangle (what sub-samples stay inside); -1s when c < 0. */
 static void chart_rect(const lm_atlas *a, int c, float rect[4])
 {
     if (c < 0) {
@@ -246,8 +246,10 @@ static void chart_rect(const lm_atlas *a, int c, float rect[4])
         return;
     }
     const lm_chart *ch = &a->charts[c];
-    rect[0] = (float)ch->x / (float)a->width, rect[1] = (float)ch->y / (float)a->height;
-    rect[2] = (float)(ch->x + ch->w) / (float)a->width, rect[3] = (float)(ch->y + ch->h) / (float)a->height;
+    /* as far as corner_uv's lookups reach: charts touch (no gutter) */
+    float in = 0.5f - (float)ch->pad;
+    rect[0] = (ch->x + in) / (float)a->width, rect[1] = (ch->y + in) / (float)a->height;
+    rect[2] = (ch->x + ch->w - in) / (float)a->width, rect[3] = (ch->y + ch->h - in) / (float)a->height;
 }
 
 static void scene_triangle(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t t, float *o)

@@ -128,7 +128,7 @@ static int land_texel(const pass *p, const lm_caustic_hit *h, deposit *d)
         return 0;
     float b[3];
     barycentrics(q, lm_v3_load(h->pos), b);
-    const float *uv = a->corner_uv + 6 * (size_t)h->tri;
+    const float *uv = a->coverage_uv + 6 * (size_t)h->tri; /* the texel the point lies in */
     float fx = (b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4]) * (float)a->width;
     float fy = (b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5]) * (float)a->height;
     if (!(fx >= 0.0f && fx < (float)a->width && fy >= 0.0f && fy < (float)a->height))
