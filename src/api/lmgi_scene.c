@@ -92,6 +92,8 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     int target = o->target_texels > 0 ? o->target_texels : LM_ATLAS_DEFAULT_TEXELS;
     if (st == LM_OK && o->texel_size <= 0.0f && !o->use_file_uv1 &&
         (so.min_surface_area = lm_surface_area_for_budget(&sc->surfaces, target)) > 0.0f) {
+        if (o->wall_texels > 0) /* walls keep their own texels (lm_atlas_options.wall_texels) */
+            so.min_surface_area = fminf(so.min_surface_area, LM_WALL_AREA);
         lm_surfaces_free(&sc->surfaces); /* the small surfaces merged, so that the budget can be met */
         st = lm_surfaces_build(sc->scene, &so, &sc->surfaces, err);
     }

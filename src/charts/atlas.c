@@ -217,7 +217,7 @@ static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, floa
         for (end = i; end < c->count && c->charts[end].surface == c->charts[i].surface; end++) {
             lmc_chart probe = c->charts[end];
             probe.texel_scale = scale;
-            small &= one_texel(&probe, ts);
+            small &= one_texel(&probe, ts) && scale == 1.0; /* a wall keeps its texels */
             tris += c->charts[end].tri_count;
         }
         for (int k = i; k < end; k += small ? end - i : 1) {
