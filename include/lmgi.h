@@ -344,7 +344,7 @@ LMGI_API void lmgi_get_texel(const lmgi_scene *scene, uint32_t i, lmgi_texel *ou
  * scene or uv is NULL). */
 LMGI_API int lmgi_triangle_lightmap_uv(const lmgi_scene *scene, uint32_t triangle, float uv[6]);
 
-/* Writes DIR/atlas.png (each chart its own colour, gutters black) and DIR/surfaces.png (the scene from
+/* Writes DIR/atlas.png (each chart its own colour, free space black) and DIR/surfaces.png (the scene from
  * its camera, or an automatic one, each surface in a flat colour) at width x height (0 = 1024x768).
  * NULL scene or dir: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_write_charts(const lmgi_scene *scene, const char *dir, int width, int height, lmgi_error *err);

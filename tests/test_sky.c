@@ -318,7 +318,7 @@ static void test_gradient_sky(void **state)
 }
 
 /* An equirectangular HDR image of the same gradient (64 x 32 pixels: each row's mean direction's height),
- * as Radiance .hdr from the file's extras with a scale of 2, and as OpenEXR through the API: the plane gets
+ * as Radiance .hdr from the file's extras (its URI percent-encoded) with a scale of 2, and as OpenEXR through the API: the plane gets
  * twice, then once, the gradient's E (within the image's rows' resolution). A PNG named .hdr, a negative
  * pixel, a missing file: refused, naming the file. */
 static void test_image_sky(void **state)
@@ -336,11 +336,12 @@ static void test_image_sky(void **state)
             for (int c = 0; c < 3; c++)
                 px[3 * (y * W + x) + c] = (float)(k_horizon[c] + (k_zenith[c] - k_horizon[c]) * up / band);
     }
-    const char *scene = plane_scene("image", "{\"image\": \"sky.hdr\", \"scale\": 2}", NULL);
+    /* percent-encoded, as exporters write URIs: "my sky.hdr" */
+    const char *scene = plane_scene("image", "{\"image\": \"my%20sky.hdr\", \"scale\": 2}", NULL);
     char dir[512], path[600];
     snprintf(dir, sizeof dir, "%s", scene);
     *strrchr(dir, '/') = '\0';
-    snprintf(path, sizeof path, "%s/sky.hdr", dir);
+    snprintf(path, sizeof path, "%s/my sky.hdr", dir);
     assert_true(stbi_write_hdr(path, W, H, 3, px) != 0);
     lmgi_scene *sc = lmt_load(scene, 4000);
     plane_against(sc, 2.0, 0.02, 0.02, 0.05);

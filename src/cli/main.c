@@ -23,7 +23,7 @@ static void usage(FILE *f)
             "commands:\n"
             "  info SCENE             counts, materials by class, lights, surfaces, charts, atlas, and which\n"
             "                         effects the scene calls for and why\n"
-            "  charts SCENE --out DIR write DIR/atlas.png (charts coloured, gutters black) and DIR/surfaces.png\n"
+            "  charts SCENE --out DIR write DIR/atlas.png (charts coloured, free space black) and DIR/surfaces.png\n"
             "                         (the scene from its camera, each surface a flat colour)\n"
             "  run SCENE --out DIR    the whole frame loop over the scene's animations (photons, AIMs, IIM\n"
             "                         gather, direct light, composite): DIR/frame_NNNN.png (every K-th also\n"

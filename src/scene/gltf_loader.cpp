@@ -406,7 +406,7 @@ lm_status Loader::check_extensions()
             ignored += (ignored.empty() ? "" : ", ") + e;
     }
     if (!ignored.empty())
-        lm_info("%s: ignoring optional extensions %s", path_, ignored.c_str());
+        lm_warn("%s: ignoring optional extensions %s (lmgi does not read them)", path_, ignored.c_str());
     return LM_OK;
 }
 
@@ -1050,6 +1050,24 @@ static bool radiance(const tinygltf::Value &v, float out[3])
 // radiance, {"sky": {"zenith": [r, g, b], "horizon": [r, g, b]}} a gradient, {"sky": {"image": URI,
 // "scale": k}} an equirectangular HDR image beside the scene (.hdr, .exr). A malformed one is an error: it is
 // light, and a scene lit wrongly is worse than one refused.
+// A URI's %XX escapes decoded, as glTF's URIs are (RFC 3986; tinygltf decodes those of images and
+// buffers itself, but keeps its decoder private). A malformed escape is kept as written.
+static std::string percent_decoded(const std::string &uri)
+{
+    std::string out;
+    for (size_t i = 0; i < uri.size(); i++) {
+        unsigned v;
+        if (uri[i] == '%' && i + 2 < uri.size() && isxdigit((unsigned char)uri[i + 1]) &&
+            isxdigit((unsigned char)uri[i + 2]) && sscanf(uri.c_str() + i + 1, "%2x", &v) == 1) {
+            out += char(v);
+            i += 2;
+        } else {
+            out += uri[i];
+        }
+    }
+    return out;
+}
+
 lm_status Loader::sky()
 {
     const tinygltf::Value &x = model_.extras;
@@ -1071,7 +1089,7 @@ lm_status Loader::sky()
             return fail(LM_ERR_INVALID, "extras.lmgi.sky.image: a scene from memory cannot name external files");
         double k = num(&v, "scale", 1.0);
         const float scale[3] = {float(k), float(k), float(k)};
-        std::string uri = v.Get("image").Get<std::string>();
+        std::string uri = percent_decoded(v.Get("image").Get<std::string>());
         std::string file = uri.size() && uri[0] == '/' ? uri : scene_dir() + "/" + uri;
         lm_error e;
         if (lm_sky_load_image(s_.get(), file.c_str(), scale, &e) != LM_OK)
