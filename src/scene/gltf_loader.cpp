@@ -23,6 +23,7 @@ extern "C" {
 #include "image_decode.h"
 #include "scene_build.h"
 #include "sky.h"
+#include "../core/vecmath.h"
 }
 
 namespace {
@@ -189,6 +190,8 @@ class Loader {
     std::vector<float> pos_, nrm_, uv0_, uv1_;
     std::vector<uint32_t> vnode_, tris_, tnode_;
     std::vector<int> tmat_;
+    std::vector<float> portal_local_; // portals' triangles, their nodes' local space, 9 floats each
+    std::vector<int> portal_node_;    // and each one's node
 };
 
 lm_status Loader::fail(lm_status st, const char *fmt, ...)
@@ -676,7 +679,7 @@ static void read_reflection_box(const tinygltf::Value &v, lm_node_settings &st, 
 // Reads the lmgi extras of a node: -1 unset, 0/1 set.
 void read_settings(const tinygltf::Value &extras, lm_node_settings &st, const char *path, const std::string &ctx)
 {
-    st.dynamic = st.caustics = st.indirect = st.shadows = st.reflections = -1;
+    st.dynamic = st.caustics = st.indirect = st.shadows = st.reflections = st.portal = -1;
     if (!extras.IsObject() || !extras.Has("lmgi"))
         return;
     const tinygltf::Value &l = extras.Get("lmgi");
@@ -686,7 +689,7 @@ void read_settings(const tinygltf::Value &extras, lm_node_settings &st, const ch
     }
     struct { const char *key; int *dst; } keys[] = {
         {"dynamic", &st.dynamic}, {"caustics", &st.caustics}, {"indirect", &st.indirect}, {"shadows", &st.shadows},
-        {"casts_shadows", &st.shadows}, {"reflections", &st.reflections}};
+        {"casts_shadows", &st.shadows}, {"reflections", &st.reflections}, {"portal", &st.portal}};
     for (const std::string &k : l.Keys()) {
         bool found = false;
         if (k == "reflection_box") {
@@ -926,12 +929,25 @@ lm_status Loader::geometry()
     for (int i = 0; i < s_->node_count; i++) {
         lm_node &n = s_->nodes[i];
         n.first_tri = uint32_t(tris_.size() / 3);
+        if (n.settings.portal == 1 && n.mesh < 0)
+            return fail(LM_ERR_INVALID, "node %d (\"%s\"): extras.lmgi.portal needs a mesh (the opening's shape)", i,
+                        n.name);
         if (n.mesh >= 0) {
             for (size_t k = 0; k < model_.meshes[size_t(n.mesh)].primitives.size(); k++) {
                 lm_status st = primitive(i, n.mesh, int(k));
                 if (st)
                     return st;
             }
+        }
+        if (n.settings.portal == 1) { /* its triangles leave the geometry: placed in world space by finish() */
+            for (size_t t = 3 * size_t(n.first_tri); t < tris_.size(); t++)
+                for (int a = 0; a < 3; a++)
+                    portal_local_.push_back(pos_[3 * size_t(tris_[t]) + a]);
+            portal_node_.resize(portal_local_.size() / 9, i);
+            tris_.resize(3 * size_t(n.first_tri)), tmat_.resize(n.first_tri), tnode_.resize(n.first_tri);
+            if (portal_node_.size() > LM_MAX_PORTAL_TRIS)
+                return fail(LM_ERR_INVALID, "node %d (\"%s\"): portals have more than %d triangles in all", i, n.name,
+                            LM_MAX_PORTAL_TRIS);
         }
         n.tri_count = uint32_t(tris_.size() / 3) - n.first_tri;
     }
@@ -1020,6 +1036,19 @@ lm_status Loader::finish()
     lm_status st = lm_scene_finish_nodes(s_.get(), animated_.data(), err_);
     if (st)
         return st;
+    if (!portal_node_.empty()) { /* the portals in world space, where the photons are aimed */
+        s_->portal_tris = calloc_n<float>(portal_local_.size());
+        s_->portal_tri_count = uint32_t(portal_node_.size());
+        for (size_t t = 0; t < portal_node_.size(); t++) {
+            const lm_node &n = s_->nodes[portal_node_[t]];
+            if (n.dynamic)
+                return fail(LM_ERR_INVALID, "node %d (\"%s\"): a portal cannot move (dynamic or animated)",
+                            portal_node_[t], n.name);
+            for (int k = 0; k < 3; k++)
+                lm_v3_store(&s_->portal_tris[9 * t + 3 * size_t(k)],
+                            lm_mat4_point(n.world, lm_v3_load(&portal_local_[9 * t + 3 * size_t(k)])));
+        }
+    }
     for (int i = 0; i < s_->node_count; i++) {
         const lm_node &n = s_->nodes[i];
         uint32_t bad = n.tri_count ? lm_count_degenerate(s_.get(), n.first_tri, n.tri_count) : 0;

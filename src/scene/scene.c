@@ -24,6 +24,7 @@ void lm_scene_free(lm_scene *s)
         free(s->animations[a].channels);
     }
     free(s->sky_image);
+    free(s->portal_tris);
     free(s->nodes);
     free(s->materials);
     free(s->textures);

@@ -83,6 +83,9 @@ typedef struct {
     int node;
 } lm_camera;
 
+/* Portal triangles a scene may have: each photon of the sun and the sky tests them all. */
+#define LM_MAX_PORTAL_TRIS 256
+
 /* Per-node lmgi settings from glTF node extras {"lmgi": {...}}. Switches are -1 (unset: inherit from
  * the parent, else on), 0 (off) or 1 (on). */
 typedef struct {
@@ -91,6 +94,8 @@ typedef struct {
     int indirect;          /* extras "indirect" */
     int shadows;           /* extras "shadows" (or "casts_shadows") */
     int reflections;       /* extras "reflections": a mirror or glossy node gets an environment map */
+    int portal;            /* extras "portal": its mesh marks an opening (a window) that the sun's and the
+                            * sky's photons are aimed through, and is no geometry (not inherited) */
     int has_reflection_box; /* extras "reflection_box": its environment map is looked up box-projected */
     float reflection_box[6]; /* that box, world space: min x, y, z, max x, y, z (not inherited) */
 } lm_node_settings;
@@ -192,6 +197,13 @@ typedef struct {
                                 * towards -z, x increasing eastwards (+x at a quarter) */
     float *sky_image;      /* sky_width x sky_height x 3 floats, times sky[] */
     float sky_image_mean[3]; /* its mean over the sphere (solid-angle weighted), made as it is loaded */
+
+    /* Portals (docs/levels.md, "Portals"): the triangles of the nodes tagged extras.lmgi.portal, world
+     * space, 9 floats each (at most LM_MAX_PORTAL_TRIS), not in tris: openings that the sun's and the
+     * sky's photons are aimed through (trace/lights.c). A portal's front (counter-clockwise) faces the
+     * outside, where the light comes from. */
+    float *portal_tris;
+    uint32_t portal_tri_count;
 
     int mesh_count;        /* number of glTF meshes (for reporting) */
     float bounds_min[3], bounds_max[3]; /* world-space bounds at load time (all nodes) */

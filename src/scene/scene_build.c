@@ -262,6 +262,7 @@ static void resolve_node(lm_scene *s, int i, const unsigned char *animated)
     n->settings.indirect = resolve_switch(n->settings.indirect, p ? p->settings.indirect : 1);
     n->settings.shadows = resolve_switch(n->settings.shadows, p ? p->settings.shadows : 1);
     n->settings.reflections = resolve_switch(n->settings.reflections, p ? p->settings.reflections : 1);
+    n->settings.portal = n->settings.portal == 1;
 }
 
 /* glTF: a node whose world matrix has a negative determinant shows its triangles' other side as the

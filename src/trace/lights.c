@@ -21,6 +21,7 @@
  * and u[1], u[2] (uniform on it), weight = Le cos_l / (d^2 pdf_area). A point or spot light's glTF
  * `range` windows its inverse square (lm_light_range_window); emissive textures are not used. */
 #include "lights.h"
+#include "portals.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -442,11 +443,25 @@ static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[
         float co = cosf(l->outer_cone), z = 1.0f - u[0] * (1.0f - co), r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
         d = lm_onb_dir(axis, r * cs, r * sn, z);
         scale *= lm_spot_attenuation(l, z) * (float)(2.0 * LM_PI) * (1.0f - co);
-    } else { /* the fitted rectangle (fit_rectangle), its area the power's */
-        lm_vec3 eu = lm_v3_load(e->rect[1]), ev = lm_v3_load(e->rect[2]);
-        o = lm_add(lm_v3_load(e->rect[0]), lm_add(lm_scale(eu, u[0]), lm_scale(ev, u[1])));
+    } else { /* the fitted rectangle (fit_rectangle), its area the power's; or through a portal */
+        lm_vec3 eu = lm_v3_load(e->rect[1]), ev = lm_v3_load(e->rect[2]), r0 = lm_v3_load(e->rect[0]);
+        float area = lm_length(eu) * lm_length(ev), x[3], n[3];
+        double across = s->portal_tri_count ? lm_portal_area(s, e->dir) : 0.0;
         d = axis;
-        scale *= lm_length(eu) * lm_length(ev);
+        o = lm_add(r0, lm_add(lm_scale(eu, u[0]), lm_scale(ev, u[1])));
+        if (across > 0.0 && u[2] < LM_PORTAL_SHARE && lm_portal_point(s, e->dir, u[0], u[1], x, n)) {
+            lm_vec3 p = lm_v3_load(x); /* moved back along the light onto the rectangle's plane */
+            o = lm_sub(p, lm_scale(d, lm_dot(lm_sub(p, r0), d)));
+        }
+        if (across > 0.0) { /* the mixture's density at this line (portals.h) */
+            float so[3], ua = lm_dot(lm_sub(o, r0), eu) / lm_dot(eu, eu), va = lm_dot(lm_sub(o, r0), ev) / lm_dot(ev, ev);
+            lm_v3_store(so, o);
+            double in_rect = ua >= 0.0f && ua <= 1.0f && va >= 0.0f && va <= 1.0f;
+            double pdf = (1.0 - LM_PORTAL_SHARE) * in_rect / area + LM_PORTAL_SHARE * lm_portal_crossings(s, so, e->dir) / across;
+            scale *= pdf > 0.0 ? (float)(1.0 / pdf) : 0.0f;
+        } else {
+            scale *= area;
+        }
     }
     lm_v3_store(out->org, o);
     lm_v3_store(out->dir, d);
