@@ -89,9 +89,8 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     so.cone_deg = o->surface_cone_deg;
     so.strict = o->strict;
     st = lm_surfaces_build(sc->scene, &so, &sc->surfaces, err);
-    int target = o->target_texels > 0 ? o->target_texels : LM_ATLAS_DEFAULT_TEXELS;
     if (st == LM_OK && o->texel_size <= 0.0f && !o->use_file_uv1 &&
-        (so.min_surface_area = lm_surface_area_for_budget(&sc->surfaces, target)) > 0.0f) {
+        (so.min_surface_area = lm_surface_area_for_budget(&sc->surfaces, o->target_texels)) > 0.0f) {
         if (o->wall_texels > 0) /* walls keep their own texels (lm_atlas_options.wall_texels) */
             so.min_surface_area = fminf(so.min_surface_area, LM_WALL_AREA);
         lm_surfaces_free(&sc->surfaces); /* the small surfaces merged, so that the budget can be met */
@@ -105,7 +104,7 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     lm_atlas_options ao;
     lm_atlas_options_default(&ao);
     ao.texel_size = o->texel_size;
-    ao.target_texels = target;
+    ao.target_texels = o->target_texels;
     ao.wall_texels = o->texel_size <= 0.0f ? o->wall_texels : 0;
     ao.gutter = o->gutter;
     ao.use_file_uv1 = o->use_file_uv1;

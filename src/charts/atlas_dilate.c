@@ -36,7 +36,7 @@ void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
                         if (a->chart_owner && a->chart_owner[i] >= 0 && a->chart_owner[j] != a->chart_owner[i])
                             continue;
                         for (int c = 0; c < channels && c < 4; c++)
-                            sum[c] += data[((size_t)yy * w + xx) * channels + c];
+                            sum[c] += data[j * channels + c];
                         count++;
                     }
                 if (!count)

@@ -36,7 +36,7 @@ static int round4(double v) { return 4 * (int)ceil(v / 4.0); }
 static int texels_for(double t, int *pad)
 {
     int covered = (int)floor(t + 0.01) + 1;
-    *pad = t + 0.01 >= 1.0 && covered >= LMC_PAD_MIN;
+    *pad = covered >= LMC_PAD_MIN;
     return t + 0.01 < 1.0 ? 1 : *pad ? covered : (int)ceil(t - 1e-6) + 1;
 }
 

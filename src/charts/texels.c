@@ -171,6 +171,14 @@ static double lookup_coord(double q, int w)
     return w <= 1 ? 0.5 : q;
 }
 
+void lm_chart_lookup_rect(const lm_atlas *a, int c, float rect[4])
+{
+    const lm_chart *ch = &a->charts[c];
+    float in = 0.5f - (float)ch->pad;
+    rect[0] = (ch->x + in) / (float)a->width, rect[1] = (ch->y + in) / (float)a->height;
+    rect[2] = (ch->x + ch->w - in) / (float)a->width, rect[3] = (ch->y + ch->h - in) / (float)a->height;
+}
+
 /* Fills this chart's corner UVs and returns its texels (row-major), or NULL when memory ran out. */
 static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
 {

@@ -238,18 +238,13 @@ static void write_triangle(const float p[3][3], const float *uv[3], const lm_mat
     }
 }
 
-/* Chart c's texel centres as a UV rectangle (what sub-samples stay inside); -1s when c < 0. */
+/* Where chart c's sub-samples stay (lm_chart_lookup_rect); -1s when c < 0. */
 static void chart_rect(const lm_atlas *a, int c, float rect[4])
 {
-    if (c < 0) {
+    if (c < 0)
         rect[0] = rect[1] = rect[2] = rect[3] = -1.0f;
-        return;
-    }
-    const lm_chart *ch = &a->charts[c];
-    /* as far as corner_uv's lookups reach: charts touch (no gutter) */
-    float in = 0.5f - (float)ch->pad;
-    rect[0] = (ch->x + in) / (float)a->width, rect[1] = (ch->y + in) / (float)a->height;
-    rect[2] = (ch->x + ch->w - in) / (float)a->width, rect[3] = (ch->y + ch->h - in) / (float)a->height;
+    else
+        lm_chart_lookup_rect(a, c, rect);
 }
 
 static void scene_triangle(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t t, float *o)

@@ -102,11 +102,8 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
         for (int k = 0; k < 3; k++)
             lm_scene_vertex_world(r->scene, r->scene->tris[3 * (size_t)h.tri + k], p[k]);
         lm_uv_gradient(p, uv, gu, gv);
-        const lm_chart *ch = &r->atlas->charts[r->atlas->tri_chart[h.tri]];
-        /* as far as corner_uv's lookups reach: charts touch (no gutter) */
-        float in = 0.5f - (float)ch->pad;
-        float lo[2] = {(ch->x + in) / r->atlas->width, (ch->y + in) / r->atlas->height};
-        float hi[2] = {(ch->x + ch->w - in) / r->atlas->width, (ch->y + ch->h - in) / r->atlas->height};
+        float lo[4], *hi = lo + 2; /* the chart's footprint stays where its lookups read only it */
+        lm_chart_lookup_rect(r->atlas, r->atlas->tri_chart[h.tri], lo);
         double num = lm_dot(ng, lm_sub(P, e));
         for (int i = 0; i < SUB; i++)
             for (int j = 0; j < SUB; j++) {

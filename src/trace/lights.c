@@ -237,6 +237,7 @@ static void place_punctual(lm_emitter *e, const lm_emitters *em, const lm_scene 
     float scale = e->kind == LM_EMIT_POINT ? (float)(4.0 * LM_PI)
                 : e->kind == LM_EMIT_SPOT  ? lm_spot_solid_angle(l)
                                            : fit_rectangle(e, em, s);
+    e->portal_across = e->kind == LM_EMIT_DIRECTIONAL && s->portal_tri_count ? lm_portal_area(s, e->dir) : 0.0;
     for (int c = 0; c < 3; c++) {
         e->radiant[c] = dark ? 0.0f : l->color[c] * l->intensity;
         e->power[c] = e->radiant[c] * scale;
@@ -445,11 +446,11 @@ static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[
         scale *= lm_spot_attenuation(l, z) * (float)(2.0 * LM_PI) * (1.0f - co);
     } else { /* the fitted rectangle (fit_rectangle), its area the power's; or through a portal */
         lm_vec3 eu = lm_v3_load(e->rect[1]), ev = lm_v3_load(e->rect[2]), r0 = lm_v3_load(e->rect[0]);
-        float area = lm_length(eu) * lm_length(ev), x[3], n[3];
-        double across = s->portal_tri_count ? lm_portal_area(s, e->dir) : 0.0;
+        float area = lm_length(eu) * lm_length(ev), x[3];
+        double across = e->portal_across;
         d = axis;
         o = lm_add(r0, lm_add(lm_scale(eu, u[0]), lm_scale(ev, u[1])));
-        if (across > 0.0 && u[2] < LM_PORTAL_SHARE && lm_portal_point(s, e->dir, u[0], u[1], x, n)) {
+        if (across > 0.0 && u[2] < LM_PORTAL_SHARE && lm_portal_point(s, e->dir, across, u[0], u[1], x)) {
             lm_vec3 p = lm_v3_load(x); /* moved back along the light onto the rectangle's plane */
             o = lm_sub(p, lm_scale(d, lm_dot(lm_sub(p, r0), d)));
         }

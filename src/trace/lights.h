@@ -39,6 +39,7 @@ typedef struct {
     float radiant[3];     /* point/spot: intensity x colour; directional: illuminance x colour */
     float rect[3][3];     /* directional: the rectangle its photons leave from, across its direction and
                            * upstream of the scene: a corner and its two edges (lights.c, "fitted") */
+    double portal_across; /* directional: the scene's portals' area across it (lm_portal_area; 0: none) */
 } lm_emitter;
 
 typedef struct {

@@ -23,9 +23,8 @@ int lm_portal_crossings(const lm_scene *s, const float o[3], const float d[3]);
 /* The sum over the portal triangles a light travelling along unit d enters by (fronts towards it) of
  * their area across d. */
 double lm_portal_area(const lm_scene *s, const float d[3]);
-/* A point p of a portal triangle that d enters by, and that triangle's unit front normal n, drawn by the
- * area lm_portal_area counts: u0 picks the triangle and, rescaled, with u1 the point. 0 when there is
- * none. */
-int lm_portal_point(const lm_scene *s, const float d[3], float u0, float u1, float p[3], float n[3]);
+/* A point p of a portal triangle that d enters by, drawn by the area lm_portal_area counts (total, as it
+ * gave it for d): u0 picks the triangle and, rescaled, with u1 the point. 0 when there is none. */
+int lm_portal_point(const lm_scene *s, const float d[3], double total, float u0, float u1, float p[3]);
 
 #endif
