@@ -37,21 +37,21 @@ static int fail(const char *what, const lmgi_error *e)
     return 1;
 }
 
-static int save(lmgi_scene *sc, lmgi_updater *u, const char *dir, const char *name)
+static int save(lmgi_scene *sc, lmgi_updater *u, lmgi_output *out, const char *name)
 {
     lmgi_info in;
     lmgi_get_info(sc, &in);
     size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
     float *rgba = malloc(n * sizeof *rgba);
-    char path[4096];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
+    char path[4200];
     lmgi_error e;
     int rc = 0;
     if (!rgba)
         rc = 1;
-    else if (lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, n, &e) != LMGI_OK ||
+    else if (lmgi_output_file(out, name, path, sizeof path, &e) != LMGI_OK ||
+             lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, n, &e) != LMGI_OK ||
              lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, rgba, NULL, &e))
-        rc = fail(path, &e);
+        rc = fail(name, &e);
     free(rgba);
     return rc;
 }
@@ -92,7 +92,7 @@ static int find_light(const lmgi_scene *sc, const char *node)
 }
 
 /* The artist's edits, each followed by a re-bake and the lightmap saved. */
-static int edit(lmgi_scene *sc, lmgi_updater *u, const char *out, const char *material, const char *light)
+static int edit(lmgi_scene *sc, lmgi_updater *u, lmgi_output *out, const char *material, const char *light)
 {
     lmgi_error e;
     int m = find_material(sc, material), l = find_light(sc, light);
@@ -131,7 +131,7 @@ static int edit(lmgi_scene *sc, lmgi_updater *u, const char *out, const char *ma
     return rebake(u, "lamp") || save(sc, u, out, "lightmap_lamp.exr");
 }
 
-static int session(lmgi_context *ctx, lmgi_scene *sc, const char *out, const char *material, const char *light)
+static int session(lmgi_context *ctx, lmgi_scene *sc, lmgi_output *out, const char *material, const char *light)
 {
     lmgi_updater_desc d = {.progress = show, .progress_user = "bake"};
     lmgi_updater *u = NULL;
@@ -141,18 +141,16 @@ static int session(lmgi_context *ctx, lmgi_scene *sc, const char *out, const cha
     int rc = save(sc, u, out, "lightmap.exr") || edit(sc, u, out, material, light);
     lmgi_camera cam;
     float *frame = malloc(3 * 320 * 240 * sizeof *frame);
-    char path[4096];
-    snprintf(path, sizeof path, "%s/view.png", out);
-    if (!rc && (!frame || lmgi_scene_camera(sc, -1, 320, 240, &cam, &e) != LMGI_OK ||
+    char path[4200];
+    if (!rc && (!frame || lmgi_output_file(out, "view.png", path, sizeof path, &e) != LMGI_OK ||
+                lmgi_scene_camera(sc, -1, 320, 240, &cam, &e) != LMGI_OK ||
                 lmgi_render(u, &cam, 320, 240, frame, &e) != LMGI_OK ||
                 lmgi_write_image(path, 320, 240, 3, frame, NULL, &e) != LMGI_OK))
         rc = fail("view", &e);
     free(frame);
-    lmgi_export_desc x = {.name = "level"};
-    if (!rc && lmgi_export_gltf(u, out, &x, &e) != LMGI_OK)
+    lmgi_export_desc x = {.name = "level", .output = out};
+    if (!rc && lmgi_export_gltf(u, NULL, &x, &e) != LMGI_OK)
         rc = fail("export", &e);
-    if (!rc)
-        printf("exported %s/level.gltf with level_lightmap.exr\n", out);
     lmgi_updater_free(u);
     return rc;
 }
@@ -183,13 +181,25 @@ int main(int argc, char **argv)
     lmgi_context *ctx = NULL;
     lmgi_scene *sc = NULL;
     lmgi_error e;
-    /* the output directory claimed first: an artist's files there are never overwritten */
-    static const char *const own[] = {"lightmap*.exr", "view.png", NULL};
-    if (lmgi_claim_output_dir(out, 0, own, &e) != LMGI_OK)
+    if (lmgi_load(scene, &o, &sc, &e) != LMGI_OK)
+        return fail(scene, &e);
+    /* The session's files go beside the last session's and replace them only when it succeeds; an
+     * artist's own files in OUT_DIR are never touched, and the scene is never overwritten. */
+    const char *const inputs[] = {scene, NULL};
+    lmgi_output *dir = NULL;
+    if (lmgi_output_open(out, "editor-session", 0, inputs, &dir, &e) != LMGI_OK) {
+        lmgi_free(sc);
         return fail("output", &e);
-    if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK)
-        return fail("context", &e);
-    int rc = lmgi_load(scene, &o, &sc, &e) == LMGI_OK ? session(ctx, sc, out, material, light) : fail(scene, &e);
+    }
+    int rc = lmgi_context_create(NULL, &ctx, &e) == LMGI_OK ? session(ctx, sc, dir, material, light)
+                                                            : fail("context", &e);
+    if (rc) {
+        lmgi_output_abort(dir);
+    } else if (lmgi_output_commit(dir, &e) != LMGI_OK) {
+        rc = fail("output", &e);
+    } else {
+        printf("wrote %s: lightmap*.exr, view.png, level.gltf with level_lightmap.exr\n", out);
+    }
     lmgi_free(sc);
     lmgi_context_free(ctx);
     return rc;

@@ -65,6 +65,7 @@ typedef struct {
 } lmgi_options;
 
 typedef struct lmgi_scene lmgi_scene;
+typedef struct lmgi_output lmgi_output; /* an output directory being written (lmgi_output_open) */
 
 /* Time spent in each stage of lmgi_load, seconds. atlas = unwrap + pack + texels. */
 typedef struct {
@@ -648,11 +649,14 @@ LMGI_API lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, floa
 typedef struct {
     const char *name;   /* the files' base name (NULL: "scene"): letters, digits, - _ . */
     int half;           /* the EXR in 16-bit half floats */
-    int force;          /* write into a directory that holds files lmgi did not write (lmgi_claim_output_dir) */
+    int force;          /* write into a directory that holds files lmgi did not write (lmgi_output_open) */
+    lmgi_output *output; /* write into this open output's new result (dir then unused, may be NULL); NULL:
+                          * open dir as the command "export", commit at the end */
 } lmgi_export_desc;
-/* NULL u or dir, a name that is not plain: LMGI_ERR_INVALID; a name that would replace the scene's own
- * file: LMGI_ERR_INVALID, nothing written; a directory lmgi may not write into, a failed write:
- * LMGI_ERR_IO naming the file. NULL desc: the defaults. Thread-safety: as the updater's. */
+/* NULL u, NULL dir without desc->output, a name that is not plain: LMGI_ERR_INVALID; the scene's own
+ * file in the way, a directory lmgi may not write into (lmgi_output_open), a failed write: LMGI_ERR_IO
+ * naming the file, and nothing of the export left. NULL desc: the defaults. Thread-safety: as the
+ * updater's. */
 LMGI_API lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export_desc *desc,
                                       lmgi_error *err);
 
@@ -798,14 +802,44 @@ typedef struct {
 LMGI_API lmgi_status lmgi_write_image(const char *path, int width, int height, int channels, const float *pixels,
                                       const lmgi_image_desc *desc, lmgi_error *err);
 
-/* Output directories, claimed before any work so that nothing a user put there is lost and no stale file
- * of an earlier, longer run is left beside the new ones (README, "Output directories"). A directory lmgi
- * writes into holds a marker file, .lmgi. The claim makes `dir` (and its parents) if needed and refuses,
- * with LMGI_ERR_IO naming a file found there, one that holds anything but lmgi's marker unless force is
- * non-zero; then it removes the files named like the caller's own output (`own`: NULL-terminated
- * fnmatch(3) patterns, NULL for none) and any NAME.partial an interrupted write left, and nothing else,
- * and writes the marker. NULL dir: LMGI_ERR_INVALID. Not thread-safe for one directory. */
-LMGI_API lmgi_status lmgi_claim_output_dir(const char *dir, int force, const char *const *own, lmgi_error *err);
+/* Writes size bytes to path whole or not at all: through PATH.partial, created exclusively (a file or a
+ * link already there is refused, never written through), every write and the close checked, then renamed
+ * over path. NULL path or data with size > 0: LMGI_ERR_INVALID; a failed write: LMGI_ERR_IO naming it. */
+LMGI_API lmgi_status lmgi_write_file(const char *path, const void *data, size_t size, lmgi_error *err);
+
+/* Output directories (README, "Output directories"; src/core/output_dir.h has the layout): one command's
+ * result, written beside the previous one and swapped in only when the command succeeds, so a failed,
+ * cancelled or killed command leaves the last good result; lmgi removes or replaces only files it wrote
+ * itself, known from a manifest it keeps in the directory (DIR/.lmgi), never by their names.
+ *
+ * lmgi_output_open makes `dir` (and its parents) if needed and locks it for this command: a second
+ * lmgi_output_open of it, from this or another process, is refused (LMGI_ERR_IO naming the holder's
+ * process) until the first commits or aborts; a killed process's lock is released by the system. It
+ * refuses a directory without lmgi's manifest that holds files unless force is non-zero (the mistake of
+ * writing into a home folder). Whatever is in `dir` that lmgi did not place there (not in the manifest, or
+ * another file put under a listed name) is never removed or replaced, with or without force. `command` (a-z and -: "bake", "run", ...)
+ * names whose result this is: the commit replaces that command's earlier files in `dir` and leaves
+ * other commands'. `inputs` (NULL-terminated paths, or NULL) are the files the command reads: none of them
+ * is ever replaced or removed (refused at open when the earlier result is one of them, and at commit).
+ * lmgi_output_file gives the path to write the new result's file `name` to (a plain file name); it is
+ * refused early when `dir` holds a file of that name lmgi did not write, or an input.
+ * lmgi_output_work_file gives a path in `dir` itself for a file that must survive a failure (a bake's
+ * checkpoint), listed in the manifest at once; the next successful commit of the command removes it.
+ * lmgi_output_commit moves the new files in, removes the command's earlier files the new result lacks
+ * (a 20-frame run after a 60-frame one leaves 20 frames) and frees the output, whatever it returns;
+ * lmgi_output_abort drops the new result and frees the output (NULL: nothing).
+ * NULL arguments or a bad name: LMGI_ERR_INVALID; what the file system refuses: LMGI_ERR_IO naming the
+ * path. Not thread-safe for one lmgi_output. */
+LMGI_API lmgi_status lmgi_output_open(const char *dir, const char *command, int force, const char *const *inputs,
+                                      lmgi_output **out, lmgi_error *err);
+LMGI_API lmgi_status lmgi_output_file(lmgi_output *o, const char *name, char *path, size_t size, lmgi_error *err);
+LMGI_API lmgi_status lmgi_output_work_file(lmgi_output *o, const char *name, char *path, size_t size,
+                                           lmgi_error *err);
+/* The folder the new result's files go into (DIR/.lmgi-new), for functions that take a directory
+ * (lmgi_write_charts); NULL for NULL. */
+LMGI_API const char *lmgi_output_folder(const lmgi_output *o);
+LMGI_API lmgi_status lmgi_output_commit(lmgi_output *o, lmgi_error *err);
+LMGI_API void lmgi_output_abort(lmgi_output *o);
 
 LMGI_API const char *lmgi_status_name(lmgi_status s);
 /* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */

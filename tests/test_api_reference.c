@@ -322,55 +322,6 @@ static void test_bad_arguments(void **state)
     lmgi_free(sc);
 }
 
-static int exists(const char *dir, const char *name)
-{
-    char path[1200];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    return access(path, F_OK) == 0;
-}
-
-static void touch(const char *dir, const char *name)
-{
-    char path[1200];
-    snprintf(path, sizeof path, "%s/%s", dir, name);
-    lmt_write_file(path, "x", 1);
-}
-
-/* A new directory is made and marked; one holding a user's file is refused and left as it was; force
- * writes there, removing only what is named like the caller's output (and interrupted writes). */
-static void test_claim_output_dir(void **state)
-{
-    (void)state;
-    static const char *const own[] = {"frame_*.png", NULL};
-    char dir[1024], user[1024];
-    const char *tmp = lmt_tmpdir();
-    lmgi_error e;
-    snprintf(dir, sizeof dir, "%s/new/deeper", tmp);
-    assert_int_equal(lmgi_claim_output_dir(dir, 0, own, &e), LMGI_OK);
-    assert_true(exists(dir, ".lmgi"));
-    touch(dir, "frame_0001.png");
-    touch(dir, "notes.txt");
-    assert_int_equal(lmgi_claim_output_dir(dir, 0, own, &e), LMGI_OK); /* marked: lmgi's own */
-    assert_false(exists(dir, "frame_0001.png"));
-    assert_true(exists(dir, "notes.txt"));
-
-    snprintf(user, sizeof user, "%s/users", tmp);
-    mkdir(user, 0755);
-    touch(user, "frame_0007.png");
-    touch(user, "thesis.tex");
-    assert_int_equal(lmgi_claim_output_dir(user, 0, own, &e), LMGI_ERR_IO);
-    assert_non_null(strstr(e.message, "not written by lmgi"));
-    assert_true(exists(user, "frame_0007.png") && exists(user, "thesis.tex") && !exists(user, ".lmgi"));
-    touch(user, "frame_0008.png.partial");
-    assert_int_equal(lmgi_claim_output_dir(user, 1, NULL, &e), LMGI_OK); /* forced, no own kind */
-    assert_true(exists(user, "frame_0007.png") && exists(user, "thesis.tex") && exists(user, ".lmgi"));
-    assert_false(exists(user, "frame_0008.png.partial"));
-    expect_invalid(lmgi_claim_output_dir(NULL, 0, own, &e), &e, "dir is NULL");
-    char file[1200];
-    snprintf(file, sizeof file, "%s/thesis.tex", user);
-    assert_int_equal(lmgi_claim_output_dir(file, 1, own, &e), LMGI_ERR_IO); /* a file, not a directory */
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -378,7 +329,6 @@ int main(void)
         cmocka_unit_test(test_reference_pixels_and_check),
         cmocka_unit_test(test_reference_parts_with_mirror),
         cmocka_unit_test(test_bad_arguments),
-        cmocka_unit_test(test_claim_output_dir),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -363,6 +363,13 @@ static void test_bake_killed_and_resumed(void **state)
     snprintf(saved, sizeof saved, "%s/saved.checkpoint", dir);
     assert_int_equal(link(ck, saved), 0);
 
+    /* another scene's resume: refused, naming the checkpoint, which stays for the right one */
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --out %s/part --resume", dir);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "a checkpoint of another scene or other settings"));
+    assert_non_null(strstr(output, "part/bake.checkpoint"));
+    assert_true(same_bytes(saved, ck));
+
     snprintf(args, sizeof args, "bake %s --texels 20000 --out %s/part --resume -v", scene, dir);
     assert_int_equal(run(args), 0);
     const char *at = strstr(output, "resuming the gather at texel ");
@@ -376,16 +383,15 @@ static void test_bake_killed_and_resumed(void **state)
     assert_true(same_bytes(a_path, b_path));
     assert_int_equal(access(ck, F_OK), -1); /* done with */
 
-    /* another scene's checkpoint: refused, named, kept */
+    /* a checkpoint lmgi did not put there is not lmgi's to read, rewrite or remove */
     char other[400];
     snprintf(other, sizeof other, "%s/other", dir);
     assert_int_equal(mkdir(other, 0755), 0);
     snprintf(ck, sizeof ck, "%s/bake.checkpoint", other);
     assert_int_equal(link(saved, ck), 0);
-    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --out %s --resume --force", other);
+    snprintf(args, sizeof args, "bake %s --texels 20000 --out %s --resume --force", scene, other);
     assert_int_equal(run(args), 1);
-    assert_non_null(strstr(output, "a checkpoint of another scene or other settings"));
-    assert_non_null(strstr(output, "other/bake.checkpoint"));
+    assert_non_null(strstr(output, "other/bake.checkpoint: lmgi did not write this file"));
     assert_true(same_bytes(saved, ck));
 
     /* a bake that fails keeps the last good lightmaps */

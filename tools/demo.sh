@@ -4,8 +4,13 @@ set -eu
 LMGI=${1:-build/lmgi}
 LMGI_DEV=$(dirname "$LMGI")/lmgi-dev # the developer's commands (tools/dev)
 mkdir -p demo
-# demo/ is the demo's own (make clean removes it): --force lets a directory from before lmgi marked its
-# output directories (README, "Output directories") be written again.
+# demo/ is the demo's own (make clean removes it). A folder an lmgi before output manifests wrote holds
+# files today's lmgi cannot tell from a user's and will not replace: the demo clears its own such folders.
+for d in demo/*/; do
+    if [ -f "$d.lmgi" ] && ! head -n 1 "$d.lmgi" | grep -q '^lmgi output'; then
+        rm -rf "$d"
+    fi
+done
 for scene in scenes/cornell.glb scenes/two_rooms.glb ../shared/scenes/cornell-box/CornellBox.glb; do
     name=$(basename "$scene" | sed 's/\.[^.]*$//')
     if [ ! -r "$scene" ]; then

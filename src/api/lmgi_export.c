@@ -412,21 +412,10 @@ static int plain_name(const char *name)
     return 1;
 }
 
-/* Whether writing NAME's files into dir would replace the scene's own file. */
-static int would_replace_input(const lm_scene *s, const char *dir, const char *name)
-{
-    char in[PATH_MAX], out_dir[PATH_MAX];
-    if (!realpath(s->path, in) || !realpath(dir, out_dir))
-        return 0;
-    const char *slash = strrchr(in, '/');
-    size_t n = (size_t)(slash - in);
-    return strlen(out_dir) == n && strncmp(in, out_dir, n) == 0 && strncmp(slash + 1, name, strlen(name)) == 0;
-}
-
 lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export_desc *desc, lmgi_error *err)
 {
     static const char fn[] = "lmgi_export_gltf";
-    if (!u || !dir)
+    if (!u || (!dir && !(desc && desc->output)))
         return lm_api_refuse(err, "%s: %s is NULL", fn, u ? "dir" : "updater");
     lmgi_export_desc d;
     memset(&d, 0, sizeof d);
@@ -437,18 +426,25 @@ lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export
         return lm_api_refuse(err, "%s: name '%s' must be 1 to 200 of a-z A-Z 0-9 - _ . and not start with '.'", fn,
                              name);
     const lmgi_scene *sc = lm_updater_scene(u);
-    if (would_replace_input(sc->scene, dir, name))
-        return lm_api_refuse(err, "%s: %s/%s.* would replace the scene's own file %s; choose another name or "
-                             "directory", fn, dir, name, sc->scene->path);
-    char own[4][260];
-    snprintf(own[0], sizeof own[0], "%s.gltf", name);
-    snprintf(own[1], sizeof own[1], "%s.bin", name);
-    snprintf(own[2], sizeof own[2], "%s_lightmap.*", name);
-    snprintf(own[3], sizeof own[3], "%s_tex*.png", name);
-    const char *const patterns[] = {own[0], own[1], own[2], own[3], NULL};
-    lmgi_status st = lmgi_claim_output_dir(dir, d.force, patterns, err);
-    if (st != LMGI_OK)
-        return st;
+    lmgi_output *own = NULL; /* the export's own output, when the caller gave none */
+    if (!d.output) {
+        const char *const inputs[] = {sc->scene->path, NULL};
+        lmgi_status st = lmgi_output_open(dir, "export", d.force, inputs, &own, err);
+        if (st != LMGI_OK)
+            return st;
+    }
+    lmgi_output *out = d.output ? d.output : own;
+    char path[4200];
+    for (int k = 0; k < 2; k++) { /* the scene's own file or a user's in the way: refused before the work */
+        char file[260];
+        snprintf(file, sizeof file, "%s.%s", name, k ? "bin" : "gltf");
+        lmgi_status st = lmgi_output_file(out, file, path, sizeof path, err);
+        if (st != LMGI_OK) {
+            lmgi_output_abort(own);
+            return st;
+        }
+    }
+    dir = lmgi_output_folder(out);
     writer w = {.s = sc->scene, .atlas = &sc->atlas, .name = name};
     lm_error e;
     lm_status ls = lm_gltf_open(&w.doc) ? LM_OK : lm_fail(&e, LM_ERR_NOMEM, "export: no memory");
@@ -459,7 +455,6 @@ lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export
     const void *bin = ls == LM_OK ? lm_gltf_bin(&w.doc, &bin_len) : NULL;
     if (ls == LM_OK && (!json || !bin))
         ls = lm_fail(&e, LM_ERR_NOMEM, "export: no memory for the document");
-    char path[4200];
     if (ls == LM_OK) {
         snprintf(path, sizeof path, "%s/%s.bin", dir, name);
         ls = lm_write_file(path, bin, bin_len, &e);
@@ -469,7 +464,9 @@ lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export
         ls = lm_write_file(path, json, json_len, &e);
     }
     lm_gltf_close(&w.doc);
-    if (ls != LM_OK)
-        return lm_export_error(err, &e);
-    return write_lightmap(u, &w, dir, d.half, err);
+    lmgi_status st = ls == LM_OK ? write_lightmap(u, &w, dir, d.half, err) : lm_export_error(err, &e);
+    if (own && st == LMGI_OK)
+        return lmgi_output_commit(own, err);
+    lmgi_output_abort(own);
+    return st;
 }

@@ -1,93 +1,83 @@
-/* The public API's output directories (lmgi_claim_output_dir): a marker file says which are lmgi's. */
+/* The public API's output directories and whole-file writes: src/core/output_dir.h under lmgi_ names. */
 #include <lmgi.h>
 
-#include <dirent.h>
-#include <errno.h>
-#include <fnmatch.h>
-#include <stdio.h>
-#include <string.h>
-#include <unistd.h>
+#include <stdlib.h>
 
 #include "../core/image.h"
+#include "../core/output_dir.h"
 #include "lmgi_scene.h"
 
-#define MARKER ".lmgi"
+struct lmgi_output {
+    lm_output *o;
+};
 
-/* A command's own kind of output, and the NAME.partial files lm_write_file leaves when a run is killed
- * mid-write (every command's). */
-static int matches(const char *name, const char *const *own)
+lmgi_status lmgi_write_file(const char *path, const void *data, size_t size, lmgi_error *err)
 {
-    if (fnmatch("*.partial", name, 0) == 0)
-        return 1;
-    for (; *own; own++)
-        if (fnmatch(*own, name, 0) == 0)
-            return 1;
-    return 0;
-}
-
-/* Whether DIR holds the marker, and the first other entry in it. */
-static lm_status survey(const char *dir, int *marked, char *other, size_t n, lm_error *err)
-{
-    DIR *d = opendir(dir);
-    if (!d)
-        return lm_fail(err, LM_ERR_IO, "%s: cannot list (%s)", dir, strerror(errno));
-    *marked = 0, other[0] = '\0';
-    for (struct dirent *e; (e = readdir(d));) {
-        if (!strcmp(e->d_name, MARKER))
-            *marked = 1;
-        else if (!other[0] && strcmp(e->d_name, ".") && strcmp(e->d_name, ".."))
-            snprintf(other, n, "%s", e->d_name);
-    }
-    closedir(d);
-    return LM_OK;
-}
-
-static lm_status remove_own(const char *dir, const char *const *own, lm_error *err)
-{
-    DIR *d = opendir(dir);
-    if (!d)
-        return lm_fail(err, LM_ERR_IO, "%s: cannot list (%s)", dir, strerror(errno));
-    lm_status st = LM_OK;
-    for (struct dirent *e; st == LM_OK && (e = readdir(d));) {
-        if (!matches(e->d_name, own))
-            continue;
-        char path[4200];
-        snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
-        if (remove(path) != 0 && errno != ENOENT)
-            st = lm_fail(err, LM_ERR_IO, "%s: cannot remove the earlier output (%s)", path, strerror(errno));
-    }
-    closedir(d);
-    return st;
-}
-
-static lm_status claim(const char *dir, int force, const char *const *own, lm_error *err)
-{
-    lm_status st = lm_mkdir_p(dir, err);
-    if (st == LM_OK && access(dir, W_OK) != 0)
-        st = lm_fail(err, LM_ERR_IO, "%s: not writable", dir);
-    int marked = 0;
-    char foreign[256];
-    if (st == LM_OK)
-        st = survey(dir, &marked, foreign, sizeof foreign, err);
-    if (st == LM_OK && !marked && foreign[0] && !force)
-        return lm_fail(err, LM_ERR_IO, "%s: not empty and not written by lmgi (it holds '%s'); give a new or "
-                       "empty directory, or force the write (lmgi's --force; lmgi then removes only files named "
-                       "like its own output)", dir, foreign);
-    if (st == LM_OK)
-        st = remove_own(dir, own, err);
-    char marker[4200];
-    snprintf(marker, sizeof marker, "%s/" MARKER, dir);
-    static const char text[] = "lmgi writes into this directory; see the README, \"Output directories\"\n";
-    if (st == LM_OK && !marked)
-        st = lm_write_file(marker, text, sizeof text - 1, err);
-    return st;
-}
-
-lmgi_status lmgi_claim_output_dir(const char *dir, int force, const char *const *own, lmgi_error *err)
-{
-    if (!dir)
-        return lm_api_refuse(err, "lmgi_claim_output_dir: dir is NULL");
-    static const char *const none[] = {NULL};
+    if (!path || (!data && size))
+        return lm_api_refuse(err, "lmgi_write_file: %s is NULL", path ? "data" : "path");
     lm_error e;
-    return claim(dir, force, own ? own : none, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+    return lm_write_file(path, data ? data : "", size, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_output_open(const char *dir, const char *command, int force, const char *const *inputs,
+                             lmgi_output **out, lmgi_error *err)
+{
+    if (!out)
+        return lm_api_refuse(err, "lmgi_output_open: out is NULL");
+    *out = NULL;
+    if (!dir || !command)
+        return lm_api_refuse(err, "lmgi_output_open: %s is NULL", dir ? "command" : "dir");
+    lmgi_output *h = malloc(sizeof *h);
+    if (!h)
+        return lm_api_refuse(err, "lmgi_output_open: no memory");
+    lm_error e;
+    if (lm_output_open(dir, command, force, inputs, &h->o, &e) != LM_OK) {
+        free(h);
+        return lm_export_error(err, &e);
+    }
+    *out = h;
+    return LMGI_OK;
+}
+
+static lmgi_status path_of(lmgi_output *o, const char *name, char *path, size_t size, int work, lmgi_error *err)
+{
+    static const char *const fn[2] = {"lmgi_output_file", "lmgi_output_work_file"};
+    if (!o || !name || !path || !size)
+        return lm_api_refuse(err, "%s: %s is NULL or empty", fn[work], !o ? "output" : !name ? "name" : "path");
+    lm_error e;
+    lm_status st = work ? lm_output_work_file(o->o, name, path, size, &e) : lm_output_file(o->o, name, path, size, &e);
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_output_file(lmgi_output *o, const char *name, char *path, size_t size, lmgi_error *err)
+{
+    return path_of(o, name, path, size, 0, err);
+}
+
+lmgi_status lmgi_output_work_file(lmgi_output *o, const char *name, char *path, size_t size, lmgi_error *err)
+{
+    return path_of(o, name, path, size, 1, err);
+}
+
+lmgi_status lmgi_output_commit(lmgi_output *o, lmgi_error *err)
+{
+    if (!o)
+        return lm_api_refuse(err, "lmgi_output_commit: output is NULL");
+    lm_error e;
+    lm_status st = lm_output_commit(o->o, &e);
+    free(o);
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+void lmgi_output_abort(lmgi_output *o)
+{
+    if (!o)
+        return;
+    lm_output_abort(o->o);
+    free(o);
+}
+
+const char *lmgi_output_folder(const lmgi_output *o)
+{
+    return o ? lm_output_stage(o->o) : NULL;
 }

@@ -30,7 +30,7 @@ static void show(void *user, float fraction, const char *stage)
     lm_progress_fraction("bake", fraction, stage, *(const double *)user);
 }
 
-static int write_maps(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half)
+static int write_maps(lmgi_scene *sc, lmgi_updater *u, lmgi_output *dir, int half)
 {
     const lmgi_image_desc exr = {.half = half};
     lmgi_info in;
@@ -68,7 +68,7 @@ static void heat(float v, float rgb[3])
 /* --accuracy: DIR/accuracy.exr (LMGI_LIGHTMAP_ACCURACY), accuracy.png (its lightmap channel as a heat map)
  * and the estimate's median and 95th percentile over the valid texels that receive indirect light,
  * printed. */
-static int write_accuracy(lmgi_scene *sc, lmgi_updater *u, const char *dir, int half, int quiet)
+static int write_accuracy(lmgi_scene *sc, lmgi_updater *u, lmgi_output *dir, int half, int quiet)
 {
     const lmgi_image_desc exr = {.half = half};
     lmgi_info in;
@@ -123,7 +123,7 @@ static int write_accuracy(lmgi_scene *sc, lmgi_updater *u, const char *dir, int 
 
 /* DIR/NAME.gltf and its lightmap, NAME the scene file's name without its extension (other characters
  * than a-z A-Z 0-9 - _ made '_'). */
-static int write_gltf(const lm_cli_args *a, lmgi_updater *u, char *name, size_t size)
+static int write_gltf(const lm_cli_args *a, lmgi_updater *u, lmgi_output *out, char *name, size_t size)
 {
     const char *base = strrchr(a->files[0], '/');
     snprintf(name, size, "%s", base ? base + 1 : a->files[0]);
@@ -133,12 +133,31 @@ static int write_gltf(const lm_cli_args *a, lmgi_updater *u, char *name, size_t 
     for (char *c = name; *c; c++)
         if (!isalnum((unsigned char)*c) && *c != '-' && *c != '_')
             *c = '_';
-    lmgi_export_desc d = {.name = name, .half = a->half};
+    lmgi_export_desc d = {.name = name, .half = a->half, .output = out};
     lmgi_error e;
     if (lmgi_export_gltf(u, a->out_dir, &d, &e) == LMGI_OK)
         return 0;
     fprintf(stderr, "lmgi: error: %s\n", e.message);
     return 1;
+}
+
+/* The scene loads before --out is touched, and the earlier bake stays until this one has succeeded
+ * (lmgi_output_commit): a mistyped scene, a cancel or a kill leaves the last good lightmaps. What the
+ * gather finished survives a cancel, a kill or a failure in DIR/bake.checkpoint (docs/levels.md, "Long
+ * bakes"), which the commit removes. */
+static lmgi_output *open_out(const lm_cli_args *a, char *checkpoint, size_t size)
+{
+    lmgi_output *out = lm_cli_open_out(a, "bake");
+    char probe[4200];
+    lmgi_error e;
+    if (!out || !lm_cli_out_path(out, "lightmap.exr", probe, sizeof probe) ||
+        !lm_cli_out_path(out, "lightmap.png", probe, sizeof probe))
+        return lm_cli_close_out(out, 1), NULL;
+    if (lmgi_output_work_file(out, "bake.checkpoint", checkpoint, size, &e) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", e.message);
+        return lm_cli_close_out(out, 1), NULL;
+    }
+    return out;
 }
 
 int lm_cli_bake(const lm_cli_args *a)
@@ -147,14 +166,16 @@ int lm_cli_bake(const lm_cli_args *a)
         fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
         return 2;
     }
-    /* Nothing of an earlier bake is removed before this one has succeeded: a mistyped scene, a cancel or a
-     * kill leaves the last good lightmaps (each file is replaced whole, lm_cli_write_image). */
-    if (!lm_cli_claim_out_dir(a, NULL))
-        return 1;
     lmgi_scene *sc = NULL;
     lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
     if (!lm_cli_load_scene(a->files[0], &o, 1, &sc))
         return 1;
+    char checkpoint[4200];
+    lmgi_output *out = open_out(a, checkpoint, sizeof checkpoint);
+    if (!out) {
+        lmgi_free(sc);
+        return 1;
+    }
     lmgi_updater_desc d;
     lm_cli_updater_desc(a, &d);
     d.frame_width = d.frame_height = 0;
@@ -163,9 +184,6 @@ int lm_cli_bake(const lm_cli_args *a)
     d.progress = a->quiet ? NULL : show;
     d.progress_user = &started;
     d.cancel = &g_cancel;
-    /* what the gather finished survives a cancel, a kill or a failure (docs/levels.md, "Long bakes") */
-    char checkpoint[4200];
-    snprintf(checkpoint, sizeof checkpoint, "%s/bake.checkpoint", a->out_dir);
     d.checkpoint = checkpoint;
     d.checkpoint_seconds = a->checkpoint_seconds;
     d.resume = a->resume;
@@ -177,8 +195,8 @@ int lm_cli_bake(const lm_cli_args *a)
     int rc = 0;
     if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK || lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK) {
         if (e.status == LMGI_ERR_CANCELLED)
-            fprintf(stderr, "\nlmgi: bake cancelled after %.1f s (%s); no lightmap written; the same command with "
-                    "--resume continues it\n", lm_cli_now() - started, e.message);
+            fprintf(stderr, "\nlmgi: bake cancelled after %.1f s (%s); no lightmap written (an earlier bake's kept); the "
+                    "same command with --resume continues it\n", lm_cli_now() - started, e.message);
         else
             fprintf(stderr, "lmgi: error: %s\n", e.message);
         rc = e.status == LMGI_ERR_CANCELLED ? 130 : 1;
@@ -186,23 +204,13 @@ int lm_cli_bake(const lm_cli_args *a)
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
     if (rc == 0)
-        rc = write_maps(sc, u, a->out_dir, a->half);
-    if (rc == 0) {
-        remove(checkpoint); /* the lightmaps hold all it held */
-        if (!a->accuracy) { /* an earlier bake's estimate would no longer describe these lightmaps */
-            static const char *const stale[] = {"accuracy.exr", "accuracy.png"};
-            for (int k = 0; k < 2; k++) {
-                char path[4200];
-                snprintf(path, sizeof path, "%s/%s", a->out_dir, stale[k]);
-                remove(path);
-            }
-        }
-    }
+        rc = write_maps(sc, u, out, a->half);
     if (rc == 0 && a->accuracy)
-        rc = write_accuracy(sc, u, a->out_dir, a->half, a->quiet);
+        rc = write_accuracy(sc, u, out, a->half, a->quiet);
     char name[256] = "";
     if (rc == 0 && a->gltf)
-        rc = write_gltf(a, u, name, sizeof name);
+        rc = write_gltf(a, u, out, name, sizeof name);
+    rc = lm_cli_close_out(out, rc);
     if (rc == 0 && !a->quiet) {
         lmgi_info in;
         lmgi_updater_info ui;

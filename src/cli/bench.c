@@ -10,6 +10,7 @@
 #include "bench_budget.h"
 #include "bench_edits.h"
 #include "bench_soak.h"
+#include "out_dir.h"
 #include "bench_scenes.h"
 
 /* Scenes timed when none are named: ours first, then the shared ones (skipped when absent). */
@@ -96,13 +97,12 @@ static void print_scaling(const result *r, int n)
     }
 }
 
-static void write_json(const char *path, const result *r, int n, const result *sr, int sn)
+static int write_json(const lm_cli_args *a, const result *r, int n, const result *sr, int sn)
 {
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        fprintf(stderr, "lmgi: bench: cannot write %s\n", path);
-        return;
-    }
+    lm_cli_single out;
+    if (!lm_cli_single_open(&out))
+        return 0;
+    FILE *f = out.f;
     fprintf(f, "{\n  \"scenes\": [\n");
     for (int pass = 0; pass < 2; pass++) {
         const result *list = pass ? sr : r;
@@ -120,7 +120,7 @@ static void write_json(const char *path, const result *r, int n, const result *s
         }
     }
     fprintf(f, "  ]\n}\n");
-    fclose(f);
+    return lm_cli_single_close(a, a->json_path, &out);
 }
 
 int lm_cli_bench(const lm_cli_args *a)
@@ -135,6 +135,8 @@ int lm_cli_bench(const lm_cli_args *a)
         files = DEFAULT_SCENES;
         count = (int)(sizeof DEFAULT_SCENES / sizeof *DEFAULT_SCENES);
     }
+    if (a->json_path && !lm_cli_single_allowed(a, a->json_path))
+        return 1;
     result *res = calloc((size_t)count + (size_t)a->scaling_count + 1, sizeof *res);
     if (!res)
         return 1;
@@ -165,8 +167,8 @@ int lm_cli_bench(const lm_cli_args *a)
     }
     if (sn > 0)
         print_scaling(sr, sn);
-    if (a->json_path)
-        write_json(a->json_path, res, n, sr, sn);
+    if (a->json_path && !write_json(a, res, n, sr, sn))
+        rc = 1;
     free(res);
     if (a->file_count == 0) {
         lm_cli_bench_budget();

@@ -9,15 +9,19 @@
 
 #include "edit_script.h"
 #include "order_stats.h"
+#include "out_dir.h"
 #include "run_cmd.h"
 
-static void report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_frame *rows)
+static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_frame *rows)
 {
     printf("lmgi bench --edits %s %s: %d updates, budget %.1f ms, %d fps, %d texels\n", a->edits_path, a->files[0],
            s->frames, (double)s->budget_ms, s->fps, s->texels);
     printf("%-28s %6s %10s %14s %14s %14s %20s\n", "edit", "frame", "error", "to 5%", "to 2%", "rewrites",
            "outside its reach");
-    FILE *json = a->json_path ? fopen(a->json_path, "w") : NULL;
+    lm_cli_single out = {0};
+    if (a->json_path && !lm_cli_single_open(&out))
+        return 0;
+    FILE *json = out.f;
     if (json)
         fprintf(json, "{\n  \"script\": \"%s\", \"scene\": \"%s\", \"budget_ms\": %g,\n  \"edits\": [\n",
                 a->edits_path, a->files[0], (double)s->budget_ms);
@@ -70,10 +74,9 @@ static void report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_
                     rows[f].texels, rows[f].photons, rows[f].aim, rows[f].changed, rows[f].error,
                     f + 1 < s->frames ? "," : "");
         fprintf(json, "  ]\n}\n");
-        if (fclose(json) != 0)
-            fprintf(stderr, "lmgi: bench: %s: write failed\n", a->json_path);
     }
     free(ms);
+    return !json || lm_cli_single_close(a, a->json_path, &out);
 }
 
 int lm_cli_bench_edits(const lm_cli_args *a)
@@ -83,7 +86,7 @@ int lm_cli_bench_edits(const lm_cli_args *a)
         return 2;
     }
     lm_edit_script s;
-    if (!lm_edit_script_read(a->edits_path, &s))
+    if ((a->json_path && !lm_cli_single_allowed(a, a->json_path)) || !lm_edit_script_read(a->edits_path, &s))
         return 1;
     lm_edit_frame *rows = calloc((size_t)s.frames, sizeof *rows);
     lmgi_updater_desc d; /* the photon and gather options given; the frame and progress as the zero desc's */
@@ -93,7 +96,7 @@ int lm_cli_bench_edits(const lm_cli_args *a)
     d.progress_user = NULL;
     int ok = rows && lm_edit_script_play(&s, a->files[0], &d, s.budget_ms, NULL, rows);
     if (ok)
-        report(a, &s, rows);
+        ok = report(a, &s, rows);
     free(rows);
     lm_edit_script_free(&s);
     return ok ? 0 : 1;

@@ -52,7 +52,7 @@ static void ratio_picture(const lmgi_check_result *c, float *rgb)
     }
 }
 
-static int write_images(const char *dir, const lmgi_check_result *c)
+static int write_images(lmgi_output *dir, const lmgi_check_result *c)
 {
     lmgi_error err;
     lmgi_status st = lm_cli_write_image(dir, "check_frame.exr", c->width, c->height, 3, c->frame, NULL, &err);
@@ -81,12 +81,14 @@ int lm_cli_check(const lm_cli_args *a)
                         "       [--samples N] [--cache DIR] [--no-cache] [--out DIR]\n");
         return 2;
     }
-    static const char *const own[] = {"check_*.exr", "check_*.png", NULL};
-    if (a->out_dir && !lm_cli_claim_out_dir(a, own))
-        return 1;
     lmgi_scene *sc = NULL;
     if (!lm_cli_run_load(a, &sc))
         return 1;
+    lmgi_output *out = NULL; /* opened before the long work, so a bad path fails at once */
+    if (a->out_dir && !(out = lm_cli_open_out(a, "check"))) {
+        lmgi_free(sc);
+        return 1;
+    }
     lmgi_updater_desc d;
     lm_cli_updater_desc(a, &d);
     d.progress = NULL;
@@ -104,10 +106,11 @@ int lm_cli_check(const lm_cli_args *a)
         rc = 1;
     } else {
         report(sc, &c);
-        if (a->out_dir && !write_images(a->out_dir, &c))
+        if (out && !write_images(out, &c))
             rc = 1;
         lmgi_check_free(&c);
     }
+    rc = lm_cli_close_out(out, rc);
     lmgi_context_free(ctx);
     lmgi_free(sc);
     return rc;

@@ -143,8 +143,8 @@ static void usage(FILE *f)
             "                   (linear, the units of an emissive surface), zenith/horizon gradient or an\n"
             "                   equirectangular HDR image (docs/levels.md): lights through photons, the\n"
             "                   gather, the background and reflections; a file's extras.lmgi.sky gives one too\n"
-            "  --force          write into a non-empty --out DIR that lmgi did not make (lmgi marks its\n"
-            "                   own with DIR/.lmgi and replaces only its own kind of file there)\n"
+            "  --force          write into a non-empty --out DIR lmgi has not written before; lmgi lists\n"
+            "                   its files in DIR/.lmgi and never removes or replaces any other file\n"
             "  -v, -q           more / less on stderr; where stderr is not a terminal, progress comes as a\n"
             "                   line every 5 s (LMGI_PROGRESS_SECONDS)\n");
 }
@@ -175,15 +175,17 @@ static int cmd_charts(const lm_cli_args *a)
         fprintf(stderr, "lmgi: charts needs --out DIR\n");
         return 2;
     }
-    static const char *const own[] = {"atlas.png", "surfaces.png", NULL};
-    if (!lm_cli_claim_out_dir(a, own))
-        return 1;
     lmgi_scene *sc = NULL;
     int rc = load(a, &sc);
     if (rc)
         return rc;
+    lmgi_output *o = lm_cli_open_out(a, "charts");
+    if (!o) {
+        lmgi_free(sc);
+        return 1;
+    }
     lmgi_error err;
-    if (lmgi_write_charts(sc, a->out_dir, a->width, a->height, &err) != LMGI_OK) {
+    if (lmgi_write_charts(sc, lmgi_output_folder(o), a->width, a->height, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         rc = 1;
     } else if (!a->quiet) {
@@ -194,7 +196,7 @@ static int cmd_charts(const lm_cli_args *a)
                in.surfaces);
     }
     lmgi_free(sc);
-    return rc;
+    return lm_cli_close_out(o, rc);
 }
 
 int main(int argc, char **argv)

@@ -38,11 +38,11 @@ void lm_cli_reference_desc(const lm_cli_args *a, lmgi_reference_desc *d)
 }
 
 /* DIR/NAME written from pixels, or the error printed. */
-static int write(const lm_cli_args *a, const char *name, int w, int h, const float *px)
+static int write(const lm_cli_args *a, lmgi_output *o, const char *name, int w, int h, const float *px)
 {
     lmgi_image_desc d = {(lmgi_tonemap)a->tonemap, 0.0f, 0};
     lmgi_error err;
-    if (lm_cli_write_image(a->out_dir, name, w, h, 3, px, &d, &err) == LMGI_OK)
+    if (lm_cli_write_image(o, name, w, h, 3, px, &d, &err) == LMGI_OK)
         return 1;
     fprintf(stderr, "lmgi: error: %s\n", err.message);
     return 0;
@@ -82,7 +82,7 @@ static void report_parts(const lmgi_reference *r, const char *const *names, cons
     }
 }
 
-static int run_texels(const lm_cli_args *a, const lmgi_scene *sc, const lmgi_reference_desc *d)
+static int run_texels(const lm_cli_args *a, lmgi_output *o, const lmgi_scene *sc, const lmgi_reference_desc *d)
 {
     lmgi_reference r;
     lmgi_error err;
@@ -95,10 +95,10 @@ static int run_texels(const lm_cli_args *a, const lmgi_scene *sc, const lmgi_ref
     static const char *const files[] = {"reference_direct.exr", "reference_iim.exr", "reference_caustic.exr",
                                         "reference_lost.exr"};
     const float *parts[] = {r.direct, r.iim, r.caustic, r.lost};
-    int ok = write(a, "reference_full.exr", r.width, r.height, r.full) &&
-             write(a, "reference_radiance.exr", r.width, r.height, r.radiance);
+    int ok = write(a, o, "reference_full.exr", r.width, r.height, r.full) &&
+             write(a, o, "reference_radiance.exr", r.width, r.height, r.radiance);
     for (int k = 0; ok && k < 4; k++)
-        ok = write(a, files[k], r.width, r.height, parts[k]);
+        ok = write(a, o, files[k], r.width, r.height, parts[k]);
     if (ok && !a->quiet) {
         lmgi_info in;
         lmgi_get_info(sc, &in);
@@ -110,7 +110,7 @@ static int run_texels(const lm_cli_args *a, const lmgi_scene *sc, const lmgi_ref
     return ok;
 }
 
-static int run_pixels(const lm_cli_args *a, const lmgi_scene *sc, const lmgi_reference_desc *d)
+static int run_pixels(const lm_cli_args *a, lmgi_output *o, const lmgi_scene *sc, const lmgi_reference_desc *d)
 {
     int w = a->width > 0 ? a->width : LM_CLI_REF_WIDTH, h = a->height > 0 ? a->height : LM_CLI_REF_HEIGHT;
     lmgi_camera cam;
@@ -124,11 +124,11 @@ static int run_pixels(const lm_cli_args *a, const lmgi_scene *sc, const lmgi_ref
     }
     static const char *const names[] = {"emission", "direct", "indirect", "caustic", "reflections", "lost"};
     const float *parts[] = {r.emission, r.direct, r.indirect, r.caustic, r.reflections, r.lost};
-    int ok = write(a, "reference_pixels.exr", w, h, r.full) && write(a, "reference_pixels.png", w, h, r.full);
+    int ok = write(a, o, "reference_pixels.exr", w, h, r.full) && write(a, o, "reference_pixels.png", w, h, r.full);
     for (int k = 0; ok && k < 6; k++) {
         char name[64];
         snprintf(name, sizeof name, "reference_pixels_%s.exr", names[k]);
-        ok = write(a, name, w, h, parts[k]);
+        ok = write(a, o, name, w, h, parts[k]);
     }
     if (ok && !a->quiet) {
         report("pixels", &r, lm_cli_now() - t0);
@@ -146,17 +146,19 @@ int lm_cli_reference(const lm_cli_args *a)
                         "       [--texel-size S]\n");
         return 2;
     }
-    static const char *const own[] = {"reference_*.exr", "reference_*.png", NULL};
-    if (!lm_cli_claim_out_dir(a, own))
-        return 1;
     lmgi_scene *sc = NULL;
     if (!lm_cli_load_scene(a->files[0], &a->options, 1, &sc))
         return 1;
+    lmgi_output *o = lm_cli_open_out(a, "reference");
+    if (!o) {
+        lmgi_free(sc);
+        return 1;
+    }
     lmgi_reference_desc d;
     lm_cli_reference_desc(a, &d);
     if (!d.caustic_photons) /* the reference command has no updater: --caustic-photons is its own */
         d.caustic_photons = a->caustic_photons;
-    int ok = run_texels(a, sc, &d) && run_pixels(a, sc, &d);
+    int ok = run_texels(a, o, sc, &d) && run_pixels(a, o, sc, &d);
     lmgi_free(sc);
-    return ok ? 0 : 1;
+    return lm_cli_close_out(o, !ok);
 }

@@ -22,6 +22,7 @@ typedef struct {
     lmgi_scene *sc;
     lmgi_context *ctx;
     lmgi_updater *u;
+    lmgi_output *out;      /* --out, committed when the run succeeds */
     FILE *csv;
     float exposure;        /* fixed from frame 0 */
     double sum_ms[8];      /* photons, gather, blend, direct, caustics, reflections, composite, total */
@@ -114,11 +115,11 @@ static lmgi_status write_pair(const run_state *r, const char *name, int w, int h
 {
     char file[80];
     snprintf(file, sizeof file, "%s.exr", name);
-    if (exr && lm_cli_write_image(r->a->out_dir, file, w, h, channels, px, NULL, err) != LMGI_OK)
+    if (exr && lm_cli_write_image(r->out, file, w, h, channels, px, NULL, err) != LMGI_OK)
         return err->status;
     snprintf(file, sizeof file, "%s.png", name);
     lmgi_image_desc png = {(lmgi_tonemap)r->a->tonemap, k > 0.0f ? k : 0.0f, 0};
-    return lm_cli_write_image(r->a->out_dir, file, w, h, channels, px, &png, err);
+    return lm_cli_write_image(r->out, file, w, h, channels, px, &png, err);
 }
 
 static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
@@ -272,22 +273,18 @@ static lmgi_status play(run_state *r, lmgi_error *err)
 /* Files are created only once the frame loop exists: a run refused for its settings writes nothing. */
 static lmgi_status open_outputs(run_state *r, lmgi_error *err)
 {
-    char path[4096];
-    snprintf(path, sizeof path, "%s/frames.csv", r->a->out_dir);
-    r->csv = fopen(path, "w");
-    return r->csv ? LMGI_OK : lm_cli_fail(err, LMGI_ERR_IO, "%s: cannot write", path);
+    char path[4200];
+    lmgi_status st = lmgi_output_file(r->out, "frames.csv", path, sizeof path, err);
+    if (st == LMGI_OK)
+        r->csv = fopen(path, "wx"); /* created, never opened through what is there */
+    return st != LMGI_OK || r->csv ? st : lm_cli_fail(err, LMGI_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
 }
 
 static lmgi_status run(run_state *r, lmgi_error *err)
 {
     lmgi_updater_desc desc;
     lm_cli_updater_desc(r->a, &desc);
-    /* the output directory, claimed before the long setup, so a bad path fails at once */
-    static const char *const own[] = {"frame_*.png", "frame_*.exr", "frames.csv", "iim.exr", "iim.png", "aim.exr",
-                                      "aim.png", "caustics.exr", "caustics.png", NULL};
-    lmgi_status st = lmgi_claim_output_dir(r->a->out_dir, r->a->force, own, err);
-    if (st == LMGI_OK)
-        st = lmgi_context_create(NULL, &r->ctx, err);
+    lmgi_status st = lmgi_context_create(NULL, &r->ctx, err);
     if (st == LMGI_OK)
         st = lmgi_updater_create(r->ctx, r->sc, &desc, &r->u, err);
     if (st == LMGI_OK)
@@ -301,8 +298,6 @@ static lmgi_status run(run_state *r, lmgi_error *err)
         st = write_atlases(r, err);
     if (st == LMGI_OK)
         st = write_caustics(r, err);
-    if (st == LMGI_OK && !r->a->quiet)
-        summary(r, r->a->frames ? r->a->frames : 60);
     return st;
 }
 
@@ -327,10 +322,17 @@ int lm_cli_run(const lm_cli_args *a)
     r.a = a;
     if (!lm_cli_run_load(a, &r.sc))
         return 1;
+    /* the output directory, opened before the long setup, so a bad path fails at once; the earlier run's
+     * files stay until this one has succeeded */
+    r.out = lm_cli_open_out(a, "run");
     lmgi_error err;
-    lmgi_status st = run(&r, &err);
-    if (st != LMGI_OK)
+    lmgi_status st = r.out ? run(&r, &err) : LMGI_ERR_IO;
+    if (st != LMGI_OK && r.out)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
+    if (r.out && lm_cli_close_out(r.out, st != LMGI_OK) != 0)
+        st = LMGI_ERR_IO;
+    if (st == LMGI_OK && !a->quiet)
+        summary(&r, a->frames ? a->frames : 60);
     lmgi_updater_free(r.u);
     lmgi_context_free(r.ctx);
     free(r.frame_ms);

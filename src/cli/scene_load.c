@@ -18,6 +18,11 @@ void lm_cli_set_sky(lm_cli_sky kind, const float zenith[3], const float horizon[
     g_sky.image = image;
 }
 
+const char *lm_cli_sky_image(void)
+{
+    return g_sky.kind == LM_CLI_SKY_IMAGE ? g_sky.image : NULL;
+}
+
 static lmgi_status set_sky(lmgi_scene *sc, lmgi_error *err)
 {
     switch (g_sky.kind) {

@@ -467,7 +467,8 @@ int lm_cli_tradeoff(const lm_cli_args *a)
     edit_scripts scripts;
     if (!read_scripts(a, &scripts))
         return 2;
-    if (!lm_cli_claim_out_dir(a, lm_tradeoff_own_files())) {
+    lmgi_output *out = lm_cli_open_out(a, "tradeoff");
+    if (!out) {
         free_scripts(&scripts);
         return 1;
     }
@@ -480,7 +481,7 @@ int lm_cli_tradeoff(const lm_cli_args *a)
     if (lmgi_context_create(NULL, &ctx, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         free_scripts(&scripts);
-        return 1;
+        return lm_cli_close_out(out, 1);
     }
     lm_tradeoff_scene *scenes = calloc((size_t)a->file_count, sizeof *scenes);
     int ok = scenes != NULL, done = 0;
@@ -494,8 +495,12 @@ int lm_cli_tradeoff(const lm_cli_args *a)
     }
     lm_tradeoff_run run = {a->quick, a->repeats, rd.target_error, scenes, done};
     /* what was measured is written even when a later scene failed */
-    int wrote = scenes && lm_tradeoff_write(a->out_dir, &run);
-    int reported = wrote && ok && lm_tradeoff_report(a->out_dir, a->quiet);
+    int wrote = scenes && lm_tradeoff_write(lmgi_output_folder(out), &run);
+    int reported = wrote && ok && lm_tradeoff_report(lmgi_output_folder(out), a->out_dir);
+    if (lm_cli_close_out(out, !wrote) != 0)
+        reported = 0;
+    else if (reported && !a->quiet)
+        printf("wrote %s/report.html\n", a->out_dir);
     for (int i = 0; i < done; i++)
         if (scenes[i].failed) {
             fprintf(stderr, "lmgi: tradeoff: %d setting(s) of %s could not be measured (above); their rows are "

@@ -10,13 +10,6 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-const char *const *lm_tradeoff_own_files(void)
-{
-    static const char *const own[] = {"tradeoff.csv", "tradeoff.json", "lag.csv", "map_*.npy", "plot_*.png",
-                                      "report.html", NULL};
-    return own;
-}
-
 void lm_tradeoff_scene_name(const char *path, char *name, size_t size)
 {
     const char *base = strrchr(path, '/');
@@ -73,7 +66,7 @@ static int write_npy(const char *path, const float *v, int height, int width)
     int len = snprintf(header, sizeof header, "{'descr': '<f4', 'fortran_order': False, 'shape': (%d, %d), }",
                        height, width);
     int total = 10 + len + 1, pad = (64 - total % 64) % 64; /* magic, version, length; aligned to 64 */
-    FILE *f = fopen(path, "wb");
+    FILE *f = fopen(path, "wbx");
     if (!f)
         return 0;
     unsigned short hl = (unsigned short)(len + pad + 1);
@@ -179,7 +172,7 @@ static void csv_row(FILE *f, const lm_tradeoff_scene *s, const lm_tradeoff_row *
 
 static int write_csv(const char *path, const lm_tradeoff_run *run)
 {
-    FILE *f = fopen(path, "w");
+    FILE *f = fopen(path, "wx");
     if (!f)
         return 0;
     fprintf(f, "scene,knob,value,x,default,atlas_texels,photons,coverage,solution_ms,trace_ms,aim_ms,gather_ms");
@@ -266,7 +259,7 @@ static int lag_of(const lm_edit_script *s, const lm_tradeoff_play *p, int i, edi
 
 static int write_lag_csv(const char *path, const lm_tradeoff_run *run)
 {
-    FILE *f = fopen(path, "w");
+    FILE *f = fopen(path, "wx");
     if (!f)
         return 0;
     fprintf(f, "scene,knob,value,default,edit,frame,error,frames_to_5,ms_to_5,frames_to_2,ms_to_2,frame_error,"
@@ -338,7 +331,7 @@ static void json_plays(FILE *f, const lm_tradeoff_scene *s)
 
 static int write_json(const char *path, const lm_tradeoff_run *run, int (*picks)[3])
 {
-    FILE *f = fopen(path, "w");
+    FILE *f = fopen(path, "wx");
     if (!f)
         return 0;
     fprintf(f, "{\"quick\": %s, \"repeats\": %d, \"reference_target_error\": %.4g, \"scenes\": [\n",
@@ -425,13 +418,13 @@ static int find_script(char *out, size_t size)
     return 0;
 }
 
-int lm_tradeoff_report(const char *dir, int quiet)
+int lm_tradeoff_report(const char *dir, const char *shown)
 {
     char script[PATH_MAX + 64];
     if (!find_script(script, sizeof script)) {
         fprintf(stderr, "lmgi: error: tools/tradeoff_report.py not found beside the lmgi executable: "
                         "%s/tradeoff.csv and .json are written; run python3 tools/tradeoff_report.py %s for the "
-                        "report\n", dir, dir);
+                        "report\n", shown, shown);
         return 0;
     }
     fflush(NULL);
@@ -439,14 +432,14 @@ int lm_tradeoff_report(const char *dir, int quiet)
     if (pid == 0) {
         /* Debian's python3 first: make deps installs matplotlib for it, whatever python3 PATH finds */
         const char *py = access("/usr/bin/python3", X_OK) == 0 ? "/usr/bin/python3" : "python3";
-        execlp(py, py, script, dir, quiet ? "-q" : (char *)NULL, (char *)NULL);
+        execlp(py, py, script, dir, "-q", (char *)NULL); /* it would name the folder it writes in, not `shown` */
         fprintf(stderr, "lmgi: error: cannot run python3: %s\n", strerror(errno));
         _exit(127);
     }
     int status = 0;
     if (pid < 0 || waitpid(pid, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0) {
         fprintf(stderr, "lmgi: error: the report (python3 %s %s) failed: it needs python3 and matplotlib "
-                        "(make deps installs them); tradeoff.csv and .json are written\n", script, dir);
+                        "(make deps installs them); tradeoff.csv and .json are written\n", script, shown);
         return 0;
     }
     return 1;

@@ -64,8 +64,6 @@ typedef struct {
     int count;
 } lm_tradeoff_run;
 
-/* The fnmatch patterns of the files the command writes (for lmgi_claim_output_dir). */
-const char *const *lm_tradeoff_own_files(void);
 void lm_tradeoff_scene_name(const char *path, char *name, size_t size);
 /* dst = src with its own copies of the maps (a setting measured once, listed under two knobs). */
 void lm_tradeoff_row_copy(lm_tradeoff_row *dst, const lm_tradeoff_row *src);
@@ -74,8 +72,9 @@ void lm_tradeoff_scene_free(lm_tradeoff_scene *s);
  * update's time, and per edit the updates and milliseconds until it is within 5% and 2%), lag.csv and
  * the maps. 0 (after printing the error) when a file cannot be written. */
 int lm_tradeoff_write(const char *dir, const lm_tradeoff_run *run);
-/* Runs tools/tradeoff_report.py DIR (found beside the executable: ../tools or ../share/lmgi). 0 (after
- * saying why and how to run it) when it is not found or fails. */
-int lm_tradeoff_report(const char *dir, int quiet);
+/* Runs tools/tradeoff_report.py DIR quietly (found beside the executable: ../tools or ../share/lmgi). 0
+ * (after saying why and how to run it, naming `shown`: where the files end up) when it is not found or
+ * fails. */
+int lm_tradeoff_report(const char *dir, const char *shown);
 
 #endif

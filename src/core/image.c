@@ -1,27 +1,37 @@
 #include "image.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>
 #include <tinyexr.h>
 
-/* A file appears whole or not at all: the bytes go to PATH.partial, every write and the close are
- * checked (a full disk shows up at fclose, when the buffer is flushed), and only then does a rename put
+/* A file appears whole or not at all: the bytes go to PATH.partial (created exclusively), every write
+ * and the close are checked (a full disk shows up at fclose, when the buffer is flushed), and only then does a rename put
  * it in place. A failure removes the partial file and leaves whatever PATH held before. */
 lm_status lm_write_file(const char *path, const void *data, size_t size, lm_error *err)
 {
     char tmp[4200];
     if (snprintf(tmp, sizeof tmp, "%s.partial", path) >= (int)sizeof tmp)
         return lm_fail(err, LM_ERR_INVALID, "%s: path too long", path);
-    FILE *f = fopen(tmp, "wb");
-    if (!f)
+    /* created, never opened: a file or a symbolic link already in the way is refused, not written through */
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd < 0 && errno == EEXIST)
+        return lm_fail(err, LM_ERR_IO, "%s: %s is in the way (a write that was killed left it, another program "
+                       "is writing it, or it is a link); lmgi will not write through it: remove it", path, tmp);
+    FILE *f = fd < 0 ? NULL : fdopen(fd, "wb");
+    if (!f) {
+        if (fd >= 0)
+            close(fd);
         return lm_fail(err, LM_ERR_IO, "%s: cannot write (%s)", path, strerror(errno));
+    }
     int ok = fwrite(data, 1, size, f) == size;
     int e = errno;
     ok = fflush(f) == 0 && ok;

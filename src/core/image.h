@@ -7,7 +7,8 @@
 #include "error.h"
 
 /* Writes size bytes to path through path.partial and a rename: the file is whole or absent, every write
- * and the close checked; on failure the message names path and the reason, and path is as it was. */
+ * and the close checked; on failure the message names path and the reason, and path is as it was.
+ * path.partial is created exclusively: one already there (a file or a link) is refused, never followed. */
 lm_status lm_write_file(const char *path, const void *data, size_t size, lm_error *err);
 /* rgba8: width*height*4 bytes, row 0 at the top. Both writers go through lm_write_file. */
 lm_status lm_write_png(const char *path, int width, int height, const uint8_t *rgba8, lm_error *err);

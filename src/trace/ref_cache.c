@@ -244,7 +244,7 @@ void lm_ref_cache_store(const char *path, uint32_t kind, const lm_ref_result *r)
         fnv(&sum, b.p, b.len);
     put(&b, &sum, sizeof sum);
     snprintf(tmp, sizeof tmp, "%s.tmp%ld", path, (long)getpid());
-    FILE *f = b.bad ? NULL : fopen(tmp, "wb");
+    FILE *f = b.bad ? NULL : fopen(tmp, "wbx"); /* created: never through a link planted there */
     int ok = f && fwrite(b.p, 1, b.len, f) == b.len;
     ok = (f && fclose(f) == 0) && ok;
     if (ok && rename(tmp, path) != 0)

@@ -60,8 +60,8 @@ static void csv_row(FILE *f, const lm_photon_stage_frame *r)
 }
 
 /* DIR/aim.exr (linear), DIR/aim.png (tone-mapped) and DIR/view.png (the scene with its AIMs). */
-static lm_status write_pictures(const lmgi_scene *sc, const lm_aim *aim, const lm_cli_args *a, float *exposure,
-                                lm_error *err)
+static lm_status write_pictures(const lmgi_scene *sc, const lm_aim *aim, const lm_cli_args *a, lmgi_output *out,
+                                float *exposure, lm_error *err)
 {
     const lm_atlas *at = &sc->atlas;
     size_t n = (size_t)at->width * at->height;
@@ -69,18 +69,18 @@ static lm_status write_pictures(const lmgi_scene *sc, const lm_aim *aim, const l
     uint8_t *img = malloc(n * 4);
     int w = a->width ? a->width : 640, h = a->height ? a->height : 480;
     uint8_t *view_img = malloc((size_t)w * h * 4);
-    char path[4096];
+    char path[4200];
     lm_status st = rgb && img && view_img ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory for the pictures");
     if (st == LM_OK) {
         memcpy(rgb, lm_aim_rgb(aim), n * 3 * sizeof *rgb);
-        snprintf(path, sizeof path, "%s/aim.exr", a->out_dir);
+        snprintf(path, sizeof path, "%s/aim.exr", lmgi_output_folder(out));
         st = lm_write_exr(path, at->width, at->height, 3, rgb, err);
     }
     if (st == LM_OK) {
         lm_atlas_dilate_gutters(at, rgb, 3);
         *exposure = lm_auto_exposure(rgb, n, 3);
         lm_tonemap_srgb8(rgb, n, 3, *exposure, img);
-        snprintf(path, sizeof path, "%s/aim.png", a->out_dir);
+        snprintf(path, sizeof path, "%s/aim.png", lmgi_output_folder(out));
         st = lm_write_png(path, at->width, at->height, img, err);
     }
     lm_gl_context *gl = NULL;
@@ -90,7 +90,7 @@ static lm_status write_pictures(const lmgi_scene *sc, const lm_aim *aim, const l
         lm_view view;
         lm_view_for_scene(sc->scene, a->camera, w, h, &view);
         st = lm_render_lightmap(sc->scene, at, rgb, *exposure, &view, w, h, view_img, err);
-        snprintf(path, sizeof path, "%s/view.png", a->out_dir);
+        snprintf(path, sizeof path, "%s/view.png", lmgi_output_folder(out));
         if (st == LM_OK)
             st = lm_write_png(path, w, h, view_img, err);
     }
@@ -152,17 +152,17 @@ int lm_dev_photons(const lm_cli_args *a)
     lm_photon_stage *stage = NULL;
     lm_photon_stage_frame setup;
     memset(&setup, 0, sizeof setup);
-    char path[4096];
+    char path[4200];
     FILE *csv = NULL;
     double sum_ms = 0.0;
     float exposure = 1.0f;
-    static const char *const own[] = {"aim.exr", "aim.png", "view.png", "stats.csv", NULL};
-    if (!lm_cli_claim_out_dir(a, own)) {
+    lmgi_output *out = lm_cli_open_out(a, "photons");
+    if (!out || !lm_cli_out_path(out, "stats.csv", path, sizeof path)) {
+        lm_cli_close_out(out, 1);
         lmgi_free(sc);
         return 1;
     }
-    snprintf(path, sizeof path, "%s/stats.csv", a->out_dir);
-    csv = fopen(path, "w");
+    csv = fopen(path, "wx");
     lm_status st = csv ? LM_OK : lm_fail(&err, LM_ERR_IO, "%s: cannot write", path);
     if (st == LM_OK)
         st = lm_photon_stage_create(&sc->world, &set, &stage, &setup, &err);
@@ -173,12 +173,12 @@ int lm_dev_photons(const lm_cli_args *a)
     if (csv && fclose(csv) != 0 && st == LM_OK)
         st = lm_fail(&err, LM_ERR_IO, "%s/stats.csv: write failed", a->out_dir);
     if (st == LM_OK)
-        st = write_pictures(sc, lm_photon_stage_aim(stage), a, &exposure, &err);
+        st = write_pictures(sc, lm_photon_stage_aim(stage), a, out, &exposure, &err);
     if (st == LM_OK && !a->quiet)
         summary(stage, &setup, a->frames ? a->frames : 60, sum_ms, exposure, a->out_dir);
     if (st != LM_OK)
         fprintf(stderr, "lmgi-dev: error: %s\n", err.msg);
     lm_photon_stage_free(stage);
     lmgi_free(sc);
-    return st == LM_OK ? 0 : 1;
+    return lm_cli_close_out(out, st != LM_OK);
 }
