@@ -354,8 +354,10 @@ LMGI_API lmgi_status lmgi_write_charts(const lmgi_scene *scene, const char *dir,
  * Context: where messages go and the OpenGL context every updater made from it renders with.
  *
  * Thread-safety: a context, and every updater made from it, is used from one thread at a time (the
- * GL context is made current on the calling thread at each call). Two contexts may be used on two
- * threads at once; nothing is shared between them but read-only scenes. */
+ * GL context is made current on the calling thread at each call); a call from a second thread while
+ * another is inside one is refused with LMGI_ERR_INVALID ("in use by another thread"), not raced (docs/
+ * api.md, "Threads"). Two contexts may be used on two threads at once; nothing is shared between them but
+ * read-only scenes. */
 typedef struct lmgi_context lmgi_context;
 
 typedef enum { LMGI_LOG_ERROR = 1, LMGI_LOG_WARN, LMGI_LOG_INFO, LMGI_LOG_DEBUG } lmgi_log_level;
@@ -719,6 +721,8 @@ typedef struct {
     float target_error;     /* the relative standard error it sampled to (the desc's, or the default) */
     uint32_t entries, converged; /* texels or pixels, and how many reached the target (the rest hit the cap) */
     uint64_t samples;       /* paths traced over all entries */
+    uint64_t paths_cut;     /* paths still going after 65536 bounces, their light past that missing: 0 but
+                             * where light never dies out (a closed room of albedo 1); a warning says so */
     double mean_rel_se, max_rel_se; /* achieved relative standard error per entry (of the path-traced parts) */
     double seconds;         /* computing time (the first computation's when it came from the cache) */
     uint64_t caustic_photons; /* photons the caustic part traced (0: the scene has no mirror, glass or light) */

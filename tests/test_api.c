@@ -8,6 +8,8 @@
 
 #include <lmgi.h>
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -897,6 +899,75 @@ static void test_scene_from_arrays(void **state)
 }
 
 /* liblmgi.so exports exactly the functions lmgi.h marks LMGI_API: nothing internal, nothing missing. */
+/* One context, two threads: while thread A is inside a call on the context (an updater's creation, held
+ * in its progress callback), thread B's calls on the context, its other updater and that updater's scene
+ * are refused with a message, not raced into a crash; afterwards B's calls go through. */
+typedef struct {
+    lmgi_context *ctx;
+    lmgi_scene *scene;
+    lmgi_updater *made;
+    atomic_int inside, done;
+    lmgi_status status;
+} held_call;
+
+static void hold(void *user, float fraction, const char *stage)
+{
+    (void)fraction, (void)stage;
+    held_call *h = user;
+    atomic_store(&h->inside, 1);
+    while (!atomic_load(&h->done))
+        nanosleep(&(struct timespec){0, 1000000}, NULL);
+}
+
+static void *create_held(void *user)
+{
+    held_call *h = user;
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.progress = hold;
+    d.progress_user = h;
+    lmgi_error e;
+    h->status = lmgi_updater_create(h->ctx, h->scene, &d, &h->made, &e);
+    return NULL;
+}
+
+static void test_second_thread_refused(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = new_context();
+    lmgi_scene *first = load_cornell(), *second = load_cornell();
+    lmgi_updater_desc d;
+    small_desc(&d);
+    lmgi_updater *u = make_updater(ctx, first, &d);
+    held_call h = {.ctx = ctx, .scene = second};
+    pthread_t a;
+    assert_int_equal(pthread_create(&a, NULL, create_held, &h), 0);
+    while (!atomic_load(&h.inside))
+        nanosleep(&(struct timespec){0, 1000000}, NULL);
+    lmgi_error e;
+    lmgi_update_stats st;
+    expect_invalid(lmgi_update(u, 0.1f, 0.0f, &st, &e), &e, "lmgi_update: the context is in use by another thread");
+    float rgb[3 * 8 * 8];
+    lmgi_camera cam;
+    assert_int_equal(lmgi_scene_camera(first, -1, 8, 8, &cam, &e), LMGI_OK);
+    expect_invalid(lmgi_render(u, &cam, 8, 8, rgb, &e), &e, "in use by another thread");
+    expect_invalid(lmgi_set_time(first, 0.5f, &e), &e, "lmgi_set_time: the context is in use by another thread");
+    lmgi_scene *third = load_cornell();
+    lmgi_updater *v = NULL;
+    expect_invalid(lmgi_updater_create(ctx, third, &d, &v, &e), &e, "in use by another thread");
+    assert_null(v);
+    lmgi_updater_free(u); /* refused: logged, kept */
+    atomic_store(&h.done, 1);
+    pthread_join(a, NULL);
+    assert_int_equal(h.status, LMGI_OK);
+    update(u, 0.1f, 0.0f, &st); /* the same calls, now the context is free */
+    assert_int_equal(lmgi_set_time(first, 0.5f, &e), LMGI_OK);
+    lmgi_updater_free(h.made);
+    lmgi_free(second);
+    lmgi_free(third);
+    close_all(u, first, ctx);
+}
+
 static void test_exported_symbols(void **state)
 {
     (void)state;
@@ -943,6 +1014,7 @@ int main(void)
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_write_image),
         cmocka_unit_test(test_scene_from_arrays),
+        cmocka_unit_test(test_second_thread_refused),
         cmocka_unit_test(test_exported_symbols),
     };
     lmgi_set_verbosity(0); /* the refusals below log errors on purpose */

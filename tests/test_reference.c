@@ -19,20 +19,24 @@
 
 #define PI 3.14159265358979323846
 
-/* A closed box of half-size 1 seen from inside: every wall faces in, albedo 0.5, emits radiance 1. */
-static const char *furnace_scene(void)
+/* A closed box of half-size 1 seen from inside: every wall faces in, albedo rho, emits radiance 1. */
+static const char *furnace_scene_of(double rho)
 {
     static char path[512];
     static lmt_mesh m;
     memset(&m, 0, sizeof m);
     lmt_mesh_cube_inward(&m, 1.0f);
-    const char *mat = "\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1],"
-                      " \"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}],";
+    char mat[400];
+    snprintf(mat, sizeof mat, "\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorFactor\": [%.17g, %.17g, "
+             "%.17g, 1], \"metallicFactor\": 0, \"roughnessFactor\": 1}, \"emissiveFactor\": [1, 1, 1]}],", rho, rho,
+             rho);
     snprintf(path, sizeof path, "%s/furnace.gltf", lmt_tmpdir());
     assert_int_equal(lmt_write_gltf(path, &m, 1, "[{\"mesh\": 0}]", NULL, 0, mat), 0);
     lmt_use_material_0(path);
     return path;
 }
+
+static const char *furnace_scene(void) { return furnace_scene_of(0.5); }
 
 static lm_ref_settings quick_settings(float target, int samples)
 {
@@ -101,6 +105,60 @@ static void test_furnace(void **state)
                   "off by %.4f; %.2f s\n", r.count, (unsigned long long)r.total_samples, r.mean_rel_se, r.max_rel_se,
                   mean, worst, lm_now() - t0);
     assert_true(r.max_rel_se <= 0.006 || r.converged < r.count);
+    lm_ref_result_free(&r);
+    lmt_pipeline_free(&p);
+}
+
+/* Bright rooms: at albedo 0.9, 0.99 and 0.999 light lives for 10, 100 and 1,000 bounces; E = pi / (1 -
+ * rho) must come out whole (a fixed depth of 64 gave 0.47 of it at 0.99), within the error the reference
+ * states, and no path is cut. At albedo 1 the answer is infinite: the reference says so. */
+static void test_bright_furnaces(void **state)
+{
+    (void)state;
+    static const double rhos[3] = {0.9, 0.99, 0.999};
+    for (int k = 0; k < 3; k++) {
+        lmt_pipeline p;
+        lmt_pipeline_load(&p, furnace_scene_of(rhos[k]), 1.0f);
+        lm_ref_settings set = quick_settings(0.05f, 64);
+        lm_ref_result r;
+        lm_error err;
+        double t0 = lm_now();
+        assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &r, &err), LM_OK);
+        /* the albedo as the scene holds it (a float): the analytic answer for that */
+        double rho = p.s->materials[0].base_color[0], expect = PI / (1.0 - rho), mean = 0.0, worst = 0.0;
+        for (uint32_t i = 0; i < r.count; i++) {
+            double ratio = r.full[3 * i] / expect;
+            mean += ratio / r.count;
+            worst = fmax(worst, fabs(ratio - 1.0) / fmax(r.rel_se[i], 1e-6)); /* in standard errors */
+        }
+        double stated = r.mean_rel_se / sqrt((double)r.count); /* the mean's standard error */
+        print_message("furnace rho %.3f: %u texels, %llu paths (%.0f per texel), mean E / expected %.4f (stated "
+                      "error of the mean %.4f), worst texel %.1f standard errors off, %llu paths cut; %.1f s\n", rho,
+                      r.count, (unsigned long long)r.total_samples, (double)r.total_samples / r.count, mean, stated,
+                      worst, (unsigned long long)r.paths_cut, lm_now() - t0);
+        assert_int_equal(r.paths_cut, 0);
+        assert_true(fabs(mean - 1.0) <= 4.0 * stated);
+        assert_true(worst < 5.0);
+        lm_ref_result_free(&r);
+        lmt_pipeline_free(&p);
+    }
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, furnace_scene_of(1.0), 1.0f);
+    lm_ref_settings set = quick_settings(0.2f, 8);
+    set.max_samples = 16;
+    set.max_depth = 2000; /* here paths live 1,000 bounces on average: some meet the guard */
+    lm_ref_result r;
+    lm_error err;
+    lm_log_level was = lm_log_get_level();
+    lm_log_set_level(LM_LOG_ERROR); /* counted, not printed */
+    lm_log_reset_warning_count();
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &r, &err), LM_OK);
+    lm_log_set_level(was);
+    print_message("furnace rho 1: %llu of %llu paths cut at %d bounces, %d warnings\n",
+                  (unsigned long long)r.paths_cut, (unsigned long long)r.total_samples, set.max_depth,
+                  lm_log_warning_count());
+    assert_true(r.paths_cut > 0);
+    assert_int_equal(lm_log_warning_count(), 2); /* the albedo, and the cut paths */
     lm_ref_result_free(&r);
     lmt_pipeline_free(&p);
 }
@@ -285,6 +343,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_over_plane),
         cmocka_unit_test(test_furnace),
+        cmocka_unit_test(test_bright_furnaces),
         cmocka_unit_test(test_furnace_pixel_parts),
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_cache_hit_and_corruption),

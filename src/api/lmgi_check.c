@@ -49,7 +49,7 @@ static lm_status export_check(lm_frame_check *c, const lmgi_scene *sc, float tar
     return LM_OK;
 }
 
-lmgi_status lmgi_check(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc,
+static lmgi_status check_owned(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc,
                        const lmgi_reference_desc *ref, int frames, lmgi_check_result *out, lmgi_error *err)
 {
     static const char fn[] = "lmgi_check";
@@ -93,7 +93,20 @@ lmgi_status lmgi_check(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_des
     return lm_export_error(err, &e);
 }
 
-lmgi_status lmgi_check_updater(lmgi_updater *u, const lmgi_camera *cam, int width, int height,
+lmgi_status lmgi_check(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc,
+                       const lmgi_reference_desc *ref, int frames, lmgi_check_result *out, lmgi_error *err)
+{
+    if (!ctx)
+        return check_owned(ctx, sc, desc, ref, frames, out, err); /* refused there, naming it */
+    lmgi_status st = lm_api_claim(ctx, "lmgi_check", err);
+    if (st != LMGI_OK)
+        return st;
+    st = check_owned(ctx, sc, desc, ref, frames, out, err);
+    lm_api_release(ctx);
+    return st;
+}
+
+static lmgi_status check_updater_owned(lmgi_updater *u, const lmgi_camera *cam, int width, int height,
                                const lmgi_reference_desc *ref, lmgi_check_result *out, lmgi_error *err)
 {
     static const char fn[] = "lmgi_check_updater";
@@ -130,6 +143,19 @@ lmgi_status lmgi_check_updater(lmgi_updater *u, const lmgi_camera *cam, int widt
         return LMGI_OK;
     lmgi_check_free(out);
     return lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_check_updater(lmgi_updater *u, const lmgi_camera *cam, int width, int height,
+                               const lmgi_reference_desc *ref, lmgi_check_result *out, lmgi_error *err)
+{
+    if (!u)
+        return check_updater_owned(u, cam, width, height, ref, out, err); /* refused there, naming it */
+    lmgi_status st = lm_api_claim(lm_updater_context(u), "lmgi_check_updater", err);
+    if (st != LMGI_OK)
+        return st;
+    st = check_updater_owned(u, cam, width, height, ref, out, err);
+    lm_api_release(lm_updater_context(u));
+    return st;
 }
 
 void lmgi_check_free(lmgi_check_result *c)

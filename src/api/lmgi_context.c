@@ -22,6 +22,30 @@ lm_log_target lm_api_enter(const lmgi_context *ctx)
 
 void lm_api_leave(lm_log_target saved) { lm_log_swap_target(saved); }
 
+/* A per-thread address: the thread's identity, never 0. */
+static uintptr_t this_thread(void)
+{
+    static _Thread_local char me;
+    return (uintptr_t)&me;
+}
+
+lmgi_status lm_api_claim(lmgi_context *ctx, const char *fn, lmgi_error *err)
+{
+    uintptr_t me = this_thread(), none = 0;
+    if (atomic_load(&ctx->owner) == me || atomic_compare_exchange_strong(&ctx->owner, &none, me)) {
+        ctx->depth++;
+        return LMGI_OK;
+    }
+    return lm_api_refuse(err, "%s: the context is in use by another thread (a context and its updaters are for one "
+                         "thread at a time; docs/api.md, \"Threads\")", fn);
+}
+
+void lm_api_release(lmgi_context *ctx)
+{
+    if (--ctx->depth == 0)
+        atomic_store(&ctx->owner, 0);
+}
+
 lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **out, lmgi_error *err)
 {
     lm_error e;

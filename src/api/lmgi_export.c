@@ -19,6 +19,7 @@
 #include "../core/image.h"
 #include "../core/vecmath.h"
 #include "gltf_write.h"
+#include "lmgi_context.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
@@ -412,7 +413,7 @@ static int plain_name(const char *name)
     return 1;
 }
 
-lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export_desc *desc, lmgi_error *err)
+static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_export_desc *desc, lmgi_error *err)
 {
     static const char fn[] = "lmgi_export_gltf";
     if (!u || (!dir && !(desc && desc->output)))
@@ -468,5 +469,17 @@ lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export
     if (own && st == LMGI_OK)
         return lmgi_output_commit(own, err);
     lmgi_output_abort(own);
+    return st;
+}
+
+lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export_desc *desc, lmgi_error *err)
+{
+    if (!u)
+        return export_owned(u, dir, desc, err); /* refused there, naming it */
+    lmgi_status st = lm_api_claim(lm_updater_context(u), "lmgi_export_gltf", err);
+    if (st != LMGI_OK)
+        return st;
+    st = export_owned(u, dir, desc, err);
+    lm_api_release(lm_updater_context(u));
     return st;
 }

@@ -50,7 +50,7 @@ static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float ta
     out->target_error = target;
     out->width = r->width, out->height = r->height;
     out->entries = r->count, out->converged = r->converged;
-    out->samples = r->total_samples;
+    out->samples = r->total_samples, out->paths_cut = r->paths_cut;
     out->mean_rel_se = r->mean_rel_se, out->max_rel_se = r->max_rel_se;
     out->seconds = r->seconds, out->from_cache = r->from_cache;
     out->caustic_photons = r->caustic_photons, out->caustic_seconds = r->caustic_seconds;
@@ -79,8 +79,8 @@ static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float ta
 static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const lm_ref_camera *cam,
                          lmgi_reference *out, lmgi_error *err)
 {
-    if (sc->updater)
-        lm_updater_sync(sc->updater);
+    if (sc->updater && lm_updater_sync(sc->updater, "the reference", err) != LMGI_OK)
+        return LMGI_ERR_INVALID;
     lm_error e;
     lm_emitters em;
     lm_ref_result r;

@@ -261,8 +261,8 @@ lmgi_status lmgi_set_node_effects(lmgi_scene *sc, int node, const lmgi_node_effe
     for (int k = 0; k < 4; k++)
         if (v[k] != 0 && v[k] != 1)
             return lm_api_refuse(err, "node '%s': %s is 0 or 1, not %d", s->nodes[node].name, names[k], v[k]);
-    if (sc->updater) /* its photon work reads the store the gather's switches write */
-        lm_updater_sync(sc->updater);
+    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_node_effects", err) != LMGI_OK) /* its photon work reads the store the gather's switches write */
+        return LMGI_ERR_INVALID;
     for (int n = 0; n < s->node_count; n++)
         if (lm_node_under(s, n, node)) { /* as extras inherit: the node and everything under it */
             lm_node_settings *st = &s->nodes[n].settings;
@@ -294,8 +294,8 @@ lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_er
                              s->nodes[n->parent].name);
     if (!dynamic && lm_node_animated_under(s, node))
         return lm_api_refuse(err, "node '%s' (or a node under it) is animated: it stays dynamic", n->name);
-    if (sc->updater) /* its photon work traces rays in the BVH about to be rebuilt */
-        lm_updater_sync(sc->updater);
+    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_node_dynamic", err) != LMGI_OK) /* its photon work traces rays in the BVH about to be rebuilt */
+        return LMGI_ERR_INVALID;
     lm_scene_set_dynamic(s, node, dynamic);
     lm_error e;
     if (lm_rt_rebuild(sc->rt, &e) != LM_OK) {
@@ -343,8 +343,8 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
     }
     /* The scene model first (children follow through their local matrices), then the rays from it; on a
      * failure the node's earlier placement comes back. */
-    if (sc->updater) /* its photon work may still be reading the scene and BVH */
-        lm_updater_sync(sc->updater);
+    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_node_transform", err) != LMGI_OK) /* its photon work may still be reading the scene and BVH */
+        return LMGI_ERR_INVALID;
     lm_node saved = *n;
     lm_status st = lm_scene_set_node_world(sc->scene, node, m)
                        ? lm_rt_sync_transforms(sc->rt, sc->scene, &e)
@@ -375,8 +375,8 @@ lmgi_status lmgi_node_resume_animation(lmgi_scene *sc, int node, lmgi_error *err
         lm_fail(&e, LM_ERR_INVALID, "lmgi_node_resume_animation: %s", sc ? "node id out of range" : "the scene is NULL");
         return lm_export_error(err, &e);
     }
-    if (sc->updater)
-        lm_updater_sync(sc->updater);
+    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_node_resume_animation", err) != LMGI_OK)
+        return LMGI_ERR_INVALID;
     lm_scene_release_node(sc->scene, node);
     return LMGI_OK;
 }
@@ -393,8 +393,8 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
         lm_fail(&e, LM_ERR_INVALID, "%s: animation time is not a finite number", sc->scene->path);
         return lm_export_error(err, &e);
     }
-    if (sc->updater)
-        lm_updater_sync(sc->updater);
+    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_time", err) != LMGI_OK)
+        return LMGI_ERR_INVALID;
     lm_scene_eval_animation(sc->scene, -1, t);
     if (lm_rt_sync_transforms(sc->rt, sc->scene, &e) != LM_OK)
         return lm_export_error(err, &e);

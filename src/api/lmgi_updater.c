@@ -192,8 +192,8 @@ static void gather_progress(void *user, uint32_t done, uint32_t total)
     d->progress(d->progress_user, total ? (float)done / (float)total : 1.0f, "gather");
 }
 
-lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc, lmgi_updater **out,
-                                lmgi_error *err)
+static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc,
+                                        lmgi_updater **out, lmgi_error *err)
 {
     if (!out)
         return lm_api_refuse(err, "lmgi_updater_create: out is NULL");
@@ -268,15 +268,35 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
     return LMGI_OK;
 }
 
+lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc, lmgi_updater **out,
+                                lmgi_error *err)
+{
+    if (out)
+        *out = NULL;
+    if (!ctx)
+        return lm_api_refuse(err, "lmgi_updater_create: context is NULL");
+    lmgi_status st = lm_api_claim(ctx, "lmgi_updater_create", err);
+    if (st != LMGI_OK)
+        return st;
+    st = updater_create_owned(ctx, sc, desc, out, err);
+    lm_api_release(ctx);
+    return st;
+}
+
 const lmgi_scene *lm_updater_scene(const lmgi_updater *u) { return u->sc; }
 
-void lm_updater_sync(lmgi_updater *u)
+lmgi_status lm_updater_sync(lmgi_updater *u, const char *fn, lmgi_error *err)
 {
+    lmgi_status st = lm_api_claim(u->ctx, fn, err); /* an edit while another thread updates: refused */
+    if (st != LMGI_OK)
+        return st;
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
     if (lm_frame_loop_sync(u->loop, &e) != LM_OK) /* reported again by the next update's own work */
         lm_log(LM_LOG_ERROR, "%s", e.msg);
     lm_api_leave(saved);
+    lm_api_release(u->ctx);
+    return LMGI_OK;
 }
 
 lmgi_context *lm_updater_context(const lmgi_updater *u) { return u->ctx; }
@@ -285,6 +305,13 @@ void lmgi_updater_free(lmgi_updater *u)
 {
     if (!u)
         return;
+    lmgi_error e;
+    if (lm_api_claim(u->ctx, "lmgi_updater_free", &e) != LMGI_OK) { /* kept: freed under the other thread's feet
+                                                                        * it would crash there */
+        lm_log(LM_LOG_ERROR, "%s; the updater is not freed", e.message);
+        return;
+    }
+    lmgi_context *ctx = u->ctx;
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_gl_make_current(u->ctx->gl, NULL); /* the loop's GL objects are deleted in its context */
     lm_frame_loop_free(u->loop);
@@ -293,6 +320,7 @@ void lmgi_updater_free(lmgi_updater *u)
     u->sc->updater = NULL;
     free(u->seen);
     free(u);
+    lm_api_release(ctx);
 }
 
 lm_gather_scheme lm_updater_gather_scheme(const lmgi_updater *u)
@@ -418,7 +446,7 @@ static void bake_progress(void *user, double fraction, const char *stage)
     d->progress(d->progress_user, (float)fraction, stage);
 }
 
-lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_report *report, lmgi_error *err)
+static lmgi_status bake_owned(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_report *report, lmgi_error *err)
 {
     lmgi_bake_desc d;
     memset(&d, 0, sizeof d);
@@ -454,7 +482,19 @@ lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_rep
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }
 
-lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)
+lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_report *report, lmgi_error *err)
+{
+    if (!u)
+        return lm_api_refuse(err, "lmgi_bake: the updater is NULL");
+    lmgi_status st = lm_api_claim(u->ctx, "lmgi_bake", err);
+    if (st != LMGI_OK)
+        return st;
+    st = bake_owned(u, desc, report, err);
+    lm_api_release(u->ctx);
+    return st;
+}
+
+static lmgi_status update_owned(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)
 {
     if (!u)
         return lm_api_refuse(err, "lmgi_update: updater is NULL");
@@ -482,6 +522,18 @@ lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_updat
     return LMGI_OK;
 }
 
+lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)
+{
+    if (!u)
+        return lm_api_refuse(err, "lmgi_update: the updater is NULL");
+    lmgi_status st = lm_api_claim(u->ctx, "lmgi_update", err);
+    if (st != LMGI_OK)
+        return st;
+    st = update_owned(u, time, budget_ms, stats, err);
+    lm_api_release(u->ctx);
+    return st;
+}
+
 const float *lmgi_frame(const lmgi_updater *u, int *width, int *height)
 {
     int w = 0, h = 0;
@@ -498,7 +550,7 @@ const float *lmgi_frame(const lmgi_updater *u, int *width, int *height)
     return img;
 }
 
-lmgi_status lmgi_get_caustics(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height, lmgi_error *err)
+static lmgi_status get_caustics_owned(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height, lmgi_error *err)
 {
     int w = 0, h = 0;
     if (u)
@@ -522,7 +574,19 @@ lmgi_status lmgi_get_caustics(lmgi_updater *u, float *rgb, size_t floats, int *w
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }
 
-lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb, lmgi_error *err)
+lmgi_status lmgi_get_caustics(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height, lmgi_error *err)
+{
+    if (!u)
+        return lm_api_refuse(err, "lmgi_get_caustics: the updater is NULL");
+    lmgi_status st = lm_api_claim(u->ctx, "lmgi_get_caustics", err);
+    if (st != LMGI_OK)
+        return st;
+    st = get_caustics_owned(u, rgb, floats, width, height, err);
+    lm_api_release(u->ctx);
+    return st;
+}
+
+static lmgi_status render_owned(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb, lmgi_error *err)
 {
     if (!u || !cam || !rgb)
         return lm_api_refuse(err, "lmgi_render: %s is NULL", !u ? "updater" : !cam ? "cam" : "rgb");
@@ -536,6 +600,18 @@ lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int 
     lm_status st = lm_updater_render(u, &v, width, height, rgb, &e);
     lm_api_leave(saved);
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int width, int height, float *rgb, lmgi_error *err)
+{
+    if (!u)
+        return lm_api_refuse(err, "lmgi_render: the updater is NULL");
+    lmgi_status st = lm_api_claim(u->ctx, "lmgi_render", err);
+    if (st != LMGI_OK)
+        return st;
+    st = render_owned(u, cam, width, height, rgb, err);
+    lm_api_release(u->ctx);
+    return st;
 }
 
 lm_status lm_updater_render(lmgi_updater *u, const lm_view *v, int width, int height, float *rgb, lm_error *err)
@@ -638,7 +714,7 @@ static lm_status read_accuracy(const lmgi_updater *u, float *rgba, lm_error *err
     return st;
 }
 
-lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
+static lmgi_status get_lightmap_owned(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
 {
     if (!u || !rgba)
         return lm_api_refuse(err, "lmgi_get_lightmap: %s is NULL", u ? "rgba" : "updater");
@@ -660,6 +736,18 @@ lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, 
                                                : read_accuracy(u, rgba, &e);
     lm_api_leave(saved);
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
+{
+    if (!u)
+        return lm_api_refuse(err, "lmgi_get_lightmap: the updater is NULL");
+    lmgi_status st = lm_api_claim(u->ctx, "lmgi_get_lightmap", err);
+    if (st != LMGI_OK)
+        return st;
+    st = get_lightmap_owned(u, kind, rgba, floats, err);
+    lm_api_release(u->ctx);
+    return st;
 }
 
 int lmgi_surface_count(const lmgi_scene *sc) { return sc ? sc->atlas.surface_count : 0; }

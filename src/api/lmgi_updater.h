@@ -17,8 +17,9 @@ lmgi_context *lm_updater_context(const lmgi_updater *u);
 /* lmgi_render's picture from a view already checked, inside the caller's lm_api_enter. */
 lm_status lm_updater_render(lmgi_updater *u, const lm_view *v, int width, int height, float *rgb, lm_error *err);
 
-/* Waits for the photon work an update left running, before the scene is changed under it. */
-void lm_updater_sync(lmgi_updater *u);
+/* Waits for the photon work an update left running, before the scene is changed under it; refused
+ * (LMGI_ERR_INVALID naming fn) while another thread is inside a call on u's context (lm_api_claim). */
+lmgi_status lm_updater_sync(lmgi_updater *u, const char *fn, lmgi_error *err);
 /* How u gathers (the frame loop's settings): a gradient or image sky needs LM_GATHER_RAYS. */
 lm_gather_scheme lm_updater_gather_scheme(const lmgi_updater *u);
 

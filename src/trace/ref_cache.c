@@ -13,7 +13,7 @@
 #include "../scene/sky.h"
 
 #define LM_REF_MAGIC "LMGIREF1"
-#define LM_REF_VERSION 2u /* 2: the split by light path (caustic, lost, pixel parts) */
+#define LM_REF_VERSION 3u /* 2: the split by light path (caustic, lost, pixel parts); 3: paths cut */
 #define LM_FNV_OFFSET LM_HASH_SEED
 
 /* ---- FNV-1a ---- */
@@ -162,6 +162,7 @@ typedef struct {
     double mean_rel_se, max_rel_se, seconds;
     uint64_t caustic_photons;
     double caustic_seconds;
+    uint64_t paths_cut;
 } file_header;
 
 /* Writes or reads the header fields one by one (no struct padding in the file). */
@@ -205,7 +206,7 @@ static void get(buffer *b, void *d, size_t n)
         op(b, &(h)->width, 4), op(b, &(h)->height, 4), op(b, &(h)->has_texel_arrays, 4);                        \
         op(b, &(h)->converged, 4), op(b, &(h)->total_samples, 8), op(b, &(h)->mean_rel_se, 8);                  \
         op(b, &(h)->max_rel_se, 8), op(b, &(h)->seconds, 8), op(b, &(h)->caustic_photons, 8);                   \
-        op(b, &(h)->caustic_seconds, 8);                                                                        \
+        op(b, &(h)->caustic_seconds, 8), op(b, &(h)->paths_cut, 8);                                             \
     } while (0)
 
 static void put_arrays(buffer *b, const lm_ref_result *r, int texels)
@@ -234,7 +235,7 @@ void lm_ref_cache_store(const char *path, uint32_t kind, const lm_ref_result *r)
     }
     file_header h = {LM_REF_VERSION, kind, r->key, r->count, r->width, r->height, r->iim != NULL, r->converged,
                      r->total_samples, r->mean_rel_se, r->max_rel_se, r->seconds, r->caustic_photons,
-                     r->caustic_seconds};
+                     r->caustic_seconds, r->paths_cut};
     buffer b = {0};
     put(&b, LM_REF_MAGIC, 8);
     XFER_FIELDS(put, &b, &h);
@@ -310,6 +311,7 @@ static int parse(buffer *b, uint32_t kind, uint64_t key, uint32_t count, int wid
     out->converged = h.converged, out->total_samples = h.total_samples;
     out->mean_rel_se = h.mean_rel_se, out->max_rel_se = h.max_rel_se, out->seconds = h.seconds;
     out->caustic_photons = h.caustic_photons, out->caustic_seconds = h.caustic_seconds;
+    out->paths_cut = h.paths_cut;
     out->from_cache = 1;
     return 1;
 }

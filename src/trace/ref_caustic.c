@@ -222,7 +222,7 @@ static void trace_photon(const pass *p, int e, const lm_caustic_generator *g, ui
     if (!lm_caustic_emit(c->em, c->s, e, p->tris[e], g, u, p->photons, org, dir, flux))
         return;
     lm_caustic_hit h;
-    if (lm_caustic_follow(c->s, c->rt, &c->em->e[e], g->node, org, dir, flux, (uint32_t)c->max_depth, next_number, &r, &h, NULL) ==
+    if (lm_caustic_follow(c->s, c->rt, &c->em->e[e], g->node, org, dir, flux, (uint32_t)LM_REF_CAUSTIC_DEPTH, next_number, &r, &h, NULL) ==
         LM_CAUSTIC_LANDED)
         p->land(p, &h, d);
 }

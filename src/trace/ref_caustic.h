@@ -10,7 +10,7 @@
  * extent are left out. Pairs: every emitter with every generator, `caustic_photons` photons each.
  * Photon k of pair p draws its numbers from lm_ref_rng seeded by (seed, LM_REF_CAUSTIC_STREAM + p, k):
  * four for lm_caustic_emit (aimed into the cone around the generator's sphere, flux for a set of
- * caustic_photons), one per specular bounce for lm_caustic_follow (at most max_depth bounces; the first
+ * caustic_photons), one per specular bounce for lm_caustic_follow (at most LM_REF_CAUSTIC_DEPTH bounces; the first
  * hit must be a specular triangle of the pair's own node, so a direction in two cones counts once).
  *
  * Where a photon of flux P lands at point p of a non-specular triangle, arriving along wi:

@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/log.h"
 #include "../core/vecmath.h"
 #include "../scene/sky.h"
 #include "bsdf.h"
@@ -46,12 +47,29 @@ float lm_ref_rng_float(lm_ref_rng *r)
 
 /* ---- context ---- */
 
+/* A surface that reflects all the light it gets (an untextured albedo of 1 in some channel): paths off
+ * it end only by roulette at 0.999 a bounce, and where nothing else absorbs or lets light out, the true
+ * answer is infinite; neither lmgi nor the reference then converges (docs/reference.md). */
+static void warn_lossless(const lm_scene *s)
+{
+    for (int i = 0; i < s->material_count; i++) {
+        const lm_material *m = &s->materials[i];
+        const float *a = m->base_color;
+        if (m->base_color_tex < 0 && !lm_material_is_specular(m->cls) && fmaxf(a[0], fmaxf(a[1], a[2])) >= 1.0f) {
+            lm_warn("reference: material '%s' reflects all the light it receives (albedo %.3g %.3g %.3g): if light "
+                    "cannot leave the scene, it never dies out and no estimate converges; real surfaces reflect at "
+                    "most about 0.95", m->name, (double)a[0], (double)a[1], (double)a[2]);
+            return;
+        }
+    }
+}
+
 lm_status lm_ref_ctx_init(lm_ref_ctx *c, const lm_scene *s, const lm_rt *rt, const lm_emitters *em,
                           const lm_ref_settings *set, lm_error *err)
 {
     memset(c, 0, sizeof *c);
     c->s = s, c->rt = rt, c->em = em;
-    c->max_depth = set->max_depth > 0 ? set->max_depth : 64;
+    c->max_depth = set->max_depth > 0 ? set->max_depth : LM_REF_MAX_DEPTH;
     c->rr_depth = set->rr_depth >= 0 ? set->rr_depth : 3;
     float size = lm_scene_size(s);
     c->eps = LM_REF_EPS_REL * (size > 0.0f ? size : 1.0f);
@@ -63,6 +81,7 @@ lm_status lm_ref_ctx_init(lm_ref_ctx *c, const lm_scene *s, const lm_rt *rt, con
     for (int e = 0; e < em->count; e++)
         for (uint32_t k = 0; k < em->e[e].tri_count; k++)
             c->tri_emitter[em->e[e].tris[k]] = e;
+    warn_lossless(s);
     return LM_OK;
 }
 
@@ -192,6 +211,7 @@ static int route_hit(route *rt, int specular)
 typedef struct {
     float total[3];
     float part[LM_REF_BACKWARD_PARTS][3];
+    int cut;
 } tally;
 
 static void tally_add(tally *t, int part, const float beta[3], const float v[3], float w)
@@ -263,6 +283,10 @@ static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, 
             beta[k] *= bs.weight[k];
         if (depth + 1 >= c->rr_depth) {
             float q = lm_bsdf_survival(&sh);
+            if (q >= 1.0f && depth + 1 >= LM_REF_SPECULAR_RR_DEPTH) { /* a mirror box: by throughput */
+                float m = fmaxf(beta[0], fmaxf(beta[1], beta[2]));
+                q = m < 0.05f ? 0.05f : m > 0.999f ? 0.999f : m;
+            }
             if (lm_ref_rng_float(r) >= q)
                 return;
             for (int k = 0; k < 3; k++)
@@ -271,6 +295,7 @@ static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, 
         dir = lm_v3_load(bs.wo);
         org = lift(c, lm_v3_load(sh.pos), lm_v3_load(sh.ng), dir);
     }
+    out->cut = 1; /* still going at max_depth: the rest of its light is missing */
 }
 
 /* ---- texels ---- */
@@ -342,6 +367,7 @@ void lm_ref_texel_sample(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng 
         out->part[LM_REF_INDIRECT][k] = area[k] + LM_PI_F * li.part[LM_REF_INDIRECT][k];
         out->part[LM_REF_LOST][k] = LM_PI_F * li.part[LM_REF_LOST][k];
     }
+    out->cut = li.cut;
 }
 
 /* ---- pixels ---- */
@@ -360,4 +386,5 @@ void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, i
     trace(c, r, lm_v3_load(cam->eye), d, 0.0f, ROUTE_EYE, &t);
     memcpy(out->full, t.total, sizeof out->full);
     memcpy(out->part, t.part, sizeof out->part);
+    out->cut = t.cut;
 }

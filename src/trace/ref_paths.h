@@ -54,6 +54,7 @@ enum {
 typedef struct {
     float full[3];
     float part[LM_REF_BACKWARD_PARTS][3];
+    int cut; /* the path was still going at max_depth */
 } lm_ref_sample;
 
 void lm_ref_texel_frame(const lm_ref_ctx *c, const lm_texel *t, lm_ref_frame *f);

@@ -23,7 +23,7 @@ void lm_ref_settings_default(lm_ref_settings *s)
     s->min_samples = 128;
     s->max_samples = 65536;
     s->seed = 1;
-    s->max_depth = 64;
+    s->max_depth = LM_REF_MAX_DEPTH;
     s->rr_depth = 3;
     s->caustic_photons = LM_REF_CAUSTIC_PHOTONS;
     s->use_cache = 1;
@@ -35,7 +35,7 @@ static double lum(const double c[3]) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.
 /* ---- per-entry statistics ---- */
 
 typedef struct {
-    uint32_t n;
+    uint32_t n, cut;
     double mean[2], m2[2];  /* Welford over the luminance of E_full [0] and E_iim [1] (texels) */
     double full[3];         /* RGB sums */
     double part[LM_REF_BACKWARD_PARTS][3];
@@ -45,6 +45,7 @@ static void stat_add(entry_stat *st, const lm_ref_sample *smp)
 {
     const float *v[2] = {smp->full, smp->part[LM_REF_INDIRECT]};
     st->n++;
+    st->cut += smp->cut;
     for (int w = 0; w < 2; w++) {
         double rgb[3] = {v[w][0], v[w][1], v[w][2]}, x = lum(rgb), d = x - st->mean[w];
         st->mean[w] += d / st->n;
@@ -217,6 +218,7 @@ static void finish(const job *j, const float *caustic, lm_ref_result *r)
         r->samples[i] = st->n;
         r->rel_se[i] = (float)e;
         r->total_samples += st->n;
+        r->paths_cut += st->cut;
         r->converged += e <= j->set->target_error;
         sum_err += e;
         r->max_rel_se = fmax(r->max_rel_se, e);
@@ -275,6 +277,11 @@ static lm_status solve(job *j, uint32_t kind, uint64_t key, int width, int heigh
     if (st == LM_OK) {
         finish(j, caustic, out);
         out->seconds = lm_now() - t0;
+        if (out->paths_cut)
+            lm_warn("reference: %llu of %llu paths were still going after %d bounces and were cut: their light "
+                    "past that is missing, so the reference is low (light that never dies out: a surface of "
+                    "albedo 1 in a closed room?)", (unsigned long long)out->paths_cut,
+                    (unsigned long long)out->total_samples, j->c->max_depth);
         if (j->set->use_cache)
             lm_ref_cache_store(path, kind, out);
     } else {

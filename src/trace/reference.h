@@ -28,7 +28,11 @@
  * exactly, emissive surfaces with one light sample each, combined with BSDF sampling by multiple
  * importance sampling, power heuristic), then one cosine-weighted ray continued as a path with NEE
  * and MIS at every non-specular vertex, specular bounces through mirror and glass, and Russian
- * roulette from bounce `rr_depth` on (survival lm_bsdf_survival). Each contribution goes to the part the
+ * roulette from bounce `rr_depth` on (survival lm_bsdf_survival; at mirror and glass, certain until
+ * bounce LM_REF_SPECULAR_RR_DEPTH, then the path's throughput), so paths end by roulette alone: a
+ * closed room of albedo 0.999 keeps its light for thousands of bounces and the estimate still has all
+ * of it (a fixed depth of 64 left out 47% of it at albedo 0.99). max_depth only guards against a path
+ * that never ends (albedo 1); the paths it cuts are counted (paths_cut) and reported. Each contribution goes to the part the
  * path's route says; the route draws no numbers, so in a scene without mirror or glass every path and
  * E_full, E_iim and the pixels are bit for bit what the solver gave before the split. The caustic part:
  * `caustic_photons` photons per (emitter, specular node) pair, traced forward (ref_caustic.h).
@@ -67,7 +71,7 @@ typedef struct {
     int min_samples;       /* never stop an entry before this many (default 2 x samples) */
     int max_samples;       /* cap per entry (default 65536) */
     uint32_t seed;         /* default 1 */
-    int max_depth;         /* bounces at most (default 64) */
+    int max_depth;         /* bounces at most: a guard, not how paths end (default LM_REF_MAX_DEPTH) */
     int rr_depth;          /* Russian roulette from this bounce on (default 3) */
     uint32_t caustic_photons; /* light-traced photons per (emitter, specular node) pair, 1 to 2^24
                                * (default LM_REF_CAUSTIC_PHOTONS) */
@@ -75,6 +79,11 @@ typedef struct {
     int use_cache;         /* read and write the cache (default 1) */
     int progress;          /* log progress through lm_info every few seconds (default 1) */
 } lm_ref_settings;
+
+#define LM_REF_MAX_DEPTH 65536
+#define LM_REF_SPECULAR_RR_DEPTH 256
+/* A caustic photon's specular bounces at most (ref_caustic.h): an L S+ D chain that long carries nothing. */
+#define LM_REF_CAUSTIC_DEPTH 64
 
 /* The caustic part's default photons per pair: scenes/cornell.glb's one pair in about a second on two
  * cores, its texels' caustic within a few percent (docs/reference.md, "Settings and their cost"). */
@@ -108,6 +117,8 @@ typedef struct {
     uint64_t total_samples;
     double mean_rel_se, max_rel_se;
     uint32_t converged;    /* entries that reached target_error (the others hit max_samples) */
+    uint64_t paths_cut;    /* paths still going at max_depth bounces: what they would have carried on is
+                            * missing (0 in any scene that loses light at its bounces) */
     double seconds;        /* time spent computing, caustic part included (the original run's when cached) */
     uint64_t caustic_photons; /* photons the caustic part traced (pairs x caustic_photons; 0 without pairs) */
     double caustic_seconds;   /* its share of `seconds` */
