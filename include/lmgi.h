@@ -486,8 +486,8 @@ typedef struct {
     int photon_chunk;          /* TILED: photons per shared-memory load, 64 to 512 (0: 256) */
     int photon_stochastic;     /* TILED: k, each pixel reads 1/k^2 of its tile's photons, then an edge-aware
                                 * k x k reconstruction, 1 to 4 (0: 1, all of them) */
-    float photon_radius;       /* the kernel radius in scene units (0: the disc that holds 128 photons on
-                                * average) */
+    float photon_radius;       /* the kernel radius in scene units, 1e-6 to 1e6 times the scene's size (0:
+                                * the disc that holds 128 photons on average) */
     /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
      * that, set non-zero (from any thread), stops it between gather passes: LMGI_ERR_CANCELLED */
     lmgi_progress_fn progress;
@@ -586,7 +586,9 @@ LMGI_API lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi
 /* One frame's work at animation time `time` (seconds; animations clamp to their range). budget_ms > 0:
  * the texels regathered are chosen from the measured cost of the last updates so that the update takes
  * about budget_ms (never fewer than 1 texel when there is work); 0: desc.texels_per_frame. stats may be
- * NULL. NULL u, a time or budget that is not finite, or a negative budget: LMGI_ERR_INVALID. */
+ * NULL. NULL u, a time or budget that is not finite, or a negative budget: LMGI_ERR_INVALID. A frame
+ * that came out with a NaN or infinity: LMGI_ERR_BACKEND naming the first stage that has them (the AIMs,
+ * the IIM lightmap, the caustics, else the direct light, reflections or composite). */
 LMGI_API lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err);
 
 /* The frame the last lmgi_update composited (frame_width x frame_height x 3 linear floats, top row
@@ -802,7 +804,9 @@ typedef struct {
 /* Writes width x height pixels of `channels` floats (1, 3 or 4; rows top first) to path: ".exr" linear
  * as given, ".png" RGB tone-mapped, alpha dropped. The file appears whole or not at all (written to
  * PATH.partial, then renamed). NULL path or pixels, sizes outside 1..65536, other channel counts, a bad
- * desc or another extension: LMGI_ERR_INVALID; a failed write: LMGI_ERR_IO naming the file. */
+ * desc, another extension, or a pixel that is NaN or infinite: LMGI_ERR_INVALID (nothing written); a failed
+ * write: LMGI_ERR_IO naming the file. Half floats: values beyond 65504 are written as 65504, with a
+ * warning that counts them. */
 LMGI_API lmgi_status lmgi_write_image(const char *path, int width, int height, int channels, const float *pixels,
                                       const lmgi_image_desc *desc, lmgi_error *err);
 

@@ -66,16 +66,12 @@ static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; } 
 static lmgi_status check_light(const lmgi_light *in, lm_light_type type, const char *name, int placed,
                                lmgi_error *err)
 {
-    for (int c = 0; c < 3; c++)
-        if (!in_range(in->color[c], 0.0f, 1000.0f))
-            return lm_api_refuse(err, "light '%s': colour %g must be in [0, 1000]", name, (double)in->color[c]);
-    if (!in_range(in->intensity, 0.0f, 1e15f) || !in_range(in->range, 0.0f, 1e15f))
-        return lm_api_refuse(err, "light '%s': intensity %g and range %g must be finite numbers >= 0", name,
-                             (double)in->intensity, (double)in->range);
-    if (type == LM_LIGHT_SPOT && !(in_range(in->inner_cone, 0.0f, (float)(LM_PI / 2)) &&
-                                   in_range(in->outer_cone, 0.0f, (float)(LM_PI / 2)) && in->inner_cone < in->outer_cone))
-        return lm_api_refuse(err, "light '%s': cones %g and %g must satisfy 0 <= inner < outer <= pi/2", name,
-                             (double)in->inner_cone, (double)in->outer_cone);
+    char what[LM_NAME_MAX + 16];
+    snprintf(what, sizeof what, "light '%s'", name);
+    lm_error e;
+    if (lm_light_check(what, in->color, in->intensity, in->range, type == LM_LIGHT_SPOT, in->inner_cone,
+                       in->outer_cone, &e) != LM_OK)
+        return lm_export_error(err, &e);
     if (!placed)
         return LMGI_OK;
     for (int k = 0; k < 3; k++)

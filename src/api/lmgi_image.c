@@ -1,6 +1,7 @@
 /* The public API's pictures: EXR as the numbers, PNG tone-mapped (core/tonemap.h). */
 #include <lmgi.h>
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -41,6 +42,12 @@ lmgi_status lmgi_write_image(const char *path, int width, int height, int channe
     else if (!(exposure >= 0.0f) || exposure > 1e30f)
         st = lm_fail(&e, LM_ERR_INVALID, "%s: exposure %g must be a finite number >= 0 (0: automatic)", path,
                      (double)exposure);
+    size_t values = st == LM_OK ? (size_t)width * (size_t)height * (size_t)channels : 0, bad = 0;
+    for (size_t i = 0; i < values; i++) /* a NaN tone-maps to some colour: a picture of one is never "ok" */
+        bad += !isfinite(pixels[i]);
+    if (bad)
+        st = lm_fail(&e, LM_ERR_INVALID, "%s: %zu values are not finite numbers (NaN or infinity): not written",
+                     path, bad);
     if (st != LM_OK)
         return lm_export_error(err, &e);
     if (ends_with(path, ".exr"))

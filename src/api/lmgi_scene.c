@@ -347,8 +347,10 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
         return LMGI_ERR_INVALID;
     lm_node saved = *n;
     lm_status st = lm_scene_set_node_world(sc->scene, node, m)
-                       ? lm_rt_sync_transforms(sc->rt, sc->scene, &e)
+                       ? lm_scene_check_extent(sc->scene, node, &e)
                        : lm_fail(&e, LM_ERR_INVALID, "node '%s': its parent's transform has no inverse", n->name);
+    if (st == LM_OK)
+        st = lm_rt_sync_transforms(sc->rt, sc->scene, &e);
     if (st != LM_OK) {
         sc->scene->nodes[node] = saved;
         lm_scene_update_world(sc->scene);

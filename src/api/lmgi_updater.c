@@ -128,6 +128,14 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: camera %d: the scene has %d", d->camera,
                        scene->camera_count);
     s->camera = d->camera;
+    if (s->width > 0) { /* a camera that shows only the background would give black frames and exit 0 */
+        lm_view v;
+        lm_view_for_scene(scene, s->camera, s->width, s->height, &v);
+        if (!lm_view_sees_box(&v, scene->bounds_min, scene->bounds_max))
+            return lm_fail(err, LM_ERR_INVALID, "%s: camera '%s' sees none of the scene (the scene's bounds lie "
+                           "wholly outside its view: behind it, off to a side, or beyond its far plane); its frames "
+                           "would show only the background", scene->path, v.name);
+    }
     if (d->reflection_size == -1)
         s->reflection_size = 0;
     else
@@ -167,9 +175,12 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     if (!lm_photon_gather_settings_check(&s->photon_gather, &why))
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: %s (photon_tile, photon_chunk, "
                        "photon_stochastic; 0: the defaults)", why.msg);
-    if (!(d->photon_radius >= 0.0f) || !isfinite(d->photon_radius))
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: photon_radius %g must be positive (0: from "
-                       "photons_per_estimate)", (double)d->photon_radius);
+    /* a kernel of 1e-30 divided by its area into infinity, every pixel NaN */
+    float size = lm_scene_size(scene), lo = 1e-6f * size, hi = 1e6f * size;
+    if (!(d->photon_radius == 0.0f || (d->photon_radius >= lo && d->photon_radius <= hi)))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: photon_radius %g must be 0 (from "
+                       "photons_per_estimate) or within 1e-6 to 1e6 times the scene's size %g", (double)d->photon_radius,
+                       (double)size);
     s->photon_radius = d->photon_radius;
     s->direct.shadows = !(d->effects_off & LMGI_EFFECT_SHADOWS);
     s->indirect = !(d->effects_off & LMGI_EFFECT_INDIRECT);
@@ -300,6 +311,7 @@ lmgi_status lm_updater_sync(lmgi_updater *u, const char *fn, lmgi_error *err)
 }
 
 lmgi_context *lm_updater_context(const lmgi_updater *u) { return u->ctx; }
+lm_frame_loop *lm_updater_loop(const lmgi_updater *u) { return u->loop; }
 
 void lmgi_updater_free(lmgi_updater *u)
 {
@@ -494,6 +506,63 @@ lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_rep
     return st;
 }
 
+static lmgi_status get_caustics_owned(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height,
+                                      lmgi_error *err);
+static lmgi_status get_lightmap_owned(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats,
+                                      lmgi_error *err);
+
+static size_t count_not_finite(const float *v, size_t n)
+{
+    size_t bad = 0;
+    for (size_t i = 0; i < n; i++)
+        bad += !isfinite(v[i]);
+    return bad;
+}
+
+/* Which stage made a frame's NaN or infinity: the lightmaps and caustics it composited are read back
+ * and counted (only on failure: a frame is scanned each update, the rest never otherwise). */
+static void name_the_stage(lmgi_updater *u, char *out, size_t size)
+{
+    lmgi_info in;
+    lmgi_get_info(u->sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    int w, h;
+    lmgi_frame(u, &w, &h);
+    size_t nc = 3 * (size_t)w * (size_t)h;
+    float *buf = malloc((n > nc ? n : nc) * sizeof *buf);
+    static const struct { lmgi_lightmap kind; const char *what; } maps[2] = {
+        {LMGI_LIGHTMAP_AIM, "the AIMs (photon estimate)"}, {LMGI_LIGHTMAP_IIM, "the IIM lightmap (the gather)"}};
+    snprintf(out, size, "none of the lightmaps or caustics has one: the direct light, reflections or composite "
+             "made them");
+    for (int k = 0; buf && k < 3; k++) {
+        lmgi_error e;
+        size_t bad = k < 2 ? (get_lightmap_owned(u, maps[k].kind, buf, n, &e) == LMGI_OK ? count_not_finite(buf, n) : 0)
+                           : (get_caustics_owned(u, buf, nc, NULL, NULL, &e) == LMGI_OK ? count_not_finite(buf, nc) : 0);
+        if (bad) { /* the earliest stage that has them: the later ones only carry them on */
+            snprintf(out, size, "the first stage that has them: %s, %zu values", k < 2 ? maps[k].what : "the caustic pass",
+                     bad);
+            break;
+        }
+    }
+    free(buf);
+}
+
+/* An update whose frame holds a NaN or infinity fails, naming the stage, rather than pass it on. */
+static lmgi_status check_frame(lmgi_updater *u, float time, lmgi_error *err)
+{
+    int w, h;
+    const float *img = lmgi_frame(u, &w, &h);
+    size_t bad = img ? count_not_finite(img, 3 * (size_t)w * (size_t)h) : 0;
+    if (!bad)
+        return LMGI_OK;
+    char stage[200];
+    name_the_stage(u, stage, sizeof stage);
+    lm_error e;
+    lm_fail(&e, LM_ERR_BACKEND, "%s: update at t = %g: %zu of the frame's values are not finite numbers (NaN or "
+            "infinity); %s", u->sc->scene->path, (double)time, bad, stage);
+    return lm_export_error(err, &e);
+}
+
 static lmgi_status update_owned(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)
 {
     if (!u)
@@ -519,7 +588,7 @@ static lmgi_status update_owned(lmgi_updater *u, float time, float budget_ms, lm
         export_stats(&fs, budget, count_changed(u), stats);
     else
         count_changed(u);
-    return LMGI_OK;
+    return check_frame(u, time, err);
 }
 
 lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err)
@@ -747,6 +816,15 @@ lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, 
         return st;
     st = get_lightmap_owned(u, kind, rgba, floats, err);
     lm_api_release(u->ctx);
+    static const char *const stage[] = {"the IIM lightmap (the gather)", "the AIMs (the photon estimate)",
+                                        "the error estimate", "the accuracy estimate"};
+    size_t bad = st == LMGI_OK ? count_not_finite(rgba, 4 * (size_t)u->sc->atlas.width * u->sc->atlas.height) : 0;
+    if (bad) { /* a lightmap is never handed on with a NaN or infinity in it */
+        lm_error e;
+        lm_fail(&e, LM_ERR_BACKEND, "%s: %zu values of %s are not finite numbers (NaN or infinity)",
+                u->sc->scene->path, bad, stage[kind]);
+        return lm_export_error(err, &e);
+    }
     return st;
 }
 

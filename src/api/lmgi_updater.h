@@ -14,6 +14,7 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
 /* The scene u works on, and the context it was made on. */
 const lmgi_scene *lm_updater_scene(const lmgi_updater *u);
 lmgi_context *lm_updater_context(const lmgi_updater *u);
+lm_frame_loop *lm_updater_loop(const lmgi_updater *u); /* tools and tests */
 /* lmgi_render's picture from a view already checked, inside the caller's lm_api_enter. */
 lm_status lm_updater_render(lmgi_updater *u, const lm_view *v, int width, int height, float *rgb, lm_error *err);
 

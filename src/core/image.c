@@ -13,6 +13,8 @@
 #include <stb/stb_image_write.h>
 #include <tinyexr.h>
 
+#include "log.h"
+
 /* A file appears whole or not at all: the bytes go to PATH.partial (created exclusively), every write
  * and the close are checked (a full disk shows up at fclose, when the buffer is flushed), and only then does a rename put
  * it in place. A failure removes the partial file and leaves whatever PATH held before. */
@@ -106,15 +108,29 @@ lm_status lm_write_exr_as(const char *path, int width, int height, int channels,
     EXRChannelInfo info[4];
     int types[4], stored[4];
     memset(info, 0, sizeof info);
+    size_t bad = 0, clamped = 0;
     for (int c = 0; c < channels; c++) {
         float *plane = planes + (size_t)c * n;
-        for (size_t i = 0; i < n; i++)
-            plane[i] = data[(size_t)channels * i + (size_t)source[channels - 1][c]];
+        for (size_t i = 0; i < n; i++) {
+            float v = data[(size_t)channels * i + (size_t)source[channels - 1][c]];
+            bad += !isfinite(v);
+            if (half && fabsf(v) > LM_HALF_MAX) /* a half above it is infinity */
+                v = copysignf(LM_HALF_MAX, v), clamped++;
+            plane[i] = v;
+        }
         plane_ptr[c] = (unsigned char *)plane;
         snprintf(info[c].name, sizeof info[c].name, "%s", names[channels - 1][c]);
         types[c] = TINYEXR_PIXELTYPE_FLOAT;
         stored[c] = half ? TINYEXR_PIXELTYPE_HALF : TINYEXR_PIXELTYPE_FLOAT;
     }
+    if (bad) {
+        free(planes);
+        return lm_fail(err, LM_ERR_INVALID, "%s: %zu values are not finite numbers (NaN or infinity): not written",
+                       path, bad);
+    }
+    if (clamped)
+        lm_warn("%s: %zu values beyond %g, the largest half float, written as %g (32-bit floats keep them)", path,
+                clamped, (double)LM_HALF_MAX, (double)LM_HALF_MAX);
     EXRHeader header;
     InitEXRHeader(&header);
     header.compression_type = width < 16 && height < 16 ? TINYEXR_COMPRESSIONTYPE_NONE : TINYEXR_COMPRESSIONTYPE_ZIP;

@@ -15,7 +15,9 @@ lm_status lm_write_png(const char *path, int width, int height, const uint8_t *r
 /* rgb: width*height*channels floats (channels 1, 3 or 4), row 0 at the top. */
 lm_status lm_write_exr(const char *path, int width, int height, int channels, const float *data, lm_error *err);
 /* The same stored as 16-bit half floats when `half` (half the size; 11 bits of precision, values up to
- * 65504). */
+ * 65504: larger ones are written as 65504, with a warning that counts them). A non-finite value in data:
+ * LM_ERR_INVALID naming the file and how many, nothing written. */
+#define LM_HALF_MAX 65504.0f
 lm_status lm_write_exr_as(const char *path, int width, int height, int channels, const float *data, int half,
                           lm_error *err);
 /* Reads an EXR as RGBA floats (caller frees *out with free()). */

@@ -35,6 +35,26 @@ static void from_file(const lm_scene *s, const lm_camera *c, float aspect, lm_vi
     snprintf(out->name, sizeof out->name, "%s", c->name[0] ? c->name : "camera");
 }
 
+int lm_view_sees_box(const lm_view *v, const float lo[3], const float hi[3])
+{
+    float vp[16], clip[8][4];
+    lm_mat4_mul(vp, v->proj, v->view);
+    for (int c = 0; c < 8; c++) {
+        float p[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        for (int r = 0; r < 4; r++)
+            clip[c][r] = vp[r] * p[0] + vp[4 + r] * p[1] + vp[8 + r] * p[2] + vp[12 + r];
+    }
+    for (int plane = 0; plane < 6; plane++) { /* -w <= x, y, z <= w, one side at a time */
+        int axis = plane / 2, outside = 0;
+        float sign = plane % 2 ? -1.0f : 1.0f;
+        for (int c = 0; c < 8; c++)
+            outside += !(sign * clip[c][axis] <= clip[c][3]); /* NaN counts as outside */
+        if (outside == 8)
+            return 0;
+    }
+    return 1;
+}
+
 static void automatic(const lm_scene *s, float aspect, lm_view *out)
 {
     lm_vec3 lo = lm_v3_load(s->bounds_min), hi = lm_v3_load(s->bounds_max);

@@ -15,6 +15,10 @@ typedef struct {
 
 /* camera: index into s->cameras, or -1 for the first one if any, else automatic. */
 void lm_view_for_scene(const lm_scene *s, int camera, int width, int height, lm_view *out);
+/* Whether any of the box lo..hi can be in v's picture: 0 when all its corners lie outside one clip plane
+ * (beyond the far plane, nearer than the near one, or off to one side), the picture then the background
+ * alone. */
+int lm_view_sees_box(const lm_view *v, const float lo[3], const float hi[3]);
 
 /* A view from an application's matrices (column-major, GL conventions: the camera looks down -z of view
  * space, proj maps to GL clip space). Returns 0 (out untouched) when view is not an invertible affine map. */

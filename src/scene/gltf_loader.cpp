@@ -621,6 +621,11 @@ lm_status Loader::materials()
                              d.emissive[0], d.emissive[1], d.emissive[2], d.transmission, d.ior};
         if (!finite_all(all, sizeof all / sizeof all[0]))
             return fail(LM_ERR_INVALID, "%s has a non-finite parameter", ctx.c_str());
+        const float uvt[] = {d.uv_offset[0], d.uv_offset[1], d.uv_scale[0], d.uv_scale[1], d.uv_rotation};
+        for (float v : uvt)
+            if (!(std::fabs(v) <= LM_MAX_UV_TRANSFORM))
+                return fail(LM_ERR_INVALID, "%s: KHR_texture_transform offset, scale and rotation must be within "
+                            "+-%g, not %g", ctx.c_str(), double(LM_MAX_UV_TRANSFORM), double(v));
         /* KHR_materials_ior: 1 or more, or 0 (a Fresnel term of 1 at every angle: all reflected) */
         if (!(d.ior >= 1.0f || d.ior == 0.0f))
             return fail(LM_ERR_INVALID, "%s: KHR_materials_ior ior %g must be at least 1 (or 0: all reflected)",
@@ -757,6 +762,32 @@ lm_status Loader::nodes()
     return node_instances();
 }
 
+// What the glTF specification forbids in a camera, each a picture of nothing (a field of view of pi or
+// more, a far plane before the near one); NULL when it is valid.
+static const char *camera_problem(const lm_camera &d)
+{
+    const float all[] = {d.yfov, d.aspect, d.znear, d.zfar, d.xmag, d.ymag};
+    for (float v : all)
+        if (!std::isfinite(v))
+            return "a parameter is not a finite number";
+    if (d.perspective) {
+        if (!(d.yfov > 0.0f && d.yfov < float(LM_PI)))
+            return "perspective yfov must be in (0, pi)";
+        if (!(d.znear > 0.0f))
+            return "perspective znear must be > 0";
+        if (!(d.zfar == 0.0f || d.zfar > d.znear))
+            return "perspective zfar must be greater than znear (or absent: infinite)";
+        if (!(d.aspect >= 0.0f))
+            return "perspective aspectRatio must be > 0";
+        return nullptr;
+    }
+    if (!(d.xmag != 0.0f && d.ymag != 0.0f))
+        return "orthographic xmag and ymag must not be 0";
+    if (!(d.znear >= 0.0f && d.zfar > d.znear))
+        return "orthographic znear must be >= 0 and zfar greater than it";
+    return nullptr;
+}
+
 // Lights and cameras are instanced per node that references them.
 lm_status Loader::node_instances()
 {
@@ -776,6 +807,8 @@ lm_status Loader::node_instances()
             d.znear = float(d.perspective ? c.perspective.znear : c.orthographic.znear);
             d.zfar = float(d.perspective ? c.perspective.zfar : c.orthographic.zfar);
             d.xmag = float(c.orthographic.xmag), d.ymag = float(c.orthographic.ymag);
+            if (const char *why = camera_problem(d))
+                return fail(LM_ERR_INVALID, "camera %d (\"%s\"): %s (the glTF 2.0 specification)", g.camera, c.name.c_str(), why);
             s_->nodes[i].camera = int(cams.size());
             cams.push_back(d);
         }
@@ -803,14 +836,11 @@ lm_status Loader::node_instances()
         d.intensity = float(l.intensity), d.range = float(l.range);
         d.inner_cone = float(l.spot.innerConeAngle), d.outer_cone = float(l.spot.outerConeAngle);
         d.node = i;
-        const float all[] = {d.color[0], d.color[1], d.color[2], d.intensity, d.range, d.inner_cone, d.outer_cone};
-        if (!finite_all(all, 7) || d.intensity < 0.0f)
-            return fail(LM_ERR_INVALID, "light %d (\"%s\") has a non-finite or negative parameter", li, l.name.c_str());
-        for (int k = 0; k < 3; k++)
-            if (!(std::fabs(d.color[k] * d.intensity) <= LM_MAX_EMISSION))
-                return fail(LM_ERR_INVALID, "light %d (\"%s\"): colour x intensity %g exceeds %g: its photon powers "
-                            "would overflow to infinity", li, l.name.c_str(), double(d.color[k]) * d.intensity,
-                            LM_MAX_EMISSION);
+        std::string what = "light " + std::to_string(li) + " (\"" + l.name + "\")";
+        lm_error e;
+        if (lm_light_check(what.c_str(), d.color, d.intensity, d.range, d.type == LM_LIGHT_SPOT, d.inner_cone,
+                           d.outer_cone, &e) != LM_OK)
+            return fail(LM_ERR_INVALID, "%s", e.msg);
         s_->nodes[i].light = int(lights.size());
         lights.push_back(d);
     }
@@ -834,9 +864,23 @@ lm_status Loader::primitive(int node, int mesh, int prim)
         lm_warn("%s: %s: no POSITION attribute; skipped", path_, ctx.c_str());
         return LM_OK;
     }
+    // An accessor without a bufferView is all zeros: positions that decode to one point. A Draco-compressed
+    // primitive writes its fallback that way when it has none; lmgi does not decode Draco, so the mesh
+    // would be nothing at all. Said here, not drawn as an invisible point.
+    int pa = attr("POSITION");
+    if (size_t(pa) < model_.accessors.size() && model_.accessors[size_t(pa)].bufferView < 0 &&
+        !model_.accessors[size_t(pa)].sparse.isSparse) {
+        if (p.extensions.count("KHR_draco_mesh_compression"))
+            return fail(LM_ERR_UNSUPPORTED, "%s: its geometry is Draco-compressed (KHR_draco_mesh_compression), which "
+                        "lmgi does not decode, and it has no uncompressed fallback (POSITION has no data)",
+                        ctx.c_str());
+        lm_warn("%s: %s: POSITION has no data (an accessor without a bufferView: every vertex at the origin); "
+                "skipped", path_, ctx.c_str());
+        return LM_OK;
+    }
     std::vector<float> pos, nrm, uv[2];
     size_t vcount = 0, c = 0;
-    lm_status st = read_floats(attr("POSITION"), TINYGLTF_TYPE_VEC3, false, "POSITION", ctx, pos, vcount);
+    lm_status st = read_floats(pa, TINYGLTF_TYPE_VEC3, false, "POSITION", ctx, pos, vcount);
     if (st)
         return st;
     long bad = lm_first_nonfinite(pos.data(), pos.size());
@@ -1021,6 +1065,12 @@ lm_status Loader::animations()
                     return fail(LM_ERR_FORMAT, "%s: sampler %d key times are not finite and increasing", ctx.c_str(), ch.sampler);
             if (!finite_all(values.data(), values.size()))
                 return fail(LM_ERR_INVALID, "%s: sampler %d has non-finite values", ctx.c_str(), ch.sampler);
+            float bound = path == LM_PATH_TRANSLATION ? LM_MAX_ANIM_TRANSLATION : LM_MAX_ANIM_SCALE;
+            for (size_t k = 0; path != LM_PATH_ROTATION && k < values.size(); k++)
+                if (!(std::fabs(values[k]) <= bound))
+                    return fail(LM_ERR_INVALID, "%s: sampler %d moves node %d to %g, beyond the %g a %s key may "
+                                "reach", ctx.c_str(), ch.sampler, ch.target_node, double(values[k]), double(bound),
+                                path == LM_PATH_TRANSLATION ? "translation" : "scale");
             lm_anim_channel &c = d.channels[d.channel_count++];
             c.node = ch.target_node, c.path = path, c.interp = in, c.key_count = int(nt), c.comps = comps;
             c.times = copy_out(times), c.values = copy_out(values);

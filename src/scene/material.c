@@ -64,6 +64,8 @@ static int wrap(int i, int n)
 static void sample_bilinear(const lm_texture *t, float u, float v, float out[3])
 {
     float x = u * (float)t->width - 0.5f, y = v * (float)t->height - 0.5f;
+    if (!isfinite(x) || !isfinite(y)) /* uvs beyond float (the loader bounds transforms; this bounds the rest) */
+        x = y = 0.0f;
     float fx = floorf(x), fy = floorf(y), ax = x - fx, ay = y - fy;
     /* keep the integer part small so the int conversion is defined for any finite uv */
     int x0 = wrap((int)fmodf(fx, (float)t->width), t->width), y0 = wrap((int)fmodf(fy, (float)t->height), t->height);

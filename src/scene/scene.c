@@ -303,6 +303,49 @@ void lm_scene_set_dynamic(lm_scene *s, int node, int dynamic)
     s->pass_version++;
 }
 
+static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; } /* false for NaN */
+
+/* Embree takes no ray whose numbers exceed about 1.8e18, and a scene near that would put rays and texel
+ * sizes there (a vertex at 1e20 gave "texel inf units" and an abort inside Embree; a node moved to 1e30
+ * a black frame). */
+lm_status lm_scene_check_extent(const lm_scene *s, int node, lm_error *err)
+{
+    for (uint32_t v = 0; v < s->vertex_count; v++) {
+        if (node >= 0 && !lm_node_under(s, (int)s->vertex_node[v], node))
+            continue;
+        float p[3];
+        lm_scene_vertex_world(s, v, p);
+        for (int k = 0; k < 3; k++)
+            if (!(fabsf(p[k]) <= LM_MAX_COORDINATE)) {
+                const char *name = s->nodes[s->vertex_node[v]].name;
+                return lm_fail(err, LM_ERR_INVALID, "%s: vertex %u (node \"%s\") lies at %g, beyond the %g a "
+                               "coordinate may reach", s->path, v, name, (double)p[k], (double)LM_MAX_COORDINATE);
+            }
+    }
+    return LM_OK;
+}
+
+lm_status lm_light_check(const char *what, const float color[3], float intensity, float range, int spot,
+                         float inner_cone, float outer_cone, lm_error *err)
+{
+    for (int c = 0; c < 3; c++)
+        if (!in_range(color[c], 0.0f, 1000.0f))
+            return lm_fail(err, LM_ERR_INVALID, "%s: colour %g must be in [0, 1000] (glTF: [0, 1])", what,
+                           (double)color[c]);
+    if (!in_range(intensity, 0.0f, 1e15f) || !in_range(range, 0.0f, 1e15f))
+        return lm_fail(err, LM_ERR_INVALID, "%s: intensity %g and range %g must be finite numbers >= 0", what,
+                       (double)intensity, (double)range);
+    for (int c = 0; c < 3; c++)
+        if (!((double)color[c] * intensity <= LM_MAX_EMISSION))
+            return lm_fail(err, LM_ERR_INVALID, "%s: colour x intensity %g exceeds %g: its photon powers would "
+                           "overflow to infinity", what, (double)color[c] * intensity, LM_MAX_EMISSION);
+    if (spot && !(in_range(inner_cone, 0.0f, (float)(LM_PI / 2)) && in_range(outer_cone, 0.0f, (float)(LM_PI / 2)) &&
+                  inner_cone <= outer_cone && outer_cone > 0.0f))
+        return lm_fail(err, LM_ERR_INVALID, "%s: spot cones %g and %g must satisfy 0 <= inner <= outer <= pi/2, "
+                       "outer > 0", what, (double)inner_cone, (double)outer_cone);
+    return LM_OK;
+}
+
 void lm_light_place(const lm_scene *s, const lm_light *l, float pos[3], float dir[3])
 {
     if (l->node < 0) {

@@ -270,10 +270,17 @@ float lm_scene_animation_duration(const lm_scene *s);
 /* The largest |coordinate| a vertex may have in world space after loading (a load error beyond it):
  * rays must stay far inside Embree's limit of about 1.8e18, and texel sizes and scene sizes finite. */
 #define LM_MAX_COORDINATE 1e15f
+/* An animation's translation and scale keys at most (the loader's rule): with them a node's vertices stay
+ * within LM_MAX_COORDINATE for any local coordinate under 5e8. */
+#define LM_MAX_ANIM_TRANSLATION 5e14f
+#define LM_MAX_ANIM_SCALE 1e6f
 /* The largest light colour x intensity or material emission (a load error beyond it): a photon's power is
  * that times 4 pi or an area, summed over bounces and texels in float; 1e38 overflowed to infinity and
  * asked for 77 billion photons. The brightest real light (the sun, about 1e5 lux) is far below. */
 #define LM_MAX_EMISSION 1e20
+/* KHR_texture_transform's offset and scale at most: a million repeats of a texture is past any real use,
+ * and 3e38 made every lookup infinite (an 81% NaN frame). */
+#define LM_MAX_UV_TRANSFORM 1e6f
 
 /* World-space position of a vertex / normal under the current node matrices. */
 void lm_scene_vertex_world(const lm_scene *s, uint32_t v, float out[3]);
@@ -304,5 +311,15 @@ const char *lm_light_type_name(lm_light_type t);
 /* Where a light is now (lmgi's world) and the unit direction it shines: its node's origin and -Z under
  * the node's world matrix, or an added light's own pos and dir. */
 void lm_light_place(const lm_scene *s, const lm_light *l, float pos[3], float dir[3]);
+/* The one rule for a light's parameters, at load and at every edit, so a light that loads can always be
+ * set again with its own values: colour in [0, 1000] (glTF: [0, 1]; brighter colours kept for engines
+ * that write them), intensity and range finite and >= 0 (range 0: unbounded), colour x intensity at most
+ * LM_MAX_EMISSION, and for a spot 0 <= inner <= outer <= pi/2 with outer > 0 (inner = outer, as Blender
+ * writes a hard-edged spot, is a hard edge). LM_ERR_INVALID naming `what` and the parameter. */
+/* Whether every vertex under `node` (-1: the whole scene) lies within LM_MAX_COORDINATE, where the node
+ * is now; LM_ERR_INVALID naming the first that does not. O(vertices). */
+lm_status lm_scene_check_extent(const lm_scene *s, int node, lm_error *err);
+lm_status lm_light_check(const char *what, const float color[3], float intensity, float range, int spot,
+                         float inner_cone, float outer_cone, lm_error *err);
 
 #endif

@@ -13,24 +13,6 @@
  * such slivers have no usable normal or lightmap area in float precision. */
 #define LM_DEGENERATE_REL 1e-7f
 
-/* Coordinates a scene may reach (scene.h, LM_MAX_COORDINATE): Embree takes no ray whose numbers exceed
- * about 1.8e18, and a scene near that would put rays and texel sizes there (a vertex at 1e20 gave
- * "texel inf units" and an abort inside Embree). */
-static lm_status check_extent(const lm_scene *s, lm_error *err)
-{
-    for (uint32_t v = 0; v < s->vertex_count; v++) {
-        float p[3];
-        lm_scene_vertex_world(s, v, p);
-        for (int k = 0; k < 3; k++)
-            if (!(fabsf(p[k]) <= LM_MAX_COORDINATE)) {
-                const char *node = s->nodes[s->vertex_node[v]].name;
-                return lm_fail(err, LM_ERR_INVALID, "%s: vertex %u (node \"%s\") lies at %g, beyond the %g a "
-                               "coordinate may reach", s->path, v, node, (double)p[k], (double)LM_MAX_COORDINATE);
-            }
-    }
-    return LM_OK;
-}
-
 size_t lm_component_size(int comp_type)
 {
     switch (comp_type) {
@@ -371,7 +353,7 @@ lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_e
     lm_scene_update_bounds(s);
     reverse_mirrored(s);
     warn_mirroring_animations(s);
-    lm_status st = check_extent(s, err);
+    lm_status st = lm_scene_check_extent(s, -1, err);
     if (st == LM_OK)
         rebase(s);
     return st;

@@ -999,6 +999,8 @@ const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl-
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }
 
+lm_iim *lm_frame_loop_iim(lm_frame_loop *fl) { return &fl->iim; }
+
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err)
 {
     size_t n = 4 * (size_t)fl->atlas->width * fl->atlas->height;
@@ -1030,7 +1032,7 @@ lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *
         const lm_photon_store *ps = lm_photons_store(lm_photon_stage_photons(fl->stage));
         for (int s = 0; s < a->surface_count; s++) {
             double e = lm_photon_store_iim_energy(ps, s), d = ps->surfaces[s].delta_i;
-            pending[s] = d <= 0.0 ? 0.0 : e > 0.0 ? d / e : 1.0;
+            pending[s] = !(d > 0.0) ? 0.0 : e > 0.0 && isfinite(d / e) ? d / e : 1.0;
         }
         float limit = fl->set.gather.backface_limit;
         double sum = 0.0;
@@ -1046,7 +1048,8 @@ lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *
             size_t at = (size_t)a->texels[i].y * a->width + a->texels[i].x;
             double f = lm_luminance(fresh + 4 * at), blend = fabs(f - lm_luminance(shown + 4 * at)) / fmax(fabs(f), floor);
             int k = a->texels[i].surface;
-            error[at] = fl->iim.sched.off[k] ? 0.0f : (float)fmax(blend, pending[k]); /* off: nothing to show */
+            double v = fl->iim.sched.off[k] ? 0.0 : fmax(blend, pending[k]); /* off: nothing to show */
+            error[at] = isfinite(v) && v < 1e30 ? (float)v : 1.0f; /* past what can be said: all of it stale */
         }
     }
     free(fresh);

@@ -165,6 +165,9 @@ const float *lm_frame_loop_image(const lm_frame_loop *fl);
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);
 /* The displayed IIM read back (atlas-sized RGBA floats, a = back-face fraction); caller frees. */
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err);
+/* The IIMs behind the displayed lightmap (tools and tests: test_bad_values writes a NaN into them to see
+ * lmgi_update name the stage). */
+lm_iim *lm_frame_loop_iim(lm_frame_loop *fl);
 /* Per atlas pixel (width*height floats, 0 outside texels), how far the displayed IIM may be from the
  * lighting as it is now, relative to the texel's irradiance: the larger of
  *   - what the display has still to blend in: |fresh - displayed| / max(|fresh|, floor), fresh being

@@ -1,0 +1,288 @@
+/* Never "ok" over NaN, infinity or black: values from a file or the API that would make one are refused
+ * by the glTF specification and the limits of float, a frame that has one anyway fails naming the stage,
+ * half floats clamp and say so, and a light that loads can always be set again with its own values. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <lmgi.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../src/api/lmgi_context.h"
+#include "../src/api/lmgi_updater.h"
+#include "../src/core/image.h"
+#include "../src/core/log.h"
+#include "../src/gpu/gl_context.h"
+#include "../src/gpu/hemicube.h"
+#include "support.h"
+
+/* A 1 x 1 PNG (200, 100, 50). */
+#define ONE_TEXEL_PNG "iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAIAAACQd1PeAAAADElEQVR4nGM4kWIEAANWAV/oF4RSAAAAAElFTkSuQmCC"
+#define GREY "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.5, 0.5, 1], \"metallicFactor\": 0}}"
+
+/* A 4 x 4 m floor (y = 0) of `material` (NULL: grey) with a point light 2 m above it (`light`: NULL, 10 cd);
+ * `nodes_extra` is appended to the nodes, `top` goes after the materials array (cameras, textures...). */
+static const char *floor_scene(const char *name, const char *material, const char *light, const char *nodes_extra,
+                               const char *top)
+{
+    static lmt_mesh m;
+    memset(&m, 0, sizeof m);
+    lmt_mesh_quad(&m, (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    char nodes[2048], materials[4096];
+    snprintf(nodes, sizeof nodes, "[{\"mesh\": 0}, {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": "
+             "{\"light\": 0}}}%s]", nodes_extra ? nodes_extra : "");
+    snprintf(materials, sizeof materials, "[%s], %s" LMT_LIGHTS("%s"), material ? material : GREY, top ? top : "",
+             light ? light : "{\"type\": \"point\", \"intensity\": 10}");
+    return lmt_write_scene(name, &m, 1, nodes, materials);
+}
+
+static lmgi_status load(const char *path, lmgi_scene **sc, lmgi_error *e)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.texel_size = 0.25f;
+    *sc = NULL;
+    return lmgi_load(path, &o, sc, e);
+}
+
+static void expect_refused(const char *path, const char *words)
+{
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    lmgi_status st = load(path, &sc, &e);
+    if (st == LMGI_OK)
+        fail_msg("%s loaded; expected a refusal naming \"%s\"", path, words);
+    if (!strstr(e.message, words))
+        fail_msg("%s: \"%s\" does not say \"%s\"", path, e.message, words);
+    assert_null(sc);
+}
+
+static void test_file_values(void **state)
+{
+    (void)state;
+    /* KHR_texture_transform of 3e38: every lookup infinite, an 81% NaN frame */
+    static const char *const transforms[] = {"\"offset\": [3e38, 0]", "\"scale\": [1, -2e6]", "\"rotation\": 1e7"};
+    for (int i = 0; i < 3; i++) {
+        char material[512];
+        snprintf(material, sizeof material, "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0, \"baseColorTexture\": "
+                 "{\"index\": 0, \"extensions\": {\"KHR_texture_transform\": {%s}}}}}", transforms[i]);
+        expect_refused(floor_scene("tt.gltf", material, NULL, NULL, "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": "
+                                   "\"data:image/png;base64," ONE_TEXEL_PNG "\"}], "), "KHR_texture_transform");
+    }
+    static const char *const bad_lights[] = {
+        "{\"type\": \"point\", \"intensity\": 10, \"color\": [1, -0.5, 1]}",
+        "{\"type\": \"spot\", \"intensity\": 10, \"spot\": {\"innerConeAngle\": -0.2, \"outerConeAngle\": 0.5}}",
+        "{\"type\": \"spot\", \"intensity\": 10, \"spot\": {\"innerConeAngle\": 0.6, \"outerConeAngle\": 0.5}}",
+        "{\"type\": \"spot\", \"intensity\": 10, \"spot\": {\"innerConeAngle\": 0, \"outerConeAngle\": 2}}"};
+    static const char *const said[] = {"colour -0.5", "spot cones -0.2", "spot cones 0.6", "spot cones 0"};
+    for (int i = 0; i < 4; i++)
+        expect_refused(floor_scene("light.gltf", NULL, bad_lights[i], NULL, NULL), said[i]);
+    static const char *const bad_cameras[] = {"{\"type\": \"perspective\", \"perspective\": {\"yfov\": 3.2, \"znear\": 0.1}}",
+                                              "{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 1, "
+                                              "\"zfar\": 0.5}}",
+                                              "{\"type\": \"orthographic\", \"orthographic\": {\"xmag\": 0, \"ymag\": 1, "
+                                              "\"znear\": 0, \"zfar\": 10}}"};
+    static const char *const cam_said[] = {"yfov must be in (0, pi)", "zfar must be greater than znear", "xmag"};
+    for (int i = 0; i < 3; i++) {
+        char top[512];
+        snprintf(top, sizeof top, "\"cameras\": [%s], ", bad_cameras[i]);
+        expect_refused(floor_scene("cam.gltf", NULL, NULL, ", {\"camera\": 0, \"translation\": [0, 1, 3]}", top),
+                       cam_said[i]);
+    }
+}
+
+/* What is within the rules loads, and a light loads only as it can be set again: Blender's hard-edged spot
+ * (inner = outer) is taken back by lmgi_set_light with its own values; a texture transform inside the
+ * bounds loads. */
+static void test_valid_values_load(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    const char *spot = "{\"type\": \"spot\", \"intensity\": 10, \"spot\": {\"innerConeAngle\": 0.5, \"outerConeAngle\": 0.5}}";
+    if (load(floor_scene("spot.gltf", NULL, spot, NULL, NULL), &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_light l;
+    assert_int_equal(lmgi_get_light(sc, 0, &l, &e), LMGI_OK);
+    assert_float_equal(l.inner_cone, l.outer_cone, 0.0);
+    if (lmgi_set_light(sc, 0, &l, &e) != LMGI_OK)
+        fail_msg("a light that loads is refused its own values: %s", e.message);
+    lmgi_free(sc);
+    char material[512];
+    snprintf(material, sizeof material, "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0, \"baseColorTexture\": "
+             "{\"index\": 0, \"extensions\": {\"KHR_texture_transform\": {\"offset\": [0.5, -3], \"scale\": [1e5, 2], "
+             "\"rotation\": 0.3}}}}}");
+    if (load(floor_scene("tt.gltf", material, NULL, NULL, "\"textures\": [{\"source\": 0}], \"images\": [{\"uri\": "
+                         "\"data:image/png;base64," ONE_TEXEL_PNG "\"}], "), &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_free(sc);
+}
+
+/* Transforms from animations and edits keep to the limit a file's own coordinates keep to (1e15): a key or
+ * an edit that moves a node to 1e30 made the whole frame black. */
+static void test_transforms_bounded(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    lmt_mesh_cube(&m[1], 0.25f);
+    const char *nodes = "[{\"mesh\": 0}, {\"name\": \"crate\", \"mesh\": 1, \"translation\": [0, 0.5, 0], \"extras\": "
+                        "{\"lmgi\": {\"dynamic\": true}}}]";
+    static const float times[2] = {0, 1}, far[6] = {0, 0.5f, 0, 1e30f, 0.5f, 0};
+    lmt_accessor acc[2] = {{times, 2, "SCALAR"}, {far, 2, "VEC3"}};
+    const char *anim = "\"animations\": [{\"samplers\": [{\"input\": 4, \"output\": 5}], \"channels\": [{\"sampler\": 0, "
+                       "\"target\": {\"node\": 1, \"path\": \"translation\"}}]}],";
+    char path[1200];
+    snprintf(path, sizeof path, "%s/anim.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, m, 2, nodes, acc, 2, anim), 0);
+    expect_refused(path, "beyond the 5e+14 a translation key may reach");
+
+    snprintf(path, sizeof path, "%s/still.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, m, 2, nodes, NULL, 0, ""), 0);
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (load(path, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    float before[16], world[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1e30f, 0.5f, 0, 1};
+    assert_true(lmgi_get_node_transform(sc, 1, before));
+    assert_int_equal(lmgi_set_node_transform(sc, 1, world, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "beyond the 1e+15 a coordinate may reach"));
+    float after[16];
+    assert_true(lmgi_get_node_transform(sc, 1, after));
+    assert_memory_equal(before, after, sizeof before); /* left where it was */
+    world[12] = 1e6f; /* scale 1e12 on a 0.25 m crate: its corners at 2.5e11 */
+    world[0] = world[5] = world[10] = 1e12f;
+    assert_int_equal(lmgi_set_node_transform(sc, 1, world, &e), LMGI_OK);
+    lmgi_free(sc);
+}
+
+/* The updater: a photon radius of 1e-30 (every pixel NaN), a camera that sees none of the scene (black
+ * frames) are refused; a NaN in a lightmap makes lmgi_update fail naming the stage. */
+static void test_updater_values(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_scene *sc = NULL;
+    if (load(floor_scene("upd.gltf", NULL, NULL, ", {\"camera\": 0, \"translation\": [0, 1, 3e7]}",
+                         "\"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 0.8, \"znear\": 0.1, "
+                         "\"zfar\": 20}}], "), &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.photons = 4000;
+    d.frame_width = d.frame_height = 32;
+    lmgi_updater *u = NULL;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID); /* 3e7 away, far plane at 20 */
+    assert_non_null(strstr(e.message, "sees none of the scene"));
+    lmgi_free(sc);
+    if (load(floor_scene("upd2.gltf", NULL, NULL, NULL, NULL), &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    d.indirect = LMGI_INDIRECT_TILED;
+    d.photon_radius = 1e-30f;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID);
+    if (!strstr(e.message, "photon_radius 1e-30"))
+        fail_msg("%s", e.message);
+    d.photon_radius = 0.0f;
+    d.indirect = LMGI_INDIRECT_LIGHTMAP;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_update_stats st;
+    assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+
+    /* a NaN in every IIM texture, as a broken gather would leave: the next update fails and says where */
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *nan = malloc(n * sizeof *nan);
+    assert_non_null(nan);
+    for (size_t i = 0; i < n; i++) /* colour NaN, alpha (the back-face share) 0: valid, composited as it is */
+        nan[i] = i % 4 == 3 ? 0.0f : NAN;
+    lm_iim *iim = lm_frame_loop_iim(lm_updater_loop(u));
+    assert_int_equal(lm_gl_make_current(ctx->gl, &(lm_error){0}), LM_OK);
+    unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
+    for (int k = 0; k < 4; k++)
+        assert_int_equal(lm_iim_texture_write(tex[k], in.atlas_width, in.atlas_height, nan, &(lm_error){0}), LM_OK);
+    free(nan);
+    assert_int_equal(lmgi_update(u, 0.1f, 0.0f, &st, &e), LMGI_ERR_BACKEND);
+    print_message("%s\n", e.message);
+    assert_non_null(strstr(e.message, "not finite numbers"));
+    assert_non_null(strstr(e.message, "the IIM lightmap (the gather)"));
+    float *rgba = malloc(n * sizeof *rgba);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, n, &e), LMGI_ERR_BACKEND); /* read back: the same */
+    assert_non_null(strstr(e.message, "not finite numbers"));
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, rgba, n, &e), LMGI_OK);
+    free(rgba);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* Pictures: a NaN is never written; half floats clamp to 65504 and count what they clamped. */
+static void test_pictures(void **state)
+{
+    (void)state;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/x.exr", lmt_tmpdir());
+    float px[12] = {1, 2, 3, 1e6f, -1e6f, 70000, 0, 0, 0, 0.5f, 0.5f, 0.5f};
+    lmgi_error e;
+    lmgi_image_desc half = {.half = 1};
+    lm_log_level was = lm_log_get_level();
+    lm_log_set_level(LM_LOG_ERROR);
+    lm_log_reset_warning_count();
+    assert_int_equal(lmgi_write_image(path, 2, 2, 3, px, &half, &e), LMGI_OK);
+    lm_log_set_level(was);
+    assert_int_equal(lm_log_warning_count(), 1);
+    int w, h;
+    float *back = NULL;
+    assert_int_equal(lm_read_exr(path, &w, &h, &back, &(lm_error){0}), LM_OK);
+    assert_float_equal(back[4 * 1 + 0], 65504.0, 0.0);
+    assert_float_equal(back[4 * 1 + 1], -65504.0, 0.0);
+    assert_float_equal(back[4 * 1 + 2], 65504.0, 0.0);
+    assert_float_equal(back[0], 1.0, 0.0);
+    free(back);
+    px[7] = NAN;
+    snprintf(path, sizeof path, "%s/y.png", lmt_tmpdir());
+    assert_int_equal(lmgi_write_image(path, 2, 2, 3, px, NULL, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "1 values are not finite"));
+    px[7] = INFINITY;
+    snprintf(path, sizeof path, "%s/y.exr", lmt_tmpdir());
+    assert_int_equal(lmgi_write_image(path, 2, 2, 3, px, NULL, &e), LMGI_ERR_INVALID);
+}
+
+/* A Draco-compressed mesh without an uncompressed fallback decodes to nothing: said, not drawn black. */
+static void test_draco_without_fallback(void **state)
+{
+    (void)state;
+    char path[1200];
+    snprintf(path, sizeof path, "%s/draco.gltf", lmt_tmpdir());
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs("{\"asset\": {\"version\": \"2.0\"}, \"extensionsUsed\": [\"KHR_draco_mesh_compression\"], \"scene\": 0, "
+          "\"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": "
+          "{\"POSITION\": 0}, \"extensions\": {\"KHR_draco_mesh_compression\": {\"bufferView\": 0, \"attributes\": "
+          "{\"POSITION\": 0}}}}]}], \"accessors\": [{\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": "
+          "[0, 0, 0], \"max\": [1, 1, 0]}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 4}], \"buffers\": "
+          "[{\"byteLength\": 4, \"uri\": \"data:application/octet-stream;base64,AAAAAA==\"}]}", f);
+    fclose(f);
+    expect_refused(path, "Draco-compressed (KHR_draco_mesh_compression), which lmgi does not decode");
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_file_values),
+        cmocka_unit_test(test_valid_values_load),
+        cmocka_unit_test(test_transforms_bounded),
+        cmocka_unit_test(test_updater_values),
+        cmocka_unit_test(test_pictures),
+        cmocka_unit_test(test_draco_without_fallback),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
