@@ -125,9 +125,10 @@ $(BUILD)/gen_scenes: tools/gen_scenes.c
 	$(CC) -std=c11 -O2 $(WARN) -D_DEFAULT_SOURCE -o $@ $< -lm
 
 # The fuzz tests always run under ASan + UBSan, whatever the main build is: fuzz_loader (byte mutations
-# through the loader) and fuzz_pipeline (structured mutations through load, photons and one frame).
+# through the loader), fuzz_pipeline (structured mutations through load, photons and one frame) and
+# fuzz_api (random call sequences with random values through the public API).
 FUZZ_BUILD := build/asan
-FUZZ_TESTS := $(FUZZ_BUILD)/tests/fuzz_loader $(FUZZ_BUILD)/tests/fuzz_pipeline
+FUZZ_TESTS := $(FUZZ_BUILD)/tests/fuzz_loader $(FUZZ_BUILD)/tests/fuzz_pipeline $(FUZZ_BUILD)/tests/fuzz_api
 $(FUZZ_BUILD)/tests/fuzz_%: FORCE
 	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) OPT="-O1 -g" \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
@@ -142,11 +143,15 @@ test: deps all $(TESTS) $(FUZZ_TESTS)
 	@LMGI_BUILD=$(BUILD) sh tests/run_tests.sh $(TESTS) $(FUZZ_TESTS)
 
 # make fuzz: FUZZ_INPUTS structured inputs through the whole pipeline under ASan + UBSan, split over
-# FUZZ_JOBS processes with seeds 1..FUZZ_JOBS (each its own inputs); logs in build/fuzz/.
+# FUZZ_JOBS processes with seeds 1..FUZZ_JOBS (each its own inputs), then FUZZ_API_SEQUENCES call
+# sequences of 200 calls through the API the same way; logs in build/fuzz/.
 FUZZ_INPUTS ?= 100000
+FUZZ_API_SEQUENCES ?= 200
 FUZZ_JOBS   ?= 2
-fuzz: deps $(FUZZ_BUILD)/tests/fuzz_pipeline
+fuzz: deps $(FUZZ_BUILD)/tests/fuzz_pipeline $(FUZZ_BUILD)/tests/fuzz_api
 	@sh tests/run_fuzz.sh $(FUZZ_BUILD)/tests/fuzz_pipeline $(FUZZ_INPUTS) $(FUZZ_JOBS) build/fuzz
+	@LMGI_FUZZ_API_STEPS=200 sh tests/run_fuzz.sh $(FUZZ_BUILD)/tests/fuzz_api $(FUZZ_API_SEQUENCES) $(FUZZ_JOBS) \
+	  build/fuzz-api
 
 test-asan: deps
 	@$(MAKE) --no-print-directory BUILD=build/asan OPT="-O1 -g" \

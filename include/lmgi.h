@@ -200,7 +200,7 @@ typedef struct {
     float color[3];           /* linear RGB, each in [0, 1000] */
     float intensity;          /* candela (point, spot) or lux (directional), >= 0 */
     float range;              /* 0: infinite */
-    float inner_cone, outer_cone; /* spot: radians, 0 <= inner < outer <= pi/2 */
+    float inner_cone, outer_cone; /* spot: radians, 0 <= inner <= outer <= pi/2, outer > 0 */
     int enabled;              /* 0: switched off (emits nothing; colour and intensity kept) */
     float position[3];        /* world position (point, spot), in the file's world */
     float direction[3];       /* unit direction it shines (spot, directional; unused for point lights).
