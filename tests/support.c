@@ -340,7 +340,7 @@ void lmt_use_material_0(const char *path)
 {
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
-    static char in[1 << 16], out[1 << 17];
+    static char in[1 << 18], out[1 << 19];
     size_t n = fread(in, 1, sizeof in - 1, f);
     fclose(f);
     in[n] = '\0';
@@ -365,12 +365,12 @@ void lmt_use_material_0(const char *path)
 const char *lmt_write_scene(const char *name, const lmt_mesh *meshes, int count, const char *nodes,
                             const char *materials)
 {
-    static char path[512];
-    char extra[2048];
+    static char path[512], extra[1 << 16];
     snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), name);
-    snprintf(extra, sizeof extra, "\"materials\": %s,", materials);
+    if (snprintf(extra, sizeof extra, "\"materials\": %s,", materials) >= (int)sizeof extra)
+        fail_msg("lmt_write_scene: the materials text is over %zu bytes", sizeof extra);
     assert_int_equal(lmt_write_gltf(path, meshes, count, nodes, NULL, 0, extra), 0);
-    static char in[1 << 16], out[1 << 17];
+    static char in[1 << 18], out[1 << 19];
     FILE *f = fopen(path, "rb");
     assert_non_null(f);
     size_t n = fread(in, 1, sizeof in - 1, f);

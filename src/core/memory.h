@@ -14,7 +14,8 @@
 /* Above this a plan is said as a warning (1 GiB). */
 #define LM_MEMORY_WARN_BYTES (1024.0 * 1024.0 * 1024.0)
 
-/* The machine's physical memory in bytes, 0 if unknown. */
+/* The memory this process can still take, in bytes: the machine's physical memory, or under an address
+ * space limit (RLIMIT_AS, ulimit -v) what is left of it if that is less; 0 if unknown. */
 uint64_t lm_memory_physical(void);
 
 /* A plan of `bytes` for `what` ("atlas 8040 x 5604 (45 M texels)"): above the physical memory an

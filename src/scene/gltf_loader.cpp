@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdarg>
@@ -13,12 +14,16 @@
 #include <sys/stat.h>
 #include <memory>
 #include <new>
+#include <omp.h>
 #include <string>
+#include <string_view>
+#include <unordered_map>
 #include <vector>
 
 extern "C" {
 #include "../core/error.h"
 #include "../core/log.h"
+#include "../core/memory.h"
 #include "scene.h"
 #include "image_decode.h"
 #include "scene_build.h"
@@ -155,7 +160,7 @@ class Loader {
     lm_status read_floats(int acc, int type, bool force_norm, const char *what, const std::string &ctx,
                           std::vector<float> &out, size_t &count);
     int image_of(int tex_index) const;
-    void decode_used_images();
+    lm_status decode_used_images();
     int texture(int tex_index, const std::string &ctx);
     void metal_rough_from_texture(const tinygltf::PbrMetallicRoughness &pbr, lm_material &d);
     lm_status materials();
@@ -487,7 +492,11 @@ int Loader::image_of(int tex_index) const
 // JPEG or PNG textures of 1024 x 1024 took 8 s on one core), each as colour (sRGB) or data as its use
 // says. An image used both ways is decoded as its first use in material order says. The warnings for
 // undecodable images follow, in image order, so the log is the same on any number of threads.
-void Loader::decode_used_images()
+// Each used image is decoded once however many glTF images name the same bytes (40 images of one file
+// were decoded 40 times), and the decoding's memory is planned before any of it: the threads' largest
+// decodes at once, plus every reduced texture kept (lm_memory_plan; above the machine's memory the load
+// is refused naming the images, never a texture silently dropped).
+lm_status Loader::decode_used_images()
 {
     size_t n = model_.images.size();
     decoded_.assign(n, Decoded());
@@ -502,12 +511,42 @@ void Loader::decode_used_images()
         mark(m.emissiveTexture.index, 1);
         mark(m.pbrMetallicRoughness.metallicRoughnessTexture.index, 0);
     }
+    std::vector<long> same(n, -1); // an earlier image with the same bytes and use, decoded in its place
+    std::unordered_map<uint64_t, long> first;
+    std::vector<double> peak;
+    double kept = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const std::vector<unsigned char> &b = model_.images[i].image;
+        if (use[i] < 0 || b.empty())
+            continue;
+        uint64_t key = std::hash<std::string_view>{}(std::string_view(reinterpret_cast<const char *>(b.data()), b.size())) ^
+                       uint64_t(use[i]);
+        auto it = first.find(key);
+        if (it != first.end() && model_.images[size_t(it->second)].image == b && use[size_t(it->second)] == use[i]) {
+            same[i] = it->second;
+            continue;
+        }
+        first[key] = long(i);
+        double bytes = lm_image_decode_bytes(b.data(), b.size(), LM_TEXTURE_MAX_SIDE);
+        peak.push_back(bytes);
+        kept += std::fmin(bytes, 4.0 * LM_TEXTURE_MAX_SIDE * LM_TEXTURE_MAX_SIDE);
+    }
+    std::sort(peak.begin(), peak.end(), std::greater<double>());
+    double at_once = kept;
+    for (size_t k = 0; k < peak.size() && k < size_t(omp_get_max_threads()); k++)
+        at_once += peak[k];
+    char what[128];
+    snprintf(what, sizeof what, "decoding %zu images", peak.size());
+    lm_error e;
+    if (lm_memory_plan(what, at_once, "smaller images (lmgi keeps at most 256 x 256 of each; decoding a huge one "
+                       "is the cost)", &e) != LM_OK)
+        return fail(e.status, "%s", e.msg);
     long count = long(n);
 #pragma omp parallel for schedule(dynamic)
     for (long i = 0; i < count; i++) {
         const tinygltf::Image &im = model_.images[size_t(i)];
         Decoded &d = decoded_[size_t(i)];
-        if (use[size_t(i)] < 0 || im.image.empty()) // unused, or unreadable (tinygltf said so as it parsed)
+        if (use[size_t(i)] < 0 || im.image.empty() || same[size_t(i)] >= 0) // unused, unreadable, or a repeat
             continue;
         uint8_t *px = nullptr;
         d.status = lm_image_decode(im.image.data(), im.image.size(), LM_TEXTURE_MAX_SIDE, use[size_t(i)], &px, &d.w,
@@ -521,16 +560,21 @@ void Loader::decode_used_images()
             free(px);
         }
     }
+    for (size_t i = 0; i < n; i++)
+        if (same[i] >= 0)
+            decoded_[i] = decoded_[size_t(same[i])];
     for (size_t i = 0; i < n; i++) {
         const tinygltf::Image &im = model_.images[i];
         model_.images[i].image.clear(); // the encoded bytes are done with
         model_.images[i].image.shrink_to_fit();
         if (decoded_[i].status == LM_ERR_NOMEM)
-            throw std::bad_alloc();
+            return fail(LM_ERR_NOMEM, "image %zu (\"%.200s\"): %s", i, (im.name.empty() ? im.uri : im.name).c_str(),
+                        decoded_[i].why);
         if (decoded_[i].status)
             lm_warn("%s: image %zu (\"%.200s\"): %s; ignored", path_, i, (im.name.empty() ? im.uri : im.name).c_str(),
                     decoded_[i].why);
     }
+    return LM_OK;
 }
 
 // lm texture index for glTF texture `tex_index` (-1 if none or undecodable); colour textures are sRGB.
@@ -578,7 +622,9 @@ lm_status Loader::materials()
     size_t n = model_.materials.size();
     s_->materials = calloc_n<lm_material>(n + 1); // room for the default material
     image_tex_.assign(model_.images.size(), -1);
-    decode_used_images();
+    lm_status decoded = decode_used_images();
+    if (decoded)
+        return decoded;
     static const float one4[4] = {1, 1, 1, 1}, zero3[3] = {0, 0, 0};
     for (size_t i = 0; i < n; i++) {
         const tinygltf::Material &m = model_.materials[i];
@@ -924,6 +970,11 @@ lm_status Loader::primitive(int node, int mesh, int prim)
             return st;
         if (sp.count > UINT32_MAX)
             return fail(LM_ERR_FORMAT, "%s: too many indices", ctx.c_str());
+        if (!sp.data) { // all zeros: every triangle a point, 2^24 of them took 3.7 GB and 43 s to drop
+            lm_warn("%s: %s: its indices have no data (an accessor without a bufferView: every triangle "
+                    "degenerate); skipped", path_, ctx.c_str());
+            return LM_OK;
+        }
         idx.assign(sp.count, 0);
         if (sp.data && !lm_decode_indices(sp.data, sp.count, sp.stride, sp.comp_type, idx.data()))
             return fail(LM_ERR_FORMAT, "%s: index accessor %d is not u8/u16/u32", ctx.c_str(), p.indices);

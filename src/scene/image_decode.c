@@ -77,9 +77,10 @@ static lm_status decode_stb(const uint8_t *bytes, size_t size, int max_side, int
         return LM_ERR_FORMAT;
     }
     uint8_t *full = stbi_load_from_memory(bytes, (int)size, &iw, &ih, &comp, 4);
-    if (!full) {
-        *why = "corrupt image";
-        return LM_ERR_FORMAT;
+    if (!full) { /* out of memory is the machine's limit, not the file's fault: never "ignored" */
+        int nomem = stbi_failure_reason() && !strcmp(stbi_failure_reason(), "outofmem");
+        *why = nomem ? "out of memory decoding it" : "corrupt image";
+        return nomem ? LM_ERR_NOMEM : LM_ERR_FORMAT;
     }
     fit(iw, ih, max_side, &ow, &oh);
     if (ow == iw && oh == ih) {
@@ -96,6 +97,23 @@ static lm_status decode_stb(const uint8_t *bytes, size_t size, int max_side, int
     }
     *rgba = px, *w = ow, *h = oh;
     return LM_OK;
+}
+
+double lm_image_decode_bytes(const uint8_t *bytes, size_t size, int max_side)
+{
+    int iw = 0, ih = 0, comp = 0, ow, oh;
+    if (!bytes || size == 0 || size > INT32_MAX)
+        return 0.0;
+    if (lm_image_is_webp(bytes, size)) {
+        if (!WebPGetInfo(bytes, size, &iw, &ih))
+            return 0.0;
+        fit(iw, ih, max_side, &ow, &oh);
+        return 4.0 * ow * oh; /* libwebp scales as it decodes */
+    }
+    if (!stbi_info_from_memory(bytes, (int)size, &iw, &ih, &comp) || (long long)iw * ih > LM_IMAGE_MAX_PIXELS)
+        return 0.0;
+    fit(iw, ih, max_side, &ow, &oh);
+    return 4.0 * iw * ih + 4.0 * ow * oh;
 }
 
 lm_status lm_image_decode(const uint8_t *bytes, size_t size, int max_side, int srgb, uint8_t **rgba, int *w, int *h,

@@ -36,6 +36,9 @@ int lm_image_is_webp(const uint8_t *bytes, size_t size);
 
 lm_status lm_image_decode(const uint8_t *bytes, size_t size, int max_side, int srgb, uint8_t **rgba, int *w, int *h,
                           const char **why);
+/* The bytes decoding the image will hold at once at most (its full-size RGBA and the reduced copy), from
+ * its header alone; 0 when the header is not one lmgi reads (the decode then refuses it cheaply). */
+double lm_image_decode_bytes(const uint8_t *bytes, size_t size, int max_side);
 
 #ifdef __cplusplus
 }
