@@ -824,8 +824,9 @@ LMGI_API lmgi_status lmgi_write_file(const char *path, const void *data, size_t 
  * lmgi_output_open of it, from this or another process, is refused (LMGI_ERR_IO naming the holder's
  * process) until the first commits or aborts; a killed process's lock is released by the system. It
  * refuses a directory without lmgi's manifest that holds files unless force is non-zero (the mistake of
- * writing into a home folder). Whatever is in `dir` that lmgi did not place there (not in the manifest, or
- * another file put under a listed name) is never removed or replaced, with or without force. `command` (a-z and -: "bake", "run", ...)
+ * writing into a home folder). Whatever is in `dir` that lmgi did not place there (not in the manifest,
+ * another file put under a listed name, or lmgi's file written over) is never removed or replaced, with or
+ * without force. `command` (a-z and -: "bake", "run", ...)
  * names whose result this is: the commit replaces that command's earlier files in `dir` and leaves
  * other commands'. `inputs` (NULL-terminated paths, or NULL) are the files the command reads: none of them
  * is ever replaced or removed (refused at open when the earlier result is one of them, and at commit).

@@ -120,6 +120,13 @@ static void test_only_its_own_files(void **state)
     static const char *const none[] = {NULL};
     assert_int_equal(result(dir, "run", 0, none, "", &e), LMGI_OK); /* a run that writes no frame 0 */
     assert_true(holds(dir, "frame_0000.png", "my frame"));
+    /* lmgi's own file written over in place (same inode) is the user's now too */
+    put_file(dir, "lightmap.exr", "edited by hand");
+    assert_int_equal(result(dir, "bake", 0, maps, "rebaked", &e), LMGI_ERR_IO);
+    assert_true(holds(dir, "lightmap.exr", "edited by hand"));
+    static const char *const other[] = {"aim.exr", NULL};
+    assert_int_equal(result(dir, "bake", 0, other, "rebaked", &e), LMGI_OK); /* nor removed when not rewritten */
+    assert_true(holds(dir, "lightmap.exr", "edited by hand") && holds(dir, "aim.exr", "rebaked"));
     for (int i = 0; i < 7; i++)
         assert_true(holds(dir, users[i], "mine"));
 }

@@ -19,10 +19,17 @@
 #define LEGACY "lmgi writes into this directory"
 #define MAX_INPUTS 16
 
+/* A file as lmgi placed it: its inode (rename keeps it), size and modification time. A user's file put
+ * under the name, or lmgi's file written over in place, no longer matches. All 0: a working file, which
+ * lmgi itself rewrites under its name. */
+typedef struct {
+    unsigned long long ino, size, mtime_ns;
+} stamp;
+
 typedef struct {
     char command[32];
     char name[256];
-    unsigned long long ino; /* the file's inode when lmgi placed it (rename keeps it); 0: a working file */
+    stamp at; /* when lmgi placed it */
 } entry;
 
 typedef struct {
@@ -73,7 +80,15 @@ static ptrdiff_t find(const entries *m, const char *name)
 }
 
 /* Adds NAME under COMMAND, or hands an existing entry of that name to COMMAND. */
-static lm_status put(entries *m, const char *command, const char *name, unsigned long long ino, lm_error *err)
+static stamp stamp_of(const struct stat *s)
+{
+    return (stamp){(unsigned long long)s->st_ino, (unsigned long long)s->st_size,
+                   (unsigned long long)s->st_mtim.tv_sec * 1000000000ull + (unsigned long long)s->st_mtim.tv_nsec};
+}
+
+static const stamp working = {0, 0, 0};
+
+static lm_status put(entries *m, const char *command, const char *name, stamp at_, lm_error *err)
 {
     ptrdiff_t at = find(m, name);
     if (at < 0) {
@@ -88,7 +103,7 @@ static lm_status put(entries *m, const char *command, const char *name, unsigned
         snprintf(m->v[at].name, sizeof m->v[at].name, "%s", name);
     }
     snprintf(m->v[at].command, sizeof m->v[at].command, "%s", command);
-    m->v[at].ino = ino;
+    m->v[at].at = at_;
     return LM_OK;
 }
 
@@ -121,15 +136,11 @@ static lm_status read_manifest(lm_output *o, lm_error *err)
     else if (strcmp(line, HEADER))
         st = lm_fail(err, LM_ERR_IO, "%s: not lmgi's manifest; lmgi leaves this directory alone", path);
     while (st == LM_OK && !o->legacy && fgets(line, sizeof line, f)) {
-        char *tab = strchr(line, '\t'), *nl = strchr(line, '\n');
-        char *tab2 = tab ? strchr(tab + 1, '\t') : NULL;
-        if (!tab2 || !nl)
-            continue;
-        *tab = *tab2 = *nl = '\0';
-        char *end;
-        unsigned long long ino = strtoull(tab + 1, &end, 10);
-        if (*end == '\0' && plain_command(line) && plain_name(tab2 + 1))
-            st = put(&o->manifest, line, tab2 + 1, ino, err);
+        char command[40], name[300];
+        stamp at;
+        if (sscanf(line, "%39[a-z-]\t%llu\t%llu\t%llu\t%299[^\n]", command, &at.ino, &at.size, &at.mtime_ns, name) == 5 &&
+            plain_command(command) && plain_name(name))
+            st = put(&o->manifest, command, name, at, err);
     }
     fclose(f);
     return st;
@@ -137,14 +148,14 @@ static lm_status read_manifest(lm_output *o, lm_error *err)
 
 static lm_status write_manifest(const lm_output *o, const entries *m, lm_error *err)
 {
-    size_t cap = sizeof HEADER + m->n * (sizeof(entry) + 24);
+    size_t cap = sizeof HEADER + m->n * (sizeof(entry) + 72);
     char *text = malloc(cap);
     if (!text)
         return lm_fail(err, LM_ERR_NOMEM, "output directory: no memory for its manifest");
     size_t len = (size_t)snprintf(text, cap, HEADER);
     for (size_t i = 0; i < m->n; i++)
-        len += (size_t)snprintf(text + len, cap - len, "%s\t%llu\t%s\n", m->v[i].command, m->v[i].ino,
-                                m->v[i].name);
+        len += (size_t)snprintf(text + len, cap - len, "%s\t%llu\t%llu\t%llu\t%s\n", m->v[i].command, m->v[i].at.ino,
+                                m->v[i].at.size, m->v[i].at.mtime_ns, m->v[i].name);
     char path[4200];
     path_in(path, sizeof path, o->dir, MANIFEST);
     lm_status st = lm_write_file(path, text, len, err);
@@ -184,7 +195,11 @@ static int ours(const lm_output *o, const char *name)
     char path[4400];
     path_in(path, sizeof path, o->dir, name);
     struct stat s;
-    return !o->manifest.v[at].ino || lstat(path, &s) != 0 || (unsigned long long)s.st_ino == o->manifest.v[at].ino;
+    if (lstat(path, &s) != 0)
+        return 1;
+    stamp now = stamp_of(&s), then = o->manifest.v[at].at;
+    return (then.ino == 0 && then.size == 0 && then.mtime_ns == 0) ||
+           (now.ino == then.ino && now.size == then.size && now.mtime_ns == then.mtime_ns);
 }
 
 /* lmgi's own bookkeeping, and NAME.partial of a file it lists (a write a kill interrupted). */
@@ -376,8 +391,8 @@ lm_status lm_output_work_file(lm_output *o, const char *name, char *path, size_t
     if (st == LM_OK && snprintf(path, size, "%s/%s", o->dir, name) >= (int)size)
         st = lm_fail(err, LM_ERR_INVALID, "%s/%s: path too long", o->dir, name);
     ptrdiff_t at = find(&o->manifest, name);
-    if (st == LM_OK && (at < 0 || strcmp(o->manifest.v[at].command, o->command) || o->manifest.v[at].ino)) {
-        st = put(&o->manifest, o->command, name, 0, err); /* 0: rewritten in place of itself, any inode */
+    if (st == LM_OK && (at < 0 || strcmp(o->manifest.v[at].command, o->command) || o->manifest.v[at].at.ino)) {
+        st = put(&o->manifest, o->command, name, working, err); /* rewritten by lmgi under its name */
         if (st == LM_OK)
             st = write_manifest(o, &o->manifest, err);
     }
@@ -402,7 +417,7 @@ static lm_status list_stage(lm_output *o, entries *fresh, lm_error *err)
         else
             st = check_place(o, e->d_name, err);
         if (st == LM_OK)
-            st = put(fresh, o->command, e->d_name, 0, err);
+            st = put(fresh, o->command, e->d_name, working, err);
     }
     closedir(d);
     return st;
@@ -421,9 +436,9 @@ static lm_status swap_in(lm_output *o, const entries *fresh, lm_error *err)
     entries all = {0};
     lm_status st = LM_OK;
     for (size_t i = 0; st == LM_OK && i < o->manifest.n; i++)
-        st = put(&all, o->manifest.v[i].command, o->manifest.v[i].name, o->manifest.v[i].ino, err);
+        st = put(&all, o->manifest.v[i].command, o->manifest.v[i].name, o->manifest.v[i].at, err);
     for (size_t i = 0; st == LM_OK && i < fresh->n; i++)
-        st = put(&all, o->command, fresh->v[i].name, 0, err); /* 0 until moved: a kill then leaves it lmgi's */
+        st = put(&all, o->command, fresh->v[i].name, working, err); /* until moved: a kill leaves it lmgi's */
     if (st == LM_OK)
         st = write_manifest(o, &all, err); /* every file lmgi may leave here, before any moves */
     for (size_t i = 0; st == LM_OK && i < fresh->n; i++) {
@@ -434,13 +449,13 @@ static lm_status swap_in(lm_output *o, const entries *fresh, lm_error *err)
         if (rename(from, to) != 0 || lstat(to, &placed) != 0)
             st = lm_fail(err, LM_ERR_IO, "%s: cannot move into place (%s)", to, strerror(errno));
         else
-            all.v[find(&all, fresh->v[i].name)].ino = (unsigned long long)placed.st_ino;
+            all.v[find(&all, fresh->v[i].name)].at = stamp_of(&placed);
     }
     entries kept = {0};
     for (size_t i = 0; st == LM_OK && i < all.n; i++) {
         const entry *e = &all.v[i];
         if (strcmp(e->command, o->command) || find(fresh, e->name) >= 0) {
-            st = put(&kept, e->command, e->name, e->ino, err);
+            st = put(&kept, e->command, e->name, e->at, err);
             continue;
         }
         char path[4400];

@@ -3,7 +3,8 @@
  *
  * Layout of DIR:
  *   .lmgi       the manifest: "lmgi output 1", then one line per file lmgi wrote here,
- *               "COMMAND<TAB>INODE<TAB>NAME" (INODE 0 for a working file, rewritten under its name).
+ *               "COMMAND<TAB>INODE<TAB>SIZE<TAB>MTIME_NS<TAB>NAME", the file as lmgi placed it (all 0 for a
+ *               working file, which lmgi rewrites under its name).
  *               An older lmgi's marker ("lmgi writes into this directory...") reads as an empty manifest.
  *   .lmgi.lock  held with flock(2) from open to commit or abort; the kernel releases it when the process
  *               dies, so a killed command never leaves the folder locked. Holds "PID COMMAND" for the
@@ -11,8 +12,8 @@
  *   .lmgi-new/  the new result while the command runs (mode 0700); the previous result is untouched until
  *               commit. A killed command's leftover is removed by the next open, which holds the lock.
  *
- * Invariants: a file not in the manifest, or not the file lmgi placed under that name (its inode), is
- * "foreign": never removed or replaced, with or without force. Force only lets a command start writing
+ * Invariants: a file not in the manifest, or not the file lmgi placed under that name (another inode, or
+ * the same one written over: another size or modification time), is "foreign": never removed or replaced, with or without force. Force only lets a command start writing
  * into an unmarked folder (no manifest) that holds foreign files, the mistake of `--out ~`; a folder with a
  * manifest is lmgi's to write into, beside whatever else it holds. The manifest always lists
  * every file lmgi placed in DIR (it is rewritten as the union before the files move in), so a kill during a
