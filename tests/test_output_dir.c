@@ -349,7 +349,7 @@ static void test_commands_keep_the_last_result(void **state)
     assert_true(exists(runs, "frame_0001.png") && !exists(runs, "frame_0002.png"));
 }
 
-/* --json: never over an input; a path that cannot be written is an error, not exit 0. */
+/* --json: never over an input; a path that cannot be written, stdout included, is an error, not exit 0. */
 static void test_single_output_files(void **state)
 {
     (void)state;
@@ -376,6 +376,8 @@ static void test_single_output_files(void **state)
     struct stat s;
     assert_int_equal(stat(scene, &s), 0);
     assert_true(s.st_nlink == 2); /* the same file as its copy: never rewritten */
+    assert_int_equal(lmgi("info scenes/cornell.glb >/dev/full"), 1); /* what it prints is its output too */
+    assert_int_equal(lmgi("info scenes/cornell.glb >/dev/null"), 0);
 }
 
 int main(void)

@@ -1,6 +1,7 @@
 /* The lmgi command. */
 #include <lmgi.h>
 
+#include <errno.h>
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
@@ -209,22 +210,22 @@ int main(int argc, char **argv)
      * full disk is, instead of a signal that kills the run. */
     signal(SIGXFSZ, SIG_IGN);
     const char *cmd = argv[1];
-    if (!strcmp(cmd, "info"))
-        return cmd_info(&a);
-    if (!strcmp(cmd, "charts"))
-        return cmd_charts(&a);
-    if (!strcmp(cmd, "reference"))
-        return lm_cli_reference(&a);
-    if (!strcmp(cmd, "run"))
-        return lm_cli_run(&a);
-    if (!strcmp(cmd, "bake"))
-        return lm_cli_bake(&a);
-    if (!strcmp(cmd, "check"))
-        return lm_cli_check(&a);
-    if (!strcmp(cmd, "bench"))
-        return lm_cli_bench(&a);
-    if (!strcmp(cmd, "tradeoff"))
-        return lm_cli_tradeoff(&a);
+    static const struct {
+        const char *name;
+        int (*run)(const lm_cli_args *a);
+    } commands[] = {{"info", cmd_info}, {"charts", cmd_charts}, {"reference", lm_cli_reference}, {"run", lm_cli_run},
+                    {"bake", lm_cli_bake}, {"check", lm_cli_check}, {"bench", lm_cli_bench},
+                    {"tradeoff", lm_cli_tradeoff}};
+    for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
+        if (!strcmp(cmd, commands[i].name)) {
+            rc = commands[i].run(&a);
+            /* what it printed is part of its result: `lmgi info > /dev/full` is not a success */
+            if ((fflush(stdout) != 0 || ferror(stdout)) && rc == 0) {
+                fprintf(stderr, "lmgi: error: cannot write the output (%s)\n", strerror(errno));
+                rc = 1;
+            }
+            return rc;
+        }
     fprintf(stderr, "lmgi: unknown command '%s'\n\n", cmd);
     usage(stderr);
     return 2;
