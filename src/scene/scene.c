@@ -333,7 +333,7 @@ lm_status lm_light_check(const char *what, const float color[3], float intensity
             return lm_fail(err, LM_ERR_INVALID, "%s: colour %g must be in [0, 1000] (glTF: [0, 1])", what,
                            (double)color[c]);
     if (!in_range(intensity, 0.0f, 1e15f) || !in_range(range, 0.0f, 1e15f))
-        return lm_fail(err, LM_ERR_INVALID, "%s: intensity %g and range %g must be finite numbers >= 0", what,
+        return lm_fail(err, LM_ERR_INVALID, "%s: intensity %g and range %g must each be in [0, 1e15]", what,
                        (double)intensity, (double)range);
     for (int c = 0; c < 3; c++)
         if (!((double)color[c] * intensity <= LM_MAX_EMISSION))

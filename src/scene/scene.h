@@ -313,8 +313,8 @@ const char *lm_light_type_name(lm_light_type t);
 void lm_light_place(const lm_scene *s, const lm_light *l, float pos[3], float dir[3]);
 /* The one rule for a light's parameters, at load and at every edit, so a light that loads can always be
  * set again with its own values: colour in [0, 1000] (glTF: [0, 1]; brighter colours kept for engines
- * that write them), intensity and range finite and >= 0 (range 0: unbounded), colour x intensity at most
- * LM_MAX_EMISSION, and for a spot 0 <= inner <= outer <= pi/2 with outer > 0 (inner = outer, as Blender
+ * that write them), intensity and range in [0, 1e15] (range 0: unbounded), colour x intensity at most
+ * LM_MAX_EMISSION (which the two bounds already keep: a guard), and for a spot 0 <= inner <= outer <= pi/2 with outer > 0 (inner = outer, as Blender
  * writes a hard-edged spot, is a hard edge). LM_ERR_INVALID naming `what` and the parameter. */
 /* Whether every vertex under `node` (-1: the whole scene) lies within LM_MAX_COORDINATE, where the node
  * is now; LM_ERR_INVALID naming the first that does not. O(vertices). */
