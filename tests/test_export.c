@@ -247,6 +247,12 @@ static void test_materials_and_lights_round_trip(void **state)
     assert_int_equal(lmgi_load_desc(&sd, &o, &sc, &e), LMGI_OK);
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_updater *u = bake(ctx, sc);
+    /* a lamp added by an edit: a node of its own, and nothing else (it was also written into the cameras
+     * and materials arrays: three errors under the Khronos validator, Blender refused the file) */
+    lmgi_light lamp = {.type = LMGI_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 3.0f, .enabled = 1,
+                       .position = {0.5f, 2.0f, 0.25f}, .direction = {0, -1, 0}};
+    int lamp_id;
+    assert_int_equal(lmgi_add_light(sc, &lamp, &lamp_id, &e), LMGI_OK);
     const char *dir = lmt_tmpdir();
     lmgi_export_desc d = {.name = "emitters"};
     assert_int_equal(lmgi_export_gltf(u, dir, &d, &e), LMGI_OK);
@@ -272,7 +278,13 @@ static void test_materials_and_lights_round_trip(void **state)
         }
         assert_int_equal(b->cls, a->cls);
     }
-    assert_int_equal(copy->light_count, 1);
+    assert_int_equal(copy->material_count, s->material_count);
+    assert_int_equal(copy->camera_count, s->camera_count);
+    assert_int_equal(copy->light_count, 2);
+    float pos[3], dir3[3];
+    lm_light_place(copy, &copy->lights[1], pos, dir3);
+    for (int k = 0; k < 3; k++)
+        assert_float_equal(pos[k] + copy->origin[k], lamp.position[k], 1e-5);
     const lm_light *la = &s->lights[0], *lb = &copy->lights[0];
     assert_int_equal(lb->type, la->type);
     assert_float_equal(lb->intensity, la->intensity, 1e-6);

@@ -267,7 +267,6 @@ static void write_materials(writer *w)
             fprintf(w->doc.json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
         fprintf(w->doc.json, "}}");
     }
-    write_added_lights(w);
     fputc(']', w->doc.json);
 }
 
@@ -304,7 +303,6 @@ static void write_lights_and_cameras(writer *w)
             fprintf(w->doc.json, ",\"zfar\":%.9g", (double)(c->zfar > 0.0f ? c->zfar : 1e6f));
         fprintf(w->doc.json, "}}");
     }
-    write_added_lights(w);
     fputc(']', w->doc.json);
 }
 
