@@ -11,7 +11,9 @@
  * (default 60 fps; 0: no pause), and the updater's photon work runs on its own thread meanwhile.
  * --texels N gathers a fixed N texels a frame instead of a time budget: the result is then the same on
  * every run and every machine (`lmgi run --texels-per-frame N` gives the same iim.exr). --move NODE
- * slides a dynamic node (by name) back and forth through lmgi_set_node_transform. */
+ * slides a dynamic node (by name) back and forth through lmgi_set_node_transform. OUT_DIR is made if
+ * missing; its earlier results are replaced only when this run succeeds (lmgi_output_open). */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, nanosleep */
 #include <lmgi.h>
 
 #include <math.h>
@@ -102,7 +104,7 @@ static long upload_changed(const lmgi_scene *sc, const lmgi_updater *u, uint32_t
     return texels;
 }
 
-static int write_results(lmgi_scene *sc, lmgi_updater *u, const char *out)
+static int write_results(lmgi_scene *sc, lmgi_updater *u, lmgi_output *out)
 {
     lmgi_info in;
     lmgi_get_info(sc, &in);
@@ -110,19 +112,19 @@ static int write_results(lmgi_scene *sc, lmgi_updater *u, const char *out)
     float *iim = malloc(n * sizeof *iim), *frame = malloc(3 * 256 * 256 * sizeof *frame);
     lmgi_camera cam;
     lmgi_error e;
-    char path[4096];
+    char path[4200];
     int rc = 0;
     if (!iim || !frame)
         rc = 1, fprintf(stderr, "runtime_loop: out of memory\n");
     else if (lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim, n, &e) != LMGI_OK)
         rc = fail("lightmap", &e);
-    else if (snprintf(path, sizeof path, "%s/iim.exr", out),
+    else if (lmgi_output_file(out, "iim.exr", path, sizeof path, &e) != LMGI_OK ||
              lmgi_write_image(path, in.atlas_width, in.atlas_height, 4, iim, NULL, &e))
         rc = fail("write", &e);
     else if (lmgi_scene_camera(sc, -1, 256, 256, &cam, &e) != LMGI_OK ||
              lmgi_render(u, &cam, 256, 256, frame, &e) != LMGI_OK)
         rc = fail("render", &e);
-    else if (snprintf(path, sizeof path, "%s/frame.png", out),
+    else if (lmgi_output_file(out, "frame.png", path, sizeof path, &e) != LMGI_OK ||
              lmgi_write_image(path, 256, 256, 3, frame, NULL, &e))
         rc = fail("write", &e);
     free(iim);
@@ -140,7 +142,7 @@ static int move(lmgi_scene *sc, int node, const float start[16], int frame)
     return lmgi_set_node_transform(sc, node, m, &e) == LMGI_OK ? 0 : fail("move", &e);
 }
 
-static int run(const options *o, lmgi_context *ctx, lmgi_scene *sc)
+static int run(const options *o, lmgi_context *ctx, lmgi_scene *sc, lmgi_output *out)
 {
     lmgi_updater_desc d = {0}; /* zeros: the defaults; no frame composited: the game draws its own */
     d.texels_per_frame = o->texels;
@@ -181,7 +183,7 @@ static int run(const options *o, lmgi_context *ctx, lmgi_scene *sc)
         printf("%d frames, %s: update median %.2f ms, 95th percentile %.2f ms; %.1f texels gathered a frame; "
                "%d surface uploads, %ld texels\n", o->frames, o->texels ? "fixed texels" : "time budget",
                ms[o->frames / 2], ms[(int)(0.95 * (o->frames - 1))], (double)texels / o->frames, surfaces, upload);
-        rc = write_results(sc, u, o->out);
+        rc = write_results(sc, u, out);
     }
     free(uploaded);
     free(ms);
@@ -205,7 +207,15 @@ int main(int argc, char **argv)
     lmgi_options_init(&lo);
     lo.target_texels = lmgi_atlas_texels_for(o.texels); /* a density the texel budget keeps up with */
     lmgi_scene *sc = NULL;
-    int rc = lmgi_load(o.scene, &lo, &sc, &e) == LMGI_OK ? run(&o, ctx, sc) : fail(o.scene, &e);
+    lmgi_output *out = NULL;
+    const char *const inputs[] = {o.scene, NULL};
+    int rc = lmgi_load(o.scene, &lo, &sc, &e) != LMGI_OK                               ? fail(o.scene, &e)
+             : lmgi_output_open(o.out, "runtime-loop", 0, inputs, &out, &e) != LMGI_OK ? fail(o.out, &e)
+                                                                                       : run(&o, ctx, sc, out);
+    if (out && rc == 0 && lmgi_output_commit(out, &e) != LMGI_OK)
+        rc = fail(o.out, &e);
+    else if (out && rc != 0)
+        lmgi_output_abort(out);
     lmgi_free(sc);
     lmgi_context_free(ctx);
     return rc;
