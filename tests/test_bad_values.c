@@ -135,7 +135,8 @@ static void test_transforms_bounded(void **state)
     lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
     lmt_mesh_cube(&m[1], 0.25f);
     const char *nodes = "[{\"mesh\": 0}, {\"name\": \"crate\", \"mesh\": 1, \"translation\": [0, 0.5, 0], \"extras\": "
-                        "{\"lmgi\": {\"dynamic\": true}}}]";
+                        "{\"lmgi\": {\"dynamic\": true}}}, {\"name\": \"lamp\", \"translation\": [0, 2, 0], "
+                        "\"extras\": {\"lmgi\": {\"dynamic\": true}}}]";
     static const float times[2] = {0, 1}, far[6] = {0, 0.5f, 0, 1e30f, 0.5f, 0};
     lmt_accessor acc[2] = {{times, 2, "SCALAR"}, {far, 2, "VEC3"}};
     const char *anim = "\"animations\": [{\"samplers\": [{\"input\": 4, \"output\": 5}], \"channels\": [{\"sampler\": 0, "
@@ -158,6 +159,10 @@ static void test_transforms_bounded(void **state)
     float after[16];
     assert_true(lmgi_get_node_transform(sc, 1, after));
     assert_memory_equal(before, after, sizeof before); /* left where it was */
+    int lamp = lmgi_find_node(sc, "lamp"); /* a node with nothing but a light: its place is the light's */
+    assert_true(lamp >= 0);
+    assert_int_equal(lmgi_set_node_transform(sc, lamp, world, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "node \"lamp\" lies at 1e+30"));
     world[12] = 1e6f; /* scale 1e12 on a 0.25 m crate: its corners at 2.5e11 */
     world[0] = world[5] = world[10] = 1e12f;
     assert_int_equal(lmgi_set_node_transform(sc, 1, world, &e), LMGI_OK);

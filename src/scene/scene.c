@@ -310,6 +310,13 @@ static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; } 
  * a black frame). */
 lm_status lm_scene_check_extent(const lm_scene *s, int node, lm_error *err)
 {
+    for (int n = 0; n < s->node_count; n++) { /* a light's or camera's place is its node's */
+        const float *w = s->nodes[n].world;
+        for (int k = 0; k < 3 && (node < 0 || lm_node_under(s, n, node)); k++)
+            if (!(fabsf(w[12 + k]) <= LM_MAX_COORDINATE))
+                return lm_fail(err, LM_ERR_INVALID, "%s: node \"%s\" lies at %g, beyond the %g a coordinate may "
+                               "reach", s->path, s->nodes[n].name, (double)w[12 + k], (double)LM_MAX_COORDINATE);
+    }
     for (uint32_t v = 0; v < s->vertex_count; v++) {
         if (node >= 0 && !lm_node_under(s, (int)s->vertex_node[v], node))
             continue;
