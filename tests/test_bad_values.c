@@ -12,6 +12,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -19,6 +22,7 @@
 #include "../src/api/lmgi_updater.h"
 #include "../src/core/image.h"
 #include "../src/core/log.h"
+#include "../src/core/timing.h"
 #include "../src/gpu/gl_context.h"
 #include "../src/gpu/hemicube.h"
 #include "support.h"
@@ -359,6 +363,48 @@ static void test_images_planned(void **state)
 #endif
 }
 
+/* Never hang on a file a scene names: a buffer or image that is a FIFO (its reader waited for a writer
+ * forever), a device, a directory or a socket is refused naming its kind, at once. */
+static void test_named_files_are_regular(void **state)
+{
+    (void)state;
+    static const char *const kinds[] = {"a FIFO (a pipe)", "a device", "a directory", "a socket"};
+    for (int k = 0; k < 4; k++) {
+        const char *dir = lmt_tmpdir();
+        char scene[1200], buf[1200];
+        snprintf(scene, sizeof scene, "%s/named.gltf", dir);
+        snprintf(buf, sizeof buf, "%s/buf.bin", dir);
+        FILE *f = fopen(scene, "w");
+        assert_non_null(f);
+        fputs("{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": [{\"mesh\": 0}], "
+              "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}}]}], \"accessors\": [{\"bufferView\": 0, "
+              "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}], "
+              "\"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}], \"buffers\": [{\"byteLength\": 36, \"uri\": "
+              "\"buf.bin\"}]}", f);
+        fclose(f);
+        if (k == 0)
+            assert_int_equal(mkfifo(buf, 0600), 0);
+        else if (k == 1)
+            assert_int_equal(symlink("/dev/zero", buf), 0);
+        else if (k == 2)
+            assert_int_equal(mkdir(buf, 0700), 0);
+        else {
+            int sock = socket(AF_UNIX, SOCK_STREAM, 0);
+            struct sockaddr_un a = {.sun_family = AF_UNIX};
+            if (sock < 0 || strlen(buf) >= sizeof a.sun_path) {
+                print_message("skipped: a socket at %s (path too long for one)\n", buf);
+                continue;
+            }
+            snprintf(a.sun_path, sizeof a.sun_path, "%s", buf);
+            assert_int_equal(bind(sock, (struct sockaddr *)&a, sizeof a), 0);
+            close(sock);
+        }
+        double t0 = lm_now();
+        expect_refused(scene, kinds[k]);
+        assert_true(lm_now() - t0 < 5.0);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -369,6 +415,7 @@ int main(void)
         cmocka_unit_test(test_pictures),
         cmocka_unit_test(test_draco_without_fallback),
         cmocka_unit_test(test_images_planned),
+        cmocka_unit_test(test_named_files_are_regular),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -191,6 +191,27 @@ float lm_linear_to_srgb(float c)
     return c <= 0.0031308f ? 12.92f * c : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
+lm_status lm_check_regular_file(const char *path, const char *what, lm_error *err)
+{
+    struct stat s; /* by its name first (a socket cannot be opened at all), then as opened, without blocking */
+    int ok = stat(path, &s) == 0, fd = -1;
+    if (!ok)
+        return lm_fail(err, LM_ERR_IO, "%s %s: cannot open: %s", what, path, strerror(errno));
+    if (S_ISREG(s.st_mode) && (fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC)) < 0)
+        return lm_fail(err, LM_ERR_IO, "%s %s: cannot open: %s", what, path, strerror(errno));
+    if (fd >= 0) {
+        ok = fstat(fd, &s) == 0;
+        close(fd);
+    }
+    if (ok && S_ISREG(s.st_mode))
+        return LM_OK;
+    const char *kind = !ok ? "unknown" : S_ISFIFO(s.st_mode) ? "a FIFO (a pipe)" : S_ISDIR(s.st_mode) ? "a directory"
+                     : S_ISSOCK(s.st_mode) ? "a socket" : S_ISCHR(s.st_mode) || S_ISBLK(s.st_mode) ? "a device"
+                     : "not a plain file";
+    return lm_fail(err, LM_ERR_IO, "%s %s is %s, not a regular file: lmgi reads only regular files a scene names",
+                   what, path, kind);
+}
+
 lm_status lm_mkdir_p(const char *path, lm_error *err)
 {
     char buf[4096];

@@ -28,6 +28,10 @@ lm_status lm_read_image8(const char *path, int *width, int *height, uint8_t **ou
 /* Linear <-> sRGB transfer (IEC 61966-2-1). */
 float lm_srgb_to_linear(float c);
 float lm_linear_to_srgb(float c);
+/* A file a scene names (an image, a buffer, a sky) is read only when it is a regular file: a FIFO blocks
+ * its reader until some writer comes (lmgi info hung on one until killed), a device never ends. Opened
+ * without blocking and checked by fstat; LM_ERR_IO naming `what`, the path and its kind otherwise. */
+lm_status lm_check_regular_file(const char *path, const char *what, lm_error *err);
 /* Creates a directory and its parents if missing. */
 lm_status lm_mkdir_p(const char *path, lm_error *err);
 

@@ -22,6 +22,7 @@
 
 extern "C" {
 #include "../core/error.h"
+#include "../core/image.h"
 #include "../core/log.h"
 #include "../core/memory.h"
 #include "scene.h"
@@ -256,14 +257,30 @@ std::string read_capped(const char *path, std::vector<unsigned char> &bytes, boo
     return "";
 }
 
+// A file the scene names (a buffer, an image): a regular file or nothing (lm_check_regular_file).
 bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
 {
     bool format = false;
     out->clear();
+    lm_error e;
+    if (lm_check_regular_file(path.c_str(), "the file", &e) != LM_OK) {
+        if (err)
+            *err += std::string(e.msg) + "\n";
+        return false;
+    }
     std::string why = read_capped(path.c_str(), *out, &format);
     if (!why.empty() && err)
         *err += path + ": " + why + "\n";
     return why.empty();
+}
+
+// Whether a file the scene names exists, by stat alone: tinygltf's own check opens it, and opening a FIFO
+// blocks until a writer comes (lmgi info hung on one until killed). read_whole_file then refuses what is
+// not a regular file, naming it.
+bool file_exists(const std::string &path, void *)
+{
+    struct stat st;
+    return stat(path.c_str(), &st) == 0;
 }
 
 // A scene from memory has no directory to find other files in: every file it names "exists", so that
@@ -373,7 +390,7 @@ lm_status Loader::parse(const std::vector<unsigned char> &bytes)
     std::string dir = scene_dir();
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(keep_image_bytes, &model_);
-    tinygltf::FsCallbacks fs = {mem_ ? &any_file_exists : &tinygltf::FileExists, &tinygltf::ExpandFilePath,
+    tinygltf::FsCallbacks fs = {mem_ ? &any_file_exists : &file_exists, &tinygltf::ExpandFilePath,
                                 mem_ ? &refuse_external_file : &read_whole_file, &tinygltf::WriteWholeFile, nullptr};
     gltf.SetFsCallbacks(fs);
     std::string terr, twarn;

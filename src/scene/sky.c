@@ -101,6 +101,9 @@ static void image_mean(const float *rgb, int w, int h, float out[3])
 /* RGB floats of the file, from .hdr (stb_image) or .exr (tinyexr), by its content. */
 static lm_status read_hdr(const char *path, int *w, int *h, float **rgb, lm_error *err)
 {
+    lm_status regular = lm_check_regular_file(path, "the sky image", err);
+    if (regular != LM_OK)
+        return regular;
     FILE *f = fopen(path, "rb");
     if (!f)
         return lm_fail(err, LM_ERR_IO, "%s: cannot open the sky image: %s", path, strerror(errno));
