@@ -161,6 +161,22 @@ static void test_bad_scene_files(void **state)
     assert_int_equal(run(args), 1);
     assert_non_null(strstr(output, "bad.gltf"));
 
+    /* A file that is not glTF says what it is and what lmgi reads (a JSON parser's complaint about its
+     * first byte before) */
+    static const struct { const char *name, *bytes, *said; } other[] = {
+        {"picture.gltf", "\x89PNG\r\n\x1a\n\0\0\0\rIHDR", "this is a PNG image, not a glTF scene"},
+        {"model.obj", "# exported\nv 0 0 0\nv 1 0 0\n", "this is a text file, not a glTF scene"},
+        {"mesh.obj", "v 0 0 0\nv 1 0 0\nf 1 2 1\n", "perhaps a Wavefront OBJ"},
+        {"scene.blend", "BLENDER-v300", "this is a Blender file"}};
+    for (int i = 0; i < 4; i++) {
+        snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), other[i].name);
+        lmt_write_file(path, other[i].bytes, strlen(other[i].bytes) + (i == 0 ? 8 : 0));
+        snprintf(args, sizeof args, "info %s", path);
+        assert_int_equal(run(args), 1);
+        assert_non_null(strstr(output, other[i].said));
+        assert_non_null(strstr(output, "lmgi reads glTF 2.0"));
+    }
+
     /* An empty scene: info says so (its bounds printed as +-3.4e38 before); run has nothing to light. */
     snprintf(path, sizeof path, "%s/empty.gltf", lmt_tmpdir());
     f = fopen(path, "w");

@@ -381,9 +381,38 @@ std::string Loader::scene_dir() const
     return slash == std::string::npos ? "." : slash == 0 ? "/" : p.substr(0, slash);
 }
 
+// What a file that is not glTF is, by its first bytes, for the message that says so: a user who gives
+// lmgi a picture, an OBJ or a .blend should hear what it is and what to give instead, not a JSON parser's
+// complaint about its first byte. NULL: it may be glTF JSON (it starts with '{').
+static const char *not_gltf(const std::vector<unsigned char> &b)
+{
+    static const struct {
+        const char *magic, *what;
+    } known[] = {{"\x89PNG", "a PNG image"},        {"\xff\xd8\xff", "a JPEG image"},     {"RIFF", "a RIFF file (WebP, WAV)"},
+                 {"BLENDER", "a Blender file"},    {"Kaydara FBX", "an FBX file"},      {"PK\x03\x04", "a zip archive"},
+                 {"#?RADIANCE", "a Radiance HDR image"}, {"v/1\x01", "an OpenEXR image"}, {"\x7f" "ELF", "a program"}};
+    for (const auto &k : known)
+        if (b.size() >= strlen(k.magic) && memcmp(b.data(), k.magic, strlen(k.magic)) == 0)
+            return k.what;
+    size_t i = 0;
+    while (i < b.size() && (b[i] == ' ' || b[i] == '\t' || b[i] == '\r' || b[i] == '\n'))
+        i++;
+    if (i + 3 <= b.size() && b[i] == 0xef && b[i + 1] == 0xbb && b[i + 2] == 0xbf) // a UTF-8 byte order mark
+        return nullptr;
+    if (i < b.size() && b[i] == '{')
+        return nullptr;
+    if (i + 2 <= b.size() && (b[i] == 'v' || b[i] == 'o' || b[i] == 'g') && b[i + 1] == ' ')
+        return "text, perhaps a Wavefront OBJ";
+    return i < b.size() && b[i] >= 0x20 && b[i] < 0x7f ? "a text file" : "a file lmgi does not know";
+}
+
 lm_status Loader::parse(const std::vector<unsigned char> &bytes)
 {
     bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
+    if (const char *what = glb ? nullptr : not_gltf(bytes))
+        return fail(LM_ERR_FORMAT, "this is %s, not a glTF scene; lmgi reads glTF 2.0: a .gltf (JSON, with its "
+                    ".bin and images beside it) or a .glb (one binary file); export one from your modelling tool "
+                    "(Blender: File > Export > glTF 2.0)", what);
     lm_status checked = glb ? check_glb(bytes) : LM_OK;
     if (checked || (checked = check_buffers(bytes, glb)))
         return checked;
