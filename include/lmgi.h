@@ -56,6 +56,10 @@ typedef struct {
     int gutter;             /* empty texels between charts (default 0; more for engines that mipmap lightmaps) */
     int use_file_uv1;       /* 1 = use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping */
     int strict;             /* 1 = degenerate triangles and non-manifold edges are errors, not warnings */
+    int untrusted;          /* 1 = a scene from a stranger: every file it names (buffers, images, its sky)
+                             * must lie inside its own folder once "..", percent-encoding and symbolic links
+                             * are resolved, else the load fails naming it (LMGI_ERR_IO); 0 (the default):
+                             * such files are read, each with a warning that it lies outside */
     float surface_cone_deg; /* max normal deviation within one surface, degrees (default 30) */
     int max_atlas_size;     /* largest atlas side; texel size grows to fit (default 8192) */
     int wall_texels;        /* with a derived texel size: each surface of at least 2 m^2 (a wall, a floor)

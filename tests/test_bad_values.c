@@ -405,6 +405,80 @@ static void test_named_files_are_regular(void **state)
     }
 }
 
+/* Confined reads: a scene names an image outside its folder four ways (../, an absolute path, "..%2F"
+ * percent-encoded, a link inside pointing out). Trusted (the default): read, with a warning that says so;
+ * untrusted: the load fails naming the file; a file inside the folder is read either way. An absolute
+ * URI is never read (tinygltf looks for it under the scene's folder): the texture is missing. */
+static void test_untrusted_scene_stays_in_its_folder(void **state)
+{
+    (void)state;
+    const char *base = lmt_tmpdir();
+    char outside[1200], scene_dir[1200], png[1300];
+    snprintf(outside, sizeof outside, "%s/outside", base);
+    snprintf(scene_dir, sizeof scene_dir, "%s/scene", base);
+    assert_int_equal(mkdir(outside, 0700), 0);
+    assert_int_equal(mkdir(scene_dir, 0700), 0);
+    static const uint8_t texel[4] = {200, 100, 50, 255};
+    snprintf(png, sizeof png, "%s/tex.png", outside);
+    assert_int_equal(lm_write_png(png, 1, 1, texel, &(lm_error){0}), LM_OK);
+    snprintf(png, sizeof png, "%s/inside.png", scene_dir);
+    assert_int_equal(lm_write_png(png, 1, 1, texel, &(lm_error){0}), LM_OK);
+    char link[1300];
+    snprintf(link, sizeof link, "%s/link.png", scene_dir);
+    assert_int_equal(symlink("../outside/tex.png", link), 0);
+    char absolute[1300];
+    snprintf(absolute, sizeof absolute, "%s/tex.png", outside);
+    const char *uris[5] = {"../outside/tex.png", absolute, "..%2Foutside%2Ftex.png", "link.png", "inside.png"};
+    for (int k = 0; k < 5; k++) {
+        char path[1300];
+        snprintf(path, sizeof path, "%s/s%d.gltf", scene_dir, k);
+        FILE *f = fopen(path, "w");
+        assert_non_null(f);
+        fprintf(f, "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0]}], \"nodes\": "
+                "[{\"mesh\": 0}], \"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"material\": 0}]}], "
+                "\"materials\": [{\"pbrMetallicRoughness\": {\"baseColorTexture\": {\"index\": 0}}}], \"textures\": "
+                "[{\"source\": 0}], \"images\": [{\"uri\": \"%s\"}], \"accessors\": [{\"bufferView\": 0, "
+                "\"componentType\": 5126, \"count\": 3, \"type\": \"VEC3\", \"min\": [0, 0, 0], \"max\": [1, 1, 0]}], "
+                "\"bufferViews\": [{\"buffer\": 0, \"byteLength\": 36}], \"buffers\": [{\"byteLength\": 36, \"uri\": "
+                "\"data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA\"}]}",
+                uris[k]);
+        fclose(f);
+        for (int untrusted = 0; untrusted < 2; untrusted++) {
+            lmgi_options o;
+            lmgi_options_init(&o);
+            o.untrusted = untrusted;
+            lmgi_scene *sc = NULL;
+            lmgi_error e;
+            lm_log_level was = lm_log_get_level();
+            lm_log_set_level(LM_LOG_ERROR);
+            lm_log_reset_warning_count();
+            lmgi_status st = lmgi_load(path, &o, &sc, &e);
+            lm_log_set_level(was);
+            int warned = lm_log_warning_count();
+            if (k == 1) { /* an absolute URI names no file at all: tinygltf looks for it under the folder */
+                assert_int_equal(st, LMGI_OK);
+                lmgi_info in;
+                lmgi_get_info(sc, &in);
+                assert_int_equal(in.textures, 0);
+                lmgi_free(sc);
+            } else if (k == 4 || !untrusted) { /* read: inside, or trusted with a warning */
+                if (st != LMGI_OK)
+                    fail_msg("%s (untrusted %d): %s", uris[k], untrusted, e.message);
+                lmgi_info in;
+                lmgi_get_info(sc, &in);
+                assert_int_equal(in.textures, 1);
+                assert_int_equal(warned, k == 4 ? 0 : 1);
+                lmgi_free(sc);
+            } else {
+                assert_int_equal(st, LMGI_ERR_IO);
+                if (!strstr(e.message, "lies outside the scene's folder"))
+                    fail_msg("%s: %s", uris[k], e.message);
+                assert_null(sc);
+            }
+        }
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -416,6 +490,7 @@ int main(void)
         cmocka_unit_test(test_draco_without_fallback),
         cmocka_unit_test(test_images_planned),
         cmocka_unit_test(test_named_files_are_regular),
+        cmocka_unit_test(test_untrusted_scene_stays_in_its_folder),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

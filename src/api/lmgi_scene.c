@@ -78,7 +78,7 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
                        lm_error *err)
 {
     double t0 = lm_now();
-    lm_load_options lo = {.strict = o->strict, .data = data, .size = size};
+    lm_load_options lo = {.strict = o->strict, .data = data, .size = size, .untrusted = o->untrusted};
     lm_status st = lm_scene_load_gltf(path, &lo, &sc->scene, err);
     if (st != LM_OK)
         return st;

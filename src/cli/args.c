@@ -357,6 +357,8 @@ int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a)
                 a->options.use_file_uv1 = 1;
             else if (!strcmp(o, "--strict"))
                 a->options.strict = 1;
+            else if (!strcmp(o, "--untrusted"))
+                a->options.untrusted = 1;
             else if (!strcmp(o, "--in-order"))
                 a->in_order = 1;
             else if (!strcmp(o, "--half"))

@@ -71,6 +71,8 @@ static void usage(FILE *f)
             "  --cone DEG       max normal deviation inside one surface (default 30)\n"
             "  --max-atlas N    largest atlas side; the texel size grows to fit (default 8192)\n"
             "  --strict         degenerate triangles and non-manifold edges are errors\n"
+            "  --untrusted      a scene from a stranger: every file it names must lie inside its folder\n"
+            "                   (else refused, naming it); by default one outside is read with a warning\n"
             "  --size WxH       picture size for 'charts' (default 1024x768) and 'run' (default 512x512)\n"
             "  --frames N       'run': frames to play at 30 per second of animation (default 60)\n"
             "  --texels-per-frame N  'run': IIM texels gathered per frame (default 20)\n"

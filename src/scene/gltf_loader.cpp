@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <climits>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
@@ -136,6 +137,7 @@ class Loader {
     Loader(const char *path, const lm_load_options *opt, lm_error *err) : path_(path), err_(err)
     {
         strict_ = opt && opt->strict;
+        untrusted_ = opt && opt->untrusted;
         if (opt && opt->data) {
             mem_ = static_cast<const unsigned char *>(opt->data);
             mem_size_ = opt->size;
@@ -178,7 +180,8 @@ class Loader {
     const unsigned char *mem_ = nullptr; // the scene's bytes when it comes from memory
     size_t mem_size_ = 0;
     lm_error *err_;
-    bool strict_ = false;
+    bool strict_ = false, untrusted_ = false;
+    std::string escaped_; // untrusted: the first file the scene named outside its folder (refused)
     tinygltf::Model model_;
     ScenePtr s_;
     std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted)
@@ -257,11 +260,57 @@ std::string read_capped(const char *path, std::vector<unsigned char> &bytes, boo
     return "";
 }
 
-// A file the scene names (a buffer, an image): a regular file or nothing (lm_check_regular_file).
-bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *)
+// Whether `path` lies inside `dir` once both are resolved (realpath: "..", links); *where gets the resolved
+// path. A file that does not exist is not inside anything.
+bool inside_folder(const std::string &dir, const std::string &path, std::string *where)
+{
+    char d[PATH_MAX], p[PATH_MAX];
+    if (!realpath(dir.c_str(), d) || !realpath(path.c_str(), p)) {
+        *where = path;
+        return false;
+    }
+    *where = p;
+    size_t n = strlen(d);
+    return strncmp(p, d, n) == 0 && (p[n] == '/' || (n == 1 && d[0] == '/'));
+}
+
+// The folder rule for a file the scene names (lm_load_options.untrusted): in untrusted mode one outside
+// its folder is refused (recorded for the load's error), else read with a warning that says where.
+struct Confine {
+    std::string dir, *escaped;
+    bool untrusted;
+    const char *scene;
+};
+
+bool confined(const Confine &c, const std::string &path, std::string *err)
+{
+    std::string where;
+    if (inside_folder(c.dir, path, &where))
+        return true;
+    struct stat st;
+    if (stat(path.c_str(), &st) != 0)
+        return true; // missing: reported as missing by the reader
+    if (c.untrusted) {
+        std::string why = path + " lies outside the scene's folder (it is " + where + "): an untrusted scene may "
+                          "name only files inside its own folder";
+        if (c.escaped->empty())
+            *c.escaped = why;
+        if (err)
+            *err += why + "\n";
+        return false;
+    }
+    lm_warn("%s: reads %s, which lies outside the scene's folder", c.scene, where.c_str());
+    return true;
+}
+
+// A file the scene names (a buffer, an image): a regular file or nothing (lm_check_regular_file), inside
+// the scene's folder when it is untrusted (confined).
+bool read_whole_file(std::vector<unsigned char> *out, std::string *err, const std::string &path, void *user)
 {
     bool format = false;
     out->clear();
+    if (user && !confined(*static_cast<const Confine *>(user), path, err))
+        return false;
     lm_error e;
     if (lm_check_regular_file(path.c_str(), "the file", &e) != LM_OK) {
         if (err)
@@ -419,8 +468,10 @@ lm_status Loader::parse(const std::vector<unsigned char> &bytes)
     std::string dir = scene_dir();
     tinygltf::TinyGLTF gltf;
     gltf.SetImageLoader(keep_image_bytes, &model_);
+    Confine confine = {dir, &escaped_, untrusted_, path_};
     tinygltf::FsCallbacks fs = {mem_ ? &any_file_exists : &file_exists, &tinygltf::ExpandFilePath,
-                                mem_ ? &refuse_external_file : &read_whole_file, &tinygltf::WriteWholeFile, nullptr};
+                                mem_ ? &refuse_external_file : &read_whole_file, &tinygltf::WriteWholeFile,
+                                mem_ ? nullptr : &confine};
     gltf.SetFsCallbacks(fs);
     std::string terr, twarn;
     bool ok = glb ? gltf.LoadBinaryFromMemory(&model_, &terr, &twarn, bytes.data(), unsigned(bytes.size()), dir)
@@ -434,6 +485,8 @@ lm_status Loader::parse(const std::vector<unsigned char> &bytes)
             lm_warn("%s: %s", path_, line.c_str());
         start = e == std::string::npos ? twarn.size() : e + 1;
     }
+    if (!escaped_.empty()) // untrusted: one file outside the folder fails the whole load, image or buffer
+        return fail(LM_ERR_IO, "%s", escaped_.c_str());
     if (!ok) {
         std::string why = first_line(terr.empty() ? twarn : terr);
         bool missing = why.find("not found") != std::string::npos || why.find("File open error") != std::string::npos;
@@ -1266,7 +1319,10 @@ lm_status Loader::sky()
         double k = num(&v, "scale", 1.0);
         const float scale[3] = {float(k), float(k), float(k)};
         std::string uri = percent_decoded(v.Get("image").Get<std::string>());
-        std::string file = uri.size() && uri[0] == '/' ? uri : scene_dir() + "/" + uri;
+        std::string file = uri.size() && uri[0] == '/' ? uri : scene_dir() + "/" + uri, why;
+        Confine confine = {scene_dir(), &escaped_, untrusted_, path_};
+        if (!confined(confine, file, &why))
+            return fail(LM_ERR_IO, "extras.lmgi.sky.image: %s", escaped_.c_str());
         lm_error e;
         if (lm_sky_load_image(s_.get(), file.c_str(), scale, &e) != LM_OK)
             return fail(e.status, "extras.lmgi.sky.image: %s", e.msg);

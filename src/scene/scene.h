@@ -219,6 +219,9 @@ typedef struct {
                             * messages, and the scene may not name external files: data: URIs or the GLB's
                             * own buffer only) */
     size_t size;
+    int untrusted;         /* files the scene names must lie inside its folder (after "..", percent-encoding
+                            * and symbolic links): another is refused, naming it; trusted (0), one outside is
+                            * read with a warning that says so */
 } lm_load_options;
 
 /* Loads a .gltf or .glb file. On failure returns the status, fills err with a message that names the
