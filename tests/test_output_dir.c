@@ -99,14 +99,15 @@ static void test_only_its_own_files(void **state)
     assert_int_equal(result(dir, "run", 0, three, "first", &e), LMGI_OK); /* made with its parents */
     assert_true(exists(dir, ".lmgi") && holds(dir, "frame_0002.png", "first"));
     static const char *const users[] = {"download.iso.partial", "thesis.docx.partial", "frame_holiday.png",
-                                        "frame_final.exr", "caustics.png", "accuracy.png", "scene_tex0.png"};
-    for (int i = 0; i < 7; i++)
+                                        "frame_final.exr", "caustics.png", "accuracy.png", "scene_tex0.png",
+                                        "frame_0000.png.partial"};
+    for (int i = 0; i < 8; i++)
         put_file(dir, users[i], "mine");
     /* the folder is lmgi's now: no force needed; the second run replaces the first's frames and nothing else */
     assert_int_equal(result(dir, "run", 0, one, "second", &e), LMGI_OK);
     assert_true(holds(dir, "frame_0000.png", "second"));
     assert_false(exists(dir, "frame_0001.png") || exists(dir, "frame_0002.png"));
-    for (int i = 0; i < 7; i++)
+    for (int i = 0; i < 8; i++)
         assert_true(holds(dir, users[i], "mine"));
     /* another command's result stays beside it */
     static const char *const maps[] = {"lightmap.exr", NULL};
@@ -127,7 +128,7 @@ static void test_only_its_own_files(void **state)
     static const char *const other[] = {"aim.exr", NULL};
     assert_int_equal(result(dir, "bake", 0, other, "rebaked", &e), LMGI_OK); /* nor removed when not rewritten */
     assert_true(holds(dir, "lightmap.exr", "edited by hand") && holds(dir, "aim.exr", "rebaked"));
-    for (int i = 0; i < 7; i++)
+    for (int i = 0; i < 8; i++)
         assert_true(holds(dir, users[i], "mine"));
 }
 

@@ -202,7 +202,9 @@ static int ours(const lm_output *o, const char *name)
            (now.ino == then.ino && now.size == then.size && now.mtime_ns == then.mtime_ns);
 }
 
-/* lmgi's own bookkeeping, and NAME.partial of a file it lists (a write a kill interrupted). */
+/* lmgi's own bookkeeping, and NAME.partial of its manifest or of a working file (a write a kill
+ * interrupted: the new result's own partial files are in the staging folder). A NAME.partial beside one
+ * of lmgi's finished files is not lmgi's to remove. */
 static int bookkeeping(const lm_output *o, const char *name, int *partial)
 {
     *partial = 0;
@@ -213,7 +215,9 @@ static int bookkeeping(const lm_output *o, const char *name, int *partial)
     if (n > 8 && !strcmp(name + n - 8, ".partial")) {
         char base[256];
         snprintf(base, sizeof base, "%.*s", (int)(n - 8), name);
-        if (!strcmp(base, MANIFEST) || find(&o->manifest, base) >= 0)
+        ptrdiff_t at = find(&o->manifest, base);
+        if (!strcmp(base, MANIFEST) ||
+            (at >= 0 && !o->manifest.v[at].at.ino && !o->manifest.v[at].at.size && !o->manifest.v[at].at.mtime_ns))
             return *partial = 1;
     }
     return 0;
