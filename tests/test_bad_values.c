@@ -479,6 +479,125 @@ static void test_untrusted_scene_stays_in_its_folder(void **state)
     }
 }
 
+/* Sparse accessors (Blender writes them): a floor and a raised square whose four corners, and one of its
+ * triangles' indices, come as sparse values over a base that has them wrong. The scene loads to the same
+ * triangles as its dense twin and bakes to the same lightmap, bit for bit. */
+static void b64(const uint8_t *d, size_t n, char *out)
+{
+    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    size_t o = 0;
+    for (size_t i = 0; i < n; i += 3) {
+        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
+        out[o++] = t[v >> 18 & 63], out[o++] = t[v >> 12 & 63];
+        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=', out[o++] = i + 2 < n ? t[v & 63] : '=';
+    }
+    out[o] = '\0';
+}
+
+static const char *two_squares(const char *name, int sparse)
+{
+    static const float pos[24] = {-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2,
+                                  -0.5f, 0.8f, 0.5f, 0.5f, 0.8f, 0.5f, 0.5f, 0.8f, -0.5f, -0.5f, 0.8f, -0.5f};
+    static const uint16_t idx[12] = {0, 1, 2, 0, 2, 3, 4, 6, 5, 4, 7, 6};
+    uint8_t buf[256];
+    size_t at = 0;
+    float base[24];
+    memcpy(base, pos, sizeof base);
+    uint16_t base_idx[12];
+    memcpy(base_idx, idx, sizeof base_idx);
+    if (sparse) {
+        memset(base + 12, 0, 12 * sizeof(float)); /* the raised square's corners: only in the sparse values */
+        base_idx[7] = base_idx[8] = 0;            /* and one triangle's indices */
+    }
+    memcpy(buf + at, base, sizeof base), at += sizeof base;        /* view 0: positions (96) */
+    memcpy(buf + at, base_idx, sizeof base_idx), at += sizeof base_idx; /* view 1: indices (24) */
+    static const uint16_t where[4] = {4, 5, 6, 7}, where_idx[2] = {7, 8};
+    memcpy(buf + at, where, sizeof where), at += sizeof where;     /* view 2 (8) */
+    memcpy(buf + at, pos + 12, 12 * sizeof(float)), at += 48;      /* view 3 (48) */
+    memcpy(buf + at, where_idx, sizeof where_idx), at += 4;        /* view 4 (4) */
+    memcpy(buf + at, idx + 7, 2 * sizeof(uint16_t)), at += 4;      /* view 5 (4) */
+    char data[400], json[4096];
+    b64(buf, at, data);
+    snprintf(json, sizeof json,
+             "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1]}], \"nodes\": [{\"mesh\": 0}, "
+             "{\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}], "
+             "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": "
+             "[{\"type\": \"point\", \"intensity\": 10}]}}, \"materials\": [" GREY "], "
+             "\"meshes\": [{\"primitives\": [{\"attributes\": {\"POSITION\": 0}, \"indices\": 1, \"material\": 0}]}], "
+             "\"accessors\": [{\"bufferView\": 0, \"componentType\": 5126, \"count\": 8, \"type\": \"VEC3\", \"min\": "
+             "[-2, 0, -2], \"max\": [2, 0.8, 2]%s}, {\"bufferView\": 1, \"componentType\": 5123, \"count\": 12, \"type\": "
+             "\"SCALAR\"%s}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 96}, {\"buffer\": 0, \"byteOffset\": 96, "
+             "\"byteLength\": 24}, {\"buffer\": 0, \"byteOffset\": 120, \"byteLength\": 8}, {\"buffer\": 0, \"byteOffset\": "
+             "128, \"byteLength\": 48}, {\"buffer\": 0, \"byteOffset\": 176, \"byteLength\": 4}, {\"buffer\": 0, "
+             "\"byteOffset\": 180, \"byteLength\": 4}], \"buffers\": [{\"byteLength\": %zu, \"uri\": "
+             "\"data:application/octet-stream;base64,%s\"}]}",
+             sparse ? ", \"sparse\": {\"count\": 4, \"indices\": {\"bufferView\": 2, \"componentType\": 5123}, \"values\": "
+                      "{\"bufferView\": 3}}" : "",
+             sparse ? ", \"sparse\": {\"count\": 2, \"indices\": {\"bufferView\": 4, \"componentType\": 5123}, \"values\": "
+                      "{\"bufferView\": 5}}" : "",
+             at, data);
+    static char path[1200];
+    snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), name);
+    lmt_write_file(path, json, strlen(json));
+    return path;
+}
+
+static float *baked_lightmap(lmgi_context *ctx, const char *path, size_t *n)
+{
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (load(path, &sc, &e) != LMGI_OK)
+        fail_msg("%s: %s", path, e.message);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.photons = 4000;
+    d.hemicube_resolution = 16;
+    lmgi_updater *u = NULL;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    *n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(*n * sizeof *rgba);
+    assert_non_null(rgba);
+    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, *n, &e), LMGI_OK);
+    assert_int_equal(in.triangles, 4);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    return rgba;
+}
+
+static void test_sparse_accessors(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    size_t nd, ns;
+    float *dense = baked_lightmap(ctx, two_squares("dense.gltf", 0), &nd);
+    float *sparse = baked_lightmap(ctx, two_squares("sparse.gltf", 1), &ns);
+    assert_int_equal(nd, ns);
+    double lit = 0.0;
+    for (size_t i = 0; i < nd; i += 4)
+        lit += dense[i];
+    assert_true(lit > 0.0); /* the raised square lights the floor under it */
+    assert_memory_equal(dense, sparse, nd * sizeof *dense);
+    free(dense);
+    free(sparse);
+    /* more sparse values than its views hold: refused naming the accessor */
+    const char *path = two_squares("bad.gltf", 1);
+    size_t size = 0;
+    char *text = (char *)lmt_read_file(path, &size, 1);
+    text[size] = '\0';
+    char *count = strstr(text, "\"count\": 4, \"indices\"");
+    assert_non_null(count);
+    count[9] = '5'; /* 5 sparse values: the views hold 4 */
+    lmt_write_file(path, text, size);
+    free(text);
+    expect_refused(path, "accessor 0 (sparse)");
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -491,6 +610,7 @@ int main(void)
         cmocka_unit_test(test_images_planned),
         cmocka_unit_test(test_named_files_are_regular),
         cmocka_unit_test(test_untrusted_scene_stays_in_its_folder),
+        cmocka_unit_test(test_sparse_accessors),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

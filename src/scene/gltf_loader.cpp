@@ -159,6 +159,8 @@ class Loader {
     lm_status check_buffers(const std::vector<unsigned char> &b, bool glb);
     lm_status parse(const std::vector<unsigned char> &bytes);
     lm_status check_extensions();
+    lm_status densify_sparse();
+    lm_status densify(int acc);
     lm_status locate(int acc, int type, const char *what, const std::string &ctx, Span &sp);
     lm_status read_floats(int acc, int type, bool force_norm, const char *what, const std::string &ctx,
                           std::vector<float> &out, size_t &count);
@@ -527,8 +529,6 @@ lm_status Loader::locate(int acc, int type, const char *what, const std::string 
     size_t cs = lm_component_size(a.componentType);
     if (a.type != type || cs == 0)
         return fail(LM_ERR_FORMAT, "%s: %s accessor %d has the wrong type or component type", ctx.c_str(), what, acc);
-    if (a.sparse.isSparse)
-        return fail(LM_ERR_UNSUPPORTED, "%s: %s accessor %d is sparse (not supported)", ctx.c_str(), what, acc);
     sp.count = a.count, sp.comp_type = a.componentType, sp.normalized = a.normalized;
     sp.ncomp = tinygltf::GetNumComponentsInType(uint32_t(a.type));
     size_t elem = cs * size_t(sp.ncomp);
@@ -1335,11 +1335,99 @@ lm_status Loader::sky()
     return LM_OK;
 }
 
+// Sparse accessors (glTF 2.0, 3.6.2.3: Blender writes them for shape keys and sparse animation) are made
+// dense once, before anything reads them: the base (its bufferView, or zeros) copied tightly packed, each
+// sparse index's value written over it, the result a buffer of its own that the accessor then names. So
+// every reader (attributes, indices, keyframes) takes them as it takes any accessor, bounds checks and all.
+lm_status Loader::densify(int acc)
+{
+    tinygltf::Accessor &a = model_.accessors[size_t(acc)];
+    const auto &sp = a.sparse;
+    std::string ctx = "accessor " + std::to_string(acc) + " (sparse)";
+    size_t cs = lm_component_size(a.componentType), ncomp = size_t(tinygltf::GetNumComponentsInType(uint32_t(a.type)));
+    if (cs == 0 || ncomp == 0 || ncomp > 16)
+        return fail(LM_ERR_FORMAT, "%s: the wrong type or component type", ctx.c_str());
+    size_t elem = cs * ncomp;
+    if (sp.count < 1 || size_t(sp.count) > a.count)
+        return fail(LM_ERR_FORMAT, "%s: %d sparse values for %zu elements", ctx.c_str(), sp.count, a.count);
+    if (a.bufferView < 0 && a.count > k_max_unbacked_elems)
+        return fail(LM_ERR_FORMAT, "%s: no bufferView and %zu elements", ctx.c_str(), a.count);
+    // where a part lies: its bufferView's bytes from `offset`, `n` elements of `size` bytes, tightly packed
+    auto part = [&](int view, size_t offset, size_t n, size_t size, const uint8_t **at) -> bool {
+        if (view < 0 || size_t(view) >= model_.bufferViews.size())
+            return false;
+        const tinygltf::BufferView &bv = model_.bufferViews[size_t(view)];
+        if (bv.buffer < 0 || size_t(bv.buffer) >= model_.buffers.size())
+            return false;
+        const tinygltf::Buffer &b = model_.buffers[size_t(bv.buffer)];
+        size_t stride = bv.byteStride ? bv.byteStride : size;
+        if (!lm_span_fits(bv.byteOffset, 1, 0, bv.byteLength, b.data.size()) || stride < size ||
+            !lm_span_fits(offset, n, stride, size, bv.byteLength))
+            return false;
+        *at = b.data.data() + bv.byteOffset + offset;
+        return stride == size; // sparse parts are tightly packed; a base with a stride is copied below
+    };
+    std::vector<unsigned char> dense(a.count * elem, 0);
+    if (a.bufferView >= 0) {
+        const tinygltf::BufferView *bv = size_t(a.bufferView) < model_.bufferViews.size()
+                                             ? &model_.bufferViews[size_t(a.bufferView)] : nullptr;
+        size_t stride = bv && bv->byteStride ? bv->byteStride : elem;
+        const uint8_t *base = nullptr;
+        part(a.bufferView, a.byteOffset, a.count, elem, &base);
+        if (!base)
+            return fail(LM_ERR_FORMAT, "%s: its base bufferView %d does not hold its %zu elements", ctx.c_str(),
+                        a.bufferView, a.count);
+        for (size_t i = 0; i < a.count; i++)
+            memcpy(dense.data() + i * elem, base + i * stride, elem);
+    }
+    size_t n = size_t(sp.count), isize = lm_component_size(sp.indices.componentType);
+    const uint8_t *idx = nullptr, *val = nullptr;
+    if (isize == 0 || sp.indices.componentType == LM_COMP_BYTE || sp.indices.componentType == LM_COMP_SHORT ||
+        sp.indices.componentType == LM_COMP_FLOAT || !part(sp.indices.bufferView, size_t(sp.indices.byteOffset), n, isize, &idx) || sp.indices.byteOffset < 0)
+        return fail(LM_ERR_FORMAT, "%s: its indices (bufferView %d, u8/u16/u32, tightly packed) do not hold %zu",
+                    ctx.c_str(), sp.indices.bufferView, n);
+    if (sp.values.byteOffset < 0 || !part(sp.values.bufferView, size_t(sp.values.byteOffset), n, elem, &val))
+        return fail(LM_ERR_FORMAT, "%s: its values (bufferView %d, tightly packed) do not hold %zu", ctx.c_str(),
+                    sp.values.bufferView, n);
+    std::vector<uint32_t> where(n);
+    if (!lm_decode_indices(idx, n, isize, sp.indices.componentType, where.data()))
+        return fail(LM_ERR_FORMAT, "%s: indices are not u8/u16/u32", ctx.c_str());
+    for (size_t i = 0; i < n; i++) {
+        if (where[i] >= a.count || (i > 0 && where[i] <= where[i - 1]))
+            return fail(LM_ERR_FORMAT, "%s: index %u (at %zu) is out of range of %zu or not increasing", ctx.c_str(),
+                        where[i], i, a.count);
+        memcpy(dense.data() + size_t(where[i]) * elem, val + i * elem, elem);
+    }
+    tinygltf::Buffer b;
+    b.data = std::move(dense);
+    tinygltf::BufferView v;
+    v.buffer = int(model_.buffers.size());
+    v.byteLength = b.data.size();
+    model_.buffers.push_back(std::move(b));
+    model_.bufferViews.push_back(v);
+    tinygltf::Accessor &d = model_.accessors[size_t(acc)]; // push_back above does not move accessors
+    d.bufferView = int(model_.bufferViews.size()) - 1;
+    d.byteOffset = 0;
+    d.sparse.isSparse = false;
+    return LM_OK;
+}
+
+lm_status Loader::densify_sparse()
+{
+    for (size_t i = 0; i < model_.accessors.size(); i++)
+        if (model_.accessors[i].sparse.isSparse) {
+            lm_status st = densify(int(i));
+            if (st)
+                return st;
+        }
+    return LM_OK;
+}
+
 lm_status Loader::run(lm_scene **out)
 {
     std::vector<unsigned char> bytes;
     lm_status st = read_file(bytes);
-    if (st || (st = parse(bytes)) || (st = check_extensions()))
+    if (st || (st = parse(bytes)) || (st = check_extensions()) || (st = densify_sparse()))
         return st;
     bytes = std::vector<unsigned char>(); // tinygltf has copied what it needs
     s_.reset(calloc_n<lm_scene>(1));
