@@ -177,6 +177,20 @@ static void test_bad_scene_files(void **state)
         assert_non_null(strstr(output, "lmgi reads glTF 2.0"));
     }
 
+    /* A scene nothing lights: run and bake say so; check refuses, black against black reads 1.000 */
+    static lmt_mesh floor_mesh;
+    memset(&floor_mesh, 0, sizeof floor_mesh);
+    lmt_mesh_quad(&floor_mesh, (float[3]){-1, 0, 1}, (float[3]){2, 0, 0}, (float[3]){0, 0, -2});
+    const char *unlit = lmt_write_scene("unlit.gltf", &floor_mesh, 1, "[{\"mesh\": 0}]", "[" LMT_DIFFUSE(0.5) "]");
+    snprintf(args, sizeof args, "bake %s --texels 500 --out %s/unlit -q", unlit, lmt_tmpdir());
+    assert_int_equal(run(args), 0);
+    snprintf(args, sizeof args, "bake %s --texels 500 --out %s/unlit", unlit, lmt_tmpdir());
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "the scene has no light"));
+    snprintf(args, sizeof args, "check %s --texels 500 --size 16x16", unlit);
+    assert_int_equal(run(args), 1);
+    assert_non_null(strstr(output, "nothing to check: the scene has no light"));
+
     /* An empty scene: info says so (its bounds printed as +-3.4e38 before); run has nothing to light. */
     snprintf(path, sizeof path, "%s/empty.gltf", lmt_tmpdir());
     f = fopen(path, "w");

@@ -9,6 +9,7 @@
 #include "out_dir.h"
 #include "reference_cmd.h"
 #include "run_cmd.h"
+#include "scene_load.h"
 
 static void print_row(const char *name, const char *material, uint32_t pixels, const double ratio[3])
 {
@@ -84,6 +85,12 @@ int lm_cli_check(const lm_cli_args *a)
     lmgi_scene *sc = NULL;
     if (!lm_cli_run_load(a, &sc))
         return 1;
+    if (lm_cli_scene_unlit(sc)) { /* black against black reads 1.000 everywhere: a check of nothing */
+        fprintf(stderr, "lmgi: error: %s: nothing to check: the scene has no light, so frame and reference are "
+                "both black\n", a->files[0]);
+        lmgi_free(sc);
+        return 1;
+    }
     lmgi_output *out = NULL; /* opened before the long work, so a bad path fails at once */
     if (a->out_dir && !(out = lm_cli_open_out(a, "check"))) {
         lmgi_free(sc);

@@ -23,6 +23,14 @@ const char *lm_cli_sky_image(void)
     return g_sky.kind == LM_CLI_SKY_IMAGE ? g_sky.image : NULL;
 }
 
+int lm_cli_scene_unlit(const lmgi_scene *sc)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    float sky[3];
+    return in.lights == 0 && in.materials_by_class[4] == 0 && !lmgi_get_environment(sc, sky);
+}
+
 static lmgi_status set_sky(lmgi_scene *sc, lmgi_error *err)
 {
     switch (g_sky.kind) {
@@ -58,5 +66,9 @@ int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_sce
         *sc = NULL;
         return 0;
     }
+    float sky[3];
+    if (lit && lm_cli_scene_unlit(*sc) && !lmgi_get_environment(*sc, sky))
+        fprintf(stderr, "lmgi: warning: %s: the scene has no light (no light, no emissive material and no sky): "
+                "its lightmaps and pictures are black; give it a light, or a sky with --sky\n", path);
     return 1;
 }

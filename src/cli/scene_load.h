@@ -12,6 +12,8 @@ int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_sce
  * gradient and image forms; the arrays are copied, the image's path kept). */
 typedef enum { LM_CLI_SKY_NONE = 0, LM_CLI_SKY_UNIFORM, LM_CLI_SKY_GRADIENT, LM_CLI_SKY_IMAGE } lm_cli_sky;
 void lm_cli_set_sky(lm_cli_sky kind, const float zenith[3], const float horizon[3], const char *image);
+/* 1 when nothing lights the scene: no light, no emissive material, no sky (its pictures are black). */
+int lm_cli_scene_unlit(const lmgi_scene *sc);
 /* The --sky image's path, NULL when the sky is not an image. */
 const char *lm_cli_sky_image(void);
 
