@@ -395,7 +395,7 @@ static void test_named_files_are_regular(void **state)
                 print_message("skipped: a socket at %s (path too long for one)\n", buf);
                 continue;
             }
-            snprintf(a.sun_path, sizeof a.sun_path, "%s", buf);
+            memcpy(a.sun_path, buf, strlen(buf) + 1); /* fits: checked above */
             assert_int_equal(bind(sock, (struct sockaddr *)&a, sizeof a), 0);
             close(sock);
         }

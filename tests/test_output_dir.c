@@ -331,6 +331,7 @@ static void test_commands_keep_the_last_result(void **state)
     if (pid == 0) {
         freopen("/dev/null", "w", stdout);
         freopen("/dev/null", "w", stderr);
+        signal(SIGINT, SIG_DFL); /* as a terminal's Ctrl-C meets it: a background job inherits SIGINT ignored */
         execl(exe, exe, "run", "scenes/cornell.glb", "--size", "32x32", "--texel-size", "0.1", "--photons", "5000",
               "--frames", "100000", "--out", runs, (char *)NULL);
         _exit(127);
