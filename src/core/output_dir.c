@@ -88,6 +88,8 @@ static stamp stamp_of(const struct stat *s)
 
 static const stamp working = {0, 0, 0};
 
+static int is_working(stamp s) { return s.ino == 0 && s.size == 0 && s.mtime_ns == 0; }
+
 static lm_status put(entries *m, const char *command, const char *name, stamp at_, lm_error *err)
 {
     ptrdiff_t at = find(m, name);
@@ -198,8 +200,7 @@ static int ours(const lm_output *o, const char *name)
     if (lstat(path, &s) != 0)
         return 1;
     stamp now = stamp_of(&s), then = o->manifest.v[at].at;
-    return (then.ino == 0 && then.size == 0 && then.mtime_ns == 0) ||
-           (now.ino == then.ino && now.size == then.size && now.mtime_ns == then.mtime_ns);
+    return is_working(then) || (now.ino == then.ino && now.size == then.size && now.mtime_ns == then.mtime_ns);
 }
 
 /* lmgi's own bookkeeping, and NAME.partial of its manifest or of a working file (a write a kill
@@ -216,8 +217,7 @@ static int bookkeeping(const lm_output *o, const char *name, int *partial)
         char base[256];
         snprintf(base, sizeof base, "%.*s", (int)(n - 8), name);
         ptrdiff_t at = find(&o->manifest, base);
-        if (!strcmp(base, MANIFEST) ||
-            (at >= 0 && !o->manifest.v[at].at.ino && !o->manifest.v[at].at.size && !o->manifest.v[at].at.mtime_ns))
+        if (!strcmp(base, MANIFEST) || (at >= 0 && is_working(o->manifest.v[at].at)))
             return *partial = 1;
     }
     return 0;
@@ -377,25 +377,29 @@ static lm_status name_ok(const char *name, lm_error *err)
     return LM_OK;
 }
 
-lm_status lm_output_file(lm_output *o, const char *name, char *path, size_t size, lm_error *err)
+/* FOLDER/NAME for a file lmgi may place as NAME: a plain name, not a foreign file or an input in DIR. */
+static lm_status path_for(const lm_output *o, const char *folder, const char *name, char *path, size_t size,
+                          lm_error *err)
 {
     lm_status st = name_ok(name, err);
     if (st == LM_OK)
         st = check_place(o, name, err);
-    if (st == LM_OK && snprintf(path, size, "%s/%s", o->stage, name) >= (int)size)
-        st = lm_fail(err, LM_ERR_INVALID, "%s/%s: path too long", o->stage, name);
+    if (st == LM_OK && snprintf(path, size, "%s/%s", folder, name) >= (int)size)
+        st = lm_fail(err, LM_ERR_INVALID, "%s/%s: path too long", folder, name);
     return st;
+}
+
+lm_status lm_output_file(lm_output *o, const char *name, char *path, size_t size, lm_error *err)
+{
+    return path_for(o, o->stage, name, path, size, err);
 }
 
 lm_status lm_output_work_file(lm_output *o, const char *name, char *path, size_t size, lm_error *err)
 {
-    lm_status st = name_ok(name, err);
-    if (st == LM_OK)
-        st = check_place(o, name, err);
-    if (st == LM_OK && snprintf(path, size, "%s/%s", o->dir, name) >= (int)size)
-        st = lm_fail(err, LM_ERR_INVALID, "%s/%s: path too long", o->dir, name);
+    lm_status st = path_for(o, o->dir, name, path, size, err);
     ptrdiff_t at = find(&o->manifest, name);
-    if (st == LM_OK && (at < 0 || strcmp(o->manifest.v[at].command, o->command) || o->manifest.v[at].at.ino)) {
+    if (st == LM_OK &&
+        (at < 0 || strcmp(o->manifest.v[at].command, o->command) || !is_working(o->manifest.v[at].at))) {
         st = put(&o->manifest, o->command, name, working, err); /* rewritten by lmgi under its name */
         if (st == LM_OK)
             st = write_manifest(o, &o->manifest, err);
