@@ -310,26 +310,33 @@ static int in_range(float v, float lo, float hi) { return v >= lo && v <= hi; } 
  * a black frame). */
 lm_status lm_scene_check_extent(const lm_scene *s, int node, lm_error *err)
 {
+    /* the nodes it covers, decided once: asking lm_node_under per vertex walked the parents a million
+     * times for each edit of a large level */
+    unsigned char *covered = malloc(s->node_count > 0 ? (size_t)s->node_count : 1);
+    if (!covered)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory to check a node's extent", s->path);
+    lm_status st = LM_OK;
     for (int n = 0; n < s->node_count; n++) { /* a light's or camera's place is its node's */
         const float *w = s->nodes[n].world;
-        for (int k = 0; k < 3 && (node < 0 || lm_node_under(s, n, node)); k++)
+        covered[n] = node < 0 || lm_node_under(s, n, node);
+        for (int k = 0; k < 3 && covered[n] && st == LM_OK; k++)
             if (!(fabsf(w[12 + k]) <= LM_MAX_COORDINATE))
-                return lm_fail(err, LM_ERR_INVALID, "%s: node \"%s\" lies at %g, beyond the %g a coordinate may "
-                               "reach", s->path, s->nodes[n].name, (double)w[12 + k], (double)LM_MAX_COORDINATE);
+                st = lm_fail(err, LM_ERR_INVALID, "%s: node \"%s\" lies at %g, beyond the %g a coordinate may "
+                             "reach", s->path, s->nodes[n].name, (double)w[12 + k], (double)LM_MAX_COORDINATE);
     }
-    for (uint32_t v = 0; v < s->vertex_count; v++) {
-        if (node >= 0 && !lm_node_under(s, (int)s->vertex_node[v], node))
+    for (uint32_t v = 0; v < s->vertex_count && st == LM_OK; v++) {
+        if (!covered[s->vertex_node[v]])
             continue;
         float p[3];
         lm_scene_vertex_world(s, v, p);
-        for (int k = 0; k < 3; k++)
-            if (!(fabsf(p[k]) <= LM_MAX_COORDINATE)) {
-                const char *name = s->nodes[s->vertex_node[v]].name;
-                return lm_fail(err, LM_ERR_INVALID, "%s: vertex %u (node \"%s\") lies at %g, beyond the %g a "
-                               "coordinate may reach", s->path, v, name, (double)p[k], (double)LM_MAX_COORDINATE);
-            }
+        for (int k = 0; k < 3 && st == LM_OK; k++)
+            if (!(fabsf(p[k]) <= LM_MAX_COORDINATE))
+                st = lm_fail(err, LM_ERR_INVALID, "%s: vertex %u (node \"%s\") lies at %g, beyond the %g a "
+                             "coordinate may reach", s->path, v, s->nodes[s->vertex_node[v]].name, (double)p[k],
+                             (double)LM_MAX_COORDINATE);
     }
-    return LM_OK;
+    free(covered);
+    return st;
 }
 
 lm_status lm_light_check(const char *what, const float color[3], float intensity, float range, int spot,

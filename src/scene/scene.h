@@ -321,7 +321,7 @@ void lm_light_place(const lm_scene *s, const lm_light *l, float pos[3], float di
  * writes a hard-edged spot, is a hard edge). LM_ERR_INVALID naming `what` and the parameter. */
 /* Whether every node (its place: a light's or camera's) and vertex under `node` (-1: the whole scene)
  * lies within LM_MAX_COORDINATE, where the node is now; LM_ERR_INVALID naming the first that does not.
- * O(nodes x depth + vertices). */
+ * O(nodes x depth + vertices), one test a vertex. */
 lm_status lm_scene_check_extent(const lm_scene *s, int node, lm_error *err);
 lm_status lm_light_check(const char *what, const float color[3], float intensity, float range, int spot,
                          float inner_cone, float outer_cone, lm_error *err);
