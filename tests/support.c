@@ -6,6 +6,7 @@
 #include <ftw.h>
 #include <math.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -151,20 +152,41 @@ void lmt_mesh_cube_inward(lmt_mesh *m, float h)
     }
 }
 
-static char *base64(const uint8_t *d, size_t n)
+void lmt_base64(const void *data, size_t n, char *out)
 {
     static const char *A = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    char *o = malloc(4 * ((n + 2) / 3) + 1), *p = o;
-    for (size_t i = 0; o && i < n; i += 3) {
+    const uint8_t *d = data;
+    char *p = out;
+    for (size_t i = 0; i < n; i += 3) {
         uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
         *p++ = A[(v >> 18) & 63];
         *p++ = A[(v >> 12) & 63];
         *p++ = i + 1 < n ? A[(v >> 6) & 63] : '=';
         *p++ = i + 2 < n ? A[v & 63] : '=';
     }
+    *p = '\0';
+}
+
+static char *base64(const uint8_t *d, size_t n)
+{
+    char *o = malloc(4 * ((n + 2) / 3) + 1);
     if (o)
-        *p = '\0';
+        lmt_base64(d, n, o);
     return o;
+}
+
+int lmt_lmgi(const char *shell_prefix, const char *args, char *output, size_t size)
+{
+    const char *build = getenv("LMGI_BUILD");
+    char cmd[4096];
+    snprintf(cmd, sizeof cmd, "%s%s/lmgi %s 2>&1", shell_prefix, build ? build : "build", args);
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(output, 1, size - 1, p);
+    output[n] = '\0';
+    int status = pclose(p);
+    assert_true(WIFEXITED(status)); /* never a crash */
+    return WEXITSTATUS(status);
 }
 
 static void float_min_max(const float *p, int count, float mn[3], float mx[3])

@@ -19,6 +19,12 @@ unsigned char *lmt_read_file(const char *path, size_t *size, size_t extra);
 uint32_t lmt_xorshift(uint32_t *state);
 /* Writes n bytes to path; fails the test when it cannot. */
 void lmt_write_file(const char *path, const void *data, size_t n);
+/* Base64 of n bytes into out, which holds 4 * ceil(n / 3) + 1 chars (NUL-terminated). */
+void lmt_base64(const void *data, size_t n, char *out);
+/* Runs `SHELL_PREFIX BUILD/lmgi ARGS 2>&1` (BUILD: $LMGI_BUILD, else build) with stdout and stderr together
+ * into output (size bytes, NUL-terminated); asserts it exited rather than crashed and returns its exit
+ * status. */
+int lmt_lmgi(const char *shell_prefix, const char *args, char *output, size_t size);
 
 /* Use in a cmocka test: skips (and says so) when the scene is not there. */
 #define LMT_REQUIRE_SCENE(var, path_expr)                                                     \

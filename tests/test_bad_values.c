@@ -482,18 +482,6 @@ static void test_untrusted_scene_stays_in_its_folder(void **state)
 /* Sparse accessors (Blender writes them): a floor and a raised square whose four corners, and one of its
  * triangles' indices, come as sparse values over a base that has them wrong. The scene loads to the same
  * triangles as its dense twin and bakes to the same lightmap, bit for bit. */
-static void b64(const uint8_t *d, size_t n, char *out)
-{
-    static const char t[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)d[i] << 16 | (i + 1 < n ? (uint32_t)d[i + 1] << 8 : 0) | (i + 2 < n ? d[i + 2] : 0);
-        out[o++] = t[v >> 18 & 63], out[o++] = t[v >> 12 & 63];
-        out[o++] = i + 1 < n ? t[v >> 6 & 63] : '=', out[o++] = i + 2 < n ? t[v & 63] : '=';
-    }
-    out[o] = '\0';
-}
-
 static const char *two_squares(const char *name, int sparse)
 {
     static const float pos[24] = {-2, 0, 2, 2, 0, 2, 2, 0, -2, -2, 0, -2,
@@ -517,7 +505,7 @@ static const char *two_squares(const char *name, int sparse)
     memcpy(buf + at, where_idx, sizeof where_idx), at += 4;        /* view 4 (4) */
     memcpy(buf + at, idx + 7, 2 * sizeof(uint16_t)), at += 4;      /* view 5 (4) */
     char data[400], json[4096];
-    b64(buf, at, data);
+    lmt_base64(buf, at, data);
     snprintf(json, sizeof json,
              "{\"asset\": {\"version\": \"2.0\"}, \"scene\": 0, \"scenes\": [{\"nodes\": [0, 1]}], \"nodes\": [{\"mesh\": 0}, "
              "{\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}], "

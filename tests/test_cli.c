@@ -22,19 +22,7 @@
 static char output[65536];
 
 /* Runs `lmgi ARGS` (stdout and stderr together into `output`) and returns its exit status. */
-static int run(const char *args)
-{
-    const char *build = getenv("LMGI_BUILD");
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s/lmgi %s 2>&1", build ? build : "build", args);
-    FILE *p = popen(cmd, "r");
-    assert_non_null(p);
-    size_t n = fread(output, 1, sizeof output - 1, p);
-    output[n] = '\0';
-    int status = pclose(p);
-    assert_true(WIFEXITED(status)); /* never a crash */
-    return WEXITSTATUS(status);
-}
+static int run(const char *args) { return lmt_lmgi("", args, output, sizeof output); }
 
 static void test_usage_errors(void **state)
 {

@@ -22,16 +22,7 @@ static char output[65536];
 /* Runs `SHELL_PREFIX lmgi ARGS` and returns its exit status (output kept in `output`). */
 static int lmgi_after(const char *shell_prefix, const char *args)
 {
-    const char *build = getenv("LMGI_BUILD");
-    char cmd[4096];
-    snprintf(cmd, sizeof cmd, "%s%s/lmgi %s 2>&1", shell_prefix, build ? build : "build", args);
-    FILE *p = popen(cmd, "r");
-    assert_non_null(p);
-    size_t n = fread(output, 1, sizeof output - 1, p);
-    output[n] = '\0';
-    int status = pclose(p);
-    assert_true(WIFEXITED(status));
-    return WEXITSTATUS(status);
+    return lmt_lmgi(shell_prefix, args, output, sizeof output);
 }
 
 static int lmgi(const char *args) { return lmgi_after("", args); }

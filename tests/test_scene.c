@@ -629,20 +629,6 @@ static void test_non_triangle_modes(void **state)
     lm_log_set_level(LM_LOG_WARN);
 }
 
-static void base64(const unsigned char *in, size_t n, char *out)
-{
-    static const char a[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    size_t o = 0;
-    for (size_t i = 0; i < n; i += 3) {
-        uint32_t v = (uint32_t)in[i] << 16 | (i + 1 < n ? (uint32_t)in[i + 1] << 8 : 0) | (i + 2 < n ? in[i + 2] : 0);
-        out[o++] = a[v >> 18 & 63];
-        out[o++] = a[v >> 12 & 63];
-        out[o++] = i + 1 < n ? a[v >> 6 & 63] : '=';
-        out[o++] = i + 2 < n ? a[v & 63] : '=';
-    }
-    out[o] = '\0';
-}
-
 /* Embedded (data: URI) buffer, an external PNG base colour texture with KHR_texture_transform,
  * emissive strength, transmission and ior, and a spot light. */
 static void test_material_and_texture(void **state)
@@ -657,7 +643,7 @@ static void test_material_and_texture(void **state)
     unsigned char b[44] = {0};
     memcpy(b, k_tri_idx, 6);
     memcpy(b + 8, k_tri_pos, 36);
-    base64(b, sizeof b, b64);
+    lmt_base64(b, sizeof b, b64);
     snprintf(json, sizeof json,
              "{\"asset\":{\"version\":\"2.0\"},"
              "\"extensionsUsed\":[\"KHR_texture_transform\",\"KHR_materials_emissive_strength\","
