@@ -170,7 +170,7 @@ static void test_furnace_pixel_parts(void **state)
     (void)state;
     lmt_pipeline p;
     lmt_pipeline_load(&p, furnace_scene(), 0.5f);
-    lm_ref_camera cam = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 1.0f, 8, 8};
+    lm_ref_camera cam = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 1.0f, 8, 8, 0.0f};
     lm_ref_settings set = quick_settings(0.01f, 64);
     lm_ref_result r;
     lm_error err;
@@ -281,7 +281,7 @@ static void test_pixels_see_lit_plane(void **state)
     (void)state;
     lmt_pipeline p;
     lmt_pipeline_load(&p, lmt_plane_scene(), 1.0f);
-    lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.2f, 16, 16};
+    lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.2f, 16, 16, 0.0f};
     lm_ref_settings set = quick_settings(0.01f, 16);
     lm_ref_result r;
     lm_error err;
@@ -296,6 +296,41 @@ static void test_pixels_see_lit_plane(void **state)
     lm_ref_result_free(&r);
     cam.yfov = 0.0f;
     assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &r, &err), LM_ERR_INVALID);
+    lmt_pipeline_free(&p);
+}
+
+/* A camera whose eye lies just above a tile (a camera placed on a wall or in a room's corner) sees past
+ * it, as the rasterised frame does that clips at the near plane: eye rays start on the near plane. */
+static void test_pixels_start_at_near_plane(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    lmt_mesh_quad(&m[1], (float[3]){-1, 4.9f, 1}, (float[3]){2, 0, 0}, (float[3]){0, 0, -2}); /* the tile */
+    const char *nodes = "[{\"children\": [1, 2, 3]}, {\"mesh\": 0}, {\"mesh\": 1},"
+                        " {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
+    const char *ext = "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\":"
+                      " {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}},";
+    char path[512];
+    snprintf(path, sizeof path, "%s/tile_over_plane.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, m, 2, nodes, NULL, 0, ext), 0);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 1.0f);
+    lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.2f, 8, 8, 0.0f};
+    lm_ref_settings set = quick_settings(0.01f, 16);
+    lm_ref_result r;
+    lm_error err;
+    assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &r, &err), LM_OK);
+    assert_float_equal(r.full[3 * (4 * 8 + 4)], 0.0, 0.0); /* the tile's unlit top */
+    lm_ref_result_free(&r);
+    cam.znear = 0.2f;
+    assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &r, &err), LM_OK);
+    double expect = 0.8 / PI * 10.0 / 4.0; /* the plane below, as in test_pixels_see_lit_plane */
+    for (int y = 3; y <= 4; y++)
+        for (int x = 3; x <= 4; x++)
+            assert_float_equal(r.full[3 * (y * 8 + x)], expect, 0.01 * expect);
+    lm_ref_result_free(&r);
     lmt_pipeline_free(&p);
 }
 
@@ -348,6 +383,7 @@ int main(void)
         cmocka_unit_test(test_deterministic_across_threads),
         cmocka_unit_test(test_cache_hit_and_corruption),
         cmocka_unit_test(test_pixels_see_lit_plane),
+        cmocka_unit_test(test_pixels_start_at_near_plane),
         cmocka_unit_test(test_invalid_settings),
         cmocka_unit_test(test_relative_rmse),
         cmocka_unit_test(test_texels_to_image),

@@ -113,6 +113,9 @@ lm_status lm_view_ref_camera(const lm_view *v, int width, int height, lm_ref_cam
     }
     cam->yfov = 2.0f * atanf(1.0f / v->proj[5]);
     cam->width = width, cam->height = height;
+    /* proj[10] = (f + n) / (n - f) and proj[14] = 2 f n / (n - f) give n = proj[14] / (proj[10] - 1) */
+    float n = v->proj[14] / (v->proj[10] - 1.0f);
+    cam->znear = isfinite(n) && n > 0.0f ? n : 0.0f;
     return LM_OK;
 }
 

@@ -37,7 +37,8 @@ lm_status lm_gbuffer_trace(lm_gbuffer *g, const lm_scene *s, const lm_rt *rt, co
         memset(g->pos + 3 * i, 0, 3 * sizeof(float));
         memset(g->normal + 3 * i, 0, 3 * sizeof(float));
         lm_rt_hit hit;
-        if (!lm_rt_intersect(rt, cam->eye, dir, 0.0f, INFINITY, &hit))
+        float tnear = cam->znear / lm_dot(lm_v3_load(dir), fwd); /* the near plane, as the frame clips */
+        if (!lm_rt_intersect(rt, cam->eye, dir, tnear, INFINITY, &hit))
             continue;
         lm_shading sh;
         lm_shading_from_hit(s, &hit, cam->eye, dir, &sh);

@@ -135,6 +135,7 @@ uint64_t lm_ref_key_pixels(const lm_scene *s, const lm_ref_camera *cam, const lm
     fnv_f(&h, cam->yfov);
     fnv_u32(&h, (uint32_t)cam->width);
     fnv_u32(&h, (uint32_t)cam->height);
+    fnv_f(&h, cam->znear);
     hash_settings(&h, set);
     return h;
 }

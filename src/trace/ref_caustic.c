@@ -28,6 +28,7 @@ struct pass {
     const lm_atlas *atlas; /* texels */
     /* pixels: the camera's frame, as lm_ref_pixel_sample builds it */
     lm_vec3 eye, fwd, right, up;
+    float znear; /* points nearer the eye are clipped (reference.h) */
     float th, aspect, pixel_area; /* tan(yfov / 2), width / height, a pixel's area at distance 1 */
     int width, height;
 };
@@ -189,11 +190,11 @@ static int land_pixel(const pass *p, const lm_caustic_hit *h, deposit *d)
     lm_vec3 pos = lm_v3_load(h->pos), ng = lm_v3_load(h->ng), rel = lm_sub(pos, p->eye);
     float dist = lm_length(rel), z = lm_dot(rel, p->fwd), f[3];
     int x, y;
-    if (!(z > 0.0f && dist > 0.0f))
+    if (!(z > p->znear && z > 0.0f && dist > 0.0f))
         return 0;
     lm_vec3 wo = lm_scale(rel, -1.0f / dist);
     if (!(lm_dot(ng, wo) > 0.0f) || !project(p, rel, z, &x, &y) || !landing_eval(p, h, wo, f) ||
-        eye_blocked(p->c, pos, ng, wo, dist))
+        eye_blocked(p->c, pos, ng, wo, dist * (1.0f - p->znear / z))) /* only up to the near plane */
         return 0;
     float cos_a = z / dist, scale = 1.0f / (dist * dist * p->pixel_area * cos_a * cos_a * cos_a);
     d->entry = y * p->width + x;
@@ -303,6 +304,7 @@ lm_status lm_ref_caustic_pixels(const lm_ref_ctx *c, const lm_ref_camera *cam, c
     p.c = c, p.photons = set->caustic_photons, p.seed = set->seed;
     p.land = land_pixel;
     p.eye = lm_v3_load(cam->eye);
+    p.znear = cam->znear;
     p.fwd = lm_normalize(lm_v3_load(cam->forward));
     p.right = lm_normalize(lm_cross(p.fwd, lm_v3_load(cam->up)));
     p.up = lm_cross(p.right, p.fwd);

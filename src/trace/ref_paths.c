@@ -382,8 +382,9 @@ void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, i
     float sx = (2.0f * ((float)x + lm_ref_rng_float(r)) / (float)cam->width - 1.0f) * th * aspect;
     float sy = (1.0f - 2.0f * ((float)y + lm_ref_rng_float(r)) / (float)cam->height) * th;
     lm_vec3 d = lm_normalize(lm_add(fwd, lm_add(lm_scale(right, sx), lm_scale(up, sy))));
-    tally t;
-    trace(c, r, lm_v3_load(cam->eye), d, 0.0f, ROUTE_EYE, &t);
+    tally t; /* from the near plane on, as the rasterised frame sees (reference.h) */
+    lm_vec3 org = lm_add(lm_v3_load(cam->eye), lm_scale(d, cam->znear / lm_dot(d, fwd)));
+    trace(c, r, org, d, 0.0f, ROUTE_EYE, &t);
     memcpy(out->full, t.total, sizeof out->full);
     memcpy(out->part, t.part, sizeof out->part);
     out->cut = t.cut;

@@ -92,11 +92,14 @@ typedef struct {
 void lm_ref_settings_default(lm_ref_settings *s);
 
 /* A pinhole camera: eye, unit forward and up (up need not be orthogonal to forward), vertical field of
- * view in radians, picture size; the aspect ratio is width / height. */
+ * view in radians, picture size; the aspect ratio is width / height. znear is the near clipping plane's
+ * distance along forward (0: none): eye rays start on it and points nearer are not seen, as in the
+ * rasterised frame, so a camera placed on a wall or in a corner sees the room, not the wall's back. */
 typedef struct {
     float eye[3], forward[3], up[3];
     float yfov;
     int width, height;
+    float znear;
 } lm_ref_camera;
 
 typedef struct {
