@@ -34,6 +34,7 @@ lmgi_status lm_api_claim(lmgi_context *ctx, const char *fn, lmgi_error *err)
     uintptr_t me = this_thread(), none = 0;
     if (atomic_load(&ctx->owner) == me || atomic_compare_exchange_strong(&ctx->owner, &none, me)) {
         ctx->depth++;
+        lm_gl_guest_enter(); /* the host's GL context is given back when the call returns */
         return LMGI_OK;
     }
     return lm_api_refuse(err, "%s: the context is in use by another thread (a context and its updaters are for one "
@@ -42,6 +43,7 @@ lmgi_status lm_api_claim(lmgi_context *ctx, const char *fn, lmgi_error *err)
 
 void lm_api_release(lmgi_context *ctx)
 {
+    lm_gl_guest_leave();
     if (--ctx->depth == 0)
         atomic_store(&ctx->owner, 0);
 }
@@ -69,7 +71,9 @@ lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **ou
     ctx->desc = d;
     ctx->desc.gl_backend = NULL; /* the caller's string need not outlive the call */
     lm_log_target saved = lm_api_enter(ctx);
+    lm_gl_guest_enter();
     lm_status st = lm_gl_context_create_backend(d.gl_backend, &ctx->gl, &e);
+    lm_gl_guest_leave();
     lm_api_leave(saved);
     if (st != LM_OK) {
         free(ctx);
@@ -90,7 +94,9 @@ void lmgi_context_free(lmgi_context *ctx)
         lm_api_leave(saved);
         return;
     }
+    lm_gl_guest_enter();
     lm_gl_context_destroy(ctx->gl);
+    lm_gl_guest_leave();
     free(ctx);
 }
 

@@ -189,24 +189,30 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
             in.timings.surfaces, in.timings.atlas, in.timings.bvh, in.timings.total);
 }
 
-static lm_status write_surface_view(const lmgi_scene *sc, const char *path, int w, int h, lm_error *e)
+static lm_status draw_surface_view(const lmgi_scene *sc, const char *path, int w, int h, lm_error *e)
 {
-    lm_gl_context *gl = NULL;
-    lm_status st = lm_gl_context_create(&gl, e);
-    if (st != LM_OK)
-        return st;
     uint8_t *img = malloc((size_t)w * h * 4);
-    if (!img) {
-        lm_gl_context_destroy(gl);
+    if (!img)
         return lm_fail(e, LM_ERR_NOMEM, "no memory for a %dx%d picture", w, h);
-    }
     lm_view view;
     lm_view_for_scene(sc->scene, -1, w, h, &view);
-    st = lm_render_surface_ids(sc->scene, &sc->surfaces, &view, w, h, img, e);
+    lm_status st = lm_render_surface_ids(sc->scene, &sc->surfaces, &view, w, h, img, e);
     if (st == LM_OK)
         st = lm_write_png(path, w, h, img, e);
     free(img);
+    return st;
+}
+
+/* On a GL context of its own, the host's given back after (gl_context.h, the guest scope). */
+static lm_status write_surface_view(const lmgi_scene *sc, const char *path, int w, int h, lm_error *e)
+{
+    lm_gl_context *gl = NULL;
+    lm_gl_guest_enter();
+    lm_status st = lm_gl_context_create(&gl, e);
+    if (st == LM_OK)
+        st = draw_surface_view(sc, path, w, h, e);
     lm_gl_context_destroy(gl);
+    lm_gl_guest_leave();
     return st;
 }
 

@@ -29,4 +29,34 @@ lm_gl_proc lm_gl_egl_get_proc(const char *name);
 /* Where the context lives: "device /dev/dri/renderD128", "surfaceless platform", "default display". */
 const char *lm_gl_egl_where(const lm_gl_egl *e);
 
+/* --- the host's context: what a good guest saves and gives back (gl_context.c's guest scope) ----------
+ * Each *_take saves the calling thread's current context of its kind, if any, and releases it (returns
+ * 1 if one was current); each *_give_back makes the saved one current again, as it was. No GL header
+ * here: the handles are kept as the kinds' own opaque pointers and XIDs. */
+
+/* EGL: the bound client API (OpenGL ES is a host's usual) and the context with its surfaces. */
+typedef struct {
+    void *dpy, *ctx, *draw, *read;
+    unsigned api;
+} lm_gl_egl_host;
+int lm_gl_egl_host_take(lm_gl_egl_host *h);
+void lm_gl_egl_host_give_back(const lm_gl_egl_host *h);
+
+/* OSMesa: the context with its colour buffer, data type, size, row length and orientation. */
+typedef struct {
+    void *ctx, *buffer;
+    int type, width, height, row_length, y_up;
+} lm_gl_osmesa_host;
+int lm_gl_osmesa_host_take(lm_gl_osmesa_host *h);
+void lm_gl_osmesa_host_give_back(const lm_gl_osmesa_host *h);
+
+/* GLX (gl_host_glx.c), looked up in the host's libGLX or libGL if the process has loaded one: a host
+ * without it has no GLX context, and lmgi links no X library. */
+typedef struct {
+    void *dpy, *ctx;
+    unsigned long draw, read;
+} lm_gl_glx_host;
+int lm_gl_glx_host_take(lm_gl_glx_host *h);
+void lm_gl_glx_host_give_back(const lm_gl_glx_host *h);
+
 #endif

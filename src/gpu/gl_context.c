@@ -22,6 +22,14 @@ struct lm_gl_context {
 /* The lmgi context current on this thread (lm_gl_cur is its function table). */
 static _Thread_local lm_gl_context *t_current;
 
+/* The guest scope (lm_gl_guest_enter): its depth, and the host's context taken from this thread. */
+static _Thread_local int t_guest_depth, t_host_taken;
+static _Thread_local struct {
+    lm_gl_egl_host egl;
+    lm_gl_glx_host glx;
+    lm_gl_osmesa_host osmesa;
+} t_host;
+
 /* auto: once EGL has failed or given a software renderer, later contexts of this process skip it. */
 static pthread_mutex_t g_auto_lock = PTHREAD_MUTEX_INITIALIZER;
 static int g_auto_skip_egl;
@@ -72,10 +80,37 @@ static void close_backend(lm_gl_context *ctx)
     ctx->osmesa = NULL;
 }
 
+/* Before lmgi makes a context current inside a guest scope: the host's, if any, is saved and let go
+ * (a GLX context current would make glvnd refuse an EGL one; OSMesa and Mesa's EGL share one slot). */
+static void take_thread_from_host(void)
+{
+    if (t_guest_depth == 0 || t_host_taken)
+        return;
+    lm_gl_glx_host_take(&t_host.glx);
+    lm_gl_egl_host_take(&t_host.egl);
+    lm_gl_osmesa_host_take(&t_host.osmesa);
+    t_host_taken = 1;
+}
+
+void lm_gl_guest_enter(void) { t_guest_depth++; }
+
+void lm_gl_guest_leave(void)
+{
+    if (t_guest_depth == 0 || --t_guest_depth > 0 || !t_host_taken)
+        return;
+    release_other_backend(NULL);
+    lm_gl_osmesa_host_give_back(&t_host.osmesa);
+    lm_gl_egl_host_give_back(&t_host.egl);
+    lm_gl_glx_host_give_back(&t_host.glx);
+    memset(&t_host, 0, sizeof t_host);
+    t_host_taken = 0;
+}
+
 /* Creates the backend's context, makes it current, loads the function table and checks for GL 4.5. */
 static lm_status open_backend(lm_gl_context *ctx, lm_gl_backend backend, lm_error *err)
 {
     ctx->backend = backend;
+    take_thread_from_host();
     release_other_backend(ctx);
     lm_status st;
     if (backend == LM_GL_BACKEND_EGL)
@@ -201,6 +236,7 @@ lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err)
         release_other_backend(NULL);
         return LM_OK;
     }
+    take_thread_from_host();
     release_other_backend(ctx);
     lm_status st = ctx->backend == LM_GL_BACKEND_EGL ? lm_gl_egl_make_current(ctx->egl, err)
                                                      : lm_gl_osmesa_make_current(ctx->osmesa, err);
@@ -223,3 +259,5 @@ int lm_gl_context_is_software(const lm_gl_context *ctx)
 {
     return ctx && is_software_renderer(lm_gl_context_description(ctx));
 }
+
+int lm_gl_current_is_software(void) { return lm_gl_context_is_software(t_current); }

@@ -26,9 +26,21 @@ lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx);
 const char *lm_gl_backend_name(lm_gl_backend backend);
 /* 1 when the context's GL rasterizes on the CPU (llvmpipe and its kind). */
 int lm_gl_context_is_software(const lm_gl_context *ctx);
+/* The same for the context current on the calling thread (0 if none is). */
+int lm_gl_current_is_software(void);
 /* Version, renderer, backend and why: "4.5 (Core Profile) Mesa 22.3.6 / llvmpipe (LLVM 15.0.6, 256 bits)
  * (OSMesa; EGL gave llvmpipe ...)" or "... (EGL, device /dev/dri/renderD128)". */
 const char *lm_gl_context_description(const lm_gl_context *ctx);
+/* Being a good guest in a host's process. A public call runs between lm_gl_guest_enter and
+ * lm_gl_guest_leave. The first time lmgi makes one of its contexts current inside the scope, the
+ * calling thread's current context (the host's: EGL with its bound API and surfaces, GLX, or OSMesa with
+ * its buffer) is saved and released; leaving the outermost scope releases lmgi's and makes the host's
+ * current again, as it was (none, if none was). Outside any scope (lmgi's own tests and tools) a context
+ * stays current as made. Per thread; nests. Cost: nothing for a call that makes no context current,
+ * else a few queries and two more make-currents (each may flush the host's GL commands). */
+void lm_gl_guest_enter(void);
+void lm_gl_guest_leave(void);
+
 /* Entry point of a GL function from the backend of the context current on the calling thread (e.g.
  * glClipControl); NULL if none is current or the backend has no such function. */
 typedef void (*lm_gl_proc)(void);

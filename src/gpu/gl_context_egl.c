@@ -258,6 +258,31 @@ void lm_gl_egl_destroy(lm_gl_egl *e)
     free(e);
 }
 
+/* --- the host's context ---------------------------------------------------------------------------- */
+
+int lm_gl_egl_host_take(lm_gl_egl_host *h)
+{
+    memset(h, 0, sizeof *h);
+    EGLContext ctx = eglGetCurrentContext();
+    if (ctx == EGL_NO_CONTEXT)
+        return 0;
+    h->api = (unsigned)eglQueryAPI();
+    h->dpy = eglGetCurrentDisplay();
+    h->ctx = ctx;
+    h->draw = eglGetCurrentSurface(EGL_DRAW);
+    h->read = eglGetCurrentSurface(EGL_READ);
+    eglMakeCurrent(h->dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); /* under the host's own API */
+    return 1;
+}
+
+void lm_gl_egl_host_give_back(const lm_gl_egl_host *h)
+{
+    if (!h->ctx)
+        return;
+    eglBindAPI((EGLenum)h->api);
+    eglMakeCurrent(h->dpy, h->draw, h->read, h->ctx);
+}
+
 lm_gl_proc lm_gl_egl_get_proc(const char *name) { return (lm_gl_proc)eglGetProcAddress(name); }
 
 const char *lm_gl_egl_where(const lm_gl_egl *e) { return e->where; }
