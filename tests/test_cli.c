@@ -24,6 +24,15 @@ static char output[65536];
 /* Runs `lmgi ARGS` (stdout and stderr together into `output`) and returns its exit status. */
 static int run(const char *args) { return lmt_lmgi("", args, output, sizeof output); }
 
+/* A run that must succeed: its output is shown when it does not. */
+static int run_ok(const char *args)
+{
+    int rc = run(args);
+    if (rc != 0)
+        print_message("lmgi %s: exit %d\n%s\n", args, rc, output);
+    return rc;
+}
+
 static void test_usage_errors(void **state)
 {
     (void)state;
@@ -680,7 +689,7 @@ static void test_tradeoff(void **state)
     snprintf(args, sizeof args, "tradeoff %s --quick --knobs photons_per_group,aim_direct --repeats 1 --size 32x32 "
              "--texels 800 "
              "--target-error 0.05 --cache %s/cache --out %s/tradeoff -q", scene, dir, dir);
-    assert_int_equal(run(args), 0);
+    assert_int_equal(run_ok(args), 0);
     snprintf(path, sizeof path, "%s/tradeoff/tradeoff.csv", dir);
     FILE *f = fopen(path, "r");
     assert_non_null(f);
@@ -756,7 +765,7 @@ static void test_tradeoff_update_lag(void **state)
     assert_non_null(strstr(output, "its \"scene\" is not on the command line"));
     snprintf(args, sizeof args, "tradeoff %s --quick --knobs hemicube_samples --repeats 1 --size 32x32 --texels 800 "
              "--target-error 0.05 --cache %s/cache --edits %s --out %s/lag --frame-lag -q", scene, dir, path, dir);
-    assert_int_equal(run(args), 0);
+    assert_int_equal(run_ok(args), 0);
     snprintf(path, sizeof path, "%s/lag/lag.csv", dir);
     f = fopen(path, "r");
     assert_non_null(f);

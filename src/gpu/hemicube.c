@@ -23,6 +23,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->coverage_samples = 4;
     s->rim_samples = 64;
     s->ray_samples = 400;
+    s->cpu_threads = 0;
 }
 
 int lm_gather_coverage_for(const lm_scene *s, int closed_form_emitters)

@@ -75,6 +75,9 @@ typedef struct {
                               spot near their horizon), with a tracer (lm_gather_set_tracer); 0 or no
                               tracer: the paper's division by F(a) */
     int ray_samples;       /* LM_GATHER_RAYS: strata per texel, rounded down to a square (default 400) */
+    int cpu_threads;       /* threads for a pass's CPU share (closed-form emitters, rim rays): 0 (default)
+                              one on a software GL, whose rasterizer takes the cores, else every OpenMP
+                              thread; n > 0: n. The IIM is the same bit for bit either way */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);

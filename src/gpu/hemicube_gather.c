@@ -4,6 +4,7 @@
 
 #include "gl_api.h"
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -34,6 +35,7 @@ struct lm_gather {
     const lm_rt *rt;       /* non-NULL (and rim_samples > 0): the rim traced (hemicube_rim.h) */
     float *aim_copy;       /* the dilated AIM as uploaded, for the rim's lookups (atlas-sized RGBA) */
     float *emit;           /* a pass's irradiance from the CPU per texel (emitters, rim), tiles^2 * 4 */
+    int cpu_threads;       /* for it (settings' cpu_threads, 0 resolved at creation) */
     GLuint aim_tex;
     int aim_w, aim_h;
     lm_gl_mesh mesh;
@@ -176,6 +178,7 @@ lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the hemicube gather");
     g->set = *set;
     g->coverage = lm_hemicube_coverage(set->enlargement);
+    g->cpu_threads = set->cpu_threads > 0 ? set->cpu_threads : lm_gl_current_is_software() ? 1 : omp_get_max_threads();
     st = lm_hemicube_programs(set->scheme == LM_GATHER_RAYS ? LM_GATHER_VIEWPORTS : set->scheme, set->samples,
                               &g->render_prog, &g->reduce_prog, err);
     if (st == LM_OK)
@@ -583,29 +586,35 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
 
 /* What each texel of a pass gets from the CPU, for the reduction to add: the emitters' closed-form
  * irradiance and the rim's (from its view's eye and axes: g->views, filled by render_tiles); the sample
- * patterns are seeded by the texel's index. On this thread, while the GL threads rasterize the pass:
- * about 8 us per texel for two emissive triangles and 10 us for the rim, where an OpenMP team competing
- * with the rasterizer's threads cost ten times that. */
+ * patterns are seeded by the texel's index, so the thread count changes nothing. While the GL rasterizes
+ * the pass: on llvmpipe on this thread alone (about 8 us per texel for two emissive triangles and 10 us
+ * for the rim, where an OpenMP team competing with the rasterizer's threads cost ten times that); on a
+ * GPU on every core, where the rim was 99% of a bake (docs/architecture.md, "On a GPU"). */
 static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
                            uint32_t count)
 {
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]},
                   g->set.enlargement, g->set.rim_samples};
-    for (uint32_t i = 0; i < count; i++) {
-        const float *o = g->views + VIEW_FLOATS * (size_t)i;
-        float *e = g->emit + 4 * (size_t)i;
-        e[0] = e[1] = e[2] = e[3] = 0.0f;
-        if (g->emitters)
-            lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], e);
-        if (g->rt && covered_at(g->rt, a, o, o + 12))
-            e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
-        if (rim_ready(g)) {
-            float b[3], t[3], r[3], ng[3] = {o[7], o[11], o[15]};
-            for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
-                b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
-            lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[i], r, NULL);
-            for (int k = 0; k < 3; k++)
-                e[k] += r[k];
+#pragma omp parallel num_threads(g->cpu_threads) if (g->cpu_threads > 1)
+    {
+        lm_rt_thread_init(); /* FTZ/DAZ as on this thread: the same numbers on any thread */
+#pragma omp for schedule(dynamic, 8)
+        for (long i = 0; i < (long)count; i++) {
+            const float *o = g->views + VIEW_FLOATS * (size_t)i;
+            float *e = g->emit + 4 * (size_t)i;
+            e[0] = e[1] = e[2] = e[3] = 0.0f;
+            if (g->emitters)
+                lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], e);
+            if (g->rt && covered_at(g->rt, a, o, o + 12))
+                e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
+            if (rim_ready(g)) {
+                float b[3], t[3], r[3], ng[3] = {o[7], o[11], o[15]};
+                for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
+                    b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
+                lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[i], r, NULL);
+                for (int k = 0; k < 3; k++)
+                    e[k] += r[k];
+            }
         }
     }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->emit_buf);
