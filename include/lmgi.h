@@ -675,6 +675,19 @@ LMGI_API int lmgi_surface_rect(const lmgi_scene *scene, int surface, int rect[4]
 /* How many updates changed what surface's lightmap shows (1 after the updater's first gather): upload a
  * surface's rectangle again only when this moved. 0 for NULL or an id out of range. */
 LMGI_API uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
+/* The rectangle an engine uploads again when the surface's version moved: its texels' rectangle grown
+ * by the texels around it that bilinear filtering reads (gutters dilated from it: max(gutter, 2)
+ * texels), clipped to the atlas. Returns 0 (rect zeroed) as lmgi_surface_rect does. */
+LMGI_API int lmgi_surface_lightmap_rect(const lmgi_scene *scene, int surface, int rect[4]);
+/* lmgi_get_lightmap's values in the atlas rectangle rect = {x, y, width, height} alone, bit for bit:
+ * rgba holds width x height RGBA floats, row 0 at rect's y (glTexSubImage2D at x, y). The IIM is read
+ * back and its invalid texels filled only around the rectangle (its surfaces' rectangles), the AIM's
+ * gutters dilated there alone; the error and accuracy estimates are made whole and cut. NULL u, rect or
+ * rgba, a rectangle not inside the atlas, rgba too small (floats < 4 x width x height) or an unknown
+ * kind: LMGI_ERR_INVALID; a value that is not finite: LMGI_ERR_BACKEND. docs/api.md, "Lightmaps to an
+ * engine", has the upload loop and its cost against the whole read. Thread-safety: as the updater's. */
+LMGI_API lmgi_status lmgi_get_lightmap_rect(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba,
+                                            size_t floats, lmgi_error *err);
 
 /* ------------------------------------------------------------------------------------------------------
  * Reference: the converged answer every error figure is measured against (docs/reference.md): Monte

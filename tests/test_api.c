@@ -268,6 +268,93 @@ static void test_lightmaps_and_versions(void **state)
 
 /* An edit reaches the updater at its next update, relights what it touches, and playing time does not
  * take it back. */
+/* The rectangle of lmgi_get_lightmap_rect against the whole read, bit for bit. */
+static void expect_rect_matches(lmgi_updater *u, lmgi_lightmap kind, const float *whole, int atlas_w, const int r[4])
+{
+    float *part = malloc(4 * sizeof(float) * (size_t)r[2] * r[3]);
+    assert_non_null(part);
+    lmgi_error e;
+    if (lmgi_get_lightmap_rect(u, kind, r, part, 4 * (size_t)r[2] * r[3], &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    for (int y = 0; y < r[3]; y++)
+        if (memcmp(part + 4 * (size_t)y * r[2], whole + 4 * ((size_t)(r[1] + y) * atlas_w + r[0]),
+                   4 * sizeof(float) * (size_t)r[2]))
+            fail_msg("kind %d, rectangle (%d, %d) %d x %d: row %d differs from the whole read", (int)kind, r[0], r[1],
+                     r[2], r[3], y);
+    free(part);
+}
+
+/* What an engine uploads when a surface's version moves: each surface's lightmap rectangle (its texels
+ * and the gutter around them) read alone gives exactly the whole read's values there, for the IIM (its
+ * invalid texels filled, under the boxes) and the AIM, after the cube has moved; so do rectangles cut
+ * anywhere, at the atlas's edges too. Bad rectangles are refused. */
+static void test_lightmap_rect(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = new_context();
+    lmgi_scene *sc = load_cornell();
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.frame_width = d.frame_height = 0;
+    d.texels_per_frame = 200;
+    lmgi_updater *u = make_updater(ctx, sc, &d);
+    for (int f = 1; f <= 6; f++)
+        update(u, 0.1f * (float)f, 0.0f, NULL);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = (size_t)in.atlas_width * in.atlas_height;
+    float *whole = malloc(4 * n * sizeof *whole);
+    assert_non_null(whole);
+    lmgi_error e;
+    const lmgi_lightmap kinds[3] = {LMGI_LIGHTMAP_IIM, LMGI_LIGHTMAP_AIM, LMGI_LIGHTMAP_ERROR};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(lmgi_get_lightmap(u, kinds[k], whole, 4 * n, &e), LMGI_OK);
+        int surfaces = lmgi_surface_count(sc), tried = 0;
+        for (int s = 0; s < surfaces; s += k == 0 ? 1 : 3) {
+            int r[4], t[4];
+            assert_int_equal(lmgi_surface_lightmap_rect(sc, s, r), lmgi_surface_rect(sc, s, t));
+            if (!r[2])
+                continue;
+            assert_true(r[0] <= t[0] && r[1] <= t[1] && r[0] + r[2] >= t[0] + t[2] && r[1] + r[3] >= t[1] + t[3]);
+            expect_rect_matches(u, kinds[k], whole, in.atlas_width, r);
+            tried++;
+        }
+        assert_true(tried >= 3);
+        const int cuts[3][4] = {{0, 0, in.atlas_width, in.atlas_height},
+                                {in.atlas_width - 7, in.atlas_height - 5, 7, 5},
+                                {in.atlas_width / 3, in.atlas_height / 4, in.atlas_width / 2, 3}};
+        for (int c = 0; c < 3; c++)
+            expect_rect_matches(u, kinds[k], whole, in.atlas_width, cuts[c]);
+        /* single texels under the boxes, filled from their surface's valid texels farther off */
+        int under = 0;
+        for (uint32_t i = 0; k == 0 && i < in.texels && under < 40; i++) {
+            lmgi_texel t;
+            lmgi_get_texel(sc, i, &t);
+            if (whole[4 * ((size_t)t.y * in.atlas_width + t.x) + 3] != 0.0f)
+                continue;
+            const int one[4] = {t.x, t.y, 1, 1};
+            expect_rect_matches(u, kinds[k], whole, in.atlas_width, one);
+            under++;
+        }
+        if (k == 0)
+            print_message("%d invalid texels read alone\n", under);
+        assert_true(k != 0 || under >= 5);
+    }
+    float one[4];
+    const int outside[4] = {in.atlas_width - 1, 0, 2, 1}, empty[4] = {0, 0, 0, 1}, fits[4] = {0, 0, 1, 1};
+    expect_invalid(lmgi_get_lightmap_rect(u, LMGI_LIGHTMAP_IIM, outside, one, 8, &e), &e, "not inside");
+    expect_invalid(lmgi_get_lightmap_rect(u, LMGI_LIGHTMAP_IIM, empty, one, 4, &e), &e, "not inside");
+    expect_invalid(lmgi_get_lightmap_rect(u, LMGI_LIGHTMAP_IIM, fits, one, 3, &e), &e, "holds 3 floats");
+    expect_invalid(lmgi_get_lightmap_rect(u, (lmgi_lightmap)9, fits, one, 4, &e), &e, "not a lightmap kind");
+    expect_invalid(lmgi_get_lightmap_rect(u, LMGI_LIGHTMAP_IIM, NULL, one, 4, &e), &e, "rect is NULL");
+    expect_invalid(lmgi_get_lightmap_rect(NULL, LMGI_LIGHTMAP_IIM, fits, one, 4, &e), &e, "NULL");
+    int r[4] = {1, 2, 3, 4};
+    assert_int_equal(lmgi_surface_lightmap_rect(sc, -1, r), 0);
+    assert_true(r[0] == 0 && r[2] == 0);
+    free(whole);
+    close_all(u, sc, ctx);
+}
+
 static void test_edit_reaches_updater(void **state)
 {
     (void)state;
@@ -1006,6 +1093,7 @@ int main(void)
         cmocka_unit_test(test_log_callback),
         cmocka_unit_test(test_two_contexts_one_thread),
         cmocka_unit_test(test_lightmaps_and_versions),
+        cmocka_unit_test(test_lightmap_rect),
         cmocka_unit_test(test_edit_reaches_updater),
         cmocka_unit_test(test_light_edit_stays_in_its_room),
         cmocka_unit_test(test_bake),

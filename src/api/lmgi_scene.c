@@ -74,6 +74,35 @@ static lm_status check_options(const char *path, const lmgi_options *o, lm_error
     return LM_OK;
 }
 
+/* Each surface's texels' bounding box, once: lmgi_surface_rect and the lightmap's window reads. */
+static lm_status find_surface_rects(lmgi_scene *sc, lm_error *err)
+{
+    const lm_atlas *at = &sc->atlas;
+    int n = at->surface_count > 0 ? at->surface_count : 1;
+    int *lo = malloc(2 * sizeof(int) * (size_t)n), *r = calloc(4 * (size_t)n, sizeof(int));
+    if (!lo || !r) {
+        free(lo);
+        free(r);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the surfaces' rectangles", sc->scene->path);
+    }
+    for (int i = 0; i < at->surface_count; i++) /* r holds the far corner + 1 until the end */
+        lo[2 * i] = at->width, lo[2 * i + 1] = at->height;
+    for (uint32_t i = 0; i < at->texel_count; i++) {
+        const lm_texel *t = &at->texels[i];
+        int *l = lo + 2 * t->surface, *h = r + 4 * t->surface;
+        l[0] = t->x < l[0] ? t->x : l[0], l[1] = t->y < l[1] ? t->y : l[1];
+        h[2] = t->x + 1 > h[2] ? t->x + 1 : h[2], h[3] = t->y + 1 > h[3] ? t->y + 1 : h[3];
+    }
+    for (int i = 0; i < at->surface_count; i++) {
+        int *h = r + 4 * i;
+        if (h[2] > 0)
+            h[0] = lo[2 * i], h[1] = lo[2 * i + 1], h[2] -= h[0], h[3] -= h[1];
+    }
+    free(lo);
+    sc->surface_rects = r;
+    return LM_OK;
+}
+
 static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_t size, const lmgi_options *o,
                        lm_error *err)
 {
@@ -113,6 +142,8 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     if (st != LM_OK)
         return st;
     sc->have_atlas = 1;
+    if ((st = find_surface_rects(sc, err)) != LM_OK)
+        return st;
     double t3 = lm_now();
 
     st = lm_rt_build(sc->scene, &sc->surfaces, &sc->rt, err);
@@ -197,6 +228,7 @@ void lmgi_free(lmgi_scene *sc)
     lm_rt_free(sc->rt);
     if (sc->have_atlas)
         lm_atlas_free(&sc->atlas);
+    free(sc->surface_rects);
     if (sc->have_surfaces)
         lm_surfaces_free(&sc->surfaces);
     lm_scene_free(sc->scene);

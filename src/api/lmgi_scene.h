@@ -15,6 +15,7 @@ struct lmgi_scene {
     lm_surfaces surfaces;
     lm_atlas atlas;
     int have_surfaces, have_atlas;
+    int *surface_rects;     /* 4 a surface: its texels' bounding box in the atlas (x, y, w, h; 0 x 0 where none) */
     lm_rt *rt;
     lm_world world;         /* the four above, for the runtime (set once they are built) */
     lm_effects effects;

@@ -828,6 +828,178 @@ lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, 
     return st;
 }
 
+/* ---- a rectangle of the lightmap (lmgi_get_lightmap_rect) ---- */
+
+/* r grown by m texels on each side, clipped to the atlas. */
+static void grow_clip(const lm_atlas *at, const int r[4], int m, int out[4])
+{
+    int x0 = r[0] - m > 0 ? r[0] - m : 0, y0 = r[1] - m > 0 ? r[1] - m : 0;
+    int x1 = r[0] + r[2] + m < at->width ? r[0] + r[2] + m : at->width;
+    int y1 = r[1] + r[3] + m < at->height ? r[1] + r[3] + m : at->height;
+    out[0] = x0, out[1] = y0, out[2] = x1 - x0, out[3] = y1 - y0;
+}
+
+static void unite(int a[4], const int b[4])
+{
+    int x0 = a[0] < b[0] ? a[0] : b[0], y0 = a[1] < b[1] ? a[1] : b[1];
+    int x1 = a[0] + a[2] > b[0] + b[2] ? a[0] + a[2] : b[0] + b[2];
+    int y1 = a[1] + a[3] > b[1] + b[3] ? a[1] + a[3] : b[1] + b[3];
+    a[0] = x0, a[1] = y0, a[2] = x1 - x0, a[3] = y1 - y0;
+}
+
+/* The window whose texels decide rect's values: the rect grown by the dilation's reach (a gutter texel
+ * takes its value from texels that near), then every surface with a texel there, whole (an invalid
+ * texel is filled from its own surface's texels, however far). */
+static void window_for(const lmgi_scene *sc, const int rect[4], int win[4])
+{
+    const lm_atlas *at = &sc->atlas;
+    int grown[4], last = -1;
+    grow_clip(at, rect, lm_atlas_dilate_reach(at), grown);
+    memcpy(win, grown, sizeof grown);
+    for (int y = grown[1]; y < grown[1] + grown[3]; y++)
+        for (int x = grown[0]; x < grown[0] + grown[2]; x++) {
+            int i = at->texel_index[(size_t)y * at->width + x];
+            if (i >= 0 && at->texels[i].surface != last)
+                unite(win, sc->surface_rects + 4 * (last = at->texels[i].surface));
+        }
+}
+
+/* Copies the rect's part of a window-sized image (channels floats a texel) into rgba's rgb. */
+static void crop_rgb(const int win[4], const float *img, int channels, const int rect[4], float *rgba)
+{
+    for (int y = 0; y < rect[3]; y++)
+        for (int x = 0; x < rect[2]; x++) {
+            const float *v = img + channels * ((size_t)(rect[1] - win[1] + y) * win[2] + (rect[0] - win[0] + x));
+            float *o = rgba + 4 * ((size_t)y * rect[2] + x);
+            for (int c = 0; c < 3; c++)
+                o[c] = v[channels == 1 ? 0 : c];
+        }
+}
+
+/* The rect's validity as rgba's alpha, from the window's raw IIM (as read_raw_iim does for the atlas). */
+static void rect_validity(const lmgi_updater *u, const int win[4], const float *raw, const int rect[4], float *rgba)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    float limit = lm_frame_loop_get_settings(u->loop)->gather.backface_limit;
+    for (int y = 0; y < rect[3]; y++)
+        for (int x = 0; x < rect[2]; x++) {
+            int ax = rect[0] + x, ay = rect[1] + y;
+            float a = raw[4 * ((size_t)(ay - win[1]) * win[2] + (ax - win[0])) + 3];
+            rgba[4 * ((size_t)y * rect[2] + x) + 3] = at->texel_index[(size_t)ay * at->width + ax] >= 0 && !(a > limit);
+        }
+}
+
+static lm_status read_iim_rect(const lmgi_updater *u, const int rect[4], float *rgba, lm_error *err)
+{
+    int win[4];
+    window_for(u->sc, rect, win);
+    float *raw = NULL;
+    lm_status st = lm_frame_loop_read_iim_window(u->loop, win, &raw, err);
+    if (st != LM_OK)
+        return st;
+    rect_validity(u, win, raw, rect, rgba);
+    lm_iim_fill_invalid_window(&u->sc->atlas, raw, lm_frame_loop_get_settings(u->loop)->gather.backface_limit, win);
+    crop_rgb(win, raw, 4, rect, rgba);
+    free(raw);
+    return LM_OK;
+}
+
+static lm_status read_aim_rect(const lmgi_updater *u, const int rect[4], float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    int win[4];
+    grow_clip(at, rect, lm_atlas_dilate_reach(at), win); /* no fill: the dilation's reach alone */
+    float *rgb = malloc(3 * sizeof(float) * (size_t)win[2] * win[3]), *raw = NULL;
+    if (!rgb)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the AIM read-back");
+    lm_status st = lm_frame_loop_sync(u->loop, err); /* the AIM is the photon work's */
+    if (st == LM_OK)
+        st = lm_frame_loop_read_iim_window(u->loop, rect, &raw, err); /* for the validity alone */
+    if (st == LM_OK) {
+        rect_validity(u, rect, raw, rect, rgba);
+        const float *aim = lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(u->loop)));
+        for (int y = 0; y < win[3]; y++)
+            memcpy(rgb + 3 * (size_t)y * win[2], aim + 3 * ((size_t)(win[1] + y) * at->width + win[0]),
+                   3 * sizeof(float) * (size_t)win[2]);
+        lm_atlas_dilate_window(at, rgb, 3, lm_atlas_dilate_reach(at), win);
+        crop_rgb(win, rgb, 3, rect, rgba);
+    }
+    free(raw);
+    free(rgb);
+    return st;
+}
+
+/* The error and accuracy estimates are made over the whole atlas: read whole, then cut. */
+static lm_status read_whole_rect(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    float *all = malloc(4 * sizeof(float) * (size_t)at->width * at->height);
+    if (!all)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the %d x %d lightmap", at->width, at->height);
+    lm_status st = kind == LMGI_LIGHTMAP_ERROR ? read_error(u, all, err) : read_accuracy(u, all, err);
+    for (int y = 0; st == LM_OK && y < rect[3]; y++)
+        memcpy(rgba + 4 * (size_t)y * rect[2], all + 4 * ((size_t)(rect[1] + y) * at->width + rect[0]),
+               4 * sizeof(float) * (size_t)rect[2]);
+    free(all);
+    return st;
+}
+
+static lmgi_status get_rect_owned(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba, size_t floats,
+                                  lmgi_error *err)
+{
+    static const char fn[] = "lmgi_get_lightmap_rect";
+    if (!rect || !rgba)
+        return lm_api_refuse(err, "%s: %s is NULL", fn, rect ? "rgba" : "rect");
+    const lm_atlas *at = &u->sc->atlas;
+    if (rect[0] < 0 || rect[1] < 0 || rect[2] < 1 || rect[3] < 1 || rect[2] > at->width - rect[0] ||
+        rect[3] > at->height - rect[1])
+        return lm_api_refuse(err, "%s: rectangle (%d, %d) %d x %d is not inside the %d x %d atlas", fn, rect[0],
+                             rect[1], rect[2], rect[3], at->width, at->height);
+    size_t need = 4 * (size_t)rect[2] * rect[3];
+    if (floats < need)
+        return lm_api_refuse(err, "%s: the buffer holds %zu floats; the %d x %d rectangle needs %zu", fn, floats,
+                             rect[2], rect[3], need);
+    if (kind < LMGI_LIGHTMAP_IIM || kind > LMGI_LIGHTMAP_ACCURACY)
+        return lm_api_refuse(err, "%s: %d is not a lightmap kind", fn, (int)kind);
+    if (kind == LMGI_LIGHTMAP_ACCURACY && !lm_photon_stage_aim(lm_frame_loop_stage(u->loop))->error)
+        return lm_api_refuse(err, "%s: the accuracy estimate needs the updater made with desc.error_estimate 1", fn);
+    lm_log_target saved = lm_api_enter(u->ctx);
+    lm_error e;
+    lm_status st = kind == LMGI_LIGHTMAP_IIM   ? read_iim_rect(u, rect, rgba, &e)
+                   : kind == LMGI_LIGHTMAP_AIM ? read_aim_rect(u, rect, rgba, &e)
+                                               : read_whole_rect(u, kind, rect, rgba, &e);
+    lm_api_leave(saved);
+    if (st == LM_OK && count_not_finite(rgba, need)) { /* as lmgi_get_lightmap: never a NaN handed on */
+        lm_fail(&e, LM_ERR_BACKEND, "%s: values of the lightmap's rectangle are not finite numbers (NaN or infinity)",
+                u->sc->scene->path);
+        st = LM_ERR_BACKEND;
+    }
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_get_lightmap_rect(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba, size_t floats,
+                                   lmgi_error *err)
+{
+    if (!u)
+        return lm_api_refuse(err, "lmgi_get_lightmap_rect: the updater is NULL");
+    lmgi_status st = lm_api_claim(u->ctx, "lmgi_get_lightmap_rect", err);
+    if (st != LMGI_OK)
+        return st;
+    st = get_rect_owned(u, kind, rect, rgba, floats, err);
+    lm_api_release(u->ctx);
+    return st;
+}
+
+int lmgi_surface_lightmap_rect(const lmgi_scene *sc, int surface, int rect[4])
+{
+    if (!lmgi_surface_rect(sc, surface, rect))
+        return 0;
+    int grown[4];
+    grow_clip(&sc->atlas, rect, lm_atlas_dilate_reach(&sc->atlas), grown);
+    memcpy(rect, grown, sizeof grown);
+    return 1;
+}
+
 int lmgi_surface_count(const lmgi_scene *sc) { return sc ? sc->atlas.surface_count : 0; }
 
 int lmgi_surface_rect(const lmgi_scene *sc, int surface, int rect[4])
@@ -835,20 +1007,9 @@ int lmgi_surface_rect(const lmgi_scene *sc, int surface, int rect[4])
     if (!rect)
         return 0;
     memset(rect, 0, 4 * sizeof *rect);
-    if (!sc || surface < 0 || surface >= sc->atlas.surface_count)
+    if (!sc || surface < 0 || surface >= sc->atlas.surface_count || sc->surface_rects[4 * surface + 2] == 0)
         return 0;
-    const lm_atlas *at = &sc->atlas;
-    int x0 = at->width, y0 = at->height, x1 = -1, y1 = -1;
-    for (uint32_t i = 0; i < at->texel_count; i++) {
-        const lm_texel *t = &at->texels[i];
-        if (t->surface != surface)
-            continue;
-        x0 = t->x < x0 ? t->x : x0, x1 = t->x > x1 ? t->x : x1;
-        y0 = t->y < y0 ? t->y : y0, y1 = t->y > y1 ? t->y : y1;
-    }
-    if (x1 < 0)
-        return 0;
-    rect[0] = x0, rect[1] = y0, rect[2] = x1 - x0 + 1, rect[3] = y1 - y0 + 1;
+    memcpy(rect, sc->surface_rects + 4 * surface, 4 * sizeof *rect);
     return 1;
 }
 

@@ -3,23 +3,24 @@
 #include <stdlib.h>
 #include <string.h>
 
-void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
+void lm_atlas_dilate_window(const lm_atlas *a, float *data, int channels, int passes, const int win[4])
 {
-    int w = a->width, h = a->height;
+    int wx = win[0], wy = win[1], w = win[2], h = win[3];
     size_t n = (size_t)w * h;
-    unsigned char *filled = malloc(n), *next = malloc(n);
+    unsigned char *filled = malloc(n ? n : 1), *next = malloc(n ? n : 1);
     if (!filled || !next) {
         free(filled);
         free(next);
         return;
     }
-    for (size_t i = 0; i < n; i++)
-        filled[i] = a->texel_index[i] >= 0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++)
+            filled[(size_t)y * w + x] = a->texel_index[(size_t)(wy + y) * a->width + (wx + x)] >= 0;
     for (int pass = 0; pass < passes; pass++) {
         memcpy(next, filled, n);
         for (int y = 0; y < h; y++)
             for (int x = 0; x < w; x++) {
-                size_t i = (size_t)y * w + x;
+                size_t i = (size_t)y * w + x, ai = (size_t)(wy + y) * a->width + (wx + x);
                 if (filled[i])
                     continue;
                 float sum[4] = {0, 0, 0, 0};
@@ -29,11 +30,11 @@ void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
                         int xx = x + dx, yy = y + dy;
                         if (xx < 0 || yy < 0 || xx >= w || yy >= h)
                             continue;
-                        size_t j = (size_t)yy * w + xx;
+                        size_t j = (size_t)yy * w + xx, aj = (size_t)(wy + yy) * a->width + (wx + xx);
                         if (!filled[j])
                             continue;
                         /* inside a chart's rect only from the same chart: rects touch (no gutter) */
-                        if (a->chart_owner && a->chart_owner[i] >= 0 && a->chart_owner[j] != a->chart_owner[i])
+                        if (a->chart_owner && a->chart_owner[ai] >= 0 && a->chart_owner[aj] != a->chart_owner[ai])
                             continue;
                         for (int c = 0; c < channels && c < 4; c++)
                             sum[c] += data[j * channels + c];
@@ -51,9 +52,17 @@ void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
     free(next);
 }
 
+void lm_atlas_dilate(const lm_atlas *a, float *data, int channels, int passes)
+{
+    const int whole[4] = {0, 0, a->width, a->height};
+    lm_atlas_dilate_window(a, data, channels, passes, whole);
+}
+
+int lm_atlas_dilate_reach(const lm_atlas *a) { return a->gutter > 2 ? a->gutter : 2; }
+
 void lm_atlas_dilate_gutters(const lm_atlas *a, float *data, int channels)
 {
-    lm_atlas_dilate(a, data, channels, a->gutter > 2 ? a->gutter : 2);
+    lm_atlas_dilate(a, data, channels, lm_atlas_dilate_reach(a));
 }
 
 void lm_atlas_dilated_rgba(const lm_atlas *a, const float *rgb, float *rgba)

@@ -302,6 +302,24 @@ static void mark_reach(bench *b)
                       : b->reach[s] || moved[2 * s] > LM_EDIT_REACH * moved[2 * s + 1];
 }
 
+/* What an engine uploads after this update, read the way it would: the rectangles of the surfaces whose
+ * version moved, each alone (into b->before's room, free until the next edit's copy). */
+static int read_changed_rects(bench *b, lm_edit_frame *row)
+{
+    double start = 1e3 * lm_cli_now();
+    for (int s = 0; s < b->surfaces; s++) {
+        int r[4];
+        lmgi_error e;
+        if (lmgi_surface_version(b->u, s) == b->version[s] || !lmgi_surface_lightmap_rect(b->sc, s, r))
+            continue;
+        if (lmgi_get_lightmap_rect(b->u, LMGI_LIGHTMAP_IIM, r, b->before, 4 * b->texels, &e) != LMGI_OK)
+            return fprintf(stderr, "lmgi: %s\n", e.message), 0;
+        row->rect_texels += (uint32_t)(r[2] * r[3]);
+    }
+    row->ms_read_rects = 1e3 * lm_cli_now() - start;
+    return 1;
+}
+
 /* The surfaces in and outside the last edit's reach whose displayed lightmap this update rewrote. */
 static void count_rewritten(bench *b, lm_edit_frame *row)
 {
@@ -352,7 +370,7 @@ static int play(const lm_edit_script *s, float budget_ms, const lm_edit_frame_ch
         }
         rows[f] = (lm_edit_frame){st.ms_total, st.ms_photons, st.ms_gather, st.ms_blend, st.texels_gathered,
                               st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0, 0, 0, 0, 0,
-                              NAN};
+                              NAN, 0.0, 0.0, 0};
         double spent = 1e3 * lm_cli_now() - start;
         if (s->fps > 0 && spent < 1e3 / s->fps) { /* the game's own frame, with the photon work beside it */
             double left = 1e3 / s->fps - spent;
@@ -367,9 +385,13 @@ static int play(const lm_edit_script *s, float budget_ms, const lm_edit_frame_ch
                 return 0;
             mark_reach(b);
         }
+        if (!read_changed_rects(b, &rows[f]))
+            return 0;
         count_rewritten(b, &rows[f]);
+        double read = 1e3 * lm_cli_now();
         if (lmgi_get_lightmap(b->u, LMGI_LIGHTMAP_IIM, b->iim, 4 * b->texels, &e) != LMGI_OK)
             return fprintf(stderr, "lmgi: %s\n", e.message), 0;
+        rows[f].ms_read_whole = 1e3 * lm_cli_now() - read;
         if (fc && next > 0 && !frame_error(b, fc, &rows[f].frame_error))
             return 0;
         rows[f].error = distance(b->iim, b->converged, b->texels);

@@ -42,6 +42,10 @@ typedef struct {
     double frame_error;    /* with a frame check: the frame's error per surface (surface_error.h) against the
                             * path-traced reference of the scene as edited so far; NAN before the first
                             * edit and without one */
+    double ms_read_whole;  /* the displayed lightmap to an engine: the whole-atlas read (lmgi_get_lightmap) */
+    double ms_read_rects;  /* the same by the rectangles of the surfaces this update changed alone
+                            * (lmgi_surface_lightmap_rect, lmgi_get_lightmap_rect) */
+    uint32_t rect_texels;  /* the texels those rectangles hold */
 } lm_edit_frame;
 
 /* A play's frame check: after every update from the first edit on, the updater's picture from the scene's

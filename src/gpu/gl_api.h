@@ -87,6 +87,7 @@
     X(glGetString, PFNGLGETSTRINGPROC) \
     X(glGetStringi, PFNGLGETSTRINGIPROC) \
     X(glGetTexImage, PFNGLGETTEXIMAGEPROC) \
+    X(glGetTextureSubImage, PFNGLGETTEXTURESUBIMAGEPROC) \
     X(glGetUniformLocation, PFNGLGETUNIFORMLOCATIONPROC) \
     X(glLinkProgram, PFNGLLINKPROGRAMPROC) \
     X(glMemoryBarrier, PFNGLMEMORYBARRIERPROC) \
@@ -259,6 +260,7 @@ lm_status lm_gl_fns_load(lm_gl_fns *fns, lm_gl_proc (*get_proc)(const char *name
 #define glGetString (lm_gl_cur->glGetString)
 #define glGetStringi (lm_gl_cur->glGetStringi)
 #define glGetTexImage (lm_gl_cur->glGetTexImage)
+#define glGetTextureSubImage (lm_gl_cur->glGetTextureSubImage)
 #define glGetTexLevelParameteriv (lm_gl_cur->glGetTexLevelParameteriv)
 #define glGetUniformLocation (lm_gl_cur->glGetUniformLocation)
 #define glIsEnabled (lm_gl_cur->glIsEnabled)

@@ -108,6 +108,15 @@ lm_status lm_iim_texture_read(unsigned tex, int width, int height, float *rgba, 
     return lm_gl_check("reading the IIM texture", err);
 }
 
+lm_status lm_iim_texture_read_window(unsigned tex, const int win[4], float *rgba, lm_error *err)
+{
+    glMemoryBarrier(GL_TEXTURE_UPDATE_BARRIER_BIT);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTextureSubImage(tex, 0, win[0], win[1], 0, win[2], win[3], 1, GL_RGBA, GL_FLOAT,
+                         (GLsizei)(sizeof(float) * 4 * (size_t)win[2] * (size_t)win[3]), rgba);
+    return lm_gl_check("reading a window of the IIM texture", err);
+}
+
 lm_status lm_iim_texture_write(unsigned tex, int width, int height, const float *rgba, lm_error *err)
 {
     glBindTexture(GL_TEXTURE_2D, tex);

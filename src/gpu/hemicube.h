@@ -151,6 +151,8 @@ unsigned lm_iim_texture_create(int width, int height);
 void lm_iim_texture_free(unsigned tex);
 /* Reads the whole texture back: width*height*4 floats, row y at offset 4 * (y * width + x). */
 lm_status lm_iim_texture_read(unsigned tex, int width, int height, float *rgba, lm_error *err);
+/* Reads the window win = {x, y, w, h} alone (inside the texture): w*h*4 floats, row 0 at win's y. */
+lm_status lm_iim_texture_read_window(unsigned tex, const int win[4], float *rgba, lm_error *err);
 /* The radiance a hemicube sees where nothing is hit (settings.sky): the scene's sky, set before each
  * gather by the frame loop, so that a sky edit reaches the next gather. */
 void lm_gather_set_sky(lm_gather *g, const float sky[3]);

@@ -158,59 +158,73 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     return lm_gl_check("IIM blend (iim_blend)", err);
 }
 
-/* One pass: every invalid texel with valid same-surface 4-neighbours gets their mean (read from the
- * state before the pass, so the result does not depend on visiting order). */
-static uint32_t fill_pass(const lm_atlas *a, float *rgba, uint8_t *valid, uint8_t *next)
+/* One pass over the window win: every invalid texel with valid same-surface 4-neighbours in it gets
+ * their mean (read from the state before the pass, so the result does not depend on visiting order).
+ * rgba and valid hold the window's cells. */
+static uint32_t fill_pass(const lm_atlas *a, const int win[4], float *rgba, uint8_t *valid, uint8_t *next)
 {
     static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    const int w = win[2], h = win[3];
     uint32_t filled = 0;
-    memcpy(next, valid, a->texel_count);
-    for (uint32_t i = 0; i < a->texel_count; i++) {
-        const lm_texel *t = &a->texels[i];
-        if (valid[i])
-            continue;
-        float sum[3] = {0, 0, 0};
-        int n = 0;
-        for (int k = 0; k < 4; k++) {
-            int x = t->x + dx[k], y = t->y + dy[k];
-            if (x < 0 || y < 0 || x >= a->width || y >= a->height)
+    memcpy(next, valid, (size_t)w * h);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            size_t c = (size_t)y * w + x;
+            int i = a->texel_index[(size_t)(win[1] + y) * a->width + (win[0] + x)];
+            if (i < 0 || valid[c])
                 continue;
-            int j = a->texel_index[y * a->width + x];
-            if (j < 0 || !valid[j] || a->texels[j].surface != t->surface)
+            float sum[3] = {0, 0, 0};
+            int n = 0;
+            for (int k = 0; k < 4; k++) {
+                int xx = x + dx[k], yy = y + dy[k];
+                if (xx < 0 || yy < 0 || xx >= w || yy >= h)
+                    continue;
+                size_t cc = (size_t)yy * w + xx;
+                int j = a->texel_index[(size_t)(win[1] + yy) * a->width + (win[0] + xx)];
+                if (j < 0 || !valid[cc] || a->texels[j].surface != a->texels[i].surface)
+                    continue;
+                for (int ch = 0; ch < 3; ch++)
+                    sum[ch] += rgba[4 * cc + ch];
+                n++;
+            }
+            if (!n)
                 continue;
-            for (int c = 0; c < 3; c++)
-                sum[c] += rgba[4 * ((size_t)y * a->width + x) + c];
-            n++;
+            float *o = rgba + 4 * c;
+            for (int ch = 0; ch < 3; ch++)
+                o[ch] = sum[ch] / (float)n;
+            o[3] = 0.0f;
+            next[c] = 1;
+            filled++;
         }
-        if (!n)
-            continue;
-        float *o = rgba + 4 * ((size_t)t->y * a->width + t->x);
-        for (int c = 0; c < 3; c++)
-            o[c] = sum[c] / (float)n;
-        o[3] = 0.0f;
-        next[i] = 1;
-        filled++;
-    }
-    memcpy(valid, next, a->texel_count);
+    memcpy(valid, next, (size_t)w * h);
     return filled;
 }
 
-uint32_t lm_iim_fill_invalid(const lm_atlas *a, float *rgba, float limit)
+uint32_t lm_iim_fill_invalid_window(const lm_atlas *a, float *rgba, float limit, const int win[4])
 {
-    uint8_t *valid = malloc(a->texel_count + 1), *next = malloc(a->texel_count + 1);
+    size_t n = (size_t)win[2] * win[3];
+    uint8_t *valid = malloc(n + 1), *next = malloc(n + 1);
     uint32_t left = 0;
     if (valid && next) {
-        for (uint32_t i = 0; i < a->texel_count; i++) {
-            const lm_texel *t = &a->texels[i];
-            valid[i] = !(rgba[4 * ((size_t)t->y * a->width + t->x) + 3] > limit);
-            left += !valid[i];
-        }
+        for (int y = 0; y < win[3]; y++)
+            for (int x = 0; x < win[2]; x++) {
+                size_t c = (size_t)y * win[2] + x;
+                int i = a->texel_index[(size_t)(win[1] + y) * a->width + (win[0] + x)];
+                valid[c] = i < 0 || !(rgba[4 * c + 3] > limit); /* gutters: nothing to fill */
+                left += !valid[c];
+            }
         uint32_t f;
-        while (left && (f = fill_pass(a, rgba, valid, next)) > 0)
+        while (left && (f = fill_pass(a, win, rgba, valid, next)) > 0)
             left -= f;
     }
     free(valid);
     free(next);
-    lm_atlas_dilate_gutters(a, rgba, 4);
+    lm_atlas_dilate_window(a, rgba, 4, lm_atlas_dilate_reach(a), win);
     return left;
+}
+
+uint32_t lm_iim_fill_invalid(const lm_atlas *a, float *rgba, float limit)
+{
+    const int whole[4] = {0, 0, a->width, a->height};
+    return lm_iim_fill_invalid_window(a, rgba, limit, whole);
 }

@@ -56,5 +56,9 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
  * 4-neighbours of the same surface, repeated until none changes; then gutters are dilated. Returns
  * how many invalid texels could not be filled (no valid texel on their surface reachable). */
 uint32_t lm_iim_fill_invalid(const lm_atlas *a, float *rgba, float limit);
+/* The same over the atlas window win = {x, y, w, h}, rgba holding the window alone: exact (as the whole
+ * atlas's) for every surface all of whose texels lie in the window, and, after the dilation, for the
+ * texels at least lm_atlas_dilate_reach from its edges whose neighbourhood is such surfaces'. */
+uint32_t lm_iim_fill_invalid_window(const lm_atlas *a, float *rgba, float limit, const int win[4]);
 
 #endif

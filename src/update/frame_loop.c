@@ -1001,9 +1001,9 @@ const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }
 
 lm_iim *lm_frame_loop_iim(lm_frame_loop *fl) { return &fl->iim; }
 
-lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err)
+lm_status lm_frame_loop_read_iim_window(const lm_frame_loop *fl, const int win[4], float **rgba, lm_error *err)
 {
-    size_t n = 4 * (size_t)fl->atlas->width * fl->atlas->height;
+    size_t n = 4 * (size_t)win[2] * win[3];
     *rgba = NULL;
     lm_status st = lm_gl_make_current(fl->gl, err);
     if (st != LM_OK)
@@ -1011,12 +1011,20 @@ lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error
     *rgba = malloc(n * sizeof(float));
     if (!*rgba)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the IIM read-back");
-    st = lm_iim_texture_read(fl->iim.display_tex, fl->atlas->width, fl->atlas->height, *rgba, err);
+    int whole = win[0] == 0 && win[1] == 0 && win[2] == fl->atlas->width && win[3] == fl->atlas->height;
+    st = whole ? lm_iim_texture_read(fl->iim.display_tex, win[2], win[3], *rgba, err)
+               : lm_iim_texture_read_window(fl->iim.display_tex, win, *rgba, err);
     if (st != LM_OK) {
         free(*rgba);
         *rgba = NULL;
     }
     return st;
+}
+
+lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err)
+{
+    const int whole[4] = {0, 0, fl->atlas->width, fl->atlas->height};
+    return lm_frame_loop_read_iim_window(fl, whole, rgba, err);
 }
 
 lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *error, lm_error *err)

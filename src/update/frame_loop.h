@@ -165,6 +165,8 @@ const float *lm_frame_loop_image(const lm_frame_loop *fl);
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);
 /* The displayed IIM read back (atlas-sized RGBA floats, a = back-face fraction); caller frees. */
 lm_status lm_frame_loop_read_iim(const lm_frame_loop *fl, float **rgba, lm_error *err);
+/* The same for the atlas window win = {x, y, w, h} alone (w*h RGBA floats); caller frees. */
+lm_status lm_frame_loop_read_iim_window(const lm_frame_loop *fl, const int win[4], float **rgba, lm_error *err);
 /* The IIMs behind the displayed lightmap (tools and tests: test_bad_values writes a NaN into them to see
  * lmgi_update name the stage). */
 lm_iim *lm_frame_loop_iim(lm_frame_loop *fl);
