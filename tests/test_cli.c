@@ -184,6 +184,7 @@ static void test_bad_scene_files(void **state)
     snprintf(args, sizeof args, "bake %s --texels 500 --out %s/unlit", unlit, lmt_tmpdir());
     assert_int_equal(run(args), 0);
     assert_non_null(strstr(output, "the scene has no light"));
+    assert_non_null(strstr(output, "nothing is gathered"));
     snprintf(args, sizeof args, "check %s --texels 500 --size 16x16", unlit);
     assert_int_equal(run(args), 1);
     assert_non_null(strstr(output, "nothing to check: the scene has no light"));

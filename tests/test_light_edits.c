@@ -275,6 +275,94 @@ static void test_first_light(void **state)
     lmgi_context_free(ctx);
 }
 
+/* A room without any light gathers nothing (lmgi info's "indirect: off"): its updates regather no texel
+ * and its lightmap is black; its first light starts the gather, every surface regathered; removing the
+ * last light blackens the lightmap at the next update, without waiting for a regather, and stops the
+ * gather again. */
+static void test_no_light_no_gather(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    lmgi_error e;
+    lmgi_scene *sc = load_room(NULL, 0);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    lmgi_update_stats st;
+    for (int f = 0; f < 5; f++) {
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+        assert_int_equal(st.texels_gathered, 0);
+    }
+    lmgi_light lamp = light_of(&LAMP);
+    int id = -1;
+    assert_int_equal(lmgi_add_light(sc, &lamp, &id, &e), LMGI_OK);
+    uint32_t gathered = 0;
+    for (int f = 0; f < 5; f++) {
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+        gathered += st.texels_gathered;
+    }
+    assert_true(gathered > 0);
+    lmgi_bake_report r;
+    lmt_bake(u, &r);
+    size_t n;
+    float *lit = lmt_iim(u, sc, &n);
+    assert_true(lmt_node_mean(sc, lit, "room") > 0.0);
+    assert_int_equal(lmgi_remove_light(sc, id, &e), LMGI_OK);
+    assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+    float *dark = lmt_iim(u, sc, &n);
+    for (size_t i = 0; i < n; i += 4) /* n floats */
+        assert_true(dark[i] == 0.0f && dark[i + 1] == 0.0f && dark[i + 2] == 0.0f);
+    for (int f = 0; f < 3; f++) {
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+        assert_int_equal(st.texels_gathered, 0);
+    }
+    free(lit);
+    free(dark);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A room where nothing can move (no dynamic node with triangles: lmgi info's "photon updates: off")
+ * re-traces no photon after its first frame; an edit of its light re-traces that light's photons, and
+ * making its block dynamic starts the round robin that watches it. */
+static void test_still_room_traces_nothing(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    lmgi_error e;
+    lmgi_scene *sc = load_room(&LAMP, 1); /* its block static, no stool */
+    int block = lmgi_find_node(sc, "block");
+    assert_true(block >= 0 && !lmgi_node_is_dynamic(sc, block));
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    lmgi_update_stats st;
+    for (int f = 0; f < 5; f++) {
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+        assert_int_equal(st.photons_retraced, 0);
+    }
+    lmgi_light l;
+    assert_int_equal(lmgi_get_light(sc, 0, &l, &e), LMGI_OK);
+    l.intensity *= 0.5f;
+    assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
+    uint32_t retraced = 0;
+    for (int f = 0; f < 5; f++) {
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+        retraced += st.photons_retraced;
+    }
+    assert_true(retraced > 0); /* the dimmed light's groups */
+    for (int f = 0; f < 60; f++) /* its groups all re-traced: quiet again */
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+    assert_int_equal(st.photons_retraced, 0);
+    assert_int_equal(lmgi_set_node_dynamic(sc, block, 1, &e), LMGI_OK);
+    retraced = 0;
+    for (int f = 0; f < 3; f++) { /* the photon work runs beside the updates: counted one update late */
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+        retraced += st.photons_retraced;
+    }
+    assert_true(retraced > 0); /* the round robin, watching the block */
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* A light added in room A of the two rooms, door closed, and removed again: room B's lightmap and its
  * surfaces' versions stay as they were, to the bit (an edit costs only what it reaches). */
 static void test_added_light_stays_in_its_room(void **state)
@@ -354,6 +442,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_add_and_remove),
         cmocka_unit_test(test_first_light),
+        cmocka_unit_test(test_no_light_no_gather),
+        cmocka_unit_test(test_still_room_traces_nothing),
         cmocka_unit_test(test_added_light_stays_in_its_room),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

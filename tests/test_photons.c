@@ -85,7 +85,7 @@ static lm_photon_frame_stats frame(world *w)
 {
     lm_photon_frame_stats st;
     lm_error err;
-    if (lm_photons_frame(w->ph, &st, &err) != LM_OK)
+    if (lm_photons_frame(w->ph, 1, &st, &err) != LM_OK)
         fail_msg("frame: %s", err.msg);
     return st;
 }

@@ -69,6 +69,7 @@ int lm_cli_load_scene(const char *path, const lmgi_options *o, int lit, lmgi_sce
     float sky[3];
     if (lit && lm_cli_scene_unlit(*sc) && !lmgi_get_environment(*sc, sky))
         fprintf(stderr, "lmgi: warning: %s: the scene has no light (no light, no emissive material and no sky): "
-                "its lightmaps and pictures are black; give it a light, or a sky with --sky\n", path);
+                "its lightmaps and pictures are black, and nothing is gathered; give it a light, or a sky with "
+                "--sky\n", path);
     return 1;
 }

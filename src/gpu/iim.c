@@ -158,6 +158,15 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     return lm_gl_check("IIM blend (iim_blend)", err);
 }
 
+lm_status lm_iim_clear(lm_iim *iim, lm_error *err)
+{
+    const unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
+    for (int i = 0; i < 4; i++)
+        glClearTexImage(tex[i], 0, GL_RGBA, GL_FLOAT, NULL);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    return lm_gl_check("clearing the IIM", err);
+}
+
 /* One pass over the window win: every invalid texel with valid same-surface 4-neighbours in it gets
  * their mean (read from the state before the pass, so the result does not depend on visiting order).
  * rgba and valid hold the window's cells. */

@@ -52,6 +52,10 @@ float lm_iim_blend_weight(const lm_iim *iim, int surface);
  * writes display = mix(old, new, t), then advances the scheduler's frame counter. instant: committed surfaces show new at once (after the first gather). */
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
 
+/* Every IIM texture (fresh, old, new, displayed) set to 0: a scene that lost its last light shows no
+ * indirect light at once, not the last gather's. */
+lm_status lm_iim_clear(lm_iim *iim, lm_error *err);
+
 /* CPU: texels (rgba, atlas-sized, a = back-face fraction) with a > limit take the mean of valid
  * 4-neighbours of the same surface, repeated until none changes; then gutters are dilated. Returns
  * how many invalid texels could not be filled (no valid texel on their surface reachable). */

@@ -470,13 +470,13 @@ static lm_status drain(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
     return ph_trace_groups(ph, ph->tmp_groups, n, st, err);
 }
 
-lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)
+lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err)
 {
     lm_photon_frame_stats local;
     lm_photon_frame_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
     double t0 = lm_now();
-    lm_status s = round_robin(ph, st, err);
+    lm_status s = anything_moves ? round_robin(ph, st, err) : LM_OK;
     if (s == LM_OK)
         s = drain(ph, st, err);
     finish_stats(ph, st, t0);

@@ -102,8 +102,11 @@ void lm_photons_reset(lm_photons *ph);
  * that did not change cause no store change). Clears the invalid queue. stats may be NULL. */
 lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);
 /* One frame: round-robin check of k photons per valid group, then re-trace of up to group_budget
- * invalid groups, oldest first. stats may be NULL. Fails only when memory runs out. */
-lm_status lm_photons_frame(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);
+ * invalid groups, oldest first. Without anything_moves (no dynamic node with triangles) the round robin
+ * is left out: no path can change but by an edit, and the edits that change paths invalidate their
+ * groups themselves (a light's placement or power, a material). stats may be NULL. Fails only when
+ * memory runs out. */
+lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err);
 
 /* Marks all groups of emitter e invalid (after it moved or changed: call lm_emitters_update first).
  * Groups already queued keep their place. Fails for an out-of-range emitter. */

@@ -16,6 +16,7 @@
 #include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
 #include "../scene/sky.h"
+#include "../trace/emitter_light.h"
 #include "bake_checkpoint.h"
 #include "stage_worker.h"
 
@@ -42,6 +43,10 @@ struct lm_frame_loop {
     uint32_t generators_version; /* ... as of this pass_version (+1: 0 is never a count yet) */
     uint32_t reflect_version;    /* the scene's pass_version the reflection maps were made for */
     uint32_t switch_version;     /* the scene's pass_version the gather's and composite's switches follow */
+    struct {                     /* whether the scene gives any light (follow_light): none, no gather */
+        int unlit, emissive;     /* emissive: it has emissive triangles, as of the scene's emissive_version */
+        uint32_t emissive_version;
+    } light;
     /* the photon paths: the store's hits as GPU records, the gather, and what its picture was made for */
     lm_photon_records records;
     lm_photon_gather *photon_gather;
@@ -333,10 +338,45 @@ static lm_status setup_render(lm_frame_loop *fl, lm_error *err)
 static void sync_gather_switches(lm_frame_loop *fl)
 {
     for (int k = 0; k < fl->surfaces->surface_count; k++) {
-        int off = !lightmap_path(fl) || !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
+        int off = !lightmap_path(fl) || fl->light.unlit ||
+                  !fl->scene->nodes[fl->surfaces->surfaces[k].node].settings.indirect;
         if (off != fl->iim.sched.off[k])
             lm_iim_sched_set_off(&fl->iim.sched, store_of(fl), k, off);
     }
+}
+
+/* Lights that shine: not removed or switched off. */
+static uint32_t lights_on(const lm_scene *s)
+{
+    uint32_t n = 0;
+    for (int i = 0; i < s->light_count; i++)
+        n += !s->lights[i].removed && !s->lights[i].off;
+    return n;
+}
+
+/* A scene without any light (no light on, no emissive triangle, no sky) has no indirect light: nothing is
+ * gathered (lmgi info's "indirect: off"), and the IIM is cleared when the last light goes; the gather
+ * starts again, every surface in full, when a light, an emissive material or a sky comes. Looked at each
+ * frame: the lights and the sky at once, the emissive triangles when a class changed (pass_version). */
+static lm_status follow_light(lm_frame_loop *fl, lm_error *err)
+{
+    const lm_scene *s = fl->scene;
+    if (fl->light.emissive_version != s->pass_version || !fl->have_iim) {
+        fl->light.emissive = lm_emissive_triangle_count(s) > 0;
+        fl->light.emissive_version = s->pass_version;
+    }
+    uint32_t lights = lights_on(s);
+    int unlit = lights == 0 && !fl->light.emissive && !s->has_sky;
+    if (unlit == fl->light.unlit && fl->have_iim)
+        return LM_OK;
+    fl->light.unlit = unlit;
+    if (unlit)
+        lm_log(LM_LOG_INFO, "%s: no light (no light on, no emissive material, no sky): the gather is skipped until "
+               "one comes", s->path);
+    if (!fl->have_iim)
+        return LM_OK;
+    sync_gather_switches(fl);
+    return unlit ? lm_iim_clear(&fl->iim, err) : LM_OK;
 }
 
 /* After edits that change which passes a node takes part in (lm_scene.pass_version: a material's class,
@@ -345,8 +385,8 @@ static void sync_gather_switches(lm_frame_loop *fl)
 static lm_status follow_pass_edits(lm_frame_loop *fl, lm_error *err)
 {
     uint32_t v = fl->scene->pass_version;
-    lm_status st = LM_OK;
-    if (fl->switch_version != v) {
+    lm_status st = follow_light(fl, err);
+    if (st == LM_OK && fl->switch_version != v) {
         sync_gather_switches(fl);
         if (fl->comp)
             st = lm_composite_update_coverage(fl->comp, fl->scene, fl->atlas, err);
@@ -384,6 +424,8 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         lm_gather_set_emitter_light(fl->gather, &fl->emitters);
     if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (gpu/hemicube_rim.h) */
         lm_gather_set_tracer(fl->gather, fl->rt);
+    if (st == LM_OK)
+        st = follow_light(fl, err); /* before the IIM: a scene without light gathers nothing */
     if (st == LM_OK && (st = lm_iim_init(&fl->iim, fl->atlas, &fl->set.iim, 1, err)) == LM_OK) {
         fl->have_iim = 1;
         sync_gather_switches(fl); /* nodes without indirect light are not gathered at all */

@@ -363,10 +363,21 @@ static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out
     return st;
 }
 
+/* Whether a node with triangles may move (is dynamic): else the photons' round robin has nothing to find
+ * (lmgi info's "photon updates: off"). Checked every frame: lmgi_set_node_dynamic can change it. */
+static int anything_moves(const lm_scene *s)
+{
+    for (int n = 0; n < s->node_count; n++)
+        if (s->nodes[n].dynamic && s->nodes[n].tri_count > 0)
+            return 1;
+    return 0;
+}
+
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
     double t1 = lm_now();
-    lm_status st = ps->set.trace ? lm_photons_frame(ps->photons, &out->photons, err) : LM_OK;
+    lm_status st = ps->set.trace ? lm_photons_frame(ps->photons, anything_moves(ps->scene), &out->photons, err)
+                                 : LM_OK;
     double t2 = lm_now();
     if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = refresh_aims(ps, ps->set.surfaces_per_frame, &out->aim, err);
