@@ -33,6 +33,88 @@ static int run_ok(const char *args)
     return rc;
 }
 
+/* The option names of a help text: every line that starts with "  -" names one ("  -o, --out DIR": --out);
+ * with `commands`, the bracketed list under it (none: every command) as a string. */
+static int help_options(const char *text, char names[][48], char commands[][160], int max)
+{
+    int n = 0;
+    for (const char *p = text; p && *p && n < max; p = strchr(p, '\n'), p = p ? p + 1 : NULL) {
+        if (strncmp(p, "  -", 3))
+            continue;
+        const char *name = strstr(p, "--");
+        const char *eol = strchr(p, '\n');
+        if (!name || (eol && name > eol))
+            continue;
+        size_t len = strcspn(name, " \n");
+        snprintf(names[n], 48, "%.*s", (int)len, name);
+        commands[n][0] = '\0';
+        /* the continuation lines up to the next option: the last one in brackets lists the commands */
+        for (const char *q = eol ? eol + 1 : NULL; q && *q && !strncmp(q, "    ", 4); q = strchr(q, '\n'), q = q ? q + 1 : NULL) {
+            const char *open = strchr(q, '['), *end = strchr(q, '\n');
+            if (open && (!end || open < end) && open - q == 20)
+                snprintf(commands[n], 160, "%.*s", (int)strcspn(open + 1, "]"), open + 1);
+        }
+        n++;
+    }
+    return n;
+}
+
+/* `lmgi help COMMAND` and `lmgi COMMAND --help` print the same text, made from the parser's own table:
+ * every option the general help gives a command is in that command's help and is accepted by it, and
+ * every other is refused by it naming the commands that take it; a misspelt option gets the nearest. */
+static void test_command_help(void **state)
+{
+    (void)state;
+    static const char *const cmds[] = {"info", "charts", "run", "bake", "check", "reference", "bench", "tradeoff"};
+    static char all[1 << 16], mine[1 << 16], names[128][48], lists[128][160], my_names[128][48], unused[128][160];
+    assert_int_equal(run("help"), 0);
+    snprintf(all, sizeof all, "%s", output);
+    int n = help_options(all, names, lists, 128);
+    assert_true(n > 60);
+    int taken_total = 0;
+    for (int c = 0; c < 8; c++) {
+        char args[256];
+        snprintf(args, sizeof args, "%s --help", cmds[c]);
+        assert_int_equal(run(args), 0);
+        snprintf(mine, sizeof mine, "%s", output);
+        assert_non_null(strstr(mine, "usage: lmgi "));
+        snprintf(args, sizeof args, "help %s", cmds[c]);
+        assert_int_equal(run(args), 0);
+        assert_string_equal(output, mine);
+        int m = help_options(mine, my_names, unused, 128);
+        for (int k = 0; k < n; k++) {
+            /* the command's word in the list, whole ("check" is not in "checkpoint") */
+            int takes = !lists[k][0];
+            for (const char *q = lists[k]; !takes && (q = strstr(q, cmds[c])) != NULL; q++)
+                takes = (q == lists[k] || q[-1] == ' ') && (q[strlen(cmds[c])] == ',' || q[strlen(cmds[c])] == ' ' ||
+                                                            q[strlen(cmds[c])] == '\0');
+            int listed = 0;
+            for (int j = 0; j < m; j++)
+                listed |= !strcmp(my_names[j], names[k]);
+            if (listed != takes)
+                fail_msg("%s: %s is %s its help, and the general help says it %s it", cmds[c], names[k],
+                         listed ? "in" : "not in", takes ? "takes" : "does not take");
+            snprintf(args, sizeof args, "%s %.47s", cmds[c], names[k]);
+            run(args);
+            int refused = strstr(output, "is not an option of") != NULL || strstr(output, "unknown option") != NULL;
+            if (refused == takes)
+                fail_msg("lmgi %s: %s (help says it %s it)", args, output, takes ? "takes" : "does not take");
+            taken_total += takes;
+        }
+    }
+    print_message("%d options, %d of them taken by each command on average\n", n, taken_total / 8);
+    assert_int_equal(run("info scenes/cornell.glb --hemicube 8"), 2);
+    assert_non_null(strstr(output, "'--hemicube' is not an option of 'info' (it is one of run, bake, check and bench"));
+    assert_int_equal(run("run scenes/cornell.glb --texel-sise 0.1 --out x"), 2);
+    assert_non_null(strstr(output, "did you mean '--texel-size'?"));
+    assert_int_equal(run("bake scenes/cornell.glb --hemicube-sample 4 --out x"), 2);
+    assert_non_null(strstr(output, "did you mean '--hemicube-samples'?"));
+    assert_int_equal(run("info scenes/cornell.glb --zzzzzzzz"), 2);
+    assert_null(strstr(output, "did you mean"));
+    assert_int_equal(run("help frobnicate"), 2);
+    assert_non_null(strstr(output, "no command 'frobnicate'"));
+}
+
 static void test_usage_errors(void **state)
 {
     (void)state;
@@ -56,7 +138,9 @@ static void test_usage_errors(void **state)
     assert_non_null(strstr(output, "--size 64x64abc"));
     assert_int_equal(run("run scenes/cornell.glb --groups 7 --out x"), 2);
     assert_non_null(strstr(output, "--groups 7"));
-    assert_int_equal(run("info scenes/cornell.glb --groups 12 -q"), 0); /* 2^2 3 */
+    assert_int_equal(run("run scenes/cornell.glb --groups 12 --out"), 2); /* 2^2 3 taken; then --out's value missing */
+    assert_non_null(strstr(output, "--out (missing)"));
+    assert_null(strstr(output, "--groups"));
     /* --sky: one radiance or three, finite and >= 0; info says what it got */
     static const char *const bad_sky[] = {"nan", "-1", "1,2", "1,2,3,4", "1,,2", "1e30", "inf", "0.5,x,1"};
     for (int k = 0; k < 8; k++) {
@@ -850,6 +934,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_usage_errors),
+        cmocka_unit_test(test_command_help),
         cmocka_unit_test(test_tiled_run),
         cmocka_unit_test(test_soak),
         cmocka_unit_test(test_bad_scene_files),

@@ -74,11 +74,16 @@ typedef struct {
     const char *knobs;        /* --knobs LIST (tradeoff): the knobs to sweep (NULL: all) */
 } lm_cli_args;
 
-/* Parses argv[first..argc). Returns 0 on success, or prints what was wrong and returns 2. */
-int lm_cli_parse(int argc, char **argv, int first, lm_cli_args *a);
+/* Parses argv[first..argc) for `command` (its name, for messages): an option outside the `commands` set
+ * of LM_CMD_* bits (options.h; ~0u: every option, lmgi-dev's too) is refused naming the commands that
+ * take it, an unknown one with the nearest spelling. Returns 0 on success, or prints what was wrong and
+ * returns 2. */
+int lm_cli_parse(int argc, char **argv, int first, const char *command, unsigned commands, lm_cli_args *a);
 /* The start a program of commands shares (`PROGRAM COMMAND [options]`): no command prints usage on
- * stderr (exit 2), help on stdout (exit 0); then argv[2..] is parsed (exit 2 when bad) and the library's
- * verbosity set from -q / -v. Returns -1 to go on with argv[1], else the exit code. */
-int lm_cli_start(int argc, char **argv, void (*usage)(FILE *), lm_cli_args *a);
+ * stderr (exit 2), help on stdout (exit 0); for lmgi (`lmgi` 1) `help COMMAND` and `COMMAND --help`
+ * print that command's usage and options (exit 0), and a command takes only its own options; then
+ * argv[2..] is parsed (exit 2 when bad) and the library's verbosity set from -q / -v. Returns -1 to go
+ * on with argv[1], else the exit code. */
+int lm_cli_start(int argc, char **argv, void (*usage)(FILE *), int lmgi, lm_cli_args *a);
 
 #endif

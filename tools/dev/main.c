@@ -34,7 +34,7 @@ static void usage(FILE *f)
 int main(int argc, char **argv)
 {
     lm_cli_args a;
-    int rc = lm_cli_start(argc, argv, usage, &a);
+    int rc = lm_cli_start(argc, argv, usage, 0, &a);
     if (rc >= 0)
         return rc;
     if (!strcmp(argv[1], "photons"))

@@ -1,0 +1,322 @@
+/* The lmgi command's commands and options (options.h): one table each, read by the parser and printed
+ * by the help. */
+#include "options.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "option_values.h"
+
+const lm_cli_command lm_cli_commands[] = {
+    {"info", LM_CMD_INFO, "info SCENE",
+     "counts, materials by class, lights, surfaces, charts, atlas, and which effects the scene calls\n"
+     "for and why"},
+    {"charts", LM_CMD_CHARTS, "charts SCENE --out DIR",
+     "write DIR/atlas.png (charts coloured, free space black) and DIR/surfaces.png (the scene from\n"
+     "its camera, each surface a flat colour)"},
+    {"run", LM_CMD_RUN, "run SCENE --out DIR",
+     "the whole frame loop over the scene's animations (photons, AIMs, IIM gather, direct light,\n"
+     "composite): DIR/frame_NNNN.png (every K-th also .exr), iim.exr/png, aim.exr/png and frames.csv\n"
+     "(work and ms per stage)"},
+    {"bake", LM_CMD_BAKE, "bake SCENE --out DIR",
+     "the full solution for the scene as it is (every photon, AIM and texel), with a progress bar and\n"
+     "the time left (Ctrl-C or SIGTERM cancels, keeping what it finished for --resume; a failed bake\n"
+     "leaves the last lightmaps): DIR/lightmap.exr (irradiance, alpha = valid), lightmap.png (a\n"
+     "preview), aim.exr; --gltf: also NAME.gltf, the scene for engines with TEXCOORD_1 = lightmap UVs"},
+    {"check", LM_CMD_CHECK, "check SCENE",
+     "one frame of 'run' (same options) against the path-traced reference: frame / reference per\n"
+     "visible surface and over the frame, and the relative RMSE (default --size 128x128; --out DIR:\n"
+     "the two EXRs)"},
+    {"reference", LM_CMD_REFERENCE, "reference SCENE --out DIR",
+     "path-traced ground truth per texel and per pixel, split by light path: direct, iim, caustic\n"
+     "(light-traced), lost; the picture also emission, indirect and reflections\n"
+     "(DIR/reference_*.exr)"},
+    {"bench", LM_CMD_BENCH, "bench [SCENE...] | bench --edits SCRIPT.json SCENE | bench --soak N [SCENE]",
+     "time load, surface split, atlas (unwrap, pack, texel table) and BVH build; --scaling FILE\n"
+     "(repeatable) adds a growth table; with no SCENE also the update time budget and every scene's\n"
+     "default frame against the reference (photon tracing and the gather: lmgi-dev bench, make\n"
+     "bench). --edits: a scripted edit sequence through the updater: per-update times, budget\n"
+     "overruns, each edit's update lag, the surfaces it rewrote in its reach and outside it, and\n"
+     "the lightmap reads an engine makes (docs/bench.md). --soak: N updates of the looped animation"},
+    {"tradeoff", LM_CMD_TRADEOFF, "tradeoff SCENE... --out DIR",
+     "what accuracy costs in time: every knob that trades one for the other swept around the defaults\n"
+     "(--knobs LIST: only those), each setting's stage times (medians of --repeats) and the error of\n"
+     "its AIM, IIM and frame against the reference: DIR/report.html (plots, the Pareto front),\n"
+     "tradeoff.csv/.json (docs/tradeoff.md); --edits SCRIPT,...: the lightmap's lag behind each\n"
+     "scripted edit per update budget (lag.csv)"},
+    {NULL, 0, NULL, NULL},
+};
+
+const lm_cli_option lm_cli_options[] = {
+    {"--texel-size", NULL, "S", LM_CMD_ALL, LM_OPT_FLOAT, offsetof(lm_cli_args, options.texel_size), 0, 0, NULL,
+     "world units per lightmap texel (default: from --texels)"},
+    {"--texels", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.target_texels), 16, 1 << 28, NULL,
+     "texels the derived texel size aims at (default 65536; run: 90 x\n--texels-per-frame, so that its IIM is refreshed in full every 3 s)"},
+    {"--gutter", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.gutter), 0, 64, NULL,
+     "empty texels between charts (default 0)"},
+    {"--use-uv1", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.use_file_uv1), 0, 0, NULL,
+     "use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping"},
+    {"--cone", NULL, "DEG", LM_CMD_ALL, LM_OPT_FLOAT, offsetof(lm_cli_args, options.surface_cone_deg), 0, 0, NULL,
+     "max normal deviation inside one surface (default 30)"},
+    {"--max-atlas", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.max_atlas_size), 64, 32768, NULL,
+     "largest atlas side; the texel size grows to fit (default 8192)"},
+    {"--strict", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.strict), 0, 0, NULL,
+     "degenerate triangles and non-manifold edges are errors"},
+    {"--untrusted", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.untrusted), 0, 0, NULL,
+     "a scene from a stranger: every file it names must lie inside its folder\n(else refused, naming it); by default one outside is read with a warning"},
+    {"--sky", NULL, "L | R,G,B | R,G,B/R,G,B | FILE.hdr|.exr", LM_CMD_ALL, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_sky,
+     "a sky around the scene, uniform (linear, the units of an emissive\nsurface), zenith/horizon gradient or an equirectangular HDR image\n(docs/levels.md): lights through photons, the gather, the background and\nreflections; a file's extras.lmgi.sky gives one too"},
+    {"--out", "-o", "DIR", LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, out_dir), 0, 0, NULL,
+     "the folder the results go to (lmgi lists its files in DIR/.lmgi)"},
+    {"--force", NULL, NULL, LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF | LM_CMD_BENCH, LM_OPT_FLAG, offsetof(lm_cli_args, force), 0, 0, NULL,
+     "write into a non-empty --out DIR (or over a --json FILE) lmgi has not\nwritten before; lmgi never removes or replaces any other file"},
+    {"--size", NULL, "WxH", LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_size,
+     "picture size (charts: default 1024x768; run: 512x512; check: 128x128;\ntradeoff: 96x96; bench --soak: 32x32)"},
+    {"--frames", NULL, "N", LM_CMD_RUN | LM_CMD_CHECK, LM_OPT_INT, offsetof(lm_cli_args, frames), 1, 1000000, NULL,
+     "frames to play at 30 per second of animation (default 60; check: the\nframe it checks)"},
+    {"--seed", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH | LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_seed,
+     "the random sequences' seed (photons' scramble, the reference's paths)"},
+    {"--photons", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, photons), 1, 100000000, NULL,
+     "total photon budget (default: groups x per-group)"},
+    {"--groups", NULL, "G", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_groups,
+     "photon groups, 2^a 3^b (default 72)"},
+    {"--per-group", NULL, "M", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, per_group), 1, 10000000, NULL,
+     "photons per group"},
+    {"--retrace", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, retrace), 1, 1000000, NULL,
+     "photons per group re-traced a frame, round robin, while anything can move\n(default 1)"},
+    {"--group-budget", NULL, "B", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, group_budget), 0, 10000000, NULL,
+     "invalid photon groups re-traced a frame (default: the scene's)"},
+    {"--nearest", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, nearest), 1, 100000, NULL,
+     "photons per AIM estimate (default 32)"},
+    {"--surfaces-per-frame", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, surface_budget), 0, 10000000, NULL,
+     "AIM refreshes a frame (default 4)"},
+    {"--target-error", NULL, "E", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_FLOAT, offsetof(lm_cli_args, target_error), 1e-6, 0, NULL,
+     "the reference's relative standard error per texel or pixel (default 0.02;\ntradeoff: 0.03)"},
+    {"--samples", NULL, "N", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_INT, offsetof(lm_cli_args, samples), 1, 100000000, NULL,
+     "the reference's samples per texel or pixel a pass"},
+    {"--caustic-photons", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH | LM_CMD_REFERENCE, LM_OPT_INT, offsetof(lm_cli_args, caustic_photons), 1, 1 << 24, NULL,
+     "caustic photons per light and mirror or glass node (default 16384);\nreference: its light-traced ones (1048576)"},
+    {"--reference-caustic-photons", NULL, "N", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_INT, offsetof(lm_cli_args, ref_caustic_photons), 1, 1 << 24, NULL,
+     "the reference's light-traced photons per light and mirror or glass node\nfor its caustic part (default 1048576)"},
+    {"--cache", NULL, "DIR", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, cache_dir), 0, 0, NULL,
+     "where references are kept (default $LMGI_CACHE, else build/reference-cache)"},
+    {"--no-cache", NULL, NULL, LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_FLAG, offsetof(lm_cli_args, no_cache), 0, 0, NULL,
+     "solve the reference again, keeping none"},
+    {"--camera", NULL, "I", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH | LM_CMD_REFERENCE, LM_OPT_INT, offsetof(lm_cli_args, camera), 0, 1000000, NULL,
+     "the file's camera I (default: its first, else one framing the scene)"},
+    {"--texels-per-frame", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, texels_per_frame), 1, 100000000, NULL,
+     "IIM texels gathered per frame (default 20)"},
+    {"--exr-every", NULL, "K", LM_CMD_RUN, LM_OPT_INT, offsetof(lm_cli_args, exr_every), 1, 1000000, NULL,
+     "every K-th frame also as linear EXR (default 10)"},
+    {"--hemicube", NULL, "R", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, hemicube), 2, 1024, NULL,
+     "hemicube plane pixels per side (default 32)"},
+    {"--hemicube-samples", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_hemicube_samples,
+     "AIM lookups per hemicube pixel, 1 or 4 (default 4: no banding)"},
+    {"--hemicube-coverage", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, hemicube_coverage), 1, 16, NULL,
+     "coverage samples per hemicube pixel, 1 to 16 within the GL's limit\n(llvmpipe: 4; default: 4 when emissive triangles are drawn into the\nhemicubes, whose small images alias, else 1)"},
+    {"--emitter-light", NULL, "M", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_emitter_light,
+     "closed (the light of emissive triangles in closed form, visibility by\nshadow rays: no plaid, no coverage samples needed) or drawn into the\nhemicubes (default: closed when the scene has 1 to 64 emissive triangles)"},
+    {"--emitter-rays", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, emitter_rays), 1, 65536, NULL,
+     "shadow rays per emissive triangle and texel (default 32)"},
+    {"--tonemap", NULL, "T", LM_CMD_RUN | LM_CMD_REFERENCE, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_tonemap,
+     "how PNGs show light: neutral (Khronos PBR Neutral, exposure from the\nmedian; the default) or clamp (linear, exposure from the 99th\npercentile); EXRs keep the linear numbers either way"},
+    {"--in-order", NULL, NULL, LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_FLAG, offsetof(lm_cli_args, in_order), 0, 0, NULL,
+     "the photon stage before the gather and render, on one thread (the paper's\norder; default: its tracing and AIM refresh run on a second thread beside\nthe render, after the gather, which then sees the previous frame's AIMs)"},
+    {"--enlargement", NULL, "A", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_FLOAT, offsetof(lm_cli_args, enlargement), 1e-3, 0, NULL,
+     "hemicube plane half-side a (default 2)"},
+    {"--rim-samples", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, rim_samples), 0, 65536, NULL,
+     "rays per texel for the light of the hemisphere's rim outside the plane\n(default 64); 0: the paper's 1 / F(a) extrapolation (surfaces 10-30% off\nwhere a bright spot lies near their horizon)"},
+    {"--aim-direct", NULL, "M", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_aim_direct,
+     "where the AIMs' direct light comes from: photons (the default: first\nhits, the paper's form, blurred by the estimate's radius), emitters\n(emissive triangles' light computed per texel: sharp contact shadows,\nabout 5x slower AIMs) or all (punctual lights' too)"},
+    {"--indirect", NULL, "P", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_indirect,
+     "how frames get indirect light: lightmap (the default: AIMs, hemicube\ngather, IIM), or every visible pixel gathers the photons on the GPU (Mara\net al. 2013): tiled (per screen tile, from shared memory), hashgrid (per\npixel from a hash grid) or bruteforce (every photon against every pixel:\nthe ground truth, small frames only)"},
+    {"--photon-tile", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_tile,
+     "with --indirect tiled: tile side, 4, 8, 16 or 32 (default 16)"},
+    {"--photon-chunk", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, photon_chunk), 64, 512, NULL,
+     "with --indirect tiled: photons per shared-memory load, 64 to 512\n(default 256)"},
+    {"--photon-stochastic", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, photon_stochastic), 1, 4, NULL,
+     "with --indirect tiled: each pixel reads 1/k^2 of its tile's photons,\nthen an edge-aware k x k average (1 to 4; default 1: all)"},
+    {"--photon-radius", NULL, "R", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_radius,
+     "the per-pixel gathers' kernel radius (default: the disc of --nearest\nphotons)"},
+    {"--effects", NULL, "LIST", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_effects,
+     "effects left out (-) or kept (+) whatever the scene calls for: -shadows\n(no shadow maps), -indirect (no photon, AIM or gather work: direct light\nonly), -reflections (no environment maps), -caustics (no caustic photons,\nno caustic pass)"},
+    {"--reflection-size", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, reflection_size), 0, 4096, NULL,
+     "texels per side of the environment cube map of each mirror, glossy or\nglass node (default 128; 0: no reflections, mirrors black)"},
+    {"--reflection-faces", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, reflection_faces), 1, 1 << 20, NULL,
+     "most environment map faces re-rendered a frame, those whose view changed\nlongest ago first, after all of them at the first frame (default 1; a\nstill scene renders none)"},
+    {"--caustic-retrace", NULL, "F", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_retrace,
+     "share of the caustic photons re-traced a frame while anything moves\n(default 0.25; a moved light or mirror/glass node re-traces its own)"},
+    {"--caustic-filter", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, caustic_filter), 0, 8, NULL,
+     "k of the caustics' (2k+1)^2 cone filter, 0 to 8 (default 3)"},
+    {"--caustic-space", NULL, "S", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_space,
+     "screen (default, the paper's filter) or world (by world distance)"},
+    {"--caustic-tile", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, caustic_tile), 4, 256, NULL,
+     "screen tile side of the caustics' occlusion queries (default 32)"},
+    {"--gather-scheme", NULL, "S", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_scheme,
+     "hemicubes by viewports, instanced or layered (layered has no\nmultisampled target: coverage 1 unless given), or rays (Embree over each\ntexel's hemisphere, no hemicube); default: rays above 20,000 triangles on\na software GL, else viewports (docs/gather.md, \"Rays\")"},
+    {"--repeats", NULL, "N", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_INT, offsetof(lm_cli_args, repeats), 1, 100, NULL,
+     "runs per measurement, the median is reported (default 3)"},
+    {"--json", NULL, "FILE", LM_CMD_BENCH, LM_OPT_TEXT, offsetof(lm_cli_args, json_path), 0, 0, NULL,
+     "also write the results as JSON"},
+    {"--scaling", NULL, "FILE", LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_scaling,
+     "(repeatable) a scene for the growth table"},
+    {"--soak", NULL, "N", LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, soak), 1, 100000000, NULL,
+     "N updates of the looped animation (default scene scenes/cornell.glb):\nresident memory, update times and non-finite frame values per block"},
+    {"--edits", NULL, "SCRIPT.json", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, edits_path), 0, 0, NULL,
+     "a scripted edit sequence (docs/bench.md); tradeoff: a comma-separated\nlist of them, the lightmap's lag behind each edit per update budget"},
+    {"--gather-scene", NULL, "FILE", 0, LM_OPT_TEXT, offsetof(lm_cli_args, gather_scene), 0, 0, NULL,
+     "lmgi-dev bench: the ~133k-triangle Cornell box"},
+    {"--half", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, half), 0, 0, NULL,
+     "EXR lightmaps in 16-bit half floats"},
+    {"--gltf", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, gltf), 0, 0, NULL,
+     "also a glTF copy of the scene with the lightmap (docs/api.md)"},
+    {"--accuracy", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, accuracy), 0, 0, NULL,
+     "also DIR/accuracy.exr, the lightmaps' estimate of their own error (r: the\nlightmap's relative standard error, g: the AIM's, b: back-face share)"},
+    {"--resume", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, resume), 0, 0, NULL,
+     "continue the bake that was cancelled or killed from DIR/bake.checkpoint\n(what its gather had finished), to the same lightmaps as one that never\nstopped"},
+    {"--checkpoint-seconds", NULL, "S", LM_CMD_BAKE, LM_OPT_FLOAT, offsetof(lm_cli_args, checkpoint_seconds), 0, 0, NULL,
+     "at most one checkpoint every S seconds (default 10)"},
+    {"--quick", NULL, NULL, LM_CMD_TRADEOFF, LM_OPT_FLAG, offsetof(lm_cli_args, quick), 0, 0, NULL,
+     "fewer values per knob, 64x64, target error 0.04 (under 3 minutes on\nscenes/cornell.glb)"},
+    {"--knobs", NULL, "LIST", LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, knobs), 0, 0, NULL,
+     "the knobs to sweep, comma-separated (default: all; docs/tradeoff.md)"},
+    {"--frame-lag", NULL, NULL, LM_CMD_TRADEOFF, LM_OPT_FLAG, offsetof(lm_cli_args, frame_lag), 0, 0, NULL,
+     "with --edits: the frame's lag too, against the path-traced reference of\nthe edited scene"},
+    {"--verbose", "-v", NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, verbose), 0, 0, NULL,
+     "more on stderr"},
+    {"--quiet", "-q", NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, quiet), 0, 0, NULL,
+     "less on stderr; where stderr is not a terminal, progress comes as a line\nevery 5 s (LMGI_PROGRESS_SECONDS)"},
+
+    {NULL, NULL, NULL, 0, LM_OPT_FLAG, 0, 0, 0, NULL, NULL},
+};
+
+const lm_cli_command *lm_cli_find_command(const char *name)
+{
+    for (const lm_cli_command *c = lm_cli_commands; name && c->name; c++)
+        if (!strcmp(c->name, name))
+            return c;
+    return NULL;
+}
+
+const lm_cli_option *lm_cli_find_option(const char *word)
+{
+    for (const lm_cli_option *o = lm_cli_options; o->name; o++)
+        if (!strcmp(o->name, word) || (o->alias && !strcmp(o->alias, word)))
+            return o;
+    return NULL;
+}
+
+/* Levenshtein distance, capped (longer words are not misspellings of each other anyway). */
+static int distance(const char *a, const char *b)
+{
+    enum { MAX = 64 };
+    size_t n = strlen(a), m = strlen(b);
+    if (n >= MAX || m >= MAX)
+        return MAX;
+    int row[MAX + 1];
+    for (size_t j = 0; j <= m; j++)
+        row[j] = (int)j;
+    for (size_t i = 1; i <= n; i++) {
+        int diag = row[0];
+        row[0] = (int)i;
+        for (size_t j = 1; j <= m; j++) {
+            int up = row[j], best = diag + (a[i - 1] != b[j - 1]);
+            best = up + 1 < best ? up + 1 : best;
+            best = row[j - 1] + 1 < best ? row[j - 1] + 1 : best;
+            diag = up;
+            row[j] = best;
+        }
+    }
+    return row[m];
+}
+
+const lm_cli_option *lm_cli_nearest_option(const char *word, unsigned commands)
+{
+    const lm_cli_option *best = NULL;
+    int best_d = 1 << 30;
+    for (const lm_cli_option *o = lm_cli_options; o->name; o++) {
+        if (!(o->commands & commands))
+            continue;
+        int d = distance(word, o->name);
+        if (d < best_d)
+            best = o, best_d = d;
+    }
+    /* a slip of a key or two, or a third of a long name */
+    int near = (int)strlen(word) / 3 > 2 ? (int)strlen(word) / 3 : 2;
+    return best && best_d <= near ? best : NULL;
+}
+
+void lm_cli_command_list(unsigned commands, char *buf, size_t size)
+{
+    int n = 0, total = 0;
+    for (const lm_cli_command *c = lm_cli_commands; c->name; c++)
+        total += (commands & c->bit) != 0;
+    size_t used = 0;
+    buf[0] = '\0';
+    for (const lm_cli_command *c = lm_cli_commands; c->name && used < size; c++) {
+        if (!(commands & c->bit))
+            continue;
+        const char *sep = n == 0 ? "" : n == total - 1 ? " and " : ", ";
+        int w = snprintf(buf + used, size - used, "%s%s", sep, c->name);
+        used += w > 0 ? (size_t)w : 0;
+        n++;
+    }
+}
+
+/* The text's lines, the first after `first` columns already printed, the rest indented by `indent`. */
+static void print_lines(FILE *f, const char *text, int first, int indent)
+{
+    int col = first;
+    for (const char *p = text; *p;) {
+        size_t n = strcspn(p, "\n");
+        fprintf(f, "%*s%.*s\n", col, "", (int)n, p);
+        col = indent;
+        p += n + (p[n] == '\n');
+    }
+}
+
+#define OPTION_COLUMN 20
+
+static void print_option(FILE *f, const lm_cli_option *o, int with_commands)
+{
+    char head[128];
+    int w = snprintf(head, sizeof head, "  %s%s%s%s%s", o->alias ? o->alias : "", o->alias ? ", " : "", o->name,
+                     o->arg ? " " : "", o->arg ? o->arg : "");
+    fputs(head, f);
+    int pad = w < OPTION_COLUMN - 1 ? OPTION_COLUMN - w : 1;
+    if (w > 40) { /* a long value list: the text on the next line */
+        fputc('\n', f);
+        pad = OPTION_COLUMN;
+    }
+    print_lines(f, o->help, pad, OPTION_COLUMN);
+    if (with_commands && o->commands != LM_CMD_ALL) {
+        char list[160];
+        lm_cli_command_list(o->commands, list, sizeof list);
+        fprintf(f, "%*s[%s]\n", OPTION_COLUMN, "", list);
+    }
+}
+
+void lm_cli_print_help(FILE *f)
+{
+    fprintf(f, "usage: lmgi COMMAND [OPTIONS] SCENE\n\ncommands (lmgi help COMMAND, or lmgi COMMAND --help: its "
+               "options alone):\n");
+    for (const lm_cli_command *c = lm_cli_commands; c->name; c++) {
+        fprintf(f, "  %s\n", c->usage);
+        print_lines(f, c->help, 6, 6);
+    }
+    fprintf(f, "  help [COMMAND]\n      this text, or the command's\n\noptions (the commands that take "
+               "each in brackets, where not every one):\n");
+    for (const lm_cli_option *o = lm_cli_options; o->name; o++)
+        if (o->commands)
+            print_option(f, o, 1);
+}
+
+void lm_cli_print_command_help(FILE *f, const lm_cli_command *c)
+{
+    fprintf(f, "usage: lmgi %s [OPTIONS]\n\n", c->usage);
+    print_lines(f, c->help, 0, 0);
+    fprintf(f, "\noptions:\n");
+    for (const lm_cli_option *o = lm_cli_options; o->name; o++)
+        if (o->commands & c->bit)
+            print_option(f, o, 0);
+}
