@@ -68,6 +68,16 @@ static lmgi_updater *make_updater(lmgi_context *ctx, lmgi_scene *sc, const lmgi_
     return u;
 }
 
+/* An updater with no frame of its own (a game draws its own) and 200 texels an update. */
+static lmgi_updater *frameless_updater(lmgi_context *ctx, lmgi_scene *sc)
+{
+    lmgi_updater_desc d;
+    small_desc(&d);
+    d.frame_width = d.frame_height = 0;
+    d.texels_per_frame = 200;
+    return make_updater(ctx, sc, &d);
+}
+
 static void update(lmgi_updater *u, float t, float budget, lmgi_update_stats *st)
 {
     lmgi_error e;
@@ -203,11 +213,7 @@ static void test_lightmaps_and_versions(void **state)
     (void)state;
     lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_cornell();
-    lmgi_updater_desc d;
-    small_desc(&d);
-    d.frame_width = d.frame_height = 0; /* no frame: the game draws its own */
-    d.texels_per_frame = 200;
-    lmgi_updater *u = make_updater(ctx, sc, &d);
+    lmgi_updater *u = frameless_updater(ctx, sc);
     assert_null(lmgi_frame(u, NULL, NULL));
     lmgi_info in;
     lmgi_get_info(sc, &in);
@@ -293,11 +299,7 @@ static void test_lightmap_rect(void **state)
     (void)state;
     lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_cornell();
-    lmgi_updater_desc d;
-    small_desc(&d);
-    d.frame_width = d.frame_height = 0;
-    d.texels_per_frame = 200;
-    lmgi_updater *u = make_updater(ctx, sc, &d);
+    lmgi_updater *u = frameless_updater(ctx, sc);
     for (int f = 1; f <= 6; f++)
         update(u, 0.1f * (float)f, 0.0f, NULL);
     lmgi_info in;
@@ -360,11 +362,7 @@ static void test_edit_reaches_updater(void **state)
     (void)state;
     lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_cornell();
-    lmgi_updater_desc d;
-    small_desc(&d);
-    d.frame_width = d.frame_height = 0;
-    d.texels_per_frame = 200;
-    lmgi_updater *u = make_updater(ctx, sc, &d);
+    lmgi_updater *u = frameless_updater(ctx, sc);
     lmgi_update_stats st;
     for (int f = 0; f < 40; f++) /* at rest at time 0 */
         update(u, 0.0f, 0.0f, &st);

@@ -47,11 +47,18 @@ const lm_cli_command lm_cli_commands[] = {
     {NULL, 0, NULL, NULL},
 };
 
+/* The commands that make an updater from the options (lm_cli_updater_desc), that solve a reference
+ * (lm_cli_reference_desc), and that write into --out. */
+#define UPDATER (LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH)
+#define REFERENCE_USERS (LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF)
+#define OUTPUTS (LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF)
+
 const lm_cli_option lm_cli_options[] = {
     {"--texel-size", NULL, "S", LM_CMD_ALL, LM_OPT_FLOAT, offsetof(lm_cli_args, options.texel_size), 0, 0, NULL,
      "world units per lightmap texel (default: from --texels)"},
     {"--texels", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.target_texels), 16, 1 << 28, NULL,
-     "texels the derived texel size aims at (default 65536; run: 90 x\n--texels-per-frame, so that its IIM is refreshed in full every 3 s)"},
+     "texels the derived texel size aims at (default 65536; run: 90 x\n"
+     "--texels-per-frame, so that its IIM is refreshed in full every 3 s)"},
     {"--gutter", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.gutter), 0, 64, NULL,
      "empty texels between charts (default 0)"},
     {"--use-uv1", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.use_file_uv1), 0, 0, NULL,
@@ -63,97 +70,141 @@ const lm_cli_option lm_cli_options[] = {
     {"--strict", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.strict), 0, 0, NULL,
      "degenerate triangles and non-manifold edges are errors"},
     {"--untrusted", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.untrusted), 0, 0, NULL,
-     "a scene from a stranger: every file it names must lie inside its folder\n(else refused, naming it); by default one outside is read with a warning"},
+     "a scene from a stranger: every file it names must lie inside its folder\n"
+     "(else refused, naming it); by default one outside is read with a warning"},
     {"--sky", NULL, "L | R,G,B | R,G,B/R,G,B | FILE.hdr|.exr", LM_CMD_ALL, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_sky,
-     "a sky around the scene, uniform (linear, the units of an emissive\nsurface), zenith/horizon gradient or an equirectangular HDR image\n(docs/levels.md): lights through photons, the gather, the background and\nreflections; a file's extras.lmgi.sky gives one too"},
-    {"--out", "-o", "DIR", LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, out_dir), 0, 0, NULL,
+     "a sky around the scene, uniform (linear, the units of an emissive\n"
+     "surface), zenith/horizon gradient or an equirectangular HDR image\n"
+     "(docs/levels.md): lights through photons, the gather, the background and\n"
+     "reflections; a file's extras.lmgi.sky gives one too"},
+    {"--out", "-o", "DIR", OUTPUTS, LM_OPT_TEXT, offsetof(lm_cli_args, out_dir), 0, 0, NULL,
      "the folder the results go to (lmgi lists its files in DIR/.lmgi)"},
-    {"--force", NULL, NULL, LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF | LM_CMD_BENCH, LM_OPT_FLAG, offsetof(lm_cli_args, force), 0, 0, NULL,
-     "write into a non-empty --out DIR (or over a --json FILE) lmgi has not\nwritten before; lmgi never removes or replaces any other file"},
-    {"--size", NULL, "WxH", LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_size,
-     "picture size (charts: default 1024x768; run: 512x512; check: 128x128;\ntradeoff: 96x96; bench --soak: 32x32)"},
+    {"--force", NULL, NULL, OUTPUTS | LM_CMD_BENCH, LM_OPT_FLAG, offsetof(lm_cli_args, force), 0, 0, NULL,
+     "write into a non-empty --out DIR (or over a --json FILE) lmgi has not\n"
+     "written before; lmgi never removes or replaces any other file"},
+    {"--size", NULL, "WxH", LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF |
+     LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_size,
+     "picture size (charts: default 1024x768; run: 512x512; check: 128x128;\n"
+     "tradeoff: 96x96; bench --soak: 32x32)"},
     {"--frames", NULL, "N", LM_CMD_RUN | LM_CMD_CHECK, LM_OPT_INT, offsetof(lm_cli_args, frames), 1, 1000000, NULL,
-     "frames to play at 30 per second of animation (default 60; check: the\nframe it checks)"},
-    {"--seed", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH | LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_seed,
+     "frames to play at 30 per second of animation (default 60; check: the\n"
+     "frame it checks)"},
+    {"--seed", NULL, "N", UPDATER | REFERENCE_USERS, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_seed,
      "the random sequences' seed (photons' scramble, the reference's paths)"},
-    {"--photons", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, photons), 1, 100000000, NULL,
+    {"--photons", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, photons), 1, 100000000, NULL,
      "total photon budget (default: groups x per-group)"},
-    {"--groups", NULL, "G", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_groups,
+    {"--groups", NULL, "G", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_groups,
      "photon groups, 2^a 3^b (default 72)"},
-    {"--per-group", NULL, "M", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, per_group), 1, 10000000, NULL,
+    {"--per-group", NULL, "M", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, per_group), 1, 10000000, NULL,
      "photons per group"},
-    {"--retrace", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, retrace), 1, 1000000, NULL,
-     "photons per group re-traced a frame, round robin, while anything can move\n(default 1)"},
-    {"--group-budget", NULL, "B", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, group_budget), 0, 10000000, NULL,
+    {"--retrace", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, retrace), 1, 1000000, NULL,
+     "photons per group re-traced a frame, round robin, while anything can move\n"
+     "(default 1)"},
+    {"--group-budget", NULL, "B", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, group_budget), 0, 10000000, NULL,
      "invalid photon groups re-traced a frame (default: the scene's)"},
-    {"--nearest", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, nearest), 1, 100000, NULL,
+    {"--nearest", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, nearest), 1, 100000, NULL,
      "photons per AIM estimate (default 32)"},
-    {"--surfaces-per-frame", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, surface_budget), 0, 10000000, NULL,
+    {"--surfaces-per-frame", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, surface_budget), 0, 10000000, NULL,
      "AIM refreshes a frame (default 4)"},
-    {"--target-error", NULL, "E", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_FLOAT, offsetof(lm_cli_args, target_error), 1e-6, 0, NULL,
-     "the reference's relative standard error per texel or pixel (default 0.02;\ntradeoff: 0.03)"},
-    {"--samples", NULL, "N", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_INT, offsetof(lm_cli_args, samples), 1, 100000000, NULL,
+    {"--target-error", NULL, "E", REFERENCE_USERS, LM_OPT_FLOAT, offsetof(lm_cli_args, target_error), 1e-6, 0, NULL,
+     "the reference's relative standard error per texel or pixel (default 0.02;\n"
+     "tradeoff: 0.03)"},
+    {"--samples", NULL, "N", REFERENCE_USERS, LM_OPT_INT, offsetof(lm_cli_args, samples), 1, 100000000, NULL,
      "the reference's samples per texel or pixel a pass"},
-    {"--caustic-photons", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH | LM_CMD_REFERENCE, LM_OPT_INT, offsetof(lm_cli_args, caustic_photons), 1, 1 << 24, NULL,
-     "caustic photons per light and mirror or glass node (default 16384);\nreference: its light-traced ones (1048576)"},
-    {"--reference-caustic-photons", NULL, "N", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_INT, offsetof(lm_cli_args, ref_caustic_photons), 1, 1 << 24, NULL,
-     "the reference's light-traced photons per light and mirror or glass node\nfor its caustic part (default 1048576)"},
-    {"--cache", NULL, "DIR", LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, cache_dir), 0, 0, NULL,
+    {"--caustic-photons", NULL, "N", UPDATER | LM_CMD_REFERENCE, LM_OPT_INT,
+     offsetof(lm_cli_args, caustic_photons), 1, 1 << 24, NULL,
+     "caustic photons per light and mirror or glass node (default 16384);\n"
+     "reference: its light-traced ones (1048576)"},
+    {"--reference-caustic-photons", NULL, "N", REFERENCE_USERS, LM_OPT_INT,
+     offsetof(lm_cli_args, ref_caustic_photons), 1, 1 << 24, NULL,
+     "the reference's light-traced photons per light and mirror or glass node\n"
+     "for its caustic part (default 1048576)"},
+    {"--cache", NULL, "DIR", REFERENCE_USERS, LM_OPT_TEXT, offsetof(lm_cli_args, cache_dir), 0, 0, NULL,
      "where references are kept (default $LMGI_CACHE, else build/reference-cache)"},
-    {"--no-cache", NULL, NULL, LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF, LM_OPT_FLAG, offsetof(lm_cli_args, no_cache), 0, 0, NULL,
+    {"--no-cache", NULL, NULL, REFERENCE_USERS, LM_OPT_FLAG, offsetof(lm_cli_args, no_cache), 0, 0, NULL,
      "solve the reference again, keeping none"},
-    {"--camera", NULL, "I", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH | LM_CMD_REFERENCE, LM_OPT_INT, offsetof(lm_cli_args, camera), 0, 1000000, NULL,
+    {"--camera", NULL, "I", UPDATER | LM_CMD_REFERENCE, LM_OPT_INT, offsetof(lm_cli_args, camera), 0, 1000000, NULL,
      "the file's camera I (default: its first, else one framing the scene)"},
-    {"--texels-per-frame", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, texels_per_frame), 1, 100000000, NULL,
+    {"--texels-per-frame", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, texels_per_frame), 1, 100000000, NULL,
      "IIM texels gathered per frame (default 20)"},
     {"--exr-every", NULL, "K", LM_CMD_RUN, LM_OPT_INT, offsetof(lm_cli_args, exr_every), 1, 1000000, NULL,
      "every K-th frame also as linear EXR (default 10)"},
-    {"--hemicube", NULL, "R", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, hemicube), 2, 1024, NULL,
+    {"--hemicube", NULL, "R", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, hemicube), 2, 1024, NULL,
      "hemicube plane pixels per side (default 32)"},
-    {"--hemicube-samples", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_hemicube_samples,
+    {"--hemicube-samples", NULL, "N", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_hemicube_samples,
      "AIM lookups per hemicube pixel, 1 or 4 (default 4: no banding)"},
-    {"--hemicube-coverage", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, hemicube_coverage), 1, 16, NULL,
-     "coverage samples per hemicube pixel, 1 to 16 within the GL's limit\n(llvmpipe: 4; default: 4 when emissive triangles are drawn into the\nhemicubes, whose small images alias, else 1)"},
-    {"--emitter-light", NULL, "M", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_emitter_light,
-     "closed (the light of emissive triangles in closed form, visibility by\nshadow rays: no plaid, no coverage samples needed) or drawn into the\nhemicubes (default: closed when the scene has 1 to 64 emissive triangles)"},
-    {"--emitter-rays", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, emitter_rays), 1, 65536, NULL,
+    {"--hemicube-coverage", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, hemicube_coverage), 1, 16, NULL,
+     "coverage samples per hemicube pixel, 1 to 16 within the GL's limit\n"
+     "(llvmpipe: 4; default: 4 when emissive triangles are drawn into the\n"
+     "hemicubes, whose small images alias, else 1)"},
+    {"--emitter-light", NULL, "M", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_emitter_light,
+     "closed (the light of emissive triangles in closed form, visibility by\n"
+     "shadow rays: no plaid, no coverage samples needed) or drawn into the\n"
+     "hemicubes (default: closed when the scene has 1 to 64 emissive triangles)"},
+    {"--emitter-rays", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, emitter_rays), 1, 65536, NULL,
      "shadow rays per emissive triangle and texel (default 32)"},
     {"--tonemap", NULL, "T", LM_CMD_RUN | LM_CMD_REFERENCE, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_tonemap,
-     "how PNGs show light: neutral (Khronos PBR Neutral, exposure from the\nmedian; the default) or clamp (linear, exposure from the 99th\npercentile); EXRs keep the linear numbers either way"},
-    {"--in-order", NULL, NULL, LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_FLAG, offsetof(lm_cli_args, in_order), 0, 0, NULL,
-     "the photon stage before the gather and render, on one thread (the paper's\norder; default: its tracing and AIM refresh run on a second thread beside\nthe render, after the gather, which then sees the previous frame's AIMs)"},
-    {"--enlargement", NULL, "A", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_FLOAT, offsetof(lm_cli_args, enlargement), 1e-3, 0, NULL,
+     "how PNGs show light: neutral (Khronos PBR Neutral, exposure from the\n"
+     "median; the default) or clamp (linear, exposure from the 99th\n"
+     "percentile); EXRs keep the linear numbers either way"},
+    {"--in-order", NULL, NULL, UPDATER, LM_OPT_FLAG, offsetof(lm_cli_args, in_order), 0, 0, NULL,
+     "the photon stage before the gather and render, on one thread (the paper's\n"
+     "order; default: its tracing and AIM refresh run on a second thread beside\n"
+     "the render, after the gather, which then sees the previous frame's AIMs)"},
+    {"--enlargement", NULL, "A", UPDATER, LM_OPT_FLOAT, offsetof(lm_cli_args, enlargement), 1e-3, 0, NULL,
      "hemicube plane half-side a (default 2)"},
-    {"--rim-samples", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, rim_samples), 0, 65536, NULL,
-     "rays per texel for the light of the hemisphere's rim outside the plane\n(default 64); 0: the paper's 1 / F(a) extrapolation (surfaces 10-30% off\nwhere a bright spot lies near their horizon)"},
-    {"--aim-direct", NULL, "M", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_aim_direct,
-     "where the AIMs' direct light comes from: photons (the default: first\nhits, the paper's form, blurred by the estimate's radius), emitters\n(emissive triangles' light computed per texel: sharp contact shadows,\nabout 5x slower AIMs) or all (punctual lights' too)"},
-    {"--indirect", NULL, "P", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_indirect,
-     "how frames get indirect light: lightmap (the default: AIMs, hemicube\ngather, IIM), or every visible pixel gathers the photons on the GPU (Mara\net al. 2013): tiled (per screen tile, from shared memory), hashgrid (per\npixel from a hash grid) or bruteforce (every photon against every pixel:\nthe ground truth, small frames only)"},
-    {"--photon-tile", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_tile,
+    {"--rim-samples", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, rim_samples), 0, 65536, NULL,
+     "rays per texel for the light of the hemisphere's rim outside the plane\n"
+     "(default 64); 0: the paper's 1 / F(a) extrapolation (surfaces 10-30% off\n"
+     "where a bright spot lies near their horizon)"},
+    {"--aim-direct", NULL, "M", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_aim_direct,
+     "where the AIMs' direct light comes from: photons (the default: first\n"
+     "hits, the paper's form, blurred by the estimate's radius), emitters\n"
+     "(emissive triangles' light computed per texel: sharp contact shadows,\n"
+     "about 5x slower AIMs) or all (punctual lights' too)"},
+    {"--indirect", NULL, "P", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_indirect,
+     "how frames get indirect light: lightmap (the default: AIMs, hemicube\n"
+     "gather, IIM), or every visible pixel gathers the photons on the GPU (Mara\n"
+     "et al. 2013): tiled (per screen tile, from shared memory), hashgrid (per\n"
+     "pixel from a hash grid) or bruteforce (every photon against every pixel:\n"
+     "the ground truth, small frames only)"},
+    {"--photon-tile", NULL, "N", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_tile,
      "with --indirect tiled: tile side, 4, 8, 16 or 32 (default 16)"},
-    {"--photon-chunk", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, photon_chunk), 64, 512, NULL,
-     "with --indirect tiled: photons per shared-memory load, 64 to 512\n(default 256)"},
-    {"--photon-stochastic", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, photon_stochastic), 1, 4, NULL,
-     "with --indirect tiled: each pixel reads 1/k^2 of its tile's photons,\nthen an edge-aware k x k average (1 to 4; default 1: all)"},
-    {"--photon-radius", NULL, "R", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_radius,
-     "the per-pixel gathers' kernel radius (default: the disc of --nearest\nphotons)"},
-    {"--effects", NULL, "LIST", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_effects,
-     "effects left out (-) or kept (+) whatever the scene calls for: -shadows\n(no shadow maps), -indirect (no photon, AIM or gather work: direct light\nonly), -reflections (no environment maps), -caustics (no caustic photons,\nno caustic pass)"},
-    {"--reflection-size", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, reflection_size), 0, 4096, NULL,
-     "texels per side of the environment cube map of each mirror, glossy or\nglass node (default 128; 0: no reflections, mirrors black)"},
-    {"--reflection-faces", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, reflection_faces), 1, 1 << 20, NULL,
-     "most environment map faces re-rendered a frame, those whose view changed\nlongest ago first, after all of them at the first frame (default 1; a\nstill scene renders none)"},
-    {"--caustic-retrace", NULL, "F", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_retrace,
-     "share of the caustic photons re-traced a frame while anything moves\n(default 0.25; a moved light or mirror/glass node re-traces its own)"},
-    {"--caustic-filter", NULL, "K", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, caustic_filter), 0, 8, NULL,
+    {"--photon-chunk", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, photon_chunk), 64, 512, NULL,
+     "with --indirect tiled: photons per shared-memory load, 64 to 512\n"
+     "(default 256)"},
+    {"--photon-stochastic", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, photon_stochastic), 1, 4, NULL,
+     "with --indirect tiled: each pixel reads 1/k^2 of its tile's photons,\n"
+     "then an edge-aware k x k average (1 to 4; default 1: all)"},
+    {"--photon-radius", NULL, "R", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_radius,
+     "the per-pixel gathers' kernel radius (default: the disc of --nearest\n"
+     "photons)"},
+    {"--effects", NULL, "LIST", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_effects,
+     "effects left out (-) or kept (+) whatever the scene calls for: -shadows\n"
+     "(no shadow maps), -indirect (no photon, AIM or gather work: direct light\n"
+     "only), -reflections (no environment maps), -caustics (no caustic photons,\n"
+     "no caustic pass)"},
+    {"--reflection-size", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, reflection_size), 0, 4096, NULL,
+     "texels per side of the environment cube map of each mirror, glossy or\n"
+     "glass node (default 128; 0: no reflections, mirrors black)"},
+    {"--reflection-faces", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, reflection_faces), 1, 1 << 20, NULL,
+     "most environment map faces re-rendered a frame, those whose view changed\n"
+     "longest ago first, after all of them at the first frame (default 1; a\n"
+     "still scene renders none)"},
+    {"--caustic-retrace", NULL, "F", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_retrace,
+     "share of the caustic photons re-traced a frame while anything moves\n"
+     "(default 0.25; a moved light or mirror/glass node re-traces its own)"},
+    {"--caustic-filter", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, caustic_filter), 0, 8, NULL,
      "k of the caustics' (2k+1)^2 cone filter, 0 to 8 (default 3)"},
-    {"--caustic-space", NULL, "S", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_space,
+    {"--caustic-space", NULL, "S", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_space,
      "screen (default, the paper's filter) or world (by world distance)"},
-    {"--caustic-tile", NULL, "N", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, caustic_tile), 4, 256, NULL,
+    {"--caustic-tile", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, caustic_tile), 4, 256, NULL,
      "screen tile side of the caustics' occlusion queries (default 32)"},
-    {"--gather-scheme", NULL, "S", LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_scheme,
-     "hemicubes by viewports, instanced or layered (layered has no\nmultisampled target: coverage 1 unless given), or rays (Embree over each\ntexel's hemisphere, no hemicube); default: rays above 20,000 triangles on\na software GL, else viewports (docs/gather.md, \"Rays\")"},
+    {"--gather-scheme", NULL, "S", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_scheme,
+     "hemicubes by viewports, instanced or layered (layered has no\n"
+     "multisampled target: coverage 1 unless given), or rays (Embree over each\n"
+     "texel's hemisphere, no hemicube); default: rays above 20,000 triangles on\n"
+     "a software GL, else viewports (docs/gather.md, \"Rays\")"},
     {"--repeats", NULL, "N", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_INT, offsetof(lm_cli_args, repeats), 1, 100, NULL,
      "runs per measurement, the median is reported (default 3)"},
     {"--json", NULL, "FILE", LM_CMD_BENCH, LM_OPT_TEXT, offsetof(lm_cli_args, json_path), 0, 0, NULL,
@@ -161,9 +212,12 @@ const lm_cli_option lm_cli_options[] = {
     {"--scaling", NULL, "FILE", LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_scaling,
      "(repeatable) a scene for the growth table"},
     {"--soak", NULL, "N", LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, soak), 1, 100000000, NULL,
-     "N updates of the looped animation (default scene scenes/cornell.glb):\nresident memory, update times and non-finite frame values per block"},
-    {"--edits", NULL, "SCRIPT.json", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, edits_path), 0, 0, NULL,
-     "a scripted edit sequence (docs/bench.md); tradeoff: a comma-separated\nlist of them, the lightmap's lag behind each edit per update budget"},
+     "N updates of the looped animation (default scene scenes/cornell.glb):\n"
+     "resident memory, update times and non-finite frame values per block"},
+    {"--edits", NULL, "SCRIPT.json", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_TEXT,
+     offsetof(lm_cli_args, edits_path), 0, 0, NULL,
+     "a scripted edit sequence (docs/bench.md); tradeoff: a comma-separated\n"
+     "list of them, the lightmap's lag behind each edit per update budget"},
     {"--gather-scene", NULL, "FILE", 0, LM_OPT_TEXT, offsetof(lm_cli_args, gather_scene), 0, 0, NULL,
      "lmgi-dev bench: the ~133k-triangle Cornell box"},
     {"--half", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, half), 0, 0, NULL,
@@ -171,21 +225,28 @@ const lm_cli_option lm_cli_options[] = {
     {"--gltf", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, gltf), 0, 0, NULL,
      "also a glTF copy of the scene with the lightmap (docs/api.md)"},
     {"--accuracy", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, accuracy), 0, 0, NULL,
-     "also DIR/accuracy.exr, the lightmaps' estimate of their own error (r: the\nlightmap's relative standard error, g: the AIM's, b: back-face share)"},
+     "also DIR/accuracy.exr, the lightmaps' estimate of their own error (r: the\n"
+     "lightmap's relative standard error, g: the AIM's, b: back-face share)"},
     {"--resume", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, resume), 0, 0, NULL,
-     "continue the bake that was cancelled or killed from DIR/bake.checkpoint\n(what its gather had finished), to the same lightmaps as one that never\nstopped"},
-    {"--checkpoint-seconds", NULL, "S", LM_CMD_BAKE, LM_OPT_FLOAT, offsetof(lm_cli_args, checkpoint_seconds), 0, 0, NULL,
+     "continue the bake that was cancelled or killed from DIR/bake.checkpoint\n"
+     "(what its gather had finished), to the same lightmaps as one that never\n"
+     "stopped"},
+    {"--checkpoint-seconds", NULL, "S", LM_CMD_BAKE, LM_OPT_FLOAT,
+     offsetof(lm_cli_args, checkpoint_seconds), 0, 0, NULL,
      "at most one checkpoint every S seconds (default 10)"},
     {"--quick", NULL, NULL, LM_CMD_TRADEOFF, LM_OPT_FLAG, offsetof(lm_cli_args, quick), 0, 0, NULL,
-     "fewer values per knob, 64x64, target error 0.04 (under 3 minutes on\nscenes/cornell.glb)"},
+     "fewer values per knob, 64x64, target error 0.04 (under 3 minutes on\n"
+     "scenes/cornell.glb)"},
     {"--knobs", NULL, "LIST", LM_CMD_TRADEOFF, LM_OPT_TEXT, offsetof(lm_cli_args, knobs), 0, 0, NULL,
      "the knobs to sweep, comma-separated (default: all; docs/tradeoff.md)"},
     {"--frame-lag", NULL, NULL, LM_CMD_TRADEOFF, LM_OPT_FLAG, offsetof(lm_cli_args, frame_lag), 0, 0, NULL,
-     "with --edits: the frame's lag too, against the path-traced reference of\nthe edited scene"},
+     "with --edits: the frame's lag too, against the path-traced reference of\n"
+     "the edited scene"},
     {"--verbose", "-v", NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, verbose), 0, 0, NULL,
      "more on stderr"},
     {"--quiet", "-q", NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, quiet), 0, 0, NULL,
-     "less on stderr; where stderr is not a terminal, progress comes as a line\nevery 5 s (LMGI_PROGRESS_SECONDS)"},
+     "less on stderr; where stderr is not a terminal, progress comes as a line\n"
+     "every 5 s (LMGI_PROGRESS_SECONDS)"},
 
     {NULL, NULL, NULL, 0, LM_OPT_FLAG, 0, 0, 0, NULL, NULL},
 };
