@@ -237,6 +237,9 @@ static inline uint32_t lm_node_file_tris(const lm_scene *s, const lm_node *n)
 {
     return s->tri_twin ? n->front_tri_count : n->tri_count;
 }
+/* 1 for a node with triangles of its own that may move: the BVH instances it apart, the photons' round
+ * robin watches it, lmgi info counts it among the dynamic. */
+static inline int lm_node_moves(const lm_node *n) { return n->dynamic && n->tri_count > 0; }
 /* 1 when triangle t is the twin (the back side) of a file's triangle. */
 static inline int lm_tri_is_back(const lm_scene *s, uint32_t t)
 {

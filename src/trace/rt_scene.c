@@ -209,7 +209,7 @@ static lm_status build(const lm_scene *s, const int *tri_surface, lm_rt **out, l
 
     lm_status st = add_static(rt, s, err);
     for (int n = 0; st == LM_OK && n < s->node_count; n++)
-        if (s->nodes[n].dynamic && s->nodes[n].tri_count > 0) {
+        if (lm_node_moves(&s->nodes[n])) {
             st = add_instance(rt, s, n, err);
             rt->instance_count += st == LM_OK;
         }

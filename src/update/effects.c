@@ -180,7 +180,7 @@ static void decide_updates(const lm_scene *s, lm_effects *e)
 {
     int dyn = 0, first = -1;
     for (int n = 0; n < s->node_count; n++)
-        if (s->nodes[n].dynamic && s->nodes[n].tri_count > 0) {
+        if (lm_node_moves(&s->nodes[n])) {
             if (first < 0)
                 first = n;
             dyn++;

@@ -368,7 +368,7 @@ static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out
 static int anything_moves(const lm_scene *s)
 {
     for (int n = 0; n < s->node_count; n++)
-        if (s->nodes[n].dynamic && s->nodes[n].tri_count > 0)
+        if (lm_node_moves(&s->nodes[n]))
             return 1;
     return 0;
 }
