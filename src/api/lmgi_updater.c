@@ -508,8 +508,8 @@ lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_bake_rep
 
 static lmgi_status get_caustics_owned(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height,
                                       lmgi_error *err);
-static lmgi_status get_lightmap_owned(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats,
-                                      lmgi_error *err);
+static lmgi_status get_lightmap_owned(lmgi_updater *u, const char *fn, lmgi_lightmap kind, const int rect[4],
+                                      float *rgba, size_t floats, lmgi_error *err);
 
 static size_t count_not_finite(const float *v, size_t n)
 {
@@ -536,8 +536,9 @@ static void name_the_stage(lmgi_updater *u, char *out, size_t size)
              "made them");
     for (int k = 0; buf && k < 3; k++) {
         lmgi_error e;
-        size_t bad = k < 2 ? (get_lightmap_owned(u, maps[k].kind, buf, n, &e) == LMGI_OK ? count_not_finite(buf, n) : 0)
-                           : (get_caustics_owned(u, buf, nc, NULL, NULL, &e) == LMGI_OK ? count_not_finite(buf, nc) : 0);
+        lmgi_status got = k < 2 ? get_lightmap_owned(u, "lmgi_update", maps[k].kind, NULL, buf, n, &e)
+                                : get_caustics_owned(u, buf, nc, NULL, NULL, &e);
+        size_t bad = got == LMGI_OK ? count_not_finite(buf, k < 2 ? n : nc) : 0;
         if (bad) { /* the earliest stage that has them: the later ones only carry them on */
             snprintf(out, size, "the first stage that has them: %s, %zu values", k < 2 ? maps[k].what : "the caustic pass",
                      bad);
@@ -688,147 +689,9 @@ lm_status lm_updater_render(lmgi_updater *u, const lm_view *v, int width, int he
     return lm_frame_loop_render(u->loop, v, width, height, rgb, err);
 }
 
-/* The displayed IIM read back into *raw (the caller frees it), and each texel's validity into rgba's
- * alpha: 1 on valid texels, 0 on gutters and on texels inside or under geometry (back-face fraction over
- * the limit: filled from their neighbours for filtering, but not light anyone sees). */
-static lm_status read_raw_iim(const lmgi_updater *u, float **raw, float *rgba, lm_error *err)
-{
-    const lm_atlas *at = &u->sc->atlas;
-    size_t n = (size_t)at->width * at->height;
-    lm_status st = lm_frame_loop_read_iim(u->loop, raw, err);
-    float limit = lm_frame_loop_get_settings(u->loop)->gather.backface_limit;
-    for (size_t i = 0; st == LM_OK && i < n; i++)
-        rgba[4 * i + 3] = at->texel_index[i] >= 0 && !((*raw)[4 * i + 3] > limit);
-    return st;
-}
+/* ---- the lightmaps, whole or a rectangle (lmgi_get_lightmap, lmgi_get_lightmap_rect) ---- */
 
-/* The displayed IIM, invalid texels filled and gutters dilated, with validity as alpha. */
-static lm_status read_iim(const lmgi_updater *u, float *rgba, lm_error *err)
-{
-    const lm_atlas *at = &u->sc->atlas;
-    size_t n = (size_t)at->width * at->height;
-    float *raw = NULL;
-    lm_status st = read_raw_iim(u, &raw, rgba, err);
-    if (st != LM_OK)
-        return st;
-    lm_iim_fill_invalid(at, raw, lm_frame_loop_get_settings(u->loop)->gather.backface_limit);
-    for (size_t i = 0; i < n; i++)
-        memcpy(rgba + 4 * i, raw + 4 * i, 3 * sizeof *rgba);
-    free(raw);
-    return LM_OK;
-}
-
-/* The AIM's radiance, gutters dilated, with the IIM's validity as alpha: its texels under geometry hold
- * only the N-nearest estimate's spill from around them. */
-static lm_status read_aim(const lmgi_updater *u, float *rgba, lm_error *err)
-{
-    const lm_atlas *at = &u->sc->atlas;
-    size_t n = (size_t)at->width * at->height;
-    float *rgb = malloc(n * 3 * sizeof *rgb), *raw = NULL;
-    if (!rgb)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory for the AIM read-back");
-    lm_status st = lm_frame_loop_sync(u->loop, err); /* the AIM is the photon work's */
-    if (st == LM_OK)
-        st = read_raw_iim(u, &raw, rgba, err); /* for the validity alone: no fill */
-    free(raw);
-    if (st == LM_OK) {
-        memcpy(rgb, lm_aim_rgb(lm_photon_stage_aim(lm_frame_loop_stage(u->loop))), n * 3 * sizeof *rgb);
-        lm_atlas_dilate_gutters(at, rgb, 3);
-        for (size_t i = 0; i < n; i++)
-            memcpy(rgba + 4 * i, rgb + 3 * i, 3 * sizeof *rgb);
-    }
-    free(rgb);
-    return st;
-}
-
-/* The error estimate (lm_frame_loop_iim_error) in rgb, gutters dilated, with the IIM's validity as alpha. */
-static lm_status read_error(const lmgi_updater *u, float *rgba, lm_error *err)
-{
-    const lm_atlas *at = &u->sc->atlas;
-    size_t n = (size_t)at->width * at->height;
-    float *e = malloc(n * sizeof *e), *raw = NULL;
-    if (!e)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
-    lm_status st = read_raw_iim(u, &raw, rgba, err); /* the validity, and what the estimate compares */
-    if (st == LM_OK)
-        st = lm_frame_loop_iim_error(u->loop, raw, e, err);
-    if (st == LM_OK) {
-        lm_atlas_dilate_gutters(at, e, 1);
-        for (size_t i = 0; i < n; i++)
-            rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = e[i];
-    }
-    free(raw);
-    free(e);
-    return st;
-}
-
-/* The accuracy estimate (lm_frame_loop_accuracy), gutters dilated, with the IIM's validity as alpha. */
-static lm_status read_accuracy(const lmgi_updater *u, float *rgba, lm_error *err)
-{
-    const lm_atlas *at = &u->sc->atlas;
-    size_t n = (size_t)at->width * at->height;
-    float *raw = NULL, *est = malloc(4 * n * sizeof *est);
-    if (!est)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory for the accuracy estimate");
-    lm_status st = read_raw_iim(u, &raw, rgba, err); /* the validity, and the IIM the estimate is relative to */
-    if (st == LM_OK)
-        st = lm_frame_loop_accuracy(u->loop, raw, est, err);
-    if (st == LM_OK) {
-        lm_atlas_dilate_gutters(at, est, 4);
-        for (size_t i = 0; i < n; i++)
-            memcpy(rgba + 4 * i, est + 4 * i, 3 * sizeof *rgba);
-    }
-    free(raw);
-    free(est);
-    return st;
-}
-
-static lmgi_status get_lightmap_owned(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
-{
-    if (!u || !rgba)
-        return lm_api_refuse(err, "lmgi_get_lightmap: %s is NULL", u ? "rgba" : "updater");
-    const lm_atlas *at = &u->sc->atlas;
-    size_t need = 4 * (size_t)at->width * at->height;
-    if (floats < need)
-        return lm_api_refuse(err, "lmgi_get_lightmap: the buffer holds %zu floats; the %d x %d atlas needs %zu", floats,
-                       at->width, at->height, need);
-    if (kind < LMGI_LIGHTMAP_IIM || kind > LMGI_LIGHTMAP_ACCURACY)
-        return lm_api_refuse(err, "lmgi_get_lightmap: %d is not a lightmap kind", (int)kind);
-    if (kind == LMGI_LIGHTMAP_ACCURACY && !lm_photon_stage_aim(lm_frame_loop_stage(u->loop))->error)
-        return lm_api_refuse(err, "lmgi_get_lightmap: the accuracy estimate needs the updater made with "
-                             "desc.error_estimate 1");
-    lm_log_target saved = lm_api_enter(u->ctx);
-    lm_error e;
-    lm_status st = kind == LMGI_LIGHTMAP_IIM   ? read_iim(u, rgba, &e)
-                   : kind == LMGI_LIGHTMAP_AIM ? read_aim(u, rgba, &e)
-                   : kind == LMGI_LIGHTMAP_ERROR ? read_error(u, rgba, &e)
-                                               : read_accuracy(u, rgba, &e);
-    lm_api_leave(saved);
-    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
-}
-
-lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
-{
-    if (!u)
-        return lm_api_refuse(err, "lmgi_get_lightmap: the updater is NULL");
-    lmgi_status st = lm_api_claim(u->ctx, "lmgi_get_lightmap", err);
-    if (st != LMGI_OK)
-        return st;
-    st = get_lightmap_owned(u, kind, rgba, floats, err);
-    lm_api_release(u->ctx);
-    static const char *const stage[] = {"the IIM lightmap (the gather)", "the AIMs (the photon estimate)",
-                                        "the error estimate", "the accuracy estimate"};
-    size_t bad = st == LMGI_OK ? count_not_finite(rgba, 4 * (size_t)u->sc->atlas.width * u->sc->atlas.height) : 0;
-    if (bad) { /* a lightmap is never handed on with a NaN or infinity in it */
-        lm_error e;
-        lm_fail(&e, LM_ERR_BACKEND, "%s: %zu values of %s are not finite numbers (NaN or infinity)",
-                u->sc->scene->path, bad, stage[kind]);
-        return lm_export_error(err, &e);
-    }
-    return st;
-}
-
-/* ---- a rectangle of the lightmap (lmgi_get_lightmap_rect) ---- */
+static void whole_atlas(const lm_atlas *at, int r[4]) { r[0] = r[1] = 0, r[2] = at->width, r[3] = at->height; }
 
 /* r grown by m texels on each side, clipped to the atlas. */
 static void grow_clip(const lm_atlas *at, const int r[4], int m, int out[4])
@@ -876,7 +739,9 @@ static void crop_rgb(const int win[4], const float *img, int channels, const int
         }
 }
 
-/* The rect's validity as rgba's alpha, from the window's raw IIM (as read_raw_iim does for the atlas). */
+/* The rect's validity as rgba's alpha, from the window's raw IIM: 1 on valid texels, 0 on gutters and on
+ * texels inside or under geometry (back-face fraction over the limit: filled from their neighbours for
+ * filtering, but not light anyone sees). */
 static void rect_validity(const lmgi_updater *u, const int win[4], const float *raw, const int rect[4], float *rgba)
 {
     const lm_atlas *at = &u->sc->atlas;
@@ -889,6 +754,7 @@ static void rect_validity(const lmgi_updater *u, const int win[4], const float *
         }
 }
 
+/* The displayed IIM in rect, invalid texels filled and gutters dilated, with validity as alpha. */
 static lm_status read_iim_rect(const lmgi_updater *u, const int rect[4], float *rgba, lm_error *err)
 {
     int win[4];
@@ -904,6 +770,8 @@ static lm_status read_iim_rect(const lmgi_updater *u, const int rect[4], float *
     return LM_OK;
 }
 
+/* The AIM's radiance in rect, gutters dilated, with the IIM's validity as alpha: its texels under geometry
+ * hold only the N-nearest estimate's spill from around them. */
 static lm_status read_aim_rect(const lmgi_updater *u, const int rect[4], float *rgba, lm_error *err)
 {
     const lm_atlas *at = &u->sc->atlas;
@@ -929,6 +797,60 @@ static lm_status read_aim_rect(const lmgi_updater *u, const int rect[4], float *
     return st;
 }
 
+/* The displayed IIM read back into *raw (the caller frees it), and each texel's validity into rgba's
+ * alpha, over the whole atlas: for the error and accuracy estimates, which compare against it. */
+static lm_status read_raw_iim(const lmgi_updater *u, float **raw, float *rgba, lm_error *err)
+{
+    int whole[4];
+    whole_atlas(&u->sc->atlas, whole);
+    lm_status st = lm_frame_loop_read_iim_window(u->loop, whole, raw, err);
+    if (st == LM_OK)
+        rect_validity(u, whole, *raw, whole, rgba);
+    return st;
+}
+
+/* The error estimate (lm_frame_loop_iim_error) in rgb, gutters dilated, with the IIM's validity as alpha. */
+static lm_status read_error(const lmgi_updater *u, float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *e = malloc(n * sizeof *e), *raw = NULL;
+    if (!e)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
+    lm_status st = read_raw_iim(u, &raw, rgba, err); /* the validity, and what the estimate compares */
+    if (st == LM_OK)
+        st = lm_frame_loop_iim_error(u->loop, raw, e, err);
+    if (st == LM_OK) {
+        lm_atlas_dilate_gutters(at, e, 1);
+        for (size_t i = 0; i < n; i++)
+            rgba[4 * i] = rgba[4 * i + 1] = rgba[4 * i + 2] = e[i];
+    }
+    free(raw);
+    free(e);
+    return st;
+}
+
+/* The accuracy estimate (lm_frame_loop_accuracy), gutters dilated, with the IIM's validity as alpha. */
+static lm_status read_accuracy(const lmgi_updater *u, float *rgba, lm_error *err)
+{
+    const lm_atlas *at = &u->sc->atlas;
+    size_t n = (size_t)at->width * at->height;
+    float *raw = NULL, *est = malloc(4 * n * sizeof *est);
+    if (!est)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the accuracy estimate");
+    lm_status st = read_raw_iim(u, &raw, rgba, err); /* the validity, and the IIM the estimate is relative to */
+    if (st == LM_OK)
+        st = lm_frame_loop_accuracy(u->loop, raw, est, err);
+    if (st == LM_OK) {
+        lm_atlas_dilate_gutters(at, est, 4);
+        for (size_t i = 0; i < n; i++)
+            memcpy(rgba + 4 * i, est + 4 * i, 3 * sizeof *rgba);
+    }
+    free(raw);
+    free(est);
+    return st;
+}
+
 /* The error and accuracy estimates are made over the whole atlas: read whole, then cut. */
 static lm_status read_whole_rect(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba, lm_error *err)
 {
@@ -944,50 +866,77 @@ static lm_status read_whole_rect(lmgi_updater *u, lmgi_lightmap kind, const int 
     return st;
 }
 
-static lmgi_status get_rect_owned(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba, size_t floats,
-                                  lmgi_error *err)
+/* The lightmap of `kind` in rect (NULL: the whole atlas) into rgba, as `fn`, on a claimed context, its
+ * arguments checked; values that are not finite are handed back as they are (name_the_stage counts them). */
+static lmgi_status get_lightmap_owned(lmgi_updater *u, const char *fn, lmgi_lightmap kind, const int rect[4],
+                                      float *rgba, size_t floats, lmgi_error *err)
 {
-    static const char fn[] = "lmgi_get_lightmap_rect";
-    if (!rect || !rgba)
-        return lm_api_refuse(err, "%s: %s is NULL", fn, rect ? "rgba" : "rect");
+    if (!rgba)
+        return lm_api_refuse(err, "%s: rgba is NULL", fn);
     const lm_atlas *at = &u->sc->atlas;
-    if (rect[0] < 0 || rect[1] < 0 || rect[2] < 1 || rect[3] < 1 || rect[2] > at->width - rect[0] ||
-        rect[3] > at->height - rect[1])
-        return lm_api_refuse(err, "%s: rectangle (%d, %d) %d x %d is not inside the %d x %d atlas", fn, rect[0],
-                             rect[1], rect[2], rect[3], at->width, at->height);
-    size_t need = 4 * (size_t)rect[2] * rect[3];
+    int r[4];
+    whole_atlas(at, r);
+    if (rect) {
+        if (rect[0] < 0 || rect[1] < 0 || rect[2] < 1 || rect[3] < 1 || rect[2] > at->width - rect[0] ||
+            rect[3] > at->height - rect[1])
+            return lm_api_refuse(err, "%s: rectangle (%d, %d) %d x %d is not inside the %d x %d atlas", fn, rect[0],
+                                 rect[1], rect[2], rect[3], at->width, at->height);
+        memcpy(r, rect, sizeof r);
+    }
+    size_t need = 4 * (size_t)r[2] * r[3];
     if (floats < need)
-        return lm_api_refuse(err, "%s: the buffer holds %zu floats; the %d x %d rectangle needs %zu", fn, floats,
-                             rect[2], rect[3], need);
+        return lm_api_refuse(err, "%s: the buffer holds %zu floats; the %d x %d %s needs %zu", fn, floats, r[2], r[3],
+                             rect ? "rectangle" : "atlas", need);
     if (kind < LMGI_LIGHTMAP_IIM || kind > LMGI_LIGHTMAP_ACCURACY)
         return lm_api_refuse(err, "%s: %d is not a lightmap kind", fn, (int)kind);
     if (kind == LMGI_LIGHTMAP_ACCURACY && !lm_photon_stage_aim(lm_frame_loop_stage(u->loop))->error)
         return lm_api_refuse(err, "%s: the accuracy estimate needs the updater made with desc.error_estimate 1", fn);
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
-    lm_status st = kind == LMGI_LIGHTMAP_IIM   ? read_iim_rect(u, rect, rgba, &e)
-                   : kind == LMGI_LIGHTMAP_AIM ? read_aim_rect(u, rect, rgba, &e)
-                                               : read_whole_rect(u, kind, rect, rgba, &e);
+    lm_status st = kind == LMGI_LIGHTMAP_IIM     ? read_iim_rect(u, r, rgba, &e)
+                   : kind == LMGI_LIGHTMAP_AIM   ? read_aim_rect(u, r, rgba, &e)
+                   : rect                        ? read_whole_rect(u, kind, r, rgba, &e)
+                   : kind == LMGI_LIGHTMAP_ERROR ? read_error(u, rgba, &e)
+                                                 : read_accuracy(u, rgba, &e);
     lm_api_leave(saved);
-    if (st == LM_OK && count_not_finite(rgba, need)) { /* as lmgi_get_lightmap: never a NaN handed on */
-        lm_fail(&e, LM_ERR_BACKEND, "%s: values of the lightmap's rectangle are not finite numbers (NaN or infinity)",
-                u->sc->scene->path);
-        st = LM_ERR_BACKEND;
-    }
     return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+/* lmgi_get_lightmap and lmgi_get_lightmap_rect: a lightmap is never handed on with a NaN or infinity in it. */
+static lmgi_status get_lightmap(lmgi_updater *u, const char *fn, lmgi_lightmap kind, const int rect[4], float *rgba,
+                                size_t floats, lmgi_error *err)
+{
+    lmgi_status st = lm_api_claim(u->ctx, fn, err);
+    if (st != LMGI_OK)
+        return st;
+    st = get_lightmap_owned(u, fn, kind, rect, rgba, floats, err);
+    lm_api_release(u->ctx);
+    static const char *const stage[] = {"the IIM lightmap (the gather)", "the AIMs (the photon estimate)",
+                                        "the error estimate", "the accuracy estimate"};
+    size_t n = rect ? 4 * (size_t)rect[2] * rect[3] : 4 * (size_t)u->sc->atlas.width * u->sc->atlas.height;
+    size_t bad = st == LMGI_OK ? count_not_finite(rgba, n) : 0;
+    if (bad) {
+        lm_error e;
+        lm_fail(&e, LM_ERR_BACKEND, "%s: %zu values of %s are not finite numbers (NaN or infinity)",
+                u->sc->scene->path, bad, stage[kind]);
+        return lm_export_error(err, &e);
+    }
+    return st;
+}
+
+lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, float *rgba, size_t floats, lmgi_error *err)
+{
+    if (!u)
+        return lm_api_refuse(err, "lmgi_get_lightmap: the updater is NULL");
+    return get_lightmap(u, "lmgi_get_lightmap", kind, NULL, rgba, floats, err);
 }
 
 lmgi_status lmgi_get_lightmap_rect(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba, size_t floats,
                                    lmgi_error *err)
 {
-    if (!u)
-        return lm_api_refuse(err, "lmgi_get_lightmap_rect: the updater is NULL");
-    lmgi_status st = lm_api_claim(u->ctx, "lmgi_get_lightmap_rect", err);
-    if (st != LMGI_OK)
-        return st;
-    st = get_rect_owned(u, kind, rect, rgba, floats, err);
-    lm_api_release(u->ctx);
-    return st;
+    if (!u || !rect)
+        return lm_api_refuse(err, "lmgi_get_lightmap_rect: %s is NULL", u ? "rect" : "the updater");
+    return get_lightmap(u, "lmgi_get_lightmap_rect", kind, rect, rgba, floats, err);
 }
 
 int lmgi_surface_lightmap_rect(const lmgi_scene *sc, int surface, int rect[4])

@@ -1053,9 +1053,7 @@ lm_status lm_frame_loop_read_iim_window(const lm_frame_loop *fl, const int win[4
     *rgba = malloc(n * sizeof(float));
     if (!*rgba)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the IIM read-back");
-    int whole = win[0] == 0 && win[1] == 0 && win[2] == fl->atlas->width && win[3] == fl->atlas->height;
-    st = whole ? lm_iim_texture_read(fl->iim.display_tex, win[2], win[3], *rgba, err)
-               : lm_iim_texture_read_window(fl->iim.display_tex, win, *rgba, err);
+    st = lm_iim_texture_read_window(fl->iim.display_tex, win, *rgba, err);
     if (st != LM_OK) {
         free(*rgba);
         *rgba = NULL;
