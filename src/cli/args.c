@@ -38,10 +38,10 @@ static int take(const lm_cli_option *o, const char *word, const char *v, lm_cli_
     return 2;
 }
 
-/* An option lmgi does not know, or one the command does not take: said with what was meant. */
-static int refuse(const char *word, const char *command, unsigned commands)
+/* An option the command does not take (o: the table's entry), or one lmgi does not know (o NULL): said
+ * with what was meant. */
+static int refuse(const lm_cli_option *o, const char *word, const char *command, unsigned commands)
 {
-    const lm_cli_option *o = lm_cli_find_option(word);
     if (o) {
         char list[160];
         lm_cli_command_list(o->commands, list, sizeof list);
@@ -49,13 +49,12 @@ static int refuse(const char *word, const char *command, unsigned commands)
                 o->commands ? "it is one of " : "it is lmgi-dev's", o->commands ? list : "", command);
         return 2;
     }
-    o = lm_cli_nearest_option(word, commands);
-    if (o)
-        fprintf(stderr, "lmgi: unknown option '%s'; did you mean '%s'? (see 'lmgi help%s%s')\n", word, o->name,
-                command ? " " : "", command ? command : "");
+    const lm_cli_option *near = lm_cli_nearest_option(word, commands);
+    if (near)
+        fprintf(stderr, "lmgi: unknown option '%s'; did you mean '%s'? (see 'lmgi help %s')\n", word, near->name,
+                command);
     else
-        fprintf(stderr, "lmgi: unknown option '%s' (see 'lmgi help%s%s')\n", word, command ? " " : "",
-                command ? command : "");
+        fprintf(stderr, "lmgi: unknown option '%s' (see 'lmgi help %s')\n", word, command);
     return 2;
 }
 
@@ -79,7 +78,7 @@ int lm_cli_parse(int argc, char **argv, int first, const char *command, unsigned
         }
         const lm_cli_option *o = lm_cli_find_option(word);
         if (!o || !(o->commands & commands || commands == ~0u)) {
-            rc = refuse(word, command, commands);
+            rc = refuse(o, word, command, commands);
             continue;
         }
         /* --effects' list starts with - or +: the word after it, whatever it is */

@@ -54,8 +54,9 @@ static const char *parse_radiance(const char *p, float rgb[3])
 
 /* --sky L | R,G,B (uniform) | R,G,B/R,G,B (zenith/horizon: a gradient) | FILE.hdr or FILE.exr (an
  * equirectangular HDR image). */
-static int parse_sky(const char *opt, const char *v)
+int lm_cli_opt_sky(const char *opt, const char *v, lm_cli_args *a)
 {
+    (void)a; /* the sky goes to the scene loader (lm_cli_set_sky) */
     static const char want[] = "a radiance L or R,G,B, a gradient ZENITH/HORIZON of two, or an HDR image "
                                "(.hdr, .exr); radiances finite numbers in [0, 1e20]";
     if (!v)
@@ -96,9 +97,9 @@ int lm_cli_parse_int(const char *opt, const char *v, int lo, int hi, int *out)
     return 0;
 }
 
-static int parse_size(const char *opt, const char *v, int *w, int *h)
+int lm_cli_opt_size(const char *opt, const char *v, lm_cli_args *a)
 {
-    int used = -1;
+    int used = -1, *w = &a->width, *h = &a->height;
     if (!v || sscanf(v, "%dx%d%n", w, h, &used) != 2 || used < 0 || v[used] || *w < 16 || *h < 16 || *w > 16384 ||
         *h > 16384)
         return lm_cli_bad(opt, v, "WxH with 16 <= W, H <= 16384");
@@ -107,12 +108,12 @@ static int parse_size(const char *opt, const char *v, int *w, int *h)
 
 /* Photon groups: 2^a 3^b (their Halton strata, docs/photons.md), checked here so that a bad value is a bad
  * command line (exit 2), not a scene that failed. */
-static int parse_groups(const char *opt, const char *v, int *out)
+int lm_cli_opt_groups(const char *opt, const char *v, lm_cli_args *a)
 {
-    int rc = lm_cli_parse_int(opt, v, 1, 1 << 20, out);
+    int rc = lm_cli_parse_int(opt, v, 1, 1 << 20, &a->groups);
     if (rc)
         return rc;
-    int n = *out;
+    int n = a->groups;
     while (n % 2 == 0)
         n /= 2;
     while (n % 3 == 0)
@@ -130,29 +131,41 @@ int lm_cli_add_file(const char **list, int *count, const char *f)
     return 0;
 }
 
-/* --emitter-light closed|drawn: 1 or 0 (unset: -1, the frame loop's choice per scene). */
-static int parse_emitter_light(const char *o, const char *v, int *out)
+/* v, one of the n names, as its value into *out; else "expected a, b or c". */
+static int choose(const char *o, const char *v, const char *const names[], const int values[], int n, int *out)
 {
-    if (v && !strcmp(v, "closed"))
-        return *out = 1, 0;
-    if (v && !strcmp(v, "drawn"))
-        return *out = 0, 0;
-    return lm_cli_bad(o, v, "closed or drawn");
+    for (int k = 0; v && k < n; k++)
+        if (!strcmp(v, names[k]))
+            return *out = values[k], 0;
+    char want[160];
+    size_t used = 0;
+    for (int k = 0; k < n && used < sizeof want; k++) {
+        int w = snprintf(want + used, sizeof want - used, "%s%s", k == 0 ? "" : k == n - 1 ? " or " : ", ", names[k]);
+        used += w > 0 ? (size_t)w : 0;
+    }
+    return lm_cli_bad(o, v, want);
 }
 
-static int parse_tonemap(const char *o, const char *v, int *out)
+/* --emitter-light closed|drawn: 1 or 0 (unset: -1, the frame loop's choice per scene). */
+int lm_cli_opt_emitter_light(const char *o, const char *v, lm_cli_args *a)
 {
-    if (v && !strcmp(v, "neutral"))
-        return *out = LMGI_TONEMAP_NEUTRAL, 0;
-    if (v && !strcmp(v, "clamp"))
-        return *out = LMGI_TONEMAP_CLAMP, 0;
-    return lm_cli_bad(o, v, "neutral or clamp");
+    static const char *const names[] = {"closed", "drawn"};
+    static const int values[] = {1, 0};
+    return choose(o, v, names, values, 2, &a->emitter_light);
+}
+
+int lm_cli_opt_tonemap(const char *o, const char *v, lm_cli_args *a)
+{
+    static const char *const names[] = {"neutral", "clamp"};
+    static const int values[] = {LMGI_TONEMAP_NEUTRAL, LMGI_TONEMAP_CLAMP};
+    return choose(o, v, names, values, 2, &a->tonemap);
 }
 
 /* A comma-separated list of -effect (left out) or +effect (kept), effect one of shadows, indirect,
  * reflections, caustics: the effects_off bits of lmgi_updater_desc. */
-static int parse_effects(const char *o, const char *v, unsigned *off)
+int lm_cli_opt_effects(const char *o, const char *v, lm_cli_args *a)
 {
+    unsigned *off = &a->effects_off;
     static const char *names[4] = {"shadows", "indirect", "reflections", "caustics"};
     static const unsigned bits[4] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS,
                                      LMGI_EFFECT_CAUSTICS};
@@ -171,67 +184,34 @@ static int parse_effects(const char *o, const char *v, unsigned *off)
     return v && *v ? 0 : lm_cli_bad(o, v, "a list such as -shadows,-indirect");
 }
 
-static int parse_caustic_space(const char *o, const char *v, int *out)
-{
-    if (v && !strcmp(v, "screen"))
-        return *out = 0, 0;
-    if (v && !strcmp(v, "world"))
-        return *out = 1, 0;
-    return lm_cli_bad(o, v, "screen or world");
-}
-
-static int parse_indirect(const char *o, const char *v, int *out)
-{
-    if (v && !strcmp(v, "lightmap"))
-        return *out = LMGI_INDIRECT_LIGHTMAP, 0;
-    if (v && !strcmp(v, "bruteforce"))
-        return *out = LMGI_INDIRECT_BRUTEFORCE, 0;
-    if (v && !strcmp(v, "tiled"))
-        return *out = LMGI_INDIRECT_TILED, 0;
-    if (v && !strcmp(v, "hashgrid"))
-        return *out = LMGI_INDIRECT_HASHGRID, 0;
-    return lm_cli_bad(o, v, "lightmap, tiled, hashgrid or bruteforce");
-}
-
-static int parse_aim_direct(const char *o, const char *v, int *out)
-{
-    if (v && !strcmp(v, "emitters"))
-        return *out = LMGI_AIM_DIRECT_EMITTERS, 0;
-    if (v && !strcmp(v, "photons"))
-        return *out = LMGI_AIM_DIRECT_PHOTONS, 0;
-    if (v && !strcmp(v, "all"))
-        return *out = LMGI_AIM_DIRECT_ALL, 0;
-    return lm_cli_bad(o, v, "emitters, photons or all");
-}
-
-static int parse_scheme(const char *o, const char *v, int *out)
-{
-    static const char *names[] = {"viewports", "instanced", "layered", "rays"};
-    for (int k = 0; v && k < 4; k++)
-        if (!strcmp(v, names[k]))
-            return *out = k, 0;
-    return lm_cli_bad(o, v, "viewports, instanced, layered or rays");
-}
-
-
-/* ---- the table's custom parsers (options.c): each takes the option, its value and the arguments ---- */
-
-int lm_cli_opt_sky(const char *o, const char *v, lm_cli_args *a) { (void)a; return parse_sky(o, v); }
-int lm_cli_opt_size(const char *o, const char *v, lm_cli_args *a) { return parse_size(o, v, &a->width, &a->height); }
-int lm_cli_opt_groups(const char *o, const char *v, lm_cli_args *a) { return parse_groups(o, v, &a->groups); }
-int lm_cli_opt_emitter_light(const char *o, const char *v, lm_cli_args *a)
-{
-    return parse_emitter_light(o, v, &a->emitter_light);
-}
-int lm_cli_opt_tonemap(const char *o, const char *v, lm_cli_args *a) { return parse_tonemap(o, v, &a->tonemap); }
-int lm_cli_opt_effects(const char *o, const char *v, lm_cli_args *a) { return parse_effects(o, v, &a->effects_off); }
 int lm_cli_opt_caustic_space(const char *o, const char *v, lm_cli_args *a)
 {
-    return parse_caustic_space(o, v, &a->caustic_world);
+    static const char *const names[] = {"screen", "world"};
+    static const int values[] = {0, 1};
+    return choose(o, v, names, values, 2, &a->caustic_world);
 }
-int lm_cli_opt_indirect(const char *o, const char *v, lm_cli_args *a) { return parse_indirect(o, v, &a->indirect); }
-int lm_cli_opt_aim_direct(const char *o, const char *v, lm_cli_args *a) { return parse_aim_direct(o, v, &a->aim_direct); }
-int lm_cli_opt_scheme(const char *o, const char *v, lm_cli_args *a) { return parse_scheme(o, v, &a->gather_scheme); }
+
+int lm_cli_opt_indirect(const char *o, const char *v, lm_cli_args *a)
+{
+    static const char *const names[] = {"lightmap", "tiled", "hashgrid", "bruteforce"};
+    static const int values[] = {LMGI_INDIRECT_LIGHTMAP, LMGI_INDIRECT_TILED, LMGI_INDIRECT_HASHGRID,
+                                 LMGI_INDIRECT_BRUTEFORCE};
+    return choose(o, v, names, values, 4, &a->indirect);
+}
+
+int lm_cli_opt_aim_direct(const char *o, const char *v, lm_cli_args *a)
+{
+    static const char *const names[] = {"emitters", "photons", "all"};
+    static const int values[] = {LMGI_AIM_DIRECT_EMITTERS, LMGI_AIM_DIRECT_PHOTONS, LMGI_AIM_DIRECT_ALL};
+    return choose(o, v, names, values, 3, &a->aim_direct);
+}
+
+int lm_cli_opt_scheme(const char *o, const char *v, lm_cli_args *a)
+{
+    static const char *const names[] = {"viewports", "instanced", "layered", "rays"};
+    static const int values[] = {0, 1, 2, 3}; /* lm_gather_scheme's order */
+    return choose(o, v, names, values, 4, &a->gather_scheme);
+}
 
 int lm_cli_opt_scaling(const char *o, const char *v, lm_cli_args *a)
 {

@@ -23,7 +23,7 @@ static _Thread_local int t_looked;
 static int find_glx(void)
 {
     static pthread_mutex_t lock = PTHREAD_MUTEX_INITIALIZER;
-    if (t_looked && g_glx.make_current)
+    if (t_looked) /* found before: the table stays */
         return 1;
     pthread_mutex_lock(&lock);
     if (!g_glx.make_current) {
