@@ -36,9 +36,12 @@ CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fvisibility-inli
 LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lwebp -lEGL -lgomp -lstdc++ -lm -lpthread
 LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
 
+# npm: Debian's, unless a node that brings its own is installed (NodeSource's nodejs conflicts with it)
+NPM_DEB := $(if $(shell command -v npm 2>/dev/null),,npm)
 DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
                 nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libwebp-dev libcmocka-dev \
-                libegl-dev libegl-mesa0 python3-matplotlib libgl-dev libx11-dev xvfb
+                libegl-dev libegl-mesa0 python3-matplotlib libgl-dev libx11-dev xvfb nodejs chromium \
+                $(NPM_DEB)
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
                              src/gpu/*.c src/update/*.c src/api/*.c))
@@ -54,7 +57,7 @@ TEST_C  := $(sort $(wildcard tests/test_*.c))
 TESTS   := $(TEST_C:tests/%.c=$(BUILD)/tests/%)
 TEST_SUPPORT := $(BUILD)/obj/tests/support.o $(BUILD)/obj/tests/edit_room.o
 
-.PHONY: all deps test test-asan demo bench tradeoff scenes clean fuzz install install-files
+.PHONY: all deps npm-deps test test-asan demo bench tradeoff scenes clean fuzz install install-files
 .PRECIOUS: $(BUILD)/obj/%.o
 .PHONY: FORCE
 all: $(BUILD)/lmgi $(BUILD)/lmgi-dev $(BUILD)/liblmgi.a $(BUILD)/liblmgi.so
@@ -142,8 +145,20 @@ $(FUZZ_BUILD)/tests/fuzz_%: FORCE
 	  -fsanitize=address,undefined -fopenmp $(LIBS) -lcmocka
 FORCE:
 
-test: deps all $(TESTS) $(FUZZ_TESTS)
-	@LMGI_BUILD=$(BUILD) sh tests/run_tests.sh $(TESTS) $(FUZZ_TESTS)
+# The engine tests' node packages (tests/test_engines.c): the Khronos glTF validator and Babylon.js, at
+# the versions the tests were written against, installed once into build/npm for every build directory.
+# Without npm or the registry the tests that need them skip and say so; make test goes on.
+NPM_DIR      := build/npm
+NPM_PACKAGES := gltf-validator@2.0.0-dev.3.10 babylonjs@9.28.0 babylonjs-loaders@9.28.0
+npm-deps:
+	@if [ "$$(cat $(NPM_DIR)/installed 2>/dev/null)" = "$(NPM_PACKAGES)" ]; then :; \
+	elif ! command -v npm > /dev/null; then echo "npm-deps: npm is missing: the engine tests will skip"; \
+	elif mkdir -p $(NPM_DIR) && npm install --prefix $(NPM_DIR) --no-audit --no-fund --no-save $(NPM_PACKAGES) \
+	     > $(NPM_DIR)/install.log 2>&1; then echo "$(NPM_PACKAGES)" > $(NPM_DIR)/installed; \
+	else echo "npm-deps: npm install failed ($(NPM_DIR)/install.log): the engine tests will skip"; fi
+
+test: deps npm-deps all $(TESTS) $(FUZZ_TESTS)
+	@LMGI_BUILD=$(BUILD) LMGI_NPM=$(NPM_DIR) sh tests/run_tests.sh $(TESTS) $(FUZZ_TESTS)
 
 # make fuzz: FUZZ_INPUTS structured inputs through the whole pipeline under ASan + UBSan, split over
 # FUZZ_JOBS processes with seeds 1..FUZZ_JOBS (each its own inputs), then FUZZ_API_SEQUENCES call

@@ -648,8 +648,10 @@ LMGI_API lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, floa
 /* Export for engines (docs/api.md, "Exporting to engines"): the scene as lmgi lit it, written to
  * DIR/NAME.gltf (+ NAME.bin, NAME_texN.png for its textures) with TEXCOORD_1 on every triangle set to its
  * lightmap UVs, and the lightmap itself beside it: NAME_lightmap.exr (the displayed IIM as
- * lmgi_get_lightmap gives it: irradiance, alpha = valid; linear float or half) and NAME_lightmap.png (a
- * tone-mapped preview). Every node is a root placed by its world matrix at the time of the export (the
+ * lmgi_get_lightmap gives it: irradiance, alpha = valid; linear float or half), NAME_lightmap.png (a
+ * tone-mapped preview) and NAME_lightmap_rgbd.png (RGBD, the texture every material with lightmap texels
+ * samples through TEXCOORD_1 by the vendor extension LMGI_lightmap, which says how to decode it: docs/api.md,
+ * "The lightmap in engines"). Every node is a root placed by its world matrix at the time of the export (the
  * baked pose; animations are not written); each node with lightmap texels names the lightmap in its
  * extras ({"lightmap": {"uri": "NAME_lightmap.exr", "texCoord": 1}}, beside {"lmgi": {...}}, its
  * settings), and the document's extras say what the lightmap holds. The copy loads back into lmgi with

@@ -111,6 +111,51 @@ static double uv1_hits(const lmgi_scene *orig, const lm_scene *copy)
     return (double)hits / total;
 }
 
+/* The RGBD image the glTF's LMGI_lightmap names, decoded with the scale the material gives, holds the
+ * lightmap within RGBD's steps (core/image.h): 0.7% of the texel's brightest channel, or of half the
+ * scale where that is darker; and 99% of the valid texels are stored with d = 1. */
+static void rgbd_holds_the_lightmap(const char *dir, const char *name, const float *lightmap, int w, int h)
+{
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
+    size_t size;
+    char *json = (char *)lmt_read_file(path, &size, 1);
+    json[size] = '\0';
+    const char *ext = strstr(json, "\"LMGI_lightmap\":{\"lightmapTexture\":{\"index\":");
+    assert_non_null(ext);
+    const char *sc = strstr(ext, "\"scale\":");
+    assert_non_null(sc);
+    float scale = strtof(sc + strlen("\"scale\":"), NULL);
+    snprintf(path, sizeof path, "%s/%s_lightmap_rgbd.png\"", dir, name);
+    assert_non_null(strstr(json, strrchr(path, '/') + 1)); /* the image the document names */
+    free(json);
+    path[strlen(path) - 1] = '\0';
+    int pw, ph;
+    uint8_t *rgbd = NULL;
+    lm_error le;
+    assert_int_equal(lm_read_image8(path, &pw, &ph, &rgbd, &le), LM_OK);
+    assert_int_equal(pw, w);
+    assert_int_equal(ph, h);
+    double worst = 0.0;
+    int valid = 0, unit_d = 0;
+    for (int p = 0; p < w * h; p++) {
+        const float *e = lightmap + 4 * (size_t)p;
+        if (e[3] < 0.5f)
+            continue;
+        float got[3], m = fmaxf(e[0], fmaxf(e[1], e[2]));
+        lm_decode_rgbd(rgbd + 4 * (size_t)p, scale, got);
+        for (int c = 0; c < 3; c++)
+            worst = fmax(worst, fabs(got[c] - e[c]) / fmax(m, 0.5 * scale));
+        valid++;
+        unit_d += rgbd[4 * p + 3] == 255;
+    }
+    print_message("RGBD lightmap (scale %g): worst error %.4f of the texel's brightest channel, %.1f%% of %d valid "
+                  "texels with d = 1\n", (double)scale, worst, 100.0 * unit_d / valid, valid);
+    assert_true(worst < 0.007);
+    assert_true(unit_d >= 0.985 * valid);
+    free(rgbd);
+}
+
 static void test_export_and_reload(void **state)
 {
     (void)state;
@@ -135,6 +180,7 @@ static void test_export_and_reload(void **state)
     assert_int_equal(h, sc->atlas.height);
     assert_memory_equal(mine, file, 4 * sizeof(float) * (size_t)w * h);
     free(file);
+    rgbd_holds_the_lightmap(dir, "box", mine, w, h);
 
     snprintf(path, sizeof path, "%s/box.gltf", dir);
     lm_load_options lo = {.strict = 0};

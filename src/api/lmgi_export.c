@@ -28,6 +28,9 @@ typedef struct {
     const lm_atlas *atlas;
     const char *name;
     lm_gltf_doc doc;
+    const float *lightmap;  /* the displayed IIM, atlas-sized RGBA */
+    float rgbd_scale;       /* the RGBD image's values times this are E */
+    int lightmap_texture;   /* its glTF texture, -1 when no triangle has texels */
 } writer;
 
 /* Which uv set a material's textures read: 0, or 2 where the file's base colour texture used TEXCOORD_1
@@ -191,14 +194,17 @@ static void write_nodes(writer *w, const int *mesh_of)
     fputc(']', w->doc.json);
 }
 
-/* Textures: each of the scene's decoded images as NAME_texN.png (8-bit sRGB), one sampler. */
+/* Textures: each of the scene's decoded images as NAME_texN.png (8-bit sRGB) with the default sampler, then
+ * the lightmap's RGBD image with its own: bilinear without mipmaps (a mip would blend charts with their
+ * neighbours), clamped at the atlas's edges. */
 static lm_status write_textures(writer *w, const char *dir, lm_error *err)
 {
     const lm_scene *s = w->s;
-    if (!s->texture_count)
+    if (!s->texture_count && w->lightmap_texture < 0)
         return LM_OK;
     lm_status st = LM_OK;
-    fprintf(w->doc.json, ",\"samplers\":[{}],\"images\":[");
+    fprintf(w->doc.json, ",\"samplers\":[{},{\"magFilter\":9729,\"minFilter\":9729,\"wrapS\":33071,"
+                         "\"wrapT\":33071}],\"images\":[");
     for (int i = 0; i < s->texture_count; i++) {
         fprintf(w->doc.json, "%s{\"uri\":\"%s_tex%d.png\"}", i ? "," : "", w->name, i); /* name checked to be plain */
         const lm_texture *t = &s->textures[i];
@@ -219,9 +225,13 @@ static lm_status write_textures(writer *w, const char *dir, lm_error *err)
         }
         free(px);
     }
+    if (w->lightmap_texture >= 0)
+        fprintf(w->doc.json, "%s{\"uri\":\"%s_lightmap_rgbd.png\"}", s->texture_count ? "," : "", w->name);
     fprintf(w->doc.json, "],\"textures\":[");
     for (int i = 0; i < s->texture_count; i++)
         fprintf(w->doc.json, "%s{\"source\":%d,\"sampler\":0}", i ? "," : "", i);
+    if (w->lightmap_texture >= 0)
+        fprintf(w->doc.json, "%s{\"source\":%d,\"sampler\":1}", s->texture_count ? "," : "", w->lightmap_texture);
     fputc(']', w->doc.json);
     return st;
 }
@@ -235,6 +245,15 @@ static void write_texture_ref(FILE *f, const lm_material *m, int texture)
                    "\"rotation\":%.9g}}", (double)m->uv_offset[0], (double)m->uv_offset[1], (double)m->uv_scale[0],
                 (double)m->uv_scale[1], (double)m->uv_rotation);
     fputc('}', f);
+}
+
+/* Whether any triangle of the material has lightmap texels (a mirror's and glass's have none). */
+static int material_has_lightmap(const writer *w, int material)
+{
+    for (uint32_t t = 0; t < w->s->tri_count; t++)
+        if (w->s->tri_material[t] == material && w->atlas->tri_chart[t] >= 0)
+            return 1;
+    return 0;
 }
 
 static void write_materials(writer *w)
@@ -265,6 +284,10 @@ static void write_materials(writer *w)
             fprintf(w->doc.json, ",\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}", (double)strength);
         if (m->transmission > 0.0f)
             fprintf(w->doc.json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
+        if (w->lightmap_texture >= 0 && material_has_lightmap(w, i)) /* docs/api.md, "The lightmap in engines" */
+            fprintf(w->doc.json, ",\"LMGI_lightmap\":{\"lightmapTexture\":{\"index\":%d,\"texCoord\":1},"
+                    "\"encoding\":\"RGBD\",\"gamma\":%.9g,\"scale\":%.9g}", w->lightmap_texture,
+                    (double)LM_RGBD_GAMMA, (double)w->rgbd_scale);
         fprintf(w->doc.json, "}}");
     }
     fputc(']', w->doc.json);
@@ -306,24 +329,58 @@ static void write_lights_and_cameras(writer *w)
     fputc(']', w->doc.json);
 }
 
-/* The lightmap: the displayed IIM (irradiance, alpha = valid) as EXR, and a tone-mapped PNG preview. */
-static lmgi_status write_lightmap(lmgi_updater *u, const writer *w, const char *dir, int half, lmgi_error *err)
+static int float_order(const void *a, const void *b)
 {
-    size_t n = 4 * (size_t)w->atlas->width * (size_t)w->atlas->height;
-    float *rgba = malloc(n * sizeof *rgba);
-    if (!rgba)
-        return lm_api_refuse(err, "lmgi_export_gltf: no memory for the %d x %d lightmap", w->atlas->width,
-                             w->atlas->height);
-    lmgi_status st = lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, rgba, n, err);
+    float x = *(const float *)a, y = *(const float *)b;
+    return (x > y) - (x < y);
+}
+
+/* The RGBD image's scale: the 99th percentile of the valid texels' brightest channel maps to 1, so 99% of
+ * them are stored with d = 1 (a loader that premultiplies alpha, as a browser's image decoder does, loses
+ * nothing there) and only the brightest 1% use d < 1; never so small that the brightest clamps at RGBD's
+ * 255. 1 for a black lightmap. */
+static float rgbd_scale(const float *rgba, size_t pixels)
+{
+    float *bright = malloc(pixels * sizeof *bright), top = 0.0f;
+    size_t n = 0;
+    for (size_t p = 0; p < pixels; p++) {
+        float m = fmaxf(rgba[4 * p], fmaxf(rgba[4 * p + 1], rgba[4 * p + 2]));
+        top = fmaxf(top, m);
+        if (bright && rgba[4 * p + 3] >= 0.5f)
+            bright[n++] = m;
+    }
+    float p99 = 0.0f;
+    if (n) {
+        qsort(bright, n, sizeof *bright, float_order);
+        p99 = bright[(size_t)(0.99 * (double)(n - 1))];
+    }
+    free(bright);
+    float scale = fmaxf(p99, top / LM_RGBD_RANGE);
+    return scale > 0.0f ? scale : 1.0f;
+}
+
+/* The lightmap: the displayed IIM (irradiance, alpha = valid) as EXR, a tone-mapped PNG preview, and the
+ * RGBD PNG the glTF's materials sample. */
+static lmgi_status write_lightmap(const writer *w, const char *dir, int half, lmgi_error *err)
+{
+    int aw = w->atlas->width, ah = w->atlas->height;
     char path[4200];
     lmgi_image_desc d = {LMGI_TONEMAP_NEUTRAL, 0.0f, half};
     snprintf(path, sizeof path, "%s/%s_lightmap.exr", dir, w->name);
-    if (st == LMGI_OK)
-        st = lmgi_write_image(path, w->atlas->width, w->atlas->height, 4, rgba, &d, err);
+    lmgi_status st = lmgi_write_image(path, aw, ah, 4, w->lightmap, &d, err);
     snprintf(path, sizeof path, "%s/%s_lightmap.png", dir, w->name);
     if (st == LMGI_OK)
-        st = lmgi_write_image(path, w->atlas->width, w->atlas->height, 4, rgba, &d, err);
-    free(rgba);
+        st = lmgi_write_image(path, aw, ah, 4, w->lightmap, &d, err);
+    if (st != LMGI_OK || w->lightmap_texture < 0)
+        return st;
+    uint8_t *rgbd = malloc(4 * (size_t)aw * (size_t)ah);
+    if (!rgbd)
+        return lm_api_refuse(err, "lmgi_export_gltf: no memory for the %d x %d RGBD lightmap", aw, ah);
+    lm_encode_rgbd(w->lightmap, (size_t)aw * (size_t)ah, w->rgbd_scale, rgbd);
+    snprintf(path, sizeof path, "%s/%s_lightmap_rgbd.png", dir, w->name);
+    lm_error e;
+    st = lm_write_png(path, aw, ah, rgbd, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+    free(rgbd);
     return st;
 }
 
@@ -340,9 +397,10 @@ static void write_extensions_used(writer *w)
                      (m->uv_offset[0] != 0.0f || m->uv_offset[1] != 0.0f || m->uv_scale[0] != 1.0f ||
                       m->uv_scale[1] != 1.0f || m->uv_rotation != 0.0f);
     }
-    fprintf(w->doc.json, ",\"extensionsUsed\":[\"KHR_materials_ior\"%s%s%s%s]",
+    fprintf(w->doc.json, ",\"extensionsUsed\":[\"KHR_materials_ior\"%s%s%s%s%s]",
             s->light_count ? ",\"KHR_lights_punctual\"" : "", strength ? ",\"KHR_materials_emissive_strength\"" : "",
-            transmission ? ",\"KHR_materials_transmission\"" : "", transform ? ",\"KHR_texture_transform\"" : "");
+            transmission ? ",\"KHR_materials_transmission\"" : "", transform ? ",\"KHR_texture_transform\"" : "",
+            w->lightmap_texture >= 0 ? ",\"LMGI_lightmap\"" : "");
 }
 
 /* The sky into the document's extras as the loader reads it back (docs/levels.md, "Sky"); an image sky's
@@ -391,9 +449,10 @@ static lm_status write_document(writer *w, const char *dir, lm_error *err)
     snprintf(bin_uri, sizeof bin_uri, "%s.bin", w->name);
     lm_gltf_finish(&w->doc, bin_uri);
     fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"lightmap\":\"%s_lightmap.exr\",\"preview\":\"%s_lightmap.png\","
-                     "\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of indirect light, emissive surfaces "
-                     "and the sky (not the punctual lights' direct light); diffuse radiance = baseColor / pi x E; alpha "
-                     "1 on valid texels\"", w->name, w->name, w->atlas->width, w->atlas->height);
+                     "\"rgbd\":\"%s_lightmap_rgbd.png\",\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of "
+                     "indirect light, emissive surfaces and the sky (not the punctual lights' direct light); diffuse "
+                     "radiance = baseColor / pi x E; alpha 1 on valid texels\"", w->name, w->name, w->name,
+            w->atlas->width, w->atlas->height);
     st = write_sky(w, dir, err);
     fputs("}}}", w->doc.json);
     return st;
@@ -444,7 +503,21 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
         }
     }
     dir = lmgi_output_folder(out);
-    writer w = {.s = sc->scene, .atlas = &sc->atlas, .name = name};
+    writer w = {.s = sc->scene, .atlas = &sc->atlas, .name = name, .lightmap_texture = -1};
+    size_t pixels = (size_t)w.atlas->width * (size_t)w.atlas->height;
+    float *lightmap = malloc(4 * pixels * sizeof *lightmap);
+    lmgi_status st = lightmap ? lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, lightmap, 4 * pixels, err)
+                              : lm_api_refuse(err, "%s: no memory for the %d x %d lightmap", fn, w.atlas->width,
+                                              w.atlas->height);
+    if (st != LMGI_OK) {
+        free(lightmap);
+        lmgi_output_abort(own);
+        return st;
+    }
+    w.lightmap = lightmap;
+    w.rgbd_scale = rgbd_scale(lightmap, pixels);
+    if (w.atlas->texel_count)
+        w.lightmap_texture = w.s->texture_count;
     lm_error e;
     lm_status ls = lm_gltf_open(&w.doc) ? LM_OK : lm_fail(&e, LM_ERR_NOMEM, "export: no memory");
     if (ls == LM_OK)
@@ -463,7 +536,8 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
         ls = lm_write_file(path, json, json_len, &e);
     }
     lm_gltf_close(&w.doc);
-    lmgi_status st = ls == LM_OK ? write_lightmap(u, &w, dir, d.half, err) : lm_export_error(err, &e);
+    st = ls == LM_OK ? write_lightmap(&w, dir, d.half, err) : lm_export_error(err, &e);
+    free(lightmap);
     if (own && st == LMGI_OK)
         return lmgi_output_commit(own, err);
     lmgi_output_abort(own);

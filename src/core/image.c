@@ -191,6 +191,31 @@ float lm_linear_to_srgb(float c)
     return c <= 0.0031308f ? 12.92f * c : 1.055f * powf(c, 1.0f / 2.4f) - 0.055f;
 }
 
+void lm_encode_rgbd(const float *rgba, size_t n, float scale, uint8_t *rgbd8)
+{
+    for (size_t p = 0; p < n; p++) {
+        float x[3], m = 0.0f;
+        for (int c = 0; c < 3; c++) {
+            float v = rgba[4 * p + c] / scale;
+            x[c] = v > 0.0f ? fminf(v, LM_RGBD_RANGE) : 0.0f; /* NaN and negatives: 0 */
+            m = fmaxf(m, x[c]);
+        }
+        /* d: the largest step of 1/255 that keeps x * d <= 1, so the stored colour uses the whole range */
+        float d8 = m > 1.0f ? floorf(LM_RGBD_RANGE / m) : 255.0f;
+        float d = fmaxf(d8, 1.0f) / 255.0f;
+        for (int c = 0; c < 3; c++)
+            rgbd8[4 * p + c] = (uint8_t)lroundf(255.0f * fminf(1.0f, powf(x[c] * d, 1.0f / LM_RGBD_GAMMA)));
+        rgbd8[4 * p + 3] = (uint8_t)fmaxf(d8, 1.0f);
+    }
+}
+
+void lm_decode_rgbd(const uint8_t rgbd8[4], float scale, float rgb[3])
+{
+    float d = (float)rgbd8[3] / 255.0f;
+    for (int c = 0; c < 3; c++)
+        rgb[c] = d > 0.0f ? scale * powf((float)rgbd8[c] / 255.0f, LM_RGBD_GAMMA) / d : 0.0f;
+}
+
 lm_status lm_check_regular_file(const char *path, const char *what, lm_error *err)
 {
     struct stat s; /* by its name first (a socket cannot be opened at all), then as opened, without blocking */

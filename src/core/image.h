@@ -2,6 +2,7 @@
 #ifndef LM_IMAGE_H
 #define LM_IMAGE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 #include "error.h"
@@ -28,6 +29,17 @@ lm_status lm_read_image8(const char *path, int *width, int *height, uint8_t **ou
 /* Linear <-> sRGB transfer (IEC 61966-2-1). */
 float lm_srgb_to_linear(float c);
 float lm_linear_to_srgb(float c);
+/* RGBD, an HDR colour in 8-bit RGBA (the encoding Babylon.js decodes for lightmaps, `isRGBD`): a value x
+ * (linear, >= 0) is stored as rgb = (x * d)^(1/2.2) and a = d, with d = min(255, floor(255 / max(x))) / 255,
+ * so x = rgb^2.2 / a for x up to 255 (above: clamped to 255). Below 1, d = 1 and the 8-bit gamma-2.2 steps
+ * set the precision (x = 0.5: 1.2%, 0.1: 2.5%, 0.01: 7%); above, about 0.5%, unless the reader premultiplies
+ * the colour by alpha on loading (browsers' image decoders do), which costs log2(1/d) bits. Encodes n pixels of
+ * rgba (4 floats each, alpha ignored) divided by `scale` into rgbd8 (4 bytes each). */
+#define LM_RGBD_GAMMA 2.2f
+#define LM_RGBD_RANGE 255.0f
+void lm_encode_rgbd(const float *rgba, size_t n, float scale, uint8_t *rgbd8);
+/* The value an RGBD pixel holds, times scale (the inverse of lm_encode_rgbd up to its rounding). */
+void lm_decode_rgbd(const uint8_t rgbd8[4], float scale, float rgb[3]);
 /* A file a scene names (an image, a buffer, a sky) is read only when it is a regular file: a FIFO blocks
  * its reader until some writer comes (lmgi info hung on one until killed), a device never ends. Opened
  * without blocking and checked by fstat; LM_ERR_IO naming `what`, the path and its kind otherwise. */

@@ -38,6 +38,9 @@ namespace {
 const char *const k_supported_required[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_transmission", "KHR_materials_ior",
                                             "KHR_texture_transform", "EXT_texture_webp"};
+// Optional extensions lmgi knows and has no use for, read without a warning: its own export's lightmap
+// (a scene lmgi loads is lit again, docs/api.md, "The lightmap in engines").
+const char *const k_known_unread[] = {"LMGI_lightmap"};
 const size_t k_max_unbacked_elems = 1u << 24;    // accessors without a bufferView (all zeros)
 const uint32_t k_glb_json = 0x4E4F534Au, k_glb_bin = 0x004E4942u;
 
@@ -510,6 +513,8 @@ lm_status Loader::check_extensions()
     for (const std::string &e : model_.extensionsUsed) {
         bool known = false;
         for (const char *k : k_supported_required)
+            known = known || e == k;
+        for (const char *k : k_known_unread)
             known = known || e == k;
         if (!known)
             ignored += (ignored.empty() ? "" : ", ") + e;
