@@ -111,6 +111,7 @@ install-files:
 	install -m 755 $(BUILD)/lmgi $(DESTDIR)$(PREFIX)/bin/
 	install -d $(DESTDIR)$(PREFIX)/share/lmgi
 	install -m 644 tools/tradeoff_report.py $(DESTDIR)$(PREFIX)/share/lmgi/
+	install -m 644 tools/engines/babylon_lmgi_lightmap.js $(DESTDIR)$(PREFIX)/share/lmgi/
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
 
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a

@@ -4,6 +4,7 @@
 #include "../src/gpu/gl_context.h"
 
 #include <ftw.h>
+#include <limits.h>
 #include <math.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -180,13 +181,7 @@ int lmt_lmgi(const char *shell_prefix, const char *args, char *output, size_t si
     const char *build = getenv("LMGI_BUILD");
     char cmd[4096];
     snprintf(cmd, sizeof cmd, "%s%s/lmgi %s 2>&1", shell_prefix, build ? build : "build", args);
-    FILE *p = popen(cmd, "r");
-    assert_non_null(p);
-    size_t n = fread(output, 1, size - 1, p);
-    output[n] = '\0';
-    int status = pclose(p);
-    assert_true(WIFEXITED(status)); /* never a crash */
-    return WEXITSTATUS(status);
+    return lmt_run(cmd, output, size);
 }
 
 static void float_min_max(const float *p, int count, float mn[3], float mx[3])
@@ -450,3 +445,45 @@ double lmt_mirror_image(double x, double z, int *inside)
 }
 
 double lmt_mirror_fresnel(double albedo, double one_minus_cos) { return albedo + (1.0 - albedo) * pow(one_minus_cos, 5.0); }
+
+const char *lmt_node_modules(const char *package, const char **why)
+{
+    static char abs[PATH_MAX];
+    char dir[PATH_MAX], probe[PATH_MAX + 64];
+    const char *npm = getenv("LMGI_NPM");
+    snprintf(dir, sizeof dir, "%s/node_modules", npm ? npm : "build/npm");
+    snprintf(probe, sizeof probe, "%s/%s/package.json", dir, package);
+    if (system("command -v node > /dev/null 2>&1") != 0) {
+        *why = "node is not installed (Debian: apt-get install nodejs npm)";
+        return NULL;
+    }
+    if (access(probe, R_OK) != 0 || !realpath(dir, abs)) {
+        *why = "the node package is not in build/npm (make test installs it with npm; was the registry reachable?)";
+        return NULL;
+    }
+    return abs;
+}
+
+int lmt_run(const char *cmd, char *out, size_t size)
+{
+    FILE *p = popen(cmd, "r");
+    assert_non_null(p);
+    size_t n = fread(out, 1, size - 1, p);
+    out[n] = '\0';
+    char sink[4096];
+    while (fread(sink, 1, sizeof sink, p) > 0) {
+    }
+    int status = pclose(p);
+    assert_true(WIFEXITED(status));
+    return WEXITSTATUS(status);
+}
+
+void lmt_gltf_validate(const char *modules, const char *gltf)
+{
+    static char out[1 << 16];
+    char cmd[3 * PATH_MAX];
+    snprintf(cmd, sizeof cmd, "node tests/engines/validate.mjs '%s' '%s' 2>&1", modules, gltf);
+    int rc = lmt_run(cmd, out, sizeof out);
+    print_message("%s", out);
+    assert_int_equal(rc, 0);
+}

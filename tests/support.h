@@ -25,6 +25,15 @@ void lmt_base64(const void *data, size_t n, char *out);
  * into output (size bytes, NUL-terminated); asserts it exited rather than crashed and returns its exit
  * status. */
 int lmt_lmgi(const char *shell_prefix, const char *args, char *output, size_t size);
+/* Runs a shell command (its stdout into output, the rest read and dropped); returns its exit status (the
+ * test fails if it did not exit, e.g. crashed). */
+int lmt_run(const char *cmd, char *output, size_t size);
+/* The node packages' folder, absolute (make test installs them into build/npm, or $LMGI_NPM), or NULL with
+ * *why saying what is missing (node, or the package). */
+const char *lmt_node_modules(const char *package, const char **why);
+/* The Khronos glTF validator (tests/engines/validate.mjs) over a .gltf and the files it names: 0 errors, or
+ * the test fails with its report, which is printed either way. */
+void lmt_gltf_validate(const char *node_modules, const char *gltf);
 
 /* Use in a cmocka test: skips (and says so) when the scene is not there. */
 #define LMT_REQUIRE_SCENE(var, path_expr)                                                     \

@@ -13,56 +13,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "../src/core/image.h"
 #include "support.h"
-
-/* The node packages' folder (make test installs them in build/npm), absolute, or NULL with why. */
-static const char *node_modules(const char *package, const char **why)
-{
-    static char abs[PATH_MAX];
-    char dir[PATH_MAX], probe[PATH_MAX + 64];
-    const char *npm = getenv("LMGI_NPM");
-    snprintf(dir, sizeof dir, "%s/node_modules", npm ? npm : "build/npm");
-    snprintf(probe, sizeof probe, "%s/%s/package.json", dir, package);
-    if (system("command -v node > /dev/null 2>&1") != 0) {
-        *why = "node is not installed (Debian: apt-get install nodejs npm)";
-        return NULL;
-    }
-    if (access(probe, R_OK) != 0 || !realpath(dir, abs)) {
-        *why = "the node package is not in build/npm (make test installs it with npm; was the registry reachable?)";
-        return NULL;
-    }
-    return abs;
-}
-
-/* Runs a shell command, its output (stdout and stderr) into out; returns its exit status. */
-static int run(const char *cmd, char *out, size_t size)
-{
-    FILE *p = popen(cmd, "r");
-    assert_non_null(p);
-    size_t n = fread(out, 1, size - 1, p);
-    out[n] = '\0';
-    char sink[4096];
-    while (fread(sink, 1, sizeof sink, p) > 0) {
-    }
-    int status = pclose(p);
-    assert_true(WIFEXITED(status));
-    return WEXITSTATUS(status);
-}
-
-/* The Khronos validator over an export: 0 errors, or the test fails with its report. */
-static void validate(const char *modules, const char *gltf)
-{
-    static char out[1 << 16];
-    char cmd[3 * PATH_MAX];
-    snprintf(cmd, sizeof cmd, "node tests/engines/validate.mjs '%s' '%s' 2>&1", modules, gltf);
-    int rc = run(cmd, out, sizeof out);
-    print_message("%s", out);
-    assert_int_equal(rc, 0);
-}
 
 /* An API call that must succeed, or the test fails with its message. */
 static void ok(lmgi_status st, const lmgi_error *e)
@@ -112,7 +66,7 @@ static void export_to(lmgi_updater *u, const char *name, char *gltf, size_t size
 static void test_exports_validate(void **state)
 {
     (void)state;
-    const char *why = NULL, *modules = node_modules("gltf-validator", &why);
+    const char *why = NULL, *modules = lmt_node_modules("gltf-validator", &why);
     if (!modules) {
         print_message("skipped: %s\n", why);
         skip();
@@ -124,7 +78,7 @@ static void test_exports_validate(void **state)
     lmgi_updater *u = bake(ctx, sc, 20000);
     char gltf[PATH_MAX];
     export_to(u, "baked", gltf, sizeof gltf);
-    validate(modules, gltf);
+    lmt_gltf_validate(modules, gltf);
 
     lmgi_light lamp = {.type = LMGI_LIGHT_SPOT, .color = {1, 0.8f, 0.6f}, .intensity = 4.0f, .enabled = 1,
                        .inner_cone = 0.3f, .outer_cone = 0.5f, .position = {0.2f, 1.5f, 0.1f}, .direction = {0, -1, 0}};
@@ -148,7 +102,7 @@ static void test_exports_validate(void **state)
     ok(lmgi_set_material(sc, 0, &mat, &e), &e);
     ok(lmgi_bake(u, NULL, NULL, &e), &e);
     export_to(u, "edited", gltf, sizeof gltf);
-    validate(modules, gltf);
+    lmt_gltf_validate(modules, gltf);
     lmgi_updater_free(u);
     lmgi_free(sc);
 
@@ -157,7 +111,7 @@ static void test_exports_validate(void **state)
         sc = load(textured, 2000);
         u = bake(ctx, sc, 20000);
         export_to(u, "suzanne", gltf, sizeof gltf);
-        validate(modules, gltf);
+        lmt_gltf_validate(modules, gltf);
         lmgi_updater_free(u);
         lmgi_free(sc);
     } else {
@@ -223,7 +177,7 @@ static uint8_t *babylon_picture(const char *modules, const char *gltf, int w, in
              "--dump-dom 'file://%s?npm=%s&extension=%s&gltf=file://%s&w=%d&h=%d' 2>/dev/null",
              dir, page, modules, extension, gltf, w, h);
     static char dom[1 << 23];
-    int rc = run(cmd, dom, sizeof dom);
+    int rc = lmt_run(cmd, dom, sizeof dom);
     const char *png = strstr(dom, "PNG data:image/png;base64,");
     if (rc != 0 || !png) {
         const char *err = strstr(dom, "ERROR");
@@ -260,7 +214,7 @@ static uint8_t *babylon_picture(const char *modules, const char *gltf, int w, in
 static void test_babylon_draws_the_lightmap(void **state)
 {
     (void)state;
-    const char *why = NULL, *modules = node_modules("babylonjs-loaders", &why);
+    const char *why = NULL, *modules = lmt_node_modules("babylonjs-loaders", &why);
     if (!modules || system("command -v chromium > /dev/null 2>&1") != 0) {
         print_message("skipped: %s\n", modules ? "chromium is not installed (Debian: apt-get install chromium)" : why);
         skip();
@@ -273,7 +227,7 @@ static void test_babylon_draws_the_lightmap(void **state)
     lmgi_updater *u = bake(ctx, sc, 100000);
     char gltf[PATH_MAX];
     export_to(u, "room", gltf, sizeof gltf);
-    validate(modules, gltf);
+    lmt_gltf_validate(modules, gltf);
     lmgi_camera cam;
     assert_int_equal(lmgi_scene_camera(sc, 0, W, H, &cam, &e), LMGI_OK);
     float *mine = malloc(sizeof(float) * 3 * W * H);

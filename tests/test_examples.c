@@ -137,6 +137,12 @@ static void test_editor_session(void **state)
         snprintf(cmd, sizeof cmd, "%s/%s", dir, files[k]);
         assert_true(file_size(cmd) > 1000);
     }
+    const char *why = NULL, *modules = lmt_node_modules("gltf-validator", &why);
+    snprintf(cmd, sizeof cmd, "%s/level.gltf", dir); /* exported after a recolour, a move and an added lamp */
+    if (modules)
+        lmt_gltf_validate(modules, cmd);
+    else
+        print_message("the export is not validated: %s\n", why);
     snprintf(cmd, sizeof cmd, "%s scenes/two_rooms.glb %s --material nothing --texels 500", prog, dir);
     assert_int_equal(sh(cmd), 1);
     assert_non_null(strstr(output, "no material 'nothing'"));
