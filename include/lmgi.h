@@ -376,6 +376,12 @@ typedef struct {
     lmgi_log_level log_level; /* the most detailed level passed on (0: LMGI_LOG_WARN) */
     const char *gl_backend;   /* "auto", "egl" or "osmesa" (NULL: the LMGI_GL environment variable, else
                                * auto: EGL when it gives a hardware renderer, else OSMesa) */
+    void *share_context;      /* the host's GL context to share textures with (lmgi_get_lightmap_texture):
+                               * an EGLContext of desktop OpenGL (EGL_OPENGL_API, any version) with
+                               * share_display its EGLDisplay, or an OSMesaContext with share_display NULL.
+                               * lmgi's context is made on that display in its share group (the backend is
+                               * the host's kind; another named in gl_backend is refused). NULL: none */
+    void *share_display;
 } lmgi_context_desc;
 
 /* Creates the GL context (OpenGL 4.5 core, no window). NULL desc: the defaults; NULL out:
@@ -690,6 +696,17 @@ LMGI_API int lmgi_surface_lightmap_rect(const lmgi_scene *scene, int surface, in
  * engine", has the upload loop and its cost against the whole read. Thread-safety: as the updater's. */
 LMGI_API lmgi_status lmgi_get_lightmap_rect(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba,
                                             size_t floats, lmgi_error *err);
+/* The displayed IIM lightmap as an OpenGL texture (docs/api.md, "The lightmap as a GL texture"): a
+ * GL_TEXTURE_2D name of lmgi's context, atlas-sized, GL_RGBA32F, one level, bilinear, clamped to the edge,
+ * holding what lmgi_get_lightmap(LMGI_LIGHTMAP_IIM) gives, bit for bit (row 0 at t = 0: sample it at the
+ * lightmap's UVs as they are). Each call brings it up to date: the first uploads the whole atlas, later ones
+ * only the rectangles (lmgi_surface_lightmap_rect) of the surfaces whose lmgi_surface_version moved since,
+ * and it returns once the upload is finished (glFinish), so a context sharing with lmgi's may sample it at
+ * once. The name is the same for the updater's life; lmgi deletes it in lmgi_updater_free; the host must
+ * not change or delete it. A host sees it only in a context that shares with lmgi's
+ * (lmgi_context_desc.share_context). NULL u or texture: LMGI_ERR_INVALID; a lightmap with a NaN: as
+ * lmgi_get_lightmap. *texture is 0 on any error. */
+LMGI_API lmgi_status lmgi_get_lightmap_texture(lmgi_updater *u, unsigned *texture, lmgi_error *err);
 
 /* ------------------------------------------------------------------------------------------------------
  * Reference: the converged answer every error figure is measured against (docs/reference.md): Monte

@@ -45,6 +45,7 @@ struct host {
     EGLDisplay egl_dpy;
     EGLContext egl_ctx;
     EGLSurface egl_surf;
+    EGLenum egl_api; /* OpenGL ES, as hosts usually are, or desktop OpenGL (lmgi can share only with this) */
     /* GLX */
     Display *x_dpy;
     GLXContext glx_ctx;
@@ -136,14 +137,14 @@ static int osmesa_host(host *h)
     return 1;
 }
 
-/* ---- EGL: OpenGL ES on a pbuffer, the bound API left at OpenGL ES ---- */
+/* ---- EGL: OpenGL ES (or desktop OpenGL) on a pbuffer, the bound API left at it ---- */
 
 
 static int egl_current(const host *h)
 {
     return eglGetCurrentContext() == h->egl_ctx && eglGetCurrentDisplay() == h->egl_dpy &&
            eglGetCurrentSurface(EGL_DRAW) == h->egl_surf && eglGetCurrentSurface(EGL_READ) == h->egl_surf &&
-           eglQueryAPI() == EGL_OPENGL_ES_API;
+           eglQueryAPI() == h->egl_api;
 }
 
 /* Mesa's surfaceless platform, else the first EGL device (NVIDIA's driver has no surfaceless platform). */
@@ -161,14 +162,16 @@ static EGLDisplay egl_host_display(void)
     return dpy != EGL_NO_DISPLAY && eglInitialize(dpy, NULL, NULL) ? dpy : EGL_NO_DISPLAY;
 }
 
-static int egl_host(host *h)
+static int egl_host(host *h, EGLenum api)
 {
     h->egl_dpy = egl_host_display();
-    if (h->egl_dpy == EGL_NO_DISPLAY || !eglBindAPI(EGL_OPENGL_ES_API))
+    h->egl_api = api;
+    if (h->egl_dpy == EGL_NO_DISPLAY || !eglBindAPI(api))
         return 0;
-    const EGLint attribs[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES2_BIT, EGL_SURFACE_TYPE, EGL_PBUFFER_BIT,
-                              EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8, EGL_BLUE_SIZE, 8, EGL_NONE};
-    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 2, EGL_NONE};
+    const EGLint attribs[] = {EGL_RENDERABLE_TYPE, api == EGL_OPENGL_API ? EGL_OPENGL_BIT : EGL_OPENGL_ES2_BIT,
+                              EGL_SURFACE_TYPE, EGL_PBUFFER_BIT, EGL_RED_SIZE, 8, EGL_GREEN_SIZE, 8,
+                              EGL_BLUE_SIZE, 8, EGL_NONE};
+    const EGLint ctx_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, api == EGL_OPENGL_API ? 3 : 2, EGL_NONE};
     const EGLint pb_attribs[] = {EGL_WIDTH, 8, EGL_HEIGHT, 8, EGL_NONE};
     EGLConfig config;
     EGLint n = 0;
@@ -385,7 +388,7 @@ static void test_egl_host(void **state)
 {
     (void)state;
     host h = {.name = "EGL (OpenGL ES)"};
-    int made = egl_host(&h);
+    int made = egl_host(&h, EGL_OPENGL_ES_API);
     if (!made)
         print_message("skipped: no EGL OpenGL ES context on a pbuffer here (surfaceless platform or device)\n");
     guest_of(&h, made);
@@ -398,6 +401,134 @@ static void test_glx_host(void **state)
     guest_of(&h, glx_host(&h)); /* glx_host says why when it cannot */
 }
 
+/* ---- sharing: the lightmap as a texture the host's own context samples ---- */
+
+typedef void (*bind_texture_fn)(unsigned, unsigned);
+typedef void (*get_tex_image_fn)(unsigned, int, unsigned, unsigned, void *);
+
+/* The host reads lmgi's texture in its own context: the same floats as lmgi_get_lightmap, bit for bit;
+ * returns them (the caller frees). */
+static float *host_sees_lightmap(const host *h, lmgi_updater *u, unsigned tex, int w, int ht)
+{
+    bind_texture_fn bind = (bind_texture_fn)h->get_proc("glBindTexture");
+    get_tex_image_fn get = (get_tex_image_fn)h->get_proc("glGetTexImage");
+    assert_true(bind && get);
+    size_t n = 4 * (size_t)w * ht;
+    float *mine = malloc(n * sizeof *mine), *theirs = malloc(n * sizeof *theirs);
+    assert_true(mine && theirs);
+    lmgi_error e;
+    MUST(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, mine, n, &e), "lmgi_get_lightmap");
+    memset(theirs, 0xff, n * sizeof *theirs);
+    bind(GL_TEXTURE_2D, tex);
+    get(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, theirs);
+    bind(GL_TEXTURE_2D, 0);
+    assert_memory_equal(mine, theirs, n * sizeof *mine);
+    free(theirs);
+    return mine;
+}
+
+/* lmgi's context made in the host's share group: lmgi_get_lightmap_texture's name, bound in the host's
+ * context, holds the lightmap, and after a cube moved and updates changed some surfaces, the next call
+ * (the same name) holds the new one; the host's context stays current throughout. */
+static void shares_texture(host *h, int made, void *share_display, void *share_context)
+{
+    if (!made) {
+        host_free(h);
+        skip();
+    }
+    const char *backend = share_display ? "egl" : "osmesa";
+    lmgi_error e;
+    lmgi_context_desc cd = {.share_context = share_context, .share_display = share_display};
+    lmgi_context *ctx = NULL;
+    MUST(lmgi_context_create(&cd, &ctx, &e), "lmgi_context_create sharing the host's");
+    print_message("%s host shares with %s\n", h->name, lmgi_context_gl_description(ctx));
+    CHECK_HOST(h, "lmgi_context_create");
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 800;
+    lmgi_scene *sc = NULL;
+    MUST(lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e), "lmgi_load");
+    lmgi_updater_desc d = {.photons = 4000, .hemicube_resolution = 16, .rim_samples = 8, .emitter_rays = 4,
+                           .reflection_size = 16, .frame_width = 24, .frame_height = 24, .texels_per_frame = 400};
+    lmgi_updater *u = NULL;
+    MUST(lmgi_updater_create(ctx, sc, &d, &u, &e), "lmgi_updater_create");
+    lmgi_info info;
+    lmgi_get_info(sc, &info);
+    unsigned tex = 0, again = 0;
+    MUST(lmgi_get_lightmap_texture(u, &tex, &e), "lmgi_get_lightmap_texture");
+    CHECK_HOST(h, "lmgi_get_lightmap_texture");
+    assert_true(tex != 0);
+    float *first = host_sees_lightmap(h, u, tex, info.atlas_width, info.atlas_height);
+
+    int surfaces = lmgi_surface_count(sc), moved = 0;
+    uint32_t *before = malloc(sizeof *before * (size_t)surfaces);
+    assert_non_null(before);
+    for (int s = 0; s < surfaces; s++)
+        before[s] = lmgi_surface_version(u, s);
+    int cube = lmgi_find_node(sc, "dynamic_cube");
+    float m[16];
+    assert_true(cube >= 0 && lmgi_get_node_transform(sc, cube, m));
+    m[12] += 0.15f;
+    MUST(lmgi_set_node_transform(sc, cube, m, &e), "lmgi_set_node_transform");
+    for (int i = 0; i < 4; i++)
+        MUST(lmgi_update(u, 0.0f, 0.0f, NULL, &e), "lmgi_update");
+    for (int s = 0; s < surfaces; s++)
+        moved += lmgi_surface_version(u, s) != before[s];
+    print_message("after the move: %d of %d surfaces changed\n", moved, surfaces);
+    assert_true(moved > 0 && moved < surfaces); /* some rectangles, not the whole atlas */
+    free(before);
+    MUST(lmgi_get_lightmap_texture(u, &again, &e), "lmgi_get_lightmap_texture");
+    CHECK_HOST(h, "lmgi_get_lightmap_texture");
+    assert_int_equal(again, tex);
+    float *second = host_sees_lightmap(h, u, tex, info.atlas_width, info.atlas_height);
+    assert_true(memcmp(first, second, 4 * sizeof(float) * (size_t)info.atlas_width * info.atlas_height) != 0);
+    free(first);
+    free(second);
+    assert_int_equal(lmgi_get_lightmap_texture(u, NULL, &e), LMGI_ERR_INVALID);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+    CHECK_HOST(h, "lmgi_context_free");
+    host_draws(h);
+    host_free(h);
+}
+
+static void test_osmesa_host_shares_texture(void **state)
+{
+    (void)state;
+    host h = {.name = "OSMesa"};
+    int made = osmesa_host(&h);
+    if (!made)
+        print_message("skipped: no libOSMesa.so.8 here\n");
+    shares_texture(&h, made, NULL, h.osmesa);
+}
+
+static void test_egl_host_shares_texture(void **state)
+{
+    (void)state;
+    host h = {.name = "EGL (OpenGL)"};
+    int made = egl_host(&h, EGL_OPENGL_API);
+    if (!made)
+        print_message("skipped: no EGL desktop OpenGL context on a pbuffer here\n");
+    shares_texture(&h, made, h.egl_dpy, h.egl_ctx);
+}
+
+/* A context cannot share with a host's of another kind, or with a display and no context. */
+static void test_share_refused(void **state)
+{
+    (void)state;
+    int dummy;
+    lmgi_error e;
+    lmgi_context *ctx = NULL;
+    lmgi_context_desc cd = {.share_display = &dummy};
+    assert_int_equal(lmgi_context_create(&cd, &ctx, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "share_context is NULL"));
+    lmgi_context_desc osmesa_display = {.gl_backend = "osmesa", .share_display = &dummy, .share_context = &dummy};
+    assert_int_equal(lmgi_context_create(&osmesa_display, &ctx, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "cannot share the host's EGL context"));
+    assert_null(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -405,6 +536,9 @@ int main(void)
         cmocka_unit_test(test_osmesa_host),
         cmocka_unit_test(test_egl_host),
         cmocka_unit_test(test_glx_host),
+        cmocka_unit_test(test_osmesa_host_shares_texture),
+        cmocka_unit_test(test_egl_host_shares_texture),
+        cmocka_unit_test(test_share_refused),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -65,6 +65,10 @@ lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **ou
                 (int)d.log_level);
         return lm_export_error(err, &e);
     }
+    if (d.share_display && !d.share_context) {
+        lm_fail(&e, LM_ERR_INVALID, "lmgi_context_create: share_display is set but share_context is NULL");
+        return lm_export_error(err, &e);
+    }
     lmgi_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return lm_export_error(err, &(lm_error){LM_ERR_NOMEM, "no memory for a context"});
@@ -72,7 +76,9 @@ lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **ou
     ctx->desc.gl_backend = NULL; /* the caller's string need not outlive the call */
     lm_log_target saved = lm_api_enter(ctx);
     lm_gl_guest_enter();
-    lm_status st = lm_gl_context_create_backend(d.gl_backend, &ctx->gl, &e);
+    lm_gl_share share = {d.share_display, d.share_context};
+    lm_status st = d.share_context ? lm_gl_context_create_backend(d.gl_backend, &share, &ctx->gl, &e)
+                                   : lm_gl_context_create_backend(d.gl_backend, NULL, &ctx->gl, &e);
     lm_gl_guest_leave();
     lm_api_leave(saved);
     if (st != LM_OK) {

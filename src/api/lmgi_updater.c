@@ -29,6 +29,7 @@ struct lmgi_updater {
     int costs;                  /* samples taken (the window holds the last min(costs, COST_WINDOW)) */
     lm_photon_stage_frame setup;
     double t_setup_gather;
+    lm_lightmap_texture *texture; /* lmgi_get_lightmap_texture's, once asked for */
 };
 
 /* A desc field: 0 keeps the default, a value in [lo, hi] replaces it, anything else is refused. */
@@ -326,6 +327,7 @@ void lmgi_updater_free(lmgi_updater *u)
     lmgi_context *ctx = u->ctx;
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_gl_make_current(u->ctx->gl, NULL); /* the loop's GL objects are deleted in its context */
+    lm_lightmap_texture_free(u->texture);
     lm_frame_loop_free(u->loop);
     lm_api_leave(saved);
     u->ctx->updaters--;
@@ -334,6 +336,8 @@ void lmgi_updater_free(lmgi_updater *u)
     free(u);
     lm_api_release(ctx);
 }
+
+lm_lightmap_texture **lm_updater_texture(lmgi_updater *u) { return &u->texture; }
 
 lm_gather_scheme lm_updater_gather_scheme(const lmgi_updater *u)
 {

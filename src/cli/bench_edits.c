@@ -17,18 +17,21 @@
 static void report_reads(const lm_edit_script *s, const lm_edit_frame *rows)
 {
     double *whole = malloc(sizeof *whole * (size_t)s->frames), *rects = malloc(sizeof *rects * (size_t)s->frames);
-    double *texels = malloc(sizeof *texels * (size_t)s->frames);
+    double *texels = malloc(sizeof *texels * (size_t)s->frames), *tex = malloc(sizeof *tex * (size_t)s->frames);
     int n = 0;
-    for (int f = 0; whole && rects && texels && f < s->frames; f++)
+    for (int f = 0; whole && rects && texels && tex && f < s->frames; f++)
         if (rows[f].rect_texels > 0)
-            whole[n] = rows[f].ms_read_whole, rects[n] = rows[f].ms_read_rects, texels[n++] = rows[f].rect_texels;
+            whole[n] = rows[f].ms_read_whole, rects[n] = rows[f].ms_read_rects, tex[n] = rows[f].ms_texture,
+            texels[n++] = rows[f].rect_texels;
     if (n > 0)
         printf("lightmap reads after the %d updates that changed surfaces: whole atlas median %.3f ms, the changed "
-               "surfaces' rectangles median %.3f ms (%.0f texels, median)\n", n, lm_cli_quantile(whole, n, 0.5),
-               lm_cli_quantile(rects, n, 0.5), lm_cli_quantile(texels, n, 0.5));
+               "surfaces' rectangles median %.3f ms (%.0f texels, median), into lmgi's GL texture median %.3f ms\n",
+               n, lm_cli_quantile(whole, n, 0.5), lm_cli_quantile(rects, n, 0.5), lm_cli_quantile(texels, n, 0.5),
+               lm_cli_quantile(tex, n, 0.5));
     free(whole);
     free(rects);
     free(texels);
+    free(tex);
 }
 
 static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_frame *rows)
@@ -90,10 +93,11 @@ static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_f
         for (int f = 0; f < s->frames; f++)
             fprintf(json, "    {\"ms\": %.3f, \"photons_ms\": %.3f, \"gather_ms\": %.3f, \"blend_ms\": %.3f, "
                     "\"texels\": %u, \"photons\": %u, \"aim_surfaces\": %d, \"surfaces_changed\": %d, "
-                    "\"error\": %.5f, \"read_whole_ms\": %.3f, \"read_rects_ms\": %.3f, \"rect_texels\": %u}%s\n",
+                    "\"error\": %.5f, \"read_whole_ms\": %.3f, \"read_rects_ms\": %.3f, \"rect_texels\": %u, "
+                    "\"texture_ms\": %.3f}%s\n",
                     rows[f].ms_total, rows[f].ms_photons, rows[f].ms_gather, rows[f].ms_blend,
                     rows[f].texels, rows[f].photons, rows[f].aim, rows[f].changed, rows[f].error,
-                    rows[f].ms_read_whole, rows[f].ms_read_rects, rows[f].rect_texels,
+                    rows[f].ms_read_whole, rows[f].ms_read_rects, rows[f].rect_texels, rows[f].ms_texture,
                     f + 1 < s->frames ? "," : "");
         fprintf(json, "  ]\n}\n");
     }

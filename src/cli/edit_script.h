@@ -46,6 +46,8 @@ typedef struct {
     double ms_read_rects;  /* the same by the rectangles of the surfaces this update changed alone
                             * (lmgi_surface_lightmap_rect, lmgi_get_lightmap_rect) */
     uint32_t rect_texels;  /* the texels those rectangles hold */
+    double ms_texture;     /* the same into lmgi's GL texture (lmgi_get_lightmap_texture: the rectangles read,
+                            * uploaded, and glFinish) */
 } lm_edit_frame;
 
 /* A play's frame check: after every update from the first edit on, the updater's picture from the scene's

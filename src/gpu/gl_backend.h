@@ -8,8 +8,9 @@
 
 /* OSMesa (gl_context_osmesa.c): Mesa llvmpipe, drawing into a 1x1 dummy buffer. */
 typedef struct lm_gl_osmesa lm_gl_osmesa;
-/* Creates the context and makes it current on the calling thread. */
-lm_status lm_gl_osmesa_create(lm_gl_osmesa **out, lm_error *err);
+/* Creates the context (in share's share group unless it is NULL) and makes it current on the calling
+ * thread. */
+lm_status lm_gl_osmesa_create(void *share, lm_gl_osmesa **out, lm_error *err);
 lm_status lm_gl_osmesa_make_current(lm_gl_osmesa *o, lm_error *err);
 /* Leaves the calling thread with no OSMesa context current. */
 void lm_gl_osmesa_release_current(void);
@@ -19,8 +20,9 @@ lm_gl_proc lm_gl_osmesa_get_proc(const char *name);
 /* EGL (gl_context_egl.c): a device display (EGL_EXT_platform_device, hardware devices first), else
  * Mesa's surfaceless platform, else the default display; current without a surface or on a 1x1 pbuffer. */
 typedef struct lm_gl_egl lm_gl_egl;
-/* Creates the context and makes it current on the calling thread; every failure names its step. */
-lm_status lm_gl_egl_create(lm_gl_egl **out, lm_error *err);
+/* Creates the context and makes it current on the calling thread; every failure names its step. With a
+ * share, only the share's display is tried, and the context joins the share context's group. */
+lm_status lm_gl_egl_create(const lm_gl_share *share, lm_gl_egl **out, lm_error *err);
 lm_status lm_gl_egl_make_current(lm_gl_egl *e, lm_error *err);
 /* Leaves the calling thread with no EGL context current. */
 void lm_gl_egl_release_current(void);

@@ -107,16 +107,16 @@ void lm_gl_guest_leave(void)
 }
 
 /* Creates the backend's context, makes it current, loads the function table and checks for GL 4.5. */
-static lm_status open_backend(lm_gl_context *ctx, lm_gl_backend backend, lm_error *err)
+static lm_status open_backend(lm_gl_context *ctx, lm_gl_backend backend, const lm_gl_share *share, lm_error *err)
 {
     ctx->backend = backend;
     take_thread_from_host();
     release_other_backend(ctx);
     lm_status st;
     if (backend == LM_GL_BACKEND_EGL)
-        st = lm_gl_egl_create(&ctx->egl, err);
+        st = lm_gl_egl_create(share, &ctx->egl, err);
     else
-        st = lm_gl_osmesa_create(&ctx->osmesa, err);
+        st = lm_gl_osmesa_create(share ? share->context : NULL, &ctx->osmesa, err);
     if (st != LM_OK)
         return st;
     set_current(ctx);
@@ -166,7 +166,7 @@ static lm_status open_auto(lm_gl_context *ctx, char *why, size_t why_size, lm_er
     int skip = g_auto_skip_egl;
     if (!skip) {
         lm_error egl_err;
-        if (open_backend(ctx, LM_GL_BACKEND_EGL, &egl_err) != LM_OK) {
+        if (open_backend(ctx, LM_GL_BACKEND_EGL, NULL, &egl_err) != LM_OK) {
             join_cut(g_auto_reason, sizeof g_auto_reason, "EGL failed: ", egl_err.msg);
             g_auto_skip_egl = skip = 1;
         } else if (is_software_renderer(gl_string(GL_RENDERER))) {
@@ -179,18 +179,26 @@ static lm_status open_auto(lm_gl_context *ctx, char *why, size_t why_size, lm_er
     pthread_mutex_unlock(&g_auto_lock);
     if (!skip)
         return LM_OK;
-    return open_backend(ctx, LM_GL_BACKEND_OSMESA, err);
+    return open_backend(ctx, LM_GL_BACKEND_OSMESA, NULL, err);
 }
 
-lm_status lm_gl_context_create_backend(const char *backend, lm_gl_context **out, lm_error *err)
+lm_status lm_gl_context_create_backend(const char *backend, const lm_gl_share *share, lm_gl_context **out,
+                                       lm_error *err)
 {
     *out = NULL;
-    const char *choice = backend && *backend ? backend : getenv("LMGI_GL");
+    const char *choice = backend && *backend ? backend : share ? NULL : getenv("LMGI_GL");
     if (!choice || !*choice)
         choice = "auto";
     if (strcmp(choice, "auto") && strcmp(choice, "egl") && strcmp(choice, "osmesa"))
         return lm_fail(err, LM_ERR_INVALID, "%s%s is not a GL backend; use auto (the default), egl or osmesa",
                        backend && *backend ? "" : "LMGI_GL=", choice);
+    if (share) { /* the host's kind decides */
+        const char *kind = share->display ? "egl" : "osmesa";
+        if (strcmp(choice, "auto") && strcmp(choice, kind))
+            return lm_fail(err, LM_ERR_INVALID, "the GL backend %s cannot share the host's %s context (%s)", choice,
+                           share->display ? "EGL" : "OSMesa", share->display ? "a display was given" : "no display");
+        choice = kind;
+    }
     lm_gl_context *ctx = calloc(1, sizeof *ctx);
     if (!ctx)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for a GL context");
@@ -199,8 +207,9 @@ lm_status lm_gl_context_create_backend(const char *backend, lm_gl_context **out,
     if (!strcmp(choice, "auto")) {
         st = open_auto(ctx, why, sizeof why, err);
     } else {
-        snprintf(why, sizeof why, "%s%s", backend && *backend ? "asked for " : "LMGI_GL=", choice);
-        st = open_backend(ctx, strcmp(choice, "egl") ? LM_GL_BACKEND_OSMESA : LM_GL_BACKEND_EGL, err);
+        snprintf(why, sizeof why, "%s%s", share ? "sharing the host's " : backend && *backend ? "asked for " : "LMGI_GL=",
+                 choice);
+        st = open_backend(ctx, strcmp(choice, "egl") ? LM_GL_BACKEND_OSMESA : LM_GL_BACKEND_EGL, share, err);
     }
     if (st != LM_OK) {
         free(ctx);
@@ -219,7 +228,7 @@ lm_status lm_gl_context_create_backend(const char *backend, lm_gl_context **out,
 
 lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err)
 {
-    return lm_gl_context_create_backend(NULL, out, err);
+    return lm_gl_context_create_backend(NULL, NULL, out, err);
 }
 
 void lm_gl_context_destroy(lm_gl_context *ctx)

@@ -17,8 +17,17 @@ typedef struct lm_gl_context lm_gl_context;
 
 /* Creates a GL >= 4.5 core context and makes it current on the calling thread. */
 lm_status lm_gl_context_create(lm_gl_context **out, lm_error *err);
-/* The same with the backend named ("auto", "egl", "osmesa"; NULL or "": LMGI_GL decides). */
-lm_status lm_gl_context_create_backend(const char *backend, lm_gl_context **out, lm_error *err);
+/* A host's context to share objects (textures) with: an EGLContext of desktop OpenGL with its EGLDisplay,
+ * or an OSMesaContext (display NULL). The new context is made on that display, in that context's share
+ * group, so a texture lmgi makes is a name the host's context can bind. */
+typedef struct {
+    void *display, *context;
+} lm_gl_share;
+/* The same with the backend named ("auto", "egl", "osmesa"; NULL or "": LMGI_GL decides) and, unless
+ * share is NULL, sharing with a host's context: then the backend is the share's kind (EGL with a display,
+ * OSMesa without), and a backend named otherwise is refused (LM_ERR_INVALID). */
+lm_status lm_gl_context_create_backend(const char *backend, const lm_gl_share *share, lm_gl_context **out,
+                                       lm_error *err);
 void lm_gl_context_destroy(lm_gl_context *ctx);
 lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err);
 lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx);

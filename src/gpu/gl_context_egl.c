@@ -60,7 +60,7 @@ static int has_extension(const char *list, const char *name)
  * would end every other context on the same display and unload the driver, only for the next context to
  * load it again. */
 
-static lm_status try_display(lm_gl_egl *e, EGLDisplay dpy, lm_error *err)
+static lm_status try_display(lm_gl_egl *e, EGLDisplay dpy, EGLContext share, lm_error *err)
 {
     if (dpy == EGL_NO_DISPLAY)
         return egl_fail(err, e->where, "getting the display");
@@ -93,9 +93,10 @@ static lm_status try_display(lm_gl_egl *e, EGLDisplay dpy, lm_error *err)
         EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
         EGL_NONE,
     };
-    e->ctx = eglCreateContext(dpy, config, EGL_NO_CONTEXT, context_attribs);
-    if (e->ctx == EGL_NO_CONTEXT)
-        return egl_fail(err, e->where, "eglCreateContext (OpenGL 4.5 core)");
+    e->ctx = eglCreateContext(dpy, config, share, context_attribs);
+    if (e->ctx == EGL_NO_CONTEXT) /* sharing: EGL_BAD_MATCH when the host's is OpenGL ES */
+        return egl_fail(err, e->where, share != EGL_NO_CONTEXT ? "eglCreateContext (OpenGL 4.5 core, sharing "
+                        "with the host's context, which must be desktop OpenGL)" : "eglCreateContext (OpenGL 4.5 core)");
 
     if (!has_extension(eglQueryString(dpy, EGL_EXTENSIONS), "EGL_KHR_surfaceless_context")) {
         EGLint surface_type = 0;
@@ -198,7 +199,7 @@ static int all_candidates(candidate *out)
 
 /* --- the interface --------------------------------------------------------------------------------- */
 
-lm_status lm_gl_egl_create(lm_gl_egl **out, lm_error *err)
+lm_status lm_gl_egl_create(const lm_gl_share *share, lm_gl_egl **out, lm_error *err)
 {
     *out = NULL;
     lm_gl_egl *e = calloc(1, sizeof *e);
@@ -209,13 +210,20 @@ lm_status lm_gl_egl_create(lm_gl_egl **out, lm_error *err)
     e->surf = EGL_NO_SURFACE;
 
     candidate cands[MAX_CANDIDATES];
-    int count = all_candidates(cands);
+    int count = 1;
+    if (share) { /* the host's display, which the host initialized */
+        cands[0].dpy = (EGLDisplay)share->display;
+        snprintf(cands[0].where, sizeof cands[0].where, "the host's display");
+    } else {
+        count = all_candidates(cands);
+    }
+    EGLContext share_ctx = share ? (EGLContext)share->context : EGL_NO_CONTEXT;
     char tried[sizeof err->msg] = "";
     size_t used = 0;
     for (int i = 0; i < count; i++) {
         lm_error one;
         memcpy(e->where, cands[i].where, sizeof e->where);
-        if (try_display(e, cands[i].dpy, &one) == LM_OK) {
+        if (try_display(e, cands[i].dpy, share_ctx, &one) == LM_OK) {
             *out = e;
             return LM_OK;
         }

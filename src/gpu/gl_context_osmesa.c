@@ -60,7 +60,7 @@ struct lm_gl_osmesa {
     unsigned char dummy[4 * 4];
 };
 
-lm_status lm_gl_osmesa_create(lm_gl_osmesa **out, lm_error *err)
+lm_status lm_gl_osmesa_create(void *share, lm_gl_osmesa **out, lm_error *err)
 {
     *out = NULL;
     if (!loaded())
@@ -77,11 +77,11 @@ lm_status lm_gl_osmesa_create(lm_gl_osmesa **out, lm_error *err)
         OSMESA_CONTEXT_MINOR_VERSION, 5,
         0,
     };
-    o->ctx = g_os.create(attribs, NULL);
+    o->ctx = g_os.create(attribs, (OSMesaContext)share);
     if (!o->ctx) {
         free(o);
-        return lm_fail(err, LM_ERR_BACKEND, "OSMesa could not create an OpenGL 4.5 core context "
-                       "(is libosmesa6 from Mesa >= 20 installed?)");
+        return lm_fail(err, LM_ERR_BACKEND, "OSMesa could not create an OpenGL 4.5 core context%s "
+                       "(is libosmesa6 from Mesa >= 20 installed?)", share ? " sharing with the host's" : "");
     }
     lm_status st = lm_gl_osmesa_make_current(o, err);
     if (st != LM_OK) {
