@@ -512,6 +512,17 @@ typedef struct {
     const char *checkpoint;
     double checkpoint_seconds;
     int resume;
+    /* a bake spread over processes or machines (docs/levels.md, "A bake in shards"): shards > 0 (at most
+     * 4096) makes the first full solution gather only share `shard` (0 to shards - 1) of its texels, into
+     * the checkpoint file (needed), which holds that share when the call returns: a part. The updater's
+     * lightmap is then incomplete: keep the part and free it. parts (part_count files, each a part of
+     * every share made by the same scene and settings) instead make the first full solution from their
+     * texels put together: the same bits as one process's. A part of another scene or other settings, two
+     * parts with the same texels, a share no part holds, an unfinished part, shard out of range, shards
+     * without a checkpoint, or parts with shards or resume: LMGI_ERR_INVALID naming it. */
+    int shard, shards;
+    const char *const *parts;
+    int part_count;
 } lmgi_updater_desc;
 
 /* What one lmgi_update did and what it cost (milliseconds). With the photon work on a second thread

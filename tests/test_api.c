@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <time.h>
 
 #include "support.h"
@@ -1053,6 +1054,73 @@ static void test_second_thread_refused(void **state)
     close_all(u, first, ctx);
 }
 
+/* The gather's first progress report cancels it (a shard with two passes or more stops after one). */
+static void cancel_in_gather(void *user, float fraction, const char *stage)
+{
+    if (!strcmp(stage, "gather") && fraction > 0.0f && fraction < 1.0f)
+        *(volatile int *)user = 1;
+}
+
+/* A shard's bake is a bake like any other: cancelled, its checkpoint keeps what it finished and a resume
+ * of the same shard ends with the same part, byte for byte, as a shard that never stopped; a resume as
+ * another shard is refused, naming both; the desc's shard fields are checked. */
+static void test_shard_cancelled_and_resumed(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = new_context();
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 8000;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    char straight[512], stopped[512];
+    const char *dir = lmt_tmpdir();
+    snprintf(straight, sizeof straight, "%s/straight.part", dir);
+    snprintf(stopped, sizeof stopped, "%s/stopped.part", dir);
+    lmgi_updater_desc d = {.photons = 6000, .shard = 0, .shards = 2, .checkpoint = straight};
+    lmgi_updater *u = make_updater(ctx, sc, &d);
+    lmgi_updater_free(u);
+
+    volatile int cancel = 0;
+    d.checkpoint = stopped;
+    d.cancel = &cancel;
+    d.progress = cancel_in_gather;
+    d.progress_user = (void *)&cancel;
+    u = NULL;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_CANCELLED);
+    assert_null(u);
+    assert_int_equal(access(stopped, R_OK), 0);
+    cancel = 0;
+    d.progress = NULL;
+    d.resume = 1;
+    d.shard = 1;
+    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID);
+    assert_non_null(strstr(e.message, "a checkpoint of shard 1 of 2, not of this bake's shard 2 of 2"));
+    d.shard = 0;
+    u = make_updater(ctx, sc, &d);
+    lmgi_updater_free(u);
+    size_t na, nb;
+    unsigned char *a = lmt_read_file(straight, &na, 0), *b = lmt_read_file(stopped, &nb, 0);
+    assert_true(na == nb && memcmp(a, b, na) == 0);
+    free(a);
+    free(b);
+
+    lmgi_updater_desc bad = {.shard = 2, .shards = 2, .checkpoint = straight};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "shard 2 of 2");
+    bad = (lmgi_updater_desc){.shard = 0, .shards = 2};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "needs a checkpoint file");
+    const char *const parts[1] = {straight};
+    bad = (lmgi_updater_desc){.parts = parts, .part_count = 1, .shards = 2, .checkpoint = straight};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "not with a shard");
+    bad = (lmgi_updater_desc){.parts = parts, .part_count = 0};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "parts given with part_count 0");
+    bad = (lmgi_updater_desc){.photons = 6000, .parts = parts, .part_count = 1};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "shard 2 of 2 is missing");
+    close_all(NULL, sc, ctx);
+}
+
 static void test_exported_symbols(void **state)
 {
     (void)state;
@@ -1101,6 +1169,7 @@ int main(void)
         cmocka_unit_test(test_write_image),
         cmocka_unit_test(test_scene_from_arrays),
         cmocka_unit_test(test_second_thread_refused),
+        cmocka_unit_test(test_shard_cancelled_and_resumed),
         cmocka_unit_test(test_exported_symbols),
     };
     lmgi_set_verbosity(0); /* the refusals below log errors on purpose */

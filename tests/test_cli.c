@@ -65,14 +65,16 @@ static int help_options(const char *text, char names[][48], char commands[][160]
 static void test_command_help(void **state)
 {
     (void)state;
-    static const char *const cmds[] = {"info", "charts", "run", "bake", "check", "reference", "bench", "tradeoff"};
+    static const char *const cmds[] = {"info",  "charts", "run",   "bake",    "merge",
+                                       "check", "reference", "bench", "tradeoff"};
+    const int ncmds = (int)(sizeof cmds / sizeof *cmds);
     static char all[1 << 16], mine[1 << 16], names[128][48], lists[128][160], my_names[128][48], unused[128][160];
     assert_int_equal(run("help"), 0);
     snprintf(all, sizeof all, "%s", output);
     int n = help_options(all, names, lists, 128);
     assert_true(n > 60);
     int taken_total = 0;
-    for (int c = 0; c < 8; c++) {
+    for (int c = 0; c < ncmds; c++) {
         char args[256];
         snprintf(args, sizeof args, "%s --help", cmds[c]);
         assert_int_equal(run(args), 0);
@@ -102,9 +104,10 @@ static void test_command_help(void **state)
             taken_total += takes;
         }
     }
-    print_message("%d options, %d of them taken by each command on average\n", n, taken_total / 8);
+    print_message("%d options, %d of them taken by each command on average\n", n, taken_total / ncmds);
     assert_int_equal(run("info scenes/cornell.glb --hemicube 8"), 2);
-    assert_non_null(strstr(output, "'--hemicube' is not an option of 'info' (it is one of run, bake, check and bench"));
+    assert_non_null(
+        strstr(output, "'--hemicube' is not an option of 'info' (it is one of run, bake, merge, check and bench"));
     assert_int_equal(run("run scenes/cornell.glb --texel-sise 0.1 --out x"), 2);
     assert_non_null(strstr(output, "did you mean '--texel-size'?"));
     assert_int_equal(run("bake scenes/cornell.glb --hemicube-sample 4 --out x"), 2);
@@ -511,6 +514,73 @@ static void test_bake_killed_and_resumed(void **state)
     assert_int_equal(run(args), 1);
     snprintf(b_path, sizeof b_path, "%s/part/lightmap.exr", dir);
     assert_true(same_bytes(a_path, b_path));
+}
+
+/* A bake in shards (docs/levels.md, "A bake in shards"): the Cornell box at 8,000 texels (four gather
+ * passes) baked as 3 shards and as 5 (one share empty), each put together by merge: the same bytes as
+ * one bake, lightmap and AIM. A missing shard, the same shard twice, a part of other settings or of a
+ * bake in another number of shards are refused, naming it, and nothing is written. */
+static void test_bake_in_shards(void **state)
+{
+    (void)state;
+    char dir[256], args[4096], a_path[600], b_path[600];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 8000 --out %s/whole -q", dir);
+    assert_int_equal(run(args), 0);
+    static const int counts[2] = {3, 5};
+    for (int c = 0; c < 2; c++) {
+        int n = counts[c];
+        char parts[2048] = "";
+        for (int k = 1; k <= n; k++) {
+            snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 8000 --shard %d/%d --out %s/s%d_%d", k, n,
+                     dir, n, k);
+            assert_int_equal(run(args), 0);
+            assert_non_null(strstr(output, "part.checkpoint"));
+            size_t used = strlen(parts);
+            snprintf(parts + used, sizeof parts - used, " %s/s%d_%d", dir, n, k);
+        }
+        snprintf(args, sizeof args, "merge scenes/cornell.glb%s --texels 8000 --out %s/merged%d", parts, dir, n);
+        if (run(args) != 0)
+            fail_msg("%s: %s", args, output);
+        static const char *const files[2] = {"lightmap.exr", "aim.exr"};
+        for (int f = 0; f < 2; f++) {
+            snprintf(a_path, sizeof a_path, "%s/whole/%s", dir, files[f]);
+            snprintf(b_path, sizeof b_path, "%s/merged%d/%s", dir, n, files[f]);
+            assert_true(same_bytes(a_path, b_path));
+        }
+        print_message("%d shards merged: lightmap.exr and aim.exr the same bytes as one bake\n", n);
+    }
+    static const struct {
+        const char *parts, *options, *says;
+    } bad[] = {
+        {"s3_1 s3_3", "", "shard 2 of 3 is missing"},
+        {"s3_1 s3_2 s3_2 s3_3", "", "are both shard 2 of 3"},
+        {"s3_1 s3_2 s3_3", " --photons 5000", "give merge the scene and the options its shards were baked with"},
+        {"s3_1 s5_2", "", "a part of a bake in 5 shards"},
+        {"whole", "", "part.checkpoint: no checkpoint"},
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof *bad; i++) {
+        char list[512] = "", *w, copy[256];
+        snprintf(copy, sizeof copy, "%s", bad[i].parts);
+        char *save = NULL;
+        for (w = strtok_r(copy, " ", &save); w; w = strtok_r(NULL, " ", &save)) {
+            size_t used = strlen(list);
+            snprintf(list + used, sizeof list - used, " %s/%s", dir, w);
+        }
+        snprintf(args, sizeof args, "merge scenes/cornell.glb%s --texels 8000%s --out %s/refused", list,
+                 bad[i].options, dir);
+        assert_int_equal(run(args), 1);
+        if (!strstr(output, bad[i].says))
+            fail_msg("merge of%s: expected \"%s\" in: %s", list, bad[i].says, output);
+        snprintf(a_path, sizeof a_path, "%s/refused/lightmap.exr", dir);
+        assert_int_equal(access(a_path, F_OK), -1);
+    }
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --shard 4/3 --out %s/x", dir);
+    assert_int_equal(run(args), 2);
+    assert_non_null(strstr(output, "1 <= K <= N"));
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --shard 1/3 --gltf --out %s/x", dir);
+    assert_int_equal(run(args), 2);
+    assert_non_null(strstr(output, "give --gltf, --accuracy and --half to lmgi merge"));
 }
 
 static void test_bake_command(void **state)
@@ -944,6 +1014,7 @@ int main(void)
         cmocka_unit_test(test_bake_command),
         cmocka_unit_test(test_progress_lines),
         cmocka_unit_test(test_bake_killed_and_resumed),
+        cmocka_unit_test(test_bake_in_shards),
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),
         cmocka_unit_test(test_tradeoff),

@@ -10,6 +10,7 @@
 #include "../charts/atlas_dilate.h"
 #include "../core/stats.h"
 #include "../scene/sky.h"
+#include "../update/bake_checkpoint.h"
 #include "../update/frame_loop.h"
 #include "lmgi_camera.h"
 #include "lmgi_context.h"
@@ -204,6 +205,28 @@ static void gather_progress(void *user, uint32_t done, uint32_t total)
     d->progress(d->progress_user, total ? (float)done / (float)total : 1.0f, "gather");
 }
 
+/* The desc's shard or parts (a bake in shards), each field checked. */
+static lm_status check_shards(const lmgi_updater_desc *d, lm_error *err)
+{
+    static const char fn[] = "lmgi_updater_create";
+    if (d->shards < 0 || d->shards > LM_MAX_SHARDS || (d->shards > 0 && (d->shard < 0 || d->shard >= d->shards)) ||
+        (d->shards == 0 && d->shard != 0))
+        return lm_fail(err, LM_ERR_INVALID, "%s: shard %d of %d: shards must be 1 to %d (0: none) and shard 0 to "
+                       "shards - 1", fn, d->shard, d->shards, LM_MAX_SHARDS);
+    if (d->shards > 0 && !d->checkpoint)
+        return lm_fail(err, LM_ERR_INVALID, "%s: a shard needs a checkpoint file to hold its part", fn);
+    if (!d->parts != !d->part_count || d->part_count < 0)
+        return lm_fail(err, LM_ERR_INVALID, "%s: parts %s with part_count %d", fn, d->parts ? "given" : "NULL",
+                       d->part_count);
+    for (int p = 0; p < d->part_count; p++)
+        if (!d->parts[p])
+            return lm_fail(err, LM_ERR_INVALID, "%s: parts[%d] is NULL", fn, p);
+    if (d->parts && (d->shards > 0 || d->resume))
+        return lm_fail(err, LM_ERR_INVALID, "%s: parts are put together into a whole bake: not with %s", fn,
+                       d->shards > 0 ? "a shard" : "resume");
+    return LM_OK;
+}
+
 static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *desc,
                                         lmgi_updater **out, lmgi_error *err)
 {
@@ -245,6 +268,9 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     if (st == LM_OK && (!(d.checkpoint_seconds >= 0.0) || (d.resume && !d.checkpoint)))
         st = lm_fail(&e, LM_ERR_INVALID, "lmgi_updater_create: %s", d.resume ? "resume without a checkpoint file"
                                                                                : "checkpoint_seconds is negative or NaN");
+    if (st == LM_OK)
+        st = check_shards(&d, &e);
+    set.shard = d.shard, set.shards = d.shards, set.parts = d.parts, set.part_count = d.part_count;
     lmgi_updater *u = st == LM_OK ? calloc(1, sizeof *u) : NULL;
     if (st == LM_OK && !u)
         st = lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");

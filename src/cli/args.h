@@ -5,7 +5,7 @@
 #include <lmgi.h>
 #include <stdio.h>
 
-#define LM_CLI_MAX_FILES 64
+#define LM_CLI_MAX_FILES 4100 /* a merge's parts: one of each of up to 4096 shards, and its scene */
 
 typedef struct {
     lmgi_options options;
@@ -66,6 +66,7 @@ typedef struct {
     int accuracy;           /* --accuracy (bake): also the lightmaps' estimate of their own error */
     int resume;             /* --resume (bake): continue from DIR/bake.checkpoint */
     float checkpoint_seconds; /* --checkpoint-seconds S (bake): at most one checkpoint every S (0: 10) */
+    int shard, shards;      /* --shard K/N (bake): share K (1-based) of N; shards 0: a whole bake */
     int frame_lag;          /* --frame-lag (tradeoff --edits): the frame's lag against the reference too */
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */

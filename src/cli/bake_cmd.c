@@ -3,11 +3,13 @@
 
 #include <lmgi.h>
 #include <ctype.h>
+#include <errno.h>
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "order_stats.h"
 #include "out_dir.h"
@@ -144,34 +146,68 @@ static int write_gltf(const lm_cli_args *a, lmgi_updater *u, lmgi_output *out, c
 /* The scene loads before --out is touched, and the earlier bake stays until this one has succeeded
  * (lmgi_output_commit): a mistyped scene, a cancel or a kill leaves the last good lightmaps. What the
  * gather finished survives a cancel, a kill or a failure in DIR/bake.checkpoint (docs/levels.md, "Long
- * bakes"), which the commit removes. */
-static lmgi_output *open_out(const lm_cli_args *a, char *checkpoint, size_t size)
+ * bakes"), which the commit removes. A shard's bake writes DIR/part.checkpoint alone. */
+static lmgi_output *open_out(const lm_cli_args *a, const char *command, char *checkpoint, size_t size)
 {
-    lmgi_output *out = lm_cli_open_out(a, "bake");
+    lmgi_output *out = lm_cli_open_out(a, command);
     char probe[4200];
     lmgi_error e;
-    if (!out || !lm_cli_out_path(out, "lightmap.exr", probe, sizeof probe) ||
-        !lm_cli_out_path(out, "lightmap.png", probe, sizeof probe))
-        return lm_cli_close_out(out, 1), NULL;
-    if (lmgi_output_work_file(out, "bake.checkpoint", checkpoint, size, &e) != LMGI_OK) {
+    static const char *const whole[] = {"lightmap.exr", "lightmap.png", NULL}, *const part[] = {"part.checkpoint", NULL};
+    for (const char *const *f = a->shards ? part : whole; out && *f; f++)
+        if (!lm_cli_out_path(out, *f, probe, sizeof probe))
+            return lm_cli_close_out(out, 1), NULL;
+    if (out && lmgi_output_work_file(out, "bake.checkpoint", checkpoint, size, &e) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", e.message);
         return lm_cli_close_out(out, 1), NULL;
     }
     return out;
 }
 
-int lm_cli_bake(const lm_cli_args *a)
+/* A shard's part: the checkpoint its gather finished, moved into the result as part.checkpoint. */
+static int keep_part(lmgi_output *out, const char *checkpoint)
 {
-    if (a->file_count != 1 || !a->out_dir) {
-        fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
-        return 2;
+    char part[4200];
+    if (!lm_cli_out_path(out, "part.checkpoint", part, sizeof part))
+        return 1;
+    if (rename(checkpoint, part) != 0) {
+        fprintf(stderr, "lmgi: error: cannot move %s to %s: %s\n", checkpoint, part, strerror(errno));
+        return 1;
     }
+    return 0;
+}
+
+static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double started, const char *name)
+{
+    lmgi_info in;
+    lmgi_updater_info ui;
+    lmgi_get_info(sc, &in);
+    lmgi_get_updater_info(u, &ui);
+    if (a->shards) {
+        printf("baked       share %d of %d of %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, "
+               "AIMs %.0f ms, gather %.0f ms)\nwrote       %s/part.checkpoint (lmgi merge puts the parts together)\n",
+               a->shard, a->shards, in.texels, in.atlas_width, in.atlas_height, ui.photons, lm_cli_now() - started,
+               ui.ms_setup_trace, ui.ms_setup_aim, ui.ms_setup_gather, a->out_dir);
+        return;
+    }
+    printf("%s      %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather "
+           "%.0f ms)\nwrote       %s/lightmap.exr (irradiance, alpha = valid), lightmap.png, aim.exr\n",
+           a->file_count > 1 ? "merged" : "baked ", in.texels, in.atlas_width, in.atlas_height, ui.photons,
+           lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim, ui.ms_setup_gather, a->out_dir);
+    if (a->gltf)
+        printf("            %s/%s.gltf (TEXCOORD_1: the lightmap's UVs) with %s_lightmap.exr and .png\n", a->out_dir,
+               name, name);
+}
+
+/* bake (parts NULL) and merge (the parts' checkpoint files): the updater's first full solution, then the
+ * lightmaps, or a shard's part. */
+static int bake(const lm_cli_args *a, const char *command, const char *const *parts, int part_count)
+{
     lmgi_scene *sc = NULL;
     lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
     if (!lm_cli_load_scene(a->files[0], &o, 1, &sc))
         return 1;
     char checkpoint[4200];
-    lmgi_output *out = open_out(a, checkpoint, sizeof checkpoint);
+    lmgi_output *out = open_out(a, command, checkpoint, sizeof checkpoint);
     if (!out) {
         lmgi_free(sc);
         return 1;
@@ -184,9 +220,16 @@ int lm_cli_bake(const lm_cli_args *a)
     d.progress = a->quiet ? NULL : show;
     d.progress_user = &started;
     d.cancel = &g_cancel;
-    d.checkpoint = checkpoint;
-    d.checkpoint_seconds = a->checkpoint_seconds;
-    d.resume = a->resume;
+    if (parts) {
+        d.parts = parts;
+        d.part_count = part_count;
+    } else {
+        d.checkpoint = checkpoint;
+        d.checkpoint_seconds = a->checkpoint_seconds;
+        d.resume = a->resume;
+        d.shard = a->shards ? a->shard - 1 : 0;
+        d.shards = a->shards;
+    }
     signal(SIGINT, on_interrupt);
     signal(SIGTERM, on_interrupt); /* a scheduler's stop, as Ctrl-C */
     lmgi_context *ctx = NULL;
@@ -195,37 +238,74 @@ int lm_cli_bake(const lm_cli_args *a)
     int rc = 0;
     if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK || lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK) {
         if (e.status == LMGI_ERR_CANCELLED)
-            fprintf(stderr, "\nlmgi: bake cancelled after %.1f s (%s); no lightmap written (an earlier bake's kept); the "
-                    "same command with --resume continues it\n", lm_cli_now() - started, e.message);
+            fprintf(stderr, "\nlmgi: %s cancelled after %.1f s (%s); no lightmap written (an earlier bake's kept); the "
+                    "same command with --resume continues it\n", command, lm_cli_now() - started, e.message);
         else
             fprintf(stderr, "lmgi: error: %s\n", e.message);
         rc = e.status == LMGI_ERR_CANCELLED ? 130 : 1;
     }
     signal(SIGINT, SIG_DFL);
     signal(SIGTERM, SIG_DFL);
-    if (rc == 0)
-        rc = write_maps(sc, u, out, a->half);
-    if (rc == 0 && a->accuracy)
-        rc = write_accuracy(sc, u, out, a->half, a->quiet);
     char name[256] = "";
-    if (rc == 0 && a->gltf)
-        rc = write_gltf(a, u, out, name, sizeof name);
-    rc = lm_cli_close_out(out, rc);
-    if (rc == 0 && !a->quiet) {
-        lmgi_info in;
-        lmgi_updater_info ui;
-        lmgi_get_info(sc, &in);
-        lmgi_get_updater_info(u, &ui);
-        printf("baked       %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather "
-               "%.0f ms)\nwrote       %s/lightmap.exr (irradiance, alpha = valid), lightmap.png, aim.exr\n",
-               in.texels, in.atlas_width, in.atlas_height, ui.photons, lm_cli_now() - started, ui.ms_setup_trace,
-               ui.ms_setup_aim, ui.ms_setup_gather, a->out_dir);
-        if (a->gltf)
-            printf("            %s/%s.gltf (TEXCOORD_1: the lightmap's UVs) with %s_lightmap.exr and .png\n", a->out_dir,
-                   name, name);
+    if (rc == 0 && a->shards) {
+        rc = keep_part(out, checkpoint);
+    } else {
+        if (rc == 0)
+            rc = write_maps(sc, u, out, a->half);
+        if (rc == 0 && a->accuracy)
+            rc = write_accuracy(sc, u, out, a->half, a->quiet);
+        if (rc == 0 && a->gltf)
+            rc = write_gltf(a, u, out, name, sizeof name);
     }
+    rc = lm_cli_close_out(out, rc);
+    if (rc == 0 && !a->quiet)
+        report(a, sc, u, started, name);
     lmgi_updater_free(u);
     lmgi_free(sc);
     lmgi_context_free(ctx);
+    return rc;
+}
+
+int lm_cli_bake(const lm_cli_args *a)
+{
+    if (a->file_count != 1 || !a->out_dir) {
+        fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
+        return 2;
+    }
+    if (a->shards && (a->gltf || a->accuracy || a->half)) {
+        fprintf(stderr, "lmgi: bake --shard writes its part alone; give --gltf, --accuracy and --half to lmgi merge\n");
+        return 2;
+    }
+    return bake(a, "bake", NULL, 0);
+}
+
+int lm_cli_merge(const lm_cli_args *a)
+{
+    if (a->file_count < 2 || !a->out_dir) {
+        fprintf(stderr, "lmgi: merge needs the scene file, then the parts (lmgi bake --shard K/N --out PART), and "
+                "--out DIR\n");
+        return 2;
+    }
+    int n = a->file_count - 1, rc = 0;
+    char (*paths)[4200] = malloc(sizeof *paths * (size_t)n);
+    const char **parts = malloc(sizeof *parts * (size_t)n);
+    if (!paths || !parts) {
+        free(paths);
+        free(parts);
+        fprintf(stderr, "lmgi: error: no memory for %d parts\n", n);
+        return 1;
+    }
+    for (int p = 0; p < n; p++) { /* a folder a shard wrote, or its file */
+        struct stat st;
+        const char *f = a->files[p + 1];
+        if (stat(f, &st) == 0 && S_ISDIR(st.st_mode))
+            snprintf(paths[p], sizeof paths[p], "%s/part.checkpoint", f);
+        else
+            snprintf(paths[p], sizeof paths[p], "%s", f);
+        parts[p] = paths[p];
+    }
+    rc = bake(a, "merge", parts, n);
+    free(paths);
+    free(parts);
     return rc;
 }

@@ -6,4 +6,6 @@
  * DIR/lightmap.exr (the IIM: irradiance, alpha = validity; --half: 16-bit floats), DIR/lightmap.png (a
  * tone-mapped preview) and DIR/aim.exr. */
 int lm_cli_bake(const lm_cli_args *a);
+/* lmgi merge SCENE PART... --out DIR: the parts of a bake in shards put together (a bake from them). */
+int lm_cli_merge(const lm_cli_args *a);
 #endif

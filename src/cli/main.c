@@ -81,7 +81,7 @@ int main(int argc, char **argv)
         const char *name;
         int (*run)(const lm_cli_args *a);
     } commands[] = {{"info", cmd_info}, {"charts", cmd_charts}, {"reference", lm_cli_reference}, {"run", lm_cli_run},
-                    {"bake", lm_cli_bake}, {"check", lm_cli_check}, {"bench", lm_cli_bench},
+                    {"bake", lm_cli_bake}, {"merge", lm_cli_merge}, {"check", lm_cli_check}, {"bench", lm_cli_bench},
                     {"tradeoff", lm_cli_tradeoff}};
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         if (!strcmp(cmd, commands[i].name)) {

@@ -225,6 +225,16 @@ int lm_cli_opt_seed(const char *o, const char *v, lm_cli_args *a)
     return rc;
 }
 
+int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a)
+{
+    int k = 0, n = 0, used = 0;
+    if (!v || sscanf(v, "%d/%d%n", &k, &n, &used) != 2 || v[used] != '\0' || n < 1 || n > 4096 || k < 1 || k > n)
+        return lm_cli_bad(o, v, "K/N: share K of N, 1 <= K <= N <= 4096 (e.g. 2/8)");
+    a->shard = k;
+    a->shards = n;
+    return 0;
+}
+
 int lm_cli_opt_caustic_retrace(const char *o, const char *v, lm_cli_args *a)
 {
     if (lm_cli_parse_float(o, v, 0.0f, &a->caustic_retrace))

@@ -24,6 +24,8 @@ int lm_cli_opt_aim_direct(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_scheme(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_scaling(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_seed(const char *o, const char *v, lm_cli_args *a);
+/* --shard K/N: share K of N, 1 <= K <= N <= 4096. */
+int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_caustic_retrace(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_photon_tile(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_hemicube_samples(const char *o, const char *v, lm_cli_args *a);

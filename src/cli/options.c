@@ -23,6 +23,11 @@ const lm_cli_command lm_cli_commands[] = {
      "the time left (Ctrl-C or SIGTERM cancels, keeping what it finished for --resume; a failed bake\n"
      "leaves the last lightmaps): DIR/lightmap.exr (irradiance, alpha = valid), lightmap.png (a\n"
      "preview), aim.exr; --gltf: also NAME.gltf, the scene for engines with TEXCOORD_1 = lightmap UVs"},
+    {"merge", LM_CMD_MERGE, "merge SCENE PART... --out DIR",
+     "a bake spread over processes put together: the parts the shards wrote (bake --shard K/N --out\n"
+     "PART; each PART a folder, or its part.checkpoint), one of each share, made with the same scene\n"
+     "and options, give the lightmaps one bake gives, to the bit (docs/levels.md, \"A bake in shards\");\n"
+     "give merge the same options"},
     {"check", LM_CMD_CHECK, "check SCENE",
      "one frame of 'run' (same options) against the path-traced reference: frame / reference per\n"
      "visible surface and over the frame, and the relative RMSE (default --size 128x128; --out DIR:\n"
@@ -49,9 +54,10 @@ const lm_cli_command lm_cli_commands[] = {
 
 /* The commands that make an updater from the options (lm_cli_updater_desc), that solve a reference
  * (lm_cli_reference_desc), and that write into --out. */
-#define UPDATER (LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_BENCH)
+#define UPDATER (LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_MERGE | LM_CMD_CHECK | LM_CMD_BENCH)
+#define BAKES (LM_CMD_BAKE | LM_CMD_MERGE)
 #define REFERENCE_USERS (LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF)
-#define OUTPUTS (LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF)
+#define OUTPUTS (LM_CMD_CHARTS | LM_CMD_RUN | BAKES | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF)
 
 const lm_cli_option lm_cli_options[] = {
     {"--texel-size", NULL, "S", LM_CMD_ALL, LM_OPT_FLOAT, offsetof(lm_cli_args, options.texel_size), 0, 0, NULL,
@@ -220,17 +226,20 @@ const lm_cli_option lm_cli_options[] = {
      "list of them, the lightmap's lag behind each edit per update budget"},
     {"--gather-scene", NULL, "FILE", 0, LM_OPT_TEXT, offsetof(lm_cli_args, gather_scene), 0, 0, NULL,
      "lmgi-dev bench: the ~133k-triangle Cornell box"},
-    {"--half", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, half), 0, 0, NULL,
+    {"--half", NULL, NULL, BAKES, LM_OPT_FLAG, offsetof(lm_cli_args, half), 0, 0, NULL,
      "EXR lightmaps in 16-bit half floats"},
-    {"--gltf", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, gltf), 0, 0, NULL,
+    {"--gltf", NULL, NULL, BAKES, LM_OPT_FLAG, offsetof(lm_cli_args, gltf), 0, 0, NULL,
      "also a glTF copy of the scene with the lightmap (docs/api.md)"},
-    {"--accuracy", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, accuracy), 0, 0, NULL,
+    {"--accuracy", NULL, NULL, BAKES, LM_OPT_FLAG, offsetof(lm_cli_args, accuracy), 0, 0, NULL,
      "also DIR/accuracy.exr, the lightmaps' estimate of their own error (r: the\n"
      "lightmap's relative standard error, g: the AIM's, b: back-face share)"},
     {"--resume", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, resume), 0, 0, NULL,
      "continue the bake that was cancelled or killed from DIR/bake.checkpoint\n"
      "(what its gather had finished), to the same lightmaps as one that never\n"
      "stopped"},
+    {"--shard", NULL, "K/N", LM_CMD_BAKE, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_shard,
+     "gather only share K of N of the bake's texels into DIR/part.checkpoint\n"
+     "(a part, for lmgi merge; docs/levels.md, \"A bake in shards\")"},
     {"--checkpoint-seconds", NULL, "S", LM_CMD_BAKE, LM_OPT_FLOAT,
      offsetof(lm_cli_args, checkpoint_seconds), 0, 0, NULL,
      "at most one checkpoint every S seconds (default 10)"},

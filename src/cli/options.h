@@ -15,7 +15,7 @@
 enum {
     LM_CMD_INFO = 1u << 0, LM_CMD_CHARTS = 1u << 1, LM_CMD_RUN = 1u << 2, LM_CMD_BAKE = 1u << 3,
     LM_CMD_CHECK = 1u << 4, LM_CMD_REFERENCE = 1u << 5, LM_CMD_BENCH = 1u << 6, LM_CMD_TRADEOFF = 1u << 7,
-    LM_CMD_ALL = (1u << 8) - 1
+    LM_CMD_MERGE = 1u << 8, LM_CMD_ALL = (1u << 9) - 1
 };
 
 typedef enum { LM_OPT_FLAG, LM_OPT_INT, LM_OPT_FLOAT, LM_OPT_TEXT, LM_OPT_CUSTOM } lm_cli_option_kind;

@@ -10,7 +10,7 @@
 #include "../core/image.h"
 #include "../scene/sky.h"
 
-static const char k_magic[8] = {'L', 'M', 'G', 'I', 'C', 'K', 'P', '1'};
+static const char k_magic[8] = {'L', 'M', 'G', 'I', 'C', 'K', 'P', '2'};
 
 uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *gather,
                            const uint32_t *order, uint32_t count, const float *aim_dilated_rgba)
@@ -34,17 +34,19 @@ uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicu
 typedef struct {
     char magic[8];
     uint64_t key;
-    uint32_t count, done;
+    uint32_t count, start, end, done, shard, shards;
     int32_t width, height;
 } header;
 
-lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, uint32_t done,
-                              const float *rgba, lm_error *err)
+lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a, uint32_t count,
+                              const lm_checkpoint_range *range, const float *rgba, lm_error *err)
 {
     header hd;
     memset(&hd, 0, sizeof hd);
     memcpy(hd.magic, k_magic, sizeof hd.magic);
-    hd.key = key, hd.count = count, hd.done = done, hd.width = a->width, hd.height = a->height;
+    hd.key = key, hd.count = count, hd.width = a->width, hd.height = a->height;
+    hd.start = range->start, hd.end = range->end, hd.done = range->done;
+    hd.shard = range->shard, hd.shards = range->shards;
     size_t n = 4 * sizeof(float) * (size_t)a->width * (size_t)a->height;
     unsigned char *file = malloc(sizeof hd + n + sizeof(uint64_t));
     if (!file)
@@ -59,7 +61,7 @@ lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a,
 }
 
 lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, float *rgba,
-                             uint32_t *done, lm_error *err)
+                             lm_checkpoint_range *range, const char *advice, lm_error *err)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
@@ -73,14 +75,15 @@ lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, 
         fclose(f);
         return lm_fail(err, LM_ERR_INVALID,
                        "%s: a checkpoint of another scene or other settings (its key %016llx, this bake's %016llx); "
-                       "bake without --resume to start again", path, (unsigned long long)hd.key,
-                       (unsigned long long)key);
+                       "%s", path, (unsigned long long)hd.key, (unsigned long long)key, advice);
     }
-    ok = ok && hd.done <= count && fread(rgba, 1, n, f) == n && fread(&sum, sizeof sum, 1, f) == 1 &&
-         fgetc(f) == EOF && sum == lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n);
+    ok = ok && hd.start <= hd.done && hd.done <= hd.end && hd.end <= count &&
+         hd.shards <= LM_MAX_SHARDS && (hd.shards ? hd.shard < hd.shards : hd.shard == 0) && fread(rgba, 1, n, f) == n &&
+         fread(&sum, sizeof sum, 1, f) == 1 && fgetc(f) == EOF &&
+         sum == lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n);
     fclose(f);
     if (!ok)
         return lm_fail(err, LM_ERR_INVALID, "%s: not an lmgi bake checkpoint, or damaged", path);
-    *done = hd.done;
+    *range = (lm_checkpoint_range){hd.start, hd.end, hd.done, hd.shard, hd.shards};
     return LM_OK;
 }

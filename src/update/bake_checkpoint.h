@@ -3,11 +3,14 @@
  *
  * Why it can: the gather writes each texel from the AIMs and the scene alone, and the first full gather
  * takes the texels in a fixed order in passes of a fixed size; a checkpoint is written only between passes.
- * So the fresh IIM after `done` texels, plus the passes from `done` on, is the uninterrupted gather.
+ * So the fresh IIM after `done` texels, plus the passes from `done` on, is the uninterrupted gather. The
+ * same holds for a range of the order (a shard of a bake spread over processes: texels [start, end) of
+ * the order, cut at pass boundaries): the parts' texels put together are the one-process gather's.
  *
- * File (little-endian, as the machine writes it): "LMGICKP1", key (u64), texel count (u32), done (u32),
- * atlas width, height (i32), width x height x 4 floats (the fresh IIM as the passes left it), and an FNV-1a
- * checksum of all before it. Written whole or not at all (lm_write_file: NAME.partial renamed over NAME),
+ * File (little-endian, as the machine writes it): "LMGICKP2", key (u64), texel count (u32), the range's
+ * start and end and done (u32: texels [start, done) of the order are gathered; a whole bake's range is
+ * [0, count)), its shard and shards (u32; 0 and 0 for a whole bake), atlas width, height (i32), width x height x 4 floats (the fresh IIM as the passes left it,
+ * 0 outside what they gathered), and an FNV-1a checksum of all before it. Written whole or not at all (lm_write_file: NAME.partial renamed over NAME),
  * so a kill leaves the previous checkpoint or the new one, never half of one.
  *
  * Key: FNV-1a over the scene's vertices, triangles, materials and node matrices, the texel table, the
@@ -29,15 +32,22 @@
 #include "../scene/scene.h"
 
 #define LM_CHECKPOINT_DEFAULT_SECONDS 10.0
+#define LM_MAX_SHARDS 4096 /* a bake in at most this many shards */
 
 uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *gather,
                            const uint32_t *order, uint32_t count, const float *aim_dilated_rgba);
 
-/* Reads the checkpoint at path into rgba (width x height x 4 floats of a) and *done; LM_ERR_INVALID when
- * there is none, or it is of another key or atlas, or damaged. */
+/* What of the order a checkpoint holds: texels [start, done) of the range [start, end), which is share
+ * `shard` (0-based) of `shards` (0 and 0: the whole order). */
+typedef struct {
+    uint32_t start, end, done, shard, shards;
+} lm_checkpoint_range;
+
+/* Reads the checkpoint at path into rgba (width x height x 4 floats of a) and *range; LM_ERR_INVALID when
+ * there is none, or it is of another key or atlas (the message then ends with `advice`), or damaged. */
 lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, float *rgba,
-                             uint32_t *done, lm_error *err);
-lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a, uint32_t count, uint32_t done,
-                              const float *rgba, lm_error *err);
+                             lm_checkpoint_range *range, const char *advice, lm_error *err);
+lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a, uint32_t count,
+                              const lm_checkpoint_range *range, const float *rgba, lm_error *err);
 
 #endif

@@ -76,6 +76,14 @@ typedef struct {
     const char *checkpoint;
     double checkpoint_seconds;
     int resume;
+    /* a bake spread over processes (docs/levels.md, "A bake in shards"): shards > 0 gathers only share
+     * `shard` (0-based) of the first full gather's order, cut at pass boundaries, into the checkpoint (which
+     * it needs), written at the end too; parts (part_count checkpoint files of every share) instead start
+     * the first gather from their texels put together, which must be all of them (LM_ERR_INVALID naming a
+     * part of another bake, two parts holding the same texels, or the share no part holds) */
+    int shard, shards;
+    const char *const *parts;
+    int part_count;
     lm_gl_context *gl;     /* borrowed, made current at each call: the context to render with (NULL, the
                             * default: the loop makes its own) */
 } lm_frame_loop_settings;
