@@ -41,6 +41,7 @@ NPM_DEB := $(if $(shell command -v npm 2>/dev/null),,npm)
 DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
                 nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libwebp-dev libcmocka-dev \
                 libegl-dev libegl-mesa0 python3-matplotlib libgl-dev libx11-dev xvfb nodejs chromium \
+                openmpi-bin libopenmpi-dev \
                 $(NPM_DEB)
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
@@ -127,6 +128,31 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
 # The GL guest test plays a GLX host on an X server: it alone links X and GLX (lmgi links neither).
 $(BUILD)/tests/test_gl_guest: LIBS += -lGL -lX11 -ldl
 
+# make mpi: build/lmgi-mpi, the lmgi command with `bake` spread over MPI ranks (docs/farm.md), where mpicc
+# is found; the plain lmgi is built and behaves as without it. make test builds it when it can.
+MPICC ?= mpicc
+HAVE_MPI := $(shell command -v $(MPICC) 2>/dev/null)
+MPI_OBJ := $(BUILD)/obj/mpi/main.o $(BUILD)/obj/mpi/main_mpi.o
+.PHONY: mpi
+mpi: $(BUILD)/lmgi-mpi
+$(BUILD)/obj/mpi/main.o: src/cli/main.c $(BUILD)/flags
+	@command -v $(MPICC) > /dev/null || { echo "make mpi: $(MPICC) not found (Debian: apt-get install libopenmpi-dev openmpi-bin)"; exit 1; }
+	@mkdir -p $(dir $@)
+	$(MPICC) $(CFLAGS_ALL) -Dmain=lm_cli_main -c $< -o $@
+$(BUILD)/obj/mpi/main_mpi.o: src/cli/mpi/main_mpi.c $(BUILD)/flags
+	@command -v $(MPICC) > /dev/null || { echo "make mpi: $(MPICC) not found (Debian: apt-get install libopenmpi-dev openmpi-bin)"; exit 1; }
+	@mkdir -p $(dir $@)
+	$(MPICC) $(CFLAGS_ALL) -c $< -o $@
+$(BUILD)/lmgi-mpi: $(MPI_OBJ) $(filter-out %/main.o,$(CLI_OBJ)) $(BUILD)/liblmgi.a
+	$(MPICC) -o $@ $^ $(LDFLAGS_ALL) $(LIBS)
+
+# make bench-mpi: the MPI bake's scaling on 1, 2 and 4 ranks of this machine (docs/farm.md)
+.PHONY: bench-mpi
+bench-mpi: deps all $(BUILD)/lmgi-mpi
+	@sh tools/bench_mpi.sh $(BUILD) scenes/two_rooms.glb --texels 20000
+	@if [ -f ../shared/scenes/occlusion-room/room_lit.glb ]; then \
+	  sh tools/bench_mpi.sh $(BUILD) ../shared/scenes/occlusion-room/room_lit.glb; fi
+
 $(BUILD)/gen_scenes: tools/gen_scenes.c
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 -O2 $(WARN) -D_DEFAULT_SOURCE -o $@ $< -lm
@@ -158,7 +184,7 @@ npm-deps:
 	     > $(NPM_DIR)/install.log 2>&1; then echo "$(NPM_PACKAGES)" > $(NPM_DIR)/installed; \
 	else echo "npm-deps: npm install failed ($(NPM_DIR)/install.log): the engine tests will skip"; fi
 
-test: deps npm-deps all $(TESTS) $(FUZZ_TESTS)
+test: deps npm-deps all $(if $(HAVE_MPI),$(BUILD)/lmgi-mpi) $(TESTS) $(FUZZ_TESTS)
 	@LMGI_BUILD=$(BUILD) LMGI_NPM=$(NPM_DIR) sh tests/run_tests.sh $(TESTS) $(FUZZ_TESTS)
 
 # make fuzz: FUZZ_INPUTS structured inputs through the whole pipeline under ASan + UBSan, split over

@@ -583,6 +583,71 @@ static void test_bake_in_shards(void **state)
     assert_non_null(strstr(output, "give --gltf, --accuracy and --half to lmgi merge"));
 }
 
+/* mpirun's command line for n ranks of build/lmgi-mpi, or NULL (printed why) where there is none. */
+static const char *mpi_command(int n)
+{
+    static char cmd[1024];
+    const char *build = getenv("LMGI_BUILD");
+    char exe[512];
+    snprintf(exe, sizeof exe, "%s/lmgi-mpi", build ? build : "build");
+    if (access(exe, X_OK) != 0 || system("command -v mpirun > /dev/null 2>&1") != 0) {
+        print_message("skipped: no %s or no mpirun (make test builds it where mpicc is found; Debian: apt-get "
+                      "install libopenmpi-dev openmpi-bin)\n", exe);
+        return NULL;
+    }
+    snprintf(cmd, sizeof cmd, "mpirun %s--oversubscribe -n %d %s", geteuid() == 0 ? "--allow-run-as-root " : "", n,
+             exe);
+    return cmd;
+}
+
+/* mpirun -n 2 lmgi-mpi bake: the same bytes as one process's bake (docs/farm.md). A killed rank ends the
+ * job with a non-zero status and nothing in --out. */
+static void test_mpi_bake(void **state)
+{
+    (void)state;
+    const char *mpi = mpi_command(2);
+    if (!mpi)
+        skip();
+    char dir[256], cmd[4096], a_path[600], b_path[600];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    snprintf(cmd, sizeof cmd, "bake scenes/cornell.glb --texels 8000 --out %s/one -q", dir);
+    assert_int_equal(run(cmd), 0);
+    snprintf(cmd, sizeof cmd, "TMPDIR=%s %s bake scenes/cornell.glb --texels 8000 --out %s/ranks 2>&1", dir, mpi, dir);
+    if (lmt_run(cmd, output, sizeof output) != 0)
+        fail_msg("%s: %s", cmd, output);
+    assert_non_null(strstr(output, "part 2 of 2 in"));
+    static const char *const files[2] = {"lightmap.exr", "aim.exr"};
+    for (int f = 0; f < 2; f++) {
+        snprintf(a_path, sizeof a_path, "%s/one/%s", dir, files[f]);
+        snprintf(b_path, sizeof b_path, "%s/ranks/%s", dir, files[f]);
+        assert_true(same_bytes(a_path, b_path));
+    }
+    print_message("2 MPI ranks: lightmap.exr and aim.exr the same bytes as one process's bake\n");
+
+    /* a rank killed while the ranks gather (each shard's checkpoint shows the gather under way) */
+    snprintf(cmd, sizeof cmd, "TMPDIR=%s %s bake scenes/two_rooms.glb --texels 20000 --checkpoint-seconds 0.05 "
+             "--out %s/killed > %s/killed.log 2>&1 & echo $!", dir, mpi, dir, dir);
+    assert_int_equal(lmt_run(cmd, output, sizeof output), 0);
+    int job = atoi(output); /* mpirun */
+    assert_true(job > 0);
+    int waited = 0, found = 0;
+    while (!found && waited < 60000) {
+        snprintf(cmd, sizeof cmd, "ls %s/lmgi-rank*/part/bake.checkpoint > /dev/null 2>&1", dir);
+        found = system(cmd) == 0;
+        usleep(20000);
+        waited += 20;
+    }
+    assert_true(found);
+    snprintf(cmd, sizeof cmd, "pkill -9 -n -P %d", job); /* the newest of mpirun's ranks */
+    assert_int_equal(system(cmd), 0);
+    snprintf(cmd, sizeof cmd, "while kill -0 %d 2> /dev/null; do sleep 0.1; done; cat %s/killed.log", job, dir);
+    lmt_run(cmd, output, sizeof output);
+    print_message("killed rank: %s\n", output);
+    assert_non_null(strstr(output, "exited on signal 9"));
+    snprintf(a_path, sizeof a_path, "%s/killed/lightmap.exr", dir);
+    assert_int_equal(access(a_path, F_OK), -1);
+}
+
 static void test_bake_command(void **state)
 {
     (void)state;
@@ -1015,6 +1080,7 @@ int main(void)
         cmocka_unit_test(test_progress_lines),
         cmocka_unit_test(test_bake_killed_and_resumed),
         cmocka_unit_test(test_bake_in_shards),
+        cmocka_unit_test(test_mpi_bake),
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),
         cmocka_unit_test(test_tradeoff),
