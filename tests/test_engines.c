@@ -172,7 +172,7 @@ static uint8_t *babylon_picture(const char *modules, const char *gltf, int w, in
     assert_non_null(realpath("tests/engines/babylon_view.html", page));
     assert_non_null(realpath("tools/engines/babylon_lmgi_lightmap.js", extension));
     snprintf(cmd, sizeof cmd,
-             "chromium --headless --no-sandbox --use-angle=swiftshader --enable-unsafe-swiftshader "
+             "chromium --headless --no-sandbox --disable-dev-shm-usage --use-angle=swiftshader --enable-unsafe-swiftshader "
              "--allow-file-access-from-files --user-data-dir='%s/chromium' --virtual-time-budget=120000 "
              "--dump-dom 'file://%s?npm=%s&extension=%s&gltf=file://%s&w=%d&h=%d' 2>/dev/null",
              dir, page, modules, extension, gltf, w, h);
