@@ -31,10 +31,23 @@ uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicu
     return lm_hash_bytes(h, aim_dilated_rgba, 4 * sizeof(float) * (size_t)a->width * (size_t)a->height);
 }
 
+uint32_t lm_checkpoint_step_pass(const lm_checkpoint_range *r, uint32_t s)
+{
+    return r->shards ? r->shard + s * r->shards : s;
+}
+
+uint32_t lm_checkpoint_steps(uint32_t count, uint32_t pass, uint32_t shard, uint32_t shards)
+{
+    uint32_t passes = pass ? (uint32_t)(((uint64_t)count + pass - 1) / pass) : 0;
+    if (!shards)
+        return passes;
+    return passes > shard ? (passes - shard + shards - 1) / shards : 0;
+}
+
 typedef struct {
     char magic[8];
     uint64_t key;
-    uint32_t count, start, end, done, shard, shards;
+    uint32_t count, pass, steps, done, shard, shards;
     int32_t width, height;
 } header;
 
@@ -45,7 +58,7 @@ lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a,
     memset(&hd, 0, sizeof hd);
     memcpy(hd.magic, k_magic, sizeof hd.magic);
     hd.key = key, hd.count = count, hd.width = a->width, hd.height = a->height;
-    hd.start = range->start, hd.end = range->end, hd.done = range->done;
+    hd.pass = range->pass, hd.steps = range->steps, hd.done = range->done;
     hd.shard = range->shard, hd.shards = range->shards;
     size_t n = 4 * sizeof(float) * (size_t)a->width * (size_t)a->height;
     unsigned char *file = malloc(sizeof hd + n + sizeof(uint64_t));
@@ -77,13 +90,13 @@ lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, 
                        "%s: a checkpoint of another scene or other settings (its key %016llx, this bake's %016llx); "
                        "%s", path, (unsigned long long)hd.key, (unsigned long long)key, advice);
     }
-    ok = ok && hd.start <= hd.done && hd.done <= hd.end && hd.end <= count &&
+    ok = ok && hd.pass > 0 && hd.done <= hd.steps && hd.steps == lm_checkpoint_steps(count, hd.pass, hd.shard, hd.shards) &&
          hd.shards <= LM_MAX_SHARDS && (hd.shards ? hd.shard < hd.shards : hd.shard == 0) && fread(rgba, 1, n, f) == n &&
          fread(&sum, sizeof sum, 1, f) == 1 && fgetc(f) == EOF &&
          sum == lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n);
     fclose(f);
     if (!ok)
         return lm_fail(err, LM_ERR_INVALID, "%s: not an lmgi bake checkpoint, or damaged", path);
-    *range = (lm_checkpoint_range){hd.start, hd.end, hd.done, hd.shard, hd.shards};
+    *range = (lm_checkpoint_range){hd.pass, hd.steps, hd.done, hd.shard, hd.shards};
     return LM_OK;
 }

@@ -3,13 +3,14 @@
  *
  * Why it can: the gather writes each texel from the AIMs and the scene alone, and the first full gather
  * takes the texels in a fixed order in passes of a fixed size; a checkpoint is written only between passes.
- * So the fresh IIM after `done` texels, plus the passes from `done` on, is the uninterrupted gather. The
- * same holds for a range of the order (a shard of a bake spread over processes: texels [start, end) of
- * the order, cut at pass boundaries): the parts' texels put together are the one-process gather's.
+ * So the fresh IIM after `done` passes, plus the passes from there on, is the uninterrupted gather. The
+ * same holds for any set of its passes: a shard of a bake spread over processes takes every shards-th
+ * pass (passes shard, shard + shards, ...: a level's dear texels, which cluster in the order, are dealt
+ * out to every shard), and the parts' texels put together are the one-process gather's.
  *
- * File (little-endian, as the machine writes it): "LMGICKP2", key (u64), texel count (u32), the range's
- * start and end and done (u32: texels [start, done) of the order are gathered; a whole bake's range is
- * [0, count)), its shard and shards (u32; 0 and 0 for a whole bake), atlas width, height (i32), width x height x 4 floats (the fresh IIM as the passes left it,
+ * File (little-endian, as the machine writes it): "LMGICKP2", key (u64), texel count (u32), texels a pass
+ * (u32), the gather's passes and those done (u32: a whole bake's passes are all the order's in turn, a
+ * shard's its own), shard and shards (u32; 0 and 0 for a whole bake), atlas width, height (i32), width x height x 4 floats (the fresh IIM as the passes left it,
  * 0 outside what they gathered), and an FNV-1a checksum of all before it. Written whole or not at all (lm_write_file: NAME.partial renamed over NAME),
  * so a kill leaves the previous checkpoint or the new one, never half of one.
  *
@@ -37,11 +38,15 @@
 uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *gather,
                            const uint32_t *order, uint32_t count, const float *aim_dilated_rgba);
 
-/* What of the order a checkpoint holds: texels [start, done) of the range [start, end), which is share
- * `shard` (0-based) of `shards` (0 and 0: the whole order). */
+/* What of the order a checkpoint holds: `done` of the `steps` passes of `pass` texels its gather takes,
+ * which are every pass of the order (shards 0) or shard `shard`'s (0-based) of `shards`: passes shard,
+ * shard + shards, ... */
 typedef struct {
-    uint32_t start, end, done, shard, shards;
+    uint32_t pass, steps, done, shard, shards;
 } lm_checkpoint_range;
+/* The order's pass that step s of a gather takes (lm_checkpoint_range), and how many steps it has. */
+uint32_t lm_checkpoint_step_pass(const lm_checkpoint_range *r, uint32_t s);
+uint32_t lm_checkpoint_steps(uint32_t count, uint32_t pass, uint32_t shard, uint32_t shards);
 
 /* Reads the checkpoint at path into rgba (width x height x 4 floats of a) and *range; LM_ERR_INVALID when
  * there is none, or it is of another key or atlas (the message then ends with `advice`), or damaged. */

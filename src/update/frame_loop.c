@@ -213,8 +213,7 @@ typedef struct {
     const char *path;
     uint64_t key;
     uint32_t count;        /* texels in the order */
-    uint32_t start, end;   /* the range this gather takes of it: all, or a shard's */
-    uint32_t shard, shards; /* which share that is (0 of 0: all) */
+    lm_checkpoint_range r; /* the passes this gather takes (all, or a shard's) and how many are done */
     double seconds, last;  /* at most one write a `seconds`, the last at `last` */
     float *rgba;           /* the fresh IIM read back */
 } checkpointing;
@@ -222,41 +221,59 @@ typedef struct {
 static lm_status checkpoint_save(lm_frame_loop *fl, checkpointing *ck, uint32_t done, lm_error *err)
 {
     lm_status st = lm_iim_texture_read(fl->iim.fresh_tex, fl->atlas->width, fl->atlas->height, ck->rgba, err);
-    lm_checkpoint_range r = {ck->start, ck->end, done, ck->shard, ck->shards};
+    ck->r.done = done;
     if (st == LM_OK)
-        st = lm_checkpoint_write(ck->path, ck->key, fl->atlas, ck->count, &r, ck->rgba, err);
+        st = lm_checkpoint_write(ck->path, ck->key, fl->atlas, ck->count, &ck->r, ck->rgba, err);
     ck->last = lm_now();
     return st;
 }
 
 /* A pass of the gather: its texels together. A pass a time when someone watches or may cancel (the first
  * full gather, a bake: tens of ms a pass, so a cancel is heard within 100 ms), else all at once. */
-static uint32_t pass_texels(const lm_frame_loop *fl, const checkpointing *ck, uint32_t count)
+static uint32_t pass_texels(const lm_frame_loop *fl, int watched, uint32_t count)
 {
-    int watched = fl->set.progress || fl->set.cancel || ck;
-    return watched ? (uint32_t)(fl->set.gather.tiles * fl->set.gather.tiles) : count;
+    watched |= fl->set.progress || fl->set.cancel;
+    uint32_t pass = watched ? (uint32_t)(fl->set.gather.tiles * fl->set.gather.tiles) : count;
+    return pass ? pass : 1;
 }
 
-/* Gathers scheduled texels [start, end) into the fresh IIM. */
-static lm_status gather_run(lm_frame_loop *fl, uint32_t start, uint32_t end, checkpointing *ck, lm_error *err)
+/* The texels of pass p of the order: [*first, *first + *n). */
+static void pass_span(uint32_t p, uint32_t pass, uint32_t count, uint32_t *first, uint32_t *n)
+{
+    uint64_t at = (uint64_t)p * pass;
+    *first = at < count ? (uint32_t)at : count;
+    *n = count - *first < pass ? count - *first : pass;
+}
+
+/* Gathers steps [r.done, r.steps) of the passes r names into the fresh IIM, a pass at a time. */
+static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t count, checkpointing *ck,
+                            lm_error *err)
 {
     lm_status st = LM_OK;
-    uint32_t chunk = pass_texels(fl, ck, end), base = ck ? ck->start : 0;
-    for (uint32_t done = start; st == LM_OK && done < end; done += chunk) {
+    for (uint32_t s = r.done; st == LM_OK && s < r.steps; s++) {
         if (fl->set.cancel && *fl->set.cancel) {
-            if (ck && (st = checkpoint_save(fl, ck, done, err)) != LM_OK)
+            if (ck && (st = checkpoint_save(fl, ck, s, err)) != LM_OK)
                 return st;
-            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u texels%s%s", fl->scene->path,
-                           done - base, end - base, ck ? ", kept in " : "", ck ? ck->path : "");
+            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u passes%s%s", fl->scene->path, s,
+                           r.steps, ck ? ", kept in " : "", ck ? ck->path : "");
         }
-        uint32_t n = end - done < chunk ? end - done : chunk;
-        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + done, n, fl->iim.fresh_tex, NULL, err);
-        if (st == LM_OK && ck && done + n < end && lm_now() - ck->last >= ck->seconds)
-            st = checkpoint_save(fl, ck, done + n, err);
+        uint32_t first, n;
+        pass_span(lm_checkpoint_step_pass(&r, s), r.pass, count, &first, &n);
+        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, n, fl->iim.fresh_tex, NULL, err);
+        if (st == LM_OK && ck && s + 1 < r.steps && lm_now() - ck->last >= ck->seconds)
+            st = checkpoint_save(fl, ck, s + 1, err);
         if (fl->set.progress)
-            fl->set.progress(fl->set.progress_user, done + n - base, end - base);
+            fl->set.progress(fl->set.progress_user, s + 1, r.steps);
     }
     return st;
+}
+
+/* Gathers the first count scheduled texels, in passes when someone watches. */
+static lm_status gather_texels(lm_frame_loop *fl, uint32_t count, lm_error *err)
+{
+    uint32_t pass = pass_texels(fl, 0, count);
+    lm_checkpoint_range all = {pass, lm_checkpoint_steps(count, pass, 0, 0), 0, 0, 0};
+    return gather_run(fl, all, count, NULL, err);
 }
 
 static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
@@ -264,38 +281,25 @@ static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
     if (count == 0)
         return LM_OK;
     lm_status st = gather_prepare(fl, err);
-    return st == LM_OK ? gather_run(fl, 0, count, NULL, err) : st;
+    return st == LM_OK ? gather_texels(fl, count, err) : st;
 }
 
-/* Share k of n of the order's count texels, its ends on pass boundaries (so each pass is the one a
- * one-process gather runs). */
-static void shard_range(uint32_t count, uint32_t pass, int k, int n, uint32_t *start, uint32_t *end)
-{
-    uint32_t passes = (count + pass - 1) / pass;
-    *start = (uint32_t)((uint64_t)passes * (uint64_t)k / (uint64_t)n) * pass;
-    *end = (uint32_t)((uint64_t)passes * (uint64_t)(k + 1) / (uint64_t)n) * pass;
-    *start = *start < count ? *start : count;
-    *end = *end < count ? *end : count;
-}
-
-/* The parts of a bake in shards put together into ck->rgba: each part's texels copied from its file, the
- * parts holding every texel once. */
+/* The parts of a bake in shards put together into ck->rgba: each part's texels copied from its file, one
+ * part of each shard, the parts holding every texel once. */
 static lm_status join_parts(lm_frame_loop *fl, checkpointing *ck, lm_error *err)
 {
     size_t n = 4 * (size_t)fl->atlas->width * (size_t)fl->atlas->height;
     float *part = malloc(n * sizeof *part);
-    int *owner = malloc(sizeof *owner * ((size_t)ck->count + 1)), have[LM_MAX_SHARDS];
+    int *have = malloc(sizeof *have * (LM_MAX_SHARDS + 1));
     uint32_t shards = 0;
-    if (!part || !owner) {
+    if (!part || !have) {
         free(part);
-        free(owner);
+        free(have);
         return lm_fail(err, LM_ERR_NOMEM, "no memory to join the bake's parts");
     }
-    for (int k = 0; k < LM_MAX_SHARDS; k++)
-        have[k] = -1;
     memset(ck->rgba, 0, n * sizeof *ck->rgba);
-    for (uint32_t i = 0; i < ck->count; i++)
-        owner[i] = -1;
+    for (int k = 0; k <= LM_MAX_SHARDS; k++)
+        have[k] = -1;
     lm_status st = LM_OK;
     for (int p = 0; p < fl->set.part_count && st == LM_OK; p++) {
         lm_checkpoint_range r;
@@ -309,40 +313,37 @@ static lm_status join_parts(lm_frame_loop *fl, checkpointing *ck, lm_error *err)
         if (st == LM_OK && have[r.shard] >= 0)
             st = lm_fail(err, LM_ERR_INVALID, "%s and %s are both shard %u of %u", fl->set.parts[have[r.shard]],
                          fl->set.parts[p], r.shard + 1, shards);
-        if (st == LM_OK)
-            have[r.shard] = p;
-        if (st == LM_OK && r.done != r.end)
-            st = lm_fail(err, LM_ERR_INVALID, "%s: an unfinished part (texels %u to %u of %u gathered of its %u to %u); "
-                         "finish its shard with --resume", fl->set.parts[p], r.start, r.done, ck->count, r.start, r.end);
-        for (uint32_t i = r.start; st == LM_OK && i < r.end; i++) {
-            if (owner[i] >= 0) {
-                st = lm_fail(err, LM_ERR_INVALID, "%s and %s both hold texel %u of the order (the same shard twice?)",
-                             fl->set.parts[owner[i]], fl->set.parts[p], i);
-                break;
+        if (st == LM_OK && r.pass != ck->r.pass) /* the key holds the settings that make the pass */
+            st = lm_fail(err, LM_ERR_INVALID, "%s: passes of %u texels, this bake's of %u", fl->set.parts[p], r.pass,
+                         ck->r.pass);
+        if (st == LM_OK && r.done != r.steps)
+            st = lm_fail(err, LM_ERR_INVALID, "%s: an unfinished part (%u of its %u passes gathered); finish its "
+                         "shard with --resume", fl->set.parts[p], r.done, r.steps);
+        if (st != LM_OK)
+            break;
+        have[r.shard] = p;
+        for (uint32_t s = 0; s < r.steps; s++) {
+            uint32_t first, count;
+            pass_span(lm_checkpoint_step_pass(&r, s), r.pass, ck->count, &first, &count);
+            for (uint32_t i = first; i < first + count; i++) {
+                const lm_texel *t = &fl->atlas->texels[fl->texels[i]];
+                size_t at = 4 * ((size_t)t->y * fl->atlas->width + t->x);
+                memcpy(ck->rgba + at, part + at, 4 * sizeof *part);
             }
-            owner[i] = p;
-            const lm_texel *t = &fl->atlas->texels[fl->texels[i]];
-            size_t at = 4 * ((size_t)t->y * fl->atlas->width + t->x);
-            memcpy(ck->rgba + at, part + at, 4 * sizeof *part);
         }
     }
     for (uint32_t k = 0; st == LM_OK && k < shards; k++)
-        if (have[k] < 0) {
-            uint32_t start, end;
-            shard_range(ck->count, pass_texels(fl, ck, ck->count), (int)k, (int)shards, &start, &end);
-            st = lm_fail(err, LM_ERR_INVALID, "%s: shard %u of %u is missing (texels %u to %u of the %u); merge needs "
-                         "one part of each", fl->scene->path, k + 1, shards, start, end, ck->count);
-        }
-    for (uint32_t i = 0; st == LM_OK && i < ck->count; i++)
-        if (owner[i] < 0) /* shards that do not tile the order: parts of different bakes */
-            st = lm_fail(err, LM_ERR_INVALID, "%s: no part holds texel %u of the %u", fl->scene->path, i, ck->count);
+        if (have[k] < 0)
+            st = lm_fail(err, LM_ERR_INVALID, "%s: shard %u of %u is missing (%u of the %u passes); merge needs one part "
+                         "of each", fl->scene->path, k + 1, shards,
+                         lm_checkpoint_steps(ck->count, ck->r.pass, k, shards), ck->r.steps);
     free(part);
-    free(owner);
+    free(have);
     return st;
 }
 
-/* The first full gather of every texel (or of a shard's share of them), checkpointed to set.checkpoint
- * when one is named (and resumed from it when set.resume says so), or put together from set.parts. */
+/* The first full gather of every texel (or of a shard's passes), checkpointed to set.checkpoint when one
+ * is named (and resumed from it when set.resume says so), or put together from set.parts. */
 static lm_status first_gather(lm_frame_loop *fl, lm_error *err)
 {
     uint32_t count = lm_iim_sched_pick_all(&fl->iim.sched, store_of(fl), fl->texels);
@@ -351,41 +352,41 @@ static lm_status first_gather(lm_frame_loop *fl, lm_error *err)
     lm_status st = gather_prepare(fl, err);
     if (st != LM_OK)
         return st;
-    checkpointing ck = {fl->set.checkpoint, 0, count, 0, count, 0, 0,
+    uint32_t pass = pass_texels(fl, 1, count), shard = (uint32_t)fl->set.shard, shards = (uint32_t)fl->set.shards;
+    checkpointing ck = {fl->set.checkpoint, 0, count,
+                        {pass, lm_checkpoint_steps(count, pass, 0, 0), 0, 0, 0},
                         fl->set.checkpoint_seconds > 0.0 ? fl->set.checkpoint_seconds : LM_CHECKPOINT_DEFAULT_SECONDS,
                         lm_now(), malloc(4 * sizeof(float) * (size_t)fl->atlas->width * (size_t)fl->atlas->height)};
     if (!ck.rgba)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the bake's checkpoint");
     ck.key = lm_checkpoint_key(fl->scene, fl->atlas, &fl->set.gather, fl->texels, count,
                                lm_aim_dilated_rgba(lm_photon_stage_aim(fl->stage)));
-    if (fl->set.shards > 0) {
-        ck.shard = (uint32_t)fl->set.shard, ck.shards = (uint32_t)fl->set.shards;
-        shard_range(count, pass_texels(fl, &ck, count), fl->set.shard, fl->set.shards, &ck.start, &ck.end);
-    }
-    uint32_t start = ck.start;
+    if (shards > 0)
+        ck.r = (lm_checkpoint_range){pass, lm_checkpoint_steps(count, pass, shard, shards), 0, shard, shards};
     if (fl->set.parts) {
         st = join_parts(fl, &ck, err);
-        start = ck.end;
+        ck.r.done = ck.r.steps;
         if (st == LM_OK)
             lm_info("%s: the gather put together from %d parts", fl->scene->path, fl->set.part_count);
     } else if (fl->set.resume) {
         lm_checkpoint_range r;
         st = lm_checkpoint_read(ck.path, ck.key, fl->atlas, count, ck.rgba, &r, "bake without --resume to start again",
                                 err);
-        if (st == LM_OK && (r.shard != ck.shard || r.shards != ck.shards))
+        if (st == LM_OK && (r.shard != shard || r.shards != shards || r.pass != pass))
             st = lm_fail(err, LM_ERR_INVALID, "%s: a checkpoint of %s%u of %u, not of this bake's %s%u of %u", ck.path,
                          r.shards ? "shard " : "the whole bake, ", r.shard + !!r.shards, r.shards,
-                         ck.shards ? "shard " : "whole bake, ", ck.shard + !!ck.shards, ck.shards);
-        start = r.done;
+                         shards ? "shard " : "whole bake, ", shard + !!shards, shards);
+        ck.r.done = r.done;
         if (st == LM_OK)
-            lm_info("%s: resuming the gather at texel %u of %u from %s", fl->scene->path, start, count, ck.path);
+            lm_info("%s: resuming the gather at texel %u of %u from %s", fl->scene->path,
+                    shards ? r.done : r.done * pass < count ? r.done * pass : count, count, ck.path);
     }
     if (st == LM_OK && (fl->set.parts || fl->set.resume))
         st = lm_iim_texture_write(fl->iim.fresh_tex, fl->atlas->width, fl->atlas->height, ck.rgba, err);
     if (st == LM_OK)
-        st = gather_run(fl, start, ck.end, fl->set.checkpoint ? &ck : NULL, err);
-    if (st == LM_OK && fl->set.shards > 0) /* the part: kept by the caller */
-        st = checkpoint_save(fl, &ck, ck.end, err);
+        st = gather_run(fl, ck.r, count, fl->set.checkpoint ? &ck : NULL, err);
+    if (st == LM_OK && shards > 0) /* the part: kept by the caller */
+        st = checkpoint_save(fl, &ck, ck.r.steps, err);
     free(ck.rgba);
     return st;
 }
@@ -921,7 +922,7 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     if (st == LM_OK)
         st = schedule(fl, o, err);
     if (st == LM_OK)
-        st = gather_run(fl, 0, o->texels_gathered, NULL, err);
+        st = gather_texels(fl, o->texels_gathered, err);
     o->t_photons = t1 - t0;
     o->t_gather = lm_now() - t1;
     return st == LM_OK ? blend_and_render(fl, o, err) : st;
@@ -946,7 +947,7 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
         st = prepare_frame(fl, o, err);
     if (st != LM_OK)
         return st;
-    st = gather_run(fl, 0, o->texels_gathered, NULL, err);
+    st = gather_texels(fl, o->texels_gathered, err);
     o->t_gather = lm_now() - t1;
     lm_stage_worker_begin(fl->worker, &o->stage);
     if (st == LM_OK)
@@ -1011,7 +1012,7 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     double t1 = lm_now();
     o->t_photons = t1 - t0;
     if (st == LM_OK)
-        st = gather_run(fl, 0, o->texels_gathered, NULL, err);
+        st = gather_texels(fl, o->texels_gathered, err);
     o->t_gather = lm_now() - t1;
     if (st == LM_OK)
         st = blend_and_render(fl, o, err); /* no frame: the blend alone */
