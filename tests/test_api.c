@@ -16,6 +16,7 @@
 #include <unistd.h>
 #include <time.h>
 
+#include "edit_room.h"
 #include "support.h"
 
 #define SIDE 40
@@ -37,17 +38,10 @@ static void close_all(lmgi_updater *u, lmgi_scene *sc, lmgi_context *ctx)
     lmgi_context_free(ctx);
 }
 
-static lmgi_scene *load_cornell(void)
-{
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 1500;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
-}
+/* One of the project's scenes at a texel budget. */
+static lmgi_scene *load_scene(const char *name, int texels) { return lmt_load(lmt_project_scene(name), texels); }
+
+static lmgi_scene *load_cornell(void) { return load_scene("cornell.glb", 1500); }
 
 static void small_desc(lmgi_updater_desc *d)
 {
@@ -397,13 +391,8 @@ static void test_light_edit_stays_in_its_room(void **state)
 {
     (void)state;
     lmgi_context *ctx = new_context();
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 3000;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = load_scene("two_rooms.glb", 3000);
     lmgi_error e;
-    if (lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     lmgi_updater_desc d;
     small_desc(&d);
     d.frame_width = d.frame_height = 0;
@@ -552,13 +541,8 @@ static void test_bake(void **state)
 {
     (void)state;
     lmgi_context *ctx = new_context();
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 3000;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = load_scene("two_rooms.glb", 3000);
     lmgi_error e;
-    if (lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     lmgi_updater_desc d;
     small_desc(&d);
     d.frame_width = d.frame_height = 0;
@@ -1068,13 +1052,8 @@ static void test_shard_cancelled_and_resumed(void **state)
 {
     (void)state;
     lmgi_context *ctx = new_context();
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 8000;
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = load_scene("cornell.glb", 8000);
     lmgi_error e;
-    if (lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     char straight[512], stopped[512];
     const char *dir = lmt_tmpdir();
     snprintf(straight, sizeof straight, "%s/straight.part", dir);

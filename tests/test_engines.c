@@ -16,6 +16,7 @@
 #include <unistd.h>
 
 #include "../src/core/image.h"
+#include "edit_room.h"
 #include "support.h"
 
 /* An API call that must succeed, or the test fails with its message. */
@@ -36,18 +37,6 @@ static lmgi_updater *bake(lmgi_context *ctx, lmgi_scene *sc, int photons)
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     return u;
-}
-
-static lmgi_scene *load(const char *path, int texels)
-{
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = texels;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
 }
 
 static void export_to(lmgi_updater *u, const char *name, char *gltf, size_t size)
@@ -74,7 +63,7 @@ static void test_exports_validate(void **state)
     lmgi_context *ctx = NULL;
     lmgi_error e;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
-    lmgi_scene *sc = load(lmt_project_scene("cornell.glb"), 2000);
+    lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), 2000);
     lmgi_updater *u = bake(ctx, sc, 20000);
     char gltf[PATH_MAX];
     export_to(u, "baked", gltf, sizeof gltf);
@@ -108,7 +97,7 @@ static void test_exports_validate(void **state)
 
     const char *textured = lmt_shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf");
     if (access(textured, R_OK) == 0) {
-        sc = load(textured, 2000);
+        sc = lmt_load(textured, 2000);
         u = bake(ctx, sc, 20000);
         export_to(u, "suzanne", gltf, sizeof gltf);
         lmt_gltf_validate(modules, gltf);
@@ -223,7 +212,7 @@ static void test_babylon_draws_the_lightmap(void **state)
     lmgi_context *ctx = NULL;
     lmgi_error e;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
-    lmgi_scene *sc = load(emitter_room(), 6000);
+    lmgi_scene *sc = lmt_load(emitter_room(), 6000);
     lmgi_updater *u = bake(ctx, sc, 100000);
     char gltf[PATH_MAX];
     export_to(u, "room", gltf, sizeof gltf);

@@ -301,6 +301,25 @@ static void host_free(host *h)
             fail_msg("%s: %s", what, e.message);                                                               \
     } while (0)
 
+/* The Cornell box at 800 texels and a small updater for it on ctx (texels_per_frame 0: the default). */
+static lmgi_updater *small_updater(lmgi_context *ctx, lmgi_scene **sc, int texels_per_frame)
+{
+    lmgi_error e;
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 800;
+    *sc = NULL;
+    if (lmgi_load(lmt_project_scene("cornell.glb"), &o, sc, &e) != LMGI_OK)
+        fail_msg("lmgi_load: %s", e.message);
+    lmgi_updater_desc d = {.photons = 4000, .hemicube_resolution = 16, .rim_samples = 8, .emitter_rays = 4,
+                           .reflection_size = 16, .frame_width = 24, .frame_height = 24,
+                           .texels_per_frame = texels_per_frame};
+    lmgi_updater *u = NULL;
+    if (lmgi_updater_create(ctx, *sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("lmgi_updater_create: %s", e.message);
+    return u;
+}
+
 /* Every kind of public call that uses GL, each followed by a look at the host's context; 0 when lmgi
  * has no such backend here (OSMesa on a machine with a GPU and no Mesa, EGL without a vendor). */
 static int calls_leave_host(const host *h, const char *backend)
@@ -315,15 +334,8 @@ static int calls_leave_host(const host *h, const char *backend)
     }
     assert_non_null(ctx);
     CHECK_HOST(h, "lmgi_context_create");
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 800;
     lmgi_scene *sc = NULL;
-    MUST(lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e), "lmgi_load");
-    lmgi_updater_desc d = {.photons = 4000, .hemicube_resolution = 16, .rim_samples = 8, .emitter_rays = 4,
-                           .reflection_size = 16, .frame_width = 24, .frame_height = 24};
-    lmgi_updater *u = NULL;
-    MUST(lmgi_updater_create(ctx, sc, &d, &u, &e), "lmgi_updater_create");
+    lmgi_updater *u = small_updater(ctx, &sc, 0);
     CHECK_HOST(h, "lmgi_updater_create");
     for (int i = 0; i < 2; i++) {
         MUST(lmgi_update(u, 0.1f * (float)i, 0.0f, NULL, &e), "lmgi_update");
@@ -443,15 +455,9 @@ static void shares_texture(host *h, int made, void *share_display, void *share_c
     MUST(lmgi_context_create(&cd, &ctx, &e), "lmgi_context_create sharing the host's");
     print_message("%s host shares with %s\n", h->name, lmgi_context_gl_description(ctx));
     CHECK_HOST(h, "lmgi_context_create");
-    lmgi_options o;
-    lmgi_options_init(&o);
-    o.target_texels = 800;
     lmgi_scene *sc = NULL;
-    MUST(lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e), "lmgi_load");
-    lmgi_updater_desc d = {.photons = 4000, .hemicube_resolution = 16, .rim_samples = 8, .emitter_rays = 4,
-                           .reflection_size = 16, .frame_width = 24, .frame_height = 24, .texels_per_frame = 400};
-    lmgi_updater *u = NULL;
-    MUST(lmgi_updater_create(ctx, sc, &d, &u, &e), "lmgi_updater_create");
+    lmgi_updater *u = small_updater(ctx, &sc, 400);
+    CHECK_HOST(h, "lmgi_updater_create");
     lmgi_info info;
     lmgi_get_info(sc, &info);
     unsigned tex = 0, again = 0;
