@@ -1,7 +1,8 @@
 #!/bin/sh
 # make bench-mpi: an MPI bake (build/lmgi-mpi) of each scene on 1, 2 and 4 ranks of this machine
 # (--oversubscribe beyond its cores), each against the plain one-process bake: wall time, speed-up,
-# efficiency, when each rank's part reached rank 0, and whether the lightmap is the same bytes.
+# efficiency, when each rank's part reached rank 0, whether the lightmap is the same bytes, and each
+# rank's stages (photon trace, AIMs, gather) and the merge.
 # Usage: tools/bench_mpi.sh BUILD SCENE [OPTIONS...]; docs/farm.md has the numbers.
 set -e
 build=$1; scene=$2; shift 2
@@ -21,4 +22,5 @@ for n in 2 4; do
     same=no; cmp -s "$out/one/lightmap.exr" "$out/n$n/lightmap.exr" && same=yes
     printf '%-6s %9.2f %9.2f %10.0f%%  %s; %s\n' $n "$t" "$(calc "$one / $t")" "$(calc "100 * $one / $t / $n")" \
         "$parts" "$same"
+    sed -n '/^stages/,/merge (/p' "$out/log" | sed 's/^/       /'
 done

@@ -200,7 +200,8 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
 
 /* bake (parts NULL) and merge (the parts' checkpoint files): the updater's first full solution, then the
  * lightmaps, or a shard's part. */
-static int bake(const lm_cli_args *a, const char *command, const char *const *parts, int part_count)
+static int bake(const lm_cli_args *a, const char *command, const char *const *parts, int part_count,
+                lm_cli_bake_times *times)
 {
     lmgi_scene *sc = NULL;
     lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
@@ -260,13 +261,20 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     rc = lm_cli_close_out(out, rc);
     if (rc == 0 && !a->quiet)
         report(a, sc, u, started, name);
+    if (times) {
+        lmgi_updater_info ui;
+        lmgi_get_updater_info(u, &ui);
+        *times = (lm_cli_bake_times){lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim, ui.ms_setup_gather};
+    }
     lmgi_updater_free(u);
     lmgi_free(sc);
     lmgi_context_free(ctx);
     return rc;
 }
 
-int lm_cli_bake(const lm_cli_args *a)
+int lm_cli_bake(const lm_cli_args *a) { return lm_cli_bake_timed(a, NULL); }
+
+int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t)
 {
     if (a->file_count != 1 || !a->out_dir) {
         fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
@@ -276,7 +284,7 @@ int lm_cli_bake(const lm_cli_args *a)
         fprintf(stderr, "lmgi: bake --shard writes its part alone; give --gltf, --accuracy and --half to lmgi merge\n");
         return 2;
     }
-    return bake(a, "bake", NULL, 0);
+    return bake(a, "bake", NULL, 0, t);
 }
 
 int lm_cli_merge(const lm_cli_args *a)
@@ -304,7 +312,7 @@ int lm_cli_merge(const lm_cli_args *a)
             snprintf(paths[p], sizeof paths[p], "%s", f);
         parts[p] = paths[p];
     }
-    rc = bake(a, "merge", parts, n);
+    rc = bake(a, "merge", parts, n, NULL);
     free(paths);
     free(parts);
     return rc;

@@ -52,16 +52,22 @@ static int write_all(const char *path, const unsigned char *data, int64_t size)
     return ok;
 }
 
-/* Sends (rank > 0) or receives (from `peer`, on rank 0) a part: its size first (-1: the shard failed). */
-static void send_part(const unsigned char *data, int64_t size)
+/* Sends (rank > 0) or receives (from `peer`, on rank 0) a part: its shard's stage times and its size
+ * first (size -1: the shard failed), then its bytes. */
+static void send_part(const lm_cli_bake_times *t, const unsigned char *data, int64_t size)
 {
+    double times[4] = {t->seconds, t->ms_trace, t->ms_aim, t->ms_gather};
+    MPI_Send(times, 4, MPI_DOUBLE, 0, TAG_SIZE, MPI_COMM_WORLD);
     MPI_Send(&size, 1, MPI_INT64_T, 0, TAG_SIZE, MPI_COMM_WORLD);
     for (int64_t at = 0; at < size; at += CHUNK)
         MPI_Send(data + at, (int)(size - at < CHUNK ? size - at : CHUNK), MPI_BYTE, 0, TAG_BYTES, MPI_COMM_WORLD);
 }
 
-static unsigned char *receive_part(int peer, int64_t *size)
+static unsigned char *receive_part(int peer, lm_cli_bake_times *t, int64_t *size)
 {
+    double times[4];
+    MPI_Recv(times, 4, MPI_DOUBLE, peer, TAG_SIZE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    *t = (lm_cli_bake_times){times[0], times[1], times[2], times[3]};
     MPI_Recv(size, 1, MPI_INT64_T, peer, TAG_SIZE, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
     if (*size < 0)
         return NULL;
@@ -76,6 +82,17 @@ static unsigned char *receive_part(int peer, int64_t *size)
     if (!data)
         *size = -2;
     return data;
+}
+
+/* Rank 0's table of the job's stages: each rank's shard (its photon trace, AIMs and gather, and the whole
+ * shard), when its part reached rank 0, and the merge. */
+static void print_stages(const lm_cli_bake_times *t, const double *arrived, int ranks, double merge)
+{
+    printf("stages      rank  trace ms  AIMs ms  gather ms  shard s  part at s\n");
+    for (int r = 0; r < ranks; r++)
+        printf("            %4d %9.0f %8.0f %10.0f %8.2f %10.2f\n", r, t[r].ms_trace, t[r].ms_aim, t[r].ms_gather,
+               t[r].seconds, arrived[r]);
+    printf("            merge (photons, AIMs, parts joined, lightmaps written) %.2f s\n", merge);
 }
 
 static int remove_entry(const char *path, const struct stat *st, int flag, struct FTW *ftw)
@@ -110,12 +127,13 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks)
     shard.quiet = 1; /* its temporary part is nobody's business; rank 0 says how the job goes */
     shard.gltf = shard.accuracy = shard.half = 0;
     double started = MPI_Wtime();
-    int rc = dir[0] ? lm_cli_bake(&shard) : 1;
+    lm_cli_bake_times mine_t = {0};
+    int rc = dir[0] ? lm_cli_bake_timed(&shard, &mine_t) : 1;
     int64_t size = -1;
     unsigned char *mine = rc == 0 ? read_all(part, &size) : NULL;
     int status = 0;
     if (rank > 0) {
-        send_part(mine, mine ? size : -1);
+        send_part(&mine_t, mine, mine ? size : -1);
     } else if (!mine) { /* the others' parts are of no use now: end the job */
         fprintf(stderr, "lmgi: error: rank 0's shard 1 of %d failed (or the job was stopped: a rank died, or "
                 "mpirun was cancelled); the MPI bake wrote nothing into %s\n", ranks, a->out_dir);
@@ -125,10 +143,15 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks)
     } else {
         char (*paths)[4400] = calloc((size_t)ranks, sizeof *paths);
         const char **parts = calloc((size_t)ranks, sizeof *parts);
-        int failed = !paths || !parts;
+        lm_cli_bake_times *times = calloc((size_t)ranks, sizeof *times);
+        double *arrived = calloc((size_t)ranks, sizeof *arrived);
+        int failed = !paths || !parts || !times || !arrived;
         for (int r = 0; r < ranks; r++) {
             int64_t n = size;
-            unsigned char *data = r ? receive_part(r, &n) : mine;
+            lm_cli_bake_times t = mine_t;
+            unsigned char *data = r ? receive_part(r, &t, &n) : mine;
+            if (times && arrived)
+                times[r] = t, arrived[r] = MPI_Wtime() - started;
             if (data && !a->quiet)
                 printf("bake: part %d of %d in (%.1f s)\n", r + 1, ranks, MPI_Wtime() - started), fflush(stdout);
             if (r && !data) {
@@ -152,13 +175,18 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks)
             merge.file_count = 1 + ranks;
             for (int r = 0; r < ranks; r++)
                 merge.files[1 + r] = parts[r];
+            double merging = MPI_Wtime();
             status = lm_cli_merge(&merge);
+            if (status == 0 && !a->quiet)
+                print_stages(times, arrived, ranks, MPI_Wtime() - merging);
         } else {
             fprintf(stderr, "lmgi: the MPI bake wrote nothing into %s\n", a->out_dir);
             status = 1;
         }
         free(paths);
         free(parts);
+        free(times);
+        free(arrived);
     }
     free(mine);
     if (dir[0])
