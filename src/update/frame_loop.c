@@ -245,11 +245,18 @@ static void pass_span(uint32_t p, uint32_t pass, uint32_t count, uint32_t *first
     *n = count - *first < pass ? count - *first : pass;
 }
 
-/* Gathers steps [r.done, r.steps) of the passes r names into the fresh IIM, a pass at a time. */
+/* Gathers steps [r.done, r.steps) of the passes r names into the fresh IIM, a pass at a time; progress
+ * counts the texels of r's passes. */
 static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t count, checkpointing *ck,
                             lm_error *err)
 {
     lm_status st = LM_OK;
+    uint32_t texels = 0, done = 0, first, n;
+    for (uint32_t s = 0; s < r.steps; s++) {
+        pass_span(lm_checkpoint_step_pass(&r, s), r.pass, count, &first, &n);
+        texels += n;
+        done += s < r.done ? n : 0;
+    }
     for (uint32_t s = r.done; st == LM_OK && s < r.steps; s++) {
         if (fl->set.cancel && *fl->set.cancel) {
             if (ck && (st = checkpoint_save(fl, ck, s, err)) != LM_OK)
@@ -257,13 +264,13 @@ static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t c
             return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u passes%s%s", fl->scene->path, s,
                            r.steps, ck ? ", kept in " : "", ck ? ck->path : "");
         }
-        uint32_t first, n;
         pass_span(lm_checkpoint_step_pass(&r, s), r.pass, count, &first, &n);
         st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, n, fl->iim.fresh_tex, NULL, err);
         if (st == LM_OK && ck && s + 1 < r.steps && lm_now() - ck->last >= ck->seconds)
             st = checkpoint_save(fl, ck, s + 1, err);
+        done += n;
         if (fl->set.progress)
-            fl->set.progress(fl->set.progress_user, s + 1, r.steps);
+            fl->set.progress(fl->set.progress_user, done, texels);
     }
     return st;
 }
