@@ -11,6 +11,7 @@
 #include <mpi.h>
 
 #include <ftw.h>
+#include <lmgi.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -41,15 +42,6 @@ static unsigned char *read_all(const char *path, int64_t *size)
         fclose(f);
     *size = data ? (int64_t)n : -1;
     return data;
-}
-
-static int write_all(const char *path, const unsigned char *data, int64_t size)
-{
-    FILE *f = fopen(path, "wb");
-    int ok = f && fwrite(data, 1, (size_t)size, f) == (size_t)size;
-    if (f && fclose(f) != 0)
-        ok = 0;
-    return ok;
 }
 
 /* Sends (rank > 0) or receives (from `peer`, on rank 0) a part: its shard's stage times and its size
@@ -129,12 +121,13 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks)
     double started = MPI_Wtime();
     lm_cli_bake_times mine_t = {0};
     int rc = dir[0] ? lm_cli_bake_timed(&shard, &mine_t) : 1;
-    int64_t size = -1;
-    unsigned char *mine = rc == 0 ? read_all(part, &size) : NULL;
     int status = 0;
     if (rank > 0) {
-        send_part(&mine_t, mine, mine ? size : -1);
-    } else if (!mine) { /* the others' parts are of no use now: end the job */
+        int64_t size = -1;
+        unsigned char *mine = rc == 0 ? read_all(part, &size) : NULL;
+        send_part(&mine_t, mine, size);
+        free(mine);
+    } else if (rc != 0) { /* the others' parts are of no use now: end the job */
         fprintf(stderr, "lmgi: error: rank 0's shard 1 of %d failed (or the job was stopped: a rank died, or "
                 "mpirun was cancelled); the MPI bake wrote nothing into %s\n", ranks, a->out_dir);
         if (dir[0])
@@ -146,29 +139,33 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks)
         lm_cli_bake_times *times = calloc((size_t)ranks, sizeof *times);
         double *arrived = calloc((size_t)ranks, sizeof *arrived);
         int failed = !paths || !parts || !times || !arrived;
-        for (int r = 0; r < ranks; r++) {
-            int64_t n = size;
+        for (int r = 0; r < ranks; r++) { /* rank 0's own part is merged where its shard wrote it */
+            int64_t n = 0;
             lm_cli_bake_times t = mine_t;
-            unsigned char *data = r ? receive_part(r, &t, &n) : mine;
+            unsigned char *data = r ? receive_part(r, &t, &n) : NULL;
+            int have = !r || data;
             if (times && arrived)
                 times[r] = t, arrived[r] = MPI_Wtime() - started;
-            if (data && !a->quiet)
+            if (have && !a->quiet)
                 printf("bake: part %d of %d in (%.1f s)\n", r + 1, ranks, MPI_Wtime() - started), fflush(stdout);
-            if (r && !data) {
+            if (!have) {
                 fprintf(stderr, "lmgi: error: rank %d's shard %d of %d %s\n", r, r + 1, ranks,
                         n == -2 ? "could not be received (no memory)" : "failed (its message above)");
                 failed = 1;
             }
-            if (data && paths && parts) {
-                snprintf(paths[r], sizeof paths[r], "%s/rank%d.checkpoint", dir, r);
+            if (have && paths && parts) {
+                if (r)
+                    snprintf(paths[r], sizeof paths[r], "%s/rank%d.checkpoint", dir, r);
+                else
+                    snprintf(paths[r], sizeof paths[r], "%s", part);
                 parts[r] = paths[r];
-                if (!write_all(paths[r], data, n)) {
-                    fprintf(stderr, "lmgi: error: cannot write %s\n", paths[r]);
+                lmgi_error e;
+                if (r && lmgi_write_file(paths[r], data, (size_t)n, &e) != LMGI_OK) {
+                    fprintf(stderr, "lmgi: error: %s\n", e.message);
                     failed = 1;
                 }
             }
-            if (r)
-                free(data);
+            free(data);
         }
         if (!failed) {
             lm_cli_args merge = *a;
@@ -188,7 +185,6 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks)
         free(times);
         free(arrived);
     }
-    free(mine);
     if (dir[0])
         nftw(dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
     return rank == 0 ? status : rc;
