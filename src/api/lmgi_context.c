@@ -77,8 +77,7 @@ lmgi_status lmgi_context_create(const lmgi_context_desc *desc, lmgi_context **ou
     lm_log_target saved = lm_api_enter(ctx);
     lm_gl_guest_enter();
     lm_gl_share share = {d.share_display, d.share_context};
-    lm_status st = d.share_context ? lm_gl_context_create_backend(d.gl_backend, &share, &ctx->gl, &e)
-                                   : lm_gl_context_create_backend(d.gl_backend, NULL, &ctx->gl, &e);
+    lm_status st = lm_gl_context_create_backend(d.gl_backend, d.share_context ? &share : NULL, &ctx->gl, &e);
     lm_gl_guest_leave();
     lm_api_leave(saved);
     if (st != LM_OK) {

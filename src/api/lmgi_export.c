@@ -31,6 +31,7 @@ typedef struct {
     const float *lightmap;  /* the displayed IIM, atlas-sized RGBA */
     float rgbd_scale;       /* the RGBD image's values times this are E */
     int lightmap_texture;   /* its glTF texture, -1 when no triangle has texels */
+    const uint8_t *material_lit; /* per material: 1 if any of its triangles has texels (mirrors, glass: 0) */
 } writer;
 
 /* Which uv set a material's textures read: 0, or 2 where the file's base colour texture used TEXCOORD_1
@@ -247,15 +248,6 @@ static void write_texture_ref(FILE *f, const lm_material *m, int texture)
     fputc('}', f);
 }
 
-/* Whether any triangle of the material has lightmap texels (a mirror's and glass's have none). */
-static int material_has_lightmap(const writer *w, int material)
-{
-    for (uint32_t t = 0; t < w->s->tri_count; t++)
-        if (w->s->tri_material[t] == material && w->atlas->tri_chart[t] >= 0)
-            return 1;
-    return 0;
-}
-
 static void write_materials(writer *w)
 {
     const lm_scene *s = w->s;
@@ -284,7 +276,7 @@ static void write_materials(writer *w)
             fprintf(w->doc.json, ",\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}", (double)strength);
         if (m->transmission > 0.0f)
             fprintf(w->doc.json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
-        if (w->lightmap_texture >= 0 && material_has_lightmap(w, i)) /* docs/api.md, "The lightmap in engines" */
+        if (w->lightmap_texture >= 0 && w->material_lit[i]) /* docs/api.md, "The lightmap in engines" */
             fprintf(w->doc.json, ",\"LMGI_lightmap\":{\"lightmapTexture\":{\"index\":%d,\"texCoord\":1},"
                     "\"encoding\":\"RGBD\",\"gamma\":%.9g,\"scale\":%.9g}", w->lightmap_texture,
                     (double)LM_RGBD_GAMMA, (double)w->rgbd_scale);
@@ -506,14 +498,19 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
     writer w = {.s = sc->scene, .atlas = &sc->atlas, .name = name, .lightmap_texture = -1};
     size_t pixels = (size_t)w.atlas->width * (size_t)w.atlas->height;
     float *lightmap = malloc(4 * pixels * sizeof *lightmap);
-    lmgi_status st = lightmap ? lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, lightmap, 4 * pixels, err)
-                              : lm_api_refuse(err, "%s: no memory for the %d x %d lightmap", fn, w.atlas->width,
-                                              w.atlas->height);
+    uint8_t *lit = calloc((size_t)w.s->material_count + 1, 1);
+    lmgi_status st = lightmap && lit ? lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, lightmap, 4 * pixels, err)
+                                     : lm_api_refuse(err, "%s: no memory for the %d x %d lightmap", fn,
+                                                     w.atlas->width, w.atlas->height);
     if (st != LMGI_OK) {
         free(lightmap);
+        free(lit);
         lmgi_output_abort(own);
         return st;
     }
+    for (uint32_t t = 0; t < w.s->tri_count; t++) /* one pass, not one per material */
+        lit[w.s->tri_material[t]] |= w.atlas->tri_chart[t] >= 0;
+    w.material_lit = lit;
     w.lightmap = lightmap;
     w.rgbd_scale = rgbd_scale(lightmap, pixels);
     if (w.atlas->texel_count)
@@ -538,6 +535,7 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
     lm_gltf_close(&w.doc);
     st = ls == LM_OK ? write_lightmap(&w, dir, d.half, err) : lm_export_error(err, &e);
     free(lightmap);
+    free(lit);
     if (own && st == LMGI_OK)
         return lmgi_output_commit(own, err);
     lmgi_output_abort(own);
