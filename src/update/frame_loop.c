@@ -261,8 +261,8 @@ static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t c
         if (fl->set.cancel && *fl->set.cancel) {
             if (ck && (st = checkpoint_save(fl, ck, s, err)) != LM_OK)
                 return st;
-            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u passes%s%s", fl->scene->path, s,
-                           r.steps, ck ? ", kept in " : "", ck ? ck->path : "");
+            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u texels%s%s", fl->scene->path, done,
+                           texels, ck ? ", kept in " : "", ck ? ck->path : "");
         }
         pass_span(lm_checkpoint_step_pass(&r, s), r.pass, count, &first, &n);
         st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, n, fl->iim.fresh_tex, NULL, err);
