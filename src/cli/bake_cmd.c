@@ -182,17 +182,18 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
     lmgi_updater_info ui;
     lmgi_get_info(sc, &in);
     lmgi_get_updater_info(u, &ui);
-    if (a->shards) {
-        printf("baked       share %d of %d of %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, "
-               "AIMs %.0f ms, gather %.0f ms)\nwrote       %s/part.checkpoint (lmgi merge puts the parts together)\n",
-               a->shard, a->shards, in.texels, in.atlas_width, in.atlas_height, ui.photons, lm_cli_now() - started,
-               ui.ms_setup_trace, ui.ms_setup_aim, ui.ms_setup_gather, a->out_dir);
-        return;
-    }
-    printf("%s      %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather "
-           "%.0f ms)\nwrote       %s/lightmap.exr (irradiance, alpha = valid), lightmap.png, aim.exr\n",
-           a->file_count > 1 ? "merged" : "baked ", in.texels, in.atlas_width, in.atlas_height, ui.photons,
-           lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim, ui.ms_setup_gather, a->out_dir);
+    char what[64];
+    if (a->shards)
+        snprintf(what, sizeof what, "baked       share %d of %d of", a->shard, a->shards);
+    else
+        snprintf(what, sizeof what, "%s     ", a->file_count > 1 ? "merged" : "baked ");
+    printf("%s %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather %.0f ms)\n",
+           what, in.texels, in.atlas_width, in.atlas_height, ui.photons, lm_cli_now() - started, ui.ms_setup_trace,
+           ui.ms_setup_aim, ui.ms_setup_gather);
+    if (a->shards)
+        printf("wrote       %s/part.checkpoint (lmgi merge puts the parts together)\n", a->out_dir);
+    else
+        printf("wrote       %s/lightmap.exr (irradiance, alpha = valid), lightmap.png, aim.exr\n", a->out_dir);
     if (a->gltf)
         printf("            %s/%s.gltf (TEXCOORD_1: the lightmap's UVs) with %s_lightmap.exr and .png\n", a->out_dir,
                name, name);
@@ -239,8 +240,9 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     int rc = 0;
     if (lmgi_context_create(NULL, &ctx, &e) != LMGI_OK || lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK) {
         if (e.status == LMGI_ERR_CANCELLED)
-            fprintf(stderr, "\nlmgi: %s cancelled after %.1f s (%s); no lightmap written (an earlier bake's kept); the "
-                    "same command with --resume continues it\n", command, lm_cli_now() - started, e.message);
+            fprintf(stderr, "\nlmgi: %s cancelled after %.1f s (%s); no lightmap written (an earlier bake's kept)%s\n",
+                    command, lm_cli_now() - started, e.message,
+                    parts ? "" : "; the same command with --resume continues it"); /* merge has no --resume */
         else
             fprintf(stderr, "lmgi: error: %s\n", e.message);
         rc = e.status == LMGI_ERR_CANCELLED ? 130 : 1;
