@@ -8,6 +8,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -171,6 +172,112 @@ static void test_deterministic(void **state)
     free(sc.h);
     world_free(&a);
     world_free(&b);
+}
+
+/* ---- a trace shared among processes (lm_photon_split), the processes played by threads ---- */
+
+#define SHARES 3
+
+typedef struct {
+    pthread_barrier_t barrier;
+    const void *mine[SHARES];
+    size_t size[SHARES];
+    int calls[SHARES];
+} hub;
+
+typedef struct {
+    hub *h;
+    uint32_t id;
+    const char *path;
+    world w;
+} process;
+
+/* An allgather over the hub: each process's bytes posted, everyone waits, reads, and waits again before
+ * a process may post the next batch's. */
+static int hub_exchange(void *user, const void *mine, size_t size, size_t *sizes, void *all)
+{
+    process *p = user;
+    hub *h = p->h;
+    h->mine[p->id] = mine, h->size[p->id] = size;
+    h->calls[p->id]++;
+    pthread_barrier_wait(&h->barrier);
+    size_t at = 0;
+    for (int q = 0; q < SHARES; q++) {
+        if (all)
+            memcpy((unsigned char *)all + at, h->mine[q], h->size[q]);
+        else
+            sizes[q] = h->size[q];
+        at += h->size[q];
+    }
+    pthread_barrier_wait(&h->barrier);
+    return 1;
+}
+
+static void *process_trace(void *arg)
+{
+    process *p = arg;
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    lm_error err;
+    if (lm_photons_create(p->w.s, &p->w.su, p->w.rt, &p->w.em, &set, &p->w.ph, &err) != LM_OK)
+        return "create";
+    lm_photon_split sp = {p->id, SHARES, hub_exchange, p};
+    lm_photons_set_split(p->w.ph, &sp);
+    return lm_photons_trace_all(p->w.ph, NULL, &err) == LM_OK ? NULL : "trace";
+}
+
+/* Three processes (threads here, one OpenMP thread each) share a full trace of the two-rooms scene: each
+ * traces a third of the photons, and every one ends with the store one process makes alone, slot for
+ * slot. */
+static void test_split_trace_is_one_process_trace(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world one;
+    world_load(&one, path);
+    world_photons(&one, &set);
+    hub h;
+    memset(&h, 0, sizeof h);
+    pthread_barrier_init(&h.barrier, NULL, SHARES);
+    process p[SHARES];
+    pthread_t t[SHARES];
+    int threads = omp_get_max_threads();
+    omp_set_num_threads(1);
+    for (uint32_t i = 0; i < SHARES; i++) {
+        p[i] = (process){&h, i, path, {0}};
+        world_load(&p[i].w, path);
+    }
+    for (uint32_t i = 0; i < SHARES; i++)
+        assert_int_equal(pthread_create(&t[i], NULL, process_trace, &p[i]), 0);
+    for (uint32_t i = 0; i < SHARES; i++) {
+        void *failed = NULL;
+        pthread_join(t[i], &failed);
+        if (failed)
+            fail_msg("process %u: %s failed", i, (const char *)failed);
+    }
+    omp_set_num_threads(threads);
+    const lm_photon_store *a = lm_photons_store(one.ph);
+    snapshot sa = take_snapshot(one.ph);
+    for (uint32_t i = 0; i < SHARES; i++) {
+        const lm_photon_store *b = lm_photons_store(p[i].w.ph);
+        assert_int_equal(b->used, a->used);
+        assert_memory_equal(b->hits, a->hits, sizeof *a->hits * a->used); /* slot for slot */
+        snapshot sb = take_snapshot(p[i].w.ph);
+        assert_same_snapshot(&sa, &sb);
+        free(sb.h);
+        assert_int_equal(h.calls[i], h.calls[0]);
+    }
+    /* two calls a batch of at most 16,384 photons */
+    assert_true(h.calls[0] >= 2 * (int)((lm_photons_count(one.ph) + 16383) / 16384));
+    print_message("%u photons, %u stored hits, traced by %d processes in %d exchanges\n", lm_photons_count(one.ph),
+                  lm_photons_stored_hits(one.ph), SHARES, h.calls[0]);
+    free(sa.h);
+    pthread_barrier_destroy(&h.barrier);
+    for (uint32_t i = 0; i < SHARES; i++)
+        world_free(&p[i].w);
+    world_free(&one);
 }
 
 /* Each group's photons share one cell of the 8 x 9 stratification of the first two QMC coordinates:
@@ -717,6 +824,7 @@ int main(void)
         cmocka_unit_test(test_settings),
         cmocka_unit_test(test_cornell_rate_and_memory),
         cmocka_unit_test(test_hidden_light),
+        cmocka_unit_test(test_split_trace_is_one_process_trace),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -273,6 +273,10 @@ static void trace_jobs(const lm_photons *ph, ph_batch *b, int *failed)
         ph_job *j = &jobs[i];
         j->buffer = (uint32_t)t;
         j->first = (uint32_t)buf.len;
+        if (b->shares > 1 && (b->first_photon + (uint64_t)i) % b->shares != b->share) {
+            j->count = j->rays = j->stored = 0; /* another process's: the exchange brings it */
+            continue;
+        }
         if (!ph_trace_photon(ph, j, &buf)) {
 #pragma omp atomic write
             *failed = 1;

@@ -418,9 +418,17 @@ lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_
         pop_invalid(ph);
     for (uint32_t g = 0; g < ph->group_count; g++)
         ph->tmp_groups[g] = g;
-    lm_status s = ph_trace_groups(ph, ph->tmp_groups, ph->group_count, st, err);
+    lm_status s = ph->split.shares > 1 ? ph_trace_groups_split(ph, ph->tmp_groups, ph->group_count, st, err)
+                                       : ph_trace_groups(ph, ph->tmp_groups, ph->group_count, st, err);
     finish_stats(ph, st, t0);
     return s;
+}
+
+void lm_photons_set_split(lm_photons *ph, const lm_photon_split *split)
+{
+    memset(&ph->split, 0, sizeof ph->split);
+    if (split && split->shares > 1 && split->share < split->shares && split->exchange)
+        ph->split = *split;
 }
 
 /* Round robin (section 2): k photons of every valid group are re-traced and compared with their

@@ -98,6 +98,25 @@ void lm_photons_free(lm_photons *ph);
  * slots, without the allocation and page faults of a first trace. */
 void lm_photons_reset(lm_photons *ph);
 
+/* A full trace shared among processes (an MPI bake, docs/farm.md). Every process holds the same scene
+ * and settings and calls lm_photons_trace_all at the same points; in each, the photons are dealt out in
+ * turn in the order they are traced (photon k of the trace to process k mod shares), each process traces
+ * its own, and `exchange` gives every process the others' paths, which each then stores in the same order
+ * as one process tracing all would: every process ends with the one-process store, to the bit.
+ *
+ * exchange is collective (every process calls it as often, with its bytes for that batch) and called
+ * twice per batch: first with all NULL, to fill sizes[0 .. shares) with each process's byte count, then
+ * with `all` holding the sum of them, to fill with every process's bytes back to back in process order.
+ * It returns 0 on failure (the trace then fails with LM_ERR_BACKEND). The round robin and re-traces of
+ * lm_photons_frame stay each process's own. */
+typedef struct {
+    uint32_t share, shares;    /* this process and how many; shares 0 or 1: no sharing */
+    int (*exchange)(void *user, const void *mine, size_t size, size_t *sizes, void *all);
+    void *user;
+} lm_photon_split;
+/* Sets (or with shares <= 1, ends) the sharing of full traces. */
+void lm_photons_set_split(lm_photons *ph, const lm_photon_split *split);
+
 /* Traces every photon and stores its path and hits (initial full trace; also a full refresh: paths
  * that did not change cause no store change). Clears the invalid queue. stats may be NULL. */
 lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);

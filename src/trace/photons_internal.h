@@ -52,6 +52,11 @@ typedef struct {
     ph_buffer *buffers;
     int buffer_count;
     uint64_t rays;             /* rays cast by the last ph_trace_batch */
+    /* A trace shared among processes (photon_split.c): with shares > 1, ph_trace_batch traces only the
+     * jobs i whose first_photon + i is share modulo shares, and leaves the others empty for the exchange
+     * to fill. shares 0 or 1: every job. */
+    uint32_t share, shares;
+    uint64_t first_photon;
 } ph_batch;
 
 struct lm_photons {
@@ -88,6 +93,7 @@ struct lm_photons {
     uint32_t *tmp_offsets;     /* max_group_photons + 1 */
     uint8_t *tmp_changed;      /* max_group_photons */
     uint32_t *tmp_groups;      /* group_count */
+    lm_photon_split split;     /* shares 0 or 1: the process traces every photon itself */
 };
 
 /* photon_trace.c: the 4 emission numbers of photon id (QMC dims 0-3), as ph_group.emit_u keeps them.
@@ -113,6 +119,12 @@ int ph_batch_push(ph_batch *b, uint32_t group, uint32_t m);
  * thread fills a re-trace's batches on its own, between applying and tracing). */
 int ph_batch_push_group(ph_batch *b, uint32_t group, uint32_t photons);
 void ph_batch_free(ph_batch *b);
+
+/* photon_split.c: ph_trace_groups for a trace shared among processes (lm_photons_set_split): each
+ * batch's photons dealt out in turn, each process tracing its own, the paths exchanged and applied by
+ * every process in batch order, so every process's store is the one-process trace's. */
+lm_status ph_trace_groups_split(lm_photons *ph, const uint32_t *list, uint32_t n, lm_photon_frame_stats *st,
+                                lm_error *err);
 
 /* photons.c: fills b with whole groups from list[*i ...] (at least one group, up to a batch's photon
  * bound); empty when the list is used up. Counts the groups' re-traces in g and st. */

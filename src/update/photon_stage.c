@@ -249,6 +249,8 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     if (!ps->set.trace) /* one photon a light, never traced: the emitters' bookkeeping without the cost */
         photons.total_photons = 0, photons.groups = 1, photons.per_group = 1;
     st = lm_photons_create(ps->scene, ps->surfaces, ps->rt, &ps->emitters, &photons, &ps->photons, err);
+    if (st == LM_OK)
+        lm_photons_set_split(ps->photons, &ps->set.split);
     if (st == LM_OK && ps->set.trace)
         st = lm_photons_trace_all(ps->photons, &first->photons, err);
     double t1 = lm_now();

@@ -25,6 +25,7 @@ typedef struct {
     int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
                               * them: no work at all). Default 0; the frame loop follows the scene's effects */
     lm_caustic_settings caustic;
+    lm_photon_split split;   /* full traces shared among processes (photons.h); zero: none */
 } lm_photon_stage_settings;
 
 typedef struct {
