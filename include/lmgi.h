@@ -523,6 +523,22 @@ typedef struct {
     int shard, shards;
     const char *const *parts;
     int part_count;
+    /* a bake by processes that work together (an MPI bake, docs/farm.md): every process has the same scene
+     * and desc but its own shard (0 to shards - 1, shards > 1), and these calls connect them.
+     * photon_exchange (NULL: each traces every photon) shares the photon trace: photon k of a full trace is
+     * traced by process k mod shards alone, and the paths are exchanged so that every process stores them
+     * all, the one-process photon map to the bit. It is collective (every process calls it as often) and
+     * called twice per batch of photons: with all NULL, to fill sizes[0 .. shards) with every process's
+     * byte count (this one's is `size`), then to fill `all` (their sum) with every process's bytes back to
+     * back in process order. Return 0 on failure (the call then fails with LMGI_ERR_BACKEND).
+     * claim_pass (NULL: every shards-th pass from shard, as above) hands out the first gather's passes as
+     * the processes finish them, so that each gathers what its speed allows: called between passes with
+     * the number of passes, it returns the next pass this process gathers (0 to passes - 1, each pass to
+     * one process only) or -1 when none is left. The part then lists the passes it took; parts are put
+     * together as above, refused when two hold one pass or a pass is in none. */
+    int (*photon_exchange)(void *user, const void *mine, size_t size, size_t *sizes, void *all);
+    int (*claim_pass)(void *user, int passes);
+    void *share_user;
 } lmgi_updater_desc;
 
 /* What one lmgi_update did and what it cost (milliseconds). With the photon work on a second thread

@@ -1100,6 +1100,142 @@ static void test_shard_cancelled_and_resumed(void **state)
     close_all(NULL, sc, ctx);
 }
 
+/* ---- a bake shared by processes that work together (the desc's photon_exchange and claim_pass),
+ * the processes played by threads, each with its own context ---- */
+
+typedef struct {
+    pthread_barrier_t barrier;
+    const void *mine[2];
+    size_t size[2];
+    atomic_int next;     /* the next pass to hand out */
+    int exchanges;
+} share_hub;
+
+typedef struct {
+    share_hub *h;
+    int id, taken;
+    char part[512];
+    lmgi_status status;
+    char message[1024];
+} share_process;
+
+static int share_exchange(void *user, const void *mine, size_t size, size_t *sizes, void *all)
+{
+    share_process *p = user;
+    share_hub *h = p->h;
+    h->mine[p->id] = mine, h->size[p->id] = size;
+    if (p->id == 0)
+        h->exchanges++;
+    pthread_barrier_wait(&h->barrier);
+    size_t at = 0;
+    for (int q = 0; q < 2; q++) {
+        if (all)
+            memcpy((unsigned char *)all + at, h->mine[q], h->size[q]);
+        else
+            sizes[q] = h->size[q];
+        at += h->size[q];
+    }
+    pthread_barrier_wait(&h->barrier);
+    return 1;
+}
+
+static int share_claim(void *user, int passes)
+{
+    share_process *p = user;
+    int pass = atomic_fetch_add(&p->h->next, 1);
+    if (pass >= passes)
+        return -1;
+    p->taken++;
+    return pass;
+}
+
+static int claim_beyond(void *user, int passes)
+{
+    (void)user;
+    return passes;
+}
+
+static void *share_bake(void *arg)
+{
+    share_process *p = arg;
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    p->status = lmgi_context_create(NULL, &ctx, &e);
+    lmgi_scene *sc = p->status == LMGI_OK ? load_scene("cornell.glb", 8000) : NULL;
+    lmgi_updater_desc d = {.photons = 6000, .shard = p->id, .shards = 2, .checkpoint = p->part,
+                           .photon_exchange = share_exchange, .claim_pass = share_claim, .share_user = p};
+    lmgi_updater *u = NULL;
+    if (p->status == LMGI_OK)
+        p->status = lmgi_updater_create(ctx, sc, &d, &u, &e);
+    if (p->status != LMGI_OK)
+        snprintf(p->message, sizeof p->message, "%s", e.message);
+    close_all(u, sc, ctx);
+    return NULL;
+}
+
+/* Two processes share a bake: the photons traced half each and exchanged, the gather's passes handed out
+ * as each finishes one; their two parts put together are one process's bake, bit for bit (IIM and AIM).
+ * A part missing, a part resumed and the desc's rules are refused, naming them. */
+static void test_shared_bake_is_one_process_bake(void **state)
+{
+    (void)state;
+    share_hub h;
+    memset(&h, 0, sizeof h);
+    pthread_barrier_init(&h.barrier, NULL, 2);
+    atomic_init(&h.next, 0);
+    share_process p[2];
+    pthread_t t[2];
+    for (int i = 0; i < 2; i++) {
+        p[i] = (share_process){.h = &h, .id = i};
+        snprintf(p[i].part, sizeof p[i].part, "%s/shared%d.part", lmt_tmpdir(), i);
+        assert_int_equal(pthread_create(&t[i], NULL, share_bake, &p[i]), 0);
+    }
+    for (int i = 0; i < 2; i++) {
+        pthread_join(t[i], NULL);
+        if (p[i].status != LMGI_OK)
+            fail_msg("process %d: %s", i, p[i].message);
+    }
+    pthread_barrier_destroy(&h.barrier);
+    print_message("passes taken: %d and %d; %d photon exchanges\n", p[0].taken, p[1].taken, h.exchanges);
+    assert_true(p[0].taken > 0 && p[1].taken > 0 && h.exchanges > 0);
+
+    lmgi_context *ctx = new_context();
+    lmgi_scene *sc = load_scene("cornell.glb", 8000);
+    lmgi_error e;
+    lmgi_updater_desc whole = {.photons = 6000};
+    const char *const parts[2] = {p[0].part, p[1].part};
+    lmgi_updater_desc merged = {.photons = 6000, .parts = parts, .part_count = 2};
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * (size_t)in.atlas_height;
+    float *maps[2][2];
+    const lmgi_updater_desc *descs[2] = {&whole, &merged};
+    for (int k = 0; k < 2; k++) {
+        lmgi_updater *u = make_updater(ctx, sc, descs[k]);
+        for (int m = 0; m < 2; m++) {
+            maps[k][m] = malloc(n * sizeof(float));
+            assert_int_equal(lmgi_get_lightmap(u, m ? LMGI_LIGHTMAP_AIM : LMGI_LIGHTMAP_IIM, maps[k][m], n, &e), LMGI_OK);
+        }
+        lmgi_updater_free(u);
+    }
+    assert_memory_equal(maps[0][0], maps[1][0], n * sizeof(float));
+    assert_memory_equal(maps[0][1], maps[1][1], n * sizeof(float));
+    for (int k = 0; k < 2; k++)
+        free(maps[k][0]), free(maps[k][1]);
+
+    lmgi_updater *u = NULL;
+    merged.part_count = 1;
+    expect_invalid(lmgi_updater_create(ctx, sc, &merged, &u, &e), &e, "are in no part");
+    lmgi_updater_desc bad = {.photons = 6000, .shard = 0, .shards = 2, .checkpoint = p[0].part, .resume = 1};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "a shared (MPI) bake: it does not resume");
+    bad = (lmgi_updater_desc){.claim_pass = share_claim, .share_user = &p[0], .checkpoint = p[0].part};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "claim_pass connects the processes");
+    bad = (lmgi_updater_desc){.photons = 6000, .shard = 0, .shards = 2, .checkpoint = p[0].part,
+                              .claim_pass = claim_beyond};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "claim_pass gave pass");
+    close_all(NULL, sc, ctx);
+}
+
 static void test_exported_symbols(void **state)
 {
     (void)state;
@@ -1149,6 +1285,7 @@ int main(void)
         cmocka_unit_test(test_scene_from_arrays),
         cmocka_unit_test(test_second_thread_refused),
         cmocka_unit_test(test_shard_cancelled_and_resumed),
+        cmocka_unit_test(test_shared_bake_is_one_process_bake),
         cmocka_unit_test(test_exported_symbols),
     };
     lmgi_set_verbosity(0); /* the refusals below log errors on purpose */

@@ -224,6 +224,9 @@ static lm_status check_shards(const lmgi_updater_desc *d, lm_error *err)
     if (d->parts && (d->shards > 0 || d->resume))
         return lm_fail(err, LM_ERR_INVALID, "%s: parts are put together into a whole bake: not with %s", fn,
                        d->shards > 0 ? "a shard" : "resume");
+    if ((d->photon_exchange || d->claim_pass) && (d->shards < 2 || d->resume))
+        return lm_fail(err, LM_ERR_INVALID, "%s: %s connects the processes of a shared bake: it needs shards > 1 "
+                       "(here %d) and no resume", fn, d->photon_exchange ? "photon_exchange" : "claim_pass", d->shards);
     return LM_OK;
 }
 
@@ -271,6 +274,9 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     if (st == LM_OK)
         st = check_shards(&d, &e);
     set.shard = d.shard, set.shards = d.shards, set.parts = d.parts, set.part_count = d.part_count;
+    set.claim_pass = d.claim_pass, set.claim_user = d.share_user;
+    if (d.photon_exchange)
+        set.stage.split = (lm_photon_split){(uint32_t)d.shard, (uint32_t)d.shards, d.photon_exchange, d.share_user};
     lmgi_updater *u = st == LM_OK ? calloc(1, sizeof *u) : NULL;
     if (st == LM_OK && !u)
         st = lm_fail(&e, LM_ERR_NOMEM, "no memory for an updater");

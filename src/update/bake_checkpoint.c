@@ -10,7 +10,7 @@
 #include "../core/image.h"
 #include "../scene/sky.h"
 
-static const char k_magic[8] = {'L', 'M', 'G', 'I', 'C', 'K', 'P', '2'};
+static const char k_magic[8] = {'L', 'M', 'G', 'I', 'C', 'K', 'P', '3'};
 
 uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *gather,
                            const uint32_t *order, uint32_t count, const float *aim_dilated_rgba)
@@ -33,7 +33,7 @@ uint64_t lm_checkpoint_key(const lm_scene *s, const lm_atlas *a, const lm_hemicu
 
 uint32_t lm_checkpoint_step_pass(const lm_checkpoint_range *r, uint32_t s)
 {
-    return r->shards ? r->shard + s * r->shards : s;
+    return r->list ? r->list[s] : r->shards ? r->shard + s * r->shards : s;
 }
 
 uint32_t lm_checkpoint_steps(uint32_t count, uint32_t pass, uint32_t shard, uint32_t shards)
@@ -47,7 +47,7 @@ uint32_t lm_checkpoint_steps(uint32_t count, uint32_t pass, uint32_t shard, uint
 typedef struct {
     char magic[8];
     uint64_t key;
-    uint32_t count, pass, steps, done, shard, shards;
+    uint32_t count, pass, steps, done, shard, shards, listed;
     int32_t width, height;
 } header;
 
@@ -59,16 +59,19 @@ lm_status lm_checkpoint_write(const char *path, uint64_t key, const lm_atlas *a,
     memcpy(hd.magic, k_magic, sizeof hd.magic);
     hd.key = key, hd.count = count, hd.width = a->width, hd.height = a->height;
     hd.pass = range->pass, hd.steps = range->steps, hd.done = range->done;
-    hd.shard = range->shard, hd.shards = range->shards;
+    hd.shard = range->shard, hd.shards = range->shards, hd.listed = range->list != NULL;
     size_t n = 4 * sizeof(float) * (size_t)a->width * (size_t)a->height;
-    unsigned char *file = malloc(sizeof hd + n + sizeof(uint64_t));
+    size_t list = hd.listed ? sizeof(uint32_t) * range->steps : 0, body = sizeof hd + n + list;
+    unsigned char *file = malloc(body + sizeof(uint64_t));
     if (!file)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake's checkpoint", path);
     memcpy(file, &hd, sizeof hd);
     memcpy(file + sizeof hd, rgba, n);
-    uint64_t sum = lm_hash_bytes(LM_HASH_SEED, file, sizeof hd + n);
-    memcpy(file + sizeof hd + n, &sum, sizeof sum);
-    lm_status st = lm_write_file(path, file, sizeof hd + n + sizeof sum, err); /* whole or not at all */
+    if (list)
+        memcpy(file + sizeof hd + n, range->list, list);
+    uint64_t sum = lm_hash_bytes(LM_HASH_SEED, file, body);
+    memcpy(file + body, &sum, sizeof sum);
+    lm_status st = lm_write_file(path, file, body + sizeof sum, err); /* whole or not at all */
     free(file);
     return st;
 }
@@ -90,13 +93,22 @@ lm_status lm_checkpoint_read(const char *path, uint64_t key, const lm_atlas *a, 
                        "%s: a checkpoint of another scene or other settings (its key %016llx, this bake's %016llx); "
                        "%s", path, (unsigned long long)hd.key, (unsigned long long)key, advice);
     }
-    ok = ok && hd.pass > 0 && hd.done <= hd.steps && hd.steps == lm_checkpoint_steps(count, hd.pass, hd.shard, hd.shards) &&
-         hd.shards <= LM_MAX_SHARDS && (hd.shards ? hd.shard < hd.shards : hd.shard == 0) && fread(rgba, 1, n, f) == n &&
-         fread(&sum, sizeof sum, 1, f) == 1 && fgetc(f) == EOF &&
-         sum == lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n);
+    uint32_t passes = ok && hd.pass > 0 ? lm_checkpoint_steps(count, hd.pass, 0, 0) : 0, *list = NULL;
+    ok = ok && hd.pass > 0 && hd.done <= hd.steps && hd.listed <= 1 && hd.shards <= LM_MAX_SHARDS &&
+         (hd.listed ? hd.steps <= passes && hd.shards > 1 : hd.steps == lm_checkpoint_steps(count, hd.pass, hd.shard, hd.shards)) &&
+         (hd.shards ? hd.shard < hd.shards : hd.shard == 0) && fread(rgba, 1, n, f) == n;
+    size_t list_bytes = hd.listed ? sizeof *list * hd.steps : 0;
+    if (ok && hd.listed && (!(list = malloc(list_bytes ? list_bytes : 1)) || fread(list, 1, list_bytes, f) != list_bytes))
+        ok = 0;
+    ok = ok && fread(&sum, sizeof sum, 1, f) == 1 && fgetc(f) == EOF &&
+         sum == lm_hash_bytes(lm_hash_bytes(lm_hash_bytes(LM_HASH_SEED, &hd, sizeof hd), rgba, n), list, list_bytes);
+    for (uint32_t s = 0; ok && list && s < hd.steps; s++)
+        ok = list[s] < passes;
     fclose(f);
-    if (!ok)
+    if (!ok) {
+        free(list);
         return lm_fail(err, LM_ERR_INVALID, "%s: not an lmgi bake checkpoint, or damaged", path);
-    *range = (lm_checkpoint_range){hd.pass, hd.steps, hd.done, hd.shard, hd.shards};
+    }
+    *range = (lm_checkpoint_range){hd.pass, hd.steps, hd.done, hd.shard, hd.shards, list};
     return LM_OK;
 }

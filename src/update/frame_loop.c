@@ -275,11 +275,40 @@ static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t c
     return st;
 }
 
+/* The passes of the order that set.claim_pass hands this process, gathered into the fresh IIM as they
+ * come; ck->r lists them. Progress says how far the handing out has gone: the whole shared bake's. */
+static lm_status gather_claimed(lm_frame_loop *fl, uint32_t count, checkpointing *ck, lm_error *err)
+{
+    uint32_t passes = lm_checkpoint_steps(count, ck->r.pass, 0, 0), first, n;
+    ck->r.steps = ck->r.done = 0;
+    if (!(ck->r.list = malloc(sizeof *ck->r.list * (passes ? passes : 1))))
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the list of the bake's passes");
+    lm_status st = LM_OK;
+    while (st == LM_OK) {
+        if (fl->set.cancel && *fl->set.cancel)
+            return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u passes of this process", fl->scene->path,
+                           ck->r.steps);
+        int p = fl->set.claim_pass(fl->set.claim_user, (int)passes);
+        if (p < 0)
+            break;
+        if ((uint32_t)p >= passes || ck->r.steps == passes)
+            return lm_fail(err, LM_ERR_INVALID, "%s: claim_pass gave pass %d of %u (%u taken already)",
+                           fl->scene->path, p, passes, ck->r.steps);
+        pass_span((uint32_t)p, ck->r.pass, count, &first, &n);
+        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, n, fl->iim.fresh_tex, NULL, err);
+        ck->r.list[ck->r.steps++] = (uint32_t)p;
+        if (fl->set.progress)
+            fl->set.progress(fl->set.progress_user, first + n, count);
+    }
+    ck->r.done = ck->r.steps;
+    return st;
+}
+
 /* Gathers the first count scheduled texels, in passes when someone watches. */
 static lm_status gather_texels(lm_frame_loop *fl, uint32_t count, lm_error *err)
 {
     uint32_t pass = pass_texels(fl, 0, count);
-    lm_checkpoint_range all = {pass, lm_checkpoint_steps(count, pass, 0, 0), 0, 0, 0};
+    lm_checkpoint_range all = {pass, lm_checkpoint_steps(count, pass, 0, 0), 0, 0, 0, NULL};
     return gather_run(fl, all, count, NULL, err);
 }
 
@@ -291,61 +320,108 @@ static lm_status gather(lm_frame_loop *fl, uint32_t count, lm_error *err)
     return st == LM_OK ? gather_texels(fl, count, err) : st;
 }
 
+/* Part p (read into r) checked against the parts before it: of a shared bake's shards, of the same
+ * count, a shard no other part is (for dealt parts), passes of this bake's size, finished. */
+static lm_status check_part(const lm_frame_loop *fl, const checkpointing *ck, int p, const lm_checkpoint_range *r,
+                            const lm_checkpoint_range *first, const int *have, lm_error *err)
+{
+    const char *const *parts = fl->set.parts;
+    if (!r->shards)
+        return lm_fail(err, LM_ERR_INVALID, "%s: a whole bake's checkpoint, not a shard's part", parts[p]);
+    if (p > 0 && (r->shards != first->shards || !r->list != !first->list))
+        return lm_fail(err, LM_ERR_INVALID, "%s: a part of a bake in %u %s; %s's was in %u %s", parts[p], r->shards,
+                       r->list ? "processes" : "shards", parts[0], first->shards, first->list ? "processes" : "shards");
+    if (have[r->shard] >= 0)
+        return lm_fail(err, LM_ERR_INVALID, "%s and %s are both shard %u of %u", parts[have[r->shard]], parts[p],
+                       r->shard + 1, r->shards);
+    if (r->pass != ck->r.pass) /* the key holds the settings that make the pass */
+        return lm_fail(err, LM_ERR_INVALID, "%s: passes of %u texels, this bake's of %u", parts[p], r->pass, ck->r.pass);
+    if (r->done != r->steps)
+        return lm_fail(err, LM_ERR_INVALID, "%s: an unfinished part (%u of its %u passes gathered); finish its "
+                       "shard with --resume", parts[p], r->done, r->steps);
+    return LM_OK;
+}
+
+/* Part p's passes marked as its own in owner[] (one part a pass) and its texels copied into ck->rgba. */
+static lm_status take_part(lm_frame_loop *fl, checkpointing *ck, int p, const lm_checkpoint_range *r,
+                           const float *part, int *owner, lm_error *err)
+{
+    for (uint32_t s = 0; s < r->steps; s++) {
+        uint32_t pass = lm_checkpoint_step_pass(r, s), first, count;
+        if (owner[pass] >= 0)
+            return lm_fail(err, LM_ERR_INVALID, "%s and %s both hold pass %u of the gather", fl->set.parts[owner[pass]],
+                           fl->set.parts[p], pass);
+        owner[pass] = p;
+        pass_span(pass, r->pass, ck->count, &first, &count);
+        for (uint32_t i = first; i < first + count; i++) {
+            const lm_texel *t = &fl->atlas->texels[fl->texels[i]];
+            size_t at = 4 * ((size_t)t->y * fl->atlas->width + t->x);
+            memcpy(ck->rgba + at, part + at, 4 * sizeof *part);
+        }
+    }
+    return LM_OK;
+}
+
+/* What no part holds, named: a dealt bake's missing shard, or a shared bake's passes in no part. */
+static lm_status missing_parts(const lm_frame_loop *fl, const checkpointing *ck, const lm_checkpoint_range *first,
+                               const int *have, const int *owner, lm_error *err)
+{
+    uint32_t passes = ck->r.steps, lost = 0, at = 0;
+    for (uint32_t k = 0; !first->list && k < first->shards; k++)
+        if (have[k] < 0)
+            return lm_fail(err, LM_ERR_INVALID, "%s: shard %u of %u is missing (%u of the %u passes); merge needs one "
+                           "part of each", fl->scene->path, k + 1, first->shards,
+                           lm_checkpoint_steps(ck->count, ck->r.pass, k, first->shards), passes);
+    for (uint32_t q = passes; q-- > 0;)
+        if (owner[q] < 0)
+            lost++, at = q;
+    if (lost)
+        return lm_fail(err, LM_ERR_INVALID, "%s: %u of the gather's %u passes (the first: pass %u) are in no part; "
+                       "a process of the shared bake is missing", fl->scene->path, lost, passes, at);
+    return LM_OK;
+}
+
 /* The parts of a bake in shards put together into ck->rgba: each part's texels copied from its file, one
- * part of each shard, the parts holding every texel once. */
+ * part of each shard, every pass of the gather in exactly one part. */
 static lm_status join_parts(lm_frame_loop *fl, checkpointing *ck, lm_error *err)
 {
     size_t n = 4 * (size_t)fl->atlas->width * (size_t)fl->atlas->height;
+    uint32_t passes = ck->r.steps;
     float *part = malloc(n * sizeof *part);
-    int *have = malloc(sizeof *have * (LM_MAX_SHARDS + 1));
-    uint32_t shards = 0;
-    if (!part || !have) {
+    int *have = malloc(sizeof *have * (LM_MAX_SHARDS + 1)), *owner = malloc(sizeof *owner * (passes + 1));
+    if (!part || !have || !owner) {
         free(part);
         free(have);
+        free(owner);
         return lm_fail(err, LM_ERR_NOMEM, "no memory to join the bake's parts");
     }
     memset(ck->rgba, 0, n * sizeof *ck->rgba);
     for (int k = 0; k <= LM_MAX_SHARDS; k++)
         have[k] = -1;
+    for (uint32_t q = 0; q < passes; q++)
+        owner[q] = -1;
     lm_status st = LM_OK;
+    lm_checkpoint_range first = {0};
     for (int p = 0; p < fl->set.part_count && st == LM_OK; p++) {
         lm_checkpoint_range r;
         st = lm_checkpoint_read(fl->set.parts[p], ck->key, fl->atlas, ck->count, part, &r,
                                 "give merge the scene and the options its shards were baked with", err);
-        if (st == LM_OK && !r.shards)
-            st = lm_fail(err, LM_ERR_INVALID, "%s: a whole bake's checkpoint, not a shard's part", fl->set.parts[p]);
-        if (st == LM_OK && (shards ? r.shards != shards : (shards = r.shards, 0)))
-            st = lm_fail(err, LM_ERR_INVALID, "%s: a part of a bake in %u shards; %s's was in %u", fl->set.parts[p],
-                         r.shards, fl->set.parts[0], shards);
-        if (st == LM_OK && have[r.shard] >= 0)
-            st = lm_fail(err, LM_ERR_INVALID, "%s and %s are both shard %u of %u", fl->set.parts[have[r.shard]],
-                         fl->set.parts[p], r.shard + 1, shards);
-        if (st == LM_OK && r.pass != ck->r.pass) /* the key holds the settings that make the pass */
-            st = lm_fail(err, LM_ERR_INVALID, "%s: passes of %u texels, this bake's of %u", fl->set.parts[p], r.pass,
-                         ck->r.pass);
-        if (st == LM_OK && r.done != r.steps)
-            st = lm_fail(err, LM_ERR_INVALID, "%s: an unfinished part (%u of its %u passes gathered); finish its "
-                         "shard with --resume", fl->set.parts[p], r.done, r.steps);
         if (st != LM_OK)
             break;
-        have[r.shard] = p;
-        for (uint32_t s = 0; s < r.steps; s++) {
-            uint32_t first, count;
-            pass_span(lm_checkpoint_step_pass(&r, s), r.pass, ck->count, &first, &count);
-            for (uint32_t i = first; i < first + count; i++) {
-                const lm_texel *t = &fl->atlas->texels[fl->texels[i]];
-                size_t at = 4 * ((size_t)t->y * fl->atlas->width + t->x);
-                memcpy(ck->rgba + at, part + at, 4 * sizeof *part);
-            }
-        }
+        if (p == 0)
+            first = r; /* its list freed at the end */
+        st = check_part(fl, ck, p, &r, &first, have, err);
+        if (st == LM_OK)
+            have[r.shard] = p, st = take_part(fl, ck, p, &r, part, owner, err);
+        if (p > 0)
+            free(r.list);
     }
-    for (uint32_t k = 0; st == LM_OK && k < shards; k++)
-        if (have[k] < 0)
-            st = lm_fail(err, LM_ERR_INVALID, "%s: shard %u of %u is missing (%u of the %u passes); merge needs one part "
-                         "of each", fl->scene->path, k + 1, shards,
-                         lm_checkpoint_steps(ck->count, ck->r.pass, k, shards), ck->r.steps);
+    if (st == LM_OK)
+        st = missing_parts(fl, ck, &first, have, owner, err);
+    free(first.list);
     free(part);
     free(have);
+    free(owner);
     return st;
 }
 
@@ -361,7 +437,7 @@ static lm_status first_gather(lm_frame_loop *fl, lm_error *err)
         return st;
     uint32_t pass = pass_texels(fl, 1, count), shard = (uint32_t)fl->set.shard, shards = (uint32_t)fl->set.shards;
     checkpointing ck = {fl->set.checkpoint, 0, count,
-                        {pass, lm_checkpoint_steps(count, pass, 0, 0), 0, 0, 0},
+                        {pass, lm_checkpoint_steps(count, pass, 0, 0), 0, 0, 0, NULL},
                         fl->set.checkpoint_seconds > 0.0 ? fl->set.checkpoint_seconds : LM_CHECKPOINT_DEFAULT_SECONDS,
                         lm_now(), malloc(4 * sizeof(float) * (size_t)fl->atlas->width * (size_t)fl->atlas->height)};
     if (!ck.rgba)
@@ -369,16 +445,20 @@ static lm_status first_gather(lm_frame_loop *fl, lm_error *err)
     ck.key = lm_checkpoint_key(fl->scene, fl->atlas, &fl->set.gather, fl->texels, count,
                                lm_aim_dilated_rgba(lm_photon_stage_aim(fl->stage)));
     if (shards > 0)
-        ck.r = (lm_checkpoint_range){pass, lm_checkpoint_steps(count, pass, shard, shards), 0, shard, shards};
+        ck.r = (lm_checkpoint_range){pass, lm_checkpoint_steps(count, pass, shard, shards), 0, shard, shards, NULL};
     if (fl->set.parts) {
         st = join_parts(fl, &ck, err);
         ck.r.done = ck.r.steps;
         if (st == LM_OK)
             lm_info("%s: the gather put together from %d parts", fl->scene->path, fl->set.part_count);
     } else if (fl->set.resume) {
-        lm_checkpoint_range r;
+        lm_checkpoint_range r = {0};
         st = lm_checkpoint_read(ck.path, ck.key, fl->atlas, count, ck.rgba, &r, "bake without --resume to start again",
                                 err);
+        if (st == LM_OK && r.list)
+            st = lm_fail(err, LM_ERR_INVALID, "%s: the part of a process of a shared (MPI) bake: it does not resume",
+                         ck.path);
+        free(r.list);
         if (st == LM_OK && (r.shard != shard || r.shards != shards || r.pass != pass))
             st = lm_fail(err, LM_ERR_INVALID, "%s: a checkpoint of %s%u of %u, not of this bake's %s%u of %u", ck.path,
                          r.shards ? "shard " : "the whole bake, ", r.shard + !!r.shards, r.shards,
@@ -390,10 +470,13 @@ static lm_status first_gather(lm_frame_loop *fl, lm_error *err)
     }
     if (st == LM_OK && (fl->set.parts || fl->set.resume))
         st = lm_iim_texture_write(fl->iim.fresh_tex, fl->atlas->width, fl->atlas->height, ck.rgba, err);
-    if (st == LM_OK)
+    if (st == LM_OK && fl->set.claim_pass && shards > 1)
+        st = gather_claimed(fl, count, &ck, err);
+    else if (st == LM_OK)
         st = gather_run(fl, ck.r, count, fl->set.checkpoint ? &ck : NULL, err);
     if (st == LM_OK && shards > 0) /* the part: kept by the caller */
         st = checkpoint_save(fl, &ck, ck.r.steps, err);
+    free(ck.r.list);
     free(ck.rgba);
     return st;
 }

@@ -82,6 +82,10 @@ typedef struct {
      * the first gather from their texels put together, which must be all of them (LM_ERR_INVALID naming a
      * part of another bake, two parts holding the same texels, or the share no part holds) */
     int shard, shards;
+    /* with shards > 1: the passes handed out as the processes finish them (lmgi_updater_desc.claim_pass;
+     * NULL: every shards-th pass from shard); the part lists the passes it took */
+    int (*claim_pass)(void *user, int passes);
+    void *claim_user;
     const char *const *parts;
     int part_count;
     lm_gl_context *gl;     /* borrowed, made current at each call: the context to render with (NULL, the
