@@ -35,13 +35,15 @@ CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fvisibility-inli
                 -I/usr/include/stb $(SAN) $(CXXFLAGS)
 LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lwebp -lEGL -lgomp -lstdc++ -lm -lpthread
 LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
+# The command line's own (not the library's: lmgi.pc does not name it): cJSON for a shard's part.json
+CLI_LIBS := -lcjson
 
 # npm: Debian's, unless a node that brings its own is installed (NodeSource's nodejs conflicts with it)
 NPM_DEB := $(if $(shell command -v npm 2>/dev/null),,npm)
 DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
                 nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libwebp-dev libcmocka-dev \
                 libegl-dev libegl-mesa0 python3-matplotlib libgl-dev libx11-dev xvfb nodejs chromium \
-                openmpi-bin libopenmpi-dev \
+                openmpi-bin libopenmpi-dev libcjson-dev \
                 $(NPM_DEB)
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
@@ -116,10 +118,10 @@ install-files:
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
 
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
-	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS)
+	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)
 
 $(BUILD)/lmgi-dev: $(DEV_OBJ) $(BUILD)/liblmgi.a
-	$(CC) -o $@ $(DEV_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS)
+	$(CC) -o $@ $(DEV_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
 	@mkdir -p $(dir $@)
@@ -143,7 +145,7 @@ $(BUILD)/obj/mpi/main_mpi.o: src/cli/mpi/main_mpi.c $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(MPICC) $(CFLAGS_ALL) -c $< -o $@
 $(BUILD)/lmgi-mpi: $(MPI_OBJ) $(filter-out %/main.o,$(CLI_OBJ)) $(BUILD)/liblmgi.a
-	$(MPICC) -o $@ $^ $(LDFLAGS_ALL) $(LIBS)
+	$(MPICC) -o $@ $^ $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)
 
 # make bench-mpi: the MPI bake's scaling on 1, 2 and 4 ranks of this machine (docs/farm.md)
 .PHONY: bench-mpi

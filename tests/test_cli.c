@@ -583,6 +583,99 @@ static void test_bake_in_shards(void **state)
     assert_non_null(strstr(output, "give --gltf, --accuracy and --half to lmgi merge"));
 }
 
+/* `lmgi merge PARTS --out DIR/refused`, which must say `says` and write nothing: its exit status. */
+static int merge_refused(const char *dir, const char *parts, const char *says)
+{
+    char args[2048], path[600];
+    snprintf(args, sizeof args, "merge %s --out %s/refused", parts, dir);
+    int rc = run(args);
+    if (!strstr(output, says))
+        fail_msg("lmgi %s: expected \"%s\" in: %s", args, says, output);
+    snprintf(path, sizeof path, "%s/refused/lightmap.exr", dir);
+    assert_int_equal(access(path, F_OK), -1);
+    return rc;
+}
+
+/* lmgi merge PART... --out DIR: the scene and the bake's options come from the parts' part.json (each
+ * shard writes its own), to the same bytes as one bake with those options. Refused, naming the part,
+ * with nothing written: a part of other options or another scene, a bake option given to the merge, a
+ * part without part.json (an older lmgi's: the form with the scene still merges it), a scene that is no
+ * longer where the parts say. */
+static void test_merge_parts_alone(void **state)
+{
+    (void)state;
+    char dir[256], args[4096], a_path[600], b_path[600], parts[2048];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    static const char options[] = "--texels 8000 --photons 20000";
+    snprintf(args, sizeof args, "bake scenes/cornell.glb %s --out %s/whole -q", options, dir);
+    assert_int_equal(run_ok(args), 0);
+    for (int k = 1; k <= 3; k++) { /* run-only options among the bake's: part.json leaves them out */
+        snprintf(args, sizeof args, "bake -q --texels 8000 --shard %d/3 scenes/cornell.glb --checkpoint-seconds 5 "
+                 "--out %s/p%d --photons 20000", k, dir, k);
+        assert_int_equal(run_ok(args), 0);
+    }
+    char scene[4096], json_path[600];
+    assert_non_null(realpath("scenes/cornell.glb", scene));
+    snprintf(json_path, sizeof json_path, "%s/p2/part.json", dir);
+    size_t size = 0;
+    char *json = (char *)lmt_read_file(json_path, &size, 1);
+    json[size] = '\0';
+    print_message("p2/part.json: %s", json);
+    assert_non_null(strstr(json, scene));
+    assert_non_null(strstr(json, "[\"--texels\", \"8000\", \"--photons\", \"20000\"]"));
+    free(json);
+
+    snprintf(parts, sizeof parts, "%s/p1 %s/p2 %s/p3", dir, dir, dir);
+    snprintf(args, sizeof args, "merge %s --out %s/merged", parts, dir);
+    if (run(args) != 0)
+        fail_msg("%s: %s", args, output);
+    static const char *const files[2] = {"lightmap.exr", "aim.exr"};
+    for (int f = 0; f < 2; f++) {
+        snprintf(a_path, sizeof a_path, "%s/whole/%s", dir, files[f]);
+        snprintf(b_path, sizeof b_path, "%s/merged/%s", dir, files[f]);
+        assert_true(same_bytes(a_path, b_path));
+    }
+    print_message("merge PART... of 3 shards (%s): the same bytes as one bake\n", options);
+
+    /* a part of other options, and a bake option given to the merge */
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 8000 --photons 5000 --shard 2/3 --out %s/other2 -q",
+             dir);
+    assert_int_equal(run_ok(args), 0);
+    snprintf(parts, sizeof parts, "%s/p1 %s/other2 %s/p3", dir, dir, dir);
+    snprintf(a_path, sizeof a_path, "%s/other2 was baked with the options '--texels 8000 --photons 5000'", dir);
+    assert_int_equal(merge_refused(dir, parts, a_path), 1);
+    snprintf(parts, sizeof parts, "%s/p1 %s/p2 %s/p3 --photons 5000", dir, dir, dir);
+    assert_int_equal(merge_refused(dir, parts, "'--photons' would change the bake"), 2);
+
+    /* an older lmgi's part: no part.json; given the scene and the options it merges as before */
+    snprintf(args, sizeof args, "cp -r %s/p2 %s/old2 && rm %s/old2/part.json", dir, dir, dir);
+    assert_int_equal(lmt_run(args, output, sizeof output), 0);
+    snprintf(parts, sizeof parts, "%s/p1 %s/old2 %s/p3", dir, dir, dir);
+    assert_int_equal(merge_refused(dir, parts, "the part was written by an older lmgi"), 1);
+    assert_non_null(strstr(output, "old2: no "));
+    snprintf(args, sizeof args, "merge scenes/cornell.glb %s %s --out %s/old -q", parts, options, dir);
+    assert_int_equal(run_ok(args), 0);
+    snprintf(a_path, sizeof a_path, "%s/whole/lightmap.exr", dir);
+    snprintf(b_path, sizeof b_path, "%s/old/lightmap.exr", dir);
+    assert_true(same_bytes(a_path, b_path));
+
+    /* a shard of a copy of the scene: another scene for the merge, and refused once the copy is gone */
+    snprintf(args, sizeof args, "mkdir %s/moved && cp scenes/cornell.glb %s/moved/", dir, dir);
+    assert_int_equal(lmt_run(args, output, sizeof output), 0);
+    snprintf(args, sizeof args, "bake %s/moved/cornell.glb %s --shard 1/3 --out %s/g1 -q", dir, options, dir);
+    assert_int_equal(run_ok(args), 0);
+    snprintf(parts, sizeof parts, "%s/p2 %s/g1", dir, dir);
+    snprintf(a_path, sizeof a_path, "%s/g1 was baked from ", dir);
+    assert_int_equal(merge_refused(dir, parts, a_path), 1);
+    assert_non_null(strstr(output, "moved/cornell.glb"));
+    snprintf(a_path, sizeof a_path, "%s/moved/cornell.glb", dir);
+    assert_int_equal(unlink(a_path), 0);
+    snprintf(parts, sizeof parts, "%s/g1", dir);
+    assert_int_equal(merge_refused(dir, parts, "moved/cornell.glb ("), 1);
+    assert_non_null(strstr(output, "which is not there"));
+    assert_non_null(strstr(output, "lmgi merge SCENE PART... --out DIR --texels 8000 --photons 20000"));
+}
+
 /* mpirun's command line for n ranks of build/lmgi-mpi, or NULL (printed why) where there is none. */
 static const char *mpi_command(int n)
 {
@@ -1085,6 +1178,7 @@ int main(void)
         cmocka_unit_test(test_progress_lines),
         cmocka_unit_test(test_bake_killed_and_resumed),
         cmocka_unit_test(test_bake_in_shards),
+        cmocka_unit_test(test_merge_parts_alone),
         cmocka_unit_test(test_mpi_bake),
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),

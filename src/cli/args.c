@@ -69,6 +69,8 @@ int lm_cli_parse(int argc, char **argv, int first, const char *command, unsigned
     a->rim_samples = -1;
     a->reflection_size = -1;
     a->caustic_filter = -1;
+    a->word_count = argc > first ? argc - first : 0;
+    a->words = argv + first;
     int rc = 0;
     for (int i = first; i < argc && rc == 0; i++) {
         const char *word = argv[i];

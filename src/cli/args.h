@@ -73,6 +73,8 @@ typedef struct {
     int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */
     int quick;                /* --quick (tradeoff): fewer values per knob, looser references */
     const char *knobs;        /* --knobs LIST (tradeoff): the knobs to sweep (NULL: all) */
+    int word_count;           /* the words parsed (argv[first..argc)), as given: a shard records its */
+    char **words;             /* bake's in part.json for lmgi merge */
 } lm_cli_args;
 
 /* Parses argv[first..argc) for `command` (its name, for messages): an option outside the `commands` set

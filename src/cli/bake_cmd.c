@@ -9,8 +9,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
+#include "merge_cmd.h"
 #include "order_stats.h"
 #include "out_dir.h"
 #include "progress.h"
@@ -146,13 +146,14 @@ static int write_gltf(const lm_cli_args *a, lmgi_updater *u, lmgi_output *out, c
 /* The scene loads before --out is touched, and the earlier bake stays until this one has succeeded
  * (lmgi_output_commit): a mistyped scene, a cancel or a kill leaves the last good lightmaps. What the
  * gather finished survives a cancel, a kill or a failure in DIR/bake.checkpoint (docs/levels.md, "Long
- * bakes"), which the commit removes. A shard's bake writes DIR/part.checkpoint alone. */
+ * bakes"), which the commit removes. A shard's bake writes DIR/part.checkpoint and part.json alone. */
 static lmgi_output *open_out(const lm_cli_args *a, const char *command, char *checkpoint, size_t size)
 {
     lmgi_output *out = lm_cli_open_out(a, command);
     char probe[4200];
     lmgi_error e;
-    static const char *const whole[] = {"lightmap.exr", "lightmap.png", NULL}, *const part[] = {"part.checkpoint", NULL};
+    static const char *const whole[] = {"lightmap.exr", "lightmap.png", NULL},
+                             *const part[] = {"part.checkpoint", "part.json", NULL};
     for (const char *const *f = a->shards ? part : whole; out && *f; f++)
         if (!lm_cli_out_path(out, *f, probe, sizeof probe))
             return lm_cli_close_out(out, 1), NULL;
@@ -252,6 +253,8 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     char name[256] = "";
     if (rc == 0 && a->shards) {
         rc = keep_part(out, checkpoint);
+        if (rc == 0)
+            rc = lm_cli_write_part_json(out, a);
     } else {
         if (rc == 0)
             rc = write_maps(sc, u, out, a->half);
@@ -289,33 +292,7 @@ int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t)
     return bake(a, "bake", NULL, 0, t);
 }
 
-int lm_cli_merge(const lm_cli_args *a)
+int lm_cli_bake_merge(const lm_cli_args *a, const char *const *parts, int part_count)
 {
-    if (a->file_count < 2 || !a->out_dir) {
-        fprintf(stderr, "lmgi: merge needs the scene file, then the parts (lmgi bake --shard K/N --out PART), and "
-                "--out DIR\n");
-        return 2;
-    }
-    int n = a->file_count - 1, rc = 0;
-    char (*paths)[4200] = malloc(sizeof *paths * (size_t)n);
-    const char **parts = malloc(sizeof *parts * (size_t)n);
-    if (!paths || !parts) {
-        free(paths);
-        free(parts);
-        fprintf(stderr, "lmgi: error: no memory for %d parts\n", n);
-        return 1;
-    }
-    for (int p = 0; p < n; p++) { /* a folder a shard wrote, or its file */
-        struct stat st;
-        const char *f = a->files[p + 1];
-        if (stat(f, &st) == 0 && S_ISDIR(st.st_mode))
-            snprintf(paths[p], sizeof paths[p], "%s/part.checkpoint", f);
-        else
-            snprintf(paths[p], sizeof paths[p], "%s", f);
-        parts[p] = paths[p];
-    }
-    rc = bake(a, "merge", parts, n, NULL);
-    free(paths);
-    free(parts);
-    return rc;
+    return bake(a, "merge", parts, part_count, NULL);
 }

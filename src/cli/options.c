@@ -23,11 +23,13 @@ const lm_cli_command lm_cli_commands[] = {
      "the time left (Ctrl-C or SIGTERM cancels, keeping what it finished for --resume; a failed bake\n"
      "leaves the last lightmaps): DIR/lightmap.exr (irradiance, alpha = valid), lightmap.png (a\n"
      "preview), aim.exr; --gltf: also NAME.gltf, the scene for engines with TEXCOORD_1 = lightmap UVs"},
-    {"merge", LM_CMD_MERGE, "merge SCENE PART... --out DIR",
-     "a bake spread over processes put together: the parts the shards wrote (bake --shard K/N --out\n"
-     "PART; each PART a folder, or its part.checkpoint), one of each share, made with the same scene\n"
-     "and options, give the lightmaps one bake gives, to the bit (docs/levels.md, \"A bake in shards\");\n"
-     "give merge the same options"},
+    {"merge", LM_CMD_MERGE, "merge PART... --out DIR | merge SCENE PART... --out DIR",
+     "a bake spread over processes put together: the parts the shards wrote (bake SCENE --shard K/N\n"
+     "--out PART; each PART a folder, or its part.checkpoint), one of each share, give the lightmaps\n"
+     "one bake gives, to the bit (docs/levels.md, \"A bake in shards\"). PART... alone: the scene and\n"
+     "the bake's options are those the parts recorded (PART/part.json), and merge takes only --out,\n"
+     "--gltf, --accuracy, --half, --force, -q and -v; SCENE PART... (parts of an older lmgi): give\n"
+     "the scene and the options the shards were baked with"},
     {"check", LM_CMD_CHECK, "check SCENE",
      "one frame of 'run' (same options) against the path-traced reference: frame / reference per\n"
      "visible surface and over the frame, and the relative RMSE (default --size 128x128; --out DIR:\n"
@@ -239,7 +241,8 @@ const lm_cli_option lm_cli_options[] = {
      "stopped"},
     {"--shard", NULL, "K/N", LM_CMD_BAKE, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_shard,
      "gather only share K of N of the bake's texels into DIR/part.checkpoint\n"
-     "(a part, for lmgi merge; docs/levels.md, \"A bake in shards\")"},
+     "(a part, for lmgi merge; docs/levels.md, \"A bake in shards\"), with\n"
+     "DIR/part.json: the scene's absolute path and the bake's options"},
     {"--checkpoint-seconds", NULL, "S", LM_CMD_BAKE, LM_OPT_FLOAT,
      offsetof(lm_cli_args, checkpoint_seconds), 0, 0, NULL,
      "at most one checkpoint every S seconds (default 10)"},
