@@ -203,7 +203,7 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
 /* bake (parts NULL) and merge (the parts' checkpoint files): the updater's first full solution, then the
  * lightmaps, or a shard's part. */
 static int bake(const lm_cli_args *a, const char *command, const char *const *parts, int part_count,
-                lm_cli_bake_times *times)
+                const lm_cli_share *share, lm_cli_bake_times *times)
 {
     lmgi_scene *sc = NULL;
     lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
@@ -220,7 +220,7 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     d.frame_width = d.frame_height = 0;
     d.error_estimate = a->accuracy;
     double started = lm_cli_now();
-    d.progress = a->quiet ? NULL : show;
+    d.progress = a->quiet && !(share && share->progress) ? NULL : show;
     d.progress_user = &started;
     d.cancel = &g_cancel;
     if (parts) {
@@ -232,6 +232,8 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
         d.resume = a->resume;
         d.shard = a->shards ? a->shard - 1 : 0;
         d.shards = a->shards;
+        if (share)
+            d.photon_exchange = share->photon_exchange, d.claim_pass = share->claim_pass, d.share_user = share->user;
     }
     signal(SIGINT, on_interrupt);
     signal(SIGTERM, on_interrupt); /* a scheduler's stop, as Ctrl-C */
@@ -243,7 +245,7 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
         if (e.status == LMGI_ERR_CANCELLED)
             fprintf(stderr, "\nlmgi: %s cancelled after %.1f s (%s); no lightmap written (an earlier bake's kept)%s\n",
                     command, lm_cli_now() - started, e.message,
-                    parts ? "" : "; the same command with --resume continues it"); /* merge has no --resume */
+                    parts || share ? "" : "; the same command with --resume continues it"); /* merge, MPI: none */
         else
             fprintf(stderr, "lmgi: error: %s\n", e.message);
         rc = e.status == LMGI_ERR_CANCELLED ? 130 : 1;
@@ -279,7 +281,9 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
 
 int lm_cli_bake(const lm_cli_args *a) { return lm_cli_bake_timed(a, NULL); }
 
-int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t)
+int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t) { return lm_cli_bake_shared(a, NULL, t); }
+
+int lm_cli_bake_shared(const lm_cli_args *a, const lm_cli_share *share, lm_cli_bake_times *t)
 {
     if (a->file_count != 1 || !a->out_dir) {
         fprintf(stderr, "lmgi: bake needs one scene file and --out DIR\n");
@@ -289,10 +293,10 @@ int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t)
         fprintf(stderr, "lmgi: bake --shard writes its part alone; give --gltf, --accuracy and --half to lmgi merge\n");
         return 2;
     }
-    return bake(a, "bake", NULL, 0, t);
+    return bake(a, "bake", NULL, 0, share, t);
 }
 
 int lm_cli_bake_merge(const lm_cli_args *a, const char *const *parts, int part_count)
 {
-    return bake(a, "merge", parts, part_count, NULL);
+    return bake(a, "merge", parts, part_count, NULL, NULL);
 }

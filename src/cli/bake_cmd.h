@@ -13,6 +13,17 @@ typedef struct {
 } lm_cli_bake_times;
 /* lm_cli_bake, and its stages' times into *t (zeroed when it fails before the solution). */
 int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t);
-/* lmgi merge SCENE PART... --out DIR: the parts of a bake in shards put together (a bake from them). */
-int lm_cli_merge(const lm_cli_args *a);
+/* What connects the processes of a shared bake (lmgi_updater_desc's photon_exchange, claim_pass and
+ * share_user: lmgi-mpi's ranks), and whether this one shows the progress even when quiet. */
+typedef struct {
+    int (*photon_exchange)(void *user, const void *mine, size_t size, size_t *sizes, void *all);
+    int (*claim_pass)(void *user, int passes);
+    void *user;
+    int progress;
+} lm_cli_share;
+/* The bake of a merge: the scene a->files[0] and the parts' checkpoint files put together into
+ * a->out_dir. The exit code. */
+int lm_cli_bake_merge(const lm_cli_args *a, const char *const *parts, int part_count);
+/* lm_cli_bake_timed of a shard (a->shards > 1) connected to the others by `share` (NULL: none). */
+int lm_cli_bake_shared(const lm_cli_args *a, const lm_cli_share *share, lm_cli_bake_times *t);
 #endif

@@ -8,6 +8,7 @@
 
 #include "args.h"
 #include "bake_cmd.h"
+#include "merge_cmd.h"
 #include "bench.h"
 #include "check_cmd.h"
 #include "options.h"

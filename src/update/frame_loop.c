@@ -279,7 +279,7 @@ static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t c
  * come; ck->r lists them. Progress says how far the handing out has gone: the whole shared bake's. */
 static lm_status gather_claimed(lm_frame_loop *fl, uint32_t count, checkpointing *ck, lm_error *err)
 {
-    uint32_t passes = lm_checkpoint_steps(count, ck->r.pass, 0, 0), first, n;
+    uint32_t passes = lm_checkpoint_steps(count, ck->r.pass, 0, 0), first, n, shown = 0;
     ck->r.steps = ck->r.done = 0;
     if (!(ck->r.list = malloc(sizeof *ck->r.list * (passes ? passes : 1))))
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the list of the bake's passes");
@@ -297,10 +297,13 @@ static lm_status gather_claimed(lm_frame_loop *fl, uint32_t count, checkpointing
         pass_span((uint32_t)p, ck->r.pass, count, &first, &n);
         st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, n, fl->iim.fresh_tex, NULL, err);
         ck->r.list[ck->r.steps++] = (uint32_t)p;
+        shown = first + n;
         if (fl->set.progress)
-            fl->set.progress(fl->set.progress_user, first + n, count);
+            fl->set.progress(fl->set.progress_user, shown, count);
     }
     ck->r.done = ck->r.steps;
+    if (st == LM_OK && fl->set.progress && shown < count) /* every pass handed out (some may be under way) */
+        fl->set.progress(fl->set.progress_user, count, count);
     return st;
 }
 
