@@ -487,3 +487,31 @@ void lmt_gltf_validate(const char *modules, const char *gltf)
     print_message("%s", out);
     assert_int_equal(rc, 0);
 }
+
+void lmt_hub_init(lmt_hub *h, int n)
+{
+    memset(h, 0, sizeof *h);
+    assert_true(n > 0 && n <= 8);
+    h->n = n;
+    assert_int_equal(pthread_barrier_init(&h->barrier, NULL, (unsigned)n), 0);
+}
+
+void lmt_hub_free(lmt_hub *h) { pthread_barrier_destroy(&h->barrier); }
+
+/* Each thread posts its bytes and waits; all read; all wait again before anyone may post the next. */
+int lmt_hub_exchange(lmt_hub *h, int id, const void *mine, size_t size, size_t *sizes, void *all)
+{
+    h->mine[id] = mine, h->size[id] = size;
+    h->calls[id]++;
+    pthread_barrier_wait(&h->barrier);
+    size_t at = 0;
+    for (int q = 0; q < h->n; q++) {
+        if (all)
+            memcpy((unsigned char *)all + at, h->mine[q], h->size[q]);
+        else
+            sizes[q] = h->size[q];
+        at += h->size[q];
+    }
+    pthread_barrier_wait(&h->barrier);
+    return 1;
+}

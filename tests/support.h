@@ -2,6 +2,7 @@
 #ifndef LM_TEST_SUPPORT_H
 #define LM_TEST_SUPPORT_H
 
+#include <pthread.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -21,6 +22,20 @@ uint32_t lmt_xorshift(uint32_t *state);
 void lmt_write_file(const char *path, const void *data, size_t n);
 /* Base64 of n bytes into out, which holds 4 * ceil(n / 3) + 1 chars (NUL-terminated). */
 void lmt_base64(const void *data, size_t n, char *out);
+/* Processes of a shared bake played by threads: an allgather over a barrier (lmgi_updater_desc's
+ * photon_exchange, lm_photon_split's exchange). Initialise with lmt_hub_init for n threads (at most 8). */
+typedef struct {
+    pthread_barrier_t barrier;
+    int n;
+    const void *mine[8];
+    size_t size[8];
+    int calls[8];                /* exchange calls each thread made */
+} lmt_hub;
+void lmt_hub_init(lmt_hub *h, int n);
+void lmt_hub_free(lmt_hub *h);
+/* Thread `id`'s part of the collective exchange: with all NULL, every thread's size into sizes; else
+ * every thread's bytes back to back into all. Returns 1. */
+int lmt_hub_exchange(lmt_hub *h, int id, const void *mine, size_t size, size_t *sizes, void *all);
 /* Runs `SHELL_PREFIX BUILD/lmgi ARGS 2>&1` (BUILD: $LMGI_BUILD, else build) with stdout and stderr together
  * into output (size bytes, NUL-terminated); asserts it exited rather than crashed and returns its exit
  * status. */

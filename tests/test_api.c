@@ -1104,11 +1104,8 @@ static void test_shard_cancelled_and_resumed(void **state)
  * the processes played by threads, each with its own context ---- */
 
 typedef struct {
-    pthread_barrier_t barrier;
-    const void *mine[2];
-    size_t size[2];
+    lmt_hub hub;
     atomic_int next;     /* the next pass to hand out */
-    int exchanges;
 } share_hub;
 
 typedef struct {
@@ -1122,21 +1119,7 @@ typedef struct {
 static int share_exchange(void *user, const void *mine, size_t size, size_t *sizes, void *all)
 {
     share_process *p = user;
-    share_hub *h = p->h;
-    h->mine[p->id] = mine, h->size[p->id] = size;
-    if (p->id == 0)
-        h->exchanges++;
-    pthread_barrier_wait(&h->barrier);
-    size_t at = 0;
-    for (int q = 0; q < 2; q++) {
-        if (all)
-            memcpy((unsigned char *)all + at, h->mine[q], h->size[q]);
-        else
-            sizes[q] = h->size[q];
-        at += h->size[q];
-    }
-    pthread_barrier_wait(&h->barrier);
-    return 1;
+    return lmt_hub_exchange(&p->h->hub, p->id, mine, size, sizes, all);
 }
 
 static int share_claim(void *user, int passes)
@@ -1180,8 +1163,7 @@ static void test_shared_bake_is_one_process_bake(void **state)
 {
     (void)state;
     share_hub h;
-    memset(&h, 0, sizeof h);
-    pthread_barrier_init(&h.barrier, NULL, 2);
+    lmt_hub_init(&h.hub, 2);
     atomic_init(&h.next, 0);
     share_process p[2];
     pthread_t t[2];
@@ -1195,9 +1177,9 @@ static void test_shared_bake_is_one_process_bake(void **state)
         if (p[i].status != LMGI_OK)
             fail_msg("process %d: %s", i, p[i].message);
     }
-    pthread_barrier_destroy(&h.barrier);
-    print_message("passes taken: %d and %d; %d photon exchanges\n", p[0].taken, p[1].taken, h.exchanges);
-    assert_true(p[0].taken > 0 && p[1].taken > 0 && h.exchanges > 0);
+    lmt_hub_free(&h.hub);
+    print_message("passes taken: %d and %d; %d photon exchange calls\n", p[0].taken, p[1].taken, h.hub.calls[0]);
+    assert_true(p[0].taken > 0 && p[1].taken > 0 && h.hub.calls[0] > 0 && h.hub.calls[0] == h.hub.calls[1]);
 
     lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_scene("cornell.glb", 8000);

@@ -8,7 +8,6 @@
 
 #include <math.h>
 #include <omp.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -179,38 +178,16 @@ static void test_deterministic(void **state)
 #define SHARES 3
 
 typedef struct {
-    pthread_barrier_t barrier;
-    const void *mine[SHARES];
-    size_t size[SHARES];
-    int calls[SHARES];
-} hub;
-
-typedef struct {
-    hub *h;
+    lmt_hub *h;
     uint32_t id;
     const char *path;
     world w;
 } process;
 
-/* An allgather over the hub: each process's bytes posted, everyone waits, reads, and waits again before
- * a process may post the next batch's. */
 static int hub_exchange(void *user, const void *mine, size_t size, size_t *sizes, void *all)
 {
     process *p = user;
-    hub *h = p->h;
-    h->mine[p->id] = mine, h->size[p->id] = size;
-    h->calls[p->id]++;
-    pthread_barrier_wait(&h->barrier);
-    size_t at = 0;
-    for (int q = 0; q < SHARES; q++) {
-        if (all)
-            memcpy((unsigned char *)all + at, h->mine[q], h->size[q]);
-        else
-            sizes[q] = h->size[q];
-        at += h->size[q];
-    }
-    pthread_barrier_wait(&h->barrier);
-    return 1;
+    return lmt_hub_exchange(p->h, (int)p->id, mine, size, sizes, all);
 }
 
 static void *process_trace(void *arg)
@@ -238,9 +215,8 @@ static void test_split_trace_is_one_process_trace(void **state)
     world one;
     world_load(&one, path);
     world_photons(&one, &set);
-    hub h;
-    memset(&h, 0, sizeof h);
-    pthread_barrier_init(&h.barrier, NULL, SHARES);
+    lmt_hub h;
+    lmt_hub_init(&h, SHARES);
     process p[SHARES];
     pthread_t t[SHARES];
     int threads = omp_get_max_threads();
@@ -274,7 +250,7 @@ static void test_split_trace_is_one_process_trace(void **state)
     print_message("%u photons, %u stored hits, traced by %d processes in %d exchanges\n", lm_photons_count(one.ph),
                   lm_photons_stored_hits(one.ph), SHARES, h.calls[0]);
     free(sa.h);
-    pthread_barrier_destroy(&h.barrier);
+    lmt_hub_free(&h);
     for (uint32_t i = 0; i < SHARES; i++)
         world_free(&p[i].w);
     world_free(&one);
