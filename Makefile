@@ -36,6 +36,7 @@ CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fvisibility-inli
 LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lwebp -lEGL -lgomp -lstdc++ -lm -lpthread
 LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
 # The command line's own (not the library's: lmgi.pc does not name it): cJSON for a shard's part.json
+# and the edit scripts of --edits
 CLI_LIBS := -lcjson
 
 # npm: Debian's, unless a node that brings its own is installed (NodeSource's nodejs conflicts with it)

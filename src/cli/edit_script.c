@@ -1,6 +1,7 @@
 /* Edit scripts: reading, applying and playing them (edit_script.h). */
 #include "edit_script.h"
 
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -19,50 +20,73 @@ static int bad(const char *path, int i, const char *what)
     return 0;
 }
 
-static double number_or(const json_value *root, const char *key, double fallback)
+/* The member key of an object; NULL when absent or obj is not an object (an edit that is a number or a
+ * list has no members). The first of repeated keys, as cJSON keeps them. */
+static const cJSON *member(const cJSON *obj, const char *key)
 {
-    const json_value *v = json_get(root, key);
-    return v && v->type == JSON_NUMBER ? v->number : fallback;
+    return cJSON_IsObject(obj) ? cJSON_GetObjectItemCaseSensitive(obj, key) : NULL;
 }
 
-static int parse_script(const char *path, const json_value *root, lm_edit_script *s)
+static double number_or(const cJSON *obj, const char *key, double fallback)
 {
-    if (root->type != JSON_OBJECT)
+    const cJSON *v = member(obj, key);
+    return cJSON_IsNumber(v) ? v->valuedouble : fallback;
+}
+
+/* The string member key, NULL when absent or not a string. */
+static const char *string_of(const cJSON *obj, const char *key)
+{
+    const cJSON *v = member(obj, key);
+    return cJSON_IsString(v) ? v->valuestring : NULL;
+}
+
+/* A count from the script as an int: one beyond int's range (1e300 frames) becomes INT_MIN, which the
+ * range checks refuse, rather than a conversion C leaves undefined. */
+static int whole(double x)
+{
+    return x > INT_MIN && x < INT_MAX ? (int)x : INT_MIN;
+}
+
+static int parse_script(const char *path, const cJSON *root, lm_edit_script *s)
+{
+    if (!cJSON_IsObject(root))
         return bad(path, -1, "the script must be a JSON object with an \"edits\" array");
-    s->frames = (int)number_or(root, "frames", 120);
-    s->fps = (int)number_or(root, "fps", 60);
-    s->texels = (int)number_or(root, "texels", 3000);
+    s->frames = whole(number_or(root, "frames", 120));
+    s->fps = whole(number_or(root, "fps", 60));
+    s->texels = whole(number_or(root, "texels", 3000));
     s->budget_ms = (float)number_or(root, "budget_ms", 8.0);
-    const json_value *scene = json_get(root, "scene");
-    s->scene = scene && scene->type == JSON_STRING ? scene->string : NULL;
+    s->scene = string_of(root, "scene");
     if (s->frames < 1 || s->frames > 100000 || s->fps < 0 || s->fps > 1000 || s->texels < 64 ||
         !(s->budget_ms >= 0.0f && s->budget_ms < 1e4f))
         return bad(path, -1, "frames (1..100000), fps (0..1000), texels (>= 64) or budget_ms (>= 0) out of range");
-    const json_value *edits = json_get(root, "edits");
-    if (!edits || edits->type != JSON_ARRAY || edits->count > LM_EDIT_MAX)
+    const cJSON *edits = member(root, "edits");
+    if (!cJSON_IsArray(edits) || cJSON_GetArraySize(edits) > LM_EDIT_MAX)
         return bad(path, -1, "\"edits\" must be an array of at most 256 edits");
-    s->edit_count = (int)edits->count;
-    for (int i = 0; i < s->edit_count; i++) {
-        const json_value *e = &edits->items[i];
-        const json_value *f = json_get(e, "frame");
-        if (!f || f->type != JSON_NUMBER || f->number < 0 || f->number >= s->frames)
+    int i = 0;
+    const cJSON *e;
+    cJSON_ArrayForEach(e, edits) {
+        const cJSON *f = member(e, "frame");
+        if (!cJSON_IsNumber(f) || f->valuedouble < 0 || f->valuedouble >= s->frames)
             return bad(path, i, "needs a \"frame\" within the script's frames");
-        if (i > 0 && f->number < s->edits[i - 1].frame)
+        if (i > 0 && f->valuedouble < s->edits[i - 1].frame)
             return bad(path, i, "edits must come in frame order");
-        s->edits[i] = (lm_edit){(int)f->number, e};
+        s->edits[i++] = (lm_edit){(int)f->valuedouble, e};
     }
+    s->edit_count = i;
     return 1;
 }
 
 /* n floats from a JSON array, each finite. */
-static int floats(const json_value *v, float *out, size_t n)
+static int floats(const cJSON *v, float *out, int n)
 {
-    if (!v || v->type != JSON_ARRAY || v->count != n)
+    if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != n)
         return 0;
-    for (size_t i = 0; i < n; i++) {
-        if (v->items[i].type != JSON_NUMBER || !isfinite(v->items[i].number))
+    int i = 0;
+    const cJSON *x;
+    cJSON_ArrayForEach(x, v) {
+        if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble))
             return 0;
-        out[i] = (float)v->items[i].number;
+        out[i++] = (float)x->valuedouble;
     }
     return 1;
 }
@@ -87,66 +111,66 @@ static int material_named(const lmgi_scene *sc, const char *name)
 
 /* Applies one edit to a scene; 0 (after saying why) when the script asks for something the scene lacks
  * or lmgi refuses. */
-static int apply(const char *path, int i, const json_value *e, lmgi_scene *sc)
+static int apply(const char *path, int i, const cJSON *e, lmgi_scene *sc)
 {
     lmgi_error err;
-    const json_value *light = json_get(e, "light"), *node = json_get(e, "node"), *mat = json_get(e, "material");
+    const char *light = string_of(e, "light"), *node = string_of(e, "node"), *mat = string_of(e, "material");
     lmgi_status st = LMGI_OK;
-    if (light && light->type == JSON_STRING) {
-        int l = light_of_node(sc, light->string);
+    if (light) {
+        int l = light_of_node(sc, light);
         lmgi_light li;
         if (l < 0 || lmgi_get_light(sc, l, &li, &err) != LMGI_OK)
             return bad(path, i, "no light on that node");
-        const json_value *v;
-        if ((v = json_get(e, "intensity")) && v->type == JSON_NUMBER)
-            li.intensity = (float)v->number;
-        if ((v = json_get(e, "enabled")) && v->type == JSON_BOOL)
-            li.enabled = v->number != 0.0;
-        if ((v = json_get(e, "color")) && !floats(v, li.color, 3))
+        const cJSON *v;
+        if (cJSON_IsNumber(v = member(e, "intensity")))
+            li.intensity = (float)v->valuedouble;
+        if (cJSON_IsBool(v = member(e, "enabled")))
+            li.enabled = cJSON_IsTrue(v);
+        if ((v = member(e, "color")) && !floats(v, li.color, 3))
             return bad(path, i, "\"color\" must be 3 numbers");
         st = lmgi_set_light(sc, l, &li, &err);
-    } else if (node && node->type == JSON_STRING) {
-        int n = lmgi_find_node(sc, node->string);
+    } else if (node) {
+        int n = lmgi_find_node(sc, node);
         float world[16], move[3];
         if (n < 0 || !lmgi_get_node_transform(sc, n, world))
             return bad(path, i, "no node of that name");
-        if (!floats(json_get(e, "translate"), move, 3))
+        if (!floats(member(e, "translate"), move, 3))
             return bad(path, i, "a node edit needs \"translate\": [x, y, z]");
         for (int k = 0; k < 3; k++)
             world[12 + k] += move[k];
         st = lmgi_set_node_transform(sc, n, world, &err);
-    } else if (mat && mat->type == JSON_STRING) {
-        int m = material_named(sc, mat->string);
+    } else if (mat) {
+        int m = material_named(sc, mat);
         lmgi_material mm;
         if (m < 0 || lmgi_get_material(sc, m, &mm, &err) != LMGI_OK)
             return bad(path, i, "no material of that name");
-        const json_value *v;
-        if ((v = json_get(e, "base_color")) && !floats(v, mm.base_color, 3))
+        const cJSON *v;
+        if ((v = member(e, "base_color")) && !floats(v, mm.base_color, 3))
             return bad(path, i, "\"base_color\" must be 3 numbers");
-        if ((v = json_get(e, "emissive")) && !floats(v, mm.emissive, 3))
+        if ((v = member(e, "emissive")) && !floats(v, mm.emissive, 3))
             return bad(path, i, "\"emissive\" must be 3 numbers");
         st = lmgi_set_material(sc, m, &mm, &err);
-    } else if ((light = json_get(e, "add_light")) && light->type == JSON_STRING) {
+    } else if ((light = string_of(e, "add_light"))) {
         static const char *const types[3] = {"point", "spot", "directional"};
         lmgi_light li = {.color = {1, 1, 1}, .intensity = 1.0f, .enabled = 1, .direction = {0, -1, 0},
                          .inner_cone = 0.0f, .outer_cone = 0.785398f};
         li.type = (lmgi_light_type)3;
         for (int t = 0; t < 3; t++)
-            if (!strcmp(light->string, types[t]))
+            if (!strcmp(light, types[t]))
                 li.type = (lmgi_light_type)t;
-        const json_value *v;
-        if ((int)li.type == 3 || !floats(json_get(e, "position"), li.position, 3))
+        const cJSON *v;
+        if ((int)li.type == 3 || !floats(member(e, "position"), li.position, 3))
             return bad(path, i, "\"add_light\" is \"point\", \"spot\" or \"directional\", with a \"position\"");
-        if ((v = json_get(e, "direction")) && !floats(v, li.direction, 3))
+        if ((v = member(e, "direction")) && !floats(v, li.direction, 3))
             return bad(path, i, "\"direction\" must be 3 numbers");
-        if ((v = json_get(e, "color")) && !floats(v, li.color, 3))
+        if ((v = member(e, "color")) && !floats(v, li.color, 3))
             return bad(path, i, "\"color\" must be 3 numbers");
-        if ((v = json_get(e, "intensity")) && v->type == JSON_NUMBER)
-            li.intensity = (float)v->number;
+        if (cJSON_IsNumber(v = member(e, "intensity")))
+            li.intensity = (float)v->valuedouble;
         int id;
         st = lmgi_add_light(sc, &li, &id, &err);
-    } else if ((light = json_get(e, "remove_light")) && light->type == JSON_STRING) {
-        int l = light_of_node(sc, light->string);
+    } else if ((light = string_of(e, "remove_light"))) {
+        int l = light_of_node(sc, light);
         if (l < 0)
             return bad(path, i, "no light on that node");
         st = lmgi_remove_light(sc, l, &err);
@@ -427,20 +451,83 @@ void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, lm_l
     *frames = -1, *ms = sum;
 }
 
-void lm_edit_describe(const json_value *e, char *out, size_t n)
+void lm_edit_describe(const cJSON *e, char *out, size_t n)
 {
     static const char *const kinds[5] = {"light", "node", "material", "add_light", "remove_light"};
     for (int k = 0; k < 5; k++) {
-        const json_value *v = json_get(e, kinds[k]);
-        if (v && v->string) {
-            snprintf(out, n, "%s %s", kinds[k], v->string);
+        const char *v = string_of(e, kinds[k]);
+        if (v) {
+            snprintf(out, n, "%s %s", kinds[k], v);
             return;
         }
     }
     snprintf(out, n, "?");
 }
 
-static json_value *read_script(const char *path)
+static int is_space(char c)
+{
+    return c == ' ' || c == '\t' || c == '\n' || c == '\r';
+}
+
+static const char *skip_space(const char *p, const char *end)
+{
+    while (p < end && is_space(*p))
+        p++;
+    return p;
+}
+
+/* Says where text (n bytes) stops being JSON, at `stop`, as the line and column an editor shows, and
+ * what is there: cJSON gives the place but not the reason. */
+static void not_json(const char *path, const char *text, size_t n, const char *stop, const char *what)
+{
+    int line = 1, col = 1;
+    for (const char *q = text; q < stop; q++)
+        line += *q == '\n', col = *q == '\n' ? 1 : col + 1;
+    char here[64];
+    if (what) {
+        snprintf(here, sizeof here, "%s", what);
+    } else if (skip_space(text, text + n) == text + n) {
+        snprintf(here, sizeof here, "no JSON value in it");
+    } else if (stop >= text + n) {
+        snprintf(here, sizeof here, "the text ends before the JSON value does");
+    } else {
+        int len = 0; /* the rest of the line, up to 24 characters */
+        while (len < 24 && stop + len < text + n && stop[len] != '\n' && stop[len] != '\r')
+            len++;
+        snprintf(here, sizeof here, "not valid JSON from \"%.*s\"", len, stop);
+    }
+    fprintf(stderr, "lmgi: %s: line %d, column %d: %s\n", path, line, col, here);
+}
+
+/* text: n bytes and a NUL after them. cJSON reads the NUL too (n + 1 bytes): it reports a stop at the end
+ * of its buffer as the buffer's last byte, so a text cut short is then placed at its end, not on its last
+ * character. It does not require the NUL right after the value: text after a whole value is checked
+ * here, to be told apart from text that is not JSON and said where it starts. */
+static cJSON *parse_text(const char *path, const char *text, size_t n)
+{
+    const char *nul = memchr(text, '\0', n);
+    if (nul) {
+        not_json(path, text, n, nul, "a NUL byte, which JSON text never holds");
+        return NULL;
+    }
+    const char *stop = NULL;
+    cJSON *root = cJSON_ParseWithLengthOpts(text, n + 1, &stop, 0);
+    if (!stop || stop < text || stop > text + n)
+        stop = text + n;
+    if (!root) {
+        not_json(path, text, n, stop, NULL);
+        return NULL;
+    }
+    stop = skip_space(stop, text + n);
+    if (stop != text + n) {
+        not_json(path, text, n, stop, "text after the value");
+        cJSON_Delete(root);
+        return NULL;
+    }
+    return root;
+}
+
+static cJSON *read_script(const char *path)
 {
     FILE *f = fopen(path, "rb");
     if (!f) {
@@ -451,14 +538,14 @@ static json_value *read_script(const char *path)
     size_t n = text ? fread(text, 1, 1 << 20, f) : 0;
     int too_big = text && n == 1 << 20;
     fclose(f);
-    char err[512];
-    json_value *root = text && !too_big ? json_parse(text, n, err, sizeof err) : NULL;
-    if (!root)
-        fprintf(stderr, "lmgi: %s: %s\n", path, !text ? "out of memory" : too_big ? "larger than 1 MiB" : err);
+    cJSON *root = NULL;
+    if (!text || too_big)
+        fprintf(stderr, "lmgi: %s: %s\n", path, !text ? "out of memory" : "larger than 1 MiB");
+    else
+        text[n] = '\0', root = parse_text(path, text, n);
     free(text);
     return root;
 }
-
 
 int lm_edit_script_read(const char *path, lm_edit_script *s)
 {
@@ -474,7 +561,7 @@ int lm_edit_script_read(const char *path, lm_edit_script *s)
 
 void lm_edit_script_free(lm_edit_script *s)
 {
-    json_free(s->root);
+    cJSON_Delete(s->root);
     s->root = NULL;
     s->edit_count = 0;
 }

@@ -6,20 +6,19 @@
 #ifndef LM_CLI_EDIT_SCRIPT_H
 #define LM_CLI_EDIT_SCRIPT_H
 
+#include <cjson/cJSON.h>
 #include <lmgi.h>
-
-#include "json.h"
 
 #define LM_EDIT_MAX 256
 
 typedef struct {
     int frame;             /* the update before which the edit is made */
-    const json_value *v;   /* the edit's object in the script */
+    const cJSON *v;        /* the edit's object in the script */
 } lm_edit;
 
 typedef struct {
     const char *path;
-    json_value *root;
+    cJSON *root;
     int frames, fps, texels;
     float budget_ms;
     const char *scene;     /* the "scene" key: the file name the script was written for (NULL: not said) */
@@ -68,8 +67,9 @@ typedef enum { LM_LAG_ATLAS = 0, LM_LAG_WORST_SURFACE = 1, LM_LAG_FRAME = 2 } lm
 #define LM_EDIT_REACH 1e-4
 #define LM_EDIT_CAUGHT_UP 0.02
 
-/* Reads and checks the script (1 MiB at most). 0, after printing what is wrong (file, edit, key), when
- * it cannot be read, is not valid JSON or is out of range. */
+/* Reads (with cJSON) and checks the script (1 MiB at most). 0, after printing what is wrong (file, edit,
+ * key; for text that is not JSON, the line and column where it stops being JSON), when it cannot be read,
+ * is not valid JSON or is out of range. */
 int lm_edit_script_read(const char *path, lm_edit_script *s);
 void lm_edit_script_free(lm_edit_script *s);
 /* Plays s on scene_path loaded at the script's texels, with desc d (NULL: the defaults) and lmgi_update's
@@ -86,6 +86,6 @@ int lm_edit_span(const lm_edit_script *s, int i, int *from, int *to);
 void lm_edit_lag(const lm_edit_frame *rows, int from, int to, double limit, lm_lag_metric by, int *frames,
                  double *ms);
 /* "light light_b2", "node door", ...: what edit e does, for tables. */
-void lm_edit_describe(const json_value *e, char *out, size_t n);
+void lm_edit_describe(const cJSON *e, char *out, size_t n);
 
 #endif
