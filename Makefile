@@ -33,7 +33,7 @@ VIS          := -fvisibility=hidden
 CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)
 CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fvisibility-inlines-hidden -fopenmp -Iinclude \
                 -I/usr/include/stb $(SAN) $(CXXFLAGS)
-LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -lwebp -lEGL -lgomp -lstdc++ -lm -lpthread
+LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -ldraco -lwebp -lEGL -lgomp -lstdc++ -lm -lpthread
 LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
 # The command line's own (not the library's: lmgi.pc does not name it): cJSON for a shard's part.json
 # and the edit scripts of --edits
@@ -44,7 +44,7 @@ NPM_DEB := $(if $(shell command -v npm 2>/dev/null),,npm)
 DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
                 nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libwebp-dev libcmocka-dev \
                 libegl-dev libegl-mesa0 python3-matplotlib libgl-dev libx11-dev xvfb nodejs chromium \
-                openmpi-bin libopenmpi-dev libcjson-dev \
+                openmpi-bin libopenmpi-dev libcjson-dev libdraco-dev draco gltfpack \
                 $(NPM_DEB)
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
@@ -126,7 +126,7 @@ $(BUILD)/lmgi-dev: $(DEV_OBJ) $(BUILD)/liblmgi.a
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
 	@mkdir -p $(dir $@)
-	$(CC) -o $@ $< $(TEST_SUPPORT) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) -lcmocka
+	$(CC) -o $@ $< $(TEST_SUPPORT) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS) -lcmocka
 
 # The GL guest test plays a GLX host on an X server: it alone links X and GLX (lmgi links neither).
 $(BUILD)/tests/test_gl_guest: LIBS += -lGL -lX11 -ldl

@@ -268,8 +268,10 @@ static void test_pictures(void **state)
     assert_int_equal(lmgi_write_image(path, 2, 2, 3, px, NULL, &e), LMGI_ERR_INVALID);
 }
 
-/* A Draco-compressed mesh without an uncompressed fallback decodes to nothing: said, not drawn black. */
-static void test_draco_without_fallback(void **state)
+/* A Draco-compressed mesh whose stream is not Draco (four zero bytes) and that has no uncompressed
+ * fallback: refused naming the primitive and the extension, not drawn as nothing (test_compressed decodes
+ * real ones). */
+static void test_draco_damaged_without_fallback(void **state)
 {
     (void)state;
     char path[1200];
@@ -283,7 +285,7 @@ static void test_draco_without_fallback(void **state)
           "[0, 0, 0], \"max\": [1, 1, 0]}], \"bufferViews\": [{\"buffer\": 0, \"byteLength\": 4}], \"buffers\": "
           "[{\"byteLength\": 4, \"uri\": \"data:application/octet-stream;base64,AAAAAA==\"}]}", f);
     fclose(f);
-    expect_refused(path, "Draco-compressed (KHR_draco_mesh_compression), which lmgi does not decode");
+    expect_refused(path, "mesh 0 primitive 0 (KHR_draco_mesh_compression): the Draco stream does not decode");
 }
 
 /* Images: memory planned before decoding. Two images whose headers say 8192 x 8192 need about 0.5 GB to
@@ -594,7 +596,7 @@ int main(void)
         cmocka_unit_test(test_transforms_bounded),
         cmocka_unit_test(test_updater_values),
         cmocka_unit_test(test_pictures),
-        cmocka_unit_test(test_draco_without_fallback),
+        cmocka_unit_test(test_draco_damaged_without_fallback),
         cmocka_unit_test(test_images_planned),
         cmocka_unit_test(test_named_files_are_regular),
         cmocka_unit_test(test_untrusted_scene_stays_in_its_folder),

@@ -32,12 +32,15 @@ extern "C" {
 #include "sky.h"
 #include "../core/vecmath.h"
 }
+#include "gltf_draco.h"
+#include "gltf_meshopt.h"
 
 namespace {
 
 const char *const k_supported_required[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_transmission", "KHR_materials_ior",
-                                            "KHR_texture_transform", "EXT_texture_webp"};
+                                            "KHR_texture_transform", "EXT_texture_webp", "EXT_meshopt_compression",
+                                            "KHR_draco_mesh_compression", "KHR_mesh_quantization"};
 // Optional extensions lmgi knows and has no use for, read without a warning: its own export's lightmap
 // (a scene lmgi loads is lit again, docs/api.md, "The lightmap in engines").
 const char *const k_known_unread[] = {"LMGI_lightmap"};
@@ -160,7 +163,9 @@ class Loader {
     lm_status read_file(std::vector<unsigned char> &bytes);
     lm_status check_glb(const std::vector<unsigned char> &b);
     lm_status check_buffers(const std::vector<unsigned char> &b, bool glb);
-    lm_status parse(const std::vector<unsigned char> &bytes);
+    lm_status parse(std::vector<unsigned char> &bytes);
+    lm_status decode_compressed();
+    lm_status stand_in_compressed(std::vector<unsigned char> &bytes, bool glb);
     lm_status check_extensions();
     lm_status densify_sparse();
     lm_status densify(int acc);
@@ -187,6 +192,7 @@ class Loader {
     lm_error *err_;
     bool strict_ = false, untrusted_ = false;
     std::string escaped_; // untrusted: the first file the scene named outside its folder (refused)
+    std::vector<MeshoptFallback> fallbacks_; // EXT_meshopt_compression's buffers that decoding fills
     tinygltf::Model model_;
     ScenePtr s_;
     std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted)
@@ -427,6 +433,45 @@ lm_status Loader::check_buffers(const std::vector<unsigned char> &b, bool glb)
     return LM_OK;
 }
 
+// The GLB b again, with `json` as its JSON chunk and its BIN chunk as it was.
+static std::vector<unsigned char> glb_with_json(const std::vector<unsigned char> &b, const std::string &json)
+{
+    size_t old_json = le32(&b[12]), rest = 20 + ((old_json + 3) & ~size_t(3)), padded = (json.size() + 3) & ~size_t(3);
+    size_t tail = b.size() > rest ? std::min(b.size(), size_t(le32(&b[8]))) - rest : 0;
+    std::vector<unsigned char> out(b.begin(), b.begin() + 20);
+    auto put32 = [&out](size_t at, uint32_t v) { for (int i = 0; i < 4; i++) out[at + size_t(i)] = (unsigned char)(v >> (8 * i)); };
+    put32(8, uint32_t(20 + padded + tail));
+    put32(12, uint32_t(padded));
+    out.insert(out.end(), json.begin(), json.end());
+    out.insert(out.end(), padded - json.size(), ' ');
+    out.insert(out.end(), b.begin() + long(rest), b.begin() + long(rest + tail));
+    return out;
+}
+
+// The compressed glTF's parts that tinygltf would refuse given stand-ins (gltf_meshopt.h, gltf_draco.h),
+// the file's bytes rewritten with them. A file naming neither extension is not parsed again.
+lm_status Loader::stand_in_compressed(std::vector<unsigned char> &bytes, bool glb)
+{
+    size_t at = glb ? 20 : 0, len = glb ? le32(&bytes[12]) : bytes.size();
+    std::string_view text(reinterpret_cast<const char *>(bytes.data() + at), len);
+    if (text.find("EXT_meshopt_compression") == text.npos && text.find("KHR_draco_mesh_compression") == text.npos)
+        return LM_OK;
+    nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
+    if (j.is_discarded())
+        return LM_OK; // tinygltf's parser says what is wrong
+    std::string why = meshopt_stand_in(j, glb, fallbacks_);
+    if (!why.empty())
+        return fail(LM_ERR_FORMAT, "%s", why.c_str());
+    if (!draco_stand_in(j) && fallbacks_.empty())
+        return LM_OK;
+    std::string json = j.dump();
+    if (glb)
+        bytes = glb_with_json(bytes, json);
+    else
+        bytes.assign(json.begin(), json.end());
+    return LM_OK;
+}
+
 // The folder of the scene file, which the files it names are relative to.
 std::string Loader::scene_dir() const
 {
@@ -460,7 +505,7 @@ static const char *not_gltf(const std::vector<unsigned char> &b)
     return i < b.size() && b[i] >= 0x20 && b[i] < 0x7f ? "a text file" : "a file lmgi does not know";
 }
 
-lm_status Loader::parse(const std::vector<unsigned char> &bytes)
+lm_status Loader::parse(std::vector<unsigned char> &bytes)
 {
     bool glb = bytes.size() >= 4 && memcmp(bytes.data(), "glTF", 4) == 0;
     if (const char *what = glb ? nullptr : not_gltf(bytes))
@@ -469,6 +514,8 @@ lm_status Loader::parse(const std::vector<unsigned char> &bytes)
                     "(Blender: File > Export > glTF 2.0)", what);
     lm_status checked = glb ? check_glb(bytes) : LM_OK;
     if (checked || (checked = check_buffers(bytes, glb)))
+        return checked;
+    if ((checked = stand_in_compressed(bytes, glb)))
         return checked;
     std::string dir = scene_dir();
     tinygltf::TinyGLTF gltf;
@@ -574,9 +621,13 @@ lm_status Loader::read_floats(int acc, int type, bool force_norm, const char *wh
         return st;
     count = sp.count;
     out.assign(sp.count * size_t(sp.ncomp), 0.0f);
-    if (sp.data) // integer texcoords are normalised whatever the flag says (the spec requires it)
+    // Integer texcoords are normalised whatever the flag says (glTF 2.0 allows no other kind), unless the
+    // file uses KHR_mesh_quantization, which allows unnormalised ones (scaled by KHR_texture_transform).
+    bool quantized = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), "KHR_mesh_quantization") !=
+                     model_.extensionsUsed.end();
+    if (sp.data)
         lm_decode_floats(sp.data, sp.count, sp.stride, sp.comp_type, sp.ncomp,
-                         sp.normalized || (force_norm && sp.comp_type != LM_COMP_FLOAT), out.data());
+                         sp.normalized || (force_norm && !quantized && sp.comp_type != LM_COMP_FLOAT), out.data());
     return LM_OK;
 }
 
@@ -1014,16 +1065,11 @@ lm_status Loader::primitive(int node, int mesh, int prim)
         lm_warn("%s: %s: no POSITION attribute; skipped", path_, ctx.c_str());
         return LM_OK;
     }
-    // An accessor without a bufferView is all zeros: positions that decode to one point. A Draco-compressed
-    // primitive writes its fallback that way when it has none; lmgi does not decode Draco, so the mesh
-    // would be nothing at all. Said here, not drawn as an invisible point.
+    // An accessor without a bufferView is all zeros: positions that decode to one point. Said here, not
+    // drawn as an invisible point. (A Draco primitive's accessors have views by now: decode_compressed.)
     int pa = attr("POSITION");
     if (size_t(pa) < model_.accessors.size() && model_.accessors[size_t(pa)].bufferView < 0 &&
         !model_.accessors[size_t(pa)].sparse.isSparse) {
-        if (p.extensions.count("KHR_draco_mesh_compression"))
-            return fail(LM_ERR_UNSUPPORTED, "%s: its geometry is Draco-compressed (KHR_draco_mesh_compression), which "
-                        "lmgi does not decode, and it has no uncompressed fallback (POSITION has no data)",
-                        ctx.c_str());
         lm_warn("%s: %s: POSITION has no data (an accessor without a bufferView: every vertex at the origin); "
                 "skipped", path_, ctx.c_str());
         return LM_OK;
@@ -1417,6 +1463,15 @@ lm_status Loader::densify(int acc)
     return LM_OK;
 }
 
+// The compressed glTF that tools write (gltf_meshopt.h, gltf_draco.h), decoded into plain accessors.
+lm_status Loader::decode_compressed()
+{
+    std::string why = meshopt_decode(model_, fallbacks_);
+    if (why.empty())
+        why = draco_decode(model_);
+    return why.empty() ? LM_OK : fail(LM_ERR_FORMAT, "%s", why.c_str());
+}
+
 lm_status Loader::densify_sparse()
 {
     for (size_t i = 0; i < model_.accessors.size(); i++)
@@ -1432,7 +1487,7 @@ lm_status Loader::run(lm_scene **out)
 {
     std::vector<unsigned char> bytes;
     lm_status st = read_file(bytes);
-    if (st || (st = parse(bytes)) || (st = check_extensions()) || (st = densify_sparse()))
+    if (st || (st = parse(bytes)) || (st = check_extensions()) || (st = decode_compressed()) || (st = densify_sparse()))
         return st;
     bytes = std::vector<unsigned char>(); // tinygltf has copied what it needs
     s_.reset(calloc_n<lm_scene>(1));
