@@ -565,6 +565,13 @@ static void check_cache_follows(const char *path, int dynamic_node)
 
     print_message("cache (%s, node %d dynamic): 4 changes, each identical to a fresh render; 4 maps rendered\n",
                   path, dynamic_node);
+
+    assert_int_equal(lm_direct_shadow_maps_held(d), 1); /* the light removed: its map given back */
+    l.s->lights[0].removed = 1;
+    live_update(&l);
+    free(render_both(d, &l, "light removed"));
+    assert_int_equal(lm_direct_shadow_maps_held(d), 0);
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 4);
     lm_direct_free(d);
     live_free(&l);
     free(first);

@@ -173,6 +173,50 @@ static void test_deterministic(void **state)
     world_free(&b);
 }
 
+/* A light removed for good: its removal's re-trace empties its groups (its hits leave the store), then
+ * lm_photons_release_emitter gives back its paths' memory (waiting groups counted until then); no other
+ * light's hit changes, and a later full trace keeps it empty. */
+static void test_release_removed_light(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world_photons(&w, &set);
+    lm_photon_memory before, after;
+    lm_photons_memory(w.ph, &before);
+    uint32_t photons = lm_photons_emitter_photons(w.ph, 1);
+    assert_true(photons > 0);
+    int light = w.em.e[1].light;
+    w.s->lights[light].removed = 1;
+    lm_emitters_update(&w.em, w.s);
+    lm_error err;
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 1, &err), LM_OK);
+    assert_int_equal(lm_photons_release_emitter(w.ph, 1), lm_photons_groups_per_emitter(w.ph)); /* all wait */
+    while (lm_photons_pending_groups(w.ph))
+        frame(&w);
+    snapshot mid = take_snapshot(w.ph);
+    assert_int_equal(lm_photons_release_emitter(w.ph, 1), 0);
+    assert_int_equal(lm_photons_release_emitter(w.ph, 1), 0); /* again: nothing left to give back */
+    lm_photons_memory(w.ph, &after);
+    print_message("light %d removed: its %u photons' paths given back, %zu -> %zu bytes of paths\n", light, photons,
+                  before.path_bytes, after.path_bytes);
+    assert_true(after.path_bytes + (size_t)photons * 20 <= before.path_bytes); /* 4 of offset + 16 of numbers */
+    for (uint32_t i = 0; i < mid.n; i++)
+        assert_true(lm_photons_group_of(w.ph, mid.h[i].photon) / lm_photons_groups_per_emitter(w.ph) != 1);
+    for (int f = 0; f < 5; f++) /* the round robin passes over it */
+        frame(&w);
+    lm_error e2;
+    assert_int_equal(lm_photons_trace_all(w.ph, NULL, &e2), LM_OK);
+    snapshot end = take_snapshot(w.ph);
+    assert_same_snapshot(&mid, &end);
+    free(mid.h);
+    free(end.h);
+    world_free(&w);
+}
+
 /* ---- a trace shared among processes (lm_photon_split), the processes played by threads ---- */
 
 #define SHARES 3
@@ -801,6 +845,7 @@ int main(void)
         cmocka_unit_test(test_cornell_rate_and_memory),
         cmocka_unit_test(test_hidden_light),
         cmocka_unit_test(test_split_trace_is_one_process_trace),
+        cmocka_unit_test(test_release_removed_light),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -378,6 +378,13 @@ static lm_status ensure_maps(lm_direct *d, int count, lm_error *err)
     return LM_OK;
 }
 
+/* A point, spot or directional light that still exists: a removed one lights nothing and keeps no map
+ * (an added light's map, a cube of 6 x 512^2 floats and its layer, was kept after its removal). */
+static int live_punctual(const lm_scene *s, const lm_emitter *e)
+{
+    return e->punctual && !(e->light >= 0 && e->light < s->light_count && s->lights[e->light].removed);
+}
+
 /* The scene from view into target t (width x height), leaving out the vertices in d->drop. */
 static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, const lm_emitters *em,
                            const lm_view *view, int width, int height, lm_error *err)
@@ -406,9 +413,11 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     d->cur = t;
     int first = -1;
     for (int i = 0; st == LM_OK && i < em->count; i++)
-        if (em->e[i].punctual) {
+        if (live_punctual(s, &em->e[i])) {
             st = shadow_map(d, s, &em->e[i], i, err);
             first = first < 0 ? i : first;
+        } else if (d->maps[i].map.tex) {
+            lm_shadow_map_free(&d->maps[i].map);
         }
     if (st != LM_OK)
         return st;
@@ -418,7 +427,7 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     first_pass(d, s, em, first, view, width, height);
     glDrawBuffers(1, all); /* the additive passes after it add radiance only */
     for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
-        if (em->e[i].punctual)
+        if (live_punctual(s, &em->e[i]))
             st = light_pass(d, s, &em->e[i], i, view, width, height, err);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return st;
@@ -507,6 +516,14 @@ lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *
 }
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
+
+int lm_direct_shadow_maps_held(const lm_direct *d)
+{
+    int n = 0;
+    for (int i = 0; i < d->map_count; i++)
+        n += d->maps[i].map.tex != 0;
+    return n;
+}
 
 lm_status lm_direct_read(lm_direct *d, float *rgb, lm_error *err)
 {

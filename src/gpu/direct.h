@@ -97,6 +97,8 @@ void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);
 lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *err);
 /* Shadow maps rendered since creation (each cube map counts once), for tests and statistics. */
 long lm_direct_shadow_maps_rendered(const lm_direct *d);
+/* How many shadow maps it holds now (a removed light's is given back at the next draw). */
+int lm_direct_shadow_maps_held(const lm_direct *d);
 
 /* One-shot: creates an lm_direct, renders, reads back and frees it.
  * Renders width x height RGB floats into rgb (3 per pixel, row 0 at the top). em must be current

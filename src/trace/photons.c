@@ -424,6 +424,30 @@ lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_
     return s;
 }
 
+uint32_t lm_photons_release_emitter(lm_photons *ph, int e)
+{
+    uint32_t waiting = 0;
+    if (e < 0 || (uint32_t)e >= ph->emitter_count)
+        return 0;
+    for (uint32_t k = 0; k < ph->G; k++) {
+        ph_group *g = &ph->groups[(uint32_t)e * ph->G + k];
+        if (g->photons == 0) /* released before, or never had any */
+            continue;
+        if (g->invalid || g->offsets[g->photons] != 0) { /* its dark re-trace has not emptied it yet */
+            waiting += g->photons > 0;
+            continue;
+        }
+        uint32_t *none = calloc(1, sizeof *none); /* offsets[0] = 0: a group of no photons */
+        if (!none)
+            return waiting + 1;
+        ph_group_free(g);
+        g->offsets = none;
+        g->photons = 0;
+        g->rr_next = 0;
+    }
+    return waiting;
+}
+
 void lm_photons_set_split(lm_photons *ph, const lm_photon_split *split)
 {
     memset(&ph->split, 0, sizeof ph->split);
@@ -556,6 +580,8 @@ uint32_t lm_photons_path(const lm_photons *ph, uint32_t photon, const lm_path_ve
     uint32_t j = photon - ph->emitter_first[e];
     const ph_group *g = &ph->groups[(uint32_t)e * ph->G + j % ph->G];
     uint32_t m = j / ph->G;
+    if (m >= g->photons) /* a released emitter's (lm_photons_release_emitter) */
+        return 0;
     *vertices = g->verts ? g->verts + g->offsets[m] : NULL;
     return g->offsets[m + 1] - g->offsets[m];
 }

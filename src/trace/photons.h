@@ -136,6 +136,11 @@ lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err);
  * tracing. Fails when the list did not grow by one light (nothing changed), or when memory runs out
  * (the light then has no photons). */
 lm_status lm_photons_add_emitter(lm_photons *ph, lm_error *err);
+/* Gives back the memory of emitter e's photons (their paths, emission numbers and slabs; its groups keep
+ * no photon) once its groups hold no path: for a light removed for good, after the re-trace its removal
+ * queued has emptied them. Returns how many of its groups still wait for that re-trace (call again after
+ * a frame); 0 when all are released. Its photon ids stay its own, traced no more. */
+uint32_t lm_photons_release_emitter(lm_photons *ph, int e);
 /* Marks invalid every group with a stored path vertex on a triangle whose material is flagged in
  * `materials` (per scene material): what a material edit reaches. Returns how many groups. */
 uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *materials);

@@ -375,11 +375,24 @@ static int anything_moves(const lm_scene *s)
     return 0;
 }
 
+/* The photons of lights removed for good given back once their removal's re-trace has emptied them: a
+ * soak that adds and removes lights held every removed light's paths (lmgi_remove_light). */
+static void release_removed(lm_photon_stage *ps)
+{
+    for (int e = 0; e < ps->emitters.count; e++) {
+        int light = ps->emitters.e[e].light;
+        if (light >= 0 && light < ps->scene->light_count && ps->scene->lights[light].removed)
+            lm_photons_release_emitter(ps->photons, e);
+    }
+}
+
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
     double t1 = lm_now();
     lm_status st = ps->set.trace ? lm_photons_frame(ps->photons, anything_moves(ps->scene), &out->photons, err)
                                  : LM_OK;
+    if (st == LM_OK && ps->set.trace)
+        release_removed(ps);
     double t2 = lm_now();
     if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = refresh_aims(ps, ps->set.surfaces_per_frame, &out->aim, err);
