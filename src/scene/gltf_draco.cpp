@@ -1,5 +1,6 @@
 // KHR_draco_mesh_compression decoded with Draco (gltf_draco.h).
 #include "gltf_draco.h"
+#include "gltf_views.h"
 
 #include <tiny_gltf.h>
 
@@ -13,21 +14,6 @@
 namespace {
 
 const char k_ext[] = "KHR_draco_mesh_compression";
-
-// A buffer and a bufferView of their own for accessor a, holding `bytes`.
-void give_view(tinygltf::Model &m, tinygltf::Accessor &a, std::vector<unsigned char> &&bytes)
-{
-    tinygltf::Buffer b;
-    b.data = std::move(bytes);
-    tinygltf::BufferView v;
-    v.buffer = int(m.buffers.size());
-    v.byteLength = b.data.size();
-    m.buffers.push_back(std::move(b));
-    a.bufferView = int(m.bufferViews.size());
-    a.byteOffset = 0;
-    a.sparse.isSparse = false;
-    m.bufferViews.push_back(std::move(v));
-}
 
 template <typename T>
 bool convert_points(const draco::PointAttribute &att, size_t points, int ncomp, std::vector<unsigned char> &out)
@@ -76,7 +62,7 @@ std::string set_indices(tinygltf::Model &m, int acc, const draco::Mesh &mesh, co
             out[3 * f + size_t(k)] = mesh.face(draco::FaceIndex(uint32_t(f)))[k].value();
     a.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
     a.type = TINYGLTF_TYPE_SCALAR;
-    give_view(m, a, std::move(bytes));
+    gltf_own_view(m, size_t(acc), std::move(bytes));
     return "";
 }
 
@@ -116,7 +102,7 @@ std::string decode_primitive(tinygltf::Model &m, tinygltf::Primitive &p, const t
             return at + ": " + std::to_string(points) + " points decoded, " + name + "'s accessor has " + std::to_string(a.count);
         if (!attribute_bytes(*att, a, points, bytes))
             return at + ": attribute " + name + " does not convert to its accessor's type";
-        give_view(m, a, std::move(bytes));
+        gltf_own_view(m, size_t(acc->second), std::move(bytes));
     }
     return err;
 }

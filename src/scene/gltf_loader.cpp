@@ -34,6 +34,7 @@ extern "C" {
 }
 #include "gltf_draco.h"
 #include "gltf_meshopt.h"
+#include "gltf_views.h"
 
 namespace {
 
@@ -1449,17 +1450,7 @@ lm_status Loader::densify(int acc)
                         where[i], i, a.count);
         memcpy(dense.data() + size_t(where[i]) * elem, val + i * elem, elem);
     }
-    tinygltf::Buffer b;
-    b.data = std::move(dense);
-    tinygltf::BufferView v;
-    v.buffer = int(model_.buffers.size());
-    v.byteLength = b.data.size();
-    model_.buffers.push_back(std::move(b));
-    model_.bufferViews.push_back(v);
-    tinygltf::Accessor &d = model_.accessors[size_t(acc)]; // push_back above does not move accessors
-    d.bufferView = int(model_.bufferViews.size()) - 1;
-    d.byteOffset = 0;
-    d.sparse.isSparse = false;
+    gltf_own_view(model_, size_t(acc), std::move(dense));
     return LM_OK;
 }
 
