@@ -510,9 +510,10 @@ static void test_bad_input(void **state)
     load_fails(p, 0, LM_ERR_INVALID, "non-finite");
 
     o = tri_defaults();
-    o.ext = "\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],\"extensionsRequired\":[\"KHR_draco_mesh_compression\"],";
+    /* a required extension lmgi does not read (KTX2 textures); Draco, once the example here, is decoded now */
+    o.ext = "\"extensionsUsed\":[\"KHR_texture_basisu\"],\"extensionsRequired\":[\"KHR_texture_basisu\"],";
     tri_case(dir, "required.gltf", &o, p, sizeof p);
-    load_fails(p, 0, LM_ERR_UNSUPPORTED, "KHR_draco_mesh_compression");
+    load_fails(p, 0, LM_ERR_UNSUPPORTED, "KHR_texture_basisu");
 
     o.ext = "\"extensionsUsed\":[\"KHR_materials_sheen\",\"KHR_materials_variants\",\"KHR_lights_punctual\"],"
             "\"extensionsRequired\":[\"KHR_lights_punctual\"],";
