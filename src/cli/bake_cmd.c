@@ -279,9 +279,7 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     return rc;
 }
 
-int lm_cli_bake(const lm_cli_args *a) { return lm_cli_bake_timed(a, NULL); }
-
-int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t) { return lm_cli_bake_shared(a, NULL, t); }
+int lm_cli_bake(const lm_cli_args *a) { return lm_cli_bake_shared(a, NULL, NULL); }
 
 int lm_cli_bake_shared(const lm_cli_args *a, const lm_cli_share *share, lm_cli_bake_times *t)
 {

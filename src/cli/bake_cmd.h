@@ -6,13 +6,11 @@
  * DIR/lightmap.exr (the IIM: irradiance, alpha = validity; --half: 16-bit floats), DIR/lightmap.png (a
  * tone-mapped preview) and DIR/aim.exr. */
 int lm_cli_bake(const lm_cli_args *a);
-/* What a bake's stages took (lm_cli_bake_timed): the whole call in seconds, the first full solution's
+/* What a bake's stages took (lm_cli_bake_shared): the whole call in seconds, the first full solution's
  * photon tracing, AIMs and gather in milliseconds (lmgi_updater_info). */
 typedef struct {
     double seconds, ms_trace, ms_aim, ms_gather;
 } lm_cli_bake_times;
-/* lm_cli_bake, and its stages' times into *t (zeroed when it fails before the solution). */
-int lm_cli_bake_timed(const lm_cli_args *a, lm_cli_bake_times *t);
 /* What connects the processes of a shared bake (lmgi_updater_desc's photon_exchange, claim_pass and
  * share_user: lmgi-mpi's ranks), and whether this one shows the progress even when quiet. */
 typedef struct {
@@ -24,6 +22,7 @@ typedef struct {
 /* The bake of a merge: the scene a->files[0] and the parts' checkpoint files put together into
  * a->out_dir. The exit code. */
 int lm_cli_bake_merge(const lm_cli_args *a, const char *const *parts, int part_count);
-/* lm_cli_bake_timed of a shard (a->shards > 1) connected to the others by `share` (NULL: none). */
+/* lm_cli_bake of a shard (a->shards > 1) connected to the others by `share` (NULL: none), its stages'
+ * times into *t (may be NULL; zeroed when it fails before the solution). */
 int lm_cli_bake_shared(const lm_cli_args *a, const lm_cli_share *share, lm_cli_bake_times *t);
 #endif

@@ -17,6 +17,7 @@
 #include "bake_cmd.h"
 #include "options.h"
 #include "out_dir.h"
+#include "read_file.h"
 
 #define PATH_SIZE 4200
 
@@ -155,25 +156,6 @@ static void json_of(const char *part, char *path, size_t size)
         snprintf(path, size, "part.json");
 }
 
-/* The whole file, NUL-terminated; NULL with errno set. */
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    long size = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-    char *text = size >= 0 && fseek(f, 0, SEEK_SET) == 0 ? malloc((size_t)size + 1) : NULL;
-    int got = text && fread(text, 1, (size_t)size, f) == (size_t)size;
-    fclose(f);
-    if (!got) {
-        free(text);
-        errno = EIO;
-        return NULL;
-    }
-    text[size] = '\0';
-    return text;
-}
-
 /* Why a part has no part.json: it is no part at all, or an older lmgi's (which wrote none). */
 static int no_part_json(const char *part, const char *json)
 {
@@ -214,7 +196,8 @@ static int read_part(const char *part, part_info *p)
         return 0;
     }
     json_of(part, p->where, sizeof p->where);
-    char *text = read_text(p->where);
+    size_t size;
+    char *text = lm_cli_read_file(p->where, &size);
     if (!text && errno == ENOENT)
         return no_part_json(part, p->where);
     if (!text) {

@@ -28,6 +28,7 @@
 #include "../bake_cmd.h"
 #include "../merge_cmd.h"
 #include "../options.h"
+#include "../read_file.h"
 
 int lm_cli_main(int argc, char **argv);
 
@@ -139,22 +140,6 @@ static void *answer_claims(void *user)
         MPI_Send(&pass, 1, MPI_INT, st.MPI_SOURCE, TAG_CLAIM, sh->claims);
     }
     return NULL;
-}
-
-static unsigned char *read_all(const char *path, int64_t *size)
-{
-    FILE *f = fopen(path, "rb");
-    unsigned char *data = NULL;
-    long n = -1;
-    if (f && fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) >= 0 && fseek(f, 0, SEEK_SET) == 0 &&
-        (data = malloc((size_t)n + 1)) != NULL && fread(data, 1, (size_t)n, f) != (size_t)n) {
-        free(data);
-        data = NULL;
-    }
-    if (f)
-        fclose(f);
-    *size = data ? (int64_t)n : -1;
-    return data;
 }
 
 /* What a rank did: its bake's stage times and the gather passes it took. */
@@ -278,9 +263,9 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks, int balanc
     MPI_Comm_free(&sh.claims);
     int status = 0;
     if (rank > 0) {
-        int64_t size = -1;
-        unsigned char *mine = read_all(part, &size);
-        send_part(&(rank_report){mine_t, sh.taken}, mine, size);
+        size_t n = 0;
+        char *mine = lm_cli_read_file(part, &n);
+        send_part(&(rank_report){mine_t, sh.taken}, (const unsigned char *)mine, mine ? (int64_t)n : -1);
         free(mine);
     } else {
         char (*paths)[4400] = calloc((size_t)ranks, sizeof *paths);
