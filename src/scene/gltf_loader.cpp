@@ -163,10 +163,10 @@ class Loader {
     lm_status fail(lm_status st, const char *fmt, ...) __attribute__((format(printf, 3, 4)));
     lm_status read_file(std::vector<unsigned char> &bytes);
     lm_status check_glb(const std::vector<unsigned char> &b);
-    lm_status check_buffers(const std::vector<unsigned char> &b, bool glb);
+    lm_status check_buffers(const nlohmann::json &j, const std::vector<unsigned char> &b, bool glb);
     lm_status parse(std::vector<unsigned char> &bytes);
     lm_status decode_compressed();
-    lm_status stand_in_compressed(std::vector<unsigned char> &bytes, bool glb);
+    lm_status stand_in_compressed(nlohmann::json &j, std::vector<unsigned char> &bytes, bool glb);
     lm_status check_extensions();
     lm_status densify_sparse();
     lm_status densify(int acc);
@@ -194,6 +194,7 @@ class Loader {
     bool strict_ = false, untrusted_ = false;
     std::string escaped_; // untrusted: the first file the scene named outside its folder (refused)
     std::vector<MeshoptFallback> fallbacks_; // EXT_meshopt_compression's buffers that decoding fills
+    bool quantized_ = false; // the file uses KHR_mesh_quantization (check_extensions)
     tinygltf::Model model_;
     ScenePtr s_;
     std::vector<int> image_tex_;             // glTF image -> lm texture (-1 not yet converted)
@@ -400,16 +401,22 @@ lm_status Loader::check_glb(const std::vector<unsigned char> &b)
     return LM_OK;
 }
 
-// Buffers as glTF requires them (byteLength at least 1; the GLB's own buffer within its BIN chunk),
-// checked before tinygltf, which indexes an empty buffer unchecked ("vector::_M_range_check"). Malformed
-// JSON is left to tinygltf's parser and its message.
-lm_status Loader::check_buffers(const std::vector<unsigned char> &b, bool glb)
+// The file's JSON (a .gltf's text, a .glb's JSON chunk), parsed once for what is checked and stood in
+// before tinygltf reads it; discarded when it is not JSON, which tinygltf's parser then says.
+static nlohmann::json file_json(const std::vector<unsigned char> &b, bool glb)
 {
     size_t json_len = glb ? le32(&b[12]) : b.size(), json_at = glb ? 20 : 0;
-    nlohmann::json j = nlohmann::json::parse(b.begin() + long(json_at), b.begin() + long(json_at + json_len), nullptr,
-                                             false);
+    return nlohmann::json::parse(b.begin() + long(json_at), b.begin() + long(json_at + json_len), nullptr, false);
+}
+
+// Buffers as glTF requires them (byteLength at least 1; the GLB's own buffer within its BIN chunk),
+// checked before tinygltf, which indexes an empty buffer unchecked ("vector::_M_range_check"). Malformed
+// JSON (j discarded) is left to tinygltf's parser and its message.
+lm_status Loader::check_buffers(const nlohmann::json &j, const std::vector<unsigned char> &b, bool glb)
+{
     if (j.is_discarded() || !j.is_object() || !j.contains("buffers") || !j["buffers"].is_array())
         return LM_OK;
+    size_t json_len = glb ? le32(&b[12]) : b.size();
     uint64_t bin_len = 0;
     uint64_t bin = 20 + ((uint64_t(json_len) + 3) & ~3ull);
     if (glb && bin + 8 <= le32(&b[8]))
@@ -449,15 +456,10 @@ static std::vector<unsigned char> glb_with_json(const std::vector<unsigned char>
     return out;
 }
 
-// The compressed glTF's parts that tinygltf would refuse given stand-ins (gltf_meshopt.h, gltf_draco.h),
-// the file's bytes rewritten with them. A file naming neither extension is not parsed again.
-lm_status Loader::stand_in_compressed(std::vector<unsigned char> &bytes, bool glb)
+// The compressed glTF's parts that tinygltf would refuse given stand-ins in j (gltf_meshopt.h,
+// gltf_draco.h), and the file's bytes rewritten with them; a file with none is left as it is.
+lm_status Loader::stand_in_compressed(nlohmann::json &j, std::vector<unsigned char> &bytes, bool glb)
 {
-    size_t at = glb ? 20 : 0, len = glb ? le32(&bytes[12]) : bytes.size();
-    std::string_view text(reinterpret_cast<const char *>(bytes.data() + at), len);
-    if (text.find("EXT_meshopt_compression") == text.npos && text.find("KHR_draco_mesh_compression") == text.npos)
-        return LM_OK;
-    nlohmann::json j = nlohmann::json::parse(text.begin(), text.end(), nullptr, false);
     if (j.is_discarded())
         return LM_OK; // tinygltf's parser says what is wrong
     std::string why = meshopt_stand_in(j, glb, fallbacks_);
@@ -514,9 +516,10 @@ lm_status Loader::parse(std::vector<unsigned char> &bytes)
                     ".bin and images beside it) or a .glb (one binary file); export one from your modelling tool "
                     "(Blender: File > Export > glTF 2.0)", what);
     lm_status checked = glb ? check_glb(bytes) : LM_OK;
-    if (checked || (checked = check_buffers(bytes, glb)))
+    if (checked)
         return checked;
-    if ((checked = stand_in_compressed(bytes, glb)))
+    nlohmann::json j = file_json(bytes, glb);
+    if ((checked = check_buffers(j, bytes, glb)) || (checked = stand_in_compressed(j, bytes, glb)))
         return checked;
     std::string dir = scene_dir();
     tinygltf::TinyGLTF gltf;
@@ -559,6 +562,7 @@ lm_status Loader::check_extensions()
     }
     std::string ignored;
     for (const std::string &e : model_.extensionsUsed) {
+        quantized_ = quantized_ || e == "KHR_mesh_quantization";
         bool known = false;
         for (const char *k : k_supported_required)
             known = known || e == k;
@@ -624,11 +628,9 @@ lm_status Loader::read_floats(int acc, int type, bool force_norm, const char *wh
     out.assign(sp.count * size_t(sp.ncomp), 0.0f);
     // Integer texcoords are normalised whatever the flag says (glTF 2.0 allows no other kind), unless the
     // file uses KHR_mesh_quantization, which allows unnormalised ones (scaled by KHR_texture_transform).
-    bool quantized = std::find(model_.extensionsUsed.begin(), model_.extensionsUsed.end(), "KHR_mesh_quantization") !=
-                     model_.extensionsUsed.end();
     if (sp.data)
         lm_decode_floats(sp.data, sp.count, sp.stride, sp.comp_type, sp.ncomp,
-                         sp.normalized || (force_norm && !quantized && sp.comp_type != LM_COMP_FLOAT), out.data());
+                         sp.normalized || (force_norm && !quantized_ && sp.comp_type != LM_COMP_FLOAT), out.data());
     return LM_OK;
 }
 
