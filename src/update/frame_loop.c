@@ -245,6 +245,14 @@ static void pass_span(uint32_t p, uint32_t pass, uint32_t count, uint32_t *first
     *n = count - *first < pass ? count - *first : pass;
 }
 
+/* Pass p of the order (passes of `pass` texels of count) gathered into the fresh IIM; *n its texels. */
+static lm_status gather_pass(lm_frame_loop *fl, uint32_t p, uint32_t pass, uint32_t count, uint32_t *n, lm_error *err)
+{
+    uint32_t first;
+    pass_span(p, pass, count, &first, n);
+    return lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, *n, fl->iim.fresh_tex, NULL, err);
+}
+
 /* Gathers steps [r.done, r.steps) of the passes r names into the fresh IIM, a pass at a time; progress
  * counts the texels of r's passes. */
 static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t count, checkpointing *ck,
@@ -264,8 +272,7 @@ static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t c
             return lm_fail(err, LM_ERR_CANCELLED, "%s: cancelled after %u of %u texels%s%s", fl->scene->path, done,
                            texels, ck ? ", kept in " : "", ck ? ck->path : "");
         }
-        pass_span(lm_checkpoint_step_pass(&r, s), r.pass, count, &first, &n);
-        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, n, fl->iim.fresh_tex, NULL, err);
+        st = gather_pass(fl, lm_checkpoint_step_pass(&r, s), r.pass, count, &n, err);
         if (st == LM_OK && ck && s + 1 < r.steps && lm_now() - ck->last >= ck->seconds)
             st = checkpoint_save(fl, ck, s + 1, err);
         done += n;
@@ -279,7 +286,7 @@ static lm_status gather_run(lm_frame_loop *fl, lm_checkpoint_range r, uint32_t c
  * come; ck->r lists them. Progress says how far the handing out has gone: the whole shared bake's. */
 static lm_status gather_claimed(lm_frame_loop *fl, uint32_t count, checkpointing *ck, lm_error *err)
 {
-    uint32_t passes = lm_checkpoint_steps(count, ck->r.pass, 0, 0), first, n, shown = 0;
+    uint32_t passes = lm_checkpoint_steps(count, ck->r.pass, 0, 0), n, shown = 0;
     ck->r.steps = ck->r.done = 0;
     if (!(ck->r.list = malloc(sizeof *ck->r.list * (passes ? passes : 1))))
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the list of the bake's passes");
@@ -294,10 +301,9 @@ static lm_status gather_claimed(lm_frame_loop *fl, uint32_t count, checkpointing
         if ((uint32_t)p >= passes || ck->r.steps == passes)
             return lm_fail(err, LM_ERR_INVALID, "%s: claim_pass gave pass %d of %u (%u taken already)",
                            fl->scene->path, p, passes, ck->r.steps);
-        pass_span((uint32_t)p, ck->r.pass, count, &first, &n);
-        st = lm_gather_texels(fl->gather, fl->scene, fl->atlas, fl->texels + first, n, fl->iim.fresh_tex, NULL, err);
+        st = gather_pass(fl, (uint32_t)p, ck->r.pass, count, &n, err);
         ck->r.list[ck->r.steps++] = (uint32_t)p;
-        shown = first + n;
+        shown = (uint32_t)p * ck->r.pass + n; /* the end of pass p */
         if (fl->set.progress)
             fl->set.progress(fl->set.progress_user, shown, count);
     }
