@@ -165,6 +165,7 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
     /* Counted in locals, written once: j lies in the batch's job array, beside other threads' jobs. */
     uint32_t rays = 0, count = 0, stored = 0;
     int ok = 1, specular_so_far = 1; /* every vertex before this one was mirror or glass */
+    uint32_t specular_run = 0;       /* mirror or glass vertices in a row */
     for (uint32_t b = 0; b < ph->set.max_bounces; b++) {
         lm_rt_hit hit;
         rays++;
@@ -184,10 +185,12 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
             ok = 0;
             break;
         }
-        specular_so_far = specular_so_far && lm_material_is_specular(sh.material->cls);
+        int specular = lm_material_is_specular(sh.material->cls);
+        specular_so_far = specular_so_far && specular;
+        specular_run = specular ? specular_run + 1 : 0;
         count++;
         stored += buf->v[buf->len - 1].surface >= 0;
-        if (!scattered)
+        if (!scattered || specular_run >= PH_SPECULAR_RUN)
             break;
     }
     j->count = count;
