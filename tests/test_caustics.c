@@ -239,6 +239,96 @@ static void test_what_moves(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* The mirror scene's floor and mirror under two point lights (emitters 0 and 1). */
+static const char *two_light_mirror_scene(void)
+{
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-4, 0, 4}, (float[3]){8, 0, 0}, (float[3]){0, 0, -8});
+    lmt_mesh_quad(&m[1], (float[3]){1, 0.75f, -0.25f}, (float[3]){0, 0, 0.5f}, (float[3]){0, 0.5f, 0});
+    return lmt_write_scene("two_light_mirror.gltf", m, 2,
+                           "[{\"mesh\": 0}, {\"mesh\": 1},"
+                           " {\"translation\": [0, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}},"
+                           " {\"translation\": [-0.5, 1.5, 0.5], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]",
+                           "[" LMT_DIFFUSE(0.8) ", " LMT_MIRROR(0.9) "], "
+                           LMT_LIGHTS("{\"type\": \"point\", \"intensity\": 10}"));
+}
+
+static void set_removed(lmt_pipeline *p, int light, int removed)
+{
+    p->s->lights[light].removed = removed;
+    lm_emitters_update(&p->em, p->s);
+}
+
+/* Frames until no whole re-trace is queued (each within the frame cap); returns how many. */
+static int catch_up(lm_caustics *c, uint32_t cap)
+{
+    lm_caustic_frame_stats st;
+    lm_error err;
+    int frames = 0;
+    while (lm_caustics_pending(c) > 0 && frames < 100) {
+        assert_int_equal(lm_caustics_frame(c, &st, &err), LM_OK);
+        assert_true(st.traced <= cap);
+        frames++;
+    }
+    assert_int_equal(lm_caustics_pending(c), 0);
+    return frames;
+}
+
+/* Lights come and go: a light that joins gets its pairs queued and traced over frames within the cap the
+ * pairs at creation set (one light's: N x 1.25), ending with the same photons as caustics made with it
+ * from the start; a removed light's pairs and slots go; a recoloured material's re-trace is queued and
+ * spread the same way. */
+static void test_lights_come_and_go(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, two_light_mirror_scene(), 0.2f);
+    const uint32_t N = 2048, cap = N + N / 4;
+    lm_caustics *both = make(&p, N, NULL);
+    assert_int_equal(lm_caustics_photon_count(both), 2 * N);
+
+    set_removed(&p, 1, 1); /* caustics made while light 1 is out: one pair */
+    lm_caustics *c = make(&p, N, NULL);
+    assert_int_equal(lm_caustics_photon_count(c), N);
+    lm_error err;
+    set_removed(&p, 1, 0); /* it joins (an added light, as the layout sees it) */
+    assert_int_equal(lm_caustics_follow_emitters(c, &err), LM_OK);
+    assert_int_equal(lm_caustics_photon_count(c), 2 * N);
+    assert_int_equal(lm_caustics_pending(c), N);
+    int frames = catch_up(c, cap);
+    assert_memory_equal(lm_caustics_hits(c), lm_caustics_hits(both), sizeof(lm_caustic_hit) * 2 * N);
+    assert_int_equal(frames, 1); /* N fit in one frame's cap */
+
+    lm_caustics_retrace_all_later(c); /* a material recoloured: both pairs, more than one frame's cap */
+    assert_int_equal(lm_caustics_pending(c), 2 * N);
+    int again = catch_up(c, cap);
+    assert_int_equal(again, 2);
+    assert_memory_equal(lm_caustics_hits(c), lm_caustics_hits(both), sizeof(lm_caustic_hit) * 2 * N);
+
+    set_removed(&p, 0, 1); /* light 0 leaves: its slots go, light 1's keep their photons */
+    assert_int_equal(lm_caustics_follow_emitters(c, &err), LM_OK);
+    assert_int_equal(lm_caustics_photon_count(c), N);
+    assert_int_equal(lm_caustics_pending(c), 0);
+    const lm_caustic_hit *h = lm_caustics_hits(c);
+    uint32_t landed = 0;
+    for (uint32_t k = 0; k < N; k++)
+        if (h[k].flux[0] > 0.0f) {
+            assert_int_equal(h[k].emitter, 1);
+            assert_memory_equal(&h[k], &lm_caustics_hits(both)[N + k], sizeof *h);
+            landed++;
+        }
+    assert_true(landed > N / 4);
+    assert_int_equal(lm_caustics_landed(c), landed);
+
+    print_message("a light joined: %u photons queued, traced in %d frame of at most %u; a recolour's %u in %d "
+                  "frames; a light left: %u slots kept, %u photons landed as before\n", N, frames, cap, 2 * N, again,
+                  lm_caustics_photon_count(c), landed);
+    lm_caustics_free(both);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
 /* Extras "caustics": false makes a mirror no generator; a spot aimed away from the mirror lands nothing;
  * a scene with no specular material has no pairs and costs nothing. */
 static void test_switches_and_empty(void **state)
@@ -480,6 +570,7 @@ int main(void)
         cmocka_unit_test(test_glass_energy),
         cmocka_unit_test(test_bounce_cap),
         cmocka_unit_test(test_what_moves),
+        cmocka_unit_test(test_lights_come_and_go),
         cmocka_unit_test(test_switches_and_empty),
         cmocka_unit_test(test_directional),
         cmocka_unit_test(test_deterministic),

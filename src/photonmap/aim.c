@@ -982,6 +982,12 @@ static lm_status run_schedule(lm_aim *aim, const lm_scene *s, const lm_surfaces 
     }
     qsort(c, (size_t)count, sizeof *c, by_priority);
     int todo = budget < 0 || budget > count ? count : budget;
+    uint64_t hits = 0;
+    for (int i = 0; i < todo && !everything && aim->set.max_hits; i++) {
+        hits += ps->surfaces[c[i].surface].count;
+        if (i > 0 && hits > aim->set.max_hits)
+            todo = i; /* never past it, never skipping it: the next refresh starts with it */
+    }
     int *chosen = malloc(sizeof *chosen * (size_t)(todo ? todo : 1));
     lm_status rc = chosen ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "AIM: no memory to schedule %d surfaces", todo);
     for (int i = 0; chosen && i < todo; i++)

@@ -269,7 +269,8 @@ typedef struct {
     uint32_t first;        /* first slot */
     uint32_t cursor;       /* next photon of the round robin */
     uint32_t remaining;    /* photons still to re-trace in the round robin's current turn */
-    int whole;             /* re-trace every photon at the next frame */
+    int whole;             /* 1: re-trace every photon, from the next frame on */
+    uint32_t whole_done;   /* photons of that re-trace done (it may span frames: frame_cap) */
 } pair;
 
 /* What an emitter's placement was when its photons were last traced: a change re-traces its pairs. */
@@ -288,6 +289,9 @@ struct lm_caustics {
     int gen_count;
     emitter_state *em_state;
     int em_count;
+    int *em_pair;            /* per emitter, its column k of the pairs (g * live_count + k), -1 for a removed
+                              * light's: a removed light keeps no photon slots */
+    int live_count;
     pair *pairs;
     int pair_count;
     uint32_t slots;
@@ -296,6 +300,8 @@ struct lm_caustics {
     uint32_t landed;
     uint64_t version;
     uint64_t world_hash;     /* of every node matrix: a change starts a round-robin turn */
+    uint32_t frame_cap;      /* most photons a frame traces: what the pairs at creation took when all moved
+                              * at once and the round robin ran, so lights added later spread their work */
     /* scratch: the frame's jobs (slot numbers) and their fates */
     uint32_t *jobs;
     uint8_t *fates;            /* per job its fate, and whether its hit differs from the slot's before */
@@ -419,9 +425,22 @@ static void trace_jobs(lm_caustics *c, uint32_t n, lm_caustic_frame_stats *st)
     c->version += changed; /* a re-trace that found every path as it was changes nothing downstream */
 }
 
+/* Whether emitter e lights anything for good: a removed light never comes back. */
+static int emitter_live(const lm_caustics *c, int e)
+{
+    int light = c->em->e[e].light;
+    return !(light >= 0 && light < c->scene->light_count && c->scene->lights[light].removed);
+}
+
 static lm_status alloc_lists(lm_caustics *c, lm_error *err)
 {
-    c->pair_count = c->gen_count * c->em_count;
+    c->em_pair = malloc(sizeof *c->em_pair * (size_t)(c->em_count ? c->em_count : 1));
+    if (!c->em_pair)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the caustic emitters", c->scene->path);
+    c->live_count = 0;
+    for (int e = 0; e < c->em_count; e++)
+        c->em_pair[e] = emitter_live(c, e) ? c->live_count++ : -1;
+    c->pair_count = c->gen_count * c->live_count;
     c->pairs = calloc((size_t)(c->pair_count ? c->pair_count : 1), sizeof *c->pairs);
     c->gen_world = calloc((size_t)(c->gen_count ? c->gen_count : 1), sizeof *c->gen_world);
     c->em_state = calloc((size_t)(c->em_count ? c->em_count : 1), sizeof *c->em_state);
@@ -449,10 +468,13 @@ static lm_status alloc_lists(lm_caustics *c, lm_error *err)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the caustic emitters", c->scene->path);
     for (int g = 0; g < c->gen_count; g++)
         for (int e = 0; e < c->em_count; e++) {
-            pair *p = &c->pairs[g * c->em_count + e];
+            if (c->em_pair[e] < 0)
+                continue;
+            int i = g * c->live_count + c->em_pair[e];
+            pair *p = &c->pairs[i];
             p->emitter = e;
             p->generator = g;
-            p->first = (uint32_t)(g * c->em_count + e) * c->set.photons;
+            p->first = (uint32_t)i * c->set.photons;
         }
     return LM_OK;
 }
@@ -492,7 +514,7 @@ lm_status lm_caustics_trace_all(lm_caustics *c, lm_caustic_frame_stats *stats, l
     for (uint32_t s = 0; s < c->slots; s++)
         c->jobs[s] = s;
     for (int p = 0; p < c->pair_count; p++)
-        c->pairs[p].remaining = 0, c->pairs[p].whole = 0;
+        c->pairs[p].remaining = 0, c->pairs[p].whole = 0, c->pairs[p].whole_done = 0;
     trace_jobs(c, c->slots, &st);
     st.seconds = lm_now() - t0;
     if (stats)
@@ -522,6 +544,9 @@ lm_status lm_caustics_create(const lm_scene *s, const lm_rt *rt, const lm_emitte
     st = lm_caustic_generators(s, &c->gen, &c->gen_count, err);
     if (st == LM_OK)
         st = alloc_lists(c, err);
+    uint32_t N = set->photons, pairs = c->pair_count > 1 ? (uint32_t)c->pair_count : 1;
+    uint64_t cap = (uint64_t)pairs * N + (uint64_t)pairs * (uint64_t)ceil((double)set->retrace * N);
+    c->frame_cap = cap > UINT32_MAX / 2 ? UINT32_MAX / 2 : (uint32_t)cap;
     if (st == LM_OK)
         st = lm_caustics_trace_all(c, stats, err);
     if (st != LM_OK) {
@@ -539,6 +564,7 @@ void lm_caustics_free(lm_caustics *c)
     free(c->gen);
     free(c->gen_world);
     free(c->em_state);
+    free(c->em_pair);
     free(c->pairs);
     free(c->hits);
     free(c->emitted);
@@ -561,8 +587,8 @@ static uint32_t mark_moved(lm_caustics *c)
             continue;
         memcpy(c->gen_world[g], w, sizeof c->gen_world[g]);
         generator_sphere(c->scene, c->gen[g].node, &c->gen[g]);
-        for (int e = 0; e < c->em_count; e++)
-            c->pairs[g * c->em_count + e].whole = 1;
+        for (int k = 0; k < c->live_count; k++)
+            c->pairs[g * c->live_count + k].whole = 1;
     }
     for (int e = 0; e < c->em_count; e++) {
         emitter_state now;
@@ -570,11 +596,27 @@ static uint32_t mark_moved(lm_caustics *c)
         if (!memcmp(&now, &c->em_state[e], sizeof now))
             continue;
         c->em_state[e] = now;
-        for (int g = 0; g < c->gen_count; g++)
-            c->pairs[g * c->em_count + e].whole = 1;
+        for (int g = 0; c->em_pair[e] >= 0 && g < c->gen_count; g++)
+            c->pairs[g * c->live_count + c->em_pair[e]].whole = 1;
     }
     for (int p = 0; p < c->pair_count; p++)
         n += c->pairs[p].whole;
+    return n;
+}
+
+#define DONE_THIS_FRAME 2 /* pair.whole: its whole re-trace was finished by this frame's jobs */
+
+/* Queues pair p's photons from the round robin's cursor, at most *left of them. */
+static uint32_t queue_round_robin(lm_caustics *c, pair *p, uint32_t per_frame, uint32_t n, uint32_t *left)
+{
+    uint32_t N = c->set.photons, take = p->remaining < per_frame ? p->remaining : per_frame;
+    take = take < *left ? take : *left;
+    for (uint32_t k = 0; k < take; k++) {
+        c->jobs[n++] = p->first + p->cursor;
+        p->cursor = (p->cursor + 1) % N;
+    }
+    p->remaining -= take;
+    *left -= take;
     return n;
 }
 
@@ -590,30 +632,117 @@ lm_status lm_caustics_frame(lm_caustics *c, lm_caustic_frame_stats *stats, lm_er
         int moved = h != c->world_hash;
         c->world_hash = h;
         uint32_t N = c->set.photons, per_frame = (uint32_t)ceil((double)c->set.retrace * N), n = 0;
+        uint32_t left = c->frame_cap;
         per_frame = per_frame < 1 ? 1 : per_frame > N ? N : per_frame;
+        /* first the pairs whose generator or emitter changed, whole (over several frames when more of them
+         * than frame_cap allows), then the round robin of the others with what is left */
+        for (int i = 0; i < c->pair_count && left > 0; i++) {
+            pair *p = &c->pairs[i];
+            if (!p->whole)
+                continue;
+            uint32_t take = N - p->whole_done < left ? N - p->whole_done : left;
+            for (uint32_t k = 0; k < take; k++)
+                c->jobs[n++] = p->first + p->whole_done + k;
+            p->whole_done += take, left -= take;
+            if (p->whole_done == N)
+                p->whole = DONE_THIS_FRAME, p->whole_done = 0;
+        }
         for (int i = 0; i < c->pair_count; i++) {
             pair *p = &c->pairs[i];
-            if (p->whole) {
-                for (uint32_t k = 0; k < N; k++)
-                    c->jobs[n++] = p->first + k;
-                p->whole = 0;
-                p->remaining = moved ? N : 0; /* the turn begins again after the scene moved */
-                continue;
+            if (p->whole == DONE_THIS_FRAME) /* its slots are in jobs once: no round robin this frame */
+                p->whole = 0, p->remaining = moved ? N : 0;
+            else if (!p->whole) {
+                p->remaining = moved ? N : p->remaining; /* the turn begins again after the scene moved */
+                n = queue_round_robin(c, p, per_frame, n, &left);
             }
-            if (moved)
-                p->remaining = N;
-            uint32_t take = p->remaining < per_frame ? p->remaining : per_frame;
-            for (uint32_t k = 0; k < take; k++) {
-                c->jobs[n++] = p->first + p->cursor;
-                p->cursor = (p->cursor + 1) % N;
-            }
-            p->remaining -= take;
         }
         trace_jobs(c, n, &st);
     }
     st.seconds = lm_now() - t0;
     if (stats)
         *stats = st;
+    return LM_OK;
+}
+
+void lm_caustics_retrace_all_later(lm_caustics *c)
+{
+    for (int i = 0; i < c->pair_count; i++)
+        if (!c->pairs[i].whole)
+            c->pairs[i].whole = 1, c->pairs[i].whole_done = 0;
+}
+
+uint32_t lm_caustics_pending(const lm_caustics *c)
+{
+    uint32_t n = 0;
+    for (int i = 0; i < c->pair_count; i++)
+        n += c->pairs[i].whole ? c->set.photons - c->pairs[i].whole_done : 0;
+    return n;
+}
+
+/* Whether the emitters, or which of them are removed lights, changed since c's pairs were laid out. */
+static int emitters_changed(const lm_caustics *c)
+{
+    if (c->em->count != c->em_count)
+        return 1;
+    for (int e = 0; e < c->em_count; e++)
+        if ((c->em_pair[e] >= 0) != emitter_live(c, e))
+            return 1;
+    return 0;
+}
+
+/* Pair (g, e) of n takes over c's: its state, hits and emitted flux. */
+static void carry_pair(lm_caustics *n, const lm_caustics *c, int g, int e)
+{
+    pair *to = &n->pairs[g * n->live_count + n->em_pair[e]];
+    const pair *from = &c->pairs[g * c->live_count + c->em_pair[e]];
+    uint32_t first = to->first, N = c->set.photons;
+    *to = *from;
+    to->first = first;
+    memcpy(n->hits + first, c->hits + from->first, sizeof *n->hits * N);
+    memcpy(n->emitted + 3 * (size_t)first, c->emitted + 3 * (size_t)from->first, sizeof *n->emitted * 3 * N);
+}
+
+/* The pairs laid out again for the emitters as they are: a new light's queued whole, a removed light's
+ * dropped with their slots, the others carried over. */
+lm_status lm_caustics_follow_emitters(lm_caustics *c, lm_error *err)
+{
+    if (!emitters_changed(c))
+        return LM_OK;
+    lm_caustics *n = calloc(1, sizeof *n);
+    if (!n)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the caustic photons", c->scene->path);
+    n->scene = c->scene, n->rt = c->rt, n->em = c->em, n->set = c->set;
+    n->em_count = c->em->count;
+    n->gen = c->gen, n->gen_count = c->gen_count;
+    c->gen = NULL;
+    lm_status st = alloc_lists(n, err);
+    if (st != LM_OK) {
+        c->gen = n->gen, n->gen = NULL;
+        lm_caustics_free(n);
+        return st;
+    }
+    memcpy(n->gen_world, c->gen_world, sizeof *c->gen_world * (size_t)c->gen_count);
+    memcpy(n->em_state, c->em_state, sizeof *c->em_state * (size_t)c->em_count);
+    for (int e = c->em_count; e < n->em_count; e++)
+        emitter_snapshot(n, e, &n->em_state[e]);
+    for (int g = 0; g < n->gen_count; g++)
+        for (int e = 0; e < n->em_count; e++) {
+            if (n->em_pair[e] < 0)
+                continue;
+            if (e < c->em_count && c->em_pair[e] >= 0)
+                carry_pair(n, c, g, e);
+            else
+                n->pairs[g * n->live_count + n->em_pair[e]].whole = 1;
+        }
+    uint32_t landed = 0;
+    for (uint32_t k = 0; k < n->slots; k++)
+        landed += n->hits[k].flux[0] != 0.0f || n->hits[k].flux[1] != 0.0f || n->hits[k].flux[2] != 0.0f;
+    n->landed = landed, n->version = c->version + 1;
+    n->world_hash = c->world_hash, n->frame_cap = c->frame_cap;
+    lm_caustics old = *c;
+    *c = *n;
+    *n = old;
+    lm_caustics_free(n);
     return LM_OK;
 }
 

@@ -4,7 +4,7 @@
  *
  * Generators: every node with mirror or glass triangles whose "caustics" switch is on (extras, or
  * lmgi_set_node_effects). Each is bounded by the sphere around its specular triangles' world bounds.
- * Pairs: every emitter (point, spot, directional, area) with every generator; pair p owns `photons`
+ * Pairs: every emitter (point, spot, directional, area; not a removed light) with every generator; pair p owns `photons`
  * photons with fixed QMC (Halton) numbers, so an unchanged scene re-traces the identical paths:
  *   point, spot   a direction uniform in the cone from the light around the generator's sphere (the
  *                 whole sphere of directions when the light is inside it), flux I att(w) Omega / N,
@@ -26,7 +26,10 @@
  *
  * Updates (lm_caustics_frame): a pair whose generator or light moved or changed is re-traced whole in the
  * frame that sees it; after any other node moved, every pair is re-traced round robin, `retrace` of its
- * photons a frame, until one full turn has passed with nothing moving. A still scene traces nothing.
+ * photons a frame, until one full turn has passed with nothing moving. A still scene traces nothing. A
+ * frame traces at most what the pairs at creation took when all moved at once with the round robin on
+ * (pairs x photons x (1 + retrace)): with lights added since, whole re-traces go first and spread over
+ * frames, and the round robin gets what is left.
  * Results are per photon slot, so they do not depend on the thread count.
  *
  * The scene, BVH and emitters are borrowed and must stay current (as for lm_photons). Not thread-safe;
@@ -121,8 +124,18 @@ lm_status lm_caustics_create(const lm_scene *s, const lm_rt *rt, const lm_emitte
 void lm_caustics_free(lm_caustics *c);
 /* One frame's update (see the file comment). stats may be NULL. Fails only when memory runs out. */
 lm_status lm_caustics_frame(lm_caustics *c, lm_caustic_frame_stats *stats, lm_error *err);
-/* Re-traces every photon (a bake, or after a change the frame cannot see: a material edit). */
+/* Re-traces every photon (a bake). */
 lm_status lm_caustics_trace_all(lm_caustics *c, lm_caustic_frame_stats *stats, lm_error *err);
+/* Queues every pair for a whole re-trace by the next frames (after a change the frames cannot see: a
+ * material recoloured). */
+void lm_caustics_retrace_all_later(lm_caustics *c);
+/* Photons of whole re-traces still queued (0 once the frames have caught up). */
+uint32_t lm_caustics_pending(const lm_caustics *c);
+/* Follows the emitter list's changes since c's pairs were laid out: the pairs of emitters appended (a
+ * light added) are queued whole, those of removed lights dropped with their photon slots (a soak adding
+ * and removing lights kept 3.2 MB of slots a removed light in the Cornell box), the others keep their
+ * photons. Fails only when memory runs out (c unchanged). */
+lm_status lm_caustics_follow_emitters(lm_caustics *c, lm_error *err);
 
 int lm_caustics_pair_count(const lm_caustics *c);
 int lm_caustics_generator_count(const lm_caustics *c);
