@@ -539,6 +539,11 @@ typedef struct {
     int (*photon_exchange)(void *user, const void *mine, size_t size, size_t *sizes, void *all);
     int (*claim_pass)(void *user, int passes);
     void *share_user;
+    /* most shadow maps re-rendered per update once something moved (0: 4; -1: every stale one at once): the
+     * maps of the brightest lights nearest to what moved first, the others keep their last map for a few
+     * updates (a scene with 56 lights and a moving box spreads their 56 maps over 14 updates). A light's
+     * first map, and lmgi_render's and lmgi_bake's, are drawn whatever the count. */
+    int shadow_maps_per_update;
 } lmgi_updater_desc;
 
 /* What one lmgi_update did and what it cost (milliseconds). With the photon work on a second thread
@@ -563,6 +568,8 @@ typedef struct {
     double ms_animate, ms_trace, ms_aim, ms_caustic_trace; /* the photon work's parts */
     double ms_photons;         /* what the update spent on or waiting for the photon work */
     double ms_gather, ms_blend, ms_direct, ms_caustics, ms_reflections, ms_composite, ms_total;
+    int shadow_maps_rendered;  /* punctual lights' shadow maps re-rendered */
+    int shadow_maps_stale;     /* stale ones left for the next updates (desc.shadow_maps_per_update) */
 } lmgi_update_stats;
 
 /* The atlas texel count `lmgi run` loads a scene at when given no texel size: what an updater gathering

@@ -666,6 +666,94 @@ static void test_cache_nothing_moved(void **state)
     free(b);
 }
 
+/* The box scene's plane and box (node 4, dynamic) under two point lights: node 2 right above the box, node
+ * 3 far off to the side; their emitters 0 and 1. */
+static void two_lights_load(live_scene *l)
+{
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    lmt_mesh_cube(&m[1], 0.25f);
+    const char *nodes = "[{\"children\": [1, 2, 3, 4]}, {\"mesh\": 0},"
+                        " {\"translation\": [0.5, 2, 0], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}},"
+                        " {\"translation\": [-8, 3, 8], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}},"
+                        " {\"mesh\": 1, \"translation\": [0.5, 1, 0]}]";
+    const char *ext = "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\":"
+                      " {\"lights\": [{\"type\": \"point\", \"intensity\": 10}]}},";
+    char path[512];
+    snprintf(path, sizeof path, "%s/two_lights.gltf", lmt_tmpdir());
+    if (lmt_write_gltf(path, m, 2, nodes, NULL, 0, ext) != 0)
+        fail_msg("cannot write %s", path);
+    lm_error err;
+    lm_load_options opt = {0};
+    assert_int_equal(lm_scene_load_gltf(path, &opt, &l->s, &err), LM_OK);
+    assert_int_equal(l->s->node_count, 5);
+    l->s->nodes[4].dynamic = 1;
+    assert_int_equal(lm_emitters_build(l->s, &l->em, &err), LM_OK);
+    assert_int_equal(l->em.count, 2);
+    lm_emitters_update(&l->em, l->s);
+    lm_scene_update_bounds(l->s);
+    top_view(&l->v);
+}
+
+/* One update's render with a budget of `maps` shadow maps. */
+static void budget_render(lm_direct *d, live_scene *l, int maps, float *rgb)
+{
+    lm_error err;
+    lm_direct_begin_update(d, maps);
+    if (lm_direct_render(d, l->s, &l->em, &l->v, W, W, rgb, &err) != LM_OK)
+        fail_msg("budget render: %s", err.msg);
+    lm_direct_end_update(d);
+}
+
+/* (l) The shadow maps' budget per update: maps never made are drawn whatever the budget; after the box
+ * moves, one map an update, the near light's first, the far light's at the next update, and then the
+ * picture is a fresh render's; with the box moving at every update, the far light's map still gets its
+ * turn (its priority grows while it waits). */
+static void test_map_budget(void **state)
+{
+    (void)state;
+    live_scene l;
+    two_lights_load(&l);
+    lm_direct *d = NULL;
+    lm_error err;
+    assert_int_equal(lm_direct_create(l.s, NULL, NULL, &d, &err), LM_OK);
+    float *rgb = malloc(sizeof(float) * 3 * W * W);
+    assert_non_null(rgb);
+    budget_render(d, &l, 0, rgb); /* no budget at all: the first maps are drawn still */
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 2);
+    assert_int_equal(lm_direct_stale_maps(d), 0);
+    free(render_both(d, &l, "first maps under a budget of 0"));
+
+    l.s->nodes[4].translation[0] -= 0.4f;
+    live_update(&l);
+    budget_render(d, &l, 1, rgb);
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 3);
+    assert_int_equal(lm_direct_stale_maps(d), 1);
+    assert_false(lm_direct_map_stale(d, 0)); /* the light above the box first */
+    assert_true(lm_direct_map_stale(d, 1));
+    budget_render(d, &l, 1, rgb);
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 4);
+    assert_int_equal(lm_direct_stale_maps(d), 0);
+    free(render_both(d, &l, "both maps caught up"));
+
+    int waited = 0;
+    for (; waited < 200; waited++) {
+        l.s->nodes[4].translation[2] += (waited & 1) ? 0.01f : -0.01f;
+        live_update(&l);
+        budget_render(d, &l, 1, rgb);
+        if (!lm_direct_map_stale(d, 1))
+            break;
+    }
+    assert_true(waited > 0);   /* the near light's map won while the far one had waited little */
+    assert_true(waited < 200); /* and the far one was not starved */
+    print_message("shadow map budget: first maps drawn at a budget of 0, near light first after a move, the far "
+                  "light's map redrawn after %d updates of a box moving every update at one map an update\n", waited);
+    free(rgb);
+    lm_direct_free(d);
+    live_free(&l);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -673,7 +761,7 @@ int main(void)
         cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
         cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
         cmocka_unit_test(test_cache_nothing_moved),
-        cmocka_unit_test(test_cube_faces_follow_casters),
+        cmocka_unit_test(test_cube_faces_follow_casters), cmocka_unit_test(test_map_budget),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

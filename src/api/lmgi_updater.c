@@ -119,6 +119,10 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     TAKE(emitter_light, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_DRAWN, &v);
     s->emitter_light = v == LMGI_EMITTERS_CLOSED_FORM ? 1 : v == LMGI_EMITTERS_DRAWN ? 0 : -1;
     TAKE(emitter_rays, 1, 65536, &s->emitter_rays);
+    if (d->shadow_maps_per_update == -1)
+        s->direct.maps_per_update = -1;
+    else
+        TAKE(shadow_maps_per_update, 1, 1000000, &s->direct.maps_per_update);
     s->overlap = !d->in_order;
     if (d->frame_width < 0 || d->frame_height < 0 || d->frame_width > 16384 || d->frame_height > 16384 ||
         (d->frame_width == 0) != (d->frame_height == 0))
@@ -471,6 +475,8 @@ static void export_stats(const lm_frame_stats *fs, int budget, int changed, lmgi
     o->caustic_tiles_lit = fs->caustic.tiles_lit;
     o->caustic_pixels_filtered = fs->caustic.pixels_filtered;
     o->cube_faces_rendered = fs->cube_faces;
+    o->shadow_maps_rendered = fs->shadow_maps;
+    o->shadow_maps_stale = fs->shadow_maps_stale;
     o->photon_gathers = fs->photon_gathers;
     o->photon_entries = fs->photon_gathers ? fs->photon_gather.entries : 0;
     o->photon_pages_uploaded = fs->photon_gather.pages_uploaded;

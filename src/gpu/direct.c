@@ -30,6 +30,7 @@ void lm_direct_settings_default(lm_direct_settings *s)
     s->max_slope = 10.0f;
     s->const_bias = 0.5f;
     s->shadows = 1;
+    s->maps_per_update = 4;
 }
 
 typedef struct {
@@ -42,6 +43,7 @@ typedef struct {
 typedef struct {
     lm_shadow_map map;
     unsigned long static_version, dynamic_version;
+    unsigned long stale_since; /* the update it went stale at, 0 while current */
 } cached_map;
 
 struct lm_direct {
@@ -62,6 +64,9 @@ struct lm_direct {
     unsigned long static_version;  /* bumped whenever a static shadow-casting node moves (an edit) */
     unsigned long dynamic_version; /* bumped whenever a dynamic shadow-casting node moves */
     long maps_rendered;
+    int maps_left;          /* shadow maps this update may still re-render (-1: every stale one) */
+    unsigned long updates;  /* lm_direct_begin_update calls, the clock of stale_since */
+    int cube_now, map_now;  /* the map sides the live lights get now (fit_live_sizes) */
     int has_lightmap;       /* the mesh carries lightmap uvs (an atlas at lm_direct_create) */
     const lm_atlas *atlas;  /* that atlas (borrowed), for a rebuild of the mesh */
     unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
@@ -81,6 +86,13 @@ static void find_uniforms(GLuint p, uniforms *u)
 }
 
 static int kind_of(const lm_emitter *e) { return e->kind == LM_EMIT_POINT ? 0 : e->kind == LM_EMIT_SPOT ? 1 : 2; }
+
+/* A point, spot or directional light that still exists: a removed one lights nothing and keeps no map
+ * (an added light's map, a cube of 6 x 512^2 floats and its layer, was kept after its removal). */
+static int live_punctual(const lm_scene *s, const lm_emitter *e)
+{
+    return e->punctual && !(e->light >= 0 && e->light < s->light_count && s->lights[e->light].removed);
+}
 
 static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)
 {
@@ -192,20 +204,97 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
     lm_direct_mesh_draw(&d->mesh, prog);
 }
 
-/* Emitter i's shadow map, re-rendered only when stale. */
-static lm_status shadow_map(lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, lm_error *err)
+/* Emitter i's map parameters now; returns 1 when its map is stale (made from other parameters or
+ * before a caster moved, or never made). */
+static int map_stale(const lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, lm_shadow_params *p)
+{
+    const cached_map *c = &d->maps[i];
+    lm_shadow_params_compute(p, s, e, e->kind == LM_EMIT_POINT ? d->cube_now : d->map_now);
+    return !c->map.tex || memcmp(p, &c->map.p, sizeof *p) || c->static_version != d->static_version ||
+           c->dynamic_version != d->dynamic_version;
+}
+
+static lm_status redraw_map(lm_direct *d, int i, const lm_shadow_params *p, lm_error *err)
 {
     cached_map *c = &d->maps[i];
-    lm_shadow_params p;
-    lm_shadow_params_compute(&p, s, e, e->kind == LM_EMIT_POINT ? d->set.cube_size : d->set.map_size);
-    int same = c->map.tex && !memcmp(&p, &c->map.p, sizeof p), static_ok = c->static_version == d->static_version;
-    if (same && static_ok && c->dynamic_version == d->dynamic_version)
-        return LM_OK;
-    lm_status st = lm_shadow_map_draw(&c->map, &p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_indices,
-                                      !static_ok, d->mesh.dynamic_lo, d->mesh.dynamic_hi, err);
+    lm_status st = lm_shadow_map_draw(&c->map, p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_indices,
+                                      c->static_version != d->static_version, d->mesh.dynamic_lo, d->mesh.dynamic_hi,
+                                      err);
     c->static_version = d->static_version;
     c->dynamic_version = d->dynamic_version;
+    c->stale_since = 0;
     d->maps_rendered++;
+    d->maps_left -= d->maps_left > 0;
+    return st;
+}
+
+/* How much a stale map's shadow matters: the light's irradiance at what moved (the dynamic casters' box,
+ * or the scene's centre when a static caster moved or nothing dynamic casts), doubled for every update it
+ * has waited, so that every stale map is redrawn in the end: a light 1,000 times dimmer there than the
+ * others waits about 10 updates while things keep moving (growing linearly, a far light waited over 200). */
+static double map_priority(const lm_direct *d, const lm_scene *s, const lm_emitter *e, int i)
+{
+    const float *r = e->radiant;
+    double watts = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2], d2 = 1.0;
+    if (e->kind != LM_EMIT_DIRECTIONAL) {
+        const float *lo = d->mesh.dynamic_lo, *hi = d->mesh.dynamic_hi;
+        int box = lo[0] <= hi[0] && d->maps[i].static_version == d->static_version;
+        d2 = 0.0;
+        for (int a = 0; a < 3; a++) {
+            double c = box ? 0.5 * (lo[a] + hi[a]) : 0.5 * (s->bounds_min[a] + s->bounds_max[a]);
+            double half = box ? 0.5 * (hi[a] - lo[a]) : 0.0, dist = fabs(e->pos[a] - c) - half;
+            d2 += dist > 0.0 ? dist * dist : 0.0;
+        }
+        double size = lm_scene_size(s);
+        d2 = d2 > 1e-4 * size * size ? d2 : 1e-4 * size * size;
+    }
+    unsigned long age = d->updates - d->maps[i].stale_since;
+    return ldexp(watts / d2, age < 900 ? (int)age : 900);
+}
+
+typedef struct {
+    double key;
+    int i;
+    lm_shadow_params p;
+} stale_map;
+
+static int by_priority(const void *a, const void *b)
+{
+    const stale_map *x = a, *y = b;
+    return x->key > y->key ? -1 : x->key < y->key ? 1 : x->i - y->i;
+}
+
+/* The stale shadow maps redrawn, within the update's budget (lm_direct_begin_update): a map never made is
+ * always drawn (a light without one would light through walls); the others by priority, the rest keep
+ * their last map (the shadow of what moved lags a few updates behind for the least of them). */
+static lm_status refresh_maps(lm_direct *d, const lm_scene *s, const lm_emitters *em, lm_error *err)
+{
+    stale_map *list = NULL;
+    int n = 0;
+    lm_status st = LM_OK;
+    for (int i = 0; st == LM_OK && i < em->count; i++) {
+        cached_map *c = &d->maps[i];
+        lm_shadow_params p;
+        if (!live_punctual(s, &em->e[i])) {
+            if (c->map.tex)
+                lm_shadow_map_free(&c->map);
+            c->stale_since = 0;
+        } else if (!map_stale(d, s, &em->e[i], i, &p)) {
+            c->stale_since = 0;
+        } else if (!c->map.tex || d->maps_left < 0) {
+            st = redraw_map(d, i, &p, err);
+        } else {
+            if (!list && !(list = malloc(sizeof *list * (size_t)em->count)))
+                return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory for %d stale shadow maps", em->count);
+            c->stale_since = c->stale_since ? c->stale_since : d->updates;
+            list[n++] = (stale_map){map_priority(d, s, &em->e[i], i), i, p};
+        }
+    }
+    if (n > 1)
+        qsort(list, (size_t)n, sizeof *list, by_priority);
+    for (int k = 0; st == LM_OK && k < n && d->maps_left > 0; k++)
+        st = redraw_map(d, list[k].i, &list[k].p, err);
+    free(list);
     return st;
 }
 
@@ -255,38 +344,63 @@ static int valid_settings(const lm_direct_settings *set)
     return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0;
 }
 
-/* Shadow-map texels for the scene's lights at the settings' sizes: a cube (6 faces) per point light, a
- * 2D map per spot and directional light, each with its static layer (shadow_maps.h), 4 bytes a texel. */
-static double shadow_bytes(const lm_scene *s, int cube_size, int map_size)
+/* Shadow-map bytes for `points` point lights and `others` spot and directional ones at the given sides: a
+ * cube (6 faces) per point light, a 2D map per spot and directional light, each with its static layer
+ * (shadow_maps.h), 4 bytes a texel. */
+static double shadow_bytes(int points, int others, int cube_size, int map_size)
 {
-    double bytes = 0.0;
-    for (int l = 0; l < s->light_count; l++)
-        bytes += s->lights[l].type == LM_LIGHT_POINT ? 6.0 * cube_size * cube_size : (double)map_size * map_size;
-    return 2.0 * 4.0 * bytes;
+    return 2.0 * 4.0 * (6.0 * cube_size * cube_size * points + (double)map_size * map_size * others);
+}
+
+/* The sides that fit LM_DIRECT_SHADOW_BUDGET: halved together down to LM_DIRECT_SHADOW_MIN_SIZE. */
+static void fit_sizes(int points, int others, int *cube, int *map)
+{
+    while (shadow_bytes(points, others, *cube, *map) > LM_DIRECT_SHADOW_BUDGET &&
+           (*cube > LM_DIRECT_SHADOW_MIN_SIZE || *map > LM_DIRECT_SHADOW_MIN_SIZE)) {
+        *cube = *cube / 2 > LM_DIRECT_SHADOW_MIN_SIZE ? *cube / 2 : LM_DIRECT_SHADOW_MIN_SIZE;
+        *map = *map / 2 > LM_DIRECT_SHADOW_MIN_SIZE ? *map / 2 : LM_DIRECT_SHADOW_MIN_SIZE;
+    }
 }
 
 /* The shadow maps share LM_DIRECT_SHADOW_BUDGET: with many lights each map is made smaller (halved down to
  * LM_DIRECT_SHADOW_MIN_SIZE, said once) instead of asking for 12 MB a point light (1,000 point lights took
  * 13.5 GB and ended in "OpenGL error 0x0505"); a scene whose lights do not fit even then is refused. */
-static lm_status fit_shadow_budget(const lm_scene *s, lm_direct_settings *set, lm_error *err)
+static lm_status fit_shadow_budget(const lm_scene *s, lm_direct *d, lm_error *err)
 {
-    int cube = set->cube_size, map = set->map_size;
-    while (shadow_bytes(s, cube, map) > LM_DIRECT_SHADOW_BUDGET &&
-           (cube > LM_DIRECT_SHADOW_MIN_SIZE || map > LM_DIRECT_SHADOW_MIN_SIZE)) {
-        cube = cube / 2 > LM_DIRECT_SHADOW_MIN_SIZE ? cube / 2 : LM_DIRECT_SHADOW_MIN_SIZE;
-        map = map / 2 > LM_DIRECT_SHADOW_MIN_SIZE ? map / 2 : LM_DIRECT_SHADOW_MIN_SIZE;
-    }
-    double mb = 1024.0 * 1024.0, need = shadow_bytes(s, cube, map);
+    int points = 0, others = 0;
+    for (int l = 0; l < s->light_count; l++)
+        if (!s->lights[l].removed)
+            *(s->lights[l].type == LM_LIGHT_POINT ? &points : &others) += 1;
+    int cube = d->set.cube_size, map = d->set.map_size;
+    fit_sizes(points, others, &cube, &map);
+    double mb = 1024.0 * 1024.0, need = shadow_bytes(points, others, cube, map);
     if (need > LM_DIRECT_SHADOW_BUDGET)
         return lm_fail(err, LM_ERR_NOMEM, "%s: %d lights need %.0f MB of shadow maps even at %d texels a side, more "
                        "than the %.0f MB they may take", s->path, s->light_count, need / mb, LM_DIRECT_SHADOW_MIN_SIZE,
                        LM_DIRECT_SHADOW_BUDGET / mb);
-    if (cube != set->cube_size || map != set->map_size)
+    if (cube != d->set.cube_size || map != d->set.map_size)
         lm_warn("%s: %d lights: shadow maps of %d (cube faces) and %d texels a side instead of %d and %d, so that "
-                "they fit in %.0f MB; their shadows are softer", s->path, s->light_count, cube, map, set->cube_size,
-                set->map_size, LM_DIRECT_SHADOW_BUDGET / mb);
-    set->cube_size = cube, set->map_size = map;
+                "they fit in %.0f MB; their shadows are softer", s->path, s->light_count, cube, map, d->set.cube_size,
+                d->set.map_size, LM_DIRECT_SHADOW_BUDGET / mb);
+    d->cube_now = cube, d->map_now = map;
     return LM_OK;
+}
+
+/* The same budget as lights are added and removed: the sides follow the live lights' count (a map made at
+ * other sides is stale, redrawn like a moved light's), so 95 lights added hold 256 MB of maps, not 1.2 GB.
+ * Beyond what fits at the smallest side (1,365 point lights) the maps stay at that side. */
+static void fit_live_sizes(lm_direct *d, const lm_scene *s, const lm_emitters *em)
+{
+    int points = 0, others = 0;
+    for (int i = 0; i < em->count; i++)
+        if (live_punctual(s, &em->e[i]))
+            *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += 1;
+    int cube = d->set.cube_size, map = d->set.map_size;
+    fit_sizes(points, others, &cube, &map);
+    if (cube != d->cube_now || map != d->map_now)
+        lm_info("%s: %d lights: shadow maps of %d (cube faces) and %d texels a side now, within %.0f MB", s->path,
+                points + others, cube, map, LM_DIRECT_SHADOW_BUDGET / (1024.0 * 1024.0));
+    d->cube_now = cube, d->map_now = map;
 }
 
 lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct_settings *settings, lm_direct **out,
@@ -306,7 +420,8 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
         return lm_fail(err, LM_ERR_INVALID, "direct_light: bad settings (map %d, cube %d, pcf %d)", bad.map_size,
                        bad.cube_size, bad.pcf_radius);
     }
-    lm_status st = fit_shadow_budget(s, &d->set, err);
+    d->maps_left = -1;
+    lm_status st = fit_shadow_budget(s, d, err);
     for (int k = 0; st == LM_OK && k < 3; k++) {
         if ((st = light_program(k, d->set.pcf_radius, 0, &d->prog[k], err)) == LM_OK)
             find_uniforms(d->prog[k], &d->u[k]);
@@ -378,13 +493,6 @@ static lm_status ensure_maps(lm_direct *d, int count, lm_error *err)
     return LM_OK;
 }
 
-/* A point, spot or directional light that still exists: a removed one lights nothing and keeps no map
- * (an added light's map, a cube of 6 x 512^2 floats and its layer, was kept after its removal). */
-static int live_punctual(const lm_scene *s, const lm_emitter *e)
-{
-    return e->punctual && !(e->light >= 0 && e->light < s->light_count && s->lights[e->light].removed);
-}
-
 /* The scene from view into target t (width x height), leaving out the vertices in d->drop. */
 static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, const lm_emitters *em,
                            const lm_view *view, int width, int height, lm_error *err)
@@ -411,16 +519,12 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     if (st != LM_OK)
         return st;
     d->cur = t;
-    int first = -1;
-    for (int i = 0; st == LM_OK && i < em->count; i++)
-        if (live_punctual(s, &em->e[i])) {
-            st = shadow_map(d, s, &em->e[i], i, err);
-            first = first < 0 ? i : first;
-        } else if (d->maps[i].map.tex) {
-            lm_shadow_map_free(&d->maps[i].map);
-        }
-    if (st != LM_OK)
+    fit_live_sizes(d, s, em);
+    if ((st = refresh_maps(d, s, em, err)) != LM_OK)
         return st;
+    int first = -1;
+    for (int i = 0; first < 0 && i < em->count; i++)
+        first = live_punctual(s, &em->e[i]) ? i : -1;
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
     static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     glDrawBuffers(3, all);
@@ -514,6 +618,24 @@ lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *
     free(rgba);
     return LM_OK;
 }
+
+void lm_direct_begin_update(lm_direct *d, int maps)
+{
+    d->updates++;
+    d->maps_left = maps < 0 ? -1 : maps;
+}
+
+void lm_direct_end_update(lm_direct *d) { d->maps_left = -1; }
+
+int lm_direct_stale_maps(const lm_direct *d)
+{
+    int n = 0;
+    for (int i = 0; i < d->map_count; i++)
+        n += d->maps[i].stale_since != 0;
+    return n;
+}
+
+int lm_direct_map_stale(const lm_direct *d, int i) { return i >= 0 && i < d->map_count && d->maps[i].stale_since; }
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
 

@@ -24,6 +24,8 @@ typedef struct {
     float const_bias;     /* constant depth bias in texels. Default 0.5 */
     int shadows;          /* 0: no node casts shadows (the run's switch; a node's own is lm_node_settings).
                            * Default 1 */
+    int maps_per_update;  /* stale shadow maps re-rendered per update (lm_direct_begin_update's count for the
+                           * frame loop; < 0: all). Default 4 */
 } lm_direct_settings;
 
 void lm_direct_settings_default(lm_direct_settings *s);
@@ -47,6 +49,18 @@ typedef struct lm_direct lm_direct;
 lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct_settings *settings, lm_direct **out,
                            lm_error *err);
 void lm_direct_free(lm_direct *d);
+/* The shadow maps' work per update: between lm_direct_begin_update and lm_direct_end_update the draws
+ * re-render at most `maps` stale shadow maps together (a light's map never made is drawn whatever the
+ * count), the rest keep their last map until a later update: those of the brightest lights nearest to
+ * what moved first, each map's priority growing with the updates it has waited (direct.c, refresh_maps).
+ * maps < 0, and outside an update: every stale map. So a scene with 56 lights whose cube moves spreads
+ * the 56 maps it needs over 14 updates at 4 instead of one update of 268 ms on llvmpipe. */
+void lm_direct_begin_update(lm_direct *d, int maps);
+void lm_direct_end_update(lm_direct *d);
+/* Stale shadow maps left for a later update by the last draw (0 when all are current), and whether
+ * emitter i's is one of them. */
+int lm_direct_stale_maps(const lm_direct *d);
+int lm_direct_map_stale(const lm_direct *d, int i);
 /* Renders into the object's width x height RGBA32F target (no read-back; rgb = radiance, GL rows
  * bottom-up), where reflections draw over it before lm_direct_read. em and s->bounds current as for lm_render_direct. */
 lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,

@@ -953,7 +953,13 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
     int w = fl->set.width, h = fl->set.height;
     if (w <= 0)
         return LM_OK;
-    return render_view(fl, &fl->view, w, h, fl->image, 1, 1, o, err); /* fl->view: prepare_frame's */
+    long before = lm_direct_shadow_maps_rendered(fl->direct_light);
+    lm_direct_begin_update(fl->direct_light, fl->set.direct.maps_per_update);
+    lm_status st = render_view(fl, &fl->view, w, h, fl->image, 1, 1, o, err); /* fl->view: prepare_frame's */
+    lm_direct_end_update(fl->direct_light);
+    o->shadow_maps = (int)(lm_direct_shadow_maps_rendered(fl->direct_light) - before);
+    o->shadow_maps_stale = lm_direct_stale_maps(fl->direct_light);
+    return st;
 }
 
 lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width, int height, float *rgb,

@@ -97,6 +97,8 @@ typedef struct {
     uint32_t texels_gathered;
     lm_caustic_pass_stats caustic; /* the frame's caustic pass */
     int cube_faces;        /* environment map faces rendered */
+    int shadow_maps;       /* shadow maps re-rendered by the frame's draws */
+    int shadow_maps_stale; /* stale ones left for later updates (lm_direct_begin_update) */
     lm_photon_gather_stats photon_gather; /* the photon paths' gather (its times are in t_gather) */
     int photon_gathers;    /* gathers run: 0 when the records, view and G-buffer were as for the last one */
     /* seconds per stage: photon stage (animate + photons + AIMs + caustic photons), IIM gather (schedule,
