@@ -67,6 +67,8 @@ int lm_cli_parse(int argc, char **argv, int first, const char *command, unsigned
     a->gather_scheme = -1;
     a->emitter_light = -1;
     a->rim_samples = -1;
+    a->group_budget = -1;
+    a->shadow_maps = -1;
     a->reflection_size = -1;
     a->caustic_filter = -1;
     a->word_count = argc > first ? argc - first : 0;

@@ -25,9 +25,10 @@ typedef struct {
     int groups;             /* --groups G */
     int per_group;          /* --per-group M */
     int retrace;            /* --retrace k: photons re-traced per group per frame */
-    int group_budget;       /* --group-budget B: invalid groups re-traced per frame */
+    int group_budget;       /* --group-budget B: invalid groups re-traced per frame (-1 unset, 0 all) */
     int nearest;            /* --nearest N: photons per AIM estimate */
     int surface_budget;     /* --surfaces-per-frame K: AIM refreshes per frame */
+    int shadow_maps;        /* --shadow-maps-per-frame N: stale shadow maps re-rendered per frame (-1 unset, 0 all) */
     float target_error;     /* --target-error E: relative standard error per texel (reference) */
     int samples;            /* --samples N: samples per texel/pixel per pass (reference) */
     int caustic_photons;    /* --caustic-photons N: caustic photons per light and mirror/glass node (a run's, or
@@ -71,6 +72,8 @@ typedef struct {
     const char *gather_scene; /* --gather-scene FILE (bench): the ~133k-triangle Cornell box */
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
     int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */
+    int random_edits;         /* --random-edits L (bench --soak): a random edit before each update, up to L lights */
+    float budget_ms;          /* --budget MS (bench --soak): lmgi_update's budget_ms (0: texels_per_frame) */
     int quick;                /* --quick (tradeoff): fewer values per knob, looser references */
     const char *knobs;        /* --knobs LIST (tradeoff): the knobs to sweep (NULL: all) */
     int word_count;           /* the words parsed (argv[first..argc)), as given: a shard records its */

@@ -38,13 +38,14 @@ const lm_cli_command lm_cli_commands[] = {
      "path-traced ground truth per texel and per pixel, split by light path: direct, iim, caustic\n"
      "(light-traced), lost; the picture also emission, indirect and reflections\n"
      "(DIR/reference_*.exr)"},
-    {"bench", LM_CMD_BENCH, "bench [SCENE...] | bench --edits SCRIPT.json SCENE | bench --soak N [SCENE]",
+    {"bench", LM_CMD_BENCH, "bench [SCENE...] | bench --edits SCRIPT.json SCENE | bench --soak N [SCENE] [--random-edits L]",
      "time load, surface split, atlas (unwrap, pack, texel table) and BVH build; --scaling FILE\n"
      "(repeatable) adds a growth table; with no SCENE also the update time budget and every scene's\n"
      "default frame against the reference (photon tracing and the gather: lmgi-dev bench, make\n"
      "bench). --edits: a scripted edit sequence through the updater: per-update times, budget\n"
      "overruns, each edit's update lag, the surfaces it rewrote in its reach and outside it, and\n"
-     "the lightmap reads an engine makes (docs/bench.md). --soak: N updates of the looped animation"},
+     "the lightmap reads an engine makes (docs/bench.md). --soak: N updates of the looped animation,\n"
+     "or with --random-edits L of random edits (lights added and removed up to L) at --budget MS"},
     {"tradeoff", LM_CMD_TRADEOFF, "tradeoff SCENE... --out DIR",
      "what accuracy costs in time: every knob that trades one for the other swept around the defaults\n"
      "(--knobs LIST: only those), each setting's stage times (medians of --repeats) and the error of\n"
@@ -109,9 +110,13 @@ const lm_cli_option lm_cli_options[] = {
      "photons per group re-traced a frame, round robin, while anything can move\n"
      "(default 1)"},
     {"--group-budget", NULL, "B", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, group_budget), 0, 10000000, NULL,
-     "invalid photon groups re-traced a frame (default: the scene's)"},
+     "invalid photon groups re-traced a frame, oldest first (default 16; 0: every\n"
+     "one at once)"},
     {"--nearest", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, nearest), 1, 100000, NULL,
      "photons per AIM estimate (default 32)"},
+    {"--shadow-maps-per-frame", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, shadow_maps), 0, 1000000, NULL,
+     "stale shadow maps re-rendered a frame once something moved, brightest\n"
+     "and nearest to it first (default 4; 0: all at once)"},
     {"--surfaces-per-frame", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, surface_budget), 0, 10000000, NULL,
      "AIM refreshes a frame (default 4)"},
     {"--target-error", NULL, "E", REFERENCE_USERS, LM_OPT_FLOAT, offsetof(lm_cli_args, target_error), 1e-6, 0, NULL,
@@ -222,6 +227,13 @@ const lm_cli_option lm_cli_options[] = {
     {"--soak", NULL, "N", LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, soak), 1, 100000000, NULL,
      "N updates of the looped animation (default scene scenes/cornell.glb):\n"
      "resident memory, update times and non-finite frame values per block"},
+    {"--random-edits", NULL, "L", LM_CMD_BENCH, LM_OPT_INT, offsetof(lm_cli_args, random_edits), 1, 200, NULL,
+     "bench --soak: a random edit before each update instead of the animation\n"
+     "(nodes moved, lights and materials edited, lights added up to L and then\n"
+     "added and removed; --seed picks them)"},
+    {"--budget", NULL, "MS", LM_CMD_BENCH, LM_OPT_FLOAT, offsetof(lm_cli_args, budget_ms), 0, 10000, NULL,
+     "bench --soak: each update's time budget in ms (lmgi_update's budget_ms;\n"
+     "default 0: --texels-per-frame texels)"},
     {"--edits", NULL, "SCRIPT.json", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_TEXT,
      offsetof(lm_cli_args, edits_path), 0, 0, NULL,
      "a scripted edit sequence (docs/bench.md); tradeoff: a comma-separated\n"

@@ -50,6 +50,7 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
     d->seed = a->seed;
     d->photons_per_estimate = a->nearest;
     d->surfaces_per_frame = a->surface_budget;
+    d->shadow_maps_per_update = a->shadow_maps < 0 ? 0 : a->shadow_maps == 0 ? -1 : a->shadow_maps;
     d->hemicube_resolution = a->hemicube;
     d->hemicube_samples = a->hemicube_samples;
     d->hemicube_coverage = a->hemicube_coverage; /* 0: chosen per scene */
