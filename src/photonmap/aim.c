@@ -983,7 +983,7 @@ static lm_status run_schedule(lm_aim *aim, const lm_scene *s, const lm_surfaces 
     qsort(c, (size_t)count, sizeof *c, by_priority);
     int todo = budget < 0 || budget > count ? count : budget;
     uint64_t hits = 0;
-    for (int i = 0; i < todo && !everything && aim->set.max_hits; i++) {
+    for (int i = 0; i < todo && budget >= 0 && aim->set.max_hits; i++) {
         hits += ps->surfaces[c[i].surface].count;
         if (i > 0 && hits > aim->set.max_hits)
             todo = i; /* never past it, never skipping it: the next refresh starts with it */

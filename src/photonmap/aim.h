@@ -48,7 +48,7 @@ typedef struct {
                                 w = 1 - d^2 / r^2, sum(w Phi) / (pi r^2 / 2): same mean, far less noise
                                 (default 1) */
     int error_estimate;      /* keep each texel's estimate error (lm_aim.error; default 0: off, no cost) */
-    uint64_t max_hits;       /* a scheduled refresh (lm_aim_refresh) stops before a surface that would take its
+    uint64_t max_hits;       /* a refresh with a budget (lm_aim_refresh) stops before a surface that would take its
                               * surfaces' stored hits past this (the first is always refreshed): the hits
                               * bound its cost, and they grow with every light added (default 0: no bound) */
 } lm_aim_settings;
