@@ -754,6 +754,60 @@ static void test_map_budget(void **state)
     live_free(&l);
 }
 
+/* (m) The maps' memory budget follows the live lights: 24 point lights share it at 256 a face; with 4 of
+ * them removed (20 x 12.6 MB would fit at 512, but fill more than 3/4 of it) the sides stay, and with 12
+ * removed they grow back to 512; adding them back shrinks them again. The pictures at 24 and 12 lights are
+ * a fresh render's. */
+static void test_map_sides_follow_lights(void **state)
+{
+    (void)state;
+    lmt_mesh m[1];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    char nodes[8192], lights[4096];
+    int n = snprintf(nodes, sizeof nodes, "[{\"mesh\": 0}");
+    for (int i = 0; i < 24; i++)
+        n += snprintf(nodes + n, sizeof nodes - (size_t)n, ", {\"translation\": [%d, 2, %d], \"extensions\": "
+                      "{\"KHR_lights_punctual\": {\"light\": 0}}}", i % 6 - 3, i / 6 - 2);
+    snprintf(nodes + n, sizeof nodes - (size_t)n, "]");
+    snprintf(lights, sizeof lights, "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": "
+             "{\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\", \"intensity\": 1}]}},");
+    char path[512];
+    snprintf(path, sizeof path, "%s/many_lights.gltf", lmt_tmpdir());
+    if (lmt_write_gltf(path, m, 1, nodes, NULL, 0, lights) != 0)
+        fail_msg("cannot write %s", path);
+    live_scene l;
+    lm_error err;
+    lm_load_options opt = {0};
+    assert_int_equal(lm_scene_load_gltf(path, &opt, &l.s, &err), LM_OK);
+    assert_int_equal(l.s->light_count, 24);
+    assert_int_equal(lm_emitters_build(l.s, &l.em, &err), LM_OK);
+    lm_emitters_update(&l.em, l.s);
+    lm_scene_update_bounds(l.s);
+    top_view(&l.v);
+    lm_direct *d = NULL;
+    assert_int_equal(lm_direct_create(l.s, NULL, NULL, &d, &err), LM_OK);
+    const int removed[4] = {0, 4, 12, 0}, want[4] = {256, 256, 512, 256};
+    for (int k = 0; k < 4; k++) {
+        for (int i = 0; i < 24; i++)
+            l.s->lights[i].removed = i < removed[k];
+        live_update(&l);
+        if (k == 1) { /* a fresh render of 20 lights makes 512 a face: only the persistent one kept 256 */
+            float *rgb = malloc(sizeof(float) * 3 * W * W);
+            assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, rgb, &err), LM_OK);
+            free(rgb);
+        } else {
+            free(render_both(d, &l, "lights removed or back"));
+        }
+        int cube = 0, map = 0;
+        lm_direct_map_sides(d, &cube, &map);
+        print_message("%d point lights: cube faces of %d\n", 24 - removed[k], cube);
+        assert_int_equal(cube, want[k]);
+    }
+    lm_direct_free(d);
+    live_free(&l);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -762,6 +816,7 @@ int main(void)
         cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
         cmocka_unit_test(test_cache_nothing_moved),
         cmocka_unit_test(test_cube_faces_follow_casters), cmocka_unit_test(test_map_budget),
+        cmocka_unit_test(test_map_sides_follow_lights),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

@@ -388,7 +388,9 @@ static lm_status fit_shadow_budget(const lm_scene *s, lm_direct *d, lm_error *er
 
 /* The same budget as lights are added and removed: the sides follow the live lights' count (a map made at
  * other sides is stale, redrawn like a moved light's), so 95 lights added hold 256 MB of maps, not 1.2 GB.
- * Beyond what fits at the smallest side (1,365 point lights) the maps stay at that side. */
+ * Beyond what fits at the smallest side (1,365 point lights) the maps stay at that side. They grow back only
+ * once they would fill at most 3/4 of the budget, so that a light count going back and forth across the
+ * line does not redraw every map each time. */
 static void fit_live_sizes(lm_direct *d, const lm_scene *s, const lm_emitters *em)
 {
     int points = 0, others = 0;
@@ -397,6 +399,9 @@ static void fit_live_sizes(lm_direct *d, const lm_scene *s, const lm_emitters *e
             *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += 1;
     int cube = d->set.cube_size, map = d->set.map_size;
     fit_sizes(points, others, &cube, &map);
+    int grows = cube > d->cube_now || map > d->map_now;
+    if (grows && shadow_bytes(points, others, cube, map) > 0.75 * LM_DIRECT_SHADOW_BUDGET)
+        return;
     if (cube != d->cube_now || map != d->map_now)
         lm_info("%s: %d lights: shadow maps of %d (cube faces) and %d texels a side now, within %.0f MB", s->path,
                 points + others, cube, map, LM_DIRECT_SHADOW_BUDGET / (1024.0 * 1024.0));
@@ -636,6 +641,12 @@ int lm_direct_stale_maps(const lm_direct *d)
 }
 
 int lm_direct_map_stale(const lm_direct *d, int i) { return i >= 0 && i < d->map_count && d->maps[i].stale_since; }
+
+void lm_direct_map_sides(const lm_direct *d, int *cube, int *map)
+{
+    *cube = d->cube_now;
+    *map = d->map_now;
+}
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
 

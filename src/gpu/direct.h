@@ -61,6 +61,8 @@ void lm_direct_end_update(lm_direct *d);
  * emitter i's is one of them. */
 int lm_direct_stale_maps(const lm_direct *d);
 int lm_direct_map_stale(const lm_direct *d, int i);
+/* The sides the live lights' maps get now: a point light's cube face and a spot or directional map. */
+void lm_direct_map_sides(const lm_direct *d, int *cube, int *map);
 /* Renders into the object's width x height RGBA32F target (no read-back; rgb = radiance, GL rows
  * bottom-up), where reflections draw over it before lm_direct_read. em and s->bounds current as for lm_render_direct. */
 lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
