@@ -128,8 +128,9 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
 	@mkdir -p $(dir $@)
 	$(CC) -o $@ $(filter %.o,$^) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS) -lcmocka
 
-# The soak test plays the random edits of `lmgi bench --soak --random-edits` (src/cli/random_edits.c).
-$(BUILD)/tests/test_soak: $(BUILD)/obj/src/cli/random_edits.o
+# The soak test plays the random edits of `lmgi bench --soak --random-edits` (src/cli/random_edits.c) and
+# reads memory as it does.
+$(BUILD)/tests/test_soak: $(BUILD)/obj/src/cli/random_edits.o $(BUILD)/obj/src/cli/resident_memory.o
 
 # The GL guest test plays a GLX host on an X server: it alone links X and GLX (lmgi links neither).
 $(BUILD)/tests/test_gl_guest: LIBS += -lGL -lX11 -ldl

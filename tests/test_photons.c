@@ -47,6 +47,17 @@ static void world_photons(world *w, const lm_photon_settings *set)
     assert_int_equal(lm_photons_trace_all(w->ph, NULL, &err), LM_OK);
 }
 
+/* Photons of `total` over the scene, traced once (stats in *st). */
+static void world_trace(world *w, uint32_t total, lm_photon_frame_stats *st)
+{
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.total_photons = total;
+    lm_error err;
+    assert_int_equal(lm_photons_create(w->s, &w->su, w->rt, &w->em, &set, &w->ph, &err), LM_OK);
+    assert_int_equal(lm_photons_trace_all(w->ph, st, &err), LM_OK);
+}
+
 static void world_free(world *w)
 {
     lm_photons_free(w->ph);
@@ -763,13 +774,8 @@ static void test_cornell_rate_and_memory(void **state)
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
     world w;
     world_load(&w, path);
-    lm_photon_settings set;
-    lm_photon_settings_default(&set);
-    set.total_photons = 72 * 1400;
-    lm_error err;
-    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &w.ph, &err), LM_OK);
     lm_photon_frame_stats st;
-    assert_int_equal(lm_photons_trace_all(w.ph, &st, &err), LM_OK);
+    world_trace(&w, 72 * 1400, &st);
     lm_photon_memory mem;
     lm_photons_memory(w.ph, &mem);
     print_message("cornell: %u photons traced in %.3f s (%.0f photons/s, %d threads); %.2f path vertices and "
@@ -850,13 +856,8 @@ static void test_light_trapped_in_glass(void **state)
                                        LMT_LIGHTS("{\"type\": \"point\", \"intensity\": 10}"));
     world w;
     world_load(&w, path);
-    lm_photon_settings set;
-    lm_photon_settings_default(&set);
-    set.total_photons = 72 * 64;
-    lm_error err;
-    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &w.ph, &err), LM_OK);
     lm_photon_frame_stats st;
-    assert_int_equal(lm_photons_trace_all(w.ph, &st, &err), LM_OK);
+    world_trace(&w, 72 * 64, &st);
     double rays = (double)st.rays / lm_photons_count(w.ph);
     print_message("lamp in a glass cube: %.1f rays a photon (a run of %u specular vertices ends one), %u hits "
                   "stored\n", rays, PH_SPECULAR_RUN, lm_photons_stored_hits(w.ph));

@@ -10,14 +10,13 @@
 #include <cmocka.h>
 
 #include <lmgi.h>
-#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #include "../src/cli/random_edits.h"
+#include "../src/cli/resident_memory.h"
 #include "edit_room.h"
 #include "support.h"
 
@@ -33,17 +32,6 @@
 #ifndef UNDER_ASAN
 #define UNDER_ASAN 0
 #endif
-
-static double resident_mb(void)
-{
-    malloc_trim(0);
-    FILE *f = fopen("/proc/self/statm", "r");
-    long pages = 0, rss = 0;
-    int ok = f && fscanf(f, "%ld %ld", &pages, &rss) == 2;
-    if (f)
-        fclose(f);
-    return ok ? (double)rss * (double)sysconf(_SC_PAGESIZE) / 1048576.0 : -1.0;
-}
 
 /* What a soak checks per update, and what it saw. */
 typedef struct {
@@ -139,7 +127,7 @@ static void soak(soak_run *r)
         check_update(r, f, &st);
         check_frame_finite(u, r->scene, f);
         if (lm_random_edits_lights(sc) == r->max_lights && f >= r->updates / 3) {
-            double mb = resident_mb();
+            double mb = lm_cli_resident_mb();
             if (r->mb_first == 0.0)
                 r->mb_first = mb;
             else if (f >= 2 * r->updates / 3)

@@ -2,34 +2,19 @@
 #include "bench_soak.h"
 
 #include <lmgi.h>
-#include <malloc.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-#include <unistd.h>
 
 #include "order_stats.h"
 #include "progress.h"
 #include "random_edits.h"
+#include "resident_memory.h"
 #include "run_cmd.h"
 
 #define SOAK_SIZE 32 /* frame side unless --size */
-
-/* Resident memory of this process in MB (Linux /proc; -1 where it cannot be read), after handing the C
- * library's free memory back (malloc_trim): without it the figure stays at the peak of any block, and
- * memory given back by a removed light would not show. */
-static double resident_mb(void)
-{
-    malloc_trim(0);
-    FILE *f = fopen("/proc/self/statm", "r");
-    long pages = 0, rss = 0;
-    int ok = f && fscanf(f, "%ld %ld", &pages, &rss) == 2;
-    if (f)
-        fclose(f);
-    return ok ? (double)rss * (double)sysconf(_SC_PAGESIZE) / 1048576.0 : -1.0;
-}
 
 static long non_finite(const float *rgb, int n)
 {
@@ -119,7 +104,7 @@ static int soak(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, int frame
         ms[k++] = took;
         if (k == every || f + 1 == frames) {
             block *x = &b[f / every];
-            x->mb = resident_mb();
+            x->mb = lm_cli_resident_mb();
             x->lights = lm_random_edits_lights(sc);
             x->p95 = lm_cli_quantile(ms, k, 0.95);
             x->worst = lm_cli_quantile(ms, k, 1.0);
