@@ -31,7 +31,7 @@ void lm_dev_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
         s->photons.per_group = (uint32_t)a->per_group, s->photons.min_total = 0;
     if (a->retrace)
         s->photons.retrace_per_group = (uint32_t)a->retrace;
-    if (a->group_budget)
+    if (a->group_budget >= 0) /* given: 0 is every invalid group, as for lm_photons */
         s->photons.group_budget = (uint32_t)a->group_budget;
     if (a->seed)
         s->photons.seed = a->seed;
