@@ -112,8 +112,9 @@ static void soak(soak_run *r)
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     d.frame_width = d.frame_height = SIDE;
+    lmgi_context *ctx = lmt_context();
     lmgi_updater *u = NULL;
-    if (lmgi_updater_create(lmt_context(), sc, &d, &u, &e) != LMGI_OK)
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     lm_random_edits edits;
     assert_int_equal(lm_random_edits_init(&edits, sc, r->max_lights, 1), 0);
@@ -151,6 +152,7 @@ static void soak(soak_run *r)
     lm_random_edits_free(&edits);
     lmgi_updater_free(u);
     lmgi_free(sc);
+    lmgi_context_free(ctx);
 }
 
 /* The two rooms: 4 lights of the file, up to 8 (dynamic door and cube, no caustics). */
