@@ -91,7 +91,7 @@ static int kind_of(const lm_emitter *e) { return e->kind == LM_EMIT_POINT ? 0 : 
  * (an added light's map, a cube of 6 x 512^2 floats and its layer, was kept after its removal). */
 static int live_punctual(const lm_scene *s, const lm_emitter *e)
 {
-    return e->punctual && !(e->light >= 0 && e->light < s->light_count && s->lights[e->light].removed);
+    return e->punctual && !lm_emitter_removed(s, e);
 }
 
 static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)

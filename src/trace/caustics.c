@@ -387,6 +387,15 @@ static void place_emitters(lm_caustics *c)
             lm_emitter_place(c->em, c->scene, e, c->tris + c->em_tri_first[e]);
 }
 
+/* The slots holding a landed photon (a flux not 0). */
+static uint32_t count_landed(const lm_caustics *c)
+{
+    uint32_t landed = 0;
+    for (uint32_t s = 0; s < c->slots; s++)
+        landed += c->hits[s].flux[0] != 0.0f || c->hits[s].flux[1] != 0.0f || c->hits[s].flux[2] != 0.0f;
+    return landed;
+}
+
 /* Traces jobs[0 .. n) (slots), in parallel, then counts. */
 static void trace_jobs(lm_caustics *c, uint32_t n, lm_caustic_frame_stats *st)
 {
@@ -418,19 +427,12 @@ static void trace_jobs(lm_caustics *c, uint32_t n, lm_caustic_frame_stats *st)
         changed |= c->changed[i];
     }
     st->traced += n;
-    uint32_t landed = 0;
-    for (uint32_t s = 0; s < c->slots; s++)
-        landed += c->hits[s].flux[0] != 0.0f || c->hits[s].flux[1] != 0.0f || c->hits[s].flux[2] != 0.0f;
-    c->landed = landed;
+    c->landed = count_landed(c);
     c->version += changed; /* a re-trace that found every path as it was changes nothing downstream */
 }
 
 /* Whether emitter e lights anything for good: a removed light never comes back. */
-static int emitter_live(const lm_caustics *c, int e)
-{
-    int light = c->em->e[e].light;
-    return !(light >= 0 && light < c->scene->light_count && c->scene->lights[light].removed);
-}
+static int emitter_live(const lm_caustics *c, int e) { return !lm_emitter_removed(c->scene, &c->em->e[e]); }
 
 static lm_status alloc_lists(lm_caustics *c, lm_error *err)
 {
@@ -734,10 +736,7 @@ lm_status lm_caustics_follow_emitters(lm_caustics *c, lm_error *err)
             else
                 n->pairs[g * n->live_count + n->em_pair[e]].whole = 1;
         }
-    uint32_t landed = 0;
-    for (uint32_t k = 0; k < n->slots; k++)
-        landed += n->hits[k].flux[0] != 0.0f || n->hits[k].flux[1] != 0.0f || n->hits[k].flux[2] != 0.0f;
-    n->landed = landed, n->version = c->version + 1;
+    n->landed = count_landed(n), n->version = c->version + 1;
     n->world_hash = c->world_hash, n->frame_cap = c->frame_cap;
     lm_caustics old = *c;
     *c = *n;

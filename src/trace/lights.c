@@ -189,6 +189,11 @@ lm_status lm_emitters_add_light(lm_emitters *em, const lm_scene *s, int light, l
     return LM_OK;
 }
 
+int lm_emitter_removed(const lm_scene *s, const lm_emitter *e)
+{
+    return e->light >= 0 && e->light < s->light_count && s->lights[e->light].removed;
+}
+
 int lm_emitters_light_count(const lm_emitters *em)
 {
     int n = 0;

@@ -60,6 +60,9 @@ lm_status lm_emitters_add_sky(lm_emitters *em, const lm_scene *s, lm_error *err)
 int lm_emitters_sky(const lm_emitters *em);
 /* Point, spot and directional emitters in em (the lights it knows). */
 int lm_emitters_light_count(const lm_emitters *em);
+/* 1 when e is the emitter of a light removed for good (lmgi_remove_light): it lights nothing again, and what
+ * it holds (shadow map, photon paths, caustic slots) may be given back. */
+int lm_emitter_removed(const lm_scene *s, const lm_emitter *e);
 /* Re-reads emitter placement and flux after node moves or light edits (world matrices, bounds). */
 void lm_emitters_update(lm_emitters *em, const lm_scene *s);
 

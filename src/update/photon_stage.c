@@ -417,11 +417,9 @@ static int anything_moves(const lm_scene *s)
  * soak that adds and removes lights held every removed light's paths (lmgi_remove_light). */
 static void release_removed(lm_photon_stage *ps)
 {
-    for (int e = 0; e < ps->emitters.count; e++) {
-        int light = ps->emitters.e[e].light;
-        if (light >= 0 && light < ps->scene->light_count && ps->scene->lights[light].removed)
+    for (int e = 0; e < ps->emitters.count; e++)
+        if (lm_emitter_removed(ps->scene, &ps->emitters.e[e]))
             lm_photons_release_emitter(ps->photons, e);
-    }
 }
 
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
