@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include "order_stats.h"
 #include "progress.h"
@@ -28,13 +27,6 @@ typedef struct {
     double mb, median, p95, worst;
     int lights;
 } block;
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 /* What the soak plays and measures. With random edits, an update's time is the caller's: the edit (which
  * waits for the photon work the last update left running) and lmgi_update, by the wall clock. */
@@ -81,7 +73,7 @@ static int soak(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, int frame
         lmgi_update_stats st;
         lmgi_error e;
         lm_edit_kind kind = LM_EDIT_KINDS;
-        double t0 = now_ms();
+        double t0 = lm_cli_now();
         if (p->random && lm_random_edit(&p->edits, sc, &kind, &e) != LMGI_OK) {
             fprintf(stderr, "lmgi: error: the random edit before update %d (%s): %s\n", f, lm_edit_kind_name(kind),
                     e.message);
@@ -93,7 +85,7 @@ static int soak(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, int frame
             rc = 1;
             break;
         }
-        double took = p->random ? now_ms() - t0 : st.ms_total;
+        double took = p->random ? 1e3 * (lm_cli_now() - t0) : st.ms_total;
         if (f > 0 && took > p->worst_ms)
             p->worst_ms = took, p->worst_at = f, p->worst_kind = kind, p->worst_stats = st;
         p->over += f > 0 && p->budget_ms > 0.0f && took > 10.0 * p->budget_ms;

@@ -1,6 +1,7 @@
 /* Edit scripts: reading, applying and playing them (edit_script.h). */
 #include "edit_script.h"
 
+#include <errno.h>
 #include <limits.h>
 #include <math.h>
 #include <stdio.h>
@@ -9,6 +10,7 @@
 #include <time.h>
 
 #include "progress.h"
+#include "read_file.h"
 #include "surface_error.h"
 
 static int bad(const char *path, int i, const char *what)
@@ -529,20 +531,14 @@ static cJSON *parse_text(const char *path, const char *text, size_t n)
 
 static cJSON *read_script(const char *path)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        fprintf(stderr, "lmgi: %s: cannot read the edit script\n", path);
+    size_t n = 0;
+    char *text = lm_cli_read_file(path, (1u << 20) - 1, &n);
+    if (!text) {
+        fprintf(stderr, "lmgi: %s: %s\n", path, errno == ENOMEM ? "out of memory" : errno == EFBIG ? "larger than 1 MiB"
+                                                                                    : "cannot read the edit script");
         return NULL;
     }
-    char *text = malloc(1 << 20);
-    size_t n = text ? fread(text, 1, 1 << 20, f) : 0;
-    int too_big = text && n == 1 << 20;
-    fclose(f);
-    cJSON *root = NULL;
-    if (!text || too_big)
-        fprintf(stderr, "lmgi: %s: %s\n", path, !text ? "out of memory" : "larger than 1 MiB");
-    else
-        text[n] = '\0', root = parse_text(path, text, n);
+    cJSON *root = parse_text(path, text, n);
     free(text);
     return root;
 }

@@ -8,6 +8,7 @@
 #include <lmgi.h>
 #include <cjson/cJSON.h>
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -197,7 +198,7 @@ static int read_part(const char *part, part_info *p)
     }
     json_of(part, p->where, sizeof p->where);
     size_t size;
-    char *text = lm_cli_read_file(p->where, &size);
+    char *text = lm_cli_read_file(p->where, SIZE_MAX, &size);
     if (!text && errno == ENOENT)
         return no_part_json(part, p->where);
     if (!text) {

@@ -67,12 +67,10 @@ static lmgi_status move_node(lm_random_edits *r, lmgi_scene *sc, lmgi_error *err
 /* A live light (never 0 when called) dimmed or brightened by up to 2x and recoloured. */
 static lmgi_status edit_light(lm_random_edits *r, lmgi_scene *sc, lmgi_error *err)
 {
-    int live[256], n = 0;
-    for (int i = 0; i < lmgi_light_count(sc) && n < 256; i++)
-        if (!lmgi_light_is_removed(sc, i))
-            live[n++] = i;
+    int k = below(r, lm_random_edits_lights(sc)), id = -1;
+    while (k >= 0) /* id: the k-th light still on */
+        k -= !lmgi_light_is_removed(sc, ++id);
     lmgi_light l;
-    int id = live[below(r, n)];
     lmgi_status st = lmgi_get_light(sc, id, &l, err);
     if (st != LMGI_OK)
         return st;

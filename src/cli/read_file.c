@@ -2,24 +2,45 @@
 #include "read_file.h"
 
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 
-char *lm_cli_read_file(const char *path, size_t *size)
+char *lm_cli_read_file(const char *path, size_t limit, size_t *size)
 {
     FILE *f = fopen(path, "rb");
     if (!f)
         return NULL;
-    long n = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
-    char *data = n >= 0 && fseek(f, 0, SEEK_SET) == 0 ? malloc((size_t)n + 1) : NULL;
-    int got = data && fread(data, 1, (size_t)n, f) == (size_t)n;
+    char *data = NULL;
+    size_t n = 0, cap = 0, most = limit < SIZE_MAX - 1 ? limit + 1 : SIZE_MAX - 1; /* a byte past the limit */
+    int fail = 0;
+    while (!fail) {
+        if (n == cap) { /* room for up to `most` bytes and the NUL */
+            size_t more = cap ? 2 * cap : 65536;
+            cap = more > most || more < cap ? most : more;
+            char *grown = realloc(data, cap + 1);
+            if (!grown) {
+                fail = ENOMEM;
+                break;
+            }
+            data = grown;
+        }
+        size_t got = fread(data + n, 1, cap - n, f);
+        n += got;
+        if (n > limit)
+            fail = EFBIG;
+        else if (got == 0)
+            break;
+    }
+    if (!fail && ferror(f))
+        fail = EIO;
     fclose(f);
-    if (!got) {
+    if (fail) {
         free(data);
-        errno = EIO;
+        errno = fail;
         return NULL;
     }
     data[n] = '\0';
-    *size = (size_t)n;
+    *size = n;
     return data;
 }

@@ -264,7 +264,7 @@ static int bake_over_ranks(const lm_cli_args *a, int rank, int ranks, int balanc
     int status = 0;
     if (rank > 0) {
         size_t n = 0;
-        char *mine = lm_cli_read_file(part, &n);
+        char *mine = lm_cli_read_file(part, SIZE_MAX, &n);
         send_part(&(rank_report){mine_t, sh.taken}, (const unsigned char *)mine, mine ? (int64_t)n : -1);
         free(mine);
     } else {
