@@ -39,13 +39,16 @@ static void world_load(world *w, const char *path)
     assert_int_equal(lm_emitters_build(w->s, &w->em, &err), LM_OK);
 }
 
-static void world_photons(world *w, const lm_photon_settings *set)
+/* The scene's photons with settings set, traced once (the trace's stats in *st when st is not NULL). */
+static void world_photons_stats(world *w, const lm_photon_settings *set, lm_photon_frame_stats *st)
 {
     lm_error err;
     if (lm_photons_create(w->s, &w->su, w->rt, &w->em, set, &w->ph, &err) != LM_OK)
         fail_msg("photons: %s", err.msg);
-    assert_int_equal(lm_photons_trace_all(w->ph, NULL, &err), LM_OK);
+    assert_int_equal(lm_photons_trace_all(w->ph, st, &err), LM_OK);
 }
+
+static void world_photons(world *w, const lm_photon_settings *set) { world_photons_stats(w, set, NULL); }
 
 /* Photons of `total` over the scene, traced once (stats in *st). */
 static void world_trace(world *w, uint32_t total, lm_photon_frame_stats *st)
@@ -53,9 +56,7 @@ static void world_trace(world *w, uint32_t total, lm_photon_frame_stats *st)
     lm_photon_settings set;
     lm_photon_settings_default(&set);
     set.total_photons = total;
-    lm_error err;
-    assert_int_equal(lm_photons_create(w->s, &w->su, w->rt, &w->em, &set, &w->ph, &err), LM_OK);
-    assert_int_equal(lm_photons_trace_all(w->ph, st, &err), LM_OK);
+    world_photons_stats(w, &set, st);
 }
 
 static void world_free(world *w)
