@@ -750,8 +750,8 @@ static void test_bad_arguments(void **state)
     lmgi_error e;
     lmgi_updater_desc d;
     static const char *const named[] = {"hemicube_samples 3", "frame 10 x 0", "camera 7", "blend_frames -5",
-                                        "enlargement", "groups"};
-    for (int k = 0; k < 6; k++) {
+                                        "enlargement", "groups", "shadow_maps_per_update -5"};
+    for (int k = 0; k < 7; k++) {
         small_desc(&d);
         if (k == 0)
             d.hemicube_samples = 3;
@@ -765,6 +765,8 @@ static void test_bad_arguments(void **state)
             d.enlargement = NAN;
         if (k == 5)
             d.groups = 5; /* not 2^a 3^b */
+        if (k == 6)
+            d.shadow_maps_per_update = -5; /* -1 is "all", other negatives nothing */
         u = (lmgi_updater *)sc;
         expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, named[k]);
         assert_null(u);
