@@ -41,7 +41,8 @@ namespace {
 const char *const k_supported_required[] = {"KHR_lights_punctual", "KHR_materials_emissive_strength",
                                             "KHR_materials_transmission", "KHR_materials_ior",
                                             "KHR_texture_transform", "EXT_texture_webp", "EXT_meshopt_compression",
-                                            "KHR_draco_mesh_compression", "KHR_mesh_quantization"};
+                                            "KHR_draco_mesh_compression", "KHR_mesh_quantization",
+                                            "EXT_lights_image_based"};
 // Optional extensions lmgi knows and has no use for, read without a warning: its own export's lightmap
 // (a scene lmgi loads is lit again, docs/api.md, "The lightmap in engines").
 const char *const k_known_unread[] = {"LMGI_lightmap"};
@@ -94,6 +95,9 @@ double num(const tinygltf::Value *o, const char *key, double def)
         return def;
     return o->Get(key).GetNumberAsDouble();
 }
+
+// A number's value, NaN when v is not one (a string, null, absent: what a message then shows as nan).
+double number_or_nan(const tinygltf::Value &v) { return v.IsNumber() ? v.GetNumberAsDouble() : NAN; }
 
 // An integer property, or def when absent or not an integer in int range.
 int int_prop(const tinygltf::Value *o, const char *key, int def)
@@ -185,6 +189,10 @@ class Loader {
     lm_status animations();
     lm_status finish();
     lm_status sky();
+    const tinygltf::Value *ibl_reference(int *scene) const;
+    lm_status ibl_sky(const tinygltf::Value &ref, int scene);
+    lm_status ibl_params(const tinygltf::Value &light, const std::string &what, float *intensity, float rotation[4]);
+    lm_status ibl_faces(const tinygltf::Value &light, const std::string &what, std::vector<uint8_t> faces[6], int *n);
     std::string scene_dir() const;
 
     const char *path_;
@@ -1351,11 +1359,145 @@ static std::string percent_decoded(const std::string &uri)
     return out;
 }
 
+// The EXT_lights_image_based reference of the scene lmgi loads (the default scene, else the first), and
+// that scene's index; NULL when it names no image-based light.
+const tinygltf::Value *Loader::ibl_reference(int *scene) const
+{
+    if (model_.scenes.empty())
+        return nullptr;
+    *scene = model_.defaultScene >= 0 && size_t(model_.defaultScene) < model_.scenes.size() ? model_.defaultScene : 0;
+    return ext_obj(model_.scenes[size_t(*scene)].extensions, "EXT_lights_image_based");
+}
+
+// The light's intensity (default 1: finite and >= 0) and rotation (default identity: a unit quaternion
+// to 1e-3, made unit), as the extension defines them; the defaults stay where the light has none.
+lm_status Loader::ibl_params(const tinygltf::Value &light, const std::string &what, float *intensity,
+                             float rotation[4])
+{
+    const char *w = what.c_str();
+    double k = num(&light, "intensity", 1.0);
+    if (light.Has("intensity") && !light.Get("intensity").IsNumber())
+        return fail(LM_ERR_INVALID, "%s: intensity must be a number", w);
+    if (!(k >= 0.0 && k <= LM_MAX_EMISSION))
+        return fail(LM_ERR_INVALID, "%s: intensity %g must be a number from 0 to %g", w, k, LM_MAX_EMISSION);
+    *intensity = float(k);
+    if (!light.Has("rotation"))
+        return LM_OK;
+    const tinygltf::Value &r = light.Get("rotation");
+    bool ok = r.IsArray() && r.ArrayLen() == 4;
+    double len2 = 0.0;
+    for (int i = 0; ok && i < 4; i++) {
+        ok = r.Get(i).IsNumber() && std::isfinite(r.Get(i).GetNumberAsDouble());
+        rotation[i] = ok ? float(r.Get(i).GetNumberAsDouble()) : 0.0f;
+        len2 += double(rotation[i]) * rotation[i];
+    }
+    if (!ok)
+        return fail(LM_ERR_INVALID, "%s: rotation must be a quaternion [x, y, z, w] of 4 finite numbers", w);
+    if (!(std::fabs(std::sqrt(len2) - 1.0) <= 1e-3))
+        return fail(LM_ERR_INVALID, "%s: rotation [%g, %g, %g, %g] is not a unit quaternion (its length is %g)", w,
+                    double(rotation[0]), double(rotation[1]), double(rotation[2]), double(rotation[3]),
+                    std::sqrt(len2));
+    lm_quat_normalize(rotation);
+    return LM_OK;
+}
+
+// The light's mip 0 (specularImages[0]: the radiance itself, roughness 0), six glTF images decoded whole
+// into 8-bit RGBA, square and of one size n. Their bytes came as every image's do (data: URIs,
+// bufferViews, files under the folder rule: parse), and stay until decode_used_images.
+lm_status Loader::ibl_faces(const tinygltf::Value &light, const std::string &what, std::vector<uint8_t> faces[6],
+                            int *n)
+{
+    static const char *const k_face[6] = {"+X", "-X", "+Y", "-Y", "+Z", "-Z"};
+    const char *w = what.c_str();
+    const tinygltf::Value *mips = light.Has("specularImages") ? &light.Get("specularImages") : nullptr;
+    if (!mips || !mips->IsArray() || mips->ArrayLen() < 1 || !mips->Get(0).IsArray())
+        return fail(LM_ERR_FORMAT, "%s: specularImages must be an array of mips, each an array of 6 faces", w);
+    const tinygltf::Value &mip0 = mips->Get(0);
+    if (mip0.ArrayLen() != 6)
+        return fail(LM_ERR_FORMAT, "%s: specularImages[0] has %zu faces; a cube has 6 (+X, -X, +Y, -Y, +Z, -Z)", w,
+                    mip0.ArrayLen());
+    int img[6];
+    double plan = 12.0 * LM_SKY_CUBE_MAX_WIDTH * (LM_SKY_CUBE_MAX_WIDTH / 2); // the equirectangular image
+    for (int f = 0; f < 6; f++) {
+        double i = number_or_nan(mip0.Get(f));
+        if (!(i >= 0.0 && i < double(model_.images.size()) && i == std::floor(i)))
+            return fail(LM_ERR_FORMAT, "%s: face %s (specularImages[0][%d]): image %g out of range (%zu images)", w,
+                        k_face[f], f, i, model_.images.size());
+        img[f] = int(i);
+        const std::vector<unsigned char> &b = model_.images[size_t(img[f])].image;
+        plan += 2.5 * lm_image_decode_bytes(b.data(), b.size(), 0); // RGBA while decoding, then linear floats
+    }
+    lm_error e;
+    if (lm_memory_plan("decoding the sky's six cube faces", plan, "smaller faces", &e) != LM_OK)
+        return fail(e.status, "%s: %s", w, e.msg);
+    for (int f = 0; f < 6; f++) {
+        const tinygltf::Image &im = model_.images[size_t(img[f])];
+        std::string label = "image " + std::to_string(img[f]); // and its name or file, where it has one
+        if (!im.name.empty() || !im.uri.empty())
+            label += " \"" + (im.name.empty() ? im.uri : im.name).substr(0, 200) + "\"";
+        if (im.image.empty())
+            return fail(LM_ERR_FORMAT, "%s: face %s (%s) has no bytes: its file is missing or unreadable", w,
+                        k_face[f], label.c_str());
+        uint8_t *px = nullptr;
+        int fw = 0, fh = 0;
+        const char *why = "";
+        lm_status st = lm_image_decode(im.image.data(), im.image.size(), 0, 0, &px, &fw, &fh, &why);
+        if (st)
+            return fail(st, "%s: face %s (%s): %s", w, k_face[f], label.c_str(), why);
+        faces[f].assign(px, px + size_t(fw) * size_t(fh) * 4);
+        free(px);
+        if (fw != fh)
+            return fail(LM_ERR_FORMAT, "%s: face %s (image %d) is %d x %d pixels; cube faces are square", w,
+                        k_face[f], img[f], fw, fh);
+        if (f > 0 && fw != *n)
+            return fail(LM_ERR_FORMAT, "%s: face %s (image %d) is %d x %d pixels, face +X %d x %d; the six faces "
+                        "are one size", w, k_face[f], img[f], fw, fh, *n, *n);
+        *n = fw;
+    }
+    return LM_OK;
+}
+
+// The scene's sky from the EXT_lights_image_based light it names (docs/levels.md, "Sky"): its mip 0's
+// cube, rotation and intensity, resampled by lm_sky_set_cube. A malformed light is an error, as a
+// malformed extras.lmgi.sky is.
+lm_status Loader::ibl_sky(const tinygltf::Value &ref, int scene)
+{
+    const tinygltf::Value *root = ext_obj(model_.extensions, "EXT_lights_image_based");
+    const tinygltf::Value *lights = root && root->Has("lights") && root->Get("lights").IsArray() ? &root->Get("lights")
+                                                                                                 : nullptr;
+    size_t count = lights ? lights->ArrayLen() : 0;
+    double li = number_or_nan(ref.Get("light"));
+    if (!(li >= 0.0 && li < double(count) && li == std::floor(li)))
+        return fail(LM_ERR_FORMAT, "scene %d: EXT_lights_image_based light %g out of range (%zu lights)", scene, li,
+                    count);
+    const tinygltf::Value &light = lights->Get(int(li));
+    std::string what = "EXT_lights_image_based light " + std::to_string(int(li));
+    if (!light.IsObject())
+        return fail(LM_ERR_FORMAT, "%s is not an object", what.c_str());
+    float intensity = 1.0f, rotation[4] = {0, 0, 0, 1};
+    std::vector<uint8_t> faces[6];
+    int n = 0;
+    lm_status st = ibl_params(light, what, &intensity, rotation);
+    if (st || (st = ibl_faces(light, what, faces, &n)))
+        return st;
+    const uint8_t *rgbd[6];
+    for (int f = 0; f < 6; f++)
+        rgbd[f] = faces[f].data();
+    lm_error e;
+    if (lm_sky_set_cube(s_.get(), rgbd, n, rotation, intensity, what.c_str(), &e) != LM_OK)
+        return fail(e.status, "%s", e.msg);
+    return LM_OK;
+}
+
 lm_status Loader::sky()
 {
     const tinygltf::Value &x = model_.extras;
+    int scene = 0;
+    const tinygltf::Value *ibl = ibl_reference(&scene);
     if (!x.IsObject() || !x.Has("lmgi") || !x.Get("lmgi").IsObject() || !x.Get("lmgi").Has("sky"))
-        return LM_OK;
+        return ibl ? ibl_sky(*ibl, scene) : LM_OK;
+    if (ibl) // lmgi's own word on its sky wins over another tool's
+        lm_warn("%s: scene %d's EXT_lights_image_based light ignored: extras.lmgi.sky gives the sky", path_, scene);
     const tinygltf::Value &v = x.Get("lmgi").Get("sky");
     if (v.IsArray()) {
         if (!radiance(v, s_->sky))
@@ -1485,8 +1627,10 @@ lm_status Loader::run(lm_scene **out)
     bytes = std::vector<unsigned char>(); // tinygltf has copied what it needs
     s_.reset(calloc_n<lm_scene>(1));
     snprintf(s_->path, sizeof s_->path, "%s", path_);
-    if ((st = materials()) || (st = nodes()) || (st = animations()) || (st = geometry()) || (st = finish()) ||
-        (st = sky()))
+    // the sky first: an EXT_lights_image_based cube's images still have their bytes (decode_used_images
+    // drops them)
+    if ((st = sky()) || (st = materials()) || (st = nodes()) || (st = animations()) || (st = geometry()) ||
+        (st = finish()))
         return st;
     *out = s_.release();
     return LM_OK;

@@ -193,8 +193,8 @@ typedef struct {
     int has_sky;
     lm_sky_kind sky_kind;
     float sky_horizon[3];  /* LM_SKY_GRADIENT: the radiance at and below the horizon */
-    int sky_width, sky_height; /* LM_SKY_IMAGE: an equirectangular image, row 0 at the zenith, column 0
-                                * towards -z, x increasing eastwards (+x at a quarter) */
+    int sky_width, sky_height; /* LM_SKY_IMAGE: an equirectangular image, row 0 at the zenith, the middle
+                                * column towards -z, +x three quarters across (sky.h) */
     float *sky_image;      /* sky_width x sky_height x 3 floats, times sky[] */
     float sky_image_mean[3]; /* its mean over the sphere (solid-angle weighted), made as it is loaded */
 

@@ -133,20 +133,14 @@ static lm_status read_hdr(const char *path, int *w, int *h, float **rgb, lm_erro
     return *rgb ? LM_OK : lm_fail(err, LM_ERR_FORMAT, "%s: corrupt HDR image: %s", path, stbi_failure_reason());
 }
 
-lm_status lm_sky_load_image(lm_scene *s, const char *path, const float scale[3], lm_error *err)
+/* rgb (w x h, malloc'd; taken whatever happens) as s's sky image, times scale, once every pixel and the
+ * scale are finite and >= 0; `what` names it in the errors. */
+static lm_status set_image(lm_scene *s, float *rgb, int w, int h, const float scale[3], const char *what,
+                           lm_error *err)
 {
-    for (int c = 0; c < 3; c++)
-        if (!(scale[c] >= 0.0f && scale[c] <= (float)LM_MAX_EMISSION))
-            return lm_fail(err, LM_ERR_INVALID, "%s: the sky image's scale %g must be a finite number >= 0", path,
-                           (double)scale[c]);
-    int w = 0, h = 0;
-    float *rgb = NULL;
-    lm_status st = read_hdr(path, &w, &h, &rgb, err);
-    if (st != LM_OK)
-        return st;
     if (w < 1 || h < 1 || (long long)w * h > LM_SKY_MAX_PIXELS) {
         free(rgb);
-        return lm_fail(err, LM_ERR_INVALID, "%s: a sky image of %d x %d pixels (1 to %d)", path, w, h,
+        return lm_fail(err, LM_ERR_INVALID, "%s: a sky image of %d x %d pixels (1 to %d)", what, w, h,
                        LM_SKY_MAX_PIXELS);
     }
     for (size_t i = 0; i < 3 * (size_t)w * (size_t)h; i++)
@@ -154,7 +148,7 @@ lm_status lm_sky_load_image(lm_scene *s, const char *path, const float scale[3],
             size_t p = i / 3;
             free(rgb);
             return lm_fail(err, LM_ERR_INVALID, "%s: pixel (%zu, %zu) of the sky image is negative or not finite",
-                           path, p % (size_t)w, p / (size_t)w);
+                           what, p % (size_t)w, p / (size_t)w);
         }
     free(s->sky_image);
     s->sky_image = rgb, s->sky_width = w, s->sky_height = h;
@@ -163,4 +157,111 @@ lm_status lm_sky_load_image(lm_scene *s, const char *path, const float scale[3],
     memcpy(s->sky, scale, sizeof s->sky);
     s->has_sky = 1;
     return LM_OK;
+}
+
+static lm_status check_scale(const float scale[3], const char *what, lm_error *err)
+{
+    for (int c = 0; c < 3; c++)
+        if (!(scale[c] >= 0.0f && scale[c] <= (float)LM_MAX_EMISSION))
+            return lm_fail(err, LM_ERR_INVALID, "%s: the sky image's scale %g must be a finite number >= 0", what,
+                           (double)scale[c]);
+    return LM_OK;
+}
+
+lm_status lm_sky_load_image(lm_scene *s, const char *path, const float scale[3], lm_error *err)
+{
+    lm_status st = check_scale(scale, path, err);
+    if (st != LM_OK)
+        return st;
+    int w = 0, h = 0;
+    float *rgb = NULL;
+    if ((st = read_hdr(path, &w, &h, &rgb, err)) != LM_OK)
+        return st;
+    return set_image(s, rgb, w, h, scale, path, err);
+}
+
+/* The cube's radiance towards cube-space direction c (not zero): the face of its largest coordinate, at
+ * the face's (s, t) as OpenGL's cube maps define them, that face's image upside down (the extension's
+ * flip: row 0 at t = 1), bilinear between texel centres and clamped at the face's edges. */
+static void cube_at(const float *const face[6], int n, const double c[3], float out[3])
+{
+    double ax = fabs(c[0]), ay = fabs(c[1]), az = fabs(c[2]), sc, tc, ma;
+    int f;
+    if (ax >= ay && ax >= az)
+        f = c[0] > 0.0 ? 0 : 1, ma = ax, sc = c[0] > 0.0 ? -c[2] : c[2], tc = -c[1];
+    else if (ay >= az)
+        f = c[1] > 0.0 ? 2 : 3, ma = ay, sc = c[0], tc = c[1] > 0.0 ? c[2] : -c[2];
+    else
+        f = c[2] > 0.0 ? 4 : 5, ma = az, sc = c[2] > 0.0 ? c[0] : -c[0], tc = -c[1];
+    double x = 0.5 * (sc / ma + 1.0) * n - 0.5, y = 0.5 * (1.0 - tc / ma) * n - 0.5;
+    x = fmin(fmax(x, 0.0), n - 1), y = fmin(fmax(y, 0.0), n - 1);
+    int x0 = (int)x, y0 = (int)y, x1 = x0 + 1 < n ? x0 + 1 : x0, y1 = y0 + 1 < n ? y0 + 1 : y0;
+    float fx = (float)(x - x0), fy = (float)(y - y0);
+    const float *p00 = face[f] + 3 * ((size_t)y0 * n + x0), *p10 = face[f] + 3 * ((size_t)y0 * n + x1);
+    const float *p01 = face[f] + 3 * ((size_t)y1 * n + x0), *p11 = face[f] + 3 * ((size_t)y1 * n + x1);
+    for (int k = 0; k < 3; k++)
+        out[k] = (1.0f - fy) * ((1.0f - fx) * p00[k] + fx * p10[k]) + fy * ((1.0f - fx) * p01[k] + fx * p11[k]);
+}
+
+/* The equirectangular image of the cube: each pixel the mean of k x k lookups across it (k > 1 where the
+ * image is coarser than the faces), a scene direction d turned into the cube's space as
+ * c = R(rotation)^T (-d.x, d.y, d.z) (the mirror: cube maps are left-handed, glTF is not). */
+static void cube_to_equirect(const float *const face[6], int n, const float rotation[4], int w, int h, int k,
+                             float *rgb)
+{
+    static const float zero[3] = {0, 0, 0}, one[3] = {1, 1, 1};
+    float r[16];
+    lm_mat4_from_trs(r, zero, rotation, one);
+#pragma omp parallel for schedule(dynamic)
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double sum[3] = {0, 0, 0};
+            for (int j = 0; j < k; j++)
+                for (int i = 0; i < k; i++) {
+                    /* the inverse of lm_sky_radiance's (u, v), mirrored in x */
+                    double phi = 2.0 * LM_PI * ((x + (i + 0.5) / k) / w - 0.5);
+                    double theta = LM_PI * (y + (j + 0.5) / k) / h;
+                    double p[3] = {-sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi)}, c[3];
+                    for (int a = 0; a < 3; a++)
+                        c[a] = r[4 * a] * p[0] + r[4 * a + 1] * p[1] + r[4 * a + 2] * p[2];
+                    float v[3];
+                    cube_at(face, n, c, v);
+                    for (int a = 0; a < 3; a++)
+                        sum[a] += v[a];
+                }
+            for (int a = 0; a < 3; a++)
+                rgb[3 * ((size_t)y * w + x) + a] = (float)(sum[a] / (k * k));
+        }
+}
+
+lm_status lm_sky_set_cube(lm_scene *s, const uint8_t *const rgbd[6], int n, const float rotation[4], float intensity,
+                          const char *what, lm_error *err)
+{
+    const float scale[3] = {intensity, intensity, intensity};
+    lm_status st = check_scale(scale, what, err);
+    if (st != LM_OK)
+        return st;
+    if (n < 1 || (long long)n * n > LM_SKY_MAX_PIXELS)
+        return lm_fail(err, LM_ERR_INVALID, "%s: cube faces of %d x %d pixels, more than the %d a sky image may "
+                       "have", what, n, n, LM_SKY_MAX_PIXELS);
+    int w = 4 * n < LM_SKY_CUBE_MIN_WIDTH ? LM_SKY_CUBE_MIN_WIDTH : 4 * n;
+    w = w > LM_SKY_CUBE_MAX_WIDTH ? LM_SKY_CUBE_MAX_WIDTH : w;
+    int h = w / 2, k = (4 * n + w - 1) / w; /* 4n across keeps the faces' detail at the horizon */
+    size_t texels = (size_t)n * (size_t)n;
+    float *linear = malloc(6 * 3 * sizeof(float) * texels), *rgb = malloc(3 * sizeof(float) * (size_t)w * h);
+    if (!linear || !rgb) {
+        free(linear);
+        free(rgb);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for a sky of six %d x %d faces", what, n, n);
+    }
+    const float *face[6];
+    for (int f = 0; f < 6; f++) { /* RGBD: an LDR face (alpha 255) reads as its colour to the power 2.2 */
+        float *out = linear + 3 * texels * (size_t)f;
+        for (size_t i = 0; i < texels; i++)
+            lm_decode_rgbd(rgbd[f] + 4 * i, 1.0f, out + 3 * i);
+        face[f] = out;
+    }
+    cube_to_equirect(face, n, rotation, w, h, k, rgb);
+    free(linear);
+    return set_image(s, rgb, w, h, scale, what, err);
 }

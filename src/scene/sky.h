@@ -4,8 +4,9 @@
  *   uniform   L(d) = sky
  *   gradient  L(d) = horizon + (sky - horizon) max(d.y, 0): the zenith's radiance overhead, the horizon's
  *             at and below the horizon (an overcast or clear sky over a ground the scene does not model)
- *   image     L(d) = sky x the equirectangular image at d (bilinear; row 0 at the zenith, column 0 towards
- *             -z, +x a quarter round): an HDR capture (.hdr, .exr)
+ *   image     L(d) = sky x the equirectangular image at d (bilinear; row 0 at the zenith, the middle column
+ *             towards -z, +x three quarters across, column 0 towards +z): an HDR capture (.hdr, .exr), or a
+ *             glTF's EXT_lights_image_based cube resampled (lm_sky_set_cube)
  *
  * d is a unit direction towards the sky (away from the scene), +y up. lm_sky_mean is L's mean over the
  * sphere (its power's share: flux = 4 pi x mean x pi R^2 through the scene's disk); for the image it is the
@@ -30,5 +31,17 @@ int lm_sky_is_uniform(const lm_scene *s);
  * LM_ERR_INVALID (a negative or non-finite pixel, too large, a bad scale), naming the file. */
 #define LM_SKY_MAX_PIXELS (1 << 24)
 lm_status lm_sky_load_image(lm_scene *s, const char *path, const float scale[3], lm_error *err);
+/* The sky image from a cube map (EXT_lights_image_based's mip 0), times intensity: six faces of n x n 8-bit
+ * RGBA (+X, -X, +Y, -Y, +Z, -Z), each RGBD (lm_decode_rgbd; an LDR face's alpha of 255 makes it its colour
+ * to the power 2.2), laid out as Babylon.js, the extension's reference, reads them: OpenGL's cube map
+ * faces stored upside down, a scene direction d seen in the cube at R(rotation)^T (-d.x, d.y, d.z),
+ * rotation a unit quaternion (x, y, z, w). Resampled into an equirectangular image of 4n x 2n (within
+ * LM_SKY_CUBE_MIN/MAX_WIDTH, k x k lookups a pixel where the faces are finer), the kind
+ * lm_sky_load_image reads. Errors name `what`: LM_ERR_INVALID (a bad size or intensity), LM_ERR_NOMEM; on
+ * failure nothing of s changes. */
+#define LM_SKY_CUBE_MIN_WIDTH 64
+#define LM_SKY_CUBE_MAX_WIDTH 2048
+lm_status lm_sky_set_cube(lm_scene *s, const uint8_t *const rgbd[6], int n, const float rotation[4], float intensity,
+                          const char *what, lm_error *err);
 
 #endif
