@@ -590,6 +590,50 @@ static void test_deterministic(void **state)
     ts_free(t);
 }
 
+/* Pages: each within the page side and a multiple of 4, the grid within LM_ATLAS_MAX_SIDE, every page
+ * used; each chart with its border (and gutters) inside its page; each texel on its chart's page; each
+ * corner's page UV its atlas UV moved into the page, in [0,1], and on one page the atlas UV to the bit. */
+static void check_pages(const lm_scene *s, const lm_atlas *a, int side)
+{
+    assert_true(a->page_count >= 1 && a->page_width <= side && a->page_height <= side);
+    assert_true(a->page_width % 4 == 0 && a->page_height % 4 == 0);
+    assert_true(a->width <= LM_ATLAS_MAX_SIDE && a->height <= LM_ATLAS_MAX_SIDE);
+    assert_int_equal(a->width, a->page_columns * a->page_width);
+    assert_int_equal(a->height, (a->page_count + a->page_columns - 1) / a->page_columns * a->page_height);
+    int *charts = calloc((size_t)a->page_count, sizeof *charts), g = a->gutter;
+    for (int c = 0; c < a->chart_count; c++) {
+        const lm_chart *r = &a->charts[c];
+        int x0, y0, x1, y1;
+        assert_int_equal(lm_atlas_page_of(a, r->x - r->pad, r->y - r->pad, &x0, &y0), r->page);
+        assert_int_equal(lm_atlas_page_of(a, r->x + r->w + r->pad - 1, r->y + r->h + r->pad - 1, &x1, &y1), r->page);
+        assert_true(x0 >= g && y0 >= g && x1 < a->page_width - g && y1 < a->page_height - g);
+        charts[r->page]++;
+    }
+    for (int p = 0; p < a->page_count; p++)
+        assert_true(charts[p] > 0);
+    free(charts);
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        assert_int_equal(lm_atlas_page_of(a, a->texels[i].x, a->texels[i].y, NULL, NULL),
+                         a->charts[a->tri_chart[a->texels[i].tri]].page);
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        int p = lm_atlas_tri_page(a, t), rect[4];
+        if (p < 0)
+            continue;
+        lm_atlas_page_rect(a, p, rect);
+        for (int k = 0; k < 3; k++) {
+            const float *uv = a->corner_uv + 6 * (size_t)t + 2 * k;
+            float in[2];
+            lm_atlas_page_uv(a, p, uv, in);
+            assert_true(in[0] >= 0.0f && in[0] <= 1.0f && in[1] >= 0.0f && in[1] <= 1.0f);
+            assert_float_equal(rect[0] + in[0] * rect[2], uv[0] * a->width, 1e-3);
+            assert_float_equal(rect[1] + in[1] * rect[3], uv[1] * a->height, 1e-3);
+            if (a->page_count == 1)
+                assert_memory_equal(in, uv, sizeof in);
+        }
+    }
+    assert_true(a->page_utilization > 0.0f && a->page_utilization <= 1.0f);
+}
+
 static void test_max_size_grows_texels(void **state)
 {
     (void)state;
@@ -607,10 +651,14 @@ static void test_max_size_grows_texels(void **state)
     lm_log_set_level(LM_LOG_ERROR);
     assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
     lm_log_set_level(LM_LOG_WARN);
+    /* max_size is a page's side: each 1000-texel face shrinks to one page (warned once), the six faces on
+     * six pages side by side */
     assert_int_equal(lm_log_warning_count(), 1);
-    assert_true(a.width <= 256 && a.height <= 256);
+    assert_true(a.page_width <= 256 && a.page_height <= 256);
+    assert_int_equal(a.page_count, 6);
     assert_true(a.texel_size > 0.001f);
     check_atlas(&t->s, &su, &a, 1e-4);
+    check_pages(&t->s, &a, 256);
     lm_atlas_free(&a);
     o.texel_size = NAN;
     assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_ERR_INVALID);
@@ -684,6 +732,90 @@ static void check_dilation(const lm_scene *s, const lm_atlas *a)
         }
     }
     free(data);
+}
+
+/* Boxes of 1 m, each its own node, at 0.1 m texels: six faces of 13 x 13 texels with their borders, two
+ * boxes to a page of 64 texels, so that 24 take 12 pages. Every node's charts share a page (a node smaller than a page is never split); the pages
+ * are used about as well as one atlas would be; lookups stay in their charts across the pages' edges; a
+ * level that fits one page has one page. */
+static void test_pages(void **state)
+{
+    (void)state;
+    enum { BOXES = 24 };
+    tscene *t = ts_new(BOXES);
+    for (int i = 0; i < BOXES; i++) {
+        float lo[3] = {2.0f * (i % 6), 0.0f, 2.0f * (i / 6)}, hi[3] = {lo[0] + 1.0f, 1.0f, lo[2] + 1.0f};
+        ts_box(t, i, MAT_DIFFUSE, lo, hi, -1, 2);
+    }
+    lm_surfaces su;
+    lm_atlas a;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    o.texel_size = 0.1f;
+    o.max_size = 64;
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    print_message("%d boxes at 0.1 texels, pages of 64: %d pages of %dx%d in a %dx%d atlas, %u texels, %.1f%% of "
+                  "the pages used\n", BOXES, a.page_count, a.page_width, a.page_height, a.width, a.height,
+                  a.texel_count, 100.0 * a.page_utilization);
+    assert_float_equal(a.texel_size, 0.1f, 1e-6f); /* pages, not a coarser texel */
+    assert_int_equal(a.page_count, 12);
+    check_atlas(&t->s, &su, &a, 1e-4);
+    check_pages(&t->s, &a, 64);
+    check_dilation(&t->s, &a);
+    for (int c = 1; c < a.chart_count; c++) {
+        int node = su.surfaces[a.charts[c].surface].node;
+        for (int d = 0; d < c; d++)
+            if (su.surfaces[a.charts[d].surface].node == node)
+                assert_int_equal(a.charts[d].page, a.charts[c].page);
+    }
+    assert_true(a.page_utilization > 0.5f);
+    lm_atlas_free(&a);
+    o.max_size = 8192; /* the same level on one page */
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    assert_int_equal(a.page_count, 1);
+    assert_int_equal(a.page_width, a.width);
+    assert_int_equal(a.page_height, a.height);
+    check_pages(&t->s, &a, 8192);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
+/* A node larger than a page is split by surface: a box of 5 m faces at 0.1 m texels, 52 texels a face
+ * with its border, takes one page of 64 for each face, each face whole on its page. A page side outside
+ * [4 (gutter + 1), 65536] is refused, naming max_size. */
+static void test_pages_split_a_large_node(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_box(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, (float[3]){5, 5, 5}, -1, 2);
+    lm_surfaces su;
+    lm_atlas a;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    o.texel_size = 0.1f;
+    o.max_size = 64;
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    assert_int_equal(su.surface_count, 6);
+    assert_int_equal(a.page_count, 6);
+    check_atlas(&t->s, &su, &a, 1e-4);
+    check_pages(&t->s, &a, 64);
+    for (int f = 0; f < su.surface_count; f++)
+        for (int c = a.surface_first_chart[f]; c < a.surface_first_chart[f] + a.surface_chart_count[f]; c++)
+            assert_int_equal(a.charts[c].page, a.charts[a.surface_first_chart[f]].page);
+    lm_atlas_free(&a);
+    static const int bad[] = {3, 65537};
+    for (int i = 0; i < 2; i++) {
+        o.max_size = bad[i];
+        assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_ERR_INVALID);
+        assert_non_null(strstr(err.msg, "max_size"));
+    }
+    lm_surfaces_free(&su);
+    ts_free(t);
 }
 
 /* ---------- shared scenes ---------- */
@@ -766,6 +898,8 @@ int main(void)
         cmocka_unit_test(test_bumpy_cornell),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_max_size_grows_texels),
+        cmocka_unit_test(test_pages),
+        cmocka_unit_test(test_pages_split_a_large_node),
         cmocka_unit_test(test_default_texel_size),
         cmocka_unit_test(test_cornell_box),
         cmocka_unit_test(test_room),

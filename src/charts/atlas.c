@@ -253,7 +253,7 @@ static lm_status lay_out(const lm_scene *s, const lm_surfaces *su, const lmc_cha
     lm_status st = collapse_small(all, su, ts, o->wall_texels, &c, err);
     if (st != LM_OK)
         return st;
-    st = lmc_pack(&c, ts, o->gutter, o->max_size, out, err);
+    st = lmc_pack(&c, su, ts, o->gutter, o->max_size, out, err);
     if (st == LM_OK)
         st = plan_memory(out, err);
     if (st == LM_OK)
@@ -336,8 +336,9 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     out->time_unwrap = t1 - t0;
     out->time_pack = t2 - t1;
     out->time_texels = lm_now() - t2;
-    lm_debug("charts: %d charts, atlas %dx%d, %u texels (%.1f%%); unwrap %.3f s, pack %.3f s, texels %.3f s",
-             out->chart_count, out->width, out->height, out->texel_count, 100.0 * out->utilization,
+    lm_debug("charts: %d charts, atlas %dx%d (%d pages of %dx%d), %u texels (%.1f%% of the pages); unwrap %.3f s, "
+             "pack %.3f s, texels %.3f s", out->chart_count, out->width, out->height, out->page_count, out->page_width,
+             out->page_height, out->texel_count, 100.0 * out->page_utilization,
              out->time_unwrap, out->time_pack, out->time_texels);
     return LM_OK;
 }

@@ -3,6 +3,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Whether two atlas texels lie on the same page (always, on an atlas of one page). */
+static int same_page(const lm_atlas *a, int x0, int y0, int x1, int y1)
+{
+    return a->page_count <= 1 || (x0 / a->page_width == x1 / a->page_width && y0 / a->page_height == y1 / a->page_height);
+}
+
 void lm_atlas_dilate_window(const lm_atlas *a, float *data, int channels, int passes, const int win[4])
 {
     int wx = win[0], wy = win[1], w = win[2], h = win[3];
@@ -35,6 +41,8 @@ void lm_atlas_dilate_window(const lm_atlas *a, float *data, int channels, int pa
                             continue;
                         /* inside a chart's rect only from the same chart: rects touch (no gutter) */
                         if (a->chart_owner && a->chart_owner[ai] >= 0 && a->chart_owner[aj] != a->chart_owner[ai])
+                            continue;
+                        if (!same_page(a, wx + x, wy + y, wx + xx, wy + yy)) /* a page is an engine's texture */
                             continue;
                         for (int c = 0; c < channels && c < 4; c++)
                             sum[c] += data[j * channels + c];

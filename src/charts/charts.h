@@ -7,7 +7,13 @@
  *
  * Each surface is unwrapped into one or more charts (planar projection, split where the projection
  * would fold or overlap); charts are packed into one atlas. The texel table lists every
- * covered texel with its world position, normal, surface, triangle and world-space area. */
+ * covered texel with its world position, normal, surface, triangle and world-space area.
+ *
+ * Pages: a level whose charts do not fit one max_size x max_size atlas at its texel size gets several
+ * pages of at most that side. Engines see the pages; inside, the pages lie side by side in a grid in the
+ * one atlas every pass samples (width x height, at most LM_ATLAS_MAX_SIDE a side), so texel (x, y),
+ * corner_uv and every atlas-sized array keep their meaning. No chart straddles a page. A level that fits
+ * one page is that page: page_count 1, the page the whole atlas. */
 #ifndef LM_CHARTS_H
 #define LM_CHARTS_H
 
@@ -64,7 +70,9 @@ typedef struct {
     int gutter;            /* empty texels between two charts (default 0: corner_uv keeps bilinear lookups
                             * inside each chart; more for engines that mipmap the lightmap) */
     int use_file_uv1;      /* take charts from the file's TEXCOORD_1 instead of unwrapping */
-    int max_size;          /* largest atlas side allowed (default 8192); texel_size grows to fit */
+    int max_size;          /* largest side of one page (default 8192): charts that do not fit one page fill
+                            * several (lm_atlas.page_count); texel_size grows only where a chart is larger
+                            * than a page or the pages would pass LM_ATLAS_MAX_SIDE */
     int wall_texels;       /* each surface of at least LM_WALL_AREA gets about this many texels at least: its
                             * charts a finer texel size than the atlas's where needed, those texels on top
                             * of target_texels (default 0: off) */
@@ -73,11 +81,16 @@ typedef struct {
 /* A wall's or floor's area in world units: 2 m^2 in glTF's metres (a door's area). */
 #define LM_WALL_AREA 2.0f
 
+/* The largest side of the atlas holding several pages: OpenGL 4.5's guaranteed GL_MAX_TEXTURE_SIZE, so
+ * every pass can sample it as one texture. */
+#define LM_ATLAS_MAX_SIDE 16384
+
 typedef struct {
     int surface;
     int x, y, w, h;        /* rectangle in the atlas, texels, gutters excluded */
     int pad;               /* texels of border of its own around it (0 or 1): what its lookups reach beyond
                             * the rect (corner_uv) */
+    int page;              /* the page holding it (0 for a level of one page) */
     uint32_t tri_count;
     uint32_t *tris;
 } lm_chart;
@@ -114,6 +127,9 @@ typedef struct {
     lm_texel *texels;
     int *texel_index;      /* width*height: index into texels, -1 where uncovered */
     float utilization;     /* covered texels / (width*height) */
+    int page_width, page_height; /* one page's size (the atlas's own for one page) */
+    int page_count, page_columns; /* pages; page p lies at column p % page_columns, row p / page_columns */
+    float page_utilization; /* covered texels / the pages' texels (the grid's empty places not counted) */
     int surface_count;
     int *surface_first_chart, *surface_chart_count; /* per surface: its charts (charts are ordered by surface) */
     double time_unwrap, time_pack, time_texels; /* seconds spent in each stage of lm_atlas_build */
@@ -138,5 +154,16 @@ void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3]);
  * its own texels: its texel centres' span, or half a texel into its border (lm_chart.pad). What a
  * footprint spread around such a lookup is clamped to, charts touching. */
 void lm_chart_lookup_rect(const lm_atlas *a, int c, float rect[4]);
+
+/* Pages (src/charts/page_map.c). The atlas rectangle {x, y, w, h} of page p (0 <= p < page_count). */
+void lm_atlas_page_rect(const lm_atlas *a, int p, int rect[4]);
+/* The page holding atlas texel (x, y), inside the atlas, and its place in that page (*px, *py; either may
+ * be NULL). A texel of the grid's empty places beyond the last page gives page_count. */
+int lm_atlas_page_of(const lm_atlas *a, int x, int y, int *px, int *py);
+/* An atlas UV (corner_uv's, [0,1] over the atlas) of a point on page p as a UV over that page alone
+ * ([0,1] over the page). Computed in double: for one page, uv itself, bit for bit. */
+void lm_atlas_page_uv(const lm_atlas *a, int p, const float uv[2], float out[2]);
+/* The page of triangle t's texels; -1 for a triangle without (mirror, glass, degenerate). */
+int lm_atlas_tri_page(const lm_atlas *a, uint32_t t);
 
 #endif

@@ -56,10 +56,26 @@ lm_status lmc_charts_from_uv1(const lm_scene *s, const lm_surfaces *su, const fl
                               lm_error *err);
 void lmc_charts_free(lmc_charts *c);
 
-/* Packs the charts at texel_size into out->width/height and out->charts (rects); grows the texel size
- * (with a warning) while the atlas would exceed max_size. Sets out->texel_size. */
-lm_status lmc_pack(const lmc_charts *c, float texel_size, int gutter, int max_size, lm_atlas *out,
-                   lm_error *err);
+/* Packs the charts at texel_size into out->width/height and out->charts (rects): into one atlas of at
+ * most max_size a side where they fit one, else onto pages of that side (lmc_pack_pages); grows the
+ * texel size (with a warning) only where a chart is larger than a page or the pages would pass
+ * LM_ATLAS_MAX_SIDE. Sets out->texel_size and the page geometry. */
+lm_status lmc_pack(const lmc_charts *c, const lm_surfaces *su, float texel_size, int gutter, int max_size,
+                   lm_atlas *out, lm_error *err);
+
+/* A chart's rect with its border (lm_chart.pad) as the packers place it, and the chart's index. */
+typedef struct {
+    int w, h, id;
+} lmc_rect;
+
+/* Shelf-packs the rects k (c->count of them, tallest first) onto pages of side x side with gutter empty
+ * texels around each, every rect at most side - 2 gutter a side: a node's charts on one page where they
+ * fit one, a larger node split by surface, a surface larger than a page by chart; units of charts placed
+ * first fit, tallest first, on the first page they fit. The pages go into a grid in out (rects, page of
+ * each chart, width, height, page geometry). *grow: 0 when the grid fits LM_ATLAS_MAX_SIDE a side, else
+ * the factor (> 1) by which the texel size must at least grow, out left unset. */
+lm_status lmc_pack_pages(const lmc_charts *c, const lm_surfaces *su, const lmc_rect *k, int side, int gutter,
+                         lm_atlas *out, double *grow, lm_error *err);
 
 /* Charts at least this many texels wide keep a border of their own rather than get a texel more
  * (lmc_pack). The texel more puts a chart's edge texels nearer its edge, where the AIM's estimate is

@@ -244,6 +244,7 @@ static lm_status assemble(lm_atlas *a, lm_texel **per, const uint32_t *count, lm
     for (uint32_t i = 0; i < a->texel_count; i++)
         a->texel_index[(size_t)a->texels[i].y * a->width + a->texels[i].x] = (int)i;
     a->utilization = (float)((double)a->texel_count / ((double)a->width * a->height));
+    a->page_utilization = (float)((double)a->texel_count / ((double)a->page_count * a->page_width * a->page_height));
     return LM_OK;
 }
 
