@@ -61,7 +61,10 @@ typedef struct {
                              * are resolved, else the load fails naming it (LMGI_ERR_IO); 0 (the default):
                              * such files are read, each with a warning that it lies outside */
     float surface_cone_deg; /* max normal deviation within one surface, degrees (default 30) */
-    int max_atlas_size;     /* largest atlas side; texel size grows to fit (default 8192) */
+    int max_atlas_size;     /* the largest side of one lightmap page, 64 to 32768 (default 8192): a level
+                             * whose charts do not fit one page gets several (lmgi_info.pages; docs/levels.md,
+                             * "Pages"); the texel size grows only where one chart is larger than a page or
+                             * the pages would pass 16384 x 16384 together */
     int wall_texels;        /* with a derived texel size: each surface of at least 2 m^2 (a wall, a floor)
                              * gets at least about this many texels, at a finer texel size than the rest
                              * where needed, on top of target_texels; 0, the default: one texel size for
@@ -86,9 +89,12 @@ typedef struct {
     int lights_by_type[3];      /* point, spot, directional */
     int surfaces, charts;
     uint32_t degenerate_triangles, nonmanifold_edges;
-    int atlas_width, atlas_height;
+    int atlas_width, atlas_height; /* the atlas: its pages side by side (one page: the page itself), what
+                                    * lmgi_get_lightmap, texel x, y and lmgi_triangle_lightmap_uv are in */
+    int pages;                  /* lightmap pages (1 unless the level does not fit max_atlas_size) */
+    int page_width, page_height; /* each page's size (all the same) */
     uint32_t texels;
-    float texel_size, utilization;
+    float texel_size, utilization; /* utilization: covered texels / the pages' texels */
     float bounds_min[3], bounds_max[3];
     lmgi_timings timings;
 } lmgi_info;
@@ -116,6 +122,8 @@ typedef struct {
     int surface;
     uint32_t triangle;
     float area;         /* world-space area the texel covers */
+    int page;           /* its lightmap page, and its coordinates there */
+    int page_x, page_y;
 } lmgi_texel;
 
 /* The defaults (NULL o: nothing). */
@@ -348,6 +356,14 @@ LMGI_API void lmgi_get_texel(const lmgi_scene *scene, uint32_t i, lmgi_texel *ou
 /* The lightmap UVs of a triangle's three corners (6 floats in [0,1]); returns 0 if it has none (or
  * scene or uv is NULL). */
 LMGI_API int lmgi_triangle_lightmap_uv(const lmgi_scene *scene, uint32_t triangle, float uv[6]);
+/* Pages (docs/api.md, "Lightmap pages"): a level too large for one max_atlas_size page has several, each
+ * an engine's lightmap texture; inside lmgi they lie side by side in the atlas. The triangle's page and
+ * its corners' UVs over that page alone (6 floats in [0,1]); returns -1 (uv untouched) where it has none,
+ * or scene or uv is NULL. With one page, page 0 and lmgi_triangle_lightmap_uv's UVs, bit for bit. */
+LMGI_API int lmgi_triangle_lightmap_page(const lmgi_scene *scene, uint32_t triangle, float uv[6]);
+/* The atlas rectangle {x, y, width, height} of page `page`; returns 0 (rect zeroed) for NULL or a page
+ * out of range. */
+LMGI_API int lmgi_page_rect(const lmgi_scene *scene, int page, int rect[4]);
 
 /* Writes DIR/atlas.png (each chart its own colour, free space black) and DIR/surfaces.png (the scene from
  * its camera, or an automatic one, each surface in a flat colour) at width x height (0 = 1024x768).
@@ -695,7 +711,10 @@ LMGI_API lmgi_status lmgi_get_lightmap(lmgi_updater *u, lmgi_lightmap kind, floa
  * baked pose; animations are not written); each node with lightmap texels names the lightmap in its
  * extras ({"lightmap": {"uri": "NAME_lightmap.exr", "texCoord": 1}}, beside {"lmgi": {...}}, its
  * settings), and the document's extras say what the lightmap holds. The copy loads back into lmgi with
- * lmgi_options.use_file_uv1 (`--use-uv1`) and lights the same. */
+ * lmgi_options.use_file_uv1 (`--use-uv1`) and lights the same. A level of several pages (lmgi_info.pages)
+ * gets those three images for each page P, NAME_lightmap_pageP.exr, .png and _rgbd.png; TEXCOORD_1 over
+ * the triangle's page; a primitive per node, material and page; and a material on several pages written
+ * once per page, each copy's LMGI_lightmap naming its page's image. */
 typedef struct {
     const char *name;   /* the files' base name (NULL: "scene"): letters, digits, - _ . */
     int half;           /* the EXR in 16-bit half floats */
@@ -714,6 +733,10 @@ LMGI_API int lmgi_surface_count(const lmgi_scene *scene); /* 0 for NULL */
 /* The atlas rectangle holding a surface's texels: rect = {x, y, width, height}; returns 0 (rect zeroed)
  * for NULL or an id out of range. A surface's charts may share the rectangle with other surfaces. */
 LMGI_API int lmgi_surface_rect(const lmgi_scene *scene, int surface, int rect[4]);
+/* The page holding a surface's texels: its node's page where the node's charts fit one page (nearly
+ * always), else the surface's own. -1 for NULL, an id out of range, a surface without texels, and a
+ * surface larger than a page, whose charts lie on several (lmgi_triangle_lightmap_page then says which). */
+LMGI_API int lmgi_surface_page(const lmgi_scene *scene, int surface);
 /* How many updates changed what surface's lightmap shows (1 after the updater's first gather): upload a
  * surface's rectangle again only when this moved. 0 for NULL or an id out of range. */
 LMGI_API uint32_t lmgi_surface_version(const lmgi_updater *u, int surface);
@@ -729,6 +752,12 @@ LMGI_API int lmgi_surface_lightmap_rect(const lmgi_scene *scene, int surface, in
  * kind: LMGI_ERR_INVALID; a value that is not finite: LMGI_ERR_BACKEND. docs/api.md, "Lightmaps to an
  * engine", has the upload loop and its cost against the whole read. Thread-safety: as the updater's. */
 LMGI_API lmgi_status lmgi_get_lightmap_rect(lmgi_updater *u, lmgi_lightmap kind, const int rect[4], float *rgba,
+                                            size_t floats, lmgi_error *err);
+/* One page of the lightmap: lmgi_get_lightmap_rect over lmgi_page_rect(page), so its values are the whole
+ * read's in that rectangle, bit for bit; rgba holds page_width x page_height RGBA floats, row 0 at v = 0
+ * of the page's UVs (lmgi_triangle_lightmap_page). A page out of range: LMGI_ERR_INVALID naming it; the
+ * rest as lmgi_get_lightmap_rect. */
+LMGI_API lmgi_status lmgi_get_lightmap_page(lmgi_updater *u, lmgi_lightmap kind, int page, float *rgba,
                                             size_t floats, lmgi_error *err);
 /* The displayed IIM lightmap as an OpenGL texture (docs/api.md, "The lightmap as a GL texture"): a
  * GL_TEXTURE_2D name of lmgi's context, atlas-sized, GL_RGBA32F, one level, bilinear, clamped to the edge,

@@ -7,7 +7,9 @@
  * need their UVs to agree), one primitive per material. Twins of double-sided surfaces are written as
  * the single-sided triangles they are in lmgi, each with its own lightmap texels, so their material is
  * single-sided in the copy. A mirrored node's triangles get the file's winding back: glTF readers reverse
- * it again for the negative determinant, as lmgi's loader did. */
+ * it again for the negative determinant, as lmgi's loader did. A level of several lightmap pages gets an
+ * image per page, a primitive per node, material and page, and a copy of a material for each further
+ * page it lies on (export_pages.h). */
 #include <lmgi.h>
 
 #include <limits.h>
@@ -18,6 +20,7 @@
 
 #include "../core/image.h"
 #include "../core/vecmath.h"
+#include "export_pages.h"
 #include "gltf_write.h"
 #include "lmgi_context.h"
 #include "lmgi_scene.h"
@@ -28,9 +31,10 @@ typedef struct {
     const lm_atlas *atlas;
     const char *name;
     lm_gltf_doc doc;
+    const lm_export_pages *ep; /* which page each primitive and material samples */
     const float *lightmap;  /* the displayed IIM, atlas-sized RGBA */
     float rgbd_scale;       /* the RGBD image's values times this are E */
-    int lightmap_texture;   /* its glTF texture, -1 when no triangle has texels */
+    int lightmap_texture;   /* its glTF texture (page p's: + p), -1 when no triangle has texels */
     const uint8_t *material_lit; /* per material: 1 if any of its triangles has texels (mirrors, glass: 0) */
 } writer;
 
@@ -38,14 +42,20 @@ typedef struct {
  * (TEXCOORD_1 now holds the lightmap's). */
 static int texture_uv(const lm_material *m) { return m->base_color_uv == 1 ? 2 : 0; }
 
-/* The vertices of node nd's triangles of `material`, three per triangle, written as one primitive (the
- * node's first when `first`). */
-static lm_status write_primitive(writer *w, const lm_node *nd, int material, int first, lm_error *err)
+/* Whether triangle t is of `material` and exported on `page`. */
+static int in_primitive(const writer *w, uint32_t t, int material, int page)
+{
+    return w->s->tri_material[t] == material && lm_export_tri_page(w->ep, w->s, w->atlas, t) == page;
+}
+
+/* The vertices of node nd's triangles of `material` on `page`, three per triangle, TEXCOORD_1 over the
+ * page, written as one primitive (the node's first when `first`). */
+static lm_status write_primitive(writer *w, const lm_node *nd, int material, int page, int first, lm_error *err)
 {
     const lm_scene *s = w->s;
     uint32_t n = 0;
     for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
-        n += s->tri_material[t] == material;
+        n += in_primitive(w, t, material, page);
     float *pos = malloc((size_t)n * 3 * 3 * sizeof(float)), *nrm = malloc((size_t)n * 3 * 3 * sizeof(float));
     float *uv0 = malloc((size_t)n * 3 * 2 * sizeof(float)), *uvl = malloc((size_t)n * 3 * 2 * sizeof(float));
     int file_uv1 = texture_uv(&s->materials[material]) == 2;
@@ -59,7 +69,7 @@ static lm_status write_primitive(writer *w, const lm_node *nd, int material, int
     const int *order = nd->mirrored ? file_order : same;
     uint32_t v = 0;
     for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++) {
-        if (s->tri_material[t] != material)
+        if (!in_primitive(w, t, material, page))
             continue;
         for (int c = 0; c < 3; c++, v++) {
             int k = order[c];
@@ -70,8 +80,9 @@ static lm_status write_primitive(writer *w, const lm_node *nd, int material, int
             if (uvf)
                 memcpy(uvf + 2 * v, s->uv1 + 2 * (size_t)sv, 2 * sizeof(float));
             const float *l = w->atlas->corner_uv + 6 * (size_t)t + 2 * k; /* NaN: no surface (mirror, glass) */
-            uvl[2 * v] = isfinite(l[0]) ? l[0] : 0.0f;
-            uvl[2 * v + 1] = isfinite(l[1]) ? l[1] : 0.0f;
+            uvl[2 * v] = uvl[2 * v + 1] = 0.0f;
+            if (isfinite(l[0]) && isfinite(l[1]))
+                lm_atlas_page_uv(w->atlas, page, l, uvl + 2 * v);
             idx[v] = v;
         }
     }
@@ -85,12 +96,37 @@ static lm_status write_primitive(writer *w, const lm_node *nd, int material, int
             first ? "" : ",", a_pos, a_nrm, a_uv0, a_uvl);
     if (a_uvf >= 0)
         fprintf(w->doc.json, ",\"TEXCOORD_2\":%d", a_uvf);
-    fprintf(w->doc.json, "},\"indices\":%d,\"material\":%d}", a_idx, material);
+    fprintf(w->doc.json, "},\"indices\":%d,\"material\":%d}", a_idx, w->ep->index[(size_t)material * w->ep->pages + page]);
     free(pos), free(nrm), free(uv0), free(uvl), free(uvf), free(idx);
     return LM_OK;
 }
 
-/* Meshes: one per node with triangles (mesh_of[node], else -1), a primitive per material it uses. */
+static int int_order(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+/* The node's primitives, by material then page, each (material, page) it uses once. */
+static lm_status write_primitives(writer *w, const lm_node *nd, lm_error *err)
+{
+    int pages = w->ep->pages, *key = malloc(((size_t)nd->tri_count + 1) * sizeof *key);
+    if (!key)
+        return lm_fail(err, LM_ERR_NOMEM, "export: no memory for node '%s'", nd->name);
+    for (uint32_t i = 0; i < nd->tri_count; i++) {
+        uint32_t t = nd->first_tri + i;
+        key[i] = w->s->tri_material[t] * pages + lm_export_tri_page(w->ep, w->s, w->atlas, t);
+    }
+    qsort(key, nd->tri_count, sizeof *key, int_order);
+    lm_status st = LM_OK;
+    for (uint32_t i = 0; i < nd->tri_count && st == LM_OK; i++)
+        if (!i || key[i] != key[i - 1])
+            st = write_primitive(w, nd, key[i] / pages, key[i] % pages, !i, err);
+    free(key);
+    return st;
+}
+
+/* Meshes: one per node with triangles (mesh_of[node], else -1), a primitive per material and page. */
 static lm_status write_meshes(writer *w, int *mesh_of, lm_error *err)
 {
     const lm_scene *s = w->s;
@@ -106,26 +142,42 @@ static lm_status write_meshes(writer *w, int *mesh_of, lm_error *err)
         fprintf(w->doc.json, "%s{\"name\":", mesh_of[i] ? "," : "");
         lm_gltf_string(w->doc.json, nd->name);
         fprintf(w->doc.json, ",\"primitives\":[");
-        int written = 0;
-        for (int m = 0; m < s->material_count && st == LM_OK; m++)
-            for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
-                if (s->tri_material[t] == m) {
-                    st = write_primitive(w, nd, m, !written++, err);
-                    break;
-                }
+        st = write_primitives(w, nd, err);
         fprintf(w->doc.json, "]}");
     }
     fputc(']', w->doc.json);
     return st;
 }
 
-/* Whether any of the node's triangles has lightmap texels (mirror and glass have none). */
-static int has_lightmap(const lm_atlas *a, const lm_node *nd)
+/* The node's lightmap in its extras, where any of its triangles has texels (mirror and glass have none):
+ * the file, and with several pages its first page and, where it lies on more, all of them. */
+static void write_node_lightmap(const writer *w, const lm_node *nd)
 {
-    for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++)
-        if (a->tri_chart[t] >= 0)
-            return 1;
-    return 0;
+    int first = -1, last = -1;
+    for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++) {
+        int p = lm_atlas_tri_page(w->atlas, t);
+        first = p >= 0 && (first < 0 || p < first) ? p : first;
+        last = p > last ? p : last;
+    }
+    if (first < 0)
+        return;
+    char file[260];
+    lm_export_lightmap_file(file, sizeof file, w->name, w->ep, first, ".exr");
+    fprintf(w->doc.json, ",\"lightmap\":{\"uri\":\"%s\"", file);
+    if (w->ep->pages > 1)
+        fprintf(w->doc.json, ",\"page\":%d", first);
+    if (last > first) { /* a node larger than a page: every page it lies on */
+        fprintf(w->doc.json, ",\"pages\":[%d", first);
+        for (int p = first + 1; p <= last; p++) {
+            uint32_t t = nd->first_tri;
+            while (t < nd->first_tri + nd->tri_count && lm_atlas_tri_page(w->atlas, t) != p)
+                t++;
+            if (t < nd->first_tri + nd->tri_count)
+                fprintf(w->doc.json, ",%d", p);
+        }
+        fputc(']', w->doc.json);
+    }
+    fprintf(w->doc.json, ",\"texCoord\":1}");
 }
 
 /* A node for each light added by an edit, at its position with its local -z along its direction. */
@@ -187,8 +239,7 @@ static void write_nodes(writer *w, const int *mesh_of)
                 fprintf(w->doc.json, "%s%.9g", k ? "," : "", (double)(ns->reflection_box[k] + s->origin[k % 3]));
             fputc(']', w->doc.json);
         }
-        if (has_lightmap(w->atlas, nd))
-            fprintf(w->doc.json, ",\"lightmap\":{\"uri\":\"%s_lightmap.exr\",\"texCoord\":1}", w->name);
+        write_node_lightmap(w, nd);
         fprintf(w->doc.json, "}}");
     }
     write_added_lights(w);
@@ -196,8 +247,8 @@ static void write_nodes(writer *w, const int *mesh_of)
 }
 
 /* Textures: each of the scene's decoded images as NAME_texN.png (8-bit sRGB) with the default sampler, then
- * the lightmap's RGBD image with its own: bilinear without mipmaps (a mip would blend charts with their
- * neighbours), clamped at the atlas's edges. */
+ * the lightmap's RGBD image (one a page) with its own: bilinear without mipmaps (a mip would blend charts
+ * with their neighbours), clamped at the atlas's edges. */
 static lm_status write_textures(writer *w, const char *dir, lm_error *err)
 {
     const lm_scene *s = w->s;
@@ -226,13 +277,17 @@ static lm_status write_textures(writer *w, const char *dir, lm_error *err)
         }
         free(px);
     }
-    if (w->lightmap_texture >= 0)
-        fprintf(w->doc.json, "%s{\"uri\":\"%s_lightmap_rgbd.png\"}", s->texture_count ? "," : "", w->name);
+    for (int p = 0; w->lightmap_texture >= 0 && p < w->ep->pages; p++) {
+        char file[260];
+        lm_export_lightmap_file(file, sizeof file, w->name, w->ep, p, "_rgbd.png");
+        fprintf(w->doc.json, "%s{\"uri\":\"%s\"}", s->texture_count || p ? "," : "", file);
+    }
     fprintf(w->doc.json, "],\"textures\":[");
     for (int i = 0; i < s->texture_count; i++)
         fprintf(w->doc.json, "%s{\"source\":%d,\"sampler\":0}", i ? "," : "", i);
-    if (w->lightmap_texture >= 0)
-        fprintf(w->doc.json, "%s{\"source\":%d,\"sampler\":1}", s->texture_count ? "," : "", w->lightmap_texture);
+    for (int p = 0; w->lightmap_texture >= 0 && p < w->ep->pages; p++)
+        fprintf(w->doc.json, "%s{\"source\":%d,\"sampler\":1}", s->texture_count || p ? "," : "",
+                w->lightmap_texture + p);
     fputc(']', w->doc.json);
     return st;
 }
@@ -248,40 +303,47 @@ static void write_texture_ref(FILE *f, const lm_material *m, int texture)
     fputc('}', f);
 }
 
+/* Material i as it samples the lightmap's page `page` (the comma before it unless `first`). */
+static void write_material(writer *w, int i, int page, int first)
+{
+    const lm_material *m = &w->s->materials[i];
+    fprintf(w->doc.json, "%s{\"name\":", first ? "" : ",");
+    lm_gltf_string(w->doc.json, m->name);
+    fprintf(w->doc.json, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
+    lm_gltf_floats(w->doc.json, m->base_color, 4);
+    fprintf(w->doc.json, ",\"metallicFactor\":%.9g,\"roughnessFactor\":%.9g", (double)m->metallic, (double)m->roughness);
+    if (m->base_color_tex >= 0) {
+        fprintf(w->doc.json, ",\"baseColorTexture\":");
+        write_texture_ref(w->doc.json, m, m->base_color_tex);
+    }
+    fputc('}', w->doc.json);
+    float strength = lm_gltf_emissive(w->doc.json, m->emissive);
+    if (m->emissive_tex >= 0) {
+        fprintf(w->doc.json, ",\"emissiveTexture\":");
+        write_texture_ref(w->doc.json, m, m->emissive_tex);
+    }
+    /* split sides are two single-sided triangles here, each with its own lightmap texels */
+    fprintf(w->doc.json, ",\"doubleSided\":%s,\"extensions\":{\"KHR_materials_ior\":{\"ior\":%.9g}",
+            m->double_sided ? "true" : "false", (double)m->ior);
+    if (strength > 0.0f)
+        fprintf(w->doc.json, ",\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}", (double)strength);
+    if (m->transmission > 0.0f)
+        fprintf(w->doc.json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
+    if (w->lightmap_texture >= 0 && w->material_lit[i]) /* docs/api.md, "The lightmap in engines" */
+        fprintf(w->doc.json, ",\"LMGI_lightmap\":{\"lightmapTexture\":{\"index\":%d,\"texCoord\":1},"
+                "\"encoding\":\"RGBD\",\"gamma\":%.9g,\"scale\":%.9g}", w->lightmap_texture + page,
+                (double)LM_RGBD_GAMMA, (double)w->rgbd_scale);
+    fprintf(w->doc.json, "}}");
+}
+
+/* The scene's materials, each on its first page, then the copies for the further pages (export_pages.h). */
 static void write_materials(writer *w)
 {
-    const lm_scene *s = w->s;
     fprintf(w->doc.json, ",\"materials\":[");
-    for (int i = 0; i < s->material_count; i++) {
-        const lm_material *m = &s->materials[i];
-        fprintf(w->doc.json, "%s{\"name\":", i ? "," : "");
-        lm_gltf_string(w->doc.json, m->name);
-        fprintf(w->doc.json, ",\"pbrMetallicRoughness\":{\"baseColorFactor\":");
-        lm_gltf_floats(w->doc.json, m->base_color, 4);
-        fprintf(w->doc.json, ",\"metallicFactor\":%.9g,\"roughnessFactor\":%.9g", (double)m->metallic, (double)m->roughness);
-        if (m->base_color_tex >= 0) {
-            fprintf(w->doc.json, ",\"baseColorTexture\":");
-            write_texture_ref(w->doc.json, m, m->base_color_tex);
-        }
-        fputc('}', w->doc.json);
-        float strength = lm_gltf_emissive(w->doc.json, m->emissive);
-        if (m->emissive_tex >= 0) {
-            fprintf(w->doc.json, ",\"emissiveTexture\":");
-            write_texture_ref(w->doc.json, m, m->emissive_tex);
-        }
-        /* split sides are two single-sided triangles here, each with its own lightmap texels */
-        fprintf(w->doc.json, ",\"doubleSided\":%s,\"extensions\":{\"KHR_materials_ior\":{\"ior\":%.9g}",
-                m->double_sided ? "true" : "false", (double)m->ior);
-        if (strength > 0.0f)
-            fprintf(w->doc.json, ",\"KHR_materials_emissive_strength\":{\"emissiveStrength\":%.9g}", (double)strength);
-        if (m->transmission > 0.0f)
-            fprintf(w->doc.json, ",\"KHR_materials_transmission\":{\"transmissionFactor\":%.9g}", (double)m->transmission);
-        if (w->lightmap_texture >= 0 && w->material_lit[i]) /* docs/api.md, "The lightmap in engines" */
-            fprintf(w->doc.json, ",\"LMGI_lightmap\":{\"lightmapTexture\":{\"index\":%d,\"texCoord\":1},"
-                    "\"encoding\":\"RGBD\",\"gamma\":%.9g,\"scale\":%.9g}", w->lightmap_texture,
-                    (double)LM_RGBD_GAMMA, (double)w->rgbd_scale);
-        fprintf(w->doc.json, "}}");
-    }
+    for (int i = 0; i < w->s->material_count; i++)
+        write_material(w, i, w->ep->first_page[i], !i);
+    for (int c = 0; c < w->ep->copies; c++)
+        write_material(w, w->ep->copy[2 * c], w->ep->copy[2 * c + 1], 0);
     fputc(']', w->doc.json);
 }
 
@@ -351,28 +413,52 @@ static float rgbd_scale(const float *rgba, size_t pixels)
     return scale > 0.0f ? scale : 1.0f;
 }
 
-/* The lightmap: the displayed IIM (irradiance, alpha = valid) as EXR, a tone-mapped PNG preview, and the
- * RGBD PNG the glTF's materials sample. */
-static lmgi_status write_lightmap(const writer *w, const char *dir, int half, lmgi_error *err)
+/* One page of the lightmap: the displayed IIM (irradiance, alpha = valid) as EXR, a tone-mapped PNG
+ * preview, and the RGBD PNG the glTF's materials sample; rgba the page's texels. */
+static lmgi_status write_page(const writer *w, const char *dir, int half, int page, const float *rgba, int pw,
+                              int ph, lmgi_error *err)
 {
-    int aw = w->atlas->width, ah = w->atlas->height;
-    char path[4200];
+    char path[4200], file[260];
     lmgi_image_desc d = {LMGI_TONEMAP_NEUTRAL, 0.0f, half};
-    snprintf(path, sizeof path, "%s/%s_lightmap.exr", dir, w->name);
-    lmgi_status st = lmgi_write_image(path, aw, ah, 4, w->lightmap, &d, err);
-    snprintf(path, sizeof path, "%s/%s_lightmap.png", dir, w->name);
+    lm_export_lightmap_file(file, sizeof file, w->name, w->ep, page, ".exr");
+    snprintf(path, sizeof path, "%s/%s", dir, file);
+    lmgi_status st = lmgi_write_image(path, pw, ph, 4, rgba, &d, err);
+    lm_export_lightmap_file(file, sizeof file, w->name, w->ep, page, ".png");
+    snprintf(path, sizeof path, "%s/%s", dir, file);
     if (st == LMGI_OK)
-        st = lmgi_write_image(path, aw, ah, 4, w->lightmap, &d, err);
+        st = lmgi_write_image(path, pw, ph, 4, rgba, &d, err);
     if (st != LMGI_OK || w->lightmap_texture < 0)
         return st;
-    uint8_t *rgbd = malloc(4 * (size_t)aw * (size_t)ah);
+    uint8_t *rgbd = malloc(4 * (size_t)pw * (size_t)ph);
     if (!rgbd)
-        return lm_api_refuse(err, "lmgi_export_gltf: no memory for the %d x %d RGBD lightmap", aw, ah);
-    lm_encode_rgbd(w->lightmap, (size_t)aw * (size_t)ah, w->rgbd_scale, rgbd);
-    snprintf(path, sizeof path, "%s/%s_lightmap_rgbd.png", dir, w->name);
+        return lm_api_refuse(err, "lmgi_export_gltf: no memory for the %d x %d RGBD lightmap", pw, ph);
+    lm_encode_rgbd(rgba, (size_t)pw * (size_t)ph, w->rgbd_scale, rgbd);
+    lm_export_lightmap_file(file, sizeof file, w->name, w->ep, page, "_rgbd.png");
+    snprintf(path, sizeof path, "%s/%s", dir, file);
     lm_error e;
-    st = lm_write_png(path, aw, ah, rgbd, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+    st = lm_write_png(path, pw, ph, rgbd, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
     free(rgbd);
+    return st;
+}
+
+/* The lightmap's pages, each cut from the atlas (one page: the atlas as it is). */
+static lmgi_status write_lightmap(const writer *w, const char *dir, int half, lmgi_error *err)
+{
+    const lm_atlas *a = w->atlas;
+    if (w->ep->pages == 1)
+        return write_page(w, dir, half, 0, w->lightmap, a->width, a->height, err);
+    float *page = malloc(4 * sizeof *page * (size_t)a->page_width * a->page_height);
+    lmgi_status st = page ? LMGI_OK : lm_api_refuse(err, "lmgi_export_gltf: no memory for a %d x %d lightmap page",
+                                                    a->page_width, a->page_height);
+    for (int p = 0; st == LMGI_OK && p < w->ep->pages; p++) {
+        int r[4];
+        lm_atlas_page_rect(a, p, r);
+        for (int y = 0; y < r[3]; y++)
+            memcpy(page + 4 * (size_t)y * r[2], w->lightmap + 4 * ((size_t)(r[1] + y) * a->width + r[0]),
+                   4 * sizeof *page * (size_t)r[2]);
+        st = write_page(w, dir, half, p, page, r[2], r[3], err);
+    }
+    free(page);
     return st;
 }
 
@@ -418,6 +504,26 @@ static lm_status write_sky(writer *w, const char *dir, lm_error *err)
     return LM_OK;
 }
 
+/* The lightmap's files in the document's extras: "lightmap", "preview", "rgbd", or with several pages a list
+ * of them, one a page ("pages"). */
+static void write_lightmap_files(writer *w)
+{
+    static const char *const key[3] = {"lightmap", "preview", "rgbd"}, *const what[3] = {".exr", ".png", "_rgbd.png"};
+    if (w->ep->pages > 1)
+        fprintf(w->doc.json, "\"pages\":[");
+    for (int p = 0; p < w->ep->pages; p++) {
+        fprintf(w->doc.json, "%s", w->ep->pages == 1 ? "" : p ? ",{" : "{");
+        for (int k = 0; k < 3; k++) {
+            char file[260];
+            lm_export_lightmap_file(file, sizeof file, w->name, w->ep, p, what[k]);
+            fprintf(w->doc.json, "%s\"%s\":\"%s\"", k ? "," : "", key[k], file);
+        }
+        fprintf(w->doc.json, "%s", w->ep->pages == 1 ? "" : "}");
+    }
+    if (w->ep->pages > 1)
+        fputc(']', w->doc.json);
+}
+
 /* Everything but the images into w's document. */
 static lm_status write_document(writer *w, const char *dir, lm_error *err)
 {
@@ -440,11 +546,11 @@ static lm_status write_document(writer *w, const char *dir, lm_error *err)
     char bin_uri[260];
     snprintf(bin_uri, sizeof bin_uri, "%s.bin", w->name);
     lm_gltf_finish(&w->doc, bin_uri);
-    fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{\"lightmap\":\"%s_lightmap.exr\",\"preview\":\"%s_lightmap.png\","
-                     "\"rgbd\":\"%s_lightmap_rgbd.png\",\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of "
-                     "indirect light, emissive surfaces and the sky (not the punctual lights' direct light); diffuse "
-                     "radiance = baseColor / pi x E; alpha 1 on valid texels\"", w->name, w->name, w->name,
-            w->atlas->width, w->atlas->height);
+    fprintf(w->doc.json, ",\"extras\":{\"lmgi\":{");
+    write_lightmap_files(w);
+    fprintf(w->doc.json, ",\"texCoord\":1,\"size\":[%d,%d],\"holds\":\"irradiance E of indirect light, emissive "
+                     "surfaces and the sky (not the punctual lights' direct light); diffuse radiance = baseColor / pi x "
+                     "E; alpha 1 on valid texels\"", w->atlas->page_width, w->atlas->page_height);
     st = write_sky(w, dir, err);
     fputs("}}}", w->doc.json);
     return st;
@@ -495,7 +601,13 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
         }
     }
     dir = lmgi_output_folder(out);
-    writer w = {.s = sc->scene, .atlas = &sc->atlas, .name = name, .lightmap_texture = -1};
+    lm_export_pages ep;
+    lm_error e;
+    if (lm_export_pages_make(sc->scene, &sc->atlas, &ep, &e) != LM_OK) {
+        lmgi_output_abort(own);
+        return lm_export_error(err, &e);
+    }
+    writer w = {.s = sc->scene, .atlas = &sc->atlas, .name = name, .ep = &ep, .lightmap_texture = -1};
     size_t pixels = (size_t)w.atlas->width * (size_t)w.atlas->height;
     float *lightmap = malloc(4 * pixels * sizeof *lightmap);
     uint8_t *lit = calloc((size_t)w.s->material_count + 1, 1);
@@ -505,6 +617,7 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
     if (st != LMGI_OK) {
         free(lightmap);
         free(lit);
+        lm_export_pages_free(&ep);
         lmgi_output_abort(own);
         return st;
     }
@@ -515,7 +628,6 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
     w.rgbd_scale = rgbd_scale(lightmap, pixels);
     if (w.atlas->texel_count)
         w.lightmap_texture = w.s->texture_count;
-    lm_error e;
     lm_status ls = lm_gltf_open(&w.doc) ? LM_OK : lm_fail(&e, LM_ERR_NOMEM, "export: no memory");
     if (ls == LM_OK)
         ls = write_document(&w, dir, &e);
@@ -536,6 +648,7 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
     st = ls == LM_OK ? write_lightmap(&w, dir, d.half, err) : lm_export_error(err, &e);
     free(lightmap);
     free(lit);
+    lm_export_pages_free(&ep);
     if (own && st == LMGI_OK)
         return lmgi_output_commit(own, err);
     lmgi_output_abort(own);

@@ -45,9 +45,12 @@ void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
     in->nonmanifold_edges = sc->surfaces.nonmanifold_edges;
     in->atlas_width = sc->atlas.width;
     in->atlas_height = sc->atlas.height;
+    in->pages = sc->atlas.page_count;
+    in->page_width = sc->atlas.page_width;
+    in->page_height = sc->atlas.page_height;
     in->texels = sc->atlas.texel_count;
     in->texel_size = sc->atlas.texel_size;
-    in->utilization = sc->atlas.utilization;
+    in->utilization = sc->atlas.page_utilization;
     for (int k = 0; k < 3; k++) /* in the file's coordinates */
         in->bounds_min[k] = s->bounds_min[k] + s->origin[k], in->bounds_max[k] = s->bounds_max[k] + s->origin[k];
     in->timings = sc->timings;
@@ -179,8 +182,13 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     fprintf(f, "surfaces    %d (%u degenerate triangles dropped, %u non-manifold edges)\n", in.surfaces,
             in.degenerate_triangles, in.nonmanifold_edges);
     fprintf(f, "charts      %d\n", in.charts);
-    fprintf(f, "atlas       %d x %d, texel %.4g units, %u texels, utilization %.1f%%\n", in.atlas_width,
-            in.atlas_height, (double)in.texel_size, in.texels, 100.0 * (double)in.utilization);
+    if (in.pages > 1)
+        fprintf(f, "atlas       %d pages of %d x %d (side by side in a %d x %d atlas), texel %.4g units, %u texels, "
+                "utilization %.1f%% of the pages\n", in.pages, in.page_width, in.page_height, in.atlas_width,
+                in.atlas_height, (double)in.texel_size, in.texels, 100.0 * (double)in.utilization);
+    else
+        fprintf(f, "atlas       %d x %d, texel %.4g units, %u texels, utilization %.1f%%\n", in.atlas_width,
+                in.atlas_height, (double)in.texel_size, in.texels, 100.0 * (double)in.utilization);
     fprintf(f, "effects\n");
     for (int i = 0; i < LM_EFFECT_COUNT; i++)
         fprintf(f, "  %s: %s — %s\n", lm_effect_name((lm_effect_id)i), sc->effects.on[i] ? "on" : "off",

@@ -70,7 +70,8 @@ static lm_status check_options(const char *path, const lmgi_options *o, lm_error
     if (o->wall_texels < 0 || o->wall_texels > 65536)
         return lm_fail(err, LM_ERR_INVALID, "%s: wall_texels %d must be in [0, 65536]", path, o->wall_texels);
     if (o->max_atlas_size < 64 || o->max_atlas_size > 32768)
-        return lm_fail(err, LM_ERR_INVALID, "%s: max atlas size %d must be in [64, 32768]", path, o->max_atlas_size);
+        return lm_fail(err, LM_ERR_INVALID, "%s: max_atlas_size (a lightmap page's side) %d must be in [64, 32768]",
+                       path, o->max_atlas_size);
     return LM_OK;
 }
 
@@ -476,6 +477,7 @@ void lmgi_get_texel(const lmgi_scene *sc, uint32_t i, lmgi_texel *out)
     out->surface = t->surface;
     out->triangle = t->tri;
     out->area = t->area;
+    out->page = lm_atlas_page_of(&sc->atlas, t->x, t->y, &out->page_x, &out->page_y);
 }
 
 int lmgi_triangle_lightmap_uv(const lmgi_scene *sc, uint32_t tri, float uv[6])
