@@ -7,8 +7,11 @@
 #include "edit_room.h"
 
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include "support.h"
 
 static int all_zero(const float *v, int n)
 {
@@ -242,6 +245,70 @@ double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node)
         }
     fail_msg("no node '%s' in the room", node);
     return 0.0;
+}
+
+lmgi_updater *lmt_updater(lmgi_context *ctx, lmgi_scene *sc)
+{
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
+lmgi_scene *lmt_export_reload(lmgi_updater *u, const char *name, int target_texels)
+{
+    char dir[64], path[600];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    lmgi_export_desc d = {.name = name, .force = 1};
+    lmgi_error e;
+    if (lmgi_export_gltf(u, dir, &d, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    snprintf(path, sizeof path, "%s/%s.gltf", dir, name);
+    return lmt_load(path, target_texels);
+}
+
+int lmt_texel_mean(const float *rgba, size_t n, double mean[3])
+{
+    int texels = 0;
+    mean[0] = mean[1] = mean[2] = 0.0;
+    for (size_t i = 0; i < n / 4; i++)
+        if (rgba[4 * i + 3] > 0.0f) {
+            for (int c = 0; c < 3; c++)
+                mean[c] += rgba[4 * i + c];
+            texels++;
+        }
+    assert_true(texels > 0);
+    for (int c = 0; c < 3; c++)
+        mean[c] /= texels;
+    return texels;
+}
+
+int lmt_reference_mean(lmgi_scene *sc, float target_error, double mean[3])
+{
+    lmgi_reference_desc d;
+    memset(&d, 0, sizeof d);
+    d.target_error = target_error;
+    d.no_cache = 1;
+    lmgi_reference r;
+    lmgi_error e;
+    if (lmgi_reference_texels(sc, &d, &r, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    int texels = 0;
+    mean[0] = mean[1] = mean[2] = 0.0;
+    for (int i = 0; i < r.width * r.height; i++)
+        if (r.full[3 * i] != 0.0f || r.full[3 * i + 1] != 0.0f) {
+            for (int c = 0; c < 3; c++)
+                mean[c] += r.full[3 * i + c];
+            texels++;
+        }
+    lmgi_reference_free(&r);
+    assert_true(texels > 0);
+    for (int c = 0; c < 3; c++)
+        mean[c] /= texels;
+    return texels;
 }
 
 void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)

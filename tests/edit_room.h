@@ -60,6 +60,16 @@ void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first,
                          double *top);
 /* The mean over node `node` ("room", "block", "stool") in an IIM of a room. */
 double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node);
+/* An updater with the default settings (a zeroed lmgi_updater_desc). */
+lmgi_updater *lmt_updater(lmgi_context *ctx, lmgi_scene *sc);
+/* lmgi_export_gltf of the updater's scene as `name` into a fresh folder, loaded back at target_texels. */
+lmgi_scene *lmt_export_reload(lmgi_updater *u, const char *name, int target_texels);
+/* The mean RGB of the valid texels (alpha > 0) of an atlas-sized RGBA lightmap of n floats; returns how
+ * many (the test fails on none). */
+int lmt_texel_mean(const float *rgba, size_t n, double mean[3]);
+/* The reference's texels for sc (lmgi_reference_texels at target_error, uncached): their mean over the
+ * atlas's texels (the gutters are 0); returns how many. */
+int lmt_reference_mean(lmgi_scene *sc, float target_error, double mean[3]);
 /* Asserts that st is LMGI_ERR_INVALID with a message naming `words`. */
 void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words);
 

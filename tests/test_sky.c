@@ -63,29 +63,10 @@ static texel_mean lightmap_mean(lmgi_updater *u, lmgi_scene *sc, lmgi_lightmap k
     assert_non_null(rgba);
     lmgi_error e;
     assert_int_equal(lmgi_get_lightmap(u, kind, rgba, n, &e), LMGI_OK);
-    texel_mean m = {{0, 0, 0}, 0};
-    for (size_t i = 0; i < n / 4; i++) {
-        if (!(rgba[4 * i + 3] > 0.0f))
-            continue;
-        for (int c = 0; c < 3; c++)
-            m.mean[c] += rgba[4 * i + c];
-        m.n++;
-    }
-    for (int c = 0; c < 3; c++)
-        m.mean[c] /= m.n > 0 ? m.n : 1;
+    texel_mean m;
+    m.n = lmt_texel_mean(rgba, n, m.mean);
     free(rgba);
     return m;
-}
-
-static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc)
-{
-    lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
-    lmgi_updater *u = NULL;
-    lmgi_error e;
-    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return u;
 }
 
 /* The plane under the sky alone: the reference's texels E = pi L to its noise (every path escapes at
@@ -102,28 +83,10 @@ static void test_open_plane(void **state)
     lmgi_error e;
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
-    lmgi_updater *u = updater(ctx, sc);
+    lmgi_updater *u = lmt_updater(ctx, sc);
     texel_mean iim = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM), aim = lightmap_mean(u, sc, LMGI_LIGHTMAP_AIM);
-
-    lmgi_reference_desc rd;
-    memset(&rd, 0, sizeof rd);
-    rd.target_error = 0.02f;
-    rd.no_cache = 1;
-    lmgi_reference r;
-    assert_int_equal(lmgi_reference_texels(sc, &rd, &r, &e), LMGI_OK);
-    double ref[3] = {0, 0, 0};
-    int texels = 0;
-    for (int i = 0; i < r.width * r.height; i++) { /* the atlas's texels: 0 in its gutters */
-        if (r.full[3 * i] == 0.0f && r.full[3 * i + 1] == 0.0f)
-            continue;
-        for (int c = 0; c < 3; c++)
-            ref[c] += r.full[3 * i + c];
-        texels++;
-    }
-    assert_int_equal(texels, iim.n);
-    for (int c = 0; c < 3; c++)
-        ref[c] /= texels;
-    lmgi_reference_free(&r);
+    double ref[3];
+    assert_int_equal(lmt_reference_mean(sc, 0.02f, ref), iim.n);
 
     for (int c = 0; c < 3; c++) {
         double want = PI * k_sky[c];
@@ -134,12 +97,7 @@ static void test_open_plane(void **state)
         assert_float_equal(aim.mean[c] / (RHO * k_sky[c]), 1.0, 0.03);
     }
     /* the export carries the sky, and loads back with it */
-    const char *dir = lmt_tmpdir();
-    lmgi_export_desc xd = {.name = "open", .force = 1};
-    assert_int_equal(lmgi_export_gltf(u, dir, &xd, &e), LMGI_OK);
-    char path[600];
-    snprintf(path, sizeof path, "%s/open.gltf", dir);
-    lmgi_scene *back = lmt_load(path, 1000);
+    lmgi_scene *back = lmt_export_reload(u, "open", 1000);
     float sky_back[3];
     assert_int_equal(lmgi_get_environment(back, sky_back), 1);
     for (int c = 0; c < 3; c++)
@@ -159,7 +117,7 @@ static void test_sky_edits(void **state)
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_scene *sc = lmt_load(plane_scene("edit", "[1, 0.5, 0.25]", NULL), 4000);
-    lmgi_updater *u = updater(ctx, sc);
+    lmgi_updater *u = lmt_updater(ctx, sc);
     texel_mean before = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
     const float twice[3] = {2.0f, 1.0f, 0.5f};
     assert_int_equal(lmgi_set_environment(sc, twice, &e), LMGI_OK);
@@ -173,7 +131,7 @@ static void test_sky_edits(void **state)
     /* the lamp's plane sees nothing of it (no other surface): its IIM is 0 until the sky comes */
     sc = lmt_load(plane_scene("lamp", NULL, "{\"type\": \"point\", \"intensity\": 10}"), 4000);
     assert_int_equal(lmgi_get_environment(sc, NULL), 0);
-    u = updater(ctx, sc);
+    u = lmt_updater(ctx, sc);
     before = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM);
     assert_int_equal(lmgi_set_environment(sc, k_sky, &e), LMGI_OK);
     assert_int_equal(lmgi_bake(u, NULL, NULL, &e), LMGI_OK);
@@ -244,30 +202,15 @@ static void plane_against(lmgi_scene *sc, double scale, double ref_tol, double i
     lmgi_error e;
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
-    lmgi_updater *u = updater(ctx, sc);
+    lmgi_updater *u = lmt_updater(ctx, sc);
     lmgi_updater_info ui;
     lmgi_get_updater_info(u, &ui);
     assert_string_equal(ui.gather_scheme, "rays");
     texel_mean iim = lightmap_mean(u, sc, LMGI_LIGHTMAP_IIM), aim = lightmap_mean(u, sc, LMGI_LIGHTMAP_AIM);
-    lmgi_reference_desc rd;
-    memset(&rd, 0, sizeof rd);
-    rd.target_error = 0.02f;
-    rd.no_cache = 1;
-    lmgi_reference r;
-    assert_int_equal(lmgi_reference_texels(sc, &rd, &r, &e), LMGI_OK);
-    double ref[3] = {0, 0, 0};
-    int texels = 0;
-    for (int i = 0; i < r.width * r.height; i++) {
-        if (r.full[3 * i] == 0.0f && r.full[3 * i + 1] == 0.0f)
-            continue;
-        for (int c = 0; c < 3; c++)
-            ref[c] += r.full[3 * i + c];
-        texels++;
-    }
-    lmgi_reference_free(&r);
+    double ref[3];
+    lmt_reference_mean(sc, 0.02f, ref);
     for (int c = 0; c < 3; c++) {
         double want = scale * gradient_e(c);
-        ref[c] /= texels;
         print_message("channel %d: E %.4f, reference %.4f, IIM %.4f; rho / pi E %.4f, AIM %.4f\n", c, want, ref[c],
                       iim.mean[c], RHO / PI * want, aim.mean[c]);
         assert_float_equal(ref[c] / want, 1.0, ref_tol);
@@ -289,14 +232,9 @@ static void test_gradient_sky(void **state)
     lmgi_error e;
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
-    lmgi_updater *u = updater(ctx, sc); /* its export carries the gradient: reloaded, the same E */
-    const char *dir = lmt_tmpdir();
-    lmgi_export_desc xd = {.name = "gradient", .force = 1};
-    assert_int_equal(lmgi_export_gltf(u, dir, &xd, &e), LMGI_OK);
+    lmgi_updater *u = lmt_updater(ctx, sc); /* its export carries the gradient: reloaded, the same E */
+    lmgi_scene *back = lmt_export_reload(u, "gradient", 4000);
     lmgi_updater_free(u);
-    char path[600];
-    snprintf(path, sizeof path, "%s/gradient.gltf", dir);
-    lmgi_scene *back = lmt_load(path, 4000);
     plane_against(back, 1.0, 0.01, 0.01, 0.04);
     lmgi_free(back);
     lmgi_updater_desc d;
@@ -382,7 +320,7 @@ static void test_sky_behind_everything(void **state)
     lmgi_error e;
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
-    lmgi_updater *u = updater(ctx, sc);
+    lmgi_updater *u = lmt_updater(ctx, sc);
     enum { SIDE = 33 };
     float rgb[3 * SIDE * SIDE];
     const float eye[3] = {0, 1, 0}, level[3] = {1, 1, 0}, up[3] = {1, 2, 0};
