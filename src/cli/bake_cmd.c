@@ -13,6 +13,7 @@
 #include "merge_cmd.h"
 #include "order_stats.h"
 #include "out_dir.h"
+#include "page_files.h"
 #include "progress.h"
 #include "run_cmd.h"
 #include "scene_load.h"
@@ -32,24 +33,31 @@ static void show(void *user, float fraction, const char *stage)
     lm_progress_fraction("bake", fraction, stage, *(const double *)user);
 }
 
+/* The files of a bake: lightmap.exr, lightmap.png and aim.exr, or those of each page (page_files.h). */
+static const char *const g_maps[3][2] = {{"lightmap", ".exr"}, {"lightmap", ".png"}, {"aim", ".exr"}};
+
 static int write_maps(lmgi_scene *sc, lmgi_updater *u, lmgi_output *dir, int half)
 {
     const lmgi_image_desc exr = {.half = half};
     lmgi_info in;
     lmgi_get_info(sc, &in);
-    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    int w, h;
+    lm_cli_page_size(&in, &w, &h);
+    size_t n = 4 * (size_t)w * h;
     float *rgba = malloc(n * sizeof *rgba);
     lmgi_error e;
     int rc = 0;
-    static const char *const files[3] = {"lightmap.exr", "lightmap.png", "aim.exr"};
-    for (int k = 0; k < 3 && rc == 0; k++) {
-        lmgi_lightmap kind = k < 2 ? LMGI_LIGHTMAP_IIM : LMGI_LIGHTMAP_AIM;
-        if (!rgba)
-            rc = 1, fprintf(stderr, "lmgi: error: no memory for the %d x %d lightmap\n", in.atlas_width, in.atlas_height);
-        else if ((k != 1 && lmgi_get_lightmap(u, kind, rgba, n, &e) != LMGI_OK) ||
-                 lm_cli_write_image(dir, files[k], in.atlas_width, in.atlas_height, 4, rgba, &exr, &e))
-            rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
-    }
+    if (!rgba)
+        rc = 1, fprintf(stderr, "lmgi: error: no memory for the %d x %d lightmap\n", w, h);
+    for (int p = 0; p < in.pages && rc == 0; p++)
+        for (int k = 0; k < 3 && rc == 0; k++) {
+            lmgi_lightmap kind = k < 2 ? LMGI_LIGHTMAP_IIM : LMGI_LIGHTMAP_AIM;
+            char file[64];
+            lm_cli_page_file(file, sizeof file, g_maps[k][0], in.pages, p, g_maps[k][1]);
+            if ((k != 1 && lm_cli_get_page(u, &in, kind, p, rgba, n, &e) != LMGI_OK) ||
+                lm_cli_write_image(dir, file, w, h, 4, rgba, &exr, &e))
+                rc = 1, fprintf(stderr, "lmgi: error: %s\n", e.message);
+        }
     free(rgba);
     return rc;
 }
@@ -147,16 +155,23 @@ static int write_gltf(const lm_cli_args *a, lmgi_updater *u, lmgi_output *out, c
  * (lmgi_output_commit): a mistyped scene, a cancel or a kill leaves the last good lightmaps. What the
  * gather finished survives a cancel, a kill or a failure in DIR/bake.checkpoint (docs/levels.md, "Long
  * bakes"), which the commit removes. A shard's bake writes DIR/part.checkpoint and part.json alone. */
-static lmgi_output *open_out(const lm_cli_args *a, const char *command, char *checkpoint, size_t size)
+static lmgi_output *open_out(const lm_cli_args *a, const char *command, int pages, char *checkpoint,
+                             size_t size)
 {
     lmgi_output *out = lm_cli_open_out(a, command);
     char probe[4200];
     lmgi_error e;
-    static const char *const whole[] = {"lightmap.exr", "lightmap.png", NULL},
-                             *const part[] = {"part.checkpoint", "part.json", NULL};
-    for (const char *const *f = a->shards ? part : whole; out && *f; f++)
+    static const char *const part[] = {"part.checkpoint", "part.json", NULL};
+    for (const char *const *f = part; a->shards && out && *f; f++)
         if (!lm_cli_out_path(out, *f, probe, sizeof probe))
             return lm_cli_close_out(out, 1), NULL;
+    for (int p = 0; !a->shards && out && p < pages; p++) /* each page's lightmap.exr and .png */
+        for (int k = 0; k < 2; k++) {
+            char file[64];
+            lm_cli_page_file(file, sizeof file, g_maps[k][0], pages, p, g_maps[k][1]);
+            if (!lm_cli_out_path(out, file, probe, sizeof probe))
+                return lm_cli_close_out(out, 1), NULL;
+        }
     if (out && lmgi_output_work_file(out, "bake.checkpoint", checkpoint, size, &e) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", e.message);
         return lm_cli_close_out(out, 1), NULL;
@@ -188,16 +203,28 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
         snprintf(what, sizeof what, "baked       share %d of %d of", a->shard, a->shards);
     else
         snprintf(what, sizeof what, "%s     ", a->file_count > 1 ? "merged" : "baked ");
-    printf("%s %u texels (%d x %d atlas) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather %.0f ms)\n",
-           what, in.texels, in.atlas_width, in.atlas_height, ui.photons, lm_cli_now() - started, ui.ms_setup_trace,
-           ui.ms_setup_aim, ui.ms_setup_gather);
+    char atlas[96], exr[320], png[64], aim[64];
+    if (in.pages > 1)
+        snprintf(atlas, sizeof atlas, "%d pages of %d x %d", in.pages, in.page_width, in.page_height);
+    else
+        snprintf(atlas, sizeof atlas, "%d x %d atlas", in.atlas_width, in.atlas_height);
+    printf("%s %u texels (%s) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather %.0f ms)\n", what,
+           in.texels, atlas, ui.photons, lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim,
+           ui.ms_setup_gather);
+    lm_cli_page_files(exr, sizeof exr, "lightmap", in.pages, ".exr");
+    lm_cli_page_files(png, sizeof png, "lightmap", in.pages, ".png");
+    lm_cli_page_files(aim, sizeof aim, "aim", in.pages, ".exr");
     if (a->shards)
         printf("wrote       %s/part.checkpoint (lmgi merge puts the parts together)\n", a->out_dir);
     else
-        printf("wrote       %s/lightmap.exr (irradiance, alpha = valid), lightmap.png, aim.exr\n", a->out_dir);
-    if (a->gltf)
-        printf("            %s/%s.gltf (TEXCOORD_1: the lightmap's UVs) with %s_lightmap.exr and .png\n", a->out_dir,
-               name, name);
+        printf("wrote       %s/%s (irradiance, alpha = valid%s), %s, %s\n", a->out_dir, exr,
+               in.pages > 1 ? ", a file a page" : "", png, aim);
+    if (a->gltf) {
+        char base[300];
+        snprintf(base, sizeof base, "%s_lightmap", name);
+        lm_cli_page_files(exr, sizeof exr, base, in.pages, ".exr");
+        printf("            %s/%s.gltf (TEXCOORD_1: the lightmap's UVs) with %s and .png\n", a->out_dir, name, exr);
+    }
 }
 
 /* bake (parts NULL) and merge (the parts' checkpoint files): the updater's first full solution, then the
@@ -210,7 +237,9 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     if (!lm_cli_load_scene(a->files[0], &o, 1, &sc))
         return 1;
     char checkpoint[4200];
-    lmgi_output *out = open_out(a, command, checkpoint, sizeof checkpoint);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    lmgi_output *out = open_out(a, command, in.pages, checkpoint, sizeof checkpoint);
     if (!out) {
         lmgi_free(sc);
         return 1;

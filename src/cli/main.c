@@ -60,9 +60,12 @@ static int cmd_charts(const lm_cli_args *a)
     } else if (!a->quiet) {
         lmgi_info in;
         lmgi_get_info(sc, &in);
-        printf("wrote %s/atlas.png (%d x %d, %d charts, %.1f%% used) and %s/surfaces.png (%d surfaces)\n",
-               a->out_dir, in.atlas_width, in.atlas_height, in.charts, 100.0 * (double)in.utilization, a->out_dir,
-               in.surfaces);
+        char pages[64] = "";
+        if (in.pages > 1)
+            snprintf(pages, sizeof pages, ": %d pages of %d x %d side by side", in.pages, in.page_width, in.page_height);
+        printf("wrote %s/atlas.png (%d x %d%s, %d charts, %.1f%% used) and %s/surfaces.png (%d surfaces)\n",
+               a->out_dir, in.atlas_width, in.atlas_height, pages, in.charts, 100.0 * (double)in.utilization,
+               a->out_dir, in.surfaces);
     }
     lmgi_free(sc);
     return lm_cli_close_out(o, rc);

@@ -16,13 +16,15 @@ const lm_cli_command lm_cli_commands[] = {
      "its camera, each surface a flat colour)"},
     {"run", LM_CMD_RUN, "run SCENE --out DIR",
      "the whole frame loop over the scene's animations (photons, AIMs, IIM gather, direct light,\n"
-     "composite): DIR/frame_NNNN.png (every K-th also .exr), iim.exr/png, aim.exr/png and frames.csv\n"
-     "(work and ms per stage)"},
+     "composite): DIR/frame_NNNN.png (every K-th also .exr), iim.exr/png, aim.exr/png (with several\n"
+     "pages iim_pageP and aim_pageP for each page P) and frames.csv (work and ms per stage)"},
     {"bake", LM_CMD_BAKE, "bake SCENE --out DIR",
      "the full solution for the scene as it is (every photon, AIM and texel), with a progress bar and\n"
      "the time left (Ctrl-C or SIGTERM cancels, keeping what it finished for --resume; a failed bake\n"
      "leaves the last lightmaps): DIR/lightmap.exr (irradiance, alpha = valid), lightmap.png (a\n"
-     "preview), aim.exr; --gltf: also NAME.gltf, the scene for engines with TEXCOORD_1 = lightmap UVs"},
+     "preview), aim.exr, or with several pages (--max-atlas) lightmap_pageP.exr, .png and\n"
+     "aim_pageP.exr for each page P; --gltf: also NAME.gltf, the scene for engines with TEXCOORD_1 =\n"
+     "lightmap UVs"},
     {"merge", LM_CMD_MERGE, "merge PART... --out DIR | merge SCENE PART... --out DIR",
      "a bake spread over processes put together: the parts the shards wrote (bake SCENE --shard K/N\n"
      "--out PART; each PART a folder, or its part.checkpoint), one of each share, give the lightmaps\n"
@@ -75,7 +77,8 @@ const lm_cli_option lm_cli_options[] = {
     {"--cone", NULL, "DEG", LM_CMD_ALL, LM_OPT_FLOAT, offsetof(lm_cli_args, options.surface_cone_deg), 0, 0, NULL,
      "max normal deviation inside one surface (default 30)"},
     {"--max-atlas", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.max_atlas_size), 64, 32768, NULL,
-     "largest atlas side; the texel size grows to fit (default 8192)"},
+     "the largest side of a lightmap page (default 8192): a level that does not fit\n"
+     "one page gets several, a file each (docs/levels.md, \"Atlas\")"},
     {"--strict", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.strict), 0, 0, NULL,
      "degenerate triangles and non-manifold edges are errors"},
     {"--untrusted", NULL, NULL, LM_CMD_ALL, LM_OPT_FLAG, offsetof(lm_cli_args, options.untrusted), 0, 0, NULL,

@@ -12,6 +12,7 @@
 #include "order_stats.h"
 #include "fail.h"
 #include "out_dir.h"
+#include "page_files.h"
 #include "progress.h"
 #include "scene_load.h"
 
@@ -153,21 +154,26 @@ static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
 }
 
 /* The IIM's E (invalid texels filled, gutters dilated) and the AIM's radiance, each with validity as alpha
- * (lmgi_get_lightmap). */
+ * (lmgi_get_lightmap): iim.exr/png and aim.exr/png, or those of each page (page_files.h). */
 static lmgi_status write_atlases(run_state *r, lmgi_error *err)
 {
     lmgi_info in;
     lmgi_get_info(r->sc, &in);
-    size_t n = (size_t)in.atlas_width * in.atlas_height;
+    int w, h;
+    lm_cli_page_size(&in, &w, &h);
+    size_t n = (size_t)w * h;
     float *rgba = malloc(n * 4 * sizeof *rgba);
     lmgi_status st = rgba ? LMGI_OK : lm_cli_fail(err, LMGI_ERR_NOMEM, "no memory for the atlases");
     static const char *const names[2] = {"iim", "aim"};
     static const lmgi_lightmap kinds[2] = {LMGI_LIGHTMAP_IIM, LMGI_LIGHTMAP_AIM};
-    for (int k = 0; k < 2 && st == LMGI_OK; k++) {
-        st = lmgi_get_lightmap(r->u, kinds[k], rgba, n * 4, err);
-        if (st == LMGI_OK)
-            st = write_pair(r, names[k], in.atlas_width, in.atlas_height, 4, rgba, 0.0f, 1, err);
-    }
+    for (int p = 0; p < in.pages && st == LMGI_OK; p++)
+        for (int k = 0; k < 2 && st == LMGI_OK; k++) {
+            char name[32];
+            lm_cli_page_file(name, sizeof name, names[k], in.pages, p, "");
+            st = lm_cli_get_page(r->u, &in, kinds[k], p, rgba, n * 4, err);
+            if (st == LMGI_OK)
+                st = write_pair(r, name, w, h, 4, rgba, 0.0f, 1, err);
+        }
     free(rgba);
     return st;
 }
@@ -236,9 +242,13 @@ static void summary(const run_state *r, int frames)
         printf("indirect    %s photon gather per pixel: radius %.4g, tile %d, chunk %d, k %d; %llu gathers, "
                "%llu list entries\n", ui.indirect, (double)ui.photon_radius, ui.photon_tile, ui.photon_chunk,
                ui.photon_stochastic, (unsigned long long)r->photon_gathers, (unsigned long long)r->photon_entries);
-    printf("atlas       %d x %d, %u texels of %.4g units: regathered in full every %u frames at %d a frame\n",
-           in.atlas_width, in.atlas_height, in.texels, (double)in.texel_size,
-           (in.texels + (uint32_t)per_frame - 1) / (uint32_t)per_frame, per_frame);
+    char atlas[96];
+    if (in.pages > 1)
+        snprintf(atlas, sizeof atlas, "%d pages of %d x %d", in.pages, in.page_width, in.page_height);
+    else
+        snprintf(atlas, sizeof atlas, "%d x %d", in.atlas_width, in.atlas_height);
+    printf("atlas       %s, %u texels of %.4g units: regathered in full every %u frames at %d a frame\n", atlas,
+           in.texels, (double)in.texel_size, (in.texels + (uint32_t)per_frame - 1) / (uint32_t)per_frame, per_frame);
     printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", ui.ms_setup_trace,
            ui.ms_setup_aim, ui.ms_setup_gather);
     printf("frames      %d, %u texels gathered, exposure %.4g (from frame 0)\n", frames, r->texels,
@@ -251,8 +261,12 @@ static void summary(const run_state *r, int frames)
     double median = lm_cli_median(r->frame_ms, frames);
     printf("median      %.2f ms (%.1f fps; the mean includes frame 0, which uploads everything)\n", median,
            median > 0.0 ? 1e3 / median : 0.0);
-    printf("wrote       %s/frame_*.png (.exr every %d), iim.exr/png, aim.exr/png, %sframes.csv\n", r->a->out_dir,
-           r->a->exr_every ? r->a->exr_every : 10, r->caustic_frames ? "caustics.exr/png (the last frame's), " : "");
+    char iim[48], aim[48];
+    lm_cli_page_files(iim, sizeof iim, "iim", in.pages, ".exr/png");
+    lm_cli_page_files(aim, sizeof aim, "aim", in.pages, ".exr/png");
+    printf("wrote       %s/frame_*.png (.exr every %d), %s, %s, %sframes.csv\n", r->a->out_dir,
+           r->a->exr_every ? r->a->exr_every : 10, iim, aim,
+           r->caustic_frames ? "caustics.exr/png (the last frame's), " : "");
 }
 
 static lmgi_status play(run_state *r, lmgi_error *err)
