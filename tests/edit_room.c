@@ -88,11 +88,24 @@ lmgi_scene *lmt_load_desc(const lmgi_scene_desc *d, int target_texels, float tex
     return load_desc(d, target_texels, texel_size);
 }
 
-lmgi_scene *lmt_load(const char *path, int target_texels)
+lmgi_scene *lmt_load(const char *path, int target_texels) { return lmt_load_paged(path, target_texels, 0); }
+
+lmgi_scene *lmt_paged_cornell(void)
+{
+    lmgi_scene *sc = lmt_load_paged(lmt_project_scene("cornell.glb"), 6000, 64);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    assert_true(in.pages > 1);
+    return sc;
+}
+
+lmgi_scene *lmt_load_paged(const char *path, int target_texels, int side)
 {
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = target_texels;
+    if (side)
+        o.max_atlas_size = side;
     lmgi_scene *sc = NULL;
     lmgi_error e;
     if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)

@@ -23,6 +23,11 @@ typedef struct {
  * units (0: derived); fails the test on an error. */
 lmgi_scene *lmt_load_desc(const lmgi_scene_desc *d, int target_texels, float texel_size);
 lmgi_scene *lmt_load(const char *path, int target_texels);
+/* lmgi_load at about target_texels texels on lightmap pages of at most `side` texels a side
+ * (lmgi_options.max_atlas_size; 0: the default); fails the test on an error. */
+lmgi_scene *lmt_load_paged(const char *path, int target_texels, int side);
+/* The project's Cornell box at 6,000 texels on pages of 64 texels: several pages (else the test fails). */
+lmgi_scene *lmt_paged_cornell(void);
 /* A perspective camera at eye looking at `at` (y up), square, vertical field of view fov radians, near 0.05,
  * far 30. */
 void lmt_look_at(const float eye[3], const float at[3], float fov, lmgi_camera *cam);

@@ -352,6 +352,130 @@ static void test_lightmap_rect(void **state)
     close_all(u, sc, ctx);
 }
 
+/* Every page read alone gives the whole read's values in its rectangle, bit for bit. */
+static void expect_pages_match(lmgi_updater *u, const lmgi_scene *sc, const lmgi_info *in, lmgi_lightmap kind,
+                               const float *whole)
+{
+    float *page = malloc(4 * sizeof(float) * (size_t)in->page_width * in->page_height);
+    assert_non_null(page);
+    for (int p = 0; p < in->pages; p++) {
+        int r[4];
+        lmgi_error e;
+        assert_int_equal(lmgi_page_rect(sc, p, r), 1);
+        assert_true(r[2] == in->page_width && r[3] == in->page_height);
+        if (lmgi_get_lightmap_page(u, kind, p, page, 4 * (size_t)r[2] * r[3], &e) != LMGI_OK)
+            fail_msg("%s", e.message);
+        for (int y = 0; y < r[3]; y++)
+            if (memcmp(page + 4 * (size_t)y * r[2], whole + 4 * ((size_t)(r[1] + y) * in->atlas_width + r[0]),
+                       4 * sizeof(float) * (size_t)r[2]))
+                fail_msg("kind %d, page %d: row %d differs from the whole read", (int)kind, p, y);
+    }
+    free(page);
+}
+
+/* A texel's page and place there, a triangle's page UVs and a surface's page agree with the page
+ * rectangles: each texel inside its page's, each triangle's texels on its page, where its page UVs put
+ * them. Returns how many surfaces lie on one page. */
+static int check_page_layout(const lmgi_scene *sc, const lmgi_info *in)
+{
+    int surfaces = lmgi_surface_count(sc), one_page = 0, *page = malloc(sizeof(int) * (size_t)surfaces);
+    assert_non_null(page);
+    for (int s = 0; s < surfaces; s++)
+        one_page += (page[s] = lmgi_surface_page(sc, s)) >= 0;
+    for (uint32_t i = 0; i < in->texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        int r[4];
+        float uv[6], whole[6];
+        assert_int_equal(lmgi_page_rect(sc, t.page, r), 1);
+        assert_true(t.page_x == t.x - r[0] && t.page_y == t.y - r[1]);
+        assert_true(t.page_x >= 0 && t.page_x < r[2] && t.page_y >= 0 && t.page_y < r[3]);
+        assert_int_equal(lmgi_triangle_lightmap_page(sc, t.triangle, uv), t.page);
+        assert_true(page[t.surface] < 0 || page[t.surface] == t.page);
+        assert_int_equal(lmgi_triangle_lightmap_uv(sc, t.triangle, whole), 1);
+        for (int k = 0; k < 6; k++) {
+            assert_true(uv[k] >= 0.0f && uv[k] <= 1.0f);
+            assert_float_equal(r[k % 2] + uv[k] * r[2 + k % 2], whole[k] * (k % 2 ? in->atlas_height : in->atlas_width),
+                               1e-3);
+        }
+    }
+    free(page);
+    return one_page;
+}
+
+/* Lightmap pages through the API: the Cornell box at 6,000 texels on pages of 64 takes several; every
+ * page read alone (IIM, AIM, error) is the whole read's rectangle, bit for bit; texels, triangles and
+ * surfaces name their pages consistently. With one page, page 0 is the whole atlas and the page UVs are
+ * the atlas UVs, bit for bit. Bad pages and page sides are refused, naming them. */
+static void test_lightmap_pages(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = new_context();
+    lmgi_scene *sc = lmt_paged_cornell();
+    lmgi_updater *u = frameless_updater(ctx, sc);
+    for (int f = 1; f <= 3; f++)
+        update(u, 0.1f * (float)f, 0.0f, NULL);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    print_message("Cornell box at 6,000 texels on pages of 64: %d pages of %d x %d in a %d x %d atlas, %u texels, "
+                  "%.1f%% of the pages used\n", in.pages, in.page_width, in.page_height, in.atlas_width,
+                  in.atlas_height, in.texels, 100.0 * in.utilization);
+    assert_true(in.pages > 1 && in.page_width <= 64 && in.page_height <= 64);
+    assert_true(in.atlas_width >= in.page_width && in.atlas_height >= in.page_height);
+    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *whole = malloc(n * sizeof *whole);
+    assert_non_null(whole);
+    lmgi_error e;
+    const lmgi_lightmap kinds[3] = {LMGI_LIGHTMAP_IIM, LMGI_LIGHTMAP_AIM, LMGI_LIGHTMAP_ERROR};
+    for (int k = 0; k < 3; k++) {
+        assert_int_equal(lmgi_get_lightmap(u, kinds[k], whole, n, &e), LMGI_OK);
+        expect_pages_match(u, sc, &in, kinds[k], whole);
+    }
+    int one_page = check_page_layout(sc, &in);
+    print_message("%d of %d surfaces on one page\n", one_page, lmgi_surface_count(sc));
+    assert_int_equal(one_page, lmgi_surface_count(sc));
+
+    float px[6];
+    int r[4] = {1, 1, 1, 1};
+    expect_invalid(lmgi_get_lightmap_page(u, LMGI_LIGHTMAP_IIM, -1, whole, n, &e), &e, "page -1");
+    expect_invalid(lmgi_get_lightmap_page(u, LMGI_LIGHTMAP_IIM, in.pages, whole, n, &e), &e, "is not one of");
+    expect_invalid(lmgi_get_lightmap_page(u, LMGI_LIGHTMAP_IIM, 0, px, 4, &e), &e, "holds 4 floats");
+    expect_invalid(lmgi_get_lightmap_page(u, LMGI_LIGHTMAP_IIM, 0, NULL, n, &e), &e, "rgba is NULL");
+    expect_invalid(lmgi_get_lightmap_page(u, (lmgi_lightmap)9, 0, whole, n, &e), &e, "not a lightmap kind");
+    expect_invalid(lmgi_get_lightmap_page(NULL, LMGI_LIGHTMAP_IIM, 0, whole, n, &e), &e, "NULL");
+    assert_int_equal(lmgi_page_rect(sc, in.pages, r), 0);
+    assert_true(r[0] == 0 && r[2] == 0);
+    assert_int_equal(lmgi_page_rect(NULL, 0, r), 0);
+    assert_int_equal(lmgi_surface_page(sc, -1), -1);
+    assert_int_equal(lmgi_surface_page(NULL, 0), -1);
+    assert_int_equal(lmgi_triangle_lightmap_page(sc, UINT32_MAX, px), -1);
+    free(whole);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+
+    sc = lmt_load_paged(lmt_project_scene("cornell.glb"), 6000, 8192); /* one page: the atlas itself */
+    lmgi_get_info(sc, &in);
+    assert_int_equal(in.pages, 1);
+    assert_true(in.page_width == in.atlas_width && in.page_height == in.atlas_height);
+    assert_int_equal(check_page_layout(sc, &in), lmgi_surface_count(sc));
+    for (uint32_t t = 0; t < in.triangles; t++) {
+        float uv[6], page_uv[6];
+        int has = lmgi_triangle_lightmap_uv(sc, t, uv);
+        assert_int_equal(lmgi_triangle_lightmap_page(sc, t, page_uv), has ? 0 : -1);
+        if (has)
+            assert_memory_equal(uv, page_uv, sizeof uv);
+    }
+    lmgi_free(sc);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    static const int bad[] = {63, 32769, 65537};
+    for (int i = 0; i < 3; i++) {
+        o.max_atlas_size = bad[i];
+        expect_invalid(lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e), &e, "max_atlas_size");
+    }
+    lmgi_context_free(ctx);
+}
+
 static void test_edit_reaches_updater(void **state)
 {
     (void)state;
@@ -1259,6 +1383,7 @@ int main(void)
         cmocka_unit_test(test_two_contexts_one_thread),
         cmocka_unit_test(test_lightmaps_and_versions),
         cmocka_unit_test(test_lightmap_rect),
+        cmocka_unit_test(test_lightmap_pages),
         cmocka_unit_test(test_edit_reaches_updater),
         cmocka_unit_test(test_light_edit_stays_in_its_room),
         cmocka_unit_test(test_bake),

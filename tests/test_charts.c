@@ -734,6 +734,19 @@ static void check_dilation(const lm_scene *s, const lm_atlas *a)
     free(data);
 }
 
+/* t's surfaces and atlas at texel size ts on pages of `side` texels. */
+static void build_paged(tscene *t, float ts, int side, lm_surfaces *su, lm_atlas *a)
+{
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, su, &err), LM_OK);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    o.texel_size = ts;
+    o.max_size = side;
+    if (lm_atlas_build(&t->s, su, &o, a, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+}
+
 /* Boxes of 1 m, each its own node, at 0.1 m texels: six faces of 13 x 13 texels with their borders, two
  * boxes to a page of 64 texels, so that 24 take 12 pages. Every node's charts share a page (a node smaller than a page is never split); the pages
  * are used about as well as one atlas would be; lookups stay in their charts across the pages' edges; a
@@ -749,13 +762,7 @@ static void test_pages(void **state)
     }
     lm_surfaces su;
     lm_atlas a;
-    lm_error err = {0};
-    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
-    lm_atlas_options o;
-    lm_atlas_options_default(&o);
-    o.texel_size = 0.1f;
-    o.max_size = 64;
-    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    build_paged(t, 0.1f, 64, &su, &a);
     print_message("%d boxes at 0.1 texels, pages of 64: %d pages of %dx%d in a %dx%d atlas, %u texels, %.1f%% of "
                   "the pages used\n", BOXES, a.page_count, a.page_width, a.page_height, a.width, a.height,
                   a.texel_count, 100.0 * a.page_utilization);
@@ -772,8 +779,8 @@ static void test_pages(void **state)
     }
     assert_true(a.page_utilization > 0.5f);
     lm_atlas_free(&a);
-    o.max_size = 8192; /* the same level on one page */
-    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    lm_surfaces_free(&su);
+    build_paged(t, 0.1f, 8192, &su, &a); /* the same level on one page */
     assert_int_equal(a.page_count, 1);
     assert_int_equal(a.page_width, a.width);
     assert_int_equal(a.page_height, a.height);
@@ -793,13 +800,7 @@ static void test_pages_split_a_large_node(void **state)
     ts_box(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, (float[3]){5, 5, 5}, -1, 2);
     lm_surfaces su;
     lm_atlas a;
-    lm_error err = {0};
-    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
-    lm_atlas_options o;
-    lm_atlas_options_default(&o);
-    o.texel_size = 0.1f;
-    o.max_size = 64;
-    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_OK);
+    build_paged(t, 0.1f, 64, &su, &a);
     assert_int_equal(su.surface_count, 6);
     assert_int_equal(a.page_count, 6);
     check_atlas(&t->s, &su, &a, 1e-4);
@@ -808,6 +809,9 @@ static void test_pages_split_a_large_node(void **state)
         for (int c = a.surface_first_chart[f]; c < a.surface_first_chart[f] + a.surface_chart_count[f]; c++)
             assert_int_equal(a.charts[c].page, a.charts[a.surface_first_chart[f]].page);
     lm_atlas_free(&a);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    lm_error err = {0};
     static const int bad[] = {3, 65537};
     for (int i = 0; i < 2; i++) {
         o.max_size = bad[i];

@@ -841,6 +841,75 @@ static void test_bake_command(void **state)
     assert_int_not_equal(access(path, F_OK), 0);
 }
 
+/* Whether DIR/NAME exists. */
+static int exists(const char *dir, const char *name)
+{
+    char path[1400];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    return access(path, F_OK) == 0;
+}
+
+/* A level on several pages (the Cornell box at 6,000 texels, --max-atlas 64): info prints the pages; bake
+ * writes lightmap_pageP.exr and .png and aim_pageP.exr for each page, each a page's size, and the glTF's
+ * images a page, no lightmap.exr, and its wrote line names them; run writes iim_pageP and aim_pageP. The
+ * same folder baked again on one page has lightmap.exr again and no page's file (lmgi replaces its own
+ * files). A page side outside 64..32768 is refused naming --max-atlas. */
+static void test_bake_pages(void **state)
+{
+    (void)state;
+    char args[2048], dir[256], paged[600], name[64];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    snprintf(paged, sizeof paged, "%s/paged", dir);
+    assert_int_equal(run_ok("info scenes/cornell.glb --texels 6000 --max-atlas 64"), 0);
+    int pages = 0, pw = 0, ph = 0;
+    const char *atlas = strstr(output, "atlas       ");
+    assert_non_null(atlas);
+    assert_int_equal(sscanf(atlas, "atlas       %d pages of %d x %d", &pages, &pw, &ph), 3);
+    assert_true(pages > 1 && pw <= 64 && ph <= 64);
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 6000 --max-atlas 64 --photons 4000 --gltf --out %s",
+             paged);
+    assert_int_equal(run_ok(args), 0);
+    snprintf(name, sizeof name, "lightmap_page0..%d.exr", pages - 1);
+    assert_non_null(strstr(output, name));
+    for (int p = 0; p < pages; p++) {
+        static const char *const kinds[] = {"lightmap_page%d.exr", "lightmap_page%d.png", "aim_page%d.exr",
+                                            "cornell_lightmap_page%d.exr", "cornell_lightmap_page%d_rgbd.png"};
+        for (int k = 0; k < 5; k++) {
+            snprintf(name, sizeof name, kinds[k], p);
+            if (!exists(paged, name))
+                fail_msg("%s/%s is missing", paged, name);
+        }
+        char path[1400];
+        snprintf(path, sizeof path, "%s/lightmap_page%d.exr", paged, p);
+        float *px = NULL;
+        int w = 0, h = 0;
+        lm_error err;
+        assert_int_equal(lm_read_exr(path, &w, &h, &px, &err), LM_OK);
+        assert_true(w == pw && h == ph);
+        free(px);
+    }
+    snprintf(name, sizeof name, "lightmap_page%d.exr", pages);
+    assert_false(exists(paged, name));
+    assert_false(exists(paged, "lightmap.exr") || exists(paged, "cornell_lightmap.exr"));
+    char ran[600];
+    snprintf(ran, sizeof ran, "%s/run", dir);
+    snprintf(args, sizeof args, "run scenes/cornell.glb --texels 6000 --max-atlas 64 --frames 2 --size 32x32 --out %s",
+             ran);
+    assert_int_equal(run_ok(args), 0);
+    assert_non_null(strstr(output, "iim_page0.."));
+    assert_true(exists(ran, "iim_page0.exr") && exists(ran, "aim_page0.png") && !exists(ran, "iim.exr"));
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --out %s", paged);
+    assert_int_equal(run_ok(args), 0);
+    assert_true(exists(paged, "lightmap.exr") && exists(paged, "aim.exr"));
+    assert_false(exists(paged, "lightmap_page0.exr") || exists(paged, "aim_page0.exr"));
+    static const char *const bad[] = {"63", "32769", "65537"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(args, sizeof args, "info scenes/cornell.glb --max-atlas %s", bad[k]);
+        assert_int_equal(run(args), 2);
+        assert_non_null(strstr(output, "--max-atlas"));
+    }
+}
+
 /* lmgi bench --edits: the lag table and the JSON from a small script; bad scripts named where they fail. */
 static void test_bench_edits(void **state)
 {
@@ -1199,6 +1268,7 @@ int main(void)
         cmocka_unit_test(test_info_on_generated_cornell),
         cmocka_unit_test(test_charts_pictures),
         cmocka_unit_test(test_bake_command),
+        cmocka_unit_test(test_bake_pages),
         cmocka_unit_test(test_progress_lines),
         cmocka_unit_test(test_bake_killed_and_resumed),
         cmocka_unit_test(test_bake_in_shards),

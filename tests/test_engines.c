@@ -49,17 +49,24 @@ static void export_to(lmgi_updater *u, const char *name, char *gltf, size_t size
     snprintf(gltf, size, "%s/%s.gltf", dir, name);
 }
 
+/* The node packages' folder holding the Khronos validator; the test skips, saying what is missing, without. */
+static const char *validator_modules(void)
+{
+    const char *why = NULL, *modules = lmt_node_modules("gltf-validator", &why);
+    if (!modules) {
+        print_message("skipped: %s\n", why);
+        skip();
+    }
+    return modules;
+}
+
 /* Exports of the Cornell box as baked, then after every kind of edit (a light added, one switched off,
  * one removed, a node moved, a material's colour changed), and of a shared scene with textures: the
  * Khronos validator finds 0 errors in each. */
 static void test_exports_validate(void **state)
 {
     (void)state;
-    const char *why = NULL, *modules = lmt_node_modules("gltf-validator", &why);
-    if (!modules) {
-        print_message("skipped: %s\n", why);
-        skip();
-    }
+    const char *modules = validator_modules();
     lmgi_context *ctx = NULL;
     lmgi_error e;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
@@ -106,6 +113,31 @@ static void test_exports_validate(void **state)
     } else {
         print_message("%s is absent: its export is not validated\n", textured);
     }
+    lmgi_context_free(ctx);
+}
+
+/* A level of several lightmap pages (the Cornell box at 6,000 texels on pages of 64 texels): its export,
+ * with an image, primitives and material copies a page, has no error and no warning. */
+static void test_paged_export_validates(void **state)
+{
+    (void)state;
+    const char *modules = validator_modules();
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_scene *sc = lmt_paged_cornell();
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    lmgi_updater *u = bake(ctx, sc, 20000);
+    char gltf[PATH_MAX], cmd[2 * PATH_MAX + 64], out[8192];
+    export_to(u, "paged", gltf, sizeof gltf);
+    snprintf(cmd, sizeof cmd, "node tests/engines/validate.mjs '%s' '%s' 2>&1", modules, gltf);
+    int rc = lmt_run(cmd, out, sizeof out);
+    print_message("%d pages: %s", in.pages, out);
+    assert_int_equal(rc, 0);
+    assert_non_null(strstr(out, ": 0 errors, 0 warnings"));
+    lmgi_updater_free(u);
+    lmgi_free(sc);
     lmgi_context_free(ctx);
 }
 
@@ -260,6 +292,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_exports_validate),
+        cmocka_unit_test(test_paged_export_validates),
         cmocka_unit_test(test_babylon_draws_the_lightmap),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+#include <cjson/cJSON.h>
 #include <lmgi.h>
 #include <math.h>
 #include <stdio.h>
@@ -16,6 +17,7 @@
 #include "../src/api/lmgi_scene.h"
 #include "../src/core/image.h"
 #include "../src/core/vecmath.h"
+#include "edit_room.h"
 #include "support.h"
 
 static lmgi_scene *load(const char *path, int use_uv1)
@@ -73,10 +75,27 @@ static float *lightmap(lmgi_updater *u, const lmgi_scene *sc)
     return rgba;
 }
 
+/* The lightmap page the exported document's material m samples: the P of its LMGI_lightmap image's
+ * NAME_lightmap_pageP_rgbd.png. */
+static int material_page(const cJSON *doc, int m)
+{
+    const cJSON *mat = cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "materials"), m);
+    const cJSON *ext = cJSON_GetObjectItem(cJSON_GetObjectItem(mat, "extensions"), "LMGI_lightmap");
+    assert_non_null(ext);
+    int tex = cJSON_GetObjectItem(cJSON_GetObjectItem(ext, "lightmapTexture"), "index")->valueint;
+    int img = cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "textures"), tex), "source")->valueint;
+    const char *uri = cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "images"), img), "uri")->valuestring;
+    const char *at = strstr(uri, "_lightmap_page");
+    assert_non_null(at);
+    return atoi(at + strlen("_lightmap_page"));
+}
+
 /* Each re-loaded triangle's TEXCOORD_1 centroid falls on a texel of the original atlas that belongs to a
  * surface of the same node and lies on the triangle (within its size and two texels): the UVs, their v
- * direction and the node matrices all agree with the lightmap file. Returns the share that does. */
-static double uv1_hits(const lmgi_scene *orig, const lm_scene *copy)
+ * direction and the node matrices all agree with the lightmap file. With several pages (doc, the copy's
+ * document, not NULL) the UVs are over the page the triangle's material samples. Returns the share that
+ * does. */
+static double uv1_hits(const lmgi_scene *orig, const lm_scene *copy, const cJSON *doc)
 {
     const lm_atlas *a = &orig->atlas;
     int hits = 0, total = 0;
@@ -95,7 +114,10 @@ static double uv1_hits(const lmgi_scene *orig, const lm_scene *copy)
         if (u == 0.0f && w == 0.0f)
             continue; /* mirror and glass: no lightmap */
         total++;
-        int x = (int)(u * a->width), y = (int)(w * a->height);
+        int r[4] = {0, 0, a->width, a->height};
+        if (doc)
+            assert_int_equal(lmgi_page_rect(orig, material_page(doc, copy->tri_material[t]), r), 1);
+        int x = (int)(r[0] + u * r[2]), y = (int)(r[1] + w * r[3]);
         if (x < 0 || y < 0 || x >= a->width || y >= a->height)
             continue;
         int ti = a->texel_index[(size_t)y * a->width + x];
@@ -196,7 +218,7 @@ static void test_export_and_reload(void **state)
         for (int k = 0; k < 16; k++)
             assert_float_equal(a->world[k], b->world[k], 1e-6);
     }
-    double share = uv1_hits(sc, copy);
+    double share = uv1_hits(sc, copy, NULL);
     print_message("export: %.2f%% of the copy's triangles find their own texels through TEXCOORD_1\n", 100.0 * share);
     assert_true(share > 0.97);
     lm_scene_free(copy);
@@ -220,6 +242,84 @@ static void test_export_and_reload(void **state)
     free(theirs);
     lmgi_updater_free(u2);
     lmgi_free(again);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A level of several pages (the Cornell box at 6,000 texels on pages of 64): each page's three images hold
+ * what lmgi_get_lightmap_page gives (the EXR bit for bit), no single-page file is written, a material on
+ * several pages is written once per page (copies under its name), and each re-loaded triangle's
+ * TEXCOORD_1 leads, on the page its material samples, to texels of its own node at its own place. */
+static void test_export_pages(void **state)
+{
+    (void)state;
+    const char *dir = lmt_tmpdir();
+    lmgi_context *ctx = NULL;
+    lmgi_error e;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    lmgi_scene *sc = lmt_paged_cornell();
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    lmgi_updater *u = bake(ctx, sc);
+    lmgi_export_desc d = {.name = "paged"};
+    assert_int_equal(lmgi_export_gltf(u, dir, &d, &e), LMGI_OK);
+    size_t n = 4 * (size_t)in.page_width * in.page_height;
+    float *mine = malloc(n * sizeof *mine);
+    assert_non_null(mine);
+    char path[1200];
+    for (int p = 0; p < in.pages; p++) {
+        assert_int_equal(lmgi_get_lightmap_page(u, LMGI_LIGHTMAP_IIM, p, mine, n, &e), LMGI_OK);
+        float *file = NULL;
+        int w, h;
+        lm_error le;
+        snprintf(path, sizeof path, "%s/paged_lightmap_page%d.exr", dir, p);
+        assert_int_equal(lm_read_exr(path, &w, &h, &file, &le), LM_OK);
+        assert_true(w == in.page_width && h == in.page_height);
+        assert_memory_equal(mine, file, n * sizeof *mine);
+        free(file);
+        uint8_t *px = NULL;
+        snprintf(path, sizeof path, "%s/paged_lightmap_page%d_rgbd.png", dir, p);
+        assert_int_equal(lm_read_image8(path, &w, &h, &px, &le), LM_OK);
+        assert_true(w == in.page_width && h == in.page_height);
+        free(px);
+        snprintf(path, sizeof path, "%s/paged_lightmap_page%d.png", dir, p);
+        assert_int_equal(access(path, R_OK), 0);
+    }
+    free(mine);
+    snprintf(path, sizeof path, "%s/paged_lightmap.exr", dir);
+    assert_int_not_equal(access(path, F_OK), 0);
+
+    snprintf(path, sizeof path, "%s/paged.gltf", dir);
+    size_t size;
+    char *json = (char *)lmt_read_file(path, &size, 1);
+    json[size] = '\0';
+    cJSON *doc = cJSON_Parse(json);
+    free(json);
+    assert_non_null(doc);
+    int materials = cJSON_GetArraySize(cJSON_GetObjectItem(doc, "materials"));
+    print_message("paged export: %d pages, %d materials written for the scene's %d\n", in.pages, materials,
+                  in.materials);
+    assert_true(materials > in.materials);
+    for (int m = in.materials; m < materials; m++) { /* a copy: a material of the scene's on a further page */
+        const char *name = cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "materials"), m), "name")->valuestring;
+        int same = 0;
+        for (int k = 0; k < in.materials; k++)
+            same += !strcmp(name, cJSON_GetObjectItem(cJSON_GetArrayItem(cJSON_GetObjectItem(doc, "materials"), k),
+                                                      "name")->valuestring);
+        assert_int_equal(same, 1);
+    }
+    lm_load_options lo = {.strict = 0};
+    lm_scene *copy = NULL;
+    lm_error le;
+    assert_int_equal(lm_scene_load_gltf(path, &lo, &copy, &le), LM_OK);
+    assert_int_equal(copy->tri_count, sc->scene->tri_count);
+    assert_int_equal(copy->material_count, materials);
+    double share = uv1_hits(sc, copy, doc);
+    print_message("paged export: %.2f%% of the copy's triangles find their own texels on their page\n", 100.0 * share);
+    assert_true(share > 0.97);
+    lm_scene_free(copy);
+    cJSON_Delete(doc);
     lmgi_updater_free(u);
     lmgi_free(sc);
     lmgi_context_free(ctx);
@@ -347,6 +447,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_export_and_reload),
+        cmocka_unit_test(test_export_pages),
         cmocka_unit_test(test_bad_exports),
         cmocka_unit_test(test_materials_and_lights_round_trip),
     };

@@ -158,7 +158,7 @@ void lm_chart_lookup_rect(const lm_atlas *a, int c, float rect[4]);
 /* Pages (src/charts/page_map.c). The atlas rectangle {x, y, w, h} of page p (0 <= p < page_count). */
 void lm_atlas_page_rect(const lm_atlas *a, int p, int rect[4]);
 /* The page holding atlas texel (x, y), inside the atlas, and its place in that page (*px, *py; either may
- * be NULL). A texel of the grid's empty places beyond the last page gives page_count. */
+ * be NULL). A texel of the grid's empty places after the last page gives page_count or more. */
 int lm_atlas_page_of(const lm_atlas *a, int x, int y, int *px, int *py);
 /* An atlas UV (corner_uv's, [0,1] over the atlas) of a point on page p as a UV over that page alone
  * ([0,1] over the page). Computed in double: for one page, uv itself, bit for bit. */
