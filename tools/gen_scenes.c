@@ -1,7 +1,8 @@
 /* gen_scenes — writes lmgi's own test scenes as binary glTF 2.0 (.glb).
  *
  * Usage:
- *   gen_scenes DIR                 writes DIR/cornell.glb, DIR/two_rooms.glb, DIR/many_rooms.glb
+ *   gen_scenes DIR                 writes DIR/cornell.glb, DIR/two_rooms.glb, DIR/many_rooms.glb,
+ *                                  DIR/sunlit_room.glb
  *   gen_scenes --rooms N OUTFILE   writes a many_rooms variant with N rooms to OUTFILE (benchmark sizes)
  *   gen_scenes --cornell-cells N OUTFILE  writes cornell.glb with an N x N cell floor (benchmark sizes)
  *
@@ -379,6 +380,7 @@ typedef struct {
     uint64_t *mesh_tris; /* triangles per glTF mesh, for the summary */
     uint64_t tris;       /* triangles as loaded (instances counted) */
     int dynamic_nodes;
+    const char *extras;  /* the root's extras (JSON object), or NULL */
     /* the animation being built */
     buf channels, samplers;
     int nchannels;
@@ -491,6 +493,15 @@ static int gl_point_light(gltf *g, const char *name, double r, double gr, double
     buf_sep(&g->lights, g->nlights);
     buf_printf(&g->lights, "{\"name\":\"%s\",\"type\":\"point\",\"color\":[%.6g,%.6g,%.6g],\"intensity\":%.6g}",
                name, r, gr, b, candela);
+    return g->nlights++;
+}
+
+/* A sun: illuminance in lux (KHR_lights_punctual), shining along its node's -Z. */
+static int gl_directional_light(gltf *g, const char *name, double r, double gr, double b, double lux)
+{
+    buf_sep(&g->lights, g->nlights);
+    buf_printf(&g->lights, "{\"name\":\"%s\",\"type\":\"directional\",\"color\":[%.6g,%.6g,%.6g],\"intensity\":%.6g}",
+               name, r, gr, b, lux);
     return g->nlights++;
 }
 
@@ -613,6 +624,8 @@ static void gl_write(gltf *g, const char *path)
         buf_put(&j, g->lights.p, g->lights.n);
         buf_put(&j, "]}}", 3);
     }
+    if (g->extras)
+        buf_printf(&j, ",\"extras\":%s", g->extras);
     buf_printf(&j, ",\"scene\":0,\"scenes\":[{\"name\":\"scene\",\"nodes\":[");
     for (int i = 0; i < g->nnodes; i++) buf_printf(&j, "%s%d", i ? "," : "", i);
     buf_put(&j, "]}]", 3);
@@ -1156,11 +1169,157 @@ static void gen_many_rooms(const char *path, int nrooms)
 }
 
 /* ------------------------------------------------------------------------------------------------ */
+/* (d) A sunlit living room                                                                          */
+
+/* A wall of one room face: the plane o + U u + W w for u in ub, w in wb, facing U x W, with the grid
+ * cell (1, 1) left open when `window` (the breakpoints put the opening there). */
+static void wall(mesh *m, v3 o, v3 U, v3 W, const float ub[4], const float wb[4], int window)
+{
+    mesh_plane(m, o, U, W, ub, window ? 4 : 2, wb, window ? 4 : 2, window ? 1u << 9 : 0, vcross(U, W));
+}
+
+/* The four faces lining an opening through a wall (jambs, sill and head): the opening spans a0..a1 along
+ * `along` and y0..y1, between the wall's faces at `in` and in + thick (the outward axis `out`). */
+static void reveal(mesh *m, v3 in, v3 along, v3 out, double a0, double a1, double y0, double y1, double thick)
+{
+    v3 d = vscale(out, thick);
+    for (int s = 0; s < 2; s++) { /* jambs face the opening's middle */
+        v3 p = vadd(in, vscale(along, s ? a1 : a0)), n = vscale(along, s ? -1.0 : 1.0);
+        v3 q[4] = {vadd(p, V(0, y0, 0)), vadd(vadd(p, d), V(0, y0, 0)), vadd(vadd(p, d), V(0, y1, 0)), vadd(p, V(0, y1, 0))};
+        if (vdot(vcross(vsub(q[1], q[0]), vsub(q[2], q[0])), n) < 0) mesh_quad(m, q[3], q[2], q[1], q[0], n);
+        else mesh_quad(m, q[0], q[1], q[2], q[3], n);
+    }
+    for (int s = 0; s < 2; s++) { /* sill faces up, head faces down */
+        v3 p0 = vadd(in, vadd(vscale(along, a0), V(0, s ? y1 : y0, 0))), p1 = vadd(in, vadd(vscale(along, a1), V(0, s ? y1 : y0, 0)));
+        v3 n = V(0, s ? -1 : 1, 0), q[4] = {p0, p1, vadd(p1, d), vadd(p0, d)};
+        if (vdot(vcross(vsub(q[1], q[0]), vsub(q[2], q[0])), n) < 0) mesh_quad(m, q[3], q[2], q[1], q[0], n);
+        else mesh_quad(m, q[0], q[1], q[2], q[3], n);
+    }
+}
+
+/* A living room lit in physical units, the way an architect's scene is (issue 30: "a sunlit interior"):
+ * 6 x 5 x 2.8 m inside, 0.2 m walls, a 2 x 1.4 m window in the south (-z) wall and a 1.2 x 1.2 m one in
+ * the west (-x) wall, open (no glass), a roof over it, on a 40 x 40 m lawn; a sun of 100,000 lux that
+ * falls through both windows onto the floor, a clear sky (extras.lmgi.sky, a gradient giving about
+ * 8,000 lux on open ground), two ceiling bulbs of 800 lm (63.7 cd) and furniture: a table, a sofa, a
+ * bookshelf, a rug in the sun, a floor lamp, window frames and a coat stand of albedo 0.02. */
+static void gen_sunlit_room(const char *path)
+{
+    gltf g = {0};
+    rng_state = 0x51ed7001u;
+    g.extras = "{\"lmgi\":{\"sky\":{\"zenith\":[1500,2200,3600],\"horizon\":[3000,3200,3500]}}}";
+    int floor_mat = gl_material(&g, "oak_floor", 0.45, 0.3, 0.18, 0, 0.8, 0);
+    int wall_mat = gl_material(&g, "wall_paint", 0.8, 0.78, 0.74, 0, 1, 0);
+    int ceil_mat = gl_material(&g, "ceiling", 0.85, 0.85, 0.85, 0, 1, 0);
+    int plaster = gl_material(&g, "plaster", 0.65, 0.6, 0.55, 0, 1, 0);
+    int roof_mat = gl_material(&g, "roof", 0.25, 0.22, 0.2, 0, 1, 0);
+    int grass = gl_material(&g, "grass", 0.18, 0.28, 0.1, 0, 1, 0);
+    int wood = gl_material(&g, "wood", 0.55, 0.38, 0.22, 0, 0.8, 0);
+    int fabric = gl_material(&g, "sofa_fabric", 0.25, 0.35, 0.6, 0, 1, 0);
+    int rug_mat = gl_material(&g, "rug", 0.7, 0.2, 0.15, 0, 1, 0);
+    int dark = gl_material(&g, "black_metal", 0.02, 0.02, 0.02, 0, 1, 0);
+    int shade = gl_material(&g, "lamp_shade", 0.9, 0.88, 0.8, 0, 1, 0);
+    const double X = 3.0, Z = 2.5, H = 2.8, T = 0.2, G = -0.05, TOP = 3.0;
+
+    /* The house: the inside lining (floor, walls, ceiling), the outside (walls and the window reveals), the roof. */
+    mesh in[3] = {{0}}, out[2] = {{0}};
+    mesh_box(&in[0], V(-X, G, -Z), V(X, 0, Z), F_PY);
+    mesh_box(&in[2], V(-X, H, -Z), V(X, TOP, Z), F_NY);
+    const float full_x[4] = {(float)-X, (float)X}, full_z[4] = {(float)-Z, (float)Z}, in_h[4] = {0, (float)H};
+    const float south_u[4] = {(float)-X, -1.5f, 0.5f, (float)X}, south_w[4] = {0, 0.8f, 2.2f, (float)H};
+    const float west_u[4] = {(float)-Z, -0.6f, 0.6f, (float)Z}, west_w[4] = {0, 1.0f, 2.2f, (float)H};
+    wall(&in[1], V(0, 0, -Z), V(1, 0, 0), V(0, 1, 0), south_u, south_w, 1); /* faces +z, into the room */
+    wall(&in[1], V(-X, 0, 0), V(0, 0, -1), V(0, 1, 0), west_u, west_w, 1);  /* faces +x */
+    wall(&in[1], V(X, 0, 0), V(0, 0, 1), V(0, 1, 0), full_z, in_h, 0);      /* faces -x */
+    wall(&in[1], V(0, 0, Z), V(-1, 0, 0), V(0, 1, 0), full_x, in_h, 0);     /* faces -z */
+    const float oX = (float)(X + T), oZ = (float)(Z + T), out_h[4] = {(float)G, (float)TOP};
+    const float south_ou[4] = {-oX, -0.5f, 1.5f, oX}, south_ow[4] = {(float)G, 0.8f, 2.2f, (float)TOP};
+    const float west_ou[4] = {-oZ, -0.6f, 0.6f, oZ}, west_ow[4] = {(float)G, 1.0f, 2.2f, (float)TOP};
+    const float east_ou[4] = {-oZ, oZ}, north_ou[4] = {-oX, oX};
+    wall(&out[0], V(0, 0, -oZ), V(-1, 0, 0), V(0, 1, 0), south_ou, south_ow, 1); /* faces -z */
+    wall(&out[0], V(-oX, 0, 0), V(0, 0, 1), V(0, 1, 0), west_ou, west_ow, 1);     /* faces -x */
+    wall(&out[0], V(oX, 0, 0), V(0, 0, -1), V(0, 1, 0), east_ou, out_h, 0);      /* faces +x */
+    wall(&out[0], V(0, 0, oZ), V(1, 0, 0), V(0, 1, 0), north_ou, out_h, 0);      /* faces +z */
+    reveal(&out[0], V(0, 0, -Z), V(1, 0, 0), V(0, 0, -1), -1.5, 0.5, 0.8, 2.2, T);
+    reveal(&out[0], V(-X, 0, 0), V(0, 0, 1), V(-1, 0, 0), -0.6, 0.6, 1.0, 2.2, T);
+    mesh_box(&out[1], V(-X - 0.4, TOP, -Z - 0.4), V(X + 0.4, TOP + 0.12, Z + 0.4), F_ALL);
+    int in_mats[3] = {floor_mat, wall_mat, ceil_mat}, out_mats[2] = {plaster, roof_mat};
+    node_desc d = node_none();
+    d.mesh = gl_mesh(&g, "room", in, in_mats, 3);
+    gl_node(&g, "room", &d);
+    d.mesh = gl_mesh(&g, "house", out, out_mats, 2);
+    gl_node(&g, "house", &d);
+    for (int i = 0; i < 3; i++) mesh_free(&in[i]);
+    for (int i = 0; i < 2; i++) mesh_free(&out[i]);
+
+    mesh lawn = {0};
+    mesh_box(&lawn, V(-20, G - 0.1, -20), V(20, G, 20), F_PY);
+    d.mesh = gl_mesh(&g, "lawn", &lawn, &grass, 1);
+    gl_node(&g, "lawn", &d);
+    mesh_free(&lawn);
+
+    /* Furniture, in place (one node each). */
+    mesh table = {0}, sofa[2] = {{0}}, shelf = {0}, rug = {0}, lamp[2] = {{0}}, frames = {0};
+    build_box_table(&table, 1.4, 0.8, 0.75);
+    mesh_box(&sofa[0], V(-1.1, 0.12, 1.55), V(1.1, 0.45, 2.4), F_ALL & ~(F_NY | F_PX | F_NX)); /* seat */
+    mesh_box(&sofa[0], V(-1.1, 0.45, 2.2), V(1.1, 0.9, 2.38), F_ALL & ~(F_NY | F_PX | F_NX)); /* back */
+    for (int s = -1; s <= 1; s += 2) mesh_box(&sofa[0], V(s > 0 ? 1.1 : -1.3, 0.12, 1.55), V(s > 0 ? 1.3 : -1.1, 0.65, 2.4), F_ALL & ~F_NY);
+    for (int s = -1; s <= 1; s += 2) /* feet */
+        for (int t = 0; t < 2; t++) mesh_cylinder(&sofa[1], V(s * 1.2, 0, t ? 2.3 : 1.65), 0.03, 0.12, 12, 1);
+    for (int i = 0; i < 5; i++) mesh_box(&shelf, V(2.62, 0.02 + 0.45 * i, -1.5), V(2.98, 0.05 + 0.45 * i, 0.5), F_ALL);
+    for (int s = 0; s < 2; s++) mesh_box(&shelf, V(2.62, 0, s ? 0.5 : -1.53), V(2.98, 1.9, s ? 0.53 : -1.5), F_ALL & ~F_NY);
+    mesh_box(&rug, V(-1.6, 0, -1.9), V(0.6, 0.01, -0.4), F_ALL & ~F_NY);
+    mesh_cylinder(&lamp[0], V(-2.5, 0, 1.9), 0.15, 0.03, 24, 3);
+    mesh_cylinder(&lamp[0], V(-2.5, 0.03, 1.9), 0.015, 1.4, 16, 0);
+    mesh_sphere(&lamp[1], V(-2.5, 1.6, 1.9), 0.2, 32, 16);
+    for (int s = 0; s < 2; s++) { /* window mullions: one upright in the middle of each opening */
+        if (s == 0) mesh_box(&frames, V(-0.53, 0.8, -Z - 0.12), V(-0.47, 2.2, -Z - 0.08), F_ALL & ~(F_NY | F_PY));
+        else mesh_box(&frames, V(-X - 0.12, 1.0, -0.03), V(-X - 0.08, 2.2, 0.03), F_ALL & ~(F_NY | F_PY));
+    }
+    mesh_cylinder(&frames, V(2.6, 0, 2.2), 0.02, 1.8, 12, 2); /* the coat stand */
+    d = node_none();
+    d.mesh = gl_mesh(&g, "table", &table, &wood, 1);
+    d.t = V(0.9, 0, 0.2);
+    gl_node(&g, "table", &d);
+    d = node_none();
+    int sofa_mats[2] = {fabric, dark}, lamp_mats[2] = {dark, shade};
+    d.mesh = gl_mesh(&g, "sofa", sofa, sofa_mats, 2);
+    gl_node(&g, "sofa", &d);
+    d.mesh = gl_mesh(&g, "bookshelf", &shelf, &wood, 1);
+    gl_node(&g, "bookshelf", &d);
+    d.mesh = gl_mesh(&g, "rug", &rug, &rug_mat, 1);
+    gl_node(&g, "rug", &d);
+    d.mesh = gl_mesh(&g, "floor_lamp", lamp, lamp_mats, 2);
+    gl_node(&g, "floor_lamp", &d);
+    d.mesh = gl_mesh(&g, "black_metal", &frames, &dark, 1);
+    gl_node(&g, "black_metal", &d);
+    mesh_free(&table); mesh_free(&shelf); mesh_free(&rug); mesh_free(&frames);
+    for (int i = 0; i < 2; i++) { mesh_free(&sofa[i]); mesh_free(&lamp[i]); }
+
+    /* The sun from the south-west, 40 degrees up: through both windows onto the floor. Two bulbs of
+     * 800 lm (800 / 4 pi cd) under the ceiling. */
+    d = node_none();
+    d.light = gl_directional_light(&g, "sun", 1.0, 0.96, 0.9, 100000);
+    quat_look_at(V(0, 0, 0), V(0.45, -0.64, 0.62), d.q);
+    gl_node(&g, "sun", &d);
+    d = node_none();
+    d.light = gl_point_light(&g, "bulb_1", 1.0, 0.85, 0.65, 800.0 / (4.0 * PI));
+    d.t = V(-1.5, 2.5, 0.8);
+    gl_node(&g, "bulb_1", &d);
+    d.light = gl_point_light(&g, "bulb_2", 1.0, 0.85, 0.65, 800.0 / (4.0 * PI));
+    d.t = V(1.6, 2.5, 1.0);
+    gl_node(&g, "bulb_2", &d);
+    add_camera(&g, V(2.6, 1.6, 2.1), V(-1.0, 0.5, -1.6), 1.1, 1.5, 100);
+    gl_write(&g, path);
+}
+
+/* ------------------------------------------------------------------------------------------------ */
 
 static void usage(void)
 {
     fprintf(stderr,
-            "usage: gen_scenes DIR                 write DIR/cornell.glb, DIR/two_rooms.glb, DIR/many_rooms.glb\n"
+            "usage: gen_scenes DIR                 write DIR/cornell.glb, DIR/two_rooms.glb, DIR/many_rooms.glb,\n"
+            "                                      DIR/sunlit_room.glb\n"
             "       gen_scenes --rooms N OUTFILE   write a many_rooms variant with N rooms (1..100000) to OUTFILE\n"
             "       gen_scenes --cornell-cells N OUTFILE  write cornell.glb with N x N floor cells (2..1000; default 80)\n"
             "The default many_rooms has 16 rooms (about 22,100 triangles each); the benchmark uses --rooms\n"
@@ -1194,5 +1353,7 @@ int main(int argc, char **argv)
     gen_two_rooms(path);
     snprintf(path, sizeof path, "%s/many_rooms.glb", dir);
     gen_many_rooms(path, 16);
+    snprintf(path, sizeof path, "%s/sunlit_room.glb", dir);
+    gen_sunlit_room(path);
     return 0;
 }
