@@ -469,6 +469,10 @@ typedef struct {
     int photons_per_estimate;  /* N nearest photons per AIM estimate (0: 32, docs/aim.md) */
     int surfaces_per_frame;    /* AIM refreshes per update (0: 4; -1: all that changed) */
     lmgi_aim_direct aim_direct; /* (0: LMGI_AIM_DIRECT_PHOTONS) */
+    int find_portals;          /* windows and doors a sun's or the sky's light gets in by, found as the updater is made
+                                * and at each bake, where the file tags no portal: half their photons drawn through
+                                * them, each weighed so the estimate is unchanged (docs/levels.md, "Portals")
+                                * (0: on; -1: off, the file's portals only) */
     int error_estimate;        /* 1: the AIMs keep their estimates' error, for LMGI_LIGHTMAP_ACCURACY (0: off,
                                 * the default: it walks each estimate's photons twice; docs/gather.md, "Error
                                 * estimate") */
@@ -613,6 +617,8 @@ typedef struct {
     const char *indirect;       /* "lightmap", "tiled", "hashgrid" or "bruteforce" */
     int photon_tile, photon_chunk, photon_stochastic; /* the per-pixel gathers' knobs (docs/tiled.md) */
     float photon_radius;        /* their kernel radius in scene units (0 before the first frame, or none) */
+    int portals_found;          /* rectangles found for suns and the sky to aim their photons through: openings, and
+                                 * places outside whose light gets in by them (find_portals; 0: none) */
 } lmgi_updater_info;
 /* NULL u: info zeroed; NULL info: nothing. */
 LMGI_API void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info);

@@ -89,6 +89,10 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: aim_direct %d is not LMGI_AIM_DIRECT_PHOTONS, "
                        "_EMITTERS or _ALL", (int)d->aim_direct);
     s->stage.exact_direct = d->aim_direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : d->aim_direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
+    if (d->find_portals != 0 && d->find_portals != -1)
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: find_portals %d must be 0 (on) or -1 (off)",
+                       d->find_portals);
+    s->stage.find_portals = d->find_portals == 0;
     if (d->error_estimate != 0 && d->error_estimate != 1)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: error_estimate %d must be 0 or 1", d->error_estimate);
     s->stage.aim.error_estimate = d->error_estimate;
@@ -409,6 +413,9 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     info->photon_chunk = s->photon_gather.chunk;
     info->photon_stochastic = s->photon_gather.stochastic;
     info->photon_radius = lm_frame_loop_photon_radius(u->loop);
+    const lm_emitters *em = lm_photon_stage_emitters(lm_frame_loop_stage(u->loop));
+    for (int e = 0; em && e < em->count; e++)
+        info->portals_found += em->e[e].portals ? (int)em->e[e].portals->found / 2 : 0;
 }
 
 /* The 95th percentile of the window's first n samples (sorting a copy). */

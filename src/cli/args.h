@@ -62,6 +62,7 @@ typedef struct {
     int photon_tile, photon_chunk, photon_stochastic; /* --photon-tile/-chunk/-stochastic; 0 unset */
     float photon_radius;    /* --photon-radius R; 0 unset */
     int aim_direct;         /* --aim-direct emitters|photons|all: lmgi_updater_desc.aim_direct (default photons) */
+    int find_portals;       /* --find-portals on|off: lmgi_updater_desc.find_portals (0 on, the default; -1 off) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     int accuracy;           /* --accuracy (bake): also the lightmaps' estimate of their own error */

@@ -206,6 +206,13 @@ int lm_cli_opt_aim_direct(const char *o, const char *v, lm_cli_args *a)
     return choose(o, v, names, values, 3, &a->aim_direct);
 }
 
+int lm_cli_opt_find_portals(const char *o, const char *v, lm_cli_args *a)
+{
+    static const char *const names[] = {"on", "off"};
+    static const int values[] = {0, -1};
+    return choose(o, v, names, values, 2, &a->find_portals);
+}
+
 int lm_cli_opt_scheme(const char *o, const char *v, lm_cli_args *a)
 {
     static const char *const names[] = {"viewports", "instanced", "layered", "rays"};

@@ -21,6 +21,7 @@ int lm_cli_opt_effects(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_caustic_space(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_indirect(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_aim_direct(const char *o, const char *v, lm_cli_args *a);
+int lm_cli_opt_find_portals(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_scheme(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_scaling(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_seed(const char *o, const char *v, lm_cli_args *a);

@@ -178,6 +178,10 @@ const lm_cli_option lm_cli_options[] = {
      "hits, the paper's form, blurred by the estimate's radius), emitters\n"
      "(emissive triangles' light computed per texel: sharp contact shadows,\n"
      "about 5x slower AIMs) or all (punctual lights' too)"},
+    {"--find-portals", NULL, "on|off", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_find_portals,
+     "the windows a sun's or the sky's light gets in by, found where the file\n"
+     "tags no portal, half their photons drawn through them (default on; off:\n"
+     "the file's portals only; docs/levels.md, \"Portals\")"},
     {"--indirect", NULL, "P", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_indirect,
      "how frames get indirect light: lightmap (the default: AIMs, hemicube\n"
      "gather, IIM), or every visible pixel gathers the photons on the GPU (Mara\n"

@@ -71,6 +71,7 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
     d->photon_stochastic = a->photon_stochastic;
     d->photon_radius = a->photon_radius;
     d->aim_direct = (lmgi_aim_direct)a->aim_direct;
+    d->find_portals = a->find_portals;
     d->gather_scheme = a->gather_scheme < 0 ? LMGI_GATHER_DEFAULT : (lmgi_gather_scheme)(a->gather_scheme + 1);
     d->emitter_light = a->emitter_light < 0 ? LMGI_EMITTERS_AUTO
                        : a->emitter_light ? LMGI_EMITTERS_CLOSED_FORM : LMGI_EMITTERS_DRAWN;

@@ -119,6 +119,16 @@ static void set_sky(lm_emitter *e)
     e->light = e->node = -1;
 }
 
+/* A sun or the sky takes the file's portals, if it has any (each emitter its own copy: a sun aims them
+ * along its direction). */
+static lm_status tag_portals(const lm_scene *s, lm_emitter *e, lm_error *err)
+{
+    if (!s->portal_tri_count || !(e->kind == LM_EMIT_DIRECTIONAL || e->kind == LM_EMIT_SKY))
+        return LM_OK;
+    e->portals = lm_portals_tagged(s->portal_tris, s->portal_tri_count, err);
+    return e->portals ? LM_OK : LM_ERR_NOMEM;
+}
+
 /* Order: the file's lights, the emissive nodes, then the lights added by edits in the order they came,
  * the order lm_emitters_add_light gives an emitter list built before the edits. */
 lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
@@ -130,23 +140,28 @@ lm_status lm_emitters_build(const lm_scene *s, lm_emitters *out, lm_error *err)
     out->e = calloc(n > 0 ? (size_t)n : 1, sizeof *out->e);
     if (!out->e)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %d emitters", s->path, n);
-    for (int i = 0; i < s->light_count; i++)
-        if (!s->lights[i].added)
-            set_punctual(s, i, &out->e[out->count++]);
-    for (int i = 0; i < s->node_count; i++) {
-        if (count_emissive(s, &s->nodes[i]) == 0)
-            continue;
-        lm_status st = add_area(s, i, &out->e[out->count++], err);
-        if (st != LM_OK) {
-            lm_emitters_free(out);
-            return st;
+    lm_status st = LM_OK;
+    for (int i = 0; st == LM_OK && i < s->light_count; i++)
+        if (!s->lights[i].added) {
+            set_punctual(s, i, &out->e[out->count]);
+            st = tag_portals(s, &out->e[out->count++], err);
         }
+    for (int i = 0; st == LM_OK && i < s->node_count; i++)
+        if (count_emissive(s, &s->nodes[i]) > 0)
+            st = add_area(s, i, &out->e[out->count++], err);
+    for (int i = 0; st == LM_OK && i < s->light_count; i++)
+        if (s->lights[i].added) {
+            set_punctual(s, i, &out->e[out->count]);
+            st = tag_portals(s, &out->e[out->count++], err);
+        }
+    if (st == LM_OK && s->has_sky) {
+        set_sky(&out->e[out->count]);
+        st = tag_portals(s, &out->e[out->count++], err);
     }
-    for (int i = 0; i < s->light_count; i++)
-        if (s->lights[i].added)
-            set_punctual(s, i, &out->e[out->count++]);
-    if (s->has_sky)
-        set_sky(&out->e[out->count++]);
+    if (st != LM_OK) {
+        lm_emitters_free(out);
+        return st;
+    }
     lm_emitters_update(out, s);
     return LM_OK;
 }
@@ -167,6 +182,10 @@ lm_status lm_emitters_add_sky(lm_emitters *em, const lm_scene *s, lm_error *err)
     if (!e)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the sky", s->path);
     set_sky(e);
+    if (tag_portals(s, e, err) != LM_OK) {
+        em->count--;
+        return LM_ERR_NOMEM;
+    }
     lm_emitters_update(em, s);
     return LM_OK;
 }
@@ -185,6 +204,10 @@ lm_status lm_emitters_add_light(lm_emitters *em, const lm_scene *s, int light, l
     if (!e)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for light '%s'", s->path, s->lights[light].name);
     set_punctual(s, light, e);
+    if (tag_portals(s, e, err) != LM_OK) {
+        em->count--;
+        return LM_ERR_NOMEM;
+    }
     lm_emitters_update(em, s);
     return LM_OK;
 }
@@ -207,6 +230,7 @@ void lm_emitters_free(lm_emitters *em)
     for (int i = 0; em->e && i < em->count; i++) {
         free(em->e[i].tris);
         free(em->e[i].cdf);
+        lm_portals_free(em->e[i].portals);
     }
     free(em->e);
     memset(em, 0, sizeof *em);
@@ -242,7 +266,8 @@ static void place_punctual(lm_emitter *e, const lm_emitters *em, const lm_scene 
     float scale = e->kind == LM_EMIT_POINT ? (float)(4.0 * LM_PI)
                 : e->kind == LM_EMIT_SPOT  ? lm_spot_solid_angle(l)
                                            : fit_rectangle(e, em, s);
-    e->portal_across = e->kind == LM_EMIT_DIRECTIONAL && s->portal_tri_count ? lm_portal_area(s, e->dir) : 0.0;
+    if (e->portals)
+        lm_portals_aim(e->portals, e->dir);
     for (int c = 0; c < 3; c++) {
         e->radiant[c] = dark ? 0.0f : l->color[c] * l->intensity;
         e->power[c] = e->radiant[c] * scale;
@@ -253,6 +278,8 @@ static void place_punctual(lm_emitter *e, const lm_emitters *em, const lm_scene 
  * (L the sky's mean over the sphere; radiant keeps it). */
 static void place_sky(lm_emitter *e, const lm_scene *s, float disk_radius)
 {
+    if (e->portals)
+        lm_portals_aim(e->portals, NULL);
     lm_sky_mean(s, e->radiant);
     for (int c = 0; c < 3; c++)
         e->power[c] = e->radiant[c] * (float)(4.0 * LM_PI * LM_PI) * disk_radius * disk_radius;
@@ -302,6 +329,14 @@ static void place_area(lm_emitter *e, const lm_scene *s)
     e->area = (float)area;
     for (int c = 0; c < 3; c++)
         e->power[c] = (float)pw[c];
+}
+
+void lm_emitter_set_portals(lm_emitters *em, int e, lm_portals *p)
+{
+    lm_portals_free(em->e[e].portals);
+    em->e[e].portals = p;
+    if (p)
+        lm_portals_aim(p, em->e[e].kind == LM_EMIT_DIRECTIONAL ? em->e[e].dir : NULL);
 }
 
 void lm_emitters_update(lm_emitters *em, const lm_scene *s)
@@ -452,18 +487,18 @@ static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[
     } else { /* the fitted rectangle (fit_rectangle), its area the power's; or through a portal */
         lm_vec3 eu = lm_v3_load(e->rect[1]), ev = lm_v3_load(e->rect[2]), r0 = lm_v3_load(e->rect[0]);
         float area = lm_length(eu) * lm_length(ev), x[3];
-        double across = e->portal_across;
+        int guided = e->portals && e->portals->usable;
         d = axis;
         o = lm_add(r0, lm_add(lm_scale(eu, u[0]), lm_scale(ev, u[1])));
-        if (across > 0.0 && u[2] < LM_PORTAL_SHARE && lm_portal_point(s, e->dir, across, u[0], u[1], x)) {
+        if (guided && u[2] < LM_PORTAL_SHARE && lm_portals_sun_point(e->portals, u[0], u[1], x)) {
             lm_vec3 p = lm_v3_load(x); /* moved back along the light onto the rectangle's plane */
             o = lm_sub(p, lm_scale(d, lm_dot(lm_sub(p, r0), d)));
         }
-        if (across > 0.0) { /* the mixture's density at this line (portals.h) */
+        if (guided) { /* the mixture's density at this line (portals.h) */
             float so[3], ua = lm_dot(lm_sub(o, r0), eu) / lm_dot(eu, eu), va = lm_dot(lm_sub(o, r0), ev) / lm_dot(ev, ev);
             lm_v3_store(so, o);
             double in_rect = ua >= 0.0f && ua <= 1.0f && va >= 0.0f && va <= 1.0f;
-            double pdf = (1.0 - LM_PORTAL_SHARE) * in_rect / area + LM_PORTAL_SHARE * lm_portal_crossings(s, so, e->dir) / across;
+            double pdf = (1.0 - LM_PORTAL_SHARE) * in_rect / area + LM_PORTAL_SHARE * lm_portals_density(e->portals, so, e->dir);
             scale *= pdf > 0.0 ? (float)(1.0 / pdf) : 0.0f;
         } else {
             scale *= area;
@@ -478,22 +513,43 @@ static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[
 /* A sky photon: its direction of travel uniform on the sphere (u[0], u[1]: similar directions for QMC
  * strata of those two), its origin uniform on the disk (u[2] radius, u[3] angle) of the scene's bounding
  * sphere across that direction, moved back outside the sphere; flux L(-d) 4 pi pi R^2 / count, L the sky's
- * radiance from where it comes (lm_sky_radiance). */
-static void emit_sky(const lm_emitters *em, const lm_scene *s, const float u[4], uint32_t count, lm_emission *out)
+ * radiance from where it comes (lm_sky_radiance). With portals (portals.h), u[2] below LM_PORTAL_SHARE
+ * draws the line through a portal instead (u[2] rescaled picks it, u[3] the point, u[0], u[1] the
+ * direction about its front), u[2] above it the line as before (u[2] rescaled the radius), the origin on
+ * the same plane across d either way, and the flux is L(-d) over count times the mixture's density. */
+static void emit_sky(const lm_emitter *e, const lm_emitters *em, const lm_scene *s, const float u[4], uint32_t count,
+                     lm_emission *out)
 {
-    float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z)), sn, cs;
-    lm_sincos_turn(u[1], &sn, &cs);
-    lm_vec3 d = lm_v3(r * cs, r * sn, z);
-    float rad = em->disk_radius * sqrtf(u[2]), back = 1.001f * em->disk_radius;
-    lm_sincos_turn(u[3], &sn, &cs);
-    lm_vec3 o = lm_add(lm_sub(lm_v3_load(em->disk_center), lm_scale(d, back)), lm_onb_dir(d, rad * cs, rad * sn, 0.0f));
+    const double uniform = 1.0 / (4.0 * LM_PI * LM_PI * (double)em->disk_radius * em->disk_radius);
+    int guided = e->portals && e->portals->usable;
+    float u2 = guided ? (u[2] - LM_PORTAL_SHARE) / (1.0f - LM_PORTAL_SHARE) : u[2], x[3], w[3];
+    lm_vec3 c = lm_v3_load(em->disk_center), d, o;
+    float back = 1.001f * em->disk_radius, sn, cs;
+    if (guided && u[2] < LM_PORTAL_SHARE && lm_portals_sky_line(e->portals, u[2] / LM_PORTAL_SHARE, u[3], u[0], u[1], x, w)) {
+        d = lm_scale(lm_v3_load(w), -1.0f); /* onto the uniform lines' plane across d, through x */
+        lm_vec3 p = lm_v3_load(x);
+        o = lm_sub(p, lm_scale(d, lm_dot(lm_sub(p, c), d) + back));
+    } else {
+        float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+        lm_sincos_turn(u[1], &sn, &cs);
+        d = lm_v3(r * cs, r * sn, z);
+        float rad = em->disk_radius * sqrtf(fminf(fmaxf(u2, 0.0f), 1.0f));
+        lm_sincos_turn(u[3], &sn, &cs);
+        o = lm_add(lm_sub(c, lm_scale(d, back)), lm_onb_dir(d, rad * cs, rad * sn, 0.0f));
+    }
     lm_v3_store(out->org, o);
     lm_v3_store(out->dir, d);
-    float scale = (float)(4.0 * LM_PI * LM_PI) * em->disk_radius * em->disk_radius / (float)count, from[3], L[3];
+    double pdf = uniform;
+    if (guided) { /* the mixture's density at this line: the uniform lines' where it crosses their disk */
+        lm_vec3 off = lm_sub(lm_sub(o, c), lm_scale(d, lm_dot(lm_sub(o, c), d)));
+        double in_disk = lm_dot(off, off) <= em->disk_radius * em->disk_radius * 1.0001f;
+        pdf = (1.0 - LM_PORTAL_SHARE) * in_disk * uniform + LM_PORTAL_SHARE * lm_portals_density(e->portals, out->org, out->dir);
+    }
+    float scale = pdf > 0.0 ? (float)(1.0 / (pdf * (double)count)) : 0.0f, from[3], L[3];
     lm_v3_store(from, lm_scale(d, -1.0f));
     lm_sky_radiance(s, from, L);
-    for (int c = 0; c < 3; c++)
-        out->flux[c] = L[c] * scale;
+    for (int k = 0; k < 3; k++)
+        out->flux[k] = L[k] * scale;
 }
 
 void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, const lm_emit_tri *tris,
@@ -506,7 +562,7 @@ void lm_emitter_emit_placed(const lm_emitters *em, const lm_scene *s, int e, con
     if (em_e->punctual && em_e->luminance > 0.0f) /* a light switched off or removed: no photon */
         emit_punctual(s, em_e, u, count, out);
     else if (em_e->kind == LM_EMIT_SKY && em_e->luminance > 0.0f)
-        emit_sky(em, s, u, count, out);
+        emit_sky(em_e, em, s, u, count, out);
     else if (em_e->tri_count > 0 && em_e->cdf[em_e->tri_count - 1] > 0.0f)
         emit_area(em_e, tris, s, u, count, out);
 }

@@ -10,7 +10,8 @@
  * that covers the scene's bounds across a direction drawn uniformly on the sphere, each with the radiance
  * from where it comes, flux 4 pi mean(L) x pi R^2 in all; it has no next-event estimation (the reference
  * meets it where rays leave the scene) and no caustic photons. It is the last emitter of a list built with
- * it; node and light are -1. */
+ * it; node and light are -1. A directional light's and the sky's photons may be aimed in part through
+ * portals (portals.h: the file's, or those found, portal_finder.h), each weighed so the estimate stays. */
 #ifndef LM_LIGHTS_H
 #define LM_LIGHTS_H
 
@@ -18,6 +19,7 @@
 
 #include "../core/error.h"
 #include "../scene/scene.h"
+#include "portals.h"
 
 typedef enum { LM_EMIT_POINT = 0, LM_EMIT_SPOT, LM_EMIT_DIRECTIONAL, LM_EMIT_AREA, LM_EMIT_SKY } lm_emitter_kind;
 
@@ -39,7 +41,9 @@ typedef struct {
     float radiant[3];     /* point/spot: intensity x colour; directional: illuminance x colour */
     float rect[3][3];     /* directional: the rectangle its photons leave from, across its direction and
                            * upstream of the scene: a corner and its two edges (lights.c, "fitted") */
-    double portal_across; /* directional: the scene's portals' area across it (lm_portal_area; 0: none) */
+    lm_portals *portals;  /* directional and sky: where a share of its photons is aimed (portals.h): the
+                           * file's portals, or those found from its photons (portal_finder.h); NULL: none.
+                           * Owned; aimed at each placement */
 } lm_emitter;
 
 typedef struct {
@@ -65,6 +69,9 @@ int lm_emitters_light_count(const lm_emitters *em);
 int lm_emitter_removed(const lm_scene *s, const lm_emitter *e);
 /* Re-reads emitter placement and flux after node moves or light edits (world matrices, bounds). */
 void lm_emitters_update(lm_emitters *em, const lm_scene *s);
+/* Emitter e's photons aimed through portals p from now on (taking p, aimed for it at once and at every
+ * lm_emitters_update), in place of what it had; NULL: none. */
+void lm_emitter_set_portals(lm_emitters *em, int e, lm_portals *p);
 
 /* A photon leaving emitter e: origin, unit direction, and its flux for a total of `count` photons
  * from this emitter (flux = power / count, times any falloff weight). u: 4 uniform numbers in [0,1)

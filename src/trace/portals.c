@@ -1,70 +1,203 @@
-/* Portals: sampling through openings, and the density of a ray crossing them (portals.h). */
+/* Portals: sampling lines through openings, and the density of a line crossing them (portals.h). */
 #include "portals.h"
 
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "../core/vecmath.h"
 
-static void corners(const lm_scene *s, uint32_t i, lm_vec3 c[3])
+static void corners(const lm_portals *p, uint32_t i, lm_vec3 c[3])
 {
     for (int k = 0; k < 3; k++)
-        c[k] = lm_v3_load(s->portal_tris + 9 * (size_t)i + 3 * (size_t)k);
+        c[k] = lm_v3_load(p->tris + 9 * (size_t)i + 3 * (size_t)k);
 }
 
-/* Triangle i's area across direction d: 0 unless d enters by its front. */
-static double weight(const lm_scene *s, uint32_t i, const float *d)
+/* Twice the area times the unit normal of triangle i (its front, counter-clockwise). */
+static lm_vec3 front(const lm_portals *p, uint32_t i)
 {
     lm_vec3 c[3];
-    corners(s, i, c);
-    lm_vec3 front = lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0]));
-    return fmax(-0.5 * lm_dot(front, lm_v3_load(d)), 0.0); /* half |front| times the cosine */
+    corners(p, i, c);
+    return lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0]));
 }
 
-int lm_portal_crossings(const lm_scene *s, const float o[3], const float d[3])
+lm_portals *lm_portals_make(const float *tris, const double *weight, const unsigned char *tagged, uint32_t n,
+                            lm_error *err)
+{
+    lm_portals *p = calloc(1, sizeof *p);
+    if (p) {
+        p->count = n;
+        p->tagged = calloc((size_t)n + 1, 1);
+        p->tris = malloc(sizeof *p->tris * 9 * ((size_t)n + 1));
+        p->weight = malloc(sizeof *p->weight * ((size_t)n + 1));
+        p->area = malloc(sizeof *p->area * ((size_t)n + 1));
+        p->density = calloc((size_t)n + 1, sizeof *p->density);
+        p->cdf = calloc((size_t)n + 1, sizeof *p->cdf);
+        p->normal = malloc(sizeof *p->normal * 3 * ((size_t)n + 1));
+    }
+    if (!p || !p->tris || !p->weight || !p->tagged || !p->area || !p->density || !p->cdf || !p->normal) {
+        lm_portals_free(p);
+        lm_fail(err, LM_ERR_NOMEM, "portals: no memory for %u triangles", n);
+        return NULL;
+    }
+    memcpy(p->tris, tris, sizeof *p->tris * 9 * (size_t)n);
+    for (uint32_t i = 0; i < n; i++) {
+        lm_vec3 f = front(p, i);
+        float len = lm_length(f);
+        p->area[i] = 0.5 * (double)len;
+        lm_v3_store(p->normal + 3 * (size_t)i, len > 0.0f ? lm_scale(f, 1.0f / len) : lm_v3(0, 0, 0));
+        p->weight[i] = weight ? weight[i] : p->area[i];
+        p->tagged[i] = tagged ? tagged[i] != 0 : 0;
+        p->found += !p->tagged[i];
+    }
+    return p;
+}
+
+lm_portals *lm_portals_tagged(const float *tris, uint32_t n, lm_error *err)
+{
+    unsigned char *all = malloc((size_t)n + 1);
+    if (!all) {
+        lm_fail(err, LM_ERR_NOMEM, "portals: no memory for %u triangles", n);
+        return NULL;
+    }
+    memset(all, 1, (size_t)n + 1);
+    lm_portals *p = lm_portals_make(tris, NULL, all, n, err);
+    free(all);
+    return p;
+}
+
+lm_portals *lm_portals_copy(const lm_portals *p, lm_error *err)
+{
+    lm_portals *c = lm_portals_make(p->tris, p->weight, p->tagged, p->count, err);
+    if (c) {
+        memcpy(c->density, p->density, sizeof *c->density * p->count);
+        memcpy(c->cdf, p->cdf, sizeof *c->cdf * p->count);
+        c->usable = p->usable;
+    }
+    return c;
+}
+
+void lm_portals_free(lm_portals *p)
+{
+    if (!p)
+        return;
+    free(p->tris);
+    free(p->weight);
+    free(p->tagged);
+    free(p->area);
+    free(p->density);
+    free(p->cdf);
+    free(p->normal);
+    free(p);
+}
+
+/* Sun: a tagged portal is picked by its area across the light (its weight is its area), a found one by
+ * its weight; neither where its front does not face the light. Sky: by weight. */
+static double pick_weight(const lm_portals *p, uint32_t i, const float *d, double *cosine)
+{
+    *cosine = 1.0;
+    if (!(p->area[i] > 0.0) || !(p->weight[i] > 0.0))
+        return 0.0;
+    if (!d)
+        return p->weight[i];
+    *cosine = -lm_dot(lm_v3_load(p->normal + 3 * (size_t)i), lm_v3_load(d));
+    if (!(*cosine > 0.0))
+        return 0.0;
+    return p->tagged[i] ? p->weight[i] * *cosine : p->weight[i];
+}
+
+void lm_portals_aim(lm_portals *p, const float d[3])
+{
+    double sum = 0.0;
+    for (uint32_t i = 0; i < p->count; i++) {
+        double cosine;
+        sum += p->cdf[i] = pick_weight(p, i, d, &cosine);
+    }
+    p->usable = sum > 0.0;
+    double acc = 0.0;
+    for (uint32_t i = 0; i < p->count; i++) {
+        double cosine, w = p->cdf[i], prob = p->usable ? w / sum : 0.0;
+        pick_weight(p, i, d, &cosine);
+        acc += prob;
+        p->cdf[i] = acc;
+        p->density[i] = prob > 0.0 ? prob / (p->area[i] * (d ? cosine : LM_PI)) : 0.0;
+    }
+    if (p->usable) /* the last pickable one ends the table at 1 exactly */
+        for (uint32_t i = p->count; i-- > 0;)
+            if (p->density[i] > 0.0) {
+                for (uint32_t k = i; k < p->count; k++)
+                    p->cdf[k] = 1.0;
+                break;
+            }
+}
+
+/* The pickable triangle whose share of the table holds u, and u's place within that share. */
+static uint32_t pick(const lm_portals *p, double u, double *rest)
+{
+    uint32_t lo = 0, hi = p->count - 1;
+    while (lo < hi) {
+        uint32_t mid = (lo + hi) / 2;
+        if (p->cdf[mid] > u)
+            hi = mid;
+        else
+            lo = mid + 1;
+    }
+    while (!(p->density[lo] > 0.0) && lo > 0) /* u at a share's end rounded onto an empty one */
+        lo--;
+    double a = lo ? p->cdf[lo - 1] : 0.0, b = p->cdf[lo];
+    *rest = b > a ? fmin(fmax((u - a) / (b - a), 0.0), 0x1.fffffep-1) : 0.5;
+    return lo;
+}
+
+/* Uniform on triangle i from two numbers. */
+static lm_vec3 on_triangle(const lm_portals *p, uint32_t i, double a, float b)
+{
+    lm_vec3 c[3];
+    corners(p, i, c);
+    float r = sqrtf((float)a);
+    return lm_add(lm_scale(c[0], 1.0f - r), lm_add(lm_scale(c[1], r * (1.0f - b)), lm_scale(c[2], r * b)));
+}
+
+int lm_portals_sun_point(const lm_portals *p, float u0, float u1, float x[3])
+{
+    if (!p || !p->usable)
+        return 0;
+    double rest;
+    uint32_t i = pick(p, u0, &rest);
+    lm_v3_store(x, on_triangle(p, i, rest, u1));
+    return 1;
+}
+
+int lm_portals_sky_line(const lm_portals *p, float u_pick, float u_tri, float u0, float u1, float x[3], float w[3])
+{
+    if (!p || !p->usable)
+        return 0;
+    double rest;
+    uint32_t i = pick(p, u_pick, &rest);
+    lm_v3_store(x, on_triangle(p, i, rest, u_tri));
+    float r = sqrtf(u0), sn, cs;
+    lm_sincos_turn(u1, &sn, &cs);
+    lm_v3_store(w, lm_onb_dir(lm_v3_load(p->normal + 3 * (size_t)i), r * cs, r * sn, sqrtf(1.0f - u0)));
+    return 1;
+}
+
+double lm_portals_density(const lm_portals *p, const float o[3], const float d[3])
 {
     lm_vec3 O = lm_v3_load(o), D = lm_v3_load(d);
-    int k = 0;
-    for (uint32_t i = 0; i < s->portal_tri_count; i++) { /* Moller-Trumbore, the line's side t > 0 */
+    double sum = 0.0;
+    for (uint32_t i = 0; p && i < p->count; i++) { /* Moller-Trumbore, the line's side t > 0 */
+        if (!(p->density[i] > 0.0))
+            continue;
         lm_vec3 c[3];
-        corners(s, i, c);
+        corners(p, i, c);
         lm_vec3 e1 = lm_sub(c[1], c[0]), e2 = lm_sub(c[2], c[0]), q = lm_cross(D, e2);
         float det = lm_dot(e1, q);
         if (!(lm_dot(lm_cross(e1, e2), D) < 0.0f) || fabsf(det) < 1e-30f)
             continue; /* not entering by its front */
         lm_vec3 tv = lm_sub(O, c[0]), r = lm_cross(tv, e1);
         float a = lm_dot(tv, q) / det, b = lm_dot(D, r) / det, t = lm_dot(e2, r) / det;
-        k += a >= 0.0f && b >= 0.0f && a + b <= 1.0f && t > 0.0f;
+        if (a >= 0.0f && b >= 0.0f && a + b <= 1.0f && t > 0.0f)
+            sum += p->density[i];
     }
-    return k;
-}
-
-double lm_portal_area(const lm_scene *s, const float d[3])
-{
-    double sum = 0.0;
-    for (uint32_t i = 0; i < s->portal_tri_count; i++)
-        sum += weight(s, i, d);
     return sum;
-}
-
-int lm_portal_point(const lm_scene *s, const float d[3], double total, float u0, float u1, float p[3])
-{
-    double at = (double)u0 * total, w = 0.0;
-    if (!(total > 0.0))
-        return 0;
-    uint32_t i = 0;
-    for (; i < s->portal_tri_count; i++) { /* the triangle whose share holds u0, and u0 within it */
-        w = weight(s, i, d);
-        if (w > 0.0 && (at < w || i + 1 == s->portal_tri_count))
-            break;
-        at -= w;
-    }
-    if (!(w > 0.0)) /* u0 rounded past the last facing triangle: the last one that faces */
-        for (i = s->portal_tri_count; i-- > 0 && !((w = weight(s, i, d)) > 0.0);)
-            ;
-    float a = (float)fmin(fmax(at / w, 0.0), 1.0), r = sqrtf(a); /* uniform on the triangle */
-    lm_vec3 c[3];
-    corners(s, i, c);
-    lm_vec3 x = lm_add(lm_scale(c[0], 1.0f - r), lm_add(lm_scale(c[1], r * (1.0f - u1)), lm_scale(c[2], r * u1)));
-    lm_v3_store(p, x);
-    return 1;
 }

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../core/timing.h"
+#include "../trace/portal_finder.h"
 #include "../trace/sealed_lights.h"
 
 /* Shadow rays per emissive triangle and point (trace/emitter_light.h): an AIM texel takes 4 points (its
@@ -66,6 +67,7 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     s->surfaces_per_frame = 4;
     s->trace = 1;
     s->aims = 1;
+    s->find_portals = 1;
     lm_caustic_settings_default(&s->caustic);
 }
 
@@ -258,6 +260,32 @@ static uint64_t worst_refresh(const lm_photon_stage *ps)
     return most;
 }
 
+/* Each sun's and the sky's portals found again (trace/portal_finder.h: the openings, or the file's, and the
+ * places outside that light through them); an emitter whose portals changed has its groups queued (its
+ * photons go elsewhere now: the full trace that follows at setup and converge takes them). */
+static lm_status find_portals(lm_photon_stage *ps, lm_error *err)
+{
+    if (!ps->set.trace || !ps->set.find_portals)
+        return LM_OK;
+    for (int e = 0; e < ps->emitters.count; e++) {
+        if (!lm_portals_guide(&ps->emitters.e[e]))
+            continue;
+        lm_portals *found = NULL;
+        lm_status st = lm_portals_find(ps->scene, ps->surfaces, ps->rt, &ps->emitters.e[e], &found, err);
+        if (st == LM_OK && lm_portals_same(found, ps->emitters.e[e].portals)) {
+            lm_portals_free(found);
+            continue;
+        }
+        if (st == LM_OK) {
+            lm_emitter_set_portals(&ps->emitters, e, found);
+            st = lm_photons_invalidate_emitter(ps->photons, e, err);
+        }
+        if (st != LM_OK)
+            return st;
+    }
+    return LM_OK;
+}
+
 static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_error *err)
 {
     double t0 = lm_now();
@@ -287,6 +315,8 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     st = lm_photons_create(ps->scene, ps->surfaces, ps->rt, &ps->emitters, &photons, &ps->photons, err);
     if (st == LM_OK)
         lm_photons_set_split(ps->photons, &ps->set.split);
+    if (st == LM_OK)
+        st = find_portals(ps, err);
     if (st == LM_OK && ps->set.trace)
         st = lm_photons_trace_all(ps->photons, &first->photons, err);
     double t1 = lm_now();
@@ -459,6 +489,8 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage
     if (st != LM_OK || !ps->set.trace)
         return st;
     double t1 = lm_now();
+    if (st == LM_OK)
+        st = find_portals(ps, err);
     if (st == LM_OK)
         st = lm_photons_trace_all(ps->photons, &out->photons, err);
     double t2 = lm_now();

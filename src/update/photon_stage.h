@@ -26,6 +26,8 @@ typedef struct {
                               * them: no work at all). Default 0; the frame loop follows the scene's effects */
     lm_caustic_settings caustic;
     lm_photon_split split;   /* full traces shared among processes (photons.h); zero: none */
+    int find_portals;        /* 1 (default): suns' and the sky's portals found (trace/portal_finder.h) at setup
+                              * and at every converge, where the file tags none; 0: only the file's */
 } lm_photon_stage_settings;
 
 typedef struct {
