@@ -211,6 +211,9 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
     printf("%s %u texels (%s) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather %.0f ms)\n", what,
            in.texels, atlas, ui.photons, lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim,
            ui.ms_setup_gather);
+    if (ui.portals_found)
+        printf("portals     %d found where the sun's or the sky's light gets in (docs/levels.md, \"Portals\")\n",
+               ui.portals_found);
     lm_cli_page_files(exr, sizeof exr, "lightmap", in.pages, ".exr");
     lm_cli_page_files(png, sizeof png, "lightmap", in.pages, ".png");
     lm_cli_page_files(aim, sizeof aim, "aim", in.pages, ".exr");
@@ -225,6 +228,12 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
         lm_cli_page_files(exr, sizeof exr, base, in.pages, ".exr");
         printf("            %s/%s.gltf (TEXCOORD_1: the lightmap's UVs) with %s and .png\n", a->out_dir, name, exr);
     }
+}
+
+uint32_t lm_cli_bake_photons(uint32_t texels)
+{
+    uint64_t n = (uint64_t)LM_CLI_BAKE_PHOTONS_PER_TEXEL * texels;
+    return n < LM_CLI_BAKE_PHOTONS_MIN ? LM_CLI_BAKE_PHOTONS_MIN : n > LM_CLI_BAKE_PHOTONS_MAX ? LM_CLI_BAKE_PHOTONS_MAX : (uint32_t)n;
 }
 
 /* bake (parts NULL) and merge (the parts' checkpoint files): the updater's first full solution, then the
@@ -246,6 +255,8 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     }
     lmgi_updater_desc d;
     lm_cli_updater_desc(a, &d);
+    if (!a->photons && !a->per_group)
+        d.photons = lm_cli_bake_photons(in.texels);
     d.frame_width = d.frame_height = 0;
     d.error_estimate = a->accuracy;
     double started = lm_cli_now();

@@ -104,7 +104,8 @@ const lm_cli_option lm_cli_options[] = {
     {"--seed", NULL, "N", UPDATER | REFERENCE_USERS, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_seed,
      "the random sequences' seed (photons' scramble, the reference's paths)"},
     {"--photons", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, photons), 1, 100000000, NULL,
-     "total photon budget (default: groups x per-group)"},
+     "total photon budget (default: groups x per-group, at least 46,080; bake:\n"
+     "4 a texel of its atlas, 46,080 to 1,048,576)"},
     {"--groups", NULL, "G", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_groups,
      "photon groups, 2^a 3^b (default 72)"},
     {"--per-group", NULL, "M", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, per_group), 1, 10000000, NULL,
