@@ -8,9 +8,9 @@
 int lm_cli_bake(const lm_cli_args *a);
 /* A bake's photons when --photons and --per-group are not given: LM_CLI_BAKE_PHOTONS_PER_TEXEL a texel of
  * its atlas, within [MIN, MAX]. Its AIMs are as fine as its atlas, and an N-nearest estimate of fewer photons
- * than texels spans several of them: a sunlit room baked at 65,536 texels from the updater's 46,080 photons
- * read 12-35% off on its walls and sofa, mottled, and within 5% from 262,144 (docs/photons.md, "A bake's
- * photons"). Tracing them costs a few percent of the gather. */
+ * than texels spans several of them: the sunlit living room baked at 65,536 texels from the updater's
+ * 46,080 photons read 3-8% bright on its walls and 25-58% on its furniture, mottled, and from 270,716 within
+ * 3% and 7% (docs/photons.md, "A bake's photons"). Tracing them costs a few percent of the gather. */
 #define LM_CLI_BAKE_PHOTONS_PER_TEXEL 4u
 #define LM_CLI_BAKE_PHOTONS_MIN 46080u
 #define LM_CLI_BAKE_PHOTONS_MAX 1048576u
