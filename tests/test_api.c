@@ -874,8 +874,8 @@ static void test_bad_arguments(void **state)
     lmgi_error e;
     lmgi_updater_desc d;
     static const char *const named[] = {"hemicube_samples 3", "frame 10 x 0", "camera 7", "blend_frames -5",
-                                        "enlargement", "groups", "shadow_maps_per_update -5"};
-    for (int k = 0; k < 7; k++) {
+                                        "enlargement", "groups", "shadow_maps_per_update -5", "find_portals 1"};
+    for (int k = 0; k < 8; k++) {
         small_desc(&d);
         if (k == 0)
             d.hemicube_samples = 3;
@@ -891,6 +891,8 @@ static void test_bad_arguments(void **state)
             d.groups = 5; /* not 2^a 3^b */
         if (k == 6)
             d.shadow_maps_per_update = -5; /* -1 is "all", other negatives nothing */
+        if (k == 7)
+            d.find_portals = 1; /* 0 on, -1 off */
         u = (lmgi_updater *)sc;
         expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, named[k]);
         assert_null(u);

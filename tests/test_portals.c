@@ -69,8 +69,9 @@ typedef struct {
 
 static const char *room(const char *name, int portal, const char *sky) { return lit_room(name, portal, sky, 20.0); }
 
-/* find: whether the updater looks for portals (lmgi_updater_desc.find_portals). */
-static outcome bake(const char *path, const lmgi_camera *cam, uint32_t photons, int find)
+/* find: whether the updater looks for portals (lmgi_updater_desc.find_portals); target: the reference's
+ * relative error per pixel. */
+static outcome bake(const char *path, const lmgi_camera *cam, uint32_t photons, int find, float target)
 {
     lmgi_scene *sc = lmt_load(path, 4000);
     lmgi_context *ctx = NULL;
@@ -113,7 +114,7 @@ static outcome bake(const char *path, const lmgi_camera *cam, uint32_t photons, 
     }
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
-    rd.target_error = 0.03f;
+    rd.target_error = target;
     lmgi_check_result c;
     assert_int_equal(lmgi_check_updater(u, cam, 48, 48, &rd, &c, &e), LMGI_OK);
     memcpy(o.ratio, c.ratio, sizeof o.ratio);
@@ -148,8 +149,8 @@ static void assert_guided(const outcome *o, const outcome *none, const outcome *
 /* The room at the default photons with neither portal (finding switched off), with the window tagged, and
  * untagged with its window found; and without portals at 16 times the photons. Measured (frame /
  * reference): the sun alone none 1.122 (its AIM +37%), tagged 0.973, found 0.982; the sun and the sky none
- * 0.949 (56 of 173 texels inside at 0), tagged 0.960, found 0.978; the sky alone none 0.474 (every texel
- * inside at 0), tagged 1.036, found 1.039. Over seeds 1 to 3 the tagged and found frames stay within 5%
+ * 0.947 (56 of 173 texels inside at 0), tagged 0.958, found 0.976; the sky alone none 0.472 (every texel
+ * inside at 0), tagged 1.033, found 1.036. Over seeds 1 to 3 the tagged and found frames stay within 5%
  * but for two at -5.1% and -8% (the tagged sun and sky of seed 2). */
 static void compare(const char *what, const char *sky, double sun)
 {
@@ -159,9 +160,13 @@ static void compare(const char *what, const char *sky, double sun)
     char open[1024];
     snprintf(name, sizeof name, "%s_open", what);
     snprintf(open, sizeof open, "%s", lit_room(name, 0, sky, sun));
-    outcome none = bake(open, &cam, 0, 0), many = bake(open, NULL, 16 * 46080, 0), found = bake(open, &cam, 0, 1);
+    /* the sky through a window is slow to path-trace: its references are noisier, still about 0.1% over the
+     * frame's 2,000 pixels */
+    float target = sky[0] ? 0.06f : 0.03f;
+    outcome none = bake(open, &cam, 0, 0, target), many = bake(open, NULL, 16 * 46080, 0, target);
+    outcome found = bake(open, &cam, 0, 1, target);
     snprintf(name, sizeof name, "%s_portal", what);
-    outcome tagged = bake(lit_room(name, 1, sky, sun), &cam, 0, 1);
+    outcome tagged = bake(lit_room(name, 1, sky, sun), &cam, 0, 1, target);
     print_message("%s, 16 x the photons, no portal: AIM mean inside %.5f, %u of %u valid texels 0\n", what,
                   many.aim_mean, many.dark, many.valid);
     print_outcome(what, "no portal", &none);
@@ -396,7 +401,7 @@ static void test_sunlit_room_against_reference(void **state)
     d.frame_width = d.frame_height = 64;
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
-    rd.target_error = 0.03f;
+    rd.target_error = 0.05f;
     lmgi_check_result c;
     if (lmgi_check(ctx, sc, &d, &rd, 1, &c, &e) != LMGI_OK)
         fail_msg("%s", e.message);

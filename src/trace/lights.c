@@ -498,7 +498,8 @@ static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[
             float so[3], ua = lm_dot(lm_sub(o, r0), eu) / lm_dot(eu, eu), va = lm_dot(lm_sub(o, r0), ev) / lm_dot(ev, ev);
             lm_v3_store(so, o);
             double in_rect = ua >= 0.0f && ua <= 1.0f && va >= 0.0f && va <= 1.0f;
-            double pdf = (1.0 - LM_PORTAL_SHARE) * in_rect / area + LM_PORTAL_SHARE * lm_portals_density(e->portals, so, e->dir);
+            double pdf = (1.0 - LM_PORTAL_SHARE) * in_rect / area +
+                         LM_PORTAL_SHARE * lm_portals_density(e->portals, so, e->dir);
             scale *= pdf > 0.0 ? (float)(1.0 / pdf) : 0.0f;
         } else {
             scale *= area;
@@ -543,7 +544,8 @@ static void emit_sky(const lm_emitter *e, const lm_emitters *em, const lm_scene 
     if (guided) { /* the mixture's density at this line: the uniform lines' where it crosses their disk */
         lm_vec3 off = lm_sub(lm_sub(o, c), lm_scale(d, lm_dot(lm_sub(o, c), d)));
         double in_disk = lm_dot(off, off) <= em->disk_radius * em->disk_radius * 1.0001f;
-        pdf = (1.0 - LM_PORTAL_SHARE) * in_disk * uniform + LM_PORTAL_SHARE * lm_portals_density(e->portals, out->org, out->dir);
+        pdf = (1.0 - LM_PORTAL_SHARE) * in_disk * uniform +
+              LM_PORTAL_SHARE * lm_portals_density(e->portals, out->org, out->dir);
     }
     float scale = pdf > 0.0 ? (float)(1.0 / (pdf * (double)count)) : 0.0f, from[3], L[3];
     lm_v3_store(from, lm_scale(d, -1.0f));

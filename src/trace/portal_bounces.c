@@ -27,22 +27,6 @@
 #define CELL_LEVELS 7     /* and up to 2^6 times that, far from it */
 #define ENTER_RAYS 64     /* rays from a place that measure the chance its light gets in */
 
-/* A place outside the light reaches and the look that found it sees through an opening. */
-typedef struct {
-    float pos[3], normal[3]; /* the side lit, facing the light */
-    double worth;
-    int64_t key[7];          /* its plane (normal in hundredths, offset), its cells' size and cell, to gather by */
-} place;
-
-static int by_cell(const void *x, const void *y)
-{
-    const place *a = x, *b = y;
-    for (int k = 0; k < 7; k++)
-        if (a->key[k] != b->key[k])
-            return a->key[k] < b->key[k] ? -1 : 1;
-    return 0;
-}
-
 /* The diffuse albedo of the material at hit h (its base colour's luminance; none for mirror and glass). */
 static double albedo(const lm_scene *s, const lm_rt_hit *h)
 {
@@ -78,7 +62,7 @@ static double light_at(const lm_scene *s, const lm_rt *rt, const lm_emitter *e, 
  * in (per unit of the light's, over pi for the sky), the unit the openings' worth is in (portal_finder.c).
  * Returns how many. */
 static uint32_t places(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d, const lm_emitter *e,
-                       const lm_found_rect *open, uint32_t n_open, place *out, double *sky_in)
+                       const lm_found_rect *open, uint32_t n_open, lm_found_point *out, double *sky_in)
 {
     static const lm_emitter sky = {.kind = LM_EMIT_SKY}; /* the rays are cosine-distributed, as the sky's */
     double cell = lm_scene_size(s) / CELLS_ACROSS, plane_step = lm_scene_size(s) / 4096.0;
@@ -90,7 +74,8 @@ static uint32_t places(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d
         for (uint32_t i = 0; i < each; i++) {
             float u[6], o[3], dir[3];
             lm_look_numbers(1, i, 6, u);
-            lm_vec3 at = lm_found_rect_point(r, r->lo[0] + u[0] * (r->hi[0] - r->lo[0]), r->lo[1] + u[1] * (r->hi[1] - r->lo[1]));
+            double x = r->lo[0] + u[0] * (r->hi[0] - r->lo[0]), y0 = r->lo[1] + u[1] * (r->hi[1] - r->lo[1]);
+            lm_vec3 at = lm_found_rect_point(r, x, y0);
             lm_vec3 org = lm_add(at, lm_scale(r->n, d->offset)), w = lm_look_direction(&sky, r->n, u[2], u[3]);
             lm_rt_hit hit;
             lm_v3_store(o, org);
@@ -107,7 +92,8 @@ static uint32_t places(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d
                 continue;
             lm_vec3 ng = lm_v3_load(hit.ng), y = lm_add(org, lm_scale(w, hit.t));
             lm_vec3 lit = lm_dot(ng, w) < 0.0f ? ng : lm_scale(ng, -1.0f), t, b;
-            place *p = &out[n];
+            lm_found_point *p = &out[n];
+            memset(p, 0, sizeof *p);
             p->worth = albedo(s, &hit) * light_at(s, rt, e, y, lit, d->offset, u[4], u[5]) * area / each;
             if (!(p->worth > 0.0))
                 continue;
@@ -116,9 +102,7 @@ static uint32_t places(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d
             lm_tangents(lit, &t, &b);
             int level = (int)floor(log2(1.0 + lm_length(lm_sub(y, mid)) / cell));
             double side = cell * (double)(1 << (level < CELL_LEVELS - 1 ? level : CELL_LEVELS - 1));
-            for (int c = 0; c < 3; c++)
-                p->key[c] = (int64_t)lround(100.0 * p->normal[c]);
-            p->key[3] = (int64_t)floor(lm_dot(y, lit) / plane_step);
+            lm_found_point_plane(p, plane_step);
             p->key[4] = (int64_t)lround(side / cell);
             p->key[5] = (int64_t)floor(lm_dot(y, t) / side);
             p->key[6] = (int64_t)floor(lm_dot(y, b) / side);
@@ -162,20 +146,20 @@ uint32_t lm_find_bounces(const lm_scene *s, const lm_rt *rt, const lm_look_draw 
     if (!n_openings)
         return 0;
     memset(sky_in, 0, sizeof *sky_in * n_openings);
-    place *p = malloc(sizeof *p * (LM_FIND_LOOKS + 1));
+    lm_found_point *p = malloc(sizeof *p * (LM_FIND_LOOKS + 1));
     if (!p) {
         lm_fail(err, LM_ERR_NOMEM, "portals: no memory to look out of the openings");
         return UINT32_MAX;
     }
     uint32_t n = places(s, rt, d, e, openings, n_openings, p, sky_in), k = 0;
     double cell = lm_scene_size(s) / CELLS_ACROSS;
-    qsort(p, n, sizeof *p, by_cell);
+    qsort(p, n, sizeof *p, lm_found_point_order);
     for (uint32_t i = 0, j; i < n && k < cap; i = j) { /* each cell's places in turn: its square on their plane */
         lm_found_rect *r = &out[k++];
         memset(r, 0, sizeof *r);
         r->n = lm_normalize(lm_v3_load(p[i].normal));
         lm_tangents(r->n, &r->t, &r->b);
-        for (j = i; j < n && !by_cell(&p[i], &p[j]); j++) {
+        for (j = i; j < n && !lm_found_point_order(&p[i], &p[j]); j++) {
             r->worth += p[j].worth;
             r->level += lm_dot(lm_v3_load(p[j].pos), r->n);
         }

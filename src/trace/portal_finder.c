@@ -8,6 +8,7 @@
 
 #include "../core/log.h"
 #include "../core/qmc.h"
+#include "../core/stats.h"
 #include "portal_looks.h"
 
 int lm_portals_guide(const lm_emitter *e) { return e->kind == LM_EMIT_DIRECTIONAL || e->kind == LM_EMIT_SKY; }
@@ -55,14 +56,7 @@ void lm_look_draw_free(lm_look_draw *d)
 void lm_look_point(const lm_look_draw *d, const lm_scene *s, const float u[3], lm_vec3 *x, lm_vec3 *front,
                    lm_vec3 *org)
 {
-    uint32_t lo = 0, hi = d->count - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (d->cdf[mid] > u[0])
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
+    uint32_t lo = lm_cdf_draw(d->cdf, d->count, u[0]);
     float c[3][3];
     for (int k = 0; k < 3; k++)
         lm_scene_vertex_world(s, s->tris[3 * (size_t)d->tri[lo] + (size_t)k], c[k]);
@@ -86,6 +80,22 @@ lm_vec3 lm_look_direction(const lm_emitter *e, lm_vec3 front, float u0, float u1
     float q = sqrtf(u0), sn, cs;
     lm_sincos_turn(u1, &sn, &cs);
     return lm_onb_dir(front, q * cs, q * sn, sqrtf(1.0f - u0));
+}
+
+void lm_found_point_plane(lm_found_point *p, double step)
+{
+    for (int k = 0; k < 3; k++)
+        p->key[k] = (int64_t)lround(100.0 * p->normal[k]);
+    p->key[3] = (int64_t)floor(lm_dot(lm_v3_load(p->pos), lm_v3_load(p->normal)) / step);
+}
+
+int lm_found_point_order(const void *x, const void *y)
+{
+    const lm_found_point *a = x, *b = y;
+    for (int k = 0; k < 7; k++)
+        if (a->key[k] != b->key[k])
+            return a->key[k] < b->key[k] ? -1 : 1;
+    return 0;
 }
 
 lm_vec3 lm_found_rect_point(const lm_found_rect *r, double x, double y)
@@ -255,7 +265,9 @@ lm_status lm_portals_find(const lm_scene *s, const lm_surfaces *su, const lm_rt 
         st = LM_ERR_NOMEM;
     for (uint32_t k = 0; st == LM_OK && !tagged && k < open; k++) /* a look stands for its share of the area */
         r[k].worth *= d.area / LM_FIND_LOOKS;
-    if (st == LM_OK && open > 0 && (places = lm_find_bounces(s, rt, &d, e, r, open, r + open, cap, sky_in, err)) == UINT32_MAX)
+    if (st == LM_OK && open > 0)
+        places = lm_find_bounces(s, rt, &d, e, r, open, r + open, cap, sky_in, err);
+    if (places == UINT32_MAX)
         st = LM_ERR_NOMEM;
     if (st == LM_OK && open > 0)
         st = (*out = portals_of(s, e, r, open, open + places, tagged, sky_in, err)) ? LM_OK : LM_ERR_NOMEM;

@@ -46,6 +46,20 @@ typedef struct {
 } lm_found_rect;
 
 lm_vec3 lm_found_rect_point(const lm_found_rect *r, double x, double y);
+
+/* A point a look found (a crossing of an opening, a place outside): where, facing where the light comes
+ * from, its worth, and the keys it is gathered by: its plane (the normal in hundredths, the offset in steps
+ * of lm_found_point_plane's) and, for a place, its cell's size and place in the plane (0 for a crossing). */
+typedef struct {
+    float pos[3], normal[3];
+    double worth;
+    int64_t key[7];
+} lm_found_point;
+
+/* Sets p's plane keys (key[0 .. 3]) from its normal and position, the offset in steps of `step`. */
+void lm_found_point_plane(lm_found_point *p, double step);
+/* qsort's order of found points by their keys: those of one plane (and cell) together. */
+int lm_found_point_order(const void *a, const void *b);
 /* Whether the ray org + s w, 0 < s < far, crosses r from its back to its front (going out, towards the
  * light). */
 int lm_found_rect_crossed_out(const lm_found_rect *r, lm_vec3 org, lm_vec3 w, float far);

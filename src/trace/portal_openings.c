@@ -86,27 +86,11 @@ static int opening_crossing(const lm_rt *rt, lm_vec3 org, lm_vec3 w, float pos[3
     return 0;
 }
 
-/* Where light gets in: its crossing of the opening, the wall's normal (out, towards the light), its worth,
- * and its wall's plane to gather by (normal in hundredths, offset). */
-typedef struct {
-    float pos[3], normal[3];
-    double worth;
-    int64_t key[4];
-} crossing;
-
-static int by_plane(const void *x, const void *y)
-{
-    const crossing *a = x, *b = y;
-    for (int k = 0; k < 4; k++)
-        if (a->key[k] != b->key[k])
-            return a->key[k] < b->key[k] ? -1 : 1;
-    return 0;
-}
-
 /* The light's crossings: each look that leaves the scene from inside (opening_crossing) is light that gets
  * in, worth the light there (a sun's cosine at the surface; the sky's luminance from there, the look's
  * draw having the cosine already). Returns how many. */
-static uint32_t crossings(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d, const lm_emitter *e, crossing *out)
+static uint32_t crossings(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d, const lm_emitter *e,
+                          lm_found_point *out)
 {
     uint32_t n = 0;
     double plane_step = lm_scene_size(s) / 4096.0;
@@ -123,16 +107,15 @@ static uint32_t crossings(const lm_scene *s, const lm_rt *rt, const lm_look_draw
         lm_v3_store(dir, w);
         if (!(facing > 0.0f) || !lm_v3_finite(w) || lm_rt_intersect(rt, o, dir, 0.0f, INFINITY, &hit))
             continue;
-        crossing *c = &out[n];
+        lm_found_point *c = &out[n];
+        memset(c, 0, sizeof *c);
         float L[3];
         if (sky)
             lm_sky_radiance(s, dir, L);
         c->worth = sky ? lm_luminance(L) : facing;
         if (!(c->worth > 0.0) || !opening_crossing(rt, org, w, c->pos, c->normal))
             continue;
-        for (int k = 0; k < 3; k++)
-            c->key[k] = (int64_t)lround(100.0 * c->normal[k]);
-        c->key[3] = (int64_t)floor(lm_dot(lm_v3_load(c->pos), lm_v3_load(c->normal)) / plane_step);
+        lm_found_point_plane(c, plane_step);
         n++;
     }
     return n;
@@ -226,7 +209,7 @@ static uint32_t plane_openings(const lm_rt *rt, const lm_found_rect *plane, doub
 uint32_t lm_find_openings(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d, const lm_emitter *e,
                           lm_found_rect *out, uint32_t cap, lm_error *err)
 {
-    crossing *c = malloc(sizeof *c * (LM_FIND_LOOKS + 1));
+    lm_found_point *c = malloc(sizeof *c * (LM_FIND_LOOKS + 1));
     double *xyw = malloc(sizeof *xyw * 3 * (LM_FIND_LOOKS + 1));
     if (!c || !xyw) {
         free(c), free(xyw);
@@ -235,9 +218,9 @@ uint32_t lm_find_openings(const lm_scene *s, const lm_rt *rt, const lm_look_draw
     }
     uint32_t n = crossings(s, rt, d, e, c), k = 0;
     double size = lm_scene_size(s);
-    qsort(c, n, sizeof *c, by_plane);
+    qsort(c, n, sizeof *c, lm_found_point_order);
     for (uint32_t i = 0, j; i < n && k < cap; i = j) { /* each wall plane's crossings in turn */
-        for (j = i + 1; j < n && !by_plane(&c[i], &c[j]);)
+        for (j = i + 1; j < n && !lm_found_point_order(&c[i], &c[j]);)
             j++;
         lm_found_rect plane;
         memset(&plane, 0, sizeof plane);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/stats.h"
 #include "../core/vecmath.h"
 
 static void corners(const lm_portals *p, uint32_t i, lm_vec3 c[3])
@@ -134,14 +135,7 @@ void lm_portals_aim(lm_portals *p, const float d[3])
 /* The pickable triangle whose share of the table holds u, and u's place within that share. */
 static uint32_t pick(const lm_portals *p, double u, double *rest)
 {
-    uint32_t lo = 0, hi = p->count - 1;
-    while (lo < hi) {
-        uint32_t mid = (lo + hi) / 2;
-        if (p->cdf[mid] > u)
-            hi = mid;
-        else
-            lo = mid + 1;
-    }
+    uint32_t lo = lm_cdf_draw(p->cdf, p->count, u);
     while (!(p->density[lo] > 0.0) && lo > 0) /* u at a share's end rounded onto an empty one */
         lo--;
     double a = lo ? p->cdf[lo - 1] : 0.0, b = p->cdf[lo];
