@@ -83,6 +83,15 @@ static inline void lm_sincos_turn(float u, float *s, float *c)
     *s = q & 2 ? -sa : sa;
     *c = (q + 1) & 2 ? -ca : ca;
 }
+/* Cosine-weighted direction around unit n (pdf cos / pi) from two uniform numbers: a diffuse bounce, a
+ * look at the sky. Unit up to rounding. The sine of the polar angle comes straight from u0, so the two
+ * roots are independent. */
+static inline lm_vec3 lm_cosine_dir(lm_vec3 n, float u0, float u1)
+{
+    float s = sqrtf(u0), sn, cs;
+    lm_sincos_turn(u1, &sn, &cs);
+    return lm_onb_dir(n, s * cs, s * sn, sqrtf(1.0f - u0));
+}
 
 void lm_mat4_identity(float m[16]);
 void lm_mat4_mul(float out[16], const float a[16], const float b[16]); /* out = a * b (out may alias) */

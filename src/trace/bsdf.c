@@ -28,16 +28,6 @@
 
 static float clampf(float x, float lo, float hi) { return x < lo ? lo : x > hi ? hi : x; }
 
-/* Cosine-weighted direction around n (pdf cos / pi): every diffuse bounce. Unit up to rounding: (x,
- * y, z) is unit and the frame orthonormal. The sine of the polar angle comes straight from u0, so
- * the two roots are independent. */
-static inline lm_vec3 sample_cosine(lm_vec3 n, float u0, float u1)
-{
-    float s = sqrtf(u0), sn, cs;
-    lm_sincos_turn(u1, &sn, &cs);
-    return lm_onb_dir(n, s * cs, s * sn, sqrtf(1.0f - u0));
-}
-
 /* Direction around n with density cos^e(angle), e > 1 (the Phong lobe). */
 static lm_vec3 sample_power_cos(lm_vec3 n, float e, float u0, float u1)
 {
@@ -195,7 +185,7 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], l
     if (sh->material->cls != LM_MAT_GLOSSY) {
         /* Cosine-weighted: f cos / pdf = (albedo / pi) cos / (cos / pi) = albedo, so no evaluation,
          * only eval_oriented's test that wo leaves above both normals. */
-        wo = sample_cosine(ns, u[0], u[1]);
+        wo = lm_cosine_dir(ns, u[0], u[1]);
         if (lm_dot(ns, wo) <= 0.0f || lm_dot(ng, wo) <= 0.0f)
             return 0;
         lm_v3_store(out->wo, wo);
@@ -205,7 +195,7 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], l
     }
     glossy_params g;
     glossy(sh, &g);
-    wo = u[2] < g.p_spec ? sample_power_cos(reflect(wi, ns), g.n, u[0], u[1]) : sample_cosine(ns, u[0], u[1]);
+    wo = u[2] < g.p_spec ? sample_power_cos(reflect(wi, ns), g.n, u[0], u[1]) : lm_cosine_dir(ns, u[0], u[1]);
     float f[3], pdf;
     eval_oriented(sh, wi, wo, ng, ns, f, &pdf);
     if (!(pdf > 0.0f))

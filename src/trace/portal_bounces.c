@@ -64,8 +64,7 @@ static double light_at(const lm_scene *s, const lm_rt *rt, const lm_emitter *e, 
 static uint32_t places(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d, const lm_emitter *e,
                        const lm_found_rect *open, uint32_t n_open, lm_found_point *out, double *sky_in)
 {
-    static const lm_emitter sky = {.kind = LM_EMIT_SKY}; /* the rays are cosine-distributed, as the sky's */
-    double cell = lm_scene_size(s) / CELLS_ACROSS, plane_step = lm_scene_size(s) / 4096.0;
+    double cell = lm_scene_size(s) / CELLS_ACROSS, plane_step = lm_found_plane_step(s);
     uint32_t n = 0, each = LM_FIND_LOOKS / n_open;
     for (uint32_t k = 0; k < n_open; k++) {
         const lm_found_rect *r = &open[k];
@@ -76,7 +75,7 @@ static uint32_t places(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d
             lm_look_numbers(1, i, 6, u);
             double x = r->lo[0] + u[0] * (r->hi[0] - r->lo[0]), y0 = r->lo[1] + u[1] * (r->hi[1] - r->lo[1]);
             lm_vec3 at = lm_found_rect_point(r, x, y0);
-            lm_vec3 org = lm_add(at, lm_scale(r->n, d->offset)), w = lm_look_direction(&sky, r->n, u[2], u[3]);
+            lm_vec3 org = lm_add(at, lm_scale(r->n, d->offset)), w = lm_cosine_dir(r->n, u[2], u[3]);
             lm_rt_hit hit;
             lm_v3_store(o, org);
             lm_v3_store(dir, w);
@@ -118,14 +117,13 @@ static uint32_t places(const lm_scene *s, const lm_rt *rt, const lm_look_draw *d
 static double chance_in(const lm_rt *rt, const lm_found_rect *r, const lm_found_rect *open, uint32_t n_open,
                         float offset)
 {
-    static const lm_emitter sky = {.kind = LM_EMIT_SKY};
     lm_vec3 mid = lm_found_rect_point(r, 0.5 * (r->lo[0] + r->hi[0]), 0.5 * (r->lo[1] + r->hi[1]));
     lm_vec3 org = lm_add(mid, lm_scale(r->n, offset));
     int in = 0;
     for (uint32_t i = 0; i < ENTER_RAYS; i++) {
         float u[2], o[3], dir[3];
         lm_look_numbers(2, i, 2, u);
-        lm_vec3 w = lm_look_direction(&sky, r->n, u[0], u[1]);
+        lm_vec3 w = lm_cosine_dir(r->n, u[0], u[1]);
         lm_rt_hit hit;
         lm_v3_store(o, org);
         lm_v3_store(dir, w);

@@ -77,10 +77,10 @@ lm_vec3 lm_look_direction(const lm_emitter *e, lm_vec3 front, float u0, float u1
 {
     if (e->kind != LM_EMIT_SKY)
         return lm_scale(lm_normalize(lm_v3_load(e->dir)), -1.0f);
-    float q = sqrtf(u0), sn, cs;
-    lm_sincos_turn(u1, &sn, &cs);
-    return lm_onb_dir(front, q * cs, q * sn, sqrtf(1.0f - u0));
+    return lm_cosine_dir(front, u0, u1);
 }
+
+double lm_found_plane_step(const lm_scene *s) { return lm_scene_size(s) / 4096.0; }
 
 void lm_found_point_plane(lm_found_point *p, double step)
 {
@@ -142,58 +142,66 @@ static uint32_t worthiest(lm_found_rect *r, uint32_t n)
     return keep;
 }
 
+/* Tagged triangle i's corners and unit front normal; returns its area. */
+static double tagged_tri(const lm_scene *s, uint32_t i, lm_vec3 c[3], lm_vec3 *n)
+{
+    for (int k = 0; k < 3; k++)
+        c[k] = lm_v3_load(s->portal_tris + 9 * (size_t)i + 3 * (size_t)k);
+    lm_vec3 cr = lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0]));
+    *n = lm_normalize(cr);
+    return 0.5 * lm_length(cr);
+}
+
+/* Which of the rectangles r[0 .. n) lies in the plane of tagged triangle i (corner c0, unit normal nn): the
+ * first facing its way within a plane step (lm_found_plane_step) of it; n when none does. */
+static uint32_t tagged_plane(const lm_scene *s, const lm_found_rect *r, uint32_t n, lm_vec3 c0, lm_vec3 nn)
+{
+    double step = lm_found_plane_step(s);
+    uint32_t k = 0;
+    while (k < n && !(lm_dot(r[k].n, nn) > 0.9999f && fabs(lm_dot(c0, nn) - r[k].level) < step))
+        k++;
+    return k;
+}
+
 /* The light tagged triangle i lets in, per unit of the light's: a sun's, its area (its cosine comes with
- * the aim, portals.h); the sky's, what its plane's rectangle r lets in (lm_find_bounces' sky_in, the sky it
- * sees from where it is), its share by area. */
+ * the aim, portals.h); the sky's, what its plane's rectangle (tagged_openings) lets in (lm_find_bounces'
+ * sky_in, the sky it sees from where it is), its share by area. */
 static double tagged_worth(const lm_scene *s, const lm_emitter *e, uint32_t i, const lm_found_rect *r,
                            const double *sky_in, uint32_t n_open)
 {
-    lm_vec3 c[3];
-    for (int k = 0; k < 3; k++)
-        c[k] = lm_v3_load(s->portal_tris + 9 * (size_t)i + 3 * (size_t)k);
-    lm_vec3 cr = lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0])), n = lm_normalize(cr);
-    double area = 0.5 * lm_length(cr);
+    lm_vec3 c[3], n;
+    double area = tagged_tri(s, i, c, &n);
     if (e->kind != LM_EMIT_SKY)
         return area;
-    for (uint32_t k = 0; k < n_open; k++) /* the rectangle of its plane, holding its corners */
-        if (lm_dot(r[k].n, n) > 0.9999f && fabs(lm_dot(c[0], n) - r[k].level) < 1e-3 * lm_scene_size(s))
-            return sky_in[k] * area / r[k].worth;
-    return 0.0;
+    uint32_t k = tagged_plane(s, r, n_open, c[0], n);
+    return k < n_open ? sky_in[k] * area / r[k].worth : 0.0;
 }
 
 /* The file's portals as openings for the places to be looked for through: the rectangle round the
  * triangles of each plane (a window's two), facing their fronts, worth their area. Returns how many. */
-static uint32_t tagged_openings(const lm_scene *s, const lm_emitter *e, lm_found_rect *out)
+static uint32_t tagged_openings(const lm_scene *s, lm_found_rect *out)
 {
     uint32_t n = 0;
-    double step = lm_scene_size(s) / 4096.0;
     for (uint32_t i = 0; i < s->portal_tri_count; i++) {
-        lm_vec3 c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = lm_v3_load(s->portal_tris + 9 * (size_t)i + 3 * (size_t)k);
-        lm_vec3 nn = lm_normalize(lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0])));
-        uint32_t k = 0; /* the rectangle of its plane so far, or a new one */
-        while (k < n && !(lm_dot(out[k].n, nn) > 0.9999f && fabs(lm_dot(c[0], nn) - out[k].level) < step))
-            k++;
+        lm_vec3 c[3], nn;
+        double area = tagged_tri(s, i, c, &nn);
+        uint32_t k = tagged_plane(s, out, n, c[0], nn); /* the rectangle of its plane so far, or a new one */
         lm_found_rect *r = &out[k];
-        if (k == n++) {
+        if (k == n) {
             memset(r, 0, sizeof *r);
             r->n = nn;
             lm_tangents(nn, &r->t, &r->b);
             r->level = lm_dot(c[0], nn);
             r->lo[0] = r->lo[1] = INFINITY, r->hi[0] = r->hi[1] = -INFINITY;
-        } else {
-            n--;
+            n++;
         }
         for (int v = 0; v < 3; v++) {
             double x = lm_dot(c[v], r->t), y = lm_dot(c[v], r->b);
             r->lo[0] = fmin(r->lo[0], x), r->hi[0] = fmax(r->hi[0], x);
             r->lo[1] = fmin(r->lo[1], y), r->hi[1] = fmax(r->hi[1], y);
         }
-        lm_vec3 cr = lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0]));
-        r->worth += 0.5 * lm_length(cr); /* its area, for now: tagged_worth shares its plane's light by it */
+        r->worth += area; /* for now: tagged_worth shares its plane's light by it */
     }
-    (void)e;
     return n;
 }
 
@@ -256,7 +264,7 @@ lm_status lm_portals_find(const lm_scene *s, const lm_surfaces *su, const lm_rt 
     lm_found_rect *r = st == LM_OK ? malloc(sizeof *r * 2 * cap) : NULL;
     if (st == LM_OK && !r)
         st = lm_fail(err, LM_ERR_NOMEM, "portals: no memory for openings");
-    uint32_t open = st != LM_OK ? 0 : tagged ? tagged_openings(s, e, r) : lm_find_openings(s, rt, &d, e, r, cap, err);
+    uint32_t open = st != LM_OK ? 0 : tagged ? tagged_openings(s, r) : lm_find_openings(s, rt, &d, e, r, cap, err);
     uint32_t places = 0;
     double *sky_in = st == LM_OK ? calloc((size_t)cap + 1, sizeof *sky_in) : NULL;
     if (st == LM_OK && !sky_in)

@@ -56,6 +56,8 @@ typedef struct {
     int64_t key[7];
 } lm_found_point;
 
+/* The step in which found planes' offsets are told apart: the level's size over 4096. */
+double lm_found_plane_step(const lm_scene *s);
 /* Sets p's plane keys (key[0 .. 3]) from its normal and position, the offset in steps of `step`. */
 void lm_found_point_plane(lm_found_point *p, double step);
 /* qsort's order of found points by their keys: those of one plane (and cell) together. */

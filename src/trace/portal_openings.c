@@ -93,7 +93,7 @@ static uint32_t crossings(const lm_scene *s, const lm_rt *rt, const lm_look_draw
                           lm_found_point *out)
 {
     uint32_t n = 0;
-    double plane_step = lm_scene_size(s) / 4096.0;
+    double plane_step = lm_found_plane_step(s);
     int sky = e->kind == LM_EMIT_SKY;
     for (uint32_t i = 0; d->count > 0 && i < LM_FIND_LOOKS; i++) {
         float u[5], o[3], dir[3];

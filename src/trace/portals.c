@@ -67,17 +67,6 @@ lm_portals *lm_portals_tagged(const float *tris, uint32_t n, lm_error *err)
     return p;
 }
 
-lm_portals *lm_portals_copy(const lm_portals *p, lm_error *err)
-{
-    lm_portals *c = lm_portals_make(p->tris, p->weight, p->tagged, p->count, err);
-    if (c) {
-        memcpy(c->density, p->density, sizeof *c->density * p->count);
-        memcpy(c->cdf, p->cdf, sizeof *c->cdf * p->count);
-        c->usable = p->usable;
-    }
-    return c;
-}
-
 void lm_portals_free(lm_portals *p)
 {
     if (!p)
@@ -110,18 +99,18 @@ static double pick_weight(const lm_portals *p, uint32_t i, const float *d, doubl
 void lm_portals_aim(lm_portals *p, const float d[3])
 {
     double sum = 0.0;
-    for (uint32_t i = 0; i < p->count; i++) {
+    for (uint32_t i = 0; i < p->count; i++) { /* for now: each one's weight in cdf, its line measure in density */
         double cosine;
         sum += p->cdf[i] = pick_weight(p, i, d, &cosine);
+        p->density[i] = p->area[i] * (d ? cosine : LM_PI);
     }
     p->usable = sum > 0.0;
     double acc = 0.0;
     for (uint32_t i = 0; i < p->count; i++) {
-        double cosine, w = p->cdf[i], prob = p->usable ? w / sum : 0.0;
-        pick_weight(p, i, d, &cosine);
+        double prob = p->usable ? p->cdf[i] / sum : 0.0;
         acc += prob;
         p->cdf[i] = acc;
-        p->density[i] = prob > 0.0 ? prob / (p->area[i] * (d ? cosine : LM_PI)) : 0.0;
+        p->density[i] = prob > 0.0 ? prob / p->density[i] : 0.0;
     }
     if (p->usable) /* the last pickable one ends the table at 1 exactly */
         for (uint32_t i = p->count; i-- > 0;)
@@ -169,9 +158,7 @@ int lm_portals_sky_line(const lm_portals *p, float u_pick, float u_tri, float u0
     double rest;
     uint32_t i = pick(p, u_pick, &rest);
     lm_v3_store(x, on_triangle(p, i, rest, u_tri));
-    float r = sqrtf(u0), sn, cs;
-    lm_sincos_turn(u1, &sn, &cs);
-    lm_v3_store(w, lm_onb_dir(lm_v3_load(p->normal + 3 * (size_t)i), r * cs, r * sn, sqrtf(1.0f - u0)));
+    lm_v3_store(w, lm_cosine_dir(lm_v3_load(p->normal + 3 * (size_t)i), u0, u1));
     return 1;
 }
 

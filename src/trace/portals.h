@@ -56,7 +56,6 @@ lm_portals *lm_portals_make(const float *tris, const double *weight, const unsig
                             lm_error *err);
 /* The file's portals: n triangles, each tagged and worth its area. */
 lm_portals *lm_portals_tagged(const float *tris, uint32_t n, lm_error *err);
-lm_portals *lm_portals_copy(const lm_portals *p, lm_error *err);
 void lm_portals_free(lm_portals *p);
 /* Sets the probabilities and densities for a sun travelling along unit d, or for the sky (d NULL). */
 void lm_portals_aim(lm_portals *p, const float d[3]);
