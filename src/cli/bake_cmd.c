@@ -204,12 +204,9 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
     else
         snprintf(what, sizeof what, "%s     ", a->file_count > 1 ? "merged" : "baked ");
     char atlas[96], exr[320], png[64], aim[64];
-    if (in.pages > 1)
-        snprintf(atlas, sizeof atlas, "%d pages of %d x %d", in.pages, in.page_width, in.page_height);
-    else
-        snprintf(atlas, sizeof atlas, "%d x %d atlas", in.atlas_width, in.atlas_height);
-    printf("%s %u texels (%s) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather %.0f ms)\n", what,
-           in.texels, atlas, ui.photons, lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim,
+    lm_cli_atlas_size(atlas, sizeof atlas, &in);
+    printf("%s %u texels (%s%s) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather %.0f ms)\n", what,
+           in.texels, atlas, in.pages > 1 ? "" : " atlas", ui.photons, lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim,
            ui.ms_setup_gather);
     if (ui.portals_found)
         printf("portals     %d found where the sun's or the sky's light gets in (docs/levels.md, \"Portals\")\n",

@@ -23,6 +23,14 @@ lmgi_status lm_cli_get_page(lmgi_updater *u, const lmgi_info *in, lmgi_lightmap 
                          : lmgi_get_lightmap(u, kind, rgba, floats, err);
 }
 
+void lm_cli_atlas_size(char *out, size_t size, const lmgi_info *in)
+{
+    if (in->pages > 1)
+        snprintf(out, size, "%d pages of %d x %d", in->pages, in->page_width, in->page_height);
+    else
+        snprintf(out, size, "%d x %d", in->atlas_width, in->atlas_height);
+}
+
 void lm_cli_page_files(char *out, size_t size, const char *base, int pages, const char *ext)
 {
     if (pages > 1)

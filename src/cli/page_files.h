@@ -14,6 +14,8 @@ void lm_cli_page_size(const lmgi_info *in, int *width, int *height);
  * lmgi_get_lightmap_page for several. */
 lmgi_status lm_cli_get_page(lmgi_updater *u, const lmgi_info *in, lmgi_lightmap kind, int page, float *rgba,
                             size_t floats, lmgi_error *err);
+/* "W x H" (the atlas) or "N pages of W x H": how the summaries size the lightmap. */
+void lm_cli_atlas_size(char *out, size_t size, const lmgi_info *in);
 /* "BASE.EXT" or "BASE_page0..P.EXT" (P the last page): how the "wrote" lines name a kind's files. */
 void lm_cli_page_files(char *out, size_t size, const char *base, int pages, const char *ext);
 

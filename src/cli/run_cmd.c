@@ -244,10 +244,7 @@ static void summary(const run_state *r, int frames)
                "%llu list entries\n", ui.indirect, (double)ui.photon_radius, ui.photon_tile, ui.photon_chunk,
                ui.photon_stochastic, (unsigned long long)r->photon_gathers, (unsigned long long)r->photon_entries);
     char atlas[96];
-    if (in.pages > 1)
-        snprintf(atlas, sizeof atlas, "%d pages of %d x %d", in.pages, in.page_width, in.page_height);
-    else
-        snprintf(atlas, sizeof atlas, "%d x %d", in.atlas_width, in.atlas_height);
+    lm_cli_atlas_size(atlas, sizeof atlas, &in);
     printf("atlas       %s, %u texels of %.4g units: regathered in full every %u frames at %d a frame\n", atlas,
            in.texels, (double)in.texel_size, (in.texels + (uint32_t)per_frame - 1) / (uint32_t)per_frame, per_frame);
     printf("setup       full trace %.1f ms, all AIMs %.1f ms, full gather %.1f ms\n", ui.ms_setup_trace,
