@@ -22,91 +22,7 @@
 #define LM_FRAME_LOOP_H
 
 #include "../gpu/camera.h"
-#include "../gpu/caustic_pass.h"
-#include "../gpu/direct.h"
-#include "../gpu/gl_context.h"
-#include "../gpu/hemicube.h"
-#include "../gpu/iim.h"
-#include "../gpu/photon_gather.h"
-#include "photon_stage.h"
-
-enum { LM_INDIRECT_LIGHTMAP = 0, LM_INDIRECT_BRUTEFORCE = 1, LM_INDIRECT_TILED = 2, LM_INDIRECT_HASHGRID = 3 };
-
-typedef struct {
-    lm_photon_stage_settings stage;
-    lm_hemicube_settings gather; /* coverage_samples 0 (the default here): 1 with the closed-form emitter
-                                  * light, else lm_gather_coverage_for the scene */
-    int emitter_light;     /* emitters' light in the gather (trace/emitter_light.h): 1 closed form with sampled
-                            * visibility, 0 drawn into the hemicubes, -1 (default) closed form when
-                            * lm_emitter_light_suits the scene */
-    int emitter_rays;      /* shadow rays per emissive triangle and texel (default 32) */
-    int overlap;           /* 1 (default): the photon stage's tracing and AIM refresh run on a second thread
-                            * beside the render, after the gather, which then sees the previous frame's
-                            * AIMs and delta_i; 0: the paper's order, all on the calling thread */
-    lm_iim_settings iim;
-    lm_direct_settings direct;
-    int width, height;     /* frame size (default 512 x 512; 0 x 0: lm_frame_loop_step composites no frame, and
-                            * the render passes are made at the first lm_frame_loop_render) */
-    int camera;            /* lm_view_for_scene's camera (default -1) */
-    int reflection_size;   /* texels per side of a mirror or glossy node's environment map (gpu/reflections.h;
-                            * default 128; 0: no reflections) */
-    int reflection_faces;  /* environment map faces re-rendered a frame, round robin, after all of them at the
-                            * first frame (default 1: a map refreshed in 6 frames) */
-    int caustics;          /* 1 (default): caustic photons (stage.caustic) and the screen-space caustic pass, which
-                            * cost nothing while no mirror or glass node has its caustics switched on; 0: none */
-    lm_caustic_pass_settings caustic_pass;
-    int indirect;          /* 0: no indirect light at all (no photon, AIM or gather work; the frame shows direct
-                            * light, emission and reflections); default 1. stage.trace follows it */
-    int indirect_path;     /* how the frame gets its indirect light: LM_INDIRECT_LIGHTMAP (default: AIMs, the
-                            * hemicube gather into the IIM, the composite) or LM_INDIRECT_TILED, _HASHGRID or
-                            * _BRUTEFORCE (straight from the photon hits at the visible pixels on the GPU,
-                            * gpu/photon_gather.h: no AIM, no IIM; the lightmaps stay 0 and environment maps
-                            * hold direct light only) */
-    lm_photon_gather_settings photon_gather; /* those three paths' tile, chunk and stochastic k (the kind
-                                              * follows indirect_path) */
-    float photon_radius;   /* their kernel radius (0, the default: the disc that holds LM_PIXEL_GATHER_HITS
-                            * hits on average, lm_pixel_gather_radius) */
-    /* called during the first full gather (seconds on big atlases) with texels done and total; NULL: none */
-    void (*progress)(void *user, uint32_t done, uint32_t total);
-    void *progress_user;
-    const volatile int *cancel; /* non-zero stops the first full gather between passes: LM_ERR_CANCELLED */
-    /* the first full gather's checkpoint file (bake_checkpoint.h; NULL: none): written at most every
-     * checkpoint_seconds (0: LM_CHECKPOINT_DEFAULT_SECONDS) between passes and on a cancel; resume
-     * non-zero: the gather starts from it (it must exist and match, else LM_ERR_INVALID) */
-    const char *checkpoint;
-    double checkpoint_seconds;
-    int resume;
-    /* a bake spread over processes (docs/levels.md, "A bake in shards"): shards > 0 gathers only share
-     * `shard` (0-based) of the first full gather's order, cut at pass boundaries, into the checkpoint (which
-     * it needs), written at the end too; parts (part_count checkpoint files of every share) instead start
-     * the first gather from their texels put together, which must be all of them (LM_ERR_INVALID naming a
-     * part of another bake, two parts holding the same texels, or the share no part holds) */
-    int shard, shards;
-    /* with shards > 1: the passes handed out as the processes finish them (lmgi_updater_desc.claim_pass;
-     * NULL: every shards-th pass from shard); the part lists the passes it took */
-    int (*claim_pass)(void *user, int passes);
-    void *claim_user;
-    const char *const *parts;
-    int part_count;
-    lm_gl_context *gl;     /* borrowed, made current at each call: the context to render with (NULL, the
-                            * default: the loop makes its own) */
-} lm_frame_loop_settings;
-
-typedef struct {
-    lm_photon_stage_frame stage;
-    uint32_t texels_gathered;
-    lm_caustic_pass_stats caustic; /* the frame's caustic pass */
-    int cube_faces;        /* environment map faces rendered */
-    int shadow_maps;       /* shadow maps re-rendered by the frame's draws */
-    int shadow_maps_stale; /* stale ones left for later updates (lm_direct_begin_update) */
-    lm_photon_gather_stats photon_gather; /* the photon paths' gather (its times are in t_gather) */
-    int photon_gathers;    /* gathers run: 0 when the records, view and G-buffer were as for the last one */
-    /* seconds per stage: photon stage (animate + photons + AIMs + caustic photons), IIM gather (schedule,
-     * scene and AIM upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps,
-     * the frame's read-back), caustics (the screen-space pass), reflections (map faces and their pass),
-     * composite (the indirect term's atlas pass); and the whole frame */
-    double t_photons, t_gather, t_blend, t_direct, t_caustics, t_reflections, t_composite, t_total;
-} lm_frame_stats;
+#include "frame_settings.h"
 
 typedef struct lm_frame_loop lm_frame_loop;
 
@@ -119,7 +35,6 @@ typedef struct lm_frame_loop lm_frame_loop;
 /* The atlas texels to aim at for that: texels_per_frame x LM_FRAME_LOOP_REFRESH_FRAMES, at least 256. */
 int lm_frame_loop_atlas_texels(int texels_per_frame);
 
-void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
 /* The photon paths' kernel radius in use (0 before their first frame, on the lightmap path, or with no
  * photon to gather). */
 float lm_frame_loop_photon_radius(const lm_frame_loop *fl);
@@ -145,7 +60,6 @@ typedef struct {
     int surfaces_changed;
     double t_photons, t_gather;
 } lm_bake_stats;
-typedef void (*lm_bake_progress)(void *user, double fraction, const char *stage);
 /* Brings the lightmaps to the converged state of the scene as it is now (animation time t): every photon
  * re-traced, the AIM of every surface whose photons changed refreshed, every texel of every surface whose
  * light changed regathered, and shown at once (no blend). What the scene's edits did not touch costs

@@ -1,0 +1,93 @@
+#include "delta_i.h"
+
+#include <math.h>
+
+#include "../core/vecmath.h"
+
+#define SEE_PAIRS 16 /* texel pairs tried between two surfaces */
+
+/* A texel's position now (its node may have moved since load) and its triangle's geometric normal now
+ * (the side its light leaves from). */
+static lm_vec3 texel_now(const lm_scene *s, const lm_atlas *a, uint32_t texel, lm_vec3 *normal)
+{
+    const lm_texel *t = &a->texels[texel];
+    const float *w = s->nodes[s->tri_node[t->tri]].world;
+    lm_vec3 c[3];
+    for (int k = 0; k < 3; k++) {
+        float v[3];
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t->tri + (size_t)k], v);
+        c[k] = lm_v3_load(v);
+    }
+    *normal = lm_normalize(lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0])));
+    return lm_mat4_point(w, lm_v3_load(t->local));
+}
+
+/* Whether surface a sees surface b (the header says how). */
+static int sees(const lm_iim_sched *iim, const lm_scene *s, const lm_atlas *at, const lm_rt *rt, int a, int b,
+                float lift)
+{
+    uint32_t na = iim->surf_first[a + 1] - iim->surf_first[a], nb = iim->surf_first[b + 1] - iim->surf_first[b];
+    if (!na || !nb)
+        return 0;
+    for (uint32_t k = 0; k < SEE_PAIRS; k++) {
+        uint32_t ta = iim->surf_texels[iim->surf_first[a] + (uint32_t)((uint64_t)k * na / SEE_PAIRS)];
+        uint32_t tb = iim->surf_texels[iim->surf_first[b] + (uint32_t)((uint64_t)((k * 7 + 3) % SEE_PAIRS) * nb / SEE_PAIRS)];
+        lm_vec3 na3, nb3;
+        lm_vec3 p = texel_now(s, at, ta, &na3), q = texel_now(s, at, tb, &nb3);
+        p = lm_add(p, lm_scale(na3, lift));
+        q = lm_add(q, lm_scale(nb3, lift));
+        lm_vec3 d = lm_sub(q, p);
+        float len = lm_length(d);
+        if (!(len > lift))
+            continue;
+        d = lm_scale(d, 1.0f / len);
+        if (!(lm_dot(na3, d) > 0.01f && lm_dot(nb3, d) < -0.01f)) /* not facing each other */
+            continue;
+        float org[3], dir[3];
+        lm_v3_store(org, p);
+        lm_v3_store(dir, d);
+        if (!lm_rt_occluded(rt, org, dir, 0.0f, len))
+            return 1;
+    }
+    return 0;
+}
+
+int lm_delta_i_widen_to_viewers(const lm_iim_sched *sched, lm_photon_store *ps, const uint8_t *refreshed,
+                                const lm_scene *s, const lm_atlas *at, const lm_rt *rt)
+{
+    int S = sched->surface_count, n = 0;
+    float lift = 1e-3f * lm_scene_size(s);
+    for (int a = 0; a < S; a++) {
+        if (ps->surfaces[a].delta_i > sched->delta_threshold)
+            continue;
+        for (int b = 0; b < S; b++)
+            if (b != a && refreshed[b] && sees(sched, s, at, rt, a, b, lift)) {
+                /* just over the threshold, whatever its size (a fixed 1e-30 vanishes beside 1; nextafter's
+                 * denormal beside 0 reads as 0 on the threads that trace, which flush denormals) */
+                double th = sched->delta_threshold;
+                ps->surfaces[a].delta_i = th + fmax(1e-30, 1e-9 * th);
+                n++;
+                break;
+            }
+    }
+    return n;
+}
+
+void lm_delta_i_save(const lm_iim_sched *sched, const lm_photon_store *ps, double *saved)
+{
+    for (int s = 0; s < sched->surface_count; s++)
+        saved[s] = ps->surfaces[s].delta_i;
+}
+
+void lm_delta_i_restore(lm_iim_sched *sched, lm_photon_store *ps, const double *saved)
+{
+    for (int s = 0; s < sched->surface_count; s++)
+        if (sched->commit[s])
+            sched->commit[s] = 0, ps->surfaces[s].delta_i = saved[s];
+}
+
+double lm_delta_i_pending(const lm_photon_store *ps, int s)
+{
+    double e = lm_photon_store_iim_energy(ps, s), d = ps->surfaces[s].delta_i;
+    return !(d > 0.0) ? 0.0 : e > 0.0 && isfinite(d / e) ? d / e : 1.0;
+}

@@ -1,0 +1,375 @@
+#include "lightmap_path.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/log.h"
+#include "../core/timing.h"
+#include "../core/vecmath.h"
+#include "../gpu/gather_error.h"
+#include "../photonmap/delta_i.h"
+#include "../scene/sky.h"
+#include "../trace/emitter_light.h"
+#include "gather_passes.h"
+
+struct lm_lightmap_path {
+    lm_frame_loop_settings *set; /* the loop's, borrowed */
+    lm_scene *scene;
+    const lm_surfaces *surfaces;
+    const lm_atlas *atlas;
+    lm_rt *rt;
+    lm_photon_stage *stage;
+    lm_gather *gather;
+    lm_iim iim;
+    int have_iim;
+    lm_emitter_light emitters; /* with have_emitters: the gather's closed-form emitter light */
+    int have_emitters;
+    uint32_t *texels;          /* scratch: the scheduled texels (atlas texel_count) */
+    uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule */
+    int aim_stale;             /* the AIM changed since the gather last uploaded it */
+    uint32_t switch_version;   /* the scene's pass_version the scheduler's switches follow */
+    struct {                   /* whether the scene gives any light (follow_light): none, no gather */
+        int unlit, emissive;   /* emissive: it has emissive triangles, as of the scene's emissive_version */
+        uint32_t emissive_version;
+    } light;
+};
+
+/* The photon store's delta_i is the IIM scheduler's input, reset once a surface is regathered. */
+static lm_photon_store *store_of(lm_lightmap_path *lp) { return lm_photon_stage_store(lp->stage); }
+
+static lm_gather_job job_of(const lm_lightmap_path *lp)
+{
+    return (lm_gather_job){lp->gather, lp->scene, lp->atlas, lp->texels, lp->iim.fresh_tex, lp->set};
+}
+
+/* Uploads the current scene and, when they changed since the last upload, the AIMs: all the gather reads
+ * of the photon stage, so that the stage may run again once this returns. */
+static lm_status gather_prepare(lm_lightmap_path *lp, lm_error *err)
+{
+    lm_status st = lm_gather_set_scene(lp->gather, lp->scene, lp->atlas, err);
+    if (lp->scene->has_sky) { /* a hemicube clears to one colour: a sky that is not uniform wants the rays scheme */
+        float mean[3];
+        lm_sky_mean(lp->scene, mean);
+        lm_gather_set_sky(lp->gather, mean);
+    }
+    if (st == LM_OK && lp->aim_stale)
+        st = lm_gather_set_aim_dilated(lp->gather, lp->atlas, lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), err);
+    if (st == LM_OK)
+        lp->aim_stale = 0;
+    return st;
+}
+
+lm_status lm_lightmap_path_gather(lm_lightmap_path *lp, uint32_t count, lm_error *err)
+{
+    lm_gather_job j = job_of(lp);
+    return lm_gather_passes(&j, count, err);
+}
+
+/* The scene and AIM uploaded, then the first count scheduled texels gathered. */
+static lm_status gather(lm_lightmap_path *lp, uint32_t count, lm_error *err)
+{
+    if (count == 0)
+        return LM_OK;
+    lm_status st = gather_prepare(lp, err);
+    return st == LM_OK ? lm_lightmap_path_gather(lp, count, err) : st;
+}
+
+/* The first full gather of every texel (or of a shard's passes), checkpointed, resumed or put together
+ * from parts when the settings name a checkpoint or parts. */
+static lm_status first_gather(lm_lightmap_path *lp, lm_error *err)
+{
+    uint32_t count = lm_iim_sched_pick_all(&lp->iim.sched, store_of(lp), lp->texels);
+    if ((!lp->set->checkpoint && !lp->set->parts) || count == 0)
+        return gather(lp, count, err);
+    lm_status st = gather_prepare(lp, err);
+    if (st != LM_OK)
+        return st;
+    lm_gather_job j = job_of(lp);
+    return lm_gather_first(&j, count, lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), err);
+}
+
+/* The closed-form emitter light when the settings (or, on auto, the scene) call for it; the gather's
+ * coverage samples when on auto: none needed with it, else as the scene's emitters need. */
+static lm_status setup_emitters(lm_lightmap_path *lp, lm_error *err)
+{
+    lm_frame_loop_settings *set = lp->set;
+    int closed_form = set->emitter_light < 0 ? lm_emitter_light_suits(lp->scene) : set->emitter_light;
+    closed_form = closed_form && lm_emissive_triangle_count(lp->scene) > 0;
+    if (set->gather.coverage_samples == 0)
+        set->gather.coverage_samples =
+            set->gather.scheme == LM_GATHER_LAYERED ? 1 : lm_gather_coverage_for(lp->scene, closed_form);
+    set->emitter_light = closed_form;
+    if (!closed_form || !lm_frame_lightmap_path(set)) /* the gather's alone */
+        return LM_OK;
+    lm_status st = lm_emitter_light_init(&lp->emitters, lp->scene, lp->rt, set->emitter_rays, err);
+    lp->have_emitters = st == LM_OK;
+    return st;
+}
+
+/* Per surface, whether its node takes indirect light (extras "indirect", lmgi_set_node_effects): the
+ * scheduler gathers only those (one switched on again is regathered in full). */
+static void sync_gather_switches(lm_lightmap_path *lp)
+{
+    for (int k = 0; k < lp->surfaces->surface_count; k++) {
+        int off = !lm_frame_lightmap_path(lp->set) || lp->light.unlit ||
+                  !lp->scene->nodes[lp->surfaces->surfaces[k].node].settings.indirect;
+        if (off != lp->iim.sched.off[k])
+            lm_iim_sched_set_off(&lp->iim.sched, store_of(lp), k, off);
+    }
+}
+
+/* Lights that shine: not removed or switched off. */
+static uint32_t lights_on(const lm_scene *s)
+{
+    uint32_t n = 0;
+    for (int i = 0; i < s->light_count; i++)
+        n += !s->lights[i].removed && !s->lights[i].off;
+    return n;
+}
+
+/* A scene without any light (no light on, no emissive triangle, no sky) has no indirect light: nothing is
+ * gathered (lmgi info's "indirect: off"), and the IIM is cleared when the last light goes; the gather
+ * starts again, every surface in full, when a light, an emissive material or a sky comes. Looked at each
+ * frame: the lights and the sky at once, the emissive triangles when a class changed (pass_version). */
+static lm_status follow_light(lm_lightmap_path *lp, lm_error *err)
+{
+    const lm_scene *s = lp->scene;
+    if (lp->light.emissive_version != s->pass_version || !lp->have_iim) {
+        lp->light.emissive = lm_emissive_triangle_count(s) > 0;
+        lp->light.emissive_version = s->pass_version;
+    }
+    uint32_t lights = lights_on(s);
+    int unlit = lights == 0 && !lp->light.emissive && !s->has_sky;
+    if (unlit == lp->light.unlit && lp->have_iim)
+        return LM_OK;
+    lp->light.unlit = unlit;
+    if (unlit)
+        lm_log(LM_LOG_INFO, "%s: no light (no light on, no emissive material, no sky): the gather is skipped until "
+               "one comes", s->path);
+    if (!lp->have_iim)
+        return LM_OK;
+    sync_gather_switches(lp);
+    return unlit ? lm_iim_clear(&lp->iim, err) : LM_OK;
+}
+
+lm_status lm_lightmap_path_follow(lm_lightmap_path *lp, lm_error *err)
+{
+    lm_status st = follow_light(lp, err);
+    if (st == LM_OK && lp->switch_version != lp->scene->pass_version) {
+        sync_gather_switches(lp);
+        lp->switch_version = lp->scene->pass_version;
+    }
+    return st;
+}
+
+lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_frame_loop_settings *set,
+                                  lm_lightmap_path **out, lm_error *err)
+{
+    *out = NULL;
+    lm_lightmap_path *lp = calloc(1, sizeof *lp);
+    if (!lp)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap path", w->scene->path);
+    lp->set = set;
+    lp->scene = w->scene;
+    lp->surfaces = w->surfaces;
+    lp->atlas = w->atlas;
+    lp->rt = w->rt;
+    lp->stage = stage;
+    lp->texels = malloc(sizeof(uint32_t) * (w->atlas->texel_count ? w->atlas->texel_count : 1));
+    lp->refreshed = malloc((size_t)w->atlas->surface_count + 1);
+    lm_status st = lp->texels && lp->refreshed ? LM_OK
+                                               : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop",
+                                                         w->scene->path);
+    if (st == LM_OK)
+        st = setup_emitters(lp, err);
+    if (st == LM_OK)
+        st = lm_gather_create(&set->gather, &lp->gather, err);
+    if (st == LM_OK && lp->have_emitters)
+        lm_gather_set_emitter_light(lp->gather, &lp->emitters);
+    if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (gpu/hemicube_rim.h) */
+        lm_gather_set_tracer(lp->gather, lp->rt);
+    if (st == LM_OK)
+        st = follow_light(lp, err); /* before the IIM: a scene without light gathers nothing */
+    if (st == LM_OK && (st = lm_iim_init(&lp->iim, lp->atlas, &set->iim, 1, err)) == LM_OK) {
+        lp->have_iim = 1;
+        sync_gather_switches(lp); /* nodes without indirect light are not gathered at all */
+        lp->switch_version = lp->scene->pass_version;
+    }
+    if (st != LM_OK) {
+        lm_lightmap_path_free(lp);
+        return st;
+    }
+    *out = lp;
+    return LM_OK;
+}
+
+void lm_lightmap_path_free(lm_lightmap_path *lp)
+{
+    if (!lp)
+        return;
+    if (lp->have_iim)
+        lm_iim_free(&lp->iim);
+    lm_gather_free(lp->gather);
+    if (lp->have_emitters)
+        lm_emitter_light_free(&lp->emitters);
+    free(lp->texels);
+    free(lp->refreshed);
+    free(lp);
+}
+
+lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_error *err)
+{
+    double t0 = lm_now();
+    lp->aim_stale = 1;
+    lm_status st = first_gather(lp, err);
+    lp->set->progress = NULL; /* per-frame gathers are small */
+    lp->set->cancel = NULL;
+    lp->set->checkpoint = NULL;
+    if (st == LM_OK)
+        st = lm_iim_blend(&lp->iim, 1, err);
+    if (t_gather)
+        *t_gather = lm_now() - t0;
+    return st;
+}
+
+void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
+
+int lm_lightmap_path_widen(lm_lightmap_path *lp)
+{
+    if (!lm_photon_stage_take_refreshed(lp->stage, lp->refreshed))
+        return 0;
+    return lm_delta_i_widen_to_viewers(&lp->iim.sched, store_of(lp), lp->refreshed, lp->scene, lp->atlas, lp->rt);
+}
+
+lm_status lm_lightmap_path_schedule(lm_lightmap_path *lp, uint32_t *count, lm_error *err)
+{
+    lm_lightmap_path_widen(lp);
+    *count = lm_iim_sched_pick(&lp->iim.sched, store_of(lp), lp->texels);
+    return *count > 0 ? gather_prepare(lp, err) : LM_OK;
+}
+
+lm_status lm_lightmap_path_blend(lm_lightmap_path *lp, int instant, lm_error *err)
+{
+    return lm_iim_blend(&lp->iim, instant, err);
+}
+
+/* The bake's gather reports through the settings' progress hook as a fraction of the whole bake. */
+typedef struct {
+    lm_bake_progress fn;
+    void *user;
+} bake_watch;
+
+static void bake_gather_progress(void *user, uint32_t done, uint32_t total)
+{
+    const bake_watch *w = user;
+    w->fn(w->user, 0.3 + 0.7 * (double)done / (total ? total : 1), "gather");
+}
+
+lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress, void *user,
+                                const volatile int *cancel, uint32_t *texels, int *surfaces_changed,
+                                lm_error *err)
+{
+    lm_photon_store *ps = store_of(lp);
+    int S = lp->iim.sched.surface_count;
+    double *saved = malloc(sizeof *saved * (size_t)(S ? S : 1));
+    if (!saved)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", lp->scene->path);
+    lm_delta_i_save(&lp->iim.sched, ps, saved);
+    uint32_t n = lm_iim_sched_pick_up_to(&lp->iim.sched, ps, lp->atlas->texel_count, lp->texels);
+    bake_watch w = {progress, user};
+    lp->set->progress = progress ? bake_gather_progress : NULL;
+    lp->set->progress_user = &w;
+    lp->set->cancel = cancel;
+    lm_status st = gather(lp, n, err);
+    lp->set->progress = NULL;
+    lp->set->cancel = NULL;
+    if (st != LM_OK) {
+        lm_delta_i_restore(&lp->iim.sched, ps, saved);
+    } else {
+        uint32_t before = 0, after = 0;
+        for (int s = 0; s < S; s++)
+            before += lp->iim.version[s];
+        st = lm_iim_blend(&lp->iim, 1, err);
+        for (int s = 0; s < S; s++)
+            after += lp->iim.version[s];
+        *texels = n;
+        *surfaces_changed = (int)(after - before);
+    }
+    free(saved);
+    return st;
+}
+
+lm_iim *lm_lightmap_path_iim(lm_lightmap_path *lp) { return &lp->iim; }
+const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp) { return &lp->iim; }
+
+void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels)
+{
+    lp->iim.sched.texels_per_frame = texels > 0 ? texels : 0;
+}
+
+lm_status lm_lightmap_path_read_window(const lm_lightmap_path *lp, const int win[4], float **rgba, lm_error *err)
+{
+    size_t n = 4 * (size_t)win[2] * win[3];
+    *rgba = malloc(n * sizeof(float));
+    if (!*rgba)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the IIM read-back");
+    lm_status st = lm_iim_texture_read_window(lp->iim.display_tex, win, *rgba, err);
+    if (st != LM_OK) {
+        free(*rgba);
+        *rgba = NULL;
+    }
+    return st;
+}
+
+lm_status lm_lightmap_path_staleness(const lm_lightmap_path *lp, const float *shown, float *error, lm_error *err)
+{
+    const lm_atlas *a = lp->atlas;
+    size_t n = (size_t)a->width * a->height;
+    float *fresh = malloc(4 * n * sizeof *fresh);
+    double *pending = calloc((size_t)(a->surface_count > 0 ? a->surface_count : 1), sizeof *pending);
+    lm_status st = fresh && pending ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "no memory for the error atlas");
+    if (st == LM_OK)
+        st = lm_iim_texture_read(lp->iim.fresh_tex, a->width, a->height, fresh, err);
+    if (st == LM_OK) {
+        const lm_photon_store *ps = lm_photons_store(lm_photon_stage_photons(lp->stage));
+        for (int s = 0; s < a->surface_count; s++)
+            pending[s] = lm_delta_i_pending(ps, s);
+        float limit = lp->set->gather.backface_limit;
+        double sum = 0.0;
+        uint32_t valid = 0;
+        for (uint32_t i = 0; i < a->texel_count; i++) {
+            const float *p = shown + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
+            if (!(p[3] > limit))
+                sum += lm_luminance(p), valid++;
+        }
+        double floor = 0.01 * (valid ? sum / valid : 0.0) + 1e-30;
+        memset(error, 0, n * sizeof *error);
+        for (uint32_t i = 0; i < a->texel_count; i++) {
+            size_t at = (size_t)a->texels[i].y * a->width + a->texels[i].x;
+            double f = lm_luminance(fresh + 4 * at), blend = fabs(f - lm_luminance(shown + 4 * at)) / fmax(fabs(f), floor);
+            int k = a->texels[i].surface;
+            double v = lp->iim.sched.off[k] ? 0.0 : fmax(blend, pending[k]); /* off: nothing to show */
+            error[at] = isfinite(v) && v < 1e30 ? (float)v : 1.0f; /* past what can be said: all of it stale */
+        }
+    }
+    free(fresh);
+    free(pending);
+    return st;
+}
+
+lm_status lm_lightmap_path_accuracy(const lm_lightmap_path *lp, const float *shown, float *out, lm_error *err)
+{
+    const lm_atlas *a = lp->atlas;
+    const lm_aim *aim = lm_photon_stage_aim(lp->stage);
+    if (!aim->error)
+        return lm_fail(err, LM_ERR_INVALID, "the error estimate needs the AIMs' own (stage.aim.error_estimate)");
+    float *source = malloc(4 * (size_t)a->width * a->height * sizeof *source);
+    if (!source)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the error estimate");
+    lm_gather_error_source(a, aim->rgb, aim->error, source);
+    lm_gather_error(&lp->set->gather, lp->scene, a, lp->rt, source, aim->error, aim->set.kernel, shown,
+                    LM_GATHER_ERROR_RAYS, out);
+    free(source);
+    return LM_OK;
+}

@@ -1,0 +1,64 @@
+/* The lightmap path of indirect light (Larsen & Christensen sections 3-4): the photon stage's AIMs
+ * gathered by hemicubes into double-buffered IIMs, texels chosen by delta_i, blended into the displayed
+ * lightmap. The frame loop (frame_loop.h) conducts it: per step schedule, gather, then blend; a bake
+ * regathers every texel whose light changed and shows it at once.
+ *
+ * It owns the gather (gpu/hemicube.h), the IIMs and their scheduler (gpu/iim.h), the closed-form emitter
+ * light the gather adds (trace/emitter_light.h) and the AIM upload. It exists on every loop (a loop on a
+ * photon path, or one with indirect light off, has every surface switched off: nothing is gathered and
+ * the lightmaps stay 0), and follows the scene's light: a scene with no light gathers nothing, and the
+ * IIM is cleared when the last light goes; a light that comes back regathers every surface in full.
+ *
+ * Reads the photon stage's AIMs, store and refreshed surfaces: only while its worker is quiet (the loop
+ * calls schedule before it starts the worker and after it joins). GL calls: on the thread whose context
+ * is current. The settings are the loop's, borrowed: the path resolves gather.coverage_samples and
+ * emitter_light in them. */
+#ifndef LM_LIGHTMAP_PATH_H
+#define LM_LIGHTMAP_PATH_H
+
+#include "frame_settings.h"
+#include "world.h"
+
+typedef struct lm_lightmap_path lm_lightmap_path;
+
+/* The gather, emitters and IIMs (GL context current); no texel gathered yet. */
+lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_frame_loop_settings *set,
+                                  lm_lightmap_path **out, lm_error *err);
+void lm_lightmap_path_free(lm_lightmap_path *lp);
+/* The first full gather of every texel (checkpointed, resumed, sharded or put together from parts as the
+ * settings say: gather_passes.h), shown at once; then the settings' progress, cancel and checkpoint are
+ * cleared (per-step gathers are small). *t_gather (may be NULL): its seconds. */
+lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_error *err);
+
+/* Follows the scene's light and its nodes' indirect switches (lm_scene.pass_version): surfaces switched
+ * on or off in the scheduler, the IIM cleared when the scene lost its last light. */
+lm_status lm_lightmap_path_follow(lm_lightmap_path *lp, lm_error *err);
+/* The AIMs changed (the stage refreshed some): uploaded again before the next gather. */
+void lm_lightmap_path_aim_changed(lm_lightmap_path *lp);
+/* Surfaces that see a refreshed AIM marked for regathering (photonmap/delta_i.h); returns how many. */
+int lm_lightmap_path_widen(lm_lightmap_path *lp);
+/* This step's texels: viewers widened, then picked by the scheduler (*count of them), and the scene and
+ * AIM uploaded when any is to be gathered. After it the stage may run again. */
+lm_status lm_lightmap_path_schedule(lm_lightmap_path *lp, uint32_t *count, lm_error *err);
+/* Gathers the count texels schedule picked into the fresh IIM. */
+lm_status lm_lightmap_path_gather(lm_lightmap_path *lp, uint32_t count, lm_error *err);
+/* Blends what completed into the displayed IIM (instant: shown at once). */
+lm_status lm_lightmap_path_blend(lm_lightmap_path *lp, int instant, lm_error *err);
+/* Every texel of every surface whose light changed gathered a pass at a time and committed at once. A
+ * cancel gives the scheduled surfaces their delta_i back and commits nothing of them. Fills out's
+ * texels_gathered and surfaces_changed; progress (may be NULL) hears 0.3 to 1 of the whole bake. */
+lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress, void *user,
+                                const volatile int *cancel, uint32_t *texels, int *surfaces_changed,
+                                lm_error *err);
+
+lm_iim *lm_lightmap_path_iim(lm_lightmap_path *lp);
+const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp);
+void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels);
+/* The displayed IIM's atlas window win = {x, y, w, h} read back (w*h RGBA floats; caller frees). */
+lm_status lm_lightmap_path_read_window(const lm_lightmap_path *lp, const int win[4], float **rgba, lm_error *err);
+/* How stale the displayed IIM is per atlas pixel (lm_frame_loop_iim_error says what it measures). */
+lm_status lm_lightmap_path_staleness(const lm_lightmap_path *lp, const float *shown, float *error, lm_error *err);
+/* The lightmaps' estimate of their own accuracy (lm_frame_loop_accuracy). */
+lm_status lm_lightmap_path_accuracy(const lm_lightmap_path *lp, const float *shown, float *out, lm_error *err);
+
+#endif
