@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "lmgi_scene.h"
+#include "api_error.h"
 
 static void to_callback(void *user, lm_log_level level, const char *message)
 {

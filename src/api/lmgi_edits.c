@@ -12,7 +12,6 @@
 #include "../scene/sky.h"
 #include "../update/effects.h"
 #include "lmgi_scene.h"
-#include "lmgi_updater.h"
 
 int lmgi_light_count(const lmgi_scene *sc) { return sc ? sc->scene->light_count : 0; }
 
@@ -115,7 +114,7 @@ lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi
     lmgi_status st = check_light(in, l->type, l->name, l->node < 0, err);
     if (st != LMGI_OK)
         return st;
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_light", err) != LMGI_OK) /* its photon work reads the lights */
+    if (lm_scene_quiet(sc, "lmgi_set_light", err) != LMGI_OK) /* its photon work reads the lights */
         return LMGI_ERR_INVALID;
     apply_light(sc, l, in);
     return LMGI_OK;
@@ -138,7 +137,7 @@ lmgi_status lmgi_add_light(lmgi_scene *sc, const lmgi_light *in, int *id, lmgi_e
         return st;
     if (s->light_count >= 1 << 20)
         return lm_api_refuse(err, "lmgi_add_light: the scene has %d lights, the most it may have", s->light_count);
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_add_light", err) != LMGI_OK)
+    if (lm_scene_quiet(sc, "lmgi_add_light", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_light *lights = realloc(s->lights, sizeof *lights * ((size_t)s->light_count + 1));
     if (!lights) {
@@ -167,7 +166,7 @@ lmgi_status lmgi_remove_light(lmgi_scene *sc, int light, lmgi_error *err)
     lm_light *l = live_light(sc, light, err);
     if (!l)
         return LMGI_ERR_INVALID;
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_remove_light", err) != LMGI_OK)
+    if (lm_scene_quiet(sc, "lmgi_remove_light", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     l->removed = 1;
     lm_effects_decide(sc->scene, &sc->effects);
@@ -255,7 +254,7 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
     lmgi_status st = new_class(m, in, &cls, err);
     if (st != LMGI_OK)
         return st;
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_material", err) != LMGI_OK) /* its photon work reads the materials */
+    if (lm_scene_quiet(sc, "lmgi_set_material", err) != LMGI_OK) /* its photon work reads the materials */
         return LMGI_ERR_INVALID;
     memcpy(m->base_color, in->base_color, sizeof m->base_color);
     memcpy(m->emissive, in->emissive, sizeof m->emissive);
@@ -286,12 +285,12 @@ static lmgi_status sky_edit_allowed(lmgi_scene *sc, int uniform, lmgi_error *err
 {
     if (!sc->updater)
         return LMGI_OK;
-    lm_gather_scheme scheme = lm_updater_gather_scheme(sc->updater);
+    lm_gather_scheme scheme = lm_frame_loop_get_settings(sc->loop)->gather.scheme;
     if (!uniform && scheme != LM_GATHER_RAYS)
         return lm_api_refuse(err, "%s: a gradient or image sky needs the rays gather, and this updater draws "
                              "hemicubes (%s): give the sky before lmgi_updater_create, or ask for rays",
                              sc->scene->path, lm_gather_scheme_name(scheme));
-    return lm_updater_sync(sc->updater, "the sky edit", err);
+    return lm_scene_quiet(sc, "the sky edit", err);
 }
 
 /* The sky is set: what the scene calls for follows. */

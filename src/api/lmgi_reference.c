@@ -9,7 +9,6 @@
 #include "lmgi_camera.h"
 #include "lmgi_reference.h"
 #include "lmgi_scene.h"
-#include "lmgi_updater.h"
 
 lmgi_status lm_api_ref_settings(const lmgi_reference_desc *desc, const char *fn, lm_ref_settings *s, lmgi_error *err)
 {
@@ -79,7 +78,7 @@ static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float ta
 static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const lm_ref_camera *cam,
                          lmgi_reference *out, lmgi_error *err)
 {
-    if (sc->updater && lm_updater_sync(sc->updater, "the reference", err) != LMGI_OK)
+    if (lm_scene_quiet(sc, "the reference", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_error e;
     lm_emitters em;

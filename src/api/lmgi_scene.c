@@ -13,8 +13,8 @@
 #include "../core/vecmath.h"
 #include "../trace/rt_scene.h"
 #include "../update/effects.h"
+#include "lmgi_context.h"
 #include "lmgi_scene.h"
-#include "lmgi_updater.h"
 
 void lmgi_options_init(lmgi_options *o)
 {
@@ -34,24 +34,20 @@ void lmgi_options_init(lmgi_options *o)
     o->max_atlas_size = ao.max_size;
 }
 
-lmgi_status lm_export_error(lmgi_error *out, const lm_error *in)
+lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err)
 {
-    if (out) {
-        out->status = (lmgi_status)in->status;
-        memcpy(out->message, in->msg, sizeof out->message);
-    }
-    return (lmgi_status)in->status;
-}
-
-lmgi_status lm_api_refuse(lmgi_error *err, const char *fmt, ...)
-{
+    if (!sc->loop)
+        return LMGI_OK;
+    lmgi_status st = lm_api_claim(sc->ctx, fn, err); /* an edit while another thread updates: refused */
+    if (st != LMGI_OK)
+        return st;
+    lm_log_target saved = lm_api_enter(sc->ctx);
     lm_error e;
-    e.status = LM_ERR_INVALID;
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(e.msg, sizeof e.msg, fmt, ap);
-    va_end(ap);
-    return lm_export_error(err, &e);
+    if (lm_frame_loop_sync(sc->loop, &e) != LM_OK) /* reported again by the next update's own work */
+        lm_log(LM_LOG_ERROR, "%s", e.msg);
+    lm_api_leave(saved);
+    lm_api_release(sc->ctx);
+    return LMGI_OK;
 }
 
 static lm_status check_options(const char *path, const lmgi_options *o, lm_error *err)
@@ -294,7 +290,7 @@ lmgi_status lmgi_set_node_effects(lmgi_scene *sc, int node, const lmgi_node_effe
     for (int k = 0; k < 4; k++)
         if (v[k] != 0 && v[k] != 1)
             return lm_api_refuse(err, "node '%s': %s is 0 or 1, not %d", s->nodes[node].name, names[k], v[k]);
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_node_effects", err) != LMGI_OK) /* its photon work reads the store the gather's switches write */
+    if (lm_scene_quiet(sc, "lmgi_set_node_effects", err) != LMGI_OK) /* its photon work reads the store the gather's switches write */
         return LMGI_ERR_INVALID;
     for (int n = 0; n < s->node_count; n++)
         if (lm_node_under(s, n, node)) { /* as extras inherit: the node and everything under it */
@@ -327,7 +323,7 @@ lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_er
                              s->nodes[n->parent].name);
     if (!dynamic && lm_node_animated_under(s, node))
         return lm_api_refuse(err, "node '%s' (or a node under it) is animated: it stays dynamic", n->name);
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_node_dynamic", err) != LMGI_OK) /* its photon work traces rays in the BVH about to be rebuilt */
+    if (lm_scene_quiet(sc, "lmgi_set_node_dynamic", err) != LMGI_OK) /* its photon work traces rays in the BVH about to be rebuilt */
         return LMGI_ERR_INVALID;
     lm_scene_set_dynamic(s, node, dynamic);
     lm_error e;
@@ -376,7 +372,7 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
     }
     /* The scene model first (children follow through their local matrices), then the rays from it; on a
      * failure the node's earlier placement comes back. */
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_node_transform", err) != LMGI_OK) /* its photon work may still be reading the scene and BVH */
+    if (lm_scene_quiet(sc, "lmgi_set_node_transform", err) != LMGI_OK) /* its photon work may still be reading the scene and BVH */
         return LMGI_ERR_INVALID;
     lm_node saved = *n;
     lm_status st = lm_scene_set_node_world(sc->scene, node, m)
@@ -410,7 +406,7 @@ lmgi_status lmgi_node_resume_animation(lmgi_scene *sc, int node, lmgi_error *err
         lm_fail(&e, LM_ERR_INVALID, "lmgi_node_resume_animation: %s", sc ? "node id out of range" : "the scene is NULL");
         return lm_export_error(err, &e);
     }
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_node_resume_animation", err) != LMGI_OK)
+    if (lm_scene_quiet(sc, "lmgi_node_resume_animation", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_scene_release_node(sc->scene, node);
     return LMGI_OK;
@@ -428,7 +424,7 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
         lm_fail(&e, LM_ERR_INVALID, "%s: animation time is not a finite number", sc->scene->path);
         return lm_export_error(err, &e);
     }
-    if (sc->updater && lm_updater_sync(sc->updater, "lmgi_set_time", err) != LMGI_OK)
+    if (lm_scene_quiet(sc, "lmgi_set_time", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_scene_eval_animation(sc->scene, -1, t);
     if (lm_rt_sync_transforms(sc->rt, sc->scene, &e) != LM_OK)

@@ -5,8 +5,10 @@
 #include <lmgi.h>
 
 #include "../charts/charts.h"
+#include "api_error.h"
 #include "../trace/rt_scene.h"
 #include "../update/effects.h"
+#include "../update/frame_loop.h"
 #include "../update/world.h"
 
 struct lmgi_scene {
@@ -20,12 +22,14 @@ struct lmgi_scene {
     lm_world world;         /* the four above, for the runtime (set once they are built) */
     lm_effects effects;
     lmgi_timings timings;
-    lmgi_updater *updater;  /* the one updater working on it (it moves nodes and the BVH), or NULL */
+    lmgi_updater *updater;  /* the one updater working on it (it moves nodes and the BVH), or NULL; */
+    lm_frame_loop *loop;    /* its frame loop and context, which an edit waits for and claims first */
+    lmgi_context *ctx;      /* (lm_scene_quiet) */
 };
 
-/* Copies an internal error into the public one and returns its status. */
-lmgi_status lm_export_error(lmgi_error *out, const lm_error *in);
-/* Fills err with LMGI_ERR_INVALID and the formatted message, and returns LMGI_ERR_INVALID. */
-lmgi_status lm_api_refuse(lmgi_error *err, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Before an edit changes what the scene's updater reads (the scene, its BVH, lights, materials, sky):
+ * the photon work the last update left running is waited for. Refused (LMGI_ERR_INVALID naming fn)
+ * while another thread is inside a call on the updater's context. LMGI_OK at once without an updater. */
+lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err);
 
 #endif

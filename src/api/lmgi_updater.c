@@ -1,5 +1,6 @@
-/* The public API's updater: the frame loop (update/frame_loop.h) behind include/lmgi.h, with a time
- * budget turned into a texel count, per-surface change counters and the lightmaps read back. */
+/* The public API's updater: the frame loop (update/frame_loop.h, which turns the time budget into work:
+ * update/budget.h) behind include/lmgi.h, with per-surface change counters and the lightmaps read
+ * back. */
 #include <lmgi.h>
 
 #include <math.h>
@@ -8,7 +9,6 @@
 #include <string.h>
 
 #include "../charts/atlas_dilate.h"
-#include "../core/stats.h"
 #include "../scene/sky.h"
 #include "../update/bake_checkpoint.h"
 #include "../update/frame_loop.h"
@@ -17,17 +17,12 @@
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
 
-#define COST_WINDOW 32
-
 struct lmgi_updater {
     lmgi_context *ctx;
     lmgi_scene *sc;
     lm_frame_loop *loop;
     int frames;                 /* updates done */
     uint32_t *seen;             /* per surface: lmgi_surface_version at the end of the last update */
-    /* the budget's cost model: the last COST_WINDOW updates' gather ms per texel, and the rest of each */
-    double per_texel[COST_WINDOW], rest[COST_WINDOW];
-    int costs;                  /* samples taken (the window holds the last min(costs, COST_WINDOW)) */
     lm_photon_stage_frame setup;
     double t_setup_gather;
     lm_lightmap_texture *texture; /* lmgi_get_lightmap_texture's, once asked for */
@@ -309,13 +304,10 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     }
     const uint32_t *ver = lm_frame_loop_surface_versions(u->loop);
     memcpy(u->seen, ver, sizeof *u->seen * (size_t)sc->atlas.surface_count);
-    /* the budget's first guess: the full gather's cost per texel (small per-frame batches cost more per
-     * texel; the model corrects itself from the first update on) */
-    u->per_texel[0] = sc->atlas.texel_count ? 1e3 * u->t_setup_gather / sc->atlas.texel_count : 0.01;
-    u->rest[0] = 0.0;
-    u->costs = 1;
     ctx->updaters++;
     sc->updater = u;
+    sc->loop = u->loop;
+    sc->ctx = ctx;
     *out = u;
     return LMGI_OK;
 }
@@ -336,20 +328,6 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
 }
 
 const lmgi_scene *lm_updater_scene(const lmgi_updater *u) { return u->sc; }
-
-lmgi_status lm_updater_sync(lmgi_updater *u, const char *fn, lmgi_error *err)
-{
-    lmgi_status st = lm_api_claim(u->ctx, fn, err); /* an edit while another thread updates: refused */
-    if (st != LMGI_OK)
-        return st;
-    lm_log_target saved = lm_api_enter(u->ctx);
-    lm_error e;
-    if (lm_frame_loop_sync(u->loop, &e) != LM_OK) /* reported again by the next update's own work */
-        lm_log(LM_LOG_ERROR, "%s", e.msg);
-    lm_api_leave(saved);
-    lm_api_release(u->ctx);
-    return LMGI_OK;
-}
 
 lmgi_context *lm_updater_context(const lmgi_updater *u) { return u->ctx; }
 lm_frame_loop *lm_updater_loop(const lmgi_updater *u) { return u->loop; }
@@ -372,6 +350,8 @@ void lmgi_updater_free(lmgi_updater *u)
     lm_api_leave(saved);
     u->ctx->updaters--;
     u->sc->updater = NULL;
+    u->sc->loop = NULL;
+    u->sc->ctx = NULL;
     free(u->seen);
     free(u);
     lm_api_release(ctx);
@@ -379,10 +359,6 @@ void lmgi_updater_free(lmgi_updater *u)
 
 lm_lightmap_texture **lm_updater_texture(lmgi_updater *u) { return &u->texture; }
 
-lm_gather_scheme lm_updater_gather_scheme(const lmgi_updater *u)
-{
-    return lm_frame_loop_get_settings(u->loop)->gather.scheme;
-}
 
 void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
 {
@@ -416,41 +392,6 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     const lm_emitters *em = lm_photon_stage_emitters(lm_frame_loop_stage(u->loop));
     for (int e = 0; em && e < em->count; e++)
         info->portals_found += em->e[e].portals ? (int)em->e[e].portals->found / 2 : 0;
-}
-
-/* The 95th percentile of the window's first n samples (sorting a copy). */
-static double p95(const double *v, int n)
-{
-    double sorted[COST_WINDOW];
-    memcpy(sorted, v, sizeof *v * (size_t)n);
-    return lm_quantile(sorted, n, 0.95);
-}
-
-/* Texels that fit in budget_ms: the budget less the 95th percentile of the rest of recent updates, over
- * the 95th percentile of their gather cost per texel, so that the 95th percentile update keeps within it
- * (a mean would let half of them run over: a gather's cost per texel varies by a third with the surfaces
- * it draws; docs/bench.md has the figures). Never fewer than one texel, never more than the atlas. */
-static int texels_for_budget(const lmgi_updater *u, float budget_ms)
-{
-    int n = u->costs < COST_WINDOW ? u->costs : COST_WINDOW;
-    double per = p95(u->per_texel, n), rest = p95(u->rest, n);
-    double texels = ((double)budget_ms - rest) / (per > 1e-6 ? per : 1e-6);
-    double most = u->sc->atlas.texel_count > 0 ? u->sc->atlas.texel_count : 1;
-    return texels < 1.0 ? 1 : texels > most ? (int)most : (int)texels;
-}
-
-/* Each update's costs go into the window (the first one, which uploads everything, is left out). The gather
- * cost per texel includes its per-pass and upload costs, so a small batch looks dearer per texel; choosing
- * n = (budget - rest) / (gather / n) still settles where the gather fills what the rest leaves. */
-static void learn_cost(lmgi_updater *u, const lm_frame_stats *fs)
-{
-    if (u->frames == 0)
-        return;
-    int i = u->costs % COST_WINDOW;
-    u->rest[i] = 1e3 * (fs->t_total - fs->t_gather);
-    u->per_texel[i] = fs->texels_gathered > 0 ? 1e3 * fs->t_gather / fs->texels_gathered
-                                               : u->per_texel[(u->costs - 1) % COST_WINDOW];
-    u->costs++;
 }
 
 static int count_changed(lmgi_updater *u)
@@ -622,9 +563,7 @@ static lmgi_status update_owned(lmgi_updater *u, float time, float budget_ms, lm
     if (!(budget_ms >= 0.0f) || !isfinite(budget_ms))
         return lm_api_refuse(err, "lmgi_update: budget %g ms must be a finite number >= 0 (0: texels_per_frame)",
                        (double)budget_ms);
-    int budget = budget_ms > 0.0f ? texels_for_budget(u, budget_ms)
-                                   : lm_frame_loop_get_settings(u->loop)->iim.texels_per_frame;
-    lm_frame_loop_set_texels_per_frame(u->loop, budget);
+    lm_frame_loop_set_budget(u->loop, budget_ms);
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_frame_stats fs;
     lm_error e;
@@ -632,10 +571,9 @@ static lmgi_status update_owned(lmgi_updater *u, float time, float budget_ms, lm
     lm_api_leave(saved);
     if (st != LM_OK)
         return lm_export_error(err, &e);
-    learn_cost(u, &fs);
     u->frames++;
     if (stats)
-        export_stats(&fs, budget, count_changed(u), stats);
+        export_stats(&fs, fs.texel_budget, count_changed(u), stats);
     else
         count_changed(u);
     return check_frame(u, time, err);

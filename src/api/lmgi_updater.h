@@ -18,16 +18,10 @@ lm_frame_loop *lm_updater_loop(const lmgi_updater *u); /* tools and tests */
 /* lmgi_render's picture from a view already checked, inside the caller's lm_api_enter. */
 lm_status lm_updater_render(lmgi_updater *u, const lm_view *v, int width, int height, float *rgb, lm_error *err);
 
-/* Waits for the photon work an update left running, before the scene is changed under it; refused
- * (LMGI_ERR_INVALID naming fn) while another thread is inside a call on u's context (lm_api_claim). */
-lmgi_status lm_updater_sync(lmgi_updater *u, const char *fn, lmgi_error *err);
 /* The updater's lightmap texture (lmgi_texture.c): NULL until lmgi_get_lightmap_texture first asks for it;
  * freed by lmgi_updater_free with the updater's GL context current. */
 typedef struct lm_lightmap_texture lm_lightmap_texture;
 lm_lightmap_texture **lm_updater_texture(lmgi_updater *u);
 void lm_lightmap_texture_free(lm_lightmap_texture *t);
-
-/* How u gathers (the frame loop's settings): a gradient or image sky needs LM_GATHER_RAYS. */
-lm_gather_scheme lm_updater_gather_scheme(const lmgi_updater *u);
 
 #endif

@@ -6,6 +6,7 @@
 
 #include "../core/memory.h"
 #include "../core/timing.h"
+#include "budget.h"
 #include "frame_passes.h"
 #include "lightmap_path.h"
 #include "photon_path.h"
@@ -28,6 +29,9 @@ struct lm_frame_loop {
     lm_frame_passes *passes;
     float *image;
     lm_view view;
+    float budget_ms;             /* lm_frame_loop_set_budget's (0: set.iim.texels_per_frame a step) */
+    lm_cost_model gather_cost;   /* the gather's ms per texel and the rest of each step */
+    int steps;                   /* steps done */
 };
 
 int lm_frame_loop_atlas_texels(int texels_per_frame)
@@ -75,7 +79,16 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         st = lm_frame_passes_create(&fl->world, fl->stage, &fl->set, &fl->passes, err);
     if (st == LM_OK && fl->set.width > 0)
         st = lm_frame_passes_setup(fl->passes, err);
-    return st == LM_OK ? lm_lightmap_path_first(fl->lightmaps, t_gather, err) : st;
+    double t = 0.0;
+    if (st == LM_OK)
+        st = lm_lightmap_path_first(fl->lightmaps, &t, err);
+    if (t_gather)
+        *t_gather = t;
+    /* the budget's first guess: the full gather's cost per texel (small per-step batches cost more per
+     * texel; the model corrects itself from the first step on) */
+    uint32_t texels = fl->world.atlas->texel_count;
+    lm_cost_model_seed(&fl->gather_cost, texels ? 1e3 * t / texels : 0.01);
+    return st;
 }
 
 /* What the frame loop adds per atlas texel to what lmgi_load holds (AIM, IIM double buffer, gather
@@ -330,6 +343,10 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
 {
     lm_frame_stats o;
     memset(&o, 0, sizeof o);
+    int most = (int)fl->world.atlas->texel_count;
+    o.texel_budget = fl->budget_ms > 0.0f ? lm_cost_model_units(&fl->gather_cost, fl->budget_ms, most)
+                                          : fl->set.iim.texels_per_frame;
+    lm_lightmap_path_set_texels_per_frame(fl->lightmaps, o.texel_budget);
     double t0 = lm_now();
     lm_status st = lm_gl_make_current(fl->gl, err);
     if (st == LM_OK)
@@ -338,6 +355,9 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
         st = !fl->worker ? step_in_order(fl, t, &o, err)
              : fl->set.width > 0 ? step_overlapped(fl, t, &o, err) : step_detached(fl, t, &o, err);
     o.t_total = lm_now() - t0;
+    /* the budget's costs (the first step, which uploads everything, is left out) */
+    if (st == LM_OK && fl->steps++ > 0)
+        lm_cost_model_learn(&fl->gather_cost, 1e3 * o.t_gather, o.texels_gathered, 1e3 * (o.t_total - o.t_gather));
     if (out)
         *out = o;
     return st;
@@ -387,10 +407,7 @@ const uint32_t *lm_frame_loop_surface_versions(const lm_frame_loop *fl)
 {
     return lm_lightmap_path_iim_const(fl->lightmaps)->version;
 }
-void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels)
-{
-    lm_lightmap_path_set_texels_per_frame(fl->lightmaps, texels);
-}
+void lm_frame_loop_set_budget(lm_frame_loop *fl, float budget_ms) { fl->budget_ms = budget_ms > 0.0f ? budget_ms : 0.0f; }
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl) { return fl->stage; }
 const lm_frame_loop_settings *lm_frame_loop_get_settings(const lm_frame_loop *fl) { return &fl->set; }
 const lm_view *lm_frame_loop_view(const lm_frame_loop *fl) { return &fl->view; }

@@ -69,9 +69,10 @@ typedef struct {
 lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progress, void *user,
                              const volatile int *cancel, lm_bake_stats *out, lm_error *err);
 
-/* The texels the next steps gather (at least 0; the settings' iim.texels_per_frame until set): the public
- * updater's time budget turns into this. */
-void lm_frame_loop_set_texels_per_frame(lm_frame_loop *fl, int texels);
+/* The time the next steps may take, in ms (budget.h): the gather's texels a step are those that fit
+ * beside the 95th percentile of the rest of recent steps, learnt from each step (at least 1, at most the
+ * atlas); 0 (the default): the settings' iim.texels_per_frame. */
+void lm_frame_loop_set_budget(lm_frame_loop *fl, float budget_ms);
 /* Renders the composited frame from `view` at width x height into rgb (width*height*3 linear floats, top
  * row first) with the lighting of the last step: lmgi_render's camera, beside the step's own frame. When
  * the steps draw no frame (width 0), the environment maps' faces due are refreshed here, and the caustics

@@ -81,6 +81,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
 /* What a step did (lm_frame_loop_step). */
 typedef struct {
     lm_photon_stage_frame stage;
+    int texel_budget;      /* the texels the step was allowed (lm_frame_loop_set_budget) */
     uint32_t texels_gathered;
     lm_caustic_pass_stats caustic; /* the frame's caustic pass */
     int cube_faces;        /* environment map faces rendered */

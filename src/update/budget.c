@@ -1,0 +1,37 @@
+#include "budget.h"
+
+#include <string.h>
+
+#include "../core/stats.h"
+
+void lm_cost_model_seed(lm_cost_model *m, double ms_per_unit)
+{
+    memset(m, 0, sizeof *m);
+    m->per_unit[0] = ms_per_unit;
+    m->samples = 1;
+}
+
+void lm_cost_model_learn(lm_cost_model *m, double ms_stage, uint32_t units, double ms_rest)
+{
+    int i = m->samples % LM_COST_WINDOW;
+    m->rest[i] = ms_rest;
+    m->per_unit[i] = units > 0 ? ms_stage / units : m->per_unit[(m->samples - 1) % LM_COST_WINDOW];
+    m->samples++;
+}
+
+/* The 95th percentile of the ring's first n samples (sorting a copy). */
+static double p95(const double *v, int n)
+{
+    double sorted[LM_COST_WINDOW];
+    memcpy(sorted, v, sizeof *v * (size_t)n);
+    return lm_quantile(sorted, n, 0.95);
+}
+
+int lm_cost_model_units(const lm_cost_model *m, double budget_ms, int most)
+{
+    int n = m->samples < LM_COST_WINDOW ? m->samples : LM_COST_WINDOW;
+    double per = p95(m->per_unit, n), rest = p95(m->rest, n);
+    double units = (budget_ms - rest) / (per > 1e-6 ? per : 1e-6);
+    double top = most > 0 ? most : 1;
+    return units < 1.0 ? 1 : units > top ? (int)top : (int)units;
+}
