@@ -170,8 +170,20 @@ LMGI_API int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);   /* 0 for
 /* A node's world matrix now (column-major; in the file's world). Returns 0 (world untouched) for a NULL
  * argument or an id out of range. */
 LMGI_API int lmgi_get_node_transform(const lmgi_scene *scene, int node, float world[16]);
-/* NULL scene or world: LMGI_ERR_INVALID. */
+/* Moves a node (its world matrix, column-major, in the file's world; its children follow). The scene
+ * model takes it at once (lmgi_get_node_transform, the next picture); the ray-tracing BVH at the next
+ * commit, which moves every node edited since in one go: lmgi_commit, or the next lmgi_update, lmgi_bake
+ * or lmgi_render, or anything of lmgi's own that traces rays (lmgi_intersect, the reference, an updater
+ * made on the scene). Moving many nodes costs one BVH commit, not one a node. NULL scene or world, an
+ * id out of range, a static node with triangles, a matrix with NaN or Inf, a singular one, or one that
+ * would mirror a node that was not mirrored at load (or the reverse): LMGI_ERR_INVALID naming it. */
 LMGI_API lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
+/* Commits the edits staged since the last commit (the nodes moved by lmgi_set_node_transform and
+ * lmgi_set_time) to the ray-tracing BVH now: one instance update per dynamic node and one top-level commit
+ * (Embree's rtcCommitScene). Optional: every call that traces rays commits first. After an updater's
+ * photon work that the edits already waited for. NULL scene: LMGI_ERR_INVALID; an error of the BVH's
+ * (out of memory): LMGI_ERR_BACKEND or LMGI_ERR_NOMEM, the edits kept for the next commit. */
+LMGI_API lmgi_status lmgi_commit(lmgi_scene *scene, lmgi_error *err);
 /* Switches a node and every node under it between static (0: in the static BVH, shadows cached) and
  * dynamic (1: lmgi_set_node_transform may move it), where they are now. The ray-tracing BVH is rebuilt at
  * once (as at load: milliseconds for thousands of triangles) and the direct pass's casters at the next
@@ -341,8 +353,8 @@ LMGI_API lmgi_status lmgi_set_material(lmgi_scene *scene, int material, const lm
 /* Hands an edited node back to its animations from the next lmgi_set_time or update on. NULL scene or
  * an id out of range: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_node_resume_animation(lmgi_scene *scene, int node, lmgi_error *err);
-/* Plays every glTF animation to time t (seconds) and moves the animated nodes. NULL scene or a t that
- * is not finite: LMGI_ERR_INVALID. */
+/* Plays every glTF animation to time t (seconds) and moves the animated nodes (the BVH at the next
+ * commit, as lmgi_set_node_transform says). NULL scene or a t that is not finite: LMGI_ERR_INVALID. */
 LMGI_API lmgi_status lmgi_set_time(lmgi_scene *scene, float t, lmgi_error *err);
 
 /* Closest hit of the ray org + t dir, t in (0, tmax). A ray with a NaN, infinite or huge (above 1.8e18)

@@ -287,7 +287,7 @@ void lmt_pipeline_load(lmt_pipeline *p, const char *path, float texel_size)
         lm_atlas_build(p->s, &p->su, &ao, &p->atlas, &err) != LM_OK || lm_rt_build(p->s, &p->su, &p->rt, &err) != LM_OK ||
         lm_emitters_build(p->s, &p->em, &err) != LM_OK)
         fail_msg("loading %s: %s", path, err.msg);
-    p->w = (lm_world){p->s, &p->su, &p->atlas, p->rt};
+    p->w = (lm_world){p->s, &p->su, &p->atlas, p->rt, NULL}; /* no edits staged: the tests move nodes themselves */
 }
 
 void lmt_pipeline_free(lmt_pipeline *p)

@@ -1,7 +1,8 @@
 /* Nodes switched between static and dynamic through the public API (lmgi_set_node_dynamic): the switch
  * itself changes no light, a static block made dynamic moves and lights the room as the same block
  * loaded dynamic does, made static again it stays where it was left, and what must stay dynamic (an
- * animated node, a node under a dynamic parent) is refused. */
+ * animated node, a node under a dynamic parent) is refused. Moves are staged: a batch of them reaches the
+ * BVH in one commit (lmgi_commit, or the next call that traces rays). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -13,6 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../src/api/lmgi_scene.h"
 #include "edit_room.h"
 #include "support.h"
 
@@ -164,11 +166,73 @@ static void test_what_stays_dynamic(void **state)
     lmgi_free(sc);
 }
 
+/* Three dynamic cubes moved: the scene model at once, the BVH not until the commit, which is one top-level
+ * commit for the three; rays see every move after it; lmgi_intersect commits first on its own, an update
+ * too, and a commit with nothing staged commits nothing. */
+static void test_moves_commit_once(void **state)
+{
+    (void)state;
+    lmt_mesh cube;
+    memset(&cube, 0, sizeof cube);
+    lmt_mesh_cube(&cube, 0.5f);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/three_cubes.gltf", lmt_tmpdir());
+    const char *nodes = "[{\"name\": \"a\", \"mesh\": 0, \"extras\": {\"lmgi\": {\"dynamic\": true}}},"
+                        " {\"name\": \"b\", \"mesh\": 0, \"translation\": [3, 0, 0],"
+                        "  \"extras\": {\"lmgi\": {\"dynamic\": true}}},"
+                        " {\"name\": \"c\", \"mesh\": 0, \"translation\": [6, 0, 0],"
+                        "  \"extras\": {\"lmgi\": {\"dynamic\": true}}}]";
+    assert_int_equal(lmt_write_gltf(path, &cube, 1, nodes, NULL, 0, ""), 0);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    uint64_t commits = lm_rt_top_commits(sc->rt);
+    for (int k = 0; k < 3; k++) { /* each cube 2 up */
+        float world[16];
+        assert_true(lmgi_get_node_transform(sc, k, world));
+        world[13] += 2.0f;
+        assert_int_equal(lmgi_set_node_transform(sc, k, world, &e), LMGI_OK);
+        assert_true(lmgi_get_node_transform(sc, k, world)); /* the scene model has it at once */
+        assert_float_equal(world[13], 2.0f, 1e-6);
+    }
+    assert_true(lm_rt_top_commits(sc->rt) == commits); /* staged: the BVH as it was */
+    assert_int_equal(lmgi_commit(sc, &e), LMGI_OK);
+    assert_true(lm_rt_top_commits(sc->rt) == commits + 1); /* one commit for the three */
+    assert_int_equal(lmgi_commit(sc, &e), LMGI_OK);
+    assert_true(lm_rt_top_commits(sc->rt) == commits + 1); /* nothing staged: nothing committed */
+    const float down[3] = {0.0f, -1.0f, 0.0f};
+    for (int k = 0; k < 3; k++) {
+        const float org[3] = {3.0f * (float)k, 10.0f, 0.0f};
+        lmgi_hit h;
+        lmgi_intersect(sc, org, down, INFINITY, &h);
+        assert_true(h.hit && h.node == k);
+        assert_float_equal(h.t, 10.0f - 2.5f, 1e-5); /* the top face, 2 up */
+    }
+    float world[16];
+    assert_true(lmgi_get_node_transform(sc, 1, world));
+    world[13] -= 2.0f;
+    assert_int_equal(lmgi_set_node_transform(sc, 1, world, &e), LMGI_OK);
+    const float org[3] = {3.0f, 10.0f, 0.0f};
+    lmgi_hit h;
+    lmgi_intersect(sc, org, down, INFINITY, &h); /* commits first */
+    assert_true(h.hit && h.node == 1);
+    assert_float_equal(h.t, 10.0f - 0.5f, 1e-5);
+    assert_true(lm_rt_top_commits(sc->rt) == commits + 2);
+    lmgi_intersect(sc, org, down, INFINITY, &h);
+    assert_true(lm_rt_top_commits(sc->rt) == commits + 2);
+    lmt_expect_invalid(lmgi_commit(NULL, &e), &e, "NULL");
+    lmgi_free(sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_static_block_made_dynamic),
         cmocka_unit_test(test_what_stays_dynamic),
+        cmocka_unit_test(test_moves_commit_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

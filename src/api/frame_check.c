@@ -100,6 +100,8 @@ static lm_status reference_pixels(const lmgi_scene *sc, const lm_view *view, con
 {
     lm_ref_camera cam;
     lm_status st = lm_view_ref_camera(view, c->width, c->height, &cam, err);
+    if (st == LM_OK) /* the edits' placements in the BVH it traces */
+        st = lm_edits_commit(&sc->world, err);
     if (st != LM_OK)
         return st;
     lm_emitters em;

@@ -80,6 +80,8 @@ static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const
 {
     if (lm_scene_quiet(sc, "the reference", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
+    if (lm_scene_commit(sc, err) != LMGI_OK) /* the edits' placements in the BVH it traces */
+        return err ? err->status : LMGI_ERR_BACKEND;
     lm_error e;
     lm_emitters em;
     lm_ref_result r;

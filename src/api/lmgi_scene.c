@@ -50,6 +50,20 @@ lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err
     return LMGI_OK;
 }
 
+lmgi_status lm_scene_commit(const lmgi_scene *sc, lmgi_error *err)
+{
+    lm_error e;
+    return lm_edits_commit(&sc->world, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+lmgi_status lmgi_commit(lmgi_scene *sc, lmgi_error *err)
+{
+    if (!sc)
+        return lm_api_refuse(err, "lmgi_commit: the scene is NULL");
+    lmgi_status st = lm_scene_quiet(sc, "lmgi_commit", err);
+    return st == LMGI_OK ? lm_scene_commit(sc, err) : st;
+}
+
 static lm_status check_options(const char *path, const lmgi_options *o, lm_error *err)
 {
     if (!(o->texel_size >= 0.0f) || !isfinite(o->texel_size))
@@ -148,7 +162,7 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
         return st;
     double t4 = lm_now();
 
-    sc->world = (lm_world){sc->scene, &sc->surfaces, &sc->atlas, sc->rt};
+    sc->world = (lm_world){sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &sc->edits};
     lm_effects_decide(sc->scene, &sc->effects);
     sc->timings.load = t1 - t0;
     sc->timings.surfaces = t2 - t1;
@@ -331,6 +345,7 @@ lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_er
         lm_scene_set_dynamic(s, node, !dynamic); /* the old BVH is still in place */
         return lm_export_error(err, &e);
     }
+    sc->edits.moved = 0; /* built from the scene model as it is: every staged placement in it */
     lm_effects_decide(s, &sc->effects);
     return LMGI_OK;
 }
@@ -370,22 +385,20 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
                 "scale flattens the node)" : "has NaN or Inf entries");
         return lm_export_error(err, &e);
     }
-    /* The scene model first (children follow through their local matrices), then the rays from it; on a
-     * failure the node's earlier placement comes back. */
+    /* The scene model now (children follow through their local matrices), the rays at the commit
+     * (update/edits.h); on a failure the node's earlier placement comes back. */
     if (lm_scene_quiet(sc, "lmgi_set_node_transform", err) != LMGI_OK) /* its photon work may still be reading the scene and BVH */
         return LMGI_ERR_INVALID;
     lm_node saved = *n;
     lm_status st = lm_scene_set_node_world(sc->scene, node, m)
                        ? lm_scene_check_extent(sc->scene, node, &e)
                        : lm_fail(&e, LM_ERR_INVALID, "node '%s': its parent's transform has no inverse", n->name);
-    if (st == LM_OK)
-        st = lm_rt_sync_transforms(sc->rt, sc->scene, &e);
     if (st != LM_OK) {
         sc->scene->nodes[node] = saved;
         lm_scene_update_world(sc->scene);
-        lm_rt_sync_transforms(sc->rt, sc->scene, NULL);
         return lm_export_error(err, &e);
     }
+    sc->edits.moved++; /* the BVH follows at the commit */
     return LMGI_OK;
 }
 
@@ -427,8 +440,7 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
     if (lm_scene_quiet(sc, "lmgi_set_time", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_scene_eval_animation(sc->scene, -1, t);
-    if (lm_rt_sync_transforms(sc->rt, sc->scene, &e) != LM_OK)
-        return lm_export_error(err, &e);
+    sc->edits.moved++; /* the BVH follows at the commit */
     return LMGI_OK;
 }
 
@@ -439,7 +451,7 @@ void lmgi_intersect(const lmgi_scene *sc, const float org[3], const float dir[3]
     lm_rt_hit h;
     memset(hit, 0, sizeof *hit);
     hit->node = hit->surface = -1;
-    if (!sc || !org || !dir)
+    if (!sc || !org || !dir || lm_scene_commit(sc, NULL) != LMGI_OK) /* the BVH unusable: nothing hit */
         return;
     const float *o = sc->scene->origin;
     const float local[3] = {org[0] - o[0], org[1] - o[1], org[2] - o[2]};

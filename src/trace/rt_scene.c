@@ -26,8 +26,16 @@ struct lm_rt {
     int *node_inst;             /* node -> instance geomID, -1 for static nodes */
     float (*inst_world)[16];    /* current world matrix of each instance */
     float (*node_nmat)[9];      /* node -> normal matrix of its world matrix (kept with inst_world) */
+    uint64_t top_commits;       /* the top level's commits (lm_rt_top_commits) */
     char device_error[256];
 };
+
+/* The top level committed (counted for lm_rt_top_commits). */
+static void commit_top(lm_rt *rt)
+{
+    rtcCommitScene(rt->top);
+    rt->top_commits++;
+}
 
 static void on_device_error(void *user, enum RTCError code, const char *str)
 {
@@ -214,7 +222,7 @@ static lm_status build(const lm_scene *s, const int *tri_surface, lm_rt **out, l
             rt->instance_count += st == LM_OK;
         }
     if (st == LM_OK) {
-        rtcCommitScene(rt->top);
+        commit_top(rt);
         if (rtcGetDeviceError(rt->device) != RTC_ERROR_NONE)
             st = fail_backend(rt, err, s->path);
     }
@@ -295,7 +303,7 @@ lm_status lm_rt_set_node_transform(lm_rt *rt, int node, const float world[16], l
                        rt->scene->nodes[node].name);
     lm_status st = move_instance(rt, node, world, err);
     if (st == LM_OK)
-        rtcCommitScene(rt->top);
+        commit_top(rt);
     return st;
 }
 
@@ -308,7 +316,7 @@ lm_status lm_rt_sync_transforms(lm_rt *rt, const lm_scene *s, lm_error *err)
         if (st != LM_OK)
             return st;
     }
-    rtcCommitScene(rt->top);
+    commit_top(rt);
     return LM_OK;
 }
 
@@ -444,3 +452,5 @@ uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir
 }
 
 uint32_t lm_rt_static_triangle_count(const lm_rt *rt) { return rt->static_count; }
+
+uint64_t lm_rt_top_commits(const lm_rt *rt) { return rt->top_commits; }

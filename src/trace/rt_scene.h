@@ -42,6 +42,9 @@ lm_status lm_rt_rebuild(lm_rt *rt, lm_error *err);
 lm_status lm_rt_set_node_transform(lm_rt *rt, int node, const float world[16], lm_error *err);
 /* Copies every dynamic node's world matrix from the scene, then commits the top level once. */
 lm_status lm_rt_sync_transforms(lm_rt *rt, const lm_scene *s, lm_error *err);
+/* How many times the top level was committed (built, rebuilt, a node moved or synced): edits staged in
+ * a batch commit it once (update/edits.h), which tests hold them to. */
+uint64_t lm_rt_top_commits(const lm_rt *rt);
 
 /* Closest hit along org + t dir, t in (tnear, tfar). Returns 1 on a hit. dir need not be unit length. */
 int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,

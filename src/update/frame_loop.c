@@ -47,11 +47,13 @@ static lm_frame_indirect indirect_of(const lm_frame_loop *fl)
                                fl->photons};
 }
 
-/* After edits (lm_scene.pass_version, the lights): the lightmap path's switches and light, then the
- * frame's passes. */
+/* After edits: the staged ones committed (the BVH), then what follows lm_scene.pass_version and the
+ * lights: the lightmap path's switches and light, the frame's passes. */
 static lm_status follow_edits(lm_frame_loop *fl, lm_error *err)
 {
-    lm_status st = lm_lightmap_path_follow(fl->lightmaps, err);
+    lm_status st = lm_edits_commit(&fl->world, err);
+    if (st == LM_OK)
+        st = lm_lightmap_path_follow(fl->lightmaps, err);
     return st == LM_OK ? lm_frame_passes_follow(fl->passes, err) : st;
 }
 
@@ -112,6 +114,8 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
     snprintf(what, sizeof what, "the lightmaps of %u texels (AIM, IIM, gather)", a->texel_count);
     lm_status st = lm_memory_plan(what, (double)a->texel_count * FRAME_LOOP_BYTES_PER_TEXEL, "a larger texel "
                                   "size (--texel-size) or fewer texels (--texels) makes it smaller", err);
+    if (st == LM_OK) /* the edits' placements in the BVH the photons are traced in */
+        st = lm_edits_commit(w, err);
     size_t n = 3 * (size_t)fl->set.width * fl->set.height;
     if (st == LM_OK && !(fl->image = malloc((n ? n : 1) * sizeof(float))))
         st = lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
