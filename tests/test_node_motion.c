@@ -28,6 +28,25 @@ static lmgi_scene *load_room(int block_dynamic)
     return lmt_room(&spec);
 }
 
+/* Unit cubes (half side 0.5) placed as the glTF nodes JSON says, written to name and loaded. */
+static lmgi_scene *load_cubes(const char *name, const char *nodes)
+{
+    lmt_mesh cube;
+    memset(&cube, 0, sizeof cube);
+    lmt_mesh_cube(&cube, 0.5f);
+    char path[1200];
+    snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), name);
+    assert_int_equal(lmt_write_gltf(path, &cube, 1, nodes, NULL, 0, ""), 0);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 800;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
 static double iim_sum(const float *iim, size_t n)
 {
     double sum = 0.0;
@@ -133,17 +152,9 @@ static void test_what_stays_dynamic(void **state)
     lmt_expect_invalid(lmgi_set_node_dynamic(sc, lmgi_find_node(sc, "dynamic_cube"), 0, &e), &e, "animated");
     lmgi_free(sc);
 
-    lmt_mesh cube;
-    memset(&cube, 0, sizeof cube);
-    lmt_mesh_cube(&cube, 0.5f);
-    char path[1200];
-    snprintf(path, sizeof path, "%s/family.gltf", lmt_tmpdir());
-    const char *nodes = "[{\"name\": \"parent\", \"mesh\": 0, \"children\": [1],"
-                        "  \"extras\": {\"lmgi\": {\"dynamic\": true}}},"
-                        " {\"name\": \"child\", \"mesh\": 0, \"translation\": [2, 0, 0]}]";
-    assert_int_equal(lmt_write_gltf(path, &cube, 1, nodes, NULL, 0, ""), 0);
-    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
+    sc = load_cubes("family.gltf", "[{\"name\": \"parent\", \"mesh\": 0, \"children\": [1],"
+                                   "  \"extras\": {\"lmgi\": {\"dynamic\": true}}},"
+                                   " {\"name\": \"child\", \"mesh\": 0, \"translation\": [2, 0, 0]}]");
     int parent = lmgi_find_node(sc, "parent"), child = lmgi_find_node(sc, "child");
     assert_true(lmgi_node_is_dynamic(sc, child));
     lmt_expect_invalid(lmgi_set_node_dynamic(sc, child, 0, &e), &e, "under dynamic node 'parent'");
@@ -172,23 +183,13 @@ static void test_what_stays_dynamic(void **state)
 static void test_moves_commit_once(void **state)
 {
     (void)state;
-    lmt_mesh cube;
-    memset(&cube, 0, sizeof cube);
-    lmt_mesh_cube(&cube, 0.5f);
-    char path[1200];
-    snprintf(path, sizeof path, "%s/three_cubes.gltf", lmt_tmpdir());
     const char *nodes = "[{\"name\": \"a\", \"mesh\": 0, \"extras\": {\"lmgi\": {\"dynamic\": true}}},"
                         " {\"name\": \"b\", \"mesh\": 0, \"translation\": [3, 0, 0],"
                         "  \"extras\": {\"lmgi\": {\"dynamic\": true}}},"
                         " {\"name\": \"c\", \"mesh\": 0, \"translation\": [6, 0, 0],"
                         "  \"extras\": {\"lmgi\": {\"dynamic\": true}}}]";
-    assert_int_equal(lmt_write_gltf(path, &cube, 1, nodes, NULL, 0, ""), 0);
-    lmgi_options o;
-    lmgi_options_init(&o);
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = load_cubes("three_cubes.gltf", nodes);
     lmgi_error e;
-    if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
     uint64_t commits = lm_rt_top_commits(sc->rt);
     for (int k = 0; k < 3; k++) { /* each cube 2 up */
         float world[16];

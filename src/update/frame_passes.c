@@ -10,9 +10,7 @@
 
 struct lm_frame_passes {
     const lm_frame_loop_settings *set; /* the loop's, borrowed */
-    lm_scene *scene;
-    const lm_surfaces *surfaces;
-    const lm_atlas *atlas;
+    const lm_world *w;                 /* the loop's, borrowed */
     const lm_photon_stage *stage;
     lm_composite *comp;
     lm_direct *direct;           /* persistent: program, buffers, the frame's targets and shadow maps */
@@ -35,9 +33,7 @@ lm_status lm_frame_passes_create(const lm_world *w, const lm_photon_stage *stage
     if (!*out)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame's passes", w->scene->path);
     (*out)->set = set;
-    (*out)->scene = w->scene;
-    (*out)->surfaces = w->surfaces;
-    (*out)->atlas = w->atlas;
+    (*out)->w = w;
     (*out)->stage = stage;
     return LM_OK;
 }
@@ -58,28 +54,28 @@ lm_status lm_frame_passes_setup(lm_frame_passes *fp, lm_error *err)
     if (fp->direct)
         return LM_OK;
     const lm_frame_loop_settings *set = fp->set;
-    lm_status st = lm_composite_create(fp->scene, fp->atlas, set->gather.backface_limit, &fp->comp, err);
+    lm_status st = lm_composite_create(fp->w->scene, fp->w->atlas, set->gather.backface_limit, &fp->comp, err);
     if (st == LM_OK)
-        st = lm_direct_create(fp->scene, fp->atlas, &set->direct, &fp->direct, err);
+        st = lm_direct_create(fp->w->scene, fp->w->atlas, &set->direct, &fp->direct, err);
     if (st == LM_OK && set->reflection_size > 0)
-        st = lm_reflections_create(fp->scene, set->reflection_size, set->reflection_faces, &fp->reflections, err);
-    fp->reflect_version = fp->coverage_version = fp->scene->pass_version;
+        st = lm_reflections_create(fp->w->scene, set->reflection_size, set->reflection_faces, &fp->reflections, err);
+    fp->reflect_version = fp->coverage_version = fp->w->scene->pass_version;
     return st;
 }
 
 lm_status lm_frame_passes_follow(lm_frame_passes *fp, lm_error *err)
 {
-    uint32_t v = fp->scene->pass_version;
+    uint32_t v = fp->w->scene->pass_version;
     lm_status st = LM_OK;
     if (fp->comp && fp->coverage_version != v)
-        st = lm_composite_update_coverage(fp->comp, fp->scene, fp->atlas, err);
+        st = lm_composite_update_coverage(fp->comp, fp->w->scene, fp->w->atlas, err);
     fp->coverage_version = v;
     if (st != LM_OK || fp->reflect_version == v || fp->set->reflection_size <= 0 || !fp->direct)
         return st;
     lm_reflections_free(fp->reflections);
     fp->reflections = NULL;
     fp->reflect_version = v;
-    return lm_reflections_create(fp->scene, fp->set->reflection_size, fp->set->reflection_faces, &fp->reflections,
+    return lm_reflections_create(fp->w->scene, fp->set->reflection_size, fp->set->reflection_faces, &fp->reflections,
                                  err);
 }
 
@@ -89,14 +85,14 @@ static int has_generators(lm_frame_passes *fp)
 {
     if (!fp->set->caustics)
         return 0;
-    if (fp->generators_version != fp->scene->pass_version + 1) {
+    if (fp->generators_version != fp->w->scene->pass_version + 1) {
         lm_caustic_generator *g = NULL;
         lm_error err;
         int n = 1; /* out of memory: taken as there being some (a sync too many, never one too few) */
-        if (lm_caustic_generators(fp->scene, &g, &n, &err) == LM_OK)
+        if (lm_caustic_generators(fp->w->scene, &g, &n, &err) == LM_OK)
             free(g);
         fp->generators = n > 0;
-        fp->generators_version = fp->scene->pass_version + 1;
+        fp->generators_version = fp->w->scene->pass_version + 1;
     }
     return fp->generators;
 }
@@ -135,7 +131,7 @@ static uint64_t lighting_hash(const lm_frame_passes *fp)
         for (int k = 0; k < 4; k++)
             h = lm_hash_bytes(h, parts[k], 3 * sizeof(float));
     }
-    h = lm_hash_bytes(h, &fp->scene->material_version, sizeof fp->scene->material_version);
+    h = lm_hash_bytes(h, &fp->w->scene->material_version, sizeof fp->w->scene->material_version);
     return lm_hash_bytes(h, &fp->caustic_version, sizeof fp->caustic_version);
 }
 
@@ -147,7 +143,7 @@ static lm_status draw_caustics(lm_frame_passes *fp, lm_caustic_pass *cp, int own
                                lm_frame_stats *o, lm_error *err)
 {
     int slot = own ? LM_CAUSTIC_SLOT_FRAME : LM_CAUSTIC_SLOT_VIEW;
-    uint64_t key = lm_scene_world_hash(fp->scene);
+    uint64_t key = lm_scene_world_hash(fp->w->scene);
     key = lm_hash_bytes(key, view->view, sizeof view->view);
     key = lm_hash_bytes(key, view->proj, sizeof view->proj);
     key = lm_hash_bytes(key, &fp->caustic_version, sizeof fp->caustic_version);
@@ -177,12 +173,12 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
     const lm_emitters *em = lm_photon_stage_emitters(fp->stage);
     lm_caustic_pass *caustics = drawn_caustics(fp);
     if (st == LM_OK && step) { /* the faces due this step; an extra view shows the maps as they are */
-        lm_reflection_inputs in = {fp->surfaces, ind->iim ? ind->iim->version : NULL, lighting_hash(fp), caustics};
-        st = lm_reflections_update(fp->reflections, fp->direct, fp->scene, em, &in, &o->cube_faces, err);
+        lm_reflection_inputs in = {fp->w->surfaces, ind->iim ? ind->iim->version : NULL, lighting_hash(fp), caustics};
+        st = lm_reflections_update(fp->reflections, fp->direct, fp->w->scene, em, &in, &o->cube_faces, err);
     }
     double t2 = lm_now();
     if (st == LM_OK)
-        st = lm_direct_draw(fp->direct, fp->scene, em, view, w, h, err);
+        st = lm_direct_draw(fp->direct, fp->w->scene, em, view, w, h, err);
     double t3 = lm_now();
     o->photon_gather.t_wait = 0.0;
     if (st == LM_OK && ind->photons)
@@ -194,7 +190,7 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
     fp->caustic_w = w, fp->caustic_h = h;
     double t4 = lm_now();
     if (st == LM_OK)
-        st = lm_reflections_draw(fp->reflections, fp->direct, fp->scene, view, err);
+        st = lm_reflections_draw(fp->reflections, fp->direct, fp->w->scene, view, err);
     double t5 = lm_now();
     if (st == LM_OK)
         st = lm_direct_read(fp->direct, rgb, err);

@@ -33,7 +33,7 @@ typedef struct {
     lm_photon_path *photons; /* the photon path (NULL: none) */
 } lm_frame_indirect;
 
-/* No GL work yet. set is the loop's, borrowed. */
+/* No GL work yet. w, stage and set are the loop's, borrowed. */
 lm_status lm_frame_passes_create(const lm_world *w, const lm_photon_stage *stage, const lm_frame_loop_settings *set,
                                  lm_frame_passes **out, lm_error *err);
 void lm_frame_passes_free(lm_frame_passes *fp);

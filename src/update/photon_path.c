@@ -7,9 +7,7 @@
 
 struct lm_photon_path {
     const lm_frame_loop_settings *set; /* the loop's, borrowed */
-    const lm_scene *scene;
-    const lm_surfaces *surfaces;
-    const lm_atlas *atlas;
+    const lm_world *w;                 /* the loop's, borrowed */
     const lm_photon_stage *stage;
     lm_photon_records records;
     lm_photon_gather *gather;
@@ -28,9 +26,7 @@ lm_status lm_photon_path_create(const lm_world *w, const lm_photon_stage *stage,
     if (!*out)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon path", w->scene->path);
     (*out)->set = set;
-    (*out)->scene = w->scene;
-    (*out)->surfaces = w->surfaces;
-    (*out)->atlas = w->atlas;
+    (*out)->w = w;
     (*out)->stage = stage;
     return LM_OK;
 }
@@ -57,7 +53,7 @@ lm_status lm_photon_path_records(lm_photon_path *pp, lm_photon_gather_stats *sta
     }
     int fresh = !pp->records.rec || pp->records.store_version != ps->version;
     if (st == LM_OK && fresh)
-        st = lm_photon_records_update(&pp->records, ps, pp->scene, err);
+        st = lm_photon_records_update(&pp->records, ps, pp->w->scene, err);
     if (st == LM_OK && fresh)
         st = lm_photon_gather_set_records(pp->gather, &pp->records, stats, err);
     /* The derived radius is kept until the gathered hits change by a tenth (its square root: 5%): a radius
@@ -67,7 +63,7 @@ lm_status lm_photon_path_records(lm_photon_path *pp, lm_photon_gather_stats *sta
     int drifted = live > was + was / 10 || was > live + live / 10;
     if (st == LM_OK && (!(pp->radius > 0.0f) || (fresh && drifted))) {
         pp->radius = pp->set->photon_radius > 0.0f ? pp->set->photon_radius
-                                                   : lm_pixel_gather_radius(ps, pp->surfaces, LM_PIXEL_GATHER_HITS);
+                                                   : lm_pixel_gather_radius(ps, pp->w->surfaces, LM_PIXEL_GATHER_HITS);
         pp->radius_live = live;
     }
     return st;
@@ -78,8 +74,8 @@ float lm_photon_path_radius(const lm_photon_path *pp) { return pp->radius; }
 lm_status lm_photon_path_coverage(lm_photon_path *pp, lm_direct *direct, lm_error *err)
 {
     uint64_t key = lm_hash_bytes(0x9e3779b97f4a7c15ull, &pp->radius, sizeof pp->radius);
-    for (int i = 0; i < pp->scene->node_count; i++) {
-        const float *m = pp->scene->nodes[i].world;
+    for (int i = 0; i < pp->w->scene->node_count; i++) {
+        const float *m = pp->w->scene->nodes[i].world;
         float len2[3];
         for (int c = 0; c < 3; c++)
             len2[c] = m[4 * c] * m[4 * c] + m[4 * c + 1] * m[4 * c + 1] + m[4 * c + 2] * m[4 * c + 2];
@@ -87,10 +83,10 @@ lm_status lm_photon_path_coverage(lm_photon_path *pp, lm_direct *direct, lm_erro
     }
     if (key == pp->coverage_key || !(pp->radius > 0.0f))
         return LM_OK;
-    float *c = malloc((size_t)(pp->atlas->texel_count ? pp->atlas->texel_count : 1) * sizeof *c);
+    float *c = malloc((size_t)(pp->w->atlas->texel_count ? pp->w->atlas->texel_count : 1) * sizeof *c);
     if (!c)
-        return lm_fail(err, LM_ERR_NOMEM, "no memory for the coverage of %u texels", pp->atlas->texel_count);
-    lm_status st = lm_aim_kernel_coverage(lm_photon_stage_aim(pp->stage), pp->scene, pp->surfaces, pp->atlas,
+        return lm_fail(err, LM_ERR_NOMEM, "no memory for the coverage of %u texels", pp->w->atlas->texel_count);
+    lm_status st = lm_aim_kernel_coverage(lm_photon_stage_aim(pp->stage), pp->w->scene, pp->w->surfaces, pp->w->atlas,
                                           pp->radius, c, err);
     if (st == LM_OK)
         st = lm_direct_set_coverage(direct, c, err);
@@ -104,15 +100,15 @@ lm_status lm_photon_path_draw(lm_photon_path *pp, lm_direct *direct, const lm_vi
 {
     if (!(pp->radius > 0.0f)) /* no photon the gather takes: no indirect light */
         return LM_OK;
-    uint64_t key = lm_scene_world_hash(pp->scene);
+    uint64_t key = lm_scene_world_hash(pp->w->scene);
     key = lm_hash_bytes(key, view->view, sizeof view->view);
     key = lm_hash_bytes(key, view->proj, sizeof view->proj);
     const int size[2] = {w, h};
     key = lm_hash_bytes(key, size, sizeof size);
     key = lm_hash_bytes(key, &pp->records.store_version, sizeof pp->records.store_version);
     key = lm_hash_bytes(key, &pp->radius, sizeof pp->radius);
-    key = lm_hash_bytes(key, &pp->scene->material_version, sizeof pp->scene->material_version);
-    key = lm_hash_bytes(key, &pp->scene->pass_version, sizeof pp->scene->pass_version);
+    key = lm_hash_bytes(key, &pp->w->scene->material_version, sizeof pp->w->scene->material_version);
+    key = lm_hash_bytes(key, &pp->w->scene->pass_version, sizeof pp->w->scene->pass_version);
     unsigned kd = lm_direct_kd_texture(direct, 0), gbuf = lm_direct_gbuffer_texture(direct);
     lm_status st = LM_OK;
     if (!pp->keyed || key != pp->key) {

@@ -24,7 +24,8 @@
 
 typedef struct lm_photon_path lm_photon_path;
 
-/* Nothing on the GPU yet (the gather is made at the first records). set is borrowed. */
+/* Nothing on the GPU yet (the gather is made at the first records). w, stage and set are the loop's,
+ * borrowed. */
 lm_status lm_photon_path_create(const lm_world *w, const lm_photon_stage *stage, const lm_frame_loop_settings *set,
                                 lm_photon_path **out, lm_error *err);
 void lm_photon_path_free(lm_photon_path *pp);
