@@ -188,8 +188,8 @@ static void test_updater_values(void **state)
         fail_msg("%s", e.message);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 4000;
-    d.frame_width = d.frame_height = 32;
+    d.photons.count = 4000;
+    d.frame.width = d.frame.height = 32;
     lmgi_updater *u = NULL;
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID); /* 3e7 away, far plane at 20 */
     assert_non_null(strstr(e.message, "sees none of the scene"));
@@ -197,11 +197,11 @@ static void test_updater_values(void **state)
     if (load(floor_scene("upd2.gltf", NULL, NULL, NULL, NULL), &sc, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     d.indirect = LMGI_INDIRECT_TILED;
-    d.photon_radius = 1e-30f;
+    d.tiled.radius = 1e-30f;
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID);
-    if (!strstr(e.message, "photon_radius 1e-30"))
+    if (!strstr(e.message, "tiled.radius 1e-30"))
         fail_msg("%s", e.message);
-    d.photon_radius = 0.0f;
+    d.tiled.radius = 0.0f;
     d.indirect = LMGI_INDIRECT_LIGHTMAP;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
@@ -540,8 +540,8 @@ static float *baked_lightmap(lmgi_context *ctx, const char *path, size_t *n)
         fail_msg("%s: %s", path, e.message);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 4000;
-    d.hemicube_resolution = 16;
+    d.photons.count = 4000;
+    d.gather.resolution = 16;
     lmgi_updater *u = NULL;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
