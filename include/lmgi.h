@@ -531,10 +531,6 @@ typedef struct {
     int (*claim_pass)(void *user, int passes);
     void *share_user;
 } lmgi_updater_desc;
-/* frame.shadow_maps_per_update: the maps of the brightest lights nearest to what moved come first, the
- * others keep their last map for a few updates (a scene with 56 lights and a moving box spreads their 56
- * maps over 14 updates). A light's first map, and lmgi_render's and lmgi_bake's, are drawn whatever the
- * count. */
 
 /* The desc's defaults resolved: every knob's default (lmgi_knobs.h) where it has one of its own, 0 where
  * the scene chooses it (lmgi_get_updater_info gives what an updater chose). NULL d: nothing. */
@@ -628,13 +624,13 @@ LMGI_API lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi
 
 /* One frame's work at animation time `time` (seconds; animations clamp to their range). budget_ms > 0:
  * the texels regathered are chosen from the measured cost of the last updates so that the update takes
- * about budget_ms (never fewer than 1 texel when there is work); 0: desc.texels_per_frame. stats may be
+ * about budget_ms (never fewer than 1 texel when there is work); 0: desc.gather.texels_per_frame. stats may be
  * NULL. NULL u, a time or budget that is not finite, or a negative budget: LMGI_ERR_INVALID. A frame
  * that came out with a NaN or infinity: LMGI_ERR_BACKEND naming the first stage that has them (the AIMs,
  * the IIM lightmap, the caustics, else the direct light, reflections or composite). */
 LMGI_API lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err);
 
-/* The frame the last lmgi_update composited (frame_width x frame_height x 3 linear floats, top row
+/* The frame the last lmgi_update composited (frame.width x frame.height x 3 linear floats, top row
  * first; valid until the next update or the free), NULL before the first update or without a frame. */
 LMGI_API const float *lmgi_frame(const lmgi_updater *u, int *width, int *height);
 
@@ -665,7 +661,7 @@ LMGI_API lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int wi
  *                           its last refresh, that change relative to their energy (an upper bound;
  *                           docs/api.md, "The error atlas"). 0 everywhere once the lightmap has caught
  *                           up: an editor shows what is not yet final, a game can wait for it. a as above.
- *   LMGI_LIGHTMAP_ACCURACY  the lightmaps' estimate of their own accuracy (needs desc.error_estimate): r the
+ *   LMGI_LIGHTMAP_ACCURACY  the lightmaps' estimate of their own accuracy (needs desc.aim.error_estimate): r the
  *                           IIM texel's relative standard error from the photon noise of the AIMs its
  *                           hemicube sees, g the AIM texel's own, b the share of its hemicube on back faces
  *                           (light it cannot know); a as above. Noise, not bias: docs/gather.md, "Error

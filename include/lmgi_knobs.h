@@ -23,7 +23,8 @@
  *   sweep         LMGI_SWEEP(order, "key", "label", (full values), (--quick values), when) when `lmgi
  *                 tradeoff` sweeps it (docs/tradeoff.md; when: 0 always, 1 with caustics, 2 with the
  *                 tiled gather's radius), else LMGI_NO_SWEEP
- *   help          the option's help, lines joined by '\n' (the first beside the option's name)
+ *   help          the option's help, lines joined by '\n' (the first beside the option's name); the values
+ *                 it names are the option's, whose 0 is LMGI_OFF where cli_zero says so
  *
  * 0 always means the default; "off" is LMGI_OFF, never a count of 0. Every field not in the table (the
  * frame's size and camera, callbacks, checkpoints, shards) is written out in lmgi.h. */
@@ -75,6 +76,8 @@ static inline int lmgi_knob_is_pow2(double v)
 
 /* photons (docs/photons.md): each light's photons, their groups and how many are re-traced */
 #define LMGI_PHOTON_KNOBS(X)                                                                                          \
+    /* count 0: groups x per_group a light, and at least 46,080 over the scene unless per_group is */                 \
+    /* given: a scene with one light gets 640 a group (docs/tradeoff.md, "Defaults against the front") */             \
     X(photons, count, LMGI_KNOB_COUNT, uint32_t, 0, 1, 100000000, 0, LMGI_NO_RULE, "--photons", "N",                \
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                          \
       "total photon budget (default: groups x per-group, at least 46,080; bake:\n"                                \
@@ -145,6 +148,7 @@ static inline int lmgi_knob_is_pow2(double v)
       "N", LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES,                                                                    \
       LMGI_SWEEP(7, "hemicube_samples", "AIM lookups per hemicube pixel", (1, 4), (1, 4), 0),                    \
       "AIM lookups per hemicube pixel, 1 or 4 (default 4: no banding)")                                           \
+    /* coverage: MSAA samples; more than the GL renders into float targets is LMGI_ERR_INVALID */                     \
     X(gather, coverage, LMGI_KNOB_INT, int, 0, 1, 16, 0, LMGI_NO_RULE, "--hemicube-coverage", "N",                 \
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES,                                                                         \
       LMGI_SWEEP(8, "coverage", "coverage samples per hemicube pixel", (1, 2, 4), (1, 4), 0),                    \
@@ -179,7 +183,8 @@ static inline int lmgi_knob_is_pow2(double v)
       LMGI_SWEEP(12, "caustic_photons", "caustic photons per light and node", (4096, 16384, 65536),              \
                  (4096, 16384, 65536), 1),                                                                         \
       "caustic photons per light and mirror or glass node (default 16384; lmgi: --caustic-photons)")              \
-    X(caustics, retrace, LMGI_KNOB_REAL, float, 0.25, 0, 1, 0, LMGI_RULE(v > 0, "a share of the caustic photons in (0, 1]"),\
+    X(caustics, retrace, LMGI_KNOB_REAL, float, 0.25, 0, 1, 0,                                                    \
+      LMGI_RULE(v > 0, "a share of the caustic photons in (0, 1]"),                                                 \
       "--caustic-retrace", "F", LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                               \
       "share of the caustic photons re-traced a frame while anything moves\n"                                     \
       "(default 0.25; a moved light or mirror/glass node re-traces its own)")                                     \
@@ -194,6 +199,9 @@ static inline int lmgi_knob_is_pow2(double v)
 
 /* the frame each lmgi_update composites: its reflections and shadow maps */
 #define LMGI_FRAME_KNOBS(X)                                                                                           \
+    /* shadow maps: those of the brightest lights nearest to what moved first, the others keep their */               \
+    /* last map a few updates (56 lights and a moving box: their maps over 14 updates); a light's */                  \
+    /* first map, and lmgi_render's and lmgi_bake's, are drawn whatever the count */                                  \
     X(frame, shadow_maps_per_update, LMGI_KNOB_INT, int, 4, 1, 1000000, 1, LMGI_NO_RULE, "--shadow-maps-per-frame",\
       "N", LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                      \
       "stale shadow maps re-rendered a frame once something moved, brightest\n"                                   \

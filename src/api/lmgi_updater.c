@@ -113,7 +113,9 @@ static void gather_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *
     s->gather.rim_samples = g->rim_samples == LMGI_OFF ? 0 : g->rim_samples;
     if (g->scheme != LMGI_GATHER_DEFAULT)
         s->gather.scheme = (lm_gather_scheme)(g->scheme - 1);
-    s->emitter_light = g->emitter_light == LMGI_EMITTERS_CLOSED_FORM ? 1 : g->emitter_light == LMGI_EMITTERS_DRAWN ? 0 : -1;
+    s->emitter_light = g->emitter_light == LMGI_EMITTERS_CLOSED_FORM ? 1
+                       : g->emitter_light == LMGI_EMITTERS_DRAWN  ? 0
+                                                                  : -1; /* chosen per scene */
     s->emitter_rays = g->emitter_rays;
 }
 
@@ -124,8 +126,8 @@ static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s
     s->height = f->height;
     s->camera = f->camera;
     s->direct.maps_per_update = f->shadow_maps_per_update; /* LMGI_OFF: -1, every stale one */
-    s->reflection_size = f->reflection_size == LMGI_OFF || (r->effects_off & LMGI_EFFECT_REFLECTIONS) ? 0
-                                                                                                      : f->reflection_size;
+    int no_reflections = f->reflection_size == LMGI_OFF || (r->effects_off & LMGI_EFFECT_REFLECTIONS);
+    s->reflection_size = no_reflections ? 0 : f->reflection_size;
     s->reflection_faces = f->reflection_faces;
     s->caustic_pass.filter_k = r->caustics.filter == LMGI_OFF ? 0 : r->caustics.filter;
     s->caustic_pass.tile = r->caustics.tile;
@@ -905,7 +907,8 @@ static lmgi_status get_lightmap_owned(lmgi_updater *u, const char *fn, lmgi_ligh
     if (kind < LMGI_LIGHTMAP_IIM || kind > LMGI_LIGHTMAP_ACCURACY)
         return lm_api_refuse(err, "%s: %d is not a lightmap kind", fn, (int)kind);
     if (kind == LMGI_LIGHTMAP_ACCURACY && !lm_photon_stage_aim(lm_frame_loop_stage(u->loop))->error)
-        return lm_api_refuse(err, "%s: the accuracy estimate needs the updater made with desc.error_estimate 1", fn);
+        return lm_api_refuse(err, "%s: the accuracy estimate needs the updater made with desc.aim.error_estimate "
+                             "LMGI_ON", fn);
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
     lm_status st = kind == LMGI_LIGHTMAP_IIM     ? read_iim_rect(u, r, rgba, &e)

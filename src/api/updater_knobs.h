@@ -5,7 +5,7 @@
  * within its range and rule. Resolving makes each 0 its default, leaving 0 where the scene chooses (the
  * line's default is 0) and LMGI_OFF as it is. Cost: one pass over the ~40 knobs. Thread-safety: pure
  * functions. Errors: lm_updater_knobs_check fails with LM_ERR_INVALID naming the knob as the desc spells
- * it ("gather.rim_samples 0.5 must be ..."). */
+ * it ("gather.samples 3 must be 1 or 4 ..."). */
 #ifndef LM_API_UPDATER_KNOBS_H
 #define LM_API_UPDATER_KNOBS_H
 

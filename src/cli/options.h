@@ -4,7 +4,9 @@
  *
  * Layout: lm_cli_options[] ends with a zeroed entry; an option's `commands` is a set of LM_CMD_* bits
  * (0: lmgi-dev's alone). The updater's knobs are options made from their own table (knob_options.h),
- * found and printed with these where the LM_OPT_KNOBS entry stands. Thread-safety: read-only tables. Errors: none here; the parser reports. */
+ * found and printed with these where the LM_OPT_KNOBS entry stands. Thread-safety: read-only tables (the
+ * first lookup lists them all: one thread).
+ * Errors: none here; the parser reports. */
 #ifndef LM_CLI_OPTIONS_H
 #define LM_CLI_OPTIONS_H
 
