@@ -28,7 +28,7 @@ static int knob_ok(int kind, double v, double lo, double hi, int off, int rule, 
     return v >= lo && v <= hi && rule; /* NaN fails */
 }
 
-/* "gather.rim_samples 0 must be ..." for a value knob_ok refused. */
+/* "gather.samples 3 must be 1 or 4 ..." for a value knob_ok refused. */
 static lm_status refuse(lm_error *err, const char *fn, const char *name, int kind, double v, double lo, double hi,
                         int off, const char *rule)
 {
