@@ -145,7 +145,7 @@ static int move(lmgi_scene *sc, int node, const float start[16], int frame)
 static int run(const options *o, lmgi_context *ctx, lmgi_scene *sc, lmgi_output *out)
 {
     lmgi_updater_desc d = {0}; /* zeros: the defaults; no frame composited: the game draws its own */
-    d.texels_per_frame = o->texels;
+    d.gather.texels_per_frame = o->texels;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)

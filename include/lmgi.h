@@ -20,6 +20,8 @@
 #include <stdint.h>
 #include <stdio.h>
 
+#include "lmgi_knobs.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -47,7 +49,8 @@ typedef struct {
     char message[1024];
 } lmgi_error;
 
-/* Settings for turning a scene file into surfaces, a lightmap atlas and a ray-tracing scene. */
+/* Settings for turning a scene file into surfaces, a lightmap atlas and a ray-tracing scene. 0 means the
+ * default in every field: a zeroed lmgi_options is the defaults (lmgi_options_init writes them out). */
 typedef struct {
     float texel_size;       /* world units per lightmap texel; 0 = derived from the scene: about target_texels */
     int target_texels;      /* texels the derived texel size aims at (0, the default: 65536).
@@ -60,8 +63,8 @@ typedef struct {
                              * must lie inside its own folder once "..", percent-encoding and symbolic links
                              * are resolved, else the load fails naming it (LMGI_ERR_IO); 0 (the default):
                              * such files are read, each with a warning that it lies outside */
-    float surface_cone_deg; /* max normal deviation within one surface, degrees (default 30) */
-    int max_atlas_size;     /* the largest side of one lightmap page, 64 to 32768 (default 8192): a level
+    float surface_cone_deg; /* max normal deviation within one surface, degrees (0: 30) */
+    int max_atlas_size;     /* the largest side of one lightmap page, 64 to 32768 (0: 8192): a level
                              * whose charts do not fit one page gets several (lmgi_info.pages; docs/levels.md,
                              * "Pages"); the texel size grows only where one chart is larger than a page or
                              * the pages would pass 16384 x 16384 together */
@@ -464,72 +467,40 @@ typedef enum {
  * the scene, photons bringing the rest (sharp contact shadows); ALL: punctual lights' too. */
 typedef enum { LMGI_AIM_DIRECT_PHOTONS = 0, LMGI_AIM_DIRECT_EMITTERS, LMGI_AIM_DIRECT_ALL } lmgi_aim_direct;
 
+/* The updater's tuning knobs, stage by stage: one struct per stage, made from the knob table
+ * (lmgi_knobs.h, which gives each knob's range, default, meaning of LMGI_OFF and help). 0 is always the
+ * default; LMGI_OFF says "off" (none, all at once, no filter: the knob's line says which). */
+typedef struct { LMGI_PHOTON_KNOBS(LMGI_KNOB_MEMBER) } lmgi_photon_knobs;   /* docs/photons.md */
+typedef struct { LMGI_AIM_KNOBS(LMGI_KNOB_MEMBER) } lmgi_aim_knobs;         /* docs/aim.md */
+typedef struct { LMGI_GATHER_KNOBS(LMGI_KNOB_MEMBER) } lmgi_gather_knobs;   /* docs/gather.md */
+typedef struct { LMGI_CAUSTIC_KNOBS(LMGI_KNOB_MEMBER) } lmgi_caustic_knobs; /* docs/caustics.md */
+typedef struct { LMGI_TILED_KNOBS(LMGI_KNOB_MEMBER) } lmgi_tiled_knobs;     /* docs/tiled.md */
+/* The frame each lmgi_update composites (what `lmgi run` writes): its size (0 x 0: none; lmgi_render
+ * draws on demand), the file's camera for it (0: its first; -1, or 0 when it has none: one framing the
+ * scene), and its knobs. */
+typedef struct {
+    int width, height;
+    int camera;
+    LMGI_FRAME_KNOBS(LMGI_KNOB_MEMBER)
+} lmgi_frame_knobs;
+
 /* Zero-initialised means the defaults (the same as `lmgi run`'s; docs/ says what each costs and buys). */
 typedef struct {
-    /* work per update */
-    int texels_per_frame;      /* IIM texels gathered per lmgi_update when its budget_ms is 0 (0: 20, the paper's) */
-    int blend_frames;          /* updates a regathered surface takes to fade in (0: 8; -1: at once) */
-    /* photons (docs/photons.md) */
-    uint32_t photons;          /* photon budget over all lights (0: groups x photons_per_group per light, and at
-                                * least 46,080 over the scene unless photons_per_group is given: a scene with
-                                * one light gets 640 a group; docs/tradeoff.md, "Defaults against the front") */
-    uint32_t groups;           /* groups per light, 2^a 3^b (0: 72) */
-    uint32_t photons_per_group; /* (0: 160) */
-    uint32_t retrace_per_group; /* photons per group re-checked per update, round robin (0: 1) */
-    uint32_t group_budget;     /* invalid groups re-traced per update (0: 16; UINT32_MAX: all) */
-    uint32_t seed;             /* another, disjoint stretch of the Halton sequence (0: the default one) */
-    int photons_per_estimate;  /* N nearest photons per AIM estimate (0: 32, docs/aim.md) */
-    int surfaces_per_frame;    /* AIM refreshes per update (0: 4; -1: all that changed) */
-    lmgi_aim_direct aim_direct; /* (0: LMGI_AIM_DIRECT_PHOTONS) */
-    int find_portals;          /* windows and doors a sun's or the sky's light gets in by, found as the updater is made
-                                * and at each bake, where the file tags no portal: half their photons drawn through
-                                * them, each weighed so the estimate is unchanged (docs/levels.md, "Portals")
-                                * (0: on; -1: off, the file's portals only) */
-    int error_estimate;        /* 1: the AIMs keep their estimates' error, for LMGI_LIGHTMAP_ACCURACY (0: off,
-                                * the default: it walks each estimate's photons twice; docs/gather.md, "Error
-                                * estimate") */
-    /* the gather (docs/gather.md) */
-    int hemicube_resolution;   /* R, plane pixels per side (0: 32) */
-    float enlargement;         /* a, the plane's half-side at distance 1 (0: 2) */
-    int hemicube_samples;      /* AIM lookups per hemicube pixel, 1 or 4 (0: 4) */
-    int hemicube_coverage;     /* MSAA samples per hemicube pixel, 1 to 16 and at most what the GL renders into
-                                * float targets (llvmpipe: 4; more: LMGI_ERR_INVALID naming it) (0: per scene) */
-    int rim_samples;           /* rays into the rim the plane misses (0: 64; -1: none, the paper's 1 / F(a)) */
-    lmgi_gather_scheme gather_scheme; /* how hemicubes are drawn (0: viewports, the fastest measured) */
-    lmgi_emitter_light emitter_light; /* emissive triangles' light in the gather (0: per scene) */
-    int emitter_rays;          /* shadow rays per emissive triangle and texel (0: 32) */
-    int in_order;              /* 1: the photon work before the gather on the calling thread (the paper's
-                                * order); 0: on a second thread beside rendering, one update behind */
-    /* the frame each lmgi_update composites (what `lmgi run` writes) */
-    int frame_width, frame_height; /* 0 x 0: none (lmgi_render draws on demand) */
-    int camera;                /* the file's camera for that frame (0: its first; -1, or 0 when it has none:
-                                * one framing the scene) */
-    int reflection_size;       /* environment map side of a mirror, glossy or glass node (0: 128; -1: no
-                                * reflections) */
-    int reflection_faces;      /* most environment map faces re-rendered per update, those whose view changed
-                                * longest ago first (0: 1; a still scene renders none) */
-    /* caustics (docs/caustics.md): photons shot from every light towards every mirror or glass node,
-     * filtered on screen */
-    uint32_t caustic_photons;  /* per light and mirror or glass node (0: 16384) */
-    float caustic_retrace;     /* share of them re-traced per update while anything moves, in (0, 1] (0: 0.25);
-                                * a moved light or mirror/glass node re-traces its own at once */
-    int caustic_filter;        /* k of the (2k + 1)^2 cone filter, 1 to 8 (0: 3; -1: k = 0, no filter) */
-    int caustic_tile;          /* screen tile side in pixels of the occlusion queries, 4 to 256 (0: 32) */
-    int caustic_world_filter;  /* 1: filter by world distance from the depth (0: the paper's screen-space one) */
+    lmgi_photon_knobs photons;
+    lmgi_aim_knobs aim;
+    lmgi_gather_knobs gather;
+    lmgi_caustic_knobs caustics;
+    lmgi_frame_knobs frame;
+    lmgi_tiled_knobs tiled;        /* the per-pixel photon gathers (indirect TILED, HASHGRID, BRUTEFORCE) */
+    lmgi_indirect_path indirect;   /* (0: LMGI_INDIRECT_LIGHTMAP) */
     /* effects this updater leaves out whatever the scene calls for (0: none), LMGI_EFFECT_* bits:
      * SHADOWS no shadow maps (lights reach everything), INDIRECT no photon, AIM or gather work at all
      * (the lightmaps stay 0; the frame shows direct light, emission, caustics and reflections), REFLECTIONS
-     * no environment maps (as reflection_size -1), CAUSTICS no caustic photons and no caustic pass. Per
-     * node: lmgi_set_node_effects */
+     * no environment maps (as frame.reflection_size LMGI_OFF), CAUSTICS no caustic photons and no caustic
+     * pass. Per node: lmgi_set_node_effects */
     unsigned effects_off;
-    lmgi_indirect_path indirect; /* (0: LMGI_INDIRECT_LIGHTMAP) */
-    /* the per-pixel photon gathers (indirect TILED, HASHGRID, BRUTEFORCE; docs/tiled.md) */
-    int photon_tile;           /* TILED: screen tile side in pixels, 4, 8, 16 or 32 (0: 16) */
-    int photon_chunk;          /* TILED: photons per shared-memory load, 64 to 512 (0: 256) */
-    int photon_stochastic;     /* TILED: k, each pixel reads 1/k^2 of its tile's photons, then an edge-aware
-                                * k x k reconstruction, 1 to 4 (0: 1, all of them) */
-    float photon_radius;       /* the kernel radius in scene units, 1e-6 to 1e6 times the scene's size (0:
-                                * the disc that holds 128 photons on average) */
+    int in_order;              /* 1: the photon work before the gather on the calling thread (the paper's
+                                * order); 0: on a second thread beside rendering, one update behind */
     /* the first full solution made by lmgi_updater_create: its gather's progress (NULL: none), and a flag
      * that, set non-zero (from any thread), stops it between gather passes: LMGI_ERR_CANCELLED */
     lmgi_progress_fn progress;
@@ -571,12 +542,11 @@ typedef struct {
     int (*photon_exchange)(void *user, const void *mine, size_t size, size_t *sizes, void *all);
     int (*claim_pass)(void *user, int passes);
     void *share_user;
-    /* most shadow maps re-rendered per update once something moved (0: 4; -1: every stale one at once): the
-     * maps of the brightest lights nearest to what moved first, the others keep their last map for a few
-     * updates (a scene with 56 lights and a moving box spreads their 56 maps over 14 updates). A light's
-     * first map, and lmgi_render's and lmgi_bake's, are drawn whatever the count. */
-    int shadow_maps_per_update;
 } lmgi_updater_desc;
+
+/* The desc's defaults resolved: every knob's default (lmgi_knobs.h) where it has one of its own, 0 where
+ * the scene chooses it (lmgi_get_updater_info gives what an updater chose). NULL d: nothing. */
+LMGI_API void lmgi_updater_defaults(lmgi_updater_desc *d);
 
 /* What one lmgi_update did and what it cost (milliseconds). With the photon work on a second thread
  * (in_order 0) its counts are those of the work that ran during this update. */
@@ -601,7 +571,7 @@ typedef struct {
     double ms_photons;         /* what the update spent on or waiting for the photon work */
     double ms_gather, ms_blend, ms_direct, ms_caustics, ms_reflections, ms_composite, ms_total;
     int shadow_maps_rendered;  /* punctual lights' shadow maps re-rendered */
-    int shadow_maps_stale;     /* stale ones left for the next updates (desc.shadow_maps_per_update) */
+    int shadow_maps_stale;     /* stale ones left for the next updates (desc.frame.shadow_maps_per_update) */
 } lmgi_update_stats;
 
 /* The atlas texel count `lmgi run` loads a scene at when given no texel size: what an updater gathering
@@ -618,19 +588,22 @@ LMGI_API void lmgi_updater_free(lmgi_updater *u); /* NULL: nothing */
 
 /* The settings an updater resolved (the desc's zeros and per-scene choices made) and its setup's cost. */
 typedef struct {
-    int texels_per_frame, hemicube_resolution, hemicube_samples, hemicube_coverage, rim_samples;
-    float enlargement;
+    /* every knob as the updater runs it: the desc's values with each 0 made its default or the scene's
+     * choice (LMGI_OFF stays LMGI_OFF); tiled.radius is 0 before the first frame of a per-pixel gather */
+    lmgi_photon_knobs photons;
+    lmgi_aim_knobs aim;
+    lmgi_gather_knobs gather;
+    lmgi_caustic_knobs caustics;
+    lmgi_frame_knobs frame;
+    lmgi_tiled_knobs tiled;
     const char *gather_scheme;  /* "viewports", "instanced", "layered" or "rays" */
     uint32_t emissive_triangles;
-    int emitters_closed_form;   /* 1: their light in closed form with emitter_rays shadow rays, 0: drawn */
-    int emitter_rays;
-    uint32_t photons;           /* stored photon paths over all lights */
+    int emitters_closed_form;   /* 1: their light in closed form with gather.emitter_rays shadow rays, 0: drawn */
+    uint32_t stored_photons;    /* stored photon paths over all lights */
     double ms_setup_trace, ms_setup_aim, ms_setup_gather; /* the full trace, every AIM, the full gather */
     const char *indirect;       /* "lightmap", "tiled", "hashgrid" or "bruteforce" */
-    int photon_tile, photon_chunk, photon_stochastic; /* the per-pixel gathers' knobs (docs/tiled.md) */
-    float photon_radius;        /* their kernel radius in scene units (0 before the first frame, or none) */
     int portals_found;          /* rectangles found for suns and the sky to aim their photons through: openings, and
-                                 * places outside whose light gets in by them (find_portals; 0: none) */
+                                 * places outside whose light gets in by them (photons.find_portals; 0: none) */
 } lmgi_updater_info;
 /* NULL u: info zeroed; NULL info: nothing. */
 LMGI_API void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info);
@@ -663,13 +636,13 @@ LMGI_API lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi
 
 /* One frame's work at animation time `time` (seconds; animations clamp to their range). budget_ms > 0:
  * the texels regathered are chosen from the measured cost of the last updates so that the update takes
- * about budget_ms (never fewer than 1 texel when there is work); 0: desc.texels_per_frame. stats may be
+ * about budget_ms (never fewer than 1 texel when there is work); 0: desc.gather.texels_per_frame. stats may be
  * NULL. NULL u, a time or budget that is not finite, or a negative budget: LMGI_ERR_INVALID. A frame
  * that came out with a NaN or infinity: LMGI_ERR_BACKEND naming the first stage that has them (the AIMs,
  * the IIM lightmap, the caustics, else the direct light, reflections or composite). */
 LMGI_API lmgi_status lmgi_update(lmgi_updater *u, float time, float budget_ms, lmgi_update_stats *stats, lmgi_error *err);
 
-/* The frame the last lmgi_update composited (frame_width x frame_height x 3 linear floats, top row
+/* The frame the last lmgi_update composited (frame.width x frame.height x 3 linear floats, top row
  * first; valid until the next update or the free), NULL before the first update or without a frame. */
 LMGI_API const float *lmgi_frame(const lmgi_updater *u, int *width, int *height);
 
@@ -700,7 +673,7 @@ LMGI_API lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int wi
  *                           its last refresh, that change relative to their energy (an upper bound;
  *                           docs/api.md, "The error atlas"). 0 everywhere once the lightmap has caught
  *                           up: an editor shows what is not yet final, a game can wait for it. a as above.
- *   LMGI_LIGHTMAP_ACCURACY  the lightmaps' estimate of their own accuracy (needs desc.error_estimate): r the
+ *   LMGI_LIGHTMAP_ACCURACY  the lightmaps' estimate of their own accuracy (needs desc.aim.error_estimate): r the
  *                           IIM texel's relative standard error from the photon noise of the AIMs its
  *                           hemicube sees, g the AIM texel's own, b the share of its hemicube on back faces
  *                           (light it cannot know); a as above. Noise, not bias: docs/gather.md, "Error

@@ -142,9 +142,9 @@ lmgi_updater *lmt_room_updater(lmgi_context *ctx, lmgi_scene *sc) { return lmt_r
 void lmt_room_desc(lmgi_updater_desc *d)
 {
     memset(d, 0, sizeof *d);
-    d->photons_per_group = 100;
-    d->hemicube_resolution = 16;
-    d->rim_samples = 16;
+    d->photons.per_group = 100;
+    d->gather.resolution = 16;
+    d->gather.rim_samples = 16;
 }
 
 lmgi_updater *lmt_room_updater_without(lmgi_context *ctx, lmgi_scene *sc, unsigned effects_off)

@@ -81,13 +81,13 @@ static void make_updater(session *s)
 {
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 3000;
-    d.hemicube_resolution = 16;
-    d.rim_samples = 4;
-    d.emitter_rays = 2;
-    d.reflection_size = 8;
-    d.caustic_photons = 2000;
-    d.frame_width = d.frame_height = SIDE;
+    d.photons.count = 3000;
+    d.gather.resolution = 16;
+    d.gather.rim_samples = 4;
+    d.gather.emitter_rays = 2;
+    d.frame.reflection_size = 8;
+    d.caustics.photons = 2000;
+    d.frame.width = d.frame.height = SIDE;
     lmgi_error e;
     snprintf(s->last, sizeof s->last, "lmgi_updater_create");
     judge(s, lmgi_updater_create(s->ctx, s->sc, &d, &s->u, &e), &e);

@@ -247,7 +247,7 @@ static float *room_aim(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, 
 {
     lmgi_updater_desc d;
     lmt_room_desc(&d);
-    d.aim_direct = mode;
+    d.aim.direct = mode;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
@@ -279,10 +279,10 @@ static void test_updater_choice(void **state)
     assert_true(l1 > 0.005 && l1 < 0.5); /* the same light, placed sharper */
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.aim_direct = (lmgi_aim_direct)7;
+    d.aim.direct = (lmgi_aim_direct)7;
     lmgi_updater *bad = NULL;
     lmgi_error e;
-    lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &bad, &e), &e, "aim_direct 7");
+    lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &bad, &e), &e, "aim.direct 7");
     free(emitters), free(photons), free(all);
     lmgi_free(sc);
     lmgi_context_free(ctx);

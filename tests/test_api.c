@@ -46,12 +46,12 @@ static lmgi_scene *load_cornell(void) { return load_scene("cornell.glb", 1500); 
 static void small_desc(lmgi_updater_desc *d)
 {
     memset(d, 0, sizeof *d);
-    d->photons = 6000;
-    d->hemicube_resolution = 16;
-    d->rim_samples = 8;
-    d->emitter_rays = 4;
-    d->reflection_size = 16;
-    d->frame_width = d->frame_height = SIDE;
+    d->photons.count = 6000;
+    d->gather.resolution = 16;
+    d->gather.rim_samples = 8;
+    d->gather.emitter_rays = 4;
+    d->frame.reflection_size = 16;
+    d->frame.width = d->frame.height = SIDE;
 }
 
 static lmgi_updater *make_updater(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *d)
@@ -68,8 +68,8 @@ static lmgi_updater *frameless_updater(lmgi_context *ctx, lmgi_scene *sc)
 {
     lmgi_updater_desc d;
     small_desc(&d);
-    d.frame_width = d.frame_height = 0;
-    d.texels_per_frame = 200;
+    d.frame.width = d.frame.height = 0;
+    d.gather.texels_per_frame = 200;
     return make_updater(ctx, sc, &d);
 }
 
@@ -519,8 +519,8 @@ static void test_light_edit_stays_in_its_room(void **state)
     lmgi_error e;
     lmgi_updater_desc d;
     small_desc(&d);
-    d.frame_width = d.frame_height = 0;
-    d.texels_per_frame = 400;
+    d.frame.width = d.frame.height = 0;
+    d.gather.texels_per_frame = 400;
     lmgi_updater *u = make_updater(ctx, sc, &d);
     lmgi_update_stats st;
     int quiet = 0;
@@ -669,7 +669,7 @@ static void test_bake(void **state)
     lmgi_error e;
     lmgi_updater_desc d;
     small_desc(&d);
-    d.frame_width = d.frame_height = 0;
+    d.frame.width = d.frame.height = 0;
     canceller c = {0, 0.5f, 0.0, 0};
     d.progress = cancel_at;
     d.progress_user = &c;
@@ -776,7 +776,7 @@ static void test_recolour_material(void **state)
 
     lmgi_updater_desc d;
     small_desc(&d);
-    d.frame_width = d.frame_height = 0;
+    d.frame.width = d.frame.height = 0;
     lmgi_updater *u = make_updater(ctx, edited, &d), *truth = make_updater(ctx, blue, &d);
     assert_int_equal(lmgi_set_material(edited, red, &recoloured, &e), LMGI_OK);
     lmgi_bake_report r;
@@ -873,26 +873,27 @@ static void test_bad_arguments(void **state)
     lmgi_updater *u = (lmgi_updater *)sc;
     lmgi_error e;
     lmgi_updater_desc d;
-    static const char *const named[] = {"hemicube_samples 3", "frame 10 x 0", "camera 7", "blend_frames -5",
-                                        "enlargement", "groups", "shadow_maps_per_update -5", "find_portals 1"};
+    static const char *const named[] = {"gather.samples 3", "frame 10 x 0", "camera 7", "gather.blend_frames -5",
+                                        "gather.enlargement", "photons.groups", "frame.shadow_maps_per_update -5",
+                                        "photons.find_portals 2"};
     for (int k = 0; k < 8; k++) {
         small_desc(&d);
         if (k == 0)
-            d.hemicube_samples = 3;
+            d.gather.samples = 3;
         if (k == 1)
-            d.frame_width = 10, d.frame_height = 0;
+            d.frame.width = 10, d.frame.height = 0;
         if (k == 2)
-            d.camera = 7;
+            d.frame.camera = 7;
         if (k == 3)
-            d.blend_frames = -5;
+            d.gather.blend_frames = -5;
         if (k == 4)
-            d.enlargement = NAN;
+            d.gather.enlargement = NAN;
         if (k == 5)
-            d.groups = 5; /* not 2^a 3^b */
+            d.photons.groups = 5; /* not 2^a 3^b */
         if (k == 6)
-            d.shadow_maps_per_update = -5; /* -1 is "all", other negatives nothing */
+            d.frame.shadow_maps_per_update = -5; /* LMGI_OFF is "all", other negatives nothing */
         if (k == 7)
-            d.find_portals = 1; /* 0 on, -1 off */
+            d.photons.find_portals = 2; /* 0 (on), LMGI_ON or LMGI_OFF */
         u = (lmgi_updater *)sc;
         expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, named[k]);
         assert_null(u);
@@ -1042,7 +1043,7 @@ static void test_scene_from_arrays(void **state)
     lmgi_context *ctx = new_context();
     lmgi_updater_desc ud;
     small_desc(&ud);
-    ud.frame_width = ud.frame_height = 0;
+    ud.frame.width = ud.frame.height = 0;
     lmgi_updater *u = make_updater(ctx, sc, &ud);
     size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
     float *iim = malloc(n * sizeof *iim);
@@ -1186,7 +1187,7 @@ static void test_shard_cancelled_and_resumed(void **state)
     const char *dir = lmt_tmpdir();
     snprintf(straight, sizeof straight, "%s/straight.part", dir);
     snprintf(stopped, sizeof stopped, "%s/stopped.part", dir);
-    lmgi_updater_desc d = {.photons = 6000, .shard = 0, .shards = 2, .checkpoint = straight};
+    lmgi_updater_desc d = {.photons.count = 6000, .shard = 0, .shards = 2, .checkpoint = straight};
     lmgi_updater *u = make_updater(ctx, sc, &d);
     lmgi_updater_free(u);
 
@@ -1223,7 +1224,7 @@ static void test_shard_cancelled_and_resumed(void **state)
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "not with a shard");
     bad = (lmgi_updater_desc){.parts = parts, .part_count = 0};
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "parts given with part_count 0");
-    bad = (lmgi_updater_desc){.photons = 6000, .parts = parts, .part_count = 1};
+    bad = (lmgi_updater_desc){.photons.count = 6000, .parts = parts, .part_count = 1};
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "shard 2 of 2 is missing");
     close_all(NULL, sc, ctx);
 }
@@ -1273,7 +1274,7 @@ static void *share_bake(void *arg)
     lmgi_error e;
     p->status = lmgi_context_create(NULL, &ctx, &e);
     lmgi_scene *sc = p->status == LMGI_OK ? load_scene("cornell.glb", 8000) : NULL;
-    lmgi_updater_desc d = {.photons = 6000, .shard = p->id, .shards = 2, .checkpoint = p->part,
+    lmgi_updater_desc d = {.photons.count = 6000, .shard = p->id, .shards = 2, .checkpoint = p->part,
                            .photon_exchange = share_exchange, .claim_pass = share_claim, .share_user = p};
     lmgi_updater *u = NULL;
     if (p->status == LMGI_OK)
@@ -1312,9 +1313,9 @@ static void test_shared_bake_is_one_process_bake(void **state)
     lmgi_context *ctx = new_context();
     lmgi_scene *sc = load_scene("cornell.glb", 8000);
     lmgi_error e;
-    lmgi_updater_desc whole = {.photons = 6000};
+    lmgi_updater_desc whole = {.photons.count = 6000};
     const char *const parts[2] = {p[0].part, p[1].part};
-    lmgi_updater_desc merged = {.photons = 6000, .parts = parts, .part_count = 2};
+    lmgi_updater_desc merged = {.photons.count = 6000, .parts = parts, .part_count = 2};
     lmgi_info in;
     lmgi_get_info(sc, &in);
     size_t n = 4 * (size_t)in.atlas_width * (size_t)in.atlas_height;
@@ -1336,11 +1337,11 @@ static void test_shared_bake_is_one_process_bake(void **state)
     lmgi_updater *u = NULL;
     merged.part_count = 1;
     expect_invalid(lmgi_updater_create(ctx, sc, &merged, &u, &e), &e, "are in no part");
-    lmgi_updater_desc bad = {.photons = 6000, .shard = 0, .shards = 2, .checkpoint = p[0].part, .resume = 1};
+    lmgi_updater_desc bad = {.photons.count = 6000, .shard = 0, .shards = 2, .checkpoint = p[0].part, .resume = 1};
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "a shared (MPI) bake: it does not resume");
     bad = (lmgi_updater_desc){.claim_pass = share_claim, .share_user = &p[0], .checkpoint = p[0].part};
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "claim_pass connects the processes");
-    bad = (lmgi_updater_desc){.photons = 6000, .shard = 0, .shards = 2, .checkpoint = p[0].part,
+    bad = (lmgi_updater_desc){.photons.count = 6000, .shard = 0, .shards = 2, .checkpoint = p[0].part,
                               .claim_pass = claim_beyond};
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "claim_pass gave pass");
     close_all(NULL, sc, ctx);

@@ -145,9 +145,9 @@ static void test_reference_pixels_and_check(void **state)
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_updater_desc ud;
     memset(&ud, 0, sizeof ud);
-    ud.photons = 4000;
-    ud.hemicube_resolution = 16;
-    ud.frame_width = ud.frame_height = SIDE;
+    ud.photons.count = 4000;
+    ud.gather.resolution = 16;
+    ud.frame.width = ud.frame.height = SIDE;
     lmgi_check_result c;
     assert_int_equal(lmgi_check(ctx, sc, &ud, &d, 1, &c, &e), LMGI_OK);
     assert_int_equal(c.width, SIDE);
@@ -175,7 +175,7 @@ static void test_reference_pixels_and_check(void **state)
 
     /* an updater of the same desc, one update in: lmgi_check_updater draws its lighting from the same
      * camera and compares it with the same reference (from the cache) */
-    ud.frame_width = ud.frame_height = 0;
+    ud.frame.width = ud.frame.height = 0;
     lmgi_updater *u = NULL;
     assert_int_equal(lmgi_updater_create(ctx, sc, &ud, &u, &e), LMGI_OK);
     assert_int_equal(lmgi_update(u, 0.0f, 0.0f, NULL, &e), LMGI_OK);
@@ -304,15 +304,15 @@ static void test_bad_arguments(void **state)
     expect_invalid(lmgi_check(ctx, sc, NULL, &d, 0, &c, &e), &e, "0 frames");
     lmgi_updater_desc ud;
     memset(&ud, 0, sizeof ud);
-    ud.hemicube_samples = 3;
+    ud.gather.samples = 3;
     expect_invalid(lmgi_check(ctx, sc, &ud, &d, 1, &c, &e), &e, "hemicube_samples 3");
     d.target_error = -1.0f;
     expect_invalid(lmgi_check(ctx, sc, NULL, &d, 1, &c, &e), &e, "target_error");
     d = quick();
-    ud.hemicube_samples = 0;
-    ud.photons = 2000;
-    ud.hemicube_resolution = 8;
-    ud.frame_width = ud.frame_height = 0;
+    ud.gather.samples = 0;
+    ud.photons.count = 2000;
+    ud.gather.resolution = 8;
+    ud.frame.width = ud.frame.height = 0;
     lmgi_updater *u = NULL;
     assert_int_equal(lmgi_updater_create(ctx, sc, &ud, &u, &e), LMGI_OK);
     expect_invalid(lmgi_check(ctx, sc, NULL, &d, 1, &c, &e), &e, "has an updater");

@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include "../src/api/lmgi_context.h"
+#include "../src/api/lmgi_scene.h"
 #include "../src/api/lmgi_updater.h"
 #include "../src/core/image.h"
 #include "../src/core/log.h"
@@ -188,8 +189,8 @@ static void test_updater_values(void **state)
         fail_msg("%s", e.message);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 4000;
-    d.frame_width = d.frame_height = 32;
+    d.photons.count = 4000;
+    d.frame.width = d.frame.height = 32;
     lmgi_updater *u = NULL;
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID); /* 3e7 away, far plane at 20 */
     assert_non_null(strstr(e.message, "sees none of the scene"));
@@ -197,11 +198,11 @@ static void test_updater_values(void **state)
     if (load(floor_scene("upd2.gltf", NULL, NULL, NULL, NULL), &sc, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     d.indirect = LMGI_INDIRECT_TILED;
-    d.photon_radius = 1e-30f;
+    d.tiled.radius = 1e-30f;
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID);
-    if (!strstr(e.message, "photon_radius 1e-30"))
+    if (!strstr(e.message, "tiled.radius 1e-30"))
         fail_msg("%s", e.message);
-    d.photon_radius = 0.0f;
+    d.tiled.radius = 0.0f;
     d.indirect = LMGI_INDIRECT_LIGHTMAP;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
@@ -540,8 +541,8 @@ static float *baked_lightmap(lmgi_context *ctx, const char *path, size_t *n)
         fail_msg("%s: %s", path, e.message);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 4000;
-    d.hemicube_resolution = 16;
+    d.photons.count = 4000;
+    d.gather.resolution = 16;
     lmgi_updater *u = NULL;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
@@ -588,6 +589,75 @@ static void test_sparse_accessors(void **state)
     lmgi_context_free(ctx);
 }
 
+/* The knob table (include/lmgi_knobs.h): a zero desc resolves to the defaults the stages have themselves
+ * (the table's defaults are theirs), each knob past its range or beside its choices is refused naming it
+ * as the desc spells it, and a zeroed lmgi_options loads as lmgi_options_init's. */
+#define SAME_DEFAULT(stage, field, kind, ctype, def, ...)                                                            \
+    if ((def) != 0 && (double)resolved.stage.field != (double)(def))                                                 \
+        fail_msg("lmgi_updater_defaults: " #stage "." #field " %g, the table says %g", (double)resolved.stage.field,  \
+                 (double)(def));
+#define REFUSED(stage, field, kind, ctype, def, lo, hi, ...)                                                          \
+    {                                                                                                                 \
+        lmgi_updater_desc bad;                                                                                        \
+        memset(&bad, 0, sizeof bad);                                                                                  \
+        double v = kind == LMGI_KNOB_SWITCH ? 2 : kind == LMGI_KNOB_CHOICE ? 99 : (double)(hi) + 1;                  \
+        if (kind != LMGI_KNOB_REAL && v < 2147483647.0) {                                                             \
+            int iv = (int)v; /* every knob but the floats is 4 bytes */                                              \
+            memcpy(&bad.stage.field, &iv, sizeof iv);                                                                 \
+            assert_int_equal(lm_updater_settings(sc->scene, &bad, &s, &err), LM_ERR_INVALID);                        \
+            if (!strstr(err.msg, #stage "." #field))                                                                  \
+                fail_msg("%s", err.msg);                                                                              \
+            refused++;                                                                                                \
+        }                                                                                                             \
+    }
+
+static void test_knob_table(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    lmgi_options zero, init;
+    memset(&zero, 0, sizeof zero);
+    lmgi_options_init(&init);
+    init.texel_size = zero.texel_size = 0.25f;
+    const char *path = floor_scene("knobs.gltf", NULL, NULL, NULL, NULL);
+    lmgi_info a, b;
+    assert_int_equal(lmgi_load(path, &zero, &sc, &e), LMGI_OK);
+    lmgi_get_info(sc, &a);
+    lmgi_free(sc);
+    assert_int_equal(lmgi_load(path, &init, &sc, &e), LMGI_OK);
+    lmgi_get_info(sc, &b);
+    assert_int_equal(a.texels, b.texels);
+    assert_int_equal(a.surfaces, b.surfaces);
+
+    lmgi_updater_desc d, resolved;
+    memset(&d, 0, sizeof d);
+    lmgi_updater_defaults(&resolved);
+    LMGI_UPDATER_KNOBS(SAME_DEFAULT)
+    lm_frame_loop_settings s, def;
+    lm_error err;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, &s, &err), LM_OK);
+    lm_frame_loop_settings_default(&def);
+    assert_int_equal(s.iim.texels_per_frame, def.iim.texels_per_frame);
+    assert_int_equal(s.iim.blend_frames, def.iim.blend_frames);
+    assert_memory_equal(&s.stage, &def.stage, sizeof s.stage);
+    assert_memory_equal(&s.gather, &def.gather, sizeof s.gather);
+    assert_memory_equal(&s.direct, &def.direct, sizeof s.direct);
+    assert_memory_equal(&s.caustic_pass, &def.caustic_pass, sizeof s.caustic_pass);
+    assert_memory_equal(&s.photon_gather, &def.photon_gather, sizeof s.photon_gather);
+    assert_int_equal(s.emitter_light, def.emitter_light);
+    assert_int_equal(s.emitter_rays, def.emitter_rays);
+    assert_int_equal(s.reflection_size, def.reflection_size);
+    assert_int_equal(s.reflection_faces, def.reflection_faces);
+    assert_int_equal(s.overlap, def.overlap);
+    assert_true(s.photon_radius == def.photon_radius);
+    int refused = 0;
+    LMGI_UPDATER_KNOBS(REFUSED)
+    print_message("%d knobs refused past their range or choices\n", refused);
+    assert_true(refused >= 25);
+    lmgi_free(sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -601,6 +671,7 @@ int main(void)
         cmocka_unit_test(test_named_files_are_regular),
         cmocka_unit_test(test_untrusted_scene_stays_in_its_folder),
         cmocka_unit_test(test_sparse_accessors),
+        cmocka_unit_test(test_knob_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

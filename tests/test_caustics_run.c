@@ -41,12 +41,12 @@ static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, unsigned effects
 {
     lmgi_updater_desc d;
     lmt_room_desc(&d);
-    d.frame_width = d.frame_height = own ? SIDE : 0;
+    d.frame.width = d.frame.height = own ? SIDE : 0;
     d.effects_off = effects_off;
     d.in_order = in_order;
-    d.caustic_photons = 8192;
-    d.reflection_size = 32;
-    d.reflection_faces = faces;
+    d.caustics.photons = 8192;
+    d.frame.reflection_size = 32;
+    d.frame.reflection_faces = faces;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
@@ -126,7 +126,7 @@ static void test_still_frame_reuses_caustics(void **state)
     lmgi_error e;
     lmgi_updater_desc d;
     lmt_room_desc(&d);
-    d.frame_width = d.frame_height = SIDE;
+    d.frame.width = d.frame.height = SIDE;
     d.in_order = 1;
     lmgi_updater *u = NULL;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
@@ -322,7 +322,7 @@ static void test_mirror_sphere_in_uniform_box(void **state)
     lmgi_context *ctx = lmt_context();
     lmgi_updater_desc ud;
     lmt_room_desc(&ud);
-    ud.reflection_size = 64;
+    ud.frame.reflection_size = 64;
     lmgi_updater *u = NULL;
     if (lmgi_updater_create(ctx, sc, &ud, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
@@ -376,9 +376,9 @@ static void test_deterministic(void **state)
             fail_msg("%s", e.message);
         lmgi_updater_desc d;
         lmt_room_desc(&d);
-        d.frame_width = d.frame_height = SIDE;
-        d.caustic_photons = 4096;
-        d.reflection_size = 32;
+        d.frame.width = d.frame.height = SIDE;
+        d.caustics.photons = 4096;
+        d.frame.reflection_size = 32;
         if (lmgi_updater_create(ctx, sc[k], &d, &u[k], &e) != LMGI_OK)
             fail_msg("%s", e.message);
     }
@@ -415,23 +415,23 @@ static void test_bad_desc(void **state)
     lmgi_updater_desc d;
     lmgi_updater *u = NULL;
     lmgi_error e;
-    static const char *const fields[4] = {"caustic_retrace", "caustic_filter", "caustic_tile", "caustic_world_filter"};
+    static const char *const fields[4] = {"caustics.retrace", "caustics.filter", "caustics.tile", "caustics.world_filter"};
     for (int k = 0; k < 4; k++) {
         lmt_room_desc(&d);
         if (k == 0)
-            d.caustic_retrace = 1.5f;
+            d.caustics.retrace = 1.5f;
         else if (k == 1)
-            d.caustic_filter = 9;
+            d.caustics.filter = 9;
         else if (k == 2)
-            d.caustic_tile = 2;
+            d.caustics.tile = 2;
         else
-            d.caustic_world_filter = 2;
+            d.caustics.world_filter = 2;
         lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, fields[k]);
         assert_null(u);
     }
     lmt_room_desc(&d);
-    d.caustic_retrace = NAN;
-    lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, "caustic_retrace");
+    d.caustics.retrace = NAN;
+    lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &u, &e), &e, "caustics.retrace");
     lmgi_free(sc);
     lmgi_context_free(ctx);
 }

@@ -167,7 +167,7 @@ static bake_result bake(lmgi_context *ctx, const char *path, int texels)
     lmgi_scene *sc = lmt_load(path, texels);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 20000;
+    d.photons.count = 20000;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)

@@ -30,8 +30,8 @@ static lmgi_updater *bake(lmgi_context *ctx, lmgi_scene *sc, int photons)
 {
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = photons;
-    d.hemicube_resolution = 32;
+    d.photons.count = photons;
+    d.gather.resolution = 32;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)

@@ -37,9 +37,9 @@ static lmgi_updater *bake(lmgi_context *ctx, lmgi_scene *sc)
 {
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 20000;
-    d.hemicube_resolution = 16;
-    d.rim_samples = 16;
+    d.photons.count = 20000;
+    d.gather.resolution = 16;
+    d.gather.rim_samples = 16;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)

@@ -311,9 +311,9 @@ static lmgi_updater *small_updater(lmgi_context *ctx, lmgi_scene **sc, int texel
     *sc = NULL;
     if (lmgi_load(lmt_project_scene("cornell.glb"), &o, sc, &e) != LMGI_OK)
         fail_msg("lmgi_load: %s", e.message);
-    lmgi_updater_desc d = {.photons = 4000, .hemicube_resolution = 16, .rim_samples = 8, .emitter_rays = 4,
-                           .reflection_size = 16, .frame_width = 24, .frame_height = 24,
-                           .texels_per_frame = texels_per_frame};
+    lmgi_updater_desc d = {.photons.count = 4000, .gather.resolution = 16, .gather.rim_samples = 8, .gather.emitter_rays = 4,
+                           .frame.reflection_size = 16, .frame.width = 24, .frame.height = 24,
+                           .gather.texels_per_frame = texels_per_frame};
     lmgi_updater *u = NULL;
     if (lmgi_updater_create(ctx, *sc, &d, &u, &e) != LMGI_OK)
         fail_msg("lmgi_updater_create: %s", e.message);

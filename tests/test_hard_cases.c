@@ -295,7 +295,7 @@ static void test_n_beyond_the_hits(void **state)
     float *usual = baked_iim(ctx, sc, &n);
     lmgi_updater_desc d;
     lmt_room_desc(&d);
-    d.photons_per_estimate = 100000;
+    d.aim.nearest = 100000;
     lmgi_updater *u = updater(ctx, sc, &d);
     lmgi_bake_report r;
     lmt_bake(u, &r);

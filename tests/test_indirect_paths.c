@@ -140,7 +140,7 @@ static void test_still_scene_does_no_gather_work(void **state)
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     d.indirect = LMGI_INDIRECT_TILED;
-    d.frame_width = d.frame_height = 64;
+    d.frame.width = d.frame.height = 64;
     d.in_order = 1;
     d.effects_off = LMGI_EFFECT_CAUSTICS | LMGI_EFFECT_REFLECTIONS;
     lmgi_updater *u = NULL;
@@ -154,7 +154,7 @@ static void test_still_scene_does_no_gather_work(void **state)
         assert_int_equal(lmgi_update(u, t[i], 0.0f, &st[i], &e), LMGI_OK);
         lmgi_updater_info ui;
         lmgi_get_updater_info(u, &ui);
-        radius[i] = ui.photon_radius;
+        radius[i] = ui.tiled.radius;
         assert_string_equal(ui.indirect, "tiled");
         int w, h;
         const float *f = lmgi_frame(u, &w, &h);

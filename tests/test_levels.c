@@ -227,7 +227,7 @@ static void bake_on_pages(lmgi_context *ctx, const char *path, int texels, int s
     lmgi_get_info(b->sc, &b->in);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 20000;
+    d.photons.count = 20000;
     lmgi_error e;
     if (lmgi_updater_create(ctx, b->sc, &d, &b->u, &e) != LMGI_OK)
         fail_msg("%s", e.message);

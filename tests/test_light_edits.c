@@ -91,9 +91,9 @@ static void test_add_and_remove(void **state)
     lmgi_bake_report r;
     lmt_bake(u, &r);
     lmgi_get_updater_info(u, &info1);
-    uint32_t added = info1.photons - info0.photons;
+    uint32_t added = info1.stored_photons - info0.stored_photons;
     print_message("the added spot: %u photons (the lamp has %u), %u paths changed of %u traced, %d surfaces\n",
-                  added, info0.photons, r.photons_changed, r.photons_traced, r.surfaces_changed);
+                  added, info0.stored_photons, r.photons_changed, r.photons_traced, r.surfaces_changed);
     assert_true(added > 0);
     assert_true(r.photons_changed <= added && r.photons_changed > added / 2); /* its photons, no other's */
     float *with = lmt_iim(u, sc, &n);
@@ -258,7 +258,7 @@ static void test_first_light(void **state)
     lmt_bake(u, &r);
     lmgi_updater_info info;
     lmgi_get_updater_info(u, &info);
-    assert_int_equal(info.photons, 72 * 100); /* photons_per_group x the default 72 groups */
+    assert_int_equal(info.stored_photons, 72 * 100); /* photons_per_group x the default 72 groups */
     float *lit = lmt_iim(u, sc, &n);
     lmgi_scene *loaded = load_room(&LAMP, 1);
     lmgi_updater *ul = lmt_room_updater(ctx, loaded);

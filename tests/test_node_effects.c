@@ -231,10 +231,10 @@ static void test_run_effects(void **state)
         lmgi_updater_info info;
         lmgi_get_updater_info(u, &info);
         print_message("-%s: frame %.1e from every node's %s off; photons %u, photon and gather work in 3 updates "
-                      "%u\n", names[k], d, names[k], info.photons, work);
+                      "%u\n", names[k], d, names[k], info.stored_photons, work);
         assert_true(d < 1e-6);
         if (bits[k] == LMGI_EFFECT_INDIRECT) {
-            assert_int_equal(info.photons, 0);
+            assert_int_equal(info.stored_photons, 0);
             assert_int_equal(work, 0);
             size_t n;
             float *iim = lmt_iim(u, run, &n);

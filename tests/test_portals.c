@@ -79,8 +79,8 @@ static outcome bake(const char *path, const lmgi_camera *cam, uint32_t photons, 
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = photons;
-    d.find_portals = find ? 0 : -1;
+    d.photons.count = photons;
+    d.photons.find_portals = find ? 0 : LMGI_OFF;
     lmgi_updater *u = NULL;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
@@ -366,7 +366,7 @@ static void test_sunlit_room_has_no_black_texels(void **state)
     for (int find = 0; find < 2; find++) {
         lmgi_updater_desc d;
         memset(&d, 0, sizeof d);
-        d.find_portals = find ? 0 : -1;
+        d.photons.find_portals = find ? 0 : LMGI_OFF;
         lmgi_updater *u = NULL;
         if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
             fail_msg("%s", e.message);
@@ -397,8 +397,8 @@ static void test_sunlit_room_against_reference(void **state)
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.photons = 4 * lmgi_texel_count(sc);
-    d.frame_width = d.frame_height = 64;
+    d.photons.count = 4 * lmgi_texel_count(sc);
+    d.frame.width = d.frame.height = 64;
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
     rd.target_error = 0.05f;
@@ -406,7 +406,7 @@ static void test_sunlit_room_against_reference(void **state)
     if (lmgi_check(ctx, sc, &d, &rd, 1, &c, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     print_message("sunlit room as lmgi bake bakes it (%u texels, %u photons): frame / reference %.3f %.3f %.3f over %u "
-                  "pixels (reference %.1f s)\n", lmgi_texel_count(sc), d.photons, c.ratio[0], c.ratio[1], c.ratio[2],
+                  "pixels (reference %.1f s)\n", lmgi_texel_count(sc), d.photons.count, c.ratio[0], c.ratio[1], c.ratio[2],
                   c.pixels, c.reference_seconds);
     for (int k = 0; k < 3; k++)
         assert_float_equal(c.ratio[k], 1.0, 0.05);

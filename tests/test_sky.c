@@ -173,7 +173,7 @@ static void test_open_box_against_reference(void **state)
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
     lmgi_updater_desc ud;
     memset(&ud, 0, sizeof ud);
-    ud.frame_width = ud.frame_height = 64;
+    ud.frame.width = ud.frame.height = 64;
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
     rd.target_error = 0.03f;
@@ -239,7 +239,7 @@ static void test_gradient_sky(void **state)
     lmgi_free(back);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.gather_scheme = LMGI_GATHER_VIEWPORTS;
+    d.gather.scheme = LMGI_GATHER_VIEWPORTS;
     u = NULL;
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_ERR_INVALID);
     assert_non_null(strstr(e.message, "rays gather"));

@@ -111,7 +111,7 @@ static void soak(soak_run *r)
         fail_msg("%s", e.message);
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.frame_width = d.frame_height = SIDE;
+    d.frame.width = d.frame.height = SIDE;
     lmgi_context *ctx = lmt_context();
     lmgi_updater *u = NULL;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)

@@ -25,9 +25,9 @@ static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, uint32_t caustic
     lmt_room_desc(&d);
     if (full)
         memset(&d, 0, sizeof d);
-    d.caustic_photons = caustic_photons;
-    d.caustic_world_filter = world_filter;
-    d.reflection_size = 128;
+    d.caustics.photons = caustic_photons;
+    d.caustics.world_filter = world_filter;
+    d.frame.reflection_size = 128;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)

@@ -68,8 +68,8 @@ static lmgi_status check_owned(lmgi_context *ctx, lmgi_scene *sc, const lmgi_upd
     memset(&d, 0, sizeof d);
     if (desc)
         d = *desc;
-    if (!d.frame_width && !d.frame_height)
-        d.frame_width = d.frame_height = CHECK_SIDE;
+    if (!d.frame.width && !d.frame.height)
+        d.frame.width = d.frame.height = CHECK_SIDE;
     d.progress = NULL;
     lm_ref_settings rs;
     if (lm_api_ref_settings(ref, fn, &rs, err) != LMGI_OK)

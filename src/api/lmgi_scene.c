@@ -64,6 +64,21 @@ lmgi_status lmgi_commit(lmgi_scene *sc, lmgi_error *err)
     return st == LMGI_OK ? lm_scene_commit(sc, err) : st;
 }
 
+/* o with each 0 made its default: 0 means the default in every field, so a zeroed lmgi_options (or
+ * none) is the defaults, as lmgi_options_init gives them. */
+static void resolve_options(const lmgi_options *o, lmgi_options *out)
+{
+    lmgi_options_init(out);
+    if (!o)
+        return;
+    lmgi_options def = *out;
+    *out = *o;
+    if (o->surface_cone_deg == 0.0f)
+        out->surface_cone_deg = def.surface_cone_deg;
+    if (o->max_atlas_size == 0)
+        out->max_atlas_size = def.max_atlas_size;
+}
+
 static lm_status check_options(const char *path, const lmgi_options *o, lm_error *err)
 {
     if (!(o->texel_size >= 0.0f) || !isfinite(o->texel_size))
@@ -186,11 +201,9 @@ static lmgi_status load(const char *path, const void *data, size_t size, const l
         return lm_export_error(err, &e);
     }
     *out = NULL;
-    lmgi_options defaults;
-    if (!o) {
-        lmgi_options_init(&defaults);
-        o = &defaults;
-    }
+    lmgi_options resolved;
+    resolve_options(o, &resolved);
+    o = &resolved;
     if (!path) {
         lm_fail(&e, LM_ERR_INVALID, "no scene file given");
         return lm_export_error(err, &e);

@@ -16,6 +16,7 @@
 #include "lmgi_context.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"
+#include "updater_knobs.h"
 
 struct lmgi_updater {
     lmgi_context *ctx;
@@ -26,141 +27,37 @@ struct lmgi_updater {
     lm_photon_stage_frame setup;
     double t_setup_gather;
     lm_lightmap_texture *texture; /* lmgi_get_lightmap_texture's, once asked for */
+    lmgi_updater_desc knobs;    /* the desc it was made from, resolved (lmgi_get_updater_info) */
 };
 
-/* A desc field: 0 keeps the default, a value in [lo, hi] replaces it, anything else is refused. */
-static int take(int v, int lo, int hi, int *dst)
+/* What the frame loop's gather schemes and indirect paths are called in the desc. */
+static const int INDIRECT_PATHS[4] = {LM_INDIRECT_LIGHTMAP, LM_INDIRECT_BRUTEFORCE, LM_INDIRECT_TILED,
+                                      LM_INDIRECT_HASHGRID};
+
+/* The frame's size and camera, the fields beside the knobs that have rules of their own. */
+static lm_status check_frame_desc(const lm_scene *scene, const lmgi_frame_knobs *f, lm_error *err)
 {
-    if (v == 0)
-        return 1;
-    if (v < lo || v > hi)
-        return 0;
-    *dst = v;
-    return 1;
-}
-
-#define TAKE(field, lo, hi, dst)                                                                                      \
-    do {                                                                                                              \
-        if (!take(d->field, lo, hi, dst))                                                                             \
-            return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: " #field " %d must be in %d..%d (0: the "       \
-                           "default)", (int)d->field, lo, hi);                                                        \
-    } while (0)
-
-/* The same for an unsigned field (photon counts). */
-#define TAKEU(field, lo, hi, dst)                                                                                     \
-    do {                                                                                                              \
-        int v_ = (int)*(dst);                                                                                         \
-        if (d->field > (uint32_t)(hi) || !take((int)d->field, lo, hi, &v_))                                           \
-            return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: " #field " %u must be in %d..%d (0: the "       \
-                           "default)", (unsigned)d->field, lo, hi);                                                   \
-        *(dst) = (uint32_t)v_;                                                                                        \
-    } while (0)
-
-/* The frame loop's settings from a desc, each field checked. */
-lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_frame_loop_settings *s,
-                              lm_error *err)
-{
-    lm_frame_loop_settings_default(s);
-    lm_photon_settings *ph = &s->stage.photons;
-    int v;
-    TAKE(texels_per_frame, 1, 100000000, &s->iim.texels_per_frame);
-    if (d->blend_frames == -1)
-        s->iim.blend_frames = 0;
-    else
-        TAKE(blend_frames, 1, 100000, &s->iim.blend_frames);
-    TAKEU(photons, 1, 100000000, &ph->total_photons);
-    TAKEU(groups, 1, 1 << 20, &ph->groups); /* 2^a 3^b: checked by photons */
-    TAKEU(photons_per_group, 1, 10000000, &ph->per_group);
-    if (d->photons_per_group)
-        ph->min_total = 0; /* photons per group as asked, without the scene's floor */
-    TAKEU(retrace_per_group, 1, 1000000, &ph->retrace_per_group);
-    if (d->group_budget == UINT32_MAX)
-        ph->group_budget = 0; /* every invalid group at once */
-    else
-        TAKEU(group_budget, 1, 10000000, &ph->group_budget);
-    ph->seed = d->seed;
-    TAKE(photons_per_estimate, 1, 100000, &s->stage.aim.n_nearest);
-    if ((int)d->aim_direct < LMGI_AIM_DIRECT_PHOTONS || (int)d->aim_direct > LMGI_AIM_DIRECT_ALL)
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: aim_direct %d is not LMGI_AIM_DIRECT_PHOTONS, "
-                       "_EMITTERS or _ALL", (int)d->aim_direct);
-    s->stage.exact_direct = d->aim_direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : d->aim_direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
-    if (d->find_portals != 0 && d->find_portals != -1)
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: find_portals %d must be 0 (on) or -1 (off)",
-                       d->find_portals);
-    s->stage.find_portals = d->find_portals == 0;
-    if (d->error_estimate != 0 && d->error_estimate != 1)
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: error_estimate %d must be 0 or 1", d->error_estimate);
-    s->stage.aim.error_estimate = d->error_estimate;
-    if (d->surfaces_per_frame == -1)
-        s->stage.surfaces_per_frame = -1;
-    else
-        TAKE(surfaces_per_frame, 1, 10000000, &s->stage.surfaces_per_frame);
-    TAKE(hemicube_resolution, 2, 1024, &s->gather.resolution);
-    if (!(d->enlargement == 0.0f || (d->enlargement >= 1e-3f && d->enlargement <= 1e3f)))
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: enlargement %g must be in [0.001, 1000] (0: "
-                       "the default)", (double)d->enlargement);
-    if (d->enlargement > 0.0f)
-        s->gather.enlargement = d->enlargement;
-    if (d->hemicube_samples != 0 && d->hemicube_samples != 1 && d->hemicube_samples != 4)
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: hemicube_samples %d must be 1 or 4 (0: the "
-                       "default)", d->hemicube_samples);
-    TAKE(hemicube_samples, 1, 4, &s->gather.samples);
-    TAKE(hemicube_coverage, 1, 16, &s->gather.coverage_samples);
-    if (d->rim_samples == -1)
-        s->gather.rim_samples = 0;
-    else
-        TAKE(rim_samples, 1, 65536, &s->gather.rim_samples);
-    v = 0;
-    TAKE(gather_scheme, LMGI_GATHER_VIEWPORTS, LMGI_GATHER_RAYS, &v);
-    if (v)
-        s->gather.scheme = (lm_gather_scheme)(v - 1);
-    v = 0;
-    TAKE(emitter_light, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_DRAWN, &v);
-    s->emitter_light = v == LMGI_EMITTERS_CLOSED_FORM ? 1 : v == LMGI_EMITTERS_DRAWN ? 0 : -1;
-    TAKE(emitter_rays, 1, 65536, &s->emitter_rays);
-    if (d->shadow_maps_per_update == -1)
-        s->direct.maps_per_update = -1;
-    else
-        TAKE(shadow_maps_per_update, 1, 1000000, &s->direct.maps_per_update);
-    s->overlap = !d->in_order;
-    if (d->frame_width < 0 || d->frame_height < 0 || d->frame_width > 16384 || d->frame_height > 16384 ||
-        (d->frame_width == 0) != (d->frame_height == 0))
+    if (f->width < 0 || f->height < 0 || f->width > 16384 || f->height > 16384 || (f->width == 0) != (f->height == 0))
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: frame %d x %d must be 0 x 0 (none) or sides in "
-                       "1..16384", d->frame_width, d->frame_height);
-    s->width = d->frame_width;
-    s->height = d->frame_height;
-    if (d->camera < -1 || (d->camera > 0 && d->camera >= scene->camera_count))
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: camera %d: the scene has %d", d->camera,
+                       "1..16384", f->width, f->height);
+    if (f->camera < -1 || (f->camera > 0 && f->camera >= scene->camera_count))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: camera %d: the scene has %d", f->camera,
                        scene->camera_count);
-    s->camera = d->camera;
-    if (s->width > 0) { /* a camera that shows only the background would give black frames and exit 0 */
+    if (f->width > 0) { /* a camera that shows only the background would give black frames and exit 0 */
         lm_view v;
-        lm_view_for_scene(scene, s->camera, s->width, s->height, &v);
+        lm_view_for_scene(scene, f->camera, f->width, f->height, &v);
         if (!lm_view_sees_box(&v, scene->bounds_min, scene->bounds_max))
             return lm_fail(err, LM_ERR_INVALID, "%s: camera '%s' sees none of the scene (the scene's bounds lie "
                            "wholly outside its view: behind it, off to a side, or beyond its far plane); its frames "
                            "would show only the background", scene->path, v.name);
     }
-    if (d->reflection_size == -1)
-        s->reflection_size = 0;
-    else
-        TAKE(reflection_size, 1, 4096, &s->reflection_size);
-    TAKE(reflection_faces, 1, 1 << 20, &s->reflection_faces);
-    TAKEU(caustic_photons, 1, 1 << 24, &s->stage.caustic.photons);
-    if (!(d->caustic_retrace == 0.0f || (d->caustic_retrace > 0.0f && d->caustic_retrace <= 1.0f)))
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: caustic_retrace %g must be in (0, 1] (0: the "
-                       "default)", (double)d->caustic_retrace);
-    if (d->caustic_retrace > 0.0f)
-        s->stage.caustic.retrace = d->caustic_retrace;
-    if (d->caustic_filter == -1)
-        s->caustic_pass.filter_k = 0;
-    else
-        TAKE(caustic_filter, 1, 8, &s->caustic_pass.filter_k);
-    TAKE(caustic_tile, 4, 256, &s->caustic_pass.tile);
-    if (d->caustic_world_filter != 0 && d->caustic_world_filter != 1)
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: caustic_world_filter %d must be 0 or 1",
-                       d->caustic_world_filter);
-    s->caustic_pass.world_space = d->caustic_world_filter;
+    return LM_OK;
+}
+
+/* The rest beside the table: effects, the indirect path, the tiled gather's combinations and a radius
+ * relative to the scene. */
+static lm_status check_modes(const lm_scene *scene, const lmgi_updater_desc *d, lm_error *err)
+{
     const unsigned all = LMGI_EFFECT_SHADOWS | LMGI_EFFECT_INDIRECT | LMGI_EFFECT_REFLECTIONS | LMGI_EFFECT_CAUSTICS;
     if (d->effects_off & ~all)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: effects_off 0x%x has bits other than "
@@ -168,31 +65,102 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     if ((int)d->indirect < LMGI_INDIRECT_LIGHTMAP || (int)d->indirect > LMGI_INDIRECT_HASHGRID)
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: indirect %d is not an indirect path "
                        "(LMGI_INDIRECT_LIGHTMAP, _BRUTEFORCE, _TILED, _HASHGRID)", (int)d->indirect);
-    static const int paths[4] = {LM_INDIRECT_LIGHTMAP, LM_INDIRECT_BRUTEFORCE, LM_INDIRECT_TILED, LM_INDIRECT_HASHGRID};
-    s->indirect_path = paths[d->indirect];
-    if (d->photon_tile)
-        s->photon_gather.tile = d->photon_tile;
-    if (d->photon_chunk)
-        s->photon_gather.chunk = d->photon_chunk;
-    if (d->photon_stochastic)
-        s->photon_gather.stochastic = d->photon_stochastic;
-    lm_error why;
-    if (!lm_photon_gather_settings_check(&s->photon_gather, &why))
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: %s (photon_tile, photon_chunk, "
-                       "photon_stochastic; 0: the defaults)", why.msg);
     /* a kernel of 1e-30 divided by its area into infinity, every pixel NaN */
     float size = lm_scene_size(scene), lo = 1e-6f * size, hi = 1e6f * size;
-    if (!(d->photon_radius == 0.0f || (d->photon_radius >= lo && d->photon_radius <= hi)))
-        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: photon_radius %g must be 0 (from "
-                       "photons_per_estimate) or within 1e-6 to 1e6 times the scene's size %g", (double)d->photon_radius,
-                       (double)size);
-    s->photon_radius = d->photon_radius;
-    s->direct.shadows = !(d->effects_off & LMGI_EFFECT_SHADOWS);
-    s->indirect = !(d->effects_off & LMGI_EFFECT_INDIRECT);
-    if (d->effects_off & LMGI_EFFECT_REFLECTIONS)
-        s->reflection_size = 0;
-    s->caustics = !(d->effects_off & LMGI_EFFECT_CAUSTICS);
-    s->cancel = d->cancel;
+    if (!(d->tiled.radius == 0.0f || (d->tiled.radius >= lo && d->tiled.radius <= hi)))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: tiled.radius %g must be 0 (from aim.nearest) or "
+                       "within 1e-6 to 1e6 times the scene's size %g", (double)d->tiled.radius, (double)size);
+    return LM_OK;
+}
+
+/* The frame loop's settings from a desc whose knobs are checked and resolved (r), stage by stage. */
+static void photon_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s)
+{
+    lm_photon_settings *ph = &s->stage.photons;
+    if (r->photons.count)
+        ph->total_photons = r->photons.count;
+    ph->groups = r->photons.groups;
+    if (r->photons.per_group) {
+        ph->per_group = r->photons.per_group;
+        ph->min_total = 0; /* photons per group as asked, without the scene's floor */
+    }
+    ph->retrace_per_group = r->photons.retrace_per_group;
+    ph->group_budget = r->photons.group_budget == LMGI_OFF ? 0 : (uint32_t)r->photons.group_budget; /* 0: all */
+    ph->seed = r->photons.seed;
+    s->stage.find_portals = r->photons.find_portals == LMGI_ON;
+    s->stage.aim.n_nearest = r->aim.nearest;
+    s->stage.surfaces_per_frame = r->aim.surfaces_per_frame; /* LMGI_OFF: -1, all that changed */
+    s->stage.exact_direct = r->aim.direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : r->aim.direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
+    s->stage.aim.error_estimate = r->aim.error_estimate == LMGI_ON;
+    s->stage.caustic.photons = r->caustics.photons;
+    s->stage.caustic.retrace = r->caustics.retrace;
+}
+
+static void gather_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s)
+{
+    const lmgi_gather_knobs *g = &r->gather;
+    s->iim.texels_per_frame = g->texels_per_frame;
+    s->iim.blend_frames = g->blend_frames == LMGI_OFF ? 0 : g->blend_frames;
+    s->gather.resolution = g->resolution;
+    s->gather.enlargement = g->enlargement;
+    s->gather.samples = g->samples;
+    s->gather.coverage_samples = g->coverage; /* 0: chosen per scene */
+    s->gather.rim_samples = g->rim_samples == LMGI_OFF ? 0 : g->rim_samples;
+    if (g->scheme != LMGI_GATHER_DEFAULT)
+        s->gather.scheme = (lm_gather_scheme)(g->scheme - 1);
+    s->emitter_light = g->emitter_light == LMGI_EMITTERS_CLOSED_FORM ? 1
+                       : g->emitter_light == LMGI_EMITTERS_DRAWN  ? 0
+                                                                  : -1; /* chosen per scene */
+    s->emitter_rays = g->emitter_rays;
+}
+
+static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s)
+{
+    const lmgi_frame_knobs *f = &r->frame;
+    s->width = f->width;
+    s->height = f->height;
+    s->camera = f->camera;
+    s->direct.maps_per_update = f->shadow_maps_per_update; /* LMGI_OFF: -1, every stale one */
+    int no_reflections = f->reflection_size == LMGI_OFF || (r->effects_off & LMGI_EFFECT_REFLECTIONS);
+    s->reflection_size = no_reflections ? 0 : f->reflection_size;
+    s->reflection_faces = f->reflection_faces;
+    s->caustic_pass.filter_k = r->caustics.filter == LMGI_OFF ? 0 : r->caustics.filter;
+    s->caustic_pass.tile = r->caustics.tile;
+    s->caustic_pass.world_space = r->caustics.world_filter == LMGI_ON;
+    s->photon_gather.tile = r->tiled.tile;
+    s->photon_gather.chunk = r->tiled.chunk;
+    s->photon_gather.stochastic = r->tiled.stochastic;
+    s->photon_radius = r->tiled.radius;
+    s->indirect_path = INDIRECT_PATHS[r->indirect];
+    s->overlap = !r->in_order;
+    s->direct.shadows = !(r->effects_off & LMGI_EFFECT_SHADOWS);
+    s->indirect = !(r->effects_off & LMGI_EFFECT_INDIRECT);
+    s->caustics = !(r->effects_off & LMGI_EFFECT_CAUSTICS);
+    s->cancel = r->cancel;
+}
+
+/* The frame loop's settings from a desc: its knobs checked against their table and resolved, the rest
+ * checked here. */
+lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_frame_loop_settings *s,
+                              lm_error *err)
+{
+    lm_frame_loop_settings_default(s);
+    lm_status st = lm_updater_knobs_check(d, "lmgi_updater_create", err);
+    if (st == LM_OK)
+        st = check_frame_desc(scene, &d->frame, err);
+    if (st == LM_OK)
+        st = check_modes(scene, d, err);
+    if (st != LM_OK)
+        return st;
+    lmgi_updater_desc r;
+    lm_updater_knobs_resolve(d, &r);
+    photon_settings(&r, s);
+    gather_settings(&r, s);
+    frame_settings(&r, s);
+    lm_error why;
+    if (!lm_photon_gather_settings_check(&s->photon_gather, &why))
+        return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: %s (tiled.tile, tiled.chunk, tiled.stochastic; "
+                       "0: the defaults)", why.msg);
     return LM_OK;
 }
 
@@ -257,7 +225,7 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     set.gl = ctx->gl;
     /* a software rasterizer's hemicube costs what the gather proxy's triangles cost; rays, the log of the
      * level's (docs/gather.md, "Rays") */
-    if (d.gather_scheme == LMGI_GATHER_DEFAULT &&
+    if (d.gather.scheme == LMGI_GATHER_DEFAULT &&
         ((sc->scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES && lm_gl_context_is_software(ctx->gl)) ||
          !lm_sky_is_uniform(sc->scene))) /* a hemicube clears to one colour */
         set.gather.scheme = LM_GATHER_RAYS;
@@ -286,6 +254,7 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     if (st == LM_OK) {
         u->ctx = ctx;
         u->sc = sc;
+        lm_updater_knobs_resolve(&d, &u->knobs);
         u->seen = calloc((size_t)(sc->atlas.surface_count > 0 ? sc->atlas.surface_count : 1), sizeof *u->seen);
         st = u->seen ? lm_frame_loop_create(&sc->world, &set, &u->loop, &u->setup,
                                             &u->t_setup_gather, &e)
@@ -367,28 +336,27 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     memset(info, 0, sizeof *info);
     if (!u)
         return;
+    /* the knobs as resolved from the desc, then what the scene chose where the desc left it */
+    const lmgi_updater_desc *k = &u->knobs;
+    info->photons = k->photons, info->aim = k->aim, info->gather = k->gather;
+    info->caustics = k->caustics, info->frame = k->frame, info->tiled = k->tiled;
     const lm_frame_loop_settings *s = lm_frame_loop_get_settings(u->loop);
-    info->texels_per_frame = s->iim.texels_per_frame;
-    info->hemicube_resolution = s->gather.resolution;
-    info->hemicube_samples = s->gather.samples;
-    info->hemicube_coverage = s->gather.coverage_samples;
-    info->rim_samples = s->gather.rim_samples;
-    info->enlargement = s->gather.enlargement;
+    info->gather.coverage = s->gather.coverage_samples;
+    info->gather.scheme = (lmgi_gather_scheme)(s->gather.scheme + 1);
+    info->gather.emitter_light = s->emitter_light ? LMGI_EMITTERS_CLOSED_FORM : LMGI_EMITTERS_DRAWN;
+    info->tiled.radius = lm_frame_loop_photon_radius(u->loop);
     info->gather_scheme = lm_gather_scheme_name(s->gather.scheme);
     info->emissive_triangles = lm_emissive_triangle_count(u->sc->scene);
     info->emitters_closed_form = s->emitter_light;
-    info->emitter_rays = s->emitter_rays;
-    info->photons = lm_frame_loop_get_settings(u->loop)->indirect /* else one untraced photon a light */
-                        ? lm_photons_count(lm_photon_stage_photons(lm_frame_loop_stage(u->loop))) : 0;
+    info->stored_photons = s->indirect /* else one untraced photon a light */
+                               ? lm_photons_count(lm_photon_stage_photons(lm_frame_loop_stage(u->loop))) : 0;
+    if (!info->photons.count) /* chosen from the groups and the scene's floor */
+        info->photons.count = info->stored_photons;
     info->ms_setup_trace = 1e3 * u->setup.t_photons;
     info->ms_setup_aim = 1e3 * u->setup.t_aim;
     info->ms_setup_gather = 1e3 * u->t_setup_gather;
     static const char *const paths[4] = {"lightmap", "bruteforce", "tiled", "hashgrid"};
     info->indirect = s->indirect_path >= 0 && s->indirect_path < 4 ? paths[s->indirect_path] : "lightmap";
-    info->photon_tile = s->photon_gather.tile;
-    info->photon_chunk = s->photon_gather.chunk;
-    info->photon_stochastic = s->photon_gather.stochastic;
-    info->photon_radius = lm_frame_loop_photon_radius(u->loop);
     const lm_emitters *em = lm_photon_stage_emitters(lm_frame_loop_stage(u->loop));
     for (int e = 0; em && e < em->count; e++)
         info->portals_found += em->e[e].portals ? (int)em->e[e].portals->found / 2 : 0;
@@ -877,7 +845,8 @@ static lmgi_status get_lightmap_owned(lmgi_updater *u, const char *fn, lmgi_ligh
     if (kind < LMGI_LIGHTMAP_IIM || kind > LMGI_LIGHTMAP_ACCURACY)
         return lm_api_refuse(err, "%s: %d is not a lightmap kind", fn, (int)kind);
     if (kind == LMGI_LIGHTMAP_ACCURACY && !lm_photon_stage_aim(lm_frame_loop_stage(u->loop))->error)
-        return lm_api_refuse(err, "%s: the accuracy estimate needs the updater made with desc.error_estimate 1", fn);
+        return lm_api_refuse(err, "%s: the accuracy estimate needs the updater made with desc.aim.error_estimate "
+                             "LMGI_ON", fn);
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_error e;
     lm_status st = kind == LMGI_LIGHTMAP_IIM     ? read_iim_rect(u, r, rgba, &e)

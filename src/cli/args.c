@@ -34,6 +34,8 @@ static int take(const lm_cli_option *o, const char *word, const char *v, lm_cli_
         return v ? (*(const char **)field = v, 0) : lm_cli_bad(word, v, o->arg);
     case LM_OPT_CUSTOM:
         return o->parse(word, v, a);
+    case LM_OPT_KNOBS: /* not an option (all_options in options.c never gives it) */
+        break;
     }
     return 2;
 }
@@ -64,13 +66,6 @@ int lm_cli_parse(int argc, char **argv, int first, const char *command, unsigned
     lmgi_options_init(&a->options);
     a->repeats = 3;
     a->camera = -1;
-    a->gather_scheme = -1;
-    a->emitter_light = -1;
-    a->rim_samples = -1;
-    a->group_budget = -1;
-    a->shadow_maps = -1;
-    a->reflection_size = -1;
-    a->caustic_filter = -1;
     a->word_count = argc > first ? argc - first : 0;
     a->words = argv + first;
     int rc = 0;

@@ -18,17 +18,12 @@ typedef struct {
     const char *files[LM_CLI_MAX_FILES];
     int scaling_count;
     const char *scaling[LM_CLI_MAX_FILES];
-    /* photon stage and reference solver (0 / NULL = the command's default) */
+    /* the updater's knobs (include/lmgi_knobs.h: their options are made from its table, knob_options.h)
+     * and its --indirect, --effects and --in-order, as lmgi_updater_desc holds them (0: the default) */
+    lmgi_updater_desc desc;
+    /* the reference solver and what the updater shares with it (0 / NULL = the command's default) */
     int frames;             /* --frames N */
-    unsigned seed;          /* --seed N */
-    int photons;            /* --photons N: total photon budget */
-    int groups;             /* --groups G */
-    int per_group;          /* --per-group M */
-    int retrace;            /* --retrace k: photons re-traced per group per frame */
-    int group_budget;       /* --group-budget B: invalid groups re-traced per frame (-1 unset, 0 all) */
-    int nearest;            /* --nearest N: photons per AIM estimate */
-    int surface_budget;     /* --surfaces-per-frame K: AIM refreshes per frame */
-    int shadow_maps;        /* --shadow-maps-per-frame N: stale shadow maps re-rendered per frame (-1 unset, 0 all) */
+    unsigned seed;          /* --seed N: the updater's photons.seed and the reference's paths */
     float target_error;     /* --target-error E: relative standard error per texel (reference) */
     int samples;            /* --samples N: samples per texel/pixel per pass (reference) */
     int caustic_photons;    /* --caustic-photons N: caustic photons per light and mirror/glass node (a run's, or
@@ -37,32 +32,9 @@ typedef struct {
     const char *cache_dir;  /* --cache DIR (reference) */
     int no_cache;           /* --no-cache */
     int camera;             /* --camera I (default: the file's first, else automatic) */
-    /* lmgi run (0 = default) */
-    int texels_per_frame;   /* --texels-per-frame N: IIM gather budget per frame */
-    int exr_every;          /* --exr-every K: every K-th frame also as EXR */
-    int hemicube;           /* --hemicube R: hemicube plane pixels per side */
-    int hemicube_samples;   /* --hemicube-samples N: AIM lookups per hemicube pixel (1 or 4) */
-    int hemicube_coverage;  /* --hemicube-coverage N: MSAA coverage samples per hemicube pixel (1 to 16) */
-    int rim_samples;        /* --rim-samples K: directions for the rim outside the plane (0: 1 / F(a)); -1 unset */
-    int reflection_size;    /* --reflection-size N: environment map side (0: no reflections); -1 unset */
-    int reflection_faces;   /* --reflection-faces N: environment map faces re-rendered a frame; 0 unset */
-    float caustic_retrace;  /* --caustic-retrace F: share of the caustic photons re-traced a frame; 0 unset */
-    int caustic_filter;     /* --caustic-filter K: k of the caustics' (2k + 1)^2 filter; -1 unset */
-    int caustic_world;      /* --caustic-space screen|world: 1 filters by world distance */
-    int caustic_tile;       /* --caustic-tile N: tile side of the caustics' occlusion queries; 0 unset */
-    float enlargement;      /* --enlargement a: hemicube plane half-side at distance 1 */
-    int gather_scheme;      /* --gather-scheme viewports|instanced|layered (-1 = default) */
-    int emitter_light;      /* --emitter-light closed|drawn: 1, 0 (-1 = per scene) */
-    int emitter_rays;       /* --emitter-rays N: shadow rays per emissive triangle and texel */
-    int in_order;           /* --in-order: photon stage before the gather, one thread (no overlap) */
+    int exr_every;          /* --exr-every K (run): every K-th frame also as EXR */
     int force;              /* --force: write into a non-empty --out directory lmgi did not make */
     int tonemap;            /* --tonemap neutral|clamp: lmgi_tonemap of the PNGs (default neutral) */
-    unsigned effects_off;   /* --effects -shadows,-indirect,-reflections,-caustics: lmgi_updater_desc.effects_off */
-    int indirect;           /* --indirect lightmap|tiled|hashgrid|bruteforce: lmgi_updater_desc.indirect */
-    int photon_tile, photon_chunk, photon_stochastic; /* --photon-tile/-chunk/-stochastic; 0 unset */
-    float photon_radius;    /* --photon-radius R; 0 unset */
-    int aim_direct;         /* --aim-direct emitters|photons|all: lmgi_updater_desc.aim_direct (default photons) */
-    int find_portals;       /* --find-portals on|off: lmgi_updater_desc.find_portals (0 on, the default; -1 off) */
     int half;               /* --half (bake): EXR lightmaps as 16-bit half floats */
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     int accuracy;           /* --accuracy (bake): also the lightmaps' estimate of their own error */

@@ -206,7 +206,7 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
     char atlas[96], exr[320], png[64], aim[64];
     lm_cli_atlas_size(atlas, sizeof atlas, &in);
     printf("%s %u texels (%s%s) from %u photons in %.1f s (trace %.0f ms, AIMs %.0f ms, gather %.0f ms)\n", what,
-           in.texels, atlas, in.pages > 1 ? "" : " atlas", ui.photons, lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim,
+           in.texels, atlas, in.pages > 1 ? "" : " atlas", ui.stored_photons, lm_cli_now() - started, ui.ms_setup_trace, ui.ms_setup_aim,
            ui.ms_setup_gather);
     if (ui.portals_found)
         printf("portals     %d found where the sun's or the sky's light gets in (docs/levels.md, \"Portals\")\n",
@@ -252,10 +252,10 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     }
     lmgi_updater_desc d;
     lm_cli_updater_desc(a, &d);
-    if (!a->photons && !a->per_group)
-        d.photons = lm_cli_bake_photons(in.texels);
-    d.frame_width = d.frame_height = 0;
-    d.error_estimate = a->accuracy;
+    if (!a->desc.photons.count && !a->desc.photons.per_group)
+        d.photons.count = lm_cli_bake_photons(in.texels);
+    d.frame.width = d.frame.height = 0;
+    d.aim.error_estimate = a->accuracy ? LMGI_ON : 0;
     double started = lm_cli_now();
     d.progress = a->quiet && !(share && share->progress) ? NULL : show;
     d.progress_user = &started;

@@ -117,7 +117,7 @@ int lm_cli_bench_edits(const lm_cli_args *a)
     lm_edit_frame *rows = calloc((size_t)s.frames, sizeof *rows);
     lmgi_updater_desc d; /* the photon and gather options given; the frame and progress as the zero desc's */
     lm_cli_updater_desc(a, &d);
-    d.frame_width = d.frame_height = 0;
+    d.frame.width = d.frame.height = 0;
     d.progress = NULL;
     d.progress_user = NULL;
     int ok = rows && lm_edit_script_play(&s, a->files[0], &d, s.budget_ms, NULL, rows);

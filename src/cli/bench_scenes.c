@@ -57,7 +57,7 @@ static void check_one(lmgi_context *ctx, const char *path)
     }
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.frame_width = d.frame_height = SIZE;
+    d.frame.width = d.frame.height = SIZE;
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
     rd.target_error = REF_ERROR;

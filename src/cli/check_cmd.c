@@ -100,7 +100,7 @@ int lm_cli_check(const lm_cli_args *a)
     lm_cli_updater_desc(a, &d);
     d.progress = NULL;
     if (!a->width)
-        d.frame_width = d.frame_height = 0; /* lmgi_check's picture: the reference's pixels take seconds */
+        d.frame.width = d.frame.height = 0; /* lmgi_check's picture: the reference's pixels take seconds */
     lmgi_reference_desc rd;
     lm_cli_reference_desc(a, &rd);
     lmgi_context *ctx = NULL;

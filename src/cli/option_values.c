@@ -106,21 +106,6 @@ int lm_cli_opt_size(const char *opt, const char *v, lm_cli_args *a)
     return 0;
 }
 
-/* Photon groups: 2^a 3^b (their Halton strata, docs/photons.md), checked here so that a bad value is a bad
- * command line (exit 2), not a scene that failed. */
-int lm_cli_opt_groups(const char *opt, const char *v, lm_cli_args *a)
-{
-    int rc = lm_cli_parse_int(opt, v, 1, 1 << 20, &a->groups);
-    if (rc)
-        return rc;
-    int n = a->groups;
-    while (n % 2 == 0)
-        n /= 2;
-    while (n % 3 == 0)
-        n /= 3;
-    return n == 1 ? 0 : lm_cli_bad(opt, v, "2^a 3^b groups (1, 2, 3, 4, 6, 8, 9, 12, ..., 72, ...) up to 2^20");
-}
-
 int lm_cli_add_file(const char **list, int *count, const char *f)
 {
     if (*count >= LM_CLI_MAX_FILES) {
@@ -131,8 +116,7 @@ int lm_cli_add_file(const char **list, int *count, const char *f)
     return 0;
 }
 
-/* v, one of the n names, as its value into *out; else "expected a, b or c". */
-static int choose(const char *o, const char *v, const char *const names[], const int values[], int n, int *out)
+int lm_cli_choose(const char *o, const char *v, const char *const names[], const int values[], int n, int *out)
 {
     for (int k = 0; v && k < n; k++)
         if (!strcmp(v, names[k]))
@@ -146,26 +130,18 @@ static int choose(const char *o, const char *v, const char *const names[], const
     return lm_cli_bad(o, v, want);
 }
 
-/* --emitter-light closed|drawn: 1 or 0 (unset: -1, the frame loop's choice per scene). */
-int lm_cli_opt_emitter_light(const char *o, const char *v, lm_cli_args *a)
-{
-    static const char *const names[] = {"closed", "drawn"};
-    static const int values[] = {1, 0};
-    return choose(o, v, names, values, 2, &a->emitter_light);
-}
-
 int lm_cli_opt_tonemap(const char *o, const char *v, lm_cli_args *a)
 {
     static const char *const names[] = {"neutral", "clamp"};
     static const int values[] = {LMGI_TONEMAP_NEUTRAL, LMGI_TONEMAP_CLAMP};
-    return choose(o, v, names, values, 2, &a->tonemap);
+    return lm_cli_choose(o, v, names, values, 2, &a->tonemap);
 }
 
 /* A comma-separated list of -effect (left out) or +effect (kept), effect one of shadows, indirect,
  * reflections, caustics: the effects_off bits of lmgi_updater_desc. */
 int lm_cli_opt_effects(const char *o, const char *v, lm_cli_args *a)
 {
-    unsigned *off = &a->effects_off;
+    unsigned *off = &a->desc.effects_off;
     static const char *names[4] = {"shadows", "indirect", "reflections", "caustics"};
     static const unsigned bits[4] = {LMGI_EFFECT_SHADOWS, LMGI_EFFECT_INDIRECT, LMGI_EFFECT_REFLECTIONS,
                                      LMGI_EFFECT_CAUSTICS};
@@ -184,40 +160,12 @@ int lm_cli_opt_effects(const char *o, const char *v, lm_cli_args *a)
     return v && *v ? 0 : lm_cli_bad(o, v, "a list such as -shadows,-indirect");
 }
 
-int lm_cli_opt_caustic_space(const char *o, const char *v, lm_cli_args *a)
-{
-    static const char *const names[] = {"screen", "world"};
-    static const int values[] = {0, 1};
-    return choose(o, v, names, values, 2, &a->caustic_world);
-}
-
 int lm_cli_opt_indirect(const char *o, const char *v, lm_cli_args *a)
 {
     static const char *const names[] = {"lightmap", "tiled", "hashgrid", "bruteforce"};
     static const int values[] = {LMGI_INDIRECT_LIGHTMAP, LMGI_INDIRECT_TILED, LMGI_INDIRECT_HASHGRID,
                                  LMGI_INDIRECT_BRUTEFORCE};
-    return choose(o, v, names, values, 4, &a->indirect);
-}
-
-int lm_cli_opt_aim_direct(const char *o, const char *v, lm_cli_args *a)
-{
-    static const char *const names[] = {"emitters", "photons", "all"};
-    static const int values[] = {LMGI_AIM_DIRECT_EMITTERS, LMGI_AIM_DIRECT_PHOTONS, LMGI_AIM_DIRECT_ALL};
-    return choose(o, v, names, values, 3, &a->aim_direct);
-}
-
-int lm_cli_opt_find_portals(const char *o, const char *v, lm_cli_args *a)
-{
-    static const char *const names[] = {"on", "off"};
-    static const int values[] = {0, -1};
-    return choose(o, v, names, values, 2, &a->find_portals);
-}
-
-int lm_cli_opt_scheme(const char *o, const char *v, lm_cli_args *a)
-{
-    static const char *const names[] = {"viewports", "instanced", "layered", "rays"};
-    static const int values[] = {0, 1, 2, 3}; /* lm_gather_scheme's order */
-    return choose(o, v, names, values, 4, &a->gather_scheme);
+    return lm_cli_choose(o, v, names, values, 4, (int *)&a->desc.indirect);
 }
 
 int lm_cli_opt_scaling(const char *o, const char *v, lm_cli_args *a)
@@ -242,31 +190,3 @@ int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a)
     return 0;
 }
 
-int lm_cli_opt_caustic_retrace(const char *o, const char *v, lm_cli_args *a)
-{
-    if (lm_cli_parse_float(o, v, 0.0f, &a->caustic_retrace))
-        return 2;
-    return a->caustic_retrace > 0.0f && a->caustic_retrace <= 1.0f
-               ? 0 : lm_cli_bad(o, v, "a share of the caustic photons in (0, 1]");
-}
-
-int lm_cli_opt_photon_tile(const char *o, const char *v, lm_cli_args *a)
-{
-    if (lm_cli_parse_int(o, v, 4, 32, &a->photon_tile))
-        return 2;
-    return (a->photon_tile & (a->photon_tile - 1)) == 0 ? 0 : lm_cli_bad(o, v, "4, 8, 16 or 32 pixels");
-}
-
-int lm_cli_opt_hemicube_samples(const char *o, const char *v, lm_cli_args *a)
-{
-    if (lm_cli_parse_int(o, v, 1, 4, &a->hemicube_samples))
-        return 2;
-    return a->hemicube_samples == 2 || a->hemicube_samples == 3 ? lm_cli_bad(o, v, "1 or 4") : 0;
-}
-
-int lm_cli_opt_photon_radius(const char *o, const char *v, lm_cli_args *a)
-{
-    if (lm_cli_parse_float(o, v, 0.0f, &a->photon_radius))
-        return 2;
-    return a->photon_radius > 0.0f ? 0 : lm_cli_bad(o, v, "a radius in scene units, above 0");
-}

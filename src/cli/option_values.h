@@ -11,25 +11,17 @@ int lm_cli_parse_int(const char *opt, const char *v, int lo, int hi, int *out);
 int lm_cli_parse_float(const char *opt, const char *v, float lo, float *out);
 /* A scene file named on the command line (at most LM_CLI_MAX_FILES). */
 int lm_cli_add_file(const char **list, int *count, const char *f);
+/* v, one of the n names, as its value into *out; else "expected a, b or c" (the names in their order). */
+int lm_cli_choose(const char *o, const char *v, const char *const names[], const int values[], int n, int *out);
 
 int lm_cli_opt_sky(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_size(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_groups(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_emitter_light(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_tonemap(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_effects(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_caustic_space(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_indirect(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_aim_direct(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_find_portals(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_scheme(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_scaling(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_seed(const char *o, const char *v, lm_cli_args *a);
 /* --shard K/N: share K of N, 1 <= K <= N <= 4096. */
 int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_caustic_retrace(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_photon_tile(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_hemicube_samples(const char *o, const char *v, lm_cli_args *a);
-int lm_cli_opt_photon_radius(const char *o, const char *v, lm_cli_args *a);
 
 #endif

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "knob_options.h"
 #include "option_values.h"
 
 const lm_cli_command lm_cli_commands[] = {
@@ -59,7 +60,7 @@ const lm_cli_command lm_cli_commands[] = {
 
 /* The commands that make an updater from the options (lm_cli_updater_desc), that solve a reference
  * (lm_cli_reference_desc), and that write into --out. */
-#define UPDATER (LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_MERGE | LM_CMD_CHECK | LM_CMD_BENCH)
+#define UPDATER LM_CMD_UPDATER
 #define BAKES (LM_CMD_BAKE | LM_CMD_MERGE)
 #define REFERENCE_USERS (LM_CMD_REFERENCE | LM_CMD_CHECK | LM_CMD_TRADEOFF)
 #define OUTPUTS (LM_CMD_CHARTS | LM_CMD_RUN | BAKES | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF)
@@ -103,26 +104,6 @@ const lm_cli_option lm_cli_options[] = {
      "frame it checks)"},
     {"--seed", NULL, "N", UPDATER | REFERENCE_USERS, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_seed,
      "the random sequences' seed (photons' scramble, the reference's paths)"},
-    {"--photons", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, photons), 1, 100000000, NULL,
-     "total photon budget (default: groups x per-group, at least 46,080; bake:\n"
-     "4 a texel of its atlas, 46,080 to 1,048,576)"},
-    {"--groups", NULL, "G", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_groups,
-     "photon groups, 2^a 3^b (default 72)"},
-    {"--per-group", NULL, "M", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, per_group), 1, 10000000, NULL,
-     "photons per group"},
-    {"--retrace", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, retrace), 1, 1000000, NULL,
-     "photons per group re-traced a frame, round robin, while anything can move\n"
-     "(default 1)"},
-    {"--group-budget", NULL, "B", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, group_budget), 0, 10000000, NULL,
-     "invalid photon groups re-traced a frame, oldest first (default 16; 0: every\n"
-     "one at once)"},
-    {"--nearest", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, nearest), 1, 100000, NULL,
-     "photons per AIM estimate (default 32)"},
-    {"--shadow-maps-per-frame", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, shadow_maps), 0, 1000000, NULL,
-     "stale shadow maps re-rendered a frame once something moved, brightest\n"
-     "and nearest to it first (default 4; 0: all at once)"},
-    {"--surfaces-per-frame", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, surface_budget), 0, 10000000, NULL,
-     "AIM refreshes a frame (default 4)"},
     {"--target-error", NULL, "E", REFERENCE_USERS, LM_OPT_FLOAT, offsetof(lm_cli_args, target_error), 1e-6, 0, NULL,
      "the reference's relative standard error per texel or pixel (default 0.02;\n"
      "tradeoff: 0.03)"},
@@ -142,90 +123,29 @@ const lm_cli_option lm_cli_options[] = {
      "solve the reference again, keeping none"},
     {"--camera", NULL, "I", UPDATER | LM_CMD_REFERENCE, LM_OPT_INT, offsetof(lm_cli_args, camera), 0, 1000000, NULL,
      "the file's camera I (default: its first, else one framing the scene)"},
-    {"--texels-per-frame", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, texels_per_frame), 1, 100000000, NULL,
-     "IIM texels gathered per frame (default 20)"},
     {"--exr-every", NULL, "K", LM_CMD_RUN, LM_OPT_INT, offsetof(lm_cli_args, exr_every), 1, 1000000, NULL,
      "every K-th frame also as linear EXR (default 10)"},
-    {"--hemicube", NULL, "R", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, hemicube), 2, 1024, NULL,
-     "hemicube plane pixels per side (default 32)"},
-    {"--hemicube-samples", NULL, "N", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_hemicube_samples,
-     "AIM lookups per hemicube pixel, 1 or 4 (default 4: no banding)"},
-    {"--hemicube-coverage", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, hemicube_coverage), 1, 16, NULL,
-     "coverage samples per hemicube pixel, 1 to 16 within the GL's limit\n"
-     "(llvmpipe: 4; default: 4 when emissive triangles are drawn into the\n"
-     "hemicubes, whose small images alias, else 1)"},
-    {"--emitter-light", NULL, "M", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_emitter_light,
-     "closed (the light of emissive triangles in closed form, visibility by\n"
-     "shadow rays: no plaid, no coverage samples needed) or drawn into the\n"
-     "hemicubes (default: closed when the scene has 1 to 64 emissive triangles)"},
-    {"--emitter-rays", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, emitter_rays), 1, 65536, NULL,
-     "shadow rays per emissive triangle and texel (default 32)"},
     {"--tonemap", NULL, "T", LM_CMD_RUN | LM_CMD_REFERENCE, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_tonemap,
      "how PNGs show light: neutral (Khronos PBR Neutral, exposure from the\n"
      "median; the default) or clamp (linear, exposure from the 99th\n"
      "percentile); EXRs keep the linear numbers either way"},
-    {"--in-order", NULL, NULL, UPDATER, LM_OPT_FLAG, offsetof(lm_cli_args, in_order), 0, 0, NULL,
+    {"--in-order", NULL, NULL, UPDATER, LM_OPT_FLAG, offsetof(lm_cli_args, desc.in_order), 0, 0, NULL,
      "the photon stage before the gather and render, on one thread (the paper's\n"
      "order; default: its tracing and AIM refresh run on a second thread beside\n"
      "the render, after the gather, which then sees the previous frame's AIMs)"},
-    {"--enlargement", NULL, "A", UPDATER, LM_OPT_FLOAT, offsetof(lm_cli_args, enlargement), 1e-3, 0, NULL,
-     "hemicube plane half-side a (default 2)"},
-    {"--rim-samples", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, rim_samples), 0, 65536, NULL,
-     "rays per texel for the light of the hemisphere's rim outside the plane\n"
-     "(default 64); 0: the paper's 1 / F(a) extrapolation (surfaces 10-30% off\n"
-     "where a bright spot lies near their horizon)"},
-    {"--aim-direct", NULL, "M", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_aim_direct,
-     "where the AIMs' direct light comes from: photons (the default: first\n"
-     "hits, the paper's form, blurred by the estimate's radius), emitters\n"
-     "(emissive triangles' light computed per texel: sharp contact shadows,\n"
-     "about 5x slower AIMs) or all (punctual lights' too)"},
-    {"--find-portals", NULL, "on|off", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_find_portals,
-     "the windows a sun's or the sky's light gets in by, found where the file\n"
-     "tags no portal, half their photons drawn through them (default on; off:\n"
-     "the file's portals only; docs/levels.md, \"Portals\")"},
     {"--indirect", NULL, "P", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_indirect,
      "how frames get indirect light: lightmap (the default: AIMs, hemicube\n"
      "gather, IIM), or every visible pixel gathers the photons on the GPU (Mara\n"
      "et al. 2013): tiled (per screen tile, from shared memory), hashgrid (per\n"
      "pixel from a hash grid) or bruteforce (every photon against every pixel:\n"
      "the ground truth, small frames only)"},
-    {"--photon-tile", NULL, "N", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_tile,
-     "with --indirect tiled: tile side, 4, 8, 16 or 32 (default 16)"},
-    {"--photon-chunk", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, photon_chunk), 64, 512, NULL,
-     "with --indirect tiled: photons per shared-memory load, 64 to 512\n"
-     "(default 256)"},
-    {"--photon-stochastic", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, photon_stochastic), 1, 4, NULL,
-     "with --indirect tiled: each pixel reads 1/k^2 of its tile's photons,\n"
-     "then an edge-aware k x k average (1 to 4; default 1: all)"},
-    {"--photon-radius", NULL, "R", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_photon_radius,
-     "the per-pixel gathers' kernel radius (default: the disc of --nearest\n"
-     "photons)"},
     {"--effects", NULL, "LIST", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_effects,
      "effects left out (-) or kept (+) whatever the scene calls for: -shadows\n"
      "(no shadow maps), -indirect (no photon, AIM or gather work: direct light\n"
      "only), -reflections (no environment maps), -caustics (no caustic photons,\n"
      "no caustic pass)"},
-    {"--reflection-size", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, reflection_size), 0, 4096, NULL,
-     "texels per side of the environment cube map of each mirror, glossy or\n"
-     "glass node (default 128; 0: no reflections, mirrors black)"},
-    {"--reflection-faces", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, reflection_faces), 1, 1 << 20, NULL,
-     "most environment map faces re-rendered a frame, those whose view changed\n"
-     "longest ago first, after all of them at the first frame (default 1; a\n"
-     "still scene renders none)"},
-    {"--caustic-retrace", NULL, "F", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_retrace,
-     "share of the caustic photons re-traced a frame while anything moves\n"
-     "(default 0.25; a moved light or mirror/glass node re-traces its own)"},
-    {"--caustic-filter", NULL, "K", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, caustic_filter), 0, 8, NULL,
-     "k of the caustics' (2k+1)^2 cone filter, 0 to 8 (default 3)"},
-    {"--caustic-space", NULL, "S", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_caustic_space,
-     "screen (default, the paper's filter) or world (by world distance)"},
-    {"--caustic-tile", NULL, "N", UPDATER, LM_OPT_INT, offsetof(lm_cli_args, caustic_tile), 4, 256, NULL,
-     "screen tile side of the caustics' occlusion queries (default 32)"},
-    {"--gather-scheme", NULL, "S", UPDATER, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_scheme,
-     "hemicubes by viewports, instanced or layered (layered has no\n"
-     "multisampled target: coverage 1 unless given), or rays (Embree over each\n"
-     "texel's hemisphere, no hemicube); default: rays above 20,000 triangles on\n"
-     "a software GL, else viewports (docs/gather.md, \"Rays\")"},
+    /* here the updater's knobs, stage by stage (knob_options.c, from include/lmgi_knobs.h) */
+    {"", NULL, NULL, 0, LM_OPT_KNOBS, 0, 0, 0, NULL, NULL},
     {"--repeats", NULL, "N", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_INT, offsetof(lm_cli_args, repeats), 1, 100, NULL,
      "runs per measurement, the median is reported (default 3)"},
     {"--json", NULL, "FILE", LM_CMD_BENCH, LM_OPT_TEXT, offsetof(lm_cli_args, json_path), 0, 0, NULL,
@@ -291,11 +211,29 @@ const lm_cli_command *lm_cli_find_command(const char *name)
     return NULL;
 }
 
+/* Every option in the help's order, NULL-terminated: the table's, with the updater's knobs that have a
+ * flag where its LM_OPT_KNOBS entry stands. */
+static const lm_cli_option *const *all_options(void)
+{
+    static const lm_cli_option *all[192];
+    if (!all[0]) {
+        int n = 0;
+        for (const lm_cli_option *o = lm_cli_options; o->name && n < 190; o++) {
+            if (o->kind != LM_OPT_KNOBS)
+                all[n++] = o;
+            for (int k = 0; o->kind == LM_OPT_KNOBS && k < lm_cli_knob_option_count && n < 190; k++)
+                if (lm_cli_knob_options[k].name)
+                    all[n++] = &lm_cli_knob_options[k];
+        }
+    }
+    return all;
+}
+
 const lm_cli_option *lm_cli_find_option(const char *word)
 {
-    for (const lm_cli_option *o = lm_cli_options; o->name; o++)
-        if (!strcmp(o->name, word) || (o->alias && !strcmp(o->alias, word)))
-            return o;
+    for (const lm_cli_option *const *o = all_options(); *o; o++)
+        if (!strcmp((*o)->name, word) || ((*o)->alias && !strcmp((*o)->alias, word)))
+            return *o;
     return NULL;
 }
 
@@ -327,12 +265,12 @@ const lm_cli_option *lm_cli_nearest_option(const char *word, unsigned commands)
 {
     const lm_cli_option *best = NULL;
     int best_d = 1 << 30;
-    for (const lm_cli_option *o = lm_cli_options; o->name; o++) {
-        if (!(o->commands & commands))
+    for (const lm_cli_option *const *o = all_options(); *o; o++) {
+        if (!((*o)->commands & commands))
             continue;
-        int d = distance(word, o->name);
+        int d = distance(word, (*o)->name);
         if (d < best_d)
-            best = o, best_d = d;
+            best = *o, best_d = d;
     }
     /* a slip of a key or two, or a third of a long name */
     int near = (int)strlen(word) / 3 > 2 ? (int)strlen(word) / 3 : 2;
@@ -399,9 +337,9 @@ void lm_cli_print_help(FILE *f)
     }
     fprintf(f, "  help [COMMAND]\n      this text, or the command's\n\noptions (the commands that take "
                "each in brackets, where not every one):\n");
-    for (const lm_cli_option *o = lm_cli_options; o->name; o++)
-        if (o->commands)
-            print_option(f, o, 1);
+    for (const lm_cli_option *const *o = all_options(); *o; o++)
+        if ((*o)->commands)
+            print_option(f, *o, 1);
 }
 
 void lm_cli_print_command_help(FILE *f, const lm_cli_command *c)
@@ -409,7 +347,7 @@ void lm_cli_print_command_help(FILE *f, const lm_cli_command *c)
     fprintf(f, "usage: lmgi %s [OPTIONS]\n\n", c->usage);
     print_lines(f, c->help, 0, 0);
     fprintf(f, "\noptions:\n");
-    for (const lm_cli_option *o = lm_cli_options; o->name; o++)
-        if (o->commands & c->bit)
-            print_option(f, o, 0);
+    for (const lm_cli_option *const *o = all_options(); *o; o++)
+        if ((*o)->commands & c->bit)
+            print_option(f, *o, 0);
 }

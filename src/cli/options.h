@@ -3,7 +3,10 @@
  * `lmgi COMMAND --help` print the same table, so the help cannot drift from what is accepted.
  *
  * Layout: lm_cli_options[] ends with a zeroed entry; an option's `commands` is a set of LM_CMD_* bits
- * (0: lmgi-dev's alone). Thread-safety: read-only tables. Errors: none here; the parser reports. */
+ * (0: lmgi-dev's alone). The updater's knobs are options made from their own table (knob_options.h),
+ * found and printed with these where the LM_OPT_KNOBS entry stands. Thread-safety: read-only tables (the
+ * first lookup lists them all: one thread).
+ * Errors: none here; the parser reports. */
 #ifndef LM_CLI_OPTIONS_H
 #define LM_CLI_OPTIONS_H
 
@@ -15,10 +18,13 @@
 enum {
     LM_CMD_INFO = 1u << 0, LM_CMD_CHARTS = 1u << 1, LM_CMD_RUN = 1u << 2, LM_CMD_BAKE = 1u << 3,
     LM_CMD_CHECK = 1u << 4, LM_CMD_REFERENCE = 1u << 5, LM_CMD_BENCH = 1u << 6, LM_CMD_TRADEOFF = 1u << 7,
-    LM_CMD_MERGE = 1u << 8, LM_CMD_ALL = (1u << 9) - 1
+    LM_CMD_MERGE = 1u << 8, LM_CMD_ALL = (1u << 9) - 1,
+    /* the commands that make an updater from the options (lm_cli_updater_desc): its knobs' */
+    LM_CMD_UPDATER = LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_MERGE | LM_CMD_CHECK | LM_CMD_BENCH
 };
 
-typedef enum { LM_OPT_FLAG, LM_OPT_INT, LM_OPT_FLOAT, LM_OPT_TEXT, LM_OPT_CUSTOM } lm_cli_option_kind;
+/* LM_OPT_KNOBS: no option, the place of the updater's knobs (knob_options.h) in the help's order. */
+typedef enum { LM_OPT_FLAG, LM_OPT_INT, LM_OPT_FLOAT, LM_OPT_TEXT, LM_OPT_CUSTOM, LM_OPT_KNOBS } lm_cli_option_kind;
 
 typedef struct {
     const char *name, *alias; /* "--out", "-o" (alias NULL: none) */

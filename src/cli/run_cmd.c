@@ -41,45 +41,12 @@ static void gather_progress(void *user, float fraction, const char *stage)
 
 void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
 {
-    memset(d, 0, sizeof *d); /* 0: the defaults */
-    d->texels_per_frame = a->texels_per_frame;
-    d->photons = (uint32_t)a->photons;
-    d->groups = (uint32_t)a->groups;
-    d->photons_per_group = (uint32_t)a->per_group;
-    d->retrace_per_group = (uint32_t)a->retrace;
-    d->group_budget = a->group_budget < 0 ? 0 : a->group_budget == 0 ? UINT32_MAX : (uint32_t)a->group_budget;
-    d->seed = a->seed;
-    d->photons_per_estimate = a->nearest;
-    d->surfaces_per_frame = a->surface_budget;
-    d->shadow_maps_per_update = a->shadow_maps < 0 ? 0 : a->shadow_maps == 0 ? -1 : a->shadow_maps;
-    d->hemicube_resolution = a->hemicube;
-    d->hemicube_samples = a->hemicube_samples;
-    d->hemicube_coverage = a->hemicube_coverage; /* 0: chosen per scene */
-    d->enlargement = a->enlargement > 0.0f ? a->enlargement : 0.0f;
-    d->rim_samples = a->rim_samples < 0 ? 0 : a->rim_samples == 0 ? -1 : a->rim_samples;
-    d->reflection_size = a->reflection_size < 0 ? 0 : a->reflection_size == 0 ? -1 : a->reflection_size;
-    d->reflection_faces = a->reflection_faces;
-    d->caustic_photons = (uint32_t)a->caustic_photons;
-    d->caustic_retrace = a->caustic_retrace;
-    d->caustic_filter = a->caustic_filter < 0 ? 0 : a->caustic_filter == 0 ? -1 : a->caustic_filter;
-    d->caustic_tile = a->caustic_tile;
-    d->caustic_world_filter = a->caustic_world;
-    d->effects_off = a->effects_off;
-    d->indirect = (lmgi_indirect_path)a->indirect;
-    d->photon_tile = a->photon_tile;
-    d->photon_chunk = a->photon_chunk;
-    d->photon_stochastic = a->photon_stochastic;
-    d->photon_radius = a->photon_radius;
-    d->aim_direct = (lmgi_aim_direct)a->aim_direct;
-    d->find_portals = a->find_portals;
-    d->gather_scheme = a->gather_scheme < 0 ? LMGI_GATHER_DEFAULT : (lmgi_gather_scheme)(a->gather_scheme + 1);
-    d->emitter_light = a->emitter_light < 0 ? LMGI_EMITTERS_AUTO
-                       : a->emitter_light ? LMGI_EMITTERS_CLOSED_FORM : LMGI_EMITTERS_DRAWN;
-    d->emitter_rays = a->emitter_rays;
-    d->in_order = a->in_order;
-    d->frame_width = a->width ? a->width : LM_CLI_FRAME_SIZE;
-    d->frame_height = a->width ? a->height : LM_CLI_FRAME_SIZE;
-    d->camera = a->camera;
+    *d = a->desc; /* the knobs as the options gave them (0: the defaults) */
+    d->photons.seed = a->seed;
+    d->caustics.photons = (uint32_t)a->caustic_photons;
+    d->frame.width = a->width ? a->width : LM_CLI_FRAME_SIZE;
+    d->frame.height = a->width ? a->height : LM_CLI_FRAME_SIZE;
+    d->frame.camera = a->camera;
     if (!a->quiet) {
         static double started;
         started = lm_cli_now();
@@ -190,7 +157,7 @@ static void print_effects(const run_state *r)
         lmgi_get_effect(r->sc, i, &e);
         int off = 0;
         for (int k = 0; k < 4; k++)
-            off |= !strcmp(e.name, run_off[k].name) && (r->a->effects_off & run_off[k].bit);
+            off |= !strcmp(e.name, run_off[k].name) && (r->a->desc.effects_off & run_off[k].bit);
         printf("%-11s %s: %s\n", i ? "" : "effects", e.name, off ? "off (left out by --effects)" : e.on ? "on" : "off");
         if (!off)
             printf("%-11s   %s\n", "", e.reason);
@@ -225,24 +192,24 @@ static void summary(const run_state *r, int frames)
     int lightmap = !strcmp(ui.indirect, "lightmap");
     if (lightmap) { /* the hemicube gather's settings; the photon paths have none */
         printf("gather      R %d, a %g, %d AIM lookup%s and %d coverage sample%s per pixel, %s scheme; ",
-               ui.hemicube_resolution, (double)ui.enlargement, ui.hemicube_samples,
-               ui.hemicube_samples > 1 ? "s" : "", ui.hemicube_coverage, ui.hemicube_coverage > 1 ? "s" : "",
+               ui.gather.resolution, (double)ui.gather.enlargement, ui.gather.samples,
+               ui.gather.samples > 1 ? "s" : "", ui.gather.coverage, ui.gather.coverage > 1 ? "s" : "",
                ui.gather_scheme);
         if (!ui.emissive_triangles)
             printf("no emissive triangles\n");
         else if (ui.emitters_closed_form)
             printf("%u emissive triangles in closed form (%d shadow rays each)\n", ui.emissive_triangles,
-                   ui.emitter_rays);
+                   ui.gather.emitter_rays);
         else
             printf("%u emissive triangles drawn\n", ui.emissive_triangles);
     }
     lmgi_info in;
     lmgi_get_info(r->sc, &in);
-    int per_frame = ui.texels_per_frame;
+    int per_frame = ui.gather.texels_per_frame;
     if (!lightmap)
         printf("indirect    %s photon gather per pixel: radius %.4g, tile %d, chunk %d, k %d; %llu gathers, "
-               "%llu list entries\n", ui.indirect, (double)ui.photon_radius, ui.photon_tile, ui.photon_chunk,
-               ui.photon_stochastic, (unsigned long long)r->photon_gathers, (unsigned long long)r->photon_entries);
+               "%llu list entries\n", ui.indirect, (double)ui.tiled.radius, ui.tiled.tile, ui.tiled.chunk,
+               ui.tiled.stochastic, (unsigned long long)r->photon_gathers, (unsigned long long)r->photon_entries);
     char atlas[96];
     lm_cli_atlas_size(atlas, sizeof atlas, &in);
     printf("atlas       %s, %u texels of %.4g units: regathered in full every %u frames at %d a frame\n", atlas,
@@ -318,7 +285,7 @@ int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc)
 {
     lmgi_options o = a->options;
     if (o.texel_size <= 0.0f && o.target_texels <= 0) { /* a density the texel budget keeps up with */
-        o.target_texels = lmgi_atlas_texels_for(a->texels_per_frame);
+        o.target_texels = lmgi_atlas_texels_for(a->desc.gather.texels_per_frame);
         o.wall_texels = LM_CLI_RUN_WALL_TEXELS; /* and that a level's walls show */
     }
     return lm_cli_load_scene(a->files[0], &o, 1, sc);

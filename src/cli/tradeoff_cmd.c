@@ -169,7 +169,7 @@ static int time_and_lightmaps(lmgi_context *ctx, const atlas_state *as, const lm
                               lmgi_error *err)
 {
     lmgi_updater_desc d = s->desc;
-    d.frame_width = width, d.frame_height = height;
+    d.frame.width = width, d.frame.height = height;
     int nu = repeats * updates;
     double *v = malloc(sizeof *v * (size_t)(12 * (repeats + nu)));
     if (!v) {
@@ -190,8 +190,8 @@ static int time_and_lightmaps(lmgi_context *ctx, const atlas_state *as, const lm
         lmgi_get_updater_info(u, &info);
         trace[r] = info.ms_setup_trace, aim[r] = info.ms_setup_aim, gather[r] = info.ms_setup_gather;
         solution[r] = trace[r] + aim[r] + gather[r];
-        m->photons = info.photons;
-        m->coverage = info.hemicube_coverage;
+        m->photons = info.stored_photons;
+        m->coverage = info.gather.coverage;
         if (r == 0 && s->desc.indirect == LMGI_INDIRECT_LIGHTMAP)
             ok = lightmap_errors(u, as, m, err);
         for (int f = 0; f <= updates && ok; f++) {
@@ -206,7 +206,7 @@ static int time_and_lightmaps(lmgi_context *ctx, const atlas_state *as, const lm
         }
         if (ok && r == 0) {
             lmgi_get_updater_info(u, &info);
-            m->photon_radius = info.photon_radius;
+            m->photon_radius = info.tiled.radius;
         }
         lmgi_updater_free(u);
     }
@@ -238,7 +238,7 @@ static int measure(lmgi_context *ctx, const atlas_state *as, const lm_tradeoff_s
     m->aim = m->iim = m->frame = (lm_tradeoff_error){NAN, NAN, NAN, 0};
     lmgi_error err;
     lmgi_updater_desc d = s->desc;
-    d.frame_width = width, d.frame_height = height;
+    d.frame.width = width, d.frame.height = height;
     if (!time_and_lightmaps(ctx, as, s, repeats, updates, width, height, m, &err) ||
         !frame_errors(ctx, as, &d, rd, m, &err)) {
         fprintf(stderr, "lmgi: error: %s = %s: %s\n", s->knob, s->value, err.message);
@@ -253,7 +253,7 @@ static float tiled_radius(lmgi_context *ctx, lmgi_scene *sc, int width, int heig
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     d.indirect = LMGI_INDIRECT_TILED;
-    d.frame_width = width, d.frame_height = height;
+    d.frame.width = width, d.frame.height = height;
     lmgi_updater *u = NULL;
     lmgi_error err;
     float r = 0.0f;
@@ -261,7 +261,7 @@ static float tiled_radius(lmgi_context *ctx, lmgi_scene *sc, int width, int heig
         lmgi_update(u, 0.0f, 0.0f, NULL, &err) == LMGI_OK) {
         lmgi_updater_info info;
         lmgi_get_updater_info(u, &info);
-        r = info.photon_radius;
+        r = info.tiled.radius;
     }
     lmgi_updater_free(u);
     return r;
@@ -310,11 +310,11 @@ static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_scrip
             memset(&d, 0, sizeof d);
             if (!is_default) {
                 if (b == 0)
-                    d.texels_per_frame = v;
+                    d.gather.texels_per_frame = v;
                 else if (b == 1)
-                    d.group_budget = (uint32_t)v;
+                    d.photons.group_budget = v;
                 else
-                    d.surfaces_per_frame = v;
+                    d.aim.surfaces_per_frame = v;
             }
             p->frames = calloc((size_t)script->frames, sizeof *p->frames);
             p->frame_lag = is_default && a->frame_lag;

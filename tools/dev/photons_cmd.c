@@ -23,23 +23,25 @@
 void lm_dev_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
 {
     lm_photon_stage_settings_default(s);
-    if (a->photons)
-        s->photons.total_photons = (uint32_t)a->photons;
-    if (a->groups)
-        s->photons.groups = (uint32_t)a->groups;
-    if (a->per_group)
-        s->photons.per_group = (uint32_t)a->per_group, s->photons.min_total = 0;
-    if (a->retrace)
-        s->photons.retrace_per_group = (uint32_t)a->retrace;
-    if (a->group_budget >= 0) /* given: 0 is every invalid group, as for lm_photons */
-        s->photons.group_budget = (uint32_t)a->group_budget;
+    const lmgi_photon_knobs *ph = &a->desc.photons;
+    if (ph->count)
+        s->photons.total_photons = ph->count;
+    if (ph->groups)
+        s->photons.groups = ph->groups;
+    if (ph->per_group)
+        s->photons.per_group = ph->per_group, s->photons.min_total = 0;
+    if (ph->retrace_per_group)
+        s->photons.retrace_per_group = ph->retrace_per_group;
+    if (ph->group_budget) /* given: LMGI_OFF is every invalid group, lm_photons' 0 */
+        s->photons.group_budget = ph->group_budget == LMGI_OFF ? 0 : (uint32_t)ph->group_budget;
     if (a->seed)
         s->photons.seed = a->seed;
-    if (a->nearest)
-        s->aim.n_nearest = a->nearest;
-    if (a->surface_budget)
-        s->surfaces_per_frame = a->surface_budget;
-    s->exact_direct = a->aim_direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : a->aim_direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
+    if (a->desc.aim.nearest)
+        s->aim.n_nearest = a->desc.aim.nearest;
+    if (a->desc.aim.surfaces_per_frame)
+        s->surfaces_per_frame = a->desc.aim.surfaces_per_frame;
+    lmgi_aim_direct direct = a->desc.aim.direct;
+    s->exact_direct = direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
 }
 
 static void csv_header(FILE *f)
