@@ -8,7 +8,7 @@
 #   make bench      timings (never part of the tests)
 #   make tradeoff   what accuracy costs in time: the quick knob sweep on the generated Cornell box,
 #                   build/tradeoff/report.html (TRADEOFF_SCENES, TRADEOFF_FLAGS: the full sweep)
-#   make install    PREFIX=DIR (default /usr/local): lmgi.h, liblmgi.a/.so, lmgi, lmgi.pc
+#   make install    PREFIX=DIR (default /usr/local): lmgi.h, lmgi_tools.h, liblmgi.a/.so, lmgi, lmgi.pc
 #   make scenes     regenerate scenes/ with tools/gen_scenes
 
 CC      ?= gcc
@@ -101,14 +101,14 @@ SONAME := liblmgi.so.0
 $(BUILD)/liblmgi.so: $(LIB_OBJ) src/api/lmgi.map
 	$(CC) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=src/api/lmgi.map -o $@ $(LIB_OBJ) $(LDFLAGS_ALL) $(LIBS)
 
-# make install PREFIX=DIR: the header, both libraries, the lmgi command and lmgi.pc for pkg-config
+# make install PREFIX=DIR: the headers, both libraries, the lmgi command and lmgi.pc for pkg-config
 # (`cc app.c $$(pkg-config --cflags --libs lmgi)`; add --static for liblmgi.a and its dependencies).
 PREFIX ?= /usr/local
 install: all install-files
 # the copying alone, of what BUILD holds (test_examples installs each build's own libraries this way)
 install-files:
 	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/bin
-	install -m 644 include/lmgi.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 include/lmgi.h include/lmgi_tools.h $(DESTDIR)$(PREFIX)/include/
 	install -m 644 $(BUILD)/liblmgi.a $(DESTDIR)$(PREFIX)/lib/
 	install -m 755 $(BUILD)/liblmgi.so $(DESTDIR)$(PREFIX)/lib/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/liblmgi.so

@@ -1,5 +1,5 @@
 /* The public API's reference: trace/reference.h's solver on a loaded scene, its results as images. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdlib.h>

@@ -2,7 +2,7 @@
 #ifndef LM_LMGI_REFERENCE_H
 #define LM_LMGI_REFERENCE_H
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include "../trace/reference.h"
 

@@ -1,5 +1,5 @@
 /* What the public API reports about a loaded scene: counts, effects, and the charts pictures. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdio.h>

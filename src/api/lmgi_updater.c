@@ -1,6 +1,6 @@
 /* The public API's updater: the frame loop (update/frame_loop.h) behind include/lmgi.h, with a time
  * budget turned into a texel count, per-surface change counters and the lightmaps read back. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdio.h>
