@@ -97,7 +97,9 @@ $(BUILD)/liblmgi.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-SONAME := liblmgi.so.0
+# The version is include/lmgi.h's (LMGI_VERSION_*): the shared library's soname and lmgi.pc follow it
+LMGI_VERSION = $(shell sed -n 's/^\#define LMGI_VERSION_\(MAJOR\|MINOR\|PATCH\) //p' include/lmgi.h | paste -sd.)
+SONAME := liblmgi.so.$(firstword $(subst ., ,$(LMGI_VERSION)))
 $(BUILD)/liblmgi.so: $(LIB_OBJ) src/api/lmgi.map
 	$(CC) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=src/api/lmgi.map -o $@ $(LIB_OBJ) $(LDFLAGS_ALL) $(LIBS)
 
@@ -116,7 +118,7 @@ install-files:
 	install -d $(DESTDIR)$(PREFIX)/share/lmgi
 	install -m 644 tools/tradeoff_report.py $(DESTDIR)$(PREFIX)/share/lmgi/
 	install -m 644 tools/engines/babylon_lmgi_lightmap.js $(DESTDIR)$(PREFIX)/share/lmgi/
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(LMGI_VERSION)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
 
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
 	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)

@@ -33,6 +33,14 @@ extern "C" {
 #define LMGI_API
 #endif
 
+/* The version of this header: a major change breaks sources or binaries built against an earlier one
+ * (liblmgi.so.MAJOR), a minor one adds to the API, a patch changes neither. LMGI_VERSION orders as the
+ * versions do. lmgi_version() (below) says which version the library itself was built as. */
+#define LMGI_VERSION_MAJOR 0
+#define LMGI_VERSION_MINOR 1
+#define LMGI_VERSION_PATCH 0
+#define LMGI_VERSION (LMGI_VERSION_MAJOR * 10000 + LMGI_VERSION_MINOR * 100 + LMGI_VERSION_PATCH)
+
 typedef enum {
     LMGI_OK = 0,
     LMGI_ERR_IO,          /* a file is missing, unreadable or unwritable */
@@ -769,6 +777,10 @@ LMGI_API lmgi_status lmgi_get_lightmap_page(lmgi_updater *u, lmgi_lightmap kind,
  * lmgi_get_lightmap. *texture is 0 on any error. */
 LMGI_API lmgi_status lmgi_get_lightmap_texture(lmgi_updater *u, unsigned *texture, lmgi_error *err);
 
+/* LMGI_VERSION as the library was compiled: a program that loads liblmgi.so at run time compares it with
+ * the LMGI_VERSION it was compiled against (a library older than the header may lack what the program
+ * calls; docs/api.md, "Versions"). */
+LMGI_API int lmgi_version(void);
 LMGI_API const char *lmgi_status_name(lmgi_status s);
 /* What lmgi prints on stderr: 0 errors only, 1 also warnings (default), 2 also progress, 3 debug. */
 LMGI_API void lmgi_set_verbosity(int level);

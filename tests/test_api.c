@@ -1346,6 +1346,16 @@ static void test_shared_bake_is_one_process_bake(void **state)
     close_all(NULL, sc, ctx);
 }
 
+/* The library says the version the header it was built with says, part by part. */
+static void test_version(void **state)
+{
+    (void)state;
+    assert_int_equal(lmgi_version(), LMGI_VERSION);
+    assert_int_equal(lmgi_version() / 10000, LMGI_VERSION_MAJOR);
+    assert_int_equal(lmgi_version() / 100 % 100, LMGI_VERSION_MINOR);
+    assert_int_equal(lmgi_version() % 100, LMGI_VERSION_PATCH);
+}
+
 static void test_exported_symbols(void **state)
 {
     (void)state;
@@ -1400,6 +1410,7 @@ int main(void)
         cmocka_unit_test(test_shard_cancelled_and_resumed),
         cmocka_unit_test(test_shared_bake_is_one_process_bake),
         cmocka_unit_test(test_exported_symbols),
+        cmocka_unit_test(test_version),
     };
     lmgi_set_verbosity(0); /* the refusals below log errors on purpose */
     return cmocka_run_group_tests(tests, NULL, NULL);
