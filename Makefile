@@ -22,8 +22,9 @@ ARCH    ?= -march=native
 SAN     ?=
 WARN    := -Wall -Wextra -Werror
 # The photon tracer's arithmetic may use fused multiply-adds (ISO C mode forbids contraction by default):
-# a multiply and an add are one instruction, rounded once. Only there: elsewhere code such as the atlas's
-# edge functions relies on a * b - c * d being computed the same way whichever way round it is taken.
+# a multiply and an add are one instruction, rounded once. Only there (and in the reference solver,
+# src/reference, which traces with it): elsewhere code such as the atlas's edge functions relies on
+# a * b - c * d being computed the same way whichever way round it is taken.
 # Its square roots are single instructions, without the test for a negative argument that would set
 # errno (nothing reads it).
 TRACE_FP := -ffp-contract=fast -fno-math-errno
@@ -47,8 +48,8 @@ DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenm
                 openmpi-bin libopenmpi-dev libcjson-dev libdraco-dev draco gltfpack \
                 $(NPM_DEB)
 
-LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
-                             src/gpu/*.c src/update/*.c src/api/*.c))
+LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/reference/*.c \
+                             src/photonmap/*.c src/gpu/*.c src/update/*.c src/api/*.c))
 LIB_CXX := $(sort $(wildcard src/scene/*.cpp src/charts/*.cpp))
 CLI_C   := $(sort $(wildcard src/cli/*.c))
 LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o)
@@ -88,6 +89,8 @@ $(BUILD)/obj/%.o: %.c $(BUILD)/flags
 	$(CC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
 
 $(BUILD)/obj/src/trace/%.o: CFLAGS_ALL += $(TRACE_FP)
+# the reference solver was written in trace/ and traces with it: the same arithmetic, the same answers
+$(BUILD)/obj/src/reference/%.o: CFLAGS_ALL += $(TRACE_FP)
 
 $(BUILD)/obj/%.o: %.cpp $(BUILD)/flags
 	@mkdir -p $(dir $@)

@@ -13,7 +13,7 @@
 #include <sys/stat.h>
 
 /* The layers, lowest first: the one list the check and docs/architecture.md's picture follow. */
-static const char *const LAYERS[] = {"core", "scene", "charts", "trace",
+static const char *const LAYERS[] = {"core", "scene", "charts", "trace", "reference",
                                      "photonmap", "gpu", "update", "api", "cli"};
 enum { LAYER_COUNT = sizeof LAYERS / sizeof LAYERS[0] };
 

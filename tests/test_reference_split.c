@@ -15,7 +15,7 @@
 
 #include "../src/core/log.h"
 #include "../src/core/timing.h"
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 #include "support.h"
 
 #define PI 3.14159265358979323846

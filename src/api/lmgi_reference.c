@@ -1,11 +1,11 @@
-/* The public API's reference: trace/reference.h's solver on a loaded scene, its results as images. */
+/* The public API's reference: reference/reference.h's solver on a loaded scene, its results as images. */
 #include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "../trace/reference.h"
+#include "../reference/reference.h"
 #include "lmgi_camera.h"
 #include "lmgi_reference.h"
 #include "lmgi_scene.h"

@@ -4,7 +4,7 @@
 
 #include <lmgi_tools.h>
 
-#include "../trace/reference.h"
+#include "../reference/reference.h"
 
 /* The solver's settings for desc (NULL or zeros: the defaults), checked: LMGI_ERR_INVALID naming the field
  * after fn (the public call's name). */

@@ -4,7 +4,7 @@
 #define LM_CAMERA_H
 
 #include "../scene/scene.h"
-#include "../trace/reference.h"
+#include "../reference/reference.h"
 
 typedef struct {
     float view[16], proj[16];

@@ -35,7 +35,7 @@
 #include "../core/error.h"
 #include "../scene/scene.h"
 #include "../trace/photon_store.h"
-#include "../trace/reference.h"
+#include "../reference/reference.h"
 #include "../trace/rt_scene.h"
 
 /* What each pixel sees: its visible point, the shading normal on the eye's side, and kd there (0 for

@@ -62,8 +62,8 @@
 #include "../charts/charts.h"
 #include "../core/error.h"
 #include "../scene/scene.h"
-#include "lights.h"
-#include "rt_scene.h"
+#include "../trace/lights.h"
+#include "../trace/rt_scene.h"
 
 typedef struct {
     float target_error;    /* relative standard error per texel/pixel to stop at (default 0.02) */

@@ -6,9 +6,9 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
-#include "bsdf.h"
-#include "caustics.h"
-#include "shading.h"
+#include "../trace/bsdf.h"
+#include "../trace/caustics.h"
+#include "../trace/shading.h"
 
 #define CHUNK 65536u      /* photons traced per parallel batch (their slots: 1 MiB) */
 #define LANDING_BACK 16.0f /* x eps: how far back along its ray a landing point is found again */

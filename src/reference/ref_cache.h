@@ -1,4 +1,4 @@
-/* The reference solver's disk cache (reference.h): keys and files. Internal to src/trace.
+/* The reference solver's disk cache (reference.h): keys and files. Internal to src/reference.
  *
  * Key: 64-bit FNV-1a over the file version, the scene's vertices, triangles, materials, textures,
  * lights, node world matrices and bounds, then the texel table (or the camera), then every setting that

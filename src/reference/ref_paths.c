@@ -20,8 +20,8 @@
 #include "../core/log.h"
 #include "../core/vecmath.h"
 #include "../scene/sky.h"
-#include "bsdf.h"
-#include "shading.h"
+#include "../trace/bsdf.h"
+#include "../trace/shading.h"
 
 #define LM_REF_EPS_REL 1e-5f /* ray offsets, relative to the scene size */
 

@@ -1,6 +1,6 @@
 /* The reference solver's estimators: one path-traced sample of a texel's irradiance or of a pixel's
  * radiance, split by light path into the parts reference.h and docs/reference.md ("Which part carries
- * which light") define. Internal to src/trace. */
+ * which light") define. Internal to src/reference. */
 #ifndef LM_REF_PATHS_H
 #define LM_REF_PATHS_H
 
