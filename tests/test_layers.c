@@ -13,8 +13,8 @@
 #include <sys/stat.h>
 
 /* The layers, lowest first: the one list the check and docs/architecture.md's picture follow. */
-static const char *const LAYERS[] = {"core", "scene", "charts", "trace", "reference",
-                                     "photonmap", "gpu", "update", "api", "cli"};
+static const char *const LAYERS[] = {"core", "scene", "charts", "trace", "photonmap",
+                                     "gpu", "update", "reference", "api", "cli"};
 enum { LAYER_COUNT = sizeof LAYERS / sizeof LAYERS[0] };
 
 typedef struct {

@@ -76,7 +76,7 @@ static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float ta
 }
 
 /* The solver on sc's world (photon work an updater left running finished first: it moves what is traced). */
-static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const lm_ref_camera *cam,
+static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const lm_view *cam,
                          lmgi_reference *out, lmgi_error *err)
 {
     if (sc->updater && lm_updater_sync(sc->updater, "the reference", err) != LMGI_OK)
@@ -127,11 +127,10 @@ lmgi_status lmgi_reference_pixels(const lmgi_scene *sc, const lmgi_reference_des
     lm_view v;
     if (lm_api_ref_settings(desc, fn, &set, err) != LMGI_OK || lm_api_view(sc, cam, fn, &v, err) != LMGI_OK)
         return LMGI_ERR_INVALID;
-    lm_ref_camera rc;
     lm_error e;
-    if (lm_view_ref_camera(&v, width, height, &rc, &e) != LM_OK)
+    if (lm_view_pinhole(&v, width, height, &e) != LM_OK)
         return lm_api_refuse(err, "%s: %s", fn, e.msg);
-    return solve(sc, &set, &rc, out, err);
+    return solve(sc, &set, &v, out, err);
 }
 
 void lmgi_reference_free(lmgi_reference *r)

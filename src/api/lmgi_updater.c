@@ -9,6 +9,7 @@
 
 #include "../charts/atlas_dilate.h"
 #include "../core/stats.h"
+#include "../scene/scene_view.h"
 #include "../scene/sky.h"
 #include "../update/bake_checkpoint.h"
 #include "../update/frame_loop.h"

@@ -41,7 +41,7 @@
 lm_status lm_ref_caustic_texels(const lm_ref_ctx *c, const lm_atlas *a, const lm_ref_settings *set, float *out,
                                 uint64_t *photons, lm_error *err);
 /* Caustic radiance per pixel of cam into out (3 per pixel, row 0 at the top, overwritten). */
-lm_status lm_ref_caustic_pixels(const lm_ref_ctx *c, const lm_ref_camera *cam, const lm_ref_settings *set,
+lm_status lm_ref_caustic_pixels(const lm_ref_ctx *c, const lm_view *cam, const lm_ref_settings *set,
                                 float *out, uint64_t *photons, lm_error *err);
 
 #endif

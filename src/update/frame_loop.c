@@ -15,6 +15,7 @@
 #include "../photonmap/pixel_gather.h"
 #include "../gpu/reflections.h"
 #include "../gpu/gl_context.h"
+#include "../scene/scene_view.h"
 #include "../scene/sky.h"
 #include "../trace/emitter_light.h"
 #include "bake_checkpoint.h"

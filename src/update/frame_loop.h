@@ -21,7 +21,7 @@
 #ifndef LM_FRAME_LOOP_H
 #define LM_FRAME_LOOP_H
 
-#include "../gpu/camera.h"
+#include "../core/camera.h"
 #include "../gpu/caustic_pass.h"
 #include "../gpu/direct.h"
 #include "../gpu/gl_context.h"
