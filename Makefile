@@ -28,7 +28,7 @@ WARN    := -Wall -Wextra -Werror
 # Its square roots are single instructions, without the test for a negative argument that would set
 # errno (nothing reads it).
 TRACE_FP := -ffp-contract=fast -fno-math-errno
-# Hidden visibility: liblmgi.so exports only what include/lmgi.h marks LMGI_API (the static library and
+# Hidden visibility: liblmgi.so exports only what include/lmgi.h and lmgi_tools.h mark LMGI_API (the static library and
 # the programs linked with it are unaffected).
 VIS          := -fvisibility=hidden
 CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)

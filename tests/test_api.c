@@ -1,4 +1,4 @@
-/* The public updater API through include/lmgi.h alone: contexts and their logs, updaters on one or two
+/* The public updater API through the public headers alone: contexts and their logs, updaters on one or two
  * contexts giving the same frames, lmgi_render against the update's own frame, the lightmaps and their
  * change counters, the time budget, and every bad argument refused without changing anything. */
 #include <setjmp.h>
@@ -1096,7 +1096,7 @@ static void test_scene_from_arrays(void **state)
     assert_non_null(strstr(e.message, "geometry.bin: a scene from memory cannot name external files"));
 }
 
-/* liblmgi.so exports exactly the functions lmgi.h marks LMGI_API: nothing internal, nothing missing. */
+/* liblmgi.so exports exactly the functions lmgi.h and lmgi_tools.h mark LMGI_API: nothing internal, nothing missing. */
 /* One context, two threads: while thread A is inside a call on the context (an updater's creation, held
  * in its progress callback), thread B's calls on the context, its other updater and that updater's scene
  * are refused with a message, not raced into a crash; afterwards B's calls go through. */
