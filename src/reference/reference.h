@@ -1,5 +1,6 @@
 /* The reference solver: brute-force Monte Carlo path tracing (Embree), the ground truth for every
- * error figure lmgi reports (docs/reference.md).
+ * error figure lmgi reports (docs/reference.md). Its own module, the lab's, above the runtime's
+ * (docs/architecture.md): it traces with core to trace, and only api (and the tests) include it.
  *
  * The light at a receiver is split by the path it came along, so that every pass of the runtime is
  * checked against its own part (docs/reference.md, "Which part carries which light"). A vertex is
