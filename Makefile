@@ -8,7 +8,7 @@
 #   make bench      timings (never part of the tests)
 #   make tradeoff   what accuracy costs in time: the quick knob sweep on the generated Cornell box,
 #                   build/tradeoff/report.html (TRADEOFF_SCENES, TRADEOFF_FLAGS: the full sweep)
-#   make install    PREFIX=DIR (default /usr/local): lmgi.h (and lmgi_knobs.h), liblmgi.a/.so, lmgi, lmgi.pc
+#   make install    PREFIX=DIR (default /usr/local): lmgi.h (and lmgi_knobs.h), lmgi_tools.h, liblmgi.a/.so, lmgi, lmgi.pc
 #   make scenes     regenerate scenes/ with tools/gen_scenes
 
 CC      ?= gcc
@@ -22,12 +22,13 @@ ARCH    ?= -march=native
 SAN     ?=
 WARN    := -Wall -Wextra -Werror
 # The photon tracer's arithmetic may use fused multiply-adds (ISO C mode forbids contraction by default):
-# a multiply and an add are one instruction, rounded once. Only there: elsewhere code such as the atlas's
-# edge functions relies on a * b - c * d being computed the same way whichever way round it is taken.
+# a multiply and an add are one instruction, rounded once. Only there (and in the reference solver,
+# src/reference, which traces with it): elsewhere code such as the atlas's edge functions relies on
+# a * b - c * d being computed the same way whichever way round it is taken.
 # Its square roots are single instructions, without the test for a negative argument that would set
 # errno (nothing reads it).
 TRACE_FP := -ffp-contract=fast -fno-math-errno
-# Hidden visibility: liblmgi.so exports only what include/lmgi.h marks LMGI_API (the static library and
+# Hidden visibility: liblmgi.so exports only what include/lmgi.h and lmgi_tools.h mark LMGI_API (the static library and
 # the programs linked with it are unaffected).
 VIS          := -fvisibility=hidden
 CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)
@@ -47,8 +48,8 @@ DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenm
                 openmpi-bin libopenmpi-dev libcjson-dev libdraco-dev draco gltfpack \
                 $(NPM_DEB)
 
-LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
-                             src/gpu/*.c src/update/*.c src/api/*.c))
+LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/reference/*.c \
+                             src/photonmap/*.c src/gpu/*.c src/update/*.c src/api/*.c))
 LIB_CXX := $(sort $(wildcard src/scene/*.cpp src/charts/*.cpp))
 CLI_C   := $(sort $(wildcard src/cli/*.c))
 LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o)
@@ -88,6 +89,8 @@ $(BUILD)/obj/%.o: %.c $(BUILD)/flags
 	$(CC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
 
 $(BUILD)/obj/src/trace/%.o: CFLAGS_ALL += $(TRACE_FP)
+# the reference solver was written in trace/ and traces with it: the same arithmetic, the same answers
+$(BUILD)/obj/src/reference/%.o: CFLAGS_ALL += $(TRACE_FP)
 
 $(BUILD)/obj/%.o: %.cpp $(BUILD)/flags
 	@mkdir -p $(dir $@)
@@ -97,18 +100,20 @@ $(BUILD)/liblmgi.a: $(LIB_OBJ)
 	@rm -f $@
 	ar rcs $@ $^
 
-SONAME := liblmgi.so.0
+# The version is include/lmgi.h's (LMGI_VERSION_*): the shared library's soname and lmgi.pc follow it
+LMGI_VERSION = $(shell sed -n 's/^\#define LMGI_VERSION_\(MAJOR\|MINOR\|PATCH\) //p' include/lmgi.h | paste -sd.)
+SONAME := liblmgi.so.$(firstword $(subst ., ,$(LMGI_VERSION)))
 $(BUILD)/liblmgi.so: $(LIB_OBJ) src/api/lmgi.map
 	$(CC) -shared -Wl,-soname,$(SONAME) -Wl,--version-script=src/api/lmgi.map -o $@ $(LIB_OBJ) $(LDFLAGS_ALL) $(LIBS)
 
-# make install PREFIX=DIR: the header, both libraries, the lmgi command and lmgi.pc for pkg-config
+# make install PREFIX=DIR: the headers, both libraries, the lmgi command and lmgi.pc for pkg-config
 # (`cc app.c $$(pkg-config --cflags --libs lmgi)`; add --static for liblmgi.a and its dependencies).
 PREFIX ?= /usr/local
 install: all install-files
 # the copying alone, of what BUILD holds (test_examples installs each build's own libraries this way)
 install-files:
 	install -d $(DESTDIR)$(PREFIX)/include $(DESTDIR)$(PREFIX)/lib/pkgconfig $(DESTDIR)$(PREFIX)/bin
-	install -m 644 include/lmgi.h include/lmgi_knobs.h $(DESTDIR)$(PREFIX)/include/
+	install -m 644 include/lmgi.h include/lmgi_knobs.h include/lmgi_tools.h $(DESTDIR)$(PREFIX)/include/
 	install -m 644 $(BUILD)/liblmgi.a $(DESTDIR)$(PREFIX)/lib/
 	install -m 755 $(BUILD)/liblmgi.so $(DESTDIR)$(PREFIX)/lib/$(SONAME)
 	ln -sf $(SONAME) $(DESTDIR)$(PREFIX)/lib/liblmgi.so
@@ -116,7 +121,7 @@ install-files:
 	install -d $(DESTDIR)$(PREFIX)/share/lmgi
 	install -m 644 tools/tradeoff_report.py $(DESTDIR)$(PREFIX)/share/lmgi/
 	install -m 644 tools/engines/babylon_lmgi_lightmap.js $(DESTDIR)$(PREFIX)/share/lmgi/
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(LMGI_VERSION)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
 
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
 	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)

@@ -1,4 +1,5 @@
-/* A level editor's session, through include/lmgi.h alone.
+/* A level editor's session, through include/lmgi.h
+ * (and include/lmgi_tools.h for its pictures and output directory).
  *
  * Loads a scene and bakes it with a progress bar (the updater's creation is the first bake), then does
  * what an artist does: recolours a wall, moves a light, adds a lamp below it, and re-bakes after each
@@ -10,7 +11,7 @@
  *
  * --material names the material to recolour (default: the first diffuse one), --light the node of the
  * light to move (default: the first light's), --texels the lightmap's texel count (default 65536). */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <stdio.h>
 #include <stdlib.h>

@@ -1,4 +1,5 @@
-/* A game's runtime lightmap updater, through include/lmgi.h alone.
+/* A game's runtime lightmap updater, through include/lmgi.h
+ * (and include/lmgi_tools.h for its pictures and output directory).
  *
  * Loads a scene, creates an updater that keeps its lightmaps current within a time budget per frame
  * (4 ms unless told otherwise), moves an object every frame, fetches the lightmaps when a surface the
@@ -14,7 +15,7 @@
  * slides a dynamic node (by name) back and forth through lmgi_set_node_transform. OUT_DIR is made if
  * missing; its earlier results are replaced only when this run succeeds (lmgi_output_open). */
 #define _POSIX_C_SOURCE 200809L /* clock_gettime, nanosleep */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdio.h>

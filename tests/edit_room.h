@@ -5,7 +5,7 @@
 #ifndef LMT_EDIT_ROOM_H
 #define LMT_EDIT_ROOM_H
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <stddef.h>
 #include <stdint.h>
 

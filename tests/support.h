@@ -82,7 +82,7 @@ void lmt_pipeline_free(lmt_pipeline *p);
 
 /* Reference texels for a loaded pipeline at a relative standard error target, uncached and quiet
  * (a test must not depend on a cache a previous run left); fails the test on error. */
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 void lmt_reference_texels(const lmt_pipeline *p, float target_error, lm_ref_result *out);
 
 /* cmocka group fixtures for tests that render: one GL context, current for the whole group. */

@@ -15,7 +15,7 @@
 
 #include "../src/api/lmgi_scene.h"
 #include "../src/core/vecmath.h"
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 #include "../src/update/frame_loop.h"
 #include "support.h"
 

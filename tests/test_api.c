@@ -1,4 +1,4 @@
-/* The public updater API through include/lmgi.h alone: contexts and their logs, updaters on one or two
+/* The public updater API through the public headers alone: contexts and their logs, updaters on one or two
  * contexts giving the same frames, lmgi_render against the update's own frame, the lightmaps and their
  * change counters, the time budget, and every bad argument refused without changing anything. */
 #include <setjmp.h>
@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -1097,7 +1097,7 @@ static void test_scene_from_arrays(void **state)
     assert_non_null(strstr(e.message, "geometry.bin: a scene from memory cannot name external files"));
 }
 
-/* liblmgi.so exports exactly the functions lmgi.h marks LMGI_API: nothing internal, nothing missing. */
+/* liblmgi.so exports exactly the functions lmgi.h and lmgi_tools.h mark LMGI_API: nothing internal, nothing missing. */
 /* One context, two threads: while thread A is inside a call on the context (an updater's creation, held
  * in its progress callback), thread B's calls on the context, its other updater and that updater's scene
  * are refused with a message, not raced into a crash; afterwards B's calls go through. */
@@ -1347,6 +1347,16 @@ static void test_shared_bake_is_one_process_bake(void **state)
     close_all(NULL, sc, ctx);
 }
 
+/* The library says the version the header it was built with says, part by part. */
+static void test_version(void **state)
+{
+    (void)state;
+    assert_int_equal(lmgi_version(), LMGI_VERSION);
+    assert_int_equal(lmgi_version() / 10000, LMGI_VERSION_MAJOR);
+    assert_int_equal(lmgi_version() / 100 % 100, LMGI_VERSION_MINOR);
+    assert_int_equal(lmgi_version() % 100, LMGI_VERSION_PATCH);
+}
+
 static void test_exported_symbols(void **state)
 {
     (void)state;
@@ -1362,18 +1372,20 @@ static void test_exported_symbols(void **state)
         if (sscanf(line, "%*s %7s %899s", type, name) != 2)
             continue;
         if (strncmp(name, "lmgi_", 5) != 0)
-            fail_msg("liblmgi.so exports %s, which is not in lmgi.h", name);
+            fail_msg("liblmgi.so exports %s, which is not in lmgi.h or lmgi_tools.h", name);
         exported++;
     }
     assert_int_equal(pclose(p), 0);
-    size_t size = 0;
-    char *header = (char *)lmt_read_file("include/lmgi.h", &size, 1);
-    header[size] = '\0';
     int declared = 0;
-    for (const char *q = header; (q = strstr(q, "\nLMGI_API ")) != NULL; q++)
-        declared++;
-    free(header);
-    print_message("liblmgi.so exports %d symbols, lmgi.h declares %d\n", exported, declared);
+    for (int h = 0; h < 2; h++) { /* the runtime's header and the lab's */
+        size_t size = 0;
+        char *header = (char *)lmt_read_file(h ? "include/lmgi_tools.h" : "include/lmgi.h", &size, 1);
+        header[size] = '\0';
+        for (const char *q = header; (q = strstr(q, "\nLMGI_API ")) != NULL; q++)
+            declared++;
+        free(header);
+    }
+    print_message("liblmgi.so exports %d symbols, lmgi.h and lmgi_tools.h declare %d\n", exported, declared);
     assert_true(declared > 30);
     assert_int_equal(exported, declared);
 }
@@ -1399,6 +1411,7 @@ int main(void)
         cmocka_unit_test(test_shard_cancelled_and_resumed),
         cmocka_unit_test(test_shared_bake_is_one_process_bake),
         cmocka_unit_test(test_exported_symbols),
+        cmocka_unit_test(test_version),
     };
     lmgi_set_verbosity(0); /* the refusals below log errors on purpose */
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -1,4 +1,4 @@
-/* The public reference, check and output-directory calls through include/lmgi.h alone: texels and pixels
+/* The public reference, check and output-directory calls through include/lmgi_tools.h alone: texels and pixels
  * against the analytic irradiance of a point light over a plane, its parts (and a mirror's caustic),
  * determinism and the cache, a frame checked against the reference, and every bad argument refused. */
 #include <setjmp.h>
@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

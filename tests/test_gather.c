@@ -19,7 +19,7 @@
 #include "../src/gpu/hemicube.h"
 #include "../src/gpu/iim.h"
 #include "../src/core/timing.h"
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 #include "../src/update/photon_stage.h"
 #include "support.h"
 

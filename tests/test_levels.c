@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include <cmocka.h>
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include "edit_room.h"
 #include "support.h"

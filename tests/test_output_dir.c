@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>

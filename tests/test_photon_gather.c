@@ -21,6 +21,7 @@
 #include "../src/gpu/photon_gather.h"
 #include "../src/photonmap/photon_records.h"
 #include "../src/photonmap/pixel_gather.h"
+#include "../src/scene/scene_view.h"
 #include "../src/update/photon_stage.h"
 #include "support.h"
 
@@ -239,11 +240,11 @@ static void test_gathers_agree(void **state)
     free(E);
 
     /* the CPU's gather: float records, a ray-traced G-buffer */
-    lm_ref_camera cam;
+    lm_view cam = f.view;
     lm_gbuffer g;
     memset(&g, 0, sizeof g);
     lm_error err;
-    if (lm_view_ref_camera(&f.view, f.w, f.h, &cam, &err) != LM_OK ||
+    if (lm_view_pinhole(&cam, f.w, f.h, &err) != LM_OK ||
         lm_gbuffer_trace(&g, f.p.s, f.p.rt, &cam, &err) != LM_OK)
         fail_msg("%s", err.msg);
     float *cpu = malloc(n * sizeof *cpu);

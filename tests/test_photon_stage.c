@@ -13,7 +13,7 @@
 #include <unistd.h>
 
 #include "../src/core/log.h"
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 #include "../src/update/photon_stage.h"
 #include "support.h"
 

@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

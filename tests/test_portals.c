@@ -16,7 +16,7 @@
 #include <string.h>
 
 #include <cmocka.h>
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include "../src/core/qmc.h"
 #include "../src/trace/lights.h"

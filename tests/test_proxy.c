@@ -17,7 +17,7 @@
 #include "../src/core/vecmath.h"
 #include "../src/gpu/gl_context.h"
 #include "../src/gpu/hemicube.h"
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 #include "../src/update/photon_stage.h"
 #include "support.h"
 

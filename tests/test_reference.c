@@ -14,7 +14,7 @@
 
 #include "../src/core/log.h"
 #include "../src/core/timing.h"
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 #include "support.h"
 
 #define PI 3.14159265358979323846
@@ -170,7 +170,8 @@ static void test_furnace_pixel_parts(void **state)
     (void)state;
     lmt_pipeline p;
     lmt_pipeline_load(&p, furnace_scene(), 0.5f);
-    lm_ref_camera cam = {{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, 1.0f, 8, 8, 0.0f};
+    lm_view cam = {.eye = {0, 0, 0}, .forward = {0, 0, -1}, .up = {0, 1, 0},
+                   .yfov = 1.0f, .width = 8, .height = 8, .znear = 0.0f};
     lm_ref_settings set = quick_settings(0.01f, 64);
     lm_ref_result r;
     lm_error err;
@@ -281,7 +282,8 @@ static void test_pixels_see_lit_plane(void **state)
     (void)state;
     lmt_pipeline p;
     lmt_pipeline_load(&p, lmt_plane_scene(), 1.0f);
-    lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.2f, 16, 16, 0.0f};
+    lm_view cam = {.eye = {0, 5, 0}, .forward = {0, -1, 0}, .up = {0, 0, -1},
+                   .yfov = 0.2f, .width = 16, .height = 16, .znear = 0.0f};
     lm_ref_settings set = quick_settings(0.01f, 16);
     lm_ref_result r;
     lm_error err;
@@ -317,7 +319,8 @@ static void test_pixels_start_at_near_plane(void **state)
     assert_int_equal(lmt_write_gltf(path, m, 2, nodes, NULL, 0, ext), 0);
     lmt_pipeline p;
     lmt_pipeline_load(&p, path, 1.0f);
-    lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.2f, 8, 8, 0.0f};
+    lm_view cam = {.eye = {0, 5, 0}, .forward = {0, -1, 0}, .up = {0, 0, -1},
+                   .yfov = 0.2f, .width = 8, .height = 8, .znear = 0.0f};
     lm_ref_settings set = quick_settings(0.01f, 16);
     lm_ref_result r;
     lm_error err;

@@ -15,7 +15,7 @@
 
 #include "../src/core/log.h"
 #include "../src/core/timing.h"
-#include "../src/trace/reference.h"
+#include "../src/reference/reference.h"
 #include "support.h"
 
 #define PI 3.14159265358979323846
@@ -170,7 +170,8 @@ static void test_mirror_caustic_pixels(void **state)
     v3 eye = {2, 7, 5}, fwd = {0, -7, -5};
     double len = sqrt(v3_dot(fwd, fwd));
     fwd = (v3){fwd.x / len, fwd.y / len, fwd.z / len};
-    lm_ref_camera cam = {{2, 7, 5}, {(float)fwd.x, (float)fwd.y, (float)fwd.z}, {0, 1, 0}, 0.9f, SIDE, SIDE, 0.0f};
+    lm_view cam = {.eye = {2, 7, 5}, .forward = {(float)fwd.x, (float)fwd.y, (float)fwd.z}, .up = {0, 1, 0},
+                   .yfov = 0.9f, .width = SIDE, .height = SIDE, .znear = 0.0f};
     lm_ref_settings set = quick_settings(LM_REF_CAUSTIC_PHOTONS);
     lm_ref_result r;
     lm_error err;
@@ -249,7 +250,8 @@ static void test_parts_and_lost_light(void **state)
         set.min_samples = set.max_samples = 256;
         lm_ref_result t, px;
         lm_error err;
-        lm_ref_camera cam = {{2, 7, 5}, {0, -0.813733f, -0.581238f}, {0, 1, 0}, 0.9f, 24, 24, 0.0f};
+        lm_view cam = {.eye = {2, 7, 5}, .forward = {0, -0.813733f, -0.581238f}, .up = {0, 1, 0},
+                       .yfov = 0.9f, .width = 24, .height = 24, .znear = 0.0f};
         assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &t, &err), LM_OK);
         assert_int_equal(lm_reference_pixels(p.s, p.rt, &p.em, &cam, &set, &px, &err), LM_OK);
         assert_parts_add_up(&t, 1);
@@ -291,7 +293,8 @@ static void test_no_specular_no_split(void **state)
     lmt_pipeline p;
     lmt_pipeline_load(&p, lmt_plane_scene(), 1.0f);
     lm_ref_settings set = quick_settings(1u << 16);
-    lm_ref_camera cam = {{0, 5, 0}, {0, -1, 0}, {0, 0, -1}, 0.5f, 16, 16, 0.0f};
+    lm_view cam = {.eye = {0, 5, 0}, .forward = {0, -1, 0}, .up = {0, 0, -1},
+                   .yfov = 0.5f, .width = 16, .height = 16, .znear = 0.0f};
     lm_ref_result t, px;
     lm_error err;
     assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &t, &err), LM_OK);
@@ -332,7 +335,8 @@ static void test_deterministic_across_threads(void **state)
     lmt_pipeline p;
     lmt_pipeline_load(&p, mirror_scene(1), 0.5f);
     lm_ref_settings set = quick_settings(1u << 16);
-    lm_ref_camera cam = {{2, 7, 5}, {0, -0.813733f, -0.581238f}, {0, 1, 0}, 0.9f, 16, 16, 0.0f};
+    lm_view cam = {.eye = {2, 7, 5}, .forward = {0, -0.813733f, -0.581238f}, .up = {0, 1, 0},
+                   .yfov = 0.9f, .width = 16, .height = 16, .znear = 0.0f};
     lm_ref_result t[2], px[2];
     lm_error err;
     int threads = omp_get_max_threads();
@@ -363,7 +367,8 @@ static void test_cache_and_settings(void **state)
     lm_ref_settings set = quick_settings(1u << 14);
     set.use_cache = 1;
     set.cache_dir = dir;
-    lm_ref_camera cam = {{2, 7, 5}, {0, -0.813733f, -0.581238f}, {0, 1, 0}, 0.9f, 12, 12, 0.0f};
+    lm_view cam = {.eye = {2, 7, 5}, .forward = {0, -0.813733f, -0.581238f}, .up = {0, 1, 0},
+                   .yfov = 0.9f, .width = 12, .height = 12, .znear = 0.0f};
     lm_ref_result a, b;
     lm_error err;
     for (int pixels = 0; pixels < 2; pixels++) {

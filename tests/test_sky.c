@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include <cmocka.h>
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <stb/stb_image_write.h>
 
 #include "edit_room.h"

@@ -4,7 +4,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -211,7 +211,7 @@ static void test_far_from_origin(void **state)
     lmgi_free(sc);
 }
 
-/* Every function of lmgi.h takes the NULLs it documents without a crash, and refuses the others. */
+/* Every function of lmgi.h and lmgi_tools.h takes the NULLs it documents without a crash, and refuses the others. */
 static void test_null_arguments(void **state)
 {
     lmgi_scene *sc = load_test_scene(state);

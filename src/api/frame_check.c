@@ -98,8 +98,8 @@ static lm_status run_frames(lmgi_scene *sc, const lm_frame_loop_settings *set, i
 static lm_status reference_pixels(const lmgi_scene *sc, const lm_view *view, const lm_ref_settings *set,
                                   lm_frame_check *c, lm_error *err)
 {
-    lm_ref_camera cam;
-    lm_status st = lm_view_ref_camera(view, c->width, c->height, &cam, err);
+    lm_view cam = *view;
+    lm_status st = lm_view_pinhole(&cam, c->width, c->height, err);
     if (st == LM_OK) /* the edits' placements in the BVH it traces */
         st = lm_edits_commit(&sc->world, err);
     if (st != LM_OK)

@@ -1,5 +1,5 @@
 /* A frame of the frame loop against the reference solver, the way a user meets the lighting: `lmgi run`'s
- * composited picture next to the path-traced radiance of the same pixels (trace/reference.h), per visible
+ * composited picture next to the path-traced radiance of the same pixels (reference/reference.h), per visible
  * surface and over the whole frame (docs/reference.md, "Frame against reference").
  *
  * What is compared: every pixel whose centre and four neighbours' centres see one surface
@@ -18,7 +18,7 @@
 #ifndef LM_FRAME_CHECK_H
 #define LM_FRAME_CHECK_H
 
-#include "../trace/reference.h"
+#include "../reference/reference.h"
 #include "../update/frame_loop.h"
 #include "lmgi_scene.h"
 
@@ -31,7 +31,7 @@ typedef struct {
 typedef struct {
     int width, height;
     float *frame, *ref;    /* 3 floats per pixel, linear radiance, row 0 at the top */
-    float *ref_indirect;   /* the reference's indirect part (trace/reference.h: the iim-like rest, shaded) */
+    float *ref_indirect;   /* the reference's indirect part (reference/reference.h: the iim-like rest, shaded) */
     int32_t *surface_at;   /* per pixel: surface index, -1 specular, -2 nothing */
     uint8_t *compared;     /* per pixel: 1 where it counts in `surface` (an interior pixel of a surface) */
     int surface_count;

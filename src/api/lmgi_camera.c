@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
+#include "../scene/scene_view.h"
 #include "lmgi_scene.h"
 
 /* The translation by sign x the scene's origin (lm_scene.origin: where lmgi's world origin lies in the

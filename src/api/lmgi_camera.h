@@ -1,11 +1,11 @@
 /* The public lmgi_camera (the file's world, GL matrices) turned into the renderer's and the reference's
- * view (lmgi's origin-relative world, gpu/camera.h). */
+ * view (lmgi's origin-relative world, core/camera.h). */
 #ifndef LM_LMGI_CAMERA_H
 #define LM_LMGI_CAMERA_H
 
 #include <lmgi.h>
 
-#include "../gpu/camera.h"
+#include "../core/camera.h"
 
 /* The view of cam in sc's world. Non-finite entries or a view matrix that is not invertible:
  * LMGI_ERR_INVALID with a message starting with fn (the public call's name). */

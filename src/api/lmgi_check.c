@@ -1,5 +1,5 @@
 /* The public API's check: api/frame_check.h's comparison behind lmgi_check, on the caller's context. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <stdlib.h>
 #include <string.h>

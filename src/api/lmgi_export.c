@@ -10,7 +10,7 @@
  * it again for the negative determinant, as lmgi's loader did. A level of several lightmap pages gets an
  * image per page, a primitive per node, material and page, and a copy of a material for each further
  * page it lies on (export_pages.h). */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <limits.h>
 #include <math.h>

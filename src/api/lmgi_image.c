@@ -1,5 +1,5 @@
 /* The public API's pictures: EXR as the numbers, PNG tone-mapped (core/tonemap.h). */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdlib.h>

@@ -1,5 +1,5 @@
 /* The public API's output directories and whole-file writes: src/core/output_dir.h under lmgi_ names. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <stdlib.h>
 

@@ -1,11 +1,11 @@
-/* The public API's reference: trace/reference.h's solver on a loaded scene, its results as images. */
-#include <lmgi.h>
+/* The public API's reference: reference/reference.h's solver on a loaded scene, its results as images. */
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "../trace/reference.h"
+#include "../reference/reference.h"
 #include "lmgi_camera.h"
 #include "lmgi_reference.h"
 #include "lmgi_scene.h"
@@ -75,7 +75,7 @@ static lm_status export_result(lm_ref_result *r, const lm_atlas *atlas, float ta
 }
 
 /* The solver on sc's world (photon work an updater left running finished first: it moves what is traced). */
-static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const lm_ref_camera *cam,
+static lmgi_status solve(const lmgi_scene *sc, const lm_ref_settings *set, const lm_view *cam,
                          lmgi_reference *out, lmgi_error *err)
 {
     if (lm_scene_quiet(sc, "the reference", err) != LMGI_OK)
@@ -128,11 +128,10 @@ lmgi_status lmgi_reference_pixels(const lmgi_scene *sc, const lmgi_reference_des
     lm_view v;
     if (lm_api_ref_settings(desc, fn, &set, err) != LMGI_OK || lm_api_view(sc, cam, fn, &v, err) != LMGI_OK)
         return LMGI_ERR_INVALID;
-    lm_ref_camera rc;
     lm_error e;
-    if (lm_view_ref_camera(&v, width, height, &rc, &e) != LM_OK)
+    if (lm_view_pinhole(&v, width, height, &e) != LM_OK)
         return lm_api_refuse(err, "%s: %s", fn, e.msg);
-    return solve(sc, &set, &rc, out, err);
+    return solve(sc, &set, &v, out, err);
 }
 
 void lmgi_reference_free(lmgi_reference *r)

@@ -2,9 +2,9 @@
 #ifndef LM_LMGI_REFERENCE_H
 #define LM_LMGI_REFERENCE_H
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
-#include "../trace/reference.h"
+#include "../reference/reference.h"
 
 /* The solver's settings for desc (NULL or zeros: the defaults), checked: LMGI_ERR_INVALID naming the field
  * after fn (the public call's name). */

@@ -1,5 +1,5 @@
 /* What the public API reports about a loaded scene: counts, effects, and the charts pictures. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -8,7 +8,7 @@
 
 #include "../charts/atlas_image.h"
 #include "../core/image.h"
-#include "../gpu/camera.h"
+#include "../scene/scene_view.h"
 #include "../gpu/gl_context.h"
 #include "../gpu/surface_view.h"
 #include "lmgi_scene.h"

@@ -1,7 +1,7 @@
 /* The public API's updater: the frame loop (update/frame_loop.h, which turns the time budget into work:
  * update/budget.h) behind include/lmgi.h, with per-surface change counters and the lightmaps read
  * back. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <math.h>
 #include <stdio.h>
@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "../charts/atlas_dilate.h"
+#include "../scene/scene_view.h"
 #include "../scene/sky.h"
 #include "../update/bake_checkpoint.h"
 #include "../update/frame_loop.h"

@@ -2,7 +2,7 @@
 #ifndef LM_CLI_ARGS_H
 #define LM_CLI_ARGS_H
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <stdio.h>
 
 #define LM_CLI_MAX_FILES 4100 /* a merge's parts: one of each of up to 4096 shards, and its scene */

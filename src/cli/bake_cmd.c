@@ -1,7 +1,7 @@
 /* lmgi bake: through the public API only. */
 #include "bake_cmd.h"
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>

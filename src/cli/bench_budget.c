@@ -1,6 +1,6 @@
 #include "bench_budget.h"
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>

@@ -7,7 +7,7 @@
 #define LM_CLI_EDIT_SCRIPT_H
 
 #include <cjson/cJSON.h>
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #define LM_EDIT_MAX 256
 

@@ -1,5 +1,5 @@
 /* The lmgi command. */
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 #include <errno.h>
 #include <signal.h>

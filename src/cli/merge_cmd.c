@@ -5,7 +5,7 @@
  * options. */
 #include "merge_cmd.h"
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <cjson/cJSON.h>
 #include <errno.h>
 #include <stdint.h>

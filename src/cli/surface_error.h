@@ -3,7 +3,7 @@
 #ifndef LM_CLI_SURFACE_ERROR_H
 #define LM_CLI_SURFACE_ERROR_H
 
-#include <lmgi.h>
+#include <lmgi_tools.h>
 
 /* Per visible surface (not emitters), |frame mean / reference mean - 1| on the sum of the channels: the
  * pixel-weighted RMS over surfaces of 20 or more compared pixels (returned; NAN when there is none), and

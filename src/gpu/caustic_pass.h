@@ -39,7 +39,7 @@
 
 #include "../core/error.h"
 #include "../trace/caustics.h"
-#include "camera.h"
+#include "../core/camera.h"
 #include "direct.h"
 
 typedef struct {

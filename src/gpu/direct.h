@@ -10,7 +10,7 @@
 #include "../core/error.h"
 #include "../scene/scene.h"
 #include "../trace/lights.h"
-#include "camera.h"
+#include "../core/camera.h"
 
 typedef struct {
     int map_size;         /* 2D shadow maps (spot, directional), texels per side. Default 1024 */

@@ -7,7 +7,7 @@
 #include <stdint.h>
 
 #include "../charts/charts.h"
-#include "camera.h"
+#include "../core/camera.h"
 
 /* Three unshared corners per triangle, 5 floats each: world position (current node matrices) and
  * lightmap UV, with UV (-1, -1) for triangles without lightmap texels. The caller frees it; NULL when

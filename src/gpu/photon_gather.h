@@ -42,7 +42,7 @@
 
 #include "../core/error.h"
 #include "../photonmap/photon_records.h"
-#include "camera.h"
+#include "../core/camera.h"
 
 typedef enum { LM_PHOTON_GATHER_TILED = 0, LM_PHOTON_GATHER_HASHGRID, LM_PHOTON_GATHER_BRUTEFORCE } lm_photon_gather_kind;
 

@@ -38,7 +38,7 @@
 #include "../scene/scene.h"
 #include "../trace/lights.h"
 #include "../charts/charts.h"
-#include "camera.h"
+#include "../core/camera.h"
 #include "caustic_pass.h"
 #include "direct.h"
 

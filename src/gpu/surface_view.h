@@ -6,7 +6,7 @@
 #include <stdint.h>
 
 #include "../charts/charts.h"
-#include "camera.h"
+#include "../core/camera.h"
 
 /* Renders into rgba8 (width*height*4 bytes, row 0 at the top). Needs a current GL context. */
 lm_status lm_render_surface_ids(const lm_scene *s, const lm_surfaces *su, const lm_view *view, int width,

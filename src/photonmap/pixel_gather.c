@@ -11,7 +11,7 @@
 
 #define KERNEL_C 0.2f /* the paper's cone clamped to a fifth of its height (eq. 2) */
 
-lm_status lm_gbuffer_trace(lm_gbuffer *g, const lm_scene *s, const lm_rt *rt, const lm_ref_camera *cam, lm_error *err)
+lm_status lm_gbuffer_trace(lm_gbuffer *g, const lm_scene *s, const lm_rt *rt, const lm_view *cam, lm_error *err)
 {
     size_t n = (size_t)cam->width * (size_t)cam->height;
     if (g->width != cam->width || g->height != cam->height) {

@@ -32,10 +32,10 @@
 #include <stdint.h>
 
 #include "../charts/charts.h"
+#include "../core/camera.h"
 #include "../core/error.h"
 #include "../scene/scene.h"
 #include "../trace/photon_store.h"
-#include "../trace/reference.h"
 #include "../trace/rt_scene.h"
 
 /* What each pixel sees: its visible point, the shading normal on the eye's side, and kd there (0 for
@@ -45,9 +45,9 @@ typedef struct {
     float *pos, *normal, *kd; /* 3 floats per pixel each, row 0 at the top */
 } lm_gbuffer;
 
-/* Casts one ray through each pixel's centre of cam (the reference's pinhole, lm_ref_camera). Grows g's
+/* Casts one ray through each pixel's centre of cam's pinhole (core/camera.h, lm_view_pinhole). Grows g's
  * arrays as the size asks (g zero-initialised the first time). */
-lm_status lm_gbuffer_trace(lm_gbuffer *g, const lm_scene *s, const lm_rt *rt, const lm_ref_camera *cam, lm_error *err);
+lm_status lm_gbuffer_trace(lm_gbuffer *g, const lm_scene *s, const lm_rt *rt, const lm_view *cam, lm_error *err);
 void lm_gbuffer_free(lm_gbuffer *g);
 
 /* The hits the per-pixel gathers' default radius holds on average: the AIMs' N of 128 they were measured

@@ -6,6 +6,7 @@
 
 #include "../core/memory.h"
 #include "../core/timing.h"
+#include "../scene/scene_view.h"
 #include "budget.h"
 #include "frame_passes.h"
 #include "lightmap_path.h"

@@ -21,7 +21,7 @@
 #ifndef LM_FRAME_LOOP_H
 #define LM_FRAME_LOOP_H
 
-#include "../gpu/camera.h"
+#include "../core/camera.h"
 #include "frame_settings.h"
 
 typedef struct lm_frame_loop lm_frame_loop;

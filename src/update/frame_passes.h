@@ -20,7 +20,7 @@
 #ifndef LM_FRAME_PASSES_H
 #define LM_FRAME_PASSES_H
 
-#include "../gpu/camera.h"
+#include "../core/camera.h"
 #include "frame_settings.h"
 #include "photon_path.h"
 #include "world.h"

@@ -14,6 +14,7 @@
 #include "../../src/gpu/gl_context.h"
 #include "../../src/gpu/photon_gather.h"
 #include "../../src/photonmap/pixel_gather.h"
+#include "../../src/scene/scene_view.h"
 #include "../../src/update/photon_stage.h"
 #include "dev_scene.h"
 

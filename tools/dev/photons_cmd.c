@@ -9,7 +9,7 @@
 #include "../../src/charts/atlas_dilate.h"
 #include "../../src/core/image.h"
 #include "../../src/core/tonemap.h"
-#include "../../src/gpu/camera.h"
+#include "../../src/scene/scene_view.h"
 #include "../../src/gpu/gl_context.h"
 #include "../../src/gpu/lightmap_view.h"
 #include "../../src/api/lmgi_scene.h"

@@ -14,7 +14,7 @@
 
 #include <ftw.h>
 #include <limits.h>
-#include <lmgi.h>
+#include <lmgi_tools.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdint.h>

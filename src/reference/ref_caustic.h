@@ -2,7 +2,7 @@
  * bounces straight from an emitter (L S+ D), estimated by light tracing, for every kind of emitter
  * (docs/reference.md, "Which part carries which light"). The path tracer cannot find these paths from
  * point, spot and directional lights at all and finds them from small emitters only rarely; it drops
- * its own estimate of them, so nothing counts twice. Internal to src/trace.
+ * its own estimate of them, so nothing counts twice. Internal to src/reference.
  *
  * Generators: every node with mirror or glass triangles, whatever its "caustics" switch (the reference
  * is the physics, not what the runtime was asked to show), each bounded by the sphere around its
@@ -41,7 +41,7 @@
 lm_status lm_ref_caustic_texels(const lm_ref_ctx *c, const lm_atlas *a, const lm_ref_settings *set, float *out,
                                 uint64_t *photons, lm_error *err);
 /* Caustic radiance per pixel of cam into out (3 per pixel, row 0 at the top, overwritten). */
-lm_status lm_ref_caustic_pixels(const lm_ref_ctx *c, const lm_ref_camera *cam, const lm_ref_settings *set,
+lm_status lm_ref_caustic_pixels(const lm_ref_ctx *c, const lm_view *cam, const lm_ref_settings *set,
                                 float *out, uint64_t *photons, lm_error *err);
 
 #endif

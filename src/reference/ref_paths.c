@@ -20,8 +20,8 @@
 #include "../core/log.h"
 #include "../core/vecmath.h"
 #include "../scene/sky.h"
-#include "bsdf.h"
-#include "shading.h"
+#include "../trace/bsdf.h"
+#include "../trace/shading.h"
 
 #define LM_REF_EPS_REL 1e-5f /* ray offsets, relative to the scene size */
 
@@ -372,7 +372,7 @@ void lm_ref_texel_sample(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng 
 
 /* ---- pixels ---- */
 
-void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, int y, lm_ref_rng *r,
+void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_view *cam, int x, int y, lm_ref_rng *r,
                          lm_ref_sample *out)
 {
     lm_vec3 fwd = lm_normalize(lm_v3_load(cam->forward));

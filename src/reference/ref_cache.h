@@ -1,4 +1,4 @@
-/* The reference solver's disk cache (reference.h): keys and files. Internal to src/trace.
+/* The reference solver's disk cache (reference.h): keys and files. Internal to src/reference.
  *
  * Key: 64-bit FNV-1a over the file version, the scene's vertices, triangles, materials, textures,
  * lights, node world matrices and bounds, then the texel table (or the camera), then every setting that
@@ -27,7 +27,7 @@ int lm_ref_result_arrays(lm_ref_result *r, int texels, float **arrays[LM_REF_MAX
 int lm_ref_result_alloc(lm_ref_result *r, uint32_t count, int texels);
 
 uint64_t lm_ref_key_texels(const lm_scene *s, const lm_atlas *a, const lm_ref_settings *set);
-uint64_t lm_ref_key_pixels(const lm_scene *s, const lm_ref_camera *cam, const lm_ref_settings *set);
+uint64_t lm_ref_key_pixels(const lm_scene *s, const lm_view *cam, const lm_ref_settings *set);
 /* DIR/KIND-KEY.lmref with DIR from the settings, $LMGI_CACHE or build/reference-cache. */
 void lm_ref_cache_path(char *buf, size_t size, const lm_ref_settings *set, uint32_t kind, uint64_t key);
 /* Fills out (allocating its arrays) from a matching file and returns 1; returns 0 if there is none, and

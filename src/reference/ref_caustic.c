@@ -6,9 +6,9 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
-#include "bsdf.h"
-#include "caustics.h"
-#include "shading.h"
+#include "../trace/bsdf.h"
+#include "../trace/caustics.h"
+#include "../trace/shading.h"
 
 #define CHUNK 65536u      /* photons traced per parallel batch (their slots: 1 MiB) */
 #define LANDING_BACK 16.0f /* x eps: how far back along its ray a landing point is found again */
@@ -296,7 +296,7 @@ lm_status lm_ref_caustic_texels(const lm_ref_ctx *c, const lm_atlas *a, const lm
     return run(&p, a->texel_count, out, photons, err);
 }
 
-lm_status lm_ref_caustic_pixels(const lm_ref_ctx *c, const lm_ref_camera *cam, const lm_ref_settings *set,
+lm_status lm_ref_caustic_pixels(const lm_ref_ctx *c, const lm_view *cam, const lm_ref_settings *set,
                                 float *out, uint64_t *photons, lm_error *err)
 {
     pass p;

@@ -80,7 +80,7 @@ typedef struct {
     const lm_ref_settings *set;
     const lm_ref_frame *frames;  /* texels, else NULL */
     const lm_atlas *atlas;       /* texels, else NULL */
-    const lm_ref_camera *cam;    /* pixels, else NULL */
+    const lm_view *cam;    /* pixels, else NULL */
     uint32_t count;
     entry_stat *st;
 } job;
@@ -320,7 +320,7 @@ lm_status lm_reference_texels(const lm_scene *s, const lm_atlas *atlas, const lm
     return st;
 }
 
-static lm_status check_camera(const lm_ref_camera *cam, lm_error *err)
+static lm_status check_camera(const lm_view *cam, lm_error *err)
 {
     float f2 = cam->forward[0] * cam->forward[0] + cam->forward[1] * cam->forward[1] + cam->forward[2] * cam->forward[2];
     int finite = isfinite(cam->eye[0]) && isfinite(cam->eye[1]) && isfinite(cam->eye[2]) && isfinite(f2) &&
@@ -331,7 +331,7 @@ static lm_status check_camera(const lm_ref_camera *cam, lm_error *err)
     return LM_OK;
 }
 
-lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitters *em, const lm_ref_camera *cam,
+lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitters *em, const lm_view *cam,
                               const lm_ref_settings *set, lm_ref_result *out, lm_error *err)
 {
     memset(out, 0, sizeof *out);

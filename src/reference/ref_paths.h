@@ -1,6 +1,6 @@
 /* The reference solver's estimators: one path-traced sample of a texel's irradiance or of a pixel's
  * radiance, split by light path into the parts reference.h and docs/reference.md ("Which part carries
- * which light") define. Internal to src/trace. */
+ * which light") define. Internal to src/reference. */
 #ifndef LM_REF_PATHS_H
 #define LM_REF_PATHS_H
 
@@ -61,7 +61,7 @@ void lm_ref_texel_frame(const lm_ref_ctx *c, const lm_texel *t, lm_ref_frame *f)
 /* One sample of a texel's irradiance. */
 void lm_ref_texel_sample(const lm_ref_ctx *c, const lm_ref_frame *f, lm_ref_rng *r, lm_ref_sample *out);
 /* One sample of the radiance through pixel (x, y), jittered inside the pixel. */
-void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_ref_camera *cam, int x, int y, lm_ref_rng *r,
+void lm_ref_pixel_sample(const lm_ref_ctx *c, const lm_view *cam, int x, int y, lm_ref_rng *r,
                          lm_ref_sample *out);
 
 #endif

@@ -1,5 +1,6 @@
 /* The reference solver: brute-force Monte Carlo path tracing (Embree), the ground truth for every
- * error figure lmgi reports (docs/reference.md).
+ * error figure lmgi reports (docs/reference.md). Its own module, the lab's, above the runtime's
+ * (docs/architecture.md): it traces with core to trace, and only api (and the tests) include it.
  *
  * The light at a receiver is split by the path it came along, so that every pass of the runtime is
  * checked against its own part (docs/reference.md, "Which part carries which light"). A vertex is
@@ -60,10 +61,11 @@
 #include <stdint.h>
 
 #include "../charts/charts.h"
+#include "../core/camera.h"
 #include "../core/error.h"
 #include "../scene/scene.h"
-#include "lights.h"
-#include "rt_scene.h"
+#include "../trace/lights.h"
+#include "../trace/rt_scene.h"
 
 typedef struct {
     float target_error;    /* relative standard error per texel/pixel to stop at (default 0.02) */
@@ -90,17 +92,6 @@ typedef struct {
 #define LM_REF_CAUSTIC_PHOTONS (1u << 20)
 
 void lm_ref_settings_default(lm_ref_settings *s);
-
-/* A pinhole camera: eye, unit forward and up (up need not be orthogonal to forward), vertical field of
- * view in radians, picture size; the aspect ratio is width / height. znear is the near clipping plane's
- * distance along forward (0: none): eye rays start on it and points nearer are not seen, as in the
- * rasterised frame, so a camera placed on a wall or in a corner sees the room, not the wall's back. */
-typedef struct {
-    float eye[3], forward[3], up[3];
-    float yfov;
-    int width, height;
-    float znear;
-} lm_ref_camera;
 
 typedef struct {
     uint32_t count;        /* entries: texels (the atlas's texel order) or pixels (row 0 at the top) */
@@ -132,8 +123,8 @@ typedef struct {
 /* Texel references for every texel of `atlas` (built from s). */
 lm_status lm_reference_texels(const lm_scene *s, const lm_atlas *atlas, const lm_rt *rt, const lm_emitters *em,
                               const lm_ref_settings *set, lm_ref_result *out, lm_error *err);
-/* Pixel radiance for a camera. */
-lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitters *em, const lm_ref_camera *cam,
+/* Pixel radiance for a camera: the rays go through its pinhole (forward .. znear, core/camera.h). */
+lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitters *em, const lm_view *cam,
                               const lm_ref_settings *set, lm_ref_result *out, lm_error *err);
 void lm_ref_result_free(lm_ref_result *r);
 

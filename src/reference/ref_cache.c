@@ -123,7 +123,7 @@ uint64_t lm_ref_key_texels(const lm_scene *s, const lm_atlas *a, const lm_ref_se
     return h;
 }
 
-uint64_t lm_ref_key_pixels(const lm_scene *s, const lm_ref_camera *cam, const lm_ref_settings *set)
+uint64_t lm_ref_key_pixels(const lm_scene *s, const lm_view *cam, const lm_ref_settings *set)
 {
     uint64_t h = LM_FNV_OFFSET;
     fnv_u32(&h, LM_REF_VERSION);
