@@ -48,7 +48,7 @@ DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenm
                 $(NPM_DEB)
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/photonmap/*.c \
-                             src/gpu/*.c src/update/*.c src/api/*.c))
+                             src/gpu/*.c src/gpu/*/*.c src/update/*.c src/api/*.c))
 LIB_CXX := $(sort $(wildcard src/scene/*.cpp src/charts/*.cpp))
 CLI_C   := $(sort $(wildcard src/cli/*.c))
 LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o)

@@ -22,12 +22,12 @@
 #define LM_FRAME_LOOP_H
 
 #include "../gpu/camera.h"
-#include "../gpu/caustic_pass.h"
-#include "../gpu/direct.h"
-#include "../gpu/gl_context.h"
-#include "../gpu/hemicube.h"
-#include "../gpu/iim.h"
-#include "../gpu/photon_gather.h"
+#include "../gpu/frame/caustic_pass.h"
+#include "../gpu/frame/direct.h"
+#include "../gpu/gl/gl_context.h"
+#include "../gpu/gather/hemicube.h"
+#include "../gpu/gather/iim.h"
+#include "../gpu/tiled/photon_gather.h"
 #include "photon_stage.h"
 
 enum { LM_INDIRECT_LIGHTMAP = 0, LM_INDIRECT_BRUTEFORCE = 1, LM_INDIRECT_TILED = 2, LM_INDIRECT_HASHGRID = 3 };
