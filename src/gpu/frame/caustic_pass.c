@@ -613,10 +613,9 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
  * probe slot) or its frame's. One quad: no geometry drawn again. */
 static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_direct *d, int slot, const int box[4])
 {
-    if (slot == LM_CAUSTIC_SLOT_PROBE)
-        lm_direct_bind_probe(d);
-    else
-        lm_direct_bind_target(d);
+    const lm_frame_targets *f = lm_direct_targets(d);
+    int which = slot == LM_CAUSTIC_SLOT_PROBE ? LM_FRAME_PROBE : LM_FRAME_VIEW;
+    lm_frame_targets_bind_radiance(f, which);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glEnable(GL_BLEND);
@@ -625,7 +624,7 @@ static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_direc
     glUseProgram(p);
     set_size(p, t->width, t->height);
     glUniform4f(glGetUniformLocation(p, "rect"), (float)box[0], (float)box[1], (float)box[2], (float)box[3]);
-    const GLuint tex[2] = {t->irr_tex, lm_direct_kd_texture(d, slot == LM_CAUSTIC_SLOT_PROBE)};
+    const GLuint tex[2] = {t->irr_tex, lm_frame_targets_kd(f, which)};
     const char *names[2] = {"irr", "kd"};
     for (int i = 0; i < 2; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);

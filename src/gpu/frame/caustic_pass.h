@@ -24,11 +24,11 @@
  *                / (pi R^2 / 3): photons on another surface than x's (a depth step) do not leak.
  *            Elsewhere E is 0.
  *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
- *            lobe the direct light's first pass wrote there: lm_direct_kd_texture).
+ *            lobe the direct light's first pass wrote there: frame_targets.h).
  *
  * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
- * environment maps' faces (_PROBE, composited into lm_direct's probe target) and other views an application
- * renders (_VIEW).
+ * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
+ * application renders (_VIEW).
  * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel, two
  * per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a current GL
  * context; not thread-safe. */

@@ -16,7 +16,6 @@
 #include "direct_shader.h"
 #include "direct_mesh.h"
 #include "../gl/gl_shader.h"
-#include "../gl/offscreen.h"
 #include "shadow_maps.h"
 #include "sky_pass.h"
 
@@ -55,9 +54,8 @@ struct lm_direct {
     lm_direct_mesh mesh;
     lm_sky_pass sky;        /* a gradient or image sky behind everything */
     lm_shadow_renderer shadow;
-    lm_float_target target;
-    lm_float_target probe;  /* environment map faces (lm_direct_draw_probe), apart from the frame's */
-    const lm_float_target *cur; /* the target of the draw in progress */
+    lm_frame_targets targets; /* the view's picture and the environment map faces' (lm_direct_draw_probe) */
+    int cur;                /* the picture of the draw in progress: LM_FRAME_VIEW or LM_FRAME_PROBE */
     int drop[2];            /* vertices the draw in progress leaves out (lm_direct_draw_probe's node) */
     cached_map *maps;       /* per emitter index */
     int map_count;
@@ -71,8 +69,6 @@ struct lm_direct {
     const lm_atlas *atlas;  /* that atlas (borrowed), for a rebuild of the mesh */
     unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
     unsigned coverage_tex;  /* else the photon gathers' kernel coverage it writes to kd's alpha (0: none) */
-    float *scratch;         /* read-back, width x height RGBA */
-    size_t scratch_px;
 };
 
 static void find_uniforms(GLuint p, uniforms *u)
@@ -302,7 +298,7 @@ static lm_status refresh_maps(lm_direct *d, const lm_scene *s, const lm_emitters
 static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, const lm_view *view,
                             int w, int h, lm_error *err)
 {
-    glBindFramebuffer(GL_FRAMEBUFFER, d->cur->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, lm_frame_targets_fbo(&d->targets, d->cur));
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
@@ -464,8 +460,7 @@ void lm_direct_free(lm_direct *d)
     for (int i = 0; i < d->map_count; i++)
         lm_shadow_map_free(&d->maps[i].map);
     free(d->maps);
-    lm_float_target_free(&d->target);
-    lm_float_target_free(&d->probe);
+    lm_frame_targets_free(&d->targets);
     if (d->coverage_tex)
         glDeleteTextures(1, &d->coverage_tex);
     if (d->mesh.first)
@@ -480,7 +475,6 @@ void lm_direct_free(lm_direct *d)
     if (d->emission)
         glDeleteProgram(d->emission);
     lm_sky_pass_free(&d->sky);
-    free(d->scratch);
     free(d);
 }
 
@@ -498,8 +492,9 @@ static lm_status ensure_maps(lm_direct *d, int count, lm_error *err)
     return LM_OK;
 }
 
-/* The scene from view into target t (width x height), leaving out the vertices in d->drop. */
-static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, const lm_emitters *em,
+/* The scene from view into picture `which` of the frame's targets (width x height), leaving out the
+ * vertices in d->drop. */
+static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_emitters *em,
                            const lm_view *view, int width, int height, lm_error *err)
 {
     if (width <= 0 || height <= 0)
@@ -520,17 +515,17 @@ static lm_status draw_into(lm_direct *d, lm_float_target *t, const lm_scene *s, 
     int moved = lm_direct_mesh_update(&d->mesh, s);
     d->static_version += (moved & LM_MESH_STATIC_CASTERS_MOVED) != 0;
     d->dynamic_version += (moved & LM_MESH_DYNAMIC_CASTERS_MOVED) != 0;
-    st = lm_float_target_ensure(t, width, height, 3, err); /* radiance; the first pass's kd and G-buffer */
+    st = lm_frame_targets_ensure(&d->targets, which, width, height, err);
     if (st != LM_OK)
         return st;
-    d->cur = t;
+    d->cur = which;
     fit_live_sizes(d, s, em);
     if ((st = refresh_maps(d, s, em, err)) != LM_OK)
         return st;
     int first = -1;
     for (int i = 0; first < 0 && i < em->count; i++)
         first = live_punctual(s, &em->e[i]) ? i : -1;
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, lm_frame_targets_fbo(&d->targets, which));
     static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     glDrawBuffers(3, all);
     first_pass(d, s, em, first, view, width, height);
@@ -546,7 +541,7 @@ lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em,
                          int height, lm_error *err)
 {
     d->drop[0] = d->drop[1] = 0;
-    return draw_into(d, &d->target, s, em, view, width, height, err);
+    return draw_into(d, LM_FRAME_VIEW, s, em, view, width, height, err);
 }
 
 lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
@@ -555,23 +550,12 @@ lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitter
     int ok = skip >= 0 && skip < d->mesh.node_count;
     d->drop[0] = ok ? d->mesh.node_first[skip] : 0;
     d->drop[1] = ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0;
-    lm_status st = draw_into(d, &d->probe, s, em, view, size, size, err);
+    lm_status st = draw_into(d, LM_FRAME_PROBE, s, em, view, size, size, err);
     d->drop[0] = d->drop[1] = 0;
     return st;
 }
 
-unsigned lm_direct_probe_texture(const lm_direct *d) { return d->probe.color[0]; }
-
-/* Binds a target for a pass that adds radiance (attachment 0; the kd attachment stays as it is). */
-static void bind_radiance(const lm_float_target *t)
-{
-    static const GLenum radiance = GL_COLOR_ATTACHMENT0;
-    glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
-    glDrawBuffers(1, &radiance);
-    glViewport(0, 0, t->width, t->height);
-}
-
-void lm_direct_bind_target(const lm_direct *d) { bind_radiance(&d->target); }
+const lm_frame_targets *lm_direct_targets(const lm_direct *d) { return &d->targets; }
 
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
 {
@@ -583,13 +567,10 @@ void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
     set_ranges(prog, ALL, ALL);
 }
 
-
-void lm_direct_bind_probe(const lm_direct *d) { bind_radiance(&d->probe); }
-
-unsigned lm_direct_depth_texture(const lm_direct *d, int probe) { return probe ? d->probe.depth : d->target.depth; }
-unsigned lm_direct_kd_texture(const lm_direct *d, int probe) { return probe ? d->probe.color[1] : d->target.color[1]; }
-unsigned lm_direct_gbuffer_texture(const lm_direct *d) { return d->target.color[2]; }
-unsigned lm_direct_radiance_texture(const lm_direct *d) { return d->target.color[0]; }
+unsigned lm_direct_depth_texture(const lm_direct *d, int probe) { return lm_frame_targets_depth(&d->targets, probe); }
+unsigned lm_direct_kd_texture(const lm_direct *d, int probe) { return lm_frame_targets_kd(&d->targets, probe); }
+unsigned lm_direct_gbuffer_texture(const lm_direct *d) { return lm_frame_targets_gbuffer(&d->targets); }
+unsigned lm_direct_radiance_texture(const lm_direct *d) { return lm_frame_targets_radiance(&d->targets, LM_FRAME_VIEW); }
 
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
 lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *err)
@@ -660,18 +641,7 @@ int lm_direct_shadow_maps_held(const lm_direct *d)
 
 lm_status lm_direct_read(lm_direct *d, float *rgb, lm_error *err)
 {
-    size_t px = (size_t)d->target.width * (size_t)d->target.height;
-    if (px > d->scratch_px) {
-        free(d->scratch);
-        d->scratch = malloc(4 * px * sizeof(float));
-        d->scratch_px = d->scratch ? px : 0;
-        if (!d->scratch)
-            return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory to read back %dx%d", d->target.width,
-                           d->target.height);
-    }
-    lm_float_target_read_rgb(&d->target, 0, rgb, d->scratch);
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    return lm_gl_check("direct_light: reading back", err);
+    return lm_frame_targets_read(&d->targets, rgb, err);
 }
 
 lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,

@@ -11,6 +11,7 @@
 #include "../../scene/scene.h"
 #include "../../trace/lights.h"
 #include "../camera.h"
+#include "frame_targets.h"
 
 typedef struct {
     int map_size;         /* 2D shadow maps (spot, directional), texels per side. Default 1024 */
@@ -63,43 +64,31 @@ int lm_direct_stale_maps(const lm_direct *d);
 int lm_direct_map_stale(const lm_direct *d, int i);
 /* The sides the live lights' maps get now: a point light's cube face and a spot or directional map. */
 void lm_direct_map_sides(const lm_direct *d, int *cube, int *map);
-/* Renders into the object's width x height RGBA32F target (no read-back; rgb = radiance, GL rows
- * bottom-up), where reflections draw over it before lm_direct_read. em and s->bounds current as for lm_render_direct. */
+/* Renders into the view's picture of the frame's targets (lm_direct_targets, frame_targets.h), width x
+ * height, no read-back, where the later passes add to it before lm_direct_read. em and s->bounds current
+ * as for lm_render_direct. */
 lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                          int height, lm_error *err);
 /* lm_direct_draw, then the image read back as RGB floats (row 0 at the top). */
 lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                            int height, float *rgb, lm_error *err);
-/* Reads the last lm_direct_draw's image (and what lm_direct_bind_target's passes added to it) back as RGB
- * floats, row 0 at the top. */
-lm_status lm_direct_read(lm_direct *d, float *rgb, lm_error *err);
-/* Binds the frame's target (after lm_direct_draw) for a further pass to add radiance to it (reflections.h). */
-void lm_direct_bind_target(const lm_direct *d);
-/* The scene from view into a second, size x size target kept apart from the frame's, node `skip`'s
- * vertices left out (-1: none): one face of skip's environment map (reflections.h). The first pass's
- * indirect term and the shadow maps are the frame's. */
+/* The scene from view into the probe's picture of the frame's targets (LM_FRAME_PROBE), size x size, node
+ * `skip`'s vertices left out (-1: none): one face of skip's environment map (reflections.h). The first
+ * pass's indirect term and the shadow maps are the frame's. */
 lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
                                int skip, lm_error *err);
-/* The last lm_direct_draw_probe's image: an RGBA32F texture (GL rows bottom-up). */
-unsigned lm_direct_probe_texture(const lm_direct *d);
 /* Draws only node's triangles with prog, a program on lm_direct_vs (its uniforms set by the caller;
  * has_tex and the base colour texture on unit 2 set here per texture group). */
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node);
-/* Binds the probe's target (after lm_direct_draw_probe) for a further pass to add to it. */
-void lm_direct_bind_probe(const lm_direct *d);
-/* The depth texture of the frame's target (probe 0) or of the probe's (1): 24-bit, GL window depth. */
+/* The frame's targets the draws fill (frame_targets.h): what the later passes bind, read and add to. */
+const lm_frame_targets *lm_direct_targets(const lm_direct *d);
+/* Shorthands of frame_targets.h on lm_direct_targets(d), for the frame loop, the tests and tools: the
+ * view's radiance read back (RGB floats, row 0 at the top), and the depth and kd textures of the view
+ * (probe 0) or the probe (1), the view's G-buffer and radiance. */
+lm_status lm_direct_read(lm_direct *d, float *rgb, lm_error *err);
 unsigned lm_direct_depth_texture(const lm_direct *d, int probe);
-/* The diffuse lobe kd the first pass found at each pixel of the frame (probe 0) or the probe (1): an
- * RGBA32F texture (rgb; 0 where nothing, the back of a single-sided surface, mirror and glass; a: 1, or
- * lm_direct_set_coverage's 1 / c), for a later pass that adds kd / pi x an irradiance per pixel (the
- * caustics, the photon gathers). */
 unsigned lm_direct_kd_texture(const lm_direct *d, int probe);
-/* The frame's G-buffer from the first pass (after lm_direct_draw): an RGBA32F texture, rgb the visible
- * point's world position, a the eye-side shading normal packed (0: nothing, or the back of a single-sided
- * surface; lm_direct_gbuffer_glsl unpacks it), for the per-pixel photon gathers (gpu/tiled/photon_gather.h). */
 unsigned lm_direct_gbuffer_texture(const lm_direct *d);
-/* The frame's radiance (after lm_direct_draw): the RGBA32F texture lm_direct_read reads, for a compute pass
- * that adds to it (the photon gathers' composite). */
 unsigned lm_direct_radiance_texture(const lm_direct *d);
 /* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at

@@ -248,14 +248,15 @@ static lm_status render_face(lm_reflections *r, int k, int face, lm_direct *d, c
     centre(s, f, f->centre);
     lm_view v;
     lm_view_cube_face(f->centre, face, 1e-4f * size, 10.0f * size, &v);
+    const lm_frame_targets *t = lm_direct_targets(d);
     lm_status st = lm_direct_draw_probe(d, s, em, &v, r->size, f->node, err);
     if (st == LM_OK && caustics) /* the face's caustics, over its own depth */
-        st = lm_caustic_pass_run(caustics, LM_CAUSTIC_SLOT_PROBE, &v, lm_direct_depth_texture(d, 1), r->size, r->size,
-                                 d, NULL, err);
+        st = lm_caustic_pass_run(caustics, LM_CAUSTIC_SLOT_PROBE, &v, lm_frame_targets_depth(t, LM_FRAME_PROBE), r->size,
+                                 r->size, d, NULL, err);
     if (st != LM_OK)
         return st;
-    glCopyImageSubData(lm_direct_probe_texture(d), GL_TEXTURE_2D, 0, 0, 0, 0, f->cube, GL_TEXTURE_CUBE_MAP, 0, 0, 0,
-                       face, r->size, r->size, 1);
+    glCopyImageSubData(lm_frame_targets_radiance(t, LM_FRAME_PROBE), GL_TEXTURE_2D, 0, 0, 0, 0, f->cube,
+                       GL_TEXTURE_CUBE_MAP, 0, 0, 0, face, r->size, r->size, 1);
     f->mips_stale = f->glossy;
     f->dirty[face] = 0;
     return LM_OK;
@@ -412,7 +413,7 @@ lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const
 {
     if (!r)
         return LM_OK;
-    lm_direct_bind_target(d);
+    lm_frame_targets_bind_radiance(lm_direct_targets(d), LM_FRAME_VIEW);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LEQUAL);
     glDepthMask(GL_FALSE);
