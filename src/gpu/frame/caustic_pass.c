@@ -10,6 +10,7 @@
 #include "../../core/timing.h"
 #include "../../core/vecmath.h"
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 
 void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
 {
@@ -21,133 +22,7 @@ void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
 /* A photon as the splat reads it: position, receiver normal (arrival side), flux. */
 #define PHOTON_FLOATS 9
 
-/* Per photon: projected to its pixel's centre, or out of the clip volume when dropped (caustic_pass.h). */
-static const char *SPLAT_VS =
-    "#version 450 core\n"
-    "layout(location = 0) in vec3 pos;\n"
-    "layout(location = 1) in vec3 ng;\n"
-    "layout(location = 2) in vec3 flux;\n"
-    "uniform mat4 view_proj, inv_proj;\n"
-    "uniform vec3 eye, view_dir;\n"
-    "uniform int ortho;\n"
-    "uniform vec2 size;\n"
-    "uniform float pix_area, pix_side;\n"
-    "uniform sampler2D depth;\n"
-    "out vec3 v_irr, v_flux;\n"
-    "float view_depth(vec2 ndc, float z) {\n"
-    "    vec4 v = inv_proj * vec4(ndc, z, 1.0);\n"
-    "    return -v.z / v.w;\n"
-    "}\n"
-    "void main() {\n"
-    "    gl_Position = vec4(2.0, 2.0, 2.0, 1.0);\n"
-    "    vec4 c = view_proj * vec4(pos, 1.0);\n"
-    "    if (c.w <= 0.0) return;\n"
-    "    vec3 ndc = c.xyz / c.w;\n"
-    "    if (any(greaterThanEqual(abs(ndc.xy), vec2(1.0))) || abs(ndc.z) > 1.0) return;\n"
-    "    ivec2 px = clamp(ivec2(floor((ndc.xy * 0.5 + 0.5) * size)), ivec2(0), ivec2(size) - 1);\n"
-    "    vec3 V = ortho != 0 ? view_dir : normalize(eye - pos);\n"
-    "    float cv = dot(ng, V);\n"
-    "    if (cv <= 1e-4) return;\n"
-    "    float tp = view_depth(ndc.xy, ndc.z);\n"
-    "    float ts = view_depth(ndc.xy, texelFetch(depth, px, 0).r * 2.0 - 1.0);\n"
-    "    float s = ortho != 0 ? pix_side : tp * pix_side;\n"
-    "    float tan_v = sqrt(max(0.0, 1.0 - cv * cv)) / cv;\n"
-    "    if (tp > ts + s * (1.0 + 2.0 * min(tan_v, 50.0)) + 1e-5 * tp) return;\n"
-    "    float area = pix_area / cv;\n"
-    "    if (ortho == 0) {\n"
-    "        float d = length(pos - eye), ca = tp / d;\n"
-    "        area *= d * d * ca * ca * ca;\n"
-    "    }\n"
-    "    v_irr = flux / area;\n"
-    "    v_flux = flux;\n"
-    "    gl_Position = vec4((vec2(px) + 0.5) / size * 2.0 - 1.0, 0.0, 1.0);\n"
-    "}\n";
-static const char *SPLAT_FS =
-    "#version 450 core\n"
-    "in vec3 v_irr, v_flux;\n"
-    "layout(location = 0) out vec4 irr;\n"
-    "layout(location = 1) out vec4 flux;\n"
-    "void main() { irr = vec4(v_irr, 1.0); flux = vec4(v_flux, 1.0); }\n";
 
-/* A pixel rectangle [rect.xy, rect.zw) as a quad: 4 vertices of a triangle strip, no attributes. */
-static const char *RECT_VS =
-    "#version 450 core\n"
-    "uniform vec4 rect;\n"
-    "uniform vec2 size;\n"
-    "void main() {\n"
-    "    vec2 c = vec2(gl_VertexID & 1, gl_VertexID >> 1);\n"
-    "    gl_Position = vec4(mix(rect.xy, rect.zw, c) / size * 2.0 - 1.0, 0.0, 1.0);\n"
-    "}\n";
-static const char *QUERY_FS =
-    "#version 450 core\n"
-    "out vec4 frag;\n"
-    "void main() { frag = vec4(0.0); }\n";
-/* The filter's quads come from a vertex buffer of pixel positions (two triangles per grown tile). */
-static const char *FILTER_VS =
-    "#version 450 core\n"
-    "layout(location = 0) in vec2 p;\n"
-    "uniform vec2 size;\n"
-    "void main() { gl_Position = vec4(p / size * 2.0 - 1.0, 0.0, 1.0); }\n";
-static const char *FILTER_HEAD =
-    "#version 450 core\n"
-    "uniform sampler2D irr, flux, depth;\n"
-    "uniform mat4 inv_proj;\n"
-    "uniform vec2 size;\n"
-    "uniform int ortho;\n"
-    "uniform float pix_side;\n"
-    "out vec4 frag;\n"
-    "const int K = FILTER_K;\n"
-    "const float PI = " LM_PI_GLSL ";\n"
-    "vec3 view_pos(ivec2 q) {\n"
-    "    vec2 ndc = (vec2(q) + 0.5) / size * 2.0 - 1.0;\n"
-    "    vec4 v = inv_proj * vec4(ndc, texelFetch(depth, q, 0).r * 2.0 - 1.0, 1.0);\n"
-    "    return v.xyz / v.w;\n"
-    "}\n";
-/* Eq. 4 normalized by its weights' sum: each photon's Phi / A_pix spread over the filter's pixels. */
-static const char *FILTER_SCREEN =
-    "void main() {\n"
-    "    ivec2 x = ivec2(gl_FragCoord.xy), hi = ivec2(size) - 1;\n"
-    "    float top = sqrt(1.0 + 2.0 * float(K * K)), wsum = 0.0;\n"
-    "    vec3 e = vec3(0.0);\n"
-    "    for (int j = -K; j <= K; j++)\n"
-    "        for (int i = -K; i <= K; i++) {\n"
-    "            float w = top - sqrt(float(i * i + j * j));\n"
-    "            wsum += w;\n"
-    "            ivec2 q = x + ivec2(i, j);\n"
-    "            if (all(greaterThanEqual(q, ivec2(0))) && all(lessThanEqual(q, hi)))\n"
-    "                e += w * texelFetch(irr, q, 0).rgb;\n"
-    "        }\n"
-    "    frag = vec4(e / wsum, 1.0);\n"
-    "}\n";
-/* A cone of world radius R = k footprints at x over the photons' flux at each pixel's view position. */
-static const char *FILTER_WORLD =
-    "void main() {\n"
-    "    ivec2 x = ivec2(gl_FragCoord.xy), hi = ivec2(size) - 1;\n"
-    "    vec3 px = view_pos(x);\n"
-    "    float R = max(float(K), 0.5) * (ortho != 0 ? pix_side : -px.z * pix_side);\n"
-    "    vec3 e = vec3(0.0);\n"
-    "    for (int j = -K; j <= K; j++)\n"
-    "        for (int i = -K; i <= K; i++) {\n"
-    "            ivec2 q = x + ivec2(i, j);\n"
-    "            if (any(lessThan(q, ivec2(0))) || any(greaterThan(q, hi))) continue;\n"
-    "            vec4 f = texelFetch(flux, q, 0);\n"
-    "            if (f.a == 0.0) continue;\n"
-    "            float w = 1.0 - length(view_pos(q) - px) / R;\n"
-    "            if (w > 0.0) e += w * f.rgb;\n"
-    "        }\n"
-    "    frag = vec4(e / (PI * R * R / 3.0), 1.0);\n"
-    "}\n";
-/* kd / pi x E at every pixel, kd as the direct light's first pass found it (0 on mirror, glass and the
- * back of single-sided surfaces). */
-static const char *COMPOSITE_FS =
-    "#version 450 core\n"
-    "uniform sampler2D irr, kd;\n"
-    "out vec4 frag;\n"
-    "const float PI = " LM_PI_GLSL ";\n"
-    "void main() {\n"
-    "    ivec2 p = ivec2(gl_FragCoord.xy);\n"
-    "    frag = vec4(texelFetch(kd, p, 0).rgb / PI * texelFetch(irr, p, 0).rgb, 0.0);\n"
-    "}\n";
 
 /* One slot's targets: the splat (two RGBA32F + depth-stencil), the irradiance, the tiles' flags. */
 typedef struct {
@@ -283,10 +158,10 @@ static lm_status make_slot(lm_caustic_pass *cp, slot_targets *t, int w, int h, l
 static lm_status build_programs(lm_caustic_pass *cp, lm_error *err)
 {
     char fs[8192];
-    lm_status st = lm_gl_program("caustic splat", SPLAT_VS, SPLAT_FS, &cp->splat_prog, err);
+    lm_status st = lm_gl_program("caustic splat", lm_glsl_caustic_splat_vs, lm_glsl_caustic_splat_fs, &cp->splat_prog, err);
     if (st == LM_OK)
-        st = lm_gl_program("caustic tile query", RECT_VS, QUERY_FS, &cp->query_prog, err);
-    int len = snprintf(fs, sizeof fs, "%s%s", FILTER_HEAD, cp->set.world_space ? FILTER_WORLD : FILTER_SCREEN);
+        st = lm_gl_program("caustic tile query", lm_glsl_caustic_rect_vs, lm_glsl_caustic_query_fs, &cp->query_prog, err);
+    int len = snprintf(fs, sizeof fs, "%s", cp->set.world_space ? lm_glsl_caustic_filter_world_fs : lm_glsl_caustic_filter_screen_fs);
     char *k = strstr(fs, "FILTER_K");
     if (st == LM_OK && (len < 0 || (size_t)len >= sizeof fs || !k))
         st = lm_fail(err, LM_ERR_BACKEND, "caustic pass: shader source buffer too small");
@@ -294,10 +169,10 @@ static lm_status build_programs(lm_caustic_pass *cp, lm_error *err)
         char digits[16];
         snprintf(digits, sizeof digits, "%-8d", cp->set.filter_k); /* "FILTER_K" is 8 characters */
         memcpy(k, digits, 8);
-        st = lm_gl_program("caustic filter", FILTER_VS, fs, &cp->filter_prog, err);
+        st = lm_gl_program("caustic filter", lm_glsl_caustic_filter_vs, fs, &cp->filter_prog, err);
     }
     if (st == LM_OK)
-        st = lm_gl_program("caustic composite", RECT_VS, COMPOSITE_FS, &cp->composite_prog, err);
+        st = lm_gl_program("caustic composite", lm_glsl_caustic_rect_vs, lm_glsl_caustic_composite_fs, &cp->composite_prog, err);
     return st;
 }
 

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 #include "../gl/offscreen.h"
 
 struct lm_composite {
@@ -20,27 +21,6 @@ struct lm_composite {
     lm_float_target lit; /* atlas-sized, linear filter: (E / pi * w, w), w = covered and valid */
 };
 
-/* Per frame, per atlas texel: E / pi premultiplied by w = covered x valid (back-face fraction
- * <= limit), and w; sampled with the texture unit's bilinear filter, rgb / a is then the bilinear filter
- * over the four nearest texels that weighs only covered, valid ones, renormalised. */
-static const char *PREMULT_VS =
-    "#version 450 core\n"
-    "void main() {\n"
-    "    vec2 p = vec2(float((gl_VertexID & 1) * 4 - 1), float((gl_VertexID & 2) * 2 - 1));\n"
-    "    gl_Position = vec4(p, 0.0, 1.0);\n"
-    "}\n";
-static const char *PREMULT_FS =
-    "#version 450 core\n"
-    "uniform sampler2D covered;\n"
-    "uniform sampler2D iim;\n"
-    "uniform float limit;\n"
-    "out vec4 frag;\n"
-    "void main() {\n"
-    "    ivec2 q = ivec2(gl_FragCoord.xy);\n"
-    "    vec4 e = texelFetch(iim, q, 0);\n"
-    "    float w = texelFetch(covered, q, 0).r * (e.a <= limit ? 1.0 : 0.0);\n"
-    "    frag = vec4(e.rgb * (w / " LM_PI_GLSL "), w);\n"
-    "}\n";
 /* 1 at every texel of the texel table (covered by some triangle) whose node takes indirect light, 0 in
  * gutters, unused corners and on nodes with indirect light switched off. */
 static void fill_covered(const lm_scene *s, const lm_atlas *a, float *out)
@@ -89,7 +69,7 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->covered_tex = coverage_texture(a->width, a->height);
     lm_status st = lm_composite_update_coverage(c, s, a, err);
     if (st == LM_OK)
-        st = lm_gl_program("composite_premultiply", PREMULT_VS, PREMULT_FS, &c->premult_prog, err);
+        st = lm_gl_program("composite_premultiply", lm_glsl_premultiply_vs, lm_glsl_premultiply_fs, &c->premult_prog, err);
     if (st != LM_OK) {
         lm_composite_free(c);
         return st;

@@ -13,9 +13,9 @@
 #include "../../core/log.h"
 #include "../../core/vecmath.h"
 #include "../../scene/sky.h"
-#include "direct_shader.h"
 #include "direct_mesh.h"
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 #include "shadow_maps.h"
 #include "sky_pass.h"
 
@@ -137,7 +137,7 @@ static void set_view_uniforms(const lm_direct *d, const uniforms *u, const lm_vi
     glUniform1i(u->base_tex, 2);
 }
 
-/* The vertex ranges of direct_shader.c for prog: keep (0, 0: all), drop. */
+/* The vertex ranges of glsl/vertex_ranges.glsl for prog: keep (0, 0: all), drop. */
 static void set_ranges(GLuint prog, const int keep[2], const int drop[2])
 {
     glUniform2i(glGetUniformLocation(prog, "keep"), keep[0], keep[1]);
@@ -321,16 +321,16 @@ static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e
  * the light pass on llvmpipe. */
 static lm_status light_program(int kind, int pcf, int first, GLuint *prog, lm_error *err)
 {
-    size_t n = strlen(lm_direct_fs_body) + 128;
+    size_t n = strlen(lm_glsl_direct_fs) + 128;
     char *fs = malloc(n);
     if (!fs)
         return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory for shader source");
     snprintf(fs, n, "#version 450 core\n#define KIND %d\n#define PCF %d\n#define FIRST %d\n%s", kind, pcf, first,
-             lm_direct_fs_body);
+             lm_glsl_direct_fs);
     static const char *names[2][3] = {
         {"direct_light (point)", "direct_light (spot)", "direct_light (directional)"},
         {"direct_light (point, first pass)", "direct_light (spot, first pass)", "direct_light (directional, first pass)"}};
-    lm_status st = lm_gl_program(names[first][kind], lm_direct_vs, fs, prog, err);
+    lm_status st = lm_gl_program(names[first][kind], lm_glsl_direct_vs, fs, prog, err);
     free(fs);
     return st;
 }
@@ -430,7 +430,7 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
             find_uniforms(d->first[k], &d->uf[k]);
     }
     if (st == LM_OK)
-        st = lm_gl_program("direct_emission", lm_direct_emission_vs, lm_direct_emission_fs, &d->emission, err);
+        st = lm_gl_program("direct_emission", lm_glsl_direct_vs, lm_glsl_emission_fs, &d->emission, err);
     if (st == LM_OK)
         st = lm_sky_pass_init(&d->sky, err);
     if (st == LM_OK) {

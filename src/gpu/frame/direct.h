@@ -77,7 +77,7 @@ lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *e
  * pass's indirect term and the shadow maps are the frame's. */
 lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
                                int skip, lm_error *err);
-/* Draws only node's triangles with prog, a program on lm_direct_vs (its uniforms set by the caller;
+/* Draws only node's triangles with prog, a program on glsl/direct_vs.glsl (its uniforms set by the caller;
  * has_tex and the base colour texture on unit 2 set here per texture group). */
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node);
 /* The frame's targets the draws fill (frame_targets.h): what the later passes bind, read and add to. */

@@ -56,7 +56,7 @@ static unsigned upload(const lm_texture *t)
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     /* row 0 (v = 0) first: GL's t = 0 is the first row, so uv addresses it as the CPU does */
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, t->width, t->height, 0, GL_RGBA, GL_FLOAT, t->rgba);
-    /* mipmapped, for surfaces whose light is linear in the albedo (direct_shader.c's look_up_albedo) */
+    /* mipmapped, for surfaces whose light is linear in the albedo (glsl/lobes.glsl's look_up_albedo) */
     glGenerateMipmap(GL_TEXTURE_2D);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
@@ -126,7 +126,7 @@ static corner_key key_of(const lm_scene *s, const lm_atlas *a, uint32_t t, int k
     key.vi = s->tris[3 * (size_t)t + k];
     key.mat = (int32_t)s->tri_material[t];
     if (a) { /* as lm_lightmapped_vertices; -2: the node's indirect light is switched off (the photon
-              * gathers read it from the G-buffer, direct_shader.c) */
+              * gathers read it from the G-buffer, glsl/gbuffer_pack.glsl) */
         const float *c = a->corner_uv + 6 * (size_t)t + 2 * k;
         int none = a->tri_chart[t] < 0 || !isfinite(c[0]), off = !s->nodes[s->tri_node[t]].settings.indirect;
         key.lm[0] = off ? -2.0f : none ? -1.0f : c[0];

@@ -12,7 +12,7 @@
 #include "../gl/gl_mesh.h"
 
 typedef struct {
-    lm_gl_mesh mesh;      /* attributes: see direct_shader.c; 7 = lightmap uv when built with an atlas */
+    lm_gl_mesh mesh;      /* attributes: see glsl/direct_vs.glsl; 7 = lightmap uv when built with an atlas */
     lm_gl_mesh casters;   /* attribute 0 = world position; indices of nodes with shadows on, those of
                            * static nodes (lm_node.dynamic 0) first */
     int static_caster_indices; /* indices of the static casters at the start of `casters` */

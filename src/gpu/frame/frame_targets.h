@@ -7,7 +7,7 @@
  *   attachment 1  kd, the diffuse lobe at the visible point (rgb; a: 1, or 1 / c, lm_direct_set_coverage),
  *                 for the passes that add kd / pi x an irradiance per pixel (caustics, photon gathers)
  *   attachment 2  the G-buffer: world position (rgb) and the packed eye-side shading normal (a;
- *                 lm_direct_gbuffer_glsl unpacks it), for the per-pixel photon gathers; the view's only
+ *                 glsl/gbuffer_normal.glsl unpacks it), for the per-pixel photon gathers; the view's only
  *   depth         24-bit GL window depth, for the caustic splat's depth test and the reflections'
  *
  * Every texture is GL rows bottom-up. The targets are kept between frames and re-made only when a size

@@ -7,30 +7,9 @@
 #include "../../core/vecmath.h"
 #include "../gl/gl_mesh.h"
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 #include "../gl/offscreen.h"
 
-static const char *VS =
-    "#version 450 core\n"
-    "layout(location = 0) in vec3 pos;\n"
-    "layout(location = 1) in vec2 uv;\n"
-    "uniform mat4 view_proj;\n"
-    "out vec2 v_uv;\n"
-    "void main() { v_uv = uv; gl_Position = view_proj * vec4(pos, 1.0); }\n";
-/* Exposure, clamp, then the sRGB transfer: the same tone map as lm_tonemap_srgb8. */
-static const char *FS =
-    "#version 450 core\n"
-    "in vec2 v_uv;\n"
-    "uniform sampler2D atlas;\n"
-    "uniform float exposure;\n"
-    "out vec4 frag;\n"
-    "vec3 srgb(vec3 c) {\n"
-    "    c = clamp(c, 0.0, 1.0);\n"
-    "    return mix(12.92 * c, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));\n"
-    "}\n"
-    "void main() {\n"
-    "    if (v_uv.x < 0.0) { frag = vec4(0.5, 0.5, 0.5, 1.0); return; }\n"
-    "    frag = vec4(srgb(exposure * texture(atlas, v_uv).rgb), 1.0);\n"
-    "}\n";
 
 float *lm_lightmapped_vertices(const lm_scene *s, const lm_atlas *a)
 {
@@ -67,7 +46,7 @@ lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *
                              const lm_view *view, int width, int height, uint8_t *rgba8, lm_error *err)
 {
     GLuint prog = 0;
-    lm_status st = lm_gl_program("lightmap_view", VS, FS, &prog, err);
+    lm_status st = lm_gl_program("lightmap_view", lm_glsl_lightmap_view_vs, lm_glsl_lightmap_view_fs, &prog, err);
     if (st != LM_OK)
         return st;
     float *verts = lm_lightmapped_vertices(s, a);

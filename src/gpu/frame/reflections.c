@@ -9,7 +9,7 @@
 #include <string.h>
 
 #include "../../core/vecmath.h"
-#include "direct_shader.h"
+#include "glsl.h"
 #include "../gl/gl_shader.h"
 
 typedef struct {
@@ -38,67 +38,6 @@ struct lm_reflections {
     GLuint prog;
 };
 
-/* Mirror: F x env(r), F the metal's Fresnel (Schlick's, the albedo as F0: lm_mirror_fresnel). Glossy: ks (n + 2) / (n + 1) max(n.r, 0) x env(r) at the mip level whose texel
- * is the lobe's width 1 / sqrt(n) (lod_base = log2(size / (pi / 2)), a face spanning pi / 2). Glass (ior
- * in the vertex's n): F env(r) + (1 - F) albedo env(t), F the dielectric Fresnel reflectance at the eye
- * ray's angle (Schlick's approximation to it; 1 for KHR_materials_ior's 0), t the ray refracted into the
- * glass at this first surface (F 1 under total internal reflection, leaving the inside), looked up as if it
- * left unbent: the glass's far side and the parallax of what lies behind are not modelled. albedo and ks from direct_shader.c's
- * lobes (lm_direct_lobes_glsl), so both passes read a material alike. The back of a single-sided surface
- * reflects nothing. Class numbers as there (1 glossy, 2 mirror, 3 glass). */
-static const char *REFLECT_HEAD =
-    "#version 450 core\n"
-    "in vec3 v_pos, v_ns;\n"
-    "flat in vec3 v_base, v_em;\n"
-    "flat in vec4 v_par;\n"
-    "in vec2 v_uv, v_lm;\n"
-    "uniform int has_tex;\n"
-    "uniform sampler2D base_tex;\n"
-    "uniform samplerCube env;\n"
-    "uniform vec3 eye;\n"
-    "uniform float lod_base;\n"
-    "uniform int use_box;\n"
-    "uniform vec3 box_lo, box_hi, centre;\n"
-    "out vec4 frag;\n"
-    /* box-projected lookup: the ray from the pixel to the proxy box, looked up from the map's centre */
-    "vec3 parallax(vec3 d) {\n"
-    "    if (use_box == 0) return d;\n"
-    "    vec3 tf = max((box_hi - v_pos) / d, (box_lo - v_pos) / d);\n"
-    "    float t = min(min(tf.x, tf.y), tf.z);\n"
-    "    return t > 0.0 ? v_pos + d * t - centre : d;\n"
-    "}\n";
-static const char *REFLECT_MAIN =
-    "void main() {\n"
-    "    look_up_albedo();\n"
-    "    bool two = v_par.y > 0.5;\n"
-    "    if (!gl_FrontFacing && !two) { frag = vec4(0.0); return; }\n"
-    "    vec3 n = normalize(gl_FrontFacing ? v_ns : -v_ns);\n"
-    "    vec3 r = reflect(normalize(v_pos - eye), n);\n"
-    "    int cls = int(v_par.w + 0.5);\n"
-    "    if (cls == 2) { /* a metal's Fresnel, Schlick's with the albedo as F0 (bsdf.c's lm_mirror_fresnel) */\n"
-    "        float m = 1.0 - clamp(abs(dot(normalize(v_pos - eye), n)), 0.0, 1.0);\n"
-    "        vec3 F = albedo + (1.0 - albedo) * (m * m * m * m * m);\n"
-    "        frag = vec4(F * textureLod(env, parallax(r), 0.0).rgb, 0.0);\n"
-    "        return;\n"
-    "    }\n"
-    "    if (cls == 3) {\n"
-    "        vec3 d = normalize(v_pos - eye);\n"
-    "        if (v_par.x == 0.0) { frag = vec4(textureLod(env, parallax(r), 0.0).rgb, 0.0); return; } /* ior 0 */\n"
-    "        float eta = gl_FrontFacing ? 1.0 / v_par.x : v_par.x, c = clamp(-dot(d, n), 0.0, 1.0);\n"
-    "        vec3 t = refract(d, n, eta);\n"
-    "        float f0 = (1.0 - v_par.x) / (1.0 + v_par.x), F = f0 * f0 + (1.0 - f0 * f0) * pow(1.0 - c, 5.0);\n"
-    "        if (dot(t, t) == 0.0) F = 1.0;\n"
-    "        vec3 through = dot(t, t) > 0.0 ? albedo * textureLod(env, parallax(t), 0.0).rgb : vec3(0.0);\n"
-    "        frag = vec4(F * textureLod(env, parallax(r), 0.0).rgb + (1.0 - F) * through, 0.0);\n"
-    "        return;\n"
-    "    }\n"
-    "    vec3 kd, ks;\n"
-    "    lobes(kd, ks);\n"
-    "    float e = v_par.x;\n"
-    "    float lod = max(0.0, lod_base - 0.5 * log2(e));\n"
-    "    float w = (e + 2.0) / (e + 1.0) * max(dot(n, r), 0.0);\n"
-    "    frag = vec4(ks * w * textureLod(env, parallax(r), lod).rgb, 0.0);\n"
-    "}\n";
 
 static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY || c == LM_MAT_GLASS; }
 
@@ -188,12 +127,8 @@ lm_status lm_reflections_create(const lm_scene *s, int size, int faces_per_frame
     }
     if (st == LM_OK)
         st = node_boxes(r, s, err);
-    char fs[4096];
-    int len = snprintf(fs, sizeof fs, "%s%s%s", REFLECT_HEAD, lm_direct_lobes_glsl, REFLECT_MAIN);
-    if (st == LM_OK && (len < 0 || (size_t)len >= sizeof fs))
-        st = lm_fail(err, LM_ERR_BACKEND, "reflections: shader source buffer too small");
     if (st == LM_OK)
-        st = lm_gl_program("reflections", lm_direct_vs, fs, &r->prog, err);
+        st = lm_gl_program("reflections", lm_glsl_direct_vs, lm_glsl_reflections_fs, &r->prog, err);
     for (int k = 0; st == LM_OK && k < r->count; k++)
         r->r[k].cube = cube_texture(size, r->r[k].glossy ? r->levels : 1);
     if (st == LM_OK)

@@ -6,26 +6,8 @@
 
 #include "../../core/vecmath.h"
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 
-static const char *VS =
-    "#version 450 core\n"
-    "layout(location = 0) in vec3 pos;\n"
-    "uniform mat4 vp;\n"
-    "out vec3 v_pos;\n"
-    "void main() { v_pos = pos; gl_Position = vp * vec4(pos, 1.0); }\n";
-/* ortho: depth along dir from origin; else distance to origin. The depth test keeps the smallest
- * metric exactly (it is the depth), whatever the projection's depth precision; there is no colour. */
-static const char *FS =
-    "#version 450 core\n"
-    "in vec3 v_pos;\n"
-    "uniform vec3 origin, dir;\n"
-    "uniform int ortho;\n"
-    "uniform float range;\n"
-    "void main() {\n"
-    "    vec3 d = v_pos - origin;\n"
-    "    float m = ortho != 0 ? dot(d, dir) : length(d);\n"
-    "    gl_FragDepth = clamp(m / range, 0.0, 1.0);\n"
-    "}\n";
 
 static void ortho_proj(float m[16], float half, float zfar)
 {
@@ -198,7 +180,7 @@ void lm_shadow_params_compute(lm_shadow_params *m, const lm_scene *s, const lm_e
 lm_status lm_shadow_renderer_create(lm_shadow_renderer *r, lm_error *err)
 {
     memset(r, 0, sizeof *r);
-    lm_status st = lm_gl_program("shadow_map", VS, FS, &r->prog, err);
+    lm_status st = lm_gl_program("shadow_map", lm_glsl_shadow_map_vs, lm_glsl_shadow_map_fs, &r->prog, err);
     if (st != LM_OK)
         return st;
     r->u_vp = glGetUniformLocation(r->prog, "vp");

@@ -6,43 +6,14 @@
 #include "../../core/vecmath.h"
 #include "../../scene/sky.h"
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 
-static const char *const k_vs =
-    "#version 450 core\n"
-    "out vec2 ndc;\n"
-    "void main() {\n"
-    "    vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);\n"
-    "    ndc = p;\n"
-    "    gl_Position = vec4(p, 0.0, 1.0);\n"
-    "}\n";
 
-/* the rule of scene/sky.h: kind 1 gradient, 2 image */
-static const char *const k_fs =
-    "#version 450 core\n"
-    "in vec2 ndc;\n"
-    "layout(location = 0) out vec4 radiance;\n"
-    "uniform mat4 inv_view;\n"
-    "uniform vec4 lens; /* the projection's x, y scales and offsets (perspective); x = 0: orthographic */\n"
-    "uniform int kind;\n"
-    "uniform vec3 zenith, horizon;\n"
-    "uniform sampler2D image;\n"
-    "const float PI = 3.14159265358979;\n"
-    "void main() {\n"
-    "    vec3 dv = lens.x == 0.0 ? vec3(0.0, 0.0, -1.0)\n"
-    "                            : vec3((ndc.x + lens.z) / lens.x, (ndc.y + lens.w) / lens.y, -1.0);\n"
-    "    vec3 d = normalize(mat3(inv_view) * dv);\n"
-    "    vec3 L;\n"
-    "    if (kind == 1)\n"
-    "        L = horizon + (zenith - horizon) * clamp(d.y, 0.0, 1.0);\n"
-    "    else\n"
-    "        L = zenith * texture(image, vec2(atan(d.x, -d.z) / (2.0 * PI) + 0.5, acos(clamp(d.y, -1.0, 1.0)) / PI)).rgb;\n"
-    "    radiance = vec4(L, 1.0);\n"
-    "}\n";
 
 lm_status lm_sky_pass_init(lm_sky_pass *p, lm_error *err)
 {
     *p = (lm_sky_pass){0};
-    lm_status st = lm_gl_program("sky", k_vs, k_fs, &p->prog, err);
+    lm_status st = lm_gl_program("sky", lm_glsl_sky_vs, lm_glsl_sky_fs, &p->prog, err);
     if (st == LM_OK)
         glGenVertexArrays(1, &p->vao);
     return st;

@@ -8,20 +8,9 @@
 #include "../../core/vecmath.h"
 #include "../gl/gl_mesh.h"
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 #include "../gl/offscreen.h"
 
-static const char *VS =
-    "#version 450 core\n"
-    "layout(location = 0) in vec3 pos;\n"
-    "layout(location = 1) in vec3 col;\n"
-    "uniform mat4 view_proj;\n"
-    "flat out vec3 v_col;\n"
-    "void main() { v_col = col; gl_Position = view_proj * vec4(pos, 1.0); }\n";
-static const char *FS =
-    "#version 450 core\n"
-    "flat in vec3 v_col;\n"
-    "out vec4 frag;\n"
-    "void main() { frag = vec4(v_col, 1.0); }\n";
 
 /* The surface index as a colour: id + 2 in 24 bits (1: a specular triangle, 0: nothing drawn). */
 static void index_color(int id, uint8_t rgb[3])
@@ -53,7 +42,7 @@ static lm_status render(const lm_scene *s, const lm_surfaces *su, const lm_view 
                         void (*color)(int, uint8_t[3]), uint8_t *rgba8, lm_error *err)
 {
     GLuint prog = 0;
-    lm_status st = lm_gl_program("surface_ids", VS, FS, &prog, err);
+    lm_status st = lm_gl_program("surface_ids", lm_glsl_surface_view_vs, lm_glsl_surface_view_fs, &prog, err);
     if (st != LM_OK)
         return st;
     float *verts = build_vertices(s, su, color);

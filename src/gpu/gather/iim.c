@@ -8,34 +8,11 @@
 
 #include "../../charts/atlas_dilate.h"
 #include "../gl/gl_shader.h"
+#include "glsl.h"
 #include "hemicube.h"
 
 #define NEVER (INT_MIN / 2)
 
-/* Per texel: commit its surface (old = display, new = fresh), then display = mix(old, new, t), clamped
- * to [old, new] so rounding never leaves the interval. */
-static const char *BLEND_CS =
-    "#version 450 core\n"
-    "layout(local_size_x = 8, local_size_y = 8) in;\n"
-    "layout(binding = 0, rgba32f) uniform readonly image2D fresh;\n"
-    "layout(binding = 1, rgba32f) uniform image2D old_map;\n"
-    "layout(binding = 2, rgba32f) uniform image2D new_map;\n"
-    "layout(binding = 3, rgba32f) uniform image2D display;\n"
-    "layout(std430, binding = 0) readonly buffer Surfaces { int surf[]; };\n"
-    "layout(std430, binding = 1) readonly buffer Params { vec2 param[]; }; /* commit, t */\n"
-    "uniform ivec2 size;\n"
-    "void main() {\n"
-    "    ivec2 q = ivec2(gl_GlobalInvocationID.xy);\n"
-    "    if (q.x >= size.x || q.y >= size.y) return;\n"
-    "    int s = surf[q.y * size.x + q.x];\n"
-    "    if (s < 0) return;\n"
-    "    vec4 o = imageLoad(old_map, q), n = imageLoad(new_map, q);\n"
-    "    if (param[s].x > 0.5) {\n"
-    "        o = imageLoad(display, q); n = imageLoad(fresh, q);\n"
-    "        imageStore(old_map, q, o); imageStore(new_map, q, n);\n"
-    "    }\n"
-    "    imageStore(display, q, clamp(mix(o, n, param[s].y), min(o, n), max(o, n)));\n"
-    "}\n";
 
 void lm_iim_settings_default(lm_iim_settings *s)
 {
@@ -50,7 +27,7 @@ static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
     for (int i = 0; i < 4; i++)
         if (!(*tex[i] = lm_iim_texture_create(a->width, a->height)))
             return lm_fail(err, LM_ERR_BACKEND, "IIM: could not make a %dx%d RGBA32F texture", a->width, a->height);
-    lm_status st = lm_gl_compute_program("iim_blend", BLEND_CS, &iim->blend_prog, err);
+    lm_status st = lm_gl_compute_program("iim_blend", lm_glsl_iim_blend_cs, &iim->blend_prog, err);
     if (st != LM_OK)
         return st;
     size_t n = (size_t)a->width * (size_t)a->height;

@@ -8,11 +8,10 @@
 
 #include "../../core/timing.h"
 #include "../../core/vecmath.h"
-#include "../frame/direct_shader.h"
 #include "../gl/gl_api.h"
 #include "../gl/gl_shader.h"
 #include "../gl/offscreen.h"
-#include "photon_gather_shaders.h"
+#include "glsl.h"
 
 enum {
     P_BOUNDS, P_INSERT_TILES, P_INSERT_CELLS, P_SCAN, P_GATHER_TILES, P_GATHER_CELLS, P_GATHER_ALL, P_FINISH, P_RESOLVE,
@@ -67,15 +66,12 @@ int lm_photon_gather_settings_check(const lm_photon_gather_settings *s, lm_error
 static lm_status compile(const lm_photon_gather_settings *s, const char *name, const char *body, GLuint *prog,
                          lm_error *err)
 {
-    const char *parts[3] = {lm_direct_gbuffer_glsl, lm_pg_common_glsl, body};
-    size_t n = 256;
-    for (int i = 0; i < 3; i++)
-        n += strlen(parts[i]);
+    size_t n = 256 + strlen(body);
     char *src = malloc(n);
     if (!src)
         return lm_fail(err, LM_ERR_NOMEM, "photon gather: no memory for a shader");
-    snprintf(src, n, "#version 450 core\n#define TILE %d\n#define CHUNK %d\n#define LIMIT %uu\n%s%s%s", s->tile, s->chunk,
-             LM_PHOTON_GATHER_MAX_ENTRIES, parts[0], parts[1], parts[2]);
+    snprintf(src, n, "#version 450 core\n#define TILE %d\n#define CHUNK %d\n#define LIMIT %uu\n%s", s->tile, s->chunk,
+             LM_PHOTON_GATHER_MAX_ENTRIES, body);
     lm_status st = lm_gl_compute_program(name, src, prog, err);
     free(src);
     return st;
@@ -99,17 +95,17 @@ lm_status lm_photon_gather_create(const lm_photon_gather_settings *s, lm_photon_
     g->k = 1;
     static const struct {
         const char *name;
-        const char *const *body;
+        const char *body;
     } progs[P_COUNT] = {
-        {"photon_gather_bounds", &lm_pg_tile_bounds_cs},   {"photon_gather_insert_tiles", &lm_pg_insert_tiles_cs},
-        {"photon_gather_insert_cells", &lm_pg_insert_cells_cs}, {"photon_gather_scan", &lm_pg_scan_cs},
-        {"photon_gather_tiles", &lm_pg_gather_tiles_cs},   {"photon_gather_cells", &lm_pg_gather_cells_cs},
-        {"photon_gather_all", &lm_pg_gather_all_cs},       {"photon_gather_finish", &lm_pg_finish_cs},
-        {"photon_gather_resolve", &lm_pg_resolve_cs},
+        {"photon_gather_bounds", lm_glsl_tile_bounds_cs},   {"photon_gather_insert_tiles", lm_glsl_insert_tiles_cs},
+        {"photon_gather_insert_cells", lm_glsl_insert_cells_cs}, {"photon_gather_scan", lm_glsl_scan_cs},
+        {"photon_gather_tiles", lm_glsl_gather_tiles_cs},   {"photon_gather_cells", lm_glsl_gather_cells_cs},
+        {"photon_gather_all", lm_glsl_gather_all_cs},       {"photon_gather_finish", lm_glsl_finish_cs},
+        {"photon_gather_resolve", lm_glsl_resolve_cs},
     };
     lm_status st = LM_OK;
     for (int i = 0; st == LM_OK && i < P_COUNT; i++)
-        st = compile(s, progs[i].name, *progs[i].body, &g->prog[i], err);
+        st = compile(s, progs[i].name, progs[i].body, &g->prog[i], err);
     glGenBuffers(B_COUNT, g->buf);
     glGenTextures(1, &g->e_tex);
     if (st == LM_OK)
@@ -188,7 +184,7 @@ lm_status lm_photon_gather_set_records(lm_photon_gather *g, const lm_photon_reco
     return lm_gl_check("photon gather: records upload", err);
 }
 
-/* The uniforms every gather program shares (photon_gather_shaders.c's common part). */
+/* The uniforms every gather program shares (glsl/photon_common.glsl). */
 static void common_uniforms(const lm_photon_gather *g, GLuint p)
 {
     float radius = g->radius;

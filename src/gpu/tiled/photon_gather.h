@@ -23,7 +23,7 @@
  *   HASHGRID    records in a hash table of cells of side 2r (count, prefix sum, fill); each pixel reads
  *               the at most 8 cells its sphere reaches.
  *   BRUTEFORCE  each pixel reads every record: O(pixels x records), for small frames.
- * The sums are exact fixed point (photon_gather_shaders.c), so the three give the same picture (equal
+ * The sums are exact fixed point (glsl/photon_common.glsl), so the three give the same picture (equal
  * terms, added in any order) and a run gives the same picture every time.
  *
  * Cost: records upload as the pages that changed (lm_photon_gather_set_records); lm_photon_gather_run
