@@ -5,13 +5,12 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 uniform ivec2 size;
 uniform uint first, count;
+#include "pixel_sums.glsl"
 void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     vec3 x, n;
-    if (any(greaterThanEqual(p, size)) || !visible_point(p, x, n)) return;
-    uint pixel = uint(p.y * size.x + p.x);
+    uint pixel;
     uvec2 s[3];
-    load_sums(pixel, s);
+    if (!pixel_sums(x, n, pixel, s)) return;
     for (uint i = first; i < first + count; i++) gather_stored(i, x, n, s);
     store_sums(pixel, s);
 }

@@ -9,13 +9,12 @@ layout(std430, binding = 4) readonly buffer List { uint list[]; };
 uniform ivec2 size;
 uniform uint entry0, entry_count;
 #include "cell_hash.glsl"
+#include "pixel_sums.glsl"
 void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     vec3 x, n;
-    if (any(greaterThanEqual(p, size)) || !visible_point(p, x, n)) return;
-    uint pixel = uint(p.y * size.x + p.x);
+    uint pixel;
     uvec2 s[3];
-    load_sums(pixel, s);
+    if (!pixel_sums(x, n, pixel, s)) return;
     ivec3 lo = ivec3(floor((x - radius) / cell)), hi = min(ivec3(floor((x + radius) / cell)), lo + 1);
     uint seen[8];
     int m = 0;

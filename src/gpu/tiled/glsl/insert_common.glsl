@@ -20,3 +20,11 @@ bool insert(uint seg, uint i) {
     if (atomicAdd(total, 1u) >= uint(LIMIT)) overflow = 1u;
     return true;
 }
+// The record this invocation inserts (base + its index) and its position; false past the records and
+// for an empty slot.
+bool record_to_insert(out uint i, out vec3 p) {
+    i = base + gl_GlobalInvocationID.x;
+    if (i >= n_records || rec[5u * i + 3u] == 0u) return false;
+    p = record_pos(i);
+    return true;
+}

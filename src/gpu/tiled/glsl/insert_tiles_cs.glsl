@@ -14,9 +14,9 @@ uniform int tiles_x, tiles_y, classes, row0, rows;
 vec4 row(int i) { return vec4(vp[0][i], vp[1][i], vp[2][i], vp[3][i]); }
 bool outside(vec4 plane, vec3 p) { return dot(plane, vec4(p, 1.0)) < -radius * length(plane.xyz); }
 void main() {
-    uint i = base + gl_GlobalInvocationID.x;
-    if (i >= n_records || rec[5u * i + 3u] == 0u) return;
-    vec3 p = uintBitsToFloat(uvec3(rec[5u * i], rec[5u * i + 1u], rec[5u * i + 2u]));
+    uint i;
+    vec3 p;
+    if (!record_to_insert(i, p)) return;
     ivec2 t0 = ivec2(0), t1 = ivec2(tiles_x - 1, tiles_y - 1);
     vec2 lo = vec2(1e30), hi = vec2(-1e30);
     bool in_front = true;
