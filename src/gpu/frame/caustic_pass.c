@@ -1,4 +1,5 @@
-/* The screen-space caustic pass: splat, tile queries, cone filter, composite (caustic_pass.h). */
+/* The screen-space caustic pass: splat, tile queries, cone filter, composite (caustic_pass.h); the
+ * shaders are glsl/caustic_*.glsl. */
 #include "caustic_pass.h"
 
 #include "../gl/gl_api.h"
@@ -21,8 +22,6 @@ void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
 
 /* A photon as the splat reads it: position, receiver normal (arrival side), flux. */
 #define PHOTON_FLOATS 9
-
-
 
 /* One slot's targets: the splat (two RGBA32F + depth-stencil), the irradiance, the tiles' flags. */
 typedef struct {

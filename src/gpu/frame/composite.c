@@ -1,6 +1,6 @@
 /* The indirect term of a frame's composite (composite.h): a premultiplied IIM / pi atlas, rendered by one
- * atlas-sized pass; the direct light's first pass samples it and multiplies by kd. Target and program
- * persist. */
+ * atlas-sized pass (glsl/premultiply_*.glsl); the direct light's first pass samples it and multiplies by
+ * kd. Target and program persist. */
 #include "composite.h"
 
 #include "../../core/vecmath.h"

@@ -10,7 +10,6 @@
 #include "glsl.h"
 #include "../gl/offscreen.h"
 
-
 float *lm_lightmapped_vertices(const lm_scene *s, const lm_atlas *a)
 {
     float *v = malloc(sizeof(float) * 15 * (size_t)(s->tri_count ? s->tri_count : 1));

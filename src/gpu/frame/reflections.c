@@ -1,5 +1,5 @@
 /* Environment cube maps for mirror and glossy nodes, and the pass that adds their reflections
- * (reflections.h). */
+ * (reflections.h; glsl/reflections_fs.glsl over the direct light's direct_vs.glsl). */
 #include "reflections.h"
 
 #include "../gl/gl_api.h"
@@ -158,7 +158,6 @@ void lm_reflections_free(lm_reflections *r)
         glDeleteProgram(r->prog);
     free(r);
 }
-
 
 
 /* The centre of the reflector's triangles' world bounds, where its map is seen from. */

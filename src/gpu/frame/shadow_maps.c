@@ -8,7 +8,6 @@
 #include "../gl/gl_shader.h"
 #include "glsl.h"
 
-
 static void ortho_proj(float m[16], float half, float zfar)
 {
     lm_mat4_identity(m);

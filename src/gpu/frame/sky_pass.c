@@ -1,4 +1,4 @@
-/* The sky drawn behind everything (sky_pass.h). */
+/* The sky drawn behind everything (sky_pass.h; glsl/sky_*.glsl). */
 #include "sky_pass.h"
 
 #include "../gl/gl_api.h"
@@ -7,8 +7,6 @@
 #include "../../scene/sky.h"
 #include "../gl/gl_shader.h"
 #include "glsl.h"
-
-
 
 lm_status lm_sky_pass_init(lm_sky_pass *p, lm_error *err)
 {

@@ -11,7 +11,6 @@
 #include "glsl.h"
 #include "../gl/offscreen.h"
 
-
 /* The surface index as a colour: id + 2 in 24 bits (1: a specular triangle, 0: nothing drawn). */
 static void index_color(int id, uint8_t rgb[3])
 {

@@ -1,4 +1,6 @@
-/* The gather's shaders. SCHEME selects how a texel's plane reaches its R x R tile:
+/* The gather's programs from its shaders (glsl/hemicube_render_vs.glsl, hemicube_render_fs.glsl,
+ * hemicube_reduce_cs.glsl) and the defines put before them. SCHEME selects how a texel's plane reaches
+ * its R x R tile:
  *   0 viewports: one draw per texel, its view in uniforms, its tile a glViewport;
  *   1 instanced: one instanced draw per pass, instance i's view from a buffer, its clip-space position
  *     scaled into tile i of the big target and cut to it by four clip distances;
@@ -10,7 +12,6 @@
 
 #include "../gl/gl_shader.h"
 #include "glsl.h"
-
 
 /* "#version", the scheme's and sample count's defines and extension, then the body. Returns 0 if it
  * does not fit. */

@@ -1,4 +1,4 @@
-/* IIM scheduling, double-buffered blending and invalid-texel filling (iim.h). */
+/* IIM scheduling, double-buffered blending (glsl/iim_blend_cs.glsl) and invalid-texel filling (iim.h). */
 #include "iim.h"
 
 #include "../gl/gl_api.h"
@@ -12,7 +12,6 @@
 #include "hemicube.h"
 
 #define NEVER (INT_MIN / 2)
-
 
 void lm_iim_settings_default(lm_iim_settings *s)
 {

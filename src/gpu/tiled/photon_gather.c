@@ -1,4 +1,5 @@
-/* The per-pixel photon gathers on the GPU (photon_gather.h): buffers, the order of the passes, limits. */
+/* The per-pixel photon gathers on the GPU (photon_gather.h): buffers, the order of the passes, limits;
+ * the shaders are the compute shaders of glsl/. */
 #include "photon_gather.h"
 
 #include <math.h>
