@@ -31,7 +31,8 @@ TRACE_FP := -ffp-contract=fast -fno-math-errno
 # Hidden visibility: liblmgi.so exports only what include/lmgi.h and lmgi_tools.h mark LMGI_API (the static library and
 # the programs linked with it are unaffected).
 VIS          := -fvisibility=hidden
-CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fopenmp -D_DEFAULT_SOURCE -Iinclude $(SAN) $(CFLAGS)
+CFLAGS_ALL   := -std=c11 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fopenmp -D_DEFAULT_SOURCE -Iinclude -I$(BUILD)/gen $(SAN) \
+                $(CFLAGS)
 CXXFLAGS_ALL := -std=c++17 $(OPT) $(ARCH) $(WARN) -fPIC $(VIS) -fvisibility-inlines-hidden -fopenmp -Iinclude \
                 -I/usr/include/stb $(SAN) $(CXXFLAGS)
 LIBS    := -ltinygltf -lstb -ltinyexr -lembree3 -lOpenMeshCore -lmeshoptimizer -ldraco -lwebp -lEGL -lgomp -lstdc++ -lm -lpthread
@@ -49,10 +50,14 @@ DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenm
                 $(NPM_DEB)
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/reference/*.c \
-                             src/photonmap/*.c src/gpu/*.c src/update/*.c src/api/*.c))
+                             src/photonmap/*.c src/gpu/*.c src/gpu/*/*.c src/update/*.c src/api/*.c))
 LIB_CXX := $(sort $(wildcard src/scene/*.cpp src/charts/*.cpp))
 CLI_C   := $(sort $(wildcard src/cli/*.c))
-LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o)
+# The shaders: src/gpu's .glsl files, made into C strings at build time by tools/glsl_embed.c (one
+# lm_glsl_NAME a file, declared in the generated glsl.h; docs/architecture.md, "Shaders")
+GLSL    := $(sort $(wildcard src/gpu/*/glsl/*.glsl))
+GLSL_C  := $(BUILD)/gen/glsl.c
+LIB_OBJ := $(LIB_C:%.c=$(BUILD)/obj/%.o) $(LIB_CXX:%.cpp=$(BUILD)/obj/%.o) $(BUILD)/obj/gen/glsl.o
 CLI_OBJ := $(CLI_C:%.c=$(BUILD)/obj/%.o)
 # lmgi-dev: the developer's commands that look inside the library (tools/dev/main.c), on the CLI's
 # option parser and helpers
@@ -91,6 +96,21 @@ $(BUILD)/obj/%.o: %.c $(BUILD)/flags
 $(BUILD)/obj/src/trace/%.o: CFLAGS_ALL += $(TRACE_FP)
 # the reference solver was written in trace/ and traces with it: the same arithmetic, the same answers
 $(BUILD)/obj/src/reference/%.o: CFLAGS_ALL += $(TRACE_FP)
+
+# glsl_embed runs on every make (a .glsl removed must leave glsl.c too) but rewrites glsl.c and glsl.h
+# only when their text changes: an edited shader rebuilds glsl.o alone, a shader added or removed the
+# files that include glsl.h.
+$(BUILD)/glsl_embed: tools/glsl_embed.c
+	@mkdir -p $(dir $@)
+	$(CC) -std=c11 -O2 $(WARN) -D_DEFAULT_SOURCE -o $@ $<
+$(GLSL_C): $(BUILD)/glsl_embed FORCE
+	@mkdir -p $(dir $@)
+	@$(BUILD)/glsl_embed $(GLSL_C) $(BUILD)/gen/glsl.h $(GLSL)
+$(BUILD)/gen/glsl.h: $(GLSL_C) ;
+$(BUILD)/obj/gen/glsl.o: $(GLSL_C) $(BUILD)/flags
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -c $< -o $@
+$(filter $(BUILD)/obj/src/gpu/%,$(LIB_OBJ)): | $(BUILD)/gen/glsl.h
 
 $(BUILD)/obj/%.o: %.cpp $(BUILD)/flags
 	@mkdir -p $(dir $@)

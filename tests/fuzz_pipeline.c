@@ -29,7 +29,7 @@
 
 #include "../src/core/log.h"
 #include "../src/core/timing.h"
-#include "../src/gpu/gl_context.h"
+#include "../src/gpu/gl/gl_context.h"
 #include "../src/update/frame_loop.h"
 #include "../src/api/lmgi_scene.h"
 #include "support.h"

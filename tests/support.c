@@ -1,7 +1,7 @@
 #define _XOPEN_SOURCE 700
 #include "support.h"
 
-#include "../src/gpu/gl_context.h"
+#include "../src/gpu/gl/gl_context.h"
 
 #include <ftw.h>
 #include <limits.h>

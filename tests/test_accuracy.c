@@ -1,4 +1,4 @@
-/* The lightmaps' estimate of their own accuracy (LMGI_LIGHTMAP_ACCURACY, gpu/gather_error.h) against
+/* The lightmaps' estimate of their own accuracy (LMGI_LIGHTMAP_ACCURACY, gpu/gather/gather_error.h) against
  * the true error from the path-traced reference: the AIM's and the IIM's estimated relative standard
  * error ranked with the error each texel and surface really has. */
 #include <setjmp.h>

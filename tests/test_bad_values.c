@@ -24,8 +24,8 @@
 #include "../src/core/image.h"
 #include "../src/core/log.h"
 #include "../src/core/timing.h"
-#include "../src/gpu/gl_context.h"
-#include "../src/gpu/hemicube.h"
+#include "../src/gpu/gl/gl_context.h"
+#include "../src/gpu/gather/hemicube.h"
 #include "support.h"
 
 /* A 1 x 1 PNG (200, 100, 50). */

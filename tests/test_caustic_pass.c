@@ -1,4 +1,4 @@
-/* The screen-space caustic pass (gpu/caustic_pass.h): the caustic a mirror throws on the floor, as the
+/* The screen-space caustic pass (gpu/frame/caustic_pass.h): the caustic a mirror throws on the floor, as the
  * pass filters it on screen, against the analytic image of the light; the tiles the occlusion queries
  * find against a count of the splatted photons; the power on screen against the photons'; both filters. */
 #include <setjmp.h>
@@ -12,7 +12,7 @@
 #include <string.h>
 
 #include "../src/core/vecmath.h"
-#include "../src/gpu/caustic_pass.h"
+#include "../src/gpu/frame/caustic_pass.h"
 #include "support.h"
 
 #define W 256

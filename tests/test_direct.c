@@ -1,4 +1,4 @@
-/* gpu/direct: direct light per pixel with shadow maps. A point light over a plane against
+/* gpu/frame/direct: direct light per pixel with shadow maps. A point light over a plane against
  * rho/pi I cos/d^2, a box's shadow (umbra black, outside lit; also beyond each of a point light's six
  * cube faces, with PCF radius 0 and 1), a grazing directional light without
  * acne (and with acne when the bias is off), a spot light's cone falloff against lm_spot_attenuation,
@@ -18,8 +18,8 @@
 #include <string.h>
 
 #include "../src/core/vecmath.h"
-#include "../src/gpu/direct.h"
-#include "../src/gpu/gl_context.h"
+#include "../src/gpu/frame/direct.h"
+#include "../src/gpu/gl/gl_context.h"
 #include "../src/trace/bsdf.h"
 #include "../src/trace/lights.h"
 #include "support.h"

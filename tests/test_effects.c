@@ -58,7 +58,7 @@ static void test_shared_cornell_box(void **state)
     lm_scene_free(s);
 }
 
-/* A glossy metal reflects (gpu/reflections.h) but focuses no caustic. */
+/* A glossy metal reflects (gpu/frame/reflections.h) but focuses no caustic. */
 static void test_glossy_reflects(void **state)
 {
     (void)state;

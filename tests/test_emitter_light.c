@@ -9,7 +9,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "../src/gpu/hemicube.h"
+#include "../src/gpu/gather/hemicube.h"
 #include "../src/trace/emitter_light.h"
 #include "support.h"
 

@@ -21,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../src/gpu/iim.h"
+#include "../src/gpu/gather/iim.h"
 #include "../src/api/frame_check.h"
 #include "support.h"
 

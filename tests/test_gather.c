@@ -1,4 +1,4 @@
-/* gpu/hemicube: the single-plane hemicube final gather (Larsen & Christensen section 4): weights against
+/* gpu/gather/hemicube: the single-plane hemicube final gather (Larsen & Christensen section 4): weights against
  * F(a), a uniform sky, the form factor to a parallel emissive square, back faces under a box, and
  * determinism. Runs on OSMesa llvmpipe, so only a few texels at R = 32. */
 #include <setjmp.h>
@@ -6,7 +6,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include "../src/gpu/gl_api.h"
+#include "../src/gpu/gl/gl_api.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -15,9 +15,9 @@
 #include <string.h>
 
 #include "../src/charts/charts.h"
-#include "../src/gpu/gl_context.h"
-#include "../src/gpu/hemicube.h"
-#include "../src/gpu/iim.h"
+#include "../src/gpu/gl/gl_context.h"
+#include "../src/gpu/gather/hemicube.h"
+#include "../src/gpu/gather/iim.h"
 #include "../src/core/timing.h"
 #include "../src/reference/reference.h"
 #include "../src/update/photon_stage.h"

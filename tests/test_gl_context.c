@@ -1,4 +1,4 @@
-/* gpu/gl_context: the GL backend chosen at run time by LMGI_GL. osmesa gives OSMesa with GL >= 4.5; egl
+/* gpu/gl/gl_context: the GL backend chosen at run time by LMGI_GL. osmesa gives OSMesa with GL >= 4.5; egl
  * gives an EGL context whose render and readback match OSMesa's numbers (skipped where no EGL vendor is
  * installed); a bad value is an error naming LMGI_GL; auto keeps EGL only for a hardware renderer; two
  * contexts of different backends take turns on one thread. */
@@ -7,7 +7,7 @@
 #include <stddef.h>
 #include <cmocka.h>
 
-#include "../src/gpu/gl_api.h"
+#include "../src/gpu/gl/gl_api.h"
 
 #include <glob.h>
 #include <math.h>
@@ -16,9 +16,9 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "../src/gpu/gl_context.h"
-#include "../src/gpu/gl_shader.h"
-#include "../src/gpu/offscreen.h"
+#include "../src/gpu/gl/gl_context.h"
+#include "../src/gpu/gl/gl_shader.h"
+#include "../src/gpu/gl/offscreen.h"
 
 #define W 32
 #define H 24

@@ -1,5 +1,5 @@
 /* The indirect paths end to end (`lmgi run --indirect`, lmgi_updater_desc.indirect): the per-pixel photon
- * gathers (gpu/photon_gather.h) against the reference solver's per-pixel indirect radiance on the shared
+ * gathers (gpu/tiled/photon_gather.h) against the reference solver's per-pixel indirect radiance on the shared
  * Cornell box, beside the lightmap path on the same pixels; the three gathers giving the same frame; and a
  * still scene and camera doing no gather work while a moving one does.
  *
@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "../src/api/frame_check.h"
-#include "../src/gpu/iim.h"
+#include "../src/gpu/gather/iim.h"
 #include "edit_room.h"
 #include "support.h"
 

@@ -1,4 +1,4 @@
-/* The per-pixel photon gathers on the GPU (gpu/photon_gather.h) and their records
+/* The per-pixel photon gathers on the GPU (gpu/tiled/photon_gather.h) and their records
  * (photonmap/photon_records.h): the packing keeps flux and direction to its stated precision; tiled,
  * hash grid and brute force give the same picture on the generated Cornell box and where photons straddle
  * tile and cell borders, lie on a tile frustum's side, behind the camera, or reach past the screen; that
@@ -16,9 +16,9 @@
 #include <string.h>
 
 #include "../src/core/vecmath.h"
-#include "../src/gpu/direct.h"
-#include "../src/gpu/gl_api.h"
-#include "../src/gpu/photon_gather.h"
+#include "../src/gpu/frame/direct.h"
+#include "../src/gpu/gl/gl_api.h"
+#include "../src/gpu/tiled/photon_gather.h"
 #include "../src/photonmap/photon_records.h"
 #include "../src/photonmap/pixel_gather.h"
 #include "../src/scene/scene_view.h"

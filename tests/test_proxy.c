@@ -1,4 +1,4 @@
-/* charts/proxy + gpu/hemicube: the gather proxy. On the generated Cornell box (scenes/cornell.glb,
+/* charts/proxy + gpu/gather/hemicube: the gather proxy. On the generated Cornell box (scenes/cornell.glb,
  * 13,790 triangles, a bumpy floor of 12,800) the proxy is much smaller, stays within its error bound
  * of the original surface, keeps lightmap UVs inside their charts, and gathers the same IIM within a
  * few percent. A tiny scene's proxy is the scene itself. */
@@ -15,8 +15,8 @@
 
 #include "../src/charts/proxy.h"
 #include "../src/core/vecmath.h"
-#include "../src/gpu/gl_context.h"
-#include "../src/gpu/hemicube.h"
+#include "../src/gpu/gl/gl_context.h"
+#include "../src/gpu/gather/hemicube.h"
 #include "../src/reference/reference.h"
 #include "../src/update/photon_stage.h"
 #include "support.h"

@@ -376,7 +376,7 @@ static void test_furnace_composite(void **state)
     }
 }
 
-/* Reflections (gpu/reflections.h): a cube at the centre of a closed room whose walls emit Le = 1 and
+/* Reflections (gpu/frame/reflections.h): a cube at the centre of a closed room whose walls emit Le = 1 and
  * reflect nothing, seen face on from inside; every pixel is the cube's front face reflecting the wall
  * behind the camera. A mirror of albedo 0.8 shows 0.8 Le; a glossy metal (albedo 0.8, roughness 0.3:
  * Phong n = 245, ks = 0.8, kd = 0) shows ks (n + 2) / (n + 1) (n.v) Le, 0.803 at the centre; a glass cube

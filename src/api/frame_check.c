@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../gpu/surface_view.h"
+#include "../gpu/frame/surface_view.h"
 
 double lm_check_ratio(const lm_check_sum *c, int channel)
 {

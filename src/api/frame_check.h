@@ -3,7 +3,7 @@
  * surface and over the whole frame (docs/reference.md, "Frame against reference").
  *
  * What is compared: every pixel whose centre and four neighbours' centres see one surface
- * (gpu/surface_view.h's index picture, drawn from the frame's own view): along an edge the reference's
+ * (gpu/frame/surface_view.h's index picture, drawn from the frame's own view): along an edge the reference's
  * pixel, an average over its area, and the frame's, a sample at its centre, see different things, which
  * is aliasing, not lighting. Mirror and glass pixels (no lightmap; their reflections are another pass)
  * and the background are left out. The frame figures (`lit`, `rel_rmse`) leave out emissive surfaces

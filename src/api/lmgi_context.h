@@ -7,7 +7,7 @@
 #include <stdint.h>
 
 #include "../core/log.h"
-#include "../gpu/gl_context.h"
+#include "../gpu/gl/gl_context.h"
 
 struct lmgi_context {
     lmgi_context_desc desc;

@@ -9,8 +9,8 @@
 #include "../charts/atlas_image.h"
 #include "../core/image.h"
 #include "../scene/scene_view.h"
-#include "../gpu/gl_context.h"
-#include "../gpu/surface_view.h"
+#include "../gpu/gl/gl_context.h"
+#include "../gpu/frame/surface_view.h"
 #include "lmgi_scene.h"
 
 void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)

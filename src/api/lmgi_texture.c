@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../gpu/gl_api.h"
+#include "../gpu/gl/gl_api.h"
 #include "lmgi_context.h"
 #include "lmgi_scene.h"
 #include "lmgi_updater.h"

@@ -105,7 +105,7 @@ void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
  * hemicube should see (4.8% of the suzanne Cornell box's ceiling, docs/aim.md). */
 #define LM_AIM_DIRECT_PARTS 2
 
-/* For the per-pixel photon gathers (pixel_gather.h, gpu/photon_gather.h), which sum one constant radius r
+/* For the per-pixel photon gathers (pixel_gather.h, gpu/tiled/photon_gather.h), which sum one constant radius r
  * (world units) with the kernel min(c, 1 - s / r), c = 1/5: per atlas texel, the part of that kernel's
  * weight that lies on the texel's surface, in [1/16, 1] (1 away from its boundary, about 1/2 at an edge,
  * 1/4 in a corner), from the same exact disc-on-surface areas as the AIM's boundary correction, in the

@@ -1,5 +1,5 @@
 /* Which IIM texels to regather, and when a surface's refresh is complete (Larsen & Christensen section 4;
- * the IIMs themselves, their GPU textures and blending, are gpu/iim.h).
+ * the IIMs themselves, their GPU textures and blending, are gpu/gather/iim.h).
  *
  * Each frame at most texels_per_frame texels are handed to the gather. Surfaces are taken in order of
  * their delta_i (photon store: energy of hits added or removed since the surface's IIM was refreshed,

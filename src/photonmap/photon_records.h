@@ -1,4 +1,4 @@
-/* The photon hits a per-pixel gather reads (gpu/photon_gather.h), packed for the GPU the way Mara et al.
+/* The photon hits a per-pixel gather reads (gpu/tiled/photon_gather.h), packed for the GPU the way Mara et al.
  * (2013) pack theirs: 20 bytes a photon, one record per slot of the photon store, so that a hit that
  * changed rewrites its own record and nothing else.
  *

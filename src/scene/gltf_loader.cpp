@@ -871,7 +871,7 @@ lm_status Loader::materials()
 }
 
 // extras.lmgi.reflection_box: [min x, y, z, max x, y, z] in world space, the proxy of what a reflector's
-// environment map sees (gpu/reflections.h); anything else is warned about and ignored.
+// environment map sees (gpu/frame/reflections.h); anything else is warned about and ignored.
 static void read_reflection_box(const tinygltf::Value &v, lm_node_settings &st, const char *path,
                                 const std::string &ctx)
 {

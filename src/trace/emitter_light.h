@@ -1,4 +1,4 @@
-/* Irradiance from the scene's emissive triangles at a point, for the final gather (gpu/hemicube.h).
+/* Irradiance from the scene's emissive triangles at a point, for the final gather (gpu/gather/hemicube.h).
  *
  * A small emitter covers only a few hemicube pixels, and which pixels it covers changes from texel to
  * texel: the gathered irradiance steps between neighbours (plaid). Here each emissive triangle's light

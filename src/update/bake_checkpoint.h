@@ -30,7 +30,7 @@
 
 #include "../charts/charts.h"
 #include "../core/error.h"
-#include "../gpu/hemicube.h"
+#include "../gpu/gather/hemicube.h"
 #include "../scene/scene.h"
 
 #define LM_CHECKPOINT_DEFAULT_SECONDS 10.0

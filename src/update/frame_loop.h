@@ -2,13 +2,13 @@
  *
  * One frame at animation time t:
  *   1. photon stage (photon_stage.h): animations, photons re-traced, AIMs refreshed;
- *   2. IIMs (gpu/iim.h, gpu/hemicube.h): up to texels_per_frame texels scheduled by delta_i, gathered
+ *   2. IIMs (gpu/gather/iim.h, gpu/gather/hemicube.h): up to texels_per_frame texels scheduled by delta_i, gathered
  *      over the current AIMs and node transforms into the fresh IIM, then blended into the display IIM;
  *   3. composite in linear HDR, the paper's Eq. 6, L = L_indirect + L_caustics + L_specular + sum L_direct
- *      shadow: the indirect term kd / pi E_IIM premultiplied over the atlas (gpu/composite.h) and added by
+ *      shadow: the indirect term kd / pi E_IIM premultiplied over the atlas (gpu/frame/composite.h) and added by
  *      the direct light's first pass at each visible surface's lightmap uv, the direct light per pixel
- *      with shadows (gpu/direct.h), the caustics filtered on screen over its depth (gpu/caustic_pass.h),
- *      then what mirror, glass and glossy nodes reflect of their environment maps (gpu/reflections.h).
+ *      with shadows (gpu/frame/direct.h), the caustics filtered on screen over its depth (gpu/frame/caustic_pass.h),
+ *      then what mirror, glass and glossy nodes reflect of their environment maps (gpu/frame/reflections.h).
  *
  * With `overlap` (the default), step 1's tracing and AIM refresh run on a second thread while the calling
  * thread does steps 2 and 3 over the previous frame's AIMs (docs/architecture.md). A loop that draws no
@@ -110,7 +110,7 @@ lm_iim *lm_frame_loop_iim(lm_frame_loop *fl);
  * 0 everywhere once every refresh is complete and blended and no photon changed since. `shown` is the
  * displayed IIM as lm_frame_loop_read_iim gives it. Joins photon work under way first. */
 lm_status lm_frame_loop_iim_error(lm_frame_loop *fl, const float *shown, float *error, lm_error *err);
-/* The lightmaps' estimate of their own accuracy (gpu/gather_error.h), atlas-sized RGBA: the IIM's relative
+/* The lightmaps' estimate of their own accuracy (gpu/gather/gather_error.h), atlas-sized RGBA: the IIM's relative
  * standard error from the AIMs' photon noise, the AIM texel's own, the hemicube's back-face fraction, 0;
  * with LM_GATHER_ERROR_RAYS rays a texel. `shown` as for lm_frame_loop_iim_error. Needs the AIMs' error
  * (stage.aim.error_estimate), else LM_ERR_INVALID. Joins photon work under way first. */

@@ -5,8 +5,8 @@
 
 #include "../core/hash.h"
 #include "../core/timing.h"
-#include "../gpu/composite.h"
-#include "../gpu/reflections.h"
+#include "../gpu/frame/composite.h"
+#include "../gpu/frame/reflections.h"
 
 struct lm_frame_passes {
     const lm_frame_loop_settings *set; /* the loop's, borrowed */

@@ -1,8 +1,8 @@
 /* The passes that draw a frame (Larsen & Christensen section 7, Eq. 6: L = L_indirect + L_caustics +
- * L_specular + sum L_direct): the composite's indirect term (gpu/composite.h: kd / pi E_IIM premultiplied
- * over the atlas), the direct light with its shadow maps, which owns the frame's targets (gpu/direct.h),
+ * L_specular + sum L_direct): the composite's indirect term (gpu/frame/composite.h: kd / pi E_IIM premultiplied
+ * over the atlas), the direct light with its shadow maps, which owns the frame's targets (gpu/frame/direct.h),
  * the photon paths' indirect light (photon_path.h) where they are taken, the screen-space caustics
- * (gpu/caustic_pass.h) and the reflections of mirror, glass and glossy nodes (gpu/reflections.h).
+ * (gpu/frame/caustic_pass.h) and the reflections of mirror, glass and glossy nodes (gpu/frame/reflections.h).
  *
  * Each pass decides here whether its inputs changed:
  *   - the composite's surfaces and the reflecting nodes follow lm_scene.pass_version (a material's class,

@@ -6,12 +6,12 @@
 #ifndef LM_FRAME_SETTINGS_H
 #define LM_FRAME_SETTINGS_H
 
-#include "../gpu/caustic_pass.h"
-#include "../gpu/direct.h"
-#include "../gpu/gl_context.h"
-#include "../gpu/hemicube.h"
-#include "../gpu/iim.h"
-#include "../gpu/photon_gather.h"
+#include "../gpu/frame/caustic_pass.h"
+#include "../gpu/frame/direct.h"
+#include "../gpu/gl/gl_context.h"
+#include "../gpu/gather/hemicube.h"
+#include "../gpu/gather/iim.h"
+#include "../gpu/tiled/photon_gather.h"
 #include "photon_stage.h"
 
 enum { LM_INDIRECT_LIGHTMAP = 0, LM_INDIRECT_BRUTEFORCE = 1, LM_INDIRECT_TILED = 2, LM_INDIRECT_HASHGRID = 3 };
@@ -32,7 +32,7 @@ typedef struct {
     int width, height;     /* frame size (default 512 x 512; 0 x 0: lm_frame_loop_step composites no frame, and
                             * the render passes are made at the first lm_frame_loop_render) */
     int camera;            /* lm_view_for_scene's camera (default -1) */
-    int reflection_size;   /* texels per side of a mirror or glossy node's environment map (gpu/reflections.h;
+    int reflection_size;   /* texels per side of a mirror or glossy node's environment map (gpu/frame/reflections.h;
                             * default 128; 0: no reflections) */
     int reflection_faces;  /* environment map faces re-rendered a frame, round robin, after all of them at the
                             * first frame (default 1: a map refreshed in 6 frames) */
@@ -44,7 +44,7 @@ typedef struct {
     int indirect_path;     /* how the frame gets its indirect light: LM_INDIRECT_LIGHTMAP (default: AIMs, the
                             * hemicube gather into the IIM, the composite) or LM_INDIRECT_TILED, _HASHGRID or
                             * _BRUTEFORCE (straight from the photon hits at the visible pixels on the GPU,
-                            * gpu/photon_gather.h: no AIM, no IIM; the lightmaps stay 0 and environment maps
+                            * gpu/tiled/photon_gather.h: no AIM, no IIM; the lightmaps stay 0 and environment maps
                             * hold direct light only) */
     lm_photon_gather_settings photon_gather; /* those three paths' tile, chunk and stochastic k (the kind
                                               * follows indirect_path) */

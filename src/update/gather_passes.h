@@ -7,7 +7,7 @@
  * Pass p holds the texels [p x pass, (p + 1) x pass) of the order, so a checkpoint or part names passes,
  * never texels, and two processes with the same scene and settings cut the same passes.
  *
- * Everything is gathered into the fresh IIM texture (gpu/iim.h); committing and blending it is the
+ * Everything is gathered into the fresh IIM texture (gpu/gather/iim.h); committing and blending it is the
  * caller's (lightmap_path.h). The job's fields are borrowed for the call; the scene and the AIM must
  * have been uploaded to the gather already. Runs on the thread whose GL context is current. */
 #ifndef LM_GATHER_PASSES_H

@@ -7,7 +7,7 @@
 #include "../core/log.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
-#include "../gpu/gather_error.h"
+#include "../gpu/gather/gather_error.h"
 #include "../photonmap/delta_i.h"
 #include "../scene/sky.h"
 #include "../trace/emitter_light.h"
@@ -187,7 +187,7 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
         st = lm_gather_create(&set->gather, &lp->gather, err);
     if (st == LM_OK && lp->have_emitters)
         lm_gather_set_emitter_light(lp->gather, &lp->emitters);
-    if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (gpu/hemicube_rim.h) */
+    if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (photonmap/hemicube_rim.h) */
         lm_gather_set_tracer(lp->gather, lp->rt);
     if (st == LM_OK)
         st = follow_light(lp, err); /* before the IIM: a scene without light gathers nothing */

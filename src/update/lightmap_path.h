@@ -3,7 +3,7 @@
  * lightmap. The frame loop (frame_loop.h) conducts it: per step schedule, gather, then blend; a bake
  * regathers every texel whose light changed and shows it at once.
  *
- * It owns the gather (gpu/hemicube.h), the IIMs and their scheduler (gpu/iim.h), the closed-form emitter
+ * It owns the gather (gpu/gather/hemicube.h), the IIMs and their scheduler (gpu/gather/iim.h), the closed-form emitter
  * light the gather adds (trace/emitter_light.h) and the AIM upload. It exists on every loop (a loop on a
  * photon path, or one with indirect light off, has every surface switched off: nothing is gathered and
  * the lightmaps stay 0), and follows the scene's light: a scene with no light gathers nothing, and the

@@ -1,5 +1,5 @@
 /* The photon paths of indirect light (Mara et al. 2013; docs/tiled.md): no AIM, no IIM; every visible
- * pixel gathers the photon store's hits on the GPU (tiled, hash grid or brute force: gpu/photon_gather.h)
+ * pixel gathers the photon store's hits on the GPU (tiled, hash grid or brute force: gpu/tiled/photon_gather.h)
  * and the frame adds kd / pi x E / c, c the kernel's part on the pixel's surface (the coverage the direct
  * pass writes beside kd).
  *

@@ -1,0 +1,638 @@
+/* The screen-space caustic pass: splat, tile queries, cone filter, composite (caustic_pass.h); the
+ * shaders are glsl/caustic_*.glsl. */
+#include "caustic_pass.h"
+
+#include "../gl/gl_api.h"
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../core/timing.h"
+#include "../../core/vecmath.h"
+#include "../gl/gl_shader.h"
+#include "glsl.h"
+
+void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
+{
+    s->filter_k = 3;
+    s->tile = 32;
+    s->world_space = 0;
+}
+
+/* A photon as the splat reads it: position, receiver normal (arrival side), flux. */
+#define PHOTON_FLOATS 9
+
+/* One slot's targets: the splat (two RGBA32F + depth-stencil), the irradiance, the tiles' flags. */
+typedef struct {
+    int width, height;
+    GLuint splat_fbo, splat_tex[2], stencil;
+    GLuint irr_fbo, irr_tex;
+    int tiles_x, tiles_y;
+    uint8_t *lit;
+    GLuint *queries;
+    int lit_count, box[4];  /* the last run's lit tiles and the box of their grown squares */
+    /* where the splat and the irradiance may hold anything but 0 (x0, y0, x1, y1): what the next run
+     * clears, the last run's lit tiles (the whole target when new) */
+    int splat_held[4], irr_held[4];
+} slot_targets;
+
+/* The pixel box of the lit tiles (grown by `grow` pixels, clamped to the target); empty (x1 <= x0) when none. */
+static void lit_box(const slot_targets *t, int tile, int grow, int box[4])
+{
+    box[0] = t->width, box[1] = t->height, box[2] = box[3] = 0;
+    for (int ty = 0; ty < t->tiles_y; ty++)
+        for (int tx = 0; tx < t->tiles_x; tx++)
+            if (t->lit[ty * t->tiles_x + tx]) {
+                int x0 = tx * tile - grow, y0 = ty * tile - grow, x1 = (tx + 1) * tile + grow, y1 = (ty + 1) * tile + grow;
+                box[0] = x0 < box[0] ? x0 : box[0], box[1] = y0 < box[1] ? y0 : box[1];
+                box[2] = x1 > box[2] ? x1 : box[2], box[3] = y1 > box[3] ? y1 : box[3];
+            }
+    box[0] = box[0] < 0 ? 0 : box[0], box[1] = box[1] < 0 ? 0 : box[1];
+    box[2] = box[2] > t->width ? t->width : box[2], box[3] = box[3] > t->height ? t->height : box[3];
+}
+
+/* Clears the bound framebuffer's colour attachments [0, colours) (and its stencil) inside box only: a pass
+ * clears what its last run wrote, not the whole screen. */
+static void clear_box(const int box[4], int colours, int stencil)
+{
+    if (box[2] <= box[0] || box[3] <= box[1])
+        return;
+    static const float zero[4] = {0, 0, 0, 0};
+    static const GLint zero_stencil = 0;
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(box[0], box[1], box[2] - box[0], box[3] - box[1]);
+    for (int i = 0; i < colours; i++)
+        glClearBufferfv(GL_COLOR, i, zero);
+    if (stencil) {
+        glStencilMask(0xFF);
+        glClearBufferiv(GL_STENCIL, 0, &zero_stencil);
+    }
+    glDisable(GL_SCISSOR_TEST);
+}
+
+struct lm_caustic_pass {
+    lm_caustic_pass_settings set;
+    GLuint splat_prog, query_prog, filter_prog, composite_prog;
+    GLuint vao, photon_vbo, index_buf, empty_vao, rect_vbo;
+    uint32_t photons;
+    float *pos;             /* the photons' positions (3 floats each), for the frustum test of each run */
+    uint32_t *visible;      /* scratch: the indices of the photons in a run's view frustum */
+    slot_targets slots[LM_CAUSTIC_SLOTS];
+    float *rects;           /* scratch: 12 floats per grown tile */
+};
+
+static void free_slot(slot_targets *t)
+{
+    if (t->splat_fbo) {
+        glDeleteFramebuffers(1, &t->splat_fbo);
+        glDeleteTextures(2, t->splat_tex);
+        glDeleteRenderbuffers(1, &t->stencil);
+        glDeleteFramebuffers(1, &t->irr_fbo);
+        glDeleteTextures(1, &t->irr_tex);
+    }
+    if (t->queries)
+        glDeleteQueries(t->tiles_x * t->tiles_y, t->queries);
+    free(t->lit);
+    free(t->queries);
+    memset(t, 0, sizeof *t);
+}
+
+static GLuint float_texture(int w, int h)
+{
+    GLuint t;
+    glGenTextures(1, &t);
+    glBindTexture(GL_TEXTURE_2D, t);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return t;
+}
+
+static lm_status make_slot(lm_caustic_pass *cp, slot_targets *t, int w, int h, lm_error *err)
+{
+    if (t->splat_fbo && t->width == w && t->height == h)
+        return LM_OK;
+    free_slot(t);
+    t->width = w, t->height = h;
+    t->tiles_x = (w + cp->set.tile - 1) / cp->set.tile;
+    t->tiles_y = (h + cp->set.tile - 1) / cp->set.tile;
+    int n = t->tiles_x * t->tiles_y;
+    t->lit = calloc((size_t)n, 1);
+    t->queries = calloc((size_t)n, sizeof *t->queries);
+    if (!t->lit || !t->queries) {
+        free_slot(t);
+        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %d tiles", n);
+    }
+    glGenQueries(n, t->queries);
+    static const GLenum bufs[2] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+    glGenFramebuffers(1, &t->splat_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, t->splat_fbo);
+    for (int i = 0; i < 2; i++) {
+        t->splat_tex[i] = float_texture(w, h);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, t->splat_tex[i], 0);
+    }
+    glGenRenderbuffers(1, &t->stencil);
+    glBindRenderbuffer(GL_RENDERBUFFER, t->stencil);
+    glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH24_STENCIL8, w, h);
+    glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, t->stencil);
+    glDrawBuffers(2, bufs);
+    const int all[4] = {0, 0, w, h}; /* new textures hold anything */
+    memcpy(t->splat_held, all, sizeof all);
+    memcpy(t->irr_held, all, sizeof all);
+    int ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glGenFramebuffers(1, &t->irr_fbo);
+    glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
+    t->irr_tex = float_texture(w, h);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->irr_tex, 0);
+    ok = ok && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    if (!ok) {
+        free_slot(t);
+        return lm_fail(err, LM_ERR_BACKEND, "caustic pass: targets of %dx%d are incomplete", w, h);
+    }
+    return lm_gl_check("caustic pass: targets", err);
+}
+
+static lm_status build_programs(lm_caustic_pass *cp, lm_error *err)
+{
+    char fs[8192];
+    lm_status st = lm_gl_program("caustic splat", lm_glsl_caustic_splat_vs, lm_glsl_caustic_splat_fs, &cp->splat_prog, err);
+    if (st == LM_OK)
+        st = lm_gl_program("caustic tile query", lm_glsl_caustic_rect_vs, lm_glsl_caustic_query_fs, &cp->query_prog, err);
+    int len = snprintf(fs, sizeof fs, "%s", cp->set.world_space ? lm_glsl_caustic_filter_world_fs : lm_glsl_caustic_filter_screen_fs);
+    char *k = strstr(fs, "FILTER_K");
+    if (st == LM_OK && (len < 0 || (size_t)len >= sizeof fs || !k))
+        st = lm_fail(err, LM_ERR_BACKEND, "caustic pass: shader source buffer too small");
+    if (st == LM_OK) {
+        char digits[16];
+        snprintf(digits, sizeof digits, "%-8d", cp->set.filter_k); /* "FILTER_K" is 8 characters */
+        memcpy(k, digits, 8);
+        st = lm_gl_program("caustic filter", lm_glsl_caustic_filter_vs, fs, &cp->filter_prog, err);
+    }
+    if (st == LM_OK)
+        st = lm_gl_program("caustic composite", lm_glsl_caustic_rect_vs, lm_glsl_caustic_composite_fs, &cp->composite_prog, err);
+    return st;
+}
+
+lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic_pass **out, lm_error *err)
+{
+    *out = NULL;
+    lm_caustic_pass_settings def;
+    if (!set) {
+        lm_caustic_pass_settings_default(&def);
+        set = &def;
+    }
+    if (set->filter_k < 0 || set->filter_k > 8)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: the filter's k must be 0 to 8, not %d", set->filter_k);
+    if (set->tile < 4 || set->tile > 256)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: the tile side must be 4 to 256 pixels, not %d", set->tile);
+    lm_caustic_pass *cp = calloc(1, sizeof *cp);
+    if (!cp)
+        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory");
+    cp->set = *set;
+    lm_status st = build_programs(cp, err);
+    if (st == LM_OK) {
+        glGenVertexArrays(1, &cp->vao);
+        glGenVertexArrays(1, &cp->empty_vao);
+        glGenBuffers(1, &cp->photon_vbo);
+        glGenBuffers(1, &cp->index_buf);
+        glGenBuffers(1, &cp->rect_vbo);
+        glBindVertexArray(cp->vao);
+        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, cp->index_buf); /* the VAO keeps it */
+        glBindBuffer(GL_ARRAY_BUFFER, cp->photon_vbo);
+        for (int a = 0; a < 3; a++) {
+            glEnableVertexAttribArray((GLuint)a);
+            glVertexAttribPointer((GLuint)a, 3, GL_FLOAT, GL_FALSE, PHOTON_FLOATS * sizeof(float),
+                                  (const void *)(size_t)(3 * a * sizeof(float)));
+        }
+        glBindVertexArray(0);
+        st = lm_gl_check("caustic pass: setup", err);
+    }
+    if (st != LM_OK) {
+        lm_caustic_pass_free(cp);
+        return st;
+    }
+    *out = cp;
+    return LM_OK;
+}
+
+void lm_caustic_pass_free(lm_caustic_pass *cp)
+{
+    if (!cp)
+        return;
+    for (int i = 0; i < LM_CAUSTIC_SLOTS; i++)
+        free_slot(&cp->slots[i]);
+    GLuint progs[4] = {cp->splat_prog, cp->query_prog, cp->filter_prog, cp->composite_prog};
+    for (int i = 0; i < 4; i++)
+        if (progs[i])
+            glDeleteProgram(progs[i]);
+    if (cp->vao) {
+        glDeleteVertexArrays(1, &cp->vao);
+        glDeleteVertexArrays(1, &cp->empty_vao);
+        glDeleteBuffers(1, &cp->photon_vbo);
+        glDeleteBuffers(1, &cp->index_buf);
+        glDeleteBuffers(1, &cp->rect_vbo);
+    }
+    free(cp->rects);
+    free(cp->pos);
+    free(cp->visible);
+    free(cp);
+}
+
+lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit *hits, uint32_t count, lm_error *err)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < count; i++)
+        n += hits[i].flux[0] != 0.0f || hits[i].flux[1] != 0.0f || hits[i].flux[2] != 0.0f;
+    float *v = malloc((size_t)(n ? n : 1) * PHOTON_FLOATS * sizeof *v);
+    float *pos = realloc(cp->pos, (size_t)(n ? n : 1) * 3 * sizeof *pos);
+    uint32_t *vis = pos ? realloc(cp->visible, (size_t)(n ? n : 1) * sizeof *vis) : NULL;
+    cp->pos = pos ? pos : cp->pos;
+    cp->visible = vis ? vis : cp->visible;
+    if (!v || !pos || !vis) {
+        free(v);
+        cp->photons = 0;
+        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %u photons", n);
+    }
+    float *p = v;
+    for (uint32_t i = 0; i < count; i++) {
+        const lm_caustic_hit *h = &hits[i];
+        if (h->flux[0] == 0.0f && h->flux[1] == 0.0f && h->flux[2] == 0.0f)
+            continue;
+        memcpy(pos, h->pos, 3 * sizeof *pos);
+        pos += 3;
+        memcpy(p, h->pos, 3 * sizeof *p);
+        memcpy(p + 3, h->ng, 3 * sizeof *p);
+        memcpy(p + 6, h->flux, 3 * sizeof *p);
+        p += PHOTON_FLOATS;
+    }
+    glBindBuffer(GL_ARRAY_BUFFER, cp->photon_vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)(n ? n : 1) * PHOTON_FLOATS * sizeof *v), v, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    free(v);
+    cp->photons = n;
+    return lm_gl_check("caustic pass: photons", err);
+}
+
+uint32_t lm_caustic_pass_photon_count(const lm_caustic_pass *cp) { return cp->photons; }
+
+/* The view's constants the passes share: image-plane pixel area at unit distance (perspective) or the
+ * pixel's world area (orthographic), its side, and whether it is orthographic. */
+typedef struct {
+    float view_proj[16], inv_proj[16];
+    float pix_area, pix_side;
+    int ortho;
+    float towards_eye[3];
+} view_consts;
+
+static int view_constants(const lm_view *v, int w, int h, view_consts *c)
+{
+    lm_mat4_mul(c->view_proj, v->proj, v->view);
+    c->ortho = v->proj[11] == 0.0f;
+    /* the projection's x and y scales: a pixel spans 2 / (p0 w) by 2 / (p5 h) at unit distance (or in
+     * world units, orthographic) */
+    float sx = 2.0f / (v->proj[0] * (float)w), sy = 2.0f / (v->proj[5] * (float)h);
+    c->pix_area = fabsf(sx * sy);
+    c->pix_side = sqrtf(c->pix_area);
+    c->towards_eye[0] = v->view[2], c->towards_eye[1] = v->view[6], c->towards_eye[2] = v->view[10];
+    /* inverse of the projection (no general 4x4 inverse here: perspective and orthographic forms) */
+    memset(c->inv_proj, 0, sizeof c->inv_proj);
+    const float *p = v->proj;
+    if (!(p[0] != 0.0f && p[5] != 0.0f))
+        return 0;
+    c->inv_proj[0] = 1.0f / p[0];
+    c->inv_proj[5] = 1.0f / p[5];
+    if (c->ortho) { /* x_c = p0 x + p12, y_c = p5 y + p13, z_c = p10 z + p14, w_c = 1 */
+        if (p[10] == 0.0f)
+            return 0;
+        c->inv_proj[10] = 1.0f / p[10];
+        c->inv_proj[12] = -p[12] / p[0];
+        c->inv_proj[13] = -p[13] / p[5];
+        c->inv_proj[14] = -p[14] / p[10];
+        c->inv_proj[15] = 1.0f;
+        return 1;
+    }
+    /* x_c = p0 x + p8 z, y_c = p5 y + p9 z, z_c = p10 z + p14, w_c = -z: z = -w_c, x = (x_c + p8 w_c) / p0,
+     * y likewise, and the point's own w = (z_c + p10 w_c) / p14 */
+    if (p[14] == 0.0f)
+        return 0;
+    c->inv_proj[12] = p[8] / p[0];
+    c->inv_proj[13] = p[9] / p[5];
+    c->inv_proj[14] = -1.0f;
+    c->inv_proj[11] = 1.0f / p[14];
+    c->inv_proj[15] = p[10] / p[14];
+    return 1;
+}
+
+static void set_size(GLuint prog, int w, int h) { glUniform2f(glGetUniformLocation(prog, "size"), (float)w, (float)h); }
+
+/* The photons inside the view's frustum (clip space, |x|, |y|, |z| <= w, w > 0) into cp->visible: the
+ * vertex stage, which llvmpipe runs on one thread, then sees only those (a sixth of them for a cube map's
+ * face). Returns how many. */
+static uint32_t visible_photons(lm_caustic_pass *cp, const float m[16])
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < cp->photons; i++) {
+        const float *p = cp->pos + 3 * (size_t)i;
+        float c[4];
+        for (int r = 0; r < 4; r++)
+            c[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+        if (c[3] > 0.0f && fabsf(c[0]) <= c[3] && fabsf(c[1]) <= c[3] && fabsf(c[2]) <= c[3])
+            cp->visible[n++] = i;
+    }
+    return n;
+}
+
+static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view, const view_consts *vc, GLuint depth,
+                       lm_caustic_pass_stats *st)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, t->splat_fbo);
+    glViewport(0, 0, t->width, t->height);
+    clear_box(t->splat_held, 2, 1);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    glEnable(GL_STENCIL_TEST);
+    glStencilFunc(GL_ALWAYS, 0, 0xFF);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+    GLuint p = cp->splat_prog;
+    glUseProgram(p);
+    glUniformMatrix4fv(glGetUniformLocation(p, "view_proj"), 1, GL_FALSE, vc->view_proj);
+    glUniformMatrix4fv(glGetUniformLocation(p, "inv_proj"), 1, GL_FALSE, vc->inv_proj);
+    glUniform3fv(glGetUniformLocation(p, "eye"), 1, view->eye);
+    glUniform3fv(glGetUniformLocation(p, "view_dir"), 1, vc->towards_eye);
+    glUniform1i(glGetUniformLocation(p, "ortho"), vc->ortho);
+    glUniform1f(glGetUniformLocation(p, "pix_area"), vc->pix_area);
+    glUniform1f(glGetUniformLocation(p, "pix_side"), vc->pix_side);
+    set_size(p, t->width, t->height);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, depth);
+    glUniform1i(glGetUniformLocation(p, "depth"), 0);
+    uint32_t n = visible_photons(cp, vc->view_proj);
+    glBindVertexArray(cp->vao);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)(n ? n : 1) * sizeof *cp->visible), cp->visible,
+                 GL_STREAM_DRAW);
+    GLuint q;
+    glGenQueries(1, &q);
+    glBeginQuery(GL_SAMPLES_PASSED, q);
+    glDrawElements(GL_POINTS, (GLsizei)n, GL_UNSIGNED_INT, NULL);
+    glEndQuery(GL_SAMPLES_PASSED);
+    GLuint64 splatted = 0;
+    glGetQueryObjectui64v(q, GL_QUERY_RESULT, &splatted);
+    glDeleteQueries(1, &q);
+    glDisable(GL_BLEND);
+    st->photons = n;
+    st->splatted = splatted;
+    return LM_OK;
+}
+
+/* One query per tile around a quad drawn where the stencil holds a photon. */
+static void query_tiles(lm_caustic_pass *cp, slot_targets *t, lm_caustic_pass_stats *st)
+{
+    GLuint p = cp->query_prog;
+    glUseProgram(p);
+    set_size(p, t->width, t->height);
+    GLint rect = glGetUniformLocation(p, "rect");
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glStencilFunc(GL_NOTEQUAL, 0, 0xFF);
+    glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+    glBindVertexArray(cp->empty_vao);
+    int T = cp->set.tile;
+    for (int ty = 0; ty < t->tiles_y; ty++)
+        for (int tx = 0; tx < t->tiles_x; tx++) {
+            float x0 = (float)(tx * T), y0 = (float)(ty * T);
+            float x1 = fminf(x0 + (float)T, (float)t->width), y1 = fminf(y0 + (float)T, (float)t->height);
+            glUniform4f(rect, x0, y0, x1, y1);
+            glBeginQuery(GL_SAMPLES_PASSED, t->queries[ty * t->tiles_x + tx]);
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+            glEndQuery(GL_SAMPLES_PASSED);
+        }
+    int lit = 0;
+    for (int i = 0; i < t->tiles_x * t->tiles_y; i++) {
+        GLuint64 n = 0;
+        glGetQueryObjectui64v(t->queries[i], GL_QUERY_RESULT, &n);
+        t->lit[i] = n > 0;
+        lit += t->lit[i];
+    }
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDisable(GL_STENCIL_TEST);
+    lit_box(t, cp->set.tile, 0, t->splat_held); /* photons landed in lit tiles only */
+    st->tiles = t->tiles_x * t->tiles_y;
+    st->tiles_lit = lit;
+}
+
+/* The lit tiles grown by k pixels as triangles (pixel coordinates) into cp->rects; their box in box. */
+static lm_status grown_tiles(lm_caustic_pass *cp, const slot_targets *t, int count, int box[4], uint64_t *pixels,
+                             lm_error *err)
+{
+    float *r = realloc(cp->rects, (size_t)(count ? count : 1) * 12 * sizeof *r);
+    if (!r)
+        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %d tiles", count);
+    cp->rects = r;
+    int T = cp->set.tile, k = cp->set.filter_k, n = 0;
+    box[0] = t->width, box[1] = t->height, box[2] = box[3] = 0;
+    *pixels = 0;
+    for (int ty = 0; ty < t->tiles_y; ty++)
+        for (int tx = 0; tx < t->tiles_x; tx++) {
+            if (!t->lit[ty * t->tiles_x + tx])
+                continue;
+            int x0 = tx * T - k, y0 = ty * T - k, x1 = tx * T + T + k, y1 = ty * T + T + k;
+            x0 = x0 < 0 ? 0 : x0, y0 = y0 < 0 ? 0 : y0;
+            x1 = x1 > t->width ? t->width : x1, y1 = y1 > t->height ? t->height : y1;
+            const float q[12] = {(float)x0, (float)y0, (float)x1, (float)y0, (float)x1, (float)y1,
+                                 (float)x0, (float)y0, (float)x1, (float)y1, (float)x0, (float)y1};
+            memcpy(r + 12 * n++, q, sizeof q);
+            box[0] = x0 < box[0] ? x0 : box[0], box[1] = y0 < box[1] ? y0 : box[1];
+            box[2] = x1 > box[2] ? x1 : box[2], box[3] = y1 > box[3] ? y1 : box[3];
+            *pixels += (uint64_t)(x1 - x0) * (uint64_t)(y1 - y0);
+        }
+    return LM_OK;
+}
+
+static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, GLuint depth, int count)
+{
+    glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
+    glViewport(0, 0, t->width, t->height);
+    clear_box(t->irr_held, 1, 0);
+    lit_box(t, cp->set.tile, cp->set.filter_k, t->irr_held);
+    if (!count)
+        return;
+    GLuint p = cp->filter_prog;
+    glUseProgram(p);
+    set_size(p, t->width, t->height);
+    glUniformMatrix4fv(glGetUniformLocation(p, "inv_proj"), 1, GL_FALSE, vc->inv_proj);
+    glUniform1i(glGetUniformLocation(p, "ortho"), vc->ortho);
+    glUniform1f(glGetUniformLocation(p, "pix_side"), vc->pix_side);
+    const GLuint tex[3] = {t->splat_tex[0], t->splat_tex[1], depth};
+    const char *names[3] = {"irr", "flux", "depth"};
+    for (int i = 0; i < 3; i++) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, tex[i]);
+        glUniform1i(glGetUniformLocation(p, names[i]), i);
+    }
+    glBindVertexArray(cp->empty_vao);
+    glBindBuffer(GL_ARRAY_BUFFER, cp->rect_vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)count * 12 * sizeof(float)), cp->rects, GL_STREAM_DRAW);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 2, GL_FLOAT, GL_FALSE, 0, NULL);
+    glDrawArrays(GL_TRIANGLES, 0, 6 * count);
+    glDisableVertexAttribArray(0);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glActiveTexture(GL_TEXTURE0);
+}
+
+/* kd / pi x E added over the box of the grown lit tiles (outside them E is 0), into d's probe target (the
+ * probe slot) or its frame's. One quad: no geometry drawn again. */
+static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_direct *d, int slot, const int box[4])
+{
+    const lm_frame_targets *f = lm_direct_targets(d);
+    int which = slot == LM_CAUSTIC_SLOT_PROBE ? LM_FRAME_PROBE : LM_FRAME_VIEW;
+    lm_frame_targets_bind_radiance(f, which);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_BLEND);
+    glBlendFunc(GL_ONE, GL_ONE);
+    GLuint p = cp->composite_prog;
+    glUseProgram(p);
+    set_size(p, t->width, t->height);
+    glUniform4f(glGetUniformLocation(p, "rect"), (float)box[0], (float)box[1], (float)box[2], (float)box[3]);
+    const GLuint tex[2] = {t->irr_tex, lm_frame_targets_kd(f, which)};
+    const char *names[2] = {"irr", "kd"};
+    for (int i = 0; i < 2; i++) {
+        glActiveTexture(GL_TEXTURE0 + (GLenum)i);
+        glBindTexture(GL_TEXTURE_2D, tex[i]);
+        glUniform1i(glGetUniformLocation(p, names[i]), i);
+    }
+    glBindVertexArray(cp->empty_vao);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glActiveTexture(GL_TEXTURE0);
+    glDisable(GL_BLEND);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,
+                              int height, const lm_direct *d, lm_caustic_pass_stats *stats, lm_error *err)
+{
+    lm_caustic_pass_stats st;
+    memset(&st, 0, sizeof st);
+    if (slot < 0 || slot >= LM_CAUSTIC_SLOTS || width <= 0 || height <= 0)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: bad slot %d or size %dx%d", slot, width, height);
+    view_consts vc;
+    if (!view_constants(view, width, height, &vc))
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: the view's projection cannot be inverted");
+    slot_targets *t = &cp->slots[slot];
+    lm_status s = make_slot(cp, t, width, height, err);
+    if (s != LM_OK || !cp->photons) {
+        if (s == LM_OK && t->irr_fbo) { /* nothing lights the slot: its irradiance is 0 */
+            memset(t->lit, 0, (size_t)(t->tiles_x * t->tiles_y));
+            t->lit_count = 0;
+            glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
+            clear_box(t->irr_held, 1, 0);
+            memset(t->irr_held, 0, sizeof t->irr_held);
+            glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        }
+        if (stats)
+            *stats = st;
+        return s;
+    }
+    double tw = lm_now();
+    glFinish(); /* the times below are the pass's own, not the frame's work before it */
+    double t0 = lm_now();
+    st.t_wait = t0 - tw;
+    splat(cp, t, view, &vc, depth, &st); /* its query's result waits for the splat */
+    double t1 = lm_now();
+    query_tiles(cp, t, &st);
+    double t2 = lm_now();
+    int box[4] = {0, 0, 0, 0};
+    s = grown_tiles(cp, t, st.tiles_lit, box, &st.pixels_filtered, err);
+    if (s == LM_OK) {
+        filter(cp, t, &vc, depth, st.tiles_lit);
+        glFinish();
+    }
+    double t3 = lm_now();
+    t->lit_count = st.tiles_lit;
+    memcpy(t->box, box, sizeof box);
+    if (s == LM_OK && d && st.tiles_lit) {
+        composite(cp, t, d, slot, box);
+        glFinish();
+    }
+    glBindVertexArray(0);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    st.t_splat = t1 - t0, st.t_query = t2 - t1, st.t_filter = t3 - t2, st.t_composite = lm_now() - t3;
+    if (stats)
+        *stats = st;
+    return s == LM_OK ? lm_gl_check("caustic pass", err) : s;
+}
+
+/* The slot asked for, the frame's when out of range. */
+static const slot_targets *slot_of(const lm_caustic_pass *cp, int slot)
+{
+    return &cp->slots[slot >= 0 && slot < LM_CAUSTIC_SLOTS ? slot : LM_CAUSTIC_SLOT_FRAME];
+}
+
+unsigned lm_caustic_pass_irradiance(const lm_caustic_pass *cp, int slot) { return slot_of(cp, slot)->irr_tex; }
+
+lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_direct *d, lm_caustic_pass_stats *stats,
+                                    lm_error *err)
+{
+    if (slot < 0 || slot >= LM_CAUSTIC_SLOTS || !cp->slots[slot].irr_fbo)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: slot %d has no irradiance to composite", slot);
+    slot_targets *t = &cp->slots[slot];
+    lm_caustic_pass_stats st;
+    memset(&st, 0, sizeof st);
+    double t0 = lm_now();
+    if (t->lit_count && cp->photons) {
+        composite(cp, t, d, slot, t->box);
+        glFinish();
+    }
+    glBindVertexArray(0);
+    st.t_composite = lm_now() - t0;
+    if (stats)
+        *stats = st;
+    return lm_gl_check("caustic pass: composite", err);
+}
+
+const uint8_t *lm_caustic_pass_tiles(const lm_caustic_pass *cp, int slot, int *tiles_x, int *tiles_y)
+{
+    const slot_targets *t = slot_of(cp, slot);
+    *tiles_x = t->tiles_x;
+    *tiles_y = t->tiles_y;
+    return t->lit;
+}
+
+static lm_status read_texture(GLuint tex, int w, int h, float *rgba, lm_error *err)
+{
+    if (!tex)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: nothing to read before a run");
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_PACK_ALIGNMENT, 4);
+    glGetTexImage(GL_TEXTURE_2D, 0, GL_RGBA, GL_FLOAT, rgba);
+    (void)w, (void)h;
+    return lm_gl_check("caustic pass: read-back", err);
+}
+
+lm_status lm_caustic_pass_read_splat(const lm_caustic_pass *cp, int slot, float *rgba, lm_error *err)
+{
+    const slot_targets *t = slot_of(cp, slot);
+    return read_texture(t->splat_tex[0], t->width, t->height, rgba, err);
+}
+
+lm_status lm_caustic_pass_read_irradiance(const lm_caustic_pass *cp, int slot, float *rgb, lm_error *err)
+{
+    const slot_targets *t = slot_of(cp, slot);
+    size_t n = (size_t)t->width * (size_t)t->height;
+    float *rgba = malloc((n ? n : 1) * 4 * sizeof *rgba);
+    if (!rgba)
+        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory to read back");
+    lm_status st = read_texture(t->irr_tex, t->width, t->height, rgba, err);
+    for (int y = 0; st == LM_OK && y < t->height; y++)
+        for (int x = 0; x < t->width; x++) {
+            const float *s = rgba + 4 * ((size_t)(t->height - 1 - y) * t->width + x);
+            float *o = rgb + 3 * ((size_t)y * t->width + x);
+            o[0] = s[0], o[1] = s[1], o[2] = s[2];
+        }
+    free(rgba);
+    return st;
+}

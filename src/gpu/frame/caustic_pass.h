@@ -1,0 +1,90 @@
+/* The screen-space caustic pass (Larsen & Christensen 2004, section 5 and Fig. 3; docs/caustics.md): the
+ * caustic photons (trace/caustics.h) drawn as points over the frame's depth, the screen tiles that hold
+ * some found by one occlusion query each, and the paper's cone filter (Eq. 4) run on those tiles alone;
+ * then each visible surface adds kd / pi x the caustic irradiance E.
+ *
+ *   splat    one point per photon, at the centre of the pixel it projects into, additively into two
+ *            RGBA32F textures: (Phi / A_pix, 1) and (Phi, 1), A_pix the world area of that pixel's
+ *            footprint on the photon's receiver (d^2 Omega_pix / cos, from its normal); and +1 into the
+ *            stencil. Depth: the photon lies on a surface, so a hardware depth test would fight with it;
+ *            the vertex shader compares its view depth with the frame's depth at that pixel instead,
+ *            within the depth the receiver spans across a pixel (1 + 2 tan of its view angle, capped, pixel
+ *            footprints) and drops photons behind, behind the camera, off screen, or on the side of
+ *            the receiver the camera does not see. Float throughout: no 8-bit count limit, coloured light.
+ *   tiles    the screen in tile x tile squares; per square an occlusion query (GL_SAMPLES_PASSED) around a
+ *            quad drawn where the stencil is not 0: a tile is lit when the query counts any pixel.
+ *   filter   over every lit tile grown by k pixels (clamped to the screen), with blending off, so that
+ *            pixels two grown tiles share get the same value twice, never twice the light:
+ *              screen (the paper's): E(x) = sum_ij t(x + i, y + j) w_ij / sum_ij w_ij,
+ *                w_ij = sqrt(1 + 2 k^2) - sqrt(i^2 + j^2), t the splat's Phi / A_pix: each photon's power
+ *                spread over the (2k + 1)^2 pixels around it, over the world area they cover (A_pix at the
+ *                photon): E integrates back to the photons' power where A_pix varies little over a filter;
+ *              world (the paper's suggestion): every pixel's view position from the depth; a cone kernel of
+ *                world radius R = k pixel footprints at x, E(x) = sum_j Phi_j max(0, 1 - |P_j - P_x| / R)
+ *                / (pi R^2 / 3): photons on another surface than x's (a depth step) do not leak.
+ *            Elsewhere E is 0.
+ *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
+ *            lobe the direct light's first pass wrote there: frame_targets.h).
+ *
+ * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
+ * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
+ * application renders (_VIEW).
+ * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel, two
+ * per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a current GL
+ * context; not thread-safe. */
+#ifndef LM_CAUSTIC_PASS_H
+#define LM_CAUSTIC_PASS_H
+
+#include <stdint.h>
+
+#include "../../core/error.h"
+#include "../../trace/caustics.h"
+#include "../../core/camera.h"
+#include "direct.h"
+
+typedef struct {
+    int filter_k;          /* k of the (2k + 1)^2 filter, 0 to 8 (default 3, the paper's 7 x 7) */
+    int tile;              /* tile side in pixels, 4 to 256 (default 32) */
+    int world_space;       /* 1: filter by world distance (default 0: the paper's screen-space cone) */
+} lm_caustic_pass_settings;
+
+void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s);
+
+typedef struct {
+    uint32_t photons;      /* photons drawn */
+    uint64_t splatted;     /* of those, the ones that landed on a visible pixel (a query around the splat) */
+    int tiles, tiles_lit;  /* tiles of the screen, and those whose query found photons */
+    uint64_t pixels_filtered; /* pixels of the grown lit tiles (shared pixels counted once per tile) */
+    double t_splat, t_query, t_filter, t_composite; /* seconds (each ends with the GPU's work done) */
+    double t_wait;         /* seconds waited first for the GPU work before the pass (the frame's direct
+                            * light, which runs asynchronously): not the pass's own */
+} lm_caustic_pass_stats;
+
+typedef struct lm_caustic_pass lm_caustic_pass;
+enum { LM_CAUSTIC_SLOT_FRAME = 0, LM_CAUSTIC_SLOT_PROBE = 1, LM_CAUSTIC_SLOT_VIEW = 2, LM_CAUSTIC_SLOTS = 3 };
+
+lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic_pass **out, lm_error *err);
+void lm_caustic_pass_free(lm_caustic_pass *cp);
+/* Uploads the landed photons of hits[0 .. count) (slots with zero flux skipped). */
+lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit *hits, uint32_t count, lm_error *err);
+uint32_t lm_caustic_pass_photon_count(const lm_caustic_pass *cp);
+/* Splat, tiles and filter for `view` over the depth texture `depth` (width x height, lm_direct_depth_texture)
+ * into slot `slot`'s irradiance; then, unless d is NULL, the composite into d's probe target (the probe
+ * slot) or its frame's (the others), whose first pass drew the same view. Nothing at all is drawn without
+ * photons. stats may be NULL. */
+lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,
+                              int height, const lm_direct *d, lm_caustic_pass_stats *stats, lm_error *err);
+/* The composite alone, over slot's irradiance as its last run left it: for a picture whose photons, view
+ * and depth are those of that run (nothing moved), which need no splat, query or filter again. */
+lm_status lm_caustic_pass_composite(lm_caustic_pass *cp, int slot, const lm_direct *d, lm_caustic_pass_stats *stats,
+                                    lm_error *err);
+/* After a run of slot: the irradiance E (RGBA32F texture, rgb), the tiles whose queries found photons
+ * (tiles_x x tiles_y flags, row 0 at the bottom as GL's), and the splat read back (width x height x 4
+ * floats, GL rows bottom-up: rgb = sum Phi / A_pix, a = photons) for tests. */
+unsigned lm_caustic_pass_irradiance(const lm_caustic_pass *cp, int slot);
+const uint8_t *lm_caustic_pass_tiles(const lm_caustic_pass *cp, int slot, int *tiles_x, int *tiles_y);
+lm_status lm_caustic_pass_read_splat(const lm_caustic_pass *cp, int slot, float *rgba, lm_error *err);
+/* The irradiance read back (width x height x 3 floats, row 0 at the top, as lm_direct_read's picture). */
+lm_status lm_caustic_pass_read_irradiance(const lm_caustic_pass *cp, int slot, float *rgb, lm_error *err);
+
+#endif

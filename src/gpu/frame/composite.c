@@ -1,0 +1,133 @@
+/* The indirect term of a frame's composite (composite.h): a premultiplied IIM / pi atlas, rendered by one
+ * atlas-sized pass (glsl/premultiply_*.glsl); the direct light's first pass samples it and multiplies by
+ * kd. Target and program persist. */
+#include "composite.h"
+
+#include "../../core/vecmath.h"
+#include "../gl/gl_api.h"
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../gl/gl_shader.h"
+#include "glsl.h"
+#include "../gl/offscreen.h"
+
+struct lm_composite {
+    int width, height;   /* atlas */
+    GLuint covered_tex, premult_prog, empty_vao;
+    float limit;
+    GLint p_limit, p_covered, p_iim;
+    lm_float_target lit; /* atlas-sized, linear filter: (E / pi * w, w), w = covered and valid */
+};
+
+/* 1 at every texel of the texel table (covered by some triangle) whose node takes indirect light, 0 in
+ * gutters, unused corners and on nodes with indirect light switched off. */
+static void fill_covered(const lm_scene *s, const lm_atlas *a, float *out)
+{
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        out[4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x)] =
+            s->nodes[s->tri_node[a->texels[i].tri]].settings.indirect ? 1.0f : 0.0f;
+}
+
+/* An atlas-sized RGBA32F texture, nearest filtered, its texels left to lm_composite_update_coverage. */
+static GLuint coverage_texture(int w, int h)
+{
+    GLuint tex;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return tex;
+}
+
+lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err)
+{
+    float *covered = calloc(4 * (size_t)a->width * a->height, sizeof(float));
+    if (!covered)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap coverage", s->path);
+    fill_covered(s, a, covered);
+    glBindTexture(GL_TEXTURE_2D, c->covered_tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, a->width, a->height, GL_RGBA, GL_FLOAT, covered);
+    free(covered);
+    return LM_OK;
+}
+
+lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
+                              lm_error *err)
+{
+    *out = NULL;
+    lm_composite *c = calloc(1, sizeof *c);
+    if (!c)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the composite", s->path);
+    c->width = a->width;
+    c->height = a->height;
+    c->limit = backface_limit;
+    c->covered_tex = coverage_texture(a->width, a->height);
+    lm_status st = lm_composite_update_coverage(c, s, a, err);
+    if (st == LM_OK)
+        st = lm_gl_program("composite_premultiply", lm_glsl_premultiply_vs, lm_glsl_premultiply_fs, &c->premult_prog, err);
+    if (st != LM_OK) {
+        lm_composite_free(c);
+        return st;
+    }
+    glGenVertexArrays(1, &c->empty_vao);
+    c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
+    c->p_covered = glGetUniformLocation(c->premult_prog, "covered");
+    c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
+    *out = c;
+    return LM_OK;
+}
+
+
+void lm_composite_free(lm_composite *c)
+{
+    if (!c)
+        return;
+    if (c->covered_tex)
+        glDeleteTextures(1, &c->covered_tex);
+    if (c->premult_prog)
+        glDeleteProgram(c->premult_prog);
+    if (c->empty_vao)
+        glDeleteVertexArrays(1, &c->empty_vao);
+    lm_float_target_free(&c->lit);
+    free(c);
+}
+
+/* The premultiplied atlas (c->lit, bound) from the display IIM. */
+static void premultiply(const lm_composite *c, unsigned iim_tex)
+{
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(c->premult_prog);
+    glUniform1f(c->p_limit, c->limit);
+    glUniform1i(c->p_covered, 0);
+    glUniform1i(c->p_iim, 1);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, c->covered_tex);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, iim_tex);
+    glBindVertexArray(c->empty_vao);
+    glDrawArrays(GL_TRIANGLES, 0, 3);
+    glBindTexture(GL_TEXTURE_2D, c->lit.color[0]); /* sampled with the bilinear filter */
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glActiveTexture(GL_TEXTURE0);
+}
+
+lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit_tex, lm_error *err)
+{
+    lm_status st = lm_float_target_ensure(&c->lit, c->width, c->height, 1, err);
+    if (st != LM_OK)
+        return st;
+    premultiply(c, iim_tex);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    *lit_tex = c->lit.color[0];
+    return lm_gl_check("composite: indirect", err);
+}

@@ -1,0 +1,28 @@
+/* The frame's composite (DESIGN.md step 7): linear RGB = direct + kd / pi * E_IIM, kd the diffuse lobe
+ * per pixel (base colour factor x texture at the pixel, docs/materials.md); E_IIM is the displayed IIM
+ * texture. This module makes the indirect term's texture: an atlas-sized RGBA32F of
+ * (E / pi * w, w), w = 1 on covered, valid texels (back-face fraction <= the limit), else 0,
+ * with a bilinear filter; sampled at a visible point's lightmap uv, rgb / a is then the filter over the
+ * four nearest texels that weighs only covered, valid ones, so gutters and invalid texels never darken a
+ * chart's border. The direct light's first pass multiplies it by kd and adds it (gpu/frame/direct.h, lm_direct_set_indirect): the
+ * sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
+ * light, nor do nodes whose indirect light is switched off (extras "indirect": false, lmgi_set_node_effects).
+ * Program and target persist. */
+#ifndef LM_COMPOSITE_H
+#define LM_COMPOSITE_H
+
+#include "../../charts/charts.h"
+
+typedef struct lm_composite lm_composite;
+
+/* Builds the coverage texture and the program. Needs a current GL context. */
+lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
+                              lm_error *err);
+void lm_composite_free(lm_composite *c);
+/* Builds the coverage again after nodes switched their indirect light on or off (lm_node_settings). */
+lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err);
+/* The indirect term from iim_tex (atlas-sized RGBA32F, a = back-face fraction) into *lit_tex (owned by c,
+ * valid until the next call). One atlas-sized pass. */
+lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit_tex, lm_error *err);
+
+#endif

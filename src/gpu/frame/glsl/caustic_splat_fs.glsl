@@ -1,0 +1,5 @@
+#version 450 core
+in vec3 v_irr, v_flux;
+layout(location = 0) out vec4 irr;
+layout(location = 1) out vec4 flux;
+void main() { irr = vec4(v_irr, 1.0); flux = vec4(v_flux, 1.0); }

@@ -1,0 +1,80 @@
+#include "lightmap_view.h"
+
+#include "../gl/gl_api.h"
+#include <math.h>
+#include <stdlib.h>
+
+#include "../../core/vecmath.h"
+#include "../gl/gl_mesh.h"
+#include "../gl/gl_shader.h"
+#include "glsl.h"
+#include "../gl/offscreen.h"
+
+float *lm_lightmapped_vertices(const lm_scene *s, const lm_atlas *a)
+{
+    float *v = malloc(sizeof(float) * 15 * (size_t)(s->tri_count ? s->tri_count : 1));
+    if (!v)
+        return NULL;
+    for (uint32_t t = 0; t < s->tri_count; t++)
+        for (int k = 0; k < 3; k++) {
+            float *o = v + 15 * (size_t)t + 5 * k;
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], o);
+            const float *uv = a->corner_uv + 6 * (size_t)t + 2 * k;
+            int none = a->tri_chart[t] < 0 || !isfinite(uv[0]);
+            o[3] = none ? -1.0f : uv[0];
+            o[4] = none ? -1.0f : uv[1];
+        }
+    return v;
+}
+
+static GLuint upload_atlas(const lm_atlas *a, const float *rgb)
+{
+    GLuint tex;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB32F, a->width, a->height, 0, GL_RGB, GL_FLOAT, rgb);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    return tex;
+}
+
+lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *rgb, float exposure,
+                             const lm_view *view, int width, int height, uint8_t *rgba8, lm_error *err)
+{
+    GLuint prog = 0;
+    lm_status st = lm_gl_program("lightmap_view", lm_glsl_lightmap_view_vs, lm_glsl_lightmap_view_fs, &prog, err);
+    if (st != LM_OK)
+        return st;
+    float *verts = lm_lightmapped_vertices(s, a);
+    if (!verts) {
+        glDeleteProgram(prog);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap view", s->path);
+    }
+    GLuint tex = upload_atlas(a, rgb);
+    lm_gl_mesh mesh;
+    const int sizes[2] = {3, 2}; /* position, lightmap UV */
+    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
+    free(verts);
+
+    lm_offscreen target;
+    st = lm_offscreen_begin(&target, width, height, err);
+    if (st == LM_OK) {
+        float vp[16];
+        lm_mat4_mul(vp, view->proj, view->view);
+        glUseProgram(prog);
+        glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
+        glUniform1f(glGetUniformLocation(prog, "exposure"), exposure);
+        glUniform1i(glGetUniformLocation(prog, "atlas"), 0);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, tex);
+        lm_gl_mesh_draw_scene_sides(&mesh, s);
+        st = lm_offscreen_end(&target, rgba8, err);
+    }
+    glDeleteTextures(1, &tex);
+    lm_gl_mesh_destroy(&mesh);
+    glDeleteProgram(prog);
+    return st;
+}

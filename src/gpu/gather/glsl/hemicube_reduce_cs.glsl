@@ -1,0 +1,33 @@
+// One invocation per tile, summing its R^2 weighted pixels in a fixed order (deterministic, and no
+// barriers: cheap on a CPU rasterizer that runs a work group's invocations as SIMD lanes).
+layout(local_size_x = 8) in;
+#if SCHEME == 2
+layout(binding = 0) uniform sampler2DArray tiles;
+#else
+layout(binding = 0) uniform sampler2D tiles;
+#endif
+layout(binding = 0, rgba32f) uniform writeonly image2D iim;
+layout(std430, binding = 0) readonly buffer Weights { float w[]; };
+layout(std430, binding = 1) readonly buffer Targets { ivec2 xy[]; };
+layout(std430, binding = 3) readonly buffer Cpu { vec4 emit[]; }; /* emitter + rim E, 1 if covered */
+uniform int R;
+uniform int tiles_x;
+uniform int count;
+uniform float scale;   /* pi / F(a), or pi when the rim is traced */
+uniform float inv_f;   /* 1 / F(a) */
+void main() {
+    int tile = int(gl_GlobalInvocationID.x);
+    if (tile >= count) return;
+    vec4 s = vec4(0.0);
+#if SCHEME == 2
+    for (int y = 0; y < R; y++)
+        for (int x = 0; x < R; x++)
+            s += w[y * R + x] * texelFetch(tiles, ivec3(x, y, tile), 0);
+#else
+    ivec2 origin = ivec2(tile % tiles_x, tile / tiles_x) * R;
+    for (int y = 0; y < R; y++)
+        for (int x = 0; x < R; x++)
+            s += w[y * R + x] * texelFetch(tiles, origin + ivec2(x, y), 0);
+#endif
+    imageStore(iim, xy[tile], vec4(scale * s.rgb + emit[tile].rgb, inv_f * s.a + emit[tile].a));
+}

@@ -1,0 +1,215 @@
+/* IIM scheduling, double-buffered blending (glsl/iim_blend_cs.glsl) and invalid-texel filling (iim.h). */
+#include "iim.h"
+
+#include "../gl/gl_api.h"
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../../charts/atlas_dilate.h"
+#include "../gl/gl_shader.h"
+#include "glsl.h"
+#include "hemicube.h"
+
+#define NEVER (INT_MIN / 2)
+
+void lm_iim_settings_default(lm_iim_settings *s)
+{
+    s->texels_per_frame = LM_IIM_DEFAULT_TEXELS_PER_FRAME;
+    s->blend_frames = 8;
+    s->delta_threshold = 0.0;
+}
+
+static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
+{
+    unsigned *tex[4] = {&iim->fresh_tex, &iim->old_tex, &iim->new_tex, &iim->display_tex};
+    for (int i = 0; i < 4; i++)
+        if (!(*tex[i] = lm_iim_texture_create(a->width, a->height)))
+            return lm_fail(err, LM_ERR_BACKEND, "IIM: could not make a %dx%d RGBA32F texture", a->width, a->height);
+    lm_status st = lm_gl_compute_program("iim_blend", lm_glsl_iim_blend_cs, &iim->blend_prog, err);
+    if (st != LM_OK)
+        return st;
+    size_t n = (size_t)a->width * (size_t)a->height;
+    int *surf = malloc(sizeof(int) * n);
+    if (!surf)
+        return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
+    for (size_t i = 0; i < n; i++)
+        surf[i] = a->texel_index[i] < 0 ? -1 : a->texels[a->texel_index[i]].surface;
+    GLuint bufs[2];
+    glGenBuffers(2, bufs);
+    iim->surface_buf = bufs[0], iim->params_buf = bufs[1];
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * n), surf, GL_STATIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * 2 * (size_t)(iim->sched.surface_count + 1)), NULL,
+                 GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    free(surf);
+    return lm_gl_check("IIM: blend buffers", err);
+}
+
+lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set, int with_gl, lm_error *err)
+{
+    memset(iim, 0, sizeof *iim);
+    iim->set = *set;
+    iim->width = a->width, iim->height = a->height;
+    size_t S = (size_t)(a->surface_count ? a->surface_count : 1);
+    iim->blend_start = malloc(S * sizeof *iim->blend_start);
+    iim->version = calloc(S, sizeof *iim->version);
+    lm_status st = iim->blend_start && iim->version
+                       ? lm_iim_sched_init(&iim->sched, a, set->texels_per_frame, set->delta_threshold, err)
+                       : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
+    for (size_t k = 0; st == LM_OK && k < S; k++)
+        iim->blend_start[k] = NEVER;
+    if (st == LM_OK && with_gl)
+        st = init_gl(iim, a, err);
+    if (st != LM_OK)
+        lm_iim_free(iim);
+    return st;
+}
+
+void lm_iim_free(lm_iim *iim)
+{
+    unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
+    for (int i = 0; i < 4; i++)
+        lm_iim_texture_free(tex[i]);
+    if (iim->blend_prog) {
+        GLuint bufs[2] = {iim->surface_buf, iim->params_buf};
+        glDeleteBuffers(2, bufs);
+        glDeleteProgram(iim->blend_prog);
+    }
+    lm_iim_sched_free(&iim->sched);
+    free(iim->blend_start);
+    free(iim->version);
+    memset(iim, 0, sizeof *iim);
+}
+
+float lm_iim_blend_weight(const lm_iim *iim, int surface)
+{
+    if (iim->set.blend_frames <= 0)
+        return 1.0f;
+    float t = (float)((double)iim->sched.frame - iim->blend_start[surface]) / (float)iim->set.blend_frames;
+    return t < 1.0f ? t : 1.0f;
+}
+
+lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
+{
+    int S = iim->sched.surface_count;
+    uint8_t *commit = iim->sched.commit;
+    float *param = malloc(sizeof(float) * 2 * (size_t)(S + 1));
+    if (!param)
+        return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
+    int any_commit = 0, blending = 0;
+    for (int s = 0; s < S; s++) {
+        /* shown differently from the last frame: committed now, or last frame's weight was below 1 */
+        if (commit[s] || (double)iim->sched.frame - 1 - iim->blend_start[s] < iim->set.blend_frames)
+            iim->version[s]++;
+        if (commit[s])
+            iim->blend_start[s] = instant ? NEVER : iim->sched.frame;
+        param[2 * s] = commit[s] ? 1.0f : 0.0f;
+        param[2 * s + 1] = lm_iim_blend_weight(iim, s);
+        any_commit |= commit[s];
+        blending |= param[2 * s + 1] < 1.0f;
+        commit[s] = 0;
+    }
+    if (!any_commit && iim->settled) { /* the last pass already wrote every final value */
+        free(param);
+        lm_iim_sched_end_frame(&iim->sched);
+        return LM_OK;
+    }
+    iim->settled = !blending;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->params_buf);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * 2 * (size_t)S), param);
+    free(param);
+    glUseProgram(iim->blend_prog);
+    glUniform2i(glGetUniformLocation(iim->blend_prog, "size"), iim->width, iim->height);
+    const unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
+    for (int i = 0; i < 4; i++)
+        glBindImageTexture((GLuint)i, tex[i], 0, GL_FALSE, 0, i ? GL_READ_WRITE : GL_READ_ONLY, GL_RGBA32F);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, iim->surface_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->params_buf);
+    glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    lm_iim_sched_end_frame(&iim->sched);
+    return lm_gl_check("IIM blend (iim_blend)", err);
+}
+
+lm_status lm_iim_clear(lm_iim *iim, lm_error *err)
+{
+    const unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
+    for (int i = 0; i < 4; i++)
+        glClearTexImage(tex[i], 0, GL_RGBA, GL_FLOAT, NULL);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    return lm_gl_check("clearing the IIM", err);
+}
+
+/* One pass over the window win: every invalid texel with valid same-surface 4-neighbours in it gets
+ * their mean (read from the state before the pass, so the result does not depend on visiting order).
+ * rgba and valid hold the window's cells. */
+static uint32_t fill_pass(const lm_atlas *a, const int win[4], float *rgba, uint8_t *valid, uint8_t *next)
+{
+    static const int dx[4] = {1, -1, 0, 0}, dy[4] = {0, 0, 1, -1};
+    const int w = win[2], h = win[3];
+    uint32_t filled = 0;
+    memcpy(next, valid, (size_t)w * h);
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            size_t c = (size_t)y * w + x;
+            int i = a->texel_index[(size_t)(win[1] + y) * a->width + (win[0] + x)];
+            if (i < 0 || valid[c])
+                continue;
+            float sum[3] = {0, 0, 0};
+            int n = 0;
+            for (int k = 0; k < 4; k++) {
+                int xx = x + dx[k], yy = y + dy[k];
+                if (xx < 0 || yy < 0 || xx >= w || yy >= h)
+                    continue;
+                size_t cc = (size_t)yy * w + xx;
+                int j = a->texel_index[(size_t)(win[1] + yy) * a->width + (win[0] + xx)];
+                if (j < 0 || !valid[cc] || a->texels[j].surface != a->texels[i].surface)
+                    continue;
+                for (int ch = 0; ch < 3; ch++)
+                    sum[ch] += rgba[4 * cc + ch];
+                n++;
+            }
+            if (!n)
+                continue;
+            float *o = rgba + 4 * c;
+            for (int ch = 0; ch < 3; ch++)
+                o[ch] = sum[ch] / (float)n;
+            o[3] = 0.0f;
+            next[c] = 1;
+            filled++;
+        }
+    memcpy(valid, next, (size_t)w * h);
+    return filled;
+}
+
+uint32_t lm_iim_fill_invalid_window(const lm_atlas *a, float *rgba, float limit, const int win[4])
+{
+    size_t n = (size_t)win[2] * win[3];
+    uint8_t *valid = malloc(n + 1), *next = malloc(n + 1);
+    uint32_t left = 0;
+    if (valid && next) {
+        for (int y = 0; y < win[3]; y++)
+            for (int x = 0; x < win[2]; x++) {
+                size_t c = (size_t)y * win[2] + x;
+                int i = a->texel_index[(size_t)(win[1] + y) * a->width + (win[0] + x)];
+                valid[c] = i < 0 || !(rgba[4 * c + 3] > limit); /* gutters: nothing to fill */
+                left += !valid[c];
+            }
+        uint32_t f;
+        while (left && (f = fill_pass(a, win, rgba, valid, next)) > 0)
+            left -= f;
+    }
+    free(valid);
+    free(next);
+    lm_atlas_dilate_window(a, rgba, 4, lm_atlas_dilate_reach(a), win);
+    return left;
+}
+
+uint32_t lm_iim_fill_invalid(const lm_atlas *a, float *rgba, float limit)
+{
+    const int whole[4] = {0, 0, a->width, a->height};
+    return lm_iim_fill_invalid_window(a, rgba, limit, whole);
+}

@@ -1,0 +1,68 @@
+/* Indirect illumination maps (IIMs): double-buffered textures and blending (Larsen & Christensen
+ * section 4; DESIGN.md step 4). Which texels are regathered and when a surface is complete is the
+ * scheduler's (photonmap/iim_schedule.h, `sched` below), which alone writes the photon store's delta_i;
+ * this module only reads its commit flags (and clears them) and its frame counter.
+ *
+ * Double buffering (GPU, no read-back): the gather writes into `fresh`. Committing a surface copies,
+ * for its texels, the currently displayed value into `old` and `fresh` into `new`; from then on
+ * display = mix(old, new, t) with t = min(1, frames since the commit / blend_frames). A texel thus
+ * never leaves [old, new], and a surface committed again mid-blend starts from what was on screen (no
+ * popping). The alpha channel (back-face fraction) blends alike.
+ *
+ * Invalid texels (back-face fraction above the limit: the texel sees the inside of geometry) are
+ * filled on the CPU copy used for output (lm_iim_fill_invalid), then gutters are dilated. */
+#ifndef LM_IIM_H
+#define LM_IIM_H
+
+#include <stdint.h>
+
+#include "../../charts/charts.h"
+#include "../../core/error.h"
+#include "../../photonmap/iim_schedule.h"
+
+#define LM_IIM_DEFAULT_TEXELS_PER_FRAME 20 /* the paper's */
+
+typedef struct {
+    int texels_per_frame;  /* gather budget per frame (default LM_IIM_DEFAULT_TEXELS_PER_FRAME) */
+    int blend_frames;      /* frames an updated surface takes to blend from old to new (default 8; 0 = pop) */
+    double delta_threshold; /* a surface is refreshed when its delta_i exceeds this (default 0) */
+} lm_iim_settings;
+
+typedef struct {
+    lm_iim_settings set;   /* blend_frames used here; texels_per_frame and delta_threshold are sched's */
+    lm_iim_sched sched;    /* which texels to regather; its frame counter is the blend's clock */
+    int width, height;
+    int *blend_start;      /* per surface: frame of its last commit (very negative: fully blended) */
+    uint32_t *version;     /* per surface: blends that changed its displayed texels (a commit, or a blend
+                            * still under way) */
+    int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
+    /* GPU side (0 when created without GL) */
+    unsigned fresh_tex, old_tex, new_tex, display_tex;
+    unsigned blend_prog, surface_buf, params_buf;
+} lm_iim;
+
+void lm_iim_settings_default(lm_iim_settings *s);
+/* with_gl: also make the four atlas-sized RGBA32F textures and the blend program (current context). */
+lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set, int with_gl, lm_error *err);
+void lm_iim_free(lm_iim *iim);
+
+/* Blend weight of a surface this frame. */
+float lm_iim_blend_weight(const lm_iim *iim, int surface);
+/* Ends the frame on the GPU: commits the surfaces the scheduler completed (clearing their flags),
+ * writes display = mix(old, new, t), then advances the scheduler's frame counter. instant: committed surfaces show new at once (after the first gather). */
+lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
+
+/* Every IIM texture (fresh, old, new, displayed) set to 0: a scene that lost its last light shows no
+ * indirect light at once, not the last gather's. */
+lm_status lm_iim_clear(lm_iim *iim, lm_error *err);
+
+/* CPU: texels (rgba, atlas-sized, a = back-face fraction) with a > limit take the mean of valid
+ * 4-neighbours of the same surface, repeated until none changes; then gutters are dilated. Returns
+ * how many invalid texels could not be filled (no valid texel on their surface reachable). */
+uint32_t lm_iim_fill_invalid(const lm_atlas *a, float *rgba, float limit);
+/* The same over the atlas window win = {x, y, w, h}, rgba holding the window alone: exact (as the whole
+ * atlas's) for every surface all of whose texels lie in the window, and, after the dilation, for the
+ * texels at least lm_atlas_dilate_reach from its edges whose neighbourhood is such surfaces'. */
+uint32_t lm_iim_fill_invalid_window(const lm_atlas *a, float *rgba, float limit, const int win[4]);
+
+#endif
