@@ -305,7 +305,7 @@ static void test_bad_arguments(void **state)
     lmgi_updater_desc ud;
     memset(&ud, 0, sizeof ud);
     ud.gather.samples = 3;
-    expect_invalid(lmgi_check(ctx, sc, &ud, &d, 1, &c, &e), &e, "hemicube_samples 3");
+    expect_invalid(lmgi_check(ctx, sc, &ud, &d, 1, &c, &e), &e, "gather.samples 3");
     d.target_error = -1.0f;
     expect_invalid(lmgi_check(ctx, sc, NULL, &d, 1, &c, &e), &e, "target_error");
     d = quick();
