@@ -374,7 +374,7 @@ static int count_changed(lmgi_updater *u)
     return changed;
 }
 
-static void export_stats(const lm_frame_stats *fs, int budget, int changed, lmgi_update_stats *o)
+static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stats *o)
 {
     const lm_photon_stage_frame *st = &fs->stage;
     memset(o, 0, sizeof *o);
@@ -385,7 +385,7 @@ static void export_stats(const lm_frame_stats *fs, int budget, int changed, lmgi
     o->groups_retraced = st->photons.groups_retraced;
     o->aim_surfaces_refreshed = st->aim.surfaces_refreshed;
     o->texels_gathered = fs->texels_gathered;
-    o->texels_budget = budget;
+    o->texels_budget = fs->texel_budget;
     o->surfaces_changed = changed;
     o->caustic_photons_retraced = st->caustics.traced;
     o->caustic_tiles = fs->caustic.tiles;
@@ -542,7 +542,7 @@ static lmgi_status update_owned(lmgi_updater *u, float time, float budget_ms, lm
         return lm_export_error(err, &e);
     u->frames++;
     if (stats)
-        export_stats(&fs, fs.texel_budget, count_changed(u), stats);
+        export_stats(&fs, count_changed(u), stats);
     else
         count_changed(u);
     return check_frame(u, time, err);

@@ -48,14 +48,21 @@ static lm_frame_indirect indirect_of(const lm_frame_loop *fl)
                                fl->photons};
 }
 
-/* After edits: the staged ones committed (the BVH), then what follows lm_scene.pass_version and the
- * lights: the lightmap path's switches and light, the frame's passes. */
+/* After edits, what follows lm_scene.pass_version and the lights: the lightmap path's switches and
+ * light, the frame's passes. */
 static lm_status follow_edits(lm_frame_loop *fl, lm_error *err)
 {
-    lm_status st = lm_edits_commit(&fl->world, err);
-    if (st == LM_OK)
-        st = lm_lightmap_path_follow(fl->lightmaps, err);
+    lm_status st = lm_lightmap_path_follow(fl->lightmaps, err);
     return st == LM_OK ? lm_frame_passes_follow(fl->passes, err) : st;
+}
+
+/* The start of a step, a bake or a picture: the GL context current, and the edits staged since the last
+ * one committed to the BVH (update/edits.h). No photon work runs then when any is staged: each edit
+ * joined it before staging, and no step has begun any since. */
+static lm_status enter(lm_frame_loop *fl, lm_error *err)
+{
+    lm_status st = lm_gl_make_current(fl->gl, err);
+    return st == LM_OK ? lm_edits_commit(&fl->world, err) : st;
 }
 
 /* The settings' GL context made current, or one of the loop's own. */
@@ -182,7 +189,7 @@ static lm_status render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width, int height, float *rgb,
                                lm_error *err)
 {
-    lm_status st = lm_gl_make_current(fl->gl, err);
+    lm_status st = enter(fl, err);
     if (st == LM_OK)
         st = lm_frame_passes_setup(fl->passes, err);
     /* the photon gather and the caustic photons read what the worker writes. A loop that draws frames of
@@ -353,7 +360,7 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
                                           : fl->set.iim.texels_per_frame;
     lm_lightmap_path_set_texels_per_frame(fl->lightmaps, o.texel_budget);
     double t0 = lm_now();
-    lm_status st = lm_gl_make_current(fl->gl, err);
+    lm_status st = enter(fl, err);
     if (st == LM_OK)
         st = follow_edits(fl, err);
     if (st == LM_OK)
@@ -374,7 +381,7 @@ lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progre
     memset(out, 0, sizeof *out);
     lm_status st = lm_frame_loop_sync(fl, err);
     if (st == LM_OK)
-        st = lm_gl_make_current(fl->gl, err);
+        st = enter(fl, err);
     if (st == LM_OK)
         st = follow_edits(fl, err);
     if (st != LM_OK)
