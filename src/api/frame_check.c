@@ -100,7 +100,9 @@ static lm_status reference_pixels(const lmgi_scene *sc, const lm_view *view, con
 {
     lm_view cam = *view;
     lm_status st = lm_view_pinhole(&cam, c->width, c->height, err);
-    if (st == LM_OK) /* the edits' placements in the BVH it traces */
+    if (st == LM_OK && lm_edits_pending(&sc->edits) && lm_scene_quiet(sc, "the frame check", NULL) != LMGI_OK)
+        st = lm_fail(err, LM_ERR_INVALID, "%s: the context is in use by another thread", sc->scene->path);
+    if (st == LM_OK) /* the edits in the scene and the BVH it traces */
         st = lm_edits_commit(&sc->world, err);
     if (st != LM_OK)
         return st;

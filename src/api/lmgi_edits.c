@@ -1,6 +1,7 @@
-/* The public API's light and material edits. The photon stage notices a light whose power or placement
- * changed (its emitter snapshot) and re-traces that light's groups alone, and a material whose colour or
- * emission changed (its material snapshot) and re-traces the groups that touch it. */
+/* The public API's light, material and sky edits: each checked, then staged until the next commit
+ * (update/edits.h), never waiting for the photon work. The commit hands the photon stage the lights and
+ * materials whose values changed: it re-traces a changed light's groups alone, and the groups that touch
+ * a changed material. Reads (lmgi_get_light, ...) see the staged values. */
 #include <lmgi.h>
 
 #include <math.h>
@@ -13,21 +14,23 @@
 #include "../update/effects.h"
 #include "lmgi_scene.h"
 
-int lmgi_light_count(const lmgi_scene *sc) { return sc ? sc->scene->light_count : 0; }
+int lmgi_light_count(const lmgi_scene *sc) { return sc ? lm_edits_light_count(&sc->edits, sc->scene) : 0; }
 
 int lmgi_light_is_removed(const lmgi_scene *sc, int light)
 {
-    return sc && light >= 0 && light < sc->scene->light_count && sc->scene->lights[light].removed;
+    const lm_light *l = sc ? lm_edits_light(&sc->edits, sc->scene, light) : NULL;
+    return l && l->removed;
 }
 
-/* The light `light` names, or NULL with err filled (an id out of range, or of a removed light). */
-static lm_light *live_light(const lmgi_scene *sc, int light, lmgi_error *err)
+/* The light `light` names as the edits left it, or NULL with err filled (an id out of range, or of a
+ * removed light). */
+static const lm_light *live_light(const lmgi_scene *sc, int light, lmgi_error *err)
 {
-    if (light < 0 || light >= sc->scene->light_count) {
-        lm_api_refuse(err, "light id %d is out of range (scene has %d lights)", light, sc->scene->light_count);
+    const lm_light *l = lm_edits_light(&sc->edits, sc->scene, light);
+    if (!l) {
+        lm_api_refuse(err, "light id %d is out of range (scene has %d lights)", light, lmgi_light_count(sc));
         return NULL;
     }
-    lm_light *l = &sc->scene->lights[light];
     if (l->removed) {
         lm_api_refuse(err, "light %d ('%s') was removed", light, l->name);
         return NULL;
@@ -85,9 +88,9 @@ static lmgi_status check_light(const lmgi_light *in, lm_light_type type, const c
     return LMGI_OK;
 }
 
-/* The edit in takes effect on l (checked): colour, intensity, range, cones, on or off, and an added
- * light's place. */
-static void apply_light(lmgi_scene *sc, lm_light *l, const lmgi_light *in)
+/* The edit in made on l (checked): colour, intensity, range, cones, on or off, and an added light's
+ * place. */
+static void apply_light(const lmgi_scene *sc, lm_light *l, const lmgi_light *in)
 {
     memcpy(l->color, in->color, sizeof l->color);
     l->intensity = in->intensity;
@@ -106,7 +109,7 @@ lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi
 {
     if (!sc || !in)
         return lm_api_refuse(err, "lmgi_set_light: %s is NULL", sc ? "the light" : "the scene");
-    lm_light *l = live_light(sc, light, err);
+    const lm_light *l = live_light(sc, light, err);
     if (!l)
         return LMGI_ERR_INVALID;
     if ((int)in->type != (int)l->type || in->node != l->node)
@@ -114,10 +117,9 @@ lmgi_status lmgi_set_light(lmgi_scene *sc, int light, const lmgi_light *in, lmgi
     lmgi_status st = check_light(in, l->type, l->name, l->node < 0, err);
     if (st != LMGI_OK)
         return st;
-    if (lm_scene_quiet(sc, "lmgi_set_light", err) != LMGI_OK) /* its photon work reads the lights */
-        return LMGI_ERR_INVALID;
-    apply_light(sc, l, in);
-    return LMGI_OK;
+    lm_light edited = *l;
+    apply_light(sc, &edited, in);
+    return lm_scene_stage_light(sc, "lmgi_set_light", light, &edited, err);
 }
 
 lmgi_status lmgi_add_light(lmgi_scene *sc, const lmgi_light *in, int *id, lmgi_error *err)
@@ -129,48 +131,38 @@ lmgi_status lmgi_add_light(lmgi_scene *sc, const lmgi_light *in, int *id, lmgi_e
     if ((int)in->type < LMGI_LIGHT_POINT || (int)in->type > LMGI_LIGHT_DIRECTIONAL)
         return lm_api_refuse(err, "lmgi_add_light: type %d is not a light type (0 point, 1 spot, 2 directional)",
                              (int)in->type);
-    lm_scene *s = sc->scene;
+    int count = lmgi_light_count(sc);
     char name[LM_NAME_MAX];
-    snprintf(name, sizeof name, "added light %d", s->light_count);
+    snprintf(name, sizeof name, "added light %d", count);
     lmgi_status st = check_light(in, (lm_light_type)in->type, name, 1, err);
     if (st != LMGI_OK)
         return st;
-    if (s->light_count >= 1 << 20)
-        return lm_api_refuse(err, "lmgi_add_light: the scene has %d lights, the most it may have", s->light_count);
-    if (lm_scene_quiet(sc, "lmgi_add_light", err) != LMGI_OK)
-        return LMGI_ERR_INVALID;
-    lm_light *lights = realloc(s->lights, sizeof *lights * ((size_t)s->light_count + 1));
-    if (!lights) {
-        lm_error e;
-        lm_fail(&e, LM_ERR_NOMEM, "lmgi_add_light: no memory for another light");
-        return lm_export_error(err, &e);
-    }
-    s->lights = lights;
-    lm_light *l = &s->lights[s->light_count];
-    memset(l, 0, sizeof *l);
-    memcpy(l->name, name, sizeof l->name);
-    l->type = (lm_light_type)in->type;
-    l->node = -1;
-    l->added = 1;
-    l->inner_cone = 0.0f, l->outer_cone = (float)(LM_PI / 4);
-    apply_light(sc, l, in);
-    *id = s->light_count++;
-    lm_effects_decide(s, &sc->effects); /* lmgi info: what the scene now calls for */
-    return LMGI_OK;
+    if (count >= 1 << 20)
+        return lm_api_refuse(err, "lmgi_add_light: the scene has %d lights, the most it may have", count);
+    lm_light l;
+    memset(&l, 0, sizeof l);
+    memcpy(l.name, name, sizeof l.name);
+    l.type = (lm_light_type)in->type;
+    l.node = -1;
+    l.added = 1;
+    l.inner_cone = 0.0f, l.outer_cone = (float)(LM_PI / 4);
+    apply_light(sc, &l, in);
+    st = lm_scene_stage_light(sc, "lmgi_add_light", -1, &l, err);
+    if (st == LMGI_OK)
+        *id = count;
+    return st;
 }
 
 lmgi_status lmgi_remove_light(lmgi_scene *sc, int light, lmgi_error *err)
 {
     if (!sc)
         return lm_api_refuse(err, "lmgi_remove_light: the scene is NULL");
-    lm_light *l = live_light(sc, light, err);
+    const lm_light *l = live_light(sc, light, err);
     if (!l)
         return LMGI_ERR_INVALID;
-    if (lm_scene_quiet(sc, "lmgi_remove_light", err) != LMGI_OK)
-        return LMGI_ERR_INVALID;
-    l->removed = 1;
-    lm_effects_decide(sc->scene, &sc->effects);
-    return LMGI_OK;
+    lm_light removed = *l;
+    removed.removed = 1;
+    return lm_scene_stage_light(sc, "lmgi_remove_light", light, &removed, err);
 }
 
 int lmgi_material_count(const lmgi_scene *sc) { return sc ? sc->scene->material_count : 0; }
@@ -189,7 +181,7 @@ lmgi_status lmgi_get_material(const lmgi_scene *sc, int material, lmgi_material 
     if (material < 0 || material >= sc->scene->material_count)
         return lm_api_refuse(err, "material id %d is out of range (scene has %d materials)", material,
                       sc->scene->material_count);
-    const lm_material *m = &sc->scene->materials[material];
+    const lm_material *m = lm_edits_material(&sc->edits, sc->scene, material);
     out->cls = (lmgi_material_class)m->cls;
     memcpy(out->base_color, m->base_color, sizeof out->base_color);
     memcpy(out->emissive, m->emissive, sizeof out->emissive);
@@ -233,7 +225,7 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
     if (material < 0 || material >= sc->scene->material_count)
         return lm_api_refuse(err, "material id %d is out of range (scene has %d materials)", material,
                       sc->scene->material_count);
-    lm_material *m = &sc->scene->materials[material];
+    const lm_material *m = lm_edits_material(&sc->edits, sc->scene, material);
     for (int c = 0; c < 4; c++)
         if (!in_range(in->base_color[c], 0.0f, 1.0f))
             return lm_api_refuse(err, "material '%s': base colour %g must be in [0, 1]", m->name, (double)in->base_color[c]);
@@ -254,19 +246,13 @@ lmgi_status lmgi_set_material(lmgi_scene *sc, int material, const lmgi_material 
     lmgi_status st = new_class(m, in, &cls, err);
     if (st != LMGI_OK)
         return st;
-    if (lm_scene_quiet(sc, "lmgi_set_material", err) != LMGI_OK) /* its photon work reads the materials */
-        return LMGI_ERR_INVALID;
-    memcpy(m->base_color, in->base_color, sizeof m->base_color);
-    memcpy(m->emissive, in->emissive, sizeof m->emissive);
-    m->metallic = in->metallic, m->roughness = in->roughness;
-    m->transmission = in->transmission, m->ior = in->ior;
-    sc->scene->material_version++;
-    if (cls != m->cls) {
-        m->cls = cls;
-        sc->scene->pass_version++;
-        lm_effects_decide(sc->scene, &sc->effects);
-    }
-    return LMGI_OK;
+    lm_material edited = *m;
+    memcpy(edited.base_color, in->base_color, sizeof edited.base_color);
+    memcpy(edited.emissive, in->emissive, sizeof edited.emissive);
+    edited.metallic = in->metallic, edited.roughness = in->roughness;
+    edited.transmission = in->transmission, edited.ior = in->ior;
+    edited.cls = cls;
+    return lm_scene_stage_material(sc, "lmgi_set_material", material, &edited, err);
 }
 
 /* A sky's radiance, refused unless finite and in [0, LM_MAX_EMISSION]. */
@@ -279,8 +265,7 @@ static lmgi_status check_sky(const float *rgb, const char *what, lmgi_error *err
     return LMGI_OK;
 }
 
-/* Before a sky edit: the updater's photon work reads the sky; one that gathers by hemicube cannot show a sky
- * that is not uniform. */
+/* Before a sky edit: an updater that gathers by hemicube cannot show a sky that is not uniform. */
 static lmgi_status sky_edit_allowed(lmgi_scene *sc, int uniform, lmgi_error *err)
 {
     if (!sc->updater)
@@ -290,24 +275,19 @@ static lmgi_status sky_edit_allowed(lmgi_scene *sc, int uniform, lmgi_error *err
         return lm_api_refuse(err, "%s: a gradient or image sky needs the rays gather, and this updater draws "
                              "hemicubes (%s): give the sky before lmgi_updater_create, or ask for rays",
                              sc->scene->path, lm_gather_scheme_name(scheme));
-    return lm_scene_quiet(sc, "the sky edit", err);
+    return LMGI_OK;
 }
 
-/* The sky is set: what the scene calls for follows. */
-static lmgi_status sky_set(lmgi_scene *sc, lm_sky_kind kind, const float sky[3], const float *horizon)
+/* A uniform or gradient sky staged. */
+static lmgi_status sky_set(lmgi_scene *sc, lm_sky_kind kind, const float sky[3], const float *horizon, lmgi_error *err)
 {
-    lm_scene *s = sc->scene;
-    memcpy(s->sky, sky, sizeof s->sky);
+    lm_staged_sky k;
+    memset(&k, 0, sizeof k);
+    k.kind = kind;
+    memcpy(k.sky, sky, sizeof k.sky);
     if (horizon)
-        memcpy(s->sky_horizon, horizon, sizeof s->sky_horizon);
-    if (kind != LM_SKY_IMAGE) {
-        free(s->sky_image);
-        s->sky_image = NULL, s->sky_width = s->sky_height = 0;
-    }
-    s->sky_kind = kind;
-    s->has_sky = 1;
-    lm_effects_decide(s, &sc->effects);
-    return LMGI_OK;
+        memcpy(k.horizon, horizon, sizeof k.horizon);
+    return lm_scene_stage_sky(sc, "the sky edit", &k, err);
 }
 
 lmgi_status lmgi_set_environment(lmgi_scene *sc, const float radiance[3], lmgi_error *err)
@@ -317,7 +297,7 @@ lmgi_status lmgi_set_environment(lmgi_scene *sc, const float radiance[3], lmgi_e
     lmgi_status st = check_sky(radiance, "", err);
     if (st == LMGI_OK)
         st = sky_edit_allowed(sc, 1, err);
-    return st == LMGI_OK ? sky_set(sc, LM_SKY_UNIFORM, radiance, NULL) : st;
+    return st == LMGI_OK ? sky_set(sc, LM_SKY_UNIFORM, radiance, NULL, err) : st;
 }
 
 lmgi_status lmgi_set_environment_gradient(lmgi_scene *sc, const float zenith[3], const float horizon[3],
@@ -330,7 +310,7 @@ lmgi_status lmgi_set_environment_gradient(lmgi_scene *sc, const float zenith[3],
         st = check_sky(horizon, "at the horizon ", err);
     if (st == LMGI_OK)
         st = sky_edit_allowed(sc, 0, err);
-    return st == LMGI_OK ? sky_set(sc, LM_SKY_GRADIENT, zenith, horizon) : st;
+    return st == LMGI_OK ? sky_set(sc, LM_SKY_GRADIENT, zenith, horizon, err) : st;
 }
 
 lmgi_status lmgi_set_environment_image(lmgi_scene *sc, const char *path, float scale, lmgi_error *err)
@@ -340,18 +320,32 @@ lmgi_status lmgi_set_environment_image(lmgi_scene *sc, const char *path, float s
     lmgi_status st = sky_edit_allowed(sc, 0, err);
     if (st != LMGI_OK)
         return st;
+    /* read into a scene of its own (lm_sky_load_image's errors name the file), then staged */
+    lm_scene *probe = calloc(1, sizeof *probe);
+    if (!probe)
+        return lm_export_error(err, &(lm_error){LM_ERR_NOMEM, "lmgi_set_environment_image: no memory"});
+    snprintf(probe->path, sizeof probe->path, "%s", sc->scene->path);
     lm_error e;
     const float k[3] = {scale, scale, scale};
-    if (lm_sky_load_image(sc->scene, path, k, &e) != LM_OK)
+    if (lm_sky_load_image(probe, path, k, &e) != LM_OK) {
+        free(probe);
         return lm_export_error(err, &e);
-    lm_effects_decide(sc->scene, &sc->effects);
-    return LMGI_OK;
+    }
+    lm_staged_sky sky = {0, LM_SKY_IMAGE, {k[0], k[1], k[2]}, {0}, probe->sky_image, probe->sky_width,
+                         probe->sky_height, {0}};
+    memcpy(sky.image_mean, probe->sky_image_mean, sizeof sky.image_mean);
+    free(probe);
+    st = lm_scene_stage_sky(sc, "lmgi_set_environment_image", &sky, err);
+    if (st != LMGI_OK)
+        free(sky.image);
+    return st;
 }
 
 int lmgi_get_environment(const lmgi_scene *sc, float out[3])
 {
-    int has = sc && sc->scene->has_sky;
+    const lm_staged_sky *k = sc ? lm_edits_sky(&sc->edits) : NULL;
+    int has = k || (sc && sc->scene->has_sky);
     for (int c = 0; out && c < 3; c++)
-        out[c] = has ? sc->scene->sky[c] : 0.0f;
+        out[c] = k ? k->sky[c] : has ? sc->scene->sky[c] : 0.0f;
     return has;
 }

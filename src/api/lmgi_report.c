@@ -20,6 +20,7 @@ void lmgi_get_info(const lmgi_scene *sc, lmgi_info *in)
     memset(in, 0, sizeof *in);
     if (!sc)
         return;
+    lm_scene_commit(sc, NULL); /* the edits staged so far in what it counts (a failure: counted as it was) */
     const lm_scene *s = sc->scene;
     in->triangles = s->tri_twin ? s->file_tri_count : s->tri_count;
     in->back_triangles = s->tri_count - in->triangles;
@@ -68,6 +69,7 @@ void lmgi_get_effect(const lmgi_scene *sc, int i, lmgi_effect *out)
     memset(out, 0, sizeof *out);
     if (!sc || i < 0 || i >= LM_EFFECT_COUNT)
         return;
+    lm_scene_commit(sc, NULL); /* the effects that the edits staged so far call for */
     out->name = lm_effect_name((lm_effect_id)i);
     out->on = sc->effects.on[i];
     snprintf(out->reason, sizeof out->reason, "%s", sc->effects.reason[i]);
@@ -149,6 +151,7 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
 {
     if (!sc || !f)
         return;
+    lm_scene_commit(sc, NULL);
     const lm_scene *s = sc->scene;
     lmgi_info in;
     lmgi_get_info(sc, &in);

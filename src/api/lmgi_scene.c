@@ -52,16 +52,79 @@ lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err
 
 lmgi_status lm_scene_commit(const lmgi_scene *sc, lmgi_error *err)
 {
+    if (!lm_edits_pending(&sc->edits))
+        return LMGI_OK;
+    lmgi_status st = lm_scene_quiet(sc, "the commit of the edits", err); /* the photon work reads the scene */
+    if (st != LMGI_OK)
+        return st;
     lm_error e;
     return lm_edits_commit(&sc->world, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+/* An edit staged: refused (naming fn) while another thread is inside a call on the updater's context,
+ * which may be committing the batch. */
+static lmgi_status stage(lmgi_scene *sc, const char *fn, lm_status (*put)(lmgi_scene *, const void *, int, lm_error *),
+                         const void *value, int id, lmgi_error *err)
+{
+    if (sc->loop && lm_api_claim(sc->ctx, fn, err) != LMGI_OK)
+        return LMGI_ERR_INVALID;
+    lm_error e;
+    lm_status st = put(sc, value, id, &e);
+    if (sc->loop)
+        lm_api_release(sc->ctx);
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
+}
+
+static lm_status put_light(lmgi_scene *sc, const void *l, int id, lm_error *err)
+{
+    int added;
+    return id < 0 ? lm_edits_add_light(&sc->edits, sc->scene, l, &added, err)
+                  : lm_edits_stage_light(&sc->edits, sc->scene, id, l, err);
+}
+
+static lm_status put_material(lmgi_scene *sc, const void *m, int id, lm_error *err)
+{
+    return lm_edits_stage_material(&sc->edits, sc->scene, id, m, err);
+}
+
+static lm_status put_sky(lmgi_scene *sc, const void *k, int id, lm_error *err)
+{
+    (void)id, (void)err;
+    lm_edits_stage_sky(&sc->edits, k);
+    return LM_OK;
+}
+
+static lm_status put_effects(lmgi_scene *sc, const void *e, int id, lm_error *err)
+{
+    (void)id;
+    return lm_edits_stage_effects(&sc->edits, e, err);
+}
+
+static lm_status put_dynamic(lmgi_scene *sc, const void *dynamic, int node, lm_error *err)
+{
+    return lm_edits_stage_dynamic(&sc->edits, node, *(const int *)dynamic, err);
+}
+
+lmgi_status lm_scene_stage_light(lmgi_scene *sc, const char *fn, int id, const lm_light *l, lmgi_error *err)
+{
+    return stage(sc, fn, put_light, l, id, err);
+}
+
+lmgi_status lm_scene_stage_material(lmgi_scene *sc, const char *fn, int id, const lm_material *m, lmgi_error *err)
+{
+    return stage(sc, fn, put_material, m, id, err);
+}
+
+lmgi_status lm_scene_stage_sky(lmgi_scene *sc, const char *fn, const lm_staged_sky *sky, lmgi_error *err)
+{
+    return stage(sc, fn, put_sky, sky, 0, err);
 }
 
 lmgi_status lmgi_commit(lmgi_scene *sc, lmgi_error *err)
 {
     if (!sc)
         return lm_api_refuse(err, "lmgi_commit: the scene is NULL");
-    lmgi_status st = lm_scene_quiet(sc, "lmgi_commit", err);
-    return st == LMGI_OK ? lm_scene_commit(sc, err) : st;
+    return lm_scene_commit(sc, err);
 }
 
 /* o with each 0 made its default: 0 means the default in every field, so a zeroed lmgi_options (or
@@ -178,6 +241,7 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     double t4 = lm_now();
 
     sc->world = (lm_world){sc->scene, &sc->surfaces, &sc->atlas, sc->rt, &sc->edits};
+    sc->edits.decided = &sc->effects;
     lm_effects_decide(sc->scene, &sc->effects);
     sc->timings.load = t1 - t0;
     sc->timings.surfaces = t2 - t1;
@@ -249,6 +313,7 @@ void lmgi_free(lmgi_scene *sc)
         lm_log(LM_LOG_ERROR, "lmgi_free: %s still has an updater; free that first (scene kept)", sc->scene->path);
         return;
     }
+    lm_edits_free(&sc->edits);
     lm_rt_free(sc->rt);
     if (sc->have_atlas)
         lm_atlas_free(&sc->atlas);
@@ -276,7 +341,7 @@ const char *lmgi_node_name(const lmgi_scene *sc, int node)
 
 int lmgi_node_is_dynamic(const lmgi_scene *sc, int node)
 {
-    return sc && node >= 0 && node < sc->scene->node_count && sc->scene->nodes[node].dynamic;
+    return sc && node >= 0 && node < sc->scene->node_count && lm_edits_node_dynamic(&sc->edits, sc->scene, node);
 }
 
 /* Whether a node or one under it has triangles (a static one of those is in the static BVH, which does not
@@ -297,11 +362,9 @@ lmgi_status lmgi_get_node_effects(const lmgi_scene *sc, int node, lmgi_node_effe
         return lm_api_refuse(err, "lmgi_get_node_effects: %s is NULL", sc ? "out" : "the scene");
     if (node < 0 || node >= sc->scene->node_count)
         return lm_api_refuse(err, "node id %d is out of range (scene has %d nodes)", node, sc->scene->node_count);
-    const lm_node_settings *st = &sc->scene->nodes[node].settings;
-    out->shadows = st->shadows;
-    out->indirect = st->indirect;
-    out->reflections = st->reflections;
-    out->caustics = st->caustics;
+    int v[4];
+    lm_edits_node_effects(&sc->edits, sc->scene, node, v);
+    out->shadows = v[0], out->indirect = v[1], out->reflections = v[2], out->caustics = v[3];
     return LMGI_OK;
 }
 
@@ -317,17 +380,8 @@ lmgi_status lmgi_set_node_effects(lmgi_scene *sc, int node, const lmgi_node_effe
     for (int k = 0; k < 4; k++)
         if (v[k] != 0 && v[k] != 1)
             return lm_api_refuse(err, "node '%s': %s is 0 or 1, not %d", s->nodes[node].name, names[k], v[k]);
-    if (lm_scene_quiet(sc, "lmgi_set_node_effects", err) != LMGI_OK) /* its photon work reads the store the gather's switches write */
-        return LMGI_ERR_INVALID;
-    for (int n = 0; n < s->node_count; n++)
-        if (lm_node_under(s, n, node)) { /* as extras inherit: the node and everything under it */
-            lm_node_settings *st = &s->nodes[n].settings;
-            st->shadows = in->shadows, st->indirect = in->indirect, st->reflections = in->reflections;
-            st->caustics = in->caustics;
-        }
-    s->pass_version++;
-    lm_effects_decide(s, &sc->effects);
-    return LMGI_OK;
+    const lm_staged_effects e = {node, in->shadows, in->indirect, in->reflections, in->caustics};
+    return stage(sc, "lmgi_set_node_effects", put_effects, &e, node, err);
 }
 
 lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_error *err)
@@ -342,25 +396,16 @@ lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_er
         return lm_api_refuse(err, "node '%s': dynamic is 0 or 1, not %d", n->name, dynamic);
     int same = 1;
     for (int i = 0; i < s->node_count; i++)
-        same &= !lm_node_under(s, i, node) || s->nodes[i].dynamic == dynamic;
+        same &= !lm_node_under(s, i, node) || lm_edits_node_dynamic(&sc->edits, s, i) == dynamic;
     if (same)
         return LMGI_OK; /* nothing to rebuild */
-    if (!dynamic && n->parent >= 0 && s->nodes[n->parent].dynamic)
+    if (!dynamic && n->parent >= 0 && lm_edits_node_dynamic(&sc->edits, s, n->parent))
         return lm_api_refuse(err, "node '%s' lies under dynamic node '%s', which moves it: it stays dynamic", n->name,
                              s->nodes[n->parent].name);
     if (!dynamic && lm_node_animated_under(s, node))
         return lm_api_refuse(err, "node '%s' (or a node under it) is animated: it stays dynamic", n->name);
-    if (lm_scene_quiet(sc, "lmgi_set_node_dynamic", err) != LMGI_OK) /* its photon work traces rays in the BVH about to be rebuilt */
-        return LMGI_ERR_INVALID;
-    lm_scene_set_dynamic(s, node, dynamic);
-    lm_error e;
-    if (lm_rt_rebuild(sc->rt, &e) != LM_OK) {
-        lm_scene_set_dynamic(s, node, !dynamic); /* the old BVH is still in place */
-        return lm_export_error(err, &e);
-    }
-    sc->edits.moved = 0; /* built from the scene model as it is: every staged placement in it */
-    lm_effects_decide(s, &sc->effects);
-    return LMGI_OK;
+    /* the BVH is rebuilt at the commit, once for every switch staged by then */
+    return stage(sc, "lmgi_set_node_dynamic", put_dynamic, &dynamic, node, err);
 }
 
 lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[16], lmgi_error *err)
@@ -388,7 +433,7 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
         lm_fail(&e, LM_ERR_INVALID, "node id %d is out of range (scene has %d nodes)", node, sc->scene->node_count);
         return lm_export_error(err, &e);
     }
-    if (!n->dynamic && carries_triangles(sc->scene, node)) {
+    if (!lm_edits_node_dynamic(&sc->edits, sc->scene, node) && carries_triangles(sc->scene, node)) {
         lm_fail(&e, LM_ERR_INVALID, "node '%s' is static and cannot be moved; mark it dynamic with extras "
                 "{\"lmgi\": {\"dynamic\": true}}", n->name);
         return lm_export_error(err, &e);
@@ -411,7 +456,7 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
         lm_scene_update_world(sc->scene);
         return lm_export_error(err, &e);
     }
-    sc->edits.moved++; /* the BVH follows at the commit */
+    lm_edits_note_moved(&sc->edits); /* the BVH follows at the commit */
     return LMGI_OK;
 }
 
@@ -453,7 +498,7 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
     if (lm_scene_quiet(sc, "lmgi_set_time", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_scene_eval_animation(sc->scene, -1, t);
-    sc->edits.moved++; /* the BVH follows at the commit */
+    lm_edits_note_moved(&sc->edits); /* the BVH follows at the commit */
     return LMGI_OK;
 }
 

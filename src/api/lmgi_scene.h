@@ -20,7 +20,7 @@ struct lmgi_scene {
     int *surface_rects;     /* 4 a surface: its texels' bounding box in the atlas (x, y, w, h; 0 x 0 where none) */
     lm_rt *rt;
     lm_world world;         /* the four above and the edits, for the runtime (set once they are built) */
-    lm_edit_batch edits;    /* edits staged for the BVH's next commit (update/edits.h) */
+    lm_edit_batch edits;    /* edits staged for the next commit (update/edits.h) */
     lm_effects effects;
     lmgi_timings timings;
     lmgi_updater *updater;  /* the one updater working on it (it moves nodes and the BVH), or NULL; */
@@ -32,7 +32,13 @@ struct lmgi_scene {
  * the photon work the last update left running is waited for. Refused (LMGI_ERR_INVALID naming fn)
  * while another thread is inside a call on the updater's context. LMGI_OK at once without an updater. */
 lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err);
-/* The staged edits committed (update/edits.h) before the API traces rays of its own. */
+/* The staged edits committed (update/edits.h), after waiting for the photon work when any are staged:
+ * before the API traces rays of its own or reads the scene model (exports, reports). */
 lmgi_status lm_scene_commit(const lmgi_scene *sc, lmgi_error *err);
+/* An edit checked by its caller staged for the next commit (refused, naming fn, while another thread is
+ * inside a call on the updater's context). id -1 adds a light. */
+lmgi_status lm_scene_stage_light(lmgi_scene *sc, const char *fn, int id, const lm_light *l, lmgi_error *err);
+lmgi_status lm_scene_stage_material(lmgi_scene *sc, const char *fn, int id, const lm_material *m, lmgi_error *err);
+lmgi_status lm_scene_stage_sky(lmgi_scene *sc, const char *fn, const lm_staged_sky *sky, lmgi_error *err);
 
 #endif

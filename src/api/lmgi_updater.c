@@ -215,6 +215,9 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     if (sc->updater)
         return lm_api_refuse(err, "%s: the scene already has an updater (it moves the scene's nodes: one at a time)",
                        sc->scene->path);
+    lmgi_status staged = lm_scene_commit(sc, err); /* its settings follow the scene with the edits made so far */
+    if (staged != LMGI_OK)
+        return staged;
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     if (desc)

@@ -57,11 +57,13 @@ static lm_status follow_edits(lm_frame_loop *fl, lm_error *err)
 }
 
 /* The start of a step, a bake or a picture: the GL context current, and the edits staged since the last
- * one committed to the BVH (update/edits.h). No photon work runs then when any is staged: each edit
- * joined it before staging, and no step has begun any since. */
+ * one committed (update/edits.h), after the photon work that reads the scene is waited for (a detached
+ * step's, still running; none is when nothing is staged). */
 static lm_status enter(lm_frame_loop *fl, lm_error *err)
 {
     lm_status st = lm_gl_make_current(fl->gl, err);
+    if (st == LM_OK && lm_edits_pending(fl->world.edits))
+        st = lm_frame_loop_sync(fl, err);
     return st == LM_OK ? lm_edits_commit(&fl->world, err) : st;
 }
 

@@ -12,28 +12,14 @@
  * 2 x 2 parts), 16 rays in all; only penumbrae are sampled. */
 #define AIM_EMITTER_RAYS 4
 
-/* What an emitter looked like when its photons were last traced: its node's world matrix, its place and
- * its power. */
+/* Where an emitter was and what it emitted when its photons were last traced: its node's world matrix,
+ * its place and its power. An emitter's placement follows from more than edits name (its node's parents,
+ * the scene's bounds for a sun, a light sealed in a closed object by a node that moved), so whether a
+ * re-placed emitter moved is decided against this. */
 typedef struct {
     float world[16];
     float pos[3], dir[3], power[3];
 } emitter_snapshot;
-
-/* What photons and AIMs read of a material: its colour, emission and what makes its class. */
-typedef struct {
-    float base_color[4], emissive[3], metallic, roughness, transmission, ior;
-    int cls;
-} material_snapshot;
-
-static void take_material(const lm_material *m, material_snapshot *out)
-{
-    memset(out, 0, sizeof *out);
-    memcpy(out->base_color, m->base_color, sizeof out->base_color);
-    memcpy(out->emissive, m->emissive, sizeof out->emissive);
-    out->metallic = m->metallic, out->roughness = m->roughness;
-    out->transmission = m->transmission, out->ior = m->ior;
-    out->cls = (int)m->cls;
-}
 
 struct lm_photon_stage {
     lm_photon_stage_settings set;
@@ -41,9 +27,10 @@ struct lm_photon_stage {
     const lm_surfaces *surfaces;
     const lm_atlas *atlas;
     lm_rt *rt;
+    lm_edit_batch *edits;        /* the edits' change list (update/edits.h); NULL: only animations change */
     lm_emitters emitters;
     emitter_snapshot *snap;
-    material_snapshot *mat_snap; /* per material, as its photons were last traced and AIMs refreshed */
+    float bounds[6];             /* the scene's bounds when the emitters were last placed (a sun's follow) */
     uint8_t *refreshed;          /* per surface: its AIM refreshed since lm_photon_stage_take_refreshed */
     double *delta_before;        /* scratch: per surface, delta_f before a refresh */
     lm_photons *photons;
@@ -138,35 +125,37 @@ static lm_status take_new_emitters(lm_photon_stage *ps, int *added, lm_error *er
     return st;
 }
 
-/* A material edit (colour, emission, class) reaches the photons that touch the material, which are re-traced,
- * and the AIMs of its surfaces, whose albedo the estimate multiplies in: those are marked for a refresh.
- * The surfaces its light reaches follow from the re-traced photons' hits. Returns the edited materials. */
-static int check_materials(lm_photon_stage *ps)
+/* The materials the edits changed (colour, emission, class; ch) reach the photons that touch them, which
+ * are re-traced, and the AIMs of their surfaces, whose albedo the estimate multiplies in: those are marked
+ * for a refresh. The surfaces their light reaches follow from the re-traced photons' hits. Returns how
+ * many. */
+static int follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch)
 {
-    const lm_scene *s = ps->scene;
-    uint8_t *changed = NULL;
-    int n = 0;
-    for (int m = 0; m < s->material_count; m++) {
-        material_snapshot now;
-        take_material(&s->materials[m], &now);
-        if (!memcmp(&now, &ps->mat_snap[m], sizeof now))
-            continue;
-        if (!changed && !(changed = calloc((size_t)s->material_count, 1)))
-            return 0; /* out of memory: seen at the next frame */
-        ps->mat_snap[m] = now;
-        changed[m] = 1;
-        n++;
-    }
-    if (!n)
+    if (!ch->materials_changed)
         return 0;
+    const uint8_t *changed = ch->materials; /* material_cap >= material_count once any is set */
     ps->caustics_stale = 1;
     lm_photons_invalidate_materials(ps->photons, changed);
     lm_photon_store *store = lm_photons_store_mutable(ps->photons);
     for (int k = 0; k < ps->surfaces->surface_count; k++)
         if (changed[ps->surfaces->surfaces[k].material]) /* over any threshold: first in line for a refresh */
             store->surfaces[k].delta_f = 1e30;
-    free(changed);
-    return n;
+    return ch->materials_changed;
+}
+
+/* Whether anything an emitter's placement or power follows from may have changed since they were last
+ * placed: an added emitter, an animation, an edit's light, material, sky or placement (ch), or the
+ * scene's bounds (set after the last frame's animations). Otherwise placing them again would find them
+ * where they were. */
+static int emitters_touched(lm_photon_stage *ps, const lm_edit_changes *ch, int added)
+{
+    const lm_scene *s = ps->scene;
+    float b[6] = {s->bounds_min[0], s->bounds_min[1], s->bounds_min[2],
+                  s->bounds_max[0], s->bounds_max[1], s->bounds_max[2]};
+    int bounds = memcmp(b, ps->bounds, sizeof b) != 0;
+    memcpy(ps->bounds, b, sizeof b);
+    return added || bounds || s->animation_count > 0 || ch->moved || ch->lights_changed || ch->sky ||
+           ch->materials_changed;
 }
 
 /* Invalidates the groups of every emitter whose placement or power changed since its last snapshot. */
@@ -299,14 +288,12 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     for (int e = 0; e < ps->emitters.count; e++)
         take_snapshot(ps, e, &ps->snap[e]);
-    ps->mat_snap = malloc(sizeof *ps->mat_snap * (size_t)(ps->scene->material_count + 1));
+    emitters_touched(ps, lm_edits_changes(NULL), 0); /* the bounds they were placed in */
     size_t S = (size_t)ps->surfaces->surface_count + 1;
     ps->refreshed = calloc(S, 1);
     ps->delta_before = calloc(S, sizeof *ps->delta_before);
-    if (!ps->mat_snap || !ps->refreshed || !ps->delta_before)
+    if (!ps->refreshed || !ps->delta_before)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
-    for (int m = 0; m < ps->scene->material_count; m++)
-        take_material(&ps->scene->materials[m], &ps->mat_snap[m]);
     lm_photon_settings photons = ps->set.photons;
     if (photons.cover_distance == 0.0f && ps->atlas) /* light closer under something than a texel is hidden */
         photons.cover_distance = ps->atlas->texel_size;
@@ -355,6 +342,7 @@ lm_status lm_photon_stage_create(const lm_world *w, const lm_photon_stage_settin
     ps->surfaces = w->surfaces;
     ps->atlas = w->atlas;
     ps->rt = w->rt;
+    ps->edits = w->edits;
     lm_photon_stage_frame scratch;
     memset(&scratch, 0, sizeof scratch);
     lm_status st = setup(ps, first ? first : &scratch, err);
@@ -379,7 +367,6 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     if (ps->have_emitters)
         lm_emitters_free(&ps->emitters);
     free(ps->snap);
-    free(ps->mat_snap);
     free(ps->refreshed);
     free(ps->delta_before);
     free(ps);
@@ -397,14 +384,19 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
         if (st != LM_OK)
             return st;
     }
+    /* what the edits committed since the last frame changed (update/edits.h), taken once */
+    const lm_edit_changes *ch = lm_edits_changes(ps->edits);
     int added = 0;
     lm_status st = take_new_emitters(ps, &added, err);
-    lm_emitters_update(&ps->emitters, ps->scene);
-    lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
-    if (st == LM_OK)
-        st = check_emitters(ps, &out->emitters_moved, err);
+    if (emitters_touched(ps, ch, added)) {
+        lm_emitters_update(&ps->emitters, ps->scene);
+        lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
+        if (st == LM_OK)
+            st = check_emitters(ps, &out->emitters_moved, err);
+    }
     out->emitters_moved += added;
-    out->materials_changed = check_materials(ps);
+    out->materials_changed = follow_materials(ps, ch);
+    lm_edits_clear_changes(ps->edits);
     out->t_animate = lm_now() - t0;
     out->t_total = out->t_animate;
     return st;
