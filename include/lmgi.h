@@ -161,11 +161,16 @@ LMGI_API int lmgi_effect_count(const lmgi_scene *scene); /* 0 for NULL */
 /* NULL scene or i out of range: out zeroed (name NULL); NULL out: nothing. */
 LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
 
-/* Edits (node transforms, static or dynamic, effect switches, lights, materials) are made between an
- * updater's calls, on the thread that uses it (a scene with an updater follows its context's one thread
- * at a time); each first waits for photon work the last update left running, then changes the scene,
- * and the updater takes it in at its next update or bake. Without an updater a scene may be edited from
- * any one thread at a time.
+/* Edits (node transforms, static or dynamic, effect switches, lights, materials, the sky) are made
+ * between an updater's calls, on the thread that uses it (a scene with an updater follows its context's
+ * one thread at a time). Each is checked at once (a refused one changes nothing) and staged: reads
+ * (lmgi_get_light, lmgi_get_material, lmgi_get_node_effects, lmgi_node_is_dynamic, lmgi_light_count,
+ * lmgi_get_environment) see it at once, and the scene takes the whole batch at the next commit
+ * (lmgi_commit, or the next update, bake or picture, or a call that reads the scene as a whole: info,
+ * effects, export, a check, the reference, an updater made on it), which waits once for the photon work
+ * the last update left running. Staging itself waits for nothing. Node moves and lmgi_set_time change the
+ * scene model at once (after waiting for that work) and reach the BVH at the commit. Without an updater a
+ * scene may be edited from any one thread at a time.
  *
  * Node lookup and edits. lmgi_set_node_transform moves a dynamic node (world matrix, column-major) and
  * its children with it; a static node, a matrix with NaN or infinite entries, a singular one (a zero
@@ -191,10 +196,12 @@ LMGI_API int lmgi_get_node_transform(const lmgi_scene *scene, int node, float wo
  * id out of range, a static node with triangles, a matrix with NaN or Inf, a singular one, or one that
  * would mirror a node that was not mirrored at load (or the reverse): LMGI_ERR_INVALID naming it. */
 LMGI_API lmgi_status lmgi_set_node_transform(lmgi_scene *scene, int node, const float world[16], lmgi_error *err);
-/* Commits the edits staged since the last commit (the nodes moved by lmgi_set_node_transform and
- * lmgi_set_time) to the ray-tracing BVH now: one instance update per dynamic node and one top-level commit
- * (Embree's rtcCommitScene). Optional: every call that traces rays commits first. After an updater's
- * photon work that the edits already waited for. NULL scene: LMGI_ERR_INVALID; an error of the BVH's
+/* Commits the edits staged since the last commit now: light, material, sky and switch edits into the
+ * scene in the order made, the nodes moved (lmgi_set_node_transform, lmgi_set_time) into the ray-tracing
+ * BVH with one instance update per dynamic node and one top-level commit (Embree's rtcCommitScene), or one
+ * rebuild when nodes were switched dynamic or static; an updater re-traces only the lights and materials
+ * whose values changed. It first waits for an updater's photon work still running. Optional: every call
+ * that traces rays or reads the scene commits first. NULL scene: LMGI_ERR_INVALID; an error of the BVH's
  * (out of memory): LMGI_ERR_BACKEND or LMGI_ERR_NOMEM, the edits kept for the next commit. */
 LMGI_API lmgi_status lmgi_commit(lmgi_scene *scene, lmgi_error *err);
 /* Switches a node and every node under it between static (0: in the static BVH, shadows cached) and

@@ -27,6 +27,7 @@ struct lm_rt {
     float (*inst_world)[16];    /* current world matrix of each instance */
     float (*node_nmat)[9];      /* node -> normal matrix of its world matrix (kept with inst_world) */
     uint64_t top_commits;       /* the top level's commits (lm_rt_top_commits) */
+    uint64_t rebuilds;          /* lm_rt_rebuild's (lm_rt_rebuilds) */
     char device_error[256];
 };
 
@@ -248,6 +249,8 @@ lm_status lm_rt_rebuild(lm_rt *rt, lm_error *err)
     lm_rt old = *rt; /* the new BVH moves into rt (whose address its users hold), the old one is freed */
     *rt = *fresh;
     *fresh = old;
+    rt->top_commits += old.top_commits; /* the counters go on across the rebuild */
+    rt->rebuilds = old.rebuilds + 1;
     rtcSetDeviceErrorFunction(rt->device, on_device_error, rt);
     lm_rt_free(fresh);
     return LM_OK;
@@ -454,3 +457,4 @@ uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir
 uint32_t lm_rt_static_triangle_count(const lm_rt *rt) { return rt->static_count; }
 
 uint64_t lm_rt_top_commits(const lm_rt *rt) { return rt->top_commits; }
+uint64_t lm_rt_rebuilds(const lm_rt *rt) { return rt->rebuilds; }

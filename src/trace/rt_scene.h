@@ -45,6 +45,8 @@ lm_status lm_rt_sync_transforms(lm_rt *rt, const lm_scene *s, lm_error *err);
 /* How many times the top level was committed (built, rebuilt, a node moved or synced): edits staged in
  * a batch commit it once (update/edits.h), which tests hold them to. */
 uint64_t lm_rt_top_commits(const lm_rt *rt);
+/* How many times lm_rt_rebuild built the BVHs again (nodes switched dynamic or static: one a batch). */
+uint64_t lm_rt_rebuilds(const lm_rt *rt);
 
 /* Closest hit along org + t dir, t in (tnear, tfar). Returns 1 on a hit. dir need not be unit length. */
 int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,

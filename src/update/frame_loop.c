@@ -316,6 +316,7 @@ static lm_status join_stage(lm_frame_loop *fl, lm_photon_stage_frame *done, lm_e
 }
 
 lm_status lm_frame_loop_sync(lm_frame_loop *fl, lm_error *err) { return join_stage(fl, NULL, err); }
+int lm_frame_loop_busy(const lm_frame_loop *fl) { return fl->pending_busy; }
 
 /* Detached (overlap without a frame of its own: a game draws between steps): the stage's job begun by
  * the last step is joined first, then animate, schedule, gather and blend as overlapped, and the next

@@ -48,8 +48,11 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
 
 /* Waits for photon work a step left running (a loop that draws no frame of its own, with overlap, lets
  * the stage's tracing and AIM refresh run on past the step, beside whatever the caller does next). Call
- * it before anything that writes the scene or BVH (an edit) or reads the AIM or photons. */
+ * it before anything that writes the scene or BVH (a commit of edits, which the loop's own steps make
+ * after it) or reads the AIM or photons. */
 lm_status lm_frame_loop_sync(lm_frame_loop *fl, lm_error *err);
+/* 1 while that photon work runs (a staged edit leaves it running: update/edits.h). */
+int lm_frame_loop_busy(const lm_frame_loop *fl);
 /* What a bake did: photon paths that changed (of all, re-traced), AIM surfaces refreshed, IIM texels
  * regathered, surfaces whose displayed lightmap changed. */
 typedef struct {
