@@ -946,7 +946,9 @@ static void test_bench_edits(void **state)
     char *json = (char *)lmt_read_file(path, &n, 1);
     json[n] = '\0';
     assert_non_null(strstr(json, "\"frames_to_5\""));
+    assert_non_null(strstr(json, "\"edit_ms\""));
     free(json);
+    assert_non_null(strstr(output, "edit calls before 3 updates: median")); /* the edits' own calls, timed */
 
     /* the work outside an edit's reach, the door closed: a light in room A, then one in room B, each caught
      * up on before the next (200 texels an update; 16 photon groups an update, the first within 2% after

@@ -86,6 +86,13 @@ static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_f
         printf("updates: median %.2f ms, 95th percentile %.2f ms, worst %.2f ms; %d of %d over the budget by more "
                "than 10%%; %.1f texels an update\n", ms[s->frames / 2], p95,
                ms[s->frames - 1], over, s->frames, texels / s->frames);
+        int n = 0; /* the edits' own calls: staged, they wait for no photon work (update/edits.h) */
+        for (int f = 0; f < s->frames; f++)
+            if (rows[f].ms_edit > 0.0)
+                ms[n++] = rows[f].ms_edit;
+        if (n > 0)
+            printf("edit calls before %d updates: median %.3f ms, worst %.3f ms\n", n, lm_cli_quantile(ms, n, 0.5),
+                   lm_cli_quantile(ms, n, 1.0));
     }
     report_reads(s, rows);
     if (json) {
@@ -94,11 +101,11 @@ static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_f
             fprintf(json, "    {\"ms\": %.3f, \"photons_ms\": %.3f, \"gather_ms\": %.3f, \"blend_ms\": %.3f, "
                     "\"texels\": %u, \"photons\": %u, \"aim_surfaces\": %d, \"surfaces_changed\": %d, "
                     "\"error\": %.5f, \"read_whole_ms\": %.3f, \"read_rects_ms\": %.3f, \"rect_texels\": %u, "
-                    "\"texture_ms\": %.3f}%s\n",
+                    "\"texture_ms\": %.3f, \"edit_ms\": %.3f}%s\n",
                     rows[f].ms_total, rows[f].ms_photons, rows[f].ms_gather, rows[f].ms_blend,
                     rows[f].texels, rows[f].photons, rows[f].aim, rows[f].changed, rows[f].error,
                     rows[f].ms_read_whole, rows[f].ms_read_rects, rows[f].rect_texels, rows[f].ms_texture,
-                    f + 1 < s->frames ? "," : "");
+                    rows[f].ms_edit, f + 1 < s->frames ? "," : "");
         fprintf(json, "  ]\n}\n");
     }
     free(ms);

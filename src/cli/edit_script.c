@@ -395,9 +395,15 @@ static int play(const lm_edit_script *s, float budget_ms, const lm_edit_frame_ch
     for (int f = 0; f < s->frames; f++) {
         double start = 1e3 * lm_cli_now();
         int edited = 0;
-        for (; next < s->edit_count && s->edits[next].frame == f; next++, edited = 1)
-            if (!apply(path, next, s->edits[next].v, b->sc) || !apply(path, next, s->edits[next].v, b->twin))
+        double ms_edit = 0.0;
+        for (; next < s->edit_count && s->edits[next].frame == f; next++, edited = 1) {
+            double t0 = 1e3 * lm_cli_now();
+            if (!apply(path, next, s->edits[next].v, b->sc))
                 return 0;
+            ms_edit += 1e3 * lm_cli_now() - t0;
+            if (!apply(path, next, s->edits[next].v, b->twin))
+                return 0;
+        }
         lmgi_update_stats st;
         lmgi_error e;
         if (lmgi_update(b->u, 0.0f, budget_ms, &st, &e) != LMGI_OK) {
@@ -406,7 +412,7 @@ static int play(const lm_edit_script *s, float budget_ms, const lm_edit_frame_ch
         }
         rows[f] = (lm_edit_frame){st.ms_total, st.ms_photons, st.ms_gather, st.ms_blend, st.texels_gathered,
                               st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0, 0, 0, 0, 0,
-                              NAN, 0.0, 0.0, 0, 0.0};
+                              NAN, 0.0, 0.0, 0, 0.0, ms_edit};
         double spent = 1e3 * lm_cli_now() - start;
         if (s->fps > 0 && spent < 1e3 / s->fps) { /* the game's own frame, with the photon work beside it */
             double left = 1e3 / s->fps - spent;

@@ -47,6 +47,8 @@ typedef struct {
     uint32_t rect_texels;  /* the texels those rectangles hold */
     double ms_texture;     /* the same into lmgi's GL texture (lmgi_get_lightmap_texture: the rectangles read,
                             * uploaded, and glFinish) */
+    double ms_edit;        /* the calls of the edits made before this update (staged: they wait for no photon
+                            * work, update/edits.h); 0 without one */
 } lm_edit_frame;
 
 /* A play's frame check: after every update from the first edit on, the updater's picture from the scene's
