@@ -411,6 +411,7 @@ lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progre
         st = lm_lightmap_path_bake(fl->lightmaps, progress, user, cancel, &out->texels_gathered,
                                    &out->surfaces_changed, err);
     }
+    lm_gl_finish(); /* the gather's time holds the GPU's work still queued */
     out->t_gather = lm_now() - t1;
     if (st == LM_OK && progress)
         progress(user, 1.0, "done");

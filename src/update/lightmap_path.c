@@ -228,6 +228,7 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
     lp->set->checkpoint = NULL;
     if (st == LM_OK)
         st = lm_iim_blend(&lp->iim, 1, err);
+    lm_gl_finish(); /* the time holds the GPU's work too: the budget's first guess starts from it */
     if (t_gather)
         *t_gather = lm_now() - t0;
     return st;

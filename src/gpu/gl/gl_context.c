@@ -270,3 +270,9 @@ int lm_gl_context_is_software(const lm_gl_context *ctx)
 }
 
 int lm_gl_current_is_software(void) { return lm_gl_context_is_software(t_current); }
+
+void lm_gl_finish(void)
+{
+    if (lm_gl_cur)
+        glFinish();
+}

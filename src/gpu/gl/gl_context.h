@@ -33,6 +33,9 @@ lm_status lm_gl_make_current(lm_gl_context *ctx, lm_error *err);
 lm_gl_backend lm_gl_context_backend(const lm_gl_context *ctx);
 /* "OSMesa" or "EGL". */
 const char *lm_gl_backend_name(lm_gl_backend backend);
+/* Waits until the current context's GPU has done every command given so far (glFinish): before a time
+ * is taken that must hold that work (on a GPU, a gather's draws are still queued when its calls return). */
+void lm_gl_finish(void);
 /* 1 when the context's GL rasterizes on the CPU (llvmpipe and its kind). */
 int lm_gl_context_is_software(const lm_gl_context *ctx);
 /* The same for the context current on the calling thread (0 if none is). */
