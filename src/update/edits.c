@@ -128,7 +128,6 @@ lm_status lm_edits_stage_material(lm_edit_batch *b, const lm_scene *s, int id, c
         m->id = id;
     }
     m->value = *value;
-    m->class_changed = value->cls != s->materials[id].cls;
     return LM_OK;
 }
 
@@ -162,23 +161,16 @@ void lm_edits_note_moved(lm_edit_batch *b)
     b->changes.moved = 1;
 }
 
-/* Room in the change list for light id and material count (grown zeroed). */
-static int room_for(lm_edit_changes *c, int lights, int materials)
+/* flags (*cap of them) grown to n, the new ones 0. */
+static int grow_flags(uint8_t **flags, int *cap, int n)
 {
-    if (lights > c->light_cap) {
-        uint8_t *p = realloc(c->lights, (size_t)lights);
-        if (!p)
-            return 0;
-        memset(p + c->light_cap, 0, (size_t)(lights - c->light_cap));
-        c->lights = p, c->light_cap = lights;
-    }
-    if (materials > c->material_cap) {
-        uint8_t *p = realloc(c->materials, (size_t)materials);
-        if (!p)
-            return 0;
-        memset(p + c->material_cap, 0, (size_t)(materials - c->material_cap));
-        c->materials = p, c->material_cap = materials;
-    }
+    if (n <= *cap)
+        return 1;
+    uint8_t *p = realloc(*flags, (size_t)n);
+    if (!p)
+        return 0;
+    memset(p + *cap, 0, (size_t)(n - *cap));
+    *flags = p, *cap = n;
     return 1;
 }
 
@@ -307,7 +299,9 @@ lm_status lm_edits_commit(const lm_world *w, lm_error *err)
     if (!lm_edits_pending(b))
         return LM_OK;
     lm_scene *s = w->scene;
-    if (!room_for(&b->changes, s->light_count + b->lights_added, s->material_count))
+    lm_edit_changes *c = &b->changes;
+    if (!grow_flags(&c->lights, &c->light_cap, s->light_count + b->lights_added) ||
+        !grow_flags(&c->materials, &c->material_cap, s->material_count))
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory to commit edits", s->path);
     int decide = b->lights_added || b->effect_count || b->dynamic_count || b->sky.staged;
     for (int i = 0; i < b->light_count; i++)

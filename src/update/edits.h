@@ -44,8 +44,7 @@ typedef struct {
 
 typedef struct {
     int id;
-    lm_material value;
-    int class_changed; /* its class differs from the scene's (a pass_version change at the commit) */
+    lm_material value; /* a class unlike the scene's changes the passes' switches at the commit */
 } lm_staged_material;
 
 typedef struct {
