@@ -75,6 +75,8 @@ static lm_status gather_run(const lm_gather_job *j, lm_checkpoint_range r, uint3
         if (st == LM_OK && ck && s + 1 < r.steps && lm_now() - ck->last >= ck->seconds)
             st = checkpoint_save(j, ck, s + 1, err);
         done += n;
+        if (j->set->progress && s + 1 == r.steps)
+            lm_gl_finish(); /* the last pass's progress says "done" once the GPU has drawn it */
         if (j->set->progress)
             j->set->progress(j->set->progress_user, done, texels);
     }
