@@ -126,6 +126,15 @@ uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *o
     return n;
 }
 
+void lm_iim_sched_restart(lm_iim_sched *s, lm_photon_store *ps)
+{
+    for (int k = 0; k < s->surface_count; k++)
+        if (s->cursor[k] > 0) {
+            s->cursor[k] = 0;
+            ps->surfaces[k].delta_i = 1e30;
+        }
+}
+
 void lm_iim_sched_end_frame(lm_iim_sched *s) { s->frame++; }
 
 void lm_iim_sched_set_off(lm_iim_sched *s, lm_photon_store *ps, int k, int off)

@@ -42,6 +42,11 @@ void lm_iim_sched_free(lm_iim_sched *s);
 uint32_t lm_iim_sched_pick(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);
 /* The same with `budget` texels in place of texels_per_frame (a bake: the whole atlas). */
 uint32_t lm_iim_sched_pick_up_to(lm_iim_sched *s, lm_photon_store *ps, uint32_t budget, uint32_t *out);
+/* Every refresh under way starts again from its surface's first texel, which stays a candidate (its
+ * delta_i set over any threshold): a bake regathers whole surfaces, since the texels a refresh gathered
+ * before the bake saw AIMs the bake's photons have changed since (a light edited and restored left them
+ * 100 times too bright). */
+void lm_iim_sched_restart(lm_iim_sched *s, lm_photon_store *ps);
 /* Every texel of every surface, for the first full gather; completes every surface. Returns the count
  * (out must hold the atlas's texel_count). */
 uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);

@@ -276,6 +276,7 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
     double *saved = malloc(sizeof *saved * (size_t)(S ? S : 1));
     if (!saved)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", lp->scene->path);
+    lm_iim_sched_restart(&lp->iim.sched, ps);
     lm_delta_i_save(&lp->iim.sched, ps, saved);
     uint32_t n = lm_iim_sched_pick_up_to(&lp->iim.sched, ps, lp->atlas->texel_count, lp->texels);
     bake_watch w = {progress, user};
