@@ -52,20 +52,21 @@ static int sees(const lm_iim_sched *iim, const lm_scene *s, const lm_atlas *at, 
     return 0;
 }
 
-int lm_delta_i_widen_to_viewers(const lm_iim_sched *sched, lm_photon_store *ps, const uint8_t *refreshed,
+int lm_delta_i_widen_to_viewers(lm_iim_sched *sched, lm_photon_store *ps, const uint8_t *refreshed,
                                 const lm_scene *s, const lm_atlas *at, const lm_rt *rt)
 {
     int S = sched->surface_count, n = 0;
     float lift = 1e-3f * lm_scene_size(s);
     for (int a = 0; a < S; a++) {
-        if (ps->surfaces[a].delta_i > sched->delta_threshold)
+        int under_way = sched->cursor[a] > 0;
+        if ((ps->surfaces[a].delta_i > sched->delta_threshold && !under_way) || sched->again[a])
             continue;
         for (int b = 0; b < S; b++)
             if (b != a && refreshed[b] && sees(sched, s, at, rt, a, b, lift)) {
-                /* just over the threshold, whatever its size (a fixed 1e-30 vanishes beside 1; nextafter's
-                 * denormal beside 0 reads as 0 on the threads that trace, which flush denormals) */
-                double th = sched->delta_threshold;
-                ps->surfaces[a].delta_i = th + fmax(1e-30, 1e-9 * th);
+                if (under_way)
+                    sched->again[a] = 1;
+                else
+                    lm_iim_sched_raise(sched, ps, a);
                 n++;
                 break;
             }

@@ -26,8 +26,12 @@
 #include "iim_schedule.h"
 
 /* Raises delta_i of each surface not already over the threshold that sees a surface with refreshed[b]
- * set (the scene as it is now: nodes may have moved since load). Returns how many were raised. */
-int lm_delta_i_widen_to_viewers(const lm_iim_sched *sched, lm_photon_store *ps, const uint8_t *refreshed,
+ * set (the scene as it is now: nodes may have moved since load). A surface whose refresh is under way
+ * and that sees one is asked to refresh again once it completes (lm_iim_sched_again): the texels it
+ * gathered before saw the old AIM, and completing resets its delta_i (in the two rooms with room B's
+ * lights removed, the ceiling's first texels kept their light for good). Returns how many were raised
+ * or asked again. */
+int lm_delta_i_widen_to_viewers(lm_iim_sched *sched, lm_photon_store *ps, const uint8_t *refreshed,
                                 const lm_scene *s, const lm_atlas *a, const lm_rt *rt);
 
 /* saved[s] = surface s's delta_i, for every surface of the scheduler. */

@@ -1,6 +1,7 @@
 #include "iim_schedule.h"
 
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -36,7 +37,8 @@ lm_status lm_iim_sched_init(lm_iim_sched *s, const lm_atlas *a, int texels_per_f
     s->last_done = malloc(S * sizeof *s->last_done);
     s->commit = calloc(S, 1);
     s->off = calloc(S, 1);
-    lm_status st = s->cursor && s->last_done && s->commit && s->off
+    s->again = calloc(S, 1);
+    lm_status st = s->cursor && s->last_done && s->commit && s->off && s->again
                        ? group_texels(s, a, err)
                        : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
     for (size_t k = 0; st == LM_OK && k < S; k++)
@@ -54,6 +56,7 @@ void lm_iim_sched_free(lm_iim_sched *s)
     free(s->last_done);
     free(s->commit);
     free(s->off);
+    free(s->again);
     memset(s, 0, sizeof *s);
 }
 
@@ -76,6 +79,18 @@ static void complete_surface(lm_iim_sched *s, lm_photon_store *ps, int k)
     s->last_done[k] = s->frame;
     s->commit[k] = 1;
     lm_photon_store_reset_delta_i(ps, k);
+    if (s->again[k]) /* what it sees changed while it was under way */
+        lm_iim_sched_raise(s, ps, k);
+    s->again[k] = 0;
+}
+
+void lm_iim_sched_raise(const lm_iim_sched *s, lm_photon_store *ps, int k)
+{
+    /* a fixed 1e-30 vanishes beside 1; nextafter's denormal beside 0 reads as 0 on the threads that
+     * trace, which flush denormals */
+    double th = s->delta_threshold;
+    if (!(ps->surfaces[k].delta_i > th))
+        ps->surfaces[k].delta_i = th + fmax(1e-30, 1e-9 * th);
 }
 
 /* Hands out texels of surface k from its cursor; completes it when its last texel is out. */
@@ -131,6 +146,7 @@ void lm_iim_sched_restart(lm_iim_sched *s, lm_photon_store *ps)
     for (int k = 0; k < s->surface_count; k++)
         if (s->cursor[k] > 0) {
             s->cursor[k] = 0;
+            s->again[k] = 0;
             ps->surfaces[k].delta_i = 1e30;
         }
 }
@@ -143,5 +159,5 @@ void lm_iim_sched_set_off(lm_iim_sched *s, lm_photon_store *ps, int k, int off)
         ps->surfaces[k].delta_i = 1e30;
     s->off[k] = (uint8_t)(off != 0);
     if (off)
-        s->cursor[k] = 0;
+        s->cursor[k] = 0, s->again[k] = 0;
 }

@@ -31,6 +31,8 @@ typedef struct {
     int *last_done;        /* per surface: frame its last refresh completed (-1: never) */
     uint8_t *commit;       /* per surface: refresh completed, for the blend to commit (and clear) */
     uint8_t *off;          /* per surface: not gathered at all (its node's indirect switched off) */
+    uint8_t *again;        /* per surface: what its refresh under way gathered is stale: refreshed again
+                            * once it completes (lm_delta_i_widen_to_viewers) */
     int frame;             /* advanced once a frame by lm_iim_sched_end_frame */
 } lm_iim_sched;
 
@@ -51,6 +53,9 @@ void lm_iim_sched_restart(lm_iim_sched *s, lm_photon_store *ps);
  * (out must hold the atlas's texel_count). */
 uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);
 void lm_iim_sched_end_frame(lm_iim_sched *s);
+/* Surface k's delta_i just over the threshold, whatever its size: a candidate, behind every surface
+ * whose light changed more. */
+void lm_iim_sched_raise(const lm_iim_sched *s, lm_photon_store *ps, int k);
 /* Switches surface k's gather off (a refresh under way is dropped) or on again; a surface switched on is
  * refreshed in full next, as if all its light had changed (its delta_i set over any threshold). */
 void lm_iim_sched_set_off(lm_iim_sched *s, lm_photon_store *ps, int k, int off);
