@@ -582,9 +582,6 @@ static lmgi_status export_owned(lmgi_updater *u, const char *dir, const lmgi_exp
         return lm_api_refuse(err, "%s: name '%s' must be 1 to 200 of a-z A-Z 0-9 - _ . and not start with '.'", fn,
                              name);
     const lmgi_scene *sc = lm_updater_scene(u);
-    lmgi_status staged = lm_scene_commit(sc, err); /* the scene with every edit made so far */
-    if (staged != LMGI_OK)
-        return staged;
     lmgi_output *own = NULL; /* the export's own output, when the caller gave none */
     if (!d.output) {
         const char *const inputs[] = {sc->scene->path, NULL};
@@ -665,7 +662,9 @@ lmgi_status lmgi_export_gltf(lmgi_updater *u, const char *dir, const lmgi_export
     lmgi_status st = lm_api_claim(lm_updater_context(u), "lmgi_export_gltf", err);
     if (st != LMGI_OK)
         return st;
-    st = export_owned(u, dir, desc, err);
+    st = lm_scene_commit(lm_updater_scene(u), err); /* the scene with every edit made so far */
+    if (st == LMGI_OK)
+        st = export_owned(u, dir, desc, err);
     lm_api_release(lm_updater_context(u));
     return st;
 }

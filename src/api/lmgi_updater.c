@@ -215,9 +215,6 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     if (sc->updater)
         return lm_api_refuse(err, "%s: the scene already has an updater (it moves the scene's nodes: one at a time)",
                        sc->scene->path);
-    lmgi_status staged = lm_scene_commit(sc, err); /* its settings follow the scene with the edits made so far */
-    if (staged != LMGI_OK)
-        return staged;
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     if (desc)
@@ -295,7 +292,10 @@ lmgi_status lmgi_updater_create(lmgi_context *ctx, lmgi_scene *sc, const lmgi_up
     lmgi_status st = lm_api_claim(ctx, "lmgi_updater_create", err);
     if (st != LMGI_OK)
         return st;
-    st = updater_create_owned(ctx, sc, desc, out, err);
+    if (sc) /* its settings follow the scene with the edits made so far */
+        st = lm_scene_commit(sc, err);
+    if (st == LMGI_OK)
+        st = updater_create_owned(ctx, sc, desc, out, err);
     lm_api_release(ctx);
     return st;
 }
