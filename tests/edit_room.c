@@ -171,6 +171,14 @@ float *lmt_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n)
     return rgba;
 }
 
+void lmt_updates(lmgi_updater *u, int n)
+{
+    lmgi_error e;
+    for (int k = 0; k < n; k++)
+        if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
+            fail_msg("%s", e.message);
+}
+
 void lmt_bake(lmgi_updater *u, lmgi_bake_report *r)
 {
     lmgi_error e;

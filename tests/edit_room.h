@@ -52,6 +52,8 @@ lmgi_updater *lmt_room_updater_without(lmgi_context *ctx, lmgi_scene *sc, unsign
 /* The displayed IIM (malloc'd, atlas-sized RGBA; *n floats). */
 float *lmt_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n);
 void lmt_bake(lmgi_updater *u, lmgi_bake_report *r);
+/* n updates at time 0 without a time budget; fails the test on an error. */
+void lmt_updates(lmgi_updater *u, int n);
 /* The frame (malloc'd, LMT_SIDE x LMT_SIDE x 3) from the room's corner at (1.9, 2, 1.9), looking at
  * (-1, 0.5, -1) with a 90 degree field of view. */
 #define LMT_SIDE 48

@@ -55,14 +55,6 @@ static float *bake(lmgi_updater *u, size_t n)
     return iim;
 }
 
-static void updates(lmgi_updater *u, int n)
-{
-    lmgi_error e;
-    for (int k = 0; k < n; k++)
-        if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
-            fail_msg("%s", e.message);
-}
-
 /* The texels of the incremental bake more than 0.1% of the lightmap's mean away from the fresh bake's
  * (the valid ones; the gathers' threads sum in any order); the worst, relative to the fresh texel (or to
  * a thousandth of the mean where that is darker), into *worst_out and the two means' ratio into *means
@@ -116,7 +108,7 @@ static void test_light_edited_and_restored(void **state)
     float was = l.intensity;
     l.intensity = 100.0f * was;
     assert_int_equal(lmgi_set_light(r.sc, 0, &l, &e), LMGI_OK);
-    updates(u, 10);
+    lmt_updates(u, 10);
     l.intensity = was;
     assert_int_equal(lmgi_set_light(r.sc, 0, &l, &e), LMGI_OK);
     float *iim = bake(u, r.n);
@@ -149,7 +141,7 @@ static void test_random_material_sequences(void **state)
         uint32_t s = 0x9e3779b9u * seed;
         for (int k = 0; k < 10; k++) {
             random_material_edit(r.sc, &s);
-            updates(u, 1 + (int)(lmt_xorshift(&s) % 6));
+            lmt_updates(u, 1 + (int)(lmt_xorshift(&s) % 6));
         }
         float *iim = bake(u, r.n);
         lmgi_updater_free(u);
@@ -213,7 +205,7 @@ static void test_random_edit_sequences(void **state)
         uint32_t s = 0x9e3779b9u * seed;
         for (int k = 0; k < 10; k++) {
             random_edit(r.sc, &s, cube);
-            updates(u, 1 + (int)(lmt_xorshift(&s) % 6));
+            lmt_updates(u, 1 + (int)(lmt_xorshift(&s) % 6));
         }
         float *iim = bake(u, r.n);
         lmgi_updater_free(u);

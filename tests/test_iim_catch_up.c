@@ -19,23 +19,6 @@
 #include "edit_room.h"
 #include "support.h"
 
-static float *lightmap(lmgi_updater *u, size_t n)
-{
-    float *iim = malloc(n * sizeof *iim);
-    assert_non_null(iim);
-    lmgi_error e;
-    assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim, n, &e), LMGI_OK);
-    return iim;
-}
-
-static void updates(lmgi_updater *u, int n)
-{
-    lmgi_error e;
-    for (int k = 0; k < n; k++)
-        if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
-            fail_msg("%s", e.message);
-}
-
 /* The largest relative L1 distance of a surface's texels in shown from want, over the surfaces with 16
  * valid texels or more. */
 static double worst_surface(const lmgi_scene *sc, const float *shown, const float *want)
@@ -82,10 +65,8 @@ static void test_recolour_catches_up_at_80_texels(void **state)
     lmgi_updater *u = NULL;
     lmgi_error e;
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_OK);
-    lmgi_info in;
-    lmgi_get_info(sc, &in);
-    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
-    updates(u, 10);
+    size_t n;
+    lmt_updates(u, 10);
     int red = -1;
     for (int m = 0; m < lmgi_material_count(sc); m++)
         if (!strcmp(lmgi_material_name(sc, m), "red"))
@@ -96,11 +77,11 @@ static void test_recolour_catches_up_at_80_texels(void **state)
     const float blue[3] = {0.1f, 0.2f, 0.63f};
     memcpy(mat.base_color, blue, sizeof blue);
     assert_int_equal(lmgi_set_material(sc, red, &mat, &e), LMGI_OK);
-    updates(u, 120); /* 9,600 texels: the 7,200 of the atlas (90 updates of them, as lmgi tradeoff sizes it) and a third */
-    float *shown = lightmap(u, n);
+    lmt_updates(u, 120); /* 9,600 texels: the 7,200 of the atlas (90 updates of them, as lmgi tradeoff sizes it) and a third */
+    float *shown = lmt_iim(u, sc, &n);
     lmgi_updater_free(u);
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_OK); /* the recoloured box's, gathered in full */
-    float *want = lightmap(u, n);
+    float *want = lmt_iim(u, sc, &n);
     double worst = worst_surface(sc, shown, want);
     print_message("red wall recoloured, 120 updates of 80 texels: worst surface %.1f%% from converged\n",
                   100.0 * worst);
@@ -129,15 +110,15 @@ static void test_room_goes_dark(void **state)
     }
     assert_true(b1 >= 0 && b2 >= 0);
     assert_int_equal(lmgi_remove_light(sc, b1, &e), LMGI_OK);
-    updates(u, 2);
+    lmt_updates(u, 2);
     assert_int_equal(lmgi_remove_light(sc, b2, &e), LMGI_OK);
-    updates(u, 24); /* the ceiling's refresh runs while the AIMs it sees go dark */
+    lmt_updates(u, 24); /* the ceiling's refresh runs while the AIMs it sees go dark */
     lmgi_bake_report r;
     lmt_bake(u, &r);
+    size_t n;
+    float *iim = lmt_iim(u, sc, &n);
     lmgi_info in;
     lmgi_get_info(sc, &in);
-    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
-    float *iim = lightmap(u, n);
     double lit = 0.0; /* room B's ceiling (y 3, facing down, x > 0.2): the door is closed, nothing lights it */
     int texels = 0;
     for (uint32_t i = 0; i < in.texels; i++) {
