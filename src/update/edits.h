@@ -18,9 +18,10 @@
  * reference solver, an updater made on the scene, exports) or when the caller asks (lmgi_commit). The
  * caller of lm_edits_commit has waited for the photon work when lm_edits_pending says there is work.
  *
- * Layout: small arrays of staged edits, each light, material and node at most once (a later edit of the
- * same one replaces its staged value), so a batch costs its edits, not the scene's size; the change list
- * is one byte per light and material, grown as lights are added.
+ * Layout: small arrays of staged edits: each light and material at most once (a later edit of the same
+ * one replaces its staged value), the effect and dynamic switches in the order made (each covers a node's
+ * subtree, so a later one may cover part of an earlier one's), so a batch costs its edits, not the
+ * scene's size; the change list is one byte per light and material, grown as lights are added.
  *
  * Not thread-safe: staging, reading staged values and the commit run on the thread that owns the world
  * (the API refuses an edit while another thread is inside a call on the updater's context). Errors: the
