@@ -61,63 +61,48 @@ lmgi_status lm_scene_commit(const lmgi_scene *sc, lmgi_error *err)
     return lm_edits_commit(&sc->world, &e) == LM_OK ? LMGI_OK : lm_export_error(err, &e);
 }
 
-/* An edit staged: refused (naming fn) while another thread is inside a call on the updater's context,
- * which may be committing the batch. */
-static lmgi_status stage(lmgi_scene *sc, const char *fn, lm_status (*put)(lmgi_scene *, const void *, int, lm_error *),
-                         const void *value, int id, lmgi_error *err)
+/* Staging an edit: refused (naming fn) while another thread is inside a call on the updater's context,
+ * which may be committing the batch; stage_end releases the context and reports what staging said. */
+static lmgi_status stage_begin(lmgi_scene *sc, const char *fn, lmgi_error *err)
 {
-    if (sc->loop && lm_api_claim(sc->ctx, fn, err) != LMGI_OK)
-        return LMGI_ERR_INVALID;
-    lm_error e;
-    lm_status st = put(sc, value, id, &e);
+    return sc->loop ? lm_api_claim(sc->ctx, fn, err) : LMGI_OK;
+}
+
+static lmgi_status stage_end(lmgi_scene *sc, lm_status st, const lm_error *e, lmgi_error *err)
+{
     if (sc->loop)
         lm_api_release(sc->ctx);
-    return st == LM_OK ? LMGI_OK : lm_export_error(err, &e);
-}
-
-static lm_status put_light(lmgi_scene *sc, const void *l, int id, lm_error *err)
-{
-    int added;
-    return id < 0 ? lm_edits_add_light(&sc->edits, sc->scene, l, &added, err)
-                  : lm_edits_stage_light(&sc->edits, sc->scene, id, l, err);
-}
-
-static lm_status put_material(lmgi_scene *sc, const void *m, int id, lm_error *err)
-{
-    return lm_edits_stage_material(&sc->edits, sc->scene, id, m, err);
-}
-
-static lm_status put_sky(lmgi_scene *sc, const void *k, int id, lm_error *err)
-{
-    (void)id, (void)err;
-    lm_edits_stage_sky(&sc->edits, k);
-    return LM_OK;
-}
-
-static lm_status put_effects(lmgi_scene *sc, const void *e, int id, lm_error *err)
-{
-    (void)id;
-    return lm_edits_stage_effects(&sc->edits, e, err);
-}
-
-static lm_status put_dynamic(lmgi_scene *sc, const void *dynamic, int node, lm_error *err)
-{
-    return lm_edits_stage_dynamic(&sc->edits, node, *(const int *)dynamic, err);
+    return st == LM_OK ? LMGI_OK : lm_export_error(err, e);
 }
 
 lmgi_status lm_scene_stage_light(lmgi_scene *sc, const char *fn, int id, const lm_light *l, lmgi_error *err)
 {
-    return stage(sc, fn, put_light, l, id, err);
+    lmgi_status claimed = stage_begin(sc, fn, err);
+    if (claimed != LMGI_OK)
+        return claimed;
+    lm_error e;
+    int added;
+    lm_status st = id < 0 ? lm_edits_add_light(&sc->edits, sc->scene, l, &added, &e)
+                          : lm_edits_stage_light(&sc->edits, sc->scene, id, l, &e);
+    return stage_end(sc, st, &e, err);
 }
 
 lmgi_status lm_scene_stage_material(lmgi_scene *sc, const char *fn, int id, const lm_material *m, lmgi_error *err)
 {
-    return stage(sc, fn, put_material, m, id, err);
+    lmgi_status claimed = stage_begin(sc, fn, err);
+    if (claimed != LMGI_OK)
+        return claimed;
+    lm_error e;
+    return stage_end(sc, lm_edits_stage_material(&sc->edits, sc->scene, id, m, &e), &e, err);
 }
 
 lmgi_status lm_scene_stage_sky(lmgi_scene *sc, const char *fn, const lm_staged_sky *sky, lmgi_error *err)
 {
-    return stage(sc, fn, put_sky, sky, 0, err);
+    lmgi_status claimed = stage_begin(sc, fn, err);
+    if (claimed != LMGI_OK)
+        return claimed;
+    lm_edits_stage_sky(&sc->edits, sky);
+    return stage_end(sc, LM_OK, NULL, err);
 }
 
 lmgi_status lmgi_commit(lmgi_scene *sc, lmgi_error *err)
@@ -380,8 +365,12 @@ lmgi_status lmgi_set_node_effects(lmgi_scene *sc, int node, const lmgi_node_effe
     for (int k = 0; k < 4; k++)
         if (v[k] != 0 && v[k] != 1)
             return lm_api_refuse(err, "node '%s': %s is 0 or 1, not %d", s->nodes[node].name, names[k], v[k]);
-    const lm_staged_effects e = {node, in->shadows, in->indirect, in->reflections, in->caustics};
-    return stage(sc, "lmgi_set_node_effects", put_effects, &e, node, err);
+    lmgi_status claimed = stage_begin(sc, "lmgi_set_node_effects", err);
+    if (claimed != LMGI_OK)
+        return claimed;
+    const lm_staged_effects fx = {node, in->shadows, in->indirect, in->reflections, in->caustics};
+    lm_error e;
+    return stage_end(sc, lm_edits_stage_effects(&sc->edits, &fx, &e), &e, err);
 }
 
 lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_error *err)
@@ -405,7 +394,11 @@ lmgi_status lmgi_set_node_dynamic(lmgi_scene *sc, int node, int dynamic, lmgi_er
     if (!dynamic && lm_node_animated_under(s, node))
         return lm_api_refuse(err, "node '%s' (or a node under it) is animated: it stays dynamic", n->name);
     /* the BVH is rebuilt at the commit, once for every switch staged by then */
-    return stage(sc, "lmgi_set_node_dynamic", put_dynamic, &dynamic, node, err);
+    lmgi_status claimed = stage_begin(sc, "lmgi_set_node_dynamic", err);
+    if (claimed != LMGI_OK)
+        return claimed;
+    lm_error e;
+    return stage_end(sc, lm_edits_stage_dynamic(&sc->edits, node, dynamic, &e), &e, err);
 }
 
 lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[16], lmgi_error *err)
