@@ -150,6 +150,9 @@ int lm_texel_parts(const lm_scene *s, const lm_atlas *a, const lm_texel *t, int 
 /* The diffuse lobe kd (lm_material_lobes) of the texel's material at its point: base colour x texture at
  * the uv its barycentrics give on its triangle. What a lightmap's irradiance is turned into radiance with. */
 void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3]);
+/* The texel's centre and unit shading normal under the current node matrices (barycentric on its
+ * triangle; the normal at load when the interpolated one vanishes). */
+void lm_texel_world(const lm_scene *s, const lm_texel *t, float pos[3], float nrm[3]);
 /* The UV rectangle (lo u, lo v, hi u, hi v) inside which bilinear lookups at chart c's corner_uv read only
  * its own texels: its texel centres' span, or half a texel into its border (lm_chart.pad). What a
  * footprint spread around such a lookup is clamped to, charts touching. */

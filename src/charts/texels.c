@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "charts_internal.h"
+#include "../core/vecmath.h"
 
 typedef struct {
     double best;   /* largest single-triangle overlap (texel units) */
@@ -347,4 +348,18 @@ void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3])
     }
     lm_material_albedo(s, m, uv[0], uv[1], albedo);
     lm_material_lobes(m, albedo, kd, ks);
+}
+
+void lm_texel_world(const lm_scene *s, const lm_texel *t, float pos[3], float nrm[3])
+{
+    lm_vec3 p = lm_v3(0, 0, 0), n = lm_v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        float v[3], vn[3];
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t->tri + k], v);
+        lm_scene_normal_world(s, s->tris[3 * (size_t)t->tri + k], vn);
+        p = lm_add(p, lm_scale(lm_v3_load(v), t->bary[k]));
+        n = lm_add(n, lm_scale(lm_v3_load(vn), t->bary[k]));
+    }
+    lm_v3_store(pos, p);
+    lm_v3_store(nrm, lm_length(n) > 0.0f ? lm_normalize(n) : lm_normalize(lm_v3_load(t->normal)));
 }

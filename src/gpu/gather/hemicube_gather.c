@@ -377,17 +377,15 @@ lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rg
  * normal's side) under the current node matrices (barycentric on its triangle). */
 static void texel_frame(const lm_scene *s, const lm_texel *tx, lm_vec3 *pos, lm_vec3 *n, lm_vec3 *ng)
 {
-    lm_vec3 p = lm_v3(0, 0, 0), nn = lm_v3(0, 0, 0), c[3];
+    float p[3], nn[3];
+    lm_texel_world(s, tx, p, nn);
+    *pos = lm_v3_load(p), *n = lm_v3_load(nn);
+    lm_vec3 c[3];
     for (int k = 0; k < 3; k++) {
-        float v[3], vn[3];
+        float v[3];
         lm_scene_vertex_world(s, s->tris[3 * (size_t)tx->tri + k], v);
-        lm_scene_normal_world(s, s->tris[3 * (size_t)tx->tri + k], vn);
         c[k] = lm_v3_load(v);
-        p = lm_add(p, lm_scale(c[k], tx->bary[k]));
-        nn = lm_add(nn, lm_scale(lm_v3_load(vn), tx->bary[k]));
     }
-    *pos = p;
-    *n = lm_length(nn) > 0.0f ? lm_normalize(nn) : lm_normalize(lm_v3_load(tx->normal));
     lm_vec3 g = lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0]));
     g = lm_length(g) > 0.0f ? lm_normalize(g) : *n;
     *ng = lm_dot(g, *n) < 0.0f ? lm_scale(g, -1.0f) : g;
