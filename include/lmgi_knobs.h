@@ -137,6 +137,12 @@ static inline int lmgi_knob_is_pow2(double v)
     X(gather, blend_frames, LMGI_KNOB_INT, int, 8, 1, 100000, 1, LMGI_NO_RULE, NULL, NULL, LMGI_CLI_ZERO_NONE,    \
       LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                                              \
       "updates a regathered surface takes to fade in (default 8; LMGI_OFF: at once)")                             \
+    X(gather, texel_change, LMGI_KNOB_REAL, float, 0.03125, 1e-6, 1e6, 1, LMGI_NO_RULE, "--texel-change", "F",    \
+      LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
+      "a texel is regathered ahead of its surface, and shown at once, when\n"                                    \
+      "the estimated change of its hemisphere (moved objects, changed AIMs)\n"                                   \
+      "exceeds F times the mean irradiance (default 1/32; off: whole\n"                                          \
+      "surfaces only, the paper's order; docs/gather.md)")                                                         \
     X(gather, resolution, LMGI_KNOB_INT, int, 32, 2, 1024, 0, LMGI_NO_RULE, "--hemicube", "R", LMGI_CLI_ZERO_NONE,\
       LMGI_NO_CHOICES, LMGI_SWEEP(5, "hemicube", "hemicube resolution R", (16, 24, 32, 48, 64), (16, 32, 64), 0),\
       "hemicube plane pixels per side (default 32)")                                                               \

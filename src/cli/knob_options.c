@@ -28,9 +28,13 @@ typedef struct {
 static int parse_real(const knob *k, const char *o, const char *v, float *out)
 {
     float f;
-    if (lm_cli_parse_float(o, v, (float)k->lo, &f))
+    if (lm_cli_parse_float(o, v, k->cli_zero != LMGI_CLI_ZERO_NONE ? 0.0f : (float)k->lo, &f))
         return 2;
-    if (!k->rule_ok(f) || f > k->hi) {
+    if (f == 0.0f && k->cli_zero != LMGI_CLI_ZERO_NONE) { /* 0: off, or the default */
+        *out = k->cli_zero == LMGI_CLI_ZERO_OFF ? (float)LMGI_OFF : 0.0f;
+        return 0;
+    }
+    if (!k->rule_ok(f) || f < k->lo || f > k->hi) {
         char want[80];
         snprintf(want, sizeof want, "a number in [%g, %g]", k->lo, k->hi);
         return lm_cli_bad(o, v, k->rule ? k->rule : want);

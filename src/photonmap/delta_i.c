@@ -22,10 +22,9 @@ static lm_vec3 texel_now(const lm_scene *s, const lm_atlas *a, uint32_t texel, l
     return lm_mat4_point(w, lm_v3_load(t->local));
 }
 
-/* Whether surface a sees surface b (the header says how). */
-static int sees(const lm_iim_sched *iim, const lm_scene *s, const lm_atlas *at, const lm_rt *rt, int a, int b,
-                float lift)
+int lm_delta_i_sees(const lm_iim_sched *iim, const lm_scene *s, const lm_atlas *at, const lm_rt *rt, int a, int b)
 {
+    float lift = 1e-3f * lm_scene_size(s);
     uint32_t na = iim->surf_first[a + 1] - iim->surf_first[a], nb = iim->surf_first[b + 1] - iim->surf_first[b];
     if (!na || !nb)
         return 0;
@@ -56,13 +55,12 @@ int lm_delta_i_widen_to_viewers(lm_iim_sched *sched, lm_photon_store *ps, const 
                                 const lm_scene *s, const lm_atlas *at, const lm_rt *rt)
 {
     int S = sched->surface_count, n = 0;
-    float lift = 1e-3f * lm_scene_size(s);
     for (int a = 0; a < S; a++) {
         int under_way = sched->cursor[a] > 0;
         if ((ps->surfaces[a].delta_i > sched->delta_threshold && !under_way) || sched->again[a])
             continue;
         for (int b = 0; b < S; b++)
-            if (b != a && refreshed[b] && sees(sched, s, at, rt, a, b, lift)) {
+            if (b != a && refreshed[b] && lm_delta_i_sees(sched, s, at, rt, a, b)) {
                 if (under_way)
                     sched->again[a] = 1;
                 else

@@ -34,6 +34,9 @@
 int lm_delta_i_widen_to_viewers(lm_iim_sched *sched, lm_photon_store *ps, const uint8_t *refreshed,
                                 const lm_scene *s, const lm_atlas *a, const lm_rt *rt);
 
+/* Whether surface a sees surface b, as above (SEE_PAIRS texel pairs; the scene as it is now). */
+int lm_delta_i_sees(const lm_iim_sched *sched, const lm_scene *s, const lm_atlas *a, const lm_rt *rt, int sa, int sb);
+
 /* saved[s] = surface s's delta_i, for every surface of the scheduler. */
 void lm_delta_i_save(const lm_iim_sched *sched, const lm_photon_store *ps, double *saved);
 /* The surfaces whose refresh completed but was not committed (a cancelled bake) get their saved delta_i

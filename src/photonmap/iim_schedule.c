@@ -38,11 +38,15 @@ lm_status lm_iim_sched_init(lm_iim_sched *s, const lm_atlas *a, int texels_per_f
     s->commit = calloc(S, 1);
     s->off = calloc(S, 1);
     s->again = calloc(S, 1);
-    lm_status st = s->cursor && s->last_done && s->commit && s->off && s->again
+    s->started = calloc(S, sizeof *s->started);
+    s->texel_frame = malloc(sizeof *s->texel_frame * (a->texel_count ? a->texel_count : 1));
+    lm_status st = s->cursor && s->last_done && s->commit && s->off && s->again && s->started && s->texel_frame
                        ? group_texels(s, a, err)
                        : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
     for (size_t k = 0; st == LM_OK && k < S; k++)
         s->last_done[k] = -1;
+    for (uint32_t i = 0; st == LM_OK && i < a->texel_count; i++)
+        s->texel_frame[i] = INT_MIN;
     if (st != LM_OK)
         lm_iim_sched_free(s);
     return st;
@@ -57,6 +61,8 @@ void lm_iim_sched_free(lm_iim_sched *s)
     free(s->commit);
     free(s->off);
     free(s->again);
+    free(s->started);
+    free(s->texel_frame);
     memset(s, 0, sizeof *s);
 }
 
@@ -93,15 +99,29 @@ void lm_iim_sched_raise(const lm_iim_sched *s, lm_photon_store *ps, int k)
         ps->surfaces[k].delta_i = th + fmax(1e-30, 1e-9 * th);
 }
 
-/* Hands out texels of surface k from its cursor; completes it when its last texel is out. */
+/* Hands out texels of surface k from its cursor, less those gathered since its refresh began (ahead of
+ * it: lm_iim_sched_gathered); completes it when its last texel is out. */
 static uint32_t take_texels(lm_iim_sched *s, lm_photon_store *ps, int k, uint32_t *out, uint32_t room)
 {
     uint32_t first = s->surf_first[k], count = s->surf_first[k + 1] - first, n = 0;
-    while (s->cursor[k] < count && n < room)
-        out[n++] = s->surf_texels[first + s->cursor[k]++];
+    if (s->cursor[k] == 0)
+        s->started[k] = s->frame;
+    while (s->cursor[k] < count && n < room) {
+        uint32_t t = s->surf_texels[first + s->cursor[k]++];
+        if (s->texel_frame[t] >= s->started[k] && s->texel_frame[t] != INT_MIN)
+            continue;
+        s->texel_frame[t] = s->frame;
+        out[n++] = t;
+    }
     if (s->cursor[k] == count)
         complete_surface(s, ps, k);
     return n;
+}
+
+void lm_iim_sched_gathered(lm_iim_sched *s, const uint32_t *texels, uint32_t n, int gathered)
+{
+    for (uint32_t j = 0; j < n; j++)
+        s->texel_frame[texels[j]] = gathered ? s->frame : INT_MIN;
 }
 
 uint32_t lm_iim_sched_pick(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out)

@@ -6,7 +6,9 @@
  * first hits of punctual lights left out), largest first, then by age (frames since the surface's last
  * completed refresh, oldest first), then by id. Only surfaces with delta_i > delta_threshold, or with a
  * refresh under way, are candidates: nothing changed means no IIM work. A surface's texels are handed out
- * in atlas order from a cursor that survives across frames; when the last one is out the refresh is
+ * in atlas order from a cursor that survives across frames, skipping those gathered since the refresh
+ * began (picked ahead of their surface: lm_iim_sched_gathered), so that work is not done twice; when the
+ * last one is out the refresh is
  * complete: the surface's delta_i is reset (the scheduler is what writes it, beside the AIM scheduler's
  * delta_f) and its commit flag is raised for the blend to consume.
  *
@@ -33,6 +35,8 @@ typedef struct {
     uint8_t *off;          /* per surface: not gathered at all (its node's indirect switched off) */
     uint8_t *again;        /* per surface: what its refresh under way gathered is stale: refreshed again
                             * once it completes (lm_delta_i_widen_to_viewers) */
+    int *started;          /* per surface: frame its refresh under way began */
+    int *texel_frame;      /* per atlas texel: frame it was last handed out (INT_MIN: never) */
     int frame;             /* advanced once a frame by lm_iim_sched_end_frame */
 } lm_iim_sched;
 
@@ -53,6 +57,10 @@ void lm_iim_sched_restart(lm_iim_sched *s, lm_photon_store *ps);
  * (out must hold the atlas's texel_count). */
 uint32_t lm_iim_sched_pick_all(lm_iim_sched *s, lm_photon_store *ps, uint32_t *out);
 void lm_iim_sched_end_frame(lm_iim_sched *s);
+/* gathered: the texels were gathered this frame outside the surfaces' order (photonmap/texel_change.h): a
+ * refresh under way, or one begun this frame, skips them. 0: they were handed out but not gathered after
+ * all (a cancelled bake): any refresh hands them out again. */
+void lm_iim_sched_gathered(lm_iim_sched *s, const uint32_t *texels, uint32_t n, int gathered);
 /* Surface k's delta_i just over the threshold, whatever its size: a candidate, behind every surface
  * whose light changed more. */
 void lm_iim_sched_raise(const lm_iim_sched *s, lm_photon_store *ps, int k);

@@ -9,6 +9,7 @@
 #include "../core/vecmath.h"
 #include "../gpu/gather/gather_error.h"
 #include "../photonmap/delta_i.h"
+#include "../photonmap/texel_change.h"
 #include "../scene/sky.h"
 #include "../trace/emitter_light.h"
 #include "gather_passes.h"
@@ -25,8 +26,12 @@ struct lm_lightmap_path {
     int have_iim;
     lm_emitter_light emitters; /* with have_emitters: the gather's closed-form emitter light */
     int have_emitters;
-    uint32_t *texels;          /* scratch: the scheduled texels (atlas texel_count) */
+    uint32_t *texels;          /* scratch: the scheduled texels (twice the atlas's texel_count) */
     uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule */
+    lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
+    int have_change;
+    uint32_t *seen;            /* per texel: the schedule that last listed it (duplicates dropped) */
+    uint32_t schedules;
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
     uint32_t switch_version;   /* the scene's pass_version the scheduler's switches follow */
     struct {                   /* whether the scene gives any light (follow_light): none, no gather */
@@ -176,9 +181,11 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
     lp->atlas = w->atlas;
     lp->rt = w->rt;
     lp->stage = stage;
-    lp->texels = malloc(sizeof(uint32_t) * (w->atlas->texel_count ? w->atlas->texel_count : 1));
+    /* twice the atlas: the texels picked ahead and the surfaces' may overlap before duplicates go */
+    lp->texels = malloc(sizeof(uint32_t) * 2 * ((size_t)w->atlas->texel_count + 1));
     lp->refreshed = malloc((size_t)w->atlas->surface_count + 1);
-    lm_status st = lp->texels && lp->refreshed ? LM_OK
+    lp->seen = calloc(w->atlas->texel_count ? w->atlas->texel_count : 1, sizeof *lp->seen);
+    lm_status st = lp->texels && lp->refreshed && lp->seen ? LM_OK
                                                : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop",
                                                          w->scene->path);
     if (st == LM_OK)
@@ -191,6 +198,7 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
         lm_gather_set_tracer(lp->gather, lp->rt);
     if (st == LM_OK)
         st = follow_light(lp, err); /* before the IIM: a scene without light gathers nothing */
+    set->iim.backface_limit = set->gather.backface_limit;
     if (st == LM_OK && (st = lm_iim_init(&lp->iim, lp->atlas, &set->iim, 1, err)) == LM_OK) {
         lp->have_iim = 1;
         sync_gather_switches(lp); /* nodes without indirect light are not gathered at all */
@@ -213,8 +221,11 @@ void lm_lightmap_path_free(lm_lightmap_path *lp)
     lm_gather_free(lp->gather);
     if (lp->have_emitters)
         lm_emitter_light_free(&lp->emitters);
+    if (lp->have_change)
+        lm_texel_change_free(&lp->change);
     free(lp->texels);
     free(lp->refreshed);
+    free(lp->seen);
     free(lp);
 }
 
@@ -228,6 +239,11 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
     lp->set->checkpoint = NULL;
     if (st == LM_OK)
         st = lm_iim_blend(&lp->iim, 1, err);
+    if (st == LM_OK && !lp->have_change) { /* from here on every texel holds what it saw now */
+        st = lm_texel_change_init(&lp->change, lp->scene, lp->atlas, lm_photon_stage_aim(lp->stage)->rgb,
+                                  lp->set->iim.texel_change, err);
+        lp->have_change = st == LM_OK;
+    }
     lm_gl_finish(); /* the time holds the GPU's work too: the budget's first guess starts from it */
     if (t_gather)
         *t_gather = lm_now() - t0;
@@ -238,15 +254,57 @@ void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
 
 int lm_lightmap_path_widen(lm_lightmap_path *lp)
 {
+    if (lp->have_change)
+        lm_texel_change_moved(&lp->change, lp->scene, lp->atlas);
     if (!lm_photon_stage_take_refreshed(lp->stage, lp->refreshed))
         return 0;
+    if (lp->have_change)
+        lm_texel_change_aim(&lp->change, &lp->iim.sched, lp->scene, lp->atlas, lp->rt,
+                            lm_photon_stage_aim(lp->stage)->rgb, lp->refreshed);
     return lm_delta_i_widen_to_viewers(&lp->iim.sched, store_of(lp), lp->refreshed, lp->scene, lp->atlas, lp->rt);
+}
+
+static int by_index(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* Texels into lp->texels: first at most `ahead` of those whose hemisphere changed most (texel_change.h),
+ * committed on their own, then the surfaces' refreshes (iim_schedule.h: the budget left, or with `whole`,
+ * a bake's, every candidate surface in full), less the texels already listed. */
+static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int whole)
+{
+    uint32_t n = 0;
+    if (lp->have_change && lp->change.threshold >= 0.0f) {
+        n = lm_texel_change_pick(&lp->change, lp->atlas, lp->iim.sched.off, ahead < budget ? ahead : budget, whole,
+                                 lp->texels);
+        lm_iim_commit_texels(&lp->iim, lp->atlas, lp->texels, n);
+        lm_iim_sched_gathered(&lp->iim.sched, lp->texels, n, 1);
+    }
+    uint32_t room = whole ? lp->atlas->texel_count : budget - n; /* a bake: every surface under way, whole */
+    room = room < lp->atlas->texel_count ? room : lp->atlas->texel_count;
+    uint32_t m = lm_iim_sched_pick_up_to(&lp->iim.sched, store_of(lp), room, lp->texels + n);
+    if (n == 0 && !whole)
+        return m;
+    lp->schedules++;
+    for (uint32_t j = 0; j < n; j++)
+        lp->seen[lp->texels[j]] = lp->schedules;
+    uint32_t kept = n;
+    for (uint32_t j = n; j < n + m; j++)
+        if (lp->seen[lp->texels[j]] != lp->schedules)
+            lp->texels[kept++] = lp->texels[j];
+    if (whole) /* a bake: in atlas order, so that where a texel lands in the gather's passes (and its
+                * rounding) depends on which texels are gathered, not on how they were picked */
+        qsort(lp->texels, kept, sizeof *lp->texels, by_index);
+    return kept;
 }
 
 lm_status lm_lightmap_path_schedule(lm_lightmap_path *lp, uint32_t *count, lm_error *err)
 {
     lm_lightmap_path_widen(lp);
-    *count = lm_iim_sched_pick(&lp->iim.sched, store_of(lp), lp->texels);
+    uint32_t budget = lp->iim.sched.texels_per_frame > 0 ? (uint32_t)lp->iim.sched.texels_per_frame : 0;
+    *count = pick(lp, budget, budget - budget / 4, 0); /* a quarter left to the surfaces' refreshes */
     return *count > 0 ? gather_prepare(lp, err) : LM_OK;
 }
 
@@ -274,11 +332,20 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
     lm_photon_store *ps = store_of(lp);
     int S = lp->iim.sched.surface_count;
     double *saved = malloc(sizeof *saved * (size_t)(S ? S : 1));
-    if (!saved)
+    size_t T = lp->atlas->texel_count;
+    float *change = lp->have_change ? malloc(sizeof *change * (2 * T + 1)) : NULL;
+    if (change) { /* a cancelled bake gives back what it took, as delta_i */
+        memcpy(change, lp->change.change, sizeof *change * T);
+        memcpy(change + T, lp->change.lit, sizeof *change * T);
+    }
+    if (!saved || (lp->have_change && !change)) {
+        free(saved);
+        free(change);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the bake", lp->scene->path);
+    }
     lm_iim_sched_restart(&lp->iim.sched, ps);
     lm_delta_i_save(&lp->iim.sched, ps, saved);
-    uint32_t n = lm_iim_sched_pick_up_to(&lp->iim.sched, ps, lp->atlas->texel_count, lp->texels);
+    uint32_t n = pick(lp, lp->atlas->texel_count, lp->atlas->texel_count, 1);
     bake_watch w = {progress, user};
     lp->set->progress = progress ? bake_gather_progress : NULL;
     lp->set->progress_user = &w;
@@ -288,6 +355,12 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
     lp->set->cancel = NULL;
     if (st != LM_OK) {
         lm_delta_i_restore(&lp->iim.sched, ps, saved);
+        lm_iim_sched_gathered(&lp->iim.sched, lp->texels, n, 0);
+        if (change) {
+            memcpy(lp->change.change, change, sizeof *change * T);
+            memcpy(lp->change.lit, change + T, sizeof *change * T);
+        }
+        lp->iim.list_count = 0;
     } else {
         uint32_t before = 0, after = 0;
         for (int s = 0; s < S; s++)
@@ -299,6 +372,7 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
         *surfaces_changed = (int)(after - before);
     }
     free(saved);
+    free(change);
     return st;
 }
 

@@ -18,6 +18,8 @@ void lm_iim_settings_default(lm_iim_settings *s)
     s->texels_per_frame = LM_IIM_DEFAULT_TEXELS_PER_FRAME;
     s->blend_frames = 8;
     s->delta_threshold = 0.0;
+    s->texel_change = 0.03125f;
+    s->backface_limit = 0.1f;
 }
 
 static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
@@ -35,13 +37,20 @@ static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
     for (size_t i = 0; i < n; i++)
         surf[i] = a->texel_index[i] < 0 ? -1 : a->texels[a->texel_index[i]].surface;
-    GLuint bufs[2];
-    glGenBuffers(2, bufs);
-    iim->surface_buf = bufs[0], iim->params_buf = bufs[1];
+    GLuint bufs[4];
+    glGenBuffers(4, bufs);
+    iim->surface_buf = bufs[0], iim->params_buf = bufs[1], iim->start_buf = bufs[2], iim->list_buf = bufs[3];
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * n), surf, GL_STATIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * 2 * (size_t)(iim->sched.surface_count + 1)), NULL,
+                 GL_DYNAMIC_DRAW);
+    for (size_t i = 0; i < n; i++)
+        surf[i] = NEVER; /* every cell's clock: fully blended */
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * n), surf, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[3]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * (a->texel_count ? a->texel_count : 1)), NULL,
                  GL_DYNAMIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     free(surf);
@@ -56,11 +65,13 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
     size_t S = (size_t)(a->surface_count ? a->surface_count : 1);
     iim->blend_start = malloc(S * sizeof *iim->blend_start);
     iim->version = calloc(S, sizeof *iim->version);
-    lm_status st = iim->blend_start && iim->version
+    iim->texel_start = malloc(S * sizeof *iim->texel_start);
+    iim->list = malloc(sizeof *iim->list * (a->texel_count ? a->texel_count : 1));
+    lm_status st = iim->blend_start && iim->version && iim->texel_start && iim->list
                        ? lm_iim_sched_init(&iim->sched, a, set->texels_per_frame, set->delta_threshold, err)
                        : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
     for (size_t k = 0; st == LM_OK && k < S; k++)
-        iim->blend_start[k] = NEVER;
+        iim->blend_start[k] = iim->texel_start[k] = NEVER;
     if (st == LM_OK && with_gl)
         st = init_gl(iim, a, err);
     if (st != LM_OK)
@@ -74,22 +85,50 @@ void lm_iim_free(lm_iim *iim)
     for (int i = 0; i < 4; i++)
         lm_iim_texture_free(tex[i]);
     if (iim->blend_prog) {
-        GLuint bufs[2] = {iim->surface_buf, iim->params_buf};
-        glDeleteBuffers(2, bufs);
+        GLuint bufs[4] = {iim->surface_buf, iim->params_buf, iim->start_buf, iim->list_buf};
+        glDeleteBuffers(4, bufs);
         glDeleteProgram(iim->blend_prog);
     }
     lm_iim_sched_free(&iim->sched);
     free(iim->blend_start);
+    free(iim->texel_start);
+    free(iim->list);
     free(iim->version);
     memset(iim, 0, sizeof *iim);
 }
 
-float lm_iim_blend_weight(const lm_iim *iim, int surface)
+/* Whether a commit at frame `start` still blends at frame `frame`. */
+static int blending_at(const lm_iim *iim, int start, double frame)
 {
-    if (iim->set.blend_frames <= 0)
-        return 1.0f;
-    float t = (float)((double)iim->sched.frame - iim->blend_start[surface]) / (float)iim->set.blend_frames;
-    return t < 1.0f ? t : 1.0f;
+    return frame - start < iim->set.blend_frames;
+}
+
+void lm_iim_commit_texels(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n)
+{
+    for (uint32_t j = 0; j < n && iim->list_count < a->texel_count; j++) {
+        const lm_texel *t = &a->texels[texels[j]];
+        iim->list[iim->list_count++] = t->y * a->width + t->x;
+        iim->texel_start[t->surface] = iim->sched.frame;
+    }
+}
+
+/* The listed cells committed on their own (mode 1 of iim_blend), before the pass over the atlas. */
+static void commit_list(lm_iim *iim, int instant)
+{
+    if (!iim->list_count)
+        return;
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->list_buf);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(int) * iim->list_count), iim->list);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, iim->list_buf);
+    GLuint groups = (GLuint)(iim->list_count + 63) / 64;
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), 1);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "list_count"), (int)iim->list_count);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "row"), 8 * (int)groups);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "instant"), instant);
+    glDispatchCompute(groups, 1, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    iim->list_count = 0;
 }
 
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
@@ -99,17 +138,22 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     float *param = malloc(sizeof(float) * 2 * (size_t)(S + 1));
     if (!param)
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
-    int any_commit = 0, blending = 0;
+    int any_commit = iim->list_count > 0, blending = 0;
+    double frame = iim->sched.frame;
     for (int s = 0; s < S; s++) {
-        /* shown differently from the last frame: committed now, or last frame's weight was below 1 */
-        if (commit[s] || (double)iim->sched.frame - 1 - iim->blend_start[s] < iim->set.blend_frames)
+        /* shown differently from the last frame: committed now (the surface or some of its texels), or
+         * still blending last frame */
+        if (commit[s] || iim->texel_start[s] == iim->sched.frame || blending_at(iim, iim->blend_start[s], frame - 1) ||
+            blending_at(iim, iim->texel_start[s], frame - 1))
             iim->version[s]++;
         if (commit[s])
             iim->blend_start[s] = instant ? NEVER : iim->sched.frame;
+        if (instant && iim->texel_start[s] == iim->sched.frame)
+            iim->texel_start[s] = NEVER;
         param[2 * s] = commit[s] ? 1.0f : 0.0f;
-        param[2 * s + 1] = lm_iim_blend_weight(iim, s);
+        param[2 * s + 1] = instant ? 1.0f : 0.0f;
         any_commit |= commit[s];
-        blending |= param[2 * s + 1] < 1.0f;
+        blending |= blending_at(iim, iim->blend_start[s], frame) || blending_at(iim, iim->texel_start[s], frame);
         commit[s] = 0;
     }
     if (!any_commit && iim->settled) { /* the last pass already wrote every final value */
@@ -123,11 +167,17 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     free(param);
     glUseProgram(iim->blend_prog);
     glUniform2i(glGetUniformLocation(iim->blend_prog, "size"), iim->width, iim->height);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "frame"), iim->sched.frame);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "blend_frames"), iim->set.blend_frames);
+    glUniform1f(glGetUniformLocation(iim->blend_prog, "limit"), iim->set.backface_limit);
     const unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
     for (int i = 0; i < 4; i++)
         glBindImageTexture((GLuint)i, tex[i], 0, GL_FALSE, 0, i ? GL_READ_WRITE : GL_READ_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, iim->surface_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->params_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, iim->start_buf);
+    commit_list(iim, instant);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), 0);
     glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     lm_iim_sched_end_frame(&iim->sched);

@@ -5,9 +5,12 @@
  *
  * Double buffering (GPU, no read-back): the gather writes into `fresh`. Committing a surface copies,
  * for its texels, the currently displayed value into `old` and `fresh` into `new`; from then on
- * display = mix(old, new, t) with t = min(1, frames since the commit / blend_frames). A texel thus
+ * display = mix(old, new, t) with t = min(1, frames since the commit / blend_frames), each texel keeping
+ * the frame of its own last commit (a texel may be committed alone: lm_iim_commit_texels). A texel thus
  * never leaves [old, new], and a surface committed again mid-blend starts from what was on screen (no
- * popping). The alpha channel (back-face fraction) blends alike.
+ * popping). The alpha channel (back-face fraction) blends alike, but a texel that turns valid or invalid
+ * (a moving object's foot) shows its new value at once: a blend with the dark value gathered from inside
+ * geometry would show as a dark square.
  *
  * Invalid texels (back-face fraction above the limit: the texel sees the inside of geometry) are
  * filled on the CPU copy used for output (lm_iim_fill_invalid), then gutters are dilated. */
@@ -26,6 +29,12 @@ typedef struct {
     int texels_per_frame;  /* gather budget per frame (default LM_IIM_DEFAULT_TEXELS_PER_FRAME) */
     int blend_frames;      /* frames an updated surface takes to blend from old to new (default 8; 0 = pop) */
     double delta_threshold; /* a surface is refreshed when its delta_i exceeds this (default 0) */
+    float texel_change;    /* a texel is regathered ahead of its surface when its hemisphere's estimated
+                            * change exceeds this fraction of the mean irradiance (photonmap/texel_change.h;
+                            * default 1/32; a negative value: never) */
+    float backface_limit;  /* a texel whose back-face fraction (alpha) is above this is invalid, as the
+                            * gather's: one turning valid or invalid shows its new value at once, never a
+                            * blend with what it saw from inside geometry (default 0.1) */
 } lm_iim_settings;
 
 typedef struct {
@@ -33,12 +42,14 @@ typedef struct {
     lm_iim_sched sched;    /* which texels to regather; its frame counter is the blend's clock */
     int width, height;
     int *blend_start;      /* per surface: frame of its last commit (very negative: fully blended) */
+    int *texel_start;      /* per surface: frame some of its texels were last committed on their own */
+    uint32_t *list, list_count; /* atlas cells to commit on their own at the next blend */
     uint32_t *version;     /* per surface: blends that changed its displayed texels (a commit, or a blend
                             * still under way) */
     int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */
     unsigned fresh_tex, old_tex, new_tex, display_tex;
-    unsigned blend_prog, surface_buf, params_buf;
+    unsigned blend_prog, surface_buf, params_buf, start_buf, list_buf;
 } lm_iim;
 
 void lm_iim_settings_default(lm_iim_settings *s);
@@ -46,8 +57,10 @@ void lm_iim_settings_default(lm_iim_settings *s);
 lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set, int with_gl, lm_error *err);
 void lm_iim_free(lm_iim *iim);
 
-/* Blend weight of a surface this frame. */
-float lm_iim_blend_weight(const lm_iim *iim, int surface);
+/* The texels (lm_atlas.texels indices) are committed on their own at the next blend, whatever their
+ * surface does: texels regathered ahead of their surface (photonmap/texel_change.h) show at once, each
+ * blending from what was shown over blend_frames from then. */
+void lm_iim_commit_texels(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n);
 /* Ends the frame on the GPU: commits the surfaces the scheduler completed (clearing their flags),
  * writes display = mix(old, new, t), then advances the scheduler's frame counter. instant: committed surfaces show new at once (after the first gather). */
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);

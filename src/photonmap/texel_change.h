@@ -1,0 +1,81 @@
+/* How much each IIM texel's hemisphere changed since the texel was last gathered (issue 32, item 1): the
+ * texel-level priority beside the scheduler's surface order (iim_schedule.h), so that the texels next to a
+ * moved object or a changed AIM are regathered first instead of waiting behind their whole surface.
+ *
+ * Units: a texel's change estimates |dE| / E_mean, the change of its irradiance as a fraction of the
+ * scene's mean irradiance (pi times the AIM's mean radiance) since it was last gathered, as two sums:
+ *   - A moved node (its world matrix differs from the one last seen): its bounding sphere at the old and at
+ *     the new place each give the sphere's form factor from the texel, min(1, r^2/d^2) * clamp(cos + r/d,
+ *     0, 1) (a point to a sphere of radius r at distance d, widened near the horizon), and their sum times
+ *     min(1, |dc| / r) (the share of the sphere's disc that moved off itself) is added: what that share
+ *     covers went from background to object or back, both of about the mean radiance. The node's own
+ *     texels add min(1, |dx| / r + (1 - n_old . n_new)): their whole hemisphere shifted.
+ *   - A refreshed AIM: each 4 x 4 atlas block of the surface adds, at every texel of other surfaces,
+ *     dL A cos_t cos_b / (d^2 + A / pi) / E_mean (the disc approximation of the form factor), dL the
+ *     block's mean change of radiance since the AIM was last seen, to a signed sum (the irradiance's
+ *     change to first order: photon noise and changes undone cancel; `lit`),
+ *     at the texels of the surfaces that see the block's (lm_delta_i_sees); occlusion within is ignored:
+ *     an over-estimate, which only orders the work. When blocks x texels would exceed LM_TEXEL_CHANGE_WORK,
+ *     whole surfaces are the emitters instead; past that too, the surface order alone carries it (a change
+ *     that reaches everything is not local).
+ * A texel's change is the motion sum plus the magnitude of the signed sum. Picking takes the texels whose
+ * change is over the threshold and over 4 times the atlas's mean change (a change that reaches everything
+ * alike, a light dimmed, is the surfaces' order's to follow), most changed first, then by index, and
+ * zeroes them.
+ *
+ * Layout: per atlas texel (lm_atlas.texels order) change, world position and normal (kept current for
+ * moved nodes), and the AIM radiance last looked at; per node its last world matrix and local bounding
+ * sphere. Memory: 36 bytes a texel, 80 a node.
+ * Cost: O(texels of moved nodes + moved nodes x texels) per moved frame; O(blocks x texels) for AIM
+ * changes, bounded as said (a few ms); O(texels log budget) to pick. Nothing when nothing changed.
+ * Deterministic (fixed order, no threads). Not thread-safe: the scene and AIM must not change meanwhile. */
+#ifndef LM_TEXEL_CHANGE_H
+#define LM_TEXEL_CHANGE_H
+
+#include <stdint.h>
+
+#include "../charts/charts.h"
+#include "../core/error.h"
+#include "../scene/scene.h"
+#include "../trace/rt_scene.h"
+#include "iim_schedule.h"
+
+#define LM_TEXEL_CHANGE_WORK 2000000.0 /* emitter x texel pairs a frame before emitters are coarsened */
+
+typedef struct {
+    uint32_t texel_count;
+    float threshold;      /* a texel is picked when its change exceeds this */
+    float *change;        /* per texel: what moved nodes changed (unsigned, summed) */
+    float *lit;           /* per texel: what changed AIMs changed, signed (first order in their change) */
+    float *pos, *nrm;     /* per texel, 3 each, world space as last seen */
+    float *aim_seen;      /* per texel, 3: AIM radiance as last looked at */
+    int node_count;
+    float *node_world;    /* per node, 16: world matrix as last seen */
+    float *node_sphere;   /* per node, 4: local centre and radius of its vertices (radius < 0: none) */
+    int *texel_node;      /* per texel */
+    double mean_e;        /* pi x the AIM's mean radiance when last looked at */
+} lm_texel_change;
+
+/* aim_rgb: the AIM as it is now (atlas width x height x 3). */
+lm_status lm_texel_change_init(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a, const float *aim_rgb,
+                               float threshold, lm_error *err);
+void lm_texel_change_free(lm_texel_change *tc);
+
+/* Adds the change of every node whose world matrix moved since the last call (or the init). Returns how
+ * many nodes moved. */
+int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a);
+/* Adds the change of the surfaces with refreshed[k] set, comparing aim_rgb with what was last seen, at the
+ * texels of the surfaces that see them (lm_delta_i_sees: a few shadow rays per pair of surfaces). */
+void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const lm_scene *s, const lm_atlas *a,
+                         const lm_rt *rt, const float *aim_rgb, const uint8_t *refreshed);
+/* At most budget texels over the threshold (and, unless `all`, over 4 times the mean: header), not on
+ * surfaces with off[k] set, most changed first, written to out (texel indices) and zeroed. A bake asks for
+ * all. Returns how many. */
+uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t budget, int all,
+                              uint32_t *out);
+/* Texel t's change (header). */
+float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel);
+/* Zeroes every texel's change (all were just gathered: a bake, the first gather). */
+void lm_texel_change_clear(lm_texel_change *tc);
+
+#endif
