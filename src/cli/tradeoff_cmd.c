@@ -279,13 +279,38 @@ static int scene_calls_for(const lmgi_scene *sc, const char *effect)
 }
 
 /* The update budgets the lag study moves, one at a time around their defaults. lmgi_update runs with
- * budget_ms 0, so that texels_per_frame is what each update gathers. */
+ * budget_ms 0, so that texels_per_frame is what each update gathers. texel_change is a switch here: 1 its
+ * default, 0 off (whole surfaces only, the paper's order). */
 static const struct {
     const char *knob;
-    int values[3], def;
-} BUDGETS[3] = {{"texels_per_frame", {5, 20, 80}, 20},
-                {"group_budget", {4, 16, 64}, 16},
-                {"surfaces_per_frame", {1, 4, 16}, 4}};
+    int n, values[3], def;
+} BUDGETS[] = {{"texels_per_frame", 3, {5, 20, 80}, 20},
+               {"group_budget", 3, {4, 16, 64}, 16},
+               {"surfaces_per_frame", 3, {1, 4, 16}, 4},
+               {"texel_change", 2, {0, 1}, 1}};
+#define BUDGET_COUNT ((int)(sizeof BUDGETS / sizeof *BUDGETS))
+
+/* The plays: the default once, and every other value of every budget. */
+static int play_total(void)
+{
+    int n = 1;
+    for (int b = 0; b < BUDGET_COUNT; b++)
+        n += BUDGETS[b].n - 1;
+    return n;
+}
+
+/* Budget b at value v into d (0 leaves the default). */
+static void set_budget(int b, int v, lmgi_updater_desc *d)
+{
+    if (b == 0)
+        d->gather.texels_per_frame = v;
+    else if (b == 1)
+        d->photons.group_budget = v;
+    else if (b == 2)
+        d->aim.surfaces_per_frame = v;
+    else
+        d->gather.texel_change = v ? 0.0f : (float)LMGI_OFF;
+}
 
 /* The scene's edit script played once per budget setting (the default once); plays into sr. A play the
  * library refuses counts as a failed setting. */
@@ -296,11 +321,12 @@ static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_scrip
      * (a reference per edited state: 64^2 costs under half of 96^2, and per-surface means need few pixels) */
     lm_edit_frame_check fc = {rd, LM_TRADEOFF_LAG_SIDE, LM_TRADEOFF_LAG_SIDE};
     sr->script = script;
-    sr->plays = calloc(7, sizeof *sr->plays);
+    int total = play_total();
+    sr->plays = calloc((size_t)total, sizeof *sr->plays);
     if (!sr->plays)
         return fprintf(stderr, "lmgi: error: no memory for the plays\n"), 0;
-    for (int b = 0; b < 3; b++)
-        for (int k = 0; k < 3; k++) {
+    for (int b = 0; b < BUDGET_COUNT; b++)
+        for (int k = 0; k < BUDGETS[b].n; k++) {
             int v = BUDGETS[b].values[k], is_default = v == BUDGETS[b].def;
             if (is_default && b > 0)
                 continue; /* the default is played once, with the first budget */
@@ -308,14 +334,8 @@ static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_scrip
             p->knob = BUDGETS[b].knob, p->value = v, p->is_default = is_default;
             lmgi_updater_desc d;
             memset(&d, 0, sizeof d);
-            if (!is_default) {
-                if (b == 0)
-                    d.gather.texels_per_frame = v;
-                else if (b == 1)
-                    d.photons.group_budget = v;
-                else
-                    d.aim.surfaces_per_frame = v;
-            }
+            if (!is_default)
+                set_budget(b, v, &d);
             p->frames = calloc((size_t)script->frames, sizeof *p->frames);
             p->frame_lag = is_default && a->frame_lag;
             if (!p->frames || !lm_edit_script_play(script, path, &d, 0.0f, p->frame_lag ? &fc : NULL, p->frames)) {
@@ -329,8 +349,8 @@ static int lag_sweep(const lm_cli_args *a, const char *path, const lm_edit_scrip
                 double ms5;
                 lm_edit_span(script, 0, &from, &to);
                 lm_edit_lag(p->frames, from, to, 0.05, LM_LAG_WORST_SURFACE, &f5, &ms5);
-                fprintf(stderr, "lmgi: tradeoff %s update lag [%d/7] %s = %d: the first edit's worst surface %s %d "
-                        "updates (%.0f ms)\n", sr->name, sr->play_count, p->knob, v,
+                fprintf(stderr, "lmgi: tradeoff %s update lag [%d/%d] %s = %d: the first edit's worst surface %s %d "
+                        "updates (%.0f ms)\n", sr->name, sr->play_count, total, p->knob, v,
                         f5 < 0 ? "still 5% off after" : "within 5% after", f5 < 0 ? to - from : f5, ms5);
             }
         }
