@@ -108,7 +108,7 @@ static uint32_t take_texels(lm_iim_sched *s, lm_photon_store *ps, int k, uint32_
         s->started[k] = s->frame;
     while (s->cursor[k] < count && n < room) {
         uint32_t t = s->surf_texels[first + s->cursor[k]++];
-        if (s->texel_frame[t] >= s->started[k] && s->texel_frame[t] != INT_MIN)
+        if (s->texel_frame[t] >= s->started[k]) /* gathered ahead since the refresh began (never: INT_MIN) */
             continue;
         s->texel_frame[t] = s->frame;
         out[n++] = t;

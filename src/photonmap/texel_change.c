@@ -11,8 +11,6 @@
 #define BLOCK 4 /* atlas texels per side of an AIM emitter block */
 #define LOCAL 4.0 /* a texel goes ahead only when its change passes this many times the atlas's mean */
 
-static double luminance3(const float *c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
-
 static const float *aim_at(const lm_atlas *a, const float *aim_rgb, uint32_t i)
 {
     return aim_rgb + 3 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
@@ -23,7 +21,7 @@ static double mean_irradiance(const lm_atlas *a, const float *aim_rgb)
 {
     double sum = 0.0, area = 0.0;
     for (uint32_t i = 0; i < a->texel_count; i++) {
-        sum += luminance3(aim_at(a, aim_rgb, i)) * a->texels[i].area;
+        sum += lm_luminance(aim_at(a, aim_rgb, i)) * a->texels[i].area;
         area += a->texels[i].area;
     }
     return area > 0.0 ? M_PI * sum / area : 0.0;
@@ -58,8 +56,7 @@ static void node_spheres(lm_texel_change *tc, const lm_scene *s)
     for (uint32_t v = 0; v < s->vertex_count; v++) {
         float *sp = tc->node_sphere + 4 * (size_t)s->vertex_node[v];
         const float *x = s->positions + 3 * (size_t)v;
-        float d = sqrtf((x[0] - sp[0]) * (x[0] - sp[0]) + (x[1] - sp[1]) * (x[1] - sp[1]) + (x[2] - sp[2]) * (x[2] - sp[2]));
-        sp[3] = fmaxf(sp[3], d);
+        sp[3] = fmaxf(sp[3], lm_length(lm_sub(lm_v3_load(x), lm_v3_load(sp))));
     }
     free(lo);
 }
@@ -124,11 +121,11 @@ static void world_sphere(const float *sp, const float m[16], float out[4])
 /* Form factor from a point (position p, normal n) to a sphere, widened near the horizon (header). */
 static float sphere_factor(const float *p, const float *n, const float sph[4])
 {
-    float d[3] = {sph[0] - p[0], sph[1] - p[1], sph[2] - p[2]};
-    float dist = sqrtf(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+    lm_vec3 d = lm_sub(lm_v3_load(sph), lm_v3_load(p));
+    float dist = lm_length(d);
     if (dist <= sph[3])
         return 1.0f;
-    float sin_a = sph[3] / dist, c = (n[0] * d[0] + n[1] * d[1] + n[2] * d[2]) / dist + sin_a;
+    float sin_a = sph[3] / dist, c = lm_dot(lm_v3_load(n), d) / dist + sin_a;
     return fminf(1.0f, sin_a * sin_a) * fminf(1.0f, fmaxf(0.0f, c));
 }
 
@@ -141,8 +138,7 @@ static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atla
     world_sphere(tc->node_sphere + 4 * n, s->nodes[n].world, now);
     /* the share of the sphere's disc that moved off itself: what a texel sees changes by about that part
      * of the sphere's form factor (a small step changes little even right under the object) */
-    float step = sqrtf((now[0] - was[0]) * (now[0] - was[0]) + (now[1] - was[1]) * (now[1] - was[1]) +
-                       (now[2] - was[2]) * (now[2] - was[2]));
+    float step = lm_length(lm_sub(lm_v3_load(now), lm_v3_load(was)));
     float moved = fminf(1.0f, step / fmaxf(now[3], 1e-20f) + fabsf(now[3] - was[3]) / fmaxf(now[3], 1e-20f));
     for (uint32_t i = 0; i < a->texel_count; i++) {
         float *p = tc->pos + 3 * (size_t)i, *nr = tc->nrm + 3 * (size_t)i;
@@ -152,8 +148,8 @@ static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atla
         }
         float q[3], m[3];
         lm_texel_world(s, &a->texels[i], q, m);
-        float dx = sqrtf((q[0] - p[0]) * (q[0] - p[0]) + (q[1] - p[1]) * (q[1] - p[1]) + (q[2] - p[2]) * (q[2] - p[2]));
-        float turn = 1.0f - (m[0] * nr[0] + m[1] * nr[1] + m[2] * nr[2]);
+        float dx = lm_length(lm_sub(lm_v3_load(q), lm_v3_load(p)));
+        float turn = 1.0f - lm_dot(lm_v3_load(m), lm_v3_load(nr));
         tc->change[i] += fminf(1.0f, dx / fmaxf(now[3], 1e-20f) + turn);
         memcpy(p, q, sizeof q);
         memcpy(nr, m, sizeof m);
@@ -191,21 +187,20 @@ static void emitter_add(emitter *e, const float *p, const float *n, double area,
     e->surface = surface;
 }
 
-/* The emitters of the refreshed surfaces' changed texels, one per block (coarse) or one per surface.
- * Updates aim_seen. Returns how many (list sized for the worst case by the caller). */
+/* The emitters of the refreshed surfaces' changed texels since aim_seen, one per block or (coarse) one per
+ * surface. Returns how many (list sized for the worst case by the caller; slot: `cells` of scratch). */
 static int gather_emitters(lm_texel_change *tc, const lm_atlas *a, const float *aim_rgb, const uint8_t *refreshed,
-                           int coarse, emitter *list, int *slot)
+                           int coarse, emitter *list, int *slot, size_t cells)
 {
     int count = 0;
+    for (size_t k = 0; k < cells; k++)
+        slot[k] = -1;
     int bw = (a->width + BLOCK - 1) / BLOCK;
     for (uint32_t i = 0; i < a->texel_count; i++) {
         const lm_texel *t = &a->texels[i];
         if (!refreshed[t->surface])
             continue;
-        float *seen = tc->aim_seen + 3 * (size_t)i;
-        const float *now = aim_at(a, aim_rgb, i);
-        double dl = luminance3(now) - luminance3(seen);
-        memcpy(seen, now, 3 * sizeof(float));
+        double dl = lm_luminance(aim_at(a, aim_rgb, i)) - lm_luminance(tc->aim_seen + 3 * (size_t)i);
         if (dl == 0.0)
             continue;
         /* a block is keyed by its cell and surface; slot[] remembers the emitter of the last key seen
@@ -256,12 +251,12 @@ static void add_emitter(lm_texel_change *tc, const lm_atlas *a, const emitter *e
         if (a->texels[i].surface == e->surface)
             continue;
         const float *p = tc->pos + 3 * (size_t)i, *np = tc->nrm + 3 * (size_t)i;
-        float d[3] = {c[0] - p[0], c[1] - p[1], c[2] - p[2]};
-        float d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2], dl = sqrtf(d2);
+        lm_vec3 d = lm_sub(lm_v3_load(c), lm_v3_load(p));
+        float d2 = lm_dot(d, d), dl = sqrtf(d2);
         if (!(dl > 0.0f))
             continue;
-        float ct = (np[0] * d[0] + np[1] * d[1] + np[2] * d[2]) / dl;
-        float ce = -(n[0] * d[0] + n[1] * d[1] + n[2] * d[2]) / dl;
+        float ct = lm_dot(lm_v3_load(np), d) / dl;
+        float ce = -lm_dot(lm_v3_load(n), d) / dl;
         ce = fmaxf(ce, 0.0f) + spread;
         if (ct <= 0.0f || ce <= 0.0f || !sees_emitter(v, a, a->texels[i].surface, e->surface))
             continue;
@@ -278,35 +273,20 @@ void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const l
     int *slot = malloc(sizeof *slot * (cells ? cells : 1));
     double e_mean = mean_irradiance(a, aim_rgb);
     tc->mean_e = e_mean > 0.0 ? e_mean : tc->mean_e;
-    if (!list || !slot || !(tc->mean_e > 0.0)) { /* no memory or no light: the surface order alone */
-        for (uint32_t i = 0; i < a->texel_count; i++)
-            if (refreshed[a->texels[i].surface])
-                memcpy(tc->aim_seen + 3 * (size_t)i, aim_at(a, aim_rgb, i), 3 * sizeof(float));
-        free(list);
-        free(slot);
-        return;
-    }
-    /* blocks first; the same texels coarsened to surfaces when that is too much work. aim_seen is only
-     * written by the first pass, so a coarse pass reads the changes from a copy. */
-    float *seen = malloc(3 * sizeof(float) * (a->texel_count ? a->texel_count : 1));
-    if (seen)
-        memcpy(seen, tc->aim_seen, 3 * sizeof(float) * a->texel_count);
-    for (size_t k = 0; k < cells; k++)
-        slot[k] = -1;
-    int count = gather_emitters(tc, a, aim_rgb, refreshed, 0, list, slot);
-    if ((double)count * a->texel_count > LM_TEXEL_CHANGE_WORK && seen) {
-        float *now_seen = tc->aim_seen;
-        tc->aim_seen = seen, seen = now_seen;
-        for (size_t k = 0; k < cells; k++)
-            slot[k] = -1;
-        count = gather_emitters(tc, a, aim_rgb, refreshed, 1, list, slot);
-    }
     viewers v = {sched, s, rt, -1, malloc((size_t)(a->surface_count ? a->surface_count : 1))};
-    if ((double)count * a->texel_count <= LM_TEXEL_CHANGE_WORK && v.seen)
-        for (int e = 0; e < count; e++)
-            add_emitter(tc, a, &list[e], 1.0 / tc->mean_e, &v);
+    if (list && slot && v.seen && tc->mean_e > 0.0) { /* else (no memory, no light) the surface order alone */
+        /* blocks first; the same texels coarsened to surfaces when that is too much work */
+        int count = gather_emitters(tc, a, aim_rgb, refreshed, 0, list, slot, cells);
+        if ((double)count * a->texel_count > LM_TEXEL_CHANGE_WORK)
+            count = gather_emitters(tc, a, aim_rgb, refreshed, 1, list, slot, cells);
+        if ((double)count * a->texel_count <= LM_TEXEL_CHANGE_WORK)
+            for (int e = 0; e < count; e++)
+                add_emitter(tc, a, &list[e], 1.0 / tc->mean_e, &v);
+    }
+    for (uint32_t i = 0; i < a->texel_count; i++) /* what was seen: the changes are counted */
+        if (refreshed[a->texels[i].surface])
+            memcpy(tc->aim_seen + 3 * (size_t)i, aim_at(a, aim_rgb, i), 3 * sizeof(float));
     free(v.seen);
-    free(seen);
     free(list);
     free(slot);
 }
@@ -387,8 +367,14 @@ float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel)
     return tc->change[texel] + fabsf(tc->lit[texel]);
 }
 
-void lm_texel_change_clear(lm_texel_change *tc)
+void lm_texel_change_save(const lm_texel_change *tc, float *saved)
 {
-    memset(tc->change, 0, sizeof *tc->change * (tc->texel_count ? tc->texel_count : 1));
-    memset(tc->lit, 0, sizeof *tc->lit * (tc->texel_count ? tc->texel_count : 1));
+    memcpy(saved, tc->change, sizeof *saved * tc->texel_count);
+    memcpy(saved + tc->texel_count, tc->lit, sizeof *saved * tc->texel_count);
+}
+
+void lm_texel_change_restore(lm_texel_change *tc, const float *saved)
+{
+    memcpy(tc->change, saved, sizeof *saved * tc->texel_count);
+    memcpy(tc->lit, saved + tc->texel_count, sizeof *saved * tc->texel_count);
 }

@@ -75,7 +75,9 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
                               uint32_t *out);
 /* Texel t's change (header). */
 float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel);
-/* Zeroes every texel's change (all were just gathered: a bake, the first gather). */
-void lm_texel_change_clear(lm_texel_change *tc);
+/* saved (2 x texel_count floats) = every texel's change, for a bake that may be cancelled; restore gives it
+ * back (what the cancelled bake picked is picked again). */
+void lm_texel_change_save(const lm_texel_change *tc, float *saved);
+void lm_texel_change_restore(lm_texel_change *tc, const float *saved);
 
 #endif

@@ -26,12 +26,10 @@ struct lm_lightmap_path {
     int have_iim;
     lm_emitter_light emitters; /* with have_emitters: the gather's closed-form emitter light */
     int have_emitters;
-    uint32_t *texels;          /* scratch: the scheduled texels (twice the atlas's texel_count) */
+    uint32_t *texels;          /* scratch: the scheduled texels (atlas texel_count) */
     uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule */
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
-    uint32_t *seen;            /* per texel: the schedule that last listed it (duplicates dropped) */
-    uint32_t schedules;
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
     uint32_t switch_version;   /* the scene's pass_version the scheduler's switches follow */
     struct {                   /* whether the scene gives any light (follow_light): none, no gather */
@@ -181,11 +179,9 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
     lp->atlas = w->atlas;
     lp->rt = w->rt;
     lp->stage = stage;
-    /* twice the atlas: the texels picked ahead and the surfaces' may overlap before duplicates go */
-    lp->texels = malloc(sizeof(uint32_t) * 2 * ((size_t)w->atlas->texel_count + 1));
+    lp->texels = malloc(sizeof(uint32_t) * (w->atlas->texel_count ? w->atlas->texel_count : 1));
     lp->refreshed = malloc((size_t)w->atlas->surface_count + 1);
-    lp->seen = calloc(w->atlas->texel_count ? w->atlas->texel_count : 1, sizeof *lp->seen);
-    lm_status st = lp->texels && lp->refreshed && lp->seen ? LM_OK
+    lm_status st = lp->texels && lp->refreshed ? LM_OK
                                                : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop",
                                                          w->scene->path);
     if (st == LM_OK)
@@ -225,7 +221,6 @@ void lm_lightmap_path_free(lm_lightmap_path *lp)
         lm_texel_change_free(&lp->change);
     free(lp->texels);
     free(lp->refreshed);
-    free(lp->seen);
     free(lp);
 }
 
@@ -272,7 +267,8 @@ static int by_index(const void *a, const void *b)
 
 /* Texels into lp->texels: first at most `ahead` of those whose hemisphere changed most (texel_change.h),
  * committed on their own, then the surfaces' refreshes (iim_schedule.h: the budget left, or with `whole`,
- * a bake's, every candidate surface in full), less the texels already listed. */
+ * a bake's, every candidate surface in full), which skip the texels picked ahead: no texel is listed
+ * twice, so the atlas's texel_count holds them all. */
 static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int whole)
 {
     uint32_t n = 0;
@@ -282,22 +278,13 @@ static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int 
         lm_iim_commit_texels(&lp->iim, lp->atlas, lp->texels, n);
         lm_iim_sched_gathered(&lp->iim.sched, lp->texels, n, 1);
     }
-    uint32_t room = whole ? lp->atlas->texel_count : budget - n; /* a bake: every surface under way, whole */
+    uint32_t room = whole ? lp->atlas->texel_count : budget; /* a bake: every surface under way, whole */
     room = room < lp->atlas->texel_count ? room : lp->atlas->texel_count;
-    uint32_t m = lm_iim_sched_pick_up_to(&lp->iim.sched, store_of(lp), room, lp->texels + n);
-    if (n == 0 && !whole)
-        return m;
-    lp->schedules++;
-    for (uint32_t j = 0; j < n; j++)
-        lp->seen[lp->texels[j]] = lp->schedules;
-    uint32_t kept = n;
-    for (uint32_t j = n; j < n + m; j++)
-        if (lp->seen[lp->texels[j]] != lp->schedules)
-            lp->texels[kept++] = lp->texels[j];
+    uint32_t count = n + lm_iim_sched_pick_up_to(&lp->iim.sched, store_of(lp), room - n, lp->texels + n);
     if (whole) /* a bake: in atlas order, so that where a texel lands in the gather's passes (and its
                 * rounding) depends on which texels are gathered, not on how they were picked */
-        qsort(lp->texels, kept, sizeof *lp->texels, by_index);
-    return kept;
+        qsort(lp->texels, count, sizeof *lp->texels, by_index);
+    return count;
 }
 
 lm_status lm_lightmap_path_schedule(lm_lightmap_path *lp, uint32_t *count, lm_error *err)
@@ -332,12 +319,9 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
     lm_photon_store *ps = store_of(lp);
     int S = lp->iim.sched.surface_count;
     double *saved = malloc(sizeof *saved * (size_t)(S ? S : 1));
-    size_t T = lp->atlas->texel_count;
-    float *change = lp->have_change ? malloc(sizeof *change * (2 * T + 1)) : NULL;
-    if (change) { /* a cancelled bake gives back what it took, as delta_i */
-        memcpy(change, lp->change.change, sizeof *change * T);
-        memcpy(change + T, lp->change.lit, sizeof *change * T);
-    }
+    float *change = lp->have_change ? malloc(sizeof *change * (2 * (size_t)lp->atlas->texel_count + 1)) : NULL;
+    if (change) /* a cancelled bake gives back what it took, as delta_i */
+        lm_texel_change_save(&lp->change, change);
     if (!saved || (lp->have_change && !change)) {
         free(saved);
         free(change);
@@ -356,10 +340,8 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
     if (st != LM_OK) {
         lm_delta_i_restore(&lp->iim.sched, ps, saved);
         lm_iim_sched_gathered(&lp->iim.sched, lp->texels, n, 0);
-        if (change) {
-            memcpy(lp->change.change, change, sizeof *change * T);
-            memcpy(lp->change.lit, change + T, sizeof *change * T);
-        }
+        if (change)
+            lm_texel_change_restore(&lp->change, change);
         lp->iim.list_count = 0;
     } else {
         uint32_t before = 0, after = 0;
