@@ -1,10 +1,12 @@
-/* photon_store: O(1) add and remove in per-surface lists, free-slot reuse, and the change
- * accumulators (delta_f counts every hit, delta_i leaves out first hits from punctual lights). */
+/* photon_store: O(1) add and remove in per-surface lists, free-slot reuse, the change accumulators
+ * (delta_f counts every hit, delta_i leaves out first hits from punctual lights) and each surface's
+ * energy kept as hits come and go. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <cmocka.h>
 
+#include <math.h>
 #include <string.h>
 
 #include "../src/trace/photon_store.h"
@@ -198,6 +200,40 @@ static void test_clear_matches_fresh(void **state)
     lm_photon_store_free(&b);
 }
 
+/* Each surface's energy is the sum of its hits' as they come and go, whatever the order: within float
+ * summation of the walk after thousands of adds and removes of powers over nine decades, and exactly 0
+ * once a surface is empty. */
+static void test_energy_follows_hits(void **state)
+{
+    (void)state;
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 3, NULL), LM_OK);
+    uint32_t slots[3000];
+    uint32_t x = 12345;
+    for (int i = 0; i < 3000; i++) {
+        x = x * 1664525u + 1013904223u;
+        float power = powf(10.0f, (float)(x >> 8) / (float)(1u << 24) * 9.0f - 4.0f);
+        lm_hit h = make_hit(i % 3, (uint32_t)i, power, 1, 0);
+        slots[i] = lm_photon_store_add(&ps, &h);
+        if (i % 4 == 3) /* every fourth step removes an earlier hit */
+            lm_photon_store_remove(&ps, slots[(i * 7) % i]);
+    }
+    for (int s = 0; s < 3; s++) {
+        double walked = 0.0;
+        for (uint32_t h = ps.surfaces[s].head; h != LM_NONE; h = ps.hits[h].next)
+            walked += lm_hit_energy(&ps.hits[h]);
+        assert_true(walked > 0.0);
+        assert_true(fabs(ps.surfaces[s].energy - walked) <= 1e-9 * walked);
+    }
+    for (int i = 0; i < 3000; i++)
+        lm_photon_store_remove(&ps, slots[i]);
+    for (int s = 0; s < 3; s++) {
+        assert_int_equal(ps.surfaces[s].count, 0);
+        assert_true(ps.surfaces[s].energy == 0.0);
+    }
+    lm_photon_store_free(&ps);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -205,6 +241,7 @@ int main(void)
         cmocka_unit_test(test_free_list_reuse),
         cmocka_unit_test(test_deltas),
         cmocka_unit_test(test_clear_matches_fresh),
+        cmocka_unit_test(test_energy_follows_hits),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -943,14 +943,11 @@ static double mean_hit_energy(const lm_photon_store *ps)
 {
     double sum = 0.0;
     uint64_t n = 0;
-    for (int i = 0; i < ps->surface_count; i++)
+    for (int i = 0; i < ps->surface_count; i++) {
         n += ps->surfaces[i].count;
-    if (n == 0)
-        return 0.0;
-    for (uint32_t h = 0; h < ps->used; h++)
-        if (ps->hits[h].surface >= 0)
-            sum += lm_hit_energy(&ps->hits[h]);
-    return sum / (double)n;
+        sum += ps->surfaces[i].energy;
+    }
+    return n ? sum / (double)n : 0.0;
 }
 
 typedef struct {

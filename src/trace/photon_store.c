@@ -25,7 +25,7 @@ void lm_photon_store_clear(lm_photon_store *ps)
     for (int i = 0; i < ps->surface_count; i++) {
         ps->surfaces[i].head = LM_NONE;
         ps->surfaces[i].count = 0;
-        ps->surfaces[i].delta_f = ps->surfaces[i].delta_i = 0.0;
+        ps->surfaces[i].delta_f = ps->surfaces[i].delta_i = ps->surfaces[i].energy = 0.0;
     }
 }
 
@@ -101,7 +101,7 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
     if (d->next != LM_NONE)
         ps->hits[d->next].prev = d->prev;
     sh->count--;
-    lm_photon_store_account(ps, d);
+    lm_photon_store_account(ps, d, -1);
     d->surface = -1;
     d->prev = LM_NONE;
     d->next = ps->free_head;

@@ -35,6 +35,9 @@ typedef struct {
     uint32_t head;         /* first hit, LM_NONE if none */
     uint32_t count;
     double delta_f, delta_i;
+    double energy;         /* the energy of the hits it holds, kept as they come and go (0 when count is 0),
+                            * so that the mean hit energy costs a sum over surfaces, not a walk of every
+                            * hit (100 lights' photons: ~50 ms an AIM refresh) */
 } lm_surface_hits;
 
 typedef struct {
@@ -112,7 +115,8 @@ static inline lm_hit *lm_photon_store_claim(lm_photon_store *ps, int surface, ui
 }
 
 /* Both deltas of h's surface grow by its energy, whether it arrives or leaves: they measure change. */
-static inline void lm_photon_store_account(lm_photon_store *ps, const lm_hit *h)
+/* sign: +1 a hit linked, -1 one removed (the deltas count both). */
+static inline void lm_photon_store_account(lm_photon_store *ps, const lm_hit *h, int sign)
 {
     lm_surface_hits *sh = &ps->surfaces[h->surface];
     double e = lm_hit_energy(h);
@@ -120,6 +124,7 @@ static inline void lm_photon_store_account(lm_photon_store *ps, const lm_hit *h)
     sh->delta_f += e;
     if (lm_hit_in_iim(h))
         sh->delta_i += e;
+    sh->energy = sh->count ? sh->energy + sign * e : 0.0;
 }
 
 static inline void lm_photon_store_link(lm_photon_store *ps, uint32_t slot)
@@ -132,7 +137,7 @@ static inline void lm_photon_store_link(lm_photon_store *ps, uint32_t slot)
         ps->hits[sh->head].prev = slot;
     sh->head = slot;
     sh->count++;
-    lm_photon_store_account(ps, d);
+    lm_photon_store_account(ps, d, 1);
 }
 
 #endif
