@@ -584,6 +584,11 @@ typedef struct {
     double ms_gather, ms_blend, ms_direct, ms_caustics, ms_reflections, ms_composite, ms_total;
     int shadow_maps_rendered;  /* punctual lights' shadow maps re-rendered */
     int shadow_maps_stale;     /* stale ones left for the next updates (desc.frame.shadow_maps_per_update) */
+    /* the stage that took the update's longest time: "photons" (invalid groups re-traced), "AIM", "caustic
+     * photons", "reflections" (environment map faces), "gather" or "frame" (the picture's own passes), and
+     * why, in words: what it did, what still waits, and what the budget planned for it */
+    const char *busiest_stage;
+    char why[160];
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative
@@ -642,8 +647,10 @@ LMGI_API lmgi_status lmgi_bake(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi
                                lmgi_error *err);
 
 /* One frame's work at animation time `time` (seconds; animations clamp to their range). budget_ms > 0:
- * the texels regathered are chosen from the measured cost of the last updates so that the update takes
- * about budget_ms (never fewer than 1 texel when there is work); 0: desc.gather.texels_per_frame. stats may be
+ * one budget for every stage: the invalid photon groups re-traced, the AIM refreshes' hits, the caustic
+ * photons, the environment map faces and the texels regathered are chosen from each stage's measured cost
+ * in the last updates so that the update takes about budget_ms (never less than one unit of a stage that
+ * has work waiting); 0: the desc's fixed counts (gather.texels_per_frame, photons.group_budget, ...). stats may be
  * NULL. NULL u, a time or budget that is not finite, or a negative budget: LMGI_ERR_INVALID. A frame
  * that came out with a NaN or infinity: LMGI_ERR_BACKEND naming the first stage that has them (the AIMs,
  * the IIM lightmap, the caustics, else the direct light, reflections or composite). */

@@ -61,6 +61,48 @@ static int count_lines(const char *path)
     return n;
 }
 
+/* `lmgi run --budget MS`: frames.csv gives each update's texels allowed, the stage that took its longest
+ * time and why, in words that name the budget (docs/api.md, "The time budget"); without it, the fixed
+ * counts (20 texels). */
+static void test_run_budget_in_csv(void **state)
+{
+    (void)state;
+    const char *runs[2] = {"-q --budget 4", "-q"};
+    for (int k = 0; k < 2; k++) {
+        const char *dir = quick_run_with(k ? "fixed" : "budget", runs[k]);
+        char path[2048], line[1024];
+        snprintf(path, sizeof path, "%s/frames.csv", dir);
+        FILE *f = fopen(path, "r");
+        assert_non_null(f);
+        assert_non_null(fgets(line, sizeof line, f));
+        assert_non_null(strstr(line, ",texels_budget,busiest_stage,why"));
+        int rows = 0;
+        while (fgets(line, sizeof line, f)) {
+            const char *why = strchr(line, '"');
+            assert_non_null(why);
+            const char *stage = why - 1; /* the field before the quoted why */
+            while (stage > line && stage[-1] != ',')
+                stage--;
+            print_message("%s", line);
+            const char *names[] = {"photons,", "AIM,", "caustic photons,", "reflections,", "gather,", "frame,"};
+            int known = 0;
+            for (int i = 0; i < 6; i++)
+                known |= strncmp(stage, names[i], strlen(names[i])) == 0;
+            assert_true(known);
+            const char *texels = stage - 1; /* the field before: the texels allowed */
+            while (texels > line && texels[-1] != ',')
+                texels--;
+            if (k == 1)
+                assert_int_equal(atoi(texels), 20);
+            if (strncmp(stage, "frame,", 6) != 0)
+                assert_non_null(strstr(why, k ? "fixed counts" : "budget 4 ms"));
+            rows++;
+        }
+        fclose(f);
+        assert_int_equal(rows, 3);
+    }
+}
+
 static void test_writes_files(void **state)
 {
     (void)state;
@@ -643,6 +685,7 @@ int main(void)
         cmocka_unit_test(test_overlap_against_order),
         cmocka_unit_test(test_setup_progress),
         cmocka_unit_test(test_atlas_follows_budget),
+        cmocka_unit_test(test_run_budget_in_csv),
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_furnace_composite),
         cmocka_unit_test(test_reflections),

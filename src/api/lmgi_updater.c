@@ -389,7 +389,7 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->groups_retraced = st->photons.groups_retraced;
     o->aim_surfaces_refreshed = st->aim.surfaces_refreshed;
     o->texels_gathered = fs->texels_gathered;
-    o->texels_budget = fs->texel_budget;
+    o->texels_budget = fs->plan.texels;
     o->surfaces_changed = changed;
     o->caustic_photons_retraced = st->caustics.traced;
     o->caustic_tiles = fs->caustic.tiles;
@@ -413,6 +413,8 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->ms_reflections = 1e3 * fs->t_reflections;
     o->ms_composite = 1e3 * fs->t_composite;
     o->ms_total = 1e3 * fs->t_total;
+    o->busiest_stage = lm_stage_name(fs->busiest);
+    snprintf(o->why, sizeof o->why, "%s", fs->why);
 }
 
 static void bake_progress(void *user, double fraction, const char *stage)

@@ -46,7 +46,7 @@ typedef struct {
     const char *edits_path;   /* --edits SCRIPT.json (bench): a scripted edit sequence */
     int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */
     int random_edits;         /* --random-edits L (bench --soak): a random edit before each update, up to L lights */
-    float budget_ms;          /* --budget MS (bench --soak): lmgi_update's budget_ms (0: texels_per_frame) */
+    float budget_ms;          /* --budget MS (run, bench --soak): lmgi_update's budget_ms (0: the fixed counts) */
     int quick;                /* --quick (tradeoff): fewer values per knob, looser references */
     const char *knobs;        /* --knobs LIST (tradeoff): the knobs to sweep (NULL: all) */
     int word_count;           /* the words parsed (argv[first..argc)), as given: a shard records its */

@@ -159,9 +159,12 @@ const lm_cli_option lm_cli_options[] = {
      "bench --soak: a random edit before each update instead of the animation\n"
      "(nodes moved, lights and materials edited, lights added up to L and then\n"
      "added and removed; --seed picks them)"},
-    {"--budget", NULL, "MS", LM_CMD_BENCH, LM_OPT_FLOAT, offsetof(lm_cli_args, budget_ms), 0, 10000, NULL,
-     "bench --soak: each update's time budget in ms (lmgi_update's budget_ms;\n"
-     "default 0: --texels-per-frame texels)"},
+    {"--budget", NULL, "MS", LM_CMD_BENCH | LM_CMD_RUN, LM_OPT_FLOAT, offsetof(lm_cli_args, budget_ms), 0, 10000,
+     NULL,
+     "run, bench --soak: each update's time budget in ms, shared by every stage\n"
+     "(lmgi_update's budget_ms; frames.csv says which stage took the time and\n"
+     "why); default 0: the fixed counts (--texels-per-frame texels, ...), the\n"
+     "same lightmaps on every machine"},
     {"--edits", NULL, "SCRIPT.json", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_TEXT,
      offsetof(lm_cli_args, edits_path), 0, 0, NULL,
      "a scripted edit sequence (docs/bench.md); tradeoff: a comma-separated\n"

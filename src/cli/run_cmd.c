@@ -57,25 +57,28 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
 
 /* Every pass's work and milliseconds: the photon work (and its parts), the gather, the blend, the direct
  * light, the caustics (photons traced, tiles queried and lit, pixels filtered), the reflections (cube
- * faces rendered), the per-pixel photon gathers (run, list entries, record pages sent), the composite. */
+ * faces rendered), the per-pixel photon gathers (run, list entries, record pages sent), the composite;
+ * the texels the update was allowed, and the stage that took its longest time and why (its time budget). */
 static void csv_header(FILE *f)
 {
     fprintf(f, "frame,time_s,photons_retraced,groups_invalidated,groups_retraced,aim_surfaces_refreshed,"
                "texels_gathered,caustic_photons_retraced,caustic_tiles,caustic_tiles_lit,caustic_pixels_filtered,"
                "cube_faces_rendered,photon_gathers,photon_entries,photon_pages_uploaded,animate_ms,trace_ms,aim_ms,"
-               "caustic_trace_ms,photons_ms,gather_ms,blend_ms,direct_ms,caustics_ms,reflections_ms,composite_ms,frame_ms\n");
+               "caustic_trace_ms,photons_ms,gather_ms,blend_ms,direct_ms,caustics_ms,reflections_ms,composite_ms,frame_ms,"
+               "texels_budget,busiest_stage,why\n");
 }
 
 /* Flushed row by row: a full disk stops the run at the row it hits, not after the last frame. */
 static int csv_row(FILE *f, const lmgi_update_stats *s)
 {
     fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%u,%d,%d,%llu,%d,%d,%llu,%u,"
-               "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n",
+               "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%s,\"%s\"\n",
             s->frame, (double)s->time, s->photons_retraced, s->groups_invalidated, s->groups_retraced,
             s->aim_surfaces_refreshed, s->texels_gathered, s->caustic_photons_retraced, s->caustic_tiles,
             s->caustic_tiles_lit, (unsigned long long)s->caustic_pixels_filtered, s->cube_faces_rendered,
             s->photon_gathers, (unsigned long long)s->photon_entries, s->photon_pages_uploaded, s->ms_animate,
-            s->ms_trace, s->ms_aim, s->ms_caustic_trace, s->ms_photons, s->ms_gather, s->ms_blend, s->ms_direct, s->ms_caustics, s->ms_reflections, s->ms_composite, s->ms_total);
+            s->ms_trace, s->ms_aim, s->ms_caustic_trace, s->ms_photons, s->ms_gather, s->ms_blend, s->ms_direct, s->ms_caustics, s->ms_reflections, s->ms_composite, s->ms_total,
+            s->texels_budget, s->busiest_stage, s->why);
     return fflush(f) == 0 && !ferror(f);
 }
 
@@ -95,7 +98,7 @@ static lmgi_status write_pair(const run_state *r, const char *name, int w, int h
 static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
 {
     lmgi_update_stats fs;
-    if (lmgi_update(r->u, (float)f / FRAME_RATE, 0.0f, &fs, err) != LMGI_OK)
+    if (lmgi_update(r->u, (float)f / FRAME_RATE, r->a->budget_ms, &fs, err) != LMGI_OK)
         return err->status;
     int w, h;
     const float *img = lmgi_frame(r->u, &w, &h);

@@ -302,6 +302,7 @@ struct lm_caustics {
     uint64_t world_hash;     /* of every node matrix: a change starts a round-robin turn */
     uint32_t frame_cap;      /* most photons a frame traces: what the pairs at creation took when all moved
                               * at once and the round robin ran, so lights added later spread their work */
+    uint32_t frame_limit;    /* lm_caustics_limit_frame's (0: frame_cap) */
     /* scratch: the frame's jobs (slot numbers) and their fates */
     uint32_t *jobs;
     uint8_t *fates;            /* per job its fate, and whether its hit differs from the slot's before */
@@ -634,7 +635,7 @@ lm_status lm_caustics_frame(lm_caustics *c, lm_caustic_frame_stats *stats, lm_er
         int moved = h != c->world_hash;
         c->world_hash = h;
         uint32_t N = c->set.photons, per_frame = (uint32_t)ceil((double)c->set.retrace * N), n = 0;
-        uint32_t left = c->frame_cap;
+        uint32_t left = c->frame_limit ? c->frame_limit : c->frame_cap;
         per_frame = per_frame < 1 ? 1 : per_frame > N ? N : per_frame;
         /* first the pairs whose generator or emitter changed, whole (over several frames when more of them
          * than frame_cap allows), then the round robin of the others with what is left */
@@ -671,6 +672,15 @@ void lm_caustics_retrace_all_later(lm_caustics *c)
     for (int i = 0; i < c->pair_count; i++)
         if (!c->pairs[i].whole)
             c->pairs[i].whole = 1, c->pairs[i].whole_done = 0;
+}
+
+void lm_caustics_limit_frame(lm_caustics *c, uint32_t most) { c->frame_limit = most; }
+
+uint32_t lm_caustics_wanted(const lm_caustics *c)
+{
+    uint32_t N = c->set.photons, turn = (uint32_t)ceil((double)c->set.retrace * N);
+    uint64_t n = lm_caustics_pending(c) + (uint64_t)c->pair_count * (turn < 1 ? 1 : turn > N ? N : turn);
+    return n < c->frame_cap ? (uint32_t)n : c->frame_cap;
 }
 
 uint32_t lm_caustics_pending(const lm_caustics *c)

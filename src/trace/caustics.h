@@ -131,6 +131,12 @@ lm_status lm_caustics_trace_all(lm_caustics *c, lm_caustic_frame_stats *stats, l
 void lm_caustics_retrace_all_later(lm_caustics *c);
 /* Photons of whole re-traces still queued (0 once the frames have caught up). */
 uint32_t lm_caustics_pending(const lm_caustics *c);
+/* What the next frame would trace while things move: the queued whole re-traces and a round-robin turn of
+ * every pair, within the frame cap. */
+uint32_t lm_caustics_wanted(const lm_caustics *c);
+/* The photons the next frames trace at most, in place of the frame cap (a time budget's count,
+ * update/budget_plan.h); 0: the frame cap again. */
+void lm_caustics_limit_frame(lm_caustics *c, uint32_t most);
 /* Follows the emitter list's changes since c's pairs were laid out: the pairs of emitters appended (a
  * light added) are queued whole, those of removed lights dropped with their photon slots (a soak adding
  * and removing lights kept 3.2 MB of slots a removed light in the Cornell box), the others keep their

@@ -491,12 +491,12 @@ static lm_status round_robin(lm_photons *ph, lm_photon_frame_stats *st, lm_error
     return LM_OK;
 }
 
-/* Re-traces up to group_budget invalid groups, oldest first. */
+/* Re-traces up to group_budget (or the frame's limit) invalid groups, oldest first. */
 static lm_status drain(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
 {
-    uint32_t n = ph->queue_len;
-    if (ph->set.group_budget && ph->set.group_budget < n)
-        n = ph->set.group_budget;
+    uint32_t n = ph->queue_len, most = ph->frame_groups ? ph->frame_groups : ph->set.group_budget;
+    if (most && most < n)
+        n = most;
     for (uint32_t i = 0; i < n; i++)
         ph->tmp_groups[i] = pop_invalid(ph);
     return ph_trace_groups(ph, ph->tmp_groups, n, st, err);
@@ -514,6 +514,8 @@ lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_s
     finish_stats(ph, st, t0);
     return s;
 }
+
+void lm_photons_limit_groups(lm_photons *ph, uint32_t most) { ph->frame_groups = most; }
 
 /* ---- accessors ---- */
 

@@ -126,6 +126,9 @@ lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_
  * groups themselves (a light's placement or power, a material). stats may be NULL. Fails only when
  * memory runs out. */
 lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err);
+/* The invalid groups the next frames re-trace at most, in place of group_budget (a time budget's count,
+ * update/budget_plan.h); 0: group_budget again. */
+void lm_photons_limit_groups(lm_photons *ph, uint32_t most);
 
 /* Marks all groups of emitter e invalid (after it moved or changed: call lm_emitters_update first).
  * Groups already queued keep their place. Fails for an out-of-range emitter. */

@@ -71,6 +71,7 @@ struct lm_photons {
     const lm_rt *rt;
     const lm_emitters *em;
     lm_photon_settings set;
+    uint32_t frame_groups;     /* lm_photons_limit_groups's (0: set.group_budget) */
     float epsilon;             /* resolved settings.epsilon */
     float ray_offset;          /* origin offset along the normal when leaving a surface */
     uint32_t G, emitter_count, group_count, photon_count;

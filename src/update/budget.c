@@ -27,9 +27,13 @@ static double p95(const double *v, int n)
     return lm_quantile(sorted, n, 0.95);
 }
 
+static int window(const lm_cost_model *m) { return m->samples < LM_COST_WINDOW ? m->samples : LM_COST_WINDOW; }
+
+double lm_cost_model_price(const lm_cost_model *m) { return p95(m->per_unit, window(m)); }
+
 int lm_cost_model_units(const lm_cost_model *m, double budget_ms, int most)
 {
-    int n = m->samples < LM_COST_WINDOW ? m->samples : LM_COST_WINDOW;
+    int n = window(m);
     double per = p95(m->per_unit, n), rest = p95(m->rest, n);
     double units = (budget_ms - rest) / (per > 1e-6 ? per : 1e-6);
     double top = most > 0 ? most : 1;

@@ -1,6 +1,6 @@
 /* A time budget turned into work (DESIGN.md: budgets are update/'s): the cost model of one stage whose
- * work comes in units (the IIM gather's texels today; photon groups, AIM surfaces, shadow maps and
- * environment map faces are units of the same kind, each stage a model of its own).
+ * work comes in units (the IIM gather's texels, photon groups, AIM hits, caustic photons, environment
+ * map faces: each stage a model of its own, budget_plan.h shares the budget among them).
  *
  * Layout: the last LM_COST_WINDOW steps' milliseconds per unit of the stage and the milliseconds of the
  * rest of each step, a ring. Units that fit in budget_ms = (budget - p95(rest)) / p95(ms per unit): the
@@ -33,5 +33,7 @@ void lm_cost_model_seed(lm_cost_model *m, double ms_per_unit);
 void lm_cost_model_learn(lm_cost_model *m, double ms_stage, uint32_t units, double ms_rest);
 /* The units that fit in budget_ms, at least 1, at most `most`. */
 int lm_cost_model_units(const lm_cost_model *m, double budget_ms, int most);
+/* The 95th percentile of the milliseconds per unit (what lm_cost_model_units prices a unit at). */
+double lm_cost_model_price(const lm_cost_model *m);
 
 #endif

@@ -7,7 +7,7 @@
 #include "../core/memory.h"
 #include "../core/timing.h"
 #include "../scene/scene_view.h"
-#include "budget.h"
+#include "budget_plan.h"
 #include "frame_passes.h"
 #include "lightmap_path.h"
 #include "photon_path.h"
@@ -30,8 +30,8 @@ struct lm_frame_loop {
     lm_frame_passes *passes;
     float *image;
     lm_view view;
-    float budget_ms;             /* lm_frame_loop_set_budget's (0: set.iim.texels_per_frame a step) */
-    lm_cost_model gather_cost;   /* the gather's ms per texel and the rest of each step */
+    float budget_ms;             /* lm_frame_loop_set_budget's (0: the settings' fixed counts) */
+    lm_budget budget;            /* each stage's cost per unit (budget_plan.h) */
     int steps;                   /* steps done */
 };
 
@@ -96,11 +96,24 @@ static lm_status setup_gpu(lm_frame_loop *fl, double *t_gather, lm_error *err)
         st = lm_lightmap_path_first(fl->lightmaps, &t, err);
     if (t_gather)
         *t_gather = t;
-    /* the budget's first guess: the full gather's cost per texel (small per-step batches cost more per
-     * texel; the model corrects itself from the first step on) */
-    uint32_t texels = fl->world.atlas->texel_count;
-    lm_cost_model_seed(&fl->gather_cost, texels ? 1e3 * t / texels : 0.01);
     return st;
+}
+
+/* The budget's first guesses: the setup's full trace, AIM fill, caustic trace and gather per unit (small
+ * per-step batches cost more per unit; the models correct themselves from the second step on), and a
+ * cube face at half a millisecond until one is measured. */
+static void seed_budget(lm_frame_loop *fl, const lm_photon_stage_frame *setup, double t_gather)
+{
+    const lm_photons *ph = lm_photon_stage_photons(fl->stage);
+    uint32_t groups = ph ? lm_photons_group_count(ph) : 0, texels = fl->world.atlas->texel_count;
+    double ms[LM_STAGE_PLANNED] = {
+        [LM_STAGE_PHOTONS] = groups ? 1e3 * setup->t_photons / groups : 0.0,
+        [LM_STAGE_AIM] = setup->aim.hits_used ? 1e3 * setup->t_aim / (double)setup->aim.hits_used : 0.0,
+        [LM_STAGE_CAUSTICS] = setup->caustics.traced ? 1e3 * setup->t_caustics / setup->caustics.traced : 0.0,
+        [LM_STAGE_REFLECTIONS] = 0.5,
+        [LM_STAGE_GATHER] = texels ? 1e3 * t_gather / texels : 0.01,
+    };
+    lm_budget_seed(&fl->budget, ms);
 }
 
 /* What the frame loop adds per atlas texel to what lmgi_load holds (AIM, IIM double buffer, gather
@@ -129,10 +142,19 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
     size_t n = 3 * (size_t)fl->set.width * fl->set.height;
     if (st == LM_OK && !(fl->image = malloc((n ? n : 1) * sizeof(float))))
         st = lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop", w->scene->path);
+    lm_photon_stage_frame first;
+    memset(&first, 0, sizeof first);
+    double t_gather = 0.0;
     if (st == LM_OK)
-        st = lm_photon_stage_create(w, &fl->set.stage, &fl->stage, setup, err);
+        st = lm_photon_stage_create(w, &fl->set.stage, &fl->stage, &first, err);
     if (st == LM_OK)
-        st = setup_gpu(fl, t_setup_gather, err);
+        st = setup_gpu(fl, &t_gather, err);
+    if (st == LM_OK)
+        seed_budget(fl, &first, t_gather);
+    if (setup)
+        *setup = first;
+    if (t_setup_gather)
+        *t_setup_gather = t_gather;
     if (st == LM_OK && fl->set.overlap)
         st = lm_stage_worker_start(fl->stage, &fl->worker, err);
     if (st != LM_OK) {
@@ -223,12 +245,35 @@ static lm_status blend_and_render(lm_frame_loop *fl, lm_frame_stats *o, lm_error
     return st == LM_OK ? render(fl, o, err) : st;
 }
 
+/* The step's counts (budget_plan.h) for the work waiting once the animations played (moved lights queue
+ * their groups), before the stage's update and the schedule: with a budget each stage's from its cost
+ * model, without it the settings' own. */
+static void plan(lm_frame_loop *fl, lm_frame_stats *o)
+{
+    lm_budget_work *w = &o->waiting;
+    lm_photon_stage_waiting(fl->stage, &w->groups, &w->aim_surfaces, &w->caustic_photons);
+    w->faces = lm_frame_passes_faces(fl->passes);
+    w->texels = (int)fl->world.atlas->texel_count;
+    lm_budget_plan *p = &o->plan;
+    if (fl->budget_ms > 0.0f)
+        lm_budget_plan_step(&fl->budget, fl->budget_ms, w, p);
+    else {
+        memset(p, 0, sizeof *p);
+        p->texels = fl->set.iim.texels_per_frame;
+    }
+    lm_photon_stage_limits l = {p->groups, p->aim_hits, p->caustic_photons};
+    lm_photon_stage_limit(fl->stage, &l);
+    lm_frame_passes_limit_faces(fl->passes, p->faces);
+    lm_lightmap_path_set_texels_per_frame(fl->lightmaps, p->texels);
+}
+
 /* Animations and the scene bounds that follow from them: written here, on the calling thread, before
- * anything that reads them (the photon thread's update among them) starts. */
+ * anything that reads them (the photon thread's update among them) starts; then the step's plan. */
 static lm_status animate(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
     lm_scene_update_bounds(fl->world.scene);
+    plan(fl, o);
     return st;
 }
 
@@ -354,14 +399,70 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     return st;
 }
 
+/* The stages' costs of a step, each over the units it did (the first step, which uploads everything,
+ * is left out by the caller). */
+static void learn(lm_frame_loop *fl, const lm_frame_stats *o)
+{
+    const lm_photon_stage_frame *f = &o->stage;
+    const double ms[LM_STAGE_PLANNED] = {1e3 * f->t_photons, 1e3 * f->t_aim, 1e3 * f->t_caustics,
+                                         1e3 * o->t_reflections, 1e3 * o->t_gather};
+    const uint64_t units[LM_STAGE_PLANNED] = {f->photons.groups_retraced, f->aim.hits_used, f->caustics.traced,
+                                              (uint64_t)o->cube_faces, o->texels_gathered};
+    lm_budget_learn(&fl->budget, ms, units, 1e3 * o->t_total);
+}
+
+/* What the step's plan was, in words, for the why of its busiest stage. */
+static void plan_words(const lm_frame_loop *fl, const lm_frame_stats *o, lm_stage s, char *out, size_t size)
+{
+    if (fl->budget_ms > 0.0f)
+        snprintf(out, size, "budget %g ms, %.2f ms planned", (double)fl->budget_ms, o->plan.ms[s]);
+    else
+        snprintf(out, size, "fixed counts");
+}
+
+/* The stage that took the step's longest time, and why (lm_frame_stats.busiest, why). */
+static void report(const lm_frame_loop *fl, lm_frame_stats *o)
+{
+    const lm_photon_stage_frame *f = &o->stage;
+    const double t[LM_STAGE_COUNT] = {f->t_photons, f->t_aim, f->t_caustics, o->t_reflections, o->t_gather,
+                                      o->t_blend + o->t_direct + o->t_caustics + o->t_composite};
+    lm_stage b = LM_STAGE_PHOTONS;
+    for (int s = 1; s < LM_STAGE_COUNT; s++)
+        b = t[s] > t[b] ? (lm_stage)s : b;
+    o->busiest = b;
+    char plan[64];
+    plan_words(fl, o, b < LM_STAGE_PLANNED ? b : LM_STAGE_GATHER, plan, sizeof plan);
+    char *w = o->why;
+    size_t n = sizeof o->why;
+    switch (b) {
+    case LM_STAGE_PHOTONS:
+        snprintf(w, n, "%u invalid photon groups re-traced, %u still waiting (%s)", f->photons.groups_retraced,
+                 f->photons.pending_groups, plan);
+        break;
+    case LM_STAGE_AIM:
+        snprintf(w, n, "%d AIM surfaces refreshed (%llu hits), %d still over their threshold (%s)",
+                 f->aim.surfaces_refreshed, (unsigned long long)f->aim.hits_used, f->aim.surfaces_pending, plan);
+        break;
+    case LM_STAGE_CAUSTICS:
+        snprintf(w, n, "%u caustic photons traced, %u pairs whole as their generator or light moved (%s)",
+                 f->caustics.traced, f->caustics.pairs_moved, plan);
+        break;
+    case LM_STAGE_REFLECTIONS:
+        snprintf(w, n, "%d environment map faces rendered (%s)", o->cube_faces, plan);
+        break;
+    case LM_STAGE_GATHER:
+        snprintf(w, n, "%u texels gathered (%s)", o->texels_gathered, plan);
+        break;
+    default:
+        snprintf(w, n, "the frame's passes: blend %.2f ms, direct light %.2f ms, caustics %.2f ms, composite %.2f ms",
+                 1e3 * o->t_blend, 1e3 * o->t_direct, 1e3 * o->t_caustics, 1e3 * o->t_composite);
+    }
+}
+
 lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm_error *err)
 {
     lm_frame_stats o;
     memset(&o, 0, sizeof o);
-    int most = (int)fl->world.atlas->texel_count;
-    o.texel_budget = fl->budget_ms > 0.0f ? lm_cost_model_units(&fl->gather_cost, fl->budget_ms, most)
-                                          : fl->set.iim.texels_per_frame;
-    lm_lightmap_path_set_texels_per_frame(fl->lightmaps, o.texel_budget);
     double t0 = lm_now();
     lm_status st = enter(fl, err);
     if (st == LM_OK)
@@ -370,9 +471,9 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
         st = !fl->worker ? step_in_order(fl, t, &o, err)
              : fl->set.width > 0 ? step_overlapped(fl, t, &o, err) : step_detached(fl, t, &o, err);
     o.t_total = lm_now() - t0;
-    /* the budget's costs (the first step, which uploads everything, is left out) */
     if (st == LM_OK && fl->steps++ > 0)
-        lm_cost_model_learn(&fl->gather_cost, 1e3 * o.t_gather, o.texels_gathered, 1e3 * (o.t_total - o.t_gather));
+        learn(fl, &o);
+    report(fl, &o);
     if (out)
         *out = o;
     return st;

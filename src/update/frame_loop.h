@@ -72,9 +72,10 @@ typedef struct {
 lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progress, void *user,
                              const volatile int *cancel, lm_bake_stats *out, lm_error *err);
 
-/* The time the next steps may take, in ms (budget.h): the gather's texels a step are those that fit
- * beside the 95th percentile of the rest of recent steps, learnt from each step (at least 1, at most the
- * atlas); 0 (the default): the settings' iim.texels_per_frame. */
+/* The time the next steps may take, in ms, shared by every stage (budget_plan.h: photon groups, AIM
+ * hits, caustic photons, environment map faces and texels, each from its cost model learnt from the
+ * steps); 0 (the default): the settings' fixed counts (iim.texels_per_frame, the photons' group_budget,
+ * ...). lm_frame_stats says what each step was allowed and which stage took its time. */
 void lm_frame_loop_set_budget(lm_frame_loop *fl, float budget_ms);
 /* Renders the composited frame from `view` at width x height into rgb (width*height*3 linear floats, top
  * row first) with the lighting of the last step: lmgi_render's camera, beside the step's own frame. When

@@ -231,3 +231,6 @@ lm_status lm_frame_passes_read_caustics(const lm_frame_passes *fp, float *rgb, l
     }
     return lm_caustic_pass_read_irradiance(fp->caustic_pass, fp->caustic_slot, rgb, err);
 }
+
+int lm_frame_passes_faces(const lm_frame_passes *fp) { return lm_reflections_face_count(fp->reflections); }
+void lm_frame_passes_limit_faces(lm_frame_passes *fp, int most) { lm_reflections_limit_faces(fp->reflections, most); }

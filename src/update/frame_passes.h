@@ -56,6 +56,10 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
  * maps_per_update) and their counts in o. */
 lm_status lm_frame_passes_draw_step(lm_frame_passes *fp, const lm_frame_indirect *ind, const lm_view *view, int w,
                                     int h, float *rgb, lm_frame_stats *o, lm_error *err);
+/* The environment maps' faces (all of them: a step marks what changed as it renders), and the most the
+ * next steps render (lm_reflections_limit_faces). */
+int lm_frame_passes_faces(const lm_frame_passes *fp);
+void lm_frame_passes_limit_faces(lm_frame_passes *fp, int most);
 /* The caustic irradiance of the last picture drawn (lm_frame_loop_read_caustics says what). */
 void lm_frame_passes_caustics_size(const lm_frame_passes *fp, int *width, int *height);
 lm_status lm_frame_passes_read_caustics(const lm_frame_passes *fp, float *rgb, lm_error *err);

@@ -12,6 +12,7 @@
 #include "../gpu/gather/hemicube.h"
 #include "../gpu/gather/iim.h"
 #include "../gpu/tiled/photon_gather.h"
+#include "budget_plan.h"
 #include "photon_stage.h"
 
 enum { LM_INDIRECT_LIGHTMAP = 0, LM_INDIRECT_BRUTEFORCE = 1, LM_INDIRECT_TILED = 2, LM_INDIRECT_HASHGRID = 3 };
@@ -81,7 +82,6 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
 /* What a step did (lm_frame_loop_step). */
 typedef struct {
     lm_photon_stage_frame stage;
-    int texel_budget;      /* the texels the step was allowed (lm_frame_loop_set_budget) */
     uint32_t texels_gathered;
     lm_caustic_pass_stats caustic; /* the frame's caustic pass */
     int cube_faces;        /* environment map faces rendered */
@@ -94,6 +94,13 @@ typedef struct {
      * the frame's read-back), caustics (the screen-space pass), reflections (map faces and their pass),
      * composite (the indirect term's atlas pass); and the whole frame */
     double t_photons, t_gather, t_blend, t_direct, t_caustics, t_reflections, t_composite, t_total;
+    /* the time budget (budget_plan.h): the work waiting when the step was planned, the counts it was
+     * allowed (zeros but texels without a budget: the settings'), the stage that took the most time and
+     * why, in words */
+    lm_budget_work waiting;
+    lm_budget_plan plan;
+    lm_stage busiest;
+    char why[160];
 } lm_frame_stats;
 
 /* A bake's progress: fractions 0 to 1 and the stage ("photons", "gather", "done"). */

@@ -44,6 +44,9 @@ struct lm_photon_stage {
     uint64_t caustic_made;       /* times they were made (lm_photon_stage_caustics_version) */
     int have_emitters, have_aim, have_area;
     int frame;
+    uint64_t hit_bound;          /* worst_refresh at creation: the AIM refresh's bound without a budget */
+    lm_photon_stage_limits limit; /* a time budget's counts (lm_photon_stage_limit); zeros: the settings' */
+    int aim_waiting;             /* surfaces the last refresh left over their threshold */
 };
 
 void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
@@ -186,7 +189,10 @@ static lm_status make_caustics(lm_photon_stage *ps, lm_caustic_frame_stats *st, 
     ps->caustic_emitters = ps->emitters.count;
     ps->caustics_stale = 0;
     ps->caustic_made++;
-    return lm_caustics_create(ps->scene, ps->rt, &ps->emitters, &ps->set.caustic, &ps->caustics, st, err);
+    lm_status rc = lm_caustics_create(ps->scene, ps->rt, &ps->emitters, &ps->set.caustic, &ps->caustics, st, err);
+    if (ps->caustics) /* a budget's count holds for the new set's frames too */
+        lm_caustics_limit_frame(ps->caustics, ps->limit.caustic_photons);
+    return rc;
 }
 
 /* Whether edits changed what the caustic photons are made of: a class or switch (pass_version), an added
@@ -316,7 +322,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);
     if (st == LM_OK)
-        ps->aim.set.max_hits = worst_refresh(ps);
+        ps->aim.set.max_hits = ps->hit_bound = worst_refresh(ps);
     double t2 = lm_now();
     if (st == LM_OK && ps->set.caustics)
         st = make_caustics(ps, &first->caustics, err);
@@ -452,8 +458,13 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
     if (st == LM_OK && ps->set.trace)
         release_removed(ps);
     double t2 = lm_now();
-    if (st == LM_OK && ps->set.trace && ps->set.aims)
-        st = refresh_aims(ps, ps->set.surfaces_per_frame, &out->aim, err);
+    if (st == LM_OK && ps->set.trace && ps->set.aims) {
+        /* a budget's bound on hits takes any number of surfaces within it */
+        ps->aim.set.max_hits = ps->limit.aim_hits ? ps->limit.aim_hits : ps->hit_bound;
+        st = refresh_aims(ps, ps->limit.aim_hits ? ps->surfaces->surface_count : ps->set.surfaces_per_frame,
+                          &out->aim, err);
+        ps->aim_waiting = out->aim.surfaces_pending;
+    }
     double t3 = lm_now();
     if (st == LM_OK)
         st = update_caustics(ps, out, err);
@@ -512,6 +523,22 @@ lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }
 const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps) { return ps->caustics; }
+
+void lm_photon_stage_limit(lm_photon_stage *ps, const lm_photon_stage_limits *l)
+{
+    ps->limit = *l;
+    if (ps->photons)
+        lm_photons_limit_groups(ps->photons, l->groups);
+    if (ps->caustics)
+        lm_caustics_limit_frame(ps->caustics, l->caustic_photons);
+}
+
+void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, int *aim_surfaces, uint32_t *caustic_photons)
+{
+    *groups = ps->photons && ps->set.trace ? lm_photons_pending_groups(ps->photons) : 0;
+    *aim_surfaces = ps->aim_waiting;
+    *caustic_photons = ps->caustics ? lm_caustics_wanted(ps->caustics) : 0;
+}
 
 uint64_t lm_photon_stage_caustics_version(const lm_photon_stage *ps)
 {

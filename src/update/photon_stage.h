@@ -70,6 +70,20 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage
  * thread. */
 int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
 
+/* What a time budget allows the next updates (update/budget_plan.h): invalid photon groups re-traced, the
+ * AIM refresh's bound on stored hits (then any number of surfaces within it; its first surface always),
+ * caustic photons traced; each 0: the settings' own count. Not while an update runs on another thread. */
+typedef struct {
+    uint32_t groups;
+    uint64_t aim_hits;
+    uint32_t caustic_photons;
+} lm_photon_stage_limits;
+void lm_photon_stage_limit(lm_photon_stage *ps, const lm_photon_stage_limits *l);
+/* The work waiting: invalid photon groups queued, the surfaces the last AIM refresh left over their
+ * threshold, the caustic photons the next update would trace (lm_caustics_wanted). */
+void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, int *aim_surfaces,
+                             uint32_t *caustic_photons);
+
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps);

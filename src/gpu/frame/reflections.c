@@ -25,6 +25,7 @@ typedef struct {
 
 struct lm_reflections {
     int size, faces_per_frame, levels;
+    int frame_faces; /* lm_reflections_limit_faces's (0: faces_per_frame) */
     reflector *r;
     int count;
     long frame;        /* updates so far */
@@ -315,7 +316,7 @@ lm_status lm_reflections_update(lm_reflections *r, lm_direct *d, const lm_scene 
     r->frame++;
     lm_status st = mark_changes(r, s, in, err);
     /* the first update renders every face, then at most faces_per_frame, the longest dirty first */
-    int budget = r->primed ? r->faces_per_frame : 6 * r->count;
+    int budget = !r->primed ? 6 * r->count : r->frame_faces ? r->frame_faces : r->faces_per_frame;
     for (int i = 0; st == LM_OK && i < budget; i++) {
         int f = oldest_dirty(r);
         if (f < 0)
@@ -332,6 +333,14 @@ lm_status lm_reflections_update(lm_reflections *r, lm_direct *d, const lm_scene 
     r->primed = 1;
     return st == LM_OK ? lm_gl_check("reflections: maps", err) : st;
 }
+
+void lm_reflections_limit_faces(lm_reflections *r, int most)
+{
+    if (r)
+        r->frame_faces = most > 0 ? most : 0;
+}
+
+int lm_reflections_face_count(const lm_reflections *r) { return r ? 6 * r->count : 0; }
 
 int lm_reflections_dirty_faces(const lm_reflections *r)
 {

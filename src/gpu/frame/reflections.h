@@ -61,6 +61,11 @@ typedef struct {
  * this frame); *faces gets how many. */
 lm_status lm_reflections_update(lm_reflections *r, lm_direct *d, const lm_scene *s, const lm_emitters *em,
                                 const lm_reflection_inputs *in, int *faces, lm_error *err);
+/* The faces the next updates render at most, in place of faces_per_frame (a time budget's count,
+ * update/budget_plan.h); 0: faces_per_frame again. NULL: nothing. */
+void lm_reflections_limit_faces(lm_reflections *r, int most);
+/* Faces of all the maps (6 a map; 0 for NULL). */
+int lm_reflections_face_count(const lm_reflections *r);
 /* Faces still dirty after the last update (0 for NULL). */
 int lm_reflections_dirty_faces(const lm_reflections *r);
 /* Adds the reflections to the frame d just drew from view (lm_direct_draw; depth test against its depth). */

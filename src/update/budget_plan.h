@@ -1,0 +1,78 @@
+/* One time budget for every stage of an update (lm_frame_loop_set_budget; docs/api.md, "The time
+ * budget"): how budget_ms is shared by the photon thread's stages (invalid photon groups re-traced, AIM
+ * refreshes, caustic photons) and the calling thread's (environment map faces, the IIM gather), each
+ * stage's count from a cost model of its own (budget.h) learnt from the updates on this machine.
+ *
+ * The share. The photon thread's stages take at most half of the budget, in pipeline order: the photons
+ * what their invalid groups need, the AIMs what the photons left, the caustic photons the rest of that
+ * half. The environment map faces take at most an eighth. The gather fills what the 95th percentile of
+ * everything else in recent updates left (lm_cost_model_units). A stage with work waiting gets at least
+ * one unit however dear: an update never does nothing while something is stale, and a stage that never
+ * fits is not starved (its unit may then pass the budget: one AIM surface's refresh is not split).
+ * Without a budget (budget_ms 0) the plan is the settings' fixed counts, the same on every machine.
+ *
+ * The units: a photon group, a stored hit put in an AIM refresh's kd-trees, a caustic photon, a cube
+ * face, a texel. Each model is seeded from the updater's setup (the full trace, every AIM, every caustic
+ * photon, every face, the full gather) and learns from every update that did some of its work, so a
+ * small batch's fixed costs count into its units' price (the plan errs on the side of less work).
+ *
+ * Invariants: every model seeded before the first plan. Cost: O(LM_COST_WINDOW log LM_COST_WINDOW) per
+ * stage a plan. Not thread-safe: the frame loop's calling thread plans and learns. No errors. */
+#ifndef LM_BUDGET_PLAN_H
+#define LM_BUDGET_PLAN_H
+
+#include <stdint.h>
+
+#include "budget.h"
+
+/* The stages an update's time goes to; the last, the frame's own passes (blend, direct light, caustic
+ * pass, composite), is not planned: it is what the scene and picture cost. */
+typedef enum {
+    LM_STAGE_PHOTONS,
+    LM_STAGE_AIM,
+    LM_STAGE_CAUSTICS,
+    LM_STAGE_REFLECTIONS,
+    LM_STAGE_GATHER,
+    LM_STAGE_FRAME,
+    LM_STAGE_COUNT
+} lm_stage;
+
+#define LM_STAGE_PLANNED LM_STAGE_FRAME /* the stages with a cost model */
+
+/* "photons", "AIM", "caustic photons", "reflections", "gather", "frame". */
+const char *lm_stage_name(lm_stage s);
+
+typedef struct {
+    lm_cost_model cost[LM_STAGE_PLANNED];
+} lm_budget;
+
+/* The work waiting when an update is planned (what the stages reported last). */
+typedef struct {
+    uint32_t groups;          /* invalid photon groups queued */
+    int aim_surfaces;         /* AIM surfaces over their refresh threshold, left by the last refresh */
+    uint32_t caustic_photons; /* caustic photons queued for whole re-traces */
+    int faces;                /* environment map faces (all: an update marks the dirty ones as it goes) */
+    int texels;               /* the most texels a step may gather (the atlas) */
+} lm_budget_work;
+
+/* What the update may do: 0 for groups, aim_hits, caustic_photons or faces means the settings' own
+ * count (no budget, or a stage with no model). */
+typedef struct {
+    uint32_t groups;          /* invalid photon groups re-traced, oldest first */
+    uint64_t aim_hits;        /* the AIM refresh's bound on stored hits (its first surface always taken) */
+    uint32_t caustic_photons; /* caustic photons traced (whole re-traces first, then the round robin) */
+    int faces;                /* environment map faces rendered */
+    int texels;               /* IIM texels gathered */
+    double ms[LM_STAGE_PLANNED]; /* the milliseconds the plan expects each to take */
+} lm_budget_plan;
+
+/* ms_per_unit: each planned stage's first guess (<= 0: a stage the setup did not measure; 1e-3 ms). */
+void lm_budget_seed(lm_budget *b, const double ms_per_unit[LM_STAGE_PLANNED]);
+/* The plan of one update within budget_ms (> 0) for the work waiting. */
+void lm_budget_plan_step(const lm_budget *b, double budget_ms, const lm_budget_work *w, lm_budget_plan *out);
+/* One update's costs: each planned stage's milliseconds over the units it did (0 units: nothing
+ * learnt for it), and the whole update's milliseconds (the gather's rest is the update less the gather). */
+void lm_budget_learn(lm_budget *b, const double ms[LM_STAGE_PLANNED], const uint64_t units[LM_STAGE_PLANNED],
+                     double ms_total);
+
+#endif
