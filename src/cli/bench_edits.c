@@ -6,6 +6,7 @@
 #include <lmgi.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "edit_script.h"
 #include "order_stats.h"
@@ -32,6 +33,31 @@ static void report_reads(const lm_edit_script *s, const lm_edit_frame *rows)
     free(rects);
     free(texels);
     free(tex);
+}
+
+
+/* How often each stage took an update's longest time (lmgi_update_stats.busiest_stage), most first. */
+static void print_busiest(const lm_edit_script *s, const lm_edit_frame *rows)
+{
+    const char *names[8];
+    int count[8], kinds = 0;
+    for (int f = 0; f < s->frames; f++) {
+        int k = 0;
+        while (k < kinds && strcmp(names[k], rows[f].busiest) != 0)
+            k++;
+        if (k == kinds)
+            names[kinds] = rows[f].busiest, count[kinds++] = 0; /* at most the 6 stage names */
+        count[k]++;
+    }
+    printf("the stage that took the most time:");
+    for (int done = 0; done < kinds; done++) {
+        int best = -1;
+        for (int k = 0; k < kinds; k++)
+            best = count[k] >= 0 && (best < 0 || count[k] > count[best]) ? k : best; /* -1: printed */
+        printf("%s %s in %d", done ? "," : "", names[best], count[best]);
+        count[best] = -1;
+    }
+    printf(" of %d updates\n", s->frames);
 }
 
 static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_frame *rows)
@@ -86,6 +112,7 @@ static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_f
         printf("updates: median %.2f ms, 95th percentile %.2f ms, worst %.2f ms; %d of %d over the budget by more "
                "than 10%%; %.1f texels an update\n", ms[s->frames / 2], p95,
                ms[s->frames - 1], over, s->frames, texels / s->frames);
+        print_busiest(s, rows);
         int n = 0; /* the edits' own calls: staged, they wait for no photon work (update/edits.h) */
         for (int f = 0; f < s->frames; f++)
             if (rows[f].ms_edit > 0.0)
