@@ -102,6 +102,23 @@ static void update(lmgi_updater *u, float budget, lmgi_update_stats *st)
     }
 }
 
+/* A small updater whose photon work runs in order, so that the counts an update reports are its own; a
+ * frame of side x side (0: none) with small environment maps and caustics. */
+static lmgi_updater *in_order_updater(lmgi_context *ctx, lmgi_scene *sc, int side)
+{
+    lmgi_updater_desc d;
+    lmt_room_desc(&d);
+    d.in_order = 1;
+    d.frame.width = d.frame.height = side;
+    d.frame.reflection_size = 16;
+    d.caustics.photons = 4096;
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
 /* A light dimmed: its 72 groups wait. Without a budget an update re-traces group_budget (16) of them; at
  * a budget too small for anything one, and one AIM surface, one texel; at a generous one all that wait. */
 static void test_budget_governs_photons_and_aims(void **state)
@@ -109,13 +126,8 @@ static void test_budget_governs_photons_and_aims(void **state)
     (void)state;
     lmgi_context *ctx = lmt_context();
     lmgi_scene *sc = lmt_load(lmt_project_scene("two_rooms.glb"), 1500);
-    lmgi_updater_desc d;
-    lmt_room_desc(&d);
-    d.in_order = 1; /* the counts an update reports are its own */
-    d.frame.width = d.frame.height = 0;
-    lmgi_updater *u = NULL;
+    lmgi_updater *u = in_order_updater(ctx, sc, 0);
     lmgi_error e;
-    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_OK);
     lmgi_update_stats st;
     for (int i = 0; i < 3; i++)
         update(u, 0.0f, &st);
@@ -162,15 +174,8 @@ static void test_budget_governs_faces_and_caustics(void **state)
     (void)state;
     lmgi_context *ctx = lmt_context();
     lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), 1500);
-    lmgi_updater_desc d;
-    lmt_room_desc(&d);
-    d.in_order = 1;
-    d.frame.width = d.frame.height = 32;
-    d.frame.reflection_size = 16;
-    d.caustics.photons = 4096;
-    lmgi_updater *u = NULL;
+    lmgi_updater *u = in_order_updater(ctx, sc, 32);
     lmgi_error e;
-    assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_OK);
     int cube = lmgi_find_node(sc, "dynamic_cube");
     float m[16];
     lmgi_get_node_transform(sc, cube, m);
