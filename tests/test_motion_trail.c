@@ -4,7 +4,7 @@
  * surfaces by their photons' change) the moving cube's own faces, whose photons hardly change, wait
  * behind the floor for good: a block of them is 2.1 times off after 60 updates and growing (the mean of
  * the samples' worst blocks 1.11). With texels picked by the change of what they see, the worst block is
- * 0.86 off and that mean 0.50. Both updaters run side by side on the same scene and times, so the test
+ * 0.66 off and that mean 0.43. Both updaters run side by side on the same scene and times, so the test
  * shows the difference it guards. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -117,8 +117,10 @@ static void test_moving_cube_followed_texel_by_texel(void **state)
                   "samples' worst %.2f) with whole surfaces only, %.2f (%.2f) with texels ahead\n",
                   FRAMES, worst[0], sum[0] / samples, worst[1], sum[1] / samples);
     assert_true(worst[0] > 1.5);  /* the stall this guards against (2.06 measured) */
-    assert_true(worst[1] < 1.2);  /* 0.86 measured (the frame budget, 20 texels, is spent every update) */
-    assert_true(sum[1] / samples < 0.6 * sum[0] / samples); /* 0.50 against 1.11 */
+    /* 0.66 and 0.43 measured (the frame budget, 20 texels, is spent every update); 0.86 and 0.50 while the
+     * texels a surface's refresh gathered kept their change, and the bar to go ahead with it */
+    assert_true(worst[1] < 0.8);
+    assert_true(sum[1] / samples < 0.45 * sum[0] / samples); /* 0.43 against 1.11 */
     for (int k = 0; k < 2; k++) {
         lmgi_updater_free(u[k]);
         lmgi_free(sc[k]);

@@ -362,6 +362,12 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
     return n;
 }
 
+void lm_texel_change_gathered(lm_texel_change *tc, const uint32_t *texels, uint32_t count)
+{
+    for (uint32_t j = 0; j < count; j++)
+        tc->change[texels[j]] = tc->lit[texels[j]] = 0.0f;
+}
+
 float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel)
 {
     return tc->change[texel] + fabsf(tc->lit[texel]);

@@ -281,6 +281,8 @@ static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int 
     uint32_t room = whole ? lp->atlas->texel_count : budget; /* a bake: every surface under way, whole */
     room = room < lp->atlas->texel_count ? room : lp->atlas->texel_count;
     uint32_t count = n + lm_iim_sched_pick_up_to(&lp->iim.sched, store_of(lp), room - n, lp->texels + n);
+    if (lp->have_change)
+        lm_texel_change_gathered(&lp->change, lp->texels + n, count - n);
     if (whole) /* a bake: in atlas order, so that where a texel lands in the gather's passes (and its
                 * rounding) depends on which texels are gathered, not on how they were picked */
         qsort(lp->texels, count, sizeof *lp->texels, by_index);
