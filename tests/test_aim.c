@@ -593,6 +593,63 @@ static void test_batch_matches_single(void **state)
     ts_free(&t);
 }
 
+/* A dense surface (every texel with N hits within its smallest radius: 90,000 hits on 400 texels) is
+ * estimated without a kd-tree, from the same hits: its radiance and error estimate equal the kd-tree's to
+ * float rounding, for both kernels. With hits on a quarter of the plane only it is not dense (the other
+ * texels have fewer than N): the kd-tree's estimate, to the bit. */
+static void test_dense_surface_without_kdtree(void **state)
+{
+    (void)state;
+    lmt_mesh m;
+    square_mesh(&m, 2.0f);
+    tscene t;
+    ts_load(&t, &m, 1, "[{\"name\": \"plane\", \"mesh\": 0}]", 0.2f);
+    const float E[1] = {2.0f}, above[3] = {0.0f, 5.0f, 0.0f};
+    for (int half = 0; half < 2; half++)
+        for (int kernel = 0; kernel < 2; kernel++) {
+            lm_photon_store ps;
+            assert_int_equal(lm_photon_store_init(&ps, 1, NULL), LM_OK);
+            g_rng = 3;
+            add_hits(&ps, &t, 0, -2.0f, -2.0f, half ? 2.0f : 4.0f, 300, density_const, E, 1.0f, above);
+            lm_aim aim[2];
+            lm_aim_stats st[2];
+            for (int dense = 0; dense < 2; dense++) {
+                lm_aim_settings set;
+                lm_aim_settings_default(&set);
+                set.kernel = kernel;
+                set.error_estimate = 1;
+                set.dense = dense;
+                init_aim(&aim[dense], &t, &set);
+                assert_int_equal(lm_aim_refresh_all(&aim[dense], t.s, &t.su, &t.a, &ps, &st[dense], NULL), LM_OK);
+            }
+            assert_int_equal(st[0].surfaces_binned, 0);
+            assert_int_equal(st[1].surfaces_binned, half ? 0 : 1);
+            double worst = 0.0, worst_error = 0.0;
+            for (uint32_t i = 0; i < t.a.texel_count; i++) {
+                const lm_texel *tx = &t.a.texels[i];
+                size_t at = (size_t)tx->y * (size_t)aim[0].width + (size_t)tx->x;
+                for (int c = 0; c < 3; c++) {
+                    double a = aim_px(&aim[0], tx)[c], b = aim_px(&aim[1], tx)[c];
+                    worst = fmax(worst, fabs(a - b) / fmax(fabs(a), 1e-30));
+                }
+                double ea = aim[0].error[2 * at], eb = aim[1].error[2 * at];
+                worst_error = fmax(worst_error, fabs(ea - eb) / fmax(ea, 1e-30));
+                assert_true(aim[0].error[2 * at + 1] == aim[1].error[2 * at + 1]); /* the radius */
+            }
+            print_message("%s plane, kernel %d: kd-tree %.1f ms, %s %.1f ms; radiance within %.2g, error within "
+                          "%.2g\n", half ? "quarter-lit" : "lit", kernel, 1e3 * st[0].seconds,
+                          half ? "again the kd-tree" : "binned", 1e3 * st[1].seconds, worst, worst_error);
+            if (half)
+                assert_true(worst == 0.0 && worst_error == 0.0);
+            else
+                assert_true(worst < 1e-6 && worst_error < 1e-6);
+            for (int k = 0; k < 2; k++)
+                lm_aim_free(&aim[k]);
+            lm_photon_store_free(&ps);
+        }
+    ts_free(&t);
+}
+
 static void test_bad_settings(void **state)
 {
     (void)state;
@@ -625,6 +682,7 @@ int main(void)
         cmocka_unit_test(test_schedule),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_batch_matches_single),
+        cmocka_unit_test(test_dense_surface_without_kdtree),
         cmocka_unit_test(test_bad_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

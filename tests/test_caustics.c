@@ -457,8 +457,10 @@ static void test_regular_photons_mark_caustic_hits(void **state)
     }
     for (int k = 0; k < ps->surface_count; k++) {
         iim += lm_photon_store_iim_energy(ps, k);
-        for (uint32_t h = ps->surfaces[k].head; h != LM_NONE; h = ps->hits[h].next)
-            all += lm_hit_energy(&ps->hits[h]) * !(ps->hits[h].bounce == 0 && ps->hits[h].source == LM_HIT_FROM_PUNCTUAL);
+        for (uint32_t j = 0; j < ps->surfaces[k].count; j++) {
+            const lm_hit *h = &ps->hits[ps->surfaces[k].slots[j]];
+            all += lm_hit_energy(h) * !(h->bounce == 0 && h->source == LM_HIT_FROM_PUNCTUAL);
+        }
     }
     print_message("%u caustic hits marked (%.4f of the energy), %u marked wrong; IIM energy %.4f = all but first "
                   "punctual hits %.4f less caustic %.4f\n", marked, caustic_energy, wrong, iim, all, caustic_energy);

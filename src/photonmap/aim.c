@@ -22,6 +22,8 @@ void lm_aim_settings_default(lm_aim_settings *o)
     o->boundary_correction = 1;
     o->kernel = 1;
     o->error_estimate = 0;
+    o->dense = 1;
+    o->max_hits = 0;
 }
 
 /* ---------- init: per-surface texel lists and boundary edges ---------- */
@@ -346,8 +348,9 @@ static lm_status gather_hits(const lm_photon_store *ps, int surface, const lm_sc
     out->flux = malloc(sizeof *out->flux * 4 * (n ? n : 1));
     if (!out->pos || !out->flux)
         return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u hits of surface %d", n, surface);
-    for (uint32_t h = ps->surfaces[surface].head; h != LM_NONE && out->count < n; h = ps->hits[h].next) {
-        const lm_hit *hit = &ps->hits[h];
+    const uint32_t *slots = ps->surfaces[surface].slots;
+    for (uint32_t k = 0; k < n; k++) {
+        const lm_hit *hit = &ps->hits[slots[k]];
         if ((front_only && !arrives_front(L, s, hit)) || (direct && lm_direct_covers_hit(direct, hit)))
             continue;
         memcpy(out->pos + 3 * out->count, hit->local, sizeof hit->local);
@@ -505,6 +508,8 @@ typedef struct {
     const lm_direct_light *direct; /* NULL: no direct light added */
     const float *world;   /* the node's world matrix (texel positions for the direct light) */
     int two_sided;        /* double-sided material: direct light on both sides */
+    const double *binned; /* a dense surface's sums (bin_dense_surface), per texel of its list: w Phi (4) and
+                           * sum (w Y)^2; NULL: the kd-tree's estimates */
 } estimate_job;
 
 typedef struct {
@@ -624,24 +629,30 @@ typedef struct {
 
 /* E = sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
  * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. 0 without hits. */
-static void photon_irradiance(const estimate_job *j, const lm_texel *t, texel_scratch *ts, float *edge_d2,
-                              double out[3], estimate_error *ee)
+static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t slot, texel_scratch *ts,
+                              float *edge_d2, double out[3], estimate_error *ee)
 {
     out[0] = out[1] = out[2] = 0.0;
     if (j->n == 0)
         return;
-    float r2 = 0.0f, *d2 = ts->d2;
-    uint32_t *idx = ts->idx, k = find_nearest(j, &ts->hint, t->local, idx, d2, &r2);
-    if (k == 0)
-        return;
     const tri_frame *tf = triangle_frame(j, t->tri, &ts->tri);
     const double *n = tf->n;
     double factor = tf->factor, rmin2 = j->rmin2_world / factor;
-    int widened = (double)r2 < rmin2;
+    float r2 = 0.0f, *d2 = ts->d2;
+    uint32_t *idx = ts->idx, k = 0;
+    int widened = j->binned != NULL; /* a dense surface's: every texel had N hits within the radius */
+    if (!widened) {
+        k = find_nearest(j, &ts->hint, t->local, idx, d2, &r2);
+        if (k == 0)
+            return;
+        widened = (double)r2 < rmin2;
+    }
     if (widened)
         r2 = (float)rmin2;
     flux_sum f = {j->hits->flux, j->kernel ? 1.0 / r2 : 0.0, {0.0, 0.0, 0.0, 0.0}};
-    if (widened)
+    if (j->binned)
+        memcpy(f.sum, j->binned + 5 * (size_t)slot, sizeof f.sum);
+    else if (widened)
         lm_kdtree_radius(j->tree, t->local, r2, add_flux, &f);
     else
         add_found(&f, idx, d2, k);
@@ -655,7 +666,9 @@ static void photon_irradiance(const estimate_job *j, const lm_texel *t, texel_sc
         out[c] = f.sum[c] / (area * factor);
     if (ee->on) { /* only when asked: a second walk over the same hits */
         square_sum q = {j->hits->flux, f.inv_r2, {ee->y[0], ee->y[1], ee->y[2]}, 0.0};
-        if (widened)
+        if (j->binned)
+            q.sum = j->binned[5 * (size_t)slot + 4];
+        else if (widened)
             lm_kdtree_radius(j->tree, t->local, r2, add_square, &q);
         else
             for (uint32_t i = 0; i < k; i++)
@@ -697,7 +710,7 @@ static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index,
 
 /* L = rho / pi (E_photons + E_direct); with error (NULL: not kept) the texel's relative standard error and
  * radius (lm_aim.error). */
-static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts,
+static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t index, uint32_t slot, texel_scratch *ts,
                            float *edge_d2, float out[3], float *error)
 {
     float rho[3];
@@ -706,7 +719,7 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t in
     estimate_error ee = {error != NULL, {lum[0] * rho[0] / LM_PI, lum[1] * rho[1] / LM_PI, lum[2] * rho[2] / LM_PI},
                          0.0, 0.0};
     double e[3];
-    photon_irradiance(j, t, ts, edge_d2, e, &ee);
+    photon_irradiance(j, t, slot, ts, edge_d2, e, &ee);
     if (j->direct)
         add_direct(j, t, index, ts, e);
     for (int c = 0; c < 3; c++)
@@ -777,11 +790,147 @@ typedef struct {
     int surface;
     hit_set hits;
     lm_kdtree tree;
+    double *binned;       /* bin_dense_surface's sums, or NULL */
     linear_map L;
     estimate_job job;
     lm_status rc;
     lm_error err;
 } surface_job;
+
+/* A surface is dense when it holds at least this many hits per texel and N (the many lights' floor of a
+ * soak: 250,000 hits for 144 texels, whose kd-tree took 30-50 ms to build for 144 lookups). */
+#define DENSE_HITS_PER_TEXEL_AND_N 4
+
+/* The grid of a dense surface's texels: cells of the largest smallest radius a side. */
+typedef struct {
+    float lo[3], h;
+    int dim[3];
+    uint32_t *first, *list; /* per cell (cells + 1 offsets) into list, texel slots */
+} texel_grid;
+
+static int grid_cell(const texel_grid *g, const float p[3], int c[3])
+{
+    for (int k = 0; k < 3; k++) {
+        c[k] = (int)floorf((p[k] - g->lo[k]) / g->h);
+        if (c[k] < 0 || c[k] >= g->dim[k])
+            return 0;
+    }
+    return 1;
+}
+
+/* The texels' grid (slots 0 .. n of the surface's list at first); 0 when it would be too large. */
+static int grid_build(texel_grid *g, const lm_atlas *a, const uint32_t *list, uint32_t n, const float *r2)
+{
+    float hi[3] = {-INFINITY, -INFINITY, -INFINITY}, h2 = 0.0f;
+    for (int k = 0; k < 3; k++)
+        g->lo[k] = INFINITY;
+    for (uint32_t i = 0; i < n; i++) {
+        const float *p = a->texels[list[i]].local;
+        for (int k = 0; k < 3; k++)
+            g->lo[k] = fminf(g->lo[k], p[k]), hi[k] = fmaxf(hi[k], p[k]);
+        h2 = fmaxf(h2, r2[i]);
+    }
+    g->h = sqrtf(h2);
+    size_t cells = 1;
+    for (int k = 0; k < 3; k++) {
+        g->dim[k] = g->h > 0.0f ? (int)fminf((hi[k] - g->lo[k]) / g->h, 4096.0f) + 1 : 1;
+        cells *= (size_t)g->dim[k];
+    }
+    if (!(g->h > 0.0f) || cells > 4 * (size_t)n + 64)
+        return 0;
+    g->first = calloc(cells + 1, sizeof *g->first);
+    g->list = malloc(sizeof *g->list * (n ? n : 1));
+    if (!g->first || !g->list)
+        return 0;
+    int c[3];
+    for (uint32_t i = 0; i < n; i++)
+        if (grid_cell(g, a->texels[list[i]].local, c))
+            g->first[((size_t)c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0] + 1]++;
+    for (size_t k = 0; k < cells; k++)
+        g->first[k + 1] += g->first[k];
+    uint32_t *fill = malloc(sizeof *fill * (cells ? cells : 1));
+    if (!fill)
+        return 0;
+    memcpy(fill, g->first, sizeof *fill * cells);
+    for (uint32_t i = 0; i < n; i++)
+        if (grid_cell(g, a->texels[list[i]].local, c))
+            g->list[fill[((size_t)c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0]]++] = i;
+    free(fill);
+    return 1;
+}
+
+/* The estimate where every texel of a surface has N hits within its smallest radius: then each is the sum
+ * over every hit within that radius (photon_irradiance's widened case) and needs no kd-tree. One pass over
+ * the hits adds each to the texels within reach (a grid of the texels); returns the sums (w Phi, 4, and
+ * sum (w Y)^2 with the error estimate) per texel of the surface's list, or NULL when the surface is not
+ * dense after all (a texel with fewer than N), or the grid would be too large or no memory. Per texel the
+ * same hits as the kd-tree's radius search (d^2 <= r^2 in float), summed in another order. */
+static double *bin_dense_surface(const lm_aim *aim, const lm_scene *s, const lm_atlas *a, const surface_job *sj)
+{
+    uint32_t first = aim->texel_first[sj->surface], n = aim->texel_first[sj->surface + 1] - first;
+    const uint32_t *list = aim->texel_list + first;
+    uint32_t N = (uint32_t)aim->set.n_nearest;
+    if (!aim->set.dense || n == 0 || (uint64_t)sj->hits.count < (uint64_t)DENSE_HITS_PER_TEXEL_AND_N * N * n)
+        return NULL;
+    float *r2 = malloc(sizeof *r2 * n);
+    double *y = malloc(sizeof *y * 3 * n), *out = calloc(5 * (size_t)n, sizeof *out);
+    uint32_t *count = calloc(n, sizeof *count);
+    texel_grid g = {0};
+    int ok = r2 && y && out && count;
+    double rmin = (double)aim->set.min_radius_texels * a->texel_size;
+    for (uint32_t i = 0; ok && i < n; i++) {
+        const lm_texel *t = &a->texels[list[i]];
+        double nrm[3];
+        float rho[3];
+        local_face_normal(s, t->tri, nrm);
+        r2[i] = (float)(rmin * rmin / area_factor(&sj->L, nrm));
+        lm_texel_kd(s, t, rho);
+        for (int c = 0; c < 3; c++) /* the error estimate's luminance weights (estimate_texel) */
+            y[3 * i + (uint32_t)c] = (c == 0 ? 0.2126 : c == 1 ? 0.7152 : 0.0722) * rho[c] / LM_PI;
+    }
+    ok = ok && grid_build(&g, a, list, n, r2);
+    for (uint32_t h = 0; ok && h < sj->hits.count; h++) {
+        const float *p = sj->hits.pos + 3 * (size_t)h;
+        const double *phi = sj->hits.flux + 4 * (size_t)h;
+        int c[3];
+        for (int k = 0; k < 3; k++)
+            c[k] = (int)floorf((p[k] - g.lo[k]) / g.h);
+        for (int z = c[2] - 1; z <= c[2] + 1; z++)
+            for (int yy = c[1] - 1; yy <= c[1] + 1; yy++)
+                for (int x = c[0] - 1; x <= c[0] + 1; x++) {
+                    if (x < 0 || yy < 0 || z < 0 || x >= g.dim[0] || yy >= g.dim[1] || z >= g.dim[2])
+                        continue;
+                    size_t cell = ((size_t)z * g.dim[1] + yy) * g.dim[0] + x;
+                    for (uint32_t k = g.first[cell]; k < g.first[cell + 1]; k++) {
+                        uint32_t i = g.list[k];
+                        const float *q = a->texels[list[i]].local;
+                        float dx = p[0] - q[0], dy = p[1] - q[1], dz = p[2] - q[2];
+                        float d2 = dx * dx + dy * dy + dz * dz;
+                        if (!(d2 <= r2[i]))
+                            continue;
+                        double w = aim->set.kernel ? fmax(1.0 - d2 * (1.0 / r2[i]), 0.0) : 1.0;
+                        double *o = out + 5 * (size_t)i;
+                        for (int ch = 0; ch < 4; ch++)
+                            o[ch] += w * phi[ch];
+                        double v = w * (y[3 * i] * phi[0] + y[3 * i + 1] * phi[1] + y[3 * i + 2] * phi[2]);
+                        o[4] += v * v;
+                        count[i]++;
+                    }
+                }
+    }
+    for (uint32_t i = 0; ok && i < n; i++)
+        ok = count[i] >= N; /* else some texel's estimate reaches past its smallest radius */
+    free(r2);
+    free(y);
+    free(count);
+    free(g.first);
+    free(g.list);
+    if (!ok) {
+        free(out);
+        return NULL;
+    }
+    return out;
+}
 
 /* Gathers the surface's hits and builds their kd-tree (independent of the other surfaces). */
 static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
@@ -793,19 +942,21 @@ static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfa
     lm_kdtree_init(&sj->tree);
     int front_only = aim->set.front_only && !m->double_sided && sj->L.det != 0.0;
     sj->rc = gather_hits(ps, sj->surface, s, &sj->L, front_only, aim->direct, &sj->hits, &sj->err);
-    if (sj->rc == LM_OK)
+    sj->binned = sj->rc == LM_OK ? bin_dense_surface(aim, s, a, sj) : NULL;
+    if (sj->rc == LM_OK && !sj->binned)
         sj->rc = lm_kdtree_build(&sj->tree, sj->hits.pos, 3, sj->hits.count, &sj->err);
     uint32_t n = (uint32_t)aim->set.n_nearest < sj->hits.count ? (uint32_t)aim->set.n_nearest : sj->hits.count;
     double rmin = (double)aim->set.min_radius_texels * a->texel_size;
     sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {s->positions, aim->edges,
                              aim->edge_first[sj->surface], aim->edge_first[sj->surface + 1]}, n, rmin * rmin,
                              aim->set.boundary_correction, aim->set.kernel, aim->direct,
-                             s->nodes[sf->node].world, m->double_sided};
+                             s->nodes[sf->node].world, m->double_sided, sj->binned};
 }
 
 static void free_surface(surface_job *sj)
 {
     lm_kdtree_free(&sj->tree);
+    free(sj->binned);
     free(sj->hits.pos);
     free(sj->hits.flux);
 }
@@ -856,8 +1007,8 @@ static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32
                 if ((i - first) % TEXEL_CHUNK == 0)
                     ts.hint.valid = 0;
                 if (ok)
-                    estimate_texel(e, t, aim->texel_list[i], &ts, &aim->edge_d2[i], aim->rgb + 3 * at,
-                                   aim->error ? aim->error + 2 * at : NULL);
+                    estimate_texel(e, t, aim->texel_list[i], (uint32_t)(i - first), &ts, &aim->edge_d2[i],
+                                   aim->rgb + 3 * at, aim->error ? aim->error + 2 * at : NULL);
             }
         }
         scratch_free(&ts);
@@ -905,6 +1056,7 @@ static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfa
             st->surfaces_refreshed++;
             st->texels_written += aim->texel_first[sf + 1] - aim->texel_first[sf];
             st->hits_used += jobs[j].hits.count;
+            st->surfaces_binned += jobs[j].binned != NULL;
         }
     }
     for (int j = 0; j < count; j++)

@@ -68,8 +68,8 @@ float lm_pixel_gather_radius(const lm_photon_store *ps, const lm_surfaces *su, i
     double area = 0.0, hits = 0.0;
     for (int k = 0; k < ps->surface_count && k < su->surface_count; k++) {
         area += su->surfaces[k].area;
-        for (uint32_t h = ps->surfaces[k].head; h != LM_NONE; h = ps->hits[h].next)
-            hits += gathered(&ps->hits[h]);
+        for (uint32_t j = 0; j < ps->surfaces[k].count; j++)
+            hits += gathered(&ps->hits[ps->surfaces[k].slots[j]]);
     }
     return hits > 0.0 ? (float)sqrt((double)n * area / (LM_PI * hits)) : 0.0f;
 }
@@ -92,8 +92,8 @@ static int pack(const lm_photon_store *ps, const lm_scene *s, packed_hits *out)
     if (!out->p || !out->side || !out->flux)
         return 0;
     for (int k = 0; k < ps->surface_count; k++)
-        for (uint32_t h = ps->surfaces[k].head; h != LM_NONE; h = ps->hits[h].next) {
-            const lm_hit *x = &ps->hits[h];
+        for (uint32_t j = 0; j < ps->surfaces[k].count; j++) {
+            const lm_hit *x = &ps->hits[ps->surfaces[k].slots[j]];
             if (!gathered(x))
                 continue;
             size_t at = 3 * (size_t)out->count++;

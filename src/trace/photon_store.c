@@ -10,7 +10,7 @@ lm_status lm_photon_store_init(lm_photon_store *ps, int surface_count, lm_error 
     memset(ps, 0, sizeof *ps);
     ps->free_head = LM_NONE;
     ps->surface_count = surface_count;
-    ps->surfaces = malloc(sizeof *ps->surfaces * (size_t)(surface_count > 0 ? surface_count : 1));
+    ps->surfaces = calloc((size_t)(surface_count > 0 ? surface_count : 1), sizeof *ps->surfaces);
     if (!ps->surfaces)
         return lm_fail(err, LM_ERR_NOMEM, "photon store: no memory for %d surfaces", surface_count);
     lm_photon_store_clear(ps);
@@ -23,7 +23,6 @@ void lm_photon_store_clear(lm_photon_store *ps)
     ps->used = 0;
     ps->free_head = LM_NONE;
     for (int i = 0; i < ps->surface_count; i++) {
-        ps->surfaces[i].head = LM_NONE;
         ps->surfaces[i].count = 0;
         ps->surfaces[i].delta_f = ps->surfaces[i].delta_i = ps->surfaces[i].energy = 0.0;
     }
@@ -31,6 +30,8 @@ void lm_photon_store_clear(lm_photon_store *ps)
 
 void lm_photon_store_free(lm_photon_store *ps)
 {
+    for (int i = 0; ps->surfaces && i < ps->surface_count; i++)
+        free(ps->surfaces[i].slots);
     free(ps->hits);
     free(ps->surfaces);
     memset(ps, 0, sizeof *ps);
@@ -77,6 +78,19 @@ uint32_t lm_photon_store_grow_slot(lm_photon_store *ps)
     return ps->used++;
 }
 
+int lm_photon_store_grow_list(lm_surface_hits *sh)
+{
+    uint32_t cap = sh->cap ? 2 * sh->cap : 64;
+    if (cap <= sh->cap) /* past 2^32 slots: the store has no more slot ids anyway */
+        return 0;
+    uint32_t *grown = realloc(sh->slots, sizeof *grown * cap);
+    if (!grown)
+        return 0;
+    sh->slots = grown;
+    sh->cap = cap;
+    return 1;
+}
+
 uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h)
 {
     uint32_t slot;
@@ -94,29 +108,42 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
         return;
     lm_hit *d = &ps->hits[slot];
     lm_surface_hits *sh = &ps->surfaces[d->surface];
-    if (d->prev != LM_NONE)
-        ps->hits[d->prev].next = d->next;
-    else
-        sh->head = d->next;
-    if (d->next != LM_NONE)
-        ps->hits[d->next].prev = d->prev;
-    sh->count--;
+    uint32_t last = sh->slots[--sh->count]; /* the last takes its place */
+    sh->slots[d->at] = last;
+    ps->hits[last].at = d->at;
     lm_photon_store_account(ps, d, -1);
     d->surface = -1;
-    d->prev = LM_NONE;
+    d->at = LM_NONE;
     d->next = ps->free_head;
     ps->free_head = slot;
 }
 
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_f = 0.0; }
 void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_i = 0.0; }
-size_t lm_photon_store_bytes(const lm_photon_store *ps) { (void)ps; return sizeof(lm_hit); }
+int lm_photon_store_same(const lm_photon_store *a, const lm_photon_store *b)
+{
+    if (a->used != b->used || a->free_head != b->free_head || a->surface_count != b->surface_count ||
+        memcmp(a->hits, b->hits, sizeof *a->hits * a->used) != 0)
+        return 0;
+    for (int i = 0; i < a->surface_count; i++) {
+        const lm_surface_hits *x = &a->surfaces[i], *y = &b->surfaces[i];
+        if (x->count != y->count || memcmp(&x->delta_f, &y->delta_f, sizeof x->delta_f) != 0 ||
+            memcmp(&x->delta_i, &y->delta_i, sizeof x->delta_i) != 0 ||
+            memcmp(&x->energy, &y->energy, sizeof x->energy) != 0 ||
+            (x->count && memcmp(x->slots, y->slots, sizeof *x->slots * x->count) != 0))
+            return 0;
+    }
+    return 1;
+}
+
+size_t lm_photon_store_bytes(const lm_photon_store *ps) { (void)ps; return sizeof(lm_hit) + sizeof(uint32_t); }
 
 double lm_photon_store_iim_energy(const lm_photon_store *ps, int surface)
 {
     double e = 0.0;
-    for (uint32_t h = ps->surfaces[surface].head; h != LM_NONE; h = ps->hits[h].next)
-        if (lm_hit_in_iim(&ps->hits[h]))
-            e += lm_hit_energy(&ps->hits[h]);
+    const lm_surface_hits *sh = &ps->surfaces[surface];
+    for (uint32_t k = 0; k < sh->count; k++)
+        if (lm_hit_in_iim(&ps->hits[sh->slots[k]]))
+            e += lm_hit_energy(&ps->hits[sh->slots[k]]);
     return e;
 }

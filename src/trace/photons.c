@@ -593,10 +593,12 @@ void lm_photons_first_hit_flux(const lm_photons *ph, double *out)
     const lm_photon_store *ps = &ph->store;
     for (int s = 0; s < ps->surface_count; s++) {
         double sum[3] = {0, 0, 0};
-        for (uint32_t i = ps->surfaces[s].head; i != LM_NONE; i = ps->hits[i].next)
-            if (ps->hits[i].bounce == 0)
+        for (uint32_t k = 0; k < ps->surfaces[s].count; k++) {
+            const lm_hit *h = &ps->hits[ps->surfaces[s].slots[k]];
+            if (h->bounce == 0)
                 for (int c = 0; c < 3; c++)
-                    sum[c] += ps->hits[i].flux[c];
+                    sum[c] += h->flux[c];
+        }
         for (int c = 0; c < 3; c++)
             out[3 * s + c] = sum[c];
     }
