@@ -13,6 +13,9 @@
 
 #define MIN_COVERAGE 0.0625 /* the disc's part on the surface is never taken below 1/16 of it */
 
+/* Luminance weights (Rec. 709), as the stored hits' energy counts them (lm_hit_energy). */
+static const double LUMINANCE[3] = {0.2126, 0.7152, 0.0722};
+
 void lm_aim_settings_default(lm_aim_settings *o)
 {
     o->n_nearest = 32;
@@ -715,8 +718,8 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t in
 {
     float rho[3];
     lm_texel_kd(j->s, t, rho);
-    static const double lum[3] = {0.2126, 0.7152, 0.0722};
-    estimate_error ee = {error != NULL, {lum[0] * rho[0] / LM_PI, lum[1] * rho[1] / LM_PI, lum[2] * rho[2] / LM_PI},
+    estimate_error ee = {error != NULL, {LUMINANCE[0] * rho[0] / LM_PI, LUMINANCE[1] * rho[1] / LM_PI,
+                                         LUMINANCE[2] * rho[2] / LM_PI},
                          0.0, 0.0};
     double e[3];
     photon_irradiance(j, t, slot, ts, edge_d2, e, &ee);
@@ -808,14 +811,26 @@ typedef struct {
     uint32_t *first, *list; /* per cell (cells + 1 offsets) into list, texel slots */
 } texel_grid;
 
-static int grid_cell(const texel_grid *g, const float p[3], int c[3])
+/* The cell coordinates of p, inside the grid or not. */
+static void grid_coords(const texel_grid *g, const float p[3], int c[3])
 {
-    for (int k = 0; k < 3; k++) {
+    for (int k = 0; k < 3; k++)
         c[k] = (int)floorf((p[k] - g->lo[k]) / g->h);
-        if (c[k] < 0 || c[k] >= g->dim[k])
-            return 0;
-    }
-    return 1;
+}
+
+/* The cell (x, y, z) inside the grid: its index, else -1. */
+static long grid_index(const texel_grid *g, int x, int y, int z)
+{
+    if (x < 0 || y < 0 || z < 0 || x >= g->dim[0] || y >= g->dim[1] || z >= g->dim[2])
+        return -1;
+    return ((long)z * g->dim[1] + y) * g->dim[0] + x;
+}
+
+static long grid_cell(const texel_grid *g, const float p[3])
+{
+    int c[3];
+    grid_coords(g, p, c);
+    return grid_index(g, c[0], c[1], c[2]);
 }
 
 /* The texels' grid (slots 0 .. n of the surface's list at first); 0 when it would be too large. */
@@ -842,19 +857,22 @@ static int grid_build(texel_grid *g, const lm_atlas *a, const uint32_t *list, ui
     g->list = malloc(sizeof *g->list * (n ? n : 1));
     if (!g->first || !g->list)
         return 0;
-    int c[3];
-    for (uint32_t i = 0; i < n; i++)
-        if (grid_cell(g, a->texels[list[i]].local, c))
-            g->first[((size_t)c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0] + 1]++;
+    for (uint32_t i = 0; i < n; i++) {
+        long cell = grid_cell(g, a->texels[list[i]].local);
+        if (cell >= 0)
+            g->first[cell + 1]++;
+    }
     for (size_t k = 0; k < cells; k++)
         g->first[k + 1] += g->first[k];
     uint32_t *fill = malloc(sizeof *fill * (cells ? cells : 1));
     if (!fill)
         return 0;
     memcpy(fill, g->first, sizeof *fill * cells);
-    for (uint32_t i = 0; i < n; i++)
-        if (grid_cell(g, a->texels[list[i]].local, c))
-            g->list[fill[((size_t)c[2] * g->dim[1] + c[1]) * g->dim[0] + c[0]]++] = i;
+    for (uint32_t i = 0; i < n; i++) {
+        long cell = grid_cell(g, a->texels[list[i]].local);
+        if (cell >= 0)
+            g->list[fill[cell]++] = i;
+    }
     free(fill);
     return 1;
 }
@@ -886,21 +904,20 @@ static double *bin_dense_surface(const lm_aim *aim, const lm_scene *s, const lm_
         r2[i] = (float)(rmin * rmin / area_factor(&sj->L, nrm));
         lm_texel_kd(s, t, rho);
         for (int c = 0; c < 3; c++) /* the error estimate's luminance weights (estimate_texel) */
-            y[3 * i + (uint32_t)c] = (c == 0 ? 0.2126 : c == 1 ? 0.7152 : 0.0722) * rho[c] / LM_PI;
+            y[3 * i + (uint32_t)c] = LUMINANCE[c] * rho[c] / LM_PI;
     }
     ok = ok && grid_build(&g, a, list, n, r2);
     for (uint32_t h = 0; ok && h < sj->hits.count; h++) {
         const float *p = sj->hits.pos + 3 * (size_t)h;
         const double *phi = sj->hits.flux + 4 * (size_t)h;
         int c[3];
-        for (int k = 0; k < 3; k++)
-            c[k] = (int)floorf((p[k] - g.lo[k]) / g.h);
+        grid_coords(&g, p, c);
         for (int z = c[2] - 1; z <= c[2] + 1; z++)
             for (int yy = c[1] - 1; yy <= c[1] + 1; yy++)
                 for (int x = c[0] - 1; x <= c[0] + 1; x++) {
-                    if (x < 0 || yy < 0 || z < 0 || x >= g.dim[0] || yy >= g.dim[1] || z >= g.dim[2])
+                    long cell = grid_index(&g, x, yy, z);
+                    if (cell < 0)
                         continue;
-                    size_t cell = ((size_t)z * g.dim[1] + yy) * g.dim[0] + x;
                     for (uint32_t k = g.first[cell]; k < g.first[cell + 1]; k++) {
                         uint32_t i = g.list[k];
                         const float *q = a->texels[list[i]].local;

@@ -623,6 +623,13 @@ static uint32_t queue_round_robin(lm_caustics *c, pair *p, uint32_t per_frame, u
     return n;
 }
 
+/* The photons of a pair a round-robin frame re-traces: its share `retrace` of them, 1 to all. */
+static uint32_t round_robin_turn(const lm_caustics *c)
+{
+    uint32_t N = c->set.photons, turn = (uint32_t)ceil((double)c->set.retrace * N);
+    return turn < 1 ? 1 : turn > N ? N : turn;
+}
+
 lm_status lm_caustics_frame(lm_caustics *c, lm_caustic_frame_stats *stats, lm_error *err)
 {
     (void)err;
@@ -634,9 +641,8 @@ lm_status lm_caustics_frame(lm_caustics *c, lm_caustic_frame_stats *stats, lm_er
         uint64_t h = lm_scene_world_hash(c->scene);
         int moved = h != c->world_hash;
         c->world_hash = h;
-        uint32_t N = c->set.photons, per_frame = (uint32_t)ceil((double)c->set.retrace * N), n = 0;
+        uint32_t N = c->set.photons, per_frame = round_robin_turn(c), n = 0;
         uint32_t left = c->frame_limit ? c->frame_limit : c->frame_cap;
-        per_frame = per_frame < 1 ? 1 : per_frame > N ? N : per_frame;
         /* first the pairs whose generator or emitter changed, whole (over several frames when more of them
          * than frame_cap allows), then the round robin of the others with what is left */
         for (int i = 0; i < c->pair_count && left > 0; i++) {
@@ -678,8 +684,7 @@ void lm_caustics_limit_frame(lm_caustics *c, uint32_t most) { c->frame_limit = m
 
 uint32_t lm_caustics_wanted(const lm_caustics *c)
 {
-    uint32_t N = c->set.photons, turn = (uint32_t)ceil((double)c->set.retrace * N);
-    uint64_t n = lm_caustics_pending(c) + (uint64_t)c->pair_count * (turn < 1 ? 1 : turn > N ? N : turn);
+    uint64_t n = lm_caustics_pending(c) + (uint64_t)c->pair_count * round_robin_turn(c);
     return n < c->frame_cap ? (uint32_t)n : c->frame_cap;
 }
 

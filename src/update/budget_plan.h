@@ -49,7 +49,6 @@ typedef struct {
 /* The work waiting when an update is planned (what the stages reported last). */
 typedef struct {
     uint32_t groups;          /* invalid photon groups queued */
-    int aim_surfaces;         /* AIM surfaces over their refresh threshold, left by the last refresh */
     uint32_t caustic_photons; /* caustic photons queued for whole re-traces */
     int faces;                /* environment map faces (all: an update marks the dirty ones as it goes) */
     int texels;               /* the most texels a step may gather (the atlas) */

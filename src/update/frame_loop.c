@@ -250,14 +250,12 @@ static lm_status blend_and_render(lm_frame_loop *fl, lm_frame_stats *o, lm_error
  * model, without it the settings' own. */
 static void plan(lm_frame_loop *fl, lm_frame_stats *o)
 {
-    lm_budget_work *w = &o->waiting;
-    lm_photon_stage_waiting(fl->stage, &w->groups, &w->aim_surfaces, &w->caustic_photons);
-    w->faces = lm_frame_passes_faces(fl->passes);
-    w->texels = (int)fl->world.atlas->texel_count;
     lm_budget_plan *p = &o->plan;
-    if (fl->budget_ms > 0.0f)
-        lm_budget_plan_step(&fl->budget, fl->budget_ms, w, p);
-    else {
+    if (fl->budget_ms > 0.0f) {
+        lm_budget_work w = {.faces = lm_frame_passes_faces(fl->passes), .texels = (int)fl->world.atlas->texel_count};
+        lm_photon_stage_waiting(fl->stage, &w.groups, &w.caustic_photons);
+        lm_budget_plan_step(&fl->budget, fl->budget_ms, &w, p);
+    } else {
         memset(p, 0, sizeof *p);
         p->texels = fl->set.iim.texels_per_frame;
     }

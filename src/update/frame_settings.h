@@ -94,10 +94,8 @@ typedef struct {
      * the frame's read-back), caustics (the screen-space pass), reflections (map faces and their pass),
      * composite (the indirect term's atlas pass); and the whole frame */
     double t_photons, t_gather, t_blend, t_direct, t_caustics, t_reflections, t_composite, t_total;
-    /* the time budget (budget_plan.h): the work waiting when the step was planned, the counts it was
-     * allowed (zeros but texels without a budget: the settings'), the stage that took the most time and
-     * why, in words */
-    lm_budget_work waiting;
+    /* the time budget (budget_plan.h): the counts the step was allowed (zeros but texels without a budget:
+     * the settings'), the stage that took the most time and why, in words */
     lm_budget_plan plan;
     lm_stage busiest;
     char why[160];

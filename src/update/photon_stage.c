@@ -46,7 +46,6 @@ struct lm_photon_stage {
     int frame;
     uint64_t hit_bound;          /* worst_refresh at creation: the AIM refresh's bound without a budget */
     lm_photon_stage_limits limit; /* a time budget's counts (lm_photon_stage_limit); zeros: the settings' */
-    int aim_waiting;             /* surfaces the last refresh left over their threshold */
 };
 
 void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
@@ -322,7 +321,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);
     if (st == LM_OK)
-        ps->aim.set.max_hits = ps->hit_bound = worst_refresh(ps);
+        ps->hit_bound = worst_refresh(ps);
     double t2 = lm_now();
     if (st == LM_OK && ps->set.caustics)
         st = make_caustics(ps, &first->caustics, err);
@@ -463,7 +462,6 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
         ps->aim.set.max_hits = ps->limit.aim_hits ? ps->limit.aim_hits : ps->hit_bound;
         st = refresh_aims(ps, ps->limit.aim_hits ? ps->surfaces->surface_count : ps->set.surfaces_per_frame,
                           &out->aim, err);
-        ps->aim_waiting = out->aim.surfaces_pending;
     }
     double t3 = lm_now();
     if (st == LM_OK)
@@ -533,10 +531,9 @@ void lm_photon_stage_limit(lm_photon_stage *ps, const lm_photon_stage_limits *l)
         lm_caustics_limit_frame(ps->caustics, l->caustic_photons);
 }
 
-void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, int *aim_surfaces, uint32_t *caustic_photons)
+void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, uint32_t *caustic_photons)
 {
     *groups = ps->photons && ps->set.trace ? lm_photons_pending_groups(ps->photons) : 0;
-    *aim_surfaces = ps->aim_waiting;
     *caustic_photons = ps->caustics ? lm_caustics_wanted(ps->caustics) : 0;
 }
 

@@ -79,10 +79,9 @@ typedef struct {
     uint32_t caustic_photons;
 } lm_photon_stage_limits;
 void lm_photon_stage_limit(lm_photon_stage *ps, const lm_photon_stage_limits *l);
-/* The work waiting: invalid photon groups queued, the surfaces the last AIM refresh left over their
- * threshold, the caustic photons the next update would trace (lm_caustics_wanted). */
-void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, int *aim_surfaces,
-                             uint32_t *caustic_photons);
+/* The work waiting: invalid photon groups queued, the caustic photons the next update would trace
+ * (lm_caustics_wanted). */
+void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, uint32_t *caustic_photons);
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */
