@@ -650,6 +650,104 @@ static void test_dense_surface_without_kdtree(void **state)
     ts_free(&t);
 }
 
+/* (f) Seams: four square nodes meet at the origin (one of them half the size and scaled 2x, so its local
+ * space is not the others'), and a point light 0.15 above that vertex puts the light's peak on the seams.
+ * With seams every texel near the vertex sums the hits of the whole disc around it, across the four
+ * surfaces, and reads what one plane under the same hits reads; with each surface's own hits only, the
+ * boundary correction's even-light assumption reads the corners dark. Each surface continues the three
+ * others (two across an edge, one across the vertex). */
+static void seam_quadrants(tscene *t, int one_plane)
+{
+    lmt_mesh m[2];
+    square_mesh(&m[0], one_plane ? 2.0f : 1.0f);
+    square_mesh(&m[1], 0.5f);
+    if (one_plane)
+        ts_load(t, m, 1, "[{\"name\": \"plane\", \"mesh\": 0}]", 0.05f);
+    else
+        ts_load(t, m, 2,
+                "[{\"name\": \"a\", \"mesh\": 0, \"translation\": [1, 0, 1]},"
+                " {\"name\": \"b\", \"mesh\": 0, \"translation\": [-1, 0, 1]},"
+                " {\"name\": \"c\", \"mesh\": 0, \"translation\": [-1, 0, -1]},"
+                " {\"name\": \"d\", \"mesh\": 1, \"translation\": [1, 0, -1], \"scale\": [2, 2, 2]}]",
+                0.05f);
+    assert_int_equal(t->su.surface_count, one_plane ? 1 : 4);
+}
+
+/* g x g stratified hits over each quadrant (on surface 0 for the one plane), flux density E of the
+ * light, local = (world - T) / scale. */
+static void seam_hits(lm_photon_store *ps, const tscene *t, const float light[4], int g)
+{
+    const float corner[4][2] = {{0, 0}, {-2, 0}, {-2, -2}, {0, -2}};
+    for (int q = 0; q < 4; q++) {
+        int k = t->su.surface_count == 1 ? 0 : q;
+        const float *w = t->s->nodes[t->su.surfaces[k].node].world;
+        for (int j = 0; j < g; j++)
+            for (int i = 0; i < g; i++) {
+                lm_hit h;
+                memset(&h, 0, sizeof h);
+                h.pos[0] = corner[q][0] + 2.0f * (i + rnd()) / g;
+                h.pos[2] = corner[q][1] + 2.0f * (j + rnd()) / g;
+                h.local[0] = (h.pos[0] - w[12]) / w[0];
+                h.local[2] = (h.pos[2] - w[14]) / w[0];
+                h.dir[1] = -1.0f;
+                float phi = point_E(light, light[3], h.pos[0], h.pos[2]) * 4.0f / (float)(g * g);
+                h.flux[0] = h.flux[1] = h.flux[2] = phi;
+                h.surface = k;
+                h.tri = t->su.surfaces[k].tris[0];
+                assert_true(lm_photon_store_add(ps, &h) != LM_NONE);
+            }
+    }
+}
+
+/* The mean signed error of the texels within 0.15 of the vertex against rho / pi E. */
+static double seam_error(const tscene *t, int one_plane, int seams)
+{
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, t->su.surface_count, NULL), LM_OK);
+    const float light[4] = {0.0f, 0.15f, 0.0f, 1.0f};
+    g_rng = 5;
+    seam_hits(&ps, t, light, 80);
+    lm_aim aim;
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    set.seams = seams;
+    init_aim(&aim, t, &set);
+    for (int k = 0; !one_plane && seams && k < 4; k++)
+        assert_int_equal(aim.seams.first[k + 1] - aim.seams.first[k], 3);
+    lm_aim_stats st;
+    assert_int_equal(lm_aim_refresh_all(&aim, t->s, &t->su, &t->a, &ps, &st, NULL), LM_OK);
+    double sum = 0.0;
+    int n = 0;
+    for (uint32_t i = 0; i < t->a.texel_count; i++) {
+        const lm_texel *tx = &t->a.texels[i];
+        if (hypotf(tx->pos[0], tx->pos[2]) > 0.15f)
+            continue;
+        double want = 0.6 / PI_F * point_E(light, light[3], tx->pos[0], tx->pos[2]);
+        sum += aim_px(&aim, tx)[1] / want - 1.0;
+        n++;
+    }
+    print_message("light on the vertex of %s: %d texels within 0.15, mean %+.2f%% (%llu hits used)\n",
+                  one_plane ? "one plane" : seams ? "four nodes, seams" : "four nodes, no seams", n,
+                  100.0 * sum / n, (unsigned long long)st.hits_used);
+    assert_true(n > 20);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    return sum / n;
+}
+
+static void test_seams(void **state)
+{
+    (void)state;
+    tscene one, four;
+    seam_quadrants(&one, 1);
+    seam_quadrants(&four, 0);
+    double plane = seam_error(&one, 1, 1), off = seam_error(&four, 0, 0), on = seam_error(&four, 0, 1);
+    assert_true(fabs(on - plane) < 0.025);
+    assert_true(off < plane - 0.05); /* without seams: dark, so the test sees what seams do */
+    ts_free(&one);
+    ts_free(&four);
+}
+
 static void test_bad_settings(void **state)
 {
     (void)state;
@@ -683,6 +781,7 @@ int main(void)
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_batch_matches_single),
         cmocka_unit_test(test_dense_surface_without_kdtree),
+        cmocka_unit_test(test_seams),
         cmocka_unit_test(test_bad_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -563,11 +563,12 @@ static void test_surface_smaller_than_a_texel(void **state)
  * photons land within 6 cm of the plate's centre, a quarter of a texel, so to every AIM estimate there
  * they are one point (the smallest radius). The plate is one quad, or four quadrant nodes (four surfaces,
  * their seams along the axes) of two triangles each, all eight meeting at the centre, where the spot's
- * axis hits: the photons lie on that vertex, its edges and the seams. Every value must be finite and the
- * light the room gets back from the plate (its IIM) within 15% of the one quad's. Not within 2%: the
- * boundary correction divides each quadrant's quarter of the photons by the part of its disc on the
- * quadrant, which assumes the light even across the disc; light all in the corner reads dark there
- * (docs/hard-cases.md). */
+ * axis hits: the photons lie on that vertex, its edges and the seams. Every value must be finite, the
+ * plate's photon energy (its AIM) within 5% of the one quad's and the light the room gets back from the
+ * plate (its IIM) within 8%. Each quadrant's estimate sums the hits of the quadrants that continue it
+ * (aim.h, seams); with its own only it lost 43% of the energy, and the room 9.4% (docs/hard-cases.md).
+ * What is left in the room is the gather's: each quadrant is its own chart, whose bilinear lookups at
+ * the centre do not blend with the others'. */
 static lmgi_scene *plate_under_spot(int quadrants)
 {
     static box_mesh room;
@@ -648,8 +649,8 @@ static void test_photons_on_a_vertex_and_seams(void **state)
                   "%.4g, %+.2f%%), room IIM %.4g (%+.2f%%)\n", energy[1], energy[0], 100.0 * (energy[1] / energy[0] - 1.0),
                   room[1], 100.0 * (room[1] / room[0] - 1.0));
     assert_true(energy[0] > 0.0 && room[0] > 0.0);
-    assert_true(energy[1] > 0.0);
-    assert_true(fabs(room[1] / room[0] - 1.0) < 0.15);
+    assert_true(fabs(energy[1] / energy[0] - 1.0) < 0.05);
+    assert_true(fabs(room[1] / room[0] - 1.0) < 0.08);
     lmgi_context_free(ctx);
 }
 

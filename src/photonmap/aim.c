@@ -26,6 +26,7 @@ void lm_aim_settings_default(lm_aim_settings *o)
     o->kernel = 1;
     o->error_estimate = 0;
     o->dense = 1;
+    o->seams = 1;
     o->max_hits = 0;
 }
 
@@ -238,6 +239,10 @@ lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, con
         st = build_texel_lists(aim, a, err);
     if (st == LM_OK)
         st = build_edges(aim, s, su, err);
+    if (st == LM_OK && aim->set.seams)
+        st = lm_seams_find(&aim->seams, s, su, err);
+    if (st == LM_OK && !(aim->seams_used = calloc((size_t)su->surface_count + 1, sizeof *aim->seams_used)))
+        st = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %d surfaces", su->surface_count);
     if (st != LM_OK)
         lm_aim_free(aim);
     return st;
@@ -254,6 +259,8 @@ void lm_aim_free(lm_aim *aim)
     free(aim->edges);
     free(aim->refresh_count);
     free(aim->edge_d2);
+    free(aim->seams_used);
+    lm_seams_free(&aim->seams);
     memset(aim, 0, sizeof *aim);
 }
 
@@ -340,26 +347,157 @@ static int arrives_front(const linear_map *L, const lm_scene *s, const lm_hit *h
     return L->det * d < 0.0;
 }
 
-/* The surface's hits that the estimate sums: from the front only (front_only), and without those whose
- * light is computed directly (direct, may be NULL). */
-static lm_status gather_hits(const lm_photon_store *ps, int surface, const lm_scene *s, const linear_map *L,
-                             int front_only, const lm_direct_light *direct, hit_set *out, lm_error *err)
+/* The local space of one node in that of another (the node with linear map L_to and world matrix w_to):
+ * how a continuing surface's hits and edges are read in the surface's own space. */
+typedef struct {
+    double m[3][3], t[3];
+} affine;
+
+static void node_to_node(const float w_from[16], const float w_to[16], const linear_map *L_to, affine *A)
 {
-    uint32_t n = ps->surfaces[surface].count;
-    out->count = 0;
-    out->pos = malloc(sizeof *out->pos * 3 * (n ? n : 1));
-    out->flux = malloc(sizeof *out->flux * 4 * (n ? n : 1));
-    if (!out->pos || !out->flux)
-        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %u hits of surface %d", n, surface);
+    for (int r = 0; r < 3; r++) {
+        A->t[r] = 0.0;
+        for (int c = 0; c < 3; c++) {
+            A->m[r][c] = 0.0;
+            for (int k = 0; k < 3; k++)
+                A->m[r][c] += L_to->inv[r][k] * w_from[c * 4 + k];
+        }
+        for (int k = 0; k < 3; k++)
+            A->t[r] += L_to->inv[r][k] * ((double)w_from[12 + k] - w_to[12 + k]);
+    }
+}
+
+static void affine_point(const affine *A, const float p[3], float out[3])
+{
+    for (int r = 0; r < 3; r++)
+        out[r] = (float)(A->m[r][0] * p[0] + A->m[r][1] * p[1] + A->m[r][2] * p[2] + A->t[r]);
+}
+
+/* Appends the hits of `surface` that an estimate sums: from the front only (front_only), without those
+ * whose light is computed directly (direct, may be NULL); mapped by A (another node's; NULL: none) and
+ * with box (a continuing surface's; NULL: every one) only those inside it (lo, hi). out has room for them
+ * all. */
+static void append_hits(const lm_photon_store *ps, int surface, const lm_scene *s, const linear_map *L,
+                        int front_only, const lm_direct_light *direct, const affine *A, const float box[6],
+                        hit_set *out)
+{
     const uint32_t *slots = ps->surfaces[surface].slots;
-    for (uint32_t k = 0; k < n; k++) {
+    for (uint32_t k = 0; k < ps->surfaces[surface].count; k++) {
         const lm_hit *hit = &ps->hits[slots[k]];
         if ((front_only && !arrives_front(L, s, hit)) || (direct && lm_direct_covers_hit(direct, hit)))
             continue;
-        memcpy(out->pos + 3 * out->count, hit->local, sizeof hit->local);
+        float *p = out->pos + 3 * out->count;
+        if (A)
+            affine_point(A, hit->local, p);
+        else
+            memcpy(p, hit->local, sizeof hit->local);
+        if (box && (p[0] < box[0] || p[1] < box[1] || p[2] < box[2] || p[0] > box[3] || p[1] > box[4] || p[2] > box[5]))
+            continue;
         for (int c = 0; c < 4; c++)
             out->flux[4 * out->count + (uint32_t)c] = c < 3 ? hit->flux[c] : 0.0;
         out->count++;
+    }
+}
+
+/* Surface k's boundary edges as local positions of the surface the estimate is for (A maps them; NULL:
+ * the same node), 6 floats each, into out. Returns how many. */
+static uint32_t append_edges(const lm_aim *aim, const lm_scene *s, int k, const affine *A, float *out)
+{
+    uint32_t n = 0;
+    for (uint32_t e = aim->edge_first[k]; e < aim->edge_first[k + 1]; e++, n++)
+        for (int v = 0; v < 2; v++) {
+            const float *p = s->positions + 3 * (size_t)aim->edges[2 * e + (uint32_t)v];
+            float *o = out + 6 * (size_t)n + 3 * v;
+            if (A)
+                affine_point(A, p, o);
+            else
+                memcpy(o, p, 3 * sizeof *o);
+        }
+    return n;
+}
+
+static int front_only_for(const lm_aim *aim, const lm_scene *s, const lm_surface *sf, const linear_map *L)
+{
+    return aim->set.front_only && !s->materials[sf->material].double_sided && L->det != 0.0;
+}
+
+/* Whether surface t's hits may join surface k's estimate now: the same node, or two that do not move. */
+static int seam_usable(const lm_scene *s, const lm_surfaces *su, int k, int t)
+{
+    int a = su->surfaces[k].node, b = su->surfaces[t].node;
+    return a == b || (!lm_node_moves(&s->nodes[a]) && !lm_node_moves(&s->nodes[b]));
+}
+
+/* How far past a surface's texels a continuing surface's hits are taken: 4 times the radius that holds N
+ * hits at the surface's mean density (an estimate whose disc reaches farther, where the light is under
+ * 1/16 of the surface's mean, misses the hits beyond, as it did without seams). Local units. */
+static double seam_reach(const lm_aim *aim, const lm_surfaces *su, int k, const linear_map *L, const lm_scene *s,
+                         uint32_t own_hits)
+{
+    if (own_hits == 0 || su->surfaces[k].tri_count == 0)
+        return INFINITY;
+    double n[3];
+    local_face_normal(s, su->surfaces[k].tris[0], n);
+    double area = (double)su->surfaces[k].area / area_factor(L, n);
+    return 4.0 * sqrt((double)aim->set.n_nearest * area / (LM_PI * own_hits));
+}
+
+/* The box around the surface's texels (local), widened by reach. */
+static void texel_box(const lm_aim *aim, const lm_atlas *a, int k, double reach, float box[6])
+{
+    for (int c = 0; c < 3; c++)
+        box[c] = INFINITY, box[3 + c] = -INFINITY;
+    for (uint32_t i = aim->texel_first[k]; i < aim->texel_first[k + 1]; i++)
+        for (int c = 0; c < 3; c++) {
+            float x = a->texels[aim->texel_list[i]].local[c];
+            box[c] = fminf(box[c], x), box[3 + c] = fmaxf(box[3 + c], x);
+        }
+    for (int c = 0; c < 3; c++)
+        box[c] = (float)(box[c] - reach), box[3 + c] = (float)(box[3 + c] + reach);
+}
+
+/* The hits the estimates of the job's surface sum, its own and (set.seams) those of the surfaces that
+ * continue it near its texels, and the edges around them all (boundary); *seams_used names the set of
+ * continuing surfaces used (0: none). */
+static lm_status gather_hits(const lm_aim *aim, const lm_photon_store *ps, const lm_scene *s,
+                             const lm_surfaces *su, const lm_atlas *a, int k, const linear_map *L,
+                             hit_set *out, float **edge_ends, uint32_t *edge_count, uint32_t *seams_used,
+                             lm_error *err)
+{
+    const lm_seams *sm = &aim->seams;
+    uint32_t first = sm->first ? sm->first[k] : 0, end = sm->first ? sm->first[k + 1] : 0;
+    uint64_t hits = ps->surfaces[k].count, edges = aim->edge_first[k + 1] - aim->edge_first[k];
+    *seams_used = 0;
+    for (uint32_t i = first; i < end; i++)
+        if (seam_usable(s, su, k, sm->list[i])) {
+            hits += ps->surfaces[sm->list[i]].count;
+            edges += aim->edge_first[sm->list[i] + 1] - aim->edge_first[sm->list[i]];
+            *seams_used = *seams_used * 31u + (uint32_t)sm->list[i] + 1u;
+        }
+    out->count = 0;
+    out->pos = malloc(sizeof *out->pos * 3 * (hits ? hits : 1));
+    out->flux = malloc(sizeof *out->flux * 4 * (hits ? hits : 1));
+    *edge_ends = malloc(sizeof **edge_ends * 6 * (edges ? edges : 1));
+    if (!out->pos || !out->flux || !*edge_ends || hits > UINT32_MAX)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %llu hits of surface %d", (unsigned long long)hits, k);
+    const lm_surface *sf = &su->surfaces[k];
+    append_hits(ps, k, s, L, front_only_for(aim, s, sf, L), aim->direct, NULL, NULL, out);
+    *edge_count = append_edges(aim, s, k, NULL, *edge_ends);
+    float box[6];
+    if (end > first)
+        texel_box(aim, a, k, seam_reach(aim, su, k, L, s, out->count), box);
+    for (uint32_t i = first; i < end; i++) {
+        int t = sm->list[i];
+        if (!seam_usable(s, su, k, t))
+            continue;
+        const lm_surface *tf = &su->surfaces[t];
+        linear_map LT;
+        affine A;
+        linear_map_of(s->nodes[tf->node].world, &LT);
+        node_to_node(s->nodes[tf->node].world, s->nodes[sf->node].world, L, &A);
+        const affine *map = tf->node == sf->node ? NULL : &A;
+        append_hits(ps, t, s, &LT, front_only_for(aim, s, tf, &LT), aim->direct, map, box, out);
+        *edge_count += append_edges(aim, s, t, map, *edge_ends + 6 * (size_t)*edge_count);
     }
     return LM_OK;
 }
@@ -409,10 +547,13 @@ static double edge_correction(const double a[2], const double b[2], double r2, i
     return inside - sector(a, b, r2, kernel);
 }
 
+/* The edges around the region an estimate's disc may cover: the surface's own boundary, and with seams
+ * the boundaries of the surfaces that continue it, all in the surface's local space. Edges shared by two
+ * of them come once each way round and cancel (each edge's correction changes sign with its direction),
+ * so the sum is the boundary of their union. */
 typedef struct {
-    const float *pos;     /* scene positions (local) */
-    const uint32_t *edges;
-    uint32_t first, end;  /* this surface's edges */
+    const float *ends;    /* 6 per edge: a, then b, local positions */
+    uint32_t count;
 } boundary;
 
 /* Squared distance from the origin to the segment ab (2-d). */
@@ -463,10 +604,10 @@ static void project_edges(edge_frame *ef, const boundary *bd, const double n[3])
     ef->bd = bd;
     memcpy(ef->n, n, sizeof ef->n);
     tangent_frame(n, ef->t1, ef->t2);
-    for (uint32_t e = bd->first; e < bd->end; e++)
+    for (uint32_t e = 0; e < bd->count; e++)
         for (int k = 0; k < 2; k++) {
-            const float *v = bd->pos + 3 * (size_t)bd->edges[2 * e + (uint32_t)k];
-            double *o = ef->uv + 4 * (size_t)(e - bd->first) + 2 * k;
+            const float *v = bd->ends + 6 * (size_t)e + 3 * k;
+            double *o = ef->uv + 4 * (size_t)e + 2 * k;
             o[0] = v[0] * ef->t1[0] + v[1] * ef->t1[1] + v[2] * ef->t1[2];
             o[1] = v[0] * ef->t2[0] + v[1] * ef->t2[1] + v[2] * ef->t2[2];
         }
@@ -484,7 +625,7 @@ static double disc_area_on_surface(edge_frame *ef, const boundary *bd, const flo
     double qa = q[0] * ef->t1[0] + q[1] * ef->t1[1] + q[2] * ef->t1[2];
     double qb = q[0] * ef->t2[0] + q[1] * ef->t2[1] + q[2] * ef->t2[2];
     double full = (kernel ? 0.5 : 1.0) * LM_PI * r2, area = full, nearest = r2, r = sqrt(r2);
-    for (uint32_t e = 0; e < bd->end - bd->first; e++) {
+    for (uint32_t e = 0; e < bd->count; e++) {
         const double *o = ef->uv + 4 * (size_t)e;
         double p[2][2] = {{o[0] - qa, o[1] - qb}, {o[2] - qa, o[3] - qb}};
         if (beside_square(p[0], p[1], r))
@@ -760,14 +901,18 @@ lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_
     edge_frame ef;
     memset(&ef, 0, sizeof ef);
     ef.uv = malloc(sizeof *ef.uv * 4 * edges_max);
-    if (!ef.uv)
+    float *ends = malloc(sizeof *ends * 6 * edges_max);
+    if (!ef.uv || !ends) {
+        free(ef.uv);
+        free(ends);
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the boundary edges of %d surfaces", su->surface_count);
+    }
     for (uint32_t i = 0; i < a->texel_count; i++)
         out[i] = 1.0f;
     for (int k = 0; k < su->surface_count; k++) {
         linear_map L;
         linear_map_of(s->nodes[su->surfaces[k].node].world, &L);
-        boundary bd = {s->positions, aim->edges, aim->edge_first[k], aim->edge_first[k + 1]};
+        boundary bd = {ends, append_edges(aim, s, k, NULL, ends)};
         ef.bd = NULL; /* bd's address is the same for every surface: reproject */
         for (uint32_t i = aim->texel_first[k]; i < aim->texel_first[k + 1]; i++) {
             const lm_texel *t = &a->texels[aim->texel_list[i]];
@@ -783,6 +928,7 @@ lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_
         }
     }
     free(ef.uv);
+    free(ends);
     return LM_OK;
 }
 
@@ -794,6 +940,8 @@ typedef struct {
     hit_set hits;
     lm_kdtree tree;
     double *binned;       /* bin_dense_surface's sums, or NULL */
+    float *edge_ends;     /* the boundary the estimates' discs are clipped to (boundary) */
+    uint32_t edge_count, seams_used;
     linear_map L;
     estimate_job job;
     lm_status rc;
@@ -957,15 +1105,14 @@ static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfa
     const lm_material *m = &s->materials[sf->material];
     linear_map_of(s->nodes[sf->node].world, &sj->L);
     lm_kdtree_init(&sj->tree);
-    int front_only = aim->set.front_only && !m->double_sided && sj->L.det != 0.0;
-    sj->rc = gather_hits(ps, sj->surface, s, &sj->L, front_only, aim->direct, &sj->hits, &sj->err);
+    sj->rc = gather_hits(aim, ps, s, su, a, sj->surface, &sj->L, &sj->hits, &sj->edge_ends, &sj->edge_count,
+                         &sj->seams_used, &sj->err);
     sj->binned = sj->rc == LM_OK ? bin_dense_surface(aim, s, a, sj) : NULL;
     if (sj->rc == LM_OK && !sj->binned)
         sj->rc = lm_kdtree_build(&sj->tree, sj->hits.pos, 3, sj->hits.count, &sj->err);
     uint32_t n = (uint32_t)aim->set.n_nearest < sj->hits.count ? (uint32_t)aim->set.n_nearest : sj->hits.count;
     double rmin = (double)aim->set.min_radius_texels * a->texel_size;
-    sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {s->positions, aim->edges,
-                             aim->edge_first[sj->surface], aim->edge_first[sj->surface + 1]}, n, rmin * rmin,
+    sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {sj->edge_ends, sj->edge_count}, n, rmin * rmin,
                              aim->set.boundary_correction, aim->set.kernel, aim->direct,
                              s->nodes[sf->node].world, m->double_sided, sj->binned};
 }
@@ -974,6 +1121,7 @@ static void free_surface(surface_job *sj)
 {
     lm_kdtree_free(&sj->tree);
     free(sj->binned);
+    free(sj->edge_ends);
     free(sj->hits.pos);
     free(sj->hits.flux);
 }
@@ -1050,13 +1198,19 @@ static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfa
     int ok = 0;
     uint32_t n_max = 0, edges_max = 0;
     for (; ok < count && jobs[ok].rc == LM_OK; ok++) {
-        const boundary *bd = &jobs[ok].job.bd;
         n_max = jobs[ok].job.n > n_max ? jobs[ok].job.n : n_max;
-        edges_max = bd->end - bd->first > edges_max ? bd->end - bd->first : edges_max;
+        edges_max = jobs[ok].edge_count > edges_max ? jobs[ok].edge_count : edges_max;
     }
     lm_status rc = ok < count ? jobs[ok].rc : LM_OK;
     if (rc != LM_OK && err)
         *err = jobs[ok].err;
+    for (int j = 0; j < ok; j++) {
+        int sf = jobs[j].surface;
+        if (jobs[j].seams_used != aim->seams_used[sf]) /* another boundary: its distances are not known */
+            for (uint32_t i = aim->texel_first[sf]; i < aim->texel_first[sf + 1]; i++)
+                aim->edge_d2[i] = -1.0f;
+        aim->seams_used[sf] = jobs[j].seams_used;
+    }
     int nomem = 0;
     write_texels(aim, jobs, ok, n_max, edges_max, &nomem);
     if (nomem) {

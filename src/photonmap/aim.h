@@ -37,6 +37,7 @@
 #include "../trace/direct_irradiance.h"
 #include "../trace/photon_store.h"
 #include "kdtree.h"
+#include "seams.h"
 
 typedef struct {
     int n_nearest;           /* N hits per estimate (default 32; clamped to the surface's hit count) */
@@ -52,6 +53,9 @@ typedef struct {
                               * estimated in one pass over its hits, without a kd-tree (the same hits summed in
                               * another order; a floor lit by 100 lights: 250,000 hits for 144 texels); 0: the
                               * kd-tree always */
+    int seams;               /* 1 (default): near its boundary a surface's estimate also uses the hits of the
+                              * surfaces that continue it across a seam (seams.h), and the disc's area is taken
+                              * on them all; 0: its own hits only, the paper's */
     uint64_t max_hits;       /* a refresh with a budget (lm_aim_refresh) stops before a surface that would take its
                               * surfaces' stored hits past this (the first is always refreshed): the hits
                               * bound its cost, and they grow with every light added (default 0: no bound) */
@@ -86,6 +90,8 @@ typedef struct {
                                 rho / pi Phi_i, over the whole value (direct light computed, not estimated,
                                 has none); and the estimate's radius in world units, over which neighbouring
                                 texels share hits. 0 and 0 where the AIM is 0. NULL when off */
+    lm_seams seams;          /* per surface, the surfaces that continue it (set.seams) */
+    uint32_t *seams_used;    /* per surface: which of them its last refresh used, hashed (edge_d2 holds for that set) */
     float mean_hit_energy;   /* as of the last refresh call */
     const lm_direct_light *direct; /* NULL (default): photons carry all light, the paper's form; else
                                       lm_aim_set_direct */
