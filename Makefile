@@ -157,6 +157,9 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
 # reads memory as it does.
 $(BUILD)/tests/test_soak: $(BUILD)/obj/src/cli/random_edits.o $(BUILD)/obj/src/cli/resident_memory.o
 
+# The per-channel criterion of `lmgi check` and `make bench` (src/cli/surface_error.c).
+$(BUILD)/tests/test_surface_error: $(BUILD)/obj/src/cli/surface_error.o
+
 # The GL guest test plays a GLX host on an X server: it alone links X and GLX (lmgi links neither).
 $(BUILD)/tests/test_gl_guest: LIBS += -lGL -lX11 -ldl
 

@@ -1049,6 +1049,11 @@ static void test_reference_and_check_commands(void **state)
     print_message("lmgi check at 32 x 32: %u pixels, frame / reference %.3f %.3f %.3f\n", pixels, r, g, b);
     assert_true(pixels > 100);
     assert_true(fabs(r - 1.0) < 0.1 && fabs(g - 1.0) < 0.1 && fabs(b - 1.0) < 0.1);
+    const char *per_channel = strstr(output, "per channel: "); /* the summary of issue 33's criterion */
+    int within, judged;
+    assert_non_null(per_channel);
+    assert_int_equal(sscanf(per_channel, "per channel: %d of %d surfaces of 100+ pixels within 5%%", &within, &judged), 2);
+    assert_true(judged >= 1 && within >= 0 && within <= judged);
     static const char *const check_files[] = {"check_frame.exr", "check_reference.exr", "check_ratio.png"};
     for (int k = 0; k < 3; k++) {
         snprintf(path, sizeof path, "%s/check/%s", dir, check_files[k]);

@@ -10,6 +10,9 @@
 #include "reference_cmd.h"
 #include "run_cmd.h"
 #include "scene_load.h"
+#include "surface_error.h"
+
+#define CHANNEL_TOLERANCE 0.05 /* issue 33's bound on every channel of every surface of 100+ pixels */
 
 static void print_row(const char *name, const char *material, uint32_t pixels, const double ratio[3])
 {
@@ -32,6 +35,14 @@ static void report(const lmgi_scene *sc, const lmgi_check_result *c)
     }
     print_row("frame (not emitters)", "", c->pixels, c->ratio);
     printf("relative RMSE over those pixels %.4f\n", c->rel_rmse);
+    lm_cli_channel_check ch;
+    lm_cli_surface_channels(sc, c, CHANNEL_TOLERANCE, &ch);
+    printf("per channel: %d of %d surfaces of 100+ pixels within %.0f%% of the reference", ch.within, ch.surfaces,
+           100.0 * CHANNEL_TOLERANCE);
+    if (ch.worst_surface >= 0)
+        printf("; furthest off: %d (%.14s) %c %+.1f%%", ch.worst_surface,
+               lmgi_node_name(sc, c->surfaces[ch.worst_surface].node), "RGB"[ch.worst_channel], 100.0 * ch.worst_ratio);
+    printf("\n");
 }
 
 /* frame / reference per compared pixel as a colour: grey at 1, red where the frame is brighter, blue where

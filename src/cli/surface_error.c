@@ -3,16 +3,22 @@
 
 #include <math.h>
 
+/* Whether surface s counts: seen, and not an emitter. */
+static int judged(const lmgi_scene *sc, const lmgi_check_surface *f, uint32_t min_pixels)
+{
+    lmgi_material mat;
+    lmgi_error err;
+    return f->pixels >= min_pixels && lmgi_get_material(sc, f->material, &mat, &err) == LMGI_OK &&
+           mat.cls != LMGI_MATERIAL_EMITTER;
+}
+
 double lm_cli_surface_error(const lmgi_scene *sc, const lmgi_check_result *c, double *worst)
 {
     double se = 0.0, w = 0.0;
     *worst = 0.0;
     for (int s = 0; s < c->surface_count; s++) {
         const lmgi_check_surface *f = &c->surfaces[s];
-        lmgi_material mat;
-        lmgi_error err;
-        if (f->pixels < 20 || lmgi_get_material(sc, f->material, &mat, &err) != LMGI_OK ||
-            mat.cls == LMGI_MATERIAL_EMITTER)
+        if (!judged(sc, f, 20))
             continue;
         double fr = f->frame_mean[0] + f->frame_mean[1] + f->frame_mean[2];
         double rf = f->reference_mean[0] + f->reference_mean[1] + f->reference_mean[2];
@@ -24,4 +30,28 @@ double lm_cli_surface_error(const lmgi_scene *sc, const lmgi_check_result *c, do
             *worst = fmax(*worst, d);
     }
     return w > 0.0 ? sqrt(se / w) : NAN;
+}
+
+void lm_cli_surface_channels(const lmgi_scene *sc, const lmgi_check_result *c, double tol, lm_cli_channel_check *out)
+{
+    *out = (lm_cli_channel_check){0, 0, -1, 0, 0.0, 0.0};
+    for (int s = 0; s < c->surface_count; s++) {
+        const lmgi_check_surface *f = &c->surfaces[s];
+        if (!judged(sc, f, 100))
+            continue;
+        const double *r = f->reference_mean, *m = f->frame_mean;
+        double floor = 0.05 * fmax(r[0], fmax(r[1], r[2])), far = 0.0;
+        if (!(floor > 0.0))
+            continue;
+        out->surfaces++;
+        for (int k = 0; k < 3; k++) {
+            double d = fabs(m[k] - r[k]) / fmax(r[k], floor);
+            far = fmax(far, d);
+            if (d > out->worst) {
+                out->worst = d, out->worst_surface = s, out->worst_channel = k;
+                out->worst_ratio = r[k] > 0.0 ? m[k] / r[k] - 1.0 : INFINITY;
+            }
+        }
+        out->within += far <= tol;
+    }
 }

@@ -11,4 +11,17 @@
  * average the reference's own noise away, which the per-pixel RMSE keeps (about its target error). */
 double lm_cli_surface_error(const lmgi_scene *sc, const lmgi_check_result *c, double *worst);
 
+/* The per-channel criterion (issue 33): over the visible surfaces of 100 or more compared pixels (not
+ * emitters), each channel's |frame - reference| / max(reference, 5% of the surface's brightest reference
+ * channel) (the floor keeps a channel the surface barely reflects, a green wall's red, from reading its
+ * noise as error): how many surfaces there are, how many are within tol in every channel, and the
+ * surface (-1: none) and channel furthest off, with its signed frame / reference - 1. */
+typedef struct {
+    int surfaces, within;
+    int worst_surface, worst_channel;
+    double worst;       /* the largest of the per-channel errors above */
+    double worst_ratio; /* that channel's frame / reference - 1 */
+} lm_cli_channel_check;
+void lm_cli_surface_channels(const lmgi_scene *sc, const lmgi_check_result *c, double tol, lm_cli_channel_check *out);
+
 #endif
