@@ -650,6 +650,52 @@ static void test_dense_surface_without_kdtree(void **state)
     ts_free(&t);
 }
 
+/* At lmgi run's density the smallest radius, not N, is the estimate's radius (docs/aim.md, "N against the
+ * smallest radius"): 100 hits a texel under a point light, N = 16 and 128 give the same map with the
+ * radius at 1 texel (both sets lie inside it, and every hit within it is summed), and different maps once
+ * the radius is a quarter of a texel. */
+static void test_min_radius_silences_n(void **state)
+{
+    (void)state;
+    lmt_mesh m;
+    square_mesh(&m, 2.0f);
+    tscene t;
+    ts_load(&t, &m, 1, "[{\"name\": \"plane\", \"mesh\": 0}]", 0.2f);
+    lm_photon_store ps;
+    assert_int_equal(lm_photon_store_init(&ps, 1, NULL), LM_OK);
+    const float light[4] = {0.3f, 1.0f, -0.2f, 10.0f};
+    g_rng = 7;
+    add_hits(&ps, &t, 0, -2.0f, -2.0f, 4.0f, 200, density_point, light, 1.0f, light);
+    double diff[2];
+    const float radius[2] = {1.0f, 0.25f};
+    for (int r = 0; r < 2; r++) {
+        lm_aim aim[2];
+        const int n[2] = {16, 128};
+        for (int k = 0; k < 2; k++) {
+            lm_aim_settings set;
+            lm_aim_settings_default(&set);
+            set.n_nearest = n[k];
+            set.min_radius_texels = radius[r];
+            init_aim(&aim[k], &t, &set);
+            assert_int_equal(lm_aim_refresh_all(&aim[k], t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+        }
+        double sum = 0.0;
+        for (uint32_t i = 0; i < t.a.texel_count; i++) {
+            double a = aim_px(&aim[0], &t.a.texels[i])[1], b = aim_px(&aim[1], &t.a.texels[i])[1];
+            sum += fabs(a - b) / fmax(fabs(b), 1e-30);
+        }
+        diff[r] = sum / t.a.texel_count;
+        print_message("smallest radius %.2f texels: N = 16 and N = 128 differ by %.3g%% per texel on average\n",
+                      (double)radius[r], 100.0 * diff[r]);
+        lm_aim_free(&aim[0]);
+        lm_aim_free(&aim[1]);
+    }
+    assert_true(diff[0] < 1e-6); /* the same hits, summed in another order where one was binned */
+    assert_true(diff[1] > 0.01);
+    lm_photon_store_free(&ps);
+    ts_free(&t);
+}
+
 /* (f) Seams: four square nodes meet at the origin (one of them half the size and scaled 2x, so its local
  * space is not the others'), and a point light 0.15 above that vertex puts the light's peak on the seams.
  * With seams every texel near the vertex sums the hits of the whole disc around it, across the four
@@ -781,6 +827,7 @@ int main(void)
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_batch_matches_single),
         cmocka_unit_test(test_dense_surface_without_kdtree),
+        cmocka_unit_test(test_min_radius_silences_n),
         cmocka_unit_test(test_seams),
         cmocka_unit_test(test_bad_settings),
     };

@@ -103,18 +103,24 @@ def knob_plots(scene, out_dir):
     for k, knob in enumerate(knobs):
         ax = axes[k // cols][k % cols]
         rs = sorted((r for r in scene["rows"] if r["knob"] == knob), key=lambda r: r["x"] if finite(r["x"]) else 0)
-        xs = [cost_of(r) for r in rs]
-        for metric, line in (("iim", "o-"), ("frame", "s--")):
-            ys = [num(r["iim"]["rmse"] if metric == "iim" else frame_error(r)) for r in rs]
-            if not any(finite(y) for y in ys):
-                continue
-            ax.plot(xs, ys, line, label="IIM per texel" if metric == "iim" else "frame per surface", markersize=4)
-            for r, x, y in zip(rs, xs, ys):
-                if finite(y):
-                    ax.annotate(r["value"], (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7)
-                    if r["default"]:
-                        ax.plot([x], [y], "*", color="black", markersize=11, zorder=5)
-        log_axes(ax, xs, [frame_error(r) for r in rs] + [r["iim"]["rmse"] for r in rs])
+        # a grid's rows ("0.25 texels x N 32") are one line per value of its first knob
+        series = {}
+        for r in rs:
+            series.setdefault(r["value"].split(" x ")[0] + " " if knob.startswith("grid_") else "", []).append(r)
+        for name, part in series.items():
+            xs = [cost_of(r) for r in part]
+            for metric, line in (("iim", "o-"), ("frame", "s--")):
+                ys = [num(r["iim"]["rmse"] if metric == "iim" else frame_error(r)) for r in part]
+                if not any(finite(y) for y in ys):
+                    continue
+                ax.plot(xs, ys, line, markersize=4,
+                        label=name + ("IIM per texel" if metric == "iim" else "frame per surface"))
+                for r, x, y in zip(part, xs, ys):
+                    if finite(y):
+                        ax.annotate(r["value"], (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7)
+                        if r["default"]:
+                            ax.plot([x], [y], "*", color="black", markersize=11, zorder=5)
+        log_axes(ax, [cost_of(r) for r in rs], [frame_error(r) for r in rs] + [r["iim"]["rmse"] for r in rs])
         ax.set_title(rs[0]["label"], fontsize=9)
         style(ax, "ms per update" if knob in UPDATE_COST else "ms for the full solution", "relative error (RMS)")
     for k in range(len(knobs), rows_n * cols):

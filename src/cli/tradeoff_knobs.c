@@ -102,9 +102,12 @@ static int swept(const knob *out[N_ENTRIES])
     return n;
 }
 
-/* The joint grid: photons per group x N, the pair that sets the AIMs' noise and blur. */
+/* The joint grids: photons per group x N, the pair that sets the AIMs' noise and blur, and N x the
+ * smallest radius, which decides whether N acts at all (at lmgi run's density the radius of 1 texel holds
+ * more than N hits). */
 static const double GRID_PER_GROUP_FULL[] = {40, 160, 640}, GRID_N_FULL[] = {32, 128, 256};
 static const double GRID_PER_GROUP_QUICK[] = {80, 320}, GRID_N_QUICK[] = {64, 256};
+static const double GRID_RADIUS_FULL[] = {0.25, 0.5}, GRID_RADIUS_QUICK[] = {0.25};
 
 const char *lm_tradeoff_knob_keys(void)
 {
@@ -116,14 +119,14 @@ const char *lm_tradeoff_knob_keys(void)
             strcat(keys, list[k]->key);
             strcat(keys, ", ");
         }
-        strcat(keys, "grid");
+        strcat(keys, "grid, grid_radius");
     }
     return keys;
 }
 
 static int known(const char *name, size_t len)
 {
-    if (len == 4 && !strncmp(name, "grid", 4))
+    if ((len == 4 && !strncmp(name, "grid", 4)) || (len == 11 && !strncmp(name, "grid_radius", 11)))
         return 1;
     for (int k = 0; k < N_ENTRIES; k++)
         if (KNOBS[k].order && strlen(KNOBS[k].key) == len && !strncmp(name, KNOBS[k].key, len))
@@ -171,7 +174,7 @@ static lm_tradeoff_setting base(const lm_tradeoff_plan *p, const char *key, cons
 int lm_tradeoff_settings(const lm_tradeoff_plan *p, lm_tradeoff_setting **out, int *count)
 {
     const knob *list[N_ENTRIES];
-    int swept_count = swept(list), cap = swept_count * MAX_VALUES + 9, n = 0;
+    int swept_count = swept(list), cap = swept_count * MAX_VALUES + 9 + 6, n = 0;
     lm_tradeoff_setting *s = calloc((size_t)cap, sizeof *s);
     if (!s)
         return 0;
@@ -205,6 +208,20 @@ int lm_tradeoff_settings(const lm_tradeoff_plan *p, lm_tradeoff_setting **out, i
                 s[n].desc.aim.nearest = (int)nn[j];
                 s[n].x = pg[i];
                 snprintf(s[n].value, sizeof s[n].value, "%g x N %g", pg[i], nn[j]);
+                n++;
+            }
+    }
+    if (wanted(p, "grid_radius")) {
+        const double *rr = p->quick ? GRID_RADIUS_QUICK : GRID_RADIUS_FULL;
+        const double *nn = p->quick ? GRID_N_QUICK : GRID_N_FULL;
+        int nr = p->quick ? 1 : 2, nnn = p->quick ? 2 : 3;
+        for (int i = 0; i < nr; i++)
+            for (int j = 0; j < nnn; j++) {
+                s[n] = base(p, "grid_radius", "smallest radius x N");
+                s[n].desc.aim.min_radius = (float)rr[i];
+                s[n].desc.aim.nearest = (int)nn[j];
+                s[n].x = nn[j];
+                snprintf(s[n].value, sizeof s[n].value, "%g texels x N %g", rr[i], nn[j]);
                 n++;
             }
     }
