@@ -43,15 +43,15 @@ static void atlas_every_budget(const char *path)
         atlas_within(path, budgets[i], 0.6);
 }
 
-/* At `lmgi run`'s density (1,800 texels and lmgi_options.wall_texels 16): every surface of 2 m^2 or more
- * gets at least `least` texels (one texel of 50 m each before, on the town), and the texels the walls add
- * stay within `most` in all. */
-static void walls_at_run_density(const char *path, uint32_t least, uint32_t most)
+/* At `lmgi run`'s density (1,800 texels and lmgi_options.wall_texels, 16 as run sets it): every surface of
+ * 2 m^2 or more gets at least `least` texels (one texel of 50 m each before, on the town), and the texels
+ * the walls add stay within `most` in all. */
+static void walls_at_density(const char *path, int wall_texels, uint32_t least, uint32_t most)
 {
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = lmgi_atlas_texels_for(0);
-    o.wall_texels = 16;
+    o.wall_texels = wall_texels;
     lmgi_scene *sc = NULL;
     lmgi_error e;
     if (lmgi_load(path, &o, &sc, &e) != LMGI_OK)
@@ -142,12 +142,24 @@ static void bake_and_check(const char *path, int texels, const lmgi_camera *cam)
 
 /* The room: its file's camera stands in the walls' corner (every reference ray from it starts on a wall's
  * back), so the frame is checked from inside, near that corner, looking at the far pillars. */
+/* A scene in centimetres makes every surface a wall (the shared Cornell box: 24 surfaces of 0.7 to 30 m^2
+ * in its units): all its texels come on top of the budget, the budget had nothing left to meet, and the
+ * texel size it scaled by 0 became 0 and then NaN; packing at that size wrote outside the atlas (heap
+ * corruption at wall_texels 256 to 65,536). Each surface now gets its wall texels and the load succeeds. */
+static void test_every_surface_a_wall(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
+    walls_at_density(path, 16, 12, 4000);
+    walls_at_density(path, 1024, 900, 40000); /* measured 25,592 */
+}
+
 static void test_occlusion_room(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("occlusion-room/room_lit.glb"));
     atlas_every_budget(path);
-    walls_at_run_density(path, 12, 4000); /* measured 1,964 */
+    walls_at_density(path, 16, 12, 4000); /* measured 1,964 */
     lmgi_camera cam;
     lmt_look_at((const float[3]){4.0f, 2.5f, 4.0f}, (const float[3]){-2.0f, 1.5f, -2.0f}, 1.1f, &cam);
     bake_and_check(path, 8000, &cam);
@@ -161,7 +173,7 @@ static void test_truck_town(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("truck-town/town_lit.gltf"));
     atlas_every_budget(path);
-    walls_at_run_density(path, 12, 40000); /* measured 30,219: 1,800 + 587 walls and roofs */
+    walls_at_density(path, 16, 12, 40000); /* measured 30,219: 1,800 + 587 walls and roofs */
     bake_and_check(path, 20000, NULL);
 }
 
@@ -302,6 +314,7 @@ static void test_pages_bake_as_one_page(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_every_surface_a_wall),
         cmocka_unit_test(test_occlusion_room),
         cmocka_unit_test(test_truck_town),
         cmocka_unit_test(test_many_rooms),

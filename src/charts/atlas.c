@@ -299,7 +299,10 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
         double target = o->target_texels > 0 ? o->target_texels : LM_ATLAS_DEFAULT_TEXELS;
         double ratio = count / target, best = fabs(ratio - 1.0);
         float best_ts = ts, last_ts = ts;
-        for (int pass = 0; st == LM_OK && o->texel_size <= 0.0f && pass < LM_BUDGET_PASSES &&
+        /* ratio 0: every texel is a wall's, on top of the budget (a level in centimetres makes every surface
+         * a wall), and the texel size has nothing to meet: scaling it by 0 made it 0 and the packing wrote
+         * outside the atlas */
+        for (int pass = 0; st == LM_OK && o->texel_size <= 0.0f && pass < LM_BUDGET_PASSES && ratio > 0.0 &&
                            best > (pass ? LM_BUDGET_SLACK : LM_BUDGET_WARN);
              pass++) {
             /* towards the near edge of the band, not its middle: the texel size moves no further than
@@ -321,7 +324,7 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
             lm_atlas_free(out);
             st = lay_out(s, su, &c, pos, best_ts, o, out, &count, err);
         }
-        if (st == LM_OK && o->texel_size <= 0.0f && best > LM_BUDGET_WARN && c.count > 0)
+        if (st == LM_OK && o->texel_size <= 0.0f && best > LM_BUDGET_WARN && c.count > 0 && count > 0.0)
             lm_warn("%s: %d charts need %.0f texels at the least; the budget of %.0f texels cannot be met "
                     "(docs/levels.md, \"Atlas\")", s->path, c.count, count, target);
         lmc_charts_free(&c);

@@ -157,6 +157,9 @@ static double try_pack(const lmc_charts *c, const lm_surfaces *su, lmc_rect *k, 
 lm_status lmc_pack(const lmc_charts *c, const lm_surfaces *su, float texel_size, int gutter, int max_size,
                    lm_atlas *out, lm_error *err)
 {
+    if (!(texel_size > 0.0f) || !isfinite(texel_size))
+        return lm_fail(err, LM_ERR_INVALID, "charts: texel size %g to pack at (a positive, finite size)",
+                       (double)texel_size);
     out->charts = calloc((size_t)c->count + 1, sizeof *out->charts);
     lmc_rect *k = malloc(((size_t)c->count + 1) * sizeof *k);
     if (!out->charts || !k) {
