@@ -40,13 +40,15 @@ LDFLAGS_ALL := -fopenmp $(SAN) $(LDFLAGS)
 # The command line's own (not the library's: lmgi.pc does not name it): cJSON for a shard's part.json
 # and the edit scripts of --edits
 CLI_LIBS := -lcjson
+# lmgi view's window (GLFW) and its drawing (the window's own OpenGL; the library links neither)
+VIEW_LIBS := -lglfw -lGL
 
 # npm: Debian's, unless a node that brings its own is installed (NodeSource's nodejs conflicts with it)
 NPM_DEB := $(if $(shell command -v npm 2>/dev/null),,npm)
 DEB_PACKAGES := build-essential pkg-config libembree-dev libosmesa6-dev libopenmesh-dev libtinygltf-dev \
                 nlohmann-json3-dev libstb-dev libtinyexr-dev libmeshoptimizer-dev libwebp-dev libcmocka-dev \
                 libegl-dev libegl-mesa0 python3-matplotlib libgl-dev libx11-dev xvfb nodejs chromium \
-                openmpi-bin libopenmpi-dev libcjson-dev libdraco-dev draco gltfpack \
+                openmpi-bin libopenmpi-dev libcjson-dev libdraco-dev draco gltfpack libglfw3-dev xdotool \
                 $(NPM_DEB)
 
 LIB_C   := $(sort $(wildcard src/core/*.c src/scene/*.c src/charts/*.c src/trace/*.c src/reference/*.c \
@@ -144,10 +146,10 @@ install-files:
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(LMGI_VERSION)|' -e 's|@LIBS@|$(LIBS) -fopenmp|' lmgi.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/lmgi.pc
 
 $(BUILD)/lmgi: $(CLI_OBJ) $(BUILD)/liblmgi.a
-	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)
+	$(CC) -o $@ $(CLI_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS) $(VIEW_LIBS)
 
 $(BUILD)/lmgi-dev: $(DEV_OBJ) $(BUILD)/liblmgi.a
-	$(CC) -o $@ $(DEV_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)
+	$(CC) -o $@ $(DEV_OBJ) $(BUILD)/liblmgi.a $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS) $(VIEW_LIBS)
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(TEST_SUPPORT) $(BUILD)/liblmgi.a
 	@mkdir -p $(dir $@)
@@ -159,6 +161,9 @@ $(BUILD)/tests/test_soak: $(BUILD)/obj/src/cli/random_edits.o $(BUILD)/obj/src/c
 
 # The per-channel criterion of `lmgi check` and `make bench` (src/cli/surface_error.c).
 $(BUILD)/tests/test_surface_error: $(BUILD)/obj/src/cli/surface_error.o
+
+# The viewer's camera (src/cli/view_camera.c)
+$(BUILD)/tests/test_view_camera: $(BUILD)/obj/src/cli/view_camera.o
 
 # The GL guest test plays a GLX host on an X server: it alone links X and GLX (lmgi links neither).
 $(BUILD)/tests/test_gl_guest: LIBS += -lGL -lX11 -ldl
@@ -178,7 +183,7 @@ $(BUILD)/obj/mpi/main_mpi.o: src/cli/mpi/main_mpi.c $(BUILD)/flags
 	@mkdir -p $(dir $@)
 	$(MPICC) $(CFLAGS_ALL) -c $< -o $@
 $(BUILD)/lmgi-mpi: $(MPI_OBJ) $(filter-out %/main.o,$(CLI_OBJ)) $(BUILD)/liblmgi.a
-	$(MPICC) -o $@ $^ $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS)
+	$(MPICC) -o $@ $^ $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS) $(VIEW_LIBS)
 
 # make bench-mpi: the MPI bake's scaling on 1, 2 and 4 ranks of this machine (docs/farm.md)
 .PHONY: bench-mpi

@@ -140,6 +140,11 @@ typedef enum { LMGI_TONEMAP_NEUTRAL = 0, LMGI_TONEMAP_CLAMP } lmgi_tonemap;
 
 /* The exposure `op` picks for `pixels` RGB values (3 floats each); 1 when none is lit or rgb is NULL. */
 LMGI_API float lmgi_auto_exposure(lmgi_tonemap op, const float *rgb, size_t pixels);
+/* The picture as its PNG would show it, for a window (lmgi view): rgba8[4 i ..] = sRGB of tone map `op` at
+ * `exposure` (0: automatic, as lmgi_auto_exposure) of the i-th of `pixels` RGB values, alpha 255. Returns
+ * the exposure used; NULL rgb or rgba8, or an unknown op: nothing written, 0. */
+LMGI_API float lmgi_tonemap_rgba8(lmgi_tonemap op, float exposure, const float *rgb, size_t pixels,
+                                  unsigned char *rgba8);
 /* How lmgi_write_image writes; zero-initialised (or NULL) means the defaults. */
 typedef struct {
     lmgi_tonemap tonemap;  /* PNG: the tone map (default neutral) */

@@ -7,6 +7,7 @@
 #include <cmocka.h>
 
 #include <lmgi_tools.h>
+#include <stb/stb_image.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -989,6 +990,43 @@ static void test_write_image(void **state)
     assert_float_equal(lmgi_auto_exposure(LMGI_TONEMAP_NEUTRAL, NULL, 3), 1.0f, 0.0);
 }
 
+/* lmgi_tonemap_rgba8 (a window's pixels, lmgi view) gives the bytes lmgi_write_image's PNG holds, for both
+ * tone maps, automatic exposure and a given one. */
+static void test_tonemap_rgba8(void **state)
+{
+    (void)state;
+    float px[3 * 6 * 4];
+    for (int i = 0; i < 3 * 6 * 4; i++)
+        px[i] = 0.37f * (float)(i % 11);
+    const lmgi_image_desc descs[3] = {{LMGI_TONEMAP_NEUTRAL, 0.0f, 0}, {LMGI_TONEMAP_CLAMP, 0.0f, 0},
+                                      {LMGI_TONEMAP_NEUTRAL, 2.5f, 0}};
+    for (int k = 0; k < 3; k++) {
+        char path[1024];
+        lmgi_error e;
+        snprintf(path, sizeof path, "%s/tone.png", lmt_tmpdir());
+        assert_int_equal(lmgi_write_image(path, 6, 4, 3, px, &descs[k], &e), LMGI_OK);
+        size_t size = 0;
+        unsigned char *data = lmt_read_file(path, &size, 0), rgba[4 * 24];
+        int w, h, n;
+        unsigned char *png = stbi_load_from_memory(data, (int)size, &w, &h, &n, 3);
+        assert_non_null(png);
+        float k_used = lmgi_tonemap_rgba8(descs[k].tonemap, descs[k].exposure, px, 24, rgba);
+        if (descs[k].exposure > 0.0f)
+            assert_true(k_used == descs[k].exposure);
+        else
+            assert_true(k_used == lmgi_auto_exposure(descs[k].tonemap, px, 24));
+        for (int i = 0; i < 24; i++) {
+            assert_memory_equal(rgba + 4 * i, png + 3 * i, 3);
+            assert_int_equal(rgba[4 * i + 3], 255);
+        }
+        stbi_image_free(png);
+        free(data);
+    }
+    unsigned char out[4];
+    assert_true(lmgi_tonemap_rgba8(LMGI_TONEMAP_NEUTRAL, 1.0f, NULL, 1, out) == 0.0f);
+    assert_true(lmgi_tonemap_rgba8((lmgi_tonemap)7, 1.0f, px, 1, out) == 0.0f);
+}
+
 /* A level from arrays (lmgi_load_desc): a floor, a dynamic box on it and a point light above, loaded,
  * hit where the arrays put them, lit by an updater, and every bad desc refused naming the mesh. */
 static void test_scene_from_arrays(void **state)
@@ -1406,6 +1444,7 @@ int main(void)
         cmocka_unit_test(test_budget_sets_texels),
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_write_image),
+        cmocka_unit_test(test_tonemap_rgba8),
         cmocka_unit_test(test_scene_from_arrays),
         cmocka_unit_test(test_second_thread_refused),
         cmocka_unit_test(test_shard_cancelled_and_resumed),

@@ -66,7 +66,7 @@ static void test_command_help(void **state)
 {
     (void)state;
     static const char *const cmds[] = {"info",  "charts", "run",   "bake",    "merge",
-                                       "check", "reference", "bench", "tradeoff"};
+                                       "check", "reference", "bench", "tradeoff", "view"};
     const int ncmds = (int)(sizeof cmds / sizeof *cmds);
     static char all[1 << 16], mine[1 << 16], names[128][48], lists[128][160], my_names[128][48], unused[128][160];
     assert_int_equal(run("help"), 0);
@@ -107,7 +107,7 @@ static void test_command_help(void **state)
     print_message("%d options, %d of them taken by each command on average\n", n, taken_total / ncmds);
     assert_int_equal(run("info scenes/cornell.glb --hemicube 8"), 2);
     assert_non_null(
-        strstr(output, "'--hemicube' is not an option of 'info' (it is one of run, bake, merge, check and bench"));
+        strstr(output, "'--hemicube' is not an option of 'info' (it is one of run, bake, merge, check, bench and view"));
     assert_int_equal(run("run scenes/cornell.glb --texel-sise 0.1 --out x"), 2);
     assert_non_null(strstr(output, "did you mean '--texel-size'?"));
     assert_int_equal(run("bake scenes/cornell.glb --hemicube-sample 4 --out x"), 2);

@@ -14,6 +14,15 @@ float lmgi_auto_exposure(lmgi_tonemap op, const float *rgb, size_t pixels)
     return rgb ? lm_tonemap_exposure((lm_tonemap_op)op, rgb, pixels, 3) : 1.0f;
 }
 
+float lmgi_tonemap_rgba8(lmgi_tonemap op, float exposure, const float *rgb, size_t pixels, unsigned char *rgba8)
+{
+    if (!rgb || !rgba8 || (op != LMGI_TONEMAP_NEUTRAL && op != LMGI_TONEMAP_CLAMP))
+        return 0.0f;
+    float k = exposure > 0.0f && isfinite(exposure) ? exposure : lm_tonemap_exposure((lm_tonemap_op)op, rgb, pixels, 3);
+    lm_tonemap((lm_tonemap_op)op, rgb, pixels, 3, k, rgba8);
+    return k;
+}
+
 static int ends_with(const char *s, const char *tail)
 {
     size_t n = strlen(s), m = strlen(tail);

@@ -183,6 +183,11 @@ static int apply(const char *path, int i, const cJSON *e, lmgi_scene *sc)
     return st == LMGI_OK ? 1 : bad(path, i, err.message);
 }
 
+int lm_edit_script_apply(const lm_edit_script *s, int i, lmgi_scene *sc)
+{
+    return apply(s->path, i, s->edits[i].v, sc);
+}
+
 /* Relative L1 distance of a from b over valid texels (b's alpha). */
 static double distance(const float *a, const float *b, size_t texels)
 {

@@ -80,6 +80,9 @@ void lm_edit_script_free(lm_edit_script *s);
  * check (NULL: none). 0 after printing the error (an edit the scene cannot take names the edit). */
 int lm_edit_script_play(const lm_edit_script *s, const char *scene_path, const lmgi_updater_desc *d,
                         float budget_ms, const lm_edit_frame_check *fc, lm_edit_frame *rows);
+/* Makes edit i of s on sc (a window playing the script: lmgi view --script). 0 after printing what is wrong,
+ * naming the script and the edit. */
+int lm_edit_script_apply(const lm_edit_script *s, int i, lmgi_scene *sc);
 /* The updates edit i's effect is measured over, [*from, *to): from its frame to the next edit's (or the
  * end). 0 when a later edit shares its frame (the last of a frame's edits reports). */
 int lm_edit_span(const lm_edit_script *s, int i, int *from, int *to);

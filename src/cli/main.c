@@ -17,6 +17,7 @@
 #include "run_cmd.h"
 #include "scene_load.h"
 #include "tradeoff_cmd.h"
+#include "view_cmd.h"
 
 static int load(const lm_cli_args *a, lmgi_scene **sc)
 {
@@ -86,7 +87,7 @@ int main(int argc, char **argv)
         int (*run)(const lm_cli_args *a);
     } commands[] = {{"info", cmd_info}, {"charts", cmd_charts}, {"reference", lm_cli_reference}, {"run", lm_cli_run},
                     {"bake", lm_cli_bake}, {"merge", lm_cli_merge}, {"check", lm_cli_check}, {"bench", lm_cli_bench},
-                    {"tradeoff", lm_cli_tradeoff}};
+                    {"tradeoff", lm_cli_tradeoff}, {"view", lm_cli_view}};
     for (size_t i = 0; i < sizeof commands / sizeof *commands; i++)
         if (!strcmp(cmd, commands[i].name)) {
             rc = commands[i].run(&a);

@@ -55,6 +55,13 @@ const lm_cli_command lm_cli_commands[] = {
      "its AIM, IIM and frame against the reference: DIR/report.html (plots, the Pareto front),\n"
      "tradeoff.csv/.json (docs/tradeoff.md); --edits SCRIPT,...: the lightmap's lag behind each\n"
      "scripted edit per update budget (lag.csv)"},
+    {"view", LM_CMD_VIEW, "view SCENE",
+     "a window showing the lighting as it follows every edit (docs/viewer.md): the updater runs each\n"
+     "frame within --budget MS; mouse: left drag orbits, right drag (or shift) pans, the wheel zooms;\n"
+     "keys: W A S D Q E fly, R the scene's camera, L the next light, + and - dim or brighten it, O\n"
+     "switches it off and on, [ and ] halve or double the budget, H the panel, P a screenshot, Esc\n"
+     "quits. --script EDITS.json plays an edit script (docs/bench.md), --frames N quits after N\n"
+     "frames, --screenshot FILE writes the last frame"},
     {NULL, 0, NULL, NULL},
 };
 
@@ -96,12 +103,14 @@ const lm_cli_option lm_cli_options[] = {
      "write into a non-empty --out DIR (or over a --json FILE) lmgi has not\n"
      "written before; lmgi never removes or replaces any other file"},
     {"--size", NULL, "WxH", LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF |
-     LM_CMD_BENCH, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_size,
+     LM_CMD_BENCH | LM_CMD_VIEW, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_size,
      "picture size (charts: default 1024x768; run: 512x512; check: 128x128;\n"
-     "tradeoff: 96x96; bench --soak: 32x32)"},
-    {"--frames", NULL, "N", LM_CMD_RUN | LM_CMD_CHECK, LM_OPT_INT, offsetof(lm_cli_args, frames), 1, 1000000, NULL,
+     "tradeoff: 96x96; bench --soak: 32x32; view: the window, 640x480)"},
+    {"--frames", NULL, "N", LM_CMD_RUN | LM_CMD_CHECK | LM_CMD_VIEW, LM_OPT_INT, offsetof(lm_cli_args, frames), 1,
+     1000000, NULL,
      "frames to play at 30 per second of animation (default 60; check: the\n"
-     "frame it checks)"},
+     "frame it checks; view: quit after N frames, the animation's time\n"
+     "then N / 30 s rather than the clock's)"},
     {"--seed", NULL, "N", UPDATER | REFERENCE_USERS, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_seed,
      "the random sequences' seed (photons' scramble, the reference's paths)"},
     {"--target-error", NULL, "E", REFERENCE_USERS, LM_OPT_FLOAT, offsetof(lm_cli_args, target_error), 1e-6, 0, NULL,
@@ -125,7 +134,7 @@ const lm_cli_option lm_cli_options[] = {
      "the file's camera I (default: its first, else one framing the scene)"},
     {"--exr-every", NULL, "K", LM_CMD_RUN, LM_OPT_INT, offsetof(lm_cli_args, exr_every), 1, 1000000, NULL,
      "every K-th frame also as linear EXR (default 10)"},
-    {"--tonemap", NULL, "T", LM_CMD_RUN | LM_CMD_REFERENCE, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_tonemap,
+    {"--tonemap", NULL, "T", LM_CMD_RUN | LM_CMD_REFERENCE | LM_CMD_VIEW, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_tonemap,
      "how PNGs show light: neutral (Khronos PBR Neutral, exposure from the\n"
      "median; the default) or clamp (linear, exposure from the 99th\n"
      "percentile); EXRs keep the linear numbers either way"},
@@ -159,12 +168,18 @@ const lm_cli_option lm_cli_options[] = {
      "bench --soak: a random edit before each update instead of the animation\n"
      "(nodes moved, lights and materials edited, lights added up to L and then\n"
      "added and removed; --seed picks them)"},
-    {"--budget", NULL, "MS", LM_CMD_BENCH | LM_CMD_RUN, LM_OPT_FLOAT, offsetof(lm_cli_args, budget_ms), 0, 10000,
-     NULL,
+    {"--budget", NULL, "MS", LM_CMD_BENCH | LM_CMD_RUN | LM_CMD_VIEW, LM_OPT_FLOAT, offsetof(lm_cli_args, budget_ms),
+     0, 10000, NULL,
      "run, bench --soak: each update's time budget in ms, shared by every stage\n"
      "(lmgi_update's budget_ms; frames.csv says which stage took the time and\n"
      "why); default 0: the fixed counts (--texels-per-frame texels, ...), the\n"
-     "same lightmaps on every machine"},
+     "same lightmaps on every machine (view: default 16)"},
+    {"--script", NULL, "EDITS.json", LM_CMD_VIEW, LM_OPT_TEXT, offsetof(lm_cli_args, script_path), 0, 0, NULL,
+     "view: play an edit script (bench --edits' format, docs/bench.md) at its\n"
+     "frames"},
+    {"--screenshot", NULL, "FILE", LM_CMD_VIEW, LM_OPT_TEXT, offsetof(lm_cli_args, screenshot_path), 0, 0, NULL,
+     "view: write the last frame to FILE (.png, or .exr for the linear\n"
+     "numbers) when the window closes or --frames ends"},
     {"--edits", NULL, "SCRIPT.json", LM_CMD_BENCH | LM_CMD_TRADEOFF, LM_OPT_TEXT,
      offsetof(lm_cli_args, edits_path), 0, 0, NULL,
      "a scripted edit sequence (docs/bench.md); tradeoff: a comma-separated\n"

@@ -18,9 +18,9 @@
 enum {
     LM_CMD_INFO = 1u << 0, LM_CMD_CHARTS = 1u << 1, LM_CMD_RUN = 1u << 2, LM_CMD_BAKE = 1u << 3,
     LM_CMD_CHECK = 1u << 4, LM_CMD_REFERENCE = 1u << 5, LM_CMD_BENCH = 1u << 6, LM_CMD_TRADEOFF = 1u << 7,
-    LM_CMD_MERGE = 1u << 8, LM_CMD_ALL = (1u << 9) - 1,
+    LM_CMD_MERGE = 1u << 8, LM_CMD_VIEW = 1u << 9, LM_CMD_ALL = (1u << 10) - 1,
     /* the commands that make an updater from the options (lm_cli_updater_desc): its knobs' */
-    LM_CMD_UPDATER = LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_MERGE | LM_CMD_CHECK | LM_CMD_BENCH
+    LM_CMD_UPDATER = LM_CMD_RUN | LM_CMD_BAKE | LM_CMD_MERGE | LM_CMD_CHECK | LM_CMD_BENCH | LM_CMD_VIEW
 };
 
 /* LM_OPT_KNOBS: no option, the place of the updater's knobs (knob_options.h) in the help's order. */
