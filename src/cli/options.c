@@ -57,11 +57,12 @@ const lm_cli_command lm_cli_commands[] = {
      "scripted edit per update budget (lag.csv)"},
     {"view", LM_CMD_VIEW, "view SCENE",
      "a window showing the lighting as it follows every edit (docs/viewer.md): the updater runs each\n"
-     "frame within --budget MS; mouse: left drag orbits, right drag (or shift) pans, the wheel zooms;\n"
-     "keys: W A S D Q E fly, R the scene's camera, L the next light, + and - dim or brighten it, O\n"
-     "switches it off and on, [ and ] halve or double the budget, H the panel, P a screenshot, Esc\n"
-     "quits. --script EDITS.json plays an edit script (docs/bench.md), --frames N quits after N\n"
-     "frames, --screenshot FILE writes the last frame"},
+     "frame within --budget MS; mouse: left drag orbits, right drag (or shift) pans, the wheel zooms,\n"
+     "a click selects a node, ctrl + drag moves it, ctrl + wheel turns it; keys: W A S D Q E fly, R\n"
+     "the scene's camera, L the next light, + and - brighten or dim it, O switches it, C recolours it,\n"
+     "N adds one, Delete removes it, ctrl+Z and ctrl+Y undo and redo, ctrl+S saves the scene, [ and\n"
+     "] the budget, H the panel, P a screenshot, Esc quits. --script EDITS.json plays an edit script\n"
+     "(docs/bench.md), --frames N quits after N frames, --screenshot FILE writes the last frame"},
     {NULL, 0, NULL, NULL},
 };
 
@@ -174,6 +175,8 @@ const lm_cli_option lm_cli_options[] = {
      "(lmgi_update's budget_ms; frames.csv says which stage took the time and\n"
      "why); default 0: the fixed counts (--texels-per-frame texels, ...), the\n"
      "same lightmaps on every machine (view: default 16)"},
+    {"--still", NULL, NULL, LM_CMD_VIEW, LM_OPT_FLAG, offsetof(lm_cli_args, still), 0, 0, NULL,
+     "view: the animations stand at time 0 (the file's pose) instead of playing"},
     {"--script", NULL, "EDITS.json", LM_CMD_VIEW, LM_OPT_TEXT, offsetof(lm_cli_args, script_path), 0, 0, NULL,
      "view: play an edit script (bench --edits' format, docs/bench.md) at its\n"
      "frames"},

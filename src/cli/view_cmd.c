@@ -15,10 +15,13 @@
 #include "run_cmd.h"
 #include "scene_load.h"
 #include "view_camera.h"
+#include "view_edit.h"
 #include "view_panel.h"
 
 #define FPS 30.0f            /* the animation's frames a second with --frames (as lmgi run) */
 #define LIGHT_STEP 1.25f     /* + and - multiply or divide a light's intensity by this */
+#define TURN_STEP 0.2617994f /* ctrl + wheel turns the selected node by 15 degrees a step */
+#define CLICK_PIXELS 3.0     /* a press and release closer than this is a click (select), not a drag */
 
 typedef struct {
     const lm_cli_args *a;
@@ -35,8 +38,12 @@ typedef struct {
     float time, paused_at;
     double start, last;
     int light;               /* the selected light, -1: none */
-    int drag;                /* 0, 1 orbit, 2 pan */
-    double mouse[2];
+    int node;                /* the selected node, -1: none */
+    int drag;                /* 0, 1 orbit, 2 pan, 3 moving the selected node */
+    double mouse[2], press[2];
+    float grab[3], grab_start[16]; /* moving a node: the point grabbed and the node's matrix then */
+    lm_view_history history;
+    int saves;
     float exposure;          /* fixed from the first picture (X meters again) */
     float *rgb;              /* the picture, linear, top row first */
     unsigned char *rgba;     /* tone-mapped, bottom row first (glDrawPixels') */
@@ -80,18 +87,109 @@ static void edit_light(viewer *v, float f)
         say(v, "no light to edit (the scene has none)");
         return;
     }
+    lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = l};
     if (f == 0.0f)
         l.enabled = !l.enabled;
-    else
+    else if (f < 0.0f) { /* the next of a few colours: white, warm, cool */
+        static const float colours[3][3] = {{1.0f, 1.0f, 1.0f}, {1.0f, 0.75f, 0.5f}, {0.6f, 0.75f, 1.0f}};
+        int next = 0;
+        for (int c = 0; c < 3; c++)
+            if (!memcmp(l.color, colours[c], sizeof l.color))
+                next = (c + 1) % 3;
+        memcpy(l.color, colours[next], sizeof l.color);
+    } else
         l.intensity *= f;
+    step.light_after = l;
     if (lmgi_set_light(v->sc, v->light, &l, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         say(v, "the light edit was refused (the terminal says why)");
         return;
     }
+    lm_view_history_push(&v->history, &step);
+    char what[128];
+    snprintf(what, sizeof what, "light %d %s, intensity %.4g, colour %.2f %.2f %.2f", v->light, l.enabled ? "on" : "off",
+             (double)l.intensity, (double)l.color[0], (double)l.color[1], (double)l.color[2]);
+    say(v, what);
+}
+
+/* N: a point light at the camera's target, raised by a tenth of the scene, as bright as the selected light
+ * (or 10 cd); Delete: the selected light removed. */
+static void add_light(viewer *v)
+{
+    lmgi_light l = {.type = LMGI_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .enabled = 1,
+                    .direction = {0, -1, 0}, .outer_cone = 0.785398f};
+    lmgi_light sel;
+    lmgi_error err;
+    if (v->light >= 0 && lmgi_get_light(v->sc, v->light, &sel, &err) == LMGI_OK && sel.type != LMGI_LIGHT_DIRECTIONAL)
+        l.intensity = sel.intensity;
+    memcpy(l.position, v->cam.target, sizeof l.position);
+    l.position[1] += 0.1f * v->cam.scene_size;
+    lm_view_step step = {.kind = LM_VIEW_LIGHT_ADDED, .light_after = l};
+    if (lmgi_add_light(v->sc, &l, &step.id, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        say(v, "the light was refused (the terminal says why)");
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    v->light = step.id;
     char what[96];
-    snprintf(what, sizeof what, "light %d %s, intensity %.4g", v->light, l.enabled ? "on" : "off",
-             (double)l.intensity);
+    snprintf(what, sizeof what, "light %d added at the target", step.id);
+    say(v, what);
+}
+
+static void remove_light(viewer *v)
+{
+    lmgi_light l;
+    lmgi_error err;
+    if (v->light < 0 || lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK) {
+        say(v, "no light selected");
+        return;
+    }
+    lm_view_step step = {.kind = LM_VIEW_LIGHT_REMOVED, .id = v->light, .light_before = l};
+    if (lmgi_remove_light(v->sc, v->light, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        say(v, "the light could not be removed (the terminal says why)");
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    char what[96];
+    snprintf(what, sizeof what, "light %d removed", v->light);
+    say(v, what);
+    select_light(v, v->light + 1);
+}
+
+static void undo_redo(viewer *v, int redo)
+{
+    char what[160];
+    lmgi_error err;
+    err.message[0] = '\0';
+    int ok = redo ? lm_view_redo(&v->history, v->sc, what, sizeof what, &err)
+                  : lm_view_undo(&v->history, v->sc, what, sizeof what, &err);
+    if (!ok && err.message[0])
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+    say(v, what);
+    if (v->light >= 0 && lmgi_light_is_removed(v->sc, v->light))
+        select_light(v, v->light + 1);
+}
+
+/* Ctrl+S: the scene as edited, with its lightmap, into the next free lmgi-view-scene-NNN folder
+ * (lmgi_export_gltf: a glTF an engine or lmgi loads again). */
+static void save_scene(viewer *v)
+{
+    char dir[64];
+    do
+        snprintf(dir, sizeof dir, "lmgi-view-scene-%03d", ++v->saves);
+    while (access(dir, F_OK) == 0 && v->saves < 100000);
+    lmgi_export_desc d = {.name = "scene"};
+    lmgi_error err;
+    if (lmgi_export_gltf(v->u, dir, &d, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        say(v, "the scene could not be saved (the terminal says why)");
+        v->failed = 1;
+        return;
+    }
+    char what[96];
+    snprintf(what, sizeof what, "saved %s/scene.gltf", dir);
     say(v, what);
 }
 
@@ -155,17 +253,36 @@ static void window_shot(viewer *v, int fw, int fh)
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
     (void)scancode;
-    (void)mods;
     viewer *v = glfwGetWindowUserPointer(w);
     if (action == GLFW_RELEASE)
         return;
+    if (mods & GLFW_MOD_CONTROL) {
+        if (key == GLFW_KEY_Z)
+            undo_redo(v, (mods & GLFW_MOD_SHIFT) != 0);
+        else if (key == GLFW_KEY_Y)
+            undo_redo(v, 1);
+        else if (key == GLFW_KEY_S)
+            save_scene(v);
+        return;
+    }
     switch (key) {
     case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(w, 1); break;
     case GLFW_KEY_H: v->panel = !v->panel; break;
     case GLFW_KEY_R: v->cam = v->home; break;
     case GLFW_KEY_X: v->exposure = 0.0f; break;
     case GLFW_KEY_P:
-    case GLFW_KEY_F12: v->want_shot = 1; break;
+    case GLFW_KEY_F12:
+        if (mods & GLFW_MOD_SHIFT) { /* the lighting alone, the linear numbers */
+            char name[64];
+            do
+                snprintf(name, sizeof name, "lmgi-view-%03d.exr", ++v->shots);
+            while (access(name, F_OK) == 0 && v->shots < 100000);
+            if (v->rgb)
+                write_frame(v, name);
+        } else {
+            v->want_shot = 1;
+        }
+        break;
     case GLFW_KEY_SPACE:
         v->paused = !v->paused;
         v->paused_at = v->time;
@@ -179,19 +296,112 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_EQUAL:
     case GLFW_KEY_KP_ADD: edit_light(v, LIGHT_STEP); break;
     case GLFW_KEY_O: edit_light(v, 0.0f); break;
+    case GLFW_KEY_C: edit_light(v, -1.0f); break;
+    case GLFW_KEY_N: add_light(v); break;
+    case GLFW_KEY_DELETE: remove_light(v); break;
     default: break;
+    }
+}
+
+/* The window's camera (window pixels, not the framebuffer's: the cursor's) and the ray under the cursor. */
+static void cursor_ray(viewer *v, double x, double y, float org[3], float dir[3])
+{
+    int ww, wh;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    lmgi_camera cam;
+    lm_view_camera_get(&v->cam, ww, wh, &cam);
+    lm_view_ray(&cam, x, y, ww, wh, org, dir);
+}
+
+/* The node under the cursor (-1: none), and the point hit. */
+static int pick(viewer *v, double x, double y, float at[3])
+{
+    float org[3], dir[3];
+    cursor_ray(v, x, y, org, dir);
+    lmgi_hit hit;
+    lmgi_intersect(v->sc, org, dir, INFINITY, &hit);
+    if (!hit.hit)
+        return -1;
+    for (int k = 0; k < 3; k++)
+        at[k] = org[k] + hit.t * dir[k];
+    return hit.node;
+}
+
+static void select_node(viewer *v, int node)
+{
+    v->node = node;
+    char what[128];
+    snprintf(what, sizeof what, node < 0 ? "nothing selected" : "selected node %.100s", node < 0 ? "" : lmgi_node_name(v->sc, node));
+    say(v, what);
+}
+
+/* Ctrl + press on a node: select it and start moving it on the horizontal plane through the point grabbed
+ * (a static node is made dynamic first: lmgi_set_node_dynamic). */
+static void grab_node(viewer *v, double x, double y)
+{
+    float at[3];
+    int node = pick(v, x, y, at);
+    select_node(v, node);
+    if (node < 0)
+        return;
+    lmgi_error err;
+    if (!lmgi_node_is_dynamic(v->sc, node) && lmgi_set_node_dynamic(v->sc, node, 1, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        say(v, "this node cannot move (the terminal says why)");
+        return;
+    }
+    memcpy(v->grab, at, sizeof v->grab);
+    lmgi_get_node_transform(v->sc, node, v->grab_start);
+    v->drag = 3;
+}
+
+static void move_node(viewer *v, double x, double y)
+{
+    float org[3], dir[3], p[3], m[16];
+    cursor_ray(v, x, y, org, dir);
+    if (!lm_view_ray_plane(org, dir, v->grab[1], p))
+        return;
+    memcpy(m, v->grab_start, sizeof m);
+    m[12] += p[0] - v->grab[0];
+    m[14] += p[2] - v->grab[2];
+    lmgi_error err;
+    if (lmgi_set_node_transform(v->sc, v->node, m, &err) != LMGI_OK)
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+}
+
+static void end_move(viewer *v)
+{
+    lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
+    memcpy(step.before, v->grab_start, sizeof step.before);
+    lmgi_get_node_transform(v->sc, v->node, step.after);
+    if (memcmp(step.before, step.after, sizeof step.after) != 0) {
+        lm_view_history_push(&v->history, &step);
+        char what[128];
+        snprintf(what, sizeof what, "moved node %.100s", lmgi_node_name(v->sc, v->node));
+        say(v, what);
     }
 }
 
 static void on_button(GLFWwindow *w, int button, int action, int mods)
 {
     viewer *v = glfwGetWindowUserPointer(w);
+    double x, y;
+    glfwGetCursorPos(w, &x, &y);
     if (action == GLFW_RELEASE) {
+        if (v->drag == 3)
+            end_move(v);
+        else if (v->drag == 1 && fabs(x - v->press[0]) + fabs(y - v->press[1]) < CLICK_PIXELS) {
+            float at[3];
+            select_node(v, pick(v, x, y, at));
+        }
         v->drag = 0;
         return;
     }
-    glfwGetCursorPos(w, &v->mouse[0], &v->mouse[1]);
-    v->drag = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT) ? 1 : 2;
+    v->mouse[0] = v->press[0] = x, v->mouse[1] = v->press[1] = y;
+    if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_CONTROL))
+        grab_node(v, x, y);
+    else
+        v->drag = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT) ? 1 : 2;
 }
 
 static void on_cursor(GLFWwindow *w, double x, double y)
@@ -203,20 +413,43 @@ static void on_cursor(GLFWwindow *w, double x, double y)
         lm_view_camera_orbit(&v->cam, x - v->mouse[0], y - v->mouse[1], wh);
     else if (v->drag == 2)
         lm_view_camera_pan(&v->cam, x - v->mouse[0], y - v->mouse[1], wh);
+    else if (v->drag == 3)
+        move_node(v, x, y);
     v->mouse[0] = x, v->mouse[1] = y;
 }
 
+/* The wheel zooms; with ctrl it turns the selected node about the vertical, 15 degrees a step. */
 static void on_scroll(GLFWwindow *w, double dx, double dy)
 {
     (void)dx;
     viewer *v = glfwGetWindowUserPointer(w);
-    lm_view_camera_zoom(&v->cam, dy);
+    if (!(glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)) {
+        lm_view_camera_zoom(&v->cam, dy);
+        return;
+    }
+    lmgi_error err;
+    if (v->node < 0 ||
+        (!lmgi_node_is_dynamic(v->sc, v->node) && lmgi_set_node_dynamic(v->sc, v->node, 1, &err) != LMGI_OK)) {
+        say(v, "select a node that may move first (click it)");
+        return;
+    }
+    lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
+    lmgi_get_node_transform(v->sc, v->node, step.before);
+    lm_view_turn(step.before, (float)dy * TURN_STEP, step.after);
+    if (lmgi_set_node_transform(v->sc, v->node, step.after, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    say(v, "turned the selected node");
 }
 
 /* W A S D fly along and across the view, Q E down and up; shift: four times as fast. */
 static void fly(viewer *v, float seconds)
 {
     GLFWwindow *w = v->win;
+    if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+        return; /* ctrl + S saves, it does not fly */
     float f = (float)(glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS);
     float r = (float)(glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS);
     float u = (float)(glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS);
@@ -276,10 +509,14 @@ static void draw_panel(viewer *v, int fw, int fh)
         lm_view_panel_add(&p, "light %d of %d: %s, intensity %.4g, colour %.2f %.2f %.2f", v->light,
                           lmgi_light_count(v->sc), l.enabled ? "on" : "off", (double)l.intensity,
                           (double)l.color[0], (double)l.color[1], (double)l.color[2]);
+    if (v->node >= 0)
+        lm_view_panel_add(&p, "selected node %s (%s): ctrl+drag moves it, ctrl+wheel turns it", lmgi_node_name(v->sc, v->node),
+                          lmgi_node_is_dynamic(v->sc, v->node) ? "dynamic" : "static");
     if (v->status[0])
         lm_view_panel_add(&p, "%s", v->status);
-    lm_view_panel_add(&p, "drag: orbit (shift, right: pan)  wheel: zoom  WASDQE: fly  L +/- O: light  [ ]: budget  "
-                          "P: screenshot  H: panel  Esc");
+    lm_view_panel_add(&p, "drag: orbit (shift, right: pan)  wheel: zoom  WASDQE: fly  click: select  L + - O C N Del: "
+                          "lights  ctrl+Z/Y: undo/redo");
+    lm_view_panel_add(&p, "ctrl+S: save scene  [ ]: budget  space: pause  P: screenshot  H: panel  Esc: quit");
     lm_view_panel_draw(&p, fw, fh, fw >= 1000 ? 2.0f : 1.0f);
 }
 
@@ -302,7 +539,9 @@ static int frame(viewer *v)
     fly(v, (float)(now - v->last));
     v->fps = now > v->last ? 0.9 * v->fps + 0.1 / (now - v->last) : v->fps;
     v->last = now;
-    if (v->a->frames)
+    if (v->a->still)
+        v->time = 0.0f;
+    else if (v->a->frames)
         v->time = (float)v->frame / FPS;
     else if (!v->paused)
         v->time = (float)(now - v->start);
@@ -448,6 +687,7 @@ int lm_cli_view(const lm_cli_args *a)
     v.a = a;
     v.name = strrchr(a->files[0], '/') ? strrchr(a->files[0], '/') + 1 : a->files[0];
     v.light = -1;
+    v.node = -1;
     int ok = preflight(&v) && start(&v);
     while (ok) { /* a frame after every poll: an edit and Esc in one poll still show the edit (and its screenshot) */
         glfwPollEvents();
@@ -467,6 +707,7 @@ int lm_cli_view(const lm_cli_args *a)
     lmgi_free(v.sc);
     if (v.have_script)
         lm_edit_script_free(&v.script);
+    lm_view_history_free(&v.history);
     free(v.rgb);
     free(v.rgba);
     return ok && !v.failed ? 0 : 1;
