@@ -51,6 +51,18 @@ const char *lmt_node_modules(const char *package, const char **why);
 void lmt_gltf_validate(const char *node_modules, const char *gltf);
 
 /* Use in a cmocka test: skips (and says so) when the scene is not there. */
+/* LMT_UNDER_ASAN: 1 in a test built with AddressSanitizer (make test-asan), else 0. */
+#if defined(__SANITIZE_ADDRESS__)
+#define LMT_UNDER_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define LMT_UNDER_ASAN 1
+#endif
+#endif
+#ifndef LMT_UNDER_ASAN
+#define LMT_UNDER_ASAN 0
+#endif
+
 #define LMT_REQUIRE_SCENE(var, path_expr)                                                     \
     const char *var = (path_expr);                                                              \
     do {                                                                                        \

@@ -22,16 +22,6 @@
 
 #define SIDE 32
 
-#if defined(__SANITIZE_ADDRESS__)
-#define UNDER_ASAN 1 /* its quarantine holds freed memory: resident memory says nothing about leaks there */
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define UNDER_ASAN 1
-#endif
-#endif
-#ifndef UNDER_ASAN
-#define UNDER_ASAN 0
-#endif
 
 /* What a soak checks per update, and what it saw. */
 typedef struct {
@@ -143,7 +133,7 @@ static void soak(soak_run *r)
                   r->worst_groups, r->worst_aims, r->worst_caustic, r->max_lights, r->mb_first, r->mb_last);
     assert_true(edits.made[LM_EDIT_REMOVE_LIGHT] >= 10); /* lights did come and go at the full count */
     assert_true(r->mb_first > 0.0 && r->mb_last > 0.0);
-    if (UNDER_ASAN)
+    if (LMT_UNDER_ASAN) /* its quarantine holds freed memory: resident memory says nothing about leaks there */
         print_message("under AddressSanitizer: resident memory not compared (its quarantine keeps freed memory)\n");
     else if (r->mb_last > 1.05 * r->mb_first + 8.0)
         fail_msg("%s: resident memory grew from %.1f to %.1f MB while the light count held at %d", r->scene,

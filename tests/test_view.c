@@ -40,17 +40,7 @@ static const char *lmgi_bin(void)
 
 /* How much longer the scripts wait for the window's work: 4 under the sanitizers (make test-asan builds
  * this test and lmgi alike), whose updates are several times slower, else 1. */
-#if defined(__SANITIZE_ADDRESS__)
-#define UNDER_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define UNDER_ASAN 1
-#endif
-#endif
-#ifndef UNDER_ASAN
-#define UNDER_ASAN 0
-#endif
-static int slow(void) { return UNDER_ASAN ? 4 : 1; }
+static int slow(void) { return LMT_UNDER_ASAN ? 4 : 1; }
 
 /* Runs `sh -c SCRIPT` under a fresh Xvfb; its exit status. */
 static int under_x(const char *script)
@@ -81,6 +71,18 @@ static double mean_of(const char *path, float **img, int *w, int *h)
     else
         free(p);
     return sum / ((double)*w * *h);
+}
+
+/* scenes/cornell.glb loaded with the defaults (the test holds it; lmgi_free). */
+static lmgi_scene *generated_cornell(void)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load("scenes/cornell.glb", &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
 }
 
 static void test_no_display(void **state)
@@ -180,11 +182,8 @@ static void test_script(void **state)
     (void)state;
     if (!have_x_tools())
         return;
-    lmgi_options o;
-    lmgi_options_init(&o);
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = generated_cornell();
     lmgi_error e;
-    assert_int_equal(lmgi_load("scenes/cornell.glb", &o, &sc, &e), LMGI_OK);
     lmgi_light l;
     assert_int_equal(lmgi_get_light(sc, 0, &l, &e), LMGI_OK);
     lmgi_free(sc);
@@ -248,11 +247,8 @@ static void test_drag_save_undo(void **state)
     (void)state;
     if (!have_x_tools())
         return;
-    lmgi_options o;
-    lmgi_options_init(&o);
-    lmgi_scene *sc = NULL;
+    lmgi_scene *sc = generated_cornell();
     lmgi_error e;
-    assert_int_equal(lmgi_load("scenes/cornell.glb", &o, &sc, &e), LMGI_OK);
     int cube = lmgi_find_node(sc, "dynamic_cube");
     float m0[16], p[4], v[4] = {0}, c[4] = {0};
     assert_true(cube >= 0 && lmgi_get_node_transform(sc, cube, m0));
@@ -289,6 +285,8 @@ static void test_drag_save_undo(void **state)
     /* the saved scene: the cube moved left, not up */
     char saved[512];
     snprintf(saved, sizeof saved, "%s/lmgi-view-scene-001/scene.gltf", dir);
+    lmgi_options o;
+    lmgi_options_init(&o);
     assert_int_equal(lmgi_load(saved, &o, &sc, &e), LMGI_OK);
     float m1[16];
     assert_true(lmgi_get_node_transform(sc, lmgi_find_node(sc, "dynamic_cube"), m1));
