@@ -990,6 +990,49 @@ static void test_write_image(void **state)
     assert_float_equal(lmgi_auto_exposure(LMGI_TONEMAP_NEUTRAL, NULL, 3), 1.0f, 0.0);
 }
 
+/* lmgi_geometry_hash: the same for two loads and after a node moves or a material changes; another for a
+ * vertex moved or a node renamed (lmgi view --watch tells edits from a new scene by it). */
+static void test_geometry_hash(void **state)
+{
+    (void)state;
+    static const float quad[12] = {-1, 0, 1, 1, 0, 1, 1, 0, -1, -1, 0, -1};
+    static const uint32_t idx[6] = {0, 1, 2, 0, 2, 3};
+    float moved[12];
+    memcpy(moved, quad, sizeof moved);
+    moved[4] = 0.001f;
+    uint64_t h[4];
+    for (int k = 0; k < 4; k++) {
+        lmgi_mesh_desc m = {.name = k == 3 ? "plate2" : "plate", .positions = k == 2 ? moved : quad, .vertex_count = 4,
+                            .indices = idx, .triangle_count = 2, .dynamic = 1};
+        lmgi_light_desc l = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 10.0f, .position = {0, 2, 0}};
+        lmgi_material_desc mat_d = {.name = "white", .base_color = {0.8f, 0.8f, 0.8f, 1.0f}};
+        lmgi_scene_desc d = {.name = "plate", .meshes = &m, .mesh_count = 1, .materials = &mat_d, .material_count = 1,
+                             .lights = &l, .light_count = 1};
+        lmgi_options o;
+        lmgi_options_init(&o);
+        lmgi_scene *sc = NULL;
+        lmgi_error e;
+        if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+            fail_msg("%s", e.message);
+        h[k] = lmgi_geometry_hash(sc);
+        if (k == 1) { /* moved and recoloured: still the same geometry */
+            float w[16];
+            assert_true(lmgi_get_node_transform(sc, 0, w));
+            w[13] += 0.5f;
+            assert_int_equal(lmgi_set_node_transform(sc, 0, w, &e), LMGI_OK);
+            lmgi_material mat;
+            assert_int_equal(lmgi_get_material(sc, 0, &mat, &e), LMGI_OK);
+            mat.base_color[0] = 0.1f;
+            assert_int_equal(lmgi_set_material(sc, 0, &mat, &e), LMGI_OK);
+            assert_true(lmgi_geometry_hash(sc) == h[k]);
+        }
+        lmgi_free(sc);
+    }
+    assert_true(h[0] != 0 && h[0] == h[1]);
+    assert_true(h[2] != h[0] && h[3] != h[0]);
+    assert_true(lmgi_geometry_hash(NULL) == 0);
+}
+
 /* lmgi_tonemap_rgba8 (a window's pixels, lmgi view) gives the bytes lmgi_write_image's PNG holds, for both
  * tone maps, automatic exposure and a given one. */
 static void test_tonemap_rgba8(void **state)
@@ -1445,6 +1488,7 @@ int main(void)
         cmocka_unit_test(test_bad_arguments),
         cmocka_unit_test(test_write_image),
         cmocka_unit_test(test_tonemap_rgba8),
+        cmocka_unit_test(test_geometry_hash),
         cmocka_unit_test(test_scene_from_arrays),
         cmocka_unit_test(test_second_thread_refused),
         cmocka_unit_test(test_shard_cancelled_and_resumed),

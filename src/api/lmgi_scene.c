@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "../charts/charts.h"
+#include "../core/hash.h"
 #include "../core/log.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
@@ -310,6 +311,22 @@ void lmgi_free(lmgi_scene *sc)
 }
 
 int lmgi_node_count(const lmgi_scene *sc) { return sc ? sc->scene->node_count : 0; }
+
+uint64_t lmgi_geometry_hash(const lmgi_scene *sc)
+{
+    if (!sc)
+        return 0;
+    const lm_scene *s = sc->scene;
+    uint64_t h = LM_HASH_SEED;
+    for (int n = 0; n < s->node_count; n++)
+        h = lm_hash_bytes(h, s->nodes[n].name, strlen(s->nodes[n].name) + 1);
+    h = lm_hash_bytes(h, &s->vertex_count, sizeof s->vertex_count);
+    h = lm_hash_bytes(h, s->positions, 3 * sizeof *s->positions * (size_t)s->vertex_count);
+    h = lm_hash_bytes(h, &s->tri_count, sizeof s->tri_count);
+    h = lm_hash_bytes(h, s->tris, 3 * sizeof *s->tris * (size_t)s->tri_count);
+    h = lm_hash_bytes(h, s->tri_node, sizeof *s->tri_node * (size_t)s->tri_count);
+    return lm_hash_bytes(h, s->tri_material, sizeof *s->tri_material * (size_t)s->tri_count);
+}
 
 int lmgi_find_node(const lmgi_scene *sc, const char *name)
 {

@@ -47,6 +47,7 @@ typedef struct {
     const char *script_path;  /* --script EDITS.json (view): an edit script played in the window */
     const char *screenshot_path; /* --screenshot FILE (view): the last frame */
     int still;                /* --still (view): the animations at time 0 */
+    int watch;                /* --watch (view): follow the scene's file as it is saved */
     int soak;                 /* --soak N (bench): N frames of the scene's animation, looped (0: none) */
     int random_edits;         /* --random-edits L (bench --soak): a random edit before each update, up to L lights */
     float budget_ms;          /* --budget MS (run, bench --soak): lmgi_update's budget_ms (0: the fixed counts) */

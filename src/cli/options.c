@@ -177,6 +177,10 @@ const lm_cli_option lm_cli_options[] = {
      "same lightmaps on every machine (view: default 16)"},
     {"--still", NULL, NULL, LM_CMD_VIEW, LM_OPT_FLAG, offsetof(lm_cli_args, still), 0, 0, NULL,
      "view: the animations stand at time 0 (the file's pose) instead of playing"},
+    {"--watch", NULL, NULL, LM_CMD_VIEW, LM_OPT_FLAG, offsetof(lm_cli_args, watch), 0, 0, NULL,
+     "view: follow the scene's file as it is saved (from Blender, on every save):\n"
+     "node moves, materials and lights become edits, so only what changed is\n"
+     "recomputed; a change of geometry loads the scene again, and says so"},
     {"--script", NULL, "EDITS.json", LM_CMD_VIEW, LM_OPT_TEXT, offsetof(lm_cli_args, script_path), 0, 0, NULL,
      "view: play an edit script (bench --edits' format, docs/bench.md) at its\n"
      "frames"},

@@ -17,11 +17,15 @@
 #include "view_camera.h"
 #include "view_edit.h"
 #include "view_panel.h"
+#include "view_watch.h"
 
 #define FPS 30.0f            /* the animation's frames a second with --frames (as lmgi run) */
 #define LIGHT_STEP 1.25f     /* + and - multiply or divide a light's intensity by this */
 #define TURN_STEP 0.2617994f /* ctrl + wheel turns the selected node by 15 degrees a step */
 #define CLICK_PIXELS 3.0     /* a press and release closer than this is a click (select), not a drag */
+#define IDLE_UPDATES 8       /* updates in a row without work before the lighting counts as caught up: the
+                              * photon work runs beside the picture, and an update may find none while it
+                              * is still under way */
 
 typedef struct {
     const lm_cli_args *a;
@@ -44,6 +48,11 @@ typedef struct {
     float grab[3], grab_start[16]; /* moving a node: the point grabbed and the node's matrix then */
     lm_view_history history;
     int saves;
+    lm_view_watch watch;     /* --watch */
+    int busy;                /* updates since work began (photons, AIMs, texels, caustics, faces, shadows) */
+    int idle;                /* of them, the last ones in a row that did none */
+    double busy_since;
+    lmgi_updater_desc desc;  /* the updater's, for a reload */
     float exposure;          /* fixed from the first picture (X meters again) */
     float *rgb;              /* the picture, linear, top row first */
     unsigned char *rgba;     /* tone-mapped, bottom row first (glDrawPixels') */
@@ -499,6 +508,10 @@ static void draw_panel(viewer *v, int fw, int fh)
     lm_view_panel_add(&p, "update %.1f ms of a %.3g ms budget (photons %.1f, gather %.1f)  picture %.1f ms",
                       s->ms_total, (double)v->budget, s->ms_photons, s->ms_gather, v->ms_render);
     lm_view_panel_add(&p, "busiest: %s: %s", s->busiest_stage ? s->busiest_stage : "-", s->why);
+    if (v->busy)
+        lm_view_panel_add(&p, "lighting: catching up for %d updates (%.1f s)", v->busy, glfwGetTime() - v->busy_since);
+    else
+        lm_view_panel_add(&p, "lighting: caught up (nothing waits)");
     lm_view_panel_add(&p, "texels %u (allowed %d)  photons %u  AIM surfaces %d  surfaces changed %d",
                       s->texels_gathered, s->texels_budget, s->photons_retraced, s->aim_surfaces_refreshed,
                       s->surfaces_changed);
@@ -532,6 +545,71 @@ static void tone_map(viewer *v)
                            v->rgba + 4 * row * (size_t)(v->height - 1 - y));
 }
 
+/* Whether the lighting still has work waiting: an update that found photon paths changed, refreshed AIMs,
+ * regathered texels, traced caustic photons or redrew reflection faces or shadow maps (the one photon group
+ * a still scene re-traces each update to look for changes is not work waiting). From the first such
+ * update the lighting is "catching up"; after IDLE_UPDATES without any, "caught up", with how long that
+ * took (the panel, and a line on the terminal a script can wait for). */
+static void track_work(viewer *v, double now)
+{
+    const lmgi_update_stats *s = &v->stats;
+    int working = s->groups_invalidated || s->aim_surfaces_refreshed || s->texels_gathered ||
+                  s->caustic_photons_retraced || s->cube_faces_rendered || s->shadow_maps_rendered ||
+                  s->shadow_maps_stale;
+    if (working) {
+        v->idle = 0;
+        if (!v->busy++) {
+            v->busy_since = now;
+            if (!v->a->quiet)
+                printf("lighting: catching up\n");
+        }
+    } else if (v->busy && ++v->idle >= IDLE_UPDATES) {
+        char line[96];
+        snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s)", v->busy, now - v->busy_since);
+        v->busy = v->idle = 0;
+        say(v, line);
+    }
+    fflush(stdout);
+}
+
+/* --watch: the file changed and settled; its differences made as edits, or the scene reloaded when they
+ * cannot be (a mesh changed, a node, material or light more or less). A file that does not load leaves
+ * the scene shown as it was. 0 only when the reloaded scene's updater cannot be made. */
+static int follow_file(viewer *v)
+{
+    lmgi_scene *next = NULL;
+    if (!lm_cli_run_load(v->a, &next)) {
+        say(v, "the saved file did not load (the terminal says why); still showing the last one");
+        return 1;
+    }
+    char what[160];
+    lmgi_error err;
+    int r = lm_view_watch_apply(v->sc, next, what, sizeof what, &err);
+    if (r >= 0 || r == -2) {
+        if (r == -2)
+            fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lmgi_free(next);
+        char line[200];
+        snprintf(line, sizeof line, r == -2 ? "the file's edit was refused (the terminal says why)" : "file saved: %s",
+                 what);
+        say(v, line);
+        return 1;
+    }
+    lmgi_updater_free(v->u);
+    v->u = NULL;
+    lmgi_free(v->sc);
+    v->sc = next;
+    lm_view_history_free(&v->history); /* its steps were the old scene's */
+    v->node = -1;
+    if (lmgi_updater_create(v->ctx, v->sc, &v->desc, &v->u, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        return 0;
+    }
+    select_light(v, 0);
+    say(v, "the file's geometry changed: the scene was loaded again");
+    return 1;
+}
+
 static int frame(viewer *v)
 {
     lmgi_error err;
@@ -545,6 +623,8 @@ static int frame(viewer *v)
         v->time = (float)v->frame / FPS;
     else if (!v->paused)
         v->time = (float)(now - v->start);
+    if (v->a->watch && lm_view_watch_due(&v->watch, now) && !follow_file(v))
+        return 0;
     while (v->have_script && v->next_edit < v->script.edit_count && v->script.edits[v->next_edit].frame <= v->frame)
         if (!lm_edit_script_apply(&v->script, v->next_edit++, v->sc))
             return 0;
@@ -552,6 +632,7 @@ static int frame(viewer *v)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
+    track_work(v, now);
     int fw, fh;
     glfwGetFramebufferSize(v->win, &fw, &fh);
     if (fw <= 0 || fh <= 0) /* minimised */
@@ -647,11 +728,10 @@ static int start(viewer *v)
     lmgi_error err;
     if (!lm_cli_run_load(a, &v->sc))
         return 0;
-    lmgi_updater_desc d;
-    lm_cli_updater_desc(a, &d);
-    d.frame.width = d.frame.height = 0; /* the window draws with lmgi_render from its own camera */
+    lm_cli_updater_desc(a, &v->desc);
+    v->desc.frame.width = v->desc.frame.height = 0; /* the window draws with lmgi_render from its own camera */
     if (lmgi_context_create(NULL, &v->ctx, &err) != LMGI_OK ||
-        lmgi_updater_create(v->ctx, v->sc, &d, &v->u, &err) != LMGI_OK) {
+        lmgi_updater_create(v->ctx, v->sc, &v->desc, &v->u, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
@@ -671,6 +751,8 @@ static int start(viewer *v)
     v->budget = a->budget_ms > 0.0f ? a->budget_ms : LM_VIEW_BUDGET_MS;
     v->panel = 1;
     select_light(v, 0);
+    if (a->watch)
+        lm_view_watch_init(&v->watch, a->files[0]);
     v->start = v->last = glfwGetTime();
     return 1;
 }
