@@ -1,476 +1,34 @@
-/* lmgi view (view_cmd.h). */
+/* lmgi view (view_cmd.h): the window, its frames and the panel; the input is view_input.c's. */
 #include "view_cmd.h"
 
-#define GLFW_INCLUDE_NONE
 #include <GL/gl.h>
-#include <GLFW/glfw3.h>
-#include <lmgi_tools.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
-#include "edit_script.h"
 #include "run_cmd.h"
 #include "scene_load.h"
-#include "view_camera.h"
-#include "view_edit.h"
 #include "view_panel.h"
-#include "view_watch.h"
+#include "view_state.h"
 
 #define FPS 30.0f            /* the animation's frames a second with --frames (as lmgi run) */
-#define LIGHT_STEP 1.25f     /* + and - multiply or divide a light's intensity by this */
-#define TURN_STEP 0.2617994f /* ctrl + wheel turns the selected node by 15 degrees a step */
-#define CLICK_PIXELS 3.0     /* a press and release closer than this is a click (select), not a drag */
 #define IDLE_UPDATES 8       /* updates in a row without work before the lighting counts as caught up: the
                               * photon work runs beside the picture, and an update may find none while it
                               * is still under way */
 
-typedef struct {
-    const lm_cli_args *a;
-    const char *name;        /* the scene's file name, for the title and the panel */
-    lmgi_scene *sc;
-    lmgi_context *ctx;
-    lmgi_updater *u;
-    GLFWwindow *win;
-    lm_view_camera cam, home;
-    lm_edit_script script;
-    int have_script, next_edit;
-    float budget;
-    int panel, paused, frame;
-    float time, paused_at;
-    double start, last;
-    int light;               /* the selected light, -1: none */
-    int node;                /* the selected node, -1: none */
-    int drag;                /* 0, 1 orbit, 2 pan, 3 moving the selected node */
-    double mouse[2], press[2];
-    float grab[3], grab_start[16]; /* moving a node: the point grabbed and the node's matrix then */
-    lm_view_history history;
-    int saves;
-    lm_view_watch watch;     /* --watch */
-    int busy;                /* updates since work began (photons, AIMs, texels, caustics, faces, shadows) */
-    int idle;                /* of them, the last ones in a row that did none */
-    double busy_since;
-    lmgi_updater_desc desc;  /* the updater's, for a reload */
-    float exposure;          /* fixed from the first picture (X meters again) */
-    float *rgb;              /* the picture, linear, top row first */
-    unsigned char *rgba;     /* tone-mapped, bottom row first (glDrawPixels') */
-    int width, height;
-    lmgi_update_stats stats;
-    double ms_render, fps;
-    int shots, want_shot;    /* want_shot: P was pressed, the window is captured after its next drawing */
-    char status[160];
-    int failed;
-} viewer;
-
 /* What the last action did, on the panel and the terminal. */
-static void say(viewer *v, const char *text)
+void lm_viewer_say(lm_viewer *v, const char *text)
 {
     snprintf(v->status, sizeof v->status, "%.150s", text);
     if (!v->a->quiet)
         printf("%s\n", text);
 }
 
-/* ---------- input ---------- */
-
-static void select_light(viewer *v, int from)
-{
-    int n = lmgi_light_count(v->sc);
-    v->light = -1;
-    for (int k = 0; k < n; k++) {
-        int id = (from + k) % n;
-        if (!lmgi_light_is_removed(v->sc, id)) {
-            v->light = id;
-            break;
-        }
-    }
-}
-
-/* The selected light changed by f (intensity times f; f = 0: switched off or on again). */
-static void edit_light(viewer *v, float f)
-{
-    lmgi_light l;
-    lmgi_error err;
-    if (v->light < 0 || lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK) {
-        say(v, "no light to edit (the scene has none)");
-        return;
-    }
-    lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = l};
-    if (f == 0.0f)
-        l.enabled = !l.enabled;
-    else if (f < 0.0f) { /* the next of a few colours: white, warm, cool */
-        static const float colours[3][3] = {{1.0f, 1.0f, 1.0f}, {1.0f, 0.75f, 0.5f}, {0.6f, 0.75f, 1.0f}};
-        int next = 0;
-        for (int c = 0; c < 3; c++)
-            if (!memcmp(l.color, colours[c], sizeof l.color))
-                next = (c + 1) % 3;
-        memcpy(l.color, colours[next], sizeof l.color);
-    } else
-        l.intensity *= f;
-    step.light_after = l;
-    if (lmgi_set_light(v->sc, v->light, &l, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        say(v, "the light edit was refused (the terminal says why)");
-        return;
-    }
-    lm_view_history_push(&v->history, &step);
-    char what[128];
-    snprintf(what, sizeof what, "light %d %s, intensity %.4g, colour %.2f %.2f %.2f", v->light, l.enabled ? "on" : "off",
-             (double)l.intensity, (double)l.color[0], (double)l.color[1], (double)l.color[2]);
-    say(v, what);
-}
-
-/* N: a point light at the camera's target, raised by a tenth of the scene, as bright as the selected light
- * (or 10 cd); Delete: the selected light removed. */
-static void add_light(viewer *v)
-{
-    lmgi_light l = {.type = LMGI_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .enabled = 1,
-                    .direction = {0, -1, 0}, .outer_cone = 0.785398f};
-    lmgi_light sel;
-    lmgi_error err;
-    if (v->light >= 0 && lmgi_get_light(v->sc, v->light, &sel, &err) == LMGI_OK && sel.type != LMGI_LIGHT_DIRECTIONAL)
-        l.intensity = sel.intensity;
-    memcpy(l.position, v->cam.target, sizeof l.position);
-    l.position[1] += 0.1f * v->cam.scene_size;
-    lm_view_step step = {.kind = LM_VIEW_LIGHT_ADDED, .light_after = l};
-    if (lmgi_add_light(v->sc, &l, &step.id, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        say(v, "the light was refused (the terminal says why)");
-        return;
-    }
-    lm_view_history_push(&v->history, &step);
-    v->light = step.id;
-    char what[96];
-    snprintf(what, sizeof what, "light %d added at the target", step.id);
-    say(v, what);
-}
-
-static void remove_light(viewer *v)
-{
-    lmgi_light l;
-    lmgi_error err;
-    if (v->light < 0 || lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK) {
-        say(v, "no light selected");
-        return;
-    }
-    lm_view_step step = {.kind = LM_VIEW_LIGHT_REMOVED, .id = v->light, .light_before = l};
-    if (lmgi_remove_light(v->sc, v->light, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        say(v, "the light could not be removed (the terminal says why)");
-        return;
-    }
-    lm_view_history_push(&v->history, &step);
-    char what[96];
-    snprintf(what, sizeof what, "light %d removed", v->light);
-    say(v, what);
-    select_light(v, v->light + 1);
-}
-
-static void undo_redo(viewer *v, int redo)
-{
-    char what[160];
-    lmgi_error err;
-    err.message[0] = '\0';
-    int ok = redo ? lm_view_redo(&v->history, v->sc, what, sizeof what, &err)
-                  : lm_view_undo(&v->history, v->sc, what, sizeof what, &err);
-    if (!ok && err.message[0])
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-    say(v, what);
-    if (v->light >= 0 && lmgi_light_is_removed(v->sc, v->light))
-        select_light(v, v->light + 1);
-}
-
-/* Ctrl+S: the scene as edited, with its lightmap, into the next free lmgi-view-scene-NNN folder
- * (lmgi_export_gltf: a glTF an engine or lmgi loads again). */
-static void save_scene(viewer *v)
-{
-    char dir[64];
-    do
-        snprintf(dir, sizeof dir, "lmgi-view-scene-%03d", ++v->saves);
-    while (access(dir, F_OK) == 0 && v->saves < 100000);
-    lmgi_export_desc d = {.name = "scene"};
-    lmgi_error err;
-    if (lmgi_export_gltf(v->u, dir, &d, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        say(v, "the scene could not be saved (the terminal says why)");
-        v->failed = 1;
-        return;
-    }
-    char what[96];
-    snprintf(what, sizeof what, "saved %s/scene.gltf", dir);
-    say(v, what);
-}
-
-/* The lighting alone (the linear picture, no panel) to path: .png tone-mapped as shown, .exr the numbers. */
-static void write_frame(viewer *v, const char *path)
-{
-    lmgi_image_desc d = {(lmgi_tonemap)v->a->tonemap, v->exposure, 0};
-    lmgi_error err;
-    if (lmgi_write_image(path, v->width, v->height, 3, v->rgb, &d, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        v->failed = 1;
-        return;
-    }
-    char what[300];
-    snprintf(what, sizeof what, "wrote %.280s", path);
-    say(v, what);
-}
-
-static double srgb_to_linear(unsigned char c)
-{
-    double s = c / 255.0;
-    return s <= 0.04045 ? s / 12.92 : pow((s + 0.055) / 1.055, 2.4);
-}
-
-/* The window as it is drawn (the panel too) to the next free lmgi-view-NNN.png in the working folder
- * (nothing is written over): its 8-bit pixels made linear and written with the clamp tone map at exposure
- * 1, which gives the same 8-bit values back. */
-static void window_shot(viewer *v, int fw, int fh)
-{
-    char name[64];
-    do
-        snprintf(name, sizeof name, "lmgi-view-%03d.png", ++v->shots);
-    while (access(name, F_OK) == 0 && v->shots < 100000);
-    unsigned char *px = malloc((size_t)fw * (size_t)fh * 3);
-    float *lin = malloc((size_t)fw * (size_t)fh * 3 * sizeof *lin);
-    if (!px || !lin) {
-        fprintf(stderr, "lmgi: error: no memory for a screenshot of %dx%d\n", fw, fh);
-        v->failed = 1;
-    } else {
-        glPixelStorei(GL_PACK_ALIGNMENT, 1);
-        glReadBuffer(GL_BACK);
-        glReadPixels(0, 0, fw, fh, GL_RGB, GL_UNSIGNED_BYTE, px);
-        for (int y = 0; y < fh; y++) /* GL's rows bottom first, the file's top first */
-            for (size_t i = 0; i < 3 * (size_t)fw; i++)
-                lin[3 * (size_t)fw * (size_t)y + i] = (float)srgb_to_linear(px[3 * (size_t)fw * (size_t)(fh - 1 - y) + i]);
-        lmgi_image_desc d = {LMGI_TONEMAP_CLAMP, 1.0f, 0};
-        lmgi_error err;
-        if (lmgi_write_image(name, fw, fh, 3, lin, &d, &err) != LMGI_OK) {
-            fprintf(stderr, "lmgi: error: %s\n", err.message);
-            v->failed = 1;
-        } else {
-            char what[96];
-            snprintf(what, sizeof what, "wrote %s (the window)", name);
-            say(v, what);
-        }
-    }
-    free(px);
-    free(lin);
-}
-
-static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
-{
-    (void)scancode;
-    viewer *v = glfwGetWindowUserPointer(w);
-    if (action == GLFW_RELEASE)
-        return;
-    if (mods & GLFW_MOD_CONTROL) {
-        if (key == GLFW_KEY_Z)
-            undo_redo(v, (mods & GLFW_MOD_SHIFT) != 0);
-        else if (key == GLFW_KEY_Y)
-            undo_redo(v, 1);
-        else if (key == GLFW_KEY_S)
-            save_scene(v);
-        return;
-    }
-    switch (key) {
-    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(w, 1); break;
-    case GLFW_KEY_H: v->panel = !v->panel; break;
-    case GLFW_KEY_R: v->cam = v->home; break;
-    case GLFW_KEY_X: v->exposure = 0.0f; break;
-    case GLFW_KEY_P:
-    case GLFW_KEY_F12:
-        if (mods & GLFW_MOD_SHIFT) { /* the lighting alone, the linear numbers */
-            char name[64];
-            do
-                snprintf(name, sizeof name, "lmgi-view-%03d.exr", ++v->shots);
-            while (access(name, F_OK) == 0 && v->shots < 100000);
-            if (v->rgb)
-                write_frame(v, name);
-        } else {
-            v->want_shot = 1;
-        }
-        break;
-    case GLFW_KEY_SPACE:
-        v->paused = !v->paused;
-        v->paused_at = v->time;
-        v->start = glfwGetTime() - v->time;
-        break;
-    case GLFW_KEY_LEFT_BRACKET: v->budget = fmaxf(0.5f, 0.5f * v->budget); break;
-    case GLFW_KEY_RIGHT_BRACKET: v->budget = fminf(1000.0f, 2.0f * v->budget); break;
-    case GLFW_KEY_L: select_light(v, v->light + 1); break;
-    case GLFW_KEY_MINUS:
-    case GLFW_KEY_KP_SUBTRACT: edit_light(v, 1.0f / LIGHT_STEP); break;
-    case GLFW_KEY_EQUAL:
-    case GLFW_KEY_KP_ADD: edit_light(v, LIGHT_STEP); break;
-    case GLFW_KEY_O: edit_light(v, 0.0f); break;
-    case GLFW_KEY_C: edit_light(v, -1.0f); break;
-    case GLFW_KEY_N: add_light(v); break;
-    case GLFW_KEY_DELETE: remove_light(v); break;
-    default: break;
-    }
-}
-
-/* The window's camera (window pixels, not the framebuffer's: the cursor's) and the ray under the cursor. */
-static void cursor_ray(viewer *v, double x, double y, float org[3], float dir[3])
-{
-    int ww, wh;
-    glfwGetWindowSize(v->win, &ww, &wh);
-    lmgi_camera cam;
-    lm_view_camera_get(&v->cam, ww, wh, &cam);
-    lm_view_ray(&cam, x, y, ww, wh, org, dir);
-}
-
-/* The node under the cursor (-1: none), and the point hit. */
-static int pick(viewer *v, double x, double y, float at[3])
-{
-    float org[3], dir[3];
-    cursor_ray(v, x, y, org, dir);
-    lmgi_hit hit;
-    lmgi_intersect(v->sc, org, dir, INFINITY, &hit);
-    if (!hit.hit)
-        return -1;
-    for (int k = 0; k < 3; k++)
-        at[k] = org[k] + hit.t * dir[k];
-    return hit.node;
-}
-
-static void select_node(viewer *v, int node)
-{
-    v->node = node;
-    char what[128];
-    snprintf(what, sizeof what, node < 0 ? "nothing selected" : "selected node %.100s", node < 0 ? "" : lmgi_node_name(v->sc, node));
-    say(v, what);
-}
-
-/* Ctrl + press on a node: select it and start moving it on the horizontal plane through the point grabbed
- * (a static node is made dynamic first: lmgi_set_node_dynamic). */
-static void grab_node(viewer *v, double x, double y)
-{
-    float at[3];
-    int node = pick(v, x, y, at);
-    select_node(v, node);
-    if (node < 0)
-        return;
-    lmgi_error err;
-    if (!lmgi_node_is_dynamic(v->sc, node) && lmgi_set_node_dynamic(v->sc, node, 1, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        say(v, "this node cannot move (the terminal says why)");
-        return;
-    }
-    memcpy(v->grab, at, sizeof v->grab);
-    lmgi_get_node_transform(v->sc, node, v->grab_start);
-    v->drag = 3;
-}
-
-static void move_node(viewer *v, double x, double y)
-{
-    float org[3], dir[3], p[3], m[16];
-    cursor_ray(v, x, y, org, dir);
-    if (!lm_view_ray_plane(org, dir, v->grab[1], p))
-        return;
-    memcpy(m, v->grab_start, sizeof m);
-    m[12] += p[0] - v->grab[0];
-    m[14] += p[2] - v->grab[2];
-    lmgi_error err;
-    if (lmgi_set_node_transform(v->sc, v->node, m, &err) != LMGI_OK)
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-}
-
-static void end_move(viewer *v)
-{
-    lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
-    memcpy(step.before, v->grab_start, sizeof step.before);
-    lmgi_get_node_transform(v->sc, v->node, step.after);
-    if (memcmp(step.before, step.after, sizeof step.after) != 0) {
-        lm_view_history_push(&v->history, &step);
-        char what[128];
-        snprintf(what, sizeof what, "moved node %.100s", lmgi_node_name(v->sc, v->node));
-        say(v, what);
-    }
-}
-
-static void on_button(GLFWwindow *w, int button, int action, int mods)
-{
-    viewer *v = glfwGetWindowUserPointer(w);
-    double x, y;
-    glfwGetCursorPos(w, &x, &y);
-    if (action == GLFW_RELEASE) {
-        if (v->drag == 3)
-            end_move(v);
-        else if (v->drag == 1 && fabs(x - v->press[0]) + fabs(y - v->press[1]) < CLICK_PIXELS) {
-            float at[3];
-            select_node(v, pick(v, x, y, at));
-        }
-        v->drag = 0;
-        return;
-    }
-    v->mouse[0] = v->press[0] = x, v->mouse[1] = v->press[1] = y;
-    if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_CONTROL))
-        grab_node(v, x, y);
-    else
-        v->drag = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT) ? 1 : 2;
-}
-
-static void on_cursor(GLFWwindow *w, double x, double y)
-{
-    viewer *v = glfwGetWindowUserPointer(w);
-    int ww, wh;
-    glfwGetWindowSize(w, &ww, &wh);
-    if (v->drag == 1)
-        lm_view_camera_orbit(&v->cam, x - v->mouse[0], y - v->mouse[1], wh);
-    else if (v->drag == 2)
-        lm_view_camera_pan(&v->cam, x - v->mouse[0], y - v->mouse[1], wh);
-    else if (v->drag == 3)
-        move_node(v, x, y);
-    v->mouse[0] = x, v->mouse[1] = y;
-}
-
-/* The wheel zooms; with ctrl it turns the selected node about the vertical, 15 degrees a step. */
-static void on_scroll(GLFWwindow *w, double dx, double dy)
-{
-    (void)dx;
-    viewer *v = glfwGetWindowUserPointer(w);
-    if (!(glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)) {
-        lm_view_camera_zoom(&v->cam, dy);
-        return;
-    }
-    lmgi_error err;
-    if (v->node < 0 ||
-        (!lmgi_node_is_dynamic(v->sc, v->node) && lmgi_set_node_dynamic(v->sc, v->node, 1, &err) != LMGI_OK)) {
-        say(v, "select a node that may move first (click it)");
-        return;
-    }
-    lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
-    lmgi_get_node_transform(v->sc, v->node, step.before);
-    lm_view_turn(step.before, (float)dy * TURN_STEP, step.after);
-    if (lmgi_set_node_transform(v->sc, v->node, step.after, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        return;
-    }
-    lm_view_history_push(&v->history, &step);
-    say(v, "turned the selected node");
-}
-
-/* W A S D fly along and across the view, Q E down and up; shift: four times as fast. */
-static void fly(viewer *v, float seconds)
-{
-    GLFWwindow *w = v->win;
-    if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
-        return; /* ctrl + S saves, it does not fly */
-    float f = (float)(glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS);
-    float r = (float)(glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS);
-    float u = (float)(glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS);
-    if (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS)
-        seconds *= 4.0f;
-    if (f != 0.0f || r != 0.0f || u != 0.0f)
-        lm_view_camera_fly(&v->cam, f, r, u, seconds);
-}
-
 /* ---------- a frame ---------- */
 
-static int picture_size(viewer *v, int w, int h)
+static int picture_size(lm_viewer *v, int w, int h)
 {
     if (w == v->width && h == v->height && v->rgb)
         return 1;
@@ -486,7 +44,7 @@ static int picture_size(viewer *v, int w, int h)
     return 1;
 }
 
-static void effects_line(viewer *v, lm_view_panel *p)
+static void effects_line(lm_viewer *v, lm_view_panel *p)
 {
     char line[LM_VIEW_PANEL_COLUMNS] = "effects:";
     for (int i = 0; i < lmgi_effect_count(v->sc); i++) {
@@ -499,7 +57,7 @@ static void effects_line(viewer *v, lm_view_panel *p)
     lm_view_panel_add(p, "%s", line);
 }
 
-static void draw_panel(viewer *v, int fw, int fh)
+static void draw_panel(lm_viewer *v, int fw, int fh)
 {
     const lmgi_update_stats *s = &v->stats;
     lm_view_panel p = {0};
@@ -534,7 +92,7 @@ static void draw_panel(viewer *v, int fw, int fh)
 }
 
 /* Tone-mapped into rgba bottom row first, as glDrawPixels reads it. */
-static void tone_map(viewer *v)
+static void tone_map(lm_viewer *v)
 {
     lmgi_tonemap op = (lmgi_tonemap)v->a->tonemap;
     size_t row = (size_t)v->width;
@@ -550,7 +108,7 @@ static void tone_map(viewer *v)
  * a still scene re-traces each update to look for changes is not work waiting). From the first such
  * update the lighting is "catching up"; after IDLE_UPDATES without any, "caught up", with how long that
  * took (the panel, and a line on the terminal a script can wait for). */
-static void track_work(viewer *v, double now)
+static void track_work(lm_viewer *v, double now)
 {
     const lmgi_update_stats *s = &v->stats;
     int working = s->groups_invalidated || s->aim_surfaces_refreshed || s->texels_gathered ||
@@ -567,7 +125,7 @@ static void track_work(viewer *v, double now)
         char line[96];
         snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s)", v->busy, now - v->busy_since);
         v->busy = v->idle = 0;
-        say(v, line);
+        lm_viewer_say(v, line);
     }
     fflush(stdout);
 }
@@ -575,11 +133,11 @@ static void track_work(viewer *v, double now)
 /* --watch: the file changed and settled; its differences made as edits, or the scene reloaded when they
  * cannot be (a mesh changed, a node, material or light more or less). A file that does not load leaves
  * the scene shown as it was. 0 only when the reloaded scene's updater cannot be made. */
-static int follow_file(viewer *v)
+static int follow_file(lm_viewer *v)
 {
     lmgi_scene *next = NULL;
     if (!lm_cli_run_load(v->a, &next)) {
-        say(v, "the saved file did not load (the terminal says why); still showing the last one");
+        lm_viewer_say(v, "the saved file did not load (the terminal says why); still showing the last one");
         return 1;
     }
     char what[160];
@@ -592,7 +150,7 @@ static int follow_file(viewer *v)
         char line[200];
         snprintf(line, sizeof line, r == -2 ? "the file's edit was refused (the terminal says why)" : "file saved: %s",
                  what);
-        say(v, line);
+        lm_viewer_say(v, line);
         return 1;
     }
     lmgi_updater_free(v->u);
@@ -605,16 +163,16 @@ static int follow_file(viewer *v)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
-    select_light(v, 0);
-    say(v, "the file's geometry changed: the scene was loaded again");
+    lm_viewer_select_light(v, 0);
+    lm_viewer_say(v, "the file's geometry changed: the scene was loaded again");
     return 1;
 }
 
-static int frame(viewer *v)
+static int frame(lm_viewer *v)
 {
     lmgi_error err;
     double now = glfwGetTime();
-    fly(v, (float)(now - v->last));
+    lm_viewer_fly(v, (float)(now - v->last));
     v->fps = now > v->last ? 0.9 * v->fps + 0.1 / (now - v->last) : v->fps;
     v->last = now;
     if (v->a->still)
@@ -657,7 +215,7 @@ static int frame(viewer *v)
         draw_panel(v, fw, fh);
     if (v->want_shot) {
         v->want_shot = 0;
-        window_shot(v, fw, fh);
+        lm_viewer_window_shot(v, fw, fh);
     }
     glfwSwapBuffers(v->win);
     v->frame++;
@@ -673,7 +231,7 @@ static void glfw_error(int code, const char *message)
 
 /* What the window needs before anything is loaded: a display, a screenshot path that is free or forced,
  * a script that reads. */
-static int preflight(viewer *v)
+static int preflight(lm_viewer *v)
 {
     const lm_cli_args *a = v->a;
     if (!getenv("DISPLAY") && !getenv("WAYLAND_DISPLAY")) {
@@ -695,7 +253,7 @@ static int preflight(viewer *v)
     return 1;
 }
 
-static int open_window(viewer *v)
+static int open_window(lm_viewer *v)
 {
     glfwSetErrorCallback(glfw_error);
     if (!glfwInit()) {
@@ -712,17 +270,13 @@ static int open_window(viewer *v)
         fprintf(stderr, "lmgi: error: view cannot open a window with an OpenGL 2.1 context (above)\n");
         return 0;
     }
-    glfwSetWindowUserPointer(v->win, v);
-    glfwSetKeyCallback(v->win, on_key);
-    glfwSetMouseButtonCallback(v->win, on_button);
-    glfwSetCursorPosCallback(v->win, on_cursor);
-    glfwSetScrollCallback(v->win, on_scroll);
+    lm_viewer_input(v);
     glfwMakeContextCurrent(v->win);
     glfwSwapInterval(0); /* the budget, not the display's refresh, paces the updates */
     return 1;
 }
 
-static int start(viewer *v)
+static int start(lm_viewer *v)
 {
     const lm_cli_args *a = v->a;
     lmgi_error err;
@@ -750,7 +304,7 @@ static int start(viewer *v)
     v->cam = v->home;
     v->budget = a->budget_ms > 0.0f ? a->budget_ms : LM_VIEW_BUDGET_MS;
     v->panel = 1;
-    select_light(v, 0);
+    lm_viewer_select_light(v, 0);
     if (a->watch)
         lm_view_watch_init(&v->watch, a->files[0]);
     v->start = v->last = glfwGetTime();
@@ -764,7 +318,7 @@ int lm_cli_view(const lm_cli_args *a)
                         "[--screenshot FILE] [run options]\n");
         return 2;
     }
-    viewer v;
+    lm_viewer v;
     memset(&v, 0, sizeof v);
     v.a = a;
     v.name = strrchr(a->files[0], '/') ? strrchr(a->files[0], '/') + 1 : a->files[0];
@@ -778,7 +332,7 @@ int lm_cli_view(const lm_cli_args *a)
             break;
     }
     if (ok && a->screenshot_path && v.rgb)
-        write_frame(&v, a->screenshot_path);
+        lm_viewer_write_frame(&v, a->screenshot_path);
     if (ok && !a->quiet)
         printf("view        %d frames of %s\n", v.frame, v.name);
     if (v.win)

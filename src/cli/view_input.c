@@ -1,0 +1,418 @@
+/* The viewer's mouse and keys (view_state.h): camera moves, node and light edits with their undo,
+ * saving, screenshots. */
+#include "view_state.h"
+
+#include <GL/gl.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define LIGHT_STEP 1.25f     /* + and - multiply or divide a light's intensity by this */
+#define TURN_STEP 0.2617994f /* ctrl + wheel turns the selected node by 15 degrees a step */
+#define CLICK_PIXELS 3.0     /* a press and release closer than this is a click (select), not a drag */
+
+void lm_viewer_select_light(lm_viewer *v, int from)
+{
+    int n = lmgi_light_count(v->sc);
+    v->light = -1;
+    for (int k = 0; k < n; k++) {
+        int id = (from + k) % n;
+        if (!lmgi_light_is_removed(v->sc, id)) {
+            v->light = id;
+            break;
+        }
+    }
+}
+
+/* The selected light changed by f (intensity times f; f = 0: switched off or on again). */
+static void edit_light(lm_viewer *v, float f)
+{
+    lmgi_light l;
+    lmgi_error err;
+    if (v->light < 0 || lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK) {
+        lm_viewer_say(v, "no light to edit (the scene has none)");
+        return;
+    }
+    lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = l};
+    if (f == 0.0f)
+        l.enabled = !l.enabled;
+    else if (f < 0.0f) { /* the next of a few colours: white, warm, cool */
+        static const float colours[3][3] = {{1.0f, 1.0f, 1.0f}, {1.0f, 0.75f, 0.5f}, {0.6f, 0.75f, 1.0f}};
+        int next = 0;
+        for (int c = 0; c < 3; c++)
+            if (!memcmp(l.color, colours[c], sizeof l.color))
+                next = (c + 1) % 3;
+        memcpy(l.color, colours[next], sizeof l.color);
+    } else
+        l.intensity *= f;
+    step.light_after = l;
+    if (lmgi_set_light(v->sc, v->light, &l, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "the light edit was refused (the terminal says why)");
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    char what[128];
+    snprintf(what, sizeof what, "light %d %s, intensity %.4g, colour %.2f %.2f %.2f", v->light, l.enabled ? "on" : "off",
+             (double)l.intensity, (double)l.color[0], (double)l.color[1], (double)l.color[2]);
+    lm_viewer_say(v, what);
+}
+
+/* N: a point light at the camera's target, raised by a tenth of the scene, as bright as the selected light
+ * (or 10 cd); Delete: the selected light removed. */
+static void add_light(lm_viewer *v)
+{
+    lmgi_light l = {.type = LMGI_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 10.0f, .enabled = 1,
+                    .direction = {0, -1, 0}, .outer_cone = 0.785398f};
+    lmgi_light sel;
+    lmgi_error err;
+    if (v->light >= 0 && lmgi_get_light(v->sc, v->light, &sel, &err) == LMGI_OK && sel.type != LMGI_LIGHT_DIRECTIONAL)
+        l.intensity = sel.intensity;
+    memcpy(l.position, v->cam.target, sizeof l.position);
+    l.position[1] += 0.1f * v->cam.scene_size;
+    lm_view_step step = {.kind = LM_VIEW_LIGHT_ADDED, .light_after = l};
+    if (lmgi_add_light(v->sc, &l, &step.id, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "the light was refused (the terminal says why)");
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    v->light = step.id;
+    char what[96];
+    snprintf(what, sizeof what, "light %d added at the target", step.id);
+    lm_viewer_say(v, what);
+}
+
+static void remove_light(lm_viewer *v)
+{
+    lmgi_light l;
+    lmgi_error err;
+    if (v->light < 0 || lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK) {
+        lm_viewer_say(v, "no light selected");
+        return;
+    }
+    lm_view_step step = {.kind = LM_VIEW_LIGHT_REMOVED, .id = v->light, .light_before = l};
+    if (lmgi_remove_light(v->sc, v->light, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "the light could not be removed (the terminal says why)");
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    char what[96];
+    snprintf(what, sizeof what, "light %d removed", v->light);
+    lm_viewer_say(v, what);
+    lm_viewer_select_light(v, v->light + 1);
+}
+
+static void undo_redo(lm_viewer *v, int redo)
+{
+    char what[160];
+    lmgi_error err;
+    err.message[0] = '\0';
+    int ok = redo ? lm_view_redo(&v->history, v->sc, what, sizeof what, &err)
+                  : lm_view_undo(&v->history, v->sc, what, sizeof what, &err);
+    if (!ok && err.message[0])
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+    lm_viewer_say(v, what);
+    if (v->light >= 0 && lmgi_light_is_removed(v->sc, v->light))
+        lm_viewer_select_light(v, v->light + 1);
+}
+
+/* Ctrl+S: the scene as edited, with its lightmap, into the next free lmgi-view-scene-NNN folder
+ * (lmgi_export_gltf: a glTF an engine or lmgi loads again). */
+static void save_scene(lm_viewer *v)
+{
+    char dir[64];
+    do
+        snprintf(dir, sizeof dir, "lmgi-view-scene-%03d", ++v->saves);
+    while (access(dir, F_OK) == 0 && v->saves < 100000);
+    lmgi_export_desc d = {.name = "scene"};
+    lmgi_error err;
+    if (lmgi_export_gltf(v->u, dir, &d, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "the scene could not be saved (the terminal says why)");
+        v->failed = 1;
+        return;
+    }
+    char what[96];
+    snprintf(what, sizeof what, "saved %s/scene.gltf", dir);
+    lm_viewer_say(v, what);
+}
+
+/* The lighting alone (the linear picture, no panel) to path: .png tone-mapped as shown, .exr the numbers. */
+void lm_viewer_write_frame(lm_viewer *v, const char *path)
+{
+    lmgi_image_desc d = {(lmgi_tonemap)v->a->tonemap, v->exposure, 0};
+    lmgi_error err;
+    if (lmgi_write_image(path, v->width, v->height, 3, v->rgb, &d, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        v->failed = 1;
+        return;
+    }
+    char what[300];
+    snprintf(what, sizeof what, "wrote %.280s", path);
+    lm_viewer_say(v, what);
+}
+
+static double srgb_to_linear(unsigned char c)
+{
+    double s = c / 255.0;
+    return s <= 0.04045 ? s / 12.92 : pow((s + 0.055) / 1.055, 2.4);
+}
+
+/* The window as it is drawn (the panel too) to the next free lmgi-view-NNN.png in the working folder
+ * (nothing is written over): its 8-bit pixels made linear and written with the clamp tone map at exposure
+ * 1, which gives the same 8-bit values back. */
+void lm_viewer_window_shot(lm_viewer *v, int fw, int fh)
+{
+    char name[64];
+    do
+        snprintf(name, sizeof name, "lmgi-view-%03d.png", ++v->shots);
+    while (access(name, F_OK) == 0 && v->shots < 100000);
+    unsigned char *px = malloc((size_t)fw * (size_t)fh * 3);
+    float *lin = malloc((size_t)fw * (size_t)fh * 3 * sizeof *lin);
+    if (!px || !lin) {
+        fprintf(stderr, "lmgi: error: no memory for a screenshot of %dx%d\n", fw, fh);
+        v->failed = 1;
+    } else {
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadBuffer(GL_BACK);
+        glReadPixels(0, 0, fw, fh, GL_RGB, GL_UNSIGNED_BYTE, px);
+        for (int y = 0; y < fh; y++) /* GL's rows bottom first, the file's top first */
+            for (size_t i = 0; i < 3 * (size_t)fw; i++)
+                lin[3 * (size_t)fw * (size_t)y + i] = (float)srgb_to_linear(px[3 * (size_t)fw * (size_t)(fh - 1 - y) + i]);
+        lmgi_image_desc d = {LMGI_TONEMAP_CLAMP, 1.0f, 0};
+        lmgi_error err;
+        if (lmgi_write_image(name, fw, fh, 3, lin, &d, &err) != LMGI_OK) {
+            fprintf(stderr, "lmgi: error: %s\n", err.message);
+            v->failed = 1;
+        } else {
+            char what[96];
+            snprintf(what, sizeof what, "wrote %s (the window)", name);
+            lm_viewer_say(v, what);
+        }
+    }
+    free(px);
+    free(lin);
+}
+
+static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
+{
+    (void)scancode;
+    lm_viewer *v = glfwGetWindowUserPointer(w);
+    if (action == GLFW_RELEASE)
+        return;
+    if (mods & GLFW_MOD_CONTROL) {
+        if (key == GLFW_KEY_Z)
+            undo_redo(v, (mods & GLFW_MOD_SHIFT) != 0);
+        else if (key == GLFW_KEY_Y)
+            undo_redo(v, 1);
+        else if (key == GLFW_KEY_S)
+            save_scene(v);
+        return;
+    }
+    switch (key) {
+    case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(w, 1); break;
+    case GLFW_KEY_H: v->panel = !v->panel; break;
+    case GLFW_KEY_R: v->cam = v->home; break;
+    case GLFW_KEY_X: v->exposure = 0.0f; break;
+    case GLFW_KEY_P:
+    case GLFW_KEY_F12:
+        if (mods & GLFW_MOD_SHIFT) { /* the lighting alone, the linear numbers */
+            char name[64];
+            do
+                snprintf(name, sizeof name, "lmgi-view-%03d.exr", ++v->shots);
+            while (access(name, F_OK) == 0 && v->shots < 100000);
+            if (v->rgb)
+                lm_viewer_write_frame(v, name);
+        } else {
+            v->want_shot = 1;
+        }
+        break;
+    case GLFW_KEY_SPACE:
+        v->paused = !v->paused;
+        v->paused_at = v->time;
+        v->start = glfwGetTime() - v->time;
+        break;
+    case GLFW_KEY_LEFT_BRACKET: v->budget = fmaxf(0.5f, 0.5f * v->budget); break;
+    case GLFW_KEY_RIGHT_BRACKET: v->budget = fminf(1000.0f, 2.0f * v->budget); break;
+    case GLFW_KEY_L: lm_viewer_select_light(v, v->light + 1); break;
+    case GLFW_KEY_MINUS:
+    case GLFW_KEY_KP_SUBTRACT: edit_light(v, 1.0f / LIGHT_STEP); break;
+    case GLFW_KEY_EQUAL:
+    case GLFW_KEY_KP_ADD: edit_light(v, LIGHT_STEP); break;
+    case GLFW_KEY_O: edit_light(v, 0.0f); break;
+    case GLFW_KEY_C: edit_light(v, -1.0f); break;
+    case GLFW_KEY_N: add_light(v); break;
+    case GLFW_KEY_DELETE: remove_light(v); break;
+    default: break;
+    }
+}
+
+/* The window's camera (window pixels, not the framebuffer's: the cursor's) and the ray under the cursor. */
+static void cursor_ray(lm_viewer *v, double x, double y, float org[3], float dir[3])
+{
+    int ww, wh;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    lmgi_camera cam;
+    lm_view_camera_get(&v->cam, ww, wh, &cam);
+    lm_view_ray(&cam, x, y, ww, wh, org, dir);
+}
+
+/* The node under the cursor (-1: none), and the point hit. */
+static int pick(lm_viewer *v, double x, double y, float at[3])
+{
+    float org[3], dir[3];
+    cursor_ray(v, x, y, org, dir);
+    lmgi_hit hit;
+    lmgi_intersect(v->sc, org, dir, INFINITY, &hit);
+    if (!hit.hit)
+        return -1;
+    for (int k = 0; k < 3; k++)
+        at[k] = org[k] + hit.t * dir[k];
+    return hit.node;
+}
+
+static void select_node(lm_viewer *v, int node)
+{
+    v->node = node;
+    char what[128];
+    snprintf(what, sizeof what, node < 0 ? "nothing selected" : "selected node %.100s", node < 0 ? "" : lmgi_node_name(v->sc, node));
+    lm_viewer_say(v, what);
+}
+
+/* Ctrl + press on a node: select it and start moving it on the horizontal plane through the point grabbed
+ * (a static node is made dynamic first: lmgi_set_node_dynamic). */
+static void grab_node(lm_viewer *v, double x, double y)
+{
+    float at[3];
+    int node = pick(v, x, y, at);
+    select_node(v, node);
+    if (node < 0)
+        return;
+    lmgi_error err;
+    if (!lmgi_node_is_dynamic(v->sc, node) && lmgi_set_node_dynamic(v->sc, node, 1, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "this node cannot move (the terminal says why)");
+        return;
+    }
+    memcpy(v->grab, at, sizeof v->grab);
+    lmgi_get_node_transform(v->sc, node, v->grab_start);
+    v->drag = 3;
+}
+
+static void move_node(lm_viewer *v, double x, double y)
+{
+    float org[3], dir[3], p[3], m[16];
+    cursor_ray(v, x, y, org, dir);
+    if (!lm_view_ray_plane(org, dir, v->grab[1], p))
+        return;
+    memcpy(m, v->grab_start, sizeof m);
+    m[12] += p[0] - v->grab[0];
+    m[14] += p[2] - v->grab[2];
+    lmgi_error err;
+    if (lmgi_set_node_transform(v->sc, v->node, m, &err) != LMGI_OK)
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+}
+
+static void end_move(lm_viewer *v)
+{
+    lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
+    memcpy(step.before, v->grab_start, sizeof step.before);
+    lmgi_get_node_transform(v->sc, v->node, step.after);
+    if (memcmp(step.before, step.after, sizeof step.after) != 0) {
+        lm_view_history_push(&v->history, &step);
+        char what[128];
+        snprintf(what, sizeof what, "moved node %.100s", lmgi_node_name(v->sc, v->node));
+        lm_viewer_say(v, what);
+    }
+}
+
+static void on_button(GLFWwindow *w, int button, int action, int mods)
+{
+    lm_viewer *v = glfwGetWindowUserPointer(w);
+    double x, y;
+    glfwGetCursorPos(w, &x, &y);
+    if (action == GLFW_RELEASE) {
+        if (v->drag == 3)
+            end_move(v);
+        else if (v->drag == 1 && fabs(x - v->press[0]) + fabs(y - v->press[1]) < CLICK_PIXELS) {
+            float at[3];
+            select_node(v, pick(v, x, y, at));
+        }
+        v->drag = 0;
+        return;
+    }
+    v->mouse[0] = v->press[0] = x, v->mouse[1] = v->press[1] = y;
+    if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_CONTROL))
+        grab_node(v, x, y);
+    else
+        v->drag = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT) ? 1 : 2;
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y)
+{
+    lm_viewer *v = glfwGetWindowUserPointer(w);
+    int ww, wh;
+    glfwGetWindowSize(w, &ww, &wh);
+    if (v->drag == 1)
+        lm_view_camera_orbit(&v->cam, x - v->mouse[0], y - v->mouse[1], wh);
+    else if (v->drag == 2)
+        lm_view_camera_pan(&v->cam, x - v->mouse[0], y - v->mouse[1], wh);
+    else if (v->drag == 3)
+        move_node(v, x, y);
+    v->mouse[0] = x, v->mouse[1] = y;
+}
+
+/* The wheel zooms; with ctrl it turns the selected node about the vertical, 15 degrees a step. */
+static void on_scroll(GLFWwindow *w, double dx, double dy)
+{
+    (void)dx;
+    lm_viewer *v = glfwGetWindowUserPointer(w);
+    if (!(glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)) {
+        lm_view_camera_zoom(&v->cam, dy);
+        return;
+    }
+    lmgi_error err;
+    if (v->node < 0 ||
+        (!lmgi_node_is_dynamic(v->sc, v->node) && lmgi_set_node_dynamic(v->sc, v->node, 1, &err) != LMGI_OK)) {
+        lm_viewer_say(v, "select a node that may move first (click it)");
+        return;
+    }
+    lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
+    lmgi_get_node_transform(v->sc, v->node, step.before);
+    lm_view_turn(step.before, (float)dy * TURN_STEP, step.after);
+    if (lmgi_set_node_transform(v->sc, v->node, step.after, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    lm_viewer_say(v, "turned the selected node");
+}
+
+/* W A S D fly along and across the view, Q E down and up; shift: four times as fast. */
+void lm_viewer_fly(lm_viewer *v, float seconds)
+{
+    GLFWwindow *w = v->win;
+    if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
+        return; /* ctrl + S saves, it does not fly */
+    float f = (float)(glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS);
+    float r = (float)(glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS);
+    float u = (float)(glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS);
+    if (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS)
+        seconds *= 4.0f;
+    if (f != 0.0f || r != 0.0f || u != 0.0f)
+        lm_view_camera_fly(&v->cam, f, r, u, seconds);
+}
+
+
+void lm_viewer_input(lm_viewer *v)
+{
+    glfwSetWindowUserPointer(v->win, v);
+    glfwSetKeyCallback(v->win, on_key);
+    glfwSetMouseButtonCallback(v->win, on_button);
+    glfwSetCursorPosCallback(v->win, on_cursor);
+    glfwSetScrollCallback(v->win, on_scroll);
+}

@@ -1,0 +1,67 @@
+/* The viewer's state shared by its files (lmgi view, docs/viewer.md): view_cmd.c makes the window and runs
+ * the frames, view_input.c turns the mouse and keys into camera moves, edits and screenshots. One viewer
+ * a process; everything on the thread that made the window (GLFW's callbacks come from glfwPollEvents). */
+#ifndef LM_CLI_VIEW_STATE_H
+#define LM_CLI_VIEW_STATE_H
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <lmgi_tools.h>
+
+#include "args.h"
+#include "edit_script.h"
+#include "view_camera.h"
+#include "view_edit.h"
+#include "view_watch.h"
+
+typedef struct lm_viewer lm_viewer;
+struct lm_viewer {
+    const lm_cli_args *a;
+    const char *name;        /* the scene's file name, for the title and the panel */
+    lmgi_scene *sc;
+    lmgi_context *ctx;
+    lmgi_updater *u;
+    GLFWwindow *win;
+    lm_view_camera cam, home;
+    lm_edit_script script;
+    int have_script, next_edit;
+    float budget;
+    int panel, paused, frame;
+    float time, paused_at;
+    double start, last;
+    int light;               /* the selected light, -1: none */
+    int node;                /* the selected node, -1: none */
+    int drag;                /* 0, 1 orbit, 2 pan, 3 moving the selected node */
+    double mouse[2], press[2];
+    float grab[3], grab_start[16]; /* moving a node: the point grabbed and the node's matrix then */
+    lm_view_history history;
+    int saves;
+    lm_view_watch watch;     /* --watch */
+    int busy;                /* updates since work began (photons, AIMs, texels, caustics, faces, shadows) */
+    int idle;                /* of them, the last ones in a row that did none */
+    double busy_since;
+    lmgi_updater_desc desc;  /* the updater's, for a reload */
+    float exposure;          /* fixed from the first picture (X meters again) */
+    float *rgb;              /* the picture, linear, top row first */
+    unsigned char *rgba;     /* tone-mapped, bottom row first (glDrawPixels') */
+    int width, height;
+    lmgi_update_stats stats;
+    double ms_render, fps;
+    int shots, want_shot;    /* want_shot: P was pressed, the window is captured after its next drawing */
+    char status[160];
+    int failed;
+};
+
+/* What the last action did, on the panel and the terminal (unless -q). */
+void lm_viewer_say(lm_viewer *v, const char *text);
+/* The first light from id `from` on (wrapping) that is not removed; -1 when there is none. */
+void lm_viewer_select_light(lm_viewer *v, int from);
+/* Installs the window's mouse and key callbacks (the window's user pointer is v). */
+void lm_viewer_input(lm_viewer *v);
+/* W A S D Q E held: the camera flown for `seconds`. */
+void lm_viewer_fly(lm_viewer *v, float seconds);
+/* The window as drawn (P) to the next free lmgi-view-NNN.png; the lighting alone to path. */
+void lm_viewer_window_shot(lm_viewer *v, int fw, int fh);
+void lm_viewer_write_frame(lm_viewer *v, const char *path);
+
+#endif
