@@ -13,6 +13,15 @@
 #define TURN_STEP 0.2617994f /* ctrl + wheel turns the selected node by 15 degrees a step */
 #define CLICK_PIXELS 3.0     /* a press and release closer than this is a click (select), not a drag */
 
+/* The next name of `fmt` (a number, then `tail`) that no file in the working folder has, counting on from
+ * *counter: what the viewer writes never replaces a file. */
+static void free_name(char *out, size_t n, const char *fmt, const char *tail, int *counter)
+{
+    do
+        snprintf(out, n, fmt, ++*counter, tail);
+    while (access(out, F_OK) == 0 && *counter < 100000);
+}
+
 void lm_viewer_select_light(lm_viewer *v, int from)
 {
     int n = lmgi_light_count(v->sc);
@@ -125,9 +134,7 @@ static void undo_redo(lm_viewer *v, int redo)
 static void save_scene(lm_viewer *v)
 {
     char dir[64];
-    do
-        snprintf(dir, sizeof dir, "lmgi-view-scene-%03d", ++v->saves);
-    while (access(dir, F_OK) == 0 && v->saves < 100000);
+    free_name(dir, sizeof dir, "lmgi-view-scene-%03d%s", "", &v->saves);
     lmgi_export_desc d = {.name = "scene"};
     lmgi_error err;
     if (lmgi_export_gltf(v->u, dir, &d, &err) != LMGI_OK) {
@@ -168,9 +175,7 @@ static double srgb_to_linear(unsigned char c)
 void lm_viewer_window_shot(lm_viewer *v, int fw, int fh)
 {
     char name[64];
-    do
-        snprintf(name, sizeof name, "lmgi-view-%03d.png", ++v->shots);
-    while (access(name, F_OK) == 0 && v->shots < 100000);
+    free_name(name, sizeof name, "lmgi-view-%03d%s", ".png", &v->shots);
     unsigned char *px = malloc((size_t)fw * (size_t)fh * 3);
     float *lin = malloc((size_t)fw * (size_t)fh * 3 * sizeof *lin);
     if (!px || !lin) {
@@ -222,9 +227,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_F12:
         if (mods & GLFW_MOD_SHIFT) { /* the lighting alone, the linear numbers */
             char name[64];
-            do
-                snprintf(name, sizeof name, "lmgi-view-%03d.exr", ++v->shots);
-            while (access(name, F_OK) == 0 && v->shots < 100000);
+            free_name(name, sizeof name, "lmgi-view-%03d%s", ".exr", &v->shots);
             if (v->rgb)
                 lm_viewer_write_frame(v, name);
         } else {
