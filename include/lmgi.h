@@ -607,7 +607,9 @@ LMGI_API void lmgi_updater_free(lmgi_updater *u); /* NULL: nothing */
 /* The settings an updater resolved (the desc's zeros and per-scene choices made) and its setup's cost. */
 typedef struct {
     /* every knob as the updater runs it: the desc's values with each 0 made its default or the scene's
-     * choice (LMGI_OFF stays LMGI_OFF); tiled.radius is 0 before the first frame of a per-pixel gather */
+     * choice (LMGI_OFF stays LMGI_OFF); tiled.radius is 0 before the first frame of a per-pixel gather;
+     * photons.per_group, when the count chose it, is the largest group's photons (the round robin re-checks
+     * every stored path in per_group / retrace_per_group updates) */
     lmgi_photon_knobs photons;
     lmgi_aim_knobs aim;
     lmgi_gather_knobs gather;

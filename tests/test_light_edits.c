@@ -73,6 +73,9 @@ static void test_add_and_remove(void **state)
     float *before = lmt_iim(u, sc, &n);
     lmgi_updater_info info0, info1;
     lmgi_get_updater_info(u, &info0);
+    /* one light: the count's split over its groups, the largest group's photons (the round robin's round) */
+    assert_true(info0.photons.per_group * info0.photons.groups >= info0.stored_photons &&
+                (info0.photons.per_group - 1) * info0.photons.groups < info0.stored_photons);
 
     lmgi_light spot = light_of(&SPOT);
     int id = -2;

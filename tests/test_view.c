@@ -45,7 +45,9 @@ static int slow(void) { return LMT_UNDER_ASAN ? 4 : 1; }
 /* Shell functions for the scripts: `C=$(caught)` counts the viewer's "lighting: caught up" lines in its log
  * (log.txt; view prints "catching up" when an update starts work on an edit and "caught up" when the work
  * is done), and `settled $C`, after an edit, waits until a new one has come and is the log's last word on
- * the lighting. */
+ * the lighting. The viewer says "caught up" only once a whole round of the round robin has passed since the
+ * last change (every stored photon re-checked: photons per group / --retrace updates, 640 at the defaults on
+ * these scenes): the scripts re-trace 16 a group an update, a round of 40 updates. */
 #define IDLE_FN                                                                                               \
     "caught() { grep -c 'caught up' log.txt || true; }\n"                                                    \
     "settled() { n=0; while :; do k=$(caught); last=$(grep '^lighting' log.txt | tail -1);\n"                \
@@ -111,7 +113,8 @@ static void test_no_display(void **state)
 /* The shared Cornell box is still, so its lighting is whole from the first frame on: the window's picture
  * from the scene's camera (--screenshot, the linear numbers) is lmgi run's frame 0, within 1% on average
  * and 5% on 99% of the pixels (the camera made again from the scene's and the picture drawn by lmgi_render
- * rather than the update's composite). */
+ * rather than the update's composite). A second --screenshot to the same file is refused, the file kept;
+ * with --force it is written. */
 static void test_picture_is_run_frame(void **state)
 {
     (void)state;
@@ -120,14 +123,26 @@ static void test_picture_is_run_frame(void **state)
         return;
     char dir[64]; /* lmt_tmpdir's buffer is its next call's */
     snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
-    char script[2048];
+    char script[4096];
     snprintf(script, sizeof script,
              "rm -rf %s/vrun %s/view.exr && %s run %s --frames 1 --size " SIZE " --out %s/vrun -q && "
-             "%s view %s --frames 3 --size " SIZE " --screenshot %s/view.exr -q",
-             dir, dir, lmgi_bin(), scene, dir, lmgi_bin(), scene, dir);
+             "%s view %s --frames 3 --size " SIZE " --screenshot %s/view.exr -q && D=%s && cp $D/view.exr $D/kept.exr && "
+             "! %s view %s --frames 1 --size " SIZE " --screenshot $D/view.exr -q 2> $D/refused.txt && "
+             "cmp $D/view.exr $D/kept.exr && %s view %s --frames 1 --size " SIZE " --screenshot $D/view.exr --force -q",
+             dir, dir, lmgi_bin(), scene, dir, lmgi_bin(), scene, dir, dir, lmgi_bin(), scene, lmgi_bin(), scene);
     int rc = under_x(script);
     if (rc != 0)
         fail_msg("exit %d: %s", rc, output);
+    /* the second screenshot over the first was refused (the file kept), the third forced */
+    char refused[512];
+    snprintf(refused, sizeof refused, "%s/refused.txt", dir);
+    FILE *rf = fopen(refused, "r");
+    assert_non_null(rf);
+    char said[512] = "";
+    assert_non_null(fgets(said, sizeof said, rf));
+    fclose(rf);
+    assert_non_null(strstr(said, "exists"));
+    assert_non_null(strstr(said, "--force"));
     char a[512], b[512];
     snprintf(a, sizeof a, "%s/view.exr", dir);
     snprintf(b, sizeof b, "%s/vrun/frame_0000.exr", dir);
@@ -282,7 +297,7 @@ static void test_drag_save_undo(void **state)
     assert_non_null(getcwd(cwd, sizeof cwd));
     snprintf(script, sizeof script,
              "set -e; B=$(cd %s && pwd)/lmgi; S=%s/scenes/cornell.glb; cd %s; F=%d\n" IDLE_FN
-             "$B view $S --still --size 320x240 --budget 500 --screenshot undone.exr > log.txt &\n"
+             "$B view $S --still --size 320x240 --budget 500 --retrace 16 --screenshot undone.exr > log.txt &\n"
              "P=$!; W=$(xdotool search --sync --name 'lmgi view')\n"
              "sleep $((2 * F)); C=$(caught); xdotool mousemove --window $W %d %d; sleep 0.3\n"
              "xdotool keydown ctrl mousedown 1; sleep 0.3; xdotool mousemove --window $W %d %d; sleep 0.3\n"
@@ -368,7 +383,7 @@ static void test_watch(void **state)
     }
     snprintf(script, sizeof script,
              "set -e; B=$(cd %s && pwd)/lmgi; cd %s; F=%d; cp a.gltf watched.gltf\n" IDLE_FN
-             "$B view watched.gltf --watch --still --size 160x120 --budget 500 > log.txt 2>&1 &\n"
+             "$B view watched.gltf --watch --still --size 160x120 --budget 500 --retrace 16 > log.txt 2>&1 &\n"
              "P=$!; W=$(xdotool search --sync --name 'lmgi view')\n"
              "sleep $((2 * F)); C=$(caught); cp b.gltf next.gltf; mv next.gltf watched.gltf; settled $C\n"
              "xdotool key --window $W shift+p; sleep $F\n"

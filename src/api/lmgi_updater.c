@@ -335,6 +335,17 @@ void lmgi_updater_free(lmgi_updater *u)
 lm_lightmap_texture **lm_updater_texture(lmgi_updater *u) { return &u->texture; }
 
 
+/* The photons of the largest group of any light (a light's P_e photons in G groups: ceil(P_e / G)). */
+static uint32_t largest_group(const lm_photons *ph)
+{
+    uint32_t g = lm_photons_groups_per_emitter(ph), most = 0;
+    for (int e = 0; g && (uint32_t)e < lm_photons_group_count(ph) / g; e++) {
+        uint32_t m = (lm_photons_emitter_photons(ph, e) + g - 1) / g;
+        most = m > most ? m : most;
+    }
+    return most;
+}
+
 void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
 {
     if (!info)
@@ -358,6 +369,8 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
                                ? lm_photons_count(lm_photon_stage_photons(lm_frame_loop_stage(u->loop))) : 0;
     if (!info->photons.count) /* chosen from the groups and the scene's floor */
         info->photons.count = info->stored_photons;
+    if (!info->photons.per_group && s->indirect) /* the count's split: the largest group's photons */
+        info->photons.per_group = largest_group(lm_photon_stage_photons(lm_frame_loop_stage(u->loop)));
     info->ms_setup_trace = 1e3 * u->setup.t_photons;
     info->ms_setup_aim = 1e3 * u->setup.t_aim;
     info->ms_setup_gather = 1e3 * u->t_setup_gather;

@@ -100,9 +100,11 @@ const lm_cli_option lm_cli_options[] = {
      "reflections; a file's extras.lmgi.sky gives one too"},
     {"--out", "-o", "DIR", OUTPUTS, LM_OPT_TEXT, offsetof(lm_cli_args, out_dir), 0, 0, NULL,
      "the folder the results go to (lmgi lists its files in DIR/.lmgi)"},
-    {"--force", NULL, NULL, OUTPUTS | LM_CMD_BENCH, LM_OPT_FLAG, offsetof(lm_cli_args, force), 0, 0, NULL,
-     "write into a non-empty --out DIR (or over a --json FILE) lmgi has not\n"
-     "written before; lmgi never removes or replaces any other file"},
+    {"--force", NULL, NULL, OUTPUTS | LM_CMD_BENCH | LM_CMD_VIEW, LM_OPT_FLAG, offsetof(lm_cli_args, force), 0, 0,
+     NULL,
+     "write into a non-empty --out DIR (or over a --json FILE, or view's\n"
+     "--screenshot FILE) lmgi has not written before; lmgi never removes or\n"
+     "replaces any other file"},
     {"--size", NULL, "WxH", LM_CMD_CHARTS | LM_CMD_RUN | LM_CMD_CHECK | LM_CMD_REFERENCE | LM_CMD_TRADEOFF |
      LM_CMD_BENCH | LM_CMD_VIEW, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_size,
      "picture size (charts: default 1024x768; run: 512x512; check: 128x128;\n"

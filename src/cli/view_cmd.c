@@ -14,6 +14,8 @@
 #include "view_state.h"
 
 #define FPS 30.0f            /* the animation's frames a second with --frames (as lmgi run) */
+#define STALE 1e-3f         /* a texel whose error estimate is above this (0.1%) is still to move: the blend
+                              * leaves rounding-sized remainders (1e-7) it never clears */
 #define IDLE_UPDATES 8       /* updates in a row without work before the lighting counts as caught up: the
                               * photon work runs beside the picture, and an update may find none while it
                               * is still under way */
@@ -66,10 +68,14 @@ static void draw_panel(lm_viewer *v, int fw, int fh)
     lm_view_panel_add(&p, "update %.1f ms of a %.3g ms budget (photons %.1f, gather %.1f)  picture %.1f ms",
                       s->ms_total, (double)v->budget, s->ms_photons, s->ms_gather, v->ms_render);
     lm_view_panel_add(&p, "busiest: %s: %s", s->busiest_stage ? s->busiest_stage : "-", s->why);
-    if (v->busy)
-        lm_view_panel_add(&p, "lighting: catching up for %d updates (%.1f s)", v->busy, glfwGetTime() - v->busy_since);
-    else
-        lm_view_panel_add(&p, "lighting: caught up (nothing waits)");
+    if (v->busy) {
+        lm_view_panel_add(&p, "lighting: catching up for %d updates (%.1f s)", v->busy - 1, glfwGetTime() - v->busy_since);
+        lm_view_panel_add(&p, "  photons checked since the last change: %d%% of a round of %d updates",
+                          v->round > 0 ? (int)fminf(100.0f, 100.0f * (float)v->idle / (float)v->round) : 100, v->round);
+        lm_view_panel_add(&p, "  texels still to move: %u, the largest by %.1f%%", v->stale_texels, 100.0 * v->stale_max);
+    } else {
+        lm_view_panel_add(&p, "lighting: caught up (every photon checked since the last change, no texel to move)");
+    }
     lm_view_panel_add(&p, "texels %u (allowed %d)  photons %u  AIM surfaces %d  surfaces changed %d",
                       s->texels_gathered, s->texels_budget, s->photons_retraced, s->aim_surfaces_refreshed,
                       s->surfaces_changed);
@@ -103,31 +109,84 @@ static void tone_map(lm_viewer *v)
                            v->rgba + 4 * row * (size_t)(v->height - 1 - y));
 }
 
-/* Whether the lighting still has work waiting: an update that found photon paths changed, refreshed AIMs,
- * regathered texels, traced caustic photons or redrew reflection faces or shadow maps (the one photon group
- * a still scene re-traces each update to look for changes is not work waiting). From the first such
- * update the lighting is "catching up"; after IDLE_UPDATES without any, "caught up", with how long that
- * took (the panel, and a line on the terminal a script can wait for). */
+/* The error atlas (LMGI_LIGHTMAP_ERROR: the updater's own estimate of how far the displayed lightmap
+ * still is from the lighting as it is now) summed up: the valid texels still to move by more than
+ * STALE, and the largest relative change still to come. */
+static void read_staleness(lm_viewer *v, double now)
+{
+    lmgi_info in;
+    lmgi_get_info(v->sc, &in);
+    size_t n = (size_t)in.atlas_width * (size_t)in.atlas_height;
+    if (n != v->error_n) {
+        free(v->error);
+        v->error = malloc(4 * n * sizeof *v->error);
+        v->error_n = v->error ? n : 0;
+    }
+    lmgi_error err;
+    v->stale_texels = 0;
+    v->stale_max = 0.0f;
+    v->stale_at = now;
+    if (!v->error || lmgi_get_lightmap(v->u, LMGI_LIGHTMAP_ERROR, v->error, 4 * n, &err) != LMGI_OK)
+        return;
+    for (size_t i = 0; i < n; i++)
+        if (v->error[4 * i + 3] > 0.0f && v->error[4 * i] > STALE) {
+            v->stale_texels++;
+            v->stale_max = fmaxf(v->stale_max, v->error[4 * i]);
+        }
+}
+
+static void begin_catching_up(lm_viewer *v, double now)
+{
+    v->idle = 0;
+    if (v->busy)
+        return;
+    v->busy = 1;
+    v->busy_since = now;
+    if (!v->a->quiet)
+        printf("lighting: catching up\n");
+}
+
+void lm_viewer_edited(lm_viewer *v) { begin_catching_up(v, glfwGetTime()); }
+
+/* Whether the lighting still has work waiting. An update that found photon paths changed, refreshed AIMs,
+ * regathered texels, traced caustic photons or redrew reflection faces or shadow maps did work; so did an
+ * edit. The round robin finds the paths an edit changed only as it re-traces them, one photon a group an
+ * update (the paper's selective re-emission), so updates without work prove nothing until a whole round
+ * has passed since the last change found. The lighting has caught up when it has (and at least
+ * IDLE_UPDATES), and the error atlas has no texel left to move: then the panel says so and the terminal
+ * prints "caught up", with how long it took, a line scripts wait for. */
 static void track_work(lm_viewer *v, double now)
 {
     const lmgi_update_stats *s = &v->stats;
     int working = s->groups_invalidated || s->aim_surfaces_refreshed || s->texels_gathered ||
                   s->caustic_photons_retraced || s->cube_faces_rendered || s->shadow_maps_rendered ||
                   s->shadow_maps_stale;
-    if (working) {
-        v->idle = 0;
-        if (!v->busy++) {
-            v->busy_since = now;
-            if (!v->a->quiet)
-                printf("lighting: catching up\n");
-        }
-    } else if (v->busy && ++v->idle >= IDLE_UPDATES) {
+    if (working)
+        begin_catching_up(v, now);
+    else if (v->busy)
+        v->idle++;
+    if (!v->busy)
+        return;
+    v->busy++;
+    int due = v->idle >= IDLE_UPDATES && v->idle > v->round;
+    if (due || now - v->stale_at > 0.25)
+        read_staleness(v, now);
+    if (due && v->stale_texels == 0) {
         char line[96];
-        snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s)", v->busy, now - v->busy_since);
+        snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s)", v->busy - 1, now - v->busy_since);
         v->busy = v->idle = 0;
         lm_viewer_say(v, line);
     }
     fflush(stdout);
+}
+
+/* The updates of a round of the round robin (view_state.h's round). */
+static void learn_round(lm_viewer *v)
+{
+    lmgi_updater_info in;
+    lmgi_get_updater_info(v->u, &in);
+    uint32_t k = in.photons.retrace_per_group ? in.photons.retrace_per_group : 1;
+    v->round = (int)((in.photons.per_group + k - 1) / k);
 }
 
 /* --watch: the file changed and settled; its differences made as edits, or the scene reloaded when they
@@ -150,6 +209,8 @@ static int follow_file(lm_viewer *v)
         char line[200];
         snprintf(line, sizeof line, r == -2 ? "the file's edit was refused (the terminal says why)" : "file saved: %s",
                  what);
+        if (r > 0)
+            lm_viewer_edited(v);
         lm_viewer_say(v, line);
         return 1;
     }
@@ -164,6 +225,8 @@ static int follow_file(lm_viewer *v)
         return 0;
     }
     lm_viewer_select_light(v, 0);
+    learn_round(v);
+    lm_viewer_edited(v);
     lm_viewer_say(v, "the file's geometry changed: the scene was loaded again");
     return 1;
 }
@@ -183,9 +246,11 @@ static int frame(lm_viewer *v)
         v->time = (float)(now - v->start);
     if (v->a->watch && lm_view_watch_due(&v->watch, now) && !follow_file(v))
         return 0;
-    while (v->have_script && v->next_edit < v->script.edit_count && v->script.edits[v->next_edit].frame <= v->frame)
+    while (v->have_script && v->next_edit < v->script.edit_count && v->script.edits[v->next_edit].frame <= v->frame) {
         if (!lm_edit_script_apply(&v->script, v->next_edit++, v->sc))
             return 0;
+        lm_viewer_edited(v);
+    }
     if (lmgi_update(v->u, v->time, v->budget, &v->stats, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
@@ -305,6 +370,7 @@ static int start(lm_viewer *v)
     v->budget = a->budget_ms > 0.0f ? a->budget_ms : LM_VIEW_BUDGET_MS;
     v->panel = 1;
     lm_viewer_select_light(v, 0);
+    learn_round(v);
     if (a->watch)
         lm_view_watch_init(&v->watch, a->files[0]);
     v->start = v->last = glfwGetTime();
@@ -346,5 +412,6 @@ int lm_cli_view(const lm_cli_args *a)
     lm_view_history_free(&v.history);
     free(v.rgb);
     free(v.rgba);
+    free(v.error);
     return ok && !v.failed ? 0 : 1;
 }

@@ -63,6 +63,7 @@ static void edit_light(lm_viewer *v, float f)
         return;
     }
     lm_view_history_push(&v->history, &step);
+    lm_viewer_edited(v);
     char what[128];
     snprintf(what, sizeof what, "light %d %s, intensity %.4g, colour %.2f %.2f %.2f", v->light, l.enabled ? "on" : "off",
              (double)l.intensity, (double)l.color[0], (double)l.color[1], (double)l.color[2]);
@@ -88,6 +89,7 @@ static void add_light(lm_viewer *v)
         return;
     }
     lm_view_history_push(&v->history, &step);
+    lm_viewer_edited(v);
     v->light = step.id;
     char what[96];
     snprintf(what, sizeof what, "light %d added at the target", step.id);
@@ -109,6 +111,7 @@ static void remove_light(lm_viewer *v)
         return;
     }
     lm_view_history_push(&v->history, &step);
+    lm_viewer_edited(v);
     char what[96];
     snprintf(what, sizeof what, "light %d removed", v->light);
     lm_viewer_say(v, what);
@@ -124,6 +127,8 @@ static void undo_redo(lm_viewer *v, int redo)
                   : lm_view_undo(&v->history, v->sc, what, sizeof what, &err);
     if (!ok && err.message[0])
         fprintf(stderr, "lmgi: error: %s\n", err.message);
+    if (ok)
+        lm_viewer_edited(v);
     lm_viewer_say(v, what);
     if (v->light >= 0 && lmgi_light_is_removed(v->sc, v->light))
         lm_viewer_select_light(v, v->light + 1);
@@ -203,12 +208,37 @@ void lm_viewer_window_shot(lm_viewer *v, int fw, int fh)
     free(lin);
 }
 
+/* W A S D fly along and across the view, Q E down and up; shift: four times as fast. */
+void lm_viewer_fly(lm_viewer *v, float seconds)
+{
+    GLFWwindow *w = v->win;
+    unsigned k = v->fly;
+    float f = (float)((k >> 0) & 1) - (float)((k >> 2) & 1), r = (float)((k >> 3) & 1) - (float)((k >> 1) & 1);
+    float u = (float)((k >> 5) & 1) - (float)((k >> 4) & 1);
+    if (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS)
+        seconds *= 4.0f;
+    if (f != 0.0f || r != 0.0f || u != 0.0f)
+        lm_view_camera_fly(&v->cam, f, r, u, seconds);
+}
+
+/* A fly key's bit (W A S D Q E: 0 to 5), or 0. */
+static unsigned fly_bit(int key)
+{
+    static const int keys[6] = {GLFW_KEY_W, GLFW_KEY_A, GLFW_KEY_S, GLFW_KEY_D, GLFW_KEY_Q, GLFW_KEY_E};
+    for (int i = 0; i < 6; i++)
+        if (keys[i] == key)
+            return 1u << i;
+    return 0;
+}
+
 static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
 {
     (void)scancode;
     lm_viewer *v = glfwGetWindowUserPointer(w);
-    if (action == GLFW_RELEASE)
+    if (action == GLFW_RELEASE) {
+        v->fly &= ~fly_bit(key);
         return;
+    }
     if (mods & GLFW_MOD_CONTROL) {
         if (key == GLFW_KEY_Z)
             undo_redo(v, (mods & GLFW_MOD_SHIFT) != 0);
@@ -218,6 +248,7 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
             save_scene(v);
         return;
     }
+    v->fly |= fly_bit(key);
     switch (key) {
     case GLFW_KEY_ESCAPE: glfwSetWindowShouldClose(w, 1); break;
     case GLFW_KEY_H: v->panel = !v->panel; break;
@@ -318,6 +349,8 @@ static void move_node(lm_viewer *v, double x, double y)
     lmgi_error err;
     if (lmgi_set_node_transform(v->sc, v->node, m, &err) != LMGI_OK)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
+    else
+        lm_viewer_edited(v);
 }
 
 static void end_move(lm_viewer *v)
@@ -392,24 +425,9 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
         return;
     }
     lm_view_history_push(&v->history, &step);
+    lm_viewer_edited(v);
     lm_viewer_say(v, "turned the selected node");
 }
-
-/* W A S D fly along and across the view, Q E down and up; shift: four times as fast. */
-void lm_viewer_fly(lm_viewer *v, float seconds)
-{
-    GLFWwindow *w = v->win;
-    if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS)
-        return; /* ctrl + S saves, it does not fly */
-    float f = (float)(glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS);
-    float r = (float)(glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS);
-    float u = (float)(glfwGetKey(w, GLFW_KEY_E) == GLFW_PRESS) - (float)(glfwGetKey(w, GLFW_KEY_Q) == GLFW_PRESS);
-    if (glfwGetKey(w, GLFW_KEY_LEFT_SHIFT) == GLFW_PRESS || glfwGetKey(w, GLFW_KEY_RIGHT_SHIFT) == GLFW_PRESS)
-        seconds *= 4.0f;
-    if (f != 0.0f || r != 0.0f || u != 0.0f)
-        lm_view_camera_fly(&v->cam, f, r, u, seconds);
-}
-
 
 void lm_viewer_input(lm_viewer *v)
 {

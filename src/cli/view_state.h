@@ -32,14 +32,25 @@ struct lm_viewer {
     int light;               /* the selected light, -1: none */
     int node;                /* the selected node, -1: none */
     int drag;                /* 0, 1 orbit, 2 pan, 3 moving the selected node */
+    unsigned fly;            /* the fly keys held (W A S D Q E, bits 0-5), pressed without ctrl: from the key
+                              * events, so that ctrl+S saves without flying back however its press and
+                              * release fall between frames */
     double mouse[2], press[2];
     float grab[3], grab_start[16]; /* moving a node: the point grabbed and the node's matrix then */
     lm_view_history history;
     int saves;
     lm_view_watch watch;     /* --watch */
-    int busy;                /* updates since work began (photons, AIMs, texels, caustics, faces, shadows) */
-    int idle;                /* of them, the last ones in a row that did none */
+    int busy;                /* updates since work began (an edit, photons, AIMs, texels, caustics, faces, shadows) */
+    int idle;                /* of them, the last ones in a row that did none and followed no edit */
     double busy_since;
+    int round;               /* updates in which the round robin re-traces every stored photon once
+                              * (photons per group / re-traced per group a frame): a change an edit made is
+                              * found within a round, not before */
+    uint32_t stale_texels;   /* the error atlas (LMGI_LIGHTMAP_ERROR): valid texels still to move, */
+    float stale_max;         /* and the largest relative change still to come */
+    double stale_at;         /* when it was read */
+    float *error;            /* its buffer, of error_n texels */
+    size_t error_n;
     lmgi_updater_desc desc;  /* the updater's, for a reload */
     float exposure;          /* fixed from the first picture (X meters again) */
     float *rgb;              /* the picture, linear, top row first */
@@ -54,6 +65,8 @@ struct lm_viewer {
 
 /* What the last action did, on the panel and the terminal (unless -q). */
 void lm_viewer_say(lm_viewer *v, const char *text);
+/* An edit was made: the lighting is catching up from now on, for a round of the round robin at least. */
+void lm_viewer_edited(lm_viewer *v);
 /* The first light from id `from` on (wrapping) that is not removed; -1 when there is none. */
 void lm_viewer_select_light(lm_viewer *v, int from);
 /* Installs the window's mouse and key callbacks (the window's user pointer is v). */
