@@ -126,6 +126,9 @@ typedef struct {
     int surface;        /* surface id, -1 for specular triangles */
     uint32_t triangle;  /* scene triangle id */
     float normal[3];    /* world-space geometric normal */
+    int material;       /* the triangle's material (lmgi_get_material), -1 where nothing was hit */
+    float uv[2];        /* barycentrics of the hit: p = (1 - u - v) corner 0 + u corner 1 + v corner 2, as the
+                         * corners of lmgi_triangle_lightmap_uv */
 } lmgi_hit;
 
 typedef struct {

@@ -510,6 +510,69 @@ static void test_edit_reaches_updater(void **state)
     close_all(u, sc, ctx);
 }
 
+/* lmgi_intersect's material and barycentrics, for an editor picking what is under the cursor: rays down
+ * onto the Cornell box's floor hit a material of the scene, and the lightmap UV the barycentrics give
+ * (over lmgi_triangle_lightmap_uv's corners) falls in a texel of the hit triangle whose world position is
+ * within two texels of the point hit; a miss gives material -1. */
+static void test_intersect_material_and_uv(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = load_cornell();
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    int *at = malloc(sizeof *at * (size_t)in.atlas_width * (size_t)in.atlas_height);
+    assert_non_null(at);
+    for (size_t i = 0; i < (size_t)in.atlas_width * (size_t)in.atlas_height; i++)
+        at[i] = -1;
+    for (uint32_t i = 0; i < lmgi_texel_count(sc); i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        at[(size_t)t.y * (size_t)in.atlas_width + (size_t)t.x] = (int)i;
+    }
+    const float down[3] = {0.0f, -1.0f, 0.0f};
+    int found = 0;
+    double worst = 0.0;
+    for (int k = 0; k < 16; k++) {
+        float x = in.bounds_min[0] + (0.1f + 0.05f * (float)k) * (in.bounds_max[0] - in.bounds_min[0]);
+        float z = in.bounds_min[2] + (0.9f - 0.05f * (float)k) * (in.bounds_max[2] - in.bounds_min[2]);
+        const float org[3] = {x, in.bounds_max[1] - 1e-3f, z};
+        lmgi_hit h;
+        lmgi_intersect(sc, org, down, INFINITY, &h);
+        assert_true(h.hit);
+        assert_true(h.material >= 0 && h.material < lmgi_material_count(sc));
+        float uv[6];
+        if (h.surface < 0 || !lmgi_triangle_lightmap_uv(sc, h.triangle, uv))
+            continue;
+        float w0 = 1.0f - h.uv[0] - h.uv[1];
+        assert_true(w0 >= -1e-5f && h.uv[0] >= -1e-5f && h.uv[1] >= -1e-5f);
+        int tx = (int)((w0 * uv[0] + h.uv[0] * uv[2] + h.uv[1] * uv[4]) * (float)in.atlas_width);
+        int ty = (int)((w0 * uv[1] + h.uv[0] * uv[3] + h.uv[1] * uv[5]) * (float)in.atlas_height);
+        int i = at[(size_t)ty * (size_t)in.atlas_width + (size_t)tx];
+        if (i < 0)
+            continue; /* a texel of the rim whose centre lies outside every triangle */
+        lmgi_texel t;
+        lmgi_get_texel(sc, (uint32_t)i, &t);
+        double d = 0.0;
+        for (int c = 0; c < 3; c++) {
+            double p = org[c] + h.t * down[c] - t.position[c];
+            d += p * p;
+        }
+        worst = fmax(worst, sqrt(d) / in.texel_size);
+        found++;
+    }
+    print_message("%d floor hits found their texel through the barycentrics, the farthest %.2f texels away\n", found,
+                  worst);
+    assert_true(found >= 8);
+    assert_true(worst < 2.0);
+    const float up[3] = {0.0f, 1.0f, 0.0f}, above[3] = {0.0f, in.bounds_max[1] + 1.0f, 0.0f};
+    lmgi_hit miss;
+    lmgi_intersect(sc, above, up, INFINITY, &miss);
+    assert_false(miss.hit);
+    assert_int_equal(miss.material, -1);
+    free(at);
+    lmgi_free(sc);
+}
+
 /* Dimming a light in room A of the two rooms with the door closed relights room A and leaves room B's
  * surfaces, IIM and AIM untouched to the bit (the paper's Fig. 5: an edit costs only what it reaches). */
 static void test_light_edit_stays_in_its_room(void **state)
@@ -1475,6 +1538,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_context),
+        cmocka_unit_test(test_intersect_material_and_uv),
         cmocka_unit_test(test_log_callback),
         cmocka_unit_test(test_two_contexts_one_thread),
         cmocka_unit_test(test_lightmaps_and_versions),

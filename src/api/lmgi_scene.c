@@ -518,7 +518,7 @@ void lmgi_intersect(const lmgi_scene *sc, const float org[3], const float dir[3]
         return;
     lm_rt_hit h;
     memset(hit, 0, sizeof *hit);
-    hit->node = hit->surface = -1;
+    hit->node = hit->surface = hit->material = -1;
     if (!sc || !org || !dir || lm_scene_commit(sc, NULL) != LMGI_OK) /* the BVH unusable: nothing hit */
         return;
     const float *o = sc->scene->origin;
@@ -530,6 +530,8 @@ void lmgi_intersect(const lmgi_scene *sc, const float org[3], const float dir[3]
     hit->node = h.node;
     hit->surface = h.surface;
     hit->triangle = h.tri;
+    hit->material = sc->scene->tri_material[h.tri];
+    hit->uv[0] = h.u, hit->uv[1] = h.v;
     memcpy(hit->normal, h.ng, sizeof hit->normal);
 }
 
