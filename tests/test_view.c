@@ -263,6 +263,29 @@ static int apart(const char *a, const char *b, double rel, int *lit, double *rat
     return off;
 }
 
+/* The generated Cornell box's cube: its world matrix, and the pixel its origin falls on in a 320 x 240
+ * picture from the scene's camera (where the viewer's window starts). */
+static void cube_pixel(float m0[16], int *x, int *y)
+{
+    lmgi_scene *sc = generated_cornell();
+    lmgi_error e;
+    int cube = lmgi_find_node(sc, "dynamic_cube");
+    float p[4], v[4] = {0}, c[4] = {0};
+    assert_true(cube >= 0 && lmgi_get_node_transform(sc, cube, m0));
+    lmgi_camera cam;
+    assert_int_equal(lmgi_scene_camera(sc, -1, 320, 240, &cam, &e), LMGI_OK);
+    memcpy(p, m0 + 12, 3 * sizeof(float));
+    p[3] = 1.0f;
+    for (int r = 0; r < 4; r++)
+        for (int k = 0; k < 4; k++)
+            v[r] += cam.view[4 * k + r] * p[k];
+    for (int r = 0; r < 4; r++)
+        for (int k = 0; k < 4; k++)
+            c[r] += cam.proj[4 * k + r] * v[k];
+    *x = (int)lround((c[0] / c[3] * 0.5 + 0.5) * 320), *y = (int)lround((0.5 - c[1] / c[3] * 0.5) * 240);
+    lmgi_free(sc);
+}
+
 /* The generated Cornell box standing still (--still: the file's pose), its cube dragged with the mouse
  * (ctrl + drag, 60 pixels left), its lighting captured (shift+P, the linear numbers), the scene saved
  * (ctrl+S), then the move undone (ctrl+Z). The saved file has the cube where the drag put it; lmgi run's
@@ -275,23 +298,9 @@ static void test_drag_save_undo(void **state)
     (void)state;
     if (!have_x_tools())
         return;
-    lmgi_scene *sc = generated_cornell();
-    lmgi_error e;
-    int cube = lmgi_find_node(sc, "dynamic_cube");
-    float m0[16], p[4], v[4] = {0}, c[4] = {0};
-    assert_true(cube >= 0 && lmgi_get_node_transform(sc, cube, m0));
-    lmgi_camera cam;
-    assert_int_equal(lmgi_scene_camera(sc, -1, 320, 240, &cam, &e), LMGI_OK);
-    memcpy(p, m0 + 12, 3 * sizeof(float));
-    p[3] = 1.0f;
-    for (int r = 0; r < 4; r++)
-        for (int k = 0; k < 4; k++)
-            v[r] += cam.view[4 * k + r] * p[k];
-    for (int r = 0; r < 4; r++)
-        for (int k = 0; k < 4; k++)
-            c[r] += cam.proj[4 * k + r] * v[k];
-    int x = (int)lround((c[0] / c[3] * 0.5 + 0.5) * 320), y = (int)lround((0.5 - c[1] / c[3] * 0.5) * 240);
-    lmgi_free(sc);
+    float m0[16];
+    int x, y;
+    cube_pixel(m0, &x, &y);
     char dir[64], cwd[1024], script[3072];
     snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
     assert_non_null(getcwd(cwd, sizeof cwd));
@@ -316,6 +325,8 @@ static void test_drag_save_undo(void **state)
     snprintf(saved, sizeof saved, "%s/lmgi-view-scene-001/scene.gltf", dir);
     lmgi_options o;
     lmgi_options_init(&o);
+    lmgi_scene *sc;
+    lmgi_error e;
     assert_int_equal(lmgi_load(saved, &o, &sc, &e), LMGI_OK);
     float m1[16];
     assert_true(lmgi_get_node_transform(sc, lmgi_find_node(sc, "dynamic_cube"), m1));
@@ -340,6 +351,103 @@ static void test_drag_save_undo(void **state)
     int back = apart(undone, original, 0.25, &lit, &ratio);
     print_message("after the undo against the unmoved scene: mean %.4f, %d of %d pixels 25%% apart\n", ratio, back, lit);
     assert_true(fabs(ratio - 1.0) < 0.005 && back < lit / 200);
+}
+
+/* Every other edit the window makes, as a person makes it, on the generated Cornell box standing still:
+ * the cube dragged 60 pixels up with Y held (along the world's y axis: it rises, x and z stay), its
+ * material recoloured (B: the first of the viewer's colours, 0.8 grey), its shadows switched off (1); the
+ * light dimmed from the keyboard (-: x 0.8) and lowered (Page Down: a twentieth of the scene); then the
+ * lighting captured once caught up (shift+P), the scene saved (ctrl+S) and the view switched to the IIM
+ * (V: the terminal says so). The saved file holds every edit, and lmgi run's frame of it is the window's
+ * lighting: the same mean within 0.5%, under 0.5% of the pixels more than 25% apart. */
+static void test_axis_material_effects_light(void **state)
+{
+    (void)state;
+    if (!have_x_tools())
+        return;
+    float m0[16];
+    int x, y;
+    cube_pixel(m0, &x, &y);
+    lmgi_scene *sc = generated_cornell();
+    lmgi_error e;
+    lmgi_light l0;
+    assert_int_equal(lmgi_get_light(sc, 0, &l0, &e), LMGI_OK);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    float size = 0.0f;
+    for (int k = 0; k < 3; k++)
+        size += (in.bounds_max[k] - in.bounds_min[k]) * (in.bounds_max[k] - in.bounds_min[k]);
+    size = sqrtf(size);
+    lmgi_free(sc);
+    char dir[64], cwd[1024], script[3072];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    snprintf(script, sizeof script,
+             "set -e; B=$(cd %s && pwd)/lmgi; S=%s/scenes/cornell.glb; cd %s; F=%d\n" IDLE_FN
+             "$B view $S --still --size 320x240 --budget 500 --retrace 16 > log.txt &\n"
+             "P=$!; W=$(xdotool search --sync --name 'lmgi view')\n"
+             "sleep $((2 * F)); C=$(caught); xdotool mousemove --window $W %d %d; sleep 0.3\n"
+             "xdotool keydown ctrl mousedown 1; sleep 0.3; xdotool key --window $W y; sleep 0.3\n"
+             "xdotool mousemove --window $W %d %d; sleep 0.3; xdotool mousemove --window $W %d %d; sleep 0.3\n"
+             "xdotool mouseup 1 keyup ctrl; settled $C\n"
+             "C=$(caught); xdotool key --window $W b; settled $C\n"
+             "C=$(caught); xdotool key --window $W 1; settled $C\n"
+             "C=$(caught); xdotool key --window $W minus; settled $C\n"
+             "C=$(caught); xdotool key --window $W Next; settled $C\n"
+             "xdotool key --window $W shift+p; sleep $F; xdotool key --window $W ctrl+s; sleep $F\n"
+             "xdotool key --window $W v; sleep $F; xdotool key --window $W Escape || true; wait $P\n"
+             "$B run lmgi-view-scene-001/scene.gltf --frames 1 --size 320x240 --out edited -q",
+             getenv("LMGI_BUILD") ? getenv("LMGI_BUILD") : "build", cwd, dir, slow(), x, y, x, y - 30, x, y - 60);
+    int rc = under_x(script);
+    if (rc != 0)
+        fail_msg("exit %d: %s", rc, output);
+    char saved[512], log[512];
+    snprintf(saved, sizeof saved, "%s/lmgi-view-scene-001/scene.gltf", dir);
+    snprintf(log, sizeof log, "%s/log.txt", dir);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    assert_int_equal(lmgi_load(saved, &o, &sc, &e), LMGI_OK);
+    int cube = lmgi_find_node(sc, "dynamic_cube");
+    float m1[16];
+    assert_true(lmgi_get_node_transform(sc, cube, m1));
+    lmgi_node_effects fx;
+    assert_int_equal(lmgi_get_node_effects(sc, cube, &fx, &e), LMGI_OK);
+    lmgi_hit hit;
+    const float above[3] = {m1[12], in.bounds_max[1] - 1e-3f, m1[14]}, down[3] = {0.0f, -1.0f, 0.0f};
+    lmgi_intersect(sc, above, down, INFINITY, &hit);
+    assert_true(hit.hit && hit.node == cube);
+    lmgi_material mat;
+    assert_int_equal(lmgi_get_material(sc, hit.material, &mat, &e), LMGI_OK);
+    lmgi_light l1;
+    assert_int_equal(lmgi_get_light(sc, 0, &l1, &e), LMGI_OK);
+    lmgi_free(sc);
+    print_message("cube moved along y: (%.3f, %.3f, %.3f) -> (%.3f, %.3f, %.3f); its material %.2f %.2f %.2f, shadows "
+                  "%d; light %.4g -> %.4g at height %.3f -> %.3f\n", (double)m0[12], (double)m0[13], (double)m0[14],
+                  (double)m1[12], (double)m1[13], (double)m1[14], (double)mat.base_color[0], (double)mat.base_color[1],
+                  (double)mat.base_color[2], fx.shadows, (double)l0.intensity, (double)l1.intensity,
+                  (double)l0.position[1], (double)l1.position[1]);
+    assert_true(m1[13] - m0[13] > 0.05f && fabsf(m1[12] - m0[12]) < 1e-4f && fabsf(m1[14] - m0[14]) < 1e-4f);
+    for (int k = 0; k < 3; k++)
+        assert_float_equal(mat.base_color[k], 0.8f, 1e-6);
+    assert_int_equal(fx.shadows, 0);
+    assert_float_equal(l1.intensity, l0.intensity / 1.25f, 1e-4 * l0.intensity);
+    assert_float_equal(l1.position[1], l0.position[1] - 0.05f * size, 1e-4 * size);
+    char said[8192];
+    FILE *f = fopen(log, "r");
+    assert_non_null(f);
+    size_t got = fread(said, 1, sizeof said - 1, f);
+    said[got] = '\0';
+    fclose(f);
+    assert_non_null(strstr(said, "view: IIM"));
+    char edited[512], window[512];
+    snprintf(edited, sizeof edited, "%s/edited/frame_0000.exr", dir);
+    snprintf(window, sizeof window, "%s/lmgi-view-001.exr", dir);
+    int lit;
+    double ratio;
+    int same = apart(window, edited, 0.25, &lit, &ratio);
+    print_message("the window's lighting against lmgi run's frame of the saved scene: mean %.4f, %d of %d pixels 25%% "
+                  "apart\n", ratio, same, lit);
+    assert_true(fabs(ratio - 1.0) < 0.005 && same < lit / 200);
 }
 
 /* A room (an inward cube of side 4), a box on its floor, a lamp and a camera inside: the box at
@@ -422,6 +530,7 @@ int main(void)
         cmocka_unit_test(test_keys_switch_light_off),
         cmocka_unit_test(test_script),
         cmocka_unit_test(test_drag_save_undo),
+        cmocka_unit_test(test_axis_material_effects_light),
         cmocka_unit_test(test_watch),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -14,8 +14,6 @@
 #include "view_state.h"
 
 #define FPS 30.0f            /* the animation's frames a second with --frames (as lmgi run) */
-#define STALE 1e-3f         /* a texel whose error estimate is above this (0.1%) is still to move: the blend
-                              * leaves rounding-sized remainders (1e-7) it never clears */
 #define IDLE_UPDATES 8       /* updates in a row without work before the lighting counts as caught up: the
                               * photon work runs beside the picture, and an update may find none while it
                               * is still under way */
@@ -86,14 +84,26 @@ static void draw_panel(lm_viewer *v, int fw, int fh)
         lm_view_panel_add(&p, "light %d of %d: %s, intensity %.4g, colour %.2f %.2f %.2f", v->light,
                           lmgi_light_count(v->sc), l.enabled ? "on" : "off", (double)l.intensity,
                           (double)l.color[0], (double)l.color[1], (double)l.color[2]);
-    if (v->node >= 0)
-        lm_view_panel_add(&p, "selected node %s (%s): ctrl+drag moves it, ctrl+wheel turns it", lmgi_node_name(v->sc, v->node),
-                          lmgi_node_is_dynamic(v->sc, v->node) ? "dynamic" : "static");
+    if (v->node >= 0) {
+        lmgi_node_effects fx = {0, 0, 0, 0};
+        lmgi_get_node_effects(v->sc, v->node, &fx, &err);
+        lm_view_panel_add(&p, "selected node %s (%s), material %s; effects 1 shadows %s, 2 indirect %s, 3 reflections "
+                          "%s, 4 caustics %s", lmgi_node_name(v->sc, v->node),
+                          lmgi_node_is_dynamic(v->sc, v->node) ? "dynamic" : "static",
+                          v->material >= 0 ? lmgi_material_name(v->sc, v->material) : "-", fx.shadows ? "on" : "off",
+                          fx.indirect ? "on" : "off", fx.reflections ? "on" : "off", fx.caustics ? "on" : "off");
+    }
+    if (v->drag == 3)
+        lm_view_panel_add(&p, "moving %s %s (X Y Z: along that axis, again: free)", lmgi_node_name(v->sc, v->node),
+                          v->axis < 0 ? "on the horizontal plane" : v->axis == 0 ? "along x" : v->axis == 1 ? "along y" : "along z");
+    lm_view_panel_add(&p, "view: %s (V: next)", lm_view_map_name(v->map));
     if (v->status[0])
         lm_view_panel_add(&p, "%s", v->status);
-    lm_view_panel_add(&p, "drag: orbit (shift, right: pan)  wheel: zoom  WASDQE: fly  click: select  L + - O C N Del: "
-                          "lights  ctrl+Z/Y: undo/redo");
-    lm_view_panel_add(&p, "ctrl+S: save scene  [ ]: budget  space: pause  P: screenshot  H: panel  Esc: quit");
+    lm_view_panel_add(&p, "drag: orbit (shift, right: pan)  wheel: zoom  WASDQE: fly  click: select  ctrl+drag: move "
+                          "(X Y Z: axis)  ctrl+wheel: turn");
+    lm_view_panel_add(&p, "lights: L select  + - dim  O off  C colour  N add  Del remove  alt+drag, PgUp PgDn move");
+    lm_view_panel_add(&p, "B base colour  G shift+G emission  1-4 effects  ctrl+Z/Y undo/redo  ctrl+S save  [ ] budget");
+    lm_view_panel_add(&p, "space: pause  P: screenshot  shift+P: EXR  X: exposure  H: panel  Esc: quit");
     lm_view_panel_draw(&p, fw, fh, fw >= 1000 ? 2.0f : 1.0f);
 }
 
@@ -102,16 +112,17 @@ static void tone_map(lm_viewer *v)
 {
     lmgi_tonemap op = (lmgi_tonemap)v->a->tonemap;
     size_t row = (size_t)v->width;
-    if (!(v->exposure > 0.0f))
+    int false_colours = v->map == LM_VIEW_ERROR || v->map == LM_VIEW_ATLAS;
+    if (!(v->exposure > 0.0f) && !false_colours)
         v->exposure = lmgi_auto_exposure(op, v->rgb, row * (size_t)v->height);
     for (int y = 0; y < v->height; y++)
-        lmgi_tonemap_rgba8(op, v->exposure, v->rgb + 3 * row * (size_t)y, row,
-                           v->rgba + 4 * row * (size_t)(v->height - 1 - y));
+        lmgi_tonemap_rgba8(false_colours ? LMGI_TONEMAP_CLAMP : op, false_colours ? 1.0f : v->exposure,
+                           v->rgb + 3 * row * (size_t)y, row, v->rgba + 4 * row * (size_t)(v->height - 1 - y));
 }
 
 /* The error atlas (LMGI_LIGHTMAP_ERROR: the updater's own estimate of how far the displayed lightmap
  * still is from the lighting as it is now) summed up: the valid texels still to move by more than
- * STALE, and the largest relative change still to come. */
+ * LM_VIEW_STALE, and the largest relative change still to come. */
 static void read_staleness(lm_viewer *v, double now)
 {
     lmgi_info in;
@@ -129,7 +140,7 @@ static void read_staleness(lm_viewer *v, double now)
     if (!v->error || lmgi_get_lightmap(v->u, LMGI_LIGHTMAP_ERROR, v->error, 4 * n, &err) != LMGI_OK)
         return;
     for (size_t i = 0; i < n; i++)
-        if (v->error[4 * i + 3] > 0.0f && v->error[4 * i] > STALE) {
+        if (v->error[4 * i + 3] > 0.0f && v->error[4 * i] > LM_VIEW_STALE) {
             v->stale_texels++;
             v->stale_max = fmaxf(v->stale_max, v->error[4 * i]);
         }
@@ -146,7 +157,11 @@ static void begin_catching_up(lm_viewer *v, double now)
         printf("lighting: catching up\n");
 }
 
-void lm_viewer_edited(lm_viewer *v) { begin_catching_up(v, glfwGetTime()); }
+void lm_viewer_edited(lm_viewer *v)
+{
+    begin_catching_up(v, glfwGetTime());
+    lm_view_maps_edited(&v->maps);
+}
 
 /* Whether the lighting still has work waiting. An update that found photon paths changed, refreshed AIMs,
  * regathered texels, traced caustic photons or redrew reflection faces or shadow maps did work; so did an
@@ -219,7 +234,7 @@ static int follow_file(lm_viewer *v)
     lmgi_free(v->sc);
     v->sc = next;
     lm_view_history_free(&v->history); /* its steps were the old scene's */
-    v->node = -1;
+    v->node = v->material = -1;
     if (lmgi_updater_create(v->ctx, v->sc, &v->desc, &v->u, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
@@ -266,6 +281,10 @@ static int frame(lm_viewer *v)
     lm_view_camera_get(&v->cam, fw, fh, &cam);
     double t0 = glfwGetTime();
     if (lmgi_render(v->u, &cam, fw, fh, v->rgb, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        return 0;
+    }
+    if (v->map != LM_VIEW_PICTURE && !lm_view_maps_draw(&v->maps, v->u, v->sc, v->map, &cam, fw, fh, v->rgb, &err)) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
@@ -389,7 +408,7 @@ int lm_cli_view(const lm_cli_args *a)
     v.a = a;
     v.name = strrchr(a->files[0], '/') ? strrchr(a->files[0], '/') + 1 : a->files[0];
     v.light = -1;
-    v.node = -1;
+    v.node = v.material = v.axis = -1;
     int ok = preflight(&v) && start(&v);
     while (ok) { /* a frame after every poll: an edit and Esc in one poll still show the edit (and its screenshot) */
         glfwPollEvents();
@@ -413,5 +432,6 @@ int lm_cli_view(const lm_cli_args *a)
     free(v.rgb);
     free(v.rgba);
     free(v.error);
+    lm_view_maps_free(&v.maps);
     return ok && !v.failed ? 0 : 1;
 }

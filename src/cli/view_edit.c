@@ -48,6 +48,12 @@ static int replay(lm_view_step *s, int forward, lmgi_scene *sc, char *what, size
         }
         snprintf(what, n, "%s: light %d removed", verb, s->id);
         return lmgi_remove_light(sc, s->id, err) == LMGI_OK;
+    case LM_VIEW_MATERIAL:
+        snprintf(what, n, "%s: material %s edited", verb, lmgi_material_name(sc, s->id));
+        return lmgi_set_material(sc, s->id, forward ? &s->material_after : &s->material_before, err) == LMGI_OK;
+    case LM_VIEW_EFFECTS:
+        snprintf(what, n, "%s: node %s's effects switched", verb, lmgi_node_name(sc, s->id));
+        return lmgi_set_node_effects(sc, s->id, forward ? &s->effects_after : &s->effects_before, err) == LMGI_OK;
     }
     return 0;
 }
@@ -96,6 +102,15 @@ int lm_view_ray_plane(const float org[3], const float dir[3], float y, float out
     for (int k = 0; k < 3; k++)
         out[k] = org[k] + t * dir[k];
     return 1;
+}
+
+float lm_view_ray_axis(const float org[3], const float dir[3], const float p[3], const float a[3])
+{
+    /* the two lines' closest points: w = org - p; s = (w.a - (w.d)(d.a)) / (1 - (d.a)^2) for unit d, a */
+    double w[3] = {org[0] - p[0], org[1] - p[1], org[2] - p[2]};
+    double wa = w[0] * a[0] + w[1] * a[1] + w[2] * a[2], wd = w[0] * dir[0] + w[1] * dir[1] + w[2] * dir[2];
+    double da = (double)dir[0] * a[0] + (double)dir[1] * a[1] + (double)dir[2] * a[2], den = 1.0 - da * da;
+    return den < 1e-6 ? 0.0f : (float)((wa - wd * da) / den);
 }
 
 void lm_view_turn(const float m[16], float angle, float out[16])

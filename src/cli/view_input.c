@@ -35,19 +35,49 @@ void lm_viewer_select_light(lm_viewer *v, int from)
     }
 }
 
-/* The selected light changed by f (intensity times f; f = 0: switched off or on again). */
+/* The window's camera (window pixels, not the framebuffer's: the cursor's) and the ray under the cursor. */
+static void cursor_ray(lm_viewer *v, double x, double y, float org[3], float dir[3])
+{
+    int ww, wh;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    lmgi_camera cam;
+    lm_view_camera_get(&v->cam, ww, wh, &cam);
+    lm_view_ray(&cam, x, y, ww, wh, org, dir);
+}
+
+/* The selected light set to l (before: as it was), as a step undo can take back. */
+static void commit_light(lm_viewer *v, const lmgi_light *before, const lmgi_light *l)
+{
+    lmgi_error err;
+    lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = *before, .light_after = *l};
+    if (lmgi_set_light(v->sc, v->light, l, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "the light edit was refused (the terminal says why)");
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    lm_viewer_edited(v);
+    char what[160];
+    snprintf(what, sizeof what, "light %d %s, intensity %.4g, colour %.2f %.2f %.2f, at %.2f %.2f %.2f", v->light,
+             l->enabled ? "on" : "off", (double)l->intensity, (double)l->color[0], (double)l->color[1],
+             (double)l->color[2], (double)l->position[0], (double)l->position[1], (double)l->position[2]);
+    lm_viewer_say(v, what);
+}
+
+/* The selected light changed by f (intensity times f; f = 0: switched off or on again; f < 0: the next
+ * of a few colours). */
 static void edit_light(lm_viewer *v, float f)
 {
-    lmgi_light l;
+    lmgi_light l, before;
     lmgi_error err;
     if (v->light < 0 || lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK) {
         lm_viewer_say(v, "no light to edit (the scene has none)");
         return;
     }
-    lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = l};
+    before = l;
     if (f == 0.0f)
         l.enabled = !l.enabled;
-    else if (f < 0.0f) { /* the next of a few colours: white, warm, cool */
+    else if (f < 0.0f) { /* white, warm, cool */
         static const float colours[3][3] = {{1.0f, 1.0f, 1.0f}, {1.0f, 0.75f, 0.5f}, {0.6f, 0.75f, 1.0f}};
         int next = 0;
         for (int c = 0; c < 3; c++)
@@ -56,17 +86,179 @@ static void edit_light(lm_viewer *v, float f)
         memcpy(l.color, colours[next], sizeof l.color);
     } else
         l.intensity *= f;
-    step.light_after = l;
-    if (lmgi_set_light(v->sc, v->light, &l, &err) != LMGI_OK) {
+    commit_light(v, &before, &l);
+}
+
+/* Holds the selected light (and its node's matrix, when a node places it) as the start of a move; 0 with a
+ * message when there is no light with a place to move. */
+static int hold_light(lm_viewer *v)
+{
+    lmgi_error err;
+    if (v->light < 0 || lmgi_get_light(v->sc, v->light, &v->light_grab, &err) != LMGI_OK ||
+        v->light_grab.type == LMGI_LIGHT_DIRECTIONAL) {
+        lm_viewer_say(v, "select a point or spot light first (L): a directional light has no place");
+        return 0;
+    }
+    if (v->light_grab.node >= 0)
+        lmgi_get_node_transform(v->sc, v->light_grab.node, v->grab_start);
+    return 1;
+}
+
+/* The held light placed at its start plus d: a light of the file by moving its node (a node without
+ * triangles may move even when static), an added one by its own position. */
+static void place_light(lm_viewer *v, const float d[3])
+{
+    lmgi_error err;
+    lmgi_status st;
+    if (v->light_grab.node >= 0) {
+        float m[16];
+        memcpy(m, v->grab_start, sizeof m);
+        for (int k = 0; k < 3; k++)
+            m[12 + k] += d[k];
+        st = lmgi_set_node_transform(v->sc, v->light_grab.node, m, &err);
+    } else {
+        lmgi_light l = v->light_grab;
+        for (int k = 0; k < 3; k++)
+            l.position[k] += d[k];
+        st = lmgi_set_light(v->sc, v->light, &l, &err);
+    }
+    if (st != LMGI_OK)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
-        lm_viewer_say(v, "the light edit was refused (the terminal says why)");
+    else
+        lm_viewer_edited(v);
+}
+
+/* The held light's move as a step undo can take back (none when it did not move). */
+static void end_light_move(lm_viewer *v)
+{
+    lmgi_light l;
+    lmgi_error err;
+    if (lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK || !memcmp(l.position, v->light_grab.position, sizeof l.position))
+        return;
+    lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = v->light_grab, .light_after = l};
+    if (l.node >= 0) {
+        step.kind = LM_VIEW_NODE, step.id = l.node;
+        memcpy(step.before, v->grab_start, sizeof step.before);
+        lmgi_get_node_transform(v->sc, l.node, step.after);
+    }
+    lm_view_history_push(&v->history, &step);
+    char what[128];
+    snprintf(what, sizeof what, "light %d moved to %.2f %.2f %.2f", v->light, (double)l.position[0],
+             (double)l.position[1], (double)l.position[2]);
+    lm_viewer_say(v, what);
+}
+
+/* Page up / down: the selected light raised or lowered by a twentieth of the scene. */
+static void raise_light(lm_viewer *v, float sign)
+{
+    if (!hold_light(v))
+        return;
+    const float d[3] = {0.0f, sign * 0.05f * v->cam.scene_size, 0.0f};
+    place_light(v, d);
+    end_light_move(v);
+}
+
+/* Alt + press: the selected light follows the cursor on the horizontal plane at its height. */
+static void grab_light(lm_viewer *v, double x, double y)
+{
+    float org[3], dir[3];
+    if (!hold_light(v))
+        return;
+    cursor_ray(v, x, y, org, dir);
+    if (!lm_view_ray_plane(org, dir, v->light_grab.position[1], v->grab)) {
+        lm_viewer_say(v, "look down at the light's height to move it (its plane is behind or level with the eye)");
+        return;
+    }
+    v->drag = 4;
+}
+
+static void move_light(lm_viewer *v, double x, double y)
+{
+    float org[3], dir[3], p[3];
+    cursor_ray(v, x, y, org, dir);
+    if (!lm_view_ray_plane(org, dir, v->grab[1], p))
+        return;
+    const float d[3] = {p[0] - v->grab[0], 0.0f, p[2] - v->grab[2]};
+    place_light(v, d);
+}
+
+/* The material clicked last, changed: B its base colour to the next of a few (its own first), G and
+ * shift+G an emitter's emission brighter or dimmer (x 1.25). */
+static void edit_material(lm_viewer *v, int emission, float f)
+{
+    lmgi_material m, before;
+    lmgi_error err;
+    if (v->material < 0 || lmgi_get_material(v->sc, v->material, &m, &err) != LMGI_OK) {
+        lm_viewer_say(v, "click a surface first: its material is the one edited");
+        return;
+    }
+    before = m;
+    if (emission) {
+        if (m.cls != LMGI_MATERIAL_EMITTER) {
+            lm_viewer_say(v, "that material does not emit (only one emissive in the file can: docs/materials.md)");
+            return;
+        }
+        for (int k = 0; k < 3; k++)
+            m.emissive[k] *= f;
+    } else {
+        static const float colours[5][3] = {
+            {0.8f, 0.8f, 0.8f}, {0.7f, 0.1f, 0.1f}, {0.1f, 0.6f, 0.1f}, {0.1f, 0.2f, 0.7f}, {0.8f, 0.6f, 0.2f}};
+        int next = 0;
+        for (int c = 0; c < 5; c++)
+            if (!memcmp(m.base_color, colours[c], sizeof colours[c]))
+                next = (c + 1) % 5;
+        memcpy(m.base_color, colours[next], sizeof colours[next]);
+    }
+    lm_view_step step = {.kind = LM_VIEW_MATERIAL, .id = v->material, .material_before = before, .material_after = m};
+    if (lmgi_set_material(v->sc, v->material, &m, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "the material edit was refused (the terminal says why)");
         return;
     }
     lm_view_history_push(&v->history, &step);
     lm_viewer_edited(v);
-    char what[128];
-    snprintf(what, sizeof what, "light %d %s, intensity %.4g, colour %.2f %.2f %.2f", v->light, l.enabled ? "on" : "off",
-             (double)l.intensity, (double)l.color[0], (double)l.color[1], (double)l.color[2]);
+    char what[200];
+    snprintf(what, sizeof what, "material %.80s: base colour %.2f %.2f %.2f, emission %.3g %.3g %.3g",
+             lmgi_material_name(v->sc, v->material), (double)m.base_color[0], (double)m.base_color[1],
+             (double)m.base_color[2], (double)m.emissive[0], (double)m.emissive[1], (double)m.emissive[2]);
+    lm_viewer_say(v, what);
+}
+
+/* 1 2 3 4: the selected node's shadows, indirect light, reflections, caustics switched (and its
+ * children's: lmgi_set_node_effects). */
+static void switch_effect(lm_viewer *v, int which)
+{
+    lmgi_node_effects e, before;
+    lmgi_error err;
+    if (v->node < 0 || lmgi_get_node_effects(v->sc, v->node, &e, &err) != LMGI_OK) {
+        lm_viewer_say(v, "click a node first: its effects are the ones switched");
+        return;
+    }
+    before = e;
+    int *sw[4] = {&e.shadows, &e.indirect, &e.reflections, &e.caustics};
+    static const char *const names[4] = {"shadows", "indirect light", "reflections", "caustics"};
+    *sw[which] = !*sw[which];
+    lm_view_step step = {.kind = LM_VIEW_EFFECTS, .id = v->node, .effects_before = before, .effects_after = e};
+    if (lmgi_set_node_effects(v->sc, v->node, &e, &err) != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err.message);
+        lm_viewer_say(v, "the switch was refused (the terminal says why)");
+        return;
+    }
+    lm_view_history_push(&v->history, &step);
+    lm_viewer_edited(v);
+    char what[160];
+    snprintf(what, sizeof what, "node %.80s: %s %s", lmgi_node_name(v->sc, v->node), names[which],
+             *sw[which] ? "on" : "off");
+    lm_viewer_say(v, what);
+}
+
+/* V, shift+V: the next or previous view (view_maps.h); the exposure is metered again for it. */
+static void next_map(lm_viewer *v, int step)
+{
+    v->map = (v->map + step + LM_VIEW_MAP_COUNT) % LM_VIEW_MAP_COUNT;
+    v->exposure = 0.0f;
+    char what[64];
+    snprintf(what, sizeof what, "view: %s", lm_view_map_name(v->map));
     lm_viewer_say(v, what);
 }
 
@@ -239,6 +431,11 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
         v->fly &= ~fly_bit(key);
         return;
     }
+    if (v->drag == 3 && key >= GLFW_KEY_X && key <= GLFW_KEY_Z) { /* moving a node: lock to an axis, or free */
+        int axis = key - GLFW_KEY_X;
+        v->axis = v->axis == axis ? -1 : axis;
+        return;
+    }
     if (mods & GLFW_MOD_CONTROL) {
         if (key == GLFW_KEY_Z)
             undo_redo(v, (mods & GLFW_MOD_SHIFT) != 0);
@@ -281,39 +478,42 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods)
     case GLFW_KEY_C: edit_light(v, -1.0f); break;
     case GLFW_KEY_N: add_light(v); break;
     case GLFW_KEY_DELETE: remove_light(v); break;
+    case GLFW_KEY_PAGE_UP: raise_light(v, 1.0f); break;
+    case GLFW_KEY_PAGE_DOWN: raise_light(v, -1.0f); break;
+    case GLFW_KEY_B: edit_material(v, 0, 1.0f); break;
+    case GLFW_KEY_G: edit_material(v, 1, mods & GLFW_MOD_SHIFT ? 1.0f / LIGHT_STEP : LIGHT_STEP); break;
+    case GLFW_KEY_1:
+    case GLFW_KEY_2:
+    case GLFW_KEY_3:
+    case GLFW_KEY_4: switch_effect(v, key - GLFW_KEY_1); break;
+    case GLFW_KEY_V: next_map(v, mods & GLFW_MOD_SHIFT ? -1 : 1); break;
     default: break;
     }
 }
 
-/* The window's camera (window pixels, not the framebuffer's: the cursor's) and the ray under the cursor. */
-static void cursor_ray(lm_viewer *v, double x, double y, float org[3], float dir[3])
-{
-    int ww, wh;
-    glfwGetWindowSize(v->win, &ww, &wh);
-    lmgi_camera cam;
-    lm_view_camera_get(&v->cam, ww, wh, &cam);
-    lm_view_ray(&cam, x, y, ww, wh, org, dir);
-}
-
-/* The node under the cursor (-1: none), and the point hit. */
-static int pick(lm_viewer *v, double x, double y, float at[3])
+/* What is under the cursor (hit.node -1: nothing), and the point hit. */
+static lmgi_hit pick(lm_viewer *v, double x, double y, float at[3])
 {
     float org[3], dir[3];
     cursor_ray(v, x, y, org, dir);
     lmgi_hit hit;
     lmgi_intersect(v->sc, org, dir, INFINITY, &hit);
-    if (!hit.hit)
-        return -1;
-    for (int k = 0; k < 3; k++)
+    for (int k = 0; hit.hit && k < 3; k++)
         at[k] = org[k] + hit.t * dir[k];
-    return hit.node;
+    return hit;
 }
 
-static void select_node(lm_viewer *v, int node)
+/* The node hit selected, with the material of the triangle clicked. */
+static void select_node(lm_viewer *v, const lmgi_hit *hit)
 {
-    v->node = node;
-    char what[128];
-    snprintf(what, sizeof what, node < 0 ? "nothing selected" : "selected node %.100s", node < 0 ? "" : lmgi_node_name(v->sc, node));
+    v->node = hit->hit ? hit->node : -1;
+    v->material = hit->hit ? hit->material : -1;
+    char what[200];
+    if (v->node < 0)
+        snprintf(what, sizeof what, "nothing selected");
+    else
+        snprintf(what, sizeof what, "selected node %.80s, material %.80s", lmgi_node_name(v->sc, v->node),
+                 v->material >= 0 ? lmgi_material_name(v->sc, v->material) : "-");
     lm_viewer_say(v, what);
 }
 
@@ -322,8 +522,9 @@ static void select_node(lm_viewer *v, int node)
 static void grab_node(lm_viewer *v, double x, double y)
 {
     float at[3];
-    int node = pick(v, x, y, at);
-    select_node(v, node);
+    lmgi_hit hit = pick(v, x, y, at);
+    select_node(v, &hit);
+    int node = v->node;
     if (node < 0)
         return;
     lmgi_error err;
@@ -335,17 +536,26 @@ static void grab_node(lm_viewer *v, double x, double y)
     memcpy(v->grab, at, sizeof v->grab);
     lmgi_get_node_transform(v->sc, node, v->grab_start);
     v->drag = 3;
+    v->axis = -1;
 }
 
+/* The node follows the cursor on the horizontal plane through the point grabbed, or, with an axis
+ * locked (X Y Z during the drag), along that world axis through it. */
 static void move_node(lm_viewer *v, double x, double y)
 {
     float org[3], dir[3], p[3], m[16];
     cursor_ray(v, x, y, org, dir);
-    if (!lm_view_ray_plane(org, dir, v->grab[1], p))
-        return;
     memcpy(m, v->grab_start, sizeof m);
-    m[12] += p[0] - v->grab[0];
-    m[14] += p[2] - v->grab[2];
+    if (v->axis >= 0) {
+        float a[3] = {0.0f, 0.0f, 0.0f};
+        a[v->axis] = 1.0f;
+        m[12 + v->axis] += lm_view_ray_axis(org, dir, v->grab, a);
+    } else {
+        if (!lm_view_ray_plane(org, dir, v->grab[1], p))
+            return;
+        m[12] += p[0] - v->grab[0];
+        m[14] += p[2] - v->grab[2];
+    }
     lmgi_error err;
     if (lmgi_set_node_transform(v->sc, v->node, m, &err) != LMGI_OK)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
@@ -374,9 +584,12 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
     if (action == GLFW_RELEASE) {
         if (v->drag == 3)
             end_move(v);
+        else if (v->drag == 4)
+            end_light_move(v);
         else if (v->drag == 1 && fabs(x - v->press[0]) + fabs(y - v->press[1]) < CLICK_PIXELS) {
             float at[3];
-            select_node(v, pick(v, x, y, at));
+            lmgi_hit hit = pick(v, x, y, at);
+            select_node(v, &hit);
         }
         v->drag = 0;
         return;
@@ -384,6 +597,8 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
     v->mouse[0] = v->press[0] = x, v->mouse[1] = v->press[1] = y;
     if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_CONTROL))
         grab_node(v, x, y);
+    else if (button == GLFW_MOUSE_BUTTON_LEFT && (mods & GLFW_MOD_ALT))
+        grab_light(v, x, y);
     else
         v->drag = button == GLFW_MOUSE_BUTTON_LEFT && !(mods & GLFW_MOD_SHIFT) ? 1 : 2;
 }
@@ -399,6 +614,8 @@ static void on_cursor(GLFWwindow *w, double x, double y)
         lm_view_camera_pan(&v->cam, x - v->mouse[0], y - v->mouse[1], wh);
     else if (v->drag == 3)
         move_node(v, x, y);
+    else if (v->drag == 4)
+        move_light(v, x, y);
     v->mouse[0] = x, v->mouse[1] = y;
 }
 

@@ -5,7 +5,7 @@
 #ifndef LM_CLI_VIEW_PANEL_H
 #define LM_CLI_VIEW_PANEL_H
 
-#define LM_VIEW_PANEL_LINES 14
+#define LM_VIEW_PANEL_LINES 20
 #define LM_VIEW_PANEL_COLUMNS 160
 
 typedef struct {

@@ -12,6 +12,7 @@
 #include "edit_script.h"
 #include "view_camera.h"
 #include "view_edit.h"
+#include "view_maps.h"
 #include "view_watch.h"
 
 typedef struct lm_viewer lm_viewer;
@@ -31,7 +32,10 @@ struct lm_viewer {
     double start, last;
     int light;               /* the selected light, -1: none */
     int node;                /* the selected node, -1: none */
-    int drag;                /* 0, 1 orbit, 2 pan, 3 moving the selected node */
+    int material;            /* the material clicked with it (under the cursor), -1: none */
+    int drag;                /* 0, 1 orbit, 2 pan, 3 moving the selected node, 4 the selected light */
+    int axis;                /* moving a node: -1 on the horizontal plane, 0 1 2 along world x y z (X Y Z held) */
+    lmgi_light light_grab;   /* moving a light: the light then */
     unsigned fly;            /* the fly keys held (W A S D Q E, bits 0-5), pressed without ctrl: from the key
                               * events, so that ctrl+S saves without flying back however its press and
                               * release fall between frames */
@@ -58,6 +62,8 @@ struct lm_viewer {
     int width, height;
     lmgi_update_stats stats;
     double ms_render, fps;
+    int map;                 /* what the window shows (view_maps.h): the picture, or a map of the lighting */
+    lm_view_maps maps;
     int shots, want_shot;    /* want_shot: P was pressed, the window is captured after its next drawing */
     char status[160];
     int failed;
