@@ -186,11 +186,12 @@ LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
  * its next lmgi_update, as it sees an animation's move. */
 LMGI_API int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
 LMGI_API int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
-/* A fingerprint of the scene's geometry: its nodes' names and each node's triangles in the node's own space
- * (vertex positions, corners, which material each has). Two loads of files that differ only in node
- * transforms, material values, lights or the sky give the same; a moved vertex, a triangle more or less, a
- * node more or renamed give another (lmgi view --watch tells edits from a new scene by it). FNV-1a, 64
- * bits: not for what an adversary chooses. 0 for NULL. */
+/* A fingerprint of the scene's geometry: the names of the nodes that hold triangles, in order, and each
+ * node's triangles in the node's own space (vertex positions, corners, which material each has). Two loads
+ * of files that differ only in node transforms, material values, lights, nodes without triangles (a lamp,
+ * a camera, an empty) or the sky give the same; a moved vertex, a triangle more or less, a node with
+ * triangles more or renamed give another (lmgi view --watch tells edits from a new scene by it). FNV-1a,
+ * 64 bits: not for what an adversary chooses. 0 for NULL or no memory. */
 LMGI_API uint64_t lmgi_geometry_hash(const lmgi_scene *scene);
 LMGI_API const char *lmgi_node_name(const lmgi_scene *scene, int node); /* NULL for NULL or an id out of range */
 LMGI_API int lmgi_node_is_dynamic(const lmgi_scene *scene, int node);   /* 0 for NULL or an id out of range */

@@ -451,9 +451,9 @@ static void test_axis_material_effects_light(void **state)
 }
 
 /* A room (an inward cube of side 4), a box on its floor, a lamp and a camera inside: the box at
- * (bx, -1.5, bz); with
- * `second`, a second box (another node: new geometry to the watch). */
-static void write_room(const char *path, float bx, float bz, int second)
+ * (bx, -1.5, bz); with `second`, a second box (another node with triangles: new geometry to the watch);
+ * with `lamp2`, a second lamp (a node without triangles: a light added, to the watch). */
+static void write_room(const char *path, float bx, float bz, int second, int lamp2)
 {
     lmt_mesh m[2];
     memset(m, 0, sizeof m);
@@ -463,19 +463,38 @@ static void write_room(const char *path, float bx, float bz, int second)
     snprintf(nodes, sizeof nodes,
              "[{\"name\": \"room\", \"mesh\": 0}, {\"name\": \"box\", \"mesh\": 1, \"translation\": [%g, -1.5, %g]},"
              " {\"name\": \"lamp\", \"translation\": [0, 1.5, 0], \"extensions\": {\"KHR_lights_punctual\": "
-             "{\"light\": 0}}}, {\"name\": \"eye\", \"camera\": 0, \"translation\": [0, 0, 1.9]}%s]",
-             (double)bx, (double)bz, second ? ", {\"name\": \"box2\", \"mesh\": 1, \"translation\": [1, -1.5, 1]}" : "");
+             "{\"light\": 0}}}, {\"name\": \"eye\", \"camera\": 0, \"translation\": [0, 0, 1.9]}%s%s]",
+             (double)bx, (double)bz, second ? ", {\"name\": \"box2\", \"mesh\": 1, \"translation\": [1, -1.5, 1]}" : "",
+             lamp2 ? ", {\"name\": \"lamp2\", \"translation\": [1, 1.5, -1], \"extensions\": {\"KHR_lights_punctual\": "
+                     "{\"light\": 1}}}" : "");
     snprintf(extra, sizeof extra,
              "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": {\"lights\": "
-             "[{\"type\": \"point\", \"intensity\": 20}]}}, \"cameras\": [{\"type\": \"perspective\", "
-             "\"perspective\": {\"yfov\": 1.2, \"znear\": 0.01}}],");
+             "[{\"type\": \"point\", \"intensity\": 20}, {\"type\": \"point\", \"intensity\": 10, \"color\": [1, 0.5, 0.3]}]}},"
+             " \"cameras\": [{\"type\": \"perspective\", \"perspective\": {\"yfov\": 1.2, \"znear\": 0.01}}],");
     assert_int_equal(lmt_write_gltf(path, m, 2, nodes, NULL, 0, extra), 0);
 }
 
+/* Pixels of a window's lighting (EXR in dir) against a fresh window's, within the test's bounds: the same
+ * mean within 0.5%, under 0.5% of the pixels 25% apart. */
+static void same_as_fresh(const char *dir, const char *shot, const char *fresh, const char *what)
+{
+    char a[512], b[512];
+    snprintf(a, sizeof a, "%s/%s", dir, shot);
+    snprintf(b, sizeof b, "%s/%s", dir, fresh);
+    int lit;
+    double ratio;
+    int off = apart(a, b, 0.25, &lit, &ratio);
+    print_message("the watched window %s against a fresh window on the saved file: mean %.4f, %d of %d pixels 25%% "
+                  "apart\n", what, ratio, off, lit);
+    assert_true(fabs(ratio - 1.0) < 0.005 && off < lit / 200);
+}
+
 /* --watch: the window follows the file as an artist saves it. The box moved in the file becomes one node
- * edit ("1 node moved"), and the window's lighting once caught up (shift+P) is what a fresh window on the
- * saved file shows (the same mean within 0.5%, under 0.5% of the pixels 25% apart; measured: none); a box
- * added to the file is new geometry: the scene is loaded again, and says so. */
+ * edit ("1 node moved"), a lamp added in the file a light added ("1 added") and the lamp taken out again
+ * a light removed ("1 removed"); after the first two the window's lighting once caught up (shift+P) is
+ * what a fresh window on the saved file shows (the same mean within 0.5%, under 0.5% of the pixels 25%
+ * apart; measured: none). A box added to the file is new geometry: the scene is loaded again, and says
+ * so. */
 static void test_watch(void **state)
 {
     (void)state;
@@ -483,21 +502,23 @@ static void test_watch(void **state)
         return;
     char dir[64], path[512], script[3072];
     snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
-    const char *names[3] = {"a.gltf", "b.gltf", "c.gltf"};
-    const float x[3] = {0.8f, -0.9f, -0.9f}, z[3] = {0.3f, -0.4f, -0.4f};
-    for (int k = 0; k < 3; k++) {
+    const char *names[4] = {"a.gltf", "b.gltf", "c.gltf", "d.gltf"};
+    const float x[4] = {0.8f, -0.9f, -0.9f, -0.9f}, z[4] = {0.3f, -0.4f, -0.4f, -0.4f};
+    for (int k = 0; k < 4; k++) {
         snprintf(path, sizeof path, "%s/%s", dir, names[k]);
-        write_room(path, x[k], z[k], k == 2);
+        write_room(path, x[k], z[k], k == 2, k == 3);
     }
     snprintf(script, sizeof script,
              "set -e; B=$(cd %s && pwd)/lmgi; cd %s; F=%d; cp a.gltf watched.gltf\n" IDLE_FN
+             "save() { C=$(caught); cp $1 next.gltf; mv next.gltf watched.gltf; settled $C; }\n"
              "$B view watched.gltf --watch --still --size 160x120 --budget 500 --retrace 16 > log.txt 2>&1 &\n"
              "P=$!; W=$(xdotool search --sync --name 'lmgi view')\n"
-             "sleep $((2 * F)); C=$(caught); cp b.gltf next.gltf; mv next.gltf watched.gltf; settled $C\n"
-             "xdotool key --window $W shift+p; sleep $F\n"
+             "sleep $((2 * F)); save b.gltf; xdotool key --window $W shift+p; sleep $F\n"
+             "save d.gltf; xdotool key --window $W shift+p; sleep $F; save b.gltf\n"
              "cp c.gltf next.gltf; mv next.gltf watched.gltf; sleep $((3 * F))\n"
              "xdotool key --window $W Escape || true; wait $P\n"
-             "$B view b.gltf --still --size 160x120 --budget 500 --frames 3 --screenshot fresh.exr -q",
+             "$B view b.gltf --still --size 160x120 --budget 500 --frames 3 --screenshot fresh_b.exr -q\n"
+             "$B view d.gltf --still --size 160x120 --budget 500 --frames 3 --screenshot fresh_d.exr -q",
              getenv("LMGI_BUILD") ? getenv("LMGI_BUILD") : "build", dir, slow());
     int rc = under_x(script);
     char log[512];
@@ -508,18 +529,13 @@ static void test_watch(void **state)
     print_message("%s", text);
     if (rc != 0)
         fail_msg("exit %d: %s", rc, output);
-    assert_non_null(strstr(text, "file saved: 1 node moved, 0 materials, 0 lights changed"));
+    assert_non_null(strstr(text, "file saved: 1 node moved, 0 materials, 0 lights changed, 0 added, 0 removed"));
+    assert_non_null(strstr(text, "file saved: 0 nodes moved, 0 materials, 0 lights changed, 1 added, 0 removed"));
+    assert_non_null(strstr(text, "file saved: 0 nodes moved, 0 materials, 0 lights changed, 0 added, 1 removed"));
     assert_non_null(strstr(text, "the file's geometry changed: the scene was loaded again"));
     free(text);
-    char moved[512], fresh[512];
-    snprintf(moved, sizeof moved, "%s/lmgi-view-001.exr", dir);
-    snprintf(fresh, sizeof fresh, "%s/fresh.exr", dir);
-    int lit;
-    double ratio;
-    int off = apart(moved, fresh, 0.25, &lit, &ratio);
-    print_message("the watched window after the box moved against a fresh window on the saved file: mean %.4f, %d of "
-                  "%d pixels 25%% apart\n", ratio, off, lit);
-    assert_true(fabs(ratio - 1.0) < 0.005 && off < lit / 200);
+    same_as_fresh(dir, "lmgi-view-001.exr", "fresh_b.exr", "after the box moved");
+    same_as_fresh(dir, "lmgi-view-002.exr", "fresh_d.exr", "after a lamp was added");
 }
 
 int main(void)

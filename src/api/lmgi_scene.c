@@ -317,14 +317,29 @@ uint64_t lmgi_geometry_hash(const lmgi_scene *sc)
     if (!sc)
         return 0;
     const lm_scene *s = sc->scene;
-    uint64_t h = LM_HASH_SEED;
+    /* the nodes that hold triangles, by name, in order; each triangle's node by its rank among them, so a
+     * node without triangles (a lamp, a camera) added or removed anywhere changes nothing */
+    int *rank = malloc(sizeof *rank * (size_t)(s->node_count > 0 ? s->node_count : 1));
+    if (!rank)
+        return 0;
     for (int n = 0; n < s->node_count; n++)
-        h = lm_hash_bytes(h, s->nodes[n].name, strlen(s->nodes[n].name) + 1);
+        rank[n] = -1;
+    for (uint32_t t = 0; t < s->tri_count; t++)
+        rank[s->tri_node[t]] = 0;
+    uint64_t h = LM_HASH_SEED;
+    int held = 0;
+    for (int n = 0; n < s->node_count; n++)
+        if (rank[n] == 0) {
+            rank[n] = held++;
+            h = lm_hash_bytes(h, s->nodes[n].name, strlen(s->nodes[n].name) + 1);
+        }
     h = lm_hash_bytes(h, &s->vertex_count, sizeof s->vertex_count);
     h = lm_hash_bytes(h, s->positions, 3 * sizeof *s->positions * (size_t)s->vertex_count);
     h = lm_hash_bytes(h, &s->tri_count, sizeof s->tri_count);
     h = lm_hash_bytes(h, s->tris, 3 * sizeof *s->tris * (size_t)s->tri_count);
-    h = lm_hash_bytes(h, s->tri_node, sizeof *s->tri_node * (size_t)s->tri_count);
+    for (uint32_t t = 0; t < s->tri_count; t++)
+        h = lm_hash_bytes(h, &rank[s->tri_node[t]], sizeof *rank);
+    free(rank);
     return lm_hash_bytes(h, s->tri_material, sizeof *s->tri_material * (size_t)s->tri_count);
 }
 

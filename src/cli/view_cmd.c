@@ -216,7 +216,7 @@ static int follow_file(lm_viewer *v)
     }
     char what[160];
     lmgi_error err;
-    int r = lm_view_watch_apply(v->sc, next, what, sizeof what, &err);
+    int r = lm_view_watch_apply(&v->watch, v->sc, next, what, sizeof what, &err);
     if (r >= 0 || r == -2) {
         if (r == -2)
             fprintf(stderr, "lmgi: error: %s\n", err.message);
@@ -226,6 +226,8 @@ static int follow_file(lm_viewer *v)
                  what);
         if (r > 0)
             lm_viewer_edited(v);
+        if (v->light < 0 || lmgi_light_is_removed(v->sc, v->light)) /* a lamp removed, or the first added */
+            lm_viewer_select_light(v, v->light < 0 ? 0 : v->light + 1);
         lm_viewer_say(v, line);
         return 1;
     }
@@ -234,6 +236,7 @@ static int follow_file(lm_viewer *v)
     lmgi_free(v->sc);
     v->sc = next;
     lm_view_history_free(&v->history); /* its steps were the old scene's */
+    lm_view_watch_reset(&v->watch);      /* so were the lights it added */
     v->node = v->material = -1;
     if (lmgi_updater_create(v->ctx, v->sc, &v->desc, &v->u, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
@@ -392,7 +395,7 @@ static int start(lm_viewer *v)
     learn_round(v);
     if (a->watch)
         lm_view_watch_init(&v->watch, a->files[0]);
-    v->start = v->last = glfwGetTime();
+    v->start = v->last = v->opened = glfwGetTime();
     return 1;
 }
 
@@ -418,8 +421,11 @@ int lm_cli_view(const lm_cli_args *a)
     }
     if (ok && a->screenshot_path && v.rgb)
         lm_viewer_write_frame(&v, a->screenshot_path);
-    if (ok && !a->quiet)
-        printf("view        %d frames of %s\n", v.frame, v.name);
+    if (ok && !a->quiet) {
+        double took = v.win ? glfwGetTime() - v.opened : 0.0;
+        printf("view        %d frames of %s in %.1f s (%.1f frames a second)\n", v.frame, v.name, took,
+               took > 0.0 ? v.frame / took : 0.0);
+    }
     if (v.win)
         glfwDestroyWindow(v.win);
     glfwTerminate();
@@ -429,6 +435,7 @@ int lm_cli_view(const lm_cli_args *a)
     if (v.have_script)
         lm_edit_script_free(&v.script);
     lm_view_history_free(&v.history);
+    lm_view_watch_free(&v.watch);
     free(v.rgb);
     free(v.rgba);
     free(v.error);

@@ -29,7 +29,7 @@ struct lm_viewer {
     float budget;
     int panel, paused, frame;
     float time, paused_at;
-    double start, last;
+    double start, last, opened; /* start: the animation's clock (pausing moves it); opened: the window's */
     int light;               /* the selected light, -1: none */
     int node;                /* the selected node, -1: none */
     int material;            /* the material clicked with it (under the cursor), -1: none */
