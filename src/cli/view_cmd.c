@@ -22,8 +22,10 @@
 void lm_viewer_say(lm_viewer *v, const char *text)
 {
     snprintf(v->status, sizeof v->status, "%.150s", text);
-    if (!v->a->quiet)
+    if (!v->a->quiet) {
         printf("%s\n", text);
+        fflush(stdout); /* a script or a log reads it now, not when a buffer fills */
+    }
 }
 
 /* ---------- a frame ---------- */
@@ -186,9 +188,12 @@ static void track_work(lm_viewer *v, double now)
     int due = v->idle >= IDLE_UPDATES && v->idle > v->round;
     if (due || now - v->stale_at > 0.25)
         read_staleness(v, now);
+    if (working || v->stale_texels || v->busy == 2) /* the lightmap still moving (or just edited) */
+        v->moved = v->busy - 1, v->moved_at = now;
     if (due && v->stale_texels == 0) {
-        char line[96];
-        snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s)", v->busy - 1, now - v->busy_since);
+        char line[160];
+        snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s); the lightmap was still from update "
+                 "%d (%.2f s) on", v->busy - 1, now - v->busy_since, v->moved, v->moved_at - v->busy_since);
         v->busy = v->idle = 0;
         lm_viewer_say(v, line);
     }

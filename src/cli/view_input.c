@@ -45,18 +45,29 @@ static void cursor_ray(lm_viewer *v, double x, double y, float org[3], float dir
     lm_view_ray(&cam, x, y, ww, wh, org, dir);
 }
 
+/* An edit the scene took (st) kept as a step undo can take back, the lighting told to catch up; a
+ * refusal said instead. 1 when taken. */
+static int keep_step(lm_viewer *v, lmgi_status st, const lm_view_step *step, const lmgi_error *err, const char *what)
+{
+    if (st != LMGI_OK) {
+        fprintf(stderr, "lmgi: error: %s\n", err->message);
+        char line[96];
+        snprintf(line, sizeof line, "the %s was refused (the terminal says why)", what);
+        lm_viewer_say(v, line);
+        return 0;
+    }
+    lm_view_history_push(&v->history, step);
+    lm_viewer_edited(v);
+    return 1;
+}
+
 /* The selected light set to l (before: as it was), as a step undo can take back. */
 static void commit_light(lm_viewer *v, const lmgi_light *before, const lmgi_light *l)
 {
     lmgi_error err;
     lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = *before, .light_after = *l};
-    if (lmgi_set_light(v->sc, v->light, l, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        lm_viewer_say(v, "the light edit was refused (the terminal says why)");
+    if (!keep_step(v, lmgi_set_light(v->sc, v->light, l, &err), &step, &err, "light edit"))
         return;
-    }
-    lm_view_history_push(&v->history, &step);
-    lm_viewer_edited(v);
     char what[160];
     snprintf(what, sizeof what, "light %d %s, intensity %.4g, colour %.2f %.2f %.2f, at %.2f %.2f %.2f", v->light,
              l->enabled ? "on" : "off", (double)l->intensity, (double)l->color[0], (double)l->color[1],
@@ -210,13 +221,8 @@ static void edit_material(lm_viewer *v, int emission, float f)
         memcpy(m.base_color, colours[next], sizeof colours[next]);
     }
     lm_view_step step = {.kind = LM_VIEW_MATERIAL, .id = v->material, .material_before = before, .material_after = m};
-    if (lmgi_set_material(v->sc, v->material, &m, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        lm_viewer_say(v, "the material edit was refused (the terminal says why)");
+    if (!keep_step(v, lmgi_set_material(v->sc, v->material, &m, &err), &step, &err, "material edit"))
         return;
-    }
-    lm_view_history_push(&v->history, &step);
-    lm_viewer_edited(v);
     char what[200];
     snprintf(what, sizeof what, "material %.80s: base colour %.2f %.2f %.2f, emission %.3g %.3g %.3g",
              lmgi_material_name(v->sc, v->material), (double)m.base_color[0], (double)m.base_color[1],
@@ -239,13 +245,8 @@ static void switch_effect(lm_viewer *v, int which)
     static const char *const names[4] = {"shadows", "indirect light", "reflections", "caustics"};
     *sw[which] = !*sw[which];
     lm_view_step step = {.kind = LM_VIEW_EFFECTS, .id = v->node, .effects_before = before, .effects_after = e};
-    if (lmgi_set_node_effects(v->sc, v->node, &e, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        lm_viewer_say(v, "the switch was refused (the terminal says why)");
+    if (!keep_step(v, lmgi_set_node_effects(v->sc, v->node, &e, &err), &step, &err, "switch"))
         return;
-    }
-    lm_view_history_push(&v->history, &step);
-    lm_viewer_edited(v);
     char what[160];
     snprintf(what, sizeof what, "node %.80s: %s %s", lmgi_node_name(v->sc, v->node), names[which],
              *sw[which] ? "on" : "off");
@@ -275,13 +276,8 @@ static void add_light(lm_viewer *v)
     memcpy(l.position, v->cam.target, sizeof l.position);
     l.position[1] += 0.1f * v->cam.scene_size;
     lm_view_step step = {.kind = LM_VIEW_LIGHT_ADDED, .light_after = l};
-    if (lmgi_add_light(v->sc, &l, &step.id, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        lm_viewer_say(v, "the light was refused (the terminal says why)");
+    if (!keep_step(v, lmgi_add_light(v->sc, &l, &step.id, &err), &step, &err, "new light"))
         return;
-    }
-    lm_view_history_push(&v->history, &step);
-    lm_viewer_edited(v);
     v->light = step.id;
     char what[96];
     snprintf(what, sizeof what, "light %d added at the target", step.id);
@@ -297,13 +293,8 @@ static void remove_light(lm_viewer *v)
         return;
     }
     lm_view_step step = {.kind = LM_VIEW_LIGHT_REMOVED, .id = v->light, .light_before = l};
-    if (lmgi_remove_light(v->sc, v->light, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        lm_viewer_say(v, "the light could not be removed (the terminal says why)");
+    if (!keep_step(v, lmgi_remove_light(v->sc, v->light, &err), &step, &err, "removal"))
         return;
-    }
-    lm_view_history_push(&v->history, &step);
-    lm_viewer_edited(v);
     char what[96];
     snprintf(what, sizeof what, "light %d removed", v->light);
     lm_viewer_say(v, what);
@@ -637,13 +628,8 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
     lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
     lmgi_get_node_transform(v->sc, v->node, step.before);
     lm_view_turn(step.before, (float)dy * TURN_STEP, step.after);
-    if (lmgi_set_node_transform(v->sc, v->node, step.after, &err) != LMGI_OK) {
-        fprintf(stderr, "lmgi: error: %s\n", err.message);
-        return;
-    }
-    lm_view_history_push(&v->history, &step);
-    lm_viewer_edited(v);
-    lm_viewer_say(v, "turned the selected node");
+    if (keep_step(v, lmgi_set_node_transform(v->sc, v->node, step.after, &err), &step, &err, "turn"))
+        lm_viewer_say(v, "turned the selected node");
 }
 
 void lm_viewer_input(lm_viewer *v)

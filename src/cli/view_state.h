@@ -47,6 +47,10 @@ struct lm_viewer {
     int busy;                /* updates since work began (an edit, photons, AIMs, texels, caustics, faces, shadows) */
     int idle;                /* of them, the last ones in a row that did none and followed no edit */
     double busy_since;
+    int moved;               /* of the updates since work began, the last that did work or left texels to
+                              * move: the lightmap is still from the next on (the rest of the wait is the
+                              * round's photon checks) */
+    double moved_at;
     int round;               /* updates in which the round robin re-traces every stored photon once
                               * (photons per group / re-traced per group a frame): a change an edit made is
                               * found within a round, not before */
