@@ -192,8 +192,8 @@ static void track_work(lm_viewer *v, double now)
         v->moved = v->busy - 1, v->moved_at = now;
     if (due && v->stale_texels == 0) {
         char line[160];
-        snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s); the lightmap was still from update "
-                 "%d (%.2f s) on", v->busy - 1, now - v->busy_since, v->moved, v->moved_at - v->busy_since);
+        snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s); the lightmap last moved at update %d "
+                 "(%.2f s)", v->busy - 1, now - v->busy_since, v->moved, v->moved_at - v->busy_since);
         v->busy = v->idle = 0;
         lm_viewer_say(v, line);
     }

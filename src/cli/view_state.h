@@ -48,8 +48,8 @@ struct lm_viewer {
     int idle;                /* of them, the last ones in a row that did none and followed no edit */
     double busy_since;
     int moved;               /* of the updates since work began, the last that did work or left texels to
-                              * move: the lightmap is still from the next on (the rest of the wait is the
-                              * round's photon checks) */
+                              * move: the lightmap is still after it (the rest of the wait is the round's
+                              * photon checks) */
     double moved_at;
     int round;               /* updates in which the round robin re-traces every stored photon once
                               * (photons per group / re-traced per group a frame): a change an edit made is
