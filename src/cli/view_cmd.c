@@ -70,11 +70,14 @@ static void draw_panel(lm_viewer *v, int fw, int fh)
     lm_view_panel_add(&p, "busiest: %s: %s", s->busiest_stage ? s->busiest_stage : "-", s->why);
     if (v->busy) {
         lm_view_panel_add(&p, "lighting: catching up for %d updates (%.1f s)", v->busy - 1, glfwGetTime() - v->busy_since);
-        lm_view_panel_add(&p, "  photons checked since the last change: %d%% of a round of %d updates",
-                          v->round > 0 ? (int)fminf(100.0f, 100.0f * (float)v->idle / (float)v->round) : 100, v->round);
+        if (v->need_round)
+            lm_view_panel_add(&p, "  photons checked since the last move: %d%% of a round of %d updates",
+                              v->round > 0 ? (int)fminf(100.0f, 100.0f * (float)v->idle / (float)v->round) : 100,
+                              v->round);
         lm_view_panel_add(&p, "  texels still to move: %u, the largest by %.1f%%", v->stale_texels, 100.0 * v->stale_max);
     } else {
-        lm_view_panel_add(&p, "lighting: caught up (every photon checked since the last change, no texel to move)");
+        lm_view_panel_add(&p, "lighting: caught up (no work waiting, no texel to move, every photon checked since "
+                              "the last move)");
     }
     lm_view_panel_add(&p, "texels %u (allowed %d)  photons %u  AIM surfaces %d  surfaces changed %d",
                       s->texels_gathered, s->texels_budget, s->photons_retraced, s->aim_surfaces_refreshed,
@@ -159,25 +162,28 @@ static void begin_catching_up(lm_viewer *v, double now)
         printf("lighting: catching up\n");
 }
 
-void lm_viewer_edited(lm_viewer *v)
+void lm_viewer_edited(lm_viewer *v, int moved)
 {
+    v->need_round |= moved;
     begin_catching_up(v, glfwGetTime());
     lm_view_maps_edited(&v->maps);
 }
 
-/* Whether the lighting still has work waiting. An update that found photon paths changed, refreshed AIMs,
+/* Whether the lighting still has work waiting. An update that re-traced photon groups, refreshed AIMs,
  * regathered texels, traced caustic photons or redrew reflection faces or shadow maps did work; so did an
- * edit. The round robin finds the paths an edit changed only as it re-traces them, one photon a group an
- * update (the paper's selective re-emission), so updates without work prove nothing until a whole round
- * has passed since the last change found. The lighting has caught up when it has (and at least
- * IDLE_UPDATES), and the error atlas has no texel left to move: then the panel says so and the terminal
- * prints "caught up", with how long it took, a line scripts wait for. */
+ * edit. A light, material or effect edit names the photons it changes (their groups are queued: explicit
+ * invalidation), so once no update does work and the error atlas has no texel left to move, the lighting
+ * has caught up. A moved node does not: the round robin finds the paths it changed only as it re-traces
+ * them, one photon a group an update (the paper's selective re-emission), so after a move, or a change the
+ * round robin found, updates without work prove nothing until a whole round has passed. Then the panel
+ * says so and the terminal prints "caught up", with how long it took, a line scripts wait for. */
 static void track_work(lm_viewer *v, double now)
 {
     const lmgi_update_stats *s = &v->stats;
-    int working = s->groups_invalidated || s->aim_surfaces_refreshed || s->texels_gathered ||
+    int working = s->groups_invalidated || s->groups_retraced || s->aim_surfaces_refreshed || s->texels_gathered ||
                   s->caustic_photons_retraced || s->cube_faces_rendered || s->shadow_maps_rendered ||
                   s->shadow_maps_stale;
+    v->need_round |= s->groups_invalidated > 0;
     if (working)
         begin_catching_up(v, now);
     else if (v->busy)
@@ -185,7 +191,7 @@ static void track_work(lm_viewer *v, double now)
     if (!v->busy)
         return;
     v->busy++;
-    int due = v->idle >= IDLE_UPDATES && v->idle > v->round;
+    int due = v->idle >= IDLE_UPDATES && (!v->need_round || v->idle > v->round);
     if (due || now - v->stale_at > 0.25)
         read_staleness(v, now);
     if (working || v->stale_texels || v->busy == 2) /* the lightmap still moving (or just edited) */
@@ -194,7 +200,7 @@ static void track_work(lm_viewer *v, double now)
         char line[160];
         snprintf(line, sizeof line, "lighting: caught up after %d updates (%.2f s); the lightmap last moved at update %d "
                  "(%.2f s)", v->busy - 1, now - v->busy_since, v->moved, v->moved_at - v->busy_since);
-        v->busy = v->idle = 0;
+        v->busy = v->idle = v->need_round = 0;
         lm_viewer_say(v, line);
     }
     fflush(stdout);
@@ -230,7 +236,7 @@ static int follow_file(lm_viewer *v)
         snprintf(line, sizeof line, r == -2 ? "the file's edit was refused (the terminal says why)" : "file saved: %s",
                  what);
         if (r > 0)
-            lm_viewer_edited(v);
+            lm_viewer_edited(v, 1);
         if (v->light < 0 || lmgi_light_is_removed(v->sc, v->light)) /* a lamp removed, or the first added */
             lm_viewer_select_light(v, v->light < 0 ? 0 : v->light + 1);
         lm_viewer_say(v, line);
@@ -249,7 +255,7 @@ static int follow_file(lm_viewer *v)
     }
     lm_viewer_select_light(v, 0);
     learn_round(v);
-    lm_viewer_edited(v);
+    lm_viewer_edited(v, 0); /* a new updater: its first solution is whole */
     lm_viewer_say(v, "the file's geometry changed: the scene was loaded again");
     return 1;
 }
@@ -270,15 +276,16 @@ static int frame(lm_viewer *v)
     if (v->a->watch && lm_view_watch_due(&v->watch, now) && !follow_file(v))
         return 0;
     while (v->have_script && v->next_edit < v->script.edit_count && v->script.edits[v->next_edit].frame <= v->frame) {
+        const lm_edit *e = &v->script.edits[v->next_edit];
         if (!lm_edit_script_apply(&v->script, v->next_edit++, v->sc))
             return 0;
-        lm_viewer_edited(v);
+        lm_viewer_edited(v, cJSON_GetObjectItemCaseSensitive(e->v, "node") != NULL); /* a node edit moves it */
     }
     if (lmgi_update(v->u, v->time, v->budget, &v->stats, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
-    track_work(v, now);
+    track_work(v, glfwGetTime()); /* after the update (and a reload's first solution), not the frame's start */
     int fw, fh;
     glfwGetFramebufferSize(v->win, &fw, &fh);
     if (fw <= 0 || fh <= 0) /* minimised */

@@ -57,7 +57,7 @@ static int keep_step(lm_viewer *v, lmgi_status st, const lm_view_step *step, con
         return 0;
     }
     lm_view_history_push(&v->history, step);
-    lm_viewer_edited(v);
+    lm_viewer_edited(v, step->kind == LM_VIEW_NODE);
     return 1;
 }
 
@@ -136,7 +136,7 @@ static void place_light(lm_viewer *v, const float d[3])
     if (st != LMGI_OK)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
     else
-        lm_viewer_edited(v);
+        lm_viewer_edited(v, v->light_grab.node >= 0); /* its node moved: anything under it too */
 }
 
 /* The held light's move as a step undo can take back (none when it did not move). */
@@ -311,7 +311,7 @@ static void undo_redo(lm_viewer *v, int redo)
     if (!ok && err.message[0])
         fprintf(stderr, "lmgi: error: %s\n", err.message);
     if (ok)
-        lm_viewer_edited(v);
+        lm_viewer_edited(v, 1); /* a step of any kind, a move among them */
     lm_viewer_say(v, what);
     if (v->light >= 0 && lmgi_light_is_removed(v->sc, v->light))
         lm_viewer_select_light(v, v->light + 1);
@@ -551,7 +551,7 @@ static void move_node(lm_viewer *v, double x, double y)
     if (lmgi_set_node_transform(v->sc, v->node, m, &err) != LMGI_OK)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
     else
-        lm_viewer_edited(v);
+        lm_viewer_edited(v, 1);
 }
 
 static void end_move(lm_viewer *v)

@@ -52,8 +52,10 @@ struct lm_viewer {
                               * photon checks) */
     double moved_at;
     int round;               /* updates in which the round robin re-traces every stored photon once
-                              * (photons per group / re-traced per group a frame): a change an edit made is
+                              * (photons per group / re-traced per group a frame): a change a move made is
                               * found within a round, not before */
+    int need_round;          /* a node moved (or the round robin found a change) since the lighting last
+                              * caught up: a whole round must pass before it can have */
     uint32_t stale_texels;   /* the error atlas (LMGI_LIGHTMAP_ERROR): valid texels still to move, */
     float stale_max;         /* and the largest relative change still to come */
     double stale_at;         /* when it was read */
@@ -75,8 +77,9 @@ struct lm_viewer {
 
 /* What the last action did, on the panel and the terminal (unless -q). */
 void lm_viewer_say(lm_viewer *v, const char *text);
-/* An edit was made: the lighting is catching up from now on, for a round of the round robin at least. */
-void lm_viewer_edited(lm_viewer *v);
+/* An edit was made: the lighting is catching up from now on; `moved` (a node moved): for a round of the
+ * round robin at least. */
+void lm_viewer_edited(lm_viewer *v, int moved);
 /* The first light from id `from` on (wrapping) that is not removed; -1 when there is none. */
 void lm_viewer_select_light(lm_viewer *v, int from);
 /* Installs the window's mouse and key callbacks (the window's user pointer is v). */
