@@ -164,7 +164,7 @@ $(BUILD)/tests/test_surface_error: $(BUILD)/obj/src/cli/surface_error.o
 
 # The viewer's camera and views (src/cli/view_camera.c, view_maps.c)
 $(BUILD)/tests/test_view_camera: $(BUILD)/obj/src/cli/view_camera.o
-$(BUILD)/tests/test_view_maps: $(BUILD)/obj/src/cli/view_maps.o
+$(BUILD)/tests/test_view_maps: $(BUILD)/obj/src/cli/view_maps.o $(BUILD)/obj/src/cli/view_edit.o
 
 # The GL guest test plays a GLX host on an X server: it alone links X and GLX (lmgi links neither).
 $(BUILD)/tests/test_gl_guest: LIBS += -lGL -lX11 -ldl

@@ -126,29 +126,12 @@ static void tone_map(lm_viewer *v)
 }
 
 /* The error atlas (LMGI_LIGHTMAP_ERROR: the updater's own estimate of how far the displayed lightmap
- * still is from the lighting as it is now) summed up: the valid texels still to move by more than
- * LM_VIEW_STALE, and the largest relative change still to come. */
+ * still is from the lighting as it is now) summed up: the texels still to move and by how much at most. */
 static void read_staleness(lm_viewer *v, double now)
 {
-    lmgi_info in;
-    lmgi_get_info(v->sc, &in);
-    size_t n = (size_t)in.atlas_width * (size_t)in.atlas_height;
-    if (n != v->error_n) {
-        free(v->error);
-        v->error = malloc(4 * n * sizeof *v->error);
-        v->error_n = v->error ? n : 0;
-    }
     lmgi_error err;
-    v->stale_texels = 0;
-    v->stale_max = 0.0f;
     v->stale_at = now;
-    if (!v->error || lmgi_get_lightmap(v->u, LMGI_LIGHTMAP_ERROR, v->error, 4 * n, &err) != LMGI_OK)
-        return;
-    for (size_t i = 0; i < n; i++)
-        if (v->error[4 * i + 3] > 0.0f && v->error[4 * i] > LM_VIEW_STALE) {
-            v->stale_texels++;
-            v->stale_max = fmaxf(v->stale_max, v->error[4 * i]);
-        }
+    lm_view_maps_staleness(&v->maps, v->u, v->sc, &v->stale_texels, &v->stale_max, &err); /* failed: none */
 }
 
 static void begin_catching_up(lm_viewer *v, double now)
@@ -450,7 +433,6 @@ int lm_cli_view(const lm_cli_args *a)
     lm_view_watch_free(&v.watch);
     free(v.rgb);
     free(v.rgba);
-    free(v.error);
     lm_view_maps_free(&v.maps);
     return ok && !v.failed ? 0 : 1;
 }

@@ -1,6 +1,8 @@
 /* The viewer's views of the lighting (view_maps.h). */
 #include "view_maps.h"
 
+#include "view_edit.h"
+
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,21 +18,12 @@ void lm_view_map_texels(const lmgi_scene *sc, const lmgi_camera *cam, int w, int
 {
     lmgi_info in;
     lmgi_get_info(sc, &in);
-    const float *v = cam->view, *p = cam->proj;
-    float org[3];
-    for (int k = 0; k < 3; k++) /* the eye: -R^T t */
-        org[k] = -(v[4 * k] * v[12] + v[4 * k + 1] * v[13] + v[4 * k + 2] * v[14]);
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {
-            /* the pixel centre's direction in view space (down -z), then by R^T to the world */
-            double ndc[2] = {2.0 * (x + 0.5) / w - 1.0, 1.0 - 2.0 * (y + 0.5) / h};
-            double d[3] = {ndc[0] / p[0], ndc[1] / p[5], -1.0};
-            float dir[3];
-            for (int k = 0; k < 3; k++)
-                dir[k] = (float)(v[4 * k] * d[0] + v[4 * k + 1] * d[1] + v[4 * k + 2] * d[2]);
+            float org[3], dir[3], uv[6];
+            lm_view_ray(cam, x + 0.5, y + 0.5, w, h, org, dir); /* through the pixel's centre */
             lmgi_hit hit;
             lmgi_intersect(sc, org, dir, INFINITY, &hit);
-            float uv[6];
             int *out = &texel[(size_t)y * (size_t)w + (size_t)x];
             *out = -1;
             if (!hit.hit || hit.surface < 0 || !lmgi_triangle_lightmap_uv(sc, hit.triangle, uv))
@@ -45,23 +38,20 @@ void lm_view_map_texels(const lmgi_scene *sc, const lmgi_camera *cam, int w, int
 
 void lm_view_maps_edited(lm_view_maps *m) { m->cast = 0; }
 
-/* The buffers for a w x h picture and the scene's atlas; 0: no memory. */
-static int ensure(lm_view_maps *m, const lmgi_scene *sc, int w, int h)
+/* The buffers for the scene's atlas (made again for a scene loaded again); 0: no memory. */
+static int ensure_atlas(lm_view_maps *m, const lmgi_scene *sc)
 {
-    if (m->w != w || m->h != h || !m->texel) {
-        free(m->texel);
-        m->texel = malloc((size_t)w * (size_t)h * sizeof *m->texel);
-        m->w = w, m->h = h, m->cast = 0;
-    }
     lmgi_info in;
     lmgi_get_info(sc, &in);
     size_t n = (size_t)in.atlas_width * (size_t)in.atlas_height;
     int surfaces = lmgi_surface_count(sc);
-    if (n != m->n || surfaces != m->surfaces || !m->atlas) { /* a scene loaded again */
+    if (n != m->n || surfaces != m->surfaces || !m->atlas) {
         free(m->atlas);
+        free(m->error);
         free(m->surface);
         free(m->version);
         m->atlas = malloc(4 * n * sizeof *m->atlas);
+        m->error = malloc(4 * n * sizeof *m->error);
         m->surface = malloc(n * sizeof *m->surface);
         m->version = calloc((size_t)(surfaces > 0 ? surfaces : 1), sizeof *m->version);
         m->n = n, m->surfaces = surfaces, m->cast = 0;
@@ -75,7 +65,43 @@ static int ensure(lm_view_maps *m, const lmgi_scene *sc, int w, int h)
             }
         }
     }
-    return m->texel && m->atlas && m->surface && m->version;
+    return m->atlas && m->error && m->surface && m->version;
+}
+
+/* The buffers for a w x h picture and the scene's atlas; 0: no memory. */
+static int ensure(lm_view_maps *m, const lmgi_scene *sc, int w, int h)
+{
+    if (m->w != w || m->h != h || !m->texel) {
+        free(m->texel);
+        m->texel = malloc((size_t)w * (size_t)h * sizeof *m->texel);
+        m->w = w, m->h = h, m->cast = 0;
+    }
+    return ensure_atlas(m, sc) && m->texel;
+}
+
+/* Whether error texel i (m->error, read back) is a valid texel still to move. */
+static int still_to_move(const lm_view_maps *m, size_t i)
+{
+    return m->error[4 * i + 3] > 0.0f && m->error[4 * i] > LM_VIEW_STALE;
+}
+
+int lm_view_maps_staleness(lm_view_maps *m, lmgi_updater *u, const lmgi_scene *sc, uint32_t *texels, float *largest,
+                           lmgi_error *err)
+{
+    *texels = 0;
+    *largest = 0.0f;
+    if (!ensure_atlas(m, sc)) {
+        snprintf(err->message, sizeof err->message, "view: no memory for the error atlas");
+        return 0;
+    }
+    if (lmgi_get_lightmap(u, LMGI_LIGHTMAP_ERROR, m->error, 4 * m->n, err) != LMGI_OK)
+        return 0;
+    for (size_t i = 0; i < m->n; i++)
+        if (still_to_move(m, i)) {
+            ++*texels;
+            *largest = fmaxf(*largest, m->error[4 * i]);
+        }
+    return 1;
 }
 
 /* The error view's ramp: dark blue at 0 (and up to LM_VIEW_STALE), through green and yellow, red at
@@ -94,8 +120,7 @@ static void ramp(float e, float *rgb)
 
 /* The atlas fitted into the picture (nearest texel), the IIM's irradiance made grey and scaled so its
  * mean sits at a quarter, texels still to move red, those of surfaces the last update changed yellow. */
-static void draw_atlas(lm_view_maps *m, lmgi_updater *u, const lmgi_scene *sc, int w, int h, float *rgb,
-                       const float *error)
+static void draw_atlas(lm_view_maps *m, lmgi_updater *u, const lmgi_scene *sc, int w, int h, float *rgb)
 {
     lmgi_info in;
     lmgi_get_info(sc, &in);
@@ -124,7 +149,7 @@ static void draw_atlas(lm_view_maps *m, lmgi_updater *u, const lmgi_scene *sc, i
             float grey = fminf(1.0f, scale * (t[0] + t[1] + t[2]) / 3.0f);
             px[0] = px[1] = px[2] = t[3] > 0.0f ? grey : 0.03f;
             int s = m->surface[i];
-            if (error && t[3] > 0.0f && error[4 * i] > LM_VIEW_STALE)
+            if (still_to_move(m, i))
                 px[0] = fmaxf(px[0], 0.9f), px[1] *= 0.3f, px[2] *= 0.3f;
             else if (changed && s >= 0 && changed[s])
                 px[0] = fmaxf(px[0], 0.9f), px[1] = fmaxf(px[1], 0.8f), px[2] *= 0.3f;
@@ -143,13 +168,13 @@ int lm_view_maps_draw(lm_view_maps *m, lmgi_updater *u, const lmgi_scene *sc, in
     if (map == LM_VIEW_CAUSTICS)
         return lmgi_get_caustics(u, rgb, 3 * pixels, NULL, NULL, err) == LMGI_OK;
     if (map == LM_VIEW_ATLAS) {
-        float *error = malloc(4 * m->n * sizeof *error);
-        int ok = lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, m->atlas, 4 * m->n, err) == LMGI_OK &&
-                 (!error || lmgi_get_lightmap(u, LMGI_LIGHTMAP_ERROR, error, 4 * m->n, err) == LMGI_OK);
-        if (ok)
-            draw_atlas(m, u, sc, w, h, rgb, error);
-        free(error);
-        return ok;
+        uint32_t texels;
+        float largest;
+        if (lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, m->atlas, 4 * m->n, err) != LMGI_OK ||
+            !lm_view_maps_staleness(m, u, sc, &texels, &largest, err))
+            return 0;
+        draw_atlas(m, u, sc, w, h, rgb);
+        return 1;
     }
     lmgi_lightmap kind = map == LM_VIEW_AIM ? LMGI_LIGHTMAP_AIM : map == LM_VIEW_ERROR ? LMGI_LIGHTMAP_ERROR : LMGI_LIGHTMAP_IIM;
     if (lmgi_get_lightmap(u, kind, m->atlas, 4 * m->n, err) != LMGI_OK)
@@ -177,6 +202,7 @@ void lm_view_maps_free(lm_view_maps *m)
 {
     free(m->texel);
     free(m->atlas);
+    free(m->error);
     free(m->surface);
     free(m->version);
     memset(m, 0, sizeof *m);

@@ -8,7 +8,8 @@
  * lmgi_triangle_lightmap_uv the atlas texel under them, lmgi_get_lightmap the values. The rays are cast
  * again only when the camera, the picture's size or the scene (an edit: lm_view_maps_edited) changed:
  * about 0.1 s for 640 x 480 on one core of this project's machine; the map is read back every frame.
- * Memory: an int a pixel, 16 bytes and an int an atlas texel, 4 bytes a surface. Not thread-safe. */
+ * The error atlas read here also tells the panel how stale the lighting is (lm_view_maps_staleness).
+ * Memory: an int a pixel, 32 bytes and an int an atlas texel, 4 bytes a surface. Not thread-safe. */
 #ifndef LM_CLI_VIEW_MAPS_H
 #define LM_CLI_VIEW_MAPS_H
 
@@ -36,6 +37,7 @@ typedef struct {
     lmgi_camera cam;     /* and their camera */
     int cast;            /* 1: texel is current for (w, h, cam) and the scene as it is */
     float *atlas;        /* the map read back, 4 floats a texel */
+    float *error;        /* the error atlas read back (lm_view_maps_staleness), 4 floats a texel */
     int *surface;        /* per atlas texel: its surface, -1 where none */
     size_t n;            /* atlas texels */
     uint32_t *version;   /* per surface: lmgi_surface_version at the last frame */
@@ -47,6 +49,11 @@ const char *lm_view_map_name(int map);
 /* The atlas index of the texel each pixel of a w x h picture from cam sees (-1: nothing hit, a mirror or
  * glass, a triangle without texels), top row first; texel holds w * h ints. */
 void lm_view_map_texels(const lmgi_scene *sc, const lmgi_camera *cam, int w, int h, int *texel);
+/* Reads the error atlas (LMGI_LIGHTMAP_ERROR) into m->error: *texels gets the valid texels still to move
+ * (above LM_VIEW_STALE), *largest the largest change still to come. 0 (both 0) with err set when the
+ * read failed or memory ran out. */
+int lm_view_maps_staleness(lm_view_maps *m, lmgi_updater *u, const lmgi_scene *sc, uint32_t *texels, float *largest,
+                           lmgi_error *err);
 /* The scene changed (a node moved): the rays are cast again at the next draw. */
 void lm_view_maps_edited(lm_view_maps *m);
 /* rgb (w x h x 3 linear floats, top row first) made map `map` (not LM_VIEW_PICTURE) as seen from cam; for

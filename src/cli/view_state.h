@@ -56,11 +56,9 @@ struct lm_viewer {
                               * found within a round, not before */
     int need_round;          /* a node moved (or the round robin found a change) since the lighting last
                               * caught up: a whole round must pass before it can have */
-    uint32_t stale_texels;   /* the error atlas (LMGI_LIGHTMAP_ERROR): valid texels still to move, */
+    uint32_t stale_texels;   /* the error atlas (lm_view_maps_staleness): valid texels still to move, */
     float stale_max;         /* and the largest relative change still to come */
     double stale_at;         /* when it was read */
-    float *error;            /* its buffer, of error_n texels */
-    size_t error_n;
     lmgi_updater_desc desc;  /* the updater's, for a reload */
     float exposure;          /* fixed from the first picture (X meters again) */
     float *rgb;              /* the picture, linear, top row first */
