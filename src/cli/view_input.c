@@ -75,6 +75,16 @@ static void commit_light(lm_viewer *v, const lmgi_light *before, const lmgi_ligh
     lm_viewer_say(v, what);
 }
 
+/* rgb made the colour after it in palette (of n), or the first when it is none of them. */
+static void next_colour(float rgb[3], const float palette[][3], int n)
+{
+    int next = 0;
+    for (int c = 0; c < n; c++)
+        if (!memcmp(rgb, palette[c], sizeof palette[c]))
+            next = (c + 1) % n;
+    memcpy(rgb, palette[next], sizeof palette[next]);
+}
+
 /* The selected light changed by f (intensity times f; f = 0: switched off or on again; f < 0: the next
  * of a few colours). */
 static void edit_light(lm_viewer *v, float f)
@@ -90,11 +100,7 @@ static void edit_light(lm_viewer *v, float f)
         l.enabled = !l.enabled;
     else if (f < 0.0f) { /* white, warm, cool */
         static const float colours[3][3] = {{1.0f, 1.0f, 1.0f}, {1.0f, 0.75f, 0.5f}, {0.6f, 0.75f, 1.0f}};
-        int next = 0;
-        for (int c = 0; c < 3; c++)
-            if (!memcmp(l.color, colours[c], sizeof l.color))
-                next = (c + 1) % 3;
-        memcpy(l.color, colours[next], sizeof l.color);
+        next_colour(l.color, colours, 3);
     } else
         l.intensity *= f;
     commit_light(v, &before, &l);
@@ -214,11 +220,7 @@ static void edit_material(lm_viewer *v, int emission, float f)
     } else {
         static const float colours[5][3] = {
             {0.8f, 0.8f, 0.8f}, {0.7f, 0.1f, 0.1f}, {0.1f, 0.6f, 0.1f}, {0.1f, 0.2f, 0.7f}, {0.8f, 0.6f, 0.2f}};
-        int next = 0;
-        for (int c = 0; c < 5; c++)
-            if (!memcmp(m.base_color, colours[c], sizeof colours[c]))
-                next = (c + 1) % 5;
-        memcpy(m.base_color, colours[next], sizeof colours[next]);
+        next_colour(m.base_color, colours, 5);
     }
     lm_view_step step = {.kind = LM_VIEW_MATERIAL, .id = v->material, .material_before = before, .material_after = m};
     if (!keep_step(v, lmgi_set_material(v->sc, v->material, &m, &err), &step, &err, "material edit"))
