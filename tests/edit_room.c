@@ -90,6 +90,23 @@ lmgi_scene *lmt_load_desc(const lmgi_scene_desc *d, int target_texels, float tex
 
 lmgi_scene *lmt_load(const char *path, int target_texels) { return lmt_load_paged(path, target_texels, 0); }
 
+int *lmt_texel_ids(const lmgi_scene *sc)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = (size_t)in.atlas_width * (size_t)in.atlas_height;
+    int *ids = malloc(sizeof *ids * (n ? n : 1));
+    assert_non_null(ids);
+    for (size_t i = 0; i < n; i++)
+        ids[i] = -1;
+    for (uint32_t i = 0; i < lmgi_texel_count(sc); i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        ids[(size_t)t.y * (size_t)in.atlas_width + (size_t)t.x] = (int)i;
+    }
+    return ids;
+}
+
 lmgi_scene *lmt_paged_cornell(void)
 {
     lmgi_scene *sc = lmt_load_paged(lmt_project_scene("cornell.glb"), 6000, 64);

@@ -26,6 +26,9 @@ lmgi_scene *lmt_load(const char *path, int target_texels);
 /* lmgi_load at about target_texels texels on lightmap pages of at most `side` texels a side
  * (lmgi_options.max_atlas_size; 0: the default); fails the test on an error. */
 lmgi_scene *lmt_load_paged(const char *path, int target_texels, int side);
+/* Where each texel lies in the atlas: atlas_width x atlas_height ints (malloc'd), the lmgi_get_texel index of
+ * the texel at each position, -1 where there is none (gutters, empty space). */
+int *lmt_texel_ids(const lmgi_scene *sc);
 /* The project's Cornell box at 6,000 texels on pages of 64 texels: several pages (else the test fails). */
 lmgi_scene *lmt_paged_cornell(void);
 /* A perspective camera at eye looking at `at` (y up), square, vertical field of view fov radians, near 0.05,

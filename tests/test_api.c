@@ -520,15 +520,7 @@ static void test_intersect_material_and_uv(void **state)
     lmgi_scene *sc = load_cornell();
     lmgi_info in;
     lmgi_get_info(sc, &in);
-    int *at = malloc(sizeof *at * (size_t)in.atlas_width * (size_t)in.atlas_height);
-    assert_non_null(at);
-    for (size_t i = 0; i < (size_t)in.atlas_width * (size_t)in.atlas_height; i++)
-        at[i] = -1;
-    for (uint32_t i = 0; i < lmgi_texel_count(sc); i++) {
-        lmgi_texel t;
-        lmgi_get_texel(sc, i, &t);
-        at[(size_t)t.y * (size_t)in.atlas_width + (size_t)t.x] = (int)i;
-    }
+    int *at = lmt_texel_ids(sc);
     const float down[3] = {0.0f, -1.0f, 0.0f};
     int found = 0;
     double worst = 0.0;

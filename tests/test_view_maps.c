@@ -46,15 +46,7 @@ static void test_texels_are_where_pixels_look(void **state)
 {
     (void)state;
     lmgi_scene *sc = room();
-    lmgi_info in;
-    lmgi_get_info(sc, &in);
-    int *texel_of = malloc(sizeof *texel_of * (size_t)in.atlas_width * (size_t)in.atlas_height);
-    assert_non_null(texel_of);
-    for (uint32_t i = 0; i < lmgi_texel_count(sc); i++) {
-        lmgi_texel t;
-        lmgi_get_texel(sc, i, &t);
-        texel_of[t.y * in.atlas_width + t.x] = (int)i;
-    }
+    int *texel_of = lmt_texel_ids(sc);
     lmgi_camera cam;
     lmt_corner_camera(&cam);
     int w = LMT_SIDE, h = LMT_SIDE, seen = 0, near = 0;
