@@ -52,7 +52,8 @@ static long append_vertices(ph_batch *b, const unsigned char *v, uint32_t n)
             return -1;
         buf->v = grown, buf->cap = cap;
     }
-    memcpy(buf->v + buf->len, v, n * sizeof(ph_vertex));
+    if (n) /* a path of no vertices: the buffer may not exist yet, and memcpy takes no NULL even for 0 bytes */
+        memcpy(buf->v + buf->len, v, n * sizeof(ph_vertex));
     buf->len += n;
     return (long)(buf->len - n);
 }
