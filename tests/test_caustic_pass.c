@@ -72,8 +72,9 @@ static void floor_point(int x, int y, double *wx, double *wz)
 }
 
 /* Pixels whose filter footprint (k pixels and a margin) lies inside the lit patch read the analytic image
- * within 10% each (their mean within 2%); those whose footprint lies outside read 0. */
-static void check_image(const float *E, int k, const char *what)
+ * within 10% each (their mean within 2%); those whose footprint at its widest (reach pixels and a margin)
+ * lies outside read 0. */
+static void check_image(const float *E, int k, int reach, const char *what)
 {
     double sum = 0.0, want = 0.0, worst = 0.0, outside = 0.0;
     int n_in = 0, n_out = 0;
@@ -85,7 +86,14 @@ static void check_image(const float *E, int k, const char *what)
                     double wx, wz;
                     floor_point(x + dx, y + dy, &wx, &wz);
                     lmt_mirror_image(wx, wz, &in);
-                    all_in &= in, all_out &= !in;
+                    all_in &= in;
+                }
+            for (int dy = -reach - 1; dy <= reach + 1; dy += 1 + (reach + 1) / 4)
+                for (int dx = -reach - 1; dx <= reach + 1; dx += 1 + (reach + 1) / 4) {
+                    double wx, wz;
+                    floor_point(x + dx, y + dy, &wx, &wz);
+                    lmt_mirror_image(wx, wz, &in);
+                    all_out &= !in;
                 }
             double wx, wz, e = E[3 * (y * W + x) + 1];
             floor_point(x, y, &wx, &wz);
@@ -112,19 +120,22 @@ static void test_mirror_caustic(void **state)
     setup(&f, 1u << 16);
     lm_caustic_pass_settings set;
     lm_caustic_pass_settings_default(&set);
-    for (int world = 0; world < 2; world++) {
-        set.world_space = world;
-        lm_caustic_pass_stats st;
-        lm_caustic_pass *cp = run(&f, &set, &st);
-        static float E[3 * W * H];
-        lm_error err;
-        assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
-        print_message("%s filter: %u photons, %llu splatted, %d of %d tiles lit, %llu pixels filtered\n",
-                      world ? "world" : "screen", st.photons, (unsigned long long)st.splatted, st.tiles_lit, st.tiles,
-                      (unsigned long long)st.pixels_filtered);
-        check_image(E, set.filter_k, world ? "world-space filter" : "screen-space filter");
-        lm_caustic_pass_free(cp);
-    }
+    for (int sized = 0; sized < 2; sized++) /* the paper's fixed filter, and sized by density (the default) */
+        for (int world = 0; world < 2; world++) {
+            set.world_space = world;
+            set.filter_photons = sized ? 32 : 0;
+            lm_caustic_pass_stats st;
+            lm_caustic_pass *cp = run(&f, &set, &st);
+            static float E[3 * W * H];
+            lm_error err;
+            assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
+            char what[64];
+            snprintf(what, sizeof what, "%s, %s filter", sized ? "sized" : "fixed", world ? "world-space" : "screen-space");
+            print_message("%s: %u photons, %llu splatted, %d of %d tiles lit, %llu pixels filtered\n", what, st.photons,
+                          (unsigned long long)st.splatted, st.tiles_lit, st.tiles, (unsigned long long)st.pixels_filtered);
+            check_image(E, set.filter_k, sized ? set.filter_k << LM_CAUSTIC_FILTER_LEVELS : set.filter_k, what);
+            lm_caustic_pass_free(cp);
+        }
     teardown(&f);
 }
 
@@ -196,6 +207,59 @@ static void test_empty_and_bad(void **state)
     set.tile = 2;
     assert_int_equal(lm_caustic_pass_create(&set, &cp, &err), LM_ERR_INVALID);
     assert_null(cp);
+    lm_caustic_pass_settings_default(&set);
+    set.filter_photons = -1;
+    assert_int_equal(lm_caustic_pass_create(&set, &cp, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "photons"));
+    teardown(&f);
+}
+
+/* Thin light: the same patch lit by 1,024 photons, about 0.15 a pixel, so the paper's 7 x 7 filter holds
+ * 7 photons and shows each as a dot. The filter sized by density (32 photons) must read the analytic
+ * image over the patch's inside (pixels 10 or more from its edge) with under half the fixed filter's
+ * per-pixel error, and both keep the light's mean within 10%. */
+static void test_thin_light(void **state)
+{
+    (void)state;
+    fixture f;
+    setup(&f, 1u << 10);
+    double rmse[2], mean[2];
+    for (int sized = 0; sized < 2; sized++) {
+        lm_caustic_pass_settings set;
+        lm_caustic_pass_settings_default(&set);
+        set.filter_photons = sized ? 32 : 0;
+        lm_caustic_pass_stats st;
+        lm_caustic_pass *cp = run(&f, &set, &st);
+        static float E[3 * W * H];
+        lm_error err;
+        assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
+        double d2 = 0.0, a2 = 0.0, sum = 0.0, want = 0.0;
+        int n = 0;
+        for (int y = 0; y < H; y++)
+            for (int x = 0; x < W; x++) {
+                int all_in = 1, in;
+                for (int dy = -10; dy <= 10; dy += 5)
+                    for (int dx = -10; dx <= 10; dx += 5) {
+                        double wx, wz;
+                        floor_point(x + dx, y + dy, &wx, &wz);
+                        lmt_mirror_image(wx, wz, &in);
+                        all_in &= in;
+                    }
+                if (!all_in)
+                    continue;
+                double wx, wz, e = E[3 * (y * W + x) + 1];
+                floor_point(x, y, &wx, &wz);
+                double a = lmt_mirror_image(wx, wz, &in);
+                d2 += (e - a) * (e - a), a2 += a * a, sum += e, want += a, n++;
+            }
+        rmse[sized] = sqrt(d2 / a2), mean[sized] = sum / want;
+        print_message("%s filter, %llu photons splatted: %d pixels inside, mean %.4f of the image, relative RMSE "
+                      "%.3f\n", sized ? "sized" : "fixed", (unsigned long long)st.splatted, n, mean[sized], rmse[sized]);
+        assert_true(n > 500);
+        assert_true(fabs(mean[sized] - 1.0) < 0.10);
+        lm_caustic_pass_free(cp);
+    }
+    assert_true(rmse[1] < 0.5 * rmse[0]);
     teardown(&f);
 }
 
@@ -205,6 +269,7 @@ int main(void)
         cmocka_unit_test(test_mirror_caustic),
         cmocka_unit_test(test_tiles_match_splat),
         cmocka_unit_test(test_empty_and_bad),
+        cmocka_unit_test(test_thin_light),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

@@ -128,6 +128,7 @@ static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s
     s->reflection_size = no_reflections ? 0 : f->reflection_size;
     s->reflection_faces = f->reflection_faces;
     s->caustic_pass.filter_k = r->caustics.filter == LMGI_OFF ? 0 : r->caustics.filter;
+    s->caustic_pass.filter_photons = r->caustics.filter_photons == LMGI_OFF ? 0 : r->caustics.filter_photons;
     s->caustic_pass.tile = r->caustics.tile;
     s->caustic_pass.world_space = r->caustics.world_filter == LMGI_ON;
     s->photon_gather.tile = r->tiled.tile;

@@ -18,7 +18,9 @@ void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
     s->filter_k = 3;
     s->tile = 32;
     s->world_space = 0;
+    s->filter_photons = 32;
 }
+
 
 /* A photon as the splat reads it: position, receiver normal (arrival side), flux. */
 #define PHOTON_FLOATS 9
@@ -73,7 +75,7 @@ static void clear_box(const int box[4], int colours, int stencil)
 
 struct lm_caustic_pass {
     lm_caustic_pass_settings set;
-    GLuint splat_prog, query_prog, filter_prog, composite_prog;
+    GLuint splat_prog, query_prog, filter_prog, composite_prog, mask_prog;
     GLuint vao, photon_vbo, index_buf, empty_vao, rect_vbo;
     uint32_t photons;
     float *pos;             /* the photons' positions (3 floats each), for the frustum test of each run */
@@ -98,14 +100,20 @@ static void free_slot(slot_targets *t)
     memset(t, 0, sizeof *t);
 }
 
-static GLuint float_texture(int w, int h)
+/* An RGBA32F texture, with its whole mipmap chain (trilinear) when `mipmaps`. */
+static GLuint float_texture(int w, int h, int mipmaps)
 {
     GLuint t;
     glGenTextures(1, &t);
     glBindTexture(GL_TEXTURE_2D, t);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    int levels = 1;
+    while (mipmaps && ((w >> levels) > 0 || (h >> levels) > 0))
+        levels++;
+    glTexStorage2D(GL_TEXTURE_2D, levels, GL_RGBA32F, w, h);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, mipmaps ? GL_LINEAR_MIPMAP_LINEAR : GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, mipmaps ? GL_LINEAR : GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     return t;
 }
 
@@ -129,7 +137,7 @@ static lm_status make_slot(lm_caustic_pass *cp, slot_targets *t, int w, int h, l
     glGenFramebuffers(1, &t->splat_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, t->splat_fbo);
     for (int i = 0; i < 2; i++) {
-        t->splat_tex[i] = float_texture(w, h);
+        t->splat_tex[i] = float_texture(w, h, cp->set.filter_photons > 0);
         glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, t->splat_tex[i], 0);
     }
     glGenRenderbuffers(1, &t->stencil);
@@ -143,7 +151,7 @@ static lm_status make_slot(lm_caustic_pass *cp, slot_targets *t, int w, int h, l
     int ok = glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     glGenFramebuffers(1, &t->irr_fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
-    t->irr_tex = float_texture(w, h);
+    t->irr_tex = float_texture(w, h, 0);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, t->irr_tex, 0);
     ok = ok && glCheckFramebufferStatus(GL_FRAMEBUFFER) == GL_FRAMEBUFFER_COMPLETE;
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -172,6 +180,8 @@ static lm_status build_programs(lm_caustic_pass *cp, lm_error *err)
     }
     if (st == LM_OK)
         st = lm_gl_program("caustic composite", lm_glsl_caustic_rect_vs, lm_glsl_caustic_composite_fs, &cp->composite_prog, err);
+    if (st == LM_OK)
+        st = lm_gl_program("caustic mask", lm_glsl_caustic_rect_vs, lm_glsl_caustic_mask_fs, &cp->mask_prog, err);
     return st;
 }
 
@@ -185,6 +195,9 @@ lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic
     }
     if (set->filter_k < 0 || set->filter_k > 8)
         return lm_fail(err, LM_ERR_INVALID, "caustic pass: the filter's k must be 0 to 8, not %d", set->filter_k);
+    if (set->filter_photons < 0)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: the filter's photons must be 0 or more, not %d",
+                       set->filter_photons);
     if (set->tile < 4 || set->tile > 256)
         return lm_fail(err, LM_ERR_INVALID, "caustic pass: the tile side must be 4 to 256 pixels, not %d", set->tile);
     lm_caustic_pass *cp = calloc(1, sizeof *cp);
@@ -223,8 +236,8 @@ void lm_caustic_pass_free(lm_caustic_pass *cp)
         return;
     for (int i = 0; i < LM_CAUSTIC_SLOTS; i++)
         free_slot(&cp->slots[i]);
-    GLuint progs[4] = {cp->splat_prog, cp->query_prog, cp->filter_prog, cp->composite_prog};
-    for (int i = 0; i < 4; i++)
+    GLuint progs[5] = {cp->splat_prog, cp->query_prog, cp->filter_prog, cp->composite_prog, cp->mask_prog};
+    for (int i = 0; i < 5; i++)
         if (progs[i])
             glDeleteProgram(progs[i]);
     if (cp->vao) {
@@ -344,14 +357,43 @@ static uint32_t visible_photons(lm_caustic_pass *cp, const float m[16])
     return n;
 }
 
+/* The receiver mask into the splat's irr alpha over the whole target (its rgb and the flux target kept):
+ * 1 where the pixel's kd is not 0 (every pixel when kd is 0, no frame targets). */
+static void receiver_mask(lm_caustic_pass *cp, const slot_targets *t, GLuint kd)
+{
+    GLuint p = cp->mask_prog;
+    glUseProgram(p);
+    set_size(p, t->width, t->height);
+    glUniform4f(glGetUniformLocation(p, "rect"), 0.0f, 0.0f, (float)t->width, (float)t->height);
+    glUniform1i(glGetUniformLocation(p, "have_kd"), kd != 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, kd);
+    glUniform1i(glGetUniformLocation(p, "kd"), 0);
+    glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_TRUE);
+    glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    glBindVertexArray(cp->empty_vao);
+    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+}
+
+/* kd of the frame targets the slot composites into (0: none). */
+static GLuint slot_kd(const lm_direct *d, int slot)
+{
+    if (!d)
+        return 0;
+    return lm_frame_targets_kd(lm_direct_targets(d), slot == LM_CAUSTIC_SLOT_PROBE ? LM_FRAME_PROBE : LM_FRAME_VIEW);
+}
+
 static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view, const view_consts *vc, GLuint depth,
-                       lm_caustic_pass_stats *st)
+                       GLuint kd, lm_caustic_pass_stats *st)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, t->splat_fbo);
     glViewport(0, 0, t->width, t->height);
     clear_box(t->splat_held, 2, 1);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    receiver_mask(cp, t, kd);
     glEnable(GL_BLEND);
     glBlendFunc(GL_ONE, GL_ONE);
     glEnable(GL_STENCIL_TEST);
@@ -370,6 +412,11 @@ static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, depth);
     glUniform1i(glGetUniformLocation(p, "depth"), 0);
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, kd);
+    glUniform1i(glGetUniformLocation(p, "kd"), 1);
+    glUniform1i(glGetUniformLocation(p, "have_kd"), kd != 0);
+    glActiveTexture(GL_TEXTURE0);
     uint32_t n = visible_photons(cp, vc->view_proj);
     glBindVertexArray(cp->vao);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)(n ? n : 1) * sizeof *cp->visible), cp->visible,
@@ -423,22 +470,37 @@ static void query_tiles(lm_caustic_pass *cp, slot_targets *t, lm_caustic_pass_st
     st->tiles_lit = lit;
 }
 
-/* The lit tiles grown by k pixels as triangles (pixel coordinates) into cp->rects; their box in box. */
-static lm_status grown_tiles(lm_caustic_pass *cp, const slot_targets *t, int count, int box[4], uint64_t *pixels,
+/* Whether tile (tx, ty) is within d tiles of a lit one. */
+static int near_lit(const slot_targets *t, int tx, int ty, int d)
+{
+    for (int y = ty - d; y <= ty + d; y++)
+        for (int x = tx - d; x <= tx + d; x++)
+            if (x >= 0 && y >= 0 && x < t->tiles_x && y < t->tiles_y && t->lit[y * t->tiles_x + x])
+                return 1;
+    return 0;
+}
+
+/* The filter's squares as triangles (pixel coordinates) into cp->rects, *count of them; their box in box.
+ * The fixed filter: each lit tile grown by k pixels. Sized by density, the filter reaches k 2^levels
+ * pixels: every tile within that of a lit one, each once (grown squares would overlap many times). */
+static lm_status grown_tiles(lm_caustic_pass *cp, const slot_targets *t, int *count, int box[4], uint64_t *pixels,
                              lm_error *err)
 {
-    float *r = realloc(cp->rects, (size_t)(count ? count : 1) * 12 * sizeof *r);
+    int T = cp->set.tile, grow = cp->set.filter_photons > 0 ? 0 : cp->set.filter_k, n = 0;
+    int reach = cp->set.filter_k << LM_CAUSTIC_FILTER_LEVELS; /* in pixels, sized by density */
+    int d = cp->set.filter_photons > 0 ? (reach + T - 1) / T : 0;
+    int most = d ? t->tiles_x * t->tiles_y : *count;
+    float *r = realloc(cp->rects, (size_t)(most ? most : 1) * 12 * sizeof *r);
     if (!r)
-        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %d tiles", count);
+        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %d tiles", most);
     cp->rects = r;
-    int T = cp->set.tile, k = cp->set.filter_k, n = 0;
     box[0] = t->width, box[1] = t->height, box[2] = box[3] = 0;
     *pixels = 0;
     for (int ty = 0; ty < t->tiles_y; ty++)
         for (int tx = 0; tx < t->tiles_x; tx++) {
-            if (!t->lit[ty * t->tiles_x + tx])
+            if (d ? !near_lit(t, tx, ty, d) : !t->lit[ty * t->tiles_x + tx])
                 continue;
-            int x0 = tx * T - k, y0 = ty * T - k, x1 = tx * T + T + k, y1 = ty * T + T + k;
+            int x0 = tx * T - grow, y0 = ty * T - grow, x1 = tx * T + T + grow, y1 = ty * T + T + grow;
             x0 = x0 < 0 ? 0 : x0, y0 = y0 < 0 ? 0 : y0;
             x1 = x1 > t->width ? t->width : x1, y1 = y1 > t->height ? t->height : y1;
             const float q[12] = {(float)x0, (float)y0, (float)x1, (float)y0, (float)x1, (float)y1,
@@ -448,15 +510,18 @@ static lm_status grown_tiles(lm_caustic_pass *cp, const slot_targets *t, int cou
             box[2] = x1 > box[2] ? x1 : box[2], box[3] = y1 > box[3] ? y1 : box[3];
             *pixels += (uint64_t)(x1 - x0) * (uint64_t)(y1 - y0);
         }
+    *count = n;
     return LM_OK;
 }
 
-static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, GLuint depth, int count)
+/* The filter over count squares of cp->rects, whose box is box (what the next run clears). */
+static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, GLuint depth, int count,
+                   const int box[4])
 {
     glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
     glViewport(0, 0, t->width, t->height);
     clear_box(t->irr_held, 1, 0);
-    lit_box(t, cp->set.tile, cp->set.filter_k, t->irr_held);
+    memcpy(t->irr_held, box, sizeof t->irr_held);
     if (!count)
         return;
     GLuint p = cp->filter_prog;
@@ -465,11 +530,15 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
     glUniformMatrix4fv(glGetUniformLocation(p, "inv_proj"), 1, GL_FALSE, vc->inv_proj);
     glUniform1i(glGetUniformLocation(p, "ortho"), vc->ortho);
     glUniform1f(glGetUniformLocation(p, "pix_side"), vc->pix_side);
+    glUniform1f(glGetUniformLocation(p, "need"), (float)cp->set.filter_photons);
+    glUniform1i(glGetUniformLocation(p, "levels"), LM_CAUSTIC_FILTER_LEVELS);
     const GLuint tex[3] = {t->splat_tex[0], t->splat_tex[1], depth};
     const char *names[3] = {"irr", "flux", "depth"};
     for (int i = 0; i < 3; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D, tex[i]);
+        if (i < 2 && cp->set.filter_photons > 0) /* the splat's means over 2^L pixels, for the density-sized filter */
+            glGenerateMipmap(GL_TEXTURE_2D);
         glUniform1i(glGetUniformLocation(p, names[i]), i);
     }
     glBindVertexArray(cp->empty_vao);
@@ -498,7 +567,7 @@ static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_direc
     glUseProgram(p);
     set_size(p, t->width, t->height);
     glUniform4f(glGetUniformLocation(p, "rect"), (float)box[0], (float)box[1], (float)box[2], (float)box[3]);
-    const GLuint tex[2] = {t->irr_tex, lm_frame_targets_kd(f, which)};
+    const GLuint tex[2] = {t->irr_tex, slot_kd(d, slot)};
     const char *names[2] = {"irr", "kd"};
     for (int i = 0; i < 2; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
@@ -541,14 +610,14 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
     glFinish(); /* the times below are the pass's own, not the frame's work before it */
     double t0 = lm_now();
     st.t_wait = t0 - tw;
-    splat(cp, t, view, &vc, depth, &st); /* its query's result waits for the splat */
+    splat(cp, t, view, &vc, depth, slot_kd(d, slot), &st); /* its query's result waits for the splat */
     double t1 = lm_now();
     query_tiles(cp, t, &st);
     double t2 = lm_now();
-    int box[4] = {0, 0, 0, 0};
-    s = grown_tiles(cp, t, st.tiles_lit, box, &st.pixels_filtered, err);
+    int box[4] = {0, 0, 0, 0}, squares = st.tiles_lit;
+    s = grown_tiles(cp, t, &squares, box, &st.pixels_filtered, err);
     if (s == LM_OK) {
-        filter(cp, t, &vc, depth, st.tiles_lit);
+        filter(cp, t, &vc, depth, squares, box);
         glFinish();
     }
     double t3 = lm_now();
@@ -616,7 +685,17 @@ static lm_status read_texture(GLuint tex, int w, int h, float *rgba, lm_error *e
 lm_status lm_caustic_pass_read_splat(const lm_caustic_pass *cp, int slot, float *rgba, lm_error *err)
 {
     const slot_targets *t = slot_of(cp, slot);
-    return read_texture(t->splat_tex[0], t->width, t->height, rgba, err);
+    size_t n = (size_t)t->width * (size_t)t->height;
+    float *flux = malloc((n ? n : 1) * 4 * sizeof *flux);
+    if (!flux)
+        return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory to read the splat");
+    lm_status st = read_texture(t->splat_tex[0], t->width, t->height, rgba, err);
+    if (st == LM_OK)
+        st = read_texture(t->splat_tex[1], t->width, t->height, flux, err);
+    for (size_t i = 0; st == LM_OK && i < n; i++) /* the photon count is the flux target's alpha */
+        rgba[4 * i + 3] = flux[4 * i + 3];
+    free(flux);
+    return st;
 }
 
 lm_status lm_caustic_pass_read_irradiance(const lm_caustic_pass *cp, int slot, float *rgb, lm_error *err)

@@ -13,8 +13,10 @@
  *            the receiver the camera does not see. Float throughout: no 8-bit count limit, coloured light.
  *   tiles    the screen in tile x tile squares; per square an occlusion query (GL_SAMPLES_PASSED) around a
  *            quad drawn where the stencil is not 0: a tile is lit when the query counts any pixel.
- *   filter   over every lit tile grown by k pixels (clamped to the screen), with blending off, so that
- *            pixels two grown tiles share get the same value twice, never twice the light:
+ *   filter   over every lit tile grown by the filter's reach (clamped to the screen), with blending off, so
+ *            that pixels two grown tiles share get the same value twice, never twice the light; the reach
+ *            is k pixels for the fixed filter, and for the density-sized one the tiles within k 2^levels
+ *            pixels of a lit tile, each drawn once:
  *              screen (the paper's): E(x) = sum_ij t(x + i, y + j) w_ij / sum_ij w_ij,
  *                w_ij = sqrt(1 + 2 k^2) - sqrt(i^2 + j^2), t the splat's Phi / A_pix: each photon's power
  *                spread over the (2k + 1)^2 pixels around it, over the world area they cover (A_pix at the
@@ -22,6 +24,11 @@
  *              world (the paper's suggestion): every pixel's view position from the depth; a cone kernel of
  *                world radius R = k pixel footprints at x, E(x) = sum_j Phi_j max(0, 1 - |P_j - P_x| / R)
  *                / (pi R^2 / 3): photons on another surface than x's (a depth step) do not leak.
+ *            Sized by density (filter_photons > 0): where the (2k + 1)^2 pixels around x hold fewer than
+ *            filter_photons photons (counted from the splat's mipmaps), the same (2k + 1)^2 taps lie s
+ *            pixels apart, each reading the splat's mean over s x s pixels (trilinear mipmaps), s up to
+ *            2^LM_CAUSTIC_FILTER_LEVELS chosen so the window holds about filter_photons: a focal spot keeps
+ *            the paper's filter, thin light is spread over more pixels instead of showing each photon.
  *            Elsewhere E is 0.
  *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
  *            lobe the direct light's first pass wrote there: frame_targets.h).
@@ -29,8 +36,9 @@
  * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
  * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
  * application renders (_VIEW).
- * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel, two
- * per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a current GL
+ * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel (and
+ * up to LM_CAUSTIC_FILTER_LEVELS + 1 to size it, plus the splat's mipmaps once a run), two per pixel of
+ * the lit tiles' box (docs/bench.md has the figures). Needs a current GL
  * context; not thread-safe. */
 #ifndef LM_CAUSTIC_PASS_H
 #define LM_CAUSTIC_PASS_H
@@ -46,7 +54,13 @@ typedef struct {
     int filter_k;          /* k of the (2k + 1)^2 filter, 0 to 8 (default 3, the paper's 7 x 7) */
     int tile;              /* tile side in pixels, 4 to 256 (default 32) */
     int world_space;       /* 1: filter by world distance (default 0: the paper's screen-space cone) */
+    int filter_photons;    /* photons a filter should hold: where the (2k + 1)^2 pixels hold fewer, the filter
+                              widens (its taps further apart over the splat's mipmaps) until about that many,
+                              up to LM_CAUSTIC_FILTER_LEVELS doublings (default 32; 0: the paper's fixed filter) */
 } lm_caustic_pass_settings;
+
+/* The density-sized filter widens up to 2^this times (8: k = 3 reaches 24 pixels). */
+#define LM_CAUSTIC_FILTER_LEVELS 3
 
 void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s);
 

@@ -1,16 +1,24 @@
-// Eq. 4 normalized by its weights' sum: each photon's Phi / A_pix spread over the filter's pixels.
+// Eq. 4 normalized by the weights' sum over the taps that are receivers (irr's alpha, the mask): each
+// photon's Phi / A_pix spread over the filter's receiver pixels, so light next to a mirror, glass or the
+// background is not diluted by pixels that cannot hold it; taps filter_scale pixels apart (1: the
+// paper's filter, texel by texel).
 #include "caustic_filter_head.glsl"
 void main() {
-    ivec2 x = ivec2(gl_FragCoord.xy), hi = ivec2(size) - 1;
+    vec2 x = gl_FragCoord.xy;
+    // each tap reads the mean over twice its spacing (2 log2 s levels up to s = 2, then log2 s + 1), so the
+    // taps overlap instead of sampling the splat's mipmaps at a stride that beats with their texels
+    float s = filter_scale(x), lod = min(2.0 * log2(s), log2(s) + 1.0);
+    if (s == 0.0) { frag = vec4(0.0); return; }
     float top = sqrt(1.0 + 2.0 * float(K * K)), wsum = 0.0;
     vec3 e = vec3(0.0);
     for (int j = -K; j <= K; j++)
         for (int i = -K; i <= K; i++) {
+            vec2 q = x + vec2(i, j) * s;
+            if (!on_screen(q)) continue;
             float w = top - sqrt(float(i * i + j * j));
-            wsum += w;
-            ivec2 q = x + ivec2(i, j);
-            if (all(greaterThanEqual(q, ivec2(0))) && all(lessThanEqual(q, hi)))
-                e += w * texelFetch(irr, q, 0).rgb;
+            vec4 t = s == 1.0 ? texelFetch(irr, ivec2(q), 0) : textureLod(irr, q / size, lod);
+            e += w * t.rgb;
+            wsum += w * t.a;
         }
-    frag = vec4(e / wsum, 1.0);
+    frag = vec4(wsum > 0.0 ? e / wsum : vec3(0.0), 1.0);
 }

@@ -1,4 +1,5 @@
-// Per photon: projected to its pixel's centre, or out of the clip volume when dropped (caustic_pass.h).
+// Per photon: projected to its pixel's centre, or out of the clip volume when dropped (caustic_pass.h):
+// also where that pixel shows no diffuse lobe (kd 0), so that light lies only where the mask says.
 #version 450 core
 layout(location = 0) in vec3 pos;
 layout(location = 1) in vec3 ng;
@@ -8,7 +9,8 @@ uniform vec3 eye, view_dir;
 uniform int ortho;
 uniform vec2 size;
 uniform float pix_area, pix_side;
-uniform sampler2D depth;
+uniform sampler2D depth, kd;
+uniform int have_kd;
 out vec3 v_irr, v_flux;
 float view_depth(vec2 ndc, float z) {
     vec4 v = inv_proj * vec4(ndc, z, 1.0);
@@ -21,6 +23,8 @@ void main() {
     vec3 ndc = c.xyz / c.w;
     if (any(greaterThanEqual(abs(ndc.xy), vec2(1.0))) || abs(ndc.z) > 1.0) return;
     ivec2 px = clamp(ivec2(floor((ndc.xy * 0.5 + 0.5) * size)), ivec2(0), ivec2(size) - 1);
+    if (have_kd != 0 && all(equal(texelFetch(kd, px, 0).rgb, vec3(0.0))))
+        return; // a pixel whose surface shows no caustic (the mask pass's rule)
     vec3 V = ortho != 0 ? view_dir : normalize(eye - pos);
     float cv = dot(ng, V);
     if (cv <= 1e-4) return;

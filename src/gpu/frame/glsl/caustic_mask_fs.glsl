@@ -1,0 +1,11 @@
+// Where the caustic filter may read light, into the splat's alpha: pixels with a diffuse lobe (kd > 0),
+// not mirror, glass, metal, the background or a back face, where a caustic would not show. Without kd
+// (a pass run with no frame targets) every pixel.
+#version 450 core
+uniform sampler2D kd;
+uniform int have_kd;
+layout(location = 0) out vec4 frag;
+void main() {
+    vec3 k = have_kd != 0 ? texelFetch(kd, ivec2(gl_FragCoord.xy), 0).rgb : vec3(1.0);
+    frag = vec4(0.0, 0.0, 0.0, any(greaterThan(k, vec3(0.0))) ? 1.0 : 0.0);
+}
