@@ -14,18 +14,22 @@ vec3 view_pos(ivec2 q) {
     vec4 v = inv_proj * vec4(ndc, texelFetch(depth, q, 0).r * 2.0 - 1.0, 1.0);
     return v.xyz / v.w;
 }
-// The filter's scale s at pixel centre c: its taps lie s pixels apart, each the splat's mean over s x s
-// pixels (the mipmaps). 1 where the paper's (2k + 1)^2 pixels hold `need` photons; else the scale whose
-// window of (2k + 1) s pixels a side holds about that many, up to 2^levels (photons counted from the
-// splat's mipmaps, flux's alpha = photons a pixel; for an even density the count grows 4x a level, so s moves
-// continuously from one level to the next); 0 when no photon lies within the widest window.
-float filter_scale(vec2 c) {
+// The filter's scale s at pixel centre c: its taps lie s pixels apart, each the splat's mean over about
+// 2s pixels (its mipmaps). 1 (the paper's filter) where its (2k + 1)^2 pixels hold `need` photons; where
+// they hold fewer, the scale whose window of (2k + 1) s pixels a side holds about that many, up to
+// 2^levels (photons counted from the mipmaps of flux's alpha, photons a pixel; for an even density the
+// count grows 4x a level, so s moves continuously from one level to the next); where they hold more than
+// SHARP, smaller, down to `smallest`, so that the window holds about SHARP (a focal spot stays sharp).
+// 0 when no photon lies within the widest window.
+const float SHARP = 512.0;
+float filter_scale(vec2 c, float smallest) {
     if (need <= 0.0) return 1.0;
     float side = float(2 * K + 1), lw = log2(side);
     for (int L = 0; L <= levels; L++) {
         float s = exp2(float(L)), w = side * s;
         float n = textureLod(flux, c / size, float(L) + lw).a * w * w;
-        if (n >= need) return L == 0 ? 1.0 : max(0.5 * s, s * sqrt(need / n));
+        if (n >= need && L == 0) return clamp(sqrt(max(SHARP, need) / n), smallest, 1.0);
+        if (n >= need) return max(0.5 * s, s * sqrt(need / n));
         if (L == levels && n == 0.0) return 0.0; // no photon within reach: E is 0, no taps read
     }
     return exp2(float(levels));

@@ -1,12 +1,13 @@
 // A cone of world radius R = k footprints x filter_scale at x over the photons' flux at each tap's view
 // position (a tap, s pixels from the next, holds the flux of s x s pixels: the splat's mean over about
-// twice that, as the screen filter reads it, times s^2).
+// twice that, as the screen filter reads it, times s^2). Never narrower than the paper's (s >= 1): the
+// cone's world radius would fall below a pixel's footprint, between the pixels it sums.
 #include "caustic_filter_head.glsl"
 void main() {
     vec2 xc = gl_FragCoord.xy;
     ivec2 x = ivec2(xc);
     vec3 px = view_pos(x);
-    float s = filter_scale(xc), lod = min(2.0 * log2(s), log2(s) + 1.0);
+    float s = filter_scale(xc, 1.0), lod = min(2.0 * log2(s), log2(s) + 1.0);
     if (s == 0.0) { frag = vec4(0.0); return; }
     float R = max(float(K), 0.5) * s * (ortho != 0 ? pix_side : -px.z * pix_side);
     vec3 e = vec3(0.0);
