@@ -208,7 +208,8 @@ static inline int lmgi_knob_is_pow2(double v)
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES,                                                                          \
       LMGI_SWEEP(15, "caustic_filter_photons", "caustic filter photons", (8, 16, 32, 64, 128), (8, 32, 128), 1),  \
       "photons a caustic filter should hold: where its (2k+1)^2 pixels hold\n"                                    \
-      "fewer it widens, up to 8 times (default 32; 0: the paper's fixed filter)")                                 \
+      "fewer it widens, up to 8 times, and where they hold over 128 it narrows\n"                                 \
+      "(default 32; 0: the paper's fixed filter)")                                                               \
     X(caustics, world_filter, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, "--caustic-space", "S",     \
       LMGI_CLI_ZERO_NONE, LMGI_CAUSTIC_SPACE_CHOICES, LMGI_NO_SWEEP,                                               \
       "screen (default, the paper's filter) or world (by world distance)")                                        \

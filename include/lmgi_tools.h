@@ -109,6 +109,13 @@ typedef struct {
     uint32_t pixels;        /* compared pixels of non-emissive surfaces */
     double frame_mean[3], reference_mean[3], ratio[3]; /* over those pixels */
     double rel_rmse;        /* relative RMSE of the frame over those pixels */
+    /* The caustic part (light off mirrors and glass straight from a light, L S+ D; docs/caustics.md): what
+     * the frame's caustic pass added (kd / pi x its E) and the reference's, width x height x 3 like frame
+     * (0 everywhere in a scene without caustics); their means and ratio per channel and the relative RMSE
+     * over the same pixels (ratio 1 and RMSE 0 where both are 0). */
+    float *caustic_frame, *caustic_reference;
+    double caustic_frame_mean[3], caustic_reference_mean[3], caustic_ratio[3];
+    double caustic_rel_rmse;
     float reference_target_error; /* the reference's target relative standard error */
     double reference_rel_se, reference_seconds; /* the reference's own noise and cost */
 } lmgi_check_result;

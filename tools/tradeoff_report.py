@@ -18,9 +18,13 @@ import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 import numpy as np  # noqa: E402
 
 # Knobs whose cost is paid every update rather than in the full solution (trace, AIMs, gather).
-UPDATE_COST = {"texels_per_frame", "caustic_photons", "caustic_filter", "tiled_k", "tiled_radius"}
+UPDATE_COST = {"texels_per_frame", "caustic_photons", "caustic_filter", "caustic_filter_photons", "tiled_k",
+               "tiled_radius"}
 # Knobs that change the frame but not the lightmaps: judged by the frame's error.
-FRAME_ONLY = {"caustic_photons", "caustic_filter", "tiled_k", "tiled_radius", "texels_per_frame"}
+FRAME_ONLY = {"caustic_photons", "caustic_filter", "caustic_filter_photons", "tiled_k", "tiled_radius",
+              "texels_per_frame"}
+# Knobs of the caustic pass: judged by the caustic part's error (a small share of the frame's light).
+CAUSTIC = {"caustic_photons", "caustic_filter", "caustic_filter_photons"}
 
 
 def finite(v):
@@ -42,8 +46,17 @@ def frame_error(row):
     return row.get("frame_surface_rms")
 
 
+def caustic_error(row):
+    """The frame's caustic part against the reference's (relative RMSE over the compared pixels); None
+    where the scene has no caustics or the row predates it."""
+    return row.get("caustic", {}).get("rmse")
+
+
 def error_of(row):
-    """The error a knob is judged by: the IIM's where the knob changes the lightmaps, else the frame's."""
+    """The error a knob is judged by: the caustic part's for the caustic pass's knobs, the IIM's where the
+    knob changes the lightmaps, else the frame's."""
+    if row["knob"] in CAUSTIC and finite(caustic_error(row)):
+        return caustic_error(row)
     if row["knob"] not in FRAME_ONLY and finite(row["iim"]["rmse"]):
         return row["iim"]["rmse"]
     return frame_error(row)
@@ -109,18 +122,23 @@ def knob_plots(scene, out_dir):
             series.setdefault(r["value"].split(" x ")[0] + " " if knob.startswith("grid_") else "", []).append(r)
         for name, part in series.items():
             xs = [cost_of(r) for r in part]
-            for metric, line in (("iim", "o-"), ("frame", "s--")):
-                ys = [num(r["iim"]["rmse"] if metric == "iim" else frame_error(r)) for r in part]
+            metrics = (("iim", "o-", "IIM per texel", lambda r: r["iim"]["rmse"]),
+                       ("frame", "s--", "frame per surface", frame_error),
+                       ("caustic", "^:", "caustic part per pixel", caustic_error))
+            for metric, line, what, value in metrics:
+                if metric == "caustic" and knob not in CAUSTIC:
+                    continue
+                ys = [num(value(r)) for r in part]
                 if not any(finite(y) for y in ys):
                     continue
-                ax.plot(xs, ys, line, markersize=4,
-                        label=name + ("IIM per texel" if metric == "iim" else "frame per surface"))
+                ax.plot(xs, ys, line, markersize=4, label=name + what)
                 for r, x, y in zip(part, xs, ys):
                     if finite(y):
                         ax.annotate(r["value"], (x, y), textcoords="offset points", xytext=(3, 3), fontsize=7)
                         if r["default"]:
                             ax.plot([x], [y], "*", color="black", markersize=11, zorder=5)
-        log_axes(ax, [cost_of(r) for r in rs], [frame_error(r) for r in rs] + [r["iim"]["rmse"] for r in rs])
+        log_axes(ax, [cost_of(r) for r in rs], [frame_error(r) for r in rs] + [r["iim"]["rmse"] for r in rs] +
+                 ([caustic_error(r) for r in rs] if knob in CAUSTIC else []))
         ax.set_title(rs[0]["label"], fontsize=9)
         style(ax, "ms per update" if knob in UPDATE_COST else "ms for the full solution", "relative error (RMS)")
     for k in range(len(knobs), rows_n * cols):
@@ -306,14 +324,16 @@ def scene_html(scene, out_dir):
         parts.append(f'<img src="{maps_png}" alt="error maps">')
     parts.append(lag_html(scene, out_dir))
     cols = ["knob", "value", "solution ms", "trace", "AIMs", "gather", "update ms", "AIM RMSE", "IIM RMSE", "IIM p99",
-            "IIM worst", "frame RMSE", "frame p99", "frame worst", "frame bias", "per surface", "worst surface"]
+            "IIM worst", "frame RMSE", "frame p99", "frame worst", "frame bias", "per surface", "worst surface",
+            "caustic RMSE"]
     parts.append("<h3>Every setting</h3><table><tr>" + "".join(f"<th>{c}</th>" for c in cols) + "</tr>")
     for r in scene["rows"]:
         cells = [r["knob"], r["value"] + (" (default)" if r["default"] else ""), fmt(r["ms"]["solution"], 1),
                  fmt(r["ms"]["trace"], 1), fmt(r["ms"]["aim"], 1), fmt(r["ms"]["gather"], 1),
                  fmt(r["ms"]["update"], 2), fmt(r["aim"]["rmse"]), fmt(r["iim"]["rmse"]), fmt(r["iim"]["p99"]),
                  fmt(r["iim"]["worst"]), fmt(r["frame"]["rmse"]), fmt(r["frame"]["p99"]), fmt(r["frame"]["worst"]),
-                 fmt(r["frame_bias"]), fmt(r.get("frame_surface_rms")), fmt(r.get("frame_surface_worst"))]
+                 fmt(r["frame_bias"]), fmt(r.get("frame_surface_rms")), fmt(r.get("frame_surface_worst")),
+                 fmt(caustic_error(r))]
         parts.append("<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in cells) + "</tr>")
     parts.append("</table>")
     return "\n".join(parts)

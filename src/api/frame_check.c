@@ -18,6 +18,8 @@ void lm_frame_check_free(lm_frame_check *c)
     free(c->frame);
     free(c->ref);
     free(c->ref_indirect);
+    free(c->caustic);
+    free(c->ref_caustic);
     free(c->surface_at);
     free(c->compared);
     free(c->surface);
@@ -66,18 +68,20 @@ static lm_status compare(const lmgi_scene *sc, lm_frame_check *c, lm_error *err)
         add(&c->surface[s], c->frame + 3 * i, c->ref + 3 * i);
         if (!emissive_surface(sc, s)) {
             add(&c->lit, c->frame + 3 * i, c->ref + 3 * i);
+            add(&c->caustic_lit, c->caustic + 3 * i, c->ref_caustic + 3 * i);
             mask[i] = 1;
         }
     }
     c->rel_rmse = lm_ref_relative_rmse(c->frame, c->ref, mask, n, 3);
+    c->caustic_rel_rmse = lm_ref_relative_rmse(c->caustic, c->ref_caustic, mask, n, 3);
     free(mask);
     return LM_OK;
 }
 
-/* The frame loop's picture after `frames` frames into rgb, and (surface_at not NULL) the surface index of
- * each of its pixels. */
+/* The frame loop's picture after `frames` frames into rgb, and (each not NULL) what its caustics added and
+ * the surface index of each of its pixels. */
 static lm_status run_frames(lmgi_scene *sc, const lm_frame_loop_settings *set, int frames, float *rgb,
-                            int32_t *surface_at, lm_view *view, lm_error *err)
+                            float *caustic, int32_t *surface_at, lm_view *view, lm_error *err)
 {
     lm_frame_loop *fl = NULL;
     lm_status st = lm_frame_loop_create(&sc->world, set, &fl, NULL, NULL, err);
@@ -89,6 +93,8 @@ static lm_status run_frames(lmgi_scene *sc, const lm_frame_loop_settings *set, i
         memcpy(rgb, lm_frame_loop_image(fl), (size_t)set->width * (size_t)set->height * 3 * sizeof(float));
         *view = *lm_frame_loop_view(fl);
     }
+    if (st == LM_OK && caustic)
+        st = lm_frame_loop_read_caustic_radiance(fl, caustic, err);
     if (st == LM_OK && surface_at) /* drawn with the loop's context still current (it has no other) */
         st = lm_render_surface_index(sc->scene, &sc->surfaces, view, set->width, set->height, surface_at, err);
     lm_frame_loop_free(fl);
@@ -116,6 +122,7 @@ static lm_status reference_pixels(const lmgi_scene *sc, const lm_view *view, con
         return st;
     memcpy(c->ref, r.full, (size_t)r.count * 3 * sizeof(float));
     memcpy(c->ref_indirect, r.indirect, (size_t)r.count * 3 * sizeof(float));
+    memcpy(c->ref_caustic, r.caustic, (size_t)r.count * 3 * sizeof(float));
     c->ref_rel_se = r.mean_rel_se;
     c->ref_seconds = r.seconds;
     lm_ref_result_free(&r);
@@ -126,7 +133,7 @@ lm_status lm_frame_check_frame(lmgi_scene *sc, const lm_frame_loop_settings *loo
                                lm_error *err)
 {
     lm_view view;
-    return run_frames(sc, loop, frames, rgb, NULL, &view, err);
+    return run_frames(sc, loop, frames, rgb, NULL, NULL, &view, err);
 }
 
 /* out's arrays for a width x height picture. */
@@ -139,10 +146,13 @@ static lm_status alloc_check(const lmgi_scene *sc, int width, int height, lm_fra
     out->frame = malloc(n * 3 * sizeof(float));
     out->ref = malloc(n * 3 * sizeof(float));
     out->ref_indirect = malloc(n * 3 * sizeof(float));
+    out->caustic = calloc(n * 3, sizeof(float));
+    out->ref_caustic = malloc(n * 3 * sizeof(float));
     out->surface_at = malloc(n * sizeof(int32_t));
     out->compared = calloc(n, 1);
     out->surface = calloc((size_t)(out->surface_count ? out->surface_count : 1), sizeof *out->surface);
-    return out->frame && out->ref && out->ref_indirect && out->surface_at && out->compared && out->surface
+    return out->frame && out->ref && out->ref_indirect && out->caustic && out->ref_caustic && out->surface_at &&
+                   out->compared && out->surface
                ? LM_OK
                : lm_fail(err, LM_ERR_NOMEM, "no memory to check a %dx%d frame", out->width, out->height);
 }
@@ -153,7 +163,7 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
     lm_status st = alloc_check(sc, loop->width, loop->height, out, err);
     lm_view view;
     if (st == LM_OK)
-        st = run_frames(sc, loop, frames, out->frame, out->surface_at, &view, err);
+        st = run_frames(sc, loop, frames, out->frame, out->caustic, out->surface_at, &view, err);
     if (st == LM_OK)
         st = reference_pixels(sc, &view, ref, out, err);
     if (st == LM_OK)
@@ -163,12 +173,15 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
     return st;
 }
 
-lm_status lm_frame_check_picture(const lmgi_scene *sc, const lm_view *view, const float *rgb, int width, int height,
-                                 const lm_ref_settings *ref, lm_frame_check *out, lm_error *err)
+lm_status lm_frame_check_picture(const lmgi_scene *sc, const lm_view *view, const float *rgb, const float *caustic,
+                                 int width, int height, const lm_ref_settings *ref, lm_frame_check *out,
+                                 lm_error *err)
 {
     lm_status st = alloc_check(sc, width, height, out, err);
     if (st == LM_OK) {
         memcpy(out->frame, rgb, (size_t)width * (size_t)height * 3 * sizeof(float));
+        if (caustic)
+            memcpy(out->caustic, caustic, (size_t)width * (size_t)height * 3 * sizeof(float));
         st = lm_render_surface_index(sc->scene, &sc->surfaces, view, width, height, out->surface_at, err);
     }
     if (st == LM_OK)

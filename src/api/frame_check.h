@@ -32,12 +32,16 @@ typedef struct {
     int width, height;
     float *frame, *ref;    /* 3 floats per pixel, linear radiance, row 0 at the top */
     float *ref_indirect;   /* the reference's indirect part (reference/reference.h: the iim-like rest, shaded) */
+    float *caustic, *ref_caustic; /* the caustic part (L S+ D): what the frame's caustic pass added (kd / pi x
+                                   * E; 0 where the frame's was not read), and the reference's */
     int32_t *surface_at;   /* per pixel: surface index, -1 specular, -2 nothing */
     uint8_t *compared;     /* per pixel: 1 where it counts in `surface` (an interior pixel of a surface) */
     int surface_count;
     lm_check_sum *surface; /* per surface */
     lm_check_sum lit;      /* every compared pixel of a non-emissive surface */
     double rel_rmse;       /* relative RMSE of the frame over those pixels (lm_ref_relative_rmse) */
+    lm_check_sum caustic_lit; /* the caustic parts over the same pixels */
+    double caustic_rel_rmse; /* relative RMSE of the frame's caustic part against the reference's there */
     double ref_rel_se;     /* the reference's mean relative standard error per pixel (its own noise) */
     double ref_seconds;    /* time the reference took (its first computation when it came from the cache) */
 } lm_frame_check;
@@ -52,10 +56,12 @@ lm_status lm_frame_check_run(lmgi_scene *sc, const lm_frame_loop_settings *loop,
                              int frames, lm_frame_check *out, lm_error *err);
 void lm_frame_check_free(lm_frame_check *c);
 /* The same comparison for a picture already drawn: rgb (width x height x 3, top row first) from `view` of sc
- * as its nodes, lights and materials are now, against the reference's pixels of that view (the cache keys
- * on all of those). The surface index picture is drawn on the current GL context. */
-lm_status lm_frame_check_picture(const lmgi_scene *sc, const lm_view *view, const float *rgb, int width, int height,
-                                 const lm_ref_settings *ref, lm_frame_check *out, lm_error *err);
+ * as its nodes, lights and materials are now, and what its caustic pass added (caustic, the same layout;
+ * NULL: none), against the reference's pixels of that view (the cache keys on all of those). The surface
+ * index picture is drawn on the current GL context. */
+lm_status lm_frame_check_picture(const lmgi_scene *sc, const lm_view *view, const float *rgb, const float *caustic,
+                                 int width, int height, const lm_ref_settings *ref, lm_frame_check *out,
+                                 lm_error *err);
 /* The frame alone (what lm_frame_check_run compares): the loop's picture after `frames` frames into rgb
  * (loop->width x loop->height x 3 floats). */
 lm_status lm_frame_check_frame(lmgi_scene *sc, const lm_frame_loop_settings *loop, int frames, float *rgb,

@@ -29,7 +29,8 @@ static lm_status export_check(lm_frame_check *c, const lmgi_scene *sc, float tar
 {
     out->width = c->width, out->height = c->height;
     out->frame = c->frame, out->reference = c->ref, out->compared = c->compared;
-    c->frame = c->ref = NULL;
+    out->caustic_frame = c->caustic, out->caustic_reference = c->ref_caustic;
+    c->frame = c->ref = c->caustic = c->ref_caustic = NULL;
     c->compared = NULL;
     out->surface_count = c->surface_count;
     out->surfaces = calloc((size_t)(c->surface_count > 0 ? c->surface_count : 1), sizeof *out->surfaces);
@@ -43,6 +44,9 @@ static lm_status export_check(lm_frame_check *c, const lmgi_scene *sc, float tar
     }
     export_sum(&c->lit, &out->pixels, out->frame_mean, out->reference_mean, out->ratio);
     out->rel_rmse = c->rel_rmse;
+    uint32_t pixels;
+    export_sum(&c->caustic_lit, &pixels, out->caustic_frame_mean, out->caustic_reference_mean, out->caustic_ratio);
+    out->caustic_rel_rmse = c->caustic_rel_rmse;
     out->reference_target_error = target;
     out->reference_rel_se = c->ref_rel_se;
     out->reference_seconds = c->ref_seconds;
@@ -121,7 +125,7 @@ static lmgi_status check_updater_owned(lmgi_updater *u, const lmgi_camera *cam, 
     lm_ref_settings rs;
     if (lm_api_view(sc, cam, fn, &v, err) != LMGI_OK || lm_api_ref_settings(ref, fn, &rs, err) != LMGI_OK)
         return LMGI_ERR_INVALID;
-    float *rgb = malloc((size_t)width * (size_t)height * 3 * sizeof *rgb);
+    float *rgb = malloc((size_t)width * (size_t)height * 6 * sizeof *rgb), *caustic = rgb + (size_t)width * height * 3;
     if (!rgb)
         return lm_export_error(err, &(lm_error){LM_ERR_NOMEM, "lmgi_check_updater: no memory for the picture"});
     lmgi_context *ctx = lm_updater_context(u);
@@ -131,9 +135,11 @@ static lmgi_status check_updater_owned(lmgi_updater *u, const lmgi_camera *cam, 
     memset(&c, 0, sizeof c);
     lm_status st = lm_updater_render(u, &v, width, height, rgb, &e); /* as lmgi_render draws it */
     if (st == LM_OK)
+        st = lm_frame_loop_read_caustic_radiance(lm_updater_loop(u), caustic, &e);
+    if (st == LM_OK)
         st = lm_gl_make_current(ctx->gl, &e); /* the surface index picture is drawn on it */
     if (st == LM_OK)
-        st = lm_frame_check_picture(sc, &v, rgb, width, height, &rs, &c, &e);
+        st = lm_frame_check_picture(sc, &v, rgb, caustic, width, height, &rs, &c, &e);
     if (st == LM_OK)
         st = export_check(&c, sc, rs.target_error, out, &e);
     lm_frame_check_free(&c);
@@ -164,6 +170,8 @@ void lmgi_check_free(lmgi_check_result *c)
         return;
     free(c->frame);
     free(c->reference);
+    free(c->caustic_frame);
+    free(c->caustic_reference);
     free(c->compared);
     free(c->surfaces);
     memset(c, 0, sizeof *c);

@@ -19,6 +19,11 @@ static void print_row(const char *name, const char *material, uint32_t pixels, c
     printf("  %-24s %-24s %7u   %6.3f %6.3f %6.3f\n", name, material, pixels, ratio[0], ratio[1], ratio[2]);
 }
 
+static int has_caustics(const lmgi_check_result *c)
+{
+    return c->caustic_reference_mean[0] + c->caustic_reference_mean[1] + c->caustic_reference_mean[2] > 0.0;
+}
+
 static void report(const lmgi_scene *sc, const lmgi_check_result *c)
 {
     printf("frame %dx%d against the reference (target error %.3g: mean relative standard error per pixel %.3f, "
@@ -35,6 +40,10 @@ static void report(const lmgi_scene *sc, const lmgi_check_result *c)
     }
     print_row("frame (not emitters)", "", c->pixels, c->ratio);
     printf("relative RMSE over those pixels %.4f\n", c->rel_rmse);
+    if (has_caustics(c))
+        printf("caustic part (light off mirrors and glass, L S+ D) over those pixels: frame / reference %.3f %.3f "
+               "%.3f, relative RMSE %.4f\n", c->caustic_ratio[0], c->caustic_ratio[1], c->caustic_ratio[2],
+               c->caustic_rel_rmse);
     lm_cli_channel_check ch;
     lm_cli_surface_channels(sc, c, CHANNEL_TOLERANCE, &ch);
     printf("per channel: %d of %d surfaces of 100+ pixels within %.0f%% of the reference", ch.within, ch.surfaces,
@@ -70,6 +79,11 @@ static int write_images(lmgi_output *dir, const lmgi_check_result *c)
     lmgi_status st = lm_cli_write_image(dir, "check_frame.exr", c->width, c->height, 3, c->frame, NULL, &err);
     if (st == LMGI_OK)
         st = lm_cli_write_image(dir, "check_reference.exr", c->width, c->height, 3, c->reference, NULL, &err);
+    if (st == LMGI_OK && has_caustics(c))
+        st = lm_cli_write_image(dir, "check_caustic.exr", c->width, c->height, 3, c->caustic_frame, NULL, &err);
+    if (st == LMGI_OK && has_caustics(c))
+        st = lm_cli_write_image(dir, "check_reference_caustic.exr", c->width, c->height, 3, c->caustic_reference,
+                                NULL, &err);
     float *rgb = st == LMGI_OK ? malloc((size_t)c->width * (size_t)c->height * 3 * sizeof *rgb) : NULL;
     if (st == LMGI_OK && !rgb) {
         fprintf(stderr, "lmgi: error: no memory for the ratio picture\n");

@@ -155,6 +155,12 @@ static int frame_errors(lmgi_context *ctx, const atlas_state *as, const lmgi_upd
         }
         m->reference_rel_se = c.reference_rel_se;
         m->frame_surface_rms = lm_cli_surface_error(as->sc, &c, &m->frame_surface_worst);
+        /* the caustic part, judged like the frame (the library's relative RMSE); none without caustics */
+        m->caustic = error_of(c.caustic_frame, 3, c.caustic_reference, c.compared, n, NULL);
+        if (m->caustic.count)
+            m->caustic.rmse = c.caustic_rel_rmse;
+        for (int k = 0; k < 3; k++)
+            m->caustic_ratio[k] = m->caustic.count ? c.caustic_ratio[k] : NAN;
     } else
         fprintf(stderr, "lmgi: error: no memory for the frame's error\n");
     lmgi_check_free(&c);
@@ -222,7 +228,9 @@ static int time_and_lightmaps(lmgi_context *ctx, const atlas_state *as, const lm
 
 static void fail_row(lm_tradeoff_row *m)
 {
-    m->aim = m->iim = m->frame = (lm_tradeoff_error){NAN, NAN, NAN, 0};
+    m->aim = m->iim = m->frame = m->caustic = (lm_tradeoff_error){NAN, NAN, NAN, 0};
+    for (int k = 0; k < 3; k++)
+        m->caustic_ratio[k] = NAN;
     m->ms_trace = m->ms_aim = m->ms_gather = m->ms_solution = NAN;
     for (int k = 0; k < 8; k++)
         m->ms_update[k] = NAN;
@@ -235,7 +243,7 @@ static int measure(lmgi_context *ctx, const atlas_state *as, const lm_tradeoff_s
                    const lmgi_reference_desc *rd, int repeats, int updates, int width, int height,
                    lm_tradeoff_row *m)
 {
-    m->aim = m->iim = m->frame = (lm_tradeoff_error){NAN, NAN, NAN, 0};
+    m->aim = m->iim = m->frame = m->caustic = (lm_tradeoff_error){NAN, NAN, NAN, 0};
     lmgi_error err;
     lmgi_updater_desc d = s->desc;
     d.frame.width = width, d.frame.height = height;
@@ -410,11 +418,15 @@ static int sweep_scene(const lm_cli_args *a, lmgi_context *ctx, const char *path
          * and the command ends with exit status 1 */
         if (!measured)
             fail_row(m), sr->failed++;
-        if (measured && !a->quiet)
+        if (measured && !a->quiet) {
             fprintf(stderr, "lmgi: tradeoff %s [%d/%d] %s = %s%s: solution %.1f ms, update %.1f ms; relative RMSE "
-                    "AIM %.4f, IIM %.4f, frame %.4f (per surface %.4f)\n", sr->name, i + 1, n, set[i].knob,
+                    "AIM %.4f, IIM %.4f, frame %.4f (per surface %.4f)", sr->name, i + 1, n, set[i].knob,
                     set[i].value, same >= 0 ? " (measured above)" : "", m->ms_solution, m->ms_update[0], m->aim.rmse,
                     m->iim.rmse, m->frame.rmse, m->frame_surface_rms);
+            if (m->caustic.count)
+                fprintf(stderr, ", caustic part %.4f", m->caustic.rmse);
+            fputc('\n', stderr);
+        }
     }
     free(set);
     free_atlas(&def);

@@ -167,6 +167,11 @@ static void csv_row(FILE *f, const lm_tradeoff_scene *s, const lm_tradeoff_row *
         fputc(',', f), num(f, r->frame_ratio[k], 0);
     fputc(',', f), num(f, r->frame_surface_rms, 0);
     fputc(',', f), num(f, r->frame_surface_worst, 0);
+    fputc(',', f), num(f, r->caustic.rmse, 0);
+    fputc(',', f), num(f, r->caustic.p99, 0);
+    fputc(',', f), num(f, r->caustic.worst, 0);
+    for (int k = 0; k < 3; k++)
+        fputc(',', f), num(f, r->caustic_ratio[k], 0);
     fputc('\n', f);
 }
 
@@ -179,7 +184,8 @@ static int write_csv(const char *path, const lm_tradeoff_run *run)
     for (int k = 0; k < 8; k++)
         fprintf(f, ",%s_ms", UPDATE_PARTS[k]);
     fprintf(f, ",aim_rmse,aim_p99,aim_worst,iim_rmse,iim_p99,iim_worst,frame_rmse,frame_p99,frame_worst,"
-               "frame_bias,frame_r,frame_g,frame_b,frame_surface_rms,frame_surface_worst\n");
+               "frame_bias,frame_r,frame_g,frame_b,frame_surface_rms,frame_surface_worst,caustic_rmse,caustic_p99,"
+               "caustic_worst,caustic_r,caustic_g,caustic_b\n");
     for (int i = 0; i < run->count; i++)
         for (int j = 0; j < run->scenes[i].count; j++)
             csv_row(f, &run->scenes[i], &run->scenes[i].rows[j]);
@@ -217,7 +223,11 @@ static void json_row(FILE *f, const lm_tradeoff_row *r)
     json_error(f, "aim", &r->aim);
     json_error(f, "iim", &r->iim);
     json_error(f, "frame", &r->frame);
-    fprintf(f, ", \"frame_bias\": ");
+    json_error(f, "caustic", &r->caustic);
+    fprintf(f, ", \"caustic_ratio\": [");
+    for (int k = 0; k < 3; k++)
+        fputs(k ? ", " : "", f), num(f, r->caustic_ratio[k], 1);
+    fprintf(f, "], \"frame_bias\": ");
     num(f, r->frame_bias, 1);
     fprintf(f, ", \"frame_surface_rms\": ");
     num(f, r->frame_surface_rms, 1);

@@ -28,6 +28,8 @@ typedef struct {
     lm_tradeoff_error aim, iim, frame;
     double frame_ratio[3], frame_bias; /* frame / reference per channel; max |ratio - 1| */
     double frame_surface_rms, frame_surface_worst; /* per visible surface (tradeoff_cmd.c surface_errors) */
+    lm_tradeoff_error caustic; /* the frame's caustic part against the reference's (NAN: no caustics) */
+    double caustic_ratio[3]; /* its sum over the reference's per channel */
     double reference_rel_se; /* the pixel reference's own relative standard error */
     float *iim_map, *frame_map;
     int map_width, map_height, frame_width, frame_height;

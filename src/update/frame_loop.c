@@ -563,3 +563,9 @@ lm_status lm_frame_loop_read_caustics(lm_frame_loop *fl, float *rgb, lm_error *e
     lm_status st = lm_gl_make_current(fl->gl, err);
     return st == LM_OK ? lm_frame_passes_read_caustics(fl->passes, rgb, err) : st;
 }
+
+lm_status lm_frame_loop_read_caustic_radiance(lm_frame_loop *fl, float *rgb, lm_error *err)
+{
+    lm_status st = lm_gl_make_current(fl->gl, err);
+    return st == LM_OK ? lm_frame_passes_read_caustic_radiance(fl->passes, rgb, err) : st;
+}

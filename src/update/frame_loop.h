@@ -93,6 +93,8 @@ const uint32_t *lm_frame_loop_surface_versions(const lm_frame_loop *fl);
  * where no caustic photon's filter reached, and everywhere without caustics: the picture added kd / pi x E. */
 void lm_frame_loop_caustics_size(const lm_frame_loop *fl, int *width, int *height);
 lm_status lm_frame_loop_read_caustics(lm_frame_loop *fl, float *rgb, lm_error *err);
+/* What the caustics added to that picture, kd / pi x E (radiance, the same layout). */
+lm_status lm_frame_loop_read_caustic_radiance(lm_frame_loop *fl, float *rgb, lm_error *err);
 /* The last frame, composited (width*height*3 linear floats, top row first); the only read-back of a frame. */
 const float *lm_frame_loop_image(const lm_frame_loop *fl);
 const lm_photon_stage *lm_frame_loop_stage(const lm_frame_loop *fl);

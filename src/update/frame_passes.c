@@ -1,5 +1,6 @@
 #include "frame_passes.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -230,6 +231,22 @@ lm_status lm_frame_passes_read_caustics(const lm_frame_passes *fp, float *rgb, l
         return LM_OK;
     }
     return lm_caustic_pass_read_irradiance(fp->caustic_pass, fp->caustic_slot, rgb, err);
+}
+
+lm_status lm_frame_passes_read_caustic_radiance(const lm_frame_passes *fp, float *rgb, lm_error *err)
+{
+    lm_status st = lm_frame_passes_read_caustics(fp, rgb, err);
+    if (st != LM_OK || !drawn_caustics(fp))
+        return st;
+    size_t n = 3 * (size_t)fp->caustic_w * (size_t)fp->caustic_h;
+    float *kd = malloc((n ? n : 1) * sizeof *kd);
+    if (!kd)
+        return lm_fail(err, LM_ERR_NOMEM, "no memory to read the caustics' kd");
+    st = lm_frame_targets_read_kd(lm_direct_targets(fp->direct), kd, err);
+    for (size_t i = 0; st == LM_OK && i < n; i++) /* what the composite added (caustic_composite_fs.glsl) */
+        rgb[i] *= kd[i] / (float)M_PI;
+    free(kd);
+    return st;
 }
 
 int lm_frame_passes_faces(const lm_frame_passes *fp) { return lm_reflections_face_count(fp->reflections); }

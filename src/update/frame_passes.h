@@ -63,5 +63,7 @@ void lm_frame_passes_limit_faces(lm_frame_passes *fp, int most);
 /* The caustic irradiance of the last picture drawn (lm_frame_loop_read_caustics says what). */
 void lm_frame_passes_caustics_size(const lm_frame_passes *fp, int *width, int *height);
 lm_status lm_frame_passes_read_caustics(const lm_frame_passes *fp, float *rgb, lm_error *err);
+/* What the caustics added to that picture: kd / pi x E at each pixel (radiance, the same layout). */
+lm_status lm_frame_passes_read_caustic_radiance(const lm_frame_passes *fp, float *rgb, lm_error *err);
 
 #endif

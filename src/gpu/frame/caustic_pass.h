@@ -27,8 +27,10 @@
  *            Sized by density (filter_photons > 0): where the (2k + 1)^2 pixels around x hold fewer than
  *            filter_photons photons (counted from the splat's mipmaps), the same (2k + 1)^2 taps lie s
  *            pixels apart, each reading the splat's mean over s x s pixels (trilinear mipmaps), s up to
- *            2^LM_CAUSTIC_FILTER_LEVELS chosen so the window holds about filter_photons: a focal spot keeps
- *            the paper's filter, thin light is spread over more pixels instead of showing each photon.
+ *            2^LM_CAUSTIC_FILTER_LEVELS chosen so the window holds about filter_photons: thin light is
+ *            spread over more pixels instead of showing each photon. Where the window holds more than
+ *            128 photons (a focal spot) the screen filter's taps close in, down to 1/16 pixel apart, until
+ *            it holds about 128: the spot as sharp as its photons allow.
  *            Elsewhere E is 0.
  *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
  *            lobe the direct light's first pass wrote there: frame_targets.h).

@@ -36,6 +36,18 @@ unsigned lm_frame_targets_kd(const lm_frame_targets *f, int which) { return f->t
 unsigned lm_frame_targets_depth(const lm_frame_targets *f, int which) { return f->t[which].depth; }
 unsigned lm_frame_targets_gbuffer(const lm_frame_targets *f) { return f->t[LM_FRAME_VIEW].color[2]; }
 
+lm_status lm_frame_targets_read_kd(const lm_frame_targets *f, float *rgb, lm_error *err)
+{
+    const lm_float_target *t = &f->t[LM_FRAME_VIEW];
+    float *rgba = malloc(((size_t)t->width * (size_t)t->height + 1) * 4 * sizeof *rgba);
+    if (!rgba)
+        return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory to read back kd of %dx%d", t->width, t->height);
+    lm_float_target_read_rgb(t, 1, rgb, rgba);
+    free(rgba);
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    return lm_gl_check("direct_light: reading back kd", err);
+}
+
 lm_status lm_frame_targets_read(lm_frame_targets *f, float *rgb, lm_error *err)
 {
     const lm_float_target *t = &f->t[LM_FRAME_VIEW];

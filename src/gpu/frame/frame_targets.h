@@ -50,5 +50,7 @@ unsigned lm_frame_targets_gbuffer(const lm_frame_targets *f);
 /* The view's radiance read back as RGB floats (width x height x 3, row 0 at the top). Errors: out of
  * memory for the read-back, a GL error. */
 lm_status lm_frame_targets_read(lm_frame_targets *f, float *rgb, lm_error *err);
+/* The view's kd (attachment 1) read back the same way. */
+lm_status lm_frame_targets_read_kd(const lm_frame_targets *f, float *rgb, lm_error *err);
 
 #endif

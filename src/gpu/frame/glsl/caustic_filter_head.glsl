@@ -21,7 +21,7 @@ vec3 view_pos(ivec2 q) {
 // count grows 4x a level, so s moves continuously from one level to the next); where they hold more than
 // SHARP, smaller, down to `smallest`, so that the window holds about SHARP (a focal spot stays sharp).
 // 0 when no photon lies within the widest window.
-const float SHARP = 512.0;
+const float SHARP = 128.0;
 float filter_scale(vec2 c, float smallest) {
     if (need <= 0.0) return 1.0;
     float side = float(2 * K + 1), lw = log2(side);
