@@ -26,7 +26,7 @@
  *                / (pi R^2 / 3): photons on another surface than x's (a depth step) do not leak.
  *            Sized by density (filter_photons > 0): where the (2k + 1)^2 pixels around x hold fewer than
  *            filter_photons photons (counted from the splat's mipmaps), the same (2k + 1)^2 taps lie s
- *            pixels apart, each reading the splat's mean over s x s pixels (trilinear mipmaps), s up to
+ *            pixels apart, each reading the splat's mean over about 2s pixels (its mipmaps), s up to
  *            2^LM_CAUSTIC_FILTER_LEVELS chosen so the window holds about filter_photons: thin light is
  *            spread over more pixels instead of showing each photon. Where the window holds more than
  *            128 photons (a focal spot) the screen filter's taps close in, down to 1/16 pixel apart, until

@@ -15,18 +15,19 @@ vec3 view_pos(ivec2 q) {
     return v.xyz / v.w;
 }
 // The filter's scale s at pixel centre c: its taps lie s pixels apart, each the splat's mean over about
-// 2s pixels (its mipmaps). 1 (the paper's filter) where its (2k + 1)^2 pixels hold `need` photons; where
-// they hold fewer, the scale whose window of (2k + 1) s pixels a side holds about that many, up to
-// 2^levels (photons counted from the mipmaps of flux's alpha, photons a pixel; for an even density the
-// count grows 4x a level, so s moves continuously from one level to the next); where they hold more than
-// SHARP, smaller, down to `smallest`, so that the window holds about SHARP (a focal spot stays sharp).
-// 0 when no photon lies within the widest window.
+// 2s pixels (its mipmaps, the nearest level). 1 (the paper's filter) where the window around it (the
+// 2^lw >= 2k + 1 pixels a side of one mip level, read bilinearly) holds `need` photons; where it holds
+// fewer, the scale whose window of 2^lw s pixels holds about that many, up to 2^levels (photons counted
+// from the mipmaps of flux's alpha, photons a pixel; for an even density the count grows 4x a level, so
+// s moves continuously from one level to the next); where it holds more than SHARP, smaller, down to
+// `smallest`, so that it holds about SHARP (a focal spot stays sharp). 0 when no photon lies within the
+// widest window.
 const float SHARP = 128.0;
 float filter_scale(vec2 c, float smallest) {
     if (need <= 0.0) return 1.0;
-    float side = float(2 * K + 1), lw = log2(side);
+    float lw = ceil(log2(float(2 * K + 1))); // the window: the mip level whose texels span 2k + 1 pixels or more
     for (int L = 0; L <= levels; L++) {
-        float s = exp2(float(L)), w = side * s;
+        float s = exp2(float(L)), w = exp2(float(L) + lw);
         float n = textureLod(flux, c / size, float(L) + lw).a * w * w;
         if (n >= need && L == 0) return clamp(sqrt(max(SHARP, need) / n), smallest, 1.0);
         if (n >= need) return max(0.5 * s, s * sqrt(need / n));
