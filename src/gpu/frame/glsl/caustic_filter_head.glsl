@@ -35,4 +35,6 @@ float filter_scale(vec2 c, float smallest) {
     }
     return exp2(float(levels));
 }
+// Whether pixel c shows a receiver (the mask in irr's alpha): elsewhere nothing shows a caustic, E is 0.
+bool receiver(vec2 c) { return texelFetch(irr, ivec2(c), 0).a > 0.0; }
 bool on_screen(vec2 q) { return all(greaterThanEqual(q, vec2(0.0))) && all(lessThan(q, size)); }

@@ -5,6 +5,7 @@
 #include "caustic_filter_head.glsl"
 void main() {
     vec2 xc = gl_FragCoord.xy;
+    if (!receiver(xc)) { frag = vec4(0.0); return; }
     ivec2 x = ivec2(xc);
     vec3 px = view_pos(x);
     float s = filter_scale(xc, 1.0), lod = min(2.0 * log2(s), log2(s) + 1.0);
