@@ -1114,9 +1114,9 @@ static void test_tradeoff(void **state)
     char header[4096], line[4096], v[64];
     assert_non_null(fgets(header, sizeof header, f));
     static const char *const names[] = {"knob", "value", "default", "photons", "solution_ms", "update_ms",
-                                        "aim_rmse", "iim_rmse", "frame_rmse", "frame_r"};
-    int col[10];
-    for (int k = 0; k < 10; k++)
+                                        "aim_rmse", "iim_rmse", "frame_rmse", "frame_r", "caustic_rmse", "caustic_g"};
+    int col[12];
+    for (int k = 0; k < 12; k++)
         assert_true((col[k] = csv_column(header, names[k])) >= 0);
     double aim[3] = {0.0, 0.0, 0.0};
     int rows = 0, defaults = 0;
@@ -1148,6 +1148,15 @@ static void test_tradeoff(void **state)
                       x[4], x[5]);
         assert_true(x[3] < 0.2);
         assert_true(fabs(x[5] - 1.0) < 0.1);
+        double caustic[2]; /* the box's mirror and glass spheres: a caustic part against the reference's */
+        for (int k = 0; k < 2; k++) {
+            csv_field(line, col[10 + k], v, sizeof v);
+            caustic[k] = v[0] ? atof(v) : NAN;
+        }
+        print_message("tradeoff: caustic part relative RMSE %.3f, its sum %.3f of the reference's\n", caustic[0],
+                      caustic[1]);
+        assert_true(isfinite(caustic[0]) && caustic[0] > 0.0 && caustic[0] < 1.0);
+        assert_true(fabs(caustic[1] - 1.0) < 0.25);
         rows++;
     }
     fclose(f);
