@@ -106,12 +106,14 @@ static void print_filter(void)
     }
     float screen = 2.0f * 6.0f * tanf((float)(LM_PI / 6.0)); /* the floor's width the picture spans */
     static const double cover[4] = {0.01, 0.05, 0.25, 1.0};
-    printf("\ncaustic pass at %d x %d, %d photons, k = 3 (the paper's 7 x 7), %d-pixel tiles; ms, median of %d:\n",
-           SIZE, SIZE, PHOTONS, 32, REPEATS);
-    printf("%-9s %11s %8s %8s %8s %10s %8s %9s\n", "covered", "tiles lit", "splat", "queries", "filter", "composite",
-           "total", "paper");
     lm_caustic_pass_settings set;
     lm_caustic_pass_settings_default(&set);
+    for (int sized = 0; sized < 2; sized++) { /* the paper's fixed filter, then sized by density (the default) */
+    printf("\ncaustic pass at %d x %d, %d photons, k = 3, %s, %d-pixel tiles; ms, median of %d:\n", SIZE, SIZE,
+           PHOTONS, sized ? "sized by density (32 photons)" : "the paper's fixed 7 x 7", 32, REPEATS);
+    printf("%-9s %11s %8s %8s %8s %10s %8s %9s\n", "covered", "tiles lit", "splat", "queries", "filter", "composite",
+           "total", "paper");
+    set.filter_photons = sized ? 32 : 0;
     if (lm_caustic_pass_create(&set, &cp, &err) != LM_OK) {
         printf("caustic pass: %s\n", err.msg);
         goto done;
@@ -133,6 +135,7 @@ static void print_filter(void)
     printf("filter at 5%% / full screen: %.3f (target <= 0.10)\n", five_filter / full_filter);
     lm_caustic_pass_free(cp);
     cp = NULL;
+    }
     /* queries alone: 100 tiles of 52 pixels (10 x 10 over 512) */
     set.tile = 52;
     if (lm_caustic_pass_create(&set, &cp, &err) == LM_OK) {
