@@ -324,6 +324,14 @@ int lmt_texel_mean(const float *rgba, size_t n, double mean[3])
     return texels;
 }
 
+void lmt_reference_pixels(lmgi_scene *sc, const lmgi_camera *cam, int side, float target_error, lmgi_reference *ref)
+{
+    lmgi_reference_desc d = {.target_error = target_error, .no_cache = 1};
+    lmgi_error e;
+    if (lmgi_reference_pixels(sc, &d, cam, side, side, ref, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+}
+
 int lmt_reference_mean(lmgi_scene *sc, float target_error, double mean[3])
 {
     lmgi_reference_desc d;

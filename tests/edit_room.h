@@ -80,6 +80,9 @@ int lmt_texel_mean(const float *rgba, size_t n, double mean[3]);
 /* The reference's texels for sc (lmgi_reference_texels at target_error, uncached): their mean over the
  * atlas's texels (the gutters are 0); returns how many. */
 int lmt_reference_mean(lmgi_scene *sc, float target_error, double mean[3]);
+/* The reference's pixels (side x side) of sc from cam at target_error, solved anew (no cache); fails the
+ * test on an error. */
+void lmt_reference_pixels(lmgi_scene *sc, const lmgi_camera *cam, int side, float target_error, lmgi_reference *ref);
 /* Asserts that st is LMGI_ERR_INVALID with a message naming `words`. */
 void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words);
 

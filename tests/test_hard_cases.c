@@ -738,23 +738,34 @@ static void quad(float out[12], const float c[3], const float u[3], const float 
     }
 }
 
-/* An updater at the defaults, its first update done. */
-static lmgi_updater *spec_updater(lmgi_context *ctx, lmgi_scene *sc)
+/* A specular case's run: an updater at the defaults with its first update done, and the reference's
+ * pixels from cam at `target` (SPEC_SIDE a side; target 0: none, the case checks against its own). */
+typedef struct {
+    lmgi_context *ctx;
+    lmgi_updater *u;
+    lmgi_camera cam;
+    lmgi_reference ref;
+} spec_run;
+
+static void spec_start(spec_run *r, lmgi_scene *sc, const float eye[3], const float at[3], float fov, float target)
 {
-    lmgi_updater *u = updater(ctx, sc, NULL);
+    lmt_look_at(eye, at, fov, &r->cam);
+    r->ctx = lmt_context();
+    memset(&r->ref, 0, sizeof r->ref);
+    if (target > 0.0f)
+        lmt_reference_pixels(sc, &r->cam, SPEC_SIDE, target, &r->ref);
+    r->u = updater(r->ctx, sc, NULL);
     lmgi_update_stats st;
     lmgi_error e;
-    if (lmgi_update(u, 0.0f, 0.0f, &st, &e) != LMGI_OK)
+    if (lmgi_update(r->u, 0.0f, 0.0f, &st, &e) != LMGI_OK)
         fail_msg("%s", e.message);
-    return u;
 }
 
-static void spec_reference(lmgi_scene *sc, const lmgi_camera *cam, float target, lmgi_reference *ref)
+static void spec_end(spec_run *r)
 {
-    lmgi_reference_desc d = {.target_error = target, .no_cache = 1};
-    lmgi_error e;
-    if (lmgi_reference_pixels(sc, &d, cam, SPEC_SIDE, SPEC_SIDE, ref, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
+    lmgi_reference_free(&r->ref);
+    lmgi_updater_free(r->u);
+    lmgi_context_free(r->ctx);
 }
 
 /* The runtime's caustic light (kd / pi x the caustic pass's E, green) against the reference's caustic
@@ -828,21 +839,15 @@ static void test_grazing_caustic(void **state)
                         .triangle_count = 2};
     lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 10.0f, .position = {0, 0.05f, 0}};
     lmgi_scene *sc = floor_and("grazing caustic", 4.0f, &m, 1, &chrome, &lamp);
-    lmgi_camera cam;
-    lmt_look_at((const float[3]){1.5f, 2.0f, 2.0f}, (const float[3]){-0.3f, 0, 0}, 0.9f, &cam);
-    lmgi_context *ctx = lmt_context();
-    lmgi_reference ref;
-    spec_reference(sc, &cam, 0.2f, &ref);
-    lmgi_updater *u = spec_updater(ctx, sc);
+    spec_run run;
+    spec_start(&run, sc, (const float[3]){1.5f, 2.0f, 2.0f}, (const float[3]){-0.3f, 0, 0}, 0.9f, 0.2f);
     int n;
-    double r = caustic_ratio(u, &cam, &ref, 0.8, 0.1, &n);
+    double r = caustic_ratio(run.u, &run.cam, &run.ref, 0.8, 0.1, &n);
     print_message("grazing caustic: %d pixels, power %.4f of the reference's caustic part\n", n, r);
     assert_true(n > 100);
     assert_true(fabs(r - 1.0) < 0.15);
-    lmgi_reference_free(&ref);
-    lmgi_updater_free(u);
+    spec_end(&run);
     lmgi_free(sc);
-    lmgi_context_free(ctx);
 }
 
 /* A generator touching its receiver: a glass ball (r 0.3) resting on the floor under a lamp at (-1, 3, 0),
@@ -860,22 +865,16 @@ static void test_caustic_generator_touching(void **state)
                         .triangle_count = t};
     lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 10.0f, .position = {-1, 3, 0}};
     lmgi_scene *sc = floor_and("ball on the floor", 4.0f, &m, 1, &glass, &lamp);
-    lmgi_camera cam;
-    lmt_look_at((const float[3]){1.4f, 1.3f, 0.9f}, (const float[3]){0.1f, 0, 0}, 0.6f, &cam);
-    lmgi_context *ctx = lmt_context();
-    lmgi_reference ref;
-    spec_reference(sc, &cam, 0.2f, &ref);
-    lmgi_updater *u = spec_updater(ctx, sc);
+    spec_run run;
+    spec_start(&run, sc, (const float[3]){1.4f, 1.3f, 0.9f}, (const float[3]){0.1f, 0, 0}, 0.6f, 0.2f);
     int n;
-    double r = caustic_ratio(u, &cam, &ref, 0.8, 0.1, &n);
+    double r = caustic_ratio(run.u, &run.cam, &run.ref, 0.8, 0.1, &n);
     print_message("glass ball touching the floor: focal spot %d pixels, power %.4f of the reference's caustic part\n",
                   n, r);
     assert_true(n > 20);
     assert_true(fabs(r - 1.0) < 0.10);
-    lmgi_reference_free(&ref);
-    lmgi_updater_free(u);
+    spec_end(&run);
     lmgi_free(sc);
-    lmgi_context_free(ctx);
 }
 
 /* Total internal reflection: a glass prism (a 45-45-90 triangle, legs 0.6 m, 0.8 m long) whose top leg is
@@ -913,22 +912,16 @@ static void test_caustic_total_internal_reflection(void **state)
     const lmgi_material_desc mats[2] = {glass, {.name = "white wall", .base_color = {0.8f, 0.8f, 0.8f, 1}}};
     lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 1000.0f, .position = {0.3f, 10, 0}};
     lmgi_scene *sc = floor_and("prism", 3.0f, m, 2, mats, &lamp);
-    lmgi_camera cam;
-    lmt_look_at((const float[3]){1.2f, 1.6f, 2.2f}, (const float[3]){-1.5f, 0.7f, 0}, 0.8f, &cam);
-    lmgi_context *ctx = lmt_context();
-    lmgi_reference ref;
-    spec_reference(sc, &cam, 0.2f, &ref);
-    lmgi_updater *u = spec_updater(ctx, sc);
+    spec_run run;
+    spec_start(&run, sc, (const float[3]){1.2f, 1.6f, 2.2f}, (const float[3]){-1.5f, 0.7f, 0}, 0.8f, 0.2f);
     int n;
-    double r = caustic_ratio(u, &cam, &ref, 0.8, 0.1, &n);
+    double r = caustic_ratio(run.u, &run.cam, &run.ref, 0.8, 0.1, &n);
     print_message("prism, total internal reflection: band %d pixels, power %.4f of the reference's caustic part\n", n,
                   r);
     assert_true(n > 100);
     assert_true(fabs(r - 1.0) < 0.10);
-    lmgi_reference_free(&ref);
-    lmgi_updater_free(u);
+    spec_end(&run);
     lmgi_free(sc);
-    lmgi_context_free(ctx);
 }
 
 /* The frame's pixels that show a mirror (their eye ray and their 4 neighbours' meet it first: the
@@ -977,27 +970,21 @@ static void test_mirror_facing_mirror(void **state)
     const lmgi_material_desc mats[2] = {chrome, chrome};
     lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 5.0f, .position = {0.2f, 1.5f, 0.3f}};
     lmgi_scene *sc = floor_and("two mirrors", 3.0f, m, 2, mats, &lamp);
-    lmgi_camera cam;
-    lmt_look_at((const float[3]){0.3f, 1.4f, 2.8f}, (const float[3]){-1, 0.6f, 0}, 0.8f, &cam);
-    lmgi_context *ctx = lmt_context();
-    lmgi_reference ref;
-    spec_reference(sc, &cam, 0.1f, &ref);
-    lmgi_updater *u = spec_updater(ctx, sc);
+    spec_run run;
+    spec_start(&run, sc, (const float[3]){0.3f, 1.4f, 2.8f}, (const float[3]){-1, 0.6f, 0}, 0.8f, 0.1f);
     int n, nm;
-    double r = caustic_ratio(u, &cam, &ref, 0.8, 0.1, &n);
+    double r = caustic_ratio(run.u, &run.cam, &run.ref, 0.8, 0.1, &n);
     static float frame[3 * SPEC_PIXELS];
     lmgi_error e;
-    assert_int_equal(lmgi_render(u, &cam, SPEC_SIDE, SPEC_SIDE, frame, &e), LMGI_OK);
-    double rmse, rm = mirror_ratio(frame, &ref, &rmse, &nm);
+    assert_int_equal(lmgi_render(run.u, &run.cam, SPEC_SIDE, SPEC_SIDE, frame, &e), LMGI_OK);
+    double rmse, rm = mirror_ratio(frame, &run.ref, &rmse, &nm);
     print_message("mirror facing a mirror: floor caustic %d pixels, power %.4f of the reference's; mirror %d pixels, "
                   "%.4f of the reference's reflections (relative RMSE %.3f)\n", n, r, nm, rm, rmse);
     assert_true(n > 100 && nm > 300);
     assert_true(fabs(r - 1.0) < 0.10);
     assert_true(rm > 0.3 && rm < 1.0); /* the first image of the other mirror, not the rest (one bounce) */
-    lmgi_reference_free(&ref);
-    lmgi_updater_free(u);
+    spec_end(&run);
     lmgi_free(sc);
-    lmgi_context_free(ctx);
 }
 
 /* A metal floor (gold, 0.9 0.7 0.3) at roughness 0.01 (a mirror) and 1.0 (glossy) in a closed room (half
@@ -1030,28 +1017,24 @@ static void test_glossy_floor_roughness(void **state)
                                            "\"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]",
                                            mats);
         lmgi_scene *sc = lmt_load(path, 1500);
-        lmgi_camera cam;
-        lmt_look_at((const float[3]){1.5f, 0.2f, 1.8f}, (const float[3]){-0.3f, -2, -0.3f}, 0.9f, &cam);
-        lmgi_context *ctx = lmt_context();
-        lmgi_updater *u = spec_updater(ctx, sc);
+        spec_run run; /* the mirror against the reference's reflections; the glossy floor checks its own */
+        spec_start(&run, sc, (const float[3]){1.5f, 0.2f, 1.8f}, (const float[3]){-0.3f, -2, -0.3f}, 0.9f,
+                   glossy ? 0.0f : 0.05f);
         lmgi_error e;
         if (!glossy) {
             static float frame[3 * SPEC_PIXELS];
-            assert_int_equal(lmgi_render(u, &cam, SPEC_SIDE, SPEC_SIDE, frame, &e), LMGI_OK);
+            assert_int_equal(lmgi_render(run.u, &run.cam, SPEC_SIDE, SPEC_SIDE, frame, &e), LMGI_OK);
             assert_true(all_finite(frame, 3 * SPEC_PIXELS));
-            lmgi_reference ref;
-            spec_reference(sc, &cam, 0.05f, &ref);
             int n;
-            double rmse, r = mirror_ratio(frame, &ref, &rmse, &n);
+            double rmse, r = mirror_ratio(frame, &run.ref, &rmse, &n);
             print_message("metal floor at roughness 0.01 (a mirror): %d pixels, %.4f of the reference's reflections "
                           "(relative RMSE %.3f)\n", n, r, rmse);
             assert_true(n > 1000);
             assert_true(fabs(r - 1.0) < 0.10);
-            lmgi_reference_free(&ref);
         } else {
             lmgi_reference_desc rd = {.target_error = 0.05f, .no_cache = 1};
             lmgi_check_result c;
-            assert_int_equal(lmgi_check_updater(u, &cam, SPEC_SIDE, SPEC_SIDE, &rd, &c, &e), LMGI_OK);
+            assert_int_equal(lmgi_check_updater(run.u, &run.cam, SPEC_SIDE, SPEC_SIDE, &rd, &c, &e), LMGI_OK);
             assert_true(all_finite(c.frame, 3 * SPEC_PIXELS));
             const lmgi_check_surface *f = NULL;
             int fl = lmgi_find_node(sc, "metal floor");
@@ -1067,9 +1050,8 @@ static void test_glossy_floor_roughness(void **state)
                 assert_true(fabs(f->ratio[k] - 1.0) < 0.15 && fabs(c.ratio[k] - 1.0) < 0.10);
             lmgi_check_free(&c);
         }
-        lmgi_updater_free(u);
+        spec_end(&run);
         lmgi_free(sc);
-        lmgi_context_free(ctx);
     }
 }
 

@@ -40,14 +40,6 @@ static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, uint32_t caustic
     return u;
 }
 
-static void reference(lmgi_scene *sc, const lmgi_camera *cam, float target, lmgi_reference *ref)
-{
-    lmgi_reference_desc d = {.target_error = target, .no_cache = 1};
-    lmgi_error e;
-    if (lmgi_reference_pixels(sc, &d, cam, SIDE, SIDE, ref, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-}
-
 /* A glass ball (r 0.3, ior 1.5) 0.5 m over a white floor (0.8) under a 10 cd lamp at (-1, 3, 0): its focal
  * spot near (0.2, 0, 0), seen from the side. The runtime's caustic there (kd / pi x the caustic pass's
  * E), screen-space filter (sized by density, the default; and the paper's fixed one) and world-space,
@@ -79,7 +71,7 @@ static void test_glass_focal_spot(void **state)
     lmt_look_at((const float[3]){1.4f, 1.3f, 0.9f}, (const float[3]){0.2f, 0.0f, 0.0f}, 0.6f, &cam);
     lmgi_context *ctx = lmt_context();
     lmgi_reference ref;
-    reference(sc, &cam, 0.2f, &ref);
+    lmt_reference_pixels(sc, &cam, SIDE, 0.2f, &ref);
     /* the spot: pixels where the reference's caustic exceeds a tenth of its brightest, grown by 4 pixels */
     double peak = 0.0;
     for (int i = 0; i < PIXELS; i++)
@@ -235,7 +227,7 @@ static void test_mirror_sphere_pixels(void **state)
     static float frame[3 * PIXELS];
     assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, frame, &e), LMGI_OK);
     lmgi_reference ref;
-    reference(sc, &cam, 0.05f, &ref);
+    lmt_reference_pixels(sc, &cam, SIDE, 0.05f, &ref);
     double rmse, ratio;
     int n;
     compare_mirror(frame, &ref, &rmse, &ratio, &n);
@@ -266,7 +258,7 @@ static void test_wall_mirror_box_projection(void **state)
         lmgi_error e;
         assert_int_equal(lmgi_render(u, &cam, SIDE, SIDE, frame, &e), LMGI_OK);
         lmgi_reference ref;
-        reference(sc, &cam, 0.05f, &ref);
+        lmt_reference_pixels(sc, &cam, SIDE, 0.05f, &ref);
         compare_mirror(frame, &ref, &rmse[box], &ratio[box], &n[box]);
         lmgi_reference_free(&ref);
         lmgi_updater_free(u);
