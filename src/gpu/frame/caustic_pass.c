@@ -21,7 +21,6 @@ void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
     s->filter_photons = 32;
 }
 
-
 /* A photon as the splat reads it: position, receiver normal (arrival side), flux. */
 #define PHOTON_FLOATS 9
 
@@ -100,7 +99,7 @@ static void free_slot(slot_targets *t)
     memset(t, 0, sizeof *t);
 }
 
-/* An RGBA32F texture, with its whole mipmap chain (trilinear) when `mipmaps`. */
+/* An RGBA32F texture, with its whole mipmap chain when `mipmaps` (read from the nearest level, bilinearly). */
 static GLuint float_texture(int w, int h, int mipmaps)
 {
     GLuint t;
