@@ -62,6 +62,15 @@ static lm_caustic_pass *run(fixture *f, const lm_caustic_pass_settings *set, lm_
     return cp;
 }
 
+/* The pass's irradiance E (W x H x 3) for set over the fixture's photons, the pass freed. */
+static void irradiance(fixture *f, const lm_caustic_pass_settings *set, lm_caustic_pass_stats *st, float *E)
+{
+    lm_caustic_pass *cp = run(f, set, st);
+    lm_error err;
+    assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
+    lm_caustic_pass_free(cp);
+}
+
 /* The floor point pixel (x, y) (row 0 at the top) sees: the camera looks straight down from y = 4. */
 static void floor_point(int x, int y, double *wx, double *wz)
 {
@@ -125,16 +134,13 @@ static void test_mirror_caustic(void **state)
             set.world_space = world;
             set.filter_photons = sized ? 32 : 0;
             lm_caustic_pass_stats st;
-            lm_caustic_pass *cp = run(&f, &set, &st);
             static float E[3 * W * H];
-            lm_error err;
-            assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
+            irradiance(&f, &set, &st, E);
             char what[64];
             snprintf(what, sizeof what, "%s, %s filter", sized ? "sized" : "fixed", world ? "world-space" : "screen-space");
             print_message("%s: %u photons, %llu splatted, %d of %d tiles lit, %llu pixels filtered\n", what, st.photons,
                           (unsigned long long)st.splatted, st.tiles_lit, st.tiles, (unsigned long long)st.pixels_filtered);
             check_image(E, set.filter_k, sized ? set.filter_k << LM_CAUSTIC_FILTER_LEVELS : set.filter_k, what);
-            lm_caustic_pass_free(cp);
         }
     teardown(&f);
 }
@@ -229,10 +235,8 @@ static void test_thin_light(void **state)
         lm_caustic_pass_settings_default(&set);
         set.filter_photons = sized ? 32 : 0;
         lm_caustic_pass_stats st;
-        lm_caustic_pass *cp = run(&f, &set, &st);
         static float E[3 * W * H];
-        lm_error err;
-        assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E, &err), LM_OK);
+        irradiance(&f, &set, &st, E);
         double d2 = 0.0, a2 = 0.0, sum = 0.0, want = 0.0;
         int n = 0;
         for (int y = 0; y < H; y++)
@@ -257,7 +261,6 @@ static void test_thin_light(void **state)
                       "%.3f\n", sized ? "sized" : "fixed", (unsigned long long)st.splatted, n, mean[sized], rmse[sized]);
         assert_true(n > 500);
         assert_true(fabs(mean[sized] - 1.0) < 0.10);
-        lm_caustic_pass_free(cp);
     }
     assert_true(rmse[1] < 0.5 * rmse[0]);
     teardown(&f);

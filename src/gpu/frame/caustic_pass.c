@@ -38,18 +38,17 @@ typedef struct {
     int splat_held[4], irr_held[4];
 } slot_targets;
 
-/* The pixel box of the lit tiles (grown by `grow` pixels, clamped to the target); empty (x1 <= x0) when none. */
-static void lit_box(const slot_targets *t, int tile, int grow, int box[4])
+/* The pixel box of the lit tiles (clamped to the target); empty (x1 <= x0) when none. */
+static void lit_box(const slot_targets *t, int tile, int box[4])
 {
     box[0] = t->width, box[1] = t->height, box[2] = box[3] = 0;
     for (int ty = 0; ty < t->tiles_y; ty++)
         for (int tx = 0; tx < t->tiles_x; tx++)
             if (t->lit[ty * t->tiles_x + tx]) {
-                int x0 = tx * tile - grow, y0 = ty * tile - grow, x1 = (tx + 1) * tile + grow, y1 = (ty + 1) * tile + grow;
+                int x0 = tx * tile, y0 = ty * tile, x1 = (tx + 1) * tile, y1 = (ty + 1) * tile;
                 box[0] = x0 < box[0] ? x0 : box[0], box[1] = y0 < box[1] ? y0 : box[1];
                 box[2] = x1 > box[2] ? x1 : box[2], box[3] = y1 > box[3] ? y1 : box[3];
             }
-    box[0] = box[0] < 0 ? 0 : box[0], box[1] = box[1] < 0 ? 0 : box[1];
     box[2] = box[2] > t->width ? t->width : box[2], box[3] = box[3] > t->height ? t->height : box[3];
 }
 
@@ -464,7 +463,7 @@ static void query_tiles(lm_caustic_pass *cp, slot_targets *t, lm_caustic_pass_st
     }
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glDisable(GL_STENCIL_TEST);
-    lit_box(t, cp->set.tile, 0, t->splat_held); /* photons landed in lit tiles only */
+    lit_box(t, cp->set.tile, t->splat_held); /* photons landed in lit tiles only */
     st->tiles = t->tiles_x * t->tiles_y;
     st->tiles_lit = lit;
 }

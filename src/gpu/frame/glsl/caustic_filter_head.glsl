@@ -35,6 +35,10 @@ float filter_scale(vec2 c, float smallest) {
     }
     return exp2(float(levels));
 }
+// The mip level a tap s pixels from the next reads: the mean over about twice its spacing (2 log2 s up to
+// s = 2, then log2 s + 1), so the taps overlap instead of sampling the mipmaps at a stride that beats
+// with their texels; below 0 (s < 1) level 0, read between its texels.
+float tap_lod(float s) { return min(2.0 * log2(s), log2(s) + 1.0); }
 // Whether pixel c shows a receiver (the mask in irr's alpha): elsewhere nothing shows a caustic, E is 0.
 bool receiver(vec2 c) { return texelFetch(irr, ivec2(c), 0).a > 0.0; }
 bool on_screen(vec2 q) { return all(greaterThanEqual(q, vec2(0.0))) && all(lessThan(q, size)); }

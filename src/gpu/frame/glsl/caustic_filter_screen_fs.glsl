@@ -6,9 +6,7 @@
 void main() {
     vec2 x = gl_FragCoord.xy;
     if (!receiver(x)) { frag = vec4(0.0); return; }
-    // each tap reads the mean over twice its spacing (2 log2 s levels up to s = 2, then log2 s + 1), so the
-    // taps overlap instead of sampling the splat's mipmaps at a stride that beats with their texels
-    float s = filter_scale(x, 1.0 / 16.0), lod = min(2.0 * log2(s), log2(s) + 1.0);
+    float s = filter_scale(x, 1.0 / 16.0), lod = tap_lod(s);
     if (s == 0.0) { frag = vec4(0.0); return; }
     float top = sqrt(1.0 + 2.0 * float(K * K)), wsum = 0.0;
     vec3 e = vec3(0.0);

@@ -8,7 +8,7 @@ void main() {
     if (!receiver(xc)) { frag = vec4(0.0); return; }
     ivec2 x = ivec2(xc);
     vec3 px = view_pos(x);
-    float s = filter_scale(xc, 1.0), lod = min(2.0 * log2(s), log2(s) + 1.0);
+    float s = filter_scale(xc, 1.0), lod = tap_lod(s);
     if (s == 0.0) { frag = vec4(0.0); return; }
     float R = max(float(K), 0.5) * s * (ortho != 0 ? pix_side : -px.z * pix_side);
     vec3 e = vec3(0.0);

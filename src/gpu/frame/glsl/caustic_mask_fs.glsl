@@ -5,7 +5,8 @@
 uniform sampler2D kd;
 uniform int have_kd;
 layout(location = 0) out vec4 frag;
+#include "caustic_receiver.glsl"
 void main() {
-    vec3 k = have_kd != 0 ? texelFetch(kd, ivec2(gl_FragCoord.xy), 0).rgb : vec3(1.0);
-    frag = vec4(0.0, 0.0, 0.0, any(greaterThan(k, vec3(0.0))) ? 1.0 : 0.0);
+    bool shows = have_kd == 0 || shows_caustic(texelFetch(kd, ivec2(gl_FragCoord.xy), 0).rgb);
+    frag = vec4(0.0, 0.0, 0.0, shows ? 1.0 : 0.0);
 }

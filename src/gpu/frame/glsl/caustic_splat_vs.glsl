@@ -12,6 +12,7 @@ uniform float pix_area, pix_side;
 uniform sampler2D depth, kd;
 uniform int have_kd;
 out vec3 v_irr, v_flux;
+#include "caustic_receiver.glsl"
 float view_depth(vec2 ndc, float z) {
     vec4 v = inv_proj * vec4(ndc, z, 1.0);
     return -v.z / v.w;
@@ -23,7 +24,7 @@ void main() {
     vec3 ndc = c.xyz / c.w;
     if (any(greaterThanEqual(abs(ndc.xy), vec2(1.0))) || abs(ndc.z) > 1.0) return;
     ivec2 px = clamp(ivec2(floor((ndc.xy * 0.5 + 0.5) * size)), ivec2(0), ivec2(size) - 1);
-    if (have_kd != 0 && all(equal(texelFetch(kd, px, 0).rgb, vec3(0.0))))
+    if (have_kd != 0 && !shows_caustic(texelFetch(kd, px, 0).rgb))
         return; // a pixel whose surface shows no caustic (the mask pass's rule)
     vec3 V = ortho != 0 ? view_dir : normalize(eye - pos);
     float cv = dot(ng, V);
