@@ -104,6 +104,7 @@ static void gather_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *
     s->iim.texels_per_frame = g->texels_per_frame;
     s->iim.blend_frames = g->blend_frames == LMGI_OFF ? 0 : g->blend_frames;
     s->iim.texel_change = g->texel_change == LMGI_OFF ? -1.0f : g->texel_change;
+    s->iim.spread = g->spread == LMGI_OFF ? 0 : g->spread;
     s->gather.resolution = g->resolution;
     s->gather.enlargement = g->enlargement;
     s->gather.samples = g->samples;

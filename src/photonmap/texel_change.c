@@ -362,6 +362,15 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
     return n;
 }
 
+uint32_t lm_texel_change_waiting(const lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t *out)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < tc->texel_count; i++)
+        if (lm_texel_change_of(tc, i) > tc->threshold && !off[a->texels[i].surface])
+            out[n++] = i;
+    return n;
+}
+
 void lm_texel_change_gathered(lm_texel_change *tc, const uint32_t *texels, uint32_t count)
 {
     for (uint32_t j = 0; j < count; j++)

@@ -73,6 +73,9 @@ void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const l
  * all. Returns how many. */
 uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t budget, int all,
                               uint32_t *out);
+/* The texels over the threshold, not on surfaces with off[k] set, in texel order, into out: those still
+ * waiting to be picked. Returns how many. */
+uint32_t lm_texel_change_waiting(const lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t *out);
 /* The texels gathered otherwise (their surfaces' refreshes) start from no change again: left, they kept
  * the atlas's mean change up, and with it the bar a texel must pass to go ahead (a moved cube's face
  * stayed 28% too bright for 120 updates below it). */

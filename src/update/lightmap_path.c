@@ -268,7 +268,8 @@ static int by_index(const void *a, const void *b)
 /* Texels into lp->texels: first at most `ahead` of those whose hemisphere changed most (texel_change.h),
  * committed on their own, then the surfaces' refreshes (iim_schedule.h: the budget left, or with `whole`,
  * a bake's, every candidate surface in full), which skip the texels picked ahead: no texel is listed
- * twice, so the atlas's texel_count holds them all. */
+ * twice, so the atlas's texel_count holds them all. Those still over the threshold wait, shown with the
+ * estimate of progressive refinement until gathered (iim.h). */
 static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int whole)
 {
     uint32_t n = 0;
@@ -281,8 +282,13 @@ static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int 
     uint32_t room = whole ? lp->atlas->texel_count : budget; /* a bake: every surface under way, whole */
     room = room < lp->atlas->texel_count ? room : lp->atlas->texel_count;
     uint32_t count = n + lm_iim_sched_pick_up_to(&lp->iim.sched, store_of(lp), room - n, lp->texels + n);
-    if (lp->have_change)
+    uint32_t waiting = 0; /* after the list: none of them is in it (their change was zeroed) */
+    if (lp->have_change) {
         lm_texel_change_gathered(&lp->change, lp->texels + n, count - n);
+        if (lp->change.threshold >= 0.0f)
+            waiting = lm_texel_change_waiting(&lp->change, lp->atlas, lp->iim.sched.off, lp->texels + count);
+    }
+    lm_iim_set_pending(&lp->iim, lp->atlas, lp->texels + count, waiting);
     if (whole) /* a bake: in atlas order, so that where a texel lands in the gather's passes (and its
                 * rounding) depends on which texels are gathered, not on how they were picked */
         qsort(lp->texels, count, sizeof *lp->texels, by_index);

@@ -20,12 +20,14 @@ void lm_iim_settings_default(lm_iim_settings *s)
     s->delta_threshold = 0.0;
     s->texel_change = 0.03125f;
     s->backface_limit = 0.1f;
+    s->spread = 3;
 }
 
 static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
 {
-    unsigned *tex[4] = {&iim->fresh_tex, &iim->old_tex, &iim->new_tex, &iim->display_tex};
-    for (int i = 0; i < 4; i++)
+    unsigned *tex[6] = {&iim->fresh_tex, &iim->old_tex,   &iim->new_tex,
+                        &iim->display_tex, &iim->delta_tex, &iim->carry_tex};
+    for (int i = 0; i < 6; i++)
         if (!(*tex[i] = lm_iim_texture_create(a->width, a->height)))
             return lm_fail(err, LM_ERR_BACKEND, "IIM: could not make a %dx%d RGBA32F texture", a->width, a->height);
     lm_status st = lm_gl_compute_program("iim_blend", lm_glsl_iim_blend_cs, &iim->blend_prog, err);
@@ -37,14 +39,25 @@ static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory");
     for (size_t i = 0; i < n; i++)
         surf[i] = a->texel_index[i] < 0 ? -1 : a->texels[a->texel_index[i]].surface;
-    GLuint bufs[4];
-    glGenBuffers(4, bufs);
+    GLuint bufs[8];
+    glGenBuffers(8, bufs);
     iim->surface_buf = bufs[0], iim->params_buf = bufs[1], iim->start_buf = bufs[2], iim->list_buf = bufs[3];
+    iim->chart_buf = bufs[4], iim->redraw_buf = bufs[5], iim->ops_buf = bufs[6], iim->flag_buf = bufs[7];
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[0]);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * n), surf, GL_STATIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[4]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * n), a->chart_owner, GL_STATIC_DRAW);
+    for (int i = 5; i <= 6; i++) { /* the frame's cells to draw and flag changes: at most one a texel */
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[i]);
+        glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int32_t) * (a->texel_count ? a->texel_count : 1)),
+                     NULL, GL_DYNAMIC_DRAW);
+    }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[1]);
     glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(float) * 2 * (size_t)(iim->sched.surface_count + 1)), NULL,
                  GL_DYNAMIC_DRAW);
+    memset(surf, 0, sizeof(int) * n); /* no cell waits */
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[7]);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof(int) * n), surf, GL_DYNAMIC_DRAW);
     for (size_t i = 0; i < n; i++)
         surf[i] = NEVER; /* every cell's clock: fully blended */
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, bufs[2]);
@@ -67,9 +80,14 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
     iim->version = calloc(S, sizeof *iim->version);
     iim->texel_start = malloc(S * sizeof *iim->texel_start);
     iim->list = malloc(sizeof *iim->list * (a->texel_count ? a->texel_count : 1));
-    lm_status st = iim->blend_start && iim->version && iim->texel_start && iim->list
+    iim->version_touch = calloc(S, 1);
+    iim->active = calloc(S, 1);
+    lm_status st = iim->blend_start && iim->version && iim->texel_start && iim->list && iim->version_touch &&
+                           iim->active
                        ? lm_iim_sched_init(&iim->sched, a, set->texels_per_frame, set->delta_threshold, err)
                        : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
+    if (st == LM_OK)
+        st = lm_iim_pending_init(&iim->pending, a->texel_count, err);
     for (size_t k = 0; st == LM_OK && k < S; k++)
         iim->blend_start[k] = iim->texel_start[k] = NEVER;
     if (st == LM_OK && with_gl)
@@ -81,18 +99,22 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
 
 void lm_iim_free(lm_iim *iim)
 {
-    unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
-    for (int i = 0; i < 4; i++)
+    unsigned tex[6] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex, iim->delta_tex, iim->carry_tex};
+    for (int i = 0; i < 6; i++)
         lm_iim_texture_free(tex[i]);
     if (iim->blend_prog) {
-        GLuint bufs[4] = {iim->surface_buf, iim->params_buf, iim->start_buf, iim->list_buf};
-        glDeleteBuffers(4, bufs);
+        GLuint bufs[8] = {iim->surface_buf, iim->params_buf, iim->start_buf, iim->list_buf,
+                          iim->chart_buf,   iim->redraw_buf, iim->ops_buf,   iim->flag_buf};
+        glDeleteBuffers(8, bufs);
         glDeleteProgram(iim->blend_prog);
     }
     lm_iim_sched_free(&iim->sched);
     free(iim->blend_start);
     free(iim->texel_start);
     free(iim->list);
+    lm_iim_pending_free(&iim->pending);
+    free(iim->version_touch);
+    free(iim->active);
     free(iim->version);
     memset(iim, 0, sizeof *iim);
 }
@@ -109,7 +131,30 @@ void lm_iim_commit_texels(lm_iim *iim, const lm_atlas *a, const uint32_t *texels
         const lm_texel *t = &a->texels[texels[j]];
         iim->list[iim->list_count++] = t->y * a->width + t->x;
         iim->texel_start[t->surface] = iim->sched.frame;
+        lm_iim_pending_committed(&iim->pending, texels[j]);
     }
+}
+
+void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n)
+{
+    if (iim->set.spread > 0)
+        lm_iim_pending_add(&iim->pending, a, texels, n, iim->version_touch);
+}
+
+/* Mode `mode` of iim_blend over the `count` entries of buffer `buf`, bound at `binding`. */
+static void dispatch_list(lm_iim *iim, int mode, unsigned buf, int binding, const void *data, size_t bytes,
+                          uint32_t count)
+{
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)bytes, data);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, buf);
+    GLuint groups = (GLuint)(count + 63) / 64;
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), mode);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "list_count"), (int)count);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "row"), 8 * (int)groups);
+    glDispatchCompute(groups, 1, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
 /* The listed cells committed on their own (mode 1 of iim_blend), before the pass over the atlas. */
@@ -117,18 +162,8 @@ static void commit_list(lm_iim *iim, int instant)
 {
     if (!iim->list_count)
         return;
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->list_buf);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(int) * iim->list_count), iim->list);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, iim->list_buf);
-    GLuint groups = (GLuint)(iim->list_count + 63) / 64;
-    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), 1);
-    glUniform1i(glGetUniformLocation(iim->blend_prog, "list_count"), (int)iim->list_count);
-    glUniform1i(glGetUniformLocation(iim->blend_prog, "row"), 8 * (int)groups);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "instant"), instant);
-    glDispatchCompute(groups, 1, 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-    iim->list_count = 0;
+    dispatch_list(iim, 1, iim->list_buf, 3, iim->list, sizeof(int) * iim->list_count, iim->list_count);
 }
 
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
@@ -141,26 +176,36 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     int any_commit = iim->list_count > 0, blending = 0;
     double frame = iim->sched.frame;
     for (int s = 0; s < S; s++) {
-        /* shown differently from the last frame: committed now (the surface or some of its texels), or
-         * still blending last frame */
-        if (commit[s] || iim->texel_start[s] == iim->sched.frame || blending_at(iim, iim->blend_start[s], frame - 1) ||
-            blending_at(iim, iim->texel_start[s], frame - 1))
-            iim->version[s]++;
+        /* shown differently from the last frame: committed now (the surface or some of its texels), still
+         * blending last frame, or with texels that began to wait (their estimate) */
+        int changed = commit[s] || iim->texel_start[s] == iim->sched.frame ||
+                      blending_at(iim, iim->blend_start[s], frame - 1) ||
+                      blending_at(iim, iim->texel_start[s], frame - 1) || iim->version_touch[s];
+        iim->version[s] += (uint32_t)changed;
+        iim->version_touch[s] = changed ? 2 : 0; /* 2: counted; lm_iim_pending_frame may add 1 below */
         if (commit[s])
             iim->blend_start[s] = instant ? NEVER : iim->sched.frame;
         if (instant && iim->texel_start[s] == iim->sched.frame)
             iim->texel_start[s] = NEVER;
+        iim->active[s] = commit[s] || iim->texel_start[s] == iim->sched.frame ||
+                         blending_at(iim, iim->blend_start[s], frame) || blending_at(iim, iim->texel_start[s], frame);
         param[2 * s] = commit[s] ? 1.0f : 0.0f;
         param[2 * s + 1] = instant ? 1.0f : 0.0f;
         any_commit |= commit[s];
         blending |= blending_at(iim, iim->blend_start[s], frame) || blending_at(iim, iim->texel_start[s], frame);
-        commit[s] = 0;
     }
-    if (!any_commit && iim->settled) { /* the last pass already wrote every final value */
+    lm_iim_pending_frame(&iim->pending, commit, iim->active, iim->version_touch);
+    for (int s = 0; s < S; s++) { /* and those with texels that stopped waiting, back to themselves */
+        iim->version[s] += iim->version_touch[s] == 1;
+        iim->version_touch[s] = commit[s] = 0;
+    }
+    const lm_iim_pending *pend = &iim->pending;
+    if (!any_commit && iim->settled && !pend->op_count && !pend->redraw_count) { /* nothing shows differently */
         free(param);
         lm_iim_sched_end_frame(&iim->sched);
         return LM_OK;
     }
+    int atlas_pass = any_commit || !iim->settled; /* else only estimates to draw */
     iim->settled = !blending;
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->params_buf);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * 2 * (size_t)S), param);
@@ -170,15 +215,30 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glUniform1i(glGetUniformLocation(iim->blend_prog, "frame"), iim->sched.frame);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "blend_frames"), iim->set.blend_frames);
     glUniform1f(glGetUniformLocation(iim->blend_prog, "limit"), iim->set.backface_limit);
-    const unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
-    for (int i = 0; i < 4; i++)
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "spread"), iim->set.spread);
+    const unsigned tex[6] = {iim->fresh_tex,   iim->old_tex,   iim->new_tex,
+                             iim->display_tex, iim->delta_tex, iim->carry_tex};
+    for (int i = 0; i < 6; i++)
         glBindImageTexture((GLuint)i, tex[i], 0, GL_FALSE, 0, i ? GL_READ_WRITE : GL_READ_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, iim->surface_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->params_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, iim->start_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, iim->chart_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, iim->flag_buf);
+    if (pend->op_count) /* which cells wait, before the commits: a committed one is drawn as itself */
+        dispatch_list(iim, 3, iim->ops_buf, 7, pend->ops, sizeof(int32_t) * pend->op_count, pend->op_count);
     commit_list(iim, instant);
-    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), 0);
-    glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
+    if (atlas_pass) {
+        glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), 0);
+        glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
+        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+    if (iim->list_count && iim->set.spread > 0 && !instant)
+        dispatch_list(iim, 4, iim->list_buf, 3, iim->list, sizeof(int) * iim->list_count, iim->list_count);
+    iim->list_count = 0;
+    if (pend->redraw_count)
+        dispatch_list(iim, 2, iim->redraw_buf, 5, pend->redraw, sizeof(int32_t) * pend->redraw_count,
+                      pend->redraw_count);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     lm_iim_sched_end_frame(&iim->sched);
     return lm_gl_check("IIM blend (iim_blend)", err);
@@ -186,8 +246,9 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
 
 lm_status lm_iim_clear(lm_iim *iim, lm_error *err)
 {
-    const unsigned tex[4] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex};
-    for (int i = 0; i < 4; i++)
+    const unsigned tex[6] = {iim->fresh_tex,   iim->old_tex,   iim->new_tex,
+                             iim->display_tex, iim->delta_tex, iim->carry_tex};
+    for (int i = 0; i < 6; i++)
         glClearTexImage(tex[i], 0, GL_RGBA, GL_FLOAT, NULL);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     return lm_gl_check("clearing the IIM", err);

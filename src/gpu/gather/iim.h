@@ -12,6 +12,17 @@
  * (a moving object's foot) shows its new value at once: a blend with the dark value gathered from inside
  * geometry would show as a dark square.
  *
+ * Progressive refinement (issue 32, item 3): texels regathered ahead of their surface come one by one, so a
+ * changed region used to show as hard-edged squares, each gathered texel among stale neighbours. The
+ * texels still waiting (lm_iim_set_pending: their hemisphere's estimated change passed the threshold;
+ * iim_pending.h) show instead their own value plus the changes of the texels of their chart within
+ * `spread` texels committed after them, weighted by distance (glsl/iim_blend_cs.glsl, mode 2): a coarse
+ * estimate from the first gathers, refined as each texel is gathered in turn. For that each commit keeps
+ * its texel's change and what the estimate added on screen, which then fades out with the blend instead
+ * of popping (two more atlas-sized RGBA32F textures, 32 bytes a cell, and 8 for each cell's chart and
+ * flag); an estimate costs (2 spread + 1)^2 reads, drawn again only while its surface has texels
+ * committed or blending.
+ *
  * Invalid texels (back-face fraction above the limit: the texel sees the inside of geometry) are
  * filled on the CPU copy used for output (lm_iim_fill_invalid), then gutters are dilated. */
 #ifndef LM_IIM_H
@@ -22,6 +33,7 @@
 #include "../../charts/charts.h"
 #include "../../core/error.h"
 #include "../../photonmap/iim_schedule.h"
+#include "iim_pending.h"
 
 #define LM_IIM_DEFAULT_TEXELS_PER_FRAME 20 /* the paper's */
 
@@ -35,6 +47,8 @@ typedef struct {
     float backface_limit;  /* a texel whose back-face fraction (alpha) is above this is invalid, as the
                             * gather's: one turning valid or invalid shows its new value at once, never a
                             * blend with what it saw from inside geometry (default 0.1) */
+    int spread;            /* texels a pending texel borrows changes from (header; default 3, 0: none,
+                            * each texel shows its old value until gathered) */
 } lm_iim_settings;
 
 typedef struct {
@@ -44,12 +58,15 @@ typedef struct {
     int *blend_start;      /* per surface: frame of its last commit (very negative: fully blended) */
     int *texel_start;      /* per surface: frame some of its texels were last committed on their own */
     uint32_t *list, list_count; /* atlas cells to commit on their own at the next blend */
+    lm_iim_pending pending; /* the texels that wait, shown with the estimate (iim_pending.h) */
+    uint8_t *version_touch; /* per surface: a texel of it began or stopped waiting (its version moves) */
+    uint8_t *active;       /* scratch per surface: a texel of it committed or blending this frame */
     uint32_t *version;     /* per surface: blends that changed its displayed texels (a commit, or a blend
                             * still under way) */
     int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */
-    unsigned fresh_tex, old_tex, new_tex, display_tex;
-    unsigned blend_prog, surface_buf, params_buf, start_buf, list_buf;
+    unsigned fresh_tex, old_tex, new_tex, display_tex, delta_tex, carry_tex;
+    unsigned blend_prog, surface_buf, params_buf, start_buf, list_buf, chart_buf, redraw_buf, flag_buf, ops_buf;
 } lm_iim;
 
 void lm_iim_settings_default(lm_iim_settings *s);
@@ -61,11 +78,14 @@ void lm_iim_free(lm_iim *iim);
  * surface does: texels regathered ahead of their surface (photonmap/texel_change.h) show at once, each
  * blending from what was shown over blend_frames from then. */
 void lm_iim_commit_texels(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n);
+/* The texels (lm_atlas.texels indices) that wait to be regathered this frame (iim_pending.h): each shows
+ * the estimate from its neighbours committed since it was (header). */
+void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n);
 /* Ends the frame on the GPU: commits the surfaces the scheduler completed (clearing their flags),
  * writes display = mix(old, new, t), then advances the scheduler's frame counter. instant: committed surfaces show new at once (after the first gather). */
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
 
-/* Every IIM texture (fresh, old, new, displayed) set to 0: a scene that lost its last light shows no
+/* Every IIM texture (fresh, old, new, displayed, the changes) set to 0: a scene that lost its last light shows no
  * indirect light at once, not the last gather's. */
 lm_status lm_iim_clear(lm_iim *iim, lm_error *err);
 
