@@ -23,11 +23,20 @@ void lm_iim_settings_default(lm_iim_settings *s)
     s->spread = 3;
 }
 
+/* The six atlas textures in binding order (glsl/iim_blend_cs.glsl): fresh, old, new, display, delta, carry. */
+#define IIM_TEXTURES 6
+static void textures(const lm_iim *iim, unsigned tex[IIM_TEXTURES])
+{
+    const unsigned t[IIM_TEXTURES] = {iim->fresh_tex,   iim->old_tex,   iim->new_tex,
+                                      iim->display_tex, iim->delta_tex, iim->carry_tex};
+    memcpy(tex, t, sizeof t);
+}
+
 static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
 {
-    unsigned *tex[6] = {&iim->fresh_tex, &iim->old_tex,   &iim->new_tex,
-                        &iim->display_tex, &iim->delta_tex, &iim->carry_tex};
-    for (int i = 0; i < 6; i++)
+    unsigned *tex[IIM_TEXTURES] = {&iim->fresh_tex,   &iim->old_tex,   &iim->new_tex,
+                                   &iim->display_tex, &iim->delta_tex, &iim->carry_tex};
+    for (int i = 0; i < IIM_TEXTURES; i++)
         if (!(*tex[i] = lm_iim_texture_create(a->width, a->height)))
             return lm_fail(err, LM_ERR_BACKEND, "IIM: could not make a %dx%d RGBA32F texture", a->width, a->height);
     lm_status st = lm_gl_compute_program("iim_blend", lm_glsl_iim_blend_cs, &iim->blend_prog, err);
@@ -99,8 +108,9 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
 
 void lm_iim_free(lm_iim *iim)
 {
-    unsigned tex[6] = {iim->fresh_tex, iim->old_tex, iim->new_tex, iim->display_tex, iim->delta_tex, iim->carry_tex};
-    for (int i = 0; i < 6; i++)
+    unsigned tex[IIM_TEXTURES];
+    textures(iim, tex);
+    for (int i = 0; i < IIM_TEXTURES; i++)
         lm_iim_texture_free(tex[i]);
     if (iim->blend_prog) {
         GLuint bufs[8] = {iim->surface_buf, iim->params_buf, iim->start_buf, iim->list_buf,
@@ -141,13 +151,16 @@ void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, 
         lm_iim_pending_add(&iim->pending, a, texels, n, iim->version_touch);
 }
 
-/* Mode `mode` of iim_blend over the `count` entries of buffer `buf`, bound at `binding`. */
+/* Mode `mode` of iim_blend over the `count` entries of buffer `buf`, bound at `binding`, after uploading
+ * them from data (NULL: the buffer holds them already). */
 static void dispatch_list(lm_iim *iim, int mode, unsigned buf, int binding, const void *data, size_t bytes,
                           uint32_t count)
 {
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)bytes, data);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    if (data) {
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
+        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)bytes, data);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    }
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, buf);
     GLuint groups = (GLuint)(count + 63) / 64;
     glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), mode);
@@ -187,12 +200,12 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
             iim->blend_start[s] = instant ? NEVER : iim->sched.frame;
         if (instant && iim->texel_start[s] == iim->sched.frame)
             iim->texel_start[s] = NEVER;
-        iim->active[s] = commit[s] || iim->texel_start[s] == iim->sched.frame ||
-                         blending_at(iim, iim->blend_start[s], frame) || blending_at(iim, iim->texel_start[s], frame);
+        int blends = blending_at(iim, iim->blend_start[s], frame) || blending_at(iim, iim->texel_start[s], frame);
+        iim->active[s] = commit[s] || iim->texel_start[s] == iim->sched.frame || blends;
         param[2 * s] = commit[s] ? 1.0f : 0.0f;
         param[2 * s + 1] = instant ? 1.0f : 0.0f;
         any_commit |= commit[s];
-        blending |= blending_at(iim, iim->blend_start[s], frame) || blending_at(iim, iim->texel_start[s], frame);
+        blending |= blends;
     }
     lm_iim_pending_frame(&iim->pending, commit, iim->active, iim->version_touch);
     for (int s = 0; s < S; s++) { /* and those with texels that stopped waiting, back to themselves */
@@ -216,9 +229,9 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glUniform1i(glGetUniformLocation(iim->blend_prog, "blend_frames"), iim->set.blend_frames);
     glUniform1f(glGetUniformLocation(iim->blend_prog, "limit"), iim->set.backface_limit);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "spread"), iim->set.spread);
-    const unsigned tex[6] = {iim->fresh_tex,   iim->old_tex,   iim->new_tex,
-                             iim->display_tex, iim->delta_tex, iim->carry_tex};
-    for (int i = 0; i < 6; i++)
+    unsigned tex[IIM_TEXTURES];
+    textures(iim, tex);
+    for (int i = 0; i < IIM_TEXTURES; i++)
         glBindImageTexture((GLuint)i, tex[i], 0, GL_FALSE, 0, i ? GL_READ_WRITE : GL_READ_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, iim->surface_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->params_buf);
@@ -233,8 +246,8 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
         glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     }
-    if (iim->list_count && iim->set.spread > 0 && !instant)
-        dispatch_list(iim, 4, iim->list_buf, 3, iim->list, sizeof(int) * iim->list_count, iim->list_count);
+    if (iim->list_count && iim->set.spread > 0 && !instant) /* the cells mode 1 committed, uploaded there */
+        dispatch_list(iim, 4, iim->list_buf, 3, NULL, 0, iim->list_count);
     iim->list_count = 0;
     if (pend->redraw_count)
         dispatch_list(iim, 2, iim->redraw_buf, 5, pend->redraw, sizeof(int32_t) * pend->redraw_count,
@@ -246,9 +259,9 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
 
 lm_status lm_iim_clear(lm_iim *iim, lm_error *err)
 {
-    const unsigned tex[6] = {iim->fresh_tex,   iim->old_tex,   iim->new_tex,
-                             iim->display_tex, iim->delta_tex, iim->carry_tex};
-    for (int i = 0; i < 6; i++)
+    unsigned tex[IIM_TEXTURES];
+    textures(iim, tex);
+    for (int i = 0; i < IIM_TEXTURES; i++)
         glClearTexImage(tex[i], 0, GL_RGBA, GL_FLOAT, NULL);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     return lm_gl_check("clearing the IIM", err);
