@@ -1,17 +1,16 @@
 /* An incremental bake against a fresh one (issue 32, item 5): lmgi_bake on an updater that followed
  * edits gives the lightmap a fresh updater's bake of the edited scene gives, within float summation
- * order (the gathers run on several threads), where the edits leave the photons' plan as a fresh
- * updater's: a light edited and restored, and any sequence of material edits. A refresh under way when
- * the bake starts is done again in full (iim_schedule.h, lm_iim_sched_restart): its first texels saw AIMs
- * the bake's photons have changed since, and a light made 100 times brighter for 10 updates and then
- * restored left 180 texels of the two rooms about 67 times too bright.
+ * order (the gathers run on several threads): a light edited and restored, lights dimmed, added and
+ * removed, any sequence of material edits, and random sequences of every kind of edit. A refresh under
+ * way when the bake starts is done again in full (iim_schedule.h, lm_iim_sched_restart): its first texels
+ * saw AIMs the bake's photons have changed since, and a light made 100 times brighter for 10 updates and
+ * then restored left 180 texels of the two rooms about 67 times too bright. After lights change in power
+ * or number, a bake with fresh_plan plans the photons again as a fresh updater does (photon_stage.c,
+ * plan_photons_again); the default keeps the shares of creation (an edit in one room costs nothing in
+ * another, test_light_edits) and is a photon noise away, up to 15% a texel at 2,000 texels.
  *
- * Not yet held here (issue 32): after a light's power changes or lights are added or removed, the
- * photons' shares follow the luminance of creation, so the bake differs from a fresh one by photon noise
- * (up to 29% a texel at 2,000 texels): random sequences of every kind of edit are held to that noise (no
- * texel off by more than 60% of itself, the lightmap's mean within 2%), which the kinds of staleness
- * fixed here exceed by far (66 times; a dark room's ceiling at 598 where it is 0). After node moves one
- * texel in 2,048 differs by 0.11% (the store's slot order after partial re-traces). */
+ * Not to the bit yet: after node moves alone, one texel in 2,048 differs by 0.11% (the store's slot
+ * order after partial re-traces; planning again would regather every surface at each bake). */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -41,15 +40,29 @@ static void rig_load(rig *r)
     r->n = 4 * (size_t)in.atlas_width * in.atlas_height;
 }
 
-/* lmgi_bake at the defaults, and the IIM it leaves (malloc'd, r->n floats). */
-static float *bake(lmgi_updater *u, const rig *r)
+static void rig_free(rig *r)
 {
-    lmgi_bake_report rep;
-    lmt_bake(u, &rep);
+    lmgi_free(r->sc);
+    lmgi_context_free(r->ctx);
+}
+
+/* lmgi_bake at the defaults but for fresh_plan, and the IIM it leaves (malloc'd, r->n floats). */
+static float *bake_planned(lmgi_updater *u, const rig *r, int fresh_plan)
+{
+    lmgi_bake_desc d = {.fresh_plan = fresh_plan};
+    lmgi_error e;
+    if (lmgi_bake(u, &d, NULL, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
     size_t n;
     float *iim = lmt_iim(u, r->sc, &n);
     assert_true(n == r->n);
     return iim;
+}
+
+/* lmgi_bake with fresh_plan (the defaults but for it), and the IIM it leaves (malloc'd, r->n floats). */
+static float *bake(lmgi_updater *u, const rig *r)
+{
+    return bake_planned(u, r, 1);
 }
 
 /* The texels of the incremental bake more than 0.1% of the lightmap's mean away from the fresh bake's
@@ -112,8 +125,53 @@ static void test_light_edited_and_restored(void **state)
     lmgi_updater_free(u);
     assert_int_equal(compare_with_fresh(&r, iim, "light x100 for 10 updates, restored"), 0);
     free(iim);
-    lmgi_free(r.sc);
-    lmgi_context_free(r.ctx);
+    rig_free(&r);
+}
+
+/* A light dimmed to a tenth, a lamp added and one of the file's lights removed, with updates between,
+ * then a bake with or without fresh_plan (the IIM it leaves, r loaded): each edit changes the photons'
+ * shares a fresh updater plans. */
+static float *dim_add_remove(rig *r, int fresh_plan)
+{
+    rig_load(r);
+    lmgi_updater *u = lmt_updater(r->ctx, r->sc);
+    lmgi_error e;
+    lmgi_light l;
+    assert_int_equal(lmgi_get_light(r->sc, 0, &l, &e), LMGI_OK);
+    l.intensity *= 0.1f;
+    assert_int_equal(lmgi_set_light(r->sc, 0, &l, &e), LMGI_OK);
+    lmt_updates(u, 3);
+    lmgi_light lamp = {.type = LMGI_LIGHT_POINT, .color = {1, 0.8f, 0.6f}, .intensity = 8.0f, .enabled = 1,
+                       .position = {1.0f, 2.0f, 0.5f}, .direction = {0, -1, 0}};
+    int id;
+    assert_int_equal(lmgi_add_light(r->sc, &lamp, &id, &e), LMGI_OK);
+    lmt_updates(u, 3);
+    assert_true(lmgi_light_count(r->sc) >= 3);
+    assert_int_equal(lmgi_remove_light(r->sc, 2, &e), LMGI_OK);
+    lmt_updates(u, 3);
+    float *iim = bake_planned(u, r, fresh_plan);
+    lmgi_updater_free(u);
+    return iim;
+}
+
+/* With fresh_plan the bake is a fresh one's; by default it keeps the shares of creation and is a photon
+ * noise away from it (what fresh_plan buys). */
+static void test_lights_dimmed_added_removed(void **state)
+{
+    (void)state;
+    for (int plan = 1; plan >= 0; plan--) {
+        rig r;
+        float *iim = dim_add_remove(&r, plan);
+        double worst = 0.0;
+        int off = compare_with_fresh_to(&r, iim, plan ? "a light dimmed, a lamp added, a light removed; fresh plan"
+                                                       : "the same, the shares of creation kept", &worst, NULL);
+        if (plan)
+            assert_int_equal(off, 0);
+        else
+            assert_true(off > 100 && worst > 0.02);
+        free(iim);
+        rig_free(&r);
+    }
 }
 
 /* One material recoloured at random (xorshift state s). */
@@ -146,8 +204,7 @@ static void test_random_material_sequences(void **state)
         snprintf(what, sizeof what, "10 random material edits, seed %u", seed);
         assert_int_equal(compare_with_fresh(&r, iim, what), 0);
         free(iim);
-        lmgi_free(r.sc);
-        lmgi_context_free(r.ctx);
+        rig_free(&r);
     }
 }
 
@@ -156,7 +213,6 @@ static void random_edit(lmgi_scene *sc, uint32_t *s, int cube)
 {
     lmgi_error e;
     int lights = lmgi_light_count(sc), pick = (int)(lmt_xorshift(s) % 6);
-    if (getenv("PICK")) pick = atoi(getenv("PICK"));
     int l = (int)(lmt_xorshift(s) % (uint32_t)lights);
     float k = 0.1f + (float)(lmt_xorshift(s) % 1000) / 100.0f; /* 0.1 to 10 */
     lmgi_light light;
@@ -188,8 +244,8 @@ static void random_edit(lmgi_scene *sc, uint32_t *s, int cube)
     }
 }
 
-/* Every kind of edit at random, 10 of them with 1 to 6 updates after each, then a bake: within the
- * photon noise of a fresh bake (the header says why not to the bit yet). */
+/* Every kind of edit at random, 10 of them with 1 to 6 updates after each, then a bake: within float
+ * summation order of a fresh bake, but for the store's slot order after node moves (the header). */
 static void test_random_edit_sequences(void **state)
 {
     (void)state;
@@ -211,11 +267,10 @@ static void test_random_edit_sequences(void **state)
         double worst = 0.0, means = 0.0;
         compare_with_fresh_to(&r, iim, what, &worst, &means);
         print_message("  the lightmap's mean %.4f of the fresh bake's\n", means);
-        assert_true(worst < 0.6);
-        assert_true(fabs(means - 1.0) < 0.02);
+        assert_true(worst < 2e-3);
+        assert_true(fabs(means - 1.0) < 1e-4);
         free(iim);
-        lmgi_free(r.sc);
-        lmgi_context_free(r.ctx);
+        rig_free(&r);
     }
 }
 
@@ -223,6 +278,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_light_edited_and_restored),
+        cmocka_unit_test(test_lights_dimmed_added_removed),
         cmocka_unit_test(test_random_material_sequences),
         cmocka_unit_test(test_random_edit_sequences),
     };

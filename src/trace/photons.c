@@ -65,30 +65,52 @@ static lm_status check_settings(const lm_photon_settings *s, lm_error *err)
  * dimmer than the sun got one photon a group: where the lamp is all the light (a room the sun does not
  * reach) its lightmap was those 72 photons' noise, 21% off (docs/hard-cases.md). The floor costs the
  * brightest emitters a share of their photons only where others are far dimmer. Dark emitters weigh 0. */
-static double emitter_weight(const lm_photons *ph, float luminance)
+static double emitter_weight(double least, float luminance)
 {
-    return luminance > 0.0f ? fmax((double)luminance, ph->weight_floor) : 0.0;
+    return luminance > 0.0f ? fmax((double)luminance, least) : 0.0;
 }
 
-static void plan_weights(lm_photons *ph, double *sum)
+/* The emitters' weights summed, and the least weight of a lit one into *least. */
+static double plan_weights(const lm_emitters *em, double *least)
 {
-    const lm_emitters *em = ph->em;
     int lit = 0;
     for (int e = 0; e < em->count; e++)
         lit += em->e[e].luminance > 0.0f;
-    ph->weight_floor = lit ? 0.5 * em->total_luminance / lit : 0.0;
-    *sum = 0.0;
+    *least = lit ? 0.5 * em->total_luminance / lit : 0.0;
+    double sum = 0.0;
     for (int e = 0; e < em->count; e++)
-        *sum += emitter_weight(ph, em->e[e].luminance);
+        sum += emitter_weight(*least, em->e[e].luminance);
+    return sum;
+}
+
+/* The photons planned over E emitters. */
+static uint64_t plan_total(const lm_photons *ph, uint32_t E)
+{
+    uint64_t total = ph->set.total_photons ? ph->set.total_photons : (uint64_t)ph->set.per_group * ph->G * E;
+    return !ph->set.total_photons && total < ph->set.min_total ? ph->set.min_total : total;
 }
 
 /* M_e: photons per group of emitter e, in proportion to its weight, at least 1. */
-static uint32_t emitter_per_group(const lm_photons *ph, int e, uint64_t total, double weights)
+static uint32_t emitter_per_group(const lm_photons *ph, int e, uint64_t total, double weights, double least)
 {
     const lm_emitters *em = ph->em;
-    double share = weights > 0.0 ? emitter_weight(ph, em->e[e].luminance) / weights : 1.0 / em->count;
+    double share = weights > 0.0 ? emitter_weight(least, em->e[e].luminance) / weights : 1.0 / em->count;
     double m = floor((double)total * share / ph->G + 0.5);
     return m < 1.0 ? 1u : (uint32_t)fmin(m, (double)PH_MAX_PHOTONS);
+}
+
+int lm_photons_plan_outdated(const lm_photons *ph)
+{
+    uint32_t E = (uint32_t)ph->em->count;
+    if (E != ph->emitter_count)
+        return 1;
+    double least, weights = plan_weights(ph->em, &least);
+    uint64_t total = plan_total(ph, E);
+    for (uint32_t e = 0; e < E; e++)
+        if ((uint64_t)emitter_per_group(ph, (int)e, total, weights, least) * ph->G !=
+            ph->emitter_first[e + 1] - ph->emitter_first[e])
+            return 1;
+    return 0;
 }
 
 /* A photon's store entry, its path and its share of the AIM kd-trees: about 240 bytes, measured on the
@@ -98,17 +120,14 @@ static uint32_t emitter_per_group(const lm_photons *ph, int e, uint64_t total, d
 static lm_status plan_counts(lm_photons *ph, lm_error *err)
 {
     uint32_t E = ph->emitter_count;
-    uint64_t total = ph->set.total_photons ? ph->set.total_photons : (uint64_t)ph->set.per_group * ph->G * E;
-    if (!ph->set.total_photons && total < ph->set.min_total)
-        total = ph->set.min_total;
+    uint64_t total = plan_total(ph, E);
     ph->emitter_first = calloc((size_t)E + 1, sizeof *ph->emitter_first);
     if (!ph->emitter_first)
         return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for %u emitters", E);
-    double weights;
-    plan_weights(ph, &weights);
+    double weights = plan_weights(ph->em, &ph->weight_floor);
     uint64_t at = 0;
     for (uint32_t e = 0; e < E; e++) {
-        at += (uint64_t)emitter_per_group(ph, (int)e, total, weights) * ph->G;
+        at += (uint64_t)emitter_per_group(ph, (int)e, total, weights, ph->weight_floor) * ph->G;
         if (at > PH_MAX_PHOTONS)
             return lm_fail(err, LM_ERR_INVALID, "photons: %llu photons over %u emitters exceed %u",
                            (unsigned long long)at, E, PH_MAX_PHOTONS);
@@ -307,7 +326,7 @@ lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err)
 static uint32_t added_per_group(const lm_photons *ph, const lm_emitter *e)
 {
     double m = e->luminance > 0.0f && ph->per_luminance > 0.0
-                   ? floor(emitter_weight(ph, e->luminance) * ph->per_luminance / ph->G + 0.5)
+                   ? floor(emitter_weight(ph->weight_floor, e->luminance) * ph->per_luminance / ph->G + 0.5)
              : ph->emitter_count ? (double)ph->photon_count / ph->emitter_count / ph->G
              : ph->set.total_photons ? (double)ph->set.total_photons / ph->G
                                      : (double)ph->set.per_group;

@@ -92,6 +92,10 @@ typedef struct lm_photons lm_photons;
 lm_status lm_photons_create(const lm_scene *s, const lm_surfaces *su, const lm_rt *rt, const lm_emitters *em,
                             const lm_photon_settings *settings, lm_photons **out, lm_error *err);
 void lm_photons_free(lm_photons *ph);
+/* 1 when lm_photons_create would plan other photon counts for ph's emitters as they are now: lights added
+ * since creation (they got the photons per weight of creation), removed, or changed in luminance, so that
+ * the shares of creation no longer follow the light; else 0. O(emitters). */
+int lm_photons_plan_outdated(const lm_photons *ph);
 /* Forgets every path and hit (and the queue and the groups' counters) but keeps the memory: slabs,
  * store slots and trace buffers stay allocated. The state is that of a fresh lm_photons_create with
  * the same arguments, and a following lm_photons_trace_all gives bit-identical paths, hits and store

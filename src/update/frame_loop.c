@@ -477,7 +477,7 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
     return st;
 }
 
-lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progress, void *user,
+lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, int fresh_plan, lm_bake_progress progress, void *user,
                              const volatile int *cancel, lm_bake_stats *out, lm_error *err)
 {
     memset(out, 0, sizeof *out);
@@ -492,7 +492,7 @@ lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progre
         progress(user, 0.0, "photons");
     double t0 = lm_now();
     lm_photon_stage_frame f;
-    st = lm_photon_stage_converge(fl->stage, t, &f, err);
+    st = lm_photon_stage_converge(fl->stage, t, fresh_plan, &f, err);
     lm_scene_update_bounds(fl->world.scene);
     out->photons_traced = f.photons.group_photons;
     out->photons_changed = f.photons.photons_updated;

@@ -69,7 +69,7 @@ typedef struct {
  * only the photons' re-trace. progress (may be NULL) hears fractions 0 to 1 and the stage ("photons",
  * "gather"); *cancel (may be NULL) set non-zero stops it between gather passes with LM_ERR_CANCELLED,
  * nothing of the unfinished gather shown and those surfaces left to the next bake or step. */
-lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, lm_bake_progress progress, void *user,
+lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, int fresh_plan, lm_bake_progress progress, void *user,
                              const volatile int *cancel, lm_bake_stats *out, lm_error *err);
 
 /* The time the next steps may take, in ms, shared by every stage (budget_plan.h: photon groups, AIM

@@ -62,8 +62,12 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err);
 
 /* A full refresh at time t, for a bake: animate, then every photon re-traced (a path that did not change
- * changes nothing in the store) and the AIM of every surface whose photons changed refreshed. */
-lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, lm_photon_stage_frame *out, lm_error *err);
+ * changes nothing in the store) and the AIM of every surface whose photons changed refreshed. With
+ * fresh_plan, photons whose plan a fresh stage would make otherwise (lights changed in power or number
+ * since creation: lm_photons_plan_outdated) are planned again as it would, traced, and every AIM
+ * refreshed (each counts as refreshed); on a failure there the old photons stay. */
+lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan, lm_photon_stage_frame *out,
+                                   lm_error *err);
 /* Per surface, 1 if its AIM was refreshed since the last call (by updates or a converge) for a change of
  * at least a thousandth of the energy stored in hits, into out
  * (surface_count bytes); clears the record. Returns how many. Not while an update runs on another
