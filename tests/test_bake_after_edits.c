@@ -274,6 +274,57 @@ static void test_random_edit_sequences(void **state)
     }
 }
 
+/* The error atlas (LMGI_LIGHTMAP_ERROR) is never 0 where the lightmap is wrong: after random edits of
+ * every kind and a few updates, each texel whose shown irradiance is more than 5% (of itself, or of a
+ * hundredth of the mean where darker) away from what a bake then brings says so. The bake keeps the
+ * shares of creation, so that what it brings is what the updates are on their way to, not photon noise. */
+static void test_error_atlas_marks_wrong_texels(void **state)
+{
+    (void)state;
+    int wrong_total = 0;
+    for (uint32_t seed = 4; seed <= 6; seed++) {
+        rig r;
+        rig_load(&r);
+        int cube = lmgi_find_node(r.sc, "dynamic_cube");
+        lmgi_updater *u = lmt_updater(r.ctx, r.sc);
+        uint32_t s = 0x9e3779b9u * seed;
+        for (int k = 0; k < 4; k++) {
+            random_edit(r.sc, &s, cube);
+            lmt_updates(u, 1 + (int)(lmt_xorshift(&s) % 6));
+        }
+        size_t n;
+        float *shown = lmt_iim(u, r.sc, &n);
+        float *error = malloc(n * sizeof *error);
+        lmgi_error e;
+        assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_ERROR, error, n, &e), LMGI_OK);
+        float *settled = bake_planned(u, &r, 0);
+        double mean = 0.0;
+        int valid = 0;
+        for (size_t i = 0; i < n; i += 4)
+            if (settled[i + 3] > 0.0f)
+                mean += settled[i] + settled[i + 1] + settled[i + 2], valid++;
+        mean /= valid > 0 ? valid : 1;
+        int wrong = 0, unmarked = 0;
+        for (size_t i = 0; i < n; i += 4) {
+            if (!(settled[i + 3] > 0.0f))
+                continue;
+            double a = shown[i] + shown[i + 1] + shown[i + 2], b = settled[i] + settled[i + 1] + settled[i + 2];
+            if (fabs(a - b) > 0.05 * fmax(b, 0.01 * mean)) {
+                wrong++;
+                unmarked += !(error[i] > 0.0f);
+            }
+        }
+        print_message("seed %u: %d of %d texels over 5%% from what the bake brings, %d of them with error 0\n",
+                      seed, wrong, valid, unmarked);
+        assert_int_equal(unmarked, 0);
+        wrong_total += wrong;
+        free(shown), free(error), free(settled);
+        lmgi_updater_free(u);
+        rig_free(&r);
+    }
+    assert_true(wrong_total > 1000); /* the edits left much to bring */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -281,6 +332,7 @@ int main(void)
         cmocka_unit_test(test_lights_dimmed_added_removed),
         cmocka_unit_test(test_random_material_sequences),
         cmocka_unit_test(test_random_edit_sequences),
+        cmocka_unit_test(test_error_atlas_marks_wrong_texels),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
