@@ -305,9 +305,9 @@ static lm_status make_photons(lm_photon_stage *ps, lm_photons **out, lm_error *e
 
 /* A bake with fresh_plan after lights were added, removed or changed in power (lm_photons_plan_outdated):
  * the photons planned again as a fresh updater plans them, so that the bake gives its lightmap and not
- * one made with the shares of creation (photon noise apart: up to 29% a texel at 2,000 texels). Nothing
- * traced yet. The store's version goes on from the old one's, for whoever keeps copies by version. On a failure
- * the old photons stay. */
+ * one made with the shares of creation (photon noise apart: up to 15% a texel at 2,000 texels). Nothing
+ * traced yet. The store's version goes on from the old one's, for whoever keeps copies by version. On
+ * a failure the old photons stay. */
 static lm_status plan_photons_again(lm_photon_stage *ps, lm_error *err)
 {
     lm_photons *fresh = NULL;
