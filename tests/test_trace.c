@@ -404,37 +404,6 @@ static void test_two_sides(void **state)
     lmt_pipeline_free(&p);
 }
 
-/* A lid (trace/rt_scene.h, lm_rt_lidded): over a floor, a 0.8 m square 2 mm up covers the points under
- * it, whatever their distance to its edge up to the slanted rays' 3.5 mm reach; a 0.4 m square 15 cm up
- * blocks the ray straight up within 25 cm but leaves most of the view open, so it is no lid at any
- * height; nothing covers the open floor. */
-static void test_lids(void **state)
-{
-    (void)state;
-    lmt_mesh m[3];
-    memset(m, 0, sizeof m);
-    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
-    lmt_mesh_quad(&m[1], (float[3]){-0.4f, 0.002f, -0.4f}, (float[3]){0.8f, 0, 0}, (float[3]){0, 0, 0.8f});
-    lmt_mesh_quad(&m[2], (float[3]){-0.2f, 0.15f, -0.2f}, (float[3]){0.4f, 0, 0}, (float[3]){0, 0, 0.4f});
-    const char *path = lmt_write_scene("lids.gltf", m, 3,
-                                       "[{\"mesh\": 0}, {\"mesh\": 1, \"translation\": [-1, 0, -1]},"
-                                       " {\"mesh\": 2, \"translation\": [1, 0, 1]}]", "[{}, {}, {}]");
-    lmt_pipeline p;
-    lmt_pipeline_load(&p, path, 0.25f);
-    const float up[3] = {0, 1, 0};
-    const float under_lid[3] = {-1.39f, 1e-4f, -0.7f}, under_square[3] = {1.1f, 1e-4f, 0.9f},
-                open[3] = {1, 1e-4f, -1};
-    assert_true(lm_rt_lidded(p.rt, under_lid, up, 0.25f));
-    assert_true(lm_rt_lidded(p.rt, under_lid, up, 0.003f));
-    assert_false(lm_rt_lidded(p.rt, under_lid, up, 0.001f)); /* nothing within 1 mm */
-    assert_true(lm_rt_occluded(p.rt, under_square, up, 0.0f, 0.25f));
-    assert_false(lm_rt_lidded(p.rt, under_square, up, 0.25f));
-    assert_false(lm_rt_lidded(p.rt, under_square, up, 10.0f));
-    assert_false(lm_rt_lidded(p.rt, open, up, 0.25f));
-    assert_false(lm_rt_lidded(p.rt, open, up, 0.0f));
-    lmt_pipeline_free(&p);
-}
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -448,7 +417,6 @@ int main(void)
         cmocka_unit_test(test_far_vertex_refused),
         cmocka_unit_test(test_target_texels),
         cmocka_unit_test(test_two_sides),
-        cmocka_unit_test(test_lids),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -435,28 +435,6 @@ void lm_rt_occluded8(const lm_rt *rt, const float org[3], const float *dir, cons
         blocked[i] = r.tfar[i] < 0.0f; /* Embree sets tfar to -inf on occlusion */
 }
 
-int lm_rt_lidded(const lm_rt *rt, const float org[3], const float n[3], float height)
-{
-    if (!(height > 0.0f) || !lm_rt_occluded(rt, org, n, 0.0f, height))
-        return 0;
-    /* 8 rays 60 degrees off n, 45 degrees apart: a cosine-weighted 75% of the hemisphere lies inside
-     * their cone. Each reaches the plane `height` above org along n (height / cos 60). */
-    const float s = 0.8660254f, c = 0.5f;
-    lm_vec3 nv = lm_v3_load(n);
-    float dir[24], tfar[8];
-    for (int i = 0; i < 8; i++) {
-        float a = (float)i * 0.78539816f;
-        lm_v3_store(dir + 3 * i, lm_onb_dir(nv, s * cosf(a), s * sinf(a), c));
-        tfar[i] = height / c;
-    }
-    int blocked[8];
-    lm_rt_occluded8(rt, org, dir, tfar, 8, blocked);
-    for (int i = 0; i < 8; i++)
-        if (!blocked[i])
-            return 0;
-    return 1;
-}
-
 uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir, uint32_t n)
 {
     uint64_t hits = 0;

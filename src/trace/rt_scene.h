@@ -57,13 +57,6 @@ int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], floa
  * org + t dir_i (dir: 3 floats each), t in (0, tfar[i]). n in 1..8. */
 void lm_rt_occluded8(const lm_rt *rt, const float org[3], const float *dir, const float *tfar, int n, int *blocked);
 
-/* Whether org lies under a lid: other geometry within `height` along unit n, straight out and on 8 rays
- * 60 degrees off it (a cosine-weighted 75% of the hemisphere), so that nearly all org sees is that
- * geometry, as on a floor under a rug or a ceiling over a lamp lying millimetres below it. Something that
- * hides only part of the view (a ball hovering over a floor, the edge of a box) is no lid, whatever lies
- * straight out. One ray, plus one packet of 8 when the first is blocked. 0 for height <= 0. */
-int lm_rt_lidded(const lm_rt *rt, const float org[3], const float n[3], float height);
-
 /* The benchmark's baseline: n closest-hit queries straight through rtcIntersect1 (no hit decoding),
  * rays i = (org + 3i, dir + 3i), spread over the OpenMP threads. Returns the number of hits. */
 uint64_t lm_rt_raw_intersect(const lm_rt *rt, const float *org, const float *dir, uint32_t n);

@@ -125,9 +125,9 @@ void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el);
  * (lm_texel_covered) is invalid (alpha 1), like a texel that sees back faces. rt is borrowed and must
  * describe the scene the gather draws (the same node matrices). */
 void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt);
-/* Whether texel `texel` is covered as the gather with a tracer decides it: from its centre (lifted by
- * set->offset), straight out the back of a triangle (the texel lies inside a closed mesh), or a lid within
- * a texel's width (trace/rt_scene.h, lm_rt_lidded) (docs/gather.md, "Covered texels"). */
+/* Whether texel `texel` is covered as the gather with a tracer decides it: straight out from its centre
+ * (lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel
+ * lies inside a closed mesh) (docs/gather.md, "Covered texels"). */
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
                      uint32_t texel);
 /* Where texel `texel` gathers from: its centre lifted along the shading normal by set->offset x the scene

@@ -438,19 +438,15 @@ void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, c
     lm_v3_store(ng, v.ng);
 }
 
-/* Whether the texel at eye, normal n is covered (lm_texel_covered): the inside of a solid (straight out
- * from it the back of a triangle by its winding: the texel is inside a closed mesh, such as the floor
- * under a box that stands on it), or under a lid within a texel's width (lm_rt_lidded). Geometry that
- * is near but hides only part of the hemisphere, such as a ball hovering a few centimetres over the
- * floor, leaves the texel valid: its gather sees the ball and the light around it. */
+/* Whether the texel at eye, normal n is covered (lm_texel_covered): straight out from it, other geometry
+ * within a texel's width, or the inside of a solid (the back of a triangle by its winding: the texel is
+ * inside a closed mesh, such as the floor under a box that stands on it). */
 static int covered_at(const lm_rt *rt, const lm_atlas *a, const float eye[3], const float n[3])
 {
     lm_rt_hit h;
     if (!lm_rt_intersect(rt, eye, n, 0.0f, INFINITY, &h))
         return 0;
-    if (lm_dot(lm_v3_load(h.ng), lm_v3_load(n)) > 0.0f)
-        return 1;
-    return h.t <= a->texel_size && lm_rt_lidded(rt, eye, n, a->texel_size);
+    return h.t <= a->texel_size || lm_dot(lm_v3_load(h.ng), lm_v3_load(n)) > 0.0f;
 }
 
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
