@@ -454,7 +454,8 @@ static lmgi_status bake_owned(lmgi_updater *u, const lmgi_bake_desc *desc, lmgi_
     lm_log_target saved = lm_api_enter(u->ctx);
     lm_bake_stats bs;
     lm_error e;
-    lm_status st = lm_frame_loop_bake(u->loop, d.time, d.fresh_plan != 0, d.progress ? bake_progress : NULL, &d, d.cancel, &bs, &e);
+    lm_status st = lm_frame_loop_bake(u->loop, d.time, d.fresh_plan != 0, d.progress ? bake_progress : NULL, &d,
+                                      d.cancel, &bs, &e);
     if (st == LM_OK)
         lm_info("%s: bake: %u of %u photon paths changed, %d AIM surfaces, %u texels (%d surfaces for what they "
                 "see), %d surfaces changed", u->sc->scene->path, bs.photons_changed, bs.photons_traced,

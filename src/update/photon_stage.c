@@ -339,7 +339,6 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     ps->delta_before = calloc(S, sizeof *ps->delta_before);
     if (!ps->refreshed || !ps->delta_before)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
-    lm_photon_settings photons = photon_settings(ps);
     st = make_photons(ps, &ps->photons, err);
     if (st == LM_OK)
         st = find_portals(ps, err);
@@ -350,7 +349,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         st = lm_aim_init(&ps->aim, ps->scene, ps->surfaces, ps->atlas, &ps->set.aim, err);
     ps->have_aim = st == LM_OK;
     if (st == LM_OK && ps->set.exact_direct)
-        st = setup_direct(ps, photons.cover_distance, err);
+        st = setup_direct(ps, photon_settings(ps).cover_distance, err);
     if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);
@@ -543,13 +542,14 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan,
     if (st == LM_OK)
         st = lm_photons_trace_all(ps->photons, &out->photons, err);
     double t2 = lm_now();
-    if (st == LM_OK && ps->set.aims && replan)
+    if (st == LM_OK && ps->set.aims && replan) {
         st = refresh_all_aims(ps, &out->aim, err);
-    float threshold = ps->aim.set.delta_threshold; /* a bake refreshes every surface whose photons changed */
-    ps->aim.set.delta_threshold = 0.0f;
-    if (st == LM_OK && ps->set.aims && !replan)
+    } else if (st == LM_OK && ps->set.aims) {
+        float threshold = ps->aim.set.delta_threshold; /* a bake refreshes every surface whose photons changed */
+        ps->aim.set.delta_threshold = 0.0f;
         st = refresh_aims(ps, -1, &out->aim, err);
-    ps->aim.set.delta_threshold = threshold;
+        ps->aim.set.delta_threshold = threshold;
+    }
     out->t_photons = t2 - t1;
     out->t_aim = lm_now() - t2;
     out->t_total = out->t_animate + out->t_photons + out->t_aim + out->t_caustics;

@@ -25,17 +25,17 @@ void lm_iim_settings_default(lm_iim_settings *s)
 
 /* The six atlas textures in binding order (glsl/iim_blend_cs.glsl): fresh, old, new, display, delta, carry. */
 #define IIM_TEXTURES 6
-static void textures(const lm_iim *iim, unsigned tex[IIM_TEXTURES])
+static void textures(lm_iim *iim, unsigned *tex[IIM_TEXTURES])
 {
-    const unsigned t[IIM_TEXTURES] = {iim->fresh_tex,   iim->old_tex,   iim->new_tex,
-                                      iim->display_tex, iim->delta_tex, iim->carry_tex};
+    unsigned *t[IIM_TEXTURES] = {&iim->fresh_tex,   &iim->old_tex,   &iim->new_tex,
+                                 &iim->display_tex, &iim->delta_tex, &iim->carry_tex};
     memcpy(tex, t, sizeof t);
 }
 
 static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
 {
-    unsigned *tex[IIM_TEXTURES] = {&iim->fresh_tex,   &iim->old_tex,   &iim->new_tex,
-                                   &iim->display_tex, &iim->delta_tex, &iim->carry_tex};
+    unsigned *tex[IIM_TEXTURES];
+    textures(iim, tex);
     for (int i = 0; i < IIM_TEXTURES; i++)
         if (!(*tex[i] = lm_iim_texture_create(a->width, a->height)))
             return lm_fail(err, LM_ERR_BACKEND, "IIM: could not make a %dx%d RGBA32F texture", a->width, a->height);
@@ -108,10 +108,10 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
 
 void lm_iim_free(lm_iim *iim)
 {
-    unsigned tex[IIM_TEXTURES];
+    unsigned *tex[IIM_TEXTURES];
     textures(iim, tex);
     for (int i = 0; i < IIM_TEXTURES; i++)
-        lm_iim_texture_free(tex[i]);
+        lm_iim_texture_free(*tex[i]);
     if (iim->blend_prog) {
         GLuint bufs[8] = {iim->surface_buf, iim->params_buf, iim->start_buf, iim->list_buf,
                           iim->chart_buf,   iim->redraw_buf, iim->ops_buf,   iim->flag_buf};
@@ -229,10 +229,10 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glUniform1i(glGetUniformLocation(iim->blend_prog, "blend_frames"), iim->set.blend_frames);
     glUniform1f(glGetUniformLocation(iim->blend_prog, "limit"), iim->set.backface_limit);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "spread"), iim->set.spread);
-    unsigned tex[IIM_TEXTURES];
+    unsigned *tex[IIM_TEXTURES];
     textures(iim, tex);
     for (int i = 0; i < IIM_TEXTURES; i++)
-        glBindImageTexture((GLuint)i, tex[i], 0, GL_FALSE, 0, i ? GL_READ_WRITE : GL_READ_ONLY, GL_RGBA32F);
+        glBindImageTexture((GLuint)i, *tex[i], 0, GL_FALSE, 0, i ? GL_READ_WRITE : GL_READ_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, iim->surface_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->params_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, iim->start_buf);
@@ -259,10 +259,10 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
 
 lm_status lm_iim_clear(lm_iim *iim, lm_error *err)
 {
-    unsigned tex[IIM_TEXTURES];
+    unsigned *tex[IIM_TEXTURES];
     textures(iim, tex);
     for (int i = 0; i < IIM_TEXTURES; i++)
-        glClearTexImage(tex[i], 0, GL_RGBA, GL_FLOAT, NULL);
+        glClearTexImage(*tex[i], 0, GL_RGBA, GL_FLOAT, NULL);
     glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     return lm_gl_check("clearing the IIM", err);
 }
