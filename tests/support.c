@@ -59,6 +59,12 @@ static void remove_tmpdirs(void)
         nftw(made[i], remove_entry, 16, FTW_DEPTH | FTW_PHYS);
 }
 
+void lmt_filter_from_env(void)
+{
+    if (getenv("LMT_FILTER"))
+        cmocka_set_test_filter(getenv("LMT_FILTER"));
+}
+
 const char *lmt_tmpdir(void)
 {
     static char buf[64];

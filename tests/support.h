@@ -11,6 +11,9 @@
 const char *lmt_shared_scene(const char *relative);
 /* Path of a file under the project's scenes/ (generated scenes); NULL if missing. */
 const char *lmt_project_scene(const char *relative);
+/* Runs only the tests whose names match $LMT_FILTER (cmocka's wildcards), when it is set: one case of a
+ * long binary while working on it, e.g. LMT_FILTER=test_command_help. Call before running the group. */
+void lmt_filter_from_env(void);
 /* A fresh empty temporary directory for the calling test (static storage). */
 const char *lmt_tmpdir(void);
 /* The whole file in a malloc'd buffer with `extra` spare bytes after it (for mutations); *size its

@@ -1075,7 +1075,6 @@ int main(void)
         cmocka_unit_test(test_mirror_facing_mirror),
         cmocka_unit_test(test_glossy_floor_roughness),
     };
-    if (getenv("LMT_FILTER")) /* one case while working on it, e.g. LMT_FILTER=test_grazing_light */
-        cmocka_set_test_filter(getenv("LMT_FILTER"));
+    lmt_filter_from_env();
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
