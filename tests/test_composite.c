@@ -16,6 +16,7 @@
 
 #include "../src/gpu/frame/composite.h"
 #include "../src/gpu/gl/gl_api.h"
+#include "../src/gpu/gl/offscreen.h"
 #include "support.h"
 
 #define HOLE 9 /* side of the square hole in quad 0's middle: its centre lies 5 steps from a valid texel */
@@ -81,13 +82,7 @@ static void test_holes_filled_within_their_surface(void **state)
     assert_true(hi[0] - lo[0] >= HOLE + 4 && hi[1] - lo[1] >= HOLE + 4);
     assert_true(touching >= hi[1] - lo[1]);
 
-    GLuint tex;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D, tex);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, W, H, 0, GL_RGBA, GL_FLOAT, iim);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    GLuint tex = lm_float_texture(W, H, iim);
     lm_composite *comp = NULL;
     lm_error err;
     unsigned lit = 0;

@@ -35,19 +35,6 @@ static void fill_covered(const lm_scene *s, const lm_atlas *a, float *out)
     }
 }
 
-/* An atlas-sized RGBA32F texture, nearest filtered, its texels left to lm_composite_update_coverage. */
-static GLuint coverage_texture(int w, int h)
-{
-    GLuint tex;
-    glGenTextures(1, &tex);
-    glBindTexture(GL_TEXTURE_2D, tex);
-    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
-    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, NULL);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    return tex;
-}
-
 lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
     float *covered = calloc(4 * (size_t)a->width * a->height, sizeof(float));
@@ -71,7 +58,7 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->width = a->width;
     c->height = a->height;
     c->limit = backface_limit;
-    c->covered_tex = coverage_texture(a->width, a->height);
+    c->covered_tex = lm_float_texture(a->width, a->height, NULL); /* texels: lm_composite_update_coverage */
     lm_status st = lm_composite_update_coverage(c, s, a, err);
     if (st == LM_OK)
         st = lm_gl_program("composite_premultiply", lm_glsl_premultiply_vs, lm_glsl_premultiply_fs, &c->premult_prog, err);

@@ -6,6 +6,18 @@
 
 #include "gl_shader.h"
 
+unsigned lm_float_texture(int w, int h, const float *rgba)
+{
+    GLuint tex;
+    glGenTextures(1, &tex);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+    glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, rgba);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    return tex;
+}
+
 void lm_offscreen_release(lm_offscreen *o)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -105,12 +117,8 @@ lm_status lm_float_target_ensure(lm_float_target *t, int width, int height, int 
     t->attachments = attachments;
     glGenFramebuffers(1, &t->fbo);
     glBindFramebuffer(GL_FRAMEBUFFER, t->fbo);
-    glGenTextures(attachments, t->color);
     for (int i = 0; i < attachments; i++) {
-        glBindTexture(GL_TEXTURE_2D, t->color[i]);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, width, height, 0, GL_RGBA, GL_FLOAT, NULL);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        t->color[i] = lm_float_texture(width, height, NULL);
         glFramebufferTexture2D(GL_FRAMEBUFFER, bufs[i], GL_TEXTURE_2D, t->color[i], 0);
     }
     /* depth as a texture: the caustic pass reads the frame's depth (gpu/frame/caustic_pass.h) */

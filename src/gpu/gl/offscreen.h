@@ -23,6 +23,10 @@ void lm_offscreen_read_rgb(const lm_offscreen *o, float *rgb);
 /* Unbinds and deletes a target (after lm_offscreen_read_rgb, or on an error path). */
 void lm_offscreen_release(lm_offscreen *o);
 
+/* A new w x h RGBA32F texture, nearest filtered, holding rgba (w*h*4 floats, row 0 first) or, for NULL,
+ * undefined texels; left bound to GL_TEXTURE_2D. */
+unsigned lm_float_texture(int w, int h, const float *rgba);
+
 /* A persistent float target for per-frame passes: 1 to 3 RGBA32F colour textures (sampleable, e.g. by
  * a later pass) and a 24-bit depth texture (sampleable: the caustic pass reads it), kept between frames
  * and re-made only when the size or the attachment count changes. Zero-initialise before the first lm_float_target_ensure. */
