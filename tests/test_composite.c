@@ -46,8 +46,9 @@ static void test_holes_filled_within_their_surface(void **state)
     int lo[2] = {W, H}, hi[2] = {0, 0}; /* quad 0's texels' bounding box */
     for (uint32_t t = 0; t < a->texel_count; t++)
         if (a->texels[t].surface == 0) {
-            lo[0] = a->texels[t].x < lo[0] ? a->texels[t].x : lo[0], lo[1] = a->texels[t].y < lo[1] ? a->texels[t].y : lo[1];
-            hi[0] = a->texels[t].x > hi[0] ? a->texels[t].x : hi[0], hi[1] = a->texels[t].y > hi[1] ? a->texels[t].y : hi[1];
+            const int at[2] = {a->texels[t].x, a->texels[t].y};
+            for (int k = 0; k < 2; k++)
+                lo[k] = at[k] < lo[k] ? at[k] : lo[k], hi[k] = at[k] > hi[k] ? at[k] : hi[k];
         }
     /* the packer leaves the charts apart: quad 0's last column is handed to surface 1, so that two
      * surfaces touch in the atlas as they may in a tight one */
@@ -86,7 +87,8 @@ static void test_holes_filled_within_their_surface(void **state)
     lm_composite *comp = NULL;
     lm_error err;
     unsigned lit = 0;
-    if (lm_composite_create(p.s, a, 0.1f, &comp, &err) != LM_OK || lm_composite_indirect(comp, tex, &lit, &err) != LM_OK)
+    if (lm_composite_create(p.s, a, 0.1f, &comp, &err) != LM_OK ||
+        lm_composite_indirect(comp, tex, &lit, &err) != LM_OK)
         fail_msg("%s", err.msg);
     float *out = malloc(sizeof *out * 4 * (size_t)W * H);
     assert_non_null(out);

@@ -131,7 +131,8 @@ static void soak(soak_run *r)
     }
     print_message("%s: %d updates after random edits (%ld lights added, %ld removed, %ld nodes moved, %ld lights "
                   "and %ld materials edited): at most %d shadow maps, %d photon groups, %d AIMs and %u caustic "
-                  "photons an update; resident memory at %d lights at most %.1f MB in the middle third, %.1f MB in the last\n", r->scene,
+                  "photons an update; resident memory at %d lights at most %.1f MB in the middle third, %.1f MB in "
+                  "the last\n", r->scene,
                   r->updates, edits.made[LM_EDIT_ADD_LIGHT], edits.made[LM_EDIT_REMOVE_LIGHT],
                   edits.made[LM_EDIT_NODE], edits.made[LM_EDIT_LIGHT], edits.made[LM_EDIT_MATERIAL], r->worst_maps,
                   r->worst_groups, r->worst_aims, r->worst_caustic, r->max_lights, r->mb_mid, r->mb_last);

@@ -9,8 +9,8 @@
  * give each invalid texel the mean colour of its valid (or already filled) 4-neighbours of the same
  * surface at a weight of 1/1024, so such a pixel shows its surface's light around the hole and a valid
  * texel in the footprint still decides the rest. Holes wider than twice the steps stay black at their
- * centre. The direct light's first pass multiplies it by kd and adds it (gpu/frame/direct.h, lm_direct_set_indirect): the
- * sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
+ * centre. The direct light's first pass multiplies it by kd and adds it (gpu/frame/direct.h,
+ * lm_direct_set_indirect): the sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
  * light, nor do nodes whose indirect light is switched off (extras "indirect": false, lmgi_set_node_effects).
  * Program and target persist. */
 #ifndef LM_COMPOSITE_H

@@ -15,10 +15,10 @@ void main() {
         frag = v;
         return;
     }
-    const ivec2 step[4] = ivec2[4](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1));
+    const ivec2 beside[4] = ivec2[4](ivec2(1, 0), ivec2(-1, 0), ivec2(0, 1), ivec2(0, -1));
     vec4 sum = vec4(0.0);
     for (int k = 0; k < 4; k++) {
-        ivec2 n = q + step[k];
+        ivec2 n = q + beside[k];
         if (any(lessThan(n, ivec2(0))) || any(greaterThanEqual(n, size)) || texelFetch(covered, n, 0).g != c.g)
             continue;
         vec4 s = texelFetch(src, n, 0);
