@@ -1,8 +1,8 @@
 /* The frame's indirect texture (gpu/frame/composite.h): the display IIM premultiplied by each texel's
  * validity, and the holes filled. Two floor quads of 20 x 20 texels, each lit uniformly (E = pi and
  * 5 pi), with texels made invalid by hand: a valid texel keeps its own value at full weight; an invalid one
- * within LM_COMPOSITE_FILL_STEPS of a valid texel of its surface gets that surface's light at a weight of
- * 1/1024, never the other surface's where the two touch in the atlas; the centre of a hole
+ * within LM_COMPOSITE_FILL_REACH (|dx| + |dy|) of a valid texel of its surface gets that surface's light
+ * at a weight of 1/1024, never the other surface's where the two touch in the atlas; the centre of a hole
  * wider than that stays empty. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -20,6 +20,7 @@
 #include "support.h"
 
 #define HOLE 9 /* side of the square hole in quad 0's middle: its centre lies 5 steps from a valid texel */
+_Static_assert(HOLE / 2 == LM_COMPOSITE_FILL_REACH, "only the hole's centre lies beyond the fill's reach");
 
 static float surface_e(int surface) { return surface == 0 ? (float)M_PI : 5.0f * (float)M_PI; }
 
@@ -112,8 +113,8 @@ static void test_holes_filled_within_their_surface(void **state)
                     assert_true(fabs(o[c] / o[3] - want) < 1e-5 * want);
                 continue;
             }
-            /* the fill steps through 4-neighbours: a texel of the hole lies 5 - max(|dx|, |dy|) steps from
-             * the valid texels around it, so only its centre is farther than the 4 steps */
+            /* a texel of the hole lies |dx| + |dy| = 5 - max(|dx|, |dy|) from the nearest valid texels
+             * around it, so only its centre is farther than the reach of 4 */
             if (s == 0 && x == cx && y == cy) {
                 assert_true(o[3] == 0.0f);
                 empty++;

@@ -1,6 +1,7 @@
 /* The indirect term of a frame's composite (composite.h): a premultiplied IIM / pi atlas, rendered by one
- * atlas-sized pass (glsl/premultiply_*.glsl); the direct light's first pass samples it and multiplies by
- * kd. Target and program persist. */
+ * atlas-sized pass (glsl/premultiply_*.glsl), and its holes filled by a second pass that the depth test
+ * confines to them (glsl/fill_holes_fs.glsl); the direct light's first pass samples it and multiplies by
+ * kd. Target and programs persist. */
 #include "composite.h"
 
 #include "../../core/vecmath.h"
@@ -18,9 +19,9 @@ struct lm_composite {
     GLuint covered_tex, premult_prog, empty_vao;
     float limit;
     GLuint fill_prog;
-    GLint p_limit, p_covered, p_iim, f_src, f_covered;
-    lm_float_target lit[2]; /* atlas-sized, linear filter: (E / pi * w, w), w = covered and valid; the
-                             * premultiply draws into 0, the hole fill's steps go 0 -> 1 -> 0 */
+    GLint p_limit, p_covered, p_iim, f_limit, f_covered, f_iim, f_reach;
+    lm_float_target lit; /* atlas-sized, linear filter: (E / pi * w, w), w = covered and valid (1), filled
+                          * (LM_COMPOSITE_FILL_WEIGHT) or 0 */
 };
 
 /* Red: 1 at every texel of the texel table (covered by some triangle) whose node takes indirect light, 0
@@ -72,8 +73,10 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
     c->p_covered = glGetUniformLocation(c->premult_prog, "covered");
     c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
-    c->f_src = glGetUniformLocation(c->fill_prog, "src");
+    c->f_limit = glGetUniformLocation(c->fill_prog, "limit");
     c->f_covered = glGetUniformLocation(c->fill_prog, "covered");
+    c->f_iim = glGetUniformLocation(c->fill_prog, "iim");
+    c->f_reach = glGetUniformLocation(c->fill_prog, "reach");
     *out = c;
     return LM_OK;
 }
@@ -91,21 +94,17 @@ void lm_composite_free(lm_composite *c)
         glDeleteProgram(c->fill_prog);
     if (c->empty_vao)
         glDeleteVertexArrays(1, &c->empty_vao);
-    lm_float_target_free(&c->lit[0]);
-    lm_float_target_free(&c->lit[1]);
+    lm_float_target_free(&c->lit);
     free(c);
 }
 
-/* The premultiplied atlas (c->lit[0], bound) from the display IIM. */
-static void premultiply(const lm_composite *c, unsigned iim_tex)
+/* Draws the full-screen triangle with program prog, the coverage on unit 0 and the IIM on unit 1. */
+static void atlas_pass(const lm_composite *c, GLuint prog, GLint limit, GLint covered, GLint iim, unsigned iim_tex)
 {
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    glDisable(GL_CULL_FACE);
-    glUseProgram(c->premult_prog);
-    glUniform1f(c->p_limit, c->limit);
-    glUniform1i(c->p_covered, 0);
-    glUniform1i(c->p_iim, 1);
+    glUseProgram(prog);
+    glUniform1f(limit, c->limit);
+    glUniform1i(covered, 0);
+    glUniform1i(iim, 1);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, c->covered_tex);
     glActiveTexture(GL_TEXTURE1);
@@ -114,42 +113,42 @@ static void premultiply(const lm_composite *c, unsigned iim_tex)
     glDrawArrays(GL_TRIANGLES, 0, 3);
 }
 
-/* One step of the hole fill (glsl/fill_holes_fs.glsl) from lit[from] into lit[1 - from]. */
-static lm_status fill_step(lm_composite *c, int from, lm_error *err)
+/* The premultiplied atlas (c->lit, bound) from the display IIM, its holes at depth 0 and every other
+ * texel at 1; then the fill over the holes alone: its triangle lies at depth 0.5 and passes GL_GREATER
+ * only there, so a frame pays for the search where there are holes, not over the atlas (on a software
+ * rasteriser a shader's untaken branch is not free). */
+static void premultiply_and_fill(const lm_composite *c, unsigned iim_tex)
 {
-    lm_status st = lm_float_target_ensure(&c->lit[1 - from], c->width, c->height, 1, err);
-    if (st != LM_OK)
-        return st;
+    glDisable(GL_BLEND);
+    glDisable(GL_CULL_FACE);
+    glEnable(GL_DEPTH_TEST);
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_ALWAYS);
+    atlas_pass(c, c->premult_prog, c->p_limit, c->p_covered, c->p_iim, iim_tex);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_GREATER);
     glUseProgram(c->fill_prog);
-    glUniform1i(c->f_src, 1);
-    glUniform1i(c->f_covered, 0);
-    glActiveTexture(GL_TEXTURE0);
-    glBindTexture(GL_TEXTURE_2D, c->covered_tex);
-    glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, c->lit[from].color[0]); /* read by texelFetch: no filter */
-    glBindVertexArray(c->empty_vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
-    return LM_OK;
+    glUniform1i(c->f_reach, LM_COMPOSITE_FILL_REACH);
+    atlas_pass(c, c->fill_prog, c->f_limit, c->f_covered, c->f_iim, iim_tex);
+    glDepthFunc(GL_LESS);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_DEPTH_TEST);
 }
 
 lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit_tex, lm_error *err)
 {
-    lm_status st = lm_float_target_ensure(&c->lit[0], c->width, c->height, 1, err);
+    lm_status st = lm_float_target_ensure(&c->lit, c->width, c->height, 1, err);
     if (st != LM_OK)
         return st;
-    premultiply(c, iim_tex);
-    for (int k = 0; k < LM_COMPOSITE_FILL_STEPS && st == LM_OK; k++)
-        st = fill_step(c, k & 1, err);
-    if (st != LM_OK)
-        return st;
+    premultiply_and_fill(c, iim_tex);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glActiveTexture(GL_TEXTURE1);
-    glBindTexture(GL_TEXTURE_2D, c->lit[0].color[0]); /* an even count of steps ends in 0 */
+    glBindTexture(GL_TEXTURE_2D, c->lit.color[0]);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR); /* sampled with the bilinear filter */
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
     glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
     glActiveTexture(GL_TEXTURE0);
-    *lit_tex = c->lit[0].color[0];
+    *lit_tex = c->lit.color[0];
     return lm_gl_check("composite: indirect", err);
 }

@@ -5,12 +5,13 @@
  * with a bilinear filter; sampled at a visible point's lightmap uv, rgb / a is then the filter over the
  * four nearest texels that weighs only covered, valid ones, so gutters and invalid texels never darken a
  * chart's border. Where none of the four is valid (a floor under a ball hovering less than a texel over
- * it, whose texels are covered: docs/gather.md), the pixel would be black: LM_COMPOSITE_FILL_STEPS passes
- * give each invalid texel the mean colour of its valid (or already filled) 4-neighbours of the same
- * surface at a weight of 1/1024, so such a pixel shows its surface's light around the hole and a valid
- * texel in the footprint still decides the rest. Holes wider than twice the steps stay black at their
- * centre. The direct light's first pass multiplies it by kd and adds it (gpu/frame/direct.h,
- * lm_direct_set_indirect): the sum needs no pass of its own. Mirror and glass (no lightmap texels) and the background get no indirect
+ * it, whose texels are covered: docs/gather.md), the pixel would be black: the same pass gives each
+ * invalid texel the mean colour of the valid texels of its surface on the nearest diamond around it
+ * (|dx| + |dy| = d <= LM_COMPOSITE_FILL_REACH) at a weight of 1/1024, so such a pixel shows its surface's
+ * light around the hole and a valid texel in the footprint still decides the rest. Holes wider than twice
+ * the reach stay black at their centre; only hole texels pay for the search. The direct light's first pass
+ * multiplies it by kd and adds it (gpu/frame/direct.h, lm_direct_set_indirect): the sum needs no pass of
+ * its own. Mirror and glass (no lightmap texels) and the background get no indirect
  * light, nor do nodes whose indirect light is switched off (extras "indirect": false, lmgi_set_node_effects).
  * Program and target persist. */
 #ifndef LM_COMPOSITE_H
@@ -20,7 +21,7 @@
 
 typedef struct lm_composite lm_composite;
 
-#define LM_COMPOSITE_FILL_STEPS 4 /* even: the last step writes the texture the frame samples */
+#define LM_COMPOSITE_FILL_REACH 4 /* texels (|dx| + |dy|) a hole texel looks for its surface's light */
 
 /* Builds the coverage texture and the program. Needs a current GL context. */
 lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backface_limit, lm_composite **out,
