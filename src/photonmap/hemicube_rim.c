@@ -64,14 +64,30 @@ static lm_vec3 rim_dir(const lm_rim *r, lm_vec3 B, lm_vec3 T, lm_vec3 N, double 
 }
 
 #define SUB 4 /* sub-directions per side of a stratum: its footprint on the hit's plane */
+#define SKY_RAYS 36 /* an image sky's directions drawn by brightness a texel, beside the strata (a square) */
+
+/* With an image sky over the whole hemisphere (the rays gather), its light is met two ways: by the K
+ * strata, cosine-weighted (p_a = cos / pi), and by SKY_RAYS directions drawn by brightness (p_b,
+ * lm_sky_sample), each weighed by the balance heuristic: a sample from either adds L cos / (K p_a + M p_b)
+ * to E. A sun a few pixels wide, which one ray a stratum hits or misses, is then found every time. */
+typedef struct {
+    int on, K, M;
+} sky_mis;
+
+/* The strata's share of a sky direction d (unit normal n) whose p_b is pdf: K p_a / (K p_a + M p_b). */
+static double strata_share(const sky_mis *m, lm_vec3 n, const float d[3], double pdf)
+{
+    double ka = m->K * fmax((double)lm_dot(lm_v3_load(d), n), 0.0) / LM_PI, mb = m->M * pdf;
+    return ka + mb > 0.0 ? ka / (ka + mb) : 1.0;
+}
 
 /* The stratum (phi0 + [0, dphi), u0 + [0, du)) of the rim: one ray through its middle and, on the plane
  * of the triangle it hits, the AIM averaged over the stratum's footprint (SUB x SUB sub-directions met
  * with that plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel
  * averages its footprint: a small bright spot is then shared among the strata it overlaps instead of
  * being all or nothing for one. Returns the weighted radiance sum (times SUB^2). */
-static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, lm_vec3 N, lm_vec3 G, double phi0,
-                    double dphi, double u0, double du, double sum[3], double *back)
+static void stratum(const lm_rim *r, const sky_mis *mis, const float eye[3], lm_vec3 B, lm_vec3 T, lm_vec3 N,
+                    lm_vec3 G, double phi0, double dphi, double u0, double du, double sum[3], double *back)
 {
     double w;
     float dir[3];
@@ -81,10 +97,15 @@ static void stratum(const lm_rim *r, const float eye[3], lm_vec3 B, lm_vec3 T, l
     lm_rt_hit h;
     if (!lm_rt_intersect(r->rt, eye, dir, 0.0f, INFINITY, &h)) {
         float sky[3] = {r->sky[0], r->sky[1], r->sky[2]};
-        if (r->scene->has_sky) /* the scene's own, which may differ by direction */
+        double share = 1.0, pdf;
+        if (mis->on) {
+            lm_sky_radiance_pdf(r->scene, dir, sky, &pdf);
+            share = strata_share(mis, N, dir, pdf);
+        } else if (r->scene->has_sky) { /* the scene's own, which may differ by direction */
             lm_sky_radiance(r->scene, dir, sky);
+        }
         for (int c = 0; c < 3; c++)
-            sum[c] += SUB * SUB * w * sky[c];
+            sum[c] += SUB * SUB * w * share * sky[c];
         return;
     }
     const lm_material *m = &r->scene->materials[r->scene->tri_material[h.tri]];
@@ -136,13 +157,27 @@ void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], co
 {
     int side = (int)sqrtf((float)r->samples);
     double shift[2], sum[3] = {0.0, 0.0, 0.0}, back_w = 0.0;
-    lm_seed_shift(seed, shift); /* shift[1] unused: the footprints already cover each stratum */
+    lm_seed_shift(seed, shift); /* shift[1]: the sky's directions only; the footprints cover each stratum */
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
     double d = 1.0 / side;
+    int K = side * side;
+    sky_mis m = {r->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r->scene), K, SKY_RAYS};
     for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
         for (int j = 0; j < side; j++)
-            stratum(r, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum, &back_w);
-    int K = side * side;
+            stratum(r, &m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum, &back_w);
+    int ms = (int)sqrt((double)SKY_RAYS);
+    for (int j = 0; m.on && j < m.M; j++) { /* the sky's own directions: a grid of strata, shifted per texel */
+        float dir[3], L[3];
+        lm_sky_sample(r->scene, (float)((j / ms + shift[1]) / ms), (float)((j % ms + shift[0]) / ms), dir);
+        double cos_n = lm_dot(lm_v3_load(dir), N);
+        if (cos_n <= 0.0 || lm_dot(lm_v3_load(dir), G) <= 0.0f || lm_rt_occluded(r->rt, eye, dir, 0.0f, INFINITY))
+            continue;
+        double pdf;
+        lm_sky_radiance_pdf(r->scene, dir, L, &pdf);
+        double f = cos_n / (K * cos_n / LM_PI + m.M * pdf) * K * SUB * SUB / LM_PI;
+        for (int c = 0; c < 3; c++)
+            sum[c] += f * L[c];
+    }
     for (int c = 0; c < 3; c++)
         out[c] = K ? (float)(LM_PI * sum[c] / ((double)K * SUB * SUB)) : 0.0f;
     if (back)

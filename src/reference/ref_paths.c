@@ -253,13 +253,17 @@ static void trace(const lm_ref_ctx *c, lm_ref_rng *r, lm_vec3 org, lm_vec3 dir, 
         lm_v3_store(of, org);
         lm_v3_store(df, dir);
         if (!lm_rt_intersect(c->rt, of, df, 0.0f, INFINITY, &hit)) {
-            /* the sky where the ray leaves: met like an emitter (no light sample of it to weigh against),
+            /* the sky where the ray leaves: met like an emitter, weighed against its light samples where
+             * an image sky is drawn by brightness (lm_emitter_sample_toward) and the vertex took them;
              * seen from the receiver it is the IIM's part, from the eye the background's */
             int part = route_hit(&rt, 0);
-            float sky[3];
-            lm_sky_radiance(c->s, df, sky);
+            float sky[3], w = 1.0f;
+            double pl;
+            lm_sky_radiance_pdf(c->s, df, sky, &pl);
+            if (prev_pdf > 0.0f && lm_sky_by_brightness(c->s))
+                w = power_heuristic(prev_pdf, (float)pl);
             if (part != DROPPED && c->s->has_sky)
-                tally_add(out, part, beta, sky, 1.0f);
+                tally_add(out, part, beta, sky, w);
             return;
         }
         lm_shading sh;

@@ -195,7 +195,8 @@ typedef struct {
     float sky_horizon[3];  /* LM_SKY_GRADIENT: the radiance at and below the horizon */
     int sky_width, sky_height; /* LM_SKY_IMAGE: an equirectangular image, row 0 at the zenith, the middle
                                 * column towards -z, +x three quarters across (sky.h) */
-    float *sky_image;      /* sky_width x sky_height x 3 floats, times sky[] */
+    float *sky_image;      /* sky_width x sky_height x 3 floats, times sky[]; then, in the same block, the
+                            * running sums lm_sky_sample draws directions by (scene/sky.c) */
     float sky_image_mean[3]; /* its mean over the sphere (solid-angle weighted), made as it is loaded */
 
     /* Portals (docs/levels.md, "Portals"): the triangles of the nodes tagged extras.lmgi.portal, world

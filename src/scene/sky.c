@@ -16,12 +16,16 @@
 
 int lm_sky_is_uniform(const lm_scene *s) { return !s->has_sky || s->sky_kind == LM_SKY_UNIFORM; }
 
-/* Bilinear lookup of the equirectangular image at (u, v) in [0, 1)^2, u wrapping round, v clamped. */
-static void image_at(const lm_scene *s, double u, double v, float out[3])
+/* Bilinear lookup of the equirectangular image at (u, v) in [0, 1)^2, u wrapping round, v clamped; with
+ * b (may be NULL) the same lookup of the pixels' brightest channel, and k the row of cells between pixel
+ * centres it lies in (lm_sky_sample's: 0 and h the clamped half rows at the top and the bottom). */
+static void image_at(const lm_scene *s, double u, double v, float out[3], double *b, int *k)
 {
     int w = s->sky_width, h = s->sky_height;
     double x = u * w - 0.5, y = v * h - 0.5;
     x -= floor(x / w) * w;
+    if (k)
+        *k = y < 0.0 ? 0 : y >= h - 1 ? h : (int)y + 1;
     y = y < 0.0 ? 0.0 : y > h - 1 ? h - 1 : y;
     int x0 = (int)x % w, x1 = (x0 + 1) % w, y0 = (int)y, y1 = y0 + 1 < h ? y0 + 1 : y0;
     float fx = (float)(x - floor(x)), fy = (float)(y - y0);
@@ -29,6 +33,12 @@ static void image_at(const lm_scene *s, double u, double v, float out[3])
     const float *p01 = s->sky_image + 3 * ((size_t)y1 * w + x0), *p11 = s->sky_image + 3 * ((size_t)y1 * w + x1);
     for (int c = 0; c < 3; c++)
         out[c] = (1.0f - fy) * ((1.0f - fx) * p00[c] + fx * p10[c]) + fy * ((1.0f - fx) * p01[c] + fx * p11[c]);
+    if (b) {
+#define BRIGHT(p) fmaxf((p)[0], fmaxf((p)[1], (p)[2]))
+        *b = (1.0 - fy) * ((1.0 - fx) * BRIGHT(p00) + fx * BRIGHT(p10)) +
+             fy * ((1.0 - fx) * BRIGHT(p01) + fx * BRIGHT(p11));
+#undef BRIGHT
+    }
 }
 
 void lm_sky_radiance(const lm_scene *s, const float d[3], float out[3])
@@ -46,7 +56,7 @@ void lm_sky_radiance(const lm_scene *s, const float d[3], float out[3])
     if (s->sky_kind == LM_SKY_IMAGE && s->sky_image) {
         double u = atan2((double)d[0], -(double)d[2]) / (2.0 * LM_PI) + 0.5;
         double v = acos(fmin(1.0, fmax(-1.0, (double)d[1]))) / LM_PI;
-        image_at(s, u, v, out);
+        image_at(s, u, v, out, NULL, NULL);
         for (int c = 0; c < 3; c++)
             out[c] *= s->sky[c];
         return;
@@ -133,8 +143,194 @@ static lm_status read_hdr(const char *path, int *w, int *h, float **rgb, lm_erro
     return *rgb ? LM_OK : lm_fail(err, LM_ERR_FORMAT, "%s: corrupt HDR image: %s", path, stbi_failure_reason());
 }
 
+/* ---- directions drawn by brightness (lm_sky_sample) ----
+ *
+ * The lookup is bilinear between pixel centres, so the brightness b (the brightest channel, bilinear like
+ * the lookup and never below any channel) is drawn exactly as it lies: in cells between four pixel
+ * centres (x wrapping round; a half-pixel band at the top and the bottom, where the lookup clamps), a row
+ * of cells by its area times its solid angle (sin theta at its middle) times its mean b, a cell of it by
+ * its mean b, and a point in it by b there (a linear marginal, then a linear conditional). So each
+ * direction's L / p stays near the same however sharp a sun; drawn pixel by pixel, uniformly inside,
+ * L / p ran over the bilinear ramp around the sun, and the rays gather's texels under it scattered twice
+ * as much. Each row's b and the rows' weights get 1/100 of their mean added, so that every direction
+ * keeps a density and float sums keep every cell however bright a sun beside it.
+ * The block after the pixels (cdf_floats): h + 1 rows of cells of w + 1 running sums (of the cells' mean
+ * b plus the row's floor), the h + 2 running sums of the rows, and the h + 1 rows' floors. */
+
+#define SKY_FLOOR 0.01 /* of the mean, added to every row's brightness and to every row's weight */
+
+static size_t cdf_floats(int w, int h) { return (size_t)(h + 1) * ((size_t)w + 1) + (size_t)(h + 2) + (size_t)(h + 1); }
+
+typedef struct {
+    const float *rgb, *cells, *rows, *floors;
+    int w, h;
+} sky_cdf;
+
+static sky_cdf cdf_of(const float *rgb, int w, int h)
+{
+    const float *cells = rgb + 3 * (size_t)w * h, *rows = cells + (size_t)(h + 1) * ((size_t)w + 1);
+    return (sky_cdf){rgb, cells, rows, rows + h + 2, w, h};
+}
+
+/* The brightest channel of pixel (x, y), x wrapping round, y clamped. */
+static float bright(const float *rgb, int w, int h, int x, int y)
+{
+    y = y < 0 ? 0 : y >= h ? h - 1 : y;
+    const float *p = rgb + 3 * ((size_t)y * w + (size_t)((x % w + w) % w));
+    return fmaxf(p[0], fmaxf(p[1], p[2]));
+}
+
+/* Cell row k: its top pixel row (the band at the top: row 0 twice; at the bottom: row h - 1 twice), its
+ * height in pixels and the y of its middle (pixel-centre coordinates, y = v h - 0.5). */
+static void cell_row(int k, int h, int *top, int *bottom, double *height, double *mid)
+{
+    *top = k == 0 ? 0 : k - 1;
+    *bottom = k == 0 ? 0 : k == h ? h - 1 : k;
+    *height = k == 0 || k == h ? 0.5 : 1.0;
+    *mid = k == 0 ? -0.25 : k == h ? h - 0.75 : k - 0.5;
+}
+
+/* The corners' b of cell (i, k), floor added: a top left, b top right, c bottom left, d bottom right. */
+static void cell_corners(const float *rgb, int w, int h, int i, int k, float f, double q[4])
+{
+    int top, bottom;
+    double height, mid;
+    cell_row(k, h, &top, &bottom, &height, &mid);
+    q[0] = bright(rgb, w, h, i, top) + f, q[1] = bright(rgb, w, h, i + 1, top) + f;
+    q[2] = bright(rgb, w, h, i, bottom) + f, q[3] = bright(rgb, w, h, i + 1, bottom) + f;
+}
+
+/* Fills the block after the pixels (cdf_floats(w, h)). */
+static void build_cdf(float *rgb, int w, int h)
+{
+    float *cells = rgb + 3 * (size_t)w * h, *rows = cells + (size_t)(h + 1) * ((size_t)w + 1), *floors = rows + h + 2;
+    double *weight = malloc(sizeof *weight * (size_t)(h + 1)), total = 0.0;
+    for (int k = 0; k <= h; k++) {
+        double q[4], sum = 0.0, run = 0.0, height, mid;
+        int top, bottom;
+        for (int i = 0; i < w; i++) {
+            cell_corners(rgb, w, h, i, k, 0.0f, q);
+            sum += 0.25 * (q[0] + q[1] + q[2] + q[3]);
+        }
+        floors[k] = sum > 0.0 ? (float)(SKY_FLOOR * sum / w) : 1.0f; /* a black row: even */
+        float *row = cells + (size_t)k * ((size_t)w + 1);
+        row[0] = 0.0f;
+        for (int i = 0; i < w; i++) {
+            cell_corners(rgb, w, h, i, k, floors[k], q);
+            run += 0.25 * (q[0] + q[1] + q[2] + q[3]);
+            row[i + 1] = (float)run;
+        }
+        cell_row(k, h, &top, &bottom, &height, &mid);
+        double wk = height * sin(LM_PI * (mid + 0.5) / h) * sum; /* area x solid angle x brightness */
+        if (weight)
+            weight[k] = wk;
+        total += wk;
+    }
+    double floor_r = SKY_FLOOR * total / (h + 1), run = 0.0;
+    rows[0] = 0.0f;
+    for (int k = 0; k <= h; k++) {
+        run += (weight ? weight[k] : 1.0) + floor_r;
+        rows[k + 1] = (float)run;
+    }
+    free(weight);
+}
+
+/* The index i of [c[i], c[i + 1]) holding t (c: n + 1 rising sums from 0; t in [0, c[n])). */
+static int find_interval(const float *c, int n, float t)
+{
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if (c[mid] <= t)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo;
+}
+
+/* t in [0, 1] where a density rising linearly from p0 to p1 over [0, 1] has its share r below. */
+static double linear_inverse(double p0, double p1, double r)
+{
+    double den = p0 + sqrt(fmax(p0 * p0 + (p1 * p1 - p0 * p0) * r, 0.0));
+    return den > 0.0 ? fmin(fmax(r * (p0 + p1) / den, 0.0), 1.0) : r;
+}
+
+/* The density per steradian of lm_sky_sample's directions where the lookup's brightness is b, in cell row
+ * k, at polar angle theta: the row's share, times the cell's share times b over the cell's mean (which is
+ * (b + floor) over the row's sum, whatever the cell), over the row's height; then per steradian, with
+ * x = u w, y = v h, u = phi / 2 pi, v = theta / pi. */
+static double density(const lm_scene *s, double b, int k, double sin_theta)
+{
+    sky_cdf c = cdf_of(s->sky_image, s->sky_width, s->sky_height);
+    double height = k == 0 || k == c.h ? 0.5 : 1.0, row = c.cells[(size_t)k * ((size_t)c.w + 1) + (size_t)c.w];
+    double xy = ((double)c.rows[k + 1] - c.rows[k]) / c.rows[c.h + 1] * (b + c.floors[k]) / row / height;
+    return xy * c.w * c.h / (2.0 * LM_PI * LM_PI * fmax(sin_theta, 1e-9));
+}
+
+void lm_sky_radiance_pdf(const lm_scene *s, const float d[3], float out[3], double *pdf)
+{
+    if (!lm_sky_by_brightness(s)) {
+        lm_sky_radiance(s, d, out);
+        *pdf = 1.0 / (4.0 * LM_PI);
+        return;
+    }
+    double u = atan2((double)d[0], -(double)d[2]) / (2.0 * LM_PI) + 0.5;
+    double v = acos(fmin(1.0, fmax(-1.0, (double)d[1]))) / LM_PI, b;
+    int k;
+    image_at(s, u, v, out, &b, &k);
+    for (int c = 0; c < 3; c++)
+        out[c] *= s->sky[c];
+    *pdf = density(s, b, k, sqrt(fmax(0.0, 1.0 - (double)d[1] * d[1])));
+}
+
+int lm_sky_by_brightness(const lm_scene *s)
+{
+    return s->has_sky && s->sky_kind == LM_SKY_IMAGE && s->sky_image &&
+           cdf_of(s->sky_image, s->sky_width, s->sky_height).rows[s->sky_height + 1] > 0.0f;
+}
+
+double lm_sky_pdf(const lm_scene *s, const float d[3])
+{
+    float L[3];
+    double pdf;
+    lm_sky_radiance_pdf(s, d, L, &pdf);
+    return pdf;
+}
+
+/* The share r of [c[i], c[i + 1]) below t. */
+static double within(const float *c, int i, float t)
+{
+    return c[i + 1] > c[i] ? fmin(fmax(((double)t - c[i]) / ((double)c[i + 1] - c[i]), 0.0), 1.0) : 0.5;
+}
+
+double lm_sky_sample(const lm_scene *s, float u0, float u1, float d[3])
+{ /* lm_sky_by_brightness(s) */
+    sky_cdf c = cdf_of(s->sky_image, s->sky_width, s->sky_height);
+    float t = fminf(fmaxf(u0, 0.0f), 1.0f) * c.rows[c.h + 1];
+    int k = find_interval(c.rows, c.h + 1, fminf(t, nextafterf(c.rows[c.h + 1], 0.0f)));
+    double r0 = within(c.rows, k, t);
+    const float *row = c.cells + (size_t)k * ((size_t)c.w + 1);
+    float tx = fminf(fmaxf(u1, 0.0f), 1.0f) * row[c.w];
+    int i = find_interval(row, c.w, fminf(tx, nextafterf(row[c.w], 0.0f)));
+    double r1 = within(row, i, tx), q[4], height, mid;
+    int top, bottom;
+    cell_row(k, c.h, &top, &bottom, &height, &mid);
+    cell_corners(c.rgb, c.w, c.h, i, k, c.floors[k], q);
+    /* the same stratum of (u0, u1) lands in the same part of the cell */
+    double fy = linear_inverse(0.5 * (q[0] + q[1]), 0.5 * (q[2] + q[3]), r0);
+    double fx = linear_inverse((1 - fy) * q[0] + fy * q[2], (1 - fy) * q[1] + fy * q[3], r1);
+    double y = k == 0 ? -0.5 + 0.5 * fy : k == c.h ? c.h - 1 + 0.5 * fy : (k - 1) + fy;
+    double theta = LM_PI * (y + 0.5) / c.h, phi = 2.0 * LM_PI * ((i + fx + 0.5) / c.w - 0.5);
+    d[0] = (float)(sin(theta) * sin(phi));
+    d[1] = (float)cos(theta);
+    d[2] = (float)(-sin(theta) * cos(phi));
+    return lm_sky_pdf(s, d);
+}
+
 /* rgb (w x h, malloc'd; taken whatever happens) as s's sky image, times scale, once every pixel and the
- * scale are finite and >= 0; `what` names it in the errors. */
+ * scale are finite and >= 0; `what` names it in the errors. The running sums of lm_sky_sample go after its
+ * pixels, in the same block, so that whoever hands the image on hands them on too. */
 static lm_status set_image(lm_scene *s, float *rgb, int w, int h, const float scale[3], const char *what,
                            lm_error *err)
 {
@@ -150,6 +346,13 @@ static lm_status set_image(lm_scene *s, float *rgb, int w, int h, const float sc
             return lm_fail(err, LM_ERR_INVALID, "%s: pixel (%zu, %zu) of the sky image is negative or not finite",
                            what, p % (size_t)w, p / (size_t)w);
         }
+    float *whole = realloc(rgb, (3 * (size_t)w * (size_t)h + cdf_floats(w, h)) * sizeof *whole);
+    if (!whole) {
+        free(rgb);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for a sky image of %d x %d pixels", what, w, h);
+    }
+    rgb = whole;
+    build_cdf(rgb, w, h);
     free(s->sky_image);
     s->sky_image = rgb, s->sky_width = w, s->sky_height = h;
     image_mean(rgb, w, h, s->sky_image_mean);

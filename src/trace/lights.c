@@ -511,19 +511,22 @@ static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[
         out->flux[c] = e->radiant[c] * scale;
 }
 
-/* A sky photon: its direction of travel uniform on the sphere (u[0], u[1]: similar directions for QMC
- * strata of those two), its origin uniform on the disk (u[2] radius, u[3] angle) of the scene's bounding
- * sphere across that direction, moved back outside the sphere; flux L(-d) 4 pi pi R^2 / count, L the sky's
- * radiance from where it comes (lm_sky_radiance). With portals (portals.h), u[2] below LM_PORTAL_SHARE
- * draws the line through a portal instead (u[2] rescaled picks it, u[3] the point, u[0], u[1] the
- * direction about its front), u[2] above it the line as before (u[2] rescaled the radius), the origin on
- * the same plane across d either way, and the flux is L(-d) over count times the mixture's density. */
+/* A sky photon: its direction of travel uniform on the sphere, or an image sky's drawn by brightness
+ * (lm_sky_sample) (u[0], u[1]: similar directions for QMC strata of those two), its origin uniform on the disk
+ * (u[2] radius, u[3] angle) of the scene's bounding sphere across that direction, moved back outside the
+ * sphere; flux L(-d) / (p(-d) pi R^2 count), L the sky's radiance from where it comes (lm_sky_radiance),
+ * p its density per steradian (1 / 4 pi when uniform). With portals (portals.h), u[2] below
+ * LM_PORTAL_SHARE draws the line through a portal instead (u[2] rescaled picks it, u[3] the point, u[0],
+ * u[1] the direction about its front), u[2] above it the line as before (u[2] rescaled the radius), the
+ * origin on the same plane across d either way, and the flux is L(-d) over count times the mixture's
+ * density. */
 static void emit_sky(const lm_emitter *e, const lm_emitters *em, const lm_scene *s, const float u[4], uint32_t count,
                      lm_emission *out)
 {
-    const double uniform = 1.0 / (4.0 * LM_PI * LM_PI * (double)em->disk_radius * em->disk_radius);
+    const double disk = LM_PI * (double)em->disk_radius * em->disk_radius;
+    const int image = lm_sky_by_brightness(s);
     int guided = e->portals && e->portals->usable;
-    float u2 = guided ? (u[2] - LM_PORTAL_SHARE) / (1.0f - LM_PORTAL_SHARE) : u[2], x[3], w[3];
+    float u2 = guided ? (u[2] - LM_PORTAL_SHARE) / (1.0f - LM_PORTAL_SHARE) : u[2], x[3], w[3], from[3];
     lm_vec3 c = lm_v3_load(em->disk_center), d, o;
     float back = 1.001f * em->disk_radius, sn, cs;
     if (guided && u[2] < LM_PORTAL_SHARE && lm_portals_sky_line(e->portals, u[2] / LM_PORTAL_SHARE, u[3], u[0], u[1], x, w)) {
@@ -531,25 +534,37 @@ static void emit_sky(const lm_emitter *e, const lm_emitters *em, const lm_scene 
         lm_vec3 p = lm_v3_load(x);
         o = lm_sub(p, lm_scale(d, lm_dot(lm_sub(p, c), d) + back));
     } else {
-        float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
-        lm_sincos_turn(u[1], &sn, &cs);
-        d = lm_v3(r * cs, r * sn, z);
+        if (image) {
+            lm_sky_sample(s, u[0], u[1], from);
+            d = lm_scale(lm_v3_load(from), -1.0f);
+        } else {
+            float z = 1.0f - 2.0f * u[0], r = sqrtf(fmaxf(0.0f, 1.0f - z * z));
+            lm_sincos_turn(u[1], &sn, &cs);
+            d = lm_v3(r * cs, r * sn, z);
+        }
         float rad = em->disk_radius * sqrtf(fminf(fmaxf(u2, 0.0f), 1.0f));
         lm_sincos_turn(u[3], &sn, &cs);
         o = lm_add(lm_sub(c, lm_scale(d, back)), lm_onb_dir(d, rad * cs, rad * sn, 0.0f));
     }
     lm_v3_store(out->org, o);
     lm_v3_store(out->dir, d);
-    double pdf = uniform;
-    if (guided) { /* the mixture's density at this line: the uniform lines' where it crosses their disk */
+    lm_v3_store(from, lm_scale(d, -1.0f));
+    /* the disk's lines' density at this one (uniform directions: as before, 1 / (4 pi pi R^2)) */
+    float L[3];
+    double dir_pdf = 0.0;
+    if (image)
+        lm_sky_radiance_pdf(s, from, L, &dir_pdf);
+    else
+        lm_sky_radiance(s, from, L);
+    double lines = image ? dir_pdf / disk : 1.0 / (4.0 * LM_PI * LM_PI * (double)em->disk_radius * em->disk_radius);
+    double pdf = lines;
+    if (guided) { /* the mixture's density at this line: the disk's lines' where it crosses their disk */
         lm_vec3 off = lm_sub(lm_sub(o, c), lm_scale(d, lm_dot(lm_sub(o, c), d)));
         double in_disk = lm_dot(off, off) <= em->disk_radius * em->disk_radius * 1.0001f;
-        pdf = (1.0 - LM_PORTAL_SHARE) * in_disk * uniform +
+        pdf = (1.0 - LM_PORTAL_SHARE) * in_disk * lines +
               LM_PORTAL_SHARE * lm_portals_density(e->portals, out->org, out->dir);
     }
-    float scale = pdf > 0.0 ? (float)(1.0 / (pdf * (double)count)) : 0.0f, from[3], L[3];
-    lm_v3_store(from, lm_scale(d, -1.0f));
-    lm_sky_radiance(s, from, L);
+    float scale = pdf > 0.0 ? (float)(1.0 / (pdf * (double)count)) : 0.0f;
     for (int k = 0; k < 3; k++)
         out->flux[k] = L[k] * scale;
 }
@@ -653,6 +668,23 @@ static int toward_area(const lm_scene *s, const lm_emitter *e, lm_vec3 p, const 
     return 1;
 }
 
+/* A direction towards an image sky drawn by brightness (lm_sky_sample), for MIS against the rays that
+ * leave the scene and meet it (which weigh themselves by lm_sky_pdf). */
+static int toward_sky(const lm_scene *s, const float u[3], lm_light_sample *out)
+{
+    float L[3];
+    double pdf;
+    lm_sky_sample(s, u[0], u[1], out->dir);
+    lm_sky_radiance_pdf(s, out->dir, L, &pdf);
+    if (!(pdf > 0.0))
+        return 0;
+    out->dist = INFINITY;
+    out->pdf = (float)pdf;
+    for (int c = 0; c < 3; c++)
+        out->weight[c] = (float)(L[c] / pdf);
+    return L[0] > 0.0f || L[1] > 0.0f || L[2] > 0.0f;
+}
+
 int lm_emitter_sample_toward(const lm_emitters *em, const lm_scene *s, int e, const float p[3],
                              const float u[3], lm_light_sample *out)
 {
@@ -660,8 +692,9 @@ int lm_emitter_sample_toward(const lm_emitters *em, const lm_scene *s, int e, co
     const lm_emitter *em_e = &em->e[e];
     if (em_e->punctual)
         return toward_punctual(s, em_e, lm_v3_load(p), out);
-    if (em_e->kind == LM_EMIT_SKY) /* found by the rays that leave the scene instead */
-        return 0;
+    if (em_e->kind == LM_EMIT_SKY) /* an image sky drawn by brightness; the others found by the rays that
+                                    * leave the scene alone */
+        return em_e->luminance > 0.0f && lm_sky_by_brightness(s) ? toward_sky(s, u, out) : 0;
     return toward_area(s, em_e, lm_v3_load(p), u, out);
 }
 
