@@ -20,8 +20,8 @@ struct lm_composite {
     float limit;
     GLuint fill_prog;
     GLint p_limit, p_covered, p_iim, f_limit, f_covered, f_iim, f_reach;
-    lm_float_target lit; /* atlas-sized, linear filter: (E / pi * w, w), w = covered and valid (1), filled
-                          * (LM_COMPOSITE_FILL_WEIGHT) or 0 */
+    lm_float_target lit; /* atlas-sized, linear filter: (E / pi * w, w), w = 1 covered and valid, 1/1024
+                          * filled (glsl/fill_holes_fs.glsl), else 0; its depth marks the holes */
 };
 
 /* Red: 1 at every texel of the texel table (covered by some triangle) whose node takes indirect light, 0
