@@ -212,7 +212,8 @@ static void build_cdf(float *rgb, int w, int h)
             cell_corners(rgb, w, h, i, k, 0.0f, q);
             sum += 0.25 * (q[0] + q[1] + q[2] + q[3]);
         }
-        floors[k] = sum > 0.0 ? (float)(SKY_FLOOR * sum / w) : 1.0f; /* a black row: even */
+        float f = (float)(SKY_FLOOR * sum / w);
+        floors[k] = f > 0.0f ? f : 1.0f; /* a black row (or one too dim for a float's floor): even */
         float *row = cells + (size_t)k * ((size_t)w + 1);
         row[0] = 0.0f;
         for (int i = 0; i < w; i++) {
