@@ -54,15 +54,23 @@ typedef struct {
     int n;
 } texel_mean;
 
-static texel_mean lightmap_mean(lmgi_updater *u, lmgi_scene *sc, lmgi_lightmap kind)
+/* The updater's lightmap of that kind, malloc'd, *n floats (RGBA over the atlas). */
+static float *read_lightmap(lmgi_updater *u, lmgi_scene *sc, lmgi_lightmap kind, size_t *n)
 {
     lmgi_info in;
     lmgi_get_info(sc, &in);
-    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
-    float *rgba = malloc(n * sizeof *rgba);
+    *n = 4 * (size_t)in.atlas_width * in.atlas_height;
+    float *rgba = malloc(*n * sizeof *rgba);
     assert_non_null(rgba);
     lmgi_error e;
-    assert_int_equal(lmgi_get_lightmap(u, kind, rgba, n, &e), LMGI_OK);
+    assert_int_equal(lmgi_get_lightmap(u, kind, rgba, *n, &e), LMGI_OK);
+    return rgba;
+}
+
+static texel_mean lightmap_mean(lmgi_updater *u, lmgi_scene *sc, lmgi_lightmap kind)
+{
+    size_t n;
+    float *rgba = read_lightmap(u, sc, kind, &n);
     texel_mean m;
     m.n = lmt_texel_mean(rgba, n, m.mean);
     free(rgba);
@@ -325,13 +333,8 @@ static double image_lookup(const float *px, int w, int h, double u, double v, in
 static double map_spread(lmgi_context *ctx, lmgi_updater *u, lmgi_scene *sc, lmgi_lightmap kind, double mean[3])
 {
     lmgi_updater *own = u ? NULL : lmt_updater(ctx, sc);
-    lmgi_info in;
-    lmgi_get_info(sc, &in);
-    size_t n = 4 * (size_t)in.atlas_width * in.atlas_height;
-    float *aim = malloc(n * sizeof *aim);
-    assert_non_null(aim);
-    lmgi_error e;
-    assert_int_equal(lmgi_get_lightmap(u ? u : own, kind, aim, n, &e), LMGI_OK);
+    size_t n;
+    float *aim = read_lightmap(u ? u : own, sc, kind, &n);
     double y_mean = 0.0, y_sq = 0.0;
     int texels = lmt_texel_mean(aim, n, mean);
     for (size_t i = 0; i < n / 4; i++)

@@ -182,11 +182,13 @@ static float bright(const float *rgb, int w, int h, int x, int y)
 
 /* Cell row k: its top pixel row (the band at the top: row 0 twice; at the bottom: row h - 1 twice), its
  * height in pixels and the y of its middle (pixel-centre coordinates, y = v h - 0.5). */
+static double row_height(int k, int h) { return k == 0 || k == h ? 0.5 : 1.0; }
+
 static void cell_row(int k, int h, int *top, int *bottom, double *height, double *mid)
 {
     *top = k == 0 ? 0 : k - 1;
     *bottom = k == 0 ? 0 : k == h ? h - 1 : k;
-    *height = k == 0 || k == h ? 0.5 : 1.0;
+    *height = row_height(k, h);
     *mid = k == 0 ? -0.25 : k == h ? h - 0.75 : k - 0.5;
 }
 
@@ -264,7 +266,7 @@ static double linear_inverse(double p0, double p1, double r)
 static double density(const lm_scene *s, double b, int k, double sin_theta)
 {
     sky_cdf c = cdf_of(s->sky_image, s->sky_width, s->sky_height);
-    double height = k == 0 || k == c.h ? 0.5 : 1.0, row = c.cells[(size_t)k * ((size_t)c.w + 1) + (size_t)c.w];
+    double height = row_height(k, c.h), row = c.cells[(size_t)k * ((size_t)c.w + 1) + (size_t)c.w];
     double xy = ((double)c.rows[k + 1] - c.rows[k]) / c.rows[c.h + 1] * (b + c.floors[k]) / row / height;
     return xy * c.w * c.h / (2.0 * LM_PI * LM_PI * fmax(sin_theta, 1e-9));
 }
@@ -291,21 +293,13 @@ int lm_sky_by_brightness(const lm_scene *s)
            cdf_of(s->sky_image, s->sky_width, s->sky_height).rows[s->sky_height + 1] > 0.0f;
 }
 
-double lm_sky_pdf(const lm_scene *s, const float d[3])
-{
-    float L[3];
-    double pdf;
-    lm_sky_radiance_pdf(s, d, L, &pdf);
-    return pdf;
-}
-
 /* The share r of [c[i], c[i + 1]) below t. */
 static double within(const float *c, int i, float t)
 {
     return c[i + 1] > c[i] ? fmin(fmax(((double)t - c[i]) / ((double)c[i + 1] - c[i]), 0.0), 1.0) : 0.5;
 }
 
-double lm_sky_sample(const lm_scene *s, float u0, float u1, float d[3])
+void lm_sky_sample(const lm_scene *s, float u0, float u1, float d[3])
 { /* lm_sky_by_brightness(s) */
     sky_cdf c = cdf_of(s->sky_image, s->sky_width, s->sky_height);
     float t = fminf(fmaxf(u0, 0.0f), 1.0f) * c.rows[c.h + 1];
@@ -314,9 +308,7 @@ double lm_sky_sample(const lm_scene *s, float u0, float u1, float d[3])
     const float *row = c.cells + (size_t)k * ((size_t)c.w + 1);
     float tx = fminf(fmaxf(u1, 0.0f), 1.0f) * row[c.w];
     int i = find_interval(row, c.w, fminf(tx, nextafterf(row[c.w], 0.0f)));
-    double r1 = within(row, i, tx), q[4], height, mid;
-    int top, bottom;
-    cell_row(k, c.h, &top, &bottom, &height, &mid);
+    double r1 = within(row, i, tx), q[4];
     cell_corners(c.rgb, c.w, c.h, i, k, c.floors[k], q);
     /* the same stratum of (u0, u1) lands in the same part of the cell */
     double fy = linear_inverse(0.5 * (q[0] + q[1]), 0.5 * (q[2] + q[3]), r0);
@@ -326,7 +318,6 @@ double lm_sky_sample(const lm_scene *s, float u0, float u1, float d[3])
     d[0] = (float)(sin(theta) * sin(phi));
     d[1] = (float)cos(theta);
     d[2] = (float)(-sin(theta) * cos(phi));
-    return lm_sky_pdf(s, d);
 }
 
 /* rgb (w x h, malloc'd; taken whatever happens) as s's sky image, times scale, once every pixel and the

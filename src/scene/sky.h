@@ -25,15 +25,14 @@ void lm_sky_mean(const lm_scene *s, float out[3]);
 uint64_t lm_sky_hash(uint64_t h, const lm_scene *s);
 /* An image sky's directions, drawn by brightness (a sun in an HDR capture gets the photons its light
  * needs, at about equal flux each, and the rays gather's own sky rays; used where lm_sky_by_brightness,
- * the other skies' photons go uniformly on the sphere): d towards the sky from (u0, u1) in [0, 1] (nearby
- * values give nearby directions, so QMC strata stay strata), and its density per steradian, which
- * lm_sky_pdf gives for any d (1 / 4 pi for the other skies). The density follows the lookup's brightest
- * channel exactly, bilinear between pixel centres, times the solid angle, with 1/100 of the mean added
- * (sky.c says how), so every direction the sky lights keeps one. */
+ * the other skies' photons go uniformly on the sphere): lm_sky_sample gives d towards the sky from
+ * (u0, u1) in [0, 1] (nearby values give nearby directions, so QMC strata stay strata);
+ * lm_sky_radiance_pdf gives, for any d, lm_sky_radiance and the density per steradian with which
+ * lm_sky_sample picks it (1 / 4 pi for the other skies), in one lookup. The density follows the lookup's
+ * brightest channel exactly, bilinear between pixel centres, times the solid angle, with 1/100 of the mean
+ * added (sky.c says how), so every direction the sky lights keeps one. */
 int lm_sky_by_brightness(const lm_scene *s); /* an image sky, not all black */
-double lm_sky_sample(const lm_scene *s, float u0, float u1, float d[3]);
-double lm_sky_pdf(const lm_scene *s, const float d[3]);
-/* lm_sky_radiance and lm_sky_pdf at d in one lookup (the two share it: the cost of one). */
+void lm_sky_sample(const lm_scene *s, float u0, float u1, float d[3]);
 void lm_sky_radiance_pdf(const lm_scene *s, const float d[3], float out[3], double *pdf);
 /* 1 when the sky looks the same every way (a uniform one): the hemicube may clear to it. */
 int lm_sky_is_uniform(const lm_scene *s);

@@ -669,7 +669,7 @@ static int toward_area(const lm_scene *s, const lm_emitter *e, lm_vec3 p, const 
 }
 
 /* A direction towards an image sky drawn by brightness (lm_sky_sample), for MIS against the rays that
- * leave the scene and meet it (which weigh themselves by lm_sky_pdf). */
+ * leave the scene and meet it (which weigh themselves by lm_sky_radiance_pdf's density). */
 static int toward_sky(const lm_scene *s, const float u[3], lm_light_sample *out)
 {
     float L[3];
