@@ -207,14 +207,15 @@ static inline int lmgi_knob_is_pow2(double v)
       "--caustic-retrace", "F", LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                               \
       "share of the caustic photons re-traced a frame while anything moves\n"                                     \
       "(default 0.25; a moved light or mirror/glass node re-traces its own)")                                     \
-    X(caustics, filter, LMGI_KNOB_INT, int, 3, 1, 8, 1, LMGI_NO_RULE, "--caustic-filter", "K", LMGI_CLI_ZERO_OFF, \
+    X(caustics, filter, LMGI_KNOB_INT, int, 2, 1, 8, 1, LMGI_NO_RULE, "--caustic-filter", "K", LMGI_CLI_ZERO_OFF, \
       LMGI_NO_CHOICES, LMGI_SWEEP(13, "caustic_filter", "caustic filter k", (1, 2, 3, 5), (1, 3, 5), 1),         \
-      "k of the caustics' (2k+1)^2 cone filter, 0 to 8 (default 3)")                                              \
+      "k of the caustics' (2k+1)^2 cone filter, 0 to 8 (default 2)")                                              \
     X(caustics, filter_photons, LMGI_KNOB_INT, int, 32, 1, 65536, 1, LMGI_NO_RULE, "--caustic-filter-photons", "N",\
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES,                                                                          \
       LMGI_SWEEP(15, "caustic_filter_photons", "caustic filter photons", (8, 16, 32, 64, 128), (8, 32, 128), 1),  \
       "photons a caustic filter should hold: where its (2k+1)^2 pixels hold\n"                                    \
-      "fewer it widens, up to 8 times, and where they hold over 128 it narrows\n"                                 \
+      "fewer it widens, up to 8 times, and where they hold more across an edge\n"                               \
+      "or a focal spot it narrows to that many\n"                                                                 \
       "(default 32; 0: the paper's fixed filter)")                                                               \
     X(caustics, world_filter, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, "--caustic-space", "S",     \
       LMGI_CLI_ZERO_NONE, LMGI_CAUSTIC_SPACE_CHOICES, LMGI_NO_SWEEP,                                               \

@@ -15,7 +15,7 @@
 
 void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
 {
-    s->filter_k = 3;
+    s->filter_k = 2;
     s->tile = 32;
     s->world_space = 0;
     s->filter_photons = 32;
@@ -479,13 +479,14 @@ static int near_lit(const slot_targets *t, int tx, int ty, int d)
 }
 
 /* The filter's squares as triangles (pixel coordinates) into cp->rects, *count of them; their box in box.
- * The fixed filter: each lit tile grown by k pixels. Sized by density, the filter reaches k 2^levels
- * pixels: every tile within that of a lit one, each once (grown squares would overlap many times). */
+ * The fixed filter: each lit tile grown by k pixels. Sized by density, the filter reaches
+ * LM_CAUSTIC_FILTER_REACH(k) pixels: every tile within that of a lit one, each once (grown squares
+ * would overlap many times). */
 static lm_status grown_tiles(lm_caustic_pass *cp, const slot_targets *t, int *count, int box[4], uint64_t *pixels,
                              lm_error *err)
 {
     int T = cp->set.tile, grow = cp->set.filter_photons > 0 ? 0 : cp->set.filter_k, n = 0;
-    int reach = cp->set.filter_k << LM_CAUSTIC_FILTER_LEVELS; /* in pixels, sized by density */
+    int reach = LM_CAUSTIC_FILTER_REACH(cp->set.filter_k); /* in pixels, sized by density */
     int d = cp->set.filter_photons > 0 ? (reach + T - 1) / T : 0;
     int most = d ? t->tiles_x * t->tiles_y : *count;
     float *r = realloc(cp->rects, (size_t)(most ? most : 1) * 12 * sizeof *r);

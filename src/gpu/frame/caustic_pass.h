@@ -27,10 +27,12 @@
  *            Sized by density (filter_photons > 0): where the (2k + 1)^2 pixels around x hold fewer than
  *            filter_photons photons (counted from the splat's mipmaps), the same (2k + 1)^2 taps lie s
  *            pixels apart, each reading the splat's mean over about 2s pixels (its mipmaps), s up to
- *            2^LM_CAUSTIC_FILTER_LEVELS chosen so the window holds about filter_photons: thin light is
- *            spread over more pixels instead of showing each photon. Where the window holds more than
- *            128 photons (a focal spot) the screen filter's taps close in, down to 1/16 pixel apart, until
- *            it holds about 128: the spot as sharp as its photons allow.
+ *            2^LM_CAUSTIC_FILTER_LEVELS chosen so the filter holds about filter_photons: thin light is
+ *            spread over more pixels instead of showing each photon. Where it holds more and the light
+ *            changes across it by more than photon noise (its four quadrants' photon counts differ by
+ *            over three standard deviations: an edge, a focal spot), the screen filter's taps close in,
+ *            down to 1/16 pixel apart, until it holds about filter_photons: the spot as sharp as its
+ *            photons allow, while an even patch keeps the whole filter and its low noise.
  *            Elsewhere E is 0.
  *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
  *            lobe the direct light's first pass wrote there: frame_targets.h).
@@ -53,16 +55,21 @@
 #include "direct.h"
 
 typedef struct {
-    int filter_k;          /* k of the (2k + 1)^2 filter, 0 to 8 (default 3, the paper's 7 x 7) */
+    int filter_k;          /* k of the (2k + 1)^2 filter, 0 to 8 (default 2; the paper's 7 x 7 is 3) */
     int tile;              /* tile side in pixels, 4 to 256 (default 32) */
     int world_space;       /* 1: filter by world distance (default 0: the paper's screen-space cone) */
     int filter_photons;    /* photons a filter should hold: where the (2k + 1)^2 pixels hold fewer, the filter
                               widens (its taps further apart over the splat's mipmaps) until about that many,
-                              up to LM_CAUSTIC_FILTER_LEVELS doublings (default 32; 0: the paper's fixed filter) */
+                              up to LM_CAUSTIC_FILTER_LEVELS doublings, and where they hold more and the light
+                              has structure it narrows to that many (default 32; 0: the paper's fixed filter) */
 } lm_caustic_pass_settings;
 
-/* The density-sized filter widens up to 2^this times (8: k = 3 reaches 24 pixels). */
+/* The density-sized filter widens up to 2^this times. */
 #define LM_CAUSTIC_FILTER_LEVELS 3
+/* How far from a pixel the density-sized filter of k reads light, in pixels: at its widest (s = 2^levels)
+ * its outer taps lie k s away, each reading the mip level whose texels span 2s pixels bilinearly, so
+ * from texels up to 2s further whose pixels reach s beyond their centre (40 pixels at k = 2). */
+#define LM_CAUSTIC_FILTER_REACH(k) (((k) + 3) << LM_CAUSTIC_FILTER_LEVELS)
 
 void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s);
 
