@@ -41,9 +41,9 @@
  * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
  * application renders (_VIEW).
  * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel (and
- * up to LM_CAUSTIC_FILTER_LEVELS + 1 to size it, plus the splat's mipmaps once a run), two per pixel of
- * the lit tiles' box (docs/bench.md has the figures). Needs a current GL
- * context; not thread-safe. */
+ * up to LM_CAUSTIC_FILTER_LEVELS + 5 to size it, four of them the structure test, plus the splat's
+ * mipmaps once a run), two per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a
+ * current GL context; not thread-safe. */
 #ifndef LM_CAUSTIC_PASS_H
 #define LM_CAUSTIC_PASS_H
 
