@@ -5,7 +5,13 @@
 passed=0; failed=0; skipped=0; bad=""; times=""
 # Sanitizer builds: third-party leaks we cannot fix are listed in tests/lsan.supp.
 LSAN_OPTIONS="suppressions=$(cd "$(dirname "$0")" && pwd)/lsan.supp${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
-export LSAN_OPTIONS
+# The sanitizer runtime of GCC 12 (Debian 12's) takes a dynamic TLS block whose address ends at 16 bytes
+# past a 4 KB boundary for a pre-2.25 glibc header, reads a bogus range from before it, and the leak check
+# at exit dies scanning it ("Tracer caught signal 11"; google/sanitizers#1322, fixed after GCC 13): half
+# the runs of `lmgi run` on test_run's far-from-origin scene. Not tracking __tls_get_addr avoids it; the
+# static TLS and every thread's stack are still scanned.
+ASAN_OPTIONS="intercept_tls_get_addr=0${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
+export LSAN_OPTIONS ASAN_OPTIONS
 for t in "$@"; do
     echo "=== $t"
     t0=$(date +%s%N)
