@@ -122,13 +122,6 @@ static void check_image(const float *E, int k, int reach, const char *what)
     assert_true(outside == 0.0);
 }
 
-static int lm_default_filter_k(void)
-{
-    lm_caustic_pass_settings set;
-    lm_caustic_pass_settings_default(&set);
-    return set.filter_k;
-}
-
 static void test_mirror_caustic(void **state)
 {
     (void)state;
@@ -136,6 +129,7 @@ static void test_mirror_caustic(void **state)
     setup(&f, 1u << 16);
     lm_caustic_pass_settings set;
     lm_caustic_pass_settings_default(&set);
+    const int default_k = set.filter_k;
     for (int sized = 0; sized < 2; sized++) /* the paper's fixed filter, and sized by density (the default) */
         for (int world = 0; world < 2; world++) {
             set.world_space = world;
@@ -143,7 +137,7 @@ static void test_mirror_caustic(void **state)
             /* the paper's filter at its 7 x 7, and the world filter at k = 3: at k = 2 its cone, k footprints
              * wide, holds too few photons where the light is dense (it never narrows below s = 1): worst pixel
              * 13.8% off; sized by density in screen space, the default k */
-            set.filter_k = sized && !world ? lm_default_filter_k() : 3;
+            set.filter_k = sized && !world ? default_k : 3;
             lm_caustic_pass_stats st;
             static float E[3 * W * H];
             irradiance(&f, &set, &st, E);

@@ -431,33 +431,6 @@ static void test_grazing_light(void **state)
     lmgi_context_free(ctx);
 }
 
-/* ---------- shading normals that bend across a face ---------- */
-
-/* A hexagonal column, radius 0.5 and 2 high, its side faces with vertex normals pointing straight out
- * from its axis (smooth: they bend 60 degrees across each face) or each face's own (flat). */
-enum { COLUMN_SIDES = 6 };
-typedef struct {
-    float v[3 * 4 * COLUMN_SIDES], n[3 * 4 * COLUMN_SIDES];
-    uint32_t idx[6 * COLUMN_SIDES];
-} column_mesh;
-
-static void make_column(column_mesh *c, int smooth)
-{
-    for (int k = 0; k < COLUMN_SIDES; k++) {
-        double a0 = 2.0 * PI * k / COLUMN_SIDES, a1 = 2.0 * PI * (k + 1) / COLUMN_SIDES, am = 0.5 * (a0 + a1);
-        const double ang[4] = {a0, a1, a1, a0}, y[4] = {0, 0, 2, 2};
-        for (int j = 0; j < 4; j++) {
-            float *p = c->v + 3 * (4 * k + j), *n = c->n + 3 * (4 * k + j);
-            p[0] = (float)(0.5 * cos(ang[j])), p[1] = (float)y[j], p[2] = (float)(-0.5 * sin(ang[j]));
-            double an = smooth ? ang[j] : am;
-            n[0] = (float)cos(an), n[1] = 0.0f, n[2] = (float)-sin(an);
-        }
-        const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
-        for (int j = 0; j < 6; j++)
-            c->idx[6 * k + j] = (uint32_t)(4 * k) + q[j];
-    }
-}
-
 /* ---------- slivers, zero-area triangles and a surface too small for a texel ---------- */
 
 /* The room with its lamp and one more mesh, `extra` (its triangles after the room's 12), plaster. */
@@ -475,56 +448,6 @@ static lmgi_scene *room_with(const lmgi_mesh_desc *extra)
     lmgi_scene_desc d = {.name = "room with one more mesh", .meshes = meshes, .mesh_count = 2, .materials = mats,
                          .material_count = 2, .lights = &lamp, .light_count = 1};
     return load(&d, 0.0f);
-}
-
-/* Issue 33, item 5: a green column whose shading normals bend 60 degrees across each face, in the lamp-lit
- * room (room_with), against the reference at 40 x 40 and a target error of 0.03: each face of the column
- * seen by 50 pixels or more, and the frame, within 3% per channel. The issue asks 2%, and this is not met
- * yet: measured, the face beside the lamp reads 0.979 0.977 0.978 (the same column with flat normals
- * 0.991 0.991 0.991), the other 0.993 0.988 0.992; the IIM there is 1.9% under the reference's texels with bending
- * normals and 1.4% with flat ones, so the rest is the frame's: the face is three texels wide and its edge
- * pixels' normals bend past the outer texels' (at 6,358 texels the face reads 0.985, its texels 0.986;
- * docs/hard-cases.md). With the lamp at (-1.2, 2.8, 1.5) instead the faces read 0.982 and 0.985. The
- * bound keeps what is there from getting worse (the issue met 4-5% once). */
-static void test_bending_shading_normals(void **state)
-{
-    (void)state;
-    static column_mesh col;
-    make_column(&col, 1);
-    lmgi_mesh_desc column = {.name = "column", .positions = col.v, .normals = col.n, .vertex_count = 4 * COLUMN_SIDES,
-                             .indices = col.idx, .triangle_count = 2 * COLUMN_SIDES};
-    lmgi_scene *sc = room_with(&column);
-    lmgi_context *ctx = lmt_context();
-    size_t n;
-    float *iim;
-    lmgi_updater *u = baked(ctx, sc, 1, &iim, &n);
-    lmgi_camera cam;
-    lmt_look_at((float[3]){0.3f, 1.2f, 1.9f}, (float[3]){0, 1.0f, 0}, 1.0f, &cam);
-    lmgi_reference_desc rd = {.target_error = 0.03f, .no_cache = 1};
-    lmgi_check_result c;
-    lmgi_error e;
-    assert_int_equal(lmgi_check_updater(u, &cam, 40, 40, &rd, &c, &e), LMGI_OK);
-    print_message("column with bending normals: frame / reference %.4f %.4f %.4f over %u pixels\n", c.ratio[0],
-                  c.ratio[1], c.ratio[2], c.pixels);
-    int faces = 0;
-    for (int k = 0; k < c.surface_count; k++) {
-        const lmgi_check_surface *f = &c.surfaces[k];
-        if (f->node != 1 || f->pixels < 50)
-            continue;
-        print_message("  column face (surface %d): %u pixels, %.4f %.4f %.4f\n", k, f->pixels, f->ratio[0], f->ratio[1],
-                      f->ratio[2]);
-        for (int ch = 0; ch < 3; ch++)
-            assert_true(fabs(f->ratio[ch] - 1.0) < 0.03);
-        faces++;
-    }
-    assert_true(faces >= 2);
-    for (int ch = 0; ch < 3; ch++)
-        assert_true(fabs(c.ratio[ch] - 1.0) < 0.03);
-    lmgi_check_free(&c);
-    free(iim);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
 }
 
 /* A 2 x 2 carpet 1 cm above the room's floor, as two triangles, and as the same square with one of them
@@ -631,6 +554,82 @@ static void test_surface_smaller_than_a_texel(void **state)
     assert_int_equal(lmgi_surface_count(b), 12);
     assert_true(fabs(g_room / w_room - 1.0) < 0.01);
     lmgi_free(a), lmgi_free(b);
+    lmgi_context_free(ctx);
+}
+
+/* ---------- shading normals that bend across a face ---------- */
+
+/* A hexagonal column, radius 0.5 and 2 high, its side faces with vertex normals pointing straight out
+ * from its axis: they bend 60 degrees across each face. */
+enum { COLUMN_SIDES = 6 };
+typedef struct {
+    float v[3 * 4 * COLUMN_SIDES], n[3 * 4 * COLUMN_SIDES];
+    uint32_t idx[6 * COLUMN_SIDES];
+} column_mesh;
+
+static void make_column(column_mesh *c)
+{
+    for (int k = 0; k < COLUMN_SIDES; k++) {
+        double a0 = 2.0 * PI * k / COLUMN_SIDES, a1 = 2.0 * PI * (k + 1) / COLUMN_SIDES;
+        const double ang[4] = {a0, a1, a1, a0}, y[4] = {0, 0, 2, 2};
+        for (int j = 0; j < 4; j++) {
+            float *p = c->v + 3 * (4 * k + j), *n = c->n + 3 * (4 * k + j);
+            p[0] = (float)(0.5 * cos(ang[j])), p[1] = (float)y[j], p[2] = (float)(-0.5 * sin(ang[j]));
+            n[0] = (float)cos(ang[j]), n[1] = 0.0f, n[2] = (float)-sin(ang[j]);
+        }
+        const uint32_t q[6] = {0, 1, 2, 0, 2, 3};
+        for (int j = 0; j < 6; j++)
+            c->idx[6 * k + j] = (uint32_t)(4 * k) + q[j];
+    }
+}
+
+/* Issue 33, item 5: a green column whose shading normals bend 60 degrees across each face, in the lamp-lit
+ * room (room_with), against the reference at 40 x 40 and a target error of 0.03: each face of the column
+ * seen by 50 pixels or more, and the frame, within 3% per channel. The issue asks 2%, and this is not met
+ * yet: measured, the face beside the lamp reads 0.979 0.977 0.978 (the same column with flat normals
+ * 0.991 0.991 0.991), the other 0.993 0.988 0.992; the IIM there is 1.9% under the reference's texels with bending
+ * normals and 1.4% with flat ones, so the rest is the frame's: the face is three texels wide and its edge
+ * pixels' normals bend past the outer texels' (at 6,358 texels the face reads 0.985, its texels 0.986;
+ * docs/hard-cases.md). With the lamp at (-1.2, 2.8, 1.5) instead the faces read 0.982 and 0.985. The
+ * bound keeps what is there from getting worse (the issue met 4-5% once). */
+static void test_bending_shading_normals(void **state)
+{
+    (void)state;
+    static column_mesh col;
+    make_column(&col);
+    lmgi_mesh_desc column = {.name = "column", .positions = col.v, .normals = col.n, .vertex_count = 4 * COLUMN_SIDES,
+                             .indices = col.idx, .triangle_count = 2 * COLUMN_SIDES};
+    lmgi_scene *sc = room_with(&column);
+    lmgi_context *ctx = lmt_context();
+    size_t n;
+    float *iim;
+    lmgi_updater *u = baked(ctx, sc, 1, &iim, &n);
+    lmgi_camera cam;
+    lmt_look_at((float[3]){0.3f, 1.2f, 1.9f}, (float[3]){0, 1.0f, 0}, 1.0f, &cam);
+    lmgi_reference_desc rd = {.target_error = 0.03f, .no_cache = 1};
+    lmgi_check_result c;
+    lmgi_error e;
+    assert_int_equal(lmgi_check_updater(u, &cam, 40, 40, &rd, &c, &e), LMGI_OK);
+    print_message("column with bending normals: frame / reference %.4f %.4f %.4f over %u pixels\n", c.ratio[0],
+                  c.ratio[1], c.ratio[2], c.pixels);
+    int faces = 0;
+    for (int k = 0; k < c.surface_count; k++) {
+        const lmgi_check_surface *f = &c.surfaces[k];
+        if (f->node != 1 || f->pixels < 50)
+            continue;
+        print_message("  column face (surface %d): %u pixels, %.4f %.4f %.4f\n", k, f->pixels, f->ratio[0], f->ratio[1],
+                      f->ratio[2]);
+        for (int ch = 0; ch < 3; ch++)
+            assert_true(fabs(f->ratio[ch] - 1.0) < 0.03);
+        faces++;
+    }
+    assert_true(faces >= 2);
+    for (int ch = 0; ch < 3; ch++)
+        assert_true(fabs(c.ratio[ch] - 1.0) < 0.03);
+    lmgi_check_free(&c);
+    free(iim);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
     lmgi_context_free(ctx);
 }
 
