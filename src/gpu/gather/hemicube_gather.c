@@ -14,6 +14,7 @@
 #include "../gl/gl_context.h"
 #include "../gl/gl_mesh.h"
 #include "../gl/gl_shader.h"
+#include "gather_passes.h"
 #include "hemicube_shaders.h"
 #include "../../trace/emitter_light.h"
 #include "../../photonmap/hemicube_rim.h"
@@ -470,33 +471,63 @@ void lm_gather_set_sky(lm_gather *g, const float sky[3])
     memcpy(g->set.sky, sky, sizeof g->set.sky);
 }
 
-/* Clears the part of the target `count` texels use: sky radiance, depth 0 (reversed). */
-static void clear_target(lm_gather *g, uint32_t count)
+/* Whether a pass's tiles [0, count) are mostly empty (an update's few texels, spread over the target by
+ * their fixed tiles): then they are cleared and resolved one by one instead of as whole rows. */
+static int sparse_pass(const lm_gather *g, const uint32_t *texels, uint32_t count)
+{
+    uint32_t used = 0, T = (uint32_t)g->set.tiles, rows = (count + T - 1) / T;
+    for (uint32_t i = 0; i < count; i++)
+        used += texels[i] != LM_GATHER_NO_TEXEL;
+    return 2 * used < rows * T;
+}
+
+/* Clears the tiles of the pass's texels (the rows or layers [0, count) that hold them, or each used
+ * tile of a sparse pass): sky radiance, depth 0 (reversed). */
+static void clear_target(lm_gather *g, const uint32_t *texels, uint32_t count, int sparse)
 {
     int R = g->set.resolution, T = g->set.tiles;
     const float sky[4] = {g->set.sky[0], g->set.sky[1], g->set.sky[2], 0.0f}, zero = 0.0f;
     if (g->set.scheme == LM_GATHER_LAYERED) {
-        glClearTexSubImage(g->color, 0, 0, 0, 0, R, R, (GLsizei)count, GL_RGBA, GL_FLOAT, sky);
-        glClearTexSubImage(g->depth, 0, 0, 0, 0, R, R, (GLsizei)count, GL_DEPTH_COMPONENT, GL_FLOAT, &zero);
+        for (uint32_t i = 0; i < count; i++) {
+            uint32_t n = sparse ? 1 : count;
+            if (sparse && texels[i] == LM_GATHER_NO_TEXEL)
+                continue;
+            glClearTexSubImage(g->color, 0, 0, 0, (GLint)i, R, R, (GLsizei)n, GL_RGBA, GL_FLOAT, sky);
+            glClearTexSubImage(g->depth, 0, 0, 0, (GLint)i, R, R, (GLsizei)n, GL_DEPTH_COMPONENT, GL_FLOAT, &zero);
+            if (!sparse)
+                break;
+        }
         return;
     }
-    int rows = (int)((count + (uint32_t)T - 1) / (uint32_t)T);
     glEnable(GL_SCISSOR_TEST);
-    glScissor(0, 0, T * R, rows * R);
     glClearColor(sky[0], sky[1], sky[2], 0.0f);
     glClearDepth(0.0);
-    glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    if (!sparse) {
+        glScissor(0, 0, T * R, (int)((count + (uint32_t)T - 1) / (uint32_t)T) * R);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    }
+    for (uint32_t i = 0; sparse && i < count; i++) {
+        if (texels[i] == LM_GATHER_NO_TEXEL)
+            continue;
+        glScissor((int)(i % (uint32_t)T) * R, (int)(i / (uint32_t)T) * R, R, R);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    }
     glDisable(GL_SCISSOR_TEST);
 }
 
 /* Every texel's view of a pass into g->views (VIEW_FLOATS each: eye and own surface, then the three
  * axes, whose fourth components hold the geometric normal), which every scheme draws from and the
- * emitter light and the rim read. */
+ * emitter light and the rim read. An empty tile (LM_GATHER_NO_TEXEL) gets a zero view: every vertex
+ * lands on one point with w = 0 in front of the near plane, so the instanced schemes draw nothing there. */
 static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
 {
     for (uint32_t i = 0; i < count; i++) {
-        texel_view v = view_of(&g->set, s, &a->texels[texels[i]]);
         float *o = g->views + VIEW_FLOATS * (size_t)i;
+        if (texels[i] == LM_GATHER_NO_TEXEL) {
+            memset(o, 0, sizeof(float) * VIEW_FLOATS);
+            continue;
+        }
+        texel_view v = view_of(&g->set, s, &a->texels[texels[i]]);
         lm_v3_store(o, v.eye);
         o[3] = v.surface;
         for (int k = 0; k < 3; k++) {
@@ -506,8 +537,8 @@ static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const
     }
 }
 
-/* Scheme 0: one draw per texel, its view in uniforms, its tile a viewport. */
-static void draw_viewports(lm_gather *g, const lm_scene *s, uint32_t count)
+/* Scheme 0: one draw per texel, its view in uniforms, its tile a viewport; empty tiles are skipped. */
+static void draw_viewports(lm_gather *g, const lm_scene *s, const uint32_t *texels, uint32_t count)
 {
     int R = g->set.resolution, T = g->set.tiles;
     GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
@@ -516,6 +547,8 @@ static void draw_viewports(lm_gather *g, const lm_scene *s, uint32_t count)
     GLint ng_loc = glGetUniformLocation(g->render_prog, "geo_n");
     float near = near_plane(g, s);
     for (uint32_t i = 0; i < count; i++) {
+        if (texels[i] == LM_GATHER_NO_TEXEL)
+            continue;
         const float *o = g->views + VIEW_FLOATS * (size_t)i;
         lm_vec3 eye = lm_v3_load(o), axes[3] = {lm_v3_load(o + 4), lm_v3_load(o + 8), lm_v3_load(o + 12)};
         float m[16];
@@ -551,20 +584,28 @@ static void draw_instanced(lm_gather *g, const lm_scene *s, uint32_t count)
         glDisable(GL_CLIP_DISTANCE0 + k);
 }
 
-/* The multisampled target's rows in use, averaged into the single-sampled one the reduction reads. */
-static void resolve(const lm_gather *g, uint32_t count)
+/* The multisampled target's rows in use (or a sparse pass's used tiles), averaged into the
+ * single-sampled one the reduction reads. */
+static void resolve(const lm_gather *g, const uint32_t *texels, uint32_t count, int sparse)
 {
     int R = g->set.resolution, T = g->set.tiles, rows = (int)((count + (uint32_t)T - 1) / (uint32_t)T);
     glBindFramebuffer(GL_READ_FRAMEBUFFER, g->ms_fbo);
     glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g->fbo);
-    glBlitFramebuffer(0, 0, T * R, rows * R, 0, 0, T * R, rows * R, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    if (!sparse)
+        glBlitFramebuffer(0, 0, T * R, rows * R, 0, 0, T * R, rows * R, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    for (uint32_t i = 0; sparse && i < count; i++) {
+        int x = (int)(i % (uint32_t)T) * R, y = (int)(i / (uint32_t)T) * R;
+        if (texels[i] != LM_GATHER_NO_TEXEL)
+            glBlitFramebuffer(x, y, x + R, y + R, x, y, x + R, y + R, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
 }
 
 static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count,
                          int *xy)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, g->ms_fbo ? g->ms_fbo : g->fbo);
-    clear_target(g, count);
+    int sparse = sparse_pass(g, texels, count);
+    clear_target(g, texels, count, sparse);
     glUseProgram(g->render_prog);
     glUniform1i(glGetUniformLocation(g->render_prog, "aim"), 0);
     glUniform1f(glGetUniformLocation(g->render_prog, "pixel"), 2.0f / (float)g->set.resolution);
@@ -572,13 +613,15 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
     fill_views(g, s, a, texels, count);
     if (g->set.scheme == LM_GATHER_VIEWPORTS)
-        draw_viewports(g, s, count);
+        draw_viewports(g, s, texels, count);
     else
         draw_instanced(g, s, count);
-    for (uint32_t i = 0; i < count; i++)
-        xy[2 * i] = a->texels[texels[i]].x, xy[2 * i + 1] = a->texels[texels[i]].y;
+    for (uint32_t i = 0; i < count; i++) { /* an empty tile's target (-1, -1) is skipped by the reduction */
+        int empty = texels[i] == LM_GATHER_NO_TEXEL;
+        xy[2 * i] = empty ? -1 : a->texels[texels[i]].x, xy[2 * i + 1] = empty ? -1 : a->texels[texels[i]].y;
+    }
     if (g->ms_fbo)
-        resolve(g, count);
+        resolve(g, texels, count, sparse);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
@@ -601,6 +644,8 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
             const float *o = g->views + VIEW_FLOATS * (size_t)i;
             float *e = g->emit + 4 * (size_t)i;
             e[0] = e[1] = e[2] = e[3] = 0.0f;
+            if (texels[i] == LM_GATHER_NO_TEXEL)
+                continue;
             if (g->emitters)
                 lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], e);
             if (g->rt && covered_at(g->rt, a, o, o + 12))
@@ -704,24 +749,29 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     double t0 = lm_now();
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
     int *xy = malloc(sizeof(int) * 2 * per_pass);
-    if (!xy)
-        return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory");
+    uint32_t *slots = malloc(sizeof *slots * per_pass), *rest = malloc(sizeof *rest * (count ? count : 1));
     PFNGLCLIPCONTROLPROC clip_control = (PFNGLCLIPCONTROLPROC)lm_gl_get_proc("glClipControl");
-    if (!clip_control) {
+    if (!xy || !slots || !rest || !clip_control) {
         free(xy);
-        return lm_fail(err, LM_ERR_BACKEND, "hemicube gather: glClipControl (GL 4.5) is missing");
+        free(slots);
+        free(rest);
+        return clip_control ? lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory")
+                            : lm_fail(err, LM_ERR_BACKEND, "hemicube gather: glClipControl (GL 4.5) is missing");
     }
+    if (count)
+        memcpy(rest, texels, sizeof *rest * count);
     clip_control(GL_LOWER_LEFT, GL_ZERO_TO_ONE); /* reversed float depth */
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDisable(GL_CULL_FACE);
     int passes = 0;
-    for (uint32_t first = 0; first < count; first += per_pass, passes++) {
-        uint32_t n = count - first < per_pass ? count - first : per_pass;
-        render_tiles(g, s, a, texels + first, n, xy);
+    for (uint32_t left = count; left > 0; passes++) {
+        uint32_t n;
+        left = lm_gather_place_pass(rest, left, slots, per_pass, &n); /* each texel in its own tile */
+        render_tiles(g, s, a, slots, n, xy);
         if (g->emitters || g->rt) {
             glFlush(); /* llvmpipe rasterizes the pass on its threads while this one computes */
-            cpu_irradiance(g, s, a, texels + first, n);
+            cpu_irradiance(g, s, a, slots, n);
         }
         reduce_tiles(g, iim_tex, xy, n);
     }
@@ -729,6 +779,8 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     glDepthFunc(GL_LESS);
     glClearDepth(1.0);
     free(xy);
+    free(slots);
+    free(rest);
     if (stats) { /* timed to the end of the GPU work; otherwise the caller's next commands queue behind it */
         glFinish();
         stats->texels = count;

@@ -17,7 +17,7 @@ uniform float scale;   /* pi / F(a), or pi when the rim is traced */
 uniform float inv_f;   /* 1 / F(a) */
 void main() {
     int tile = int(gl_GlobalInvocationID.x);
-    if (tile >= count) return;
+    if (tile >= count || xy[tile].x < 0) return; /* past the pass, or an empty tile (gather_passes.h) */
     vec4 s = vec4(0.0);
 #if SCHEME == 2
     for (int y = 0; y < R; y++)
