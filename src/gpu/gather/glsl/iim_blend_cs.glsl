@@ -44,7 +44,9 @@ vec4 own_at(ivec2 g, int c, int f)
     vec4 o = imageLoad(old_map, g), n = imageLoad(new_map, g);
     float t = blend_t_at(c, f);
     if ((o.a <= limit) != (n.a <= limit)) t = 1.0; /* turned valid or invalid: no blend with the inside */
-    return clamp(mix(o, n, t), min(o, n), max(o, n));
+    /* blended in: new itself (mix may be o + t (n - o), a rounding away from n, and a bake then differed
+     * from a fresh one's by an ulp where old was not new) */
+    return t >= 1.0 ? n : clamp(mix(o, n, t), min(o, n), max(o, n));
 }
 vec4 own(ivec2 g, int c) { return own_at(g, c, frame); }
 
