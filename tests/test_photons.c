@@ -732,6 +732,53 @@ static void test_reset_matches_fresh(void **state)
     world_free(&w);
 }
 
+/* A full trace keeps a path whose hits moved by float noise (within epsilon and the flux tolerance: a
+ * node switched static holds its place through another matrix); the exact one stores it again, as a
+ * fresh trace would. Two hits nudged by an ulp stand for that noise. */
+static void test_exact_trace_replaces_noise(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    world_photons(&w, &set);
+    lm_photon_store *ps = lm_photons_store_mutable(w.ph);
+    uint32_t a = ps->surfaces[0].slots[0], b = ps->surfaces[1].slots[0];
+    lm_hit ha = ps->hits[a], hb = ps->hits[b];
+    int c = fabsf(hb.local[0]) > fabsf(hb.local[2]) ? 0 : 2; /* a coordinate far from 0 */
+    ps->hits[a].flux[0] = nextafterf(ha.flux[0], INFINITY);
+    ps->hits[b].local[c] = nextafterf(hb.local[c], INFINITY);
+    lm_photon_frame_stats st;
+    lm_error err;
+    assert_int_equal(lm_photons_trace_all(w.ph, &st, &err), LM_OK);
+    assert_int_equal(st.photons_updated, 0);
+    assert_true(ps->hits[a].flux[0] != ha.flux[0] && ps->hits[b].local[c] != hb.local[c]);
+    assert_int_equal(lm_photons_trace_all_exact(w.ph, &st, &err), LM_OK);
+    assert_int_equal(st.photons_updated, 2);
+    assert_int_equal(lm_photons_trace_all_exact(w.ph, &st, &err), LM_OK);
+    assert_int_equal(st.photons_updated, 0); /* an unchanged scene traces the same bits */
+    lm_photons *fresh = NULL;
+    assert_int_equal(lm_photons_create(w.s, &w.su, w.rt, &w.em, &set, &fresh, &err), LM_OK);
+    assert_int_equal(lm_photons_trace_all(fresh, NULL, &err), LM_OK);
+    for (uint32_t p = 0; p < lm_photons_count(fresh); p++) { /* every hit as fresh, wherever its slot */
+        const lm_path_vertex *va, *vb;
+        uint32_t na = lm_photons_path(w.ph, p, &va), nb = lm_photons_path(fresh, p, &vb);
+        assert_int_equal(na, nb);
+        for (uint32_t i = 0; i < na; i++) {
+            assert_int_equal(va[i].slot == LM_NONE, vb[i].slot == LM_NONE);
+            if (va[i].slot == LM_NONE)
+                continue;
+            const lm_hit *x = &ps->hits[va[i].slot], *y = &lm_photons_store(fresh)->hits[vb[i].slot];
+            assert_memory_equal(x->local, y->local, sizeof x->local);
+            assert_memory_equal(x->flux, y->flux, sizeof x->flux);
+        }
+    }
+    lm_photons_free(fresh);
+    world_free(&w);
+}
+
 /* ---- settings and sizes ---- */
 
 static void test_settings(void **state)
@@ -879,6 +926,7 @@ int main(void)
         cmocka_unit_test(test_invalidate_emitter),
         cmocka_unit_test(test_move_and_back),
         cmocka_unit_test(test_reset_matches_fresh),
+        cmocka_unit_test(test_exact_trace_replaces_noise),
         cmocka_unit_test(test_settings),
         cmocka_unit_test(test_cornell_rate_and_memory),
         cmocka_unit_test(test_hidden_light),

@@ -45,6 +45,14 @@ static int hit_changed(const lm_photons *ph, const lm_hit *h, const ph_vertex *v
     return dist2(placed, v->pos) > eps2 || flux_changed(h->flux, v->flux);
 }
 
+/* The stored hit is the new vertex's to the bit. */
+static int hit_differs(const lm_hit *h, const ph_vertex *v)
+{
+    return memcmp(h->pos, v->pos, sizeof h->pos) || memcmp(h->local, v->local, sizeof h->local) ||
+           memcmp(h->dir, v->dir, sizeof h->dir) || memcmp(h->flux, v->flux, sizeof h->flux) ||
+           h->tri != v->tri || h->bounce != v->bounce || h->caustic != v->caustic;
+}
+
 int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n)
 {
     uint32_t first = g->offsets[m];
@@ -53,12 +61,14 @@ int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const p
     float eps2 = ph->epsilon * ph->epsilon;
     for (uint32_t i = 0; i < n; i++) {
         const lm_path_vertex *p = &g->verts[first + i];
-        if (p->node != v[i].node || p->tri != v[i].tri || dist2(p->pos, v[i].pos) > eps2)
+        if (p->node != v[i].node || p->tri != v[i].tri || dist2(p->pos, v[i].pos) > eps2 ||
+            (ph->exact && memcmp(p->pos, v[i].pos, sizeof p->pos)))
             return 1;
         int stored = v[i].surface >= 0;
         if (stored != (p->slot != LM_NONE))
             return 1;
-        if (stored && hit_changed(ph, &ph->store.hits[p->slot], &v[i], eps2))
+        const lm_hit *h = stored ? &ph->store.hits[p->slot] : NULL;
+        if (h && (ph->exact ? hit_differs(h, &v[i]) : hit_changed(ph, h, &v[i], eps2)))
             return 1;
     }
     return 0;

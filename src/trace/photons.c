@@ -443,6 +443,14 @@ lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_
     return s;
 }
 
+lm_status lm_photons_trace_all_exact(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)
+{
+    ph->exact = 1;
+    lm_status s = lm_photons_trace_all(ph, stats, err);
+    ph->exact = 0;
+    return s;
+}
+
 uint32_t lm_photons_release_emitter(lm_photons *ph, int e)
 {
     uint32_t waiting = 0;

@@ -124,6 +124,11 @@ void lm_photons_set_split(lm_photons *ph, const lm_photon_split *split);
 /* Traces every photon and stores its path and hits (initial full trace; also a full refresh: paths
  * that did not change cause no store change). Clears the invalid queue. stats may be NULL. */
 lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);
+/* The same, but a path counts as changed when any number of it or of its hits differs in any bit, not
+ * beyond epsilon or the flux tolerance: the store then holds what a fresh trace of the scene would, where
+ * lm_photons_trace_all keeps a path that moved by float noise (a node switched static holds the same
+ * place through another matrix; docs/photons.md). What a bake that must equal a fresh one uses. */
+lm_status lm_photons_trace_all_exact(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);
 /* One frame: round-robin check of k photons per valid group, then re-trace of up to group_budget
  * invalid groups, oldest first. Without anything_moves (no dynamic node with triangles) the round robin
  * is left out: no path can change but by an edit, and the edits that change paths invalidate their

@@ -73,6 +73,8 @@ struct lm_photons {
     lm_photon_settings set;
     uint32_t frame_groups;     /* lm_photons_limit_groups's (0: set.group_budget) */
     float epsilon;             /* resolved settings.epsilon */
+    int exact;                 /* while lm_photons_trace_all_exact runs: a path is unchanged only when every
+                                * number of it and of its hits is the same to the bit (ph_path_changed) */
     float ray_offset;          /* origin offset along the normal when leaving a surface */
     uint32_t G, emitter_count, group_count, photon_count;
     uint32_t *emitter_first;   /* first photon id of each emitter, emitter_count + 1 entries */
@@ -141,7 +143,8 @@ lm_status ph_fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, uint3
 /* photon_paths.c: path storage, comparison and store updates. */
 const ph_vertex *ph_job_vertices(const ph_batch *b, const ph_job *j);
 /* 1 if the traced path differs from photon m's stored one (photons.h: (node, tri) sequence, a vertex
- * that moved more than epsilon in world or node-local space, or flux changed). */
+ * that moved more than epsilon in world or node-local space, or flux changed; with ph->exact, any bit of
+ * a vertex or a hit). */
 int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n);
 /* Rebuilds a group's slab from the jobs [first, first + M) of batch b (one per photon, in order):
  * photons whose path changed get their old hits removed and new ones added; the others keep theirs. */
