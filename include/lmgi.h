@@ -645,12 +645,13 @@ typedef struct {
                                  * gather passes): LMGI_ERR_CANCELLED, the lightmaps as before the bake
                                  * and what it did not finish left to the next bake or update */
     float time;                 /* animation time to bake at (seconds) */
-    int fresh_plan;             /* 1: where lights changed in power or number since the updater's creation,
-                                 * the photons are planned again as a fresh updater plans them, so that
-                                 * the bake gives a fresh updater's lightmap (within float summation
-                                 * order), at the cost of every photon path and texel; 0 (default): the
-                                 * shares of creation are kept, and an edit in one room re-traces and
-                                 * regathers nothing of another's (docs/api.md, "Baking") */
+    int fresh_plan;             /* 1: the bake gives a fresh updater's lightmap of the scene as it is now,
+                                 * to the bit: where lights changed in power or number since the updater's
+                                 * creation the photons are planned again as a fresh updater plans them
+                                 * (at the cost of every photon path and texel), and a path that moved by
+                                 * float noise is stored again; 0 (default): the shares of creation are
+                                 * kept, and an edit in one room re-traces and regathers nothing of
+                                 * another's (docs/api.md, "Baking") */
 } lmgi_bake_desc;
 typedef struct {
     uint32_t photons_traced, photons_changed; /* re-traced, and of those the paths the edits changed */

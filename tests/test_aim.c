@@ -794,6 +794,57 @@ static void test_seams(void **state)
     ts_free(&four);
 }
 
+/* A refresh owes its surface's change to the surfaces that continue it across a seam: their texels near the
+ * seam sum its hits too. After hits are added on one quadrant only, a refresh with a budget of one surface
+ * takes that quadrant, and the next takes the three others although their own hits did not change; a
+ * refresh without a budget takes all four at once. Either way the map is what a refresh of everything
+ * gives, to the bit (a bake after a box moved on one floor tile differed from a fresh one's by 3% along the
+ * next tile's seam). */
+static void test_seam_change_is_owed(void **state)
+{
+    (void)state;
+    tscene t;
+    seam_quadrants(&t, 0);
+    const float light[4] = {0.0f, 0.15f, 0.0f, 1.0f}, spot[4] = {0.05f, 0.1f, 0.05f, 1.0f};
+    size_t floats = 3 * (size_t)t.a.width * (size_t)t.a.height;
+    float *want = malloc(sizeof *want * floats);
+    assert_non_null(want);
+    for (int budget = 1; budget >= -1; budget -= 2) {
+        lm_photon_store ps;
+        assert_int_equal(lm_photon_store_init(&ps, t.su.surface_count, NULL), LM_OK);
+        g_rng = 5;
+        seam_hits(&ps, &t, light, 40);
+        lm_aim aim;
+        lm_aim_settings set;
+        lm_aim_settings_default(&set);
+        init_aim(&aim, &t, &set);
+        lm_aim_stats st;
+        assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, &st, NULL), LM_OK);
+        lm_photon_store more; /* a second light's hits on quadrant a alone, moved into the store */
+        assert_int_equal(lm_photon_store_init(&more, t.su.surface_count, NULL), LM_OK);
+        seam_hits(&more, &t, spot, 20);
+        for (uint32_t k = 0; k < more.surfaces[0].count; k++)
+            assert_true(lm_photon_store_add(&ps, &more.hits[more.surfaces[0].slots[k]]) != LM_NONE);
+        lm_photon_store_free(&more);
+        assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, budget, &st, NULL), LM_OK);
+        assert_int_equal(st.surfaces_refreshed, budget < 0 ? 4 : 1);
+        if (budget > 0) {
+            assert_true(aim.owed[1] > 0.0 && aim.owed[2] > 0.0 && aim.owed[3] > 0.0 && aim.owed[0] == 0.0);
+            assert_int_equal(lm_aim_refresh(&aim, t.s, &t.su, &t.a, &ps, 3, &st, NULL), LM_OK);
+            assert_int_equal(st.surfaces_refreshed, 3);
+        }
+        for (int k = 0; k < 4; k++)
+            assert_true(aim.owed[k] == 0.0);
+        memcpy(want, aim.rgb, sizeof *want * floats);
+        assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, &st, NULL), LM_OK);
+        assert_memory_equal(want, aim.rgb, sizeof *want * floats);
+        lm_aim_free(&aim);
+        lm_photon_store_free(&ps);
+    }
+    free(want);
+    ts_free(&t);
+}
+
 static void test_bad_settings(void **state)
 {
     (void)state;
@@ -829,6 +880,7 @@ int main(void)
         cmocka_unit_test(test_dense_surface_without_kdtree),
         cmocka_unit_test(test_min_radius_silences_n),
         cmocka_unit_test(test_seams),
+        cmocka_unit_test(test_seam_change_is_owed),
         cmocka_unit_test(test_bad_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -241,7 +241,8 @@ lm_status lm_aim_init(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, con
         st = build_edges(aim, s, su, err);
     if (st == LM_OK && aim->set.seams)
         st = lm_seams_find(&aim->seams, s, su, err);
-    if (st == LM_OK && !(aim->seams_used = calloc((size_t)su->surface_count + 1, sizeof *aim->seams_used)))
+    if (st == LM_OK && (!(aim->seams_used = calloc((size_t)su->surface_count + 1, sizeof *aim->seams_used)) ||
+                        !(aim->owed = calloc((size_t)su->surface_count + 1, sizeof *aim->owed))))
         st = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %d surfaces", su->surface_count);
     if (st != LM_OK)
         lm_aim_free(aim);
@@ -260,6 +261,7 @@ void lm_aim_free(lm_aim *aim)
     free(aim->refresh_count);
     free(aim->edge_d2);
     free(aim->seams_used);
+    free(aim->owed);
     lm_seams_free(&aim->seams);
     memset(aim, 0, sizeof *aim);
 }
@@ -1183,6 +1185,23 @@ static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32
 /* Recomputes the texels of the given surfaces from their current hits (trees built in parallel, then all
  * texels in one parallel pass), resets their delta_f and counts them in st. On an error, the surfaces
  * before the failing one are still refreshed. */
+/* The surfaces refreshed now (jobs[0, count)) owe their change to those that continue them across a seam
+ * and read their hits now (seam_usable): those refreshed in this call already read them (their owed is
+ * reset after this), the others are due a refresh (a moved box's hits changed on one face of a floor; the
+ * next tile's texels along the seam were left as they were, and a bake differed from a fresh one by up
+ * to 3% there). */
+static void owe_across_seams(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_photon_store *ps,
+                             const surface_job *jobs, int count)
+{
+    const lm_seams *sm = &aim->seams;
+    for (int j = 0; sm->first && j < count; j++) {
+        int k = jobs[j].surface;
+        for (uint32_t i = sm->first[k]; i < sm->first[k + 1]; i++)
+            if (seam_usable(s, su, sm->list[i], k))
+                aim->owed[sm->list[i]] += ps->surfaces[k].delta_f;
+    }
+}
+
 static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                   lm_photon_store *ps, const int *surfaces, int count, lm_aim_stats *st,
                                   lm_error *err)
@@ -1217,11 +1236,13 @@ static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfa
         ok = 0;
         rc = lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for N = %u lookups", n_max);
     }
+    owe_across_seams(aim, s, su, ps, jobs, ok);
     for (int j = 0; j < ok; j++) {
         int sf = jobs[j].surface;
         if (jobs[j].hits.count == 0 && !aim->direct)
             clear_texels(aim, a, aim->texel_first[sf], aim->texel_first[sf + 1]);
         lm_photon_store_reset_delta_f(ps, sf);
+        aim->owed[sf] = 0.0;
         aim->refresh_count[sf]++;
         if (st) {
             st->surfaces_refreshed++;
@@ -1296,7 +1317,7 @@ static lm_status run_schedule(lm_aim *aim, const lm_scene *s, const lm_surfaces 
         return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory to schedule %d surfaces", aim->surface_count);
     int count = 0;
     for (int i = 0; i < aim->surface_count; i++) {
-        double df = ps->surfaces[i].delta_f;
+        double df = ps->surfaces[i].delta_f + aim->owed[i];
         if (everything || (df > threshold && df > 0.0))
             c[count++] = (candidate){df / fmax((double)su->surfaces[i].area, 1e-12), i};
     }
@@ -1331,6 +1352,18 @@ static lm_status refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, 
     lm_status rc = check_inputs(aim, su, a, ps, err);
     if (rc == LM_OK)
         rc = run_schedule(aim, s, su, a, ps, budget, all, st, err);
+    int owed = 0;
+    for (int k = 0; budget < 0 && !all && k < aim->surface_count; k++)
+        owed |= aim->owed[k] > 0.0;
+    if (rc == LM_OK && owed) { /* without a budget, what the refreshed surfaces owe across seams too */
+        lm_aim_stats more;
+        memset(&more, 0, sizeof more);
+        rc = run_schedule(aim, s, su, a, ps, budget, 0, &more, err);
+        st->surfaces_refreshed += more.surfaces_refreshed;
+        st->texels_written += more.texels_written;
+        st->hits_used += more.hits_used;
+        st->surfaces_binned += more.surfaces_binned;
+    }
     st->seconds = lm_now() - t0;
     return rc;
 }

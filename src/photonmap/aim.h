@@ -92,6 +92,9 @@ typedef struct {
                                 texels share hits. 0 and 0 where the AIM is 0. NULL when off */
     lm_seams seams;          /* per surface, the surfaces that continue it (set.seams) */
     uint32_t *seams_used;    /* per surface: which of them its last refresh used, hashed (edge_d2 holds for that set) */
+    double *owed;            /* per surface: the delta_f of the continuing surfaces refreshed since its own last
+                                refresh; its estimate near the seam reads their hits too, so it is due a refresh
+                                as if its own had changed (scheduled by delta_f + owed) */
     float mean_hit_energy;   /* as of the last refresh call */
     const lm_direct_light *direct; /* NULL (default): photons carry all light, the paper's form; else
                                       lm_aim_set_direct */
@@ -126,8 +129,9 @@ void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
 lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                  float radius, float *out, lm_error *err);
 
-/* Refreshes up to `budget` surfaces (budget < 0: no limit) whose delta_f is over the threshold, in
- * order of delta_f / area (ties: lower surface id first), and resets their delta_f. stats may be NULL. */
+/* Refreshes up to `budget` surfaces (budget < 0: no limit) whose delta_f + owed is over the threshold, in
+ * order of (delta_f + owed) / area (ties: lower surface id first), and resets both; the delta_f of each is
+ * owed to the surfaces that continue it and were not refreshed with it. stats may be NULL. */
 lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                          lm_photon_store *ps, int budget, lm_aim_stats *stats, lm_error *err);
 /* Refreshes every surface (initialisation, or after a settings change) and resets every delta_f. */

@@ -32,7 +32,8 @@ struct lm_photon_stage {
     emitter_snapshot *snap;
     float bounds[6];             /* the scene's bounds when the emitters were last placed (a sun's follow) */
     uint8_t *refreshed;          /* per surface: its AIM refreshed since lm_photon_stage_take_refreshed */
-    double *delta_before;        /* scratch: per surface, delta_f before a refresh */
+    double *delta_before;        /* scratch: per surface, delta_f + owed before a refresh (aim.h) */
+    uint32_t *count_before;      /* scratch: per surface, its refresh count before it */
     lm_photons *photons;
     lm_aim aim;
     lm_emitter_light area;       /* with have_area: the emissive triangles' closed form, for the AIMs */
@@ -337,7 +338,8 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     size_t S = (size_t)ps->surfaces->surface_count + 1;
     ps->refreshed = calloc(S, 1);
     ps->delta_before = calloc(S, sizeof *ps->delta_before);
-    if (!ps->refreshed || !ps->delta_before)
+    ps->count_before = calloc(S, sizeof *ps->count_before);
+    if (!ps->refreshed || !ps->delta_before || !ps->count_before)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     st = make_photons(ps, &ps->photons, err);
     if (st == LM_OK)
@@ -407,6 +409,7 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->snap);
     free(ps->refreshed);
     free(ps->delta_before);
+    free(ps->count_before);
     free(ps);
 }
 
@@ -452,14 +455,15 @@ static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out
     lm_photon_store *store = lm_photons_store_mutable(ps->photons);
     int S = ps->surfaces->surface_count;
     uint64_t hits = 0;
-    for (int k = 0; k < S; k++) {
-        ps->delta_before[k] = store->surfaces[k].delta_f;
+    for (int k = 0; k < S; k++) { /* the change each would be refreshed for, and whether it was (its count) */
+        ps->delta_before[k] = store->surfaces[k].delta_f + ps->aim.owed[k];
+        ps->count_before[k] = ps->aim.refresh_count[k];
         hits += store->surfaces[k].count;
     }
     lm_status st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, store, budget, out, err);
     double seen = SEEN_CHANGE * ps->aim.mean_hit_energy * (double)hits;
     for (int k = 0; k < S; k++)
-        ps->refreshed[k] |= ps->delta_before[k] > seen && !(store->surfaces[k].delta_f > 0.0);
+        ps->refreshed[k] |= ps->delta_before[k] > seen && ps->aim.refresh_count[k] != ps->count_before[k];
     return st;
 }
 
@@ -539,8 +543,9 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan,
         st = find_portals(ps, err);
     if (st == LM_OK && replan)
         st = plan_photons_again(ps, err);
-    if (st == LM_OK)
-        st = lm_photons_trace_all(ps->photons, &out->photons, err);
+    if (st == LM_OK) /* with fresh_plan, what a fresh trace stores, to the bit */
+        st = fresh_plan ? lm_photons_trace_all_exact(ps->photons, &out->photons, err)
+                        : lm_photons_trace_all(ps->photons, &out->photons, err);
     double t2 = lm_now();
     if (st == LM_OK && ps->set.aims && replan) {
         st = refresh_all_aims(ps, &out->aim, err);

@@ -65,7 +65,9 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
  * changes nothing in the store) and the AIM of every surface whose photons changed refreshed. With
  * fresh_plan, photons whose plan a fresh stage would make otherwise (lights changed in power or number
  * since creation: lm_photons_plan_outdated) are planned again as it would, traced, and every AIM
- * refreshed (each counts as refreshed); on a failure there the old photons stay. */
+ * refreshed (each counts as refreshed); on a failure there the old photons stay. With fresh_plan the
+ * trace also replaces every path that differs in any bit (lm_photons_trace_all_exact), so that the store
+ * is a fresh stage's. */
 lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan, lm_photon_stage_frame *out,
                                    lm_error *err);
 /* Per surface, 1 if its AIM was refreshed since the last call (by updates or a converge) for a change of
