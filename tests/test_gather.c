@@ -913,12 +913,7 @@ static void test_same_iim_in_any_grouping(void **state)
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
     lmt_pipeline p;
     lmt_pipeline_load(&p, path, 0.1153f);
-    lm_photon_stage_settings ps;
-    lm_photon_stage_settings_default(&ps);
-    lm_photon_stage *st = NULL;
-    lm_error err;
-    if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK)
-        fail_msg("%s", err.msg);
+    lm_photon_stage *st = stage_for(&p, 0); /* the default photons */
     uint32_t n = p.atlas.texel_count < 700 ? p.atlas.texel_count : 700, *texels = all_texels(&p.atlas);
     uint32_t *reversed = malloc(sizeof *reversed * n);
     assert_non_null(reversed);

@@ -1182,9 +1182,6 @@ static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32
     }
 }
 
-/* Recomputes the texels of the given surfaces from their current hits (trees built in parallel, then all
- * texels in one parallel pass), resets their delta_f and counts them in st. On an error, the surfaces
- * before the failing one are still refreshed. */
 /* The surfaces refreshed now (jobs[0, count)) owe their change to those that continue them across a seam
  * and read their hits now (seam_usable): those refreshed in this call already read them (their owed is
  * reset after this), the others are due a refresh (a moved box's hits changed on one face of a floor; the
@@ -1202,6 +1199,9 @@ static void owe_across_seams(lm_aim *aim, const lm_scene *s, const lm_surfaces *
     }
 }
 
+/* Recomputes the texels of the given surfaces from their current hits (trees built in parallel, then all
+ * texels in one parallel pass), owes their change across seams, resets their delta_f and owed and counts
+ * them in st. On an error, the surfaces before the failing one are still refreshed. */
 static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                   lm_photon_store *ps, const int *surfaces, int count, lm_aim_stats *st,
                                   lm_error *err)

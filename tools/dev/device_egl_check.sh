@@ -3,19 +3,23 @@
 #
 # It answers: does LMGI_GL=egl (and auto) make an OpenGL 4.5 core context on the GPU's EGL device
 # platform, which renderer and version does it report, do the same commands give the same pictures and
-# lightmaps as on llvmpipe, how long does a level's bake take there, and does test_gl_guest (lmgi in an
-# EGL host's share group) pass there. Written for a bare GPU machine that cannot reach the network (the
+# lightmaps as on llvmpipe, how long does a level's bake take there, and do test_gl_guest (lmgi in an
+# EGL host's share group), test_gather (a texel's gathered bits whatever it is gathered with) and
+# test_bake_after_edits (a bake after edits is a fresh one's, to the bit) pass there. Written for a bare GPU machine that cannot reach the network (the
 # NVIDIA H200 machines lent to sessions): everything it needs travels in one folder, the bundle.
 #
 # 1. Build here for the architecture's baseline, so that the binaries run on another x86-64 CPU:
-#      make ARCH=-march=x86-64-v3 build/lmgi build/tests/test_gl_guest
+#      make ARCH=-march=x86-64-v3 build/lmgi build/tests/test_gl_guest build/tests/test_gather \
+#           build/tests/test_bake_after_edits
+#    (or into another folder, BUILD=build/x86-64-v3 for make and for the bundle step below)
 # 2. Make the bundle (the binaries, the shared libraries they need from this machine except glibc and
 #    GL's own -- libEGL, libGL, libGLX, libGLdispatch come from the GPU machine's glvnd, so that its
 #    vendor library is used --, this script as run.sh, tools/dev/device/exr_diff.c built here, and the
 #    scenes):
 #      tools/dev/device_egl_check.sh bundle DIR [SHARED_SCENES]
 #    SHARED_SCENES (default ../shared/scenes) gives cornell-box/CornellBox.glb and
-#    occlusion-room/room_lit.glb; lmgi's own scenes/cornell.glb is copied too. The libraries are packed
+#    occlusion-room/room_lit.glb; lmgi's own scenes/cornell.glb and two_rooms.glb are copied too (the tests
+#    run in the bundle's folder and find them in its scenes/). The libraries are packed
 #    in DIR/libs.tar.xz (Embree alone is 43 MB unpacked); about 16 MB in all.
 # 3. Run it on the GPU machine (and the same here, for llvmpipe):
 #      DIR/run.sh OUT [BACKENDS]    there: DIR/run.sh /tmp/out "egl auto";   here: DIR/run.sh /tmp/here egl
@@ -48,15 +52,17 @@ die() { echo "device_egl_check: $*" >&2; exit 1; }
 
 # ---------------------------------------------------------------------------------------------------
 bundle() {
-    local dir=$1 shared=${2:-../shared/scenes}
-    [ -x build/lmgi ] || die "run from the repository root after make (build/lmgi missing)"
+    local dir=$1 shared=${2:-../shared/scenes} b=${BUILD:-build}
+    [ -x "$b/lmgi" ] || die "run from the repository root after make ($b/lmgi missing; BUILD names another build folder)"
     [ -f "$shared/cornell-box/CornellBox.glb" ] || die "no $shared/cornell-box/CornellBox.glb"
     mkdir -p "$dir/bin" "$dir/scenes" "$dir/.libs" || exit 1
-    strip -o "$dir/bin/lmgi" build/lmgi
-    [ -x build/tests/test_gl_guest ] && strip -o "$dir/bin/test_gl_guest" build/tests/test_gl_guest
+    strip -o "$dir/bin/lmgi" "$b/lmgi"
+    for t in test_gl_guest test_gather test_bake_after_edits; do
+        [ -x "$b/tests/$t" ] && strip -o "$dir/bin/$t" "$b/tests/$t"
+    done
     cc -O2 -o "$dir/bin/exr_diff" tools/dev/device/exr_diff.c -ltinyexr -lm || die "exr_diff did not build"
     cp "$0" "$dir/run.sh" && chmod +x "$dir/run.sh"
-    cp scenes/cornell.glb "$shared/cornell-box/CornellBox.glb" "$shared/occlusion-room/room_lit.glb" "$dir/scenes/"
+    cp scenes/cornell.glb scenes/two_rooms.glb "$shared/cornell-box/CornellBox.glb" "$shared/occlusion-room/room_lit.glb" "$dir/scenes/"
     # every library the binaries load but glibc's and GL's (the GPU machine's glvnd and driver give those)
     ldd "$dir"/bin/* | awk '$3 ~ /^\// {print $3}' | sort -u |
         grep -Ev '/(libc|libm|libdl|librt|libpthread|ld-linux-x86-64|libEGL|libGL|libGLX|libGLdispatch|libOpenGL)\.so' |
@@ -148,7 +154,10 @@ run_all() {
             step "bake_$be" "$be" "$B/bin/lmgi" bake "$B/scenes/room_lit.glb" --out "bake_$be"
             step "bake_rays_$be" "$be" "$B/bin/lmgi" bake "$B/scenes/room_lit.glb" --gather-scheme rays --out "bake_rays_$be"
             step "bake_viewports_$be" "$be" "$B/bin/lmgi" bake "$B/scenes/room_lit.glb" --gather-scheme viewports --out "bake_viewports_$be"
-            [ -x "$B/bin/test_gl_guest" ] && step "test_gl_guest" default bash -c 'cd "$0" && exec bin/test_gl_guest' "$B"
+            for t in test_gl_guest test_gather test_bake_after_edits; do # the guest test makes its own host
+                [ -x "$B/bin/$t" ] && step "$t" "$([ $t = test_gl_guest ] && echo default || echo "$be")" \
+                    bash -c 'cd "$0" && exec "bin/$1"' "$B" "$t"
+            done
             step "bake4x_rays_$be" "$be" "$B/bin/lmgi" bake "$B/scenes/room_lit.glb" --texels 262144 --gather-scheme rays --out "bake4x_rays_$be"
             step "bake4x_viewports_$be" "$be" "$B/bin/lmgi" bake "$B/scenes/room_lit.glb" --texels 262144 --gather-scheme viewports --out "bake4x_viewports_$be"
             first=0

@@ -487,15 +487,13 @@ static void clear_target(lm_gather *g, const uint32_t *texels, uint32_t count, i
 {
     int R = g->set.resolution, T = g->set.tiles;
     const float sky[4] = {g->set.sky[0], g->set.sky[1], g->set.sky[2], 0.0f}, zero = 0.0f;
-    if (g->set.scheme == LM_GATHER_LAYERED) {
-        for (uint32_t i = 0; i < count; i++) {
-            uint32_t n = sparse ? 1 : count;
+    if (g->set.scheme == LM_GATHER_LAYERED) { /* layers [0, count), or each used one */
+        for (uint32_t i = 0; i < (sparse ? count : 1); i++) {
+            GLsizei n = sparse ? 1 : (GLsizei)count;
             if (sparse && texels[i] == LM_GATHER_NO_TEXEL)
                 continue;
-            glClearTexSubImage(g->color, 0, 0, 0, (GLint)i, R, R, (GLsizei)n, GL_RGBA, GL_FLOAT, sky);
-            glClearTexSubImage(g->depth, 0, 0, 0, (GLint)i, R, R, (GLsizei)n, GL_DEPTH_COMPONENT, GL_FLOAT, &zero);
-            if (!sparse)
-                break;
+            glClearTexSubImage(g->color, 0, 0, 0, (GLint)i, R, R, n, GL_RGBA, GL_FLOAT, sky);
+            glClearTexSubImage(g->depth, 0, 0, 0, (GLint)i, R, R, n, GL_DEPTH_COMPONENT, GL_FLOAT, &zero);
         }
         return;
     }
