@@ -113,14 +113,14 @@ static inline int lmgi_knob_is_pow2(double v)
     X(aim, nearest, LMGI_KNOB_INT, int, 32, 1, 100000, 0, LMGI_NO_RULE, "--nearest", "N", LMGI_CLI_ZERO_NONE,     \
       LMGI_NO_CHOICES,                                                                                             \
       LMGI_SWEEP(3, "nearest", "photons per AIM estimate N", (16, 32, 64, 128, 256), (16, 32, 128), 0),          \
-      "photons per AIM estimate (default 32; at lmgi run's density the smallest\n"                                 \
-      "radius holds more, and sets the estimate instead: --min-radius)")                                          \
+      "photons per AIM estimate (default 32; where hits are denser, the smallest\n"                               \
+      "radius, which grows with sqrt(N), holds more: --min-radius)")                                              \
     X(aim, min_radius, LMGI_KNOB_REAL, float, 1, 0.01, 100, 0, LMGI_NO_RULE, "--min-radius", "T",                 \
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES,                                                                         \
       LMGI_SWEEP(4, "min_radius", "AIM's smallest radius in texels", (0.25, 0.5, 1, 2), (0.25, 1), 0),           \
-      "the AIM estimate's smallest radius, in texels (default 1): where N hits\n"                                 \
-      "lie closer, every hit within it is summed; smaller makes the AIM sharper\n"                                \
-      "and noisier, and lets N act at lmgi run's density (docs/aim.md)")                                           \
+      "the AIM estimate's smallest radius, in texels at N = 32 and sqrt(N / 32)\n"                               \
+      "times that at another N (default 1): where N hits lie closer, every hit\n"                                \
+      "within it is summed; smaller makes the AIM sharper and noisier (docs/aim.md)")                             \
     X(aim, surfaces_per_frame, LMGI_KNOB_INT, int, 4, 1, 10000000, 1, LMGI_NO_RULE, "--surfaces-per-frame", "K",  \
       LMGI_CLI_ZERO_DEFAULT, LMGI_NO_CHOICES, LMGI_NO_SWEEP, "AIM refreshes a frame (default 4)")                 \
     X(aim, direct, LMGI_KNOB_CHOICE, lmgi_aim_direct, LMGI_AIM_DIRECT_PHOTONS, 0, 0, 0, LMGI_NO_RULE,             \

@@ -650,11 +650,13 @@ static void test_dense_surface_without_kdtree(void **state)
     ts_free(&t);
 }
 
-/* At lmgi run's density the smallest radius, not N, is the estimate's radius (docs/aim.md, "N against the
- * smallest radius"): 100 hits a texel under a point light, N = 16 and 128 give the same map with the
- * radius at 1 texel (both sets lie inside it, and every hit within it is summed), and different maps once
- * the radius is a quarter of a texel. */
-static void test_min_radius_silences_n(void **state)
+/* N and the smallest radius (docs/aim.md, "N against the smallest radius"): 100 hits a texel under a point
+ * light, as dense as at `lmgi run`'s atlas. The smallest radius is min_radius_texels texels at N = 32 and
+ * grows with sqrt(N), so N sets the disc however dense the hits: every texel's radius (the error
+ * estimate's) is 1, 1/sqrt(2) and 2 texels at N = 32, 16 and 128, and the maps of N = 16 and 128 differ.
+ * Before, the radius was 1 texel at every N, N = 16 and 128 gave the same map, and the tradeoff sweep's N
+ * line was flat at `run`'s density. */
+static void test_n_acts_at_any_density(void **state)
 {
     (void)state;
     lmt_mesh m;
@@ -666,32 +668,35 @@ static void test_min_radius_silences_n(void **state)
     const float light[4] = {0.3f, 1.0f, -0.2f, 10.0f};
     g_rng = 7;
     add_hits(&ps, &t, 0, -2.0f, -2.0f, 4.0f, 200, density_point, light, 1.0f, light);
-    double diff[2];
-    const float radius[2] = {1.0f, 0.25f};
-    for (int r = 0; r < 2; r++) {
-        lm_aim aim[2];
-        const int n[2] = {16, 128};
-        for (int k = 0; k < 2; k++) {
-            lm_aim_settings set;
-            lm_aim_settings_default(&set);
-            set.n_nearest = n[k];
-            set.min_radius_texels = radius[r];
-            init_aim(&aim[k], &t, &set);
-            assert_int_equal(lm_aim_refresh_all(&aim[k], t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
-        }
-        double sum = 0.0;
+    const int n[3] = {32, 16, 128};
+    const double texels[3] = {1.0, sqrt(0.5), 2.0};
+    lm_aim aim[3];
+    for (int k = 0; k < 3; k++) {
+        lm_aim_settings set;
+        lm_aim_settings_default(&set);
+        set.n_nearest = n[k];
+        set.error_estimate = 1;
+        init_aim(&aim[k], &t, &set);
+        assert_int_equal(lm_aim_refresh_all(&aim[k], t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);
+        int at_floor = 0;
         for (uint32_t i = 0; i < t.a.texel_count; i++) {
-            double a = aim_px(&aim[0], &t.a.texels[i])[1], b = aim_px(&aim[1], &t.a.texels[i])[1];
-            sum += fabs(a - b) / fmax(fabs(b), 1e-30);
+            const lm_texel *tx = &t.a.texels[i];
+            float r = aim[k].error[2 * ((size_t)tx->y * t.a.width + tx->x) + 1];
+            at_floor += fabs(r / (texels[k] * t.a.texel_size) - 1.0) < 1e-5;
         }
-        diff[r] = sum / t.a.texel_count;
-        print_message("smallest radius %.2f texels: N = 16 and N = 128 differ by %.3g%% per texel on average\n",
-                      (double)radius[r], 100.0 * diff[r]);
-        lm_aim_free(&aim[0]);
-        lm_aim_free(&aim[1]);
+        print_message("N = %d: %d of %u texels estimated over %.3f texels\n", n[k], at_floor, t.a.texel_count,
+                      texels[k]);
+        assert_true(at_floor > (int)(0.9 * t.a.texel_count)); /* the hits are dense everywhere */
     }
-    assert_true(diff[0] < 1e-6); /* the same hits, summed in another order where one was binned */
-    assert_true(diff[1] > 0.01);
+    double sum = 0.0;
+    for (uint32_t i = 0; i < t.a.texel_count; i++) {
+        double a = aim_px(&aim[1], &t.a.texels[i])[1], b = aim_px(&aim[2], &t.a.texels[i])[1];
+        sum += fabs(a - b) / fmax(fabs(b), 1e-30);
+    }
+    print_message("N = 16 and N = 128 differ by %.3g%% per texel on average\n", 100.0 * sum / t.a.texel_count);
+    assert_true(sum / t.a.texel_count > 0.01);
+    for (int k = 0; k < 3; k++)
+        lm_aim_free(&aim[k]);
     lm_photon_store_free(&ps);
     ts_free(&t);
 }
@@ -878,7 +883,7 @@ int main(void)
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_batch_matches_single),
         cmocka_unit_test(test_dense_surface_without_kdtree),
-        cmocka_unit_test(test_min_radius_silences_n),
+        cmocka_unit_test(test_n_acts_at_any_density),
         cmocka_unit_test(test_seams),
         cmocka_unit_test(test_seam_change_is_owed),
         cmocka_unit_test(test_bad_settings),

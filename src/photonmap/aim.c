@@ -328,6 +328,17 @@ static void local_face_normal(const lm_scene *s, uint32_t t, double n[3])
         n[a] = l > 0.0 ? n[a] / l : (a == 2);
 }
 
+/* The estimate's smallest radius, world units of the atlas, for a surface of `hits` hits: min_radius_texels
+ * texels at N = LM_AIM_FLOOR_N, growing with sqrt(N) (aim.h: where hits are denser than that, N still sets
+ * the disc). Above LM_AIM_FLOOR_N, N counts for at most the surface's hits: with fewer the disc reaches the
+ * farthest as before, and a floor wider than the surface would meet the boundary correction's clamp
+ * (N = 100,000 read a room 25% dark). */
+static double smallest_radius(const lm_aim *aim, const lm_atlas *a, uint64_t hits)
+{
+    double n = aim->set.n_nearest, most = fmax((double)hits, LM_AIM_FLOOR_N);
+    return (double)aim->set.min_radius_texels * a->texel_size * sqrt(fmin(n, most) / LM_AIM_FLOOR_N);
+}
+
 /* ---------- gathering a surface's hits ---------- */
 
 typedef struct {
@@ -1045,7 +1056,7 @@ static double *bin_dense_surface(const lm_aim *aim, const lm_scene *s, const lm_
     uint32_t *count = calloc(n, sizeof *count);
     texel_grid g = {0};
     int ok = r2 && y && out && count;
-    double rmin = (double)aim->set.min_radius_texels * a->texel_size;
+    double rmin = smallest_radius(aim, a, sj->hits.count);
     for (uint32_t i = 0; ok && i < n; i++) {
         const lm_texel *t = &a->texels[list[i]];
         double nrm[3];
@@ -1113,7 +1124,7 @@ static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfa
     if (sj->rc == LM_OK && !sj->binned)
         sj->rc = lm_kdtree_build(&sj->tree, sj->hits.pos, 3, sj->hits.count, &sj->err);
     uint32_t n = (uint32_t)aim->set.n_nearest < sj->hits.count ? (uint32_t)aim->set.n_nearest : sj->hits.count;
-    double rmin = (double)aim->set.min_radius_texels * a->texel_size;
+    double rmin = smallest_radius(aim, a, sj->hits.count);
     sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {sj->edge_ends, sj->edge_count}, n, rmin * rmin,
                              aim->set.boundary_correction, aim->set.kernel, aim->direct,
                              s->nodes[sf->node].world, m->double_sided, sj->binned};

@@ -29,6 +29,9 @@
 #ifndef LM_AIM_H
 #define LM_AIM_H
 
+/* The N at which the smallest radius is min_radius_texels texels (see the settings). */
+#define LM_AIM_FLOOR_N 32.0
+
 #include <stdint.h>
 
 #include "../charts/charts.h"
@@ -41,7 +44,8 @@
 
 typedef struct {
     int n_nearest;           /* N hits per estimate (default 32; clamped to the surface's hit count) */
-    float min_radius_texels; /* smallest gather radius, in texels of the atlas (default 1) */
+    float min_radius_texels; /* smallest gather radius, in texels of the atlas at N = LM_AIM_FLOOR_N, and
+                              * sqrt(N / LM_AIM_FLOOR_N) times that at another N (default 1) */
     float delta_threshold;   /* refresh when delta_f > this x the mean stored hit energy (default 0.01) */
     int front_only;          /* single-sided materials count only hits arriving from the front (default 1) */
     int boundary_correction; /* use the disc's area on the surface near its boundary (default 1) */
