@@ -4,12 +4,12 @@
  * sequence of material edits, and random sequences of every kind of edit. What it took, each found by a
  * test here: a texel is gathered in the same tile of a pass whatever else is gathered with it
  * (gather_passes.h); the bake's full trace replaces a path that changed in any bit, where an update's
- * keeps one within its tolerance (lm_photons_trace_all); a refreshed surface's change is owed to the
- * surfaces that continue it across a seam (lm_aim.owed); a texel blended in shows new itself (the blend's
- * mix could round an ulp away). A refresh under
- * way when the bake starts is done again in full (iim_schedule.h, lm_iim_sched_restart): its first texels
- * saw AIMs the bake's photons have changed since, and a light made 100 times brighter for 10 updates and
- * then restored left 180 texels of the two rooms about 67 times too bright. After lights change in power
+ * keeps one within its tolerance (lm_photons_trace_all_exact); a refreshed surface's change is owed to
+ * the surfaces that continue it across a seam (lm_aim.owed); a texel blended in shows new itself (the
+ * blend's mix could round an ulp away). A refresh under way when the bake starts is done again in full
+ * (iim_schedule.h, lm_iim_sched_restart): its first texels saw AIMs the bake's photons have changed
+ * since, and a light made 100 times brighter for 10 updates and then restored left 180 texels of the two
+ * rooms about 67 times too bright. After lights change in power
  * or number, a bake with fresh_plan plans the photons again as a fresh updater does (photon_stage.c,
  * plan_photons_again); the default keeps the shares of creation (an edit in one room costs nothing in
  * another, test_light_edits) and is a photon noise away, up to 15% a texel at 2,000 texels. */
@@ -131,8 +131,8 @@ static void test_light_edited_and_restored(void **state)
 }
 
 /* The dynamic cube moved ten times along the floor, with 1 to 6 updates after each, then a bake: the
- * fresh bake's lightmap to the bit (before each texel had its own tile in the gather, 172 of 2,048 texels
- * differed by up to 2.4e-5; gather_passes.h). */
+ * fresh bake's lightmap to the bit (before, 541 texels of the atlas differed by up to 2.2e-5: the gather's
+ * tiles, gather_passes.h, and the floor's surfaces along a seam to the one the cube stood on, lm_aim.owed). */
 static void test_node_moves_to_the_bit(void **state)
 {
     (void)state;

@@ -1366,15 +1366,9 @@ static lm_status refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, 
     int owed = 0;
     for (int k = 0; budget < 0 && !all && k < aim->surface_count; k++)
         owed |= aim->owed[k] > 0.0;
-    if (rc == LM_OK && owed) { /* without a budget, what the refreshed surfaces owe across seams too */
-        lm_aim_stats more;
-        memset(&more, 0, sizeof more);
-        rc = run_schedule(aim, s, su, a, ps, budget, 0, &more, err);
-        st->surfaces_refreshed += more.surfaces_refreshed;
-        st->texels_written += more.texels_written;
-        st->hits_used += more.hits_used;
-        st->surfaces_binned += more.surfaces_binned;
-    }
+    if (rc == LM_OK && owed) /* without a budget, what the refreshed surfaces owe across seams too (its
+                              * counts add to st's; nothing is left pending without a budget) */
+        rc = run_schedule(aim, s, su, a, ps, budget, 0, st, err);
     st->seconds = lm_now() - t0;
     return rc;
 }

@@ -29,9 +29,6 @@
 #ifndef LM_AIM_H
 #define LM_AIM_H
 
-/* The N at which the smallest radius is min_radius_texels texels (see the settings). */
-#define LM_AIM_FLOOR_N 32.0
-
 #include <stdint.h>
 
 #include "../charts/charts.h"
@@ -41,6 +38,9 @@
 #include "../trace/photon_store.h"
 #include "kdtree.h"
 #include "seams.h"
+
+/* The N at which the smallest radius is min_radius_texels texels (see the settings). */
+#define LM_AIM_FLOOR_N 32.0
 
 typedef struct {
     int n_nearest;           /* N hits per estimate (default 32; clamped to the surface's hit count) */
