@@ -243,11 +243,12 @@ static void test_lamp_under_ceiling(void **state)
  * EMITTERS computes emissive triangles' light, and the room has none, so its AIM is the default's (the
  * paper's) to the bit; ALL computes the lamp's light too, and the AIM changes; a value out of range is
  * refused. */
-static float *room_aim(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, size_t *n)
+static float *room_aim_with(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, int occluders, size_t *n)
 {
     lmgi_updater_desc d;
     lmt_room_desc(&d);
     d.aim.direct = mode;
+    d.aim.occluders = occluders;
     lmgi_updater *u = NULL;
     lmgi_error e;
     if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
@@ -260,6 +261,11 @@ static float *room_aim(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, 
     assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim, *n, &e), LMGI_OK);
     lmgi_updater_free(u);
     return aim;
+}
+
+static float *room_aim(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, size_t *n)
+{
+    return room_aim_with(ctx, sc, mode, 0, n);
 }
 
 static void test_updater_choice(void **state)
@@ -288,12 +294,43 @@ static void test_updater_choice(void **state)
     lmgi_context_free(ctx);
 }
 
+/* The updater's visibility test (lmgi_updater_desc.aim.occluders; its estimate: tests/test_aim.c): off is the
+ * default to the bit; on, the floor beside the block keeps the block's shadow (the AIM changes there and
+ * hardly elsewhere); a value that is neither is refused. */
+static void test_updater_occluders(void **state)
+{
+    (void)state;
+    static const lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 4.0f,
+                                         .position = {-1.2f, 2.5f, -1.0f}};
+    lmgi_context *ctx = lmt_context();
+    lmt_room_spec spec = {.lights = &lamp, .light_count = 1};
+    lmgi_scene *sc = lmt_room(&spec);
+    size_t n;
+    float *dflt = room_aim_with(ctx, sc, LMGI_AIM_DIRECT_PHOTONS, 0, &n),
+          *off = room_aim_with(ctx, sc, LMGI_AIM_DIRECT_PHOTONS, LMGI_OFF, &n),
+          *on = room_aim_with(ctx, sc, LMGI_AIM_DIRECT_PHOTONS, LMGI_ON, &n);
+    assert_memory_equal(dflt, off, n * sizeof *off);
+    double l1 = lmt_relative_l1(on, off, n);
+    print_message("AIM with the visibility test: %.4f relative L1 from the paper's estimate\n", l1);
+    assert_true(l1 > 1e-4 && l1 < 0.2); /* the same light, kept out of the block's shadow */
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.aim.occluders = 7;
+    lmgi_updater *bad = NULL;
+    lmgi_error e;
+    lmt_expect_invalid(lmgi_updater_create(ctx, sc, &d, &bad, &e), &e, "aim.occluders 7");
+    free(dflt), free(off), free(on);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_shadow_edge),
         cmocka_unit_test(test_lamp_under_ceiling),
         cmocka_unit_test(test_updater_choice),
+        cmocka_unit_test(test_updater_occluders),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -161,6 +161,8 @@ static void test_usage_errors(void **state)
     assert_int_equal(run("run scenes/cornell.glb --aim-direct exact --out x"), 2);
     assert_non_null(strstr(output, "--aim-direct exact"));
     assert_non_null(strstr(output, "emitters, photons or all"));
+    assert_int_equal(run("run scenes/cornell.glb --aim-occluders maybe --out x"), 2);
+    assert_non_null(strstr(output, "--aim-occluders maybe: expected on or off"));
     /* the indirect paths and their knobs (docs/tiled.md) */
     assert_int_equal(run("run scenes/cornell.glb --indirect photons --out x"), 2);
     assert_non_null(strstr(output, "--indirect photons"));

@@ -506,6 +506,61 @@ static void test_energy_closed_box(void **state)
     world_free(&w);
 }
 
+/* Each stored hit knows where its photon came from (lm_hit.travelled, for the AIM's visibility test): a
+ * first hit lies that far from the lamp back along its direction, a later one that far from a wall of the
+ * box it bounced off. */
+static void test_hits_know_where_they_came_from(void **state)
+{
+    (void)state;
+    static lmt_mesh box;
+    memset(&box, 0, sizeof box);
+    lmt_mesh_cube_inward(&box, 1.0f);
+    const char *nodes = "[{\"name\": \"root\", \"children\": [1, 2]}, {\"name\": \"box\", \"mesh\": 0},"
+                        " {\"name\": \"lamp\", \"translation\": [0.2, 0.3, -0.1],"
+                        "  \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
+    const char *lights = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+                         " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\","
+                         " \"intensity\": 10}]}},";
+    char path[512];
+    snprintf(path, sizeof path, "%s/box_from.gltf", lmt_tmpdir());
+    assert_int_equal(lmt_write_gltf(path, &box, 1, nodes, NULL, 0, lights), 0);
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.total_photons = 5000;
+    world_photons(&w, &set);
+    const lm_photon_store *ps = lm_photons_store(w.ph);
+    const float lamp[3] = {0.2f, 0.3f, -0.1f};
+    double worst_first = 0.0, worst_later = 0.0;
+    uint32_t first = 0, later = 0;
+    for (int s = 0; s < ps->surface_count; s++)
+        for (uint32_t k = 0; k < ps->surfaces[s].count; k++) {
+            const lm_hit *h = &ps->hits[ps->surfaces[s].slots[k]];
+            assert_true(h->travelled > 0.0f);
+            float q[3], wall = 0.0f, half = 0.0f;
+            for (int c = 0; c < 3; c++) {
+                q[c] = h->pos[c] - h->travelled * h->dir[c];
+                wall = fmaxf(wall, fabsf(q[c]));
+                half = fmaxf(half, fabsf(h->pos[c])); /* every hit lies on a wall */
+            }
+            if (h->bounce == 0) {
+                for (int c = 0; c < 3; c++)
+                    worst_first = fmax(worst_first, fabs(q[c] - lamp[c]));
+                first++;
+            } else {
+                worst_later = fmax(worst_later, fabs(wall - half));
+                later++;
+            }
+        }
+    print_message("%u first hits: at most %.2e from the lamp; %u later ones: their previous vertex at most %.2e off "
+                  "a wall\n", first, worst_first, later, worst_later);
+    assert_true(first > 1000 && later > 1000);
+    assert_true(worst_first < 1e-4);
+    assert_true(worst_later < 1e-3);
+    world_free(&w);
+}
+
 /* Russian roulette by the albedo's largest channel: no channel of a photon's flux grows at a bounce, so
  * in a closed box of saturated red (0.8 0.2 0.1) no stored hit carries more, per channel, than the
  * photon left the lamp with. (With the luminance, 0.32, as the survival the red channel grew 2.5x a
@@ -832,7 +887,7 @@ static void test_cornell_rate_and_memory(void **state)
                   mem.store_bytes, mem.other_bytes);
     assert_int_equal(st.group_photons, lm_photons_count(w.ph));
     assert_true(mem.mean_path_vertices >= mem.mean_hits && mem.mean_hits > 1.0);
-    assert_float_equal(mem.live_per_photon, 4.0 + 16.0 + 24.0 * mem.mean_path_vertices + 72.0 * mem.mean_hits, 1e-6);
+    assert_float_equal(mem.live_per_photon, 4.0 + 16.0 + 24.0 * mem.mean_path_vertices + 76.0 * mem.mean_hits, 1e-6);
     assert_true(mem.per_photon >= mem.live_per_photon && mem.per_photon < 2.5 * mem.live_per_photon);
     world_free(&w);
 }
@@ -922,6 +977,7 @@ int main(void)
         cmocka_unit_test(test_locality_door_closed),
         cmocka_unit_test(test_locality_door_open),
         cmocka_unit_test(test_energy_closed_box),
+        cmocka_unit_test(test_hits_know_where_they_came_from),
         cmocka_unit_test(test_no_channel_grows),
         cmocka_unit_test(test_invalidate_emitter),
         cmocka_unit_test(test_move_and_back),

@@ -10,6 +10,7 @@
 #include "../charts/atlas_dilate.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
+#include "aim_sight.h"
 
 #define MIN_COVERAGE 0.0625 /* the disc's part on the surface is never taken below 1/16 of it */
 
@@ -268,6 +269,13 @@ void lm_aim_free(lm_aim *aim)
 
 void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d) { aim->direct = d; }
 
+void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover)
+{
+    aim->occluders = rt;
+    aim->occluder_lift = lift;
+    aim->occluder_cover = cover;
+}
+
 const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
 const float *lm_aim_dilated_rgba(const lm_aim *aim) { return aim->dilated; }
 
@@ -344,6 +352,8 @@ static double smallest_radius(const lm_aim *aim, const lm_atlas *a, uint64_t hit
 typedef struct {
     float *pos;  /* local positions, 3 per hit */
     double *flux; /* RGB and a 0, 4 per hit (widened once here rather than per lookup; 4 for paired ops) */
+    float *ends;  /* with occluders (lm_aim_set_occluders), 6 per hit: its world position and that of the
+                   * vertex its photon left (NaN: not known), for the visibility test (aim_sight.h); else NULL */
     uint32_t count;
 } hit_set;
 
@@ -408,6 +418,11 @@ static void append_hits(const lm_photon_store *ps, int surface, const lm_scene *
             continue;
         for (int c = 0; c < 4; c++)
             out->flux[4 * out->count + (uint32_t)c] = c < 3 ? hit->flux[c] : 0.0;
+        for (int c = 0; out->ends && c < 3; c++) {
+            out->ends[6 * out->count + (uint32_t)c] = hit->pos[c];
+            out->ends[6 * out->count + 3 + (uint32_t)c] =
+                hit->travelled > 0.0f ? hit->pos[c] - hit->travelled * hit->dir[c] : NAN;
+        }
         out->count++;
     }
 }
@@ -490,8 +505,9 @@ static lm_status gather_hits(const lm_aim *aim, const lm_photon_store *ps, const
     out->count = 0;
     out->pos = malloc(sizeof *out->pos * 3 * (hits ? hits : 1));
     out->flux = malloc(sizeof *out->flux * 4 * (hits ? hits : 1));
+    out->ends = aim->occluders ? malloc(sizeof *out->ends * 6 * (hits ? hits : 1)) : NULL;
     *edge_ends = malloc(sizeof **edge_ends * 6 * (edges ? edges : 1));
-    if (!out->pos || !out->flux || !*edge_ends || hits > UINT32_MAX)
+    if (!out->pos || !out->flux || (aim->occluders && !out->ends) || !*edge_ends || hits > UINT32_MAX)
         return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for %llu hits of surface %d", (unsigned long long)hits, k);
     const lm_surface *sf = &su->surfaces[k];
     append_hits(ps, k, s, L, front_only_for(aim, s, sf, L), aim->direct, NULL, NULL, out);
@@ -663,8 +679,9 @@ typedef struct {
     double rmin2_world;   /* squared smallest radius, world units */
     int boundary_correction, kernel;
     const lm_direct_light *direct; /* NULL: no direct light added */
-    const float *world;   /* the node's world matrix (texel positions for the direct light) */
+    const float *world;   /* the node's world matrix (texel positions for the direct light and the sight) */
     int two_sided;        /* double-sided material: direct light on both sides */
+    lm_aim_sight sight;   /* the visibility test (aim_sight.h; rt NULL: none) */
     const double *binned; /* a dense surface's sums (bin_dense_surface), per texel of its list: w Phi (4) and
                            * sum (w Y)^2; NULL: the kd-tree's estimates */
 } estimate_job;
@@ -753,13 +770,54 @@ static const tri_frame *triangle_frame(const estimate_job *j, uint32_t tri, tri_
     return tf;
 }
 
+/* A texel's hits within a radius with their weights, for the visibility test (grown as needed). */
+typedef struct {
+    uint32_t *idx;
+    float *d2, *weight;
+    uint32_t count, cap;
+} hit_list;
+
 struct texel_scratch {
     uint32_t *idx;  /* N found hits ... */
     float *d2;      /* ... and their squared distances */
     tri_frame tri;
     edge_frame ef;
     lm_kdtree_hint hint;
+    hit_list sighted;
 };
+
+static int hit_list_reserve(hit_list *l, uint32_t n)
+{
+    if (n <= l->cap)
+        return 1;
+    uint32_t cap = l->cap ? l->cap : 64;
+    while (cap < n)
+        cap *= 2;
+    uint32_t *idx = realloc(l->idx, sizeof *idx * cap);
+    if (idx)
+        l->idx = idx;
+    float *d2 = realloc(l->d2, sizeof *d2 * cap);
+    if (d2)
+        l->d2 = d2;
+    float *w = realloc(l->weight, sizeof *w * cap);
+    if (w)
+        l->weight = w;
+    if (!idx || !d2 || !w)
+        return 0;
+    l->cap = cap;
+    return 1;
+}
+
+/* The radius search's visitor for the visibility test: lists the hit (one that finds no memory is left
+ * out, as if not found). */
+static void list_hit(void *ctx, uint32_t index, float d2)
+{
+    hit_list *l = ctx;
+    if (!hit_list_reserve(l, l->count + 1))
+        return;
+    l->idx[l->count] = index;
+    l->d2[l->count++] = d2;
+}
 
 /* For the error estimate (lm_aim.error): sum((w_i Y_i)^2), Y_i = y . Phi_i. */
 typedef struct {
@@ -776,6 +834,31 @@ static void add_square(void *ctx, uint32_t index, float d2)
     q->sum += v * v;
 }
 
+/* The sums of photon_irradiance and the error estimate's (q: NULL when off) with each of the k hits idx (d2
+ * their squared distances) weighed by the visibility test too (aim_sight.h), in list order. */
+static void sighted_sums(const estimate_job *j, const lm_texel *t, uint32_t index, const tri_frame *tf,
+                         texel_scratch *ts, const uint32_t *idx, const float *d2, uint32_t k, float r2, flux_sum *f,
+                         square_sum *q)
+{
+    if (!hit_list_reserve(&ts->sighted, k))
+        return; /* no memory: no light rather than untested light */
+    float *weight = ts->sighted.weight;
+    lm_aim_sight_texel st = {{0.0f}, {tf->n_world[0], tf->n_world[1], tf->n_world[2]},
+                             (float)sqrt((double)r2 * tf->factor), index};
+    lm_v3_store(st.x, lm_mat4_point(j->world, lm_v3_load(t->local)));
+    lm_aim_sight_weigh(&j->sight, &st, j->hits->ends, idx, k, weight);
+    for (uint32_t i = 0; i < k; i++) {
+        double w = fmax(1.0 - d2[i] * f->inv_r2, 0.0) * weight[i];
+        const double *phi = f->flux + 4 * (size_t)idx[i];
+        for (int c = 0; c < 3; c++)
+            f->sum[c] += w * phi[c];
+        if (q) {
+            double v = w * (q->y[0] * phi[0] + q->y[1] * phi[1] + q->y[2] * phi[2]);
+            q->sum += v * v;
+        }
+    }
+}
+
 /* What the error estimate keeps of one texel's photon estimate: the variance of y . E, as a sum of
  * independently placed hits, and the radius^2 in world units. */
 typedef struct {
@@ -786,8 +869,8 @@ typedef struct {
 
 /* E = sum(w_i Phi_i) / A_w over the N nearest hits (or every hit within the smallest radius);
  * A_w = pi r^2 (box) or pi r^2 / 2 (Epanechnikov) away from the surface's boundary. 0 without hits. */
-static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t slot, texel_scratch *ts,
-                              float *edge_d2, double out[3], estimate_error *ee)
+static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t index, uint32_t slot,
+                              texel_scratch *ts, float *edge_d2, double out[3], estimate_error *ee)
 {
     out[0] = out[1] = out[2] = 0.0;
     if (j->n == 0)
@@ -807,7 +890,17 @@ static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t
     if (widened)
         r2 = (float)rmin2;
     flux_sum f = {j->hits->flux, j->kernel ? 1.0 / r2 : 0.0, {0.0, 0.0, 0.0, 0.0}};
-    if (j->binned)
+    square_sum q = {j->hits->flux, f.inv_r2, {ee->y[0], ee->y[1], ee->y[2]}, 0.0};
+    if (j->sight.rt) { /* binned is off then */
+        if (widened) {
+            ts->sighted.count = 0;
+            lm_kdtree_radius(j->tree, t->local, r2, list_hit, &ts->sighted);
+            k = ts->sighted.count;
+            idx = ts->sighted.idx;
+            d2 = ts->sighted.d2;
+        }
+        sighted_sums(j, t, index, tf, ts, idx, d2, k, r2, &f, ee->on ? &q : NULL);
+    } else if (j->binned)
         memcpy(f.sum, j->binned + 5 * (size_t)slot, sizeof f.sum);
     else if (widened)
         lm_kdtree_radius(j->tree, t->local, r2, add_flux, &f);
@@ -821,13 +914,12 @@ static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t
     }
     for (int c = 0; c < 3; c++)
         out[c] = f.sum[c] / (area * factor);
-    if (ee->on) { /* only when asked: a second walk over the same hits */
-        square_sum q = {j->hits->flux, f.inv_r2, {ee->y[0], ee->y[1], ee->y[2]}, 0.0};
+    if (ee->on) { /* only when asked: a second walk over the same hits (summed above with the weights) */
         if (j->binned)
             q.sum = j->binned[5 * (size_t)slot + 4];
-        else if (widened)
+        else if (!j->sight.rt && widened)
             lm_kdtree_radius(j->tree, t->local, r2, add_square, &q);
-        else
+        else if (!j->sight.rt)
             for (uint32_t i = 0; i < k; i++)
                 add_square(&q, idx[i], d2[i]);
         ee->var = q.sum / (area * factor * area * factor);
@@ -876,7 +968,7 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t in
                                          LUMINANCE[2] * rho[2] / LM_PI},
                          0.0, 0.0};
     double e[3];
-    photon_irradiance(j, t, slot, ts, edge_d2, e, &ee);
+    photon_irradiance(j, t, index, slot, ts, edge_d2, e, &ee);
     if (j->direct)
         add_direct(j, t, index, ts, e);
     for (int c = 0; c < 3; c++)
@@ -1049,8 +1141,9 @@ static double *bin_dense_surface(const lm_aim *aim, const lm_scene *s, const lm_
     uint32_t first = aim->texel_first[sj->surface], n = aim->texel_first[sj->surface + 1] - first;
     const uint32_t *list = aim->texel_list + first;
     uint32_t N = (uint32_t)aim->set.n_nearest;
-    if (!aim->set.dense || n == 0 || (uint64_t)sj->hits.count < (uint64_t)DENSE_HITS_PER_TEXEL_AND_N * N * n)
-        return NULL;
+    if (!aim->set.dense || aim->occluders || n == 0 ||
+        (uint64_t)sj->hits.count < (uint64_t)DENSE_HITS_PER_TEXEL_AND_N * N * n)
+        return NULL; /* with occluders every hit needs its own rays: the kd-tree */
     float *r2 = malloc(sizeof *r2 * n);
     double *y = malloc(sizeof *y * 3 * n), *out = calloc(5 * (size_t)n, sizeof *out);
     uint32_t *count = calloc(n, sizeof *count);
@@ -1127,7 +1220,8 @@ static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfa
     double rmin = smallest_radius(aim, a, sj->hits.count);
     sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {sj->edge_ends, sj->edge_count}, n, rmin * rmin,
                              aim->set.boundary_correction, aim->set.kernel, aim->direct,
-                             s->nodes[sf->node].world, m->double_sided, sj->binned};
+                             s->nodes[sf->node].world, m->double_sided,
+                             {aim->occluders, aim->occluder_lift, aim->occluder_cover, aim->set.kernel}, sj->binned};
 }
 
 static void free_surface(surface_job *sj)
@@ -1137,6 +1231,7 @@ static void free_surface(surface_job *sj)
     free(sj->edge_ends);
     free(sj->hits.pos);
     free(sj->hits.flux);
+    free(sj->hits.ends);
 }
 
 static int scratch_init(texel_scratch *ts, uint32_t n_max, uint32_t edges_max)
@@ -1153,6 +1248,9 @@ static void scratch_free(texel_scratch *ts)
     free(ts->idx);
     free(ts->d2);
     free(ts->ef.uv);
+    free(ts->sighted.idx);
+    free(ts->sighted.d2);
+    free(ts->sighted.weight);
 }
 
 /* Texels per work unit. A unit's texels run in order on one thread, and the search hints never cross

@@ -102,6 +102,8 @@ typedef struct {
     float mean_hit_energy;   /* as of the last refresh call */
     const lm_direct_light *direct; /* NULL (default): photons carry all light, the paper's form; else
                                       lm_aim_set_direct */
+    const lm_rt *occluders;  /* NULL (default): every hit near a texel counts; else lm_aim_set_occluders */
+    float occluder_lift, occluder_cover;
 } lm_aim;
 
 void lm_aim_settings_default(lm_aim_settings *o);
@@ -118,6 +120,16 @@ void lm_aim_free(lm_aim *aim);
  * other hits gets its direct light alone. NULL: back to photons for everything. d is borrowed. The
  * caller refreshes every surface after a change (lm_aim_refresh_all) if the maps must agree at once. */
 void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
+/* From the next refresh on, a hit counts towards a texel's estimate only if the texel sees the vertex its
+ * photon left (the emission point, or its previous hit: lm_hit.travelled back along its direction), weighed
+ * by 1 / the share of the estimate's disc that sees it (aim_sight.h): a photon that reached the floor
+ * beside a box from the far side of it would not have reached the floor at the box's foot, so the contact
+ * shadow is not blurred into light (docs/aim.md, "Occluders"). Shadow rays in rt from points lifted `lift`
+ * off the surface: about N + 8 a texel for each distinct vertex it sees, 5 to 12 times the estimate's cost.
+ * Dense surfaces then take the kd-tree too. A texel whose point has geometry closer than `cover` straight
+ * out on a side (the photons' cover distance: under a box on the floor) counts that side's hits untested:
+ * it is hidden, not dark. NULL: every hit counts (the paper's). rt is borrowed. */
+void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover);
 /* The direct light is averaged over this many squared parts of a texel (lm_texel_parts; covered parts
  * left out): near a lamp it falls off within a texel, and the centroid's value alone lost energy the
  * hemicube should see (4.8% of the suzanne Cornell box's ceiling, docs/aim.md). */

@@ -21,6 +21,9 @@ typedef struct {
     float local[3];        /* position in the hit node's local space (AIM lookups match texel.local) */
     float dir[3];          /* unit direction the photon travelled, towards the surface */
     float flux[3];         /* RGB flux */
+    float travelled;       /* distance from the vertex it left (the emission point or the previous hit) to
+                            * this one: that vertex lies at pos - travelled dir (0: unknown). The AIM's
+                            * visibility test joins it to a texel (docs/aim.md, "Occluders") */
     uint32_t photon;       /* owning photon */
     uint32_t tri;
     int32_t surface;

@@ -94,7 +94,7 @@ static int covered(const lm_photons *ph, const lm_shading *sh, const float dir[3
 }
 
 static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *sh, const float dir[3],
-                       const float flux[3], uint32_t b, int caustic)
+                       const float flux[3], float travelled, uint32_t b, int caustic)
 {
     if (!buffer_reserve(buf))
         return 0;
@@ -109,6 +109,7 @@ static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *s
     memcpy(v->local, sh->local, sizeof v->local);
     memcpy(v->dir, dir, sizeof v->dir);
     memcpy(v->flux, flux, sizeof v->flux);
+    v->travelled = travelled;
     return 1;
 }
 
@@ -181,7 +182,7 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
          * then the shading's stores have left the store buffer, and copying them does not stall. */
         float in_dir[3] = {dir[0], dir[1], dir[2]}, in_flux[3] = {flux[0], flux[1], flux[2]};
         int scattered = scatter(ph, id, b, &sh, org, dir, flux);
-        if (!push_vertex(ph, buf, &sh, in_dir, in_flux, b, b > 0 && specular_so_far)) {
+        if (!push_vertex(ph, buf, &sh, in_dir, in_flux, hit.t, b, b > 0 && specular_so_far)) {
             ok = 0;
             break;
         }

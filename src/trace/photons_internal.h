@@ -33,6 +33,7 @@ typedef struct {
     uint16_t bounce;
     uint8_t caustic;           /* every vertex before it was mirror or glass (L S+ D: lm_hit.caustic) */
     float pos[3], local[3], dir[3], flux[3];
+    float travelled;           /* lm_hit.travelled */
 } ph_vertex;
 
 /* Per-thread growable vertex buffer. */

@@ -352,6 +352,11 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     ps->have_aim = st == LM_OK;
     if (st == LM_OK && ps->set.exact_direct)
         st = setup_direct(ps, photon_settings(ps).cover_distance, err);
+    if (st == LM_OK && ps->set.occluders) { /* lifted off surfaces as far as the gather's texels are */
+        float size = lm_scene_size(ps->scene);
+        lm_aim_set_occluders(&ps->aim, ps->rt, 1e-4f * (size > 0.0f && isfinite(size) ? size : 1.0f),
+                             photon_settings(ps).cover_distance);
+    }
     if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                 lm_photons_store_mutable(ps->photons), &first->aim, err);

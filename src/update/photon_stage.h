@@ -22,6 +22,8 @@ typedef struct {
     int exact_direct;        /* AIM texels compute direct light (trace/direct_irradiance.h), photons bring the
                               * rest: 1 from emissive triangles, 2 from punctual lights too; 0 (default):
                               * photons bring all of it (the paper's form) */
+    int occluders;           /* 1: an AIM texel counts only the hits whose photon came from where it sees
+                              * (lm_aim_set_occluders); 0 (default): every hit near it, the paper's */
     int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
                               * them: no work at all). Default 0; the frame loop follows the scene's effects */
     lm_caustic_settings caustic;
