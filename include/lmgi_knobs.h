@@ -135,7 +135,7 @@ static inline int lmgi_knob_is_pow2(double v)
       LMGI_SWEEP(16, "aim_occluders", "AIM hits seen from the texel (0 off, 1 on)", (0, 1), (), 0),           \
       "a photon hit counts towards an AIM texel only if the texel sees where\n"                                  \
       "the photon came from, weighed up where the estimate's disc sees it less\n"                                \
-      "(shadow rays: sharper contact shadows, AIM refreshes 5-12x slower;\n"                                      \
+      "(shadow rays: sharper contact shadows, AIM refreshes 4-9x slower;\n"                                       \
       "default off; docs/aim.md, \"Occluders\")")                                                                 \
     X(aim, error_estimate, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, NULL, NULL, LMGI_CLI_ZERO_NONE, \
       LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                                              \

@@ -125,7 +125,7 @@ void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
  * by 1 / the share of the estimate's disc that sees it (aim_sight.h): a photon that reached the floor
  * beside a box from the far side of it would not have reached the floor at the box's foot, so the contact
  * shadow is not blurred into light (docs/aim.md, "Occluders"). Shadow rays in rt from points lifted `lift`
- * off the surface: about N + 8 a texel for each distinct vertex it sees, 5 to 12 times the estimate's cost.
+ * off the surface: N a texel and 8 more for each distinct vertex it sees, 4 to 9 times the estimate's cost.
  * Dense surfaces then take the kd-tree too. A texel whose point has geometry closer than `cover` straight
  * out on a side (the photons' cover distance: under a box on the floor) counts that side's hits untested:
  * it is hidden, not dark. NULL: every hit counts (the paper's). rt is borrowed. */

@@ -77,6 +77,41 @@ static void place_points(const lm_aim_sight *s, const lm_aim_sight_texel *t, dis
     }
 }
 
+/* How many of the points (lifted off the surface to q's side) see q: one packet of rays from q, moved off
+ * q's own surface towards the texel, to the points. */
+static int points_seeing(const lm_aim_sight *s, const disc_points *d, const lm_aim_sight_texel *t, const float q[3],
+                         float side)
+{
+    float u[3], lu = 0.0f;
+    for (int c = 0; c < 3; c++) {
+        u[c] = t->x[c] + side * t->n[c] - q[c];
+        lu += u[c] * u[c];
+    }
+    lu = sqrtf(lu);
+    if (!(lu > 4.0f * s->lift))
+        return d->count; /* q at the texel itself */
+    float org[3], dir[3 * LM_AIM_SIGHT_POINTS], tfar[LM_AIM_SIGHT_POINTS];
+    int blocked[LM_AIM_SIGHT_POINTS], seen = 0;
+    for (int c = 0; c < 3; c++)
+        org[c] = q[c] + 2.0f * s->lift * u[c] / lu;
+    for (int m = 0; m < d->count; m++) {
+        float len = 0.0f, *v = dir + 3 * m;
+        for (int c = 0; c < 3; c++) {
+            v[c] = d->p[m][c] + side * t->n[c] - org[c];
+            len += v[c] * v[c];
+        }
+        len = sqrtf(len);
+        for (int c = 0; c < 3; c++)
+            v[c] = len > 0.0f ? v[c] / len : t->n[c];
+        tfar[m] = len;
+    }
+    if (d->count)
+        lm_rt_occluded8(s->rt, org, dir, tfar, d->count, blocked);
+    for (int m = 0; m < d->count; m++)
+        seen += !blocked[m];
+    return seen;
+}
+
 void lm_aim_sight_weigh(const lm_aim_sight *s, const lm_aim_sight_texel *t, const float *ends, const uint32_t *idx,
                         uint32_t k, float *weight)
 {
@@ -107,9 +142,7 @@ void lm_aim_sight_weigh(const lm_aim_sight *s, const lm_aim_sight_texel *t, cons
             place_points(s, t, &d);
             placed = 1;
         }
-        int seen = 0;
-        for (int m = 0; m < d.count; m++)
-            seen += segment_clear(s, d.p[m], t->n, q, side);
+        int seen = points_seeing(s, &d, t, q, side);
         /* The hit's own point saw q: at least one point's worth. */
         weight[i] = last_w = d.count ? (float)d.count / (float)(seen > 0 ? seen : 1) : 1.0f;
     }

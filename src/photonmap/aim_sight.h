@@ -16,7 +16,8 @@
  * and where nothing occludes the estimate is the paper's).
  *
  * Cost: per texel 2 LM_AIM_SIGHT_POINTS rays to place the points; per hit summed one segment from x, and
- * where x sees q one more per point (remembered while q repeats: a point light's first hits share it).
+ * where x sees q one more per point, traced as one packet from q (remembered while q repeats: a point
+ * light's first hits share it).
  * Points are lifted `lift` off the surface towards q's side; a segment stops 2 lift short of q (its own
  * surface). A texel with geometry closer than `cover` straight out on q's side (under a box standing on
  * the floor) is hidden, not dark: its hits on that side weigh 1. Thread-safe (reads rt only).
