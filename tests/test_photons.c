@@ -460,23 +460,30 @@ static void test_locality_door_open(void **state)
 
 /* ---- energy: a point light in a closed box ---- */
 
-static void test_energy_closed_box(void **state)
+/* The inward unit cube with a point lamp of intensity 10 and colour `color` (a JSON array) at
+ * (0.2, 0.3, -0.1), written to `file` in the temporary folder and loaded into w. */
+static void load_lamp_box(world *w, const char *file, const char *color)
 {
-    (void)state;
     static lmt_mesh box;
     memset(&box, 0, sizeof box);
     lmt_mesh_cube_inward(&box, 1.0f);
     const char *nodes = "[{\"name\": \"root\", \"children\": [1, 2]}, {\"name\": \"box\", \"mesh\": 0},"
                         " {\"name\": \"lamp\", \"translation\": [0.2, 0.3, -0.1],"
                         "  \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
-    const char *lights = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
-                         " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\","
-                         " \"intensity\": 10, \"color\": [1, 0.5, 0.25]}]}},";
-    char path[512];
-    snprintf(path, sizeof path, "%s/box.gltf", lmt_tmpdir());
+    char lights[512], path[512];
+    snprintf(lights, sizeof lights, "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
+             " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\","
+             " \"intensity\": 10, \"color\": %s}]}},", color);
+    snprintf(path, sizeof path, "%s/%s", lmt_tmpdir(), file);
     assert_int_equal(lmt_write_gltf(path, &box, 1, nodes, NULL, 0, lights), 0);
+    world_load(w, path);
+}
+
+static void test_energy_closed_box(void **state)
+{
+    (void)state;
     world w;
-    world_load(&w, path);
+    load_lamp_box(&w, "box.gltf", "[1, 0.5, 0.25]");
     assert_int_equal(w.em.count, 1);
     lm_photon_settings set;
     lm_photon_settings_default(&set);
@@ -512,20 +519,8 @@ static void test_energy_closed_box(void **state)
 static void test_hits_know_where_they_came_from(void **state)
 {
     (void)state;
-    static lmt_mesh box;
-    memset(&box, 0, sizeof box);
-    lmt_mesh_cube_inward(&box, 1.0f);
-    const char *nodes = "[{\"name\": \"root\", \"children\": [1, 2]}, {\"name\": \"box\", \"mesh\": 0},"
-                        " {\"name\": \"lamp\", \"translation\": [0.2, 0.3, -0.1],"
-                        "  \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]";
-    const char *lights = "\"extensionsUsed\": [\"KHR_lights_punctual\"],"
-                         " \"extensions\": {\"KHR_lights_punctual\": {\"lights\": [{\"type\": \"point\","
-                         " \"intensity\": 10}]}},";
-    char path[512];
-    snprintf(path, sizeof path, "%s/box_from.gltf", lmt_tmpdir());
-    assert_int_equal(lmt_write_gltf(path, &box, 1, nodes, NULL, 0, lights), 0);
     world w;
-    world_load(&w, path);
+    load_lamp_box(&w, "box_from.gltf", "[1, 1, 1]");
     lm_photon_settings set;
     lm_photon_settings_default(&set);
     set.total_photons = 5000;
