@@ -263,11 +263,15 @@ bench: deps all $(BUILD)/gen_scenes
 	$(BUILD)/lmgi bake $(BUILD)/bench/rooms_12.glb --out $(BUILD)/bench/bake_rooms_12 --force 2>/dev/null
 	$(BUILD)/lmgi bench --json $(BUILD)/bench/bench.json $(foreach n,$(BENCH_ROOMS),--scaling $(BUILD)/bench/rooms_$(n).glb)
 	$(BUILD)/lmgi bench --edits bench/two_rooms_edits.json scenes/two_rooms.glb --json $(BUILD)/bench/edits.json
+	$(if $(wildcard ../shared/scenes/occlusion-room/room_lit.glb),$(BUILD)/lmgi bench --edits bench/room_lit_edits.json \
+	  ../shared/scenes/occlusion-room/room_lit.glb --json $(BUILD)/bench/edits_room_lit.json)
 	$(BUILD)/lmgi bench --soak 100000 scenes/cornell.glb --size 32x32
 
 # The full sweep of docs/tradeoff.md: make tradeoff TRADEOFF_SCENES="scenes/cornell.glb
 # ../shared/scenes/cornell-box/CornellBox.glb scenes/two_rooms.glb"
-# TRADEOFF_FLAGS="--edits bench/cornell_edits.json,bench/two_rooms_lag.json"
+# TRADEOFF_FLAGS="--edits bench/cornell_edits.json,bench/two_rooms_lag.json"; the shared level's lag:
+# make tradeoff TRADEOFF_SCENES=../shared/scenes/occlusion-room/room_lit.glb
+# TRADEOFF_FLAGS="--knobs hemicube_samples --quick --edits bench/room_lit_edits.json --frame-lag"
 TRADEOFF_SCENES ?= scenes/cornell.glb
 TRADEOFF_FLAGS  ?= --quick --edits bench/cornell_edits.json
 tradeoff: deps all
