@@ -26,12 +26,10 @@ static int segment_clear(const lm_aim_sight *s, const float p[3], const float n[
 /* Geometry closer than the cover distance straight out from p, on the side `side` points to. */
 static int is_covered(const lm_aim_sight *s, const float p[3], const float n[3], float side)
 {
-    float org[3], out[3];
-    for (int c = 0; c < 3; c++) {
-        org[c] = p[c] + side * n[c];
+    float out[3];
+    for (int c = 0; c < 3; c++)
         out[c] = side < 0.0f ? -n[c] : n[c];
-    }
-    return s->cover > 0.0f && lm_rt_occluded(s->rt, org, out, 0.0f, s->cover);
+    return lm_rt_covered(s->rt, p, out, s->lift, s->cover);
 }
 
 typedef struct {

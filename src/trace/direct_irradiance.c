@@ -8,12 +8,10 @@
 /* 1 when other geometry lies within d->cover straight out from p on the side of normal n. */
 static int covered(const lm_direct_light *d, lm_vec3 p, lm_vec3 n)
 {
-    if (!(d->cover > 0.0f))
-        return 0;
-    float org[3], dir[3];
-    lm_v3_store(org, lm_add(p, lm_scale(n, d->lift)));
+    float at[3], dir[3];
+    lm_v3_store(at, p);
     lm_v3_store(dir, n);
-    return lm_rt_occluded(d->rt, org, dir, 0.0f, d->cover);
+    return lm_rt_covered(d->rt, at, dir, d->lift, d->cover);
 }
 
 /* Every punctual light's E = weight cos, where a shadow ray from p (lifted to the side the light is on)

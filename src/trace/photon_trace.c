@@ -87,10 +87,9 @@ static int covered(const lm_photons *ph, const lm_shading *sh, const float dir[3
     lm_vec3 n = lm_v3_load(sh->ng);
     if (lm_dot(n, lm_v3_load(dir)) > 0.0f)
         n = lm_scale(n, -1.0f);
-    float org[3], out[3];
-    lm_v3_store(org, lm_add(lm_v3_load(sh->pos), lm_scale(n, ph->ray_offset)));
+    float out[3];
     lm_v3_store(out, n);
-    return lm_rt_occluded(ph->rt, org, out, 0.0f, ph->set.cover_distance);
+    return lm_rt_covered(ph->rt, sh->pos, out, ph->ray_offset, ph->set.cover_distance);
 }
 
 static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *sh, const float dir[3],

@@ -412,6 +412,16 @@ int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], floa
     return rh.ray.tfar < 0.0f; /* Embree sets tfar to -inf on occlusion */
 }
 
+int lm_rt_covered(const lm_rt *rt, const float p[3], const float n[3], float lift, float cover)
+{
+    if (!(cover > 0.0f))
+        return 0;
+    float org[3];
+    for (int c = 0; c < 3; c++)
+        org[c] = p[c] + n[c] * lift;
+    return lm_rt_occluded(rt, org, n, 0.0f, cover);
+}
+
 void lm_rt_occluded8(const lm_rt *rt, const float org[3], const float *dir, const float *tfar, int n, int *blocked)
 {
     struct RTCIntersectContext ctx;

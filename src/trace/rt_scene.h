@@ -53,6 +53,10 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
                     lm_rt_hit *hit);
 /* 1 if anything blocks the segment (tnear, tfar). */
 int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar);
+/* 1 if other geometry lies within `cover` straight out from p along unit n (the ray leaving p + lift n):
+ * that side of p is hidden under something, a box on the floor or a lamp just under a ceiling, rather than
+ * dark (photons' cover distance, computed direct light, the AIM's visibility test). 0 when cover <= 0. */
+int lm_rt_covered(const lm_rt *rt, const float p[3], const float n[3], float lift, float cover);
 /* Up to 8 segments from one origin as one Embree packet: blocked[i] = 1 if anything lies on
  * org + t dir_i (dir: 3 floats each), t in (0, tfar[i]). n in 1..8. */
 void lm_rt_occluded8(const lm_rt *rt, const float org[3], const float *dir, const float *tfar, int n, int *blocked);
