@@ -4,6 +4,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "../core/vecmath.h"
+
 #define GOLDEN_ANGLE 2.39996323f
 
 /* Whether the point p, lifted off the surface of normal n by side (signed lift), sees q. */
@@ -44,14 +46,11 @@ typedef struct {
 static void place_points(const lm_aim_sight *s, const lm_aim_sight_texel *t, disc_points *d)
 {
     const float *n = t->n;
-    float a[3] = {1.0f, 0.0f, 0.0f}, t1[3], t2[3];
-    if (fabsf(n[0]) > 0.9f)
-        a[0] = 0.0f, a[1] = 1.0f;
-    t1[0] = a[1] * n[2] - a[2] * n[1], t1[1] = a[2] * n[0] - a[0] * n[2], t1[2] = a[0] * n[1] - a[1] * n[0];
-    float l = sqrtf(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]);
-    for (int c = 0; c < 3; c++)
-        t1[c] /= l;
-    t2[0] = n[1] * t1[2] - n[2] * t1[1], t2[1] = n[2] * t1[0] - n[0] * t1[2], t2[2] = n[0] * t1[1] - n[1] * t1[0];
+    lm_vec3 tv, bv;
+    lm_tangents(lm_v3_load(n), &tv, &bv);
+    float t1[3], t2[3];
+    lm_v3_store(t1, tv);
+    lm_v3_store(t2, bv);
     float turn = (float)(t->index % 1024u) * GOLDEN_ANGLE;
     d->count = 0;
     for (int m = 0; m < LM_AIM_SIGHT_POINTS; m++) {

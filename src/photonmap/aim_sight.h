@@ -34,7 +34,7 @@
 typedef struct {
     const lm_rt *rt; /* NULL: no test, every weight 1 */
     float lift, cover;
-    int kernel;      /* the estimate's kernel: 1 Epanechnikov (the points weigh 1 - d^2 / r^2), 0 box */
+    int kernel;      /* the estimate's kernel, which spreads the points: 1 Epanechnikov, 0 box */
 } lm_aim_sight;
 
 /* The texel: world point x, unit front normal n, the estimate's radius r (world units), its atlas index

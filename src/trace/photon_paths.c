@@ -50,7 +50,8 @@ static int hit_differs(const lm_hit *h, const ph_vertex *v)
 {
     return memcmp(h->pos, v->pos, sizeof h->pos) || memcmp(h->local, v->local, sizeof h->local) ||
            memcmp(h->dir, v->dir, sizeof h->dir) || memcmp(h->flux, v->flux, sizeof h->flux) ||
-           memcmp(&h->travelled, &v->travelled, sizeof h->travelled) || h->tri != v->tri || h->bounce != v->bounce || h->caustic != v->caustic;
+           memcmp(&h->travelled, &v->travelled, sizeof h->travelled) || h->tri != v->tri || h->bounce != v->bounce ||
+           h->caustic != v->caustic;
 }
 
 int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n)
