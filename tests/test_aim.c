@@ -523,7 +523,6 @@ static void test_occluders_keep_shadow_edges(void **state)
         const float *v[2] = {v0 + 3 * i, v1 + 3 * i};
         if (fabsf(z) > 1.8f)
             continue; /* the plane's own edges */
-
         if (x > 0.0f && x < 0.99f) { /* in the shadow (`lit`: what the light would give there) */
             for (int k = 0; k < 2; k++)
                 shadow_max[k] = fmax(shadow_max[k], v[k][0] / lit);
@@ -538,7 +537,7 @@ static void test_occluders_keep_shadow_edges(void **state)
         }
     }
     print_message("beside a wall: in its shadow (%d texels) at most %.3f (paper's) / %.3f (tested) of the light "
-                  "beside it; lit within a radius of an edge (%d texels) mean error %.1f%% / %.1f%%; elsewhere (%d) "
+                  "beside it; lit on the shadow's edge (%d texels) mean error %.1f%% / %.1f%%; elsewhere (%d) "
                   "at most %.2e apart\n", shadowed, shadow_max[0], shadow_max[1], edges, 100.0 * edge_err[0] / edges,
                   100.0 * edge_err[1] / edges, far, far_diff);
     assert_true(shadowed > 500 && edges > 50 && far > 2000);
