@@ -27,16 +27,21 @@ static lmgi_scene *load_room(void)
 }
 
 /* Invalid photon groups re-traced by the updates until none has been for 3 of them (an edit's re-trace is
- * spread over updates, and an update's photon work is reported by the next one when it runs on past it). */
-static uint32_t retraced_until_still(lmgi_updater *u)
+ * spread over updates, and an update's photon work is reported by the next one when it runs on past it);
+ * the lights those updates scaled (changed in power alone) into *scaled (may be NULL). */
+static uint32_t retraced_until_still(lmgi_updater *u, int *scaled)
 {
     uint32_t sum = 0;
+    if (scaled)
+        *scaled = 0;
     for (int k = 0, quiet = 0; quiet < 3; k++) {
         assert_true(k < 400);
         lmgi_update_stats st;
         lmgi_error e;
         assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
         sum += st.groups_retraced;
+        if (scaled)
+            *scaled += st.lights_scaled;
         quiet = st.groups_retraced ? 0 : quiet + 1;
     }
     return sum;
@@ -48,7 +53,7 @@ static void test_light_edits_wait_for_nothing(void **state)
     lmgi_scene *sc = load_room();
     lmgi_context *ctx = lmt_context();
     lmgi_updater *u = lmt_room_updater(ctx, sc);
-    assert_int_equal(retraced_until_still(u), 0); /* nothing moves, nothing edited */
+    assert_int_equal(retraced_until_still(u, NULL), 0); /* nothing moves, nothing edited */
     assert_true(lm_frame_loop_busy(sc->loop));   /* the last update's photon work runs on past it */
     lmgi_error e;
     lmgi_light l;
@@ -60,14 +65,23 @@ static void test_light_edits_wait_for_nothing(void **state)
     lmgi_light back;
     assert_int_equal(lmgi_get_light(sc, 0, &back, &e), LMGI_OK); /* reads see the edit at once */
     assert_float_equal(back.intensity, 8.0f, 0.0);
-    uint32_t groups = retraced_until_still(u);
+    int scaled = 0;
+    uint32_t groups = retraced_until_still(u, &scaled);
     assert_float_equal(sc->scene->lights[0].intensity, 8.0f, 0.0); /* committed by the update */
-    assert_true(groups > 0);
+    assert_int_equal(groups, 0); /* in power alone: its photons' hits scaled, none re-traced */
+    assert_int_equal(scaled, 1);
     assert_int_equal(lmgi_set_light(sc, 0, &back, &e), LMGI_OK); /* the same values: nothing changes */
-    assert_int_equal(retraced_until_still(u), 0);
-    back.enabled = 0; /* switched off: that light's groups, as many as the dimming took */
+    assert_int_equal(retraced_until_still(u, &scaled), 0);
+    assert_int_equal(scaled, 0);
+    back.enabled = 0; /* switched off: its light gone at once with its hits (a dark light emits no photon:
+                       * nothing left to re-trace) */
     assert_int_equal(lmgi_set_light(sc, 0, &back, &e), LMGI_OK);
-    assert_int_equal(retraced_until_still(u), groups);
+    assert_int_equal(retraced_until_still(u, &scaled), 0);
+    assert_int_equal(scaled, 1);
+    back.enabled = 1; /* on again: nothing to scale, every group of it traced again */
+    assert_int_equal(lmgi_set_light(sc, 0, &back, &e), LMGI_OK);
+    assert_true(retraced_until_still(u, &scaled) > 0);
+    assert_int_equal(scaled, 0);
 
     /* added and removed: ids and counts at once, the scene model at the commit */
     lmgi_light lamp = {.type = LMGI_LIGHT_POINT, .color = {1, 1, 1}, .intensity = 2.0f, .enabled = 1,

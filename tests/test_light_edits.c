@@ -2,7 +2,16 @@
  * lights the room as the same light loaded from the level does, only its own photons are traced,
  * removing it gives back the lightmap from before, removing every light leaves the room dark, the same
  * edits give the same lightmaps, an added light in one room of the two-room scene leaves the other
- * untouched, and bad lights are refused naming what is wrong. */
+ * untouched, and bad lights are refused naming what is wrong.
+ *
+ * Lights changed in power alone (issue 32, item 2; docs/tradeoff.md, "Light edits at once"): a light
+ * dimmed, brightened, recoloured or switched off shows in the lightmaps at the next update. Its photons
+ * keep their paths, so their hits are scaled (or dropped) instead of traced again, the AIMs they reach are
+ * refreshed at once, and each IIM texel is scaled by the ratio of two small ray gathers over the AIM before
+ * and after (update/light_scale.h). Lit by one light, that is the lightmap a fresh updater makes of the
+ * edited room; lit by two, a first guess that the regathers refine. Before, the lightmaps kept the old
+ * light until the light's photons were traced again and every surface regathered: 60 to 120 updates at
+ * `run`'s texels. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -346,11 +355,21 @@ static void test_still_room_traces_nothing(void **state)
     l.intensity *= 0.5f;
     assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
     uint32_t retraced = 0;
+    int scaled = 0;
+    for (int f = 0; f < 5; f++) {
+        assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+        retraced += st.photons_retraced;
+        scaled += st.lights_scaled;
+    }
+    assert_int_equal(retraced, 0); /* dimmed: its hits scaled, not one photon traced (test_light_edits) */
+    assert_int_equal(scaled, 1);
+    l.range = 3.0f; /* its reach cut short: its paths' light changes */
+    assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
     for (int f = 0; f < 5; f++) {
         assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
         retraced += st.photons_retraced;
     }
-    assert_true(retraced > 0); /* the dimmed light's groups */
+    assert_true(retraced > 0); /* the reshaped light's groups */
     for (int f = 0; f < 60; f++) /* its groups all re-traced: quiet again */
         assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
     assert_int_equal(st.photons_retraced, 0);
@@ -440,6 +459,105 @@ static void test_added_light_stays_in_its_room(void **state)
     lmgi_context_free(ctx);
 }
 
+/* One update, which must scale `scaled` lights and trace no photon group again. */
+static void update_scaling(lmgi_updater *u, int scaled, int retraced)
+{
+    lmgi_update_stats st;
+    lmgi_error e;
+    assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+    assert_int_equal(st.lights_scaled, scaled);
+    if (!retraced)
+        assert_int_equal(st.groups_retraced, 0);
+}
+
+static void edit_light(lmgi_scene *sc, int id, float intensity_by, const float *color, int enabled)
+{
+    lmgi_light l;
+    lmgi_error e;
+    assert_int_equal(lmgi_get_light(sc, id, &l, &e), LMGI_OK);
+    l.intensity *= intensity_by;
+    if (color)
+        memcpy(l.color, color, sizeof l.color);
+    l.enabled = enabled;
+    assert_int_equal(lmgi_set_light(sc, id, &l, &e), LMGI_OK);
+}
+
+/* Lit by one lamp, dimmed and recoloured: the next update's lightmap and frame are a fresh updater's of
+ * the edited room (same photon paths, so to float rounding), and the updates after change nothing. */
+static void test_one_light_at_once(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    lmgi_scene *sc = load_room(&LAMP, 1);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    lmt_updates(u, 3);
+    size_t n;
+    float *before = lmt_iim(u, sc, &n);
+    const float tint[3] = {0.4f, 0.9f, 1.0f};
+    edit_light(sc, 0, 0.3f, tint, 1);
+    update_scaling(u, 1, 0);
+    float *now = lmt_iim(u, sc, &n), *frame = lmt_corner_frame(u);
+    lmt_updates(u, 60);
+    float *later = lmt_iim(u, sc, &n);
+    lmgi_updater_free(u);
+    lmgi_updater *fresh = lmt_room_updater(ctx, sc);
+    lmt_updates(fresh, 3);
+    float *want = lmt_iim(fresh, sc, &n), *want_frame = lmt_corner_frame(fresh);
+    double was = lmt_relative_l1(before, want, n), at_once = lmt_relative_l1(now, want, n);
+    double shown = lmt_relative_l1(frame, want_frame, 3 * LMT_SIDE * LMT_SIDE), after = lmt_relative_l1(later, want, n);
+    print_message("one lamp dimmed and recoloured: lightmap against a fresh updater's %.3g before the edit, %.3g "
+                  "at the next update (frame %.3g), %.3g 60 updates later\n", was, at_once, shown, after);
+    assert_true(was > 0.5);
+    assert_true(at_once < 1e-4);
+    assert_true(shown < 1e-4);
+    assert_true(after < 1e-4);
+    free(before), free(now), free(frame), free(later), free(want), free(want_frame);
+    lmgi_updater_free(fresh);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* Lit by a warm lamp and a blue spot, one of them dimmed (or switched off): at the next update the
+ * lightmap has made most of the way to what the same photons give once every surface is regathered (a bake
+ * with the shares of creation kept). */
+static void two_lights(int id, float by, int enabled, double most)
+{
+    lmgi_context *ctx = lmt_context();
+    const lmgi_light_desc both[2] = {LAMP, SPOT};
+    lmgi_scene *sc = load_room(both, 2);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    lmt_updates(u, 3);
+    size_t n;
+    float *before = lmt_iim(u, sc, &n);
+    edit_light(sc, id, by, NULL, enabled);
+    update_scaling(u, 1, !enabled);
+    float *now = lmt_iim(u, sc, &n);
+    lmt_bake(u, NULL);
+    float *want = lmt_iim(u, sc, &n);
+    double was = lmt_relative_l1(before, want, n), at_once = lmt_relative_l1(now, want, n);
+    print_message("%s %s: lightmap against the regathered one %.3g before the edit, %.3g at the next update\n",
+                  id ? "spot" : "lamp", enabled ? "dimmed" : "switched off", was, at_once);
+    assert_true(was > 0.1);
+    assert_true(at_once < most * was);
+    free(before), free(now), free(want);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+static void test_two_lights_first_guess(void **state)
+{
+    (void)state;
+    two_lights(0, 0.25f, 1, 0.02); /* 0.0073 of the change is left */
+    two_lights(1, 3.0f, 1, 0.12);  /* 0.068: the spot's light is a tenth of the room's */
+}
+
+static void test_switched_off(void **state)
+{
+    (void)state;
+    two_lights(0, 1.0f, 0, 0.02); /* 0.0072 */
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -448,6 +566,9 @@ int main(void)
         cmocka_unit_test(test_no_light_no_gather),
         cmocka_unit_test(test_still_room_traces_nothing),
         cmocka_unit_test(test_added_light_stays_in_its_room),
+        cmocka_unit_test(test_one_light_at_once),
+        cmocka_unit_test(test_two_lights_first_guess),
+        cmocka_unit_test(test_switched_off),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -479,6 +479,55 @@ static void load_lamp_box(world *w, const char *file, const char *color)
     world_load(w, path);
 }
 
+/* Issue 32, item 2: a light changed in power alone keeps its photons' paths, which follow albedos and
+ * never power (photon_trace.c), so scaling the flux of its stored hits (lm_photons_scale_emitter) stores
+ * what tracing them again with the new colour does, up to rounding, and each surface's energy and deltas
+ * follow the change. */
+static void test_power_edit_scales_hits(void **state)
+{
+    (void)state;
+    world w;
+    load_lamp_box(&w, "power.gltf", "[1, 0.5, 0.25]");
+    world_trace(&w, 20000, NULL);
+    const lm_photon_store *store = lm_photons_store(w.ph);
+    int S = store->surface_count;
+    double *scaled = calloc(3 * (size_t)S, sizeof *scaled), *traced = calloc(3 * (size_t)S, sizeof *traced);
+    double *delta = calloc((size_t)S, sizeof *delta);
+    assert_non_null(scaled);
+    assert_non_null(traced);
+    assert_non_null(delta);
+    for (int k = 0; k < S; k++)
+        delta[k] = store->surfaces[k].delta_f;
+    const float by[3] = {0.3f, 1.7f, 0.45f};
+    lm_error err;
+    assert_int_equal(lm_photons_scale_emitter(w.ph, 0, by, &err), LM_OK);
+    lm_photon_store_surface_flux(store, scaled);
+    for (int k = 0; k < S; k++) { /* the energy kept as hits come and go is the hits' own, and it moved */
+        double e = 0.0;
+        for (uint32_t i = 0; i < store->surfaces[k].count; i++)
+            e += lm_hit_energy(&store->hits[store->surfaces[k].slots[i]]);
+        assert_float_equal(store->surfaces[k].energy, e, 1e-9 * e);
+        assert_true(store->surfaces[k].delta_f > delta[k]);
+    }
+    /* the same light with that colour, every path traced again and stored where any bit differs */
+    for (int c = 0; c < 3; c++)
+        w.s->lights[0].color[c] *= by[c];
+    lm_emitters_update(&w.em, w.s);
+    lm_photon_frame_stats st;
+    assert_int_equal(lm_photons_trace_all_exact(w.ph, &st, &err), LM_OK);
+    lm_photon_store_surface_flux(store, traced);
+    double worst = 0.0;
+    for (int i = 0; i < 3 * S; i++)
+        worst = fmax(worst, fabs(scaled[i] - traced[i]) / fmax(traced[i], 1e-12));
+    print_message("power edit: hits scaled against traced again, per surface and channel worst %.2g (%u of %u "
+                  "paths differ in some bit)\n", worst, st.photons_updated, lm_photons_count(w.ph));
+    assert_true(worst < 1e-5);
+    free(scaled);
+    free(traced);
+    free(delta);
+    world_free(&w);
+}
+
 static void test_energy_closed_box(void **state)
 {
     (void)state;
@@ -973,6 +1022,7 @@ int main(void)
         cmocka_unit_test(test_locality_door_open),
         cmocka_unit_test(test_energy_closed_box),
         cmocka_unit_test(test_hits_know_where_they_came_from),
+        cmocka_unit_test(test_power_edit_scales_hits),
         cmocka_unit_test(test_no_channel_grows),
         cmocka_unit_test(test_invalidate_emitter),
         cmocka_unit_test(test_move_and_back),

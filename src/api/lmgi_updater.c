@@ -404,6 +404,7 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->photons_retraced = st->photons.rr_photons + st->photons.group_photons;
     o->groups_invalidated = st->photons.groups_invalidated;
     o->groups_retraced = st->photons.groups_retraced;
+    o->lights_scaled = st->emitters_scaled;
     o->aim_surfaces_refreshed = st->aim.surfaces_refreshed;
     o->texels_gathered = fs->texels_gathered;
     o->texels_budget = fs->plan.texels;

@@ -279,6 +279,7 @@ void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover)
 const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
 const float *lm_aim_dilated_rgba(const lm_aim *aim) { return aim->dilated; }
 
+
 /* ---------- the node's transform ---------- */
 
 typedef struct {
@@ -1450,9 +1451,11 @@ static lm_status run_schedule(lm_aim *aim, const lm_scene *s, const lm_surfaces 
     return rc;
 }
 
-/* One scheduled refresh: up to `budget` changed surfaces (budget < 0: no limit), or every one. */
+/* One scheduled refresh: up to `budget` changed surfaces (budget < 0: no limit), or every one; or, with a
+ * list, the `count` surfaces it names. */
 static lm_status refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
-                         lm_photon_store *ps, int budget, int all, lm_aim_stats *stats, lm_error *err)
+                         lm_photon_store *ps, int budget, int all, const int *list, int count, lm_aim_stats *stats,
+                         lm_error *err)
 {
     lm_aim_stats local;
     lm_aim_stats *st = stats ? stats : &local;
@@ -1460,9 +1463,10 @@ static lm_status refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, 
     double t0 = lm_now();
     lm_status rc = check_inputs(aim, su, a, ps, err);
     if (rc == LM_OK)
-        rc = run_schedule(aim, s, su, a, ps, budget, all, st, err);
+        rc = list ? refresh_surfaces(aim, s, su, a, ps, list, count, st, err)
+                  : run_schedule(aim, s, su, a, ps, budget, all, st, err);
     int owed = 0;
-    for (int k = 0; budget < 0 && !all && k < aim->surface_count; k++)
+    for (int k = 0; budget < 0 && !all && !list && k < aim->surface_count; k++)
         owed |= aim->owed[k] > 0.0;
     if (rc == LM_OK && owed) /* without a budget, what the refreshed surfaces owe across seams too (its
                               * counts add to st's; nothing is left pending without a budget) */
@@ -1471,14 +1475,21 @@ static lm_status refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, 
     return rc;
 }
 
+lm_status lm_aim_refresh_listed(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                lm_photon_store *ps, const int *surfaces, int count, lm_aim_stats *stats,
+                                lm_error *err)
+{
+    return refresh(aim, s, su, a, ps, count, 0, surfaces, count, stats, err);
+}
+
 lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                          lm_photon_store *ps, int budget, lm_aim_stats *stats, lm_error *err)
 {
-    return refresh(aim, s, su, a, ps, budget, 0, stats, err);
+    return refresh(aim, s, su, a, ps, budget, 0, NULL, 0, stats, err);
 }
 
 lm_status lm_aim_refresh_all(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                              lm_photon_store *ps, lm_aim_stats *stats, lm_error *err)
 {
-    return refresh(aim, s, su, a, ps, -1, 1, stats, err);
+    return refresh(aim, s, su, a, ps, -1, 1, NULL, 0, stats, err);
 }

@@ -153,6 +153,11 @@ lm_status lm_aim_refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, 
 /* Refreshes every surface (initialisation, or after a settings change) and resets every delta_f. */
 lm_status lm_aim_refresh_all(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                              lm_photon_store *ps, lm_aim_stats *stats, lm_error *err);
+/* Refreshes the `count` listed surfaces (distinct ids), whatever their delta_f, and resets it: the
+ * surfaces a light's power edit scaled (update/photon_stage.c). stats may be NULL. */
+lm_status lm_aim_refresh_listed(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
+                                lm_photon_store *ps, const int *surfaces, int count, lm_aim_stats *stats,
+                                lm_error *err);
 /* Recomputes one surface's texels from its current hits and resets its delta_f. */
 lm_status lm_aim_refresh_surface(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                  lm_photon_store *ps, int surface, lm_aim_stats *stats, lm_error *err);

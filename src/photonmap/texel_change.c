@@ -393,3 +393,10 @@ void lm_texel_change_restore(lm_texel_change *tc, const float *saved)
     memcpy(tc->change, saved, sizeof *saved * tc->texel_count);
     memcpy(tc->lit, saved + tc->texel_count, sizeof *saved * tc->texel_count);
 }
+
+void lm_texel_change_scale(lm_texel_change *tc, const lm_atlas *a, const float *factor)
+{
+    for (uint32_t i = 0; i < tc->texel_count; i++)
+        for (int c = 0; c < 3; c++)
+            tc->aim_seen[3 * (size_t)i + c] *= factor[3 * a->texels[i].surface + c];
+}

@@ -68,6 +68,10 @@ int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas
  * texels of the surfaces that see them (lm_delta_i_sees: a few shadow rays per pair of surfaces). */
 void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const lm_scene *s, const lm_atlas *a,
                          const lm_rt *rt, const float *aim_rgb, const uint8_t *refreshed);
+/* The AIM radiance last looked at, of every texel of surface k, multiplied by factor[3 k + c]: a light's
+ * power edit changed its surface's light so (update/photon_stage.h, lm_photon_stage_take_scale), and the
+ * IIM texels that saw it were scaled alike, so a later refresh counts only what came after. */
+void lm_texel_change_scale(lm_texel_change *tc, const lm_atlas *a, const float *factor);
 /* At most budget texels over the threshold (and, unless `all`, over 4 times the mean: header), not on
  * surfaces with off[k] set, most changed first, written to out (texel indices) and zeroed. A bake asks for
  * all. Returns how many. */

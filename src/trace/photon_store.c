@@ -1,5 +1,6 @@
 #include "photon_store.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -116,6 +117,34 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
     d->at = LM_NONE;
     d->next = ps->free_head;
     ps->free_head = slot;
+}
+
+void lm_photon_store_scale(lm_photon_store *ps, uint32_t slot, const float s[3])
+{
+    if (slot >= ps->used || ps->hits[slot].surface < 0)
+        return;
+    lm_hit *h = &ps->hits[slot];
+    double before = lm_hit_energy(h);
+    for (int c = 0; c < 3; c++)
+        h->flux[c] *= s[c];
+    double moved = lm_hit_energy(h) - before;
+    lm_surface_hits *sh = &ps->surfaces[h->surface];
+    ps->version++;
+    sh->delta_f += fabs(moved);
+    if (lm_hit_in_iim(h))
+        sh->delta_i += fabs(moved);
+    sh->energy += moved;
+}
+
+void lm_photon_store_surface_flux(const lm_photon_store *ps, double *out)
+{
+    memset(out, 0, sizeof *out * 3 * (size_t)ps->surface_count);
+    for (uint32_t i = 0; i < ps->used; i++) {
+        const lm_hit *h = &ps->hits[i];
+        if (h->surface >= 0)
+            for (int c = 0; c < 3; c++)
+                out[3 * h->surface + c] += h->flux[c];
+    }
 }
 
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_f = 0.0; }

@@ -95,6 +95,13 @@ static inline double lm_hit_energy(const lm_hit *h)
 /* The energy of a surface's stored hits that an IIM holds (lm_hit_in_iim, as delta_i counts them): what
  * delta_i is measured against. O(hits on the surface). */
 double lm_photon_store_iim_energy(const lm_photon_store *ps, int surface);
+/* Multiplies the flux of the live hit in `slot` by s, per channel (a light whose power alone changed:
+ * lm_photons_scale_emitter). Both deltas grow by how far its energy moved, and its surface's energy
+ * follows. */
+void lm_photon_store_scale(lm_photon_store *ps, uint32_t slot, const float s[3]);
+/* The flux of every live hit summed per surface into out[surface * 3 + c] (surface_count x 3 doubles,
+ * overwritten). O(slots). */
+void lm_photon_store_surface_flux(const lm_photon_store *ps, double *out);
 /* Sets a surface's delta_f (after its AIM refresh) or delta_i (after its IIM refresh) to zero. */
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface);
 void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface);

@@ -320,6 +320,51 @@ lm_status lm_photons_invalidate_emitter(lm_photons *ph, int e, lm_error *err)
     return LM_OK;
 }
 
+/* Every stored hit of emitter e's photons: scaled by s, or (s NULL) its flux added to flux per surface. */
+static void emitter_hits(lm_photons *ph, int e, const float s[3], double *flux)
+{
+    for (uint32_t i = (uint32_t)e * ph->G; i < ((uint32_t)e + 1) * ph->G; i++) {
+        const ph_group *g = &ph->groups[i];
+        for (uint32_t v = 0; v < g->offsets[g->photons]; v++) {
+            uint32_t slot = g->verts[v].slot;
+            if (slot == LM_NONE || slot >= ph->store.used || ph->store.hits[slot].surface < 0)
+                continue;
+            if (s)
+                lm_photon_store_scale(&ph->store, slot, s);
+            else
+                for (int c = 0; c < 3; c++)
+                    flux[3 * ph->store.hits[slot].surface + c] += ph->store.hits[slot].flux[c];
+        }
+    }
+}
+
+lm_status lm_photons_scale_emitter(lm_photons *ph, int e, const float s[3], lm_error *err)
+{
+    if (e < 0 || (uint32_t)e >= ph->emitter_count)
+        return lm_fail(err, LM_ERR_INVALID, "photons: emitter %d out of range (%u emitters)", e,
+                       ph->emitter_count);
+    emitter_hits(ph, e, s, NULL);
+    return LM_OK;
+}
+
+lm_status lm_photons_retrace_emitter(lm_photons *ph, int e, lm_error *err)
+{
+    if (e < 0 || (uint32_t)e >= ph->emitter_count)
+        return lm_fail(err, LM_ERR_INVALID, "photons: emitter %d out of range (%u emitters)", e,
+                       ph->emitter_count);
+    lm_photon_frame_stats st;
+    memset(&st, 0, sizeof st);
+    for (uint32_t k = 0; k < ph->G; k++)
+        ph->tmp_groups[k] = (uint32_t)e * ph->G + k;
+    return ph_trace_groups(ph, ph->tmp_groups, ph->G, &st, err);
+}
+
+void lm_photons_emitter_flux(const lm_photons *ph, int e, double *flux)
+{
+    if (e >= 0 && (uint32_t)e < ph->emitter_count)
+        emitter_hits((lm_photons *)ph, e, NULL, flux);
+}
+
 /* M_e of an emitter added after creation: the photons per unit of weight the others got (emitter_weight,
  * with the floor of creation), so that its photons carry about their power; a light added dark (or to a
  * scene with none lit) gets the mean emitter's count. */

@@ -135,6 +135,20 @@ lm_status lm_photons_trace_all_exact(lm_photons *ph, lm_photon_frame_stats *stat
  * groups themselves (a light's placement or power, a material). stats may be NULL. Fails only when
  * memory runs out. */
 lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err);
+/* Emitter e changed in power alone (a light's colour or intensity; its place and shape as they were):
+ * its photons keep their paths, which follow albedos and never power (photon_trace.c), so instead of
+ * re-tracing them the flux of each of its stored hits is multiplied by s, per channel, which gives the
+ * hits a re-trace would store up to rounding. Not for a light turned dark (s all 0): a dark light stores
+ * no hits (lights.c), so its groups are traced again instead (lm_photons_retrace_emitter). Fails for an
+ * out-of-range emitter. */
+lm_status lm_photons_scale_emitter(lm_photons *ph, int e, const float s[3], lm_error *err);
+/* Traces emitter e's groups now, queued or not: a light turned dark, whose hits are then gone at once (a
+ * dark light emits no photon, so no ray is cast; a queued group's later re-trace finds it so again). Fails
+ * for an out-of-range emitter or when memory runs out. */
+lm_status lm_photons_retrace_emitter(lm_photons *ph, int e, lm_error *err);
+/* The flux of emitter e's stored hits added per surface into flux[surface * 3 + c] (e in range). */
+void lm_photons_emitter_flux(const lm_photons *ph, int e, double *flux);
+
 /* The invalid groups the next frames re-trace at most, in place of group_budget (a time budget's count,
  * update/budget_plan.h); 0: group_budget again. */
 void lm_photons_limit_groups(lm_photons *ph, uint32_t most);

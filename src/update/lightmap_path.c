@@ -13,6 +13,7 @@
 #include "../scene/sky.h"
 #include "../trace/emitter_light.h"
 #include "gather_passes.h"
+#include "light_scale.h"
 
 struct lm_lightmap_path {
     lm_frame_loop_settings *set; /* the loop's, borrowed */
@@ -28,6 +29,7 @@ struct lm_lightmap_path {
     int have_emitters;
     uint32_t *texels;          /* scratch: the scheduled texels (atlas texel_count) */
     uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule */
+    float *scale;              /* scratch: per surface x 3, lights' power edits (lm_photon_stage_take_scale) */
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
@@ -181,7 +183,8 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
     lp->stage = stage;
     lp->texels = malloc(sizeof(uint32_t) * (w->atlas->texel_count ? w->atlas->texel_count : 1));
     lp->refreshed = malloc((size_t)w->atlas->surface_count + 1);
-    lm_status st = lp->texels && lp->refreshed ? LM_OK
+    lp->scale = malloc(sizeof *lp->scale * 3 * ((size_t)w->atlas->surface_count + 1));
+    lm_status st = lp->texels && lp->refreshed && lp->scale ? LM_OK
                                                : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the frame loop",
                                                          w->scene->path);
     if (st == LM_OK)
@@ -221,6 +224,7 @@ void lm_lightmap_path_free(lm_lightmap_path *lp)
         lm_texel_change_free(&lp->change);
     free(lp->texels);
     free(lp->refreshed);
+    free(lp->scale);
     free(lp);
 }
 
@@ -247,8 +251,43 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
 
 void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
 
+/* Lights changed in power alone since the last call: each IIM texel scaled by its own factor
+ * (light_scale.h; its surface's where that cannot be had), shown at the next blend, and the AIM uploaded
+ * again before the next gather. */
+static void follow_scale(lm_lightmap_path *lp)
+{
+    float *before = NULL;
+    if (!lm_photon_stage_take_scale(lp->stage, lp->scale, &before))
+        return;
+    lp->aim_stale = 1;
+    if (lp->have_change)
+        lm_texel_change_scale(&lp->change, lp->atlas, lp->scale);
+    float *texel = lp->have_iim ? malloc(sizeof *texel * 3 * ((size_t)lp->atlas->texel_count + 1)) : NULL;
+    for (uint32_t i = 0; texel && !before && i < lp->atlas->texel_count; i++)
+        for (int c = 0; c < 3; c++)
+            texel[3 * i + c] = lp->scale[3 * lp->atlas->texels[i].surface + c];
+    if (texel && before)
+        lm_light_scale_texels(lp->scene, lp->atlas, lp->rt, &lp->set->gather, before,
+                              lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->scale, texel);
+    for (uint32_t i = 0; texel && i < lp->atlas->texel_count; i++) /* scaled texels are regathered in the end */
+        if (texel[3 * i] != 1.0f || texel[3 * i + 1] != 1.0f || texel[3 * i + 2] != 1.0f) {
+            int k = lp->atlas->texels[i].surface;
+            if (!(store_of(lp)->surfaces[k].delta_i > lp->iim.sched.delta_threshold))
+                lm_iim_sched_raise(&lp->iim.sched, store_of(lp), k);
+        }
+    lm_error e;
+    if (!texel && lp->have_iim)
+        lm_log(LM_LOG_WARN, "%s: no memory to scale the lightmap after a light's edit: it follows by regathers",
+               lp->scene->path);
+    else if (texel && lm_iim_scale(&lp->iim, lp->atlas, texel, &e) != LM_OK)
+        lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
+    free(texel);
+    free(before);
+}
+
 int lm_lightmap_path_widen(lm_lightmap_path *lp)
 {
+    follow_scale(lp);
     if (lp->have_change)
         lm_texel_change_moved(&lp->change, lp->scene, lp->atlas);
     if (!lm_photon_stage_take_refreshed(lp->stage, lp->refreshed))

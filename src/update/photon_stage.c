@@ -19,6 +19,7 @@
 typedef struct {
     float world[16];
     float pos[3], dir[3], power[3];
+    float shape[12];  /* a sun's rectangle, a light's range and cones: the rest its photons' paths follow */
 } emitter_snapshot;
 
 struct lm_photon_stage {
@@ -43,6 +44,14 @@ struct lm_photon_stage {
     int caustic_emitters;        /* the emitters they were made for */
     int caustics_stale;          /* a material was edited: made again at the next update */
     uint64_t caustic_made;       /* times they were made (lm_photon_stage_caustics_version) */
+    float *light_scale;          /* per surface x 3: what light edits scaled its light by since
+                                  * lm_photon_stage_take_scale (1: nothing) */
+    int scaled;                  /* light_scale holds something other than 1 */
+    float *aim_before;           /* with scaled: the dilated AIM before the first of those scalings (or NULL:
+                                  * no memory for it), lm_photon_stage_take_scale's to hand on */
+    double *flux_before, *flux_after, *flux_of; /* scratch: per surface x 3 (note_scale) */
+    float *factor;               /* scratch: per surface x 3, this frame's scale (apply_scale) */
+    int *touched;                /* scratch: per surface, the surfaces it scaled (apply_scale) */
     int have_emitters, have_aim, have_area;
     int frame;
     uint64_t hit_bound;          /* worst_refresh at creation: the AIM refresh's bound without a budget */
@@ -92,6 +101,11 @@ static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *ou
         memcpy(out->dir, em->dir, sizeof out->dir);
     }
     memcpy(out->power, em->power, sizeof out->power);
+    memcpy(out->shape, em->rect, sizeof em->rect);
+    if (em->light >= 0 && em->light < ps->scene->light_count) {
+        const lm_light *l = &ps->scene->lights[em->light];
+        out->shape[9] = l->range, out->shape[10] = l->inner_cone, out->shape[11] = l->outer_cone;
+    }
 }
 
 /* Scene light `light` (-1: the sky), come after the emitter list was built, joins it last and the photons,
@@ -161,22 +175,103 @@ static int emitters_touched(lm_photon_stage *ps, const lm_edit_changes *ch, int 
            ch->materials_changed;
 }
 
-/* Invalidates the groups of every emitter whose placement or power changed since its last snapshot. */
-static lm_status check_emitters(lm_photon_stage *ps, int *moved, lm_error *err)
+/* Whether a punctual light's change from `was` to `now` is in power alone (its colour, intensity or
+ * switch: the same place and shape), and by how much, per channel, into s. A channel that was dark and
+ * is lit is not a scale: its photons carry nothing to scale (their paths are traced again). */
+static int power_alone(const lm_emitter *em, const emitter_snapshot *was, const emitter_snapshot *now, float s[3])
 {
-    *moved = 0;
+    if (!em->punctual || memcmp(was->world, now->world, sizeof now->world) || memcmp(was->pos, now->pos, sizeof now->pos) ||
+        memcmp(was->dir, now->dir, sizeof now->dir) || memcmp(was->shape, now->shape, sizeof now->shape))
+        return 0;
+    for (int c = 0; c < 3; c++) {
+        if (!(was->power[c] > 0.0f))
+            return 0; /* dark, or not a number */
+        s[c] = now->power[c] / was->power[c];
+        if (!isfinite(s[c]) || s[c] < 0.0f)
+            return 0;
+    }
+    return 1;
+}
+
+/* Emitter e's light scaled by s (power_alone): its share of each surface's hits' flux (flux_of) moves the
+ * surfaces' totals after the edit (flux_after), from those before every scaling of this frame
+ * (flux_before, taken at the first). */
+static void note_scale(lm_photon_stage *ps, int e, const float s[3], int first)
+{
+    size_t n = 3 * (size_t)ps->surfaces->surface_count;
+    if (first) {
+        lm_photon_store_surface_flux(lm_photons_store(ps->photons), ps->flux_before);
+        memcpy(ps->flux_after, ps->flux_before, sizeof *ps->flux_after * n);
+    }
+    memset(ps->flux_of, 0, sizeof *ps->flux_of * n);
+    lm_photons_emitter_flux(ps->photons, e, ps->flux_of);
+    for (size_t i = 0; i < n; i++)
+        ps->flux_after[i] += ((double)s[i % 3] - 1.0) * ps->flux_of[i];
+}
+
+/* The light of this frame's scaled emitters shown at once (issue 32, item 2; docs/tradeoff.md, "Light
+ * edits at once"): their hits are what a re-trace would store (scaled, or gone for a light turned dark),
+ * so the AIMs of the surfaces whose hits' flux changed are refreshed from them at once, exact whatever
+ * mix of lights they hold. Each surface's factor, how much the flux of its hits changed per channel (one
+ * that no hit reaches: 1, or the whole scene's where its AIM computes the lights' direct light), waits
+ * for the IIM (lm_photon_stage_take_scale) with the AIM from before. */
+static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
+{
+    int S = ps->surfaces->surface_count, moved = 0;
+    double all_before[3] = {0, 0, 0}, all_after[3] = {0, 0, 0};
+    for (int k = 0; k < S; k++)
+        for (int c = 0; c < 3; c++)
+            all_before[c] += ps->flux_before[3 * k + c], all_after[c] += ps->flux_after[3 * k + c];
+    for (int k = 0; k < S; k++) {
+        int changed = 0;
+        for (int c = 0; c < 3; c++) {
+            double b = ps->flux_before[3 * k + c], a = ps->flux_after[3 * k + c];
+            if (!(b > 0.0) && ps->set.exact_direct == 2) /* its AIM may hold the lights' direct light alone */
+                b = all_before[c], a = all_after[c];
+            float f = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
+            ps->factor[3 * k + c] = f;
+            ps->light_scale[3 * k + c] *= f;
+            changed |= f != 1.0f;
+        }
+        if (changed)
+            ps->touched[moved++] = k;
+    }
+    size_t cells = 4 * (size_t)ps->atlas->width * ps->atlas->height;
+    if (!ps->scaled && (ps->aim_before = malloc(sizeof *ps->aim_before * cells)) != NULL)
+        memcpy(ps->aim_before, lm_aim_dilated_rgba(&ps->aim), sizeof *ps->aim_before * cells);
+    ps->scaled = 1;
+    lm_aim_stats st;
+    return lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
+                                 ps->touched, moved, &st, err);
+}
+
+/* Invalidates the groups of every emitter whose placement or power changed since its last snapshot; a
+ * light changed in power alone keeps its photons, whose hits are scaled (lm_photons_scale_emitter), or,
+ * turned dark, are traced again to go; either way its light is scaled at once (apply_scale). *scaled
+ * counts those. */
+static lm_status check_emitters(lm_photon_stage *ps, int *moved, int *scaled, lm_error *err)
+{
+    *moved = *scaled = 0;
+    int noted = 0;
     for (int e = 0; e < ps->emitters.count; e++) {
         emitter_snapshot now;
         take_snapshot(ps, e, &now);
         if (!memcmp(&now, &ps->snap[e], sizeof now))
             continue;
+        float s[3];
+        int by_power = power_alone(&ps->emitters.e[e], &ps->snap[e], &now, s);
         ps->snap[e] = now;
-        (*moved)++;
-        lm_status st = lm_photons_invalidate_emitter(ps->photons, e, err);
+        if (by_power && ps->have_aim)
+            note_scale(ps, e, s, !noted++);
+        *scaled += by_power;
+        *moved += !by_power;
+        lm_status st = !by_power                                  ? lm_photons_invalidate_emitter(ps->photons, e, err)
+                       : ps->emitters.e[e].luminance > 0.0f ? lm_photons_scale_emitter(ps->photons, e, s, err)
+                                                            : lm_photons_retrace_emitter(ps->photons, e, err);
         if (st != LM_OK)
             return st;
     }
-    return LM_OK;
+    return noted ? apply_scale(ps, err) : LM_OK;
 }
 
 /* The caustic photons for the scene as it is now (made again after edits that change the generators or
@@ -339,7 +434,16 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     ps->refreshed = calloc(S, 1);
     ps->delta_before = calloc(S, sizeof *ps->delta_before);
     ps->count_before = calloc(S, sizeof *ps->count_before);
-    if (!ps->refreshed || !ps->delta_before || !ps->count_before)
+    ps->light_scale = malloc(3 * S * sizeof *ps->light_scale);
+    ps->flux_before = malloc(3 * S * sizeof *ps->flux_before);
+    ps->flux_after = malloc(3 * S * sizeof *ps->flux_after);
+    ps->flux_of = malloc(3 * S * sizeof *ps->flux_of);
+    ps->factor = malloc(3 * S * sizeof *ps->factor);
+    ps->touched = malloc(S * sizeof *ps->touched);
+    for (size_t i = 0; ps->light_scale && i < 3 * S; i++)
+        ps->light_scale[i] = 1.0f;
+    if (!ps->factor || !ps->touched || !ps->refreshed || !ps->delta_before || !ps->count_before || !ps->light_scale || !ps->flux_before ||
+        !ps->flux_after || !ps->flux_of)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     st = make_photons(ps, &ps->photons, err);
     if (st == LM_OK)
@@ -415,6 +519,13 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->refreshed);
     free(ps->delta_before);
     free(ps->count_before);
+    free(ps->light_scale);
+    free(ps->flux_before);
+    free(ps->flux_after);
+    free(ps->flux_of);
+    free(ps->factor);
+    free(ps->touched);
+    free(ps->aim_before);
     free(ps);
 }
 
@@ -438,7 +549,7 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
         lm_emitters_update(&ps->emitters, ps->scene);
         lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
         if (st == LM_OK)
-            st = check_emitters(ps, &out->emitters_moved, err);
+            st = check_emitters(ps, &out->emitters_moved, &out->emitters_scaled, err);
     }
     out->emitters_moved += added;
     out->materials_changed = follow_materials(ps, ch);
@@ -574,6 +685,19 @@ int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out)
         ps->refreshed[k] = 0;
     }
     return n;
+}
+
+int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before)
+{
+    int S = ps->surfaces->surface_count, any = ps->scaled;
+    for (int i = 0; i < 3 * S; i++) {
+        out[i] = ps->light_scale[i];
+        ps->light_scale[i] = 1.0f;
+    }
+    *aim_before = ps->aim_before;
+    ps->aim_before = NULL;
+    ps->scaled = 0;
+    return any;
 }
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }

@@ -35,7 +35,11 @@ typedef struct {
 typedef struct {
     int frame;
     float time;              /* animation time, seconds */
-    int emitters_moved;      /* emitters whose placement or power changed this frame, or that were added */
+    int emitters_moved;      /* emitters whose placement changed this frame, that were added, or lit from
+                              * dark: their photons are traced again */
+    int emitters_scaled;     /* lights changed in power alone this frame, their light scaled at once
+                              * (lm_photon_stage_take_scale): their hits scaled, not traced again, or, turned
+                              * dark, traced again to go */
     int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
     lm_photon_frame_stats photons;
     lm_aim_stats aim;
@@ -77,6 +81,14 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan,
  * (surface_count bytes); clears the record. Returns how many. Not while an update runs on another
  * thread. */
 int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
+
+/* Per surface and channel (surface_count x 3 floats into out), what the lights changed in power alone
+ * since the last call multiplied its light by: its AIM was scaled so in the update that saw the edit
+ * (docs/tradeoff.md, "Light edits at once"); 1 where nothing changed. *aim_before: the dilated AIM before
+ * those scalings (malloc'd, the caller's to free; NULL when nothing was scaled or memory ran out), from
+ * which the IIM's own factors follow (update/light_scale.h). Resets them. Returns 0 when nothing was
+ * scaled. Not while an update runs on another thread. */
+int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before);
 
 /* What a time budget allows the next updates (update/budget_plan.h): invalid photon groups re-traced, the
  * AIM refresh's bound on stored hits (then any number of surfaces within it; its first surface always),

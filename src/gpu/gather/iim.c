@@ -118,6 +118,10 @@ void lm_iim_free(lm_iim *iim)
         glDeleteBuffers(8, bufs);
         glDeleteProgram(iim->blend_prog);
     }
+    if (iim->scale_prog) {
+        glDeleteBuffers(1, &iim->factor_buf);
+        glDeleteProgram(iim->scale_prog);
+    }
     lm_iim_sched_free(&iim->sched);
     free(iim->blend_start);
     free(iim->texel_start);
@@ -255,6 +259,47 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     lm_iim_sched_end_frame(&iim->sched);
     return lm_gl_check("IIM blend (iim_blend)", err);
+}
+
+lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, lm_error *err)
+{
+    uint8_t *touch = iim->active; /* scratch: lm_iim_blend fills it afresh */
+    memset(touch, 0, (size_t)iim->sched.surface_count);
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        touch[a->texels[i].surface] |= factor[3 * i] != 1.0f || factor[3 * i + 1] != 1.0f || factor[3 * i + 2] != 1.0f;
+    for (int k = 0; k < iim->sched.surface_count; k++)
+        iim->version[k] += touch[k];
+    if (!iim->blend_prog)
+        return LM_OK;
+    if (!iim->scale_prog) {
+        lm_status st = lm_gl_compute_program("iim_scale", lm_glsl_iim_scale_cs, &iim->scale_prog, err);
+        if (st != LM_OK)
+            return st;
+        glGenBuffers(1, &iim->factor_buf);
+    }
+    size_t cells = (size_t)a->width * a->height;
+    float *f4 = malloc(sizeof *f4 * 4 * (cells ? cells : 1));
+    if (!f4)
+        return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory to scale %zu cells", cells);
+    for (size_t c = 0; c < 4 * cells; c++)
+        f4[c] = 1.0f;
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        memcpy(f4 + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x), factor + 3 * (size_t)i, 3 * sizeof *f4);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->factor_buf);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof *f4 * 4 * (cells ? cells : 1)), f4, GL_DYNAMIC_DRAW);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    free(f4);
+    glUseProgram(iim->scale_prog);
+    glUniform2i(glGetUniformLocation(iim->scale_prog, "size"), iim->width, iim->height);
+    unsigned *tex[IIM_TEXTURES];
+    textures(iim, tex);
+    for (int i = 0; i < IIM_TEXTURES; i++)
+        glBindImageTexture((GLuint)i, *tex[i], 0, GL_FALSE, 0, GL_READ_WRITE, GL_RGBA32F);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, iim->surface_buf);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->factor_buf);
+    glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+    return lm_gl_check("IIM scale (iim_scale)", err);
 }
 
 lm_status lm_iim_clear(lm_iim *iim, lm_error *err)

@@ -66,6 +66,7 @@ typedef struct {
     int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */
     unsigned fresh_tex, old_tex, new_tex, display_tex, delta_tex, carry_tex;
+    unsigned scale_prog, factor_buf; /* lm_iim_scale's program and factors, made at its first call */
     unsigned blend_prog, surface_buf, params_buf, start_buf, list_buf, chart_buf, redraw_buf, flag_buf, ops_buf;
 } lm_iim;
 
@@ -84,6 +85,12 @@ void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, 
 /* Ends the frame on the GPU: commits the surfaces the scheduler completed (clearing their flags),
  * writes display = mix(old, new, t), then advances the scheduler's frame counter. instant: committed surfaces show new at once (after the first gather). */
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
+
+/* Every texel i of the atlas, in every map (fresh, old, new, displayed, its change and what its estimate
+ * carries), multiplied by factor[3 i + c] per channel (a->texel_count x 3 floats; alpha stays): a light
+ * changed in power alone shows at once (update/light_scale.h). Each surface with a texel scaled moves its
+ * version. Without GL only the versions move. */
+lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, lm_error *err);
 
 /* Every IIM texture (fresh, old, new, displayed, the changes) set to 0: a scene that lost its last light shows no
  * indirect light at once, not the last gather's. */
