@@ -302,14 +302,15 @@ static void test_random_edit_sequences(void **state)
 }
 
 /* The error atlas (LMGI_LIGHTMAP_ERROR) is never 0 where the lightmap is wrong: after random edits of
- * every kind and a few updates, each texel whose shown irradiance is more than 5% (of itself, or of a
- * hundredth of the mean where darker) away from what a bake then brings says so. The bake keeps the
+ * every kind and a few updates, each texel whose shown irradiance is more than 2% (of itself, or of a
+ * hundredth of the mean where darker) away from what a bake then brings says so (5% and three seeds
+ * until light and material edits were shown at once: 2,229 texels were over 5% off then, 30 now). The bake keeps the
  * shares of creation, so that what it brings is what the updates are on their way to, not photon noise. */
 static void test_error_atlas_marks_wrong_texels(void **state)
 {
     (void)state;
     int wrong_total = 0;
-    for (uint32_t seed = 4; seed <= 6; seed++) {
+    for (uint32_t seed = 4; seed <= 9; seed++) {
         rig r;
         rig_load(&r);
         int cube = lmgi_find_node(r.sc, "dynamic_cube");
@@ -336,12 +337,12 @@ static void test_error_atlas_marks_wrong_texels(void **state)
             if (!(settled[i + 3] > 0.0f))
                 continue;
             double a = shown[i] + shown[i + 1] + shown[i + 2], b = settled[i] + settled[i + 1] + settled[i + 2];
-            if (fabs(a - b) > 0.05 * fmax(b, 0.01 * mean)) {
+            if (fabs(a - b) > 0.02 * fmax(b, 0.01 * mean)) {
                 wrong++;
                 unmarked += !(error[i] > 0.0f);
             }
         }
-        print_message("seed %u: %d of %d texels over 5%% from what the bake brings, %d of them with error 0\n",
+        print_message("seed %u: %d of %d texels over 2%% from what the bake brings, %d of them with error 0\n",
                       seed, wrong, valid, unmarked);
         assert_int_equal(unmarked, 0);
         wrong_total += wrong;

@@ -558,6 +558,38 @@ static void test_switched_off(void **state)
     two_lights(0, 1.0f, 0, 0.02); /* 0.0072 */
 }
 
+/* The block recoloured from red to blue (issue 32, item 2, to first order): at the next update the AIMs of
+ * its surfaces reflect the new colour from the light they receive, and the texels that see them follow;
+ * the light the recoloured block sends on to what it lights comes with the re-traced photons after. */
+static void test_recolour_first_order(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    lmgi_scene *sc = load_room(&LAMP, 1);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    lmt_updates(u, 3);
+    size_t n;
+    float *before = lmt_iim(u, sc, &n);
+    lmgi_material m;
+    lmgi_error e;
+    assert_int_equal(lmgi_get_material(sc, 1, &m, &e), LMGI_OK);
+    m.base_color[0] = 0.1f, m.base_color[1] = 0.2f, m.base_color[2] = 0.8f;
+    assert_int_equal(lmgi_set_material(sc, 1, &m, &e), LMGI_OK);
+    lmt_updates(u, 1);
+    float *now = lmt_iim(u, sc, &n);
+    lmt_bake(u, NULL);
+    float *want = lmt_iim(u, sc, &n);
+    double was = lmt_relative_l1(before, want, n), at_once = lmt_relative_l1(now, want, n);
+    print_message("block recoloured: lightmap against the regathered one %.3g before the edit, %.3g at the next "
+                  "update\n", was, at_once);
+    assert_true(was > 0.02);
+    assert_true(at_once < 0.5 * was);
+    free(before), free(now), free(want);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -569,6 +601,7 @@ int main(void)
         cmocka_unit_test(test_one_light_at_once),
         cmocka_unit_test(test_two_lights_first_guess),
         cmocka_unit_test(test_switched_off),
+        cmocka_unit_test(test_recolour_first_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -528,6 +528,53 @@ static void test_power_edit_scales_hits(void **state)
     world_free(&w);
 }
 
+/* Issue 32, item 2: a diffuse material recoloured alone. Its photons' paths follow the albedo only through
+ * the survival probability (the largest channel), so a recolour that keeps the largest channel keeps every
+ * path, and reweighting the hits after each bounce off it (lm_photons_scale_materials) stores what tracing
+ * them again does, up to rounding. */
+static void test_recolour_reweights_hits(void **state)
+{
+    (void)state;
+    world w;
+    load_lamp_box(&w, "recolour.gltf", "[1, 1, 1]");
+    lm_material *m = &w.s->materials[w.s->tri_material[0]];
+    const float was[3] = {0.8f, 0.5f, 0.3f}, now[3] = {0.8f, 0.2f, 0.6f};
+    memcpy(m->base_color, was, sizeof was);
+    world_trace(&w, 20000, NULL);
+    const lm_photon_store *store = lm_photons_store(w.ph);
+    int S = store->surface_count, M = w.s->material_count;
+    double *scaled = calloc(3 * (size_t)S, sizeof *scaled), *traced = calloc(3 * (size_t)S, sizeof *traced);
+    float *ratio = malloc(3 * sizeof *ratio * (size_t)M);
+    uint8_t *touched = calloc((size_t)S, 1);
+    assert_non_null(scaled);
+    assert_non_null(traced);
+    assert_non_null(ratio);
+    assert_non_null(touched);
+    for (int i = 0; i < 3 * M; i++)
+        ratio[i] = 1.0f;
+    for (int c = 0; c < 3; c++)
+        ratio[3 * w.s->tri_material[0] + c] = now[c] / was[c];
+    lm_photons_scale_materials(w.ph, ratio, M, touched);
+    lm_photon_store_surface_flux(store, scaled);
+    int reached = 0;
+    for (int k = 0; k < S; k++)
+        reached += touched[k];
+    memcpy(m->base_color, now, sizeof now);
+    lm_photon_frame_stats st;
+    lm_error err;
+    assert_int_equal(lm_photons_trace_all_exact(w.ph, &st, &err), LM_OK);
+    lm_photon_store_surface_flux(store, traced);
+    double worst = 0.0;
+    for (int i = 0; i < 3 * S; i++)
+        worst = fmax(worst, fabs(scaled[i] - traced[i]) / fmax(traced[i], 1e-12));
+    print_message("recolour: hits reweighted against traced again, per surface and channel worst %.2g (%d of %d "
+                  "surfaces reached)\n", worst, reached, S);
+    assert_int_equal(reached, S);
+    assert_true(worst < 1e-5);
+    free(scaled), free(traced), free(ratio), free(touched);
+    world_free(&w);
+}
+
 static void test_energy_closed_box(void **state)
 {
     (void)state;
@@ -1023,6 +1070,7 @@ int main(void)
         cmocka_unit_test(test_energy_closed_box),
         cmocka_unit_test(test_hits_know_where_they_came_from),
         cmocka_unit_test(test_power_edit_scales_hits),
+        cmocka_unit_test(test_recolour_reweights_hits),
         cmocka_unit_test(test_no_channel_grows),
         cmocka_unit_test(test_invalidate_emitter),
         cmocka_unit_test(test_move_and_back),

@@ -325,7 +325,7 @@ static void emitter_hits(lm_photons *ph, int e, const float s[3], double *flux)
 {
     for (uint32_t i = (uint32_t)e * ph->G; i < ((uint32_t)e + 1) * ph->G; i++) {
         const ph_group *g = &ph->groups[i];
-        for (uint32_t v = 0; v < g->offsets[g->photons]; v++) {
+        for (uint32_t v = 0; g->offsets && v < g->offsets[g->photons]; v++) {
             uint32_t slot = g->verts[v].slot;
             if (slot == LM_NONE || slot >= ph->store.used || ph->store.hits[slot].surface < 0)
                 continue;
@@ -425,6 +425,29 @@ lm_status lm_photons_add_emitter(lm_photons *ph, lm_error *err)
         return st;
     }
     return lm_photons_invalidate_emitter(ph, (int)E, err);
+}
+
+void lm_photons_scale_materials(lm_photons *ph, const float *ratio, int materials, uint8_t *touched)
+{
+    const int *tri_material = ph->scene->tri_material;
+    for (uint32_t gi = 0; gi < ph->group_count; gi++) {
+        const ph_group *g = &ph->groups[gi];
+        for (uint32_t m = 0; g->offsets && m < g->photons; m++) {
+            float w[3] = {1.0f, 1.0f, 1.0f}; /* what the bounces so far on recoloured materials multiply */
+            int any = 0;
+            for (uint32_t i = g->offsets[m]; i < g->offsets[m + 1]; i++) {
+                const lm_path_vertex *v = &g->verts[i];
+                if (any && v->slot != LM_NONE && v->slot < ph->store.used && ph->store.hits[v->slot].surface >= 0) {
+                    touched[ph->store.hits[v->slot].surface] = 1;
+                    lm_photon_store_scale(&ph->store, v->slot, w);
+                }
+                int mat = tri_material[v->tri];
+                const float *r = mat >= 0 && mat < materials ? ratio + 3 * (size_t)mat : NULL;
+                if (r && (r[0] != 1.0f || r[1] != 1.0f || r[2] != 1.0f))
+                    w[0] *= r[0], w[1] *= r[1], w[2] *= r[2], any = 1;
+            }
+        }
+    }
 }
 
 uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *materials)

@@ -52,6 +52,10 @@ struct lm_photon_stage {
     double *flux_before, *flux_after, *flux_of; /* scratch: per surface x 3 (note_scale) */
     float *factor;               /* scratch: per surface x 3, this frame's scale (apply_scale) */
     int *touched;                /* scratch: per surface, the surfaces it scaled (apply_scale) */
+    uint8_t *reached;            /* scratch: per surface, reweighted photons reach it (follow_materials) */
+    lm_material *materials;      /* the scene's materials as the photons last saw them (material_count) */
+    float *ratio;                /* scratch: per material x 3, a recolour's ratio (follow_materials) */
+    int material_count;
     int have_emitters, have_aim, have_area;
     int frame;
     uint64_t hit_bound;          /* worst_refresh at creation: the AIM refresh's bound without a budget */
@@ -142,22 +146,75 @@ static lm_status take_new_emitters(lm_photon_stage *ps, int *added, lm_error *er
     return st;
 }
 
-/* The materials the edits changed (colour, emission, class; ch) reach the photons that touch them, which
- * are re-traced, and the AIMs of their surfaces, whose albedo the estimate multiplies in: those are marked
- * for a refresh. The surfaces their light reaches follow from the re-traced photons' hits. Returns how
- * many. */
-static int follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch)
+/* Keeps the dilated AIM as it is before the first change this frame shows at once (light power edits,
+ * material edits), for the IIM's factors (lm_photon_stage_take_scale): at most once between takes. */
+static void keep_aim_before(lm_photon_stage *ps)
 {
-    if (!ch->materials_changed)
+    size_t cells = 4 * (size_t)ps->atlas->width * ps->atlas->height;
+    if (!ps->scaled && (ps->aim_before = malloc(sizeof *ps->aim_before * cells)) != NULL)
+        memcpy(ps->aim_before, lm_aim_dilated_rgba(&ps->aim), sizeof *ps->aim_before * cells);
+    ps->scaled = 1;
+}
+
+/* Whether material `now` differs from `was` in its base colour alone (rgb), both diffuse and `was` lit
+ * in every channel: the BSDF weight of a diffuse bounce is the albedo, base colour x texture, so the photons
+ * that bounced off it may be reweighted by now / was (lm_photons_scale_materials) into r. */
+static int recoloured(const lm_material *was, const lm_material *now, float r[3])
+{
+    if (was->cls != LM_MAT_DIFFUSE || now->cls != LM_MAT_DIFFUSE || was->base_color[3] != now->base_color[3] ||
+        was->base_color_tex != now->base_color_tex || was->metallic != now->metallic ||
+        was->roughness != now->roughness || was->emissive_tex != now->emissive_tex ||
+        memcmp(was->emissive, now->emissive, sizeof now->emissive) || was->transmission != now->transmission)
         return 0;
+    for (int c = 0; c < 3; c++) {
+        if (!(was->base_color[c] > 0.0f))
+            return 0;
+        r[c] = now->base_color[c] / was->base_color[c];
+        if (!isfinite(r[c]) || r[c] < 0.0f)
+            return 0;
+    }
+    return 1;
+}
+
+/* The materials the edits changed (colour, emission, class; ch) reach the photons that touch them, which
+ * are re-traced under the group budget. At once, the photons that bounced off a diffuse material
+ * recoloured alone are reweighted (lm_photons_scale_materials), and the AIMs of the surfaces of the
+ * changed materials and of those the reweighted photons reach are refreshed: the changed light at every
+ * bounce shows at the next update (issue 32, item 2), that of other material edits to first order (the
+ * AIM multiplies in the new albedo), and the IIM texels that see them follow (update/light_scale.h).
+ * *count: how many materials changed. */
+static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch, int *count, lm_error *err)
+{
+    *count = 0;
+    if (!ch->materials_changed)
+        return LM_OK;
     const uint8_t *changed = ch->materials; /* material_cap >= material_count once any is set */
     ps->caustics_stale = 1;
     lm_photons_invalidate_materials(ps->photons, changed);
-    lm_photon_store *store = lm_photons_store_mutable(ps->photons);
-    for (int k = 0; k < ps->surfaces->surface_count; k++)
-        if (changed[ps->surfaces->surfaces[k].material]) /* over any threshold: first in line for a refresh */
-            store->surfaces[k].delta_f = 1e30;
-    return ch->materials_changed;
+    *count = ch->materials_changed;
+    int S = ps->surfaces->surface_count, M = ps->material_count, any = 0;
+    for (int m = 0; m < M; m++) {
+        float *r = ps->ratio + 3 * m;
+        r[0] = r[1] = r[2] = 1.0f;
+        if (changed[m] && !recoloured(&ps->materials[m], &ps->scene->materials[m], r))
+            r[0] = r[1] = r[2] = 1.0f;
+        any |= r[0] != 1.0f || r[1] != 1.0f || r[2] != 1.0f;
+        if (changed[m])
+            ps->materials[m] = ps->scene->materials[m];
+    }
+    memset(ps->reached, 0, (size_t)S);
+    if (any)
+        lm_photons_scale_materials(ps->photons, ps->ratio, M, ps->reached);
+    int n = 0;
+    for (int k = 0; k < S; k++)
+        if (ps->reached[k] || changed[ps->surfaces->surfaces[k].material])
+            ps->touched[n++] = k;
+    if (!ps->have_aim || n == 0)
+        return LM_OK;
+    keep_aim_before(ps);
+    lm_aim_stats st;
+    return lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
+                                 ps->touched, n, &st, err);
 }
 
 /* Whether anything an emitter's placement or power follows from may have changed since they were last
@@ -236,10 +293,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
         if (changed)
             ps->touched[moved++] = k;
     }
-    size_t cells = 4 * (size_t)ps->atlas->width * ps->atlas->height;
-    if (!ps->scaled && (ps->aim_before = malloc(sizeof *ps->aim_before * cells)) != NULL)
-        memcpy(ps->aim_before, lm_aim_dilated_rgba(&ps->aim), sizeof *ps->aim_before * cells);
-    ps->scaled = 1;
+    keep_aim_before(ps);
     lm_aim_stats st;
     return lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
                                  ps->touched, moved, &st, err);
@@ -440,9 +494,16 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     ps->flux_of = malloc(3 * S * sizeof *ps->flux_of);
     ps->factor = malloc(3 * S * sizeof *ps->factor);
     ps->touched = malloc(S * sizeof *ps->touched);
+    ps->reached = malloc(S);
+    ps->material_count = ps->scene->material_count;
+    size_t M = (size_t)ps->material_count + 1;
+    ps->materials = malloc(M * sizeof *ps->materials);
+    ps->ratio = malloc(3 * M * sizeof *ps->ratio);
+    if (ps->materials)
+        memcpy(ps->materials, ps->scene->materials, (M - 1) * sizeof *ps->materials);
     for (size_t i = 0; ps->light_scale && i < 3 * S; i++)
         ps->light_scale[i] = 1.0f;
-    if (!ps->factor || !ps->touched || !ps->refreshed || !ps->delta_before || !ps->count_before || !ps->light_scale || !ps->flux_before ||
+    if (!ps->factor || !ps->touched || !ps->reached || !ps->materials || !ps->ratio || !ps->refreshed || !ps->delta_before || !ps->count_before || !ps->light_scale || !ps->flux_before ||
         !ps->flux_after || !ps->flux_of)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     st = make_photons(ps, &ps->photons, err);
@@ -525,6 +586,9 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->flux_of);
     free(ps->factor);
     free(ps->touched);
+    free(ps->reached);
+    free(ps->materials);
+    free(ps->ratio);
     free(ps->aim_before);
     free(ps);
 }
@@ -552,7 +616,8 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
             st = check_emitters(ps, &out->emitters_moved, &out->emitters_scaled, err);
     }
     out->emitters_moved += added;
-    out->materials_changed = follow_materials(ps, ch);
+    lm_status sm = follow_materials(ps, ch, &out->materials_changed, st == LM_OK ? err : NULL);
+    st = st == LM_OK ? sm : st;
     lm_edits_clear_changes(ps->edits);
     out->t_animate = lm_now() - t0;
     out->t_total = out->t_animate;
