@@ -459,6 +459,32 @@ static void test_added_light_stays_in_its_room(void **state)
     lmgi_context_free(ctx);
 }
 
+/* The room lit by `lights`, its updater after three updates and the lightmap they show (n floats). */
+typedef struct {
+    lmgi_context *ctx;
+    lmgi_scene *sc;
+    lmgi_updater *u;
+    float *before;
+    size_t n;
+} settled_room;
+
+static void settle(settled_room *r, const lmgi_light_desc *lights, int count)
+{
+    r->ctx = lmt_context();
+    r->sc = load_room(lights, count);
+    r->u = lmt_room_updater(r->ctx, r->sc);
+    lmt_updates(r->u, 3);
+    r->before = lmt_iim(r->u, r->sc, &r->n);
+}
+
+static void unsettle(settled_room *r)
+{
+    free(r->before);
+    lmgi_updater_free(r->u);
+    lmgi_free(r->sc);
+    lmgi_context_free(r->ctx);
+}
+
 /* One update, which must scale `scaled` lights and trace no photon group again. */
 static void update_scaling(lmgi_updater *u, int scaled, int retraced)
 {
@@ -487,23 +513,20 @@ static void edit_light(lmgi_scene *sc, int id, float intensity_by, const float *
 static void test_one_light_at_once(void **state)
 {
     (void)state;
-    lmgi_context *ctx = lmt_context();
-    lmgi_scene *sc = load_room(&LAMP, 1);
-    lmgi_updater *u = lmt_room_updater(ctx, sc);
-    lmt_updates(u, 3);
-    size_t n;
-    float *before = lmt_iim(u, sc, &n);
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    size_t n = r.n;
     const float tint[3] = {0.4f, 0.9f, 1.0f};
-    edit_light(sc, 0, 0.3f, tint, 1);
-    update_scaling(u, 1, 0);
-    float *now = lmt_iim(u, sc, &n), *frame = lmt_corner_frame(u);
-    lmt_updates(u, 60);
-    float *later = lmt_iim(u, sc, &n);
-    lmgi_updater_free(u);
-    lmgi_updater *fresh = lmt_room_updater(ctx, sc);
-    lmt_updates(fresh, 3);
-    float *want = lmt_iim(fresh, sc, &n), *want_frame = lmt_corner_frame(fresh);
-    double was = lmt_relative_l1(before, want, n), at_once = lmt_relative_l1(now, want, n);
+    edit_light(r.sc, 0, 0.3f, tint, 1);
+    update_scaling(r.u, 1, 0);
+    float *now = lmt_iim(r.u, r.sc, &n), *frame = lmt_corner_frame(r.u);
+    lmt_updates(r.u, 60);
+    float *later = lmt_iim(r.u, r.sc, &n);
+    lmgi_updater_free(r.u);
+    r.u = lmt_room_updater(r.ctx, r.sc); /* a fresh one, of the edited room */
+    lmt_updates(r.u, 3);
+    float *want = lmt_iim(r.u, r.sc, &n), *want_frame = lmt_corner_frame(r.u);
+    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
     double shown = lmt_relative_l1(frame, want_frame, 3 * LMT_SIDE * LMT_SIDE), after = lmt_relative_l1(later, want, n);
     print_message("one lamp dimmed and recoloured: lightmap against a fresh updater's %.3g before the edit, %.3g "
                   "at the next update (frame %.3g), %.3g 60 updates later\n", was, at_once, shown, after);
@@ -511,10 +534,8 @@ static void test_one_light_at_once(void **state)
     assert_true(at_once < 1e-4);
     assert_true(shown < 1e-4);
     assert_true(after < 1e-4);
-    free(before), free(now), free(frame), free(later), free(want), free(want_frame);
-    lmgi_updater_free(fresh);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    free(now), free(frame), free(later), free(want), free(want_frame);
+    unsettle(&r);
 }
 
 /* Lit by a warm lamp and a blue spot, one of them dimmed (or switched off): at the next update the
@@ -522,27 +543,22 @@ static void test_one_light_at_once(void **state)
  * with the shares of creation kept). */
 static void two_lights(int id, float by, int enabled, double most)
 {
-    lmgi_context *ctx = lmt_context();
     const lmgi_light_desc both[2] = {LAMP, SPOT};
-    lmgi_scene *sc = load_room(both, 2);
-    lmgi_updater *u = lmt_room_updater(ctx, sc);
-    lmt_updates(u, 3);
-    size_t n;
-    float *before = lmt_iim(u, sc, &n);
-    edit_light(sc, id, by, NULL, enabled);
-    update_scaling(u, 1, !enabled);
-    float *now = lmt_iim(u, sc, &n);
-    lmt_bake(u, NULL);
-    float *want = lmt_iim(u, sc, &n);
-    double was = lmt_relative_l1(before, want, n), at_once = lmt_relative_l1(now, want, n);
+    settled_room r;
+    settle(&r, both, 2);
+    size_t n = r.n;
+    edit_light(r.sc, id, by, NULL, enabled);
+    update_scaling(r.u, 1, !enabled);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    lmt_bake(r.u, NULL);
+    float *want = lmt_iim(r.u, r.sc, &n);
+    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
     print_message("%s %s: lightmap against the regathered one %.3g before the edit, %.3g at the next update\n",
                   id ? "spot" : "lamp", enabled ? "dimmed" : "switched off", was, at_once);
     assert_true(was > 0.1);
     assert_true(at_once < most * was);
-    free(before), free(now), free(want);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    free(now), free(want);
+    unsettle(&r);
 }
 
 static void test_two_lights_first_guess(void **state)
@@ -558,36 +574,31 @@ static void test_switched_off(void **state)
     two_lights(0, 1.0f, 0, 0.02); /* 0.0072 */
 }
 
-/* The block recoloured from red to blue (issue 32, item 2, to first order): at the next update the AIMs of
- * its surfaces reflect the new colour from the light they receive, and the texels that see them follow;
- * the light the recoloured block sends on to what it lights comes with the re-traced photons after. */
-static void test_recolour_first_order(void **state)
+/* The block recoloured from red to blue (issue 32, item 2): at the next update the AIMs of its surfaces
+ * reflect the new colour, the photons that bounced off it carry it on (reweighted), and the texels that see
+ * what changed follow; the re-traced photons after bring only their own noise. */
+static void test_recolour_at_once(void **state)
 {
     (void)state;
-    lmgi_context *ctx = lmt_context();
-    lmgi_scene *sc = load_room(&LAMP, 1);
-    lmgi_updater *u = lmt_room_updater(ctx, sc);
-    lmt_updates(u, 3);
-    size_t n;
-    float *before = lmt_iim(u, sc, &n);
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    size_t n = r.n;
     lmgi_material m;
     lmgi_error e;
-    assert_int_equal(lmgi_get_material(sc, 1, &m, &e), LMGI_OK);
+    assert_int_equal(lmgi_get_material(r.sc, 1, &m, &e), LMGI_OK);
     m.base_color[0] = 0.1f, m.base_color[1] = 0.2f, m.base_color[2] = 0.8f;
-    assert_int_equal(lmgi_set_material(sc, 1, &m, &e), LMGI_OK);
-    lmt_updates(u, 1);
-    float *now = lmt_iim(u, sc, &n);
-    lmt_bake(u, NULL);
-    float *want = lmt_iim(u, sc, &n);
-    double was = lmt_relative_l1(before, want, n), at_once = lmt_relative_l1(now, want, n);
+    assert_int_equal(lmgi_set_material(r.sc, 1, &m, &e), LMGI_OK);
+    lmt_updates(r.u, 1);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    lmt_bake(r.u, NULL);
+    float *want = lmt_iim(r.u, r.sc, &n);
+    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
     print_message("block recoloured: lightmap against the regathered one %.3g before the edit, %.3g at the next "
                   "update\n", was, at_once);
     assert_true(was > 0.02);
-    assert_true(at_once < 0.5 * was);
-    free(before), free(now), free(want);
-    lmgi_updater_free(u);
-    lmgi_free(sc);
-    lmgi_context_free(ctx);
+    assert_true(at_once < 0.35 * was); /* 0.23: the first order alone, without the reweighting, 0.71 */
+    free(now), free(want);
+    unsettle(&r);
 }
 
 int main(void)
@@ -601,7 +612,7 @@ int main(void)
         cmocka_unit_test(test_one_light_at_once),
         cmocka_unit_test(test_two_lights_first_guess),
         cmocka_unit_test(test_switched_off),
-        cmocka_unit_test(test_recolour_first_order),
+        cmocka_unit_test(test_recolour_at_once),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

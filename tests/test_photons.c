@@ -479,6 +479,26 @@ static void load_lamp_box(world *w, const char *file, const char *color)
     world_load(w, path);
 }
 
+/* Every path traced again with the scene as it is now, stored where any bit differs: the worst relative
+ * difference per surface and channel between what the store held (`held`, lm_photon_store_surface_flux)
+ * and what it holds then; the paths that differed into *differ. */
+static double against_a_trace(world *w, const double *held, uint32_t *differ)
+{
+    const lm_photon_store *store = lm_photons_store(w->ph);
+    int S = store->surface_count;
+    double *traced = calloc(3 * (size_t)S, sizeof *traced), worst = 0.0;
+    assert_non_null(traced);
+    lm_photon_frame_stats st;
+    lm_error err;
+    assert_int_equal(lm_photons_trace_all_exact(w->ph, &st, &err), LM_OK);
+    lm_photon_store_surface_flux(store, traced);
+    for (int i = 0; i < 3 * S; i++)
+        worst = fmax(worst, fabs(held[i] - traced[i]) / fmax(traced[i], 1e-12));
+    *differ = st.photons_updated;
+    free(traced);
+    return worst;
+}
+
 /* Issue 32, item 2: a light changed in power alone keeps its photons' paths, which follow albedos and
  * never power (photon_trace.c), so scaling the flux of its stored hits (lm_photons_scale_emitter) stores
  * what tracing them again with the new colour does, up to rounding, and each surface's energy and deltas
@@ -491,10 +511,8 @@ static void test_power_edit_scales_hits(void **state)
     world_trace(&w, 20000, NULL);
     const lm_photon_store *store = lm_photons_store(w.ph);
     int S = store->surface_count;
-    double *scaled = calloc(3 * (size_t)S, sizeof *scaled), *traced = calloc(3 * (size_t)S, sizeof *traced);
-    double *delta = calloc((size_t)S, sizeof *delta);
+    double *scaled = calloc(3 * (size_t)S, sizeof *scaled), *delta = calloc((size_t)S, sizeof *delta);
     assert_non_null(scaled);
-    assert_non_null(traced);
     assert_non_null(delta);
     for (int k = 0; k < S; k++)
         delta[k] = store->surfaces[k].delta_f;
@@ -509,21 +527,15 @@ static void test_power_edit_scales_hits(void **state)
         assert_float_equal(store->surfaces[k].energy, e, 1e-9 * e);
         assert_true(store->surfaces[k].delta_f > delta[k]);
     }
-    /* the same light with that colour, every path traced again and stored where any bit differs */
-    for (int c = 0; c < 3; c++)
+    for (int c = 0; c < 3; c++) /* the same light with that colour */
         w.s->lights[0].color[c] *= by[c];
     lm_emitters_update(&w.em, w.s);
-    lm_photon_frame_stats st;
-    assert_int_equal(lm_photons_trace_all_exact(w.ph, &st, &err), LM_OK);
-    lm_photon_store_surface_flux(store, traced);
-    double worst = 0.0;
-    for (int i = 0; i < 3 * S; i++)
-        worst = fmax(worst, fabs(scaled[i] - traced[i]) / fmax(traced[i], 1e-12));
+    uint32_t differ = 0;
+    double worst = against_a_trace(&w, scaled, &differ);
     print_message("power edit: hits scaled against traced again, per surface and channel worst %.2g (%u of %u "
-                  "paths differ in some bit)\n", worst, st.photons_updated, lm_photons_count(w.ph));
+                  "paths differ in some bit)\n", worst, differ, lm_photons_count(w.ph));
     assert_true(worst < 1e-5);
     free(scaled);
-    free(traced);
     free(delta);
     world_free(&w);
 }
@@ -543,11 +555,10 @@ static void test_recolour_reweights_hits(void **state)
     world_trace(&w, 20000, NULL);
     const lm_photon_store *store = lm_photons_store(w.ph);
     int S = store->surface_count, M = w.s->material_count;
-    double *scaled = calloc(3 * (size_t)S, sizeof *scaled), *traced = calloc(3 * (size_t)S, sizeof *traced);
+    double *scaled = calloc(3 * (size_t)S, sizeof *scaled);
     float *ratio = malloc(3 * sizeof *ratio * (size_t)M);
     uint8_t *touched = calloc((size_t)S, 1);
     assert_non_null(scaled);
-    assert_non_null(traced);
     assert_non_null(ratio);
     assert_non_null(touched);
     for (int i = 0; i < 3 * M; i++)
@@ -560,18 +571,13 @@ static void test_recolour_reweights_hits(void **state)
     for (int k = 0; k < S; k++)
         reached += touched[k];
     memcpy(m->base_color, now, sizeof now);
-    lm_photon_frame_stats st;
-    lm_error err;
-    assert_int_equal(lm_photons_trace_all_exact(w.ph, &st, &err), LM_OK);
-    lm_photon_store_surface_flux(store, traced);
-    double worst = 0.0;
-    for (int i = 0; i < 3 * S; i++)
-        worst = fmax(worst, fabs(scaled[i] - traced[i]) / fmax(traced[i], 1e-12));
+    uint32_t differ = 0;
+    double worst = against_a_trace(&w, scaled, &differ);
     print_message("recolour: hits reweighted against traced again, per surface and channel worst %.2g (%d of %d "
                   "surfaces reached)\n", worst, reached, S);
     assert_int_equal(reached, S);
     assert_true(worst < 1e-5);
-    free(scaled), free(traced), free(ratio), free(touched);
+    free(scaled), free(ratio), free(touched);
     world_free(&w);
 }
 
