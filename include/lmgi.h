@@ -599,9 +599,10 @@ typedef struct {
      * why, in words: what it did, what still waits, and what the budget planned for it */
     const char *busiest_stage;
     char why[160];
-    int lights_scaled;         /* lights changed in power alone (colour, intensity, switched off): their photons'
-                                * hits scaled instead of re-traced, and their light shown in the lightmaps at
-                                * once, refined by the regathers after (docs/tradeoff.md, "Light edits at once") */
+    int lights_scaled;         /* lights changed in power alone (colour, intensity, switched off) and emitters
+                                * in their emission: their photons' hits scaled instead of re-traced, and their
+                                * light shown in the lightmaps at once, refined by the regathers after
+                                * (docs/tradeoff.md, "Light edits at once") */
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative

@@ -147,9 +147,11 @@ static void stratum(const lm_rim *r, const sky_mis *mis, const float eye[3], lm_
                     sum[k] += ws * L[k];
             }
     }
-    if (r->emission)
+    if (r->emission) {
+        const float *em = r->emissive ? r->emissive + 3 * (size_t)r->scene->tri_material[h.tri] : m->emissive;
         for (int k = 0; k < 3; k++)
-            sum[k] += SUB * SUB * w * m->emissive[k];
+            sum[k] += SUB * SUB * w * em[k];
+    }
 }
 
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],

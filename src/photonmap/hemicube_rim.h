@@ -39,6 +39,8 @@ typedef struct {
     float sky[3];
     float enlargement;     /* a */
     int samples;           /* K, rounded down to a square */
+    const float *emissive; /* with emission: per material rgb emission in place of the scene's (NULL: the
+                              scene's), as a light edit's first gather saw it before (light_scale.h) */
 } lm_rim;
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y

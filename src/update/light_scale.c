@@ -32,7 +32,8 @@ static void texel_ratio(const lm_scene *s, const lm_atlas *a, const lm_hemicube_
 }
 
 void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
-                           const float *before, const float *after, const float *surface_factor, float *texel_factor)
+                           const float *before, const float *emissive_before, const float *after,
+                           const float *surface_factor, float *texel_factor)
 {
     uint32_t T = a->texel_count;
     if (T == 0)
@@ -41,11 +42,12 @@ void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt
     if (K < 4) /* the fewest rays a texel still reads a ratio from; past that, every stride-th texel */
         K = 4, stride = (4 * T + LM_LIGHT_SCALE_WORK - 1) / LM_LIGHT_SCALE_WORK;
     K = K > 64 ? 64 : K;
-    lm_rim was = {s, a, rt, before, 1, {set->sky[0], set->sky[1], set->sky[2]}, 0.0f, (int)K};
+    lm_rim was = {s, a, rt, before, 1, {set->sky[0], set->sky[1], set->sky[2]}, 0.0f, (int)K, emissive_before};
     if (s->has_sky)
         lm_sky_mean(s, was.sky);
     lm_rim now = was;
     now.aim = after;
+    now.emissive = NULL;
 #pragma omp parallel
     {
         lm_rt_thread_init();

@@ -3,7 +3,7 @@
  * changes, so the photon stage scales their hits and each surface's AIM by how much the flux of its hits
  * changed (update/photon_stage.h). An IIM texel's light is what it sees of those AIMs, so its own factor
  * is the ratio of two small ray gathers from the texel, through the same rays, over the AIM before and
- * after the scaling:
+ * after the scaling (and the emitters' emission before and after):
  *
  *     f(texel) = E_after / E_before   per channel (photonmap/hemicube_rim.h with the whole hemisphere)
  *
@@ -34,9 +34,11 @@
  * the schedule a regather for nothing visible (lmgi bench --edits, "outside its reach"). */
 #define LM_LIGHT_SCALE_KEEP 1e-3f
 
-/* before, after: atlas-sized RGBA AIMs, dilated (lm_aim_dilated_rgba); surface_factor: surface_count x 3.
- * texel_factor: a->texel_count x 3, written. set: the gather's (offset, sky). */
+/* before, after: atlas-sized RGBA AIMs, dilated (lm_aim_dilated_rgba); emissive_before: per material rgb
+ * emission before (NULL: the scene's now); surface_factor: surface_count x 3. texel_factor:
+ * a->texel_count x 3, written. set: the gather's (offset, sky). */
 void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
-                           const float *before, const float *after, const float *surface_factor, float *texel_factor);
+                           const float *before, const float *emissive_before, const float *after,
+                           const float *surface_factor, float *texel_factor);
 
 #endif

@@ -256,8 +256,8 @@ void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
  * again before the next gather. */
 static void follow_scale(lm_lightmap_path *lp)
 {
-    float *before = NULL;
-    if (!lm_photon_stage_take_scale(lp->stage, lp->scale, &before))
+    float *before = NULL, *emissive = NULL;
+    if (!lm_photon_stage_take_scale(lp->stage, lp->scale, &before, &emissive))
         return;
     lp->aim_stale = 1;
     if (lp->have_change)
@@ -267,7 +267,7 @@ static void follow_scale(lm_lightmap_path *lp)
         for (int c = 0; c < 3; c++)
             texel[3 * i + c] = lp->scale[3 * lp->atlas->texels[i].surface + c];
     if (texel && before)
-        lm_light_scale_texels(lp->scene, lp->atlas, lp->rt, &lp->set->gather, before,
+        lm_light_scale_texels(lp->scene, lp->atlas, lp->rt, &lp->set->gather, before, emissive,
                               lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->scale, texel);
     for (uint32_t i = 0; texel && i < lp->atlas->texel_count; i++) /* scaled texels are regathered in the end */
         if (texel[3 * i] != 1.0f || texel[3 * i + 1] != 1.0f || texel[3 * i + 2] != 1.0f) {
@@ -283,6 +283,7 @@ static void follow_scale(lm_lightmap_path *lp)
         lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
     free(texel);
     free(before);
+    free(emissive);
 }
 
 int lm_lightmap_path_widen(lm_lightmap_path *lp)

@@ -49,6 +49,7 @@ struct lm_photon_stage {
     int scaled;                  /* light_scale holds something other than 1 */
     float *aim_before;           /* with scaled: the dilated AIM before the first of those scalings (or NULL:
                                   * no memory for it), lm_photon_stage_take_scale's to hand on */
+    float *emissive_before;      /* with scaled: per material, the emission the photons saw before them */
     double *flux_before, *flux_after, *flux_of; /* scratch: per surface x 3 (note_scale) */
     float *factor;               /* scratch: per surface x 3, this frame's scale (apply_scale) */
     int *touched;                /* scratch: per surface, the surfaces it scaled (apply_scale) */
@@ -150,10 +151,18 @@ static lm_status take_new_emitters(lm_photon_stage *ps, int *added, lm_error *er
  * material edits), for the IIM's factors (lm_photon_stage_take_scale): at most once between takes. */
 static void keep_aim_before(lm_photon_stage *ps)
 {
-    size_t cells = 4 * (size_t)ps->atlas->width * ps->atlas->height;
-    if (!ps->scaled && (ps->aim_before = malloc(sizeof *ps->aim_before * cells)) != NULL)
-        memcpy(ps->aim_before, lm_aim_dilated_rgba(&ps->aim), sizeof *ps->aim_before * cells);
+    if (ps->scaled)
+        return;
     ps->scaled = 1;
+    size_t cells = 4 * (size_t)ps->atlas->width * ps->atlas->height;
+    if ((ps->aim_before = malloc(sizeof *ps->aim_before * cells)) != NULL)
+        memcpy(ps->aim_before, lm_aim_dilated_rgba(&ps->aim), sizeof *ps->aim_before * cells);
+    int M = ps->scene->material_count; /* the emissions the photons last saw, for the gathers before */
+    if ((ps->emissive_before = malloc(sizeof *ps->emissive_before * 3 * (size_t)(M ? M : 1))) == NULL)
+        return;
+    for (int m = 0; m < M; m++)
+        memcpy(ps->emissive_before + 3 * m, (m < ps->material_count ? ps->materials : ps->scene->materials)[m].emissive,
+               3 * sizeof *ps->emissive_before);
 }
 
 /* Whether material `now` differs from `was` in its base colour alone (rgb), both diffuse and `was` lit
@@ -193,6 +202,8 @@ static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch
     lm_photons_invalidate_materials(ps->photons, changed);
     *count = ch->materials_changed;
     int S = ps->surfaces->surface_count, M = ps->material_count, any = 0;
+    if (ps->have_aim) /* before the snapshot below takes the new emissions */
+        keep_aim_before(ps);
     for (int m = 0; m < M; m++) {
         float *r = ps->ratio + 3 * m;
         r[0] = r[1] = r[2] = 1.0f;
@@ -211,7 +222,6 @@ static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch
             ps->touched[n++] = k;
     if (!ps->have_aim || n == 0)
         return LM_OK;
-    keep_aim_before(ps);
     lm_aim_stats st;
     return lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
                                  ps->touched, n, &st, err);
@@ -232,12 +242,26 @@ static int emitters_touched(lm_photon_stage *ps, const lm_edit_changes *ch, int 
            ch->materials_changed;
 }
 
-/* Whether a punctual light's change from `was` to `now` is in power alone (its colour, intensity or
- * switch: the same place and shape), and by how much, per channel, into s. A channel that was dark and
- * is lit is not a scale: its photons carry nothing to scale (their paths are traced again). */
-static int power_alone(const lm_emitter *em, const emitter_snapshot *was, const emitter_snapshot *now, float s[3])
+/* Whether an area emitter's triangles share one material: then an edit of its emission scales every
+ * triangle's alike, and the choice of triangle by flux, so every path, stays. */
+static int one_material(const lm_scene *sc, const lm_emitter *em)
 {
-    if (!em->punctual || memcmp(was->world, now->world, sizeof now->world) || memcmp(was->pos, now->pos, sizeof now->pos) ||
+    if (em->kind != LM_EMIT_AREA || em->tri_count == 0)
+        return 0;
+    for (uint32_t i = 1; i < em->tri_count; i++)
+        if (sc->tri_material[em->tris[i]] != sc->tri_material[em->tris[0]])
+            return 0;
+    return 1;
+}
+
+/* Whether a punctual light's change from `was` to `now` is in power alone (its colour, intensity or
+ * switch: the same place and shape), or an area emitter's of one material in its emission alone, and by
+ * how much, per channel, into s. A channel that was dark and is lit is not a scale: its photons carry
+ * nothing to scale (their paths are traced again). */
+static int power_alone(const lm_scene *sc, const lm_emitter *em, const emitter_snapshot *was,
+                       const emitter_snapshot *now, float s[3])
+{
+    if (!(em->punctual || one_material(sc, em)) || memcmp(was->world, now->world, sizeof now->world) || memcmp(was->pos, now->pos, sizeof now->pos) ||
         memcmp(was->dir, now->dir, sizeof now->dir) || memcmp(was->shape, now->shape, sizeof now->shape))
         return 0;
     for (int c = 0; c < 3; c++) {
@@ -313,7 +337,7 @@ static lm_status check_emitters(lm_photon_stage *ps, int *moved, int *scaled, lm
         if (!memcmp(&now, &ps->snap[e], sizeof now))
             continue;
         float s[3];
-        int by_power = power_alone(&ps->emitters.e[e], &ps->snap[e], &now, s);
+        int by_power = power_alone(ps->scene, &ps->emitters.e[e], &ps->snap[e], &now, s);
         ps->snap[e] = now;
         if (by_power && ps->have_aim)
             note_scale(ps, e, s, !noted++);
@@ -590,6 +614,7 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->materials);
     free(ps->ratio);
     free(ps->aim_before);
+    free(ps->emissive_before);
     free(ps);
 }
 
@@ -752,7 +777,7 @@ int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out)
     return n;
 }
 
-int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before)
+int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before, float **emissive_before)
 {
     int S = ps->surfaces->surface_count, any = ps->scaled;
     for (int i = 0; i < 3 * S; i++) {
@@ -760,7 +785,8 @@ int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_befo
         ps->light_scale[i] = 1.0f;
     }
     *aim_before = ps->aim_before;
-    ps->aim_before = NULL;
+    *emissive_before = ps->emissive_before;
+    ps->aim_before = ps->emissive_before = NULL;
     ps->scaled = 0;
     return any;
 }

@@ -37,7 +37,8 @@ typedef struct {
     float time;              /* animation time, seconds */
     int emitters_moved;      /* emitters whose placement changed this frame, that were added, or lit from
                               * dark: their photons are traced again */
-    int emitters_scaled;     /* lights changed in power alone this frame, their light scaled at once
+    int emitters_scaled;     /* lights changed in power alone this frame (or emitters of one material in their
+                              * emission), their light scaled at once
                               * (lm_photon_stage_take_scale): their hits scaled, not traced again, or, turned
                               * dark, traced again to go */
     int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
@@ -82,13 +83,14 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan,
  * thread. */
 int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
 
-/* Per surface and channel (surface_count x 3 floats into out), what the lights changed in power alone
- * since the last call multiplied its light by: its AIM was scaled so in the update that saw the edit
- * (docs/tradeoff.md, "Light edits at once"); 1 where nothing changed. *aim_before: the dilated AIM before
- * those scalings (malloc'd, the caller's to free; NULL when nothing was scaled or memory ran out), from
- * which the IIM's own factors follow (update/light_scale.h). Resets them. Returns 0 when nothing was
- * scaled. Not while an update runs on another thread. */
-int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before);
+/* Per surface and channel (surface_count x 3 floats into out), what the lights and emitters changed in
+ * power alone since the last call multiplied its hits' light by (docs/tradeoff.md, "Light edits at
+ * once"); 1 where nothing changed. Those edits and material edits refreshed the AIMs they reach in the
+ * update that saw them; *aim_before is the dilated AIM before, and *emissive_before each material's
+ * emission before (material_count x 3), from which the IIM's own factors follow (update/light_scale.h):
+ * both malloc'd, the caller's to free, NULL when nothing changed or memory ran out. Resets them. Returns
+ * 0 when nothing changed. Not while an update runs on another thread. */
+int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before, float **emissive_before);
 
 /* What a time budget allows the next updates (update/budget_plan.h): invalid photon groups re-traced, the
  * AIM refresh's bound on stored hits (then any number of surfaces within it; its first surface always),

@@ -633,7 +633,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                            uint32_t count)
 {
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]},
-                  g->set.enlargement, g->set.rim_samples};
+                  g->set.enlargement, g->set.rim_samples, NULL};
 #pragma omp parallel num_threads(g->cpu_threads) if (g->cpu_threads > 1)
     {
         lm_rt_thread_init(); /* FTZ/DAZ as on this thread: the same numbers on any thread */
@@ -694,7 +694,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
     if (!rim_ready(g))
         return lm_fail(err, LM_ERR_INVALID, "ray gather: it needs the scene's tracer (lm_gather_set_tracer)");
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]}, 0.0f,
-                  g->set.ray_samples};
+                  g->set.ray_samples, NULL};
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
     glBindTexture(GL_TEXTURE_2D, iim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
