@@ -8,7 +8,8 @@
  *     f(texel) = E_after / E_before   per channel (photonmap/hemicube_rim.h with the whole hemisphere)
  *
  * a mean of the seen surfaces' factors weighed by how much light each brings (emitters and the sky, which
- * the edit did not change, weigh in with 1). Both gathers meet the same points, so the ratio is far less
+ * the edit did not change, weigh in with 1), summed over the texel's neighbours on its surface
+ * (LM_LIGHT_SCALE_SPREAD). Both gathers meet the same points, so the ratio is far less
  * noisy than either: in a scene lit by one emitter every factor is the light's own and the IIM is
  * exact at once; where several light the seen surfaces in different proportions it is a first guess
  * that the regathers the scaled hits call for refine. A texel whose rays met no light before takes its
@@ -33,6 +34,12 @@
  * (the edge of a closed door lit from the far room), and rewriting it would cost an engine a re-read and
  * the schedule a regather for nothing visible (lmgi bench --edits, "outside its reach"). */
 #define LM_LIGHT_SCALE_KEEP 1e-3f
+/* Texels either side a texel's factor sums its surface's gathers over (1: a 3 x 3 window). One texel's 16
+ * rays left the factor noisy where a large change fills part of its view: the Cornell box's red wall
+ * recoloured blue read 0.050 from a fresh updater's lightmap at the next update, blotched; summed over
+ * 3 x 3 texels 0.0215, over 5 x 5 0.024 and 7 x 7 0.031 (the factor's own change across them); the shared
+ * room's lamp dimmed 0.018, 0.017, 0.019 and 0.021. */
+#define LM_LIGHT_SCALE_SPREAD 1
 
 /* before, after: atlas-sized RGBA AIMs, dilated (lm_aim_dilated_rgba); emissive_before: per material rgb
  * emission before (NULL: the scene's now); surface_factor: surface_count x 3. texel_factor:
