@@ -538,6 +538,37 @@ static void test_one_light_at_once(void **state)
     unsettle(&r);
 }
 
+/* The same on an atlas past LM_LIGHT_SCALE_WORK / 4 texels, where only every stride-th texel gathers its
+ * factor and the others sum their neighbours' (light_scale.h): still a fresh updater's at once. */
+static void test_large_atlas_at_once(void **state)
+{
+    (void)state;
+    lmt_room_spec spec = {.lights = &LAMP, .light_count = 1, .texel_size = 0.07f};
+    lmgi_context *ctx = lmt_context();
+    lmgi_scene *sc = lmt_room(&spec);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    assert_true(in.texels > 8192);
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    lmt_updates(u, 2);
+    edit_light(sc, 0, 0.4f, NULL, 1);
+    update_scaling(u, 1, 0);
+    size_t n;
+    float *now = lmt_iim(u, sc, &n);
+    lmgi_updater_free(u);
+    u = lmt_room_updater(ctx, sc);
+    lmt_updates(u, 2);
+    float *want = lmt_iim(u, sc, &n);
+    double at_once = lmt_relative_l1(now, want, n);
+    print_message("%u texels, lamp dimmed: lightmap against a fresh updater's %.3g at the next update\n", in.texels,
+                  at_once);
+    assert_true(at_once < 1e-4);
+    free(now), free(want);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* Lit by a warm lamp and a blue spot, one of them dimmed (or switched off): at the next update the
  * lightmap has made most of the way to what the same photons give once every surface is regathered (a bake
  * with the shares of creation kept). */
@@ -648,6 +679,7 @@ int main(void)
         cmocka_unit_test(test_still_room_traces_nothing),
         cmocka_unit_test(test_added_light_stays_in_its_room),
         cmocka_unit_test(test_one_light_at_once),
+        cmocka_unit_test(test_large_atlas_at_once),
         cmocka_unit_test(test_two_lights_first_guess),
         cmocka_unit_test(test_switched_off),
         cmocka_unit_test(test_recolour_at_once),

@@ -22,30 +22,32 @@ static void gathers(const lm_scene *s, const lm_atlas *a, const lm_hemicube_sett
     lm_rim_irradiance(now, eye, b, t, n, ng, i, e1, NULL);
 }
 
-/* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within LM_LIGHT_SCALE_SPREAD
- * of it that gathered (done), a ratio that varies slowly over a surface and is far less noisy summed; 1
- * where they see no light either way, or where it is within LM_LIGHT_SCALE_KEEP of 1; its surface's where
- * they saw none before. */
-static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done,
+/* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within `spread` of it
+ * that gathered (done), a ratio that varies slowly over a surface and is far less noisy summed; 1 where
+ * they see no light either way, or where it is within LM_LIGHT_SCALE_KEEP of 1; its surface's where they
+ * saw none before, or where none of them gathered. */
+static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, int spread,
                         const float *surface_factor, uint32_t i, float *out)
 {
     const lm_texel *t = &a->texels[i];
     double s0[3] = {0, 0, 0}, s1[3] = {0, 0, 0};
-    for (int dy = -LM_LIGHT_SCALE_SPREAD; dy <= LM_LIGHT_SCALE_SPREAD; dy++)
-        for (int dx = -LM_LIGHT_SCALE_SPREAD; dx <= LM_LIGHT_SCALE_SPREAD; dx++) {
+    int met = 0;
+    for (int dy = -spread; dy <= spread; dy++)
+        for (int dx = -spread; dx <= spread; dx++) {
             int x = (int)t->x + dx, y = (int)t->y + dy;
             if (x < 0 || y < 0 || x >= a->width || y >= a->height)
                 continue;
             int q = a->texel_index[(size_t)y * a->width + x];
             if (q < 0 || !done[q] || a->texels[q].surface != t->surface)
                 continue;
+            met++;
             for (int c = 0; c < 3; c++)
                 s0[c] += e0[3 * (size_t)q + c], s1[c] += e1[3 * (size_t)q + c];
         }
     const float *own = surface_factor + 3 * t->surface;
     int keep = 1;
-    for (int c = 0; c < 3; c++) {
-        float f = s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : s1[c] > 0.0 ? own[c] : 1.0f;
+    for (int c = 0; c < 3; c++) { /* no neighbour gathered (a large atlas's strides): its surface's */
+        float f = !met ? own[c] : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : s1[c] > 0.0 ? own[c] : 1.0f;
         out[c] = isfinite(f) && f >= 0.0f ? f : own[c];
         keep &= fabsf(out[c] - 1.0f) < LM_LIGHT_SCALE_KEEP;
     }
@@ -55,15 +57,19 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
 
 void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
                            const float *before, const float *emissive_before, const float *after,
-                           const float *surface_factor, float *texel_factor)
+                           const float *surface_factor, uint32_t work, float *texel_factor)
 {
     uint32_t T = a->texel_count;
     if (T == 0)
         return;
-    uint32_t K = LM_LIGHT_SCALE_WORK / T, stride = 1;
+    work = work ? work : LM_LIGHT_SCALE_WORK;
+    uint32_t K = work / T, stride = 1;
     if (K < 4) /* the fewest rays a texel still reads a ratio from; past that, every stride-th texel */
-        K = 4, stride = (4 * T + LM_LIGHT_SCALE_WORK - 1) / LM_LIGHT_SCALE_WORK;
+        K = 4, stride = (uint32_t)(((uint64_t)4 * T + work - 1) / work);
     K = K > 64 ? 64 : K;
+    int spread = LM_LIGHT_SCALE_SPREAD; /* wide enough to hold about one texel that gathered */
+    while ((uint32_t)((2 * spread + 1) * (2 * spread + 1)) < 2 * stride)
+        spread++;
     float *e = malloc(sizeof *e * 6 * (size_t)T);
     uint8_t *done = calloc(T, 1);
     if (!e || !done) { /* no memory: each texel as its surface's hits */
@@ -90,7 +96,7 @@ void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt
                 gathers(s, a, set, &was, &now, (uint32_t)i, e + 3 * (size_t)i, e + 3 * ((size_t)T + (size_t)i));
 #pragma omp for schedule(static)
         for (long i = 0; i < (long)T; i++)
-            texel_ratio(a, e, e + 3 * (size_t)T, done, surface_factor, (uint32_t)i, texel_factor + 3 * i);
+            texel_ratio(a, e, e + 3 * (size_t)T, done, spread, surface_factor, (uint32_t)i, texel_factor + 3 * i);
     }
     free(e);
     free(done);

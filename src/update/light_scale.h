@@ -18,8 +18,8 @@
  * Cost: two gathers of K rays a texel, each ray with its 16 AIM lookups (K = LM_LIGHT_SCALE_WORK / texels
  * rounded down to a square, at most 64: 16 at `run`'s 1,800 texels), on every OpenMP thread, once, in the
  * update that sees the edit (34 ms on the shared room at 1,800 texels, 2 cores). Past LM_LIGHT_SCALE_WORK / 4
- * texels only every stride-th gathers with K = 4, and the texels between take the factor of the one
- * before them on their surface: the work stays bounded on any atlas. Errors: none (deterministic: each
+ * texels only every stride-th gathers with K = 4, and each texel sums over a window wide enough to hold
+ * about two that did (its surface's factor where it holds none): the work stays bounded on any atlas. Errors: none (deterministic: each
  * texel's rays are seeded by its index). Thread-safe as the tracer is. */
 #ifndef LM_LIGHT_SCALE_H
 #define LM_LIGHT_SCALE_H
@@ -42,10 +42,11 @@
 #define LM_LIGHT_SCALE_SPREAD 1
 
 /* before, after: atlas-sized RGBA AIMs, dilated (lm_aim_dilated_rgba); emissive_before: per material rgb
- * emission before (NULL: the scene's now); surface_factor: surface_count x 3. texel_factor:
- * a->texel_count x 3, written. set: the gather's (offset, sky). */
+ * emission before (NULL: the scene's now); surface_factor: surface_count x 3; work: rays a gather takes at
+ * most (0: LM_LIGHT_SCALE_WORK). texel_factor: a->texel_count x 3, written. set: the gather's (offset,
+ * sky). */
 void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
                            const float *before, const float *emissive_before, const float *after,
-                           const float *surface_factor, float *texel_factor);
+                           const float *surface_factor, uint32_t work, float *texel_factor);
 
 #endif

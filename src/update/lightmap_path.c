@@ -268,7 +268,7 @@ static void follow_scale(lm_lightmap_path *lp)
             texel[3 * i + c] = lp->scale[3 * lp->atlas->texels[i].surface + c];
     if (texel && before)
         lm_light_scale_texels(lp->scene, lp->atlas, lp->rt, &lp->set->gather, before, emissive,
-                              lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->scale, texel);
+                              lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->scale, 0, texel);
     for (uint32_t i = 0; texel && i < lp->atlas->texel_count; i++) /* scaled texels are regathered in the end */
         if (texel[3 * i] != 1.0f || texel[3 * i + 1] != 1.0f || texel[3 * i + 2] != 1.0f) {
             int k = lp->atlas->texels[i].surface;
