@@ -29,7 +29,7 @@ struct lm_lightmap_path {
     int have_emitters;
     uint32_t *texels;          /* scratch: the scheduled texels (atlas texel_count) */
     uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule */
-    float *scale;              /* scratch: per surface x 3, lights' power edits (lm_photon_stage_take_scale) */
+    float *scale;              /* scratch: per surface x 3, what power edits scaled (lm_photon_stage_take_scale) */
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
@@ -251,9 +251,9 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
 
 void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
 
-/* Lights changed in power alone since the last call: each IIM texel scaled by its own factor
- * (light_scale.h; its surface's where that cannot be had), shown at the next blend, and the AIM uploaded
- * again before the next gather. */
+/* Lights or emitters changed in power alone, or materials edited, since the last call: each IIM texel
+ * scaled by its own factor (light_scale.h; its surface's where that cannot be had), shown at the next
+ * blend, and the AIM uploaded again before the next gather. */
 static void follow_scale(lm_lightmap_path *lp)
 {
     float *before = NULL, *emissive = NULL;
