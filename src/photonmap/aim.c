@@ -279,7 +279,6 @@ void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover)
 const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
 const float *lm_aim_dilated_rgba(const lm_aim *aim) { return aim->dilated; }
 
-
 /* ---------- the node's transform ---------- */
 
 typedef struct {

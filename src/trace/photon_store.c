@@ -105,9 +105,9 @@ uint32_t lm_photon_store_add(lm_photon_store *ps, const lm_hit *h)
 
 void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
 {
-    if (slot >= ps->used || ps->hits[slot].surface < 0) /* not a live hit: nothing to unlink */
+    lm_hit *d = lm_photon_store_live(ps, slot);
+    if (!d) /* not a live hit: nothing to unlink */
         return;
-    lm_hit *d = &ps->hits[slot];
     lm_surface_hits *sh = &ps->surfaces[d->surface];
     uint32_t last = sh->slots[--sh->count]; /* the last takes its place */
     sh->slots[d->at] = last;
@@ -121,9 +121,9 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
 
 void lm_photon_store_scale(lm_photon_store *ps, uint32_t slot, const float s[3])
 {
-    if (slot >= ps->used || ps->hits[slot].surface < 0)
+    lm_hit *h = lm_photon_store_live(ps, slot);
+    if (!h)
         return;
-    lm_hit *h = &ps->hits[slot];
     double before = lm_hit_energy(h);
     for (int c = 0; c < 3; c++)
         h->flux[c] *= s[c];

@@ -112,6 +112,13 @@ int lm_photon_store_same(const lm_photon_store *a, const lm_photon_store *b);
 /* Bytes held per stored hit slot (for the memory report). */
 size_t lm_photon_store_bytes(const lm_photon_store *ps);
 
+/* The hit in `slot` when it is live (linked on a surface), else NULL: a path vertex's slot may be LM_NONE
+ * (specular) or freed since. */
+static inline lm_hit *lm_photon_store_live(const lm_photon_store *ps, uint32_t slot)
+{
+    return slot < ps->used && ps->hits[slot].surface >= 0 ? &ps->hits[slot] : NULL;
+}
+
 /* ---- inline: applying a traced batch claims and links every stored hit ---- */
 
 uint32_t lm_photon_store_grow_slot(lm_photon_store *ps); /* take_slot's rare path (photon_store.c) */

@@ -327,13 +327,12 @@ static void emitter_hits(lm_photons *ph, int e, const float s[3], double *flux)
         const ph_group *g = &ph->groups[i];
         for (uint32_t v = 0; g->offsets && v < g->offsets[g->photons]; v++) {
             uint32_t slot = g->verts[v].slot;
-            if (slot == LM_NONE || slot >= ph->store.used || ph->store.hits[slot].surface < 0)
-                continue;
-            if (s)
+            const lm_hit *h = lm_photon_store_live(&ph->store, slot);
+            if (h && s)
                 lm_photon_store_scale(&ph->store, slot, s);
-            else
+            else if (h)
                 for (int c = 0; c < 3; c++)
-                    flux[3 * ph->store.hits[slot].surface + c] += ph->store.hits[slot].flux[c];
+                    flux[3 * h->surface + c] += h->flux[c];
         }
     }
 }
@@ -437,8 +436,9 @@ void lm_photons_scale_materials(lm_photons *ph, const float *ratio, int material
             int any = 0;
             for (uint32_t i = g->offsets[m]; i < g->offsets[m + 1]; i++) {
                 const lm_path_vertex *v = &g->verts[i];
-                if (any && v->slot != LM_NONE && v->slot < ph->store.used && ph->store.hits[v->slot].surface >= 0) {
-                    touched[ph->store.hits[v->slot].surface] = 1;
+                const lm_hit *h = any ? lm_photon_store_live(&ph->store, v->slot) : NULL;
+                if (h) {
+                    touched[h->surface] = 1;
                     lm_photon_store_scale(&ph->store, v->slot, w);
                 }
                 int mat = tri_material[v->tri];

@@ -147,8 +147,8 @@ lm_status lm_photons_scale_emitter(lm_photons *ph, int e, const float s[3], lm_e
  * for an out-of-range emitter or when memory runs out. */
 lm_status lm_photons_retrace_emitter(lm_photons *ph, int e, lm_error *err);
 /* Diffuse materials recoloured (their base colour alone changed, by ratio[3 m + c] per channel for the
- * first `materials` materials; 1 for the others): every stored hit a photon brings after bouncing off one is multiplied by the ratios of the
- * bounces before it, and touched[surface] set for its surface. A path's later decisions follow albedos
+ * first `materials` materials; 1 for the others): every stored hit a photon brings after bouncing off one
+ * is multiplied by the ratios of the bounces before it, and touched[surface] set for its surface. A path's later decisions follow albedos
  * through the survival probability, which the old colour set: the old path with the new weight is an
  * unbiased estimate of the new light (importance sampling), noisier where a ratio is large, until the
  * groups are traced again (lm_photons_invalidate_materials). O(path vertices), no ray. */

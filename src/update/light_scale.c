@@ -57,26 +57,25 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
 
 void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
                            const float *before, const float *emissive_before, const float *after,
-                           const float *surface_factor, uint32_t work, float *texel_factor)
+                           const float *surface_factor, float *texel_factor)
 {
     uint32_t T = a->texel_count;
     if (T == 0)
         return;
-    work = work ? work : LM_LIGHT_SCALE_WORK;
-    uint32_t K = work / T, stride = 1;
+    uint32_t K = LM_LIGHT_SCALE_WORK / T, stride = 1;
     if (K < 4) /* the fewest rays a texel still reads a ratio from; past that, every stride-th texel */
-        K = 4, stride = (uint32_t)(((uint64_t)4 * T + work - 1) / work);
+        K = 4, stride = (4 * T + LM_LIGHT_SCALE_WORK - 1) / LM_LIGHT_SCALE_WORK;
     K = K > 64 ? 64 : K;
-    int spread = LM_LIGHT_SCALE_SPREAD; /* wide enough to hold about one texel that gathered */
+    int spread = LM_LIGHT_SCALE_SPREAD; /* wide enough to hold about two texels that gathered */
     while ((uint32_t)((2 * spread + 1) * (2 * spread + 1)) < 2 * stride)
         spread++;
-    float *e = malloc(sizeof *e * 6 * (size_t)T);
-    uint8_t *done = calloc(T, 1);
-    if (!e || !done) { /* no memory: each texel as its surface's hits */
+    float *e = before ? malloc(sizeof *e * 6 * (size_t)T) : NULL;
+    uint8_t *done = e ? calloc(T, 1) : NULL;
+    if (!done) { /* no AIM from before, or no memory: each texel as its surface's hits */
         for (uint32_t i = 0; i < T; i++)
             for (int c = 0; c < 3; c++)
                 texel_factor[3 * i + c] = surface_factor[3 * a->texels[i].surface + c];
-        free(e), free(done);
+        free(e);
         return;
     }
     lm_rim was = {s, a, rt, before, 1, {set->sky[0], set->sky[1], set->sky[2]}, 0.0f, (int)K, emissive_before};
@@ -86,7 +85,7 @@ void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt
     now.aim = after;
     now.emissive = NULL;
     for (uint32_t i = 0; i < T; i++) /* a surface's first texel gathers too: its surface then has one */
-        done[i] = i % stride == 0 || i == 0 || a->texels[i].surface != a->texels[i - 1].surface;
+        done[i] = i % stride == 0 || a->texels[i].surface != a->texels[i - 1].surface;
 #pragma omp parallel
     {
         lm_rt_thread_init();

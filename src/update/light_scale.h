@@ -41,12 +41,12 @@
  * room's lamp dimmed 0.018, 0.017, 0.019 and 0.021. */
 #define LM_LIGHT_SCALE_SPREAD 1
 
-/* before, after: atlas-sized RGBA AIMs, dilated (lm_aim_dilated_rgba); emissive_before: per material rgb
- * emission before (NULL: the scene's now); surface_factor: surface_count x 3; work: rays a gather takes at
- * most (0: LM_LIGHT_SCALE_WORK). texel_factor: a->texel_count x 3, written. set: the gather's (offset,
+/* before, after: atlas-sized RGBA AIMs, dilated (lm_aim_dilated_rgba; before NULL: each texel takes its
+ * surface's factor); emissive_before: per material rgb emission before (NULL: the scene's now);
+ * surface_factor: surface_count x 3. texel_factor: a->texel_count x 3, written. set: the gather's (offset,
  * sky). */
 void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
                            const float *before, const float *emissive_before, const float *after,
-                           const float *surface_factor, uint32_t work, float *texel_factor);
+                           const float *surface_factor, float *texel_factor);
 
 #endif

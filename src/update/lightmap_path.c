@@ -28,7 +28,8 @@ struct lm_lightmap_path {
     lm_emitter_light emitters; /* with have_emitters: the gather's closed-form emitter light */
     int have_emitters;
     uint32_t *texels;          /* scratch: the scheduled texels (atlas texel_count) */
-    uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule */
+    uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule (before that,
+                                * in follow_scale, whether its texels were scaled) */
     float *scale;              /* scratch: per surface x 3, what power edits scaled (lm_photon_stage_take_scale) */
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
@@ -263,24 +264,19 @@ static void follow_scale(lm_lightmap_path *lp)
     if (lp->have_change)
         lm_texel_change_scale(&lp->change, lp->atlas, lp->scale);
     float *texel = lp->have_iim ? malloc(sizeof *texel * 3 * ((size_t)lp->atlas->texel_count + 1)) : NULL;
-    for (uint32_t i = 0; texel && !before && i < lp->atlas->texel_count; i++)
-        for (int c = 0; c < 3; c++)
-            texel[3 * i + c] = lp->scale[3 * lp->atlas->texels[i].surface + c];
-    if (texel && before)
+    if (texel)
         lm_light_scale_texels(lp->scene, lp->atlas, lp->rt, &lp->set->gather, before, emissive,
-                              lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->scale, 0, texel);
-    for (uint32_t i = 0; texel && i < lp->atlas->texel_count; i++) /* scaled texels are regathered in the end */
-        if (texel[3 * i] != 1.0f || texel[3 * i + 1] != 1.0f || texel[3 * i + 2] != 1.0f) {
-            int k = lp->atlas->texels[i].surface;
-            if (!(store_of(lp)->surfaces[k].delta_i > lp->iim.sched.delta_threshold))
-                lm_iim_sched_raise(&lp->iim.sched, store_of(lp), k);
-        }
+                              lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->scale, texel);
     lm_error e;
+    uint8_t *scaled = lp->refreshed; /* scratch until lm_lightmap_path_widen takes the refreshed surfaces */
     if (!texel && lp->have_iim)
         lm_log(LM_LOG_WARN, "%s: no memory to scale the lightmap after a light's edit: it follows by regathers",
                lp->scene->path);
-    else if (texel && lm_iim_scale(&lp->iim, lp->atlas, texel, &e) != LM_OK)
+    else if (texel && lm_iim_scale(&lp->iim, lp->atlas, texel, scaled, &e) != LM_OK)
         lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
+    for (int k = 0; texel && k < lp->surfaces->surface_count; k++) /* scaled texels are regathered in the end */
+        if (scaled[k] && !(store_of(lp)->surfaces[k].delta_i > lp->iim.sched.delta_threshold))
+            lm_iim_sched_raise(&lp->iim.sched, store_of(lp), k);
     free(texel);
     free(before);
     free(emissive);

@@ -51,7 +51,6 @@ struct lm_photon_stage {
                                   * no memory for it), lm_photon_stage_take_scale's to hand on */
     float *emissive_before;      /* with scaled: per material, the emission the photons saw before them */
     double *flux_before, *flux_after, *flux_of; /* scratch: per surface x 3 (note_scale) */
-    float *factor;               /* scratch: per surface x 3, this frame's scale (apply_scale) */
     int *touched;                /* scratch: per surface, the surfaces it scaled (apply_scale) */
     uint8_t *reached;            /* scratch: per surface, reweighted photons reach it (follow_materials) */
     lm_material *materials;      /* the scene's materials as the photons last saw them (material_count) */
@@ -261,8 +260,9 @@ static int one_material(const lm_scene *sc, const lm_emitter *em)
 static int power_alone(const lm_scene *sc, const lm_emitter *em, const emitter_snapshot *was,
                        const emitter_snapshot *now, float s[3])
 {
-    if (!(em->punctual || one_material(sc, em)) || memcmp(was->world, now->world, sizeof now->world) || memcmp(was->pos, now->pos, sizeof now->pos) ||
-        memcmp(was->dir, now->dir, sizeof now->dir) || memcmp(was->shape, now->shape, sizeof now->shape))
+    if (!(em->punctual || one_material(sc, em)) || memcmp(was->world, now->world, sizeof now->world) ||
+        memcmp(was->pos, now->pos, sizeof now->pos) || memcmp(was->dir, now->dir, sizeof now->dir) ||
+        memcmp(was->shape, now->shape, sizeof now->shape))
         return 0;
     for (int c = 0; c < 3; c++) {
         if (!(was->power[c] > 0.0f))
@@ -310,7 +310,6 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
             if (!(b > 0.0) && ps->set.exact_direct == 2) /* its AIM may hold the lights' direct light alone */
                 b = all_before[c], a = all_after[c];
             float f = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
-            ps->factor[3 * k + c] = f;
             ps->light_scale[3 * k + c] *= f;
             changed |= f != 1.0f;
         }
@@ -343,7 +342,7 @@ static lm_status check_emitters(lm_photon_stage *ps, int *moved, int *scaled, lm
             note_scale(ps, e, s, !noted++);
         *scaled += by_power;
         *moved += !by_power;
-        lm_status st = !by_power                                  ? lm_photons_invalidate_emitter(ps->photons, e, err)
+        lm_status st = !by_power ? lm_photons_invalidate_emitter(ps->photons, e, err)
                        : ps->emitters.e[e].luminance > 0.0f ? lm_photons_scale_emitter(ps->photons, e, s, err)
                                                             : lm_photons_retrace_emitter(ps->photons, e, err);
         if (st != LM_OK)
@@ -516,7 +515,6 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     ps->flux_before = malloc(3 * S * sizeof *ps->flux_before);
     ps->flux_after = malloc(3 * S * sizeof *ps->flux_after);
     ps->flux_of = malloc(3 * S * sizeof *ps->flux_of);
-    ps->factor = malloc(3 * S * sizeof *ps->factor);
     ps->touched = malloc(S * sizeof *ps->touched);
     ps->reached = malloc(S);
     ps->material_count = ps->scene->material_count;
@@ -527,8 +525,8 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         memcpy(ps->materials, ps->scene->materials, (M - 1) * sizeof *ps->materials);
     for (size_t i = 0; ps->light_scale && i < 3 * S; i++)
         ps->light_scale[i] = 1.0f;
-    if (!ps->factor || !ps->touched || !ps->reached || !ps->materials || !ps->ratio || !ps->refreshed || !ps->delta_before || !ps->count_before || !ps->light_scale || !ps->flux_before ||
-        !ps->flux_after || !ps->flux_of)
+    if (!ps->refreshed || !ps->delta_before || !ps->count_before || !ps->light_scale || !ps->flux_before ||
+        !ps->flux_after || !ps->flux_of || !ps->touched || !ps->reached || !ps->materials || !ps->ratio)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     st = make_photons(ps, &ps->photons, err);
     if (st == LM_OK)
@@ -608,7 +606,6 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->flux_before);
     free(ps->flux_after);
     free(ps->flux_of);
-    free(ps->factor);
     free(ps->touched);
     free(ps->reached);
     free(ps->materials);

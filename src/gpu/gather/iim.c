@@ -261,14 +261,13 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     return lm_gl_check("IIM blend (iim_blend)", err);
 }
 
-lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, lm_error *err)
+lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, uint8_t *scaled, lm_error *err)
 {
-    uint8_t *touch = iim->active; /* scratch: lm_iim_blend fills it afresh */
-    memset(touch, 0, (size_t)iim->sched.surface_count);
+    memset(scaled, 0, (size_t)iim->sched.surface_count);
     for (uint32_t i = 0; i < a->texel_count; i++)
-        touch[a->texels[i].surface] |= factor[3 * i] != 1.0f || factor[3 * i + 1] != 1.0f || factor[3 * i + 2] != 1.0f;
+        scaled[a->texels[i].surface] |= factor[3 * i] != 1.0f || factor[3 * i + 1] != 1.0f || factor[3 * i + 2] != 1.0f;
     for (int k = 0; k < iim->sched.surface_count; k++)
-        iim->version[k] += touch[k];
+        iim->version[k] += scaled[k];
     if (!iim->blend_prog)
         return LM_OK;
     if (!iim->scale_prog) {

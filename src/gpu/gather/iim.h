@@ -89,8 +89,9 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
 /* Every texel i of the atlas, in every map (fresh, old, new, displayed, its change and what its estimate
  * carries), multiplied by factor[3 i + c] per channel (a->texel_count x 3 floats; alpha stays): a light
  * changed in power alone shows at once (update/light_scale.h). Each surface with a texel scaled moves its
- * version. Without GL only the versions move. */
-lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, lm_error *err);
+ * version and has scaled[k] set (surface_count bytes, written before anything can fail). Without GL only
+ * the versions move. */
+lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, uint8_t *scaled, lm_error *err);
 
 /* Every IIM texture (fresh, old, new, displayed, the changes) set to 0: a scene that lost its last light shows no
  * indirect light at once, not the last gather's. */
