@@ -483,11 +483,19 @@ typedef enum {
     LMGI_INDIRECT_TILED,
     LMGI_INDIRECT_HASHGRID
 } lmgi_indirect_path;
-/* Where the approximate illumination maps (docs/aim.md) get direct light. PHOTONS: photon first hits bring it
- * all (the paper's form: blurred across shadow edges by the photon estimate's radius); EMITTERS: emissive
- * triangles' light computed per texel (closed form, sampled shadows) where the gather's closed form suits
- * the scene, photons bringing the rest (sharp contact shadows); ALL: punctual lights' too. */
-typedef enum { LMGI_AIM_DIRECT_PHOTONS = 0, LMGI_AIM_DIRECT_EMITTERS, LMGI_AIM_DIRECT_ALL } lmgi_aim_direct;
+/* Where the approximate illumination maps (docs/aim.md) get direct light. SUNS (the default): directional
+ * lights' computed per texel by shadow rays, photons bringing the rest (a sun's photons are spread over the
+ * whole scene, a large level's ground included, so its direct light is the first to starve); PHOTONS: photon
+ * first hits bring it all (the paper's form: blurred across shadow edges by the photon estimate's radius);
+ * EMITTERS: emissive triangles' light computed per texel (closed form, sampled shadows) where the gather's
+ * closed form suits the scene, photons bringing the rest (sharp contact shadows); ALL: emissive triangles'
+ * and every punctual light's. */
+typedef enum {
+    LMGI_AIM_DIRECT_SUNS = 0,
+    LMGI_AIM_DIRECT_EMITTERS,
+    LMGI_AIM_DIRECT_ALL,
+    LMGI_AIM_DIRECT_PHOTONS
+} lmgi_aim_direct;
 
 /* The updater's tuning knobs, stage by stage: one struct per stage, made from the knob table
  * (lmgi_knobs.h, which gives each knob's range, default, meaning of LMGI_OFF and help). 0 is always the

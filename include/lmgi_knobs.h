@@ -66,7 +66,7 @@ static inline int lmgi_knob_is_pow2(double v)
 
 #define LMGI_NO_CHOICES(Y)
 #define LMGI_AIM_DIRECT_CHOICES(Y)                                                                                    \
-    Y("emitters", LMGI_AIM_DIRECT_EMITTERS) Y("photons", LMGI_AIM_DIRECT_PHOTONS) Y("all", LMGI_AIM_DIRECT_ALL)
+    Y("suns", LMGI_AIM_DIRECT_SUNS) Y("emitters", LMGI_AIM_DIRECT_EMITTERS) Y("photons", LMGI_AIM_DIRECT_PHOTONS) Y("all", LMGI_AIM_DIRECT_ALL)
 #define LMGI_GATHER_SCHEME_CHOICES(Y)                                                                                 \
     Y("viewports", LMGI_GATHER_VIEWPORTS) Y("instanced", LMGI_GATHER_INSTANCED) Y("layered", LMGI_GATHER_LAYERED)     \
     Y("rays", LMGI_GATHER_RAYS)
@@ -123,13 +123,14 @@ static inline int lmgi_knob_is_pow2(double v)
       "within it is summed; smaller makes the AIM sharper and noisier (docs/aim.md)")                             \
     X(aim, surfaces_per_frame, LMGI_KNOB_INT, int, 4, 1, 10000000, 1, LMGI_NO_RULE, "--surfaces-per-frame", "K",  \
       LMGI_CLI_ZERO_DEFAULT, LMGI_NO_CHOICES, LMGI_NO_SWEEP, "AIM refreshes a frame (default 4)")                 \
-    X(aim, direct, LMGI_KNOB_CHOICE, lmgi_aim_direct, LMGI_AIM_DIRECT_PHOTONS, 0, 0, 0, LMGI_NO_RULE,             \
+    X(aim, direct, LMGI_KNOB_CHOICE, lmgi_aim_direct, LMGI_AIM_DIRECT_SUNS, 0, 0, 0, LMGI_NO_RULE,                \
       "--aim-direct", "M", LMGI_CLI_ZERO_NONE, LMGI_AIM_DIRECT_CHOICES,                                           \
-      LMGI_SWEEP(10, "aim_direct", "AIM direct light (0 photons, 1 emitters)", (0, 1), (0, 1), 0),               \
-      "where the AIMs' direct light comes from: photons (the default: first\n"                                    \
-      "hits, the paper's form, blurred by the estimate's radius), emitters\n"                                     \
-      "(emissive triangles' light computed per texel: sharp contact shadows,\n"                                   \
-      "about 5x slower AIMs) or all (punctual lights' too)")                                                       \
+      LMGI_SWEEP(10, "aim_direct", "AIM direct light (0 suns, 3 photons, 1 emitters)", (0, 3, 1), (0, 3), 0),    \
+      "where the AIMs' direct light comes from: suns (the default: directional\n"                                \
+      "lights' computed per texel by shadow rays, photons bring the rest),\n"                                     \
+      "photons (first hits, the paper's form, blurred by the estimate's\n"                                       \
+      "radius), emitters (emissive triangles' light computed per texel: sharp\n"                                  \
+      "contact shadows, about 5x slower AIMs) or all (every light's)")                                             \
     X(aim, occluders, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, "--aim-occluders", "on|off",         \
       LMGI_CLI_ZERO_NONE, LMGI_ON_OFF_CHOICES,                                                                     \
       LMGI_SWEEP(16, "aim_occluders", "AIM hits seen from the texel (0 off, 1 on)", (0, 1), (), 0),           \

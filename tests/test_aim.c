@@ -480,7 +480,7 @@ static uint32_t aim_beside_wall(int occluders, int threads, float **xz_out, floa
     lm_aim_settings_default(&set);
     init_aim(&aim, &t, &set);
     if (occluders)
-        lm_aim_set_occluders(&aim, rt, 1e-4f * 4.0f, 0.05f);
+        lm_aim_set_occluders(&aim, rt, 1e-4f * 4.0f, 0.05f, NULL);
     int before = omp_get_max_threads();
     omp_set_num_threads(threads);
     assert_int_equal(lm_aim_refresh_all(&aim, t.s, &t.su, &t.a, &ps, NULL, NULL), LM_OK);

@@ -126,7 +126,7 @@ static void test_point_light_shadow_edge(void **state)
     lm_aim aim;
     lm_error err;
     assert_int_equal(lm_aim_init(&aim, p.s, &p.su, &p.atlas, &set, &err), LM_OK);
-    lm_direct_light d = {p.s, p.rt, &p.em, NULL, 1, 1e-5f, 0.05f};
+    lm_direct_light d = {p.s, p.rt, &p.em, NULL, LM_DIRECT_PUNCTUAL, 1e-5f, 0.05f, NULL};
     lm_aim_set_direct(&aim, &d);
     assert_int_equal(lm_aim_refresh_all(&aim, p.s, &p.su, &p.atlas, &ps, NULL, &err), LM_OK);
     double worst = 0.0, worst_edge = 0.0;
@@ -196,7 +196,7 @@ static void test_lamp_under_ceiling(void **state)
     lm_aim_settings_default(&set);
     lm_aim aim;
     assert_int_equal(lm_aim_init(&aim, p.s, &p.su, &p.atlas, &set, &err), LM_OK);
-    lm_direct_light d = {p.s, p.rt, &p.em, &el, 0, 1e-5f, 0.05f};
+    lm_direct_light d = {p.s, p.rt, &p.em, &el, LM_DIRECT_NONE, 1e-5f, 0.05f, NULL};
     lm_aim_set_direct(&aim, &d);
     assert_int_equal(lm_aim_refresh_all(&aim, p.s, &p.su, &p.atlas, &ps, NULL, &err), LM_OK);
     int above = 0, floor_texels = 0;
@@ -240,18 +240,15 @@ static void test_lamp_under_ceiling(void **state)
 }
 
 /* The updater's choice (lmgi_updater_desc.aim_direct) on the edit room, lit by a point light only:
- * EMITTERS computes emissive triangles' light, and the room has none, so its AIM is the default's (the
- * paper's) to the bit; ALL computes the lamp's light too, and the AIM changes; a value out of range is
+ * EMITTERS computes emissive triangles' light, and the room has none, and SUNS (the default) directional
+ * lights', and it has none, so either AIM is the paper's to the bit; ALL computes the lamp's light too, and the AIM changes; a value out of range is
  * refused. */
-static float *room_aim_with(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, int occluders, size_t *n)
+/* The AIM (atlas-sized RGBA, malloc'd; *n floats) of a fresh updater with desc d. */
+static float *aim_of(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *d, size_t *n)
 {
-    lmgi_updater_desc d;
-    lmt_room_desc(&d);
-    d.aim.direct = mode;
-    d.aim.occluders = occluders;
     lmgi_updater *u = NULL;
     lmgi_error e;
-    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+    if (lmgi_updater_create(ctx, sc, d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     lmgi_info in;
     lmgi_get_info(sc, &in);
@@ -261,6 +258,15 @@ static float *room_aim_with(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct m
     assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_AIM, aim, *n, &e), LMGI_OK);
     lmgi_updater_free(u);
     return aim;
+}
+
+static float *room_aim_with(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, int occluders, size_t *n)
+{
+    lmgi_updater_desc d;
+    lmt_room_desc(&d);
+    d.aim.direct = mode;
+    d.aim.occluders = occluders;
+    return aim_of(ctx, sc, &d, n);
 }
 
 static float *room_aim(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, size_t *n)
@@ -280,6 +286,9 @@ static void test_updater_choice(void **state)
     float *emitters = room_aim(ctx, sc, LMGI_AIM_DIRECT_EMITTERS, &n), *photons = room_aim(ctx, sc, LMGI_AIM_DIRECT_PHOTONS, &n),
           *all = room_aim(ctx, sc, LMGI_AIM_DIRECT_ALL, &n);
     assert_memory_equal(emitters, photons, n * sizeof *photons);
+    float *suns = room_aim(ctx, sc, LMGI_AIM_DIRECT_SUNS, &n); /* the default: no directional light here */
+    assert_memory_equal(suns, photons, n * sizeof *photons);
+    free(suns);
     double l1 = lmt_relative_l1(all, photons, n);
     print_message("AIM with the lamp's light computed: %.3f relative L1 from the photons' estimate\n", l1);
     assert_true(l1 > 0.005 && l1 < 0.5); /* the same light, placed sharper */
@@ -305,12 +314,82 @@ static void test_updater_choice(void **state)
     lmgi_context_free(ctx);
 }
 
+/* A sun over a large level (the default, aim.direct SUNS): a 400 m ground and a 3 m box under a sun, the
+ * box's top given its own texels (lmgi_options.wall_texels, as lmgi run's density does). The default
+ * photons, spread over the sun's scene-sized disc, bring the top a few photons; its sunlight computed per
+ * texel makes the top read as the open ground far from the box (both see only the sun), texel by texel.
+ * Left to the photons (PHOTONS, the paper's form) the same top is starved and spotty. */
+static void sun_box_top(lmgi_context *ctx, lmgi_scene *sc, lmgi_aim_direct mode, double *ratio, double *spread)
+{
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.aim.direct = mode;
+    size_t n;
+    float *map = aim_of(ctx, sc, &d, &n);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    double top = 0.0, ground = 0.0, lo = INFINITY, hi = 0.0;
+    int tops = 0, grounds = 0;
+    for (uint32_t i = 0; i < lmgi_texel_count(sc); i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        const float *v = map + 4 * ((size_t)t.y * in.atlas_width + t.x);
+        if (!(v[3] > 0.0f) || t.normal[1] < 0.99f)
+            continue;
+        if (t.position[1] > 2.9f) {
+            top += v[1], tops++;
+            lo = fmin(lo, v[1]), hi = fmax(hi, v[1]);
+        } else if (fabsf(t.position[0]) > 30.0f && fabsf(t.position[0]) < 150.0f) {
+            ground += v[1], grounds++;
+        }
+    }
+    assert_true(tops >= 16 && grounds >= 100);
+    *ratio = (top / tops) / (ground / grounds);
+    *spread = (hi - lo) / (top / tops);
+    free(map);
+}
+
+static void test_sun_over_a_large_level(void **state)
+{
+    (void)state;
+    float ground_v[12] = {-200, 0, -200, -200, 0, 200, 200, 0, 200, 200, 0, -200}, box_v[72];
+    uint32_t ground_i[6] = {0, 1, 2, 0, 2, 3}, box_i[36];
+    lmt_box((const float[3]){-1.5f, 0, -1.5f}, (const float[3]){1.5f, 3, 1.5f}, 0, box_v, box_i);
+    lmgi_mesh_desc meshes[2] = {
+        {.name = "ground", .positions = ground_v, .vertex_count = 4, .indices = ground_i, .triangle_count = 2},
+        {.name = "box", .positions = box_v, .vertex_count = 24, .indices = box_i, .triangle_count = 12}};
+    lmgi_material_desc grey = {.name = "grey", .base_color = {0.5f, 0.5f, 0.5f, 1.0f}};
+    lmgi_light_desc sun = {.name = "sun", .type = LMGI_LIGHT_DIRECTIONAL, .intensity = 3.0f,
+                           .direction = {0.3f, -0.9f, 0.2f}};
+    lmgi_scene_desc sd = {.name = "sun level", .meshes = meshes, .mesh_count = 2, .materials = &grey,
+                          .material_count = 1, .lights = &sun, .light_count = 1};
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 20000;
+    o.wall_texels = 64;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&sd, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_context *ctx = lmt_context();
+    double ratio[2], spread[2];
+    sun_box_top(ctx, sc, LMGI_AIM_DIRECT_SUNS, &ratio[0], &spread[0]);
+    sun_box_top(ctx, sc, LMGI_AIM_DIRECT_PHOTONS, &ratio[1], &spread[1]);
+    print_message("box top / open ground: %.4f with the sun computed (spread %.4f), %.4f from photons (spread "
+                  "%.4f)\n", ratio[0], spread[0], ratio[1], spread[1]);
+    assert_true(fabs(ratio[0] - 1.0) < 0.02 && spread[0] < 0.02);
+    assert_true(fabs(ratio[1] - 1.0) > 0.1 || spread[1] > 0.2); /* the test sees what photons miss */
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_shadow_edge),
         cmocka_unit_test(test_lamp_under_ceiling),
         cmocka_unit_test(test_updater_choice),
+        cmocka_unit_test(test_sun_over_a_large_level),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

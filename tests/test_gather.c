@@ -40,8 +40,10 @@ typedef struct {
     lm_atlas a;
 } tscene;
 
-static void ts_load(tscene *t, const lmt_mesh *meshes, int count, const char *nodes, const char *materials,
-                    float texel_size)
+/* The scene at texel_size, or (texel_size 0) at about `target` texels with `wall_texels` texels at least
+ * on each surface of 2 m^2 or more (lm_atlas_options). */
+static void ts_load_walls(tscene *t, const lmt_mesh *meshes, int count, const char *nodes, const char *materials,
+                          float texel_size, int target, int wall_texels)
 {
     const char *path = lmt_write_scene("gather.gltf", meshes, count, nodes, materials);
     lm_error err;
@@ -54,7 +56,15 @@ static void ts_load(tscene *t, const lmt_mesh *meshes, int count, const char *no
     lm_atlas_options ao;
     lm_atlas_options_default(&ao);
     ao.texel_size = texel_size;
+    ao.target_texels = target;
+    ao.wall_texels = wall_texels;
     assert_int_equal(lm_atlas_build(t->s, &t->su, &ao, &t->a, &err), LM_OK);
+}
+
+static void ts_load(tscene *t, const lmt_mesh *meshes, int count, const char *nodes, const char *materials,
+                    float texel_size)
+{
+    ts_load_walls(t, meshes, count, nodes, materials, texel_size, 0, 0);
 }
 
 static void ts_free(tscene *t)
@@ -358,6 +368,51 @@ static void test_tilted_normals(void **state)
     assert_true(fabs(E / want - 1.0) < 0.01);
     free(rgba);
     free(aim);
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
+/* "Within a texel's width" is the texel's own width: a 2 x 2 m panel 1 m over a 100 m floor, at a density
+ * that gives the floor 5 m texels and the panel its own 0.25 m ones (wall_texels, lmgi run's density). The
+ * floor's texel under the panel is covered; the panel, four of its texels from the floor, is not (with the
+ * atlas's width every texel of it was, and nothing lit it: a Godot level's retaining wall read 0.3 of the
+ * reference facing such a slope). */
+static void test_covered_by_own_texel_width(void **state)
+{
+    (void)state;
+    lmt_mesh m[2];
+    square(&m[0], 50.0f, 0.0f, 1);
+    square(&m[1], 1.0f, 1.0f, 0);
+    tscene t;
+    ts_load_walls(&t, m, 2, "[{\"children\": [1, 2]}, {\"mesh\": 0}, {\"mesh\": 1}]", "[{}, {}]", 0.0f, 400, 64);
+    int floor_s = -1, panel = -1;
+    for (uint32_t i = 0; i < t.a.texel_count; i++)
+        if (t.a.texels[i].pos[1] > 0.5f)
+            panel = t.a.texels[i].surface;
+        else
+            floor_s = t.a.texels[i].surface;
+    assert_true(panel >= 0 && floor_s >= 0);
+    print_message("texel width: atlas %.3f, floor %.3f, panel %.3f\n", (double)t.a.texel_size,
+                  (double)t.a.surface_texel_size[floor_s], (double)t.a.surface_texel_size[panel]);
+    assert_true(t.a.texel_size > 2.0f && t.a.surface_texel_size[floor_s] == t.a.texel_size);
+    assert_true(t.a.surface_texel_size[panel] > 0.2f && t.a.surface_texel_size[panel] < 0.3f);
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    int panel_covered = 0, panel_texels = 0, floor_covered = 0;
+    for (uint32_t i = 0; i < t.a.texel_count; i++) {
+        const lm_texel *x = &t.a.texels[i];
+        int c = lm_texel_covered(rt, t.s, &t.a, &set, i);
+        if (x->surface == panel)
+            panel_texels++, panel_covered += c;
+        else if (fabsf(x->pos[0]) < 1.0f && fabsf(x->pos[2]) < 1.0f)
+            floor_covered += c;
+    }
+    assert_true(panel_texels >= 48);
+    assert_int_equal(panel_covered, 0);
+    assert_true(floor_covered >= 1);
     lm_rt_free(rt);
     ts_free(&t);
 }
@@ -1204,6 +1259,7 @@ int main(void)
         cmocka_unit_test(test_rim_traced),
         cmocka_unit_test(test_tilted_normals),
         cmocka_unit_test(test_covered_texels),
+        cmocka_unit_test(test_covered_by_own_texel_width),
         cmocka_unit_test(test_box_backfaces),
         cmocka_unit_test(test_deterministic),
         cmocka_unit_test(test_coverage_beyond_the_gl_limit),

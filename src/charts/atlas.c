@@ -121,14 +121,15 @@ static lm_status link_surfaces(const lm_surfaces *su, lm_atlas *a, lm_error *err
     a->surface_count = su->surface_count;
     a->surface_first_chart = malloc(n * sizeof(int));
     a->surface_chart_count = calloc(n, sizeof(int));
-    if (!a->surface_first_chart || !a->surface_chart_count)
+    a->surface_texel_size = malloc(n * sizeof(float));
+    if (!a->surface_first_chart || !a->surface_chart_count || !a->surface_texel_size)
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
     for (int i = 0; i < su->surface_count; i++)
-        a->surface_first_chart[i] = -1;
+        a->surface_first_chart[i] = -1, a->surface_texel_size[i] = a->texel_size;
     for (int c = 0; c < a->chart_count; c++) {
         int f = a->charts[c].surface;
         if (a->surface_chart_count[f]++ == 0)
-            a->surface_first_chart[f] = c;
+            a->surface_first_chart[f] = c, a->surface_texel_size[f] = a->charts[c].texel_size;
     }
     return LM_OK;
 }
@@ -361,5 +362,6 @@ void lm_atlas_free(lm_atlas *a)
     free(a->texel_index);
     free(a->surface_first_chart);
     free(a->surface_chart_count);
+    free(a->surface_texel_size);
     memset(a, 0, sizeof *a);
 }

@@ -91,6 +91,7 @@ typedef struct {
     int pad;               /* texels of border of its own around it (0 or 1): what its lookups reach beyond
                             * the rect (corner_uv) */
     int page;              /* the page holding it (0 for a level of one page) */
+    float texel_size;      /* world units per texel: the atlas's, or finer on a wall (wall_texels) */
     uint32_t tri_count;
     uint32_t *tris;
 } lm_chart;
@@ -132,6 +133,8 @@ typedef struct {
     float page_utilization; /* covered texels / the pages' texels (the grid's empty places not counted) */
     int surface_count;
     int *surface_first_chart, *surface_chart_count; /* per surface: its charts (charts are ordered by surface) */
+    float *surface_texel_size; /* per surface: its charts' texel_size (the atlas's where it has none): how far
+                                * "within a texel" reaches there (the covered-texel rule, docs/gather.md) */
     double time_unwrap, time_pack, time_texels; /* seconds spent in each stage of lm_atlas_build */
 } lm_atlas;
 

@@ -191,7 +191,9 @@ lm_status lmc_pack(const lmc_charts *c, const lm_surfaces *su, float texel_size,
                 "size %g; texel size raised to %g (%d pages of %dx%d)", max_size, LM_ATLAS_MAX_SIDE,
                 LM_ATLAS_MAX_SIDE, (double)texel_size, (double)ts, out->page_count, out->page_width,
                 out->page_height);
-    for (int i = 0; i < c->count; i++)
+    for (int i = 0; i < c->count; i++) {
         out->charts[i].surface = c->charts[i].surface;
+        out->charts[i].texel_size = (float)(out->texel_size * c->charts[i].texel_scale);
+    }
     return LM_OK;
 }

@@ -10,6 +10,7 @@
 #include "../charts/atlas_dilate.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
+#include "../trace/photons.h"
 #include "aim_sight.h"
 
 #define MIN_COVERAGE 0.0625 /* the disc's part on the surface is never taken below 1/16 of it */
@@ -269,11 +270,12 @@ void lm_aim_free(lm_aim *aim)
 
 void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d) { aim->direct = d; }
 
-void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover)
+void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover, const float *cover_by_surface)
 {
     aim->occluders = rt;
     aim->occluder_lift = lift;
     aim->occluder_cover = cover;
+    aim->occluder_cover_by_surface = cover_by_surface;
 }
 
 const float *lm_aim_rgb(const lm_aim *aim) { return aim->rgb; }
@@ -947,7 +949,7 @@ static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index,
         float p[3], d[3];
         lm_v3_store(p, lm_mat4_point(j->world, lm_v3_load(local[i])));
         uint32_t seed = index * (LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS) + (uint32_t)i;
-        if (!lm_direct_irradiance(j->direct, p, tf->n_world, j->two_sided, seed, d))
+        if (!lm_direct_irradiance(j->direct, t->surface, p, tf->n_world, j->two_sided, seed, d))
             continue;
         seen += share[i];
         for (int c = 0; c < 3; c++)
@@ -1221,7 +1223,10 @@ static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfa
     sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {sj->edge_ends, sj->edge_count}, n, rmin * rmin,
                              aim->set.boundary_correction, aim->set.kernel, aim->direct,
                              s->nodes[sf->node].world, m->double_sided,
-                             {aim->occluders, aim->occluder_lift, aim->occluder_cover, aim->set.kernel}, sj->binned};
+                             {aim->occluders, aim->occluder_lift,
+                              lm_cover_reach(aim->occluder_cover, aim->occluder_cover_by_surface, sj->surface),
+                              aim->set.kernel},
+                             sj->binned};
 }
 
 static void free_surface(surface_job *sj)

@@ -104,6 +104,7 @@ typedef struct {
                                       lm_aim_set_direct */
     const lm_rt *occluders;  /* NULL (default): every hit near a texel counts; else lm_aim_set_occluders */
     float occluder_lift, occluder_cover;
+    const float *occluder_cover_by_surface; /* NULL: occluder_cover everywhere (trace/photons.h's cover_by_surface) */
 } lm_aim;
 
 void lm_aim_settings_default(lm_aim_settings *o);
@@ -127,9 +128,10 @@ void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
  * shadow is not blurred into light (docs/aim.md, "Occluders"). Shadow rays in rt from points lifted `lift`
  * off the surface: N a texel and 8 more for each distinct vertex it sees, 4 to 9 times the estimate's cost.
  * Dense surfaces then take the kd-tree too. A texel whose point has geometry closer than `cover` straight
- * out on a side (the photons' cover distance: under a box on the floor) counts that side's hits untested:
- * it is hidden, not dark. NULL: every hit counts (the paper's). rt is borrowed. */
-void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover);
+ * out on a side (the photons' cover distance: under a box on the floor; per surface id where cover_by_surface
+ * is given) counts that side's hits untested: it is hidden, not dark. NULL rt: every hit counts (the
+ * paper's). rt and cover_by_surface are borrowed. */
+void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover, const float *cover_by_surface);
 /* The direct light is averaged over this many squared parts of a texel (lm_texel_parts; covered parts
  * left out): near a lamp it falls off within a texel, and the centroid's value alone lost energy the
  * hemicube should see (4.8% of the suzanne Cornell box's ceiling, docs/aim.md). */

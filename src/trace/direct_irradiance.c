@@ -2,16 +2,17 @@
 #include "direct_irradiance.h"
 
 #include "../core/vecmath.h"
+#include "photons.h"
 
 #include <math.h>
 
-/* 1 when other geometry lies within d->cover straight out from p on the side of normal n. */
-static int covered(const lm_direct_light *d, lm_vec3 p, lm_vec3 n)
+/* 1 when other geometry lies within the cover distance straight out from p on the side of normal n. */
+static int covered(const lm_direct_light *d, float reach, lm_vec3 p, lm_vec3 n)
 {
     float at[3], dir[3];
     lm_v3_store(at, p);
     lm_v3_store(dir, n);
-    return lm_rt_covered(d->rt, at, dir, d->lift, d->cover);
+    return lm_rt_covered(d->rt, at, dir, d->lift, reach);
 }
 
 /* Every punctual light's E = weight cos, where a shadow ray from p (lifted to the side the light is on)
@@ -21,7 +22,8 @@ static void punctual(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, int sides, 
     const float none[3] = {0.0f, 0.0f, 0.0f};
     for (int k = 0; k < d->em->count; k++) {
         const lm_emitter *em = &d->em->e[k];
-        if (!em->punctual || (em->radiant[0] == 0.0f && em->radiant[1] == 0.0f && em->radiant[2] == 0.0f))
+        if (!em->punctual || (em->radiant[0] == 0.0f && em->radiant[1] == 0.0f && em->radiant[2] == 0.0f) ||
+            (d->punctual == LM_DIRECT_SUNS && em->kind != LM_EMIT_DIRECTIONAL))
             continue;
         float at[3];
         lm_v3_store(at, p);
@@ -54,12 +56,13 @@ static void area(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, uint32_t seed, 
         e[c] += out[c];
 }
 
-int lm_direct_irradiance(const lm_direct_light *d, const float p[3], const float n[3], int two_sided,
+int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], int two_sided,
                           uint32_t seed, float out[3])
 {
     double e[3] = {0.0, 0.0, 0.0};
     lm_vec3 pv = lm_v3_load(p), nv = lm_v3_load(n), back = lm_scale(nv, -1.0f);
-    int sides = (covered(d, pv, nv) ? 0 : 1) | (two_sided && !covered(d, pv, back) ? 2 : 0);
+    float reach = lm_cover_reach(d->cover, d->cover_by_surface, surface);
+    int sides = (covered(d, reach, pv, nv) ? 0 : 1) | (two_sided && !covered(d, reach, pv, back) ? 2 : 0);
     if (d->punctual)
         punctual(d, pv, nv, sides, e);
     if (d->area && (sides & 1))

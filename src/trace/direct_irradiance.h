@@ -27,23 +27,31 @@
 #include "photon_store.h"
 #include "rt_scene.h"
 
+/* lm_direct_light.punctual: none, every point, spot and directional light, or directional lights alone (a
+ * sun's photons are spread over the whole scene, so its sharp, strong light is the first to starve). */
+enum { LM_DIRECT_NONE = 0, LM_DIRECT_PUNCTUAL = 1, LM_DIRECT_SUNS = 2 };
+
 typedef struct {
     const lm_scene *scene;
     const lm_rt *rt;
     const lm_emitters *em;            /* punctual lights: every one whose radiant is non-zero */
     const lm_emitter_light *area;     /* NULL: emissive triangles are left to the photons */
-    int punctual;                     /* 0: point, spot and directional lights are left to the photons */
+    int punctual;                     /* which punctual lights are computed (LM_DIRECT_*); the rest are left to
+                                       * the photons */
     float lift;                       /* ray origins this far off the surface (world units) */
     float cover;                      /* a side with other geometry closer than this straight out from it
                                        * gets nothing, as photons store no hit there (trace/photons.h's
                                        * cover_distance: a lamp millimetres under a ceiling); <= 0: off */
+    const float *cover_by_surface;    /* with cover > 0: per surface id instead (trace/photons.h's
+                                       * cover_by_surface); NULL: cover everywhere */
 } lm_direct_light;
 
 /* Irradiance at world point p of a surface with unit geometric normal n, from the front side only, or
  * from both sides added (two_sided: a double-sided material, whose photon estimate counts both). seed
  * picks the emitter light's sample pattern (pass the same one for the same point: no flicker). Returns
- * 0 when every side asked for is covered (d->cover: out is 0, and the point is hidden, not dark), else 1. */
-int lm_direct_irradiance(const lm_direct_light *d, const float p[3], const float n[3], int two_sided,
+ * 0 when every side asked for is covered (d->cover on `surface`: out is 0, and the point is hidden, not dark),
+ * else 1. */
+int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], int two_sided,
                           uint32_t seed, float out[3]);
 
 /* 1 when hit h carries light that lm_direct_irradiance computes (a first hit of a punctual light, or of
@@ -51,7 +59,8 @@ int lm_direct_irradiance(const lm_direct_light *d, const float p[3], const float
  * leaves it out. */
 static inline int lm_direct_covers_hit(const lm_direct_light *d, const lm_hit *h)
 {
-    return h->bounce == 0 && (h->source == LM_HIT_FROM_PUNCTUAL ? d->punctual
+    return h->bounce == 0 && (h->source == LM_HIT_FROM_PUNCTUAL ? d->punctual == LM_DIRECT_PUNCTUAL
+                              : h->source == LM_HIT_FROM_SUN ? d->punctual != LM_DIRECT_NONE
                               : h->source == LM_HIT_FROM_AREA && d->area != NULL);
 }
 

@@ -126,7 +126,11 @@ static int replace_path(lm_photons *ph, const ph_group *g, uint32_t m, const ph_
         }
     uint32_t photon = g->first_id + m * ph->G;
     const lm_emitter *em = &ph->em->e[g->emitter];
-    int source = em->punctual ? LM_HIT_FROM_PUNCTUAL : em->kind == LM_EMIT_SKY ? LM_HIT_FROM_SKY : LM_HIT_FROM_AREA, ok = 1;
+    int source = em->kind == LM_EMIT_DIRECTIONAL ? LM_HIT_FROM_SUN
+                 : em->punctual                  ? LM_HIT_FROM_PUNCTUAL
+                 : em->kind == LM_EMIT_SKY       ? LM_HIT_FROM_SKY
+                                                 : LM_HIT_FROM_AREA,
+        ok = 1;
     for (uint32_t i = 0; i < n; i++) {
         out[i].node = v[i].node;
         out[i].tri = v[i].tri;

@@ -14,7 +14,9 @@
 
 #define LM_NONE 0xFFFFFFFFu
 
-enum { LM_HIT_FROM_AREA = 0, LM_HIT_FROM_PUNCTUAL = 1, LM_HIT_FROM_SKY = 2 };
+/* What a photon came from: emissive triangles, a point or spot light, the sky, or a directional light (a
+ * sun: punctual too, told apart for the AIMs' direct light, direct_irradiance.h). */
+enum { LM_HIT_FROM_AREA = 0, LM_HIT_FROM_PUNCTUAL = 1, LM_HIT_FROM_SKY = 2, LM_HIT_FROM_SUN = 3 };
 
 typedef struct {
     float pos[3];          /* world position when stored */
@@ -29,7 +31,7 @@ typedef struct {
     int32_t surface;
     uint16_t bounce;       /* 0 = first hit after leaving the emitter */
     uint8_t source;        /* what the photon came from: LM_HIT_FROM_AREA (emissive triangles), _PUNCTUAL
-                            * (a point, spot or directional light) or _SKY */
+                            * (a point or spot light), _SUN (a directional light) or _SKY */
     uint8_t caustic;       /* it came off mirrors and glass only, straight from its emitter (L S+ D): light
                             * the caustic pass carries, not the receiver's IIM (docs/caustics.md) */
     uint32_t at;           /* its place in its surface's slot list */
@@ -85,7 +87,7 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot);
  * pass's), not a caustic hit (the caustic pass's). */
 static inline int lm_hit_in_iim(const lm_hit *h)
 {
-    return !(h->bounce == 0 && h->source == LM_HIT_FROM_PUNCTUAL) && !h->caustic;
+    return !(h->bounce == 0 && (h->source == LM_HIT_FROM_PUNCTUAL || h->source == LM_HIT_FROM_SUN)) && !h->caustic;
 }
 /* Energy of a hit as the deltas count it. */
 static inline double lm_hit_energy(const lm_hit *h)

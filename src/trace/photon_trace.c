@@ -89,7 +89,8 @@ static int covered(const lm_photons *ph, const lm_shading *sh, const float dir[3
         n = lm_scale(n, -1.0f);
     float out[3];
     lm_v3_store(out, n);
-    return lm_rt_covered(ph->rt, sh->pos, out, ph->ray_offset, ph->set.cover_distance);
+    return lm_rt_covered(ph->rt, sh->pos, out, ph->ray_offset,
+                         lm_cover_reach(ph->set.cover_distance, ph->set.cover_by_surface, sh->surface));
 }
 
 static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *sh, const float dir[3],

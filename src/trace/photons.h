@@ -49,7 +49,18 @@ typedef struct {
                                 * under a box, and the N-nearest estimate would spread it over the visible
                                 * texels around (docs/aim.md). <= 0 (default here): every hit is stored;
                                 * the photon stage makes it the atlas's texel size */
+    const float *cover_by_surface; /* with cover_distance > 0: the distance per surface id instead (borrowed;
+                                * the photon stage gives each surface its own texel width,
+                                * lm_atlas.surface_texel_size); NULL: cover_distance everywhere */
 } lm_photon_settings;
+
+/* How far "covered" reaches on surface `surface` (-1: none) under a distance and an optional per-surface
+ * table (lm_photon_settings.cover_by_surface): the one rule the photons, the AIM's direct light and its
+ * occluder test share. */
+static inline float lm_cover_reach(float distance, const float *by_surface, int surface)
+{
+    return distance > 0.0f && by_surface && surface >= 0 ? by_surface[surface] : distance;
+}
 
 /* The scene's default photon floor, 72 groups of 640: one light's photons when the scene has one, 160 a
  * group per light from four lights on. A single light at 160 a group left the shared Cornell box's small

@@ -74,13 +74,23 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     lm_caustic_settings_default(&s->caustic);
 }
 
-/* The AIMs take direct light from trace/direct_irradiance.h: punctual lights always, emissive triangles
- * where their closed form suits the scene; nothing where the photons' cover distance hides a side. */
-static lm_status setup_direct(lm_photon_stage *ps, float cover, lm_error *err)
+static int has_sun(const lm_emitters *em)
 {
-    if (!(ps->set.exact_direct == 2) && !lm_emitter_light_suits(ps->scene))
+    for (int k = 0; k < em->count; k++)
+        if (em->e[k].kind == LM_EMIT_DIRECTIONAL)
+            return 1;
+    return 0;
+}
+
+/* The AIMs take direct light from trace/direct_irradiance.h: (exact_direct) emissive triangles where their
+ * closed form suits the scene (1), and every punctual light (2), or directional lights alone (3); nothing
+ * where the photons' cover distance hides a side. */
+static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph, lm_error *err)
+{
+    int suns = ps->set.exact_direct == 3, all = ps->set.exact_direct == 2;
+    if (suns ? !has_sun(&ps->emitters) : !all && !lm_emitter_light_suits(ps->scene))
         return LM_OK; /* nothing to compute: photons bring all light, as in the paper */
-    if (lm_emitter_light_suits(ps->scene)) {
+    if (!suns && lm_emitter_light_suits(ps->scene)) {
         lm_status st = lm_emitter_light_init(&ps->area, ps->scene, ps->rt, AIM_EMITTER_RAYS, err);
         if (st != LM_OK)
             return st;
@@ -88,8 +98,9 @@ static lm_status setup_direct(lm_photon_stage *ps, float cover, lm_error *err)
     }
     float size = lm_scene_size(ps->scene);
     ps->direct = (lm_direct_light){ps->scene, ps->rt, &ps->emitters, ps->have_area ? &ps->area : NULL,
-                                   ps->set.exact_direct == 2, 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f),
-                                   cover};
+                                   all ? LM_DIRECT_PUNCTUAL : suns ? LM_DIRECT_SUNS : LM_DIRECT_NONE,
+                                   1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f),
+                                   ph->cover_distance, ph->cover_by_surface};
     lm_aim_set_direct(&ps->aim, &ps->direct);
     return LM_OK;
 }
@@ -307,7 +318,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
         int changed = 0;
         for (int c = 0; c < 3; c++) {
             double b = ps->flux_before[3 * k + c], a = ps->flux_after[3 * k + c];
-            if (!(b > 0.0) && ps->set.exact_direct == 2) /* its AIM may hold the lights' direct light alone */
+            if (!(b > 0.0) && ps->set.exact_direct >= 2) /* its AIM may hold the lights' direct light alone */
                 b = all_before[c], a = all_after[c];
             float f = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
             ps->light_scale[3 * k + c] *= f;
@@ -457,8 +468,10 @@ static lm_status find_portals(lm_photon_stage *ps, lm_error *err)
 static lm_photon_settings photon_settings(const lm_photon_stage *ps)
 {
     lm_photon_settings photons = ps->set.photons;
-    if (photons.cover_distance == 0.0f && ps->atlas) /* light closer under something than a texel is hidden */
+    if (photons.cover_distance == 0.0f && ps->atlas) { /* light closer under something than a texel is hidden */
         photons.cover_distance = ps->atlas->texel_size;
+        photons.cover_by_surface = ps->atlas->surface_texel_size; /* each surface's own texel */
+    }
     if (!ps->set.trace) /* one photon a light, never traced: the emitters' bookkeeping without the cost */
         photons.total_photons = 0, photons.groups = 1, photons.per_group = 1;
     return photons;
@@ -537,12 +550,13 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     if (st == LM_OK)
         st = lm_aim_init(&ps->aim, ps->scene, ps->surfaces, ps->atlas, &ps->set.aim, err);
     ps->have_aim = st == LM_OK;
+    lm_photon_settings ph = photon_settings(ps);
     if (st == LM_OK && ps->set.exact_direct)
-        st = setup_direct(ps, photon_settings(ps).cover_distance, err);
+        st = setup_direct(ps, &ph, err);
     if (st == LM_OK && ps->set.occluders) { /* lifted off surfaces as far as the gather's texels are */
         float size = lm_scene_size(ps->scene);
         lm_aim_set_occluders(&ps->aim, ps->rt, 1e-4f * (size > 0.0f && isfinite(size) ? size : 1.0f),
-                             photon_settings(ps).cover_distance);
+                             ph.cover_distance, ph.cover_by_surface);
     }
     if (st == LM_OK && ps->set.trace && ps->set.aims)
         st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,

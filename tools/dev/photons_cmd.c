@@ -40,8 +40,7 @@ void lm_dev_photon_settings(const lm_cli_args *a, lm_photon_stage_settings *s)
         s->aim.n_nearest = a->desc.aim.nearest;
     if (a->desc.aim.surfaces_per_frame)
         s->surfaces_per_frame = a->desc.aim.surfaces_per_frame;
-    lmgi_aim_direct direct = a->desc.aim.direct;
-    s->exact_direct = direct == LMGI_AIM_DIRECT_EMITTERS ? 1 : direct == LMGI_AIM_DIRECT_ALL ? 2 : 0;
+    s->exact_direct = lm_exact_direct_of(a->desc.aim.direct);
 }
 
 static void csv_header(FILE *f)
