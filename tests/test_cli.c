@@ -1157,7 +1157,7 @@ static void test_tradeoff(void **state)
     int rows = 0, defaults = 0;
     while (fgets(line, sizeof line, f)) {
         csv_field(line, col[0], v, sizeof v);
-        if (!strcmp(v, "aim_direct")) { /* its photons-from-first-hits row is the default desc */
+        if (!strcmp(v, "aim_direct")) { /* its suns row (value 0) is the default desc */
             csv_field(line, col[2], v, sizeof v);
             defaults += atoi(v);
             continue;
