@@ -71,6 +71,7 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     s->trace = 1;
     s->aims = 1;
     s->find_portals = 1;
+    s->exact_direct = 3; /* suns (lmgi_aim_direct SUNS, the default) */
     lm_caustic_settings_default(&s->caustic);
 }
 

@@ -21,7 +21,8 @@ typedef struct {
                               * photons themselves) */
     int exact_direct;        /* AIM texels compute direct light (trace/direct_irradiance.h), photons bring the
                               * rest: 1 from emissive triangles, 2 from punctual lights too, 3 from
-                              * directional lights alone; 0: photons bring all of it (the paper's form) */
+                              * directional lights alone (the default); 0: photons bring all of it (the
+                              * paper's form) */
     int occluders;           /* 1: an AIM texel counts only the hits whose photon came from where it sees
                               * (lm_aim_set_occluders); 0 (default): every hit near it, the paper's */
     int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
