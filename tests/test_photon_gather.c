@@ -156,6 +156,9 @@ static void test_records(void **state)
     h.source = LM_HIT_FROM_PUNCTUAL; /* a punctual light's first hit: the direct pass's */
     lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
+    h.source = LM_HIT_FROM_SUN; /* a sun's first hit: the direct pass's too */
+    lm_photon_record_encode(&h, up, &r);
+    assert_false(lm_photon_record_decode(&r, pos, from, flux));
     h.source = LM_HIT_FROM_AREA, h.caustic = 1; /* the caustic pass's */
     lm_photon_record_encode(&h, up, &r);
     assert_false(lm_photon_record_decode(&r, pos, from, flux));
