@@ -155,7 +155,7 @@ static void test_shared_cornell_box(void **state)
     lm_frame_loop_settings ls;
     lm_frame_loop_settings_default(&ls);
     ls.width = ls.height = SIZE;
-    ls.stage.exact_direct = 1;
+    ls.stage.exact_direct = LM_EXACT_EMITTERS;
     lm_ref_settings rs;
     ref_settings(&rs, REF_ERROR);
     lm_error err;

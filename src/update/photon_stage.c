@@ -71,7 +71,7 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     s->trace = 1;
     s->aims = 1;
     s->find_portals = 1;
-    s->exact_direct = 3; /* suns (lmgi_aim_direct SUNS, the default) */
+    s->exact_direct = LM_EXACT_SUNS; /* lmgi_aim_direct's default */
     lm_caustic_settings_default(&s->caustic);
 }
 
@@ -83,12 +83,11 @@ static int has_sun(const lm_emitters *em)
     return 0;
 }
 
-/* The AIMs take direct light from trace/direct_irradiance.h: (exact_direct) emissive triangles where their
- * closed form suits the scene (1), and every punctual light (2), or directional lights alone (3); nothing
+/* The AIMs take direct light from trace/direct_irradiance.h as exact_direct says (LM_EXACT_*); nothing
  * where the photons' cover distance hides a side. */
 static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph, lm_error *err)
 {
-    int suns = ps->set.exact_direct == 3, all = ps->set.exact_direct == 2;
+    int suns = ps->set.exact_direct == LM_EXACT_SUNS, all = ps->set.exact_direct == LM_EXACT_ALL;
     if (suns ? !has_sun(&ps->emitters) : !all && !lm_emitter_light_suits(ps->scene))
         return LM_OK; /* nothing to compute: photons bring all light, as in the paper */
     if (!suns && lm_emitter_light_suits(ps->scene)) {
@@ -311,6 +310,7 @@ static void note_scale(lm_photon_stage *ps, int e, const float s[3], int first)
 static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
 {
     int S = ps->surfaces->surface_count, moved = 0;
+    int computed = ps->set.exact_direct == LM_EXACT_ALL || ps->set.exact_direct == LM_EXACT_SUNS; /* lights' direct */
     double all_before[3] = {0, 0, 0}, all_after[3] = {0, 0, 0};
     for (int k = 0; k < S; k++)
         for (int c = 0; c < 3; c++)
@@ -319,7 +319,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
         int changed = 0;
         for (int c = 0; c < 3; c++) {
             double b = ps->flux_before[3 * k + c], a = ps->flux_after[3 * k + c];
-            if (!(b > 0.0) && ps->set.exact_direct >= 2) /* its AIM may hold the lights' direct light alone */
+            if (!(b > 0.0) && computed) /* its AIM may hold the lights' direct light alone */
                 b = all_before[c], a = all_after[c];
             float f = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
             ps->light_scale[3 * k + c] *= f;
@@ -354,7 +354,7 @@ static lm_status check_emitters(lm_photon_stage *ps, int *moved, int *scaled, lm
             note_scale(ps, e, s, !noted++);
         *scaled += by_power;
         *moved += !by_power;
-        lm_status st = !by_power ? lm_photons_invalidate_emitter(ps->photons, e, err)
+        lm_status st = !by_power                            ? lm_photons_invalidate_emitter(ps->photons, e, err)
                        : ps->emitters.e[e].luminance > 0.0f ? lm_photons_scale_emitter(ps->photons, e, s, err)
                                                             : lm_photons_retrace_emitter(ps->photons, e, err);
         if (st != LM_OK)
@@ -552,7 +552,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         st = lm_aim_init(&ps->aim, ps->scene, ps->surfaces, ps->atlas, &ps->set.aim, err);
     ps->have_aim = st == LM_OK;
     lm_photon_settings ph = photon_settings(ps);
-    if (st == LM_OK && ps->set.exact_direct)
+    if (st == LM_OK && ps->set.exact_direct != LM_EXACT_NONE)
         st = setup_direct(ps, &ph, err);
     if (st == LM_OK && ps->set.occluders) { /* lifted off surfaces as far as the gather's texels are */
         float size = lm_scene_size(ps->scene);

@@ -20,9 +20,7 @@ typedef struct {
     int aims;                /* 0: photons traced, no AIM filled (an indirect path that gathers from the
                               * photons themselves) */
     int exact_direct;        /* AIM texels compute direct light (trace/direct_irradiance.h), photons bring the
-                              * rest: 1 from emissive triangles, 2 from punctual lights too, 3 from
-                              * directional lights alone (the default); 0: photons bring all of it (the
-                              * paper's form) */
+                              * rest (LM_EXACT_*) */
     int occluders;           /* 1: an AIM texel counts only the hits whose photon came from where it sees
                               * (lm_aim_set_occluders); 0 (default): every hit near it, the paper's */
     int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
@@ -51,9 +49,17 @@ typedef struct {
 
 typedef struct lm_photon_stage lm_photon_stage;
 
+/* exact_direct: which direct light the AIM texels compute. NONE: photons bring all of it (the paper's form);
+ * EMITTERS: emissive triangles' (where their closed form suits the scene); ALL: theirs and every punctual
+ * light's; SUNS (the default): directional lights' alone. */
+enum { LM_EXACT_NONE = 0, LM_EXACT_EMITTERS = 1, LM_EXACT_ALL = 2, LM_EXACT_SUNS = 3 };
+
 void lm_photon_stage_settings_default(lm_photon_stage_settings *s);
 /* exact_direct for lmgi.h's lmgi_aim_direct value v (0 suns, 1 emitters, 2 all, 3 photons). */
-static inline int lm_exact_direct_of(int v) { return v == 3 ? 0 : v == 0 ? 3 : v; }
+static inline int lm_exact_direct_of(int v)
+{
+    return v == 3 ? LM_EXACT_NONE : v == 0 ? LM_EXACT_SUNS : v == 1 ? LM_EXACT_EMITTERS : LM_EXACT_ALL;
+}
 /* Builds emitters, traces every photon and fills every AIM (the first frame's state). `setup` (may be
  * NULL) gets the time of that full trace and refresh. The world (update/world.h) is borrowed and must
  * outlive the stage; the stage moves the BVH's instances as animations play. */
