@@ -1,4 +1,4 @@
-/* core: matrices, quaternions, sRGB, images, palette. */
+/* core: matrices, quaternions, a view's part of a box, sRGB, images, palette. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -14,6 +14,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "../src/core/camera.h"
 #include "../src/core/image.h"
 #include "../src/core/memory.h"
 #include "../src/core/palette.h"
@@ -47,6 +48,74 @@ static void test_affine_inverse(void **state)
         assert_float_equal(id[i], (i % 5 == 0) ? 1.0f : 0.0f, 1e-5);
     float sing[16] = {0};
     assert_false(lm_mat4_invert_affine(inv, sing));
+}
+
+/* A projection (not affine) times its inverse is the identity; a singular matrix has none. */
+static void test_general_inverse(void **state)
+{
+    (void)state;
+    float p[16], v[16], m[16], inv[16], id[16];
+    lm_mat4_perspective(p, 0.9f, 1.5f, 0.1f, 500.0f);
+    lm_mat4_look_at(v, lm_v3(3, 4, 5), lm_v3(0, 1, -2), lm_v3(0, 1, 0));
+    lm_mat4_mul(m, p, v);
+    assert_true(lm_mat4_invert(inv, m));
+    lm_mat4_mul(id, m, inv);
+    for (int i = 0; i < 16; i++)
+        assert_float_equal(id[i], (i % 5 == 0) ? 1.0f : 0.0f, 1e-4);
+    float sing[16] = {1, 2, 3, 4, 2, 4, 6, 8, 0, 0, 1, 0, 0, 0, 0, 1};
+    assert_false(lm_mat4_invert(inv, sing));
+}
+
+/* The points' bounds, and whether every point lies in lo..hi and inside v's clip volume (to eps). */
+static void part_bounds(const lm_view *v, const float lo[3], const float hi[3], float (*pts)[3], int n, float b0[3],
+                        float b1[3])
+{
+    float vp[16];
+    lm_mat4_mul(vp, v->proj, v->view);
+    for (int k = 0; k < 3; k++)
+        b0[k] = INFINITY, b1[k] = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        float c[4];
+        for (int r = 0; r < 4; r++)
+            c[r] = vp[r] * pts[i][0] + vp[4 + r] * pts[i][1] + vp[8 + r] * pts[i][2] + vp[12 + r];
+        for (int k = 0; k < 3; k++) {
+            b0[k] = fminf(b0[k], pts[i][k]), b1[k] = fmaxf(b1[k], pts[i][k]);
+            assert_true(pts[i][k] >= lo[k] - 1e-3f && pts[i][k] <= hi[k] + 1e-3f);
+            assert_true(fabsf(c[k]) <= c[3] * (1.0f + 1e-4f) + 1e-4f);
+        }
+    }
+}
+
+/* lm_view_box_part: a 90-degree camera at the origin looking down -z (near 1, far 100). A slab z in
+ * [-10, -5] wider than the view: the frustum's slice, corners (+-5, +-5, -5) and (+-10, +-10, -10). A box
+ * holding the whole frustum: its 8 corners. A box behind the camera: nothing. */
+static void test_view_box_part(void **state)
+{
+    (void)state;
+    lm_view v;
+    memset(&v, 0, sizeof v);
+    lm_mat4_identity(v.view);
+    lm_mat4_perspective(v.proj, (float)M_PI / 2, 1.0f, 1.0f, 100.0f);
+    float pts[LM_VIEW_BOX_POINTS][3], b0[3], b1[3];
+    const float lo[3] = {-100, -100, -10}, hi[3] = {100, 100, -5};
+    int n = lm_view_box_part(&v, lo, hi, pts);
+    assert_true(n >= 8);
+    part_bounds(&v, lo, hi, pts, n, b0, b1);
+    const float want0[3] = {-10, -10, -10}, want1[3] = {10, 10, -5};
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(b0[k], want0[k], 1e-3);
+        assert_float_equal(b1[k], want1[k], 1e-3);
+    }
+    const float big0[3] = {-200, -200, -200}, big1[3] = {200, 200, 200};
+    n = lm_view_box_part(&v, big0, big1, pts);
+    part_bounds(&v, big0, big1, pts, n, b0, b1);
+    const float f0[3] = {-100, -100, -100}, f1[3] = {100, 100, -1};
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(b0[k], f0[k], 1e-2);
+        assert_float_equal(b1[k], f1[k], 1e-2);
+    }
+    const float back0[3] = {-5, -5, 2}, back1[3] = {5, 5, 8};
+    assert_int_equal(lm_view_box_part(&v, back0, back1, pts), 0);
 }
 
 static void test_normal_transform_non_uniform_scale(void **state)
@@ -328,7 +397,7 @@ int main(void)
         cmocka_unit_test(test_write_past_limit),
         cmocka_unit_test(test_memory_plan),
         cmocka_unit_test(test_palette_distinct),
-        cmocka_unit_test(test_mkdir_p),
+        cmocka_unit_test(test_mkdir_p), cmocka_unit_test(test_general_inverse), cmocka_unit_test(test_view_box_part),
         cmocka_unit_test(test_tonemap),
         cmocka_unit_test(test_tonemap_neutral),
     };

@@ -84,6 +84,8 @@ static float *render(const char *path) { return render_with(path, NULL); }
 
 static const char *scene_box_at(const char *name, int box, float box_y, const char *light_node,
                                 const char *light);
+static const char *scene_plane_box(const char *name, float plane_half, int box, float box_y, const char *light_node,
+                                   const char *light);
 
 /* The plane of lmt_plane_scene, an optional box and one light (node json, light json). */
 static const char *scene_with(const char *name, int box, const char *light_node, const char *light)
@@ -94,10 +96,18 @@ static const char *scene_with(const char *name, int box, const char *light_node,
 /* As scene_with, the box centred at (0.5, box_y, 0). */
 static const char *scene_box_at(const char *name, int box, float box_y, const char *light_node, const char *light)
 {
+    return scene_plane_box(name, 10.0f, box, box_y, light_node, light);
+}
+
+/* As scene_box_at, the plane 2 plane_half wide. */
+static const char *scene_plane_box(const char *name, float plane_half, int box, float box_y, const char *light_node,
+                                   const char *light)
+{
     static char path[512];
     static lmt_mesh m[2];
     memset(m, 0, sizeof m);
-    lmt_mesh_quad(&m[0], (float[3]){-10, 0, 10}, (float[3]){20, 0, 0}, (float[3]){0, 0, -20});
+    float h = plane_half;
+    lmt_mesh_quad(&m[0], (float[3]){-h, 0, h}, (float[3]){2 * h, 0, 0}, (float[3]){0, 0, -2 * h});
     lmt_mesh_cube(&m[1], 0.25f);
     char nodes[1024], ext[512], box_node[128];
     snprintf(box_node, sizeof box_node, ", {\"mesh\": 1, \"translation\": [0.5, %.6f, 0]}", box_y);
@@ -808,6 +818,88 @@ static void test_map_sides_follow_lights(void **state)
     live_free(&l);
 }
 
+/* (l) A sun over a level 2 km across (the whole-scene map's texel 2.8 m, which would blur the 0.5 m box's
+ * shadow away): the map fitted to the view (top_view, 4 m across) puts the umbra on the plane beyond the
+ * box black and the plane round it at rho / pi E cos 30; the same view again, or moved by a centimetre,
+ * redraws no map; moved 10 m it redraws the view's map once, and the shadow is the same. */
+static void check_sun_shadow(const float *rgb, const char *what)
+{
+    double want = RHO / PI * cos(30.0 * PI / 180.0), worst_umbra = 0.0, worst_lit = 0.0;
+    int umbra = 0, lit = 0;
+    double reach = 0.5 * tan(30.0 * PI / 180.0); /* the box's top edge at 0.5 throws the shadow this far in -z */
+    for (int r = 0; r < W; r++)
+        for (int i = 0; i < W; i++) {
+            double x, z;
+            pixel_xz(i, r, &x, &z); /* relative to the view, which moves with the box */
+            double got = lum(rgb + 3 * (r * W + i));
+            if (fabs(x - 0.5) < 0.2 && z < -0.27 && z > -0.25 - reach + 0.03) {
+                umbra++;
+                worst_umbra = fmax(worst_umbra, got / want);
+            } else if (fabs(x - 0.5) > 0.35 || z > 0.35 || z < -0.25 - reach - 0.1) {
+                lit++;
+                worst_lit = fmax(worst_lit, rel(got, want));
+            }
+        }
+    print_message("%s: %d umbra pixels, worst %.2e of lit; %d lit pixels, worst error %.2e\n", what, umbra,
+                  worst_umbra, lit, worst_lit);
+    assert_true(umbra > 15 && lit > 2000);
+    assert_true(worst_umbra <= 0.01);
+    assert_true(worst_lit < 0.02);
+}
+
+static void test_sun_over_a_large_level(void **state)
+{
+    (void)state;
+    char node[256]; /* rotation about x by -60 degrees: the light travels along (0, -cos 30, -sin 30) */
+    snprintf(node, sizeof node,
+             "{\"rotation\": [%.9f, 0, 0, %.9f], \"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}",
+             sin(-30.0 * PI / 180.0), cos(-30.0 * PI / 180.0));
+    live_scene l;
+    live_load(&l, scene_plane_box("large_level", 1000.0f, 1, 0.25f, node, "{\"type\": \"directional\", \"intensity\": 1}"),
+              3);
+    lm_direct *d = NULL;
+    lm_error err;
+    assert_int_equal(lm_direct_create(l.s, NULL, NULL, &d, &err), LM_OK);
+    float *a = malloc(sizeof(float) * 3 * W * W), *b = malloc(sizeof(float) * 3 * W * W);
+    assert_non_null(a);
+    assert_non_null(b);
+    assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, a, &err), LM_OK);
+    float texel = 0.0f;
+    assert_true(lm_direct_view_map_texel(d, 0, &texel));
+    print_message("sun over 2 km: the view's map texel %.4f m\n", texel);
+    assert_true(texel < 0.02f);
+    check_sun_shadow(a, "sun over 2 km, the view's map");
+    assert_int_equal(lm_direct_view_maps_rendered(d), 1);
+
+    assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, b, &err), LM_OK); /* the same view */
+    assert_memory_equal(a, b, sizeof(float) * 3 * W * W);
+    for (int k = 0; k < 2; k++) { /* a centimetre to the side and back: inside one snap cell */
+        float step = k ? -0.01f : 0.01f, shift[16];
+        lm_mat4_identity(shift);
+        shift[12] = -step;
+        lm_mat4_mul(l.v.view, l.v.view, shift);
+        l.v.eye[0] += step;
+        assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, b, &err), LM_OK);
+    }
+    assert_int_equal(lm_direct_view_maps_rendered(d), 1);
+    assert_int_equal(lm_direct_shadow_maps_rendered(d), 1);
+
+    l.s->nodes[3].translation[0] += 10.0f; /* box and camera 10 m on */
+    live_update(&l);
+    float shift[16];
+    lm_mat4_identity(shift);
+    shift[12] = -10.0f;
+    lm_mat4_mul(l.v.view, l.v.view, shift);
+    l.v.eye[0] += 10.0f;
+    assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, b, &err), LM_OK);
+    check_sun_shadow(b, "the box and the view 10 m on");
+    assert_int_equal(lm_direct_view_maps_rendered(d), 2);
+    lm_direct_free(d);
+    live_free(&l);
+    free(a);
+    free(b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -816,7 +908,7 @@ int main(void)
         cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
         cmocka_unit_test(test_cache_nothing_moved),
         cmocka_unit_test(test_cube_faces_follow_casters), cmocka_unit_test(test_map_budget),
-        cmocka_unit_test(test_map_sides_follow_lights),
+        cmocka_unit_test(test_map_sides_follow_lights), cmocka_unit_test(test_sun_over_a_large_level),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

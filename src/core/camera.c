@@ -70,3 +70,69 @@ int lm_view_from_matrices(const float view[16], const float proj[16], lm_view *o
     snprintf(out->name, sizeof out->name, "application camera");
     return 1;
 }
+
+/* Polygon poly (n points) clipped to the half-space pl . (x, 1) >= 0 (Sutherland-Hodgman) into out;
+ * returns the new count (at most n + 1). */
+static int clip_polygon(const double pl[4], const double (*poly)[3], int n, double (*out)[3])
+{
+    int m = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = poly[i], *b = poly[(i + 1) % n];
+        double fa = pl[0] * a[0] + pl[1] * a[1] + pl[2] * a[2] + pl[3];
+        double fb = pl[0] * b[0] + pl[1] * b[1] + pl[2] * b[2] + pl[3];
+        if (fa >= 0.0)
+            memcpy(out[m++], a, sizeof out[0]);
+        if ((fa >= 0.0) != (fb >= 0.0)) {
+            double t = fa / (fa - fb);
+            for (int k = 0; k < 3; k++)
+                out[m][k] = a[k] + t * (b[k] - a[k]);
+            m++;
+        }
+    }
+    return m;
+}
+
+int lm_view_box_part(const lm_view *v, const float lo[3], const float hi[3], float pts[][3])
+{
+    float vp[16];
+    lm_mat4_mul(vp, v->proj, v->view);
+    double planes[6][4]; /* w + x, w - x, w + y, ...: the clip-space half-spaces as world planes */
+    for (int p = 0; p < 6; p++)
+        for (int k = 0; k < 4; k++)
+            planes[p][k] = (double)vp[k * 4 + 3] + (p % 2 ? -1.0 : 1.0) * (double)vp[k * 4 + p / 2];
+    int n = 0;
+    for (int face = 0; face < 6; face++) { /* face: axis face / 2, at lo (even) or hi (odd) */
+        int axis = face / 2, u = (axis + 1) % 3, w = (axis + 2) % 3;
+        double poly[2][12][3];
+        for (int c = 0; c < 4; c++) {
+            poly[0][c][axis] = face % 2 ? hi[axis] : lo[axis];
+            poly[0][c][u] = c == 1 || c == 2 ? hi[u] : lo[u];
+            poly[0][c][w] = c >= 2 ? hi[w] : lo[w];
+        }
+        int count = 4, cur = 0;
+        for (int p = 0; p < 6 && count > 0; p++, cur ^= 1)
+            count = clip_polygon(planes[p], (const double(*)[3])poly[cur], count, poly[cur ^ 1]);
+        for (int c = 0; c < count && n < LM_VIEW_BOX_POINTS; c++, n++)
+            for (int k = 0; k < 3; k++)
+                pts[n][k] = (float)poly[cur][c][k];
+    }
+    float inv[16];
+    if (!lm_mat4_invert(inv, vp))
+        return n;
+    for (int c = 0; c < 8 && n < LM_VIEW_BOX_POINTS; c++) { /* the frustum's corners inside the box */
+        double ndc[4] = {c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1, 1}, q[4] = {0, 0, 0, 0};
+        for (int r = 0; r < 4; r++)
+            for (int k = 0; k < 4; k++)
+                q[r] += (double)inv[k * 4 + r] * ndc[k];
+        if (!(q[3] > 1e-12 * (fabs(q[0]) + fabs(q[1]) + fabs(q[2]) + 1e-30)))
+            continue; /* at infinity */
+        int inside = 1;
+        for (int k = 0; k < 3; k++) {
+            double x = q[k] / q[3];
+            inside &= x >= lo[k] && x <= hi[k];
+            pts[n][k] = (float)x;
+        }
+        n += inside;
+    }
+    return n;
+}

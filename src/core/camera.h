@@ -39,6 +39,13 @@ typedef struct {
  * alone. */
 int lm_view_sees_box(const lm_view *v, const float lo[3], const float hi[3]);
 
+/* The part of box lo..hi inside v's frustum, as the vertices of that convex part: the box's faces clipped
+ * by the frustum's six planes, and the frustum's corners inside the box (a far plane at infinity has none).
+ * Writes at most LM_VIEW_BOX_POINTS points to pts and returns how many: 0 when the view sees none of the
+ * box. Cost: a few hundred flops. */
+#define LM_VIEW_BOX_POINTS 72
+int lm_view_box_part(const lm_view *v, const float lo[3], const float hi[3], float pts[][3]);
+
 /* A view from an application's matrices (column-major, GL conventions: the camera looks down -z of view
  * space, proj maps to GL clip space). Returns 0 (out untouched) when view is not an invertible affine map. */
 int lm_view_from_matrices(const float view[16], const float proj[16], lm_view *out);

@@ -152,3 +152,39 @@ void lm_quat_slerp(float out[4], const float a[4], const float b[4], float t)
         out[i] = wa * a[i] + wb * bb[i];
     lm_quat_normalize(out);
 }
+
+int lm_mat4_invert(float out[16], const float m[16])
+{
+    /* Gauss-Jordan with partial pivoting, in double: a projection's rows differ by orders of magnitude. */
+    double a[4][8];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) {
+            a[r][c] = m[c * 4 + r];
+            a[r][4 + c] = r == c;
+        }
+    for (int c = 0; c < 4; c++) {
+        int p = c;
+        for (int r = c + 1; r < 4; r++)
+            p = fabs(a[r][c]) > fabs(a[p][c]) ? r : p;
+        if (!(fabs(a[p][c]) > 1e-300))
+            return 0;
+        for (int k = 0; k < 8; k++) {
+            double t = a[c][k];
+            a[c][k] = a[p][k];
+            a[p][k] = t;
+        }
+        double inv = 1.0 / a[c][c];
+        for (int k = 0; k < 8; k++)
+            a[c][k] *= inv;
+        for (int r = 0; r < 4; r++)
+            if (r != c) {
+                double f = a[r][c];
+                for (int k = 0; k < 8; k++)
+                    a[r][k] -= f * a[c][k];
+            }
+    }
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++)
+            out[c * 4 + r] = (float)a[r][4 + c];
+    return 1;
+}

@@ -99,6 +99,8 @@ void lm_mat4_mul(float out[16], const float a[16], const float b[16]); /* out = 
 void lm_mat4_from_trs(float m[16], const float t[3], const float q[4], const float s[3]);
 /* Inverse of a general affine matrix; returns 0 if singular. */
 int lm_mat4_invert_affine(float out[16], const float m[16]);
+/* Inverse of any 4 x 4 matrix (a projection too); returns 0 if singular. */
+int lm_mat4_invert(float out[16], const float m[16]);
 /* Inline: photon shading transforms every hit with these two, without a call per hit. */
 static inline lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p)
 {

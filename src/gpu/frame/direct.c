@@ -36,13 +36,17 @@ typedef struct {
     GLint lpos, ldir, radiant, origin, cos_outer, spot_width, texel, map_size, light_vp;
     GLint view_proj, eye, view_dir, ortho_view, normal_offset, slope_bias, max_slope, const_bias, range, light_range;
     GLint map2d, mapcube, base_tex, lit, use_lit;
+    GLint map_near, near_vp, near_texel, has_near;
 } uniforms;
 
-/* One punctual light's map and the caster geometry versions it was rendered over. */
+/* One punctual light's map and the caster geometry versions it was rendered over; for a directional
+ * light also the map fitted to the frame's view (near.tex 0: none, the view sees most of the scene). */
 typedef struct {
     lm_shadow_map map;
     unsigned long static_version, dynamic_version;
     unsigned long stale_since; /* the update it went stale at, 0 while current */
+    lm_shadow_map near;
+    unsigned long near_static, near_dynamic;
 } cached_map;
 
 struct lm_direct {
@@ -62,6 +66,7 @@ struct lm_direct {
     unsigned long static_version;  /* bumped whenever a static shadow-casting node moves (an edit) */
     unsigned long dynamic_version; /* bumped whenever a dynamic shadow-casting node moves */
     long maps_rendered;
+    long near_rendered;     /* view-fitted sun maps rendered (refresh_near_maps), apart from maps_rendered */
     int maps_left;          /* shadow maps this update may still re-render (-1: every stale one) */
     unsigned long updates;  /* lm_direct_begin_update calls, the clock of stale_since */
     int cube_now, map_now;  /* the map sides the live lights get now (fit_live_sizes) */
@@ -78,6 +83,7 @@ static void find_uniforms(GLuint p, uniforms *u)
     LOC(spot_width); LOC(texel); LOC(map_size); LOC(light_vp); LOC(view_proj); LOC(eye); LOC(view_dir);
     LOC(ortho_view); LOC(normal_offset); LOC(slope_bias); LOC(max_slope); LOC(const_bias); LOC(range); LOC(light_range);
     LOC(map2d); LOC(mapcube); LOC(base_tex); LOC(lit); LOC(use_lit);
+    LOC(map_near); LOC(near_vp); LOC(near_texel); LOC(has_near);
 #undef LOC
 }
 
@@ -90,8 +96,9 @@ static int live_punctual(const lm_scene *s, const lm_emitter *e)
     return e->punctual && !lm_emitter_removed(s, e);
 }
 
-static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_emitter *e, const lm_shadow_map *m)
+static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_emitter *e, const cached_map *c)
 {
+    const lm_shadow_map *m = &c->map;
     int kind = kind_of(e);
     float cos_outer = -2.0f, width = 1.0f;
     if (kind == 1) { /* the same falloff as lm_spot_attenuation */
@@ -114,6 +121,14 @@ static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_em
     glUniformMatrix4fv(u->light_vp, 1, GL_FALSE, m->p.light_vp);
     glActiveTexture(m->p.cube ? GL_TEXTURE1 : GL_TEXTURE0);
     glBindTexture(m->p.cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D, m->tex);
+    glUniform1i(u->has_near, c->near.tex != 0);
+    if (c->near.tex) {
+        glUniformMatrix4fv(u->near_vp, 1, GL_FALSE, c->near.p.light_vp);
+        glUniform1f(u->near_texel, c->near.p.texel);
+    }
+    glActiveTexture(GL_TEXTURE5);
+    glBindTexture(GL_TEXTURE_2D, c->near.tex);
+    glActiveTexture(GL_TEXTURE0);
 }
 
 static void set_view_uniforms(const lm_direct *d, const uniforms *u, const lm_view *view)
@@ -135,6 +150,7 @@ static void set_view_uniforms(const lm_direct *d, const uniforms *u, const lm_vi
     glUniform1i(u->map2d, 0);
     glUniform1i(u->mapcube, 1);
     glUniform1i(u->base_tex, 2);
+    glUniform1i(u->map_near, 5);
 }
 
 /* The vertex ranges of glsl/vertex_ranges.glsl for prog: keep (0, 0: all), drop. */
@@ -195,7 +211,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
     glUseProgram(prog);
     set_ranges(prog, ALL, d->drop);
     set_view_uniforms(d, u, view);
-    set_light_uniforms(u, s, e, &d->maps[light].map);
+    set_light_uniforms(u, s, e, &d->maps[light]);
     bind_indirect(d, u->lit, u->use_lit);
     lm_direct_mesh_draw(&d->mesh, prog);
 }
@@ -274,6 +290,8 @@ static lm_status refresh_maps(lm_direct *d, const lm_scene *s, const lm_emitters
         if (!live_punctual(s, &em->e[i])) {
             if (c->map.tex)
                 lm_shadow_map_free(&c->map);
+            if (c->near.tex)
+                lm_shadow_map_free(&c->near);
             c->stale_since = 0;
         } else if (!map_stale(d, s, &em->e[i], i, &p)) {
             c->stale_since = 0;
@@ -294,6 +312,34 @@ static lm_status refresh_maps(lm_direct *d, const lm_scene *s, const lm_emitters
     return st;
 }
 
+/* The directional lights' maps fitted to the frame's view (lm_shadow_params_fit_view): made or dropped as
+ * the view asks, redrawn when the fit or a caster changed. A camera moving inside one snap cell redraws
+ * nothing; a moving one redraws one map a sun per update, outside the update's map count (it is the
+ * frame's own view, not a light that may wait). */
+static lm_status refresh_near_maps(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view,
+                                   lm_error *err)
+{
+    lm_status st = LM_OK;
+    for (int i = 0; st == LM_OK && i < em->count; i++) {
+        cached_map *c = &d->maps[i];
+        lm_shadow_params p;
+        if (!c->map.tex || !c->map.p.ortho || !lm_shadow_params_fit_view(&p, &c->map.p, s, view)) {
+            if (c->near.tex)
+                lm_shadow_map_free(&c->near);
+            continue;
+        }
+        if (c->near.tex && !memcmp(&p, &c->near.p, sizeof p) && c->near_static == d->static_version &&
+            c->near_dynamic == d->dynamic_version)
+            continue;
+        st = lm_shadow_map_draw(&c->near, &p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_indices,
+                                c->near_static != d->static_version, d->mesh.dynamic_lo, d->mesh.dynamic_hi, err);
+        c->near_static = d->static_version;
+        c->near_dynamic = d->dynamic_version;
+        d->near_rendered++;
+    }
+    return st;
+}
+
 /* A further light: an additive pass over the laid-down depth (its shadow map is ready). */
 static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e, int i, const lm_view *view,
                             int w, int h, lm_error *err)
@@ -309,7 +355,7 @@ static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e
     glUseProgram(prog);
     set_ranges(prog, ALL, d->drop);
     set_view_uniforms(d, &d->u[kind_of(e)], view);
-    set_light_uniforms(&d->u[kind_of(e)], s, e, &d->maps[i].map);
+    set_light_uniforms(&d->u[kind_of(e)], s, e, &d->maps[i]);
     lm_direct_mesh_draw(&d->mesh, prog);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
@@ -340,9 +386,9 @@ static int valid_settings(const lm_direct_settings *set)
     return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0;
 }
 
-/* Shadow-map bytes for `points` point lights and `others` spot and directional ones at the given sides: a
- * cube (6 faces) per point light, a 2D map per spot and directional light, each with its static layer
- * (shadow_maps.h), 4 bytes a texel. */
+/* Shadow-map bytes for `points` point lights and `others` 2D maps at the given sides: a cube (6 faces) per
+ * point light, a 2D map per spot light and two per directional one (the whole scene's and the view's),
+ * each with its static layer (shadow_maps.h), 4 bytes a texel. */
 static double shadow_bytes(int points, int others, int cube_size, int map_size)
 {
     return 2.0 * 4.0 * (6.0 * cube_size * cube_size * points + (double)map_size * map_size * others);
@@ -366,7 +412,7 @@ static lm_status fit_shadow_budget(const lm_scene *s, lm_direct *d, lm_error *er
     int points = 0, others = 0;
     for (int l = 0; l < s->light_count; l++)
         if (!s->lights[l].removed)
-            *(s->lights[l].type == LM_LIGHT_POINT ? &points : &others) += 1;
+            *(s->lights[l].type == LM_LIGHT_POINT ? &points : &others) += s->lights[l].type == LM_LIGHT_DIRECTIONAL ? 2 : 1;
     int cube = d->set.cube_size, map = d->set.map_size;
     fit_sizes(points, others, &cube, &map);
     double mb = 1024.0 * 1024.0, need = shadow_bytes(points, others, cube, map);
@@ -392,7 +438,7 @@ static void fit_live_sizes(lm_direct *d, const lm_scene *s, const lm_emitters *e
     int points = 0, others = 0;
     for (int i = 0; i < em->count; i++)
         if (live_punctual(s, &em->e[i]))
-            *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += 1;
+            *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += em->e[i].kind == LM_EMIT_DIRECTIONAL ? 2 : 1;
     int cube = d->set.cube_size, map = d->set.map_size;
     fit_sizes(points, others, &cube, &map);
     int grows = cube > d->cube_now || map > d->map_now;
@@ -457,8 +503,10 @@ void lm_direct_free(lm_direct *d)
 {
     if (!d)
         return;
-    for (int i = 0; i < d->map_count; i++)
+    for (int i = 0; i < d->map_count; i++) {
         lm_shadow_map_free(&d->maps[i].map);
+        lm_shadow_map_free(&d->maps[i].near);
+    }
     free(d->maps);
     lm_frame_targets_free(&d->targets);
     if (d->coverage_tex)
@@ -521,6 +569,8 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
     d->cur = which;
     fit_live_sizes(d, s, em);
     if ((st = refresh_maps(d, s, em, err)) != LM_OK)
+        return st;
+    if (which == LM_FRAME_VIEW && (st = refresh_near_maps(d, s, em, view, err)) != LM_OK)
         return st;
     int first = -1;
     for (int i = 0; first < 0 && i < em->count; i++)
@@ -630,6 +680,14 @@ void lm_direct_map_sides(const lm_direct *d, int *cube, int *map)
 }
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
+long lm_direct_view_maps_rendered(const lm_direct *d) { return d->near_rendered; }
+int lm_direct_view_map_texel(const lm_direct *d, int i, float *texel)
+{
+    if (i < 0 || i >= d->map_count || !d->maps[i].near.tex)
+        return 0;
+    *texel = d->maps[i].near.p.texel;
+    return 1;
+}
 
 int lm_direct_shadow_maps_held(const lm_direct *d)
 {

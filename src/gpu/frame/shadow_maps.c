@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "../../core/camera.h"
 #include "../../core/vecmath.h"
 #include "../gl/gl_shader.h"
 #include "glsl.h"
@@ -140,17 +141,60 @@ static void spot_map(lm_shadow_params *m, const lm_light *l, lm_vec3 p, lm_vec3 
     m->texel = 2.0f * tanf(half) / (float)m->size;
 }
 
-static void directional_map(lm_shadow_params *m, const lm_scene *s, lm_vec3 d)
+/* A directional light's view: along d towards the scene's centre from 1.01 r upstream, r the scene's
+ * bounding radius, so that the depth range 0..2.02 r holds every caster. */
+static void directional_view(const lm_scene *s, lm_vec3 d, float view[16], lm_vec3 *eye, float *r)
 {
     lm_vec3 lo = lm_v3_load(s->bounds_min), hi = lm_v3_load(s->bounds_max);
     lm_vec3 c = lm_scale(lm_add(lo, hi), 0.5f);
-    float r = fmaxf(0.5f * lm_length(lm_sub(hi, lo)), 1e-4f), view[16], proj[16];
-    lm_vec3 eye = lm_sub(c, lm_scale(d, 1.01f * r));
-    lm_mat4_look_at(view, eye, c, up_for(d));
+    *r = fmaxf(0.5f * lm_length(lm_sub(hi, lo)), 1e-4f);
+    *eye = lm_sub(c, lm_scale(d, 1.01f * *r));
+    lm_mat4_look_at(view, *eye, c, up_for(d));
+}
+
+static void directional_map(lm_shadow_params *m, const lm_scene *s, lm_vec3 d)
+{
+    float r, view[16], proj[16];
+    lm_vec3 eye;
+    directional_view(s, d, view, &eye, &r);
     ortho_proj(proj, r, 2.02f * r);
     lm_mat4_mul(m->light_vp, proj, view);
     lm_v3_store(m->origin, eye);
     m->texel = 2.0f * r / (float)m->size;
+}
+
+int lm_shadow_params_fit_view(lm_shadow_params *near, const lm_shadow_params *whole, const lm_scene *s,
+                              const lm_view *v)
+{
+    if (!whole->ortho)
+        return 0;
+    float pts[LM_VIEW_BOX_POINTS][3], view[16], r;
+    lm_vec3 eye;
+    int n = lm_view_box_part(v, s->bounds_min, s->bounds_max, pts);
+    if (n == 0)
+        return 0;
+    directional_view(s, lm_v3_load(whole->dir), view, &eye, &r);
+    float x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+    for (int i = 0; i < n; i++) {
+        lm_vec3 q = lm_mat4_point(view, lm_v3_load(pts[i]));
+        x0 = fminf(x0, q.x), x1 = fmaxf(x1, q.x), y0 = fminf(y0, q.y), y1 = fmaxf(y1, q.y);
+    }
+    /* Side: the whole map's over a power of two, with room for the corner's snap (a sixteenth), so that a
+     * camera moving inside one cell keeps the same map and a moving one's shadows do not crawl. */
+    float side = 2.0f * r, need = fmaxf(fmaxf(x1 - x0, y1 - y0), 2.0f * r / 65536.0f) * 16.0f / 15.0f;
+    int k = 0;
+    while (k < 16 && side * 0.5f >= need)
+        side *= 0.5f, k++;
+    if (k == 0 || !isfinite(x0 + x1 + y0 + y1))
+        return 0; /* the view sees about half the scene or more: the whole map is as fine */
+    float cell = side / 16.0f, left = floorf(x0 / cell) * cell, bottom = floorf(y0 / cell) * cell, proj[16];
+    ortho_proj(proj, 0.5f * side, 2.02f * r);
+    proj[12] = -(2.0f * left + side) / side;
+    proj[13] = -(2.0f * bottom + side) / side;
+    *near = *whole;
+    lm_mat4_mul(near->light_vp, proj, view);
+    near->texel = side / (float)whole->size;
+    return 1;
 }
 
 void lm_shadow_params_compute(lm_shadow_params *m, const lm_scene *s, const lm_emitter *e, int size)

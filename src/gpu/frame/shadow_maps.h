@@ -1,13 +1,14 @@
 /* Shadow maps for the punctual lights (docs/direct.md): a cube map for a point light, a 2D perspective
  * map for a spot light (its cone = the outer angle) and an orthographic map fitted to the scene's bounds
- * for a directional light. Each texel holds a float distance metric of the nearest caster, divided by the
- * map's range: the distance to the light (point, spot) or the depth along the light's direction
- * (directional). The maps are DEPTH_COMPONENT32F textures with hardware comparison and a linear filter,
- * so one lookup with a reference metric / range returns the lit fraction of the 2 x 2 texels around it
- * (bilinear PCF). */
+ * for a directional light, with a second one fitted to the part of them a view sees. Each texel holds a
+ * float distance metric of the nearest caster, divided by the map's range: the distance to the light
+ * (point, spot) or the depth along the light's direction (directional). The maps are DEPTH_COMPONENT32F
+ * textures with hardware comparison and a linear filter, so one lookup with a reference metric / range
+ * returns the lit fraction of the 2 x 2 texels around it (bilinear PCF). */
 #ifndef LM_SHADOW_MAPS_H
 #define LM_SHADOW_MAPS_H
 
+#include "../../core/camera.h"
 #include "../../core/error.h"
 #include "../../scene/scene.h"
 #include "../../trace/lights.h"
@@ -51,6 +52,14 @@ void lm_shadow_renderer_free(lm_shadow_renderer *r);
 
 /* The parameters of punctual emitter e's map (pos/dir current, s->bounds current). */
 void lm_shadow_params_compute(lm_shadow_params *p, const lm_scene *s, const lm_emitter *e, int size);
+/* A directional light's map fitted to what view v sees of the scene (docs/direct.md, "The view's sun
+ * map"): the part of the scene's bounds inside v's frustum, as the light sees it, in a square a power of
+ * two smaller than `whole`'s (the light's whole-scene map, lm_shadow_params_compute), its corner on a
+ * sixteenth of its side. Same size, origin, direction and depth range as `whole`, so its metric is the
+ * same. Returns 0 (near untouched) for a map that is not directional, a view that sees none of the scene,
+ * or one that sees about half of it or more (the whole map is then as fine). */
+int lm_shadow_params_fit_view(lm_shadow_params *near, const lm_shadow_params *whole, const lm_scene *s,
+                              const lm_view *v);
 /* Renders map m with parameters p over the caster triangles `casters` (attribute 0 = world position),
  * (re)allocating its textures when the kind or size changed. The first static_count vertices (indices
  * when the mesh is indexed) are static casters: when some follow them, the static ones are drawn into

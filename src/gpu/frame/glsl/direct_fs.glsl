@@ -22,6 +22,10 @@ uniform float normal_offset, slope_bias, max_slope, const_bias, range;
 uniform float light_range; /* KHR_lights_punctual range, 0: none (lm_light_range_window) */
 uniform mat4 light_vp;
 uniform sampler2DShadow map2d;   /* metric / range, compared in the sampler (bilinear PCF) */
+uniform sampler2DShadow map_near; /* directional: the map fitted to the view, same metric (has_near) */
+uniform mat4 near_vp;
+uniform float near_texel;
+uniform int has_near;
 uniform samplerCubeShadow mapcube;
 #if FIRST
 layout(location = 0) out vec4 frag;
@@ -41,28 +45,38 @@ float cube_shadow(vec3 q, float m, float T) {
             lit += texture(mapcube, vec4(d + (tap(i) * t + tap(j) * b) * T, ref));
     return lit;
 }
-float map_shadow(vec3 q, float m) {
-    vec4 c = light_vp * vec4(q, 1.0);
+float map_shadow(sampler2DShadow map, mat4 vp, vec3 q, float m) {
+    vec4 c = vp * vec4(q, 1.0);
     vec2 uv = c.xy / c.w * 0.5 + 0.5;
     float lit = 0.0, ref = m / range;
     for (int i = 0; i < taps; i++)
         for (int j = 0; j < taps; j++) {
             vec2 u = uv + vec2(tap(i), tap(j)) / map_size;
             bool out_ = any(lessThan(u, vec2(0.0))) || any(greaterThan(u, vec2(1.0)));
-            lit += out_ ? 1.0 : texture(map2d, vec3(u, ref));
+            lit += out_ ? 1.0 : texture(map, vec3(u, ref));
         }
     return lit;
+}
+// A directional light's map fitted to the view (has_near), where p and its PCF taps fall inside it; the
+// light's whole-scene map elsewhere (direct.c, refresh_near_maps).
+bool in_near(vec3 p) {
+    if (kind != 2 || has_near == 0) return false;
+    vec2 uv = (near_vp * vec4(p, 1.0)).xy * 0.5 + 0.5;
+    float edge = (normal_offset + float(taps) + 1.0) / map_size;
+    return all(greaterThan(uv, vec2(edge))) && all(lessThan(uv, vec2(1.0 - edge)));
 }
 // Fraction of PCF taps that see the light from p (geometric normal ng, unit L towards the light).
 float shadow(vec3 p, vec3 ng, vec3 L, float dist) {
     float c = clamp(dot(ng, L), 1e-4, 1.0);
     float tan_t = min(sqrt(1.0 - c * c) / c, max_slope);
     vec3 a = kind == 0 ? abs(L) : vec3(abs(dot(L, ldir)));
-    float T = kind == 2 ? texel : texel * dist / max(max(a.x, a.y), max(a.z, 0.2));
+    bool near = in_near(p);
+    float T = kind == 2 ? (near ? near_texel : texel) : texel * dist / max(max(a.x, a.y), max(a.z, 0.2));
     vec3 q = p + ng * (normal_offset * T);
     float bias = T * (const_bias + slope_bias * float(pcf + 1) * tan_t);
     float m = (kind == 2 ? dot(q - origin, ldir) : length(q - lpos)) - bias;
-    float lit = kind == 0 ? cube_shadow(q, m, T) : map_shadow(q, m);
+    float lit = kind == 0 ? cube_shadow(q, m, T) : near ? map_shadow(map_near, near_vp, q, m)
+                                                        : map_shadow(map2d, light_vp, q, m);
     return lit / float(taps * taps);
 }
 #include "lobes.glsl"
