@@ -75,8 +75,13 @@ float shadow(vec3 p, vec3 ng, vec3 L, float dist) {
     vec3 q = p + ng * (normal_offset * T);
     float bias = T * (const_bias + slope_bias * float(pcf + 1) * tan_t);
     float m = (kind == 2 ? dot(q - origin, ldir) : length(q - lpos)) - bias;
-    float lit = kind == 0 ? cube_shadow(q, m, T) : near ? map_shadow(map_near, near_vp, q, m)
-                                                        : map_shadow(map2d, light_vp, q, m);
+    float lit; /* branches, not ?: (llvmpipe evaluates both sides of a select: twice the lookups) */
+    if (kind == 0)
+        lit = cube_shadow(q, m, T);
+    else if (near)
+        lit = map_shadow(map_near, near_vp, q, m);
+    else
+        lit = map_shadow(map2d, light_vp, q, m);
     return lit / float(taps * taps);
 }
 #include "lobes.glsl"
