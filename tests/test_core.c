@@ -87,8 +87,9 @@ static void part_bounds(const lm_view *v, const float lo[3], const float hi[3], 
 }
 
 /* lm_view_box_part: a 90-degree camera at the origin looking down -z (near 1, far 100). A slab z in
- * [-10, -5] wider than the view: the frustum's slice, corners (+-5, +-5, -5) and (+-10, +-10, -10). A box
- * holding the whole frustum: its 8 corners. A box behind the camera: nothing. */
+ * [-10, -5] wider than the view: the frustum's slice, corners (+-5, +-5, -5) and (+-10, +-10, -10); no
+ * deeper than 7.5: (+-7.5, +-7.5, -7.5) the far ones. A box holding the whole frustum: its 8 corners. A
+ * box behind the camera: nothing. lm_view_box_reach: the slab's 10, the far plane's 100. */
 static void test_view_box_part(void **state)
 {
     (void)state;
@@ -98,7 +99,7 @@ static void test_view_box_part(void **state)
     lm_mat4_perspective(v.proj, (float)M_PI / 2, 1.0f, 1.0f, 100.0f);
     float pts[LM_VIEW_BOX_POINTS][3], b0[3], b1[3];
     const float lo[3] = {-100, -100, -10}, hi[3] = {100, 100, -5};
-    int n = lm_view_box_part(&v, lo, hi, pts);
+    int n = lm_view_box_part(&v, lo, hi, 0.0f, pts);
     assert_true(n >= 8);
     part_bounds(&v, lo, hi, pts, n, b0, b1);
     const float want0[3] = {-10, -10, -10}, want1[3] = {10, 10, -5};
@@ -106,8 +107,17 @@ static void test_view_box_part(void **state)
         assert_float_equal(b0[k], want0[k], 1e-3);
         assert_float_equal(b1[k], want1[k], 1e-3);
     }
+    assert_float_equal(lm_view_box_reach(&v, lo, hi), 10.0f, 1e-3);
+    n = lm_view_box_part(&v, lo, hi, 7.5f, pts);
+    part_bounds(&v, lo, hi, pts, n, b0, b1);
+    const float cut0[3] = {-7.5f, -7.5f, -7.5f}, cut1[3] = {7.5f, 7.5f, -5};
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(b0[k], cut0[k], 1e-3);
+        assert_float_equal(b1[k], cut1[k], 1e-3);
+    }
     const float big0[3] = {-200, -200, -200}, big1[3] = {200, 200, 200};
-    n = lm_view_box_part(&v, big0, big1, pts);
+    assert_float_equal(lm_view_box_reach(&v, big0, big1), 100.0f, 1e-2);
+    n = lm_view_box_part(&v, big0, big1, 0.0f, pts);
     part_bounds(&v, big0, big1, pts, n, b0, b1);
     const float f0[3] = {-100, -100, -100}, f1[3] = {100, 100, -1};
     for (int k = 0; k < 3; k++) {
@@ -115,7 +125,7 @@ static void test_view_box_part(void **state)
         assert_float_equal(b1[k], f1[k], 1e-2);
     }
     const float back0[3] = {-5, -5, 2}, back1[3] = {5, 5, 8};
-    assert_int_equal(lm_view_box_part(&v, back0, back1, pts), 0);
+    assert_int_equal(lm_view_box_part(&v, back0, back1, 0.0f, pts), 0);
 }
 
 static void test_normal_transform_non_uniform_scale(void **state)

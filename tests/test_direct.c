@@ -198,10 +198,37 @@ static const char *box_scene(void)
 /* The umbra of box_scene's box (centred at (0.5, 1, box_z)) in a top view of the plane: the umbra
  * pixels' worst fraction of the unshadowed radiance and the lit pixels' worst error; the box's own
  * footprint (seen from above: its top) is skipped. Asserts enough of each. */
+/* What a shadow test saw: pixels in the umbra and their worst against the lit value, lit pixels and their
+ * worst relative error. */
+typedef struct {
+    int umbra, lit;
+    double worst_umbra, worst_lit;
+} shadow_tally;
+
+static void tally_add(shadow_tally *t, int in_umbra, double got, double want)
+{
+    if (in_umbra) {
+        t->umbra++;
+        t->worst_umbra = fmax(t->worst_umbra, got / want);
+    } else {
+        t->lit++;
+        t->worst_lit = fmax(t->worst_lit, rel(got, want));
+    }
+}
+
+/* Enough of each, the umbra at most 1% of lit, the lit within lit_tol. */
+static void tally_check(const shadow_tally *t, const char *what, int min_umbra, int min_lit, double lit_tol)
+{
+    print_message("%s: %d umbra pixels, worst %.2e of lit; %d lit pixels, worst error %.2e\n", what, t->umbra,
+                  t->worst_umbra, t->lit, t->worst_lit);
+    assert_true(t->umbra > min_umbra && t->lit > min_lit);
+    assert_true(t->worst_umbra <= 0.01);
+    assert_true(t->worst_lit < lit_tol);
+}
+
 static void check_box_shadow(const char *what, const float *rgb, double box_z)
 {
-    int umbra = 0, lit = 0;
-    double worst_umbra = 0.0, worst_lit = 0.0;
+    shadow_tally t = {0};
     for (int r = 0; r < W; r++)
         for (int i = 0; i < W; i++) {
             double x, z;
@@ -209,20 +236,10 @@ static void check_box_shadow(const char *what, const float *rgb, double box_z)
             if (fabs(x - 0.5) < 0.35 && fabs(z - box_z) < 0.35)
                 continue; /* the box top */
             double d2 = x * x + z * z + 4.0, want = RHO / PI * 20.0 / (d2 * sqrt(d2));
-            double got = lum(rgb + 3 * (r * W + i));
-            if (hits_box(x, z, box_z, 0.2)) {
-                umbra++;
-                worst_umbra = fmax(worst_umbra, got / want);
-            } else if (!hits_box(x, z, box_z, 0.3)) {
-                lit++;
-                worst_lit = fmax(worst_lit, rel(got, want));
-            }
+            if (hits_box(x, z, box_z, 0.2) || !hits_box(x, z, box_z, 0.3))
+                tally_add(&t, hits_box(x, z, box_z, 0.2), lum(rgb + 3 * (r * W + i)), want);
         }
-    print_message("%s: %d umbra pixels, worst %.2e of lit; %d lit pixels, worst error %.2e\n", what, umbra,
-                  worst_umbra, lit, worst_lit);
-    assert_true(umbra > 50 && lit > 1000);
-    assert_true(worst_umbra <= 0.01);
-    assert_true(worst_lit < 0.03);
+    tally_check(&t, what, 50, 1000, 0.03);
 }
 
 /* (b) The umbra of a box between the light and the plane. */
@@ -824,27 +841,18 @@ static void test_map_sides_follow_lights(void **state)
  * redraws no map; moved 10 m it redraws the view's map once, and the shadow is the same. */
 static void check_sun_shadow(const float *rgb, const char *what)
 {
-    double want = RHO / PI * cos(30.0 * PI / 180.0), worst_umbra = 0.0, worst_lit = 0.0;
-    int umbra = 0, lit = 0;
+    double want = RHO / PI * cos(30.0 * PI / 180.0);
+    shadow_tally t = {0};
     double reach = 0.5 * tan(30.0 * PI / 180.0); /* the box's top edge at 0.5 throws the shadow this far in -z */
     for (int r = 0; r < W; r++)
         for (int i = 0; i < W; i++) {
             double x, z;
             pixel_xz(i, r, &x, &z); /* relative to the view, which moves with the box */
-            double got = lum(rgb + 3 * (r * W + i));
-            if (fabs(x - 0.5) < 0.2 && z < -0.27 && z > -0.25 - reach + 0.03) {
-                umbra++;
-                worst_umbra = fmax(worst_umbra, got / want);
-            } else if (fabs(x - 0.5) > 0.35 || z > 0.35 || z < -0.25 - reach - 0.1) {
-                lit++;
-                worst_lit = fmax(worst_lit, rel(got, want));
-            }
+            int umbra = fabs(x - 0.5) < 0.2 && z < -0.27 && z > -0.25 - reach + 0.03;
+            if (umbra || fabs(x - 0.5) > 0.35 || z > 0.35 || z < -0.25 - reach - 0.1)
+                tally_add(&t, umbra, lum(rgb + 3 * (r * W + i)), want);
         }
-    print_message("%s: %d umbra pixels, worst %.2e of lit; %d lit pixels, worst error %.2e\n", what, umbra,
-                  worst_umbra, lit, worst_lit);
-    assert_true(umbra > 15 && lit > 2000);
-    assert_true(worst_umbra <= 0.01);
-    assert_true(worst_lit < 0.02);
+    tally_check(&t, what, 15, 2000, 0.02);
 }
 
 static void test_sun_over_a_large_level(void **state)
@@ -865,7 +873,7 @@ static void test_sun_over_a_large_level(void **state)
     assert_non_null(b);
     assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, a, &err), LM_OK);
     float texel = 0.0f;
-    assert_true(lm_direct_view_map_texel(d, 0, &texel));
+    assert_true(lm_direct_view_map_texel(d, 0, 1, &texel));
     print_message("sun over 2 km: the view's map texel %.4f m\n", texel);
     assert_true(texel < 0.02f);
     check_sun_shadow(a, "sun over 2 km, the view's map");
@@ -894,6 +902,43 @@ static void test_sun_over_a_large_level(void **state)
     assert_int_equal(lm_direct_render(d, l.s, &l.em, &l.v, W, W, b, &err), LM_OK);
     check_sun_shadow(b, "the box and the view 10 m on");
     assert_int_equal(lm_direct_view_maps_rendered(d), 2);
+
+    /* A perspective camera 3 m up on the shadow's side looking out over the plane, far 100: the nearest
+     * 25 m get their own map (the nearer cascade), which holds the box; its umbra black and a ring round
+     * it lit. */
+    lm_view p;
+    memset(&p, 0, sizeof p);
+    lm_vec3 eye = lm_v3(10.5f, 3.0f, -3.5f);
+    lm_mat4_look_at(p.view, eye, lm_v3(10.5f, 0.0f, 12.0f), lm_v3(0, 1, 0)); /* over the box, to the horizon */
+    lm_mat4_perspective(p.proj, 1.4f, 1.0f, 0.1f, 100.0f);
+    lm_v3_store(p.eye, eye);
+    assert_int_equal(lm_direct_render(d, l.s, &l.em, &p, W, W, b, &err), LM_OK);
+    float near_texel = 0.0f, far_texel = 0.0f;
+    assert_true(lm_direct_view_map_texel(d, 0, 0, &near_texel));
+    assert_true(lm_direct_view_map_texel(d, 0, 1, &far_texel));
+    print_message("perspective view: cascade texels %.4f m and %.4f m\n", near_texel, far_texel);
+    assert_true(near_texel < far_texel && near_texel < 0.1f);
+    float vp[16];
+    lm_mat4_mul(vp, p.proj, p.view);
+    double want = RHO / PI * cos(30.0 * PI / 180.0);
+    shadow_tally t = {0};
+    for (int k = 0; k < 400; k++) { /* umbra points, then a ring 1.2-1.8 m from the box */
+        double x, z;
+        if (k < 100) {
+            x = 10.4 + 0.2 * (k % 10) / 9.0, z = -0.30 - 0.12 * (k / 10) / 9.0;
+        } else {
+            double a = 2.0 * PI * (k - 100) / 300.0, r = 1.2 + 0.6 * ((k * 7) % 300) / 300.0;
+            x = 10.5 + r * cos(a), z = r * sin(a);
+        }
+        float c[4];
+        for (int q = 0; q < 4; q++)
+            c[q] = vp[q] * (float)x + vp[12 + q] + vp[8 + q] * (float)z;
+        int i = (int)((c[0] / c[3] * 0.5f + 0.5f) * W), r = (int)((0.5f - c[1] / c[3] * 0.5f) * W);
+        if (i < 0 || i >= W || r < 0 || r >= W)
+            continue;
+        tally_add(&t, k < 100, lum(b + 3 * (r * W + i)), want);
+    }
+    tally_check(&t, "perspective view, the near cascade (points, not pixels)", 80, 200, 0.02);
     lm_direct_free(d);
     live_free(&l);
     free(a);

@@ -92,47 +92,122 @@ static int clip_polygon(const double pl[4], const double (*poly)[3], int n, doub
     return m;
 }
 
-int lm_view_box_part(const lm_view *v, const float lo[3], const float hi[3], float pts[][3])
+/* Clips the convex polygon poly (n points) by every half-space of planes and appends what is left to pts
+ * (at *n_out, up to LM_VIEW_BOX_POINTS). */
+static void clip_append(const double (*planes)[4], int plane_count, const double (*poly)[3], int n, float (*pts)[3],
+                        int *n_out)
 {
-    float vp[16];
+    double buf[2][4 + 8][3];
+    memcpy(buf[0], poly, sizeof buf[0][0] * (size_t)n);
+    int cur = 0;
+    for (int p = 0; p < plane_count && n > 0; p++, cur ^= 1)
+        n = clip_polygon(planes[p], (const double(*)[3])buf[cur], n, buf[cur ^ 1]);
+    for (int c = 0; c < n && *n_out < LM_VIEW_BOX_POINTS; c++, (*n_out)++)
+        for (int k = 0; k < 3; k++)
+            pts[*n_out][k] = (float)buf[cur][c][k];
+}
+
+/* q = m (x, y, z, 1), in double. */
+static void transform4(const float m[16], double x, double y, double z, double q[4])
+{
+    for (int r = 0; r < 4; r++)
+        q[r] = (double)m[r] * x + (double)m[4 + r] * y + (double)m[8 + r] * z + (double)m[12 + r];
+}
+
+/* Depth in front of the eye of view matrix z: -(row 2 . (p, 1)). */
+#define DEPTH(p) (-((double)z[2] * (p)[0] + (double)z[6] * (p)[1] + (double)z[10] * (p)[2] + (double)z[14]))
+
+float lm_view_box_reach(const lm_view *v, const float lo[3], const float hi[3])
+{
+    const float *z = v->view;
+    double reach = -INFINITY, q[4];
+    for (int c = 0; c < 8; c++) {
+        double corner[3] = {c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2]};
+        reach = fmax(reach, DEPTH(corner));
+    }
+    float vp[16], inv[16];
     lm_mat4_mul(vp, v->proj, v->view);
-    double planes[6][4]; /* w + x, w - x, w + y, ...: the clip-space half-spaces as world planes */
-    for (int p = 0; p < 6; p++)
+    if (lm_mat4_invert(inv, vp)) {
+        transform4(inv, 0.0, 0.0, 1.0, q); /* the far plane's centre */
+        if (q[3] > 1e-12 * (fabs(q[0]) + fabs(q[1]) + fabs(q[2]))) {
+            double far[3] = {q[0] / q[3], q[1] / q[3], q[2] / q[3]};
+            reach = fmin(reach, DEPTH(far));
+        }
+    }
+    return (float)reach;
+}
+
+int lm_view_box_part(const lm_view *v, const float lo[3], const float hi[3], float max_depth, float pts[][3])
+{
+    float vp[16], inv[16];
+    lm_mat4_mul(vp, v->proj, v->view);
+    if (!lm_mat4_invert(inv, vp))
+        return 0;
+    const float *z = v->view;
+    double reach = lm_view_box_reach(v, lo, hi); /* no farther than the box, the far plane and max_depth */
+    if (max_depth > 0.0f)
+        reach = fmin(reach, (double)max_depth);
+    /* The frustum cut at depth `reach`: corners c = x + 2 y + 4 z (z 0 near, 1 cut). */
+    double corner[8][3];
+    for (int c = 0; c < 4; c++) {
+        double x = c & 1 ? 1.0 : -1.0, y = c & 2 ? 1.0 : -1.0, n[4], f[4];
+        transform4(inv, x, y, -1.0, n);
+        transform4(inv, x, y, 1.0, f);
+        if (!(n[3] > 0.0))
+            return 0;
+        for (int k = 0; k < 3; k++)
+            corner[c][k] = n[k] / n[3];
+        double dn = DEPTH(corner[c]), dir[3], dd;
+        if (reach <= dn)
+            return 0; /* the box lies nearer than the near plane */
+        if (f[3] > 1e-12 * (fabs(f[0]) + fabs(f[1]) + fabs(f[2]))) { /* a finite far plane */
+            for (int k = 0; k < 3; k++)
+                dir[k] = f[k] / f[3] - corner[c][k];
+        } else {
+            for (int k = 0; k < 3; k++)
+                dir[k] = f[k];
+        }
+        dd = DEPTH(dir) + (double)z[14]; /* the direction's depth, without the translation */
+        double t = dd > 0.0 ? (reach - dn) / dd : 0.0;
+        if (f[3] > 1e-12 * (fabs(f[0]) + fabs(f[1]) + fabs(f[2])))
+            t = fmin(t, 1.0);
+        for (int k = 0; k < 3; k++)
+            corner[c + 4][k] = corner[c][k] + t * dir[k];
+    }
+    double cut = DEPTH(corner[4]);
+    double planes[6][4]; /* the frustum's sides and near plane (clip space's w + x, w - x, ...), the cut */
+    for (int p = 0; p < 5; p++)
         for (int k = 0; k < 4; k++)
             planes[p][k] = (double)vp[k * 4 + 3] + (p % 2 ? -1.0 : 1.0) * (double)vp[k * 4 + p / 2];
-    int n = 0;
-    for (int face = 0; face < 6; face++) { /* face: axis face / 2, at lo (even) or hi (odd) */
-        int axis = face / 2, u = (axis + 1) % 3, w = (axis + 2) % 3;
-        double poly[2][12][3];
-        for (int c = 0; c < 4; c++) {
-            poly[0][c][axis] = face % 2 ? hi[axis] : lo[axis];
-            poly[0][c][u] = c == 1 || c == 2 ? hi[u] : lo[u];
-            poly[0][c][w] = c >= 2 ? hi[w] : lo[w];
-        }
-        int count = 4, cur = 0;
-        for (int p = 0; p < 6 && count > 0; p++, cur ^= 1)
-            count = clip_polygon(planes[p], (const double(*)[3])poly[cur], count, poly[cur ^ 1]);
-        for (int c = 0; c < count && n < LM_VIEW_BOX_POINTS; c++, n++)
-            for (int k = 0; k < 3; k++)
-                pts[n][k] = (float)poly[cur][c][k];
+    for (int k = 0; k < 3; k++) /* depth <= cut */
+        planes[5][k] = (double)z[k * 4 + 2];
+    planes[5][3] = (double)z[14] + cut;
+    double box[6][4]; /* x >= lo, x <= hi, ... */
+    for (int f = 0; f < 6; f++) {
+        memset(box[f], 0, sizeof box[f]);
+        box[f][f / 2] = f % 2 ? -1.0 : 1.0;
+        box[f][3] = f % 2 ? hi[f / 2] : -lo[f / 2];
     }
-    float inv[16];
-    if (!lm_mat4_invert(inv, vp))
-        return n;
-    for (int c = 0; c < 8 && n < LM_VIEW_BOX_POINTS; c++) { /* the frustum's corners inside the box */
-        double ndc[4] = {c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1, 1}, q[4] = {0, 0, 0, 0};
-        for (int r = 0; r < 4; r++)
-            for (int k = 0; k < 4; k++)
-                q[r] += (double)inv[k * 4 + r] * ndc[k];
-        if (!(q[3] > 1e-12 * (fabs(q[0]) + fabs(q[1]) + fabs(q[2]) + 1e-30)))
-            continue; /* at infinity */
-        int inside = 1;
-        for (int k = 0; k < 3; k++) {
-            double x = q[k] / q[3];
-            inside &= x >= lo[k] && x <= hi[k];
-            pts[n][k] = (float)x;
+    /* A vertex of the part lies on a face of the box or of the cut frustum, and that face clipped by the
+     * other solid keeps it. */
+    int n = 0;
+    for (int face = 0; face < 6; face++) {
+        int axis = face / 2, u = (axis + 1) % 3, w = (axis + 2) % 3;
+        double poly[4][3];
+        for (int c = 0; c < 4; c++) {
+            poly[c][axis] = face % 2 ? hi[axis] : lo[axis];
+            poly[c][u] = c == 1 || c == 2 ? hi[u] : lo[u];
+            poly[c][w] = c >= 2 ? hi[w] : lo[w];
         }
-        n += inside;
+        clip_append((const double(*)[4])planes, 6, (const double(*)[3])poly, 4, pts, &n);
+    }
+    static const int faces[6][4] = {{0, 2, 6, 4}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 3, 7, 6}, {0, 1, 3, 2}, {4, 5, 7, 6}};
+    for (int f = 0; f < 6; f++) {
+        double poly[4][3];
+        for (int c = 0; c < 4; c++)
+            memcpy(poly[c], corner[faces[f][c]], sizeof poly[c]);
+        clip_append((const double(*)[4])box, 6, (const double(*)[3])poly, 4, pts, &n);
     }
     return n;
 }
+#undef DEPTH

@@ -39,12 +39,16 @@ typedef struct {
  * alone. */
 int lm_view_sees_box(const lm_view *v, const float lo[3], const float hi[3]);
 
-/* The part of box lo..hi inside v's frustum, as the vertices of that convex part: the box's faces clipped
- * by the frustum's six planes, and the frustum's corners inside the box (a far plane at infinity has none).
- * Writes at most LM_VIEW_BOX_POINTS points to pts and returns how many: 0 when the view sees none of the
- * box. Cost: a few hundred flops. */
-#define LM_VIEW_BOX_POINTS 72
-int lm_view_box_part(const lm_view *v, const float lo[3], const float hi[3], float pts[][3]);
+/* The part of box lo..hi inside v's frustum, no deeper than max_depth in front of the eye (<= 0: to the
+ * far plane), as the vertices of that convex part: the box's faces clipped by the cut frustum's planes and
+ * the cut frustum's faces clipped by the box's (a far plane at infinity is cut at the box's farthest
+ * corner). Writes at most LM_VIEW_BOX_POINTS points to pts and returns how many: 0 when the view sees
+ * none of the box. Cost: a few thousand flops. */
+#define LM_VIEW_BOX_POINTS 128
+/* How deep in front of v's eye the box lo..hi reaches: its farthest corner's depth, or the far plane's
+ * where that is nearer. */
+float lm_view_box_reach(const lm_view *v, const float lo[3], const float hi[3]);
+int lm_view_box_part(const lm_view *v, const float lo[3], const float hi[3], float max_depth, float pts[][3]);
 
 /* A view from an application's matrices (column-major, GL conventions: the camera looks down -z of view
  * space, proj maps to GL clip space). Returns 0 (out untouched) when view is not an invertible affine map. */

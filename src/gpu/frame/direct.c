@@ -36,17 +36,18 @@ typedef struct {
     GLint lpos, ldir, radiant, origin, cos_outer, spot_width, texel, map_size, light_vp;
     GLint view_proj, eye, view_dir, ortho_view, normal_offset, slope_bias, max_slope, const_bias, range, light_range;
     GLint map2d, mapcube, base_tex, lit, use_lit;
-    GLint map_near, near_vp, near_texel, has_near;
+    GLint map_near[LM_VIEW_CASCADES], near_vp, near_texel, has_near;
 } uniforms;
 
 /* One punctual light's map and the caster geometry versions it was rendered over; for a directional
- * light also the map fitted to the frame's view (near.tex 0: none, the view sees most of the scene). */
+ * light also the maps fitted to the frame's view, the nearest quarter of its depth and all of it (a
+ * cascade's tex 0: none). */
 typedef struct {
     lm_shadow_map map;
     unsigned long static_version, dynamic_version;
     unsigned long stale_since; /* the update it went stale at, 0 while current */
-    lm_shadow_map near;
-    unsigned long near_static, near_dynamic;
+    lm_shadow_map near[LM_VIEW_CASCADES];
+    unsigned long near_static[LM_VIEW_CASCADES], near_dynamic[LM_VIEW_CASCADES];
 } cached_map;
 
 struct lm_direct {
@@ -83,7 +84,9 @@ static void find_uniforms(GLuint p, uniforms *u)
     LOC(spot_width); LOC(texel); LOC(map_size); LOC(light_vp); LOC(view_proj); LOC(eye); LOC(view_dir);
     LOC(ortho_view); LOC(normal_offset); LOC(slope_bias); LOC(max_slope); LOC(const_bias); LOC(range); LOC(light_range);
     LOC(map2d); LOC(mapcube); LOC(base_tex); LOC(lit); LOC(use_lit);
-    LOC(map_near); LOC(near_vp); LOC(near_texel); LOC(has_near);
+    LOC(near_vp); LOC(near_texel); LOC(has_near);
+    u->map_near[0] = glGetUniformLocation(p, "map_near0");
+    u->map_near[1] = glGetUniformLocation(p, "map_near1");
 #undef LOC
 }
 
@@ -121,13 +124,18 @@ static void set_light_uniforms(const uniforms *u, const lm_scene *s, const lm_em
     glUniformMatrix4fv(u->light_vp, 1, GL_FALSE, m->p.light_vp);
     glActiveTexture(m->p.cube ? GL_TEXTURE1 : GL_TEXTURE0);
     glBindTexture(m->p.cube ? GL_TEXTURE_CUBE_MAP : GL_TEXTURE_2D, m->tex);
-    glUniform1i(u->has_near, c->near.tex != 0);
-    if (c->near.tex) {
-        glUniformMatrix4fv(u->near_vp, 1, GL_FALSE, c->near.p.light_vp);
-        glUniform1f(u->near_texel, c->near.p.texel);
+    int has[LM_VIEW_CASCADES];
+    float vps[16 * LM_VIEW_CASCADES], texels[LM_VIEW_CASCADES];
+    for (int k = 0; k < LM_VIEW_CASCADES; k++) {
+        has[k] = c->near[k].tex != 0;
+        memcpy(vps + 16 * k, c->near[k].p.light_vp, sizeof c->near[k].p.light_vp);
+        texels[k] = c->near[k].p.texel;
+        glActiveTexture(GL_TEXTURE5 + (GLenum)k);
+        glBindTexture(GL_TEXTURE_2D, c->near[k].tex);
     }
-    glActiveTexture(GL_TEXTURE5);
-    glBindTexture(GL_TEXTURE_2D, c->near.tex);
+    glUniform1iv(u->has_near, LM_VIEW_CASCADES, has);
+    glUniformMatrix4fv(u->near_vp, LM_VIEW_CASCADES, GL_FALSE, vps);
+    glUniform1fv(u->near_texel, LM_VIEW_CASCADES, texels);
     glActiveTexture(GL_TEXTURE0);
 }
 
@@ -150,7 +158,8 @@ static void set_view_uniforms(const lm_direct *d, const uniforms *u, const lm_vi
     glUniform1i(u->map2d, 0);
     glUniform1i(u->mapcube, 1);
     glUniform1i(u->base_tex, 2);
-    glUniform1i(u->map_near, 5);
+    for (int k = 0; k < LM_VIEW_CASCADES; k++)
+        glUniform1i(u->map_near[k], 5 + k);
 }
 
 /* The vertex ranges of glsl/vertex_ranges.glsl for prog: keep (0, 0: all), drop. */
@@ -290,8 +299,8 @@ static lm_status refresh_maps(lm_direct *d, const lm_scene *s, const lm_emitters
         if (!live_punctual(s, &em->e[i])) {
             if (c->map.tex)
                 lm_shadow_map_free(&c->map);
-            if (c->near.tex)
-                lm_shadow_map_free(&c->near);
+            for (int k = 0; k < LM_VIEW_CASCADES; k++)
+                lm_shadow_map_free(&c->near[k]);
             c->stale_since = 0;
         } else if (!map_stale(d, s, &em->e[i], i, &p)) {
             c->stale_since = 0;
@@ -312,30 +321,42 @@ static lm_status refresh_maps(lm_direct *d, const lm_scene *s, const lm_emitters
     return st;
 }
 
-/* The directional lights' maps fitted to the frame's view (lm_shadow_params_fit_view): made or dropped as
- * the view asks, redrawn when the fit or a caster changed. A camera moving inside one snap cell redraws
- * nothing; a moving one redraws one map a sun per update, outside the update's map count (it is the
- * frame's own view, not a light that may wait). */
+/* The directional lights' maps fitted to the frame's view (lm_shadow_params_fit_view): the nearest
+ * quarter of its depth into the scene and all of it, each made or dropped as the view asks (the near one
+ * also when it would be no finer than the other), redrawn when its fit or a caster changed. A camera
+ * moving inside one snap cell redraws nothing; a moving one redraws up to two maps a sun per update,
+ * outside the update's map count (it is the frame's own view, not a light that may wait). */
 static lm_status refresh_near_maps(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view,
                                    lm_error *err)
 {
     lm_status st = LM_OK;
+    float reach = lm_view_box_reach(view, s->bounds_min, s->bounds_max);
     for (int i = 0; st == LM_OK && i < em->count; i++) {
         cached_map *c = &d->maps[i];
-        lm_shadow_params p;
-        if (!c->map.tex || !c->map.p.ortho || !lm_shadow_params_fit_view(&p, &c->map.p, s, view)) {
-            if (c->near.tex)
-                lm_shadow_map_free(&c->near);
-            continue;
+        lm_shadow_params p[LM_VIEW_CASCADES];
+        int fit[LM_VIEW_CASCADES];
+        for (int k = 0; k < LM_VIEW_CASCADES; k++) {
+            float depth = k + 1 < LM_VIEW_CASCADES ? ldexpf(reach, -2 * (LM_VIEW_CASCADES - 1 - k)) : 0.0f;
+            fit[k] = c->map.tex && c->map.p.ortho && lm_shadow_params_fit_view(&p[k], &c->map.p, s, view, depth);
         }
-        if (c->near.tex && !memcmp(&p, &c->near.p, sizeof p) && c->near_static == d->static_version &&
-            c->near_dynamic == d->dynamic_version)
-            continue;
-        st = lm_shadow_map_draw(&c->near, &p, &d->shadow, &d->mesh.casters, d->mesh.static_caster_indices,
-                                c->near_static != d->static_version, d->mesh.dynamic_lo, d->mesh.dynamic_hi, err);
-        c->near_static = d->static_version;
-        c->near_dynamic = d->dynamic_version;
-        d->near_rendered++;
+        for (int k = 0; k + 1 < LM_VIEW_CASCADES; k++)
+            fit[k] = fit[k] && !(fit[k + 1] && p[k].texel >= p[k + 1].texel);
+        for (int k = 0; st == LM_OK && k < LM_VIEW_CASCADES; k++) {
+            lm_shadow_map *m = &c->near[k];
+            if (!fit[k]) {
+                lm_shadow_map_free(m);
+                continue;
+            }
+            if (m->tex && !memcmp(&p[k], &m->p, sizeof p[k]) && c->near_static[k] == d->static_version &&
+                c->near_dynamic[k] == d->dynamic_version)
+                continue;
+            st = lm_shadow_map_draw(m, &p[k], &d->shadow, &d->mesh.casters, d->mesh.static_caster_indices,
+                                    c->near_static[k] != d->static_version, d->mesh.dynamic_lo, d->mesh.dynamic_hi,
+                                    err);
+            c->near_static[k] = d->static_version;
+            c->near_dynamic[k] = d->dynamic_version;
+            d->near_rendered++;
+        }
     }
     return st;
 }
@@ -387,8 +408,8 @@ static int valid_settings(const lm_direct_settings *set)
 }
 
 /* Shadow-map bytes for `points` point lights and `others` 2D maps at the given sides: a cube (6 faces) per
- * point light, a 2D map per spot light and two per directional one (the whole scene's and the view's),
- * each with its static layer (shadow_maps.h), 4 bytes a texel. */
+ * point light, a 2D map per spot light and 1 + LM_VIEW_CASCADES per directional one (the whole scene's and
+ * the view's), each with its static layer (shadow_maps.h), 4 bytes a texel. */
 static double shadow_bytes(int points, int others, int cube_size, int map_size)
 {
     return 2.0 * 4.0 * (6.0 * cube_size * cube_size * points + (double)map_size * map_size * others);
@@ -412,7 +433,7 @@ static lm_status fit_shadow_budget(const lm_scene *s, lm_direct *d, lm_error *er
     int points = 0, others = 0;
     for (int l = 0; l < s->light_count; l++)
         if (!s->lights[l].removed)
-            *(s->lights[l].type == LM_LIGHT_POINT ? &points : &others) += s->lights[l].type == LM_LIGHT_DIRECTIONAL ? 2 : 1;
+            *(s->lights[l].type == LM_LIGHT_POINT ? &points : &others) += s->lights[l].type == LM_LIGHT_DIRECTIONAL ? 1 + LM_VIEW_CASCADES : 1;
     int cube = d->set.cube_size, map = d->set.map_size;
     fit_sizes(points, others, &cube, &map);
     double mb = 1024.0 * 1024.0, need = shadow_bytes(points, others, cube, map);
@@ -438,7 +459,7 @@ static void fit_live_sizes(lm_direct *d, const lm_scene *s, const lm_emitters *e
     int points = 0, others = 0;
     for (int i = 0; i < em->count; i++)
         if (live_punctual(s, &em->e[i]))
-            *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += em->e[i].kind == LM_EMIT_DIRECTIONAL ? 2 : 1;
+            *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += em->e[i].kind == LM_EMIT_DIRECTIONAL ? 1 + LM_VIEW_CASCADES : 1;
     int cube = d->set.cube_size, map = d->set.map_size;
     fit_sizes(points, others, &cube, &map);
     int grows = cube > d->cube_now || map > d->map_now;
@@ -505,7 +526,8 @@ void lm_direct_free(lm_direct *d)
         return;
     for (int i = 0; i < d->map_count; i++) {
         lm_shadow_map_free(&d->maps[i].map);
-        lm_shadow_map_free(&d->maps[i].near);
+        for (int k = 0; k < LM_VIEW_CASCADES; k++)
+            lm_shadow_map_free(&d->maps[i].near[k]);
     }
     free(d->maps);
     lm_frame_targets_free(&d->targets);
@@ -681,11 +703,11 @@ void lm_direct_map_sides(const lm_direct *d, int *cube, int *map)
 
 long lm_direct_shadow_maps_rendered(const lm_direct *d) { return d->maps_rendered; }
 long lm_direct_view_maps_rendered(const lm_direct *d) { return d->near_rendered; }
-int lm_direct_view_map_texel(const lm_direct *d, int i, float *texel)
+int lm_direct_view_map_texel(const lm_direct *d, int i, int cascade, float *texel)
 {
-    if (i < 0 || i >= d->map_count || !d->maps[i].near.tex)
+    if (i < 0 || i >= d->map_count || cascade < 0 || cascade >= LM_VIEW_CASCADES || !d->maps[i].near[cascade].tex)
         return 0;
-    *texel = d->maps[i].near.p.texel;
+    *texel = d->maps[i].near[cascade].p.texel;
     return 1;
 }
 

@@ -102,11 +102,13 @@ void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);
 lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *err);
 /* Shadow maps rendered since creation (each cube map counts once), for tests and statistics. */
 long lm_direct_shadow_maps_rendered(const lm_direct *d);
-/* The directional lights' maps fitted to the frame's view (docs/direct.md, "The view's sun map") rendered
- * since creation, counted apart from lm_direct_shadow_maps_rendered; and whether emitter i has one now,
- * with its texel's world size. */
+/* The directional lights' maps fitted to the frame's view (docs/direct.md, "The view's sun maps"): the
+ * nearest quarter of the view's depth into the scene (cascade 0) and all of it (cascade 1). */
+#define LM_VIEW_CASCADES 2
+/* Those maps rendered since creation, counted apart from lm_direct_shadow_maps_rendered; and whether
+ * emitter i has cascade c now, with its texel's world size. */
 long lm_direct_view_maps_rendered(const lm_direct *d);
-int lm_direct_view_map_texel(const lm_direct *d, int i, float *texel);
+int lm_direct_view_map_texel(const lm_direct *d, int i, int cascade, float *texel);
 /* How many shadow maps it holds now (a removed light's is given back at the next draw). */
 int lm_direct_shadow_maps_held(const lm_direct *d);
 

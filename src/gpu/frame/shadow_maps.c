@@ -164,13 +164,13 @@ static void directional_map(lm_shadow_params *m, const lm_scene *s, lm_vec3 d)
 }
 
 int lm_shadow_params_fit_view(lm_shadow_params *near, const lm_shadow_params *whole, const lm_scene *s,
-                              const lm_view *v)
+                              const lm_view *v, float max_depth)
 {
     if (!whole->ortho)
         return 0;
     float pts[LM_VIEW_BOX_POINTS][3], view[16], r;
     lm_vec3 eye;
-    int n = lm_view_box_part(v, s->bounds_min, s->bounds_max, pts);
+    int n = lm_view_box_part(v, s->bounds_min, s->bounds_max, max_depth, pts);
     if (n == 0)
         return 0;
     directional_view(s, lm_v3_load(whole->dir), view, &eye, &r);

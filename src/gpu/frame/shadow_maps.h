@@ -53,13 +53,14 @@ void lm_shadow_renderer_free(lm_shadow_renderer *r);
 /* The parameters of punctual emitter e's map (pos/dir current, s->bounds current). */
 void lm_shadow_params_compute(lm_shadow_params *p, const lm_scene *s, const lm_emitter *e, int size);
 /* A directional light's map fitted to what view v sees of the scene (docs/direct.md, "The view's sun
- * map"): the part of the scene's bounds inside v's frustum, as the light sees it, in a square a power of
- * two smaller than `whole`'s (the light's whole-scene map, lm_shadow_params_compute), its corner on a
- * sixteenth of its side. Same size, origin, direction and depth range as `whole`, so its metric is the
- * same. Returns 0 (near untouched) for a map that is not directional, a view that sees none of the scene,
- * or one that sees about half of it or more (the whole map is then as fine). */
+ * maps"): the part of the scene's bounds inside v's frustum and no deeper than max_depth (<= 0: all of
+ * it), as the light sees it, in a square a power of two smaller than `whole`'s (the light's whole-scene
+ * map, lm_shadow_params_compute), its corner on a sixteenth of its side. Same size, origin, direction
+ * and depth range as `whole`, so its metric is the same. Returns 0 (near untouched) for a map that is not
+ * directional, a view that sees none of the scene, or one that sees about half of it or more (the whole
+ * map is then as fine). */
 int lm_shadow_params_fit_view(lm_shadow_params *near, const lm_shadow_params *whole, const lm_scene *s,
-                              const lm_view *v);
+                              const lm_view *v, float max_depth);
 /* Renders map m with parameters p over the caster triangles `casters` (attribute 0 = world position),
  * (re)allocating its textures when the kind or size changed. The first static_count vertices (indices
  * when the mesh is indexed) are static casters: when some follow them, the static ones are drawn into

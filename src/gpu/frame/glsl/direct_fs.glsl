@@ -22,10 +22,12 @@ uniform float normal_offset, slope_bias, max_slope, const_bias, range;
 uniform float light_range; /* KHR_lights_punctual range, 0: none (lm_light_range_window) */
 uniform mat4 light_vp;
 uniform sampler2DShadow map2d;   /* metric / range, compared in the sampler (bilinear PCF) */
-uniform sampler2DShadow map_near; /* directional: the map fitted to the view, same metric (has_near) */
-uniform mat4 near_vp;
-uniform float near_texel;
-uniform int has_near;
+// directional: the maps fitted to the view, the nearest quarter of its depth and all of it (has_near),
+// with the whole map's metric
+uniform sampler2DShadow map_near0, map_near1;
+uniform mat4 near_vp[2];
+uniform float near_texel[2];
+uniform int has_near[2];
 uniform samplerCubeShadow mapcube;
 #if FIRST
 layout(location = 0) out vec4 frag;
@@ -57,29 +59,35 @@ float map_shadow(sampler2DShadow map, mat4 vp, vec3 q, float m) {
         }
     return lit;
 }
-// A directional light's map fitted to the view (has_near), where p and its PCF taps fall inside it; the
-// light's whole-scene map elsewhere (direct.c, refresh_near_maps).
-bool in_near(vec3 p) {
-    if (kind != 2 || has_near == 0) return false;
-    vec2 uv = (near_vp * vec4(p, 1.0)).xy * 0.5 + 0.5;
+// Which of a directional light's maps fitted to the view holds p and its PCF taps, the finer first (-1:
+// neither; the light's whole-scene map then) (direct.c, refresh_near_maps).
+int view_map(vec3 p) {
+    if (kind != 2) return -1;
     float edge = (normal_offset + float(taps) + 1.0) / map_size;
-    return all(greaterThan(uv, vec2(edge))) && all(lessThan(uv, vec2(1.0 - edge)));
+    for (int k = 0; k < 2; k++) {
+        if (has_near[k] == 0) continue;
+        vec2 uv = (near_vp[k] * vec4(p, 1.0)).xy * 0.5 + 0.5;
+        if (all(greaterThan(uv, vec2(edge))) && all(lessThan(uv, vec2(1.0 - edge)))) return k;
+    }
+    return -1;
 }
 // Fraction of PCF taps that see the light from p (geometric normal ng, unit L towards the light).
 float shadow(vec3 p, vec3 ng, vec3 L, float dist) {
     float c = clamp(dot(ng, L), 1e-4, 1.0);
     float tan_t = min(sqrt(1.0 - c * c) / c, max_slope);
     vec3 a = kind == 0 ? abs(L) : vec3(abs(dot(L, ldir)));
-    bool near = in_near(p);
-    float T = kind == 2 ? (near ? near_texel : texel) : texel * dist / max(max(a.x, a.y), max(a.z, 0.2));
+    int vm = view_map(p);
+    float T = kind == 2 ? (vm >= 0 ? near_texel[vm] : texel) : texel * dist / max(max(a.x, a.y), max(a.z, 0.2));
     vec3 q = p + ng * (normal_offset * T);
     float bias = T * (const_bias + slope_bias * float(pcf + 1) * tan_t);
     float m = (kind == 2 ? dot(q - origin, ldir) : length(q - lpos)) - bias;
     float lit; /* branches, not ?: (llvmpipe evaluates both sides of a select: twice the lookups) */
     if (kind == 0)
         lit = cube_shadow(q, m, T);
-    else if (near)
-        lit = map_shadow(map_near, near_vp, q, m);
+    else if (vm == 0)
+        lit = map_shadow(map_near0, near_vp[0], q, m);
+    else if (vm == 1)
+        lit = map_shadow(map_near1, near_vp[1], q, m);
     else
         lit = map_shadow(map2d, light_vp, q, m);
     return lit / float(taps * taps);
