@@ -39,6 +39,8 @@ typedef struct {
     GLint map_near[LM_VIEW_CASCADES], near_vp, near_texel, has_near;
 } uniforms;
 
+_Static_assert(LM_VIEW_CASCADES == 2, "glsl/direct_fs.glsl samples two view cascades, map_near0 and map_near1");
+
 /* One punctual light's map and the caster geometry versions it was rendered over; for a directional
  * light also the maps fitted to the frame's view, the nearest quarter of its depth and all of it (a
  * cascade's tex 0: none). */
