@@ -66,11 +66,14 @@ static void test_general_inverse(void **state)
     assert_false(lm_mat4_invert(inv, sing));
 }
 
-/* The points' bounds, and whether every point lies in lo..hi and inside v's clip volume (to eps). */
-static void part_bounds(const lm_view *v, const float lo[3], const float hi[3], float (*pts)[3], int n, float b0[3],
-                        float b1[3])
+/* lm_view_box_part(v, lo, hi, max_depth): at least 8 points (a slice of the frustum), every one in lo..hi
+ * and inside v's clip volume (to eps), their bounds want0..want1 (to tol). */
+static void check_part(const lm_view *v, const float lo[3], const float hi[3], float max_depth, const float want0[3],
+                       const float want1[3], double tol)
 {
-    float vp[16];
+    float pts[LM_VIEW_BOX_POINTS][3], vp[16], b0[3], b1[3];
+    int n = lm_view_box_part(v, lo, hi, max_depth, pts);
+    assert_true(n >= 8);
     lm_mat4_mul(vp, v->proj, v->view);
     for (int k = 0; k < 3; k++)
         b0[k] = INFINITY, b1[k] = -INFINITY;
@@ -83,6 +86,10 @@ static void part_bounds(const lm_view *v, const float lo[3], const float hi[3], 
             assert_true(pts[i][k] >= lo[k] - 1e-3f && pts[i][k] <= hi[k] + 1e-3f);
             assert_true(fabsf(c[k]) <= c[3] * (1.0f + 1e-4f) + 1e-4f);
         }
+    }
+    for (int k = 0; k < 3; k++) {
+        assert_float_equal(b0[k], want0[k], tol);
+        assert_float_equal(b1[k], want1[k], tol);
     }
 }
 
@@ -97,33 +104,14 @@ static void test_view_box_part(void **state)
     memset(&v, 0, sizeof v);
     lm_mat4_identity(v.view);
     lm_mat4_perspective(v.proj, (float)M_PI / 2, 1.0f, 1.0f, 100.0f);
-    float pts[LM_VIEW_BOX_POINTS][3], b0[3], b1[3];
     const float lo[3] = {-100, -100, -10}, hi[3] = {100, 100, -5};
-    int n = lm_view_box_part(&v, lo, hi, 0.0f, pts);
-    assert_true(n >= 8);
-    part_bounds(&v, lo, hi, pts, n, b0, b1);
-    const float want0[3] = {-10, -10, -10}, want1[3] = {10, 10, -5};
-    for (int k = 0; k < 3; k++) {
-        assert_float_equal(b0[k], want0[k], 1e-3);
-        assert_float_equal(b1[k], want1[k], 1e-3);
-    }
+    check_part(&v, lo, hi, 0.0f, (const float[3]){-10, -10, -10}, (const float[3]){10, 10, -5}, 1e-3);
     assert_float_equal(lm_view_box_reach(&v, lo, hi), 10.0f, 1e-3);
-    n = lm_view_box_part(&v, lo, hi, 7.5f, pts);
-    part_bounds(&v, lo, hi, pts, n, b0, b1);
-    const float cut0[3] = {-7.5f, -7.5f, -7.5f}, cut1[3] = {7.5f, 7.5f, -5};
-    for (int k = 0; k < 3; k++) {
-        assert_float_equal(b0[k], cut0[k], 1e-3);
-        assert_float_equal(b1[k], cut1[k], 1e-3);
-    }
+    check_part(&v, lo, hi, 7.5f, (const float[3]){-7.5f, -7.5f, -7.5f}, (const float[3]){7.5f, 7.5f, -5}, 1e-3);
     const float big0[3] = {-200, -200, -200}, big1[3] = {200, 200, 200};
     assert_float_equal(lm_view_box_reach(&v, big0, big1), 100.0f, 1e-2);
-    n = lm_view_box_part(&v, big0, big1, 0.0f, pts);
-    part_bounds(&v, big0, big1, pts, n, b0, b1);
-    const float f0[3] = {-100, -100, -100}, f1[3] = {100, 100, -1};
-    for (int k = 0; k < 3; k++) {
-        assert_float_equal(b0[k], f0[k], 1e-2);
-        assert_float_equal(b1[k], f1[k], 1e-2);
-    }
+    check_part(&v, big0, big1, 0.0f, (const float[3]){-100, -100, -100}, (const float[3]){100, 100, -1}, 1e-2);
+    float pts[LM_VIEW_BOX_POINTS][3];
     const float back0[3] = {-5, -5, 2}, back1[3] = {5, 5, 8};
     assert_int_equal(lm_view_box_part(&v, back0, back1, 0.0f, pts), 0);
 }

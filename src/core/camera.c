@@ -160,16 +160,12 @@ int lm_view_box_part(const lm_view *v, const float lo[3], const float hi[3], flo
         double dn = DEPTH(corner[c]), dir[3], dd;
         if (reach <= dn)
             return 0; /* the box lies nearer than the near plane */
-        if (f[3] > 1e-12 * (fabs(f[0]) + fabs(f[1]) + fabs(f[2]))) { /* a finite far plane */
-            for (int k = 0; k < 3; k++)
-                dir[k] = f[k] / f[3] - corner[c][k];
-        } else {
-            for (int k = 0; k < 3; k++)
-                dir[k] = f[k];
-        }
+        int finite = f[3] > 1e-12 * (fabs(f[0]) + fabs(f[1]) + fabs(f[2])); /* the far plane */
+        for (int k = 0; k < 3; k++) /* towards the far corner, or along the ray to it at infinity */
+            dir[k] = finite ? f[k] / f[3] - corner[c][k] : f[k];
         dd = DEPTH(dir) + (double)z[14]; /* the direction's depth, without the translation */
         double t = dd > 0.0 ? (reach - dn) / dd : 0.0;
-        if (f[3] > 1e-12 * (fabs(f[0]) + fabs(f[1]) + fabs(f[2])))
+        if (finite)
             t = fmin(t, 1.0);
         for (int k = 0; k < 3; k++)
             corner[c + 4][k] = corner[c][k] + t * dir[k];

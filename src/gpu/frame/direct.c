@@ -92,6 +92,14 @@ static void find_uniforms(GLuint p, uniforms *u)
 #undef LOC
 }
 
+/* A light's maps and the view's cascades given back (a zeroed map has none). */
+static void free_cached_map(cached_map *c)
+{
+    lm_shadow_map_free(&c->map);
+    for (int k = 0; k < LM_VIEW_CASCADES; k++)
+        lm_shadow_map_free(&c->near[k]);
+}
+
 static int kind_of(const lm_emitter *e) { return e->kind == LM_EMIT_POINT ? 0 : e->kind == LM_EMIT_SPOT ? 1 : 2; }
 
 /* A point, spot or directional light that still exists: a removed one lights nothing and keeps no map
@@ -299,10 +307,7 @@ static lm_status refresh_maps(lm_direct *d, const lm_scene *s, const lm_emitters
         cached_map *c = &d->maps[i];
         lm_shadow_params p;
         if (!live_punctual(s, &em->e[i])) {
-            if (c->map.tex)
-                lm_shadow_map_free(&c->map);
-            for (int k = 0; k < LM_VIEW_CASCADES; k++)
-                lm_shadow_map_free(&c->near[k]);
+            free_cached_map(c);
             c->stale_since = 0;
         } else if (!map_stale(d, s, &em->e[i], i, &p)) {
             c->stale_since = 0;
@@ -412,6 +417,9 @@ static int valid_settings(const lm_direct_settings *set)
 /* Shadow-map bytes for `points` point lights and `others` 2D maps at the given sides: a cube (6 faces) per
  * point light, a 2D map per spot light and 1 + LM_VIEW_CASCADES per directional one (the whole scene's and
  * the view's), each with its static layer (shadow_maps.h), 4 bytes a texel. */
+/* The 2D maps (whole-scene and the view's) a spot (0) or directional (1) light holds. */
+static int maps_2d(int directional) { return directional ? 1 + LM_VIEW_CASCADES : 1; }
+
 static double shadow_bytes(int points, int others, int cube_size, int map_size)
 {
     return 2.0 * 4.0 * (6.0 * cube_size * cube_size * points + (double)map_size * map_size * others);
@@ -435,7 +443,8 @@ static lm_status fit_shadow_budget(const lm_scene *s, lm_direct *d, lm_error *er
     int points = 0, others = 0;
     for (int l = 0; l < s->light_count; l++)
         if (!s->lights[l].removed)
-            *(s->lights[l].type == LM_LIGHT_POINT ? &points : &others) += s->lights[l].type == LM_LIGHT_DIRECTIONAL ? 1 + LM_VIEW_CASCADES : 1;
+            *(s->lights[l].type == LM_LIGHT_POINT ? &points : &others) +=
+                maps_2d(s->lights[l].type == LM_LIGHT_DIRECTIONAL);
     int cube = d->set.cube_size, map = d->set.map_size;
     fit_sizes(points, others, &cube, &map);
     double mb = 1024.0 * 1024.0, need = shadow_bytes(points, others, cube, map);
@@ -461,7 +470,7 @@ static void fit_live_sizes(lm_direct *d, const lm_scene *s, const lm_emitters *e
     int points = 0, others = 0;
     for (int i = 0; i < em->count; i++)
         if (live_punctual(s, &em->e[i]))
-            *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += em->e[i].kind == LM_EMIT_DIRECTIONAL ? 1 + LM_VIEW_CASCADES : 1;
+            *(em->e[i].kind == LM_EMIT_POINT ? &points : &others) += maps_2d(em->e[i].kind == LM_EMIT_DIRECTIONAL);
     int cube = d->set.cube_size, map = d->set.map_size;
     fit_sizes(points, others, &cube, &map);
     int grows = cube > d->cube_now || map > d->map_now;
@@ -526,11 +535,8 @@ void lm_direct_free(lm_direct *d)
 {
     if (!d)
         return;
-    for (int i = 0; i < d->map_count; i++) {
-        lm_shadow_map_free(&d->maps[i].map);
-        for (int k = 0; k < LM_VIEW_CASCADES; k++)
-            lm_shadow_map_free(&d->maps[i].near[k]);
-    }
+    for (int i = 0; i < d->map_count; i++)
+        free_cached_map(&d->maps[i]);
     free(d->maps);
     lm_frame_targets_free(&d->targets);
     if (d->coverage_tex)

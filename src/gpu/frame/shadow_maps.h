@@ -1,6 +1,6 @@
 /* Shadow maps for the punctual lights (docs/direct.md): a cube map for a point light, a 2D perspective
  * map for a spot light (its cone = the outer angle) and an orthographic map fitted to the scene's bounds
- * for a directional light, with a second one fitted to the part of them a view sees. Each texel holds a
+ * for a directional light, with more fitted to the parts of them a view sees. Each texel holds a
  * float distance metric of the nearest caster, divided by the map's range: the distance to the light
  * (point, spot) or the depth along the light's direction (directional). The maps are DEPTH_COMPONENT32F
  * textures with hardware comparison and a linear filter, so one lookup with a reference metric / range
