@@ -462,7 +462,8 @@ typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_
 typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
 typedef enum {
     LMGI_GATHER_DEFAULT = 0, /* the hemicube, or rays for a scene of over LMGI_RAYS_ABOVE_TRIANGLES where the GL
-                              * rasterizes in software (docs/gather.md, "Rays") */
+                              * rasterizes in software, and under a sky that is not uniform (docs/gather.md,
+                              * "Rays"); lmgi_check chooses as lmgi_updater_create does */
     LMGI_GATHER_VIEWPORTS,   /* hemicubes, one draw per texel */
     LMGI_GATHER_INSTANCED,   /* hemicubes, one instanced draw per pass */
     LMGI_GATHER_LAYERED,     /* hemicubes, into a layered target */

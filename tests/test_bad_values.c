@@ -604,7 +604,7 @@ static void test_sparse_accessors(void **state)
         if (kind != LMGI_KNOB_REAL && v < 2147483647.0) {                                                             \
             int iv = (int)v; /* every knob but the floats is 4 bytes */                                              \
             memcpy(&bad.stage.field, &iv, sizeof iv);                                                                 \
-            assert_int_equal(lm_updater_settings(sc->scene, &bad, &s, &err), LM_ERR_INVALID);                        \
+            assert_int_equal(lm_updater_settings(sc->scene, &bad, NULL, &s, &err), LM_ERR_INVALID);                        \
             if (!strstr(err.msg, #stage "." #field))                                                                  \
                 fail_msg("%s", err.msg);                                                                              \
             refused++;                                                                                                \
@@ -636,7 +636,7 @@ static void test_knob_table(void **state)
     LMGI_UPDATER_KNOBS(SAME_DEFAULT)
     lm_frame_loop_settings s, def;
     lm_error err;
-    assert_int_equal(lm_updater_settings(sc->scene, &d, &s, &err), LM_OK);
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
     lm_frame_loop_settings_default(&def);
     assert_int_equal(s.iim.texels_per_frame, def.iim.texels_per_frame);
     assert_int_equal(s.iim.blend_frames, def.iim.blend_frames);
@@ -658,6 +658,35 @@ static void test_knob_table(void **state)
     lmgi_free(sc);
 }
 
+/* The gather scheme on auto is chosen with the settings, so that lmgi_check runs the gather an updater runs:
+ * under a gradient sky, rays (a hemicube clears to one colour); hemicubes asked for there are refused. Before,
+ * the choice was lmgi_updater_create's alone, and lmgi_check drew hemicubes under the sky's mean. */
+static void test_scheme_chosen_with_the_settings(void **state)
+{
+    (void)state;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    const char *path = floor_scene("gradient.gltf", NULL, NULL, NULL,
+                                   "\"extras\": {\"lmgi\": {\"sky\": {\"zenith\": [1, 1, 2], \"horizon\": [2, 2, 2]}}}, ");
+    assert_int_equal(load(path, &sc, &e), LMGI_OK);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    lm_frame_loop_settings s;
+    lm_error err;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.gather.scheme, LM_GATHER_RAYS);
+    d.gather.scheme = LMGI_GATHER_VIEWPORTS;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "rays gather"));
+    lmgi_free(sc);
+    path = floor_scene("uniform.gltf", NULL, NULL, NULL, NULL); /* 2 triangles, no sky: hemicubes */
+    assert_int_equal(load(path, &sc, &e), LMGI_OK);
+    d.gather.scheme = LMGI_GATHER_DEFAULT;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
+    lmgi_free(sc);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -672,6 +701,7 @@ int main(void)
         cmocka_unit_test(test_untrusted_scene_stays_in_its_folder),
         cmocka_unit_test(test_sparse_accessors),
         cmocka_unit_test(test_knob_table),
+        cmocka_unit_test(test_scheme_chosen_with_the_settings),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

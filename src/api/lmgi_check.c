@@ -83,8 +83,7 @@ static lmgi_status check_owned(lmgi_context *ctx, lmgi_scene *sc, const lmgi_upd
     lm_frame_loop_settings ls;
     lm_frame_check c;
     memset(&c, 0, sizeof c);
-    lm_status st = lm_updater_settings(sc->scene, &d, &ls, &e);
-    ls.gl = ctx->gl;
+    lm_status st = lm_updater_settings(sc->scene, &d, ctx->gl, &ls, &e);
     if (st == LM_OK)
         st = lm_frame_check_run(sc, &ls, &rs, frames, &c, &e);
     if (st == LM_OK)

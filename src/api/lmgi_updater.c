@@ -145,10 +145,25 @@ static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s
     s->cancel = r->cancel;
 }
 
+/* The gather scheme on auto: rays where the GL rasterizes in software and the level is large (a software
+ * hemicube costs what the gather proxy's triangles cost, rays the log of the level's: docs/gather.md,
+ * "Rays") and under any sky that is not uniform (a hemicube clears to one colour). */
+static lm_status choose_scheme(const lm_scene *scene, const lmgi_updater_desc *d, const lm_gl_context *gl,
+                               lm_frame_loop_settings *s, lm_error *err)
+{
+    if (d->gather.scheme == LMGI_GATHER_DEFAULT &&
+        ((scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES && lm_gl_context_is_software(gl)) || !lm_sky_is_uniform(scene)))
+        s->gather.scheme = LM_GATHER_RAYS;
+    if (s->gather.scheme != LM_GATHER_RAYS && !lm_sky_is_uniform(scene))
+        return lm_fail(err, LM_ERR_INVALID, "%s: a gradient or image sky needs the rays gather (--gather-scheme rays), "
+                       "not hemicubes (%s)", scene->path, lm_gather_scheme_name(s->gather.scheme));
+    return LM_OK;
+}
+
 /* The frame loop's settings from a desc: its knobs checked against their table and resolved, the rest
  * checked here. */
-lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_frame_loop_settings *s,
-                              lm_error *err)
+lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_gl_context *gl,
+                              lm_frame_loop_settings *s, lm_error *err)
 {
     lm_frame_loop_settings_default(s);
     lm_status st = lm_updater_knobs_check(d, "lmgi_updater_create", err);
@@ -163,6 +178,10 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     photon_settings(&r, s);
     gather_settings(&r, s);
     frame_settings(&r, s);
+    s->gl = gl;
+    st = choose_scheme(scene, d, gl, s, err);
+    if (st != LM_OK)
+        return st;
     lm_error why;
     if (!lm_photon_gather_settings_check(&s->photon_gather, &why))
         return lm_fail(err, LM_ERR_INVALID, "lmgi_updater_create: %s (tiled.tile, tiled.chunk, tiled.stochastic; "
@@ -227,17 +246,7 @@ static lmgi_status updater_create_owned(lmgi_context *ctx, lmgi_scene *sc, const
     lm_log_target saved = lm_api_enter(ctx);
     lm_error e;
     lm_frame_loop_settings set;
-    lm_status st = lm_updater_settings(sc->scene, &d, &set, &e);
-    set.gl = ctx->gl;
-    /* a software rasterizer's hemicube costs what the gather proxy's triangles cost; rays, the log of the
-     * level's (docs/gather.md, "Rays") */
-    if (d.gather.scheme == LMGI_GATHER_DEFAULT &&
-        ((sc->scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES && lm_gl_context_is_software(ctx->gl)) ||
-         !lm_sky_is_uniform(sc->scene))) /* a hemicube clears to one colour */
-        set.gather.scheme = LM_GATHER_RAYS;
-    if (st == LM_OK && set.gather.scheme != LM_GATHER_RAYS && !lm_sky_is_uniform(sc->scene))
-        st = lm_fail(&e, LM_ERR_INVALID, "%s: a gradient or image sky needs the rays gather (--gather-scheme rays), "
-                     "not hemicubes (%s)", sc->scene->path, lm_gather_scheme_name(set.gather.scheme));
+    lm_status st = lm_updater_settings(sc->scene, &d, ctx->gl, &set, &e);
     if (d.progress) {
         set.progress = gather_progress;
         set.progress_user = &d;

@@ -7,9 +7,10 @@
 #include "../update/frame_loop.h"
 
 /* The frame loop's settings for a desc (its zeros the defaults), each field checked: LM_ERR_INVALID naming
- * the field and its range. s->gl and s->progress are the caller's to set beyond the desc's. */
-lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_frame_loop_settings *s,
-                              lm_error *err);
+ * the field and its range. The gather scheme on auto is chosen for the scene and the GL context gl (s->gl),
+ * so that an updater and lmgi_check's run gather alike. s->progress is the caller's to set. */
+lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_gl_context *gl,
+                              lm_frame_loop_settings *s, lm_error *err);
 
 /* The scene u works on, and the context it was made on. */
 const lmgi_scene *lm_updater_scene(const lmgi_updater *u);
