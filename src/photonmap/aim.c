@@ -255,6 +255,8 @@ void lm_aim_free(lm_aim *aim)
 {
     free(aim->rgb);
     free(aim->dilated);
+    free(aim->rest);
+    free(aim->rest_dilated);
     free(aim->error);
     free(aim->texel_first);
     free(aim->texel_list);
@@ -269,6 +271,21 @@ void lm_aim_free(lm_aim *aim)
 }
 
 void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d) { aim->direct = d; }
+
+lm_status lm_aim_keep_rest(lm_aim *aim, lm_error *err)
+{
+    size_t cells = (size_t)aim->width * (size_t)aim->height;
+    if (!aim->rest)
+        aim->rest = calloc(cells * 3, sizeof *aim->rest);
+    if (!aim->rest_dilated)
+        aim->rest_dilated = calloc(cells * 4, sizeof *aim->rest_dilated);
+    if (!aim->rest || !aim->rest_dilated)
+        return lm_fail(err, LM_ERR_NOMEM, "AIM: no memory for a %dx%d map of the light besides the punctual lights'",
+                       aim->width, aim->height);
+    return LM_OK;
+}
+
+const float *lm_aim_rest_dilated_rgba(const lm_aim *aim) { return aim->rest_dilated; }
 
 void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover, const float *cover_by_surface)
 {
@@ -933,8 +950,10 @@ static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t
 /* E_direct averaged over the texel's parts at their current world positions (seeded by the atlas index,
  * so the same every refresh), added to e. Covered parts (under a box standing on the floor) are left out
  * of the average, not counted dark: the texel's value is what its visible part receives, as the photon
- * estimate, which has no hits under the box either, gives it. */
-static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts, double e[3])
+ * estimate, which has no hits under the box either, gives it. The punctual lights' cosine takes the shading
+ * normal at the texel's centre (lm_direct_irradiance). */
+static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts, double e[3],
+                       double punct[3])
 {
     float local[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS][3], share[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS];
     int n = lm_texel_parts(j->s, j->a, t, LM_AIM_DIRECT_PARTS, local, share);
@@ -944,37 +963,48 @@ static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index,
         n = 1;
     }
     const tri_frame *tf = triangle_frame(j, t->tri, &ts->tri);
-    double sum[3] = {0.0, 0.0, 0.0}, seen = 0.0;
+    float ns[3]; /* the shading normal at the texel's centre, for the punctual lights' cosine */
+    lm_vec3 nsum = lm_v3(0.0f, 0.0f, 0.0f);
+    for (int k = 0; k < 3; k++) {
+        float vn[3];
+        lm_scene_normal_world(j->s, j->s->tris[3 * (size_t)t->tri + k], vn);
+        nsum = lm_add(nsum, lm_scale(lm_v3_load(vn), t->bary[k]));
+    }
+    lm_v3_store(ns, lm_length(nsum) > 0.0f ? lm_normalize(nsum) : lm_v3_load(tf->n_world));
+    double sum[3] = {0.0, 0.0, 0.0}, sum_p[3] = {0.0, 0.0, 0.0}, seen = 0.0;
     for (int i = 0; i < n; i++) {
-        float p[3], d[3];
+        float p[3], d[3], dp[3];
         lm_v3_store(p, lm_mat4_point(j->world, lm_v3_load(local[i])));
         uint32_t seed = index * (LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS) + (uint32_t)i;
-        if (!lm_direct_irradiance(j->direct, t->surface, p, tf->n_world, j->two_sided, seed, d))
+        if (!lm_direct_irradiance(j->direct, t->surface, p, tf->n_world, ns, j->two_sided, seed, d, dp))
             continue;
         seen += share[i];
         for (int c = 0; c < 3; c++)
-            sum[c] += (double)share[i] * d[c];
+            sum[c] += (double)share[i] * d[c], sum_p[c] += (double)share[i] * dp[c];
     }
     for (int c = 0; seen > 0.0 && c < 3; c++)
-        e[c] += sum[c] / seen;
+        e[c] += sum[c] / seen, punct[c] = sum_p[c] / seen;
 }
 
-/* L = rho / pi (E_photons + E_direct); with error (NULL: not kept) the texel's relative standard error and
- * radius (lm_aim.error). */
+/* L = rho / pi (E_photons + E_direct); rest (NULL: not kept) the same without the punctual lights' part of
+ * E_direct (lm_aim.rest); with error (NULL: not kept) the texel's relative standard error and radius
+ * (lm_aim.error). */
 static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t index, uint32_t slot, texel_scratch *ts,
-                           float *edge_d2, float out[3], float *error)
+                           float *edge_d2, float out[3], float rest[3], float *error)
 {
     float rho[3];
     lm_texel_kd(j->s, t, rho);
     estimate_error ee = {error != NULL, {LUMINANCE[0] * rho[0] / LM_PI, LUMINANCE[1] * rho[1] / LM_PI,
                                          LUMINANCE[2] * rho[2] / LM_PI},
                          0.0, 0.0};
-    double e[3];
+    double e[3], punct[3] = {0.0, 0.0, 0.0};
     photon_irradiance(j, t, index, slot, ts, edge_d2, e, &ee);
     if (j->direct)
-        add_direct(j, t, index, ts, e);
+        add_direct(j, t, index, ts, e, punct);
     for (int c = 0; c < 3; c++)
         out[c] = (float)(rho[c] / LM_PI * e[c]);
+    for (int c = 0; rest && c < 3; c++)
+        rest[c] = (float)(rho[c] / LM_PI * (e[c] - punct[c]));
     if (error) {
         double y = ee.y[0] * e[0] + ee.y[1] * e[1] + ee.y[2] * e[2];
         error[0] = y > 0.0 ? (float)(sqrt(ee.var) / y) : 0.0f;
@@ -988,6 +1018,8 @@ static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_
         const lm_texel *t = &a->texels[aim->texel_list[i]];
         size_t at = (size_t)t->y * (size_t)aim->width + (size_t)t->x;
         memset(aim->rgb + 3 * at, 0, 3 * sizeof(float));
+        if (aim->rest)
+            memset(aim->rest + 3 * at, 0, 3 * sizeof(float));
         if (aim->error)
             memset(aim->error + 2 * at, 0, 2 * sizeof(float));
     }
@@ -1289,7 +1321,8 @@ static void write_texels(lm_aim *aim, const surface_job *jobs, int count, uint32
                     ts.hint.valid = 0;
                 if (ok)
                     estimate_texel(e, t, aim->texel_list[i], (uint32_t)(i - first), &ts, &aim->edge_d2[i],
-                                   aim->rgb + 3 * at, aim->error ? aim->error + 2 * at : NULL);
+                                   aim->rgb + 3 * at, aim->rest ? aim->rest + 3 * at : NULL,
+                                   aim->error ? aim->error + 2 * at : NULL);
             }
         }
         scratch_free(&ts);
@@ -1370,6 +1403,8 @@ static lm_status refresh_surfaces(lm_aim *aim, const lm_scene *s, const lm_surfa
     free(jobs);
     if (ok > 0) {
         lm_atlas_dilated_rgba(a, aim->rgb, aim->dilated);
+        if (aim->rest)
+            lm_atlas_dilated_rgba(a, aim->rest, aim->rest_dilated);
     }
     return rc;
 }

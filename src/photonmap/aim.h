@@ -99,6 +99,9 @@ typedef struct {
     double *owed;            /* per surface: the delta_f of the continuing surfaces refreshed since its own last
                                 refresh; its estimate near the seam reads their hits too, so it is due a refresh
                                 as if its own had changed (scheduled by delta_f + owed) */
+    float *rest;             /* with lm_aim_keep_rest, rgb less the punctual lights' direct part (width * height
+                                * 3), for a gather that computes that part where its rays hit; else NULL */
+    float *rest_dilated;     /* rest as RGBA, dilated as `dilated` is; NULL without rest */
     float mean_hit_energy;   /* as of the last refresh call */
     const lm_direct_light *direct; /* NULL (default): photons carry all light, the paper's form; else
                                       lm_aim_set_direct */
@@ -121,6 +124,15 @@ void lm_aim_free(lm_aim *aim);
  * other hits gets its direct light alone. NULL: back to photons for everything. d is borrowed. The
  * caller refreshes every surface after a change (lm_aim_refresh_all) if the maps must agree at once. */
 void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
+/* From the next refresh on, each texel also keeps its value without the punctual lights' part of the
+ * direct light (lm_aim.rest; 0 without lm_aim_set_direct): a ray gather adds that part exactly where each
+ * of its rays hits (photonmap/hemicube_rim.h) instead of reading it as the average over the texel it hits,
+ * which a sunlit road's 7 m texels blur across every house's shadow (docs/aim.md, "Shaded walls"). Costs
+ * 7 floats an atlas texel and a second dilation per refresh. Call before the first refresh (the refresh
+ * of a surface writes its texels). Errors: out of memory. */
+lm_status lm_aim_keep_rest(lm_aim *aim, lm_error *err);
+/* rest as RGBA dilated into the gutters, kept up to date by every refresh; NULL without lm_aim_keep_rest. */
+const float *lm_aim_rest_dilated_rgba(const lm_aim *aim);
 /* From the next refresh on, a hit counts towards a texel's estimate only if the texel sees the vertex its
  * photon left (the emission point, or its previous hit: lm_hit.travelled back along its direction), weighed
  * by 1 / the share of the estimate's disc that sees it (aim_sight.h): a photon that reached the floor

@@ -7,6 +7,7 @@
 #include "../core/qmc.h"
 #include "../core/vecmath.h"
 #include "../scene/sky.h"
+#include "../trace/shading.h"
 
 
 void lm_atlas_sample_rgb(const lm_atlas *a, const float *rgba, float u, float v, float out[3])
@@ -81,6 +82,22 @@ static double strata_share(const sky_mis *m, lm_vec3 n, const float d[3], double
     return ka + mb > 0.0 ? ka / (ka + mb) : 1.0;
 }
 
+/* kd / pi E_punctual at the ray's hit h (direction dir from eye): the punctual lights' direct light there,
+ * as the AIM computes it for a texel (geometric normal, both sides of a double-sided material). */
+static void punctual_at_hit(const lm_rim *r, const float eye[3], const float dir[3], const lm_rt_hit *h, float out[3])
+{
+    lm_shading sh;
+    lm_shading_from_hit(r->scene, h, eye, dir, &sh);
+    float kd[3], ks[3], E[3];
+    lm_material_lobes(sh.material, sh.albedo, kd, ks);
+    out[0] = out[1] = out[2] = 0.0f;
+    if (!(kd[0] > 0.0f || kd[1] > 0.0f || kd[2] > 0.0f))
+        return;
+    lm_direct_punctual_at(r->direct, sh.pos, sh.ng, sh.ns, sh.material->double_sided, E);
+    for (int c = 0; c < 3; c++)
+        out[c] = (float)(kd[c] / LM_PI * E[c]);
+}
+
 /* The stratum (phi0 + [0, dphi), u0 + [0, du)) of the rim: one ray through its middle and, on the plane
  * of the triangle it hits, the AIM averaged over the stratum's footprint (SUB x SUB sub-directions met
  * with that plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel
@@ -146,6 +163,12 @@ static void stratum(const lm_rim *r, const sky_mis *mis, const float eye[3], lm_
                 for (int k = 0; k < 3; k++)
                     sum[k] += ws * L[k];
             }
+        if (r->direct) { /* at the ray's own point, for the whole footprint */
+            float L[3];
+            punctual_at_hit(r, eye, dir, &h, L);
+            for (int k = 0; k < 3; k++)
+                sum[k] += SUB * SUB * w * L[k];
+        }
     }
     if (r->emission) {
         const float *em = r->emissive ? r->emissive + 3 * (size_t)r->scene->tri_material[h.tri] : m->emissive;

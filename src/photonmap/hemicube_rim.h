@@ -17,6 +17,9 @@
  * L(hit) is what the hemicube would show there: the AIM at the hit's lightmap uv (bilinear, from the
  * gather's copy of the dilated AIM), plus the emitted radiance when emitters are drawn rather than in
  * closed form; 0 on the back of a single-sided surface, on mirror and glass; the sky where nothing is hit.
+ * With `direct`, the punctual lights' direct part of the AIM is taken at the hit point itself rather than
+ * as its texel's average: a 7 m road texel half in a house's shadow reads as half lit to every wall that
+ * sees it, a ray hit reads lit or shadowed as the point is (docs/aim.md, "Shaded walls").
  *
  * Cost: K rays and AIM lookups per texel, on the gather's calling thread while the GPU rasterizes
  * (docs/gather.md, "The rim", for the measured time). Noise: the rim is a band near the horizon; a
@@ -28,6 +31,7 @@
 #include <stdint.h>
 
 #include "../charts/charts.h"
+#include "../trace/direct_irradiance.h"
 #include "../trace/rt_scene.h"
 
 typedef struct {
@@ -41,6 +45,10 @@ typedef struct {
     int samples;           /* K, rounded down to a square */
     const float *emissive; /* with emission: per material rgb emission in place of the scene's (NULL: the
                               scene's), as a light edit's first gather saw it before (light_scale.h) */
+    const lm_direct_light *direct; /* NULL: aim holds all the light. Else aim holds the light besides the
+                              punctual lights' direct part (lm_aim_rest_dilated_rgba), and that part is
+                              computed where each stratum's ray hits (lm_direct_punctual_at, kd / pi times it):
+                              one shadow ray per light a stratum */
 } lm_rim;
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y

@@ -16,8 +16,10 @@ static int covered(const lm_direct_light *d, float reach, lm_vec3 p, lm_vec3 n)
 }
 
 /* Every punctual light's E = weight cos, where a shadow ray from p (lifted to the side the light is on)
- * reaches it; sides: bit 0 the front (n), bit 1 the back. */
-static void punctual(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, int sides, double e[3])
+ * reaches it; sides: bit 0 the front (n), bit 1 the back. The side is the geometric normal n's, the cosine
+ * the shading normal ns's (on n's side), as the reference's next event takes it; 0 where the two
+ * disagree. */
+static void punctual(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, lm_vec3 ns, int sides, double e[3])
 {
     const float none[3] = {0.0f, 0.0f, 0.0f};
     for (int k = 0; k < d->em->count; k++) {
@@ -30,10 +32,10 @@ static void punctual(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, int sides, 
         lm_light_sample ls;
         if (!lm_emitter_sample_toward(d->em, d->scene, k, at, none, &ls))
             continue;
-        float c = lm_dot(n, lm_v3_load(ls.dir));
-        int front = c >= 0.0f;
-        c = fabsf(c);
-        if (!(sides & (front ? 1 : 2)) || !(c > 0.0f))
+        float cg = lm_dot(n, lm_v3_load(ls.dir)), c = lm_dot(ns, lm_v3_load(ls.dir));
+        int front = cg >= 0.0f;
+        c = front ? c : -c;
+        if (!(sides & (front ? 1 : 2)) || !(c > 0.0f) || cg == 0.0f)
             continue;
         float org[3];
         lm_v3_store(org, lm_add(p, lm_scale(n, front ? d->lift : -d->lift)));
@@ -56,15 +58,24 @@ static void area(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, uint32_t seed, 
         e[c] += out[c];
 }
 
-int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], int two_sided,
-                          uint32_t seed, float out[3])
+/* ns (NULL: n) turned to n's side. */
+static lm_vec3 shading_side(const float n[3], const float ns[3])
+{
+    lm_vec3 nv = lm_v3_load(n), sv = ns ? lm_v3_load(ns) : nv;
+    return lm_dot(sv, nv) < 0.0f ? lm_scale(sv, -1.0f) : sv;
+}
+
+int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], const float ns[3],
+                         int two_sided, uint32_t seed, float out[3], float punctual_out[3])
 {
     double e[3] = {0.0, 0.0, 0.0};
     lm_vec3 pv = lm_v3_load(p), nv = lm_v3_load(n), back = lm_scale(nv, -1.0f);
     float reach = lm_cover_reach(d->cover, d->cover_by_surface, surface);
     int sides = (covered(d, reach, pv, nv) ? 0 : 1) | (two_sided && !covered(d, reach, pv, back) ? 2 : 0);
     if (d->punctual)
-        punctual(d, pv, nv, sides, e);
+        punctual(d, pv, nv, shading_side(n, ns), sides, e);
+    for (int c = 0; punctual_out && c < 3; c++)
+        punctual_out[c] = (float)e[c];
     if (d->area && (sides & 1))
         area(d, pv, nv, seed, e);
     if (d->area && (sides & 2))
@@ -72,4 +83,14 @@ int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3]
     for (int c = 0; c < 3; c++)
         out[c] = (float)e[c];
     return sides != 0;
+}
+
+void lm_direct_punctual_at(const lm_direct_light *d, const float p[3], const float n[3], const float ns[3],
+                           int two_sided, float out[3])
+{
+    double e[3] = {0.0, 0.0, 0.0};
+    if (d->punctual)
+        punctual(d, lm_v3_load(p), lm_v3_load(n), shading_side(n, ns), two_sided ? 3 : 1, e);
+    for (int c = 0; c < 3; c++)
+        out[c] = (float)e[c];
 }

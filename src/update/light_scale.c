@@ -78,7 +78,7 @@ void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt
         free(e);
         return;
     }
-    lm_rim was = {s, a, rt, before, 1, {set->sky[0], set->sky[1], set->sky[2]}, 0.0f, (int)K, emissive_before};
+    lm_rim was = {s, a, rt, before, 1, {set->sky[0], set->sky[1], set->sky[2]}, 0.0f, (int)K, emissive_before, NULL};
     if (s->has_sky)
         lm_sky_mean(s, was.sky);
     lm_rim now = was;

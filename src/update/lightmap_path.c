@@ -49,6 +49,14 @@ static lm_gather_job job_of(const lm_lightmap_path *lp)
     return (lm_gather_job){lp->gather, lp->scene, lp->atlas, lp->texels, lp->iim.fresh_tex, lp->set};
 }
 
+/* The AIM as the gather reads it: without the punctual lights' direct part when the gather computes that
+ * part at its rays' hits (lm_gather_direct_at_hits), else whole. */
+static const float *gather_aim(const lm_lightmap_path *lp)
+{
+    const lm_aim *aim = lm_photon_stage_aim(lp->stage);
+    return lm_gather_direct_at_hits(lp->gather) ? lm_aim_rest_dilated_rgba(aim) : lm_aim_dilated_rgba(aim);
+}
+
 /* Uploads the current scene and, when they changed since the last upload, the AIMs: all the gather reads
  * of the photon stage, so that the stage may run again once this returns. */
 static lm_status gather_prepare(lm_lightmap_path *lp, lm_error *err)
@@ -60,7 +68,7 @@ static lm_status gather_prepare(lm_lightmap_path *lp, lm_error *err)
         lm_gather_set_sky(lp->gather, mean);
     }
     if (st == LM_OK && lp->aim_stale)
-        st = lm_gather_set_aim_dilated(lp->gather, lp->atlas, lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), err);
+        st = lm_gather_set_aim_dilated(lp->gather, lp->atlas, gather_aim(lp), err);
     if (st == LM_OK)
         lp->aim_stale = 0;
     return st;
@@ -92,7 +100,7 @@ static lm_status first_gather(lm_lightmap_path *lp, lm_error *err)
     if (st != LM_OK)
         return st;
     lm_gather_job j = job_of(lp);
-    return lm_gather_first(&j, count, lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), err);
+    return lm_gather_first(&j, count, gather_aim(lp), err);
 }
 
 /* The closed-form emitter light when the settings (or, on auto, the scene) call for it; the gather's
@@ -196,6 +204,8 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
         lm_gather_set_emitter_light(lp->gather, &lp->emitters);
     if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (photonmap/hemicube_rim.h) */
         lm_gather_set_tracer(lp->gather, lp->rt);
+    if (st == LM_OK && lm_aim_rest_dilated_rgba(lm_photon_stage_aim(stage))) /* the AIM keeps it for the rays */
+        lm_gather_set_direct_at_hits(lp->gather, lm_photon_stage_direct(stage));
     if (st == LM_OK)
         st = follow_light(lp, err); /* before the IIM: a scene without light gathers nothing */
     set->iim.backface_limit = set->gather.backface_limit;

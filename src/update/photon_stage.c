@@ -102,7 +102,7 @@ static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph,
                                    1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f),
                                    ph->cover_distance, ph->cover_by_surface};
     lm_aim_set_direct(&ps->aim, &ps->direct);
-    return LM_OK;
+    return ps->set.punctual_at_hits && ps->direct.punctual != LM_DIRECT_NONE ? lm_aim_keep_rest(&ps->aim, err) : LM_OK;
 }
 
 static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *out)
@@ -806,6 +806,7 @@ int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_befo
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }
+const lm_direct_light *lm_photon_stage_direct(const lm_photon_stage *ps) { return ps->aim.direct; }
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }
 const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps) { return ps->caustics; }
 

@@ -21,6 +21,9 @@ typedef struct {
                               * photons themselves) */
     int exact_direct;        /* AIM texels compute direct light (trace/direct_irradiance.h), photons bring the
                               * rest (LM_EXACT_*) */
+    int punctual_at_hits;    /* 1: the AIM also keeps its texels without the punctual lights' direct part
+                              * (lm_aim_keep_rest), for a ray gather that computes that part at its hits
+                              * (lm_gather_set_direct_at_hits); 0 (default): not kept */
     int occluders;           /* 1: an AIM texel counts only the hits whose photon came from where it sees
                               * (lm_aim_set_occluders); 0 (default): every hit near it, the paper's */
     int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
@@ -118,6 +121,8 @@ const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps);
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps);
+/* The direct light the AIM texels compute (exact_direct), NULL when they compute none. */
+const lm_direct_light *lm_photon_stage_direct(const lm_photon_stage *ps);
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
 /* The caustic photons; NULL when the settings have none. A class or switch edit (lm_scene.pass_version), an
  * added light or an edited material makes them again at the next update (a full trace). */

@@ -30,6 +30,8 @@ typedef struct {
     lmgi_scene *sc;
     lm_photon_stage *stage;
     const float *aim;      /* dilated AIM (atlas RGBA, the photon stage's) */
+    const float *rest;     /* the same less the suns' direct part, for the rays with the sun at their hits
+                              (NULL: the AIMs compute no sun) */
     lm_emitter_light el;   /* with has_el: the closed-form emitter light the frame loop would take */
     int has_el;
     uint32_t texels[PASS];
@@ -45,6 +47,7 @@ static int open_scene(const char *label, int paper_row, const char *path, bench_
         return 0;
     lm_photon_stage_settings set;
     lm_photon_stage_settings_default(&set);
+    set.punctual_at_hits = 1; /* as the frame loop's rays scheme sets it */
     lm_error err;
     const lm_atlas *a = &b->sc->atlas;
     if (lm_photon_stage_create(&b->sc->world, &set, &b->stage, NULL, &err) != LM_OK) {
@@ -52,6 +55,7 @@ static int open_scene(const char *label, int paper_row, const char *path, bench_
         return 0;
     }
     b->aim = lm_aim_dilated_rgba(lm_photon_stage_aim(b->stage));
+    b->rest = lm_aim_rest_dilated_rgba(lm_photon_stage_aim(b->stage));
     b->has_el = lm_emitter_light_suits(b->sc->scene) &&
                 lm_emitter_light_init(&b->el, b->sc->scene, b->sc->rt, LM_EMITTER_LIGHT_DEFAULT_RAYS, &err) == LM_OK;
     /* a pass of a ~100k-triangle scene without the proxy takes seconds: a quarter pass there */
@@ -110,6 +114,21 @@ static lm_gather *gather_traced(const bench_scene *b, int R, int proxy, lm_gathe
     }
     *tris = lm_gather_proxy(g) ? (int)lm_gather_proxy(g)->tri_count : (int)b->sc->scene->tri_count;
     return g;
+}
+
+/* The rays gather g with the sun's light taken at its hits, as the frame loop's (docs/gather.md, "Rays"),
+ * where the AIMs compute a sun; g is freed and NULL returned on failure. */
+static lm_gather *sun_at_hits(lm_gather *g, const bench_scene *b)
+{
+    lm_error err;
+    if (!g || !b->rest)
+        return g;
+    lm_gather_set_direct_at_hits(g, lm_photon_stage_direct(b->stage));
+    if (lm_gather_set_aim_dilated(g, &b->sc->atlas, b->rest, &err) == LM_OK)
+        return g;
+    printf("  %s: %s\n", b->label, err.msg);
+    lm_gather_free(g);
+    return NULL;
 }
 
 /* Seconds for one pass of b's texels. */
@@ -442,12 +461,12 @@ void lm_dev_bench_levels(const char *const *paths, int count)
         printf("\ngather on levels: skipped (%s)\n", err.msg);
         return;
     }
-    printf("\ngather on levels, the frame loop's defaults (R = 32 with the proxy and the rim traced; rays: %d strata), "
-           "ms per texel of "
-           "wall time (median of %d passes of up to %d texels spread over the atlas; x first: against the first "
+    printf("\ngather on levels, the frame loop's defaults (R = 32 with the proxy and the rim traced; rays: %d strata, "
+           "the sun at their hits; sun texels: the rays reading the sun from the AIM's texels instead), ms per texel "
+           "of wall time (median of %d passes of up to %d texels spread over the atlas; x first: against the first "
            "scene's hemicube) on %s:\n", LM_DEV_RAY_STRATA, REPEATS, PASS, lm_gl_context_description(gl));
-    printf("%-24s %10s %11s %10s %8s %10s %8s\n", "scene", "triangles", "proxy tris", "hemicube", "x first", "rays",
-           "x first");
+    printf("%-24s %10s %11s %10s %8s %10s %8s %11s\n", "scene", "triangles", "proxy tris", "hemicube", "x first", "rays",
+           "x first", "sun texels");
     double first = NAN;
     for (int i = 0; i < count; i++) {
         const char *label = strrchr(paths[i], '/') ? strrchr(paths[i], '/') + 1 : paths[i];
@@ -457,17 +476,18 @@ void lm_dev_bench_levels(const char *const *paths, int count)
             continue;
         }
         int tris = 0, ray_tris = 0;
-        lm_gather *g[2] = {gather_traced(&b, 32, 1, LM_GATHER_VIEWPORTS, 0, 1, &tris),
+        lm_gather *g[3] = {gather_traced(&b, 32, 1, LM_GATHER_VIEWPORTS, 0, 1, &tris),
+                           sun_at_hits(gather_traced(&b, 32, 1, LM_GATHER_RAYS, 0, 1, &ray_tris), &b),
                            gather_traced(&b, 32, 1, LM_GATHER_RAYS, 0, 1, &ray_tris)};
-        double ms[2] = {NAN, NAN};
-        time_configs(g, 2, &b, ms);
+        double ms[3] = {NAN, NAN, NAN};
+        time_configs(g, 3, &b, ms);
         if (isnan(first))
             first = ms[0];
-        printf("%-24s %10u %11d %10.3f %8.2f %10.3f %8.2f\n", label, b.sc->scene->tri_count, tris, ms[0],
-               ms[0] / first, ms[1], ms[1] / first);
+        printf("%-24s %10u %11d %10.3f %8.2f %10.3f %8.2f %11.3f\n", label, b.sc->scene->tri_count, tris, ms[0],
+               ms[0] / first, ms[1], ms[1] / first, ms[2]);
         fflush(stdout);
-        lm_gather_free(g[0]);
-        lm_gather_free(g[1]);
+        for (int k = 0; k < 3; k++)
+            lm_gather_free(g[k]);
         close_scene(&b);
     }
     lm_gl_context_destroy(gl);

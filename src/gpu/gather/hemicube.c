@@ -23,6 +23,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->coverage_samples = 4;
     s->rim_samples = 64;
     s->ray_samples = 400;
+    s->direct_at_hits = 1;
     s->cpu_threads = 0;
 }
 

@@ -34,6 +34,8 @@ struct lm_gather {
     float *views;          /* a pass's views (schemes 1, 2), tiles^2 * VIEW_FLOATS */
     const lm_emitter_light *emitters; /* non-NULL: emitters' light in closed form, not drawn */
     const lm_rt *rt;       /* non-NULL (and rim_samples > 0): the rim traced (photonmap/hemicube_rim.h) */
+    lm_direct_light direct; /* with has_direct: the punctual lights' direct light at the rays' hits */
+    int has_direct;
     float *aim_copy;       /* the dilated AIM as uploaded, for the rim's lookups (atlas-sized RGBA) */
     float *emit;           /* a pass's irradiance from the CPU per texel (emitters, rim), tiles^2 * 4 */
     int cpu_threads;       /* for it (settings' cpu_threads, 0 resolved at creation) */
@@ -304,6 +306,21 @@ const lm_proxy *lm_gather_proxy(const lm_gather *g) { return g->has_proxy ? &g->
 void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el) { g->emitters = el; }
 
 void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt) { g->rt = rt; }
+
+void lm_gather_set_direct_at_hits(lm_gather *g, const lm_direct_light *d)
+{
+    g->has_direct = d && d->punctual != LM_DIRECT_NONE;
+    if (!g->has_direct)
+        return;
+    g->direct = *d;
+    g->direct.area = NULL; /* emissive triangles' light stays in the AIM */
+    g->direct.cover = 0.0f; /* a ray reached the point: it is not hidden */
+}
+
+int lm_gather_direct_at_hits(const lm_gather *g)
+{
+    return g->has_direct && g->set.direct_at_hits && g->set.scheme == LM_GATHER_RAYS;
+}
 
 static int traces_rim(const lm_gather *g)
 {
@@ -635,7 +652,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                            uint32_t count)
 {
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]},
-                  g->set.enlargement, g->set.rim_samples, NULL};
+                  g->set.enlargement, g->set.rim_samples, NULL, NULL};
 #pragma omp parallel num_threads(g->cpu_threads) if (g->cpu_threads > 1)
     {
         lm_rt_thread_init(); /* FTZ/DAZ as on this thread: the same numbers on any thread */
@@ -696,7 +713,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
     if (!rim_ready(g))
         return lm_fail(err, LM_ERR_INVALID, "ray gather: it needs the scene's tracer (lm_gather_set_tracer)");
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]}, 0.0f,
-                  g->set.ray_samples, NULL};
+                  g->set.ray_samples, NULL, lm_gather_direct_at_hits(g) ? &g->direct : NULL};
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
     glBindTexture(GL_TEXTURE_2D, iim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
