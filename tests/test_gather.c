@@ -565,6 +565,34 @@ static void test_furnace(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* The rays gather of `count` texels over AIM map aim_rgb (undilated RGB), with the stage's direct light at
+ * the rays' hits (at_hits) or read from aim_rgb; returns the whole IIM texture read back (caller frees). */
+static float *gather_rays_of(const lmt_pipeline *p, const lm_photon_stage *st, int at_hits, const float *aim_rgb,
+                             const uint32_t *texels, uint32_t count)
+{
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    set.scheme = LM_GATHER_RAYS;
+    set.direct_at_hits = at_hits;
+    lm_gather *g = NULL;
+    lm_error err;
+    if (lm_gather_create(&set, &g, &err) != LM_OK)
+        fail_msg("gather: %s", err.msg);
+    lm_gather_set_tracer(g, p->rt);
+    lm_gather_set_direct_at_hits(g, lm_photon_stage_direct(st));
+    assert_int_equal(lm_gather_direct_at_hits(g), at_hits);
+    assert_int_equal(lm_gather_set_scene(g, p->s, &p->atlas, &err), LM_OK);
+    assert_int_equal(lm_gather_set_aim(g, &p->atlas, aim_rgb, &err), LM_OK);
+    unsigned tex = lm_iim_texture_create(p->atlas.width, p->atlas.height);
+    float *rgba = malloc(4 * sizeof(float) * (size_t)p->atlas.width * (size_t)p->atlas.height);
+    assert_true(tex && rgba);
+    assert_int_equal(lm_gather_texels(g, p->s, &p->atlas, texels, count, tex, NULL, &err), LM_OK);
+    assert_int_equal(lm_iim_texture_read(tex, p->atlas.width, p->atlas.height, rgba, &err), LM_OK);
+    lm_iim_texture_free(tex);
+    lm_gather_free(g);
+    return rgba;
+}
+
 /* The rays gather with the sun's direct light taken where its rays hit (lm_gather_set_direct_at_hits). A sun
  * straight down on a 400 m ground of albedo 0.5; a black slab 50 m up shades the ground's x < 0 half, so the
  * shadow's edge runs through a ground texel 8 m wide; two small receivers 2 m up face down at x = +1 and
@@ -617,24 +645,10 @@ static void test_sun_at_the_rays_hits(void **state)
     uint32_t texels[2];
     for (int k = 0; k < 2; k++)
         texels[k] = texel_near(&(tscene){p.s, p.su, p.atlas}, 3 + (uint32_t)k, xs[k], 0.0f);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
     for (int at_hits = 1; at_hits >= 0; at_hits--) {
-        lm_hemicube_settings set;
-        lm_hemicube_settings_default(&set);
-        set.scheme = LM_GATHER_RAYS;
-        set.direct_at_hits = at_hits;
-        lm_gather *g = NULL;
-        if (lm_gather_create(&set, &g, &err) != LM_OK)
-            fail_msg("gather: %s", err.msg);
-        lm_gather_set_tracer(g, p.rt);
-        lm_gather_set_direct_at_hits(g, lm_photon_stage_direct(st));
-        assert_int_equal(lm_gather_direct_at_hits(g), at_hits);
-        assert_int_equal(lm_gather_set_scene(g, p.s, &p.atlas, &err), LM_OK);
-        assert_int_equal(lm_gather_set_aim(g, &p.atlas, at_hits ? aim->rest : aim->rgb, &err), LM_OK);
-        unsigned tex = lm_iim_texture_create(p.atlas.width, p.atlas.height);
-        float *rgba = malloc(4 * sizeof(float) * (size_t)p.atlas.width * (size_t)p.atlas.height);
-        assert_true(tex && rgba);
-        assert_int_equal(lm_gather_texels(g, p.s, &p.atlas, texels, 2, tex, NULL, &err), LM_OK);
-        assert_int_equal(lm_iim_texture_read(tex, p.atlas.width, p.atlas.height, rgba, &err), LM_OK);
+        float *rgba = gather_rays_of(&p, st, at_hits, at_hits ? aim->rest : aim->rgb, texels, 2);
         double worst = 0.0;
         for (int k = 0; k < 2; k++) {
             const lm_texel *tx = &p.atlas.texels[texels[k]];
@@ -651,9 +665,7 @@ static void test_sun_at_the_rays_hits(void **state)
             assert_true(worst < 0.03);
         else
             assert_true(worst > 0.10); /* what the hits are for: the texels blur the edge */
-        lm_iim_texture_free(tex);
         free(rgba);
-        lm_gather_free(g);
     }
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
@@ -665,8 +677,8 @@ static void test_sun_at_the_rays_hits(void **state)
  * from it), the -x floor's 70 degrees away (100 degrees: none of the sun, though its faces are lit). An AIM
  * texel's sun part is rho / pi E cos(ns, l) (the geometric normal's cos 30 gives both floors 0.2757: 12%
  * low on the one, lit where it is dark on the other), and a receiver 2 m over the +x floor gathers
- * rho E cos(ns, l) F at the rays' hits. On truck-town's smooth terrain the two normals differ by tens of degrees: the grass beside the
- * retaining wall gave it half its light (docs/aim.md, "Shaded walls"). */
+ * rho E cos(ns, l) F at the rays' hits. On truck-town's smooth terrain the two normals differ by tens of
+ * degrees: the grass beside the retaining wall gave it half its light (docs/aim.md, "Suns"). */
 static void test_sun_cosine_on_shading_normals(void **state)
 {
     (void)state;
@@ -725,28 +737,15 @@ static void test_sun_cosine_on_shading_normals(void **state)
     }
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    set.scheme = LM_GATHER_RAYS;
-    lm_gather *g = NULL;
-    assert_int_equal(lm_gather_create(&set, &g, &err), LM_OK);
-    lm_gather_set_tracer(g, p.rt);
-    lm_gather_set_direct_at_hits(g, lm_photon_stage_direct(st));
-    assert_int_equal(lm_gather_set_scene(g, p.s, &p.atlas, &err), LM_OK);
-    assert_int_equal(lm_gather_set_aim(g, &p.atlas, aim->rest, &err), LM_OK);
     uint32_t texel = texel_near(&(tscene){p.s, p.su, p.atlas}, 3, rx, 0.0f);
-    unsigned tex = lm_iim_texture_create(p.atlas.width, p.atlas.height);
-    float *rgba = malloc(4 * sizeof(float) * (size_t)p.atlas.width * (size_t)p.atlas.height);
-    assert_true(tex && rgba);
-    assert_int_equal(lm_gather_texels(g, p.s, &p.atlas, &texel, 1, tex, NULL, &err), LM_OK);
-    assert_int_equal(lm_iim_texture_read(tex, p.atlas.width, p.atlas.height, rgba, &err), LM_OK);
+    float *rgba = gather_rays_of(&p, st, 1, aim->rest, &texel, 1);
     double y = h - set.offset * lm_scene_size(p.s), a = 100.0; /* the +x floor's far edges: beyond 100 m */
     double F = 0.5 * (1.0 + a / sqrt(a * a + y * y)), E = PI * want[0] * F; /* the -x floor gives nothing */
     const float *got = texel_value_at(&p.atlas, rgba, texel);
     print_message("receiver over the tilted floor: E %.4f, rho E cos(ns, l) F %.4f (%+.2f%%)\n", (double)got[0], E,
                   100.0 * (got[0] / E - 1.0));
     assert_true(fabs(got[0] / E - 1.0) < 0.02);
-    lm_iim_texture_free(tex);
     free(rgba);
-    lm_gather_free(g);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }

@@ -127,7 +127,7 @@ void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
 /* From the next refresh on, each texel also keeps its value without the punctual lights' part of the
  * direct light (lm_aim.rest; 0 without lm_aim_set_direct): a ray gather adds that part exactly where each
  * of its rays hits (photonmap/hemicube_rim.h) instead of reading it as the average over the texel it hits,
- * which a sunlit road's 7 m texels blur across every house's shadow (docs/aim.md, "Shaded walls"). Costs
+ * which a sunlit road's 7 m texels blur across every house's shadow (docs/aim.md, "Suns"). Costs
  * 7 floats an atlas texel and a second dilation per refresh. Call before the first refresh (the refresh
  * of a surface writes its texels). Errors: out of memory. */
 lm_status lm_aim_keep_rest(lm_aim *aim, lm_error *err);

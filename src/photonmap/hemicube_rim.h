@@ -19,7 +19,7 @@
  * closed form; 0 on the back of a single-sided surface, on mirror and glass; the sky where nothing is hit.
  * With `direct`, the punctual lights' direct part of the AIM is taken at the hit point itself rather than
  * as its texel's average: a 7 m road texel half in a house's shadow reads as half lit to every wall that
- * sees it, a ray hit reads lit or shadowed as the point is (docs/aim.md, "Shaded walls").
+ * sees it, a ray hit reads lit or shadowed as the point is (docs/aim.md, "Suns").
  *
  * Cost: K rays and AIM lookups per texel, on the gather's calling thread while the GPU rasterizes
  * (docs/gather.md, "The rim", for the measured time). Noise: the rim is a band near the horizon; a
