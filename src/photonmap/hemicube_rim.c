@@ -83,7 +83,8 @@ static double strata_share(const sky_mis *m, lm_vec3 n, const float d[3], double
 }
 
 /* kd / pi E_punctual at the ray's hit h (direction dir from eye): the punctual lights' direct light there,
- * as the AIM computes it for a texel (geometric normal, both sides of a double-sided material). */
+ * as the AIM computes it for a texel (the side the geometric normal's, the cosine the shading normal's,
+ * both sides of a double-sided material). */
 static void punctual_at_hit(const lm_rim *r, const float eye[3], const float dir[3], const lm_rt_hit *h, float out[3])
 {
     lm_shading sh;
