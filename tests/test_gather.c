@@ -634,8 +634,9 @@ static void test_sun_at_the_rays_hits(void **state)
     assert_non_null(lm_photon_stage_direct(st));
     const double lit = 0.5 / PI * 2.0;
     const float at_x[2] = {100.0f, -100.0f};
+    const tscene t = {p.s, p.su, p.atlas}; /* for texel_near */
     for (int k = 0; k < 2; k++) {
-        const lm_texel *tx = &p.atlas.texels[texel_near(&(tscene){p.s, p.su, p.atlas}, 1, at_x[k], 0.0f)];
+        const lm_texel *tx = &p.atlas.texels[texel_near(&t, 1, at_x[k], 0.0f)];
         size_t i = 3 * ((size_t)tx->y * p.atlas.width + tx->x);
         print_message("ground at x = %.0f: AIM %.5f, rest %.2e (sun's part %.5f, want %.5f)\n", (double)at_x[k],
                       (double)aim->rgb[i], (double)aim->rest[i], (double)(aim->rgb[i] - aim->rest[i]), k ? 0.0 : lit);
@@ -644,7 +645,7 @@ static void test_sun_at_the_rays_hits(void **state)
     }
     uint32_t texels[2];
     for (int k = 0; k < 2; k++)
-        texels[k] = texel_near(&(tscene){p.s, p.su, p.atlas}, 3 + (uint32_t)k, xs[k], 0.0f);
+        texels[k] = texel_near(&t, 3 + (uint32_t)k, xs[k], 0.0f);
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
     for (int at_hits = 1; at_hits >= 0; at_hits--) {
@@ -699,10 +700,10 @@ static void test_sun_cosine_on_shading_normals(void **state)
     lmt_pipeline p;
     lmt_pipeline_load(&p, path, 8.0f);
     const double tilt[2] = {40.0 * PI / 180.0, -70.0 * PI / 180.0};
-    for (uint32_t t = 0; t < p.s->tri_count; t++) {
-        uint32_t node = p.s->tri_node[t];
+    for (uint32_t tri = 0; tri < p.s->tri_count; tri++) {
+        uint32_t node = p.s->tri_node[tri];
         for (int k = 0; node <= 2 && k < 3; k++) {
-            float *n = p.s->normals + 3 * (size_t)p.s->tris[3 * (size_t)t + k];
+            float *n = p.s->normals + 3 * (size_t)p.s->tris[3 * (size_t)tri + k];
             n[0] = (float)sin(tilt[node - 1]), n[1] = (float)cos(tilt[node - 1]), n[2] = 0.0f;
         }
     }
@@ -724,11 +725,11 @@ static void test_sun_cosine_on_shading_normals(void **state)
     if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK)
         fail_msg("%s", err.msg);
     const lm_aim *aim = lm_photon_stage_aim(st);
+    const tscene t = {p.s, p.su, p.atlas}; /* for texel_near */
     double want[2];
     for (int k = 0; k < 2; k++) {
         want[k] = 0.5 / PI * 2.0 * fmax(0.0, sin(tilt[k]) * l[0] + cos(tilt[k]) * l[1]);
-        const lm_texel *tx = &p.atlas.texels[texel_near(&(tscene){p.s, p.su, p.atlas}, 1 + (uint32_t)k,
-                                                        k ? -100.0f : 100.0f, 0.0f)];
+        const lm_texel *tx = &p.atlas.texels[texel_near(&t, 1 + (uint32_t)k, k ? -100.0f : 100.0f, 0.0f)];
         size_t i = 3 * ((size_t)tx->y * p.atlas.width + tx->x);
         print_message("floor tilted %+.0f degrees: the AIM's sun part %.5f, rho / pi E cos(ns, l) %.5f "
                       "(cos(ng, l): %.5f)\n", tilt[k] * 180.0 / PI, (double)(aim->rgb[i] - aim->rest[i]), want[k],
@@ -737,7 +738,7 @@ static void test_sun_cosine_on_shading_normals(void **state)
     }
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    uint32_t texel = texel_near(&(tscene){p.s, p.su, p.atlas}, 3, rx, 0.0f);
+    uint32_t texel = texel_near(&t, 3, rx, 0.0f);
     float *rgba = gather_rays_of(&p, st, 1, aim->rest, &texel, 1);
     double y = h - set.offset * lm_scene_size(p.s), a = 100.0; /* the +x floor's far edges: beyond 100 m */
     double F = 0.5 * (1.0 + a / sqrt(a * a + y * y)), E = PI * want[0] * F; /* the -x floor gives nothing */

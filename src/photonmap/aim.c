@@ -963,14 +963,8 @@ static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index,
         n = 1;
     }
     const tri_frame *tf = triangle_frame(j, t->tri, &ts->tri);
-    float ns[3]; /* the shading normal at the texel's centre, for the punctual lights' cosine */
-    lm_vec3 nsum = lm_v3(0.0f, 0.0f, 0.0f);
-    for (int k = 0; k < 3; k++) {
-        float vn[3];
-        lm_scene_normal_world(j->s, j->s->tris[3 * (size_t)t->tri + k], vn);
-        nsum = lm_add(nsum, lm_scale(lm_v3_load(vn), t->bary[k]));
-    }
-    lm_v3_store(ns, lm_length(nsum) > 0.0f ? lm_normalize(nsum) : lm_v3_load(tf->n_world));
+    float centre[3], ns[3]; /* the shading normal at the texel's centre, for the punctual lights' cosine */
+    lm_texel_world(j->s, t, centre, ns);
     double sum[3] = {0.0, 0.0, 0.0}, sum_p[3] = {0.0, 0.0, 0.0}, seen = 0.0;
     for (int i = 0; i < n; i++) {
         float p[3], d[3], dp[3];

@@ -414,11 +414,12 @@ static int valid_settings(const lm_direct_settings *set)
     return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0;
 }
 
+/* The 2D maps (whole-scene and the view's) a spot (0) or directional (1) light holds. */
+static int maps_2d(int directional) { return directional ? 1 + LM_VIEW_CASCADES : 1; }
+
 /* Shadow-map bytes for `points` point lights and `others` 2D maps at the given sides: a cube (6 faces) per
  * point light, a 2D map per spot light and 1 + LM_VIEW_CASCADES per directional one (the whole scene's and
  * the view's), each with its static layer (shadow_maps.h), 4 bytes a texel. */
-/* The 2D maps (whole-scene and the view's) a spot (0) or directional (1) light holds. */
-static int maps_2d(int directional) { return directional ? 1 + LM_VIEW_CASCADES : 1; }
 
 static double shadow_bytes(int points, int others, int cube_size, int map_size)
 {
