@@ -585,7 +585,8 @@ typedef struct {
     int frame;                 /* updates before this one */
     float time;                /* animation time, seconds */
     uint32_t photons_retraced, groups_invalidated, groups_retraced;
-    int aim_surfaces_refreshed;
+    int aim_surfaces_refreshed; /* for the photons that changed, and at once for a light, emission or colour
+                                 * edit (those are in ms_aim too, not ms_animate) */
     uint32_t texels_gathered;  /* IIM texels regathered */
     int texels_budget;         /* the texels this update was allowed (budget_ms > 0: from the measured cost) */
     int surfaces_changed;      /* surfaces whose displayed lightmap changed (lmgi_surface_version moved) */

@@ -1508,6 +1508,16 @@ static lm_status refresh(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, 
     return rc;
 }
 
+void lm_aim_stats_add(lm_aim_stats *to, const lm_aim_stats *from)
+{
+    to->surfaces_refreshed += from->surfaces_refreshed;
+    to->surfaces_pending = from->surfaces_pending;
+    to->texels_written += from->texels_written;
+    to->hits_used += from->hits_used;
+    to->surfaces_binned += from->surfaces_binned;
+    to->seconds += from->seconds;
+}
+
 lm_status lm_aim_refresh_listed(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                 lm_photon_store *ps, const int *surfaces, int count, lm_aim_stats *stats,
                                 lm_error *err)

@@ -73,6 +73,8 @@ typedef struct {
     int surfaces_binned;     /* of the surfaces refreshed, those estimated without a kd-tree (set.dense) */
     double seconds;
 } lm_aim_stats;
+/* to += from: counts and seconds added, surfaces_pending taken from `from` (the later refresh's). */
+void lm_aim_stats_add(lm_aim_stats *to, const lm_aim_stats *from);
 
 typedef struct {
     lm_aim_settings set;

@@ -375,12 +375,17 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     lm_status st = join_stage(fl, &done, err);
     if (st == LM_OK)
         st = animate(fl, t, o, err);
-    /* the counts and times of the stage's work that finished in this step (begun by the last one) */
+    /* the counts and times of the stage's work that finished in this step (begun by the last one), with
+     * the AIM refreshes this step's edits made at once (animate) */
+    lm_aim_stats edits = o->stage.aim;
+    double t_edits = o->stage.t_aim;
     o->stage.photons = done.photons;
     o->stage.aim = done.aim;
+    lm_aim_stats_add(&o->stage.aim, &edits);
+    o->stage.aim.surfaces_pending = done.aim.surfaces_pending;
     o->stage.caustics = done.caustics;
     o->stage.t_photons = done.t_photons;
-    o->stage.t_aim = done.t_aim;
+    o->stage.t_aim = done.t_aim + t_edits;
     o->stage.t_caustics = done.t_caustics;
     if (st == LM_OK)
         st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
@@ -393,6 +398,8 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
         st = blend_and_render(fl, o, err); /* no frame: the blend alone */
     if (st == LM_OK) {
         fl->pending = o->stage;
+        memset(&fl->pending.aim, 0, sizeof fl->pending.aim); /* the job counts its own refreshes */
+        fl->pending.t_aim = 0.0;
         fl->pending_busy = 1;
         lm_stage_worker_begin(fl->worker, &fl->pending);
     }

@@ -195,6 +195,15 @@ static int recoloured(const lm_material *was, const lm_material *now, float r[3]
     return 1;
 }
 
+/* An AIM refresh's counts and time added to the frame's (out->aim, out->t_aim): a frame may refresh for
+ * its edits (animate) and for its photons (update), and both are AIM work that the budget's cost model
+ * learns and lmgi_update's stats report. */
+static void add_aim_stats(lm_photon_stage_frame *out, const lm_aim_stats *st)
+{
+    lm_aim_stats_add(&out->aim, st);
+    out->t_aim += st->seconds;
+}
+
 /* The materials the edits changed (colour, emission, class; ch) reach the photons that touch them, which
  * are re-traced under the group budget. At once, the photons that bounced off a diffuse material
  * recoloured alone are reweighted (lm_photons_scale_materials), and the AIMs of the surfaces of the
@@ -202,8 +211,10 @@ static int recoloured(const lm_material *was, const lm_material *now, float r[3]
  * bounce shows at the next update (issue 32, item 2), that of other material edits to first order (the
  * AIM multiplies in the new albedo), and the IIM texels that see them follow (update/light_scale.h).
  * *count: how many materials changed. */
-static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch, int *count, lm_error *err)
+static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch, lm_photon_stage_frame *out,
+                                  lm_error *err)
 {
+    int *count = &out->materials_changed;
     *count = 0;
     if (!ch->materials_changed)
         return LM_OK;
@@ -233,8 +244,10 @@ static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch
     if (!ps->have_aim || n == 0)
         return LM_OK;
     lm_aim_stats st;
-    return lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
-                                 ps->touched, n, &st, err);
+    lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
+                                         lm_photons_store_mutable(ps->photons), ps->touched, n, &st, err);
+    add_aim_stats(out, &st);
+    return rc;
 }
 
 /* Whether anything an emitter's placement or power follows from may have changed since they were last
@@ -307,7 +320,7 @@ static void note_scale(lm_photon_stage *ps, int e, const float s[3], int first)
  * mix of lights they hold. Each surface's factor, how much the flux of its hits changed per channel (one
  * that no hit reaches: 1, or the whole scene's where its AIM computes the lights' direct light), waits
  * for the IIM (lm_photon_stage_take_scale) with the AIM from before. */
-static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
+static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
     int S = ps->surfaces->surface_count, moved = 0;
     int computed = ps->set.exact_direct == LM_EXACT_ALL || ps->set.exact_direct == LM_EXACT_SUNS; /* lights' direct */
@@ -330,16 +343,19 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_error *err)
     }
     keep_aim_before(ps);
     lm_aim_stats st;
-    return lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas, lm_photons_store_mutable(ps->photons),
-                                 ps->touched, moved, &st, err);
+    lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
+                                         lm_photons_store_mutable(ps->photons), ps->touched, moved, &st, err);
+    add_aim_stats(out, &st);
+    return rc;
 }
 
 /* Invalidates the groups of every emitter whose placement or power changed since its last snapshot; a
  * light changed in power alone keeps its photons, whose hits are scaled (lm_photons_scale_emitter), or,
  * turned dark, are traced again to go; either way its light is scaled at once (apply_scale). *scaled
  * counts those. */
-static lm_status check_emitters(lm_photon_stage *ps, int *moved, int *scaled, lm_error *err)
+static lm_status check_emitters(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
+    int *moved = &out->emitters_moved, *scaled = &out->emitters_scaled;
     *moved = *scaled = 0;
     int noted = 0;
     for (int e = 0; e < ps->emitters.count; e++) {
@@ -360,7 +376,7 @@ static lm_status check_emitters(lm_photon_stage *ps, int *moved, int *scaled, lm
         if (st != LM_OK)
             return st;
     }
-    return noted ? apply_scale(ps, err) : LM_OK;
+    return noted ? apply_scale(ps, out, err) : LM_OK;
 }
 
 /* The caustic photons for the scene as it is now (made again after edits that change the generators or
@@ -650,14 +666,14 @@ lm_status lm_photon_stage_animate(lm_photon_stage *ps, float t, lm_photon_stage_
         lm_emitters_update(&ps->emitters, ps->scene);
         lm_emitters_seal(&ps->emitters, ps->scene, ps->rt);
         if (st == LM_OK)
-            st = check_emitters(ps, &out->emitters_moved, &out->emitters_scaled, err);
+            st = check_emitters(ps, out, err);
     }
     out->emitters_moved += added;
-    lm_status sm = follow_materials(ps, ch, &out->materials_changed, st == LM_OK ? err : NULL);
+    lm_status sm = follow_materials(ps, ch, out, st == LM_OK ? err : NULL);
     st = st == LM_OK ? sm : st;
     lm_edits_clear_changes(ps->edits);
-    out->t_animate = lm_now() - t0;
-    out->t_total = out->t_animate;
+    out->t_total = lm_now() - t0;
+    out->t_animate = out->t_total - out->t_aim; /* the edits' AIM refreshes are AIM time */
     return st;
 }
 
@@ -725,15 +741,15 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
     if (st == LM_OK && ps->set.trace && ps->set.aims) {
         /* a budget's bound on hits takes any number of surfaces within it */
         ps->aim.set.max_hits = ps->limit.aim_hits ? ps->limit.aim_hits : ps->hit_bound;
-        st = refresh_aims(ps, ps->limit.aim_hits ? ps->surfaces->surface_count : ps->set.surfaces_per_frame,
-                          &out->aim, err);
+        lm_aim_stats as;
+        st = refresh_aims(ps, ps->limit.aim_hits ? ps->surfaces->surface_count : ps->set.surfaces_per_frame, &as,
+                          err);
+        add_aim_stats(out, &as);
     }
-    double t3 = lm_now();
     if (st == LM_OK)
         st = update_caustics(ps, out, err);
     out->t_photons = t2 - t1;
-    out->t_aim = t3 - t2;
-    out->t_total = out->t_animate + (lm_now() - t1);
+    out->t_total += lm_now() - t1;
     return st;
 }
 
@@ -765,16 +781,18 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan,
         st = fresh_plan ? lm_photons_trace_all_exact(ps->photons, &out->photons, err)
                         : lm_photons_trace_all(ps->photons, &out->photons, err);
     double t2 = lm_now();
+    lm_aim_stats as;
+    memset(&as, 0, sizeof as);
     if (st == LM_OK && ps->set.aims && replan) {
-        st = refresh_all_aims(ps, &out->aim, err);
+        st = refresh_all_aims(ps, &as, err);
     } else if (st == LM_OK && ps->set.aims) {
         float threshold = ps->aim.set.delta_threshold; /* a bake refreshes every surface whose photons changed */
         ps->aim.set.delta_threshold = 0.0f;
-        st = refresh_aims(ps, -1, &out->aim, err);
+        st = refresh_aims(ps, -1, &as, err);
         ps->aim.set.delta_threshold = threshold;
     }
+    add_aim_stats(out, &as);
     out->t_photons = t2 - t1;
-    out->t_aim = lm_now() - t2;
     out->t_total = out->t_animate + out->t_photons + out->t_aim + out->t_caustics;
     return st;
 }
