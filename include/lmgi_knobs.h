@@ -200,7 +200,13 @@ static inline int lmgi_knob_is_pow2(double v)
       "shadow rays: no plaid, no coverage samples needed) or drawn into the\n"                                    \
       "hemicubes (default: closed when the scene has 1 to 64 emissive triangles)")                                \
     X(gather, emitter_rays, LMGI_KNOB_INT, int, 32, 1, 65536, 0, LMGI_NO_RULE, "--emitter-rays", "N",              \
-      LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP, "shadow rays per emissive triangle and texel (default 32)")
+      LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP, "shadow rays per emissive triangle and texel (default 32)") \
+    X(gather, bounce_passes, LMGI_KNOB_INT, int, LMGI_OFF, 1, 8, 1, LMGI_NO_RULE, "--bounce-passes", "N",          \
+      LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
+      "after the first full gather, N more with the bounced light read from\n"                                     \
+      "the last one's lightmap instead of the photons (rays scheme; the first\n"                                  \
+      "solution only: later regathers read the photons; not in a shard: give\n"                                   \
+      "it to the merge; default off; docs/gather.md, \"Bounce passes\")")
 
 /* caustics (docs/caustics.md): photons shot from every light towards every mirror or glass node, filtered
  * on screen */

@@ -1370,6 +1370,8 @@ static void test_shard_cancelled_and_resumed(void **state)
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "not with a shard");
     bad = (lmgi_updater_desc){.parts = parts, .part_count = 0};
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "parts given with part_count 0");
+    bad = (lmgi_updater_desc){.shard = 0, .shards = 2, .checkpoint = straight, .gather.bounce_passes = 2};
+    expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "bounce_passes 2 in a shard");
     bad = (lmgi_updater_desc){.photons.count = 6000, .parts = parts, .part_count = 1};
     expect_invalid(lmgi_updater_create(ctx, sc, &bad, &u, &e), &e, "shard 2 of 2 is missing");
     close_all(NULL, sc, ctx);
@@ -1493,6 +1495,45 @@ static void test_shared_bake_is_one_process_bake(void **state)
     close_all(NULL, sc, ctx);
 }
 
+/* Bounce passes (docs/gather.md) in a bake in shards: the shards gather their parts of the first pass
+ * alone (a shard is refused bounce passes: test_shard_cancelled_and_resumed), and the merge makes them from
+ * the parts put together, to the same bits as one process's bake with them. */
+static void test_merge_makes_the_bounce_passes(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = new_context();
+    lmgi_scene *sc = load_scene("cornell.glb", 8000);
+    lmgi_error e;
+    char part[2][512];
+    for (int i = 0; i < 2; i++) {
+        snprintf(part[i], sizeof part[i], "%s/bounce%d.part", lmt_tmpdir(), i);
+        lmgi_updater_desc d = {.photons.count = 6000, .gather.scheme = LMGI_GATHER_RAYS, .shard = i, .shards = 2,
+                               .checkpoint = part[i]};
+        lmgi_updater_free(make_updater(ctx, sc, &d));
+    }
+    const char *const parts[2] = {part[0], part[1]};
+    lmgi_updater_desc whole = {.photons.count = 6000, .gather.scheme = LMGI_GATHER_RAYS, .gather.bounce_passes = 2};
+    lmgi_updater_desc merged = whole, first = whole;
+    merged.parts = parts, merged.part_count = 2;
+    first.gather.bounce_passes = LMGI_OFF;
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    size_t n = 4 * (size_t)in.atlas_width * (size_t)in.atlas_height;
+    float *iim[3];
+    const lmgi_updater_desc *descs[3] = {&whole, &merged, &first};
+    for (int k = 0; k < 3; k++) {
+        lmgi_updater *u = make_updater(ctx, sc, descs[k]);
+        iim[k] = malloc(n * sizeof(float));
+        assert_int_equal(lmgi_get_lightmap(u, LMGI_LIGHTMAP_IIM, iim[k], n, &e), LMGI_OK);
+        lmgi_updater_free(u);
+    }
+    assert_memory_equal(iim[0], iim[1], n * sizeof(float));
+    assert_true(memcmp(iim[0], iim[2], n * sizeof(float)) != 0); /* the passes did gather again */
+    for (int k = 0; k < 3; k++)
+        free(iim[k]);
+    close_all(NULL, sc, ctx);
+}
+
 /* The library says the version the header it was built with says, part by part. */
 static void test_version(void **state)
 {
@@ -1559,6 +1600,7 @@ int main(void)
         cmocka_unit_test(test_second_thread_refused),
         cmocka_unit_test(test_shard_cancelled_and_resumed),
         cmocka_unit_test(test_shared_bake_is_one_process_bake),
+        cmocka_unit_test(test_merge_makes_the_bounce_passes),
         cmocka_unit_test(test_exported_symbols),
         cmocka_unit_test(test_version),
     };

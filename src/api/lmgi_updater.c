@@ -117,6 +117,7 @@ static void gather_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *
                        : g->emitter_light == LMGI_EMITTERS_DRAWN  ? 0
                                                                   : -1; /* chosen per scene */
     s->emitter_rays = g->emitter_rays;
+    s->bounce_passes = g->bounce_passes == LMGI_OFF ? 0 : g->bounce_passes;
 }
 
 static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s)
@@ -217,6 +218,10 @@ static lm_status check_shards(const lmgi_updater_desc *d, lm_error *err)
     for (int p = 0; p < d->part_count; p++)
         if (!d->parts[p])
             return lm_fail(err, LM_ERR_INVALID, "%s: parts[%d] is NULL", fn, p);
+    if (d->shards > 0 && d->gather.bounce_passes > 0)
+        return lm_fail(err, LM_ERR_INVALID, "%s: bounce_passes %d in a shard: each pass reads the whole last "
+                       "gather, which a shard does not hold; give them to the merge of the parts", fn,
+                       d->gather.bounce_passes);
     if (d->parts && (d->shards > 0 || d->resume))
         return lm_fail(err, LM_ERR_INVALID, "%s: parts are put together into a whole bake: not with %s", fn,
                        d->shards > 0 ? "a shard" : "resume");

@@ -21,6 +21,9 @@ typedef struct {
     lm_photon_stage_settings stage;
     lm_hemicube_settings gather; /* coverage_samples 0 (the default here): 1 with the closed-form emitter
                                   * light, else lm_gather_coverage_for the scene */
+    int bounce_passes;     /* after the first full gather, this many more, each reading the bounced light as
+                            * rho / pi times the last one's IIM instead of the photons' AIM (rays scheme with
+                            * the punctual light at its hits only; lightmap_path.c); 0: none */
     int emitter_light;     /* emitters' light in the gather (trace/emitter_light.h): 1 closed form with sampled
                             * visibility, 0 drawn into the hemicubes, -1 (default) closed form when
                             * lm_emitter_light_suits the scene */

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../charts/atlas_dilate.h"
 #include "../core/log.h"
 #include "../core/timing.h"
 #include "../core/vecmath.h"
@@ -11,6 +12,7 @@
 #include "../photonmap/delta_i.h"
 #include "../photonmap/texel_change.h"
 #include "../scene/sky.h"
+#include "../trace/direct_irradiance.h"
 #include "../trace/emitter_light.h"
 #include "gather_passes.h"
 #include "light_scale.h"
@@ -239,16 +241,92 @@ void lm_lightmap_path_free(lm_lightmap_path *lp)
     free(lp);
 }
 
+/* The bounced light as the next pass reads it: rho / pi times the IIM just gathered, per texel, dilated
+ * into the gutters (out: RGBA, atlas-sized; rgb: atlas-sized scratch). The IIM holds everything but the
+ * punctual lights' direct light (the sky seen, the emitters' light, the bounces), and the passes take
+ * every punctual light at their hits: what the first pass reads from the AIMs and its hits, with the
+ * photons' noise gathered once more. */
+static lm_status bounce_map(lm_lightmap_path *lp, const float *aim, float *rgb, float *out, lm_error *err)
+{
+    const lm_atlas *a = lp->atlas;
+    float *iim;
+    lm_status st = lm_lightmap_path_read_window(lp, (const int[4]){0, 0, a->width, a->height}, &iim, err);
+    if (st != LM_OK)
+        return st;
+    memset(rgb, 0, sizeof *rgb * 3 * (size_t)a->width * a->height);
+    float limit = lp->set->gather.backface_limit;
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        const lm_texel *t = &a->texels[i];
+        size_t at = (size_t)t->y * a->width + t->x;
+        float kd[3];
+        lm_texel_kd(lp->scene, t, kd);
+        int valid = iim[4 * at + 3] <= limit; /* else the gather saw back faces: it is inside geometry */
+        for (int c = 0; c < 3; c++)
+            rgb[3 * at + c] = valid ? kd[c] / LM_PI * iim[4 * at + c] : aim[4 * at + c];
+    }
+    free(iim);
+    lm_atlas_dilated_rgba(a, rgb, out);
+    return LM_OK;
+}
+
+/* Bounce passes (docs/gather.md, "Bounce passes"): every texel gathered again, as many times as the
+ * settings say, each pass reading its bounced light from the last pass's IIM instead of the AIMs. A
+ * photon estimate's noise (a few heavy photons that came in through a window) then reaches the lightmap
+ * only through that many more gathers, each of which multiplies it by an albedo and spreads it over the
+ * hemisphere. Only where the gather takes the punctual lights' direct light at its own hits (the rays
+ * scheme): a hemicube reads it from the map, which the IIM does not hold. A shard holds part of the
+ * first gather, and is refused them (lmgi_updater.c). The AIM is uploaded again for the next gather. */
+static lm_status bounce_passes(lm_lightmap_path *lp, lm_error *err)
+{
+    const lm_atlas *a = lp->atlas;
+    if (lp->set->bounce_passes <= 0 || a->texel_count == 0)
+        return LM_OK;
+    if (lp->set->gather.scheme != LM_GATHER_RAYS) {
+        lm_log(LM_LOG_WARN, "%s: no bounce pass: they need the rays gather, which takes the punctual light at its "
+               "hits (a hemicube reads that light from the map, which an IIM does not hold)", lp->scene->path);
+        return LM_OK;
+    }
+    /* the map holds no punctual light: each is taken at the hits, the suns as before and the others too */
+    const lm_direct_light *d = lm_gather_direct_at_hits(lp->gather) ? lm_photon_stage_direct(lp->stage) : NULL;
+    float size = lm_scene_size(lp->scene), lift = 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f);
+    const float *aim = gather_aim(lp); /* what the first pass read, for the texels inside geometry */
+    lm_direct_light every = d ? *d
+                              : (lm_direct_light){lp->scene, lp->rt, lm_photon_stage_emitters(lp->stage), NULL,
+                                                  LM_DIRECT_PUNCTUAL, lift, 0.0f, NULL};
+    every.punctual = LM_DIRECT_PUNCTUAL;
+    lm_gather_set_direct_at_hits(lp->gather, &every);
+    size_t cells = (size_t)a->width * a->height;
+    float *rgb = malloc(sizeof *rgb * 3 * cells), *map = malloc(sizeof *map * 4 * cells);
+    lm_status st = rgb && map ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for a bounce pass", lp->scene->path);
+    for (int p = 0; st == LM_OK && p < lp->set->bounce_passes; p++) {
+        lm_log(LM_LOG_INFO, "bounce pass %d of %d", p + 1, lp->set->bounce_passes);
+        st = bounce_map(lp, aim, rgb, map, err);
+        if (st == LM_OK)
+            st = lm_gather_set_aim_dilated(lp->gather, a, map, err);
+        if (st == LM_OK)
+            st = lm_lightmap_path_gather(lp, lm_iim_sched_pick_all(&lp->iim.sched, store_of(lp), lp->texels), err);
+        if (st == LM_OK)
+            st = lm_iim_blend(&lp->iim, 1, err);
+    }
+    lm_gather_set_direct_at_hits(lp->gather, d);
+    lp->aim_stale = 1;
+    free(rgb);
+    free(map);
+    return st;
+}
+
 lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_error *err)
 {
     double t0 = lm_now();
     lp->aim_stale = 1;
     lm_status st = first_gather(lp, err);
-    lp->set->progress = NULL; /* per-frame gathers are small */
-    lp->set->cancel = NULL;
-    lp->set->checkpoint = NULL;
+    lp->set->checkpoint = NULL; /* it holds the first gather; bounce passes are made again from it */
     if (st == LM_OK)
         st = lm_iim_blend(&lp->iim, 1, err);
+    if (st == LM_OK) /* shown and cancellable as the first gather is */
+        st = bounce_passes(lp, err);
+    lp->set->progress = NULL; /* per-frame gathers are small */
+    lp->set->cancel = NULL;
     if (st == LM_OK && !lp->have_change) { /* from here on every texel holds what it saw now */
         st = lm_texel_change_init(&lp->change, lp->scene, lp->atlas, lm_photon_stage_aim(lp->stage)->rgb,
                                   lp->set->iim.texel_change, err);
