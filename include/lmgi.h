@@ -613,6 +613,9 @@ typedef struct {
                                 * in their emission: their photons' hits scaled instead of re-traced, and their
                                 * light shown in the lightmaps at once, refined by the regathers after
                                 * (docs/tradeoff.md, "Light edits at once") */
+    int aim_surfaces_at_once;  /* of aim_surfaces_refreshed, those refreshed at once for this update's light,
+                                * emission or colour edits: as many as the edits reach, outside the AIM budget
+                                * that bounds the others (issue 32, item 4) */
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative

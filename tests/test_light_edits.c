@@ -498,7 +498,8 @@ static void update_scaling(lmgi_updater *u, int scaled, int retraced)
     print_message("the edit's update: %d AIM surfaces refreshed in %.2f ms\n", st.aim_surfaces_refreshed,
                   st.ms_aim);
     if (scaled && !retraced)
-        assert_true(st.aim_surfaces_refreshed > 0 && st.ms_aim > 0.0);
+        assert_true(st.aim_surfaces_at_once > 0 && st.aim_surfaces_at_once <= st.aim_surfaces_refreshed &&
+                    st.ms_aim > 0.0);
 }
 
 static void edit_light(lmgi_scene *sc, int id, float intensity_by, const float *color, int enabled)

@@ -247,6 +247,7 @@ static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch
     lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                          lm_photons_store_mutable(ps->photons), ps->touched, n, &st, err);
     add_aim_stats(out, &st);
+    out->aim_at_once += st.surfaces_refreshed;
     return rc;
 }
 
@@ -346,6 +347,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm
     lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                          lm_photons_store_mutable(ps->photons), ps->touched, moved, &st, err);
     add_aim_stats(out, &st);
+    out->aim_at_once += st.surfaces_refreshed;
     return rc;
 }
 

@@ -44,6 +44,8 @@ typedef struct {
                               * (lm_photon_stage_take_scale): their hits scaled, not traced again, or, turned
                               * dark, traced again to go */
     int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
+    int aim_at_once;         /* of aim.surfaces_refreshed, those refreshed at once for this frame's light,
+                              * emission or colour edits (lm_photon_stage_animate) */
     lm_photon_frame_stats photons;
     lm_aim_stats aim;
     lm_caustic_frame_stats caustics; /* its seconds are t_caustics */
