@@ -377,15 +377,11 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
         st = animate(fl, t, o, err);
     /* the counts and times of the stage's work that finished in this step (begun by the last one), with
      * the AIM refreshes this step's edits made at once (animate) */
-    lm_aim_stats edits = o->stage.aim;
-    double t_edits = o->stage.t_aim;
     o->stage.photons = done.photons;
-    o->stage.aim = done.aim;
-    lm_aim_stats_add(&o->stage.aim, &edits);
-    o->stage.aim.surfaces_pending = done.aim.surfaces_pending;
+    lm_aim_stats_add(&o->stage.aim, &done.aim);
     o->stage.caustics = done.caustics;
     o->stage.t_photons = done.t_photons;
-    o->stage.t_aim = done.t_aim + t_edits;
+    o->stage.t_aim += done.t_aim;
     o->stage.t_caustics = done.t_caustics;
     if (st == LM_OK)
         st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);

@@ -12,7 +12,6 @@
 #include "../photonmap/delta_i.h"
 #include "../photonmap/texel_change.h"
 #include "../scene/sky.h"
-#include "../trace/direct_irradiance.h"
 #include "../trace/emitter_light.h"
 #include "gather_passes.h"
 #include "light_scale.h"
@@ -288,12 +287,8 @@ static lm_status bounce_passes(lm_lightmap_path *lp, lm_error *err)
     }
     /* the map holds no punctual light: each is taken at the hits, the suns as before and the others too */
     const lm_direct_light *d = lm_gather_direct_at_hits(lp->gather) ? lm_photon_stage_direct(lp->stage) : NULL;
-    float size = lm_scene_size(lp->scene), lift = 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f);
     const float *aim = gather_aim(lp); /* what the first pass read, for the texels inside geometry */
-    lm_direct_light every = d ? *d
-                              : (lm_direct_light){lp->scene, lp->rt, lm_photon_stage_emitters(lp->stage), NULL,
-                                                  LM_DIRECT_PUNCTUAL, lift, 0.0f, NULL};
-    every.punctual = LM_DIRECT_PUNCTUAL;
+    lm_direct_light every = lm_photon_stage_punctual_light(lp->stage);
     lm_gather_set_direct_at_hits(lp->gather, &every);
     size_t cells = (size_t)a->width * a->height;
     float *rgb = malloc(sizeof *rgb * 3 * cells), *map = malloc(sizeof *map * 4 * cells);

@@ -83,6 +83,13 @@ static int has_sun(const lm_emitters *em)
     return 0;
 }
 
+/* How far shadow rays leave a surface: a share of the scene's size. */
+static float direct_lift(const lm_scene *s)
+{
+    float size = lm_scene_size(s);
+    return 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f);
+}
+
 /* The AIMs take direct light from trace/direct_irradiance.h as exact_direct says (LM_EXACT_*); nothing
  * where the photons' cover distance hides a side. */
 static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph, lm_error *err)
@@ -96,11 +103,9 @@ static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph,
             return st;
         ps->have_area = 1;
     }
-    float size = lm_scene_size(ps->scene);
     ps->direct = (lm_direct_light){ps->scene, ps->rt, &ps->emitters, ps->have_area ? &ps->area : NULL,
                                    all ? LM_DIRECT_PUNCTUAL : suns ? LM_DIRECT_SUNS : LM_DIRECT_NONE,
-                                   1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f),
-                                   ph->cover_distance, ph->cover_by_surface};
+                                   direct_lift(ps->scene), ph->cover_distance, ph->cover_by_surface};
     lm_aim_set_direct(&ps->aim, &ps->direct);
     return ps->set.punctual_at_hits && ps->direct.punctual != LM_DIRECT_NONE ? lm_aim_keep_rest(&ps->aim, err) : LM_OK;
 }
@@ -204,6 +209,18 @@ static void add_aim_stats(lm_photon_stage_frame *out, const lm_aim_stats *st)
     out->t_aim += st->seconds;
 }
 
+/* The AIMs of the first `count` surfaces of ps->touched refreshed at once for this frame's edits, counted
+ * in out beside the budgeted refreshes (aim_at_once). */
+static lm_status refresh_at_once(lm_photon_stage *ps, int count, lm_photon_stage_frame *out, lm_error *err)
+{
+    lm_aim_stats st;
+    lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
+                                         lm_photons_store_mutable(ps->photons), ps->touched, count, &st, err);
+    add_aim_stats(out, &st);
+    out->aim_at_once += st.surfaces_refreshed;
+    return rc;
+}
+
 /* The materials the edits changed (colour, emission, class; ch) reach the photons that touch them, which
  * are re-traced under the group budget. At once, the photons that bounced off a diffuse material
  * recoloured alone are reweighted (lm_photons_scale_materials), and the AIMs of the surfaces of the
@@ -241,14 +258,7 @@ static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch
     for (int k = 0; k < S; k++)
         if (ps->reached[k] || changed[ps->surfaces->surfaces[k].material])
             ps->touched[n++] = k;
-    if (!ps->have_aim || n == 0)
-        return LM_OK;
-    lm_aim_stats st;
-    lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
-                                         lm_photons_store_mutable(ps->photons), ps->touched, n, &st, err);
-    add_aim_stats(out, &st);
-    out->aim_at_once += st.surfaces_refreshed;
-    return rc;
+    return ps->have_aim && n > 0 ? refresh_at_once(ps, n, out, err) : LM_OK;
 }
 
 /* Whether anything an emitter's placement or power follows from may have changed since they were last
@@ -343,12 +353,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm
             ps->touched[moved++] = k;
     }
     keep_aim_before(ps);
-    lm_aim_stats st;
-    lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
-                                         lm_photons_store_mutable(ps->photons), ps->touched, moved, &st, err);
-    add_aim_stats(out, &st);
-    out->aim_at_once += st.surfaces_refreshed;
-    return rc;
+    return refresh_at_once(ps, moved, out, err);
 }
 
 /* Invalidates the groups of every emitter whose placement or power changed since its last snapshot; a
@@ -827,6 +832,14 @@ const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }
 const lm_direct_light *lm_photon_stage_direct(const lm_photon_stage *ps) { return ps->aim.direct; }
+lm_direct_light lm_photon_stage_punctual_light(const lm_photon_stage *ps)
+{
+    lm_direct_light d = ps->aim.direct ? *ps->aim.direct
+                                       : (lm_direct_light){ps->scene, ps->rt, &ps->emitters, NULL, LM_DIRECT_NONE,
+                                                           direct_lift(ps->scene), 0.0f, NULL};
+    d.punctual = LM_DIRECT_PUNCTUAL;
+    return d;
+}
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }
 const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps) { return ps->caustics; }
 

@@ -125,6 +125,9 @@ lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps);
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps);
 /* The direct light the AIM texels compute (exact_direct), NULL when they compute none. */
 const lm_direct_light *lm_photon_stage_direct(const lm_photon_stage *ps);
+/* Every punctual light's direct light at a point, for a gather that takes it at its rays' hits: the AIMs'
+ * direct light with every punctual light on, or, where the AIMs compute none, one made for the purpose. */
+lm_direct_light lm_photon_stage_punctual_light(const lm_photon_stage *ps);
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
 /* The caustic photons; NULL when the settings have none. A class or switch edit (lm_scene.pass_version), an
  * added light or an edited material makes them again at the next update (a full trace). */

@@ -420,7 +420,6 @@ static int maps_2d(int directional) { return directional ? 1 + LM_VIEW_CASCADES 
 /* Shadow-map bytes for `points` point lights and `others` 2D maps at the given sides: a cube (6 faces) per
  * point light, a 2D map per spot light and 1 + LM_VIEW_CASCADES per directional one (the whole scene's and
  * the view's), each with its static layer (shadow_maps.h), 4 bytes a texel. */
-
 static double shadow_bytes(int points, int others, int cube_size, int map_size)
 {
     return 2.0 * 4.0 * (6.0 * cube_size * cube_size * points + (double)map_size * map_size * others);
