@@ -216,12 +216,18 @@ void lm_bsdf_eval(const lm_shading *sh, const float wi_[3], const float wo_[3], 
     eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, out, &pdf);
 }
 
-float lm_bsdf_pdf(const lm_shading *sh, const float wi_[3], const float wo_[3])
+void lm_bsdf_eval_pdf(const lm_shading *sh, const float wi_[3], const float wo_[3], float f[3], float *pdf)
 {
     lm_vec3 wi = lm_v3_load(wi_), ng, ns;
-    float f[3], pdf = 0.0f;
-    if (lm_material_is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
-        return 0.0f;
-    eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, f, &pdf);
+    f[0] = f[1] = f[2] = 0.0f;
+    *pdf = 0.0f;
+    if (!lm_material_is_specular(sh->material->cls) && orient(sh, wi, &ng, &ns))
+        eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, f, pdf);
+}
+
+float lm_bsdf_pdf(const lm_shading *sh, const float wi[3], const float wo[3])
+{
+    float f[3], pdf;
+    lm_bsdf_eval_pdf(sh, wi, wo, f, &pdf);
     return pdf;
 }

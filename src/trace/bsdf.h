@@ -67,6 +67,8 @@ static inline int lm_material_stores_hits(lm_material_class c)
  * medium of index eta_i onto one of index eta_t; 1 under total internal reflection.
  * lm_phong_exponent: the glossy lobe's exponent for a roughness, n = 2 / r^4 - 2 clamped to [1, 1e4]. */
 float lm_bsdf_pdf(const lm_shading *sh, const float wi[3], const float wo[3]);
+/* Both at once: f cos as lm_bsdf_eval, the density as lm_bsdf_pdf. */
+void lm_bsdf_eval_pdf(const lm_shading *sh, const float wi[3], const float wo[3], float f[3], float *pdf);
 float lm_fresnel_dielectric(float cos_i, float eta_i, float eta_t);
 /* A mirror's reflectance at cos_i (the cosine between the incoming direction and the normal, either sign):
  * Schlick's F0 + (1 - F0)(1 - cos)^5 per channel, F0 the albedo. The reflection pass's shader computes

@@ -4,7 +4,8 @@
  * Dimensions of photon id (Halton index halton_base + id): 0-3 emission (0-1 the direction, so groups
  * of equal id mod G leave in similar directions), then 4 per path vertex b: 4 + 4b .. 4 + 4b + 2 sample
  * the BSDF, 4 + 4b + 3 decides Russian roulette. Past LM_QMC_MAX_DIMS a hash of (seed, id, dim) takes
- * over, still a pure function of the photon. */
+ * over, still a pure function of the photon; so is the hash of (seed, id, b) that decides whether a bounce
+ * outside is aimed in through the light's openings (portals.h, "Bounces aimed in"). */
 #include <math.h>
 #include <omp.h>
 #include <stdlib.h>
@@ -113,10 +114,56 @@ static int push_vertex(const lm_photons *ph, ph_buffer *buf, const lm_shading *s
     return 1;
 }
 
-/* Russian roulette on the albedo, then a BSDF sample; flux *= weight / p_survive. Returns 0 when the
- * photon is absorbed. On success org and dir hold the next ray. */
-static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shading *sh, float org[3],
-                   float dir[3], float flux[3])
+/* The number that decides whether bounce b is aimed in through the openings (portals.h): a hash of the
+ * photon and the bounce, not a Halton dimension (the bounce's four are taken). */
+static float aim_number(const lm_photons *ph, uint32_t id, uint32_t b)
+{
+    uint64_t h = mix64(((uint64_t)ph->set.seed << 32 | id) ^ 0xD1B54A32D192ED03ull * (b + 1));
+    return (float)(h >> 40) * 0x1.0p-24f;
+}
+
+/* A bounce at a place outside that sees openings of the photon's light (reach > 0, n the side wi came
+ * from): aimed at them or drawn from the BSDF, weighed by the mixture's density (portals.h, "Bounces
+ * aimed in"). bs as lm_bsdf_sample fills it; 0: absorbed. */
+static int aimed_sample(const lm_photons *ph, const lm_portals *aim, double reach, uint32_t id, uint32_t b,
+                        const lm_shading *sh, const float wi[3], const float n[3], const float u[3],
+                        lm_bsdf_sample_t *bs)
+{
+    const double share = LM_PORTAL_BOUNCE_SHARE;
+    if (aim_number(ph, id, b) < share) {
+        if (!lm_portals_bounce_dir(aim, sh->pos, n, reach, u[0], u[1], bs->wo))
+            return 0;
+    } else if (!lm_bsdf_sample(sh, wi, u, bs)) {
+        return 0;
+    }
+    float f[3], pdf;
+    lm_bsdf_eval_pdf(sh, wi, bs->wo, f, &pdf);
+    double mix = (1.0 - share) * pdf + share * lm_portals_bounce_density(aim, sh->pos, n, reach, bs->wo);
+    if (!(mix > 0.0) || !(f[0] + f[1] + f[2] > 0.0f))
+        return 0;
+    for (int c = 0; c < 3; c++)
+        bs->weight[c] = (float)(f[c] / mix);
+    bs->specular = bs->transmitted = 0;
+    return 1;
+}
+
+/* What the openings of the photon's light fill at its hit (lm_portals_bounce_reach), n the side its
+ * bounce leaves by; 0 where the bounce is the BSDF's alone: no openings, mirror, glass or an emitter. */
+static double aim_reach(const lm_portals *aim, const lm_shading *sh, const float wi[3], float n[3])
+{
+    lm_material_class c = sh->material->cls;
+    if (!aim || (c != LM_MAT_DIFFUSE && c != LM_MAT_GLOSSY))
+        return 0.0;
+    lm_vec3 ng = lm_v3_load(sh->ng);
+    lm_v3_store(n, lm_dot(ng, lm_v3_load(wi)) > 0.0f ? lm_scale(ng, -1.0f) : ng);
+    return lm_portals_bounce_reach(aim, sh->pos, n);
+}
+
+/* Russian roulette on the albedo, then a BSDF sample (or one aimed in through the openings of aim, the
+ * photon's light's portals); flux *= weight / p_survive. Returns 0 when the photon is absorbed. On
+ * success org and dir hold the next ray. */
+static int scatter(const lm_photons *ph, const lm_portals *aim, uint32_t id, uint32_t b, const lm_shading *sh,
+                   float org[3], float dir[3], float flux[3])
 {
     uint32_t d = PH_EMIT_DIMS + PH_DIMS_PER_BOUNCE * b;
     float p = lm_bsdf_photon_survival(sh), u[3] = {0.0f, 0.0f, 0.0f};
@@ -129,7 +176,9 @@ static int scatter(const lm_photons *ph, uint32_t id, uint32_t b, const lm_shadi
     if (n)
         photon_samples(ph, id, d, n, u);
     lm_bsdf_sample_t bs;
-    if (!lm_bsdf_sample(sh, dir, u, &bs))
+    float n_out[3];
+    double reach = aim_reach(aim, sh, dir, n_out);
+    if (reach > 0.0 ? !aimed_sample(ph, aim, reach, id, b, sh, dir, n_out, u, &bs) : !lm_bsdf_sample(sh, dir, u, &bs))
         return 0;
     float inv_p = 1.0f / p;
     for (int c = 0; c < 3; c++)
@@ -160,6 +209,8 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
     /* The ray lives in emi itself: copying the values just stored there stalled on wide loads of
      * narrow stores (no store-to-load forwarding). */
     float *org = emi.org, *dir = emi.dir, *flux = emi.flux;
+    /* its bounces outside aimed in (portals.h) */
+    const lm_portals *aim = ph->set.aim_bounces ? ph->em->e[g->emitter].portals : NULL;
     j->count = j->rays = j->stored = 0;
     if (dir[0] == 0.0f && dir[1] == 0.0f && dir[2] == 0.0f) /* an emitter that emits nothing */
         return 1;
@@ -181,7 +232,7 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
         /* The vertex is recorded after the scatter (with the direction and flux it arrived with): by
          * then the shading's stores have left the store buffer, and copying them does not stall. */
         float in_dir[3] = {dir[0], dir[1], dir[2]}, in_flux[3] = {flux[0], flux[1], flux[2]};
-        int scattered = scatter(ph, id, b, &sh, org, dir, flux);
+        int scattered = scatter(ph, aim, id, b, &sh, org, dir, flux);
         if (!push_vertex(ph, buf, &sh, in_dir, in_flux, hit.t, b, b > 0 && specular_so_far)) {
             ok = 0;
             break;

@@ -28,6 +28,7 @@ void lm_photon_settings_default(lm_photon_settings *s)
     s->retrace_per_group = 1;
     s->group_budget = 16;
     s->max_bounces = 1024;
+    s->aim_bounces = 1;
 }
 
 static int is_2a3b(uint32_t n)

@@ -211,18 +211,20 @@ static uint32_t tagged_openings(const lm_scene *s, lm_found_rect *out)
 static lm_portals *portals_of(const lm_scene *s, const lm_emitter *e, lm_found_rect *r, uint32_t n_open, uint32_t n,
                               int tagged, const double *sky_in, lm_error *err)
 {
+    for (uint32_t i = 0; i < n; i++)
+        r[i].opening = i < n_open;
     uint32_t kept = tagged ? worthiest(r + n_open, n - n_open) : worthiest(r, n);
     uint32_t count = (tagged ? s->portal_tri_count : 0) + 2 * kept;
     float *tris = malloc(sizeof *tris * 9 * ((size_t)count + 1));
     double *weight = malloc(sizeof *weight * ((size_t)count + 1));
-    unsigned char *flag = calloc((size_t)count + 1, 1);
+    unsigned char *flag = calloc((size_t)count + 1, 1), *opening = calloc((size_t)count + 1, 1);
     lm_portals *p = NULL;
-    if (tris && weight && flag) {
+    if (tris && weight && flag && opening) {
         uint32_t t = 0;
         for (uint32_t i = 0; tagged && i < s->portal_tri_count; i++, t++) {
             memcpy(tris + 9 * t, s->portal_tris + 9 * (size_t)i, sizeof *tris * 9);
             weight[t] = tagged_worth(s, e, i, r, sky_in, n_open);
-            flag[t] = 1;
+            flag[t] = opening[t] = 1;
         }
         for (uint32_t i = tagged ? n_open : 0; i < (tagged ? n_open : 0) + kept; i++) {
             const lm_found_rect *f = &r[i];
@@ -232,15 +234,17 @@ static lm_portals *portals_of(const lm_scene *s, const lm_emitter *e, lm_found_r
             for (int q = 0; q < 6; q++)
                 lm_v3_store(tris + 9 * t + 3 * q, v[order[q]]);
             weight[t] = weight[t + 1] = 0.5 * f->worth;
+            opening[t] = opening[t + 1] = (unsigned char)f->opening;
             t += 2;
         }
-        p = lm_portals_make(tris, weight, flag, t, err);
+        p = lm_portals_make(tris, weight, flag, opening, t, err);
     } else {
         lm_fail(err, LM_ERR_NOMEM, "portals: no memory for %u triangles", count);
     }
     free(tris);
     free(weight);
     free(flag);
+    free(opening);
     return p;
 }
 
@@ -294,6 +298,6 @@ int lm_portals_same(const lm_portals *a, const lm_portals *b)
     if (!a || !b)
         return a == b;
     return a->count == b->count && !memcmp(a->tagged, b->tagged, a->count) &&
-           !memcmp(a->tris, b->tris, sizeof *a->tris * 9 * a->count) &&
+           !memcmp(a->opening, b->opening, a->count) && !memcmp(a->tris, b->tris, sizeof *a->tris * 9 * a->count) &&
            !memcmp(a->weight, b->weight, sizeof *a->weight * a->count);
 }

@@ -38,11 +38,13 @@ void lm_look_numbers(uint32_t stretch, uint32_t index, int n, float *u);
 lm_vec3 lm_look_direction(const lm_emitter *e, lm_vec3 front, float u0, float u1);
 
 /* A rectangle found in a plane: axes t, b (t x b = n), normal n facing where the light comes from, at
- * `level` along n; [lo, hi] along t and b; what it is worth. */
+ * `level` along n; [lo, hi] along t and b; what it is worth; whether it is an opening (a way in) or a
+ * place outside (set by lm_portals_find, where both are known). */
 typedef struct {
     lm_vec3 t, b, n;
     double level, lo[2], hi[2];
     double worth;
+    int opening;
 } lm_found_rect;
 
 lm_vec3 lm_found_rect_point(const lm_found_rect *r, double x, double y);

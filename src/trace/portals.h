@@ -41,6 +41,7 @@ typedef struct {
     float *tris;               /* 9 floats each: world corners, the front facing where light comes from */
     double *weight;            /* what each is worth (above) */
     unsigned char *tagged;     /* 1: tagged in the file (its weight its area), 0: found */
+    unsigned char *opening;    /* 1: a way in (tagged, or an opening found), 0: a place outside */
     uint32_t found;            /* how many were found */
     /* Made by lm_portals_aim for one light: */
     double *area;              /* A_k */
@@ -50,10 +51,11 @@ typedef struct {
     int usable;                /* some triangle can be picked for this light */
 } lm_portals;
 
-/* A set of n triangles (9 floats each) with their weights and whether each is tagged, copied: NULL weight,
- * each its area; NULL tagged, none is. NULL on running out of memory (err says so). */
-lm_portals *lm_portals_make(const float *tris, const double *weight, const unsigned char *tagged, uint32_t n,
-                            lm_error *err);
+/* A set of n triangles (9 floats each) with their weights, whether each is tagged and whether it is a way
+ * in, copied: NULL weight, each its area; NULL tagged, none is; NULL opening, each is one. NULL on running
+ * out of memory (err says so). */
+lm_portals *lm_portals_make(const float *tris, const double *weight, const unsigned char *tagged,
+                            const unsigned char *opening, uint32_t n, lm_error *err);
 /* The file's portals: n triangles, each tagged and worth its area. */
 lm_portals *lm_portals_tagged(const float *tris, uint32_t n, lm_error *err);
 void lm_portals_free(lm_portals *p);
@@ -69,5 +71,25 @@ int lm_portals_sun_point(const lm_portals *p, float u0, float u1, float x[3]);
 int lm_portals_sky_line(const lm_portals *p, float u_pick, float u_tri, float u0, float u1, float x[3], float w[3]);
 /* The portals' density at the line o + t d, t > 0 (the sum above, for the light p was aimed for). */
 double lm_portals_density(const lm_portals *p, const float o[3], const float d[3]);
+
+/* Bounces outside aimed in through the openings (docs/levels.md, "Bounces aimed in"). A photon's diffuse
+ * bounce at x, outside in front of the openings, is drawn with probability LM_PORTAL_BOUNCE_SHARE (a quarter) towards
+ * a point uniform on an opening (opening i picked in proportion to the cosine-weighted solid angle it fills
+ * at x, judged from its centre), else from the BSDF, and weighed by the mixture's density at the direction
+ * drawn (one-sample multiple importance sampling, as for emission): the estimate stays the one without, but
+ * the light of a sunlit lawn gets in as many light photons instead of a rare heavy one. Places outside are
+ * not aimed at, and a point behind every opening (inside) bounces as before.
+ *   lm_portals_bounce_reach: the sum of what the openings fill at x (unit normal n, the side the bounce
+ *     leaves by); 0: none in sight, the bounce is the BSDF's alone;
+ *   lm_portals_bounce_dir: a unit direction w from x towards an opening from two uniform numbers (u0 picks
+ *     the opening and, rescaled, with u1 the point); 0 when there is none;
+ *   lm_portals_bounce_density: that draw's density per unit solid angle at unit w (total: the reach).
+ * Cost: a pass over the set's triangles per call. Reads only: thread-safe. */
+#define LM_PORTAL_BOUNCE_SHARE 0.25f
+double lm_portals_bounce_reach(const lm_portals *p, const float x[3], const float n[3]);
+int lm_portals_bounce_dir(const lm_portals *p, const float x[3], const float n[3], double total, float u0, float u1,
+                          float w[3]);
+double lm_portals_bounce_density(const lm_portals *p, const float x[3], const float n[3], double total,
+                                 const float w[3]);
 
 #endif
