@@ -537,6 +537,46 @@ static void test_bake_killed_and_resumed(void **state)
     assert_true(same_bytes(a_path, b_path));
 }
 
+/* lmgi bake makes one bounce pass unless told otherwise (docs/gather.md, "Bounce passes"): the sunlit room
+ * (its sky makes the gather rays) baked at the defaults is the same bytes as with --bounce-passes 1, not as
+ * with 0; baked in two shards (which make none) and merged, the same bytes as one bake. The Cornell box's
+ * hemicube gather makes none, and says so without a warning. */
+static void test_bake_makes_a_bounce_pass(void **state)
+{
+    (void)state;
+    char dir[256], args[4096], a_path[600], b_path[600];
+    snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    static const char *const runs[3][2] = {{"whole", ""}, {"one", " --bounce-passes 1"}, {"none", " --bounce-passes 0"}};
+    for (int r = 0; r < 3; r++) {
+        snprintf(args, sizeof args, "bake scenes/sunlit_room.glb --texels 2000%s --out %s/%s -q", runs[r][1], dir,
+                 runs[r][0]);
+        if (run(args) != 0)
+            fail_msg("%s: %s", args, output);
+    }
+    for (int k = 1; k <= 2; k++) {
+        snprintf(args, sizeof args, "bake scenes/sunlit_room.glb --texels 2000 --shard %d/2 --out %s/s%d", k, dir, k);
+        if (run(args) != 0)
+            fail_msg("%s: %s", args, output);
+    }
+    snprintf(args, sizeof args, "merge scenes/sunlit_room.glb %s/s1 %s/s2 --texels 2000 --out %s/merged -q", dir, dir,
+             dir);
+    if (run(args) != 0)
+        fail_msg("%s: %s", args, output);
+    static const char *const same_as[3] = {"one", "merged", "none"};
+    for (int k = 0; k < 3; k++) {
+        snprintf(a_path, sizeof a_path, "%s/whole/lightmap.exr", dir);
+        snprintf(b_path, sizeof b_path, "%s/%s/lightmap.exr", dir, same_as[k]);
+        assert_int_equal(same_bytes(a_path, b_path), k < 2);
+    }
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --out %s/box", dir);
+    assert_int_equal(run(args), 0);
+    assert_null(strstr(output, "bounce pass"));
+    assert_null(strstr(output, "warning"));
+    snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --out %s/box_v -v", dir);
+    assert_int_equal(run(args), 0);
+    assert_non_null(strstr(output, "info: scenes/cornell.glb: no bounce pass: they need the rays gather"));
+}
+
 /* A bake in shards (docs/levels.md, "A bake in shards"): the Cornell box at 8,000 texels (four gather
  * passes) baked as 3 shards and as 5 (one share empty), each put together by merge: the same bytes as
  * one bake, lightmap and AIM. A missing shard, the same shard twice, a part of other settings or of a
@@ -1330,6 +1370,7 @@ int main(void)
         cmocka_unit_test(test_bake_pages),
         cmocka_unit_test(test_progress_lines),
         cmocka_unit_test(test_bake_killed_and_resumed),
+        cmocka_unit_test(test_bake_makes_a_bounce_pass),
         cmocka_unit_test(test_bake_in_shards),
         cmocka_unit_test(test_merge_parts_alone),
         cmocka_unit_test(test_mpi_bake),

@@ -410,9 +410,11 @@ static void test_sunlit_room_has_no_black_texels(void **state)
 }
 
 /* The same room as the issue measures it, everything on (the sun, the sky, the bulbs), baked as `lmgi bake`
- * bakes it (65,536 texels, 4 photons a texel: lm_cli_bake_photons), its frame from the file's camera
- * against the reference: over the frame and on each of its large surfaces (the walls, floor and ceiling,
- * 300 pixels or more at 64 x 64) within 5% per channel. */
+ * bakes it (65,536 texels, 4 photons a texel: lm_cli_bake_photons; one bounce pass), its frame from the
+ * file's camera against the reference: over the frame within 2%, and every visible surface of 25 pixels or
+ * more at 64 x 64 (100 at lmgi check's 128 x 128: the walls, floor, ceiling, table, sofa and the lawn seen
+ * through the window) within 5% per channel. Measured: the frame 0.988 0.989 0.988, the floor furthest
+ * off at 0.956 in blue. */
 static void test_sunlit_room_against_reference(void **state)
 {
     (void)state;
@@ -423,6 +425,7 @@ static void test_sunlit_room_against_reference(void **state)
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     d.photons.count = 4 * lmgi_texel_count(sc);
+    d.gather.bounce_passes = 1; /* lmgi bake's own (LM_CLI_BAKE_BOUNCE_PASSES) */
     d.frame.width = d.frame.height = 64;
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
@@ -434,14 +437,14 @@ static void test_sunlit_room_against_reference(void **state)
                   "pixels (reference %.1f s)\n", lmgi_texel_count(sc), d.photons.count, c.ratio[0], c.ratio[1], c.ratio[2],
                   c.pixels, c.reference_seconds);
     for (int k = 0; k < 3; k++)
-        assert_float_equal(c.ratio[k], 1.0, 0.05);
+        assert_float_equal(c.ratio[k], 1.0, 0.02);
     for (int i = 0; i < c.surface_count; i++) {
         const lmgi_check_surface *f = &c.surfaces[i];
         if (f->pixels == 0)
             continue;
         print_message("  surface %d (node %d): %u pixels, %.3f %.3f %.3f\n", i, f->node, f->pixels, f->ratio[0],
                       f->ratio[1], f->ratio[2]);
-        for (int k = 0; f->pixels >= 300 && k < 3; k++)
+        for (int k = 0; f->pixels >= 25 && k < 3; k++)
             assert_float_equal(f->ratio[k], 1.0, 0.05);
     }
     lmgi_check_free(&c);

@@ -254,6 +254,8 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     lm_cli_updater_desc(a, &d);
     if (!a->desc.photons.count && !a->desc.photons.per_group)
         d.photons.count = lm_cli_bake_photons(in.texels);
+    if (!a->desc.gather.bounce_passes && (parts || !a->shards)) /* a shard's are its merge's */
+        d.gather.bounce_passes = LM_CLI_BAKE_BOUNCE_PASSES;
     d.frame.width = d.frame.height = 0;
     d.aim.error_estimate = a->accuracy ? LMGI_ON : 0;
     double started = lm_cli_now();

@@ -281,7 +281,8 @@ static lm_status bounce_passes(lm_lightmap_path *lp, lm_error *err)
     if (lp->set->bounce_passes <= 0 || a->texel_count == 0)
         return LM_OK;
     if (lp->set->gather.scheme != LM_GATHER_RAYS) {
-        lm_log(LM_LOG_WARN, "%s: no bounce pass: they need the rays gather, which takes the punctual light at its "
+        /* said, not warned: lmgi bake asks for one whatever the scheme resolves to */
+        lm_log(LM_LOG_INFO, "%s: no bounce pass: they need the rays gather, which takes the punctual light at its "
                "hits (a hemicube reads that light from the map, which an IIM does not hold)", lp->scene->path);
         return LM_OK;
     }
