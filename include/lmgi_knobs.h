@@ -206,7 +206,8 @@ static inline int lmgi_knob_is_pow2(double v)
       "after the first full gather, N more with the bounced light read from\n"                                     \
       "the last one's lightmap instead of the photons (rays scheme; the first\n"                                  \
       "solution only: later regathers read the photons; not in a shard: give\n"                                   \
-      "it to the merge; default off, bake: 1; docs/gather.md, \"Bounce passes\")")
+      "it to the merge; default off, bake: 1 up to 8 lamps; docs/gather.md,\n"                                    \
+      "\"Bounce passes\")")
 
 /* caustics (docs/caustics.md): photons shot from every light towards every mirror or glass node, filtered
  * on screen */

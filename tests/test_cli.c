@@ -540,7 +540,7 @@ static void test_bake_killed_and_resumed(void **state)
 /* lmgi bake makes one bounce pass unless told otherwise (docs/gather.md, "Bounce passes"): the sunlit room
  * (its sky makes the gather rays) baked at the defaults is the same bytes as with --bounce-passes 1, not as
  * with 0; baked in two shards (which make none) and merged, the same bytes as one bake. The Cornell box's
- * hemicube gather makes none, and says so without a warning. */
+ * hemicube gather makes none, and says so without a warning; a level of more than 8 lamps makes none. */
 static void test_bake_makes_a_bounce_pass(void **state)
 {
     (void)state;
@@ -575,6 +575,29 @@ static void test_bake_makes_a_bounce_pass(void **state)
     snprintf(args, sizeof args, "bake scenes/cornell.glb --texels 2000 --photons 4000 --out %s/box_v -v", dir);
     assert_int_equal(run(args), 0);
     assert_non_null(strstr(output, "info: scenes/cornell.glb: no bounce pass: they need the rays gather"));
+    /* a floor under 8 lamps gets its pass, under 9 none (each lamp costs a shadow ray at each of its hits) */
+    static lmt_mesh floor_mesh;
+    memset(&floor_mesh, 0, sizeof floor_mesh);
+    lmt_mesh_quad(&floor_mesh, (float[3]){-5, 0, 5}, (float[3]){10, 0, 0}, (float[3]){0, 0, -10});
+    for (int lamps = 8; lamps <= 9; lamps++) {
+        char nodes[2048] = "[{\"mesh\": 0}", lights[2048] = "";
+        for (int k = 0; k < lamps; k++) {
+            size_t n = strlen(nodes), l = strlen(lights);
+            snprintf(nodes + n, sizeof nodes - n, ", {\"translation\": [%d, 1, 0], \"extensions\": "
+                     "{\"KHR_lights_punctual\": {\"light\": %d}}}", k - 4, k);
+            snprintf(lights + l, sizeof lights - l, "%s{\"type\": \"point\", \"intensity\": 5}", k ? ", " : "");
+        }
+        strcat(nodes, "]");
+        char materials[4096], name[64];
+        snprintf(materials, sizeof materials, "[" LMT_DIFFUSE(0.5) "], \"extensionsUsed\": [\"KHR_lights_punctual\"], "
+                 "\"extensions\": {\"KHR_lights_punctual\": {\"lights\": [%s]}}", lights);
+        snprintf(name, sizeof name, "lamps%d.gltf", lamps);
+        const char *path = lmt_write_scene(name, &floor_mesh, 1, nodes, materials);
+        snprintf(args, sizeof args, "bake %s --texels 500 --gather-scheme rays --out %s/lamps%d -v", path, dir, lamps);
+        if (run(args) != 0)
+            fail_msg("%s: %s", args, output);
+        assert_int_equal(strstr(output, "bounce pass 1 of 1") != NULL, lamps <= 8);
+    }
 }
 
 /* A bake in shards (docs/levels.md, "A bake in shards"): the Cornell box at 8,000 texels (four gather

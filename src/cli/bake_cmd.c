@@ -254,8 +254,9 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     lm_cli_updater_desc(a, &d);
     if (!a->desc.photons.count && !a->desc.photons.per_group)
         d.photons.count = lm_cli_bake_photons(in.texels);
-    if (!a->desc.gather.bounce_passes && (parts || !a->shards)) /* a shard's are its merge's */
-        d.gather.bounce_passes = LM_CLI_BAKE_BOUNCE_PASSES;
+    int local_lights = in.lights_by_type[LMGI_LIGHT_POINT] + in.lights_by_type[LMGI_LIGHT_SPOT];
+    if (!a->desc.gather.bounce_passes && (parts || !a->shards) && local_lights <= LM_CLI_BAKE_PASS_MAX_LIGHTS)
+        d.gather.bounce_passes = LM_CLI_BAKE_BOUNCE_PASSES; /* a shard's are its merge's */
     d.frame.width = d.frame.height = 0;
     d.aim.error_estimate = a->accuracy ? LMGI_ON : 0;
     double started = lm_cli_now();
