@@ -21,7 +21,7 @@ uint32_t lm_cli_bake_photons(uint32_t texels);
  * read 7, 8 and 8 of its 8 surfaces within 5% for seeds 0-2 without, 8, 8 and 8 with one pass, for about
  * twice the gather's time. Not in a shard (its merge makes them); under a hemicube gather there are none;
  * none where the level has more than LM_CLI_BAKE_PASS_MAX_LIGHTS point and spot lights, each of which the
- * pass takes at every ray's hit by a shadow ray (45 made a generated level of 994k triangles 5.3x as long
+ * pass takes at every ray's hit by a shadow ray (45 made a generated level of 994k triangles 4.2x as long
  * to bake). */
 #define LM_CLI_BAKE_BOUNCE_PASSES 1
 #define LM_CLI_BAKE_PASS_MAX_LIGHTS 8
