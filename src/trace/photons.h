@@ -52,9 +52,9 @@ typedef struct {
     const float *cover_by_surface; /* with cover_distance > 0: the distance per surface id instead (borrowed;
                                 * the photon stage gives each surface its own texel width,
                                 * lm_atlas.surface_texel_size); NULL: cover_distance everywhere */
-    int aim_bounces;           /* a sun's or the sky's photons bouncing outside, in front of its openings, are
-                                * half of them aimed in through them (portals.h, "Bounces aimed in"; default
-                                * 1; 0: every bounce is the BSDF's, to measure against) */
+    int aim_bounces;           /* a sun's or the sky's photons bouncing outside, in front of its openings: a
+                                * quarter of those bounces aimed in through them (portals.h, "Bounces aimed
+                                * in"; default 1; 0: every bounce is the BSDF's, to measure against) */
 } lm_photon_settings;
 
 /* How far "covered" reaches on surface `surface` (-1: none) under a distance and an optional per-surface
