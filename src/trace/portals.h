@@ -73,11 +73,12 @@ int lm_portals_sky_line(const lm_portals *p, float u_pick, float u_tri, float u0
 double lm_portals_density(const lm_portals *p, const float o[3], const float d[3]);
 
 /* Bounces outside aimed in through the openings (docs/levels.md, "Bounces aimed in"). A photon's diffuse
- * bounce at x, outside in front of the openings, is drawn with probability LM_PORTAL_BOUNCE_SHARE (a quarter) towards
- * a point uniform on an opening (opening i picked in proportion to the cosine-weighted solid angle it fills
- * at x, judged from its centre), else from the BSDF, and weighed by the mixture's density at the direction
- * drawn (one-sample multiple importance sampling, as for emission): the estimate stays the one without, but
- * the light of a sunlit lawn gets in as many light photons instead of a rare heavy one. Places outside are
+ * bounce at x, outside in front of the openings, is drawn with probability LM_PORTAL_BOUNCE_SHARE (a
+ * quarter) towards a point uniform on an opening (opening i picked in proportion to the cosine-weighted
+ * solid angle it fills at x, judged from its centre), else from the BSDF, and weighed by the mixture's
+ * density at the direction drawn (one-sample multiple importance sampling, as for emission): the estimate
+ * stays the one without, but the light of a sunlit lawn gets in as many light photons instead of a rare
+ * heavy one. Places outside are
  * not aimed at, and a point behind every opening (inside) bounces as before.
  *   lm_portals_bounce_reach: the sum of what the openings fill at x (unit normal n, the side the bounce
  *     leaves by); 0: none in sight, the bounce is the BSDF's alone;
