@@ -249,6 +249,12 @@ float lm_scene_size(const lm_scene *s)
     return d.x >= 0.0f ? lm_length(d) : 0.0f;
 }
 
+float lm_scene_ray_lift(const lm_scene *s)
+{
+    float size = lm_scene_size(s);
+    return 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f);
+}
+
 /* Bounds of the vertices that triangles use (unreferenced vertices don't count). An empty scene gets
  * min > max (size 0). */
 void lm_scene_update_bounds(lm_scene *s)

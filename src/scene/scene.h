@@ -296,6 +296,8 @@ void lm_scene_normal_world(const lm_scene *s, uint32_t v, float out[3]);
 float lm_scene_tri_area_world(const lm_scene *s, uint32_t t);
 /* Length of the world bounds' diagonal: the scene's size, used for relative tolerances. */
 float lm_scene_size(const lm_scene *s);
+/* How far a shadow ray leaves a surface: 1e-5 of the scene's size (of 1 for an empty or unbounded one). */
+float lm_scene_ray_lift(const lm_scene *s);
 /* A hash (core/hash.h) of every node's world matrix: what changes when anything moves. */
 uint64_t lm_scene_world_hash(const lm_scene *s);
 /* Recomputes bounds_min/max from the current world matrices. */

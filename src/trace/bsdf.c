@@ -206,16 +206,6 @@ int lm_bsdf_sample(const lm_shading *sh, const float wi_[3], const float u[3], l
     return out->weight[0] > 0.0f || out->weight[1] > 0.0f || out->weight[2] > 0.0f;
 }
 
-void lm_bsdf_eval(const lm_shading *sh, const float wi_[3], const float wo_[3], float out[3])
-{
-    lm_vec3 wi = lm_v3_load(wi_), ng, ns;
-    float pdf;
-    out[0] = out[1] = out[2] = 0.0f;
-    if (lm_material_is_specular(sh->material->cls) || !orient(sh, wi, &ng, &ns))
-        return;
-    eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, out, &pdf);
-}
-
 void lm_bsdf_eval_pdf(const lm_shading *sh, const float wi_[3], const float wo_[3], float f[3], float *pdf)
 {
     lm_vec3 wi = lm_v3_load(wi_), ng, ns;
@@ -223,6 +213,12 @@ void lm_bsdf_eval_pdf(const lm_shading *sh, const float wi_[3], const float wo_[
     *pdf = 0.0f;
     if (!lm_material_is_specular(sh->material->cls) && orient(sh, wi, &ng, &ns))
         eval_oriented(sh, wi, lm_v3_load(wo_), ng, ns, f, pdf);
+}
+
+void lm_bsdf_eval(const lm_shading *sh, const float wi[3], const float wo[3], float out[3])
+{
+    float pdf;
+    lm_bsdf_eval_pdf(sh, wi, wo, out, &pdf);
 }
 
 float lm_bsdf_pdf(const lm_shading *sh, const float wi[3], const float wo[3])

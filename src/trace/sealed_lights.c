@@ -16,7 +16,7 @@ static int hits_back(const lm_scene *s, const lm_rt *rt, const float org[3], con
 
 int lm_point_sealed(const lm_scene *s, const lm_rt *rt, const float p[3])
 {
-    float size = lm_scene_size(s), lift = 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f);
+    float lift = lm_scene_ray_lift(s);
     static const float dirs[14][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1},
                                       {1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {1, -1, -1}, {-1, 1, 1}, {-1, 1, -1},
                                       {-1, -1, 1}, {-1, -1, -1}};

@@ -83,13 +83,6 @@ static int has_sun(const lm_emitters *em)
     return 0;
 }
 
-/* How far shadow rays leave a surface: a share of the scene's size. */
-static float direct_lift(const lm_scene *s)
-{
-    float size = lm_scene_size(s);
-    return 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f);
-}
-
 /* The AIMs take direct light from trace/direct_irradiance.h as exact_direct says (LM_EXACT_*); nothing
  * where the photons' cover distance hides a side. */
 static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph, lm_error *err)
@@ -105,7 +98,7 @@ static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph,
     }
     ps->direct = (lm_direct_light){ps->scene, ps->rt, &ps->emitters, ps->have_area ? &ps->area : NULL,
                                    all ? LM_DIRECT_PUNCTUAL : suns ? LM_DIRECT_SUNS : LM_DIRECT_NONE,
-                                   direct_lift(ps->scene), ph->cover_distance, ph->cover_by_surface};
+                                   lm_scene_ray_lift(ps->scene), ph->cover_distance, ph->cover_by_surface};
     lm_aim_set_direct(&ps->aim, &ps->direct);
     return ps->set.punctual_at_hits && ps->direct.punctual != LM_DIRECT_NONE ? lm_aim_keep_rest(&ps->aim, err) : LM_OK;
 }
@@ -836,7 +829,7 @@ lm_direct_light lm_photon_stage_punctual_light(const lm_photon_stage *ps)
 {
     lm_direct_light d = ps->aim.direct ? *ps->aim.direct
                                        : (lm_direct_light){ps->scene, ps->rt, &ps->emitters, NULL, LM_DIRECT_NONE,
-                                                           direct_lift(ps->scene), 0.0f, NULL};
+                                                           lm_scene_ray_lift(ps->scene), 0.0f, NULL};
     d.punctual = LM_DIRECT_PUNCTUAL;
     return d;
 }
