@@ -593,6 +593,9 @@ typedef struct {
     uint32_t caustic_photons_retraced; /* caustic photons traced (a moved light or mirror/glass node: all its) */
     int caustic_tiles, caustic_tiles_lit; /* screen tiles queried, and those found holding caustic photons */
     uint64_t caustic_pixels_filtered; /* pixels the caustic filter ran on (the lit tiles grown by k) */
+    uint32_t caustic_photons_landed, caustic_photons_thin; /* caustic photons that landed, and of those the ones
+                                * the lightmaps carry as thin light (docs/caustics.md, "Thin light in the
+                                * lightmaps"); the rest are the screen pass's */
     int cube_faces_rendered;   /* environment map faces rendered */
     int photon_gathers;        /* per-pixel photon gathers run (indirect TILED, HASHGRID, BRUTEFORCE): 0 when
                                 * the photons, the view and the scene were as for the last one (its picture
@@ -731,9 +734,10 @@ LMGI_API lmgi_status lmgi_render(lmgi_updater *u, const lmgi_camera *cam, int wi
  * A diffuse surface's indirect radiance is albedo / pi * E (docs/materials.md). */
 typedef enum { LMGI_LIGHTMAP_IIM = 0, LMGI_LIGHTMAP_AIM, LMGI_LIGHTMAP_ERROR, LMGI_LIGHTMAP_ACCURACY } lmgi_lightmap;
 /* The caustics of the last picture the updater drew, an update's own frame or lmgi_render's
- * (docs/caustics.md): the irradiance E the screen-space caustic pass filtered at each pixel, width x height
- * x 3 linear floats, top row first (the picture added kd / pi x E there); 0 where no caustic photon's
- * filter reached, and everywhere in a scene without caustics. *width and *height (each may be NULL) get
+ * (docs/caustics.md): the caustic irradiance E at each pixel, the screen-space pass's filter plus the thin
+ * light the lightmaps carry (caustics.thin), width x height x 3 linear floats, top row first (the picture
+ * added kd / pi x E there); 0 where no caustic photon's light reached, and everywhere in a scene without
+ * caustics. *width and *height (each may be NULL) get
  * the picture's size, 0 x 0 before any; rgb must hold `floats` >= 3 x width x height. NULL u or rgb, too
  * small, or no picture yet: LMGI_ERR_INVALID (the size still given). */
 LMGI_API lmgi_status lmgi_get_caustics(lmgi_updater *u, float *rgb, size_t floats, int *width, int *height,

@@ -183,6 +183,53 @@ static void test_glass_block(void **state)
     lmgi_context_free(ctx);
 }
 
+/* The caustic light split (docs/caustics.md, "Thin light"): by default the photons whose light is thin next
+ * to the floor's other light are carried by the lightmaps, the rest by the screen pass; with caustics.thin
+ * off every photon is the screen's. The same photons land; the caustics a picture shows (lmgi_get_caustics:
+ * the screen's plus the lightmaps' at each pixel) and the frame agree. (The tiles it spares: test_cli's
+ * test_run_caustic_tiles.) */
+static void test_thin_light_in_the_lightmaps(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    lmgi_scene *sc[2] = {room(&glass, 0), room(&glass, 0)}; /* an updater each */
+    lmgi_updater *u[2];
+    lmgi_update_stats st[2];
+    static float rgb[2][PIXELS], frame[2][PIXELS];
+    double E[2];
+    for (int k = 0; k < 2; k++) {
+        lmgi_updater_desc d;
+        lmt_room_desc(&d);
+        d.frame.width = d.frame.height = SIDE;
+        d.in_order = 1;
+        d.caustics.photons = 8192;
+        d.caustics.thin = k ? LMGI_OFF : 0.0f;
+        lmgi_error e;
+        if (lmgi_updater_create(ctx, sc[k], &d, &u[k], &e) != LMGI_OK)
+            fail_msg("%s", e.message);
+        update(u[k], &st[k]);
+        E[k] = caustics(u[k], rgb[k], frame[k]);
+    }
+    double diff = 0.0, total = 0.0;
+    for (int i = 0; i < PIXELS; i++)
+        diff += fabs(frame[0][i] - frame[1][i]), total += frame[1][i];
+    print_message("glass block, thin light in the lightmaps / all on screen: photons landed %u / %u, of them thin "
+                  "%u / %u; caustic sum %.4f / %.4f; frame's relative L1 %.4f\n", st[0].caustic_photons_landed,
+                  st[1].caustic_photons_landed, st[0].caustic_photons_thin, st[1].caustic_photons_thin, E[0], E[1],
+                  diff / total);
+    assert_true(st[0].caustic_photons_landed > 0);
+    assert_int_equal(st[0].caustic_photons_landed, st[1].caustic_photons_landed);
+    assert_true(st[0].caustic_photons_thin > st[0].caustic_photons_landed / 4);
+    assert_int_equal(st[1].caustic_photons_thin, 0);
+    assert_true(fabs(E[0] / E[1] - 1.0) < 0.03);
+    assert_true(diff / total < 0.01);
+    for (int k = 0; k < 2; k++) {
+        lmgi_updater_free(u[k]);
+        lmgi_free(sc[k]);
+    }
+    lmgi_context_free(ctx);
+}
+
 /* The block's caustics switched off (lmgi_set_node_effects) give, to the bit, the frame of a run without
  * caustics (effects_off), with no caustic work; switched on again, the caustic returns. */
 static void test_switches(void **state)
@@ -442,6 +489,7 @@ int main(void)
         cmocka_unit_test(test_no_specular_no_work),
         cmocka_unit_test(test_glass_block),
         cmocka_unit_test(test_still_frame_reuses_caustics),
+        cmocka_unit_test(test_thin_light_in_the_lightmaps),
         cmocka_unit_test(test_switches),
         cmocka_unit_test(test_moved_generator),
         cmocka_unit_test(test_dirty_faces),

@@ -1187,6 +1187,52 @@ static void csv_field(const char *line, int col, char *out, size_t size)
     snprintf(out, size, "%.*s", (int)len, p);
 }
 
+/* The last row's value of column `name` of DIR/frames.csv. */
+static double frames_csv_last(const char *dir, const char *name)
+{
+    char path[2048], header[8192], line[8192], last[8192] = "", field[64];
+    snprintf(path, sizeof path, "%s/frames.csv", dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    assert_non_null(fgets(header, sizeof header, f));
+    while (fgets(line, sizeof line, f))
+        memcpy(last, line, sizeof last);
+    fclose(f);
+    int col = csv_column(header, name);
+    assert_true(col >= 0);
+    csv_field(last, col, field, sizeof field);
+    return atof(field);
+}
+
+/* The showcase's caustics (issue 37): by default the thin light its convex mirror and glass spread over the
+ * box is the lightmaps' (docs/caustics.md, "Thin light"), so the screen pass's occlusion queries find few
+ * lit tiles; with --caustic-thin 0 every photon is the screen's and nearly every tile is lit. */
+static void test_run_caustic_tiles(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(scene, lmt_project_scene("cornell.glb"));
+    const char *dir = lmt_tmpdir();
+    char args[2048], out[2][1024];
+    double lit[2], tiles[2], thin[2], landed[2];
+    for (int k = 0; k < 2; k++) {
+        snprintf(out[k], sizeof out[k], "%s/caustic_tiles_%d", dir, k);
+        snprintf(args, sizeof args, "run %s --frames 3 --size 256x256 %s --out %s", scene,
+                 k ? "--caustic-thin 0" : "", out[k]);
+        assert_int_equal(run(args), 0);
+        lit[k] = frames_csv_last(out[k], "caustic_tiles_lit");
+        tiles[k] = frames_csv_last(out[k], "caustic_tiles");
+        thin[k] = frames_csv_last(out[k], "caustic_photons_thin");
+        landed[k] = frames_csv_last(out[k], "caustic_photons_landed");
+    }
+    print_message("cornell.glb at 256 x 256, thin light in the lightmaps / all on screen: tiles lit %.0f of %.0f / "
+                  "%.0f of %.0f; photons thin %.0f of %.0f / %.0f of %.0f\n", lit[0], tiles[0], lit[1], tiles[1],
+                  thin[0], landed[0], thin[1], landed[1]);
+    assert_true(tiles[0] > 0 && tiles[1] > 0);
+    assert_true(lit[0] < 0.15 * tiles[0]);
+    assert_true(lit[1] > 0.75 * tiles[1]);
+    assert_true(thin[0] > 0.25 * landed[0] && thin[1] == 0.0);
+}
+
 /* `lmgi tradeoff` on one knob: a row per value with the photons it asked for (exactly: a given number per
  * group is not raised to the scene's floor), its stage times and its errors against the reference; 16
  * times the photons leave the AIM closer to the reference; the error maps and the report beside them.
@@ -1400,6 +1446,7 @@ int main(void)
         cmocka_unit_test(test_bench_edits),
         cmocka_unit_test(test_reference_and_check_commands),
         cmocka_unit_test(test_check_caustic_part),
+        cmocka_unit_test(test_run_caustic_tiles),
         cmocka_unit_test(test_tradeoff),
         cmocka_unit_test(test_tradeoff_update_lag),
         cmocka_unit_test(test_cli_sees_only_the_public_header),

@@ -133,6 +133,7 @@ static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s
     s->caustic_pass.filter_k = r->caustics.filter == LMGI_OFF ? 0 : r->caustics.filter;
     s->caustic_pass.filter_photons = r->caustics.filter_photons == LMGI_OFF ? 0 : r->caustics.filter_photons;
     s->caustic_pass.tile = r->caustics.tile;
+    s->caustic_thin = r->caustics.thin == LMGI_OFF ? 0.0f : r->caustics.thin;
     s->caustic_pass.world_space = r->caustics.world_filter == LMGI_ON;
     s->photon_gather.tile = r->tiled.tile;
     s->photon_gather.chunk = r->tiled.chunk;
@@ -428,6 +429,8 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->caustic_tiles = fs->caustic.tiles;
     o->caustic_tiles_lit = fs->caustic.tiles_lit;
     o->caustic_pixels_filtered = fs->caustic.pixels_filtered;
+    o->caustic_photons_landed = fs->caustic_landed;
+    o->caustic_photons_thin = fs->caustic_thin;
     o->cube_faces_rendered = fs->cube_faces;
     o->shadow_maps_rendered = fs->shadow_maps;
     o->shadow_maps_stale = fs->shadow_maps_stale;

@@ -7,7 +7,9 @@
 #include "../core/hash.h"
 #include "../core/timing.h"
 #include "../gpu/frame/composite.h"
+#include "../gpu/frame/lightmap_view.h"
 #include "../gpu/frame/reflections.h"
+#include "../photonmap/caustic_split.h"
 
 struct lm_frame_passes {
     const lm_frame_loop_settings *set; /* the loop's, borrowed */
@@ -23,6 +25,10 @@ struct lm_frame_passes {
     int caustic_slot, caustic_w, caustic_h; /* the last picture drawn: its caustics' slot and size (w 0: none yet) */
     uint64_t caustic_key[LM_CAUSTIC_SLOTS]; /* what each slot's last run was made for (draw_caustics) */
     int caustic_keyed[LM_CAUSTIC_SLOTS];
+    lm_caustic_split split;      /* the photons' split between the lightmaps and the screen (caustic_split.h) */
+    int thin;                    /* the composite holds thin caustic light (split made with the lightmaps) */
+    double split_seconds;        /* the splits since the last step's frame: its caustics' time */
+    lm_view caustic_view;        /* the last picture's view (for the thin light at its pixels) */
     int generators;              /* the scene has caustic generators (mirror or glass nodes, caustics on) ... */
     uint32_t generators_version; /* ... as of this pass_version (+1: 0 is never a count yet) */
 };
@@ -47,6 +53,7 @@ void lm_frame_passes_free(lm_frame_passes *fp)
     lm_composite_free(fp->comp);
     lm_reflections_free(fp->reflections);
     lm_caustic_pass_free(fp->caustic_pass);
+    lm_caustic_split_free(&fp->split);
     free(fp);
 }
 
@@ -106,18 +113,62 @@ static lm_caustic_pass *drawn_caustics(const lm_frame_passes *fp)
 
 int lm_frame_passes_want_caustics(lm_frame_passes *fp) { return has_generators(fp) || drawn_caustics(fp); }
 
+/* Whether the caustic photons are split between the lightmaps and the screen: set->caustic_thin, and a
+ * frame whose indirect term is the lightmaps' composite. */
+static int split_on(const lm_frame_passes *fp)
+{
+    return fp->set->caustic_thin > 0.0f && fp->comp && lm_frame_lightmap_path(fp->set);
+}
+
+/* The photons for the screen pass (*hits): all of them, or when split_on, those where caustics are
+ * concentrated, the thin light's texels into the composite. */
+static lm_status split_caustics(lm_frame_passes *fp, const lm_caustics *c, const lm_caustic_hit **hits, lm_error *err)
+{
+    *hits = lm_caustics_hits(c);
+    int split = split_on(fp);
+    lm_status st = LM_OK;
+    double t0 = lm_now();
+    if (split)
+        st = lm_caustic_split_make(fp->w->scene, fp->w->atlas, lm_aim_rgb(lm_photon_stage_aim(fp->stage)), *hits,
+                                   lm_caustics_photon_count(c), fp->set->caustic_thin, &fp->split, err);
+    else {
+        lm_caustic_split_free(&fp->split);
+        fp->split.landed = lm_caustics_landed(c); /* all of them the screen's */
+    }
+    if (st == LM_OK && split)
+        *hits = fp->split.screen;
+    fp->thin = st == LM_OK && split && fp->split.thin_photons > 0;
+    fp->split_seconds += lm_now() - t0;
+    if (st == LM_OK && fp->comp)
+        st = lm_composite_set_caustics(fp->comp, fp->thin ? fp->split.thin : NULL, err);
+    return st;
+}
+
 lm_status lm_frame_passes_upload_caustics(lm_frame_passes *fp, lm_error *err)
 {
     const lm_caustics *c = lm_photon_stage_caustics(fp->stage);
     uint64_t version = lm_photon_stage_caustics_version(fp->stage);
-    if (!c || version == fp->caustic_version || (!fp->caustic_pass && !lm_caustics_landed(c)))
+    if (!c || version == fp->caustic_version || (!fp->caustic_pass && !lm_caustics_landed(c) && !fp->thin))
         return LM_OK;
-    lm_status st = fp->caustic_pass ? LM_OK : lm_caustic_pass_create(&fp->set->caustic_pass, &fp->caustic_pass, err);
+    const lm_caustic_hit *hits = NULL;
+    lm_status st = split_caustics(fp, c, &hits, err);
+    if (st == LM_OK && !fp->caustic_pass) {
+        lm_caustic_pass_settings set = fp->set->caustic_pass;
+        if (split_on(fp)) /* the screen holds concentrated photons only: no thin light to widen over */
+            set.widen_levels = set.widen_levels < LM_CAUSTIC_SPLIT_WIDEN ? set.widen_levels : LM_CAUSTIC_SPLIT_WIDEN;
+        st = lm_caustic_pass_create(&set, &fp->caustic_pass, err);
+    }
     if (st == LM_OK)
-        st = lm_caustic_pass_set_photons(fp->caustic_pass, lm_caustics_hits(c), lm_caustics_photon_count(c), err);
+        st = lm_caustic_pass_set_photons(fp->caustic_pass, hits, lm_caustics_photon_count(c), err);
     if (st == LM_OK)
         fp->caustic_version = version;
     return st;
+}
+
+void lm_frame_passes_caustic_split(const lm_frame_passes *fp, uint32_t *landed, uint32_t *thin)
+{
+    *landed = fp->split.landed;
+    *thin = fp->thin ? fp->split.thin_photons : 0;
 }
 
 /* What lights the scene besides the lightmaps, as the environment maps' dirty tracking compares it: the
@@ -189,6 +240,7 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
         st = draw_caustics(fp, caustics, own, view, w, h, o, err);
     fp->caustic_slot = own ? LM_CAUSTIC_SLOT_FRAME : LM_CAUSTIC_SLOT_VIEW;
     fp->caustic_w = w, fp->caustic_h = h;
+    fp->caustic_view = *view;
     double t4 = lm_now();
     if (st == LM_OK)
         st = lm_reflections_draw(fp->reflections, fp->direct, fp->w->scene, view, err);
@@ -198,7 +250,9 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
     o->t_composite = t1 - t0;
     /* the caustic pass and the photon gather first wait for the direct light's GPU work: that wait is
      * the direct light's */
-    o->t_caustics = t4 - t3p - o->caustic.t_wait;
+    o->t_caustics = t4 - t3p - o->caustic.t_wait + (own ? fp->split_seconds : 0.0);
+    fp->split_seconds = own ? 0.0 : fp->split_seconds;
+    lm_frame_passes_caustic_split(fp, &o->caustic_landed, &o->caustic_thin);
     o->t_gather += t3p - t3 - o->photon_gather.t_wait;
     o->t_reflections = (t2 - t1) + (t5 - t4);
     o->t_direct = (t3 - t2) + o->caustic.t_wait + o->photon_gather.t_wait + (lm_now() - t5);
@@ -226,17 +280,21 @@ void lm_frame_passes_caustics_size(const lm_frame_passes *fp, int *width, int *h
 lm_status lm_frame_passes_read_caustics(const lm_frame_passes *fp, float *rgb, lm_error *err)
 {
     size_t n = 3 * (size_t)fp->caustic_w * (size_t)fp->caustic_h;
-    if (!drawn_caustics(fp)) { /* none drawn: none */
+    lm_status st = LM_OK;
+    if (drawn_caustics(fp))
+        st = lm_caustic_pass_read_irradiance(fp->caustic_pass, fp->caustic_slot, rgb, err);
+    else /* none drawn on screen */
         memset(rgb, 0, n * sizeof *rgb);
-        return LM_OK;
-    }
-    return lm_caustic_pass_read_irradiance(fp->caustic_pass, fp->caustic_slot, rgb, err);
+    if (st == LM_OK && fp->thin && fp->caustic_w > 0) /* and what the lightmaps carry */
+        st = lm_render_atlas_irradiance(fp->w->scene, fp->w->atlas, lm_composite_caustics_texture(fp->comp),
+                                        &fp->caustic_view, fp->caustic_w, fp->caustic_h, rgb, err);
+    return st;
 }
 
 lm_status lm_frame_passes_read_caustic_radiance(const lm_frame_passes *fp, float *rgb, lm_error *err)
 {
     lm_status st = lm_frame_passes_read_caustics(fp, rgb, err);
-    if (st != LM_OK || !drawn_caustics(fp))
+    if (st != LM_OK || (!drawn_caustics(fp) && !fp->thin))
         return st;
     size_t n = 3 * (size_t)fp->caustic_w * (size_t)fp->caustic_h;
     float *kd = malloc((n ? n : 1) * sizeof *kd);

@@ -41,8 +41,12 @@ void lm_frame_passes_free(lm_frame_passes *fp);
 lm_status lm_frame_passes_setup(lm_frame_passes *fp, lm_error *err);
 /* After edits that change which passes a node takes part in (lm_scene.pass_version). */
 lm_status lm_frame_passes_follow(lm_frame_passes *fp, lm_error *err);
-/* The stage's caustic photons into the caustic pass when they changed. */
+/* The stage's caustic photons into the caustic pass when they changed; with the lightmap path and
+ * set->caustic_thin, the thin ones' light into the composite instead (photonmap/caustic_split.h), from
+ * the stage's AIM as it is now. */
 lm_status lm_frame_passes_upload_caustics(lm_frame_passes *fp, lm_error *err);
+/* The photons of the last upload that landed, and of those the ones the lightmaps carry. */
+void lm_frame_passes_caustic_split(const lm_frame_passes *fp, uint32_t *landed, uint32_t *thin);
 /* Whether the scene has caustic generators now (mirror or glass nodes with caustics on), or the caustic
  * pass holds photons: a loop that draws no frame of its own takes the newest caustic photons. */
 int lm_frame_passes_want_caustics(lm_frame_passes *fp);
@@ -60,7 +64,8 @@ lm_status lm_frame_passes_draw_step(lm_frame_passes *fp, const lm_frame_indirect
  * next steps render (lm_reflections_limit_faces). */
 int lm_frame_passes_faces(const lm_frame_passes *fp);
 void lm_frame_passes_limit_faces(lm_frame_passes *fp, int most);
-/* The caustic irradiance of the last picture drawn (lm_frame_loop_read_caustics says what). */
+/* The caustic irradiance of the last picture drawn (lm_frame_loop_read_caustics says what): the screen
+ * pass's plus the thin light the lightmaps carry at each pixel. */
 void lm_frame_passes_caustics_size(const lm_frame_passes *fp, int *width, int *height);
 lm_status lm_frame_passes_read_caustics(const lm_frame_passes *fp, float *rgb, lm_error *err);
 /* What the caustics added to that picture: kd / pi x E at each pixel (radiance, the same layout). */

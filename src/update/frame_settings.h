@@ -12,6 +12,7 @@
 #include "../gpu/gather/hemicube.h"
 #include "../gpu/gather/iim.h"
 #include "../gpu/tiled/photon_gather.h"
+#include "../photonmap/caustic_split.h"
 #include "budget_plan.h"
 #include "photon_stage.h"
 
@@ -43,6 +44,9 @@ typedef struct {
     int caustics;          /* 1 (default): caustic photons (stage.caustic) and the screen-space caustic pass, which
                             * cost nothing while no mirror or glass node has its caustics switched on; 0: none */
     lm_caustic_pass_settings caustic_pass;
+    float caustic_thin;    /* with the lightmap path: caustic light under this x a texel's other light is carried
+                            * by the lightmaps, the rest by the screen pass (photonmap/caustic_split.h; default
+                            * LM_CAUSTIC_THIN_DEFAULT; 0: every photon on screen, the paper's) */
     int indirect;          /* 0: no indirect light at all (no photon, AIM or gather work; the frame shows direct
                             * light, emission and reflections); default 1. stage.trace follows it */
     int indirect_path;     /* how the frame gets its indirect light: LM_INDIRECT_LIGHTMAP (default: AIMs, the
@@ -87,6 +91,8 @@ typedef struct {
     lm_photon_stage_frame stage;
     uint32_t texels_gathered;
     lm_caustic_pass_stats caustic; /* the frame's caustic pass */
+    uint32_t caustic_landed, caustic_thin; /* the caustic photons the frame showed, and of those the ones its
+                                            * lightmaps carried (photonmap/caustic_split.h) */
     int cube_faces;        /* environment map faces rendered */
     int shadow_maps;       /* shadow maps re-rendered by the frame's draws */
     int shadow_maps_stale; /* stale ones left for later updates (lm_direct_begin_update) */
@@ -94,7 +100,8 @@ typedef struct {
     int photon_gathers;    /* gathers run: 0 when the records, view and G-buffer were as for the last one */
     /* seconds per stage: photon stage (animate + photons + AIMs + caustic photons), IIM gather (schedule,
      * scene and AIM upload, hemicubes), blend, direct light (emission and indirect, lights, shadow maps,
-     * the frame's read-back), caustics (the screen-space pass), reflections (map faces and their pass),
+     * the frame's read-back), caustics (the split of the photons between the lightmaps and the screen, and
+     * the screen-space pass), reflections (map faces and their pass),
      * composite (the indirect term's atlas pass); and the whole frame */
     double t_photons, t_gather, t_blend, t_direct, t_caustics, t_reflections, t_composite, t_total;
     /* the time budget (budget_plan.h): the counts the step was allowed (zeros but texels without a budget:

@@ -13,6 +13,7 @@
 #include "../../src/core/timing.h"
 #include "../../src/core/vecmath.h"
 #include "../../src/gpu/frame/caustic_pass.h"
+#include "../../src/photonmap/caustic_split.h"
 #include "../../src/gpu/gl/gl_context.h"
 #include "../../src/trace/caustics.h"
 #include "../../src/update/frame_loop.h"
@@ -109,10 +110,16 @@ static void print_filter(void)
     lm_caustic_pass_settings set;
     lm_caustic_pass_settings_default(&set);
     const int default_k = set.filter_k;
-    for (int sized = 0; sized < 2; sized++) { /* the paper's fixed filter, then sized by density (the default) */
+    /* the paper's fixed filter; sized by density (the default); and as a frame loop runs it when the thin
+     * light is the lightmaps' (photonmap/caustic_split.h): the concentrated photons alone, as dense as the
+     * full screen's (PHOTONS x covered), a filter that widens 2x */
+    for (int sized = 0; sized < 3; sized++) {
     set.filter_k = sized ? default_k : 3;
+    set.widen_levels = sized == 2 ? LM_CAUSTIC_SPLIT_WIDEN : LM_CAUSTIC_FILTER_LEVELS;
+    const char *name[3] = {"the paper's fixed 7 x 7", "sized by density (32 photons)",
+                           "sized, widening 2x, photons x covered (thin light in the lightmaps)"};
     printf("\ncaustic pass at %d x %d, %d photons, k = %d, %s, %d-pixel tiles; ms, median of %d:\n", SIZE, SIZE,
-           PHOTONS, set.filter_k, sized ? "sized by density (32 photons)" : "the paper's fixed 7 x 7", 32, REPEATS);
+           PHOTONS, set.filter_k, name[sized], 32, REPEATS);
     printf("%-9s %11s %8s %8s %8s %10s %8s %9s\n", "covered", "tiles lit", "splat", "queries", "filter", "composite",
            "total", "paper");
     set.filter_photons = sized ? 32 : 0;
@@ -125,7 +132,8 @@ static void print_filter(void)
         /* the photons' square; at 100% a little wider, so that the filter's border reaches every pixel */
         square_photons(screen * (float)sqrt(cover[c]) * (c == 3 ? 1.05f : 1.0f), hits);
         pass_times t;
-        if (lm_caustic_pass_set_photons(cp, hits, PHOTONS, &err) != LM_OK || !time_pass(cp, &v, d,
+        uint32_t n = sized == 2 ? (uint32_t)(PHOTONS * cover[c]) : PHOTONS;
+        if (lm_caustic_pass_set_photons(cp, hits, n, &err) != LM_OK || !time_pass(cp, &v, d,
                                                                                         lm_direct_depth_texture(d, 0), &t))
             goto done;
         const char *paper = c == 0 ? "0.38" : c == 3 ? "37.6" : "";
@@ -206,11 +214,13 @@ static void print_tracing(lmgi_scene *sc)
 enum { P_PHOTONS, P_GATHER, P_BLEND, P_DIRECT, P_CAUSTICS, P_REFLECT, P_COMPOSITE, P_TOTAL, P_COUNT };
 
 /* The frame loop on scenes/cornell.glb at 512 x 512 with `faces` environment map faces a frame and the
- * caustics on or off: median ms per pass over FRAMES frames (30 per second of animation). */
-static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflections)
+ * caustics on or off, their thin light in the lightmaps or all of it on screen (`thin` 0): median ms per
+ * pass over FRAMES frames (30 per second of animation). */
+static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflections, int thin)
 {
     lm_frame_loop_settings set;
     lm_frame_loop_settings_default(&set);
+    set.caustic_thin = thin ? set.caustic_thin : 0.0f;
     set.reflection_faces = faces;
     set.caustics = caustics;
     set.reflection_size = reflections ? set.reflection_size : 0;
@@ -245,8 +255,11 @@ static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflection
     double m[P_COUNT];
     for (int k = 0; k < P_COUNT; k++)
         m[k] = lm_median(t[k], FRAMES);
-    printf("%-34s %7.1f %5.1f %8.2f %7.2f %6.2f %7.2f %9.2f %8.2f %7.2f", caustics ? reflections ? "caustics + reflections"
-           : "caustics" : reflections ? "reflections" : "neither", m[P_TOTAL], 1e3 / m[P_TOTAL], m[P_PHOTONS],
+    char name[64];
+    snprintf(name, sizeof name, "%s%s", caustics ? reflections ? "caustics + reflections" : "caustics"
+                                        : reflections ? "reflections" : "neither",
+             caustics && !thin ? ", all on screen" : "");
+    printf("%-34s %7.1f %5.1f %8.2f %7.2f %6.2f %7.2f %9.2f %8.2f %7.2f", name, m[P_TOTAL], 1e3 / m[P_TOTAL], m[P_PHOTONS],
            m[P_GATHER], m[P_BLEND], m[P_DIRECT], m[P_CAUSTICS], m[P_REFLECT], m[P_COMPOSITE]);
     if (faced)
         printf("   %d faces a frame: %.2f ms a face", faces, lm_median(per_face, faced));
@@ -276,11 +289,13 @@ void lm_dev_bench_caustics(void)
                "frames:\n", path, SIZE, SIZE, FRAMES);
         printf("%-34s %7s %5s %8s %7s %6s %7s %9s %8s %7s\n", "", "frame", "fps", "photons", "gather", "blend", "direct",
                "caustics", "reflect", "compos.");
-        print_frames(sc, 1, 0, 0);
-        print_frames(sc, 1, 1, 0);
-        print_frames(sc, 1, 0, 1);
-        print_frames(sc, 1, 1, 1);
-        print_frames(sc, 6, 1, 1);
+        print_frames(sc, 1, 0, 0, 1);
+        print_frames(sc, 1, 1, 0, 0);
+        print_frames(sc, 1, 1, 0, 1);
+        print_frames(sc, 1, 0, 1, 1);
+        print_frames(sc, 1, 1, 1, 0);
+        print_frames(sc, 1, 1, 1, 1);
+        print_frames(sc, 6, 1, 1, 1);
         lmgi_free(sc);
     } else {
         printf("\ncaustics on %s: skipped (not loaded)\n", path);

@@ -19,6 +19,7 @@ void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
     s->tile = 32;
     s->world_space = 0;
     s->filter_photons = 32;
+    s->widen_levels = LM_CAUSTIC_FILTER_LEVELS;
 }
 
 /* A photon as the splat reads it: position, receiver normal (arrival side), flux. */
@@ -196,6 +197,9 @@ lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic
     if (set->filter_photons < 0)
         return lm_fail(err, LM_ERR_INVALID, "caustic pass: the filter's photons must be 0 or more, not %d",
                        set->filter_photons);
+    if (set->widen_levels < 0 || set->widen_levels > LM_CAUSTIC_FILTER_LEVELS)
+        return lm_fail(err, LM_ERR_INVALID, "caustic pass: the filter widens 0 to %d levels, not %d",
+                       LM_CAUSTIC_FILTER_LEVELS, set->widen_levels);
     if (set->tile < 4 || set->tile > 256)
         return lm_fail(err, LM_ERR_INVALID, "caustic pass: the tile side must be 4 to 256 pixels, not %d", set->tile);
     lm_caustic_pass *cp = calloc(1, sizeof *cp);
@@ -486,7 +490,7 @@ static lm_status grown_tiles(lm_caustic_pass *cp, const slot_targets *t, int *co
                              lm_error *err)
 {
     int T = cp->set.tile, grow = cp->set.filter_photons > 0 ? 0 : cp->set.filter_k, n = 0;
-    int reach = LM_CAUSTIC_FILTER_REACH(cp->set.filter_k); /* in pixels, sized by density */
+    int reach = LM_CAUSTIC_FILTER_REACH_AT(cp->set.filter_k, cp->set.widen_levels); /* in pixels, sized by density */
     int d = cp->set.filter_photons > 0 ? (reach + T - 1) / T : 0;
     int most = d ? t->tiles_x * t->tiles_y : *count;
     float *r = realloc(cp->rects, (size_t)(most ? most : 1) * 12 * sizeof *r);
@@ -530,7 +534,7 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
     glUniform1i(glGetUniformLocation(p, "ortho"), vc->ortho);
     glUniform1f(glGetUniformLocation(p, "pix_side"), vc->pix_side);
     glUniform1f(glGetUniformLocation(p, "need"), (float)cp->set.filter_photons);
-    glUniform1i(glGetUniformLocation(p, "levels"), LM_CAUSTIC_FILTER_LEVELS);
+    glUniform1i(glGetUniformLocation(p, "levels"), cp->set.widen_levels);
     const GLuint tex[3] = {t->splat_tex[0], t->splat_tex[1], depth};
     const char *names[3] = {"irr", "flux", "depth"};
     for (int i = 0; i < 3; i++) {

@@ -62,6 +62,9 @@ typedef struct {
                               widens (its taps further apart over the splat's mipmaps) until about that many,
                               up to LM_CAUSTIC_FILTER_LEVELS doublings, and where they hold more and the light
                               has structure it narrows to that many (default 32; 0: the paper's fixed filter) */
+    int widen_levels;      /* the density-sized filter widens up to 2^this times, 0 to LM_CAUSTIC_FILTER_LEVELS
+                              (default LM_CAUSTIC_FILTER_LEVELS; 1 where thin light is the lightmaps' and the
+                              screen holds only concentrated photons, update/frame_passes.c) */
 } lm_caustic_pass_settings;
 
 /* The density-sized filter widens up to 2^this times. */
@@ -69,7 +72,9 @@ typedef struct {
 /* How far from a pixel the density-sized filter of k reads light, in pixels: at its widest (s = 2^levels)
  * its outer taps lie k s away, each reading the mip level whose texels span 2s pixels bilinearly, so
  * from texels up to 2s further whose pixels reach s beyond their centre (40 pixels at k = 2). */
-#define LM_CAUSTIC_FILTER_REACH(k) (((k) + 3) << LM_CAUSTIC_FILTER_LEVELS)
+#define LM_CAUSTIC_FILTER_REACH(k) LM_CAUSTIC_FILTER_REACH_AT(k, LM_CAUSTIC_FILTER_LEVELS)
+/* The same for a filter that widens up to 2^levels times (lm_caustic_pass_settings.widen_levels). */
+#define LM_CAUSTIC_FILTER_REACH_AT(k, levels) (((k) + 3) << (levels))
 
 void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s);
 

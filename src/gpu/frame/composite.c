@@ -19,7 +19,8 @@ struct lm_composite {
     GLuint covered_tex, premult_prog, empty_vao;
     float limit;
     GLuint fill_prog;
-    GLint p_limit, p_covered, p_iim, f_limit, f_covered, f_iim, f_reach;
+    GLint p_limit, p_covered, p_iim, p_thin, p_use_thin, f_limit, f_covered, f_iim, f_reach;
+    GLuint thin_tex;     /* atlas-sized RGBA32F: the caustics' thin light (lm_composite_set_caustics), 0: none */
     lm_float_target lit; /* atlas-sized, linear filter: (E / pi * w, w), w = 1 covered and valid, 1/1024
                           * filled (glsl/fill_holes_fs.glsl), else 0; its depth marks the holes */
 };
@@ -73,6 +74,8 @@ lm_status lm_composite_create(const lm_scene *s, const lm_atlas *a, float backfa
     c->p_limit = glGetUniformLocation(c->premult_prog, "limit");
     c->p_covered = glGetUniformLocation(c->premult_prog, "covered");
     c->p_iim = glGetUniformLocation(c->premult_prog, "iim");
+    c->p_thin = glGetUniformLocation(c->premult_prog, "thin");
+    c->p_use_thin = glGetUniformLocation(c->premult_prog, "use_thin");
     c->f_limit = glGetUniformLocation(c->fill_prog, "limit");
     c->f_covered = glGetUniformLocation(c->fill_prog, "covered");
     c->f_iim = glGetUniformLocation(c->fill_prog, "iim");
@@ -94,6 +97,8 @@ void lm_composite_free(lm_composite *c)
         glDeleteProgram(c->fill_prog);
     if (c->empty_vao)
         glDeleteVertexArrays(1, &c->empty_vao);
+    if (c->thin_tex)
+        glDeleteTextures(1, &c->thin_tex);
     lm_float_target_free(&c->lit);
     free(c);
 }
@@ -124,6 +129,11 @@ static void premultiply_and_fill(const lm_composite *c, unsigned iim_tex)
     glEnable(GL_DEPTH_TEST);
     glDepthMask(GL_TRUE);
     glDepthFunc(GL_ALWAYS);
+    glUseProgram(c->premult_prog);
+    glUniform1i(c->p_use_thin, c->thin_tex != 0);
+    glUniform1i(c->p_thin, 2);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, c->thin_tex);
     atlas_pass(c, c->premult_prog, c->p_limit, c->p_covered, c->p_iim, iim_tex);
     glDepthMask(GL_FALSE);
     glDepthFunc(GL_GREATER);
@@ -152,3 +162,27 @@ lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit
     *lit_tex = c->lit.color[0];
     return lm_gl_check("composite: indirect", err);
 }
+
+lm_status lm_composite_set_caustics(lm_composite *c, const float *thin, lm_error *err)
+{
+    if (!thin) {
+        if (c->thin_tex)
+            glDeleteTextures(1, &c->thin_tex);
+        c->thin_tex = 0;
+        return LM_OK;
+    }
+    if (!c->thin_tex) { /* the premultiply pass reads it texel by texel, a view of it bilinearly */
+        c->thin_tex = lm_float_texture(c->width, c->height, thin);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    } else {
+        glBindTexture(GL_TEXTURE_2D, c->thin_tex);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, c->width, c->height, GL_RGBA, GL_FLOAT, thin);
+    }
+    return lm_gl_check("composite: the caustics' thin light", err);
+}
+
+unsigned lm_composite_caustics_texture(const lm_composite *c) { return c->thin_tex; }

@@ -13,6 +13,7 @@
  * multiplies it by kd and adds it (gpu/frame/direct.h, lm_direct_set_indirect): the sum needs no pass of
  * its own. Mirror and glass (no lightmap texels) and the background get no indirect
  * light, nor do nodes whose indirect light is switched off (extras "indirect": false, lmgi_set_node_effects).
+ * The caustics' thin light (lm_composite_set_caustics) is added to E_IIM texel by texel in the same pass.
  * Program and target persist. */
 #ifndef LM_COMPOSITE_H
 #define LM_COMPOSITE_H
@@ -32,5 +33,11 @@ lm_status lm_composite_update_coverage(lm_composite *c, const lm_scene *s, const
 /* The indirect term from iim_tex (atlas-sized RGBA32F, a = back-face fraction) into *lit_tex (owned by c,
  * valid until the next call). One atlas-sized pass. */
 lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit_tex, lm_error *err);
+/* The caustics' thin light the lightmaps carry (photonmap/caustic_split.h): atlas-sized RGBA floats, rgb
+ * the irradiance each texel adds to E_IIM in the indirect term from the next lm_composite_indirect on.
+ * NULL: none (the default). Copied to a texture c owns. Errors: a GL error. */
+lm_status lm_composite_set_caustics(lm_composite *c, const float *thin, lm_error *err);
+/* That texture (rgb E, a 1 on texels that show indirect light), 0: none. */
+unsigned lm_composite_caustics_texture(const lm_composite *c);
 
 #endif

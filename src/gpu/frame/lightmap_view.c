@@ -78,3 +78,46 @@ lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *
     glDeleteProgram(prog);
     return st;
 }
+
+lm_status lm_render_atlas_irradiance(const lm_scene *s, const lm_atlas *a, unsigned tex, const lm_view *view,
+                                     int width, int height, float *rgb, lm_error *err)
+{
+    GLuint prog = 0;
+    lm_status st = lm_gl_program("atlas_irradiance", lm_glsl_lightmap_view_vs, lm_glsl_atlas_irradiance_fs, &prog, err);
+    if (st != LM_OK)
+        return st;
+    float *verts = lm_lightmapped_vertices(s, a);
+    size_t n = 3 * (size_t)width * height;
+    float *seen = malloc((n ? n : 1) * sizeof *seen);
+    if (!verts || !seen) {
+        free(verts);
+        free(seen);
+        glDeleteProgram(prog);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the atlas's view", s->path);
+    }
+    lm_gl_mesh mesh;
+    const int sizes[2] = {3, 2}; /* position, lightmap UV */
+    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
+    free(verts);
+    lm_offscreen target;
+    st = lm_offscreen_begin_float(&target, width, height, err);
+    if (st == LM_OK) {
+        float vp[16];
+        lm_mat4_mul(vp, view->proj, view->view);
+        glUseProgram(prog);
+        glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
+        glUniform1i(glGetUniformLocation(prog, "atlas"), 0);
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, tex);
+        lm_gl_mesh_draw_scene_sides(&mesh, s);
+        lm_offscreen_read_rgb(&target, seen);
+        lm_offscreen_release(&target);
+        for (size_t i = 0; i < n; i++)
+            rgb[i] += seen[i];
+        st = lm_gl_check("the atlas's view", err);
+    }
+    free(seen);
+    lm_gl_mesh_destroy(&mesh);
+    glDeleteProgram(prog);
+    return st;
+}
