@@ -41,6 +41,30 @@ static GLuint upload_atlas(const lm_atlas *a, const float *rgb)
     return tex;
 }
 
+/* The scene's lightmapped triangles drawn with prog into the bound target, the atlas texture tex on unit 0
+ * as "atlas", the view's matrix as "view_proj". Fails only when memory runs out. */
+static lm_status draw_lightmapped(const lm_scene *s, const lm_atlas *a, GLuint prog, GLuint tex, const lm_view *view,
+                                  lm_error *err)
+{
+    float *verts = lm_lightmapped_vertices(s, a);
+    if (!verts)
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap view", s->path);
+    lm_gl_mesh mesh;
+    const int sizes[2] = {3, 2}; /* position, lightmap UV */
+    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
+    free(verts);
+    float vp[16];
+    lm_mat4_mul(vp, view->proj, view->view);
+    glUseProgram(prog);
+    glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
+    glUniform1i(glGetUniformLocation(prog, "atlas"), 0);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    lm_gl_mesh_draw_scene_sides(&mesh, s);
+    lm_gl_mesh_destroy(&mesh);
+    return LM_OK;
+}
+
 lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *rgb, float exposure,
                              const lm_view *view, int width, int height, uint8_t *rgba8, lm_error *err)
 {
@@ -48,33 +72,19 @@ lm_status lm_render_lightmap(const lm_scene *s, const lm_atlas *a, const float *
     lm_status st = lm_gl_program("lightmap_view", lm_glsl_lightmap_view_vs, lm_glsl_lightmap_view_fs, &prog, err);
     if (st != LM_OK)
         return st;
-    float *verts = lm_lightmapped_vertices(s, a);
-    if (!verts) {
-        glDeleteProgram(prog);
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the lightmap view", s->path);
-    }
     GLuint tex = upload_atlas(a, rgb);
-    lm_gl_mesh mesh;
-    const int sizes[2] = {3, 2}; /* position, lightmap UV */
-    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
-    free(verts);
-
     lm_offscreen target;
     st = lm_offscreen_begin(&target, width, height, err);
     if (st == LM_OK) {
-        float vp[16];
-        lm_mat4_mul(vp, view->proj, view->view);
         glUseProgram(prog);
-        glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
         glUniform1f(glGetUniformLocation(prog, "exposure"), exposure);
-        glUniform1i(glGetUniformLocation(prog, "atlas"), 0);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, tex);
-        lm_gl_mesh_draw_scene_sides(&mesh, s);
-        st = lm_offscreen_end(&target, rgba8, err);
+        st = draw_lightmapped(s, a, prog, tex, view, err);
+        if (st == LM_OK)
+            st = lm_offscreen_end(&target, rgba8, err);
+        else
+            lm_offscreen_release(&target);
     }
     glDeleteTextures(1, &tex);
-    lm_gl_mesh_destroy(&mesh);
     glDeleteProgram(prog);
     return st;
 }
@@ -86,38 +96,20 @@ lm_status lm_render_atlas_irradiance(const lm_scene *s, const lm_atlas *a, unsig
     lm_status st = lm_gl_program("atlas_irradiance", lm_glsl_lightmap_view_vs, lm_glsl_atlas_irradiance_fs, &prog, err);
     if (st != LM_OK)
         return st;
-    float *verts = lm_lightmapped_vertices(s, a);
     size_t n = 3 * (size_t)width * height;
     float *seen = malloc((n ? n : 1) * sizeof *seen);
-    if (!verts || !seen) {
-        free(verts);
-        free(seen);
-        glDeleteProgram(prog);
-        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the atlas's view", s->path);
-    }
-    lm_gl_mesh mesh;
-    const int sizes[2] = {3, 2}; /* position, lightmap UV */
-    lm_gl_mesh_create(&mesh, verts, (int)(3 * s->tri_count), sizes, 2);
-    free(verts);
     lm_offscreen target;
-    st = lm_offscreen_begin_float(&target, width, height, err);
+    st = seen ? lm_offscreen_begin_float(&target, width, height, err)
+              : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the atlas's view", s->path);
     if (st == LM_OK) {
-        float vp[16];
-        lm_mat4_mul(vp, view->proj, view->view);
-        glUseProgram(prog);
-        glUniformMatrix4fv(glGetUniformLocation(prog, "view_proj"), 1, GL_FALSE, vp);
-        glUniform1i(glGetUniformLocation(prog, "atlas"), 0);
-        glActiveTexture(GL_TEXTURE0);
-        glBindTexture(GL_TEXTURE_2D, tex);
-        lm_gl_mesh_draw_scene_sides(&mesh, s);
-        lm_offscreen_read_rgb(&target, seen);
+        st = draw_lightmapped(s, a, prog, tex, view, err);
+        if (st == LM_OK)
+            lm_offscreen_read_rgb(&target, seen);
         lm_offscreen_release(&target);
-        for (size_t i = 0; i < n; i++)
-            rgb[i] += seen[i];
-        st = lm_gl_check("the atlas's view", err);
     }
+    for (size_t i = 0; st == LM_OK && i < n; i++)
+        rgb[i] += seen[i];
     free(seen);
-    lm_gl_mesh_destroy(&mesh);
     glDeleteProgram(prog);
-    return st;
+    return st == LM_OK ? lm_gl_check("the atlas's view", err) : st;
 }
