@@ -591,7 +591,8 @@ typedef struct {
     int texels_budget;         /* the texels this update was allowed (budget_ms > 0: from the measured cost) */
     int surfaces_changed;      /* surfaces whose displayed lightmap changed (lmgi_surface_version moved) */
     uint32_t caustic_photons_retraced; /* caustic photons traced (a moved light or mirror/glass node: all its) */
-    int caustic_tiles, caustic_tiles_lit; /* screen tiles queried, and those found holding caustic photons */
+    int caustic_tiles, caustic_tiles_lit; /* screen tiles (each queried when a photon projects into it), and
+                                           * those found holding caustic photons */
     uint64_t caustic_pixels_filtered; /* pixels the caustic filter ran on (the lit tiles grown by k) */
     uint32_t caustic_photons_landed, caustic_photons_thin; /* caustic photons that landed, and of those the ones
                                 * the lightmaps carry as thin light (docs/caustics.md, "Thin light in the

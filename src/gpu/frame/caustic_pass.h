@@ -11,8 +11,10 @@
  *            within the depth the receiver spans across a pixel (1 + 2 tan of its view angle, capped, pixel
  *            footprints) and drops photons behind, behind the camera, off screen, or on the side of
  *            the receiver the camera does not see. Float throughout: no 8-bit count limit, coloured light.
- *   tiles    the screen in tile x tile squares; per square an occlusion query (GL_SAMPLES_PASSED) around a
- *            quad drawn where the stencil is not 0: a tile is lit when the query counts any pixel.
+ *   tiles    the screen in tile x tile squares; per square that a photon projects into (found on the CPU
+ *            with the frustum culling), an occlusion query (GL_SAMPLES_PASSED) around a quad drawn where
+ *            the stencil is not 0: a tile is lit when the query counts any pixel (a photon behind the depth
+ *            leaves its tile unlit); squares no photon projects into are unlit without a query.
  *   filter   over every lit tile grown by the filter's reach (clamped to the screen), with blending off, so
  *            that pixels two grown tiles share get the same value twice, never twice the light; the reach
  *            is k pixels for the fixed filter, and for the density-sized one the tiles within k 2^levels
@@ -40,9 +42,9 @@
  * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
  * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
  * application renders (_VIEW).
- * Cost: one point per photon, one query quad per tile, (2k + 1)^2 texture reads per filtered pixel (and
- * up to LM_CAUSTIC_FILTER_LEVELS + 5 to size it, four of them the structure test, plus the splat's
- * mipmaps once a run), two per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a
+ * Cost: one point per photon, one query quad per tile a photon projects into, (2k + 1)^2 texture reads
+ * per filtered pixel (and up to LM_CAUSTIC_FILTER_LEVELS + 5 to size it, four of them the structure test,
+ * plus the splat's mipmaps once a run), two per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a
  * current GL context; not thread-safe. */
 #ifndef LM_CAUSTIC_PASS_H
 #define LM_CAUSTIC_PASS_H
