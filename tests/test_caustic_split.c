@@ -81,8 +81,9 @@ static int teardown(void **state)
     return 0;
 }
 
-/* An AIM whose radiance is kd / pi x e on every covered texel: other light of irradiance e. */
-static float *aim_of(double e)
+/* An AIM whose radiance is kd / pi x e on every covered texel (left: x < 0, e_left there): other light of
+ * irradiance e. */
+static float *aim_of2(double e, double e_left)
 {
     const lm_atlas *a = &pipe_.atlas;
     float *rgb = calloc(3 * (size_t)a->width * a->height, sizeof *rgb);
@@ -91,19 +92,23 @@ static float *aim_of(double e)
         float kd[3];
         lm_texel_kd(pipe_.s, &a->texels[i], kd);
         for (int c = 0; c < 3; c++)
-            rgb[3 * ((size_t)a->texels[i].y * a->width + a->texels[i].x) + c] = (float)(kd[c] / M_PI * e);
+            rgb[3 * ((size_t)a->texels[i].y * a->width + a->texels[i].x) + c] =
+                (float)(kd[c] / M_PI * (a->texels[i].pos[0] < 0.0f ? e_left : e));
     }
     return rgb;
 }
 
-static void split(double other, float fraction, lm_caustic_split *out)
+static float *aim_of(double e) { return aim_of2(e, e); }
+
+static void split_aim(float *aim, float fraction, lm_caustic_split *out)
 {
-    float *aim = aim_of(other);
     lm_error err;
     memset(out, 0, sizeof *out);
     assert_int_equal(lm_caustic_split_make(pipe_.s, &pipe_.atlas, aim, hits, FIELD + SPOT, fraction, out, &err), LM_OK);
     free(aim);
 }
+
+static void split(double other, float fraction, lm_caustic_split *out) { split_aim(aim_of(other), fraction, out); }
 
 /* The lightmaps' power (E_thin x texel area) and the screen's (its photons' flux), green. */
 static void powers(const lm_caustic_split *sp, double *lightmap, double *screen)
@@ -179,6 +184,23 @@ static void test_other_light_decides(void **state)
     print_message("next to 1000 times the field's light: %u of %u photons thin\n", sp.thin_photons, sp.landed);
     assert_true(sp.thin_photons > FIELD);
     assert_true(sp.thin_photons < FIELD + SPOT);
+    lm_caustic_split_free(&sp);
+    /* the texel's own light too: the plane's mean light is bright (0.54), but where it is 0.08 (x < 0) the
+     * field's 0.05 is not under half of the rest, 0.015 */
+    split_aim(aim_of2(1.0, 0.08), 0.5f, &sp);
+    uint32_t left = 0, left_thin = 0, right = 0, right_thin = 0;
+    for (uint32_t i = 0; i < FIELD; i++) {
+        double dx = hits[i].pos[0] - 3.0, dz = hits[i].pos[2] - 3.0;
+        int thin = sp.screen[i].flux[1] == 0.0f;
+        if (hits[i].pos[0] < -1.0f)
+            left++, left_thin += (uint32_t)thin;
+        else if (hits[i].pos[0] > 1.0f && sqrt(dx * dx + dz * dz) > 2.0)
+            right++, right_thin += (uint32_t)thin;
+    }
+    print_message("dark left half: %u of %u field photons thin there, %u of %u on the bright half\n", left_thin, left,
+                  right_thin, right);
+    assert_int_equal(left_thin, 0);
+    assert_int_equal(right_thin, right);
     lm_caustic_split_free(&sp);
 }
 

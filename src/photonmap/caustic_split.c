@@ -78,7 +78,8 @@ static void bin_photons(const lm_caustic_hit *hits, const long *cell_of, uint32_
 
 /* Per surface: the mean irradiance of its light other than the caustic photons', luminance: the AIM's
  * (pi Y(L) / Y(kd) over its texels, by area) less the caustic photons' flux over its area. */
-static void other_light(const lm_scene *s, const lm_atlas *a, const float *aim_rgb, const float *flux, double *other)
+static void other_light(const lm_scene *s, const lm_atlas *a, const float *aim_rgb, const float *flux, double *other,
+                        float *local)
 {
     int ns = a->surface_count;
     double *area = calloc((size_t)ns + 1, sizeof *area), *caustic = calloc((size_t)ns + 1, sizeof *caustic);
@@ -91,8 +92,8 @@ static void other_light(const lm_scene *s, const lm_atlas *a, const float *aim_r
         float y_kd = lm_luminance(kd);
         area[t->surface] += t->area;
         caustic[t->surface] += lm_luminance(flux + 3 * cell);
-        if (y_kd > 0.0f)
-            other[t->surface] += t->area * M_PI * lm_luminance(aim_rgb + 3 * cell) / y_kd;
+        local[cell] = y_kd > 0.0f ? (float)M_PI * lm_luminance(aim_rgb + 3 * cell) / y_kd : 0.0f;
+        other[t->surface] += t->area * local[cell];
     }
     for (int k = 0; area && caustic && k < ns; k++)
         other[k] = area[k] > 0.0 ? fmax((other[k] - caustic[k]) / area[k], 0.0) : 0.0;
@@ -168,7 +169,9 @@ static int has_structure(const chart_sums *cs, int x, int y, int r)
         double n0 = lo[k][S_PHOTONS], n1 = hi[k][S_PHOTONS], a0 = lo[k][S_AREA], a1 = hi[k][S_AREA];
         if (!(a0 > 0.0) || !(a1 > 0.0) || n0 + n1 < LM_CAUSTIC_SPLIT_PHOTONS)
             continue;
-        if (fabs(n0 / a0 - n1 / a1) > LM_CAUSTIC_SPLIT_SIGMA * sqrt(n0 / (a0 * a0) + n1 / (a1 * a1)))
+        double d0 = n0 / a0, d1 = n1 / a1;
+        if (fabs(d0 - d1) > LM_CAUSTIC_SPLIT_SIGMA * sqrt(n0 / (a0 * a0) + n1 / (a1 * a1)) &&
+            fmax(d0, d1) > LM_CAUSTIC_SPLIT_STEP * fmin(d0, d1))
             return 1;
     }
     return 0;
@@ -176,8 +179,8 @@ static int has_structure(const chart_sums *cs, int x, int y, int r)
 
 /* The chart's texels: each one's window half side + 1 (0: no photon within the widest) and whether it is
  * thin next to its surface's other light. */
-static void classify(const lm_atlas *a, const chart_sums *cs, const double *other, float fraction, uint8_t *radius,
-                     uint8_t *thin)
+static void classify(const lm_atlas *a, const chart_sums *cs, const double *other, const float *local, float fraction,
+                     uint8_t *radius, uint8_t *thin)
 {
     for (int y = cs->y0; y < cs->y0 + cs->h; y++)
         for (int x = cs->x0; x < cs->x0 + cs->w; x++) {
@@ -195,8 +198,9 @@ static void classify(const lm_atlas *a, const chart_sums *cs, const double *othe
             float ec[3] = {(float)(v[S_FLUX] / v[S_AREA]), (float)(v[S_FLUX + 1] / v[S_AREA]),
                            (float)(v[S_FLUX + 2] / v[S_AREA])};
             int surface = a->texels[a->texel_index[cell]].surface;
-            thin[cell] = radius[cell] && v[S_AREA] > 0.0 && lm_luminance(ec) < fraction * other[surface] &&
-                         !has_structure(cs, x, y, r > 1 ? r : 1);
+            float y_c = lm_luminance(ec);
+            thin[cell] = radius[cell] && v[S_AREA] > 0.0 && y_c < fraction * other[surface] &&
+                         y_c < fraction * fmaxf(local[cell] - y_c, 0.0f) && !has_structure(cs, x, y, r > 1 ? r : 1);
         }
 }
 
@@ -252,7 +256,8 @@ static int thin_layer(const lm_scene *s, const lm_atlas *a, const chart_sums *cs
 /* Per chart (in parallel; charts own disjoint cells): the sums of the bins, then `pass` 0 classifies
  * its texels, pass 1 spreads the thin photons. Returns 0 when memory ran out. */
 static int over_charts(const lm_scene *s, const lm_atlas *a, int pass, const uint32_t *n, const float *flux,
-                       const double *other, float fraction, uint8_t *radius, uint8_t *thin, float *out)
+                       const double *other, const float *local, float fraction, uint8_t *radius, uint8_t *thin,
+                       float *out)
 {
     int ok = 1;
 #pragma omp parallel for schedule(dynamic, 1) reduction(&& : ok)
@@ -263,7 +268,7 @@ static int over_charts(const lm_scene *s, const lm_atlas *a, int pass, const uin
             continue;
         }
         if (pass == 0)
-            classify(a, &cs, other, fraction, radius, thin);
+            classify(a, &cs, other, local, fraction, radius, thin);
         else
             ok = thin_layer(s, a, &cs, n, flux, radius, out) && ok;
         free(cs.sum);
@@ -282,10 +287,11 @@ lm_status lm_caustic_split_make(const lm_scene *s, const lm_atlas *a, const floa
     uint32_t *n = malloc((cells ? cells : 1) * sizeof *n);
     float *flux = malloc((cells ? cells : 1) * 3 * sizeof *flux);
     double *other = malloc(((size_t)a->surface_count + 1) * sizeof *other);
+    float *local = calloc(cells ? cells : 1, sizeof *local);
     out->thin = malloc((cells ? cells : 1) * 4 * sizeof *out->thin);
     out->screen = malloc((count ? count : 1) * sizeof *out->screen);
     lm_status st = LM_OK;
-    if (!cell_of || !thin_photon || !radius || !thin || !n || !flux || !other || !out->thin || !out->screen)
+    if (!cell_of || !thin_photon || !radius || !thin || !n || !flux || !other || !local || !out->thin || !out->screen)
         goto nomem;
     uint32_t landed = 0;
 #pragma omp parallel for schedule(static) reduction(+ : landed)
@@ -296,11 +302,11 @@ lm_status lm_caustic_split_make(const lm_scene *s, const lm_atlas *a, const floa
     }
     out->landed = landed;
     bin_photons(hits, cell_of, count, NULL, n, flux, cells);
-    other_light(s, a, aim_rgb, flux, other);
+    other_light(s, a, aim_rgb, flux, other, local);
     memset(radius, 0, cells);
     memset(thin, 0, cells);
     memset(out->thin, 0, 4 * cells * sizeof *out->thin);
-    if (!over_charts(s, a, 0, n, flux, other, fraction, radius, thin, NULL))
+    if (!over_charts(s, a, 0, n, flux, other, local, fraction, radius, thin, NULL))
         goto nomem;
     memcpy(out->screen, hits, count * sizeof *hits);
     out->count = count;
@@ -316,7 +322,7 @@ lm_status lm_caustic_split_make(const lm_scene *s, const lm_atlas *a, const floa
         out->texels_concentrated += radius[cell] > 0 && !thin[cell];
     }
     bin_photons(hits, cell_of, count, thin_photon, n, flux, cells);
-    if (over_charts(s, a, 1, n, flux, other, fraction, radius, thin, out->thin))
+    if (over_charts(s, a, 1, n, flux, other, local, fraction, radius, thin, out->thin))
         goto done;
 nomem:
     st = lm_fail(err, LM_ERR_NOMEM, "%s: no memory to split the caustic photons", s->path);
@@ -329,5 +335,6 @@ done:
     free(n);
     free(flux);
     free(other);
+    free(local);
     return st;
 }

@@ -16,15 +16,16 @@
  * LM_CAUSTIC_SPLIT_REACH whose window holds LM_CAUSTIC_SPLIT_PHOTONS photons (a focal spot's texel alone
  * is its own window, so its light is not averaged away before it is judged). t is thin when
  *
- *     Y(E_c(t)) < fraction x E_other(surface of t)
+ *     Y(E_c(t)) < fraction x E_other(surface of t)   and   Y(E_c(t)) < fraction x E_other(t)
  *
  * (Y the luminance) and the photon densities of W_r(t)'s halves either side of t (along x, and along y)
  * differ by at most LM_CAUSTIC_SPLIT_SIGMA standard deviations (no structure the texels would blur: a
- * focal spot's rim). E_other is the surface's mean irradiance other than the caustic photons': pi
- * Y(L_aim) / Y(kd) over its texels by area (the AIM's radiance L_aim counts all the light arriving, the
- * global map's caustic photons included) less the caustic photons' flux over its area; taken over the
- * surface rather than at t, so that a focal spot, whose light the AIM blurs into its neighbours, is not
- * measured against itself. A photon on a thin texel is carried by the lightmap layer: each texel's thin
+ * focal spot's rim). E_other(surface) is the surface's mean irradiance other than the caustic photons':
+ * pi Y(L_aim) / Y(kd) over its texels by area (the AIM's radiance L_aim counts all the light arriving, the
+ * global map's caustic photons included) less the caustic photons' flux over its area; E_other(t) the
+ * same at t (pi Y(L_aim(t)) / Y(kd(t)) - Y(E_c(t))). The surface's keeps a focal spot, whose light the AIM
+ * blurs into its neighbours, from being measured against itself; the texel's keeps a patch as bright as
+ * the light around it (a glass block's) on screen. A photon on a thin texel is carried by the lightmap layer: each texel's thin
  * photons are spread evenly over its own window's area (so their power is kept exactly). Every other
  * photon (a concentrated texel, no texel under it, a node whose indirect light is off) stays with the
  * screen pass. No light is lost or counted twice: each photon is in one of the two.
@@ -32,7 +33,7 @@
  * Cost: one pass over the photons (three vertex transforms each), one over the texels (their kd) and,
  * per chart, two summed-area tables and up to LM_CAUSTIC_SPLIT_REACH + 5 window reads a texel (OpenMP over
  * charts, each chart's sums in a fixed order, so the result does not depend on the thread count).
- * Memory: the layer (16 bytes an atlas cell), 22 bytes an atlas cell and 8 a surface of scratch, 64 bytes
+ * Memory: the layer (16 bytes an atlas cell), 26 bytes an atlas cell and 8 a surface of scratch, 64 bytes
  * a cell of the largest chart per thread, and a copy of the photons for the screen. Errors: out of memory. */
 #ifndef LM_CAUSTIC_SPLIT_H
 #define LM_CAUSTIC_SPLIT_H
@@ -52,10 +53,12 @@
  * accuracy; at 20 the focal spot's rim does (22 texels, 9 tiles), and without the test it blurs (the
  * caustic part's relative RMSE 0.13 instead of 0.08) */
 #define LM_CAUSTIC_SPLIT_SIGMA 20.0
+#define LM_CAUSTIC_SPLIT_STEP 1.0
 /* The screen filter's widening (gpu/frame/caustic_pass.h widen_levels) when the photons are split: 2x,
  * not 8x, so its reach is 10 pixels, not 40 (a lit tile is filtered with its 8 neighbours, not 24) */
 #define LM_CAUSTIC_SPLIT_WIDEN 1
-#define LM_CAUSTIC_THIN_DEFAULT 1.0f /* the fraction a frame loop splits at (update/frame_settings.h) */
+/* The fraction measured best (docs/caustics.md); frame loops split only when asked (update/frame_settings.h) */
+#define LM_CAUSTIC_THIN_SUGGESTED 0.25f
 
 typedef struct {
     float *thin;             /* atlas width x height x 4: rgb E_thin (irradiance), a 1 on covered texels of

@@ -152,14 +152,15 @@ lm_status lm_frame_passes_upload_caustics(lm_frame_passes *fp, lm_error *err)
         return LM_OK;
     const lm_caustic_hit *hits = NULL;
     lm_status st = split_caustics(fp, c, &hits, err);
-    if (st == LM_OK && !fp->caustic_pass) {
-        lm_caustic_pass_settings set = fp->set->caustic_pass;
-        if (split_on(fp)) /* the screen holds concentrated photons only: no thin light to widen over */
-            set.widen_levels = set.widen_levels < LM_CAUSTIC_SPLIT_WIDEN ? set.widen_levels : LM_CAUSTIC_SPLIT_WIDEN;
-        st = lm_caustic_pass_create(&set, &fp->caustic_pass, err);
-    }
-    if (st == LM_OK)
+    if (st == LM_OK && !fp->caustic_pass)
+        st = lm_caustic_pass_create(&fp->set->caustic_pass, &fp->caustic_pass, err);
+    if (st == LM_OK) { /* with the thin light in the lightmaps the screen holds concentrated photons: no
+                        * thin light for its filter to widen over */
+        int levels = fp->set->caustic_pass.widen_levels;
+        lm_caustic_pass_set_widening(fp->caustic_pass, fp->thin && levels > LM_CAUSTIC_SPLIT_WIDEN ? LM_CAUSTIC_SPLIT_WIDEN
+                                                                                               : levels);
         st = lm_caustic_pass_set_photons(fp->caustic_pass, hits, lm_caustics_photon_count(c), err);
+    }
     if (st == LM_OK)
         fp->caustic_version = version;
     return st;

@@ -220,7 +220,7 @@ static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflection
 {
     lm_frame_loop_settings set;
     lm_frame_loop_settings_default(&set);
-    set.caustic_thin = thin ? set.caustic_thin : 0.0f;
+    set.caustic_thin = thin ? LM_CAUSTIC_THIN_SUGGESTED : 0.0f;
     set.reflection_faces = faces;
     set.caustics = caustics;
     set.reflection_size = reflections ? set.reflection_size : 0;
@@ -258,7 +258,7 @@ static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflection
     char name[64];
     snprintf(name, sizeof name, "%s%s", caustics ? reflections ? "caustics + reflections" : "caustics"
                                         : reflections ? "reflections" : "neither",
-             caustics && !thin ? ", all on screen" : "");
+             caustics && thin ? ", thin light in lightmaps" : "");
     printf("%-34s %7.1f %5.1f %8.2f %7.2f %6.2f %7.2f %9.2f %8.2f %7.2f", name, m[P_TOTAL], 1e3 / m[P_TOTAL], m[P_PHOTONS],
            m[P_GATHER], m[P_BLEND], m[P_DIRECT], m[P_CAUSTICS], m[P_REFLECT], m[P_COMPOSITE]);
     if (faced)

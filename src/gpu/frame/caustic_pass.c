@@ -290,6 +290,11 @@ lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit 
     return lm_gl_check("caustic pass: photons", err);
 }
 
+void lm_caustic_pass_set_widening(lm_caustic_pass *cp, int levels)
+{
+    cp->set.widen_levels = levels < 0 ? 0 : levels > LM_CAUSTIC_FILTER_LEVELS ? LM_CAUSTIC_FILTER_LEVELS : levels;
+}
+
 uint32_t lm_caustic_pass_photon_count(const lm_caustic_pass *cp) { return cp->photons; }
 
 /* The view's constants the passes share: image-plane pixel area at unit distance (perspective) or the

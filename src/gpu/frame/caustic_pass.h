@@ -65,8 +65,8 @@ typedef struct {
                               up to LM_CAUSTIC_FILTER_LEVELS doublings, and where they hold more and the light
                               has structure it narrows to that many (default 32; 0: the paper's fixed filter) */
     int widen_levels;      /* the density-sized filter widens up to 2^this times, 0 to LM_CAUSTIC_FILTER_LEVELS
-                              (default LM_CAUSTIC_FILTER_LEVELS; 1 where thin light is the lightmaps' and the
-                              screen holds only concentrated photons, update/frame_passes.c) */
+                              (default LM_CAUSTIC_FILTER_LEVELS; fewer where thin light is the lightmaps' and the
+                              screen holds concentrated photons: lm_caustic_pass_set_widening) */
 } lm_caustic_pass_settings;
 
 /* The density-sized filter widens up to 2^this times. */
@@ -98,6 +98,9 @@ void lm_caustic_pass_free(lm_caustic_pass *cp);
 /* Uploads the landed photons of hits[0 .. count) (slots with zero flux skipped). */
 lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit *hits, uint32_t count, lm_error *err);
 uint32_t lm_caustic_pass_photon_count(const lm_caustic_pass *cp);
+/* From the next run on, the density-sized filter widens up to 2^levels times (clamped to 0 ..
+ * LM_CAUSTIC_FILTER_LEVELS): the photons' set decides it, not the pass's life (update/frame_passes.c). */
+void lm_caustic_pass_set_widening(lm_caustic_pass *cp, int levels);
 /* Splat, tiles and filter for `view` over the depth texture `depth` (width x height, lm_direct_depth_texture)
  * into slot `slot`'s irradiance; then, unless d is NULL, the composite into d's probe target (the probe
  * slot) or its frame's (the others), whose first pass drew the same view. Nothing at all is drawn without
