@@ -48,7 +48,7 @@ static long texel_under(const lm_scene *s, const lm_atlas *a, uint32_t t, const 
         return -1;
     int x = (int)floorf(uv[0] * (float)a->width), y = (int)floorf(uv[1] * (float)a->height);
     long best = -1;
-    for (int r = 0; r <= 1 && best < 0; r++) /* the cell itself, else the nearest of its ring */
+    for (int r = 0; r <= 1 && best < 0; r++) /* the cell itself, else the first of its ring, in a fixed order */
         for (int dy = -r; dy <= r && best < 0; dy++)
             for (int dx = -r; dx <= r && best < 0; dx++) {
                 int cx = x + dx, cy = y + dy;
@@ -77,7 +77,9 @@ static void bin_photons(const lm_caustic_hit *hits, const long *cell_of, uint32_
 }
 
 /* Per surface: the mean irradiance of its light other than the caustic photons', luminance: the AIM's
- * (pi Y(L) / Y(kd) over its texels, by area) less the caustic photons' flux over its area. */
+ * (pi Y(L) / Y(kd) over its texels, by area) less the caustic photons' flux over its area; and per covered
+ * atlas cell in local, the texel's own pi Y(L) / Y(kd). Out of memory for the sums, every surface's is 0:
+ * no texel is thin, and every photon stays on screen. */
 static void other_light(const lm_scene *s, const lm_atlas *a, const float *aim_rgb, const float *flux, double *other,
                         float *local)
 {
