@@ -166,7 +166,8 @@ lm_status lm_frame_passes_upload_caustics(lm_frame_passes *fp, lm_error *err)
     return st;
 }
 
-void lm_frame_passes_caustic_split(const lm_frame_passes *fp, uint32_t *landed, uint32_t *thin)
+/* The photons of the last upload that landed, and of those the ones the lightmaps carry. */
+static void caustic_split_counts(const lm_frame_passes *fp, uint32_t *landed, uint32_t *thin)
 {
     *landed = fp->split.landed;
     *thin = fp->thin ? fp->split.thin_photons : 0;
@@ -253,7 +254,7 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
      * the direct light's */
     o->t_caustics = t4 - t3p - o->caustic.t_wait + (own ? fp->split_seconds : 0.0);
     fp->split_seconds = own ? 0.0 : fp->split_seconds;
-    lm_frame_passes_caustic_split(fp, &o->caustic_landed, &o->caustic_thin);
+    caustic_split_counts(fp, &o->caustic_landed, &o->caustic_thin);
     o->t_gather += t3p - t3 - o->photon_gather.t_wait;
     o->t_reflections = (t2 - t1) + (t5 - t4);
     o->t_direct = (t3 - t2) + o->caustic.t_wait + o->photon_gather.t_wait + (lm_now() - t5);

@@ -45,8 +45,6 @@ lm_status lm_frame_passes_follow(lm_frame_passes *fp, lm_error *err);
  * set->caustic_thin, the thin ones' light into the composite instead (photonmap/caustic_split.h), from
  * the stage's AIM as it is now. */
 lm_status lm_frame_passes_upload_caustics(lm_frame_passes *fp, lm_error *err);
-/* The photons of the last upload that landed, and of those the ones the lightmaps carry. */
-void lm_frame_passes_caustic_split(const lm_frame_passes *fp, uint32_t *landed, uint32_t *thin);
 /* Whether the scene has caustic generators now (mirror or glass nodes with caustics on), or the caustic
  * pass holds photons: a loop that draws no frame of its own takes the newest caustic photons. */
 int lm_frame_passes_want_caustics(lm_frame_passes *fp);
