@@ -1,6 +1,7 @@
 /* The screen-space caustic pass (gpu/frame/caustic_pass.h): the caustic a mirror throws on the floor, as the
  * pass filters it on screen, against the analytic image of the light; the tiles the occlusion queries
- * find against a count of the splatted photons; the power on screen against the photons'; both filters. */
+ * find against a count of the splatted photons; the power on screen against the photons'; both filters;
+ * nothing read outside the photons' neighbourhood. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -271,6 +272,77 @@ static void test_thin_light(void **state)
     teardown(&f);
 }
 
+/* The receiver mask and the mipmaps are made only near the tiles a photon projects into: a run reads
+ * nothing outside them. After a run over the whole patch, a run over the photons of its left quarter reads
+ * the same bits whatever the first run left elsewhere (the patch's photons at 1 or 3 times their flux),
+ * at the widest filter and at the split's 2x. A view that sees no photon then reads 0 everywhere. */
+static void test_reads_only_near_photons(void **state)
+{
+    (void)state;
+    fixture f;
+    setup(&f, 1u << 14);
+    const lm_caustic_hit *hits = lm_caustics_hits(f.c);
+    uint32_t n = lm_caustics_photon_count(f.c), left = 0;
+    lm_caustic_hit *some = malloc(n * sizeof *some), *bright = malloc(n * sizeof *bright);
+    assert_true(some && bright);
+    float lo = INFINITY, hi = -INFINITY; /* the patch's extent along x; its left quarter */
+    for (uint32_t i = 0; i < n; i++)
+        if (hits[i].flux[1] > 0.0f)
+            lo = fminf(lo, hits[i].pos[0]), hi = fmaxf(hi, hits[i].pos[0]);
+    for (uint32_t i = 0; i < n; i++) {
+        some[i] = bright[i] = hits[i];
+        for (int c = 0; c < 3; c++)
+            bright[i].flux[c] *= 3.0f;
+        if (hits[i].pos[0] > lo + 0.25f * (hi - lo))
+            memset(some[i].flux, 0, sizeof some[i].flux);
+        else
+            left += hits[i].flux[1] > 0.0f;
+    }
+    static float E[2][3 * W * H];
+    lm_error err;
+    for (int widen = 1; widen <= LM_CAUSTIC_FILTER_LEVELS; widen += LM_CAUSTIC_FILTER_LEVELS - 1) {
+        lm_caustic_pass_stats st[2];
+        for (int k = 0; k < 2; k++) {
+            lm_caustic_pass *cp = NULL;
+            assert_int_equal(lm_caustic_pass_create(NULL, &cp, &err), LM_OK);
+            lm_caustic_pass_set_widening(cp, widen);
+            unsigned depth = lm_direct_depth_texture(f.d, 0);
+            assert_int_equal(lm_caustic_pass_set_photons(cp, k ? bright : hits, n, &err), LM_OK);
+            assert_int_equal(lm_caustic_pass_run(cp, 0, &f.view, depth, W, H, NULL, &st[k], &err), LM_OK);
+            assert_int_equal(lm_caustic_pass_set_photons(cp, some, n, &err), LM_OK);
+            assert_int_equal(lm_caustic_pass_run(cp, 0, &f.view, depth, W, H, NULL, &st[k], &err), LM_OK);
+            assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E[k], &err), LM_OK);
+            if (k == 1) { /* looking up, away from the floor: no photon in view */
+                lm_view up;
+                float view[16], proj[16];
+                lm_mat4_look_at(view, lm_v3(-0.15f, 4.0f, 0.0f), lm_v3(-0.15f, 8.0f, 0.0f), lm_v3(0.0f, 0.0f, -1.0f));
+                lm_mat4_perspective(proj, (float)(M_PI / 3.0), 1.0f, 0.1f, 20.0f);
+                assert_true(lm_view_from_matrices(view, proj, &up));
+                lm_caustic_pass_stats none;
+                static float Z[3 * W * H];
+                assert_int_equal(lm_caustic_pass_run(cp, 0, &up, depth, W, H, NULL, &none, &err), LM_OK);
+                assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, Z, &err), LM_OK);
+                assert_int_equal(none.tiles_lit, 0);
+                for (int i = 0; i < 3 * W * H; i++)
+                    assert_true(Z[i] == 0.0f);
+            }
+            lm_caustic_pass_free(cp);
+        }
+        double sum = 0.0;
+        for (int i = 0; i < 3 * W * H; i++)
+            sum += E[0][i];
+        print_message("widening %dx: %u photons on the left, %d of %d tiles lit, E summed %.4g; after the bright "
+                      "patch the same to the bit: %s\n", 1 << widen, left, st[0].tiles_lit, st[0].tiles, sum,
+                      memcmp(E[0], E[1], sizeof E[0]) ? "no" : "yes");
+        assert_true(st[0].tiles_lit > 0 && st[0].tiles_lit < st[0].tiles / 2);
+        assert_true(sum > 0.0);
+        assert_memory_equal(E[0], E[1], sizeof E[0]);
+    }
+    free(some);
+    free(bright);
+    teardown(&f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -278,6 +350,7 @@ int main(void)
         cmocka_unit_test(test_tiles_match_splat),
         cmocka_unit_test(test_empty_and_bad),
         cmocka_unit_test(test_thin_light),
+        cmocka_unit_test(test_reads_only_near_photons),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

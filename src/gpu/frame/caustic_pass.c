@@ -37,6 +37,9 @@ typedef struct {
     /* where the splat and the irradiance may hold anything but 0 (x0, y0, x1, y1): what the next run
      * clears, the last run's lit tiles (the whole target when new) */
     int splat_held[4], irr_held[4];
+    /* the pixel rectangles (x0, y0, x1, y1) the filter may read this run, aligned to its coarsest mip
+     * level's texels: where the receiver mask and the mipmaps are made (needed_rects) */
+    int *read_rects, read_count;
 } slot_targets;
 
 /* The pixel box of the lit tiles (clamped to the target); empty (x1 <= x0) when none. */
@@ -74,8 +77,8 @@ static void clear_box(const int box[4], int colours, int stencil)
 
 struct lm_caustic_pass {
     lm_caustic_pass_settings set;
-    GLuint splat_prog, query_prog, filter_prog, composite_prog, mask_prog;
-    GLuint vao, photon_vbo, index_buf, empty_vao, rect_vbo;
+    GLuint splat_prog, query_prog, filter_prog, composite_prog, mask_prog, mip_prog;
+    GLuint vao, photon_vbo, index_buf, empty_vao, rect_vbo, mip_fbo;
     uint32_t photons;
     float *pos;             /* the photons' positions (3 floats each), for the frustum test of each run */
     uint32_t *visible;      /* scratch: the indices of the photons in a run's view frustum */
@@ -96,6 +99,7 @@ static void free_slot(slot_targets *t)
         glDeleteQueries(t->tiles_x * t->tiles_y, t->queries);
     free(t->lit);
     free(t->queries);
+    free(t->read_rects);
     memset(t, 0, sizeof *t);
 }
 
@@ -127,7 +131,8 @@ static lm_status make_slot(lm_caustic_pass *cp, slot_targets *t, int w, int h, l
     int n = t->tiles_x * t->tiles_y;
     t->lit = calloc((size_t)n, 1);
     t->queries = calloc((size_t)n, sizeof *t->queries);
-    if (!t->lit || !t->queries) {
+    t->read_rects = malloc((size_t)n * 4 * sizeof *t->read_rects);
+    if (!t->lit || !t->queries || !t->read_rects) {
         free_slot(t);
         return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %d tiles", n);
     }
@@ -181,6 +186,8 @@ static lm_status build_programs(lm_caustic_pass *cp, lm_error *err)
         st = lm_gl_program("caustic composite", lm_glsl_caustic_rect_vs, lm_glsl_caustic_composite_fs, &cp->composite_prog, err);
     if (st == LM_OK)
         st = lm_gl_program("caustic mask", lm_glsl_caustic_rect_vs, lm_glsl_caustic_mask_fs, &cp->mask_prog, err);
+    if (st == LM_OK)
+        st = lm_gl_program("caustic mipmaps", lm_glsl_caustic_rect_vs, lm_glsl_caustic_mip_fs, &cp->mip_prog, err);
     return st;
 }
 
@@ -213,6 +220,7 @@ lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic
         glGenBuffers(1, &cp->photon_vbo);
         glGenBuffers(1, &cp->index_buf);
         glGenBuffers(1, &cp->rect_vbo);
+        glGenFramebuffers(1, &cp->mip_fbo);
         glBindVertexArray(cp->vao);
         glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, cp->index_buf); /* the VAO keeps it */
         glBindBuffer(GL_ARRAY_BUFFER, cp->photon_vbo);
@@ -238,8 +246,9 @@ void lm_caustic_pass_free(lm_caustic_pass *cp)
         return;
     for (int i = 0; i < LM_CAUSTIC_SLOTS; i++)
         free_slot(&cp->slots[i]);
-    GLuint progs[5] = {cp->splat_prog, cp->query_prog, cp->filter_prog, cp->composite_prog, cp->mask_prog};
-    for (int i = 0; i < 5; i++)
+    GLuint progs[6] = {cp->splat_prog, cp->query_prog, cp->filter_prog, cp->composite_prog, cp->mask_prog,
+                       cp->mip_prog};
+    for (int i = 0; i < 6; i++)
         if (progs[i])
             glDeleteProgram(progs[i]);
     if (cp->vao) {
@@ -248,6 +257,7 @@ void lm_caustic_pass_free(lm_caustic_pass *cp)
         glDeleteBuffers(1, &cp->photon_vbo);
         glDeleteBuffers(1, &cp->index_buf);
         glDeleteBuffers(1, &cp->rect_vbo);
+        glDeleteFramebuffers(1, &cp->mip_fbo);
     }
     free(cp->rects);
     free(cp->pos);
@@ -379,14 +389,14 @@ static uint32_t visible_photons(lm_caustic_pass *cp, slot_targets *t, const floa
     return n;
 }
 
-/* The receiver mask into the splat's irr alpha over the whole target (its rgb and the flux target kept):
- * 1 where the pixel's kd is not 0 (every pixel when kd is 0, no frame targets). */
+/* The receiver mask into the splat's irr alpha over the rectangles the filter reads (its rgb and the flux
+ * target kept): 1 where the pixel's kd is not 0 (every pixel when kd is 0, no frame targets). */
 static void receiver_mask(lm_caustic_pass *cp, const slot_targets *t, GLuint kd)
 {
     GLuint p = cp->mask_prog;
     glUseProgram(p);
     set_size(p, t->width, t->height);
-    glUniform4f(glGetUniformLocation(p, "rect"), 0.0f, 0.0f, (float)t->width, (float)t->height);
+    GLint rect = glGetUniformLocation(p, "rect");
     glUniform1i(glGetUniformLocation(p, "have_kd"), kd != 0);
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(GL_TEXTURE_2D, kd);
@@ -394,7 +404,11 @@ static void receiver_mask(lm_caustic_pass *cp, const slot_targets *t, GLuint kd)
     glColorMaski(0, GL_FALSE, GL_FALSE, GL_FALSE, GL_TRUE);
     glColorMaski(1, GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     glBindVertexArray(cp->empty_vao);
-    glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    for (int i = 0; i < t->read_count; i++) {
+        const int *r = t->read_rects + 4 * i;
+        glUniform4f(rect, (float)r[0], (float)r[1], (float)r[2], (float)r[3]);
+        glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+    }
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
@@ -406,8 +420,9 @@ static GLuint slot_kd(const lm_direct *d, int slot)
     return lm_frame_targets_kd(lm_direct_targets(d), slot == LM_CAUSTIC_SLOT_PROBE ? LM_FRAME_PROBE : LM_FRAME_VIEW);
 }
 
+/* Splats the n photons visible_photons listed. */
 static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view, const view_consts *vc, GLuint depth,
-                       GLuint kd, lm_caustic_pass_stats *st)
+                       GLuint kd, uint32_t n, lm_caustic_pass_stats *st)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, t->splat_fbo);
     glViewport(0, 0, t->width, t->height);
@@ -439,7 +454,6 @@ static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view
     glUniform1i(glGetUniformLocation(p, "kd"), 1);
     glUniform1i(glGetUniformLocation(p, "have_kd"), kd != 0);
     glActiveTexture(GL_TEXTURE0);
-    uint32_t n = visible_photons(cp, t, vc->view_proj);
     glBindVertexArray(cp->vao);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)(n ? n : 1) * sizeof *cp->visible), cp->visible,
                  GL_STREAM_DRAW);
@@ -506,6 +520,93 @@ static int near_lit(const slot_targets *t, int tx, int ty, int d)
     return 0;
 }
 
+/* The coarsest mip level the filter reads (0: none, the paper's fixed filter): filter_scale's density window
+ * at the widest scale, level widen_levels + ceil(log2(2k + 1)) (caustic_filter_head.glsl). */
+static int top_level(const lm_caustic_pass *cp)
+{
+    if (cp->set.filter_photons <= 0)
+        return 0;
+    int lw = 0;
+    while ((1 << lw) < 2 * cp->set.filter_k + 1)
+        lw++;
+    return cp->set.widen_levels + lw;
+}
+
+/* Whether any of tile column tx's tiles in rows ty .. ty + band - 1 is within d tiles of a lit one. */
+static int needed_column(const slot_targets *t, int tx, int ty, int band, int d)
+{
+    for (int y = ty; y < ty + band && y < t->tiles_y; y++)
+        if (near_lit(t, tx, y, d))
+            return 1;
+    return 0;
+}
+
+/* t->read_rects: the pixels the filter may read this run, from the tiles a photon projects into
+ * (visible_photons' flags), as runs of tiles along bands of tile rows (one row, or as many as one texel
+ * of the coarsest mip level read spans), each widened to whole texels of that level (so every texel of every level there is made from texels made too). The filter
+ * runs on tiles within LM_CAUSTIC_FILTER_REACH_AT of a lit one (grown_tiles) and reads within that reach
+ * of them, and its density window, bilinearly at the coarsest level, reads 1.5 of that level's texels
+ * from the pixel; the fixed filter grows each lit tile by k and reads k further. */
+static void needed_rects(const lm_caustic_pass *cp, slot_targets *t)
+{
+    int T = cp->set.tile, k = cp->set.filter_k, top = top_level(cp), px;
+    if (cp->set.filter_photons > 0) {
+        int reach = LM_CAUSTIC_FILTER_REACH_AT(k, cp->set.widen_levels), window = 3 << top >> 1;
+        px = (reach + T - 1) / T * T + (reach > window ? reach : window);
+    } else {
+        px = 2 * k;
+    }
+    int d = (px + T - 1) / T, align = 1 << top, band = align > T ? align / T : 1; /* tile rows a rect spans */
+    t->read_count = 0;
+    for (int ty = 0; ty < t->tiles_y; ty += band)
+        for (int tx = 0; tx < t->tiles_x;) {
+            int end = tx;
+            while (end < t->tiles_x && needed_column(t, end, ty, band, d))
+                end++;
+            if (end == tx) {
+                tx++;
+                continue;
+            }
+            int *r = t->read_rects + 4 * t->read_count++;
+            r[0] = tx * T / align * align, r[1] = ty * T / align * align;
+            r[2] = (end * T + align - 1) / align * align, r[3] = ((ty + band) * T + align - 1) / align * align;
+            r[2] = r[2] < t->width ? r[2] : t->width, r[3] = r[3] < t->height ? r[3] : t->height;
+            tx = end;
+        }
+}
+
+/* Mip levels 1 .. top_level of the splat texture tex over t->read_rects only: glGenerateMipmap would make
+ * every level over the whole target, most of the pass's fixed cost once the lit tiles are few. */
+static void mip_region(lm_caustic_pass *cp, const slot_targets *t, GLuint tex)
+{
+    int top = top_level(cp);
+    glUseProgram(cp->mip_prog);
+    glUniform1i(glGetUniformLocation(cp->mip_prog, "src"), 0);
+    GLint rect = glGetUniformLocation(cp->mip_prog, "rect");
+    glBindFramebuffer(GL_FRAMEBUFFER, cp->mip_fbo);
+    glBindVertexArray(cp->empty_vao);
+    glActiveTexture(GL_TEXTURE0);
+    glBindTexture(GL_TEXTURE_2D, tex);
+    for (int level = 1; level <= top && (t->width >> level) > 0 && (t->height >> level) > 0; level++) {
+        int w = t->width >> level, h = t->height >> level;
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, tex, level);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, level - 1);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, level - 1);
+        glViewport(0, 0, w, h);
+        set_size(cp->mip_prog, w, h);
+        for (int i = 0; i < t->read_count; i++) {
+            const int *r = t->read_rects + 4 * i;
+            int x1 = (r[2] + (1 << level) - 1) >> level, y1 = (r[3] + (1 << level) - 1) >> level;
+            glUniform4f(rect, (float)(r[0] >> level), (float)(r[1] >> level), (float)(x1 < w ? x1 : w),
+                        (float)(y1 < h ? y1 : h));
+            glDrawArrays(GL_TRIANGLE_STRIP, 0, 4);
+        }
+    }
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_BASE_LEVEL, 0);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAX_LEVEL, 1000);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, 0, 0);
+}
+
 /* The filter's squares as triangles (pixel coordinates) into cp->rects, *count of them; their box in box.
  * The fixed filter: each lit tile grown by k pixels. Sized by density, the filter reaches
  * LM_CAUSTIC_FILTER_REACH(k) pixels: every tile within that of a lit one, each once (grown squares
@@ -545,6 +646,8 @@ static lm_status grown_tiles(lm_caustic_pass *cp, const slot_targets *t, int *co
 static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, GLuint depth, int count,
                    const int box[4])
 {
+    for (int i = 0; i < 2 && count && cp->set.filter_photons > 0; i++) /* the splat's means over 2^L pixels */
+        mip_region(cp, t, t->splat_tex[i]);
     glBindFramebuffer(GL_FRAMEBUFFER, t->irr_fbo);
     glViewport(0, 0, t->width, t->height);
     clear_box(t->irr_held, 1, 0);
@@ -564,8 +667,6 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
     for (int i = 0; i < 3; i++) {
         glActiveTexture(GL_TEXTURE0 + (GLenum)i);
         glBindTexture(GL_TEXTURE_2D, tex[i]);
-        if (i < 2 && cp->set.filter_photons > 0) /* the splat's means over 2^L pixels, for the density-sized filter */
-            glGenerateMipmap(GL_TEXTURE_2D);
         glUniform1i(glGetUniformLocation(p, names[i]), i);
     }
     glBindVertexArray(cp->empty_vao);
@@ -620,7 +721,12 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
         return lm_fail(err, LM_ERR_INVALID, "caustic pass: the view's projection cannot be inverted");
     slot_targets *t = &cp->slots[slot];
     lm_status s = make_slot(cp, t, width, height, err);
-    if (s != LM_OK || !cp->photons) {
+    /* no photon in the view (an environment map face that sees no focal spot): no GL work at all */
+    uint32_t visible = s == LM_OK && cp->photons ? visible_photons(cp, t, vc.view_proj) : 0;
+    if (visible)
+        needed_rects(cp, t);
+    if (s != LM_OK || !visible) {
+        st.tiles = s == LM_OK ? t->tiles_x * t->tiles_y : 0;
         if (s == LM_OK && t->irr_fbo) { /* nothing lights the slot: its irradiance is 0 */
             memset(t->lit, 0, (size_t)(t->tiles_x * t->tiles_y));
             t->lit_count = 0;
@@ -637,7 +743,7 @@ lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view
     glFinish(); /* the times below are the pass's own, not the frame's work before it */
     double t0 = lm_now();
     st.t_wait = t0 - tw;
-    splat(cp, t, view, &vc, depth, slot_kd(d, slot), &st); /* its query's result waits for the splat */
+    splat(cp, t, view, &vc, depth, slot_kd(d, slot), visible, &st); /* its query's result waits for the splat */
     double t1 = lm_now();
     query_tiles(cp, t, &st);
     double t2 = lm_now();

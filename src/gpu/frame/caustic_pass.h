@@ -35,16 +35,20 @@
  *            over three standard deviations: an edge, a focal spot), the screen filter's taps close in,
  *            down to 1/16 pixel apart, until it holds about filter_photons: the spot as sharp as its
  *            photons allow, while an even patch keeps the whole filter and its low noise.
- *            Elsewhere E is 0.
+ *            Elsewhere E is 0. The receiver mask (splat.a: kd > 0) and the mipmaps are made only over
+ *            the tiles the filter may read, those within its reach and its density window's of a tile a
+ *            photon projects into, widened to whole texels of the coarsest level read: a few lit tiles
+ *            pay for their neighbourhood, not for the screen.
  *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
  *            lobe the direct light's first pass wrote there: frame_targets.h).
  *
  * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
  * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
  * application renders (_VIEW).
+ * A view no photon projects into (an environment map face that sees no focal spot) costs no GL work.
  * Cost: one point per photon, one query quad per tile a photon projects into, (2k + 1)^2 texture reads
  * per filtered pixel (and up to LM_CAUSTIC_FILTER_LEVELS + 5 to size it, four of them the structure test,
- * plus the splat's mipmaps once a run), two per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a
+ * plus the splat's mipmaps there once a run), two per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a
  * current GL context; not thread-safe. */
 #ifndef LM_CAUSTIC_PASS_H
 #define LM_CAUSTIC_PASS_H
