@@ -237,11 +237,11 @@ static inline int lmgi_knob_is_pow2(double v)
       "screen (default, the paper's filter) or world (by world distance)")                                        \
     X(caustics, tile, LMGI_KNOB_INT, int, 32, 4, 256, 0, LMGI_NO_RULE, "--caustic-tile", "N", LMGI_CLI_ZERO_NONE, \
       LMGI_NO_CHOICES, LMGI_NO_SWEEP, "screen tile side of the caustics' occlusion queries (default 32)")         \
-    X(caustics, thin, LMGI_KNOB_REAL, float, LMGI_OFF, 0.001, 1000, 1, LMGI_NO_RULE, "--caustic-thin", "F",       \
+    X(caustics, thin, LMGI_KNOB_REAL, float, 0.25, 0.001, 1000, 1, LMGI_NO_RULE, "--caustic-thin", "F",       \
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
       "caustic light under F x its surface's and its texel's other light,\n"                                     \
       "without sharp structure, is carried by the lightmaps and only the rest\n"                                 \
-      "filtered on screen (0.25 measured best; default off: every photon on\n"                                   \
+      "filtered on screen (default 0.25, measured best; 0: every photon on\n"                                   \
       "screen, the paper's; docs/caustics.md, \"Thin light in the lightmaps\")")
 
 /* the frame each lmgi_update composites: its reflections and shadow maps */

@@ -1,7 +1,8 @@
 /* The caustic photons' split between the lightmaps and the screen (photonmap/caustic_split.h) on the
  * 20 x 20 plane at 0.25 texels: a thin, even field of photons and a dense spot, the plane's other light
  * given as its AIM. Power kept to rounding, the spot the screen's, the field the lightmaps' at its analytic
- * irradiance, the fraction and the other light deciding, and the same bits every run. */
+ * irradiance, the fraction and the other light deciding, light gathered in a window left on screen, and the
+ * same bits every run. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -204,6 +205,46 @@ static void test_other_light_decides(void **state)
     lm_caustic_split_free(&sp);
 }
 
+/* A fan a few texels across in sparse light: 80 photons within 0.3 m of (-4, -4) among 2,000 spread over
+ * the plane (0.3 a texel, so a window gathers its 128 photons 6 texels out). Both are thin next to the
+ * plane's light, but spread over the clump's window its power would leave the clump (the grazing hard
+ * case's fan): the clump is the screen's, the sparse field away from it the lightmaps'. */
+static void test_light_gathered_in_a_window_stays_on_screen(void **state)
+{
+    (void)state;
+    enum { SPARSE = 2000, CLUMP = 80 };
+    static lm_caustic_hit few[SPARSE + CLUMP];
+    const lm_scene *s = pipe_.s;
+    const double e = 0.005, flux = e * 400.0 / SPARSE;
+    for (uint32_t i = 0; i < SPARSE; i++)
+        put(&few[i], s, -10.0f + 20.0f * (float)lm_halton(0, i + 1), -10.0f + 20.0f * (float)lm_halton(1, i + 1),
+            (float)flux);
+    for (uint32_t i = 0; i < CLUMP; i++) {
+        double r = 0.3 * sqrt(lm_halton(0, i + 1)), phi = 2.0 * M_PI * lm_halton(1, i + 1);
+        put(&few[SPARSE + i], s, (float)(-4.0 + r * cos(phi)), (float)(-4.0 + r * sin(phi)), (float)flux);
+    }
+    lm_caustic_split sp;
+    lm_error err;
+    memset(&sp, 0, sizeof sp);
+    float *aim = aim_of(1.0);
+    assert_int_equal(lm_caustic_split_make(s, &pipe_.atlas, aim, few, SPARSE + CLUMP, 1.0f, &sp, &err), LM_OK);
+    free(aim);
+    uint32_t clump_on_screen = 0, far = 0, far_thin = 0;
+    for (uint32_t i = 0; i < SPARSE + CLUMP; i++) {
+        double dx = few[i].pos[0] + 4.0, dz = few[i].pos[2] + 4.0;
+        int thin = sp.screen[i].flux[1] == 0.0f;
+        if (i >= SPARSE)
+            clump_on_screen += (uint32_t)!thin;
+        else if (sqrt(dx * dx + dz * dz) > 2.0 && fabs(few[i].pos[0]) < 8.0f && fabs(few[i].pos[2]) < 8.0f)
+            far++, far_thin += (uint32_t)thin;
+    }
+    print_message("a clump of %d photons in sparse light: %u of them on screen; %u of %u sparse photons 2 away thin\n",
+                  CLUMP, clump_on_screen, far_thin, far);
+    assert_int_equal(clump_on_screen, CLUMP);
+    assert_int_equal(far_thin, far);
+    lm_caustic_split_free(&sp);
+}
+
 static void test_deterministic(void **state)
 {
     (void)state;
@@ -222,6 +263,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_field_to_lightmaps_spot_to_screen),
         cmocka_unit_test(test_other_light_decides),
+        cmocka_unit_test(test_light_gathered_in_a_window_stays_on_screen),
         cmocka_unit_test(test_deterministic),
     };
     lmt_filter_from_env();

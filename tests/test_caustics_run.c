@@ -183,9 +183,9 @@ static void test_glass_block(void **state)
     lmgi_context_free(ctx);
 }
 
-/* The caustic light split (docs/caustics.md, "Thin light in the lightmaps"): with caustics.thin 0.25 the
- * photons whose light is thin next to the floor's other light are carried by the lightmaps, the rest by the
- * screen pass; by default (off) every photon is the screen's. The same photons land; the caustics a picture shows (lmgi_get_caustics:
+/* The caustic light split (docs/caustics.md, "Thin light in the lightmaps"): by default (caustics.thin 0.25)
+ * the photons whose light is thin next to the floor's other light are carried by the lightmaps, the rest by
+ * the screen pass; with it off every photon is the screen's. The same photons land; the caustics a picture shows (lmgi_get_caustics:
  * the screen's plus the lightmaps' at each pixel) and the frame agree. (The tiles it spares: test_cli's
  * test_run_caustic_tiles.) */
 static void test_thin_light_in_the_lightmaps(void **state)
@@ -203,7 +203,7 @@ static void test_thin_light_in_the_lightmaps(void **state)
         d.frame.width = d.frame.height = SIDE;
         d.in_order = 1;
         d.caustics.photons = 8192;
-        d.caustics.thin = k ? 0.0f : 0.25f; /* the default (off) for k = 1 */
+        d.caustics.thin = k ? LMGI_OFF : 0.0f; /* the default (0.25) for k = 0 */
         lmgi_error e;
         if (lmgi_updater_create(ctx, sc[k], &d, &u[k], &e) != LMGI_OK)
             fail_msg("%s", e.message);

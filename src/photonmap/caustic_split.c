@@ -179,6 +179,25 @@ static int has_structure(const chart_sums *cs, int x, int y, int r)
     return 0;
 }
 
+/* Whether the light in the window of half side r around (x, y) is gathered into its middle: the photon
+ * density of the middle (half side r / 2) is over 1 + LM_CAUSTIC_SPLIT_GATHERED times the whole window's,
+ * by more than LM_CAUSTIC_SPLIT_GATHERED_SIGMA standard deviations of the middle's binomial count under an
+ * even density. The window is then wider than the light: spread evenly over it, a fan or a spot a few
+ * texels across would be carried out of itself (a lamp's reflection at grazing incidence, falling as
+ * 1 / d^3). Light that changes linearly across the window is spread without error, and a dark middle (a
+ * shadow in thin light) is only blurred, so neither keeps the light on screen. */
+static int gathered_in_middle(const chart_sums *cs, int x, int y, int r)
+{
+    if (r < 1)
+        return 0;
+    double v[S_COUNT], mid[S_COUNT];
+    box(cs, x - r, y - r, x + r, y + r, v);
+    box(cs, x - r / 2, y - r / 2, x + r / 2, y + r / 2, mid);
+    double p = v[S_AREA] > 0.0 ? mid[S_AREA] / v[S_AREA] : 0.0, want = v[S_PHOTONS] * p, got = mid[S_PHOTONS];
+    return p > 0.0 && p < 1.0 && got > (1.0 + LM_CAUSTIC_SPLIT_GATHERED) * want &&
+           got - want > LM_CAUSTIC_SPLIT_GATHERED_SIGMA * sqrt(want * (1.0 - p));
+}
+
 /* The chart's texels: each one's window half side + 1 (0: no photon within the widest) and whether it is
  * thin next to its surface's other light. */
 static void classify(const lm_atlas *a, const chart_sums *cs, const double *other, const float *local, float fraction,
@@ -202,7 +221,8 @@ static void classify(const lm_atlas *a, const chart_sums *cs, const double *othe
             int surface = a->texels[a->texel_index[cell]].surface;
             float y_c = lm_luminance(ec);
             thin[cell] = radius[cell] && v[S_AREA] > 0.0 && y_c < fraction * other[surface] &&
-                         y_c < fraction * fmaxf(local[cell] - y_c, 0.0f) && !has_structure(cs, x, y, r > 1 ? r : 1);
+                         y_c < fraction * fmaxf(local[cell] - y_c, 0.0f) && !has_structure(cs, x, y, r > 1 ? r : 1) &&
+                         !gathered_in_middle(cs, x, y, r);
         }
 }
 

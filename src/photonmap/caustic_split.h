@@ -18,9 +18,10 @@
  *
  *     Y(E_c(t)) < fraction x E_other(surface of t)   and   Y(E_c(t)) < fraction x E_other(t)
  *
- * (Y the luminance) and the photon densities of W_r(t)'s halves either side of t (along x, and along y)
+ * (Y the luminance), the photon densities of W_r(t)'s halves either side of t (along x, and along y)
  * differ by at most LM_CAUSTIC_SPLIT_SIGMA standard deviations (no structure the texels would blur: a
- * focal spot's rim). E_other(surface) is the surface's mean irradiance other than the caustic photons':
+ * focal spot's rim), and W_r(t)'s middle is not much denser than W_r(t) (LM_CAUSTIC_SPLIT_GATHERED: the
+ * window is not wider than the light in it, as for a fan at grazing incidence a few texels across). E_other(surface) is the surface's mean irradiance other than the caustic photons':
  * pi Y(L_aim) / Y(kd) over its texels by area (the AIM's radiance L_aim counts all the light arriving, the
  * global map's caustic photons included) less the caustic photons' flux over its area; E_other(t) the
  * same at t (pi Y(L_aim(t)) / Y(kd(t)) - Y(E_c(t))). The surface's keeps a focal spot, whose light the AIM
@@ -31,7 +32,7 @@
  * screen pass. No light is lost or counted twice: each photon is in one of the two.
  *
  * Cost: one pass over the photons (three vertex transforms each), one over the texels (their kd) and,
- * per chart, two summed-area tables and up to LM_CAUSTIC_SPLIT_REACH + 5 window reads a texel (OpenMP over
+ * per chart, two summed-area tables and up to LM_CAUSTIC_SPLIT_REACH + 7 window reads a texel (OpenMP over
  * charts, each chart's sums in a fixed order, so the result does not depend on the thread count).
  * Memory: the layer (16 bytes an atlas cell), 26 bytes an atlas cell and 8 a surface of scratch, 64 bytes
  * a cell of the largest chart per thread, and a copy of the photons for the screen. Errors: out of memory. */
@@ -54,11 +55,17 @@
  * caustic part's relative RMSE 0.13 instead of 0.08) */
 #define LM_CAUSTIC_SPLIT_SIGMA 20.0
 #define LM_CAUSTIC_SPLIT_STEP 1.0
+/* How much denser than its whole window a window's middle may be and its light still be thin (over
+ * 1 + this times the window's density), and by how many standard deviations (caustic_split.c,
+ * gathered_in_middle). At 0.5 the grazing hard case read 1.01 of the reference and the Cornell showcase
+ * lit 52 of 256 tiles; at 1, 0.94 and 12; at 2 the fan was thin (0.17). */
+#define LM_CAUSTIC_SPLIT_GATHERED 1.0
+#define LM_CAUSTIC_SPLIT_GATHERED_SIGMA 4.0
 /* The screen filter's widening (gpu/frame/caustic_pass.h widen_levels) when the photons are split: 2x,
  * not 8x, so its reach is 10 pixels, not 40 (a lit tile is filtered with its 8 neighbours, not 24) */
 #define LM_CAUSTIC_SPLIT_WIDEN 1
-/* The fraction measured best (docs/caustics.md); frame loops split only when asked (update/frame_settings.h) */
-#define LM_CAUSTIC_THIN_SUGGESTED 0.25f
+/* The fraction measured best, the default (docs/caustics.md; include/lmgi_knobs.h says it too) */
+#define LM_CAUSTIC_THIN_DEFAULT 0.25f
 
 typedef struct {
     float *thin;             /* atlas width x height x 4: rgb E_thin (irradiance), a 1 on covered texels of

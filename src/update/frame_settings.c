@@ -22,7 +22,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s)
     s->reflection_faces = 1;
     s->caustics = 1;
     lm_caustic_pass_settings_default(&s->caustic_pass);
-    s->caustic_thin = 0.0f; /* off: issue 37's grazing hard case, docs/caustics.md */
+    s->caustic_thin = LM_CAUSTIC_THIN_DEFAULT;
     s->indirect = 1;
     s->indirect_path = LM_INDIRECT_LIGHTMAP;
     lm_photon_gather_settings_default(&s->photon_gather);

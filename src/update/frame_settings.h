@@ -46,7 +46,7 @@ typedef struct {
     lm_caustic_pass_settings caustic_pass;
     float caustic_thin;    /* with the lightmap path: caustic light under this x a texel's other light is carried
                             * by the lightmaps, the rest by the screen pass (photonmap/caustic_split.h;
-                            * LM_CAUSTIC_THIN_SUGGESTED; default 0: every photon on screen, the paper's) */
+                            * default LM_CAUSTIC_THIN_DEFAULT; 0: every photon on screen, the paper's) */
     int indirect;          /* 0: no indirect light at all (no photon, AIM or gather work; the frame shows direct
                             * light, emission and reflections); default 1. stage.trace follows it */
     int indirect_path;     /* how the frame gets its indirect light: LM_INDIRECT_LIGHTMAP (default: AIMs, the

@@ -220,7 +220,7 @@ static void print_frames(lmgi_scene *sc, int faces, int caustics, int reflection
 {
     lm_frame_loop_settings set;
     lm_frame_loop_settings_default(&set);
-    set.caustic_thin = thin ? LM_CAUSTIC_THIN_SUGGESTED : 0.0f;
+    set.caustic_thin = thin ? LM_CAUSTIC_THIN_DEFAULT : 0.0f;
     set.reflection_faces = faces;
     set.caustics = caustics;
     set.reflection_size = reflections ? set.reflection_size : 0;
