@@ -172,26 +172,24 @@ static int has_structure(const chart_sums *cs, int x, int y, int r)
         if (!(a0 > 0.0) || !(a1 > 0.0) || n0 + n1 < LM_CAUSTIC_SPLIT_PHOTONS)
             continue;
         double d0 = n0 / a0, d1 = n1 / a1;
-        if (fabs(d0 - d1) > LM_CAUSTIC_SPLIT_SIGMA * sqrt(n0 / (a0 * a0) + n1 / (a1 * a1)) &&
-            fmax(d0, d1) > LM_CAUSTIC_SPLIT_STEP * fmin(d0, d1))
+        if (fabs(d0 - d1) > LM_CAUSTIC_SPLIT_SIGMA * sqrt(n0 / (a0 * a0) + n1 / (a1 * a1)))
             return 1;
     }
     return 0;
 }
 
-/* Whether the light in the window of half side r around (x, y) is gathered into its middle: the photon
+/* Whether the light in the window of half side r around (x, y), whose sums are v, is gathered into its middle: the photon
  * density of the middle (half side r / 2) is over 1 + LM_CAUSTIC_SPLIT_GATHERED times the whole window's,
  * by more than LM_CAUSTIC_SPLIT_GATHERED_SIGMA standard deviations of the middle's binomial count under an
  * even density. The window is then wider than the light: spread evenly over it, a fan or a spot a few
  * texels across would be carried out of itself (a lamp's reflection at grazing incidence, falling as
  * 1 / d^3). Light that changes linearly across the window is spread without error, and a dark middle (a
  * shadow in thin light) is only blurred, so neither keeps the light on screen. */
-static int gathered_in_middle(const chart_sums *cs, int x, int y, int r)
+static int gathered_in_middle(const chart_sums *cs, int x, int y, int r, const double v[S_COUNT])
 {
     if (r < 1)
         return 0;
-    double v[S_COUNT], mid[S_COUNT];
-    box(cs, x - r, y - r, x + r, y + r, v);
+    double mid[S_COUNT];
     box(cs, x - r / 2, y - r / 2, x + r / 2, y + r / 2, mid);
     double p = v[S_AREA] > 0.0 ? mid[S_AREA] / v[S_AREA] : 0.0, want = v[S_PHOTONS] * p, got = mid[S_PHOTONS];
     return p > 0.0 && p < 1.0 && got > (1.0 + LM_CAUSTIC_SPLIT_GATHERED) * want &&
@@ -222,7 +220,7 @@ static void classify(const lm_atlas *a, const chart_sums *cs, const double *othe
             float y_c = lm_luminance(ec);
             thin[cell] = radius[cell] && v[S_AREA] > 0.0 && y_c < fraction * other[surface] &&
                          y_c < fraction * fmaxf(local[cell] - y_c, 0.0f) && !has_structure(cs, x, y, r > 1 ? r : 1) &&
-                         !gathered_in_middle(cs, x, y, r);
+                         !gathered_in_middle(cs, x, y, r, v);
         }
 }
 

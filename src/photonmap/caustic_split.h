@@ -54,7 +54,6 @@
  * accuracy; at 20 the focal spot's rim does (22 texels, 9 tiles), and without the test it blurs (the
  * caustic part's relative RMSE 0.13 instead of 0.08) */
 #define LM_CAUSTIC_SPLIT_SIGMA 20.0
-#define LM_CAUSTIC_SPLIT_STEP 1.0
 /* How much denser than its whole window a window's middle may be and its light still be thin (over
  * 1 + this times the window's density), and by how many standard deviations (caustic_split.c,
  * gathered_in_middle). At 0.5 the grazing hard case read 1.01 of the reference and the Cornell showcase

@@ -154,10 +154,7 @@ lm_status lm_composite_indirect(lm_composite *c, unsigned iim_tex, unsigned *lit
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glActiveTexture(GL_TEXTURE1);
     glBindTexture(GL_TEXTURE_2D, c->lit.color[0]);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR); /* sampled with the bilinear filter */
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    lm_texture_linear_clamped(); /* sampled with the bilinear filter */
     glActiveTexture(GL_TEXTURE0);
     *lit_tex = c->lit.color[0];
     return lm_gl_check("composite: indirect", err);
@@ -173,10 +170,7 @@ lm_status lm_composite_set_caustics(lm_composite *c, const float *thin, lm_error
     }
     if (!c->thin_tex) { /* the premultiply pass reads it texel by texel, a view of it bilinearly */
         c->thin_tex = lm_float_texture(c->width, c->height, thin);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        lm_texture_linear_clamped();
     } else {
         glBindTexture(GL_TEXTURE_2D, c->thin_tex);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);

@@ -15,6 +15,7 @@
 #include "../../scene/sky.h"
 #include "direct_mesh.h"
 #include "../gl/gl_shader.h"
+#include "../gl/offscreen.h"
 #include "glsl.h"
 #include "shadow_maps.h"
 #include "sky_pass.h"
@@ -673,10 +674,7 @@ lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *
     if (!d->coverage_tex) {
         glGenTextures(1, &d->coverage_tex);
         glBindTexture(GL_TEXTURE_2D, d->coverage_tex);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        lm_texture_linear_clamped();
     }
     glBindTexture(GL_TEXTURE_2D, d->coverage_tex);
     glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, a->width, a->height, 0, GL_RGBA, GL_FLOAT, rgba);

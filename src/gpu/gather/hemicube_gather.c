@@ -14,6 +14,7 @@
 #include "../gl/gl_context.h"
 #include "../gl/gl_mesh.h"
 #include "../gl/gl_shader.h"
+#include "../gl/offscreen.h"
 #include "gather_passes.h"
 #include "hemicube_shaders.h"
 #include "../../trace/emitter_light.h"
@@ -361,10 +362,7 @@ lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float
         glGenTextures(1, &g->aim_tex);
         glBindTexture(GL_TEXTURE_2D, g->aim_tex);
         glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA32F, a->width, a->height);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        lm_texture_linear_clamped();
         g->aim_w = a->width, g->aim_h = a->height;
     }
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);

@@ -18,6 +18,14 @@ unsigned lm_float_texture(int w, int h, const float *rgba)
     return tex;
 }
 
+void lm_texture_linear_clamped(void)
+{
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+}
+
 void lm_offscreen_release(lm_offscreen *o)
 {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

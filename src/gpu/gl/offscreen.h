@@ -26,6 +26,9 @@ void lm_offscreen_release(lm_offscreen *o);
 /* A new w x h RGBA32F texture, nearest filtered, holding rgba (w*h*4 floats, row 0 first) or, for NULL,
  * undefined texels; left bound to GL_TEXTURE_2D. */
 unsigned lm_float_texture(int w, int h, const float *rgba);
+/* The bound GL_TEXTURE_2D sampled bilinearly and clamped at its edges (an atlas or a picture read between
+ * its texels). */
+void lm_texture_linear_clamped(void);
 
 /* A persistent float target for per-frame passes: 1 to 3 RGBA32F colour textures (sampleable, e.g. by
  * a later pass) and a 24-bit depth texture (sampleable: the caustic pass reads it), kept between frames
