@@ -94,6 +94,9 @@ unsigned lm_direct_radiance_texture(const lm_direct *d);
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
  * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */
 void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);
+/* Whether the view's draws write its G-buffer (lm_direct_gbuffer_texture): on from lm_direct_create; off
+ * leaves it as the last draw that wrote it, for a frame without per-pixel photon gathers. */
+void lm_direct_write_gbuffer(lm_direct *d, int on);
 /* For the per-pixel photon gathers, with no indirect term set: coverage (one float per atlas texel, NULL:
  * none) is the part of the gathers' kernel on each texel's surface, c (photonmap/aim.h
  * lm_aim_kernel_coverage). The first pass then writes 1 / c, taken over the valid texels of the pixel's

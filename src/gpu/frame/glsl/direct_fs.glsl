@@ -39,9 +39,11 @@ out vec4 frag;
 #include "../../gl/glsl/pi.glsl"
 float cube_shadow(vec3 q, float m, float T) {
     vec3 d = q - lpos, a = abs(d);
+    float ref = m / range;
+    if (taps == 1) return texture(mapcube, vec4(d, ref)); /* no tap frame to build (a constant) */
     vec3 t = normalize(cross(d, a.x < a.y ? vec3(1, 0, 0) : vec3(0, 1, 0)));
     vec3 b = normalize(cross(d, t));
-    float lit = 0.0, ref = m / range;
+    float lit = 0.0;
     for (int i = 0; i < taps; i++)
         for (int j = 0; j < taps; j++)
             lit += texture(mapcube, vec4(d + (tap(i) * t + tap(j) * b) * T, ref));
