@@ -19,6 +19,8 @@
 #include "../src/gpu/gather/gather_passes.h"
 #include "../src/gpu/gather/hemicube.h"
 #include "../src/gpu/gather/iim.h"
+#include "../src/core/vecmath.h"
+#include "../src/photonmap/hemicube_rim.h"
 #include "../src/core/timing.h"
 #include "../src/reference/reference.h"
 #include "../src/update/photon_stage.h"
@@ -1096,6 +1098,67 @@ static void test_rim_smooth(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* A light edit's two gathers through one set of rays (lm_rim_irradiance_pair, update/light_scale.c): the
+ * same irradiance to the bit as two lm_rim_irradiance calls, for rims that differ in their AIM and in the
+ * emission they read (the material's own, or a table of the one before the edit), over every 7th texel of
+ * scenes/cornell.glb at `lmgi run`'s density. */
+static void test_rim_pair_same_as_two(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 0.1153f);
+    lm_photon_stage_settings ps;
+    lm_photon_stage_settings_default(&ps);
+    lm_photon_stage *st = NULL;
+    lm_error err;
+    if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    size_t cells = (size_t)p.atlas.width * p.atlas.height;
+    const float *rgb = lm_aim_rgb(lm_photon_stage_aim(st));
+    float *before = malloc(4 * sizeof(float) * cells), *after = malloc(4 * sizeof(float) * cells);
+    float *emissive = calloc(3 * (size_t)p.s->material_count, sizeof(float));
+    assert_non_null(before);
+    assert_non_null(after);
+    assert_non_null(emissive);
+    for (size_t c = 0; c < cells; c++)
+        for (int k = 0; k < 4; k++) { /* the edit: a red light turned half as bright and greener */
+            before[4 * c + k] = k < 3 ? rgb[3 * c + k] : 1.0f;
+            after[4 * c + k] = k == 0 ? 0.5f * rgb[3 * c] : k == 1 ? 1.5f * rgb[3 * c + 1] : before[4 * c + k];
+        }
+    for (int m = 0; m < p.s->material_count; m++)
+        emissive[3 * m + 1] = 0.25f * (float)m; /* what the emitters showed before */
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    lm_rim was = {p.s, &p.atlas, p.rt, before, 1, {0.1f, 0.2f, 0.3f}, 0.0f, 16, emissive, NULL}, now = was;
+    now.aim = after;
+    now.emissive = NULL;
+    uint32_t tested = 0, differ = 0;
+    for (uint32_t i = 0; i < p.atlas.texel_count; i += 7) {
+        float eye[3], n[3], ng[3], b[3], t[3], one[2][3], pair[2][3];
+        lm_gather_texel_frame(&set, p.s, &p.atlas, i, eye, n, ng);
+        lm_vec3 tv, bv;
+        lm_tangents(lm_v3_load(n), &tv, &bv);
+        lm_v3_store(t, tv);
+        lm_v3_store(b, bv);
+        lm_rim_irradiance(&was, eye, b, t, n, ng, i, one[0], NULL);
+        lm_rim_irradiance(&now, eye, b, t, n, ng, i, one[1], NULL);
+        lm_rim_irradiance_pair(&was, &now, eye, b, t, n, ng, i, pair[0], pair[1]);
+        assert_memory_equal(one, pair, sizeof one);
+        differ += memcmp(one[0], one[1], sizeof one[0]) != 0;
+        tested++;
+    }
+    print_message("rim pair: %u texels the same to the bit as two gathers, %u of them lit differently before and "
+                  "after\n", tested, differ);
+    assert_true(tested > 100);
+    assert_true(differ > tested / 2); /* the two rims read different light: the test can tell them apart */
+    free(before);
+    free(after);
+    free(emissive);
+    lm_photon_stage_free(st);
+    lmt_pipeline_free(&p);
+}
+
 /* A pass's CPU share (the emitters' closed form, the rim's rays, the covered test) on one thread or on
  * several (as on a GPU, where the rasterizer leaves the cores free) gives the same IIM bit for bit: each
  * texel's sample patterns are seeded by its index, never by the thread. */
@@ -1459,6 +1522,7 @@ int main(void)
         cmocka_unit_test(test_schemes_agree),
         cmocka_unit_test(test_no_banding_under_the_ceiling),
         cmocka_unit_test(test_rim_smooth),
+        cmocka_unit_test(test_rim_pair_same_as_two),
         cmocka_unit_test(test_cpu_threads_same_iim),
         cmocka_unit_test(test_same_iim_in_any_grouping),
         cmocka_unit_test(test_no_plaid_from_small_emitters),

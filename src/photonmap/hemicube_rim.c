@@ -103,51 +103,57 @@ static void punctual_at_hit(const lm_rim *r, const float eye[3], const float dir
  * of the triangle it hits, the AIM averaged over the stratum's footprint (SUB x SUB sub-directions met
  * with that plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel
  * averages its footprint: a small bright spot is then shared among the strata it overlaps instead of
- * being all or nothing for one. Returns the weighted radiance sum (times SUB^2). */
-static void stratum(const lm_rim *r, const sky_mis *mis, const float eye[3], lm_vec3 B, lm_vec3 T, lm_vec3 N,
-                    lm_vec3 G, double phi0, double dphi, double u0, double du, double sum[3], double *back)
+ * being all or nothing for one. Adds the weighted radiance sum (times SUB^2) of each of the nr rims r[k]
+ * into sum[k]: one ray and one footprint for all of them (r[0]'s scene, atlas and tracer), each read in
+ * its own AIM, emission and direct light. */
+static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3], lm_vec3 B, lm_vec3 T,
+                    lm_vec3 N, lm_vec3 G, double phi0, double dphi, double u0, double du, double (*sum)[3],
+                    double *back)
 {
+    const lm_rim *r0 = r[0];
     double w;
     float dir[3];
-    lm_v3_store(dir, rim_dir(r, B, T, N, phi0 + 0.5 * dphi, u0 + 0.5 * du, &w));
+    lm_v3_store(dir, rim_dir(r0, B, T, N, phi0 + 0.5 * dphi, u0 + 0.5 * du, &w));
     if (lm_dot(lm_v3_load(dir), G) <= 0.0f)
         return; /* into the texel's own surface */
     lm_rt_hit h;
-    if (!lm_rt_intersect(r->rt, eye, dir, 0.0f, INFINITY, &h)) {
-        float sky[3] = {r->sky[0], r->sky[1], r->sky[2]};
-        double share = 1.0, pdf;
-        if (mis->on) {
-            lm_sky_radiance_pdf(r->scene, dir, sky, &pdf);
-            share = strata_share(mis, N, dir, pdf);
-        } else if (r->scene->has_sky) { /* the scene's own, which may differ by direction */
-            lm_sky_radiance(r->scene, dir, sky);
+    if (!lm_rt_intersect(r0->rt, eye, dir, 0.0f, INFINITY, &h)) {
+        for (int k = 0; k < nr; k++) {
+            float sky[3] = {r[k]->sky[0], r[k]->sky[1], r[k]->sky[2]};
+            double share = 1.0, pdf;
+            if (mis->on) {
+                lm_sky_radiance_pdf(r0->scene, dir, sky, &pdf);
+                share = strata_share(mis, N, dir, pdf);
+            } else if (r0->scene->has_sky) { /* the scene's own, which may differ by direction */
+                lm_sky_radiance(r0->scene, dir, sky);
+            }
+            for (int c = 0; c < 3; c++)
+                sum[k][c] += SUB * SUB * w * share * sky[c];
         }
-        for (int c = 0; c < 3; c++)
-            sum[c] += SUB * SUB * w * share * sky[c];
         return;
     }
-    const lm_material *m = &r->scene->materials[r->scene->tri_material[h.tri]];
+    const lm_material *m = &r0->scene->materials[r0->scene->tri_material[h.tri]];
     lm_vec3 ng = lm_v3_load(h.ng), d = lm_v3_load(dir);
     if (!m->double_sided && lm_dot(ng, d) > 0.0f) {
         *back += w; /* the back of a single-sided surface: black, as on the plane */
         return;
     }
-    const float *c = r->atlas->corner_uv + 6 * (size_t)h.tri;
+    const float *c = r0->atlas->corner_uv + 6 * (size_t)h.tri;
     lm_vec3 e = lm_v3_load(eye), P = lm_add(e, lm_scale(d, h.t));
     float hit[2];
-    if (lm_atlas_hit_uv(r->atlas, &h, hit)) {
+    if (lm_atlas_hit_uv(r0->atlas, &h, hit)) {
         float p[3][3], gu[3], gv[3];
         const float *uv[3] = {c, c + 2, c + 4};
         for (int k = 0; k < 3; k++)
-            lm_scene_vertex_world(r->scene, r->scene->tris[3 * (size_t)h.tri + k], p[k]);
+            lm_scene_vertex_world(r0->scene, r0->scene->tris[3 * (size_t)h.tri + k], p[k]);
         lm_uv_gradient(p, uv, gu, gv);
         float lo[4], *hi = lo + 2; /* the chart's footprint stays where its lookups read only it */
-        lm_chart_lookup_rect(r->atlas, r->atlas->tri_chart[h.tri], lo);
+        lm_chart_lookup_rect(r0->atlas, r0->atlas->tri_chart[h.tri], lo);
         double num = lm_dot(ng, lm_sub(P, e));
         for (int i = 0; i < SUB; i++)
             for (int j = 0; j < SUB; j++) {
                 double ws;
-                lm_vec3 ds = rim_dir(r, B, T, N, phi0 + (i + 0.5) / SUB * dphi, u0 + (j + 0.5) / SUB * du, &ws);
+                lm_vec3 ds = rim_dir(r0, B, T, N, phi0 + (i + 0.5) / SUB * dphi, u0 + (j + 0.5) / SUB * du, &ws);
                 if (lm_dot(ds, G) <= 0.0f)
                     continue;
                 double den = lm_dot(ng, ds), ts = num / den;
@@ -160,52 +166,81 @@ static void stratum(const lm_rim *r, const sky_mis *mis, const float eye[3], lm_
                     su = fminf(fmaxf(hit[0] + lm_dot(lm_v3_load(gu), off), lo[0]), hi[0]);
                     sv = fminf(fmaxf(hit[1] + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
                 }
-                lm_atlas_sample_rgb(r->atlas, r->aim, su, sv, L);
-                for (int k = 0; k < 3; k++)
-                    sum[k] += ws * L[k];
+                for (int k = 0; k < nr; k++) {
+                    lm_atlas_sample_rgb(r0->atlas, r[k]->aim, su, sv, L);
+                    for (int q = 0; q < 3; q++)
+                        sum[k][q] += ws * L[q];
+                }
             }
-        if (r->direct) { /* at the ray's own point, for the whole footprint */
-            float L[3];
-            punctual_at_hit(r, eye, dir, &h, L);
-            for (int k = 0; k < 3; k++)
-                sum[k] += SUB * SUB * w * L[k];
+        for (int k = 0; k < nr; k++)
+            if (r[k]->direct) { /* at the ray's own point, for the whole footprint */
+                float L[3];
+                punctual_at_hit(r[k], eye, dir, &h, L);
+                for (int q = 0; q < 3; q++)
+                    sum[k][q] += SUB * SUB * w * L[q];
+            }
+    }
+    for (int k = 0; k < nr; k++)
+        if (r[k]->emission) {
+            const float *em = r[k]->emissive ? r[k]->emissive + 3 * (size_t)r0->scene->tri_material[h.tri]
+                                             : m->emissive;
+            for (int q = 0; q < 3; q++)
+                sum[k][q] += SUB * SUB * w * em[q];
         }
+}
+
+/* lm_rim_irradiance over the nr rims r[k] at once (lm_rim_irradiance_pair): the same rays, out[k] each. */
+static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], const float b[3], const float t[3],
+                           const float n[3], const float ng[3], uint32_t seed, float (*out)[3], float *back)
+{
+    const lm_rim *r0 = r[0];
+    int side = (int)sqrtf((float)r0->samples);
+    double shift[2], sum[LM_RIM_MAX][3], back_w = 0.0;
+    memset(sum, 0, sizeof sum);
+    lm_seed_shift(seed, shift); /* shift[1]: the sky's directions only; the footprints cover each stratum */
+    lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
+    double d = 1.0 / side;
+    int K = side * side;
+    sky_mis m = {r0->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r0->scene), K, SKY_RAYS};
+    for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
+        for (int j = 0; j < side; j++)
+            stratum(r, nr, &m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum, &back_w);
+    int ms = (int)sqrt((double)SKY_RAYS);
+    for (int j = 0; m.on && j < m.M; j++) { /* the sky's own directions: a grid of strata, shifted per texel */
+        float dir[3], L[3];
+        lm_sky_sample(r0->scene, (float)((j / ms + shift[1]) / ms), (float)((j % ms + shift[0]) / ms), dir);
+        double cos_n = lm_dot(lm_v3_load(dir), N);
+        if (cos_n <= 0.0 || lm_dot(lm_v3_load(dir), G) <= 0.0f || lm_rt_occluded(r0->rt, eye, dir, 0.0f, INFINITY))
+            continue;
+        double pdf;
+        lm_sky_radiance_pdf(r0->scene, dir, L, &pdf);
+        double f = cos_n / (K * cos_n / LM_PI + m.M * pdf) * K * SUB * SUB / LM_PI;
+        for (int k = 0; k < nr; k++)
+            for (int c = 0; c < 3; c++)
+                sum[k][c] += f * L[c];
     }
-    if (r->emission) {
-        const float *em = r->emissive ? r->emissive + 3 * (size_t)r->scene->tri_material[h.tri] : m->emissive;
-        for (int k = 0; k < 3; k++)
-            sum[k] += SUB * SUB * w * em[k];
-    }
+    for (int k = 0; k < nr; k++)
+        for (int c = 0; c < 3; c++)
+            out[k][c] = K ? (float)(LM_PI * sum[k][c] / ((double)K * SUB * SUB)) : 0.0f;
+    if (back)
+        *back = K ? (float)(back_w / K) : 0.0f;
 }
 
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
                        const float ng[3], uint32_t seed, float out[3], float *back)
 {
-    int side = (int)sqrtf((float)r->samples);
-    double shift[2], sum[3] = {0.0, 0.0, 0.0}, back_w = 0.0;
-    lm_seed_shift(seed, shift); /* shift[1]: the sky's directions only; the footprints cover each stratum */
-    lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
-    double d = 1.0 / side;
-    int K = side * side;
-    sky_mis m = {r->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r->scene), K, SKY_RAYS};
-    for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
-        for (int j = 0; j < side; j++)
-            stratum(r, &m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum, &back_w);
-    int ms = (int)sqrt((double)SKY_RAYS);
-    for (int j = 0; m.on && j < m.M; j++) { /* the sky's own directions: a grid of strata, shifted per texel */
-        float dir[3], L[3];
-        lm_sky_sample(r->scene, (float)((j / ms + shift[1]) / ms), (float)((j % ms + shift[0]) / ms), dir);
-        double cos_n = lm_dot(lm_v3_load(dir), N);
-        if (cos_n <= 0.0 || lm_dot(lm_v3_load(dir), G) <= 0.0f || lm_rt_occluded(r->rt, eye, dir, 0.0f, INFINITY))
-            continue;
-        double pdf;
-        lm_sky_radiance_pdf(r->scene, dir, L, &pdf);
-        double f = cos_n / (K * cos_n / LM_PI + m.M * pdf) * K * SUB * SUB / LM_PI;
-        for (int c = 0; c < 3; c++)
-            sum[c] += f * L[c];
-    }
-    for (int c = 0; c < 3; c++)
-        out[c] = K ? (float)(LM_PI * sum[c] / ((double)K * SUB * SUB)) : 0.0f;
-    if (back)
-        *back = K ? (float)(back_w / K) : 0.0f;
+    float o[1][3];
+    rim_irradiance(&r, 1, eye, b, t, n, ng, seed, o, back);
+    memcpy(out, o[0], sizeof o[0]);
+}
+
+void lm_rim_irradiance_pair(const lm_rim *was, const lm_rim *now, const float eye[3], const float b[3],
+                            const float t[3], const float n[3], const float ng[3], uint32_t seed, float out_was[3],
+                            float out_now[3])
+{
+    const lm_rim *r[LM_RIM_MAX] = {was, now};
+    float o[LM_RIM_MAX][3];
+    rim_irradiance(r, 2, eye, b, t, n, ng, seed, o, NULL);
+    memcpy(out_was, o[0], sizeof o[0]);
+    memcpy(out_now, o[1], sizeof o[1]);
 }

@@ -60,6 +60,16 @@ typedef struct {
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
                        const float ng[3], uint32_t seed, float out[3], float *back);
 
+/* The most rims one call reads over the same rays (lm_rim_irradiance_pair). */
+#define LM_RIM_MAX 2
+/* lm_rim_irradiance of was and of now, bit for bit, through one set of rays: rims that differ only in what
+ * they read where a ray lands (aim, emission, emissive, direct, sky), over the same scene, atlas, tracer,
+ * enlargement and samples (was's). About half the time of two calls: the rays, the footprints' uv
+ * gradients and the sub-directions are shared; the AIM lookups are not. */
+void lm_rim_irradiance_pair(const lm_rim *was, const lm_rim *now, const float eye[3], const float b[3],
+                            const float t[3], const float n[3], const float ng[3], uint32_t seed, float out_was[3],
+                            float out_now[3]);
+
 /* Bilinear lookup of an atlas-sized RGBA map's rgb at lightmap uv in [0, 1]^2 (texel (x, y) spans
  * [x, x + 1] / width), clamped to the atlas's edge. */
 void lm_atlas_sample_rgb(const lm_atlas *a, const float *rgba, float u, float v, float out[3]);

@@ -18,8 +18,7 @@ static void gathers(const lm_scene *s, const lm_atlas *a, const lm_hemicube_sett
     lm_tangents(lm_v3_load(n), &tv, &bv);
     lm_v3_store(t, tv);
     lm_v3_store(b, bv);
-    lm_rim_irradiance(was, eye, b, t, n, ng, i, e0, NULL);
-    lm_rim_irradiance(now, eye, b, t, n, ng, i, e1, NULL);
+    lm_rim_irradiance_pair(was, now, eye, b, t, n, ng, i, e0, e1);
 }
 
 /* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within `spread` of it
