@@ -51,17 +51,31 @@ void lm_uv_gradient(const float p[3][3], const float *uv[3], float gu[3], float 
     }
 }
 
-/* A direction of the rim in the texel's frame: azimuth phi (turns) and u in [0, 1) across the rim beyond
- * the plane's edge in that azimuth; *weight is that azimuth's share of the rim, 1 - s_edge. */
-static lm_vec3 rim_dir(const lm_rim *r, lm_vec3 B, lm_vec3 T, lm_vec3 N, double phi, double u, double *weight)
-{
+/* An azimuth of the rim: phi (turns) and where the plane's edge lies in it, s_edge (sin^2 of its polar
+ * angle); 1 - s_edge is the azimuth's share of the rim. */
+typedef struct {
     float sn, cs;
-    lm_sincos_turn((float)phi, &sn, &cs);
-    double m = fmax(fabs((double)cs), fabs((double)sn)), t2 = (double)r->enlargement * r->enlargement / (m * m);
-    double s_edge = t2 / (1.0 + t2), s = s_edge + (1.0 - s_edge) * u;
+    double s_edge;
+} rim_azimuth;
+
+static rim_azimuth azimuth(const lm_rim *r, double phi)
+{
+    rim_azimuth a;
+    lm_sincos_turn((float)phi, &a.sn, &a.cs);
+    double m = fmax(fabs((double)a.cs), fabs((double)a.sn)), t2 = (double)r->enlargement * r->enlargement / (m * m);
+    a.s_edge = t2 / (1.0 + t2);
+    return a;
+}
+
+/* The direction of the rim in the texel's frame at azimuth a and u in [0, 1) across the rim beyond the
+ * plane's edge there; *weight is the azimuth's share of the rim. (A stratum's sub-directions share their
+ * azimuths: each is computed once.) */
+static lm_vec3 rim_dir(const rim_azimuth *a, lm_vec3 B, lm_vec3 T, lm_vec3 N, double u, double *weight)
+{
+    double s = a->s_edge + (1.0 - a->s_edge) * u;
     float st = (float)sqrt(s), z = (float)sqrt(fmax(0.0, 1.0 - s));
-    *weight = 1.0 - s_edge;
-    return lm_normalize(lm_add(lm_add(lm_scale(B, st * cs), lm_scale(T, st * sn)), lm_scale(N, z)));
+    *weight = 1.0 - a->s_edge;
+    return lm_normalize(lm_add(lm_add(lm_scale(B, st * a->cs), lm_scale(T, st * a->sn)), lm_scale(N, z)));
 }
 
 #define SUB 4 /* sub-directions per side of a stratum: its footprint on the hit's plane */
@@ -113,7 +127,8 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
     const lm_rim *r0 = r[0];
     double w;
     float dir[3];
-    lm_v3_store(dir, rim_dir(r0, B, T, N, phi0 + 0.5 * dphi, u0 + 0.5 * du, &w));
+    rim_azimuth mid = azimuth(r0, phi0 + 0.5 * dphi);
+    lm_v3_store(dir, rim_dir(&mid, B, T, N, u0 + 0.5 * du, &w));
     if (lm_dot(lm_v3_load(dir), G) <= 0.0f)
         return; /* into the texel's own surface */
     lm_rt_hit h;
@@ -150,10 +165,11 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
         float lo[4], *hi = lo + 2; /* the chart's footprint stays where its lookups read only it */
         lm_chart_lookup_rect(r0->atlas, r0->atlas->tri_chart[h.tri], lo);
         double num = lm_dot(ng, lm_sub(P, e));
-        for (int i = 0; i < SUB; i++)
+        for (int i = 0; i < SUB; i++) {
+            rim_azimuth az = azimuth(r0, phi0 + (i + 0.5) / SUB * dphi);
             for (int j = 0; j < SUB; j++) {
                 double ws;
-                lm_vec3 ds = rim_dir(r0, B, T, N, phi0 + (i + 0.5) / SUB * dphi, u0 + (j + 0.5) / SUB * du, &ws);
+                lm_vec3 ds = rim_dir(&az, B, T, N, u0 + (j + 0.5) / SUB * du, &ws);
                 if (lm_dot(ds, G) <= 0.0f)
                     continue;
                 double den = lm_dot(ng, ds), ts = num / den;
@@ -172,6 +188,7 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
                         sum[k][q] += ws * L[q];
                 }
             }
+        }
         for (int k = 0; k < nr; k++)
             if (r[k]->direct) { /* at the ray's own point, for the whole footprint */
                 float L[3];
