@@ -1045,6 +1045,20 @@ static double face_roughness(const lm_atlas *a, const float *rgba, const uint32_
     return sqrt(lap2 / m) / (sum / n);
 }
 
+/* The scene at path (scenes/cornell.glb) at `lmgi run`'s lightmap density there, into p, and a photon
+ * stage over it with the default settings (its AIMs made). */
+static lm_photon_stage *photons_at_run_density(lmt_pipeline *p, const char *path)
+{
+    lmt_pipeline_load(p, path, 0.1153f);
+    lm_photon_stage_settings ps;
+    lm_photon_stage_settings_default(&ps);
+    lm_photon_stage *st = NULL;
+    lm_error err;
+    if (lm_photon_stage_create(&p->w, &ps, &st, NULL, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    return st;
+}
+
 /* The rim's noise: on scenes/cornell.glb at the lightmap density of `lmgi run`, with its photon count, the
  * tall block's front face sees the ceiling's bright spot over the point light near its horizon (straight
  * up, for a wall), where only the rim's rays find it: 40% of the face's E. One AIM lookup per ray made
@@ -1056,13 +1070,7 @@ static void test_rim_smooth(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
     lmt_pipeline p;
-    lmt_pipeline_load(&p, path, 0.1153f); /* lmgi run's density on this scene */
-    lm_photon_stage_settings ps;
-    lm_photon_stage_settings_default(&ps);
-    lm_photon_stage *st = NULL;
-    lm_error err;
-    if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK)
-        fail_msg("%s", err.msg);
+    lm_photon_stage *st = photons_at_run_density(&p, path);
     /* the tall block's face towards the camera (+z), texels 0.2 m to 1.2 m high */
     uint32_t *face = malloc(sizeof(uint32_t) * p.atlas.texel_count), n = 0;
     assert_non_null(face);
@@ -1107,13 +1115,7 @@ static void test_rim_pair_same_as_two(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
     lmt_pipeline p;
-    lmt_pipeline_load(&p, path, 0.1153f);
-    lm_photon_stage_settings ps;
-    lm_photon_stage_settings_default(&ps);
-    lm_photon_stage *st = NULL;
-    lm_error err;
-    if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK)
-        fail_msg("%s", err.msg);
+    lm_photon_stage *st = photons_at_run_density(&p, path);
     size_t cells = (size_t)p.atlas.width * p.atlas.height;
     const float *rgb = lm_aim_rgb(lm_photon_stage_aim(st));
     float *before = malloc(4 * sizeof(float) * cells), *after = malloc(4 * sizeof(float) * cells);
@@ -1167,14 +1169,10 @@ static void test_cpu_threads_same_iim(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
     lmt_pipeline p;
-    lmt_pipeline_load(&p, path, 0.1153f);
-    lm_photon_stage_settings ps;
-    lm_photon_stage_settings_default(&ps);
-    lm_photon_stage *st = NULL;
+    lm_photon_stage *st = photons_at_run_density(&p, path);
     lm_emitter_light el;
     lm_error err;
-    if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK ||
-        lm_emitter_light_init(&el, p.s, p.rt, 8, &err) != LM_OK)
+    if (lm_emitter_light_init(&el, p.s, p.rt, 8, &err) != LM_OK)
         fail_msg("%s", err.msg);
     uint32_t n = p.atlas.texel_count < 600 ? p.atlas.texel_count : 600, *texels = all_texels(&p.atlas);
     float *iim[2];
