@@ -79,6 +79,7 @@ static lm_vec3 rim_dir(const rim_azimuth *a, lm_vec3 B, lm_vec3 T, lm_vec3 N, do
 }
 
 #define SUB 4 /* sub-directions per side of a stratum: its footprint on the hit's plane */
+#define RIMS_AT_ONCE 2 /* the most rims one pass reads over the same rays (lm_rim_irradiance_pair) */
 #define SKY_RAYS 36 /* an image sky's directions drawn by brightness a texel, beside the strata (a square) */
 
 /* With an image sky over the whole hemisphere (the rays gather), its light is met two ways: by the K
@@ -133,15 +134,17 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
         return; /* into the texel's own surface */
     lm_rt_hit h;
     if (!lm_rt_intersect(r0->rt, eye, dir, 0.0f, INFINITY, &h)) {
+        float scene_sky[3]; /* the scene's own, which may differ by direction: the same for every rim */
+        double share = 1.0, pdf;
+        int by_direction = mis->on || r0->scene->has_sky;
+        if (mis->on) {
+            lm_sky_radiance_pdf(r0->scene, dir, scene_sky, &pdf);
+            share = strata_share(mis, N, dir, pdf);
+        } else if (by_direction) {
+            lm_sky_radiance(r0->scene, dir, scene_sky);
+        }
         for (int k = 0; k < nr; k++) {
-            float sky[3] = {r[k]->sky[0], r[k]->sky[1], r[k]->sky[2]};
-            double share = 1.0, pdf;
-            if (mis->on) {
-                lm_sky_radiance_pdf(r0->scene, dir, sky, &pdf);
-                share = strata_share(mis, N, dir, pdf);
-            } else if (r0->scene->has_sky) { /* the scene's own, which may differ by direction */
-                lm_sky_radiance(r0->scene, dir, sky);
-            }
+            const float *sky = by_direction ? scene_sky : r[k]->sky;
             for (int c = 0; c < 3; c++)
                 sum[k][c] += SUB * SUB * w * share * sky[c];
         }
@@ -212,7 +215,7 @@ static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], c
 {
     const lm_rim *r0 = r[0];
     int side = (int)sqrtf((float)r0->samples);
-    double shift[2], sum[LM_RIM_MAX][3], back_w = 0.0;
+    double shift[2], sum[RIMS_AT_ONCE][3], back_w = 0.0;
     memset(sum, 0, sizeof sum);
     lm_seed_shift(seed, shift); /* shift[1]: the sky's directions only; the footprints cover each stratum */
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
@@ -255,8 +258,8 @@ void lm_rim_irradiance_pair(const lm_rim *was, const lm_rim *now, const float ey
                             const float t[3], const float n[3], const float ng[3], uint32_t seed, float out_was[3],
                             float out_now[3])
 {
-    const lm_rim *r[LM_RIM_MAX] = {was, now};
-    float o[LM_RIM_MAX][3];
+    const lm_rim *r[RIMS_AT_ONCE] = {was, now};
+    float o[RIMS_AT_ONCE][3];
     rim_irradiance(r, 2, eye, b, t, n, ng, seed, o, NULL);
     memcpy(out_was, o[0], sizeof o[0]);
     memcpy(out_now, o[1], sizeof o[1]);

@@ -60,8 +60,6 @@ typedef struct {
 void lm_rim_irradiance(const lm_rim *r, const float eye[3], const float b[3], const float t[3], const float n[3],
                        const float ng[3], uint32_t seed, float out[3], float *back);
 
-/* The most rims one call reads over the same rays (lm_rim_irradiance_pair). */
-#define LM_RIM_MAX 2
 /* lm_rim_irradiance of was and of now, bit for bit, through one set of rays: rims that differ only in what
  * they read where a ray lands (aim, emission, emissive, direct, sky), over the same scene, atlas, tracer,
  * enlargement and samples (was's). About half the time of two calls: the rays, the footprints' uv

@@ -79,7 +79,6 @@ struct lm_direct {
     unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
     unsigned coverage_tex;  /* else the photon gathers' kernel coverage it writes to kd's alpha (0: none) */
     int gbuffer;            /* the view's first pass writes the G-buffer (lm_direct_write_gbuffer) */
-    int draw_buffers;       /* the first pass in progress writes attachments 0 .. draw_buffers - 1 */
 };
 
 static void find_uniforms(GLuint p, uniforms *u)
@@ -196,9 +195,10 @@ static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit)
 }
 
 /* The first pass: clears, writes depth, the emitted radiance and the indirect term at each visible
- * surface's lightmap uv, and punctual emitter `light` (-1: none, an emission-only pass). */
+ * surface's lightmap uv, and punctual emitter `light` (-1: none, an emission-only pass), into the
+ * framebuffer's first `buffers` draw buffers (radiance, kd and, with 3, the G-buffer). */
 static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, int light, const lm_view *view,
-                       int w, int h)
+                       int w, int h, int buffers)
 {
     glViewport(0, 0, w, h);
     glEnable(GL_DEPTH_TEST);
@@ -212,7 +212,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
     lm_sky_mean(s, sky);
     glClearBufferfv(GL_COLOR, 0, sky);
     static const float nothing[4] = {0.0f, 0.0f, 0.0f, 1.0f}; /* kd and the G-buffer where nothing is seen */
-    for (int b = 1; b < d->draw_buffers; b++)
+    for (int b = 1; b < buffers; b++)
         glClearBufferfv(GL_COLOR, b, nothing);
     lm_sky_pass_draw(&d->sky, s, view->view, view->proj); /* by direction, where it varies */
     if (light < 0) {
@@ -616,9 +616,9 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
     static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     /* only the view's G-buffer is read (by the photon gathers), and only when they run: another float
      * attachment written and cleared costs about a tenth of the pass on llvmpipe */
-    d->draw_buffers = which == LM_FRAME_VIEW && d->gbuffer ? 3 : 2;
-    glDrawBuffers(d->draw_buffers, all);
-    first_pass(d, s, em, first, view, width, height);
+    int buffers = which == LM_FRAME_VIEW && d->gbuffer ? 3 : 2;
+    glDrawBuffers(buffers, all);
+    first_pass(d, s, em, first, view, width, height, buffers);
     glDrawBuffers(1, all); /* the additive passes after it add radiance only */
     for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
         if (live_punctual(s, &em->e[i]))
