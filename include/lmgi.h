@@ -620,6 +620,10 @@ typedef struct {
     int aim_surfaces_at_once;  /* of aim_surfaces_refreshed, those refreshed at once for this update's light,
                                 * emission or colour edits: as many as the edits reach, outside the AIM budget
                                 * that bounds the others (issue 32, item 4) */
+    double ms_light_scale;     /* of ms_photons or ms_gather: a light, emission or colour edit's texel factors,
+                                * their first guess at the edit, then their refinement a few surfaces an update
+                                * within the budget (docs/tradeoff.md, "Light edits at once") */
+    uint32_t light_scale_rays; /* the rays of one of their two gathers this update cast */
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative

@@ -239,6 +239,46 @@ static void test_random_material_sequences(void **state)
     }
 }
 
+/* The same under a time budget (issue 32, item 4), with lights dimmed too: the edits' AIMs are scaled at
+ * once instead of refreshed, their texel factors a first guess refined over the updates, and the bake,
+ * however far those got, still a fresh one's to the bit. */
+static void test_budgeted_edits_bake_to_the_bit(void **state)
+{
+    (void)state;
+    rig r;
+    rig_load(&r);
+    lmgi_updater *u = lmt_updater(r.ctx, r.sc);
+    uint32_t s = 0x51ed2701u;
+    int at_once = 0, refining = 0;
+    for (int k = 0; k < 8; k++) {
+        if (k % 2)
+            random_material_edit(r.sc, &s);
+        else {
+            lmgi_light l;
+            lmgi_error e;
+            int id = (int)(lmt_xorshift(&s) % (uint32_t)lmgi_light_count(r.sc));
+            assert_int_equal(lmgi_get_light(r.sc, id, &l, &e), LMGI_OK);
+            l.intensity *= 0.5f + (float)(lmt_xorshift(&s) % 100) / 50.0f;
+            assert_int_equal(lmgi_set_light(r.sc, id, &l, &e), LMGI_OK);
+        }
+        for (int i = 1 + (int)(lmt_xorshift(&s) % 6); i > 0; i--) {
+            lmgi_update_stats st;
+            lmgi_error e;
+            assert_int_equal(lmgi_update(u, 0.0f, 4.0f, &st, &e), LMGI_OK);
+            at_once += st.aim_surfaces_at_once;
+            refining += st.light_scale_rays > 0;
+        }
+    }
+    float *iim = bake(u, &r);
+    lmgi_updater_free(u);
+    assert_int_equal(bits_from_fresh(&r, iim, "8 light and material edits at a 4 ms budget"), 0);
+    print_message("AIM surfaces refreshed at once: %d; updates that cast texel factors' rays: %d\n", at_once,
+                  refining);
+    assert_true(refining > 8); /* the edits' first guesses and their refinement ran */
+    free(iim);
+    rig_free(&r);
+}
+
 /* One random edit of the scene (xorshift state s). */
 static void random_edit(lmgi_scene *sc, uint32_t *s, int cube)
 {
@@ -360,6 +400,7 @@ int main(void)
         cmocka_unit_test(test_node_moves_to_the_bit),
         cmocka_unit_test(test_lights_dimmed_added_removed),
         cmocka_unit_test(test_random_material_sequences),
+        cmocka_unit_test(test_budgeted_edits_bake_to_the_bit),
         cmocka_unit_test(test_random_edit_sequences),
         cmocka_unit_test(test_error_atlas_marks_wrong_texels),
     };

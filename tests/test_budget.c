@@ -83,14 +83,55 @@ static void test_plan_learns(void **state)
     assert_string_equal(lm_stage_name(LM_STAGE_FRAME), "frame");
 }
 
+/* A light edit's texel factors (update/light_scale.h): at most a quarter of the budget an update for
+ * their refinement, what the rest leaves of the whole budget for an edit's first guess, and what is
+ * planned for them comes off the gather's share this update, not off its rest in the updates after. */
+static void test_plan_light_scale(void **state)
+{
+    (void)state;
+    lm_budget b;
+    const double price[LM_STAGE_PLANNED] = {2.0, 1.0 / 8192, 1.0 / 1024, 1.0, 0.125, 1.0 / 1024};
+    lm_budget_seed(&b, price);
+    lm_budget_plan p;
+    lm_budget_work w = {.texels = 5000};
+    lm_budget_plan_step(&b, 16.0, &w, &p); /* nothing waits: bounded all the same, the gather unchanged */
+    assert_int_equal(p.scale_rays, 4096); /* 4 ms at 1/1024 ms a ray */
+    assert_int_equal(p.texels, 128);
+    w.scale_rays = 100000; /* a refinement under way */
+    lm_budget_plan_step(&b, 16.0, &w, &p);
+    assert_int_equal(p.scale_rays, 4096);
+    assert_int_equal(p.texels, 96);       /* (16 - 4) ms at 0.125 ms a texel */
+    w.scale_rays = 100;                   /* its last rays */
+    lm_budget_plan_step(&b, 16.0, &w, &p);
+    assert_int_equal(p.scale_rays, 100);
+    assert_int_equal(p.texels, 127);
+    w.scale_rays = 32768, w.scale_edit = 1; /* an edit's first guess: all but one texel's gather */
+    lm_budget_plan_step(&b, 16.0, &w, &p);
+    assert_int_equal(p.scale_rays, 16256); /* 15.875 ms */
+    assert_int_equal(p.texels, 1);
+
+    const double ms[LM_STAGE_PLANNED] = {12.0, 0.0, 0.0, 0.0, 7.5, 2.0};
+    const uint64_t units[LM_STAGE_PLANNED] = {3, 0, 0, 0, 30, 2048};
+    for (int i = 0; i < LM_COST_WINDOW; i++)
+        lm_budget_learn(&b, ms, units, 13.5);
+    w.scale_rays = 0, w.scale_edit = 0;
+    lm_budget_plan_step(&b, 16.0, &w, &p);
+    assert_int_equal(p.texels, 48);       /* (16 - 4 ms of rest, the 2 ms of factors not in it) at 0.25 ms */
+    assert_int_equal(p.scale_rays, 4096); /* a quarter: less than the 11.75 ms the rest and a texel leave */
+    lm_budget_plan_step(&b, 5.0, &w, &p);
+    assert_int_equal(p.scale_rays, 768);  /* 5 - 4 - 0.25 ms: less than a quarter */
+    assert_int_equal(p.texels, 4);
+    assert_string_equal(lm_stage_name(LM_STAGE_LIGHT_SCALE), "light scale");
+}
+
 static void update(lmgi_updater *u, float budget, lmgi_update_stats *st)
 {
     lmgi_error e;
     if (lmgi_update(u, 0.0f, budget, st, &e) != LMGI_OK)
         fail_msg("%s", e.message);
-    const char *stages[] = {"photons", "AIM", "caustic photons", "reflections", "gather", "frame"};
+    const char *stages[] = {"photons", "AIM", "caustic photons", "reflections", "gather", "light scale", "frame"};
     int known = 0;
-    for (int i = 0; i < 6; i++)
+    for (int i = 0; i < 7; i++)
         known |= st->busiest_stage && strcmp(st->busiest_stage, stages[i]) == 0;
     assert_true(known);
     assert_true(strlen(st->why) > 10);
@@ -212,6 +253,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_plan_shares),
         cmocka_unit_test(test_plan_learns),
+        cmocka_unit_test(test_plan_light_scale),
         cmocka_unit_test(test_budget_governs_photons_and_aims),
         cmocka_unit_test(test_budget_governs_faces_and_caustics),
     };

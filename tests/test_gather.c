@@ -23,6 +23,7 @@
 #include "../src/photonmap/hemicube_rim.h"
 #include "../src/core/timing.h"
 #include "../src/reference/reference.h"
+#include "../src/update/light_scale.h"
 #include "../src/update/photon_stage.h"
 #include "support.h"
 
@@ -1161,6 +1162,105 @@ static void test_rim_pair_same_as_two(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* A copy of n floats (the light scale takes ownership of what it is given). */
+static float *floats_copy(const float *v, size_t n)
+{
+    float *c = malloc(sizeof *c * n);
+    assert_non_null(c);
+    memcpy(c, v, sizeof *c * n);
+    return c;
+}
+
+/* A light edit's texel factors within a budget (update/light_scale.h): a coarse first guess, then the
+ * refinement a few hundred rays at a time, whose corrections bring every texel to the factor the full
+ * quality gives at once (to float rounding: the same rays, seeded by the texel), and leave the texels
+ * regathered meanwhile alone. On scenes/cornell.glb at `lmgi run`'s density, the AIM after the edit
+ * changed unevenly over the atlas (redder to the left, dimmer to the top), the emitters dimmed. */
+static void test_light_scale_refined_equals_full(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lmt_pipeline p;
+    lm_photon_stage *st = photons_at_run_density(&p, path);
+    size_t cells = (size_t)p.atlas.width * p.atlas.height, T = p.atlas.texel_count, S = (size_t)p.atlas.surface_count;
+    const float *before = lm_aim_dilated_rgba(lm_photon_stage_aim(st));
+    float *after = floats_copy(before, 4 * cells), *emissive = calloc(3 * (size_t)p.s->material_count + 3, sizeof(float));
+    float *surface = malloc(sizeof(float) * 3 * S), *full = malloc(sizeof(float) * 3 * T);
+    float *shown = malloc(sizeof(float) * 3 * T), *corr = malloc(sizeof(float) * 3 * T);
+    assert_non_null(emissive), assert_non_null(surface), assert_non_null(full), assert_non_null(shown);
+    assert_non_null(corr);
+    for (size_t c = 0; c < cells; c++) {
+        float x = (float)(c % (size_t)p.atlas.width) / (float)p.atlas.width;
+        float y = (float)(c / (size_t)p.atlas.width) / (float)p.atlas.height;
+        after[4 * c] *= 1.5f - x, after[4 * c + 1] *= 0.5f + 0.5f * y;
+    }
+    for (int m = 0; m < p.s->material_count; m++)
+        for (int k = 0; k < 3; k++) /* what the emitters showed before: twice what they show now */
+            emissive[3 * m + k] = 2.0f * p.s->materials[m].emissive[k];
+    for (size_t i = 0; i < 3 * S; i++)
+        surface[i] = 0.75f;
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
+    lm_light_scale ls;
+    lm_light_scale_init(&ls);
+    size_t ne = 3 * (size_t)p.s->material_count + 3;
+    uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), after,
+                                        surface, 0, full);
+    assert_false(ls.active); /* no bound: the full quality at once */
+    uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), after,
+                                          surface, 600, shown);
+    assert_true(ls.active);
+    assert_true(first <= 600 + 64 && first < all / 8); /* about what it was given */
+    uint32_t left = lm_light_scale_waiting(&ls, &p.atlas);
+    assert_int_equal(left, all);
+    const uint32_t kept[3] = {0, (uint32_t)T / 2, (uint32_t)T - 1}; /* regathered before the refinement */
+    lm_light_scale_regathered(&ls, kept, 3);
+    float was[3][3];
+    for (int j = 0; j < 3; j++)
+        memcpy(was[j], shown + 3 * kept[j], sizeof was[j]);
+    int steps = 0;
+    double first_off = 0.0;
+    for (size_t i = 0; i < 3 * T; i++)
+        first_off = fmax(first_off, fabs(shown[i] - full[i]) / fmax(fabs(full[i]), 1e-3));
+    while (ls.active && steps < 1000) {
+        int corrected = 0;
+        uint32_t cast = lm_light_scale_refine(&ls, &w, after, 700, corr, &corrected);
+        assert_true(cast > 0 && cast < 700 + 64); /* about what it was given: at most a texel's rays past it */
+        uint32_t now = lm_light_scale_waiting(&ls, &p.atlas);
+        assert_int_equal(now, left - cast);
+        left = now;
+        for (size_t i = 0; i < 3 * T; i++)
+            shown[i] *= corr[i];
+        steps++;
+    }
+    assert_false(ls.active);
+    assert_int_equal(left, 0);
+    double worst = 0.0;
+    uint32_t compared = 0;
+    for (uint32_t i = 0; i < T; i++) {
+        int regathered = i == kept[0] || i == kept[1] || i == kept[2];
+        for (int c = 0; c < 3 && !regathered; c++)
+            if (full[3 * i + c] > 1e-3f) {
+                worst = fmax(worst, fabs(shown[3 * i + c] - full[3 * i + c]) / full[3 * i + c]);
+                compared++;
+            }
+    }
+    for (int j = 0; j < 3; j++) /* a regathered texel keeps what it showed */
+        assert_memory_equal(was[j], shown + 3 * kept[j], sizeof was[j]);
+    print_message("light scale: %u rays at once; a first guess of %u rays (%.3g off the full at worst), then %d "
+                  "refinements: %.3g off the full at worst over %u texel channels\n",
+                  all, first, first_off, steps, worst, compared);
+    assert_true(first_off > 0.05); /* the first guess is coarse: the test sees what the refinement does */
+    assert_true(steps > 10);
+    assert_true(compared > 3 * T / 2);
+    assert_true(worst < 1e-5);
+    lm_light_scale_free(&ls);
+    free(after), free(emissive), free(surface), free(full), free(shown), free(corr);
+    lm_photon_stage_free(st);
+    lmt_pipeline_free(&p);
+}
+
 /* A pass's CPU share (the emitters' closed form, the rim's rays, the covered test) on one thread or on
  * several (as on a GPU, where the rasterizer leaves the cores free) gives the same IIM bit for bit: each
  * texel's sample patterns are seeded by its index, never by the thread. */
@@ -1521,6 +1621,7 @@ int main(void)
         cmocka_unit_test(test_no_banding_under_the_ceiling),
         cmocka_unit_test(test_rim_smooth),
         cmocka_unit_test(test_rim_pair_same_as_two),
+        cmocka_unit_test(test_light_scale_refined_equals_full),
         cmocka_unit_test(test_cpu_threads_same_iim),
         cmocka_unit_test(test_same_iim_in_any_grouping),
         cmocka_unit_test(test_no_plaid_from_small_emitters),

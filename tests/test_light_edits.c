@@ -676,6 +676,97 @@ static void test_emission_at_once(void **state)
     lmgi_context_free(ctx);
 }
 
+/* n updates at budget_ms; the rays the light edit's texel factors cast over them (and the edit's own
+ * update's stats in *first, when given). */
+static uint64_t budgeted_updates(lmgi_updater *u, float budget_ms, int n, lmgi_update_stats *first)
+{
+    uint64_t rays = 0;
+    for (int i = 0; i < n; i++) {
+        lmgi_update_stats st;
+        lmgi_error e;
+        assert_int_equal(lmgi_update(u, 0.0f, budget_ms, &st, &e), LMGI_OK);
+        rays += i > 0 ? st.light_scale_rays : 0;
+        if (i == 0 && first)
+            *first = st;
+    }
+    return rays;
+}
+
+/* Under a time budget (issue 32, item 4) the lamp dimmed and tinted: the edit's update does not refresh
+ * the AIMs at once but scales them as their hits were scaled, and its texel factors are a first guess
+ * within the budget that the next updates refine; lit by one lamp, every factor is the lamp's, so the
+ * next update's lightmap is already a fresh updater's, and stays so while the refinement runs. */
+static void test_one_light_within_budget(void **state)
+{
+    (void)state;
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    size_t n = r.n;
+    budgeted_updates(r.u, 4.0f, 3, NULL); /* the cost models learn this machine */
+    const float tint[3] = {0.4f, 0.9f, 1.0f};
+    edit_light(r.sc, 0, 0.3f, tint, 1);
+    lmgi_update_stats st;
+    budgeted_updates(r.u, 4.0f, 1, &st);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    uint64_t refined = budgeted_updates(r.u, 4.0f, 60, NULL);
+    float *later = lmt_iim(r.u, r.sc, &n);
+    lmgi_updater_free(r.u);
+    r.u = lmt_room_updater(r.ctx, r.sc); /* a fresh one, of the edited room */
+    lmt_updates(r.u, 3);
+    float *want = lmt_iim(r.u, r.sc, &n);
+    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
+    double after = lmt_relative_l1(later, want, n);
+    print_message("4 ms budget, one lamp dimmed and tinted: %d AIMs refreshed at once, a first guess of %u rays "
+                  "in %.2f ms, %llu rays of refinement after; lightmap against a fresh updater's %.3g before, %.3g "
+                  "at the next update, %.3g 60 updates later\n",
+                  st.aim_surfaces_at_once, st.light_scale_rays, st.ms_light_scale, (unsigned long long)refined,
+                  was, at_once, after);
+    assert_int_equal(st.lights_scaled, 1);
+    assert_int_equal(st.aim_surfaces_at_once, 0);
+    assert_true(st.light_scale_rays > 0 && refined > 0);
+    assert_true(was > 0.5);
+    assert_true(at_once < 1e-4);
+    assert_true(after < 1e-4);
+    free(now), free(later), free(want);
+    unsettle(&r);
+}
+
+/* The block recoloured under a time budget: its AIM scaled by the colour's ratio at once, the surfaces
+ * its reweighted photons reach by how much their hits' flux changed, the texel factors a first guess; the
+ * refinement and the budgeted refreshes then bring the lightmap to where the unbudgeted edit's first
+ * update left it (test_recolour_at_once). */
+static void test_recolour_within_budget(void **state)
+{
+    (void)state;
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    size_t n = r.n;
+    budgeted_updates(r.u, 4.0f, 3, NULL);
+    lmgi_material m;
+    lmgi_error e;
+    assert_int_equal(lmgi_get_material(r.sc, 1, &m, &e), LMGI_OK);
+    m.base_color[0] = 0.1f, m.base_color[1] = 0.2f, m.base_color[2] = 0.8f;
+    assert_int_equal(lmgi_set_material(r.sc, 1, &m, &e), LMGI_OK);
+    lmgi_update_stats st;
+    budgeted_updates(r.u, 4.0f, 1, &st);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    budgeted_updates(r.u, 4.0f, 120, NULL);
+    float *later = lmt_iim(r.u, r.sc, &n);
+    lmt_bake(r.u, NULL);
+    float *want = lmt_iim(r.u, r.sc, &n);
+    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
+    double after = lmt_relative_l1(later, want, n);
+    print_message("4 ms budget, block recoloured: %d AIMs refreshed at once, a first guess of %u rays; lightmap "
+                  "against the regathered one %.3g before the edit, %.3g at the next update, %.3g 120 updates "
+                  "later\n", st.aim_surfaces_at_once, st.light_scale_rays, was, at_once, after);
+    assert_int_equal(st.aim_surfaces_at_once, 0);
+    assert_true(was > 0.02);
+    assert_true(at_once < 0.5 * was);
+    assert_true(after < 0.25 * was);
+    free(now), free(later), free(want);
+    unsettle(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -690,6 +781,8 @@ int main(void)
         cmocka_unit_test(test_switched_off),
         cmocka_unit_test(test_recolour_at_once),
         cmocka_unit_test(test_emission_at_once),
+        cmocka_unit_test(test_one_light_within_budget),
+        cmocka_unit_test(test_recolour_within_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

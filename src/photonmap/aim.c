@@ -1019,6 +1019,28 @@ static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_
     }
 }
 
+void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, int count, const float *factor)
+{
+    for (int j = 0; j < count; j++) {
+        int sf = surfaces[j];
+        const float *f = factor + 3 * (size_t)sf;
+        for (uint32_t i = aim->texel_first[sf]; i < aim->texel_first[sf + 1]; i++) {
+            const lm_texel *t = &a->texels[aim->texel_list[i]];
+            size_t at = (size_t)t->y * (size_t)aim->width + (size_t)t->x;
+            for (int c = 0; c < 3; c++) {
+                aim->rgb[3 * at + c] *= f[c];
+                if (aim->rest)
+                    aim->rest[3 * at + c] *= f[c];
+            }
+        }
+    }
+    if (count > 0) {
+        lm_atlas_dilated_rgba(a, aim->rgb, aim->dilated);
+        if (aim->rest)
+            lm_atlas_dilated_rgba(a, aim->rest, aim->rest_dilated);
+    }
+}
+
 /* ---------- the per-pixel gathers' kernel on the surface ---------- */
 
 lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,

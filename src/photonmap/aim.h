@@ -174,6 +174,13 @@ lm_status lm_aim_refresh_all(lm_aim *aim, const lm_scene *s, const lm_surfaces *
 lm_status lm_aim_refresh_listed(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                 lm_photon_store *ps, const int *surfaces, int count, lm_aim_stats *stats,
                                 lm_error *err);
+/* The listed surfaces' texels (rgb, and rest where kept) multiplied by factor[3 k + c] per channel
+ * (surface_count x 3), the dilated maps made again; delta_f and owed untouched. A first guess that is
+ * exact where every hit of a surface scaled alike (a light's power edit in a scene lit by one, a base
+ * colour edit for the surfaces of that material: the AIM multiplies in the albedo), cheap where the
+ * refresh it stands in for is not (update/photon_stage.c, under a time budget). Cost: the listed
+ * surfaces' texels and one pass over the atlas. */
+void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, int count, const float *factor);
 /* Recomputes one surface's texels from its current hits and resets its delta_f. */
 lm_status lm_aim_refresh_surface(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                  lm_photon_store *ps, int surface, lm_aim_stats *stats, lm_error *err);

@@ -30,6 +30,7 @@ static double p95(const double *v, int n)
 static int window(const lm_cost_model *m) { return m->samples < LM_COST_WINDOW ? m->samples : LM_COST_WINDOW; }
 
 double lm_cost_model_price(const lm_cost_model *m) { return p95(m->per_unit, window(m)); }
+double lm_cost_model_rest(const lm_cost_model *m) { return p95(m->rest, window(m)); }
 
 int lm_cost_model_units(const lm_cost_model *m, double budget_ms, int most)
 {

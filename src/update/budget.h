@@ -35,5 +35,7 @@ void lm_cost_model_learn(lm_cost_model *m, double ms_stage, uint32_t units, doub
 int lm_cost_model_units(const lm_cost_model *m, double budget_ms, int most);
 /* The 95th percentile of the milliseconds per unit (what lm_cost_model_units prices a unit at). */
 double lm_cost_model_price(const lm_cost_model *m);
+/* The 95th percentile of the milliseconds of the rest of the step. */
+double lm_cost_model_rest(const lm_cost_model *m);
 
 #endif

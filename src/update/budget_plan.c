@@ -6,7 +6,7 @@
 const char *lm_stage_name(lm_stage s)
 {
     static const char *names[LM_STAGE_COUNT] = {"photons", "AIM", "caustic photons", "reflections", "gather",
-                                                "frame"};
+                                                "light scale", "frame"};
     return s >= 0 && s < LM_STAGE_COUNT ? names[s] : "none";
 }
 
@@ -42,7 +42,17 @@ void lm_budget_plan_step(const lm_budget *b, double budget_ms, const lm_budget_w
         out->caustic_photons = (uint32_t)take(b, LM_STAGE_CAUSTICS, left, w->caustic_photons, &ms[LM_STAGE_CAUSTICS]);
     if (w->faces > 0)
         out->faces = take(b, LM_STAGE_REFLECTIONS, 0.125 * budget_ms, w->faces, &ms[LM_STAGE_REFLECTIONS]);
-    out->texels = take(b, LM_STAGE_GATHER, budget_ms, w->texels, &ms[LM_STAGE_GATHER]);
+    /* what the rest of recent updates and one texel's gather leave, at most a quarter but for an edit's
+     * first guess; planned with no work waiting too: an edit the photon stage takes after this plan (in
+     * order, its update follows the plan) is bounded */
+    const lm_cost_model *g = &b->cost[LM_STAGE_GATHER];
+    double spare = budget_ms - lm_cost_model_rest(g) - lm_cost_model_price(g);
+    if (!w->scale_edit && spare > 0.25 * budget_ms)
+        spare = 0.25 * budget_ms;
+    out->scale_rays = (uint32_t)take(b, LM_STAGE_LIGHT_SCALE, spare, w->scale_rays > 0 ? w->scale_rays : INT_MAX,
+                                     &ms[LM_STAGE_LIGHT_SCALE]);
+    double gather = w->scale_rays > 0 ? budget_ms - ms[LM_STAGE_LIGHT_SCALE] : budget_ms;
+    out->texels = take(b, LM_STAGE_GATHER, gather, w->texels, &ms[LM_STAGE_GATHER]);
 }
 
 void lm_budget_learn(lm_budget *b, const double ms[LM_STAGE_PLANNED], const uint64_t units[LM_STAGE_PLANNED],
@@ -50,8 +60,8 @@ void lm_budget_learn(lm_budget *b, const double ms[LM_STAGE_PLANNED], const uint
 {
     for (int s = 0; s < LM_STAGE_PLANNED; s++) {
         uint32_t n = units[s] > UINT32_MAX ? UINT32_MAX : (uint32_t)units[s];
-        if (s == LM_STAGE_GATHER) /* its rest: everything else the update did */
-            lm_cost_model_learn(&b->cost[s], ms[s], n, ms_total - ms[s]);
+        if (s == LM_STAGE_GATHER) /* its rest: everything else the update did but the planned texel factors */
+            lm_cost_model_learn(&b->cost[s], ms[s], n, ms_total - ms[s] - ms[LM_STAGE_LIGHT_SCALE]);
         else if (n > 0)
             lm_cost_model_learn(&b->cost[s], ms[s], n, 0.0);
     }

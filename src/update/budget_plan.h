@@ -5,14 +5,19 @@
  *
  * The share. The photon thread's stages take at most half of the budget, in pipeline order: the photons
  * what their invalid groups need, the AIMs what the photons left, the caustic photons the rest of that
- * half. The environment map faces take at most an eighth. The gather fills what the 95th percentile of
- * everything else in recent updates left (lm_cost_model_units). A stage with work waiting gets at least
+ * half. The environment map faces take at most an eighth. A light edit's texel factors take what the
+ * rest of recent updates and one texel's gather leave of the whole budget for their first guess in the
+ * edit's update (what the edit changed is worth more than an update's regathers), then at most a quarter
+ * an update for their refinement. The gather fills what the 95th percentile of
+ * everything else in recent updates left (lm_cost_model_units), less what the texel factors are planned
+ * this update: their work comes in bursts after an edit, and counted into the gather's rest it would
+ * starve the gather for LM_COST_WINDOW updates after each. A stage with work waiting gets at least
  * one unit however dear: an update never does nothing while something is stale, and a stage that never
  * fits is not starved (its unit may then pass the budget: one AIM surface's refresh is not split).
  * Without a budget (budget_ms 0) the plan is the settings' fixed counts, the same on every machine.
  *
  * The units: a photon group, a stored hit put in an AIM refresh's kd-trees, a caustic photon, a cube
- * face, a texel. Each model is seeded from the updater's setup (the full trace, every AIM, every caustic
+ * face, a texel, a ray of a light edit's texel gathers. Each model is seeded from the updater's setup (the full trace, every AIM, every caustic
  * photon, every face, the full gather) and learns from every update that did some of its work, so a
  * small batch's fixed costs count into its units' price (the plan errs on the side of less work).
  *
@@ -33,13 +38,14 @@ typedef enum {
     LM_STAGE_CAUSTICS,
     LM_STAGE_REFLECTIONS,
     LM_STAGE_GATHER,
+    LM_STAGE_LIGHT_SCALE,
     LM_STAGE_FRAME,
     LM_STAGE_COUNT
 } lm_stage;
 
 #define LM_STAGE_PLANNED LM_STAGE_FRAME /* the stages with a cost model */
 
-/* "photons", "AIM", "caustic photons", "reflections", "gather", "frame". */
+/* "photons", "AIM", "caustic photons", "reflections", "gather", "light scale", "frame". */
 const char *lm_stage_name(lm_stage s);
 
 typedef struct {
@@ -52,6 +58,8 @@ typedef struct {
     uint32_t caustic_photons; /* caustic photons queued for whole re-traces */
     int faces;                /* environment map faces (all: an update marks the dirty ones as it goes) */
     int texels;               /* the most texels a step may gather (the atlas) */
+    uint32_t scale_rays;      /* rays a light edit's texel factors wait for (an edit's at the full quality) */
+    int scale_edit;           /* an edit's first guess waits: it may take what the whole budget leaves */
 } lm_budget_work;
 
 /* What the update may do: 0 for groups, aim_hits, caustic_photons or faces means the settings' own
@@ -62,6 +70,7 @@ typedef struct {
     uint32_t caustic_photons; /* caustic photons traced (whole re-traces first, then the round robin) */
     int faces;                /* environment map faces rendered */
     int texels;               /* IIM texels gathered */
+    uint32_t scale_rays;      /* rays a light edit's texel factors cast (update/light_scale.h) */
     double ms[LM_STAGE_PLANNED]; /* the milliseconds the plan expects each to take */
 } lm_budget_plan;
 

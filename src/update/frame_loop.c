@@ -9,6 +9,7 @@
 #include "../scene/scene_view.h"
 #include "budget_plan.h"
 #include "frame_passes.h"
+#include "light_scale.h"
 #include "lightmap_path.h"
 #include "photon_path.h"
 #include "stage_worker.h"
@@ -256,6 +257,8 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
     if (fl->budget_ms > 0.0f) {
         lm_budget_work w = {.faces = lm_frame_passes_faces(fl->passes), .texels = (int)fl->world.atlas->texel_count};
         lm_photon_stage_waiting(fl->stage, &w.groups, &w.caustic_photons);
+        w.scale_edit = lm_photon_stage_scale_waiting(fl->stage);
+        w.scale_rays = w.scale_edit ? LM_LIGHT_SCALE_WORK : lm_lightmap_path_scale_waiting(fl->lightmaps);
         lm_budget_plan_step(&fl->budget, fl->budget_ms, &w, p);
     } else {
         memset(p, 0, sizeof *p);
@@ -265,6 +268,7 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
     lm_photon_stage_limit(fl->stage, &l);
     lm_frame_passes_limit_faces(fl->passes, p->faces);
     lm_lightmap_path_set_texels_per_frame(fl->lightmaps, p->texels);
+    lm_lightmap_path_set_scale_rays(fl->lightmaps, p->scale_rays);
 }
 
 /* Animations and the scene bounds that follow from them: written here, on the calling thread, before
@@ -407,10 +411,10 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
 static void learn(lm_frame_loop *fl, const lm_frame_stats *o)
 {
     const lm_photon_stage_frame *f = &o->stage;
-    const double ms[LM_STAGE_PLANNED] = {1e3 * f->t_photons, 1e3 * f->t_aim, 1e3 * f->t_caustics,
-                                         1e3 * o->t_reflections, 1e3 * o->t_gather};
+    const double ms[LM_STAGE_PLANNED] = {1e3 * f->t_photons,     1e3 * f->t_aim, 1e3 * f->t_caustics,
+                                         1e3 * o->t_reflections, 1e3 * o->t_gather, 1e3 * o->t_light_scale};
     const uint64_t units[LM_STAGE_PLANNED] = {f->photons.groups_retraced, f->aim.hits_used, f->caustics.traced,
-                                              (uint64_t)o->cube_faces, o->texels_gathered};
+                                              (uint64_t)o->cube_faces, o->texels_gathered, o->scale_rays};
     lm_budget_learn(&fl->budget, ms, units, 1e3 * o->t_total);
 }
 
@@ -427,7 +431,8 @@ static void plan_words(const lm_frame_loop *fl, const lm_frame_stats *o, lm_stag
 static void report(const lm_frame_loop *fl, lm_frame_stats *o)
 {
     const lm_photon_stage_frame *f = &o->stage;
-    const double t[LM_STAGE_COUNT] = {f->t_photons, f->t_aim, f->t_caustics, o->t_reflections, o->t_gather,
+    const double t[LM_STAGE_COUNT] = {f->t_photons, f->t_aim, f->t_caustics, o->t_reflections,
+                                      o->t_gather,  o->t_light_scale,
                                       o->t_blend + o->t_direct + o->t_caustics + o->t_composite};
     lm_stage b = LM_STAGE_PHOTONS;
     for (int s = 1; s < LM_STAGE_COUNT; s++)
@@ -456,6 +461,10 @@ static void report(const lm_frame_loop *fl, lm_frame_stats *o)
     case LM_STAGE_GATHER:
         snprintf(w, n, "%u texels gathered (%s)", o->texels_gathered, plan);
         break;
+    case LM_STAGE_LIGHT_SCALE:
+        snprintf(w, n, "a light edit's texel factors: %llu rays, %u still to cast (%s)",
+                 (unsigned long long)o->scale_rays, lm_lightmap_path_scale_waiting(fl->lightmaps), plan);
+        break;
     default:
         snprintf(w, n, "the frame's passes: blend %.2f ms, direct light %.2f ms, caustics %.2f ms, composite %.2f ms",
                  1e3 * o->t_blend, 1e3 * o->t_direct, 1e3 * o->t_caustics, 1e3 * o->t_composite);
@@ -474,6 +483,9 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
         st = !fl->worker ? step_in_order(fl, t, &o, err)
              : fl->set.width > 0 ? step_overlapped(fl, t, &o, err) : step_detached(fl, t, &o, err);
     o.t_total = lm_now() - t0;
+    double scale_ms = 0.0;
+    o.scale_rays = lm_lightmap_path_take_scale_work(fl->lightmaps, &scale_ms);
+    o.t_light_scale = 1e-3 * scale_ms;
     if (st == LM_OK && fl->steps++ > 0)
         learn(fl, &o);
     report(fl, &o);

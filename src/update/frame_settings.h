@@ -104,6 +104,10 @@ typedef struct {
      * the screen-space pass), reflections (map faces and their pass),
      * composite (the indirect term's atlas pass); and the whole frame */
     double t_photons, t_gather, t_blend, t_direct, t_caustics, t_reflections, t_composite, t_total;
+    /* of t_photons or t_gather (where the step schedules), a light edit's texel factors (update/light_scale.h):
+     * their seconds and the rays of one of their gathers */
+    double t_light_scale;
+    uint64_t scale_rays;
     /* the time budget (budget_plan.h): the counts the step was allowed (zeros but texels without a budget:
      * the settings'), the stage that took the most time and why, in words */
     lm_budget_plan plan;

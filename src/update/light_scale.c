@@ -1,19 +1,69 @@
-/* The IIM texels' factors after lights changed in power alone (light_scale.h). */
+/* The IIM texels' factors after lights changed in power alone, at once or refined within the budget
+ * (light_scale.h). */
 #include "light_scale.h"
 
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "../core/vecmath.h"
 #include "../photonmap/hemicube_rim.h"
 #include "../scene/sky.h"
 
+/* The fewest rays a texel still reads a ratio from, and the first guess's count. */
+#define FEWEST_RAYS 4u
+/* The rays the first guess's window sums, about: on the Cornell box at an 8 ms budget (lmgi bench --edits,
+ * the red wall recoloured, a first guess of 2 ms: 4 rays for every 4th texel), a window of 8 read 8.3% off
+ * at the edit, of 32 6.1%, 64 5.8%, 128 6.2% (the factor's own change across a wider window). */
+#define FIRST_GUESS_SUMMED 64u
+
+/* One pass's quality: K rays for every stride-th texel (and each surface's first), the window summed. */
+typedef struct {
+    uint32_t K, stride;
+    int spread;
+} quality;
+
+/* K rays (at most 64, rounded down to a square as the rim casts them) for every stride-th texel, with the
+ * window that holds about two of them. */
+static quality quality_of(uint32_t K, uint32_t stride)
+{
+    uint32_t side = (uint32_t)sqrt((double)(K > 64 ? 64 : K));
+    quality q = {side * side, stride, LM_LIGHT_SCALE_SPREAD};
+    while ((uint32_t)((2 * q.spread + 1) * (2 * q.spread + 1)) < 2 * q.stride)
+        q.spread++;
+    return q;
+}
+
+/* The full quality on T texels (header). */
+static quality full_quality(uint32_t T)
+{
+    uint32_t K = LM_LIGHT_SCALE_WORK / T, stride = 1;
+    if (K < FEWEST_RAYS) /* past that, every stride-th texel */
+        K = FEWEST_RAYS, stride = (FEWEST_RAYS * T + LM_LIGHT_SCALE_WORK - 1) / LM_LIGHT_SCALE_WORK;
+    return quality_of(K, stride);
+}
+
+/* Whether texel i gathers at stride: every stride-th, and a surface's first (its surface then has one). */
+static int gathers_at(const lm_atlas *a, uint32_t i, uint32_t stride)
+{
+    return i % stride == 0 || a->texels[i].surface != a->texels[i - 1].surface;
+}
+
+/* Rays of one gather that texels [lo, hi) cast at quality q. */
+static uint32_t rays_of(const lm_atlas *a, uint32_t lo, uint32_t hi, quality q)
+{
+    uint32_t n = 0;
+    for (uint32_t i = lo; i < hi; i++)
+        n += gathers_at(a, i, q.stride);
+    return n * q.K;
+}
+
 /* Texel i's two gathers (header) into e0 and e1 (3 floats each). */
-static void gathers(const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set, const lm_rim *was,
-                    const lm_rim *now, uint32_t i, float *e0, float *e1)
+static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_rim *now, uint32_t i, float *e0,
+                    float *e1)
 {
     float eye[3], n[3], ng[3], b[3], t[3];
-    lm_gather_texel_frame(set, s, a, i, eye, n, ng);
+    lm_gather_texel_frame(w->set, w->scene, w->atlas, i, eye, n, ng);
     lm_vec3 tv, bv;
     lm_tangents(lm_v3_load(n), &tv, &bv);
     lm_v3_store(t, tv);
@@ -54,48 +104,212 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         out[c] = 1.0f;
 }
 
-void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
-                           const float *before, const float *emissive_before, const float *after,
-                           const float *surface_factor, float *texel_factor)
+/* Texels [lo, hi) gathered at quality q into ls->e (those that gather at it, flagged done). */
+static void gather_range(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, quality q,
+                         uint32_t lo, uint32_t hi)
 {
-    uint32_t T = a->texel_count;
-    if (T == 0)
-        return;
-    uint32_t K = LM_LIGHT_SCALE_WORK / T, stride = 1;
-    if (K < 4) /* the fewest rays a texel still reads a ratio from; past that, every stride-th texel */
-        K = 4, stride = (4 * T + LM_LIGHT_SCALE_WORK - 1) / LM_LIGHT_SCALE_WORK;
-    K = K > 64 ? 64 : K;
-    int spread = LM_LIGHT_SCALE_SPREAD; /* wide enough to hold about two texels that gathered */
-    while ((uint32_t)((2 * spread + 1) * (2 * spread + 1)) < 2 * stride)
-        spread++;
-    float *e = before ? malloc(sizeof *e * 6 * (size_t)T) : NULL;
-    uint8_t *done = e ? calloc(T, 1) : NULL;
-    if (!done) { /* no AIM from before, or no memory: each texel as its surface's hits */
-        for (uint32_t i = 0; i < T; i++)
-            for (int c = 0; c < 3; c++)
-                texel_factor[3 * i + c] = surface_factor[3 * a->texels[i].surface + c];
-        free(e);
-        return;
-    }
-    lm_rim was = {s, a, rt, before, 1, {set->sky[0], set->sky[1], set->sky[2]}, 0.0f, (int)K, emissive_before, NULL};
-    if (s->has_sky)
-        lm_sky_mean(s, was.sky);
+    const lm_atlas *a = w->atlas;
+    size_t T = a->texel_count;
+    lm_rim was = {w->scene, a, w->rt, ls->before, 1, {w->set->sky[0], w->set->sky[1], w->set->sky[2]}, 0.0f,
+                  (int)q.K, ls->emissive_before, NULL};
+    if (w->scene->has_sky)
+        lm_sky_mean(w->scene, was.sky);
     lm_rim now = was;
     now.aim = after;
     now.emissive = NULL;
-    for (uint32_t i = 0; i < T; i++) /* a surface's first texel gathers too: its surface then has one */
-        done[i] = i % stride == 0 || a->texels[i].surface != a->texels[i - 1].surface;
+    for (uint32_t i = lo; i < hi; i++)
+        ls->done[i] = (uint8_t)gathers_at(a, i, q.stride);
 #pragma omp parallel
     {
         lm_rt_thread_init();
 #pragma omp for schedule(dynamic, 16)
-        for (long i = 0; i < (long)T; i++)
-            if (done[i])
-                gathers(s, a, set, &was, &now, (uint32_t)i, e + 3 * (size_t)i, e + 3 * ((size_t)T + (size_t)i));
-#pragma omp for schedule(static)
-        for (long i = 0; i < (long)T; i++)
-            texel_ratio(a, e, e + 3 * (size_t)T, done, spread, surface_factor, (uint32_t)i, texel_factor + 3 * i);
+        for (long i = (long)lo; i < (long)hi; i++)
+            if (ls->done[i])
+                gathers(w, &was, &now, (uint32_t)i, ls->e + 3 * (size_t)i, ls->e + 3 * (T + (size_t)i));
     }
-    free(e);
-    free(done);
+}
+
+/* The factors of texels [lo, hi), whole surfaces gathered, into f (3 per texel, texel lo's first). */
+static void ratios(const lm_light_scale *ls, const lm_atlas *a, int spread, uint32_t lo, uint32_t hi, float *f)
+{
+    const float *e0 = ls->e, *e1 = ls->e + 3 * (size_t)a->texel_count;
+#pragma omp parallel for schedule(static)
+    for (long i = (long)lo; i < (long)hi; i++)
+        texel_ratio(a, e0, e1, ls->done, spread, ls->surface_factor, (uint32_t)i, f + 3 * (i - (long)lo));
+}
+
+void lm_light_scale_init(lm_light_scale *ls) { memset(ls, 0, sizeof *ls); }
+
+void lm_light_scale_free(lm_light_scale *ls)
+{
+    free(ls->before);
+    free(ls->emissive_before);
+    free(ls->surface_factor);
+    free(ls->e);
+    free(ls->done);
+    free(ls->kept);
+    free(ls->applied);
+    free(ls->range);
+    free(ls->order);
+    lm_light_scale_init(ls);
+}
+
+/* Every texel its surface's factor: no AIM from before, or no memory. */
+static void surface_factors(const lm_atlas *a, const float *surface_factor, float *factor)
+{
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        memcpy(factor + 3 * (size_t)i, surface_factor + 3 * a->texels[i].surface, 3 * sizeof *factor);
+}
+
+/* How far surface k's first guess moved its texels: the sum of |f - 1| over them and their channels. */
+static double moved_by(const lm_light_scale *ls, int k)
+{
+    double m = 0.0;
+    for (uint32_t i = ls->range[2 * k]; i < ls->range[2 * k + 1]; i++)
+        for (int c = 0; c < 3; c++)
+            m += fabs((double)ls->applied[3 * (size_t)i + c] - 1.0);
+    return m;
+}
+
+/* The refinement's order: each surface's run of texels (range), the surfaces the first guess moved most
+ * first (what the edit changed most is right soonest), ties by id. 0: no memory. */
+static int plan_order(lm_light_scale *ls, const lm_atlas *a)
+{
+    int S = a->surface_count;
+    ls->range = calloc(2 * (size_t)S + 1, sizeof *ls->range);
+    ls->order = malloc(sizeof *ls->order * (size_t)(S ? S : 1));
+    double *moved = malloc(sizeof *moved * (size_t)(S ? S : 1));
+    if (!ls->range || !ls->order || !moved) {
+        free(moved);
+        return 0;
+    }
+    ls->count = 0;
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        int k = a->texels[i].surface;
+        if (i == 0 || k != a->texels[i - 1].surface)
+            ls->range[2 * k] = i, ls->order[ls->count++] = k;
+        ls->range[2 * k + 1] = i + 1;
+    }
+    for (int j = 0; j < ls->count; j++)
+        moved[ls->order[j]] = moved_by(ls, ls->order[j]);
+    for (int j = 1; j < ls->count; j++) { /* insertion sort: a handful to thousands of surfaces, once */
+        int k = ls->order[j], at = j;
+        for (; at > 0 && moved[ls->order[at - 1]] < moved[k]; at--)
+            ls->order[at] = ls->order[at - 1];
+        ls->order[at] = k;
+    }
+    free(moved);
+    ls->at = 0;
+    ls->next = 0;
+    return 1;
+}
+
+uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
+                              float *emissive_before, const float *after, const float *surface_factor, uint32_t rays,
+                              float *factor)
+{
+    const lm_atlas *a = w->atlas;
+    size_t T = a->texel_count, S = (size_t)a->surface_count;
+    lm_light_scale_free(ls);
+    ls->before = before;
+    ls->emissive_before = emissive_before;
+    ls->surface_factor = malloc(sizeof *ls->surface_factor * 3 * (S ? S : 1));
+    ls->e = before && T ? malloc(sizeof *ls->e * 6 * T) : NULL;
+    ls->done = ls->e ? calloc(T, 1) : NULL;
+    ls->kept = ls->done ? calloc(T, 1) : NULL;
+    ls->applied = ls->kept ? malloc(sizeof *ls->applied * 3 * T) : NULL;
+    if (!ls->applied || !ls->surface_factor) {
+        surface_factors(a, surface_factor, factor);
+        lm_light_scale_free(ls);
+        return 0;
+    }
+    memcpy(ls->surface_factor, surface_factor, sizeof *ls->surface_factor * 3 * S);
+    quality full = full_quality((uint32_t)T), q = full;
+    uint32_t want = rays_of(a, 0, (uint32_t)T, full);
+    if (rays > 0 && rays < want) { /* the first guess: FEWEST_RAYS for every stride-th, the stride that fits */
+        uint32_t runs = 0; /* each surface's first texel gathers whatever the stride */
+        for (uint32_t i = 0; i < T; i++)
+            runs += i == 0 || a->texels[i].surface != a->texels[i - 1].surface;
+        runs *= FEWEST_RAYS;
+        uint32_t strided = rays > runs + FEWEST_RAYS ? rays - runs : FEWEST_RAYS;
+        uint32_t stride = (uint32_t)((FEWEST_RAYS * T + strided - 1) / strided);
+        q = quality_of(FEWEST_RAYS, stride > full.stride ? stride : full.stride);
+        while ((uint32_t)((2 * q.spread + 1) * (2 * q.spread + 1)) * q.K < FIRST_GUESS_SUMMED * q.stride)
+            q.spread++;
+    }
+    gather_range(ls, w, after, q, 0, (uint32_t)T);
+    ratios(ls, a, q.spread, 0, (uint32_t)T, factor);
+    uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
+    if (q.K == full.K && q.stride == full.stride) { /* the full quality: nothing to refine */
+        lm_light_scale_free(ls);
+        return cast;
+    }
+    memcpy(ls->applied, factor, sizeof *factor * 3 * T);
+    ls->K = full.K, ls->stride = full.stride, ls->spread = full.spread;
+    ls->active = plan_order(ls, a);
+    if (!ls->active) /* no memory: the first guess stays, which regathers refine */
+        lm_light_scale_free(ls);
+    return cast;
+}
+
+uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, uint32_t rays,
+                               float *factor, int *corrected)
+{
+    *corrected = 0;
+    if (!ls->active)
+        return 0;
+    const lm_atlas *a = w->atlas;
+    quality q = {ls->K, ls->stride, ls->spread};
+    uint32_t cast = 0;
+    rays = rays ? rays : UINT32_MAX; /* no bound (the budget switched off): the rest at once */
+    for (size_t c = 0; c < 3 * (size_t)a->texel_count; c++)
+        factor[c] = 1.0f;
+    while (ls->at < ls->count && (cast == 0 || cast < rays)) { /* at least one texel that gathers */
+        int k = ls->order[ls->at];
+        uint32_t start = ls->range[2 * k], end = ls->range[2 * k + 1];
+        uint32_t lo = ls->next > start ? ls->next : start, hi = lo;
+        while (hi < end && (cast == 0 || cast < rays))
+            cast += gathers_at(a, hi++, q.stride) ? q.K : 0;
+        gather_range(ls, w, after, q, lo, hi);
+        ls->next = hi;
+        if (hi < end)
+            break;
+        float *f = malloc(sizeof *f * 3 * (size_t)(end - start));
+        if (!f) { /* the rest keeps its first guess, which regathers refine */
+            lm_light_scale_free(ls);
+            return cast;
+        }
+        ratios(ls, a, q.spread, start, end, f);
+        for (uint32_t i = start; i < end; i++)
+            for (int c = 0; c < 3; c++) {
+                float was = ls->applied[3 * (size_t)i + c], now = f[3 * (size_t)(i - start) + c];
+                /* a channel the first guess took to 0 cannot be scaled back: its regather brings it */
+                if (!ls->kept[i] && was > 1e-6f && now != was)
+                    factor[3 * (size_t)i + c] = now / was, *corrected = 1;
+            }
+        free(f);
+        ls->at++;
+        ls->next = 0; /* the next surface's run starts anywhere */
+    }
+    if (ls->at >= ls->count)
+        lm_light_scale_free(ls);
+    return cast;
+}
+
+void lm_light_scale_regathered(lm_light_scale *ls, const uint32_t *texels, uint32_t n)
+{
+    for (uint32_t i = 0; ls->active && i < n; i++)
+        ls->kept[texels[i]] = 1;
+}
+
+uint32_t lm_light_scale_waiting(const lm_light_scale *ls, const lm_atlas *a)
+{
+    quality q = {ls->K, ls->stride, ls->spread};
+    uint32_t n = 0;
+    for (int j = ls->active ? ls->at : ls->count; j < ls->count; j++) {
+        int k = ls->order[j];
+        uint32_t lo = ls->range[2 * k];
+        n += rays_of(a, j == ls->at && ls->next > lo ? ls->next : lo, ls->range[2 * k + 1], q);
+    }
+    return n;
 }

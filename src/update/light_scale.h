@@ -1,26 +1,42 @@
 /* The lightmap's first guess after lights changed in power alone (issue 32, item 2; docs/tradeoff.md,
- * "Light edits at once"). A light's photons keep their paths when only its colour, intensity or switch
- * changes, so the photon stage scales their hits and each surface's AIM by how much the flux of its hits
- * changed (update/photon_stage.h). An IIM texel's light is what it sees of those AIMs, so its own factor
- * is the ratio of two small ray gathers from the texel, through the same rays, over the AIM before and
- * after the scaling (and the emitters' emission before and after):
+ * "Light edits at once"), and its refinement within the update budget (item 4). A light's photons keep
+ * their paths when only its colour, intensity or switch changes, so the photon stage scales their hits
+ * and each surface's AIM by how much the flux of its hits changed (update/photon_stage.h). An IIM texel's
+ * light is what it sees of those AIMs, so its own factor is the ratio of two small ray gathers from the
+ * texel, through the same rays, over the AIM before and after the scaling (and the emitters' emission
+ * before and after):
  *
  *     f(texel) = E_after / E_before   per channel (photonmap/hemicube_rim.h with the whole hemisphere)
  *
  * a mean of the seen surfaces' factors weighed by how much light each brings (emitters and the sky, which
  * the edit did not change, weigh in with 1), summed over the texel's neighbours on its surface
- * (LM_LIGHT_SCALE_SPREAD). Both gathers meet the same points, so the ratio is far less
- * noisy than either: in a scene lit by one emitter every factor is the light's own and the IIM is
- * exact at once; where several light the seen surfaces in different proportions it is a first guess
- * that the regathers the scaled hits call for refine. A texel whose rays met no light before takes its
- * surface's factor (1 where they meet none after either).
+ * (LM_LIGHT_SCALE_SPREAD). Both gathers meet the same points, so the ratio is far less noisy than
+ * either: in a scene lit by one emitter every factor is the light's own and the IIM is exact at once;
+ * where several light the seen surfaces in different proportions it is a first guess that the regathers
+ * the scaled hits call for refine. A texel whose rays met no light before takes its surface's factor (1
+ * where they meet none after either).
  *
- * Cost: two gathers of K rays a texel, each ray with its 16 AIM lookups (K = LM_LIGHT_SCALE_WORK / texels
- * rounded down to a square, at most 64: 16 at `run`'s 1,800 texels), on every OpenMP thread, once, in the
- * update that sees the edit (34 ms on the shared room at 1,800 texels, 2 cores). Past LM_LIGHT_SCALE_WORK / 4
- * texels only every stride-th gathers with K = 4, and each texel sums over a window wide enough to hold
- * about two that did (its surface's factor where it holds none): the work stays bounded on any atlas. Errors: none (deterministic: each
- * texel's rays are seeded by its index). Thread-safe as the tracer is. */
+ * The full quality: K rays a texel (K = LM_LIGHT_SCALE_WORK / texels rounded down to a square, at most
+ * 64: 16 at `run`'s 1,800 texels) for each of the two gathers, each ray with its 16 AIM lookups (34 ms on
+ * the shared room at 1,800 texels, 2 cores). Past LM_LIGHT_SCALE_WORK / 4 texels only every stride-th
+ * gathers with K = 4, and each texel sums over a window wide enough to hold about two that did (its
+ * surface's factor where it holds none): the work stays bounded on any atlas.
+ *
+ * Within a budget. lm_light_scale_begin is given the rays the update may cast. With enough (or 0: no
+ * budget) the full quality is had at once, the IIM scaled once. With fewer, the first guess is the same
+ * estimate at K = 4 over every stride-th texel, the stride that fits (a coarser gather over blocks of
+ * texels); then each lm_light_scale_refine casts about the rays it is given over the next texels at the
+ * full quality, and once a surface's have all gathered, its factors correct what the first guess applied
+ * (f_full / f_first). A texel
+ * regathered since the edit (lm_light_scale_regathered) holds its fresh value and is left alone.
+ *
+ * Layout: the job owns the AIM and the emissions from before until it ends; per texel its two gathers,
+ * what the IIM holds of this edit (the factor applied so far) and two flags (38 bytes a texel, freed when
+ * the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
+ * a surface's texels are a run and a factor, which sums over its own surface's texels alone, is final once
+ * its run is gathered. Cost: the rays cast, as above. Errors: none (deterministic: each texel's rays are
+ * seeded by its index; no memory: each texel takes its surface's factor at once). Not thread-safe (one
+ * job per lightmap path; the gathers themselves run on every OpenMP thread). */
 #ifndef LM_LIGHT_SCALE_H
 #define LM_LIGHT_SCALE_H
 
@@ -41,12 +57,50 @@
  * room's lamp dimmed 0.018, 0.017, 0.019 and 0.021. */
 #define LM_LIGHT_SCALE_SPREAD 1
 
-/* before, after: atlas-sized RGBA AIMs, dilated (lm_aim_dilated_rgba; before NULL: each texel takes its
- * surface's factor); emissive_before: per material rgb emission before (NULL: the scene's now);
- * surface_factor: surface_count x 3. texel_factor: a->texel_count x 3, written. set: the gather's (offset,
- * sky). */
-void lm_light_scale_texels(const lm_scene *s, const lm_atlas *a, const lm_rt *rt, const lm_hemicube_settings *set,
-                           const float *before, const float *emissive_before, const float *after,
-                           const float *surface_factor, float *texel_factor);
+typedef struct {
+    const lm_scene *scene;
+    const lm_atlas *atlas;
+    const lm_rt *rt;
+    const lm_hemicube_settings *set; /* the gather's (offset, sky) */
+} lm_light_scale_world;
+
+typedef struct {
+    float *before, *emissive_before; /* owned: the dilated AIM and per material emission before the edit */
+    float *surface_factor;           /* surface_count x 3 */
+    float *e;                        /* texel_count x 6: the gathers before (first half) and after */
+    uint8_t *done;                   /* per texel: its gathers are in e */
+    uint8_t *kept;                   /* per texel: regathered since the edit (no factor applies) */
+    float *applied;                  /* texel_count x 3: the factor the IIM holds of this edit */
+    uint32_t *range;                 /* per surface: its run of texels [range[2 k], range[2 k + 1]) */
+    int *order, count;               /* the surfaces with texels, in the refinement's order */
+    int at;                          /* order[at]: the surface under way */
+    uint32_t next;                   /* its first texel not yet gathered (0: none yet) */
+    uint32_t K, stride;              /* the full quality */
+    int spread;
+    int active;                      /* a refinement is under way */
+} lm_light_scale;
+
+void lm_light_scale_init(lm_light_scale *ls);
+/* Ends the job: texels the refinement had not reached keep their first guess (regathers refine them). */
+void lm_light_scale_free(lm_light_scale *ls);
+
+/* A new edit's factors into factor (a->texel_count x 3), to multiply the IIM by now. Ends a job under way
+ * first; takes before and emissive_before (malloc'd; before NULL: each texel takes its surface's factor;
+ * emissive_before NULL: the scene's now). after: the dilated AIM now; surface_factor: surface_count x 3.
+ * rays: the rays of one gather the update may cast (0: no bound, the full quality at once). Returns the
+ * rays of one gather cast. */
+uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
+                              float *emissive_before, const float *after, const float *surface_factor, uint32_t rays,
+                              float *factor);
+/* The next texels at the full quality, until about `rays` rays of one gather are cast (at least one
+ * texel's; 0: every one left): factor (texel_count x 3) gets the correction of each texel of the surfaces that completed, 1
+ * elsewhere; *corrected: whether any is not 1 (else the IIM needs no pass). Returns the rays cast (0: no
+ * job under way). */
+uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, uint32_t rays,
+                               float *factor, int *corrected);
+/* The texels (atlas texel indices) regathered this update: they keep their fresh value. */
+void lm_light_scale_regathered(lm_light_scale *ls, const uint32_t *texels, uint32_t n);
+/* The rays of one gather the refinement has still to cast (0: none under way). */
+uint32_t lm_light_scale_waiting(const lm_light_scale *ls, const lm_atlas *a);
 
 #endif

@@ -32,6 +32,10 @@ struct lm_lightmap_path {
     uint8_t *refreshed;        /* scratch: per surface, its AIM refreshed since the last schedule (before that,
                                 * in follow_scale, whether its texels were scaled) */
     float *scale;              /* scratch: per surface x 3, what power edits scaled (lm_photon_stage_take_scale) */
+    lm_light_scale scaling;    /* the last power edit's texel factors, refined within the budget */
+    uint32_t scale_rays;       /* the rays its gathers may cast an update (0: no bound) */
+    double scale_ms;           /* since lm_lightmap_path_take_scale_work: its time and rays */
+    uint64_t scale_cast;
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
@@ -191,6 +195,7 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
     lp->atlas = w->atlas;
     lp->rt = w->rt;
     lp->stage = stage;
+    lm_light_scale_init(&lp->scaling);
     lp->texels = malloc(sizeof(uint32_t) * (w->atlas->texel_count ? w->atlas->texel_count : 1));
     lp->refreshed = malloc((size_t)w->atlas->surface_count + 1);
     lp->scale = malloc(sizeof *lp->scale * 3 * ((size_t)w->atlas->surface_count + 1));
@@ -237,6 +242,7 @@ void lm_lightmap_path_free(lm_lightmap_path *lp)
     free(lp->texels);
     free(lp->refreshed);
     free(lp->scale);
+    lm_light_scale_free(&lp->scaling);
     free(lp);
 }
 
@@ -336,34 +342,57 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
 
 void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
 
+/* The IIM's texels multiplied by factor (texel_count x 3), surfaces with one changed set in scaled. */
+static void scale_iim(lm_lightmap_path *lp, const float *factor, uint8_t *scaled)
+{
+    lm_error e;
+    if (lm_iim_scale(&lp->iim, lp->atlas, factor, scaled, &e) != LM_OK)
+        lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
+}
+
 /* Lights or emitters changed in power alone, or materials edited, since the last call: each IIM texel
  * scaled by its own factor (light_scale.h; its surface's where that cannot be had), shown at the next
- * blend, and the AIM uploaded again before the next gather. */
+ * blend, and the AIM uploaded again before the next gather. Else the last such edit's factors refined,
+ * a few surfaces an update, within the rays the plan gives them. */
 static void follow_scale(lm_lightmap_path *lp)
 {
     float *before = NULL, *emissive = NULL;
-    if (!lm_photon_stage_take_scale(lp->stage, lp->scale, &before, &emissive))
+    int edit = lm_photon_stage_take_scale(lp->stage, lp->scale, &before, &emissive);
+    if (!edit && !lp->scaling.active)
         return;
+    double t0 = lm_now();
+    lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather};
+    const float *after = lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage));
+    float *texel = lp->have_iim ? malloc(sizeof *texel * 3 * ((size_t)lp->atlas->texel_count + 1)) : NULL;
+    uint8_t *scaled = lp->refreshed; /* scratch until lm_lightmap_path_widen takes the refreshed surfaces */
+    if (!edit) {
+        int corrected = 0;
+        lp->scale_cast += texel ? lm_light_scale_refine(&lp->scaling, &w, after, lp->scale_rays, texel, &corrected) : 0;
+        if (corrected)
+            scale_iim(lp, texel, scaled);
+        free(texel);
+        lp->scale_ms += 1e3 * (lm_now() - t0);
+        return;
+    }
     lp->aim_stale = 1;
     if (lp->have_change)
         lm_texel_change_scale(&lp->change, lp->atlas, lp->scale);
-    float *texel = lp->have_iim ? malloc(sizeof *texel * 3 * ((size_t)lp->atlas->texel_count + 1)) : NULL;
-    if (texel)
-        lm_light_scale_texels(lp->scene, lp->atlas, lp->rt, &lp->set->gather, before, emissive,
-                              lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->scale, texel);
-    lm_error e;
-    uint8_t *scaled = lp->refreshed; /* scratch until lm_lightmap_path_widen takes the refreshed surfaces */
-    if (!texel && lp->have_iim)
-        lm_log(LM_LOG_WARN, "%s: no memory to scale the lightmap after a light's edit: it follows by regathers",
-               lp->scene->path);
-    else if (texel && lm_iim_scale(&lp->iim, lp->atlas, texel, scaled, &e) != LM_OK)
-        lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
+    if (texel) {
+        lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, lp->scale_rays,
+                                               texel);
+        scale_iim(lp, texel, scaled);
+    } else {
+        free(before);
+        free(emissive);
+        if (lp->have_iim)
+            lm_log(LM_LOG_WARN, "%s: no memory to scale the lightmap after a light's edit: it follows by regathers",
+                   lp->scene->path);
+    }
     for (int k = 0; texel && k < lp->surfaces->surface_count; k++) /* scaled texels are regathered in the end */
         if (scaled[k] && !(store_of(lp)->surfaces[k].delta_i > lp->iim.sched.delta_threshold))
             lm_iim_sched_raise(&lp->iim.sched, store_of(lp), k);
     free(texel);
-    free(before);
-    free(emissive);
+    lp->scale_ms += 1e3 * (lm_now() - t0);
 }
 
 int lm_lightmap_path_widen(lm_lightmap_path *lp)
@@ -409,6 +438,7 @@ static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int 
             waiting = lm_texel_change_waiting(&lp->change, lp->atlas, lp->iim.sched.off, lp->texels + count);
     }
     lm_iim_set_pending(&lp->iim, lp->atlas, lp->texels + count, waiting);
+    lm_light_scale_regathered(&lp->scaling, lp->texels, count); /* fresh: a refined factor would spoil them */
     if (whole) /* a bake: in atlas order, so that where a texel lands in the gather's passes (and its
                 * rounding) depends on which texels are gathered, not on how they were picked */
         qsort(lp->texels, count, sizeof *lp->texels, by_index);
@@ -480,6 +510,7 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
             after += lp->iim.version[s];
         *texels = n;
         *surfaces_changed = (int)(after - before);
+        lm_light_scale_free(&lp->scaling); /* every texel a light edit's factors reached is regathered */
     }
     free(saved);
     free(change);
@@ -492,6 +523,22 @@ const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp) { return &l
 void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels)
 {
     lp->iim.sched.texels_per_frame = texels > 0 ? texels : 0;
+}
+
+void lm_lightmap_path_set_scale_rays(lm_lightmap_path *lp, uint32_t rays) { lp->scale_rays = rays; }
+
+uint32_t lm_lightmap_path_scale_waiting(const lm_lightmap_path *lp)
+{
+    return lm_light_scale_waiting(&lp->scaling, lp->atlas);
+}
+
+uint64_t lm_lightmap_path_take_scale_work(lm_lightmap_path *lp, double *ms)
+{
+    uint64_t n = lp->scale_cast;
+    *ms = lp->scale_ms;
+    lp->scale_cast = 0;
+    lp->scale_ms = 0.0;
+    return n;
 }
 
 lm_status lm_lightmap_path_read_window(const lm_lightmap_path *lp, const int win[4], float **rgba, lm_error *err)

@@ -55,6 +55,7 @@ struct lm_photon_stage {
     uint8_t *reached;            /* scratch: per surface, reweighted photons reach it (follow_materials) */
     lm_material *materials;      /* the scene's materials as the photons last saw them (material_count) */
     float *ratio;                /* scratch: per material x 3, a recolour's ratio (follow_materials) */
+    float *aim_factor;           /* scratch: per surface x 3, what an edit scales its AIM by (under a budget) */
     int material_count;
     int have_emitters, have_aim, have_area;
     int frame;
@@ -202,16 +203,63 @@ static void add_aim_stats(lm_photon_stage_frame *out, const lm_aim_stats *st)
     out->t_aim += st->seconds;
 }
 
-/* The AIMs of the first `count` surfaces of ps->touched refreshed at once for this frame's edits, counted
- * in out beside the budgeted refreshes (aim_at_once). */
-static lm_status refresh_at_once(lm_photon_stage *ps, int count, lm_photon_stage_frame *out, lm_error *err)
+/* The AIMs of the listed surfaces refreshed at once for this frame's edits, counted in out beside the
+ * budgeted refreshes (aim_at_once); refresh_at_once: the first `count` of ps->touched. */
+static lm_status refresh_listed_at_once(lm_photon_stage *ps, const int *surfaces, int count,
+                                        lm_photon_stage_frame *out, lm_error *err)
 {
     lm_aim_stats st;
     lm_status rc = lm_aim_refresh_listed(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
-                                         lm_photons_store_mutable(ps->photons), ps->touched, count, &st, err);
+                                         lm_photons_store_mutable(ps->photons), surfaces, count, &st, err);
     add_aim_stats(out, &st);
     out->aim_at_once += st.surfaces_refreshed;
     return rc;
+}
+
+static lm_status refresh_at_once(lm_photon_stage *ps, int count, lm_photon_stage_frame *out, lm_error *err)
+{
+    return refresh_listed_at_once(ps, ps->touched, count, out, err);
+}
+
+/* Whether the frame loop gives the stage a time budget (lm_photon_stage_limit): then an edit's AIM work
+ * at once is the cheap first guess, the refreshes left to the budgeted ones. */
+static int budgeted(const lm_photon_stage *ps) { return ps->limit.aim_hits > 0; }
+
+/* Under a budget, the AIMs after material edits (follow_materials), each scaled at once: a recoloured
+ * material's surfaces by its ratio, exact while their hits are as they were (the AIM multiplies in the
+ * albedo); the surfaces the reweighted photons reach (reweighted: flux_before and flux_after hold their
+ * hits' flux) by how much that flux changed, a first guess of their second bounce's change that the
+ * budgeted refreshes their hits' delta_f asks for refine. The surfaces of materials changed otherwise,
+ * and the reached ones where the AIM computes direct light (which their hits then lack, so that their
+ * flux's change is not the AIM's), are refreshed at once. */
+static lm_status recolour_aims(lm_photon_stage *ps, const uint8_t *changed, int reweighted,
+                               lm_photon_stage_frame *out, lm_error *err)
+{
+    int S = ps->surfaces->surface_count, scaled = 0, other = 0;
+    for (int k = 0; k < S; k++) {
+        int m = ps->surfaces->surfaces[k].material, by = 0;
+        float *f = ps->aim_factor + 3 * k;
+        f[0] = f[1] = f[2] = 1.0f;
+        for (int c = 0; c < 3 && reweighted && ps->reached[k] && !ps->aim.direct; c++) {
+            double b = ps->flux_before[3 * k + c], a = ps->flux_after[3 * k + c];
+            f[c] = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
+            by |= f[c] != 1.0f;
+        }
+        const float *r = ps->ratio + 3 * m;
+        int recoloured = changed[m] && (r[0] != 1.0f || r[1] != 1.0f || r[2] != 1.0f);
+        double moved = 0.0;
+        for (int c = 0; c < 3 && recoloured; c++)
+            f[c] *= r[c], moved = fmax(moved, fabs((double)r[c] - 1.0));
+        /* owed a refresh as if its hits had changed that much: the budgeted refreshes and a bake make it
+         * again from its hits, so that it ends as a fresh updater's (the scaled one is so to rounding) */
+        ps->aim.owed[k] += moved * lm_photons_store(ps->photons)->surfaces[k].energy;
+        if ((changed[m] && !recoloured) || (reweighted && ps->reached[k] && ps->aim.direct))
+            ps->touched[S - 1 - other++] = k; /* from the end: the two lists share the scratch */
+        else if (by || recoloured)
+            ps->touched[scaled++] = k;
+    }
+    lm_aim_scale_surfaces(&ps->aim, ps->atlas, ps->touched, scaled, ps->aim_factor);
+    return other > 0 ? refresh_listed_at_once(ps, ps->touched + S - other, other, out, err) : LM_OK;
 }
 
 /* The materials the edits changed (colour, emission, class; ch) reach the photons that touch them, which
@@ -245,8 +293,15 @@ static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch
             ps->materials[m] = ps->scene->materials[m];
     }
     memset(ps->reached, 0, (size_t)S);
+    int first_guess = ps->have_aim && budgeted(ps);
+    if (any && first_guess) /* the reached surfaces' flux before and after, for their AIM's first guess */
+        lm_photon_store_surface_flux(lm_photons_store(ps->photons), ps->flux_before);
     if (any)
         lm_photons_scale_materials(ps->photons, ps->ratio, M, ps->reached);
+    if (any && first_guess)
+        lm_photon_store_surface_flux(lm_photons_store(ps->photons), ps->flux_after);
+    if (first_guess)
+        return recolour_aims(ps, changed, any, out, err);
     int n = 0;
     for (int k = 0; k < S; k++)
         if (ps->reached[k] || changed[ps->surfaces->surfaces[k].material])
@@ -340,12 +395,19 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm
                 b = all_before[c], a = all_after[c];
             float f = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
             ps->light_scale[3 * k + c] *= f;
+            ps->aim_factor[3 * k + c] = f;
             changed |= f != 1.0f;
         }
         if (changed)
             ps->touched[moved++] = k;
     }
     keep_aim_before(ps);
+    /* scaled as their hits were, refreshed as those hits' delta_f asks, within the budget; not where the
+     * AIM computes direct light, which the hits' flux then lacks */
+    if (budgeted(ps) && !ps->aim.direct) {
+        lm_aim_scale_surfaces(&ps->aim, ps->atlas, ps->touched, moved, ps->aim_factor);
+        return LM_OK;
+    }
     return refresh_at_once(ps, moved, out, err);
 }
 
@@ -543,6 +605,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     ps->count_before = calloc(S, sizeof *ps->count_before);
     ps->light_scale = malloc(3 * S * sizeof *ps->light_scale);
     ps->flux_before = malloc(3 * S * sizeof *ps->flux_before);
+    ps->aim_factor = malloc(3 * S * sizeof *ps->aim_factor);
     ps->flux_after = malloc(3 * S * sizeof *ps->flux_after);
     ps->flux_of = malloc(3 * S * sizeof *ps->flux_of);
     ps->touched = malloc(S * sizeof *ps->touched);
@@ -556,7 +619,7 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
     for (size_t i = 0; ps->light_scale && i < 3 * S; i++)
         ps->light_scale[i] = 1.0f;
     if (!ps->refreshed || !ps->delta_before || !ps->count_before || !ps->light_scale || !ps->flux_before ||
-        !ps->flux_after || !ps->flux_of || !ps->touched || !ps->reached || !ps->materials || !ps->ratio)
+        !ps->flux_after || !ps->aim_factor || !ps->flux_of || !ps->touched || !ps->reached || !ps->materials || !ps->ratio)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     st = make_photons(ps, &ps->photons, err);
     if (st == LM_OK)
@@ -636,6 +699,7 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->light_scale);
     free(ps->flux_before);
     free(ps->flux_after);
+    free(ps->aim_factor);
     free(ps->flux_of);
     free(ps->touched);
     free(ps->reached);
@@ -821,6 +885,7 @@ int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_befo
     return any;
 }
 
+int lm_photon_stage_scale_waiting(const lm_photon_stage *ps) { return ps->scaled; }
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }
 lm_photon_store *lm_photon_stage_store(lm_photon_stage *ps) { return lm_photons_store_mutable(ps->photons); }
 const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps) { return &ps->aim; }

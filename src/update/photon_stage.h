@@ -105,6 +105,8 @@ int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
  * both malloc'd, the caller's to free, NULL when nothing changed or memory ran out. Resets them. Returns
  * 0 when nothing changed. Not while an update runs on another thread. */
 int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before, float **emissive_before);
+/* Whether a scaling waits for lm_photon_stage_take_scale (the plan of the update that takes it). */
+int lm_photon_stage_scale_waiting(const lm_photon_stage *ps);
 
 /* What a time budget allows the next updates (update/budget_plan.h): invalid photon groups re-traced, the
  * AIM refresh's bound on stored hits (then any number of surfaces within it; its first surface always),
