@@ -1171,8 +1171,8 @@ static float *floats_copy(const float *v, size_t n)
     return c;
 }
 
-/* A light edit's texel factors within a budget (update/light_scale.h): a coarse first guess, then the
- * refinement a few hundred rays at a time, whose corrections bring every texel to the factor the full
+/* A light edit's texel factors within a budget (update/light_scale.h): a coarse first guess (of more rays
+ * than the surfaces, and of fewer), then the refinement a few hundred rays at a time, whose corrections bring every texel to the factor the full
  * quality gives at once (to float rounding: the same rays, seeded by the texel), and leave the texels
  * regathered meanwhile alone. On scenes/cornell.glb at `lmgi run`'s density, the AIM after the edit
  * changed unevenly over the atlas (redder to the left, dimmer to the top), the emitters dimmed. */
@@ -1208,53 +1208,58 @@ static void test_light_scale_refined_equals_full(void **state)
     uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), after,
                                         surface, 0, full);
     assert_false(ls.active); /* no bound: the full quality at once */
-    uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), after,
-                                          surface, 600, shown);
-    assert_true(ls.active);
-    assert_true(first <= 600 + 64 && first < all / 8); /* about what it was given */
-    uint32_t left = lm_light_scale_waiting(&ls, &p.atlas);
-    assert_int_equal(left, all);
-    const uint32_t kept[3] = {0, (uint32_t)T / 2, (uint32_t)T - 1}; /* regathered before the refinement */
-    lm_light_scale_regathered(&ls, kept, 3);
-    float was[3][3];
-    for (int j = 0; j < 3; j++)
-        memcpy(was[j], shown + 3 * kept[j], sizeof was[j]);
-    int steps = 0;
-    double first_off = 0.0;
-    for (size_t i = 0; i < 3 * T; i++)
-        first_off = fmax(first_off, fabs(shown[i] - full[i]) / fmax(fabs(full[i]), 1e-3));
-    while (ls.active && steps < 1000) {
-        int corrected = 0;
-        uint32_t cast = lm_light_scale_refine(&ls, &w, after, 700, corr, &corrected);
-        assert_true(cast > 0 && cast < 700 + 64); /* about what it was given: at most a texel's rays past it */
-        uint32_t now = lm_light_scale_waiting(&ls, &p.atlas);
-        assert_int_equal(now, left - cast);
-        left = now;
+    /* 600 rays: 4 for every stride-th texel and each surface's first; 40: fewer than the surfaces, so
+     * only the stride's, the others' their surface's factor */
+    const uint32_t budget[2] = {600, 40};
+    for (int r = 0; r < 2; r++) {
+        uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), after,
+                                              surface, budget[r], shown);
+        assert_true(ls.active);
+        assert_true(first <= budget[r] + 64 && first < all / 8); /* about what it was given */
+        uint32_t left = lm_light_scale_waiting(&ls, &p.atlas);
+        assert_int_equal(left, all);
+        const uint32_t kept[3] = {0, (uint32_t)T / 2, (uint32_t)T - 1}; /* regathered before the refinement */
+        lm_light_scale_regathered(&ls, kept, 3);
+        float was[3][3];
+        for (int j = 0; j < 3; j++)
+            memcpy(was[j], shown + 3 * kept[j], sizeof was[j]);
+        int steps = 0;
+        double first_off = 0.0;
         for (size_t i = 0; i < 3 * T; i++)
-            shown[i] *= corr[i];
-        steps++;
+            first_off = fmax(first_off, fabs(shown[i] - full[i]) / fmax(fabs(full[i]), 1e-3));
+        while (ls.active && steps < 1000) {
+            int corrected = 0;
+            uint32_t cast = lm_light_scale_refine(&ls, &w, after, 700, corr, &corrected);
+            assert_true(cast > 0 && cast < 700 + 64); /* about what it was given: at most a texel's rays past it */
+            uint32_t now = lm_light_scale_waiting(&ls, &p.atlas);
+            assert_int_equal(now, left - cast);
+            left = now;
+            for (size_t i = 0; i < 3 * T; i++)
+                shown[i] *= corr[i];
+            steps++;
+        }
+        assert_false(ls.active);
+        assert_int_equal(left, 0);
+        double worst = 0.0;
+        uint32_t compared = 0;
+        for (uint32_t i = 0; i < T; i++) {
+            int regathered = i == kept[0] || i == kept[1] || i == kept[2];
+            for (int c = 0; c < 3 && !regathered; c++)
+                if (full[3 * i + c] > 1e-3f) {
+                    worst = fmax(worst, fabs(shown[3 * i + c] - full[3 * i + c]) / full[3 * i + c]);
+                    compared++;
+                }
+        }
+        for (int j = 0; j < 3; j++) /* a regathered texel keeps what it showed */
+            assert_memory_equal(was[j], shown + 3 * kept[j], sizeof was[j]);
+        print_message("light scale: %u rays at once; a first guess of %u rays for %u (%.3g off the full at worst), "
+                      "then %d refinements: %.3g off the full at worst over %u texel channels\n",
+                      all, first, budget[r], first_off, steps, worst, compared);
+        assert_true(first_off > 0.05); /* the first guess is coarse: the test sees what the refinement does */
+        assert_true(steps > 10);
+        assert_true(compared > 3 * T / 2);
+        assert_true(worst < 1e-5);
     }
-    assert_false(ls.active);
-    assert_int_equal(left, 0);
-    double worst = 0.0;
-    uint32_t compared = 0;
-    for (uint32_t i = 0; i < T; i++) {
-        int regathered = i == kept[0] || i == kept[1] || i == kept[2];
-        for (int c = 0; c < 3 && !regathered; c++)
-            if (full[3 * i + c] > 1e-3f) {
-                worst = fmax(worst, fabs(shown[3 * i + c] - full[3 * i + c]) / full[3 * i + c]);
-                compared++;
-            }
-    }
-    for (int j = 0; j < 3; j++) /* a regathered texel keeps what it showed */
-        assert_memory_equal(was[j], shown + 3 * kept[j], sizeof was[j]);
-    print_message("light scale: %u rays at once; a first guess of %u rays (%.3g off the full at worst), then %d "
-                  "refinements: %.3g off the full at worst over %u texel channels\n",
-                  all, first, first_off, steps, worst, compared);
-    assert_true(first_off > 0.05); /* the first guess is coarse: the test sees what the refinement does */
-    assert_true(steps > 10);
-    assert_true(compared > 3 * T / 2);
-    assert_true(worst < 1e-5);
     lm_light_scale_free(&ls);
     free(after), free(emissive), free(surface), free(full), free(shown), free(corr);
     lm_photon_stage_free(st);

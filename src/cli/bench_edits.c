@@ -128,11 +128,11 @@ static int report(const lm_cli_args *a, const lm_edit_script *s, const lm_edit_f
             fprintf(json, "    {\"ms\": %.3f, \"photons_ms\": %.3f, \"gather_ms\": %.3f, \"blend_ms\": %.3f, "
                     "\"texels\": %u, \"photons\": %u, \"aim_surfaces\": %d, \"surfaces_changed\": %d, "
                     "\"error\": %.5f, \"read_whole_ms\": %.3f, \"read_rects_ms\": %.3f, \"rect_texels\": %u, "
-                    "\"texture_ms\": %.3f, \"edit_ms\": %.3f}%s\n",
+                    "\"texture_ms\": %.3f, \"edit_ms\": %.3f, \"light_scale_ms\": %.3f, \"busiest\": \"%s\"}%s\n",
                     rows[f].ms_total, rows[f].ms_photons, rows[f].ms_gather, rows[f].ms_blend,
                     rows[f].texels, rows[f].photons, rows[f].aim, rows[f].changed, rows[f].error,
                     rows[f].ms_read_whole, rows[f].ms_read_rects, rows[f].rect_texels, rows[f].ms_texture,
-                    rows[f].ms_edit, f + 1 < s->frames ? "," : "");
+                    rows[f].ms_edit, rows[f].ms_light_scale, rows[f].busiest, f + 1 < s->frames ? "," : "");
         fprintf(json, "  ]\n}\n");
     }
     free(ms);

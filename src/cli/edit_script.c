@@ -417,7 +417,7 @@ static int play(const lm_edit_script *s, float budget_ms, const lm_edit_frame_ch
         }
         rows[f] = (lm_edit_frame){st.ms_total, st.ms_photons, st.ms_gather, st.ms_blend, st.texels_gathered,
                               st.photons_retraced, st.aim_surfaces_refreshed, st.surfaces_changed, 0.0, 0.0, 0, 0, 0, 0,
-                              NAN, 0.0, 0.0, 0, 0.0, ms_edit, st.busiest_stage};
+                              NAN, 0.0, 0.0, 0, 0.0, ms_edit, st.busiest_stage, st.ms_light_scale};
         double spent = 1e3 * lm_cli_now() - start;
         if (s->fps > 0 && spent < 1e3 / s->fps) { /* the game's own frame, with the photon work beside it */
             double left = 1e3 / s->fps - spent;

@@ -50,6 +50,7 @@ typedef struct {
     double ms_edit;        /* the calls of the edits made before this update (staged: they wait for no photon
                             * work, update/edits.h); 0 without one */
     const char *busiest;   /* the stage that took the update's longest time (lmgi_update_stats.busiest_stage) */
+    double ms_light_scale; /* of ms_photons or ms_gather: a light or colour edit's texel factors */
 } lm_edit_frame;
 
 /* A play's frame check: after every update from the first edit on, the updater's picture from the scene's

@@ -17,19 +17,25 @@
  * at the edit, of 32 6.1%, 64 5.8%, 128 6.2% (the factor's own change across a wider window). */
 #define FIRST_GUESS_SUMMED 64u
 
-/* One pass's quality: K rays for every stride-th texel (and each surface's first), the window summed. */
+/* One pass's quality: K rays for every stride-th texel (and, with firsts, each surface's first), the
+ * window summed. */
 typedef struct {
     uint32_t K, stride;
-    int spread;
+    int spread, firsts;
 } quality;
 
-/* K rays (at most 64, rounded down to a square as the rim casts them) for every stride-th texel, with the
- * window that holds about two of them. */
+/* The widest window a factor sums (17 x 17 texels): what the full quality needs past a million texels,
+ * and a bound on a first guess's, whose few rays would otherwise ask for windows that cost more to sum
+ * than the rays to cast (a 171 x 171 window a texel, 44 ms on the shared room at 192 rays). */
+#define MOST_SPREAD 8
+
+/* K rays (at most 64, rounded down to a square as the rim casts them) for every stride-th texel and each
+ * surface's first, with the window that holds about two of them. */
 static quality quality_of(uint32_t K, uint32_t stride)
 {
     uint32_t side = (uint32_t)sqrt((double)(K > 64 ? 64 : K));
-    quality q = {side * side, stride, LM_LIGHT_SCALE_SPREAD};
-    while ((uint32_t)((2 * q.spread + 1) * (2 * q.spread + 1)) < 2 * q.stride)
+    quality q = {side * side, stride, LM_LIGHT_SCALE_SPREAD, 1};
+    while ((uint32_t)((2 * q.spread + 1) * (2 * q.spread + 1)) < 2 * q.stride && q.spread < MOST_SPREAD)
         q.spread++;
     return q;
 }
@@ -43,10 +49,11 @@ static quality full_quality(uint32_t T)
     return quality_of(K, stride);
 }
 
-/* Whether texel i gathers at stride: every stride-th, and a surface's first (its surface then has one). */
-static int gathers_at(const lm_atlas *a, uint32_t i, uint32_t stride)
+/* Whether texel i gathers at q: every stride-th, and with firsts a surface's first (its surface then has
+ * one). */
+static int gathers_at(const lm_atlas *a, uint32_t i, quality q)
 {
-    return i % stride == 0 || a->texels[i].surface != a->texels[i - 1].surface;
+    return i % q.stride == 0 || (q.firsts && a->texels[i].surface != a->texels[i - 1].surface);
 }
 
 /* Rays of one gather that texels [lo, hi) cast at quality q. */
@@ -54,7 +61,7 @@ static uint32_t rays_of(const lm_atlas *a, uint32_t lo, uint32_t hi, quality q)
 {
     uint32_t n = 0;
     for (uint32_t i = lo; i < hi; i++)
-        n += gathers_at(a, i, q.stride);
+        n += gathers_at(a, i, q);
     return n * q.K;
 }
 
@@ -118,7 +125,7 @@ static void gather_range(lm_light_scale *ls, const lm_light_scale_world *w, cons
     now.aim = after;
     now.emissive = NULL;
     for (uint32_t i = lo; i < hi; i++)
-        ls->done[i] = (uint8_t)gathers_at(a, i, q.stride);
+        ls->done[i] = (uint8_t)gathers_at(a, i, q);
 #pragma omp parallel
     {
         lm_rt_thread_init();
@@ -227,20 +234,23 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     quality full = full_quality((uint32_t)T), q = full;
     uint32_t want = rays_of(a, 0, (uint32_t)T, full);
     if (rays > 0 && rays < want) { /* the first guess: FEWEST_RAYS for every stride-th, the stride that fits */
-        uint32_t runs = 0; /* each surface's first texel gathers whatever the stride */
+        uint32_t runs = 0; /* each surface's first texel, if that fits */
         for (uint32_t i = 0; i < T; i++)
             runs += i == 0 || a->texels[i].surface != a->texels[i - 1].surface;
         runs *= FEWEST_RAYS;
-        uint32_t strided = rays > runs + FEWEST_RAYS ? rays - runs : FEWEST_RAYS;
+        int firsts = rays >= runs + FEWEST_RAYS;
+        uint32_t strided = firsts ? rays - runs : rays;
         uint32_t stride = (uint32_t)((FEWEST_RAYS * T + strided - 1) / strided);
         q = quality_of(FEWEST_RAYS, stride > full.stride ? stride : full.stride);
-        while ((uint32_t)((2 * q.spread + 1) * (2 * q.spread + 1)) * q.K < FIRST_GUESS_SUMMED * q.stride)
+        q.firsts = firsts; /* else a surface none of whose texels gathers takes its surface's factor */
+        while ((uint32_t)((2 * q.spread + 1) * (2 * q.spread + 1)) * q.K < FIRST_GUESS_SUMMED * q.stride &&
+               q.spread < MOST_SPREAD)
             q.spread++;
     }
     gather_range(ls, w, after, q, 0, (uint32_t)T);
     ratios(ls, a, q.spread, 0, (uint32_t)T, factor);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
-    if (q.K == full.K && q.stride == full.stride) { /* the full quality: nothing to refine */
+    if (q.K == full.K && q.stride == full.stride && q.firsts) { /* the full quality: nothing to refine */
         lm_light_scale_free(ls);
         return cast;
     }
@@ -259,7 +269,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
     if (!ls->active)
         return 0;
     const lm_atlas *a = w->atlas;
-    quality q = {ls->K, ls->stride, ls->spread};
+    quality q = {ls->K, ls->stride, ls->spread, 1};
     uint32_t cast = 0;
     rays = rays ? rays : UINT32_MAX; /* no bound (the budget switched off): the rest at once */
     for (size_t c = 0; c < 3 * (size_t)a->texel_count; c++)
@@ -269,7 +279,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
         uint32_t start = ls->range[2 * k], end = ls->range[2 * k + 1];
         uint32_t lo = ls->next > start ? ls->next : start, hi = lo;
         while (hi < end && (cast == 0 || cast < rays))
-            cast += gathers_at(a, hi++, q.stride) ? q.K : 0;
+            cast += gathers_at(a, hi++, q) ? q.K : 0;
         gather_range(ls, w, after, q, lo, hi);
         ls->next = hi;
         if (hi < end)
@@ -304,7 +314,7 @@ void lm_light_scale_regathered(lm_light_scale *ls, const uint32_t *texels, uint3
 
 uint32_t lm_light_scale_waiting(const lm_light_scale *ls, const lm_atlas *a)
 {
-    quality q = {ls->K, ls->stride, ls->spread};
+    quality q = {ls->K, ls->stride, ls->spread, 1};
     uint32_t n = 0;
     for (int j = ls->active ? ls->at : ls->count; j < ls->count; j++) {
         int k = ls->order[j];
