@@ -378,8 +378,8 @@ static void follow_scale(lm_lightmap_path *lp)
     if (lp->have_change)
         lm_texel_change_scale(&lp->change, lp->atlas, lp->scale);
     if (texel) {
-        lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, lp->scale_rays,
-                                               texel);
+        uint32_t rays = lp->scale_rays && lp->scale_rays < LM_LIGHT_SCALE_LEAST ? LM_LIGHT_SCALE_LEAST : lp->scale_rays;
+        lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, rays, texel);
         scale_iim(lp, texel, scaled);
     } else {
         free(before);
