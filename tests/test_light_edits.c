@@ -767,6 +767,47 @@ static void test_recolour_within_budget(void **state)
     unsettle(&r);
 }
 
+/* Lit by the lamp and the spot, the lamp dimmed under a time budget: each surface's AIM is scaled by how
+ * much its hits' flux changed (a guess where both lights reach it, which the budgeted refreshes replace),
+ * and the texel factors are a first guess refined over the updates after; once the refinement is done
+ * the lightmap is nearer the regathered one than the full quality at once brings it without a budget
+ * (test_two_lights_first_guess: under 0.015 of the change). */
+static void test_two_lights_within_budget(void **state)
+{
+    (void)state;
+    const lmgi_light_desc both[2] = {LAMP, SPOT};
+    settled_room r;
+    settle(&r, both, 2);
+    size_t n = r.n;
+    budgeted_updates(r.u, 4.0f, 3, NULL);
+    edit_light(r.sc, 0, 0.25f, NULL, 1);
+    lmgi_update_stats st;
+    budgeted_updates(r.u, 4.0f, 1, &st);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    int updates = 0, refining = 0;
+    for (int quiet = 0; updates < 600 && quiet < 20; updates++) { /* until no factor's ray for 20 updates */
+        lmgi_update_stats u;
+        lmgi_error e;
+        assert_int_equal(lmgi_update(r.u, 0.0f, 4.0f, &u, &e), LMGI_OK);
+        refining += u.light_scale_rays > 0;
+        quiet = refining && u.light_scale_rays == 0 ? quiet + 1 : 0;
+    }
+    float *later = lmt_iim(r.u, r.sc, &n);
+    lmt_bake(r.u, NULL);
+    float *want = lmt_iim(r.u, r.sc, &n);
+    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
+    double after = lmt_relative_l1(later, want, n);
+    print_message("4 ms budget, lamp dimmed beside the spot: %d AIMs at once; against the regathered lightmap %.3g "
+                  "before, %.3g at the next update, %.3g after %d updates (the refinement cast rays in %d)\n",
+                  st.aim_surfaces_at_once, was, at_once, after, updates, refining);
+    assert_int_equal(st.aim_surfaces_at_once, 0);
+    assert_true(refining > 0 && updates < 600);
+    assert_true(at_once < 0.2 * was);
+    assert_true(after < 0.015 * was);
+    free(now), free(later), free(want);
+    unsettle(&r);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -783,6 +824,7 @@ int main(void)
         cmocka_unit_test(test_emission_at_once),
         cmocka_unit_test(test_one_light_within_budget),
         cmocka_unit_test(test_recolour_within_budget),
+        cmocka_unit_test(test_two_lights_within_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
