@@ -731,6 +731,19 @@ static void test_one_light_within_budget(void **state)
     unsettle(&r);
 }
 
+/* After a bake of r's updater, the relative L1 distances from its lightmap of r->before, now and later. */
+static void off_regathered(settled_room *r, const float *now, const float *later, double *was, double *at_once,
+                           double *after)
+{
+    size_t n = r->n;
+    lmt_bake(r->u, NULL);
+    float *want = lmt_iim(r->u, r->sc, &n);
+    *was = lmt_relative_l1(r->before, want, n);
+    *at_once = lmt_relative_l1(now, want, n);
+    *after = lmt_relative_l1(later, want, n);
+    free(want);
+}
+
 /* The block recoloured under a time budget: its AIM scaled by the colour's ratio at once, the surfaces
  * its reweighted photons reach by how much their hits' flux changed, the texel factors a first guess; the
  * refinement and the budgeted refreshes then bring the lightmap to where the unbudgeted edit's first
@@ -752,10 +765,8 @@ static void test_recolour_within_budget(void **state)
     float *now = lmt_iim(r.u, r.sc, &n);
     budgeted_updates(r.u, 4.0f, 120, NULL);
     float *later = lmt_iim(r.u, r.sc, &n);
-    lmt_bake(r.u, NULL);
-    float *want = lmt_iim(r.u, r.sc, &n);
-    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
-    double after = lmt_relative_l1(later, want, n);
+    double was, at_once, after;
+    off_regathered(&r, now, later, &was, &at_once, &after);
     print_message("4 ms budget, block recoloured: %d AIMs refreshed at once, a first guess of %u rays; lightmap "
                   "against the regathered one %.3g before the edit, %.3g at the next update, %.3g 120 updates "
                   "later\n", st.aim_surfaces_at_once, st.light_scale_rays, was, at_once, after);
@@ -763,7 +774,7 @@ static void test_recolour_within_budget(void **state)
     assert_true(was > 0.02);
     assert_true(at_once < 0.5 * was);
     assert_true(after < 0.25 * was);
-    free(now), free(later), free(want);
+    free(now), free(later);
     unsettle(&r);
 }
 
@@ -793,10 +804,8 @@ static void test_two_lights_within_budget(void **state)
         quiet = refining && u.light_scale_rays == 0 ? quiet + 1 : 0;
     }
     float *later = lmt_iim(r.u, r.sc, &n);
-    lmt_bake(r.u, NULL);
-    float *want = lmt_iim(r.u, r.sc, &n);
-    double was = lmt_relative_l1(r.before, want, n), at_once = lmt_relative_l1(now, want, n);
-    double after = lmt_relative_l1(later, want, n);
+    double was, at_once, after;
+    off_regathered(&r, now, later, &was, &at_once, &after);
     print_message("4 ms budget, lamp dimmed beside the spot: %d AIMs at once; against the regathered lightmap %.3g "
                   "before, %.3g at the next update, %.3g after %d updates (the refinement cast rays in %d)\n",
                   st.aim_surfaces_at_once, was, at_once, after, updates, refining);
@@ -804,7 +813,7 @@ static void test_two_lights_within_budget(void **state)
     assert_true(refining > 0 && updates < 600);
     assert_true(at_once < 0.2 * was);
     assert_true(after < 0.015 * was);
-    free(now), free(later), free(want);
+    free(now), free(later);
     unsettle(&r);
 }
 
