@@ -49,11 +49,17 @@ static quality full_quality(uint32_t T)
     return quality_of(K, stride);
 }
 
+/* Whether texel i is its surface's first (texels lie in the atlas by surface). */
+static int run_start(const lm_atlas *a, uint32_t i)
+{
+    return i == 0 || a->texels[i].surface != a->texels[i - 1].surface;
+}
+
 /* Whether texel i gathers at q: every stride-th, and with firsts a surface's first (its surface then has
  * one). */
 static int gathers_at(const lm_atlas *a, uint32_t i, quality q)
 {
-    return i % q.stride == 0 || (q.firsts && a->texels[i].surface != a->texels[i - 1].surface);
+    return i % q.stride == 0 || (q.firsts && run_start(a, i));
 }
 
 /* Rays of one gather that texels [lo, hi) cast at quality q. */
@@ -193,7 +199,7 @@ static int plan_order(lm_light_scale *ls, const lm_atlas *a)
     ls->count = 0;
     for (uint32_t i = 0; i < a->texel_count; i++) {
         int k = a->texels[i].surface;
-        if (i == 0 || k != a->texels[i - 1].surface)
+        if (run_start(a, i))
             ls->range[2 * k] = i, ls->order[ls->count++] = k;
         ls->range[2 * k + 1] = i + 1;
     }
@@ -232,11 +238,11 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     }
     memcpy(ls->surface_factor, surface_factor, sizeof *ls->surface_factor * 3 * S);
     quality full = full_quality((uint32_t)T), q = full;
-    uint32_t want = rays_of(a, 0, (uint32_t)T, full);
-    if (rays > 0 && rays < want) { /* the first guess: FEWEST_RAYS for every stride-th, the stride that fits */
+    int coarse = rays > 0 && rays < rays_of(a, 0, (uint32_t)T, full);
+    if (coarse) { /* the first guess: FEWEST_RAYS for every stride-th, the stride that fits */
         uint32_t runs = 0; /* each surface's first texel, if that fits */
         for (uint32_t i = 0; i < T; i++)
-            runs += i == 0 || a->texels[i].surface != a->texels[i - 1].surface;
+            runs += run_start(a, i);
         runs *= FEWEST_RAYS;
         int firsts = rays >= runs + FEWEST_RAYS;
         uint32_t strided = firsts ? rays - runs : rays;
@@ -250,12 +256,11 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     gather_range(ls, w, after, q, 0, (uint32_t)T);
     ratios(ls, a, q.spread, 0, (uint32_t)T, factor);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
-    if (q.K == full.K && q.stride == full.stride && q.firsts) { /* the full quality: nothing to refine */
+    if (!coarse) { /* the full quality: nothing to refine */
         lm_light_scale_free(ls);
         return cast;
     }
     memcpy(ls->applied, factor, sizeof *factor * 3 * T);
-    ls->K = full.K, ls->stride = full.stride, ls->spread = full.spread;
     ls->active = plan_order(ls, a);
     if (!ls->active) /* no memory: the first guess stays, which regathers refine */
         lm_light_scale_free(ls);
@@ -269,7 +274,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
     if (!ls->active)
         return 0;
     const lm_atlas *a = w->atlas;
-    quality q = {ls->K, ls->stride, ls->spread, 1};
+    quality q = full_quality(a->texel_count);
     uint32_t cast = 0;
     rays = rays ? rays : UINT32_MAX; /* no bound (the budget switched off): the rest at once */
     for (size_t c = 0; c < 3 * (size_t)a->texel_count; c++)
@@ -314,9 +319,11 @@ void lm_light_scale_regathered(lm_light_scale *ls, const uint32_t *texels, uint3
 
 uint32_t lm_light_scale_waiting(const lm_light_scale *ls, const lm_atlas *a)
 {
-    quality q = {ls->K, ls->stride, ls->spread, 1};
+    if (!ls->active) /* none under way (an atlas without texels never starts one) */
+        return 0;
+    quality q = full_quality(a->texel_count);
     uint32_t n = 0;
-    for (int j = ls->active ? ls->at : ls->count; j < ls->count; j++) {
+    for (int j = ls->at; j < ls->count; j++) {
         int k = ls->order[j];
         uint32_t lo = ls->range[2 * k];
         n += rays_of(a, j == ls->at && ls->next > lo ? ls->next : lo, ls->range[2 * k + 1], q);

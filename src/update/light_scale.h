@@ -82,8 +82,6 @@ typedef struct {
     int *order, count;               /* the surfaces with texels, in the refinement's order */
     int at;                          /* order[at]: the surface under way */
     uint32_t next;                   /* its first texel not yet gathered (0: none yet) */
-    uint32_t K, stride;              /* the full quality */
-    int spread;
     int active;                      /* a refinement is under way */
 } lm_light_scale;
 
