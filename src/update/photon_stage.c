@@ -221,6 +221,12 @@ static lm_status refresh_at_once(lm_photon_stage *ps, int count, lm_photon_stage
     return refresh_listed_at_once(ps, ps->touched, count, out, err);
 }
 
+/* How much a surface's hits' flux changed in a channel, from `before` to `after`: 1 where it had none. */
+static float flux_ratio(double before, double after)
+{
+    return before > 0.0 ? (float)fmax(after / before, 0.0) : 1.0f;
+}
+
 /* Whether the frame loop gives the stage a time budget (lm_photon_stage_limit): then an edit's AIM work
  * at once is the cheap first guess, the refreshes left to the budgeted ones. */
 static int budgeted(const lm_photon_stage *ps) { return ps->limit.aim_hits > 0; }
@@ -241,8 +247,7 @@ static lm_status recolour_aims(lm_photon_stage *ps, const uint8_t *changed, int 
         float *f = ps->aim_factor + 3 * k;
         f[0] = f[1] = f[2] = 1.0f;
         for (int c = 0; c < 3 && reweighted && ps->reached[k] && !ps->aim.direct; c++) {
-            double b = ps->flux_before[3 * k + c], a = ps->flux_after[3 * k + c];
-            f[c] = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
+            f[c] = flux_ratio(ps->flux_before[3 * k + c], ps->flux_after[3 * k + c]);
             by |= f[c] != 1.0f;
         }
         const float *r = ps->ratio + 3 * m;
@@ -393,7 +398,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm
             double b = ps->flux_before[3 * k + c], a = ps->flux_after[3 * k + c];
             if (!(b > 0.0) && computed) /* its AIM may hold the lights' direct light alone */
                 b = all_before[c], a = all_after[c];
-            float f = b > 0.0 ? (float)fmax(a / b, 0.0) : 1.0f;
+            float f = flux_ratio(b, a);
             ps->light_scale[3 * k + c] *= f;
             ps->aim_factor[3 * k + c] = f;
             changed |= f != 1.0f;
