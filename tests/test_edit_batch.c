@@ -78,9 +78,14 @@ static void test_light_edits_wait_for_nothing(void **state)
     assert_int_equal(lmgi_set_light(sc, 0, &back, &e), LMGI_OK);
     assert_int_equal(retraced_until_still(u, &scaled), 0);
     assert_int_equal(scaled, 1);
-    back.enabled = 1; /* on again: nothing to scale, every group of it traced again */
+    back.enabled = 1; /* on again: nothing to scale; every group of it traced in the edit's update (no time
+                       * budget), none left for the re-trace queue */
     assert_int_equal(lmgi_set_light(sc, 0, &back, &e), LMGI_OK);
-    assert_true(retraced_until_still(u, &scaled) > 0);
+    lmgi_update_stats on_again;
+    assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &on_again, &e), LMGI_OK);
+    assert_int_equal(on_again.lights_lit, 1);
+    assert_int_equal(on_again.lights_scaled, 0);
+    assert_int_equal(retraced_until_still(u, &scaled), 0);
     assert_int_equal(scaled, 0);
 
     /* added and removed: ids and counts at once, the scene model at the commit */

@@ -611,6 +611,63 @@ static void test_switched_off(void **state)
     two_lights(0, 1.0f, 0, 0.015); /* 0.0046 */
 }
 
+/* A light lit where there was none (issue 32, item 6), without a budget: the edit's update traces its
+ * photons and refreshes the AIMs they reach (every one of its groups traced: no re-trace left of them to
+ * wait for), and the IIM takes each texel's factor from them, so that its lightmap has made most of the
+ * way to what the same photons give once every surface is regathered. Before, the light's groups were
+ * queued and traced over the updates after, and the lightmap at the next update was where it had been. */
+static void lit_at_once(settled_room *r, int id, const char *what, double most)
+{
+    lmgi_update_stats st;
+    lmgi_error e;
+    size_t n = r->n;
+    assert_int_equal(lmgi_update(r->u, 0.0f, 0.0f, &st, &e), LMGI_OK);
+    float *now = lmt_iim(r->u, r->sc, &n);
+    lmgi_light l;
+    assert_int_equal(lmgi_get_light(r->sc, id, &l, &e), LMGI_OK);
+    assert_true(l.enabled && st.aim_surfaces_at_once > 0 && st.ms_aim > 0.0);
+    assert_int_equal(st.lights_lit, 1);
+    assert_int_equal(st.lights_scaled, 0);
+    lmt_bake(r->u, NULL);
+    float *want = lmt_iim(r->u, r->sc, &n);
+    double was = lmt_relative_l1(r->before, want, n), at_once = lmt_relative_l1(now, want, n);
+    print_message("%s: lightmap against the regathered one %.3g before the edit, %.3g at the next update "
+                  "(%d AIM surfaces refreshed at once, %.1f ms)\n", what, was, at_once, st.aim_surfaces_at_once,
+                  st.ms_aim);
+    assert_true(was > 0.1);
+    assert_true(at_once < most * was);
+    free(now), free(want);
+}
+
+static void test_added_light_at_once(void **state)
+{
+    (void)state;
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    lmgi_light spot = light_of(&SPOT);
+    spot.intensity *= 3.0f; /* a change the size of the lamp's light */
+    int id = -1;
+    lmgi_error e;
+    assert_int_equal(lmgi_add_light(r.sc, &spot, &id, &e), LMGI_OK);
+    lit_at_once(&r, id, "spot added", 0.1);
+    unsettle(&r);
+}
+
+static void test_switched_on_at_once(void **state)
+{
+    (void)state;
+    const lmgi_light_desc both[2] = {LAMP, SPOT};
+    settled_room r;
+    settle(&r, both, 2);
+    edit_light(r.sc, 1, 3.0f, NULL, 0);
+    lmt_updates(r.u, 3);
+    free(r.before);
+    r.before = lmt_iim(r.u, r.sc, &r.n);
+    edit_light(r.sc, 1, 1.0f, NULL, 1);
+    lit_at_once(&r, 1, "spot switched on", 0.1);
+    unsettle(&r);
+}
+
 /* The block recoloured from red to blue (issue 32, item 2): at the next update the AIMs of its surfaces
  * reflect the new colour, the photons that bounced off it carry it on (reweighted), and the texels that see
  * what changed follow; the re-traced photons after bring only their own noise. */
@@ -791,6 +848,41 @@ static void test_recolour_within_budget(void **state)
     unsettle(&r);
 }
 
+/* The spot added to the lamp-lit room under a 4 ms budget: the edit's update still traces its photons
+ * (lights_lit; their cost is the edit's, like a power edit's first guess), scales the AIMs that had
+ * light by how much their hits' flux grew instead of refreshing them at once, and shows the IIM's first
+ * guess; the refinement and the budgeted refreshes then bring it to the regathered lightmap. Before, its
+ * groups waited in the re-trace queue and the lightmap at the next update was where it had been. */
+static void test_added_light_within_budget(void **state)
+{
+    (void)state;
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    size_t n = r.n;
+    budgeted_updates(r.u, 4.0f, 3, NULL);
+    lmgi_light spot = light_of(&SPOT);
+    spot.intensity *= 3.0f;
+    int id = -1;
+    lmgi_error e;
+    assert_int_equal(lmgi_add_light(r.sc, &spot, &id, &e), LMGI_OK);
+    lmgi_update_stats st;
+    budgeted_updates(r.u, 4.0f, 1, &st);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    uint64_t refined = finish_refinement(r.u);
+    float *later = lmt_iim(r.u, r.sc, &n);
+    double was, at_once, after;
+    off_regathered(&r, now, later, &was, &at_once, &after);
+    print_message("4 ms budget, spot added: %d AIMs at once, %.2f ms; against the regathered lightmap %.3g before, "
+                  "%.3g at the next update, %.3g once refined (%llu rays within the budget)\n",
+                  st.aim_surfaces_at_once, st.ms_total, was, at_once, after, (unsigned long long)refined);
+    assert_int_equal(st.lights_lit, 1);
+    assert_int_equal(st.aim_surfaces_at_once, 0);
+    assert_true(at_once < 0.5 * was); /* 0.33: the scaled AIMs are a guess where the spot lights other places */
+    assert_true(after < 0.05 * was);
+    free(now), free(later);
+    unsettle(&r);
+}
+
 /* Lit by the lamp and the spot, the lamp dimmed under a time budget: each surface's AIM is scaled by how
  * much its hits' flux changed (a guess where both lights reach it, which the refreshes after replace),
  * and the texel factors are a first guess refined over the updates after (finish_refinement); then the
@@ -835,11 +927,14 @@ int main(void)
         cmocka_unit_test(test_large_atlas_at_once),
         cmocka_unit_test(test_two_lights_first_guess),
         cmocka_unit_test(test_switched_off),
+        cmocka_unit_test(test_added_light_at_once),
+        cmocka_unit_test(test_switched_on_at_once),
         cmocka_unit_test(test_recolour_at_once),
         cmocka_unit_test(test_emission_at_once),
         cmocka_unit_test(test_one_light_within_budget),
         cmocka_unit_test(test_recolour_within_budget),
         cmocka_unit_test(test_two_lights_within_budget),
+        cmocka_unit_test(test_added_light_within_budget),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -775,6 +775,44 @@ static void test_invalidate_emitter(void **state)
 
 /* ---- move a dynamic object and back: the original hits return exactly ---- */
 
+/* An emitter traced at once (lm_photons_retrace_emitter: a light switched on or added, shown at the next
+ * update) leaves the re-trace queue; the groups of the others queued with it keep their place and order,
+ * and the re-trace it spares would have changed nothing. */
+static void test_retrace_emitter_leaves_queue(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    world w;
+    world_load(&w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.group_budget = 16;
+    world_photons(&w, &set);
+    lm_error err;
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 0, &err), LM_OK);
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 1, &err), LM_OK);
+    assert_int_equal(lm_photons_invalidate_emitter(w.ph, 2, &err), LM_OK);
+    assert_int_equal(lm_photons_pending_groups(w.ph), 216);
+    snapshot s0 = take_snapshot(w.ph);
+    assert_int_equal(lm_photons_retrace_emitter(w.ph, 1, &err), LM_OK);
+    assert_int_equal(lm_photons_pending_groups(w.ph), 144);
+    assert_emitter_pending(w.ph, 1, 72);
+    snapshot s1 = take_snapshot(w.ph); /* the same scene: the same paths and hits */
+    assert_int_equal(s0.n, s1.n);
+    assert_memory_equal(s0.h, s1.h, s0.n * sizeof *s0.h);
+    for (int f = 1; f <= 9; f++) { /* emitter 0's groups first, then 2's, as they were queued */
+        lm_photon_frame_stats st = frame(&w);
+        assert_int_equal(st.groups_retraced, 16);
+        uint32_t done = 16u * (uint32_t)f;
+        assert_emitter_pending(w.ph, 0, done < 72 ? done : 72);
+        assert_emitter_pending(w.ph, 2, done > 72 ? done - 72 : 0);
+    }
+    assert_int_equal(frame(&w).groups_retraced, 0);
+    assert_int_equal(lm_photons_retrace_emitter(w.ph, (int)(lm_photons_group_count(w.ph) / 72), &err), LM_ERR_INVALID);
+    free(s0.h), free(s1.h);
+    world_free(&w);
+}
+
 /* Places node `node` at world matrix m, in the scene and the BVH, as an animation would. */
 static void move_node(world *w, int node, const float m[16])
 {
@@ -1079,6 +1117,7 @@ int main(void)
         cmocka_unit_test(test_recolour_reweights_hits),
         cmocka_unit_test(test_no_channel_grows),
         cmocka_unit_test(test_invalidate_emitter),
+        cmocka_unit_test(test_retrace_emitter_leaves_queue),
         cmocka_unit_test(test_move_and_back),
         cmocka_unit_test(test_reset_matches_fresh),
         cmocka_unit_test(test_exact_trace_replaces_noise),

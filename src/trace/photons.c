@@ -347,6 +347,20 @@ lm_status lm_photons_scale_emitter(lm_photons *ph, int e, const float s[3], lm_e
     return LM_OK;
 }
 
+/* Emitter e's groups taken off the queue (the others keep their order). */
+static void unqueue_emitter(lm_photons *ph, int e)
+{
+    uint32_t kept = 0, n = ph->group_count;
+    for (uint32_t i = 0; i < ph->queue_len; i++) {
+        uint32_t group = ph->queue[(ph->queue_head + i) % n];
+        if (group / ph->G == (uint32_t)e)
+            ph->groups[group].invalid = 0;
+        else
+            ph->queue[(ph->queue_head + kept++) % n] = group;
+    }
+    ph->queue_len = kept;
+}
+
 lm_status lm_photons_retrace_emitter(lm_photons *ph, int e, lm_error *err)
 {
     if (e < 0 || (uint32_t)e >= ph->emitter_count)
@@ -356,7 +370,10 @@ lm_status lm_photons_retrace_emitter(lm_photons *ph, int e, lm_error *err)
     memset(&st, 0, sizeof st);
     for (uint32_t k = 0; k < ph->G; k++)
         ph->tmp_groups[k] = (uint32_t)e * ph->G + k;
-    return ph_trace_groups(ph, ph->tmp_groups, ph->G, &st, err);
+    lm_status rc = ph_trace_groups(ph, ph->tmp_groups, ph->G, &st, err);
+    if (rc == LM_OK)
+        unqueue_emitter(ph, e);
+    return rc;
 }
 
 void lm_photons_emitter_flux(const lm_photons *ph, int e, double *flux)

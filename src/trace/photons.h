@@ -156,9 +156,10 @@ lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_s
  * no hits (lights.c), so its groups are traced again instead (lm_photons_retrace_emitter). Fails for an
  * out-of-range emitter. */
 lm_status lm_photons_scale_emitter(lm_photons *ph, int e, const float s[3], lm_error *err);
-/* Traces emitter e's groups now, queued or not: a light turned dark, whose hits are then gone at once (a
- * dark light emits no photon, so no ray is cast; a queued group's later re-trace finds it so again). Fails
- * for an out-of-range emitter or when memory runs out. */
+/* Traces emitter e's groups now, queued or not, and takes them off the queue: a light turned dark, whose
+ * hits are then gone at once (a dark light emits no photon, so no ray is cast), or one lit where it gave
+ * no light, whose light then shows at once (update/photon_stage.c). Fails for an out-of-range emitter or
+ * when memory runs out. */
 lm_status lm_photons_retrace_emitter(lm_photons *ph, int e, lm_error *err);
 /* Diffuse materials recoloured (their base colour alone changed, by ratio[3 m + c] per channel for the
  * first `materials` materials; 1 for the others): every stored hit a photon brings after bouncing off one
