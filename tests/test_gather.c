@@ -1172,10 +1172,13 @@ static float *floats_copy(const float *v, size_t n)
 }
 
 /* A light edit's texel factors within a budget (update/light_scale.h): a coarse first guess (of more rays
- * than the surfaces, and of fewer), then the refinement a few hundred rays at a time, whose corrections bring every texel to the factor the full
- * quality gives at once (to float rounding: the same rays, seeded by the texel), and leave the texels
- * regathered meanwhile alone. On scenes/cornell.glb at `lmgi run`'s density, the AIM after the edit
- * changed unevenly over the atlas (redder to the left, dimmer to the top), the emitters dimmed. */
+ * than the surfaces, and of fewer), then the refinement a few hundred rays at a time, whose corrections
+ * bring every texel to the value the full quality gives at once (to float rounding: the same rays, seeded
+ * by the texel), and leave the texels regathered meanwhile alone. On scenes/cornell.glb at `lmgi run`'s
+ * density, the AIM after the edit changed unevenly over the atlas (redder to the left, dimmer to the top),
+ * the emitters dimmed; then again with the emitters dark before and the AIM's left half near black, so
+ * that the texels that saw next to nothing before take the change added (LM_LIGHT_SCALE_DARK). Each
+ * texel's value starts at 1: IIM x factor + add. */
 static void test_light_scale_refined_equals_full(void **state)
 {
     (void)state;
@@ -1187,8 +1190,10 @@ static void test_light_scale_refined_equals_full(void **state)
     float *after = floats_copy(before, 4 * cells), *emissive = calloc(3 * (size_t)p.s->material_count + 3, sizeof(float));
     float *surface = malloc(sizeof(float) * 3 * S), *full = malloc(sizeof(float) * 3 * T);
     float *shown = malloc(sizeof(float) * 3 * T), *corr = malloc(sizeof(float) * 3 * T);
+    float *full_add = malloc(sizeof(float) * 3 * T), *shown_add = malloc(sizeof(float) * 3 * T);
+    float *corr_add = malloc(sizeof(float) * 3 * T), *lit_before = floats_copy(before, 4 * cells);
     assert_non_null(emissive), assert_non_null(surface), assert_non_null(full), assert_non_null(shown);
-    assert_non_null(corr);
+    assert_non_null(corr), assert_non_null(full_add), assert_non_null(shown_add), assert_non_null(corr_add);
     for (size_t c = 0; c < cells; c++) {
         float x = (float)(c % (size_t)p.atlas.width) / (float)p.atlas.width;
         float y = (float)(c / (size_t)p.atlas.width) / (float)p.atlas.height;
@@ -1205,15 +1210,29 @@ static void test_light_scale_refined_equals_full(void **state)
     lm_light_scale ls;
     lm_light_scale_init(&ls);
     size_t ne = 3 * (size_t)p.s->material_count + 3;
-    uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), after,
-                                        surface, 0, full);
-    assert_false(ls.active); /* no bound: the full quality at once */
     /* 600 rays: 4 for every stride-th texel and each surface's first; 40: fewer than the surfaces, so
-     * only the stride's, the others' their surface's factor */
-    const uint32_t budget[2] = {600, 40};
-    for (int r = 0; r < 2; r++) {
-        uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), after,
-                                              surface, budget[r], shown);
+     * only the stride's, the others' their surface's factor; the third run with the dark texels */
+    const uint32_t budget[3] = {600, 40, 600};
+    for (int r = 0; r < 3; r++) {
+        if (r == 2) { /* the emitters dark before, the AIM's left half near black */
+            memset(emissive, 0, sizeof *emissive * ne);
+            for (size_t c = 0; c < cells; c++)
+                for (int k = 0; k < 3 && c % (size_t)p.atlas.width < (size_t)p.atlas.width / 2; k++)
+                    lit_before[4 * c + k] *= 0.01f;
+        }
+        uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
+                                            after, surface, 0, full, full_add);
+        assert_false(ls.active); /* no bound: the full quality at once */
+        uint32_t added = 0, scaled = 0;
+        for (size_t i = 0; i < 3 * T; i++)
+            added += full_add[i] > 0.0f, scaled += full_add[i] == 0.0f && full[i] != 1.0f;
+        assert_true(r < 2 ? added == 0 : added > T / 8 && scaled > T / 8); /* both kinds in the third */
+        for (size_t i = 0; i < 3 * T; i++)
+            full[i] += full_add[i]; /* the value from 1 */
+        uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
+                                              after, surface, budget[r], shown, shown_add);
+        for (size_t i = 0; i < 3 * T; i++)
+            shown[i] += shown_add[i];
         assert_true(ls.active);
         assert_true(first <= budget[r] + 64 && first < all / 8); /* about what it was given */
         uint32_t left = lm_light_scale_waiting(&ls, &p.atlas);
@@ -1229,13 +1248,13 @@ static void test_light_scale_refined_equals_full(void **state)
             first_off = fmax(first_off, fabs(shown[i] - full[i]) / fmax(fabs(full[i]), 1e-3));
         while (ls.active && steps < 1000) {
             int corrected = 0;
-            uint32_t cast = lm_light_scale_refine(&ls, &w, after, 700, corr, &corrected);
+            uint32_t cast = lm_light_scale_refine(&ls, &w, after, 700, corr, corr_add, &corrected);
             assert_true(cast > 0 && cast < 700 + 64); /* about what it was given: at most a texel's rays past it */
             uint32_t now = lm_light_scale_waiting(&ls, &p.atlas);
             assert_int_equal(now, left - cast);
             left = now;
             for (size_t i = 0; i < 3 * T; i++)
-                shown[i] *= corr[i];
+                shown[i] = shown[i] * corr[i] + corr_add[i];
             steps++;
         }
         assert_false(ls.active);
@@ -1252,9 +1271,10 @@ static void test_light_scale_refined_equals_full(void **state)
         }
         for (int j = 0; j < 3; j++) /* a regathered texel keeps what it showed */
             assert_memory_equal(was[j], shown + 3 * kept[j], sizeof was[j]);
-        print_message("light scale: %u rays at once; a first guess of %u rays for %u (%.3g off the full at worst), "
-                      "then %d refinements: %.3g off the full at worst over %u texel channels\n",
-                      all, first, budget[r], first_off, steps, worst, compared);
+        print_message("light scale: %u rays at once (%u texel channels added to, %u scaled); a first guess of %u "
+                      "rays for %u (%.3g off the full at worst), then %d refinements: %.3g off the full at worst "
+                      "over %u texel channels\n",
+                      all, added, scaled, first, budget[r], first_off, steps, worst, compared);
         assert_true(first_off > 0.05); /* the first guess is coarse: the test sees what the refinement does */
         assert_true(steps > 10);
         assert_true(compared > 3 * T / 2);
@@ -1262,6 +1282,7 @@ static void test_light_scale_refined_equals_full(void **state)
     }
     lm_light_scale_free(&ls);
     free(after), free(emissive), free(surface), free(full), free(shown), free(corr);
+    free(full_add), free(shown_add), free(corr_add), free(lit_before);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }

@@ -848,6 +848,44 @@ static void test_recolour_within_budget(void **state)
     unsettle(&r);
 }
 
+/* The room's only lamp switched off, then on again: nothing lit the room in between, so no factor can
+ * bring its light back (0 times anything); each texel takes the change its two gathers saw, added
+ * (update/light_scale.h, LM_LIGHT_SCALE_DARK), and under a budget the AIMs the lamp alone lights are
+ * refreshed at once (none could be scaled). Before, the lightmap stayed black at the next update and took
+ * 90 updates of regathers to come back. */
+static void dark_room_switched_on(float budget_ms, double most)
+{
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    size_t n = r.n;
+    edit_light(r.sc, 0, 1.0f, NULL, 0);
+    budgeted_updates(r.u, budget_ms, 3, NULL);
+    float *dark = lmt_iim(r.u, r.sc, &n);
+    edit_light(r.sc, 0, 1.0f, NULL, 1);
+    lmgi_update_stats st;
+    budgeted_updates(r.u, budget_ms, 1, &st);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    lmt_bake(r.u, NULL);
+    float *want = lmt_iim(r.u, r.sc, &n);
+    double off = lmt_relative_l1(dark, want, n), at_once = lmt_relative_l1(now, want, n);
+    print_message("the room's only lamp switched on again, budget %.0f ms: lightmap against the regathered one "
+                  "%.3g while it was off, %.3g at the next update (%d AIMs at once)\n", budget_ms, off, at_once,
+                  st.aim_surfaces_at_once);
+    assert_int_equal(st.lights_lit, 1);
+    assert_true(st.aim_surfaces_at_once > 0);
+    assert_true(off > 0.5);
+    assert_true(at_once < most);
+    free(dark), free(now), free(want);
+    unsettle(&r);
+}
+
+static void test_dark_room_switched_on(void **state)
+{
+    (void)state;
+    dark_room_switched_on(0.0f, 0.1);
+    dark_room_switched_on(4.0f, 0.2);
+}
+
 /* The spot added to the lamp-lit room under a 4 ms budget: the edit's update still traces its photons
  * (lights_lit; their cost is the edit's, like a power edit's first guess), scales the AIMs that had
  * light by how much their hits' flux grew instead of refreshing them at once, and shows the IIM's first
@@ -929,6 +967,7 @@ int main(void)
         cmocka_unit_test(test_switched_off),
         cmocka_unit_test(test_added_light_at_once),
         cmocka_unit_test(test_switched_on_at_once),
+        cmocka_unit_test(test_dark_room_switched_on),
         cmocka_unit_test(test_recolour_at_once),
         cmocka_unit_test(test_emission_at_once),
         cmocka_unit_test(test_one_light_within_budget),

@@ -86,10 +86,12 @@ static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_r
 
 /* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within `spread` of it
  * that gathered (done), a ratio that varies slowly over a surface and is far less noisy summed; 1 where
- * they see no light either way, or where it is within LM_LIGHT_SCALE_KEEP of 1; its surface's where they
- * saw none before, or where none of them gathered. */
+ * they see no light either way, or where it is within LM_LIGHT_SCALE_KEEP of 1; its surface's where none
+ * of them gathered. Where they saw next to no light before (LM_LIGHT_SCALE_DARK), no factor can light
+ * the texel: its factor is 1 and *add the gathers' mean change, what a regather would add to it to first
+ * order (the gathers estimate the IIM's irradiance itself), unless that is under `least`. */
 static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, int spread,
-                        const float *surface_factor, uint32_t i, float *out)
+                        const float *surface_factor, float least, uint32_t i, float *out, float *add)
 {
     const lm_texel *t = &a->texels[i];
     double s0[3] = {0, 0, 0}, s1[3] = {0, 0, 0};
@@ -109,9 +111,12 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
     const float *own = surface_factor + 3 * t->surface;
     int keep = 1;
     for (int c = 0; c < 3; c++) { /* no neighbour gathered (a large atlas's strides): its surface's */
-        float f = !met ? own[c] : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : s1[c] > 0.0 ? own[c] : 1.0f;
+        int dark = met && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
+        float f = !met || dark ? (met ? 1.0f : own[c]) : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : 1.0f;
+        float d = dark ? (float)((s1[c] - s0[c]) / met) : 0.0f;
         out[c] = isfinite(f) && f >= 0.0f ? f : own[c];
-        keep &= fabsf(out[c] - 1.0f) < LM_LIGHT_SCALE_KEEP;
+        add[c] = isfinite(d) && d >= least ? d : 0.0f;
+        keep &= fabsf(out[c] - 1.0f) < LM_LIGHT_SCALE_KEEP && add[c] == 0.0f;
     }
     for (int c = 0; keep && c < 3; c++)
         out[c] = 1.0f;
@@ -142,13 +147,29 @@ static void gather_range(lm_light_scale *ls, const lm_light_scale_world *w, cons
     }
 }
 
-/* The factors of texels [lo, hi), whole surfaces gathered, into f (3 per texel, texel lo's first). */
-static void ratios(const lm_light_scale *ls, const lm_atlas *a, int spread, uint32_t lo, uint32_t hi, float *f)
+/* The factors and additions of texels [lo, hi), whole surfaces gathered, into f and d (3 per texel,
+ * texel lo's first). */
+static void ratios(const lm_light_scale *ls, const lm_atlas *a, int spread, uint32_t lo, uint32_t hi, float *f,
+                   float *d)
 {
     const float *e0 = ls->e, *e1 = ls->e + 3 * (size_t)a->texel_count;
 #pragma omp parallel for schedule(static)
     for (long i = (long)lo; i < (long)hi; i++)
-        texel_ratio(a, e0, e1, ls->done, spread, ls->surface_factor, (uint32_t)i, f + 3 * (i - (long)lo));
+        texel_ratio(a, e0, e1, ls->done, spread, ls->surface_factor, ls->least, (uint32_t)i, f + 3 * (i - (long)lo),
+                    d + 3 * (i - (long)lo));
+}
+
+/* The smallest addition worth a rewrite: LM_LIGHT_SCALE_KEEP of the mean irradiance the gathers of the
+ * first pass saw after the edit (the few photons a closed door lets into a dark room rewrite nothing). */
+static float least_add(const lm_light_scale *ls, const lm_atlas *a)
+{
+    const float *e1 = ls->e + 3 * (size_t)a->texel_count;
+    double sum = 0.0;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        if (ls->done[i])
+            sum += e1[3 * (size_t)i] + e1[3 * (size_t)i + 1] + e1[3 * (size_t)i + 2], n++;
+    return n ? (float)(LM_LIGHT_SCALE_KEEP * sum / (3.0 * n)) : 0.0f;
 }
 
 void lm_light_scale_init(lm_light_scale *ls) { memset(ls, 0, sizeof *ls); }
@@ -162,25 +183,28 @@ void lm_light_scale_free(lm_light_scale *ls)
     free(ls->done);
     free(ls->kept);
     free(ls->applied);
+    free(ls->added);
     free(ls->range);
     free(ls->order);
     lm_light_scale_init(ls);
 }
 
-/* Every texel its surface's factor: no AIM from before, or no memory. */
-static void surface_factors(const lm_atlas *a, const float *surface_factor, float *factor)
+/* Every texel its surface's factor, nothing added: no AIM from before, or no memory. */
+static void surface_factors(const lm_atlas *a, const float *surface_factor, float *factor, float *add)
 {
     for (uint32_t i = 0; i < a->texel_count; i++)
         memcpy(factor + 3 * (size_t)i, surface_factor + 3 * a->texels[i].surface, 3 * sizeof *factor);
+    memset(add, 0, sizeof *add * 3 * (size_t)a->texel_count);
 }
 
-/* How far surface k's first guess moved its texels: the sum of |f - 1| over them and their channels. */
+/* How far surface k's first guess moved its texels: the sum of |f - 1| over them and their channels, a
+ * texel given an addition counting as moved all the way. */
 static double moved_by(const lm_light_scale *ls, int k)
 {
     double m = 0.0;
     for (uint32_t i = ls->range[2 * k]; i < ls->range[2 * k + 1]; i++)
         for (int c = 0; c < 3; c++)
-            m += fabs((double)ls->applied[3 * (size_t)i + c] - 1.0);
+            m += ls->added[3 * (size_t)i + c] > 0.0f ? 1.0 : fabs((double)ls->applied[3 * (size_t)i + c] - 1.0);
     return m;
 }
 
@@ -219,7 +243,7 @@ static int plan_order(lm_light_scale *ls, const lm_atlas *a)
 
 uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
                               float *emissive_before, const float *after, const float *surface_factor, uint32_t rays,
-                              float *factor)
+                              float *factor, float *add)
 {
     const lm_atlas *a = w->atlas;
     size_t T = a->texel_count, S = (size_t)a->surface_count;
@@ -231,8 +255,9 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     ls->done = ls->e ? calloc(T, 1) : NULL;
     ls->kept = ls->done ? calloc(T, 1) : NULL;
     ls->applied = ls->kept ? malloc(sizeof *ls->applied * 3 * T) : NULL;
-    if (!ls->applied || !ls->surface_factor) {
-        surface_factors(a, surface_factor, factor);
+    ls->added = ls->applied ? malloc(sizeof *ls->added * 3 * T) : NULL;
+    if (!ls->added || !ls->surface_factor) {
+        surface_factors(a, surface_factor, factor, add);
         lm_light_scale_free(ls);
         return 0;
     }
@@ -254,13 +279,15 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
             q.spread++;
     }
     gather_range(ls, w, after, q, 0, (uint32_t)T);
-    ratios(ls, a, q.spread, 0, (uint32_t)T, factor);
+    ls->least = least_add(ls, a);
+    ratios(ls, a, q.spread, 0, (uint32_t)T, factor, add);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
     if (!coarse) { /* the full quality: nothing to refine */
         lm_light_scale_free(ls);
         return cast;
     }
     memcpy(ls->applied, factor, sizeof *factor * 3 * T);
+    memcpy(ls->added, add, sizeof *add * 3 * T);
     ls->active = plan_order(ls, a);
     if (!ls->active) /* no memory: the first guess stays, which regathers refine */
         lm_light_scale_free(ls);
@@ -268,7 +295,7 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
 }
 
 uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, uint32_t rays,
-                               float *factor, int *corrected)
+                               float *factor, float *add, int *corrected)
 {
     *corrected = 0;
     if (!ls->active)
@@ -278,7 +305,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
     uint32_t cast = 0;
     rays = rays ? rays : UINT32_MAX; /* no bound (the budget switched off): the rest at once */
     for (size_t c = 0; c < 3 * (size_t)a->texel_count; c++)
-        factor[c] = 1.0f;
+        factor[c] = 1.0f, add[c] = 0.0f;
     while (ls->at < ls->count && (cast == 0 || cast < rays)) { /* at least one texel that gathers */
         int k = ls->order[ls->at];
         uint32_t start = ls->range[2 * k], end = ls->range[2 * k + 1];
@@ -289,18 +316,21 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
         ls->next = hi;
         if (hi < end)
             break;
-        float *f = malloc(sizeof *f * 3 * (size_t)(end - start));
+        float *f = malloc(sizeof *f * 6 * (size_t)(end - start)), *d = f + 3 * (size_t)(end - start);
         if (!f) { /* the rest keeps its first guess, which regathers refine */
             lm_light_scale_free(ls);
             return cast;
         }
-        ratios(ls, a, q.spread, start, end, f);
+        ratios(ls, a, q.spread, start, end, f, d);
         for (uint32_t i = start; i < end; i++)
             for (int c = 0; c < 3; c++) {
-                float was = ls->applied[3 * (size_t)i + c], now = f[3 * (size_t)(i - start) + c];
-                /* a channel the first guess took to 0 cannot be scaled back: its regather brings it */
-                if (!ls->kept[i] && was > 1e-6f && now != was)
-                    factor[3 * (size_t)i + c] = now / was, *corrected = 1;
+                size_t j = 3 * (size_t)i + c, o = 3 * (size_t)(i - start) + c;
+                float was = ls->applied[j], now = f[o], had = ls->added[j], adds = d[o];
+                /* from v f1 + a1 to v f2 + a2: times f2 / f1, plus a2 - a1 f2 / f1. A channel the first guess
+                 * took to 0 cannot be scaled back: its regather brings it */
+                if (ls->kept[i] || !(was > 1e-6f) || (now == was && adds == had))
+                    continue;
+                factor[j] = now / was, add[j] = adds - had * factor[j], *corrected = 1;
             }
         free(f);
         ls->at++;

@@ -16,8 +16,10 @@
  * (LM_LIGHT_SCALE_SPREAD). Both gathers meet the same points, so the ratio is far less noisy than
  * either: in a scene lit by one emitter every factor is the light's own and the IIM is exact at once;
  * where several light the seen surfaces in different proportions it is a first guess that the regathers
- * the scaled hits call for refine. A texel whose rays met no light before takes its surface's factor (1
- * where they meet none after either).
+ * the scaled hits call for refine. A texel whose rays met next to no light before (LM_LIGHT_SCALE_DARK:
+ * a dark room whose lamp is switched on) has no factor that lights it: it takes instead the change the two
+ * gathers saw, added (E_after - E_before over the window, what its regather would add), and is 1 where
+ * they meet no light after either.
  *
  * The full quality: K rays a texel (K = LM_LIGHT_SCALE_WORK / texels rounded down to a square, at most
  * 64: 16 at `run`'s 1,800 texels) for each of the two gathers, each ray with its 16 AIM lookups (34 ms on
@@ -31,12 +33,12 @@
  * K = 4 over every stride-th texel, the stride that fits, each factor summing a window that holds about 64
  * rays, at most 17 x 17 texels (a coarser gather over blocks of texels); then each lm_light_scale_refine casts about the rays it is given over the next texels at the
  * full quality, and once a surface's have all gathered, its factors correct what the first guess applied
- * (f_full / f_first). A texel
+ * (f_full / f_first, and a_full - a_first f_full / f_first for what was added). A texel
  * regathered since the edit (lm_light_scale_regathered) holds its fresh value and is left alone.
  *
  * Layout: the job owns the AIM and the emissions from before until it ends; per texel its two gathers,
- * what the IIM holds of this edit (the factor applied so far) and two flags (38 bytes a texel, freed when
- * the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
+ * what the IIM holds of this edit (the factor and addition applied so far) and two flags (50 bytes a
+ * texel, freed when the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
  * a surface's texels are a run and a factor, which sums over its own surface's texels alone, is final once
  * its run is gathered. Cost: the rays cast, as above. Errors: none (deterministic: each texel's rays are
  * seeded by its index; no memory: each texel takes its surface's factor at once). Not thread-safe (one
@@ -60,6 +62,11 @@
  * (the edge of a closed door lit from the far room), and rewriting it would cost an engine a re-read and
  * the schedule a regather for nothing visible (lmgi bench --edits, "outside its reach"). */
 #define LM_LIGHT_SCALE_KEEP 1e-3f
+/* A texel whose gathers saw more than this times as much light after the edit as before (none before: a
+ * dark room whose lamp is switched on) takes the change they saw added rather than their ratio, which
+ * would leave what was dark dark: the two gathers' mean difference over its window estimates what its
+ * regather adds, to the gathers' noise (16 rays a texel summed over 3 x 3 at the full quality). */
+#define LM_LIGHT_SCALE_DARK 16.0
 /* Texels either side a texel's factor sums its surface's gathers over (1: a 3 x 3 window). One texel's 16
  * rays left the factor noisy where a large change fills part of its view: the Cornell box's red wall
  * recoloured blue read 0.050 from a fresh updater's lightmap at the next update, blotched; summed over
@@ -81,6 +88,8 @@ typedef struct {
     uint8_t *done;                   /* per texel: its gathers are in e */
     uint8_t *kept;                   /* per texel: regathered since the edit (no factor applies) */
     float *applied;                  /* texel_count x 3: the factor the IIM holds of this edit */
+    float *added;                    /* texel_count x 3: and what it added after it (LM_LIGHT_SCALE_DARK) */
+    float least;                     /* the smallest addition applied (light_scale.c, least_add) */
     uint32_t *range;                 /* per surface: its run of texels [range[2 k], range[2 k + 1]) */
     int *order, count;               /* the surfaces with texels, in the refinement's order */
     int at;                          /* order[at]: the surface under way */
@@ -92,20 +101,20 @@ void lm_light_scale_init(lm_light_scale *ls);
 /* Ends the job: texels the refinement had not reached keep their first guess (regathers refine them). */
 void lm_light_scale_free(lm_light_scale *ls);
 
-/* A new edit's factors into factor (a->texel_count x 3), to multiply the IIM by now. Ends a job under way
- * first; takes before and emissive_before (malloc'd; before NULL: each texel takes its surface's factor;
- * emissive_before NULL: the scene's now). after: the dilated AIM now; surface_factor: surface_count x 3.
- * rays: the rays of one gather the update may cast (0: no bound, the full quality at once). Returns the
- * rays of one gather cast. */
+/* A new edit's factors into factor and additions into add (a->texel_count x 3 each): the IIM becomes
+ * IIM x factor + add now. Ends a job under way first; takes before and emissive_before (malloc'd; before
+ * NULL: each texel takes its surface's factor; emissive_before NULL: the scene's now). after: the dilated
+ * AIM now; surface_factor: surface_count x 3. rays: the rays of one gather the update may cast (0: no
+ * bound, the full quality at once). Returns the rays of one gather cast. */
 uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
                               float *emissive_before, const float *after, const float *surface_factor, uint32_t rays,
-                              float *factor);
+                              float *factor, float *add);
 /* The next texels at the full quality, until about `rays` rays of one gather are cast (at least one
- * texel's; 0: every one left): factor (texel_count x 3) gets the correction of each texel of the surfaces that completed, 1
- * elsewhere; *corrected: whether any is not 1 (else the IIM needs no pass). Returns the rays cast (0: no
- * job under way). */
+ * texel's; 0: every one left): factor and add (texel_count x 3 each) get the correction of each texel of
+ * the surfaces that completed (IIM x factor + add), 1 and 0 elsewhere; *corrected: whether any is not (else
+ * the IIM needs no pass). Returns the rays cast (0: no job under way). */
 uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, uint32_t rays,
-                               float *factor, int *corrected);
+                               float *factor, float *add, int *corrected);
 /* The texels (atlas texel indices) regathered this update: they keep their fresh value. */
 void lm_light_scale_regathered(lm_light_scale *ls, const uint32_t *texels, uint32_t n);
 /* The rays of one gather the refinement has still to cast (0: none under way). */

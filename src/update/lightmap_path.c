@@ -169,7 +169,7 @@ static lm_status follow_light(lm_lightmap_path *lp, lm_error *err)
     if (!lp->have_iim)
         return LM_OK;
     sync_gather_switches(lp);
-    return unlit ? lm_iim_clear(&lp->iim, err) : LM_OK;
+    return unlit ? lm_iim_clear(&lp->iim, lp->atlas, err) : LM_OK;
 }
 
 lm_status lm_lightmap_path_follow(lm_lightmap_path *lp, lm_error *err)
@@ -342,11 +342,12 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
 
 void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
 
-/* The IIM's texels multiplied by factor (texel_count x 3), surfaces with one changed set in scaled. */
-static void scale_iim(lm_lightmap_path *lp, const float *factor, uint8_t *scaled)
+/* The IIM's texels multiplied by factor and add added (texel_count x 3 each), surfaces with one changed
+ * set in scaled. */
+static void scale_iim(lm_lightmap_path *lp, const float *factor, const float *add, uint8_t *scaled)
 {
     lm_error e;
-    if (lm_iim_scale(&lp->iim, lp->atlas, factor, scaled, &e) != LM_OK)
+    if (lm_iim_scale(&lp->iim, lp->atlas, factor, add, scaled, &e) != LM_OK)
         lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
 }
 
@@ -363,13 +364,15 @@ static void follow_scale(lm_lightmap_path *lp)
     double t0 = lm_now();
     lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather};
     const float *after = lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage));
-    float *texel = lp->have_iim ? malloc(sizeof *texel * 3 * ((size_t)lp->atlas->texel_count + 1)) : NULL;
+    size_t T = lp->atlas->texel_count;
+    float *texel = lp->have_iim ? malloc(sizeof *texel * 6 * (T + 1)) : NULL, *add = texel ? texel + 3 * T : NULL;
     uint8_t *scaled = lp->refreshed; /* scratch until lm_lightmap_path_widen takes the refreshed surfaces */
     if (!edit) {
         int corrected = 0;
-        lp->scale_cast += texel ? lm_light_scale_refine(&lp->scaling, &w, after, lp->scale_rays, texel, &corrected) : 0;
+        lp->scale_cast +=
+            texel ? lm_light_scale_refine(&lp->scaling, &w, after, lp->scale_rays, texel, add, &corrected) : 0;
         if (corrected)
-            scale_iim(lp, texel, scaled);
+            scale_iim(lp, texel, add, scaled);
         free(texel);
         lp->scale_ms += 1e3 * (lm_now() - t0);
         return;
@@ -379,8 +382,8 @@ static void follow_scale(lm_lightmap_path *lp)
         lm_texel_change_scale(&lp->change, lp->atlas, lp->scale);
     if (texel) {
         uint32_t rays = lp->scale_rays && lp->scale_rays < LM_LIGHT_SCALE_LEAST ? LM_LIGHT_SCALE_LEAST : lp->scale_rays;
-        lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, rays, texel);
-        scale_iim(lp, texel, scaled);
+        lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, rays, texel, add);
+        scale_iim(lp, texel, add, scaled);
     } else {
         free(before);
         free(emissive);

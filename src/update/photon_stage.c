@@ -396,8 +396,8 @@ static int lights_at_once(const lm_photon_stage *ps) { return ps->have_aim && ps
  * are traced now and taken off the re-trace queue, rather than traced over the updates the queue takes
  * (the shared room's added lamp read 67% off the converged lightmap for 108 updates), and its hits' flux,
  * all new (a dark light stores none), moves the surfaces' totals, so that apply_scale refreshes the AIMs
- * it reaches (under a budget: scales those that had hits, and leaves those it alone lights to the
- * budgeted refreshes its hits' delta_f asks for) and the IIM takes its factors from them as after a
+ * it reaches (under a budget: scales those that had hits, and refreshes those it alone lights) and the
+ * IIM takes its factors from them as after a
  * power edit (update/light_scale.h): a first guess where the new light falls elsewhere than the light
  * there was, which the regathers of those surfaces refine. The trace is paid in the edit's update
  * whatever its budget, as a power edit's first guess is (LM_LIGHT_SCALE_LEAST): 20-24 ms for the shared
@@ -419,8 +419,9 @@ static lm_status light_now(lm_photon_stage *ps, int e, int first, lm_photon_stag
  * for the IIM (lm_photon_stage_take_scale) with the AIM from before. */
 static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
-    int S = ps->surfaces->surface_count, moved = 0;
+    int S = ps->surfaces->surface_count, moved = 0, dark = 0;
     int computed = ps->set.exact_direct == LM_EXACT_ALL || ps->set.exact_direct == LM_EXACT_SUNS; /* lights' direct */
+    int first_guess = budgeted(ps) && !ps->aim.direct; /* the AIMs scaled, not refreshed (below) */
     double all_before[3] = {0, 0, 0}, all_after[3] = {0, 0, 0};
     for (int k = 0; k < S; k++)
         for (int c = 0; c < 3; c++)
@@ -436,15 +437,20 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm
             ps->aim_factor[3 * k + c] = f;
             changed |= f != 1.0f || (!(b > 0.0) && a > 0.0); /* lit by a new light's photons alone */
         }
-        if (changed)
+        const double *had = ps->flux_before + 3 * k, *has = ps->flux_after + 3 * k;
+        int lit_now = !(had[0] > 0.0 || had[1] > 0.0 || had[2] > 0.0) && (has[0] > 0.0 || has[1] > 0.0 || has[2] > 0.0);
+        if (changed && first_guess && lit_now) /* by a new light's hits alone */
+            ps->touched[S - 1 - dark++] = k; /* from the end: the two lists share the scratch */
+        else if (changed)
             ps->touched[moved++] = k;
     }
     keep_aim_before(ps);
     /* scaled as their hits were, refreshed as those hits' delta_f asks, within the budget; not where the
-     * AIM computes direct light, which the hits' flux then lacks */
-    if (budgeted(ps) && !ps->aim.direct) {
+     * AIM computes direct light, which the hits' flux then lacks, nor where a new light's hits are all it
+     * has (no factor lights a dark surface) */
+    if (first_guess) {
         lm_aim_scale_surfaces(&ps->aim, ps->atlas, ps->touched, moved, ps->aim_factor);
-        return LM_OK;
+        return dark ? refresh_listed_at_once(ps, ps->touched + S - dark, dark, out, err) : LM_OK;
     }
     return refresh_at_once(ps, moved, out, err);
 }

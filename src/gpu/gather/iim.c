@@ -261,11 +261,13 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     return lm_gl_check("IIM blend (iim_blend)", err);
 }
 
-lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, uint8_t *scaled, lm_error *err)
+lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, const float *add, uint8_t *scaled,
+                       lm_error *err)
 {
     memset(scaled, 0, (size_t)iim->sched.surface_count);
     for (uint32_t i = 0; i < a->texel_count; i++)
-        scaled[a->texels[i].surface] |= factor[3 * i] != 1.0f || factor[3 * i + 1] != 1.0f || factor[3 * i + 2] != 1.0f;
+        scaled[a->texels[i].surface] |= factor[3 * i] != 1.0f || factor[3 * i + 1] != 1.0f || factor[3 * i + 2] != 1.0f ||
+                                        (add && (add[3 * i] != 0.0f || add[3 * i + 1] != 0.0f || add[3 * i + 2] != 0.0f));
     for (int k = 0; k < iim->sched.surface_count; k++)
         iim->version[k] += scaled[k];
     if (!iim->blend_prog)
@@ -276,16 +278,20 @@ lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, uint
             return st;
         glGenBuffers(1, &iim->factor_buf);
     }
-    size_t cells = (size_t)a->width * a->height;
-    float *f4 = malloc(sizeof *f4 * 4 * (cells ? cells : 1));
+    size_t cells = (size_t)a->width * a->height, n = cells ? cells : 1;
+    float *f4 = malloc(sizeof *f4 * 8 * n); /* per cell: the factor, then the addition (rgb, one unused) */
     if (!f4)
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory to scale %zu cells", cells);
-    for (size_t c = 0; c < 4 * cells; c++)
-        f4[c] = 1.0f;
-    for (uint32_t i = 0; i < a->texel_count; i++)
-        memcpy(f4 + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x), factor + 3 * (size_t)i, 3 * sizeof *f4);
+    for (size_t c = 0; c < 8 * n; c++)
+        f4[c] = c % 8 < 4 ? 1.0f : 0.0f;
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        float *cell = f4 + 8 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
+        memcpy(cell, factor + 3 * (size_t)i, 3 * sizeof *f4);
+        if (add)
+            memcpy(cell + 4, add + 3 * (size_t)i, 3 * sizeof *f4);
+    }
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->factor_buf);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof *f4 * 4 * (cells ? cells : 1)), f4, GL_DYNAMIC_DRAW);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (GLsizeiptr)(sizeof *f4 * 8 * n), f4, GL_DYNAMIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     free(f4);
     glUseProgram(iim->scale_prog);
@@ -301,14 +307,15 @@ lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, uint
     return lm_gl_check("IIM scale (iim_scale)", err);
 }
 
-lm_status lm_iim_clear(lm_iim *iim, lm_error *err)
+lm_status lm_iim_clear(lm_iim *iim, const lm_atlas *a, lm_error *err)
 {
-    unsigned *tex[IIM_TEXTURES];
-    textures(iim, tex);
-    for (int i = 0; i < IIM_TEXTURES; i++)
-        glClearTexImage(*tex[i], 0, GL_RGBA, GL_FLOAT, NULL);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
-    return lm_gl_check("clearing the IIM", err);
+    float *zero = calloc(3 * (size_t)a->texel_count + 3, sizeof *zero);
+    uint8_t *scaled = malloc((size_t)iim->sched.surface_count + 1);
+    lm_status st = zero && scaled ? lm_iim_scale(iim, a, zero, NULL, scaled, err)
+                                  : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory to clear %u texels", a->texel_count);
+    free(zero);
+    free(scaled);
+    return st;
 }
 
 /* One pass over the window win: every invalid texel with valid same-surface 4-neighbours in it gets

@@ -87,15 +87,21 @@ void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, 
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);
 
 /* Every texel i of the atlas, in every map (fresh, old, new, displayed, its change and what its estimate
- * carries), multiplied by factor[3 i + c] per channel (a->texel_count x 3 floats; alpha stays): a light
- * changed in power alone shows at once (update/light_scale.h). Each surface with a texel scaled moves its
- * version and has scaled[k] set (surface_count bytes, written before anything can fail). Without GL only
- * the versions move. */
-lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, uint8_t *scaled, lm_error *err);
+ * carries), multiplied by factor[3 i + c] per channel (a->texel_count x 3 floats; alpha stays), and
+ * add[3 i + c] added to its values (fresh, old, new, displayed; add may be NULL: none): a light's edit
+ * shows at once (update/light_scale.h). Each surface with a texel changed moves its version and has
+ * scaled[k] set (surface_count bytes, written before anything can fail). Without GL only the versions
+ * move. */
+lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, const float *add, uint8_t *scaled,
+                       lm_error *err);
 
-/* Every IIM texture (fresh, old, new, displayed, the changes) set to 0: a scene that lost its last light shows no
- * indirect light at once, not the last gather's. */
-lm_status lm_iim_clear(lm_iim *iim, lm_error *err);
+/* Every texel's colour in every map (fresh, old, new, displayed, the changes) set to 0, as lm_iim_scale by
+ * 0 does, its alpha kept: a scene that lost its last light shows no indirect light at once, not the last
+ * gather's, and a texel that sees the inside of geometry stays invalid (filled from its neighbours on
+ * output) until its regather, not a black texel among the first guess's when a light comes back (once,
+ * the back-face fractions cleared too, a black block under the Cornell box's sphere). Errors: out of
+ * memory, GL. */
+lm_status lm_iim_clear(lm_iim *iim, const lm_atlas *a, lm_error *err);
 
 /* CPU: texels (rgba, atlas-sized, a = back-face fraction) with a > limit take the mean of valid
  * 4-neighbours of the same surface, repeated until none changes; then gutters are dilated. Returns
