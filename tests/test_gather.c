@@ -1176,9 +1176,9 @@ static float *floats_copy(const float *v, size_t n)
  * bring every texel to the value the full quality gives at once (to float rounding: the same rays, seeded
  * by the texel), and leave the texels regathered meanwhile alone. On scenes/cornell.glb at `lmgi run`'s
  * density, the AIM after the edit changed unevenly over the atlas (redder to the left, dimmer to the top),
- * the emitters dimmed; then again with the emitters dark before and the AIM's left half near black, so
- * that the texels that saw next to nothing before take the change added (LM_LIGHT_SCALE_DARK). Each
- * texel's value starts at 1: IIM x factor + add. */
+ * the emitters dimmed; then again, as after an edit that adds light, with the emitters dark before and
+ * the AIM's left half near black, so that the texels that saw next to nothing before take the change
+ * added (LM_LIGHT_SCALE_DARK). Each texel's value starts at 1: IIM x factor + add. */
 static void test_light_scale_refined_equals_full(void **state)
 {
     (void)state;
@@ -1221,7 +1221,7 @@ static void test_light_scale_refined_equals_full(void **state)
                     lit_before[4 * c + k] *= 0.01f;
         }
         uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
-                                            after, surface, 0, full, full_add);
+                                            after, surface, r == 2, 0, full, full_add);
         assert_false(ls.active); /* no bound: the full quality at once */
         uint32_t added = 0, scaled = 0;
         for (size_t i = 0; i < 3 * T; i++)
@@ -1230,7 +1230,7 @@ static void test_light_scale_refined_equals_full(void **state)
         for (size_t i = 0; i < 3 * T; i++)
             full[i] += full_add[i]; /* the value from 1 */
         uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
-                                              after, surface, budget[r], shown, shown_add);
+                                              after, surface, r == 2, budget[r], shown, shown_add);
         for (size_t i = 0; i < 3 * T; i++)
             shown[i] += shown_add[i];
         assert_true(ls.active);

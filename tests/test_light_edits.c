@@ -544,6 +544,28 @@ static void test_one_light_at_once(void **state)
     unsettle(&r);
 }
 
+/* Brightened 30 times: past LM_LIGHT_SCALE_DARK, but a power edit keeps its factors (exact where one light
+ * lights the room), which an addition of the gathers' change would replace by their noise. */
+static void test_one_light_brightened(void **state)
+{
+    (void)state;
+    settled_room r;
+    settle(&r, &LAMP, 1);
+    size_t n = r.n;
+    edit_light(r.sc, 0, 30.0f, NULL, 1);
+    update_scaling(r.u, 1, 0);
+    float *now = lmt_iim(r.u, r.sc, &n);
+    lmgi_updater_free(r.u);
+    r.u = lmt_room_updater(r.ctx, r.sc);
+    lmt_updates(r.u, 3);
+    float *want = lmt_iim(r.u, r.sc, &n);
+    double at_once = lmt_relative_l1(now, want, n);
+    print_message("one lamp brightened 30 times: lightmap against a fresh updater's %.3g at the next update\n", at_once);
+    assert_true(at_once < 1e-4);
+    free(now), free(want);
+    unsettle(&r);
+}
+
 /* The same on an atlas past LM_LIGHT_SCALE_WORK / 4 texels, where only every stride-th texel gathers its
  * factor and the others sum their neighbours' (light_scale.h): still a fresh updater's at once. */
 static void test_large_atlas_at_once(void **state)
@@ -962,6 +984,7 @@ int main(void)
         cmocka_unit_test(test_still_room_traces_nothing),
         cmocka_unit_test(test_added_light_stays_in_its_room),
         cmocka_unit_test(test_one_light_at_once),
+        cmocka_unit_test(test_one_light_brightened),
         cmocka_unit_test(test_large_atlas_at_once),
         cmocka_unit_test(test_two_lights_first_guess),
         cmocka_unit_test(test_switched_off),

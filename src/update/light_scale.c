@@ -87,9 +87,10 @@ static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_r
 /* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within `spread` of it
  * that gathered (done), a ratio that varies slowly over a surface and is far less noisy summed; 1 where
  * they see no light either way, or where it is within LM_LIGHT_SCALE_KEEP of 1; its surface's where none
- * of them gathered. Where they saw next to no light before (LM_LIGHT_SCALE_DARK), no factor can light
- * the texel: its factor is 1 and *add the gathers' mean change, what a regather would add to it to first
- * order (the gathers estimate the IIM's irradiance itself), unless that is under `least`. */
+ * of them gathered. After an edit that adds light, where they saw next to no light before
+ * (LM_LIGHT_SCALE_DARK), no factor can light the texel: its factor is 1 and *add the gathers' mean change,
+ * what a regather would add to it to first order (the gathers estimate the IIM's irradiance itself),
+ * unless that is under `least` (a negative `least`: no edit that adds, nothing added). */
 static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, int spread,
                         const float *surface_factor, float least, uint32_t i, float *out, float *add)
 {
@@ -111,8 +112,11 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
     const float *own = surface_factor + 3 * t->surface;
     int keep = 1;
     for (int c = 0; c < 3; c++) { /* no neighbour gathered (a large atlas's strides): its surface's */
-        int dark = met && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
-        float f = !met || dark ? (met ? 1.0f : own[c]) : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : 1.0f;
+        int dark = met && least >= 0.0f && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
+        float f = !met || dark     ? (met ? 1.0f : own[c])
+                  : s0[c] > 0.0    ? (float)(s1[c] / s0[c])
+                  : s1[c] > 0.0    ? own[c]
+                                   : 1.0f;
         float d = dark ? (float)((s1[c] - s0[c]) / met) : 0.0f;
         out[c] = isfinite(f) && f >= 0.0f ? f : own[c];
         add[c] = isfinite(d) && d >= least ? d : 0.0f;
@@ -242,8 +246,8 @@ static int plan_order(lm_light_scale *ls, const lm_atlas *a)
 }
 
 uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
-                              float *emissive_before, const float *after, const float *surface_factor, uint32_t rays,
-                              float *factor, float *add)
+                              float *emissive_before, const float *after, const float *surface_factor, int adds,
+                              uint32_t rays, float *factor, float *add)
 {
     const lm_atlas *a = w->atlas;
     size_t T = a->texel_count, S = (size_t)a->surface_count;
@@ -279,7 +283,7 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
             q.spread++;
     }
     gather_range(ls, w, after, q, 0, (uint32_t)T);
-    ls->least = least_add(ls, a);
+    ls->least = adds ? least_add(ls, a) : -1.0f;
     ratios(ls, a, q.spread, 0, (uint32_t)T, factor, add);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
     if (!coarse) { /* the full quality: nothing to refine */

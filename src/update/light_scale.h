@@ -16,10 +16,12 @@
  * (LM_LIGHT_SCALE_SPREAD). Both gathers meet the same points, so the ratio is far less noisy than
  * either: in a scene lit by one emitter every factor is the light's own and the IIM is exact at once;
  * where several light the seen surfaces in different proportions it is a first guess that the regathers
- * the scaled hits call for refine. A texel whose rays met next to no light before (LM_LIGHT_SCALE_DARK:
- * a dark room whose lamp is switched on) has no factor that lights it: it takes instead the change the two
- * gathers saw, added (E_after - E_before over the window, what its regather would add), and is 1 where
- * they meet no light after either.
+ * the scaled hits call for refine. A texel whose rays met no light before takes its surface's factor (1
+ * where they meet none after either), except after an edit that `adds` light where there may have been
+ * none (a light added or switched on: a dark room whose lamp comes on): there a texel whose rays met next
+ * to no light before (LM_LIGHT_SCALE_DARK) has no factor that lights it, and takes instead the change the
+ * two gathers saw, added (E_after - E_before over the window, what its regather would add). A power edit
+ * keeps its factors, which are exact where one light lights the scene, however much it brightens.
  *
  * The full quality: K rays a texel (K = LM_LIGHT_SCALE_WORK / texels rounded down to a square, at most
  * 64: 16 at `run`'s 1,800 texels) for each of the two gathers, each ray with its 16 AIM lookups (34 ms on
@@ -62,10 +64,11 @@
  * (the edge of a closed door lit from the far room), and rewriting it would cost an engine a re-read and
  * the schedule a regather for nothing visible (lmgi bench --edits, "outside its reach"). */
 #define LM_LIGHT_SCALE_KEEP 1e-3f
-/* A texel whose gathers saw more than this times as much light after the edit as before (none before: a
- * dark room whose lamp is switched on) takes the change they saw added rather than their ratio, which
- * would leave what was dark dark: the two gathers' mean difference over its window estimates what its
- * regather adds, to the gathers' noise (16 rays a texel summed over 3 x 3 at the full quality). */
+/* After an edit that adds light (lm_light_scale_begin's `adds`), a texel whose gathers saw more than this
+ * times as much light after it as before (none before: a dark room whose lamp is switched on) takes the
+ * change they saw added rather than their ratio, which would leave what was dark dark: the two gathers'
+ * mean difference over its window estimates what its regather adds, to the gathers' noise (16 rays a
+ * texel summed over 3 x 3 at the full quality). */
 #define LM_LIGHT_SCALE_DARK 16.0
 /* Texels either side a texel's factor sums its surface's gathers over (1: a 3 x 3 window). One texel's 16
  * rays left the factor noisy where a large change fills part of its view: the Cornell box's red wall
@@ -89,7 +92,8 @@ typedef struct {
     uint8_t *kept;                   /* per texel: regathered since the edit (no factor applies) */
     float *applied;                  /* texel_count x 3: the factor the IIM holds of this edit */
     float *added;                    /* texel_count x 3: and what it added after it (LM_LIGHT_SCALE_DARK) */
-    float least;                     /* the smallest addition applied (light_scale.c, least_add) */
+    float least;                     /* the smallest addition applied (light_scale.c, least_add); negative:
+                                        the edit adds no light (lm_light_scale_begin's adds), nothing is */
     uint32_t *range;                 /* per surface: its run of texels [range[2 k], range[2 k + 1]) */
     int *order, count;               /* the surfaces with texels, in the refinement's order */
     int at;                          /* order[at]: the surface under way */
@@ -104,11 +108,12 @@ void lm_light_scale_free(lm_light_scale *ls);
 /* A new edit's factors into factor and additions into add (a->texel_count x 3 each): the IIM becomes
  * IIM x factor + add now. Ends a job under way first; takes before and emissive_before (malloc'd; before
  * NULL: each texel takes its surface's factor; emissive_before NULL: the scene's now). after: the dilated
- * AIM now; surface_factor: surface_count x 3. rays: the rays of one gather the update may cast (0: no
- * bound, the full quality at once). Returns the rays of one gather cast. */
+ * AIM now; surface_factor: surface_count x 3; adds: the edit lit a light where it gave no light (added or
+ * switched on), so that texels dark before take the change added (header). rays: the rays of one gather
+ * the update may cast (0: no bound, the full quality at once). Returns the rays of one gather cast. */
 uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
-                              float *emissive_before, const float *after, const float *surface_factor, uint32_t rays,
-                              float *factor, float *add);
+                              float *emissive_before, const float *after, const float *surface_factor, int adds,
+                              uint32_t rays, float *factor, float *add);
 /* The next texels at the full quality, until about `rays` rays of one gather are cast (at least one
  * texel's; 0: every one left): factor and add (texel_count x 3 each) get the correction of each texel of
  * the surfaces that completed (IIM x factor + add), 1 and 0 elsewhere; *corrected: whether any is not (else

@@ -382,7 +382,8 @@ static void follow_scale(lm_lightmap_path *lp)
         lm_texel_change_scale(&lp->change, lp->atlas, lp->scale);
     if (texel) {
         uint32_t rays = lp->scale_rays && lp->scale_rays < LM_LIGHT_SCALE_LEAST ? LM_LIGHT_SCALE_LEAST : lp->scale_rays;
-        lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, rays, texel, add);
+        lp->scale_cast +=
+            lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, edit == 2, rays, texel, add);
         scale_iim(lp, texel, add, scaled);
     } else {
         free(before);

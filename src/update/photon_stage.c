@@ -47,6 +47,7 @@ struct lm_photon_stage {
     float *light_scale;          /* per surface x 3: what light edits scaled its light by since
                                   * lm_photon_stage_take_scale (1: nothing) */
     int scaled;                  /* light_scale holds something other than 1 */
+    int scaled_lit;              /* and a light was lit where it gave no light (light_now) */
     float *aim_before;           /* with scaled: the dilated AIM before the first of those scalings (or NULL:
                                   * no memory for it), lm_photon_stage_take_scale's to hand on */
     float *emissive_before;      /* with scaled: per material, the emission the photons saw before them */
@@ -408,6 +409,7 @@ static lm_status light_now(lm_photon_stage *ps, int e, int first, lm_photon_stag
     lm_status st = lm_photons_retrace_emitter(ps->photons, e, err);
     note_flux(ps, e, (const float[3]){1.0f, 1.0f, 1.0f}, 0);
     out->emitters_lit++;
+    ps->scaled_lit = 1;
     return st;
 }
 
@@ -944,7 +946,7 @@ int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out)
 
 int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before, float **emissive_before)
 {
-    int S = ps->surfaces->surface_count, any = ps->scaled;
+    int S = ps->surfaces->surface_count, any = ps->scaled ? 1 + ps->scaled_lit : 0;
     for (int i = 0; i < 3 * S; i++) {
         out[i] = ps->light_scale[i];
         ps->light_scale[i] = 1.0f;
@@ -952,7 +954,7 @@ int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_befo
     *aim_before = ps->aim_before;
     *emissive_before = ps->emissive_before;
     ps->aim_before = ps->emissive_before = NULL;
-    ps->scaled = 0;
+    ps->scaled = ps->scaled_lit = 0;
     return any;
 }
 

@@ -105,7 +105,9 @@ int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
  * update that saw them; *aim_before is the dilated AIM before, and *emissive_before each material's
  * emission before (material_count x 3), from which the IIM's own factors follow (update/light_scale.h):
  * both malloc'd, the caller's to free, NULL when nothing changed or memory ran out. Resets them. Returns
- * 0 when nothing changed. Not while an update runs on another thread. */
+ * 0 when nothing changed, 2 when a light was lit where it gave no light (added or switched on: its light
+ * falls where there may have been none, light_scale.h's `adds`), else 1. Not while an update runs on
+ * another thread. */
 int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before, float **emissive_before);
 /* Whether a scaling waits for lm_photon_stage_take_scale (the plan of the update that takes it). */
 int lm_photon_stage_scale_waiting(const lm_photon_stage *ps);
