@@ -718,16 +718,22 @@ static void assert_emitter_pending(const lm_photons *ph, int e, uint32_t valid_g
     }
 }
 
+/* The scene at path traced with the default settings, 16 invalid groups re-traced a frame. */
+static void queue_world(world *w, const char *path)
+{
+    world_load(w, path);
+    lm_photon_settings set;
+    lm_photon_settings_default(&set);
+    set.group_budget = 16;
+    world_photons(w, &set);
+}
+
 static void test_invalidate_emitter(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
     world w;
-    world_load(&w, path);
-    lm_photon_settings set;
-    lm_photon_settings_default(&set);
-    set.group_budget = 16;
-    world_photons(&w, &set);
+    queue_world(&w, path);
     lm_error err;
     assert_int_equal(lm_photons_invalidate_emitter(w.ph, 99, &err), LM_ERR_INVALID);
     assert_non_null(strstr(err.msg, "99"));
@@ -783,11 +789,7 @@ static void test_retrace_emitter_leaves_queue(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
     world w;
-    world_load(&w, path);
-    lm_photon_settings set;
-    lm_photon_settings_default(&set);
-    set.group_budget = 16;
-    world_photons(&w, &set);
+    queue_world(&w, path);
     lm_error err;
     assert_int_equal(lm_photons_invalidate_emitter(w.ph, 0, &err), LM_OK);
     assert_int_equal(lm_photons_invalidate_emitter(w.ph, 1, &err), LM_OK);
