@@ -1013,7 +1013,10 @@ static void test_bench_edits(void **state)
     assert_non_null(row = strstr(output, "remove_light light_b2"));
     assert_int_equal(sscanf(row, "remove_light light_b2 %d %lf%%", &frame, &removed), 2);
     assert_int_equal(frame, 8);
-    assert_true(added > 5.0 && removed > 5.0);
+    /* both shown at the next update: the lamp's photons traced at once (docs/tradeoff.md, "Lights added or
+     * switched on"; 19% and 18% off when its groups waited in the re-trace queue), the light removed in
+     * power alone */
+    assert_true(added < 5.0 && removed < 5.0);
     snprintf(path, sizeof path, "%s/out.json", dir);
     size_t n = 0;
     char *json = (char *)lmt_read_file(path, &n, 1);
