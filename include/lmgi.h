@@ -624,7 +624,7 @@ typedef struct {
                                 * their first guess at the edit, then their refinement a few surfaces an update
                                 * within the budget (docs/tradeoff.md, "Light edits at once") */
     uint32_t light_scale_rays; /* the rays of one of their two gathers this update cast */
-    int lights_lit;            /* lights added or switched on from dark without a time budget: their photons
+    int lights_lit;            /* lights added or switched on from dark, whatever the budget: their photons
                                 * traced in this update, not over the updates after, and their light shown in
                                 * the lightmaps at once as a first guess that the regathers after refine
                                 * (docs/tradeoff.md, "Lights added or switched on") */

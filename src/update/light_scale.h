@@ -2,8 +2,8 @@
  * "Light edits at once"), and its refinement within the update budget (item 4). A light's photons keep
  * their paths when only its colour, intensity or switch changes, so the photon stage scales their hits
  * and each surface's AIM by how much the flux of its hits changed (update/photon_stage.h); a light added
- * or switched on from dark, without a budget, has its photons traced and the AIMs they reach refreshed
- * at once, and the same factors follow it, a first guess where it lights other places than the lights
+ * or switched on from dark has its photons traced and the AIMs they reach refreshed (under a budget,
+ * scaled where they had light) at once, and the same factors follow it, a first guess where it lights other places than the lights
  * there were (docs/tradeoff.md, "Lights added or switched on"). An IIM texel's
  * light is what it sees of those AIMs, so its own factor is the ratio of two small ray gathers from the
  * texel, through the same rays, over the AIM before and after the scaling (and the emitters' emission

@@ -342,6 +342,10 @@ static int one_material(const lm_scene *sc, const lm_emitter *em)
     return 1;
 }
 
+/* Whether a power, or a surface's hits' flux, is lit in some channel. */
+static int any_lit(const float p[3]) { return p[0] > 0.0f || p[1] > 0.0f || p[2] > 0.0f; }
+static int any_flux(const double f[3]) { return f[0] > 0.0 || f[1] > 0.0 || f[2] > 0.0; }
+
 /* Whether an emitter stays where and as it was from `was` to `now` (its paths' start and shape). */
 static int same_place(const emitter_snapshot *was, const emitter_snapshot *now)
 {
@@ -398,9 +402,8 @@ static int lights_at_once(const lm_photon_stage *ps) { return ps->have_aim && ps
  * (the shared room's added lamp read 67% off the converged lightmap for 108 updates), and its hits' flux,
  * all new (a dark light stores none), moves the surfaces' totals, so that apply_scale refreshes the AIMs
  * it reaches (under a budget: scales those that had hits, and refreshes those it alone lights) and the
- * IIM takes its factors from them as after a
- * power edit (update/light_scale.h): a first guess where the new light falls elsewhere than the light
- * there was, which the regathers of those surfaces refine. The trace is paid in the edit's update
+ * IIM takes its factors from them as after a power edit (update/light_scale.h): a first guess where the
+ * new light falls elsewhere than the light there was, which the regathers of those surfaces refine. The trace is paid in the edit's update
  * whatever its budget, as a power edit's first guess is (LM_LIGHT_SCALE_LEAST): 20-24 ms for the shared
  * room's lamp of 15,912 photons on 2 cores. */
 static lm_status light_now(lm_photon_stage *ps, int e, int first, lm_photon_stage_frame *out, lm_error *err)
@@ -439,8 +442,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm
             ps->aim_factor[3 * k + c] = f;
             changed |= f != 1.0f || (!(b > 0.0) && a > 0.0); /* lit by a new light's photons alone */
         }
-        const double *had = ps->flux_before + 3 * k, *has = ps->flux_after + 3 * k;
-        int lit_now = !(had[0] > 0.0 || had[1] > 0.0 || had[2] > 0.0) && (has[0] > 0.0 || has[1] > 0.0 || has[2] > 0.0);
+        int lit_now = !any_flux(ps->flux_before + 3 * k) && any_flux(ps->flux_after + 3 * k);
         if (changed && first_guess && lit_now) /* by a new light's hits alone */
             ps->touched[S - 1 - dark++] = k; /* from the end: the two lists share the scratch */
         else if (changed)
@@ -460,8 +462,7 @@ static lm_status apply_scale(lm_photon_stage *ps, lm_photon_stage_frame *out, lm
 /* Whether an emitter dark in every channel (was) is lit now in the same place and shape: switched on. */
 static int switched_on(const emitter_snapshot *was, const emitter_snapshot *now)
 {
-    int dark = !(was->power[0] > 0.0f || was->power[1] > 0.0f || was->power[2] > 0.0f);
-    return dark && same_place(was, now) && (now->power[0] > 0.0f || now->power[1] > 0.0f || now->power[2] > 0.0f);
+    return !any_lit(was->power) && any_lit(now->power) && same_place(was, now);
 }
 
 /* Invalidates the groups of every emitter whose placement or power changed since its last snapshot; a
@@ -479,7 +480,7 @@ static lm_status check_emitters(lm_photon_stage *ps, int added, int at_once, lm_
         emitter_snapshot now;
         take_snapshot(ps, e, &now);
         int is_new = e >= ps->emitters.count - added;
-        int lit = at_once && now.power[0] + now.power[1] + now.power[2] > 0.0f;
+        int lit = at_once && any_lit(now.power);
         if (is_new && lit) { /* placed now, after its snapshot as it joined */
             ps->snap[e] = now;
             lm_status st = light_now(ps, e, !noted++, out, err);

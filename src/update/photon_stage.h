@@ -44,7 +44,8 @@ typedef struct {
                               * (lm_photon_stage_take_scale): their hits scaled, not traced again, or, turned
                               * dark, traced again to go */
     int emitters_lit;        /* of emitters_moved, those lit where they gave no light (added, or switched on
-                              * from dark) and traced at once this frame, not queued (no time budget) */
+                              * from dark) and traced at once this frame, not queued (not in a bake, which
+                              * traces every photon) */
     int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
     int aim_at_once;         /* of aim.surfaces_refreshed, those refreshed at once for this frame's light,
                               * emission or colour edits (lm_photon_stage_animate) */
