@@ -72,7 +72,7 @@ static void test_plan_learns(void **state)
     const double ms[LM_STAGE_PLANNED] = {12.0, 0.0, 0.0, 0.0, 7.5};
     const uint64_t units[LM_STAGE_PLANNED] = {3, 0, 0, 0, 30};
     for (int i = 0; i < LM_COST_WINDOW; i++)
-        lm_budget_learn(&b, ms, units, 11.5);
+        lm_budget_learn(&b, ms, units, 11.5, 0.0);
     lm_budget_plan p;
     lm_budget_work w = {.groups = 40, .caustic_photons = 100000, .texels = 5000};
     lm_budget_plan_step(&b, 16.0, &w, &p);
@@ -81,6 +81,23 @@ static void test_plan_learns(void **state)
     assert_true(p.aim_hits == 1);         /* its price kept: nothing left after the photons */
     assert_string_equal(lm_stage_name(LM_STAGE_CAUSTICS), "caustic photons");
     assert_string_equal(lm_stage_name(LM_STAGE_FRAME), "frame");
+
+    /* three edits in the window (a light switched off and on, a lamp added) whose updates did 40 ms of
+     * work at once (a lit light's photons, AIMs refreshed at once): their cost is their own, and the gather
+     * keeps its share; counted into its rest, they would make its 95th percentile 44 ms, and the gather
+     * would get one texel an update for the next 29 */
+    lm_budget edits = b, counted = b;
+    for (int i = 0; i < 3; i++) {
+        lm_budget_learn(&edits, ms, units, 51.5, 40.0);
+        lm_budget_learn(&counted, ms, units, 51.5, 0.0);
+    }
+    lm_budget_plan_step(&edits, 16.0, &w, &p);
+    assert_int_equal(p.texels, 48);
+    lm_budget_plan_step(&counted, 16.0, &w, &p);
+    assert_int_equal(p.texels, 1);
+    w.ms_spent = 4.0; /* the update waited 4 ms for the photon job the last one began: off its budget */
+    lm_budget_plan_step(&edits, 16.0, &w, &p);
+    assert_int_equal(p.texels, 32);
 }
 
 /* A light edit's texel factors (update/light_scale.h): at most a quarter of the budget an update for
@@ -113,7 +130,7 @@ static void test_plan_light_scale(void **state)
     const double ms[LM_STAGE_PLANNED] = {12.0, 0.0, 0.0, 0.0, 7.5, 2.0};
     const uint64_t units[LM_STAGE_PLANNED] = {3, 0, 0, 0, 30, 2048};
     for (int i = 0; i < LM_COST_WINDOW; i++)
-        lm_budget_learn(&b, ms, units, 13.5);
+        lm_budget_learn(&b, ms, units, 13.5, 0.0);
     w.scale_rays = 0, w.scale_edit = 0;
     lm_budget_plan_step(&b, 16.0, &w, &p);
     assert_int_equal(p.texels, 48);       /* (16 - 4 ms of rest, the 2 ms of factors not in it) at 0.25 ms */

@@ -425,6 +425,7 @@ static void trace_jobs(lm_caustics *c, uint32_t n, lm_caustic_frame_stats *st)
     for (uint32_t i = 0; i < n; i++) {
         (*fate_count[c->fates[i]])++;
         st->rays += c->job_rays[i];
+        st->cast += c->job_rays[i] > 0;
         changed |= c->changed[i];
     }
     st->traced += n;

@@ -108,6 +108,8 @@ lm_status lm_caustic_generators(const lm_scene *s, lm_caustic_generator **out, i
 /* What one lm_caustics_frame (or the first trace) did. */
 typedef struct {
     uint32_t traced;       /* photons traced */
+    uint32_t cast;         /* of those, the ones that cast a ray (a dark light's cost nothing: what a time
+                            * budget's price per photon learns from, update/budget_plan.h) */
     uint32_t landed, missed, escaped, absorbed, capped; /* their fates */
     uint32_t pairs_moved;  /* pairs re-traced whole because their generator or emitter changed */
     uint64_t rays;

@@ -46,22 +46,24 @@ void lm_budget_plan_step(const lm_budget *b, double budget_ms, const lm_budget_w
      * first guess; planned with no work waiting too: an edit the photon stage takes after this plan (in
      * order, its update follows the plan) is bounded */
     const lm_cost_model *g = &b->cost[LM_STAGE_GATHER];
-    double spare = budget_ms - lm_cost_model_rest(g) - lm_cost_model_price(g);
+    double spare = budget_ms - w->ms_spent - lm_cost_model_rest(g) - lm_cost_model_price(g);
     if (!w->scale_edit && spare > 0.25 * budget_ms)
         spare = 0.25 * budget_ms;
     out->scale_rays = (uint32_t)take(b, LM_STAGE_LIGHT_SCALE, spare, w->scale_rays > 0 ? w->scale_rays : INT_MAX,
                                      &ms[LM_STAGE_LIGHT_SCALE]);
-    double gather = w->scale_rays > 0 ? budget_ms - ms[LM_STAGE_LIGHT_SCALE] : budget_ms;
+    double gather = (w->scale_rays > 0 ? budget_ms - ms[LM_STAGE_LIGHT_SCALE] : budget_ms) - w->ms_spent;
     out->texels = take(b, LM_STAGE_GATHER, gather, w->texels, &ms[LM_STAGE_GATHER]);
 }
 
 void lm_budget_learn(lm_budget *b, const double ms[LM_STAGE_PLANNED], const uint64_t units[LM_STAGE_PLANNED],
-                     double ms_total)
+                     double ms_total, double ms_aside)
 {
     for (int s = 0; s < LM_STAGE_PLANNED; s++) {
         uint32_t n = units[s] > UINT32_MAX ? UINT32_MAX : (uint32_t)units[s];
-        if (s == LM_STAGE_GATHER) /* its rest: everything else the update did but the planned texel factors */
-            lm_cost_model_learn(&b->cost[s], ms[s], n, ms_total - ms[s] - ms[LM_STAGE_LIGHT_SCALE]);
+        if (s == LM_STAGE_GATHER) { /* its rest: everything else the update did but the texel factors, aside */
+            double rest = ms_total - ms[s] - ms[LM_STAGE_LIGHT_SCALE] - ms_aside;
+            lm_cost_model_learn(&b->cost[s], ms[s], n, rest > 0.0 ? rest : 0.0);
+        }
         else if (n > 0)
             lm_cost_model_learn(&b->cost[s], ms[s], n, 0.0);
     }

@@ -9,14 +9,20 @@
  * rest of recent updates and one texel's gather leave of the whole budget for their first guess in the
  * edit's update (what the edit changed is worth more than an update's regathers), then at most a quarter
  * an update for their refinement. The gather fills what the 95th percentile of
- * everything else in recent updates left (lm_cost_model_units), less what the texel factors are planned
- * this update: their work comes in bursts after an edit, and counted into the gather's rest it would
- * starve the gather for LM_COST_WINDOW updates after each. A stage with work waiting gets at least
+ * everything else in recent updates left (lm_cost_model_units), less what the update already spent
+ * waiting for the photon thread's job the last update began (a detached loop: with no frame of the
+ * caller's to hide it, all of it; known when the plan is made, so a burst of photon work costs the updates
+ * that wait for it, not the LM_COST_WINDOW after), less what the texel factors are planned this update: their work comes in bursts after an edit, and counted into the gather's rest it would
+ * starve the gather for LM_COST_WINDOW updates after each. So would the work an edit does at once in
+ * its own update (a lit light's photons, AIMs refreshed at once) and the time the photon thread's stages
+ * run past their plan while their models learn a new price, which are left out of the rest too. A stage with work waiting gets at least
  * one unit however dear: an update never does nothing while something is stale, and a stage that never
  * fits is not starved (its unit may then pass the budget: one AIM surface's refresh is not split).
  * Without a budget (budget_ms 0) the plan is the settings' fixed counts, the same on every machine.
  *
- * The units: a photon group, a stored hit put in an AIM refresh's kd-trees, a caustic photon, a cube
+ * The units: a photon group, a stored hit put in an AIM refresh's kd-trees, a caustic photon (priced by those that
+ * cast a ray: a dark light's cost nothing, and a price learnt while a light was off made the first update
+ * after it was switched on trace 23,000 photons in 16 ms of a 2 ms plan), a cube
  * face, a texel, a ray of a light edit's texel gathers. Each model is seeded from the updater's setup (the full trace, every AIM, every caustic
  * photon, every face, the full gather) and learns from every update that did some of its work, so a
  * small batch's fixed costs count into its units' price (the plan errs on the side of less work).
@@ -60,6 +66,8 @@ typedef struct {
     int texels;               /* the most texels a step may gather (the atlas) */
     uint32_t scale_rays;      /* rays a light edit's texel factors wait for (an edit's at the full quality) */
     int scale_edit;           /* an edit's first guess waits: it may take what the whole budget leaves */
+    double ms_spent;          /* what the update spent before its plan that its rest does not hold (the
+                               * photon job begun by the last update, waited for): off the budget now */
 } lm_budget_work;
 
 /* What the update may do: 0 for groups, aim_hits, caustic_photons or faces means the settings' own
@@ -79,8 +87,13 @@ void lm_budget_seed(lm_budget *b, const double ms_per_unit[LM_STAGE_PLANNED]);
 /* The plan of one update within budget_ms (> 0) for the work waiting. */
 void lm_budget_plan_step(const lm_budget *b, double budget_ms, const lm_budget_work *w, lm_budget_plan *out);
 /* One update's costs: each planned stage's milliseconds over the units it did (0 units: nothing
- * learnt for it), and the whole update's milliseconds (the gather's rest is the update less the gather). */
+ * learnt for it), the whole update's milliseconds, and of those the milliseconds set aside: the edits'
+ * work done at once (a light traced as it was lit, AIMs refreshed for a light or colour edit) and how far
+ * the photon thread's stages ran past their plan (a price their own models learn). The gather's rest is
+ * the update less the gather, the texel factors and what is set aside: counted into the rest, a burst
+ * would starve the gather for up to LM_COST_WINDOW updates after it (three such in the window are its
+ * 95th percentile). */
 void lm_budget_learn(lm_budget *b, const double ms[LM_STAGE_PLANNED], const uint64_t units[LM_STAGE_PLANNED],
-                     double ms_total);
+                     double ms_total, double ms_aside);
 
 #endif

@@ -110,7 +110,7 @@ static void seed_budget(lm_frame_loop *fl, const lm_photon_stage_frame *setup, d
     double ms[LM_STAGE_PLANNED] = {
         [LM_STAGE_PHOTONS] = groups ? 1e3 * setup->t_photons / groups : 0.0,
         [LM_STAGE_AIM] = setup->aim.hits_used ? 1e3 * setup->t_aim / (double)setup->aim.hits_used : 0.0,
-        [LM_STAGE_CAUSTICS] = setup->caustics.traced ? 1e3 * setup->t_caustics / setup->caustics.traced : 0.0,
+        [LM_STAGE_CAUSTICS] = setup->caustics.cast ? 1e3 * setup->t_caustics / setup->caustics.cast : 0.0,
         [LM_STAGE_REFLECTIONS] = 0.5,
         [LM_STAGE_GATHER] = texels ? 1e3 * t_gather / texels : 0.01,
     };
@@ -259,6 +259,7 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
         lm_photon_stage_waiting(fl->stage, &w.groups, &w.caustic_photons);
         w.scale_edit = lm_photon_stage_scale_waiting(fl->stage);
         w.scale_rays = w.scale_edit ? LM_LIGHT_SCALE_WORK : lm_lightmap_path_scale_waiting(fl->lightmaps);
+        w.ms_spent = 1e3 * o->t_waited;
         lm_budget_plan_step(&fl->budget, fl->budget_ms, &w, p);
     } else {
         memset(p, 0, sizeof *p);
@@ -275,10 +276,33 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
  * anything that reads them (the photon thread's update among them) starts; then the step's plan. */
 static lm_status animate(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
+    double t0 = lm_now();
     lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
+    const lm_photon_stage_frame *f = &o->stage; /* an edit's own work, done at once */
+    if (f->emitters_lit > 0 || f->emitters_scaled > 0 || f->materials_changed > 0 || f->aim_at_once > 0)
+        o->t_edits = lm_now() - t0;
     lm_scene_update_bounds(fl->world.scene);
     plan(fl, o);
     return st;
+}
+
+/* The seconds of the photon stage's job (its tracing, AIM refreshes and caustic photons) in f so far. */
+static double job_seconds(const lm_photon_stage_frame *f) { return f->t_photons + f->t_aim + f->t_caustics; }
+
+/* The seconds a plan gave the photon stage's job; negative without a budget (no plan). */
+static double job_planned(const lm_frame_loop *fl, const lm_budget_plan *p)
+{
+    return fl->budget_ms > 0.0f ? 1e-3 * (p->ms[LM_STAGE_PHOTONS] + p->ms[LM_STAGE_AIM] + p->ms[LM_STAGE_CAUSTICS])
+                                : -1.0;
+}
+
+/* How far a job of `job` seconds ran past the `planned` it was given, at most the `waited` seconds the
+ * step waited for it (lm_frame_stats.t_overrun). */
+static double overrun(double planned, double job, double waited)
+{
+    double x = planned < 0.0 ? 0.0 : job - planned;
+    x = x < waited ? x : waited;
+    return x > 0.0 ? x : 0.0;
 }
 
 /* The stage's work of this step (or of the last one, overlapped) refreshed AIMs: the gather's are stale. */
@@ -293,8 +317,10 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
 {
     double t0 = lm_now();
     lm_status st = animate(fl, t, o, err);
+    double job = job_seconds(&o->stage), tu = lm_now();
     if (st == LM_OK)
         st = lm_photon_stage_update(fl->stage, &o->stage, err);
+    o->t_overrun = overrun(job_planned(fl, &o->plan), job_seconds(&o->stage) - job, lm_now() - tu);
     note_stage(fl, &o->stage);
     if (st == LM_OK)
         st = prepare_frame(fl, o, err);
@@ -329,12 +355,14 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
         return st;
     st = lm_lightmap_path_gather(fl->lightmaps, o->texels_gathered, err);
     o->t_gather = lm_now() - t1;
+    double job = job_seconds(&o->stage);
     lm_stage_worker_begin(fl->worker, &o->stage);
     if (st == LM_OK)
         st = blend_and_render(fl, o, err);
     double t4 = lm_now();
     lm_error worker_err;
     lm_status ws = lm_stage_worker_end(fl->worker, &worker_err);
+    o->t_overrun = overrun(job_planned(fl, &o->plan), job_seconds(&o->stage) - job, lm_now() - t4);
     if (ws != LM_OK && st == LM_OK) {
         st = ws;
         if (err)
@@ -377,6 +405,7 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     lm_photon_stage_frame done;
     memset(&done, 0, sizeof done);
     lm_status st = join_stage(fl, &done, err);
+    o->t_waited = lm_now() - t0; /* before the plan: it knows what is left */
     if (st == LM_OK)
         st = animate(fl, t, o, err);
     /* the counts and times of the stage's work that finished in this step (begun by the last one), with
@@ -413,9 +442,9 @@ static void learn(lm_frame_loop *fl, const lm_frame_stats *o)
     const lm_photon_stage_frame *f = &o->stage;
     const double ms[LM_STAGE_PLANNED] = {1e3 * f->t_photons,     1e3 * f->t_aim, 1e3 * f->t_caustics,
                                          1e3 * o->t_reflections, 1e3 * o->t_gather, 1e3 * o->t_light_scale};
-    const uint64_t units[LM_STAGE_PLANNED] = {f->photons.groups_retraced, f->aim.hits_used, f->caustics.traced,
+    const uint64_t units[LM_STAGE_PLANNED] = {f->photons.groups_retraced, f->aim.hits_used, f->caustics.cast,
                                               (uint64_t)o->cube_faces, o->texels_gathered, o->scale_rays};
-    lm_budget_learn(&fl->budget, ms, units, 1e3 * o->t_total);
+    lm_budget_learn(&fl->budget, ms, units, 1e3 * o->t_total, 1e3 * (o->t_edits + o->t_waited + o->t_overrun));
 }
 
 /* What the step's plan was, in words, for the why of its busiest stage. */

@@ -108,6 +108,15 @@ typedef struct {
      * their seconds and the rays of one of their gathers */
     double t_light_scale;
     uint64_t scale_rays;
+    /* of t_photons, the edits' work the photon stage did at once (a lit light's photons traced, AIMs
+     * refreshed for a light or colour edit: lm_photon_stage_animate), which the budget's model of the
+     * gather's rest leaves out like the texel factors (budget_plan.h) */
+    double t_edits;
+    /* of t_photons, how far the photon stage's job that finished in this step ran past what its plan gave
+     * it, at most what the step waited for it (in order and overlapped): a price its stages' models learn
+     * from this step on, which the gather's rest leaves out too; detached, the wait for the job the last
+     * step began, at the step's start, which the plan takes off the budget instead (budget_plan.h) */
+    double t_overrun, t_waited;
     /* the time budget (budget_plan.h): the counts the step was allowed (zeros but texels without a budget:
      * the settings'), the stage that took the most time and why, in words */
     lm_budget_plan plan;
