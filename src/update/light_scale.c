@@ -95,8 +95,7 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
                         const float *surface_factor, float least, uint32_t i, float *out, float *add)
 {
     const lm_texel *t = &a->texels[i];
-    double s0[3] = {0, 0, 0}, s1[3] = {0, 0, 0};
-    int met = 0;
+    double s0[3] = {0, 0, 0}, s1[3] = {0, 0, 0}, met = 0.0;
     for (int dy = -spread; dy <= spread; dy++)
         for (int dx = -spread; dx <= spread; dx++) {
             int x = (int)t->x + dx, y = (int)t->y + dy;
@@ -105,15 +104,18 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
             int q = a->texel_index[(size_t)y * a->width + x];
             if (q < 0 || !done[q] || a->texels[q].surface != t->surface)
                 continue;
-            met++;
+            /* a tent: a gather entering the window as it moves by one texel weighs little, so that the
+             * sums, and the factors, change smoothly from texel to texel where few texels gathered */
+            double w = (double)(spread + 1 - abs(dx)) * (spread + 1 - abs(dy));
+            met += w;
             for (int c = 0; c < 3; c++)
-                s0[c] += e0[3 * (size_t)q + c], s1[c] += e1[3 * (size_t)q + c];
+                s0[c] += w * e0[3 * (size_t)q + c], s1[c] += w * e1[3 * (size_t)q + c];
         }
     const float *own = surface_factor + 3 * t->surface;
     int keep = 1;
     for (int c = 0; c < 3; c++) { /* no neighbour gathered (a large atlas's strides): its surface's */
-        int dark = met && least >= 0.0f && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
-        float f = !met || dark     ? (met ? 1.0f : own[c])
+        int dark = met > 0.0 && least >= 0.0f && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
+        float f = !(met > 0.0) || dark ? (met > 0.0 ? 1.0f : own[c])
                   : s0[c] > 0.0    ? (float)(s1[c] / s0[c])
                   : s1[c] > 0.0    ? own[c]
                                    : 1.0f;
