@@ -84,17 +84,18 @@ static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_r
     lm_rim_irradiance_pair(was, now, eye, b, t, n, ng, i, e0, e1);
 }
 
-/* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within `spread` of it
+/* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within at.spread of it
  * that gathered (done), a ratio that varies slowly over a surface and is far less noisy summed; 1 where
  * they see no light either way, or where it is within LM_LIGHT_SCALE_KEEP of 1; its surface's where none
  * of them gathered. After an edit that adds light, where they saw next to no light before
  * (LM_LIGHT_SCALE_DARK), no factor can light the texel: its factor is 1 and *add the gathers' mean change,
  * what a regather would add to it to first order (the gathers estimate the IIM's irradiance itself),
  * unless that is under `least` (a negative `least`: no edit that adds, nothing added). */
-static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, int spread,
+static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
                         const float *surface_factor, float least, uint32_t i, float *out, float *add)
 {
     const lm_texel *t = &a->texels[i];
+    const int spread = at.spread;
     double s0[3] = {0, 0, 0}, s1[3] = {0, 0, 0}, met = 0.0;
     for (int dy = -spread; dy <= spread; dy++)
         for (int dx = -spread; dx <= spread; dx++) {
@@ -104,9 +105,10 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
             int q = a->texel_index[(size_t)y * a->width + x];
             if (q < 0 || !done[q] || a->texels[q].surface != t->surface)
                 continue;
-            /* a tent: a gather entering the window as it moves by one texel weighs little, so that the
-             * sums, and the factors, change smoothly from texel to texel where few texels gathered */
-            double w = (double)(spread + 1 - abs(dx)) * (spread + 1 - abs(dy));
+            /* where few texels gathered, a tent: a gather entering the window as it moves by one texel
+             * weighs little, so that the sums, and the factors, change smoothly from texel to texel; where
+             * all did, flat (the tent would weigh a texel's own noise more) */
+            double w = at.stride > 1 ? (double)(spread + 1 - abs(dx)) * (spread + 1 - abs(dy)) : 1.0;
             met += w;
             for (int c = 0; c < 3; c++)
                 s0[c] += w * e0[3 * (size_t)q + c], s1[c] += w * e1[3 * (size_t)q + c];
@@ -155,13 +157,13 @@ static void gather_range(lm_light_scale *ls, const lm_light_scale_world *w, cons
 
 /* The factors and additions of texels [lo, hi), whole surfaces gathered, into f and d (3 per texel,
  * texel lo's first). */
-static void ratios(const lm_light_scale *ls, const lm_atlas *a, int spread, uint32_t lo, uint32_t hi, float *f,
+static void ratios(const lm_light_scale *ls, const lm_atlas *a, quality q, uint32_t lo, uint32_t hi, float *f,
                    float *d)
 {
     const float *e0 = ls->e, *e1 = ls->e + 3 * (size_t)a->texel_count;
 #pragma omp parallel for schedule(static)
     for (long i = (long)lo; i < (long)hi; i++)
-        texel_ratio(a, e0, e1, ls->done, spread, ls->surface_factor, ls->least, (uint32_t)i, f + 3 * (i - (long)lo),
+        texel_ratio(a, e0, e1, ls->done, q, ls->surface_factor, ls->least, (uint32_t)i, f + 3 * (i - (long)lo),
                     d + 3 * (i - (long)lo));
 }
 
@@ -286,7 +288,7 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     }
     gather_range(ls, w, after, q, 0, (uint32_t)T);
     ls->least = adds ? least_add(ls, a) : -1.0f;
-    ratios(ls, a, q.spread, 0, (uint32_t)T, factor, add);
+    ratios(ls, a, q, 0, (uint32_t)T, factor, add);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
     if (!coarse) { /* the full quality: nothing to refine */
         lm_light_scale_free(ls);
@@ -327,7 +329,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
             lm_light_scale_free(ls);
             return cast;
         }
-        ratios(ls, a, q.spread, start, end, f, d);
+        ratios(ls, a, q, start, end, f, d);
         for (uint32_t i = start; i < end; i++)
             for (int c = 0; c < 3; c++) {
                 size_t j = 3 * (size_t)i + c, o = 3 * (size_t)(i - start) + c;
