@@ -755,15 +755,22 @@ static void test_emission_at_once(void **state)
     lmgi_context_free(ctx);
 }
 
+/* One update at budget_ms (0: none), which must succeed; its stats. */
+static lmgi_update_stats one_update(lmgi_updater *u, float budget_ms)
+{
+    lmgi_update_stats st;
+    lmgi_error e;
+    assert_int_equal(lmgi_update(u, 0.0f, budget_ms, &st, &e), LMGI_OK);
+    return st;
+}
+
 /* n updates at budget_ms (0: none); the rays the light edits' texel factors cast over them, and the first
  * update's stats in *first when given. */
 static uint64_t budgeted_updates(lmgi_updater *u, float budget_ms, int n, lmgi_update_stats *first)
 {
     uint64_t rays = 0;
     for (int i = 0; i < n; i++) {
-        lmgi_update_stats st;
-        lmgi_error e;
-        assert_int_equal(lmgi_update(u, 0.0f, budget_ms, &st, &e), LMGI_OK);
+        lmgi_update_stats st = one_update(u, budget_ms);
         rays += st.light_scale_rays;
         if (i == 0 && first)
             *first = st;
@@ -975,7 +982,6 @@ static void test_two_lights_within_budget(void **state)
     unsettle(&r);
 }
 
-
 /* n updates at budget_ms: the mean texels_budget, and into *idle (may be NULL) how many were allowed a
  * single texel and yet took under half the budget, and into *longest the longest update's milliseconds. */
 static double texel_budgets(lmgi_updater *u, float budget_ms, int n, int *idle, double *longest)
@@ -983,9 +989,7 @@ static double texel_budgets(lmgi_updater *u, float budget_ms, int n, int *idle, 
     double sum = 0.0;
     *longest = 0.0;
     for (int i = 0; i < n; i++) {
-        lmgi_update_stats st;
-        lmgi_error e;
-        assert_int_equal(lmgi_update(u, 0.0f, budget_ms, &st, &e), LMGI_OK);
+        lmgi_update_stats st = one_update(u, budget_ms);
         sum += st.texels_budget;
         *longest = fmax(*longest, st.ms_total);
         if (idle)
