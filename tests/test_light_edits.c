@@ -633,6 +633,17 @@ static void test_switched_off(void **state)
     two_lights(0, 1.0f, 0, 0.015); /* 0.0046 */
 }
 
+/* The spot added to r's scene at three times its intensity (a change the size of the lamp's light); its id. */
+static int add_bright_spot(settled_room *r)
+{
+    lmgi_light spot = light_of(&SPOT);
+    spot.intensity *= 3.0f;
+    int id = -1;
+    lmgi_error e;
+    assert_int_equal(lmgi_add_light(r->sc, &spot, &id, &e), LMGI_OK);
+    return id;
+}
+
 /* A light lit where there was none (issue 32, item 6), without a budget: the edit's update traces its
  * photons and refreshes the AIMs they reach (every one of its groups traced: no re-trace left of them to
  * wait for), and the IIM takes each texel's factor from them, so that its lightmap has made most of the
@@ -666,12 +677,7 @@ static void test_added_light_at_once(void **state)
     (void)state;
     settled_room r;
     settle(&r, &LAMP, 1);
-    lmgi_light spot = light_of(&SPOT);
-    spot.intensity *= 3.0f; /* a change the size of the lamp's light */
-    int id = -1;
-    lmgi_error e;
-    assert_int_equal(lmgi_add_light(r.sc, &spot, &id, &e), LMGI_OK);
-    lit_at_once(&r, id, "spot added", 0.1);
+    lit_at_once(&r, add_bright_spot(&r), "spot added", 0.1);
     unsettle(&r);
 }
 
@@ -830,17 +836,24 @@ static uint64_t finish_refinement(lmgi_updater *u)
     return within;
 }
 
-/* After a bake of r's updater, the relative L1 distances from its lightmap of r->before, now and later. */
-static void off_regathered(settled_room *r, const float *now, const float *later, double *was, double *at_once,
-                           double *after)
+/* The edit's update within 4 ms (its stats into *st), then the refinement finished (finish_refinement),
+ * then a bake: the relative L1 distances from the baked lightmap of r->before, of the lightmap at the
+ * edit's update and of the one once refined. Returns the refinement's rays within the budget. */
+static uint64_t refined_then_regathered(settled_room *r, lmgi_update_stats *st, double *was, double *at_once,
+                                        double *after)
 {
     size_t n = r->n;
+    budgeted_updates(r->u, 4.0f, 1, st);
+    float *now = lmt_iim(r->u, r->sc, &n);
+    uint64_t refined = finish_refinement(r->u);
+    float *later = lmt_iim(r->u, r->sc, &n);
     lmt_bake(r->u, NULL);
     float *want = lmt_iim(r->u, r->sc, &n);
     *was = lmt_relative_l1(r->before, want, n);
     *at_once = lmt_relative_l1(now, want, n);
     *after = lmt_relative_l1(later, want, n);
-    free(want);
+    free(now), free(later), free(want);
+    return refined;
 }
 
 /* The block recoloured under a time budget: its AIM scaled by the colour's ratio at once, the surfaces
@@ -852,7 +865,6 @@ static void test_recolour_within_budget(void **state)
     (void)state;
     settled_room r;
     settle(&r, &LAMP, 1);
-    size_t n = r.n;
     budgeted_updates(r.u, 4.0f, 3, NULL);
     lmgi_material m;
     lmgi_error e;
@@ -860,12 +872,8 @@ static void test_recolour_within_budget(void **state)
     m.base_color[0] = 0.1f, m.base_color[1] = 0.2f, m.base_color[2] = 0.8f;
     assert_int_equal(lmgi_set_material(r.sc, 1, &m, &e), LMGI_OK);
     lmgi_update_stats st;
-    budgeted_updates(r.u, 4.0f, 1, &st);
-    float *now = lmt_iim(r.u, r.sc, &n);
-    assert_true(finish_refinement(r.u) > 0);
-    float *later = lmt_iim(r.u, r.sc, &n);
     double was, at_once, after;
-    off_regathered(&r, now, later, &was, &at_once, &after);
+    assert_true(refined_then_regathered(&r, &st, &was, &at_once, &after) > 0);
     print_message("4 ms budget, block recoloured: %d AIMs refreshed at once, a first guess of %u rays; lightmap "
                   "against the regathered one %.3g before the edit, %.3g at the next update, %.3g once refined\n",
                   st.aim_surfaces_at_once, st.light_scale_rays, was, at_once, after);
@@ -873,7 +881,6 @@ static void test_recolour_within_budget(void **state)
     assert_true(was > 0.02);
     assert_true(at_once < 0.5 * was);
     assert_true(after < 0.25 * was);
-    free(now), free(later);
     unsettle(&r);
 }
 
@@ -925,20 +932,11 @@ static void test_added_light_within_budget(void **state)
     (void)state;
     settled_room r;
     settle(&r, &LAMP, 1);
-    size_t n = r.n;
     budgeted_updates(r.u, 4.0f, 3, NULL);
-    lmgi_light spot = light_of(&SPOT);
-    spot.intensity *= 3.0f;
-    int id = -1;
-    lmgi_error e;
-    assert_int_equal(lmgi_add_light(r.sc, &spot, &id, &e), LMGI_OK);
+    add_bright_spot(&r);
     lmgi_update_stats st;
-    budgeted_updates(r.u, 4.0f, 1, &st);
-    float *now = lmt_iim(r.u, r.sc, &n);
-    uint64_t refined = finish_refinement(r.u);
-    float *later = lmt_iim(r.u, r.sc, &n);
     double was, at_once, after;
-    off_regathered(&r, now, later, &was, &at_once, &after);
+    uint64_t refined = refined_then_regathered(&r, &st, &was, &at_once, &after);
     print_message("4 ms budget, spot added: %d AIMs at once, %.2f ms; against the regathered lightmap %.3g before, "
                   "%.3g at the next update, %.3g once refined (%llu rays within the budget)\n",
                   st.aim_surfaces_at_once, st.ms_total, was, at_once, after, (unsigned long long)refined);
@@ -946,7 +944,6 @@ static void test_added_light_within_budget(void **state)
     assert_int_equal(st.aim_surfaces_at_once, 0);
     assert_true(at_once < 0.5 * was); /* 0.33: the scaled AIMs are a guess where the spot lights other places */
     assert_true(after < 0.05 * was);
-    free(now), free(later);
     unsettle(&r);
 }
 
@@ -961,16 +958,11 @@ static void test_two_lights_within_budget(void **state)
     const lmgi_light_desc both[2] = {LAMP, SPOT};
     settled_room r;
     settle(&r, both, 2);
-    size_t n = r.n;
     budgeted_updates(r.u, 4.0f, 3, NULL);
     edit_light(r.sc, 0, 0.25f, NULL, 1);
     lmgi_update_stats st;
-    budgeted_updates(r.u, 4.0f, 1, &st);
-    float *now = lmt_iim(r.u, r.sc, &n);
-    uint64_t refined = finish_refinement(r.u);
-    float *later = lmt_iim(r.u, r.sc, &n);
     double was, at_once, after;
-    off_regathered(&r, now, later, &was, &at_once, &after);
+    uint64_t refined = refined_then_regathered(&r, &st, &was, &at_once, &after);
     print_message("4 ms budget, lamp dimmed beside the spot: %d AIMs at once; against the regathered lightmap %.3g "
                   "before, %.3g at the next update, %.3g once refined (%llu rays within the budget)\n",
                   st.aim_surfaces_at_once, was, at_once, after, (unsigned long long)refined);
@@ -978,7 +970,6 @@ static void test_two_lights_within_budget(void **state)
     assert_true(refined > 0);
     assert_true(at_once < 0.2 * was);
     assert_true(after < 0.015 * was);
-    free(now), free(later);
     unsettle(&r);
 }
 
