@@ -130,9 +130,10 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         out[c] = 1.0f;
 }
 
-/* Texels [lo, hi) gathered at quality q into ls->e (those that gather at it, flagged done). */
-static void gather_range(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, quality q,
-                         uint32_t lo, uint32_t hi)
+/* Texels list[0 .. n) (list NULL: lo, lo + 1, ...) gathered at quality q into ls->e (those that gather at
+ * it, flagged done), in one parallel pass. */
+static void gather_texels(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, quality q,
+                          const uint32_t *list, uint32_t lo, uint32_t n)
 {
     const lm_atlas *a = w->atlas;
     size_t T = a->texel_count;
@@ -143,15 +144,19 @@ static void gather_range(lm_light_scale *ls, const lm_light_scale_world *w, cons
     lm_rim now = was;
     now.aim = after;
     now.emissive = NULL;
-    for (uint32_t i = lo; i < hi; i++)
+    for (uint32_t j = 0; j < n; j++) {
+        uint32_t i = list ? list[j] : lo + j;
         ls->done[i] = (uint8_t)gathers_at(a, i, q);
+    }
 #pragma omp parallel
     {
         lm_rt_thread_init();
 #pragma omp for schedule(dynamic, 16)
-        for (long i = (long)lo; i < (long)hi; i++)
+        for (long j = 0; j < (long)n; j++) {
+            uint32_t i = list ? list[j] : lo + (uint32_t)j;
             if (ls->done[i])
-                gathers(w, &was, &now, (uint32_t)i, ls->e + 3 * (size_t)i, ls->e + 3 * (T + (size_t)i));
+                gathers(w, &was, &now, i, ls->e + 3 * (size_t)i, ls->e + 3 * (T + (size_t)i));
+        }
     }
 }
 
@@ -194,6 +199,7 @@ void lm_light_scale_free(lm_light_scale *ls)
     free(ls->added);
     free(ls->range);
     free(ls->order);
+    free(ls->list);
     lm_light_scale_init(ls);
 }
 
@@ -223,8 +229,9 @@ static int plan_order(lm_light_scale *ls, const lm_atlas *a)
     int S = a->surface_count;
     ls->range = calloc(2 * (size_t)S + 1, sizeof *ls->range);
     ls->order = malloc(sizeof *ls->order * (size_t)(S ? S : 1));
+    ls->list = malloc(sizeof *ls->list * ((size_t)a->texel_count + 1));
     double *moved = malloc(sizeof *moved * (size_t)(S ? S : 1));
-    if (!ls->range || !ls->order || !moved) {
+    if (!ls->range || !ls->order || !ls->list || !moved) {
         free(moved);
         return 0;
     }
@@ -286,7 +293,7 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
                q.spread < MOST_SPREAD)
             q.spread++;
     }
-    gather_range(ls, w, after, q, 0, (uint32_t)T);
+    gather_texels(ls, w, after, q, NULL, 0, (uint32_t)T);
     ls->least = adds ? least_add(ls, a) : -1.0f;
     ratios(ls, a, q, 0, (uint32_t)T, factor, add);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
@@ -314,16 +321,29 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
     rays = rays ? rays : UINT32_MAX; /* no bound (the budget switched off): the rest at once */
     for (size_t c = 0; c < 3 * (size_t)a->texel_count; c++)
         factor[c] = 1.0f, add[c] = 0.0f;
-    while (ls->at < ls->count && (cast == 0 || cast < rays)) { /* at least one texel that gathers */
-        int k = ls->order[ls->at];
+    /* this update's texels, over every surface the rays reach, gathered in one parallel pass: gathered a
+     * surface at a time, the shared room's surfaces of a few texels each kept one core busy and the other
+     * idle, and a refinement's ray cost 3 to 9 times the first guess's, past its plan */
+    int at = ls->at;
+    uint32_t next = ls->next, n = 0;
+    while (at < ls->count && (cast == 0 || cast < rays)) { /* at least one texel that gathers */
+        int k = ls->order[at];
         uint32_t start = ls->range[2 * k], end = ls->range[2 * k + 1];
-        uint32_t lo = ls->next > start ? ls->next : start, hi = lo;
-        while (hi < end && (cast == 0 || cast < rays))
-            cast += gathers_at(a, hi++, q) ? q.K : 0;
-        gather_range(ls, w, after, q, lo, hi);
-        ls->next = hi;
+        uint32_t lo = next > start ? next : start, hi = lo;
+        while (hi < end && (cast == 0 || cast < rays)) {
+            cast += gathers_at(a, hi, q) ? q.K : 0;
+            ls->list[n++] = hi++;
+        }
+        next = hi;
         if (hi < end)
             break;
+        at++;
+        next = 0; /* the next surface's run starts anywhere */
+    }
+    gather_texels(ls, w, after, q, ls->list, 0, n);
+    for (; ls->at < at; ls->at++) { /* the surfaces whose texels have all gathered: their factors */
+        int k = ls->order[ls->at];
+        uint32_t start = ls->range[2 * k], end = ls->range[2 * k + 1];
         float *f = malloc(sizeof *f * 6 * (size_t)(end - start)), *d = f + 3 * (size_t)(end - start);
         if (!f) { /* the rest keeps its first guess, which regathers refine */
             lm_light_scale_free(ls);
@@ -341,9 +361,8 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
                 factor[j] = now / was, add[j] = adds - had * factor[j], *corrected = 1;
             }
         free(f);
-        ls->at++;
-        ls->next = 0; /* the next surface's run starts anywhere */
     }
+    ls->next = next;
     if (ls->at >= ls->count)
         lm_light_scale_free(ls);
     return cast;

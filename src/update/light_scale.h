@@ -44,10 +44,11 @@
  * regathered since the edit (lm_light_scale_regathered) holds its fresh value and is left alone.
  *
  * Layout: the job owns the AIM and the emissions from before until it ends; per texel its two gathers,
- * what the IIM holds of this edit (the factor and addition applied so far) and two flags (50 bytes a
- * texel, freed when the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
+ * what the IIM holds of this edit (the factor and addition applied so far), two flags and a scratch list
+ * of the texels one refinement step gathers (54 bytes a texel, freed when the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
  * a surface's texels are a run and a factor, which sums over its own surface's texels alone, is final once
- * its run is gathered. Cost: the rays cast, as above. Errors: none (deterministic: each texel's rays are
+ * its run is gathered. Cost: the rays cast, as above; a refinement step gathers all its texels, over
+ * however many surfaces, in one parallel pass. Errors: none (deterministic: each texel's rays are
  * seeded by its index; no memory: each texel takes its surface's factor at once). Not thread-safe (one
  * job per lightmap path; the gathers themselves run on every OpenMP thread). */
 #ifndef LM_LIGHT_SCALE_H
@@ -101,6 +102,7 @@ typedef struct {
                                         the edit adds no light (lm_light_scale_begin's adds), nothing is */
     uint32_t *range;                 /* per surface: its run of texels [range[2 k], range[2 k + 1]) */
     int *order, count;               /* the surfaces with texels, in the refinement's order */
+    uint32_t *list;                  /* scratch: the texels one refinement step gathers */
     int at;                          /* order[at]: the surface under way */
     uint32_t next;                   /* its first texel not yet gathered (0: none yet) */
     int active;                      /* a refinement is under way */
