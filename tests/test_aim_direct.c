@@ -106,29 +106,42 @@ static int surface_of_node(const lmt_pipeline *p, int node)
  * parts (V decided at each part's own position), within the N-nearest estimate's error on the uniform
  * bounced part alone (first hits carry 100 times the light and must not count). In the paper's form the
  * texels beside the shadow's edge are off by tens of percent; here the edge is as sharp as the parts. */
+/* The shadow scene's floor hits: g x g stratified points, one bounced hit (E_BOUNCED in all) and one first
+ * hit (100 times that) each; the AIM with the light's direct part computed (rest kept with keep_rest),
+ * refreshed. Returns the floor's surface. */
+#define SHADOW_POINTS 200
+static int shadow_aim(lmt_pipeline *p, lm_photon_store *ps, lm_aim *aim, lm_direct_light *d, int keep_rest)
+{
+    lmt_pipeline_load(p, shadow_scene(), 0.05f);
+    int floor = surface_of_node(p, 0);
+    assert_int_equal(lm_photon_store_init(ps, p->su.surface_count, NULL), LM_OK);
+    const int g = SHADOW_POINTS;
+    for (int j = 0; j < g; j++)
+        for (int i = 0; i < g; i++) {
+            float x = -2.0f + 4.0f * (i + 0.5f) / g, z = -2.0f + 4.0f * (j + 0.5f) / g;
+            add_hit(ps, p, floor, x, z, E_BOUNCED * 16.0f / (float)(g * g), 1);
+            add_hit(ps, p, floor, x, z, 100.0f * E_BOUNCED * 16.0f / (float)(g * g), 0);
+        }
+    lm_aim_settings set;
+    lm_aim_settings_default(&set);
+    lm_error err;
+    assert_int_equal(lm_aim_init(aim, p->s, &p->su, &p->atlas, &set, &err), LM_OK);
+    *d = (lm_direct_light){p->s, p->rt, &p->em, NULL, LM_DIRECT_PUNCTUAL, 1e-5f, 0.05f, NULL};
+    lm_aim_set_direct(aim, d);
+    if (keep_rest)
+        assert_int_equal(lm_aim_keep_rest(aim, &err), LM_OK);
+    assert_int_equal(lm_aim_refresh_all(aim, p->s, &p->su, &p->atlas, ps, NULL, &err), LM_OK);
+    return floor;
+}
+
 static void test_point_light_shadow_edge(void **state)
 {
     (void)state;
     lmt_pipeline p;
-    lmt_pipeline_load(&p, shadow_scene(), 0.05f);
-    int floor = surface_of_node(&p, 0);
     lm_photon_store ps;
-    assert_int_equal(lm_photon_store_init(&ps, p.su.surface_count, NULL), LM_OK);
-    const int g = 200; /* g x g stratified points over the floor, one bounced and one first hit each */
-    for (int j = 0; j < g; j++)
-        for (int i = 0; i < g; i++) {
-            float x = -2.0f + 4.0f * (i + 0.5f) / g, z = -2.0f + 4.0f * (j + 0.5f) / g;
-            add_hit(&ps, &p, floor, x, z, E_BOUNCED * 16.0f / (float)(g * g), 1);
-            add_hit(&ps, &p, floor, x, z, 100.0f * E_BOUNCED * 16.0f / (float)(g * g), 0);
-        }
-    lm_aim_settings set;
-    lm_aim_settings_default(&set);
     lm_aim aim;
-    lm_error err;
-    assert_int_equal(lm_aim_init(&aim, p.s, &p.su, &p.atlas, &set, &err), LM_OK);
-    lm_direct_light d = {p.s, p.rt, &p.em, NULL, LM_DIRECT_PUNCTUAL, 1e-5f, 0.05f, NULL};
-    lm_aim_set_direct(&aim, &d);
-    assert_int_equal(lm_aim_refresh_all(&aim, p.s, &p.su, &p.atlas, &ps, NULL, &err), LM_OK);
+    lm_direct_light d;
+    int floor = shadow_aim(&p, &ps, &aim, &d, 0);
     double worst = 0.0, worst_edge = 0.0;
     int shadowed = 0, lit = 0, edge = 0;
     for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
@@ -160,6 +173,59 @@ static void test_point_light_shadow_edge(void **state)
     assert_true(shadowed > 50 && lit > 1000 && edge > 30);
     assert_true(worst < 0.06);  /* the bounced part's estimate: boundary-corrected, uniform */
     assert_true(worst_edge < 0.06);
+    lm_aim_free(&aim);
+    lm_photon_store_free(&ps);
+    lmt_pipeline_free(&p);
+}
+
+/* The first guess of an edit that scales the photons' light alone beside a light whose direct part the AIM
+ * computes (update/photon_stage.c, by_rest): the first hits that part covers sum to their flux
+ * (lm_direct_covered_flux); the bounced hits doubled, the AIM scaled with its rest doubled and its computed
+ * part kept (lm_aim_scale_surfaces) is, texel for texel, the AIM refreshed from the doubled hits, while
+ * scaling the whole value, as a first guess without rest must, would double the light's direct part too. */
+static void test_scale_rest_alone(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lm_photon_store ps;
+    lm_aim aim;
+    lm_direct_light d;
+    int floor = shadow_aim(&p, &ps, &aim, &d, 1);
+    double *covered = calloc(3 * (size_t)p.su.surface_count, sizeof *covered);
+    lm_direct_covered_flux(&d, &ps, covered);
+    assert_float_equal(covered[3 * floor], 100.0 * E_BOUNCED * 16.0, 1e-3 * 100.0 * E_BOUNCED * 16.0);
+    size_t cells = 3 * (size_t)aim.width * aim.height;
+    float *scaled = malloc(sizeof *scaled * cells), *whole = malloc(sizeof *whole * cells);
+    float *factor = malloc(sizeof *factor * 3 * (size_t)p.su.surface_count);
+    float *computed = malloc(sizeof *computed * 3 * (size_t)p.su.surface_count);
+    for (int c = 0; c < 3 * p.su.surface_count; c++)
+        factor[c] = 2.0f, computed[c] = 1.0f;
+    memcpy(whole, lm_aim_rgb(&aim), sizeof *whole * cells);
+    lm_aim_scale_surfaces(&aim, &p.atlas, &floor, 1, factor, computed);
+    memcpy(scaled, lm_aim_rgb(&aim), sizeof *scaled * cells);
+    for (uint32_t slot = 0; slot < ps.used; slot++) /* the bounced hits doubled, and the AIM made again */
+        if (ps.hits[slot].bounce > 0)
+            lm_photon_store_scale(&ps, slot, (const float[3]){2.0f, 2.0f, 2.0f});
+    lm_error err;
+    assert_int_equal(lm_aim_refresh_all(&aim, p.s, &p.su, &p.atlas, &ps, NULL, &err), LM_OK);
+    const float *fresh = lm_aim_rgb(&aim);
+    double worst = 0.0, worst_whole = 0.0;
+    int n = 0;
+    for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
+        const lm_texel *t = &p.atlas.texels[i];
+        size_t at = 3 * ((size_t)t->y * (size_t)aim.width + (size_t)t->x);
+        if (t->surface != floor || !(fresh[at] > 0.0f))
+            continue;
+        n++;
+        worst = fmax(worst, fabs(scaled[at] - fresh[at]) / fresh[at]);
+        worst_whole = fmax(worst_whole, fabs(2.0f * whole[at] - fresh[at]) / fresh[at]);
+    }
+    print_message("%d floor texels, the bounced light doubled: the AIM with its rest scaled %.2g off the one "
+                  "refreshed, %.3g with its whole value scaled\n", n, worst, worst_whole);
+    assert_true(n > 1000);
+    assert_true(worst < 1e-5);
+    assert_true(worst_whole > 0.4); /* 0.53: where the light's direct part is twice the bounced light */
+    free(covered), free(scaled), free(whole), free(factor), free(computed);
     lm_aim_free(&aim);
     lm_photon_store_free(&ps);
     lmt_pipeline_free(&p);
@@ -387,6 +453,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_shadow_edge),
+        cmocka_unit_test(test_scale_rest_alone),
         cmocka_unit_test(test_lamp_under_ceiling),
         cmocka_unit_test(test_updater_choice),
         cmocka_unit_test(test_sun_over_a_large_level),

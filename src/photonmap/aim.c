@@ -1019,18 +1019,21 @@ static void clear_texels(lm_aim *aim, const lm_atlas *a, uint32_t first, uint32_
     }
 }
 
-void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, int count, const float *factor)
+void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, int count, const float *factor,
+                           const float *computed)
 {
     for (int j = 0; j < count; j++) {
         int sf = surfaces[j];
-        const float *f = factor + 3 * (size_t)sf;
+        const float *f = factor + 3 * (size_t)sf, *g = computed && aim->rest ? computed + 3 * (size_t)sf : f;
         for (uint32_t i = aim->texel_first[sf]; i < aim->texel_first[sf + 1]; i++) {
             const lm_texel *t = &a->texels[aim->texel_list[i]];
             size_t at = (size_t)t->y * (size_t)aim->width + (size_t)t->x;
             for (int c = 0; c < 3; c++) {
-                aim->rgb[3 * at + c] *= f[c];
-                if (aim->rest)
-                    aim->rest[3 * at + c] *= f[c];
+                float *v = aim->rgb + 3 * at + c, *r = aim->rest ? aim->rest + 3 * at + c : NULL;
+                if (r) /* the part computed (rgb - rest) by g, the rest by f */
+                    *v = (*v - *r) * g[c] + *r * f[c], *r *= f[c];
+                else
+                    *v *= f[c];
             }
         }
     }

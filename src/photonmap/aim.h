@@ -129,8 +129,10 @@ void lm_aim_set_direct(lm_aim *aim, const lm_direct_light *d);
 /* From the next refresh on, each texel also keeps its value without the punctual lights' part of the
  * direct light (lm_aim.rest; 0 without lm_aim_set_direct): a ray gather adds that part exactly where each
  * of its rays hits (photonmap/hemicube_rim.h) instead of reading it as the average over the texel it hits,
- * which a sunlit road's 7 m texels blur across every house's shadow (docs/aim.md, "Suns"). Costs
- * 7 floats an atlas texel and a second dilation per refresh. Call before the first refresh (the refresh
+ * which a sunlit road's 7 m texels blur across every house's shadow (docs/aim.md, "Suns"); and an edit
+ * that changes the photons' light alone may scale the rest and keep the computed part
+ * (lm_aim_scale_surfaces, docs/tradeoff.md, "Beside a sun"). Costs 7 floats an atlas texel and a second
+ * dilation per refresh. Call before the first refresh (the refresh
  * of a surface writes its texels). Errors: out of memory. */
 lm_status lm_aim_keep_rest(lm_aim *aim, lm_error *err);
 /* rest as RGBA dilated into the gutters, kept up to date by every refresh; NULL without lm_aim_keep_rest. */
@@ -178,9 +180,13 @@ lm_status lm_aim_refresh_listed(lm_aim *aim, const lm_scene *s, const lm_surface
  * (surface_count x 3), the dilated maps made again; delta_f and owed untouched. A first guess that is
  * exact where every hit of a surface scaled alike (a light's power edit in a scene lit by one, a base
  * colour edit for the surfaces of that material: the AIM multiplies in the albedo), cheap where the
- * refresh it stands in for is not (update/photon_stage.c, under a time budget). Cost: the listed
+ * refresh it stands in for is not (update/photon_stage.c, under a time budget). Where rest is kept and
+ * `computed` is given (surface_count x 3, else NULL), the punctual lights' direct part, rgb - rest, is
+ * multiplied by computed instead, and rest, the part the photons bring, by factor: a lamp's power edit
+ * beside a sun whose direct light the AIM computes scales the photons' part alone. Cost: the listed
  * surfaces' texels and one pass over the atlas. */
-void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, int count, const float *factor);
+void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, int count, const float *factor,
+                           const float *computed);
 /* Recomputes one surface's texels from its current hits and resets its delta_f. */
 lm_status lm_aim_refresh_surface(lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
                                  lm_photon_store *ps, int surface, lm_aim_stats *stats, lm_error *err);

@@ -5,6 +5,7 @@
 #include "photons.h"
 
 #include <math.h>
+#include <string.h>
 
 /* 1 when other geometry lies within the cover distance straight out from p on the side of normal n. */
 static int covered(const lm_direct_light *d, float reach, lm_vec3 p, lm_vec3 n)
@@ -93,4 +94,15 @@ void lm_direct_punctual_at(const lm_direct_light *d, const float p[3], const flo
         punctual(d, lm_v3_load(p), lm_v3_load(n), shading_side(n, ns), two_sided ? 3 : 1, e);
     for (int c = 0; c < 3; c++)
         out[c] = (float)e[c];
+}
+
+void lm_direct_covered_flux(const lm_direct_light *d, const lm_photon_store *ps, double *out)
+{
+    memset(out, 0, sizeof *out * 3 * (size_t)ps->surface_count);
+    for (uint32_t i = 0; i < ps->used; i++) {
+        const lm_hit *h = &ps->hits[i];
+        if (h->surface >= 0 && lm_direct_covers_hit(d, h))
+            for (int c = 0; c < 3; c++)
+                out[3 * h->surface + c] += h->flux[c];
+    }
 }

@@ -71,5 +71,17 @@ static inline int lm_direct_covers_hit(const lm_direct_light *d, const lm_hit *h
                               : h->source == LM_HIT_FROM_SUN ? d->punctual != LM_DIRECT_NONE
                               : h->source == LM_HIT_FROM_AREA && d->area != NULL);
 }
+/* 1 when emitter em's first hits are ones lm_direct_covers_hit leaves out: an edit of its power changes
+ * the direct light computed, not only the photons an estimate sums. */
+static inline int lm_direct_covers_emitter(const lm_direct_light *d, const lm_emitter *em)
+{
+    return em->kind == LM_EMIT_DIRECTIONAL ? d->punctual != LM_DIRECT_NONE
+           : em->kind == LM_EMIT_AREA      ? d->area != NULL
+           : em->kind == LM_EMIT_SKY       ? 0
+                                           : d->punctual == LM_DIRECT_PUNCTUAL;
+}
+/* The flux of the live hits lm_direct_covers_hit leaves out, summed per surface into
+ * out[surface * 3 + c] (surface_count x 3 doubles, overwritten). O(slots). */
+void lm_direct_covered_flux(const lm_direct_light *d, const lm_photon_store *ps, double *out);
 
 #endif

@@ -210,7 +210,7 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
         lm_gather_set_emitter_light(lp->gather, &lp->emitters);
     if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (photonmap/hemicube_rim.h) */
         lm_gather_set_tracer(lp->gather, lp->rt);
-    if (st == LM_OK && lm_aim_rest_dilated_rgba(lm_photon_stage_aim(stage))) /* the AIM keeps it for the rays */
+    if (st == LM_OK && set->stage.punctual_at_hits && lm_aim_rest_dilated_rgba(lm_photon_stage_aim(stage)))
         lm_gather_set_direct_at_hits(lp->gather, lm_photon_stage_direct(stage));
     if (st == LM_OK)
         st = follow_light(lp, err); /* before the IIM: a scene without light gathers nothing */

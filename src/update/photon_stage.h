@@ -23,7 +23,9 @@ typedef struct {
                               * rest (LM_EXACT_*) */
     int punctual_at_hits;    /* 1: the AIM also keeps its texels without the punctual lights' direct part
                               * (lm_aim_keep_rest), for a ray gather that computes that part at its hits
-                              * (lm_gather_set_direct_at_hits); 0 (default): not kept */
+                              * (lm_gather_set_direct_at_hits); 0 (default): kept only where that part is
+                              * all the AIM computes (no emissive triangles'), for the first guess of other
+                              * lights' edits under a budget (photon_stage.c, by_rest) */
     int occluders;           /* 1: an AIM texel counts only the hits whose photon came from where it sees
                               * (lm_aim_set_occluders); 0 (default): every hit near it, the paper's */
     int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
