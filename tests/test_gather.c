@@ -1263,10 +1263,17 @@ static void test_light_scale_refined_equals_full(void **state)
         double first_off = 0.0;
         for (size_t i = 0; i < 3 * T; i++)
             first_off = fmax(first_off, fabs(shown[i] - full[i]) / fmax(fabs(full[i]), 1e-3));
+        /* the second run's refinement bound by time alone, a nanosecond: a chunk of texels a step, whatever
+         * the rays (lm_light_scale_refine's ms) */
+        const uint32_t rays = r == 1 ? 1u << 30 : 700;
+        const double ms = r == 1 ? 1e-6 : 0.0;
         while (ls.active && steps < 1000) {
             int corrected = 0;
-            uint32_t cast = lm_light_scale_refine(&ls, &w, after, 700, corr, corr_add, &corrected);
-            assert_true(cast > 0 && cast < 700 + 64); /* about what it was given: at most a texel's rays past it */
+            uint32_t cast = lm_light_scale_refine(&ls, &w, after, rays, ms, corr, corr_add, &corrected);
+            if (r == 1) /* one chunk: at most its texels' rays */
+                assert_true(cast > 0 && cast <= LM_LIGHT_SCALE_CHUNK * 64);
+            else /* about what it was given: at most a texel's rays past it */
+                assert_true(cast > 0 && cast < 700 + 64);
             uint32_t now = lm_light_scale_waiting(&ls, &p.atlas);
             assert_int_equal(now, left - cast);
             left = now;

@@ -269,7 +269,7 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
     lm_photon_stage_limit(fl->stage, &l);
     lm_frame_passes_limit_faces(fl->passes, p->faces);
     lm_lightmap_path_set_texels_per_frame(fl->lightmaps, p->texels);
-    lm_lightmap_path_set_scale_rays(fl->lightmaps, p->scale_rays);
+    lm_lightmap_path_set_scale_rays(fl->lightmaps, p->scale_rays, p->ms[LM_STAGE_LIGHT_SCALE]);
 }
 
 /* Animations and the scene bounds that follow from them: written here, on the calling thread, before

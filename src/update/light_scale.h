@@ -82,6 +82,9 @@
  * 3 x 3 texels 0.0215, over 5 x 5 0.024 and 7 x 7 0.031 (the factor's own change across them); the shared
  * room's lamp dimmed 0.018, 0.017, 0.019 and 0.021. */
 #define LM_LIGHT_SCALE_SPREAD 1
+/* Texels a refinement gathers between looks at the time it was given (lm_light_scale_refine): two of the
+ * gather's dynamic chunks of 16 for each of two cores, 1 to 9 ms at 16 rays a texel on the shared room. */
+#define LM_LIGHT_SCALE_CHUNK 64u
 
 typedef struct {
     const lm_scene *scene;
@@ -122,11 +125,13 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
                               float *emissive_before, const float *after, const float *surface_factor, int adds,
                               uint32_t rays, float *factor, float *add);
 /* The next texels at the full quality, until about `rays` rays of one gather are cast (at least one
- * texel's; 0: every one left): factor and add (texel_count x 3 each) get the correction of each texel of
- * the surfaces that completed (IIM x factor + add), 1 and 0 elsewhere; *corrected: whether any is not (else
- * the IIM needs no pass). Returns the rays cast (0: no job under way). */
+ * texel's; 0: every one left), or, past `ms` milliseconds (> 0), at the end of the chunk of
+ * LM_LIGHT_SCALE_CHUNK texels under way (the first chunk always): factor and add (texel_count x 3 each)
+ * get the correction of each texel of the surfaces that completed (IIM x factor + add), 1 and 0
+ * elsewhere; *corrected: whether any is not (else the IIM needs no pass). Returns the rays cast (0: no job
+ * under way). With ms the texels reached depend on the machine's speed, as any budget's work does. */
 uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, uint32_t rays,
-                               float *factor, float *add, int *corrected);
+                               double ms, float *factor, float *add, int *corrected);
 /* The texels (atlas texel indices) regathered this update: they keep their fresh value. */
 void lm_light_scale_regathered(lm_light_scale *ls, const uint32_t *texels, uint32_t n);
 /* The rays of one gather the refinement has still to cast (0: none under way). */

@@ -34,6 +34,7 @@ struct lm_lightmap_path {
     float *scale;              /* scratch: per surface x 3, what power edits scaled (lm_photon_stage_take_scale) */
     lm_light_scale scaling;    /* the last power edit's texel factors, refined within the budget */
     uint32_t scale_rays;       /* the rays its gathers may cast an update (0: no bound) */
+    double scale_ms_plan;      /* and the milliseconds its refinement may take (0: no bound) */
     double scale_ms;           /* since lm_lightmap_path_take_scale_work: its time and rays */
     uint64_t scale_cast;
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
@@ -370,7 +371,9 @@ static void follow_scale(lm_lightmap_path *lp)
     if (!edit) {
         int corrected = 0;
         lp->scale_cast +=
-            texel ? lm_light_scale_refine(&lp->scaling, &w, after, lp->scale_rays, texel, add, &corrected) : 0;
+            texel ? lm_light_scale_refine(&lp->scaling, &w, after, lp->scale_rays, lp->scale_ms_plan, texel, add,
+                                          &corrected)
+                  : 0;
         if (corrected)
             scale_iim(lp, texel, add, scaled);
         free(texel);
@@ -529,7 +532,11 @@ void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels)
     lp->iim.sched.texels_per_frame = texels > 0 ? texels : 0;
 }
 
-void lm_lightmap_path_set_scale_rays(lm_lightmap_path *lp, uint32_t rays) { lp->scale_rays = rays; }
+void lm_lightmap_path_set_scale_rays(lm_lightmap_path *lp, uint32_t rays, double ms)
+{
+    lp->scale_rays = rays;
+    lp->scale_ms_plan = ms;
+}
 
 uint32_t lm_lightmap_path_scale_waiting(const lm_lightmap_path *lp)
 {

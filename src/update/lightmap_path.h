@@ -55,9 +55,10 @@ lm_iim *lm_lightmap_path_iim(lm_lightmap_path *lp);
 const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp);
 void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels);
 /* The rays a light edit's texel factors may cast an update (update/light_scale.h; 0: no bound, the full
- * quality in the edit's update), what its refinement still has to cast, and the rays it cast and the
- * milliseconds it took since the last take (then zeroed). */
-void lm_lightmap_path_set_scale_rays(lm_lightmap_path *lp, uint32_t rays);
+ * quality in the edit's update) and the milliseconds its refinement may take (0: no bound), what its
+ * refinement still has to cast, and the rays it cast and the milliseconds it took since the last take
+ * (then zeroed). */
+void lm_lightmap_path_set_scale_rays(lm_lightmap_path *lp, uint32_t rays, double ms);
 uint32_t lm_lightmap_path_scale_waiting(const lm_lightmap_path *lp);
 uint64_t lm_lightmap_path_take_scale_work(lm_lightmap_path *lp, double *ms);
 /* The displayed IIM's atlas window win = {x, y, w, h} read back (w*h RGBA floats; caller frees). */
