@@ -1303,6 +1303,10 @@ static void test_light_scale_refined_equals_full(void **state)
          * 600 rays; a box, 0.130, where a gather entered or left the window */
         if (r == 0)
             assert_true(step < 0.08);
+        /* fewer rays than surfaces: a window that loses its last gather leans on the surface's factor as the
+         * gather's weight falls, 0.30; the surface's factor at once past it, 0.61 */
+        if (r == 1)
+            assert_true(step < 0.4);
         assert_true(first_off > 0.05); /* the first guess is coarse: the test sees what the refinement does */
         assert_true(steps > 10);
         assert_true(compared > 3 * T / 2);

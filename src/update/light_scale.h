@@ -38,7 +38,9 @@
  * budget) the full quality is had at once, the IIM scaled once. With fewer (the updater gives it at
  * least LM_LIGHT_SCALE_LEAST), the first guess is the same estimate at
  * K = 4 over every stride-th texel, the stride that fits, each factor summing a window that holds about 64
- * rays, at most 17 x 17 texels (a coarser gather over blocks of texels); then each lm_light_scale_refine casts about the rays it is given over the next texels at the
+ * rays, at most 17 x 17 texels (a coarser gather over blocks of texels; with fewer rays than four a
+ * surface, a texel whose window holds less than one gather's weight leans on its surface's factor as that
+ * weight falls); then each lm_light_scale_refine casts about the rays it is given over the next texels at the
  * full quality, and once a surface's have all gathered, its factors correct what the first guess applied
  * (f_full / f_first, and a_full - a_first f_full / f_first for what was added). A texel
  * regathered since the edit (lm_light_scale_regathered) holds its fresh value and is left alone.
