@@ -5,7 +5,6 @@
 #include "photons.h"
 
 #include <math.h>
-#include <string.h>
 
 /* 1 when other geometry lies within the cover distance straight out from p on the side of normal n. */
 static int covered(const lm_direct_light *d, float reach, lm_vec3 p, lm_vec3 n)
@@ -96,13 +95,9 @@ void lm_direct_punctual_at(const lm_direct_light *d, const float p[3], const flo
         out[c] = (float)e[c];
 }
 
+static int covers(const lm_hit *h, const void *d) { return lm_direct_covers_hit(d, h); }
+
 void lm_direct_covered_flux(const lm_direct_light *d, const lm_photon_store *ps, double *out)
 {
-    memset(out, 0, sizeof *out * 3 * (size_t)ps->surface_count);
-    for (uint32_t i = 0; i < ps->used; i++) {
-        const lm_hit *h = &ps->hits[i];
-        if (h->surface >= 0 && lm_direct_covers_hit(d, h))
-            for (int c = 0; c < 3; c++)
-                out[3 * h->surface + c] += h->flux[c];
-    }
+    lm_photon_store_surface_flux_of(ps, covers, d, out);
 }

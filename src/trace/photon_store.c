@@ -136,15 +136,21 @@ void lm_photon_store_scale(lm_photon_store *ps, uint32_t slot, const float s[3])
     sh->energy += moved;
 }
 
-void lm_photon_store_surface_flux(const lm_photon_store *ps, double *out)
+void lm_photon_store_surface_flux_of(const lm_photon_store *ps, int (*keep)(const lm_hit *, const void *),
+                                     const void *user, double *out)
 {
     memset(out, 0, sizeof *out * 3 * (size_t)ps->surface_count);
     for (uint32_t i = 0; i < ps->used; i++) {
         const lm_hit *h = &ps->hits[i];
-        if (h->surface >= 0)
+        if (h->surface >= 0 && (!keep || keep(h, user)))
             for (int c = 0; c < 3; c++)
                 out[3 * h->surface + c] += h->flux[c];
     }
+}
+
+void lm_photon_store_surface_flux(const lm_photon_store *ps, double *out)
+{
+    lm_photon_store_surface_flux_of(ps, NULL, NULL, out);
 }
 
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_f = 0.0; }

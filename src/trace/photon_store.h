@@ -104,6 +104,9 @@ void lm_photon_store_scale(lm_photon_store *ps, uint32_t slot, const float s[3])
 /* The flux of every live hit summed per surface into out[surface * 3 + c] (surface_count x 3 doubles,
  * overwritten). O(slots). */
 void lm_photon_store_surface_flux(const lm_photon_store *ps, double *out);
+/* The same over the live hits for which keep(hit, user) is non-zero (keep NULL: all of them). */
+void lm_photon_store_surface_flux_of(const lm_photon_store *ps, int (*keep)(const lm_hit *, const void *),
+                                     const void *user, double *out);
 /* Sets a surface's delta_f (after its AIM refresh) or delta_i (after its IIM refresh) to zero. */
 void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface);
 void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface);

@@ -140,10 +140,10 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         out[c] = 1.0f;
 }
 
-/* Texels list[0 .. n) (list NULL: lo, lo + 1, ...) gathered at quality q into ls->e (those that gather at
- * it, flagged done), in one parallel pass. */
+/* Texels list[0 .. n) (list NULL: 0 .. n) gathered at quality q into ls->e (those that gather at it,
+ * flagged done), in one parallel pass. */
 static void gather_texels(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, quality q,
-                          const uint32_t *list, uint32_t lo, uint32_t n)
+                          const uint32_t *list, uint32_t n)
 {
     const lm_atlas *a = w->atlas;
     size_t T = a->texel_count;
@@ -155,7 +155,7 @@ static void gather_texels(lm_light_scale *ls, const lm_light_scale_world *w, con
     now.aim = after;
     now.emissive = NULL;
     for (uint32_t j = 0; j < n; j++) {
-        uint32_t i = list ? list[j] : lo + j;
+        uint32_t i = list ? list[j] : j;
         ls->done[i] = (uint8_t)gathers_at(a, i, q);
     }
 #pragma omp parallel
@@ -163,7 +163,7 @@ static void gather_texels(lm_light_scale *ls, const lm_light_scale_world *w, con
         lm_rt_thread_init();
 #pragma omp for schedule(dynamic, 16)
         for (long j = 0; j < (long)n; j++) {
-            uint32_t i = list ? list[j] : lo + (uint32_t)j;
+            uint32_t i = list ? list[j] : (uint32_t)j;
             if (ls->done[i])
                 gathers(w, &was, &now, i, ls->e + 3 * (size_t)i, ls->e + 3 * (T + (size_t)i));
         }
@@ -305,7 +305,7 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
                q.spread < MOST_SPREAD)
             q.spread++;
     }
-    gather_texels(ls, w, after, q, NULL, 0, (uint32_t)T);
+    gather_texels(ls, w, after, q, NULL, (uint32_t)T);
     ls->least = adds ? least_add(ls, a) : -1.0f;
     ratios(ls, a, q, 0, (uint32_t)T, factor, add);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
@@ -368,7 +368,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
     double t0 = lm_now();
     while (done < n && (done == 0 || !(ms > 0.0) || 1e3 * (lm_now() - t0) < ms)) {
         uint32_t m = n - done < LM_LIGHT_SCALE_CHUNK ? n - done : LM_LIGHT_SCALE_CHUNK;
-        gather_texels(ls, w, after, q, ls->list + done, 0, m);
+        gather_texels(ls, w, after, q, ls->list + done, m);
         done += m;
     }
     if (done < n) { /* stopped by the time: where the gathers got to */
