@@ -363,3 +363,26 @@ void lmt_expect_invalid(lmgi_status st, const lmgi_error *e, const char *words)
     if (!strstr(e->message, words))
         fail_msg("'%s' does not name '%s'", e->message, words);
 }
+
+int lmt_light_on_node(const lmgi_scene *sc, const char *name)
+{
+    for (int l = 0; l < lmgi_light_count(sc); l++) {
+        lmgi_light li;
+        lmgi_error e;
+        assert_int_equal(lmgi_get_light(sc, l, &li, &e), LMGI_OK);
+        const char *node = lmgi_node_name(sc, li.node);
+        if (node && !strcmp(node, name))
+            return l;
+    }
+    fail_msg("no light on node '%s'", name);
+    return -1;
+}
+
+int lmt_material_named(const lmgi_scene *sc, const char *name)
+{
+    for (int m = 0; m < lmgi_material_count(sc); m++)
+        if (!strcmp(lmgi_material_name(sc, m), name))
+            return m;
+    fail_msg("no material '%s'", name);
+    return -1;
+}

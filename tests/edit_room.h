@@ -70,6 +70,10 @@ void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first,
                          double *top);
 /* The mean over node `node` ("room", "block", "stool") in an IIM of a room. */
 double lmt_node_mean(const lmgi_scene *sc, const float *iim, const char *node);
+/* The id of the light on the node named `name` (every light read must succeed: none removed), and of the
+ * material named `name` (the test fails where there is none). */
+int lmt_light_on_node(const lmgi_scene *sc, const char *name);
+int lmt_material_named(const lmgi_scene *sc, const char *name);
 /* An updater with the default settings (a zeroed lmgi_updater_desc). */
 lmgi_updater *lmt_updater(lmgi_context *ctx, lmgi_scene *sc);
 /* lmgi_export_gltf of the updater's scene as `name` into a fresh folder, loaded back at target_texels. */

@@ -597,14 +597,7 @@ static void test_light_edit_stays_in_its_room(void **state)
     for (int s = 0; s < surfaces; s++)
         ver0[s] = lmgi_surface_version(u, s);
 
-    int a1 = -1;
-    for (int l = 0; l < lmgi_light_count(sc); l++) {
-        lmgi_light li;
-        assert_int_equal(lmgi_get_light(sc, l, &li, &e), LMGI_OK);
-        if (!strcmp(lmgi_node_name(sc, li.node), "light_a1"))
-            a1 = l;
-    }
-    assert_true(a1 >= 0);
+    int a1 = lmt_light_on_node(sc, "light_a1");
     lmgi_light li;
     assert_int_equal(lmgi_get_light(sc, a1, &li, &e), LMGI_OK);
     assert_true(li.enabled && li.intensity > 0.0f);

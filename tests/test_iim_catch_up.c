@@ -67,11 +67,7 @@ static void test_recolour_catches_up_at_80_texels(void **state)
     assert_int_equal(lmgi_updater_create(ctx, sc, &d, &u, &e), LMGI_OK);
     size_t n;
     lmt_updates(u, 10);
-    int red = -1;
-    for (int m = 0; m < lmgi_material_count(sc); m++)
-        if (!strcmp(lmgi_material_name(sc, m), "red"))
-            red = m;
-    assert_true(red >= 0);
+    int red = lmt_material_named(sc, "red");
     lmgi_material mat;
     assert_int_equal(lmgi_get_material(sc, red, &mat, &e), LMGI_OK);
     const float blue[3] = {0.1f, 0.2f, 0.63f};

@@ -406,10 +406,7 @@ static void test_added_light_stays_in_its_room(void **state)
     for (int s = 0; s < surfaces; s++)
         ver0[s] = lmgi_surface_version(u, s);
     lmgi_light a1;
-    int id = -1;
-    for (int l = 0; l < lmgi_light_count(sc); l++)
-        if (lmgi_get_light(sc, l, &a1, &e) == LMGI_OK && !strcmp(lmgi_node_name(sc, a1.node), "light_a1"))
-            id = l;
+    int id = lmt_light_on_node(sc, "light_a1");
     assert_int_equal(lmgi_get_light(sc, id, &a1, &e), LMGI_OK);
     lmgi_light lamp = {.type = LMGI_LIGHT_POINT, .color = {1.0f, 0.5f, 0.2f}, .intensity = 2.0f * a1.intensity,
                        .enabled = 1, .position = {a1.position[0] + 0.5f, a1.position[1] - 0.5f, a1.position[2]}};
@@ -978,18 +975,6 @@ static void test_two_lights_within_budget(void **state)
     unsettle(&r);
 }
 
-/* The id of the light on the node named `name` (the test fails where there is none). */
-static int light_on_node(const lmgi_scene *sc, const char *name)
-{
-    for (int l = 0; l < lmgi_light_count(sc); l++) {
-        lmgi_light li;
-        if (lmgi_get_light(sc, l, &li, NULL) == LMGI_OK && !strcmp(lmgi_node_name(sc, li.node), name))
-            return l;
-    }
-    fail_msg("no light on node %s", name);
-    return -1;
-}
-
 /* The shared sunlit room at 1,800 texels, settled, its cost models taught a 4 ms budget (skips the test
  * where ../shared is absent). Its AIMs compute the sun's direct light, the photons bring the rest. */
 static int sunlit_room(settled_room *r)
@@ -1017,7 +1002,7 @@ static void test_sunlit_lamp_within_budget(void **state)
     settled_room r;
     if (!sunlit_room(&r))
         skip();
-    edit_light(r.sc, light_on_node(r.sc, "RoomLight"), 0.3f, NULL, 1);
+    edit_light(r.sc, lmt_light_on_node(r.sc, "RoomLight"), 0.3f, NULL, 1);
     lmgi_update_stats st;
     double was, at_once, after;
     edit_within_budget(&r, "the sunlit room's lamp dimmed", &st, &was, &at_once, &after);
@@ -1037,10 +1022,7 @@ static void test_sunlit_recolour_within_budget(void **state)
     settled_room r;
     if (!sunlit_room(&r))
         skip();
-    int glass = -1;
-    for (int m = 0; m < lmgi_material_count(r.sc) && glass < 0; m++)
-        glass = !strcmp(lmgi_material_name(r.sc, m), "Glass") ? m : -1;
-    assert_true(glass >= 0);
+    int glass = lmt_material_named(r.sc, "Glass");
     lmgi_material m;
     lmgi_error e;
     assert_int_equal(lmgi_get_material(r.sc, glass, &m, &e), LMGI_OK);

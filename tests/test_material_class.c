@@ -27,15 +27,6 @@ static lmgi_scene *load_room(const lmgi_material_desc *block, float texel_size)
     return lmt_room(&spec);
 }
 
-static int material_named(const lmgi_scene *sc, const char *name)
-{
-    for (int m = 0; m < lmgi_material_count(sc); m++)
-        if (!strcmp(lmgi_material_name(sc, m), name))
-            return m;
-    fail_msg("no material '%s'", name);
-    return -1;
-}
-
 static void test_diffuse_to_mirror_and_back(void **state)
 {
     (void)state;
@@ -50,7 +41,7 @@ static void test_diffuse_to_mirror_and_back(void **state)
     lmgi_updater *u = lmt_room_updater(ctx, sc), *ut = lmt_room_updater(ctx, twin);
     size_t n, nt;
     float *before = lmt_iim(u, sc, &n), *frame_before = lmt_corner_frame(u);
-    int red = material_named(sc, "red");
+    int red = lmt_material_named(sc, "red");
     lmgi_material m;
     assert_int_equal(lmgi_get_material(sc, red, &m, &e), LMGI_OK);
     assert_int_equal(m.cls, LMGI_MATERIAL_DIFFUSE);
@@ -112,7 +103,7 @@ static void test_diffuse_to_mirror_and_back(void **state)
     assert_int_equal(m.cls, LMGI_MATERIAL_GLOSSY);
 
     /* the twin's block was a mirror at load: no lightmap texels; glass it may become, diffuse not */
-    int tred = material_named(twin, "red");
+    int tred = lmt_material_named(twin, "red");
     assert_int_equal(lmgi_get_material(twin, tred, &m, &e), LMGI_OK);
     m.metallic = 0.0f, m.roughness = 1.0f;
     lmt_expect_invalid(lmgi_set_material(twin, tred, &m, &e), &e, "no lightmap texels");
@@ -138,7 +129,7 @@ static void test_emitter_keeps_its_class(void **state)
     const lmgi_material_desc panel = {.name = "panel", .base_color = {1, 1, 1, 1}, .emissive = {2, 2, 2}};
     lmgi_scene *sc = load_room(&panel, 0.0f);
     lmgi_error e;
-    int p = material_named(sc, "panel");
+    int p = lmt_material_named(sc, "panel");
     lmgi_material m;
     assert_int_equal(lmgi_get_material(sc, p, &m, &e), LMGI_OK);
     assert_int_equal(m.cls, LMGI_MATERIAL_EMITTER);
