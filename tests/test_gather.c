@@ -1319,6 +1319,63 @@ static void test_light_scale_refined_equals_full(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* Texels whose rays meet no light, before the edit or after, take their surface's factor: the rays say
+ * nothing of it. On truck-town a dark corner's 36 rays all missed the sunlit AIM; it took 1, and when the
+ * sun was dimmed to half its refinement sent it back to its light from before the edit, twice the
+ * converged lightmap, until its surface's regather 60 updates later. Here the AIM is black before and after
+ * and the Cornell box's emitters are dark, so no ray of any texel meets light; each surface has a factor of
+ * its own, at once and through a budget's first guess and refinement. */
+static void test_light_scale_unlit_rays_take_surface_factor(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lmt_pipeline p;
+    lm_photon_stage *st = photons_at_run_density(&p, path);
+    size_t cells = (size_t)p.atlas.width * p.atlas.height, T = p.atlas.texel_count, S = (size_t)p.atlas.surface_count;
+    size_t ne = 3 * (size_t)p.s->material_count + 3;
+    for (int m = 0; m < p.s->material_count; m++) /* the emitters dark now, and before (emissive below) */
+        memset(p.s->materials[m].emissive, 0, sizeof p.s->materials[m].emissive);
+    float *black = calloc(4 * cells, sizeof(float)), *emissive = calloc(ne, sizeof(float));
+    float *surface = malloc(sizeof(float) * 3 * S), *f = malloc(sizeof(float) * 3 * T), *add = malloc(sizeof(float) * 3 * T);
+    float *corr = malloc(sizeof(float) * 3 * T), *corr_add = malloc(sizeof(float) * 3 * T);
+    assert_non_null(black), assert_non_null(emissive), assert_non_null(surface), assert_non_null(f);
+    assert_non_null(add), assert_non_null(corr), assert_non_null(corr_add);
+    for (size_t k = 0; k < S; k++)
+        for (int c = 0; c < 3; c++)
+            surface[3 * k + c] = 0.5f + 0.02f * (float)k + 0.1f * (float)c;
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
+    lm_light_scale ls;
+    lm_light_scale_init(&ls);
+    const uint32_t budget[2] = {0, 600}; /* the full quality at once; a first guess, then refined */
+    for (int r = 0; r < 2; r++) {
+        lm_light_scale_begin(&ls, &w, floats_copy(black, 4 * cells), floats_copy(emissive, ne), black, surface, 0,
+                             budget[r], f, add);
+        for (size_t i = 0; i < 3 * T; i++)
+            f[i] += add[i]; /* the value of a texel that was 1 */
+        int steps = 0;
+        while (ls.active && steps++ < 1000) {
+            int corrected = 0;
+            lm_light_scale_refine(&ls, &w, black, 700, 0.0, corr, corr_add, &corrected);
+            for (size_t i = 0; i < 3 * T; i++)
+                f[i] = f[i] * corr[i] + corr_add[i];
+        }
+        assert_false(ls.active);
+        double worst = 0.0;
+        for (uint32_t i = 0; i < T; i++)
+            for (int c = 0; c < 3; c++)
+                worst = fmax(worst, fabs(f[3 * i + c] - surface[3 * p.atlas.texels[i].surface + c]));
+        print_message("rays meeting no light, %s: every texel its surface's factor to %.3g\n",
+                      r ? "a first guess refined" : "the full quality at once", worst);
+        assert_true(worst < 1e-6); /* 1 in every texel before */
+    }
+    lm_light_scale_free(&ls);
+    free(black), free(emissive), free(surface), free(f), free(add), free(corr), free(corr_add);
+    lm_photon_stage_free(st);
+    lmt_pipeline_free(&p);
+}
+
 /* A pass's CPU share (the emitters' closed form, the rim's rays, the covered test) on one thread or on
  * several (as on a GPU, where the rasterizer leaves the cores free) gives the same IIM bit for bit: each
  * texel's sample patterns are seeded by its index, never by the thread. */
@@ -1680,6 +1737,7 @@ int main(void)
         cmocka_unit_test(test_rim_smooth),
         cmocka_unit_test(test_rim_pair_same_as_two),
         cmocka_unit_test(test_light_scale_refined_equals_full),
+        cmocka_unit_test(test_light_scale_unlit_rays_take_surface_factor),
         cmocka_unit_test(test_cpu_threads_same_iim),
         cmocka_unit_test(test_same_iim_in_any_grouping),
         cmocka_unit_test(test_no_plaid_from_small_emitters),

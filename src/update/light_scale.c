@@ -119,10 +119,10 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
     int keep = 1;
     for (int c = 0; c < 3; c++) { /* no neighbour gathered (a large atlas's strides): its surface's */
         int dark = met > 0.0 && least >= 0.0f && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
-        float f = !(met > 0.0) || dark ? (met > 0.0 ? 1.0f : own[c])
-                  : s0[c] > 0.0    ? (float)(s1[c] / s0[c])
-                  : s1[c] > 0.0    ? own[c]
-                                   : 1.0f;
+        /* rays that met no light either way say nothing of the factor: the surface's own says what its
+         * light did (a dark corner of truck-town whose 36 rays all missed the sunlit AIM took 1 and, at the
+         * refinement, went back to its light before the sun was dimmed, twice the converged lightmap) */
+        float f = !(met > 0.0) || dark ? (met > 0.0 ? 1.0f : own[c]) : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : own[c];
         float d = dark ? (float)((s1[c] - s0[c]) / met) : 0.0f;
         out[c] = isfinite(f) && f >= 0.0f ? f : own[c];
         /* where only every stride-th texel gathered, not each surface's first (fewer rays than surfaces), a

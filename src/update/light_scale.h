@@ -21,9 +21,10 @@
  * recoloured took 33 updates to 2% with it, 22 without, lmgi bench --edits bench/cornell_edits.json). Both gathers meet the same points, so the ratio is far less noisy than
  * either: in a scene lit by one emitter every factor is the light's own and the IIM is exact at once;
  * where several light the seen surfaces in different proportions it is a first guess that the regathers
- * the scaled hits call for refine. A texel whose rays met no light before takes its surface's factor (1
- * where they meet none after either), except after an edit that `adds` light where there may have been
- * none (a light added or switched on: a dark room whose lamp comes on): there a texel whose rays met next
+ * the scaled hits call for refine. A texel whose rays met no light before takes its surface's factor (rays
+ * that met none either way say nothing of it; its surface's light does), except after an edit that `adds`
+ * light where there may have been none (a light added or switched on: a dark room whose lamp comes on):
+ * there a texel whose rays met next
  * to no light before (LM_LIGHT_SCALE_DARK) has no factor that lights it, and takes instead the change the
  * two gathers saw, added (E_after - E_before over the window, what its regather would add). A power edit
  * keeps its factors, which are exact where one light lights the scene, however much it brightens.
