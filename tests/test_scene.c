@@ -766,6 +766,47 @@ static void test_deep_hierarchy(void **state)
     lm_scene_free(s);
 }
 
+/* The scene's bounds after nodes move are those of every triangle corner transformed again, to the bit,
+ * though only the moved nodes' corners are (lm_scene_keep_bounds' cache): on scenes/cornell.glb, each node
+ * moved in turn, then all back. */
+static void test_bounds_follow_moved_nodes(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lm_scene *s = load_ok(path, 0);
+    assert_non_null(s->node_bounds); /* the loader keeps the cache */
+    float *was = malloc(sizeof(float) * 16 * (size_t)s->node_count);
+    assert_non_null(was);
+    for (int n = 0; n < s->node_count; n++)
+        memcpy(was + 16 * n, s->nodes[n].world, sizeof s->nodes[n].world);
+    int moved = 0;
+    for (int step = 0; step <= s->node_count; step++) {
+        if (step < s->node_count && s->nodes[step].tri_count > 0) { /* node `step` moved and turned */
+            float w[16];
+            memcpy(w, s->nodes[step].world, sizeof w);
+            w[12] += 0.5f + 0.25f * (float)step, w[13] -= 0.3f, w[0] *= 0.5f;
+            assert_true(lm_scene_set_node_world(s, step, w));
+            moved++;
+        } else if (step == s->node_count) { /* every node back where it was */
+            for (int n = 0; n < s->node_count; n++)
+                memcpy(s->nodes[n].world, was + 16 * n, sizeof s->nodes[n].world);
+        }
+        lm_scene_update_bounds(s);
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (uint32_t t = 0; t < 3 * s->tri_count; t++) {
+            float p[3];
+            lm_scene_vertex_world(s, s->tris[t], p);
+            for (int k = 0; k < 3; k++)
+                lo[k] = fminf(lo[k], p[k]), hi[k] = fmaxf(hi[k], p[k]);
+        }
+        assert_memory_equal(lo, s->bounds_min, sizeof lo);
+        assert_memory_equal(hi, s->bounds_max, sizeof hi);
+    }
+    assert_true(moved > 3);
+    free(was);
+    lm_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -785,6 +826,7 @@ int main(void)
         cmocka_unit_test(test_material_and_texture),
         cmocka_unit_test(test_texture_transform_rotation),
         cmocka_unit_test(test_deep_hierarchy),
+        cmocka_unit_test(test_bounds_follow_moved_nodes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

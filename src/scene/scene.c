@@ -40,6 +40,7 @@ void lm_scene_free(lm_scene *s)
     free(s->tri_material);
     free(s->tri_node);
     free(s->tri_twin);
+    free(s->node_bounds);
     free(s);
 }
 
@@ -257,15 +258,46 @@ float lm_scene_ray_lift(const lm_scene *s)
 
 /* Bounds of the vertices that triangles use (unreferenced vertices don't count). An empty scene gets
  * min > max (size 0). */
-void lm_scene_update_bounds(lm_scene *s)
+/* The world bounds of the corners of triangles [first, first + count), widened into *lo and *hi. */
+static void widen_by_tris(const lm_scene *s, uint32_t first, uint32_t count, lm_vec3 *lo, lm_vec3 *hi)
 {
-    lm_vec3 lo = lm_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = lm_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
-    for (uint32_t t = 0; t < s->tri_count; t++) {
+    for (uint32_t t = first; t < first + count; t++) {
         for (int k = 0; k < 3; k++) {
             float p[3];
             lm_scene_vertex_world(s, s->tris[3 * (size_t)t + (size_t)k], p);
-            lo = lm_vmin(lo, lm_v3_load(p));
-            hi = lm_vmax(hi, lm_v3_load(p));
+            *lo = lm_vmin(*lo, lm_v3_load(p));
+            *hi = lm_vmax(*hi, lm_v3_load(p));
+        }
+    }
+}
+
+void lm_scene_keep_bounds(lm_scene *s)
+{
+    free(s->node_bounds);
+    s->node_bounds = s->node_count > 0 ? malloc(sizeof *s->node_bounds * LM_NODE_BOUNDS * (size_t)s->node_count) : NULL;
+    s->bounds_tris = NULL;
+}
+
+void lm_scene_update_bounds(lm_scene *s)
+{
+    lm_vec3 lo = lm_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = lm_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
+    if (!s->node_bounds) { /* no cache (lm_scene_keep_bounds): every corner */
+        widen_by_tris(s, 0, s->tri_count, &lo, &hi);
+    } else {
+        int fresh = s->bounds_tris != s->tris; /* none made yet, or the triangles split into sides since */
+        s->bounds_tris = s->tris;
+        for (int n = 0; n < s->node_count; n++) {
+            const lm_node *nd = &s->nodes[n];
+            float *c = s->node_bounds + LM_NODE_BOUNDS * (size_t)n, *m = c + 6;
+            if (fresh || memcmp(m, nd->world, sizeof nd->world)) {
+                lm_vec3 nlo = lm_v3(FLT_MAX, FLT_MAX, FLT_MAX), nhi = lm_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);
+                widen_by_tris(s, nd->first_tri, nd->tri_count, &nlo, &nhi);
+                lm_v3_store(c, nlo);
+                lm_v3_store(c + 3, nhi);
+                memcpy(m, nd->world, sizeof nd->world);
+            }
+            lo = lm_vmin(lo, lm_v3_load(c));
+            hi = lm_vmax(hi, lm_v3_load(c + 3));
         }
     }
     lm_v3_store(s->bounds_min, lo);

@@ -350,6 +350,7 @@ lm_status lm_scene_finish_nodes(lm_scene *s, const unsigned char *animated, lm_e
         resolve_node(s, order[i], animated);
     free(order);
     lm_scene_update_world(s);
+    lm_scene_keep_bounds(s);
     lm_scene_update_bounds(s);
     reverse_mirrored(s);
     warn_mirroring_animations(s);
