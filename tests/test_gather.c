@@ -500,6 +500,60 @@ static void test_deterministic(void **state)
     ts_free(&t);
 }
 
+/* The gather's mesh is made again when, and only when, what it is made from changed: a call with nothing
+ * changed uploads nothing, and the texels one gather object gathers after an emission edit and after a
+ * node moved are those a fresh one gathers. */
+static void test_scene_upload_follows_changes(void **state)
+{
+    (void)state;
+    lmt_mesh m[2];
+    square(&m[0], 0.5f, 0.0f, 1);
+    square(&m[1], 0.7f, 0.8f, 0);
+    tscene t;
+    ts_load(&t, m, 2, "[{\"children\": [1, 2]}, {\"mesh\": 0}, {\"mesh\": 1}]",
+            "[{}, {\"emissiveFactor\": [1, 1, 1]}]", 0.1f);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    uint32_t texels[8];
+    for (int i = 0; i < 8; i++)
+        texels[i] = texel_near(&t, 1, -0.45f + 0.12f * (float)i, 0.1f * (float)(i % 3));
+    lm_error err;
+    lm_gather *g = NULL;
+    assert_int_equal(lm_gather_create(&set, &g, &err), LM_OK);
+    size_t cells = (size_t)t.a.width * t.a.height;
+    float *aim = calloc(3 * cells, sizeof(float)), *kept = malloc(4 * sizeof(float) * cells);
+    assert_non_null(aim), assert_non_null(kept);
+    unsigned tex = lm_iim_texture_create(t.a.width, t.a.height);
+    assert_true(tex != 0);
+    assert_int_equal(lm_gather_set_aim(g, &t.a, aim, &err), LM_OK);
+    int emitter = t.s->tri_material[t.s->nodes[2].first_tri];
+    for (int step = 0; step < 4; step++) {
+        if (step == 2) /* the emitter dimmed and tinted */
+            t.s->materials[emitter].emissive[0] = 0.25f, t.s->materials[emitter].emissive[2] = 0.5f;
+        if (step == 3) { /* the emitter moved closer */
+            float w[16];
+            memcpy(w, t.s->nodes[2].world, sizeof w);
+            w[13] -= 0.3f;
+            assert_true(lm_scene_set_node_world(t.s, 2, w));
+        }
+        assert_int_equal(lm_gather_set_scene(g, t.s, &t.a, &err), LM_OK);
+        assert_int_equal(lm_gather_scene_uploads(g), step < 2 ? 1 : (uint64_t)step); /* step 1: nothing changed */
+        lm_gather_stats st;
+        assert_int_equal(lm_gather_texels(g, t.s, &t.a, texels, 8, tex, &st, &err), LM_OK);
+        assert_int_equal(lm_iim_texture_read(tex, t.a.width, t.a.height, kept, &err), LM_OK);
+        float *fresh = gather(&t, &set, texels, 8, NULL);
+        for (int i = 0; i < 8; i++)
+            assert_memory_equal(texel_value(&t, kept, texels[i]), texel_value(&t, fresh, texels[i]), 4 * sizeof(float));
+        if (step == 2) /* the edit shows: the test can tell a stale mesh */
+            assert_true(texel_value(&t, fresh, texels[0])[0] < 0.5f * texel_value(&t, fresh, texels[0])[1]);
+        free(fresh);
+    }
+    lm_iim_texture_free(tex);
+    lm_gather_free(g);
+    free(aim), free(kept);
+    ts_free(&t);
+}
+
 static lm_photon_stage *stage_for(lmt_pipeline *p, uint32_t photons)
 {
     lm_photon_stage_settings set;
@@ -1724,6 +1778,7 @@ int main(void)
         cmocka_unit_test(test_covered_by_own_texel_width),
         cmocka_unit_test(test_box_backfaces),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_scene_upload_follows_changes),
         cmocka_unit_test(test_coverage_beyond_the_gl_limit),
         cmocka_unit_test(test_schedule_order_and_budget),
         cmocka_unit_test(test_blend_stays_between),

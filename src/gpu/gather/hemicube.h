@@ -117,8 +117,12 @@ lm_status lm_gather_create(const lm_hemicube_settings *set, lm_gather **out, lm_
 void lm_gather_free(lm_gather *g);
 /* Uploads every triangle in world space under the current node matrices, with lightmap UVs, emitted
  * radiance and face normals. Call again after nodes move. With proxy_error > 0 the triangles are those
- * of the gather proxy (proxy.h), built on the first call for (s, a) and kept for later calls. */
+ * of the gather proxy (proxy.h), built on the first call for (s, a) and kept for later calls. A call that
+ * finds (s, a), the node matrices, the materials' emission and sides and the emitter light as the last
+ * upload had them uploads nothing (it hashes them: O(nodes + materials)). */
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err);
+/* How many times lm_gather_set_scene made and uploaded the mesh. */
+uint64_t lm_gather_scene_uploads(const lm_gather *g);
 /* With an emitter light (NULL: none, the default), emissive triangles are drawn without their emission
  * (they still occlude) and each texel gets their irradiance in closed form with sampled visibility
  * instead (trace/emitter_light.h: no plaid from small emitters, no coverage samples needed). Takes

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "../../charts/atlas_dilate.h"
+#include "../../core/hash.h"
 #include "../../core/timing.h"
 #include "../../core/vecmath.h"
 #include "../gl/gl_context.h"
@@ -44,6 +45,8 @@ struct lm_gather {
     int aim_w, aim_h;
     lm_gl_mesh mesh;
     int has_mesh;
+    uint64_t mesh_key;     /* with has_mesh: scene_key of what the mesh was made from */
+    uint64_t mesh_uploads; /* how many times lm_gather_set_scene made the mesh */
     lm_proxy proxy;        /* with has_proxy: built for proxy_scene, proxy_atlas */
     int has_proxy;
     const lm_scene *proxy_scene;
@@ -304,6 +307,8 @@ static lm_status ensure_proxy(lm_gather *g, const lm_scene *s, const lm_atlas *a
 
 const lm_proxy *lm_gather_proxy(const lm_gather *g) { return g->has_proxy ? &g->proxy : NULL; }
 
+uint64_t lm_gather_scene_uploads(const lm_gather *g) { return g->mesh_uploads; }
+
 void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el) { g->emitters = el; }
 
 void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt) { g->rt = rt; }
@@ -330,11 +335,33 @@ static int traces_rim(const lm_gather *g)
 /* The rim is traced and the AIM's copy it looks up exists (lm_gather_set_aim after the tracer). */
 static int rim_ready(const lm_gather *g) { return traces_rim(g) && g->aim_copy; }
 
+/* What the gather's mesh is made from (write_triangle): the scene and atlas, the proxy, whether emission is
+ * drawn, the nodes' world matrices and the materials' emission and sides. */
+static uint64_t scene_key(const lm_gather *g, const lm_scene *s, const lm_atlas *a)
+{
+    const void *from[2] = {s, a};
+    const uint32_t counts[3] = {s->tri_count, g->has_proxy ? g->proxy.tri_count : 0, g->emitters != NULL};
+    uint64_t h = lm_hash_bytes(LM_HASH_SEED, from, sizeof from);
+    h = lm_hash_bytes(h, counts, sizeof counts);
+    h ^= lm_scene_world_hash(s);
+    for (int m = 0; m < s->material_count; m++) {
+        const lm_material *x = &s->materials[m];
+        const int sides[2] = {x->double_sided, x->split_sides};
+        h = lm_hash_bytes(lm_hash_bytes(h, x->emissive, sizeof x->emissive), sides, sizeof sides);
+    }
+    return h;
+}
+
 lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a, lm_error *err)
 {
     lm_status st = ensure_proxy(g, s, a, err);
     if (st != LM_OK)
         return st;
+    /* made again only when something it is made from changed: every triangle is transformed and uploaded
+     * (on the shared room, 4.6% of an 8 ms budget's run, with nothing moving) */
+    uint64_t key = scene_key(g, s, a);
+    if (g->has_mesh && g->mesh_key == key)
+        return LM_OK;
     uint32_t count = g->has_proxy ? g->proxy.tri_count : s->tri_count;
     float *v = malloc(sizeof(float) * 3 * VERTEX_FLOATS * (size_t)(count ? count : 1));
     if (!v)
@@ -349,6 +376,8 @@ lm_status lm_gather_set_scene(lm_gather *g, const lm_scene *s, const lm_atlas *a
         lm_gl_mesh_destroy(&g->mesh);
     const int sizes[9] = {3, 2, 3, 3, 1, 1, 3, 3, 4};
     g->has_mesh = lm_gl_mesh_create_indexed(&g->mesh, v, (int)(3 * count), sizes, 9);
+    g->mesh_key = key;
+    g->mesh_uploads++;
     free(v);
     if (!g->has_mesh)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the gather geometry", s->path);
