@@ -476,22 +476,28 @@ static void test_box_backfaces(void **state)
     ts_free(&t);
 }
 
+/* A floor (node 1) under an emitting square (node 2, 0.8 above it) and eight texels of the floor. */
+static void floor_under_emitter(tscene *t, uint32_t texels[8])
+{
+    lmt_mesh m[2];
+    square(&m[0], 0.5f, 0.0f, 1);
+    square(&m[1], 0.7f, 0.8f, 0);
+    ts_load(t, m, 2, "[{\"children\": [1, 2]}, {\"mesh\": 0}, {\"mesh\": 1}]",
+            "[{}, {\"emissiveFactor\": [1, 1, 1]}]", 0.1f);
+    for (int i = 0; i < 8; i++)
+        texels[i] = texel_near(t, 1, -0.45f + 0.12f * (float)i, 0.1f * (float)(i % 3));
+}
+
 /* (e) Two gathers of the same texels give identical IIMs. */
 static void test_deterministic(void **state)
 {
     (void)state;
-    lmt_mesh m[2];
-    square(&m[0], 0.5f, 0.0f, 1);
-    square(&m[1], 0.7f, 0.8f, 0);
     tscene t;
-    ts_load(&t, m, 2, "[{\"children\": [1, 2]}, {\"mesh\": 0}, {\"mesh\": 1}]",
-            "[{}, {\"emissiveFactor\": [1, 1, 1]}]", 0.1f);
+    uint32_t texels[8];
+    floor_under_emitter(&t, texels);
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
     set.sky[2] = 0.5f;
-    uint32_t texels[8];
-    for (int i = 0; i < 8; i++)
-        texels[i] = texel_near(&t, 1, -0.45f + 0.12f * (float)i, 0.1f * (float)(i % 3));
     float *a = gather(&t, &set, texels, 8, NULL), *b = gather(&t, &set, texels, 8, NULL);
     assert_memory_equal(a, b, 4 * sizeof(float) * (size_t)t.a.width * (size_t)t.a.height);
     assert_true(texel_value(&t, a, texels[0])[0] > 0.0f);
@@ -506,17 +512,11 @@ static void test_deterministic(void **state)
 static void test_scene_upload_follows_changes(void **state)
 {
     (void)state;
-    lmt_mesh m[2];
-    square(&m[0], 0.5f, 0.0f, 1);
-    square(&m[1], 0.7f, 0.8f, 0);
     tscene t;
-    ts_load(&t, m, 2, "[{\"children\": [1, 2]}, {\"mesh\": 0}, {\"mesh\": 1}]",
-            "[{}, {\"emissiveFactor\": [1, 1, 1]}]", 0.1f);
+    uint32_t texels[8];
+    floor_under_emitter(&t, texels);
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    uint32_t texels[8];
-    for (int i = 0; i < 8; i++)
-        texels[i] = texel_near(&t, 1, -0.45f + 0.12f * (float)i, 0.1f * (float)(i % 3));
     lm_error err;
     lm_gather *g = NULL;
     assert_int_equal(lm_gather_create(&set, &g, &err), LM_OK);
