@@ -93,7 +93,8 @@ static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_r
  * what a regather would add to it to first order (the gathers estimate the IIM's irradiance itself),
  * unless that is under `least` (a negative `least`: no edit that adds, nothing added). */
 static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
-                        const float *surface_factor, float least, uint32_t i, float *out, float *add)
+                        const float *surface_factor, const uint8_t *black, float least, uint32_t i, float *out,
+                        float *add)
 {
     const lm_texel *t = &a->texels[i];
     const int spread = at.spread;
@@ -121,8 +122,10 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         int dark = met > 0.0 && least >= 0.0f && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
         /* rays that met no light either way say nothing of the factor: the surface's own says what its
          * light did (a dark corner of truck-town whose 36 rays all missed the sunlit AIM took 1 and, at the
-         * refinement, went back to its light before the sun was dimmed, twice the converged lightmap) */
-        float f = !(met > 0.0) || dark ? (met > 0.0 ? 1.0f : own[c]) : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : own[c];
+         * refinement, went back to its light before the sun was dimmed, twice the converged lightmap); a
+         * texel the IIM shows black keeps 1, as where no neighbour gathered */
+        float none = black && black[i] ? 1.0f : own[c]; /* a black texel: nothing to scale, nothing rewritten */
+        float f = !(met > 0.0) || dark ? (met > 0.0 ? 1.0f : none) : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : none;
         float d = dark ? (float)((s1[c] - s0[c]) / met) : 0.0f;
         out[c] = isfinite(f) && f >= 0.0f ? f : own[c];
         /* where only every stride-th texel gathered, not each surface's first (fewer rays than surfaces), a
@@ -180,8 +183,8 @@ static void ratios(const lm_light_scale *ls, const lm_atlas *a, quality q, uint3
      * apiece, took 4-18 ms an update on the shared room where their sums took microseconds */
 #pragma omp parallel for schedule(static) if (hi - lo > 1024)
     for (long i = (long)lo; i < (long)hi; i++)
-        texel_ratio(a, e0, e1, ls->done, q, ls->surface_factor, ls->least, (uint32_t)i, f + 3 * (i - (long)lo),
-                    d + 3 * (i - (long)lo));
+        texel_ratio(a, e0, e1, ls->done, q, ls->surface_factor, ls->black, ls->least, (uint32_t)i,
+                    f + 3 * (i - (long)lo), d + 3 * (i - (long)lo));
 }
 
 /* The smallest addition worth a rewrite: LM_LIGHT_SCALE_KEEP of the mean irradiance the gathers of the
@@ -207,6 +210,7 @@ void lm_light_scale_free(lm_light_scale *ls)
     free(ls->e);
     free(ls->done);
     free(ls->kept);
+    free(ls->black);
     free(ls->applied);
     free(ls->added);
     free(ls->range);
@@ -289,6 +293,8 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
         return 0;
     }
     memcpy(ls->surface_factor, surface_factor, sizeof *ls->surface_factor * 3 * S);
+    if (w->black && (ls->black = malloc(T)) != NULL) /* without memory: every such texel its surface's factor */
+        memcpy(ls->black, w->black, T);
     quality full = full_quality((uint32_t)T), q = full;
     int coarse = rays > 0 && rays < rays_of(a, 0, (uint32_t)T, full);
     if (coarse) { /* the first guess: FEWEST_RAYS for every stride-th, the stride that fits */

@@ -22,7 +22,8 @@
  * either: in a scene lit by one emitter every factor is the light's own and the IIM is exact at once;
  * where several light the seen surfaces in different proportions it is a first guess that the regathers
  * the scaled hits call for refine. A texel whose rays met no light before takes its surface's factor (rays
- * that met none either way say nothing of it; its surface's light does), except after an edit that `adds`
+ * that met none either way say nothing of it; its surface's light does, unless the IIM shows it black:
+ * scaling 0 would rewrite it for nothing, outside the edit's reach), except after an edit that `adds`
  * light where there may have been none (a light added or switched on: a dark room whose lamp comes on):
  * there a texel whose rays met next
  * to no light before (LM_LIGHT_SCALE_DARK) has no factor that lights it, and takes instead the change the
@@ -48,7 +49,7 @@
  *
  * Layout: the job owns the AIM and the emissions from before until it ends; per texel its two gathers,
  * what the IIM holds of this edit (the factor and addition applied so far), two flags and a scratch list
- * of the texels one refinement step gathers (54 bytes a texel, freed when the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
+ * of the texels one refinement step gathers (55 bytes a texel with the black texels, freed when the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
  * a surface's texels are a run and a factor, which sums over its own surface's texels alone, is final once
  * its run is gathered. Cost: the rays cast, as above; a refinement step gathers all its texels, over
  * however many surfaces, in one parallel pass. Errors: none (deterministic: each texel's rays are
@@ -94,6 +95,8 @@ typedef struct {
     const lm_atlas *atlas;
     const lm_rt *rt;
     const lm_hemicube_settings *set; /* the gather's (offset, sky) */
+    const uint8_t *black;            /* per texel, 1 where the IIM is black in every map it blends (NULL:
+                                        not known): read by lm_light_scale_begin, kept for the refinement */
 } lm_light_scale_world;
 
 typedef struct {
@@ -102,6 +105,7 @@ typedef struct {
     float *e;                        /* texel_count x 6: the gathers before (first half) and after */
     uint8_t *done;                   /* per texel: its gathers are in e */
     uint8_t *kept;                   /* per texel: regathered since the edit (no factor applies) */
+    uint8_t *black;                  /* per texel: black in the IIM at the edit (lm_light_scale_world's) */
     float *applied;                  /* texel_count x 3: the factor the IIM holds of this edit */
     float *added;                    /* texel_count x 3: and what it added after it (LM_LIGHT_SCALE_DARK) */
     float least;                     /* the smallest addition applied (light_scale.c, least_add); negative:

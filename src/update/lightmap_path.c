@@ -352,6 +352,34 @@ static void scale_iim(lm_lightmap_path *lp, const float *factor, const float *ad
         lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
 }
 
+/* Per texel, 1 where every map the IIM blends (fresh, old, new, shown) is black: a light edit's factor
+ * changes nothing there (NULL: no memory, or the maps could not be read; a warning says which). */
+static uint8_t *black_texels(const lm_lightmap_path *lp)
+{
+    const lm_atlas *a = lp->atlas;
+    size_t cells = (size_t)a->width * a->height;
+    float *rgba = malloc(sizeof *rgba * 4 * cells);
+    uint8_t *black = rgba ? malloc(a->texel_count ? a->texel_count : 1) : NULL;
+    const unsigned tex[4] = {lp->iim.fresh_tex, lp->iim.old_tex, lp->iim.new_tex, lp->iim.display_tex};
+    lm_error e;
+    for (uint32_t i = 0; black && i < a->texel_count; i++)
+        black[i] = 1;
+    for (int k = 0; black && k < 4; k++) {
+        if (lm_iim_texture_read(tex[k], a->width, a->height, rgba, &e) != LM_OK) {
+            lm_log(LM_LOG_WARN, "%s", e.msg);
+            free(black);
+            black = NULL;
+            break;
+        }
+        for (uint32_t i = 0; i < a->texel_count; i++) {
+            const float *v = rgba + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
+            black[i] &= v[0] == 0.0f && v[1] == 0.0f && v[2] == 0.0f;
+        }
+    }
+    free(rgba);
+    return black;
+}
+
 /* Lights or emitters changed in power alone, or materials edited, since the last call: each IIM texel
  * scaled by its own factor (light_scale.h; its surface's where that cannot be had), shown at the next
  * blend, and the AIM uploaded again before the next gather. Else the last such edit's factors refined,
@@ -363,7 +391,9 @@ static void follow_scale(lm_lightmap_path *lp)
     if (!edit && !lp->scaling.active)
         return;
     double t0 = lm_now();
-    lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather};
+    lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather, NULL};
+    uint8_t *black = edit && lp->have_iim ? black_texels(lp) : NULL;
+    w.black = black;
     const float *after = lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage));
     size_t T = lp->atlas->texel_count;
     float *texel = lp->have_iim ? malloc(sizeof *texel * 6 * (T + 1)) : NULL, *add = texel ? texel + 3 * T : NULL;
@@ -387,10 +417,12 @@ static void follow_scale(lm_lightmap_path *lp)
         uint32_t rays = lp->scale_rays && lp->scale_rays < LM_LIGHT_SCALE_LEAST ? LM_LIGHT_SCALE_LEAST : lp->scale_rays;
         lp->scale_cast +=
             lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, edit == 2, rays, texel, add);
+        free(black); /* the job keeps its copy */
         scale_iim(lp, texel, add, scaled);
     } else {
         free(before);
         free(emissive);
+        free(black);
         if (lp->have_iim)
             lm_log(LM_LOG_WARN, "%s: no memory to scale the lightmap after a light's edit: it follows by regathers",
                    lp->scene->path);
