@@ -256,8 +256,6 @@ float lm_scene_ray_lift(const lm_scene *s)
     return 1e-5f * (size > 0.0f && isfinite(size) ? size : 1.0f);
 }
 
-/* Bounds of the vertices that triangles use (unreferenced vertices don't count). An empty scene gets
- * min > max (size 0). */
 /* The world bounds of the corners of triangles [first, first + count), widened into *lo and *hi. */
 static void widen_by_tris(const lm_scene *s, uint32_t first, uint32_t count, lm_vec3 *lo, lm_vec3 *hi)
 {
@@ -278,6 +276,8 @@ void lm_scene_keep_bounds(lm_scene *s)
     s->bounds_tris = NULL;
 }
 
+/* Bounds of the vertices that triangles use (unreferenced vertices don't count). An empty scene gets
+ * min > max (size 0). */
 void lm_scene_update_bounds(lm_scene *s)
 {
     lm_vec3 lo = lm_v3(FLT_MAX, FLT_MAX, FLT_MAX), hi = lm_v3(-FLT_MAX, -FLT_MAX, -FLT_MAX);

@@ -18,17 +18,17 @@
  * gathers lie apart showed hard-edged squares where one entered or left the window (issue 32, item 3;
  * test_gather: its largest step between neighbours 0.130 flat, 0.047 with the tent). Where every texel
  * gathered the window stays flat: the tent would weigh a texel's own noise more (the Cornell box's red wall
- * recoloured took 33 updates to 2% with it, 22 without, lmgi bench --edits bench/cornell_edits.json). Both gathers meet the same points, so the ratio is far less noisy than
- * either: in a scene lit by one emitter every factor is the light's own and the IIM is exact at once;
+ * recoloured took 33 updates to 2% with it, 22 without, lmgi bench --edits bench/cornell_edits.json).
+ * Both gathers meet the same points, so the ratio is far less noisy than either: in a scene lit by one emitter every factor is the light's own and the IIM is exact at once;
  * where several light the seen surfaces in different proportions it is a first guess that the regathers
  * the scaled hits call for refine. A texel whose rays met no light before takes its surface's factor (rays
  * that met none either way say nothing of it; its surface's light does, unless the IIM shows it black:
  * scaling 0 would rewrite it for nothing, outside the edit's reach), except after an edit that `adds`
  * light where there may have been none (a light added or switched on: a dark room whose lamp comes on):
- * there a texel whose rays met next
- * to no light before (LM_LIGHT_SCALE_DARK) has no factor that lights it, and takes instead the change the
- * two gathers saw, added (E_after - E_before over the window, what its regather would add). A power edit
- * keeps its factors, which are exact where one light lights the scene, however much it brightens.
+ * there a texel whose rays met next to no light before (LM_LIGHT_SCALE_DARK) has no factor that lights
+ * it, and takes instead the change the two gathers saw, added (E_after - E_before over the window, what
+ * its regather would add). A power edit keeps its factors, which are exact where one light lights the
+ * scene, however much it brightens.
  *
  * The full quality: K rays a texel (K = LM_LIGHT_SCALE_WORK / texels rounded down to a square, at most
  * 64: 16 at `run`'s 1,800 texels) for each of the two gathers, each ray with its 16 AIM lookups (34 ms on
@@ -49,7 +49,8 @@
  *
  * Layout: the job owns the AIM and the emissions from before until it ends; per texel its two gathers,
  * what the IIM holds of this edit (the factor and addition applied so far), two flags and a scratch list
- * of the texels one refinement step gathers (55 bytes a texel with the black texels, freed when the refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
+ * of the texels one refinement step gathers (55 bytes a texel with the black texels, freed when the
+ * refinement ends). Invariants: texels lie in the atlas by surface (charts are ordered by surface), so
  * a surface's texels are a run and a factor, which sums over its own surface's texels alone, is final once
  * its run is gathered. Cost: the rays cast, as above; a refinement step gathers all its texels, over
  * however many surfaces, in one parallel pass. Errors: none (deterministic: each texel's rays are
