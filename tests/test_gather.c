@@ -1276,7 +1276,7 @@ static void test_light_scale_refined_equals_full(void **state)
         surface[i] = 0.75f;
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set, NULL};
+    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
     lm_light_scale ls;
     lm_light_scale_init(&ls);
     size_t ne = 3 * (size_t)p.s->material_count + 3;
@@ -1291,7 +1291,7 @@ static void test_light_scale_refined_equals_full(void **state)
                     lit_before[4 * c + k] *= 0.01f;
         }
         uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
-                                            after, surface, r == 2, 0, full, full_add);
+                                            NULL, after, surface, r == 2, 0, full, full_add);
         assert_false(ls.active); /* no bound: the full quality at once */
         uint32_t added = 0, scaled = 0;
         for (size_t i = 0; i < 3 * T; i++)
@@ -1300,7 +1300,7 @@ static void test_light_scale_refined_equals_full(void **state)
         for (size_t i = 0; i < 3 * T; i++)
             full[i] += full_add[i]; /* the value from 1 */
         uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
-                                              after, surface, r == 2, budget[r], shown, shown_add);
+                                              NULL, after, surface, r == 2, budget[r], shown, shown_add);
         for (size_t i = 0; i < 3 * T; i++)
             shown[i] += shown_add[i];
         assert_true(ls.active);
@@ -1379,7 +1379,7 @@ static void test_light_scale_refined_equals_full(void **state)
  * converged lightmap, until its surface's regather 60 updates later. Here the AIM is black before and after
  * and the Cornell box's emitters are dark, so no ray of any texel meets light; each surface has a factor of
  * its own, at once and through a budget's first guess and refinement. Where the IIM is black
- * (lm_light_scale_world's black) they keep 1: scaling 0 changes nothing but would rewrite them (the two
+ * (lm_light_scale_begin's black) they keep 1: scaling 0 changes nothing but would rewrite them (the two
  * rooms' hidden faces, outside the edit's reach: test_cli's test_bench_edits). */
 static void test_light_scale_unlit_rays_take_surface_factor(void **state)
 {
@@ -1401,7 +1401,7 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
             surface[3 * k + c] = 0.5f + 0.02f * (float)k + 0.1f * (float)c;
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set, NULL};
+    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
     lm_light_scale ls;
     lm_light_scale_init(&ls);
     /* the full quality at once; a first guess, then refined; each again with every other texel black */
@@ -1411,9 +1411,13 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
     for (uint32_t i = 0; i < T; i++)
         dark[i] = i % 2;
     for (int r = 0; r < 4; r++) {
-        w.black = r < 2 ? NULL : dark;
-        lm_light_scale_begin(&ls, &w, floats_copy(black, 4 * cells), floats_copy(emissive, ne), black, surface, 0,
-                             budget[r], f, add);
+        uint8_t *marked = NULL; /* the black texels, each run's own (the job takes them) */
+        if (r >= 2) {
+            assert_non_null(marked = malloc(T));
+            memcpy(marked, dark, T);
+        }
+        lm_light_scale_begin(&ls, &w, floats_copy(black, 4 * cells), floats_copy(emissive, ne), marked, black, surface,
+                             0, budget[r], f, add);
         for (size_t i = 0; i < 3 * T; i++)
             f[i] += add[i]; /* the value of a texel that was 1 */
         int steps = 0;
@@ -1427,7 +1431,7 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
         double worst = 0.0;
         for (uint32_t i = 0; i < T; i++)
             for (int c = 0; c < 3; c++) /* a black texel keeps 1 */
-                worst = fmax(worst, fabs(f[3 * i + c] - (w.black && dark[i] ? 1.0f
+                worst = fmax(worst, fabs(f[3 * i + c] - (r >= 2 && dark[i] ? 1.0f
                                                                             : surface[3 * p.atlas.texels[i].surface + c])));
         print_message("rays meeting no light, %s%s: every texel its surface's factor to %.3g\n",
                       r % 2 ? "a first guess refined" : "the full quality at once",

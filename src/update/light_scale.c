@@ -273,14 +273,15 @@ static int plan_order(lm_light_scale *ls, const lm_atlas *a)
 }
 
 uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
-                              float *emissive_before, const float *after, const float *surface_factor, int adds,
-                              uint32_t rays, float *factor, float *add)
+                              float *emissive_before, uint8_t *black, const float *after, const float *surface_factor,
+                              int adds, uint32_t rays, float *factor, float *add)
 {
     const lm_atlas *a = w->atlas;
     size_t T = a->texel_count, S = (size_t)a->surface_count;
     lm_light_scale_free(ls);
     ls->before = before;
     ls->emissive_before = emissive_before;
+    ls->black = black;
     ls->surface_factor = malloc(sizeof *ls->surface_factor * 3 * (S ? S : 1));
     ls->e = before && T ? malloc(sizeof *ls->e * 6 * T) : NULL;
     ls->done = ls->e ? calloc(T, 1) : NULL;
@@ -293,8 +294,6 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
         return 0;
     }
     memcpy(ls->surface_factor, surface_factor, sizeof *ls->surface_factor * 3 * S);
-    if (w->black && (ls->black = malloc(T)) != NULL) /* without memory: every such texel its surface's factor */
-        memcpy(ls->black, w->black, T);
     quality full = full_quality((uint32_t)T), q = full;
     int coarse = rays > 0 && rays < rays_of(a, 0, (uint32_t)T, full);
     if (coarse) { /* the first guess: FEWEST_RAYS for every stride-th, the stride that fits */

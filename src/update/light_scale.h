@@ -96,8 +96,6 @@ typedef struct {
     const lm_atlas *atlas;
     const lm_rt *rt;
     const lm_hemicube_settings *set; /* the gather's (offset, sky) */
-    const uint8_t *black;            /* per texel, 1 where the IIM is black in every map it blends (NULL:
-                                        not known): read by lm_light_scale_begin, kept for the refinement */
 } lm_light_scale_world;
 
 typedef struct {
@@ -106,7 +104,7 @@ typedef struct {
     float *e;                        /* texel_count x 6: the gathers before (first half) and after */
     uint8_t *done;                   /* per texel: its gathers are in e */
     uint8_t *kept;                   /* per texel: regathered since the edit (no factor applies) */
-    uint8_t *black;                  /* per texel: black in the IIM at the edit (lm_light_scale_world's) */
+    uint8_t *black;                  /* owned, may be NULL: per texel, 1 where the IIM was black at the edit */
     float *applied;                  /* texel_count x 3: the factor the IIM holds of this edit */
     float *added;                    /* texel_count x 3: and what it added after it (LM_LIGHT_SCALE_DARK) */
     float least;                     /* the smallest addition applied (light_scale.c, least_add); negative:
@@ -124,14 +122,15 @@ void lm_light_scale_init(lm_light_scale *ls);
 void lm_light_scale_free(lm_light_scale *ls);
 
 /* A new edit's factors into factor and additions into add (a->texel_count x 3 each): the IIM becomes
- * IIM x factor + add now. Ends a job under way first; takes before and emissive_before (malloc'd; before
- * NULL: each texel takes its surface's factor; emissive_before NULL: the scene's now). after: the dilated
+ * IIM x factor + add now. Ends a job under way first; takes before, emissive_before and black (malloc'd;
+ * before NULL: each texel takes its surface's factor; emissive_before NULL: the scene's now; black, per
+ * texel 1 where every map the IIM blends is black, NULL: not known). after: the dilated
  * AIM now; surface_factor: surface_count x 3; adds: the edit lit a light where it gave no light (added or
  * switched on), so that texels dark before take the change added (header). rays: the rays of one gather
  * the update may cast (0: no bound, the full quality at once). Returns the rays of one gather cast. */
 uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
-                              float *emissive_before, const float *after, const float *surface_factor, int adds,
-                              uint32_t rays, float *factor, float *add);
+                              float *emissive_before, uint8_t *black, const float *after, const float *surface_factor,
+                              int adds, uint32_t rays, float *factor, float *add);
 /* The next texels at the full quality, until about `rays` rays of one gather are cast (at least one
  * texel's; 0: every one left), or, past `ms` milliseconds (> 0), at the end of the chunk of
  * LM_LIGHT_SCALE_CHUNK texels under way (the first chunk always): factor and add (texel_count x 3 each)

@@ -362,8 +362,8 @@ static uint8_t *black_texels(const lm_lightmap_path *lp)
     uint8_t *black = rgba ? malloc(a->texel_count ? a->texel_count : 1) : NULL;
     const unsigned tex[4] = {lp->iim.fresh_tex, lp->iim.old_tex, lp->iim.new_tex, lp->iim.display_tex};
     lm_error e;
-    for (uint32_t i = 0; black && i < a->texel_count; i++)
-        black[i] = 1;
+    if (black)
+        memset(black, 1, a->texel_count);
     for (int k = 0; black && k < 4; k++) {
         if (lm_iim_texture_read(tex[k], a->width, a->height, rgba, &e) != LM_OK) {
             lm_log(LM_LOG_WARN, "%s", e.msg);
@@ -391,9 +391,7 @@ static void follow_scale(lm_lightmap_path *lp)
     if (!edit && !lp->scaling.active)
         return;
     double t0 = lm_now();
-    lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather, NULL};
-    uint8_t *black = edit && lp->have_iim ? black_texels(lp) : NULL;
-    w.black = black;
+    lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather};
     const float *after = lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage));
     size_t T = lp->atlas->texel_count;
     float *texel = lp->have_iim ? malloc(sizeof *texel * 6 * (T + 1)) : NULL, *add = texel ? texel + 3 * T : NULL;
@@ -415,14 +413,12 @@ static void follow_scale(lm_lightmap_path *lp)
         lm_texel_change_scale(&lp->change, lp->atlas, lp->scale);
     if (texel) {
         uint32_t rays = lp->scale_rays && lp->scale_rays < LM_LIGHT_SCALE_LEAST ? LM_LIGHT_SCALE_LEAST : lp->scale_rays;
-        lp->scale_cast +=
-            lm_light_scale_begin(&lp->scaling, &w, before, emissive, after, lp->scale, edit == 2, rays, texel, add);
-        free(black); /* the job keeps its copy */
+        lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, black_texels(lp), after, lp->scale,
+                                               edit == 2, rays, texel, add);
         scale_iim(lp, texel, add, scaled);
     } else {
         free(before);
         free(emissive);
-        free(black);
         if (lp->have_iim)
             lm_log(LM_LOG_WARN, "%s: no memory to scale the lightmap after a light's edit: it follows by regathers",
                    lp->scene->path);
