@@ -211,7 +211,8 @@ static void unchanged_where_version_stayed(lmgi_updater *u, const lmgi_scene *sc
 /* Progressive refinement (issue 32, item 3): after one move of the cube, at 20 texels an update, every
  * update's lightmap against a fresh bake of the moved scene. Texels gathered ahead among stale neighbours
  * showed as steps (squares in the frame); with the texels that wait shown from their gathered neighbours'
- * changes, the steps and the blocks' error are smaller at every moment, and both converge. */
+ * changes, the steps and the blocks' error are smaller at every moment, and both converge: the moved
+ * texels are gathered again once the photon stage has caught up with the move. */
 static void test_one_move_refined(void **state)
 {
     (void)state;
@@ -224,6 +225,7 @@ static void test_one_move_refined(void **state)
     lmgi_info in;
     lmgi_get_info(moved, &in);
     double step[2] = {0}, step_sum[2] = {0}, block[2] = {0}, block_sum[2] = {0}, last[2] = {0};
+    int within[2] = {0, 0}; /* the updates after which every 4 x 4 block stays within 10% of the fresh bake */
     enum { UPDATES = 40 };
     for (int k = 0; k < 2; k++) {
         lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
@@ -245,26 +247,35 @@ static void test_one_move_refined(void **state)
             step[k] = fmax(step[k], st), step_sum[k] += st;
             block[k] = fmax(block[k], b), block_sum[k] += b;
             last[k] = b;
+            within[k] = b > 0.1 ? f + 1 : within[k];
             free(shown);
         }
         print_message("the cube moved once, %d updates, %s: worst step between neighbours %.2f of the mean texel "
-                      "(mean over the updates %.2f), worst 4x4 block %.2f (mean %.2f, last %.2f)\n",
+                      "(mean over the updates %.2f), worst 4x4 block %.2f (mean %.2f, last %.2f; every block within "
+                      "10%% after %d updates)\n",
                       UPDATES, k ? "those waiting shown from their neighbours" : "each texel alone", step[k],
-                      step_sum[k] / UPDATES, block[k], block_sum[k] / UPDATES, last[k]);
-        assert_true(last[k] < 0.6); /* converging (0.44 and 0.46 measured: the cube's face, docs/gather.md) */
+                      step_sum[k] / UPDATES, block[k], block_sum[k] / UPDATES, last[k], within[k]);
+        /* converged: 0.03 both, every block within 10% after 26 and 24 updates (issue 32, item 6, asks 10 after
+         * a node passes). Before, 0.44 and 0.46 after 40 updates, never within 10%: the moved cube's paths were
+         * found one photon a group an update, its faces were gathered from AIMs that had not caught up and not
+         * again, and a floor texel by its old place held its old contact shadow while the floor's refresh
+         * lasted (photons.h lm_photons_invalidate_boxes, texel_change.h lm_texel_change_settle,
+         * lightmap_path.c commit_waiting) */
+        assert_true(last[k] < 0.1);
+        assert_true(within[k] <= 30);
         free(before);
         free(prev);
         free(version);
         lmgi_updater_free(u);
         lmgi_free(sc);
     }
-    /* the steps a texel gathered among stale ones makes: 0.32 of the mean texel on average over the updates
-     * alone, 0.18 with those waiting shown from it; the worst, 0.81 alone, in the first update (a texel
+    /* the steps a texel gathered among stale ones makes: 0.26 of the mean texel on average over the updates
+     * alone, 0.15 with those waiting shown from it; the worst, 0.81 alone, in the first update (a texel
      * gathered beside those that came out of the cube's old place, which show at once, blending in from the
-     * old contact shadow), 0.32 with it starting from its neighbours' estimate */
+     * old contact shadow), 0.43 with it starting from its neighbours' estimate */
     assert_true(step_sum[1] < 0.7 * step_sum[0]);
     assert_true(step[1] < 0.6 * step[0]);
-    assert_true(block_sum[1] < 1.1 * block_sum[0]); /* and the blocks no worse (0.48 both) */
+    assert_true(block_sum[1] < 1.1 * block_sum[0]); /* and the blocks no worse (0.22 both) */
     free(want);
     lmgi_updater_free(fresh);
     lmgi_free(moved);

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
+#include "../scene/moved_nodes.h"
 #include "delta_i.h"
 
 #define BLOCK 4 /* atlas texels per side of an AIM emitter block */
@@ -37,14 +38,7 @@ static void node_spheres(lm_texel_change *tc, const lm_scene *s)
             tc->node_sphere[4 * n + 3] = -1.0f;
         return;
     }
-    for (int n = 0; n < s->node_count; n++)
-        for (int k = 0; k < 3; k++)
-            lo[6 * n + k] = INFINITY, lo[6 * n + 3 + k] = -INFINITY;
-    for (uint32_t v = 0; v < s->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float *b = lo + 6 * (size_t)s->vertex_node[v], x = s->positions[3 * (size_t)v + k];
-            b[k] = fminf(b[k], x), b[3 + k] = fmaxf(b[3 + k], x);
-        }
+    lm_scene_node_local_boxes(s, lo);
     for (int n = 0; n < s->node_count; n++) {
         float *sp = tc->node_sphere + 4 * n, *b = lo + 6 * n;
         sp[3] = -1.0f;
@@ -71,14 +65,15 @@ lm_status lm_texel_change_init(lm_texel_change *tc, const lm_scene *s, const lm_
     tc->node_count = s->node_count;
     tc->change = calloc(T, sizeof *tc->change);
     tc->lit = calloc(T, sizeof *tc->lit);
+    tc->unsettled = calloc(T, sizeof *tc->unsettled);
     tc->pos = malloc(3 * T * sizeof *tc->pos);
     tc->nrm = malloc(3 * T * sizeof *tc->nrm);
     tc->aim_seen = malloc(3 * T * sizeof *tc->aim_seen);
     tc->texel_node = malloc(T * sizeof *tc->texel_node);
     tc->node_world = malloc(16 * N * sizeof *tc->node_world);
     tc->node_sphere = malloc(4 * N * sizeof *tc->node_sphere);
-    if (!tc->change || !tc->lit || !tc->pos || !tc->nrm || !tc->aim_seen || !tc->texel_node || !tc->node_world ||
-        !tc->node_sphere) {
+    if (!tc->change || !tc->lit || !tc->unsettled || !tc->pos || !tc->nrm || !tc->aim_seen || !tc->texel_node ||
+        !tc->node_world || !tc->node_sphere) {
         lm_texel_change_free(tc);
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for the texels' change estimates (%u texels)",
                        a->texel_count);
@@ -99,6 +94,7 @@ void lm_texel_change_free(lm_texel_change *tc)
 {
     free(tc->change);
     free(tc->lit);
+    free(tc->unsettled);
     free(tc->pos);
     free(tc->nrm);
     free(tc->aim_seen);
@@ -140,17 +136,22 @@ static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atla
      * of the sphere's form factor (a small step changes little even right under the object) */
     float step = lm_length(lm_sub(lm_v3_load(now), lm_v3_load(was)));
     float moved = fminf(1.0f, step / fmaxf(now[3], 1e-20f) + fabsf(now[3] - was[3]) / fmaxf(now[3], 1e-20f));
+    tc->any_unsettled = 1;
     for (uint32_t i = 0; i < a->texel_count; i++) {
         float *p = tc->pos + 3 * (size_t)i, *nr = tc->nrm + 3 * (size_t)i;
         if (tc->texel_node[i] != n) {
-            tc->change[i] += moved * (sphere_factor(p, nr, was) + sphere_factor(p, nr, now));
+            float c = moved * (sphere_factor(p, nr, was) + sphere_factor(p, nr, now));
+            tc->change[i] += c;
+            tc->unsettled[i] += c;
             continue;
         }
         float q[3], m[3];
         lm_texel_world(s, &a->texels[i], q, m);
         float dx = lm_length(lm_sub(lm_v3_load(q), lm_v3_load(p)));
         float turn = 1.0f - lm_dot(lm_v3_load(m), lm_v3_load(nr));
-        tc->change[i] += fminf(1.0f, dx / fmaxf(now[3], 1e-20f) + turn);
+        float c = fminf(1.0f, dx / fmaxf(now[3], 1e-20f) + turn);
+        tc->change[i] += c;
+        tc->unsettled[i] += c;
         memcpy(p, q, sizeof q);
         memcpy(nr, m, sizeof m);
     }
@@ -382,16 +383,29 @@ float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel)
     return tc->change[texel] + fabsf(tc->lit[texel]);
 }
 
+uint32_t lm_texel_change_settle(lm_texel_change *tc)
+{
+    uint32_t n = 0;
+    for (uint32_t i = 0; tc->any_unsettled && i < tc->texel_count; i++)
+        if (tc->unsettled[i] > 0.0f)
+            tc->change[i] += tc->unsettled[i], tc->unsettled[i] = 0.0f, n++;
+    tc->any_unsettled = 0;
+    return n;
+}
+
 void lm_texel_change_save(const lm_texel_change *tc, float *saved)
 {
     memcpy(saved, tc->change, sizeof *saved * tc->texel_count);
     memcpy(saved + tc->texel_count, tc->lit, sizeof *saved * tc->texel_count);
+    memcpy(saved + 2 * (size_t)tc->texel_count, tc->unsettled, sizeof *saved * tc->texel_count);
 }
 
 void lm_texel_change_restore(lm_texel_change *tc, const float *saved)
 {
     memcpy(tc->change, saved, sizeof *saved * tc->texel_count);
     memcpy(tc->lit, saved + tc->texel_count, sizeof *saved * tc->texel_count);
+    memcpy(tc->unsettled, saved + 2 * (size_t)tc->texel_count, sizeof *saved * tc->texel_count);
+    tc->any_unsettled = 1;
 }
 
 void lm_texel_change_scale(lm_texel_change *tc, const lm_atlas *a, const float *factor)

@@ -22,10 +22,16 @@
  * change is over the threshold and over 4 times the atlas's mean change (a change that reaches everything
  * alike, a light dimmed, is the surfaces' order's to follow), most changed first, then by index, and
  * zeroes them.
+ * A texel gathered for a move right after it saw the AIMs around as the move's photons had yet to change
+ * them (the moved cube's faces saw the floor without its new shadow, 40% too bright, and the AIMs' later
+ * refreshes lent them too little change to pass the bar: 200 updates until the surfaces' order came
+ * round). So the motion sum is also kept aside, unsettled, and added to the change again once the photon
+ * stage has caught up (lm_texel_change_settle): the moved texels are gathered once more, from AIMs that
+ * have caught up.
  *
  * Layout: per atlas texel (lm_atlas.texels order) change, world position and normal (kept current for
- * moved nodes), and the AIM radiance last looked at; per node its last world matrix and local bounding
- * sphere. Memory: 36 bytes a texel, 80 a node.
+ * moved nodes), the unsettled motion sum and the AIM radiance last looked at; per node its last world
+ * matrix and local bounding sphere. Memory: 40 bytes a texel, 80 a node.
  * Cost: O(texels of moved nodes + moved nodes x texels) per moved frame; O(blocks x texels) for AIM
  * changes, bounded as said (a few ms); O(texels log budget) to pick. Nothing when nothing changed.
  * Deterministic (fixed order, no threads). Not thread-safe: the scene and AIM must not change meanwhile. */
@@ -47,6 +53,8 @@ typedef struct {
     float threshold;      /* a texel is picked when its change exceeds this */
     float *change;        /* per texel: what moved nodes changed (unsigned, summed) */
     float *lit;           /* per texel: what changed AIMs changed, signed (first order in their change) */
+    float *unsettled;     /* per texel: the motion sum since the last lm_texel_change_settle */
+    int any_unsettled;    /* a move since then (else settling has nothing to scan) */
     float *pos, *nrm;     /* per texel, 3 each, world space as last seen */
     float *aim_seen;      /* per texel, 3: AIM radiance as last looked at */
     int node_count;
@@ -64,6 +72,10 @@ void lm_texel_change_free(lm_texel_change *tc);
 /* Adds the change of every node whose world matrix moved since the last call (or the init). Returns how
  * many nodes moved. */
 int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a);
+/* The photon stage has no work of a move waiting (no photon group to re-trace, no AIM over its threshold):
+ * every texel's unsettled motion sum is added to its change (header) and cleared. Returns how many texels
+ * had one. */
+uint32_t lm_texel_change_settle(lm_texel_change *tc);
 /* Adds the change of the surfaces with refreshed[k] set, comparing aim_rgb with what was last seen, at the
  * texels of the surfaces that see them (lm_delta_i_sees: a few shadow rays per pair of surfaces). */
 void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const lm_scene *s, const lm_atlas *a,
@@ -86,8 +98,9 @@ uint32_t lm_texel_change_waiting(const lm_texel_change *tc, const lm_atlas *a, c
 void lm_texel_change_gathered(lm_texel_change *tc, const uint32_t *texels, uint32_t count);
 /* Texel t's change (header). */
 float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel);
-/* saved (2 x texel_count floats) = every texel's change, for a bake that may be cancelled; restore gives it
- * back (what the cancelled bake picked is picked again). */
+/* saved (LM_TEXEL_CHANGE_SAVED x texel_count floats) = every texel's change, for a bake that may be
+ * cancelled; restore gives it back (what the cancelled bake picked is picked again). */
+#define LM_TEXEL_CHANGE_SAVED 3
 void lm_texel_change_save(const lm_texel_change *tc, float *saved);
 void lm_texel_change_restore(lm_texel_change *tc, const float *saved);
 

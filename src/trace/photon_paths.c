@@ -75,6 +75,49 @@ int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const p
     return 0;
 }
 
+/* Whether the segment a -> b crosses the box (slabs clipped to the segment's [0, 1]). */
+static int segment_meets_box(const float a[3], const float b[3], const float box[6])
+{
+    float t0 = 0.0f, t1 = 1.0f;
+    for (int k = 0; k < 3; k++) {
+        float d = b[k] - a[k];
+        if (d == 0.0f) {
+            if (a[k] < box[k] || a[k] > box[3 + k])
+                return 0;
+            continue;
+        }
+        float n = (box[k] - a[k]) / d, f = (box[3 + k] - a[k]) / d;
+        if (n > f) {
+            float x = n;
+            n = f, f = x;
+        }
+        t0 = n > t0 ? n : t0;
+        t1 = f < t1 ? f : t1;
+        if (t0 > t1)
+            return 0;
+    }
+    return 1;
+}
+
+int ph_path_meets_boxes(const lm_photons *ph, const ph_group *g, uint32_t m, const float *boxes, int n)
+{
+    uint32_t first = g->offsets[m], end = g->offsets[m + 1];
+    if (first == end)
+        return 0;
+    lm_emission emi;
+    uint32_t count = ph->emitter_first[g->emitter + 1] - ph->emitter_first[g->emitter];
+    lm_emitter_emit_placed(ph->em, ph->scene, g->emitter, NULL, g->emit_u + PH_EMIT_DIMS * (size_t)m, count, &emi);
+    const float *from = emi.org;
+    for (uint32_t i = first; i < end; i++) {
+        const float *to = g->verts[i].pos;
+        for (int k = 0; k < n; k++)
+            if (segment_meets_box(from, to, boxes + 6 * k))
+                return 1;
+        from = to;
+    }
+    return 0;
+}
+
 /* Grows *verts to hold need vertices: doubling for scratch, exactly for a group's slab (rebuilt
  * only when the group is re-traced, so slack would just be kept memory). */
 static int reserve_verts(lm_path_vertex **verts, uint32_t *cap, uint32_t need, int exact)

@@ -18,7 +18,6 @@
 #include "photons_internal.h"
 #include "shading.h"
 
-#define PH_EMIT_DIMS 4u
 /* Smaller batches (a round-robin frame) run on the calling thread: waking a thread team costs more
  * than tracing a few hundred photons, and much more when the cores are shared. */
 #define PH_PARALLEL_MIN_JOBS 1024u

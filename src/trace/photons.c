@@ -484,6 +484,37 @@ uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *material
     return n;
 }
 
+uint32_t lm_photons_invalidate_boxes(lm_photons *ph, const float *boxes, int n)
+{
+    if (n <= 0)
+        return 0;
+    uint8_t *meets = calloc(ph->group_count ? ph->group_count : 1, 1);
+    float *padded = malloc(sizeof *padded * 6 * (size_t)n);
+    if (!meets || !padded) { /* the round robin still finds them, later */
+        free(meets);
+        free(padded);
+        return 0;
+    }
+    for (int k = 0; k < 6 * n; k++) /* a hit on the node's face lies on its box: rounding must not lose it */
+        padded[k] = boxes[k] + (k % 6 < 3 ? -ph->epsilon : ph->epsilon);
+#pragma omp parallel for schedule(dynamic, 1)
+    for (uint32_t gi = 0; gi < ph->group_count; gi++) {
+        const ph_group *g = &ph->groups[gi];
+        for (uint32_t m = 0; !g->invalid && g->offsets && m < g->photons && !meets[gi]; m++)
+            meets[gi] = (uint8_t)ph_path_meets_boxes(ph, g, m, padded, n);
+    }
+    free(padded);
+    uint32_t count = 0;
+    for (uint32_t gi = 0; gi < ph->group_count; gi++) /* in group order: the queue's order is the same */
+        if (meets[gi]) {
+            mark_invalid(ph, gi);
+            ph->groups[gi].invalidations++;
+            count++;
+        }
+    free(meets);
+    return count;
+}
+
 /* ---- re-tracing groups: trace in parallel, apply serially in group and photon order ---- */
 
 /* 1 if group g fits in batch b (a batch always takes at least one group). */

@@ -149,6 +149,13 @@ lm_status lm_photons_trace_all_exact(lm_photons *ph, lm_photon_frame_stats *stat
  * groups themselves (a light's placement or power, a material). stats may be NULL. Fails only when
  * memory runs out. */
 lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err);
+/* Queues every valid group with a photon whose stored path crosses one of the n boxes (6 floats each: min
+ * x, y, z, max x, y, z): where a node an edit moved was and where it is now. The round robin finds such
+ * paths one photon a group an update; a box test finds them at once, without a ray (the last leg of a
+ * photon that left the scene is not stored and is left to the round robin). O(path vertices x n), on
+ * OpenMP threads; the queue's order does not depend on them. Returns how many groups it queued (0 also
+ * when memory ran out: the round robin then finds them). */
+uint32_t lm_photons_invalidate_boxes(lm_photons *ph, const float *boxes, int n);
 /* Emitter e changed in power alone (a light's colour or intensity; its place and shape as they were):
  * its photons keep their paths, which follow albedos and never power (photon_trace.c), so instead of
  * re-tracing them the flux of each of its stored hits is multiplied by s, per channel, which gives the

@@ -7,6 +7,7 @@
  * that could still leave carries less than 1e-40 of it. */
 #define PH_SPECULAR_RUN 64u
 #define LM_PHOTONS_INTERNAL_H
+#define PH_EMIT_DIMS 4u /* QMC dimensions of a photon's emission (ph_group.emit_u) */
 
 #include "photons.h"
 
@@ -147,6 +148,10 @@ const ph_vertex *ph_job_vertices(const ph_batch *b, const ph_job *j);
  * that moved more than epsilon in world or node-local space, or flux changed; with ph->exact, any bit of
  * a vertex or a hit). */
 int ph_path_changed(const lm_photons *ph, const ph_group *g, uint32_t m, const ph_vertex *v, uint32_t n);
+/* 1 if photon m's stored path, from its emission point (as the emitter places it now) through its
+ * vertices, crosses one of the n boxes (6 floats each: min x, y, z, max x, y, z). The part after the last
+ * vertex (a photon that left the scene, or was absorbed) is not stored and not tested. */
+int ph_path_meets_boxes(const lm_photons *ph, const ph_group *g, uint32_t m, const float *boxes, int n);
 /* Rebuilds a group's slab from the jobs [first, first + M) of batch b (one per photon, in order):
  * photons whose path changed get their old hits removed and new ones added; the others keep theirs. */
 lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs,

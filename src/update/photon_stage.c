@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "../core/timing.h"
+#include "../scene/moved_nodes.h"
 #include "../trace/portal_finder.h"
 #include "../trace/sealed_lights.h"
 
@@ -33,6 +34,9 @@ struct lm_photon_stage {
     emitter_snapshot *snap;
     float bounds[6];             /* the scene's bounds when the emitters were last placed (a sun's follow) */
     uint8_t *refreshed;          /* per surface: its AIM refreshed since lm_photon_stage_take_refreshed */
+    int aim_pending;             /* AIM surfaces over their threshold that the last refresh left for later */
+    lm_moved_nodes moves;        /* the nodes edits moved, whose paths are queued at once (moved_nodes.h) */
+    float *move_boxes;           /* scratch: LM_MOVED_NODE_BOXES floats a node */
     double *delta_before;        /* scratch: per surface, delta_f + owed before a refresh (aim.h) */
     uint32_t *count_before;      /* scratch: per surface, its refresh count before it */
     lm_photons *photons;
@@ -732,6 +736,11 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     st = make_photons(ps, &ps->photons, err);
     if (st == LM_OK)
+        st = lm_moved_nodes_init(&ps->moves, ps->scene, err);
+    if (st == LM_OK && !(ps->move_boxes = malloc(sizeof *ps->move_boxes * LM_MOVED_NODE_BOXES *
+                                                 (size_t)(ps->scene->node_count ? ps->scene->node_count : 1))))
+        st = lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
+    if (st == LM_OK)
         st = find_portals(ps, err);
     if (st == LM_OK && ps->set.trace)
         st = lm_photons_trace_all(ps->photons, &first->photons, err);
@@ -815,6 +824,8 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps->reached);
     free(ps->materials);
     free(ps->ratio);
+    lm_moved_nodes_free(&ps->moves);
+    free(ps->move_boxes);
     free(ps->aim_before);
     free(ps->emissive_before);
     free(ps);
@@ -836,6 +847,10 @@ static lm_status animate(lm_photon_stage *ps, float t, int bake, lm_photon_stage
     }
     /* what the edits committed since the last frame changed (update/edits.h), taken once */
     const lm_edit_changes *ch = lm_edits_changes(ps->edits);
+    if (ch->moved && ps->photons && ps->set.trace) { /* an edit's move: its paths queued now (moved_nodes.h) */
+        int boxes = lm_moved_nodes_boxes(&ps->moves, ps->scene, ps->move_boxes);
+        lm_photons_invalidate_boxes(ps->photons, ps->move_boxes, boxes);
+    }
     int added = 0;
     lm_status st = take_new_emitters(ps, &added, err);
     if (emitters_touched(ps, ch, added)) {
@@ -876,6 +891,7 @@ static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out
         hits += store->surfaces[k].count;
     }
     lm_status st = lm_aim_refresh(&ps->aim, ps->scene, ps->surfaces, ps->atlas, store, budget, out, err);
+    ps->aim_pending = st == LM_OK ? out->surfaces_pending : ps->aim_pending;
     double seen = SEEN_CHANGE * ps->aim.mean_hit_energy * (double)hits;
     for (int k = 0; k < S; k++)
         ps->refreshed[k] |= ps->delta_before[k] > seen && ps->aim.refresh_count[k] != ps->count_before[k];
@@ -889,6 +905,7 @@ static lm_status refresh_all_aims(lm_photon_stage *ps, lm_aim_stats *out, lm_err
     lm_status st = lm_aim_refresh_all(&ps->aim, ps->scene, ps->surfaces, ps->atlas,
                                       lm_photons_store_mutable(ps->photons), out, err);
     memset(ps->refreshed, 1, (size_t)ps->surfaces->surface_count);
+    ps->aim_pending = st == LM_OK ? 0 : ps->aim_pending;
     return st;
 }
 
@@ -1031,6 +1048,11 @@ void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, uint32
 {
     *groups = ps->photons && ps->set.trace ? lm_photons_pending_groups(ps->photons) : 0;
     *caustic_photons = ps->caustics ? lm_caustics_wanted(ps->caustics) : 0;
+}
+
+int lm_photon_stage_settled(const lm_photon_stage *ps)
+{
+    return !(ps->photons && ps->set.trace && lm_photons_pending_groups(ps->photons)) && !ps->aim_pending;
 }
 
 uint64_t lm_photon_stage_caustics_version(const lm_photon_stage *ps)

@@ -127,6 +127,9 @@ void lm_photon_stage_limit(lm_photon_stage *ps, const lm_photon_stage_limits *l)
 /* The work waiting: invalid photon groups queued, the caustic photons the next update would trace
  * (lm_caustics_wanted). */
 void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, uint32_t *caustic_photons);
+/* Whether the stage has caught up: no invalid photon group queued, and the last AIM refresh left no surface
+ * over its threshold for later. Not while an update runs on another thread. */
+int lm_photon_stage_settled(const lm_photon_stage *ps);
 
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps);
 /* The photon store, writable: the IIM scheduler resets a surface's delta_i once it is regathered. */

@@ -1,0 +1,86 @@
+#include "moved_nodes.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../core/vecmath.h"
+
+void lm_scene_node_local_boxes(const lm_scene *s, float *out)
+{
+    for (int n = 0; n < s->node_count; n++)
+        for (int k = 0; k < 3; k++)
+            out[6 * n + k] = INFINITY, out[6 * n + 3 + k] = -INFINITY;
+    for (uint32_t v = 0; v < s->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            float *b = out + 6 * (size_t)s->vertex_node[v], x = s->positions[3 * (size_t)v + k];
+            b[k] = fminf(b[k], x), b[3 + k] = fmaxf(b[3 + k], x);
+        }
+}
+
+lm_status lm_moved_nodes_init(lm_moved_nodes *m, const lm_scene *s, lm_error *err)
+{
+    memset(m, 0, sizeof *m);
+    size_t n = (size_t)(s->node_count ? s->node_count : 1);
+    m->world = malloc(16 * n * sizeof *m->world);
+    m->local_box = malloc(6 * n * sizeof *m->local_box);
+    if (!m->world || !m->local_box) {
+        lm_moved_nodes_free(m);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory to follow moved nodes (%d nodes)", s->path, s->node_count);
+    }
+    m->node_count = s->node_count;
+    for (int i = 0; i < s->node_count; i++)
+        memcpy(m->world + 16 * i, s->nodes[i].world, 16 * sizeof(float));
+    lm_scene_node_local_boxes(s, m->local_box);
+    return LM_OK;
+}
+
+void lm_moved_nodes_free(lm_moved_nodes *m)
+{
+    free(m->world);
+    free(m->local_box);
+    memset(m, 0, sizeof *m);
+}
+
+/* Whether an animation places the node: a channel on it or above it, on a node no edit has taken over. */
+static int animated(const lm_scene *s, int node)
+{
+    for (int a = 0; a < s->animation_count; a++)
+        for (int c = 0; c < s->animations[a].channel_count; c++) {
+            int target = s->animations[a].channels[c].node;
+            if (target >= 0 && target < s->node_count && !s->nodes[target].edited && lm_node_under(s, node, target))
+                return 1;
+        }
+    return 0;
+}
+
+/* The world box of local box b under matrix w: its 8 corners transformed. */
+static void world_box(const float b[6], const float w[16], float out[6])
+{
+    for (int k = 0; k < 3; k++)
+        out[k] = INFINITY, out[3 + k] = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        lm_vec3 p = lm_mat4_point(w, lm_v3(b[c & 1 ? 3 : 0], b[c & 2 ? 4 : 1], b[c & 4 ? 5 : 2]));
+        float q[3];
+        lm_v3_store(q, p);
+        for (int k = 0; k < 3; k++)
+            out[k] = fminf(out[k], q[k]), out[3 + k] = fmaxf(out[3 + k], q[k]);
+    }
+}
+
+int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out)
+{
+    int boxes = 0;
+    for (int n = 0; n < s->node_count && n < m->node_count; n++) {
+        float *seen = m->world + 16 * n;
+        if (!memcmp(seen, s->nodes[n].world, 16 * sizeof(float)))
+            continue;
+        const float *b = m->local_box + 6 * n;
+        if (b[0] <= b[3] && !animated(s, n)) {
+            world_box(b, seen, out + 6 * boxes++);
+            world_box(b, s->nodes[n].world, out + 6 * boxes++);
+        }
+        memcpy(seen, s->nodes[n].world, 16 * sizeof(float));
+    }
+    return boxes;
+}
