@@ -414,3 +414,14 @@ void lm_texel_change_scale(lm_texel_change *tc, const lm_atlas *a, const float *
         for (int c = 0; c < 3; c++)
             tc->aim_seen[3 * (size_t)i + c] *= factor[3 * a->texels[i].surface + c];
 }
+
+void lm_texel_change_first_guess(lm_texel_change *tc, const float *factor, const float *add)
+{
+    for (uint32_t i = 0; i < tc->texel_count; i++) {
+        float c = 0.0f;
+        for (int k = 0; k < 3; k++)
+            c = fmaxf(c, fabsf(factor[3 * (size_t)i + k] - 1.0f) +
+                             (tc->mean_e > 0.0 ? fabsf(add[3 * (size_t)i + k]) / (float)tc->mean_e : 0.0f));
+        tc->change[i] += isfinite(c) ? c : 0.0f;
+    }
+}

@@ -84,6 +84,13 @@ void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const l
  * power edit changed its surface's light so (update/photon_stage.h, lm_photon_stage_take_scale), and the
  * IIM texels that saw it were scaled alike, so a later refresh counts only what came after. */
 void lm_texel_change_scale(lm_texel_change *tc, const lm_atlas *a, const float *factor);
+/* A material's edit moved every IIM texel to factor x IIM + add at once (update/light_scale.h; texel_count x
+ * 3 each): right to first order only, so the texels it moved most are regathered first. Each texel's change
+ * grows by its largest channel's |factor - 1| + |add| / E_mean; an edit that moves every texel alike stays
+ * under the bar of 4 times the mean and is left to the surfaces' order. (The Cornell box's red wall turned
+ * blue: the tall block's face toward it kept the first guess's 8.5% for 80 updates, until its surface's
+ * refresh came round.) */
+void lm_texel_change_first_guess(lm_texel_change *tc, const float *factor, const float *add);
 /* At most budget texels over the threshold (and, unless `all`, over 4 times the mean: header), not on
  * surfaces with off[k] set, most changed first, written to out (texel indices) and zeroed. A bake asks for
  * all. Returns how many. */

@@ -387,6 +387,7 @@ static uint8_t *black_texels(const lm_lightmap_path *lp)
 static void follow_scale(lm_lightmap_path *lp)
 {
     float *before = NULL, *emissive = NULL;
+    int recoloured = lm_photon_stage_scale_recoloured(lp->stage);
     int edit = lm_photon_stage_take_scale(lp->stage, lp->scale, &before, &emissive);
     if (!edit && !lp->scaling.active)
         return;
@@ -416,6 +417,8 @@ static void follow_scale(lm_lightmap_path *lp)
         lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, black_texels(lp), after, lp->scale,
                                                edit == 2, rays, texel, add);
         scale_iim(lp, texel, add, scaled);
+        if (lp->have_change && recoloured)
+            lm_texel_change_first_guess(&lp->change, texel, add);
     } else {
         free(before);
         free(emissive);

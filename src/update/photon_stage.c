@@ -52,6 +52,7 @@ struct lm_photon_stage {
                                   * lm_photon_stage_take_scale (1: nothing) */
     int scaled;                  /* light_scale holds something other than 1 */
     int scaled_lit;              /* and a light was lit where it gave no light (light_now) */
+    int scaled_materials;        /* and a material was edited (lm_photon_stage_scale_recoloured) */
     int scaled_computed;         /* and one of those lights' direct light is computed by the AIM (its first
                                   * hits are left out of the estimate, lm_direct_covers_emitter) */
     float *aim_before;           /* with scaled: the dilated AIM before the first of those scalings (or NULL:
@@ -325,6 +326,7 @@ static lm_status follow_materials(lm_photon_stage *ps, const lm_edit_changes *ch
     int S = ps->surfaces->surface_count, M = ps->material_count, any = 0;
     if (ps->have_aim) /* before the snapshot below takes the new emissions */
         keep_aim_before(ps);
+    ps->scaled_materials = 1;
     for (int m = 0; m < M; m++) {
         float *r = ps->ratio + 3 * m;
         r[0] = r[1] = r[2] = 1.0f;
@@ -1015,9 +1017,11 @@ int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_befo
     *aim_before = ps->aim_before;
     *emissive_before = ps->emissive_before;
     ps->aim_before = ps->emissive_before = NULL;
-    ps->scaled = ps->scaled_lit = 0;
+    ps->scaled = ps->scaled_lit = ps->scaled_materials = 0;
     return any;
 }
+
+int lm_photon_stage_scale_recoloured(const lm_photon_stage *ps) { return ps->scaled_materials; }
 
 int lm_photon_stage_scale_waiting(const lm_photon_stage *ps) { return ps->scaled; }
 const lm_photons *lm_photon_stage_photons(const lm_photon_stage *ps) { return ps->photons; }

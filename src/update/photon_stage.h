@@ -112,6 +112,10 @@ int lm_photon_stage_take_refreshed(lm_photon_stage *ps, uint8_t *out);
  * falls where there may have been none, light_scale.h's `adds`), else 1. Not while an update runs on
  * another thread. */
 int lm_photon_stage_take_scale(lm_photon_stage *ps, float *out, float **aim_before, float **emissive_before);
+/* Whether the scaling lm_photon_stage_take_scale would hand on includes a material's edit: its first guess
+ * is right to first order only (a light's power is exact in its own light), so the texels it moved most are
+ * regathered first (photonmap/texel_change.h, lm_texel_change_first_guess). */
+int lm_photon_stage_scale_recoloured(const lm_photon_stage *ps);
 /* Whether a scaling waits for lm_photon_stage_take_scale (the plan of the update that takes it). */
 int lm_photon_stage_scale_waiting(const lm_photon_stage *ps);
 
