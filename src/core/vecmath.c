@@ -76,6 +76,17 @@ lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d)
                  m[2] * d.x + m[6] * d.y + m[10] * d.z);
 }
 
+void lm_box_placed(const float b[6], const float m[16], float out[6])
+{
+    out[0] = out[1] = out[2] = INFINITY, out[3] = out[4] = out[5] = -INFINITY;
+    for (int c = 0; c < 8; c++) {
+        lm_vec3 p = lm_mat4_point(m, lm_v3(b[c & 1 ? 3 : 0], b[c & 2 ? 4 : 1], b[c & 4 ? 5 : 2]));
+        const float q[3] = {p.x, p.y, p.z};
+        for (int a = 0; a < 3; a++)
+            out[a] = fminf(out[a], q[a]), out[3 + a] = fmaxf(out[3 + a], q[a]);
+    }
+}
+
 int lm_mat4_singular(const float m[16])
 {
     lm_vec3 a = lm_v3(m[0], m[1], m[2]), b = lm_v3(m[4], m[5], m[6]), c = lm_v3(m[8], m[9], m[10]);

@@ -109,6 +109,8 @@ static inline lm_vec3 lm_mat4_point(const float m[16], lm_vec3 p)
                  m[2] * p.x + m[6] * p.y + m[10] * p.z + m[14]);
 }
 lm_vec3 lm_mat4_dir(const float m[16], lm_vec3 d);
+/* The world box (min x, y, z, max x, y, z) of a local box under m: its 8 corners placed. */
+void lm_box_placed(const float local[6], const float m[16], float out[6]);
 /* The matrix that takes normals to world space under m: the cofactors of m's upper 3x3 (its inverse
  * transpose times det), turned by det's sign so the normal keeps its side. Column-major 3x3. */
 static inline void lm_mat4_normal_matrix(const float m[16], float out[9])

@@ -6,7 +6,6 @@
 #include <string.h>
 
 #include "../core/vecmath.h"
-#include "../scene/moved_nodes.h"
 #include "delta_i.h"
 
 #define BLOCK 4 /* atlas texels per side of an AIM emitter block */
@@ -38,7 +37,14 @@ static void node_spheres(lm_texel_change *tc, const lm_scene *s)
             tc->node_sphere[4 * n + 3] = -1.0f;
         return;
     }
-    lm_scene_node_local_boxes(s, lo);
+    for (int n = 0; n < s->node_count; n++)
+        for (int k = 0; k < 3; k++)
+            lo[6 * n + k] = INFINITY, lo[6 * n + 3 + k] = -INFINITY;
+    for (uint32_t v = 0; v < s->vertex_count; v++)
+        for (int k = 0; k < 3; k++) {
+            float *b = lo + 6 * (size_t)s->vertex_node[v], x = s->positions[3 * (size_t)v + k];
+            b[k] = fminf(b[k], x), b[3 + k] = fmaxf(b[3 + k], x);
+        }
     for (int n = 0; n < s->node_count; n++) {
         float *sp = tc->node_sphere + 4 * n, *b = lo + 6 * n;
         sp[3] = -1.0f;

@@ -1,22 +1,9 @@
 #include "moved_nodes.h"
 
-#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "../core/vecmath.h"
-
-void lm_scene_node_local_boxes(const lm_scene *s, float *out)
-{
-    for (int n = 0; n < s->node_count; n++)
-        for (int k = 0; k < 3; k++)
-            out[6 * n + k] = INFINITY, out[6 * n + 3 + k] = -INFINITY;
-    for (uint32_t v = 0; v < s->vertex_count; v++)
-        for (int k = 0; k < 3; k++) {
-            float *b = out + 6 * (size_t)s->vertex_node[v], x = s->positions[3 * (size_t)v + k];
-            b[k] = fminf(b[k], x), b[3 + k] = fmaxf(b[3 + k], x);
-        }
-}
 
 lm_status lm_moved_nodes_init(lm_moved_nodes *m, const lm_scene *s, lm_error *err)
 {
@@ -54,20 +41,6 @@ static int animated(const lm_scene *s, int node)
     return 0;
 }
 
-/* The world box of local box b under matrix w: its 8 corners transformed. */
-static void world_box(const float b[6], const float w[16], float out[6])
-{
-    for (int k = 0; k < 3; k++)
-        out[k] = INFINITY, out[3 + k] = -INFINITY;
-    for (int c = 0; c < 8; c++) {
-        lm_vec3 p = lm_mat4_point(w, lm_v3(b[c & 1 ? 3 : 0], b[c & 2 ? 4 : 1], b[c & 4 ? 5 : 2]));
-        float q[3];
-        lm_v3_store(q, p);
-        for (int k = 0; k < 3; k++)
-            out[k] = fminf(out[k], q[k]), out[3 + k] = fmaxf(out[3 + k], q[k]);
-    }
-}
-
 int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out)
 {
     int boxes = 0;
@@ -77,8 +50,8 @@ int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out)
             continue;
         const float *b = m->local_box + 6 * n;
         if (b[0] <= b[3] && !animated(s, n)) {
-            world_box(b, seen, out + 6 * boxes++);
-            world_box(b, s->nodes[n].world, out + 6 * boxes++);
+            lm_box_placed(b, seen, out + 6 * boxes++);
+            lm_box_placed(b, s->nodes[n].world, out + 6 * boxes++);
         }
         memcpy(seen, s->nodes[n].world, 16 * sizeof(float));
     }

@@ -4,11 +4,12 @@
  *
  * A node counts when its world matrix changed and no animation drives it (no channel on it or on a node
  * above it that is not itself placed by an edit, lm_node.edited): animated nodes move a little every frame
- * and are the round robin's, as in the paper. Its box is its own vertices' box in its local space under
- * the old and the new matrix (8 corners each), so a child that follows an edited parent counts too.
+ * and are the round robin's, as in the paper. Its box is its triangles' box in its local space
+ * (lm_scene_node_local_boxes) placed by the old and the new matrix (lm_box_placed), so a child that follows
+ * an edited parent counts too.
  *
  * Layout: per node the world matrix last seen (16 floats) and its local box (6 floats; min > max: no
- * vertices). Memory: 88 bytes a node. Cost: O(nodes) a call, O(channels x depth) for a moved node.
+ * triangles). Memory: 88 bytes a node. Cost: O(nodes) a call, O(channels x depth) for a moved node.
  * Deterministic. Not thread-safe: the scene must not change meanwhile. Errors: no memory at init. */
 #ifndef LM_MOVED_NODES_H
 #define LM_MOVED_NODES_H
@@ -24,13 +25,10 @@ typedef struct {
 
 lm_status lm_moved_nodes_init(lm_moved_nodes *m, const lm_scene *s, lm_error *err);
 void lm_moved_nodes_free(lm_moved_nodes *m);
-/* Into out (room for 12 x node_count floats, LM_MOVED_NODE_BOXES a node): for every node with vertices an
+/* Into out (room for 12 x node_count floats, LM_MOVED_NODE_BOXES a node): for every node with triangles an
  * edit moved since the last call (or the init), its world box where it was, then where it is; every node's
  * matrix noted. Returns how many boxes (two a moved node). */
 #define LM_MOVED_NODE_BOXES 12
 int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out);
-/* Every node's box of its own vertices in its local space, 6 floats a node into out (min > max for a node
- * without vertices). O(vertices). */
-void lm_scene_node_local_boxes(const lm_scene *s, float *out);
 
 #endif

@@ -276,6 +276,21 @@ void lm_scene_keep_bounds(lm_scene *s)
     s->bounds_tris = NULL;
 }
 
+void lm_scene_node_local_boxes(const lm_scene *s, float *out)
+{
+    for (int n = 0; n < s->node_count; n++) {
+        const lm_node *node = &s->nodes[n];
+        float *b = out + 6 * (size_t)n;
+        b[0] = b[1] = b[2] = INFINITY, b[3] = b[4] = b[5] = -INFINITY;
+        for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++)
+            for (int k = 0; k < 3; k++) {
+                const float *p = s->positions + 3 * (size_t)s->tris[3 * (size_t)t + (size_t)k];
+                for (int a = 0; a < 3; a++)
+                    b[a] = fminf(b[a], p[a]), b[3 + a] = fmaxf(b[3 + a], p[a]);
+            }
+    }
+}
+
 /* Bounds of the vertices that triangles use (unreferenced vertices don't count). An empty scene gets
  * min > max (size 0). */
 void lm_scene_update_bounds(lm_scene *s)

@@ -314,6 +314,9 @@ void lm_scene_update_bounds(lm_scene *s);
  * corner each time); the scene's node count must not change after. */
 #define LM_NODE_BOUNDS 22
 void lm_scene_keep_bounds(lm_scene *s);
+/* Every node's box of its own triangles' corners in its local space, 6 floats a node into out (min x, y, z,
+ * max x, y, z; min > max for a node without triangles). O(triangles). */
+void lm_scene_node_local_boxes(const lm_scene *s, float *out);
 
 /* Mirror and glass: light leaves them in one direction; they store no photon and get no lightmap texels. */
 static inline int lm_material_is_specular(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLASS; }

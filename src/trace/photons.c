@@ -506,9 +506,8 @@ uint32_t lm_photons_invalidate_boxes(lm_photons *ph, const float *boxes, int n)
     free(padded);
     uint32_t count = 0;
     for (uint32_t gi = 0; gi < ph->group_count; gi++) /* in group order: the queue's order is the same */
-        if (meets[gi]) {
+        if (meets[gi]) { /* not counted in the group's invalidations: those are the round robin's */
             mark_invalid(ph, gi);
-            ph->groups[gi].invalidations++;
             count++;
         }
     free(meets);

@@ -78,17 +78,7 @@ static lm_status node_boxes(lm_reflections *r, const lm_scene *s, lm_error *err)
     r->local_box = malloc(((size_t)s->node_count + 1) * sizeof *r->local_box);
     if (!r->world || !r->local_box)
         return lm_fail(err, LM_ERR_NOMEM, "reflections: no memory");
-    for (int n = 0; n < s->node_count; n++) {
-        const lm_node *node = &s->nodes[n];
-        float *b = r->local_box[n];
-        b[0] = b[1] = b[2] = INFINITY, b[3] = b[4] = b[5] = -INFINITY;
-        for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++)
-            for (int k = 0; k < 3; k++) {
-                const float *p = s->positions + 3 * (size_t)s->tris[3 * (size_t)t + (size_t)k];
-                for (int a = 0; a < 3; a++)
-                    b[a] = fminf(b[a], p[a]), b[3 + a] = fmaxf(b[3 + a], p[a]);
-            }
-    }
+    lm_scene_node_local_boxes(s, &r->local_box[0][0]);
     return LM_OK;
 }
 
@@ -210,13 +200,7 @@ static int world_box(const lm_reflections *r, int n, const float m[16], float ou
     const float *b = r->local_box[n];
     if (!(b[0] <= b[3]))
         return 0;
-    out[0] = out[1] = out[2] = INFINITY, out[3] = out[4] = out[5] = -INFINITY;
-    for (int c = 0; c < 8; c++) {
-        lm_vec3 p = lm_mat4_point(m, lm_v3(b[c & 1 ? 3 : 0], b[c & 2 ? 4 : 1], b[c & 4 ? 5 : 2]));
-        const float q[3] = {p.x, p.y, p.z};
-        for (int a = 0; a < 3; a++)
-            out[a] = fminf(out[a], q[a]), out[3 + a] = fmaxf(out[3 + a], q[a]);
-    }
+    lm_box_placed(b, m, out);
     return 1;
 }
 
