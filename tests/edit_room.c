@@ -250,6 +250,30 @@ double lmt_relative_l1(const float *a, const float *b, size_t n)
     return s > 0.0 ? d / s : d;
 }
 
+double lmt_worst_surface(const lmgi_scene *sc, const float *shown, const float *want)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    int S = in.surfaces;
+    double *d = calloc(3 * (size_t)(S ? S : 1), sizeof *d), worst = 0.0;
+    assert_non_null(d);
+    for (uint32_t t = 0; t < lmgi_texel_count(sc); t++) {
+        lmgi_texel tx;
+        lmgi_get_texel(sc, t, &tx);
+        size_t k = 4 * ((size_t)tx.y * in.atlas_width + tx.x);
+        if (tx.surface < 0 || !(want[k + 3] > 0.0f) || !(shown[k + 3] > 0.0f))
+            continue;
+        for (int c = 0; c < 3; c++)
+            d[3 * tx.surface] += fabs(shown[k + c] - want[k + c]), d[3 * tx.surface + 1] += fabs(want[k + c]);
+        d[3 * tx.surface + 2] += 1.0;
+    }
+    for (int j = 0; j < S; j++)
+        if (d[3 * j + 2] >= 16 && d[3 * j + 1] > 0.0)
+            worst = fmax(worst, d[3 * j] / d[3 * j + 1]);
+    free(d);
+    return worst;
+}
+
 void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first, uint32_t count, double *mean,
                          double *top)
 {

@@ -64,6 +64,9 @@ float *lmt_corner_frame(lmgi_updater *u);
 void lmt_corner_camera(lmgi_camera *cam);
 /* Relative L1 distance of a from b over n floats. */
 double lmt_relative_l1(const float *a, const float *b, size_t n);
+/* The largest relative L1 distance of one surface's texels (16 or more valid in both) in an IIM `shown`
+ * from want's (lmt_iim's layout): the lag tables' "lightmap's worst surface" (lmgi tradeoff --edits). */
+double lmt_worst_surface(const lmgi_scene *sc, const float *shown, const float *want);
 /* Mean and largest irradiance (R + G + B) over the valid texels of triangles [first, first + count) in an
  * IIM (more than 20 of them, or the test fails). */
 void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first, uint32_t count, double *mean,

@@ -1262,6 +1262,8 @@ static void test_light_scale_refined_equals_full(void **state)
     float *shown = malloc(sizeof(float) * 3 * T), *corr = malloc(sizeof(float) * 3 * T);
     float *full_add = malloc(sizeof(float) * 3 * T), *shown_add = malloc(sizeof(float) * 3 * T);
     float *corr_add = malloc(sizeof(float) * 3 * T), *lit_before = floats_copy(before, 4 * cells);
+    float *doubt = malloc(sizeof(float) * T), *full_doubt = malloc(sizeof(float) * T);
+    assert_non_null(doubt), assert_non_null(full_doubt);
     assert_non_null(emissive), assert_non_null(surface), assert_non_null(full), assert_non_null(shown);
     assert_non_null(corr), assert_non_null(full_add), assert_non_null(shown_add), assert_non_null(corr_add);
     for (size_t c = 0; c < cells; c++) {
@@ -1291,7 +1293,7 @@ static void test_light_scale_refined_equals_full(void **state)
                     lit_before[4 * c + k] *= 0.01f;
         }
         uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
-                                            NULL, after, surface, r == 2, 0, full, full_add);
+                                            NULL, after, surface, r == 2, 0, full, full_add, full_doubt);
         assert_false(ls.active); /* no bound: the full quality at once */
         uint32_t added = 0, scaled = 0;
         for (size_t i = 0; i < 3 * T; i++)
@@ -1300,9 +1302,11 @@ static void test_light_scale_refined_equals_full(void **state)
         for (size_t i = 0; i < 3 * T; i++)
             full[i] += full_add[i]; /* the value from 1 */
         uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
-                                              NULL, after, surface, r == 2, budget[r], shown, shown_add);
+                                              NULL, after, surface, r == 2, budget[r], shown, shown_add, doubt);
         for (size_t i = 0; i < 3 * T; i++)
             shown[i] += shown_add[i];
+        for (size_t i = 0; i < T; i++) /* a first guess's few rays leave the doubt to the refinement */
+            assert_true(doubt[i] == 0.0f);
         assert_true(ls.active);
         assert_true(first <= budget[r] + 64 && first < all / 8); /* about what it was given */
         uint32_t left = lm_light_scale_waiting(&ls, &p.atlas);
@@ -1312,8 +1316,9 @@ static void test_light_scale_refined_equals_full(void **state)
         float was[3][3];
         for (int j = 0; j < 3; j++)
             memcpy(was[j], shown + 3 * kept[j], sizeof was[j]);
-        double step = worst_step(&p.atlas, shown);
+        double step = worst_step(&p.atlas, shown), doubt_off = 0.0;
         int steps = 0;
+        uint32_t doubted = 0;
         double first_off = 0.0;
         for (size_t i = 0; i < 3 * T; i++)
             first_off = fmax(first_off, fabs(shown[i] - full[i]) / fmax(fabs(full[i]), 1e-3));
@@ -1323,7 +1328,7 @@ static void test_light_scale_refined_equals_full(void **state)
         const double ms = r == 1 ? 1e-6 : 0.0;
         while (ls.active && steps < 1000) {
             int corrected = 0;
-            uint32_t cast = lm_light_scale_refine(&ls, &w, after, rays, ms, corr, corr_add, &corrected);
+            uint32_t cast = lm_light_scale_refine(&ls, &w, after, rays, ms, corr, corr_add, doubt, &corrected);
             if (r == 1) /* one chunk: at most its texels' rays */
                 assert_true(cast > 0 && cast <= LM_LIGHT_SCALE_CHUNK * 64);
             else /* about what it was given: at most a texel's rays past it */
@@ -1333,6 +1338,9 @@ static void test_light_scale_refined_equals_full(void **state)
             left = now;
             for (size_t i = 0; i < 3 * T; i++)
                 shown[i] = shown[i] * corr[i] + corr_add[i];
+            for (uint32_t i = 0; i < T; i++) /* the refined factors' doubt is the full quality's */
+                if (doubt[i] != 0.0f)
+                    doubted++, doubt_off = fmax(doubt_off, fabs(doubt[i] - full_doubt[i]));
             steps++;
         }
         assert_false(ls.active);
@@ -1365,10 +1373,71 @@ static void test_light_scale_refined_equals_full(void **state)
         assert_true(steps > 10);
         assert_true(compared > 3 * T / 2);
         assert_true(worst < 1e-5);
+        assert_true(doubted > T / 2 && doubt_off < 1e-6);
     }
     lm_light_scale_free(&ls);
     free(after), free(emissive), free(surface), free(full), free(shown), free(corr);
-    free(full_add), free(shown_add), free(corr_add), free(lit_before);
+    free(full_add), free(shown_add), free(corr_add), free(lit_before), free(doubt), free(full_doubt);
+    lm_photon_stage_free(st);
+    lmt_pipeline_free(&p);
+}
+
+/* The doubt of a light edit's factors (light_scale.h, lm_light_scale_begin's doubt): the spread of the
+ * gathers' ratios over a texel's window. Every AIM texel halved, every ray's ratio is the factor and no
+ * texel doubts it (one light lights the scene); the AIM of the atlas's left half halved and the rest kept
+ * (two lights whose shares differ from surface to surface), each texel's rays see the two in different
+ * shares, and the texels doubt their factors. */
+static void test_light_scale_doubt(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
+    lmt_pipeline p;
+    lm_photon_stage *st = photons_at_run_density(&p, path);
+    size_t cells = (size_t)p.atlas.width * p.atlas.height, T = p.atlas.texel_count, S = (size_t)p.atlas.surface_count;
+    size_t ne = 3 * (size_t)p.s->material_count + 3;
+    const float *before = lm_aim_dilated_rgba(lm_photon_stage_aim(st));
+    float *after = floats_copy(before, 4 * cells), *emissive = calloc(ne, sizeof(float));
+    float *surface = malloc(sizeof(float) * 3 * S), *f = malloc(sizeof(float) * 3 * T);
+    float *add = malloc(sizeof(float) * 3 * T), *doubt = malloc(sizeof(float) * T);
+    assert_non_null(emissive), assert_non_null(surface), assert_non_null(f), assert_non_null(add);
+    assert_non_null(doubt);
+    for (size_t i = 0; i < 3 * S; i++)
+        surface[i] = 0.5f;
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
+    lm_light_scale ls;
+    lm_light_scale_init(&ls);
+    for (int m = 0; m < p.s->material_count; m++) /* the emitters halved too */
+        for (int k = 0; k < 3; k++)
+            emissive[3 * m + k] = 2.0f * p.s->materials[m].emissive[k];
+    for (int r = 0; r < 2; r++) { /* all halved; the left half alone */
+        for (size_t c = 0; c < cells; c++)
+            for (int k = 0; k < 3; k++)
+                after[4 * c + k] = before[4 * c + k] *
+                                   (r == 0 || c % (size_t)p.atlas.width < (size_t)p.atlas.width / 2 ? 0.5f : 1.0f);
+        lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), NULL, after, surface,
+                             0, 0, f, add, doubt);
+        double sum = 0.0, most = 0.0, off = 0.0;
+        uint32_t doubted = 0;
+        for (uint32_t i = 0; i < T; i++) {
+            sum += doubt[i], most = fmax(most, doubt[i]), doubted += doubt[i] > 1e-3f;
+            for (int c = 0; c < 3; c++)
+                off = fmax(off, fabs(f[3 * i + c] - 0.5));
+        }
+        print_message("%s: factors at most %.3g from 0.5, doubt mean %.3g, largest %.3g, over 0.001 at %u of %zu "
+                      "texels\n", r == 0 ? "the AIM halved" : "its left half halved", off, sum / (double)T,
+                      most, doubted, T);
+        if (r == 0) {
+            assert_true(off < 1e-5);
+            assert_true(most < 1e-5);
+        } else {
+            assert_true(off > 0.05);
+            assert_true(doubted > T / 4 && sum / (double)T > 1e-3);
+        }
+    }
+    lm_light_scale_free(&ls);
+    free(after), free(emissive), free(surface), free(f), free(add), free(doubt);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }
@@ -1394,6 +1463,8 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
     float *black = calloc(4 * cells, sizeof(float)), *emissive = calloc(ne, sizeof(float));
     float *surface = malloc(sizeof(float) * 3 * S), *f = malloc(sizeof(float) * 3 * T), *add = malloc(sizeof(float) * 3 * T);
     float *corr = malloc(sizeof(float) * 3 * T), *corr_add = malloc(sizeof(float) * 3 * T);
+    float *doubt = malloc(sizeof(float) * T);
+    assert_non_null(doubt);
     assert_non_null(black), assert_non_null(emissive), assert_non_null(surface), assert_non_null(f);
     assert_non_null(add), assert_non_null(corr), assert_non_null(corr_add);
     for (size_t k = 0; k < S; k++)
@@ -1417,13 +1488,13 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
             memcpy(marked, dark, T);
         }
         lm_light_scale_begin(&ls, &w, floats_copy(black, 4 * cells), floats_copy(emissive, ne), marked, black, surface,
-                             0, budget[r], f, add);
+                             0, budget[r], f, add, doubt);
         for (size_t i = 0; i < 3 * T; i++)
             f[i] += add[i]; /* the value of a texel that was 1 */
         int steps = 0;
         while (ls.active && steps++ < 1000) {
             int corrected = 0;
-            lm_light_scale_refine(&ls, &w, black, 700, 0.0, corr, corr_add, &corrected);
+            lm_light_scale_refine(&ls, &w, black, 700, 0.0, corr, corr_add, doubt, &corrected);
             for (size_t i = 0; i < 3 * T; i++)
                 f[i] = f[i] * corr[i] + corr_add[i];
         }
@@ -1440,7 +1511,7 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
     }
     free(dark);
     lm_light_scale_free(&ls);
-    free(black), free(emissive), free(surface), free(f), free(add), free(corr), free(corr_add);
+    free(black), free(emissive), free(surface), free(f), free(add), free(corr), free(corr_add), free(doubt);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }
@@ -1807,6 +1878,7 @@ int main(void)
         cmocka_unit_test(test_rim_smooth),
         cmocka_unit_test(test_rim_pair_same_as_two),
         cmocka_unit_test(test_light_scale_refined_equals_full),
+        cmocka_unit_test(test_light_scale_doubt),
         cmocka_unit_test(test_light_scale_unlit_rays_take_surface_factor),
         cmocka_unit_test(test_cpu_threads_same_iim),
         cmocka_unit_test(test_same_iim_in_any_grouping),

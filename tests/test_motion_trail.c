@@ -296,29 +296,6 @@ static void recolour(lmgi_scene *sc, const char *name)
     assert_int_equal(lmgi_set_material(sc, k, &m, &e), LMGI_OK);
 }
 
-/* The largest relative L1 distance of one surface's texels (16 or more valid in both) from want's. */
-static double worst_surface(const lmgi_scene *sc, const lmgi_info *in, const float *shown, const float *want)
-{
-    int S = in->surfaces;
-    double *d = calloc(3 * (size_t)S, sizeof *d), worst = 0.0;
-    assert_non_null(d);
-    for (uint32_t t = 0; t < lmgi_texel_count(sc); t++) {
-        lmgi_texel tx;
-        lmgi_get_texel(sc, t, &tx);
-        size_t k = 4 * ((size_t)tx.y * in->atlas_width + tx.x);
-        if (tx.surface < 0 || !(want[k + 3] > 0.0f) || !(shown[k + 3] > 0.0f))
-            continue;
-        for (int c = 0; c < 3; c++)
-            d[3 * tx.surface] += fabs(shown[k + c] - want[k + c]), d[3 * tx.surface + 1] += fabs(want[k + c]);
-        d[3 * tx.surface + 2] += 1.0;
-    }
-    for (int j = 0; j < S; j++)
-        if (d[3 * j + 2] >= 16 && d[3 * j + 1] > 0.0)
-            worst = fmax(worst, d[3 * j] / d[3 * j + 1]);
-    free(d);
-    return worst;
-}
-
 /* The red wall recoloured blue (issue 32, items 2 and 6): its first guess (update/light_scale.h) is right
  * to first order only, and the texels it moved most are regathered first (texel_change.h,
  * lm_texel_change_first_guess). Against a fresh bake of the recoloured box, the lightmap's worst surface is
@@ -333,8 +310,6 @@ static void test_recolour_worst_surface_first(void **state)
     lmgi_updater *fresh = updater(ctx, edited, 0.0f, 0);
     size_t n;
     float *want = lmt_iim(fresh, edited, &n);
-    lmgi_info in;
-    lmgi_get_info(edited, &in);
     lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
     lmgi_updater *u = updater(ctx, sc, 0.0f, 0);
     recolour(sc, "red");
@@ -346,7 +321,7 @@ static void test_recolour_worst_surface_first(void **state)
         if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
             fail_msg("%s", e.message);
         float *shown = lmt_iim(u, sc, &n);
-        last = worst_surface(sc, &in, shown, want);
+        last = lmt_worst_surface(sc, shown, want);
         first = f ? first : last;
         within = last < 0.05 ? (within < 0 ? f + 1 : within) : -1;
         free(shown);

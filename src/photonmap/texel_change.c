@@ -72,13 +72,14 @@ lm_status lm_texel_change_init(lm_texel_change *tc, const lm_scene *s, const lm_
     tc->change = calloc(T, sizeof *tc->change);
     tc->lit = calloc(T, sizeof *tc->lit);
     tc->unsettled = calloc(T, sizeof *tc->unsettled);
+    tc->doubt = calloc(T, sizeof *tc->doubt);
     tc->pos = malloc(3 * T * sizeof *tc->pos);
     tc->nrm = malloc(3 * T * sizeof *tc->nrm);
     tc->aim_seen = malloc(3 * T * sizeof *tc->aim_seen);
     tc->texel_node = malloc(T * sizeof *tc->texel_node);
     tc->node_world = malloc(16 * N * sizeof *tc->node_world);
     tc->node_sphere = malloc(4 * N * sizeof *tc->node_sphere);
-    if (!tc->change || !tc->lit || !tc->unsettled || !tc->pos || !tc->nrm || !tc->aim_seen || !tc->texel_node ||
+    if (!tc->change || !tc->lit || !tc->unsettled || !tc->doubt || !tc->pos || !tc->nrm || !tc->aim_seen || !tc->texel_node ||
         !tc->node_world || !tc->node_sphere) {
         lm_texel_change_free(tc);
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for the texels' change estimates (%u texels)",
@@ -101,6 +102,7 @@ void lm_texel_change_free(lm_texel_change *tc)
     free(tc->change);
     free(tc->lit);
     free(tc->unsettled);
+    free(tc->doubt);
     free(tc->pos);
     free(tc->nrm);
     free(tc->aim_seen);
@@ -338,6 +340,12 @@ static void heap_offer(candidate *h, uint32_t *n, uint32_t k, candidate c)
     h[i] = c;
 }
 
+void lm_texel_change_doubt(lm_texel_change *tc, const float *doubt)
+{
+    for (uint32_t i = 0; i < tc->texel_count; i++) /* two standard errors: how far off it may well be */
+        tc->doubt[i] += isfinite(doubt[i]) && doubt[i] > 0.0f ? 2.0f * doubt[i] : 0.0f;
+}
+
 uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t budget,
                               int all, uint32_t *out)
 {
@@ -353,17 +361,20 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
     uint32_t on = 0;
     for (uint32_t i = 0; i < tc->texel_count; i++)
         if (!off[a->texels[i].surface])
-            mean += lm_texel_change_of(tc, i), on++;
+            mean += tc->change[i] + fabsf(tc->lit[i]), on++;
     float floor = all ? tc->threshold : fmaxf(tc->threshold, (float)(LOCAL * mean / (on ? on : 1)));
+    /* a doubted factor is this texel's own error, not a change that reached everything alike: it goes
+     * ahead past the threshold alone */
     for (uint32_t i = 0; i < tc->texel_count; i++) {
         float p = lm_texel_change_of(tc, i);
-        if (p > floor && !off[a->texels[i].surface])
+        if ((p - tc->doubt[i] > floor || tc->doubt[i] > tc->threshold) && p > tc->threshold &&
+            !off[a->texels[i].surface])
             heap_offer(h, &n, k, (candidate){p, i});
     }
     qsort(h, n, sizeof *h, by_change); /* most changed first */
     for (uint32_t j = 0; j < n; j++) {
         out[j] = h[j].texel;
-        tc->change[h[j].texel] = tc->lit[h[j].texel] = 0.0f;
+        tc->change[h[j].texel] = tc->lit[h[j].texel] = tc->doubt[h[j].texel] = 0.0f;
     }
     free(h);
     return n;
@@ -381,12 +392,12 @@ uint32_t lm_texel_change_waiting(const lm_texel_change *tc, const lm_atlas *a, c
 void lm_texel_change_gathered(lm_texel_change *tc, const uint32_t *texels, uint32_t count)
 {
     for (uint32_t j = 0; j < count; j++)
-        tc->change[texels[j]] = tc->lit[texels[j]] = 0.0f;
+        tc->change[texels[j]] = tc->lit[texels[j]] = tc->doubt[texels[j]] = 0.0f;
 }
 
 float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel)
 {
-    return tc->change[texel] + fabsf(tc->lit[texel]);
+    return tc->change[texel] + fabsf(tc->lit[texel]) + tc->doubt[texel];
 }
 
 uint32_t lm_texel_change_settle(lm_texel_change *tc)
@@ -404,6 +415,7 @@ void lm_texel_change_save(const lm_texel_change *tc, float *saved)
     memcpy(saved, tc->change, sizeof *saved * tc->texel_count);
     memcpy(saved + tc->texel_count, tc->lit, sizeof *saved * tc->texel_count);
     memcpy(saved + 2 * (size_t)tc->texel_count, tc->unsettled, sizeof *saved * tc->texel_count);
+    memcpy(saved + 3 * (size_t)tc->texel_count, tc->doubt, sizeof *saved * tc->texel_count);
 }
 
 void lm_texel_change_restore(lm_texel_change *tc, const float *saved)
@@ -411,6 +423,7 @@ void lm_texel_change_restore(lm_texel_change *tc, const float *saved)
     memcpy(tc->change, saved, sizeof *saved * tc->texel_count);
     memcpy(tc->lit, saved + tc->texel_count, sizeof *saved * tc->texel_count);
     memcpy(tc->unsettled, saved + 2 * (size_t)tc->texel_count, sizeof *saved * tc->texel_count);
+    memcpy(tc->doubt, saved + 3 * (size_t)tc->texel_count, sizeof *saved * tc->texel_count);
     tc->any_unsettled = 1;
 }
 

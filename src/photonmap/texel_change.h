@@ -18,10 +18,13 @@
  *     an over-estimate, which only orders the work. When blocks x texels would exceed LM_TEXEL_CHANGE_WORK,
  *     whole surfaces are the emitters instead; past that too, the surface order alone carries it (a change
  *     that reaches everything is not local).
- * A texel's change is the motion sum plus the magnitude of the signed sum. Picking takes the texels whose
- * change is over the threshold and over 4 times the atlas's mean change (a change that reaches everything
- * alike, a light dimmed, is the surfaces' order's to follow), most changed first, then by index, and
- * zeroes them.
+ *   - A light's edit whose factor (update/light_scale.h) is in doubt: twice the factor's relative standard
+ *     error (lm_texel_change_doubt), kept apart, since it is the texel's own error and not a change that
+ *     reached everything alike.
+ * A texel's change is the motion sum plus the magnitude of the signed sum plus the doubt. Picking takes the
+ * texels whose change is over the threshold and, less the doubt, over 4 times the atlas's mean change (a
+ * change that reaches everything alike, a light dimmed, is the surfaces' order's to follow) or whose doubt
+ * alone is over the threshold, most changed first, then by index, and zeroes them.
  * A texel gathered for a move right after it saw the AIMs around as the move's photons had yet to change
  * them (the moved cube's faces saw the floor without its new shadow, 40% too bright, and the AIMs' later
  * refreshes lent them too little change to pass the bar: 200 updates until the surfaces' order came
@@ -30,8 +33,8 @@
  * have caught up.
  *
  * Layout: per atlas texel (lm_atlas.texels order) change, world position and normal (kept current for
- * moved nodes), the unsettled motion sum and the AIM radiance last looked at; per node its last world
- * matrix and local bounding sphere. Memory: 40 bytes a texel, 80 a node.
+ * moved nodes), the unsettled motion sum, the doubt and the AIM radiance last looked at; per node its last
+ * world matrix and local bounding sphere. Memory: 44 bytes a texel, 80 a node.
  * Cost: O(texels of moved nodes + moved nodes x texels) per moved frame; O(blocks x texels) for AIM
  * changes, bounded as said (a few ms); O(texels log budget) to pick. Nothing when nothing changed.
  * Deterministic (fixed order, no threads). Not thread-safe: the scene and AIM must not change meanwhile. */
@@ -54,6 +57,7 @@ typedef struct {
     float *change;        /* per texel: what moved nodes changed (unsigned, summed) */
     float *lit;           /* per texel: what changed AIMs changed, signed (first order in their change) */
     float *unsettled;     /* per texel: the motion sum since the last lm_texel_change_settle */
+    float *doubt;         /* per texel: how far a light edit's factor may be off (lm_texel_change_doubt) */
     int any_unsettled;    /* a move since then (else settling has nothing to scan) */
     float *pos, *nrm;     /* per texel, 3 each, world space as last seen */
     float *aim_seen;      /* per texel, 3: AIM radiance as last looked at */
@@ -91,7 +95,15 @@ void lm_texel_change_scale(lm_texel_change *tc, const lm_atlas *a, const float *
  * blue: the tall block's face toward it kept the first guess's 8.5% for 80 updates, until its surface's
  * refresh came round.) */
 void lm_texel_change_first_guess(lm_texel_change *tc, const float *factor, const float *add);
-/* At most budget texels over the threshold (and, unless `all`, over 4 times the mean: header), not on
+/* A light's edit scaled every IIM texel by a factor whose relative standard error is doubt[texel]
+ * (update/light_scale.h): 0 where one light lights what the texel sees, larger where several do in
+ * different shares. Each texel's change grows by twice it, kept apart from the rest: a doubted texel goes
+ * ahead once that passes the threshold, whatever the atlas's mean change (its error is its own, not a
+ * change that reached everything alike), so that the texels whose factor may be furthest off are
+ * regathered first. */
+void lm_texel_change_doubt(lm_texel_change *tc, const float *doubt);
+/* At most budget texels over the threshold (and, unless `all`, over 4 times the mean or doubted past the
+ * threshold: header), not on
  * surfaces with off[k] set, most changed first, written to out (texel indices) and zeroed. A bake asks for
  * all. Returns how many. */
 uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t budget, int all,
@@ -107,7 +119,7 @@ void lm_texel_change_gathered(lm_texel_change *tc, const uint32_t *texels, uint3
 float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel);
 /* saved (LM_TEXEL_CHANGE_SAVED x texel_count floats) = every texel's change, for a bake that may be
  * cancelled; restore gives it back (what the cancelled bake picked is picked again). */
-#define LM_TEXEL_CHANGE_SAVED 3
+#define LM_TEXEL_CHANGE_SAVED 4
 void lm_texel_change_save(const lm_texel_change *tc, float *saved);
 void lm_texel_change_restore(lm_texel_change *tc, const float *saved);
 

@@ -85,39 +85,80 @@ static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_r
     lm_rim_irradiance_pair(was, now, eye, b, t, n, ng, i, e0, e1);
 }
 
+/* Whether texel i's window at `at` holds the texel dx, dy from it: on its surface and gathered (done).
+ * Gives its index and its weight: where few texels gathered, a tent, so that a gather entering the window
+ * as it moves by one texel weighs little and the sums, and the factors, change smoothly from texel to
+ * texel; where all did, flat (the tent would weigh a texel's own noise more). */
+static int in_window(const lm_atlas *a, const uint8_t *done, quality at, uint32_t i, int dx, int dy, int *q,
+                     double *w)
+{
+    const lm_texel *t = &a->texels[i];
+    int x = (int)t->x + dx, y = (int)t->y + dy;
+    if (x < 0 || y < 0 || x >= a->width || y >= a->height)
+        return 0;
+    *q = a->texel_index[(size_t)y * a->width + x];
+    if (*q < 0 || !done[*q] || a->texels[*q].surface != t->surface)
+        return 0;
+    *w = at.stride > 1 ? (double)(at.spread + 1 - abs(dx)) * (at.spread + 1 - abs(dy)) : 1.0;
+    return 1;
+}
+
+/* The relative standard error of texel i's factors f (the channels with use[c] set), as a ratio estimator
+ * over its window: sqrt(sum w^2 (e1 - f e0)^2) / sum w e1, over the channels together. 0 where every
+ * texel of the window saw its light change by the same factor: one light lights them, and the factor is
+ * exact whatever rays the gathers cast. Where several lights light the window in different shares, the
+ * gathers' few rays per texel each see a different mix, and the spread of their ratios says how far the
+ * sum's ratio may be off (the two rooms' light_a2 removed: a face it lit to 80% kept -21..+20% per texel,
+ * 10% over the surface, for the 35 updates the script watched). */
+static float window_doubt(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
+                          uint32_t i, const float *f, const int *use)
+{
+    double r2 = 0.0, sum = 0.0;
+    for (int dy = -at.spread; dy <= at.spread; dy++)
+        for (int dx = -at.spread; dx <= at.spread; dx++) {
+            int q;
+            double w;
+            if (!in_window(a, done, at, i, dx, dy, &q, &w))
+                continue;
+            for (int c = 0; c < 3; c++)
+                if (use[c]) {
+                    double r = e1[3 * (size_t)q + c] - f[c] * e0[3 * (size_t)q + c];
+                    r2 += w * w * r * r, sum += w * e1[3 * (size_t)q + c];
+                }
+        }
+    double u = sum > 0.0 ? sqrt(r2) / sum : 0.0;
+    return isfinite(u) ? (float)u : 0.0f;
+}
+
 /* Texel i's factor: the ratio of the gathers' sums over the texels of its surface within at.spread of it
  * that gathered (done), a ratio that varies slowly over a surface and is far less noisy summed; 1 where
  * they see no light either way, or where it is within LM_LIGHT_SCALE_KEEP of 1; its surface's where none
  * of them gathered. After an edit that adds light, where they saw next to no light before
  * (LM_LIGHT_SCALE_DARK), no factor can light the texel: its factor is 1 and *add the gathers' mean change,
  * what a regather would add to it to first order (the gathers estimate the IIM's irradiance itself),
- * unless that is under `least` (a negative `least`: no edit that adds, nothing added). */
+ * unless that is under `least` (a negative `least`: no edit that adds, nothing added). *doubt: the
+ * factor's relative standard error (window_doubt), 0 where it is not the window's ratio. */
 static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
                         const float *surface_factor, const uint8_t *black, float least, uint32_t i, float *out,
-                        float *add)
+                        float *add, float *doubt)
 {
     const lm_texel *t = &a->texels[i];
     const int spread = at.spread;
     double s0[3] = {0, 0, 0}, s1[3] = {0, 0, 0}, met = 0.0;
     for (int dy = -spread; dy <= spread; dy++)
         for (int dx = -spread; dx <= spread; dx++) {
-            int x = (int)t->x + dx, y = (int)t->y + dy;
-            if (x < 0 || y < 0 || x >= a->width || y >= a->height)
+            int q;
+            double w;
+            if (!in_window(a, done, at, i, dx, dy, &q, &w))
                 continue;
-            int q = a->texel_index[(size_t)y * a->width + x];
-            if (q < 0 || !done[q] || a->texels[q].surface != t->surface)
-                continue;
-            /* where few texels gathered, a tent: a gather entering the window as it moves by one texel
-             * weighs little, so that the sums, and the factors, change smoothly from texel to texel; where
-             * all did, flat (the tent would weigh a texel's own noise more) */
-            double w = at.stride > 1 ? (double)(spread + 1 - abs(dx)) * (spread + 1 - abs(dy)) : 1.0;
             met += w;
             for (int c = 0; c < 3; c++)
                 s0[c] += w * e0[3 * (size_t)q + c], s1[c] += w * e1[3 * (size_t)q + c];
         }
     const float *own = surface_factor + 3 * t->surface;
     const double full = (double)(spread + 1) * (spread + 1); /* one gather's weight at the window's centre */
-    int keep = 1;
+    int keep = 1, use[3] = {0, 0, 0};
+    float ratio[3] = {1.0f, 1.0f, 1.0f};
     for (int c = 0; c < 3; c++) { /* no neighbour gathered (a large atlas's strides): its surface's */
         int dark = met > 0.0 && least >= 0.0f && s1[c] > LM_LIGHT_SCALE_DARK * s0[c];
         /* rays that met no light either way say nothing of the factor: the surface's own says what its
@@ -128,6 +169,7 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         float f = !(met > 0.0) || dark ? (met > 0.0 ? 1.0f : none) : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : none;
         float d = dark ? (float)((s1[c] - s0[c]) / met) : 0.0f;
         out[c] = isfinite(f) && f >= 0.0f ? f : own[c];
+        use[c] = met > 0.0 && !dark && s0[c] > 0.0 && out[c] == f, ratio[c] = out[c];
         /* where only every stride-th texel gathered, not each surface's first (fewer rays than surfaces), a
          * texel whose window holds less than one gather's weight at its centre leans on its surface's
          * factor as that weight falls: else the factor jumped where the last gather left the window
@@ -139,6 +181,7 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         add[c] = isfinite(d) && d >= least ? d : 0.0f;
         keep &= fabsf(out[c] - 1.0f) < LM_LIGHT_SCALE_KEEP && add[c] == 0.0f;
     }
+    *doubt = keep ? 0.0f : window_doubt(a, e0, e1, done, at, i, ratio, use);
     for (int c = 0; keep && c < 3; c++)
         out[c] = 1.0f;
 }
@@ -173,10 +216,10 @@ static void gather_texels(lm_light_scale *ls, const lm_light_scale_world *w, con
     }
 }
 
-/* The factors and additions of texels [lo, hi), whole surfaces gathered, into f and d (3 per texel,
- * texel lo's first). */
+/* The factors, additions and doubts of texels [lo, hi), whole surfaces gathered, into f and d (3 per texel)
+ * and u (1 per texel), texel lo's first. */
 static void ratios(const lm_light_scale *ls, const lm_atlas *a, quality q, uint32_t lo, uint32_t hi, float *f,
-                   float *d)
+                   float *d, float *u)
 {
     const float *e0 = ls->e, *e1 = ls->e + 3 * (size_t)a->texel_count;
     /* one thread for a small surface: the refinement's surfaces of a few texels each, a parallel region
@@ -184,7 +227,7 @@ static void ratios(const lm_light_scale *ls, const lm_atlas *a, quality q, uint3
 #pragma omp parallel for schedule(static) if (hi - lo > 1024)
     for (long i = (long)lo; i < (long)hi; i++)
         texel_ratio(a, e0, e1, ls->done, q, ls->surface_factor, ls->black, ls->least, (uint32_t)i,
-                    f + 3 * (i - (long)lo), d + 3 * (i - (long)lo));
+                    f + 3 * (i - (long)lo), d + 3 * (i - (long)lo), u + (i - (long)lo));
 }
 
 /* The smallest addition worth a rewrite: LM_LIGHT_SCALE_KEEP of the mean irradiance the gathers of the
@@ -274,7 +317,7 @@ static int plan_order(lm_light_scale *ls, const lm_atlas *a)
 
 uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w, float *before,
                               float *emissive_before, uint8_t *black, const float *after, const float *surface_factor,
-                              int adds, uint32_t rays, float *factor, float *add)
+                              int adds, uint32_t rays, float *factor, float *add, float *doubt)
 {
     const lm_atlas *a = w->atlas;
     size_t T = a->texel_count, S = (size_t)a->surface_count;
@@ -290,6 +333,7 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     ls->added = ls->applied ? malloc(sizeof *ls->added * 3 * T) : NULL;
     if (!ls->added || !ls->surface_factor) {
         surface_factors(a, surface_factor, factor, add);
+        memset(doubt, 0, sizeof *doubt * T);
         lm_light_scale_free(ls);
         return 0;
     }
@@ -312,8 +356,10 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     }
     gather_texels(ls, w, after, q, NULL, (uint32_t)T);
     ls->least = adds ? least_add(ls, a) : -1.0f;
-    ratios(ls, a, q, 0, (uint32_t)T, factor, add);
+    ratios(ls, a, q, 0, (uint32_t)T, factor, add, doubt);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
+    if (coarse) /* a first guess's few rays doubt everything mixed: the refinement's say */
+        memset(doubt, 0, sizeof *doubt * T);
     if (!coarse) { /* the full quality: nothing to refine */
         lm_light_scale_free(ls);
         return cast;
@@ -354,7 +400,7 @@ static uint32_t walk(const lm_light_scale *ls, const lm_atlas *a, quality q, uin
 }
 
 uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, uint32_t rays,
-                               double ms, float *factor, float *add, int *corrected)
+                               double ms, float *factor, float *add, float *doubt, int *corrected)
 {
     *corrected = 0;
     if (!ls->active)
@@ -364,6 +410,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
     rays = rays ? rays : UINT32_MAX; /* no bound (the budget switched off): the rest at once */
     for (size_t c = 0; c < 3 * (size_t)a->texel_count; c++)
         factor[c] = 1.0f, add[c] = 0.0f;
+    memset(doubt, 0, sizeof *doubt * a->texel_count);
     /* this update's texels, over every surface the rays reach, gathered together: a surface at a time, the
      * shared room's surfaces of a few texels each kept one core busy and the other idle, and a
      * refinement's ray cost 3 to 9 times the first guess's, past its plan. In chunks, so that `ms` can
@@ -383,13 +430,14 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
     for (; ls->at < at; ls->at++) { /* the surfaces whose texels have all gathered: their factors */
         int k = ls->order[ls->at];
         uint32_t start = ls->range[2 * k], end = ls->range[2 * k + 1];
-        float *f = malloc(sizeof *f * 6 * (size_t)(end - start)), *d = f + 3 * (size_t)(end - start);
+        float *f = malloc(sizeof *f * 7 * (size_t)(end - start)), *d = f ? f + 3 * (size_t)(end - start) : NULL;
         if (!f) { /* the rest keeps its first guess, which regathers refine */
             lm_light_scale_free(ls);
             return cast;
         }
-        ratios(ls, a, q, start, end, f, d);
-        for (uint32_t i = start; i < end; i++)
+        ratios(ls, a, q, start, end, f, d, d + 3 * (size_t)(end - start));
+        for (uint32_t i = start; i < end; i++) {
+            doubt[i] = ls->kept[i] ? 0.0f : d[3 * (size_t)(end - start) + (i - start)];
             for (int c = 0; c < 3; c++) {
                 size_t j = 3 * (size_t)i + c, o = 3 * (size_t)(i - start) + c;
                 float was = ls->applied[j], now = f[o], had = ls->added[j], adds = d[o];
@@ -399,6 +447,7 @@ uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w
                     continue;
                 factor[j] = now / was, add[j] = adds - had * factor[j], *corrected = 1;
             }
+        }
         free(f);
     }
     ls->next = next;

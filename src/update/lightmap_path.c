@@ -395,16 +395,19 @@ static void follow_scale(lm_lightmap_path *lp)
     lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather};
     const float *after = lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage));
     size_t T = lp->atlas->texel_count;
-    float *texel = lp->have_iim ? malloc(sizeof *texel * 6 * (T + 1)) : NULL, *add = texel ? texel + 3 * T : NULL;
+    float *texel = lp->have_iim ? malloc(sizeof *texel * 7 * (T + 1)) : NULL, *add = texel ? texel + 3 * T : NULL;
+    float *doubt = texel ? texel + 6 * T : NULL;
     uint8_t *scaled = lp->refreshed; /* scratch until lm_lightmap_path_widen takes the refreshed surfaces */
     if (!edit) {
         int corrected = 0;
         lp->scale_cast +=
             texel ? lm_light_scale_refine(&lp->scaling, &w, after, lp->scale_rays, lp->scale_ms_plan, texel, add,
-                                          &corrected)
+                                          doubt, &corrected)
                   : 0;
         if (corrected)
             scale_iim(lp, texel, add, scaled);
+        if (corrected && lp->have_change)
+            lm_texel_change_doubt(&lp->change, doubt);
         free(texel);
         lp->scale_ms += 1e3 * (lm_now() - t0);
         return;
@@ -415,10 +418,12 @@ static void follow_scale(lm_lightmap_path *lp)
     if (texel) {
         uint32_t rays = lp->scale_rays && lp->scale_rays < LM_LIGHT_SCALE_LEAST ? LM_LIGHT_SCALE_LEAST : lp->scale_rays;
         lp->scale_cast += lm_light_scale_begin(&lp->scaling, &w, before, emissive, black_texels(lp), after, lp->scale,
-                                               edit == 2, rays, texel, add);
+                                               edit == 2, rays, texel, add, doubt);
         scale_iim(lp, texel, add, scaled);
         if (lp->have_change && recoloured)
             lm_texel_change_first_guess(&lp->change, texel, add);
+        if (lp->have_change)
+            lm_texel_change_doubt(&lp->change, doubt);
     } else {
         free(before);
         free(emissive);
