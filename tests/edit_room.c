@@ -274,6 +274,22 @@ double lmt_worst_surface(const lmgi_scene *sc, const float *shown, const float *
     return worst;
 }
 
+int lmt_worst_surface_lag(lmgi_updater *u, const lmgi_scene *sc, const float *want, int updates, double *first,
+                          double *last)
+{
+    int within = -1;
+    for (int f = 0; f < updates; f++) {
+        lmt_updates(u, 1);
+        size_t n;
+        float *shown = lmt_iim(u, sc, &n);
+        *last = lmt_worst_surface(sc, shown, want);
+        *first = f ? *first : *last;
+        within = *last < 0.05 ? (within < 0 ? f + 1 : within) : -1;
+        free(shown);
+    }
+    return within;
+}
+
 void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first, uint32_t count, double *mean,
                          double *top)
 {

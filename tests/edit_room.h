@@ -67,6 +67,11 @@ double lmt_relative_l1(const float *a, const float *b, size_t n);
 /* The largest relative L1 distance of one surface's texels (16 or more valid in both) in an IIM `shown`
  * from want's (lmt_iim's layout): the lag tables' "lightmap's worst surface" (lmgi tradeoff --edits). */
 double lmt_worst_surface(const lmgi_scene *sc, const float *shown, const float *want);
+/* `updates` updates at time 0 without a budget, the worst surface against want after each: *first after the
+ * first, *last after the last. Returns the update (from 1) from which it stays within 5%, -1 if it ends
+ * over. */
+int lmt_worst_surface_lag(lmgi_updater *u, const lmgi_scene *sc, const float *want, int updates, double *first,
+                          double *last);
 /* Mean and largest irradiance (R + G + B) over the valid texels of triangles [first, first + count) in an
  * IIM (more than 20 of them, or the test fails). */
 void lmt_triangles_stats(const lmgi_scene *sc, const float *iim, uint32_t first, uint32_t count, double *mean,

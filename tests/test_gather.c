@@ -1249,15 +1249,43 @@ static double worst_step(const lm_atlas *a, const float *v)
     return worst;
 }
 
+/* The Cornell box at `run`'s density, its AIM and a light scale job over it (the default gather settings). */
+typedef struct {
+    lmt_pipeline p;
+    lm_photon_stage *st;
+    size_t cells, T, S, ne; /* atlas cells, texels, surfaces, emission floats */
+    lm_hemicube_settings set;
+    lm_light_scale_world w;
+    lm_light_scale ls;
+} scale_rig;
+
+static void scale_rig_init(scale_rig *g, const char *path)
+{
+    g->st = photons_at_run_density(&g->p, path);
+    g->cells = (size_t)g->p.atlas.width * g->p.atlas.height, g->T = g->p.atlas.texel_count;
+    g->S = (size_t)g->p.atlas.surface_count, g->ne = 3 * (size_t)g->p.s->material_count + 3;
+    lm_hemicube_settings_default(&g->set);
+    g->w = (lm_light_scale_world){g->p.s, &g->p.atlas, g->p.rt, &g->set};
+    lm_light_scale_init(&g->ls);
+}
+
+static void scale_rig_free(scale_rig *g)
+{
+    lm_light_scale_free(&g->ls);
+    lm_photon_stage_free(g->st);
+    lmt_pipeline_free(&g->p);
+}
+
 static void test_light_scale_refined_equals_full(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
-    lmt_pipeline p;
-    lm_photon_stage *st = photons_at_run_density(&p, path);
-    size_t cells = (size_t)p.atlas.width * p.atlas.height, T = p.atlas.texel_count, S = (size_t)p.atlas.surface_count;
-    const float *before = lm_aim_dilated_rgba(lm_photon_stage_aim(st));
-    float *after = floats_copy(before, 4 * cells), *emissive = calloc(3 * (size_t)p.s->material_count + 3, sizeof(float));
+    scale_rig g;
+    scale_rig_init(&g, path);
+    lmt_pipeline *p = &g.p;
+    size_t cells = g.cells, T = g.T, S = g.S, ne = g.ne;
+    const float *before = lm_aim_dilated_rgba(lm_photon_stage_aim(g.st));
+    float *after = floats_copy(before, 4 * cells), *emissive = calloc(ne, sizeof(float));
     float *surface = malloc(sizeof(float) * 3 * S), *full = malloc(sizeof(float) * 3 * T);
     float *shown = malloc(sizeof(float) * 3 * T), *corr = malloc(sizeof(float) * 3 * T);
     float *full_add = malloc(sizeof(float) * 3 * T), *shown_add = malloc(sizeof(float) * 3 * T);
@@ -1267,21 +1295,15 @@ static void test_light_scale_refined_equals_full(void **state)
     assert_non_null(emissive), assert_non_null(surface), assert_non_null(full), assert_non_null(shown);
     assert_non_null(corr), assert_non_null(full_add), assert_non_null(shown_add), assert_non_null(corr_add);
     for (size_t c = 0; c < cells; c++) {
-        float x = (float)(c % (size_t)p.atlas.width) / (float)p.atlas.width;
-        float y = (float)(c / (size_t)p.atlas.width) / (float)p.atlas.height;
+        float x = (float)(c % (size_t)p->atlas.width) / (float)p->atlas.width;
+        float y = (float)(c / (size_t)p->atlas.width) / (float)p->atlas.height;
         after[4 * c] *= 1.5f - x, after[4 * c + 1] *= 0.5f + 0.5f * y;
     }
-    for (int m = 0; m < p.s->material_count; m++)
+    for (int m = 0; m < p->s->material_count; m++)
         for (int k = 0; k < 3; k++) /* what the emitters showed before: twice what they show now */
-            emissive[3 * m + k] = 2.0f * p.s->materials[m].emissive[k];
+            emissive[3 * m + k] = 2.0f * p->s->materials[m].emissive[k];
     for (size_t i = 0; i < 3 * S; i++)
         surface[i] = 0.75f;
-    lm_hemicube_settings set;
-    lm_hemicube_settings_default(&set);
-    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
-    lm_light_scale ls;
-    lm_light_scale_init(&ls);
-    size_t ne = 3 * (size_t)p.s->material_count + 3;
     /* 600 rays: 4 for every stride-th texel and each surface's first; 40: fewer than the surfaces, so
      * only the stride's, the others' their surface's factor; the third run with the dark texels */
     const uint32_t budget[3] = {600, 40, 600};
@@ -1289,34 +1311,35 @@ static void test_light_scale_refined_equals_full(void **state)
         if (r == 2) { /* the emitters dark before, the AIM's left half near black */
             memset(emissive, 0, sizeof *emissive * ne);
             for (size_t c = 0; c < cells; c++)
-                for (int k = 0; k < 3 && c % (size_t)p.atlas.width < (size_t)p.atlas.width / 2; k++)
+                for (int k = 0; k < 3 && c % (size_t)p->atlas.width < (size_t)p->atlas.width / 2; k++)
                     lit_before[4 * c + k] *= 0.01f;
         }
-        uint32_t all = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
+        uint32_t all = lm_light_scale_begin(&g.ls, &g.w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
                                             NULL, after, surface, r == 2, 0, full, full_add, full_doubt);
-        assert_false(ls.active); /* no bound: the full quality at once */
+        assert_false(g.ls.active); /* no bound: the full quality at once */
         uint32_t added = 0, scaled = 0;
         for (size_t i = 0; i < 3 * T; i++)
             added += full_add[i] > 0.0f, scaled += full_add[i] == 0.0f && full[i] != 1.0f;
         assert_true(r < 2 ? added == 0 : added > T / 8 && scaled > T / 8); /* both kinds in the third */
         for (size_t i = 0; i < 3 * T; i++)
             full[i] += full_add[i]; /* the value from 1 */
-        uint32_t first = lm_light_scale_begin(&ls, &w, floats_copy(lit_before, 4 * cells), floats_copy(emissive, ne),
-                                              NULL, after, surface, r == 2, budget[r], shown, shown_add, doubt);
+        uint32_t first = lm_light_scale_begin(&g.ls, &g.w, floats_copy(lit_before, 4 * cells),
+                                              floats_copy(emissive, ne), NULL, after, surface, r == 2, budget[r], shown,
+                                              shown_add, doubt);
         for (size_t i = 0; i < 3 * T; i++)
             shown[i] += shown_add[i];
         for (size_t i = 0; i < T; i++) /* a first guess's few rays leave the doubt to the refinement */
             assert_true(doubt[i] == 0.0f);
-        assert_true(ls.active);
+        assert_true(g.ls.active);
         assert_true(first <= budget[r] + 64 && first < all / 8); /* about what it was given */
-        uint32_t left = lm_light_scale_waiting(&ls, &p.atlas);
+        uint32_t left = lm_light_scale_waiting(&g.ls, &p->atlas);
         assert_int_equal(left, all);
         const uint32_t kept[3] = {0, (uint32_t)T / 2, (uint32_t)T - 1}; /* regathered before the refinement */
-        lm_light_scale_regathered(&ls, kept, 3);
+        lm_light_scale_regathered(&g.ls, kept, 3);
         float was[3][3];
         for (int j = 0; j < 3; j++)
             memcpy(was[j], shown + 3 * kept[j], sizeof was[j]);
-        double step = worst_step(&p.atlas, shown), doubt_off = 0.0;
+        double step = worst_step(&p->atlas, shown), doubt_off = 0.0;
         int steps = 0;
         uint32_t doubted = 0;
         double first_off = 0.0;
@@ -1326,14 +1349,14 @@ static void test_light_scale_refined_equals_full(void **state)
          * the rays (lm_light_scale_refine's ms) */
         const uint32_t rays = r == 1 ? 1u << 30 : 700;
         const double ms = r == 1 ? 1e-6 : 0.0;
-        while (ls.active && steps < 1000) {
+        while (g.ls.active && steps < 1000) {
             int corrected = 0;
-            uint32_t cast = lm_light_scale_refine(&ls, &w, after, rays, ms, corr, corr_add, doubt, &corrected);
+            uint32_t cast = lm_light_scale_refine(&g.ls, &g.w, after, rays, ms, corr, corr_add, doubt, &corrected);
             if (r == 1) /* one chunk: at most its texels' rays */
                 assert_true(cast > 0 && cast <= LM_LIGHT_SCALE_CHUNK * 64);
             else /* about what it was given: at most a texel's rays past it */
                 assert_true(cast > 0 && cast < 700 + 64);
-            uint32_t now = lm_light_scale_waiting(&ls, &p.atlas);
+            uint32_t now = lm_light_scale_waiting(&g.ls, &p->atlas);
             assert_int_equal(now, left - cast);
             left = now;
             for (size_t i = 0; i < 3 * T; i++)
@@ -1343,7 +1366,7 @@ static void test_light_scale_refined_equals_full(void **state)
                     doubted++, doubt_off = fmax(doubt_off, fabs(doubt[i] - full_doubt[i]));
             steps++;
         }
-        assert_false(ls.active);
+        assert_false(g.ls.active);
         assert_int_equal(left, 0);
         double worst = 0.0;
         uint32_t compared = 0;
@@ -1375,11 +1398,9 @@ static void test_light_scale_refined_equals_full(void **state)
         assert_true(worst < 1e-5);
         assert_true(doubted > T / 2 && doubt_off < 1e-6);
     }
-    lm_light_scale_free(&ls);
     free(after), free(emissive), free(surface), free(full), free(shown), free(corr);
     free(full_add), free(shown_add), free(corr_add), free(lit_before), free(doubt), free(full_doubt);
-    lm_photon_stage_free(st);
-    lmt_pipeline_free(&p);
+    scale_rig_free(&g);
 }
 
 /* The doubt of a light edit's factors (light_scale.h, lm_light_scale_begin's doubt): the spread of the
@@ -1391,11 +1412,11 @@ static void test_light_scale_doubt(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
-    lmt_pipeline p;
-    lm_photon_stage *st = photons_at_run_density(&p, path);
-    size_t cells = (size_t)p.atlas.width * p.atlas.height, T = p.atlas.texel_count, S = (size_t)p.atlas.surface_count;
-    size_t ne = 3 * (size_t)p.s->material_count + 3;
-    const float *before = lm_aim_dilated_rgba(lm_photon_stage_aim(st));
+    scale_rig g;
+    scale_rig_init(&g, path);
+    lmt_pipeline *p = &g.p;
+    size_t cells = g.cells, T = g.T, S = g.S, ne = g.ne;
+    const float *before = lm_aim_dilated_rgba(lm_photon_stage_aim(g.st));
     float *after = floats_copy(before, 4 * cells), *emissive = calloc(ne, sizeof(float));
     float *surface = malloc(sizeof(float) * 3 * S), *f = malloc(sizeof(float) * 3 * T);
     float *add = malloc(sizeof(float) * 3 * T), *doubt = malloc(sizeof(float) * T);
@@ -1403,21 +1424,16 @@ static void test_light_scale_doubt(void **state)
     assert_non_null(doubt);
     for (size_t i = 0; i < 3 * S; i++)
         surface[i] = 0.5f;
-    lm_hemicube_settings set;
-    lm_hemicube_settings_default(&set);
-    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
-    lm_light_scale ls;
-    lm_light_scale_init(&ls);
-    for (int m = 0; m < p.s->material_count; m++) /* the emitters halved too */
+    for (int m = 0; m < p->s->material_count; m++) /* the emitters halved too */
         for (int k = 0; k < 3; k++)
-            emissive[3 * m + k] = 2.0f * p.s->materials[m].emissive[k];
+            emissive[3 * m + k] = 2.0f * p->s->materials[m].emissive[k];
     for (int r = 0; r < 2; r++) { /* all halved; the left half alone */
         for (size_t c = 0; c < cells; c++)
             for (int k = 0; k < 3; k++)
                 after[4 * c + k] = before[4 * c + k] *
-                                   (r == 0 || c % (size_t)p.atlas.width < (size_t)p.atlas.width / 2 ? 0.5f : 1.0f);
-        lm_light_scale_begin(&ls, &w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), NULL, after, surface,
-                             0, 0, f, add, doubt);
+                                   (r == 0 || c % (size_t)p->atlas.width < (size_t)p->atlas.width / 2 ? 0.5f : 1.0f);
+        lm_light_scale_begin(&g.ls, &g.w, floats_copy(before, 4 * cells), floats_copy(emissive, ne), NULL, after,
+                             surface, 0, 0, f, add, doubt);
         double sum = 0.0, most = 0.0, off = 0.0;
         uint32_t doubted = 0;
         for (uint32_t i = 0; i < T; i++) {
@@ -1436,10 +1452,8 @@ static void test_light_scale_doubt(void **state)
             assert_true(doubted > T / 4 && sum / (double)T > 1e-3);
         }
     }
-    lm_light_scale_free(&ls);
     free(after), free(emissive), free(surface), free(f), free(add), free(doubt);
-    lm_photon_stage_free(st);
-    lmt_pipeline_free(&p);
+    scale_rig_free(&g);
 }
 
 /* Texels whose rays meet no light, before the edit or after, take their surface's factor: the rays say
@@ -1454,12 +1468,12 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
-    lmt_pipeline p;
-    lm_photon_stage *st = photons_at_run_density(&p, path);
-    size_t cells = (size_t)p.atlas.width * p.atlas.height, T = p.atlas.texel_count, S = (size_t)p.atlas.surface_count;
-    size_t ne = 3 * (size_t)p.s->material_count + 3;
-    for (int m = 0; m < p.s->material_count; m++) /* the emitters dark now, and before (emissive below) */
-        memset(p.s->materials[m].emissive, 0, sizeof p.s->materials[m].emissive);
+    scale_rig g;
+    scale_rig_init(&g, path);
+    lmt_pipeline *p = &g.p;
+    size_t cells = g.cells, T = g.T, S = g.S, ne = g.ne;
+    for (int m = 0; m < p->s->material_count; m++) /* the emitters dark now, and before (emissive below) */
+        memset(p->s->materials[m].emissive, 0, sizeof p->s->materials[m].emissive);
     float *black = calloc(4 * cells, sizeof(float)), *emissive = calloc(ne, sizeof(float));
     float *surface = malloc(sizeof(float) * 3 * S), *f = malloc(sizeof(float) * 3 * T), *add = malloc(sizeof(float) * 3 * T);
     float *corr = malloc(sizeof(float) * 3 * T), *corr_add = malloc(sizeof(float) * 3 * T);
@@ -1470,11 +1484,6 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
     for (size_t k = 0; k < S; k++)
         for (int c = 0; c < 3; c++)
             surface[3 * k + c] = 0.5f + 0.02f * (float)k + 0.1f * (float)c;
-    lm_hemicube_settings set;
-    lm_hemicube_settings_default(&set);
-    lm_light_scale_world w = {p.s, &p.atlas, p.rt, &set};
-    lm_light_scale ls;
-    lm_light_scale_init(&ls);
     /* the full quality at once; a first guess, then refined; each again with every other texel black */
     const uint32_t budget[4] = {0, 600, 0, 600};
     uint8_t *dark = malloc(T);
@@ -1487,33 +1496,31 @@ static void test_light_scale_unlit_rays_take_surface_factor(void **state)
             assert_non_null(marked = malloc(T));
             memcpy(marked, dark, T);
         }
-        lm_light_scale_begin(&ls, &w, floats_copy(black, 4 * cells), floats_copy(emissive, ne), marked, black, surface,
-                             0, budget[r], f, add, doubt);
+        lm_light_scale_begin(&g.ls, &g.w, floats_copy(black, 4 * cells), floats_copy(emissive, ne), marked, black,
+                             surface, 0, budget[r], f, add, doubt);
         for (size_t i = 0; i < 3 * T; i++)
             f[i] += add[i]; /* the value of a texel that was 1 */
         int steps = 0;
-        while (ls.active && steps++ < 1000) {
+        while (g.ls.active && steps++ < 1000) {
             int corrected = 0;
-            lm_light_scale_refine(&ls, &w, black, 700, 0.0, corr, corr_add, doubt, &corrected);
+            lm_light_scale_refine(&g.ls, &g.w, black, 700, 0.0, corr, corr_add, doubt, &corrected);
             for (size_t i = 0; i < 3 * T; i++)
                 f[i] = f[i] * corr[i] + corr_add[i];
         }
-        assert_false(ls.active);
+        assert_false(g.ls.active);
         double worst = 0.0;
         for (uint32_t i = 0; i < T; i++)
             for (int c = 0; c < 3; c++) /* a black texel keeps 1 */
-                worst = fmax(worst, fabs(f[3 * i + c] - (r >= 2 && dark[i] ? 1.0f
-                                                                            : surface[3 * p.atlas.texels[i].surface + c])));
+                worst = fmax(worst, fabs(f[3 * i + c] -
+                                         (r >= 2 && dark[i] ? 1.0f : surface[3 * p->atlas.texels[i].surface + c])));
         print_message("rays meeting no light, %s%s: every texel its surface's factor to %.3g\n",
                       r % 2 ? "a first guess refined" : "the full quality at once",
                       r < 2 ? "" : ", every other texel black (1)", worst);
         assert_true(worst < 1e-6); /* 1 in every texel before */
     }
     free(dark);
-    lm_light_scale_free(&ls);
     free(black), free(emissive), free(surface), free(f), free(add), free(corr), free(corr_add), free(doubt);
-    lm_photon_stage_free(st);
-    lmt_pipeline_free(&p);
+    scale_rig_free(&g);
 }
 
 /* A pass's CPU share (the emitters' closed form, the rim's rays, the covered test) on one thread or on

@@ -1112,7 +1112,8 @@ static void test_removed_light_doubted_first(void **state)
     memset(&d, 0, sizeof d); /* the defaults */
     lmgi_updater *u = NULL, *fresh = NULL;
     assert_int_equal(lmgi_remove_light(edited, lmt_light_on_node(edited, "light_a2"), &e), LMGI_OK);
-    if (lmgi_updater_create(ctx, edited, &d, &fresh, &e) != LMGI_OK || lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+    if (lmgi_updater_create(ctx, edited, &d, &fresh, &e) != LMGI_OK ||
+        lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
         fail_msg("%s", e.message);
     size_t n;
     float *want = lmt_iim(fresh, edited, &n);
@@ -1120,15 +1121,7 @@ static void test_removed_light_doubted_first(void **state)
     assert_int_equal(lmgi_remove_light(sc, lmt_light_on_node(sc, "light_a2"), &e), LMGI_OK);
     enum { UPDATES = 40 };
     double first = 0.0, last = 0.0;
-    int within = -1; /* the update from which the worst surface stays within 5% */
-    for (int f = 0; f < UPDATES; f++) {
-        lmt_updates(u, 1);
-        float *shown = lmt_iim(u, sc, &n);
-        last = lmt_worst_surface(sc, shown, want);
-        first = f ? first : last;
-        within = last < 0.05 ? (within < 0 ? f + 1 : within) : -1;
-        free(shown);
-    }
+    int within = lmt_worst_surface_lag(u, sc, want, UPDATES, &first, &last);
     print_message("light_a2 removed, 20 texels an update: the worst surface %.3f off a fresh updater's at the next "
                   "update, within 5%% from update %d on, %.3f after %d\n", first, within, last, UPDATES);
     assert_true(first > 0.05);

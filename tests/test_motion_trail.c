@@ -315,17 +315,7 @@ static void test_recolour_worst_surface_first(void **state)
     recolour(sc, "red");
     enum { UPDATES = 40 };
     double first = 0.0, last = 0.0;
-    int within = -1; /* the update from which the worst surface stays within 5% */
-    lmgi_error e;
-    for (int f = 0; f < UPDATES; f++) {
-        if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
-            fail_msg("%s", e.message);
-        float *shown = lmt_iim(u, sc, &n);
-        last = lmt_worst_surface(sc, shown, want);
-        first = f ? first : last;
-        within = last < 0.05 ? (within < 0 ? f + 1 : within) : -1;
-        free(shown);
-    }
+    int within = lmt_worst_surface_lag(u, sc, want, UPDATES, &first, &last);
     print_message("red wall recoloured, 20 texels an update: the worst surface %.3f off a fresh bake at the next "
                   "update, within 5%% from update %d on, %.3f after %d\n", first, within, last, UPDATES);
     assert_true(first > 0.05);
