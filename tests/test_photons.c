@@ -879,9 +879,12 @@ static int edit_cube(world *w, lm_moved_nodes *mv, float *boxes)
     m[14] += 0.5f;
     memcpy(w->s->nodes[cube].world, m, sizeof m); /* as its animation would: no box */
     assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes), 0);
+    lm_error err; /* its paths caught up, as the round robin would in time */
+    assert_int_equal(lm_rt_set_node_transform(w->rt, cube, w->s->nodes[cube].world, &err), LM_OK);
+    lm_photon_frame_stats st;
+    assert_int_equal(lm_photons_trace_all(w->ph, &st, &err), LM_OK);
     m[12] -= 0.1f;
     assert_true(lm_scene_set_node_world(w->s, cube, m)); /* an edit */
-    lm_error err;
     assert_int_equal(lm_rt_set_node_transform(w->rt, cube, w->s->nodes[cube].world, &err), LM_OK);
     int n = lm_moved_nodes_boxes(mv, w->s, boxes);
     assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes), 0); /* seen once */
@@ -902,9 +905,11 @@ static uint32_t paths_behind(world *w)
 }
 
 /* An edit's move (scene/moved_nodes.h): the groups whose stored paths cross the node's box where it was or
- * where it is now are queued at once (lm_photons_invalidate_boxes); re-tracing them leaves 12 of the 630
- * changed paths behind for the round robin, those the test cannot see (a last leg that left the scene is not
- * stored). An animated node is the round robin's alone: no box. */
+ * where it is now are queued at once (lm_photons_invalidate_boxes), and re-tracing them leaves none of the
+ * 346 changed paths behind. An animated node is the round robin's alone: no box (the paths its move changed
+ * are caught up first, as the round robin would in time; left out, 12 of them, which hit the cube where it
+ * stood before, stayed behind). The two rooms are closed: no path leaves the scene, whose last leg the test
+ * could not see (it is not stored). */
 static void test_moved_node_boxes_queue_its_paths(void **state)
 {
     (void)state;
@@ -947,7 +952,7 @@ static void test_moved_node_boxes_queue_its_paths(void **state)
     assert_true(queued > 0 && queued < G);
     assert_int_equal(b_lights, 0);
     assert_true(changed > 100);
-    assert_true(behind * 20 < changed);
+    assert_int_equal(behind, 0);
     free(boxes);
     for (int k = 0; k < 2; k++) {
         lm_moved_nodes_free(&mv[k]);
