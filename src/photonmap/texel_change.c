@@ -79,8 +79,8 @@ lm_status lm_texel_change_init(lm_texel_change *tc, const lm_scene *s, const lm_
     tc->texel_node = malloc(T * sizeof *tc->texel_node);
     tc->node_world = malloc(16 * N * sizeof *tc->node_world);
     tc->node_sphere = malloc(4 * N * sizeof *tc->node_sphere);
-    if (!tc->change || !tc->lit || !tc->unsettled || !tc->doubt || !tc->pos || !tc->nrm || !tc->aim_seen || !tc->texel_node ||
-        !tc->node_world || !tc->node_sphere) {
+    if (!tc->change || !tc->lit || !tc->unsettled || !tc->doubt || !tc->pos || !tc->nrm || !tc->aim_seen ||
+        !tc->texel_node || !tc->node_world || !tc->node_sphere) {
         lm_texel_change_free(tc);
         return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for the texels' change estimates (%u texels)",
                        a->texel_count);

@@ -103,9 +103,8 @@ void lm_texel_change_first_guess(lm_texel_change *tc, const float *factor, const
  * regathered first. */
 void lm_texel_change_doubt(lm_texel_change *tc, const float *doubt);
 /* At most budget texels over the threshold (and, unless `all`, over 4 times the mean or doubted past the
- * threshold: header), not on
- * surfaces with off[k] set, most changed first, written to out (texel indices) and zeroed. A bake asks for
- * all. Returns how many. */
+ * threshold: header), not on surfaces with off[k] set, most changed first, written to out (texel indices)
+ * and zeroed. A bake asks for all. Returns how many. */
 uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t budget, int all,
                               uint32_t *out);
 /* The texels over the threshold, not on surfaces with off[k] set, in texel order, into out: those still

@@ -108,8 +108,8 @@ static int in_window(const lm_atlas *a, const uint8_t *done, quality at, uint32_
  * texel of the window saw its light change by the same factor: one light lights them, and the factor is
  * exact whatever rays the gathers cast. Where several lights light the window in different shares, the
  * gathers' few rays per texel each see a different mix, and the spread of their ratios says how far the
- * sum's ratio may be off (the two rooms' light_a2 removed: a face it lit to 80% kept -21..+20% per texel,
- * 10% over the surface, for the 35 updates the script watched). */
+ * sum's ratio may be off (the two rooms' light_a2 removed: a face it lit to 80% read -21..+20% per texel,
+ * 10% over the face, and kept it for the 75 updates the surfaces' order spent elsewhere). */
 static float window_doubt(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
                           uint32_t i, const float *f, const int *use)
 {
@@ -169,7 +169,8 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         float f = !(met > 0.0) || dark ? (met > 0.0 ? 1.0f : none) : s0[c] > 0.0 ? (float)(s1[c] / s0[c]) : none;
         float d = dark ? (float)((s1[c] - s0[c]) / met) : 0.0f;
         out[c] = isfinite(f) && f >= 0.0f ? f : own[c];
-        use[c] = met > 0.0 && !dark && s0[c] > 0.0 && out[c] == f, ratio[c] = out[c];
+        use[c] = met > 0.0 && !dark && s0[c] > 0.0 && out[c] == f;
+        ratio[c] = out[c];
         /* where only every stride-th texel gathered, not each surface's first (fewer rays than surfaces), a
          * texel whose window holds less than one gather's weight at its centre leans on its surface's
          * factor as that weight falls: else the factor jumped where the last gather left the window
@@ -358,12 +359,11 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     ls->least = adds ? least_add(ls, a) : -1.0f;
     ratios(ls, a, q, 0, (uint32_t)T, factor, add, doubt);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
-    if (coarse) /* a first guess's few rays doubt everything mixed: the refinement's say */
-        memset(doubt, 0, sizeof *doubt * T);
     if (!coarse) { /* the full quality: nothing to refine */
         lm_light_scale_free(ls);
         return cast;
     }
+    memset(doubt, 0, sizeof *doubt * T); /* a first guess's few rays doubt all that is mixed: the refinement's say */
     memcpy(ls->applied, factor, sizeof *factor * 3 * T);
     memcpy(ls->added, add, sizeof *add * 3 * T);
     ls->active = plan_order(ls, a);

@@ -28,7 +28,8 @@
  * regathered first (photonmap/texel_change.h, lm_texel_change_doubt): in the two rooms, light_a2 removed
  * left a face it lit to 80% 6.5% off the converged lightmap (up to 21% a texel) while the surfaces' order
  * went elsewhere, for 75 updates; with the doubt first, within 5% in 18 (test_light_edits). A first guess
- * of a few rays doubts nothing: its refinement says it, surface by surface. A texel whose rays met no light before takes its surface's factor (rays
+ * of a few rays doubts nothing: its refinement says it, surface by surface.
+ * A texel whose rays met no light before takes its surface's factor (rays
  * that met none either way say nothing of it; its surface's light does, unless the IIM shows it black:
  * scaling 0 would rewrite it for nothing, outside the edit's reach), except after an edit that `adds`
  * light where there may have been none (a light added or switched on: a dark room whose lamp comes on):
@@ -144,8 +145,9 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
  * texel's; 0: every one left), or, past `ms` milliseconds (> 0), at the end of the chunk of
  * LM_LIGHT_SCALE_CHUNK texels under way (the first chunk always): factor and add (texel_count x 3 each)
  * get the correction of each texel of the surfaces that completed (IIM x factor + add), 1 and 0
- * elsewhere, and doubt (texel_count) their refined factors' relative standard error, 0 elsewhere; *corrected: whether any is not (else the IIM needs no pass). Returns the rays cast (0: no job
- * under way). With ms the texels reached depend on the machine's speed, as any budget's work does. */
+ * elsewhere, and doubt (texel_count) their refined factors' relative standard error, 0 elsewhere;
+ * *corrected: whether any is not (else the IIM needs no pass). Returns the rays cast (0: no job under
+ * way). With ms the texels reached depend on the machine's speed, as any budget's work does. */
 uint32_t lm_light_scale_refine(lm_light_scale *ls, const lm_light_scale_world *w, const float *after, uint32_t rays,
                                double ms, float *factor, float *add, float *doubt, int *corrected);
 /* The texels (atlas texel indices) regathered this update: they keep their fresh value. */
