@@ -1108,13 +1108,8 @@ static void test_removed_light_doubted_first(void **state)
     if (lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &sc, &e) != LMGI_OK ||
         lmgi_load(lmt_project_scene("two_rooms.glb"), &o, &edited, &e) != LMGI_OK)
         fail_msg("%s", e.message);
-    lmgi_updater_desc d;
-    memset(&d, 0, sizeof d); /* the defaults */
-    lmgi_updater *u = NULL, *fresh = NULL;
     assert_int_equal(lmgi_remove_light(edited, lmt_light_on_node(edited, "light_a2"), &e), LMGI_OK);
-    if (lmgi_updater_create(ctx, edited, &d, &fresh, &e) != LMGI_OK ||
-        lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
+    lmgi_updater *fresh = lmt_updater(ctx, edited), *u = lmt_updater(ctx, sc); /* the defaults */
     size_t n;
     float *want = lmt_iim(fresh, edited, &n);
     lmt_updates(u, 5);

@@ -285,10 +285,7 @@ static void test_one_move_refined(void **state)
 /* Material `name` of sc recoloured as bench/cornell_edits.json does the red wall. */
 static void recolour(lmgi_scene *sc, const char *name)
 {
-    int k = 0;
-    while (lmgi_material_name(sc, k) && strcmp(lmgi_material_name(sc, k), name))
-        k++;
-    assert_non_null(lmgi_material_name(sc, k));
+    int k = lmt_material_named(sc, name);
     lmgi_material m;
     lmgi_error e;
     assert_int_equal(lmgi_get_material(sc, k, &m, &e), LMGI_OK);

@@ -137,7 +137,7 @@ static float window_doubt(const lm_atlas *a, const float *e0, const float *e1, c
  * (LM_LIGHT_SCALE_DARK), no factor can light the texel: its factor is 1 and *add the gathers' mean change,
  * what a regather would add to it to first order (the gathers estimate the IIM's irradiance itself),
  * unless that is under `least` (a negative `least`: no edit that adds, nothing added). *doubt: the
- * factor's relative standard error (window_doubt), 0 where it is not the window's ratio. */
+ * factor's relative standard error (window_doubt), 0 where it is not the window's ratio (NULL: not wanted). */
 static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
                         const float *surface_factor, const uint8_t *black, float least, uint32_t i, float *out,
                         float *add, float *doubt)
@@ -182,7 +182,8 @@ static void texel_ratio(const lm_atlas *a, const float *e0, const float *e1, con
         add[c] = isfinite(d) && d >= least ? d : 0.0f;
         keep &= fabsf(out[c] - 1.0f) < LM_LIGHT_SCALE_KEEP && add[c] == 0.0f;
     }
-    *doubt = keep ? 0.0f : window_doubt(a, e0, e1, done, at, i, ratio, use);
+    if (doubt)
+        *doubt = keep ? 0.0f : window_doubt(a, e0, e1, done, at, i, ratio, use);
     for (int c = 0; keep && c < 3; c++)
         out[c] = 1.0f;
 }
@@ -218,7 +219,7 @@ static void gather_texels(lm_light_scale *ls, const lm_light_scale_world *w, con
 }
 
 /* The factors, additions and doubts of texels [lo, hi), whole surfaces gathered, into f and d (3 per texel)
- * and u (1 per texel), texel lo's first. */
+ * and u (1 per texel; NULL: no doubts), texel lo's first. */
 static void ratios(const lm_light_scale *ls, const lm_atlas *a, quality q, uint32_t lo, uint32_t hi, float *f,
                    float *d, float *u)
 {
@@ -228,7 +229,7 @@ static void ratios(const lm_light_scale *ls, const lm_atlas *a, quality q, uint3
 #pragma omp parallel for schedule(static) if (hi - lo > 1024)
     for (long i = (long)lo; i < (long)hi; i++)
         texel_ratio(a, e0, e1, ls->done, q, ls->surface_factor, ls->black, ls->least, (uint32_t)i,
-                    f + 3 * (i - (long)lo), d + 3 * (i - (long)lo), u + (i - (long)lo));
+                    f + 3 * (i - (long)lo), d + 3 * (i - (long)lo), u ? u + (i - (long)lo) : NULL);
 }
 
 /* The smallest addition worth a rewrite: LM_LIGHT_SCALE_KEEP of the mean irradiance the gathers of the
@@ -357,7 +358,7 @@ uint32_t lm_light_scale_begin(lm_light_scale *ls, const lm_light_scale_world *w,
     }
     gather_texels(ls, w, after, q, NULL, (uint32_t)T);
     ls->least = adds ? least_add(ls, a) : -1.0f;
-    ratios(ls, a, q, 0, (uint32_t)T, factor, add, doubt);
+    ratios(ls, a, q, 0, (uint32_t)T, factor, add, coarse ? NULL : doubt);
     uint32_t cast = rays_of(a, 0, (uint32_t)T, q);
     if (!coarse) { /* the full quality: nothing to refine */
         lm_light_scale_free(ls);
