@@ -183,7 +183,10 @@ LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
  * The rule between edits and animations: an edit wins. A moved node's own animation channels stop
  * driving it (lmgi_set_time and updates play the others), until lmgi_node_resume_animation hands it
  * back; its children's channels still play, relative to where it now is. An updater sees an edit at
- * its next lmgi_update, as it sees an animation's move. */
+ * its next lmgi_update, as it sees an animation's move. Without a time budget, a move after an update in
+ * which no edit moved a node is caught up in one go: the photon paths it changed are re-traced and the
+ * AIMs they reach refreshed beside that update, whatever photons.group_budget and
+ * aim.surfaces_per_frame say; moves in update after update stay within those counts (docs/api.md). */
 LMGI_API int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
 LMGI_API int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
 /* A fingerprint of the scene's geometry: the names of the nodes that hold triangles, in order, and each
@@ -271,10 +274,10 @@ LMGI_API lmgi_status lmgi_get_light(const lmgi_scene *scene, int light, lmgi_lig
  * removed: LMGI_ERR_INVALID, nothing changed. */
 LMGI_API lmgi_status lmgi_set_light(lmgi_scene *scene, int light, const lmgi_light *l, lmgi_error *err);
 /* Adds a light of any type, placed by l's position and direction (l->node is ignored), and returns its
- * id in *id (the next one; -1 on failure). An updater traces its photons from its next update on: as
- * many per unit of power as the scene's lights at the updater's creation got (the mean light's count for
- * a light added dark), in its own groups under the group budget, so the frames that follow catch up on
- * it like after a light's move; no other light's photons change. The values as lmgi_set_light checks
+ * id in *id (the next one; -1 on failure). An updater traces its photons at its next update: as many
+ * per unit of power as the scene's lights at the updater's creation got (the mean light's count for a
+ * light added dark), in its own groups, all at once for a light that gives light, whatever the budget
+ * (docs/tradeoff.md, "Lights added or switched on"); no other light's photons change. The values as lmgi_set_light checks
  * them, plus a spot or directional light's direction not 0: LMGI_ERR_INVALID, nothing added. */
 LMGI_API lmgi_status lmgi_add_light(lmgi_scene *scene, const lmgi_light *l, int *id, lmgi_error *err);
 /* Removes a light (the file's or an added one): from the next update on it emits nothing, its photons'

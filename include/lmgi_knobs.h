@@ -98,7 +98,7 @@ static inline int lmgi_knob_is_pow2(double v)
     X(photons, group_budget, LMGI_KNOB_INT, int, 16, 1, 10000000, 1, LMGI_NO_RULE, "--group-budget", "B",         \
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
       "invalid photon groups re-traced a frame, oldest first (default 16; 0: every\n"                             \
-      "one at once)")                                                                                              \
+      "one at once; a node moved after a still frame: all its groups at once)")                                  \
     X(photons, seed, LMGI_KNOB_COUNT, uint32_t, 0, 0, 4294967295.0, 0, LMGI_NO_RULE, NULL, NULL,                   \
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                          \
       "another, disjoint stretch of the Halton sequence (0: the default one; lmgi: --seed)")                      \
@@ -122,7 +122,9 @@ static inline int lmgi_knob_is_pow2(double v)
       "times that at another N (default 1): where N hits lie closer, every hit\n"                                \
       "within it is summed; smaller makes the AIM sharper and noisier (docs/aim.md)")                             \
     X(aim, surfaces_per_frame, LMGI_KNOB_INT, int, 4, 1, 10000000, 1, LMGI_NO_RULE, "--surfaces-per-frame", "K",  \
-      LMGI_CLI_ZERO_DEFAULT, LMGI_NO_CHOICES, LMGI_NO_SWEEP, "AIM refreshes a frame (default 4)")                 \
+      LMGI_CLI_ZERO_DEFAULT, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                       \
+      "AIM refreshes a frame (default 4; a node moved after a still frame: all\n"                                  \
+      "that its photons changed)")                                                                                 \
     X(aim, direct, LMGI_KNOB_CHOICE, lmgi_aim_direct, LMGI_AIM_DIRECT_SUNS, 0, 0, 0, LMGI_NO_RULE,                \
       "--aim-direct", "M", LMGI_CLI_ZERO_NONE, LMGI_AIM_DIRECT_CHOICES,                                           \
       LMGI_SWEEP(10, "aim_direct", "AIM direct light (0 suns, 3 photons, 1 emitters)", (0, 3, 1), (0, 3), 0),    \

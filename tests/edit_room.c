@@ -190,10 +190,17 @@ float *lmt_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n)
 
 void lmt_updates(lmgi_updater *u, int n)
 {
-    lmgi_error e;
     for (int k = 0; k < n; k++)
-        if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
-            fail_msg("%s", e.message);
+        lmt_update(u);
+}
+
+lmgi_update_stats lmt_update(lmgi_updater *u)
+{
+    lmgi_update_stats st;
+    lmgi_error e;
+    if (lmgi_update(u, 0.0f, 0.0f, &st, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return st;
 }
 
 void lmt_bake(lmgi_updater *u, lmgi_bake_report *r)

@@ -57,6 +57,8 @@ float *lmt_iim(lmgi_updater *u, const lmgi_scene *sc, size_t *n);
 void lmt_bake(lmgi_updater *u, lmgi_bake_report *r);
 /* n updates at time 0 without a time budget; fails the test on an error. */
 void lmt_updates(lmgi_updater *u, int n);
+/* One such update, and what it did. */
+lmgi_update_stats lmt_update(lmgi_updater *u);
 /* The frame (malloc'd, LMT_SIDE x LMT_SIDE x 3) from the room's corner at (1.9, 2, 1.9), looking at
  * (-1, 0.5, -1) with a 90 degree field of view. */
 #define LMT_SIDE 48

@@ -1129,6 +1129,49 @@ static void test_removed_light_doubted_first(void **state)
     lmgi_context_free(ctx);
 }
 
+static void widen_cone(lmgi_scene *sc)
+{
+    lmgi_light l;
+    lmgi_error e;
+    assert_int_equal(lmgi_get_light(sc, 0, &l, &e), LMGI_OK);
+    l.outer_cone += 0.05f;
+    assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
+}
+
+/* A spot light's cone widened after still updates: a change of its shape, so all its photon groups are
+ * traced again, and in one go (photon_stage.c, catch_up; tests/test_motion_trail.c holds the same for a
+ * moved node), not 16 an update. Widened again in every update after, it keeps to those 16. */
+static void test_reshaped_light_caught_up(void **state)
+{
+    (void)state;
+    static const lmgi_light_desc spot = {.name = "spot", .type = LMGI_LIGHT_SPOT, .intensity = 30.0f,
+                                         .outer_cone = 0.5f, .position = {0.0f, 2.8f, 0.0f},
+                                         .direction = {0.0f, -1.0f, 0.0f}};
+    lmt_room_spec spec = {.lights = &spot, .light_count = 1};
+    lmgi_scene *sc = lmt_room(&spec);
+    lmgi_context *ctx = lmt_context();
+    lmgi_updater *u = lmt_room_updater(ctx, sc);
+    lmt_updates(u, 3);
+    uint32_t g[3];
+    for (int f = 0; f < 3; f++) { /* widened once, then still: it reports in the edit's update or the next */
+        if (f == 0)
+            widen_cone(sc);
+        g[f] = lmt_update(u).groups_retraced;
+    }
+    print_message("a spot's cone widened after still updates: %u + %u groups re-traced, then %u\n", g[0], g[1], g[2]);
+    assert_true(g[0] + g[1] > 16); /* 72 measured: all of its groups */
+    assert_int_equal(g[2], 0);
+    for (int f = 0; f < 6; f++) { /* widened at every update: the first is caught up, the rest are not */
+        widen_cone(sc);
+        uint32_t n = lmt_update(u).groups_retraced;
+        if (f >= 2)
+            assert_true(n <= 16);
+    }
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1143,6 +1186,7 @@ int main(void)
         cmocka_unit_test(test_two_lights_first_guess),
         cmocka_unit_test(test_switched_off),
         cmocka_unit_test(test_removed_light_doubted_first),
+        cmocka_unit_test(test_reshaped_light_caught_up),
         cmocka_unit_test(test_added_light_at_once),
         cmocka_unit_test(test_switched_on_at_once),
         cmocka_unit_test(test_dark_room_switched_on),
