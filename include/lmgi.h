@@ -185,8 +185,9 @@ LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
  * back; its children's channels still play, relative to where it now is. An updater sees an edit at
  * its next lmgi_update, as it sees an animation's move. Without a time budget, a move after an update in
  * which no edit moved a node is caught up in one go: the photon paths it changed are re-traced and the
- * AIMs they reach refreshed beside that update, whatever photons.group_budget and
- * aim.surfaces_per_frame say; moves in update after update stay within those counts (docs/api.md). */
+ * AIMs they reach refreshed in that update (lmgi_update_stats.groups_at_once), whatever
+ * photons.group_budget and aim.surfaces_per_frame say; moves in update after update stay within those
+ * counts (docs/api.md). */
 LMGI_API int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
 LMGI_API int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
 /* A fingerprint of the scene's geometry: the names of the nodes that hold triangles, in order, and each
@@ -621,8 +622,9 @@ typedef struct {
                                 * light shown in the lightmaps at once, refined by the regathers after
                                 * (docs/tradeoff.md, "Light edits at once") */
     int aim_surfaces_at_once;  /* of aim_surfaces_refreshed, those refreshed at once for this update's light,
-                                * emission or colour edits: as many as the edits reach, outside the AIM budget
-                                * that bounds the others (issue 32, item 4) */
+                                * emission or colour edits, or a placement's catch-up (groups_at_once): as many
+                                * as the edits reach, outside the AIM budget that bounds the others (issue 32,
+                                * item 4) */
     double ms_light_scale;     /* of ms_photons or ms_gather: a light, emission or colour edit's texel factors,
                                 * their first guess at the edit, then their refinement a few surfaces an update
                                 * within the budget (docs/tradeoff.md, "Light edits at once") */
@@ -631,6 +633,11 @@ typedef struct {
                                 * traced in this update, not over the updates after, and their light shown in
                                 * the lightmaps at once as a first guess that the regathers after refine
                                 * (docs/tradeoff.md, "Lights added or switched on") */
+    uint32_t groups_at_once;   /* of groups_retraced, those re-traced at once for a node or light this
+                                * update's edits placed or reshaped after an update whose edits placed none
+                                * (without a time budget; the AIMs they changed are in aim_surfaces_at_once):
+                                * the edit's own work, beyond photons.group_budget (docs/photons.md, "Caught
+                                * up in one update") */
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative

@@ -178,7 +178,9 @@ static lmgi_updater *in_order_updater(lmgi_context *ctx, lmgi_scene *sc, int sid
 }
 
 /* A light's reach cut short (its range): its 72 groups wait. Without a budget an update re-traces group_budget (16) of them; at
- * a budget too small for anything one, and one AIM surface, one texel; at a generous one all that wait. */
+ * a budget too small for anything one, and one AIM surface, one texel; at a generous one all that wait.
+ * (The first such edit after still updates is caught up at once, without a budget: all 72 in its update,
+ * lmgi_update_stats.groups_at_once; the counts hold for the edits that follow it update after update.) */
 static void test_budget_governs_photons_and_aims(void **state)
 {
     (void)state;
@@ -192,9 +194,15 @@ static void test_budget_governs_photons_and_aims(void **state)
     lmgi_light l;
     assert_int_equal(lmgi_get_light(sc, 0, &l, &e), LMGI_OK);
 
-    l.range = 6.0f; /* a light dimmed alone keeps its photons (test_light_edits): nothing would wait */
+    l.range = 6.5f; /* a light dimmed alone keeps its photons (test_light_edits): nothing would wait */
     assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
     update(u, 0.0f, &st);
+    assert_int_equal(st.groups_at_once, 72);
+    assert_int_equal(st.groups_retraced, 72);
+    l.range = 6.0f;
+    assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
+    update(u, 0.0f, &st);
+    assert_int_equal(st.groups_at_once, 0);
     print_message("no budget: %u groups, %d AIMs, %d texels; busiest %s: %s\n", st.groups_retraced,
                   st.aim_surfaces_refreshed, st.texels_budget, st.busiest_stage, st.why);
     assert_int_equal(st.groups_retraced, 16);

@@ -270,34 +270,22 @@ static void test_one_move_refined(void **state)
         lmgi_updater_free(u);
         lmgi_free(sc);
     }
-    /* the steps a texel gathered among stale ones makes: 0.26 of the mean texel on average over the updates
-     * alone, 0.15 with those waiting shown from it; the worst, 0.81 alone, in the first update (a texel
+    /* the steps a texel gathered among stale ones makes: 0.23 of the mean texel on average over the updates
+     * alone, 0.13 with those waiting shown from it; the worst, 0.82 alone, in the first update (a texel
      * gathered beside those that came out of the cube's old place, which show at once, blending in from the
-     * old contact shadow), 0.43 with it starting from its neighbours' estimate */
+     * old contact shadow), 0.33 with it starting from its neighbours' estimate (0.26, 0.15, 0.81 and 0.43
+     * while the move's photons and AIMs caught up over 9 updates) */
     assert_true(step_sum[1] < 0.7 * step_sum[0]);
     assert_true(step[1] < 0.6 * step[0]);
-    assert_true(block_sum[1] < 1.1 * block_sum[0]); /* and the blocks no worse (0.22 both) */
+    assert_true(block_sum[1] < 1.1 * block_sum[0]); /* and the blocks no worse (0.19 and 0.18) */
     free(want);
     lmgi_updater_free(fresh);
     lmgi_free(moved);
     lmgi_context_free(ctx);
 }
 
-/* The photon work one update reported: groups re-traced and AIMs refreshed (none for light edits here). */
-typedef struct {
-    uint32_t groups;
-    int aims;
-} stage_work;
-
-static stage_work step(lmgi_updater *u)
-{
-    lmgi_update_stats st = lmt_update(u);
-    assert_int_equal(st.aim_surfaces_at_once, 0);
-    return (stage_work){st.groups_retraced, st.aim_surfaces_refreshed};
-}
-
-/* A move after a still update is caught up in the photon stage's next update: every group it queued
- * re-traced and every AIM it changed refreshed, whatever the fixed counts (16 groups, 4 AIMs an update),
+/* A move after a still update is caught up as the edit's own work: every group it queued re-traced and
+ * every AIM it changed refreshed in its update, whatever the fixed counts (16 groups, 4 AIMs an update),
  * then nothing is left. Moves repeated every update stay within those counts: an engine that drives a
  * node through edits pays the round robin's cost, not a full catch-up every frame. */
 static void test_move_after_stillness_caught_up(void **state)
@@ -306,15 +294,15 @@ static void test_move_after_stillness_caught_up(void **state)
     lmgi_context *ctx = lmt_context();
     lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
     lmgi_updater *u = updater(ctx, sc, 0.0f, 0);
-    step(u);
+    lmt_update(u);
     move_cube(sc);
-    stage_work w[3];
-    for (int f = 0; f < 3; f++)
-        w[f] = step(u);
-    /* the move's photon work runs beside its update and reports in the next: 66 groups, 15 AIMs measured */
-    assert_true(w[0].groups + w[1].groups > 16);
-    assert_true(w[0].aims + w[1].aims > 4);
-    assert_int_equal(w[2].groups, 0);
+    lmgi_update_stats w[2] = {lmt_update(u), lmt_update(u)};
+    print_message("the cube moved after a still update: %u groups and %d AIMs at once, then %u groups\n",
+                  w[0].groups_at_once, w[0].aim_surfaces_at_once, w[1].groups_retraced);
+    assert_true(w[0].groups_at_once > 16); /* 66 measured */
+    assert_true(w[0].groups_retraced >= w[0].groups_at_once);
+    assert_true(w[0].aim_surfaces_at_once > 4); /* 15 */
+    assert_int_equal(w[1].groups_retraced, 0);
     int node = lmgi_find_node(sc, "dynamic_cube");
     for (int f = 0; f < 8; f++) { /* a step every update: the first follows a still one and is caught up */
         float m[16];
@@ -322,10 +310,14 @@ static void test_move_after_stillness_caught_up(void **state)
         assert_true(lmgi_get_node_transform(sc, node, m));
         m[12] += 0.02f;
         assert_int_equal(lmgi_set_node_transform(sc, node, m, &e), LMGI_OK);
-        stage_work s = step(u);
-        if (f >= 2) {
-            assert_true(s.groups <= 16);
-            assert_true(s.aims <= 4);
+        lmgi_update_stats s = lmt_update(u);
+        if (f == 0) {
+            assert_true(s.groups_at_once > 0);
+        } else {
+            assert_int_equal(s.groups_at_once, 0);
+            assert_true(s.groups_retraced <= 16);
+            assert_true(s.aim_surfaces_refreshed - s.aim_surfaces_at_once <= 4);
+            assert_int_equal(s.aim_surfaces_at_once, 0);
         }
     }
     lmgi_updater_free(u);

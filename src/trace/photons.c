@@ -634,10 +634,10 @@ static lm_status round_robin(lm_photons *ph, lm_photon_frame_stats *st, lm_error
     return LM_OK;
 }
 
-/* Re-traces up to group_budget (or the frame's limit) invalid groups, oldest first. */
-static lm_status drain(lm_photons *ph, lm_photon_frame_stats *st, lm_error *err)
+/* Re-traces up to `most` invalid groups (0: all), oldest first. */
+static lm_status drain(lm_photons *ph, uint32_t most, lm_photon_frame_stats *st, lm_error *err)
 {
-    uint32_t n = ph->queue_len, most = ph->frame_groups ? ph->frame_groups : ph->set.group_budget;
+    uint32_t n = ph->queue_len;
     if (most && most < n)
         n = most;
     for (uint32_t i = 0; i < n; i++)
@@ -652,8 +652,19 @@ lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_s
     memset(st, 0, sizeof *st);
     double t0 = lm_now();
     lm_status s = anything_moves ? round_robin(ph, st, err) : LM_OK;
-    if (s == LM_OK)
-        s = drain(ph, st, err);
+    if (s == LM_OK) /* up to group_budget, or the frame's limit */
+        s = drain(ph, ph->frame_groups ? ph->frame_groups : ph->set.group_budget, st, err);
+    finish_stats(ph, st, t0);
+    return s;
+}
+
+lm_status lm_photons_drain_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)
+{
+    lm_photon_frame_stats local;
+    lm_photon_frame_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    double t0 = lm_now();
+    lm_status s = drain(ph, 0, st, err);
     finish_stats(ph, st, t0);
     return s;
 }

@@ -149,6 +149,9 @@ lm_status lm_photons_trace_all_exact(lm_photons *ph, lm_photon_frame_stats *stat
  * groups themselves (a light's placement or power, a material). stats may be NULL. Fails only when
  * memory runs out. */
 lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err);
+/* Re-traces every queued invalid group now, whatever group_budget (an edit's catch-up, update/photon_stage.c),
+ * counted in stats (may be NULL) as lm_photons_frame counts its. Fails only when memory runs out. */
+lm_status lm_photons_drain_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err);
 /* Queues every valid group with a photon whose stored path crosses one of the n boxes (6 floats each: min
  * x, y, z, max x, y, z): where a node an edit moved was and where it is now. The round robin finds such
  * paths one photon a group an update; a box test finds them at once, without a ray (the last leg of a

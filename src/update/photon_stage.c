@@ -37,8 +37,6 @@ struct lm_photon_stage {
     int aim_pending;             /* AIM surfaces over their threshold that the last refresh left for later */
     lm_moved_nodes moves;        /* the nodes edits moved, whose paths are queued at once (moved_nodes.h) */
     int moved_before;            /* the last update's edits placed or reshaped a node or a light */
-    int catch_up;                /* this update's did, after an update whose did not: every queued group is
-                                  * re-traced and every AIM over its threshold refreshed (animate) */
     float *move_boxes;           /* scratch: LM_MOVED_NODE_BOXES floats a node */
     double *delta_before;        /* scratch: per surface, delta_f + owed before a refresh (aim.h) */
     uint32_t *count_before;      /* scratch: per surface, its refresh count before it */
@@ -836,6 +834,28 @@ void lm_photon_stage_free(lm_photon_stage *ps)
     free(ps);
 }
 
+static lm_status refresh_aims(lm_photon_stage *ps, int budget, lm_aim_stats *out, lm_error *err);
+
+/* A node or a light placed or reshaped by an edit after a still update (an artist's drag released, a door
+ * set open) is caught up as the edit's own work, as a light lit is (light_now): every group it queued is
+ * re-traced and every AIM over its threshold refreshed now, rather than 16 groups and 4 AIMs an update. The
+ * lightmaps' regathers wait on those: the moved cube's faces and the floor around it took 24 updates to
+ * come within 10% of a fresh bake. Edits that move something every update (an engine driving a node
+ * through them) stay with the fixed counts, as does everything under a time budget, whose plan holds
+ * (update/budget_plan.h). */
+static lm_status catch_up(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
+{
+    lm_status st = lm_photons_drain_all(ps->photons, &out->caught_up, err);
+    if (st != LM_OK || !ps->set.aims)
+        return st;
+    ps->aim.set.max_hits = 0; /* no bound: every surface over its threshold */
+    lm_aim_stats as;
+    st = refresh_aims(ps, ps->surfaces->surface_count, &as, err);
+    add_aim_stats(out, &as);
+    out->aim_at_once += as.surfaces_refreshed;
+    return st;
+}
+
 /* lm_photon_stage_animate; `bake`: a full trace follows, which traces newly lit emitters with the rest
  * (and counts their paths as changed), so they are not traced at once here. */
 static lm_status animate(lm_photon_stage *ps, float t, int bake, lm_photon_stage_frame *out, lm_error *err)
@@ -865,14 +885,9 @@ static lm_status animate(lm_photon_stage *ps, float t, int bake, lm_photon_stage
         if (st == LM_OK)
             st = check_emitters(ps, added, !bake && lights_at_once(ps), out, err);
     }
-    /* A node or a light placed or reshaped by an edit after a still update (an artist's drag released, a
-     * door set open) is caught up in this update rather than a few groups and AIMs an update: the
-     * lightmaps' regathers wait on those, and the moved cube's faces and the floor around it took 24
-     * updates to come within 10% instead of 17. Edits that move something every update (an engine driving
-     * a node through them) stay with the fixed counts, as does everything under a time budget, whose plan
-     * holds (update/budget_plan.h). */
     int placed = (moved || (ch->lights_changed && out->emitters_moved > 0)) && ps->photons && ps->set.trace;
-    ps->catch_up = placed && !ps->moved_before && !bake && !budgeted(ps);
+    if (st == LM_OK && placed && !ps->moved_before && !bake && !budgeted(ps))
+        st = catch_up(ps, out, err);
     ps->moved_before = placed;
     out->emitters_moved += added;
     lm_status sm = follow_materials(ps, ch, out, st == LM_OK ? err : NULL);
@@ -946,26 +961,21 @@ static void release_removed(lm_photon_stage *ps)
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
     double t1 = lm_now();
-    if (ps->catch_up)
-        lm_photons_limit_groups(ps->photons, UINT32_MAX);
     lm_status st = ps->set.trace ? lm_photons_frame(ps->photons, anything_moves(ps->scene), &out->photons, err)
                                  : LM_OK;
-    if (ps->catch_up)
-        lm_photons_limit_groups(ps->photons, ps->limit.groups);
     if (st == LM_OK && ps->set.trace)
         release_removed(ps);
     double t2 = lm_now();
     if (st == LM_OK && ps->set.trace && ps->set.aims) {
         /* a budget's bound on hits takes any number of surfaces within it */
-        ps->aim.set.max_hits = ps->catch_up ? 0 : ps->limit.aim_hits ? ps->limit.aim_hits : ps->hit_bound;
+        ps->aim.set.max_hits = ps->limit.aim_hits ? ps->limit.aim_hits : ps->hit_bound;
         lm_aim_stats as;
-        int all = ps->limit.aim_hits || ps->catch_up;
-        st = refresh_aims(ps, all ? ps->surfaces->surface_count : ps->set.surfaces_per_frame, &as, err);
+        st = refresh_aims(ps, ps->limit.aim_hits ? ps->surfaces->surface_count : ps->set.surfaces_per_frame, &as,
+                          err);
         add_aim_stats(out, &as);
     }
     if (st == LM_OK)
         st = update_caustics(ps, out, err);
-    ps->catch_up = 0;
     out->t_photons = t2 - t1;
     out->t_total += lm_now() - t1;
     return st;

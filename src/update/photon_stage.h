@@ -50,7 +50,11 @@ typedef struct {
                               * traces every photon) */
     int materials_changed;   /* materials whose colour or emission an edit changed since last frame */
     int aim_at_once;         /* of aim.surfaces_refreshed, those refreshed at once for this frame's light,
-                              * emission or colour edits (lm_photon_stage_animate) */
+                              * emission or colour edits, or for a node or light placed after a still frame
+                              * (lm_photon_stage_animate) */
+    lm_photon_frame_stats caught_up; /* the invalid groups that placement's edit re-traced at once (its
+                              * catch-up: docs/photons.md, "Caught up in one update"); apart from photons,
+                              * which are the round robin's and the group budget's */
     lm_photon_frame_stats photons;
     lm_aim_stats aim;
     lm_caustic_frame_stats caustics; /* its seconds are t_caustics */
