@@ -183,11 +183,10 @@ LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
  * The rule between edits and animations: an edit wins. A moved node's own animation channels stop
  * driving it (lmgi_set_time and updates play the others), until lmgi_node_resume_animation hands it
  * back; its children's channels still play, relative to where it now is. An updater sees an edit at
- * its next lmgi_update, as it sees an animation's move. Without a time budget, a move after an update in
- * which no edit moved a node is caught up in one go: the photon paths it changed are re-traced and the
- * AIMs they reach refreshed in that update (lmgi_update_stats.groups_at_once), whatever
- * photons.group_budget and aim.surfaces_per_frame say; moves in update after update stay within those
- * counts (docs/api.md). */
+ * its next lmgi_update, as it sees an animation's move. Without a time budget, a move after an update
+ * without edits is caught up in one go: the photon paths it changed are re-traced and the AIMs they
+ * reach refreshed in that update (lmgi_update_stats.groups_at_once), whatever photons.group_budget and
+ * aim.surfaces_per_frame say; edits made update after update stay within those counts (docs/api.md). */
 LMGI_API int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
 LMGI_API int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
 /* A fingerprint of the scene's geometry: the names of the nodes that hold triangles, in order, and each
@@ -634,7 +633,7 @@ typedef struct {
                                 * the lightmaps at once as a first guess that the regathers after refine
                                 * (docs/tradeoff.md, "Lights added or switched on") */
     uint32_t groups_at_once;   /* of groups_retraced, those re-traced at once for a node or light this
-                                * update's edits placed or reshaped after an update whose edits placed none
+                                * update's edits placed or reshaped after an update without edits
                                 * (without a time budget; the AIMs they changed are in aim_surfaces_at_once):
                                 * the edit's own work, beyond photons.group_budget (docs/photons.md, "Caught
                                 * up in one update") */

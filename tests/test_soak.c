@@ -52,8 +52,8 @@ static void check_update(soak_run *r, int f, const lmgi_update_stats *st)
     /* a light added by this update's edit draws its first map beside the 4 of the budget at most; a light,
      * emission or colour edit refreshes the AIMs it reaches at once beside the AIM budget's 4 (counted
      * since 2026-11-30; lmgi_update_stats.aim_surfaces_at_once); a node or light placed after an update
-     * that placed none is caught up at once, its groups beside the budget's 16 (counted since 2026-12-02;
-     * lmgi_update_stats.groups_at_once) */
+     * without edits is caught up at once, its groups beside the budget's 16 (counted since 2026-12-02;
+     * lmgi_update_stats.groups_at_once; never here, where an edit comes before every update) */
     if (st->shadow_maps_rendered > 5 || groups > 16 || budgeted > 4 ||
         st->caustic_photons_retraced > r->caustic_cap)
         fail_msg("%s, update %d: %d shadow maps, %d photon groups by the budget, %d AIMs by the budget, %u caustic "
