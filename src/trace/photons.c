@@ -645,28 +645,29 @@ static lm_status drain(lm_photons *ph, uint32_t most, lm_photon_frame_stats *st,
     return ph_trace_groups(ph, ph->tmp_groups, n, st, err);
 }
 
-lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err)
+/* The round robin (with anything_moves), then up to `most` queued groups (0: all), counted in stats. */
+static lm_status step(lm_photons *ph, int anything_moves, uint32_t most, lm_photon_frame_stats *stats,
+                      lm_error *err)
 {
     lm_photon_frame_stats local;
     lm_photon_frame_stats *st = stats ? stats : &local;
     memset(st, 0, sizeof *st);
     double t0 = lm_now();
     lm_status s = anything_moves ? round_robin(ph, st, err) : LM_OK;
-    if (s == LM_OK) /* up to group_budget, or the frame's limit */
-        s = drain(ph, ph->frame_groups ? ph->frame_groups : ph->set.group_budget, st, err);
+    if (s == LM_OK)
+        s = drain(ph, most, st, err);
     finish_stats(ph, st, t0);
     return s;
 }
 
+lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err)
+{
+    return step(ph, anything_moves, ph->frame_groups ? ph->frame_groups : ph->set.group_budget, stats, err);
+}
+
 lm_status lm_photons_drain_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)
 {
-    lm_photon_frame_stats local;
-    lm_photon_frame_stats *st = stats ? stats : &local;
-    memset(st, 0, sizeof *st);
-    double t0 = lm_now();
-    lm_status s = drain(ph, 0, st, err);
-    finish_stats(ph, st, t0);
-    return s;
+    return step(ph, 0, 0, stats, err);
 }
 
 void lm_photons_limit_groups(lm_photons *ph, uint32_t most) { ph->frame_groups = most; }

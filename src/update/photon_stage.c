@@ -849,9 +849,8 @@ static lm_status catch_up(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_er
     lm_status st = lm_photons_drain_all(ps->photons, &out->caught_up, err);
     if (st != LM_OK || !ps->set.aims)
         return st;
-    ps->aim.set.max_hits = 0; /* no bound: every surface over its threshold */
     lm_aim_stats as;
-    st = refresh_aims(ps, ps->surfaces->surface_count, &as, err);
+    st = refresh_aims(ps, -1, &as, err); /* every surface over its threshold, no bound on hits (as a bake) */
     add_aim_stats(out, &as);
     out->aim_at_once += as.surfaces_refreshed;
     return st;
