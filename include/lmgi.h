@@ -82,6 +82,12 @@ typedef struct {
                              * gets at least about this many texels, at a finer texel size than the rest
                              * where needed, on top of target_texels; 0, the default: one texel size for
                              * all ('lmgi run': 16; docs/levels.md, "Density") */
+    float bend_deg;         /* with a derived texel size: a surface of 8 texels or more whose shading normals
+                             * turn more than this many degrees across one of its texels (a column's smooth
+                             * faces) gets finer texels, so that they turn at most this much, where 2 x finer
+                             * is enough (else it keeps the atlas's); they count against target_texels. 0:
+                             * the default, 15; LMGI_OFF: one texel size for all (docs/charts.md, "Bending
+                             * normals") */
 } lmgi_options;
 
 typedef struct lmgi_scene lmgi_scene;

@@ -33,6 +33,7 @@ void lmgi_options_init(lmgi_options *o)
     o->strict = so.strict;
     o->surface_cone_deg = so.cone_deg;
     o->max_atlas_size = ao.max_size;
+    o->bend_deg = LM_BEND_DEFAULT_DEG;
 }
 
 lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err)
@@ -126,6 +127,8 @@ static void resolve_options(const lmgi_options *o, lmgi_options *out)
         out->surface_cone_deg = def.surface_cone_deg;
     if (o->max_atlas_size == 0)
         out->max_atlas_size = def.max_atlas_size;
+    if (o->bend_deg == 0.0f)
+        out->bend_deg = def.bend_deg;
 }
 
 static lm_status check_options(const char *path, const lmgi_options *o, lm_error *err)
@@ -143,6 +146,9 @@ static lm_status check_options(const char *path, const lmgi_options *o, lm_error
                        (double)o->surface_cone_deg);
     if (o->wall_texels < 0 || o->wall_texels > 65536)
         return lm_fail(err, LM_ERR_INVALID, "%s: wall_texels %d must be in [0, 65536]", path, o->wall_texels);
+    if (o->bend_deg != (float)LMGI_OFF && !(o->bend_deg > 0.0f && o->bend_deg <= 180.0f))
+        return lm_fail(err, LM_ERR_INVALID, "%s: bend_deg %g must be in (0, 180] degrees, or LMGI_OFF", path,
+                       (double)o->bend_deg);
     if (o->max_atlas_size < 64 || o->max_atlas_size > 32768)
         return lm_fail(err, LM_ERR_INVALID, "%s: max_atlas_size (a lightmap page's side) %d must be in [64, 32768]",
                        path, o->max_atlas_size);
@@ -210,6 +216,7 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     ao.texel_size = o->texel_size;
     ao.target_texels = o->target_texels;
     ao.wall_texels = o->texel_size <= 0.0f ? o->wall_texels : 0;
+    ao.bend_deg = o->texel_size <= 0.0f && o->bend_deg > 0.0f ? o->bend_deg : 0.0f;
     ao.gutter = o->gutter;
     ao.use_file_uv1 = o->use_file_uv1;
     ao.max_size = o->max_atlas_size;

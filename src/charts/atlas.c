@@ -8,6 +8,7 @@
 #include "../core/log.h"
 #include "../core/memory.h"
 #include "../core/timing.h"
+#include "../core/vecmath.h"
 #include "charts_internal.h"
 
 void lm_atlas_options_default(lm_atlas_options *o)
@@ -18,6 +19,7 @@ void lm_atlas_options_default(lm_atlas_options *o)
     o->use_file_uv1 = 0;
     o->max_size = 8192;
     o->wall_texels = 0;
+    o->bend_deg = 0.0f;
 }
 
 float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su, int target)
@@ -108,6 +110,8 @@ static lm_status check_options(const lm_scene *s, const lm_surfaces *su, const l
                        LM_ATLAS_DEFAULT_TEXELS);
     if (o->wall_texels < 0 || o->wall_texels > 65536)
         return lm_fail(err, LM_ERR_INVALID, "charts: wall_texels %d must be in [0, 65536]", o->wall_texels);
+    if (!(o->bend_deg >= 0.0f && o->bend_deg <= 180.0f))
+        return lm_fail(err, LM_ERR_INVALID, "charts: bend_deg %g must be in [0, 180]", (double)o->bend_deg);
     if (o->max_size < 4 * (o->gutter + 1) || o->max_size > 65536)
         return lm_fail(err, LM_ERR_INVALID, "charts: max_size %d must be in [%d, 65536]", o->max_size,
                        4 * (o->gutter + 1));
@@ -185,6 +189,52 @@ static double texel_scale(const lm_surface *f, float ts, int wall_texels)
     return own < ts ? own / ts : 1.0;
 }
 
+/* Per surface: how fast its shading normals turn, radians per world unit: over its triangles, the
+ * area-weighted mean of the fastest turn along an edge (the angle between the edge's two vertex normals
+ * over its length). An area weighting, not the largest: a sliver's short edge must not set it. */
+static double *surface_bends(const lm_scene *s, const lm_surfaces *su, const float *pos)
+{
+    float *nrm = lmc_world_normals(s);
+    double *bend = calloc((size_t)su->surface_count + 1, sizeof *bend);
+    if (!nrm || !bend) {
+        free(nrm), free(bend);
+        return NULL;
+    }
+    for (int f = 0; f < su->surface_count; f++) {
+        const lm_surface *sf = &su->surfaces[f];
+        double sum = 0.0, area = 0.0;
+        for (uint32_t i = 0; i < sf->tri_count; i++) {
+            const uint32_t *v = s->tris + 3 * (size_t)sf->tris[i];
+            double fastest = 0.0, a = lm_scene_tri_area_world(s, sf->tris[i]);
+            for (int e = 0; e < 3; e++) {
+                const float *pa = pos + 3 * (size_t)v[e], *pb = pos + 3 * (size_t)v[(e + 1) % 3];
+                const float *na = nrm + 3 * (size_t)v[e], *nb = nrm + 3 * (size_t)v[(e + 1) % 3];
+                double len = 0.0, c = 0.0;
+                for (int k = 0; k < 3; k++)
+                    len += ((double)pa[k] - pb[k]) * (pa[k] - pb[k]), c += (double)na[k] * nb[k];
+                len = sqrt(len);
+                if (len > 0.0)
+                    fastest = fmax(fastest, acos(fmax(-1.0, fmin(1.0, c))) / len);
+            }
+            if (a > 0.0)
+                sum += a * fastest, area += a;
+        }
+        bend[f] = area > 0.0 ? sum / area : 0.0;
+    }
+    free(nrm);
+    return bend;
+}
+
+/* A bending surface's texel size over the atlas's ts: 1, or less where its normals would turn more than
+ * bend_deg a texel (lm_atlas_options.bend_deg; 0: off), but never finer than 1 / LM_BEND_REFINE. */
+static double bend_scale(double bend, float ts, float bend_deg)
+{
+    double most = bend_deg * LM_PI / 180.0;
+    if (!(bend_deg > 0.0f) || !(bend * ts > most) || bend * ts > most * LM_BEND_REFINE)
+        return 1.0;
+    return most / (bend * ts);
+}
+
 static int cmp_u32(const void *a, const void *b)
 {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
@@ -204,8 +254,8 @@ static void free_view(lmc_charts *v)
  * a small object unwrapped into several charts (a sphere's caps and sides) needs no more than one texel
  * when it is smaller than one, and a level of thousands of them could otherwise never meet a small
  * budget. The one chart's triangles overlap inside its texel, which then holds their summed area. */
-static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, float ts, int wall_texels,
-                                lmc_charts *v, lm_error *err)
+static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, const double *bend, float ts,
+                                const lm_atlas_options *o, lmc_charts *v, lm_error *err)
 {
     memset(v, 0, sizeof *v);
     v->tri_uv = c->tri_uv;
@@ -215,17 +265,22 @@ static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, floa
     for (int i = 0, end; i < c->count; i = end) {
         int small = 1;
         uint32_t tris = 0;
-        double scale = texel_scale(&su->surfaces[c->charts[i].surface], ts, wall_texels);
+        double scale = texel_scale(&su->surfaces[c->charts[i].surface], ts, o->wall_texels);
         for (end = i; end < c->count && c->charts[end].surface == c->charts[i].surface; end++) {
             lmc_chart probe = c->charts[end];
             probe.texel_scale = scale;
             small &= one_texel(&probe, ts) && scale == 1.0; /* a wall keeps its texels */
             tris += c->charts[end].tri_count;
         }
+        /* a bending surface's finer texels count against the budget, a wall's do not */
+        int wall = scale < 1.0;
+        if (!small && su->surfaces[c->charts[i].surface].area >= LM_BEND_MIN_TEXELS * ts * ts)
+            scale = fmin(scale, bend_scale(bend[c->charts[i].surface], ts, o->bend_deg));
         for (int k = i; k < end; k += small ? end - i : 1) {
             lmc_chart *d = &v->charts[v->count++];
             *d = c->charts[k];
             d->texel_scale = scale;
+            d->on_top = wall;
             d->tri_count = small ? tris : c->charts[k].tri_count;
             d->tris = malloc(((size_t)d->tri_count + 1) * sizeof *d->tris);
             if (!d->tris) {
@@ -248,10 +303,11 @@ static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, floa
 
 /* The charts packed at texel size ts, their triangles copied and their texels made, into out. */
 static lm_status lay_out(const lm_scene *s, const lm_surfaces *su, const lmc_charts *all, const float *pos,
-                         float ts, const lm_atlas_options *o, lm_atlas *out, double *budgeted, lm_error *err)
+                         const double *bend, float ts, const lm_atlas_options *o, lm_atlas *out, double *budgeted,
+                         lm_error *err)
 {
     lmc_charts c;
-    lm_status st = collapse_small(all, su, ts, o->wall_texels, &c, err);
+    lm_status st = collapse_small(all, su, bend, ts, o, &c, err);
     if (st != LM_OK)
         return st;
     st = lmc_pack(&c, su, ts, o->gutter, o->max_size, out, err);
@@ -264,7 +320,7 @@ static lm_status lay_out(const lm_scene *s, const lm_surfaces *su, const lmc_cha
     /* what counts against the budget: the walls' extra texels come on top of it */
     *budgeted = out->texel_count;
     for (uint32_t i = 0; st == LM_OK && i < out->texel_count; i++)
-        *budgeted -= c.charts[out->tri_chart[out->texels[i].tri]].texel_scale < 1.0;
+        *budgeted -= c.charts[out->tri_chart[out->texels[i].tri]].on_top;
     free_view(&c);
     return st;
 }
@@ -286,12 +342,17 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     float *pos = lmc_world_positions(s, &size);
     if (!pos)
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    double *bend = surface_bends(s, su, pos);
+    if (!bend) {
+        free(pos);
+        return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
+    }
     lmc_charts c;
     st = o->use_file_uv1 ? lmc_charts_from_uv1(s, su, pos, &c, err) : lmc_unwrap(s, su, pos, &c, err);
     double t1 = lm_now(), t2 = t1;
     if (st == LM_OK) {
         double count = 0.0;
-        st = lay_out(s, su, &c, pos, ts, o, out, &count, err);
+        st = lay_out(s, su, &c, pos, bend, ts, o, out, &count, err);
         t2 = lm_now();
         /* A texel budget is met by the texel size, but charts round up to whole texels: a level of many small
          * charts got 10x the texels it asked for (scenes/many_rooms.glb at 2,000). The texel size is scaled
@@ -311,7 +372,7 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
              * +1% at the area's texel size and +6.5% a step further at 5 texels) */
             last_ts = best_ts * (float)sqrt(ratio / (ratio > 1.0 ? 1.0 + LM_BUDGET_AIM : 1.0 - LM_BUDGET_AIM));
             lm_atlas_free(out);
-            st = lay_out(s, su, &c, pos, last_ts, o, out, &count, err);
+            st = lay_out(s, su, &c, pos, bend, last_ts, o, out, &count, err);
             double r = count / target;
             lm_debug("charts: texel size %g: %u texels (budget %.0f)", (double)last_ts, out->texel_count, target);
             /* kept only if nearer, and if the count answered the texel size at least a quarter as much as the
@@ -323,14 +384,14 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
         }
         if (st == LM_OK && last_ts != best_ts) {
             lm_atlas_free(out);
-            st = lay_out(s, su, &c, pos, best_ts, o, out, &count, err);
+            st = lay_out(s, su, &c, pos, bend, best_ts, o, out, &count, err);
         }
         if (st == LM_OK && o->texel_size <= 0.0f && best > LM_BUDGET_WARN && c.count > 0 && count > 0.0)
             lm_warn("%s: %d charts need %.0f texels at the least; the budget of %.0f texels cannot be met "
                     "(docs/levels.md, \"Atlas\")", s->path, c.count, count, target);
         lmc_charts_free(&c);
     }
-    free(pos);
+    free(pos), free(bend);
     if (st == LM_OK)
         st = link_surfaces(su, out, err);
     if (st != LM_OK) {

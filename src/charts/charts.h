@@ -76,7 +76,19 @@ typedef struct {
     int wall_texels;       /* each surface of at least LM_WALL_AREA gets about this many texels at least: its
                             * charts a finer texel size than the atlas's where needed, those texels on top
                             * of target_texels (default 0: off) */
+    float bend_deg;        /* a surface of LM_BEND_MIN_TEXELS texels or more whose shading normals turn more
+                            * than this many degrees across one texel gets a finer texel size, so that
+                            * they turn this much, where LM_BEND_REFINE times finer is enough (else it
+                            * keeps the atlas's); those texels count against target_texels (default 0:
+                            * off) */
 } lm_atlas_options;
+
+/* The bend rule's limits (lm_atlas_options.bend_deg): how much finer than the atlas's a bending
+ * surface's texels may be, the fewest texels a surface refined has at the atlas's texel size, and
+ * lmgi_options.bend_deg's default. */
+#define LM_BEND_REFINE 2.0
+#define LM_BEND_MIN_TEXELS 8.0
+#define LM_BEND_DEFAULT_DEG 15.0f
 
 /* A wall's or floor's area in world units: 2 m^2 in glTF's metres (a door's area). */
 #define LM_WALL_AREA 2.0f

@@ -33,7 +33,9 @@ typedef struct {
     uint32_t *tris;
     double ext[2];
     double texel_scale; /* its texel size over the atlas's, set where charts are laid out (atlas.c): 1, or
-                         * less where a wall-sized surface would get too few texels */
+                         * less where a wall-sized surface would get too few texels or a surface's normals
+                         * bend (lm_atlas_options.bend_deg) */
+    int on_top;         /* its texels come on top of the texel budget (a wall's, lm_atlas_options.wall_texels) */
 } lmc_chart;
 
 /* A chart's extent along axis (0, 1) in its own texels at the atlas's texel size ts. */

@@ -190,3 +190,17 @@ int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a)
     return 0;
 }
 
+
+int lm_cli_opt_bend(const char *o, const char *v, lm_cli_args *a)
+{
+    if (v && !strcmp(v, "off")) {
+        a->options.bend_deg = (float)LMGI_OFF;
+        return 0;
+    }
+    char *end = NULL;
+    double d = v ? strtod(v, &end) : 0.0;
+    if (!v || end == v || *end || !(d > 0.0 && d <= 180.0))
+        return lm_cli_bad(o, v, "degrees in (0, 180], or off");
+    a->options.bend_deg = (float)d;
+    return 0;
+}

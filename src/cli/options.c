@@ -85,6 +85,10 @@ const lm_cli_option lm_cli_options[] = {
      "use the file's TEXCOORD_1 as lightmap UVs instead of unwrapping"},
     {"--cone", NULL, "DEG", LM_CMD_ALL, LM_OPT_FLOAT, offsetof(lm_cli_args, options.surface_cone_deg), 0, 0, NULL,
      "max normal deviation inside one surface (default 30)"},
+    {"--bend", NULL, "DEG|off", LM_CMD_ALL, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_bend,
+     "the most a surface's shading normals may turn across one texel before its\n"
+     "texels are made finer, up to 2x, within --texels (default 15; off: one\n"
+     "texel size for all; docs/charts.md, \"Bending normals\")"},
     {"--max-atlas", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.max_atlas_size), 64, 32768, NULL,
      "the largest side of a lightmap page (default 8192): a level that does not fit\n"
      "one page gets several, a file each (docs/levels.md, \"Atlas\")"},
