@@ -474,6 +474,12 @@ static void test_lightmap_pages(void **state)
         o.max_atlas_size = bad[i];
         expect_invalid(lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e), &e, "max_atlas_size");
     }
+    lmgi_options_init(&o);
+    static const float bad_bend[] = {-2.0f, 181.0f, NAN};
+    for (int i = 0; i < 3; i++) {
+        o.bend_deg = bad_bend[i];
+        expect_invalid(lmgi_load(lmt_project_scene("cornell.glb"), &o, &sc, &e), &e, "bend_deg");
+    }
     lmgi_context_free(ctx);
 }
 

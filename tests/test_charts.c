@@ -469,6 +469,69 @@ static void test_hemisphere(void **state)
     ts_free(t);
 }
 
+/* A hexagonal column of radius r and height h at (cx, 0, 0) on `node`, its side faces' vertex normals
+ * pointing straight out from its axis: they turn 60 degrees across each face, r wide, so 60 / r degrees a
+ * unit. */
+static void ts_column(tscene *t, int node, float cx, float r, float h)
+{
+    for (int k = 0; k < 6; k++) {
+        uint32_t v[4];
+        const double ang[4] = {LM_PI * k / 3, LM_PI * (k + 1) / 3, LM_PI * (k + 1) / 3, LM_PI * k / 3};
+        for (int j = 0; j < 4; j++)
+            v[j] = ts_vertex(t, node, cx + r * (float)cos(ang[j]), j < 2 ? 0.0f : h, -r * (float)sin(ang[j]),
+                             (float)cos(ang[j]), 0.0f, (float)-sin(ang[j]));
+        ts_tri(t, node, MAT_DIFFUSE, v[0], v[1], v[2]);
+        ts_tri(t, node, MAT_DIFFUSE, v[0], v[2], v[3]);
+    }
+}
+
+/* lm_atlas_options.bend_deg 15 at 0.2 per texel: a floor keeps the atlas's texels; a column of radius 0.5
+ * and height 2, whose normals turn 120 degrees a unit (24 a texel), gets texels of 15 / 120 = 0.125; one
+ * of radius 0.2 (60 degrees a texel: more than 2 x finer would need) keeps 0.2, and so does one of radius
+ * 0.5 and height 0.4, whose faces (0.2 m^2) are under LM_BEND_MIN_TEXELS texels. With bend_deg 0 every
+ * chart keeps 0.2. */
+static void test_bending_normals_finer_texels(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(4);
+    ts_quad(t, 0, MAT_DIFFUSE, (float[3]){-3, 0, 3}, (float[3]){0, 0, -6}, (float[3]){6, 0, 0}, 4, 4, NULL);
+    ts_column(t, 1, -2.0f, 0.5f, 2.0f);
+    ts_column(t, 2, 0.0f, 0.2f, 2.0f);
+    ts_column(t, 3, 2.0f, 0.5f, 0.4f);
+    lm_surfaces su;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    for (int bend = 0; bend < 2; bend++) {
+        lm_atlas_options o;
+        lm_atlas_options_default(&o);
+        o.texel_size = 0.2f;
+        o.bend_deg = bend ? 15.0f : 0.0f;
+        lm_atlas a;
+        if (lm_atlas_build(&t->s, &su, &o, &a, &err) != LM_OK)
+            fail_msg("%s", err.msg);
+        check_atlas(&t->s, &su, &a, 1e-4);
+        int charts[4] = {0};
+        for (int c = 0; c < a.chart_count; c++) {
+            int node = su.surfaces[a.charts[c].surface].node;
+            float want = bend && node == 1 ? 0.125f : 0.2f;
+            assert_float_equal(a.charts[c].texel_size, want, 1e-4);
+            charts[node]++;
+        }
+        print_message("bend_deg %g: %u texels; charts of the floor and the columns %d %d %d %d\n", (double)o.bend_deg,
+                      a.texel_count, charts[0], charts[1], charts[2], charts[3]);
+        assert_true(charts[1] >= 6 && charts[2] >= 6 && charts[3] >= 6);
+        lm_atlas_free(&a);
+    }
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    o.bend_deg = -1.0f;
+    lm_atlas a;
+    assert_int_equal(lm_atlas_build(&t->s, &su, &o, &a, &err), LM_ERR_INVALID);
+    assert_non_null(strstr(err.msg, "bend_deg"));
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
 /* The flawed scene still gets a valid atlas by default; strict mode refuses it, naming `what`.
  * Frees su and t. */
 static void atlas_ok_then_strict_fails(tscene *t, lm_surfaces *su, const char *what)
@@ -897,6 +960,7 @@ int main(void)
         cmocka_unit_test(test_bumpy_field),
         cmocka_unit_test(test_l_shape),
         cmocka_unit_test(test_hemisphere),
+        cmocka_unit_test(test_bending_normals_finer_texels),
         cmocka_unit_test(test_degenerate_and_strict),
         cmocka_unit_test(test_nonmanifold_fin),
         cmocka_unit_test(test_bumpy_cornell),

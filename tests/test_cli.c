@@ -161,6 +161,15 @@ static void test_usage_errors(void **state)
     assert_int_equal(run("run scenes/cornell.glb --aim-direct exact --out x"), 2);
     assert_non_null(strstr(output, "--aim-direct exact"));
     assert_non_null(strstr(output, "emitters, photons or all"));
+    static const char *const bad_bend[] = {"0", "-5", "181", "15x", "on"};
+    for (int k = 0; k < 5; k++) {
+        char args[256];
+        snprintf(args, sizeof args, "info scenes/cornell.glb --bend %s", bad_bend[k]);
+        assert_int_equal(run(args), 2);
+        assert_non_null(strstr(output, "expected degrees in (0, 180], or off"));
+    }
+    assert_int_equal(run("info scenes/cornell.glb --bend off"), 0);
+    assert_int_equal(run("info scenes/cornell.glb --bend 30"), 0);
     assert_int_equal(run("run scenes/cornell.glb --aim-occluders maybe --out x"), 2);
     assert_non_null(strstr(output, "--aim-occluders maybe: expected on or off"));
     /* the indirect paths and their knobs (docs/tiled.md) */

@@ -434,19 +434,28 @@ static void test_grazing_light(void **state)
 /* ---------- slivers, zero-area triangles and a surface too small for a texel ---------- */
 
 /* The room with its lamp and one more mesh, `extra` (its triangles after the room's 12), plaster. */
-static lmgi_scene *room_with(const lmgi_mesh_desc *extra)
+/* The plaster room lit by a lamp with one more mesh, green (meshes: room, extra; *d points at them). */
+static void room_desc(const lmgi_mesh_desc *extra, lmgi_mesh_desc meshes[2], lmgi_scene_desc *d)
 {
     static box_mesh room;
+    static const lmgi_material_desc mats[2] = {{.name = "plaster", .base_color = {0.7f, 0.7f, 0.7f, 1.0f}},
+                                               {.name = "green", .base_color = {0.2f, 0.7f, 0.3f, 1.0f}}};
+    static const lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 4.0f,
+                                         .position = {-1.2f, 2.5f, -1.0f}};
     make_box(&room, (float[3]){-2, 0, -2}, (float[3]){2, 3, 2}, 1);
-    lmgi_mesh_desc meshes[2] = {
-        {.name = "room", .positions = room.v, .vertex_count = 24, .indices = room.idx, .triangle_count = 12}, *extra};
+    meshes[0] = (lmgi_mesh_desc){.name = "room", .positions = room.v, .vertex_count = 24, .indices = room.idx,
+                                 .triangle_count = 12};
+    meshes[1] = *extra;
     meshes[1].material = 1;
-    lmgi_material_desc mats[2] = {{.name = "plaster", .base_color = {0.7f, 0.7f, 0.7f, 1.0f}},
-                                  {.name = "green", .base_color = {0.2f, 0.7f, 0.3f, 1.0f}}};
-    lmgi_light_desc lamp = {.name = "lamp", .type = LMGI_LIGHT_POINT, .intensity = 4.0f,
-                            .position = {-1.2f, 2.5f, -1.0f}};
-    lmgi_scene_desc d = {.name = "room with one more mesh", .meshes = meshes, .mesh_count = 2, .materials = mats,
-                         .material_count = 2, .lights = &lamp, .light_count = 1};
+    *d = (lmgi_scene_desc){.name = "room with one more mesh", .meshes = meshes, .mesh_count = 2, .materials = mats,
+                           .material_count = 2, .lights = &lamp, .light_count = 1};
+}
+
+static lmgi_scene *room_with(const lmgi_mesh_desc *extra)
+{
+    lmgi_mesh_desc meshes[2];
+    lmgi_scene_desc d;
+    room_desc(extra, meshes, &d);
     return load(&d, 0.0f);
 }
 
@@ -585,21 +594,32 @@ static void make_column(column_mesh *c)
 
 /* Issue 33, item 5: a green column whose shading normals bend 60 degrees across each face, in the lamp-lit
  * room (room_with), against the reference at 40 x 40 and a target error of 0.03: each face of the column
- * seen by 50 pixels or more, and the frame, within 3% per channel. The issue asks 2%, and this is not met
- * yet: measured, the face beside the lamp reads 0.979 0.977 0.978 (the same column with flat normals
- * 0.991 0.991 0.991), the other 0.993 0.988 0.992; the IIM there is 1.9% under the reference's texels with bending
- * normals and 1.4% with flat ones, so the rest is the frame's: the face is three texels wide and its edge
- * pixels' normals bend past the outer texels' (at 6,358 texels the face reads 0.985, its texels 0.986;
- * docs/hard-cases.md). With the lamp at (-1.2, 2.8, 1.5) instead the faces read 0.982 and 0.985. The
- * bound keeps what is there from getting worse (the issue met 4-5% once). */
-static void test_bending_shading_normals(void **state)
+ * seen by 50 pixels or more, and the frame, within 2% per channel. The faces' normals turn 24 degrees a
+ * texel at the room's budget (1,500), so the column's texels are 0.55 x as wide (lmgi_options.bend_deg,
+ * docs/charts.md "Bending normals"; 1,424 texels in all, the room's coarser): measured, the face beside
+ * the lamp reads 0.991 0.988 0.990, the other 0.999 0.995 0.998. With one texel size (bend_deg LMGI_OFF,
+ * 1,678 texels) the face read 0.979 0.977 0.978, each edge pixel's normal bent past its outer texels'
+ * (flat normals: 0.991), which the second half asserts: the finer texels are what meets 2%. */
+/* The column in the room, baked at the defaults with bend_deg as given, against the reference: the frame
+ * within 2% per channel; returns the worst channel's |frame / reference - 1| over the column's faces seen
+ * by 50 pixels or more (at least two of them). */
+static double column_worst_face(float bend_deg)
 {
-    (void)state;
     static column_mesh col;
     make_column(&col);
-    lmgi_mesh_desc column = {.name = "column", .positions = col.v, .normals = col.n, .vertex_count = 4 * COLUMN_SIDES,
-                             .indices = col.idx, .triangle_count = 2 * COLUMN_SIDES};
-    lmgi_scene *sc = room_with(&column);
+    lmgi_mesh_desc meshes[2] = {{0}, {.name = "column", .positions = col.v, .normals = col.n,
+                                      .vertex_count = 4 * COLUMN_SIDES, .indices = col.idx,
+                                      .triangle_count = 2 * COLUMN_SIDES}};
+    lmgi_scene_desc d;
+    room_desc(&meshes[1], meshes, &d);
+    lmgi_options o;
+    lmgi_options_init(&o);
+    o.target_texels = 1500;
+    o.bend_deg = bend_deg;
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
     lmgi_context *ctx = lmt_context();
     size_t n;
     float *iim;
@@ -608,11 +628,11 @@ static void test_bending_shading_normals(void **state)
     lmt_look_at((float[3]){0.3f, 1.2f, 1.9f}, (float[3]){0, 1.0f, 0}, 1.0f, &cam);
     lmgi_reference_desc rd = {.target_error = 0.03f, .no_cache = 1};
     lmgi_check_result c;
-    lmgi_error e;
     assert_int_equal(lmgi_check_updater(u, &cam, 40, 40, &rd, &c, &e), LMGI_OK);
-    print_message("column with bending normals: frame / reference %.4f %.4f %.4f over %u pixels\n", c.ratio[0],
-                  c.ratio[1], c.ratio[2], c.pixels);
+    print_message("column with bending normals, bend_deg %g, %u texels: frame / reference %.4f %.4f %.4f over %u "
+                  "pixels\n", (double)bend_deg, lmgi_texel_count(sc), c.ratio[0], c.ratio[1], c.ratio[2], c.pixels);
     int faces = 0;
+    double worst = 0.0;
     for (int k = 0; k < c.surface_count; k++) {
         const lmgi_check_surface *f = &c.surfaces[k];
         if (f->node != 1 || f->pixels < 50)
@@ -620,17 +640,27 @@ static void test_bending_shading_normals(void **state)
         print_message("  column face (surface %d): %u pixels, %.4f %.4f %.4f\n", k, f->pixels, f->ratio[0], f->ratio[1],
                       f->ratio[2]);
         for (int ch = 0; ch < 3; ch++)
-            assert_true(fabs(f->ratio[ch] - 1.0) < 0.03);
+            worst = fmax(worst, fabs(f->ratio[ch] - 1.0));
         faces++;
     }
     assert_true(faces >= 2);
     for (int ch = 0; ch < 3; ch++)
-        assert_true(fabs(c.ratio[ch] - 1.0) < 0.03);
+        assert_true(fabs(c.ratio[ch] - 1.0) < 0.02);
     lmgi_check_free(&c);
     free(iim);
     lmgi_updater_free(u);
     lmgi_free(sc);
     lmgi_context_free(ctx);
+    return worst;
+}
+
+static void test_bending_shading_normals(void **state)
+{
+    (void)state;
+    double finer = column_worst_face(0.0f), one_size = column_worst_face((float)LMGI_OFF);
+    print_message("column's worst face: %.4f off with finer texels, %.4f with one texel size\n", finer, one_size);
+    assert_true(finer < 0.02);
+    assert_true(one_size > 0.02);
 }
 
 /* ---------- photons on one vertex, along edges and seams ---------- */
