@@ -30,17 +30,22 @@ lmgi_context *lmt_context(void)
     return ctx;
 }
 
+lmgi_scene *lmt_load_desc_with(const lmgi_scene_desc *d, const lmgi_options *o)
+{
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    if (lmgi_load_desc(d, o, &sc, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return sc;
+}
+
 static lmgi_scene *load_desc(const lmgi_scene_desc *d, int target_texels, float texel_size)
 {
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = target_texels;
     o.texel_size = texel_size;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load_desc(d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return sc;
+    return lmt_load_desc_with(d, &o);
 }
 
 lmgi_scene *lmt_room(const lmt_room_spec *spec)

@@ -22,6 +22,8 @@ typedef struct {
 /* lmgi_load_desc / lmgi_load at about target_texels texels (0: the default), or texels of texel_size world
  * units (0: derived); fails the test on an error. */
 lmgi_scene *lmt_load_desc(const lmgi_scene_desc *d, int target_texels, float texel_size);
+/* lmgi_load_desc with options o (NULL: the defaults); a failure fails the test. */
+lmgi_scene *lmt_load_desc_with(const lmgi_scene_desc *d, const lmgi_options *o);
 lmgi_scene *lmt_load(const char *path, int target_texels);
 /* lmgi_load at about target_texels texels on lightmap pages of at most `side` texels a side
  * (lmgi_options.max_atlas_size; 0: the default); fails the test on an error. */

@@ -520,6 +520,7 @@ static void test_bending_normals_finer_texels(void **state)
         print_message("bend_deg %g: %u texels; charts of the floor and the columns %d %d %d %d\n", (double)o.bend_deg,
                       a.texel_count, charts[0], charts[1], charts[2], charts[3]);
         assert_true(charts[1] >= 6 && charts[2] >= 6 && charts[3] >= 6);
+        assert_int_equal(a.bent_surfaces, bend ? 6 : 0); /* the wide column's six faces */
         lm_atlas_free(&a);
     }
     lm_atlas_options o;

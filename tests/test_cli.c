@@ -24,6 +24,17 @@ static char output[65536];
 /* Runs `lmgi ARGS` (stdout and stderr together into `output`) and returns its exit status. */
 static int run(const char *args) { return lmt_lmgi("", args, output, sizeof output); }
 
+/* `lmgi info scenes/cornell.glb OPTION VALUE` refused (exit 2) for each of the n values, saying `says`. */
+static void refused(const char *option, const char *const *values, int n, const char *says)
+{
+    for (int k = 0; k < n; k++) {
+        char args[256];
+        snprintf(args, sizeof args, "info scenes/cornell.glb %s %s", option, values[k]);
+        assert_int_equal(run(args), 2);
+        assert_non_null(strstr(output, says));
+    }
+}
+
 /* A run that must succeed: its output is shown when it does not. */
 static int run_ok(const char *args)
 {
@@ -148,12 +159,7 @@ static void test_usage_errors(void **state)
     assert_null(strstr(output, "--groups"));
     /* --sky: one radiance or three, finite and >= 0; info says what it got */
     static const char *const bad_sky[] = {"nan", "-1", "1,2", "1,2,3,4", "1,,2", "1e30", "inf", "0.5,x,1"};
-    for (int k = 0; k < 8; k++) {
-        char args[256];
-        snprintf(args, sizeof args, "info scenes/cornell.glb --sky %s", bad_sky[k]);
-        assert_int_equal(run(args), 2);
-        assert_non_null(strstr(output, "--sky"));
-    }
+    refused("--sky", bad_sky, 8, "--sky");
     assert_int_equal(run("info scenes/cornell.glb --sky 0.5,0.25,1"), 0);
     assert_non_null(strstr(output, "sky         uniform radiance (0.5 0.25 1)"));
     assert_int_equal(run("info scenes/cornell.glb --sky 2"), 0);
@@ -162,12 +168,7 @@ static void test_usage_errors(void **state)
     assert_non_null(strstr(output, "--aim-direct exact"));
     assert_non_null(strstr(output, "emitters, photons or all"));
     static const char *const bad_bend[] = {"0", "-5", "181", "15x", "on"};
-    for (int k = 0; k < 5; k++) {
-        char args[256];
-        snprintf(args, sizeof args, "info scenes/cornell.glb --bend %s", bad_bend[k]);
-        assert_int_equal(run(args), 2);
-        assert_non_null(strstr(output, "expected degrees in (0, 180], or off"));
-    }
+    refused("--bend", bad_bend, 5, "expected degrees in (0, 180], or off");
     assert_int_equal(run("info scenes/cornell.glb --bend off"), 0);
     assert_int_equal(run("info scenes/cornell.glb --bend 30"), 0);
     assert_int_equal(run("run scenes/cornell.glb --aim-occluders maybe --out x"), 2);

@@ -607,19 +607,17 @@ static double column_worst_face(float bend_deg)
 {
     static column_mesh col;
     make_column(&col);
-    lmgi_mesh_desc meshes[2] = {{0}, {.name = "column", .positions = col.v, .normals = col.n,
-                                      .vertex_count = 4 * COLUMN_SIDES, .indices = col.idx,
-                                      .triangle_count = 2 * COLUMN_SIDES}};
+    const lmgi_mesh_desc column = {.name = "column", .positions = col.v, .normals = col.n,
+                                   .vertex_count = 4 * COLUMN_SIDES, .indices = col.idx,
+                                   .triangle_count = 2 * COLUMN_SIDES};
+    lmgi_mesh_desc meshes[2];
     lmgi_scene_desc d;
-    room_desc(&meshes[1], meshes, &d);
+    room_desc(&column, meshes, &d);
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = 1500;
     o.bend_deg = bend_deg;
-    lmgi_scene *sc = NULL;
-    lmgi_error e;
-    if (lmgi_load_desc(&d, &o, &sc, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
+    lmgi_scene *sc = lmt_load_desc_with(&d, &o);
     lmgi_context *ctx = lmt_context();
     size_t n;
     float *iim;
@@ -628,6 +626,7 @@ static double column_worst_face(float bend_deg)
     lmt_look_at((float[3]){0.3f, 1.2f, 1.9f}, (float[3]){0, 1.0f, 0}, 1.0f, &cam);
     lmgi_reference_desc rd = {.target_error = 0.03f, .no_cache = 1};
     lmgi_check_result c;
+    lmgi_error e;
     assert_int_equal(lmgi_check_updater(u, &cam, 40, 40, &rd, &c, &e), LMGI_OK);
     print_message("column with bending normals, bend_deg %g, %u texels: frame / reference %.4f %.4f %.4f over %u "
                   "pixels\n", (double)bend_deg, lmgi_texel_count(sc), c.ratio[0], c.ratio[1], c.ratio[2], c.pixels);

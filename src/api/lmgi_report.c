@@ -192,6 +192,9 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     else
         fprintf(f, "atlas       %d x %d, texel %.4g units, %u texels, utilization %.1f%%\n", in.atlas_width,
                 in.atlas_height, (double)in.texel_size, in.texels, 100.0 * (double)in.utilization);
+    if (sc->atlas.bent_surfaces > 0)
+        fprintf(f, "            finer texels on %d surfaces whose shading normals bend (--bend; docs/charts.md)\n",
+                sc->atlas.bent_surfaces);
     fprintf(f, "effects\n");
     for (int i = 0; i < LM_EFFECT_COUNT; i++)
         fprintf(f, "  %s: %s — %s\n", lm_effect_name((lm_effect_id)i), sc->effects.on[i] ? "on" : "off",

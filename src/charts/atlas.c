@@ -317,6 +317,9 @@ static lm_status lay_out(const lm_scene *s, const lm_surfaces *su, const lmc_cha
         st = copy_chart_tris(&c, out, err);
     if (st == LM_OK)
         st = lmc_texels(s, &c, pos, out, err);
+    for (int i = 0; st == LM_OK && i < c.count; i++) /* a surface's charts are consecutive */
+        out->bent_surfaces += c.charts[i].texel_scale < 1.0 && !c.charts[i].on_top &&
+                              (i == 0 || c.charts[i - 1].surface != c.charts[i].surface);
     /* what counts against the budget: the walls' extra texels come on top of it */
     *budgeted = out->texel_count;
     for (uint32_t i = 0; st == LM_OK && i < out->texel_count; i++)

@@ -147,6 +147,7 @@ typedef struct {
     int *surface_first_chart, *surface_chart_count; /* per surface: its charts (charts are ordered by surface) */
     float *surface_texel_size; /* per surface: its charts' texel_size (the atlas's where it has none): how far
                                 * "within a texel" reaches there (the covered-texel rule, docs/gather.md) */
+    int bent_surfaces;     /* surfaces given finer texels for their bending normals (lm_atlas_options.bend_deg) */
     double time_unwrap, time_pack, time_texels; /* seconds spent in each stage of lm_atlas_build */
 } lm_atlas;
 
