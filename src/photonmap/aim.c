@@ -1046,8 +1046,62 @@ void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, 
 
 /* ---------- the per-pixel gathers' kernel on the surface ---------- */
 
+/* The kernel's weight (as lm_aim_kernel_coverage sums it: sum_g w_g pi x_g^2 over the Gauss radii x_g) on
+ * the surfaces other than texel t's own that the per-pixel gathers take hits from: facing within 60
+ * degrees of its normal, within r/2 of its tangent plane and x_g of it (pixel_gather.h). Sampled by
+ * COVER_RINGS x COVER_SPOKES rays a radius into the tangent disc, straight down from r/2 above it, at the
+ * texel's world position and face normal; a tilted surface counts 1 / cos as much (its area, and hits,
+ * above the sample). World units. */
+#define COVER_RINGS 3
+#define COVER_SPOKES 8
+static double kernel_on_others(const lm_rt *rt, const lm_scene *s, const lm_texel *t, int own, double radius,
+                               const double *xs, const double *ws)
+{
+    float p[3][3], e1[3], e2[3], n[3];
+    for (int v = 0; v < 3; v++)
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t->tri + (size_t)v], p[v]);
+    for (int c = 0; c < 3; c++)
+        e1[c] = p[1][c] - p[0][c], e2[c] = p[2][c] - p[0][c];
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0.0f))
+        return 0.0;
+    for (int c = 0; c < 3; c++)
+        n[c] /= len;
+    float tu[3], tv[3], dir[3] = {-n[0], -n[1], -n[2]};
+    lm_vec3 vt, vb;
+    lm_onb(lm_v3_load(n), &vt, &vb);
+    lm_v3_store(tu, vt), lm_v3_store(tv, vb);
+    double sum = 0.0;
+    for (int g = 0; g < 3; g++) {
+        double took = 0.0;
+        for (int i = 0; i < COVER_RINGS; i++)
+            for (int j = 0; j < COVER_SPOKES; j++) {
+                double rho = xs[g] * sqrt((i + 0.5) / COVER_RINGS), phi = 2.0 * LM_PI * (j + 0.5 * (i & 1)) / COVER_SPOKES;
+                float o[3];
+                for (int c = 0; c < 3; c++)
+                    o[c] = t->pos[c] + (float)(rho * cos(phi)) * tu[c] + (float)(rho * sin(phi)) * tv[c] +
+                           (float)(0.5 * radius) * n[c];
+                lm_rt_hit h;
+                float cosine = 0.0f;
+                double d2 = 0.0;
+                if (lm_rt_intersect(rt, o, dir, 0.0f, (float)radius, &h) && h.surface >= 0 && h.surface != own) {
+                    cosine = h.ng[0] * n[0] + h.ng[1] * n[1] + h.ng[2] * n[2]; /* its front towards X's side */
+                    for (int c = 0; c < 3; c++) /* the gathers' distance is in 3D */
+                        d2 += ((double)o[c] + h.t * dir[c] - t->pos[c]) * ((double)o[c] + h.t * dir[c] - t->pos[c]);
+                }
+                if (d2 >= xs[g] * xs[g])
+                    cosine = 0.0f;
+                if (cosine >= 0.5f) /* a tilted surface holds 1 / cos as much area, and hits, above the sample */
+                    took += 1.0 / cosine;
+            }
+        sum += ws[g] * LM_PI * xs[g] * xs[g] * took / (COVER_RINGS * COVER_SPOKES);
+    }
+    return sum;
+}
+
 lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
-                                 float radius, float *out, lm_error *err)
+                                 const lm_rt *rt, float radius, float *out, lm_error *err)
 {
     static const double GX[3] = {-0.7745966692414834, 0.0, 0.7745966692414834}, GW[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
     const double c = 0.2; /* the kernel's clamp (pixel_gather.h) */
@@ -1076,11 +1130,20 @@ lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_
             const lm_texel *t = &a->texels[aim->texel_list[i]];
             double n[3];
             local_face_normal(s, t->tri, n);
-            double r = (double)radius / sqrt(area_factor(&L, n)), on = 0.0, full = 0.0, nearest;
+            double r = (double)radius / sqrt(area_factor(&L, n)), on = 0.0, full = 0.0, nearest, xs[3];
             for (int g = 0; g < 3; g++) {
                 double x = r * (1.0 - 0.5 * c + 0.5 * c * GX[g]);
                 on += GW[g] * disc_area_on_surface(&ef, &bd, t->local, n, x * x, 0, &nearest);
                 full += GW[g] * LM_PI * x * x;
+                xs[g] = (double)radius * (1.0 - 0.5 * c + 0.5 * c * GX[g]);
+            }
+            /* where the disc leaves the surface, the gathers also take the hits of the surfaces around that
+             * face the same way (a sphere's other facets): their part of the disc counts too, in world units */
+            if (rt && on < full * (1.0 - 1e-6)) {
+                double world = 0.0;
+                for (int g = 0; g < 3; g++)
+                    world += GW[g] * LM_PI * xs[g] * xs[g];
+                on += kernel_on_others(rt, s, t, k, radius, xs, GW) * full / world;
             }
             out[aim->texel_list[i]] = full > 0.0 ? (float)fmin(fmax(on / full, MIN_COVERAGE), 1.0) : 1.0f;
         }

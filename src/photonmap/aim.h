@@ -36,6 +36,7 @@
 #include "../scene/scene.h"
 #include "../trace/direct_irradiance.h"
 #include "../trace/photon_store.h"
+#include "../trace/rt_scene.h"
 #include "kdtree.h"
 #include "seams.h"
 
@@ -159,9 +160,12 @@ void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover,
  * 1/4 in a corner), from the same exact disc-on-surface areas as the AIM's boundary correction, in the
  * texel's tangent plane at its node's current scale. The kernel is the integral of box discs of radius t
  * over t in [(1 - c) r, r], weight 1 / r, taken with 3-point Gauss-Legendre (exact for the full disc).
- * out: a->texel_count floats. Cost: O(texels x boundary edges within r). Errors: out of memory. */
+ * With rt, a texel whose disc leaves its surface also counts the part on the surfaces whose hits the
+ * gathers take there (the other facets of a ball, facing within 60 degrees), sampled by 24 rays a Gauss
+ * radius; without, its own surface's part alone. out: a->texel_count floats. Cost: O(texels x boundary
+ * edges within r), and 72 rays a texel near a boundary with rt. Errors: out of memory. */
 lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_surfaces *su, const lm_atlas *a,
-                                 float radius, float *out, lm_error *err);
+                                 const lm_rt *rt, float radius, float *out, lm_error *err);
 
 /* Refreshes up to `budget` surfaces (budget < 0: no limit) whose delta_f + owed is over the threshold, in
  * order of (delta_f + owed) / area (ties: lower surface id first), and resets both; the delta_f of each is

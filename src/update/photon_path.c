@@ -87,7 +87,7 @@ lm_status lm_photon_path_coverage(lm_photon_path *pp, lm_direct *direct, lm_erro
     if (!c)
         return lm_fail(err, LM_ERR_NOMEM, "no memory for the coverage of %u texels", pp->w->atlas->texel_count);
     lm_status st = lm_aim_kernel_coverage(lm_photon_stage_aim(pp->stage), pp->w->scene, pp->w->surfaces, pp->w->atlas,
-                                          pp->radius, c, err);
+                                          pp->w->rt, pp->radius, c, err);
     if (st == LM_OK)
         st = lm_direct_set_coverage(direct, c, err);
     free(c);
