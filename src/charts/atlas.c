@@ -191,7 +191,8 @@ static double texel_scale(const lm_surface *f, float ts, int wall_texels)
 
 /* Per surface: how fast its shading normals turn, radians per world unit: over its triangles, the
  * area-weighted mean of the fastest turn along an edge (the angle between the edge's two vertex normals
- * over its length). An area weighting, not the largest: a sliver's short edge must not set it. */
+ * over its length). An area weighting, not the largest: a sliver's short edge must not set it. pos: the
+ * world positions (lmc_world_positions). */
 static double *surface_bends(const lm_scene *s, const lm_surfaces *su, const float *pos)
 {
     float *nrm = lmc_world_normals(s);
@@ -205,7 +206,9 @@ static double *surface_bends(const lm_scene *s, const lm_surfaces *su, const flo
         double sum = 0.0, area = 0.0;
         for (uint32_t i = 0; i < sf->tri_count; i++) {
             const uint32_t *v = s->tris + 3 * (size_t)sf->tris[i];
-            double fastest = 0.0, a = lm_scene_tri_area_world(s, sf->tris[i]);
+            lm_vec3 p0 = lm_v3_load(pos + 3 * (size_t)v[0]), p1 = lm_v3_load(pos + 3 * (size_t)v[1]),
+                    p2 = lm_v3_load(pos + 3 * (size_t)v[2]);
+            double fastest = 0.0, a = 0.5 * (double)lm_length(lm_cross(lm_sub(p1, p0), lm_sub(p2, p0)));
             for (int e = 0; e < 3; e++) {
                 const float *pa = pos + 3 * (size_t)v[e], *pb = pos + 3 * (size_t)v[(e + 1) % 3];
                 const float *na = nrm + 3 * (size_t)v[e], *nb = nrm + 3 * (size_t)v[(e + 1) % 3];
@@ -226,11 +229,11 @@ static double *surface_bends(const lm_scene *s, const lm_surfaces *su, const flo
 }
 
 /* A bending surface's texel size over the atlas's ts: 1, or less where its normals would turn more than
- * bend_deg a texel (lm_atlas_options.bend_deg; 0: off), but never finer than 1 / LM_BEND_REFINE. */
+ * bend_deg (> 0) a texel, where 1 / LM_BEND_REFINE is fine enough. */
 static double bend_scale(double bend, float ts, float bend_deg)
 {
     double most = bend_deg * LM_PI / 180.0;
-    if (!(bend_deg > 0.0f) || !(bend * ts > most) || bend * ts > most * LM_BEND_REFINE)
+    if (!(bend * ts > most) || bend * ts > most * LM_BEND_REFINE)
         return 1.0;
     return most / (bend * ts);
 }
@@ -274,7 +277,7 @@ static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, cons
         }
         /* a bending surface's finer texels count against the budget, a wall's do not */
         int wall = scale < 1.0;
-        if (!small && su->surfaces[c->charts[i].surface].area >= LM_BEND_MIN_TEXELS * ts * ts)
+        if (bend && !small && su->surfaces[c->charts[i].surface].area >= LM_BEND_MIN_TEXELS * ts * ts)
             scale = fmin(scale, bend_scale(bend[c->charts[i].surface], ts, o->bend_deg));
         for (int k = i; k < end; k += small ? end - i : 1) {
             lmc_chart *d = &v->charts[v->count++];
@@ -345,8 +348,8 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     float *pos = lmc_world_positions(s, &size);
     if (!pos)
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
-    double *bend = surface_bends(s, su, pos);
-    if (!bend) {
+    double *bend = o->bend_deg > 0.0f ? surface_bends(s, su, pos) : NULL; /* NULL: the rule is off */
+    if (o->bend_deg > 0.0f && !bend) {
         free(pos);
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
     }

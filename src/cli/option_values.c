@@ -190,7 +190,6 @@ int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a)
     return 0;
 }
 
-
 int lm_cli_opt_bend(const char *o, const char *v, lm_cli_args *a)
 {
     if (v && !strcmp(v, "off")) {

@@ -1121,6 +1121,9 @@ lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_
     }
     for (uint32_t i = 0; i < a->texel_count; i++)
         out[i] = 1.0f;
+    double xs[3], world = 0.0; /* the Gauss radii in world units, and the whole kernel's weight there */
+    for (int g = 0; g < 3; g++)
+        xs[g] = (double)radius * (1.0 - 0.5 * c + 0.5 * c * GX[g]), world += GW[g] * LM_PI * xs[g] * xs[g];
     for (int k = 0; k < su->surface_count; k++) {
         linear_map L;
         linear_map_of(s->nodes[su->surfaces[k].node].world, &L);
@@ -1130,21 +1133,16 @@ lm_status lm_aim_kernel_coverage(const lm_aim *aim, const lm_scene *s, const lm_
             const lm_texel *t = &a->texels[aim->texel_list[i]];
             double n[3];
             local_face_normal(s, t->tri, n);
-            double r = (double)radius / sqrt(area_factor(&L, n)), on = 0.0, full = 0.0, nearest, xs[3];
+            double r = (double)radius / sqrt(area_factor(&L, n)), on = 0.0, full = 0.0, nearest;
             for (int g = 0; g < 3; g++) {
                 double x = r * (1.0 - 0.5 * c + 0.5 * c * GX[g]);
                 on += GW[g] * disc_area_on_surface(&ef, &bd, t->local, n, x * x, 0, &nearest);
                 full += GW[g] * LM_PI * x * x;
-                xs[g] = (double)radius * (1.0 - 0.5 * c + 0.5 * c * GX[g]);
             }
             /* where the disc leaves the surface, the gathers also take the hits of the surfaces around that
-             * face the same way (a sphere's other facets): their part of the disc counts too, in world units */
-            if (rt && on < full * (1.0 - 1e-6)) {
-                double world = 0.0;
-                for (int g = 0; g < 3; g++)
-                    world += GW[g] * LM_PI * xs[g] * xs[g];
-                on += kernel_on_others(rt, s, t, k, radius, xs, GW) * full / world;
-            }
+             * face the same way (a sphere's other facets): their part of the disc counts too (world units) */
+            if (rt && on < full * (1.0 - 1e-6))
+                on += kernel_on_others(rt, s, t, k, radius, xs, GW) / world * full;
             out[aim->texel_list[i]] = full > 0.0 ? (float)fmin(fmax(on / full, MIN_COVERAGE), 1.0) : 1.0f;
         }
     }
