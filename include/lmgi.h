@@ -192,7 +192,9 @@ LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
  * its next lmgi_update, as it sees an animation's move. Without a time budget, a move after an update
  * without edits is caught up in one go: the photon paths it changed are re-traced and the AIMs they
  * reach refreshed in that update (lmgi_update_stats.groups_at_once), whatever photons.group_budget and
- * aim.surfaces_per_frame say; edits made update after update stay within those counts (docs/api.md). */
+ * aim.surfaces_per_frame say, and the lightmap texels it changed most, 32 updates' worth of
+ * gather.texels_per_frame, gathered and shown at once, without the blend; edits made update after update
+ * stay within those counts (docs/api.md). */
 LMGI_API int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
 LMGI_API int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
 /* A fingerprint of the scene's geometry: the names of the nodes that hold triangles, in order, and each

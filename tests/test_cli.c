@@ -1344,8 +1344,11 @@ static void test_tradeoff_update_lag(void **state)
     snprintf(path, sizeof path, "%s/lag_script.json", dir);
     FILE *f = fopen(path, "w");
     assert_non_null(f);
+    /* the move right after a nudge (a drag under way): not caught up in its own update, as a move after a
+     * still update is (photon_stage.c catch_up), so its lag is the budgets' to set */
     fprintf(f, "{\"scene\": \"cornell.glb\", \"frames\": 60, \"fps\": 0, \"budget_ms\": 0, \"texels\": 800,\n"
-               " \"edits\": [{\"frame\": 2, \"node\": \"dynamic_cube\", \"translate\": [-1.1, 0, 0]}]}\n");
+               " \"edits\": [{\"frame\": 1, \"node\": \"dynamic_cube\", \"translate\": [-0.001, 0, 0]},\n"
+               "  {\"frame\": 2, \"node\": \"dynamic_cube\", \"translate\": [-1.099, 0, 0]}]}\n");
     fclose(f);
     snprintf(args, sizeof args, "tradeoff two_rooms.glb --edits %s --out %s/lagbad", path, dir);
     assert_int_equal(run(args), 2);
@@ -1361,9 +1364,14 @@ static void test_tradeoff_update_lag(void **state)
     int knob = csv_column(header, "knob"), value = csv_column(header, "value"), error = csv_column(header, "error");
     int to5 = csv_column(header, "frames_to_5"), def = csv_column(header, "default");
     int frame_error = csv_column(header, "frame_error"), frame_end = csv_column(header, "frame_end");
-    assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0 && def >= 0 && frame_error >= 0 && frame_end >= 0);
+    int frame = csv_column(header, "frame");
+    assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0 && def >= 0 && frame_error >= 0 && frame_end >= 0 &&
+                frame >= 0);
     int plays = 0, lag5 = -2, lag80 = -2, lag_default = -2, lag_surfaces = -2;
     while (fgets(line, sizeof line, f)) {
+        csv_field(line, frame, v, sizeof v);
+        if (atoi(v) != 2) /* the nudge */
+            continue;
         plays++;
         csv_field(line, error, v, sizeof v);
         double e = atof(v);

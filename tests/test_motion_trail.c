@@ -4,8 +4,8 @@
  * surfaces by their photons' change) the moving cube's own faces, whose photons hardly change, wait
  * behind the floor for good: a block of them is 2.1 times off after 60 updates and growing (the mean of
  * the samples' worst blocks 1.11). With texels picked by the change of what they see, the worst block is
- * 0.66 off and that mean 0.43; with the texels still waiting shown from the changes of those gathered
- * (progressive refinement, item 3; gpu/gather/iim.h), 0.48 and 0.33. The updaters run side by side on the
+ * 0.62 off and that mean 0.35; with the texels still waiting shown from the changes of those gathered
+ * (progressive refinement, item 3; gpu/gather/iim.h), 0.47 and 0.29. The updaters run side by side on the
  * same scene and times, so the test shows the difference it guards. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -164,13 +164,14 @@ static void test_moving_cube_followed_texel_by_texel(void **state)
                       "the samples' worst %.2f); worst step between neighbours %.2f of the mean texel (mean %.2f)\n",
                       FRAMES, name[k], worst[k], sum[k] / samples, step[k], step_sum[k] / samples);
     assert_true(worst[0] > 1.5);  /* the stall this guards against (2.06 measured) */
-    /* each alone: 0.66 and 0.43 measured (the frame budget, 20 texels, is spent every update); 0.86 and 0.50
+    /* each alone: 0.62 and 0.35 measured (0.66 and 0.43 with the bar to go ahead at 4 times the atlas's mean
+     * change, not its median) (the frame budget, 20 texels, is spent every update); 0.86 and 0.50
      * while the texels a surface's refresh gathered kept their change, and the bar to go ahead with it */
     assert_true(worst[1] < 0.8);
-    assert_true(sum[1] / samples < 0.45 * sum[0] / samples); /* 0.43 against 1.11 */
+    assert_true(sum[1] / samples < 0.45 * sum[0] / samples); /* 0.35 against 1.11 */
     /* those waiting shown from their gathered neighbours (progressive refinement, issue 32 item 3) */
-    assert_true(worst[2] < 0.58); /* 0.48 measured */
-    assert_true(sum[2] / samples < 0.85 * sum[1] / samples); /* 0.33 against 0.43 */
+    assert_true(worst[2] < 0.58); /* 0.47 measured */
+    assert_true(sum[2] / samples < 0.85 * sum[1] / samples); /* 0.29 against 0.35 */
     for (int k = 0; k < 3; k++) {
         lmgi_updater_free(u[k]);
         lmgi_free(sc[k]);
@@ -178,17 +179,20 @@ static void test_moving_cube_followed_texel_by_texel(void **state)
     lmgi_context_free(ctx);
 }
 
-/* The cube moved once (bench/cornell_edits.json's edit) in a scene made `spread` or not. */
-static void move_cube(lmgi_scene *sc)
+/* The cube moved along x by dx. */
+static void move_cube_by(lmgi_scene *sc, float dx)
 {
     int node = lmgi_find_node(sc, "dynamic_cube");
     float m[16];
     lmgi_error e;
     assert_true(node >= 0 && lmgi_get_node_transform(sc, node, m));
-    m[12] -= 1.1f;
+    m[12] += dx;
     if (lmgi_set_node_transform(sc, node, m, &e) != LMGI_OK)
         fail_msg("%s", e.message);
 }
+
+/* The cube moved once, as bench/cornell_edits.json's edit does. */
+static void move_cube(lmgi_scene *sc) { move_cube_by(sc, -1.1f); }
 
 /* An engine re-reads only the surfaces whose lmgi_surface_version moved: every texel of the others must be
  * as it was (the estimates of texels that wait move versions too). version[] is brought up to date. */
@@ -208,11 +212,73 @@ static void unchanged_where_version_stayed(lmgi_updater *u, const lmgi_scene *sc
         version[j] = lmgi_surface_version(u, j);
 }
 
-/* Progressive refinement (issue 32, item 3): after one move of the cube, at 20 texels an update, every
- * update's lightmap against a fresh bake of the moved scene. Texels gathered ahead among stale neighbours
- * showed as steps (squares in the frame); with the texels that wait shown from their gathered neighbours'
- * changes, the steps and the blocks' error are smaller at every moment, and both converge: the moved
- * texels are gathered again once the photon stage has caught up with the move. */
+typedef struct {
+    double step, step_sum, block, block_sum, last;
+    int within; /* the updates after which every 4 x 4 block stays within 10% of the fresh bake (0: at once) */
+} move_lag;
+
+/* The cube moved once in a fresh updater's scene (`spread`: texels that wait shown from their gathered
+ * neighbours, or not), its lightmap compared with `want` at each of `updates` updates. `after_edit`: the
+ * update before the move nudged the cube (a drag under way), so the move is not caught up at once
+ * (update/photon_stage.c catch_up) and follows at 20 texels an update. */
+static move_lag one_move(lmgi_context *ctx, const lmgi_info *in, const float *want, int spread, int after_edit,
+                         int updates)
+{
+    move_lag r = {0};
+    lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
+    lmgi_updater *u = updater(ctx, sc, 0.0f, spread ? 0 : LMGI_OFF);
+    size_t n;
+    if (after_edit) {
+        move_cube_by(sc, -0.001f);
+        lmt_update(u);
+    }
+    float *before = lmt_iim(u, sc, &n), *prev = lmt_iim(u, sc, &n);
+    uint32_t *version = malloc(sizeof *version * (size_t)in->surfaces);
+    assert_non_null(version);
+    for (int j = 0; j < in->surfaces; j++)
+        version[j] = lmgi_surface_version(u, j);
+    move_cube_by(sc, after_edit ? -1.099f : -1.1f);
+    lmgi_error e;
+    for (int f = 0; f < updates; f++) {
+        if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
+            fail_msg("%s", e.message);
+        float *shown = lmt_iim(u, sc, &n);
+        unchanged_where_version_stayed(u, sc, version, prev, shown);
+        memcpy(prev, shown, sizeof *prev * n);
+        double st = worst_step(in, shown, want, before), b = worst_block(in, shown, want);
+        r.step = fmax(r.step, st), r.step_sum += st;
+        r.block = fmax(r.block, b), r.block_sum += b;
+        r.last = b;
+        r.within = b > 0.1 ? f + 1 : r.within;
+        free(shown);
+    }
+    print_message("the cube moved once%s, %d updates, %s: worst step between neighbours %.2f of the mean texel (mean "
+                  "over the updates %.2f), worst 4x4 block %.2f (mean %.2f, last %.2f; every block within 10%% after "
+                  "%d updates)\n",
+                  after_edit ? " right after a nudge" : " after a still update", updates,
+                  spread ? "those waiting shown from their neighbours" : "each texel alone", r.step,
+                  r.step_sum / updates, r.block, r.block_sum / updates, r.last, r.within);
+    free(before);
+    free(prev);
+    free(version);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    return r;
+}
+
+/* Issue 32, item 6 (no trail: no 4 x 4 block more than 10% off for more than 10 updates after a node
+ * passes) and item 3 (progressive refinement): after one move of the cube, every update's lightmap against a
+ * fresh bake of the moved scene, at `lmgi run`'s 20 texels an update.
+ * - After a still update (an artist's drag released) the move is caught up in its own update: its photons
+ *   and AIMs (photon_stage.c), then its texels, LM_CATCH_UP_UPDATES updates' worth gathered and shown at once
+ *   (lightmap_path.c). Every block is within 10% from the first update on (0.03 measured); before, the
+ *   texels went 15 an update, blended over 8, and the last blocks (the walls by the floor beside the cube's
+ *   new and old places, 17% off) waited 17 updates behind a bar of 4 times the atlas's mean change, which the
+ *   cube's own faces had lifted over them (texel_change.c, typical_change).
+ * - Right after another edit (a drag under way) the move follows at 20 texels an update. Texels gathered ahead
+ *   among stale neighbours showed as steps (squares in the frame); with the texels that wait shown from their
+ *   gathered neighbours' changes, the steps and the blocks' error are smaller at every moment, and both
+ *   converge: the moved texels are gathered again once the photon stage has caught up with the move. */
 static void test_one_move_refined(void **state)
 {
     (void)state;
@@ -224,60 +290,31 @@ static void test_one_move_refined(void **state)
     float *want = lmt_iim(fresh, moved, &n);
     lmgi_info in;
     lmgi_get_info(moved, &in);
-    double step[2] = {0}, step_sum[2] = {0}, block[2] = {0}, block_sum[2] = {0}, last[2] = {0};
-    int within[2] = {0, 0}; /* the updates after which every 4 x 4 block stays within 10% of the fresh bake */
     enum { UPDATES = 40 };
     for (int k = 0; k < 2; k++) {
-        lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
-        lmgi_updater *u = updater(ctx, sc, 0.0f, k ? 0 : LMGI_OFF);
-        float *before = lmt_iim(u, sc, &n), *prev = lmt_iim(u, sc, &n);
-        uint32_t *version = malloc(sizeof *version * (size_t)in.surfaces);
-        assert_non_null(version);
-        for (int j = 0; j < in.surfaces; j++)
-            version[j] = lmgi_surface_version(u, j);
-        move_cube(sc);
-        lmgi_error e;
-        for (int f = 0; f < UPDATES; f++) {
-            if (lmgi_update(u, 0.0f, 0.0f, NULL, &e) != LMGI_OK)
-                fail_msg("%s", e.message);
-            float *shown = lmt_iim(u, sc, &n);
-            unchanged_where_version_stayed(u, sc, version, prev, shown);
-            memcpy(prev, shown, sizeof *prev * n);
-            double st = worst_step(&in, shown, want, before), b = worst_block(&in, shown, want);
-            step[k] = fmax(step[k], st), step_sum[k] += st;
-            block[k] = fmax(block[k], b), block_sum[k] += b;
-            last[k] = b;
-            within[k] = b > 0.1 ? f + 1 : within[k];
-            free(shown);
-        }
-        print_message("the cube moved once, %d updates, %s: worst step between neighbours %.2f of the mean texel "
-                      "(mean over the updates %.2f), worst 4x4 block %.2f (mean %.2f, last %.2f; every block within "
-                      "10%% after %d updates)\n",
-                      UPDATES, k ? "those waiting shown from their neighbours" : "each texel alone", step[k],
-                      step_sum[k] / UPDATES, block[k], block_sum[k] / UPDATES, last[k], within[k]);
-        /* converged: 0.03 both, every block within 10% after 20 and 17 updates (issue 32, item 6, asks 10 after
-         * a node passes); 26 and 24 while the move's 66 photon groups were re-traced 16 an update and its
-         * AIMs refreshed 4 an update (photon_stage.c, catch_up). Before that, 0.44 and 0.46 after 40 updates,
-         * never within 10%: the moved cube's paths were found one photon a group an update, its faces were
-         * gathered from AIMs that had not caught up and not again, and a floor texel by its old place held
+        move_lag r = one_move(ctx, &in, want, k, 0, UPDATES);
+        assert_int_equal(r.within, 0); /* every block within 10% at once: 0.03 measured, both */
+        assert_true(r.step < 0.15);    /* no square: 0.05 measured */
+    }
+    move_lag r[2];
+    for (int k = 0; k < 2; k++) {
+        r[k] = one_move(ctx, &in, want, k, 1, UPDATES);
+        assert_true(r[k].last < 0.1);
+        /* 27 and 24 measured: the move's 66 photon groups re-traced 16 an update and its AIMs refreshed 4 an
+         * update (photon_stage.c), its texels 15 an update, blended over 8. Before, 0.44 and 0.46 after 40
+         * updates, never within 10%: the moved cube's paths were found one photon a group an update, its faces
+         * were gathered from AIMs that had not caught up and not again, and a floor texel by its old place held
          * its old contact shadow while the floor's refresh lasted (photons.h lm_photons_invalidate_boxes,
          * texel_change.h lm_texel_change_settle, lightmap_path.c commit_waiting) */
-        assert_true(last[k] < 0.1);
-        assert_true(within[k] <= (k ? 19 : 22));
-        free(before);
-        free(prev);
-        free(version);
-        lmgi_updater_free(u);
-        lmgi_free(sc);
+        assert_true(r[k].within <= (k ? 27 : 30));
     }
-    /* the steps a texel gathered among stale ones makes: 0.23 of the mean texel on average over the updates
-     * alone, 0.13 with those waiting shown from it; the worst, 0.82 alone, in the first update (a texel
+    /* the steps a texel gathered among stale ones makes: 0.28 of the mean texel on average over the updates
+     * alone, 0.17 with those waiting shown from it; the worst, 0.81 alone, in the first update (a texel
      * gathered beside those that came out of the cube's old place, which show at once, blending in from the
-     * old contact shadow), 0.33 with it starting from its neighbours' estimate (0.26, 0.15, 0.81 and 0.43
-     * while the move's photons and AIMs caught up over 9 updates) */
-    assert_true(step_sum[1] < 0.7 * step_sum[0]);
-    assert_true(step[1] < 0.6 * step[0]);
-    assert_true(block_sum[1] < 1.1 * block_sum[0]); /* and the blocks no worse (0.19 and 0.18) */
+     * old contact shadow), 0.46 with it starting from its neighbours' estimate */
+    assert_true(r[1].step_sum < 0.7 * r[0].step_sum);
+    assert_true(r[1].step < 0.6 * r[0].step);
+    assert_true(r[1].block_sum < 1.1 * r[0].block_sum); /* and the blocks no worse (0.27 and 0.25) */
     free(want);
     lmgi_updater_free(fresh);
     lmgi_free(moved);

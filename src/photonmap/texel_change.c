@@ -9,7 +9,8 @@
 #include "delta_i.h"
 
 #define BLOCK 4 /* atlas texels per side of an AIM emitter block */
-#define LOCAL 4.0 /* a texel goes ahead only when its change passes this many times the atlas's mean */
+#define LOCAL 4.0 /* a texel goes ahead only when its change passes this many times the atlas's median */
+#define TYPICAL_SAMPLES 8192 /* texels the median is taken over (every stride-th), bounding its cost */
 
 static const float *aim_at(const lm_atlas *a, const float *aim_rgb, uint32_t i)
 {
@@ -135,7 +136,8 @@ static float sphere_factor(const float *p, const float *n, const float sph[4])
 
 /* Node n moved from matrix old to its current one: every other texel sees its sphere at both places;
  * its own texels' hemispheres shifted with them (their positions and normals brought up to date). */
-static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a, int n, const float old[16])
+static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a, int n, const float old[16],
+                           int settled)
 {
     float was[4], now[4];
     world_sphere(tc->node_sphere + 4 * n, old, was);
@@ -144,13 +146,15 @@ static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atla
      * of the sphere's form factor (a small step changes little even right under the object) */
     float step = lm_length(lm_sub(lm_v3_load(now), lm_v3_load(was)));
     float moved = fminf(1.0f, step / fmaxf(now[3], 1e-20f) + fabsf(now[3] - was[3]) / fmaxf(now[3], 1e-20f));
-    tc->any_unsettled = 1;
+    float *unsettled = settled ? NULL : tc->unsettled;
+    tc->any_unsettled |= !settled;
     for (uint32_t i = 0; i < a->texel_count; i++) {
         float *p = tc->pos + 3 * (size_t)i, *nr = tc->nrm + 3 * (size_t)i;
         if (tc->texel_node[i] != n) {
             float c = moved * (sphere_factor(p, nr, was) + sphere_factor(p, nr, now));
             tc->change[i] += c;
-            tc->unsettled[i] += c;
+            if (unsettled)
+                unsettled[i] += c;
             continue;
         }
         float q[3], m[3];
@@ -159,13 +163,14 @@ static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atla
         float turn = 1.0f - lm_dot(lm_v3_load(m), lm_v3_load(nr));
         float c = fminf(1.0f, dx / fmaxf(now[3], 1e-20f) + turn);
         tc->change[i] += c;
-        tc->unsettled[i] += c;
+        if (unsettled)
+            unsettled[i] += c;
         memcpy(p, q, sizeof q);
         memcpy(nr, m, sizeof m);
     }
 }
 
-int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a)
+int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a, int settled)
 {
     int moved = 0;
     for (int n = 0; n < s->node_count && n < tc->node_count; n++) {
@@ -173,7 +178,7 @@ int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas
         if (!memcmp(seen, s->nodes[n].world, 16 * sizeof(float)))
             continue;
         if (tc->node_sphere[4 * n + 3] >= 0.0f)
-            add_moved_node(tc, s, a, n, seen);
+            add_moved_node(tc, s, a, n, seen, settled);
         memcpy(seen, s->nodes[n].world, 16 * sizeof(float));
         moved++;
     }
@@ -300,6 +305,54 @@ void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const l
     free(slot);
 }
 
+/* The k-th smallest of v[0..n) (k < n), v reordered (quickselect, Hoare's partition). */
+static float kth_smallest(float *v, uint32_t n, uint32_t k)
+{
+    uint32_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        float pivot = v[lo + (hi - lo) / 2];
+        uint32_t i = lo, j = hi;
+        while (i <= j) {
+            while (v[i] < pivot)
+                i++;
+            while (v[j] > pivot)
+                j--;
+            if (i <= j) {
+                float t = v[i];
+                v[i] = v[j], v[j] = t;
+                i++;
+                if (j == 0)
+                    break;
+                j--;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return v[k];
+    }
+    return v[k];
+}
+
+/* The median change of the texels not on surfaces switched off, over at most TYPICAL_SAMPLES of them (every
+ * stride-th, so the same texels each time). What reached every texel alike (a light dimmed) moves it; a
+ * local change (a node moved) leaves most texels, and with them the median, at about nothing. */
+static float typical_change(const lm_texel_change *tc, const lm_atlas *a, const uint8_t *off)
+{
+    uint32_t stride = tc->texel_count / TYPICAL_SAMPLES + 1, n = 0;
+    float *v = malloc(sizeof *v * (tc->texel_count / stride + 1));
+    if (!v)
+        return 0.0f; /* no bar above the threshold: every changed texel may go ahead */
+    for (uint32_t i = 0; i < tc->texel_count; i += stride)
+        if (!off[a->texels[i].surface])
+            v[n++] = tc->change[i] + fabsf(tc->lit[i]);
+    float m = n ? kth_smallest(v, n, n / 2) : 0.0f;
+    free(v);
+    return m;
+}
+
 typedef struct {
     float change;
     uint32_t texel;
@@ -354,15 +407,12 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
     if (!h)
         return 0;
     /* a change that reached everything alike (a light dimmed) is the surfaces' order's to follow: a texel
-     * goes ahead only when it changed more than LOCAL times the atlas's mean (with 2, texels re-flagged as
+     * goes ahead only when it changed more than LOCAL times the atlas's median (with 2, texels re-flagged as
      * the AIMs caught up over many updates took the budget, and the Cornell box's halved light was not
-     * within 5% in 120 updates; 101 with whole surfaces only, 102 with 4) */
-    double mean = 0.0;
-    uint32_t on = 0;
-    for (uint32_t i = 0; i < tc->texel_count; i++)
-        if (!off[a->texels[i].surface])
-            mean += tc->change[i] + fabsf(tc->lit[i]), on++;
-    float floor = all ? tc->threshold : fmaxf(tc->threshold, (float)(LOCAL * mean / (on ? on : 1)));
+     * within 5% in 120 updates; 101 with whole surfaces only, 102 with 4). The median, not the mean: a
+     * moved cube's own faces and the floor under it lifted the mean's bar over the walls beside its new
+     * place, whose light changed by 17%, and they waited 11 updates for their surfaces' turn. */
+    float floor = all ? tc->threshold : fmaxf(tc->threshold, (float)LOCAL * typical_change(tc, a, off));
     /* a doubted factor is this texel's own error, not a change that reached everything alike: it goes
      * ahead past the threshold alone */
     for (uint32_t i = 0; i < tc->texel_count; i++) {

@@ -22,21 +22,25 @@
  *     error (lm_texel_change_doubt), kept apart, since it is the texel's own error and not a change that
  *     reached everything alike.
  * A texel's change is the motion sum plus the magnitude of the signed sum plus the doubt. Picking takes the
- * texels whose change is over the threshold and, less the doubt, over 4 times the atlas's mean change (a
- * change that reaches everything alike, a light dimmed, is the surfaces' order's to follow) or whose doubt
- * alone is over the threshold, most changed first, then by index, and zeroes them.
+ * texels whose change is over the threshold and, less the doubt, over 4 times the atlas's median change (a
+ * change that reaches everything alike, a light dimmed, is the surfaces' order's to follow; the median, not
+ * the mean, so that the large sums of a moved node's own faces do not lift the bar over the texels around
+ * it) or whose doubt alone is over the threshold, most changed first, then by index, and zeroes them.
  * A texel gathered for a move right after it saw the AIMs around as the move's photons had yet to change
  * them (the moved cube's faces saw the floor without its new shadow, 40% too bright, and the AIMs' later
  * refreshes lent them too little change to pass the bar: 200 updates until the surfaces' order came
  * round). So the motion sum is also kept aside, unsettled, and added to the change again once the photon
  * stage has caught up (lm_texel_change_settle): the moved texels are gathered once more, from AIMs that
- * have caught up.
+ * have caught up. Unless the stage caught up before the move's first gather (a placement after a still
+ * update, update/photon_stage.c catch_up): a second pass then only doubled the move's work, and the
+ * texels it changed least waited behind it.
  *
  * Layout: per atlas texel (lm_atlas.texels order) change, world position and normal (kept current for
  * moved nodes), the unsettled motion sum, the doubt and the AIM radiance last looked at; per node its last
  * world matrix and local bounding sphere. Memory: 44 bytes a texel, 80 a node.
  * Cost: O(texels of moved nodes + moved nodes x texels) per moved frame; O(blocks x texels) for AIM
- * changes, bounded as said (a few ms); O(texels log budget) to pick. Nothing when nothing changed.
+ * changes, bounded as said (a few ms); O(texels log budget) to pick, the median over at most 8,192 texels
+ * (every stride-th) with a scratch copy of them. Nothing when nothing changed.
  * Deterministic (fixed order, no threads). Not thread-safe: the scene and AIM must not change meanwhile. */
 #ifndef LM_TEXEL_CHANGE_H
 #define LM_TEXEL_CHANGE_H
@@ -74,8 +78,9 @@ lm_status lm_texel_change_init(lm_texel_change *tc, const lm_scene *s, const lm_
 void lm_texel_change_free(lm_texel_change *tc);
 
 /* Adds the change of every node whose world matrix moved since the last call (or the init). Returns how
- * many nodes moved. */
-int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a);
+ * many nodes moved. `settled`: the photons and AIMs already hold the moves (the photon stage caught up with
+ * them before this gather), so the texels gathered from here on see them and none is kept unsettled. */
+int lm_texel_change_moved(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a, int settled);
 /* The photon stage has no work of a move waiting (no photon group to re-trace, no AIM over its threshold):
  * every texel's unsettled motion sum is added to its change (header) and cleared. Returns how many texels
  * had one. */
@@ -91,18 +96,18 @@ void lm_texel_change_scale(lm_texel_change *tc, const lm_atlas *a, const float *
 /* A material's edit moved every IIM texel to factor x IIM + add at once (update/light_scale.h; texel_count x
  * 3 each): right to first order only, so the texels it moved most are regathered first. Each texel's change
  * grows by its largest channel's |factor - 1| + |add| / E_mean; an edit that moves every texel alike stays
- * under the bar of 4 times the mean and is left to the surfaces' order. (The Cornell box's red wall turned
+ * under the bar of 4 times the median and is left to the surfaces' order. (The Cornell box's red wall turned
  * blue: the tall block's face toward it kept the first guess's 8.5% for 80 updates, until its surface's
  * refresh came round.) */
 void lm_texel_change_first_guess(lm_texel_change *tc, const float *factor, const float *add);
 /* A light's edit scaled every IIM texel by a factor whose relative standard error is doubt[texel]
  * (update/light_scale.h): 0 where one light lights what the texel sees, larger where several do in
  * different shares. Each texel's change grows by twice it, kept apart from the rest: a doubted texel goes
- * ahead once that passes the threshold, whatever the atlas's mean change (its error is its own, not a
+ * ahead once that passes the threshold, whatever the atlas's median change (its error is its own, not a
  * change that reached everything alike), so that the texels whose factor may be furthest off are
  * regathered first. */
 void lm_texel_change_doubt(lm_texel_change *tc, const float *doubt);
-/* At most budget texels over the threshold (and, unless `all`, over 4 times the mean or doubted past the
+/* At most budget texels over the threshold (and, unless `all`, over 4 times the median or doubted past the
  * threshold: header), not on surfaces with off[k] set, most changed first, written to out (texel indices)
  * and zeroed. A bake asks for all. Returns how many. */
 uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t budget, int all,
@@ -111,7 +116,7 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
  * waiting to be picked. Returns how many. */
 uint32_t lm_texel_change_waiting(const lm_texel_change *tc, const lm_atlas *a, const uint8_t *off, uint32_t *out);
 /* The texels gathered otherwise (their surfaces' refreshes) start from no change again: left, they kept
- * the atlas's mean change up, and with it the bar a texel must pass to go ahead (a moved cube's face
+ * the atlas's typical change up, and with it the bar a texel must pass to go ahead (a moved cube's face
  * stayed 28% too bright for 120 updates below it). */
 void lm_texel_change_gathered(lm_texel_change *tc, const uint32_t *texels, uint32_t count);
 /* Texel t's change (header). */

@@ -283,7 +283,7 @@ static lm_status animate(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error
         f->caught_up.groups_retraced > 0)
         o->t_edits = lm_now() - t0;
     if (f->caught_up.groups_retraced > 0) /* a placement's catch-up: its AIMs reach this step's gather */
-        lm_lightmap_path_aim_changed(fl->lightmaps);
+        lm_lightmap_path_caught_up(fl->lightmaps);
     lm_scene_update_bounds(fl->world.scene);
     plan(fl, o);
     return st;

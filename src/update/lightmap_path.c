@@ -40,6 +40,8 @@ struct lm_lightmap_path {
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
+    int caught_up;             /* the stage caught up with this step's placements before its gather */
+    int placed_now;            /* and this step's widen saw them move: its gather catches up too (schedule) */
     uint32_t switch_version;   /* the scene's pass_version the scheduler's switches follow */
     struct {                   /* whether the scene gives any light (follow_light): none, no gather */
         int unlit, emissive;   /* emissive: it has emissive triangles, as of the scene's emissive_version */
@@ -343,6 +345,12 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
 
 void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
 
+void lm_lightmap_path_caught_up(lm_lightmap_path *lp)
+{
+    lp->aim_stale = 1;
+    lp->caught_up = 1;
+}
+
 /* The IIM's texels multiplied by factor and add added (texel_count x 3 each), surfaces with one changed
  * set in scaled. */
 static void scale_iim(lm_lightmap_path *lp, const float *factor, const float *add, uint8_t *scaled)
@@ -441,7 +449,12 @@ static void follow_scale(lm_lightmap_path *lp)
 int lm_lightmap_path_widen(lm_lightmap_path *lp)
 {
     follow_scale(lp);
-    int moved = lp->have_change ? lm_texel_change_moved(&lp->change, lp->scene, lp->atlas) : 0;
+    int caught_up = lp->caught_up && lm_photon_stage_settled(lp->stage);
+    lp->caught_up = 0;
+    if (lp->have_change && caught_up) /* earlier moves' texels, gathered from AIMs the stage now caught up */
+        lm_texel_change_settle(&lp->change);
+    int moved = lp->have_change ? lm_texel_change_moved(&lp->change, lp->scene, lp->atlas, caught_up) : 0;
+    lp->placed_now = moved && caught_up;
     /* not in the call that saw a move: the stage has yet to see it (its groups are queued by its update) */
     if (lp->have_change && !moved && lm_photon_stage_settled(lp->stage))
         lm_texel_change_settle(&lp->change);
@@ -515,13 +528,16 @@ lm_status lm_lightmap_path_schedule(lm_lightmap_path *lp, uint32_t *count, lm_er
 {
     lm_lightmap_path_widen(lp);
     uint32_t budget = lp->iim.sched.texels_per_frame > 0 ? (uint32_t)lp->iim.sched.texels_per_frame : 0;
-    *count = pick(lp, budget, budget - budget / 4, 0); /* a quarter left to the surfaces' refreshes */
+    uint32_t ahead = budget - budget / 4; /* a quarter left to the surfaces' refreshes */
+    if (lp->placed_now) /* the move's texels caught up with its photons, shown at once (LM_CATCH_UP_UPDATES) */
+        ahead *= LM_CATCH_UP_UPDATES, budget = ahead + budget / 4;
+    *count = pick(lp, budget, ahead, 0);
     return *count > 0 ? gather_prepare(lp, err) : LM_OK;
 }
 
 lm_status lm_lightmap_path_blend(lm_lightmap_path *lp, int instant, lm_error *err)
 {
-    return lm_iim_blend(&lp->iim, instant, err);
+    return lm_iim_blend(&lp->iim, instant || lp->placed_now, err);
 }
 
 /* The bake's gather reports through the settings' progress hook as a fraction of the whole bake. */
