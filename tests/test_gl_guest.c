@@ -469,20 +469,23 @@ static void shares_texture(host *h, int made, void *share_display, void *share_c
     int surfaces = lmgi_surface_count(sc), moved = 0;
     uint32_t *before = malloc(sizeof *before * (size_t)surfaces);
     assert_non_null(before);
-    for (int s = 0; s < surfaces; s++)
-        before[s] = lmgi_surface_version(u, s);
     int cube = lmgi_find_node(sc, "dynamic_cube");
     float m[16];
     assert_true(cube >= 0 && lmgi_get_node_transform(sc, cube, m));
+    /* a nudge first, so that the move follows an edit and is not caught up in its update (a move after a
+     * still update gathers every texel it changed at once: all 16 surfaces here) */
+    m[12] += 0.001f;
+    MUST(lmgi_set_node_transform(sc, cube, m, &e), "lmgi_set_node_transform");
+    MUST(lmgi_update(u, 0.0f, 0.0f, NULL, &e), "lmgi_update");
+    for (int s = 0; s < surfaces; s++)
+        before[s] = lmgi_surface_version(u, s);
     m[12] += 0.15f;
     MUST(lmgi_set_node_transform(sc, cube, m, &e), "lmgi_set_node_transform");
-    /* one update: 12 of the 16 surfaces change (the move is caught up in it, its photons and AIMs at once,
-     * so at 400 texels an update all 16 have changed by the third) */
     MUST(lmgi_update(u, 0.0f, 0.0f, NULL, &e), "lmgi_update");
     for (int s = 0; s < surfaces; s++)
         moved += lmgi_surface_version(u, s) != before[s];
     print_message("after the move: %d of %d surfaces changed\n", moved, surfaces);
-    assert_true(moved > 0 && moved < surfaces); /* some rectangles, not the whole atlas */
+    assert_true(moved > 0 && moved < surfaces); /* some rectangles, not the whole atlas (11 of 16 measured) */
     free(before);
     MUST(lmgi_get_lightmap_texture(u, &again, &e), "lmgi_get_lightmap_texture");
     CHECK_HOST(h, "lmgi_get_lightmap_texture");
