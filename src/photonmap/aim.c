@@ -1057,20 +1057,12 @@ void lm_aim_scale_surfaces(lm_aim *aim, const lm_atlas *a, const int *surfaces, 
 static double kernel_on_others(const lm_rt *rt, const lm_scene *s, const lm_texel *t, int own, double radius,
                                const double *xs, const double *ws)
 {
-    float p[3][3], e1[3], e2[3], n[3];
-    for (int v = 0; v < 3; v++)
-        lm_scene_vertex_world(s, s->tris[3 * (size_t)t->tri + (size_t)v], p[v]);
-    for (int c = 0; c < 3; c++)
-        e1[c] = p[1][c] - p[0][c], e2[c] = p[2][c] - p[0][c];
-    n[0] = e1[1] * e2[2] - e1[2] * e2[1], n[1] = e1[2] * e2[0] - e1[0] * e2[2], n[2] = e1[0] * e2[1] - e1[1] * e2[0];
-    float len = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-    if (!(len > 0.0f))
+    lm_vec3 vn = lm_scene_tri_normal_world(s, t->tri), vt, vb;
+    if (!(lm_length(vn) > 0.0f))
         return 0.0;
-    for (int c = 0; c < 3; c++)
-        n[c] /= len;
-    float tu[3], tv[3], dir[3] = {-n[0], -n[1], -n[2]};
-    lm_vec3 vt, vb;
-    lm_onb(lm_v3_load(n), &vt, &vb);
+    float n[3], tu[3], tv[3], dir[3] = {-vn.x, -vn.y, -vn.z};
+    lm_v3_store(n, vn);
+    lm_onb(vn, &vt, &vb);
     lm_v3_store(tu, vt), lm_v3_store(tv, vb);
     double sum = 0.0;
     for (int g = 0; g < 3; g++) {

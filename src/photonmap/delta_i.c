@@ -11,15 +11,8 @@
 static lm_vec3 texel_now(const lm_scene *s, const lm_atlas *a, uint32_t texel, lm_vec3 *normal)
 {
     const lm_texel *t = &a->texels[texel];
-    const float *w = s->nodes[s->tri_node[t->tri]].world;
-    lm_vec3 c[3];
-    for (int k = 0; k < 3; k++) {
-        float v[3];
-        lm_scene_vertex_world(s, s->tris[3 * (size_t)t->tri + (size_t)k], v);
-        c[k] = lm_v3_load(v);
-    }
-    *normal = lm_normalize(lm_cross(lm_sub(c[1], c[0]), lm_sub(c[2], c[0])));
-    return lm_mat4_point(w, lm_v3_load(t->local));
+    *normal = lm_scene_tri_normal_world(s, t->tri);
+    return lm_mat4_point(s->nodes[s->tri_node[t->tri]].world, lm_v3_load(t->local));
 }
 
 int lm_delta_i_sees(const lm_iim_sched *iim, const lm_scene *s, const lm_atlas *at, const lm_rt *rt, int a, int b)

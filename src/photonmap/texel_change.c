@@ -305,7 +305,8 @@ void lm_texel_change_aim(lm_texel_change *tc, const lm_iim_sched *sched, const l
     free(slot);
 }
 
-/* The k-th smallest of v[0..n) (k < n), v reordered (quickselect, Hoare's partition). */
+/* The k-th smallest of v[0..n) (k < n), v reordered (quickselect, Hoare's partition): linear, where
+ * core/stats.h's lm_quantile sorts, and this runs at every update's pick. */
 static float kth_smallest(float *v, uint32_t n, uint32_t k)
 {
     uint32_t lo = 0, hi = n - 1;

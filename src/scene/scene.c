@@ -235,6 +235,15 @@ void lm_scene_normal_world(const lm_scene *s, uint32_t v, float out[3])
     lm_v3_store(out, lm_mat4_normal(m, lm_v3_load(s->normals + 3 * (size_t)v)));
 }
 
+lm_vec3 lm_scene_tri_normal_world(const lm_scene *s, uint32_t t)
+{
+    float p[3][3];
+    for (int k = 0; k < 3; k++)
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t + (size_t)k], p[k]);
+    lm_vec3 a = lm_v3_load(p[0]);
+    return lm_normalize(lm_cross(lm_sub(lm_v3_load(p[1]), a), lm_sub(lm_v3_load(p[2]), a)));
+}
+
 float lm_scene_tri_area_world(const lm_scene *s, uint32_t t)
 {
     float p[3][3];

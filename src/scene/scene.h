@@ -13,6 +13,7 @@
 #include <stdint.h>
 
 #include "../core/error.h"
+#include "../core/vecmath.h"
 
 #define LM_NAME_MAX 64
 
@@ -297,7 +298,9 @@ float lm_scene_animation_duration(const lm_scene *s);
 /* World-space position of a vertex / normal under the current node matrices. */
 void lm_scene_vertex_world(const lm_scene *s, uint32_t v, float out[3]);
 void lm_scene_normal_world(const lm_scene *s, uint32_t v, float out[3]);
-/* Geometric (face) normal and area of a triangle in world space. */
+/* Geometric (face) normal, unit and as wound (zero for a degenerate triangle), and area of a triangle in
+ * world space. */
+lm_vec3 lm_scene_tri_normal_world(const lm_scene *s, uint32_t t);
 float lm_scene_tri_area_world(const lm_scene *s, uint32_t t);
 /* Length of the world bounds' diagonal: the scene's size, used for relative tolerances. */
 float lm_scene_size(const lm_scene *s);
