@@ -194,7 +194,8 @@ LMGI_API void lmgi_get_effect(const lmgi_scene *scene, int i, lmgi_effect *out);
  * reach refreshed in that update (lmgi_update_stats.groups_at_once), whatever photons.group_budget and
  * aim.surfaces_per_frame say, and the lightmap texels it changed most, 32 updates' worth of
  * gather.texels_per_frame, gathered and shown at once, without the blend; edits made update after update
- * stay within those counts (docs/api.md). */
+ * (a drag committed every frame) stay within those counts while they last, and what their moves left is
+ * caught up the same way at the first update without edits after them (the drag released; docs/api.md). */
 LMGI_API int lmgi_node_count(const lmgi_scene *scene);                 /* 0 for NULL */
 LMGI_API int lmgi_find_node(const lmgi_scene *scene, const char *name); /* -1 if absent or either is NULL */
 /* A fingerprint of the scene's geometry: the names of the nodes that hold triangles, in order, and each
@@ -641,10 +642,11 @@ typedef struct {
                                 * the lightmaps at once as a first guess that the regathers after refine
                                 * (docs/tradeoff.md, "Lights added or switched on") */
     uint32_t groups_at_once;   /* of groups_retraced, those re-traced at once for a node or light this
-                                * update's edits placed or reshaped after an update without edits
-                                * (without a time budget; the AIMs they changed are in aim_surfaces_at_once):
-                                * the edit's own work, beyond photons.group_budget (docs/photons.md, "Caught
-                                * up in one update") */
+                                * update's edits placed or reshaped after an update without edits, or that
+                                * edits in a row placed, in the first update without edits after them (a drag
+                                * released); without a time budget; the AIMs they changed are in
+                                * aim_surfaces_at_once: the edits' own work, beyond photons.group_budget
+                                * (docs/photons.md, "Caught up in one update") */
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative

@@ -280,9 +280,9 @@ static lm_status animate(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error
     lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
     const lm_photon_stage_frame *f = &o->stage; /* an edit's own work, done at once */
     if (f->emitters_lit > 0 || f->emitters_scaled > 0 || f->materials_changed > 0 || f->aim_at_once > 0 ||
-        f->caught_up.groups_retraced > 0)
+        f->placed)
         o->t_edits = lm_now() - t0;
-    if (f->caught_up.groups_retraced > 0) /* a placement's catch-up: its AIMs reach this step's gather */
+    if (f->placed) /* a placement's catch-up: its AIMs reach this step's gather */
         lm_lightmap_path_caught_up(fl->lightmaps);
     lm_scene_update_bounds(fl->world.scene);
     plan(fl, o);

@@ -41,7 +41,9 @@ struct lm_lightmap_path {
     int have_change;
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
     int caught_up;             /* the stage caught up with this step's placements before its gather */
-    int placed_now;            /* and this step's widen saw them move: its gather catches up too (schedule) */
+    int placed_now;            /* and this step's widen saw them move, or saw moves since the last catch-up
+                                * (a drag released): its gather catches up too (schedule) */
+    int moved_uncaught;        /* widen saw nodes move since the stage last caught up */
     uint32_t switch_version;   /* the scene's pass_version the scheduler's switches follow */
     struct {                   /* whether the scene gives any light (follow_light): none, no gather */
         int unlit, emissive;   /* emissive: it has emissive triangles, as of the scene's emissive_version */
@@ -454,7 +456,8 @@ int lm_lightmap_path_widen(lm_lightmap_path *lp)
     if (lp->have_change && caught_up) /* earlier moves' texels, gathered from AIMs the stage now caught up */
         lm_texel_change_settle(&lp->change);
     int moved = lp->have_change ? lm_texel_change_moved(&lp->change, lp->scene, lp->atlas, caught_up) : 0;
-    lp->placed_now = moved && caught_up;
+    lp->placed_now = (moved || lp->moved_uncaught) && caught_up;
+    lp->moved_uncaught = (lp->moved_uncaught || moved) && !caught_up;
     /* not in the call that saw a move: the stage has yet to see it (its groups are queued by its update) */
     if (lp->have_change && !moved && lm_photon_stage_settled(lp->stage))
         lm_texel_change_settle(&lp->change);

@@ -16,8 +16,9 @@
 #ifndef LM_LIGHTMAP_PATH_H
 #define LM_LIGHTMAP_PATH_H
 
-/* A node placed after a still update is caught up in its own update (photon_stage.c catch_up): its photons and
- * AIMs, then its texels, this many updates' worth of those picked ahead (texel_change.h), gathered and shown
+/* A node placed after a still update is caught up in its own update (photon_stage.c catch_up), and nodes
+ * placed by edits in a row (a drag) at the first update without edits after them: their photons and AIMs,
+ * then their texels, this many updates' worth of those picked ahead (texel_change.h), gathered and shown
  * at once, without the blend. At 16 the Cornell box's cube move left two blocks 10-11% off for 3 updates; at
  * 32 every block was within 10% at once (tests/test_motion_trail.c). */
 #define LM_CATCH_UP_UPDATES 32
@@ -41,7 +42,7 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
 lm_status lm_lightmap_path_follow(lm_lightmap_path *lp, lm_error *err);
 /* The AIMs changed (the stage refreshed some): uploaded again before the next gather. */
 void lm_lightmap_path_aim_changed(lm_lightmap_path *lp);
-/* As aim_changed, from a placement's catch-up in this step's animate (photon_stage.h caught_up): the
+/* As aim_changed, from a placement's catch-up in this step's animate (photon_stage.h placed): the
  * step's gather sees the moves, so their texels are not gathered a second time (texel_change.h). */
 void lm_lightmap_path_caught_up(lm_lightmap_path *lp);
 /* Surfaces that see a refreshed AIM marked for regathering (photonmap/delta_i.h); returns how many. */

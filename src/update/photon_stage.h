@@ -52,9 +52,12 @@ typedef struct {
     int aim_at_once;         /* of aim.surfaces_refreshed, those refreshed at once for this frame's light,
                               * emission or colour edits, or for a node or light placed after a still frame
                               * (lm_photon_stage_animate) */
-    lm_photon_frame_stats caught_up; /* the invalid groups that placement's edit re-traced at once (its
-                              * catch-up: docs/photons.md, "Caught up in one update"); apart from photons,
-                              * which are the round robin's and the group budget's */
+    int placed;              /* this frame caught up with placements: a node or light placed after a still
+                              * frame, or those placed by edits in a row, at the first frame without edits
+                              * after them (docs/photons.md, "Caught up in one update") */
+    lm_photon_frame_stats caught_up; /* the invalid groups that catch-up re-traced at once (none where the
+                              * group budget had already taken them); apart from photons, which are the
+                              * round robin's and the group budget's */
     lm_photon_frame_stats photons;
     lm_aim_stats aim;
     lm_caustic_frame_stats caustics; /* its seconds are t_caustics */
