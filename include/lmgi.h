@@ -647,6 +647,11 @@ typedef struct {
                                 * released); without a time budget; the AIMs they changed are in
                                 * aim_surfaces_at_once: the edits' own work, beyond photons.group_budget
                                 * (docs/photons.md, "Caught up in one update") */
+    int placements_caught_up;  /* 1: this update caught up with the nodes and lights edits placed (its
+                                * groups_at_once, its AIMs at once, the lightmap texels they changed most
+                                * gathered and shown at once), whether or not a group was left to re-trace:
+                                * after a still update, or the first update without edits after edits in a
+                                * row (a drag released); never under a time budget */
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative

@@ -395,6 +395,7 @@ static void test_drag_released_caught_up(void **state)
     for (int f = 0; f < STEPS; f++) {
         move_cube_by(sc, -1.1f / STEPS);
         lmgi_update_stats s = lmt_update(u);
+        assert_int_equal(s.placements_caught_up, f == 0);
         if (f > 0) {
             assert_int_equal(s.groups_at_once, 0);
             assert_true(s.groups_retraced <= 16);
@@ -405,6 +406,7 @@ static void test_drag_released_caught_up(void **state)
     size_t n;
     for (int f = 0; f < UPDATES; f++) {
         lmgi_update_stats s = lmt_update(u);
+        assert_int_equal(s.placements_caught_up, f == 0);
         if (f == 0)
             queued = s.groups_at_once;
         else
@@ -422,6 +424,35 @@ static void test_drag_released_caught_up(void **state)
     assert_true(queued > 16);
     assert_int_equal(within, 0);
     free(want);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
+/* A drag under a time budget (an editor's window: lmgi view) is not caught up while the budget holds, nor
+ * at the first update without edits under it; the first update without a budget catches it up, whatever
+ * the budgeted update before it planned (update/photon_stage.h lm_photon_stage_set_budgeted). */
+static void test_drag_released_under_budget(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
+    lmgi_updater *u = updater(ctx, sc, 0.0f, 0);
+    lmgi_update_stats s;
+    lmgi_error e;
+    for (int f = 0; f < 6; f++) { /* three steps, each after an update without edits */
+        if (f % 2 == 0)
+            move_cube_by(sc, -0.2f);
+        assert_int_equal(lmgi_update(u, 0.0f, 8.0f, &s, &e), LMGI_OK);
+        assert_int_equal(s.placements_caught_up, 0);
+        assert_int_equal(s.groups_at_once, 0);
+    }
+    assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &s, &e), LMGI_OK);
+    print_message("a drag under an 8 ms budget, then an update without it: caught up %d, %u groups at once, %u "
+                  "texels\n", s.placements_caught_up, s.groups_at_once, s.texels_gathered);
+    assert_int_equal(s.placements_caught_up, 1);
+    assert_int_equal(lmgi_update(u, 0.0f, 0.0f, &s, &e), LMGI_OK);
+    assert_int_equal(s.placements_caught_up, 0); /* once */
     lmgi_updater_free(u);
     lmgi_free(sc);
     lmgi_context_free(ctx);
@@ -477,6 +508,7 @@ int main(void)
         cmocka_unit_test(test_one_move_refined),
         cmocka_unit_test(test_move_after_stillness_caught_up),
         cmocka_unit_test(test_drag_released_caught_up),
+        cmocka_unit_test(test_drag_released_under_budget),
         cmocka_unit_test(test_recolour_worst_surface_first),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

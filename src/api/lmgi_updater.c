@@ -420,6 +420,7 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->groups_invalidated = st->photons.groups_invalidated;
     o->groups_retraced = st->photons.groups_retraced + st->caught_up.groups_retraced;
     o->groups_at_once = st->caught_up.groups_retraced;
+    o->placements_caught_up = st->placed;
     o->lights_scaled = st->emitters_scaled;
     o->lights_lit = st->emitters_lit;
     o->aim_surfaces_refreshed = st->aim.surfaces_refreshed;

@@ -152,6 +152,19 @@ void lm_viewer_edited(lm_viewer *v, int moved)
     lm_view_maps_edited(&v->maps);
 }
 
+/* After a drag's release (view_state.h released): the update that caught it up says so, with its time. */
+static void released(lm_viewer *v)
+{
+    v->released = v->stats.placements_caught_up ? 0 : v->released - 1;
+    if (!v->stats.placements_caught_up)
+        return;
+    char line[160];
+    snprintf(line, sizeof line,
+             "drag released: its light followed at once, in one update of %.0f ms (%u photon groups, %d AIMs, %u texels)",
+             v->stats.ms_total, v->stats.groups_at_once, v->stats.aim_surfaces_at_once, v->stats.texels_gathered);
+    lm_viewer_say(v, line);
+}
+
 /* Whether the lighting still has work waiting. An update that re-traced photon groups, refreshed AIMs,
  * regathered texels, traced caustic photons or redrew reflection faces or shadow maps did work; so did an
  * edit. A light, material or effect edit names the photons it changes (their groups are queued: explicit
@@ -264,10 +277,13 @@ static int frame(lm_viewer *v)
             return 0;
         lm_viewer_edited(v, cJSON_GetObjectItemCaseSensitive(e->v, "node") != NULL); /* a node edit moves it */
     }
-    if (lmgi_update(v->u, v->time, v->budget, &v->stats, &err) != LMGI_OK) {
+    /* a drag released: its lighting caught up in one update, outside the budget (docs/viewer.md) */
+    if (lmgi_update(v->u, v->time, v->released > 0 ? 0.0f : v->budget, &v->stats, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
+    if (v->released > 0)
+        released(v);
     track_work(v, glfwGetTime()); /* after the update (and a reload's first solution), not the frame's start */
     int fw, fh;
     glfwGetFramebufferSize(v->win, &fw, &fh);

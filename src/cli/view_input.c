@@ -12,6 +12,10 @@
 #define LIGHT_STEP 1.25f     /* + and - multiply or divide a light's intensity by this */
 #define TURN_STEP 0.2617994f /* ctrl + wheel turns the selected node by 15 degrees a step */
 #define CLICK_PIXELS 3.0     /* a press and release closer than this is a click (select), not a drag */
+/* A drag's moves, committed frame after frame under the budget, are caught up at its release by updates
+ * without the budget: the first of them, or the second when the first still carries the drag's last move
+ * (its motion and the release came in one poll); a third to spare. */
+#define RELEASE_UPDATES 3
 
 /* The next name of `fmt` (a number, then `tail`) that no file in the working folder has, counting on from
  * *counter: what the viewer writes never replaces a file. */
@@ -152,6 +156,7 @@ static void end_light_move(lm_viewer *v)
     lmgi_error err;
     if (lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK || !memcmp(l.position, v->light_grab.position, sizeof l.position))
         return;
+    v->released = RELEASE_UPDATES;
     lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = v->light_grab, .light_after = l};
     if (l.node >= 0) {
         step.kind = LM_VIEW_NODE, step.id = l.node;
@@ -566,6 +571,7 @@ static void end_move(lm_viewer *v)
         char what[128];
         snprintf(what, sizeof what, "moved node %.100s", lmgi_node_name(v->sc, v->node));
         lm_viewer_say(v, what);
+        v->released = RELEASE_UPDATES;
     }
 }
 

@@ -40,6 +40,8 @@ struct lm_viewer {
                               * events, so that ctrl+S saves without flying back however its press and
                               * release fall between frames */
     double mouse[2], press[2];
+    int released;            /* a drag was released: updates left to run without the budget, until the first
+                              * without edits catches it up (lmgi_update_stats.placements_caught_up) */
     float grab[3], grab_start[16]; /* moving a node: the point grabbed and the node's matrix then */
     lm_view_history history;
     int saves;

@@ -277,6 +277,7 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
 static lm_status animate(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
+    lm_photon_stage_set_budgeted(fl->stage, fl->budget_ms > 0.0f);
     lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
     const lm_photon_stage_frame *f = &o->stage; /* an edit's own work, done at once */
     if (f->emitters_lit > 0 || f->emitters_scaled > 0 || f->materials_changed > 0 || f->aim_at_once > 0 ||

@@ -38,6 +38,7 @@ struct lm_photon_stage {
     lm_moved_nodes moves;        /* the nodes edits moved, whose paths are queued at once (moved_nodes.h) */
     int edited_before;           /* the last update saw edits of any kind (catch_up) */
     int uncaught;                /* a placement since then was not caught up: the next still update does it */
+    int budgeted;                /* this update runs under a time budget (lm_photon_stage_set_budgeted) */
     float *move_boxes;           /* scratch: LM_MOVED_NODE_BOXES floats a node */
     double *delta_before;        /* scratch: per surface, delta_f + owed before a refresh (aim.h) */
     uint32_t *count_before;      /* scratch: per surface, its refresh count before it */
@@ -242,9 +243,9 @@ static float flux_ratio(double before, double after)
     return before > 0.0 ? (float)fmax(after / before, 0.0) : 1.0f;
 }
 
-/* Whether the frame loop gives the stage a time budget (lm_photon_stage_limit): then an edit's AIM work
- * at once is the cheap first guess, the refreshes left to the budgeted ones. */
-static int budgeted(const lm_photon_stage *ps) { return ps->limit.aim_hits > 0; }
+/* Whether the frame loop gives this update a time budget (lm_photon_stage_set_budgeted): then an edit's
+ * AIM work at once is the cheap first guess, the refreshes left to the budgeted ones. */
+static int budgeted(const lm_photon_stage *ps) { return ps->budgeted; }
 
 /* Whether, where the AIM computes direct light, an edit's first guess may still scale it: its rest (the
  * part the photons bring) is kept apart from the punctual lights' direct part, which is then all it
@@ -1072,6 +1073,8 @@ lm_direct_light lm_photon_stage_punctual_light(const lm_photon_stage *ps)
 }
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }
 const lm_caustics *lm_photon_stage_caustics(const lm_photon_stage *ps) { return ps->caustics; }
+
+void lm_photon_stage_set_budgeted(lm_photon_stage *ps, int on) { ps->budgeted = on; }
 
 void lm_photon_stage_limit(lm_photon_stage *ps, const lm_photon_stage_limits *l)
 {

@@ -135,6 +135,10 @@ typedef struct {
     uint32_t caustic_photons;
 } lm_photon_stage_limits;
 void lm_photon_stage_limit(lm_photon_stage *ps, const lm_photon_stage_limits *l);
+/* Whether this update runs under a time budget, set before its animate: an edit's work at once is then
+ * the cheap first guess, and no placement is caught up (catch_up). Before, the last update's limits
+ * said so, and the first update given a budget (or the first without one) still followed the one before. */
+void lm_photon_stage_set_budgeted(lm_photon_stage *ps, int budgeted);
 /* The work waiting: invalid photon groups queued, the caustic photons the next update would trace
  * (lm_caustics_wanted). */
 void lm_photon_stage_waiting(const lm_photon_stage *ps, uint32_t *groups, uint32_t *caustic_photons);
