@@ -73,6 +73,17 @@ static int under_x(const char *script)
 
 /* Mean luminance (sum of the channels) of an EXR's pixels, and the picture itself into *img (NULL: not
  * kept). */
+/* What the window printed (log.txt in dir), as one string to free. */
+static char *window_log(const char *dir)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/log.txt", dir);
+    size_t size = 0;
+    char *text = (char *)lmt_read_file(path, &size, 1);
+    text[size] = '\0';
+    return text;
+}
+
 static double mean_of(const char *path, float **img, int *w, int *h)
 {
     float *p = NULL;
@@ -336,11 +347,7 @@ static void test_drag_save_undo(void **state)
                   (double)m0[12], (double)m0[13], (double)m0[14], (double)m1[12], (double)m1[13], (double)m1[14]);
     assert_true(m0[12] - m1[12] > 0.1f && fabsf(m1[13] - m0[13]) < 1e-4f);
     /* the drag, committed under the window's budget, caught up at its release by an update without it */
-    char logpath[512];
-    snprintf(logpath, sizeof logpath, "%s/log.txt", dir);
-    size_t log_size;
-    char *log = (char *)lmt_read_file(logpath, &log_size, 1);
-    log[log_size] = '\0';
+    char *log = window_log(dir);
     const char *release = strstr(log, "drag released: its light followed at once");
     print_message("%.*s\n", release ? (int)strcspn(release, "\n") : 4, release ? release : "none");
     assert_non_null(release);
@@ -412,9 +419,8 @@ static void test_axis_material_effects_light(void **state)
     int rc = under_x(script);
     if (rc != 0)
         fail_msg("exit %d: %s", rc, output);
-    char saved[512], log[512];
+    char saved[512];
     snprintf(saved, sizeof saved, "%s/lmgi-view-scene-001/scene.gltf", dir);
-    snprintf(log, sizeof log, "%s/log.txt", dir);
     lmgi_options o;
     lmgi_options_init(&o);
     assert_int_equal(lmgi_load(saved, &o, &sc, &e), LMGI_OK);
@@ -443,13 +449,9 @@ static void test_axis_material_effects_light(void **state)
     assert_int_equal(fx.shadows, 0);
     assert_float_equal(l1.intensity, l0.intensity / 1.25f, 1e-4 * l0.intensity);
     assert_float_equal(l1.position[1], l0.position[1] - 0.05f * size, 1e-4 * size);
-    char said[8192];
-    FILE *f = fopen(log, "r");
-    assert_non_null(f);
-    size_t got = fread(said, 1, sizeof said - 1, f);
-    said[got] = '\0';
-    fclose(f);
+    char *said = window_log(dir);
     assert_non_null(strstr(said, "view: IIM"));
+    free(said);
     char edited[512], window[512];
     snprintf(edited, sizeof edited, "%s/edited/frame_0000.exr", dir);
     snprintf(window, sizeof window, "%s/lmgi-view-001.exr", dir);
@@ -532,11 +534,7 @@ static void test_watch(void **state)
              "$B view d.gltf --still --size 160x120 --budget 500 --frames 3 --screenshot fresh_d.exr -q",
              getenv("LMGI_BUILD") ? getenv("LMGI_BUILD") : "build", dir, slow());
     int rc = under_x(script);
-    char log[512];
-    snprintf(log, sizeof log, "%s/log.txt", dir);
-    size_t size = 0;
-    char *text = (char *)lmt_read_file(log, &size, 1);
-    text[size] = '\0';
+    char *text = window_log(dir);
     print_message("%s", text);
     if (rc != 0)
         fail_msg("exit %d: %s", rc, output);
