@@ -304,7 +304,8 @@ static void cube_pixel(float m0[16], int *x, int *y)
  * more than 25% apart; measured: none), which the unmoved scene is not (4% or more of the pixels 25% apart:
  * the cube is elsewhere); after the undo the picture is the unmoved scene's again (the same bounds). Each
  * picture is taken when the window says its lighting caught up with the edit. The drag's moves, made under
- * the window's budget, are caught up at the release by one update without it, which the window reports. */
+ * the window's budget, are caught up at the release by one update without it, which the window reports;
+ * so is the undo. */
 static void test_drag_save_undo(void **state)
 {
     (void)state;
@@ -351,6 +352,10 @@ static void test_drag_save_undo(void **state)
     const char *release = strstr(log, "drag released: its light followed at once");
     print_message("%.*s\n", release ? (int)strcspn(release, "\n") : 4, release ? release : "none");
     assert_non_null(release);
+    /* so is the undo, a move made in one go */
+    const char *undo = strstr(log, "undo: its light followed at once");
+    print_message("%.*s\n", undo ? (int)strcspn(undo, "\n") : 4, undo ? undo : "none");
+    assert_non_null(undo);
     free(log);
     char edited[512], original[512], undone[512], window[512];
     snprintf(edited, sizeof edited, "%s/edited/frame_0000.exr", dir);
@@ -451,6 +456,9 @@ static void test_axis_material_effects_light(void **state)
     assert_float_equal(l1.position[1], l0.position[1] - 0.05f * size, 1e-4 * size);
     char *said = window_log(dir);
     assert_non_null(strstr(said, "view: IIM"));
+    /* the drag and Page Down each caught up by an update without the budget */
+    assert_non_null(strstr(said, "drag released: its light followed at once"));
+    assert_non_null(strstr(said, "light lowered: its light followed at once"));
     free(said);
     char edited[512], window[512];
     snprintf(edited, sizeof edited, "%s/edited/frame_0000.exr", dir);
@@ -542,6 +550,7 @@ static void test_watch(void **state)
     assert_non_null(strstr(text, "file saved: 0 nodes moved, 0 materials, 0 lights changed, 1 added, 0 removed"));
     assert_non_null(strstr(text, "file saved: 0 nodes moved, 0 materials, 0 lights changed, 0 added, 1 removed"));
     assert_non_null(strstr(text, "the file's geometry changed: the scene was loaded again"));
+    assert_non_null(strstr(text, "file saved: its light followed at once")); /* the move, outside the budget */
     free(text);
     same_as_fresh(dir, "lmgi-view-001.exr", "fresh_b.exr", "after the box moved");
     same_as_fresh(dir, "lmgi-view-002.exr", "fresh_d.exr", "after a lamp was added");

@@ -152,16 +152,26 @@ void lm_viewer_edited(lm_viewer *v, int moved)
     lm_view_maps_edited(&v->maps);
 }
 
-/* After a drag's release (view_state.h released): the update that caught it up says so, with its time. */
-static void released(lm_viewer *v)
+/* Updates a placement may take to be caught up without the budget: a drag's last motion and its release
+ * can come in one poll, so that the first update still has an edit; a third to spare. */
+#define CATCH_UP_UPDATES 3
+
+void lm_viewer_placed(lm_viewer *v, const char *what)
 {
-    v->released = v->stats.placements_caught_up ? 0 : v->released - 1;
+    v->catch_up = CATCH_UP_UPDATES;
+    snprintf(v->catch_up_what, sizeof v->catch_up_what, "%s", what);
+}
+
+/* After a placement (lm_viewer_placed): the update that caught it up says so, with its time. */
+static void caught_up(lm_viewer *v)
+{
+    v->catch_up = v->stats.placements_caught_up ? 0 : v->catch_up - 1;
     if (!v->stats.placements_caught_up)
         return;
-    char line[160];
+    char line[200];
     snprintf(line, sizeof line,
-             "drag released: its light followed at once, in one update of %.0f ms (%u photon groups, %d AIMs, %u texels)",
-             v->stats.ms_total, v->stats.groups_at_once, v->stats.aim_surfaces_at_once, v->stats.texels_gathered);
+             "%s: its light followed at once, in one update of %.0f ms (%u photon groups, %d AIMs, %u texels)",
+             v->catch_up_what, v->stats.ms_total, v->stats.groups_at_once, v->stats.aim_surfaces_at_once, v->stats.texels_gathered);
     lm_viewer_say(v, line);
 }
 
@@ -231,8 +241,10 @@ static int follow_file(lm_viewer *v)
         char line[200];
         snprintf(line, sizeof line, r == -2 ? "the file's edit was refused (the terminal says why)" : "file saved: %s",
                  what);
-        if (r > 0)
+        if (r > 0) {
             lm_viewer_edited(v, 1);
+            lm_viewer_placed(v, "file saved");
+        }
         if (v->light < 0 || lmgi_light_is_removed(v->sc, v->light)) /* a lamp removed, or the first added */
             lm_viewer_select_light(v, v->light < 0 ? 0 : v->light + 1);
         lm_viewer_say(v, line);
@@ -277,13 +289,13 @@ static int frame(lm_viewer *v)
             return 0;
         lm_viewer_edited(v, cJSON_GetObjectItemCaseSensitive(e->v, "node") != NULL); /* a node edit moves it */
     }
-    /* a drag released: its lighting caught up in one update, outside the budget (docs/viewer.md) */
-    if (lmgi_update(v->u, v->time, v->released > 0 ? 0.0f : v->budget, &v->stats, &err) != LMGI_OK) {
+    /* a placement: its lighting caught up in one update, outside the budget (docs/viewer.md) */
+    if (lmgi_update(v->u, v->time, v->catch_up > 0 ? 0.0f : v->budget, &v->stats, &err) != LMGI_OK) {
         fprintf(stderr, "lmgi: error: %s\n", err.message);
         return 0;
     }
-    if (v->released > 0)
-        released(v);
+    if (v->catch_up > 0)
+        caught_up(v);
     track_work(v, glfwGetTime()); /* after the update (and a reload's first solution), not the frame's start */
     int fw, fh;
     glfwGetFramebufferSize(v->win, &fw, &fh);

@@ -12,10 +12,6 @@
 #define LIGHT_STEP 1.25f     /* + and - multiply or divide a light's intensity by this */
 #define TURN_STEP 0.2617994f /* ctrl + wheel turns the selected node by 15 degrees a step */
 #define CLICK_PIXELS 3.0     /* a press and release closer than this is a click (select), not a drag */
-/* A drag's moves, committed frame after frame under the budget, are caught up at its release by updates
- * without the budget: the first of them, or the second when the first still carries the drag's last move
- * (its motion and the release came in one poll); a third to spare. */
-#define RELEASE_UPDATES 3
 
 /* The next name of `fmt` (a number, then `tail`) that no file in the working folder has, counting on from
  * *counter: what the viewer writes never replaces a file. */
@@ -149,14 +145,15 @@ static void place_light(lm_viewer *v, const float d[3])
         lm_viewer_edited(v, v->light_grab.node >= 0); /* its node moved: anything under it too */
 }
 
-/* The held light's move as a step undo can take back (none when it did not move). */
-static void end_light_move(lm_viewer *v)
+/* The held light's move as a step undo can take back (none when it did not move); `how` names it (a drag
+ * released, a key's step) for the line that says when its light followed (lm_viewer_placed). */
+static void end_light_move(lm_viewer *v, const char *how)
 {
     lmgi_light l;
     lmgi_error err;
     if (lmgi_get_light(v->sc, v->light, &l, &err) != LMGI_OK || !memcmp(l.position, v->light_grab.position, sizeof l.position))
         return;
-    v->released = RELEASE_UPDATES;
+    lm_viewer_placed(v, how);
     lm_view_step step = {.kind = LM_VIEW_LIGHT, .id = v->light, .light_before = v->light_grab, .light_after = l};
     if (l.node >= 0) {
         step.kind = LM_VIEW_NODE, step.id = l.node;
@@ -177,7 +174,7 @@ static void raise_light(lm_viewer *v, float sign)
         return;
     const float d[3] = {0.0f, sign * 0.05f * v->cam.scene_size, 0.0f};
     place_light(v, d);
-    end_light_move(v);
+    end_light_move(v, sign > 0.0f ? "light raised" : "light lowered");
 }
 
 /* Alt + press: the selected light follows the cursor on the horizontal plane at its height. */
@@ -310,6 +307,11 @@ static void remove_light(lm_viewer *v)
 
 static void undo_redo(lm_viewer *v, int redo)
 {
+    const lm_view_history *h = &v->history;
+    const lm_view_step *step = redo ? (h->done < h->count ? &h->steps[h->done] : NULL)
+                                    : (h->done > 0 ? &h->steps[h->done - 1] : NULL);
+    /* a node or a light put back where it was (or a light's colour: then nothing is placed) */
+    int places = step && (step->kind == LM_VIEW_NODE || step->kind == LM_VIEW_LIGHT);
     char what[160];
     lmgi_error err;
     err.message[0] = '\0';
@@ -319,6 +321,8 @@ static void undo_redo(lm_viewer *v, int redo)
         fprintf(stderr, "lmgi: error: %s\n", err.message);
     if (ok)
         lm_viewer_edited(v, 1); /* a step of any kind, a move among them */
+    if (ok && places)
+        lm_viewer_placed(v, redo ? "redo" : "undo");
     lm_viewer_say(v, what);
     if (v->light >= 0 && lmgi_light_is_removed(v->sc, v->light))
         lm_viewer_select_light(v, v->light + 1);
@@ -571,7 +575,7 @@ static void end_move(lm_viewer *v)
         char what[128];
         snprintf(what, sizeof what, "moved node %.100s", lmgi_node_name(v->sc, v->node));
         lm_viewer_say(v, what);
-        v->released = RELEASE_UPDATES;
+        lm_viewer_placed(v, "drag released");
     }
 }
 
@@ -584,7 +588,7 @@ static void on_button(GLFWwindow *w, int button, int action, int mods)
         if (v->drag == 3)
             end_move(v);
         else if (v->drag == 4)
-            end_light_move(v);
+            end_light_move(v, "drag released");
         else if (v->drag == 1 && fabs(x - v->press[0]) + fabs(y - v->press[1]) < CLICK_PIXELS) {
             float at[3];
             lmgi_hit hit = pick(v, x, y, at);
@@ -636,8 +640,10 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
     lm_view_step step = {.kind = LM_VIEW_NODE, .id = v->node};
     lmgi_get_node_transform(v->sc, v->node, step.before);
     lm_view_turn(step.before, (float)dy * TURN_STEP, step.after);
-    if (keep_step(v, lmgi_set_node_transform(v->sc, v->node, step.after, &err), &step, &err, "turn"))
+    if (keep_step(v, lmgi_set_node_transform(v->sc, v->node, step.after, &err), &step, &err, "turn")) {
         lm_viewer_say(v, "turned the selected node");
+        lm_viewer_placed(v, "turn");
+    }
 }
 
 void lm_viewer_input(lm_viewer *v)

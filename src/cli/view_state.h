@@ -40,8 +40,9 @@ struct lm_viewer {
                               * events, so that ctrl+S saves without flying back however its press and
                               * release fall between frames */
     double mouse[2], press[2];
-    int released;            /* a drag was released: updates left to run without the budget, until the first
-                              * without edits catches it up (lmgi_update_stats.placements_caught_up) */
+    int catch_up;            /* a move made (lm_viewer_placed): updates left to run without the budget, until
+                              * one catches it up (lmgi_update_stats.placements_caught_up) */
+    char catch_up_what[32];  /* what made it, for the line that says so */
     float grab[3], grab_start[16]; /* moving a node: the point grabbed and the node's matrix then */
     lm_view_history history;
     int saves;
@@ -80,6 +81,12 @@ void lm_viewer_say(lm_viewer *v, const char *text);
 /* An edit was made: the lighting is catching up from now on; `moved` (a node moved): for a round of the
  * round robin at least. */
 void lm_viewer_edited(lm_viewer *v, int moved);
+/* A node or light put somewhere in one go, after lm_viewer_edited: a drag released, an undo, a key's
+ * step, the watched file saved. The updater catches a placement up only in an update without a budget
+ * (docs/api.md), so the window runs its next updates without it, at most a few, until one has; that one
+ * says so, naming `what`. A drag's own moves, and a script's edits (an application's stream), are not
+ * this: they stay within the budget. */
+void lm_viewer_placed(lm_viewer *v, const char *what);
 /* The first light from id `from` on (wrapping) that is not removed; -1 when there is none. */
 void lm_viewer_select_light(lm_viewer *v, int from);
 /* Installs the window's mouse and key callbacks (the window's user pointer is v). */
