@@ -1337,6 +1337,7 @@ static void test_tradeoff(void **state)
  * - The red wall recoloured is shown at once from its first guess (update/light_scale.h), then regathered
  *   texel by texel, those it moved most first: its lag is the texel budget's to set, shorter at 80 texels an
  *   update than at 5, and longer with whole surfaces only.
+ * - The report's lag plot draws the nudge and the move, one update apart, as one gesture's panel.
  * A script for a scene not on the command line is refused. */
 static void test_tradeoff_update_lag(void **state)
 {
@@ -1421,6 +1422,16 @@ static void test_tradeoff_update_lag(void **state)
     assert_true(lag_surfaces == -1 || lag_surfaces > 2 * lag_default); /* 35 and 4 when written */
     snprintf(path, sizeof path, "%s/lag/plot_cornell_lag.png", dir);
     assert_int_equal(access(path, R_OK), 0);
+    /* the nudge and the move, one update apart, are one gesture: one panel of the plot, not one each */
+    snprintf(path, sizeof path, "%s/lag/report.html", dir);
+    size_t size = 0;
+    char *html = (char *)lmt_read_file(path, &size, 1);
+    html[size] = '\0';
+    const char *panels = strstr(html, "<p>Panels");
+    print_message("%.*s\n", panels ? (int)strcspn(panels, "\n") : 4, panels ? panels : "none");
+    assert_non_null(panels);
+    assert_non_null(strstr(panels, ": node dynamic_cube x2 (updates 1-2); material red (update 20)."));
+    free(html);
 }
 
 /* The lmgi command is the public API's first user: no file of src/cli/ includes anything of the library

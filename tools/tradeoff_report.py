@@ -201,37 +201,67 @@ def map_plots(scene, out_dir):
     return save(fig, scene, "maps", "relative error (estimate / reference - 1; grey: not compared)", out_dir)
 
 
+# Edits this many updates apart or closer are one gesture (a drag commits its node every update): they
+# share a panel of the lag plot, measured from the first, instead of a panel each of one update.
+GESTURE_GAP = 2
+
+
+def edit_groups(edits, frames):
+    """The edits as gestures: (first, last, start, end): edits first..last, updates start..end (the next
+    gesture's first update, or the script's end), and a title naming them."""
+    groups = []
+    for e, edit in enumerate(edits):
+        if groups and edit["frame"] - edits[groups[-1][1]]["frame"] <= GESTURE_GAP:
+            groups[-1][1] = e
+        else:
+            groups.append([e, e])
+    out = []
+    for g, (first, last) in enumerate(groups):
+        start = edits[first]["frame"]
+        end = edits[groups[g + 1][0]]["frame"] if g + 1 < len(groups) else frames
+        names = list(dict.fromkeys(edits[k]["edit"] for k in range(first, last + 1)))
+        if first == last:
+            title = f"{names[0]} (update {start})"
+        else:
+            title = f"{', '.join(names)} x{last - first + 1} (updates {start}-{edits[last]['frame']})"
+        out.append((first, last, start, end, title))
+    return out
+
+
 def lag_plot(scene, out_dir):
-    """After each edit, the lightmap's distance from the converged one against the update time spent since,
-    one curve per update budget."""
+    """After each edit, or each gesture of edits a few updates apart, the lightmap's distance from the
+    converged one against the update time spent since, one curve per update budget; the panels' titles."""
     plays = [p for p in scene.get("plays", []) if p["frames"]]
     if not plays:
-        return None
-    edits = plays[0]["edits"]
-    fig, axes = plt.subplots(1, len(edits), figsize=(4.4 * len(edits), 3.8), squeeze=False)
-    frames = scene["script_frames"]
-    for e, edit in enumerate(edits):
-        ax = axes[0][e]
-        start = edit["frame"]
-        end = edits[e + 1]["frame"] if e + 1 < len(edits) else frames
+        return None, []
+    groups = edit_groups(plays[0]["edits"], scene["script_frames"])
+    fig, axes = plt.subplots(1, len(groups), figsize=(4.4 * len(groups), 3.8), squeeze=False)
+    for g, (first, last, start, end, title) in enumerate(groups):
+        ax = axes[0][g]
         for p in plays:
-            ms, xs, ys, fs = 0.0, [], [], []
-            for err, t, _whole, frame in p["frames"][start:end]:
+            ms, xs, ys, fs, marks = 0.0, [], [], [], []
+            for k, (err, t, _whole, frame) in enumerate(p["frames"][start:end]):
                 ms += t
                 xs.append(ms)
                 ys.append(max(err, 1e-4))
                 fs.append(max(frame, 1e-4) if frame is not None else None)
+                if p["default"] and k and any(p["edits"][e]["frame"] == start + k for e in range(first + 1, last + 1)):
+                    marks.append(ms)
             ax.plot(xs, ys, "-" if p["default"] else "--", linewidth=2.2 if p["default"] else 1.2,
                     label="defaults" if p["default"] else f"{p['knob']} {p['value']}")
             if any(f is not None for f in fs):
                 ax.plot([x for x, f in zip(xs, fs) if f is not None], [f for f in fs if f is not None], ":",
                         color="black", linewidth=1.6, label="defaults: frame vs path-traced reference")
+            for m in marks:  # the gesture's later edits, at the defaults' time
+                ax.axvline(m, color="tab:red", linewidth=0.5, alpha=0.5)
         ax.axhline(0.05, color="grey", linewidth=0.8)
         ax.axhline(0.02, color="grey", linewidth=0.8, linestyle=":")
         ax.set_yscale("log")
-        ax.set_title(f"{edit['edit']} (update {start})", fontsize=9)
-        style(ax, "update ms since the edit", "worst surface from converged (frame: vs reference)", 7 if e == 0 else 0)
-    return save(fig, scene, "lag", "update lag after each edit (lines at 5% and 2%)", out_dir, 0.93)
+        ax.set_title(title, fontsize=9)
+        style(ax, "update ms since the edit" if first == last else "update ms since the first edit (red: the others)",
+              "worst surface from converged (frame: vs reference)", 7 if g == 0 else 0)
+    name = save(fig, scene, "lag", "update lag after each edit (lines at 5% and 2%)", out_dir, 0.93)
+    return name, [gr[4] for gr in groups]
 
 
 def lag_html(scene, out_dir):
@@ -239,9 +269,11 @@ def lag_html(scene, out_dir):
     if not plays:
         return ""
     parts = [f"<h3>Update lag ({html.escape(scene['script'])})</h3>"]
-    png = lag_plot(scene, out_dir)
+    png, panels = lag_plot(scene, out_dir)
     if png:
         parts.append(f'<img src="{png}" alt="update lag">')
+        parts.append("<p>Panels, one an edit, or one a gesture of edits at most {} updates apart (a drag): {}.</p>"
+                     .format(GESTURE_GAP, "; ".join(html.escape(t) for t in panels)))
 
     def cell(f, ms):
         return f"{f} ({ms:.0f} ms)" if f >= 0 else f"not in {ms:.0f} ms"
