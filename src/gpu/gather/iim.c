@@ -133,10 +133,11 @@ void lm_iim_free(lm_iim *iim)
     memset(iim, 0, sizeof *iim);
 }
 
-/* Whether a commit at frame `start` still blends at frame `frame`. */
+/* Whether a commit at frame `start` still blends at frame `frame` (glsl/iim_blend_cs.glsl, blend_t_at: the
+ * commit's frame shows 1 / blend_frames of it, frame start + blend_frames - 1 all of it). */
 static int blending_at(const lm_iim *iim, int start, double frame)
 {
-    return frame - start < iim->set.blend_frames;
+    return frame - start + 1 < iim->set.blend_frames;
 }
 
 void lm_iim_commit_texels(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n)

@@ -35,7 +35,10 @@ uniform float limit; /* back-face fraction above which a texel is invalid */
 const int NEVER = -1073741824;
 const float INSIDE = 1e30;
 
-float blend_t_at(int c, int f) { return blend_frames <= 0 ? 1.0 : min(1.0, float(f - start[c]) / float(blend_frames)); }
+// The commit's own frame already shows 1 / blend_frames of the change: a texel committed again every frame
+// (gathered every update while a node moves beside it) then follows its gathers with a lag of about
+// blend_frames, where a first step of 0 left it showing its first value for as long as the commits went on.
+float blend_t_at(int c, int f) { return blend_frames <= 0 ? 1.0 : min(1.0, float(f - start[c] + 1) / float(blend_frames)); }
 float blend_t(int c) { return blend_t_at(c, frame); }
 
 // The texel's own blend of old and new at frame f.
