@@ -1783,57 +1783,80 @@ static void check_between(const tscene *t, const float *d, const float *lo, cons
     }
 }
 
+/* Three surfaces' IIM blending over 4 frames: display `old` 1 (the first full gather, shown at once), and
+ * fresh `nw` 3, not yet committed; d for the display read back, all for the scheduler's picks. */
+typedef struct {
+    tscene t;
+    lm_iim iim;
+    lm_iim_settings set;
+    lm_photon_store ps;
+    float *old, *nw, *d;
+    uint32_t *all;
+    size_t k0; /* the first texel's cell, as floats */
+} blend_case;
+
+static void blend_case_init(blend_case *b)
+{
+    three_surfaces(&b->t);
+    lm_iim_settings_default(&b->set);
+    b->set.blend_frames = 4;
+    lm_error err;
+    assert_int_equal(lm_iim_init(&b->iim, &b->t.a, &b->set, 1, &err), LM_OK);
+    assert_int_equal(lm_photon_store_init(&b->ps, 3, &err), LM_OK);
+    const lm_atlas *a = &b->t.a;
+    size_t n = 4 * (size_t)a->width * (size_t)a->height;
+    b->old = malloc(sizeof(float) * n), b->nw = malloc(sizeof(float) * n), b->d = malloc(sizeof(float) * n);
+    b->all = malloc(sizeof(uint32_t) * a->texel_count);
+    assert_true(b->old && b->nw && b->d && b->all);
+    set_fresh(&b->iim, 1.0f); /* first full gather: shown at once */
+    lm_iim_sched_pick_all(&b->iim.sched, &b->ps, b->all);
+    assert_int_equal(lm_iim_blend(&b->iim, 1, &err), LM_OK);
+    assert_int_equal(lm_iim_texture_read(b->iim.display_tex, a->width, a->height, b->old, &err), LM_OK);
+    set_fresh(&b->iim, 3.0f);
+    assert_int_equal(lm_iim_texture_read(b->iim.fresh_tex, a->width, a->height, b->nw, &err), LM_OK);
+    b->k0 = 4 * ((size_t)a->texels[0].y * (size_t)a->width + (size_t)a->texels[0].x);
+}
+
+static void blend_case_free(blend_case *b)
+{
+    free(b->old), free(b->nw), free(b->d), free(b->all);
+    lm_photon_store_free(&b->ps);
+    lm_iim_free(&b->iim);
+    ts_free(&b->t);
+}
+
 /* A blending texel never leaves [old, new], reaches new after blend_frames, and a surface committed
  * again mid-blend starts from what was displayed; the commit's own frame shows 1 / blend_frames of the
  * step (no pop, and a texel committed every frame still moves: test_blend_recommitted_every_frame). */
 static void test_blend_stays_between(void **state)
 {
     (void)state;
-    tscene t;
-    three_surfaces(&t);
-    lm_iim iim;
-    lm_iim_settings set;
-    lm_iim_settings_default(&set);
-    set.blend_frames = 4;
+    blend_case b;
+    blend_case_init(&b);
+    const lm_atlas *a = &b.t.a;
+    const size_t n = 4 * (size_t)a->width * (size_t)a->height, k0 = b.k0;
     lm_error err;
-    assert_int_equal(lm_iim_init(&iim, &t.a, &set, 1, &err), LM_OK);
-    lm_photon_store ps;
-    assert_int_equal(lm_photon_store_init(&ps, 3, &err), LM_OK);
-    size_t n = 4 * (size_t)t.a.width * (size_t)t.a.height;
-    float *old = malloc(sizeof(float) * n), *nw = malloc(sizeof(float) * n), *d = malloc(sizeof(float) * n);
-    uint32_t *all = malloc(sizeof(uint32_t) * t.a.texel_count);
-    assert_true(old && nw && d && all);
-    set_fresh(&iim, 1.0f); /* first full gather: shown at once */
-    lm_iim_sched_pick_all(&iim.sched, &ps, all);
-    assert_int_equal(lm_iim_blend(&iim, 1, &err), LM_OK);
-    assert_int_equal(lm_iim_texture_read(iim.display_tex, t.a.width, t.a.height, old, &err), LM_OK);
-    set_fresh(&iim, 3.0f);
-    assert_int_equal(lm_iim_texture_read(iim.fresh_tex, t.a.width, t.a.height, nw, &err), LM_OK);
-    lm_iim_sched_pick_all(&iim.sched, &ps, all);
+    lm_iim_sched_pick_all(&b.iim.sched, &b.ps, b.all);
     float prev = -1.0f;
-    const lm_texel *t0 = &t.a.texels[0];
-    size_t k0 = 4 * ((size_t)t0->y * (size_t)t.a.width + (size_t)t0->x);
-    for (int f = 0; f <= set.blend_frames + 2; f++) { /* recommit at 2: new reached at 1 + blend_frames */
+    for (int f = 0; f <= b.set.blend_frames + 2; f++) { /* recommit at 2: new reached at 1 + blend_frames */
         if (f == 2) { /* recommitted mid-blend: old becomes what is displayed */
-            memcpy(old, d, sizeof(float) * n);
-            set_fresh(&iim, 0.5f);
-            assert_int_equal(lm_iim_texture_read(iim.fresh_tex, t.a.width, t.a.height, nw, &err), LM_OK);
-            lm_iim_sched_pick_all(&iim.sched, &ps, all);
+            memcpy(b.old, b.d, sizeof(float) * n);
+            set_fresh(&b.iim, 0.5f);
+            assert_int_equal(lm_iim_texture_read(b.iim.fresh_tex, a->width, a->height, b.nw, &err), LM_OK);
+            lm_iim_sched_pick_all(&b.iim.sched, &b.ps, b.all);
             prev = 1e9f;
         }
-        assert_int_equal(lm_iim_blend(&iim, 0, &err), LM_OK);
-        assert_int_equal(lm_iim_texture_read(iim.display_tex, t.a.width, t.a.height, d, &err), LM_OK);
-        check_between(&t, d, old, nw);
+        assert_int_equal(lm_iim_blend(&b.iim, 0, &err), LM_OK);
+        assert_int_equal(lm_iim_texture_read(b.iim.display_tex, a->width, a->height, b.d, &err), LM_OK);
+        check_between(&b.t, b.d, b.old, b.nw);
         if (f == 0 || f == 2) /* a first step of 1 / blend_frames at the commit */
-            assert_float_equal(d[k0], old[k0] + (nw[k0] - old[k0]) / (float)set.blend_frames, 1e-5 * fabsf(old[k0]));
-        assert_true(f < 2 ? d[k0] >= prev : d[k0] <= prev); /* monotone towards new */
-        prev = d[k0];
+            assert_float_equal(b.d[k0], b.old[k0] + (b.nw[k0] - b.old[k0]) / (float)b.set.blend_frames,
+                               1e-5 * fabsf(b.old[k0]));
+        assert_true(f < 2 ? b.d[k0] >= prev : b.d[k0] <= prev); /* monotone towards new */
+        prev = b.d[k0];
     }
-    assert_true(d[k0] == nw[k0]);
-    free(old), free(nw), free(d), free(all);
-    lm_photon_store_free(&ps);
-    lm_iim_free(&iim);
-    ts_free(&t);
+    assert_true(b.d[k0] == b.nw[k0]);
+    blend_case_free(&b);
 }
 
 /* A surface committed again every frame (gathered every update beside a node that keeps moving) follows
@@ -1843,42 +1866,22 @@ static void test_blend_stays_between(void **state)
 static void test_blend_recommitted_every_frame(void **state)
 {
     (void)state;
-    tscene t;
-    three_surfaces(&t);
-    lm_iim iim;
-    lm_iim_settings set;
-    lm_iim_settings_default(&set);
-    set.blend_frames = 4;
+    blend_case b;
+    blend_case_init(&b);
+    const lm_atlas *a = &b.t.a;
+    const size_t k0 = b.k0;
     lm_error err;
-    assert_int_equal(lm_iim_init(&iim, &t.a, &set, 1, &err), LM_OK);
-    lm_photon_store ps;
-    assert_int_equal(lm_photon_store_init(&ps, 3, &err), LM_OK);
-    size_t n = 4 * (size_t)t.a.width * (size_t)t.a.height;
-    float *old = malloc(sizeof(float) * n), *nw = malloc(sizeof(float) * n), *d = malloc(sizeof(float) * n);
-    uint32_t *all = malloc(sizeof(uint32_t) * t.a.texel_count);
-    assert_true(old && nw && d && all);
-    set_fresh(&iim, 1.0f);
-    lm_iim_sched_pick_all(&iim.sched, &ps, all);
-    assert_int_equal(lm_iim_blend(&iim, 1, &err), LM_OK);
-    assert_int_equal(lm_iim_texture_read(iim.display_tex, t.a.width, t.a.height, old, &err), LM_OK);
-    set_fresh(&iim, 3.0f);
-    assert_int_equal(lm_iim_texture_read(iim.fresh_tex, t.a.width, t.a.height, nw, &err), LM_OK);
-    const lm_texel *t0 = &t.a.texels[0];
-    size_t k0 = 4 * ((size_t)t0->y * (size_t)t.a.width + (size_t)t0->x);
     double left = 1.0; /* the share of the step still to show */
     for (int k = 1; k <= 12; k++) {
-        lm_iim_sched_pick_all(&iim.sched, &ps, all); /* committed again, every frame */
-        assert_int_equal(lm_iim_blend(&iim, 0, &err), LM_OK);
-        assert_int_equal(lm_iim_texture_read(iim.display_tex, t.a.width, t.a.height, d, &err), LM_OK);
-        check_between(&t, d, old, nw);
-        left *= 1.0 - 1.0 / set.blend_frames;
-        assert_float_equal(d[k0], nw[k0] - (nw[k0] - old[k0]) * left, 1e-4 * nw[k0]);
+        lm_iim_sched_pick_all(&b.iim.sched, &b.ps, b.all); /* committed again, every frame */
+        assert_int_equal(lm_iim_blend(&b.iim, 0, &err), LM_OK);
+        assert_int_equal(lm_iim_texture_read(b.iim.display_tex, a->width, a->height, b.d, &err), LM_OK);
+        check_between(&b.t, b.d, b.old, b.nw);
+        left *= 1.0 - 1.0 / b.set.blend_frames;
+        assert_float_equal(b.d[k0], b.nw[k0] - (b.nw[k0] - b.old[k0]) * left, 1e-4 * b.nw[k0]);
     }
-    assert_true(fabsf(d[k0] - nw[k0]) < 0.03f * nw[k0]); /* 2.1% short after 12 commits */
-    free(old), free(nw), free(d), free(all);
-    lm_photon_store_free(&ps);
-    lm_iim_free(&iim);
-    ts_free(&t);
+    assert_true(fabsf(b.d[k0] - b.nw[k0]) < 0.03f * b.nw[k0]); /* 2.1% short after 12 commits */
+    blend_case_free(&b);
 }
 
 /* Invalid texels take their valid same-surface neighbours' mean. */
