@@ -310,8 +310,10 @@ static void undo_redo(lm_viewer *v, int redo)
     const lm_view_history *h = &v->history;
     const lm_view_step *step = redo ? (h->done < h->count ? &h->steps[h->done] : NULL)
                                     : (h->done > 0 ? &h->steps[h->done - 1] : NULL);
-    /* a node or a light put back where it was (or a light's colour: then nothing is placed) */
-    int places = step && (step->kind == LM_VIEW_NODE || step->kind == LM_VIEW_LIGHT);
+    /* a node or a light put back where it was (a light's colour or power places nothing) */
+    int places = step && (step->kind == LM_VIEW_NODE ||
+                          (step->kind == LM_VIEW_LIGHT &&
+                           memcmp(step->light_before.position, step->light_after.position, sizeof step->light_after.position)));
     char what[160];
     lmgi_error err;
     err.message[0] = '\0';
