@@ -8,11 +8,11 @@
  * display = mix(old, new, t) with t = min(1, (frames since the commit + 1) / blend_frames), each texel
  * keeping the frame of its own last commit (a texel may be committed alone: lm_iim_commit_texels). A texel
  * thus never leaves [old, new], and a surface committed again mid-blend starts from what was on screen (no
- * popping). The commit's own frame shows a first 1 / blend_frames of the step: a texel committed again
- * every frame (gathered every update beside a moving node) follows its gathers as a running mean over about
- * blend_frames updates; with t 0 at the commit it kept showing its first value for as long as the commits
- * went on (the animated Cornell box's cube faces and the floor under it, frozen while the cube moved). The alpha channel (back-face fraction) blends alike, but a texel that turns valid or invalid
- * (a moving object's foot) shows its new value at once: a blend with the dark value gathered from inside
+ * popping). The commit's own frame shows a first 1 / blend_frames of the step, so that a texel committed
+ * again every frame (gathered every update beside a moving node) follows its gathers as a running mean over
+ * about blend_frames updates; with none shown there it would keep its first value for as long as the
+ * commits go on. The alpha channel (back-face fraction) blends alike, but a texel that turns valid or
+ * invalid (a moving object's foot) shows its new value at once: a blend with the dark value gathered from inside
  * geometry would show as a dark square.
  *
  * Progressive refinement (issue 32, item 3): texels regathered ahead of their surface come one by one, so a

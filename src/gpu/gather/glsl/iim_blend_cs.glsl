@@ -35,9 +35,9 @@ uniform float limit; /* back-face fraction above which a texel is invalid */
 const int NEVER = -1073741824;
 const float INSIDE = 1e30;
 
-// The commit's own frame already shows 1 / blend_frames of the change: a texel committed again every frame
-// (gathered every update while a node moves beside it) then follows its gathers with a lag of about
-// blend_frames, where a first step of 0 left it showing its first value for as long as the commits went on.
+// The commit's own frame already shows 1 / blend_frames of the step: with none shown there, a texel
+// committed again every frame (gathered every update while a node moves beside it) would keep its first
+// value for as long as the commits go on; so it follows them as a running mean over about blend_frames.
 float blend_t_at(int c, int f) { return blend_frames <= 0 ? 1.0 : min(1.0, float(f - start[c] + 1) / float(blend_frames)); }
 float blend_t(int c) { return blend_t_at(c, frame); }
 
