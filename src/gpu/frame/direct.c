@@ -31,6 +31,7 @@ void lm_direct_settings_default(lm_direct_settings *s)
     s->const_bias = 0.5f;
     s->shadows = 1;
     s->maps_per_update = 4;
+    s->probe_lod = LM_DIRECT_PROBE_LOD;
 }
 
 typedef struct {
@@ -183,6 +184,14 @@ static void set_ranges(GLuint prog, const int keep[2], const int drop[2])
 
 static const int ALL[2] = {0, 0};
 
+/* The scene's triangles for the picture being drawn: an environment face's simplified (probe_lod). */
+static void draw_scene(const lm_direct *d, GLuint prog)
+{
+    (d->cur == LM_FRAME_PROBE ? lm_direct_mesh_draw_lod : lm_direct_mesh_draw)(&d->mesh, prog);
+}
+
+static float lod_error(const lm_direct *d, const lm_scene *s) { return d->set.probe_lod * lm_scene_size(s); }
+
 /* The indirect term's texture on unit 3 for a first-pass program (lit, use_lit: its uniforms). */
 static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit)
 {
@@ -227,7 +236,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
         glUniform1i(glGetUniformLocation(d->emission, "ortho_view"), view->proj[11] == 0.0f && view->proj[15] != 0.0f);
         glUniform1i(glGetUniformLocation(d->emission, "base_tex"), 2);
         bind_indirect(d, d->e_lit, d->e_use_lit);
-        lm_direct_mesh_draw(&d->mesh, d->emission);
+        draw_scene(d, d->emission);
         return;
     }
     const lm_emitter *e = &em->e[light];
@@ -238,7 +247,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
     set_view_uniforms(d, u, view);
     set_light_uniforms(u, s, e, &d->maps[light]);
     bind_indirect(d, u->lit, u->use_lit);
-    lm_direct_mesh_draw(&d->mesh, prog);
+    draw_scene(d, prog);
 }
 
 /* Emitter i's map parameters now; returns 1 when its map is stale (made from other parameters or
@@ -390,7 +399,7 @@ static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e
     set_ranges(prog, ALL, d->drop);
     set_view_uniforms(d, &d->u[kind_of(e)], view);
     set_light_uniforms(&d->u[kind_of(e)], s, e, &d->maps[i]);
-    lm_direct_mesh_draw(&d->mesh, prog);
+    draw_scene(d, prog);
     glDisable(GL_BLEND);
     glDepthMask(GL_TRUE);
     return lm_gl_check("direct_light: light pass", err);
@@ -417,7 +426,7 @@ static lm_status light_program(int kind, int pcf, int first, GLuint *prog, lm_er
 
 static int valid_settings(const lm_direct_settings *set)
 {
-    return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0;
+    return set->map_size > 0 && set->cube_size > 0 && set->pcf_radius >= 0 && set->probe_lod >= 0.0f;
 }
 
 /* The 2D maps (whole-scene and the view's) a spot (0) or directional (1) light holds. */
@@ -502,8 +511,8 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
     if (!valid_settings(&d->set)) {
         lm_direct_settings bad = d->set;
         free(d);
-        return lm_fail(err, LM_ERR_INVALID, "direct_light: bad settings (map %d, cube %d, pcf %d)", bad.map_size,
-                       bad.cube_size, bad.pcf_radius);
+        return lm_fail(err, LM_ERR_INVALID, "direct_light: bad settings (map %d, cube %d, pcf %d, probe lod %g)",
+                       bad.map_size, bad.cube_size, bad.pcf_radius, (double)bad.probe_lod);
     }
     d->maps_left = -1;
     lm_status st = fit_shadow_budget(s, d, err);
@@ -524,7 +533,7 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
         st = lm_shadow_renderer_create(&d->shadow, err);
     }
     if (st == LM_OK)
-        st = lm_direct_mesh_build(&d->mesh, s, a, d->set.shadows, err);
+        st = lm_direct_mesh_build(&d->mesh, s, a, d->set.shadows, lod_error(d, s), err);
     d->has_lightmap = a != NULL;
     d->gbuffer = 1;
     d->atlas = a;
@@ -589,7 +598,7 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
         /* nodes switched between static and dynamic, or shadows on or off: the casters chosen and split
          * again, every shadow redrawn */
         lm_direct_mesh fresh;
-        if ((st = lm_direct_mesh_build(&fresh, s, d->atlas, d->set.shadows, err)) == LM_OK) {
+        if ((st = lm_direct_mesh_build(&fresh, s, d->atlas, d->set.shadows, lod_error(d, s), err)) == LM_OK) {
             lm_direct_mesh_free(&d->mesh);
             d->mesh = fresh;
             d->static_version++, d->dynamic_version++;
@@ -646,6 +655,7 @@ lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitter
 }
 
 const lm_frame_targets *lm_direct_targets(const lm_direct *d) { return &d->targets; }
+uint32_t lm_direct_probe_triangles(const lm_direct *d) { return d->mesh.lod_tris; }
 
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node)
 {

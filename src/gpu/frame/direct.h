@@ -27,9 +27,17 @@ typedef struct {
                            * Default 1 */
     int maps_per_update;  /* stale shadow maps re-rendered per update (lm_direct_begin_update's count for the
                            * frame loop; < 0: all). Default 4 */
+    float probe_lod;      /* environment map faces (lm_direct_draw_probe) draw the scene simplified to this
+                           * error, a fraction of the scene's size (direct_mesh.h; 0: every triangle).
+                           * Default LM_DIRECT_PROBE_LOD */
 } lm_direct_settings;
 
 void lm_direct_settings_default(lm_direct_settings *s);
+
+/* The environment faces' level of detail: 0.002 of the scene's size, 7 mm in the 3.5 m Cornell box, a
+ * tenth of a face's pixel there at its default 128 texels (docs/direct.md, "Reflections"). Larsen &
+ * Christensen section 9: LOD works with their methods. */
+#define LM_DIRECT_PROBE_LOD 0.002f
 
 /* What all shadow maps together may take, and the smallest side they are shrunk to to fit (direct.c,
  * fit_shadow_budget): 256 MB holds 10 point lights at the default 512 a face, 1,365 at 64. */
@@ -77,6 +85,8 @@ lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *e
  * pass's indirect term and the shadow maps are the frame's. */
 lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
                                int skip, lm_error *err);
+/* The triangles an environment face draws (settings.probe_lod), the skipped node's included. */
+uint32_t lm_direct_probe_triangles(const lm_direct *d);
 /* Draws only node's triangles with prog, a program on glsl/direct_vs.glsl (its uniforms set by the caller;
  * has_tex and the base colour texture on unit 2 set here per texture group). */
 void lm_direct_draw_node(const lm_direct *d, unsigned prog, int node);

@@ -2,6 +2,7 @@
 
 #include "../gl/gl_api.h"
 #include <math.h>
+#include <meshoptimizer.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -139,8 +140,8 @@ static corner_key key_of(const lm_scene *s, const lm_atlas *a, uint32_t t, int k
 typedef struct {
     float *vert, *lm_uv, *caster_pos;
     uint32_t *corner;        /* per triangle corner: its vertex */
-    uint32_t *index, *caster_index;
-    int verts, casters, caster_indices;
+    uint32_t *index, *caster_index; /* index: the full triangles, then the simplified ones */
+    int verts, indices, casters, caster_indices;
 } built;
 
 static void built_free(built *b)
@@ -202,6 +203,82 @@ static int shading_indices(lm_direct_mesh *d, const lm_scene *s, built *b)
         o[g] += 3;
     }
     free(at);
+    b->indices = 3 * (int)s->tri_count;
+    return 1;
+}
+
+/* The node whose vertex range holds mesh vertex v (node_first ascends with the node). */
+static int node_of_vertex(const lm_direct_mesh *d, uint32_t v)
+{
+    int lo = 0, hi = d->node_count - 1;
+    while (lo < hi) {
+        int mid = (lo + hi + 1) / 2;
+        if ((uint32_t)d->node_first[mid] <= v)
+            lo = mid;
+        else
+            hi = mid - 1;
+    }
+    return lo; /* the last node to start at or before v (one without vertices starts where the next does) */
+}
+
+/* Appends to b->index the simplified form of the n indices at `in`, whole triangles over node `node`'s
+ * vertices; 0 when out of memory. */
+static int simplify_run(const lm_direct_mesh *d, built *b, int node, size_t in, size_t n, float lod_error)
+{
+    unsigned *local = malloc(sizeof(unsigned) * 2 * n), *out = local + n;
+    if (!local)
+        return 0;
+    uint32_t first = (uint32_t)d->node_first[node];
+    for (size_t i = 0; i < n; i++)
+        local[i] = b->index[in + i] - first;
+    const float *pos = b->vert + (size_t)FLOATS * first;
+    size_t verts = (size_t)d->node_verts[node], stride = sizeof(float) * FLOATS;
+    float extent = meshopt_simplifyScale(pos, verts, stride); /* meshopt's error is relative to it */
+    size_t m = n;
+    if (extent > 0.0f)
+        m = meshopt_simplify(out, local, n, pos, verts, stride, 0, lod_error / extent, 0, NULL);
+    else
+        memcpy(out, local, sizeof(unsigned) * n);
+    for (size_t i = 0; i < m; i++)
+        b->index[(size_t)b->indices + i] = out[i] + first;
+    b->indices += (int)m;
+    free(local);
+    return 1;
+}
+
+/* The simplified triangles (lm_direct_mesh.lod_*) after the full ones: per group, its unpaired and then
+ * its paired triangles, each node's run simplified on its own; 0 when out of memory. Without lod_error
+ * the ranges are the full ones. */
+static int lod_indices(lm_direct_mesh *d, built *b, float lod_error)
+{
+    if (!(lod_error > 0.0f)) {
+        memcpy(d->lod_first, d->first, sizeof(int) * (size_t)d->groups);
+        memcpy(d->lod_count, d->count, sizeof(int) * (size_t)d->groups);
+        memcpy(d->lod_paired, d->paired, sizeof(int) * (size_t)d->groups);
+        d->lod_tris = (uint32_t)b->indices / 3;
+        return 1;
+    }
+    int full = b->indices;
+    for (int g = 0; g < d->groups; g++) {
+        d->lod_first[g] = b->indices;
+        for (int side = 0; side < 2; side++) {
+            int split = d->first[g] + d->count[g] - d->paired[g];
+            int lo = side ? split : d->first[g], hi = side ? d->first[g] + d->count[g] : split, before = b->indices;
+            for (int i = lo; i < hi;) {
+                int node = node_of_vertex(d, b->index[i]), j = i;
+                uint32_t v0 = (uint32_t)d->node_first[node], v1 = v0 + (uint32_t)d->node_verts[node];
+                while (j < hi && b->index[j] >= v0 && b->index[j] < v1)
+                    j += 3;
+                if (!simplify_run(d, b, node, (size_t)i, (size_t)(j - i), lod_error))
+                    return 0;
+                i = j;
+            }
+            if (side)
+                d->lod_paired[g] = b->indices - before;
+        }
+        d->lod_count[g] = b->indices - d->lod_first[g];
+    }
+    d->lod_tris = (uint32_t)(b->indices - full) / 3;
     return 1;
 }
 
@@ -254,6 +331,9 @@ static int allocate(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, bui
     d->first = calloc((size_t)d->groups, sizeof(int));
     d->count = calloc((size_t)d->groups, sizeof(int));
     d->paired = calloc((size_t)d->groups, sizeof(int));
+    d->lod_first = calloc((size_t)d->groups, sizeof(int));
+    d->lod_count = calloc((size_t)d->groups, sizeof(int));
+    d->lod_paired = calloc((size_t)d->groups, sizeof(int));
     d->tex = calloc((size_t)d->groups, sizeof(unsigned));
     d->node_first = calloc(nodes, sizeof(int));
     d->node_verts = calloc(nodes, sizeof(int));
@@ -268,9 +348,9 @@ static int allocate(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, bui
     b->lm_uv = a ? malloc(sizeof(float) * 2 * corners) : NULL;
     b->caster_pos = malloc(sizeof(float) * 3 * corners);
     b->corner = malloc(sizeof(uint32_t) * corners);
-    b->index = malloc(sizeof(uint32_t) * corners);
+    b->index = malloc(sizeof(uint32_t) * 2 * corners); /* the simplified triangles after the full ones */
     b->caster_index = malloc(sizeof(uint32_t) * corners);
-    return d->first && d->count && d->paired && d->tex && d->node_first && d->node_verts && d->caster_first &&
+    return d->first && d->count && d->paired && d->lod_first && d->lod_count && d->lod_paired && d->tex && d->node_first && d->node_verts && d->caster_first &&
            d->caster_verts && d->vert_src && d->vert_mat && d->caster_src && d->node_world && d->scratch &&
            b->vert && (b->lm_uv || !a) && b->caster_pos && b->corner && b->index && b->caster_index;
 }
@@ -278,7 +358,7 @@ static int allocate(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, bui
 static void upload_meshes(lm_direct_mesh *d, const lm_scene *s, const built *b)
 {
     const int sizes[6] = {3, 3, 3, 4, 3, 2}, pos_only[1] = {3};
-    lm_gl_mesh_create_elements(&d->mesh, b->vert, b->verts, sizes, 6, b->index, (int)(3 * s->tri_count));
+    lm_gl_mesh_create_elements(&d->mesh, b->vert, b->verts, sizes, 6, b->index, b->indices);
     lm_gl_mesh_create_elements(&d->casters, b->caster_pos, b->casters, pos_only, 1, b->caster_index,
                                b->caster_indices);
     for (int g = 1; g < d->groups; g++)
@@ -310,7 +390,8 @@ static void dynamic_bounds(lm_direct_mesh *d, const lm_scene *s)
     }
 }
 
-lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, int shadows, lm_error *err)
+lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, int shadows, float lod_error,
+                               lm_error *err)
 {
     memset(d, 0, sizeof *d);
     d->material_version = s->material_version;
@@ -321,7 +402,7 @@ lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_at
     memset(&b, 0, sizeof b);
     corner_map map = {NULL, NULL, 0};
     int ok = allocate(d, s, a, &b) && shading_vertices(d, s, a, &map, &b) && shading_indices(d, s, &b) &&
-             caster_geometry(d, s, shadows, &map, &b);
+             lod_indices(d, &b, lod_error) && caster_geometry(d, s, shadows, &map, &b);
     if (ok) {
         for (int i = 0; i < s->node_count; i++)
             memcpy(d->node_world + 16 * (size_t)i, s->nodes[i].world, sizeof s->nodes[i].world);
@@ -382,22 +463,29 @@ int lm_direct_mesh_update(lm_direct_mesh *d, const lm_scene *s)
     return moved;
 }
 
-void lm_direct_mesh_draw(const lm_direct_mesh *d, unsigned prog)
+static void draw_groups(const lm_direct_mesh *d, unsigned prog, const int *first, const int *count, const int *paired)
 {
     GLint has_tex = prog ? glGetUniformLocation(prog, "has_tex") : -1;
     for (int g = 0; g < d->groups; g++) {
-        if (!d->count[g])
+        if (!count[g])
             continue;
         if (has_tex >= 0)
             glUniform1i(has_tex, g > 0);
         glActiveTexture(GL_TEXTURE2);
         glBindTexture(GL_TEXTURE_2D, g > 0 ? d->tex[g - 1] : 0);
-        int unpaired = d->count[g] - d->paired[g];
+        int unpaired = count[g] - paired[g];
         if (unpaired)
-            lm_gl_mesh_draw_range(&d->mesh, d->first[g], unpaired);
-        if (d->paired[g]) /* both sides lie in one plane: only the one facing the eye is drawn */
-            lm_gl_mesh_draw_front_range(&d->mesh, d->first[g] + unpaired, d->paired[g]);
+            lm_gl_mesh_draw_range(&d->mesh, first[g], unpaired);
+        if (paired[g]) /* both sides lie in one plane: only the one facing the eye is drawn */
+            lm_gl_mesh_draw_front_range(&d->mesh, first[g] + unpaired, paired[g]);
     }
+}
+
+void lm_direct_mesh_draw(const lm_direct_mesh *d, unsigned prog) { draw_groups(d, prog, d->first, d->count, d->paired); }
+
+void lm_direct_mesh_draw_lod(const lm_direct_mesh *d, unsigned prog)
+{
+    draw_groups(d, prog, d->lod_first, d->lod_count, d->lod_paired);
 }
 
 void lm_direct_mesh_free(lm_direct_mesh *d)
@@ -414,6 +502,9 @@ void lm_direct_mesh_free(lm_direct_mesh *d)
     free(d->first);
     free(d->count);
     free(d->paired);
+    free(d->lod_first);
+    free(d->lod_count);
+    free(d->lod_paired);
     free(d->tex);
     free(d->node_first);
     free(d->node_verts);

@@ -20,6 +20,9 @@ typedef struct {
     int *first, *count;   /* index range of each group */
     int *paired;          /* of which the last `paired` are sides of split double-sided surfaces, drawn
                            * with back faces culled (the twin on the same plane shows the other side) */
+    int *lod_first, *lod_count, *lod_paired; /* the same per group for the simplified triangles, after the full
+                           * ones in the index buffer (lm_direct_mesh_draw_lod) */
+    uint32_t lod_tris;    /* triangles of the simplified mesh (the scene's own without lod_error) */
     unsigned *tex;        /* GL texture of group g + 1 (0 when the group is empty) */
     int node_count;
     int *node_first, *node_verts;     /* per node: its vertex range in `mesh` */
@@ -37,8 +40,13 @@ typedef struct {
 
 /* Builds the meshes; with an atlas (may be NULL) also attribute 7: each vertex's lightmap uv, (-1, -1) on
  * triangles without a chart (uvs are fixed: they do not move with their node). shadows 0: no casters at
- * all (the run's switch), else the nodes whose own switch is on. */
-lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, int shadows, lm_error *err);
+ * all (the run's switch), else the nodes whose own switch is on. lod_error > 0 (world units): also a
+ * simplified set of triangles over the same vertices, each node's triangles of one texture and side rule
+ * simplified on their own by meshoptimizer's edge collapse (quadric error about lod_error, under the world
+ * matrices at the build); vertices are only removed, and corners that differ in any attribute (a chart's
+ * border, a hard edge's normals) stay apart, so the simplified triangles keep their lightmap charts. */
+lm_status lm_direct_mesh_build(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, int shadows, float lod_error,
+                               lm_error *err);
 /* Re-uploads the vertices of every node whose world matrix changed since they were uploaded, and of
  * every node after a material edit (lm_scene.material_version). Returns
  * LM_MESH_MOVED when some node moved, | LM_MESH_DYNAMIC_CASTERS_MOVED or LM_MESH_STATIC_CASTERS_MOVED
@@ -48,6 +56,8 @@ int lm_direct_mesh_update(lm_direct_mesh *d, const lm_scene *s);
 /* Draws every group, binding its texture to unit 2 and setting uniform `has_tex` of prog (prog 0: the
  * current program, no uniform set). */
 void lm_direct_mesh_draw(const lm_direct_mesh *d, unsigned prog);
+/* The same with the simplified triangles (lm_direct_mesh_build's lod_error). */
+void lm_direct_mesh_draw_lod(const lm_direct_mesh *d, unsigned prog);
 void lm_direct_mesh_free(lm_direct_mesh *d);
 
 #endif
