@@ -263,7 +263,12 @@ static inline int lmgi_knob_is_pow2(double v)
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                          \
       "most environment map faces re-rendered a frame, those whose view changed\n"                                \
       "longest ago first, after all of them at the first frame (default 1; a\n"                                   \
-      "still scene renders none)")
+      "still scene renders none)")                                                                                 \
+    X(frame, reflection_lod, LMGI_KNOB_REAL, float, 0.001953125, 1e-6, 0.1, 1, LMGI_NO_RULE, "--reflection-lod", "E", \
+      LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
+      "environment map faces draw the scene simplified to E x its size, what\n"                                    \
+      "they show off by up to that much (default 1/512; 0: every triangle;\n"                                      \
+      "docs/direct.md, \"Reflections\")")
 
 /* the per-pixel photon gathers (indirect TILED, HASHGRID, BRUTEFORCE; docs/tiled.md) */
 #define LMGI_TILED_KNOBS(X)                                                                                           \

@@ -651,6 +651,14 @@ static void test_knob_table(void **state)
     assert_int_equal(s.reflection_faces, def.reflection_faces);
     assert_int_equal(s.overlap, def.overlap);
     assert_true(s.photon_radius == def.photon_radius);
+    /* the environment faces' simplification reaches the direct pass: off is every triangle */
+    d.frame.reflection_lod = LMGI_OFF;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_true(s.direct.probe_lod == 0.0f);
+    d.frame.reflection_lod = 0.01f;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_true(s.direct.probe_lod == 0.01f);
+    d.frame.reflection_lod = 0.0f;
     int refused = 0;
     LMGI_UPDATER_KNOBS(REFUSED)
     print_message("%d knobs refused past their range or choices\n", refused);

@@ -171,6 +171,13 @@ static void test_usage_errors(void **state)
     refused("--bend", bad_bend, 5, "expected degrees in (0, 180], or off");
     assert_int_equal(run("info scenes/cornell.glb --bend off"), 0);
     assert_int_equal(run("info scenes/cornell.glb --bend 30"), 0);
+    /* a negative number is a number: the message says which it must be, not "a finite number" */
+    assert_int_equal(run("run scenes/cornell.glb --reflection-lod -1 --out x"), 2);
+    assert_non_null(strstr(output, "--reflection-lod -1: expected a number of at least 0"));
+    assert_int_equal(run("run scenes/cornell.glb --caustic-thin -0.5 --out x"), 2);
+    assert_non_null(strstr(output, "--caustic-thin -0.5: expected a number of at least 0"));
+    assert_int_equal(run("run scenes/cornell.glb --reflection-lod 0.5 --out x"), 2);
+    assert_non_null(strstr(output, "--reflection-lod 0.5: expected a number in [1e-06, 0.1]"));
     assert_int_equal(run("run scenes/cornell.glb --aim-occluders maybe --out x"), 2);
     assert_non_null(strstr(output, "--aim-occluders maybe: expected on or off"));
     /* the indirect paths and their knobs (docs/tiled.md) */

@@ -967,7 +967,7 @@ static float *probe_face(lm_direct *d, lm_scene *s, const lm_emitters *em, const
  * the six faces seen from the mirror sphere's place (the sphere left out, as lm_reflections draws them)
  * reads as with every triangle within 5% over the face, and under 5% of its pixels are more than 10% off:
  * direct light only, and what differs is the floor's shadow edges, where the simplified floor lies up to
- * 7 mm off the one the shadow map holds (measured 3.3% and 3.2% on the face looking down, under 1.3% and
+ * 7 mm off the one the shadow map holds (measured 3.5% and 3.2% on the face looking down, under 1.3% and
  * 1% on the others; the light through a face is what matters, the frame shows it on the spheres alone).
  * The frame's own view draws every triangle: the same to the bit. With probe_lod 0 the faces draw every
  * triangle; a negative one is refused. */

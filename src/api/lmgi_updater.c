@@ -130,6 +130,7 @@ static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s
     int no_reflections = f->reflection_size == LMGI_OFF || (r->effects_off & LMGI_EFFECT_REFLECTIONS);
     s->reflection_size = no_reflections ? 0 : f->reflection_size;
     s->reflection_faces = f->reflection_faces;
+    s->direct.probe_lod = f->reflection_lod == LMGI_OFF ? 0.0f : f->reflection_lod;
     s->caustic_pass.filter_k = r->caustics.filter == LMGI_OFF ? 0 : r->caustics.filter;
     s->caustic_pass.filter_photons = r->caustics.filter_photons == LMGI_OFF ? 0 : r->caustics.filter_photons;
     s->caustic_pass.tile = r->caustics.tile;

@@ -23,8 +23,13 @@ int lm_cli_parse_float(const char *opt, const char *v, float lo, float *out)
         return lm_cli_bad(opt, v, "a number");
     errno = 0;
     double d = strtod(v, &end);
-    if (errno || end == v || *end || !isfinite(d) || d < lo)
+    if (errno || end == v || *end || !isfinite(d))
         return lm_cli_bad(opt, v, "a finite number");
+    if (d < lo) { /* "-1" is a number: say which it must be (the range, where a knob has one, is checked later) */
+        char want[48];
+        snprintf(want, sizeof want, "a number of at least %g", (double)lo);
+        return lm_cli_bad(opt, v, want);
+    }
     *out = (float)d;
     return 0;
 }

@@ -34,10 +34,10 @@ typedef struct {
 
 void lm_direct_settings_default(lm_direct_settings *s);
 
-/* The environment faces' level of detail: 0.002 of the scene's size, 7 mm in the 3.5 m Cornell box, a
+/* The environment faces' level of detail: 1/512 of the scene's size, 7 mm in the 3.5 m Cornell box, a
  * tenth of a face's pixel there at its default 128 texels (docs/direct.md, "Reflections"). Larsen &
  * Christensen section 9: LOD works with their methods. */
-#define LM_DIRECT_PROBE_LOD 0.002f
+#define LM_DIRECT_PROBE_LOD (1.0f / 512.0f)
 
 /* What all shadow maps together may take, and the smallest side they are shrunk to to fit (direct.c,
  * fit_shadow_budget): 256 MB holds 10 point lights at the default 512 a face, 1,365 at 64. */
