@@ -70,19 +70,6 @@ static void ts_load(tscene *t, const lmt_mesh *meshes, int count, const char *no
     ts_load_walls(t, meshes, count, nodes, materials, texel_size, 0, 0);
 }
 
-/* The atlas built again over the scene's vertex normals as they are now: its texels take their normals
- * when it is built (lm_texel.lnormal), and these tests edit the normals after loading. */
-static void rebuild_atlas(const lm_scene *s, const lm_surfaces *su, float texel_size, lm_atlas *a)
-{
-    lm_error err;
-    lm_atlas_options ao;
-    lm_atlas_options_default(&ao);
-    ao.texel_size = texel_size;
-    lm_atlas_free(a);
-    if (lm_atlas_build(s, su, &ao, a, &err) != LM_OK)
-        fail_msg("atlas: %s", err.msg);
-}
-
 static void ts_free(tscene *t)
 {
     lm_atlas_free(&t->a);
@@ -367,7 +354,6 @@ static void test_tilted_normals(void **state)
         float *n = t.s->normals + 3 * (size_t)v;
         n[0] = (float)sin(tilt), n[1] = (float)cos(tilt), n[2] = 0.0f;
     }
-    rebuild_atlas(t.s, &t.su, 0.25f, &t.a);
     lm_rt *rt = NULL;
     lm_error err;
     assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
@@ -778,7 +764,6 @@ static void test_sun_cosine_on_shading_normals(void **state)
             n[0] = (float)sin(tilt[node - 1]), n[1] = (float)cos(tilt[node - 1]), n[2] = 0.0f;
         }
     }
-    rebuild_atlas(p.s, &p.su, 8.0f, &p.atlas);
     lm_error err;
     lm_rt_free(p.rt); /* a flat triangle's shading normal is the BVH's */
     assert_int_equal(lm_rt_build(p.s, &p.su, &p.rt, &err), LM_OK);
