@@ -350,8 +350,9 @@ static int allocate(lm_direct_mesh *d, const lm_scene *s, const lm_atlas *a, bui
     b->corner = malloc(sizeof(uint32_t) * corners);
     b->index = malloc(sizeof(uint32_t) * 2 * corners); /* the simplified triangles after the full ones */
     b->caster_index = malloc(sizeof(uint32_t) * corners);
-    return d->first && d->count && d->paired && d->lod_first && d->lod_count && d->lod_paired && d->tex && d->node_first && d->node_verts && d->caster_first &&
-           d->caster_verts && d->vert_src && d->vert_mat && d->caster_src && d->node_world && d->scratch &&
+    return d->first && d->count && d->paired && d->lod_first && d->lod_count && d->lod_paired && d->tex &&
+           d->node_first && d->node_verts && d->caster_first && d->caster_verts && d->vert_src && d->vert_mat &&
+           d->caster_src && d->node_world && d->scratch &&
            b->vert && (b->lm_uv || !a) && b->caster_pos && b->corner && b->index && b->caster_index;
 }
 
