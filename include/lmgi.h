@@ -139,7 +139,7 @@ typedef struct {
 
 typedef struct {
     float position[3];  /* world position (centroid of the texel's overlap with its triangle) */
-    float normal[3];
+    float normal[3];    /* shading normal: the mean over the texel's part of its surface, by area (at load) */
     int x, y;           /* texel coordinates in the atlas */
     int surface;
     uint32_t triangle;

@@ -533,6 +533,52 @@ static void test_bending_normals_finer_texels(void **state)
     ts_free(t);
 }
 
+/* A texel's shading normal is the mean over the triangles it covers, weighted by area, not the normal at its
+ * centre: a hexagonal column whose vertex normals turn 60 degrees across each 0.5 m face, at 1 m texels (a
+ * face in one texel), gets each face's texel facing straight out through the face's middle (the normal at
+ * the centroid of one of its two triangles leaned 10 degrees off), and lm_texel_world turns it with the
+ * node (a dynamic node's texels keep their mean). */
+static void test_texel_normal_is_the_mean(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(1);
+    ts_column(t, 0, 0.0f, 0.5f, 0.5f);
+    lm_surfaces su;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    o.texel_size = 1.0f;
+    lm_atlas a;
+    if (lm_atlas_build(&t->s, &su, &o, &a, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    check_atlas(&t->s, &su, &a, 1e-4);
+    const float turn[16] = {0, 0, -1, 0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1}; /* 90 degrees about y */
+    double worst = 0.0, worst_turned = 0.0;
+    for (uint32_t i = 0; i < a.texel_count; i++) {
+        const lm_texel *x = &a.texels[i];
+        double ang = atan2(-(double)x->pos[2], (double)x->pos[0]);
+        ang = ang < 0.0 ? ang + 2.0 * LM_PI : ang;
+        double mid = (floor(ang / (LM_PI / 3.0)) + 0.5) * LM_PI / 3.0; /* the face's middle */
+        lm_vec3 want = lm_v3((float)cos(mid), 0.0f, (float)-sin(mid));
+        worst = fmax(worst, acos(fmin(1.0, (double)lm_dot(lm_v3_load(x->normal), want))) * 180.0 / LM_PI);
+        memcpy(t->s.nodes[0].world, turn, sizeof turn);
+        float p[3], n[3];
+        lm_texel_world(&t->s, x, p, n);
+        lm_mat4_identity(t->s.nodes[0].world);
+        lm_vec3 turned = lm_mat4_normal(turn, want);
+        worst_turned = fmax(worst_turned, acos(fmin(1.0, (double)lm_dot(lm_v3_load(n), turned))) * 180.0 / LM_PI);
+    }
+    print_message("column at 1 m texels: %u texels, worst angle to the face's middle %.3f deg, turned %.3f deg\n",
+                  a.texel_count, worst, worst_turned);
+    assert_true(a.texel_count >= 6);
+    assert_true(worst < 0.5);
+    assert_true(worst_turned < 0.5);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
 /* The flawed scene still gets a valid atlas by default; strict mode refuses it, naming `what`.
  * Frees su and t. */
 static void atlas_ok_then_strict_fails(tscene *t, lm_surfaces *su, const char *what)
@@ -962,6 +1008,7 @@ int main(void)
         cmocka_unit_test(test_l_shape),
         cmocka_unit_test(test_hemisphere),
         cmocka_unit_test(test_bending_normals_finer_texels),
+        cmocka_unit_test(test_texel_normal_is_the_mean),
         cmocka_unit_test(test_degenerate_and_strict),
         cmocka_unit_test(test_nonmanifold_fin),
         cmocka_unit_test(test_bumpy_cornell),

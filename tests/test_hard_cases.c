@@ -597,9 +597,10 @@ static void make_column(column_mesh *c)
  * seen by 50 pixels or more, and the frame, within 2% per channel. The faces' normals turn 24 degrees a
  * texel at the room's budget (1,500), so the column's texels are 0.55 x as wide (lmgi_options.bend_deg,
  * docs/charts.md "Bending normals"; 1,424 texels in all, the room's coarser): measured, the face beside
- * the lamp reads 0.991 0.988 0.990, the other 0.999 0.995 0.998. With one texel size (bend_deg LMGI_OFF,
+ * the lamp reads 0.991 0.989 0.991, the other 1.000 0.995 0.999. With one texel size (bend_deg LMGI_OFF,
  * 1,678 texels) the face read 0.979 0.977 0.978, each edge pixel's normal bent past its outer texels'
- * (flat normals: 0.991), which the second half asserts: the finer texels are what meets 2%. */
+ * (flat normals: 0.991); since each texel's normal is the mean over what it covers (2026-12-03), 0.984
+ * 0.981 0.983. The second half asserts that the finer texels still buy more than half a point. */
 /* The column in the room, baked at the defaults with bend_deg as given, against the reference: the frame
  * within 2% per channel; returns the worst channel's |frame / reference - 1| over the column's faces seen
  * by 50 pixels or more (at least two of them). */
@@ -659,7 +660,7 @@ static void test_bending_shading_normals(void **state)
     double finer = column_worst_face(0.0f), one_size = column_worst_face((float)LMGI_OFF);
     print_message("column's worst face: %.4f off with finer texels, %.4f with one texel size\n", finer, one_size);
     assert_true(finer < 0.02);
-    assert_true(one_size > 0.02);
+    assert_true(one_size > finer + 0.005);
 }
 
 /* ---------- photons on one vertex, along edges and seams ---------- */

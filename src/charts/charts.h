@@ -112,7 +112,11 @@ typedef struct {
     float pos[3];          /* world position: centroid of the texel's overlap with its triangle */
     float local[3];        /* the same point in its node's local space (follows a dynamic node) */
     float bary[3];         /* its barycentric weights on the triangle's corners 0, 1, 2 */
-    float normal[3];       /* interpolated shading normal, world space */
+    float normal[3];       /* shading normal, world space: the mean of the interpolated shading normals over
+                              the texel's overlap with its surface's triangles, weighted by area (a texel across
+                              a sphere's facets or a terrain's coarse triangles stands for all of them, not for
+                              the one holding pos) */
+    float lnormal[3];      /* the same in its node's local space (follows a dynamic node) */
     int x, y;              /* texel coordinates */
     int surface;
     uint32_t tri;
@@ -166,9 +170,14 @@ int lm_texel_parts(const lm_scene *s, const lm_atlas *a, const lm_texel *t, int 
 /* The diffuse lobe kd (lm_material_lobes) of the texel's material at its point: base colour x texture at
  * the uv its barycentrics give on its triangle. What a lightmap's irradiance is turned into radiance with. */
 void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3]);
-/* The texel's centre and unit shading normal under the current node matrices (barycentric on its
- * triangle; the normal at load when the interpolated one vanishes). */
+/* The texel's centre (barycentric on its triangle) and unit shading normal (lnormal) under the current
+ * node matrices. */
 void lm_texel_world(const lm_scene *s, const lm_texel *t, float pos[3], float nrm[3]);
+/* The same centre with the shading normal interpolated there, on the one triangle that holds it (the mean
+ * where that vanishes). What the cover test looks along (lm_texel_covered): a texel on a sphere's facet
+ * beside another sphere is covered only if its own point faces into it; the mean over facets turned towards
+ * the neighbour found it covered where it is not (black speckles where room_lit's spheres touch). */
+void lm_texel_centre_normal(const lm_scene *s, const lm_texel *t, float pos[3], float nrm[3]);
 /* The UV rectangle (lo u, lo v, hi u, hi v) inside which bilinear lookups at chart c's corner_uv read only
  * its own texels: its texel centres' span, or half a texel into its border (lm_chart.pad). What a
  * footprint spread around such a lookup is clamped to, charts touching. */

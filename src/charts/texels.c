@@ -11,6 +11,7 @@ typedef struct {
     double cx, cy; /* centroid of that overlap, chart-local texel coordinates */
     double area;   /* world area of all overlaps */
     int tri;       /* triangle with the largest overlap, -1 if none */
+    double nsum[3], lsum[3]; /* interpolated shading normals over the overlaps, by world area (world, local) */
 } texel_acc;
 
 typedef struct {
@@ -96,7 +97,26 @@ static double chart_corners(const texel_job *j, int ci, uint32_t t, pt out[3], i
     return fabs(sa);
 }
 
-static void accumulate(texel_acc *acc, const lm_chart *r, uint32_t t, const pt c[3], double scale, double world)
+/* Adds weight times the shading normals (world and local) at chart-local point m of triangle t (corners c,
+ * in the order ord of chart_corners) to e's sums. */
+static void add_normal(const texel_job *j, uint32_t t, const pt c[3], const int ord[3], pt m, double weight,
+                       texel_acc *e)
+{
+    double d = (c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y);
+    double b1 = d != 0.0 ? ((m.x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (m.y - c[0].y)) / d : 1.0 / 3.0;
+    double b2 = d != 0.0 ? ((c[1].x - c[0].x) * (m.y - c[0].y) - (m.x - c[0].x) * (c[1].y - c[0].y)) / d : 1.0 / 3.0;
+    double w[3] = {1.0 - b1 - b2, b1, b2};
+    for (int k = 0; k < 3; k++) {
+        uint32_t v = j->s->tris[3 * (size_t)t + ord[k]];
+        for (int a = 0; a < 3; a++) {
+            e->nsum[a] += weight * w[k] * j->nrm[3 * (size_t)v + a];
+            e->lsum[a] += weight * w[k] * j->s->normals[3 * (size_t)v + a];
+        }
+    }
+}
+
+static void accumulate(const texel_job *j, const int ord[3], texel_acc *acc, const lm_chart *r, uint32_t t,
+                       const pt c[3], double scale, double world)
 {
     double lo[2] = {fmin(c[0].x, fmin(c[1].x, c[2].x)), fmin(c[0].y, fmin(c[1].y, c[2].y))};
     double hi[2] = {fmax(c[0].x, fmax(c[1].x, c[2].x)), fmax(c[0].y, fmax(c[1].y, c[2].y))};
@@ -111,6 +131,7 @@ static void accumulate(texel_acc *acc, const lm_chart *r, uint32_t t, const pt c
                 continue;
             texel_acc *e = &acc[(size_t)y * r->w + x];
             e->area += ov * scale;
+            add_normal(j, t, c, ord, m, ov * scale, e);
             covered = 1;
             if (ov > e->best) {
                 e->best = ov;
@@ -126,6 +147,7 @@ static void accumulate(texel_acc *acc, const lm_chart *r, uint32_t t, const pt c
     int x = (int)fmin(fmax(floor(mx), 0.0), r->w - 1.0), y = (int)fmin(fmax(floor(my), 0.0), r->h - 1.0);
     texel_acc *e = &acc[(size_t)y * r->w + x];
     e->area += world;
+    add_normal(j, t, c, ord, (pt){mx, my}, world, e);
     if (e->tri < 0) {
         e->tri = (int)t;
         e->cx = mx;
@@ -143,7 +165,7 @@ static void texel_point(const texel_job *j, int ci, uint32_t t, double px, doubl
     double b1 = d != 0.0 ? ((px - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (py - c[0].y)) / d : 1.0 / 3.0;
     double b2 = d != 0.0 ? ((c[1].x - c[0].x) * (py - c[0].y) - (px - c[0].x) * (c[1].y - c[0].y)) / d : 1.0 / 3.0;
     double w[3] = {fmax(1.0 - b1 - b2, 0.0), fmax(b1, 0.0), fmax(b2, 0.0)}, sum = w[0] + w[1] + w[2];
-    double p[3] = {0, 0, 0}, n[3] = {0, 0, 0}, local[3] = {0, 0, 0};
+    double p[3] = {0, 0, 0}, n[3] = {0, 0, 0}, local[3] = {0, 0, 0}, ln[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++) {
         uint32_t v = j->s->tris[3 * (size_t)t + ord[k]];
         out->bary[ord[k]] = (float)(w[k] / sum);
@@ -151,17 +173,37 @@ static void texel_point(const texel_job *j, int ci, uint32_t t, double px, doubl
             p[a] += w[k] / sum * j->pos[3 * (size_t)v + a];
             n[a] += w[k] / sum * j->nrm[3 * (size_t)v + a];
             local[a] += w[k] / sum * j->s->positions[3 * (size_t)v + a];
+            ln[a] += w[k] / sum * j->s->normals[3 * (size_t)v + a];
         }
     }
-    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), ll = sqrt(ln[0] * ln[0] + ln[1] * ln[1] + ln[2] * ln[2]);
     if (!(l > 1e-12)) {
         l = 2.0 * lmc_tri_area(j->s, j->pos, t, n);
         l = l > 0.0 ? l : 1.0;
+    }
+    if (!(ll > 1e-12)) {
+        ll = 2.0 * lmc_tri_area(j->s, j->s->positions, t, ln);
+        ll = ll > 0.0 ? ll : 1.0;
     }
     for (int a = 0; a < 3; a++) {
         out->pos[a] = (float)p[a];
         out->local[a] = (float)local[a];
         out->normal[a] = (float)(n[a] / l);
+        out->lnormal[a] = (float)(ln[a] / ll);
+    }
+}
+
+/* The texel's normals: the area-weighted means of its overlaps' (texel_acc), where they do not cancel;
+ * else the point's own (texel_point's). */
+static void mean_normal(const texel_acc *e, lm_texel *o)
+{
+    double ln = sqrt(e->nsum[0] * e->nsum[0] + e->nsum[1] * e->nsum[1] + e->nsum[2] * e->nsum[2]);
+    double ll = sqrt(e->lsum[0] * e->lsum[0] + e->lsum[1] * e->lsum[1] + e->lsum[2] * e->lsum[2]);
+    if (!(ln > 1e-12) || !(ll > 1e-12))
+        return;
+    for (int a = 0; a < 3; a++) {
+        o->normal[a] = (float)(e->nsum[a] / ln);
+        o->lnormal[a] = (float)(e->lsum[a] / ll);
     }
 }
 
@@ -189,7 +231,7 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
     if (!acc)
         return NULL;
     for (size_t i = 0; i < (size_t)r->w * r->h; i++)
-        acc[i] = (texel_acc){0.0, 0.0, 0.0, 0.0, -1};
+        acc[i] = (texel_acc){0.0, 0.0, 0.0, 0.0, -1, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
     for (uint32_t i = 0; i < ch->tri_count; i++) {
         uint32_t t = ch->tris[i];
         pt c[3];
@@ -203,7 +245,7 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
             uv[1] = (float)((r->y + lookup_coord(c[k].y, r->h)) / j->a->height);
         }
         j->a->tri_chart[t] = ci;
-        accumulate(acc, r, t, c, uv_area > 0.0 ? world / uv_area : 0.0, world);
+        accumulate(j, ord, acc, r, t, c, uv_area > 0.0 ? world / uv_area : 0.0, world);
     }
     uint32_t n = 0;
     for (size_t i = 0; i < (size_t)r->w * r->h; i++)
@@ -218,6 +260,7 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
                     continue;
                 lm_texel *o = &tx[n++];
                 texel_point(j, ci, (uint32_t)e->tri, e->cx, e->cy, o);
+                mean_normal(e, o);
                 o->x = r->x + x;
                 o->y = r->y + y;
                 o->surface = ch->surface;
@@ -351,6 +394,20 @@ void lm_texel_kd(const lm_scene *s, const lm_texel *t, float kd[3])
 }
 
 void lm_texel_world(const lm_scene *s, const lm_texel *t, float pos[3], float nrm[3])
+{
+    lm_vec3 p = lm_v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        float v[3];
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t->tri + k], v);
+        p = lm_add(p, lm_scale(lm_v3_load(v), t->bary[k]));
+    }
+    lm_v3_store(pos, p);
+    const float *m = s->nodes[s->vertex_node[s->tris[3 * (size_t)t->tri]]].world;
+    lm_vec3 n = lm_mat4_normal(m, lm_v3_load(t->lnormal));
+    lm_v3_store(nrm, lm_length(n) > 0.5f ? n : lm_normalize(lm_v3_load(t->normal)));
+}
+
+void lm_texel_centre_normal(const lm_scene *s, const lm_texel *t, float pos[3], float nrm[3])
 {
     lm_vec3 p = lm_v3(0, 0, 0), n = lm_v3(0, 0, 0);
     for (int k = 0; k < 3; k++) {

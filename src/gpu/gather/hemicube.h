@@ -143,7 +143,7 @@ void lm_gather_set_direct_at_hits(lm_gather *g, const lm_direct_light *d);
  * AIM to give it is then the rest. */
 int lm_gather_direct_at_hits(const lm_gather *g);
 /* Whether texel `texel` is covered as the gather with a tracer decides it: straight out from its centre
- * (lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel
+ * along the shading normal there (lm_texel_centre_normal, lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel
  * lies inside a closed mesh) (docs/gather.md, "Covered texels"). */
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
                      uint32_t texel);

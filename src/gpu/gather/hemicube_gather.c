@@ -483,11 +483,16 @@ void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, c
     lm_v3_store(ng, v.ng);
 }
 
-/* Whether the texel at eye, normal n is covered (lm_texel_covered): straight out from it, other geometry
+/* Whether the texel is covered (lm_texel_covered): straight out from its centre along the shading normal
+ * there (lm_texel_centre_normal, not the mean its view faces), from the view's eye offset, other geometry
  * within a texel's width, or the inside of a solid (the back of a triangle by its winding: the texel is
  * inside a closed mesh, such as the floor under a box that stands on it). */
-static int covered_at(const lm_rt *rt, const lm_atlas *a, uint32_t texel, const float eye[3], const float n[3])
+static int covered_at(const lm_rt *rt, const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a,
+                      uint32_t texel)
 {
+    float p[3], n[3], eye[3];
+    lm_texel_centre_normal(s, &a->texels[texel], p, n);
+    lm_v3_store(eye, lm_add(lm_v3_load(p), lm_scale(lm_v3_load(n), set->offset * lm_scene_size(s))));
     lm_rt_hit h;
     if (!lm_rt_intersect(rt, eye, n, 0.0f, INFINITY, &h))
         return 0;
@@ -499,11 +504,7 @@ static int covered_at(const lm_rt *rt, const lm_atlas *a, uint32_t texel, const 
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
                      uint32_t texel)
 {
-    texel_view v = view_of(set, s, &a->texels[texel]);
-    float eye[3], dir[3];
-    lm_v3_store(eye, v.eye);
-    lm_v3_store(dir, v.axes[2]);
-    return covered_at(rt, a, texel, eye, dir);
+    return covered_at(rt, set, s, a, texel);
 }
 
 static float near_plane(const lm_gather *g, const lm_scene *s)
@@ -692,7 +693,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                 continue;
             if (g->emitters)
                 lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], e);
-            if (g->rt && covered_at(g->rt, a, texels[i], o, o + 12))
+            if (g->rt && covered_at(g->rt, &g->set, s, a, texels[i]))
                 e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
             if (rim_ready(g)) {
                 float b[3], t[3], r[3], ng[3] = {o[7], o[11], o[15]};
@@ -763,7 +764,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
                 lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[first + (uint32_t)i], r, &back);
                 for (int k = 0; k < 3; k++)
                     e[k] += r[k];
-                e[3] = covered_at(g->rt, a, texels[first + (uint32_t)i], o, o + 12) ? 1.0f : back;
+                e[3] = covered_at(g->rt, &g->set, s, a, texels[first + (uint32_t)i]) ? 1.0f : back;
             }
         }
         for (uint32_t i = 0; i < n; i++) {
