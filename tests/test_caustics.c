@@ -419,6 +419,30 @@ static void test_deterministic(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* The frame's trace casts 16 photons as one Embree packet a bounce; each photon lands where it lands traced
+ * on its own, ray by ray, bit for bit (a glass ball: two refractions or a reflection). */
+static void test_packets_as_one_by_one(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, room_scene("packets.gltf", LMT_GLASS, "{\"type\": \"point\", \"intensity\": 10}", 2.0f, 0.3f),
+                      0.5f);
+    lm_caustics *c = make(&p, 4096, NULL);
+    const lm_caustic_hit *hits = lm_caustics_hits(c);
+    uint32_t n = lm_caustics_photon_count(c), landed = 0, differ = 0;
+    for (uint32_t s = 0; s < n; s++) {
+        lm_caustic_hit h;
+        landed += lm_caustics_trace_one(c, s, &h) == LM_CAUSTIC_LANDED;
+        differ += memcmp(&h, &hits[s], sizeof h) != 0;
+    }
+    print_message("%u photons, %u landed one by one, %u differ from the packets'\n", n, landed, differ);
+    assert_true(landed > n / 2);
+    assert_int_equal(landed, lm_caustics_landed(c));
+    assert_int_equal(differ, 0);
+    lm_caustics_free(c);
+    lmt_pipeline_free(&p);
+}
+
 /* The photon stage's own photons mark the hits that came off mirrors and glass only (L S+ D): exactly those
  * whose path before them is all specular. Their light is the caustic pass's: the IIM's energy and delta_i
  * leave them out. */
@@ -576,6 +600,7 @@ int main(void)
         cmocka_unit_test(test_switches_and_empty),
         cmocka_unit_test(test_directional),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_packets_as_one_by_one),
         cmocka_unit_test(test_regular_photons_mark_caustic_hits),
         cmocka_unit_test(test_odd_glass),
         cmocka_unit_test(test_bad_settings),

@@ -17,6 +17,10 @@
 #define CAUSTIC_RAY_OFFSET 1e-5f /* x scene size, as the photon stage's */
 /* Fewer photons than this are traced on the calling thread (a thread team costs more). */
 #define CAUSTIC_PARALLEL_MIN 512u
+#define CAUSTIC_PACKET 16u /* photons traced together (lm_rt_intersect16) */
+/* Slots whose Halton index is the same modulo 2^a 3^b have their first two numbers in the same 2^-a x 3^-b
+ * cell: leaving the light together, they travel together */
+#define CAUSTIC_CELLS 432u
 
 void lm_caustic_settings_default(lm_caustic_settings *s)
 {
@@ -106,71 +110,108 @@ int lm_caustic_emit(const lm_emitters *em, const lm_scene *s, int e, const lm_em
 
 /* ---- paths ---- */
 
+/* A photon's path between bounces: where its next ray starts and goes, what it carries, the bounce it is
+ * at and the rays cast; done once it has landed or ended (fate). */
+typedef struct {
+    float org[3], dir[3], flux[3];
+    uint32_t bounce, rays;
+    lm_caustic_fate fate;
+    int done;
+} follow_state;
+
+/* What a path follows: the scene, its emitter and generator, and where its numbers come from. */
+typedef struct {
+    const lm_scene *s;
+    const lm_emitter *source;
+    int generator;
+    uint32_t max_bounces;
+    lm_caustic_numbers next;
+    void *user;
+    float offset;
+} follow_rules;
+
+static void follow_begin(follow_state *f, const float org[3], const float dir[3], const float flux[3])
+{
+    memcpy(f->org, org, sizeof f->org);
+    memcpy(f->dir, dir, sizeof f->dir);
+    memcpy(f->flux, flux, sizeof f->flux);
+    f->bounce = f->rays = 0;
+    f->fate = LM_CAUSTIC_CAPPED;
+    f->done = 0;
+}
+
+/* The path's ray met h (NULL: nothing): it lands (hit filled), ends, or goes on from the specular surface. */
+static void follow_step(follow_state *f, const follow_rules *r, const lm_rt_hit *h, lm_caustic_hit *hit)
+{
+    uint32_t b = f->bounce;
+    f->rays++;
+    f->done = 1;
+    if (!h) {
+        f->fate = b == 0 ? LM_CAUSTIC_MISSED : LM_CAUSTIC_ESCAPED;
+        return;
+    }
+    if (b == 0) {
+        float w = lm_emitter_range_window(r->s, r->source, h->t);
+        f->flux[0] *= w, f->flux[1] *= w, f->flux[2] *= w;
+    }
+    lm_shading sh;
+    lm_shading_from_hit(r->s, h, f->org, f->dir, &sh);
+    int specular = lm_material_is_specular(sh.material->cls);
+    if (b == 0 && (!specular || (r->generator >= 0 && sh.node != r->generator))) {
+        f->fate = LM_CAUSTIC_MISSED;
+        return;
+    }
+    if (!specular) {
+        lm_vec3 ng = lm_v3_load(sh.ng);
+        if (lm_dot(ng, lm_v3_load(f->dir)) > 0.0f)
+            ng = lm_scale(ng, -1.0f);
+        memcpy(hit->pos, sh.pos, sizeof hit->pos);
+        lm_v3_store(hit->ng, ng);
+        memcpy(hit->flux, f->flux, sizeof hit->flux);
+        memcpy(hit->dir, f->dir, sizeof hit->dir);
+        hit->node = sh.node;
+        hit->tri = sh.tri;
+        hit->bounces = (uint16_t)b;
+        f->fate = LM_CAUSTIC_LANDED;
+        return;
+    }
+    if (b == r->max_bounces) /* one more specular bounce than allowed */
+        return;
+    float u[3] = {r->next(r->user, b), 0.0f, 0.0f};
+    lm_bsdf_sample_t bs;
+    if (!lm_bsdf_sample(&sh, f->dir, u, &bs)) {
+        f->fate = LM_CAUSTIC_ABSORBED;
+        return;
+    }
+    for (int c = 0; c < 3; c++)
+        f->flux[c] *= bs.weight[c];
+    if (!lm_v3_finite(lm_v3_load(f->flux))) {
+        f->fate = LM_CAUSTIC_ABSORBED;
+        return;
+    }
+    lm_vec3 ng = lm_v3_load(sh.ng), wo = lm_v3_load(bs.wo);
+    float side = lm_dot(ng, wo) >= 0.0f ? r->offset : -r->offset;
+    lm_v3_store(f->org, lm_add(lm_v3_load(sh.pos), lm_scale(ng, side)));
+    memcpy(f->dir, bs.wo, sizeof f->dir);
+    f->bounce = b + 1;
+    f->done = 0;
+}
+
 lm_caustic_fate lm_caustic_follow(const lm_scene *s, const lm_rt *rt, const lm_emitter *source, int generator,
-                                  const float org_[3], const float dir_[3], const float flux_[3], uint32_t max_bounces,
+                                  const float org[3], const float dir[3], const float flux[3], uint32_t max_bounces,
                                   lm_caustic_numbers next, void *user, lm_caustic_hit *hit, uint32_t *rays)
 {
-    float org[3], dir[3], flux[3];
-    memcpy(org, org_, sizeof org);
-    memcpy(dir, dir_, sizeof dir);
-    memcpy(flux, flux_, sizeof flux);
-    float offset = CAUSTIC_RAY_OFFSET * lm_scene_size(s);
-    uint32_t n = 0;
-    lm_caustic_fate fate = LM_CAUSTIC_CAPPED;
-    for (uint32_t b = 0; b <= max_bounces; b++) {
+    follow_rules r = {s, source, generator, max_bounces, next, user, CAUSTIC_RAY_OFFSET * lm_scene_size(s)};
+    follow_state f;
+    follow_begin(&f, org, dir, flux);
+    while (!f.done) {
         lm_rt_hit h;
-        n++;
-        if (!lm_rt_intersect(rt, org, dir, 0.0f, INFINITY, &h)) {
-            fate = b == 0 ? LM_CAUSTIC_MISSED : LM_CAUSTIC_ESCAPED;
-            break;
-        }
-        if (b == 0) {
-            float w = lm_emitter_range_window(s, source, h.t);
-            flux[0] *= w, flux[1] *= w, flux[2] *= w;
-        }
-        lm_shading sh;
-        lm_shading_from_hit(s, &h, org, dir, &sh);
-        int specular = lm_material_is_specular(sh.material->cls);
-        if (b == 0 && (!specular || (generator >= 0 && sh.node != generator))) {
-            fate = LM_CAUSTIC_MISSED;
-            break;
-        }
-        if (!specular) {
-            lm_vec3 ng = lm_v3_load(sh.ng);
-            if (lm_dot(ng, lm_v3_load(dir)) > 0.0f)
-                ng = lm_scale(ng, -1.0f);
-            memcpy(hit->pos, sh.pos, sizeof hit->pos);
-            lm_v3_store(hit->ng, ng);
-            memcpy(hit->flux, flux, sizeof hit->flux);
-            memcpy(hit->dir, dir, sizeof hit->dir);
-            hit->node = sh.node;
-            hit->tri = sh.tri;
-            hit->bounces = (uint16_t)b;
-            fate = LM_CAUSTIC_LANDED;
-            break;
-        }
-        if (b == max_bounces) /* one more specular bounce than allowed */
-            break;
-        float u[3] = {next(user, b), 0.0f, 0.0f};
-        lm_bsdf_sample_t bs;
-        if (!lm_bsdf_sample(&sh, dir, u, &bs)) {
-            fate = LM_CAUSTIC_ABSORBED;
-            break;
-        }
-        for (int c = 0; c < 3; c++)
-            flux[c] *= bs.weight[c];
-        if (!lm_v3_finite(lm_v3_load(flux))) {
-            fate = LM_CAUSTIC_ABSORBED;
-            break;
-        }
-        lm_vec3 ng = lm_v3_load(sh.ng), wo = lm_v3_load(bs.wo);
-        float side = lm_dot(ng, wo) >= 0.0f ? offset : -offset;
-        lm_v3_store(org, lm_add(lm_v3_load(sh.pos), lm_scale(ng, side)));
-        memcpy(dir, bs.wo, sizeof dir);
+        int got = lm_rt_intersect(rt, f.org, f.dir, 0.0f, INFINITY, &h);
+        follow_step(&f, &r, got ? &h : NULL, hit);
     }
     if (rays)
-        *rays = n;
-    return fate;
+        *rays = f.rays;
+    return f.fate;
 }
 
 /* ---- generators ---- */
@@ -305,6 +346,7 @@ struct lm_caustics {
     uint32_t frame_limit;    /* lm_caustics_limit_frame's (0: frame_cap) */
     /* scratch: the frame's jobs (slot numbers) and their fates */
     uint32_t *jobs;
+    uint32_t *order;           /* scratch for ordering the jobs by cell (order_by_cell) */
     uint8_t *fates;            /* per job its fate, and whether its hit differs from the slot's before */
     uint8_t *changed;
     uint32_t *job_rays;
@@ -353,31 +395,87 @@ static const pair *pair_of(const lm_caustics *c, uint32_t slot)
     return &c->pairs[slot / c->set.photons];
 }
 
-/* Traces the photon of `slot` into its hit slot; returns its fate, *rays the rays cast. */
-static lm_caustic_fate trace_slot(const lm_caustics *c, uint32_t slot, lm_caustic_hit *hit, double emitted[3],
-                                  uint32_t *rays)
+/* A photon of one slot while its packet traces: its path, the rules it follows, the numbers' source and
+ * what it emitted. */
+typedef struct {
+    follow_state f;
+    follow_rules r;
+    numbers_user nu;
+    float emitted[3];
+} slot_path;
+
+/* Emits the photon of `slot` (its hit cleared): 0 if its emission missed (the path is then done). */
+static int slot_begin(const lm_caustics *c, uint32_t slot, slot_path *sp, lm_caustic_hit *hit)
 {
     const pair *p = pair_of(c, slot);
-    float u[4], org[3], dir[3], flux[3];
+    float u[4], org[3], dir[3];
     for (uint32_t k = 0; k < CAUSTIC_EMIT_DIMS; k++)
         u[k] = caustic_number(c, slot, k);
     memset(hit, 0, sizeof *hit);
-    emitted[0] = emitted[1] = emitted[2] = 0.0;
-    *rays = 0;
+    sp->nu = (numbers_user){c, slot};
+    sp->r = (follow_rules){c->scene, &c->em->e[p->emitter], c->gen[p->generator].node, c->set.max_bounces,
+                           bounce_number, &sp->nu, CAUSTIC_RAY_OFFSET * lm_scene_size(c->scene)};
     const lm_emit_tri *tris = c->em->e[p->emitter].punctual ? NULL : c->tris + c->em_tri_first[p->emitter];
-    if (!lm_caustic_emit(c->em, c->scene, p->emitter, tris, &c->gen[p->generator], u, c->set.photons, org, dir,
-                         flux))
-        return LM_CAUSTIC_MISSED;
-    numbers_user nu = {c, slot};
-    lm_caustic_fate f = lm_caustic_follow(c->scene, c->rt, &c->em->e[p->emitter], c->gen[p->generator].node, org,
-                                          dir, flux, c->set.max_bounces, bounce_number, &nu, hit, rays);
-    if (f != LM_CAUSTIC_MISSED)
-        for (int k = 0; k < 3; k++)
-            emitted[k] = flux[k];
-    hit->emitter = (uint16_t)p->emitter;
-    if (f != LM_CAUSTIC_LANDED)
+    int emitted = lm_caustic_emit(c->em, c->scene, p->emitter, tris, &c->gen[p->generator], u, c->set.photons, org,
+                                  dir, sp->emitted);
+    follow_begin(&sp->f, org, dir, sp->emitted);
+    if (!emitted) {
+        sp->f.done = 1;
+        sp->f.fate = LM_CAUSTIC_MISSED;
+    }
+    return emitted;
+}
+
+/* The slot's hit and emitted flux once its path is done (a photon that did not land keeps none). */
+static void slot_end(const lm_caustics *c, uint32_t slot, const slot_path *sp, lm_caustic_hit *hit, double emitted[3])
+{
+    for (int k = 0; k < 3; k++)
+        emitted[k] = sp->f.fate != LM_CAUSTIC_MISSED ? sp->emitted[k] : 0.0;
+    hit->emitter = (uint16_t)pair_of(c, slot)->emitter;
+    if (sp->f.fate != LM_CAUSTIC_LANDED)
         memset(hit, 0, sizeof *hit);
-    return f;
+}
+
+/* Traces slots[0 .. n) (n <= CAUSTIC_PACKET) together: each round casts the rays of the paths still going
+ * as one Embree packet (a light's photons towards one generator start together and mostly stay so through
+ * it), then takes each path one bounce on. Each path meets what lm_caustic_follow would give it. */
+static void trace_packet(const lm_caustics *c, const uint32_t *slots, uint32_t n, lm_caustic_hit *hits,
+                         slot_path *sp)
+{
+    for (uint32_t i = 0; i < n; i++)
+        slot_begin(c, slots[i], &sp[i], &hits[i]);
+    for (;;) {
+        float org[3 * CAUSTIC_PACKET], dir[3 * CAUSTIC_PACKET];
+        uint32_t lane[CAUSTIC_PACKET];
+        int m = 0;
+        for (uint32_t i = 0; i < n; i++)
+            if (!sp[i].f.done) {
+                memcpy(org + 3 * m, sp[i].f.org, sizeof sp[i].f.org);
+                memcpy(dir + 3 * m, sp[i].f.dir, sizeof sp[i].f.dir);
+                lane[m++] = i;
+            }
+        if (!m)
+            return;
+        lm_rt_hit h[CAUSTIC_PACKET];
+        int got[CAUSTIC_PACKET];
+        lm_rt_intersect16(c->rt, org, dir, m, h, got);
+        for (int k = 0; k < m; k++)
+            follow_step(&sp[lane[k]].f, &sp[lane[k]].r, got[k] ? &h[k] : NULL, &hits[lane[k]]);
+    }
+}
+
+lm_caustic_fate lm_caustics_trace_one(const lm_caustics *c, uint32_t slot, lm_caustic_hit *hit)
+{
+    slot_path sp;
+    double emitted[3];
+    slot_begin(c, slot, &sp, hit);
+    while (!sp.f.done) {
+        lm_rt_hit h;
+        int got = lm_rt_intersect(c->rt, sp.f.org, sp.f.dir, 0.0f, INFINITY, &h);
+        follow_step(&sp.f, &sp.r, got ? &h : NULL, hit);
+    }
+    slot_end(c, slot, &sp, hit, emitted);
+    return sp.f.fate;
 }
 
 /* Places the area emitters' triangles for this frame's traces. */
@@ -397,27 +495,50 @@ static uint32_t count_landed(const lm_caustics *c)
     return landed;
 }
 
+/* Orders jobs[0 .. n) so that each run of consecutive slots of one pair is taken cell by cell
+ * (CAUSTIC_CELLS): the photons a packet traces together then leave the light in nearby directions. Only
+ * the order changes: each slot's path is its own. */
+static void order_by_cell(lm_caustics *c, uint32_t n)
+{
+    uint32_t w = 0, per = c->set.photons;
+    for (uint32_t i = 0, len; i < n; i += len) {
+        uint32_t s0 = c->jobs[i];
+        for (len = 1; i + len < n && c->jobs[i + len] == s0 + len && (s0 + len) / per == s0 / per; len++)
+            ;
+        for (uint32_t r = 0; r < CAUSTIC_CELLS && r < len; r++)
+            for (uint32_t k = r; k < len; k += CAUSTIC_CELLS)
+                c->order[w++] = s0 + k;
+    }
+    memcpy(c->jobs, c->order, sizeof *c->jobs * n);
+}
+
 /* Traces jobs[0 .. n) (slots), in parallel, then counts. */
 static void trace_jobs(lm_caustics *c, uint32_t n, lm_caustic_frame_stats *st)
 {
     if (!n)
         return;
     place_emitters(c);
+    order_by_cell(c, n);
     const lm_caustics *cc = c;
 #pragma omp parallel if (n >= CAUSTIC_PARALLEL_MIN)
     {
         lm_rt_thread_init();
-#pragma omp for schedule(dynamic, 64)
-        for (long i = 0; i < (long)n; i++) {
-            uint32_t slot = c->jobs[i];
-            lm_caustic_hit h;
-            double em[3];
-            uint32_t rays;
-            c->fates[i] = (uint8_t)trace_slot(cc, slot, &h, em, &rays);
-            c->job_rays[i] = rays;
-            c->changed[i] = memcmp(&c->hits[slot], &h, sizeof h) != 0;
-            c->hits[slot] = h;
-            memcpy(c->emitted + 3 * (size_t)slot, em, sizeof em);
+#pragma omp for schedule(dynamic, 4)
+        for (long first = 0; first < (long)n; first += CAUSTIC_PACKET) {
+            uint32_t m = n - (uint32_t)first < CAUSTIC_PACKET ? n - (uint32_t)first : CAUSTIC_PACKET;
+            lm_caustic_hit h[CAUSTIC_PACKET];
+            slot_path sp[CAUSTIC_PACKET];
+            trace_packet(cc, c->jobs + first, m, h, sp);
+            for (uint32_t k = 0; k < m; k++) {
+                uint32_t i = (uint32_t)first + k, slot = c->jobs[i];
+                double em[3];
+                slot_end(cc, slot, &sp[k], &h[k], em);
+                c->fates[i] = (uint8_t)sp[k].f.fate;
+                c->job_rays[i] = sp[k].f.rays;
+                c->changed[i] = memcmp(&c->hits[slot], &h[k], sizeof h[k]) != 0;
+                c->hits[slot] = h[k];
+                memcpy(c->emitted + 3 * (size_t)slot, em, sizeof em);
+            }
         }
     }
     uint32_t *fate_count[5] = {&st->landed, &st->missed, &st->escaped, &st->absorbed, &st->capped};
@@ -458,10 +579,11 @@ static lm_status alloc_lists(lm_caustics *c, lm_error *err)
     c->hits = calloc(n, sizeof *c->hits);
     c->emitted = calloc(3 * n, sizeof *c->emitted);
     c->jobs = malloc(n * sizeof *c->jobs);
+    c->order = malloc(n * sizeof *c->order);
     c->fates = malloc(n);
     c->changed = malloc(n);
     c->job_rays = malloc(n * sizeof *c->job_rays);
-    if (!c->pairs || !c->gen_world || !c->em_state || !c->em_tri_first || !c->hits || !c->emitted || !c->jobs ||
+    if (!c->pairs || !c->gen_world || !c->em_state || !c->em_tri_first || !c->hits || !c->emitted || !c->jobs || !c->order ||
         !c->fates || !c->changed || !c->job_rays)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %llu caustic photons", c->scene->path,
                        (unsigned long long)slots);
@@ -573,6 +695,7 @@ void lm_caustics_free(lm_caustics *c)
     free(c->hits);
     free(c->emitted);
     free(c->jobs);
+    free(c->order);
     free(c->fates);
     free(c->changed);
     free(c->job_rays);

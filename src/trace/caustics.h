@@ -149,6 +149,10 @@ int lm_caustics_pair_count(const lm_caustics *c);
 int lm_caustics_generator_count(const lm_caustics *c);
 const lm_caustic_generator *lm_caustics_generator(const lm_caustics *c, int i);
 uint32_t lm_caustics_photon_count(const lm_caustics *c); /* slots: pairs x photons */
+/* Traces the photon of one slot again ray by ray (lm_caustic_follow's way) into *hit, leaving c as it is:
+ * what the packets of a frame's trace (16 photons of one cell of their Halton numbers together, one
+ * Embree packet a bounce) must give it. For tests. */
+lm_caustic_fate lm_caustics_trace_one(const lm_caustics *c, uint32_t slot, lm_caustic_hit *hit);
 /* Every slot, pair by pair (a slot whose flux is 0 holds no photon). */
 const lm_caustic_hit *lm_caustics_hits(const lm_caustics *c);
 /* Landed photons now, and a counter of changes to the slots: it moves when a trace changed a slot (a copy

@@ -351,6 +351,44 @@ static int ray_ok(const float org[3], const float dir[3], float tnear, float tfa
     return (dir[0] != 0.0f || dir[1] != 0.0f || dir[2] != 0.0f) && tnear >= 0.0f && tnear <= big && tfar >= tnear;
 }
 
+/* Embree's closest hit (instance inst, primitive prim, its Ng, t, u, v) along direction dir as lmgi's. */
+static void decode_hit(const lm_rt *rt, const float dir[3], unsigned inst, unsigned prim, lm_vec3 ng_raw, float t,
+                       float u, float v, lm_rt_hit *hit)
+{
+    lm_vec3 ng;
+    if (inst != rt->static_inst) {
+        int node = rt->inst_node[inst];
+        hit->node = node;
+        hit->tri = rt->scene->nodes[node].first_tri + prim;
+        /* Embree's Ng is in the instance's space and follows the stored winding, which the loader reversed
+         * for a node mirrored at load (lm_node.mirrored): the front is the side its file normals face,
+         * through any later transform (nmat keeps that side) */
+        ng = lm_normalize(lm_scale(lm_mat3_normal(rt->node_nmat[node], ng_raw), rt->scene->nodes[node].mirrored ? -1.0f : 1.0f));
+        hit->ns = NULL;
+    } else {
+        hit->tri = rt->static_tri[prim];
+        hit->node = (int)rt->scene->tri_node[hit->tri];
+        ng = lm_v3_load(rt->static_ng[prim]);
+        const float *ns = rt->static_ns[prim];
+        hit->ns = isnan(ns[0]) ? NULL : ns;
+    }
+    hit->nmat = rt->node_nmat[hit->node];
+    hit->t = t;
+    hit->u = u;
+    hit->v = v;
+    const int32_t *twin = rt->scene->tri_twin;
+    if (twin && twin[hit->tri] >= 0 && lm_dot(ng, lm_v3(dir[0], dir[1], dir[2])) > 0.0f) {
+        /* the back of a split triangle is its twin: corners (0, 2, 1), so u and v swap */
+        hit->tri = (uint32_t)twin[hit->tri];
+        hit->u = v;
+        hit->v = u;
+        ng = lm_scale(ng, -1.0f);
+        hit->ns = NULL;
+    }
+    hit->surface = rt->tri_surface ? rt->tri_surface[hit->tri] : -1;
+    lm_v3_store(hit->ng, ng);
+}
+
 int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,
                     lm_rt_hit *hit)
 {
@@ -363,41 +401,39 @@ int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], flo
     rtcIntersect1(rt->top, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
-    lm_vec3 ng;
-    unsigned inst = rh.hit.instID[0];
-    if (inst != rt->static_inst) {
-        int node = rt->inst_node[inst];
-        hit->node = node;
-        hit->tri = rt->scene->nodes[node].first_tri + rh.hit.primID;
-        /* Embree's Ng is in the instance's space and follows the stored winding, which the loader reversed
-         * for a node mirrored at load (lm_node.mirrored): the front is the side its file normals face,
-         * through any later transform (nmat keeps that side) */
-        ng = lm_normalize(lm_scale(lm_mat3_normal(rt->node_nmat[node], lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z)),
-                                   rt->scene->nodes[node].mirrored ? -1.0f : 1.0f));
-        hit->ns = NULL;
-    } else {
-        hit->tri = rt->static_tri[rh.hit.primID];
-        hit->node = (int)rt->scene->tri_node[hit->tri];
-        ng = lm_v3_load(rt->static_ng[rh.hit.primID]);
-        const float *ns = rt->static_ns[rh.hit.primID];
-        hit->ns = isnan(ns[0]) ? NULL : ns;
-    }
-    hit->nmat = rt->node_nmat[hit->node];
-    hit->t = rh.ray.tfar;
-    hit->u = rh.hit.u;
-    hit->v = rh.hit.v;
-    const int32_t *twin = rt->scene->tri_twin;
-    if (twin && twin[hit->tri] >= 0 && lm_dot(ng, lm_v3(dir[0], dir[1], dir[2])) > 0.0f) {
-        /* the back of a split triangle is its twin: corners (0, 2, 1), so u and v swap */
-        hit->tri = (uint32_t)twin[hit->tri];
-        hit->u = rh.hit.v;
-        hit->v = rh.hit.u;
-        ng = lm_scale(ng, -1.0f);
-        hit->ns = NULL;
-    }
-    hit->surface = rt->tri_surface ? rt->tri_surface[hit->tri] : -1;
-    lm_v3_store(hit->ng, ng);
+    decode_hit(rt, dir, rh.hit.instID[0], rh.hit.primID, lm_v3(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z), rh.ray.tfar,
+               rh.hit.u, rh.hit.v, hit);
     return 1;
+}
+
+void lm_rt_intersect16(const lm_rt *rt, const float *org, const float *dir, int n, lm_rt_hit *hits, int *hit)
+{
+    struct RTCIntersectContext ctx;
+    rtcInitIntersectContext(&ctx);
+    ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    _Alignas(64) struct RTCRayHit16 r;
+    _Alignas(64) int valid[16];
+    memset(&r, 0, sizeof r);
+    for (int i = 0; i < 16; i++) {
+        int on = i < n && ray_ok(org + 3 * i, dir + 3 * i, 0.0f, INFINITY);
+        valid[i] = on ? -1 : 0;
+        r.ray.org_x[i] = on ? org[3 * i] : 0.0f, r.ray.org_y[i] = on ? org[3 * i + 1] : 0.0f;
+        r.ray.org_z[i] = on ? org[3 * i + 2] : 0.0f;
+        r.ray.dir_x[i] = on ? dir[3 * i] : 0.0f, r.ray.dir_y[i] = on ? dir[3 * i + 1] : 0.0f;
+        r.ray.dir_z[i] = on ? dir[3 * i + 2] : 1.0f;
+        r.ray.tfar[i] = on ? INFINITY : 0.0f;
+        r.ray.mask[i] = 0xFFFFFFFFu;
+        r.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        r.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+    }
+    rtcIntersect16(valid, rt->top, &ctx, &r);
+    for (int i = 0; i < n; i++) {
+        hit[i] = valid[i] && r.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+        if (hit[i])
+            decode_hit(rt, dir + 3 * i, r.hit.instID[0][i], r.hit.primID[i],
+                       lm_v3(r.hit.Ng_x[i], r.hit.Ng_y[i], r.hit.Ng_z[i]), r.ray.tfar[i], r.hit.u[i], r.hit.v[i],
+                       &hits[i]);
+    }
 }
 
 int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar)

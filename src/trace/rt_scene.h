@@ -51,6 +51,11 @@ uint64_t lm_rt_rebuilds(const lm_rt *rt);
 /* Closest hit along org + t dir, t in (tnear, tfar). Returns 1 on a hit. dir need not be unit length. */
 int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,
                     lm_rt_hit *hit);
+/* Up to 16 closest-hit queries (rays i = (org + 3i, dir + 3i), t in (0, inf)) as one Embree packet, for
+ * rays that travel together (a light's photons towards one generator): hit[i] = 1 and hits[i] as
+ * lm_rt_intersect gives it where ray i hits, hit[i] = 0 where it misses or is not one Embree takes. n in
+ * 1..16. */
+void lm_rt_intersect16(const lm_rt *rt, const float *org, const float *dir, int n, lm_rt_hit *hits, int *hit);
 /* 1 if anything blocks the segment (tnear, tfar). */
 int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar);
 /* 1 if other geometry lies within `cover` straight out from p along unit n (the ray leaving p + lift n):
