@@ -8,6 +8,7 @@
 
 #include "bench.h"
 #include "progress.h"
+#include "run_cmd.h"
 #include "surface_error.h"
 
 /* scenes/many_rooms.glb is left out: its reference took over 10 minutes here. */
@@ -19,6 +20,8 @@ static const char *SCENES[] = {
     "../shared/scenes/depth-of-field/DepthOfFieldExample.glb",
     "../shared/scenes/mixed-lighting/MixedLightingExample.gltf",
     "../shared/scenes/cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf",
+    "../shared/scenes/occlusion-room/room_lit.glb", /* the two shared levels (issue 33, item 4) */
+    "../shared/scenes/truck-town/town_lit.gltf",
 };
 
 #define SIZE 96
@@ -46,6 +49,7 @@ static void check_one(lmgi_context *ctx, const char *path)
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = lmgi_atlas_texels_for(0);
+    o.wall_texels = LM_CLI_RUN_WALL_TEXELS; /* as lmgi run and lmgi check load it (lm_cli_run_load) */
     lmgi_scene *sc = NULL;
     lmgi_error err;
     if (lmgi_load(path, &o, &sc, &err) != LMGI_OK) {
