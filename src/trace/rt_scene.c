@@ -389,15 +389,24 @@ static void decode_hit(const lm_rt *rt, const float dir[3], unsigned inst, unsig
     lm_v3_store(hit->ng, ng);
 }
 
-int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,
-                    lm_rt_hit *hit)
+/* One ray's context and query, if Embree may take the ray (ray_ok): 0 if not. */
+static int start_ray(struct RTCIntersectContext *ctx, struct RTCRayHit *rh, const float org[3], const float dir[3],
+                     float tnear, float tfar)
 {
     if (!ray_ok(org, dir, tnear, tfar))
         return 0;
+    rtcInitIntersectContext(ctx);
+    setup_ray(rh, org, dir, tnear, tfar);
+    return 1;
+}
+
+int lm_rt_intersect(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar,
+                    lm_rt_hit *hit)
+{
     struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
-    setup_ray(&rh, org, dir, tnear, tfar);
+    if (!start_ray(&ctx, &rh, org, dir, tnear, tfar))
+        return 0;
     rtcIntersect1(rt->top, &ctx, &rh);
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID)
         return 0;
@@ -438,12 +447,10 @@ void lm_rt_intersect16(const lm_rt *rt, const float *org, const float *dir, int 
 
 int lm_rt_occluded(const lm_rt *rt, const float org[3], const float dir[3], float tnear, float tfar)
 {
-    if (!ray_ok(org, dir, tnear, tfar))
-        return 0;
     struct RTCIntersectContext ctx;
-    rtcInitIntersectContext(&ctx);
     struct RTCRayHit rh;
-    setup_ray(&rh, org, dir, tnear, tfar);
+    if (!start_ray(&ctx, &rh, org, dir, tnear, tfar))
+        return 0;
     rtcOccluded1(rt->top, &ctx, &rh.ray);
     return rh.ray.tfar < 0.0f; /* Embree sets tfar to -inf on occlusion */
 }
