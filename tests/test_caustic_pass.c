@@ -144,14 +144,15 @@ static void test_mirror_caustic(void **state)
             irradiance(&f, &set, &st, E);
             char what[64];
             snprintf(what, sizeof what, "%s, %s filter", sized ? "sized" : "fixed", world ? "world-space" : "screen-space");
-            print_message("%s: %u photons, %llu splatted, %d of %d tiles lit, %llu pixels filtered\n", what, st.photons,
+            print_message("%s: %u photons (%u points), %llu splatted, %d of %d tiles lit, %llu pixels filtered\n", what, st.photons, st.points,
                           (unsigned long long)st.splatted, st.tiles_lit, st.tiles, (unsigned long long)st.pixels_filtered);
             check_image(E, set.filter_k, sized ? LM_CAUSTIC_FILTER_REACH(set.filter_k) : set.filter_k, what);
         }
     teardown(&f);
 }
 
-/* The tiles the queries call lit are exactly those a count of the splat's photons finds. */
+/* The tiles the queries call lit are exactly those a count of the splat's photons finds (a point a photon,
+ * so that the query counts photons). */
 static void test_tiles_match_splat(void **state)
 {
     (void)state;
@@ -159,6 +160,7 @@ static void test_tiles_match_splat(void **state)
     setup(&f, 1u << 14);
     lm_caustic_pass_settings set;
     lm_caustic_pass_settings_default(&set);
+    set.merge = 0;
     for (int tile = 8; tile <= 64; tile *= 2) {
         set.tile = tile;
         lm_caustic_pass_stats st;
@@ -189,6 +191,50 @@ static void test_tiles_match_splat(void **state)
         assert_true(fabs(photons - (double)st.splatted) < 0.5);
         lm_caustic_pass_free(cp);
     }
+    teardown(&f);
+}
+
+/* The photons of one pixel, receiver triangle and side drawn as one point (the default) splat what a point
+ * each splats: every pixel's photon count the same, its Phi / A_pix and the irradiance within float
+ * rounding; with several times fewer points. */
+static void test_points_merge_photons(void **state)
+{
+    (void)state;
+    fixture f;
+    setup(&f, 1u << 14);
+    lm_caustic_pass_settings set;
+    lm_caustic_pass_settings_default(&set);
+    assert_int_equal(set.merge, 1);
+    static float splat[2][4 * W * H], E[2][3 * W * H];
+    lm_caustic_pass_stats st[2];
+    lm_error err;
+    for (int merge = 0; merge < 2; merge++) {
+        set.merge = merge;
+        lm_caustic_pass *cp = run(&f, &set, &st[merge]);
+        assert_int_equal(lm_caustic_pass_read_splat(cp, 0, splat[merge], &err), LM_OK);
+        assert_int_equal(lm_caustic_pass_read_irradiance(cp, 0, E[merge], &err), LM_OK);
+        lm_caustic_pass_free(cp);
+    }
+    int counts_differ = 0;
+    double irr_max = 0.0, irr_diff = 0.0, e_max = 0.0, e_diff = 0.0;
+    for (int i = 0; i < W * H; i++) {
+        counts_differ += splat[0][4 * i + 3] != splat[1][4 * i + 3];
+        for (int c = 0; c < 3; c++) {
+            irr_max = fmax(irr_max, splat[0][4 * i + c]);
+            irr_diff = fmax(irr_diff, fabs(splat[0][4 * i + c] - splat[1][4 * i + c]));
+            e_max = fmax(e_max, E[0][3 * i + c]);
+            e_diff = fmax(e_diff, fabs(E[0][3 * i + c] - E[1][3 * i + c]));
+        }
+    }
+    print_message("%u photons as %u points (a point each: %u); pixels whose count differs %d; largest difference "
+                  "of Phi / A_pix %.2e and of E %.2e of their largest\n", st[1].photons, st[1].points, st[0].points,
+                  counts_differ, irr_diff / irr_max, e_diff / e_max);
+    assert_int_equal(st[0].points, st[0].photons);
+    assert_int_equal(st[1].photons, st[0].photons);
+    assert_true(st[1].points < 0.6 * st[1].photons); /* 3,429 of 7,307 */
+    assert_int_equal(counts_differ, 0);
+    assert_true(irr_max > 0.0 && irr_diff < 1e-4 * irr_max);
+    assert_true(e_max > 0.0 && e_diff < 1e-4 * e_max);
     teardown(&f);
 }
 
@@ -348,6 +394,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_mirror_caustic),
         cmocka_unit_test(test_tiles_match_splat),
+        cmocka_unit_test(test_points_merge_photons),
         cmocka_unit_test(test_empty_and_bad),
         cmocka_unit_test(test_thin_light),
         cmocka_unit_test(test_reads_only_near_photons),

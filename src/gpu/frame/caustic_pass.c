@@ -20,10 +20,11 @@ void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s)
     s->world_space = 0;
     s->filter_photons = 32;
     s->widen_levels = LM_CAUSTIC_FILTER_LEVELS;
+    s->merge = 1;
 }
 
-/* A photon as the splat reads it: position, receiver normal (arrival side), flux. */
-#define PHOTON_FLOATS 9
+/* A point as the splat reads it: position, receiver normal (arrival side), flux, the photons it stands for. */
+#define POINT_FLOATS 10
 
 /* One slot's targets: the splat (two RGBA32F + depth-stencil), the irradiance, the tiles' flags. */
 typedef struct {
@@ -78,13 +79,22 @@ static void clear_box(const int box[4], int colours, int stencil)
 struct lm_caustic_pass {
     lm_caustic_pass_settings set;
     GLuint splat_prog, query_prog, filter_prog, composite_prog, mask_prog, mip_prog;
-    GLuint vao, photon_vbo, index_buf, empty_vao, rect_vbo, mip_fbo;
+    GLuint vao, point_vbo, empty_vao, rect_vbo, mip_fbo;
     uint32_t photons;
-    float *pos;             /* the photons' positions (3 floats each), for the frustum test of each run */
-    uint32_t *visible;      /* scratch: the indices of the photons in a run's view frustum */
+    lm_caustic_hit *hits;   /* the landed photons, for each run's frustum test and points */
+    /* scratch, sized for every photon: a run's photons in its view frustum (indices into hits) and the
+     * pixel each projects into; its points (POINT_FLOATS each), their position sums and first photons;
+     * the open-addressing table of points by key (table_size entries, -1 empty) */
+    uint32_t *visible, *pixel, *first;
+    float *points;
+    double *sum;
+    int32_t *table;
+    uint32_t table_size;
     slot_targets slots[LM_CAUSTIC_SLOTS];
     float *rects;           /* scratch: 12 floats per grown tile */
 };
+
+static void free_photons(lm_caustic_pass *cp);
 
 static void free_slot(slot_targets *t)
 {
@@ -217,19 +227,18 @@ lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic
     if (st == LM_OK) {
         glGenVertexArrays(1, &cp->vao);
         glGenVertexArrays(1, &cp->empty_vao);
-        glGenBuffers(1, &cp->photon_vbo);
-        glGenBuffers(1, &cp->index_buf);
+        glGenBuffers(1, &cp->point_vbo);
         glGenBuffers(1, &cp->rect_vbo);
         glGenFramebuffers(1, &cp->mip_fbo);
         glBindVertexArray(cp->vao);
-        glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, cp->index_buf); /* the VAO keeps it */
-        glBindBuffer(GL_ARRAY_BUFFER, cp->photon_vbo);
-        for (int a = 0; a < 3; a++) {
+        glBindBuffer(GL_ARRAY_BUFFER, cp->point_vbo);
+        for (int a = 0; a < 4; a++) { /* position, normal, flux; the count */
             glEnableVertexAttribArray((GLuint)a);
-            glVertexAttribPointer((GLuint)a, 3, GL_FLOAT, GL_FALSE, PHOTON_FLOATS * sizeof(float),
+            glVertexAttribPointer((GLuint)a, a < 3 ? 3 : 1, GL_FLOAT, GL_FALSE, POINT_FLOATS * sizeof(float),
                                   (const void *)(size_t)(3 * a * sizeof(float)));
         }
         glBindVertexArray(0);
+        glBindBuffer(GL_ARRAY_BUFFER, 0);
         st = lm_gl_check("caustic pass: setup", err);
     }
     if (st != LM_OK) {
@@ -254,50 +263,52 @@ void lm_caustic_pass_free(lm_caustic_pass *cp)
     if (cp->vao) {
         glDeleteVertexArrays(1, &cp->vao);
         glDeleteVertexArrays(1, &cp->empty_vao);
-        glDeleteBuffers(1, &cp->photon_vbo);
-        glDeleteBuffers(1, &cp->index_buf);
+        glDeleteBuffers(1, &cp->point_vbo);
         glDeleteBuffers(1, &cp->rect_vbo);
         glDeleteFramebuffers(1, &cp->mip_fbo);
     }
     free(cp->rects);
-    free(cp->pos);
-    free(cp->visible);
+    free_photons(cp);
     free(cp);
+}
+
+static int landed(const lm_caustic_hit *h) { return h->flux[0] != 0.0f || h->flux[1] != 0.0f || h->flux[2] != 0.0f; }
+
+static void free_photons(lm_caustic_pass *cp)
+{
+    free(cp->hits), free(cp->visible), free(cp->pixel), free(cp->first), free(cp->points), free(cp->sum);
+    free(cp->table);
+    cp->hits = NULL, cp->visible = cp->pixel = cp->first = NULL, cp->points = NULL, cp->sum = NULL;
+    cp->table = NULL;
+    cp->photons = cp->table_size = 0;
 }
 
 lm_status lm_caustic_pass_set_photons(lm_caustic_pass *cp, const lm_caustic_hit *hits, uint32_t count, lm_error *err)
 {
-    uint32_t n = 0;
+    free_photons(cp);
+    uint32_t n = 0, size = 1;
     for (uint32_t i = 0; i < count; i++)
-        n += hits[i].flux[0] != 0.0f || hits[i].flux[1] != 0.0f || hits[i].flux[2] != 0.0f;
-    float *v = malloc((size_t)(n ? n : 1) * PHOTON_FLOATS * sizeof *v);
-    float *pos = realloc(cp->pos, (size_t)(n ? n : 1) * 3 * sizeof *pos);
-    uint32_t *vis = pos ? realloc(cp->visible, (size_t)(n ? n : 1) * sizeof *vis) : NULL;
-    cp->pos = pos ? pos : cp->pos;
-    cp->visible = vis ? vis : cp->visible;
-    if (!v || !pos || !vis) {
-        free(v);
-        cp->photons = 0;
+        n += landed(&hits[i]);
+    while (size < 2 * n)
+        size <<= 1;
+    size_t m = n ? n : 1;
+    cp->hits = malloc(m * sizeof *cp->hits);
+    cp->visible = malloc(m * sizeof *cp->visible);
+    cp->pixel = malloc(m * sizeof *cp->pixel);
+    cp->first = malloc(m * sizeof *cp->first);
+    cp->points = malloc(m * POINT_FLOATS * sizeof *cp->points);
+    cp->sum = malloc(m * 3 * sizeof *cp->sum);
+    cp->table = malloc(size * sizeof *cp->table);
+    if (!cp->hits || !cp->visible || !cp->pixel || !cp->first || !cp->points || !cp->sum || !cp->table) {
+        free_photons(cp);
         return lm_fail(err, LM_ERR_NOMEM, "caustic pass: no memory for %u photons", n);
     }
-    float *p = v;
-    for (uint32_t i = 0; i < count; i++) {
-        const lm_caustic_hit *h = &hits[i];
-        if (h->flux[0] == 0.0f && h->flux[1] == 0.0f && h->flux[2] == 0.0f)
-            continue;
-        memcpy(pos, h->pos, 3 * sizeof *pos);
-        pos += 3;
-        memcpy(p, h->pos, 3 * sizeof *p);
-        memcpy(p + 3, h->ng, 3 * sizeof *p);
-        memcpy(p + 6, h->flux, 3 * sizeof *p);
-        p += PHOTON_FLOATS;
-    }
-    glBindBuffer(GL_ARRAY_BUFFER, cp->photon_vbo);
-    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)(n ? n : 1) * PHOTON_FLOATS * sizeof *v), v, GL_DYNAMIC_DRAW);
-    glBindBuffer(GL_ARRAY_BUFFER, 0);
-    free(v);
+    for (uint32_t i = 0, k = 0; i < count; i++)
+        if (landed(&hits[i]))
+            cp->hits[k++] = hits[i];
     cp->photons = n;
-    return lm_gl_check("caustic pass: photons", err);
+    cp->table_size = size;
+    return LM_OK;
 }
 
 void lm_caustic_pass_set_widening(lm_caustic_pass *cp, int levels)
@@ -370,14 +381,18 @@ static uint32_t visible_photons(lm_caustic_pass *cp, slot_targets *t, const floa
     int T = cp->set.tile;
     memset(t->lit, 0, (size_t)(t->tiles_x * t->tiles_y));
     for (uint32_t i = 0; i < cp->photons; i++) {
-        const float *p = cp->pos + 3 * (size_t)i;
+        const float *p = cp->hits[i].pos;
         float c[4];
         for (int r = 0; r < 4; r++)
             c[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
         if (!(c[3] > 0.0f && fabsf(c[0]) <= c[3] && fabsf(c[1]) <= c[3] && fabsf(c[2]) <= c[3]))
             continue;
-        cp->visible[n++] = i;
         float px = (0.5f * c[0] / c[3] + 0.5f) * (float)t->width, py = (0.5f * c[1] / c[3] + 0.5f) * (float)t->height;
+        int ix = (int)floorf(px), iy = (int)floorf(py);
+        ix = ix < 0 ? 0 : ix >= t->width ? t->width - 1 : ix;
+        iy = iy < 0 ? 0 : iy >= t->height ? t->height - 1 : iy;
+        cp->pixel[n] = (uint32_t)iy * (uint32_t)t->width + (uint32_t)ix;
+        cp->visible[n++] = i;
         for (int dy = -1; dy <= 1; dy += 2)
             for (int dx = -1; dx <= 1; dx += 2) {
                 int tx = (int)floorf((px + (float)dx) / (float)T), ty = (int)floorf((py + (float)dy) / (float)T);
@@ -387,6 +402,69 @@ static uint32_t visible_photons(lm_caustic_pass *cp, slot_targets *t, const floa
             }
     }
     return n;
+}
+
+/* A photon's side of its receiver: the signs of its normal's components (a triangle's two sides differ in
+ * every component that is not 0). */
+static unsigned side_of(const float ng[3]) { return (ng[0] > 0.0f) | (ng[1] > 0.0f) << 1 | (ng[2] > 0.0f) << 2; }
+
+/* Whether the run's visible photons a and b fall in one point: the same pixel, receiver triangle and side. */
+static int same_point(const lm_caustic_pass *cp, uint32_t a, uint32_t b)
+{
+    const lm_caustic_hit *x = &cp->hits[cp->visible[a]], *y = &cp->hits[cp->visible[b]];
+    return cp->pixel[a] == cp->pixel[b] && x->node == y->node && x->tri == y->tri && side_of(x->ng) == side_of(y->ng);
+}
+
+static uint32_t point_hash(const lm_caustic_pass *cp, uint32_t a)
+{
+    const lm_caustic_hit *x = &cp->hits[cp->visible[a]];
+    uint32_t h = cp->pixel[a] * 2654435761u;
+    h = (h ^ (uint32_t)x->node) * 2246822519u;
+    h = (h ^ x->tri) * 3266489917u;
+    return (h ^ side_of(x->ng) ^ h >> 15) & (cp->table_size - 1);
+}
+
+/* The points a run draws for its n visible photons, into cp->points; returns how many. With `merge`, the
+ * photons in one pixel on one receiver triangle and side are one point: their mean position (inside the
+ * pixel, since a projection keeps what lies between points between their images), their summed flux, and
+ * their count, which the splat adds to its photon count; the splat would draw each at that pixel's centre
+ * anyway. What the points save is llvmpipe's per-point cost: a focal spot seen by an environment map face
+ * puts 13,000 photons in a few pixels, whose points its rasterizer draws one after another on one thread
+ * (docs/caustics.md, "Points"). Without `merge`, a point a photon. */
+static uint32_t make_points(lm_caustic_pass *cp, uint32_t n)
+{
+    uint32_t m = 0;
+    if (cp->set.merge)
+        memset(cp->table, 0xff, cp->table_size * sizeof *cp->table);
+    for (uint32_t i = 0; i < n; i++) {
+        const lm_caustic_hit *h = &cp->hits[cp->visible[i]];
+        uint32_t k = m;
+        if (cp->set.merge) {
+            uint32_t b = point_hash(cp, i);
+            while (cp->table[b] >= 0 && !same_point(cp, cp->first[cp->table[b]], i))
+                b = (b + 1) & (cp->table_size - 1);
+            if (cp->table[b] < 0)
+                cp->table[b] = (int32_t)m;
+            k = (uint32_t)cp->table[b];
+        }
+        float *q = cp->points + (size_t)k * POINT_FLOATS;
+        double *sum = cp->sum + 3 * (size_t)k;
+        if (k == m) { /* a new point */
+            cp->first[m++] = i;
+            memcpy(q + 3, h->ng, 3 * sizeof *q);
+            memset(q + 6, 0, 4 * sizeof *q);
+            sum[0] = sum[1] = sum[2] = 0.0;
+        }
+        for (int c = 0; c < 3; c++)
+            sum[c] += h->pos[c], q[6 + c] += h->flux[c];
+        q[9] += 1.0f;
+    }
+    for (uint32_t k = 0; k < m; k++) {
+        float *q = cp->points + (size_t)k * POINT_FLOATS;
+        for (int c = 0; c < 3; c++)
+            q[c] = (float)(cp->sum[3 * (size_t)k + c] / q[9]);
+    }
+    return m;
 }
 
 /* The receiver mask into the splat's irr alpha over the rectangles the filter reads (its rgb and the flux
@@ -454,19 +532,23 @@ static lm_status splat(lm_caustic_pass *cp, slot_targets *t, const lm_view *view
     glUniform1i(glGetUniformLocation(p, "kd"), 1);
     glUniform1i(glGetUniformLocation(p, "have_kd"), kd != 0);
     glActiveTexture(GL_TEXTURE0);
-    glBindVertexArray(cp->vao);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, (GLsizeiptr)((size_t)(n ? n : 1) * sizeof *cp->visible), cp->visible,
+    uint32_t points = make_points(cp, n);
+    glBindBuffer(GL_ARRAY_BUFFER, cp->point_vbo);
+    glBufferData(GL_ARRAY_BUFFER, (GLsizeiptr)((size_t)(points ? points : 1) * POINT_FLOATS * sizeof(float)), cp->points,
                  GL_STREAM_DRAW);
+    glBindBuffer(GL_ARRAY_BUFFER, 0);
+    glBindVertexArray(cp->vao);
     GLuint q;
     glGenQueries(1, &q);
     glBeginQuery(GL_SAMPLES_PASSED, q);
-    glDrawElements(GL_POINTS, (GLsizei)n, GL_UNSIGNED_INT, NULL);
+    glDrawArrays(GL_POINTS, 0, (GLsizei)points);
     glEndQuery(GL_SAMPLES_PASSED);
     GLuint64 splatted = 0;
     glGetQueryObjectui64v(q, GL_QUERY_RESULT, &splatted);
     glDeleteQueries(1, &q);
     glDisable(GL_BLEND);
     st->photons = n;
+    st->points = points;
     st->splatted = splatted;
     return LM_OK;
 }

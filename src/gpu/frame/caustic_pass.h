@@ -3,10 +3,12 @@
  * some found by one occlusion query each, and the paper's cone filter (Eq. 4) run on those tiles alone;
  * then each visible surface adds kd / pi x the caustic irradiance E.
  *
- *   splat    one point per photon, at the centre of the pixel it projects into, additively into two
- *            RGBA32F textures: (Phi / A_pix, 1) and (Phi, 1), A_pix the world area of that pixel's
- *            footprint on the photon's receiver (d^2 Omega_pix / cos, from its normal); and +1 into the
- *            stencil. Depth: the photon lies on a surface, so a hardware depth test would fight with it;
+ *   splat    one point per photon (with `merge`, the default, one per pixel, receiver triangle and side,
+ *            carrying the photons there: their mean position, summed Phi and count n), at the centre of the
+ *            pixel it projects into, additively into two RGBA32F textures: (Phi / A_pix, 1) and (Phi, n),
+ *            A_pix the world area of that pixel's footprint on the photon's receiver (d^2 Omega_pix / cos,
+ *            from its normal); and +1 into the stencil. Depth: the photon lies on a surface, so a hardware
+ *            depth test would fight with it;
  *            the vertex shader compares its view depth with the frame's depth at that pixel instead,
  *            within the depth the receiver spans across a pixel (1 + 2 tan of its view angle, capped, pixel
  *            footprints) and drops photons behind, behind the camera, off screen, or on the side of
@@ -46,7 +48,7 @@
  * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
  * application renders (_VIEW).
  * A view no photon projects into (an environment map face that sees no focal spot) costs no GL work.
- * Cost: one point per photon, one query quad per tile a photon projects into, (2k + 1)^2 texture reads
+ * Cost: one point per photon in the view (fewer where they crowd into pixels), one query quad per tile a photon projects into, (2k + 1)^2 texture reads
  * per filtered pixel (and up to LM_CAUSTIC_FILTER_LEVELS + 5 to size it, four of them the structure test,
  * plus the splat's mipmaps there once a run), two per pixel of the lit tiles' box (docs/bench.md has the figures). Needs a
  * current GL context; not thread-safe. */
@@ -71,6 +73,9 @@ typedef struct {
     int widen_levels;      /* the density-sized filter widens up to 2^this times, 0 to LM_CAUSTIC_FILTER_LEVELS
                               (default LM_CAUSTIC_FILTER_LEVELS; fewer where thin light is the lightmaps' and the
                               screen holds concentrated photons: lm_caustic_pass_set_widening) */
+    int merge;             /* 1: a run draws the photons that fall in one pixel on one receiver triangle and side
+                              as one point with their summed flux and their count (default 1; 0: a point a
+                              photon, so that a query counts photons) */
 } lm_caustic_pass_settings;
 
 /* The density-sized filter widens up to 2^this times. */
@@ -85,8 +90,10 @@ typedef struct {
 void lm_caustic_pass_settings_default(lm_caustic_pass_settings *s);
 
 typedef struct {
-    uint32_t photons;      /* photons drawn */
-    uint64_t splatted;     /* of those, the ones that landed on a visible pixel (a query around the splat) */
+    uint32_t photons;      /* photons drawn (in the view's frustum) */
+    uint32_t points;       /* the points they were drawn as (settings.merge) */
+    uint64_t splatted;     /* of those points, the ones that landed on a visible pixel (a query around the
+                            * splat): photons when merge is 0 */
     int tiles, tiles_lit;  /* tiles of the screen, and those whose query found photons */
     uint64_t pixels_filtered; /* pixels of the grown lit tiles (shared pixels counted once per tile) */
     double t_splat, t_query, t_filter, t_composite; /* seconds (each ends with the GPU's work done) */

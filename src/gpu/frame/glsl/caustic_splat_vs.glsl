@@ -4,6 +4,7 @@
 layout(location = 0) in vec3 pos;
 layout(location = 1) in vec3 ng;
 layout(location = 2) in vec3 flux;
+layout(location = 3) in float count; /* the photons the point stands for (caustic_pass.c, make_points) */
 uniform mat4 view_proj, inv_proj;
 uniform vec3 eye, view_dir;
 uniform int ortho;
@@ -12,6 +13,7 @@ uniform float pix_area, pix_side;
 uniform sampler2D depth, kd;
 uniform int have_kd;
 out vec3 v_irr, v_flux;
+out float v_count;
 #include "caustic_receiver.glsl"
 float view_depth(vec2 ndc, float z) {
     vec4 v = inv_proj * vec4(ndc, z, 1.0);
@@ -41,5 +43,6 @@ void main() {
     }
     v_irr = flux / area;
     v_flux = flux;
+    v_count = count;
     gl_Position = vec4((vec2(px) + 0.5) / size * 2.0 - 1.0, 0.0, 1.0);
 }
