@@ -694,6 +694,33 @@ static void test_cache_nothing_moved(void **state)
     free(b);
 }
 
+/* A class edit that makes the plane glossy (lm_scene.pass_version moves, as lmgi's material edit moves it)
+ * gives a persistent lm_direct the glossy lobe, whose programs a scene without a glossy material leaves
+ * out (direct.c, light_program); the edit undone takes it away again: each render equals a fresh one, the
+ * last the first to the bit. */
+static void test_class_edit_glossy(void **state)
+{
+    (void)state;
+    live_scene l;
+    lm_direct *d = NULL;
+    float *diffuse = live_start(&l, &d);
+    lm_material *m = &l.s->materials[l.s->tri_material[0]], was = *m;
+    make_glossy(l.s);
+    l.s->pass_version++;
+    float *glossy = render_both(d, &l, "plane made glossy");
+    assert_true(differs(diffuse, glossy));
+    *m = was;
+    l.s->pass_version++;
+    float *back = render_both(d, &l, "plane diffuse again");
+    assert_memory_equal(diffuse, back, sizeof(float) * 3 * W * W);
+    print_message("class edits: glossy and back, each as a fresh render\n");
+    lm_direct_free(d);
+    live_free(&l);
+    free(diffuse);
+    free(glossy);
+    free(back);
+}
+
 /* The box scene's plane and box (node 4, dynamic) under two point lights: node 2 right above the box, node
  * 3 far off to the side; their emitters 0 and 1. */
 static void two_lights_load(live_scene *l)
@@ -1049,7 +1076,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_plane), cmocka_unit_test(test_point_plane_range), cmocka_unit_test(test_box_shadow), cmocka_unit_test(test_box_shadow_every_face), cmocka_unit_test(test_grazing),
-        cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_texture),
+        cmocka_unit_test(test_spot), cmocka_unit_test(test_contact), cmocka_unit_test(test_glossy), cmocka_unit_test(test_class_edit_glossy), cmocka_unit_test(test_texture),
         cmocka_unit_test(test_deterministic), cmocka_unit_test(test_cache_follows_changes),
         cmocka_unit_test(test_cache_nothing_moved),
         cmocka_unit_test(test_cube_faces_follow_casters), cmocka_unit_test(test_map_budget),

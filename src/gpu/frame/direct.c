@@ -58,6 +58,8 @@ struct lm_direct {
     lm_direct_settings set;
     GLuint prog[3], first[3], emission; /* per light kind (point, spot, directional): additive light program,
                                          * first-pass program; the emission-only program */
+    int glossy;                         /* the light programs have the glossy lobe (the scene has a glossy
+                                         * material: scene_glossy) */
     GLint e_view_proj, e_lit, e_use_lit;
     uniforms u[3], uf[3];
     lm_direct_mesh mesh;
@@ -405,23 +407,59 @@ static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e
     return lm_gl_check("direct_light: light pass", err);
 }
 
-/* The light program for one kind (0 point, 1 spot, 2 directional), PCF radius and pass (first or
- * additive). Compiling them as constants takes the branches on them out of every pixel: about 20% of
- * the light pass on llvmpipe. */
-static lm_status light_program(int kind, int pcf, int first, GLuint *prog, lm_error *err)
+/* The light program for one kind (0 point, 1 spot, 2 directional), PCF radius, pass (first or additive)
+ * and whether any material is glossy. Compiling them as constants takes the branches on them out of
+ * every pixel: about 20% of the light pass on llvmpipe for the kind; without a glossy material the
+ * lobe's pow, which llvmpipe computes for every pixel of a draw with a glossy one in it, goes too. */
+static lm_status light_program(int kind, int pcf, int first, int glossy, GLuint *prog, lm_error *err)
 {
     size_t n = strlen(lm_glsl_direct_fs) + 128;
     char *fs = malloc(n);
     if (!fs)
         return lm_fail(err, LM_ERR_NOMEM, "direct_light: no memory for shader source");
-    snprintf(fs, n, "#version 450 core\n#define KIND %d\n#define PCF %d\n#define FIRST %d\n%s", kind, pcf, first,
-             lm_glsl_direct_fs);
+    snprintf(fs, n, "#version 450 core\n#define KIND %d\n#define PCF %d\n#define FIRST %d\n#define GLOSSY %d\n%s", kind,
+             pcf, first, glossy, lm_glsl_direct_fs);
     static const char *names[2][3] = {
         {"direct_light (point)", "direct_light (spot)", "direct_light (directional)"},
         {"direct_light (point, first pass)", "direct_light (spot, first pass)", "direct_light (directional, first pass)"}};
     lm_status st = lm_gl_program(names[first][kind], lm_glsl_direct_vs, fs, prog, err);
     free(fs);
     return st;
+}
+
+static void free_light_programs(lm_direct *d)
+{
+    for (int k = 0; k < 3; k++) {
+        if (d->prog[k])
+            glDeleteProgram(d->prog[k]);
+        if (d->first[k])
+            glDeleteProgram(d->first[k]);
+        d->prog[k] = d->first[k] = 0;
+    }
+}
+
+/* Every light program, made again (with or without the glossy lobe). */
+static lm_status light_programs(lm_direct *d, int glossy, lm_error *err)
+{
+    free_light_programs(d);
+    lm_status st = LM_OK;
+    for (int k = 0; st == LM_OK && k < 3; k++) {
+        if ((st = light_program(k, d->set.pcf_radius, 0, glossy, &d->prog[k], err)) == LM_OK)
+            find_uniforms(d->prog[k], &d->u[k]);
+        if (st == LM_OK && (st = light_program(k, d->set.pcf_radius, 1, glossy, &d->first[k], err)) == LM_OK)
+            find_uniforms(d->first[k], &d->uf[k]);
+    }
+    d->glossy = glossy;
+    return st;
+}
+
+/* Whether a material of the scene is glossy (its class can change only with lm_scene.pass_version). */
+static int scene_glossy(const lm_scene *s)
+{
+    for (int m = 0; m < s->material_count; m++)
+        if (s->materials[m].cls == LM_MAT_GLOSSY)
+            return 1;
+    return 0;
 }
 
 static int valid_settings(const lm_direct_settings *set)
@@ -516,12 +554,8 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
     }
     d->maps_left = -1;
     lm_status st = fit_shadow_budget(s, d, err);
-    for (int k = 0; st == LM_OK && k < 3; k++) {
-        if ((st = light_program(k, d->set.pcf_radius, 0, &d->prog[k], err)) == LM_OK)
-            find_uniforms(d->prog[k], &d->u[k]);
-        if (st == LM_OK && (st = light_program(k, d->set.pcf_radius, 1, &d->first[k], err)) == LM_OK)
-            find_uniforms(d->first[k], &d->uf[k]);
-    }
+    if (st == LM_OK)
+        st = light_programs(d, scene_glossy(s), err);
     if (st == LM_OK)
         st = lm_gl_program("direct_emission", lm_glsl_direct_vs, lm_glsl_emission_fs, &d->emission, err);
     if (st == LM_OK)
@@ -560,12 +594,7 @@ void lm_direct_free(lm_direct *d)
     if (d->mesh.first)
         lm_direct_mesh_free(&d->mesh);
     lm_shadow_renderer_free(&d->shadow);
-    for (int k = 0; k < 3; k++) {
-        if (d->prog[k])
-            glDeleteProgram(d->prog[k]);
-        if (d->first[k])
-            glDeleteProgram(d->first[k]);
-    }
+    free_light_programs(d);
     if (d->emission)
         glDeleteProgram(d->emission);
     lm_sky_pass_free(&d->sky);
@@ -603,6 +632,8 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
             d->mesh = fresh;
             d->static_version++, d->dynamic_version++;
         }
+        if (st == LM_OK && scene_glossy(s) != d->glossy) /* a class edit: the glossy lobe comes or goes */
+            st = light_programs(d, !d->glossy, err);
     }
     if (st != LM_OK)
         return st;

@@ -1,5 +1,6 @@
-// The light fragment shader without its first lines: "#version 450 core", then KIND, PCF and FIRST
-// defined, go before it (direct.c, light_program, compiles one per kind and pass).
+// The light fragment shader without its first lines: "#version 450 core", then KIND, PCF, FIRST and GLOSSY
+// defined, go before it (direct.c, light_program, compiles one per kind and pass, with the glossy lobe
+// when a material of the scene is glossy).
 // kind: 0 point, 1 spot, 2 directional. FIRST 1: the frame's first pass, which also writes depth and adds
 // the emitted radiance and the indirect term (as emission_fs.glsl); FIRST 0: a further light, added
 // over the laid-down depth. texel: world size of a shadow-map texel (directional) or its
@@ -111,10 +112,13 @@ vec3 light(vec3 p, vec3 ns, vec3 ng, vec3 V) {
         }
     }
     if (dot(ng, L) <= 0.0 || max(E.r, max(E.g, E.b)) <= 0.0) return vec3(0.0);
-    float n = v_par.x, lobe = pow(max(dot(reflect(-L, ns), V), 0.0), n);
     vec3 kd, ks;
     lobes(kd, ks);
-    vec3 f = kd / PI + ks * (n + 2.0) / (2.0 * PI) * lobe;
+    vec3 f = kd / PI;
+#if GLOSSY /* ks is 0 but on a glossy surface: without one, no pow for every pixel */
+    float n = v_par.x;
+    f += ks * (n + 2.0) / (2.0 * PI) * pow(max(dot(reflect(-L, ns), V), 0.0), n);
+#endif
     return f * E * max(dot(ns, L), 0.0) * shadow(p, ng, L, dist);
 }
 #include "indirect.glsl"
