@@ -60,6 +60,8 @@ struct lm_direct {
                                          * first-pass program; the emission-only program */
     int glossy;                         /* the light programs have the glossy lobe (the scene has a glossy
                                          * material: scene_glossy) */
+    uint32_t programs_version;          /* the scene's pass_version the light programs were last made or
+                                         * found right for (a failed remake keeps the old: tried again) */
     GLint e_view_proj, e_lit, e_use_lit;
     uniforms u[3], uf[3];
     lm_direct_mesh mesh;
@@ -449,7 +451,7 @@ static lm_status light_programs(lm_direct *d, int glossy, lm_error *err)
         if (st == LM_OK && (st = light_program(k, d->set.pcf_radius, 1, glossy, &d->first[k], err)) == LM_OK)
             find_uniforms(d->first[k], &d->uf[k]);
     }
-    d->glossy = glossy;
+    d->glossy = st == LM_OK ? glossy : -1; /* -1: half made, made again at the next draw */
     return st;
 }
 
@@ -556,6 +558,7 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
     lm_status st = fit_shadow_budget(s, d, err);
     if (st == LM_OK)
         st = light_programs(d, scene_glossy(s), err);
+    d->programs_version = s->pass_version;
     if (st == LM_OK)
         st = lm_gl_program("direct_emission", lm_glsl_direct_vs, lm_glsl_emission_fs, &d->emission, err);
     if (st == LM_OK)
@@ -632,8 +635,12 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
             d->mesh = fresh;
             d->static_version++, d->dynamic_version++;
         }
-        if (st == LM_OK && scene_glossy(s) != d->glossy) /* a class edit: the glossy lobe comes or goes */
-            st = light_programs(d, !d->glossy, err);
+    }
+    if (st == LM_OK && d->programs_version != s->pass_version) { /* a class edit: the glossy lobe may come or go */
+        int glossy = scene_glossy(s);
+        if (glossy != d->glossy)
+            st = light_programs(d, glossy, err);
+        d->programs_version = st == LM_OK ? s->pass_version : d->programs_version;
     }
     if (st != LM_OK)
         return st;
