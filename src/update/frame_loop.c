@@ -338,14 +338,15 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     return st == LM_OK ? blend_and_render(fl, o, err) : st;
 }
 
-/* Overlapped: animate, schedule and upload what the gather needs, gather, then the photon stage's
- * tracing and AIM refresh run on the worker while this thread blends and renders. The gather therefore
+/* Overlapped: animate, schedule and upload what the gather needs, gather and blend, then the photon
+ * stage's tracing and AIM refresh run on the worker while this thread renders. The gather therefore
  * sees the AIMs and delta_i of the previous frame's stage (one frame later than in order; the IIM blends
  * over several frames anyway). Every result depends only on that fixed order, not on timing. The gather
  * runs before the worker starts: its CPU work (the emitter light's shadow rays, llvmpipe's vertex work
  * for one view per texel) is on the frame's critical path and slows down sharing the cores with the
  * stage, while the direct light, whose second rasterizer thread gains little, hides the stage as well
- * alone (docs/bench.md has the figures). */
+ * alone (docs/bench.md has the figures). So does the blend: its few small compute dispatches each wait for
+ * a core, which the stage's threads hold (on two cores about 1 ms of the frame). */
 static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
@@ -359,10 +360,14 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
         return st;
     st = lm_lightmap_path_gather(fl->lightmaps, o->texels_gathered, err);
     o->t_gather = lm_now() - t1;
+    double t2 = lm_now();
+    if (st == LM_OK)
+        st = lm_lightmap_path_blend(fl->lightmaps, 0, err);
+    o->t_blend = lm_now() - t2;
     double job = job_seconds(&o->stage);
     lm_stage_worker_begin(fl->worker, &o->stage);
     if (st == LM_OK)
-        st = blend_and_render(fl, o, err);
+        st = render(fl, o, err);
     double t4 = lm_now();
     lm_error worker_err;
     lm_status ws = lm_stage_worker_end(fl->worker, &worker_err);
