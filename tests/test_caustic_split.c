@@ -55,6 +55,12 @@ static void put(lm_caustic_hit *h, const lm_scene *s, float x, float z, float fl
     h->flux[0] = h->flux[1] = h->flux[2] = flux;
     h->tri = (uint32_t)t;
     h->bounces = 1;
+    float v[3][3]; /* (x, z)'s barycentrics on t, as the tracer's hit gives them */
+    for (int k = 0; k < 3; k++)
+        lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], v[k]);
+    float d = (v[1][0] - v[0][0]) * (v[2][2] - v[0][2]) - (v[2][0] - v[0][0]) * (v[1][2] - v[0][2]);
+    h->bary[0] = ((x - v[0][0]) * (v[2][2] - v[0][2]) - (v[2][0] - v[0][0]) * (z - v[0][2])) / d;
+    h->bary[1] = ((v[1][0] - v[0][0]) * (z - v[0][2]) - (x - v[0][0]) * (v[1][2] - v[0][2])) / d;
 }
 
 static int setup(void **state)
@@ -258,6 +264,27 @@ static void test_deterministic(void **state)
     lm_caustic_split_free(&b);
 }
 
+/* A photon is placed by where it fell on its triangle, not by its world position: after the receiver
+ * moved (a node placed 2 m away between the trace and the split) its photons keep their texels. */
+static void test_moved_receiver_keeps_its_photons(void **state)
+{
+    (void)state;
+    lm_caustic_split a, b;
+    split(1.0, 1.0f, &a);
+    lm_node *n = &((lm_scene *)pipe_.s)->nodes[pipe_.s->tri_node[hits[0].tri]];
+    float saved[16];
+    memcpy(saved, n->world, sizeof saved);
+    n->world[12] += 2.0f;
+    split(1.0, 1.0f, &b);
+    memcpy(n->world, saved, sizeof saved);
+    size_t cells = (size_t)pipe_.atlas.width * pipe_.atlas.height;
+    assert_true(a.thin_photons > 0);
+    assert_int_equal(a.thin_photons, b.thin_photons);
+    assert_memory_equal(a.thin, b.thin, 4 * cells * sizeof *a.thin);
+    lm_caustic_split_free(&a);
+    lm_caustic_split_free(&b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -265,6 +292,7 @@ int main(void)
         cmocka_unit_test(test_other_light_decides),
         cmocka_unit_test(test_light_gathered_in_a_window_stays_on_screen),
         cmocka_unit_test(test_deterministic),
+        cmocka_unit_test(test_moved_receiver_keeps_its_photons),
     };
     lmt_filter_from_env();
     return cmocka_run_group_tests(tests, setup, teardown);

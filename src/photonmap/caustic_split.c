@@ -13,37 +13,17 @@ void lm_caustic_split_free(lm_caustic_split *sp)
     memset(sp, 0, sizeof *sp);
 }
 
-/* The barycentric weights of p's projection onto triangle (a, b, c). */
-static void barycentric(const float a[3], const float b[3], const float c[3], const float p[3], float w[3])
-{
-    lm_vec3 e0 = lm_sub(lm_v3_load(b), lm_v3_load(a)), e1 = lm_sub(lm_v3_load(c), lm_v3_load(a));
-    lm_vec3 d = lm_sub(lm_v3_load(p), lm_v3_load(a));
-    float d00 = lm_dot(e0, e0), d01 = lm_dot(e0, e1), d11 = lm_dot(e1, e1);
-    float d20 = lm_dot(d, e0), d21 = lm_dot(d, e1), den = d00 * d11 - d01 * d01;
-    if (!(fabsf(den) > 0.0f)) {
-        w[0] = 1.0f, w[1] = w[2] = 0.0f;
-        return;
-    }
-    w[1] = (d11 * d20 - d01 * d21) / den;
-    w[2] = (d00 * d21 - d01 * d20) / den;
-    w[0] = 1.0f - w[1] - w[2];
-}
-
-/* The covered atlas cell a photon on triangle t at world point p lies on, or -1: none of its chart
- * within one texel, or a node that takes no indirect light (its lightmap shows none). */
-static long texel_under(const lm_scene *s, const lm_atlas *a, uint32_t t, const float p[3])
+/* The covered atlas cell a photon landed on (triangle t, barycentrics b as lm_caustic_hit's), or -1:
+ * none of its chart within one texel, or a node that takes no indirect light (its lightmap shows none).
+ * The barycentrics are where it landed as it was traced: a receiver that moved since keeps its photons
+ * where they fell on it. */
+static long texel_under(const lm_scene *s, const lm_atlas *a, uint32_t t, const float b[2])
 {
     int chart = t < s->tri_count ? a->tri_chart[t] : -1;
     if (chart < 0 || !s->nodes[s->tri_node[t]].settings.indirect)
         return -1;
-    float v[3][3], w[3], uv[2] = {0.0f, 0.0f};
-    for (int k = 0; k < 3; k++)
-        lm_scene_vertex_world(s, s->tris[3 * (size_t)t + k], v[k]);
-    barycentric(v[0], v[1], v[2], p, w);
-    for (int k = 0; k < 3; k++) {
-        uv[0] += w[k] * a->coverage_uv[6 * (size_t)t + 2 * k];
-        uv[1] += w[k] * a->coverage_uv[6 * (size_t)t + 2 * k + 1];
-    }
+    const float w[3] = {1.0f - b[0] - b[1], b[0], b[1]}, *c = a->coverage_uv + 6 * (size_t)t;
+    float uv[2] = {w[0] * c[0] + w[1] * c[2] + w[2] * c[4], w[0] * c[1] + w[1] * c[3] + w[2] * c[5]};
     if (!isfinite(uv[0]) || !isfinite(uv[1]))
         return -1;
     int x = (int)floorf(uv[0] * (float)a->width), y = (int)floorf(uv[1] * (float)a->height);
@@ -318,7 +298,7 @@ lm_status lm_caustic_split_make(const lm_scene *s, const lm_atlas *a, const floa
     for (long i = 0; i < (long)count; i++) {
         int on = hits[i].flux[0] > 0.0f || hits[i].flux[1] > 0.0f || hits[i].flux[2] > 0.0f;
         landed += (uint32_t)on;
-        cell_of[i] = on ? texel_under(s, a, hits[i].tri, hits[i].pos) : -1;
+        cell_of[i] = on ? texel_under(s, a, hits[i].tri, hits[i].bary) : -1;
     }
     out->landed = landed;
     bin_photons(hits, cell_of, count, NULL, n, flux, cells);

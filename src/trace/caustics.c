@@ -171,6 +171,7 @@ static void follow_step(follow_state *f, const follow_rules *r, const lm_rt_hit 
         memcpy(hit->dir, f->dir, sizeof hit->dir);
         hit->node = sh.node;
         hit->tri = sh.tri;
+        hit->bary[0] = h->u, hit->bary[1] = h->v;
         hit->bounces = (uint16_t)b;
         f->fate = LM_CAUSTIC_LANDED;
         return;

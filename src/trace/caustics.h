@@ -62,6 +62,8 @@ typedef struct {
     float dir[3];          /* unit direction it travelled, towards the receiver */
     int32_t node;          /* receiver's node and triangle */
     uint32_t tri;
+    float bary[2];         /* where on tri: pos = (1 - u - v) v0 + u v1 + v v2 (lm_rt_hit's u, v), at the node's
+                            * placement when it landed */
     uint16_t bounces;      /* specular bounces before landing (1 = straight off the generator) */
     uint16_t emitter;      /* emitter index */
 } lm_caustic_hit;
