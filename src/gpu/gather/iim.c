@@ -156,32 +156,51 @@ void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, 
         lm_iim_pending_add(&iim->pending, a, texels, n, iim->version_touch);
 }
 
-/* Mode `mode` of iim_blend over the `count` entries of buffer `buf`, bound at `binding`, after uploading
- * them from data (NULL: the buffer holds them already). */
-static void dispatch_list(lm_iim *iim, int mode, unsigned buf, int binding, const void *data, size_t bytes,
-                          uint32_t count)
+/* One list pass of iim_blend: mode `mode` over the `count` entries of buffer `buf`, bound at `binding`,
+ * uploaded from data first (NULL: the buffer holds them already). */
+typedef struct {
+    int mode;
+    unsigned buf;
+    int binding;
+    const int32_t *data;
+    uint32_t count;
+} list_pass;
+
+/* Passes a and b (b.count may be 0) as one dispatch, their entries one after the other: two passes that
+ * neither read what the other writes (glsl/iim_blend_cs.glsl), for one wait for llvmpipe's threads
+ * instead of two. */
+static void dispatch_lists(lm_iim *iim, const list_pass *a, const list_pass *b)
 {
-    if (data) {
-        glBindBuffer(GL_SHADER_STORAGE_BUFFER, buf);
-        glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)bytes, data);
-        glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+    const list_pass *passes[2] = {a, b};
+    for (int i = 0; i < 2; i++) {
+        const list_pass *l = passes[i];
+        if (l->data && l->count) {
+            glBindBuffer(GL_SHADER_STORAGE_BUFFER, l->buf);
+            glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(int32_t) * l->count), l->data);
+            glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+        }
+        if (l->count)
+            glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)l->binding, l->buf);
     }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, (GLuint)binding, buf);
-    GLuint groups = (GLuint)(count + 63) / 64;
-    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), mode);
-    glUniform1i(glGetUniformLocation(iim->blend_prog, "list_count"), (int)count);
+    GLuint groups = (GLuint)(a->count + b->count + 63) / 64;
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), a->mode);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "list_count"), (int)a->count);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "mode2"), b->mode);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "count2"), (int)b->count);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "row"), 8 * (int)groups);
     glDispatchCompute(groups, 1, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
 }
 
-/* The listed cells committed on their own (mode 1 of iim_blend), before the pass over the atlas. */
-static void commit_list(lm_iim *iim, int instant)
+/* Runs the passes given: both at once, the one with entries alone, or none. */
+static void run_lists(lm_iim *iim, list_pass a, list_pass b)
 {
-    if (!iim->list_count)
-        return;
-    glUniform1i(glGetUniformLocation(iim->blend_prog, "instant"), instant);
-    dispatch_list(iim, 1, iim->list_buf, 3, iim->list, sizeof(int) * iim->list_count, iim->list_count);
+    if (!a.count) {
+        a = b;
+        b.count = 0;
+    }
+    if (a.count)
+        dispatch_lists(iim, &a, &b);
 }
 
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
@@ -243,20 +262,21 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, iim->start_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, iim->chart_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 6, iim->flag_buf);
-    if (pend->op_count) /* which cells wait, before the commits: a committed one is drawn as itself */
-        dispatch_list(iim, 3, iim->ops_buf, 7, pend->ops, sizeof(int32_t) * pend->op_count, pend->op_count);
-    commit_list(iim, instant);
+    /* which cells wait (mode 3, read by the atlas pass: a committed one is drawn as itself) and the cells
+     * committed on their own (mode 1) */
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "instant"), instant);
+    run_lists(iim, (list_pass){3, iim->ops_buf, 7, pend->ops, pend->op_count},
+              (list_pass){1, iim->list_buf, 3, (const int32_t *)iim->list, iim->list_count});
     if (atlas_pass) {
         glUniform1i(glGetUniformLocation(iim->blend_prog, "mode"), 0);
         glDispatchCompute((GLuint)(iim->width + 7) / 8, (GLuint)(iim->height + 7) / 8, 1);
         glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
     }
-    if (iim->list_count && iim->set.spread > 0 && !instant) /* the cells mode 1 committed, uploaded there */
-        dispatch_list(iim, 4, iim->list_buf, 3, NULL, 0, iim->list_count);
+    /* the cells mode 1 committed rebased (mode 4, uploaded there) and the waiting cells' estimates (2) */
+    uint32_t rebased = iim->set.spread > 0 && !instant ? iim->list_count : 0;
+    run_lists(iim, (list_pass){4, iim->list_buf, 3, NULL, rebased},
+              (list_pass){2, iim->redraw_buf, 5, pend->redraw, pend->redraw_count});
     iim->list_count = 0;
-    if (pend->redraw_count)
-        dispatch_list(iim, 2, iim->redraw_buf, 5, pend->redraw, sizeof(int32_t) * pend->redraw_count,
-                      pend->redraw_count);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     lm_iim_sched_end_frame(&iim->sched);
     return lm_gl_check("IIM blend (iim_blend)", err);

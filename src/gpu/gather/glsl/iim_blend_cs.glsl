@@ -2,7 +2,8 @@
 // then display = mix(old, new, t), t from the frames since its last commit, clamped to [old, new] so
 // rounding never leaves the interval; a texel turning valid or invalid shows its new value at once. Each
 // commit also keeps the texel's change, delta = new - old, for the estimates of the texels that wait.
-// The passes of one frame, in order:
+// The passes of one frame, in order (3 and 1 in one dispatch, 4 and 2 in another: neither of a pair reads
+// what the other writes):
 // mode 3: the flag changes in `ops` (which cells wait: mode 0 leaves their estimate on display).
 // mode 1: only commits, of the cells listed in `list` (texels regathered on their own, texel_change.h),
 // shown at once when instant.
@@ -31,6 +32,7 @@ layout(std430, binding = 6) buffer Flags { int waiting[]; };           /* per ce
 layout(std430, binding = 7) readonly buffer Ops { int ops[]; };        /* cell + 1: waits, -(cell + 1): no longer */
 uniform ivec2 size;
 uniform int mode, frame, blend_frames, list_count, row, instant, spread;
+uniform int mode2, count2; /* a second list pass in the same dispatch (iim.c, dispatch_lists), after the first's entries */
 uniform float limit; /* back-face fraction above which a texel is invalid */
 const int NEVER = -1073741824;
 const float INSIDE = 1e30;
@@ -137,17 +139,20 @@ void rebase(ivec2 g, int c)
 void main() {
     ivec2 g = ivec2(gl_GlobalInvocationID.xy);
     if (mode != 0) {
-        int k = g.y * row + g.x;
-        if (k >= list_count) return;
-        if (mode == 3) {
+        int k = g.y * row + g.x, m = mode;
+        if (k >= list_count) {
+            k -= list_count, m = mode2;
+            if (k >= count2) return;
+        }
+        if (m == 3) {
             waiting[abs(ops[k]) - 1] = ops[k] > 0 ? 1 : 0;
             return;
         }
-        int c = mode == 1 || mode == 4 ? list[k] : redraw[k];
+        int c = m == 1 || m == 4 ? list[k] : redraw[k];
         ivec2 q = ivec2(c % size.x, c / size.x);
-        if (mode == 1)
+        if (m == 1)
             commit(q, c, instant != 0);
-        else if (mode == 4)
+        else if (m == 4)
             rebase(q, c);
         else
             imageStore(display, q, waiting[c] != 0 ? estimate(q, c) : shown(q, c));
