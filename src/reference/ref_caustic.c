@@ -100,17 +100,6 @@ static lm_status place_emitters(pass *p, lm_error *err)
 
 /* ---- landing on texels ---- */
 
-/* Barycentric weights of p (on the triangle's plane) on corners q. */
-static void barycentrics(const lm_vec3 q[3], lm_vec3 p, float b[3])
-{
-    lm_vec3 e1 = lm_sub(q[1], q[0]), e2 = lm_sub(q[2], q[0]), w = lm_sub(p, q[0]);
-    float d11 = lm_dot(e1, e1), d12 = lm_dot(e1, e2), d22 = lm_dot(e2, e2);
-    float w1 = lm_dot(w, e1), w2 = lm_dot(w, e2), den = d11 * d22 - d12 * d12;
-    b[1] = den != 0.0f ? (d22 * w1 - d12 * w2) / den : 0.0f;
-    b[2] = den != 0.0f ? (d11 * w2 - d12 * w1) / den : 0.0f;
-    b[0] = 1.0f - b[1] - b[2];
-}
-
 static int land_texel(const pass *p, const lm_caustic_hit *h, deposit *d)
 {
     const lm_scene *s = p->c->s;
@@ -127,8 +116,7 @@ static int land_texel(const pass *p, const lm_caustic_hit *h, deposit *d)
     lm_vec3 front = lm_cross(lm_sub(q[1], q[0]), lm_sub(q[2], q[0])); /* as wound: the lit side */
     if (!(lm_dot(front, lm_v3_load(h->dir)) < 0.0f))
         return 0;
-    float b[3];
-    barycentrics(q, lm_v3_load(h->pos), b);
+    const float b[3] = {1.0f - h->bary[0] - h->bary[1], h->bary[0], h->bary[1]}; /* where its hit fell */
     const float *uv = a->coverage_uv + 6 * (size_t)h->tri; /* the texel the point lies in */
     float fx = (b[0] * uv[0] + b[1] * uv[2] + b[2] * uv[4]) * (float)a->width;
     float fy = (b[0] * uv[1] + b[1] * uv[3] + b[2] * uv[5]) * (float)a->height;

@@ -239,12 +239,19 @@ lm_status lm_frame_loop_render(lm_frame_loop *fl, const lm_view *view, int width
     return st == LM_OK ? lm_frame_passes_draw(fl->passes, &ind, view, width, height, rgb, 0, refresh, &o, err) : st;
 }
 
-/* Blend (timed into o), then render. */
-static lm_status blend_and_render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
+/* The IIM's blend, timed into o. */
+static lm_status blend(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
     lm_status st = lm_lightmap_path_blend(fl->lightmaps, 0, err);
     o->t_blend = lm_now() - t0;
+    return st;
+}
+
+/* Blend, then render. */
+static lm_status blend_and_render(lm_frame_loop *fl, lm_frame_stats *o, lm_error *err)
+{
+    lm_status st = blend(fl, o, err);
     return st == LM_OK ? render(fl, o, err) : st;
 }
 
@@ -360,10 +367,8 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
         return st;
     st = lm_lightmap_path_gather(fl->lightmaps, o->texels_gathered, err);
     o->t_gather = lm_now() - t1;
-    double t2 = lm_now();
     if (st == LM_OK)
-        st = lm_lightmap_path_blend(fl->lightmaps, 0, err);
-    o->t_blend = lm_now() - t2;
+        st = blend(fl, o, err);
     double job = job_seconds(&o->stage);
     lm_stage_worker_begin(fl->worker, &o->stage);
     if (st == LM_OK)
