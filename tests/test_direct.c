@@ -19,6 +19,7 @@
 
 #include "../src/core/vecmath.h"
 #include "../src/gpu/frame/direct.h"
+#include "../src/gpu/frame/direct_mesh.h"
 #include "../src/gpu/gl/gl_api.h"
 #include "../src/gpu/gl/gl_context.h"
 #include "../src/trace/bsdf.h"
@@ -1072,6 +1073,44 @@ static void test_probe_lod(void **state)
     lm_scene_free(s);
 }
 
+/* (m) The nodes are drawn smallest first (direct_mesh.c, draw_order), so that the enclosing plane's hidden
+ * pixels fail the early depth test behind the box instead of being shaded and covered: in box_scene's
+ * index buffer every one of the box's triangles comes before every one of the plane's, although the file
+ * lists the plane first. */
+static void test_small_nodes_drawn_first(void **state)
+{
+    (void)state;
+    lm_scene *s = NULL;
+    lm_error err;
+    lm_load_options opt = {0};
+    assert_int_equal(lm_scene_load_gltf(box_scene(), &opt, &s, &err), LM_OK);
+    int plane = -1, box = -1;
+    for (int n = 0; n < s->node_count; n++)
+        if (s->nodes[n].tri_count)
+            *(plane < 0 ? &plane : &box) = n;
+    assert_true(plane >= 0 && box > plane); /* the file's order: the plane, then the box */
+    lm_direct_mesh m;
+    assert_int_equal(lm_direct_mesh_build(&m, s, NULL, 1, 0.0f, &err), LM_OK);
+    uint32_t *index = malloc(sizeof(uint32_t) * (size_t)m.mesh.vertices);
+    assert_non_null(index);
+    glBindVertexArray(m.mesh.vao);
+    glGetBufferSubData(GL_ELEMENT_ARRAY_BUFFER, 0, (GLsizeiptr)(sizeof(uint32_t) * (size_t)m.mesh.vertices), index);
+    glBindVertexArray(0);
+    int last_box = -1, first_plane = m.mesh.vertices, seen[2] = {0, 0};
+    for (int i = 0; i < m.mesh.vertices; i++) {
+        int v = (int)index[i];
+        if (v >= m.node_first[box] && v < m.node_first[box] + m.node_verts[box])
+            last_box = i, seen[0]++;
+        if (v >= m.node_first[plane] && v < m.node_first[plane] + m.node_verts[plane])
+            first_plane = i < first_plane ? i : first_plane, seen[1]++;
+    }
+    assert_true(seen[0] > 0 && seen[1] > 0);
+    assert_true(last_box < first_plane);
+    free(index);
+    lm_direct_mesh_free(&m);
+    lm_scene_free(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1081,7 +1120,7 @@ int main(void)
         cmocka_unit_test(test_cache_nothing_moved),
         cmocka_unit_test(test_cube_faces_follow_casters), cmocka_unit_test(test_map_budget),
         cmocka_unit_test(test_map_sides_follow_lights), cmocka_unit_test(test_sun_over_a_large_level),
-        cmocka_unit_test(test_probe_lod),
+        cmocka_unit_test(test_probe_lod), cmocka_unit_test(test_small_nodes_drawn_first),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

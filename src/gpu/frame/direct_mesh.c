@@ -182,13 +182,60 @@ static int shading_vertices(lm_direct_mesh *d, const lm_scene *s, const lm_atlas
     return 1;
 }
 
-/* Indices grouped by texture (counting sort, triangle order within a group), each group's split sides
- * last (lm_direct_mesh.paired); 0 when out of memory. */
+typedef struct {
+    float size; /* the diagonal of the node's world bounds, squared */
+    int node;
+} node_size;
+
+static int smaller_first(const void *a, const void *b)
+{
+    const node_size *x = a, *y = b;
+    return x->size < y->size ? -1 : x->size > y->size ? 1 : x->node - y->node;
+}
+
+/* The nodes in the order they are drawn: the smallest first, by their vertices' world bounds at the build
+ * (ties by index). The walls, floors and terrain that enclose a scene are its largest nodes and lie behind
+ * the props in most views, so drawn last their hidden pixels fail the early depth test instead of being
+ * shaded and then covered (llvmpipe skips a block's shading when all of it fails). Where depths are equal
+ * (a prop's foot on the floor) the prop is seen: GL_LESS keeps what was drawn first. NULL when out of memory. */
+static int *draw_order(const lm_direct_mesh *d, const built *b)
+{
+    node_size *ns = malloc(sizeof *ns * (size_t)(d->node_count ? d->node_count : 1));
+    int *order = malloc(sizeof(int) * (size_t)(d->node_count ? d->node_count : 1));
+    if (!ns || !order) {
+        free(ns);
+        free(order);
+        return NULL;
+    }
+    for (int n = 0; n < d->node_count; n++) {
+        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int v = d->node_first[n]; v < d->node_first[n] + d->node_verts[n]; v++)
+            for (int k = 0; k < 3; k++) {
+                lo[k] = fminf(lo[k], b->vert[(size_t)FLOATS * v + k]);
+                hi[k] = fmaxf(hi[k], b->vert[(size_t)FLOATS * v + k]);
+            }
+        ns[n].node = n;
+        ns[n].size = 0.0f;
+        for (int k = 0; k < 3 && d->node_verts[n]; k++)
+            ns[n].size += (hi[k] - lo[k]) * (hi[k] - lo[k]);
+    }
+    qsort(ns, (size_t)d->node_count, sizeof *ns, smaller_first);
+    for (int n = 0; n < d->node_count; n++)
+        order[n] = ns[n].node;
+    free(ns);
+    return order;
+}
+
+/* Indices grouped by texture (counting sort), the nodes in draw_order's order within a group, each group's
+ * split sides last (lm_direct_mesh.paired); 0 when out of memory. */
 static int shading_indices(lm_direct_mesh *d, const lm_scene *s, built *b)
 {
-    int *at = malloc(sizeof(int) * 2 * (size_t)d->groups), *at_paired = at + d->groups;
-    if (!at)
+    int *at = malloc(sizeof(int) * 2 * (size_t)d->groups), *at_paired = at + d->groups, *order = draw_order(d, b);
+    if (!at || !order) {
+        free(at);
+        free(order);
         return 0;
+    }
     for (uint32_t t = 0; t < s->tri_count; t++) {
         d->count[group_of(s, t)] += 3;
         d->paired[group_of(s, t)] += s->materials[s->tri_material[t]].split_sides ? 3 : 0;
@@ -197,12 +244,16 @@ static int shading_indices(lm_direct_mesh *d, const lm_scene *s, built *b)
         d->first[g] = d->first[g - 1] + d->count[g - 1];
     for (int g = 0; g < d->groups; g++)
         at[g] = d->first[g], at_paired[g] = d->first[g] + d->count[g] - d->paired[g];
-    for (uint32_t t = 0; t < s->tri_count; t++) {
-        int g = group_of(s, t), *o = s->materials[s->tri_material[t]].split_sides ? at_paired : at;
-        memcpy(b->index + o[g], b->corner + 3 * (size_t)t, 3 * sizeof(uint32_t));
-        o[g] += 3;
+    for (int k = 0; k < s->node_count; k++) {
+        const lm_node *nd = &s->nodes[order[k]];
+        for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++) {
+            int g = group_of(s, t), *o = s->materials[s->tri_material[t]].split_sides ? at_paired : at;
+            memcpy(b->index + o[g], b->corner + 3 * (size_t)t, 3 * sizeof(uint32_t));
+            o[g] += 3;
+        }
     }
     free(at);
+    free(order);
     b->indices = 3 * (int)s->tri_count;
     return 1;
 }

@@ -2,7 +2,10 @@
  * texture, those textures uploaded, and an indexed positions-only buffer of the shadow casters. Corners
  * that share a scene vertex, a material and a lightmap uv share one GPU vertex, so llvmpipe shades each
  * vertex once instead of once per triangle corner (a sixth of the vertex work on the Cornell box). Each
- * node's vertices are contiguous, so a moved node re-uploads one range. Internal to gpu/frame/direct. */
+ * node's vertices are contiguous, so a moved node re-uploads one range. Within a group the triangles run
+ * node by node, the smallest node first (its world bounds at the build): enclosing walls and floors are
+ * drawn last, so their pixels hidden behind props fail the early depth test instead of being shaded and
+ * covered. Internal to gpu/frame/direct. */
 #ifndef LM_DIRECT_MESH_H
 #define LM_DIRECT_MESH_H
 
