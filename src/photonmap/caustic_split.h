@@ -78,8 +78,8 @@ typedef struct {
 
 /* Splits hits[0 .. count) (slots of flux 0 hold no photon) over the atlas a of scene s, each by its
  * triangle and barycentrics (so a receiver that moved since the trace keeps them where they fell).
- * aim_rgb: the AIM's radiance (a->width x a->height x 3). fraction > 0 (see above). *out is replaced (lm_caustic_split_free first if
- * it held one); on failure it is left empty. */
+ * aim_rgb: the AIM's radiance (a->width x a->height x 3). fraction > 0 (see above). *out is replaced
+ * (lm_caustic_split_free first if it held one); on failure it is left empty. */
 lm_status lm_caustic_split_make(const lm_scene *s, const lm_atlas *a, const float *aim_rgb, const lm_caustic_hit *hits,
                                 uint32_t count, float fraction, lm_caustic_split *out, lm_error *err);
 void lm_caustic_split_free(lm_caustic_split *sp);

@@ -32,7 +32,7 @@ layout(std430, binding = 6) buffer Flags { int waiting[]; };           /* per ce
 layout(std430, binding = 7) readonly buffer Ops { int ops[]; };        /* cell + 1: waits, -(cell + 1): no longer */
 uniform ivec2 size;
 uniform int mode, frame, blend_frames, list_count, row, instant, spread;
-uniform int mode2, count2; /* a second list pass in the same dispatch (iim.c, dispatch_lists), after the first's entries */
+uniform int mode2, count2; /* a second list pass in one dispatch (iim.c, dispatch_lists), after the first's */
 uniform float limit; /* back-face fraction above which a texel is invalid */
 const int NEVER = -1073741824;
 const float INSIDE = 1e30;
