@@ -132,7 +132,8 @@ static inline int lmgi_knob_is_pow2(double v)
       "lights' computed per texel by shadow rays, photons bring the rest),\n"                                     \
       "photons (first hits, the paper's form, blurred by the estimate's\n"                                       \
       "radius), emitters (emissive triangles' light computed per texel: sharp\n"                                  \
-      "contact shadows, about 5x slower AIMs) or all (every light's)")                                             \
+      "contact shadows, about 5x slower AIMs; the rays gather computes it at\n"                                   \
+      "its hits, about 2x its time) or all (every light's)")                                                       \
     X(aim, occluders, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, "--aim-occluders", "on|off",         \
       LMGI_CLI_ZERO_NONE, LMGI_ON_OFF_CHOICES,                                                                     \
       LMGI_SWEEP(16, "aim_occluders", "AIM hits seen from the texel (0 off, 1 on)", (0, 1), (), 0),           \

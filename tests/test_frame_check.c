@@ -167,6 +167,48 @@ static void test_shared_cornell_box(void **state)
     lmgi_free(sc);
 }
 
+/* The same with the rays gather, which takes the light the AIMs compute at each ray's hit instead of as
+ * the AIM texel's average: the floor at the small box's foot, in the lamp's contact shadow, reads dark
+ * where the rays meet it, not as its 46 mm texels' mean. At `lmgi check`'s size, every face of the small
+ * box of 100+ pixels within 5% per channel (issue 33's per-surface criterion). Measured
+ * (frame / reference R G B, the side face 8 and the front face 12): at the hits 0.980 1.014 0.978 and
+ * 0.991 0.984 1.029; read from the AIM texels (direct_at_hits 0) face 8 1.099 1.024 1.101, failing. At other
+ * photon seeds face 8 moves by +-5% either way (docs/aim.md). */
+#define CHECK_SIZE 128
+#define CONTACT_CHANNEL_TOL 0.05
+static void test_shared_cornell_box_direct_at_hits(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
+    lmgi_scene *sc = load_as_run(path, 0);
+    lm_frame_loop_settings ls;
+    lm_frame_loop_settings_default(&ls);
+    ls.width = ls.height = CHECK_SIZE;
+    ls.stage.exact_direct = LM_EXACT_EMITTERS;
+    ls.gather.scheme = LM_GATHER_RAYS;
+    lm_ref_settings rs;
+    ref_settings(&rs, REF_ERROR);
+    lm_frame_check c;
+    lm_error err;
+    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    assert_frame("shared Cornell box, the rays gather, emitters' light at its hits", sc, &c, 0.03, SURFACE_TOL, 0.06);
+    int faces = 0;
+    for (int s = 0; s < c.surface_count; s++) {
+        const lm_check_sum *sum = &c.surface[s];
+        if (sum->pixels < MIN_PIXELS || strcmp(sc->scene->nodes[sc->surfaces.surfaces[s].node].name, "small.box"))
+            continue;
+        faces++;
+        print_message("  small box face %d: %.3f %.3f %.3f\n", s, lm_check_ratio(sum, 0), lm_check_ratio(sum, 1),
+                      lm_check_ratio(sum, 2));
+        for (int k = 0; k < 3; k++)
+            assert_true(fabs(lm_check_ratio(sum, k) - 1.0) < CONTACT_CHANNEL_TOL);
+    }
+    assert_true(faces >= 2);
+    lm_frame_check_free(&c);
+    lmgi_free(sc);
+}
+
 static void test_generated_cornell_box(void **state)
 {
     (void)state;
@@ -339,6 +381,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_shared_cornell_box),
+        cmocka_unit_test(test_shared_cornell_box_direct_at_hits),
         cmocka_unit_test(test_mixed_lighting),
         cmocka_unit_test(test_generated_cornell_box),
         cmocka_unit_test(test_two_rooms),
@@ -347,5 +390,6 @@ int main(void)
         cmocka_unit_test(test_iim_run_density),
         cmocka_unit_test(test_iim_bake_density),
     };
+    lmt_filter_from_env();
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -587,7 +587,7 @@ static double light_inside(lmt_pipeline *p, uint32_t photons, uint32_t seed, int
     set.photons.total_photons = photons;
     set.photons.seed = seed;
     set.photons.aim_bounces = aim;
-    set.punctual_at_hits = 1;
+    set.direct_at_hits = 1;
     lm_photon_stage *st = NULL;
     lm_error err;
     if (lm_photon_stage_create(&p->w, &set, &st, NULL, &err) != LM_OK)

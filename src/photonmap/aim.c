@@ -953,7 +953,7 @@ static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t
  * estimate, which has no hits under the box either, gives it. The punctual lights' cosine takes the shading
  * normal at the texel's centre (lm_direct_irradiance). */
 static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts, double e[3],
-                       double punct[3])
+                       double direct[3])
 {
     float local[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS][3], share[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS];
     int n = lm_texel_parts(j->s, j->a, t, LM_AIM_DIRECT_PARTS, local, share);
@@ -965,24 +965,23 @@ static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index,
     const tri_frame *tf = triangle_frame(j, t->tri, &ts->tri);
     float centre[3], ns[3]; /* the shading normal at the texel's centre, for the punctual lights' cosine */
     lm_texel_world(j->s, t, centre, ns);
-    double sum[3] = {0.0, 0.0, 0.0}, sum_p[3] = {0.0, 0.0, 0.0}, seen = 0.0;
+    double sum[3] = {0.0, 0.0, 0.0}, seen = 0.0;
     for (int i = 0; i < n; i++) {
-        float p[3], d[3], dp[3];
+        float p[3], d[3];
         lm_v3_store(p, lm_mat4_point(j->world, lm_v3_load(local[i])));
         uint32_t seed = index * (LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS) + (uint32_t)i;
-        if (!lm_direct_irradiance(j->direct, t->surface, p, tf->n_world, ns, j->two_sided, seed, d, dp))
+        if (!lm_direct_irradiance(j->direct, t->surface, p, tf->n_world, ns, j->two_sided, seed, d))
             continue;
         seen += share[i];
         for (int c = 0; c < 3; c++)
-            sum[c] += (double)share[i] * d[c], sum_p[c] += (double)share[i] * dp[c];
+            sum[c] += (double)share[i] * d[c];
     }
     for (int c = 0; seen > 0.0 && c < 3; c++)
-        e[c] += sum[c] / seen, punct[c] = sum_p[c] / seen;
+        direct[c] = sum[c] / seen, e[c] += direct[c];
 }
 
-/* L = rho / pi (E_photons + E_direct); rest (NULL: not kept) the same without the punctual lights' part of
- * E_direct (lm_aim.rest); with error (NULL: not kept) the texel's relative standard error and radius
- * (lm_aim.error). */
+/* L = rho / pi (E_photons + E_direct); rest (NULL: not kept) the same without E_direct (lm_aim.rest); with
+ * error (NULL: not kept) the texel's relative standard error and radius (lm_aim.error). */
 static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t index, uint32_t slot, texel_scratch *ts,
                            float *edge_d2, float out[3], float rest[3], float *error)
 {
@@ -991,14 +990,14 @@ static void estimate_texel(const estimate_job *j, const lm_texel *t, uint32_t in
     estimate_error ee = {error != NULL, {LUMINANCE[0] * rho[0] / LM_PI, LUMINANCE[1] * rho[1] / LM_PI,
                                          LUMINANCE[2] * rho[2] / LM_PI},
                          0.0, 0.0};
-    double e[3], punct[3] = {0.0, 0.0, 0.0};
+    double e[3], direct[3] = {0.0, 0.0, 0.0};
     photon_irradiance(j, t, index, slot, ts, edge_d2, e, &ee);
     if (j->direct)
-        add_direct(j, t, index, ts, e, punct);
+        add_direct(j, t, index, ts, e, direct);
     for (int c = 0; c < 3; c++)
         out[c] = (float)(rho[c] / LM_PI * e[c]);
     for (int c = 0; rest && c < 3; c++)
-        rest[c] = (float)(rho[c] / LM_PI * (e[c] - punct[c]));
+        rest[c] = (float)(rho[c] / LM_PI * (e[c] - direct[c]));
     if (error) {
         double y = ee.y[0] * e[0] + ee.y[1] * e[1] + ee.y[2] * e[2];
         error[0] = y > 0.0 ? (float)(sqrt(ee.var) / y) : 0.0f;

@@ -102,8 +102,9 @@ typedef struct {
     double *owed;            /* per surface: the delta_f of the continuing surfaces refreshed since its own last
                                 refresh; its estimate near the seam reads their hits too, so it is due a refresh
                                 as if its own had changed (scheduled by delta_f + owed) */
-    float *rest;             /* with lm_aim_keep_rest, rgb less the punctual lights' direct part (width * height
-                                * 3), for a gather that computes that part where its rays hit; else NULL */
+    float *rest;             /* with lm_aim_keep_rest, rgb less the direct part it computes (lm_aim_set_direct;
+                                width * height * 3), for a gather that computes that part where its rays hit;
+                                else NULL */
     float *rest_dilated;     /* rest as RGBA, dilated as `dilated` is; NULL without rest */
     float mean_hit_energy;   /* as of the last refresh call */
     const lm_direct_light *direct; /* NULL (default): photons carry all light, the paper's form; else
@@ -185,7 +186,7 @@ lm_status lm_aim_refresh_listed(lm_aim *aim, const lm_scene *s, const lm_surface
  * exact where every hit of a surface scaled alike (a light's power edit in a scene lit by one, a base
  * colour edit for the surfaces of that material: the AIM multiplies in the albedo), cheap where the
  * refresh it stands in for is not (update/photon_stage.c, under a time budget). Where rest is kept and
- * `computed` is given (surface_count x 3, else NULL), the punctual lights' direct part, rgb - rest, is
+ * `computed` is given (surface_count x 3, else NULL), the computed direct part, rgb - rest, is
  * multiplied by computed instead, and rest, the part the photons bring, by factor: a lamp's power edit
  * beside a sun whose direct light the AIM computes scales the photons' part alone. Cost: the listed
  * surfaces' texels and one pass over the atlas. */

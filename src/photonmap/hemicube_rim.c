@@ -97,10 +97,12 @@ static double strata_share(const sky_mis *m, lm_vec3 n, const float d[3], double
     return ka + mb > 0.0 ? ka / (ka + mb) : 1.0;
 }
 
-/* kd / pi E_punctual at the ray's hit h (direction dir from eye): the punctual lights' direct light there,
- * as the AIM computes it for a texel (the side the geometric normal's, the cosine the shading normal's,
- * both sides of a double-sided material). */
-static void punctual_at_hit(const lm_rim *r, const float eye[3], const float dir[3], const lm_rt_hit *h, float out[3])
+/* kd / pi E_direct at the ray's hit h (direction dir from eye): the direct light the AIM computes for a
+ * texel (r->direct: punctual lights, emissive triangles), computed there (the side the geometric normal's,
+ * a punctual light's cosine the shading normal's, both sides of a double-sided material); seed picks the
+ * emissive triangles' shadow rays. */
+static void direct_at_hit(const lm_rim *r, const float eye[3], const float dir[3], const lm_rt_hit *h, uint32_t seed,
+                          float out[3])
 {
     lm_shading sh;
     lm_shading_from_hit(r->scene, h, eye, dir, &sh);
@@ -109,7 +111,7 @@ static void punctual_at_hit(const lm_rim *r, const float eye[3], const float dir
     out[0] = out[1] = out[2] = 0.0f;
     if (!(kd[0] > 0.0f || kd[1] > 0.0f || kd[2] > 0.0f))
         return;
-    lm_direct_punctual_at(r->direct, sh.pos, sh.ng, sh.ns, sh.material->double_sided, E);
+    lm_direct_at_hit(r->direct, sh.pos, sh.ng, sh.ns, sh.material->double_sided, seed, E);
     for (int c = 0; c < 3; c++)
         out[c] = (float)(kd[c] / LM_PI * E[c]);
 }
@@ -120,10 +122,11 @@ static void punctual_at_hit(const lm_rim *r, const float eye[3], const float dir
  * averages its footprint: a small bright spot is then shared among the strata it overlaps instead of
  * being all or nothing for one. Adds the weighted radiance sum (times SUB^2) of each of the nr rims r[k]
  * into sum[k]: one ray and one footprint for all of them (r[0]'s scene, atlas and tracer), each read in
- * its own AIM, emission and direct light. */
+ * its own AIM, emission and direct light. seed: the stratum's own (the texel's and its index), for the
+ * emissive triangles' shadow rays at the hit. */
 static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3], lm_vec3 B, lm_vec3 T,
-                    lm_vec3 N, lm_vec3 G, double phi0, double dphi, double u0, double du, double (*sum)[3],
-                    double *back)
+                    lm_vec3 N, lm_vec3 G, double phi0, double dphi, double u0, double du, uint32_t seed,
+                    double (*sum)[3], double *back)
 {
     const lm_rim *r0 = r[0];
     double w;
@@ -195,7 +198,7 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
         for (int k = 0; k < nr; k++)
             if (r[k]->direct) { /* at the ray's own point, for the whole footprint */
                 float L[3];
-                punctual_at_hit(r[k], eye, dir, &h, L);
+                direct_at_hit(r[k], eye, dir, &h, seed, L);
                 for (int q = 0; q < 3; q++)
                     sum[k][q] += SUB * SUB * w * L[q];
             }
@@ -224,7 +227,8 @@ static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], c
     sky_mis m = {r0->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r0->scene), K, SKY_RAYS};
     for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
         for (int j = 0; j < side; j++)
-            stratum(r, nr, &m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d, sum, &back_w);
+            stratum(r, nr, &m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d,
+                    seed * (uint32_t)K + (uint32_t)(i * side + j), sum, &back_w);
     int ms = (int)sqrt((double)SKY_RAYS);
     for (int j = 0; m.on && j < m.M; j++) { /* the sky's own directions: a grid of strata, shifted per texel */
         float dir[3], L[3];

@@ -17,9 +17,11 @@
  * L(hit) is what the hemicube would show there: the AIM at the hit's lightmap uv (bilinear, from the
  * gather's copy of the dilated AIM), plus the emitted radiance when emitters are drawn rather than in
  * closed form; 0 on the back of a single-sided surface, on mirror and glass; the sky where nothing is hit.
- * With `direct`, the punctual lights' direct part of the AIM is taken at the hit point itself rather than
- * as its texel's average: a 7 m road texel half in a house's shadow reads as half lit to every wall that
- * sees it, a ray hit reads lit or shadowed as the point is (docs/aim.md, "Suns").
+ * With `direct`, the direct part the AIM computes (punctual lights; emissive triangles where direct->area is
+ * set) is taken at the hit point itself rather than as its texel's average: a 7 m road texel half in a
+ * house's shadow reads as half lit to every wall that sees it, a ray hit reads lit or shadowed as the
+ * point is (docs/aim.md, "Suns"); so does the floor at a box's foot in a lamp's contact shadow
+ * (docs/gather.md, "Rays").
  *
  * Cost: K rays and AIM lookups per texel, on the gather's calling thread while the GPU rasterizes
  * (docs/gather.md, "The rim", for the measured time). Noise: the rim is a band near the horizon; a
@@ -46,9 +48,10 @@ typedef struct {
     const float *emissive; /* with emission: per material rgb emission in place of the scene's (NULL: the
                               scene's), as a light edit's first gather saw it before (light_scale.h) */
     const lm_direct_light *direct; /* NULL: aim holds all the light. Else aim holds the light besides the
-                              punctual lights' direct part (lm_aim_rest_dilated_rgba), and that part is
-                              computed where each stratum's ray hits (lm_direct_punctual_at, kd / pi times it):
-                              one shadow ray per light a stratum */
+                              direct part the AIM computes (lm_aim_rest_dilated_rgba), and that part is
+                              computed where each stratum's ray hits (lm_direct_at_hit, kd / pi times it):
+                              one shadow ray per punctual light a stratum, and area->rays per emissive
+                              triangle */
 } lm_rim;
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y

@@ -65,34 +65,37 @@ static lm_vec3 shading_side(const float n[3], const float ns[3])
     return lm_dot(sv, nv) < 0.0f ? lm_scale(sv, -1.0f) : sv;
 }
 
-int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], const float ns[3],
-                         int two_sided, uint32_t seed, float out[3], float punctual_out[3])
+/* The computed light on the sides asked for (bit 1: n's, bit 2: the back) into out. */
+static void computed(const lm_direct_light *d, lm_vec3 p, const float n[3], const float ns[3], int sides,
+                     uint32_t seed, float out[3])
 {
     double e[3] = {0.0, 0.0, 0.0};
-    lm_vec3 pv = lm_v3_load(p), nv = lm_v3_load(n), back = lm_scale(nv, -1.0f);
-    float reach = lm_cover_reach(d->cover, d->cover_by_surface, surface);
-    int sides = (covered(d, reach, pv, nv) ? 0 : 1) | (two_sided && !covered(d, reach, pv, back) ? 2 : 0);
+    lm_vec3 nv = lm_v3_load(n);
     if (d->punctual)
-        punctual(d, pv, nv, shading_side(n, ns), sides, e);
-    for (int c = 0; punctual_out && c < 3; c++)
-        punctual_out[c] = (float)e[c];
+        punctual(d, p, nv, shading_side(n, ns), sides, e);
     if (d->area && (sides & 1))
-        area(d, pv, nv, seed, e);
+        area(d, p, nv, seed, e);
     if (d->area && (sides & 2))
-        area(d, pv, back, seed ^ 0x9e3779b9u, e);
+        area(d, p, lm_scale(nv, -1.0f), seed ^ 0x9e3779b9u, e);
     for (int c = 0; c < 3; c++)
         out[c] = (float)e[c];
+}
+
+int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], const float ns[3],
+                         int two_sided, uint32_t seed, float out[3])
+{
+    lm_vec3 pv = lm_v3_load(p), nv = lm_v3_load(n);
+    float reach = lm_cover_reach(d->cover, d->cover_by_surface, surface);
+    int sides = (covered(d, reach, pv, nv) ? 0 : 1) |
+                (two_sided && !covered(d, reach, pv, lm_scale(nv, -1.0f)) ? 2 : 0);
+    computed(d, pv, n, ns, sides, seed, out);
     return sides != 0;
 }
 
-void lm_direct_punctual_at(const lm_direct_light *d, const float p[3], const float n[3], const float ns[3],
-                           int two_sided, float out[3])
+void lm_direct_at_hit(const lm_direct_light *d, const float p[3], const float n[3], const float ns[3], int two_sided,
+                      uint32_t seed, float out[3])
 {
-    double e[3] = {0.0, 0.0, 0.0};
-    if (d->punctual)
-        punctual(d, lm_v3_load(p), lm_v3_load(n), shading_side(n, ns), two_sided ? 3 : 1, e);
-    for (int c = 0; c < 3; c++)
-        out[c] = (float)e[c];
+    computed(d, lm_v3_load(p), n, ns, two_sided ? 3 : 1, seed, out);
 }
 
 static int covers(const lm_hit *h, const void *d) { return lm_direct_covers_hit(d, h); }

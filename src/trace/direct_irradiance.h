@@ -52,15 +52,16 @@ typedef struct {
  * n's), as the reference and the frame's direct pass take it: on a terrain of smooth normals over coarse
  * triangles the two differ by tens of degrees (truck-town's grass beside the retaining wall: half the
  * light), and a light on the other side of either gives nothing. seed picks the emitter light's sample
- * pattern (pass the same one for the same point: no flicker). punctual_out (may be NULL) gets the part of
- * out that the punctual lights bring. Returns 0 when every side asked for is covered (d->cover on
- * `surface`: out is 0, and the point is hidden, not dark), else 1. */
+ * pattern (pass the same one for the same point: no flicker). Returns 0 when every side asked for is
+ * covered (d->cover on `surface`: out is 0, and the point is hidden, not dark), else 1. */
 int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], const float ns[3],
-                         int two_sided, uint32_t seed, float out[3], float punctual_out[3]);
-/* The punctual lights' part alone (d->punctual says which), at a point known to be seen (a gather ray's
- * hit, photonmap/hemicube_rim.h): no cover test, one shadow ray per light facing the side(s). */
-void lm_direct_punctual_at(const lm_direct_light *d, const float p[3], const float n[3], const float ns[3],
-                           int two_sided, float out[3]);
+                         int two_sided, uint32_t seed, float out[3]);
+/* What lm_direct_irradiance computes, at a point known to be seen (a gather ray's hit,
+ * photonmap/hemicube_rim.h): no cover test; one shadow ray per punctual light facing the side(s) (d->punctual
+ * says which), and the emissive triangles' light where d->area is set (its rays per triangle, seed as
+ * above). */
+void lm_direct_at_hit(const lm_direct_light *d, const float p[3], const float n[3], const float ns[3], int two_sided,
+                      uint32_t seed, float out[3]);
 
 /* 1 when hit h carries light that lm_direct_irradiance computes (a first hit of a punctual light, or of
  * an emissive triangle when d->area is set; never the sky's): an estimate that adds lm_direct_irradiance

@@ -133,8 +133,8 @@ lm_status lm_frame_loop_create(const lm_world *w, const lm_frame_loop_settings *
     fl->set.stage.trace = fl->set.stage.trace && fl->set.indirect;
     fl->set.stage.caustics = fl->set.caustics;
     fl->set.stage.aims = fl->set.stage.aims && lm_frame_lightmap_path(&fl->set);
-    fl->set.stage.punctual_at_hits = fl->set.stage.aims && fl->set.gather.scheme == LM_GATHER_RAYS &&
-                                     fl->set.gather.direct_at_hits; /* the rest is for the lightmap path's gather */
+    fl->set.stage.direct_at_hits = fl->set.stage.aims && fl->set.gather.scheme == LM_GATHER_RAYS &&
+                                   fl->set.gather.direct_at_hits; /* the rest is for the lightmap path's gather */
     fl->world = *w;
     char what[128];
     snprintf(what, sizeof what, "the lightmaps of %u texels (AIM, IIM, gather)", a->texel_count);

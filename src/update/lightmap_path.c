@@ -59,8 +59,8 @@ static lm_gather_job job_of(const lm_lightmap_path *lp)
     return (lm_gather_job){lp->gather, lp->scene, lp->atlas, lp->texels, lp->iim.fresh_tex, lp->set};
 }
 
-/* The AIM as the gather reads it: without the punctual lights' direct part when the gather computes that
- * part at its rays' hits (lm_gather_direct_at_hits), else whole. */
+/* The AIM as the gather reads it: without the direct part it computes when the gather computes that part
+ * at its rays' hits (lm_gather_direct_at_hits), else whole. */
 static const float *gather_aim(const lm_lightmap_path *lp)
 {
     const lm_aim *aim = lm_photon_stage_aim(lp->stage);
@@ -215,7 +215,7 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
         lm_gather_set_emitter_light(lp->gather, &lp->emitters);
     if (st == LM_OK) /* the rim outside the plane traced, not extrapolated (photonmap/hemicube_rim.h) */
         lm_gather_set_tracer(lp->gather, lp->rt);
-    if (st == LM_OK && set->stage.punctual_at_hits && lm_aim_rest_dilated_rgba(lm_photon_stage_aim(stage)))
+    if (st == LM_OK && set->stage.direct_at_hits && lm_aim_rest_dilated_rgba(lm_photon_stage_aim(stage)))
         lm_gather_set_direct_at_hits(lp->gather, lm_photon_stage_direct(stage));
     if (st == LM_OK)
         st = follow_light(lp, err); /* before the IIM: a scene without light gathers nothing */

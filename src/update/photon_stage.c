@@ -114,10 +114,9 @@ static lm_status setup_direct(lm_photon_stage *ps, const lm_photon_settings *ph,
                                    all ? LM_DIRECT_PUNCTUAL : suns ? LM_DIRECT_SUNS : LM_DIRECT_NONE,
                                    lm_scene_ray_lift(ps->scene), ph->cover_distance, ph->cover_by_surface};
     lm_aim_set_direct(&ps->aim, &ps->direct);
-    /* rest: for a ray gather that adds the punctual lights' part at its hits, and, where it is all the AIM
-     * computes (no emissive triangles'), for the first guess of other lights' edits (by_rest) */
-    int keep = ps->set.punctual_at_hits || !ps->have_area;
-    return keep && ps->direct.punctual != LM_DIRECT_NONE ? lm_aim_keep_rest(&ps->aim, err) : LM_OK;
+    /* rest: for a ray gather that adds the computed part at its hits, and, where the punctual lights' part is
+     * all the AIM computes (no emissive triangles'), for the first guess of other lights' edits (by_rest) */
+    return ps->set.direct_at_hits || !ps->have_area ? lm_aim_keep_rest(&ps->aim, err) : LM_OK;
 }
 
 static void take_snapshot(const lm_photon_stage *ps, int e, emitter_snapshot *out)
@@ -1069,6 +1068,7 @@ lm_direct_light lm_photon_stage_punctual_light(const lm_photon_stage *ps)
                                        : (lm_direct_light){ps->scene, ps->rt, &ps->emitters, NULL, LM_DIRECT_NONE,
                                                            lm_scene_ray_lift(ps->scene), 0.0f, NULL};
     d.punctual = LM_DIRECT_PUNCTUAL;
+    d.area = NULL; /* a bounce pass's map holds the emitters' light */
     return d;
 }
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps) { return &ps->emitters; }

@@ -21,11 +21,11 @@ typedef struct {
                               * photons themselves) */
     int exact_direct;        /* AIM texels compute direct light (trace/direct_irradiance.h), photons bring the
                               * rest (LM_EXACT_*) */
-    int punctual_at_hits;    /* 1: the AIM also keeps its texels without the punctual lights' direct part
+    int direct_at_hits;      /* 1: the AIM also keeps its texels without the direct part it computes
                               * (lm_aim_keep_rest), for a ray gather that computes that part at its hits
-                              * (lm_gather_set_direct_at_hits); 0 (default): kept only where that part is
-                              * all the AIM computes (no emissive triangles'), for the first guess of other
-                              * lights' edits under a budget (photon_stage.c, by_rest) */
+                              * (lm_gather_set_direct_at_hits); 0 (default): kept only where the punctual
+                              * lights' part is all the AIM computes (no emissive triangles'), for the first
+                              * guess of other lights' edits under a budget (photon_stage.c, by_rest) */
     int occluders;           /* 1: an AIM texel counts only the hits whose photon came from where it sees
                               * (lm_aim_set_occluders); 0 (default): every hit near it, the paper's */
     int caustics;            /* 1: caustic photons towards the mirror and glass nodes (none exist without
@@ -153,7 +153,8 @@ const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps);
 /* The direct light the AIM texels compute (exact_direct), NULL when they compute none. */
 const lm_direct_light *lm_photon_stage_direct(const lm_photon_stage *ps);
 /* Every punctual light's direct light at a point, for a gather that takes it at its rays' hits: the AIMs'
- * direct light with every punctual light on, or, where the AIMs compute none, one made for the purpose. */
+ * direct light with every punctual light on and no emissive triangle (a bounce pass's map holds their
+ * light), or, where the AIMs compute none, one made for the purpose. */
 lm_direct_light lm_photon_stage_punctual_light(const lm_photon_stage *ps);
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
 /* The caustic photons; NULL when the settings have none. A class or switch edit (lm_scene.pass_version), an

@@ -47,7 +47,7 @@ static int open_scene(const char *label, int paper_row, const char *path, bench_
         return 0;
     lm_photon_stage_settings set;
     lm_photon_stage_settings_default(&set);
-    set.punctual_at_hits = 1; /* as the frame loop's rays scheme sets it */
+    set.direct_at_hits = 1; /* as the frame loop's rays scheme sets it */
     lm_error err;
     const lm_atlas *a = &b->sc->atlas;
     if (lm_photon_stage_create(&b->sc->world, &set, &b->stage, NULL, &err) != LM_OK) {

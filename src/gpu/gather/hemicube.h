@@ -77,8 +77,9 @@ typedef struct {
                               tracer: the paper's division by F(a) */
     int ray_samples;       /* LM_GATHER_RAYS: strata per texel, rounded down to a square (default 400) */
     int direct_at_hits;    /* LM_GATHER_RAYS with a direct light (lm_gather_set_direct_at_hits): 1 (default) the
-                              punctual lights' direct light computed where each stratum's ray hits; 0: read
-                              from the AIM texel it hits, as the hemicube does */
+                              direct light the AIM computes (punctual lights, emissive triangles) computed
+                              where each stratum's ray hits; 0: read from the AIM texel it hits, as the
+                              hemicube does */
     int cpu_threads;       /* threads for a pass's CPU share (closed-form emitters, rim rays): 0 (default)
                               one on a software GL, whose rasterizer takes the cores, else every OpenMP
                               thread; n > 0: n. The IIM is the same bit for bit either way */
@@ -133,14 +134,15 @@ void lm_gather_set_emitter_light(lm_gather *g, const lm_emitter_light *el);
  * (lm_texel_covered) is invalid (alpha 1), like a texel that sees back faces. rt is borrowed and must
  * describe the scene the gather draws (the same node matrices). */
 void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt);
-/* With a direct light whose punctual part is on (NULL or LM_DIRECT_NONE: off, the default), the rays scheme
- * (LM_GATHER_RAYS, with a tracer) computes that part at each ray's hit (photonmap/hemicube_rim.h), and
- * the AIM it is given must then hold everything else: lm_aim_rest_dilated_rgba, not the whole AIM. The
- * hemicube schemes ignore it. d is copied (its emitters and tracer are borrowed); its area part and cover
- * distance are not used. */
+/* With a direct light that computes something (punctual lights or emissive triangles; NULL or neither:
+ * off, the default), the rays scheme (LM_GATHER_RAYS, with a tracer) computes that part at each ray's hit
+ * (photonmap/hemicube_rim.h), and the AIM it is given must then hold everything else:
+ * lm_aim_rest_dilated_rgba, not the whole AIM. The hemicube schemes ignore it. d is copied (its emitters,
+ * emissive triangles and tracer are borrowed; the triangles take as many shadow rays at a hit as at an AIM
+ * texel's part); its cover distance is not used. */
 void lm_gather_set_direct_at_hits(lm_gather *g, const lm_direct_light *d);
-/* Whether the gather computes the punctual direct light at its hits (the rays scheme with one set): the
- * AIM to give it is then the rest. */
+/* Whether the gather computes the direct light at its hits (the rays scheme with one set): the AIM to give
+ * it is then the rest. */
 int lm_gather_direct_at_hits(const lm_gather *g);
 /* Whether texel `texel` is covered as the gather with a tracer decides it: straight out from its centre
  * along the shading normal there (lm_texel_centre_normal, lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel

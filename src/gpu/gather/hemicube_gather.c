@@ -36,7 +36,7 @@ struct lm_gather {
     float *views;          /* a pass's views (schemes 1, 2), tiles^2 * VIEW_FLOATS */
     const lm_emitter_light *emitters; /* non-NULL: emitters' light in closed form, not drawn */
     const lm_rt *rt;       /* non-NULL (and rim_samples > 0): the rim traced (photonmap/hemicube_rim.h) */
-    lm_direct_light direct; /* with has_direct: the punctual lights' direct light at the rays' hits */
+    lm_direct_light direct; /* with has_direct: the direct light the AIM computes, at the rays' hits */
     int has_direct;
     float *aim_copy;       /* the dilated AIM as uploaded, for the rim's lookups (atlas-sized RGBA) */
     float *emit;           /* a pass's irradiance from the CPU per texel (emitters, rim), tiles^2 * 4 */
@@ -315,11 +315,10 @@ void lm_gather_set_tracer(lm_gather *g, const lm_rt *rt) { g->rt = rt; }
 
 void lm_gather_set_direct_at_hits(lm_gather *g, const lm_direct_light *d)
 {
-    g->has_direct = d && d->punctual != LM_DIRECT_NONE;
+    g->has_direct = d && (d->punctual != LM_DIRECT_NONE || d->area);
     if (!g->has_direct)
         return;
     g->direct = *d;
-    g->direct.area = NULL; /* emissive triangles' light stays in the AIM */
     g->direct.cover = 0.0f; /* a ray reached the point: it is not hidden */
 }
 
