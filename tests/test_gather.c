@@ -738,15 +738,14 @@ static void shadow_edge_meshes(lmt_mesh *m)
 }
 
 /* The shadow edge's scene at path loaded into p with 8 m texels, and its photon stage (20,000 photons; the
- * AIMs' direct light as exact_direct says, -1 the default) keeping the AIM's rest for a gather at its hits. */
+ * AIMs' direct light as exact_direct says) keeping the AIM's rest for a gather at its hits. */
 static lm_photon_stage *edge_stage(lmt_pipeline *p, const char *path, int exact_direct)
 {
     lmt_pipeline_load(p, path, 8.0f);
     lm_photon_stage_settings ps;
     lm_photon_stage_settings_default(&ps);
     ps.photons.total_photons = 20000;
-    if (exact_direct >= 0)
-        ps.exact_direct = exact_direct;
+    ps.exact_direct = exact_direct;
     ps.direct_at_hits = 1;
     lm_photon_stage *st = NULL;
     lm_error err;
@@ -809,7 +808,7 @@ static void test_sun_at_the_rays_hits(void **state)
         "[" LMT_DIFFUSE(0.5) ", " LMT_DIFFUSE(0) ", " LMT_DIFFUSE(0.5) ", " LMT_DIFFUSE(0.5) "], "
         LMT_LIGHTS("{\"type\": \"directional\", \"intensity\": 2}"));
     lmt_pipeline p;
-    lm_photon_stage *st = edge_stage(&p, path, -1);
+    lm_photon_stage *st = edge_stage(&p, path, LM_EXACT_SUNS);
     const lm_aim *aim = lm_photon_stage_aim(st);
     const double lit = 0.5 / PI * 2.0;
     const float at_x[2] = {100.0f, -100.0f};
@@ -845,7 +844,7 @@ static void test_sun_at_the_rays_hits(void **state)
 static double lamp_ground_irradiance(double x, double z, double le_a, double H)
 {
     double d2 = x * x + z * z + H * H;
-    return x > 0.0 && fabs(x) <= 196.0 && fabs(z) <= 200.0 ? le_a * H * H / (d2 * d2) : 0.0;
+    return x > 0.0 && x <= 196.0 && fabs(z) <= 200.0 ? le_a * H * H / (d2 * d2) : 0.0;
 }
 
 static double receiver_irradiance(double a, double y, double le_a, double H)
