@@ -133,7 +133,7 @@ static inline int lmgi_knob_is_pow2(double v)
       "photons (first hits, the paper's form, blurred by the estimate's\n"                                       \
       "radius), emitters (emissive triangles' light computed per texel: sharp\n"                                  \
       "contact shadows, about 5x slower AIMs; the rays gather computes it at\n"                                   \
-      "its hits, about 2x its time) or all (every light's)")                                                       \
+      "its near hits, --direct-near) or all (every light's)")                                                      \
     X(aim, occluders, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, "--aim-occluders", "on|off",         \
       LMGI_CLI_ZERO_NONE, LMGI_ON_OFF_CHOICES,                                                                     \
       LMGI_SWEEP(16, "aim_occluders", "AIM hits seen from the texel (0 off, 1 on)", (0, 1), (), 0),           \
@@ -204,6 +204,12 @@ static inline int lmgi_knob_is_pow2(double v)
       "hemicubes (default: closed when the scene has 1 to 64 emissive triangles)")                                \
     X(gather, emitter_rays, LMGI_KNOB_INT, int, 32, 1, 65536, 0, LMGI_NO_RULE, "--emitter-rays", "N",              \
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP, "shadow rays per emissive triangle and texel (default 32)") \
+    X(gather, direct_near, LMGI_KNOB_REAL, float, 16, 0.01, 1e6, 1, LMGI_NO_RULE, "--direct-near", "K",            \
+      LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
+      "with the emissive triangles' light at the rays gather's hits\n"                                             \
+      "(--aim-direct emitters or all): only hits within K of their surface's\n"                                    \
+      "texel widths take the direct light there, further ones read it in their\n"                                  \
+      "AIM texel (default 16; 0: every hit; docs/gather.md, \"Near and far hits\")")                              \
     X(gather, bounce_passes, LMGI_KNOB_INT, int, LMGI_OFF, 1, 8, 1, LMGI_NO_RULE, "--bounce-passes", "N",          \
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
       "after the first full gather, N more with the bounced light read from\n"                                     \

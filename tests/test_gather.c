@@ -694,14 +694,17 @@ static void test_furnace(void **state)
 }
 
 /* The rays gather of `count` texels over AIM map aim_rgb (undilated RGB), with the stage's direct light at
- * the rays' hits (at_hits) or read from aim_rgb; returns the whole IIM texture read back (caller frees). */
-static float *gather_rays_of(const lmt_pipeline *p, const lm_photon_stage *st, int at_hits, const float *aim_rgb,
-                             const uint32_t *texels, uint32_t count)
+ * the rays' hits (at_hits) or read from aim_rgb; with whole (the AIM's lm_aim_dilated_rgba; NULL: none),
+ * hits further than near texel widths read that instead. Returns the whole IIM texture read back (caller
+ * frees). */
+static float *gather_rays_split(const lmt_pipeline *p, const lm_photon_stage *st, int at_hits, const float *aim_rgb,
+                                const float *whole, float near, const uint32_t *texels, uint32_t count)
 {
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
     set.scheme = LM_GATHER_RAYS;
     set.direct_at_hits = at_hits;
+    set.direct_near = near;
     lm_gather *g = NULL;
     lm_error err;
     if (lm_gather_create(&set, &g, &err) != LM_OK)
@@ -711,6 +714,7 @@ static float *gather_rays_of(const lmt_pipeline *p, const lm_photon_stage *st, i
     assert_int_equal(lm_gather_direct_at_hits(g), at_hits);
     assert_int_equal(lm_gather_set_scene(g, p->s, &p->atlas, &err), LM_OK);
     assert_int_equal(lm_gather_set_aim(g, &p->atlas, aim_rgb, &err), LM_OK);
+    assert_int_equal(lm_gather_set_aim_whole(g, &p->atlas, whole, &err), LM_OK);
     unsigned tex = lm_iim_texture_create(p->atlas.width, p->atlas.height);
     float *rgba = malloc(4 * sizeof(float) * (size_t)p->atlas.width * (size_t)p->atlas.height);
     assert_true(tex && rgba);
@@ -719,6 +723,13 @@ static float *gather_rays_of(const lmt_pipeline *p, const lm_photon_stage *st, i
     lm_iim_texture_free(tex);
     lm_gather_free(g);
     return rgba;
+}
+
+/* The same with every hit alike: the direct light at each (at_hits) or read from aim_rgb. */
+static float *gather_rays_of(const lmt_pipeline *p, const lm_photon_stage *st, int at_hits, const float *aim_rgb,
+                             const uint32_t *texels, uint32_t count)
+{
+    return gather_rays_split(p, st, at_hits, aim_rgb, NULL, 0.0f, texels, count);
 }
 
 /* The shadow edge's scene (test_sun_at_the_rays_hits): m[0] a 400 m ground whose texels are 8 m (the edge
@@ -787,6 +798,38 @@ static void receivers_at_hits_and_texels(const lmt_pipeline *p, const lm_photon_
     }
 }
 
+/* Near and far hits (settings.direct_near, docs/gather.md): with the whole AIM given, the hits within 4 of the
+ * ground's 8 m texels (all but the last 1/256 of a receiver's cosine-weighted hemisphere, 2 m up) take the
+ * direct light at the hit: within 3% of want, as every hit does. With 0.1 texel widths none does: where
+ * emissive triangles light the scene (area) every hit reads the whole AIM, the texels' gather to 1e-5;
+ * with punctual lights alone the split is off, and the gather is every hit's to the bit. */
+static void receivers_near_and_far(const lmt_pipeline *p, const lm_photon_stage *st, const uint32_t texels[2],
+                                   const double want[2], int area)
+{
+    const lm_aim *aim = lm_photon_stage_aim(st);
+    const float *whole = lm_aim_dilated_rgba(aim);
+    float *near = gather_rays_split(p, st, 1, aim->rest, whole, 4.0f, texels, 2);
+    float *far = gather_rays_split(p, st, 1, aim->rest, whole, 0.1f, texels, 2);
+    float *alike = area ? gather_rays_of(p, st, 0, aim->rgb, texels, 2) : gather_rays_of(p, st, 1, aim->rest, texels, 2);
+    for (int k = 0; k < 2; k++) {
+        const float *n = texel_value_at(&p->atlas, near, texels[k]), *f = texel_value_at(&p->atlas, far, texels[k]),
+                    *a = texel_value_at(&p->atlas, alike, texels[k]);
+        print_message("receiver %d: near hits at the hit %.4f (exact %.4f, %+.1f%%); none %.4f, %s %.4f\n", k,
+                      (double)n[1], want[k], 100.0 * (n[1] / want[k] - 1.0), (double)f[1],
+                      area ? "from the texels" : "every hit", (double)a[1]);
+        for (int c = 0; c < 3; c++) {
+            assert_true(fabs(n[c] / want[k] - 1.0) < 0.03);
+            if (area)
+                assert_float_equal(f[c], a[c], 1e-5 * fabs(a[c]));
+            else
+                assert_memory_equal(&f[c], &a[c], sizeof f[c]);
+        }
+    }
+    free(near);
+    free(far);
+    free(alike);
+}
+
 /* The rays gather with the sun's direct light taken where its rays hit (lm_gather_set_direct_at_hits). A sun
  * straight down on a 400 m ground of albedo 0.5; a black slab 50 m up shades the ground's x < 0 half, so the
  * shadow's edge runs through a ground texel 8 m wide; two small receivers 2 m up face down at x = +1 and
@@ -830,6 +873,7 @@ static void test_sun_at_the_rays_hits(void **state)
         want[k] = 0.5 * 2.0 * 0.5 * (1.0 + a / sqrt(a * a + y * y));
     }
     receivers_at_hits_and_texels(&p, st, texels, want, "the sun at the rays' hits");
+    receivers_near_and_far(&p, st, texels, want, 0);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }
@@ -899,6 +943,7 @@ static void test_emitter_at_the_rays_hits(void **state)
     for (int k = 0; k < 2; k++)
         want[k] = receiver_irradiance(p.atlas.texels[texels[k]].pos[0], receiver_eye(&p, EDGE_H), le_a, H);
     receivers_at_hits_and_texels(&p, st, texels, want, "the lamp at the rays' hits");
+    receivers_near_and_far(&p, st, texels, want, 1);
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }
@@ -1362,7 +1407,7 @@ static void test_rim_pair_same_as_two(void **state)
         emissive[3 * m + 1] = 0.25f * (float)m; /* what the emitters showed before */
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    lm_rim was = {p.s, &p.atlas, p.rt, before, 1, {0.1f, 0.2f, 0.3f}, 0.0f, 16, emissive, NULL}, now = was;
+    lm_rim was = {p.s, &p.atlas, p.rt, before, 1, {0.1f, 0.2f, 0.3f}, 0.0f, 16, emissive, NULL, NULL, 0.0f}, now = was;
     now.aim = after;
     now.emissive = NULL;
     uint32_t tested = 0, differ = 0;

@@ -97,6 +97,12 @@ static double strata_share(const sky_mis *m, lm_vec3 n, const float d[3], double
     return ka + mb > 0.0 ? ka / (ka + mb) : 1.0;
 }
 
+/* The width of a texel of the surface hit h met (the atlas's where it met none). */
+static float hit_texel_width(const lm_atlas *a, const lm_rt_hit *h)
+{
+    return a->surface_texel_size && h->surface >= 0 ? a->surface_texel_size[h->surface] : a->texel_size;
+}
+
 /* kd / pi E_direct at the ray's hit h (direction dir from eye): the direct light the AIM computes for a
  * texel (r->direct: punctual lights, emissive triangles), computed there (the side the geometric normal's,
  * a punctual light's cosine the shading normal's, both sides of a double-sided material); seed picks the
@@ -161,6 +167,9 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
     }
     const float *c = r0->atlas->corner_uv + 6 * (size_t)h.tri;
     lm_vec3 e = lm_v3_load(eye), P = lm_add(e, lm_scale(d, h.t));
+    int at_hit[RIMS_AT_ONCE];
+    for (int k = 0; k < nr; k++)
+        at_hit[k] = r[k]->direct && (!r[k]->whole || h.t <= r[k]->near * hit_texel_width(r0->atlas, &h));
     float hit[2];
     if (lm_atlas_hit_uv(r0->atlas, &h, hit)) {
         float p[3][3], gu[3], gv[3];
@@ -189,14 +198,14 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
                     sv = fminf(fmaxf(hit[1] + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
                 }
                 for (int k = 0; k < nr; k++) {
-                    lm_atlas_sample_rgb(r0->atlas, r[k]->aim, su, sv, L);
+                    lm_atlas_sample_rgb(r0->atlas, at_hit[k] || !r[k]->direct ? r[k]->aim : r[k]->whole, su, sv, L);
                     for (int q = 0; q < 3; q++)
                         sum[k][q] += ws * L[q];
                 }
             }
         }
         for (int k = 0; k < nr; k++)
-            if (r[k]->direct) { /* at the ray's own point, for the whole footprint */
+            if (at_hit[k]) { /* at the ray's own point, for the whole footprint */
                 float L[3];
                 direct_at_hit(r[k], eye, dir, &h, seed, L);
                 for (int q = 0; q < 3; q++)

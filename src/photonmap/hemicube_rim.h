@@ -21,7 +21,9 @@
  * set) is taken at the hit point itself rather than as its texel's average: a 7 m road texel half in a
  * house's shadow reads as half lit to every wall that sees it, a ray hit reads lit or shadowed as the
  * point is (docs/aim.md, "Suns"); so does the floor at a box's foot in a lamp's contact shadow
- * (docs/gather.md, "Rays").
+ * (docs/gather.md, "Rays"). Only where it matters, with `whole`: a hit a few of its own texels away
+ * or nearer, where the eye can tell a point from its texel's average; further hits read the whole AIM,
+ * for fewer shadow rays (Jensen's final gather treats its near hits apart for the same reason).
  *
  * Cost: K rays and AIM lookups per texel, on the gather's calling thread while the GPU rasterizes
  * (docs/gather.md, "The rim", for the measured time). Noise: the rim is a band near the horizon; a
@@ -52,6 +54,11 @@ typedef struct {
                               computed where each stratum's ray hits (lm_direct_at_hit, kd / pi times it):
                               one shadow ray per punctual light a stratum, and area->rays per emissive
                               triangle */
+    const float *whole;    /* with direct: the whole AIM (lm_aim_dilated_rgba), read where a ray's hit lies
+                              further than near x the hit surface's texel width, its direct part then the
+                              texel's average as a hemicube reads it (docs/gather.md, "Near and far hits");
+                              NULL: every hit takes its direct light at the hit */
+    float near;            /* texel widths (with whole) */
 } lm_rim;
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y

@@ -79,6 +79,13 @@ static lm_status gather_prepare(lm_lightmap_path *lp, lm_error *err)
     }
     if (st == LM_OK && lp->aim_stale)
         st = lm_gather_set_aim_dilated(lp->gather, lp->atlas, gather_aim(lp), err);
+    /* the far hits' map, where only the near ones take the emitters' light (docs/gather.md, "Near and far
+     * hits"); punctual lights alone are taken at every hit */
+    const lm_direct_light *d = lm_photon_stage_direct(lp->stage);
+    int far_map = lm_gather_direct_at_hits(lp->gather) && d && d->area;
+    if (st == LM_OK && lp->aim_stale)
+        st = lm_gather_set_aim_whole(lp->gather, lp->atlas,
+                                     far_map ? lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)) : NULL, err);
     if (st == LM_OK)
         lp->aim_stale = 0;
     return st;
@@ -302,6 +309,7 @@ static lm_status bounce_passes(lm_lightmap_path *lp, lm_error *err)
     const float *aim = gather_aim(lp); /* what the first pass read, for the texels inside geometry */
     lm_direct_light every = lm_photon_stage_punctual_light(lp->stage);
     lm_gather_set_direct_at_hits(lp->gather, &every);
+    lm_gather_set_aim_whole(lp->gather, a, NULL, NULL); /* the map holds no direct light: every hit takes it */
     size_t cells = (size_t)a->width * a->height;
     float *rgb = malloc(sizeof *rgb * 3 * cells), *map = malloc(sizeof *map * 4 * cells);
     lm_status st = rgb && map ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for a bounce pass", lp->scene->path);

@@ -80,6 +80,11 @@ typedef struct {
                               direct light the AIM computes (punctual lights, emissive triangles) computed
                               where each stratum's ray hits; 0: read from the AIM texel it hits, as the
                               hemicube does */
+    float direct_near;     /* with direct_at_hits, emissive triangles in the direct light and the whole AIM
+                              given (lm_gather_set_aim_whole): only hits within this many of their own
+                              surface's texel widths take the direct light at the hit, further ones read it
+                              in the whole AIM (default 16; docs/gather.md, "Near and far hits"); <= 0, or
+                              punctual lights alone: every hit */
     int cpu_threads;       /* threads for a pass's CPU share (closed-form emitters, rim rays): 0 (default)
                               one on a software GL, whose rasterizer takes the cores, else every OpenMP
                               thread; n > 0: n. The IIM is the same bit for bit either way */
@@ -144,6 +149,10 @@ void lm_gather_set_direct_at_hits(lm_gather *g, const lm_direct_light *d);
 /* Whether the gather computes the direct light at its hits (the rays scheme with one set): the AIM to give
  * it is then the rest. */
 int lm_gather_direct_at_hits(const lm_gather *g);
+/* With the direct light at the hits: the whole AIM as well (lm_aim_dilated_rgba, atlas-sized RGBA, copied),
+ * which hits further than settings.direct_near texel widths read instead of the rest and the direct light at
+ * the hit; NULL (as after creation) forgets it, and every hit takes its direct light. */
+lm_status lm_gather_set_aim_whole(lm_gather *g, const lm_atlas *a, const float *dilated_rgba, lm_error *err);
 /* Whether texel `texel` is covered as the gather with a tracer decides it: straight out from its centre
  * along the shading normal there (lm_texel_centre_normal, lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel
  * lies inside a closed mesh) (docs/gather.md, "Covered texels"). */

@@ -39,6 +39,7 @@ struct lm_gather {
     lm_direct_light direct; /* with has_direct: the direct light the AIM computes, at the rays' hits */
     int has_direct;
     float *aim_copy;       /* the dilated AIM as uploaded, for the rim's lookups (atlas-sized RGBA) */
+    float *whole_copy;     /* with the direct light at the hits: the whole AIM for the far hits (NULL: none) */
     float *emit;           /* a pass's irradiance from the CPU per texel (emitters, rim), tiles^2 * 4 */
     int cpu_threads;       /* for it (settings' cpu_threads, 0 resolved at creation) */
     GLuint aim_tex;
@@ -213,6 +214,7 @@ void lm_gather_free(lm_gather *g)
     free(g->views);
     free(g->emit);
     free(g->aim_copy);
+    free(g->whole_copy);
     GLuint tex[5] = {g->aim_tex, g->color, g->depth, g->ms_color, g->ms_depth};
     glDeleteTextures(5, tex);
     glDeleteFramebuffers(1, &g->ms_fbo);
@@ -404,6 +406,21 @@ lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float
         g->aim_copy = memcpy(copy, dilated_rgba, bytes);
     }
     return lm_gl_check("hemicube gather: AIM upload", err);
+}
+
+lm_status lm_gather_set_aim_whole(lm_gather *g, const lm_atlas *a, const float *dilated_rgba, lm_error *err)
+{
+    if (!dilated_rgba) {
+        free(g->whole_copy);
+        g->whole_copy = NULL;
+        return LM_OK;
+    }
+    size_t bytes = sizeof(float) * 4 * (size_t)a->width * (size_t)a->height;
+    float *copy = realloc(g->whole_copy, bytes);
+    if (!copy)
+        return lm_fail(err, LM_ERR_NOMEM, "ray gather: no memory for the whole AIM's copy");
+    g->whole_copy = memcpy(copy, dilated_rgba, bytes);
+    return LM_OK;
 }
 
 lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err)
@@ -679,7 +696,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                            uint32_t count)
 {
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]},
-                  g->set.enlargement, g->set.rim_samples, NULL, NULL};
+                  g->set.enlargement, g->set.rim_samples, NULL, NULL, NULL, 0.0f};
 #pragma omp parallel num_threads(g->cpu_threads) if (g->cpu_threads > 1)
     {
         lm_rt_thread_init(); /* FTZ/DAZ as on this thread: the same numbers on any thread */
@@ -739,8 +756,14 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
 {
     if (!rim_ready(g))
         return lm_fail(err, LM_ERR_INVALID, "ray gather: it needs the scene's tracer (lm_gather_set_tracer)");
+    /* far hits read the whole AIM only where emissive triangles' shadow rays are to be saved: with punctual
+     * lights alone a hit costs one shadow ray a light, and the town's sunlit ground read from its texels
+     * left the retaining wall darker (docs/gather.md, "Near and far hits") */
+    int at_hits = lm_gather_direct_at_hits(g),
+        near_only = at_hits && g->direct.area && g->whole_copy && g->set.direct_near > 0.0f;
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]}, 0.0f,
-                  g->set.ray_samples, NULL, lm_gather_direct_at_hits(g) ? &g->direct : NULL};
+                  g->set.ray_samples, NULL, at_hits ? &g->direct : NULL, near_only ? g->whole_copy : NULL,
+                  g->set.direct_near};
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
     glBindTexture(GL_TEXTURE_2D, iim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
