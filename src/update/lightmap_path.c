@@ -262,27 +262,38 @@ void lm_lightmap_path_free(lm_lightmap_path *lp)
  * into the gutters (out: RGBA, atlas-sized; rgb: atlas-sized scratch). The IIM holds everything but the
  * punctual lights' direct light (the sky seen, the emitters' light, the bounces), and the passes take
  * every punctual light at their hits: what the first pass reads from the AIMs and its hits, with the
- * photons' noise gathered once more. */
-static lm_status bounce_map(lm_lightmap_path *lp, const float *aim, float *rgb, float *out, lm_error *err)
+ * photons' noise gathered once more. With whole (NULL: not wanted) the passes take the emitters' light at
+ * their near hits too, as the first did ("Near and far hits"): out then leaves out what the gather added of
+ * it at each texel (lm_gather_emitted_at), and whole is the map with it, for the far hits. Texels inside
+ * geometry read the AIM the first pass read (aim, and aim_whole for whole). */
+static lm_status bounce_map(lm_lightmap_path *lp, const float *aim, const float *aim_whole, float *rgb, float *out,
+                            float *whole, lm_error *err)
 {
     const lm_atlas *a = lp->atlas;
     float *iim;
     lm_status st = lm_lightmap_path_read_window(lp, (const int[4]){0, 0, a->width, a->height}, &iim, err);
     if (st != LM_OK)
         return st;
-    memset(rgb, 0, sizeof *rgb * 3 * (size_t)a->width * a->height);
+    size_t cells = (size_t)a->width * a->height;
     float limit = lp->set->gather.backface_limit;
-    for (uint32_t i = 0; i < a->texel_count; i++) {
-        const lm_texel *t = &a->texels[i];
-        size_t at = (size_t)t->y * a->width + t->x;
-        float kd[3];
-        lm_texel_kd(lp->scene, t, kd);
-        int valid = iim[4 * at + 3] <= limit; /* else the gather saw back faces: it is inside geometry */
-        for (int c = 0; c < 3; c++)
-            rgb[3 * at + c] = valid ? kd[c] / LM_PI * iim[4 * at + c] : aim[4 * at + c];
+    for (int map = whole ? 1 : 0; map >= 0; map--) { /* the whole map first, then the rest */
+        memset(rgb, 0, sizeof *rgb * 3 * cells);
+        const float *inside = map ? aim_whole : aim;
+#pragma omp parallel for schedule(dynamic, 256) if (whole)
+        for (int64_t i = 0; i < (int64_t)a->texel_count; i++) {
+            const lm_texel *t = &a->texels[i];
+            size_t at = (size_t)t->y * a->width + t->x;
+            float kd[3], emitted[3] = {0.0f, 0.0f, 0.0f};
+            lm_texel_kd(lp->scene, t, kd);
+            int valid = iim[4 * at + 3] <= limit; /* else the gather saw back faces: it is inside geometry */
+            if (valid && whole && !map)
+                lm_gather_emitted_at(lp->gather, lp->scene, a, (uint32_t)i, emitted);
+            for (int c = 0; c < 3; c++)
+                rgb[3 * at + c] = valid ? kd[c] / LM_PI * (iim[4 * at + c] - emitted[c]) : inside[4 * at + c];
+        }
+        lm_atlas_dilated_rgba(a, rgb, map ? whole : out);
     }
     free(iim);
-    lm_atlas_dilated_rgba(a, rgb, out);
     return LM_OK;
 }
 
@@ -304,20 +315,27 @@ static lm_status bounce_passes(lm_lightmap_path *lp, lm_error *err)
                "hits (a hemicube reads that light from the map, which an IIM does not hold)", lp->scene->path);
         return LM_OK;
     }
-    /* the map holds no punctual light: each is taken at the hits, the suns as before and the others too */
+    /* the map holds no punctual light: each is taken at the hits, the suns as before and the others too; where
+     * the first pass took the emitters' light at its hits, so do the passes (their map then without it) */
     const lm_direct_light *d = lm_gather_direct_at_hits(lp->gather) ? lm_photon_stage_direct(lp->stage) : NULL;
     const float *aim = gather_aim(lp); /* what the first pass read, for the texels inside geometry */
+    int emitters = d && d->area && lp->have_emitters;
     lm_direct_light every = lm_photon_stage_punctual_light(lp->stage);
+    every.area = emitters ? d->area : NULL;
     lm_gather_set_direct_at_hits(lp->gather, &every);
-    lm_gather_set_aim_whole(lp->gather, a, NULL, NULL); /* the map holds no direct light: every hit takes it */
     size_t cells = (size_t)a->width * a->height;
     float *rgb = malloc(sizeof *rgb * 3 * cells), *map = malloc(sizeof *map * 4 * cells);
-    lm_status st = rgb && map ? LM_OK : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for a bounce pass", lp->scene->path);
+    float *whole = emitters ? malloc(sizeof *whole * 4 * cells) : NULL;
+    lm_status st = rgb && map && (whole || !emitters)
+                       ? LM_OK
+                       : lm_fail(err, LM_ERR_NOMEM, "%s: no memory for a bounce pass", lp->scene->path);
     for (int p = 0; st == LM_OK && p < lp->set->bounce_passes; p++) {
         lm_log(LM_LOG_INFO, "bounce pass %d of %d", p + 1, lp->set->bounce_passes);
-        st = bounce_map(lp, aim, rgb, map, err);
+        st = bounce_map(lp, aim, lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), rgb, map, whole, err);
         if (st == LM_OK)
             st = lm_gather_set_aim_dilated(lp->gather, a, map, err);
+        if (st == LM_OK) /* NULL without the emitters at the hits: every hit takes the punctual lights */
+            st = lm_gather_set_aim_whole(lp->gather, a, whole, err);
         if (st == LM_OK)
             st = lm_lightmap_path_gather(lp, lm_iim_sched_pick_all(&lp->iim.sched, store_of(lp), lp->texels), err);
         if (st == LM_OK)
@@ -327,6 +345,7 @@ static lm_status bounce_passes(lm_lightmap_path *lp, lm_error *err)
     lp->aim_stale = 1;
     free(rgb);
     free(map);
+    free(whole);
     return st;
 }
 

@@ -154,7 +154,8 @@ const lm_aim *lm_photon_stage_aim(const lm_photon_stage *ps);
 const lm_direct_light *lm_photon_stage_direct(const lm_photon_stage *ps);
 /* Every punctual light's direct light at a point, for a gather that takes it at its rays' hits: the AIMs'
  * direct light with every punctual light on and no emissive triangle (a bounce pass's map holds their
- * light), or, where the AIMs compute none, one made for the purpose. */
+ * light unless it sets them back, lightmap_path.c), or, where the AIMs compute none, one made for the
+ * purpose. */
 lm_direct_light lm_photon_stage_punctual_light(const lm_photon_stage *ps);
 const lm_emitters *lm_photon_stage_emitters(const lm_photon_stage *ps);
 /* The caustic photons; NULL when the settings have none. A class or switch edit (lm_scene.pass_version), an

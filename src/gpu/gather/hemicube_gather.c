@@ -499,6 +499,19 @@ void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, c
     lm_v3_store(ng, v.ng);
 }
 
+void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t texel, float e[3])
+{
+    e[0] = e[1] = e[2] = 0.0f;
+    if (!g->emitters)
+        return;
+    texel_view v = view_of(&g->set, s, &a->texels[texel]);
+    float eye[3], n[3], out[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    lm_v3_store(eye, v.eye);
+    lm_v3_store(n, v.axes[2]);
+    lm_emitter_irradiance(g->emitters, eye, n, texel, out);
+    memcpy(e, out, 3 * sizeof *e);
+}
+
 /* Whether the texel is covered (lm_texel_covered): straight out from its centre along the shading normal
  * there (lm_texel_centre_normal, not the mean its view faces), from the view's eye offset, other geometry
  * within a texel's width, or the inside of a solid (the back of a triangle by its winding: the texel is
