@@ -149,6 +149,22 @@ static void assert_small_box(const lmgi_scene *sc, const lm_frame_check *c, uint
     assert_true(faces >= 2);
 }
 
+/* sc's frame under ls against the reference (REF_ERROR): the frame (assert_frame's bounds for the shared box)
+ * and the small box's faces (assert_small_box). */
+static void check_small_box(const char *name, lmgi_scene *sc, const lm_frame_loop_settings *ls,
+                            uint32_t min_pixels, int per_channel)
+{
+    lm_ref_settings rs;
+    ref_settings(&rs, REF_ERROR);
+    lm_frame_check c;
+    lm_error err;
+    if (lm_frame_check_run(sc, ls, &rs, 1, &c, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    assert_frame(name, sc, &c, 0.03, SURFACE_TOL, 0.06);
+    assert_small_box(sc, &c, min_pixels, per_channel);
+    lm_frame_check_free(&c);
+}
+
 static void test_shared_cornell_box(void **state)
 {
     (void)state;
@@ -161,14 +177,7 @@ static void test_shared_cornell_box(void **state)
     lm_frame_loop_settings_default(&ls);
     ls.width = ls.height = SIZE;
     ls.stage.exact_direct = LM_EXACT_EMITTERS;
-    lm_ref_settings rs;
-    ref_settings(&rs, REF_ERROR);
-    lm_error err;
-    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
-        fail_msg("%s", err.msg);
-    assert_frame("shared Cornell box, emitters' light computed in the AIMs", sc, &c, 0.03, SURFACE_TOL, 0.06);
-    assert_small_box(sc, &c, SMALL_FACE_PIXELS, 0);
-    lm_frame_check_free(&c);
+    check_small_box("shared Cornell box, emitters' light computed in the AIMs", sc, &ls, SMALL_FACE_PIXELS, 0);
     lmgi_free(sc);
 }
 
@@ -193,21 +202,9 @@ static void test_shared_cornell_box_direct_at_hits(void **state)
     ls.width = ls.height = CHECK_SIZE;
     ls.stage.exact_direct = LM_EXACT_EMITTERS;
     ls.gather.scheme = LM_GATHER_RAYS;
-    lm_ref_settings rs;
-    ref_settings(&rs, REF_ERROR);
-    lm_frame_check c;
-    lm_error err;
-    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
-        fail_msg("%s", err.msg);
-    assert_frame("shared Cornell box, the rays gather, emitters' light at its hits", sc, &c, 0.03, SURFACE_TOL, 0.06);
-    assert_small_box(sc, &c, MIN_PIXELS, 1);
-    lm_frame_check_free(&c);
+    check_small_box("shared Cornell box, the rays gather, emitters' light at its hits", sc, &ls, MIN_PIXELS, 1);
     ls.bounce_passes = 1; /* as lmgi bake gathers: the pass takes the emitters at its hits too */
-    if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
-        fail_msg("%s", err.msg);
-    assert_frame("the same after a bounce pass", sc, &c, 0.03, SURFACE_TOL, 0.06);
-    assert_small_box(sc, &c, MIN_PIXELS, 1);
-    lm_frame_check_free(&c);
+    check_small_box("the same after a bounce pass", sc, &ls, MIN_PIXELS, 1);
     lmgi_free(sc);
 }
 

@@ -167,9 +167,9 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
     }
     const float *c = r0->atlas->corner_uv + 6 * (size_t)h.tri;
     lm_vec3 e = lm_v3_load(eye), P = lm_add(e, lm_scale(d, h.t));
-    int at_hit[RIMS_AT_ONCE];
+    int far[RIMS_AT_ONCE]; /* the direct light read in the whole AIM, not taken at the hit */
     for (int k = 0; k < nr; k++)
-        at_hit[k] = r[k]->direct && (!r[k]->whole || h.t <= r[k]->near * hit_texel_width(r0->atlas, &h));
+        far[k] = r[k]->direct && r[k]->whole && h.t > r[k]->near * hit_texel_width(r0->atlas, &h);
     float hit[2];
     if (lm_atlas_hit_uv(r0->atlas, &h, hit)) {
         float p[3][3], gu[3], gv[3];
@@ -198,14 +198,14 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
                     sv = fminf(fmaxf(hit[1] + lm_dot(lm_v3_load(gv), off), lo[1]), hi[1]);
                 }
                 for (int k = 0; k < nr; k++) {
-                    lm_atlas_sample_rgb(r0->atlas, at_hit[k] || !r[k]->direct ? r[k]->aim : r[k]->whole, su, sv, L);
+                    lm_atlas_sample_rgb(r0->atlas, far[k] ? r[k]->whole : r[k]->aim, su, sv, L);
                     for (int q = 0; q < 3; q++)
                         sum[k][q] += ws * L[q];
                 }
             }
         }
         for (int k = 0; k < nr; k++)
-            if (at_hit[k]) { /* at the ray's own point, for the whole footprint */
+            if (r[k]->direct && !far[k]) { /* at the ray's own point, for the whole footprint */
                 float L[3];
                 direct_at_hit(r[k], eye, dir, &h, seed, L);
                 for (int q = 0; q < 3; q++)

@@ -77,15 +77,16 @@ static lm_status gather_prepare(lm_lightmap_path *lp, lm_error *err)
         lm_sky_mean(lp->scene, mean);
         lm_gather_set_sky(lp->gather, mean);
     }
-    if (st == LM_OK && lp->aim_stale)
+    if (st == LM_OK && lp->aim_stale) {
         st = lm_gather_set_aim_dilated(lp->gather, lp->atlas, gather_aim(lp), err);
-    /* the far hits' map, where only the near ones take the emitters' light (docs/gather.md, "Near and far
-     * hits"); punctual lights alone are taken at every hit */
-    const lm_direct_light *d = lm_photon_stage_direct(lp->stage);
-    int far_map = lm_gather_direct_at_hits(lp->gather) && d && d->area;
-    if (st == LM_OK && lp->aim_stale)
-        st = lm_gather_set_aim_whole(lp->gather, lp->atlas,
-                                     far_map ? lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)) : NULL, err);
+        /* the far hits' map, where only the near ones take the emitters' light (docs/gather.md, "Near and far
+         * hits"); punctual lights alone are taken at every hit */
+        const lm_direct_light *d = lm_photon_stage_direct(lp->stage);
+        int far_map = lm_gather_direct_at_hits(lp->gather) && d && d->area;
+        if (st == LM_OK)
+            st = lm_gather_set_aim_whole(lp->gather, lp->atlas,
+                                         far_map ? lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)) : NULL, err);
+    }
     if (st == LM_OK)
         lp->aim_stale = 0;
     return st;

@@ -504,12 +504,9 @@ void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas 
     e[0] = e[1] = e[2] = 0.0f;
     if (!g->emitters)
         return;
-    texel_view v = view_of(&g->set, s, &a->texels[texel]);
-    float eye[3], n[3], out[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    lm_v3_store(eye, v.eye);
-    lm_v3_store(n, v.axes[2]);
-    lm_emitter_irradiance(g->emitters, eye, n, texel, out);
-    memcpy(e, out, 3 * sizeof *e);
+    float eye[3], n[3], ng[3]; /* the view fill_views gives the texel */
+    lm_gather_texel_frame(&g->set, s, a, texel, eye, n, ng);
+    lm_emitter_irradiance(g->emitters, eye, n, texel, e);
 }
 
 /* Whether the texel is covered (lm_texel_covered): straight out from its centre along the shading normal
