@@ -474,7 +474,8 @@ typedef enum { LMGI_EMITTERS_AUTO = 0, LMGI_EMITTERS_CLOSED_FORM, LMGI_EMITTERS_
 typedef void (*lmgi_progress_fn)(void *user, float fraction, const char *stage);
 typedef enum {
     LMGI_GATHER_DEFAULT = 0, /* the hemicube, or rays for a scene of over LMGI_RAYS_ABOVE_TRIANGLES where the GL
-                              * rasterizes in software, and under a sky that is not uniform (docs/gather.md,
+                              * rasterizes in software, under a sky that is not uniform, and where emissive
+                              * triangles alone light the scene with aim.direct on auto (docs/gather.md,
                               * "Rays"); lmgi_check chooses as lmgi_updater_create does */
     LMGI_GATHER_VIEWPORTS,   /* hemicubes, one draw per texel */
     LMGI_GATHER_INSTANCED,   /* hemicubes, one instanced draw per pass */
@@ -496,15 +497,18 @@ typedef enum {
     LMGI_INDIRECT_TILED,
     LMGI_INDIRECT_HASHGRID
 } lmgi_indirect_path;
-/* Where the approximate illumination maps (docs/aim.md) get direct light. SUNS (the default): directional
+/* Where the approximate illumination maps (docs/aim.md) get direct light. DEFAULT: EMITTERS with the rays
+ * gather where a scene is lit by emissive triangles alone, in closed form (no punctual light, no sky; the
+ * gather scheme on auto is then rays: docs/gather.md, "Near and far hits"), else SUNS. SUNS: directional
  * lights' computed per texel by shadow rays, photons bringing the rest (a sun's photons are spread over the
  * whole scene, a large level's ground included, so its direct light is the first to starve); PHOTONS: photon
  * first hits bring it all (the paper's form: blurred across shadow edges by the photon estimate's radius);
  * EMITTERS: emissive triangles' light computed per texel (closed form, sampled shadows) where the gather's
- * closed form suits the scene, photons bringing the rest (sharp contact shadows); ALL: emissive triangles'
- * and every punctual light's. */
+ * closed form suits the scene, photons bringing the rest (sharp contact shadows; the rays gather takes it
+ * at its near hits); ALL: emissive triangles' and every punctual light's. */
 typedef enum {
-    LMGI_AIM_DIRECT_SUNS = 0,
+    LMGI_AIM_DIRECT_DEFAULT = 0,
+    LMGI_AIM_DIRECT_SUNS,
     LMGI_AIM_DIRECT_EMITTERS,
     LMGI_AIM_DIRECT_ALL,
     LMGI_AIM_DIRECT_PHOTONS

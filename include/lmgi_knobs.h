@@ -125,15 +125,17 @@ static inline int lmgi_knob_is_pow2(double v)
       LMGI_CLI_ZERO_DEFAULT, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                       \
       "AIM refreshes a frame (default 4; a node moved after a still frame: all\n"                                  \
       "that its photons changed)")                                                                                 \
-    X(aim, direct, LMGI_KNOB_CHOICE, lmgi_aim_direct, LMGI_AIM_DIRECT_SUNS, 0, 0, 0, LMGI_NO_RULE,                \
+    X(aim, direct, LMGI_KNOB_CHOICE, lmgi_aim_direct, 0, 0, 0, 0, LMGI_NO_RULE,                                   \
       "--aim-direct", "M", LMGI_CLI_ZERO_NONE, LMGI_AIM_DIRECT_CHOICES,                                           \
-      LMGI_SWEEP(10, "aim_direct", "AIM direct light (0 suns, 3 photons, 1 emitters)", (0, 3, 1), (0, 3), 0),    \
-      "where the AIMs' direct light comes from: suns (the default: directional\n"                                \
-      "lights' computed per texel by shadow rays, photons bring the rest),\n"                                     \
-      "photons (first hits, the paper's form, blurred by the estimate's\n"                                       \
-      "radius), emitters (emissive triangles' light computed per texel: sharp\n"                                  \
-      "contact shadows, about 5x slower AIMs; the rays gather computes it at\n"                                   \
-      "its near hits, --direct-near) or all (every light's)")                                                      \
+      LMGI_SWEEP(10, "aim_direct", "AIM direct light (0 the scene's, 4 photons, 2 emitters)", (0, 4, 2), (0, 4), \
+                 0),                                                                                             \
+      "where the AIMs' direct light comes from: suns (directional lights'\n"                                      \
+      "computed per texel by shadow rays, photons bring the rest), photons\n"                                    \
+      "(first hits, the paper's form, blurred by the estimate's radius),\n"                                      \
+      "emitters (emissive triangles' light computed per texel: sharp contact\n"                                  \
+      "shadows, about 5x slower AIMs; the rays gather computes it at its near\n"                                 \
+      "hits, --direct-near) or all (every light's); default: emitters and the\n"                                 \
+      "rays gather where emissive triangles alone light the scene, else suns")                                    \
     X(aim, occluders, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, "--aim-occluders", "on|off",         \
       LMGI_CLI_ZERO_NONE, LMGI_ON_OFF_CHOICES,                                                                     \
       LMGI_SWEEP(16, "aim_occluders", "AIM hits seen from the texel (0 off, 1 on)", (0, 1), (), 0),           \
@@ -196,7 +198,9 @@ static inline int lmgi_knob_is_pow2(double v)
       "hemicubes by viewports, instanced or layered (layered has no\n"                                            \
       "multisampled target: coverage 1 unless given), or rays (Embree over each\n"                                \
       "texel's hemisphere, no hemicube); default: rays above 20,000 triangles on\n"                               \
-      "a software GL, else viewports (docs/gather.md, \"Rays\")")                                                 \
+      "a software GL, under a sky that is not uniform and where emissive\n"                                       \
+      "triangles alone light the scene (--aim-direct not given), else viewports\n"                               \
+      "(docs/gather.md, \"Rays\")")                                                                               \
     X(gather, emitter_light, LMGI_KNOB_CHOICE, lmgi_emitter_light, 0, 0, 0, 0, LMGI_NO_RULE, "--emitter-light", "M",\
       LMGI_CLI_ZERO_NONE, LMGI_EMITTER_LIGHT_CHOICES, LMGI_NO_SWEEP,                                               \
       "closed (the light of emissive triangles in closed form, visibility by\n"                                   \

@@ -692,6 +692,65 @@ static void test_scheme_chosen_with_the_settings(void **state)
     d.gather.scheme = LMGI_GATHER_DEFAULT;
     assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
     assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
+    assert_int_equal(s.stage.exact_direct, LM_EXACT_SUNS); /* a point light: the AIMs compute the suns' */
+    lmgi_free(sc);
+}
+
+/* A scene lit by emissive triangles alone (a lamp over a floor, no punctual light, no sky): on auto the rays
+ * gather, with the emitters' light computed in the AIMs and taken at the rays' near hits (docs/gather.md,
+ * "Scenes lit by emitters alone"). Either given keeps the other's old default: suns give hemicubes,
+ * hemicubes the suns. lmgi_get_updater_info tells what was chosen. */
+static void test_emitters_alone_chosen(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-0.5f, 2, -0.5f}, (float[3]){1, 0, 0}, (float[3]){0, 0, 1});
+    lmt_mesh_quad(&m[1], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    const char *path = lmt_write_scene("lamp_alone.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}]",
+                                       "[{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, "
+                                       "\"emissiveFactor\": [1, 1, 1]}, " GREY "]");
+    lmgi_scene *sc = NULL;
+    lmgi_error e;
+    assert_int_equal(load(path, &sc, &e), LMGI_OK);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    lm_frame_loop_settings s;
+    lm_error err;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.gather.scheme, LM_GATHER_RAYS);
+    assert_int_equal(s.stage.exact_direct, LM_EXACT_EMITTERS);
+    d.aim.direct = LMGI_AIM_DIRECT_SUNS;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
+    assert_int_equal(s.stage.exact_direct, LM_EXACT_SUNS);
+    d.aim.direct = LMGI_AIM_DIRECT_DEFAULT;
+    d.gather.scheme = LMGI_GATHER_VIEWPORTS;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
+    assert_int_equal(s.stage.exact_direct, LM_EXACT_SUNS);
+    d.gather.scheme = LMGI_GATHER_RAYS; /* the rays asked for: the emitters at their hits */
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.stage.exact_direct, LM_EXACT_EMITTERS);
+    d.gather.scheme = LMGI_GATHER_DEFAULT;
+    d.gather.emitter_light = LMGI_EMITTERS_DRAWN; /* drawn into hemicubes: nothing computes them */
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
+    assert_int_equal(s.stage.exact_direct, LM_EXACT_SUNS);
+
+    lmgi_context *ctx = NULL;
+    assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);
+    memset(&d, 0, sizeof d);
+    d.frame.width = d.frame.height = 0;
+    lmgi_updater *u = NULL;
+    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    lmgi_updater_info info;
+    lmgi_get_updater_info(u, &info);
+    assert_int_equal(info.aim.direct, LMGI_AIM_DIRECT_EMITTERS);
+    assert_int_equal(info.gather.scheme, LMGI_GATHER_RAYS);
+    lmgi_updater_free(u);
+    lmgi_context_free(ctx);
     lmgi_free(sc);
 }
 
@@ -710,6 +769,7 @@ int main(void)
         cmocka_unit_test(test_sparse_accessors),
         cmocka_unit_test(test_knob_table),
         cmocka_unit_test(test_scheme_chosen_with_the_settings),
+        cmocka_unit_test(test_emitters_alone_chosen),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -11,6 +11,7 @@
 #include "../charts/atlas_dilate.h"
 #include "../scene/scene_view.h"
 #include "../scene/sky.h"
+#include "../trace/emitter_light.h"
 #include "../update/bake_checkpoint.h"
 #include "../update/frame_loop.h"
 #include "lmgi_camera.h"
@@ -149,18 +150,32 @@ static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s
     s->cancel = r->cancel;
 }
 
-/* The gather scheme on auto: rays where the GL rasterizes in software and the level is large (a software
- * hemicube costs what the gather proxy's triangles cost, rays the log of the level's: docs/gather.md,
- * "Rays") and under any sky that is not uniform (a hemicube clears to one colour). */
-static lm_status choose_scheme(const lm_scene *scene, const lmgi_updater_desc *d, const lm_gl_context *gl,
+/* A scene lit by its emissive triangles alone, in closed form: no punctual or directional light, no sky,
+ * emitters not drawn into hemicubes. */
+static int lit_by_emitters_alone(const lm_scene *scene, const lm_frame_loop_settings *s)
+{
+    return scene->light_count == 0 && !scene->has_sky && s->emitter_light != 0 && lm_emitter_light_suits(scene);
+}
+
+/* The gather scheme and the AIMs' direct light on auto. Rays where the GL rasterizes in software and the
+ * level is large (a software hemicube costs what the gather proxy's triangles cost, rays the log of the
+ * level's: docs/gather.md, "Rays"), under any sky that is not uniform (a hemicube clears to one colour), and
+ * where emissive triangles alone light the scene: there the rays take their light at each near hit (the
+ * AIMs' direct light EMITTERS), which keeps the contact shadows a texel's mean blurs, for about twice the
+ * hemicube's time (docs/gather.md, "Near and far hits"). Elsewhere the AIMs compute the suns' light. */
+static lm_status choose_gather(const lm_scene *scene, const lmgi_updater_desc *d, const lm_gl_context *gl,
                                lm_frame_loop_settings *s, lm_error *err)
 {
+    int emitters_alone = d->aim.direct == LMGI_AIM_DIRECT_DEFAULT && lit_by_emitters_alone(scene, s);
     if (d->gather.scheme == LMGI_GATHER_DEFAULT &&
-        ((scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES && lm_gl_context_is_software(gl)) || !lm_sky_is_uniform(scene)))
+        ((scene->tri_count > LMGI_RAYS_ABOVE_TRIANGLES && lm_gl_context_is_software(gl)) ||
+         !lm_sky_is_uniform(scene) || emitters_alone))
         s->gather.scheme = LM_GATHER_RAYS;
     if (s->gather.scheme != LM_GATHER_RAYS && !lm_sky_is_uniform(scene))
         return lm_fail(err, LM_ERR_INVALID, "%s: a gradient or image sky needs the rays gather (--gather-scheme rays), "
                        "not hemicubes (%s)", scene->path, lm_gather_scheme_name(s->gather.scheme));
+    if (emitters_alone && s->gather.scheme == LM_GATHER_RAYS)
+        s->stage.exact_direct = LM_EXACT_EMITTERS;
     return LM_OK;
 }
 
@@ -183,7 +198,7 @@ lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d,
     gather_settings(&r, s);
     frame_settings(&r, s);
     s->gl = gl;
-    st = choose_scheme(scene, d, gl, s, err);
+    st = choose_gather(scene, d, gl, s, err);
     if (st != LM_OK)
         return st;
     lm_error why;
@@ -366,6 +381,15 @@ static uint32_t largest_group(const lm_photons *ph)
     return most;
 }
 
+/* The lmgi_aim_direct value of exact_direct (lm_exact_direct_of's inverse). */
+static lmgi_aim_direct aim_direct_of(int exact)
+{
+    return exact == LM_EXACT_NONE        ? LMGI_AIM_DIRECT_PHOTONS
+           : exact == LM_EXACT_EMITTERS ? LMGI_AIM_DIRECT_EMITTERS
+           : exact == LM_EXACT_ALL      ? LMGI_AIM_DIRECT_ALL
+                                        : LMGI_AIM_DIRECT_SUNS;
+}
+
 void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
 {
     if (!info)
@@ -380,6 +404,7 @@ void lmgi_get_updater_info(const lmgi_updater *u, lmgi_updater_info *info)
     const lm_frame_loop_settings *s = lm_frame_loop_get_settings(u->loop);
     info->gather.coverage = s->gather.coverage_samples;
     info->gather.scheme = (lmgi_gather_scheme)(s->gather.scheme + 1);
+    info->aim.direct = aim_direct_of(s->stage.exact_direct);
     info->gather.emitter_light = s->emitter_light ? LMGI_EMITTERS_CLOSED_FORM : LMGI_EMITTERS_DRAWN;
     info->tiled.radius = lm_frame_loop_photon_radius(u->loop);
     info->gather_scheme = lm_gather_scheme_name(s->gather.scheme);

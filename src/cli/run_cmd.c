@@ -189,6 +189,14 @@ static lmgi_status write_caustics(run_state *r, lmgi_error *err)
     return st;
 }
 
+/* The --aim-direct name of a resolved value. */
+static const char *aim_direct_name(lmgi_aim_direct v)
+{
+#define AIM_DIRECT_NAME(name, value) v == value ? name:
+    return LMGI_AIM_DIRECT_CHOICES(AIM_DIRECT_NAME) "?";
+#undef AIM_DIRECT_NAME
+}
+
 static void summary(const run_state *r, int frames)
 {
     const double *s = r->sum_ms;
@@ -209,6 +217,7 @@ static void summary(const run_state *r, int frames)
                    ui.gather.emitter_rays);
         else
             printf("%u emissive triangles drawn\n", ui.emissive_triangles);
+        printf("aims        N %d, direct light: %s (--aim-direct)\n", ui.aim.nearest, aim_direct_name(ui.aim.direct));
     }
     lmgi_info in;
     lmgi_get_info(r->sc, &in);

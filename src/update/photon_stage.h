@@ -72,10 +72,12 @@ typedef struct lm_photon_stage lm_photon_stage;
 enum { LM_EXACT_NONE = 0, LM_EXACT_EMITTERS = 1, LM_EXACT_ALL = 2, LM_EXACT_SUNS = 3 };
 
 void lm_photon_stage_settings_default(lm_photon_stage_settings *s);
-/* exact_direct for lmgi.h's lmgi_aim_direct value v (0 suns, 1 emitters, 2 all, 3 photons). */
+/* exact_direct for lmgi.h's lmgi_aim_direct value v (1 suns, 2 emitters, 3 all, 4 photons; 0, the scene's
+ * choice, is SUNS here: lmgi_updater_create makes it EMITTERS where emissive triangles alone light the
+ * scene). */
 static inline int lm_exact_direct_of(int v)
 {
-    return v == 3 ? LM_EXACT_NONE : v == 0 ? LM_EXACT_SUNS : v == 1 ? LM_EXACT_EMITTERS : LM_EXACT_ALL;
+    return v == 4 ? LM_EXACT_NONE : v == 2 ? LM_EXACT_EMITTERS : v == 3 ? LM_EXACT_ALL : LM_EXACT_SUNS;
 }
 /* Builds emitters, traces every photon and fills every AIM (the first frame's state). `setup` (may be
  * NULL) gets the time of that full trace and refresh. The world (update/world.h) is borrowed and must
