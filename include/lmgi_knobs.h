@@ -161,13 +161,13 @@ static inline int lmgi_knob_is_pow2(double v)
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
       "a texel is regathered ahead of its surface, and shown at once, when\n"                                    \
       "the estimated change of its hemisphere (moved objects, changed AIMs)\n"                                   \
-      "exceeds F times the mean irradiance (default 1/32; off: whole\n"                                          \
+      "exceeds F times the mean irradiance (default 1/32; 0: off, whole\n"                                          \
       "surfaces only, the paper's order; docs/gather.md)")                                                         \
     X(gather, spread, LMGI_KNOB_INT, int, 3, 1, 64, 1, LMGI_NO_RULE, "--texel-spread", "R", LMGI_CLI_ZERO_OFF,       \
       LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                                              \
       "a texel waiting to be regathered after a change shows, until it is,\n"                                    \
       "the changes its neighbours within R texels were gathered with (default 3;\n"                             \
-      "off: its old value, so a changed region fills in texel by texel;\n"                                      \
+      "0: off, its old value, so a changed region fills in texel by texel;\n"                                      \
       "docs/gather.md, \"Progressive refinement\")")                                                             \
     X(gather, resolution, LMGI_KNOB_INT, int, 32, 2, 1024, 0, LMGI_NO_RULE, "--hemicube", "R", LMGI_CLI_ZERO_NONE,\
       LMGI_NO_CHOICES, LMGI_SWEEP(5, "hemicube", "hemicube resolution R", (16, 24, 32, 48, 64), (16, 32, 64), 0),\
