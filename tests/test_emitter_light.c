@@ -1,6 +1,6 @@
 /* The closed-form emitter light (trace/emitter_light.h): Lambert's formula against analytic irradiance,
- * clipping at the horizon, single- and double-sided emitters, and the sampled visibility against exact
- * half and full shadows. */
+ * clipping at the horizon (the shading normal's and the geometric one's), single- and double-sided
+ * emitters, and the sampled visibility against exact half and full shadows. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -92,9 +92,9 @@ static void test_sampled_visibility(void **state)
         const float at[3] = {xs[k], 1e-4f, 0.0f};
         double open = PI * lm_form_factor_rect(-0.5 - xs[k], 0.5 - xs[k], -0.5, 0.5, 2.0 - 1e-4);
         float e[3], again[3];
-        lm_emitter_irradiance(&el, at, n, 7u, e);
-        lm_emitter_irradiance(&el, at, n, 7u, again);
-        assert_memory_equal(e, again, sizeof e); /* same seed, same samples */
+        lm_emitter_irradiance(&el, at, n, NULL, 7u, e);
+        lm_emitter_irradiance(&el, at, n, n, 7u, again);
+        assert_memory_equal(e, again, sizeof e); /* same seed, same samples; ng = n cuts nothing */
         const double want[3] = {0.5 * open, open, 0.0};
         print_message("x = %+g: E %.6f (%.6f, %.6f), want %.6f\n", (double)xs[k], (double)e[0], (double)e[1],
                       (double)e[2], want[k]);
@@ -106,6 +106,27 @@ static void test_sampled_visibility(void **state)
             assert_true(e[0] == 0.0f);
         assert_true(fabs(e[1] - 0.5 * e[0]) <= 1e-6 * e[0] && fabs(e[2] - 0.25 * e[0]) <= 1e-6 * e[0]);
     }
+    /* A point of the emitter itself, lifted 1e-4 off its face (down, its front), whose shading normal leans
+     * 55 degrees from the face's (a slab lamp's smoothed edge): above the shading normal's horizon lies
+     * half the emitter's plane, at the lift's distance, and it read as lighting the point (cornell-suzanne's
+     * lamp gathered 7 times what its room gives it); above the geometric horizon too, none of it. */
+    const float on[3] = {0.2f, 2.0f - 1e-4f, 0.0f}, ng[3] = {0, -1, 0};
+    const float lean[3] = {sinf(55.0f * (float)PI / 180.0f), -cosf(55.0f * (float)PI / 180.0f), 0};
+    float self[3], kept[3];
+    lm_emitter_irradiance(&el, on, lean, NULL, 7u, self);
+    lm_emitter_irradiance(&el, on, lean, ng, 7u, kept);
+    print_message("a point of the emitter, shading normal leaning 55 degrees: E %.4f by the shading normal's "
+                  "horizon alone, %.4f by both\n", (double)self[0], (double)kept[0]);
+    assert_true(self[0] > 0.3f);
+    assert_true(kept[0] == 0.0f);
+    /* on the floor beside it, a shading normal leaning 30 degrees away: the emitter lies above the geometric
+     * horizon, which then changes nothing, to the bit */
+    const float floor_at[3] = {3.0f, 1e-4f, 0.0f}, up[3] = {0, 1, 0};
+    const float away[3] = {sinf(30.0f * (float)PI / 180.0f), cosf(30.0f * (float)PI / 180.0f), 0};
+    lm_emitter_irradiance(&el, floor_at, away, NULL, 7u, self);
+    lm_emitter_irradiance(&el, floor_at, away, up, 7u, kept);
+    assert_true(self[0] > 0.0f);
+    assert_memory_equal(self, kept, sizeof self);
     lm_emitter_light_free(&el);
     lmt_pipeline_free(&p);
 }

@@ -53,7 +53,7 @@ static void area(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, uint32_t seed, 
     float at[3], nrm[3], out[3];
     lm_v3_store(at, lm_add(p, lm_scale(n, d->lift)));
     lm_v3_store(nrm, n);
-    lm_emitter_irradiance(d->area, at, nrm, seed, out);
+    lm_emitter_irradiance(d->area, at, nrm, NULL, seed, out); /* n is the geometric normal here */
     for (int c = 0; c < 3; c++)
         e[c] += out[c];
 }

@@ -81,6 +81,16 @@ static int clip_to_horizon(const dvec *in, int n, dvec nrm, dvec *out)
     return m;
 }
 
+/* Whether a corner of q[0, m) lies below the horizon of nrm by more than rounding: where the shading normal
+ * is the geometric one, the second clip leaves the polygon as it was, to the bit. */
+static int dips_below(const dvec *q, int m, dvec nrm)
+{
+    for (int i = 0; i < m; i++)
+        if (ddot(nrm, q[i]) < -1e-9 * dlen(q[i]))
+            return 1;
+    return 0;
+}
+
 /* Lambert's formula: irradiance per unit radiance from polygon q[0, n) (relative to the point, above
  * its horizon) at a point with normal nrm. */
 static double lambert(const dvec *q, int n, dvec nrm)
@@ -175,7 +185,8 @@ static void sample_triangle(const lm_emitter_light *el, dvec p, dvec nrm, dvec f
     }
 }
 
-/* Fraction of polygon q[0, m) (3 or 4 corners, relative to p) that p sees, weighted by the integrand. */
+/* Fraction of polygon q[0, m) (3 to 5 corners, relative to p) that p sees, weighted by the integrand: its
+ * fan of triangles from q[0], the rays shared by area (the first at least one). */
 static double visibility(const lm_emitter_light *el, dvec p, dvec nrm, const dvec *q, int m, uint32_t seed)
 {
     dvec face = dcross(dsub(q[1], q[0]), dsub(q[2], q[0]));
@@ -183,24 +194,30 @@ static double visibility(const lm_emitter_light *el, dvec p, dvec nrm, const dve
     if (!(lf > 0.0))
         return 1.0;
     face = dscale(face, 1.0 / lf);
-    double a1 = 0.5 * dlen(dcross(dsub(q[1], q[0]), dsub(q[2], q[0])));
-    double a2 = m == 4 ? 0.5 * dlen(dcross(dsub(q[2], q[0]), dsub(q[3], q[0]))) : 0.0;
-    int k1 = m == 4 ? (int)lround(el->rays * a1 / (a1 + a2)) : el->rays;
-    k1 = k1 < 1 ? 1 : k1;
+    double area[3], total = 0.0;
+    for (int i = 0; i < m - 2; i++)
+        total += area[i] = 0.5 * dlen(dcross(dsub(q[i + 1], q[0]), dsub(q[i + 2], q[0])));
     double shift[2];
     lm_seed_shift(seed, shift);
     vis_sum vs = {0.0, 0.0};
-    const dvec t1[3] = {q[0], q[1], q[2]};
-    sample_triangle(el, p, nrm, face, t1, k1, shift, &vs);
-    if (m == 4 && el->rays - k1 > 0) {
-        const dvec t2[3] = {q[0], q[2], q[3]};
-        sample_triangle(el, p, nrm, face, t2, el->rays - k1, shift, &vs);
+    int given = 0;
+    double before = 0.0;
+    for (int i = 0; i < m - 2; i++) {
+        before += area[i];
+        int k = i == m - 3 ? el->rays - given : (int)lround(el->rays * before / total) - given;
+        if (i == 0)
+            k = k < 1 ? 1 : k;
+        if (k <= 0)
+            continue;
+        const dvec t[3] = {q[0], q[i + 1], q[i + 2]};
+        sample_triangle(el, p, nrm, face, t, k, shift, &vs);
+        given += k;
     }
     return vs.f > 0.0 ? vs.fv / vs.f : 1.0;
 }
 
-void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const float n[3], uint32_t seed,
-                           float out[3])
+void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const float n[3], const float ng[3],
+                           uint32_t seed, float out[3])
 {
     double e[3] = {0.0, 0.0, 0.0};
     dvec pd = dload(p), nrm = dload(n);
@@ -210,8 +227,13 @@ void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const f
         float v[3][3];
         for (int k = 0; k < 3; k++)
             lm_scene_vertex_world(el->scene, el->scene->tris[3 * (size_t)t + k], v[k]);
-        dvec q[4];
+        dvec q[5]; /* a triangle clipped to two horizons has at most 5 corners */
         int corners = visible_polygon(v, m->double_sided, pd, nrm, q);
+        if (ng && corners >= 3 && dips_below(q, corners, dload(ng))) { /* and above the geometric horizon */
+            dvec both[5];
+            corners = clip_to_horizon(q, corners, dload(ng), both);
+            memcpy(q, both, sizeof *q * (size_t)corners);
+        }
         double factor = corners >= 3 ? lambert(q, corners, nrm) : 0.0;
         if (!(factor > 0.0))
             continue;

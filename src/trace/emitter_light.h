@@ -49,9 +49,12 @@ int lm_emitter_light_suits(const lm_scene *s);
 lm_status lm_emitter_light_init(lm_emitter_light *el, const lm_scene *s, const lm_rt *rt, int rays, lm_error *err);
 void lm_emitter_light_free(lm_emitter_light *el);
 /* Irradiance at p (world), surface normal n (unit), from every emissive triangle; rays leave from p, so
- * lift p off its surface first. Thread-safe (Embree queries only). */
-void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const float n[3], uint32_t seed,
-                           float out[3]);
+ * lift p off its surface first. ng (unit, or NULL: n): the surface's geometric normal, where n is a
+ * shading normal that may lean away from it. Only what lies above both horizons lights p: a shading normal
+ * leaning over the surface's own plane (a slab lamp's smoothed edges) would otherwise see the emitter the
+ * point lies on, at the lift's distance. Thread-safe (Embree queries only). */
+void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const float n[3], const float ng[3],
+                           uint32_t seed, float out[3]);
 /* The unoccluded part alone for one triangle (world corners v[3][3]): E_j above, 0 when p is behind a
  * single-sided emitter or the triangle lies below p's horizon. */
 double lm_triangle_irradiance_factor(const float v[3][3], int double_sided, const float p[3], const float n[3]);

@@ -506,7 +506,7 @@ void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas 
         return;
     float eye[3], n[3], ng[3]; /* the view fill_views gives the texel */
     lm_gather_texel_frame(&g->set, s, a, texel, eye, n, ng);
-    lm_emitter_irradiance(g->emitters, eye, n, texel, e);
+    lm_emitter_irradiance(g->emitters, eye, n, ng, texel, e);
 }
 
 /* Whether the texel is covered (lm_texel_covered): straight out from its centre along the shading normal
@@ -717,8 +717,10 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
             e[0] = e[1] = e[2] = e[3] = 0.0f;
             if (texels[i] == LM_GATHER_NO_TEXEL)
                 continue;
-            if (g->emitters)
-                lm_emitter_irradiance(g->emitters, o, o + 12, texels[i], e);
+            if (g->emitters) {
+                const float view_ng[3] = {o[7], o[11], o[15]};
+                lm_emitter_irradiance(g->emitters, o, o + 12, view_ng, texels[i], e);
+            }
             if (g->rt && covered_at(g->rt, &g->set, s, a, texels[i]))
                 e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
             if (rim_ready(g)) {
@@ -790,7 +792,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
                 float b[3], t[3], ng[3] = {o[7], o[11], o[15]};
                 e[0] = e[1] = e[2] = e[3] = 0.0f;
                 if (g->emitters)
-                    lm_emitter_irradiance(g->emitters, o, o + 12, texels[first + (uint32_t)i], e);
+                    lm_emitter_irradiance(g->emitters, o, o + 12, ng, texels[first + (uint32_t)i], e);
                 for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
                     b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
                 lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[first + (uint32_t)i], r, &back);
