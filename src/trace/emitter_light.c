@@ -81,12 +81,12 @@ static int clip_to_horizon(const dvec *in, int n, dvec nrm, dvec *out)
     return m;
 }
 
-/* Whether a corner of q[0, m) lies below the horizon of nrm by more than rounding: where the shading normal
- * is the geometric one, the second clip leaves the polygon as it was, to the bit. */
+/* Whether a corner of q[0, m) lies below the horizon of nrm by more than a float normal's rounding: where
+ * the shading normal is the geometric one, the second clip leaves the polygon as it was. */
 static int dips_below(const dvec *q, int m, dvec nrm)
 {
     for (int i = 0; i < m; i++)
-        if (ddot(nrm, q[i]) < -1e-9 * dlen(q[i]))
+        if (ddot(nrm, q[i]) < -1e-5 * dlen(q[i]))
             return 1;
     return 0;
 }

@@ -52,7 +52,8 @@ void lm_emitter_light_free(lm_emitter_light *el);
  * lift p off its surface first. ng (unit, or NULL: n): the surface's geometric normal, where n is a
  * shading normal that may lean away from it. Only what lies above both horizons lights p: a shading normal
  * leaning over the surface's own plane (a slab lamp's smoothed edges) would otherwise see the emitter the
- * point lies on, at the lift's distance. Thread-safe (Embree queries only). */
+ * point lies on, at the lift's distance; where no corner lies below the geometric horizon by more than a
+ * float normal's rounding, the polygon is left as it was. Thread-safe (Embree queries only). */
 void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const float n[3], const float ng[3],
                            uint32_t seed, float out[3]);
 /* The unoccluded part alone for one triangle (world corners v[3][3]): E_j above, 0 when p is behind a
