@@ -713,30 +713,33 @@ static void test_emitters_alone_chosen(void **state)
     lmgi_scene *sc = NULL;
     lmgi_error e;
     assert_int_equal(load(path, &sc, &e), LMGI_OK);
+    /* {aim.direct, gather.scheme, emitter_light} given -> the scheme and the AIMs' direct light chosen */
+    static const struct {
+        lmgi_aim_direct direct;
+        lmgi_gather_scheme scheme;
+        lmgi_emitter_light emitters;
+        lm_gather_scheme want_scheme;
+        int want_direct;
+    } cases[] = {
+        {LMGI_AIM_DIRECT_DEFAULT, LMGI_GATHER_DEFAULT, LMGI_EMITTERS_AUTO, LM_GATHER_RAYS, LM_EXACT_EMITTERS},
+        {LMGI_AIM_DIRECT_SUNS, LMGI_GATHER_DEFAULT, LMGI_EMITTERS_AUTO, LM_GATHER_VIEWPORTS, LM_EXACT_SUNS},
+        {LMGI_AIM_DIRECT_DEFAULT, LMGI_GATHER_VIEWPORTS, LMGI_EMITTERS_AUTO, LM_GATHER_VIEWPORTS, LM_EXACT_SUNS},
+        {LMGI_AIM_DIRECT_DEFAULT, LMGI_GATHER_RAYS, LMGI_EMITTERS_AUTO, LM_GATHER_RAYS, LM_EXACT_EMITTERS},
+        /* drawn into hemicubes: nothing computes them */
+        {LMGI_AIM_DIRECT_DEFAULT, LMGI_GATHER_DEFAULT, LMGI_EMITTERS_DRAWN, LM_GATHER_VIEWPORTS, LM_EXACT_SUNS},
+    };
     lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
-    lm_frame_loop_settings s;
-    lm_error err;
-    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
-    assert_int_equal(s.gather.scheme, LM_GATHER_RAYS);
-    assert_int_equal(s.stage.exact_direct, LM_EXACT_EMITTERS);
-    d.aim.direct = LMGI_AIM_DIRECT_SUNS;
-    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
-    assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
-    assert_int_equal(s.stage.exact_direct, LM_EXACT_SUNS);
-    d.aim.direct = LMGI_AIM_DIRECT_DEFAULT;
-    d.gather.scheme = LMGI_GATHER_VIEWPORTS;
-    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
-    assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
-    assert_int_equal(s.stage.exact_direct, LM_EXACT_SUNS);
-    d.gather.scheme = LMGI_GATHER_RAYS; /* the rays asked for: the emitters at their hits */
-    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
-    assert_int_equal(s.stage.exact_direct, LM_EXACT_EMITTERS);
-    d.gather.scheme = LMGI_GATHER_DEFAULT;
-    d.gather.emitter_light = LMGI_EMITTERS_DRAWN; /* drawn into hemicubes: nothing computes them */
-    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
-    assert_int_equal(s.gather.scheme, LM_GATHER_VIEWPORTS);
-    assert_int_equal(s.stage.exact_direct, LM_EXACT_SUNS);
+    for (size_t k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        memset(&d, 0, sizeof d);
+        d.aim.direct = cases[k].direct;
+        d.gather.scheme = cases[k].scheme;
+        d.gather.emitter_light = cases[k].emitters;
+        lm_frame_loop_settings s;
+        lm_error err;
+        assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+        assert_int_equal(s.gather.scheme, cases[k].want_scheme);
+        assert_int_equal(s.stage.exact_direct, cases[k].want_direct);
+    }
 
     lmgi_context *ctx = NULL;
     assert_int_equal(lmgi_context_create(NULL, &ctx, &e), LMGI_OK);

@@ -46,6 +46,22 @@ static lmgi_scene *load_as_run(const char *path, int target_texels)
     return sc;
 }
 
+/* A scene lit by its emissive triangles alone, loaded as `lmgi check` loads it, and the settings it
+ * resolves for it from the defaults (lm_updater_settings): the rays gather, the emitters' light at its
+ * near hits, asserted. */
+static lmgi_scene *load_as_check(const char *path, lm_frame_loop_settings *ls)
+{
+    lmgi_scene *sc = load_as_run(path, 0);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    lm_error err;
+    if (lm_updater_settings(sc->scene, &d, NULL, ls, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(ls->gather.scheme, LM_GATHER_RAYS);
+    assert_int_equal(ls->stage.exact_direct, LM_EXACT_EMITTERS);
+    return sc;
+}
+
 static void ref_settings(lm_ref_settings *rs, float target_error)
 {
     lm_ref_settings_default(rs);
@@ -199,15 +215,8 @@ static void test_shared_cornell_box_direct_at_hits(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
-    lmgi_scene *sc = load_as_run(path, 0);
-    lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
     lm_frame_loop_settings ls;
-    lm_error err;
-    if (lm_updater_settings(sc->scene, &d, NULL, &ls, &err) != LM_OK)
-        fail_msg("%s", err.msg);
-    assert_int_equal(ls.gather.scheme, LM_GATHER_RAYS);
-    assert_int_equal(ls.stage.exact_direct, LM_EXACT_EMITTERS);
+    lmgi_scene *sc = load_as_check(path, &ls);
     ls.width = ls.height = CHECK_SIZE;
     check_small_box("shared Cornell box at lmgi check's defaults: the rays gather, emitters' light at its hits", sc,
                     &ls, MIN_PIXELS, 1);
@@ -379,19 +388,14 @@ static void test_cornell_suzanne_bounce_pass(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf"));
-    lmgi_scene *sc = load_as_run(path, 0);
-    lmgi_updater_desc d;
-    memset(&d, 0, sizeof d);
     lm_frame_loop_settings ls;
-    lm_error err;
-    if (lm_updater_settings(sc->scene, &d, NULL, &ls, &err) != LM_OK)
-        fail_msg("%s", err.msg);
-    assert_int_equal(ls.gather.scheme, LM_GATHER_RAYS);
+    lmgi_scene *sc = load_as_check(path, &ls);
     ls.width = ls.height = SIZE;
     ls.bounce_passes = 1;
     lm_ref_settings rs;
     ref_settings(&rs, REF_ERROR);
     lm_frame_check c;
+    lm_error err;
     if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
         fail_msg("%s", err.msg);
     assert_frame("cornell-suzanne after a bounce pass", sc, &c, 0.03, 0.06, 0.1);
