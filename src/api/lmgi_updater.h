@@ -8,7 +8,8 @@
 
 /* The frame loop's settings for a desc (its zeros the defaults), each field checked: LM_ERR_INVALID naming
  * the field and its range. The gather scheme and the AIMs' direct light on auto are chosen for the scene
- * and the GL context gl (s->gl), so that an updater and lmgi_check's run gather alike. s->progress is the caller's to set. */
+ * and the GL context gl (s->gl), so that an updater and lmgi_check's run gather alike. s->progress is the
+ * caller's to set. */
 lm_status lm_updater_settings(const lm_scene *scene, const lmgi_updater_desc *d, lm_gl_context *gl,
                               lm_frame_loop_settings *s, lm_error *err);
 

@@ -220,7 +220,7 @@ void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const f
                            uint32_t seed, float out[3])
 {
     double e[3] = {0.0, 0.0, 0.0};
-    dvec pd = dload(p), nrm = dload(n);
+    dvec pd = dload(p), nrm = dload(n), geo = ng ? dload(ng) : nrm;
     for (int j = 0; j < el->count; j++) {
         uint32_t t = el->tris[j];
         const lm_material *m = &el->scene->materials[el->scene->tri_material[t]];
@@ -229,9 +229,9 @@ void lm_emitter_irradiance(const lm_emitter_light *el, const float p[3], const f
             lm_scene_vertex_world(el->scene, el->scene->tris[3 * (size_t)t + k], v[k]);
         dvec q[5]; /* a triangle clipped to two horizons has at most 5 corners */
         int corners = visible_polygon(v, m->double_sided, pd, nrm, q);
-        if (ng && corners >= 3 && dips_below(q, corners, dload(ng))) { /* and above the geometric horizon */
+        if (ng && corners >= 3 && dips_below(q, corners, geo)) { /* and above the geometric horizon */
             dvec both[5];
-            corners = clip_to_horizon(q, corners, dload(ng), both);
+            corners = clip_to_horizon(q, corners, geo, both);
             memcpy(q, both, sizeof *q * (size_t)corners);
         }
         double factor = corners >= 3 ? lambert(q, corners, nrm) : 0.0;

@@ -717,14 +717,13 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
             e[0] = e[1] = e[2] = e[3] = 0.0f;
             if (texels[i] == LM_GATHER_NO_TEXEL)
                 continue;
-            if (g->emitters) {
-                const float view_ng[3] = {o[7], o[11], o[15]};
-                lm_emitter_irradiance(g->emitters, o, o + 12, view_ng, texels[i], e);
-            }
+            float ng[3] = {o[7], o[11], o[15]}; /* the view's geometric normal */
+            if (g->emitters)
+                lm_emitter_irradiance(g->emitters, o, o + 12, ng, texels[i], e);
             if (g->rt && covered_at(g->rt, &g->set, s, a, texels[i]))
                 e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
             if (rim_ready(g)) {
-                float b[3], t[3], r[3], ng[3] = {o[7], o[11], o[15]};
+                float b[3], t[3], r[3];
                 for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
                     b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
                 lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[i], r, NULL);
