@@ -948,23 +948,22 @@ static void test_emitter_at_the_rays_hits(void **state)
     lmt_pipeline_free(&p);
 }
 
-/* The punctual lights' cosine on the shading normal, as the reference and the frame's direct pass take it:
- * two 200 m floors side by side (y = 0, albedo 0.5) under a sun 30 degrees from vertical towards +x
+/* Two 200 m floors side by side (y = 0, albedo 0.5) under a sun 30 degrees from vertical towards +x
  * (intensity 2), their vertex normals tilted about z: the +x floor's 40 degrees towards the sun (10 degrees
- * from it), the -x floor's 70 degrees away (100 degrees: none of the sun, though its faces are lit). An AIM
- * texel's sun part is rho / pi E cos(ns, l) (the geometric normal's cos 30 gives both floors 0.2757: 12%
- * low on the one, lit where it is dark on the other), and a receiver 2 m over the +x floor gathers
- * rho E cos(ns, l) F at the rays' hits. On truck-town's smooth terrain the two normals differ by tens of
- * degrees: the grass beside the retaining wall gave it half its light (docs/aim.md, "Suns"). */
-static void test_sun_cosine_on_shading_normals(void **state)
+ * from it), the -x floor's 70 degrees away (100 degrees: none of the sun, though its faces are lit); and a
+ * 10 cm receiver 2 m over the +x floor at x = FLOOR_RX. Loaded into p at 8 m texels; tilt: the floors'
+ * tilts (radians), l: the unit direction towards the sun. */
+#define FLOOR_RX 100.0f
+#define FLOOR_H 2.0f
+static void tilted_floors(lmt_pipeline *p, double tilt[2], double l[3])
 {
-    (void)state;
     lmt_mesh m[3];
     memset(m, 0, sizeof m);
     lmt_mesh_quad(&m[0], (float[3]){0, 0, 100}, (float[3]){200, 0, 0}, (float[3]){0, 0, -200});
     lmt_mesh_quad(&m[1], (float[3]){-200, 0, 100}, (float[3]){200, 0, 0}, (float[3]){0, 0, -200});
-    const float h = 2.0f, half = 0.05f, rx = 100.0f;
-    lmt_mesh_quad(&m[2], (float[3]){rx - half, h, -half}, (float[3]){2 * half, 0, 0}, (float[3]){0, 0, 2 * half});
+    const float half = 0.05f;
+    lmt_mesh_quad(&m[2], (float[3]){FLOOR_RX - half, FLOOR_H, -half}, (float[3]){2 * half, 0, 0},
+                  (float[3]){0, 0, 2 * half});
     /* the light's -Z turned down (-90 degrees about x), then 30 degrees about z towards -x */
     const char *path = lmt_write_scene(
         "sun_tilted.gltf", m, 3,
@@ -973,27 +972,42 @@ static void test_sun_cosine_on_shading_normals(void **state)
         "{\"light\": 0}}}]",
         "[" LMT_DIFFUSE(0.5) ", " LMT_DIFFUSE(0.5) ", " LMT_DIFFUSE(0.5) "], "
         LMT_LIGHTS("{\"type\": \"directional\", \"intensity\": 2}"));
-    lmt_pipeline p;
-    lmt_pipeline_load(&p, path, 8.0f);
-    const double tilt[2] = {40.0 * PI / 180.0, -70.0 * PI / 180.0};
-    for (uint32_t tri = 0; tri < p.s->tri_count; tri++) {
-        uint32_t node = p.s->tri_node[tri];
+    lmt_pipeline_load(p, path, 8.0f);
+    tilt[0] = 40.0 * PI / 180.0, tilt[1] = -70.0 * PI / 180.0;
+    for (uint32_t tri = 0; tri < p->s->tri_count; tri++) {
+        uint32_t node = p->s->tri_node[tri];
         for (int k = 0; node <= 2 && k < 3; k++) {
-            float *n = p.s->normals + 3 * (size_t)p.s->tris[3 * (size_t)tri + k];
+            float *n = p->s->normals + 3 * (size_t)p->s->tris[3 * (size_t)tri + k];
             n[0] = (float)sin(tilt[node - 1]), n[1] = (float)cos(tilt[node - 1]), n[2] = 0.0f;
         }
     }
-    rebuild_atlas(p.s, &p.su, 8.0f, &p.atlas);
+    rebuild_atlas(p->s, &p->su, 8.0f, &p->atlas);
     lm_error err;
-    lm_rt_free(p.rt); /* a flat triangle's shading normal is the BVH's */
-    assert_int_equal(lm_rt_build(p.s, &p.su, &p.rt, &err), LM_OK);
-    p.w.rt = p.rt;
-    const lm_emitter *sun = &p.em.e[0];
+    lm_rt_free(p->rt); /* a flat triangle's shading normal is the BVH's */
+    assert_int_equal(lm_rt_build(p->s, &p->su, &p->rt, &err), LM_OK);
+    p->w.rt = p->rt;
+    const lm_emitter *sun = &p->em.e[0];
     assert_int_equal(sun->kind, LM_EMIT_DIRECTIONAL);
-    const double l[3] = {-sun->dir[0], -sun->dir[1], -sun->dir[2]};
+    for (int k = 0; k < 3; k++)
+        l[k] = -sun->dir[k];
     print_message("towards the sun: %.4f %.4f %.4f (want 0.5 0.866 0)\n", l[0], l[1], l[2]);
     assert_float_equal(l[0], 0.5, 1e-4);
     assert_float_equal(l[1], cos(PI / 6), 1e-4);
+}
+
+/* The punctual lights' cosine on the shading normal, as the reference and the frame's direct pass take it,
+ * on tilted_floors. An AIM texel's sun part is rho / pi E cos(ns, l) (the geometric normal's cos 30 gives
+ * both floors 0.2757: 12% low on the one, lit where it is dark on the other), and the receiver gathers
+ * rho E cos(ns, l) F at the rays' hits. On truck-town's smooth terrain the two normals differ by tens of
+ * degrees: the grass beside the retaining wall gave it half its light (docs/aim.md, "Suns"). */
+static void test_sun_cosine_on_shading_normals(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    double tilt[2], l[3];
+    tilted_floors(&p, tilt, l);
+    const float rx = FLOOR_RX, h = FLOOR_H;
+    lm_error err;
     lm_photon_stage_settings ps;
     lm_photon_stage_settings_default(&ps);
     ps.photons.total_photons = 20000;
@@ -1024,6 +1038,48 @@ static void test_sun_cosine_on_shading_normals(void **state)
                   100.0 * (got[0] / E - 1.0));
     assert_true(fabs(got[0] / E - 1.0) < 0.02);
     free(rgba);
+    lm_photon_stage_free(st);
+    lmt_pipeline_free(&p);
+}
+
+/* Photons on shading normals (lm_shading_arrival_weight): on tilted_floors with the sun's light carried by
+ * photons alone (`--aim-direct photons`), the AIM's mean over each floor's inner texels is rho / pi E cos(ns,
+ * l), the exact sun part above: 0.3135 on the +x floor and 0 on the -x floor. A photon's density there
+ * follows the geometric cosine, and unweighted both floors read 0.2757: 12% low on the one and lit where
+ * the reference, the frame and the exact direct light see it dark. Measured (200,000 photons, 400 texels a
+ * floor): 0.3135 and 0.0000; unweighted, the +x floor read 0.2757. */
+static void test_photons_on_shading_normals(void **state)
+{
+    (void)state;
+    lmt_pipeline p;
+    double tilt[2], l[3];
+    tilted_floors(&p, tilt, l);
+    lm_photon_stage_settings ps;
+    lm_photon_stage_settings_default(&ps);
+    ps.photons.total_photons = 200000;
+    ps.exact_direct = LM_EXACT_NONE;
+    lm_photon_stage *st = NULL;
+    lm_error err;
+    if (lm_photon_stage_create(&p.w, &ps, &st, NULL, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    const lm_aim *aim = lm_photon_stage_aim(st);
+    for (int k = 0; k < 2; k++) {
+        double want = 0.5 / PI * 2.0 * fmax(0.0, sin(tilt[k]) * l[0] + cos(tilt[k]) * l[1]), sum = 0.0;
+        uint32_t n = 0;
+        for (uint32_t i = 0; i < p.atlas.texel_count; i++) {
+            const lm_texel *t = &p.atlas.texels[i];
+            /* inner texels of floor k (node 1 + k), away from its edges and from the seam at x = 0 */
+            if (p.s->tri_node[t->tri] != 1 + (uint32_t)k || fabsf(t->pos[2]) > 80.0f ||
+                fabsf(fabsf(t->pos[0]) - 100.0f) > 80.0f)
+                continue;
+            sum += aim->rgb[3 * ((size_t)t->y * p.atlas.width + t->x)], n++;
+        }
+        assert_true(n > 100);
+        print_message("floor tilted %+.0f degrees, photons alone: the AIM's mean %.4f over %u texels, rho / pi E "
+                      "cos(ns, l) %.4f (cos(ng, l): %.4f)\n", tilt[k] * 180.0 / PI, sum / n, n, want,
+                      0.5 / PI * 2.0 * l[1]);
+        assert_true(fabs(sum / n - want) < 0.02 * 0.3135);
+    }
     lm_photon_stage_free(st);
     lmt_pipeline_free(&p);
 }
@@ -2151,6 +2207,7 @@ int main(void)
         cmocka_unit_test(test_sun_at_the_rays_hits),
         cmocka_unit_test(test_emitter_at_the_rays_hits),
         cmocka_unit_test(test_sun_cosine_on_shading_normals),
+        cmocka_unit_test(test_photons_on_shading_normals),
         cmocka_unit_test(test_cornell_box_against_reference),
         cmocka_unit_test(test_schemes_agree),
         cmocka_unit_test(test_no_banding_under_the_ceiling),

@@ -228,14 +228,19 @@ int ph_trace_photon(const lm_photons *ph, ph_job *j, ph_buffer *buf)
         }
         lm_shading sh;
         lm_shading_from_hit(ph->scene, &hit, org, dir, &sh);
+        float w = lm_shading_arrival_weight(&sh, dir); /* shading normals: what the reference receives */
+        flux[0] *= w, flux[1] *= w, flux[2] *= w;
         /* The vertex is recorded after the scatter (with the direction and flux it arrived with): by
          * then the shading's stores have left the store buffer, and copying them does not stall. */
         float in_dir[3] = {dir[0], dir[1], dir[2]}, in_flux[3] = {flux[0], flux[1], flux[2]};
-        int scattered = scatter(ph, aim, id, b, &sh, org, dir, flux);
+        int scattered = w > 0.0f && scatter(ph, aim, id, b, &sh, org, dir, flux);
         if (!push_vertex(ph, buf, &sh, in_dir, in_flux, hit.t, b, b > 0 && specular_so_far)) {
             ok = 0;
             break;
         }
+        if (!(w > 0.0f)) /* arrived behind its shading normal: recorded (a node moving into its path must
+                          * find it) but holds nothing */
+            buf->v[buf->len - 1].surface = -1;
         int specular = lm_material_is_specular(sh.material->cls);
         specular_so_far = specular_so_far && specular;
         specular_run = specular ? specular_run + 1 : 0;

@@ -1,6 +1,7 @@
 /* Hit point attributes for light transport (shading.h). */
 #include "shading.h"
 
+#include <math.h>
 #include <string.h>
 
 #include "../core/vecmath.h"
@@ -78,4 +79,22 @@ void lm_shading_from_hit(const lm_scene *s, const lm_rt_hit *hit, const float or
     sh->node = hit->node;
     sh->surface = hit->surface;
     sh->tri = hit->tri;
+}
+
+/* Normals agreeing within this (|ratio - 1|) differ by rounding alone: the weight stays exactly 1, so a
+ * flat triangle's photons are the same bits as without the weight. */
+#define LM_ARRIVAL_SAME 1e-4f
+
+float lm_shading_arrival_weight(const lm_shading *sh, const float dir[3])
+{
+    if (lm_material_is_specular(sh->material->cls))
+        return 1.0f;
+    lm_vec3 d = lm_v3_load(dir), ng = lm_v3_load(sh->ng), ns = lm_v3_load(sh->ns);
+    float cg = lm_dot(d, ng), cs = lm_dot(d, ns);
+    if (!(fabsf(cg) > 0.0f))
+        return 1.0f;
+    float w = cs / cg; /* the same sign when both normals face dir's side, negative when ns faces away */
+    if (fabsf(w - 1.0f) <= LM_ARRIVAL_SAME)
+        return 1.0f;
+    return w > 0.0f ? w : 0.0f;
 }
