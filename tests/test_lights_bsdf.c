@@ -509,6 +509,47 @@ static void shading_up(lm_shading *sh, lm_material_class cls, float albedo)
     sh->material = &g_mat;
 }
 
+/* A photon at a diffuse face whose shading normal leans 40 degrees (shading.h, Veach 1997 section 5.3):
+ * arriving 30 degrees off the face's normal, 10 off the shading normal, its weight is cos 10 / cos 30;
+ * arriving behind the shading normal, 0; on a flat face, exactly 1. Its bounce (lm_shading_for_bounce)
+ * leaves with the geometric cosine and the albedo as its weight: mean weight 0.6 and mean cos(ng) 2/3 over
+ * a stratified hemisphere. Drawn about the leaning normal, the directions below the face were lost:
+ * measured mean weight 0.530, 12% of the albedo, (1 - cos 40) / 2 of the lobe. Glossy faces keep theirs. */
+static void test_photons_on_leaning_normals(void **state)
+{
+    (void)state;
+    lm_shading sh, flat;
+    shading_up(&sh, LM_MAT_DIFFUSE, 0.6f);
+    float in30[3] = {(float)-sin(PI / 6), (float)-cos(PI / 6), 0.0f}, in_behind[3] = {0.9f, -0.43589f, 0.0f};
+    assert_true(lm_shading_arrival_weight(&sh, in30) == 1.0f);
+    assert_true(lm_shading_for_bounce(&sh, &flat) == &sh);
+    sh.ns[0] = (float)sin(40.0 * PI / 180.0), sh.ns[1] = (float)cos(40.0 * PI / 180.0);
+    assert_float_equal(lm_shading_arrival_weight(&sh, in30), cos(PI / 18) / cos(PI / 6), 1e-5);
+    assert_true(lm_shading_arrival_weight(&sh, in_behind) == 0.0f);
+    double mean[2] = {0.0, 0.0}, cos_g = 0.0;
+    const int n = 128;
+    for (int k = 0; k < 2; k++) {
+        const lm_shading *b = k ? lm_shading_for_bounce(&sh, &flat) : &sh;
+        for (int i = 0; i < n * n; i++) {
+            float u[3] = {(i % n + 0.5f) / n, (i / n + 0.5f) / n, 0.5f};
+            lm_bsdf_sample_t bs;
+            if (!lm_bsdf_sample(b, in30, u, &bs))
+                continue;
+            mean[k] += bs.weight[0] / (n * n);
+            if (k)
+                cos_g += bs.wo[1] / (n * n);
+        }
+    }
+    print_message("leaning 40 degrees: bounce weight %.4f about the shading normal, %.4f about the face's (mean "
+                  "cos %.4f)\n", mean[0], mean[1], cos_g);
+    assert_float_equal(mean[1], 0.6, 1e-3);
+    assert_float_equal(cos_g, 2.0 / 3.0, 2e-3);
+    assert_true(mean[0] < 0.6 * 0.9);
+    shading_up(&sh, LM_MAT_GLOSSY, 0.6f);
+    sh.ns[0] = (float)sin(40.0 * PI / 180.0), sh.ns[1] = (float)cos(40.0 * PI / 180.0);
+    assert_true(lm_shading_for_bounce(&sh, &flat) == &sh);
+}
+
 static void test_diffuse_energy_and_cosine(void **state)
 {
     (void)state;
@@ -711,6 +752,7 @@ int main(void)
         cmocka_unit_test(test_shading_moved_node),
         cmocka_unit_test(test_hit_normals_follow_winding),
         cmocka_unit_test(test_static_shading_normals),
+        cmocka_unit_test(test_photons_on_leaning_normals),
         cmocka_unit_test(test_diffuse_energy_and_cosine),
         cmocka_unit_test(test_single_sided_back_absorbs),
         cmocka_unit_test(test_glossy_energy_and_consistency),

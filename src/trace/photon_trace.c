@@ -174,6 +174,8 @@ static int scatter(const lm_photons *ph, const lm_portals *aim, uint32_t id, uin
     uint32_t n = (uint32_t)lm_bsdf_sample_dims(sh);
     if (n)
         photon_samples(ph, id, d, n, u);
+    lm_shading flat;
+    sh = lm_shading_for_bounce(sh, &flat); /* a diffuse bounce leaves with the geometric cosine */
     lm_bsdf_sample_t bs;
     float n_out[3];
     double reach = aim_reach(aim, sh, dir, n_out);

@@ -81,20 +81,29 @@ void lm_shading_from_hit(const lm_scene *s, const lm_rt_hit *hit, const float or
     sh->tri = hit->tri;
 }
 
-/* Normals agreeing within this (|ratio - 1|) differ by rounding alone: the weight stays exactly 1, so a
- * flat triangle's photons are the same bits as without the weight. */
-#define LM_ARRIVAL_SAME 1e-4f
+int lm_shading_normals_lean(const lm_shading *sh)
+{
+    return lm_dot(lm_v3_load(sh->ns), lm_v3_load(sh->ng)) < LM_NORMALS_AGREE;
+}
 
 float lm_shading_arrival_weight(const lm_shading *sh, const float dir[3])
 {
-    if (lm_material_is_specular(sh->material->cls))
+    if (lm_material_is_specular(sh->material->cls) || !lm_shading_normals_lean(sh))
         return 1.0f;
-    lm_vec3 d = lm_v3_load(dir), ng = lm_v3_load(sh->ng), ns = lm_v3_load(sh->ns);
-    float cg = lm_dot(d, ng), cs = lm_dot(d, ns);
+    lm_vec3 d = lm_v3_load(dir);
+    float cg = lm_dot(d, lm_v3_load(sh->ng)), cs = lm_dot(d, lm_v3_load(sh->ns));
     if (!(fabsf(cg) > 0.0f))
-        return 1.0f;
-    float w = cs / cg; /* the same sign when both normals face dir's side, negative when ns faces away */
-    if (fabsf(w - 1.0f) <= LM_ARRIVAL_SAME)
-        return 1.0f;
+        return 0.0f; /* along the face: no density to weigh */
+    float w = cs / cg; /* ns lies on ng's side: the same sign unless dir comes from behind ns */
     return w > 0.0f ? w : 0.0f;
+}
+
+const lm_shading *lm_shading_for_bounce(const lm_shading *sh, lm_shading *flat)
+{
+    lm_material_class c = sh->material->cls;
+    if ((c != LM_MAT_DIFFUSE && c != LM_MAT_EMITTER) || !lm_shading_normals_lean(sh))
+        return sh;
+    *flat = *sh;
+    memcpy(flat->ns, flat->ng, sizeof flat->ns);
+    return flat;
 }
