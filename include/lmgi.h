@@ -88,6 +88,13 @@ typedef struct {
                              * is enough (else it keeps the atlas's); they count against target_texels. 0:
                              * the default, 15; LMGI_OFF: one texel size for all (docs/charts.md, "Bending
                              * normals") */
+    float open_need;        /* with a derived texel size: a surface whose texels are worth less than this
+                             * fraction of the level's, per area, by what its points see (its need, the
+                             * integral of 1/R^2 over it, R the harmonic mean distance its rays hit, misses
+                             * infinitely far: a town's open ground) gets texels in proportion to that
+                             * worth, up to 64 x coarser, and the rest of target_texels goes to the others
+                             * (a fraction in (0, 1]). 0, the default, and LMGI_OFF: texels in proportion to
+                             * area ('lmgi run' and 'lmgi check': 0.25; docs/charts.md, "Open surfaces") */
 } lmgi_options;
 
 typedef struct lmgi_scene lmgi_scene;

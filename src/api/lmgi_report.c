@@ -195,6 +195,9 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     if (sc->atlas.bent_surfaces > 0)
         fprintf(f, "            finer texels on %d surfaces whose shading normals bend (--bend; docs/charts.md)\n",
                 sc->atlas.bent_surfaces);
+    if (sc->atlas.open_surfaces > 0)
+        fprintf(f, "            coarser texels on %d surfaces that see mostly open sky (--open-need; docs/charts.md)\n",
+                sc->atlas.open_surfaces);
     fprintf(f, "effects\n");
     for (int i = 0; i < LM_EFFECT_COUNT; i++)
         fprintf(f, "  %s: %s — %s\n", lm_effect_name((lm_effect_id)i), sc->effects.on[i] ? "on" : "off",

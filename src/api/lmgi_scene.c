@@ -13,6 +13,7 @@
 #include "../core/timing.h"
 #include "../core/vecmath.h"
 #include "../trace/rt_scene.h"
+#include "../trace/surface_need.h"
 #include "../update/effects.h"
 #include "lmgi_context.h"
 #include "lmgi_scene.h"
@@ -34,6 +35,7 @@ void lmgi_options_init(lmgi_options *o)
     o->surface_cone_deg = so.cone_deg;
     o->max_atlas_size = ao.max_size;
     o->bend_deg = LM_BEND_DEFAULT_DEG;
+    o->open_need = 0.0f; /* off, unless a caller (lmgi run) asks for it */
 }
 
 lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err)
@@ -149,6 +151,9 @@ static lm_status check_options(const char *path, const lmgi_options *o, lm_error
     if (o->bend_deg != (float)LMGI_OFF && !(o->bend_deg > 0.0f && o->bend_deg <= 180.0f))
         return lm_fail(err, LM_ERR_INVALID, "%s: bend_deg %g must be in (0, 180] degrees, or LMGI_OFF", path,
                        (double)o->bend_deg);
+    if (o->open_need != (float)LMGI_OFF && !(o->open_need >= 0.0f && o->open_need <= 1.0f))
+        return lm_fail(err, LM_ERR_INVALID, "%s: open_need %g must be in (0, 1], 0 or LMGI_OFF", path,
+                       (double)o->open_need);
     if (o->max_atlas_size < 64 || o->max_atlas_size > 32768)
         return lm_fail(err, LM_ERR_INVALID, "%s: max_atlas_size (a lightmap page's side) %d must be in [64, 32768]",
                        path, o->max_atlas_size);
@@ -184,6 +189,26 @@ static lm_status find_surface_rects(lmgi_scene *sc, lm_error *err)
     return LM_OK;
 }
 
+/* Each surface's need and its rays' share that see the sky (trace/surface_need.h), where the open-surface rule
+ * applies (a derived texel size, lmgi_options.open_need in (0, 1]): *need (malloc'd, surface_count entries of
+ * each, the sky's after the need's; NULL where the rule does not apply). R is clamped at the texel the budget
+ * would give by area alone: nearer than that no texel resolves, and a level's contact lines would otherwise
+ * raise its mean need until its rooms' walls looked open. */
+static lm_status surface_needs(const lmgi_scene *sc, const lmgi_options *o, double **need, lm_error *err)
+{
+    *need = NULL;
+    size_t n = (size_t)sc->surfaces.surface_count;
+    if (o->texel_size > 0.0f || o->use_file_uv1 || !(o->open_need > 0.0f) || !n)
+        return LM_OK;
+    float ts = lm_atlas_default_texel_size(sc->scene, &sc->surfaces, o->target_texels);
+    if (!(*need = malloc(2 * n * sizeof **need)))
+        return lm_fail(err, LM_ERR_NOMEM, "%s: out of memory", sc->scene->path);
+    lm_status st = lm_surface_need(sc->rt, sc->scene, &sc->surfaces, ts, *need, *need + n, err);
+    if (st != LM_OK)
+        free(*need), *need = NULL;
+    return st;
+}
+
 static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_t size, const lmgi_options *o,
                        lm_error *err)
 {
@@ -211,6 +236,15 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     sc->have_surfaces = 1;
     double t2 = lm_now();
 
+    /* the BVH before the atlas: what each surface sees sets its texels (lm_atlas_options.open_need) */
+    st = lm_rt_build(sc->scene, &sc->surfaces, &sc->rt, err);
+    if (st != LM_OK)
+        return st;
+    double t3 = lm_now();
+    double *need = NULL;
+    if ((st = surface_needs(sc, o, &need, err)) != LM_OK)
+        return st;
+
     lm_atlas_options ao;
     lm_atlas_options_default(&ao);
     ao.texel_size = o->texel_size;
@@ -220,16 +254,15 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     ao.gutter = o->gutter;
     ao.use_file_uv1 = o->use_file_uv1;
     ao.max_size = o->max_atlas_size;
+    ao.need = need;
+    ao.sky = need ? need + sc->surfaces.surface_count : NULL;
+    ao.open_need = need ? o->open_need : 0.0f;
     st = lm_atlas_build(sc->scene, &sc->surfaces, &ao, &sc->atlas, err);
+    free(need);
     if (st != LM_OK)
         return st;
     sc->have_atlas = 1;
     if ((st = find_surface_rects(sc, err)) != LM_OK)
-        return st;
-    double t3 = lm_now();
-
-    st = lm_rt_build(sc->scene, &sc->surfaces, &sc->rt, err);
-    if (st != LM_OK)
         return st;
     double t4 = lm_now();
 
@@ -241,8 +274,8 @@ static lm_status build(lmgi_scene *sc, const char *path, const void *data, size_
     sc->timings.unwrap = sc->atlas.time_unwrap;
     sc->timings.pack = sc->atlas.time_pack;
     sc->timings.texels = sc->atlas.time_texels;
-    sc->timings.atlas = t3 - t2;
-    sc->timings.bvh = t4 - t3;
+    sc->timings.atlas = t4 - t3;
+    sc->timings.bvh = t3 - t2;
     sc->timings.total = t4 - t0;
     return LM_OK;
 }

@@ -20,6 +20,8 @@ void lm_atlas_options_default(lm_atlas_options *o)
     o->max_size = 8192;
     o->wall_texels = 0;
     o->bend_deg = 0.0f;
+    o->need = o->sky = NULL;
+    o->open_need = 0.0f;
 }
 
 float lm_atlas_default_texel_size(const lm_scene *s, const lm_surfaces *su, int target)
@@ -112,6 +114,8 @@ static lm_status check_options(const lm_scene *s, const lm_surfaces *su, const l
         return lm_fail(err, LM_ERR_INVALID, "charts: wall_texels %d must be in [0, 65536]", o->wall_texels);
     if (!(o->bend_deg >= 0.0f && o->bend_deg <= 180.0f))
         return lm_fail(err, LM_ERR_INVALID, "charts: bend_deg %g must be in [0, 180]", (double)o->bend_deg);
+    if (!(o->open_need >= 0.0f && o->open_need <= 1.0f))
+        return lm_fail(err, LM_ERR_INVALID, "charts: open_need %g must be in [0, 1]", (double)o->open_need);
     if (o->max_size < 4 * (o->gutter + 1) || o->max_size > 65536)
         return lm_fail(err, LM_ERR_INVALID, "charts: max_size %d must be in [%d, 65536]", o->max_size,
                        4 * (o->gutter + 1));
@@ -238,6 +242,28 @@ static double bend_scale(double bend, float ts, float bend_deg)
     return most / (bend * ts);
 }
 
+/* Per surface, its texel size over the atlas's for what its texels are worth (lm_atlas_options.open_need):
+ * 1, or where it is open and its need per area is q < open_need times the level's, sqrt(open_need / q) (its texel density
+ * then follows its need, meeting the rest's at q = open_need), at most LM_OPEN_COARSEN. All 1 where the level
+ * needs nothing (a lone floor under the sky). NULL: out of memory. */
+static double *open_scales(const lm_surfaces *su, const lm_atlas_options *o)
+{
+    double *scale = malloc(((size_t)su->surface_count + 1) * sizeof *scale), need = 0.0, area = 0.0;
+    if (!scale)
+        return NULL;
+    for (int f = 0; f < su->surface_count; f++) {
+        scale[f] = 1.0;
+        if (isfinite(o->need[f]) && o->need[f] >= 0.0)
+            need += o->need[f], area += su->surfaces[f].area;
+    }
+    for (int f = 0; need > 0.0 && area > 0.0 && f < su->surface_count; f++) {
+        double q = o->need[f] / (su->surfaces[f].area * (need / area)), limit = o->open_need;
+        if (su->surfaces[f].area > 0.0f && o->sky[f] >= LM_OPEN_SKY && q >= 0.0 && q < limit)
+            scale[f] = q > limit / (LM_OPEN_COARSEN * LM_OPEN_COARSEN) ? sqrt(limit / q) : LM_OPEN_COARSEN;
+    }
+    return scale;
+}
+
 static int cmp_u32(const void *a, const void *b)
 {
     uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
@@ -257,8 +283,8 @@ static void free_view(lmc_charts *v)
  * a small object unwrapped into several charts (a sphere's caps and sides) needs no more than one texel
  * when it is smaller than one, and a level of thousands of them could otherwise never meet a small
  * budget. The one chart's triangles overlap inside its texel, which then holds their summed area. */
-static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, const double *bend, float ts,
-                                const lm_atlas_options *o, lmc_charts *v, lm_error *err)
+static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, const double *bend, const double *open,
+                                float ts, const lm_atlas_options *o, lmc_charts *v, lm_error *err)
 {
     memset(v, 0, sizeof *v);
     v->tri_uv = c->tri_uv;
@@ -266,19 +292,21 @@ static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, cons
     if (!v->charts)
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
     for (int i = 0, end; i < c->count; i = end) {
-        int small = 1;
+        int small = 1, f = c->charts[i].surface;
         uint32_t tris = 0;
-        double scale = texel_scale(&su->surfaces[c->charts[i].surface], ts, o->wall_texels);
-        for (end = i; end < c->count && c->charts[end].surface == c->charts[i].surface; end++) {
+        /* an open surface's coarser size is its own, which the wall and bend rules refine from */
+        double coarse = open ? open[f] : 1.0, wall_scale = texel_scale(&su->surfaces[f], (float)(ts * coarse), o->wall_texels);
+        double scale = coarse * wall_scale;
+        /* a wall's finer texels come on top of the budget, a bending surface's count against it */
+        int wall = wall_scale < 1.0;
+        for (end = i; end < c->count && c->charts[end].surface == f; end++) {
             lmc_chart probe = c->charts[end];
             probe.texel_scale = scale;
-            small &= one_texel(&probe, ts) && scale == 1.0; /* a wall keeps its texels */
+            small &= one_texel(&probe, ts) && !wall; /* a wall keeps its texels */
             tris += c->charts[end].tri_count;
         }
-        /* a bending surface's finer texels count against the budget, a wall's do not */
-        int wall = scale < 1.0;
-        if (bend && !small && su->surfaces[c->charts[i].surface].area >= LM_BEND_MIN_TEXELS * ts * ts)
-            scale = fmin(scale, bend_scale(bend[c->charts[i].surface], ts, o->bend_deg));
+        if (bend && !small && su->surfaces[f].area >= LM_BEND_MIN_TEXELS * ts * ts * coarse * coarse)
+            scale = fmin(scale, coarse * bend_scale(bend[f], (float)(ts * coarse), o->bend_deg));
         for (int k = i; k < end; k += small ? end - i : 1) {
             lmc_chart *d = &v->charts[v->count++];
             *d = c->charts[k];
@@ -306,11 +334,11 @@ static lm_status collapse_small(const lmc_charts *c, const lm_surfaces *su, cons
 
 /* The charts packed at texel size ts, their triangles copied and their texels made, into out. */
 static lm_status lay_out(const lm_scene *s, const lm_surfaces *su, const lmc_charts *all, const float *pos,
-                         const double *bend, float ts, const lm_atlas_options *o, lm_atlas *out, double *budgeted,
-                         lm_error *err)
+                         const double *bend, const double *open, float ts, const lm_atlas_options *o, lm_atlas *out,
+                         double *budgeted, lm_error *err)
 {
     lmc_charts c;
-    lm_status st = collapse_small(all, su, bend, ts, o, &c, err);
+    lm_status st = collapse_small(all, su, bend, open, ts, o, &c, err);
     if (st != LM_OK)
         return st;
     st = lmc_pack(&c, su, ts, o->gutter, o->max_size, out, err);
@@ -320,9 +348,12 @@ static lm_status lay_out(const lm_scene *s, const lm_surfaces *su, const lmc_cha
         st = copy_chart_tris(&c, out, err);
     if (st == LM_OK)
         st = lmc_texels(s, &c, pos, out, err);
-    for (int i = 0; st == LM_OK && i < c.count; i++) /* a surface's charts are consecutive */
-        out->bent_surfaces += c.charts[i].texel_scale < 1.0 && !c.charts[i].on_top &&
-                              (i == 0 || c.charts[i - 1].surface != c.charts[i].surface);
+    for (int i = 0; st == LM_OK && i < c.count; i++) { /* a surface's charts are consecutive */
+        int first = i == 0 || c.charts[i - 1].surface != c.charts[i].surface, f = c.charts[i].surface;
+        double coarse = open ? open[f] : 1.0;
+        out->bent_surfaces += first && c.charts[i].texel_scale < coarse && !c.charts[i].on_top;
+        out->open_surfaces += first && coarse > 1.0;
+    }
     /* what counts against the budget: the walls' extra texels come on top of it */
     *budgeted = out->texel_count;
     for (uint32_t i = 0; st == LM_OK && i < out->texel_count; i++)
@@ -349,8 +380,10 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     if (!pos)
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
     double *bend = o->bend_deg > 0.0f ? surface_bends(s, su, pos) : NULL; /* NULL: the rule is off */
-    if (o->bend_deg > 0.0f && !bend) {
-        free(pos);
+    int open_rule = o->need && o->sky && o->open_need > 0.0f && !o->use_file_uv1 && o->texel_size <= 0.0f;
+    double *open = open_rule ? open_scales(su, o) : NULL;
+    if ((o->bend_deg > 0.0f && !bend) || (open_rule && !open)) {
+        free(pos), free(bend), free(open);
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory");
     }
     lmc_charts c;
@@ -358,7 +391,7 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
     double t1 = lm_now(), t2 = t1;
     if (st == LM_OK) {
         double count = 0.0;
-        st = lay_out(s, su, &c, pos, bend, ts, o, out, &count, err);
+        st = lay_out(s, su, &c, pos, bend, open, ts, o, out, &count, err);
         t2 = lm_now();
         /* A texel budget is met by the texel size, but charts round up to whole texels: a level of many small
          * charts got 10x the texels it asked for (scenes/many_rooms.glb at 2,000). The texel size is scaled
@@ -367,6 +400,10 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
         double target = o->target_texels > 0 ? o->target_texels : LM_ATLAS_DEFAULT_TEXELS;
         double ratio = count / target, best = fabs(ratio - 1.0);
         float best_ts = ts, last_ts = ts;
+        /* the texel sizes known too fine (over the budget) and too coarse: the count is not 1 / ts^2 where
+         * surfaces cross the wall or open rules' limits as ts moves (truck-town's town counts only once its
+         * surfaces hold more than wall_texels), and a step that jumps past the budget is bisected */
+        double too_fine = ratio > 1.0 ? ts : 0.0, too_coarse = ratio > 1.0 ? INFINITY : ts;
         /* ratio 0: every texel is a wall's, on top of the budget (a level in centimetres makes every surface
          * a wall), and the texel size has nothing to meet: scaling it by 0 made it 0 and the packing wrote
          * outside the atlas */
@@ -376,28 +413,39 @@ lm_status lm_atlas_build(const lm_scene *s, const lm_surfaces *su, const lm_atla
             /* towards the near edge of the band, not its middle: the texel size moves no further than
              * the budget needs (the shared Cornell box's small box, 6 texels a face at run's 1,800, read
              * +1% at the area's texel size and +6.5% a step further at 5 texels) */
-            last_ts = best_ts * (float)sqrt(ratio / (ratio > 1.0 ? 1.0 + LM_BUDGET_AIM : 1.0 - LM_BUDGET_AIM));
+            double step = best_ts * sqrt(ratio / (ratio > 1.0 ? 1.0 + LM_BUDGET_AIM : 1.0 - LM_BUDGET_AIM));
+            if (!(step > too_fine && step < too_coarse)) /* between the two, or halfway in scale past the one known */
+                step = too_fine > 0.0 && isfinite(too_coarse) ? sqrt(too_fine * too_coarse)
+                     : too_fine > 0.0                         ? 2.0 * too_fine
+                                                              : 0.5 * too_coarse;
+            last_ts = (float)step;
             lm_atlas_free(out);
-            st = lay_out(s, su, &c, pos, bend, last_ts, o, out, &count, err);
+            st = lay_out(s, su, &c, pos, bend, open, last_ts, o, out, &count, err);
             double r = count / target;
-            lm_debug("charts: texel size %g: %u texels (budget %.0f)", (double)last_ts, out->texel_count, target);
-            /* kept only if nearer, and if the count answered the texel size at least a quarter as much as the
-             * area says (1 / ratio): charts already at their fewest texels would otherwise take texels of
-             * hundreds of metres for a few texels fewer (truck-town at run's 1,800) */
-            if (st != LM_OK || !(fabs(r - 1.0) < best - 0.01) || (ratio > 1.0 && r > 0.75 * ratio + 0.25))
+            lm_debug("charts: texel size %g: %u texels, %.0f counted (budget %.0f)", (double)last_ts, out->texel_count,
+                     count, target);
+            /* stop where the count answered a coarser texel size less than a quarter as much as the area says
+             * (1 / ratio): charts already at their fewest texels would otherwise take texels of hundreds of
+             * metres for a few texels fewer (truck-town at run's 1,800) */
+            if (st != LM_OK || (ratio > 1.0 && r > 1.0 && last_ts > best_ts && r > 0.75 * ratio + 0.25))
                 break;
-            best = fabs(r - 1.0), best_ts = last_ts, ratio = r;
+            if (r > 1.0)
+                too_fine = fmax(too_fine, last_ts);
+            else
+                too_coarse = fmin(too_coarse, last_ts);
+            if (fabs(r - 1.0) < best - 0.01)
+                best = fabs(r - 1.0), best_ts = last_ts, ratio = r;
         }
         if (st == LM_OK && last_ts != best_ts) {
             lm_atlas_free(out);
-            st = lay_out(s, su, &c, pos, bend, best_ts, o, out, &count, err);
+            st = lay_out(s, su, &c, pos, bend, open, best_ts, o, out, &count, err);
         }
         if (st == LM_OK && o->texel_size <= 0.0f && best > LM_BUDGET_WARN && c.count > 0 && count > 0.0)
             lm_warn("%s: %d charts need %.0f texels at the least; the budget of %.0f texels cannot be met "
                     "(docs/levels.md, \"Atlas\")", s->path, c.count, count, target);
         lmc_charts_free(&c);
     }
-    free(pos), free(bend);
+    free(pos), free(bend), free(open);
     if (st == LM_OK)
         st = link_surfaces(su, out, err);
     if (st != LM_OK) {

@@ -81,7 +81,22 @@ typedef struct {
                             * they turn this much, where LM_BEND_REFINE times finer is enough (else it
                             * keeps the atlas's); those texels count against target_texels (default 0:
                             * off) */
+    const double *need;    /* per surface, what its texels are worth (trace/surface_need.h); NULL: every
+                            * surface at the atlas's texel size */
+    const double *sky;     /* with need: per surface, the share of its rays that see the sky (the same) */
+    float open_need;       /* with need: an open surface (at least LM_OPEN_SKY of its rays see the sky) whose
+                            * need per area is under open_need times the level's gets texels in proportion
+                            * to its need instead of its area, coarser than the atlas's by up to
+                            * LM_OPEN_COARSEN (a town's open ground, a closed room's outside); its texels count
+                            * against target_texels, which the rest then share (default 0: off) */
 } lm_atlas_options;
+
+/* The open-surface rule's limits (lm_atlas_options.open_need): the share of a surface's rays that must see
+ * the sky (a room's inside, which sees none, keeps its texels however little it needs: the animated Cornell
+ * box's dynamic cube read 3% further off the reference when coarsened), and how much coarser than the
+ * atlas's its texels may be. */
+#define LM_OPEN_SKY 0.5
+#define LM_OPEN_COARSEN 64.0
 
 /* The bend rule's limits (lm_atlas_options.bend_deg): how much finer than the atlas's a bending
  * surface's texels may be, the fewest texels a surface refined has at the atlas's texel size, and
@@ -152,6 +167,7 @@ typedef struct {
     float *surface_texel_size; /* per surface: its charts' texel_size (the atlas's where it has none): how far
                                 * "within a texel" reaches there (the covered-texel rule, docs/gather.md) */
     int bent_surfaces;     /* surfaces given finer texels for their bending normals (lm_atlas_options.bend_deg) */
+    int open_surfaces;     /* surfaces given coarser texels for what they see (lm_atlas_options.open_need) */
     double time_unwrap, time_pack, time_texels; /* seconds spent in each stage of lm_atlas_build */
 } lm_atlas;
 

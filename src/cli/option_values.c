@@ -195,6 +195,20 @@ int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a)
     return 0;
 }
 
+int lm_cli_opt_open_need(const char *o, const char *v, lm_cli_args *a)
+{
+    if (v && !strcmp(v, "off")) {
+        a->options.open_need = (float)LMGI_OFF;
+        return 0;
+    }
+    char *end = NULL;
+    double d = v ? strtod(v, &end) : 0.0;
+    if (!v || end == v || *end || !(d > 0.0 && d <= 1.0))
+        return lm_cli_bad(o, v, "a fraction in (0, 1], or off");
+    a->options.open_need = (float)d;
+    return 0;
+}
+
 int lm_cli_opt_bend(const char *o, const char *v, lm_cli_args *a)
 {
     if (v && !strcmp(v, "off")) {

@@ -23,6 +23,7 @@ int lm_cli_opt_scaling(const char *o, const char *v, lm_cli_args *a);
 int lm_cli_opt_seed(const char *o, const char *v, lm_cli_args *a);
 /* --bend DEG in (0, 180], or off (lmgi_options.bend_deg). */
 int lm_cli_opt_bend(const char *o, const char *v, lm_cli_args *a);
+int lm_cli_opt_open_need(const char *o, const char *v, lm_cli_args *a);
 /* --shard K/N: share K of N, 1 <= K <= N <= 4096. */
 int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a);
 

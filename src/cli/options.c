@@ -89,6 +89,11 @@ const lm_cli_option lm_cli_options[] = {
      "the most a surface's shading normals may turn across one texel before its\n"
      "texels are made finer, up to 2x, within --texels (default 15; off: one\n"
      "texel size for all; docs/charts.md, \"Bending normals\")"},
+    {"--open-need", NULL, "F|off", LM_CMD_ALL, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_open_need,
+     "a surface that sees mostly sky and whose texels are worth less than F of the\n"
+     "level's, per area, gets texels by their worth, up to 64x coarser, and the\n"
+     "rest of --texels goes to the others (run, check: default 0.25; bake,\n"
+     "info: default off; off: texels by area; docs/charts.md, \"Open surfaces\")"},
     {"--max-atlas", NULL, "N", LM_CMD_ALL, LM_OPT_INT, offsetof(lm_cli_args, options.max_atlas_size), 64, 32768, NULL,
      "the largest side of a lightmap page (default 8192): a level that does not fit\n"
      "one page gets several, a file each (docs/levels.md, \"Atlas\")"},

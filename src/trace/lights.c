@@ -10,7 +10,8 @@
  *                across the light: fitted, where the bounding sphere's disk sent a third to a half of
  *                a flat level's sun photons past it), moved back by 1.001 R (R half the bounds'
  *                diagonal) against the light's direction from the bounds' centre: outside the bounding
- *                sphere; flux = E area / count.
+ *                sphere; flux = E area / count. Where it has a guide (sun_guide.h: a level with open
+ *                ground) the origin is drawn from the guide's density instead, flux divided by it.
  *   area         u[2] picks a triangle by its flux (CDF), its leftover the side (double-sided
  *                materials) and then one barycentric coordinate, u[3] the other (uniform on the
  *                triangle); u[0], u[1] a cosine-weighted direction about the emitting side's normal;
@@ -231,6 +232,7 @@ void lm_emitters_free(lm_emitters *em)
         free(em->e[i].tris);
         free(em->e[i].cdf);
         lm_portals_free(em->e[i].portals);
+        lm_sun_guide_free(em->e[i].guide);
     }
     free(em->e);
     memset(em, 0, sizeof *em);
@@ -337,6 +339,12 @@ void lm_emitter_set_portals(lm_emitters *em, int e, lm_portals *p)
     em->e[e].portals = p;
     if (p)
         lm_portals_aim(p, em->e[e].kind == LM_EMIT_DIRECTIONAL ? em->e[e].dir : NULL);
+}
+
+void lm_emitter_set_guide(lm_emitters *em, int e, lm_sun_guide *g)
+{
+    lm_sun_guide_free(em->e[e].guide);
+    em->e[e].guide = g;
 }
 
 void lm_emitters_update(lm_emitters *em, const lm_scene *s)
@@ -501,6 +509,11 @@ static void emit_punctual(const lm_scene *s, const lm_emitter *e, const float u[
             double pdf = (1.0 - LM_PORTAL_SHARE) * in_rect / area +
                          LM_PORTAL_SHARE * lm_portals_density(e->portals, so, e->dir);
             scale *= pdf > 0.0 ? (float)(1.0 / pdf) : 0.0f;
+        } else if (e->guide && !memcmp(e->guide->rect, e->rect, sizeof e->rect)) { /* sun_guide.h */
+            float g[2] = {u[0], u[1]};
+            double density = lm_sun_guide_draw(e->guide, g);
+            o = lm_add(r0, lm_add(lm_scale(eu, g[0]), lm_scale(ev, g[1])));
+            scale *= (float)(area / density);
         } else {
             scale *= area;
         }

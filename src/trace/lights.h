@@ -20,6 +20,7 @@
 #include "../core/error.h"
 #include "../scene/scene.h"
 #include "portals.h"
+#include "sun_guide.h"
 
 typedef enum { LM_EMIT_POINT = 0, LM_EMIT_SPOT, LM_EMIT_DIRECTIONAL, LM_EMIT_AREA, LM_EMIT_SKY } lm_emitter_kind;
 
@@ -44,6 +45,8 @@ typedef struct {
     lm_portals *portals;  /* directional and sky: where a share of its photons is aimed (portals.h): the
                            * file's portals, or those found from its photons (portal_finder.h); NULL: none.
                            * Owned; aimed at each placement */
+    lm_sun_guide *guide;  /* directional, without usable portals: where its photons leave the rectangle
+                           * (sun_guide.h); NULL: uniformly. Owned */
 } lm_emitter;
 
 typedef struct {
@@ -72,6 +75,9 @@ void lm_emitters_update(lm_emitters *em, const lm_scene *s);
 /* Emitter e's photons aimed through portals p from now on (taking p, aimed for it at once and at every
  * lm_emitters_update), in place of what it had; NULL: none. */
 void lm_emitter_set_portals(lm_emitters *em, int e, lm_portals *p);
+/* Emitter e's (a sun's) photons drawn from guide g from now on (taking g), in place of what it had; NULL:
+ * uniformly. */
+void lm_emitter_set_guide(lm_emitters *em, int e, lm_sun_guide *g);
 
 /* A photon leaving emitter e: origin, unit direction, and its flux for a total of `count` photons
  * from this emitter (flux = power / count, times any falloff weight). u: 4 uniform numbers in [0,1)

@@ -658,6 +658,33 @@ static lm_status find_portals(lm_photon_stage *ps, lm_error *err)
     return LM_OK;
 }
 
+/* Each sun's guide made again (trace/sun_guide.h) where the level has open surfaces and the sun no usable
+ * portals; a sun whose guide changed has its photons invalidated (the full trace that follows at setup and
+ * converge takes them). */
+static lm_status guide_suns(lm_photon_stage *ps, lm_error *err)
+{
+    if (!ps->set.trace || !ps->atlas || ps->atlas->open_surfaces <= 0)
+        return LM_OK;
+    for (int e = 0; e < ps->emitters.count; e++) {
+        lm_emitter *em = &ps->emitters.e[e];
+        if (em->kind != LM_EMIT_DIRECTIONAL || (em->portals && em->portals->usable))
+            continue;
+        lm_sun_guide *g = NULL;
+        lm_status st = lm_sun_guide_make(ps->rt, ps->scene, ps->atlas, (const float(*)[3])em->rect, em->dir, &g, err);
+        if (st == LM_OK && lm_sun_guide_same(g, em->guide)) {
+            lm_sun_guide_free(g);
+            continue;
+        }
+        if (st == LM_OK) {
+            lm_emitter_set_guide(&ps->emitters, e, g);
+            st = lm_photons_invalidate_emitter(ps->photons, e, err);
+        }
+        if (st != LM_OK)
+            return st;
+    }
+    return LM_OK;
+}
+
 /* The photon settings of the stage's photons: the settings given, with the defaults the stage chooses. */
 static lm_photon_settings photon_settings(const lm_photon_stage *ps)
 {
@@ -746,6 +773,8 @@ static lm_status setup(lm_photon_stage *ps, lm_photon_stage_frame *first, lm_err
         st = lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the photon stage", ps->scene->path);
     if (st == LM_OK)
         st = find_portals(ps, err);
+    if (st == LM_OK)
+        st = guide_suns(ps, err);
     if (st == LM_OK && ps->set.trace)
         st = lm_photons_trace_all(ps->photons, &first->photons, err);
     double t1 = lm_now();
@@ -1009,6 +1038,8 @@ lm_status lm_photon_stage_converge(lm_photon_stage *ps, float t, int fresh_plan,
     int replan = fresh_plan && lm_photons_plan_outdated(ps->photons);
     if (st == LM_OK)
         st = find_portals(ps, err);
+    if (st == LM_OK)
+        st = guide_suns(ps, err);
     if (st == LM_OK && replan)
         st = plan_photons_again(ps, err);
     if (st == LM_OK) /* with fresh_plan, what a fresh trace stores, to the bit */
