@@ -272,12 +272,74 @@ static void test_cornell_gather_with_proxy(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* Largest distance from an original triangle's corner to the proxy of its node (a bump's top). */
+static float corners_to_proxy(const lm_scene *s, const lm_proxy *px)
+{
+    float worst = 0.0f;
+    for (uint32_t t = 0; t < s->tri_count; t++) {
+        lm_vec3 p[3];
+        scene_tri(s, t, p);
+        for (int k = 0; k < 3; k++)
+            worst = fmaxf(worst, dist_to_proxy(s, px, s->tri_node[t], p[k]));
+    }
+    return worst;
+}
+
+/* A bumpy 100 x 100 m patch (6 x 6 vertices, the inner ones 6 m up or down in a checker) on a 2 km ground, at
+ * the default budget's texel (7.8 m): 0.005 of the scene's size is 14 m, which flattens the patch; the error
+ * stays within a quarter of the texel (LM_PROXY_TEXEL_ERROR), and the patch keeps its bumps. */
+static void test_proxy_within_a_texel(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    for (int j = 0; j < 6; j++)
+        for (int i = 0; i < 6; i++) {
+            float *v = m[0].pos + 3 * (j * 6 + i);
+            int inner = i > 0 && i < 5 && j > 0 && j < 5;
+            v[0] = 20.0f * i, v[1] = inner ? ((i + j) % 2 ? 6.0f : -6.0f) + 10.0f : 10.0f, v[2] = 20.0f * j;
+        }
+    m[0].vertex_count = 36;
+    for (int j = 0; j < 5; j++)
+        for (int i = 0; i < 5; i++) {
+            uint16_t a = (uint16_t)(j * 6 + i), b = (uint16_t)(a + 1), c = (uint16_t)(a + 6), d = (uint16_t)(a + 7);
+            uint16_t quad[6] = {a, c, b, b, c, d};
+            memcpy(m[0].idx + m[0].index_count, quad, sizeof quad);
+            m[0].index_count += 6;
+        }
+    lmt_mesh_quad(&m[1], (float[3]){-1000, 0, -1000}, (float[3]){0, 0, 2000}, (float[3]){2000, 0, 0});
+    const char *path = lmt_write_scene("proxy_patch.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}]",
+                                       "[" LMT_DIFFUSE(0.5) ", " LMT_DIFFUSE(0.5) "]");
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 0.0f);
+    lm_proxy px, coarse;
+    lm_error err;
+    assert_int_equal(lm_proxy_build(p.s, &p.atlas, LM_PROXY_DEFAULT_ERROR, &px, &err), LM_OK);
+    lm_atlas huge = p.atlas; /* the texel's bound out of the way: the scene size's alone */
+    huge.texel_size = 1e30f;
+    assert_int_equal(lm_proxy_build(p.s, &huge, LM_PROXY_DEFAULT_ERROR, &coarse, &err), LM_OK);
+    float bound = LM_PROXY_TEXEL_ERROR * p.atlas.texel_size, back = corners_to_proxy(p.s, &px);
+    float was = corners_to_proxy(p.s, &coarse);
+    print_message("patch on a 2 km ground, texel %.2f: %u -> %u proxy triangles, meshopt error %.3f, corners->proxy "
+                  "%.3f (bound %.3f); by the scene's size alone %u triangles, corners->proxy %.3f\n",
+                  (double)p.atlas.texel_size, p.s->tri_count, px.tri_count, (double)px.max_error, (double)back,
+                  (double)bound, coarse.tri_count, (double)was);
+    assert_true(px.max_error <= bound);
+    assert_true(back <= PROXY_HAUSDORFF_FACTOR * bound);
+    assert_true(was > PROXY_HAUSDORFF_FACTOR * bound); /* the bumps flattened */
+    check_uvs(&p.atlas, &px);
+    lm_proxy_free(&px);
+    lm_proxy_free(&coarse);
+    lmt_pipeline_free(&p);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_tiny_scene_unchanged),
         cmocka_unit_test(test_cornell_proxy),
         cmocka_unit_test(test_cornell_gather_with_proxy),
+        cmocka_unit_test(test_proxy_within_a_texel),
     };
     return cmocka_run_group_tests(tests, lmt_gl_setup, lmt_gl_teardown);
 }

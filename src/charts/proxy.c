@@ -76,7 +76,9 @@ lm_status lm_proxy_build(const lm_scene *s, const lm_atlas *a, float error, lm_p
     out->tris = malloc(sizeof(uint32_t) * 3 * cap);
     out->tri_node = malloc(sizeof(uint32_t) * cap);
     int ok = out->vertices && out->tris && out->tri_node;
-    float abs_error = out->error * lm_scene_size(s);
+    /* at most a share of a texel: on a level whose size is its open ground (truck-town's 2 km) the share of
+     * its size was 10 m, and the hemicube saw a town of blocks (docs/gather.md, "The gather proxy") */
+    float abs_error = fminf(out->error * lm_scene_size(s), LM_PROXY_TEXEL_ERROR * a->texel_size);
     for (int i = 0; ok && i < s->node_count; i++)
         if (s->nodes[i].tri_count)
             ok = add_node(s, a, i, abs_error, out);

@@ -17,6 +17,8 @@
 #include "charts.h"
 
 #define LM_PROXY_DEFAULT_ERROR 0.005f
+/* The proxy's error is at most this share of the atlas's texel size, whatever the scene's size. */
+#define LM_PROXY_TEXEL_ERROR 0.25f
 
 typedef struct {
     float pos[3];          /* node local space */
@@ -26,7 +28,8 @@ typedef struct {
 } lm_proxy_vertex;
 
 typedef struct {
-    float error;           /* target error, x scene size (0: no simplification) */
+    float error;           /* target error, x scene size, at most LM_PROXY_TEXEL_ERROR texels (0: no
+                            * simplification) */
     float max_error;       /* largest error meshopt reports over the nodes, world units */
     uint32_t source_tris;  /* scene triangles it stands for */
     uint32_t vertex_count, tri_count;
@@ -36,7 +39,8 @@ typedef struct {
 } lm_proxy;
 
 /* Builds the proxy of every node's triangles under the current node matrices (they set the error's
- * scale). error <= 0 keeps every triangle. */
+ * scale): target error `error` x scene size, at most LM_PROXY_TEXEL_ERROR x a's texel size. error <= 0
+ * keeps every triangle. */
 lm_status lm_proxy_build(const lm_scene *s, const lm_atlas *a, float error, lm_proxy *out, lm_error *err);
 void lm_proxy_free(lm_proxy *p);
 /* World position of a proxy vertex under the current matrix of `node`. */

@@ -195,30 +195,27 @@ int lm_cli_opt_shard(const char *o, const char *v, lm_cli_args *a)
     return 0;
 }
 
-int lm_cli_opt_open_need(const char *o, const char *v, lm_cli_args *a)
+/* "off" (LMGI_OFF) or a number in (0, most] into *out; else refused with `want` as what was wanted. */
+static int number_or_off(const char *o, const char *v, double most, const char *want, float *out)
 {
     if (v && !strcmp(v, "off")) {
-        a->options.open_need = (float)LMGI_OFF;
+        *out = (float)LMGI_OFF;
         return 0;
     }
     char *end = NULL;
     double d = v ? strtod(v, &end) : 0.0;
-    if (!v || end == v || *end || !(d > 0.0 && d <= 1.0))
-        return lm_cli_bad(o, v, "a fraction in (0, 1], or off");
-    a->options.open_need = (float)d;
+    if (!v || end == v || *end || !(d > 0.0 && d <= most))
+        return lm_cli_bad(o, v, want);
+    *out = (float)d;
     return 0;
+}
+
+int lm_cli_opt_open_need(const char *o, const char *v, lm_cli_args *a)
+{
+    return number_or_off(o, v, 1.0, "a fraction in (0, 1], or off", &a->options.open_need);
 }
 
 int lm_cli_opt_bend(const char *o, const char *v, lm_cli_args *a)
 {
-    if (v && !strcmp(v, "off")) {
-        a->options.bend_deg = (float)LMGI_OFF;
-        return 0;
-    }
-    char *end = NULL;
-    double d = v ? strtod(v, &end) : 0.0;
-    if (!v || end == v || *end || !(d > 0.0 && d <= 180.0))
-        return lm_cli_bad(o, v, "degrees in (0, 180], or off");
-    a->options.bend_deg = (float)d;
-    return 0;
+    return number_or_off(o, v, 180.0, "degrees in (0, 180], or off", &a->options.bend_deg);
 }
