@@ -122,7 +122,7 @@ int lm_cli_check(const lm_cli_args *a)
         return 1;
     }
     lmgi_updater_desc d;
-    lm_cli_updater_desc(a, &d);
+    lm_cli_run_desc(a, sc, &d);
     d.progress = NULL;
     if (!a->width)
         d.frame.width = d.frame.height = 0; /* lmgi_check's picture: the reference's pixels take seconds */

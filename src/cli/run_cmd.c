@@ -9,6 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "bake_cmd.h"
 #include "order_stats.h"
 #include "fail.h"
 #include "out_dir.h"
@@ -53,6 +54,14 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
         d->progress = gather_progress;
         d->progress_user = &started;
     }
+}
+
+void lm_cli_run_desc(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater_desc *d)
+{
+    lm_cli_updater_desc(a, d);
+    uint32_t n = lm_cli_bake_photons(lmgi_texel_count(sc));
+    if (!a->desc.photons.count && !a->desc.photons.per_group && n > LM_CLI_BAKE_PHOTONS_MIN)
+        d->photons.count = n; /* else the updater's own default, split among the lights as it splits it */
 }
 
 /* Every pass's work and milliseconds: the photon work (and its parts), the gather, the blend, the direct
@@ -279,7 +288,7 @@ static lmgi_status open_outputs(run_state *r, lmgi_error *err)
 static lmgi_status run(run_state *r, lmgi_error *err)
 {
     lmgi_updater_desc desc;
-    lm_cli_updater_desc(r->a, &desc);
+    lm_cli_run_desc(r->a, r->sc, &desc);
     lmgi_status st = lmgi_context_create(NULL, &r->ctx, err);
     if (st == LMGI_OK)
         st = lmgi_updater_create(r->ctx, r->sc, &desc, &r->u, err);

@@ -63,7 +63,8 @@ typedef struct {
     float enlargement;     /* a, half-side of the plane at distance 1 (default 2: F = 0.831) */
     float sky[3];          /* radiance where nothing is hit (default 0) */
     float backface_limit;  /* back-face weight fraction above which a texel is invalid (default 0.1) */
-    float offset;          /* texel centre lifted along its normal by this x scene size (default 1e-4) */
+    float offset;          /* texel centre lifted along its normal by this x scene size (default 1e-4), at most
+                            * LM_GATHER_TEXEL_LIFT x the atlas's texel size (lm_gather_lift) */
     int tiles;             /* tiles per side of the render target: tiles^2 texels per pass (default 16) */
     float proxy_error;     /* gather proxy's error bound x scene size (default 0.005; 0: the full scene) */
     lm_gather_scheme scheme; /* default LM_GATHER_VIEWPORTS, the fastest measured (docs/gather.md) */
@@ -158,12 +159,15 @@ void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas 
  * the hit; NULL (as after creation) forgets it, and every hit takes its direct light. */
 lm_status lm_gather_set_aim_whole(lm_gather *g, const lm_atlas *a, const float *dilated_rgba, lm_error *err);
 /* Whether texel `texel` is covered as the gather with a tracer decides it: straight out from its centre
- * along the shading normal there (lm_texel_centre_normal, lifted by set->offset), other geometry within a texel's width, or the back of a triangle (the texel
+ * along the shading normal there (lm_texel_centre_normal, lifted by lm_gather_lift), other geometry within a texel's width, or the back of a triangle (the texel
  * lies inside a closed mesh) (docs/gather.md, "Covered texels"). */
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
                      uint32_t texel);
-/* Where texel `texel` gathers from: its centre lifted along the shading normal by set->offset x the scene
- * size (eye), the unit shading normal n the plane faces, and the geometric normal ng turned to n's side
+/* How far a texel's eye is lifted off it: set->offset x the scene size, at most LM_GATHER_TEXEL_LIFT x a's
+ * texel size. The hemicube's near plane is half of it. */
+#define LM_GATHER_TEXEL_LIFT 0.01f
+float lm_gather_lift(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a);
+/* Where texel `texel` gathers from: its centre lifted along the shading normal by lm_gather_lift (eye), the unit shading normal n the plane faces, and the geometric normal ng turned to n's side
  * (directions below its plane are blocked by the texel's own surface), under the current node matrices. */
 void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, uint32_t texel,
                            float eye[3], float n[3], float ng[3]);

@@ -53,6 +53,7 @@ struct lm_gather {
     const lm_scene *proxy_scene;
     const lm_atlas *proxy_atlas;
     double coverage;
+    float lift;            /* the eyes' lift off their texels in the pass being drawn (lm_gather_lift) */
 };
 
 /* Schemes 0, 1: one (tiles R)^2 2D target; scheme 2: R x R x tiles^2 layers. */
@@ -479,12 +480,19 @@ typedef struct {
     float surface;
 } texel_view;
 
-static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, const lm_texel *tx)
+float lm_gather_lift(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a)
+{
+    /* at most a share of a texel: a level's size is its open ground's, and 1e-4 of truck-town's 2.9 km lifted
+     * a house wall's eyes 29 cm off it, its foot's row 7-29% bright (docs/gather.md, "Eye lift") */
+    return fminf(set->offset * lm_scene_size(s), LM_GATHER_TEXEL_LIFT * a->texel_size);
+}
+
+static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, const lm_texel *tx)
 {
     lm_vec3 p, n;
     texel_view v;
     texel_frame(s, tx, &p, &n, &v.ng);
-    v.eye = lm_add(p, lm_scale(n, set->offset * lm_scene_size(s)));
+    v.eye = lm_add(p, lm_scale(n, lm_gather_lift(set, s, a)));
     plane_axes(n, set->enlargement, v.axes);
     v.surface = (float)tx->surface;
     return v;
@@ -493,7 +501,7 @@ static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, co
 void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, uint32_t texel,
                            float eye[3], float n[3], float ng[3])
 {
-    texel_view v = view_of(set, s, &a->texels[texel]);
+    texel_view v = view_of(set, s, a, &a->texels[texel]);
     lm_v3_store(eye, v.eye);
     lm_v3_store(n, v.axes[2]);
     lm_v3_store(ng, v.ng);
@@ -518,7 +526,7 @@ static int covered_at(const lm_rt *rt, const lm_hemicube_settings *set, const lm
 {
     float p[3], n[3], eye[3];
     lm_texel_centre_normal(s, &a->texels[texel], p, n);
-    lm_v3_store(eye, lm_add(lm_v3_load(p), lm_scale(lm_v3_load(n), set->offset * lm_scene_size(s))));
+    lm_v3_store(eye, lm_add(lm_v3_load(p), lm_scale(lm_v3_load(n), lm_gather_lift(set, s, a))));
     lm_rt_hit h;
     if (!lm_rt_intersect(rt, eye, n, 0.0f, INFINITY, &h))
         return 0;
@@ -533,9 +541,9 @@ int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, cons
     return covered_at(rt, set, s, a, texel);
 }
 
-static float near_plane(const lm_gather *g, const lm_scene *s)
+static float near_plane(const lm_gather *g)
 {
-    float near = 0.5f * g->set.offset * lm_scene_size(s);
+    float near = 0.5f * g->lift;
     return near > 0.0f ? near : 1e-6f;
 }
 
@@ -592,13 +600,14 @@ static void clear_target(lm_gather *g, const uint32_t *texels, uint32_t count, i
  * lands on one point with w = 0 in front of the near plane, so the instanced schemes draw nothing there. */
 static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels, uint32_t count)
 {
+    g->lift = lm_gather_lift(&g->set, s, a);
     for (uint32_t i = 0; i < count; i++) {
         float *o = g->views + VIEW_FLOATS * (size_t)i;
         if (texels[i] == LM_GATHER_NO_TEXEL) {
             memset(o, 0, sizeof(float) * VIEW_FLOATS);
             continue;
         }
-        texel_view v = view_of(&g->set, s, &a->texels[texels[i]]);
+        texel_view v = view_of(&g->set, s, a, &a->texels[texels[i]]);
         lm_v3_store(o, v.eye);
         o[3] = v.surface;
         for (int k = 0; k < 3; k++) {
@@ -609,14 +618,14 @@ static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const
 }
 
 /* Scheme 0: one draw per texel, its view in uniforms, its tile a viewport; empty tiles are skipped. */
-static void draw_viewports(lm_gather *g, const lm_scene *s, const uint32_t *texels, uint32_t count)
+static void draw_viewports(lm_gather *g, const uint32_t *texels, uint32_t count)
 {
     int R = g->set.resolution, T = g->set.tiles;
     GLint vp_loc = glGetUniformLocation(g->render_prog, "view_proj"), eye_loc = glGetUniformLocation(g->render_prog, "eye");
     GLint own_loc = glGetUniformLocation(g->render_prog, "own_surface");
     GLint ax_loc = glGetUniformLocation(g->render_prog, "axis_x"), ay_loc = glGetUniformLocation(g->render_prog, "axis_y");
     GLint ng_loc = glGetUniformLocation(g->render_prog, "geo_n");
-    float near = near_plane(g, s);
+    float near = near_plane(g);
     for (uint32_t i = 0; i < count; i++) {
         if (texels[i] == LM_GATHER_NO_TEXEL)
             continue;
@@ -638,13 +647,13 @@ static void draw_viewports(lm_gather *g, const lm_scene *s, const uint32_t *texe
 }
 
 /* Schemes 1, 2: the views into a buffer, then one instanced draw. */
-static void draw_instanced(lm_gather *g, const lm_scene *s, uint32_t count)
+static void draw_instanced(lm_gather *g, uint32_t count)
 {
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->views_buf);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * VIEW_FLOATS * count), g->views);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g->views_buf);
     glUniform1i(glGetUniformLocation(g->render_prog, "tiles"), g->set.tiles);
-    glUniform1f(glGetUniformLocation(g->render_prog, "near"), near_plane(g, s));
+    glUniform1f(glGetUniformLocation(g->render_prog, "near"), near_plane(g));
     int R = g->set.resolution, side = g->set.scheme == LM_GATHER_LAYERED ? R : g->set.tiles * R;
     glViewport(0, 0, side, side);
     int clip = g->set.scheme == LM_GATHER_INSTANCED;
@@ -684,9 +693,9 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
     glBindTexture(GL_TEXTURE_2D, g->aim_tex);
     fill_views(g, s, a, texels, count);
     if (g->set.scheme == LM_GATHER_VIEWPORTS)
-        draw_viewports(g, s, texels, count);
+        draw_viewports(g, texels, count);
     else
-        draw_instanced(g, s, count);
+        draw_instanced(g, count);
     for (uint32_t i = 0; i < count; i++) { /* an empty tile's target (-1, -1) is skipped by the reduction */
         int empty = texels[i] == LM_GATHER_NO_TEXEL;
         xy[2 * i] = empty ? -1 : a->texels[texels[i]].x, xy[2 * i + 1] = empty ? -1 : a->texels[texels[i]].y;
