@@ -259,7 +259,7 @@ static double *open_scales(const lm_surfaces *su, const lm_atlas_options *o)
     for (int f = 0; need > 0.0 && area > 0.0 && f < su->surface_count; f++) {
         double q = o->need[f] / (su->surfaces[f].area * (need / area)), limit = o->open_need;
         if (su->surfaces[f].area > 0.0f && o->sky[f] >= LM_OPEN_SKY && q >= 0.0 && q < limit)
-            scale[f] = q > limit / (LM_OPEN_COARSEN * LM_OPEN_COARSEN) ? sqrt(limit / q) : LM_OPEN_COARSEN;
+            scale[f] = q > 0.0 ? fmin(sqrt(limit / q), LM_OPEN_COARSEN) : LM_OPEN_COARSEN;
     }
     return scale;
 }

@@ -6,7 +6,6 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "bake_cmd.h"
 #include "bench.h"
 #include "progress.h"
 #include "run_cmd.h"
@@ -61,8 +60,7 @@ static void check_one(lmgi_context *ctx, const char *path)
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     d.frame.width = d.frame.height = SIZE;
-    if (lm_cli_bake_photons(lmgi_texel_count(sc)) > LM_CLI_BAKE_PHOTONS_MIN) /* as lmgi check (lm_cli_run_desc) */
-        d.photons.count = lm_cli_bake_photons(lmgi_texel_count(sc));
+    d.photons.count = lm_cli_run_photons(sc); /* as lmgi check (lm_cli_run_desc) */
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
     rd.target_error = REF_ERROR;

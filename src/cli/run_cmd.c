@@ -56,12 +56,17 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
     }
 }
 
+uint32_t lm_cli_run_photons(const lmgi_scene *sc)
+{
+    uint32_t n = lm_cli_bake_photons(lmgi_texel_count(sc));
+    return n > LM_CLI_BAKE_PHOTONS_MIN ? n : 0; /* 0: the updater's own default, split among the lights */
+}
+
 void lm_cli_run_desc(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater_desc *d)
 {
     lm_cli_updater_desc(a, d);
-    uint32_t n = lm_cli_bake_photons(lmgi_texel_count(sc));
-    if (!a->desc.photons.count && !a->desc.photons.per_group && n > LM_CLI_BAKE_PHOTONS_MIN)
-        d->photons.count = n; /* else the updater's own default, split among the lights as it splits it */
+    if (!a->desc.photons.count && !a->desc.photons.per_group)
+        d->photons.count = lm_cli_run_photons(sc);
 }
 
 /* Every pass's work and milliseconds: the photon work (and its parts), the gather, the blend, the direct

@@ -22,6 +22,9 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d);
  * 27,801 texels of 4 m held 1.7 of the default photons each, and its grass slope read 6% dark from them
  * (docs/photons.md, "A bake's photons"). */
 void lm_cli_run_desc(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater_desc *d);
+/* The photons lm_cli_run_desc gives sc when not told: a bake's for its atlas where more than the updater's
+ * 46,080, else 0 (the updater's default). */
+uint32_t lm_cli_run_photons(const lmgi_scene *sc);
 /* Loads a->files[0] as 'run' does: at the lightmap density its texel budget keeps up with unless told a
  * texel size or count. 0 (after printing the error) on failure. */
 int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc);

@@ -487,12 +487,13 @@ float lm_gather_lift(const lm_hemicube_settings *set, const lm_scene *s, const l
     return fminf(set->offset * lm_scene_size(s), LM_GATHER_TEXEL_LIFT * a->texel_size);
 }
 
-static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, const lm_texel *tx)
+/* The view of texel tx, its eye lifted `lift` (lm_gather_lift) off it. */
+static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, float lift, const lm_texel *tx)
 {
     lm_vec3 p, n;
     texel_view v;
     texel_frame(s, tx, &p, &n, &v.ng);
-    v.eye = lm_add(p, lm_scale(n, lm_gather_lift(set, s, a)));
+    v.eye = lm_add(p, lm_scale(n, lift));
     plane_axes(n, set->enlargement, v.axes);
     v.surface = (float)tx->surface;
     return v;
@@ -501,7 +502,7 @@ static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, co
 void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, uint32_t texel,
                            float eye[3], float n[3], float ng[3])
 {
-    texel_view v = view_of(set, s, a, &a->texels[texel]);
+    texel_view v = view_of(set, s, lm_gather_lift(set, s, a), &a->texels[texel]);
     lm_v3_store(eye, v.eye);
     lm_v3_store(n, v.axes[2]);
     lm_v3_store(ng, v.ng);
@@ -607,7 +608,7 @@ static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const
             memset(o, 0, sizeof(float) * VIEW_FLOATS);
             continue;
         }
-        texel_view v = view_of(&g->set, s, a, &a->texels[texels[i]]);
+        texel_view v = view_of(&g->set, s, g->lift, &a->texels[texels[i]]);
         lm_v3_store(o, v.eye);
         o[3] = v.surface;
         for (int k = 0; k < 3; k++) {
