@@ -149,6 +149,27 @@ void lmt_mesh_cube(lmt_mesh *m, float h)
         }
 }
 
+void lmt_mesh_cap(lmt_mesh *m, double alpha, double r, double cy)
+{
+    enum { SEG = 16 };
+    memset(m, 0, sizeof *m);
+    m->pos[1] = (float)(cy + r);
+    for (int ring = 1; ring <= 2; ring++)
+        for (int k = 0; k < SEG; k++) {
+            double th = alpha * ring / 2.0, ph = 2.0 * 3.14159265358979323846 * k / SEG;
+            float *p = m->pos + 3 * (1 + (ring - 1) * SEG + k);
+            p[0] = (float)(r * sin(th) * cos(ph)), p[1] = (float)(cy + r * cos(th)), p[2] = (float)(r * sin(th) * sin(ph));
+        }
+    m->vertex_count = 1 + 2 * SEG;
+    for (int k = 0; k < SEG; k++) { /* counter-clockwise seen from outside (above) */
+        int a = 1 + k, b = 1 + (k + 1) % SEG, c = a + SEG, d = b + SEG;
+        uint16_t tri[9] = {0, (uint16_t)b, (uint16_t)a, (uint16_t)a, (uint16_t)b, (uint16_t)d,
+                           (uint16_t)a, (uint16_t)d, (uint16_t)c};
+        memcpy(m->idx + m->index_count, tri, sizeof tri);
+        m->index_count += 9;
+    }
+}
+
 void lmt_mesh_cube_inward(lmt_mesh *m, float h)
 {
     lmt_mesh_cube(m, h);

@@ -152,6 +152,10 @@ void lmt_mesh_quad(lmt_mesh *m, const float corner[3], const float edge_u[3], co
 void lmt_mesh_cube(lmt_mesh *m, float h);
 /* The same cube seen from inside: winding turned so every face points inwards (a closed room). */
 void lmt_mesh_cube_inward(lmt_mesh *m, float h);
+/* A spherical cap around +y of half-angle alpha (radians) on the sphere of radius r centred at (0, cy, 0):
+ * its top, two rings of 16 vertices, 48 triangles facing out. glTF gives it flat normals; a test that
+ * wants the sphere's sets them after loading. */
+void lmt_mesh_cap(lmt_mesh *m, double alpha, double r, double cy);
 
 /* Writes a .gltf at `path` with one buffer (base64 data URI) holding the meshes, and one mesh per
  * entry. `nodes_json` is the JSON array of nodes (mesh i = meshes[i]); `extra_json` is inserted at the

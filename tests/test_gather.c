@@ -389,6 +389,131 @@ static void test_tilted_normals(void **state)
     ts_free(&t);
 }
 
+/* A texel that stands for a whole curved piece is gathered over its footprint (lm_atlas.footprints): a
+ * spherical cap of half-angle 25 degrees (radius 0.5, smooth normals, 16 segments) a little over a black
+ * floor under a uniform sky, at 2 m texels (its chart one texel). A point with normal n there gets
+ * E = pi (1 + n.y) / 2 (the floor hides the lower half of the directions), so the cap's mean is
+ * pi (1 + (1 + cos a) / 2) / 2 = 3.068, while the texel's own point, facing the cap's mean normal (up),
+ * gets pi: 2.4% over. The texel reads the mean of its four points' light, in every scheme. */
+/* The cap's scene: its floor, the cap (node 1) and with `lid` a square a centimetre over its top (node 2). */
+static void cap_scene(tscene *t, double alpha, double r, double cy, int lid)
+{
+    lmt_mesh m[3];
+    square(&m[0], 20.0f, 0.0f, 1);
+    square(&m[2], 1.0f, (float)(cy + r + 0.01), 0);
+    lmt_mesh_cap(&m[1], alpha, r, cy);
+    ts_load(t, m, lid ? 3 : 2, lid ? "[{\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}]" : "[{\"mesh\": 0}, {\"mesh\": 1}]",
+            lid ? "[{}, {}, {}]" : "[{}, {}]", 2.0f);
+    for (uint32_t v = 0; v < t->s->vertex_count; v++) { /* the sphere's own normals on the cap */
+        const float *p = t->s->positions + 3 * (size_t)v;
+        if (t->s->vertex_node[v] != 1)
+            continue;
+        double d[3] = {p[0], p[1] - cy, p[2]}, l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; a++)
+            t->s->normals[3 * (size_t)v + a] = (float)(d[a] / l);
+    }
+    rebuild_atlas(t->s, &t->su, 2.0f, &t->a);
+}
+
+/* The cap's one texel. */
+static uint32_t cap_texel(const tscene *t)
+{
+    uint32_t texel = UINT32_MAX;
+    for (uint32_t i = 0; i < t->a.texel_count; i++)
+        if (t->s->tri_node[t->a.texels[i].tri] == 1) {
+            assert_int_equal(texel, UINT32_MAX);
+            texel = i;
+        }
+    assert_true(texel != UINT32_MAX);
+    return texel;
+}
+
+static const lm_gather_scheme footprint_schemes[] = {LM_GATHER_RAYS, LM_GATHER_VIEWPORTS, LM_GATHER_INSTANCED};
+
+static void test_footprint_of_a_curved_piece(void **state)
+{
+    (void)state;
+    const double alpha = 25.0 * PI / 180.0, r = 0.5, cy = -0.4;
+    tscene t;
+    cap_scene(&t, alpha, r, cy, 0);
+
+    /* the cap's one texel and its four points, spread over it by area */
+    uint32_t texel = cap_texel(&t);
+    double cap_area = 0.0;
+    for (uint32_t tr = 0; tr < t.s->tri_count; tr++)
+        if (t.s->tri_node[tr] == 1) {
+            const float *a = t.s->positions + 3 * (size_t)t.s->tris[3 * tr], *b = t.s->positions + 3 * (size_t)t.s->tris[3 * tr + 1],
+                        *c = t.s->positions + 3 * (size_t)t.s->tris[3 * tr + 2];
+            lm_vec3 n = lm_cross(lm_sub(lm_v3_load(b), lm_v3_load(a)), lm_sub(lm_v3_load(c), lm_v3_load(a)));
+            cap_area += 0.5 * lm_length(n);
+        }
+    assert_true(t.a.texels[texel].normal[1] > 0.999f); /* facing the mean: up */
+    const lm_texel *pts;
+    assert_int_equal(lm_texel_footprint(&t.a, texel, &pts), LM_FOOTPRINT_POINTS);
+    double area = 0.0, want = 0.0;
+    for (int k = 0; k < LM_FOOTPRINT_POINTS; k++) {
+        const float *p = pts[k].pos;
+        double dist = sqrt(p[0] * p[0] + (p[1] - cy) * (p[1] - cy) + p[2] * p[2]);
+        assert_int_equal(t.s->tri_node[pts[k].tri], 1);
+        assert_true(dist > 0.98 * r && dist < r + 1e-5); /* on the cap's triangles */
+        assert_true(pts[k].normal[1] > cos(alpha) && pts[k].normal[1] < 0.999f); /* off its middle */
+        area += pts[k].area;
+        want += PI * (1.0 + pts[k].normal[1]) / 2.0 / LM_FOOTPRINT_POINTS;
+    }
+    assert_true(fabs(area / cap_area - 1.0) < 1e-4);
+    for (uint32_t i = 0; i < t.a.texel_count; i++) /* the floor's texels stand for no curved piece */
+        assert_true(i == texel || lm_texel_footprint(&t.a, i, &pts) == 0);
+
+    const double mean = PI * (1.0 + (1.0 + cos(alpha)) / 2.0) / 2.0, own = PI;
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    for (int k = 0; k < 3; k++) {
+        lm_hemicube_settings set;
+        lm_hemicube_settings_default(&set);
+        set.scheme = footprint_schemes[k];
+        set.sky[0] = set.sky[1] = set.sky[2] = 1.0f;
+        float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, &texel, 1, NULL);
+        double E = texel_value(&t, rgba, texel)[0];
+        print_message("scheme %d: E = %.4f; its points' mean %.4f; the cap's mean %.4f; its own point %.4f\n",
+                      (int)footprint_schemes[k], E, want, mean, own);
+        assert_true(fabs(E / want - 1.0) < 0.005);
+        assert_true(fabs(E - mean) < 0.5 * (own - mean));
+        assert_true(texel_value(&t, rgba, texel)[3] < 0.5f); /* valid */
+        free(rgba);
+    }
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
+/* A footprint point with geometry within a texel straight out from it is covered and left out, as a texel
+ * would be; where every point is, the texel is its own point as before: under a lid a centimetre over the
+ * cap's top, that point is covered too, and the texel invalid (never shown) in every scheme. */
+static void test_footprint_covered(void **state)
+{
+    (void)state;
+    tscene t;
+    cap_scene(&t, 25.0 * PI / 180.0, 0.5, -0.4, 1);
+    uint32_t texel = cap_texel(&t);
+    const lm_texel *pts;
+    assert_int_equal(lm_texel_footprint(&t.a, texel, &pts), LM_FOOTPRINT_POINTS);
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    assert_true(lm_texel_covered(rt, t.s, &t.a, &set, texel));
+    for (int k = 0; k < 3; k++) {
+        set.scheme = footprint_schemes[k];
+        set.sky[0] = set.sky[1] = set.sky[2] = 1.0f;
+        float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, &texel, 1, NULL);
+        assert_true(texel_value(&t, rgba, texel)[3] >= 1.0f); /* invalid */
+        free(rgba);
+    }
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
 /* "Within a texel's width" is the texel's own width: a 2 x 2 m panel 1 m over a 100 m floor, at a density
  * that gives the floor 5 m texels and the panel its own 0.25 m ones (wall_texels, lmgi run's density). The
  * floor's texel under the panel is covered; the panel, four of its texels from the floor, is not (with the
@@ -2192,6 +2317,8 @@ int main(void)
         cmocka_unit_test(test_parallel_square),
         cmocka_unit_test(test_rim_traced),
         cmocka_unit_test(test_tilted_normals),
+        cmocka_unit_test(test_footprint_of_a_curved_piece),
+        cmocka_unit_test(test_footprint_covered),
         cmocka_unit_test(test_covered_texels),
         cmocka_unit_test(test_covered_along_centre_normal),
         cmocka_unit_test(test_covered_by_own_texel_width),

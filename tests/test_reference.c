@@ -79,6 +79,61 @@ static void test_point_light_over_plane(void **state)
     lmt_pipeline_free(&p);
 }
 
+/* A texel that stands for a curved piece (lm_atlas.footprints) is referenced as the gather takes it: its
+ * samples at its footprint points in turn, the mean of their light. A spherical cap of half-angle 25
+ * degrees (radius 0.5, smooth normals) under a point light 0.5 over its top, alone, at 2 m texels: at each
+ * point E = I (n . l) / d^2 and nothing bounces (one shadow ray a sample: no noise). The texel's own point
+ * (on one of the cap's triangles, facing its mean normal) reads 2.2% less than the points' mean. */
+static void test_footprint_texel(void **state)
+{
+    (void)state;
+    const double alpha = 25.0 * PI / 180.0, r = 0.5, I = 10.0, light_y = 1.0;
+    static lmt_mesh m;
+    lmt_mesh_cap(&m, alpha, r, 0.0);
+    char path[512], ext[400];
+    snprintf(path, sizeof path, "%s/cap.gltf", lmt_tmpdir());
+    snprintf(ext, sizeof ext, "\"extensionsUsed\": [\"KHR_lights_punctual\"], \"extensions\": {\"KHR_lights_punctual\": "
+             "{\"lights\": [{\"type\": \"point\", \"intensity\": %g}]}},", I);
+    assert_int_equal(lmt_write_gltf(path, &m, 1, "[{\"children\": [1, 2]}, {\"mesh\": 0}, {\"translation\": [0, 1, 0], "
+                                    "\"extensions\": {\"KHR_lights_punctual\": {\"light\": 0}}}]", NULL, 0, ext), 0);
+    lmt_pipeline p;
+    lmt_pipeline_load(&p, path, 2.0f);
+    for (uint32_t v = 0; v < p.s->vertex_count; v++) { /* the sphere's own normals */
+        const float *q = p.s->positions + 3 * (size_t)v;
+        double l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+        for (int a = 0; a < 3; a++)
+            p.s->normals[3 * (size_t)v + a] = (float)(q[a] / l);
+    }
+    lm_atlas_options ao;
+    lm_atlas_options_default(&ao);
+    ao.texel_size = 2.0f;
+    lm_error err;
+    lm_atlas_free(&p.atlas);
+    assert_int_equal(lm_atlas_build(p.s, &p.su, &ao, &p.atlas, &err), LM_OK);
+    assert_int_equal(p.atlas.texel_count, 1);
+    const lm_texel *pts;
+    uint32_t n = lm_texel_footprint(&p.atlas, 0, &pts);
+    assert_int_equal(n, LM_FOOTPRINT_POINTS);
+    double want = 0.0, own = 0.0;
+    for (uint32_t k = 0; k <= n; k++) {
+        const lm_texel *t = k < n ? &pts[k] : &p.atlas.texels[0];
+        double l[3] = {-t->pos[0], light_y - t->pos[1], -t->pos[2]}, d2 = l[0] * l[0] + l[1] * l[1] + l[2] * l[2];
+        double e = I * (t->normal[0] * l[0] + t->normal[1] * l[1] + t->normal[2] * l[2]) / sqrt(d2) / d2;
+        if (k < n)
+            want += e / n;
+        else
+            own = e;
+    }
+    lm_ref_settings set = quick_settings(0.01f, 8);
+    lm_ref_result res;
+    assert_int_equal(lm_reference_texels(p.s, &p.atlas, p.rt, &p.em, &set, &res, &err), LM_OK);
+    print_message("cap texel: reference %.4f, its points' mean %.4f, its own point %.4f\n", (double)res.full[1], want, own);
+    assert_true(fabs(own / want - 1.0) > 0.015);
+    assert_float_equal(res.full[1], want, 0.002 * want);
+    lm_ref_result_free(&res);
+    lmt_pipeline_free(&p);
+}
+
 /* Furnace: radiance Le / (1 - rho) everywhere, so E = pi Le / (1 - rho) = 2 pi; E_iim = E_full. */
 static void test_furnace(void **state)
 {
@@ -380,6 +435,7 @@ int main(void)
     lm_log_set_level(LM_LOG_ERROR);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_point_light_over_plane),
+        cmocka_unit_test(test_footprint_texel),
         cmocka_unit_test(test_furnace),
         cmocka_unit_test(test_bright_furnaces),
         cmocka_unit_test(test_furnace_pixel_parts),

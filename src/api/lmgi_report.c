@@ -198,6 +198,12 @@ void lmgi_print_info(const lmgi_scene *sc, FILE *f)
     if (sc->atlas.open_surfaces > 0)
         fprintf(f, "            coarser texels on %d surfaces that see mostly open sky (--open-need; docs/charts.md)\n",
                 sc->atlas.open_surfaces);
+    uint32_t pieces = 0;
+    for (uint32_t i = 0; sc->atlas.footprint_first && i < sc->atlas.texel_count; i++)
+        pieces += sc->atlas.footprint_first[i + 1] > sc->atlas.footprint_first[i];
+    if (pieces > 0)
+        fprintf(f, "            %u texels stand for curved pieces and are gathered at %u points spread over them "
+                "(docs/charts.md, \"Footprints\")\n", pieces, sc->atlas.footprint_count);
     fprintf(f, "effects\n");
     for (int i = 0; i < LM_EFFECT_COUNT; i++)
         fprintf(f, "  %s: %s — %s\n", lm_effect_name((lm_effect_id)i), sc->effects.on[i] ? "on" : "off",

@@ -475,6 +475,8 @@ void lm_atlas_free(lm_atlas *a)
     free(a->tri_chart);
     free(a->texels);
     free(a->texel_index);
+    free(a->footprint_first);
+    free(a->footprints);
     free(a->surface_first_chart);
     free(a->surface_chart_count);
     free(a->surface_texel_size);

@@ -158,6 +158,14 @@ typedef struct {
     uint32_t texel_count;
     lm_texel *texels;
     int *texel_index;      /* width*height: index into texels, -1 where uncovered */
+    uint32_t *footprint_first; /* texel_count + 1: texel i is gathered at footprints[footprint_first[i] ..
+                              footprint_first[i + 1]) when that is not empty (lm_texel_footprint) */
+    lm_texel *footprints;  /* points spread over the piece a texel stands for, where its chart is one texel
+                              and its shading normals spread past LM_FOOTPRINT_SPREAD (a sphere's facet at a
+                              level's density): each a texel of its own (its triangle, barycentrics, the
+                              shading normal interpolated there, the area of its part), x, y and surface the
+                              texel's */
+    uint32_t footprint_count;
     float utilization;     /* covered texels / (width*height) */
     int page_width, page_height; /* one page's size (the atlas's own for one page) */
     int page_count, page_columns; /* pages; page p lies at column p % page_columns, row p / page_columns */
@@ -170,6 +178,25 @@ typedef struct {
     int open_surfaces;     /* surfaces given coarser texels for what they see (lm_atlas_options.open_need) */
     double time_unwrap, time_pack, time_texels; /* seconds spent in each stage of lm_atlas_build */
 } lm_atlas;
+
+/* A texel whose chart is one texel stands for a whole piece, and where the piece's shading normals spread
+ * so that their area-weighted mean is shorter than this (about 10 degrees off on average), its light
+ * changes across it faster than linearly (a sphere's facet beside the next sphere): it is gathered at
+ * LM_FOOTPRINT_POINTS points over the piece and their light averaged (docs/charts.md, "Footprints"). */
+#define LM_FOOTPRINT_SPREAD 0.985
+#define LM_FOOTPRINT_POINTS 4
+
+/* Texel i's footprint points (lm_atlas.footprints): how many, 0 for a texel gathered at its own point (and
+ * for every texel of an atlas made by hand, without footprint_first). */
+static inline uint32_t lm_texel_footprint(const lm_atlas *a, uint32_t i, const lm_texel **points)
+{
+    if (!a->footprint_first) {
+        *points = NULL;
+        return 0;
+    }
+    *points = a->footprints + a->footprint_first[i];
+    return a->footprint_first[i + 1] - a->footprint_first[i];
+}
 
 void lm_atlas_options_default(lm_atlas_options *o);
 /* sqrt(total surface area / target): about `target` texels for the whole scene (fewer where charts round

@@ -93,6 +93,20 @@ void lmc_chart_offset(const lmc_chart *c, const lm_chart *r, float texel_size, d
 /* Fills corner_uv, tri_chart, the texel table, texel_index and utilization. */
 lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, lm_atlas *a, lm_error *err);
 
+/* A point on a triangle: its barycentric weights on the corners 0, 1, 2, and the area it stands for. */
+typedef struct {
+    uint32_t tri;
+    float w[3];
+    float area;
+} lmc_point;
+
+/* Where a texel that stands for a whole curved piece is gathered (lm_atlas.footprints): triangles
+ * tris[0..n) (world positions pos) cut into up to 4 parts of about equal area, at the area median of
+ * their centroids along the widest axis and each half again, and each part's point the one of its
+ * triangles nearest its area-weighted centroid. Returns how many points (0 for fewer than two triangles
+ * of positive area; -1 out of memory). Deterministic (ties by triangle index). Cost O(n log n). */
+int lmc_footprint(const lm_scene *s, const float *pos, const uint32_t *tris, uint32_t n, lmc_point out[LM_FOOTPRINT_POINTS]);
+
 /* Area and unnormalized normal (cross product) of triangle t from world positions, in double. */
 double lmc_tri_area(const lm_scene *s, const float *pos, uint32_t t, double n[3]);
 

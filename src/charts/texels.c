@@ -155,25 +155,18 @@ static void accumulate(const texel_job *j, const int ord[3], texel_acc *acc, con
     }
 }
 
-/* World position and shading normal at chart-local point (px, py) of triangle t. */
-static void texel_point(const texel_job *j, int ci, uint32_t t, double px, double py, lm_texel *out)
+/* World position and shading normal at barycentric weights w (summing to 1) on the corners of triangle t. */
+static void texel_at(const texel_job *j, uint32_t t, const double w[3], lm_texel *out)
 {
-    pt c[3];
-    int ord[3];
-    chart_corners(j, ci, t, c, ord);
-    double d = (c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y);
-    double b1 = d != 0.0 ? ((px - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (py - c[0].y)) / d : 1.0 / 3.0;
-    double b2 = d != 0.0 ? ((c[1].x - c[0].x) * (py - c[0].y) - (px - c[0].x) * (c[1].y - c[0].y)) / d : 1.0 / 3.0;
-    double w[3] = {fmax(1.0 - b1 - b2, 0.0), fmax(b1, 0.0), fmax(b2, 0.0)}, sum = w[0] + w[1] + w[2];
     double p[3] = {0, 0, 0}, n[3] = {0, 0, 0}, local[3] = {0, 0, 0}, ln[3] = {0, 0, 0};
     for (int k = 0; k < 3; k++) {
-        uint32_t v = j->s->tris[3 * (size_t)t + ord[k]];
-        out->bary[ord[k]] = (float)(w[k] / sum);
+        uint32_t v = j->s->tris[3 * (size_t)t + k];
+        out->bary[k] = (float)w[k];
         for (int a = 0; a < 3; a++) {
-            p[a] += w[k] / sum * j->pos[3 * (size_t)v + a];
-            n[a] += w[k] / sum * j->nrm[3 * (size_t)v + a];
-            local[a] += w[k] / sum * j->s->positions[3 * (size_t)v + a];
-            ln[a] += w[k] / sum * j->s->normals[3 * (size_t)v + a];
+            p[a] += w[k] * j->pos[3 * (size_t)v + a];
+            n[a] += w[k] * j->nrm[3 * (size_t)v + a];
+            local[a] += w[k] * j->s->positions[3 * (size_t)v + a];
+            ln[a] += w[k] * j->s->normals[3 * (size_t)v + a];
         }
     }
     double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]), ll = sqrt(ln[0] * ln[0] + ln[1] * ln[1] + ln[2] * ln[2]);
@@ -191,6 +184,21 @@ static void texel_point(const texel_job *j, int ci, uint32_t t, double px, doubl
         out->normal[a] = (float)(n[a] / l);
         out->lnormal[a] = (float)(ln[a] / ll);
     }
+}
+
+/* World position and shading normal at chart-local point (px, py) of triangle t. */
+static void texel_point(const texel_job *j, int ci, uint32_t t, double px, double py, lm_texel *out)
+{
+    pt c[3];
+    int ord[3];
+    chart_corners(j, ci, t, c, ord);
+    double d = (c[1].x - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (c[1].y - c[0].y);
+    double b1 = d != 0.0 ? ((px - c[0].x) * (c[2].y - c[0].y) - (c[2].x - c[0].x) * (py - c[0].y)) / d : 1.0 / 3.0;
+    double b2 = d != 0.0 ? ((c[1].x - c[0].x) * (py - c[0].y) - (px - c[0].x) * (c[1].y - c[0].y)) / d : 1.0 / 3.0;
+    double w[3] = {fmax(1.0 - b1 - b2, 0.0), fmax(b1, 0.0), fmax(b2, 0.0)}, sum = w[0] + w[1] + w[2], wt[3];
+    for (int k = 0; k < 3; k++)
+        wt[ord[k]] = w[k] / sum;
+    texel_at(j, t, wt, out);
 }
 
 /* The texel's normals: the area-weighted means of its overlaps' (texel_acc), where they do not cancel;
@@ -222,8 +230,39 @@ void lm_chart_lookup_rect(const lm_atlas *a, int c, float rect[4])
     rect[2] = (ch->x + ch->w - in) / (float)a->width, rect[3] = (ch->y + ch->h - in) / (float)a->height;
 }
 
-/* Fills this chart's corner UVs and returns its texels (row-major), or NULL when memory ran out. */
-static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
+/* The texel's footprint points (lm_atlas.footprints) when its chart is one texel whose shading normals
+ * spread past LM_FOOTPRINT_SPREAD: *foot (NULL, 0 when none). Returns 0 when memory ran out. */
+static int footprint(const texel_job *j, const lmc_chart *ch, const texel_acc *e, const lm_texel *tx,
+                     lm_texel **foot, uint32_t *foot_count)
+{
+    *foot = NULL, *foot_count = 0;
+    double len = sqrt(e->nsum[0] * e->nsum[0] + e->nsum[1] * e->nsum[1] + e->nsum[2] * e->nsum[2]);
+    if (!(e->area > 0.0) || len >= LM_FOOTPRINT_SPREAD * e->area)
+        return 1;
+    lmc_point pts[LM_FOOTPRINT_POINTS];
+    int n = lmc_footprint(j->s, j->pos, ch->tris, ch->tri_count, pts);
+    if (n < 0)
+        return 0;
+    if (n < 2)
+        return 1;
+    *foot = malloc((size_t)n * sizeof **foot);
+    if (!*foot)
+        return 0;
+    for (int i = 0; i < n; i++) {
+        lm_texel *o = &(*foot)[i];
+        double w[3] = {pts[i].w[0], pts[i].w[1], pts[i].w[2]};
+        *o = *tx;
+        o->tri = pts[i].tri;
+        texel_at(j, o->tri, w, o);
+        o->area = pts[i].area;
+    }
+    *foot_count = (uint32_t)n;
+    return 1;
+}
+
+/* Fills this chart's corner UVs and returns its texels (row-major), or NULL when memory ran out; a chart
+ * of one texel over a curved piece also its footprint points (footprint). */
+static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_texel **foot, uint32_t *foot_count)
 {
     const lmc_chart *ch = &j->c->charts[ci];
     const lm_chart *r = &j->a->charts[ci];
@@ -259,32 +298,46 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count)
                 if (e->tri < 0)
                     continue;
                 lm_texel *o = &tx[n++];
-                texel_point(j, ci, (uint32_t)e->tri, e->cx, e->cy, o);
+                o->tri = (uint32_t)e->tri;
+                texel_point(j, ci, o->tri, e->cx, e->cy, o);
                 mean_normal(e, o);
                 o->x = r->x + x;
                 o->y = r->y + y;
                 o->surface = ch->surface;
-                o->tri = (uint32_t)e->tri;
                 o->area = (float)e->area;
             }
         *count = n;
+        *foot = NULL, *foot_count = 0;
+        if (r->w == 1 && r->h == 1 && n == 1 && !footprint(j, ch, &acc[0], &tx[0], foot, foot_count)) {
+            free(tx);
+            tx = NULL;
+        }
     }
     free(acc);
     return tx;
 }
 
-static lm_status assemble(lm_atlas *a, lm_texel **per, const uint32_t *count, lm_error *err)
+static lm_status assemble(lm_atlas *a, lm_texel **per, const uint32_t *count, lm_texel **foot,
+                          const uint32_t *foot_count, lm_error *err)
 {
-    size_t total = 0;
+    size_t total = 0, feet = 0;
     for (int i = 0; i < a->chart_count; i++)
-        total += count[i];
+        total += count[i], feet += foot_count[i];
     a->texels = malloc((total + 1) * sizeof *a->texels);
-    if (!a->texels)
+    a->footprint_first = malloc((total + 1) * sizeof *a->footprint_first);
+    a->footprints = malloc((feet + 1) * sizeof *a->footprints);
+    if (!a->texels || !a->footprint_first || !a->footprints)
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for %zu texels", total);
     for (int i = 0; i < a->chart_count; i++) {
         memcpy(a->texels + a->texel_count, per[i], count[i] * sizeof *per[i]);
+        for (uint32_t k = 0; k < count[i]; k++) /* a chart's footprint points are its one texel's */
+            a->footprint_first[a->texel_count + k] = a->footprint_count;
+        if (foot_count[i]) /* memcpy from NULL is undefined even for no bytes */
+            memcpy(a->footprints + a->footprint_count, foot[i], foot_count[i] * sizeof *foot[i]);
+        a->footprint_count += foot_count[i];
         a->texel_count += count[i];
     }
+    a->footprint_first[a->texel_count] = a->footprint_count;
     for (uint32_t i = 0; i < a->texel_count; i++)
         a->texel_index[(size_t)a->texels[i].y * a->width + a->texels[i].x] = (int)i;
     a->utilization = (float)((double)a->texel_count / ((double)a->width * a->height));
@@ -300,12 +353,13 @@ lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, l
     a->chart_owner = malloc(np * sizeof *a->chart_owner + 1);
     a->tri_chart = malloc((size_t)s->tri_count * sizeof *a->tri_chart + 1);
     a->texel_index = malloc(np * sizeof *a->texel_index + 1);
-    lm_texel **per = calloc((size_t)a->chart_count + 1, sizeof *per);
+    lm_texel **per = calloc((size_t)a->chart_count + 1, sizeof *per), **foot = calloc((size_t)a->chart_count + 1, sizeof *foot);
     uint32_t *count = calloc((size_t)a->chart_count + 1, sizeof *count);
+    uint32_t *foot_count = calloc((size_t)a->chart_count + 1, sizeof *foot_count);
     float *nrm = lmc_world_normals(s);
     lm_status st = LM_OK;
     if (!a->corner_uv || !a->coverage_uv || !a->chart_owner || !a->tri_chart || !a->texel_index || !per || !count ||
-        !nrm) {
+        !foot || !foot_count || !nrm) {
         st = lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for the texel table");
         goto done;
     }
@@ -325,15 +379,18 @@ lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, l
     int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
     for (int i = 0; i < a->chart_count; i++) {
-        per[i] = chart_texels(&j, i, &count[i]);
+        per[i] = chart_texels(&j, i, &count[i], &foot[i], &foot_count[i]);
         failed |= per[i] == NULL;
     }
-    st = failed ? lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for the texel table") : assemble(a, per, count, err);
+    st = failed ? lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for the texel table")
+                : assemble(a, per, count, foot, foot_count, err);
 done:
-    for (int i = 0; per && i < a->chart_count; i++)
-        free(per[i]);
+    for (int i = 0; per && foot && i < a->chart_count; i++)
+        free(per[i]), free(foot[i]);
     free(per);
+    free(foot);
     free(count);
+    free(foot_count);
     free(nrm);
     return st;
 }

@@ -119,6 +119,14 @@ uint64_t lm_ref_key_texels(const lm_scene *s, const lm_atlas *a, const lm_ref_se
         fnv_u32(&h, (uint32_t)t->y);
         fnv_u32(&h, t->tri);
     }
+    for (uint32_t i = 0; i < a->footprint_count; i++) { /* none: the key as before footprints */
+        const lm_texel *t = &a->footprints[i];
+        fnv(&h, t->pos, sizeof t->pos);
+        fnv(&h, t->normal, sizeof t->normal);
+        fnv_u32(&h, t->tri);
+    }
+    for (uint32_t i = 0; a->footprint_count && i <= a->texel_count; i++)
+        fnv_u32(&h, a->footprint_first[i]);
     hash_settings(&h, set);
     return h;
 }

@@ -79,6 +79,7 @@ typedef struct {
     const lm_ref_ctx *c;
     const lm_ref_settings *set;
     const lm_ref_frame *frames;  /* texels, else NULL */
+    const lm_ref_frame *points;  /* texels: the atlas's footprint points (lm_atlas.footprints), if any */
     const lm_atlas *atlas;       /* texels, else NULL */
     const lm_view *cam;    /* pixels, else NULL */
     uint32_t count;
@@ -89,8 +90,11 @@ static void sample_entry(const job *j, uint32_t i, uint32_t k, lm_ref_sample *ou
 {
     lm_ref_rng r;
     lm_ref_rng_seed(&r, j->set->seed, i, k);
-    if (j->frames)
-        lm_ref_texel_sample(j->c, &j->frames[i], &r, out);
+    if (j->frames) { /* a texel gathered over its footprint: its samples taken at its points in turn */
+        const lm_texel *first;
+        uint32_t m = lm_texel_footprint(j->atlas, i, &first);
+        lm_ref_texel_sample(j->c, m ? &j->points[first - j->atlas->footprints + k % m] : &j->frames[i], &r, out);
+    }
     else
         lm_ref_pixel_sample(j->c, j->cam, (int)(i % (uint32_t)j->cam->width), (int)(i / (uint32_t)j->cam->width), &r,
                             out);
@@ -311,10 +315,19 @@ lm_status lm_reference_texels(const lm_scene *s, const lm_atlas *atlas, const lm
         lm_ref_ctx_free(&c);
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %u reference texels", s->path, atlas->texel_count);
     }
+    lm_ref_frame *points = malloc((atlas->footprint_count ? atlas->footprint_count : 1) * sizeof *points);
+    if (!points) {
+        free(frames);
+        lm_ref_ctx_free(&c);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for %u reference texels", s->path, atlas->texel_count);
+    }
     for (uint32_t i = 0; i < atlas->texel_count; i++)
         lm_ref_texel_frame(&c, &atlas->texels[i], &frames[i]);
-    job j = {&c, &fixed, frames, atlas, NULL, atlas->texel_count, NULL};
+    for (uint32_t i = 0; i < atlas->footprint_count; i++)
+        lm_ref_texel_frame(&c, &atlas->footprints[i], &points[i]);
+    job j = {&c, &fixed, frames, points, atlas, NULL, atlas->texel_count, NULL};
     st = solve(&j, LM_REF_KIND_TEXELS, lm_ref_key_texels(s, atlas, &fixed), atlas->width, atlas->height, out, err);
+    free(points);
     free(frames);
     lm_ref_ctx_free(&c);
     return st;
@@ -345,7 +358,7 @@ lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitt
     lm_ref_ctx c;
     if ((st = lm_ref_ctx_init(&c, s, rt, em, &fixed, err)) != LM_OK)
         return st;
-    job j = {&c, &fixed, NULL, NULL, cam, (uint32_t)cam->width * (uint32_t)cam->height, NULL};
+    job j = {&c, &fixed, NULL, NULL, NULL, cam, (uint32_t)cam->width * (uint32_t)cam->height, NULL};
     st = solve(&j, LM_REF_KIND_PIXELS, lm_ref_key_pixels(s, cam, &fixed), cam->width, cam->height, out, err);
     lm_ref_ctx_free(&c);
     return st;

@@ -54,6 +54,7 @@ struct lm_gather {
     const lm_atlas *proxy_atlas;
     double coverage;
     float lift;            /* the eyes' lift off their texels in the pass being drawn (lm_gather_lift) */
+    int round;             /* which of its footprint points a texel of the pass is gathered at (gather_points) */
 };
 
 /* Schemes 0, 1: one (tiles R)^2 2D target; scheme 2: R x R x tiles^2 layers. */
@@ -521,25 +522,54 @@ void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas 
 /* Whether the texel is covered (lm_texel_covered): straight out from its centre along the shading normal
  * there (lm_texel_centre_normal, not the mean its view faces), from the view's eye offset, other geometry
  * within a texel's width, or the inside of a solid (the back of a triangle by its winding: the texel is
- * inside a closed mesh, such as the floor under a box that stands on it). */
-static int covered_at(const lm_rt *rt, const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a,
-                      uint32_t texel)
+ * inside a closed mesh, such as the floor under a box that stands on it). tx: a texel or one of its
+ * footprint points. */
+static int covered_point(const lm_rt *rt, const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a,
+                         const lm_texel *tx)
 {
     float p[3], n[3], eye[3];
-    lm_texel_centre_normal(s, &a->texels[texel], p, n);
+    lm_texel_centre_normal(s, tx, p, n);
     lm_v3_store(eye, lm_add(lm_v3_load(p), lm_scale(lm_v3_load(n), lm_gather_lift(set, s, a))));
     lm_rt_hit h;
     if (!lm_rt_intersect(rt, eye, n, 0.0f, INFINITY, &h))
         return 0;
     /* the texel's own width: a wall given finer texels than the atlas's (wall_texels) is not covered by
      * a slope metres in front of it */
-    return h.t <= a->surface_texel_size[a->texels[texel].surface] || lm_dot(lm_v3_load(h.ng), lm_v3_load(n)) > 0.0f;
+    return h.t <= a->surface_texel_size[tx->surface] || lm_dot(lm_v3_load(h.ng), lm_v3_load(n)) > 0.0f;
+}
+
+static int covered_at(const lm_rt *rt, const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a,
+                      uint32_t texel)
+{
+    return covered_point(rt, set, s, a, &a->texels[texel]);
 }
 
 int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, const lm_hemicube_settings *set,
                      uint32_t texel)
 {
     return covered_at(rt, set, s, a, texel);
+}
+
+/* Texel t's footprint points that are not covered (covered_point; all of them without a tracer), into
+ * out; how many. 0 where it has none, or all are covered: then it is gathered at its own point, and
+ * covered_at says whether that is covered. With n > 0 its light is the mean of the n points'. */
+static int gather_points(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t t,
+                         const lm_texel *out[LM_FOOTPRINT_POINTS])
+{
+    const lm_texel *pts;
+    uint32_t m = lm_texel_footprint(a, t, &pts);
+    int n = 0;
+    for (uint32_t k = 0; k < m && n < LM_FOOTPRINT_POINTS; k++)
+        if (!g->rt || !covered_point(g->rt, &g->set, s, a, &pts[k]))
+            out[n++] = &pts[k];
+    return n;
+}
+
+/* Whether texel t is covered: only where it is gathered at its own point (gather_points found none open). */
+static int covered_in_round(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t t)
+{
+    const lm_texel *pts[LM_FOOTPRINT_POINTS];
+    return g->rt && gather_points(g, s, a, t, pts) == 0 && covered_at(g->rt, &g->set, s, a, t);
 }
 
 static float near_plane(const lm_gather *g)
@@ -595,6 +625,17 @@ static void clear_target(lm_gather *g, const uint32_t *texels, uint32_t count, i
     glDisable(GL_SCISSOR_TEST);
 }
 
+/* View v as VIEW_FLOATS floats at o. */
+static void store_view(texel_view v, float *o)
+{
+    lm_v3_store(o, v.eye);
+    o[3] = v.surface;
+    for (int k = 0; k < 3; k++) {
+        lm_v3_store(o + 4 * (k + 1), v.axes[k]);
+        o[4 * (k + 1) + 3] = k == 0 ? v.ng.x : k == 1 ? v.ng.y : v.ng.z;
+    }
+}
+
 /* Every texel's view of a pass into g->views (VIEW_FLOATS each: eye and own surface, then the three
  * axes, whose fourth components hold the geometric normal), which every scheme draws from and the
  * emitter light and the rim read. An empty tile (LM_GATHER_NO_TEXEL) gets a zero view: every vertex
@@ -608,13 +649,9 @@ static void fill_views(lm_gather *g, const lm_scene *s, const lm_atlas *a, const
             memset(o, 0, sizeof(float) * VIEW_FLOATS);
             continue;
         }
-        texel_view v = view_of(&g->set, s, g->lift, &a->texels[texels[i]]);
-        lm_v3_store(o, v.eye);
-        o[3] = v.surface;
-        for (int k = 0; k < 3; k++) {
-            lm_v3_store(o + 4 * (k + 1), v.axes[k]);
-            o[4 * (k + 1) + 3] = k == 0 ? v.ng.x : k == 1 ? v.ng.y : v.ng.z;
-        }
+        const lm_texel *pts[LM_FOOTPRINT_POINTS];
+        int n = gather_points(g, s, a, texels[i], pts);
+        store_view(view_of(&g->set, s, g->lift, n > g->round ? pts[g->round] : &a->texels[texels[i]]), o);
     }
 }
 
@@ -730,7 +767,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
             float ng[3] = {o[7], o[11], o[15]}; /* the view's geometric normal */
             if (g->emitters)
                 lm_emitter_irradiance(g->emitters, o, o + 12, ng, texels[i], e);
-            if (g->rt && covered_at(g->rt, &g->set, s, a, texels[i]))
+            if (covered_in_round(g, s, a, texels[i]))
                 e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
             if (rim_ready(g)) {
                 float b[3], t[3], r[3];
@@ -746,7 +783,8 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(float) * 4 * count), g->emit);
 }
 
-static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t count)
+/* Sums each tile of the pass into its texel of iim_tex, keeping `keep` of what the texel held (0: a new value). */
+static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t count, float keep)
 {
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, g->targets_buf);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, (GLsizeiptr)(sizeof(int) * 2 * count), xy);
@@ -759,13 +797,29 @@ static void reduce_tiles(lm_gather *g, unsigned iim_tex, const int *xy, uint32_t
     glUniform1f(glGetUniformLocation(g->reduce_prog, "inv_f"), (float)(1.0 / g->coverage));
     glActiveTexture(GL_TEXTURE0);
     glBindTexture(g->set.scheme == LM_GATHER_LAYERED ? GL_TEXTURE_2D_ARRAY : GL_TEXTURE_2D, g->color);
-    glBindImageTexture(0, iim_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(0, iim_tex, 0, GL_FALSE, 0, keep > 0.0f ? GL_READ_WRITE : GL_WRITE_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, g->weights_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g->targets_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, g->emit_buf);
     glUniform1i(glGetUniformLocation(g->reduce_prog, "count"), (GLint)count);
+    glUniform1f(glGetUniformLocation(g->reduce_prog, "keep"), keep);
     glDispatchCompute((count + 7) / 8, 1, 1);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
+}
+
+/* The rays' irradiance from view o (VIEW_FLOATS) of texel t into e, the back-face share into e[3]. */
+static void ray_view(const lm_gather *g, const lm_rim *rim, const float *o, uint32_t t, float e[4])
+{
+    float b[3], tv[3], r[3], back = 0.0f, ng[3] = {o[7], o[11], o[15]};
+    e[0] = e[1] = e[2] = e[3] = 0.0f;
+    if (g->emitters)
+        lm_emitter_irradiance(g->emitters, o, o + 12, ng, t, e);
+    for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
+        b[k] = o[4 + k] * g->set.enlargement, tv[k] = o[8 + k] * g->set.enlargement;
+    lm_rim_irradiance(rim, o, b, tv, o + 12, ng, t, r, &back);
+    for (int k = 0; k < 3; k++)
+        e[k] += r[k];
+    e[3] = back;
 }
 
 /* LM_GATHER_RAYS: each texel's whole hemisphere by rays, in parallel (what the hemicube and its rim
@@ -796,18 +850,26 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
             lm_rt_thread_init();
 #pragma omp for schedule(dynamic, 4)
             for (long i = 0; i < (long)n; i++) {
-                const float *o = g->views + VIEW_FLOATS * (size_t)i;
-                float *e = g->emit + 4 * (size_t)i, r[3], back = 0.0f;
-                float b[3], t[3], ng[3] = {o[7], o[11], o[15]};
+                uint32_t t = texels[first + (uint32_t)i];
+                float *e = g->emit + 4 * (size_t)i;
+                const lm_texel *pts[LM_FOOTPRINT_POINTS];
+                int m = gather_points(g, s, a, t, pts);
+                if (m == 0) {
+                    ray_view(g, &rim, g->views + VIEW_FLOATS * (size_t)i, t, e);
+                    e[3] = covered_at(g->rt, &g->set, s, a, t) ? 1.0f : e[3];
+                    continue;
+                }
+                /* a piece's footprint: the strata shared among its open points, their light averaged */
+                lm_rim part = rim;
+                part.samples = rim.samples / m > 1 ? rim.samples / m : 1;
                 e[0] = e[1] = e[2] = e[3] = 0.0f;
-                if (g->emitters)
-                    lm_emitter_irradiance(g->emitters, o, o + 12, ng, texels[first + (uint32_t)i], e);
-                for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
-                    b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
-                lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texels[first + (uint32_t)i], r, &back);
-                for (int k = 0; k < 3; k++)
-                    e[k] += r[k];
-                e[3] = covered_at(g->rt, &g->set, s, a, texels[first + (uint32_t)i]) ? 1.0f : back;
+                for (int k = 0; k < m; k++) {
+                    float o[VIEW_FLOATS], ek[4];
+                    store_view(view_of(&g->set, s, g->lift, pts[k]), o);
+                    ray_view(g, &part, o, t, ek);
+                    for (int c = 0; c < 4; c++)
+                        e[c] += ek[c] / (float)m;
+                }
             }
         }
         for (uint32_t i = 0; i < n; i++) {
@@ -816,6 +878,27 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
         }
     }
     return lm_gl_check("ray gather", err);
+}
+
+/* The hemicube passes of rest[0, left) (which they use up), each texel at its point of round g->round;
+ * a round past the first blends its light into the texel's mean so far (round / (round + 1) of it kept).
+ * Returns how many passes. */
+static int hemicube_passes(lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t *rest, uint32_t left,
+                           uint32_t *slots, int *xy, unsigned iim_tex)
+{
+    uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
+    int passes = 0;
+    for (; left > 0; passes++) {
+        uint32_t n;
+        left = lm_gather_place_pass(rest, left, slots, per_pass, &n); /* each texel in its own tile */
+        render_tiles(g, s, a, slots, n, xy);
+        if (g->emitters || g->rt) {
+            glFlush(); /* llvmpipe rasterizes the pass on its threads while this one computes */
+            cpu_irradiance(g, s, a, slots, n);
+        }
+        reduce_tiles(g, iim_tex, xy, n, (float)g->round / (float)(g->round + 1));
+    }
+    return passes;
 }
 
 lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
@@ -852,17 +935,19 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDisable(GL_CULL_FACE);
-    int passes = 0;
-    for (uint32_t left = count; left > 0; passes++) {
-        uint32_t n;
-        left = lm_gather_place_pass(rest, left, slots, per_pass, &n); /* each texel in its own tile */
-        render_tiles(g, s, a, slots, n, xy);
-        if (g->emitters || g->rt) {
-            glFlush(); /* llvmpipe rasterizes the pass on its threads while this one computes */
-            cpu_irradiance(g, s, a, slots, n);
-        }
-        reduce_tiles(g, iim_tex, xy, n);
+    int passes = hemicube_passes(g, s, a, rest, count, slots, xy, iim_tex);
+    /* a piece's footprint (gather_points): a round more for each open point past the first, each blended
+     * into the mean of those before it */
+    for (g->round = 1; g->round < LM_FOOTPRINT_POINTS; g->round++) {
+        const lm_texel *first, *pts[LM_FOOTPRINT_POINTS];
+        uint32_t left = 0;
+        for (uint32_t i = 0; i < count; i++)
+            if (lm_texel_footprint(a, texels[i], &first) > (uint32_t)g->round &&
+                gather_points(g, s, a, texels[i], pts) > g->round)
+                rest[left++] = texels[i];
+        passes += hemicube_passes(g, s, a, rest, left, slots, xy, iim_tex);
     }
+    g->round = 0;
     clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     glDepthFunc(GL_LESS);
     glClearDepth(1.0);

@@ -6,7 +6,7 @@ layout(binding = 0) uniform sampler2DArray tiles;
 #else
 layout(binding = 0) uniform sampler2D tiles;
 #endif
-layout(binding = 0, rgba32f) uniform writeonly image2D iim;
+layout(binding = 0, rgba32f) uniform image2D iim;
 layout(std430, binding = 0) readonly buffer Weights { float w[]; };
 layout(std430, binding = 1) readonly buffer Targets { ivec2 xy[]; };
 layout(std430, binding = 3) readonly buffer Cpu { vec4 emit[]; }; /* emitter + rim E, 1 if covered */
@@ -15,6 +15,7 @@ uniform int tiles_x;
 uniform int count;
 uniform float scale;   /* pi / F(a), or pi when the rim is traced */
 uniform float inv_f;   /* 1 / F(a) */
+uniform float keep;    /* the share of what the texel held that stays: a footprint's later points (0: none) */
 void main() {
     int tile = int(gl_GlobalInvocationID.x);
     if (tile >= count || xy[tile].x < 0) return; /* past the pass, or an empty tile (gather_passes.h) */
@@ -29,5 +30,8 @@ void main() {
         for (int x = 0; x < R; x++)
             s += w[y * R + x] * texelFetch(tiles, origin + ivec2(x, y), 0);
 #endif
-    imageStore(iim, xy[tile], vec4(scale * s.rgb + emit[tile].rgb, inv_f * s.a + emit[tile].a));
+    vec4 v = vec4(scale * s.rgb + emit[tile].rgb, inv_f * s.a + emit[tile].a);
+    if (keep > 0.0)
+        v = mix(v, imageLoad(iim, xy[tile]), keep);
+    imageStore(iim, xy[tile], v);
 }
