@@ -214,6 +214,12 @@ static inline int lmgi_knob_is_pow2(double v)
       "(--aim-direct emitters or all): only hits within K of their surface's\n"                                    \
       "texel widths take the direct light there, further ones read it in their\n"                                  \
       "AIM texel (default 16; 0: every hit; docs/gather.md, \"Near and far hits\")")                              \
+    X(gather, adapt, LMGI_KNOB_REAL, float, LMGI_OFF, 0.001, 1, 1, LMGI_NO_RULE, "--gather-adapt", "E",            \
+      LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
+      "the rays gather: a texel whose strata estimate their mean's relative\n"                                     \
+      "standard error above E in some channel (beside a contact, facing a\n"                                     \
+      "penumbra) traces 4 x as many strata more (default off; 0.05 doubles\n"                                    \
+      "the shared Cornell box's gather; docs/gather.md, \"Adaptive strata\")")                                   \
     X(gather, bounce_passes, LMGI_KNOB_INT, int, LMGI_OFF, 1, 8, 1, LMGI_NO_RULE, "--bounce-passes", "N",          \
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
       "after the first full gather, N more with the bounced light read from\n"                                     \

@@ -351,6 +351,70 @@ static void test_rim_traced(void **state)
     check_square_rim(40.0f, 1.0f);
 }
 
+/* Adaptive strata (lm_hemicube_settings.adapt, the rays gather): a small emitting square (side 0.3) 1 m
+ * over the receiver, met by a dozen of a texel's 400 strata: their estimate of the mean's error is far
+ * over 2%, so such a texel traces 1,600 strata more, five times the rays: its error against pi Le F about
+ * sqrt(5) times smaller (measured over 9 texels: mean 7.6% -> 4.0%, worst 18.9% -> 8.4%); under a uniform
+ * sky, where every stratum agrees, nothing more is traced and the texel is the same to the bit. */
+static void test_adaptive_strata(void **state)
+{
+    (void)state;
+    tscene t;
+    square_under_emitter(&t, 0.3f, 1.0f);
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    uint32_t texels[64], n = 0;
+    for (uint32_t i = 0; i < t.a.texel_count && n < 64; i++)
+        if (t.s->tri_node[t.a.texels[i].tri] == 1)
+            texels[n++] = i;
+    assert_true(n >= 4);
+    double err_of[2] = {0.0, 0.0}, worst[2] = {0.0, 0.0};
+    for (int adapt = 0; adapt < 2; adapt++) {
+        lm_hemicube_settings set;
+        lm_hemicube_settings_default(&set);
+        set.scheme = LM_GATHER_RAYS;
+        set.adapt = adapt ? 0.02f : 0.0f;
+        float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, texels, n, NULL);
+        for (uint32_t k = 0; k < n; k++) {
+            const lm_texel *tx = &t.a.texels[texels[k]];
+            double h = 0.15, px = tx->pos[0], pz = tx->pos[2], dd = 1.0 - set.offset * lm_scene_size(t.s);
+            double F = lm_form_factor_rect(-h - px, h - px, -h - pz, h - pz, dd);
+            double e = fabs(texel_value(&t, rgba, texels[k])[0] / (PI * F) - 1.0);
+            err_of[adapt] += e / n;
+            worst[adapt] = fmax(worst[adapt], e);
+        }
+        free(rgba);
+    }
+    print_message("%u texels under a small emitter: mean error %.4f, worst %.4f; adaptive %.4f, %.4f\n", n,
+                  err_of[0], worst[0], err_of[1], worst[1]);
+    assert_true(worst[0] > 0.1);
+    assert_true(worst[1] < 0.5 * worst[0]);
+    assert_true(err_of[1] < 0.6 * err_of[0]);
+    lm_rt_free(rt);
+    ts_free(&t);
+
+    lmt_mesh m; /* a uniform sky: the same bits */
+    square(&m, 0.1f, 0.0f, 1);
+    ts_load(&t, &m, 1, "[{\"mesh\": 0}]", "[{}]", 0.05f);
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    uint32_t texel = texel_near(&t, 0, 0.0f, 0.0f);
+    float *v[2];
+    for (int adapt = 0; adapt < 2; adapt++) {
+        lm_hemicube_settings set;
+        lm_hemicube_settings_default(&set);
+        set.scheme = LM_GATHER_RAYS;
+        set.adapt = adapt ? 0.02f : 0.0f;
+        set.sky[0] = 1.0f, set.sky[1] = 2.0f, set.sky[2] = 0.25f;
+        v[adapt] = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, &texel, 1, NULL);
+    }
+    assert_memory_equal(texel_value(&t, v[0], texel), texel_value(&t, v[1], texel), 4 * sizeof(float));
+    free(v[0]);
+    free(v[1]);
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
 /* Shading normals tilted off the geometric one (a floor whose corner normals were averaged with the walls'):
  * the plane and the rim reach below the floor, where the reference's texel sees nothing (the floor itself
  * is in the way): under a uniform sky L the texel gets pi L (1 + cos t) / 2 for tilt t, whatever the
@@ -1588,7 +1652,7 @@ static void test_rim_pair_same_as_two(void **state)
         emissive[3 * m + 1] = 0.25f * (float)m; /* what the emitters showed before */
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    lm_rim was = {p.s, &p.atlas, p.rt, before, 1, {0.1f, 0.2f, 0.3f}, 0.0f, 16, emissive, NULL, NULL, 0.0f}, now = was;
+    lm_rim was = {p.s, &p.atlas, p.rt, before, 1, {0.1f, 0.2f, 0.3f}, 0.0f, 16, emissive, NULL, NULL, 0.0f, 0.0f}, now = was;
     now.aim = after;
     now.emissive = NULL;
     uint32_t tested = 0, differ = 0;
@@ -2319,6 +2383,7 @@ int main(void)
         cmocka_unit_test(test_tilted_normals),
         cmocka_unit_test(test_footprint_of_a_curved_piece),
         cmocka_unit_test(test_footprint_covered),
+        cmocka_unit_test(test_adaptive_strata),
         cmocka_unit_test(test_covered_texels),
         cmocka_unit_test(test_covered_along_centre_normal),
         cmocka_unit_test(test_covered_by_own_texel_width),

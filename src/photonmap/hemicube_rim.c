@@ -222,6 +222,38 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
 }
 
 /* lm_rim_irradiance over the nr rims r[k] at once (lm_rim_irradiance_pair): the same rays, out[k] each. */
+/* The K = side^2 strata of a grid turned by shift, their weighted sums added to sum and back; returns the
+ * relative standard error of their mean in r[0]'s channel where it is largest (a colour's weak channel
+ * is what a coloured wall's bounce leaves noisy), estimated from the differences of neighbouring strata
+ * in pairs (Var of the mean ~ sum of squared pair differences / K^2: larger than the truth where the light
+ * changes between neighbours, never smaller). */
+static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const float eye[3], lm_vec3 B, lm_vec3 T,
+                     lm_vec3 N, lm_vec3 G, int side, const double shift[2], uint32_t seed,
+                     double (*sum)[3], double *back_w)
+{
+    double d = 1.0 / side, total[3] = {0, 0, 0}, sq[3] = {0, 0, 0}, first[3] = {0, 0, 0};
+    int K = side * side;
+    for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
+        for (int j = 0; j < side; j++) {
+            double before[3] = {sum[0][0], sum[0][1], sum[0][2]};
+            stratum(r, nr, m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d,
+                    seed * (uint32_t)K + (uint32_t)(i * side + j), sum, back_w);
+            for (int c = 0; c < 3; c++) {
+                double x = sum[0][c] - before[c];
+                total[c] += x;
+                if (j % 2 == 0)
+                    first[c] = x;
+                else
+                    sq[c] += (x - first[c]) * (x - first[c]);
+            }
+        }
+    double rel = 0.0;
+    for (int c = 0; c < 3; c++)
+        if (total[c] > 0.0)
+            rel = fmax(rel, sqrt(sq[c]) / total[c]);
+    return rel;
+}
+
 static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], const float b[3], const float t[3],
                            const float n[3], const float ng[3], uint32_t seed, float (*out)[3], float *back)
 {
@@ -231,13 +263,17 @@ static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], c
     memset(sum, 0, sizeof sum);
     lm_seed_shift(seed, shift); /* shift[1]: the sky's directions only; the footprints cover each stratum */
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
-    double d = 1.0 / side;
     int K = side * side;
     sky_mis m = {r0->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r0->scene), K, SKY_RAYS};
-    for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
-        for (int j = 0; j < side; j++)
-            stratum(r, nr, &m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d,
-                    seed * (uint32_t)K + (uint32_t)(i * side + j), sum, &back_w);
+    double rel = strata(r, nr, &m, eye, B, T, N, G, side, shift, seed, sum, &back_w);
+    if (r0->adapt > 0.0f && !m.on && rel > r0->adapt) {
+        /* a noisy texel (beside a contact, a penumbra on the floor it sees): a finer grid turned apart,
+         * its strata's own seeds, the mean of both */
+        double more[2];
+        lm_seed_shift(seed ^ 0x5bd1e995u, more);
+        strata(r, nr, &m, eye, B, T, N, G, 2 * side, more, seed ^ 0x5bd1e995u, sum, &back_w);
+        K += 4 * side * side;
+    }
     int ms = (int)sqrt((double)SKY_RAYS);
     for (int j = 0; m.on && j < m.M; j++) { /* the sky's own directions: a grid of strata, shifted per texel */
         float dir[3], L[3];

@@ -25,6 +25,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->ray_samples = 400;
     s->direct_at_hits = 1;
     s->direct_near = 16.0f;
+    s->adapt = 0.0f;
     s->cpu_threads = 0;
 }
 

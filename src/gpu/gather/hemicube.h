@@ -86,6 +86,9 @@ typedef struct {
                               surface's texel widths take the direct light at the hit, further ones read it
                               in the whole AIM (default 16; docs/gather.md, "Near and far hits"); <= 0, or
                               punctual lights alone: every hit */
+    float adapt;           /* LM_GATHER_RAYS: a texel whose strata estimate the relative standard error of their
+                              mean above this in some channel gets 4 x as many strata more (lm_rim.adapt;
+                              docs/gather.md, "Adaptive strata"); 0 (default): the strata alone */
     int cpu_threads;       /* threads for a pass's CPU share (closed-form emitters, rim rays): 0 (default)
                               one on a software GL, whose rasterizer takes the cores, else every OpenMP
                               thread; n > 0: n. The IIM is the same bit for bit either way */

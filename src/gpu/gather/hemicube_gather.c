@@ -152,6 +152,7 @@ static lm_status check_settings(const lm_hemicube_settings *s, lm_error *err)
         (s->scheme != LM_GATHER_LAYERED && (long)s->resolution * s->tiles > max_side) ||
         (unsigned)s->scheme > LM_GATHER_RAYS || (s->samples != 1 && s->samples != 4) ||
         (s->scheme == LM_GATHER_RAYS && (s->ray_samples < 1 || s->ray_samples > 65536)) ||
+        !(s->adapt >= 0.0f && s->adapt <= 1.0f) ||
         s->coverage_samples < 1 || s->coverage_samples > 16 ||
         (s->coverage_samples > 1 && s->scheme == LM_GATHER_LAYERED) || s->rim_samples < 0 ||
         s->rim_samples > 65536)
@@ -753,7 +754,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                            uint32_t count)
 {
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]},
-                  g->set.enlargement, g->set.rim_samples, NULL, NULL, NULL, 0.0f};
+                  g->set.enlargement, g->set.rim_samples, NULL, NULL, NULL, 0.0f, 0.0f};
 #pragma omp parallel num_threads(g->cpu_threads) if (g->cpu_threads > 1)
     {
         lm_rt_thread_init(); /* FTZ/DAZ as on this thread: the same numbers on any thread */
@@ -838,7 +839,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
         near_only = at_hits && g->direct.area && g->whole_copy && g->set.direct_near > 0.0f;
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]}, 0.0f,
                   g->set.ray_samples, NULL, at_hits ? &g->direct : NULL, near_only ? g->whole_copy : NULL,
-                  g->set.direct_near};
+                  g->set.direct_near, g->set.adapt};
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
     glBindTexture(GL_TEXTURE_2D, iim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
