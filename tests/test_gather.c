@@ -459,15 +459,17 @@ static void test_tilted_normals(void **state)
  * E = pi (1 + n.y) / 2 (the floor hides the lower half of the directions), so the cap's mean is
  * pi (1 + (1 + cos a) / 2) / 2 = 3.068, while the texel's own point, facing the cap's mean normal (up),
  * gets pi: 2.4% over. The texel reads the mean of its four points' light, in every scheme. */
-/* The cap's scene: its floor, the cap (node 1) and with `lid` a square a centimetre over its top (node 2). */
+/* The cap's scene: its floor, the cap (node 1) and with `lid` 1 a square a centimetre over its top, with 2
+ * an emitting square (radiance 1, side 3) 3 m over it, past a texel's width (node 2). */
 static void cap_scene(tscene *t, double alpha, double r, double cy, int lid)
 {
     lmt_mesh m[3];
     square(&m[0], 20.0f, 0.0f, 1);
-    square(&m[2], 1.0f, (float)(cy + r + 0.01), 0);
+    square(&m[2], lid == 2 ? 1.5f : 1.0f, (float)(cy + r + (lid == 2 ? 3.0 : 0.01)), 0);
     lmt_mesh_cap(&m[1], alpha, r, cy);
     ts_load(t, m, lid ? 3 : 2, lid ? "[{\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}]" : "[{\"mesh\": 0}, {\"mesh\": 1}]",
-            lid ? "[{}, {}, {}]" : "[{}, {}]", 2.0f);
+            lid == 2 ? "[{}, {}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 1, 1]}]"
+            : lid ? "[{}, {}, {}]" : "[{}, {}]", 2.0f);
     for (uint32_t v = 0; v < t->s->vertex_count; v++) { /* the sphere's own normals on the cap */
         const float *p = t->s->positions + 3 * (size_t)v;
         if (t->s->vertex_node[v] != 1)
@@ -574,6 +576,48 @@ static void test_footprint_covered(void **state)
         assert_true(texel_value(&t, rgba, texel)[3] >= 1.0f); /* invalid */
         free(rgba);
     }
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
+/* A bounce pass takes the emitters' closed form the gather added out of each texel (lm_gather_emitted_at):
+ * over a footprint, the mean over the same points. The cap under an emitting square, a black AIM: the
+ * texel's whole light is the emitters', and lm_gather_emitted_at gives it back (0.71447 in both schemes),
+ * where the cap's own point alone would give 3.3% more. */
+static void test_footprint_emitted(void **state)
+{
+    (void)state;
+    tscene t;
+    cap_scene(&t, 25.0 * PI / 180.0, 0.5, -0.4, 2);
+    uint32_t texel = cap_texel(&t);
+    lm_rt *rt = NULL;
+    lm_error err;
+    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
+    lm_emitter_light el;
+    assert_int_equal(lm_emitter_light_init(&el, t.s, rt, 32, &err), LM_OK);
+    for (int k = 0; k < 2; k++) {
+        lm_hemicube_settings set;
+        lm_hemicube_settings_default(&set);
+        set.scheme = footprint_schemes[k];
+        float *rgba = gather_traced(t.s, &t.a, NULL, &el, rt, &set, &texel, 1, NULL);
+        lm_gather *g = NULL;
+        assert_int_equal(lm_gather_create(&set, &g, &err), LM_OK);
+        lm_gather_set_emitter_light(g, &el);
+        lm_gather_set_tracer(g, rt);
+        float e[3], own[3], eye[3], n[3], ng[3];
+        lm_gather_emitted_at(g, t.s, &t.a, texel, e);
+        lm_gather_texel_frame(&set, t.s, &t.a, texel, eye, n, ng);
+        lm_emitter_irradiance(&el, eye, n, ng, texel, own);
+        const float *E = texel_value(&t, rgba, texel);
+        print_message("scheme %d: gathered %.5f, emitted_at %.5f, the own point's %.5f\n", (int)set.scheme,
+                      (double)E[0], (double)e[0], (double)own[0]);
+        for (int c = 0; c < 3; c++)
+            assert_true(fabs(e[c] / E[c] - 1.0) < 1e-4);
+        assert_true(fabs(own[0] / E[0] - 1.0) > 0.01);
+        lm_gather_free(g);
+        free(rgba);
+    }
+    lm_emitter_light_free(&el);
     lm_rt_free(rt);
     ts_free(&t);
 }
@@ -2383,6 +2427,7 @@ int main(void)
         cmocka_unit_test(test_tilted_normals),
         cmocka_unit_test(test_footprint_of_a_curved_piece),
         cmocka_unit_test(test_footprint_covered),
+        cmocka_unit_test(test_footprint_emitted),
         cmocka_unit_test(test_adaptive_strata),
         cmocka_unit_test(test_covered_texels),
         cmocka_unit_test(test_covered_along_centre_normal),

@@ -155,7 +155,8 @@ void lm_gather_set_direct_at_hits(lm_gather *g, const lm_direct_light *d);
 int lm_gather_direct_at_hits(const lm_gather *g);
 /* The emissive triangles' light in closed form that the gather adds to texel `texel`'s irradiance
  * (lm_gather_set_emitter_light; 0 without one): the same point, normal and seed as its gather takes, so the
- * same bits. The IIM less it is what the texel gathered from the AIM. Thread-safe. */
+ * same bits (for a texel gathered over its footprint, the mean over the same points, to float rounding).
+ * The IIM less it is what the texel gathered from the AIM. Thread-safe. */
 void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t texel, float e[3]);
 /* With the direct light at the hits: the whole AIM as well (lm_aim_dilated_rgba, atlas-sized RGBA, copied),
  * which hits further than settings.direct_near texel widths read instead of the rest and the direct light at

@@ -510,16 +510,6 @@ void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, c
     lm_v3_store(ng, v.ng);
 }
 
-void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t texel, float e[3])
-{
-    e[0] = e[1] = e[2] = 0.0f;
-    if (!g->emitters)
-        return;
-    float eye[3], n[3], ng[3]; /* the view fill_views gives the texel */
-    lm_gather_texel_frame(&g->set, s, a, texel, eye, n, ng);
-    lm_emitter_irradiance(g->emitters, eye, n, ng, texel, e);
-}
-
 /* Whether the texel is covered (lm_texel_covered): straight out from its centre along the shading normal
  * there (lm_texel_centre_normal, not the mean its view faces), from the view's eye offset, other geometry
  * within a texel's width, or the inside of a solid (the back of a triangle by its winding: the texel is
@@ -551,6 +541,17 @@ int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, cons
     return covered_at(rt, set, s, a, texel);
 }
 
+/* View v as VIEW_FLOATS floats at o. */
+static void store_view(texel_view v, float *o)
+{
+    lm_v3_store(o, v.eye);
+    o[3] = v.surface;
+    for (int k = 0; k < 3; k++) {
+        lm_v3_store(o + 4 * (k + 1), v.axes[k]);
+        o[4 * (k + 1) + 3] = k == 0 ? v.ng.x : k == 1 ? v.ng.y : v.ng.z;
+    }
+}
+
 /* Texel t's footprint points that are not covered (covered_point; all of them without a tracer), into
  * out; how many. 0 where it has none, or all are covered: then it is gathered at its own point, and
  * covered_at says whether that is covered. With n > 0 its light is the mean of the n points'. */
@@ -564,6 +565,28 @@ static int gather_points(const lm_gather *g, const lm_scene *s, const lm_atlas *
         if (!g->rt || !covered_point(g->rt, &g->set, s, a, &pts[k]))
             out[n++] = &pts[k];
     return n;
+}
+
+void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas *a, uint32_t texel, float e[3])
+{
+    e[0] = e[1] = e[2] = 0.0f;
+    if (!g->emitters)
+        return;
+    const lm_texel *pts[LM_FOOTPRINT_POINTS];
+    int m = gather_points(g, s, a, texel, pts);
+    if (m == 0) {
+        float eye[3], n[3], ng[3]; /* the view fill_views gives the texel */
+        lm_gather_texel_frame(&g->set, s, a, texel, eye, n, ng);
+        lm_emitter_irradiance(g->emitters, eye, n, ng, texel, e);
+        return;
+    }
+    for (int k = 0; k < m; k++) { /* a piece's footprint: the mean over its open points, as gathered */
+        float o[VIEW_FLOATS], ek[3];
+        store_view(view_of(&g->set, s, lm_gather_lift(&g->set, s, a), pts[k]), o);
+        lm_emitter_irradiance(g->emitters, o, o + 12, (const float[3]){o[7], o[11], o[15]}, texel, ek);
+        for (int c = 0; c < 3; c++)
+            e[c] += ek[c] / (float)m;
+    }
 }
 
 /* Whether texel t is covered: only where it is gathered at its own point (gather_points found none open). */
@@ -624,17 +647,6 @@ static void clear_target(lm_gather *g, const uint32_t *texels, uint32_t count, i
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     }
     glDisable(GL_SCISSOR_TEST);
-}
-
-/* View v as VIEW_FLOATS floats at o. */
-static void store_view(texel_view v, float *o)
-{
-    lm_v3_store(o, v.eye);
-    o[3] = v.surface;
-    for (int k = 0; k < 3; k++) {
-        lm_v3_store(o + 4 * (k + 1), v.axes[k]);
-        o[4 * (k + 1) + 3] = k == 0 ? v.ng.x : k == 1 ? v.ng.y : v.ng.z;
-    }
 }
 
 /* Every texel's view of a pass into g->views (VIEW_FLOATS each: eye and own surface, then the three
