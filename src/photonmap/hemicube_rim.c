@@ -221,7 +221,6 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
         }
 }
 
-/* lm_rim_irradiance over the nr rims r[k] at once (lm_rim_irradiance_pair): the same rays, out[k] each. */
 /* The K = side^2 strata of a grid turned by shift, their weighted sums added to sum and back; returns the
  * relative standard error of their mean in r[0]'s channel where it is largest (a colour's weak channel
  * is what a coloured wall's bounce leaves noisy), estimated from the differences of neighbouring strata
@@ -254,6 +253,7 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
     return rel;
 }
 
+/* lm_rim_irradiance over the nr rims r[k] at once (lm_rim_irradiance_pair): the same rays, out[k] each. */
 static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], const float b[3], const float t[3],
                            const float n[3], const float ng[3], uint32_t seed, float (*out)[3], float *back)
 {

@@ -60,9 +60,9 @@ typedef struct {
                               NULL: every hit takes its direct light at the hit */
     float near;            /* texel widths (with whole) */
     float adapt;           /* > 0 (the rays gather, lm_hemicube_settings.adapt): where the strata's estimate
-                              of their mean's relative standard error in luminance exceeds this, 4 x as many
-                              strata more, and the mean of all (not with an image sky's own directions);
-                              0: the strata alone */
+                              of their mean's relative standard error in the first rim's worst channel
+                              exceeds this, 4 x as many strata more, and the mean of all (not with an image
+                              sky's own directions); 0: the strata alone */
 } lm_rim;
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y
