@@ -659,6 +659,11 @@ static void test_knob_table(void **state)
     assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
     assert_true(s.direct.probe_lod == 0.01f);
     d.frame.reflection_lod = 0.0f;
+    /* the rays gather's strata reach its settings */
+    d.gather.rays = 1600;
+    assert_int_equal(lm_updater_settings(sc->scene, &d, NULL, &s, &err), LM_OK);
+    assert_int_equal(s.gather.ray_samples, 1600);
+    d.gather.rays = 0;
     int refused = 0;
     LMGI_UPDATER_KNOBS(REFUSED)
     print_message("%d knobs refused past their range or choices\n", refused);

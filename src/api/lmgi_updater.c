@@ -121,6 +121,7 @@ static void gather_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *
     s->bounce_passes = g->bounce_passes == LMGI_OFF ? 0 : g->bounce_passes;
     s->gather.direct_near = g->direct_near == LMGI_OFF ? 0.0f : g->direct_near;
     s->gather.adapt = g->adapt == LMGI_OFF ? 0.0f : g->adapt;
+    s->gather.ray_samples = g->rays;
 }
 
 static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s)
