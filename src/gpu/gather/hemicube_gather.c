@@ -501,13 +501,20 @@ static texel_view view_of(const lm_hemicube_settings *set, const lm_scene *s, fl
     return v;
 }
 
-void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, uint32_t texel,
-                           float eye[3], float n[3], float ng[3])
+/* The eye, normal and geometric normal of the view of tx (a texel or one of its footprint points). */
+static void point_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, const lm_texel *tx,
+                        float eye[3], float n[3], float ng[3])
 {
-    texel_view v = view_of(set, s, lm_gather_lift(set, s, a), &a->texels[texel]);
+    texel_view v = view_of(set, s, lm_gather_lift(set, s, a), tx);
     lm_v3_store(eye, v.eye);
     lm_v3_store(n, v.axes[2]);
     lm_v3_store(ng, v.ng);
+}
+
+void lm_gather_texel_frame(const lm_hemicube_settings *set, const lm_scene *s, const lm_atlas *a, uint32_t texel,
+                           float eye[3], float n[3], float ng[3])
+{
+    point_frame(set, s, a, &a->texels[texel], eye, n, ng);
 }
 
 /* Whether the texel is covered (lm_texel_covered): straight out from its centre along the shading normal
@@ -541,17 +548,6 @@ int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, cons
     return covered_at(rt, set, s, a, texel);
 }
 
-/* View v as VIEW_FLOATS floats at o. */
-static void store_view(texel_view v, float *o)
-{
-    lm_v3_store(o, v.eye);
-    o[3] = v.surface;
-    for (int k = 0; k < 3; k++) {
-        lm_v3_store(o + 4 * (k + 1), v.axes[k]);
-        o[4 * (k + 1) + 3] = k == 0 ? v.ng.x : k == 1 ? v.ng.y : v.ng.z;
-    }
-}
-
 /* Texel t's footprint points that are not covered (covered_point; all of them without a tracer), into
  * out; how many. 0 where it has none, or all are covered: then it is gathered at its own point, and
  * covered_at says whether that is covered. With n > 0 its light is the mean of the n points'. */
@@ -574,16 +570,12 @@ void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas 
         return;
     const lm_texel *pts[LM_FOOTPRINT_POINTS];
     int m = gather_points(g, s, a, texel, pts);
-    if (m == 0) {
-        float eye[3], n[3], ng[3]; /* the view fill_views gives the texel */
-        lm_gather_texel_frame(&g->set, s, a, texel, eye, n, ng);
-        lm_emitter_irradiance(g->emitters, eye, n, ng, texel, e);
-        return;
-    }
-    for (int k = 0; k < m; k++) { /* a piece's footprint: the mean over its open points, as gathered */
-        float o[VIEW_FLOATS], ek[3];
-        store_view(view_of(&g->set, s, lm_gather_lift(&g->set, s, a), pts[k]), o);
-        lm_emitter_irradiance(g->emitters, o, o + 12, (const float[3]){o[7], o[11], o[15]}, texel, ek);
+    if (m == 0) /* gathered at its own point, else over its footprint's open points: their mean, as gathered */
+        pts[0] = &a->texels[texel], m = 1;
+    for (int k = 0; k < m; k++) {
+        float eye[3], n[3], ng[3], ek[3]; /* the view fill_views gives the point */
+        point_frame(&g->set, s, a, pts[k], eye, n, ng);
+        lm_emitter_irradiance(g->emitters, eye, n, ng, texel, ek);
         for (int c = 0; c < 3; c++)
             e[c] += ek[c] / (float)m;
     }
@@ -647,6 +639,17 @@ static void clear_target(lm_gather *g, const uint32_t *texels, uint32_t count, i
         glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
     }
     glDisable(GL_SCISSOR_TEST);
+}
+
+/* View v as VIEW_FLOATS floats at o. */
+static void store_view(texel_view v, float *o)
+{
+    lm_v3_store(o, v.eye);
+    o[3] = v.surface;
+    for (int k = 0; k < 3; k++) {
+        lm_v3_store(o + 4 * (k + 1), v.axes[k]);
+        o[4 * (k + 1) + 3] = k == 0 ? v.ng.x : k == 1 ? v.ng.y : v.ng.z;
+    }
 }
 
 /* Every texel's view of a pass into g->views (VIEW_FLOATS each: eye and own surface, then the three
