@@ -78,6 +78,10 @@ static lm_vec3 rim_dir(const rim_azimuth *a, lm_vec3 B, lm_vec3 T, lm_vec3 N, do
     return lm_normalize(lm_add(lm_add(lm_scale(B, st * a->cs), lm_scale(T, st * a->sn)), lm_scale(N, z)));
 }
 
+/* Each azimuth column of strata puts its rays at its own fraction of their elevation strata, the texel's
+ * shift plus i times the golden ratio's fraction (a Kronecker sequence): a ring of strata under a source
+ * smaller than one ring then reads it at as many elevations as it has azimuths, not all at one. */
+#define LM_GOLDEN_FRACTION 0.6180339887498949
 #define SUB 4 /* sub-directions per side of a stratum: its footprint on the hit's plane */
 #define RIMS_AT_ONCE 2 /* the most rims one pass reads over the same rays (lm_rim_irradiance_pair) */
 #define SKY_RAYS 36 /* an image sky's directions drawn by brightness a texel, beside the strata (a square) */
@@ -122,23 +126,25 @@ static void direct_at_hit(const lm_rim *r, const float eye[3], const float dir[3
         out[c] = (float)(kd[c] / LM_PI * E[c]);
 }
 
-/* The stratum (phi0 + [0, dphi), u0 + [0, du)) of the rim: one ray through its middle and, on the plane
- * of the triangle it hits, the AIM averaged over the stratum's footprint (SUB x SUB sub-directions met
- * with that plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel
- * averages its footprint: a small bright spot is then shared among the strata it overlaps instead of
- * being all or nothing for one. Adds the weighted radiance sum (times SUB^2) of each of the nr rims r[k]
- * into sum[k]: one ray and one footprint for all of them (r[0]'s scene, atlas and tracer), each read in
- * its own AIM, emission and direct light. seed: the stratum's own (the texel's and its index), for the
- * emissive triangles' shadow rays at the hit. */
+/* The stratum (phi0 + [0, dphi), u0 + [0, du)) of the rim: one ray through its middle azimuth at the
+ * fraction `at` of its width in u (with every ray at the middle, the elevation's midpoint rule put the same
+ * error into every texel that sees a small source, a horizon or a contact line alike: a bias, not noise;
+ * docs/gather.md, "Strata") and, on the plane of the triangle it hits, the AIM averaged over the stratum's
+ * footprint (SUB x SUB sub-directions met with that plane, their uv from the triangle's uv gradient, kept
+ * inside its chart), as a hemicube pixel averages its footprint: a small bright spot is then shared among
+ * the strata it overlaps instead of being all or nothing for one. Adds the weighted radiance sum (times
+ * SUB^2) of each of the nr rims r[k] into sum[k]: one ray and one footprint for all of them (r[0]'s scene,
+ * atlas and tracer), each read in its own AIM, emission and direct light. seed: the stratum's own (the
+ * texel's and its index), for the emissive triangles' shadow rays at the hit. */
 static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3], lm_vec3 B, lm_vec3 T,
-                    lm_vec3 N, lm_vec3 G, double phi0, double dphi, double u0, double du, uint32_t seed,
-                    double (*sum)[3], double *back)
+                    lm_vec3 N, lm_vec3 G, double phi0, double dphi, double u0, double du, double at,
+                    uint32_t seed, double (*sum)[3], double *back)
 {
     const lm_rim *r0 = r[0];
     double w;
     float dir[3];
     rim_azimuth mid = azimuth(r0, phi0 + 0.5 * dphi);
-    lm_v3_store(dir, rim_dir(&mid, B, T, N, u0 + 0.5 * du, &w));
+    lm_v3_store(dir, rim_dir(&mid, B, T, N, u0 + at * du, &w));
     if (lm_dot(lm_v3_load(dir), G) <= 0.0f)
         return; /* into the texel's own surface */
     lm_rt_hit h;
@@ -236,7 +242,7 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
         for (int j = 0; j < side; j++) {
             double before[3] = {sum[0][0], sum[0][1], sum[0][2]};
             stratum(r, nr, m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d,
-                    seed * (uint32_t)K + (uint32_t)(i * side + j), sum, back_w);
+                    fmod(shift[1] + i * LM_GOLDEN_FRACTION, 1.0), seed * (uint32_t)K + (uint32_t)(i * side + j), sum, back_w);
             for (int c = 0; c < 3; c++) {
                 double x = sum[0][c] - before[c];
                 total[c] += x;
@@ -261,7 +267,7 @@ static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], c
     int side = (int)sqrtf((float)r0->samples);
     double shift[2], sum[RIMS_AT_ONCE][3], back_w = 0.0;
     memset(sum, 0, sizeof sum);
-    lm_seed_shift(seed, shift); /* shift[1]: the sky's directions only; the footprints cover each stratum */
+    lm_seed_shift(seed, shift); /* shift[0]: the azimuths' turn; shift[1]: the rays' elevation in their strata */
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
     int K = side * side;
     sky_mis m = {r0->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r0->scene), K, SKY_RAYS};
