@@ -299,7 +299,7 @@ static void test_near_and_far_hits(void **state)
 
 /* Issue 33 item 1's per-texel bound: the shared box's small box, its side faces' texels in the first 20 mm
  * above the floor, against the reference's texels (luminance). Their error is the rays gather's own noise,
- * fixed per texel by its strata's pattern: over its four side faces' 18 such texels, 0.84-1.11 of the
+ * fixed per texel by its strata's pattern: over its four side faces' 18 such texels, 0.84-1.20 of the
  * reference with 400 strata, 0.95-1.04 with 1,600 (docs/gather.md, "Strata"; the photons' count moves them
  * little). Loaded as `lmgi run` and `lmgi check`
  * load it (16 texels at least on a wall, open surfaces coarser), so that the texels are the ones measured. */
@@ -355,7 +355,7 @@ static void test_contact_texels_strata(void **state)
     print_message("the small box's %d texels in the first 20 mm: %.3f-%.3f of the reference with 400 strata, "
                   "%.3f-%.3f with 1,600\n", n, lo[0], hi[0], lo[1], hi[1]);
     assert_true(n >= 8);
-    assert_true(lo[0] < 0.9 || hi[0] > 1.1); /* the noise this guards against (0.84-1.11 measured) */
+    assert_true(lo[0] < 0.9 || hi[0] > 1.1); /* the noise this guards against (0.84-1.20 measured) */
     assert_true(lo[1] > 0.9 && hi[1] < 1.1);
     lm_ref_result_free(&ref);
     lm_emitters_free(&em);
