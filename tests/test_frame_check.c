@@ -152,9 +152,9 @@ static void check_scene(const char *name, const char *path, double rmse_bound)
  * 0.032 (its door -1.8%). The RMSE bounds leave room for the reference's noise. */
 /* The small box's faces of min_pixels compared pixels or more, each relative to its own reference (they are
  * dim: SURFACE_TOL measures them against the frame's mean), within CONTACT_TOL on the sum of the channels
- * (channel_tol 0), or within channel_tol in each channel; at least two of them. From SMALL_FACE_PIXELS, on the sum: at the
- * old defaults (160 photons a group, N = 128) the face towards the camera read +21..34% per channel: the
- * estimate's radius blurred the floor's contact shadow at the box's foot into the light. The scene's
+ * (channel_tol 0), or within channel_tol in each channel; at least two of them. From SMALL_FACE_PIXELS, on
+ * the sum: at the old defaults (160 photons a group, N = 128) the face towards the camera read +21..34% per
+ * channel: the estimate's radius blurred the floor's contact shadow at the box's foot into the light. The scene's
  * photon floor (72 x 640 for one light) and N = 32 bring the two faces to +1.3% and +2.7% (+2.1%, +1.7%
  * with the emitters' light computed in the AIMs); docs/tradeoff.md, "Defaults against the front". */
 #define CONTACT_TOL 0.05
@@ -333,7 +333,7 @@ static void test_contact_texels_strata(void **state)
     iim[0] = first_iim(sc, &ls);
     ls.gather.ray_samples = 1600;
     iim[1] = first_iim(sc, &ls);
-    ls.bounce_passes = 1; /* issue 33 item 1's setting: its faces' bound too (test_item_1_setting) */
+    ls.bounce_passes = 1; /* issue 33 item 1's setting (its faces: test_shared_cornell_box_direct_at_hits) */
     iim[2] = first_iim(sc, &ls);
     lm_ref_settings rs;
     lm_ref_settings_default(&rs);

@@ -259,8 +259,8 @@ static double mc_form_factor(double x0, double x1, double y0, double y1, double 
     return (double)hits / n;
 }
 
-/* A small floor (node 1) under a parallel emitting square (Le = (1, 0.5, 0.25), black) of the given side
- * at height d. */
+/* A floor (node 1, receiver_half its half side, texels that wide) under a parallel emitting square (Le =
+ * (1, 0.5, 0.25), black) of the given side at height d. */
 static void receiver_under_emitter(tscene *t, float side, float d, float receiver_half, float texel)
 {
     lmt_mesh m[2];
@@ -271,6 +271,7 @@ static void receiver_under_emitter(tscene *t, float side, float d, float receive
             texel);
 }
 
+/* The same under a small floor (0.1 wide, 0.05 texels). */
 static void square_under_emitter(tscene *t, float side, float d)
 {
     receiver_under_emitter(t, side, d, 0.05f, 0.05f);

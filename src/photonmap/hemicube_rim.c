@@ -238,11 +238,12 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
 {
     double d = 1.0 / side, total[3] = {0, 0, 0}, sq[3] = {0, 0, 0}, first[3] = {0, 0, 0};
     int K = side * side;
-    for (int i = 0; i < side; i++) /* the azimuths turned per texel (a turn is periodic) */
+    for (int i = 0; i < side; i++) { /* the azimuths turned per texel (a turn is periodic) */
+        double phi0 = fmod((i + shift[0]) * d, 1.0), at = fmod(shift[1] + i * LM_GOLDEN_FRACTION, 1.0);
         for (int j = 0; j < side; j++) {
             double before[3] = {sum[0][0], sum[0][1], sum[0][2]};
-            stratum(r, nr, m, eye, B, T, N, G, fmod((i + shift[0]) * d, 1.0), d, j * d, d,
-                    fmod(shift[1] + i * LM_GOLDEN_FRACTION, 1.0), seed * (uint32_t)K + (uint32_t)(i * side + j), sum, back_w);
+            stratum(r, nr, m, eye, B, T, N, G, phi0, d, j * d, d, at, seed * (uint32_t)K + (uint32_t)(i * side + j),
+                    sum, back_w);
             for (int c = 0; c < 3; c++) {
                 double x = sum[0][c] - before[c];
                 total[c] += x;
@@ -252,6 +253,7 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
                     sq[c] += (x - first[c]) * (x - first[c]);
             }
         }
+    }
     double rel = 0.0;
     for (int c = 0; c < 3; c++)
         if (total[c] > 0.0)
