@@ -357,11 +357,14 @@ static void test_rim_traced(void **state)
     check_square_rim(40.0f, 1.0f);
 }
 
+#define EACH_MAX 1024 /* the most texels whose errors errors_under_emitter gives one by one */
+
 /* The rays gather under a small emitting square (side 0.3) 1 m over a receiver (half its side: half, its
  * texels that wide), with `set` (its scheme set to rays): the mean and worst relative error of the
- * receiver's texels against pi Le F, and (bias, if given) their signed mean. */
-static void errors_under_emitter(lm_hemicube_settings set, float half, float texel, double *mean, double *worst,
-                                 double *bias)
+ * receiver's texels against pi Le F, (bias, if given) their signed mean, and (each, if given, EACH_MAX)
+ * each texel's signed error, in the atlas's order; returns how many texels the receiver has. */
+static uint32_t errors_under_emitter_each(lm_hemicube_settings set, float half, float texel, double *mean,
+                                      double *worst, double *bias, double *each)
 {
     tscene t;
     receiver_under_emitter(&t, 0.3f, 1.0f, half, texel);
@@ -384,6 +387,10 @@ static void errors_under_emitter(lm_hemicube_settings set, float half, float tex
         double h = 0.15, px = tx->pos[0], pz = tx->pos[2], dd = 1.0 - set.offset * lm_scene_size(t.s);
         double F = lm_form_factor_rect(-h - px, h - px, -h - pz, h - pz, dd);
         double e = texel_value(&t, rgba, texels[k])[0] / (PI * F) - 1.0;
+        if (each) {
+            assert_true(k < EACH_MAX);
+            each[k] = e;
+        }
         *mean += fabs(e) / n;
         *worst = fmax(*worst, fabs(e));
         if (bias)
@@ -393,6 +400,13 @@ static void errors_under_emitter(lm_hemicube_settings set, float half, float tex
     free(rgba);
     lm_rt_free(rt);
     ts_free(&t);
+    return n;
+}
+
+static void errors_under_emitter(lm_hemicube_settings set, float half, float texel, double *mean, double *worst,
+                                 double *bias)
+{
+    errors_under_emitter_each(set, half, texel, mean, worst, bias, NULL);
 }
 
 /* Adaptive strata (lm_hemicube_settings.adapt, the rays gather): a small emitting square (side 0.3) 1 m
@@ -465,7 +479,7 @@ static void test_more_strata(void **state)
 /* The strata's rays are not all through their strata's middle elevation: under the small emitting square,
  * which lies in the first ring of 20 strata around the normal, a ray through each stratum's middle met the
  * square at one elevation for the whole ring, the same for every texel beneath it, and the texels read
- * 12% low on average (signed mean over a receiver of 400 texels -0.120, mean error 0.140); with each azimuth's
+ * 12% low on average (signed mean over a receiver of 441 texels -0.120, mean error 0.140); with each azimuth's
  * own elevation in its strata (a Kronecker sequence from the texel's shift) the error is noise that averages
  * out (+0.007, mean error 0.083). */
 static void test_strata_unbiased(void **state)
@@ -479,6 +493,39 @@ static void test_strata_unbiased(void **state)
                   "%+.4f\n", mean, worst, bias);
     assert_true(mean > 0.03); /* each texel's own error is the strata's noise */
     assert_true(fabs(bias) < 0.01);
+}
+
+/* The settings' seed (lm_hemicube_settings.seed, `lmgi --seed`) draws other strata patterns: under the
+ * small emitting square, most of the receiver's 441 texels read another value at seed 1 than at seed 0
+ * (measured: 316), and each texel's mean over 8 seeds is nearer pi Le F than one seed's value, as
+ * independent draws' mean is (mean error 0.083 at seed 0, 0.081 at seed 1, 0.027 over seeds 0-7: about
+ * 1 / sqrt(8) of one). Before the seed reached the gather, every seed drew seed 0's pattern. */
+static void test_seed_moves_strata(void **state)
+{
+    (void)state;
+    enum { SEEDS = 8 };
+    static double each[SEEDS][EACH_MAX];
+    double mean[SEEDS], worst, bias;
+    int n = 0, moved = 0;
+    for (int k = 0; k < SEEDS; k++) {
+        lm_hemicube_settings set;
+        lm_hemicube_settings_default(&set);
+        set.seed = (uint32_t)k;
+        n = (int)errors_under_emitter_each(set, 0.1f, 0.01f, &mean[k], &worst, &bias, each[k]);
+    }
+    double of_mean = 0.0;
+    for (int i = 0; i < n; i++) {
+        double m = 0.0;
+        for (int k = 0; k < SEEDS; k++)
+            m += each[k][i] / SEEDS;
+        of_mean += fabs(m) / n;
+        moved += fabs(each[1][i] - each[0][i]) > 1e-4;
+    }
+    print_message("%d texels under a small emitter: mean error %.4f at seed 0, %.4f at seed 1, %.4f over 8 "
+                  "seeds' mean; %d moved by seed 1\n", n, mean[0], mean[1], of_mean, moved);
+    assert_true(moved > n / 2); /* a texel's value counts the rays that meet the square: some counts repeat */
+    assert_true(of_mean < 0.5 * mean[0]);
+    assert_true(fabs(mean[1] / mean[0] - 1.0) < 0.3); /* another draw of the same noise, not a worse one */
 }
 
 /* Shading normals tilted off the geometric one (a floor whose corner normals were averaged with the walls'):
@@ -2497,6 +2544,7 @@ int main(void)
         cmocka_unit_test(test_adaptive_strata),
         cmocka_unit_test(test_more_strata),
         cmocka_unit_test(test_strata_unbiased),
+        cmocka_unit_test(test_seed_moves_strata),
         cmocka_unit_test(test_covered_texels),
         cmocka_unit_test(test_covered_along_centre_normal),
         cmocka_unit_test(test_covered_by_own_texel_width),

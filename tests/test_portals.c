@@ -498,18 +498,20 @@ static void test_bounce_passes_steady_the_room(void **state)
             lmgi_updater_free(u);
         }
     print_message("sunlit room, 8,000 texels, the IIM inside against the reference (relative L1), seeds 0-2: "
-                  "%.3f %.3f %.3f; with 2 bounce passes %.3f %.3f %.3f (reference %.1f s)\n", err[0][0], err[0][1],
+                  "%.4f %.4f %.4f; with 2 bounce passes %.4f %.4f %.4f (reference %.1f s)\n", err[0][0], err[0][1],
                   err[0][2], err[1][0], err[1][1], err[1][2], ref.seconds);
     double lo[2] = {1e9, 1e9}, hi[2] = {0.0, 0.0};
     for (int p = 0; p < 2; p++)
         for (int seed = 0; seed < 3; seed++)
             lo[p] = fmin(lo[p], err[p][seed]), hi[p] = fmax(hi[p], err[p][seed]);
-    /* Measured: 0.112 0.113 0.112 without, 0.104 0.105 0.104 with. Before the lawn's bounces were aimed in
-     * (portals.h) the photons alone read 0.174 0.134 0.124, and the passes halved that spread; now the photons
-     * hardly spread, and what the passes still bring is the gather's bounce in place of the AIM's. */
+    /* Measured: 0.1107 0.1153 0.1129 without, 0.1026 0.1069 0.1077 with. Before the lawn's bounces were aimed
+     * in (portals.h) the photons alone read 0.174 0.134 0.124, and the passes halved that spread; now the
+     * photons hardly spread, and what the passes still bring is the gather's bounce in place of the AIM's.
+     * The spread with the passes also holds the gather's own noise since the seed draws its strata too
+     * (lm_hemicube_settings.seed): 0.104 0.105 0.104 before, a spread of 0.001 that left that noise out. */
     for (int seed = 0; seed < 3; seed++)
         assert_true(err[1][seed] < err[0][seed] - 0.004);
-    assert_true(hi[1] < 0.11 && hi[1] - lo[1] < 0.005);
+    assert_true(hi[1] < 0.11 && hi[1] - lo[1] < 0.008);
     lmgi_reference_free(&ref);
     lmgi_context_free(ctx);
     lmgi_free(sc);

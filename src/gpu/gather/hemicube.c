@@ -26,6 +26,7 @@ void lm_hemicube_settings_default(lm_hemicube_settings *s)
     s->direct_at_hits = 1;
     s->direct_near = 16.0f;
     s->adapt = 0.0f;
+    s->seed = 0;
     s->cpu_threads = 0;
 }
 

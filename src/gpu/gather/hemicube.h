@@ -89,6 +89,10 @@ typedef struct {
     float adapt;           /* LM_GATHER_RAYS: a texel whose strata estimate the relative standard error of their
                               mean above this in some channel gets 4 x as many strata more (lm_rim.adapt;
                               docs/gather.md, "Adaptive strata"); 0 (default): the strata alone */
+    uint32_t seed;         /* mixed into every texel's sample patterns (the strata's turn and elevations, the
+                              emitters' and the rim's samples), which are seeded by the texel's index: 0
+                              (default) the index alone; another seed, other patterns, so that a sweep of
+                              seeds (`lmgi check --seed`) shows the gather's noise too (texel_seed) */
     int cpu_threads;       /* threads for a pass's CPU share (closed-form emitters, rim rays): 0 (default)
                               one on a software GL, whose rasterizer takes the cores, else every OpenMP
                               thread; n > 0: n. The IIM is the same bit for bit either way */
