@@ -178,11 +178,11 @@ mpi: $(BUILD)/lmgi-mpi
 $(BUILD)/obj/mpi/main.o: src/cli/main.c $(BUILD)/flags
 	@command -v $(MPICC) > /dev/null || { echo "make mpi: $(MPICC) not found (Debian: apt-get install libopenmpi-dev openmpi-bin)"; exit 1; }
 	@mkdir -p $(dir $@)
-	$(MPICC) $(CFLAGS_ALL) -Dmain=lm_cli_main -c $< -o $@
+	$(MPICC) $(CFLAGS_ALL) -MMD -MP -Dmain=lm_cli_main -c $< -o $@
 $(BUILD)/obj/mpi/main_mpi.o: src/cli/mpi/main_mpi.c $(BUILD)/flags
 	@command -v $(MPICC) > /dev/null || { echo "make mpi: $(MPICC) not found (Debian: apt-get install libopenmpi-dev openmpi-bin)"; exit 1; }
 	@mkdir -p $(dir $@)
-	$(MPICC) $(CFLAGS_ALL) -c $< -o $@
+	$(MPICC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
 $(BUILD)/lmgi-mpi: $(MPI_OBJ) $(filter-out %/main.o,$(CLI_OBJ)) $(BUILD)/liblmgi.a
 	$(MPICC) -o $@ $^ $(LDFLAGS_ALL) $(LIBS) $(CLI_LIBS) $(VIEW_LIBS)
 
