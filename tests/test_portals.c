@@ -508,9 +508,16 @@ static void test_bounce_passes_steady_the_room(void **state)
      * in (portals.h) the photons alone read 0.174 0.134 0.124, and the passes halved that spread; now the
      * photons hardly spread, and what the passes still bring is the gather's bounce in place of the AIM's.
      * The spread with the passes also holds the gather's own noise since the seed draws its strata too
-     * (lm_hemicube_settings.seed): 0.104 0.105 0.104 before, a spread of 0.001 that left that noise out. */
-    for (int seed = 0; seed < 3; seed++)
-        assert_true(err[1][seed] < err[0][seed] - 0.004);
+     * (lm_hemicube_settings.seed): 0.104 0.105 0.104 before, a spread of 0.001 that left that noise out.
+     * So does each seed's gain: 0.0081 0.0084 0.0052 here (the sanitizer build, its sums in another order:
+     * 0.0078 0.0085 0.0035), where one pattern for every seed had given each about 0.008; the gain on the
+     * seeds' mean is 0.0072 (0.0066). */
+    double gain = 0.0;
+    for (int seed = 0; seed < 3; seed++) {
+        assert_true(err[1][seed] < err[0][seed] - 0.002);
+        gain += (err[0][seed] - err[1][seed]) / 3.0;
+    }
+    assert_true(gain > 0.005);
     assert_true(hi[1] < 0.11 && hi[1] - lo[1] < 0.008);
     lmgi_reference_free(&ref);
     lmgi_context_free(ctx);
