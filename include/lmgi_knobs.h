@@ -214,8 +214,8 @@ static inline int lmgi_knob_is_pow2(double v)
       "the rays gather: cosine-weighted strata over each texel's hemisphere,\n"                                   \
       "rounded down to a square (default 400; 1,600 takes the shared Cornell\n"                                  \
       "box's texels at the floor from 20% to 5% off for 3-4 x the solution's\n"                                 \
-      "time, and with --bounce-passes 1 its faces within 2%; docs/gather.md,\n"                                 \
-      "\"Strata\")")                                                                                             \
+      "time, and with --bounce-passes 1 its faces within 2.5% over 8 seeds;\n"                                  \
+      "docs/gather.md, \"Strata\")")                                                                             \
     X(gather, direct_near, LMGI_KNOB_REAL, float, 16, 0.01, 1e6, 1, LMGI_NO_RULE, "--direct-near", "K",            \
       LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
       "with the emissive triangles' light at the rays gather's hits\n"                                             \
