@@ -101,8 +101,8 @@ static inline int lmgi_knob_is_pow2(double v)
       "one at once; a node moved after a still frame: all its groups at once)")                                  \
     X(photons, seed, LMGI_KNOB_COUNT, uint32_t, 0, 0, 4294967295.0, 0, LMGI_NO_RULE, NULL, NULL,                   \
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                          \
-      "another, disjoint stretch of the Halton sequence, and other strata patterns in\n"                          \
-      "the gather (0: the default ones; lmgi: --seed)")                                                            \
+      "another, disjoint stretch of the Halton sequence, and other sample patterns in\n"                         \
+      "the gather and a light edit's factors (0: the default ones; lmgi: --seed)")                                 \
     X(photons, find_portals, LMGI_KNOB_SWITCH, int, LMGI_ON, 0, 0, 1, LMGI_NO_RULE, "--find-portals", "on|off",   \
       LMGI_CLI_ZERO_NONE, LMGI_ON_OFF_CHOICES, LMGI_NO_SWEEP,                                                      \
       "the windows a sun's or the sky's light gets in by, found where the file\n"                                 \

@@ -122,8 +122,8 @@ static void gather_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *
     s->gather.direct_near = g->direct_near == LMGI_OFF ? 0.0f : g->direct_near;
     s->gather.adapt = g->adapt == LMGI_OFF ? 0.0f : g->adapt;
     s->gather.ray_samples = g->rays;
-    s->gather.seed = r->photons.seed; /* the gather's patterns follow the photons' seed (not yet a light edit's
-                                       * factors: light_scale.c seeds its rays by the texel's index) */
+    s->gather.seed = r->photons.seed; /* the gather's patterns, and a light edit's factors', follow the photons'
+                                       * seed */
 }
 
 static void frame_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *s)

@@ -124,8 +124,8 @@ const lm_cli_option lm_cli_options[] = {
      "frame it checks; view: quit after N frames, the animation's time\n"
      "then N / 30 s rather than the clock's)"},
     {"--seed", NULL, "N", UPDATER | REFERENCE_USERS, LM_OPT_CUSTOM, 0, 0, 0, lm_cli_opt_seed,
-     "the random sequences' seed (photons' scramble, the gather's strata, the\n"
-     "reference's paths)"},
+     "the random sequences' seed (photons' scramble, the gather's strata, a light\n"
+     "edit's factors, the reference's paths)"},
     {"--target-error", NULL, "E", REFERENCE_USERS, LM_OPT_FLOAT, offsetof(lm_cli_args, target_error), 1e-6, 0, NULL,
      "the reference's relative standard error per texel or pixel (default 0.02;\n"
      "tradeoff: 0.03)"},

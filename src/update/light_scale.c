@@ -82,7 +82,7 @@ static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_r
     lm_tangents(lm_v3_load(n), &tv, &bv);
     lm_v3_store(t, tv);
     lm_v3_store(b, bv);
-    lm_rim_irradiance_pair(was, now, eye, b, t, n, ng, i, e0, e1);
+    lm_rim_irradiance_pair(was, now, eye, b, t, n, ng, lm_gather_texel_seed(w->set, i), e0, e1);
 }
 
 /* Whether texel i's window at `at` holds the texel dx, dy from it: on its surface and gathered (done).

@@ -90,15 +90,24 @@ typedef struct {
                               mean above this in some channel gets 4 x as many strata more (lm_rim.adapt;
                               docs/gather.md, "Adaptive strata"); 0 (default): the strata alone */
     uint32_t seed;         /* mixed into every texel's sample patterns (the strata's turn and elevations, the
-                              emitters' and the rim's samples), which are seeded by the texel's index: 0
-                              (default) the index alone; another seed, other patterns, so that a sweep of
-                              seeds (`lmgi check --seed`) shows the gather's noise too (texel_seed) */
+                              emitters' and the rim's samples, a light edit's factors' rays), which are
+                              seeded by the texel's index: 0 (default) the index alone; another seed, other
+                              patterns, so that a sweep of seeds (`lmgi check --seed`) shows the gather's
+                              noise too (lm_gather_texel_seed) */
     int cpu_threads;       /* threads for a pass's CPU share (closed-form emitters, rim rays): 0 (default)
                               one on a software GL, whose rasterizer takes the cores, else every OpenMP
                               thread; n > 0: n. The IIM is the same bit for bit either way */
 } lm_hemicube_settings;
 
 void lm_hemicube_settings_default(lm_hemicube_settings *s);
+/* The seed of texel t's sample patterns: its index, moved by the settings' seed times 2^32 / the golden
+ * ratio (mod 2^32; 0: the index alone), so that seeds 0 and 1 share no texel's pattern on an atlas of under
+ * 1.6 billion texels. Every ray a texel casts for the gather or for a light edit's factors (light_scale.h)
+ * draws from it. */
+static inline uint32_t lm_gather_texel_seed(const lm_hemicube_settings *s, uint32_t t)
+{
+    return t + s->seed * 0x9e3779b9u;
+}
 
 /* The coverage samples a scene calls for: 4 when a triangle is emissive and its light is drawn into the
  * hemicubes (small emitters alias), else 1: with the emitters' light in closed form (closed_form_emitters,

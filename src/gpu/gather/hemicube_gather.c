@@ -548,14 +548,6 @@ int lm_texel_covered(const lm_rt *rt, const lm_scene *s, const lm_atlas *a, cons
     return covered_at(rt, set, s, a, texel);
 }
 
-/* The seed of texel t's sample patterns: its index, moved by the settings' seed times 2^32 / the golden ratio
- * (mod 2^32; 0: the index alone), so that seeds 0 and 1 share no texel's pattern on an atlas of under 1.6
- * billion texels. */
-static uint32_t texel_seed(const lm_gather *g, uint32_t t)
-{
-    return t + g->set.seed * 0x9e3779b9u;
-}
-
 /* Texel t's footprint points that are not covered (covered_point; all of them without a tracer), into
  * out; how many. 0 where it has none, or all are covered: then it is gathered at its own point, and
  * covered_at says whether that is covered. With n > 0 its light is the mean of the n points'. */
@@ -583,7 +575,7 @@ void lm_gather_emitted_at(const lm_gather *g, const lm_scene *s, const lm_atlas 
     for (int k = 0; k < m; k++) {
         float eye[3], n[3], ng[3], ek[3]; /* the view fill_views gives the point */
         point_frame(&g->set, s, a, pts[k], eye, n, ng);
-        lm_emitter_irradiance(g->emitters, eye, n, ng, texel_seed(g, texel), ek);
+        lm_emitter_irradiance(g->emitters, eye, n, ng, lm_gather_texel_seed(&g->set, texel), ek);
         for (int c = 0; c < 3; c++)
             e[c] += ek[c] / (float)m;
     }
@@ -769,8 +761,8 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
 
 /* What each texel of a pass gets from the CPU, for the reduction to add: the emitters' closed-form
  * irradiance and the rim's (from its view's eye and axes: g->views, filled by render_tiles); the sample
- * patterns are seeded by the texel's index (texel_seed), so the thread count changes nothing. While the GL
- * rasterizes the pass: on llvmpipe on this thread alone (about 8 us per texel for two emissive triangles
+ * patterns are seeded by the texel's index (lm_gather_texel_seed), so the thread count changes nothing.
+ * While the GL rasterizes the pass: on llvmpipe on this thread alone (about 8 us per texel for two emissive triangles
  * and 10 us for the rim, where an OpenMP team competing with the rasterizer's threads cost ten times that);
  * on a GPU on every core, where the rim was 99% of a bake (docs/architecture.md, "On a GPU"). */
 static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
@@ -790,14 +782,14 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                 continue;
             float ng[3] = {o[7], o[11], o[15]}; /* the view's geometric normal */
             if (g->emitters)
-                lm_emitter_irradiance(g->emitters, o, o + 12, ng, texel_seed(g, texels[i]), e);
+                lm_emitter_irradiance(g->emitters, o, o + 12, ng, lm_gather_texel_seed(&g->set, texels[i]), e);
             if (covered_in_round(g, s, a, texels[i]))
                 e[3] = 1.0f; /* counted as all back faces: invalid, never shown */
             if (rim_ready(g)) {
                 float b[3], t[3], r[3];
                 for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
                     b[k] = o[4 + k] * g->set.enlargement, t[k] = o[8 + k] * g->set.enlargement;
-                lm_rim_irradiance(&rim, o, b, t, o + 12, ng, texel_seed(g, texels[i]), r, NULL);
+                lm_rim_irradiance(&rim, o, b, t, o + 12, ng, lm_gather_texel_seed(&g->set, texels[i]), r, NULL);
                 for (int k = 0; k < 3; k++)
                     e[k] += r[k];
             }
@@ -837,10 +829,10 @@ static void ray_view(const lm_gather *g, const lm_rim *rim, const float *o, uint
     float b[3], tv[3], r[3], back = 0.0f, ng[3] = {o[7], o[11], o[15]};
     e[0] = e[1] = e[2] = e[3] = 0.0f;
     if (g->emitters)
-        lm_emitter_irradiance(g->emitters, o, o + 12, ng, texel_seed(g, t), e);
+        lm_emitter_irradiance(g->emitters, o, o + 12, ng, lm_gather_texel_seed(&g->set, t), e);
     for (int k = 0; k < 3; k++) /* the views hold b / a and t / a */
         b[k] = o[4 + k] * g->set.enlargement, tv[k] = o[8 + k] * g->set.enlargement;
-    lm_rim_irradiance(rim, o, b, tv, o + 12, ng, texel_seed(g, t), r, &back);
+    lm_rim_irradiance(rim, o, b, tv, o + 12, ng, lm_gather_texel_seed(&g->set, t), r, &back);
     for (int k = 0; k < 3; k++)
         e[k] += r[k];
     e[3] = back;
