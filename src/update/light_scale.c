@@ -104,16 +104,18 @@ static int in_window(const lm_atlas *a, const uint8_t *done, quality at, uint32_
 }
 
 /* The relative standard error of texel i's factors f (the channels with use[c] set), as a ratio estimator
- * over its window: sqrt(sum w^2 (e1 - f e0)^2) / sum w e1, over the channels together. 0 where every
- * texel of the window saw its light change by the same factor: one light lights them, and the factor is
- * exact whatever rays the gathers cast. Where several lights light the window in different shares, the
+ * over its window: sqrt(sum w^2 (e1 - f e0)^2) / sum w e1 per channel, the largest. (Over the channels
+ * together, the residuals added in quadrature over their sum, it read a channel's own error over sqrt 3
+ * where they change alike and over 3 where one changes: a third of two seeds' spread, test_gather
+ * test_light_scale_seed.) 0 where every texel of the window saw its light change by the same factor: one
+ * light lights them, and the factor is exact whatever rays the gathers cast. Where several lights light the window in different shares, the
  * gathers' few rays per texel each see a different mix, and the spread of their ratios says how far the
  * sum's ratio may be off (the two rooms' light_a2 removed: a face it lit to 80% read -21..+20% per texel,
  * 10% over the face, and kept it for the 75 updates the surfaces' order spent elsewhere). */
 static float window_doubt(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
                           uint32_t i, const float *f, const int *use)
 {
-    double r2 = 0.0, sum = 0.0;
+    double r2[3] = {0, 0, 0}, sum[3] = {0, 0, 0};
     for (int dy = -at.spread; dy <= at.spread; dy++)
         for (int dx = -at.spread; dx <= at.spread; dx++) {
             int q;
@@ -123,10 +125,13 @@ static float window_doubt(const lm_atlas *a, const float *e0, const float *e1, c
             for (int c = 0; c < 3; c++)
                 if (use[c]) {
                     double r = e1[3 * (size_t)q + c] - f[c] * e0[3 * (size_t)q + c];
-                    r2 += w * w * r * r, sum += w * e1[3 * (size_t)q + c];
+                    r2[c] += w * w * r * r, sum[c] += w * e1[3 * (size_t)q + c];
                 }
         }
-    double u = sum > 0.0 ? sqrt(r2) / sum : 0.0;
+    double u = 0.0;
+    for (int c = 0; c < 3; c++)
+        if (sum[c] > 0.0)
+            u = fmax(u, sqrt(r2[c]) / sum[c]);
     return isfinite(u) ? (float)u : 0.0f;
 }
 
