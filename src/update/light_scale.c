@@ -104,14 +104,14 @@ static int in_window(const lm_atlas *a, const uint8_t *done, quality at, uint32_
 }
 
 /* The relative standard error of texel i's factors f (the channels with use[c] set), as a ratio estimator
- * over its window: sqrt(sum w^2 (e1 - f e0)^2) / sum w e1 per channel, the largest. (Over the channels
- * together, the residuals added in quadrature over their sum, it read a channel's own error over sqrt 3
- * where they change alike and over 3 where one changes: a third of two seeds' spread, test_gather
- * test_light_scale_seed.) 0 where every texel of the window saw its light change by the same factor: one
- * light lights them, and the factor is exact whatever rays the gathers cast. Where several lights light the window in different shares, the
- * gathers' few rays per texel each see a different mix, and the spread of their ratios says how far the
- * sum's ratio may be off (the two rooms' light_a2 removed: a face it lit to 80% read -21..+20% per texel,
- * 10% over the face, and kept it for the 75 updates the surfaces' order spent elsewhere). */
+ * over its window: sqrt(sum w^2 (e1 - f e0)^2) / sum w e1 per channel, the largest (the channels' residuals
+ * added together in quadrature over their summed light read a channel's own error over sqrt 3 where they
+ * change alike, over 3 where one changes). 0 where every texel of the window saw its light change by the
+ * same factor: one light lights them, and the factor is exact whatever rays the gathers cast. Where
+ * several lights light the window in different shares, the gathers' few rays per texel each see a
+ * different mix, and the spread of their ratios says how far the sum's ratio may be off (the two rooms'
+ * light_a2 removed: a face it lit to 80% read -21..+20% per texel, 10% over the face, and kept it for the
+ * 75 updates the surfaces' order spent elsewhere). */
 static float window_doubt(const lm_atlas *a, const float *e0, const float *e1, const uint8_t *done, quality at,
                           uint32_t i, const float *f, const int *use)
 {

@@ -63,8 +63,8 @@
  * its run is gathered. Cost: the rays cast, as above; a refinement step gathers all its texels, over
  * however many surfaces, in one parallel pass. Errors: none (deterministic: each texel's rays are
  * seeded by its index and the gather's seed, lm_gather_texel_seed; no memory: each texel takes its
- * surface's factor at once). Not thread-safe (one
- * job per lightmap path; the gathers themselves run on every OpenMP thread). */
+ * surface's factor at once). Not thread-safe (one job per lightmap path; the gathers themselves run on
+ * every OpenMP thread). */
 #ifndef LM_LIGHT_SCALE_H
 #define LM_LIGHT_SCALE_H
 

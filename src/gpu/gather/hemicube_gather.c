@@ -762,9 +762,10 @@ static void render_tiles(lm_gather *g, const lm_scene *s, const lm_atlas *a, con
 /* What each texel of a pass gets from the CPU, for the reduction to add: the emitters' closed-form
  * irradiance and the rim's (from its view's eye and axes: g->views, filled by render_tiles); the sample
  * patterns are seeded by the texel's index (lm_gather_texel_seed), so the thread count changes nothing.
- * While the GL rasterizes the pass: on llvmpipe on this thread alone (about 8 us per texel for two emissive triangles
- * and 10 us for the rim, where an OpenMP team competing with the rasterizer's threads cost ten times that);
- * on a GPU on every core, where the rim was 99% of a bake (docs/architecture.md, "On a GPU"). */
+ * While the GL rasterizes the pass: on llvmpipe on this thread alone (about 8 us per texel for two
+ * emissive triangles and 10 us for the rim, where an OpenMP team competing with the rasterizer's threads
+ * cost ten times that); on a GPU on every core, where the rim was 99% of a bake (docs/architecture.md,
+ * "On a GPU"). */
 static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, const uint32_t *texels,
                            uint32_t count)
 {
