@@ -7,8 +7,8 @@
  * The shared Cornell box once rendered 1.64x too bright here while every other test passed; these would
  * have caught it (docs/reference.md, "Frame against reference").
  *
- * The references: uncached (a test must not lean on what an earlier run left), at a relative standard
- * error of 0.03 per pixel. A looser target reads the generated Cornell box about 3% dark: its light,
+ * The references: kept only in this program's own folder (a test must not lean on what an earlier run left;
+ * a view checked under several settings shares one), at a relative standard error of 0.03 per pixel. A looser target reads the generated Cornell box about 3% dark: its light,
  * 10 cm under the ceiling, makes a few rare, bright paths, and a pixel that has not met one yet looks
  * converged and stops early. */
 #include <setjmp.h>
@@ -24,7 +24,7 @@
 #include "../src/gpu/gather/iim.h"
 #include "../src/api/frame_check.h"
 #include "../src/api/lmgi_updater.h"
-#include "../src/cli/run_cmd.h"
+#include "../src/cli/run_options.h"
 #include "../src/reference/reference.h"
 #include "support.h"
 
@@ -35,7 +35,7 @@
 #define BLOCK_RMSE 0.1   /* cornell-suzanne's textured block, per pixel (test_cornell_suzanne) */
 #define MIN_PIXELS 100    /* surfaces with fewer compared pixels are reported, not asserted */
 
-/* A scene loaded as `lmgi run` loads it (lm_cli_run_load): the lightmap density its default texel budget
+/* A scene loaded as `lmgi run` loads it (lm_cli_run_options): the lightmap density its default texel budget
  * keeps up with and 16 texels at least on a wall, or target_texels (> 0) as `--texels` asks; open surfaces
  * coarser either way. */
 static lmgi_scene *load_as_run(const char *path, int target_texels)
@@ -43,11 +43,7 @@ static lmgi_scene *load_as_run(const char *path, int target_texels)
     lmgi_options o;
     lmgi_options_init(&o);
     o.target_texels = target_texels;
-    if (!target_texels) {
-        o.target_texels = lm_frame_loop_atlas_texels(LM_IIM_DEFAULT_TEXELS_PER_FRAME);
-        o.wall_texels = LM_CLI_RUN_WALL_TEXELS;
-    }
-    o.open_need = LM_CLI_RUN_OPEN_NEED;
+    lm_cli_run_options(&o, 0);
     lmgi_scene *sc = NULL;
     lmgi_error err;
     if (lmgi_load(path, &o, &sc, &err) != LMGI_OK)
@@ -73,9 +69,13 @@ static lmgi_scene *load_as_check(const char *path, lm_frame_loop_settings *ls)
 
 static void ref_settings(lm_ref_settings *rs, float target_error)
 {
+    static const char *cache; /* this program's own folder */
+    if (!cache)
+        cache = lmt_tmpdir();
     lm_ref_settings_default(rs);
     rs->target_error = target_error;
-    rs->use_cache = 0;
+    rs->use_cache = 1;
+    rs->cache_dir = cache;
     rs->progress = 0;
 }
 
@@ -182,11 +182,6 @@ static void check_small_box(const char *name, lmgi_scene *sc, const lm_frame_loo
 {
     lm_ref_settings rs;
     ref_settings(&rs, REF_ERROR);
-    static const char *cache; /* this program's own folder: one reference for every setting checked of a view */
-    if (!cache)
-        cache = lmt_tmpdir();
-    rs.use_cache = 1;
-    rs.cache_dir = cache;
     lm_frame_check c;
     lm_error err;
     if (lm_frame_check_run(sc, ls, &rs, 1, &c, &err) != LM_OK)

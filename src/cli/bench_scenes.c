@@ -48,9 +48,7 @@ static void check_one(lmgi_context *ctx, const char *path)
 {
     lmgi_options o;
     lmgi_options_init(&o);
-    o.target_texels = lmgi_atlas_texels_for(0);
-    o.wall_texels = LM_CLI_RUN_WALL_TEXELS; /* as lmgi run and lmgi check load it (lm_cli_run_load) */
-    o.open_need = LM_CLI_RUN_OPEN_NEED;
+    lm_cli_run_options(&o, 0); /* as lmgi run and lmgi check load it */
     lmgi_scene *sc = NULL;
     lmgi_error err;
     if (lmgi_load(path, &o, &sc, &err) != LMGI_OK) {

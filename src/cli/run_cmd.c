@@ -314,12 +314,7 @@ static lmgi_status run(run_state *r, lmgi_error *err)
 int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc)
 {
     lmgi_options o = a->options;
-    if (o.texel_size <= 0.0f && o.target_texels <= 0) { /* a density the texel budget keeps up with */
-        o.target_texels = lmgi_atlas_texels_for(a->desc.gather.texels_per_frame);
-        o.wall_texels = LM_CLI_RUN_WALL_TEXELS; /* and that a level's walls show */
-    }
-    if (o.open_need == 0.0f) /* and where a level's texels are worth something (docs/charts.md) */
-        o.open_need = LM_CLI_RUN_OPEN_NEED;
+    lm_cli_run_options(&o, a->desc.gather.texels_per_frame);
     return lm_cli_load_scene(a->files[0], &o, 1, sc);
 }
 

@@ -5,15 +5,8 @@
 int lm_cli_run(const lm_cli_args *a);
 
 #include <lmgi.h>
+#include "run_options.h"
 #define LM_CLI_FRAME_SIZE 512 /* lmgi run's frame side when not given --size */
-/* Texels each wall or floor gets at least at run's density (lmgi_options.wall_texels) */
-#define LM_CLI_RUN_WALL_TEXELS 16
-/* The share of the level's worth per area under which an open surface's texels are coarsened, at run's
- * density and any other 'lmgi run' and 'lmgi check' derive (lmgi_options.open_need; docs/charts.md, "Open
- * surfaces"). Not the library's default, nor bake's, until the atlas packs a level's many small charts
- * tighter: truck-town's atlas at 2,000 to 1,000,000 texels is then
- * 26-45% used, under issue 30's 60%. */
-#define LM_CLI_RUN_OPEN_NEED 0.25f
 /* The updater's desc from the command line (0, the defaults, where not given). */
 void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d);
 /* lm_cli_updater_desc for a scene as run and check load it (lm_cli_run_load), its photons a bake's for its
@@ -25,7 +18,6 @@ void lm_cli_run_desc(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater_desc *d)
 /* The photons lm_cli_run_desc gives sc when not told: a bake's for its atlas where more than the updater's
  * 46,080, else 0 (the updater's default). */
 uint32_t lm_cli_run_photons(const lmgi_scene *sc);
-/* Loads a->files[0] as 'run' does: at the lightmap density its texel budget keeps up with unless told a
- * texel size or count. 0 (after printing the error) on failure. */
+/* Loads a->files[0] as 'run' does (lm_cli_run_options). 0 (after printing the error) on failure. */
 int lm_cli_run_load(const lm_cli_args *a, lmgi_scene **sc);
 #endif
