@@ -78,6 +78,14 @@ const char *lmt_tmpdir(void)
     return buf;
 }
 
+const char *lmt_reference_cache(void)
+{
+    static char dir[64];
+    if (!dir[0])
+        snprintf(dir, sizeof dir, "%s", lmt_tmpdir());
+    return dir;
+}
+
 unsigned char *lmt_read_file(const char *path, size_t *size, size_t extra)
 {
     FILE *f = fopen(path, "rb");

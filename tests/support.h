@@ -16,6 +16,10 @@ const char *lmt_project_scene(const char *relative);
 void lmt_filter_from_env(void);
 /* A fresh empty temporary directory for the calling test (static storage). */
 const char *lmt_tmpdir(void);
+/* The folder this program keeps its references in (lmgi_reference_desc.cache_dir, lm_ref_settings.cache_dir):
+ * made at the first call and the same for every later one, removed at exit. A test reuses a reference
+ * solved earlier in the same run, never one an earlier run left in build/reference-cache. */
+const char *lmt_reference_cache(void);
 /* The whole file in a malloc'd buffer with `extra` spare bytes after it (for mutations); *size its
  * length. Fails the test when it cannot be read. */
 unsigned char *lmt_read_file(const char *path, size_t *size, size_t extra);

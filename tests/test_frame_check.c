@@ -7,10 +7,11 @@
  * The shared Cornell box once rendered 1.64x too bright here while every other test passed; these would
  * have caught it (docs/reference.md, "Frame against reference").
  *
- * The references: kept only in this program's own folder (a test must not lean on what an earlier run left;
- * a view checked under several settings shares one), at a relative standard error of 0.03 per pixel. A looser target reads the generated Cornell box about 3% dark: its light,
- * 10 cm under the ceiling, makes a few rare, bright paths, and a pixel that has not met one yet looks
- * converged and stops early. */
+ * The references: kept only in this program's own folder (lmt_reference_cache: a test must not lean on what
+ * an earlier run left; a view checked under several settings shares one), at a relative standard error of
+ * 0.03 per pixel. A looser target reads the generated Cornell box about 3% dark: its light, 10 cm under the
+ * ceiling, makes a few rare, bright paths, and a pixel that has not met one yet looks converged and stops
+ * early. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -69,13 +70,10 @@ static lmgi_scene *load_as_check(const char *path, lm_frame_loop_settings *ls)
 
 static void ref_settings(lm_ref_settings *rs, float target_error)
 {
-    static const char *cache; /* this program's own folder */
-    if (!cache)
-        cache = lmt_tmpdir();
     lm_ref_settings_default(rs);
     rs->target_error = target_error;
     rs->use_cache = 1;
-    rs->cache_dir = cache;
+    rs->cache_dir = lmt_reference_cache();
     rs->progress = 0;
 }
 

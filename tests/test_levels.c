@@ -124,6 +124,7 @@ static void bake_and_check(const char *path, int texels, const lmgi_camera *cam)
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
     rd.target_error = 0.03f;
+    rd.cache_dir = lmt_reference_cache();
     lmgi_check_result c;
     assert_int_equal(lmgi_check_updater(u, cam, 64, 64, &rd, &c, &e), LMGI_OK);
     print_message("%s at %d texels under the sky: %u of %u valid texels exactly 0; frame / reference %.4f %.4f "

@@ -117,6 +117,7 @@ static outcome bake(const char *path, const lmgi_camera *cam, uint32_t photons, 
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
     rd.target_error = target;
+    rd.cache_dir = lmt_reference_cache();
     lmgi_check_result c;
     assert_int_equal(lmgi_check_updater(u, cam, 48, 48, &rd, &c, &e), LMGI_OK);
     memcpy(o.ratio, c.ratio, sizeof o.ratio);
@@ -430,6 +431,7 @@ static void test_sunlit_room_against_reference(void **state)
     lmgi_reference_desc rd;
     memset(&rd, 0, sizeof rd);
     rd.target_error = 0.05f;
+    rd.cache_dir = lmt_reference_cache();
     lmgi_check_result c;
     if (lmgi_check(ctx, sc, &d, &rd, 1, &c, &e) != LMGI_OK)
         fail_msg("%s", e.message);
