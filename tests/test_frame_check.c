@@ -22,7 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "../src/gpu/gather/iim.h"
 #include "../src/api/frame_check.h"
 #include "../src/api/lmgi_updater.h"
 #include "../src/cli/run_options.h"
