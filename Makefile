@@ -205,10 +205,15 @@ $(BUILD)/gen_scenes: tools/gen_scenes.c
 # fuzz_api (random call sequences with random values through the public API).
 FUZZ_BUILD := build/asan
 FUZZ_TESTS := $(FUZZ_BUILD)/tests/fuzz_loader $(FUZZ_BUILD)/tests/fuzz_pipeline $(FUZZ_BUILD)/tests/fuzz_api
-$(FUZZ_BUILD)/tests/fuzz_%: FORCE
+# Their library is one make of its own (run once however many fuzz tests are linked at a time), and never
+# beside the build of BUILD: under make test-asan both are build/asan (make test builds them one after
+# the other)
+.PHONY: fuzz-lib
+fuzz-lib:
 	@$(MAKE) --no-print-directory BUILD=$(FUZZ_BUILD) OPT="-O1 -g" \
 	  SAN="-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined" \
 	  $(FUZZ_BUILD)/liblmgi.a $(FUZZ_BUILD)/obj/tests/support.o
+$(FUZZ_BUILD)/tests/fuzz_%: fuzz-lib
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 -O1 -g $(WARN) -D_DEFAULT_SOURCE -Iinclude -fsanitize=address,undefined \
 	  -o $@ tests/fuzz_$*.c $(FUZZ_BUILD)/obj/tests/support.o $(FUZZ_BUILD)/liblmgi.a \
@@ -227,11 +232,24 @@ npm-deps:
 	     > $(NPM_DIR)/install.log 2>&1; then echo "$(NPM_PACKAGES)" > $(NPM_DIR)/installed; \
 	else echo "npm-deps: npm install failed ($(NPM_DIR)/install.log): the engine tests will skip"; fi
 
-# lmgi-mpi is built here, not as a prerequisite: deps may have just installed mpicc
-test: deps npm-deps all $(TESTS) $(FUZZ_TESTS)
+# make test builds and runs its binaries TEST_JOBS at a time (default: one a core; TEST_JOBS=1: one after
+# the other). The binaries go longest first (TEST_LONGEST, as measured: `slowest binaries` at the end of
+# its output), so that the last to finish is a short one (tests/run_tests.sh).
+TEST_JOBS    ?= $(shell nproc 2>/dev/null || echo 1)
+TEST_LONGEST := $(addprefix $(BUILD)/tests/,test_frame_check test_cli test_portals test_soak test_view \
+                  test_hard_cases test_run test_photon_gather test_api test_motion_trail test_accuracy \
+                  test_bake_after_edits)
+TESTS_RUN    := $(foreach t,$(TEST_LONGEST),$(filter $(t),$(TESTS))) $(FUZZ_TESTS) \
+                $(filter-out $(TEST_LONGEST),$(TESTS))
+
+# The build is a make of its own, after deps (which may have just installed what it needs, mpicc for
+# lmgi-mpi among them), so that it can run TEST_JOBS compilers at a time
+test: deps npm-deps
+	@$(MAKE) --no-print-directory -j$(TEST_JOBS) all $(TESTS)
+	@$(MAKE) --no-print-directory -j$(TEST_JOBS) $(FUZZ_TESTS)
 	@if command -v $(MPICC) > /dev/null 2>&1; then $(MAKE) --no-print-directory $(BUILD)/lmgi-mpi; \
 	else echo "make test: no $(MPICC): the MPI test will skip"; fi
-	@LMGI_BUILD=$(BUILD) LMGI_NPM=$(NPM_DIR) sh tests/run_tests.sh $(TESTS) $(FUZZ_TESTS)
+	@LMGI_BUILD=$(BUILD) LMGI_NPM=$(NPM_DIR) LMGI_TEST_JOBS=$(TEST_JOBS) sh tests/run_tests.sh $(TESTS_RUN)
 
 # make fuzz: FUZZ_INPUTS structured inputs through the whole pipeline under ASan + UBSan, split over
 # FUZZ_JOBS processes with seeds 1..FUZZ_JOBS (each its own inputs), then FUZZ_API_SEQUENCES call

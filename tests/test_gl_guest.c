@@ -233,8 +233,16 @@ static int glx_host(host *h)
 {
     const char *display = getenv("DISPLAY");
     h->x_dpy = display && *display ? XOpenDisplay(NULL) : NULL;
-    if (!h->x_dpy)
+    /* An Xvfb can lose the display number it chose to another starting at the same moment (make test runs
+     * binaries side by side, test_view's xvfb-run among them) and exit: a new one picks again. */
+    for (int tries = 0; tries < 3 && !h->x_dpy; tries++) {
+        if (h->xvfb > 0) {
+            kill(h->xvfb, SIGTERM);
+            waitpid(h->xvfb, NULL, 0);
+            h->xvfb = 0;
+        }
         h->x_dpy = start_xvfb(h);
+    }
     if (!h->x_dpy) {
         print_message("skipped: no X server for a GLX host (DISPLAY %s; /usr/bin/Xvfb %s; make deps installs "
                       "xvfb)\n", display && *display ? "did not open" : "unset",

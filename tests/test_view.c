@@ -67,7 +67,10 @@ static int under_x(const char *script)
     assert_non_null(f);
     fprintf(f, "%s\n", script);
     fclose(f);
-    snprintf(cmd, sizeof cmd, "xvfb-run -a -s '-screen 0 320x240x24 -nolisten tcp' sh %s 2>&1", path);
+    /* -a tries the next display number while one is taken; starting from one of this process's own keeps
+     * two runs side by side (make test and make test-asan) from picking the same free one at once */
+    snprintf(cmd, sizeof cmd, "xvfb-run -a -n %d -s '-screen 0 320x240x24 -nolisten tcp' sh %s 2>&1",
+             100 + (int)(getpid() % 800), path);
     return lmt_run(cmd, output, sizeof output);
 }
 
