@@ -242,9 +242,10 @@ TEST_LONGEST := $(addprefix $(BUILD)/tests/,test_frame_check test_cli test_porta
 TESTS_RUN    := $(foreach t,$(TEST_LONGEST),$(filter $(t),$(TESTS))) $(FUZZ_TESTS) \
                 $(filter-out $(TEST_LONGEST),$(TESTS))
 
-# The build is a make of its own, after deps (which may have just installed what it needs, mpicc for
-# lmgi-mpi among them), so that it can run TEST_JOBS compilers at a time
-test: deps npm-deps
+# npm-deps and the build are makes of their own, after deps (which may have just installed what they
+# need: npm, mpicc for lmgi-mpi), whatever -j the caller gave; the build runs TEST_JOBS compilers at a time
+test: deps
+	@$(MAKE) --no-print-directory npm-deps
 	@$(MAKE) --no-print-directory -j$(TEST_JOBS) all $(TESTS)
 	@$(MAKE) --no-print-directory -j$(TEST_JOBS) $(FUZZ_TESTS)
 	@if command -v $(MPICC) > /dev/null 2>&1; then $(MAKE) --no-print-directory $(BUILD)/lmgi-mpi; \
