@@ -42,6 +42,9 @@ for t in "$@"; do
     printf '%d %s\n' "$n" "$t"
 done | xargs -P "$jobs" -L 1 sh -c "$run_one" "$logs"
 
+# Test cases cmocka counted on its closing line "[  WORD ] N test(s)" in output file $2 (WORD is $1, padded
+# as cmocka pads it); 0 where there is none.
+cases() { sed -n "s/^\[  $1\] \([0-9]*\) test.*/\1/p" "$2" 2>/dev/null | awk '{s+=$1} END {print s+0}'; }
 passed=0; failed=0; skipped=0; bad=""; times=""; n=0
 for t in "$@"; do
     n=$((n + 1))
@@ -49,9 +52,7 @@ for t in "$@"; do
     rc=$(cat "$logs/$n.rc" 2>/dev/null || echo 1) # none: the runner was stopped before it ended
     times="$times$(cat "$logs/$n.secs" 2>/dev/null || echo 0) $t
 "
-    p=$(sed -n 's/^\[  PASSED  \] \([0-9]*\) test.*/\1/p' "$out" 2>/dev/null | awk '{s+=$1} END {print s+0}')
-    f=$(sed -n 's/^\[  FAILED  \] \([0-9]*\) test.*/\1/p' "$out" 2>/dev/null | awk '{s+=$1} END {print s+0}')
-    s=$(sed -n 's/^\[  SKIPPED \] \([0-9]*\) test.*/\1/p' "$out" 2>/dev/null | awk '{s+=$1} END {print s+0}')
+    p=$(cases "PASSED  " "$out"); f=$(cases "FAILED  " "$out"); s=$(cases "SKIPPED " "$out")
     passed=$((passed + p)); failed=$((failed + f)); skipped=$((skipped + s))
     if [ "$rc" -ne 0 ]; then
         bad="$bad $t"
