@@ -51,6 +51,7 @@ struct host {
     GLXContext glx_ctx;
     GLXPbuffer glx_pbuf;
     pid_t xvfb;
+    char xvfb_failed[96]; /* the last try's step that failed, for the skip's message */
 };
 
 /* The host's context clears to a colour and reads it back: it is current and works. */
@@ -195,21 +196,34 @@ static int glx_current(const host *h)
            glXGetCurrentDrawable() == h->glx_pbuf && glXGetCurrentReadDrawable() == h->glx_pbuf;
 }
 
-/* Starts Xvfb on a free display (-displayfd: it writes the number it took) and opens it. */
+/* Xvfb's messages, kept in the test's folder for a skip to show */
+static const char *xvfb_log(void)
+{
+    static char path[96];
+    if (!path[0])
+        snprintf(path, sizeof path, "%s/xvfb.log", lmt_tmpdir());
+    return path;
+}
+
+/* Starts Xvfb on a free display (-displayfd: it writes the number it took) and opens it; on failure
+ * h->xvfb_failed says which step failed. */
 static Display *start_xvfb(host *h)
 {
     int fds[2];
-    if (access("/usr/bin/Xvfb", X_OK) != 0 || pipe(fds) != 0)
+    if (access("/usr/bin/Xvfb", X_OK) != 0 || pipe(fds) != 0) {
+        snprintf(h->xvfb_failed, sizeof h->xvfb_failed, "no /usr/bin/Xvfb or no pipe");
         return NULL;
+    }
+    const char *log_path = xvfb_log(); /* named here: the child's folder would be its own */
     h->xvfb = fork();
     if (h->xvfb == 0) {
         close(fds[0]);
         char fd[16];
         snprintf(fd, sizeof fd, "%d", fds[1]);
         prctl(PR_SET_PDEATHSIG, SIGTERM); /* gone with the test, even one that fails on the way */
-        int null = open("/dev/null", O_WRONLY);
+        int null = open("/dev/null", O_WRONLY), log = open(log_path, O_WRONLY | O_CREAT | O_APPEND, 0644);
         dup2(null, 1); /* the test runner's pipe must not be held open after the test */
-        dup2(null, 2);
+        dup2(log >= 0 ? log : null, 2);
         execl("/usr/bin/Xvfb", "Xvfb", "-displayfd", fd, "-screen", "0", "64x64x24", "-nolisten", "tcp",
               (char *)NULL);
         _exit(127);
@@ -218,15 +232,42 @@ static Display *start_xvfb(host *h)
     char num[16] = "";
     ssize_t got = h->xvfb > 0 ? read(fds[0], num, sizeof num - 1) : -1; /* blocks until Xvfb is ready */
     close(fds[0]);
-    if (got <= 0)
+    if (got <= 0) {
+        int status = 0;
+        pid_t done = h->xvfb > 0 ? waitpid(h->xvfb, &status, WNOHANG) : -1;
+        snprintf(h->xvfb_failed, sizeof h->xvfb_failed, "Xvfb %s before it was ready%s%d",
+                 done == h->xvfb ? "exited" : "closed -displayfd",
+                 done == h->xvfb && WIFSIGNALED(status) ? ", signal " : ", status ",
+                 done == h->xvfb ? (WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status)) : -1);
+        if (done == h->xvfb)
+            h->xvfb = 0;
         return NULL;
+    }
     num[got] = '\0';
     char name[32];
     snprintf(name, sizeof name, ":%d", atoi(num));
     Display *d = NULL; /* ready, it said; a server that just left the same number can still be going */
     for (int tries = 0; tries < 30 && !(d = XOpenDisplay(name)); tries++)
         usleep(100000);
+    if (!d)
+        snprintf(h->xvfb_failed, sizeof h->xvfb_failed, "Xvfb said %s was ready, which did not open in 3 s", name);
     return d;
+}
+
+/* The last lines of Xvfb's messages, printed with a skip */
+static void print_xvfb_log(void)
+{
+    char buf[1024];
+    FILE *f = fopen(xvfb_log(), "r");
+    if (!f)
+        return;
+    fseek(f, 0, SEEK_END);
+    long size = ftell(f);
+    fseek(f, size > (long)sizeof buf - 1 ? size - (long)sizeof buf + 1 : 0, SEEK_SET);
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = '\0';
+    print_message("Xvfb's last messages (%s):\n%s\n", xvfb_log(), buf);
 }
 
 /* Ends the Xvfb the test started, if any. */
@@ -245,15 +286,17 @@ static int glx_host(host *h)
     h->x_dpy = display && *display ? XOpenDisplay(NULL) : NULL;
     /* An Xvfb can exit before it is ready, as when another takes the display number it chose (make test
      * runs binaries side by side): a new one picks again. On a loaded machine all three have failed once,
-     * for a reason not yet known (the skip's message says "did not start"). */
+     * for a reason not yet known: the skip now says which step failed and prints Xvfb's own messages. */
     for (int tries = 0; tries < 3 && !h->x_dpy; tries++) {
         stop_xvfb(h);
         h->x_dpy = start_xvfb(h);
     }
     if (!h->x_dpy) {
-        print_message("skipped: no X server for a GLX host (DISPLAY %s; /usr/bin/Xvfb %s; make deps installs "
+        print_message("skipped: no X server for a GLX host (DISPLAY %s; /usr/bin/Xvfb %s%s; make deps installs "
                       "xvfb)\n", display && *display ? "did not open" : "unset",
-                      access("/usr/bin/Xvfb", X_OK) ? "absent" : "did not start");
+                      access("/usr/bin/Xvfb", X_OK) ? "absent" : "did not start: ",
+                      access("/usr/bin/Xvfb", X_OK) ? "" : h->xvfb_failed);
+        print_xvfb_log();
         return 0;
     }
     const int attribs[] = {GLX_DRAWABLE_TYPE, GLX_PBUFFER_BIT, GLX_RENDER_TYPE, GLX_RGBA_BIT, GLX_RED_SIZE, 8,
