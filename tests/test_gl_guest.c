@@ -234,13 +234,14 @@ static Display *start_xvfb(host *h)
     close(fds[0]);
     if (got <= 0) {
         int status = 0;
-        pid_t done = h->xvfb > 0 ? waitpid(h->xvfb, &status, WNOHANG) : -1;
-        snprintf(h->xvfb_failed, sizeof h->xvfb_failed, "Xvfb %s before it was ready%s%d",
-                 done == h->xvfb ? "exited" : "closed -displayfd",
-                 done == h->xvfb && WIFSIGNALED(status) ? ", signal " : ", status ",
-                 done == h->xvfb ? (WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status)) : -1);
-        if (done == h->xvfb)
+        if (h->xvfb > 0 && waitpid(h->xvfb, &status, WNOHANG) == h->xvfb) {
+            snprintf(h->xvfb_failed, sizeof h->xvfb_failed, "Xvfb exited before it was ready, %s %d",
+                     WIFSIGNALED(status) ? "signal" : "status",
+                     WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status));
             h->xvfb = 0;
+        } else {
+            snprintf(h->xvfb_failed, sizeof h->xvfb_failed, "Xvfb closed -displayfd before it was ready");
+        }
         return NULL;
     }
     num[got] = '\0';
@@ -254,20 +255,16 @@ static Display *start_xvfb(host *h)
     return d;
 }
 
-/* The last lines of Xvfb's messages, printed with a skip */
+/* The last KiB of Xvfb's messages, printed with a skip */
 static void print_xvfb_log(void)
 {
-    char buf[1024];
-    FILE *f = fopen(xvfb_log(), "r");
-    if (!f)
+    if (access(xvfb_log(), R_OK) != 0)
         return;
-    fseek(f, 0, SEEK_END);
-    long size = ftell(f);
-    fseek(f, size > (long)sizeof buf - 1 ? size - (long)sizeof buf + 1 : 0, SEEK_SET);
-    size_t n = fread(buf, 1, sizeof buf - 1, f);
-    fclose(f);
-    buf[n] = '\0';
-    print_message("Xvfb's last messages (%s):\n%s\n", xvfb_log(), buf);
+    size_t size;
+    char *text = (char *)lmt_read_file(xvfb_log(), &size, 1);
+    text[size] = '\0';
+    print_message("Xvfb's last messages (%s):\n%s\n", xvfb_log(), size > 1024 ? text + size - 1024 : text);
+    free(text);
 }
 
 /* Ends the Xvfb the test started, if any. */
@@ -292,10 +289,10 @@ static int glx_host(host *h)
         h->x_dpy = start_xvfb(h);
     }
     if (!h->x_dpy) {
+        int absent = access("/usr/bin/Xvfb", X_OK) != 0;
         print_message("skipped: no X server for a GLX host (DISPLAY %s; /usr/bin/Xvfb %s%s; make deps installs "
                       "xvfb)\n", display && *display ? "did not open" : "unset",
-                      access("/usr/bin/Xvfb", X_OK) ? "absent" : "did not start: ",
-                      access("/usr/bin/Xvfb", X_OK) ? "" : h->xvfb_failed);
+                      absent ? "absent" : "did not start: ", absent ? "" : h->xvfb_failed);
         print_xvfb_log();
         return 0;
     }
