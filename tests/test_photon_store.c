@@ -69,6 +69,7 @@ static void test_add_remove(void **state)
     for (uint32_t s = ps.free_head; s != LM_NONE; s = ps.hits[s].next)
         freed++;
     assert_int_equal(freed, 4);
+    assert_int_equal(ps.free_count, 4);
 
     /* Out-of-range surfaces are refused and leave the store as it was. */
     lm_hit bad = make_hit(3, 99, 1.0f, 0, 0);
@@ -108,6 +109,40 @@ static void test_free_list_reuse(void **state)
     assert_int_equal(walk(&ps, 0), 1000);
     lm_hit h = make_hit(1, 9999, 0.5f, 2, 0);
     assert_int_equal(lm_photon_store_add(&ps, &h), 2000);
+    lm_photon_store_free(&ps);
+}
+
+/* A batch's reservation counts the free slots its adds take first: a re-trace that replaces half the hits
+ * must not double the array (it did, by 40 MB in the two rooms' soak, tests/test_soak.c). */
+static void test_reserve_counts_free_slots(void **state)
+{
+    (void)state;
+    lm_photon_store ps;
+    lm_error err;
+    assert_int_equal(lm_photon_store_init(&ps, 1, &err), LM_OK);
+    uint32_t slot[2048];
+    for (int i = 0; i < 2048; i++) {
+        lm_hit h = make_hit(0, (uint32_t)i, 1.0f, 1, 0);
+        slot[i] = lm_photon_store_add(&ps, &h);
+    }
+    assert_int_equal(ps.used, 2048);
+    assert_int_equal(ps.capacity, 2048); /* 1024 doubled once: full */
+    for (int i = 0; i < 2048; i += 2)
+        lm_photon_store_remove(&ps, slot[i]);
+    assert_int_equal(ps.free_count, 1024);
+    assert_true(lm_photon_store_reserve(&ps, 1024)); /* the free slots hold them all */
+    assert_int_equal(ps.capacity, 2048);
+    for (int i = 0; i < 1000; i++) {
+        lm_hit h = make_hit(0, 5000u + (uint32_t)i, 1.0f, 1, 0);
+        assert_true(lm_photon_store_add(&ps, &h) < 2048);
+    }
+    assert_int_equal(ps.free_count, 24);
+    assert_true(lm_photon_store_reserve(&ps, 24));
+    assert_int_equal(ps.capacity, 2048);
+    assert_true(lm_photon_store_reserve(&ps, 25)); /* one past the free slots: the array grows */
+    assert_int_equal(ps.capacity, 4096);
+    lm_photon_store_clear(&ps);
+    assert_int_equal(ps.free_count, 0);
     lm_photon_store_free(&ps);
 }
 
@@ -232,6 +267,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_add_remove),
         cmocka_unit_test(test_free_list_reuse),
+        cmocka_unit_test(test_reserve_counts_free_slots),
         cmocka_unit_test(test_deltas),
         cmocka_unit_test(test_clear_matches_fresh),
         cmocka_unit_test(test_energy_follows_hits),

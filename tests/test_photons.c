@@ -582,6 +582,60 @@ static void test_recolour_reweights_hits(void **state)
     world_free(&w);
 }
 
+/* A channel recoloured far down and back (0.9 -> 0.001 -> 0.9): a path that bounced k times off the
+ * material had its hits scaled by 1e-3^k and then by 1e3^k, and past 1e-12 their float flux has lost its
+ * digits (0 x inf: NaN in the AIMs of the two rooms' soak after 874 updates, tests/test_soak.c). Every
+ * hit stays finite, the groups of such paths are queued again at once, and once traced the store holds
+ * what tracing every path again does. */
+static void test_recolour_far_and_back(void **state)
+{
+    (void)state;
+    world w;
+    load_lamp_box(&w, "far.gltf", "[1, 1, 1]");
+    lm_material *m = &w.s->materials[w.s->tri_material[0]];
+    const float was[3] = {0.9f, 0.9f, 0.9f}, low[3] = {0.9f, 0.001f, 0.9f};
+    memcpy(m->base_color, was, sizeof was);
+    world_trace(&w, 20000, NULL);
+    const lm_photon_store *store = lm_photons_store(w.ph);
+    int S = store->surface_count, M = w.s->material_count;
+    float *ratio = malloc(3 * sizeof *ratio * (size_t)M);
+    uint8_t *touched = calloc((size_t)S, 1);
+    double *held = calloc(3 * (size_t)S, sizeof *held);
+    assert_non_null(ratio);
+    assert_non_null(touched);
+    assert_non_null(held);
+    for (int i = 0; i < 3 * M; i++)
+        ratio[i] = 1.0f;
+    assert_int_equal(lm_photons_pending_groups(w.ph), 0);
+    for (int step = 0; step < 2; step++) {
+        const float *from = step ? low : was, *to = step ? was : low;
+        for (int c = 0; c < 3; c++)
+            ratio[3 * w.s->tri_material[0] + c] = to[c] / from[c];
+        lm_photons_scale_materials(w.ph, ratio, M, touched);
+        memcpy(m->base_color, to, sizeof was);
+    }
+    uint32_t hits = 0;
+    for (uint32_t i = 0; i < store->used; i++) {
+        const lm_hit *h = lm_photon_store_live(store, i);
+        if (h && !(isfinite(h->flux[0]) && isfinite(h->flux[1]) && isfinite(h->flux[2])))
+            fail_msg("hit %u: flux %g %g %g after a recolour far down and back", i, (double)h->flux[0],
+                     (double)h->flux[1], (double)h->flux[2]);
+        hits += h != NULL;
+    }
+    uint32_t queued = lm_photons_pending_groups(w.ph);
+    while (lm_photons_pending_groups(w.ph))
+        frame(&w);
+    lm_photon_store_surface_flux(store, held);
+    uint32_t differ = 0;
+    double worst = against_a_trace(&w, held, &differ);
+    print_message("recolour far and back: %u hits finite, %u groups queued again; then against every path traced "
+                  "again, per surface and channel worst %.2g\n", hits, queued, worst);
+    assert_true(queued > 0);
+    assert_true(worst < 1e-5);
+    free(ratio), free(touched), free(held);
+    world_free(&w);
+}
+
 static void test_energy_closed_box(void **state)
 {
     (void)state;
@@ -1210,6 +1264,7 @@ int main(void)
         cmocka_unit_test(test_hits_know_where_they_came_from),
         cmocka_unit_test(test_power_edit_scales_hits),
         cmocka_unit_test(test_recolour_reweights_hits),
+        cmocka_unit_test(test_recolour_far_and_back),
         cmocka_unit_test(test_no_channel_grows),
         cmocka_unit_test(test_invalidate_emitter),
         cmocka_unit_test(test_retrace_emitter_leaves_queue),

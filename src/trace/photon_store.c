@@ -1,5 +1,6 @@
 #include "photon_store.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,6 +24,7 @@ void lm_photon_store_clear(lm_photon_store *ps)
     ps->version++;
     ps->used = 0;
     ps->free_head = LM_NONE;
+    ps->free_count = 0;
     for (int i = 0; i < ps->surface_count; i++) {
         ps->surfaces[i].count = 0;
         ps->surfaces[i].delta_f = ps->surfaces[i].delta_i = ps->surfaces[i].energy = 0.0;
@@ -59,12 +61,13 @@ static int grow(lm_photon_store *ps, uint64_t need)
 
 int lm_photon_store_reserve(lm_photon_store *ps, uint64_t n)
 {
-    if (!grow(ps, ps->used + n))
+    uint64_t past = n > ps->free_count ? n - ps->free_count : 0; /* the adds the free slots do not take */
+    if (!grow(ps, ps->used + past))
         return 0;
     /* The batch's adds fill these next: fault them in at once, but only those never touched yet
      * (after lm_photon_store_clear the slots stay mapped, and asking the kernel again for pages it
      * already has walks the page tables for nothing, once per batch of a warm re-trace). */
-    uint32_t from = ps->used > ps->mapped ? ps->used : ps->mapped, to = ps->used + (uint32_t)n;
+    uint32_t from = ps->used > ps->mapped ? ps->used : ps->mapped, to = ps->used + (uint32_t)past;
     if (to > from) {
         lm_prefault(ps->hits + from, sizeof *ps->hits * (to - from));
         ps->mapped = to;
@@ -117,6 +120,7 @@ void lm_photon_store_remove(lm_photon_store *ps, uint32_t slot)
     d->at = LM_NONE;
     d->next = ps->free_head;
     ps->free_head = slot;
+    ps->free_count++;
 }
 
 void lm_photon_store_scale(lm_photon_store *ps, uint32_t slot, const float s[3])
@@ -125,8 +129,8 @@ void lm_photon_store_scale(lm_photon_store *ps, uint32_t slot, const float s[3])
     if (!h)
         return;
     double before = lm_hit_energy(h);
-    for (int c = 0; c < 3; c++)
-        h->flux[c] *= s[c];
+    for (int c = 0; c < 3; c++) /* a channel at 0 stays 0 (never 0 x inf), the rest at most FLT_MAX */
+        h->flux[c] = h->flux[c] > 0.0f ? (float)fmin((double)h->flux[c] * s[c], FLT_MAX) : 0.0f;
     double moved = lm_hit_energy(h) - before;
     lm_surface_hits *sh = &ps->surfaces[h->surface];
     ps->version++;
@@ -157,7 +161,8 @@ void lm_photon_store_reset_delta_f(lm_photon_store *ps, int surface) { ps->surfa
 void lm_photon_store_reset_delta_i(lm_photon_store *ps, int surface) { ps->surfaces[surface].delta_i = 0.0; }
 int lm_photon_store_same(const lm_photon_store *a, const lm_photon_store *b)
 {
-    if (a->used != b->used || a->free_head != b->free_head || a->surface_count != b->surface_count ||
+    if (a->used != b->used || a->free_head != b->free_head || a->free_count != b->free_count ||
+        a->surface_count != b->surface_count ||
         memcmp(a->hits, b->hits, sizeof *a->hits * a->used) != 0)
         return 0;
     for (int i = 0; i < a->surface_count; i++) {

@@ -2,6 +2,7 @@
  * check and the budgeted re-trace of invalid groups (Larsen & Christensen 2004, section 2). */
 #include "photons.h"
 
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,6 +15,10 @@
 
 /* Photons traced per batch in a group re-trace: bounds the trace buffers. */
 #define PH_BATCH_PHOTONS 16384u
+/* A path reweighted by recolours (lm_photons_scale_materials) by less than this, or more than its inverse,
+ * is traced again: its hits keep their flux in floats, which a soak's 180 recolours drove below the
+ * smallest float and back up by the inverse, 0 x inf (NaN) in the AIMs after 874 updates */
+#define LM_SCALE_LEAST 1e-12
 #define PH_MAX_PHOTONS (1u << 30)
 
 void lm_photon_settings_default(lm_photon_settings *s)
@@ -449,22 +454,29 @@ void lm_photons_scale_materials(lm_photons *ph, const float *ratio, int material
     const int *tri_material = ph->scene->tri_material;
     for (uint32_t gi = 0; gi < ph->group_count; gi++) {
         const ph_group *g = &ph->groups[gi];
+        int extreme = 0;
         for (uint32_t m = 0; g->offsets && m < g->photons; m++) {
-            float w[3] = {1.0f, 1.0f, 1.0f}; /* what the bounces so far on recoloured materials multiply */
+            double w[3] = {1.0, 1.0, 1.0}; /* what the bounces so far on recoloured materials multiply */
             int any = 0;
             for (uint32_t i = g->offsets[m]; i < g->offsets[m + 1]; i++) {
                 const lm_path_vertex *v = &g->verts[i];
                 const lm_hit *h = any ? lm_photon_store_live(&ph->store, v->slot) : NULL;
                 if (h) {
+                    float s[3] = {(float)fmin(w[0], FLT_MAX), (float)fmin(w[1], FLT_MAX), (float)fmin(w[2], FLT_MAX)};
                     touched[h->surface] = 1;
-                    lm_photon_store_scale(&ph->store, v->slot, w);
+                    lm_photon_store_scale(&ph->store, v->slot, s);
                 }
                 int mat = tri_material[v->tri];
                 const float *r = mat >= 0 && mat < materials ? ratio + 3 * (size_t)mat : NULL;
                 if (r && (r[0] != 1.0f || r[1] != 1.0f || r[2] != 1.0f))
-                    w[0] *= r[0], w[1] *= r[1], w[2] *= r[2], any = 1;
+                    for (int c = 0; c < 3; c++) {
+                        w[c] *= r[c], any = 1;
+                        extreme |= w[c] > 0.0 && !(w[c] >= LM_SCALE_LEAST && w[c] <= 1.0 / LM_SCALE_LEAST);
+                    }
             }
         }
+        if (extreme) /* its hits' flux has lost its digits, or soon would: traced again from the colours */
+            mark_invalid(ph, gi);
     }
 }
 

@@ -176,7 +176,9 @@ lm_status lm_photons_retrace_emitter(lm_photons *ph, int e, lm_error *err);
  * is multiplied by the ratios of the bounces before it, and touched[surface] set for its surface. A path's later decisions follow albedos
  * through the survival probability, which the old colour set: the old path with the new weight is an
  * unbiased estimate of the new light (importance sampling), noisier where a ratio is large, until the
- * groups are traced again (lm_photons_invalidate_materials). O(path vertices), no ray. */
+ * groups are traced again (lm_photons_invalidate_materials). A group with a path whose weight left
+ * [1e-12, 1e12] (many recolours of a material it bounces off often) is queued for tracing again at once:
+ * floats hold its hits' flux, and that far down their digits are gone. O(path vertices), no ray. */
 void lm_photons_scale_materials(lm_photons *ph, const float *ratio, int materials, uint8_t *touched);
 /* The flux of emitter e's stored hits added per surface into flux[surface * 3 + c] (e in range). */
 void lm_photons_emitter_flux(const lm_photons *ph, int e, double *flux);
