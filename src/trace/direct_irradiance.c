@@ -47,13 +47,18 @@ static void punctual(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, lm_vec3 ns,
     }
 }
 
-/* The emissive triangles' light on the side of normal n, from p lifted to that side. */
-static void area(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, uint32_t seed, double e[3])
+/* The emissive triangles' light on the side of geometric normal n, from p lifted to that side: the shading
+ * normal ns's cosine (on n's side), as the reference's next event and the photons' arrival weight take it,
+ * over what lies above both horizons. Light that grazes a surface whose shading normal leans towards it
+ * (a ceiling beside a slab lamp's 1 cm edges, its corner-averaged normals leaning 30 degrees) is many times
+ * what the geometric cosine gives: cornell-suzanne's lamp edges lit the room 30% short with it. */
+static void area(const lm_direct_light *d, lm_vec3 p, lm_vec3 n, lm_vec3 ns, uint32_t seed, double e[3])
 {
-    float at[3], nrm[3], out[3];
+    float at[3], nrm[3], geo[3], out[3];
     lm_v3_store(at, lm_add(p, lm_scale(n, d->lift)));
-    lm_v3_store(nrm, n);
-    lm_emitter_irradiance(d->area, at, nrm, NULL, seed, out); /* n is the geometric normal here */
+    lm_v3_store(nrm, ns);
+    lm_v3_store(geo, n);
+    lm_emitter_irradiance(d->area, at, nrm, geo, seed, out);
     for (int c = 0; c < 3; c++)
         e[c] += out[c];
 }
@@ -74,9 +79,11 @@ static void computed(const lm_direct_light *d, lm_vec3 p, const float n[3], cons
     if (d->punctual)
         punctual(d, p, nv, shading_side(n, ns), sides, e);
     if (d->area && (sides & 1))
-        area(d, p, nv, seed, e);
-    if (d->area && (sides & 2))
-        area(d, p, lm_scale(nv, -1.0f), seed ^ 0x9e3779b9u, e);
+        area(d, p, nv, shading_side(n, ns), seed, e);
+    if (d->area && (sides & 2)) {
+        float back[3] = {-n[0], -n[1], -n[2]};
+        area(d, p, lm_scale(nv, -1.0f), shading_side(back, ns), seed ^ 0x9e3779b9u, e);
+    }
     for (int c = 0; c < 3; c++)
         out[c] = (float)e[c];
 }

@@ -48,10 +48,12 @@ typedef struct {
 
 /* Irradiance at world point p of a surface with unit geometric normal n, from the front side only, or
  * from both sides added (two_sided: a double-sided material, whose photon estimate counts both). A
- * punctual light's cosine is taken with the unit shading normal ns (NULL: n; either side, it is turned to
- * n's), as the reference and the frame's direct pass take it: on a terrain of smooth normals over coarse
- * triangles the two differ by tens of degrees (truck-town's grass beside the retaining wall: half the
- * light), and a light on the other side of either gives nothing. seed picks the emitter light's sample
+ * punctual light's cosine, and an emissive triangle's, is taken with the unit shading normal ns (NULL: n;
+ * either side, it is turned to n's), as the reference, the photons' arrival weight and the frame's direct
+ * pass take it: on a terrain of smooth normals over coarse triangles the two differ by tens of degrees
+ * (truck-town's grass beside the retaining wall: half the light), light that grazes a surface differs by
+ * ten times (a ceiling beside a slab lamp's 1 cm edges), and a light on the other side of either gives
+ * nothing. seed picks the emitter light's sample
  * pattern (pass the same one for the same point: no flicker). Returns 0 when every side asked for is
  * covered (d->cover on `surface`: out is 0, and the point is hidden, not dark), else 1. */
 int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], const float ns[3],
