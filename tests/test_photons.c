@@ -541,6 +541,23 @@ static void test_power_edit_scales_hits(void **state)
     world_free(&w);
 }
 
+/* The lamp box's material (the box's, its only one) recoloured from `was` to `now` as an edit does: every
+ * hit reweighted (lm_photons_scale_materials), then the colour set; touched (surface_count) marks the
+ * surfaces reached. */
+static void recolour_box(world *w, const float was[3], const float now[3], uint8_t *touched)
+{
+    int M = w->s->material_count, box = w->s->tri_material[0];
+    float *ratio = malloc(3 * sizeof *ratio * (size_t)M);
+    assert_non_null(ratio);
+    for (int i = 0; i < 3 * M; i++)
+        ratio[i] = 1.0f;
+    for (int c = 0; c < 3; c++)
+        ratio[3 * box + c] = now[c] / was[c];
+    lm_photons_scale_materials(w->ph, ratio, M, touched);
+    memcpy(w->s->materials[box].base_color, now, 3 * sizeof *now);
+    free(ratio);
+}
+
 /* Issue 32, item 2: a diffuse material recoloured alone. Its photons' paths follow the albedo only through
  * the survival probability (the largest channel), so a recolour that keeps the largest channel keeps every
  * path, and reweighting the hits after each bounce off it (lm_photons_scale_materials) stores what tracing
@@ -555,30 +572,23 @@ static void test_recolour_reweights_hits(void **state)
     memcpy(m->base_color, was, sizeof was);
     world_trace(&w, 20000, NULL);
     const lm_photon_store *store = lm_photons_store(w.ph);
-    int S = store->surface_count, M = w.s->material_count;
+    int S = store->surface_count;
     double *scaled = calloc(3 * (size_t)S, sizeof *scaled);
-    float *ratio = malloc(3 * sizeof *ratio * (size_t)M);
     uint8_t *touched = calloc((size_t)S, 1);
     assert_non_null(scaled);
-    assert_non_null(ratio);
     assert_non_null(touched);
-    for (int i = 0; i < 3 * M; i++)
-        ratio[i] = 1.0f;
-    for (int c = 0; c < 3; c++)
-        ratio[3 * w.s->tri_material[0] + c] = now[c] / was[c];
-    lm_photons_scale_materials(w.ph, ratio, M, touched);
+    recolour_box(&w, was, now, touched);
     lm_photon_store_surface_flux(store, scaled);
     int reached = 0;
     for (int k = 0; k < S; k++)
         reached += touched[k];
-    memcpy(m->base_color, now, sizeof now);
     uint32_t differ = 0;
     double worst = against_a_trace(&w, scaled, &differ);
     print_message("recolour: hits reweighted against traced again, per surface and channel worst %.2g (%d of %d "
                   "surfaces reached)\n", worst, reached, S);
     assert_int_equal(reached, S);
     assert_true(worst < 1e-5);
-    free(scaled), free(ratio), free(touched);
+    free(scaled), free(touched);
     world_free(&w);
 }
 
@@ -597,23 +607,14 @@ static void test_recolour_far_and_back(void **state)
     memcpy(m->base_color, was, sizeof was);
     world_trace(&w, 20000, NULL);
     const lm_photon_store *store = lm_photons_store(w.ph);
-    int S = store->surface_count, M = w.s->material_count;
-    float *ratio = malloc(3 * sizeof *ratio * (size_t)M);
+    int S = store->surface_count;
     uint8_t *touched = calloc((size_t)S, 1);
     double *held = calloc(3 * (size_t)S, sizeof *held);
-    assert_non_null(ratio);
     assert_non_null(touched);
     assert_non_null(held);
-    for (int i = 0; i < 3 * M; i++)
-        ratio[i] = 1.0f;
     assert_int_equal(lm_photons_pending_groups(w.ph), 0);
-    for (int step = 0; step < 2; step++) {
-        const float *from = step ? low : was, *to = step ? was : low;
-        for (int c = 0; c < 3; c++)
-            ratio[3 * w.s->tri_material[0] + c] = to[c] / from[c];
-        lm_photons_scale_materials(w.ph, ratio, M, touched);
-        memcpy(m->base_color, to, sizeof was);
-    }
+    recolour_box(&w, was, low, touched);
+    recolour_box(&w, low, was, touched);
     uint32_t hits = 0;
     for (uint32_t i = 0; i < store->used; i++) {
         const lm_hit *h = lm_photon_store_live(store, i);
@@ -632,7 +633,7 @@ static void test_recolour_far_and_back(void **state)
                   "again, per surface and channel worst %.2g\n", hits, queued, worst);
     assert_true(queued > 0);
     assert_true(worst < 1e-5);
-    free(ratio), free(touched), free(held);
+    free(touched), free(held);
     world_free(&w);
 }
 
