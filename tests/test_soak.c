@@ -1,9 +1,10 @@
 /* A soak of random edits through the public API (issue 38; the same edits as `lmgi bench --soak N
  * --random-edits L`, src/cli/random_edits.h): nodes moved, lights and materials edited, lights added up to
  * a count and then added and removed. Resident memory holds flat once the light count does (no trend);
- * every update's work stays within its bounds however many lights came and went (shadow maps, photon groups, AIM
- * refreshes, caustic photons), which is what keeps an update near its budget; and once the edits stop the
- * updater catches up: no shadow map left stale, and the frame is what lmgi_render draws from scratch. */
+ * every update's work stays within its bounds however many lights came and went (shadow maps, photon
+ * groups, AIM refreshes, caustic photons), which is what keeps an update near its budget; and once the
+ * edits stop the updater catches up: no shadow map left stale, and the frame is what lmgi_render draws from
+ * scratch. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>

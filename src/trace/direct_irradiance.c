@@ -75,15 +75,13 @@ static void computed(const lm_direct_light *d, lm_vec3 p, const float n[3], cons
                      uint32_t seed, float out[3])
 {
     double e[3] = {0.0, 0.0, 0.0};
-    lm_vec3 nv = lm_v3_load(n);
+    lm_vec3 nv = lm_v3_load(n), sv = shading_side(n, ns); /* the back's: both turned over */
     if (d->punctual)
-        punctual(d, p, nv, shading_side(n, ns), sides, e);
+        punctual(d, p, nv, sv, sides, e);
     if (d->area && (sides & 1))
-        area(d, p, nv, shading_side(n, ns), seed, e);
-    if (d->area && (sides & 2)) {
-        float back[3] = {-n[0], -n[1], -n[2]};
-        area(d, p, lm_scale(nv, -1.0f), shading_side(back, ns), seed ^ 0x9e3779b9u, e);
-    }
+        area(d, p, nv, sv, seed, e);
+    if (d->area && (sides & 2))
+        area(d, p, lm_scale(nv, -1.0f), lm_scale(sv, -1.0f), seed ^ 0x9e3779b9u, e);
     for (int c = 0; c < 3; c++)
         out[c] = (float)e[c];
 }

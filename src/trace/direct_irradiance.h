@@ -53,9 +53,9 @@ typedef struct {
  * pass take it: on a terrain of smooth normals over coarse triangles the two differ by tens of degrees
  * (truck-town's grass beside the retaining wall: half the light), light that grazes a surface differs by
  * ten times (a ceiling beside a slab lamp's 1 cm edges), and a light on the other side of either gives
- * nothing. seed picks the emitter light's sample
- * pattern (pass the same one for the same point: no flicker). Returns 0 when every side asked for is
- * covered (d->cover on `surface`: out is 0, and the point is hidden, not dark), else 1. */
+ * nothing. seed picks the emitter light's sample pattern (pass the same one for the same point: no
+ * flicker). Returns 0 when every side asked for is covered (d->cover on `surface`: out is 0, and the point
+ * is hidden, not dark), else 1. */
 int lm_direct_irradiance(const lm_direct_light *d, int surface, const float p[3], const float n[3], const float ns[3],
                          int two_sided, uint32_t seed, float out[3]);
 /* What lm_direct_irradiance computes, at a point known to be seen (a gather ray's hit,

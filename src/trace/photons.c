@@ -15,11 +15,11 @@
 
 /* Photons traced per batch in a group re-trace: bounds the trace buffers. */
 #define PH_BATCH_PHOTONS 16384u
+#define PH_MAX_PHOTONS (1u << 30)
 /* A path reweighted by recolours (lm_photons_scale_materials) by less than this, or more than its inverse,
  * is traced again: its hits keep their flux in floats, which a soak's 180 recolours drove below the
  * smallest float and back up by the inverse, 0 x inf (NaN) in the AIMs after 874 updates */
-#define LM_SCALE_LEAST 1e-12
-#define PH_MAX_PHOTONS (1u << 30)
+#define PH_SCALE_LEAST 1e-12
 
 void lm_photon_settings_default(lm_photon_settings *s)
 {
@@ -461,18 +461,20 @@ void lm_photons_scale_materials(lm_photons *ph, const float *ratio, int material
             for (uint32_t i = g->offsets[m]; i < g->offsets[m + 1]; i++) {
                 const lm_path_vertex *v = &g->verts[i];
                 const lm_hit *h = any ? lm_photon_store_live(&ph->store, v->slot) : NULL;
-                if (h) {
+                if (h) { /* a double past FLT_MAX has no float: clamped before the conversion */
                     float s[3] = {(float)fmin(w[0], FLT_MAX), (float)fmin(w[1], FLT_MAX), (float)fmin(w[2], FLT_MAX)};
                     touched[h->surface] = 1;
                     lm_photon_store_scale(&ph->store, v->slot, s);
                 }
                 int mat = tri_material[v->tri];
                 const float *r = mat >= 0 && mat < materials ? ratio + 3 * (size_t)mat : NULL;
-                if (r && (r[0] != 1.0f || r[1] != 1.0f || r[2] != 1.0f))
-                    for (int c = 0; c < 3; c++) {
-                        w[c] *= r[c], any = 1;
-                        extreme |= w[c] > 0.0 && !(w[c] >= LM_SCALE_LEAST && w[c] <= 1.0 / LM_SCALE_LEAST);
-                    }
+                if (!r || (r[0] == 1.0f && r[1] == 1.0f && r[2] == 1.0f))
+                    continue;
+                any = 1;
+                for (int c = 0; c < 3; c++) {
+                    w[c] *= r[c];
+                    extreme |= w[c] > 0.0 && !(w[c] >= PH_SCALE_LEAST && w[c] <= 1.0 / PH_SCALE_LEAST);
+                }
             }
         }
         if (extreme) /* its hits' flux has lost its digits, or soon would: traced again from the colours */
