@@ -621,6 +621,9 @@ typedef struct {
                                 * the lightmaps carry as thin light (docs/caustics.md, "Thin light in the
                                 * lightmaps"); the rest are the screen pass's */
     int cube_faces_rendered;   /* environment map faces rendered */
+    int planar_maps_rendered;  /* flat reflectors' pictures of the view mirrored in their plane, drawn when
+                                * the view or what they show changed (docs/direct.md, "Flat reflectors";
+                                * their time is in ms_direct) */
     int photon_gathers;        /* per-pixel photon gathers run (indirect TILED, HASHGRID, BRUTEFORCE): 0 when
                                 * the photons, the view and the scene were as for the last one (its picture
                                 * is shown again; the gather's time is in ms_gather) */

@@ -424,13 +424,17 @@ static void test_furnace_composite(void **state)
  * Phong n = 245, ks = 0.8, kd = 0) shows ks (n + 2) / (n + 1) (n.v) Le, 0.803 at the centre; a glass cube
  * (ior 1.5, tint 0.5 0.8 1) F Le + (1 - F) 0.8 Le in green, F = 0.04 face on: 0.808, and a clear one Le
  * (what it reflects and what it lets through add up: nothing lost, nothing gained); with
- * --reflection-size 0 the mirror is black. */
-static void check_reflection(const char *material, const char *opts, double want)
+ * --reflection-size 0 the mirror is black. `flat`: the cube's front face alone, a flat reflector, which
+ * shows the same through its mirrored picture of the view instead of a cube map. */
+static void check_reflection(const char *material, const char *opts, int flat, double want)
 {
     static lmt_mesh m[2];
     memset(m, 0, sizeof m);
     lmt_mesh_cube_inward(&m[0], 10.0f);
-    lmt_mesh_cube(&m[1], 1.0f);
+    if (flat)
+        lmt_mesh_quad(&m[1], (float[3]){-1, -1, 1}, (float[3]){2, 0, 0}, (float[3]){0, 2, 0});
+    else
+        lmt_mesh_cube(&m[1], 1.0f);
     char materials[1024];
     snprintf(materials, sizeof materials,
              "[{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 1, 1]}, %s],"
@@ -449,10 +453,78 @@ static void check_reflection(const char *material, const char *opts, double want
     double centre = px[4 * ((h / 2) * w + w / 2) + 1], worst = 0.0;
     for (int i = 0; i < w * h; i++)
         worst = fmax(worst, px[4 * i + 1]);
-    print_message("reflection (%s): centre %.4f (want %.4f), brightest %.4f\n", opts, centre, want, worst);
+    print_message("reflection (%s%s%s): centre %.4f (want %.4f), brightest %.4f\n", flat ? "flat" : "cube",
+                  *opts ? ", " : "", opts, centre, want, worst);
     assert_true(fabs(centre - want) <= 0.02 * fmax(want, 0.05));
     assert_true(worst <= fmax(want, 0.0) * 1.02 + 1e-6);
     free(px);
+}
+
+/* A flat mirror (gpu/frame/reflections.h, "Flat reflectors"): a 4 x 4 m metal floor (albedo 0.8, roughness
+ * 0) under a 0.6 m square emitter (Le = 1, facing down) 1 m above (0.5, 1, -0.5), seen from (0, 2, 3)
+ * looking at the origin. Each pixel's expected value is ray-cast here: the eye ray to the floor, reflected,
+ * meets the emitter's front (F Le, F the metal's Schlick Fresnel at the eye ray's angle) or the black sky
+ * (0); pixels whose eye ray meets the emitter first, or misses the floor, are not compared. A cube map seen
+ * from the floor's centre (the way before flat reflectors) puts the emitter's image about 1 m off (the
+ * emitter is 1 m from the map's centre), so its lit pixels and the expected ones barely overlap. */
+static void test_flat_mirror_image(void **state)
+{
+    (void)state;
+    static lmt_mesh m[2];
+    memset(m, 0, sizeof m);
+    lmt_mesh_quad(&m[0], (float[3]){-2, 0, 2}, (float[3]){4, 0, 0}, (float[3]){0, 0, -4});
+    lmt_mesh_quad(&m[1], (float[3]){0.2f, 1, -0.8f}, (float[3]){0.6f, 0, 0}, (float[3]){0, 0, 0.6f}); /* facing down */
+    const double pitch = atan2(2.0, 3.0), yfov = 0.7; /* looking down at the origin */
+    char nodes[512], materials[1024];
+    snprintf(nodes, sizeof nodes, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"camera\": 0, \"translation\": [0, 2, 3], "
+             "\"rotation\": [%.9f, 0, 0, %.9f]}]", -sin(0.5 * pitch), cos(0.5 * pitch));
+    snprintf(materials, sizeof materials, "[%s, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, "
+             "\"emissiveFactor\": [1, 1, 1]}], \"cameras\": [{\"type\": \"perspective\", \"perspective\": "
+             "{\"yfov\": %g, \"znear\": 0.01, \"aspectRatio\": 1}}]", LMT_MIRROR(0.8), yfov);
+    const char *path = lmt_write_scene("flat_mirror.gltf", m, 2, nodes, materials);
+    char args[4096], dir[1100];
+    snprintf(dir, sizeof dir, "%s/flat_mirror_out", lmt_tmpdir());
+    snprintf(args, sizeof args, "run %s --frames 1 --size 64x64 --photons 20000 -q --out %s", path, dir);
+    if (lmgi(args) != 0)
+        fail_msg("lmgi run failed: %s", output);
+    int w, h;
+    float *px = read_exr(dir, "frame_0000.exr", &w, &h);
+    int lit_both = 0, lit_want = 0, lit_got = 0, compared = 0;
+    double ratio = 0.0;
+    for (int y = 0; y < h; y++)
+        for (int x = 0; x < w; x++) {
+            double t = tan(0.5 * yfov), a = t * (2.0 * (x + 0.5) / w - 1.0), b = t * (1.0 - 2.0 * (y + 0.5) / h);
+            /* the view ray (a, b, -1) pitched down about x */
+            double d[3] = {a, b * cos(pitch) - sin(pitch), -b * sin(pitch) - cos(pitch)};
+            double e[3] = {0.0, 2.0, 3.0};
+            double te = (1.0 - e[1]) / d[1], ex = e[0] + te * d[0], ez = e[2] + te * d[2];
+            if (te > 0.0 && ex > 0.2 && ex < 0.8 && ez > -0.8 && ez < -0.2)
+                continue; /* the emitter's back, in front of the floor */
+            double tf = -e[1] / d[1], fx = e[0] + tf * d[0], fz = e[2] + tf * d[2];
+            if (!(tf > 0.0) || fabs(fx) > 1.95 || fabs(fz) > 1.95)
+                continue;
+            /* reflected: (d.x, -d.y, d.z) from the floor point, up to y = 1 */
+            double tr = 1.0 / -d[1], rx = fx + tr * d[0], rz = fz + tr * d[2];
+            double len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            double want = rx > 0.2 && rx < 0.8 && rz > -0.8 && rz < -0.2
+                              ? lmt_mirror_fresnel(0.8, 1.0 + d[1] / len) : 0.0;
+            double got = px[4 * (y * w + x) + 1];
+            compared++;
+            lit_want += want > 0.4;
+            lit_got += got > 0.4;
+            if (want > 0.4 && got > 0.4) {
+                lit_both++;
+                ratio += got / want;
+            }
+        }
+    free(px);
+    int lit_any = lit_want + lit_got - lit_both;
+    print_message("flat mirror: %d pixels compared, the emitter's image %d expected, %d drawn, %d both (overlap "
+                  "%.3f), drawn / expected where both %.4f\n", compared, lit_want, lit_got, lit_both,
+                  lit_any ? (double)lit_both / lit_any : 0.0, lit_both ? ratio / lit_both : 0.0);
+    assert_true(compared > w * h / 2 && lit_want > 60);
+    assert_true(lit_both >= 0.85 * lit_any); /* only the image's edge pixels may differ */
+    assert_true(fabs(ratio / lit_both - 1.0) < 0.02);
 }
 
 /* A node flattened by a zero scale (glTF allows it; animations hide nodes so): a static one makes zero-area
@@ -663,17 +735,19 @@ static void test_reflections(void **state)
                          " \"roughnessFactor\": 0}}";
     const char *glossy = "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.8, 0.8, 0.8, 1], \"metallicFactor\": 1,"
                          " \"roughnessFactor\": 0.3}}";
-    check_reflection(mirror, "", 0.8);
     double n = 2.0 / (0.3 * 0.3 * 0.3 * 0.3) - 2.0;
-    check_reflection(glossy, "", 0.8 * (n + 2.0) / (n + 1.0));
-    check_reflection(mirror, "--reflection-size 0", 0.0);
+    for (int flat = 0; flat < 2; flat++) {
+        check_reflection(mirror, "", flat, 0.8);
+        check_reflection(glossy, "", flat, 0.8 * (n + 2.0) / (n + 1.0));
+        check_reflection(mirror, "--reflection-size 0", flat, 0.0);
+    }
     const char *glass = "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0.5, 0.8, 1, 1], \"metallicFactor\": 0},"
                         " \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1},"
                         " \"KHR_materials_ior\": {\"ior\": 1.5}}}";
     const char *clear = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 0},"
                         " \"extensions\": {\"KHR_materials_transmission\": {\"transmissionFactor\": 1}}}";
-    check_reflection(glass, "", 0.04 + 0.96 * 0.8);
-    check_reflection(clear, "", 1.0);
+    check_reflection(glass, "", 0, 0.04 + 0.96 * 0.8);
+    check_reflection(clear, "", 0, 1.0);
 }
 
 int main(void)
@@ -689,6 +763,7 @@ int main(void)
         cmocka_unit_test(test_bad_args),
         cmocka_unit_test(test_furnace_composite),
         cmocka_unit_test(test_reflections),
+        cmocka_unit_test(test_flat_mirror_image),
         cmocka_unit_test(test_flattened_node),
         cmocka_unit_test(test_mirrored_nodes),
         cmocka_unit_test(test_output_dir),

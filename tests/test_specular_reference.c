@@ -241,9 +241,13 @@ static void test_mirror_sphere_pixels(void **state)
     lmgi_context_free(ctx);
 }
 
-/* A 2 x 2 m mirror on a wall, seen from across the room: the plain cube map (seen from the mirror's
- * centre) shows the room displaced; box-projected onto the room's box it shows it where it is. */
-static void test_wall_mirror_box_projection(void **state)
+/* A 2 x 2 m mirror on a wall, seen from across the room. As a flat reflector it shows the view mirrored in
+ * its plane (reflections.h): measured relative RMSE 0.095, mean 0.989, the error at the panels' edges,
+ * which the picture samples at the pixel's centre as the frame does and the reference averages over the
+ * pixel. Given a reflection_box it keeps a cube map, box-projected onto the room's box: 0.076, mean 0.999
+ * (its bilinear lookup softens those edges). A plain cube map, seen from the mirror's centre, showed the
+ * room displaced: 0.49, mean 0.93 (docs/caustics.md). */
+static void test_wall_mirror(void **state)
 {
     (void)state;
     double rmse[2], ratio[2];
@@ -265,10 +269,11 @@ static void test_wall_mirror_box_projection(void **state)
         lmgi_free(sc);
         lmgi_context_free(ctx);
     }
-    print_message("wall mirror (%d pixels): plain cube map relative RMSE %.3f (mean %.3f of the reference), "
-                  "box-projected %.3f (mean %.3f)\n", n[0], rmse[0], ratio[0], rmse[1], ratio[1]);
+    print_message("wall mirror (%d pixels): its mirrored picture relative RMSE %.3f (mean %.3f of the reference), "
+                  "a box-projected cube map %.3f (mean %.3f)\n", n[0], rmse[0], ratio[0], rmse[1], ratio[1]);
     assert_true(n[0] > 300 && n[0] == n[1]);
-    assert_true(rmse[1] < 0.5 * rmse[0]);
+    assert_true(rmse[0] < 0.15);
+    assert_true(fabs(ratio[0] - 1.0) < 0.03);
     assert_true(rmse[1] < 0.25);
     assert_true(fabs(ratio[1] - 1.0) < 0.10);
 }
@@ -278,7 +283,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_glass_focal_spot),
         cmocka_unit_test(test_mirror_sphere_pixels),
-        cmocka_unit_test(test_wall_mirror_box_projection),
+        cmocka_unit_test(test_wall_mirror),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

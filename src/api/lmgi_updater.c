@@ -466,6 +466,7 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->caustic_photons_landed = fs->caustic_landed;
     o->caustic_photons_thin = fs->caustic_thin;
     o->cube_faces_rendered = fs->cube_faces;
+    o->planar_maps_rendered = fs->plane_maps;
     o->shadow_maps_rendered = fs->shadow_maps;
     o->shadow_maps_stale = fs->shadow_maps_stale;
     o->photon_gathers = fs->photon_gathers;

@@ -227,11 +227,15 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
         st = lm_photon_path_coverage(ind->photons, fp->direct, err);
     const lm_emitters *em = lm_photon_stage_emitters(fp->stage);
     lm_caustic_pass *caustics = drawn_caustics(fp);
-    if (st == LM_OK && step) { /* the faces due this step; an extra view shows the maps as they are */
-        lm_reflection_inputs in = {fp->w->surfaces, ind->iim ? ind->iim->version : NULL, lighting_hash(fp), caustics};
+    lm_reflection_inputs in = {fp->w->surfaces, ind->iim ? ind->iim->version : NULL, lighting_hash(fp), caustics};
+    if (st == LM_OK && step) /* the faces due this step; an extra view shows the maps as they are */
         st = lm_reflections_update(fp->reflections, fp->direct, fp->w->scene, em, &in, &o->cube_faces, err);
-    }
     double t2 = lm_now();
+    /* a flat reflector's picture is a direct pass of the view's own (mirrored), drawn whenever what it
+     * shows changed: a cost of the view like the direct pass, counted in it, not a stage the budget plans */
+    if (st == LM_OK)
+        st = lm_reflections_draw_planes(fp->reflections, fp->direct, fp->w->scene, em, &in, view, w, h,
+                                        &o->plane_maps, err);
     if (st == LM_OK)
         st = lm_direct_draw(fp->direct, fp->w->scene, em, view, w, h, err);
     double t3 = lm_now();

@@ -94,6 +94,7 @@ typedef struct {
     uint32_t caustic_landed, caustic_thin; /* the caustic photons the frame showed, and of those the ones its
                                             * lightmaps carried (photonmap/caustic_split.h) */
     int cube_faces;        /* environment map faces rendered */
+    int plane_maps;        /* flat reflectors' mirrored pictures drawn (reflections.h) */
     int shadow_maps;       /* shadow maps re-rendered by the frame's draws */
     int shadow_maps_stale; /* stale ones left for later updates (lm_direct_begin_update) */
     lm_photon_gather_stats photon_gather; /* the photon paths' gather (its times are in t_gather) */

@@ -68,8 +68,9 @@ struct lm_direct {
     lm_sky_pass sky;        /* a gradient or image sky behind everything */
     lm_shadow_renderer shadow;
     lm_frame_targets targets; /* the view's picture and the environment map faces' (lm_direct_draw_probe) */
-    int cur;                /* the picture of the draw in progress: LM_FRAME_VIEW or LM_FRAME_PROBE */
+    int cur;                /* the picture of the draw in progress: LM_FRAME_VIEW, _PROBE or _MIRROR */
     int drop[2];            /* vertices the draw in progress leaves out (lm_direct_draw_probe's node) */
+    float clip[4];          /* the draw in progress keeps dot(clip, (p, 1)) >= 0 (a mirror's side); 0: all */
     cached_map *maps;       /* per emitter index */
     int map_count;
     unsigned long static_version;  /* bumped whenever a static shadow-casting node moves (an edit) */
@@ -188,6 +189,14 @@ static void set_ranges(GLuint prog, const int keep[2], const int drop[2])
 
 static const int ALL[2] = {0, 0};
 
+/* What the picture being drawn leaves out: a node's vertices (an environment face's own node) and what
+ * lies behind the clip plane (a mirror's far side; GL_CLIP_DISTANCE0 is on only while one is drawn). */
+static void set_left_out(const lm_direct *d, GLuint prog)
+{
+    set_ranges(prog, ALL, d->drop);
+    glUniform4fv(glGetUniformLocation(prog, "clip_plane"), 1, d->clip);
+}
+
 /* The scene's triangles for the picture being drawn: an environment face's simplified (probe_lod). */
 static void draw_scene(const lm_direct *d, GLuint prog)
 {
@@ -232,7 +241,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
         float vp[16];
         lm_mat4_mul(vp, view->proj, view->view);
         glUseProgram(d->emission);
-        set_ranges(d->emission, ALL, d->drop);
+        set_left_out(d, d->emission);
         glUniformMatrix4fv(d->e_view_proj, 1, GL_FALSE, vp);
         const float towards_eye[3] = {view->view[2], view->view[6], view->view[10]}; /* as set_view_uniforms */
         glUniform3fv(glGetUniformLocation(d->emission, "eye"), 1, view->eye);
@@ -247,7 +256,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
     const uniforms *u = &d->uf[kind_of(e)];
     GLuint prog = d->first[kind_of(e)];
     glUseProgram(prog);
-    set_ranges(prog, ALL, d->drop);
+    set_left_out(d, prog);
     set_view_uniforms(d, u, view);
     set_light_uniforms(u, s, e, &d->maps[light]);
     bind_indirect(d, u->lit, u->use_lit);
@@ -400,7 +409,7 @@ static lm_status light_pass(lm_direct *d, const lm_scene *s, const lm_emitter *e
     glBlendFunc(GL_ONE, GL_ONE);
     GLuint prog = d->prog[kind_of(e)];
     glUseProgram(prog);
-    set_ranges(prog, ALL, d->drop);
+    set_left_out(d, prog);
     set_view_uniforms(d, &d->u[kind_of(e)], view);
     set_light_uniforms(&d->u[kind_of(e)], s, e, &d->maps[i]);
     draw_scene(d, prog);
@@ -660,6 +669,10 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
     for (int i = 0; first < 0 && i < em->count; i++)
         first = live_punctual(s, &em->e[i]) ? i : -1;
     glBindFramebuffer(GL_FRAMEBUFFER, lm_frame_targets_fbo(&d->targets, which));
+    if (which == LM_FRAME_MIRROR) { /* the scene reflected: its triangles' winding turns over */
+        glEnable(GL_CLIP_DISTANCE0);
+        glFrontFace(GL_CW);
+    }
     static const GLenum all[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
     /* only the view's G-buffer is read (by the photon gathers), and only when they run: another float
      * attachment written and cleared costs about a tenth of the pass on llvmpipe */
@@ -670,6 +683,8 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
     for (int i = first + 1; first >= 0 && st == LM_OK && i < em->count; i++)
         if (live_punctual(s, &em->e[i]))
             st = light_pass(d, s, &em->e[i], i, view, width, height, err);
+    glDisable(GL_CLIP_DISTANCE0);
+    glFrontFace(GL_CCW);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     return st;
 }
@@ -689,6 +704,19 @@ lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitter
     d->drop[1] = ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0;
     lm_status st = draw_into(d, LM_FRAME_PROBE, s, em, view, size, size, err);
     d->drop[0] = d->drop[1] = 0;
+    return st;
+}
+
+lm_status lm_direct_draw_mirror(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *mirrored,
+                                int width, int height, int skip, const float plane[4], lm_error *err)
+{
+    int ok = skip >= 0 && skip < d->mesh.node_count;
+    d->drop[0] = ok ? d->mesh.node_first[skip] : 0;
+    d->drop[1] = ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0;
+    memcpy(d->clip, plane, sizeof d->clip);
+    lm_status st = draw_into(d, LM_FRAME_MIRROR, s, em, mirrored, width, height, err);
+    d->drop[0] = d->drop[1] = 0;
+    memset(d->clip, 0, sizeof d->clip);
     return st;
 }
 

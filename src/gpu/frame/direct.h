@@ -85,6 +85,14 @@ lm_status lm_direct_render(lm_direct *d, const lm_scene *s, const lm_emitters *e
  * pass's indirect term and the shadow maps are the frame's. */
 lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
                                int skip, lm_error *err);
+/* The scene seen in a flat reflector into the mirror's picture of the frame's targets (LM_FRAME_MIRROR),
+ * width x height, every triangle: `mirrored` is the frame's view reflected about the reflector's plane
+ * (view matrix times the reflection, eye reflected), plane = (n, w) the world plane whose side
+ * dot(n, p) + w >= 0 is kept (the side the eye is on; what lies behind the reflector is not in it), node
+ * `skip`'s vertices left out. The reflection turns the triangles' winding over; the draw takes that into
+ * account, so that a surface's front is its front. reflections.h looks the picture up. */
+lm_status lm_direct_draw_mirror(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *mirrored,
+                                int width, int height, int skip, const float plane[4], lm_error *err);
 /* The triangles an environment face draws (settings.probe_lod), the skipped node's included. */
 uint32_t lm_direct_probe_triangles(const lm_direct *d);
 /* Draws only node's triangles with prog, a program on glsl/direct_vs.glsl (its uniforms set by the caller;

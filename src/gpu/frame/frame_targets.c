@@ -8,8 +8,8 @@
 
 void lm_frame_targets_free(lm_frame_targets *f)
 {
-    lm_float_target_free(&f->t[LM_FRAME_VIEW]);
-    lm_float_target_free(&f->t[LM_FRAME_PROBE]);
+    for (int k = 0; k < LM_FRAME_PICTURES; k++)
+        lm_float_target_free(&f->t[k]);
     free(f->scratch);
     f->scratch = NULL;
     f->scratch_px = 0;

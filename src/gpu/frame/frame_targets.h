@@ -1,5 +1,6 @@
-/* The frame's render targets, in one place (docs/direct.md): the picture of the view and the picture of
- * an environment map's face (the probe), each an RGBA32F target of three colour attachments and a depth
+/* The frame's render targets, in one place (docs/direct.md): the picture of the view, the picture of
+ * an environment map's face (the probe) and the picture of the view mirrored in a flat reflector (the
+ * mirror, reflections.h), each an RGBA32F target of three colour attachments and a depth
  * texture that the direct light's first pass lays down and the later passes read or add to:
  *
  *   attachment 0  radiance (rgb; the passes after the first add to it: the direct light's further
@@ -23,11 +24,12 @@
 #include "../../core/error.h"
 #include "../gl/offscreen.h"
 
-/* Which picture: the view's frame or the environment map face being drawn. */
-enum { LM_FRAME_VIEW = 0, LM_FRAME_PROBE = 1 };
+/* Which picture: the view's frame, the environment map face being drawn, or the view mirrored in a flat
+ * reflector. */
+enum { LM_FRAME_VIEW = 0, LM_FRAME_PROBE = 1, LM_FRAME_MIRROR = 2, LM_FRAME_PICTURES = 3 };
 
 typedef struct {
-    lm_float_target t[2]; /* by LM_FRAME_VIEW, LM_FRAME_PROBE */
+    lm_float_target t[LM_FRAME_PICTURES];
     float *scratch;       /* read-back of the view's radiance, width x height RGBA */
     size_t scratch_px;
 } lm_frame_targets;

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../../core/hash.h"
 #include "../../core/vecmath.h"
 #include "glsl.h"
 #include "../gl/gl_shader.h"
@@ -21,6 +22,12 @@ typedef struct {
     float centre[3]; /* where its faces were last rendered from */
     long dirty[6];  /* per face: the update it became dirty at, 0 when clean */
     GLuint cube;
+    /* a flat reflector (planar): the view mirrored in its plane, no cube map */
+    int planar;
+    GLuint plane_tex, plane_depth; /* the mirrored picture's radiance (mips when glossy) and depth */
+    int plane_w, plane_h, plane_levels;
+    uint64_t plane_key;            /* what it was drawn from (0: never drawn) */
+    float plane[4];                /* its world plane, the eye's side positive, when drawn */
 } reflector;
 
 struct lm_reflections {
@@ -41,6 +48,59 @@ struct lm_reflections {
 
 
 static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY || c == LM_MAT_GLASS; }
+
+/* The plane of the reflector's triangles in the world as it is now: n the area-weighted mean of their
+ * normals (each turned to the sum's side: a two-sided surface's back copies), w = -n.p at their first
+ * corner. Returns the largest distance of a corner from that plane, and writes the bounds' diagonal to
+ * *extent; -1 when the triangles have no area. */
+static float fit_plane(const lm_scene *s, const reflector *f, float plane[4], float *extent)
+{
+    lm_vec3 sum = lm_v3(0.0f, 0.0f, 0.0f), lo = lm_v3(INFINITY, INFINITY, INFINITY), hi = lm_scale(lo, -1.0f);
+    for (uint32_t i = 0; i < f->tri_count; i++) {
+        lm_vec3 p[3];
+        for (int k = 0; k < 3; k++) {
+            float w[3];
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)f->tris[i] + k], w);
+            p[k] = lm_v3_load(w);
+            lo = lm_vmin(lo, p[k]);
+            hi = lm_vmax(hi, p[k]);
+        }
+        lm_vec3 c = lm_cross(lm_sub(p[1], p[0]), lm_sub(p[2], p[0]));
+        sum = lm_add(sum, lm_dot(c, sum) < 0.0f ? lm_scale(c, -1.0f) : c); /* a two-sided copy's back: turned */
+    }
+    *extent = lm_length(lm_sub(hi, lo));
+    if (!(lm_length(sum) > 0.0f))
+        return -1.0f;
+    lm_vec3 n = lm_normalize(sum);
+    float p0[3];
+    lm_scene_vertex_world(s, s->tris[3 * (size_t)f->tris[0]], p0);
+    float w = -lm_dot(n, lm_v3_load(p0)), far = 0.0f;
+    for (uint32_t i = 0; i < f->tri_count; i++)
+        for (int k = 0; k < 3; k++) {
+            float q[3];
+            lm_scene_vertex_world(s, s->tris[3 * (size_t)f->tris[i] + k], q);
+            far = fmaxf(far, fabsf(lm_dot(n, lm_v3_load(q)) + w));
+        }
+    lm_v3_store(plane, n);
+    plane[3] = w;
+    return far;
+}
+
+/* A reflector is flat when its corners lie within 1e-4 of its size of one plane and none of its triangles
+ * is glass (glass shows what lies behind it, which a mirrored picture does not hold). A node given a
+ * reflection_box keeps its box-projected cube map: the user's choice, redrawn only when what it sees
+ * changes, where the mirrored picture is redrawn whenever the view moves. */
+#define PLANAR_TOLERANCE 1e-4f
+static int is_planar(const lm_scene *s, const reflector *f)
+{
+    if (s->nodes[f->node].settings.has_reflection_box)
+        return 0;
+    for (uint32_t i = 0; i < f->tri_count; i++)
+        if (s->materials[s->tri_material[f->tris[i]]].cls == LM_MAT_GLASS)
+            return 0;
+    float plane[4], extent, far = fit_plane(s, f, plane, &extent);
+    return far >= 0.0f && far <= PLANAR_TOLERANCE * extent;
+}
 
 /* The nodes with mirror or glossy triangles, each with its list of them (from the node's own range). */
 static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error *err)
@@ -64,6 +124,7 @@ static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error 
         }
         if (f->tri_count) {
             f->node = n;
+            f->planar = is_planar(s, f);
             r->count++;
         }
     }
@@ -121,7 +182,8 @@ lm_status lm_reflections_create(const lm_scene *s, int size, int faces_per_frame
     if (st == LM_OK)
         st = lm_gl_program("reflections", lm_glsl_direct_vs, lm_glsl_reflections_fs, &r->prog, err);
     for (int k = 0; st == LM_OK && k < r->count; k++)
-        r->r[k].cube = cube_texture(size, r->r[k].glossy ? r->levels : 1);
+        if (!r->r[k].planar)
+            r->r[k].cube = cube_texture(size, r->r[k].glossy ? r->levels : 1);
     if (st == LM_OK)
         st = lm_gl_check("reflections: setup", err);
     if (st != LM_OK) {
@@ -140,6 +202,10 @@ void lm_reflections_free(lm_reflections *r)
         free(r->r[k].tris);
         if (r->r[k].cube)
             glDeleteTextures(1, &r->r[k].cube);
+        if (r->r[k].plane_tex)
+            glDeleteTextures(1, &r->r[k].plane_tex);
+        if (r->r[k].plane_depth)
+            glDeleteTextures(1, &r->r[k].plane_depth);
     }
     free(r->r);
     free(r->world);
@@ -190,7 +256,7 @@ static lm_status render_face(lm_reflections *r, int k, int face, lm_direct *d, c
 /* Marks a face dirty (keeping the update it first became dirty at). */
 static void mark(lm_reflections *r, int k, int face)
 {
-    if (!r->r[k].dirty[face])
+    if (!r->r[k].planar && !r->r[k].dirty[face])
         r->r[k].dirty[face] = r->frame;
 }
 
@@ -300,7 +366,7 @@ lm_status lm_reflections_update(lm_reflections *r, lm_direct *d, const lm_scene 
     r->frame++;
     lm_status st = mark_changes(r, s, in, err);
     /* the first update renders every face, then at most faces_per_frame, the longest dirty first */
-    int budget = !r->primed ? 6 * r->count : r->frame_faces ? r->frame_faces : r->faces_per_frame;
+    int budget = !r->primed ? lm_reflections_face_count(r) : r->frame_faces ? r->frame_faces : r->faces_per_frame;
     for (int i = 0; st == LM_OK && i < budget; i++) {
         int f = oldest_dirty(r);
         if (f < 0)
@@ -324,7 +390,21 @@ void lm_reflections_limit_faces(lm_reflections *r, int most)
         r->frame_faces = most > 0 ? most : 0;
 }
 
-int lm_reflections_face_count(const lm_reflections *r) { return r ? 6 * r->count : 0; }
+int lm_reflections_face_count(const lm_reflections *r)
+{
+    int n = 0;
+    for (int k = 0; r && k < r->count; k++)
+        n += r->r[k].planar ? 0 : 6;
+    return n;
+}
+
+int lm_reflections_plane_count(const lm_reflections *r)
+{
+    int n = 0;
+    for (int k = 0; r && k < r->count; k++)
+        n += r->r[k].planar;
+    return n;
+}
 
 int lm_reflections_dirty_faces(const lm_reflections *r)
 {
@@ -333,6 +413,111 @@ int lm_reflections_dirty_faces(const lm_reflections *r)
         for (int face = 0; face < 6; face++)
             n += r->r[k].dirty[face] != 0;
     return n;
+}
+
+/* The reflection about plane (n, w), p -> p - 2 (n.p + w) n, as a column-major matrix. */
+static void reflection_matrix(const float plane[4], float m[16])
+{
+    lm_mat4_identity(m);
+    for (int c = 0; c < 3; c++) {
+        for (int row = 0; row < 3; row++)
+            m[4 * c + row] -= 2.0f * plane[row] * plane[c];
+        m[12 + c] = -2.0f * plane[3] * plane[c];
+    }
+}
+
+/* The flat reflector's picture textures at width x height (re-made when that changes). */
+static void plane_textures(reflector *f, int width, int height)
+{
+    if (f->plane_tex && f->plane_w == width && f->plane_h == height)
+        return;
+    if (f->plane_tex)
+        glDeleteTextures(1, &f->plane_tex);
+    if (f->plane_depth)
+        glDeleteTextures(1, &f->plane_depth);
+    int side = width > height ? width : height;
+    f->plane_levels = f->glossy ? 1 + (int)floor(log2((double)side)) : 1;
+    glGenTextures(1, &f->plane_tex);
+    glBindTexture(GL_TEXTURE_2D, f->plane_tex);
+    glTexStorage2D(GL_TEXTURE_2D, f->plane_levels, GL_RGBA32F, width, height);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, f->plane_levels > 1 ? GL_LINEAR_MIPMAP_LINEAR : GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+    glGenTextures(1, &f->plane_depth);
+    glBindTexture(GL_TEXTURE_2D, f->plane_depth);
+    glTexStorage2D(GL_TEXTURE_2D, 1, GL_DEPTH_COMPONENT24, width, height);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    f->plane_w = width, f->plane_h = height;
+    f->plane_key = 0;
+}
+
+/* What a flat reflector's picture is drawn from: the mirrored view, its size, the lighting, where every
+ * node is, the displayed lightmaps and the shadow maps. */
+static uint64_t plane_key(const lm_view *mirrored, int width, int height, const lm_scene *s,
+                          const lm_reflection_inputs *in, const lm_direct *d)
+{
+    uint64_t key = lm_hash_bytes(lm_scene_world_hash(s), mirrored->view, sizeof mirrored->view);
+    key = lm_hash_bytes(key, mirrored->proj, sizeof mirrored->proj);
+    const int size[2] = {width, height};
+    long maps = lm_direct_shadow_maps_rendered(d);
+    key = lm_hash_bytes(key, size, sizeof size);
+    key = lm_hash_bytes(key, &in->lighting, sizeof in->lighting);
+    key = lm_hash_bytes(key, &maps, sizeof maps);
+    if (in->surfaces && in->surface_version)
+        key = lm_hash_bytes(key, in->surface_version,
+                            sizeof *in->surface_version * (size_t)in->surfaces->surface_count);
+    return key | 1; /* never 0, "never drawn" */
+}
+
+lm_status lm_reflections_draw_planes(lm_reflections *r, lm_direct *d, const lm_scene *s, const lm_emitters *em,
+                                     const lm_reflection_inputs *in, const lm_view *view, int width, int height,
+                                     int *drawn, lm_error *err)
+{
+    *drawn = 0;
+    lm_status st = LM_OK;
+    for (int k = 0; r && st == LM_OK && k < r->count; k++) {
+        reflector *f = &r->r[k];
+        if (!f->planar)
+            continue;
+        float extent, plane[4];
+        fit_plane(s, f, plane, &extent);
+        float side = lm_dot(lm_v3_load(plane), lm_v3_load(view->eye)) + plane[3];
+        if (side < 0.0f) /* the eye's side positive: what lies there is what the plane reflects */
+            for (int c = 0; c < 4; c++)
+                plane[c] = -plane[c];
+        lm_view m = *view;
+        float refl[16];
+        reflection_matrix(plane, refl);
+        lm_mat4_mul(m.view, view->view, refl);
+        lm_v3_store(m.eye, lm_mat4_point(refl, lm_v3_load(view->eye)));
+        plane_textures(f, width, height);
+        uint64_t key = plane_key(&m, width, height, s, in, d);
+        memcpy(f->plane, plane, sizeof plane);
+        if (key == f->plane_key)
+            continue;
+        /* what touches the plane stays in (an object standing on it): the cut lies 1e-4 of the scene's
+         * size behind it */
+        float clip[4] = {plane[0], plane[1], plane[2], plane[3] + 1e-4f * lm_scene_size(s)};
+        st = lm_direct_draw_mirror(d, s, em, &m, width, height, f->node, clip, err);
+        if (st != LM_OK)
+            break;
+        const lm_frame_targets *t = lm_direct_targets(d);
+        glCopyImageSubData(lm_frame_targets_radiance(t, LM_FRAME_MIRROR), GL_TEXTURE_2D, 0, 0, 0, 0, f->plane_tex,
+                           GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+        glCopyImageSubData(lm_frame_targets_depth(t, LM_FRAME_MIRROR), GL_TEXTURE_2D, 0, 0, 0, 0, f->plane_depth,
+                           GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
+        if (f->plane_levels > 1) {
+            glBindTexture(GL_TEXTURE_2D, f->plane_tex);
+            glGenerateMipmap(GL_TEXTURE_2D);
+            glBindTexture(GL_TEXTURE_2D, 0);
+        }
+        f->plane_key = key;
+        ++*drawn;
+    }
+    return st == LM_OK ? lm_gl_check("reflections: flat reflectors", err) : st;
 }
 
 lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const lm_scene *s, const lm_view *view,
@@ -356,7 +541,27 @@ lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const
     glUniform1f(glGetUniformLocation(r->prog, "lod_base"), (float)log2(r->size / (0.5 * LM_PI)));
     glUniform1i(glGetUniformLocation(r->prog, "base_tex"), 2);
     glUniform1i(glGetUniformLocation(r->prog, "env"), 4);
+    glUniform1i(glGetUniformLocation(r->prog, "plane_tex"), 5);
+    glUniform1i(glGetUniformLocation(r->prog, "plane_depth"), 6);
+    int ortho = view->proj[11] == 0.0f;
+    /* a mirrored picture's pixel (x, y) is the view's; its depths turned back into distances along the
+     * view's axis (perspective: P14 / (z_ndc + P10); orthographic: -(z_ndc - P14) / P10) */
+    glUniform4f(glGetUniformLocation(r->prog, "lens"), view->proj[10], view->proj[14], view->proj[5], (float)ortho);
     for (int k = 0; k < r->count; k++) {
+        const reflector *f = &r->r[k];
+        glUniform1i(glGetUniformLocation(r->prog, "planar"), f->planar && f->plane_key);
+        if (f->planar) {
+            if (!f->plane_key) /* not drawn for this view: lm_reflections_draw_planes first */
+                continue;
+            glUniform3f(glGetUniformLocation(r->prog, "plane_size"), (float)f->plane_w, (float)f->plane_h,
+                        (float)(f->plane_levels - 1));
+            glActiveTexture(GL_TEXTURE5);
+            glBindTexture(GL_TEXTURE_2D, f->plane_tex);
+            glActiveTexture(GL_TEXTURE6);
+            glBindTexture(GL_TEXTURE_2D, f->plane_depth);
+            lm_direct_draw_node(d, r->prog, f->node);
+            continue;
+        }
         const lm_node_settings *ns = &s->nodes[r->r[k].node].settings;
         glUniform1i(glGetUniformLocation(r->prog, "use_box"), ns->has_reflection_box);
         glUniform3fv(glGetUniformLocation(r->prog, "box_lo"), 1, ns->reflection_box);

@@ -19,9 +19,13 @@
  * reflected ray leaves that box, seen from the map's centre (a parallax-corrected cube map): right for a
  * room's walls seen in a mirror anywhere inside it, where the plain lookup is right only at the centre.
  *
+ * Flat reflectors (lm_reflections_draw_planes): a node whose mirror and glossy triangles lie in one plane
+ * (no glass, no reflection_box) gets no cube map but the frame's view mirrored in that plane, looked up
+ * at the pixel itself, blurred for a glossy lobe by how far behind the plane the reflected surface lies.
+ *
  * Approximations (docs/caustics.md measures them): the map is seen from one point, so a reflection of
- * something near a large reflector is displaced (parallax; a planar mirror is the worst case, a box proxy
- * the cure where the surroundings are a box); reflectors see each other without their reflections (one
+ * something near a large curved reflector is displaced (parallax; a box proxy the cure where the
+ * surroundings are a box); reflectors see each other without their reflections (one
  * bounce); glass bends the ray at its near surface only and looks it up unbent by the far one (no image
  * through a lens), and the light it focuses is the caustics'.
  *
@@ -30,7 +34,8 @@
  * change, or the lighting changed (the caller's hash: lights, materials, caustic photons; every face). A
  * reflector that moved has all its faces dirty. Each update renders every face at the first call, then up
  * to `faces_per_frame` dirty faces, longest dirty first; a still scene renders none. Cost: a direct pass of
- * size^2 pixels per face (and the caustic pass over it). Needs a current GL context; not thread-safe. */
+ * size^2 pixels per face (and the caustic pass over it); a flat reflector's picture a direct pass of the
+ * frame's size whenever the view or what it shows changed. Needs a current GL context; not thread-safe. */
 #ifndef LM_REFLECTIONS_H
 #define LM_REFLECTIONS_H
 
@@ -68,6 +73,16 @@ void lm_reflections_limit_faces(lm_reflections *r, int most);
 int lm_reflections_face_count(const lm_reflections *r);
 /* Faces still dirty after the last update (0 for NULL). */
 int lm_reflections_dirty_faces(const lm_reflections *r);
+/* Flat reflectors (every mirror and glossy triangle of the node within 1e-4 of its size of one plane, no
+ * glass): instead of a cube map, the frame's view mirrored in the plane (lm_direct_draw_mirror: what lies
+ * on the eye's side of it, the node itself left out), width x height as the frame, drawn again when the
+ * view or anything in the key of lm_reflection_inputs changed; *drawn gets how many were. Call before
+ * lm_reflections_draw for the same view. */
+lm_status lm_reflections_draw_planes(lm_reflections *r, lm_direct *d, const lm_scene *s, const lm_emitters *em,
+                                     const lm_reflection_inputs *in, const lm_view *view, int width, int height,
+                                     int *drawn, lm_error *err);
+/* Flat reflectors (0 for NULL); they have no faces. */
+int lm_reflections_plane_count(const lm_reflections *r);
 /* Adds the reflections to the frame d just drew from view (lm_direct_draw; depth test against its depth). */
 lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const lm_scene *s, const lm_view *view,
                               lm_error *err);

@@ -15,6 +15,8 @@ layout(location = 4) in vec3 em;
 layout(location = 5) in vec2 uv;
 layout(location = 7) in vec2 lm_uv;
 uniform mat4 view_proj;
+uniform vec4 clip_plane; // a mirror's picture keeps dot(clip_plane, (pos, 1)) >= 0 (GL_CLIP_DISTANCE0 on)
+out float gl_ClipDistance[1];
 out vec3 v_pos, v_ns;
 flat out vec3 v_base, v_em;
 flat out vec4 v_par;
@@ -24,4 +26,5 @@ invariant gl_Position;
 void main() {
     v_pos = pos; v_ns = ns; v_base = base; v_par = par; v_em = em; v_uv = uv; v_lm = lm_uv;
     gl_Position = dropped() ? vec4(2.0, 2.0, 2.0, 1.0) : view_proj * vec4(pos, 1.0);
+    gl_ClipDistance[0] = dot(clip_plane, vec4(pos, 1.0));
 }

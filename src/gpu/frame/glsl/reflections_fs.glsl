@@ -6,6 +6,10 @@
 // left unbent: the glass's far side and the parallax of what lies behind are not modelled. albedo and ks
 // from the direct light's lobes (lobes.glsl), so both passes read a material alike. The back of a
 // single-sided surface reflects nothing. Class numbers as there (1 glossy, 2 mirror, 3 glass).
+// A flat reflector (planar; reflections.h) looks its mirrored picture up at this pixel instead of the
+// cube map: what the plane reflects towards the eye is there (the shading normal's bend is not followed),
+// blurred for a glossy lobe to the mip level whose texel is the lobe's width where it reaches the
+// reflected surface: (distance behind the plane) x width, seen from the mirrored eye, in pixels.
 #version 450 core
 #include "mesh_inputs.glsl"
 uniform int has_tex;
@@ -15,6 +19,10 @@ uniform vec3 eye;
 uniform float lod_base;
 uniform int use_box;
 uniform vec3 box_lo, box_hi, centre;
+uniform int planar;
+uniform sampler2D plane_tex, plane_depth;
+uniform vec3 plane_size; // the picture's width, height, and its last mip level
+uniform vec4 lens;       // the view's P10, P14, P5 and whether it is orthographic
 out vec4 frag;
 // box-projected lookup: the ray from the pixel to the proxy box, looked up from the map's centre
 vec3 parallax(vec3 d) {
@@ -22,6 +30,26 @@ vec3 parallax(vec3 d) {
     vec3 tf = max((box_hi - v_pos) / d, (box_lo - v_pos) / d);
     float t = min(min(tf.x, tf.y), tf.z);
     return t > 0.0 ? v_pos + d * t - centre : d;
+}
+// distance along the view's axis of a window depth (the frame's and the mirrored picture's projection)
+float axial(float depth) {
+    float z = 2.0 * depth - 1.0;
+    return lens.w > 0.5 ? (lens.y - z) / lens.x : lens.y / (z + lens.x);
+}
+// the mirrored picture at this pixel, blurred to an angular width (0: sharp)
+vec3 plane_seen(float width) {
+    vec2 uv = gl_FragCoord.xy / plane_size.xy;
+    if (width <= 0.0) return textureLod(plane_tex, uv, 0.0).rgb;
+    float here = axial(gl_FragCoord.z), hit = axial(texelFetch(plane_depth, ivec2(gl_FragCoord.xy), 0).r);
+    float pixels = 0.5 * lens.z * plane_size.y; // a unit across at axial distance 1
+    float behind = max(hit - here, 0.0) * length(v_pos - eye) / here; // along the reflected ray
+    float across = behind * width * pixels / (lens.w > 0.5 ? 1.0 : hit);
+    return textureLod(plane_tex, uv, clamp(log2(max(across, 1.0)), 0.0, plane_size.z)).rgb;
+}
+// what the surface reflects along r, blurred to an angular width (0: sharp); cube lod as the header says
+vec3 seen(vec3 r, float width) {
+    if (planar == 1) return plane_seen(width);
+    return textureLod(env, parallax(r), width > 0.0 ? max(0.0, lod_base + log2(width)) : 0.0).rgb;
 }
 #include "lobes.glsl"
 void main() {
@@ -34,7 +62,7 @@ void main() {
     if (cls == 2) { /* a metal's Fresnel, Schlick's with the albedo as F0 (bsdf.c's lm_mirror_fresnel) */
         float m = 1.0 - clamp(abs(dot(normalize(v_pos - eye), n)), 0.0, 1.0);
         vec3 F = albedo + (1.0 - albedo) * (m * m * m * m * m);
-        frag = vec4(F * textureLod(env, parallax(r), 0.0).rgb, 0.0);
+        frag = vec4(F * seen(r, 0.0), 0.0);
         return;
     }
     if (cls == 3) {
@@ -51,7 +79,6 @@ void main() {
     vec3 kd, ks;
     lobes(kd, ks);
     float e = v_par.x;
-    float lod = max(0.0, lod_base - 0.5 * log2(e));
     float w = (e + 2.0) / (e + 1.0) * max(dot(n, r), 0.0);
-    frag = vec4(ks * w * textureLod(env, parallax(r), lod).rgb, 0.0);
+    frag = vec4(ks * w * seen(r, inversesqrt(e)), 0.0);
 }
