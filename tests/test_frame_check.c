@@ -9,9 +9,10 @@
  *
  * The references: kept only in this program's own folder (lmt_reference_cache: a test must not lean on what
  * an earlier run left; a view checked under several settings shares one), at a relative standard error of
- * 0.03 per pixel. A looser target reads the generated Cornell box about 3% dark: its light, 10 cm under the
- * ceiling, makes a few rare, bright paths, and a pixel that has not met one yet looks converged and stops
- * early. */
+ * 0.03 per pixel, the generated Cornell box's at 0.05: its light, 10 cm under the ceiling, makes a few rare,
+ * bright paths, and its reference is most of this program's time. Since a pixel's error pools its
+ * neighbours' variance (docs/reference.md, "Stopping rule") 0.05 reads it as 0.03 does (frame 0.988 and
+ * 0.987 of it); with each pixel's own variance alone 0.05 and 0.1 read it 2% and 4% dark. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -30,6 +31,7 @@
 
 #define SIZE 96           /* frame side: about 100 to 1,800 compared pixels per surface */
 #define REF_ERROR 0.03f   /* the reference's target relative standard error per pixel */
+#define REF_ERROR_RARE 0.05f /* the generated Cornell box's (the header) */
 #define SURFACE_TOL 0.03  /* per surface: |frame - reference| <= tol x max(reference, frame mean), tol this
                            * unless a scene says otherwise */
 #define BLOCK_RMSE 0.1   /* cornell-suzanne's textured block, per pixel (test_cornell_suzanne) */
@@ -111,14 +113,14 @@ static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_
 /* One default frame of the scene at SIZE against the reference, asserted: frame within 3% per channel,
  * surfaces within surface_tol, relative RMSE under rmse_bound. The caller frees c and the scene. */
 static lmgi_scene *run_check(const char *name, const char *path, double surface_tol, double rmse_bound,
-                             lm_frame_check *c)
+                             float ref_error, lm_frame_check *c)
 {
     lmgi_scene *sc = load_as_run(path, 0);
     lm_frame_loop_settings ls;
     lm_frame_loop_settings_default(&ls);
     ls.width = ls.height = SIZE;
     lm_ref_settings rs;
-    ref_settings(&rs, REF_ERROR);
+    ref_settings(&rs, ref_error);
     lm_error err;
     if (lm_frame_check_run(sc, &ls, &rs, 1, c, &err) != LM_OK)
         fail_msg("%s: %s", name, err.msg);
@@ -126,17 +128,18 @@ static lmgi_scene *run_check(const char *name, const char *path, double surface_
     return sc;
 }
 
-static void check_scene_tol(const char *name, const char *path, double surface_tol, double rmse_bound)
+static void check_scene_tol(const char *name, const char *path, double surface_tol, double rmse_bound,
+                            float ref_error)
 {
     lm_frame_check c;
-    lmgi_scene *sc = run_check(name, path, surface_tol, rmse_bound, &c);
+    lmgi_scene *sc = run_check(name, path, surface_tol, rmse_bound, ref_error, &c);
     lm_frame_check_free(&c);
     lmgi_free(sc);
 }
 
 static void check_scene(const char *name, const char *path, double rmse_bound)
 {
-    check_scene_tol(name, path, SURFACE_TOL, rmse_bound);
+    check_scene_tol(name, path, SURFACE_TOL, rmse_bound, REF_ERROR);
 }
 
 /* Measured at 96 x 96 at the defaults (frame / reference; relative RMSE, of which the reference's own
@@ -193,7 +196,7 @@ static void test_shared_cornell_box(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
     lm_frame_check c;
-    lmgi_scene *sc = run_check("shared Cornell box", path, SURFACE_TOL, 0.06, &c);
+    lmgi_scene *sc = run_check("shared Cornell box", path, SURFACE_TOL, 0.06, REF_ERROR, &c);
     assert_small_box(sc, &c, SMALL_FACE_PIXELS, 0);
     lm_frame_check_free(&c);
     lm_frame_loop_settings ls;
@@ -371,7 +374,7 @@ static void test_generated_cornell_box(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("cornell.glb"));
-    check_scene("generated Cornell box", path, 0.07);
+    check_scene_tol("generated Cornell box", path, SURFACE_TOL, 0.07, REF_ERROR_RARE);
 }
 
 static void test_two_rooms(void **state)
@@ -379,7 +382,7 @@ static void test_two_rooms(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
     lm_frame_check c;
-    lmgi_scene *sc = run_check("two rooms", path, SURFACE_TOL, 0.05, &c);
+    lmgi_scene *sc = run_check("two rooms", path, SURFACE_TOL, 0.05, REF_ERROR, &c);
     /* no mirror or glass: no caustic part on either side, and its error 0 */
     for (int k = 0; k < 3; k++)
         assert_true(c.caustic_lit.frame[k] == 0.0 && c.caustic_lit.ref[k] == 0.0);
@@ -445,7 +448,7 @@ static void test_cornell_suzanne(void **state)
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf"));
     lm_frame_check c;
-    lmgi_scene *sc = run_check("cornell-suzanne", path, 0.05, 0.1, &c);
+    lmgi_scene *sc = run_check("cornell-suzanne", path, 0.05, 0.1, REF_ERROR, &c);
     double block = surface_rmse(&c, 0);
     print_message("  textured block: relative RMSE over its pixels %.4f\n", block);
     assert_true(block < BLOCK_RMSE);

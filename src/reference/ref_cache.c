@@ -13,7 +13,7 @@
 #include "../scene/sky.h"
 
 #define LM_REF_MAGIC "LMGIREF1"
-#define LM_REF_VERSION 3u /* 2: the split by light path (caustic, lost, pixel parts); 3: paths cut */
+#define LM_REF_VERSION 4u /* 2: the split by light path (caustic, lost, pixel parts); 3: paths cut; 4: errors pooled */
 #define LM_FNV_OFFSET LM_HASH_SEED
 
 /* ---- FNV-1a ---- */

@@ -14,6 +14,8 @@
 
 #define LM_REF_DARK_FLOOR 0.01    /* relative errors are taken against max(mean, 1% of the mean entry) */
 #define LM_REF_PROGRESS_SECONDS 3.0
+#define LM_REF_POOL_RADIUS 2          /* pixels: the error pools the 5 x 5 around each (entry_errors) */
+#define LM_REF_POOL_RADIUS_TEXELS 12  /* texels: the 25 around each in the atlas's order */
 
 void lm_ref_settings_default(lm_ref_settings *s)
 {
@@ -58,19 +60,19 @@ static void stat_add(entry_stat *st, const lm_ref_sample *smp)
     }
 }
 
-/* Relative standard error of the mean: sqrt(M2 / (n - 1) / n) / max(mean, floor). */
-static double rel_se(const entry_stat *st, int w, double floor)
+/* Relative variance of one sample: M2 / (n - 1) / max(mean, floor)^2 (its standard error's square times n). */
+static double rel_var(const entry_stat *st, int w, double floor)
 {
     if (st->n < 2)
         return INFINITY;
-    double se = sqrt(fmax(0.0, st->m2[w]) / (st->n - 1.0) / st->n), d = fmax(st->mean[w], floor);
-    return d > 0.0 ? se / d : se > 0.0 ? INFINITY : 0.0;
+    double var = fmax(0.0, st->m2[w]) / (st->n - 1.0), d = fmax(st->mean[w], floor);
+    return d > 0.0 ? var / (d * d) : var > 0.0 ? INFINITY : 0.0;
 }
 
-static double entry_error(const entry_stat *st, int has_iim, double floor)
+static double entry_rel_var(const entry_stat *st, int has_iim, double floor)
 {
-    double e = rel_se(st, 0, floor);
-    return has_iim ? fmax(e, rel_se(st, 1, floor)) : e;
+    double v = rel_var(st, 0, floor);
+    return has_iim ? fmax(v, rel_var(st, 1, floor)) : v;
 }
 
 /* ---- passes ---- */
@@ -84,6 +86,7 @@ typedef struct {
     const lm_view *cam;    /* pixels, else NULL */
     uint32_t count;
     entry_stat *st;
+    double *rv, *err;            /* per entry, scratch: its relative variance, its pooled error (entry_errors) */
 } job;
 
 static void sample_entry(const job *j, uint32_t i, uint32_t k, lm_ref_sample *out)
@@ -136,15 +139,44 @@ static double dark_floor(const job *j)
     return j->count ? LM_REF_DARK_FLOOR * s / j->count : 0.0;
 }
 
+/* Every entry's error, j->err: the relative standard error of its mean, sqrt(v / n), where v is the larger of
+ * its own samples' relative variance and the mean of those of its neighbours (pixels: the 5 x 5 around it;
+ * texels: the 12 before and after it in the atlas's order, along its chart's rows). A variance from a
+ * pixel's own samples alone is low wherever the rare bright paths (a lamp's hot spot on the ceiling seen
+ * by a bounce) have not been met yet: such a pixel looked converged and stopped early, and at a target of
+ * 0.1 the generated Cornell box's reference read 4% dark, its surfaces up to 17%. Its neighbours that did
+ * meet one keep it sampling. */
+static void entry_errors(const job *j, double floor)
+{
+    int has_iim = j->frames != NULL;
+    for (uint32_t i = 0; i < j->count; i++)
+        j->rv[i] = entry_rel_var(&j->st[i], has_iim, floor);
+    int w = j->cam ? j->cam->width : (int)j->count, h = j->cam ? j->cam->height : 1;
+    int rx = j->cam ? LM_REF_POOL_RADIUS : LM_REF_POOL_RADIUS_TEXELS, ry = j->cam ? LM_REF_POOL_RADIUS : 0;
+    for (uint32_t i = 0; i < j->count; i++) {
+        int x = (int)(i % (uint32_t)w), y = (int)(i / (uint32_t)w);
+        double sum = 0.0, own = j->rv[i];
+        int k = 0;
+        for (int yy = y - ry; yy <= y + ry; yy++)
+            for (int xx = x - rx; xx <= x + rx; xx++)
+                if (yy >= 0 && yy < h && xx >= 0 && xx < w) {
+                    sum += j->rv[(size_t)yy * (size_t)w + (size_t)xx];
+                    k++;
+                }
+        double v = fmax(own, sum / k); /* an infinite neighbour (one sample) keeps it going too */
+        j->err[i] = j->st[i].n ? sqrt(v / j->st[i].n) : INFINITY;
+    }
+}
+
 /* Entries that do not meet the stopping rule under the current floor. Every entry is checked, so one
  * stopped under an earlier (higher) floor resumes, and the final report holds the same rule. */
 static uint32_t still_active(const job *j, uint32_t *active, double floor)
 {
     uint32_t keep = 0, min = (uint32_t)j->set->min_samples;
+    entry_errors(j, floor);
     for (uint32_t i = 0; i < j->count; i++) {
         const entry_stat *st = &j->st[i];
-        int done = st->n >= (uint32_t)j->set->max_samples ||
-                   (st->n >= min && entry_error(st, j->frames != NULL, floor) <= j->set->target_error);
+        int done = st->n >= (uint32_t)j->set->max_samples || (st->n >= min && j->err[i] <= j->set->target_error);
         if (!done)
             active[keep++] = i;
     }
@@ -154,14 +186,14 @@ static uint32_t still_active(const job *j, uint32_t *active, double floor)
 /* Seconds left, estimated: an entry's standard error falls as 1 / sqrt(samples), so one at error e over
  * the target t needs about n (e / t)^2 samples in all (within max_samples); the samples still needed at
  * the rate so far. Rough while the errors themselves are noisy, it settles after the first passes. */
-static double seconds_left(const job *j, const uint32_t *active, uint32_t na, double floor, double spent)
+static double seconds_left(const job *j, const uint32_t *active, uint32_t na, double spent)
 {
     double done = 0.0, needed = 0.0, t = j->set->target_error;
     for (uint32_t i = 0; i < j->count; i++)
         done += j->st[i].n;
     for (uint32_t a = 0; a < na; a++) {
         const entry_stat *st = &j->st[active[a]];
-        double e = entry_error(st, j->frames != NULL, floor), want = st->n * (e / t) * (e / t);
+        double e = j->err[active[a]], want = st->n * (e / t) * (e / t);
         if (!(want <= j->set->max_samples)) /* also an error not yet finite */
             want = j->set->max_samples;
         want = fmax(want, j->set->min_samples);
@@ -183,7 +215,7 @@ static void adaptive(const job *j, uint32_t *active)
         if (j->set->progress && na > 0 && lm_now() - last >= LM_REF_PROGRESS_SECONDS) {
             last = lm_now();
             lm_info("reference: pass %d, %.0f s: %u of %u %s still sampling, about %.0f s left", pass, last - t0, na,
-                    j->count, j->frames ? "texels" : "pixels", seconds_left(j, active, na, floor, last - t0));
+                    j->count, j->frames ? "texels" : "pixels", seconds_left(j, active, na, last - t0));
         }
     }
 }
@@ -214,10 +246,11 @@ static void entry_result(const job *j, uint32_t i, const float *caustic, lm_ref_
 
 static void finish(const job *j, const float *caustic, lm_ref_result *r)
 {
-    double floor = dark_floor(j), sum_err = 0.0;
+    double sum_err = 0.0;
+    entry_errors(j, dark_floor(j));
     for (uint32_t i = 0; i < j->count; i++) {
         const entry_stat *st = &j->st[i];
-        double e = entry_error(st, j->frames != NULL, floor);
+        double e = j->err[i];
         entry_result(j, i, caustic, r);
         r->samples[i] = st->n;
         r->rel_se[i] = (float)e;
@@ -269,9 +302,11 @@ static lm_status solve(job *j, uint32_t kind, uint64_t key, int width, int heigh
     double t0 = lm_now();
     size_t n = j->count ? j->count : 1;
     j->st = calloc(n, sizeof *j->st);
+    j->rv = malloc(n * sizeof *j->rv);
+    j->err = malloc(n * sizeof *j->err);
     uint32_t *active = malloc(n * sizeof *active);
     float *caustic = malloc(n * 3 * sizeof *caustic);
-    lm_status st = j->st && active && caustic && lm_ref_result_alloc(out, j->count, kind == LM_REF_KIND_TEXELS)
+    lm_status st = j->st && j->rv && j->err && active && caustic && lm_ref_result_alloc(out, j->count, kind == LM_REF_KIND_TEXELS)
                        ? LM_OK
                        : lm_fail(err, LM_ERR_NOMEM, "no memory for %u reference values", j->count);
     if (st == LM_OK) {
@@ -294,7 +329,9 @@ static lm_status solve(job *j, uint32_t kind, uint64_t key, int width, int heigh
     free(caustic);
     free(active);
     free(j->st);
-    j->st = NULL;
+    free(j->rv);
+    free(j->err);
+    j->st = NULL, j->rv = j->err = NULL;
     return st;
 }
 
@@ -325,7 +362,7 @@ lm_status lm_reference_texels(const lm_scene *s, const lm_atlas *atlas, const lm
         lm_ref_texel_frame(&c, &atlas->texels[i], &frames[i]);
     for (uint32_t i = 0; i < atlas->footprint_count; i++)
         lm_ref_texel_frame(&c, &atlas->footprints[i], &points[i]);
-    job j = {&c, &fixed, frames, points, atlas, NULL, atlas->texel_count, NULL};
+    job j = {&c, &fixed, frames, points, atlas, NULL, atlas->texel_count, NULL, NULL, NULL};
     st = solve(&j, LM_REF_KIND_TEXELS, lm_ref_key_texels(s, atlas, &fixed), atlas->width, atlas->height, out, err);
     free(points);
     free(frames);
@@ -358,7 +395,7 @@ lm_status lm_reference_pixels(const lm_scene *s, const lm_rt *rt, const lm_emitt
     lm_ref_ctx c;
     if ((st = lm_ref_ctx_init(&c, s, rt, em, &fixed, err)) != LM_OK)
         return st;
-    job j = {&c, &fixed, NULL, NULL, NULL, cam, (uint32_t)cam->width * (uint32_t)cam->height, NULL};
+    job j = {&c, &fixed, NULL, NULL, NULL, cam, (uint32_t)cam->width * (uint32_t)cam->height, NULL, NULL, NULL};
     st = solve(&j, LM_REF_KIND_PIXELS, lm_ref_key_pixels(s, cam, &fixed), cam->width, cam->height, out, err);
     lm_ref_ctx_free(&c);
     return st;

@@ -39,8 +39,10 @@
  * `caustic_photons` photons per (emitter, specular node) pair, traced forward (ref_caustic.h).
  *
  * Adaptive sampling: passes of `samples` paths per active texel (pixel); per entry a running mean and
- * variance (Welford) of the luminance; an entry stops when its relative standard error
- * se / max(mean, floor) is at most `target_error` (for texels: for E_full and E_iim both), with
+ * variance (Welford) of the luminance; an entry stops when its relative standard error sqrt(v / n) is at
+ * most `target_error` (for texels: for E_full and E_iim both), v the larger of its own relative variance
+ * var / max(mean, floor)^2 and its neighbours' mean (pixels: 5 x 5; texels: 25 in atlas order), so that
+ * one that has not met a rare bright path its neighbours met keeps sampling, with
  * floor = 1% of the mean luminance over all entries (so black texels stop too), after at least
  * `min_samples`, or at `max_samples`. The rule reads the path tracer's part of E_full (the caustic
  * part has a fixed photon count and is added after).
