@@ -92,6 +92,7 @@ struct lm_caustic_pass {
     uint32_t table_size;
     slot_targets slots[LM_CAUSTIC_SLOTS];
     float *rects;           /* scratch: 12 floats per grown tile */
+    float clip[4];          /* photons with dot(clip, (p, 1)) < 0 are left out (lm_caustic_pass_set_clip) */
 };
 
 static void free_photons(lm_caustic_pass *cp);
@@ -382,6 +383,8 @@ static uint32_t visible_photons(lm_caustic_pass *cp, slot_targets *t, const floa
     memset(t->lit, 0, (size_t)(t->tiles_x * t->tiles_y));
     for (uint32_t i = 0; i < cp->photons; i++) {
         const float *p = cp->hits[i].pos;
+        if (cp->clip[0] * p[0] + cp->clip[1] * p[1] + cp->clip[2] * p[2] + cp->clip[3] < 0.0f)
+            continue;
         float c[4];
         for (int r = 0; r < 4; r++)
             c[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
@@ -490,12 +493,20 @@ static void receiver_mask(lm_caustic_pass *cp, const slot_targets *t, GLuint kd)
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
 }
 
+/* The picture of the frame targets a slot composites into. */
+static int slot_picture(int slot)
+{
+    return slot == LM_CAUSTIC_SLOT_PROBE    ? LM_FRAME_PROBE
+           : slot == LM_CAUSTIC_SLOT_MIRROR ? LM_FRAME_MIRROR
+                                            : LM_FRAME_VIEW;
+}
+
 /* kd of the frame targets the slot composites into (0: none). */
 static GLuint slot_kd(const lm_direct *d, int slot)
 {
     if (!d)
         return 0;
-    return lm_frame_targets_kd(lm_direct_targets(d), slot == LM_CAUSTIC_SLOT_PROBE ? LM_FRAME_PROBE : LM_FRAME_VIEW);
+    return lm_frame_targets_kd(lm_direct_targets(d), slot_picture(slot));
 }
 
 /* Splats the n photons visible_photons listed. */
@@ -762,13 +773,12 @@ static void filter(lm_caustic_pass *cp, slot_targets *t, const view_consts *vc, 
     glActiveTexture(GL_TEXTURE0);
 }
 
-/* kd / pi x E added over the box of the grown lit tiles (outside them E is 0), into d's probe target (the
- * probe slot) or its frame's. One quad: no geometry drawn again. */
+/* kd / pi x E added over the box of the grown lit tiles (outside them E is 0), into d's picture of the slot
+ * (slot_picture). One quad: no geometry drawn again. */
 static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_direct *d, int slot, const int box[4])
 {
     const lm_frame_targets *f = lm_direct_targets(d);
-    int which = slot == LM_CAUSTIC_SLOT_PROBE ? LM_FRAME_PROBE : LM_FRAME_VIEW;
-    lm_frame_targets_bind_radiance(f, which);
+    lm_frame_targets_bind_radiance(f, slot_picture(slot));
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_CULL_FACE);
     glEnable(GL_BLEND);
@@ -789,6 +799,12 @@ static void composite(lm_caustic_pass *cp, const slot_targets *t, const lm_direc
     glActiveTexture(GL_TEXTURE0);
     glDisable(GL_BLEND);
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+void lm_caustic_pass_set_clip(lm_caustic_pass *cp, const float plane[4])
+{
+    for (int k = 0; k < 4; k++)
+        cp->clip[k] = plane ? plane[k] : 0.0f;
 }
 
 lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,

@@ -44,9 +44,9 @@
  *   composite  one quad over the box of the grown tiles, each pixel adding kd / pi x E (kd the diffuse
  *            lobe the direct light's first pass wrote there: frame_targets.h).
  *
- * Three slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
- * environment maps' faces (_PROBE, composited into the frame targets' probe picture) and other views an
- * application renders (_VIEW).
+ * Four slots of targets, each re-made when its size changes: the frame's (LM_CAUSTIC_SLOT_FRAME), the
+ * environment maps' faces (_PROBE, composited into the frame targets' probe picture), other views an
+ * application renders (_VIEW) and a flat reflector's mirrored view (_MIRROR, into the mirror picture).
  * A view no photon projects into (an environment map face that sees no focal spot) costs no GL work.
  * Cost: one point per photon in the view (fewer where they crowd into pixels), one query quad per tile a photon projects into, (2k + 1)^2 texture reads
  * per filtered pixel (and up to LM_CAUSTIC_FILTER_LEVELS + 5 to size it, four of them the structure test,
@@ -102,7 +102,13 @@ typedef struct {
 } lm_caustic_pass_stats;
 
 typedef struct lm_caustic_pass lm_caustic_pass;
-enum { LM_CAUSTIC_SLOT_FRAME = 0, LM_CAUSTIC_SLOT_PROBE = 1, LM_CAUSTIC_SLOT_VIEW = 2, LM_CAUSTIC_SLOTS = 3 };
+enum {
+    LM_CAUSTIC_SLOT_FRAME = 0,
+    LM_CAUSTIC_SLOT_PROBE = 1,
+    LM_CAUSTIC_SLOT_VIEW = 2,
+    LM_CAUSTIC_SLOT_MIRROR = 3,
+    LM_CAUSTIC_SLOTS = 4
+};
 
 lm_status lm_caustic_pass_create(const lm_caustic_pass_settings *set, lm_caustic_pass **out, lm_error *err);
 void lm_caustic_pass_free(lm_caustic_pass *cp);
@@ -112,9 +118,12 @@ uint32_t lm_caustic_pass_photon_count(const lm_caustic_pass *cp);
 /* From the next run on, the density-sized filter widens up to 2^levels times (clamped to 0 ..
  * LM_CAUSTIC_FILTER_LEVELS): the photons' set decides it, not the pass's life (update/frame_passes.c). */
 void lm_caustic_pass_set_widening(lm_caustic_pass *cp, int levels);
+/* The runs after this one leave out the photons with dot(plane, (p, 1)) < 0 (a flat reflector's far side,
+ * which its mirrored view would otherwise show in front of it); NULL: none left out. */
+void lm_caustic_pass_set_clip(lm_caustic_pass *cp, const float plane[4]);
 /* Splat, tiles and filter for `view` over the depth texture `depth` (width x height, lm_direct_depth_texture)
  * into slot `slot`'s irradiance; then, unless d is NULL, the composite into d's probe target (the probe
- * slot) or its frame's (the others), whose first pass drew the same view. Nothing at all is drawn without
+ * slot), mirror picture (the mirror slot) or frame's (the others), whose first pass drew the same view. Nothing at all is drawn without
  * photons. stats may be NULL. */
 lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,
                               int height, const lm_direct *d, lm_caustic_pass_stats *stats, lm_error *err);

@@ -502,9 +502,15 @@ lm_status lm_reflections_draw_planes(lm_reflections *r, lm_direct *d, const lm_s
          * size behind it */
         float clip[4] = {plane[0], plane[1], plane[2], plane[3] + 1e-4f * lm_scene_size(s)};
         st = lm_direct_draw_mirror(d, s, em, &m, width, height, f->node, clip, err);
+        const lm_frame_targets *t = lm_direct_targets(d);
+        if (st == LM_OK && in->caustics) { /* the picture's caustics, over its own depth */
+            lm_caustic_pass_set_clip(in->caustics, clip);
+            st = lm_caustic_pass_run(in->caustics, LM_CAUSTIC_SLOT_MIRROR, &m,
+                                     lm_frame_targets_depth(t, LM_FRAME_MIRROR), width, height, d, NULL, err);
+            lm_caustic_pass_set_clip(in->caustics, NULL);
+        }
         if (st != LM_OK)
             break;
-        const lm_frame_targets *t = lm_direct_targets(d);
         glCopyImageSubData(lm_frame_targets_radiance(t, LM_FRAME_MIRROR), GL_TEXTURE_2D, 0, 0, 0, 0, f->plane_tex,
                            GL_TEXTURE_2D, 0, 0, 0, 0, width, height, 1);
         glCopyImageSubData(lm_frame_targets_depth(t, LM_FRAME_MIRROR), GL_TEXTURE_2D, 0, 0, 0, 0, f->plane_depth,
