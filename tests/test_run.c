@@ -166,6 +166,18 @@ static float *read_exr(const char *dir, const char *file, int *w, int *h)
     return px;
 }
 
+/* `lmgi run SCENE --frames 1 -q OPTS` into lmt_tmpdir()/out: its first frame (RGBA floats, row 0 at the
+ * top), w x h. */
+static float *run_frame(const char *scene, const char *out, const char *opts, int *w, int *h)
+{
+    char args[4096], dir[1100];
+    snprintf(dir, sizeof dir, "%s/%s", lmt_tmpdir(), out);
+    snprintf(args, sizeof args, "run %s --frames 1 -q %s --out %s", scene, opts, dir);
+    if (lmgi(args) != 0)
+        fail_msg("lmgi run failed: %s", output);
+    return read_exr(dir, "frame_0000.exr", w, h);
+}
+
 static void test_deterministic(void **state)
 {
     (void)state;
@@ -443,13 +455,10 @@ static void check_reflection(const char *material, const char *opts, int flat, d
              material);
     const char *path = lmt_write_scene("mirror.gltf", m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"camera\": 0, "
                                        "\"translation\": [0, 0, 4]}]", materials);
-    char args[4096], dir[1100];
-    snprintf(dir, sizeof dir, "%s/mirror_out", lmt_tmpdir());
-    snprintf(args, sizeof args, "run %s --frames 1 --size 32x32 --photons 20000 -q %s --out %s", path, opts, dir);
-    if (lmgi(args) != 0)
-        fail_msg("lmgi run failed: %s", output);
+    char run_opts[1024];
+    snprintf(run_opts, sizeof run_opts, "--size 32x32 --photons 20000 %s", opts);
     int w, h;
-    float *px = read_exr(dir, "frame_0000.exr", &w, &h);
+    float *px = run_frame(path, "mirror_out", run_opts, &w, &h);
     double centre = px[4 * ((h / 2) * w + w / 2) + 1], worst = 0.0;
     for (int i = 0; i < w * h; i++)
         worst = fmax(worst, px[4 * i + 1]);
@@ -482,13 +491,8 @@ static void test_flat_mirror_image(void **state)
              "\"emissiveFactor\": [1, 1, 1]}], \"cameras\": [{\"type\": \"perspective\", \"perspective\": "
              "{\"yfov\": %g, \"znear\": 0.01, \"aspectRatio\": 1}}]", LMT_MIRROR(0.8), yfov);
     const char *path = lmt_write_scene("flat_mirror.gltf", m, 2, nodes, materials);
-    char args[4096], dir[1100];
-    snprintf(dir, sizeof dir, "%s/flat_mirror_out", lmt_tmpdir());
-    snprintf(args, sizeof args, "run %s --frames 1 --size 64x64 --photons 20000 -q --out %s", path, dir);
-    if (lmgi(args) != 0)
-        fail_msg("lmgi run failed: %s", output);
     int w, h;
-    float *px = read_exr(dir, "frame_0000.exr", &w, &h);
+    float *px = run_frame(path, "flat_mirror_out", "--size 64x64 --photons 20000", &w, &h);
     int lit_both = 0, lit_want = 0, lit_got = 0, compared = 0;
     double ratio = 0.0;
     for (int y = 0; y < h; y++)
@@ -557,15 +561,11 @@ static void test_flat_mirror_shows_caustic(void **state)
     const char *path = lmt_write_scene("mirror_caustic.gltf", m, 2, nodes, materials);
     float *px[2];
     int w = 0, h = 0;
-    for (int on = 0; on < 2; on++) {
-        char args[4096], dir[1100];
-        snprintf(dir, sizeof dir, "%s/mirror_caustic_%d", lmt_tmpdir(), on);
-        snprintf(args, sizeof args, "run %s --frames 1 --size 96x96 --photons 40000 --caustic-photons 65536 -q %s "
-                 "--out %s", path, on ? "" : "--effects -caustics", dir);
-        if (lmgi(args) != 0)
-            fail_msg("lmgi run failed: %s", output);
-        px[on] = read_exr(dir, "frame_0000.exr", &w, &h);
-    }
+    for (int on = 0; on < 2; on++)
+        px[on] = run_frame(path, on ? "mirror_caustic_on" : "mirror_caustic_off",
+                           on ? "--size 96x96 --photons 40000 --caustic-photons 65536"
+                              : "--size 96x96 --photons 40000 --caustic-photons 65536 --effects -caustics",
+                           &w, &h);
     double got[2] = {0.0, 0.0}, want[2] = {0.0, 0.0}; /* the floor's, the mirror's */
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {

@@ -27,7 +27,6 @@ typedef struct {
     GLuint plane_tex, plane_depth; /* the mirrored picture's radiance (mips when glossy) and depth */
     int plane_w, plane_h, plane_levels;
     uint64_t plane_key;            /* what it was drawn from (0: never drawn) */
-    float plane[4];                /* its world plane, the eye's side positive, when drawn */
 } reflector;
 
 struct lm_reflections {
@@ -398,13 +397,6 @@ int lm_reflections_face_count(const lm_reflections *r)
     return n;
 }
 
-int lm_reflections_plane_count(const lm_reflections *r)
-{
-    int n = 0;
-    for (int k = 0; r && k < r->count; k++)
-        n += r->r[k].planar;
-    return n;
-}
 
 int lm_reflections_dirty_faces(const lm_reflections *r)
 {
@@ -495,7 +487,6 @@ lm_status lm_reflections_draw_planes(lm_reflections *r, lm_direct *d, const lm_s
         lm_v3_store(m.eye, lm_mat4_point(refl, lm_v3_load(view->eye)));
         plane_textures(f, width, height);
         uint64_t key = plane_key(&m, width, height, s, in, d);
-        memcpy(f->plane, plane, sizeof plane);
         if (key == f->plane_key)
             continue;
         /* what touches the plane stays in (an object standing on it): the cut lies 1e-4 of the scene's

@@ -69,7 +69,7 @@ lm_status lm_reflections_update(lm_reflections *r, lm_direct *d, const lm_scene 
 /* The faces the next updates render at most, in place of faces_per_frame (a time budget's count,
  * update/budget_plan.h); 0: faces_per_frame again. NULL: nothing. */
 void lm_reflections_limit_faces(lm_reflections *r, int most);
-/* Faces of all the maps (6 a map; 0 for NULL). */
+/* Faces of all the maps (6 a map; 0 for NULL and for a flat reflector, which has none). */
 int lm_reflections_face_count(const lm_reflections *r);
 /* Faces still dirty after the last update (0 for NULL). */
 int lm_reflections_dirty_faces(const lm_reflections *r);
@@ -81,8 +81,6 @@ int lm_reflections_dirty_faces(const lm_reflections *r);
 lm_status lm_reflections_draw_planes(lm_reflections *r, lm_direct *d, const lm_scene *s, const lm_emitters *em,
                                      const lm_reflection_inputs *in, const lm_view *view, int width, int height,
                                      int *drawn, lm_error *err);
-/* Flat reflectors (0 for NULL); they have no faces. */
-int lm_reflections_plane_count(const lm_reflections *r);
 /* Adds the reflections to the frame d just drew from view (lm_direct_draw; depth test against its depth). */
 lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const lm_scene *s, const lm_view *view,
                               lm_error *err);
