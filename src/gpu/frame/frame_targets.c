@@ -17,7 +17,9 @@ void lm_frame_targets_free(lm_frame_targets *f)
 
 lm_status lm_frame_targets_ensure(lm_frame_targets *f, int which, int width, int height, lm_error *err)
 {
-    return lm_float_target_ensure(&f->t[which], width, height, 3, err); /* radiance, kd, G-buffer */
+    /* radiance, kd and the view's G-buffer (only the view's is read: a 1080p mirror picture would hold
+     * 33 MB of it for nothing) */
+    return lm_float_target_ensure(&f->t[which], width, height, which == LM_FRAME_VIEW ? 3 : 2, err);
 }
 
 unsigned lm_frame_targets_fbo(const lm_frame_targets *f, int which) { return f->t[which].fbo; }

@@ -1,14 +1,14 @@
 /* The frame's render targets, in one place (docs/direct.md): the picture of the view, the picture of
  * an environment map's face (the probe) and the picture of the view mirrored in a flat reflector (the
- * mirror, reflections.h), each an RGBA32F target of three colour attachments and a depth
- * texture that the direct light's first pass lays down and the later passes read or add to:
+ * mirror, reflections.h), each an RGBA32F target of colour attachments (three the view's, two the others')
+ * and a depth texture that the direct light's first pass lays down and the later passes read or add to:
  *
  *   attachment 0  radiance (rgb; the passes after the first add to it: the direct light's further
  *                 lights, the caustics, the reflections, the per-pixel photon gathers)
  *   attachment 1  kd, the diffuse lobe at the visible point (rgb; a: 1, or 1 / c, lm_direct_set_coverage),
  *                 for the passes that add kd / pi x an irradiance per pixel (caustics, photon gathers)
  *   attachment 2  the G-buffer: world position (rgb) and the packed eye-side shading normal (a;
- *                 glsl/gbuffer_normal.glsl unpacks it), for the per-pixel photon gathers; the view's only
+ *                 glsl/gbuffer_normal.glsl unpacks it), for the per-pixel photon gathers; the view's alone
  *   depth         24-bit GL window depth, for the caustic splat's depth test and the reflections'
  *
  * Every texture is GL rows bottom-up. The targets are kept between frames and re-made only when a size
