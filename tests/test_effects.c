@@ -4,8 +4,11 @@
 #include <stddef.h>
 #include <cmocka.h>
 
+#include <math.h>
+#include <stdio.h>
 #include <string.h>
 
+#include "../src/scene/flat_reflectors.h"
 #include "../src/update/effects.h"
 #include "support.h"
 
@@ -68,7 +71,45 @@ static void test_glossy_reflects(void **state)
     lm_effects_decide(s, &e);
     assert_false(e.on[LM_EFFECT_CAUSTICS]);
     assert_true(e.on[LM_EFFECT_REFLECTIONS]);
-    assert_string_equal(e.reason[LM_EFFECT_REFLECTIONS], "1 glossy material on node 'CircuitBoard'");
+    assert_string_equal(e.reason[LM_EFFECT_REFLECTIONS], "1 glossy material on node 'CircuitBoard'; 1 flat node: "
+                        "the view mirrored in its plane");
+    lm_scene_free(s);
+}
+
+/* Flat reflectors (scene/flat_reflectors.h): a mirror quad is one, and stays one with a corner lifted by a
+ * tenth of the tolerance; lifted by ten times it, it is not, nor is a mirror cube, a glossy quad given a
+ * reflection_box, a glass quad or a diffuse one. A two-sided glossy quad (its back copies wound the other
+ * way) is one, its plane y = 0.5. */
+static void test_flat_reflectors(void **state)
+{
+    (void)state;
+    static lmt_mesh m[8];
+    memset(m, 0, sizeof m);
+    for (int k = 0; k < 8; k++)
+        lmt_mesh_quad(&m[k], (float[3]){-1, k == 7 ? 0.5f : 0.0f, 1}, (float[3]){2, 0, 0}, (float[3]){0, 0, -2});
+    float diagonal = 2.0f * sqrtf(2.0f);
+    m[1].pos[1] += 0.1f * LM_FLAT_TOLERANCE * diagonal;
+    m[2].pos[1] += 10.0f * LM_FLAT_TOLERANCE * diagonal;
+    lmt_mesh_cube(&m[3], 0.5f);
+    const char *glossy = "{\"pbrMetallicRoughness\": {\"metallicFactor\": 1, \"roughnessFactor\": 0.3}";
+    char materials[2048];
+    snprintf(materials, sizeof materials, "[%s, %s, %s, %s, %s}, %s, %s, %s, \"doubleSided\": true}], %s",
+             LMT_MIRROR(0.9), LMT_MIRROR(0.9), LMT_MIRROR(0.9), LMT_MIRROR(0.9), glossy, LMT_GLASS, LMT_DIFFUSE(0.5), glossy,
+             LMT_LIGHTS("{\"type\": \"point\", \"intensity\": 1}"));
+    const char *path = lmt_write_scene("flat_reflectors.gltf", m, 8, "[{\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}, "
+                                       "{\"mesh\": 3}, {\"mesh\": 4, \"extras\": {\"lmgi\": {\"reflection_box\": "
+                                       "[-2, -2, -2, 2, 2, 2]}}}, {\"mesh\": 5}, {\"mesh\": 6}, {\"mesh\": 7}]",
+                                       materials);
+    lm_scene *s = load(path);
+    const int want[8] = {1, 1, 0, 0, 0, 0, 0, 1};
+    for (int n = 0; n < 8; n++)
+        assert_int_equal(lm_node_is_flat_reflector(s, n), want[n]);
+    float plane[4], extent, far = lm_node_reflector_plane(s, 7, plane, &extent);
+    assert_true(far >= 0.0f && far < 1e-6f && fabsf(extent - diagonal) < 1e-5f);
+    assert_true(fabsf(fabsf(plane[1]) - 1.0f) < 1e-6f && fabsf(plane[3] + 0.5f * plane[1]) < 1e-6f);
+    lm_effects e;
+    lm_effects_decide(s, &e);
+    assert_non_null(strstr(e.reason[LM_EFFECT_REFLECTIONS], "; 3 flat nodes: the view mirrored in their plane"));
     lm_scene_free(s);
 }
 
@@ -117,6 +158,7 @@ int main(void)
         cmocka_unit_test(test_generated_cornell),
         cmocka_unit_test(test_shared_cornell_box),
         cmocka_unit_test(test_glossy_reflects),
+        cmocka_unit_test(test_flat_reflectors),
         cmocka_unit_test(test_switches_turn_effects_off),
         cmocka_unit_test(test_static_scene_traces_once),
     };

@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../scene/flat_reflectors.h"
+
 const char *lm_effect_name(lm_effect_id e)
 {
     static const char *names[LM_EFFECT_COUNT] = {"direct", "shadows", "indirect", "caustics", "reflections",
@@ -169,6 +171,14 @@ static void decide_specular(const lm_scene *s, lm_effects *e)
     on = describe_materials(s, r, kinds, 3, e->reason[LM_EFFECT_REFLECTIONS], 256);
     off = first_off(r, 3);
     e->on[LM_EFFECT_REFLECTIONS] = on > 0;
+    int flat = 0;
+    for (int n = 0; on > 0 && n < s->node_count; n++)
+        flat += s->nodes[n].settings.reflections && lm_node_is_flat_reflector(s, n);
+    if (flat) { /* which of them reflect the view mirrored in their plane, not a cube map */
+        size_t len = strlen(e->reason[LM_EFFECT_REFLECTIONS]);
+        snprintf(e->reason[LM_EFFECT_REFLECTIONS] + len, 256 - len, "; %d flat node%s: the view mirrored in %s plane",
+                 flat, flat == 1 ? "" : "s", flat == 1 ? "its" : "their");
+    }
     if (!on && off >= 0)
         snprintf(e->reason[LM_EFFECT_REFLECTIONS], 256, "mirror, glossy and glass materials only on nodes with "
                  "reflections switched off (first: '%s')", s->nodes[off].name);

@@ -10,6 +10,7 @@
 
 #include "../../core/hash.h"
 #include "../../core/vecmath.h"
+#include "../../scene/flat_reflectors.h"
 #include "glsl.h"
 #include "../gl/gl_shader.h"
 
@@ -48,58 +49,6 @@ struct lm_reflections {
 
 static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY || c == LM_MAT_GLASS; }
 
-/* The plane of the reflector's triangles in the world as it is now: n the area-weighted mean of their
- * normals (each turned to the sum's side: a two-sided surface's back copies), w = -n.p at their first
- * corner. Returns the largest distance of a corner from that plane, and writes the bounds' diagonal to
- * *extent; -1 when the triangles have no area. */
-static float fit_plane(const lm_scene *s, const reflector *f, float plane[4], float *extent)
-{
-    lm_vec3 sum = lm_v3(0.0f, 0.0f, 0.0f), lo = lm_v3(INFINITY, INFINITY, INFINITY), hi = lm_scale(lo, -1.0f);
-    for (uint32_t i = 0; i < f->tri_count; i++) {
-        lm_vec3 p[3];
-        for (int k = 0; k < 3; k++) {
-            float w[3];
-            lm_scene_vertex_world(s, s->tris[3 * (size_t)f->tris[i] + k], w);
-            p[k] = lm_v3_load(w);
-            lo = lm_vmin(lo, p[k]);
-            hi = lm_vmax(hi, p[k]);
-        }
-        lm_vec3 c = lm_cross(lm_sub(p[1], p[0]), lm_sub(p[2], p[0]));
-        sum = lm_add(sum, lm_dot(c, sum) < 0.0f ? lm_scale(c, -1.0f) : c); /* a two-sided copy's back: turned */
-    }
-    *extent = lm_length(lm_sub(hi, lo));
-    if (!(lm_length(sum) > 0.0f))
-        return -1.0f;
-    lm_vec3 n = lm_normalize(sum);
-    float p0[3];
-    lm_scene_vertex_world(s, s->tris[3 * (size_t)f->tris[0]], p0);
-    float w = -lm_dot(n, lm_v3_load(p0)), far = 0.0f;
-    for (uint32_t i = 0; i < f->tri_count; i++)
-        for (int k = 0; k < 3; k++) {
-            float q[3];
-            lm_scene_vertex_world(s, s->tris[3 * (size_t)f->tris[i] + k], q);
-            far = fmaxf(far, fabsf(lm_dot(n, lm_v3_load(q)) + w));
-        }
-    lm_v3_store(plane, n);
-    plane[3] = w;
-    return far;
-}
-
-/* A reflector is flat when its corners lie within 1e-4 of its size of one plane and none of its triangles
- * is glass (glass shows what lies behind it, which a mirrored picture does not hold). A node given a
- * reflection_box keeps its box-projected cube map: the user's choice, redrawn only when what it sees
- * changes, where the mirrored picture is redrawn whenever the view moves. */
-#define PLANAR_TOLERANCE 1e-4f
-static int is_planar(const lm_scene *s, const reflector *f)
-{
-    if (s->nodes[f->node].settings.has_reflection_box)
-        return 0;
-    for (uint32_t i = 0; i < f->tri_count; i++)
-        if (s->materials[s->tri_material[f->tris[i]]].cls == LM_MAT_GLASS)
-            return 0;
-    float plane[4], extent, far = fit_plane(s, f, plane, &extent);
-    return far >= 0.0f && far <= PLANAR_TOLERANCE * extent;
-}
 
 /* The nodes with mirror or glossy triangles, each with its list of them (from the node's own range). */
 static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error *err)
@@ -123,7 +72,7 @@ static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error 
         }
         if (f->tri_count) {
             f->node = n;
-            f->planar = is_planar(s, f);
+            f->planar = lm_node_is_flat_reflector(s, n);
             r->count++;
         }
     }
@@ -475,7 +424,7 @@ lm_status lm_reflections_draw_planes(lm_reflections *r, lm_direct *d, const lm_s
         if (!f->planar)
             continue;
         float extent, plane[4];
-        fit_plane(s, f, plane, &extent);
+        lm_node_reflector_plane(s, f->node, plane, &extent);
         float side = lm_dot(lm_v3_load(plane), lm_v3_load(view->eye)) + plane[3];
         if (side < 0.0f) /* the eye's side positive: what lies there is what the plane reflects */
             for (int c = 0; c < 4; c++)
