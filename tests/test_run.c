@@ -166,12 +166,34 @@ static float *read_exr(const char *dir, const char *file, int *w, int *h)
     return px;
 }
 
-/* `lmgi run SCENE --frames 1 -q OPTS` into lmt_tmpdir()/out: its first frame (RGBA floats, row 0 at the
- * top), w x h. */
-static float *run_frame(const char *scene, const char *out, const char *opts, int *w, int *h)
+/* The sum over its rows of column `name` of DIR/frames.csv. */
+static long csv_column_sum(const char *dir, const char *name)
 {
-    char args[4096], dir[1100];
-    snprintf(dir, sizeof dir, "%s/%s", lmt_tmpdir(), out);
+    char path[2048], line[8192];
+    snprintf(path, sizeof path, "%s/frames.csv", dir);
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    assert_non_null(fgets(line, sizeof line, f));
+    int col = 0, at = -1;
+    for (char *tok = strtok(line, ",\n"); tok; tok = strtok(NULL, ",\n"), col++)
+        at = strcmp(tok, name) ? at : col;
+    assert_true(at >= 0);
+    long sum = 0;
+    while (fgets(line, sizeof line, f)) {
+        col = 0;
+        for (char *tok = strtok(line, ",\n"); tok; tok = strtok(NULL, ",\n"), col++)
+            sum += col == at ? atol(tok) : 0;
+    }
+    fclose(f);
+    return sum;
+}
+
+/* `lmgi run SCENE --frames 1 -q OPTS` into a fresh folder lmt_tmpdir()/out (its path in dir, 1,100 bytes):
+ * its first frame (RGBA floats, row 0 at the top), w x h. */
+static float *run_frame(const char *scene, const char *out, const char *opts, char *dir, int *w, int *h)
+{
+    char args[4096];
+    snprintf(dir, 1100, "%s/%s", lmt_tmpdir(), out);
     snprintf(args, sizeof args, "run %s --frames 1 -q %s --out %s", scene, opts, dir);
     if (lmgi(args) != 0)
         fail_msg("lmgi run failed: %s", output);
@@ -458,7 +480,8 @@ static void check_reflection(const char *material, const char *opts, int flat, d
     char run_opts[1024];
     snprintf(run_opts, sizeof run_opts, "--size 32x32 --photons 20000 %s", opts);
     int w, h;
-    float *px = run_frame(path, "mirror_out", run_opts, &w, &h);
+    char dir[1100];
+    float *px = run_frame(path, "mirror_out", run_opts, dir, &w, &h);
     double centre = px[4 * ((h / 2) * w + w / 2) + 1], worst = 0.0;
     for (int i = 0; i < w * h; i++)
         worst = fmax(worst, px[4 * i + 1]);
@@ -475,7 +498,8 @@ static void check_reflection(const char *material, const char *opts, int flat, d
  * meets the emitter's front (F Le, F the metal's Schlick Fresnel at the eye ray's angle) or the black sky
  * (0); pixels whose eye ray meets the emitter first, or misses the floor, are not compared. A cube map seen
  * from the floor's centre (the way before flat reflectors) puts the emitter's image about 1 m off (the
- * emitter is 1 m from the map's centre), so its lit pixels and the expected ones barely overlap. */
+ * emitter is 1 m from the map's centre), so its lit pixels and the expected ones barely overlap. The
+ * frame drew the floor's mirrored picture once and no cube map face (frames.csv). */
 static void test_flat_mirror_image(void **state)
 {
     (void)state;
@@ -492,7 +516,10 @@ static void test_flat_mirror_image(void **state)
              "{\"yfov\": %g, \"znear\": 0.01, \"aspectRatio\": 1}}]", LMT_MIRROR(0.8), yfov);
     const char *path = lmt_write_scene("flat_mirror.gltf", m, 2, nodes, materials);
     int w, h;
-    float *px = run_frame(path, "flat_mirror_out", "--size 64x64 --photons 20000", &w, &h);
+    char dir[1100];
+    float *px = run_frame(path, "flat_mirror_out", "--size 64x64 --photons 20000", dir, &w, &h);
+    assert_int_equal(csv_column_sum(dir, "planar_maps_rendered"), 1);
+    assert_int_equal(csv_column_sum(dir, "cube_faces_rendered"), 0);
     int lit_both = 0, lit_want = 0, lit_got = 0, compared = 0;
     double ratio = 0.0;
     for (int y = 0; y < h; y++)
@@ -561,11 +588,12 @@ static void test_flat_mirror_shows_caustic(void **state)
     const char *path = lmt_write_scene("mirror_caustic.gltf", m, 2, nodes, materials);
     float *px[2];
     int w = 0, h = 0;
+    char dir[1100];
     for (int on = 0; on < 2; on++)
         px[on] = run_frame(path, on ? "mirror_caustic_on" : "mirror_caustic_off",
                            on ? "--size 96x96 --photons 40000 --caustic-photons 65536"
                               : "--size 96x96 --photons 40000 --caustic-photons 65536 --effects -caustics",
-                           &w, &h);
+                           dir, &w, &h);
     double got[2] = {0.0, 0.0}, want[2] = {0.0, 0.0}; /* the floor's, the mirror's */
     for (int y = 0; y < h; y++)
         for (int x = 0; x < w; x++) {

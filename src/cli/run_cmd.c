@@ -28,7 +28,7 @@ typedef struct {
     FILE *csv;
     float exposure;        /* fixed from frame 0 */
     double sum_ms[8];      /* photons, gather, blend, direct, caustics, reflections, composite, total */
-    uint64_t caustic_photons, cube_faces; /* over all frames */
+    uint64_t caustic_photons, cube_faces, planar_maps; /* over all frames */
     uint64_t photon_gathers, photon_entries;
     int caustic_frames;    /* frames that had caustic photons to draw */
     double *frame_ms;      /* each frame's total, for the median */
@@ -136,6 +136,7 @@ static lmgi_status play_frame(run_state *r, int f, int every, lmgi_error *err)
     r->caustic_photons += fs.caustic_photons_retraced;
     r->caustic_frames += fs.caustic_tiles > 0;
     r->cube_faces += (uint64_t)fs.cube_faces_rendered;
+    r->planar_maps += (uint64_t)fs.planar_maps_rendered;
     r->photon_gathers += (uint64_t)fs.photon_gathers;
     r->photon_entries += fs.photon_entries;
     r->frame_ms[f] = fs.ms_total;
@@ -252,8 +253,9 @@ static void summary(const run_state *r, int frames)
     printf("mean frame  %.2f ms (%.1f fps): photons %.2f, gather %.2f, blend %.2f, direct %.2f, caustics %.2f, "
            "reflections %.2f, composite %.2f\n", s[7] / frames, s[7] > 0 ? 1e3 * frames / s[7] : 0.0, s[0] / frames,
            s[1] / frames, s[2] / frames, s[3] / frames, s[4] / frames, s[5] / frames, s[6] / frames);
-    printf("work        %llu caustic photons traced, %llu environment map faces rendered\n",
-           (unsigned long long)r->caustic_photons, (unsigned long long)r->cube_faces);
+    printf("work        %llu caustic photons traced, %llu environment map faces rendered, %llu flat reflectors' "
+           "pictures drawn\n", (unsigned long long)r->caustic_photons, (unsigned long long)r->cube_faces,
+           (unsigned long long)r->planar_maps);
     double median = lm_cli_median(r->frame_ms, frames);
     printf("median      %.2f ms (%.1f fps; the mean includes frame 0, which uploads everything)\n", median,
            median > 0.0 ? 1e3 / median : 0.0);
