@@ -5,8 +5,6 @@
 
 #include "../core/vecmath.h"
 
-static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY || c == LM_MAT_GLASS; }
-
 static lm_vec3 corner(const lm_scene *s, uint32_t t, int k)
 {
     float p[3];
@@ -20,7 +18,7 @@ float lm_node_reflector_plane(const lm_scene *s, int node, float plane[4], float
     lm_vec3 sum = lm_v3(0.0f, 0.0f, 0.0f), lo = lm_v3(INFINITY, INFINITY, INFINITY), hi = lm_scale(lo, -1.0f);
     uint32_t first = UINT32_MAX;
     for (uint32_t t = nd->first_tri; t < nd->first_tri + nd->tri_count; t++) {
-        if (!reflects(s->materials[s->tri_material[t]].cls))
+        if (!lm_material_reflects(s->materials[s->tri_material[t]].cls))
             continue;
         first = first == UINT32_MAX ? t : first;
         lm_vec3 p[3] = {corner(s, t, 0), corner(s, t, 1), corner(s, t, 2)};
@@ -35,7 +33,7 @@ float lm_node_reflector_plane(const lm_scene *s, int node, float plane[4], float
     lm_vec3 n = lm_normalize(sum);
     float w = -lm_dot(n, corner(s, first, 0)), far = 0.0f;
     for (uint32_t t = first; t < nd->first_tri + nd->tri_count; t++)
-        for (int k = 0; k < 3 && reflects(s->materials[s->tri_material[t]].cls); k++)
+        for (int k = 0; k < 3 && lm_material_reflects(s->materials[s->tri_material[t]].cls); k++)
             far = fmaxf(far, fabsf(lm_dot(n, corner(s, t, k)) + w));
     lm_v3_store(plane, n);
     plane[3] = w;

@@ -323,6 +323,8 @@ void lm_scene_node_local_boxes(const lm_scene *s, float *out);
 
 /* Mirror and glass: light leaves them in one direction; they store no photon and get no lightmap texels. */
 static inline int lm_material_is_specular(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLASS; }
+/* Mirror, glossy and glass: the classes whose reflections of the scene the frame draws (gpu/frame/reflections.h). */
+static inline int lm_material_reflects(lm_material_class c) { return lm_material_is_specular(c) || c == LM_MAT_GLOSSY; }
 /* Applies the material class rule to m's parameters (sets m->cls and returns it). */
 lm_material_class lm_material_classify(lm_material *m);
 const char *lm_material_class_name(lm_material_class c);

@@ -123,8 +123,8 @@ void lm_caustic_pass_set_widening(lm_caustic_pass *cp, int levels);
 void lm_caustic_pass_set_clip(lm_caustic_pass *cp, const float plane[4]);
 /* Splat, tiles and filter for `view` over the depth texture `depth` (width x height, lm_direct_depth_texture)
  * into slot `slot`'s irradiance; then, unless d is NULL, the composite into d's probe target (the probe
- * slot), mirror picture (the mirror slot) or frame's (the others), whose first pass drew the same view. Nothing at all is drawn without
- * photons. stats may be NULL. */
+ * slot), mirror picture (the mirror slot) or frame's (the others), whose first pass drew the same view.
+ * Nothing at all is drawn without photons. stats may be NULL. */
 lm_status lm_caustic_pass_run(lm_caustic_pass *cp, int slot, const lm_view *view, unsigned depth, int width,
                               int height, const lm_direct *d, lm_caustic_pass_stats *stats, lm_error *err);
 /* The composite alone, over slot's irradiance as its last run left it: for a picture whose photons, view

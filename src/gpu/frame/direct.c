@@ -689,34 +689,39 @@ static lm_status draw_into(lm_direct *d, int which, const lm_scene *s, const lm_
     return st;
 }
 
+/* What the next draws leave out (set_left_out): node `skip`'s vertices (-1: none) and what lies behind
+ * `clip` (NULL: nothing). */
+static void leave_out(lm_direct *d, int skip, const float clip[4])
+{
+    int ok = skip >= 0 && skip < d->mesh.node_count;
+    d->drop[0] = ok ? d->mesh.node_first[skip] : 0;
+    d->drop[1] = ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0;
+    for (int k = 0; k < 4; k++)
+        d->clip[k] = clip ? clip[k] : 0.0f;
+}
+
 lm_status lm_direct_draw(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int width,
                          int height, lm_error *err)
 {
-    d->drop[0] = d->drop[1] = 0;
+    leave_out(d, -1, NULL);
     return draw_into(d, LM_FRAME_VIEW, s, em, view, width, height, err);
 }
 
 lm_status lm_direct_draw_probe(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *view, int size,
                                int skip, lm_error *err)
 {
-    int ok = skip >= 0 && skip < d->mesh.node_count;
-    d->drop[0] = ok ? d->mesh.node_first[skip] : 0;
-    d->drop[1] = ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0;
+    leave_out(d, skip, NULL);
     lm_status st = draw_into(d, LM_FRAME_PROBE, s, em, view, size, size, err);
-    d->drop[0] = d->drop[1] = 0;
+    leave_out(d, -1, NULL);
     return st;
 }
 
 lm_status lm_direct_draw_mirror(lm_direct *d, const lm_scene *s, const lm_emitters *em, const lm_view *mirrored,
                                 int width, int height, int skip, const float plane[4], lm_error *err)
 {
-    int ok = skip >= 0 && skip < d->mesh.node_count;
-    d->drop[0] = ok ? d->mesh.node_first[skip] : 0;
-    d->drop[1] = ok ? d->mesh.node_first[skip] + d->mesh.node_verts[skip] : 0;
-    memcpy(d->clip, plane, sizeof d->clip);
+    leave_out(d, skip, plane);
     lm_status st = draw_into(d, LM_FRAME_MIRROR, s, em, mirrored, width, height, err);
-    d->drop[0] = d->drop[1] = 0;
-    memset(d->clip, 0, sizeof d->clip);
+    leave_out(d, -1, NULL);
     return st;
 }
 

@@ -47,9 +47,6 @@ struct lm_reflections {
 };
 
 
-static int reflects(lm_material_class c) { return c == LM_MAT_MIRROR || c == LM_MAT_GLOSSY || c == LM_MAT_GLASS; }
-
-
 /* The nodes with mirror or glossy triangles, each with its list of them (from the node's own range). */
 static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error *err)
 {
@@ -63,7 +60,7 @@ static lm_status find_reflectors(lm_reflections *r, const lm_scene *s, lm_error 
             continue;
         for (uint32_t t = node->first_tri; t < node->first_tri + node->tri_count; t++) {
             lm_material_class c = s->materials[s->tri_material[t]].cls;
-            if (!reflects(c))
+            if (!lm_material_reflects(c))
                 continue;
             if (!f->tris && !(f->tris = malloc(sizeof(uint32_t) * node->tri_count)))
                 return lm_fail(err, LM_ERR_NOMEM, "reflections: no memory");
@@ -346,7 +343,6 @@ int lm_reflections_face_count(const lm_reflections *r)
     return n;
 }
 
-
 int lm_reflections_dirty_faces(const lm_reflections *r)
 {
     int n = 0;
@@ -495,7 +491,7 @@ lm_status lm_reflections_draw(const lm_reflections *r, const lm_direct *d, const
     glUniform4f(glGetUniformLocation(r->prog, "lens"), view->proj[10], view->proj[14], view->proj[5], (float)ortho);
     for (int k = 0; k < r->count; k++) {
         const reflector *f = &r->r[k];
-        glUniform1i(glGetUniformLocation(r->prog, "planar"), f->planar && f->plane_key);
+        glUniform1i(glGetUniformLocation(r->prog, "planar"), f->planar);
         if (f->planar) {
             if (!f->plane_key) /* not drawn for this view: lm_reflections_draw_planes first */
                 continue;
