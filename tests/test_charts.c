@@ -999,6 +999,43 @@ static void test_cornell_suzanne(void **state)
     shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf", -1, 0);
 }
 
+/* lm_footprint_turn: light that is a plane over the normals, E = a + g . n, comes back as that plane within
+ * the ridge's shrink (1% of the normals' spread, which lies in two directions here: 2% of each); a channel
+ * of 0, two points with one normal, one point: no turn. */
+static void test_footprint_turn_fit(void **state)
+{
+    (void)state;
+    const float n[4][3] = {{0.9f, 0.3f, 0.3f}, {0.9f, -0.3f, 0.3f}, {0.9f, 0.3f, -0.3f}, {0.9f, -0.3f, -0.3f}};
+    const double a[3] = {2.0, 1.0, 0.5}, g[3][3] = {{0.0, 1.2, 0.0}, {0.0, 0.4, -0.6}, {0.0, 0.0, 0.0}};
+    float e[4][3], turn[LM_TURN_FLOATS];
+    for (int k = 0; k < 4; k++)
+        for (int c = 0; c < 3; c++)
+            e[k][c] = (float)(a[c] + g[c][0] * n[k][0] + g[c][1] * n[k][1] + g[c][2] * n[k][2]);
+    lm_footprint_turn(4, n, e, turn);
+    for (int c = 0; c < 3; c++) {
+        double mean = a[c] + g[c][0] * 0.9;
+        for (int k = 0; k < 4; k++) { /* each point's own light from the mean and the turn */
+            const float *r = turn + 4 * c;
+            double got = mean * (1.0 + r[0] * n[k][0] + r[1] * n[k][1] + r[2] * n[k][2] - r[3]);
+            assert_true(fabs(got - e[k][c]) < 0.021 * fabs(e[k][c] - mean) + 1e-6);
+        }
+        for (int i = 0; i < 3; i++)
+            assert_true(fabs(turn[4 * c + i] * mean - g[c][i]) <= 0.021 * fabs(g[c][i]) + 1e-6);
+    }
+    for (int k = 0; k < 4; k++) /* blue is 0: no turn */
+        e[k][2] = 0.0f;
+    lm_footprint_turn(4, n, e, turn);
+    for (int i = 8; i < 12; i++)
+        assert_true(turn[i] == 0.0f);
+    const float same[2][3] = {{0.0f, 1.0f, 0.0f}, {0.0f, 1.0f, 0.0f}};
+    lm_footprint_turn(2, same, e, turn);
+    for (int i = 0; i < LM_TURN_FLOATS; i++)
+        assert_true(turn[i] == 0.0f);
+    lm_footprint_turn(1, n, e, turn);
+    for (int i = 0; i < LM_TURN_FLOATS; i++)
+        assert_true(turn[i] == 0.0f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1009,6 +1046,7 @@ int main(void)
         cmocka_unit_test(test_hemisphere),
         cmocka_unit_test(test_bending_normals_finer_texels),
         cmocka_unit_test(test_texel_normal_is_the_mean),
+        cmocka_unit_test(test_footprint_turn_fit),
         cmocka_unit_test(test_degenerate_and_strict),
         cmocka_unit_test(test_nonmanifold_fin),
         cmocka_unit_test(test_bumpy_cornell),

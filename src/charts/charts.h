@@ -186,6 +186,16 @@ typedef struct {
 #define LM_FOOTPRINT_SPREAD 0.985
 #define LM_FOOTPRINT_POINTS 4
 
+/* How a footprint texel's light turns with the normal (docs/charts.md, "Turning with the normal"): one
+ * value for a curved piece is its mean, but a pixel on the piece's dark side wants less and one on its
+ * bright side more. Per channel c, the least-squares plane through the m points' light e[k][c] over their
+ * unit normals n[k], E(n) = mean_c (1 + r_c . n - r_c . nbar), nbar the normals' mean (ridge 1% of their
+ * spread, so a direction they do not spread in, the radial one, stays 0). out: LM_TURN_FLOATS floats,
+ * per channel r_c (3) then r_c . nbar, all 0 where m < 2, the normals do not spread (under 1e-6) or the
+ * channel's mean is 0. Relative, so a light's edit that scales a texel's light leaves it true. O(m). */
+#define LM_TURN_FLOATS 12
+void lm_footprint_turn(int m, const float n[][3], const float e[][3], float out[LM_TURN_FLOATS]);
+
 /* Texel i's footprint points (lm_atlas.footprints): how many, 0 for a texel gathered at its own point (and
  * for every texel of an atlas made by hand, without footprint_first). */
 static inline uint32_t lm_texel_footprint(const lm_atlas *a, uint32_t i, const lm_texel **points)

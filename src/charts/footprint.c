@@ -150,3 +150,51 @@ int lmc_footprint(const lm_scene *s, const float *pos, const uint32_t *tris, uin
     free(p);
     return count;
 }
+
+/* x = (A + ridge I)^-1 b for symmetric 3 x 3 A, by Cramer's rule (A + ridge I is positive definite). */
+static void solve3(const double A[3][3], double ridge, const double b[3], double x[3])
+{
+    double m[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            m[i][j] = A[i][j] + (i == j ? ridge : 0.0);
+    double c0 = m[1][1] * m[2][2] - m[1][2] * m[2][1], c1 = m[1][2] * m[2][0] - m[1][0] * m[2][2],
+           c2 = m[1][0] * m[2][1] - m[1][1] * m[2][0], det = m[0][0] * c0 + m[0][1] * c1 + m[0][2] * c2;
+    double inv[3][3] = {{c0, m[0][2] * m[2][1] - m[0][1] * m[2][2], m[0][1] * m[1][2] - m[0][2] * m[1][1]},
+                        {c1, m[0][0] * m[2][2] - m[0][2] * m[2][0], m[0][2] * m[1][0] - m[0][0] * m[1][2]},
+                        {c2, m[0][1] * m[2][0] - m[0][0] * m[2][1], m[0][0] * m[1][1] - m[0][1] * m[1][0]}};
+    for (int i = 0; i < 3; i++)
+        x[i] = (inv[i][0] * b[0] + inv[i][1] * b[1] + inv[i][2] * b[2]) / det;
+}
+
+void lm_footprint_turn(int m, const float n[][3], const float e[][3], float out[LM_TURN_FLOATS])
+{
+    memset(out, 0, LM_TURN_FLOATS * sizeof *out);
+    if (m < 2)
+        return;
+    double nbar[3] = {0.0, 0.0, 0.0}, spread[3][3] = {{0.0}};
+    for (int k = 0; k < m; k++)
+        for (int i = 0; i < 3; i++)
+            nbar[i] += n[k][i] / m;
+    for (int k = 0; k < m; k++)
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                spread[i][j] += (n[k][i] - nbar[i]) * (n[k][j] - nbar[j]);
+    double trace = spread[0][0] + spread[1][1] + spread[2][2];
+    if (!(trace > 1e-6))
+        return;
+    for (int c = 0; c < 3; c++) {
+        double mean = 0.0, b[3] = {0.0, 0.0, 0.0}, g[3];
+        for (int k = 0; k < m; k++)
+            mean += e[k][c] / m;
+        if (!(mean > 0.0))
+            continue;
+        for (int k = 0; k < m; k++)
+            for (int i = 0; i < 3; i++)
+                b[i] += (n[k][i] - nbar[i]) * (e[k][c] - mean);
+        solve3(spread, 0.01 * trace, b, g);
+        for (int i = 0; i < 3; i++)
+            out[4 * c + i] = (float)(g[i] / mean);
+        out[4 * c + 3] = (float)((g[0] * nbar[0] + g[1] * nbar[1] + g[2] * nbar[2]) / mean);
+    }
+}
