@@ -221,7 +221,7 @@ lm_status lm_frame_passes_draw(lm_frame_passes *fp, const lm_frame_indirect *ind
     if (ind->iim) /* else the first pass adds none */
         st = lm_composite_indirect(fp->comp, ind->iim->display_tex, &lit, err);
     double t1 = lm_now();
-    lm_direct_set_indirect(fp->direct, lit);
+    lm_direct_set_indirect(fp->direct, lit, ind->iim ? ind->iim->turn_tex : NULL);
     lm_direct_write_gbuffer(fp->direct, ind->photons != NULL); /* the photon gathers read it, nothing else */
     if (st == LM_OK && ind->photons)
         st = lm_photon_path_coverage(ind->photons, fp->direct, err);

@@ -230,6 +230,7 @@ lm_status lm_lightmap_path_create(const lm_world *w, lm_photon_stage *stage, lm_
     set->iim.backface_limit = set->gather.backface_limit;
     if (st == LM_OK && (st = lm_iim_init(&lp->iim, lp->atlas, &set->iim, 1, err)) == LM_OK) {
         lp->have_iim = 1;
+        lm_gather_set_turn(lp->gather, lp->iim.turn_tex); /* the footprint texels' turns, where there are any */
         sync_gather_switches(lp); /* nodes without indirect light are not gathered at all */
         lp->switch_version = lp->scene->pass_version;
     }

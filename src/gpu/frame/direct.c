@@ -37,7 +37,7 @@ void lm_direct_settings_default(lm_direct_settings *s)
 typedef struct {
     GLint lpos, ldir, radiant, origin, cos_outer, spot_width, texel, map_size, light_vp;
     GLint view_proj, eye, view_dir, ortho_view, normal_offset, slope_bias, max_slope, const_bias, range, light_range;
-    GLint map2d, mapcube, base_tex, lit, use_lit;
+    GLint map2d, mapcube, base_tex, lit, use_lit, turn, use_turn;
     GLint map_near[LM_VIEW_CASCADES], near_vp, near_texel, has_near;
 } uniforms;
 
@@ -62,7 +62,7 @@ struct lm_direct {
                                          * material: scene_glossy) */
     uint32_t programs_version;          /* the scene's pass_version the light programs were last made or
                                          * found right for (a failed remake keeps the old: tried again) */
-    GLint e_view_proj, e_lit, e_use_lit;
+    GLint e_view_proj, e_lit, e_use_lit, e_turn, e_use_turn;
     uniforms u[3], uf[3];
     lm_direct_mesh mesh;
     lm_sky_pass sky;        /* a gradient or image sky behind everything */
@@ -83,6 +83,7 @@ struct lm_direct {
     int has_lightmap;       /* the mesh carries lightmap uvs (an atlas at lm_direct_create) */
     const lm_atlas *atlas;  /* that atlas (borrowed), for a rebuild of the mesh */
     unsigned indirect_tex;  /* the indirect term the first pass adds (0: none) */
+    unsigned turn_tex[3];   /* the footprint texels' turns (lm_direct_set_indirect; 0: none) */
     unsigned coverage_tex;  /* else the photon gathers' kernel coverage it writes to kd's alpha (0: none) */
     int gbuffer;            /* the view's first pass writes the G-buffer (lm_direct_write_gbuffer) */
 };
@@ -93,7 +94,7 @@ static void find_uniforms(GLuint p, uniforms *u)
     LOC(lpos); LOC(ldir); LOC(radiant); LOC(origin); LOC(cos_outer);
     LOC(spot_width); LOC(texel); LOC(map_size); LOC(light_vp); LOC(view_proj); LOC(eye); LOC(view_dir);
     LOC(ortho_view); LOC(normal_offset); LOC(slope_bias); LOC(max_slope); LOC(const_bias); LOC(range); LOC(light_range);
-    LOC(map2d); LOC(mapcube); LOC(base_tex); LOC(lit); LOC(use_lit);
+    LOC(map2d); LOC(mapcube); LOC(base_tex); LOC(lit); LOC(use_lit); LOC(turn); LOC(use_turn);
     LOC(near_vp); LOC(near_texel); LOC(has_near);
     u->map_near[0] = glGetUniformLocation(p, "map_near0");
     u->map_near[1] = glGetUniformLocation(p, "map_near1");
@@ -205,14 +206,23 @@ static void draw_scene(const lm_direct *d, GLuint prog)
 
 static float lod_error(const lm_direct *d, const lm_scene *s) { return d->set.probe_lod * lm_scene_size(s); }
 
-/* The indirect term's texture on unit 3 for a first-pass program (lit, use_lit: its uniforms). */
-static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit)
+/* The indirect term's texture on unit 3 and the turn maps on units 8-10 for a first-pass program (lit,
+ * use_lit, turn, use_turn: its uniforms). */
+static void bind_indirect(const lm_direct *d, GLint lit, GLint use_lit, GLint turn, GLint use_turn)
 {
     unsigned tex = !d->has_lightmap ? 0 : d->indirect_tex ? d->indirect_tex : d->coverage_tex;
     glUniform1i(use_lit, !tex ? 0 : d->indirect_tex ? 1 : 2);
     glUniform1i(lit, 3);
     glActiveTexture(GL_TEXTURE3);
     glBindTexture(GL_TEXTURE_2D, tex);
+    int turns = tex && d->indirect_tex && d->turn_tex[0];
+    glUniform1i(use_turn, turns);
+    static const GLint units[3] = {8, 9, 10};
+    glUniform1iv(turn, 3, units);
+    for (int c = 0; c < 3; c++) {
+        glActiveTexture(GL_TEXTURE8 + (GLenum)c);
+        glBindTexture(GL_TEXTURE_2D, turns ? d->turn_tex[c] : 0);
+    }
     glActiveTexture(GL_TEXTURE0);
 }
 
@@ -248,7 +258,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
         glUniform3fv(glGetUniformLocation(d->emission, "view_dir"), 1, towards_eye);
         glUniform1i(glGetUniformLocation(d->emission, "ortho_view"), view->proj[11] == 0.0f && view->proj[15] != 0.0f);
         glUniform1i(glGetUniformLocation(d->emission, "base_tex"), 2);
-        bind_indirect(d, d->e_lit, d->e_use_lit);
+        bind_indirect(d, d->e_lit, d->e_use_lit, d->e_turn, d->e_use_turn);
         draw_scene(d, d->emission);
         return;
     }
@@ -259,7 +269,7 @@ static void first_pass(lm_direct *d, const lm_scene *s, const lm_emitters *em, i
     set_left_out(d, prog);
     set_view_uniforms(d, u, view);
     set_light_uniforms(u, s, e, &d->maps[light]);
-    bind_indirect(d, u->lit, u->use_lit);
+    bind_indirect(d, u->lit, u->use_lit, u->turn, u->use_turn);
     draw_scene(d, prog);
 }
 
@@ -576,6 +586,8 @@ lm_status lm_direct_create(const lm_scene *s, const lm_atlas *a, const lm_direct
         d->e_view_proj = glGetUniformLocation(d->emission, "view_proj");
         d->e_lit = glGetUniformLocation(d->emission, "lit");
         d->e_use_lit = glGetUniformLocation(d->emission, "use_lit");
+        d->e_turn = glGetUniformLocation(d->emission, "turn");
+        d->e_use_turn = glGetUniformLocation(d->emission, "use_turn");
         st = lm_shadow_renderer_create(&d->shadow, err);
     }
     if (st == LM_OK)
@@ -743,7 +755,12 @@ unsigned lm_direct_kd_texture(const lm_direct *d, int probe) { return lm_frame_t
 unsigned lm_direct_gbuffer_texture(const lm_direct *d) { return lm_frame_targets_gbuffer(&d->targets); }
 unsigned lm_direct_radiance_texture(const lm_direct *d) { return lm_frame_targets_radiance(&d->targets, LM_FRAME_VIEW); }
 
-void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex) { d->indirect_tex = lit_tex; }
+void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex, const unsigned turn_tex[3])
+{
+    d->indirect_tex = lit_tex;
+    for (int c = 0; c < 3; c++)
+        d->turn_tex[c] = turn_tex ? turn_tex[c] : 0;
+}
 void lm_direct_write_gbuffer(lm_direct *d, int on) { d->gbuffer = on != 0; }
 lm_status lm_direct_set_coverage(lm_direct *d, const float *coverage, lm_error *err)
 {

@@ -110,8 +110,10 @@ unsigned lm_direct_gbuffer_texture(const lm_direct *d);
 unsigned lm_direct_radiance_texture(const lm_direct *d);
 /* The indirect term the first pass adds at each visible surface's lightmap uv: the premultiplied atlas
  * of lm_composite_indirect (rgb / a = albedo / pi * E_IIM; a = 0: none). 0 = none. Needs an atlas at
- * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. */
-void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex);
+ * lm_direct_create; surfaces without a chart (mirror, glass) and the background get none. turn_tex (NULL
+ * or zeros: none): the IIM's turn maps (gpu/gather/iim.h), by which a footprint texel's value turns with
+ * the pixel's shading normal (glsl/indirect.glsl; docs/charts.md, "Turning with the normal"). */
+void lm_direct_set_indirect(lm_direct *d, unsigned lit_tex, const unsigned turn_tex[3]);
 /* Whether the view's draws write its G-buffer (lm_direct_gbuffer_texture): on from lm_direct_create; off
  * leaves it as the last draw that wrote it, for a frame without per-pixel photon gathers. */
 void lm_direct_write_gbuffer(lm_direct *d, int on);

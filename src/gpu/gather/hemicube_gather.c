@@ -55,6 +55,8 @@ struct lm_gather {
     double coverage;
     float lift;            /* the eyes' lift off their texels in the pass being drawn (lm_gather_lift) */
     int round;             /* which of its footprint points a texel of the pass is gathered at (gather_points) */
+    GLuint turn_tex[3];    /* where each footprint texel's turn goes (lm_gather_set_turn); 0: nowhere */
+    float *turn;           /* the rays gather's turns of a pass, tiles^2 * LM_TURN_FLOATS */
 };
 
 /* Schemes 0, 1: one (tiles R)^2 2D target; scheme 2: R x R x tiles^2 layers. */
@@ -216,6 +218,7 @@ void lm_gather_free(lm_gather *g)
     glDeleteBuffers(4, bufs);
     free(g->views);
     free(g->emit);
+    free(g->turn);
     free(g->aim_copy);
     free(g->whole_copy);
     GLuint tex[5] = {g->aim_tex, g->color, g->depth, g->ms_color, g->ms_depth};
@@ -594,6 +597,12 @@ static float near_plane(const lm_gather *g)
     return near > 0.0f ? near : 1e-6f;
 }
 
+void lm_gather_set_turn(lm_gather *g, const unsigned tex[3])
+{
+    for (int c = 0; c < 3; c++)
+        g->turn_tex[c] = tex ? tex[c] : 0;
+}
+
 void lm_gather_set_sky(lm_gather *g, const float sky[3])
 {
     memcpy(g->set.sky, sky, sizeof g->set.sky);
@@ -839,6 +848,30 @@ static void ray_view(const lm_gather *g, const lm_rim *rim, const float *o, uint
     e[3] = back;
 }
 
+/* The turn of a texel gathered at m points (0: at its own point, no turn) of normals n and light e. */
+static void turn_of(int m, const float n[][3], const float e[][4], float out[LM_TURN_FLOATS])
+{
+    float rgb[LM_FOOTPRINT_POINTS][3];
+    for (int k = 0; k < m; k++)
+        memcpy(rgb[k], e[k], sizeof rgb[k]);
+    lm_footprint_turn(m, n, rgb, out);
+}
+
+/* The turns (LM_TURN_FLOATS a texel, in the order of texels) of the footprint texels among texels into
+ * the turn maps; every other texel's stays 0. */
+static void write_turns(const lm_gather *g, const lm_atlas *a, const uint32_t *texels, uint32_t n, const float *turn)
+{
+    for (int c = 0; c < 3; c++) {
+        glBindTexture(GL_TEXTURE_2D, g->turn_tex[c]);
+        for (uint32_t i = 0; i < n; i++) {
+            const lm_texel *pts, *tx = &a->texels[texels[i]];
+            if (lm_texel_footprint(a, texels[i], &pts))
+                glTexSubImage2D(GL_TEXTURE_2D, 0, tx->x, tx->y, 1, 1, GL_RGBA, GL_FLOAT,
+                                turn + LM_TURN_FLOATS * (size_t)i + 4 * c);
+        }
+    }
+}
+
 /* LM_GATHER_RAYS: each texel's whole hemisphere by rays, in parallel (what the hemicube and its rim
  * together see: the AIM where a ray meets a surface, the back of a single-sided one black and counted
  * into the back-face share, the sky where nothing is met, the emitters in closed form or as met), a pass
@@ -857,6 +890,9 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
                   g->set.ray_samples, NULL, at_hits ? &g->direct : NULL, near_only ? g->whole_copy : NULL,
                   g->set.direct_near, g->set.adapt};
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
+    if (g->turn_tex[0] && !g->turn && !(g->turn = malloc(sizeof(float) * LM_TURN_FLOATS * per_pass)))
+        return lm_fail(err, LM_ERR_NOMEM, "ray gather: no memory");
+    float *turn = g->turn_tex[0] ? g->turn : NULL;
     glBindTexture(GL_TEXTURE_2D, iim_tex);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
     for (uint32_t first = 0; first < count; first += per_pass) {
@@ -871,30 +907,103 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
                 float *e = g->emit + 4 * (size_t)i;
                 const lm_texel *pts[LM_FOOTPRINT_POINTS];
                 int m = gather_points(g, s, a, t, pts);
+                float nk[LM_FOOTPRINT_POINTS][3], ek[LM_FOOTPRINT_POINTS][4];
                 if (m == 0) {
                     ray_view(g, &rim, g->views + VIEW_FLOATS * (size_t)i, t, e);
                     e[3] = covered_at(g->rt, &g->set, s, a, t) ? 1.0f : e[3];
-                    continue;
+                } else { /* a piece's footprint: the strata shared among its open points, their light averaged */
+                    lm_rim part = rim;
+                    part.samples = rim.samples / m > 1 ? rim.samples / m : 1;
+                    e[0] = e[1] = e[2] = e[3] = 0.0f;
+                    for (int k = 0; k < m; k++) {
+                        float o[VIEW_FLOATS];
+                        store_view(view_of(&g->set, s, g->lift, pts[k]), o);
+                        memcpy(nk[k], o + 12, sizeof nk[k]); /* the view's third axis: the point's normal */
+                        ray_view(g, &part, o, t, ek[k]);
+                        for (int c = 0; c < 4; c++)
+                            e[c] += ek[k][c] / (float)m;
+                    }
                 }
-                /* a piece's footprint: the strata shared among its open points, their light averaged */
-                lm_rim part = rim;
-                part.samples = rim.samples / m > 1 ? rim.samples / m : 1;
-                e[0] = e[1] = e[2] = e[3] = 0.0f;
-                for (int k = 0; k < m; k++) {
-                    float o[VIEW_FLOATS], ek[4];
-                    store_view(view_of(&g->set, s, g->lift, pts[k]), o);
-                    ray_view(g, &part, o, t, ek);
-                    for (int c = 0; c < 4; c++)
-                        e[c] += ek[c] / (float)m;
-                }
+                if (turn)
+                    turn_of(m, nk, ek, turn + LM_TURN_FLOATS * (size_t)i);
             }
         }
         for (uint32_t i = 0; i < n; i++) {
             const lm_texel *tx = &a->texels[texels[first + i]];
             glTexSubImage2D(GL_TEXTURE_2D, 0, tx->x, tx->y, 1, 1, GL_RGBA, GL_FLOAT, g->emit + 4 * (size_t)i);
         }
+        if (turn)
+            write_turns(g, a, texels + first, n, turn);
+        glBindTexture(GL_TEXTURE_2D, iim_tex);
     }
     return lm_gl_check("ray gather", err);
+}
+
+/* The footprint texels of a hemicube gather, for their turns: the IIM's running mean of each after each
+ * round r, read back (the light of its point r is then (r + 1) mean_r - r mean_(r-1)). */
+typedef struct {
+    uint32_t count, *texel;
+    float (*mean)[LM_FOOTPRINT_POINTS][4];
+} round_means;
+
+static lm_status round_means_init(round_means *rm, const lm_atlas *a, const uint32_t *texels, uint32_t count,
+                                  lm_error *err)
+{
+    const lm_texel *pts;
+    uint32_t n = 0;
+    for (uint32_t i = 0; i < count; i++)
+        n += lm_texel_footprint(a, texels[i], &pts) > 0;
+    if (n == 0)
+        return LM_OK;
+    rm->texel = malloc(sizeof *rm->texel * n);
+    rm->mean = calloc(n, sizeof *rm->mean);
+    if (!rm->texel || !rm->mean) {
+        free(rm->texel), free(rm->mean);
+        rm->texel = NULL, rm->mean = NULL;
+        return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory for %u footprint texels", n);
+    }
+    for (uint32_t i = 0; i < count; i++)
+        if (lm_texel_footprint(a, texels[i], &pts) > 0)
+            rm->texel[rm->count++] = texels[i];
+    return LM_OK;
+}
+
+static void round_means_free(round_means *rm)
+{
+    free(rm->texel);
+    free(rm->mean);
+}
+
+/* Each footprint texel's value after round r (the texels gathered in it, and the others: their value
+ * stays, and is not used). One read a texel: footprint texels are few (a level's curved pieces). */
+static void read_round(round_means *rm, unsigned iim_tex, const lm_atlas *a, int r)
+{
+    for (uint32_t i = 0; i < rm->count; i++) {
+        const lm_texel *tx = &a->texels[rm->texel[i]];
+        glGetTextureSubImage(iim_tex, 0, tx->x, tx->y, 0, 1, 1, 1, GL_RGBA, GL_FLOAT, sizeof rm->mean[i][r],
+                             rm->mean[i][r]);
+    }
+}
+
+/* The footprint texels' turns from their rounds' running means, into the turn maps. */
+static void round_turns(lm_gather *g, const lm_scene *s, const lm_atlas *a, const round_means *rm)
+{
+    float *turn = malloc(sizeof(float) * LM_TURN_FLOATS * rm->count);
+    if (!turn) /* the turns stay as they were: the texels' means are right, only their turn is old */
+        return;
+    for (uint32_t i = 0; i < rm->count; i++) {
+        const lm_texel *pts[LM_FOOTPRINT_POINTS];
+        float n[LM_FOOTPRINT_POINTS][3], e[LM_FOOTPRINT_POINTS][4], eye[3], ng[3];
+        int m = gather_points(g, s, a, rm->texel[i], pts);
+        for (int k = 0; k < m; k++) {
+            point_frame(&g->set, s, a, pts[k], eye, n[k], ng);
+            for (int c = 0; c < 4; c++)
+                e[k][c] = (float)(k + 1) * rm->mean[i][k][c] - (k > 0 ? (float)k * rm->mean[i][k - 1][c] : 0.0f);
+        }
+        turn_of(m, n, e, turn + LM_TURN_FLOATS * (size_t)i);
+    }
+    write_turns(g, a, rm->texel, rm->count, turn);
+    free(turn);
 }
 
 /* The hemicube passes of rest[0, left) (which they use up), each texel at its point of round g->round;
@@ -952,10 +1061,13 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_GREATER);
     glDisable(GL_CULL_FACE);
-    int passes = hemicube_passes(g, s, a, rest, count, slots, xy, iim_tex);
+    round_means rm = {0};
+    lm_status st = g->turn_tex[0] ? round_means_init(&rm, a, texels, count, err) : LM_OK;
+    int passes = st == LM_OK ? hemicube_passes(g, s, a, rest, count, slots, xy, iim_tex) : 0;
+    read_round(&rm, iim_tex, a, 0);
     /* a piece's footprint (gather_points): a round more for each open point past the first, each blended
      * into the mean of those before it */
-    for (g->round = 1; g->round < LM_FOOTPRINT_POINTS; g->round++) {
+    for (g->round = 1; st == LM_OK && g->round < LM_FOOTPRINT_POINTS; g->round++) {
         const lm_texel *first, *pts[LM_FOOTPRINT_POINTS];
         uint32_t left = 0;
         for (uint32_t i = 0; i < count; i++)
@@ -963,8 +1075,12 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                 gather_points(g, s, a, texels[i], pts) > g->round)
                 rest[left++] = texels[i];
         passes += hemicube_passes(g, s, a, rest, left, slots, xy, iim_tex);
+        read_round(&rm, iim_tex, a, g->round);
     }
     g->round = 0;
+    if (rm.count)
+        round_turns(g, s, a, &rm);
+    round_means_free(&rm);
     clip_control(GL_LOWER_LEFT, GL_NEGATIVE_ONE_TO_ONE);
     glDepthFunc(GL_LESS);
     glClearDepth(1.0);
@@ -977,5 +1093,5 @@ lm_status lm_gather_texels(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
         stats->passes = passes;
         stats->seconds = lm_now() - t0;
     }
-    return lm_gl_check("hemicube gather (hemicube_render, hemicube_reduce)", err);
+    return st != LM_OK ? st : lm_gl_check("hemicube gather (hemicube_render, hemicube_reduce)", err);
 }

@@ -32,6 +32,25 @@ static void textures(lm_iim *iim, unsigned *tex[IIM_TEXTURES])
     memcpy(tex, t, sizeof t);
 }
 
+/* The footprint texels' turn maps (iim.h), where the atlas has footprint texels. Half floats: a turn is a
+ * relative change of a few tenths, and 3 digits are more than its estimate holds. */
+static lm_status init_turn(lm_iim *iim, const lm_atlas *a, lm_error *err)
+{
+    if (a->footprint_count == 0)
+        return LM_OK;
+    glGenTextures(3, iim->turn_tex);
+    const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    for (int c = 0; c < 3; c++) {
+        glBindTexture(GL_TEXTURE_2D, iim->turn_tex[c]);
+        glTexStorage2D(GL_TEXTURE_2D, 1, GL_RGBA16F, a->width, a->height);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glClearTexImage(iim->turn_tex[c], 0, GL_RGBA, GL_FLOAT, zero);
+    }
+    glBindTexture(GL_TEXTURE_2D, 0);
+    return lm_gl_check("IIM: the turn maps", err);
+}
+
 static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
 {
     unsigned *tex[IIM_TEXTURES];
@@ -76,7 +95,8 @@ static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
                  GL_DYNAMIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     free(surf);
-    return lm_gl_check("IIM: blend buffers", err);
+    st = lm_gl_check("IIM: blend buffers", err);
+    return st == LM_OK ? init_turn(iim, a, err) : st;
 }
 
 lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set, int with_gl, lm_error *err)
@@ -112,6 +132,8 @@ void lm_iim_free(lm_iim *iim)
     textures(iim, tex);
     for (int i = 0; i < IIM_TEXTURES; i++)
         lm_iim_texture_free(*tex[i]);
+    if (iim->turn_tex[0])
+        glDeleteTextures(3, iim->turn_tex);
     if (iim->blend_prog) {
         GLuint bufs[8] = {iim->surface_buf, iim->params_buf, iim->start_buf, iim->list_buf,
                           iim->chart_buf,   iim->redraw_buf, iim->ops_buf,   iim->flag_buf};
