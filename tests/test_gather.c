@@ -572,6 +572,21 @@ static void test_tilted_normals(void **state)
  * E = pi (1 + n.y) / 2 (the floor hides the lower half of the directions), so the cap's mean is
  * pi (1 + (1 + cos a) / 2) / 2 = 3.068, while the texel's own point, facing the cap's mean normal (up),
  * gets pi: 2.4% over. The texel reads the mean of its four points' light, in every scheme. */
+/* The cap's (node 1) vertices get the normals of their sphere, centred at (0, cy, 0), and the atlas is made
+ * again for them (2 m texels). */
+static void sphere_normals(tscene *t, double cy)
+{
+    for (uint32_t v = 0; v < t->s->vertex_count; v++) {
+        const float *p = t->s->positions + 3 * (size_t)v;
+        if (t->s->vertex_node[v] != 1)
+            continue;
+        double d[3] = {p[0], p[1] - cy, p[2]}, l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        for (int a = 0; a < 3; a++)
+            t->s->normals[3 * (size_t)v + a] = (float)(d[a] / l);
+    }
+    rebuild_atlas(t->s, &t->su, 2.0f, &t->a);
+}
+
 /* The cap's scene: its floor, the cap (node 1) and with `lid` 1 a square a centimetre over its top, with 2
  * an emitting square (radiance 1, side 3) 3 m over it, past a texel's width (node 2). */
 static void cap_scene(tscene *t, double alpha, double r, double cy, int lid)
@@ -583,15 +598,7 @@ static void cap_scene(tscene *t, double alpha, double r, double cy, int lid)
     ts_load(t, m, lid ? 3 : 2, lid ? "[{\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2}]" : "[{\"mesh\": 0}, {\"mesh\": 1}]",
             lid == 2 ? "[{}, {}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 1, 1]}]"
             : lid ? "[{}, {}, {}]" : "[{}, {}]", 2.0f);
-    for (uint32_t v = 0; v < t->s->vertex_count; v++) { /* the sphere's own normals on the cap */
-        const float *p = t->s->positions + 3 * (size_t)v;
-        if (t->s->vertex_node[v] != 1)
-            continue;
-        double d[3] = {p[0], p[1] - cy, p[2]}, l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        for (int a = 0; a < 3; a++)
-            t->s->normals[3 * (size_t)v + a] = (float)(d[a] / l);
-    }
-    rebuild_atlas(t->s, &t->su, 2.0f, &t->a);
+    sphere_normals(t, cy);
 }
 
 /* The cap's one texel. */
@@ -678,15 +685,7 @@ static void side_cap_scene(tscene *t, double alpha, double r, double cy)
         p[0] = p[1], p[1] = (float)cy - x;
     }
     ts_load(t, m, 2, "[{\"mesh\": 0}, {\"mesh\": 1}]", "[{}, {}]", 2.0f);
-    for (uint32_t v = 0; v < t->s->vertex_count; v++) { /* the sphere's own normals on the cap */
-        const float *p = t->s->positions + 3 * (size_t)v;
-        if (t->s->vertex_node[v] != 1)
-            continue;
-        double d[3] = {p[0], p[1] - cy, p[2]}, l = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-        for (int a = 0; a < 3; a++)
-            t->s->normals[3 * (size_t)v + a] = (float)(d[a] / l);
-    }
-    rebuild_atlas(t->s, &t->su, 2.0f, &t->a);
+    sphere_normals(t, cy);
 }
 
 /* One texel gathered (a black AIM) with the turn maps set: its value into e, its turn into turn. */
