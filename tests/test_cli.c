@@ -1185,12 +1185,13 @@ static void check_level_channels(const char *path, int within, double worst)
  * its texels and photons where it needs them (docs/levels.md, "Built: open surfaces, a guided sun"),
  * its gather's eyes and proxy within a texel (docs/gather.md): every surface within 5% (measured 8 of 8,
  * worst G +3.6%; room_lit 8 of 9, R +7.1%). room_lit's facets gathered over their footprints (docs/charts.md,
- * "Footprints"): every surface within 5% (measured 9 of 9, worst B -3.7%). */
+ * "Footprints"): every surface within 5% (measured 9 of 9, worst B -3.7%; later -4.5%). Their one texel
+ * turned with each pixel's normal ("Turning with the normal"): within 4% (measured 9 of 9, worst B -3.4%). */
 static void test_check_levels_per_channel(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(room, lmt_shared_scene("occlusion-room/room_lit.glb"));
-    check_level_channels(room, 9, 0.05);
+    check_level_channels(room, 9, 0.04);
     LMT_REQUIRE_SCENE(town, lmt_shared_scene("truck-town/town_lit.gltf"));
     check_level_channels(town, 8, 0.05);
 }
