@@ -999,6 +999,66 @@ static void test_cornell_suzanne(void **state)
     shared_scene("cornell-suzanne/cornellBox-2.80-Eevee-gltf.gltf", -1, 0);
 }
 
+/* Where a chart of several texels turns (a hemisphere of radius 1 at 0.5 m texels, its 30-degree surfaces
+ * 2 to 3 texels across), each texel whose interpolated normals spread past LM_FOOTPRINT_SPREAD is gathered
+ * at its quarters: 2 to 4 points, each inside its own quarter of the texel's square (its uv through its
+ * triangle's coverage uv), their areas summing to the texel's. A flat floor of the same texels has none. */
+static void test_quarter_footprints(void **state)
+{
+    (void)state;
+    tscene *t = ts_new(2);
+    ts_sphere(t, 0, MAT_DIFFUSE, (float[3]){0, 0, 0}, 1.0f, 16, 8, 1);
+    ts_quad(t, 1, MAT_DIFFUSE, (float[3]){-1, -0.5f, 1}, (float[3]){2, 0, 0}, (float[3]){0, 0, -2}, 4, 4, NULL);
+    lm_surfaces su;
+    lm_error err = {0};
+    assert_int_equal(lm_surfaces_build(&t->s, NULL, &su, &err), LM_OK);
+    lm_atlas_options o;
+    lm_atlas_options_default(&o);
+    o.texel_size = 0.5f;
+    o.bend_deg = 0.0f;
+    lm_atlas a;
+    if (lm_atlas_build(&t->s, &su, &o, &a, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    int quartered = 0, multi = 0;
+    for (uint32_t i = 0; i < a.texel_count; i++) {
+        const lm_texel *tx = &a.texels[i], *pts;
+        const lm_chart *ch = &a.charts[a.chart_owner[(size_t)tx->y * a.width + tx->x]];
+        uint32_t n = lm_texel_footprint(&a, i, &pts);
+        int node = t->s.tri_node[tx->tri];
+        if (node == 1) { /* the floor */
+            assert_int_equal(n, 0);
+            continue;
+        }
+        multi += ch->w > 1 || ch->h > 1;
+        if (n == 0 || (ch->w == 1 && ch->h == 1))
+            continue;
+        assert_true(n >= 2 && n <= 4);
+        assert_false(lm_texel_turns(&a, i)); /* its chart is not that texel alone */
+        int seen[4] = {0};
+        double area = 0.0;
+        for (uint32_t k = 0; k < n; k++) {
+            const float *uv = a.coverage_uv + 6 * (size_t)pts[k].tri;
+            double u = 0.0, v = 0.0;
+            for (int c = 0; c < 3; c++)
+                u += pts[k].bary[c] * uv[2 * c] * a.width, v += pts[k].bary[c] * uv[2 * c + 1] * a.height;
+            assert_true(u >= tx->x - 1e-3 && u <= tx->x + 1 + 1e-3 && v >= tx->y - 1e-3 && v <= tx->y + 1 + 1e-3);
+            int q = (v - tx->y >= 0.5) * 2 + (u - tx->x >= 0.5);
+            assert_int_equal(seen[q], 0);
+            seen[q] = 1;
+            area += pts[k].area;
+            assert_int_equal(pts[k].surface, tx->surface);
+        }
+        assert_true(fabs(area / tx->area - 1.0) < 1e-3);
+        quartered++;
+    }
+    print_message("hemisphere at 0.5 m texels: %d texels on charts of several, %d of them at their quarters\n", multi,
+                  quartered);
+    assert_true(quartered >= 8);
+    lm_atlas_free(&a);
+    lm_surfaces_free(&su);
+    ts_free(t);
+}
+
 /* lm_footprint_turn: light that is a plane over the normals, E = a + g . n, comes back as that plane within
  * the ridge's shrink (1% of the normals' spread, which lies in two directions here: 2% of each); a channel
  * of 0, two points with one normal, one point: no turn. */
@@ -1047,6 +1107,7 @@ int main(void)
         cmocka_unit_test(test_bending_normals_finer_texels),
         cmocka_unit_test(test_texel_normal_is_the_mean),
         cmocka_unit_test(test_footprint_turn_fit),
+        cmocka_unit_test(test_quarter_footprints),
         cmocka_unit_test(test_degenerate_and_strict),
         cmocka_unit_test(test_nonmanifold_fin),
         cmocka_unit_test(test_bumpy_cornell),

@@ -160,11 +160,11 @@ typedef struct {
     int *texel_index;      /* width*height: index into texels, -1 where uncovered */
     uint32_t *footprint_first; /* texel_count + 1: texel i is gathered at footprints[footprint_first[i] ..
                               footprint_first[i + 1]) when that is not empty (lm_texel_footprint) */
-    lm_texel *footprints;  /* points spread over the piece a texel stands for, where its chart is one texel
-                              and its shading normals spread past LM_FOOTPRINT_SPREAD (a sphere's facet at a
-                              level's density): each a texel of its own (its triangle, barycentrics, the
-                              shading normal interpolated there, the area of its part), x, y and surface the
-                              texel's */
+    lm_texel *footprints;  /* points spread over what a texel stands for, where its shading normals spread
+                              past LM_FOOTPRINT_SPREAD and its chart is one texel (a sphere's facet at a
+                              level's density) or has triangles that turn (LM_FOOTPRINT_TURNING: a terrain's
+                              slope): each a texel of its own (its triangle, barycentrics, the shading normal
+                              interpolated there, the area of its part), x, y and surface the texel's */
     uint32_t footprint_count;
     float utilization;     /* covered texels / (width*height) */
     int page_width, page_height; /* one page's size (the atlas's own for one page) */
@@ -182,15 +182,19 @@ typedef struct {
 /* A texel whose chart is one texel stands for a whole piece, and where the piece's shading normals spread
  * so that their area-weighted mean is shorter than this (about 10 degrees off on average), its light
  * changes across it faster than linearly (a sphere's facet beside the next sphere): it is gathered at
- * LM_FOOTPRINT_POINTS points over the piece and their light averaged (docs/charts.md, "Footprints"). */
+ * LM_FOOTPRINT_POINTS points over the piece and their light averaged (docs/charts.md, "Footprints"). So is
+ * a texel of a chart of several whose triangles turn (the mean of their unit geometric normals, by area,
+ * shorter than LM_FOOTPRINT_TURNING) where its own shading normals spread as much: at its four quarters
+ * (a terrain's coarse texel across a hollow; not a flat wall whose corners carry averaged normals). */
 #define LM_FOOTPRINT_SPREAD 0.985
+#define LM_FOOTPRINT_TURNING 0.999
 #define LM_FOOTPRINT_POINTS 4
 
 /* How a footprint texel's light turns with the normal (docs/charts.md, "Turning with the normal"): one
  * value for a curved piece is its mean, but a pixel on the piece's dark side wants less and one on its
  * bright side more. Per channel c, the least-squares plane through the m points' light e[k][c] over their
  * unit normals n[k], E(n) = mean_c (1 + r_c . n - r_c . nbar), nbar the normals' mean (ridge 1% of their
- * spread, so a direction they do not spread in, the radial one, stays 0). out: LM_TURN_FLOATS floats,
+ * spread, so that a direction they hardly spread in, the radial one, stays near 0). out: LM_TURN_FLOATS floats,
  * per channel r_c (3) then r_c . nbar, all 0 where m < 2, the normals do not spread (under 1e-6) or the
  * channel's mean is 0. Relative, so a light's edit that scales a texel's light leaves it true. O(m). */
 #define LM_TURN_FLOATS 12
@@ -206,6 +210,16 @@ static inline uint32_t lm_texel_footprint(const lm_atlas *a, uint32_t i, const l
     }
     *points = a->footprints + a->footprint_first[i];
     return a->footprint_first[i + 1] - a->footprint_first[i];
+}
+
+/* Whether texel i turns with the normal (lm_footprint_turn): a footprint texel whose chart is that texel
+ * alone, every corner at its centre, so that a pixel's lookup reads it and nothing else (a chart of several
+ * would read its turns texel by texel, in steps). */
+static inline int lm_texel_turns(const lm_atlas *a, uint32_t i)
+{
+    const lm_texel *pts, *tx = &a->texels[i];
+    const lm_chart *ch = &a->charts[a->chart_owner[(size_t)tx->y * a->width + tx->x]];
+    return lm_texel_footprint(a, i, &pts) > 0 && ch->w == 1 && ch->h == 1;
 }
 
 void lm_atlas_options_default(lm_atlas_options *o);

@@ -260,10 +260,106 @@ static int footprint(const texel_job *j, const lmc_chart *ch, const texel_acc *e
     return 1;
 }
 
-/* Fills this chart's corner UVs and returns its texels (row-major), or NULL when memory ran out; a chart
- * of one texel over a curved piece also its footprint points (footprint). */
-static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_texel **foot, uint32_t *foot_count)
+/* Whether a chart's triangles turn: the area-weighted mean of their unit geometric normals is shorter than
+ * LM_FOOTPRINT_TURNING (a terrain's slope, a column; not a wall, whose interpolated normals may still
+ * disagree at its corners). */
+static int chart_turns(const texel_job *j, const lmc_chart *ch)
 {
+    double g[3] = {0.0, 0.0, 0.0}, area = 0.0;
+    for (uint32_t i = 0; i < ch->tri_count; i++) {
+        double n[3], a = lmc_tri_area(j->s, j->pos, ch->tris[i], n), l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; l > 0.0 && k < 3; k++)
+            g[k] += a * n[k] / l;
+        area += a;
+    }
+    return area > 0.0 && sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]) < LM_FOOTPRINT_TURNING * area;
+}
+
+/* Each quarter of a texel square: its largest overlap's triangle and centroid, and the world area of all. */
+typedef struct {
+    double best, cx, cy, area;
+    int tri;
+} quarter;
+
+/* The quarters (4 a cell, row-major cells) of chart ci's rect from its triangles. */
+static void fill_quarters(const texel_job *j, int ci, quarter *q)
+{
+    const lmc_chart *ch = &j->c->charts[ci];
+    const lm_chart *r = &j->a->charts[ci];
+    for (size_t i = 0; i < (size_t)r->w * r->h * 4; i++)
+        q[i] = (quarter){0.0, 0.0, 0.0, 0.0, -1};
+    for (uint32_t i = 0; i < ch->tri_count; i++) {
+        uint32_t t = ch->tris[i];
+        pt c[3];
+        int ord[3];
+        double uv_area = chart_corners(j, ci, t, c, ord), n[3], world = lmc_tri_area(j->s, j->pos, t, n);
+        double scale = uv_area > 0.0 ? world / uv_area : 0.0;
+        double lo[2] = {fmin(c[0].x, fmin(c[1].x, c[2].x)), fmin(c[0].y, fmin(c[1].y, c[2].y))};
+        double hi[2] = {fmax(c[0].x, fmax(c[1].x, c[2].x)), fmax(c[0].y, fmax(c[1].y, c[2].y))};
+        int x0 = (int)fmax(floor(2.0 * lo[0]), 0.0), x1 = (int)fmin(floor(2.0 * hi[0]), 2.0 * r->w - 1.0);
+        int y0 = (int)fmax(floor(2.0 * lo[1]), 0.0), y1 = (int)fmin(floor(2.0 * hi[1]), 2.0 * r->h - 1.0);
+        for (int y = y0; y <= y1; y++)
+            for (int x = x0; x <= x1; x++) {
+                pt m;
+                double ov = clip_square(c, 0.5 * x, 0.5 * y, 0.5, &m);
+                if (ov <= 0.0)
+                    continue;
+                quarter *e = &q[((size_t)(y / 2) * r->w + (size_t)(x / 2)) * 4 + (size_t)(y % 2 * 2 + x % 2)];
+                e->area += ov * scale;
+                if (ov > e->best)
+                    *e = (quarter){ov, m.x, m.y, e->area, (int)t};
+            }
+    }
+}
+
+/* The footprints of a chart of several texels whose triangles turn (chart_turns): each texel whose shading
+ * normals spread past LM_FOOTPRINT_SPREAD is gathered at its quarters' points (their largest overlaps'
+ * centroids), where two or more quarters are covered; n texels tx, their accumulators acc (row-major cells).
+ * *foot gets the points, (*per_texel)[k] how many texel k has. Returns 0 when memory ran out. */
+static int quarter_footprints(const texel_job *j, int ci, const texel_acc *acc, const lm_texel *tx, uint32_t n,
+                              lm_texel **foot, uint32_t *foot_count, uint32_t **per_texel)
+{
+    const lm_chart *r = &j->a->charts[ci];
+    quarter *q = malloc((size_t)r->w * r->h * 4 * sizeof *q);
+    *per_texel = calloc((size_t)n + 1, sizeof **per_texel);
+    *foot = malloc(((size_t)n * 4 + 1) * sizeof **foot);
+    if (!q || !*per_texel || !*foot) {
+        free(q);
+        return 0;
+    }
+    fill_quarters(j, ci, q);
+    uint32_t k = 0, f = 0;
+    for (size_t cell = 0; cell < (size_t)r->w * r->h; cell++) {
+        const texel_acc *e = &acc[cell];
+        if (e->tri < 0)
+            continue;
+        double len = sqrt(e->nsum[0] * e->nsum[0] + e->nsum[1] * e->nsum[1] + e->nsum[2] * e->nsum[2]);
+        uint32_t got = 0;
+        for (int i = 0; e->area > 0.0 && len < LM_FOOTPRINT_SPREAD * e->area && i < 4; i++) {
+            const quarter *p = &q[cell * 4 + (size_t)i];
+            if (p->tri < 0)
+                continue;
+            lm_texel *o = &(*foot)[f + got++];
+            *o = tx[k];
+            o->tri = (uint32_t)p->tri;
+            texel_point(j, ci, o->tri, p->cx, p->cy, o);
+            o->area = (float)p->area;
+        }
+        (*per_texel)[k++] = got >= 2 ? got : 0;
+        f += got >= 2 ? got : 0;
+    }
+    *foot_count = f;
+    free(q);
+    return 1;
+}
+
+/* Fills this chart's corner UVs and returns its texels (row-major), or NULL when memory ran out; a chart
+ * of one texel over a curved piece also its footprint points (footprint), a chart of several whose
+ * triangles turn its texels' (quarter_footprints: *per_texel, NULL where no texel has any). */
+static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_texel **foot, uint32_t *foot_count,
+                              uint32_t **per_texel)
+{
+    *per_texel = NULL;
     const lmc_chart *ch = &j->c->charts[ci];
     const lm_chart *r = &j->a->charts[ci];
     texel_acc *acc = malloc((size_t)r->w * r->h * sizeof *acc);
@@ -311,6 +407,10 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_te
         if (r->w == 1 && r->h == 1 && n == 1 && !footprint(j, ch, &acc[0], &tx[0], foot, foot_count)) {
             free(tx);
             tx = NULL;
+        } else if ((r->w > 1 || r->h > 1) && chart_turns(j, ch) &&
+                   !quarter_footprints(j, ci, acc, tx, n, foot, foot_count, per_texel)) {
+            free(tx);
+            tx = NULL;
         }
     }
     free(acc);
@@ -318,7 +418,7 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_te
 }
 
 static lm_status assemble(lm_atlas *a, lm_texel **per, const uint32_t *count, lm_texel **foot,
-                          const uint32_t *foot_count, lm_error *err)
+                          const uint32_t *foot_count, uint32_t **per_texel, lm_error *err)
 {
     size_t total = 0, feet = 0;
     for (int i = 0; i < a->chart_count; i++)
@@ -330,8 +430,10 @@ static lm_status assemble(lm_atlas *a, lm_texel **per, const uint32_t *count, lm
         return lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for %zu texels", total);
     for (int i = 0; i < a->chart_count; i++) {
         memcpy(a->texels + a->texel_count, per[i], count[i] * sizeof *per[i]);
-        for (uint32_t k = 0; k < count[i]; k++) /* a chart's footprint points are its one texel's */
-            a->footprint_first[a->texel_count + k] = a->footprint_count;
+        for (uint32_t k = 0, at = a->footprint_count; k < count[i]; k++) { /* a chart's points are its one texel's, or per_texel's */
+            a->footprint_first[a->texel_count + k] = at;
+            at += per_texel[i] ? per_texel[i][k] : 0;
+        }
         if (foot_count[i]) /* memcpy from NULL is undefined even for no bytes */
             memcpy(a->footprints + a->footprint_count, foot[i], foot_count[i] * sizeof *foot[i]);
         a->footprint_count += foot_count[i];
@@ -356,6 +458,7 @@ lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, l
     lm_texel **per = calloc((size_t)a->chart_count + 1, sizeof *per), **foot = calloc((size_t)a->chart_count + 1, sizeof *foot);
     uint32_t *count = calloc((size_t)a->chart_count + 1, sizeof *count);
     uint32_t *foot_count = calloc((size_t)a->chart_count + 1, sizeof *foot_count);
+    uint32_t **per_texel = calloc((size_t)a->chart_count + 1, sizeof *per_texel);
     float *nrm = lmc_world_normals(s);
     lm_status st = LM_OK;
     if (!a->corner_uv || !a->coverage_uv || !a->chart_owner || !a->tri_chart || !a->texel_index || !per || !count ||
@@ -379,14 +482,15 @@ lm_status lmc_texels(const lm_scene *s, const lmc_charts *c, const float *pos, l
     int failed = 0;
 #pragma omp parallel for schedule(dynamic, 1) reduction(| : failed)
     for (int i = 0; i < a->chart_count; i++) {
-        per[i] = chart_texels(&j, i, &count[i], &foot[i], &foot_count[i]);
+        per[i] = chart_texels(&j, i, &count[i], &foot[i], &foot_count[i], &per_texel[i]);
         failed |= per[i] == NULL;
     }
     st = failed ? lm_fail(err, LM_ERR_NOMEM, "charts: out of memory for the texel table")
-                : assemble(a, per, count, foot, foot_count, err);
+                : assemble(a, per, count, foot, foot_count, per_texel, err);
 done:
     for (int i = 0; per && foot && i < a->chart_count; i++)
-        free(per[i]), free(foot[i]);
+        free(per[i]), free(foot[i]), free(per_texel[i]);
+    free(per_texel);
     free(per);
     free(foot);
     free(count);

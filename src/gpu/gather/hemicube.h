@@ -194,11 +194,11 @@ const lm_proxy *lm_gather_proxy(const lm_gather *g);
 lm_status lm_gather_set_aim(lm_gather *g, const lm_atlas *a, const float *aim_rgb, lm_error *err);
 /* The same for an AIM already dilated as RGBA (lm_aim_dilated_rgba): uploaded as it is. */
 lm_status lm_gather_set_aim_dilated(lm_gather *g, const lm_atlas *a, const float *dilated_rgba, lm_error *err);
-/* Where each footprint texel's turn goes (charts.h, lm_footprint_turn; docs/charts.md, "Turning with the
- * normal"): three atlas-sized textures, channel c's r_c and r_c . nbar as RGBA, written by every later
- * lm_gather_texels for the footprint texels it gathers (a texel gathered at one point gets 0; the others'
- * are never written). NULL or zeros: nowhere (the default). The hemicube schemes read each footprint
- * texel back once a round to get its points' light apart (a few hundred reads on a level). */
+/* Where each turning texel's turn goes (charts.h, lm_texel_turns and lm_footprint_turn; docs/charts.md,
+ * "Turning with the normal"): three atlas-sized textures, channel c's r_c and r_c . nbar as RGBA, written
+ * by every later lm_gather_texels for the turning texels it gathers (one gathered at one point gets 0; the
+ * other texels' are never written). NULL or zeros: nowhere (the default). The hemicube schemes read each
+ * turning texel back once a round to get its points' light apart (a few hundred reads on a level). */
 void lm_gather_set_turn(lm_gather *g, const unsigned tex[3]);
 /* Gathers texels (indices into a->texels) into iim_tex (an RGBA32F texture of the atlas's size, from
  * lm_iim_texture_create): rgb = indirect irradiance E, a = back-face fraction. stats may be NULL. */

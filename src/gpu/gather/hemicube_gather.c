@@ -857,15 +857,15 @@ static void turn_of(int m, const float n[][3], const float e[][4], float out[LM_
     lm_footprint_turn(m, n, rgb, out);
 }
 
-/* The turns (LM_TURN_FLOATS a texel, in the order of texels) of the footprint texels among texels into
- * the turn maps; every other texel's stays 0. */
+/* The turns (LM_TURN_FLOATS a texel, in the order of texels) of the turning texels among texels into the
+ * turn maps; every other texel's stays 0. */
 static void write_turns(const lm_gather *g, const lm_atlas *a, const uint32_t *texels, uint32_t n, const float *turn)
 {
     for (int c = 0; c < 3; c++) {
         glBindTexture(GL_TEXTURE_2D, g->turn_tex[c]);
         for (uint32_t i = 0; i < n; i++) {
-            const lm_texel *pts, *tx = &a->texels[texels[i]];
-            if (lm_texel_footprint(a, texels[i], &pts))
+            const lm_texel *tx = &a->texels[texels[i]];
+            if (lm_texel_turns(a, texels[i]))
                 glTexSubImage2D(GL_TEXTURE_2D, 0, tx->x, tx->y, 1, 1, GL_RGBA, GL_FLOAT,
                                 turn + LM_TURN_FLOATS * (size_t)i + 4 * c);
         }
@@ -939,7 +939,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
     return lm_gl_check("ray gather", err);
 }
 
-/* The footprint texels of a hemicube gather, for their turns: the IIM's running mean of each after each
+/* The turning texels of a hemicube gather, for their turns: the IIM's running mean of each after each
  * round r, read back (the light of its point r is then (r + 1) mean_r - r mean_(r-1)). */
 typedef struct {
     uint32_t count, *texel;
@@ -949,10 +949,9 @@ typedef struct {
 static lm_status round_means_init(round_means *rm, const lm_atlas *a, const uint32_t *texels, uint32_t count,
                                   lm_error *err)
 {
-    const lm_texel *pts;
     uint32_t n = 0;
     for (uint32_t i = 0; i < count; i++)
-        n += lm_texel_footprint(a, texels[i], &pts) > 0;
+        n += lm_texel_turns(a, texels[i]);
     if (n == 0)
         return LM_OK;
     rm->texel = malloc(sizeof *rm->texel * n);
@@ -963,7 +962,7 @@ static lm_status round_means_init(round_means *rm, const lm_atlas *a, const uint
         return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory for %u footprint texels", n);
     }
     for (uint32_t i = 0; i < count; i++)
-        if (lm_texel_footprint(a, texels[i], &pts) > 0)
+        if (lm_texel_turns(a, texels[i]))
             rm->texel[rm->count++] = texels[i];
     return LM_OK;
 }

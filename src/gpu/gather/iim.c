@@ -32,11 +32,14 @@ static void textures(lm_iim *iim, unsigned *tex[IIM_TEXTURES])
     memcpy(tex, t, sizeof t);
 }
 
-/* The footprint texels' turn maps (iim.h), where the atlas has footprint texels. Half floats: a turn is a
+/* The turn maps (iim.h), where the atlas has texels that turn (lm_texel_turns). Half floats: a turn is a
  * relative change of a few tenths, and 3 digits are more than its estimate holds. */
 static lm_status init_turn(lm_iim *iim, const lm_atlas *a, lm_error *err)
 {
-    if (a->footprint_count == 0)
+    uint32_t turns = 0;
+    for (uint32_t i = 0; a->footprint_count && i < a->texel_count && !turns; i++)
+        turns = lm_texel_turns(a, i);
+    if (!turns)
         return LM_OK;
     glGenTextures(3, iim->turn_tex);
     const float zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};

@@ -26,9 +26,9 @@
  * flag); an estimate costs (2 spread + 1)^2 reads, drawn again only while its surface has texels
  * committed or blending.
  *
- * A footprint texel (charts.h) also has a turn: how its light changes with the normal across the piece it
- * stands for (lm_footprint_turn), three more atlas-sized RGBA16F maps (24 bytes a cell) made only where the
- * atlas has such texels; the frame scales the displayed value by it at each pixel (docs/charts.md,
+ * A footprint texel whose chart is that texel alone (charts.h, lm_texel_turns) also has a turn: how its
+ * light changes with the normal across the piece it stands for (lm_footprint_turn), three more atlas-sized
+ * RGBA16F maps (24 bytes a cell) made only where the atlas has such texels; the frame scales the displayed value by it at each pixel (docs/charts.md,
  * "Turning with the normal").
  *
  * Invalid texels (back-face fraction above the limit: the texel sees the inside of geometry) are
@@ -76,7 +76,7 @@ typedef struct {
     unsigned fresh_tex, old_tex, new_tex, display_tex, delta_tex, carry_tex;
     unsigned turn_tex[3];  /* the footprint texels' turns (hemicube.h, lm_gather_set_turn), RGBA16F, written
                             * by the gather as it goes, not blended: relative, so the value they turn is
-                            * the displayed one; all 0 where the atlas has no footprint texels */
+                            * the displayed one; all 0 where no texel turns */
     unsigned scale_prog, factor_buf; /* lm_iim_scale's program and factors, made at its first call */
     unsigned blend_prog, surface_buf, params_buf, start_buf, list_buf, chart_buf, redraw_buf, flag_buf, ops_buf;
 } lm_iim;
