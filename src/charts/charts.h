@@ -218,8 +218,10 @@ static inline uint32_t lm_texel_footprint(const lm_atlas *a, uint32_t i, const l
 static inline int lm_texel_turns(const lm_atlas *a, uint32_t i)
 {
     const lm_texel *pts, *tx = &a->texels[i];
+    if (lm_texel_footprint(a, i, &pts) == 0)
+        return 0;
     const lm_chart *ch = &a->charts[a->chart_owner[(size_t)tx->y * a->width + tx->x]];
-    return lm_texel_footprint(a, i, &pts) > 0 && ch->w == 1 && ch->h == 1;
+    return ch->w == 1 && ch->h == 1;
 }
 
 void lm_atlas_options_default(lm_atlas_options *o);

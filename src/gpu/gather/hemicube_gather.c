@@ -55,7 +55,7 @@ struct lm_gather {
     double coverage;
     float lift;            /* the eyes' lift off their texels in the pass being drawn (lm_gather_lift) */
     int round;             /* which of its footprint points a texel of the pass is gathered at (gather_points) */
-    GLuint turn_tex[3];    /* where each footprint texel's turn goes (lm_gather_set_turn); 0: nowhere */
+    GLuint turn_tex[3];    /* where each turning texel's turn goes (lm_gather_set_turn); 0: nowhere */
     float *turn;           /* the rays gather's turns of a pass, tiles^2 * LM_TURN_FLOATS */
 };
 
@@ -924,7 +924,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
                             e[c] += ek[k][c] / (float)m;
                     }
                 }
-                if (turn)
+                if (turn && lm_texel_turns(a, t))
                     turn_of(m, nk, ek, turn + LM_TURN_FLOATS * (size_t)i);
             }
         }
@@ -959,7 +959,7 @@ static lm_status round_means_init(round_means *rm, const lm_atlas *a, const uint
     if (!rm->texel || !rm->mean) {
         free(rm->texel), free(rm->mean);
         rm->texel = NULL, rm->mean = NULL;
-        return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory for %u footprint texels", n);
+        return lm_fail(err, LM_ERR_NOMEM, "hemicube gather: no memory for %u turning texels", n);
     }
     for (uint32_t i = 0; i < count; i++)
         if (lm_texel_turns(a, texels[i]))
@@ -973,8 +973,8 @@ static void round_means_free(round_means *rm)
     free(rm->mean);
 }
 
-/* Each footprint texel's value after round r (the texels gathered in it, and the others: their value
- * stays, and is not used). One read a texel: footprint texels are few (a level's curved pieces). */
+/* Each turning texel's value after round r (the texels gathered in it, and the others: their value
+ * stays, and is not used). One read a texel: turning texels are few (a level's curved pieces). */
 static void read_round(round_means *rm, unsigned iim_tex, const lm_atlas *a, int r)
 {
     for (uint32_t i = 0; i < rm->count; i++) {
@@ -984,7 +984,7 @@ static void read_round(round_means *rm, unsigned iim_tex, const lm_atlas *a, int
     }
 }
 
-/* The footprint texels' turns from their rounds' running means, into the turn maps. */
+/* The turning texels' turns from their rounds' running means, into the turn maps. */
 static void round_turns(lm_gather *g, const lm_scene *s, const lm_atlas *a, const round_means *rm)
 {
     float *turn = malloc(sizeof(float) * LM_TURN_FLOATS * rm->count);
