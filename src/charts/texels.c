@@ -115,16 +115,23 @@ static void add_normal(const texel_job *j, uint32_t t, const pt c[3], const int 
     }
 }
 
-static void accumulate(const texel_job *j, const int ord[3], texel_acc *acc, const lm_chart *r, uint32_t t,
-                       const pt c[3], double scale, double world)
+/* The cells of side 1 / k texels (k 1: texels; 2: their quarters) of chart rect r that triangle c's bounds
+ * touch: x in [xy[0], xy[1]], y in [xy[2], xy[3]]. */
+static void cell_range(const pt c[3], int k, const lm_chart *r, int xy[4])
 {
     double lo[2] = {fmin(c[0].x, fmin(c[1].x, c[2].x)), fmin(c[0].y, fmin(c[1].y, c[2].y))};
     double hi[2] = {fmax(c[0].x, fmax(c[1].x, c[2].x)), fmax(c[0].y, fmax(c[1].y, c[2].y))};
-    int x0 = (int)fmax(floor(lo[0]), 0.0), x1 = (int)fmin(floor(hi[0]), r->w - 1.0);
-    int y0 = (int)fmax(floor(lo[1]), 0.0), y1 = (int)fmin(floor(hi[1]), r->h - 1.0);
-    int covered = 0;
-    for (int y = y0; y <= y1; y++)
-        for (int x = x0; x <= x1; x++) {
+    xy[0] = (int)fmax(floor(k * lo[0]), 0.0), xy[1] = (int)fmin(floor(k * hi[0]), k * r->w - 1.0);
+    xy[2] = (int)fmax(floor(k * lo[1]), 0.0), xy[3] = (int)fmin(floor(k * hi[1]), k * r->h - 1.0);
+}
+
+static void accumulate(const texel_job *j, const int ord[3], texel_acc *acc, const lm_chart *r, uint32_t t,
+                       const pt c[3], double scale, double world)
+{
+    int xy[4], covered = 0;
+    cell_range(c, 1, r, xy);
+    for (int y = xy[2]; y <= xy[3]; y++)
+        for (int x = xy[0]; x <= xy[1]; x++) {
             pt m;
             double ov = clip_texel(c, x, y, &m);
             if (ov <= 0.0)
@@ -230,14 +237,21 @@ void lm_chart_lookup_rect(const lm_atlas *a, int c, float rect[4])
     rect[2] = (ch->x + ch->w - in) / (float)a->width, rect[3] = (ch->y + ch->h - in) / (float)a->height;
 }
 
+/* Whether a texel's interpolated shading normals spread past LM_FOOTPRINT_SPREAD: their area-weighted
+ * mean is shorter than that. */
+static int normals_spread(const texel_acc *e)
+{
+    double len = sqrt(e->nsum[0] * e->nsum[0] + e->nsum[1] * e->nsum[1] + e->nsum[2] * e->nsum[2]);
+    return e->area > 0.0 && len < LM_FOOTPRINT_SPREAD * e->area;
+}
+
 /* The texel's footprint points (lm_atlas.footprints) when its chart is one texel whose shading normals
- * spread past LM_FOOTPRINT_SPREAD: *foot (NULL, 0 when none). Returns 0 when memory ran out. */
+ * spread (normals_spread): *foot (NULL, 0 when none). Returns 0 when memory ran out. */
 static int footprint(const texel_job *j, const lmc_chart *ch, const texel_acc *e, const lm_texel *tx,
                      lm_texel **foot, uint32_t *foot_count)
 {
     *foot = NULL, *foot_count = 0;
-    double len = sqrt(e->nsum[0] * e->nsum[0] + e->nsum[1] * e->nsum[1] + e->nsum[2] * e->nsum[2]);
-    if (!(e->area > 0.0) || len >= LM_FOOTPRINT_SPREAD * e->area)
+    if (!normals_spread(e))
         return 1;
     lmc_point pts[LM_FOOTPRINT_POINTS];
     int n = lmc_footprint(j->s, j->pos, ch->tris, ch->tri_count, pts);
@@ -281,61 +295,45 @@ typedef struct {
     int tri;
 } quarter;
 
-/* The quarters (4 a cell, row-major cells) of chart ci's rect from its triangles. */
-static void fill_quarters(const texel_job *j, int ci, quarter *q)
+/* Triangle t's (chart-local corners c, world area per uv area `scale`) overlaps with the quarters of chart
+ * rect r's cells (4 a cell, row-major cells) added to q. */
+static void add_quarters(quarter *q, const lm_chart *r, uint32_t t, const pt c[3], double scale)
 {
-    const lmc_chart *ch = &j->c->charts[ci];
-    const lm_chart *r = &j->a->charts[ci];
-    for (size_t i = 0; i < (size_t)r->w * r->h * 4; i++)
-        q[i] = (quarter){0.0, 0.0, 0.0, 0.0, -1};
-    for (uint32_t i = 0; i < ch->tri_count; i++) {
-        uint32_t t = ch->tris[i];
-        pt c[3];
-        int ord[3];
-        double uv_area = chart_corners(j, ci, t, c, ord), n[3], world = lmc_tri_area(j->s, j->pos, t, n);
-        double scale = uv_area > 0.0 ? world / uv_area : 0.0;
-        double lo[2] = {fmin(c[0].x, fmin(c[1].x, c[2].x)), fmin(c[0].y, fmin(c[1].y, c[2].y))};
-        double hi[2] = {fmax(c[0].x, fmax(c[1].x, c[2].x)), fmax(c[0].y, fmax(c[1].y, c[2].y))};
-        int x0 = (int)fmax(floor(2.0 * lo[0]), 0.0), x1 = (int)fmin(floor(2.0 * hi[0]), 2.0 * r->w - 1.0);
-        int y0 = (int)fmax(floor(2.0 * lo[1]), 0.0), y1 = (int)fmin(floor(2.0 * hi[1]), 2.0 * r->h - 1.0);
-        for (int y = y0; y <= y1; y++)
-            for (int x = x0; x <= x1; x++) {
-                pt m;
-                double ov = clip_square(c, 0.5 * x, 0.5 * y, 0.5, &m);
-                if (ov <= 0.0)
-                    continue;
-                quarter *e = &q[((size_t)(y / 2) * r->w + (size_t)(x / 2)) * 4 + (size_t)(y % 2 * 2 + x % 2)];
-                e->area += ov * scale;
-                if (ov > e->best)
-                    *e = (quarter){ov, m.x, m.y, e->area, (int)t};
-            }
-    }
+    int xy[4];
+    cell_range(c, 2, r, xy);
+    for (int y = xy[2]; y <= xy[3]; y++)
+        for (int x = xy[0]; x <= xy[1]; x++) {
+            pt m;
+            double ov = clip_square(c, 0.5 * x, 0.5 * y, 0.5, &m);
+            if (ov <= 0.0)
+                continue;
+            quarter *e = &q[((size_t)(y / 2) * r->w + (size_t)(x / 2)) * 4 + (size_t)(y % 2 * 2 + x % 2)];
+            e->area += ov * scale;
+            if (ov > e->best)
+                *e = (quarter){ov, m.x, m.y, e->area, (int)t};
+        }
 }
 
 /* The footprints of a chart of several texels whose triangles turn (chart_turns): each texel whose shading
- * normals spread past LM_FOOTPRINT_SPREAD is gathered at its quarters' points (their largest overlaps'
- * centroids), where two or more quarters are covered; n texels tx, their accumulators acc (row-major cells).
- * *foot gets the points, (*per_texel)[k] how many texel k has. Returns 0 when memory ran out. */
-static int quarter_footprints(const texel_job *j, int ci, const texel_acc *acc, const lm_texel *tx, uint32_t n,
-                              lm_texel **foot, uint32_t *foot_count, uint32_t **per_texel)
+ * normals spread (normals_spread) is gathered at its quarters' points (their largest overlaps' centroids,
+ * q from add_quarters), where two or more quarters are covered; n texels tx, their accumulators acc
+ * (row-major cells). *foot gets the points, (*per_texel)[k] how many texel k has. Returns 0 when memory ran
+ * out. */
+static int quarter_footprints(const texel_job *j, int ci, const texel_acc *acc, const quarter *q, const lm_texel *tx,
+                              uint32_t n, lm_texel **foot, uint32_t *foot_count, uint32_t **per_texel)
 {
     const lm_chart *r = &j->a->charts[ci];
-    quarter *q = malloc((size_t)r->w * r->h * 4 * sizeof *q);
     *per_texel = calloc((size_t)n + 1, sizeof **per_texel);
     *foot = malloc(((size_t)n * 4 + 1) * sizeof **foot);
-    if (!q || !*per_texel || !*foot) {
-        free(q);
+    if (!*per_texel || !*foot)
         return 0;
-    }
-    fill_quarters(j, ci, q);
     uint32_t k = 0, f = 0;
     for (size_t cell = 0; cell < (size_t)r->w * r->h; cell++) {
         const texel_acc *e = &acc[cell];
         if (e->tri < 0)
             continue;
-        double len = sqrt(e->nsum[0] * e->nsum[0] + e->nsum[1] * e->nsum[1] + e->nsum[2] * e->nsum[2]);
         uint32_t got = 0;
-        for (int i = 0; e->area > 0.0 && len < LM_FOOTPRINT_SPREAD * e->area && i < 4; i++) {
+        for (int i = 0; normals_spread(e) && i < 4; i++) {
             const quarter *p = &q[cell * 4 + (size_t)i];
             if (p->tri < 0)
                 continue;
@@ -349,7 +347,6 @@ static int quarter_footprints(const texel_job *j, int ci, const texel_acc *acc, 
         f += got >= 2 ? got : 0;
     }
     *foot_count = f;
-    free(q);
     return 1;
 }
 
@@ -362,11 +359,20 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_te
     *per_texel = NULL;
     const lmc_chart *ch = &j->c->charts[ci];
     const lm_chart *r = &j->a->charts[ci];
-    texel_acc *acc = malloc((size_t)r->w * r->h * sizeof *acc);
-    if (!acc)
+    size_t cells = (size_t)r->w * r->h;
+    texel_acc *acc = malloc(cells * sizeof *acc);
+    /* a chart of several texels whose triangles turn: its texels' quarters too (quarter_footprints) */
+    int quartered = (r->w > 1 || r->h > 1) && chart_turns(j, ch);
+    quarter *q = quartered ? malloc(cells * 4 * sizeof *q) : NULL;
+    if (!acc || (quartered && !q)) {
+        free(acc);
+        free(q);
         return NULL;
-    for (size_t i = 0; i < (size_t)r->w * r->h; i++)
+    }
+    for (size_t i = 0; i < cells; i++)
         acc[i] = (texel_acc){0.0, 0.0, 0.0, 0.0, -1, {0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+    for (size_t i = 0; q && i < cells * 4; i++)
+        q[i] = (quarter){0.0, 0.0, 0.0, 0.0, -1};
     for (uint32_t i = 0; i < ch->tri_count; i++) {
         uint32_t t = ch->tris[i];
         pt c[3];
@@ -380,7 +386,10 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_te
             uv[1] = (float)((r->y + lookup_coord(c[k].y, r->h)) / j->a->height);
         }
         j->a->tri_chart[t] = ci;
-        accumulate(j, ord, acc, r, t, c, uv_area > 0.0 ? world / uv_area : 0.0, world);
+        double scale = uv_area > 0.0 ? world / uv_area : 0.0;
+        accumulate(j, ord, acc, r, t, c, scale, world);
+        if (q)
+            add_quarters(q, r, t, c, scale);
     }
     uint32_t n = 0;
     for (size_t i = 0; i < (size_t)r->w * r->h; i++)
@@ -407,13 +416,13 @@ static lm_texel *chart_texels(const texel_job *j, int ci, uint32_t *count, lm_te
         if (r->w == 1 && r->h == 1 && n == 1 && !footprint(j, ch, &acc[0], &tx[0], foot, foot_count)) {
             free(tx);
             tx = NULL;
-        } else if ((r->w > 1 || r->h > 1) && chart_turns(j, ch) &&
-                   !quarter_footprints(j, ci, acc, tx, n, foot, foot_count, per_texel)) {
+        } else if (q && !quarter_footprints(j, ci, acc, q, tx, n, foot, foot_count, per_texel)) {
             free(tx);
             tx = NULL;
         }
     }
     free(acc);
+    free(q);
     return tx;
 }
 
