@@ -616,6 +616,16 @@ static uint32_t cap_texel(const tscene *t)
 
 static const lm_gather_scheme footprint_schemes[] = {LM_GATHER_RAYS, LM_GATHER_VIEWPORTS, LM_GATHER_INSTANCED};
 
+/* The defaults with footprint scheme k under the cap scenes' uniform sky of 1. */
+static lm_hemicube_settings under_sky(int k)
+{
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    set.scheme = footprint_schemes[k];
+    set.sky[0] = set.sky[1] = set.sky[2] = 1.0f;
+    return set;
+}
+
 static void test_footprint_of_a_curved_piece(void **state)
 {
     (void)state;
@@ -655,10 +665,7 @@ static void test_footprint_of_a_curved_piece(void **state)
     lm_error err;
     assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
     for (int k = 0; k < 3; k++) {
-        lm_hemicube_settings set;
-        lm_hemicube_settings_default(&set);
-        set.scheme = footprint_schemes[k];
-        set.sky[0] = set.sky[1] = set.sky[2] = 1.0f;
+        lm_hemicube_settings set = under_sky(k);
         float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, &texel, 1, NULL);
         double E = texel_value(&t, rgba, texel)[0];
         print_message("scheme %d: E = %.4f; its points' mean %.4f; the cap's mean %.4f; its own point %.4f\n",
@@ -750,10 +757,7 @@ static void test_footprint_turn(void **state)
     lm_error err;
     assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
     for (int k = 0; k < 3; k++) {
-        lm_hemicube_settings set;
-        lm_hemicube_settings_default(&set);
-        set.scheme = footprint_schemes[k];
-        set.sky[0] = set.sky[1] = set.sky[2] = 1.0f;
+        lm_hemicube_settings set = under_sky(k);
         set.ray_samples = 6400, set.rim_samples = 1600; /* the turn is a slope between the points: their noise its */
         float e[4], turn[LM_TURN_FLOATS];
         gather_turned(&t, rt, &set, texel, e, turn);
@@ -801,8 +805,7 @@ static void test_footprint_covered(void **state)
     lm_hemicube_settings_default(&set);
     assert_true(lm_texel_covered(rt, t.s, &t.a, &set, texel));
     for (int k = 0; k < 3; k++) {
-        set.scheme = footprint_schemes[k];
-        set.sky[0] = set.sky[1] = set.sky[2] = 1.0f;
+        set = under_sky(k);
         float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, &texel, 1, NULL);
         assert_true(texel_value(&t, rgba, texel)[3] >= 1.0f); /* invalid */
         free(rgba);
