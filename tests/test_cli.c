@@ -1196,6 +1196,44 @@ static void test_check_levels_per_channel(void **state)
     check_level_channels(town, 8, 0.05);
 }
 
+/* `lmgi check --as-bake` checks the lightmap `lmgi bake` makes (src/cli/bake_options.h): 4 photons a texel
+ * (at least 46,080) and a bounce pass, which it says; plain `check` solves as `run` does, with neither. The
+ * frame is right either way (measured at 32 x 32: 0.99-1.01 per channel). */
+static void test_check_as_bake(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(box, lmt_shared_scene("cornell-box/CornellBox.glb"));
+    char args[1200];
+    const char *as_bake[2] = {"", " --as-bake"};
+    for (int k = 0; k < 2; k++) {
+        snprintf(args, sizeof args, "check %s --texels 12000 --size 32x32 --target-error 0.1 --no-cache -q%s", box,
+                 as_bake[k]);
+        assert_int_equal(run(args), 0);
+        const char *line = strstr(output, "the lightmap as lmgi bake makes it: ");
+        if (!k) {
+            assert_null(line);
+        } else {
+            unsigned texels, photons;
+            int passes;
+            assert_non_null(line);
+            assert_int_equal(sscanf(line, "the lightmap as lmgi bake makes it: %u texels, %u photons, %d bounce pass",
+                                    &texels, &photons, &passes), 3);
+            print_message("check --as-bake: %u texels, %u photons, %d bounce pass\n", texels, photons, passes);
+            assert_true(texels > 9000 && texels < 15000);
+            assert_int_equal(photons, 4 * texels);
+            assert_int_equal(passes, 1);
+        }
+        const char *row = strstr(output, "frame (not emitters)");
+        assert_non_null(row);
+        unsigned pixels;
+        double c[3];
+        assert_int_equal(sscanf(row + strlen("frame (not emitters)"), "%u %lf %lf %lf", &pixels, &c[0], &c[1], &c[2]),
+                         4);
+        for (int i = 0; i < 3; i++)
+            assert_true(fabs(c[i] - 1.0) < 0.05);
+    }
+}
+
 /* Issue 37's measure of the caustic filter: `lmgi check` of the generated Cornell box at 256 x 256 and the
  * defaults, its caustic part (the mirror and glass spheres' light) against the reference's light-traced
  * one: relative RMSE per pixel under 0.10 and its sum within 3%. The reference's caustic part does not
@@ -1539,6 +1577,7 @@ int main(void)
         cmocka_unit_test(test_reference_and_check_commands),
         cmocka_unit_test(test_check_caustic_part),
         cmocka_unit_test(test_check_levels_per_channel),
+        cmocka_unit_test(test_check_as_bake),
         cmocka_unit_test(test_run_caustic_tiles),
         cmocka_unit_test(test_tradeoff),
         cmocka_unit_test(test_tradeoff_update_lag),

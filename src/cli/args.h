@@ -39,6 +39,7 @@ typedef struct {
     int gltf;               /* --gltf (bake): also a glTF copy of the scene with the lightmap's UVs */
     int accuracy;           /* --accuracy (bake): also the lightmaps' estimate of their own error */
     int resume;             /* --resume (bake): continue from DIR/bake.checkpoint */
+    int as_bake;            /* --as-bake (check): the lightmap a bake makes (bake_options.h), not run's */
     float checkpoint_seconds; /* --checkpoint-seconds S (bake): at most one checkpoint every S (0: 10) */
     int shard, shards;      /* --shard K/N (bake): share K (1-based) of N; shards 0: a whole bake */
     int frame_lag;          /* --frame-lag (tradeoff --edits): the frame's lag against the reference too */

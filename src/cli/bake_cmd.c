@@ -227,12 +227,6 @@ static void report(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater *u, double
     }
 }
 
-uint32_t lm_cli_bake_photons(uint32_t texels)
-{
-    uint64_t n = (uint64_t)LM_CLI_BAKE_PHOTONS_PER_TEXEL * texels;
-    return n < LM_CLI_BAKE_PHOTONS_MIN ? LM_CLI_BAKE_PHOTONS_MIN : n > LM_CLI_BAKE_PHOTONS_MAX ? LM_CLI_BAKE_PHOTONS_MAX : (uint32_t)n;
-}
-
 /* bake (parts NULL) and merge (the parts' checkpoint files): the updater's first full solution, then the
  * lightmaps, or a shard's part. */
 static int bake(const lm_cli_args *a, const char *command, const char *const *parts, int part_count,
@@ -252,11 +246,7 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
     }
     lmgi_updater_desc d;
     lm_cli_updater_desc(a, &d);
-    if (!a->desc.photons.count && !a->desc.photons.per_group)
-        d.photons.count = lm_cli_bake_photons(in.texels);
-    int local_lights = in.lights_by_type[LMGI_LIGHT_POINT] + in.lights_by_type[LMGI_LIGHT_SPOT];
-    if (!a->desc.gather.bounce_passes && (parts || !a->shards) && local_lights <= LM_CLI_BAKE_PASS_MAX_LIGHTS)
-        d.gather.bounce_passes = LM_CLI_BAKE_BOUNCE_PASSES; /* a shard's are its merge's */
+    lm_cli_bake_solution(&in, parts || !a->shards, &d);
     d.frame.width = d.frame.height = 0;
     d.aim.error_estimate = a->accuracy ? LMGI_ON : 0;
     double started = lm_cli_now();

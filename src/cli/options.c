@@ -212,6 +212,10 @@ const lm_cli_option lm_cli_options[] = {
     {"--accuracy", NULL, NULL, BAKES, LM_OPT_FLAG, offsetof(lm_cli_args, accuracy), 0, 0, NULL,
      "also DIR/accuracy.exr, the lightmaps' estimate of their own error (r: the\n"
      "lightmap's relative standard error, g: the AIM's, b: back-face share)"},
+    {"--as-bake", NULL, NULL, LM_CMD_CHECK, LM_OPT_FLAG, offsetof(lm_cli_args, as_bake), 0, 0, NULL,
+     "the lightmap 'lmgi bake' makes, not the one 'lmgi run' starts from: the\n"
+     "bake's density (--texels' default, open surfaces not made coarser), its\n"
+     "photons and its bounce pass"},
     {"--resume", NULL, NULL, LM_CMD_BAKE, LM_OPT_FLAG, offsetof(lm_cli_args, resume), 0, 0, NULL,
      "continue the bake that was cancelled or killed from DIR/bake.checkpoint\n"
      "(what its gather had finished), to the same lightmaps as one that never\n"
