@@ -1,8 +1,9 @@
 /* End to end, the way a user meets the lighting: `lmgi run`'s frame at its default settings against the
  * reference's pixels (api/frame_check.h), per visible surface and over the frame, on the shared Cornell
  * box as shipped (its double-sided lamp 0.9 mm under the ceiling), the generated Cornell box and the
- * two-room scene; and the displayed IIM against the reference's E_iim per surface on the shared Cornell
- * box, at `lmgi run`'s lightmap density and at a bake's (64k texels).
+ * two-room scene, each surface of 100+ pixels within 5% per channel (issue 33, item 4); and the displayed IIM
+ * against the reference's E_iim per surface on the shared Cornell box, at `lmgi run`'s lightmap density and
+ * as `lmgi bake` solves it (64k texels, its photons and bounce pass).
  *
  * The shared Cornell box once rendered 1.64x too bright here while every other test passed; these would
  * have caught it (docs/reference.md, "Frame against reference").
@@ -25,6 +26,7 @@
 
 #include "../src/api/frame_check.h"
 #include "../src/api/lmgi_updater.h"
+#include "../src/cli/bake_options.h"
 #include "../src/cli/run_options.h"
 #include "../src/reference/reference.h"
 #include "support.h"
@@ -36,6 +38,18 @@
                            * unless a scene says otherwise */
 #define BLOCK_RMSE 0.1   /* cornell-suzanne's textured block, per pixel (test_cornell_suzanne) */
 #define MIN_PIXELS 100    /* surfaces with fewer compared pixels are reported, not asserted */
+#define CHANNEL_TOL 0.05  /* issue 33's per-surface criterion, per channel (channel_off), asserted against
+                           * references of REF_ERROR or finer: at REF_ERROR_RARE the generated box's dynamic cube
+                           * face (100 pixels) reads G +6.0% within its reference's own noise */
+
+static lmgi_scene *load_with(const char *path, const lmgi_options *o)
+{
+    lmgi_scene *sc = NULL;
+    lmgi_error err;
+    if (lmgi_load(path, o, &sc, &err) != LMGI_OK)
+        fail_msg("%s", err.message);
+    return sc;
+}
 
 /* A scene loaded as `lmgi run` loads it (lm_cli_run_options): the lightmap density its default texel budget
  * keeps up with and 16 texels at least on a wall, or target_texels (> 0) as `--texels` asks; open surfaces
@@ -46,11 +60,7 @@ static lmgi_scene *load_as_run(const char *path, int target_texels)
     lmgi_options_init(&o);
     o.target_texels = target_texels;
     lm_cli_run_options(&o, 0);
-    lmgi_scene *sc = NULL;
-    lmgi_error err;
-    if (lmgi_load(path, &o, &sc, &err) != LMGI_OK)
-        fail_msg("%s", err.message);
-    return sc;
+    return load_with(path, &o);
 }
 
 /* A scene lit by its emissive triangles alone, loaded as `lmgi check` loads it (as `lmgi run` does:
@@ -80,12 +90,24 @@ static void ref_settings(lm_ref_settings *rs, float target_error)
 
 static double lum(const double c[3]) { return c[0] + c[1] + c[2]; }
 
+/* How far a surface's frame f is off its reference r in its furthest channel, as `lmgi check` judges issue 33's
+ * criterion (src/cli/surface_error.c): each channel against the larger of its reference and 5% of the
+ * surface's brightest reference channel, so that a channel the surface hardly has (a green wall's red) is
+ * not judged by its noise; 0 for a black surface. */
+static double channel_off(const double f[3], const double r[3])
+{
+    double floor = 0.05 * fmax(r[0], fmax(r[1], r[2])), far = 0.0;
+    for (int k = 0; floor > 0.0 && k < 3; k++)
+        far = fmax(far, fabs(f[k] - r[k]) / fmax(r[k], floor));
+    return far;
+}
+
 /* Every surface with MIN_PIXELS compared pixels within SURFACE_TOL (of its own mean, or of the frame's
- * for surfaces darker than that: a dim face's few percent are a sliver of the picture), the frame within
- * `frame_tol` per channel, the relative RMSE under `rmse_bound`. */
+ * for surfaces darker than that: a dim face's few percent are a sliver of the picture) and, with channel_tol
+ * > 0, within that in each channel (channel_off: issue 33, item 4); the frame within `frame_tol` per channel,
+ * the relative RMSE under `rmse_bound`. */
 static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_check *c, double frame_tol,
-                         double surface_tol,
-                         double rmse_bound)
+                         double surface_tol, double rmse_bound, double channel_tol)
 {
     double mean = lum(c->lit.ref) / (c->lit.pixels ? c->lit.pixels : 1);
     print_message("%s: frame / reference %.3f %.3f %.3f over %u pixels, relative RMSE %.4f (reference se %.3f, "
@@ -97,12 +119,15 @@ static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_
             continue;
         double f = lum(sum->frame) / sum->pixels, r = lum(sum->ref) / sum->pixels;
         int asserted = sum->pixels >= MIN_PIXELS;
-        print_message("  surface %2d (%s, %s): %4u pixels, frame %.4g, reference %.4g (%+.1f%%)%s\n", s,
-                      sc->scene->nodes[sc->surfaces.surfaces[s].node].name,
+        print_message("  surface %2d (%s, %s): %4u pixels, frame %.4g, reference %.4g (%+.1f%%; per channel %.3f "
+                      "%.3f %.3f)%s\n", s, sc->scene->nodes[sc->surfaces.surfaces[s].node].name,
                       sc->scene->materials[sc->surfaces.surfaces[s].material].name, sum->pixels, f, r,
-                      r > 0.0 ? 100.0 * (f / r - 1.0) : 0.0, asserted ? "" : " (few pixels: not asserted)");
-        if (asserted)
+                      r > 0.0 ? 100.0 * (f / r - 1.0) : 0.0, lm_check_ratio(sum, 0), lm_check_ratio(sum, 1),
+                      lm_check_ratio(sum, 2), asserted ? "" : " (few pixels: not asserted)");
+        if (asserted) {
             assert_true(fabs(f - r) <= surface_tol * fmax(r, mean));
+            assert_true(!(channel_tol > 0.0) || channel_off(sum->frame, sum->ref) <= channel_tol); /* issue 33, item 4 */
+        }
     }
     for (int k = 0; k < 3; k++)
         if (c->lit.ref[k] > 0.05 * fmax(c->lit.ref[0], fmax(c->lit.ref[1], c->lit.ref[2])))
@@ -124,7 +149,7 @@ static lmgi_scene *run_check(const char *name, const char *path, double surface_
     lm_error err;
     if (lm_frame_check_run(sc, &ls, &rs, 1, c, &err) != LM_OK)
         fail_msg("%s: %s", name, err.msg);
-    assert_frame(name, sc, c, 0.03, surface_tol, rmse_bound);
+    assert_frame(name, sc, c, 0.03, surface_tol, rmse_bound, ref_error <= REF_ERROR ? CHANNEL_TOL : 0.0);
     return sc;
 }
 
@@ -186,7 +211,7 @@ static void check_small_box(const char *name, lmgi_scene *sc, const lm_frame_loo
     lm_error err;
     if (lm_frame_check_run(sc, ls, &rs, 1, &c, &err) != LM_OK)
         fail_msg("%s", err.msg);
-    assert_frame(name, sc, &c, 0.03, SURFACE_TOL, 0.06);
+    assert_frame(name, sc, &c, 0.03, SURFACE_TOL, 0.06, CHANNEL_TOL);
     assert_small_box(sc, &c, min_pixels, channel_tol);
     lm_frame_check_free(&c);
 }
@@ -312,59 +337,93 @@ static void test_near_and_far_hits(void **state)
     lmgi_free(sc);
 }
 
+/* Of sc's atlas, the texels of the small box's side faces whose centres lie in the first 20 mm above the floor
+ * (its units are millimetres): an atlas of those alone, for a reference of them (caller frees its texels). */
+static lm_atlas contact_texels(const lmgi_scene *sc, uint32_t **index)
+{
+    const lm_atlas *a = &sc->atlas;
+    lm_atlas sub = *a;
+    sub.texels = malloc(sizeof *sub.texels * (a->texel_count ? a->texel_count : 1));
+    *index = malloc(sizeof **index * (a->texel_count ? a->texel_count : 1));
+    assert_true(sub.texels && *index);
+    sub.texel_count = 0;
+    sub.footprint_first = NULL, sub.footprints = NULL, sub.footprint_count = 0; /* flat faces: none */
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        const lm_texel *t = &a->texels[i];
+        if (strcmp(sc->scene->nodes[sc->surfaces.surfaces[t->surface].node].name, "small.box") ||
+            fabsf(t->normal[1]) > 0.5f || t->pos[1] > 20.0f)
+            continue;
+        (*index)[sub.texel_count] = i;
+        sub.texels[sub.texel_count++] = *t;
+    }
+    return sub;
+}
+
+/* The luminance of iim (RGBA, sc's displayed IIM) over the reference's E_iim at each texel of sub (from
+ * contact_texels: index maps its texels to sc's): the least and the most, in *lo and *hi. */
+static void contact_range(const lmgi_scene *sc, const float *iim, const lm_atlas *sub, const uint32_t *index,
+                          const lm_ref_result *ref, double *lo, double *hi)
+{
+    *lo = INFINITY, *hi = 0.0;
+    for (uint32_t j = 0; j < sub->texel_count; j++) {
+        const lm_texel *t = &sc->atlas.texels[index[j]];
+        const float *v = iim + 4 * ((size_t)t->y * sc->atlas.width + t->x), *r = ref->iim + 3 * (size_t)j;
+        double q = (0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]) / (0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2]);
+        *lo = fmin(*lo, q), *hi = fmax(*hi, q);
+    }
+}
+
+/* The reference's texels of sub (contact_texels) at target error e, not cached (caller frees). */
+static void contact_reference(const lmgi_scene *sc, const lm_atlas *sub, float e, lm_ref_result *ref)
+{
+    lm_ref_settings rs;
+    lm_ref_settings_default(&rs);
+    rs.target_error = e;
+    rs.use_cache = 0;
+    rs.progress = 0;
+    lm_emitters em;
+    lm_error err;
+    assert_int_equal(lm_emitters_build(sc->scene, &em, &err), LM_OK);
+    assert_int_equal(lm_reference_texels(sc->scene, sub, sc->rt, &em, &rs, ref, &err), LM_OK);
+    lm_emitters_free(&em);
+}
+
 /* Issue 33 item 1's per-texel bound: the shared box's small box, its side faces' texels in the first 20 mm
- * above the floor, against the reference's texels (luminance). Their error is the rays gather's own noise,
- * fixed per texel by its strata's pattern: over its four side faces' 18 such texels, 0.84-1.20 of the
- * reference with 400 strata, 0.95-1.04 with 1,600 (docs/gather.md, "Strata"; the photons' count moves them
- * little). Loaded as `lmgi run` and `lmgi check` load it (load_as_check). */
+ * above the floor, against the reference's texels (luminance; those texels alone, at 0.01). Their error is the
+ * rays gather's own noise, fixed per texel by its strata's pattern: over its four side faces' 18 such texels,
+ * 0.80-1.23 of the reference with 400 strata, 0.90-1.03 with 1,600, and within 10% only with a bounce pass as
+ * well, 0.95-1.01 (docs/gather.md, "Strata"; the photons' count moves them little; against the whole atlas's
+ * reference at 0.02 they had read 0.84-1.20, 0.94-1.03 and 0.96-1.02). Loaded as `lmgi run` and `lmgi check`
+ * load it (load_as_check). */
 static void test_contact_texels_strata(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
     lm_frame_loop_settings ls;
     lmgi_scene *sc = load_as_check(path, &ls);
-    lm_error err;
     float *iim[3];
     iim[0] = first_iim(sc, &ls);
     ls.gather.ray_samples = 1600;
     iim[1] = first_iim(sc, &ls);
     ls.bounce_passes = 1; /* issue 33 item 1's setting (its faces: test_shared_cornell_box_direct_at_hits) */
     iim[2] = first_iim(sc, &ls);
-    lm_ref_settings rs;
-    lm_ref_settings_default(&rs);
-    rs.target_error = 0.02f;
-    rs.use_cache = 0;
-    rs.progress = 0;
-    lm_emitters em;
-    assert_int_equal(lm_emitters_build(sc->scene, &em, &err), LM_OK);
+    uint32_t *index;
+    lm_atlas sub = contact_texels(sc, &index);
     lm_ref_result ref;
-    const lm_atlas *a = &sc->atlas;
-    assert_int_equal(lm_reference_texels(sc->scene, a, sc->rt, &em, &rs, &ref, &err), LM_OK);
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {0.0, 0.0, 0.0};
-    int n = 0;
-    for (uint32_t i = 0; i < a->texel_count; i++) {
-        const lm_texel *t = &a->texels[i];
-        if (strcmp(sc->scene->nodes[sc->surfaces.surfaces[t->surface].node].name, "small.box") ||
-            fabsf(t->normal[1]) > 0.5f || t->pos[1] > 20.0f)
-            continue;
-        const float *r = ref.iim + 3 * (size_t)i;
-        double want = 0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2];
-        for (int k = 0; k < 3; k++) {
-            const float *v = iim[k] + 4 * ((size_t)t->y * a->width + t->x);
-            double q = (0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]) / want;
-            lo[k] = fmin(lo[k], q), hi[k] = fmax(hi[k], q);
-        }
-        n++;
-    }
-    print_message("the small box's %d texels in the first 20 mm: %.3f-%.3f of the reference with 400 strata, "
-                  "%.3f-%.3f with 1,600, %.3f-%.3f with 1,600 and a bounce pass\n", n, lo[0], hi[0], lo[1], hi[1],
-                  lo[2], hi[2]);
-    assert_true(n >= 8);
-    assert_true(lo[0] < 0.9 || hi[0] > 1.1); /* the noise this guards against (0.84-1.20 measured) */
-    assert_true(lo[1] > 0.9 && hi[1] < 1.1);
-    assert_true(lo[2] > 0.9 && hi[2] < 1.1);
+    contact_reference(sc, &sub, 0.01f, &ref);
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; k++)
+        contact_range(sc, iim[k], &sub, index, &ref, &lo[k], &hi[k]);
+    print_message("the small box's %u texels in the first 20 mm: %.3f-%.3f of the reference with 400 strata, "
+                  "%.3f-%.3f with 1,600, %.3f-%.3f with 1,600 and a bounce pass\n", sub.texel_count, lo[0], hi[0],
+                  lo[1], hi[1], lo[2], hi[2]);
+    assert_true(sub.texel_count >= 8);
+    assert_true(lo[0] < 0.9 || hi[0] > 1.1); /* the noise this guards against (0.80-1.23 measured) */
+    assert_true(hi[1] - lo[1] < 0.5 * (hi[0] - lo[0])); /* 1,600 strata: 0.90-1.03 */
+    assert_true(lo[2] > 0.9 && hi[2] < 1.1); /* and the bounce pass: 0.95-1.01 */
     lm_ref_result_free(&ref);
-    lm_emitters_free(&em);
+    free(sub.texels);
+    free(index);
     for (int k = 0; k < 3; k++)
         free(iim[k]);
     lmgi_free(sc);
@@ -479,19 +538,44 @@ static void test_cornell_suzanne_bounce_pass(void **state)
     lm_error err;
     if (lm_frame_check_run(sc, &ls, &rs, 1, &c, &err) != LM_OK)
         fail_msg("%s", err.msg);
-    assert_frame("cornell-suzanne after a bounce pass", sc, &c, 0.03, 0.06, 0.1);
+    assert_frame("cornell-suzanne after a bounce pass", sc, &c, 0.03, 0.06, 0.1, CHANNEL_TOL);
     lm_frame_check_free(&c);
     lmgi_free(sc);
 }
 
-/* The displayed IIM (what `lmgi run` exports as iim.exr, before invalid texels are filled) against the
- * reference's E_iim: per surface over its valid texels, asserted for surfaces of at least min_texels. */
-static void check_iim(const char *path, int target_texels, float ref_error, uint32_t min_texels)
+/* Per surface of sc's atlas, over its valid texels of iim (RGBA, the displayed IIM) and the reference's E_iim:
+ * the means per channel, the texel count (caller frees the three). */
+static void surface_means(const lmgi_scene *sc, const float *iim, const uint8_t *valid, const lm_ref_result *ref,
+                          double **est_mean, double **ref_mean, uint32_t **count)
 {
-    lmgi_scene *sc = load_as_run(path, target_texels);
-    lm_frame_loop_settings ls;
-    lm_frame_loop_settings_default(&ls);
-    float *rgba = first_iim(sc, &ls);
+    const lm_atlas *a = &sc->atlas;
+    int S = sc->surfaces.surface_count;
+    *est_mean = calloc(3 * (size_t)S, sizeof(double));
+    *ref_mean = calloc(3 * (size_t)S, sizeof(double));
+    *count = calloc((size_t)S, sizeof(uint32_t));
+    assert_true(*est_mean && *ref_mean && *count);
+    for (uint32_t i = 0; i < a->texel_count; i++) {
+        int s = a->texels[i].surface;
+        if (!valid[i] || s < 0)
+            continue;
+        const float *v = iim + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
+        for (int k = 0; k < 3; k++)
+            (*est_mean)[3 * s + k] += v[k], (*ref_mean)[3 * s + k] += ref->iim[3 * i + k];
+        (*count)[s]++;
+    }
+    for (int s = 0; s < S; s++)
+        for (int k = 0; (*count)[s] && k < 3; k++)
+            (*est_mean)[3 * s + k] /= (*count)[s], (*ref_mean)[3 * s + k] /= (*count)[s];
+}
+
+/* The displayed IIM (what `lmgi run` exports as iim.exr, before invalid texels are filled) of sc's first full
+ * solution under ls against the reference's E_iim: per surface over its valid texels, asserted for surfaces of
+ * at least min_texels; with box_tol > 0, every face of the small box of 100+ texels per channel within box_tol
+ * too (issue 33, item 1). */
+static void check_iim(lmgi_scene *sc, lm_frame_loop_settings *ls, float ref_error, uint32_t min_texels,
+                      double box_tol)
+{
+    float *rgba = first_iim(sc, ls);
     lm_error err;
     lm_ref_settings rs;
     ref_settings(&rs, ref_error);
@@ -507,7 +591,7 @@ static void check_iim(const char *path, int target_texels, float ref_error, uint
     uint32_t n_valid = 0;
     for (uint32_t i = 0; i < a->texel_count; i++) {
         const float *v = rgba + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
-        valid[i] = !(v[3] > ls.gather.backface_limit);
+        valid[i] = !(v[3] > ls->gather.backface_limit);
         memcpy(est + 3 * i, v, 3 * sizeof(float));
         if (valid[i])
             all += ref.iim[3 * i] + ref.iim[3 * i + 1] + ref.iim[3 * i + 2], n_valid++;
@@ -516,31 +600,34 @@ static void check_iim(const char *path, int target_texels, float ref_error, uint
     double rmse = lm_ref_relative_rmse(est, ref.iim, valid, a->texel_count, 3);
     print_message("IIM at %u texels: %u valid, relative RMSE %.4f (reference se %.3f, %.1f s)\n", a->texel_count,
                   n_valid, rmse, ref.mean_rel_se, ref.seconds);
+    double *e, *r;
+    uint32_t *n;
+    surface_means(sc, rgba, valid, &ref, &e, &r, &n);
+    int box_faces = 0;
     for (int s = 0; s < sc->surfaces.surface_count; s++) {
-        double e = 0.0, r = 0.0;
-        uint32_t n = 0;
-        for (uint32_t i = 0; i < a->texel_count; i++)
-            if (valid[i] && a->texels[i].surface == s) {
-                for (int k = 0; k < 3; k++)
-                    e += est[3 * i + k], r += ref.iim[3 * i + k];
-                n++;
-            }
-        if (n < 100)
+        if (n[s] < 100)
             continue;
-        e /= n, r /= n;
-        print_message("  surface %2d (%s): %5u texels, E %.4g, reference %.4g (%+.1f%%)%s\n", s,
-                      sc->scene->nodes[sc->surfaces.surfaces[s].node].name, n, e, r,
-                      r > 0.0 ? 100.0 * (e / r - 1.0) : 0.0, n >= min_texels ? "" : " (not asserted)");
-        if (n >= min_texels)
-            assert_true(fabs(e - r) <= SURFACE_TOL * fmax(r, all));
+        double es = e[3 * s] + e[3 * s + 1] + e[3 * s + 2], rs3 = r[3 * s] + r[3 * s + 1] + r[3 * s + 2];
+        int box = !strcmp(sc->scene->nodes[sc->surfaces.surfaces[s].node].name, "small.box");
+        print_message("  surface %2d (%s): %5u texels, E %.4g, reference %.4g (%+.1f%%; per channel %.3f %.3f %.3f)%s\n",
+                      s, sc->scene->nodes[sc->surfaces.surfaces[s].node].name, n[s], es / 3, rs3 / 3,
+                      rs3 > 0.0 ? 100.0 * (es / rs3 - 1.0) : 0.0, e[3 * s] / r[3 * s], e[3 * s + 1] / r[3 * s + 1],
+                      e[3 * s + 2] / r[3 * s + 2], n[s] >= min_texels ? "" : " (not asserted)");
+        if (n[s] >= min_texels)
+            assert_true(fabs(es - rs3) / 3 <= SURFACE_TOL * fmax(rs3 / 3, all / 3));
+        if (box && box_tol > 0.0 && rs3 > 0.0) /* lit: the face under the box is not */
+            assert_true(channel_off(e + 3 * s, r + 3 * s) <= box_tol), box_faces++;
     }
+    assert_true(box_tol == 0.0 || box_faces >= 4);
     assert_true(rmse < 0.1);
+    free(e);
+    free(r);
+    free(n);
     free(valid);
     free(est);
     free(rgba);
     lm_ref_result_free(&ref);
     lm_emitters_free(&em);
-    lmgi_free(sc);
 }
 
 /* Measured: run density (1,964 texels) every surface of 100 texels or more (walls, floor, ceiling) within
@@ -549,20 +636,47 @@ static void test_iim_run_density(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
-    check_iim(path, 0, REF_ERROR, 100);
+    lmgi_scene *sc = load_as_run(path, 0);
+    lm_frame_loop_settings ls;
+    lm_frame_loop_settings_default(&ls);
+    check_iim(sc, &ls, REF_ERROR, 100, 0.0);
+    lmgi_free(sc);
+}
+
+/* A scene loaded as `lmgi bake` loads it (the loader's own density) and the settings its first full solution
+ * resolves from a bake's (src/cli/bake_options.h: 4 photons a texel, a bounce pass). */
+static lmgi_scene *load_as_bake(const char *path, lm_frame_loop_settings *ls)
+{
+    lmgi_options o;
+    lmgi_options_init(&o);
+    lmgi_scene *sc = load_with(path, &o);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    lm_cli_bake_solution(&in, 1, &d);
+    lm_error err;
+    if (lm_updater_settings(sc->scene, &d, NULL, ls, &err) != LM_OK)
+        fail_msg("%s", err.msg);
+    assert_int_equal(ls->bounce_passes, LM_CLI_BAKE_BOUNCE_PASSES);
+    return sc;
 }
 
 /* At 66,816 texels, with the photon count `lmgi run` took before the scene's floor (11,520): walls, floor
  * and ceiling within 2%, relative RMSE 0.053; the boxes' faces (529 to 1,035 texels) read -6% to +10%,
- * the AIM's photon noise where they meet the floor (within 2% with 200k photons), so they are reported,
- * not asserted. With the floor (46,080) and N = 32: relative RMSE 0.051. The
- * reference's 0.05 is enough for means over thousands of texels (this scene has no rare bright paths:
- * its light is an area light). */
+ * the AIM's photon noise where they meet the floor (within 2% with 200k photons). Loaded and solved as
+ * `lmgi bake` solves it (load_as_bake: 4 photons a texel, a bounce pass), the small box's lit faces are issue
+ * 33's item 1 at a bake's density: each within 2% per channel (measured within 0.7%; `lmgi check
+ * --as-bake`'s frame at 7 of 8 seeds, docs/gather.md, "Strata"). The reference's 0.05 is enough for means
+ * over hundreds of texels (this scene has no rare bright paths: its light is an area light). */
 static void test_iim_bake_density(void **state)
 {
     (void)state;
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
-    check_iim(path, LM_ATLAS_DEFAULT_TEXELS, 0.05f, 2000);
+    lm_frame_loop_settings ls;
+    lmgi_scene *sc = load_as_bake(path, &ls);
+    check_iim(sc, &ls, 0.05f, 2000, ITEM_1_TOL);
+    lmgi_free(sc);
 }
 
 int main(void)
