@@ -163,8 +163,9 @@ $(BUILD)/tests/test_soak: $(BUILD)/obj/src/cli/random_edits.o $(BUILD)/obj/src/c
 $(BUILD)/tests/test_surface_error: $(BUILD)/obj/src/cli/surface_error.o
 
 # The frame checks load scenes as `lmgi run`, `lmgi check` and `lmgi bake` do (src/cli/run_options.c,
-# bake_options.c).
-$(BUILD)/tests/test_frame_check: $(BUILD)/obj/src/cli/run_options.o $(BUILD)/obj/src/cli/bake_options.o
+# bake_options.c) and judge a surface's channels as `lmgi check` does (surface_error.c).
+$(BUILD)/tests/test_frame_check: $(BUILD)/obj/src/cli/run_options.o $(BUILD)/obj/src/cli/bake_options.o \
+	$(BUILD)/obj/src/cli/surface_error.o
 
 # The viewer's camera and views (src/cli/view_camera.c, view_maps.c)
 $(BUILD)/tests/test_view_camera: $(BUILD)/obj/src/cli/view_camera.o

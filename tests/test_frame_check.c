@@ -28,6 +28,7 @@
 #include "../src/api/lmgi_updater.h"
 #include "../src/cli/bake_options.h"
 #include "../src/cli/run_options.h"
+#include "../src/cli/surface_error.h"
 #include "../src/reference/reference.h"
 #include "support.h"
 
@@ -38,7 +39,7 @@
                            * unless a scene says otherwise */
 #define BLOCK_RMSE 0.1   /* cornell-suzanne's textured block, per pixel (test_cornell_suzanne) */
 #define MIN_PIXELS 100    /* surfaces with fewer compared pixels are reported, not asserted */
-#define CHANNEL_TOL 0.05  /* issue 33's per-surface criterion, per channel (channel_off), asserted against
+#define CHANNEL_TOL 0.05  /* issue 33's per-surface criterion, per channel (lm_cli_channel_off), asserted against
                            * references of REF_ERROR or finer: at REF_ERROR_RARE the generated box's dynamic cube
                            * face (100 pixels) reads G +6.0% within its reference's own noise */
 
@@ -90,21 +91,9 @@ static void ref_settings(lm_ref_settings *rs, float target_error)
 
 static double lum(const double c[3]) { return c[0] + c[1] + c[2]; }
 
-/* How far a surface's frame f is off its reference r in its furthest channel, as `lmgi check` judges issue 33's
- * criterion (src/cli/surface_error.c): each channel against the larger of its reference and 5% of the
- * surface's brightest reference channel, so that a channel the surface hardly has (a green wall's red) is
- * not judged by its noise; 0 for a black surface. */
-static double channel_off(const double f[3], const double r[3])
-{
-    double floor = 0.05 * fmax(r[0], fmax(r[1], r[2])), far = 0.0;
-    for (int k = 0; floor > 0.0 && k < 3; k++)
-        far = fmax(far, fabs(f[k] - r[k]) / fmax(r[k], floor));
-    return far;
-}
-
 /* Every surface with MIN_PIXELS compared pixels within SURFACE_TOL (of its own mean, or of the frame's
  * for surfaces darker than that: a dim face's few percent are a sliver of the picture) and, with channel_tol
- * > 0, within that in each channel (channel_off: issue 33, item 4); the frame within `frame_tol` per channel,
+ * > 0, within that in each channel as `lmgi check` judges it (lm_cli_channel_off: issue 33, item 4); the frame within `frame_tol` per channel,
  * the relative RMSE under `rmse_bound`. */
 static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_check *c, double frame_tol,
                          double surface_tol, double rmse_bound, double channel_tol)
@@ -126,7 +115,7 @@ static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_
                       lm_check_ratio(sum, 2), asserted ? "" : " (few pixels: not asserted)");
         if (asserted) {
             assert_true(fabs(f - r) <= surface_tol * fmax(r, mean));
-            assert_true(!(channel_tol > 0.0) || channel_off(sum->frame, sum->ref) <= channel_tol); /* issue 33, item 4 */
+            assert_true(!(channel_tol > 0.0) || lm_cli_channel_off(sum->frame, sum->ref, NULL) <= channel_tol); /* issue 33, item 4 */
         }
     }
     for (int k = 0; k < 3; k++)
@@ -616,7 +605,7 @@ static void check_iim(lmgi_scene *sc, lm_frame_loop_settings *ls, float ref_erro
         if (n[s] >= min_texels)
             assert_true(fabs(es - rs3) / 3 <= SURFACE_TOL * fmax(rs3 / 3, all / 3));
         if (box && box_tol > 0.0 && rs3 > 0.0) /* lit: the face under the box is not */
-            assert_true(channel_off(e + 3 * s, r + 3 * s) <= box_tol), box_faces++;
+            assert_true(lm_cli_channel_off(e + 3 * s, r + 3 * s, NULL) <= box_tol), box_faces++;
     }
     assert_true(box_tol == 0.0 || box_faces >= 4);
     assert_true(rmse < 0.1);

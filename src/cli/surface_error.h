@@ -23,5 +23,9 @@ typedef struct {
     double worst_ratio; /* that channel's frame / reference - 1 */
 } lm_cli_channel_check;
 void lm_cli_surface_channels(const lmgi_scene *sc, const lmgi_check_result *c, double tol, lm_cli_channel_check *out);
+/* That criterion for one surface's frame and reference means (rgb): the largest of its per-channel errors, and
+ * into *channel (may be NULL) the first channel that has it; -1 (and channel -1) for a black reference, which
+ * is not judged. What lm_cli_surface_channels reads each surface by, and tests/test_frame_check.c too. */
+double lm_cli_channel_off(const double frame[3], const double ref[3], int *channel);
 
 #endif
