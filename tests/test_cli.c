@@ -1098,6 +1098,17 @@ static void test_bench_edits(void **state)
     assert_non_null(strstr(output, "edit 0: no light on that node"));
 }
 
+/* `lmgi check`'s row over the frame in the last command's output: frame / reference per channel into c, and
+ * its compared pixels (returned). */
+static unsigned check_frame_row(double c[3])
+{
+    const char *row = strstr(output, "frame (not emitters)");
+    assert_non_null(row);
+    unsigned pixels;
+    assert_int_equal(sscanf(row + strlen("frame (not emitters)"), "%u %lf %lf %lf", &pixels, &c[0], &c[1], &c[2]), 4);
+    return pixels;
+}
+
 /* `lmgi reference` writes the atlas-sized texel images and the picture, and `lmgi check` compares a frame
  * with the reference: the frame within 10% of it over the lit pixels at these small settings. */
 static void test_reference_and_check_commands(void **state)
@@ -1134,14 +1145,11 @@ static void test_reference_and_check_commands(void **state)
     snprintf(args, sizeof args, "check scenes/cornell.glb --texels 800 --size 32x32 --photons 6000 --hemicube 16 "
              "--target-error 0.1 --no-cache --out %s/check -q", dir);
     assert_int_equal(run(args), 0);
-    const char *row = strstr(output, "frame (not emitters)");
-    assert_non_null(row);
-    unsigned pixels;
-    double r, g, b;
-    assert_int_equal(sscanf(row + strlen("frame (not emitters)"), "%u %lf %lf %lf", &pixels, &r, &g, &b), 4);
-    print_message("lmgi check at 32 x 32: %u pixels, frame / reference %.3f %.3f %.3f\n", pixels, r, g, b);
+    double c[3];
+    unsigned pixels = check_frame_row(c);
+    print_message("lmgi check at 32 x 32: %u pixels, frame / reference %.3f %.3f %.3f\n", pixels, c[0], c[1], c[2]);
     assert_true(pixels > 100);
-    assert_true(fabs(r - 1.0) < 0.1 && fabs(g - 1.0) < 0.1 && fabs(b - 1.0) < 0.1);
+    assert_true(fabs(c[0] - 1.0) < 0.1 && fabs(c[1] - 1.0) < 0.1 && fabs(c[2] - 1.0) < 0.1);
     const char *per_channel = strstr(output, "per channel: "); /* the summary of issue 33's criterion */
     int within, judged;
     assert_non_null(per_channel);
@@ -1223,12 +1231,8 @@ static void test_check_as_bake(void **state)
             assert_int_equal(photons, 4 * texels);
             assert_int_equal(passes, 1);
         }
-        const char *row = strstr(output, "frame (not emitters)");
-        assert_non_null(row);
-        unsigned pixels;
         double c[3];
-        assert_int_equal(sscanf(row + strlen("frame (not emitters)"), "%u %lf %lf %lf", &pixels, &c[0], &c[1], &c[2]),
-                         4);
+        check_frame_row(c);
         for (int i = 0; i < 3; i++)
             assert_true(fabs(c[i] - 1.0) < 0.05);
     }

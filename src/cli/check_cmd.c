@@ -101,6 +101,21 @@ static int write_images(lmgi_output *dir, const lmgi_check_result *c)
     return st == LMGI_OK;
 }
 
+/* --as-bake: the updater's desc as lmgi bake makes it (bake_options.h), said in a line above the table. */
+static void bake_desc(const lm_cli_args *a, const lmgi_scene *sc, lmgi_updater_desc *d)
+{
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    lm_cli_updater_desc(a, d);
+    lm_cli_bake_solution(&in, 1, d);
+    printf("the lightmap as lmgi bake makes it: %u texels, ", in.texels);
+    if (d->photons.count)
+        printf("%u photons, ", d->photons.count);
+    else
+        printf("%u photons a group, ", d->photons.per_group);
+    printf("%d bounce pass%s\n", d->gather.bounce_passes, d->gather.bounce_passes == 1 ? "" : "es");
+}
+
 int lm_cli_check(const lm_cli_args *a)
 {
     if (a->file_count != 1) {
@@ -109,8 +124,8 @@ int lm_cli_check(const lm_cli_args *a)
         return 2;
     }
     lmgi_scene *sc = NULL;
-    lmgi_options bake_density = a->options; /* --as-bake: the loader's own density, as bake loads */
-    if (a->as_bake ? !lm_cli_load_scene(a->files[0], &bake_density, 1, &sc) : !lm_cli_run_load(a, &sc))
+    /* --as-bake: the loader's own density, as bake loads */
+    if (a->as_bake ? !lm_cli_load_scene(a->files[0], &a->options, 1, &sc) : !lm_cli_run_load(a, &sc))
         return 1;
     if (lm_cli_scene_unlit(sc)) { /* black against black reads 1.000 everywhere: a check of nothing */
         fprintf(stderr, "lmgi: error: %s: nothing to check: the scene has no light, so frame and reference are "
@@ -124,20 +139,10 @@ int lm_cli_check(const lm_cli_args *a)
         return 1;
     }
     lmgi_updater_desc d;
-    if (a->as_bake) {
-        lmgi_info in;
-        lmgi_get_info(sc, &in);
-        lm_cli_updater_desc(a, &d);
-        lm_cli_bake_solution(&in, 1, &d);
-        printf("the lightmap as lmgi bake makes it: %u texels, ", in.texels);
-        if (d.photons.count)
-            printf("%u photons, ", d.photons.count);
-        else
-            printf("%u photons a group, ", d.photons.per_group);
-        printf("%d bounce pass%s\n", d.gather.bounce_passes, d.gather.bounce_passes == 1 ? "" : "es");
-    } else {
+    if (a->as_bake)
+        bake_desc(a, sc, &d);
+    else
         lm_cli_run_desc(a, sc, &d);
-    }
     d.progress = NULL;
     if (!a->width)
         d.frame.width = d.frame.height = 0; /* lmgi_check's picture: the reference's pixels take seconds */
