@@ -137,6 +137,12 @@ static inline int lmgi_knob_is_pow2(double v)
       "shadows, about 5x slower AIMs; the rays gather computes it at its near\n"                                 \
       "hits, --direct-near) or all (every light's); default: emitters and the\n"                                 \
       "rays gather where emissive triangles alone light the scene, else suns")                                    \
+    X(aim, direct_parts, LMGI_KNOB_INT, int, 2, 1, 8, 0, LMGI_NO_RULE, "--direct-parts", "P", LMGI_CLI_ZERO_NONE,  \
+      LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                                              \
+      "the AIMs' computed direct light averaged over P x P parts of each texel\n"                                 \
+      "(1 to 8; default 2, lmgi bake 4): near a lamp it falls off within a\n"                                     \
+      "texel; more parts cost a direct-light evaluation each and spread a\n"                                      \
+      "contact shadow over its texel (docs/aim.md, \"Averaged over the texel\")")                                 \
     X(aim, occluders, LMGI_KNOB_SWITCH, int, LMGI_OFF, 0, 0, 1, LMGI_NO_RULE, "--aim-occluders", "on|off",         \
       LMGI_CLI_ZERO_NONE, LMGI_ON_OFF_CHOICES,                                                                     \
       LMGI_SWEEP(16, "aim_occluders", "AIM hits seen from the texel (0 off, 1 on)", (0, 1), (), 0),           \

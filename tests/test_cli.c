@@ -1205,7 +1205,7 @@ static void test_check_levels_per_channel(void **state)
 }
 
 /* `lmgi check --as-bake` checks the lightmap `lmgi bake` makes (src/cli/bake_options.h): 4 photons a texel
- * (at least 46,080) and a bounce pass, which it says; plain `check` solves as `run` does, with neither. The
+ * (at least 46,080), a bounce pass and the AIMs' direct light over 4 x 4 parts a texel, which it says; plain `check` solves as `run` does, with neither. The
  * frame is right either way (measured at 32 x 32: 0.99-1.01 per channel). */
 static void test_check_as_bake(void **state)
 {
@@ -1222,14 +1222,17 @@ static void test_check_as_bake(void **state)
             assert_null(line);
         } else {
             unsigned texels, photons;
-            int passes;
+            int passes, parts[2];
             assert_non_null(line);
-            assert_int_equal(sscanf(line, "the lightmap as lmgi bake makes it: %u texels, %u photons, %d bounce pass",
-                                    &texels, &photons, &passes), 3);
-            print_message("check --as-bake: %u texels, %u photons, %d bounce pass\n", texels, photons, passes);
+            assert_int_equal(sscanf(line, "the lightmap as lmgi bake makes it: %u texels, %u photons, %d bounce pass, "
+                                          "direct light over %d x %d parts a texel",
+                                    &texels, &photons, &passes, &parts[0], &parts[1]), 5);
+            print_message("check --as-bake: %u texels, %u photons, %d bounce pass, %d x %d direct parts\n", texels,
+                          photons, passes, parts[0], parts[1]);
             assert_true(texels > 9000 && texels < 15000);
             assert_int_equal(photons, 4 * texels);
             assert_int_equal(passes, 1);
+            assert_int_equal(parts[0], 4);
         }
         double c[3];
         check_frame_row(c);

@@ -113,7 +113,12 @@ static void bake_desc(const lm_cli_args *a, const lmgi_scene *sc, lmgi_updater_d
         printf("%u photons, ", d->photons.count);
     else
         printf("%u photons a group, ", d->photons.per_group);
-    printf("%d bounce pass%s\n", d->gather.bounce_passes, d->gather.bounce_passes == 1 ? "" : "es");
+    int passes = d->gather.bounce_passes == LMGI_OFF ? 0 : d->gather.bounce_passes;
+    if (passes)
+        printf("%d bounce pass%s, ", passes, passes == 1 ? "" : "es");
+    else
+        printf("no bounce pass, ");
+    printf("direct light over %d x %d parts a texel\n", d->aim.direct_parts, d->aim.direct_parts);
 }
 
 int lm_cli_check(const lm_cli_args *a)

@@ -29,6 +29,7 @@ void lm_aim_settings_default(lm_aim_settings *o)
     o->error_estimate = 0;
     o->dense = 1;
     o->seams = 1;
+    o->direct_parts = LM_AIM_DIRECT_PARTS;
     o->max_hits = 0;
 }
 
@@ -202,10 +203,13 @@ static lm_status build_edges(lm_aim *aim, const lm_scene *s, const lm_surfaces *
 static lm_status check_settings(const lm_aim_settings *o, lm_error *err)
 {
     if (o->n_nearest < 1 || !(o->min_radius_texels > 0.0f) || !isfinite(o->min_radius_texels) ||
-        !(o->delta_threshold >= 0.0f) || !isfinite(o->delta_threshold))
+        !(o->delta_threshold >= 0.0f) || !isfinite(o->delta_threshold) || o->direct_parts < 1 ||
+        o->direct_parts > LM_AIM_DIRECT_PARTS_MAX)
         return lm_fail(err, LM_ERR_INVALID,
-                       "AIM settings: n_nearest %d (>= 1), min_radius_texels %g (> 0), delta_threshold %g (>= 0)",
-                       o->n_nearest, (double)o->min_radius_texels, (double)o->delta_threshold);
+                       "AIM settings: n_nearest %d (>= 1), min_radius_texels %g (> 0), delta_threshold %g (>= 0), "
+                       "direct_parts %d (1 to %d)",
+                       o->n_nearest, (double)o->min_radius_texels, (double)o->delta_threshold, o->direct_parts,
+                       LM_AIM_DIRECT_PARTS_MAX);
     return LM_OK;
 }
 
@@ -698,6 +702,7 @@ typedef struct {
     double rmin2_world;   /* squared smallest radius, world units */
     int boundary_correction, kernel;
     const lm_direct_light *direct; /* NULL: no direct light added */
+    int direct_parts;     /* the direct light's parts a side (lm_aim_settings.direct_parts) */
     const float *world;   /* the node's world matrix (texel positions for the direct light and the sight) */
     int two_sided;        /* double-sided material: direct light on both sides */
     lm_aim_sight sight;   /* the visibility test (aim_sight.h; rt NULL: none) */
@@ -955,8 +960,9 @@ static void photon_irradiance(const estimate_job *j, const lm_texel *t, uint32_t
 static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index, texel_scratch *ts, double e[3],
                        double direct[3])
 {
-    float local[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS][3], share[LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS];
-    int n = lm_texel_parts(j->s, j->a, t, LM_AIM_DIRECT_PARTS, local, share);
+    float local[LM_AIM_DIRECT_PARTS_MAX * LM_AIM_DIRECT_PARTS_MAX][3];
+    float share[LM_AIM_DIRECT_PARTS_MAX * LM_AIM_DIRECT_PARTS_MAX];
+    int n = lm_texel_parts(j->s, j->a, t, j->direct_parts, local, share);
     if (n == 0) { /* a degenerate triangle: its centroid */
         memcpy(local[0], t->local, sizeof local[0]);
         share[0] = 1.0f;
@@ -969,7 +975,7 @@ static void add_direct(const estimate_job *j, const lm_texel *t, uint32_t index,
     for (int i = 0; i < n; i++) {
         float p[3], d[3];
         lm_v3_store(p, lm_mat4_point(j->world, lm_v3_load(local[i])));
-        uint32_t seed = index * (LM_AIM_DIRECT_PARTS * LM_AIM_DIRECT_PARTS) + (uint32_t)i;
+        uint32_t seed = index * (uint32_t)(j->direct_parts * j->direct_parts) + (uint32_t)i;
         if (!lm_direct_irradiance(j->direct, t->surface, p, tf->n_world, ns, j->two_sided, seed, d))
             continue;
         seen += share[i];
@@ -1324,7 +1330,7 @@ static void prepare_surface(const lm_aim *aim, const lm_scene *s, const lm_surfa
     uint32_t n = (uint32_t)aim->set.n_nearest < sj->hits.count ? (uint32_t)aim->set.n_nearest : sj->hits.count;
     double rmin = smallest_radius(aim, a, sj->hits.count);
     sj->job = (estimate_job){s, a, &sj->tree, &sj->hits, &sj->L, {sj->edge_ends, sj->edge_count}, n, rmin * rmin,
-                             aim->set.boundary_correction, aim->set.kernel, aim->direct,
+                             aim->set.boundary_correction, aim->set.kernel, aim->direct, aim->set.direct_parts,
                              s->nodes[sf->node].world, m->double_sided,
                              {aim->occluders, aim->occluder_lift,
                               lm_cover_reach(aim->occluder_cover, aim->occluder_cover_by_surface, sj->surface),

@@ -61,6 +61,8 @@ typedef struct {
     int seams;               /* 1 (default): near its boundary a surface's estimate also uses the hits of the
                               * surfaces that continue it across a seam (seams.h), and the disc's area is taken
                               * on them all; 0: its own hits only, the paper's */
+    int direct_parts;        /* with lm_aim_set_direct: the direct light is averaged over direct_parts^2 parts of
+                              * each texel, 1 to LM_AIM_DIRECT_PARTS_MAX (default LM_AIM_DIRECT_PARTS; see there) */
     uint64_t max_hits;       /* a refresh with a budget (lm_aim_refresh) stops before a surface that would take its
                               * surfaces' stored hits past this (the first is always refreshed): the hits
                               * bound its cost, and they grow with every light added (default 0: no bound) */
@@ -150,10 +152,13 @@ const float *lm_aim_rest_dilated_rgba(const lm_aim *aim);
  * is given) counts that side's hits untested: it is hidden, not dark. NULL rt: every hit counts (the
  * paper's). rt and cover_by_surface are borrowed. */
 void lm_aim_set_occluders(lm_aim *aim, const lm_rt *rt, float lift, float cover, const float *cover_by_surface);
-/* The direct light is averaged over this many squared parts of a texel (lm_texel_parts; covered parts
- * left out): near a lamp it falls off within a texel, and the centroid's value alone lost energy the
- * hemicube should see (4.8% of the suzanne Cornell box's ceiling, docs/aim.md). */
+/* The direct light is averaged over this many squared parts of a texel by default (lm_texel_parts; covered
+ * parts left out): near a lamp it falls off within a texel, and the centroid's value alone lost energy the
+ * hemicube should see (4.8% of the suzanne Cornell box's ceiling, docs/aim.md). More parts cost one more
+ * direct-light evaluation each and blur a contact shadow over the texel; a bake asks for more
+ * (lm_aim_settings.direct_parts, docs/aim.md "Averaged over the texel"). */
 #define LM_AIM_DIRECT_PARTS 2
+#define LM_AIM_DIRECT_PARTS_MAX 8
 
 /* For the per-pixel photon gathers (pixel_gather.h, gpu/tiled/photon_gather.h), which sum one constant radius r
  * (world units) with the kernel min(c, 1 - s / r), c = 1/5: per atlas texel, the part of that kernel's
