@@ -654,8 +654,8 @@ static lmgi_scene *load_as_bake(const char *path, lm_frame_loop_settings *ls)
 /* At 66,816 texels, with the photon count `lmgi run` took before the scene's floor (11,520): walls, floor
  * and ceiling within 2%, relative RMSE 0.053; the boxes' faces (529 to 1,035 texels) read -6% to +10%,
  * the AIM's photon noise where they meet the floor (within 2% with 200k photons). Loaded and solved as
- * `lmgi bake` solves it (load_as_bake: 4 photons a texel, a bounce pass), the small box's lit faces are issue
- * 33's item 1 at a bake's density: each within 2% per channel (measured within 0.7%; `lmgi check
+ * `lmgi bake` solves it (load_as_bake: 4 photons a texel, a bounce pass, 4 x 4 direct parts), the small box's
+ * lit faces are issue 33's item 1 at a bake's density: each within 2% per channel (measured within 0.9%; `lmgi check
  * --as-bake`'s frame at 7 of 8 seeds, docs/gather.md, "Strata"). The reference's 0.05 is enough for means
  * over hundreds of texels (this scene has no rare bright paths: its light is an area light). */
 static void test_iim_bake_density(void **state)
