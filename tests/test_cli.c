@@ -1205,8 +1205,9 @@ static void test_check_levels_per_channel(void **state)
 }
 
 /* `lmgi check --as-bake` checks the lightmap `lmgi bake` makes (src/cli/bake_options.h): 4 photons a texel
- * (at least 46,080), a bounce pass and the AIMs' direct light over 4 x 4 parts a texel, which it says; plain `check` solves as `run` does, with neither. The
- * frame is right either way (measured at 32 x 32: 0.99-1.01 per channel). */
+ * (at least 46,080), a bounce pass and the AIMs' direct light over 4 x 4 parts a texel, which it says; plain
+ * `check` solves as `run` does, with none of them. The frame is right either way (measured at 32 x 32:
+ * 0.99-1.01 per channel). */
 static void test_check_as_bake(void **state)
 {
     (void)state;
