@@ -94,6 +94,8 @@ static void photon_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *
     s->stage.aim.min_radius_texels = r->aim.min_radius;
     s->stage.surfaces_per_frame = r->aim.surfaces_per_frame; /* LMGI_OFF: -1, all that changed */
     s->stage.exact_direct = lm_exact_direct_of(r->aim.direct);
+    /* lmgi_knobs.h's aim.direct_parts: its default and its most are the AIM's own */
+    _Static_assert(LM_AIM_DIRECT_PARTS == 2 && LM_AIM_DIRECT_PARTS_MAX == 8, "aim.direct_parts' table line");
     s->stage.aim.direct_parts = r->aim.direct_parts;
     s->stage.aim.error_estimate = r->aim.error_estimate == LMGI_ON;
     s->stage.occluders = r->aim.occluders == LMGI_ON;
