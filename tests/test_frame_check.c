@@ -93,8 +93,8 @@ static double lum(const double c[3]) { return c[0] + c[1] + c[2]; }
 
 /* Every surface with MIN_PIXELS compared pixels within SURFACE_TOL (of its own mean, or of the frame's
  * for surfaces darker than that: a dim face's few percent are a sliver of the picture) and, with channel_tol
- * > 0, within that in each channel as `lmgi check` judges it (lm_cli_channel_off: issue 33, item 4); the frame within `frame_tol` per channel,
- * the relative RMSE under `rmse_bound`. */
+ * > 0, within that in each channel as `lmgi check` judges it (lm_cli_channel_off: issue 33, item 4); the
+ * frame within `frame_tol` per channel, the relative RMSE under `rmse_bound`. */
 static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_check *c, double frame_tol,
                          double surface_tol, double rmse_bound, double channel_tol)
 {
@@ -115,7 +115,8 @@ static void assert_frame(const char *name, const lmgi_scene *sc, const lm_frame_
                       lm_check_ratio(sum, 2), asserted ? "" : " (few pixels: not asserted)");
         if (asserted) {
             assert_true(fabs(f - r) <= surface_tol * fmax(r, mean));
-            assert_true(!(channel_tol > 0.0) || lm_cli_channel_off(sum->frame, sum->ref, NULL) <= channel_tol); /* issue 33, item 4 */
+            /* issue 33, item 4 */
+            assert_true(!(channel_tol > 0.0) || lm_cli_channel_off(sum->frame, sum->ref, NULL) <= channel_tol);
         }
     }
     for (int k = 0; k < 3; k++)
@@ -655,8 +656,8 @@ static lmgi_scene *load_as_bake(const char *path, lm_frame_loop_settings *ls)
  * and ceiling within 2%, relative RMSE 0.053; the boxes' faces (529 to 1,035 texels) read -6% to +10%,
  * the AIM's photon noise where they meet the floor (within 2% with 200k photons). Loaded and solved as
  * `lmgi bake` solves it (load_as_bake: 4 photons a texel, a bounce pass, 4 x 4 direct parts), the small box's
- * lit faces are issue 33's item 1 at a bake's density: each within 2% per channel (measured within 0.9%; `lmgi check
- * --as-bake`'s frame at 7 of 8 seeds, docs/gather.md, "Strata"). The reference's 0.05 is enough for means
+ * lit faces are issue 33's item 1 at a bake's density: each within 2% per channel (measured within 0.9%;
+ * `lmgi check --as-bake`'s frame at 7 of 8 seeds, docs/gather.md, "Strata"). The reference's 0.05 is enough for means
  * over hundreds of texels (this scene has no rare bright paths: its light is an area light). */
 static void test_iim_bake_density(void **state)
 {
