@@ -1461,12 +1461,13 @@ static void test_tradeoff_update_lag(void **state)
     char header[1024], line[1024], v[64];
     assert_non_null(fgets(header, sizeof header, f));
     int knob = csv_column(header, "knob"), value = csv_column(header, "value"), error = csv_column(header, "error");
-    int to5 = csv_column(header, "frames_to_5"), def = csv_column(header, "default");
+    int to5 = csv_column(header, "frames_to_5"), to2 = csv_column(header, "frames_to_2");
+    int def = csv_column(header, "default");
     int frame_error = csv_column(header, "frame_error"), frame_end = csv_column(header, "frame_end");
     int frame = csv_column(header, "frame");
-    assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0 && def >= 0 && frame_error >= 0 && frame_end >= 0 &&
-                frame >= 0);
-    int plays = 0, lag5 = -2, lag80 = -2, lag_default = -2, lag_surfaces = -2;
+    assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0 && to2 >= 0 && def >= 0 && frame_error >= 0 &&
+                frame_end >= 0 && frame >= 0);
+    int plays = 0, lag5 = -2, lag80 = -2, lag_default = -2, lag2_80 = -2, lag2_default = -2, lag2_surfaces = -2;
     while (fgets(line, sizeof line, f)) {
         csv_field(line, frame, v, sizeof v);
         int at = atoi(v);
@@ -1495,8 +1496,10 @@ static void test_tradeoff_update_lag(void **state)
         int n = atoi(v);
         csv_field(line, to5, v, sizeof v);
         int lag = atoi(v);
-        print_message("lag, %s: %s %d: distance at the edit %.3f, within 5%% after %d updates\n",
-                      at == MOVE ? "the move" : "the recolour", name, n, e, lag);
+        csv_field(line, to2, v, sizeof v);
+        int lag2 = atoi(v);
+        print_message("lag, %s: %s %d: distance at the edit %.3f, within 5%% after %d updates, 2%% after %d\n",
+                      at == MOVE ? "the move" : "the recolour", name, n, e, lag, lag2);
         if (at == MOVE) {
             assert_true(lag >= 0 && lag <= 2);
             continue;
@@ -1504,17 +1507,21 @@ static void test_tradeoff_update_lag(void **state)
         if (is_texels && n == 5)
             lag5 = lag;
         if (is_texels && n == 80)
-            lag80 = lag;
+            lag80 = lag, lag2_80 = lag2;
         if (is_texels && n == 20)
-            lag_default = lag;
+            lag_default = lag, lag2_default = lag2;
         if (!strcmp(name, "texel_change") && n == 0)
-            lag_surfaces = lag;
+            lag2_surfaces = lag2;
     }
     fclose(f);
     assert_int_equal(plays, 8); /* the defaults, two values of each of three budgets, the texel change off */
     assert_true(lag80 > 0 && lag5 > 0 && lag_default > 0);
     assert_true(lag5 > lag80);
-    assert_true(lag_surfaces == -1 || lag_surfaces > 2 * lag_default); /* 35 and 4 when written */
+    /* to 2%: 7 updates at 80 texels, 21 at the default 20, not in the play's 60 with whole surfaces only
+     * (to 5% that was 34 against 3 until the upright strata, docs/gather.md, took the gather's noise on the
+     * walls down, and with it the distance at the edit; now 2 against 1) */
+    assert_true(lag2_default > 0 && lag2_80 > 0 && lag2_80 < lag2_default);
+    assert_true(lag2_surfaces == -1 || lag2_surfaces > 2 * lag2_default);
     snprintf(path, sizeof path, "%s/lag/plot_cornell_lag.png", dir);
     assert_int_equal(access(path, R_OK), 0);
     /* the nudge and the move, one update apart, are one gesture: one panel of the plot, not one each */

@@ -379,12 +379,14 @@ static void contact_reference(const lmgi_scene *sc, const lm_atlas *sub, float e
 }
 
 /* Issue 33 item 1's per-texel bound: the shared box's small box, its side faces' texels in the first 20 mm
- * above the floor, against the reference's texels (luminance; those texels alone, at 0.01). Their error is the
- * rays gather's own noise, fixed per texel by its strata's pattern: over its four side faces' 18 such texels,
- * 0.80-1.23 of the reference with 400 strata, 0.90-1.03 with 1,600, and within 10% only with a bounce pass as
- * well, 0.95-1.01 (docs/gather.md, "Strata"; the photons' count moves them little; against the whole atlas's
- * reference at 0.02 they had read 0.84-1.20, 0.94-1.03 and 0.96-1.02). Loaded as `lmgi run` and `lmgi check`
- * load it (load_as_check). */
+ * above the floor, against the reference's texels (luminance; those texels alone, at 0.01), loaded as `lmgi
+ * run` and `lmgi check` load it (load_as_check). Their error is the rays gather's noise, fixed per texel by
+ * its strata's pattern, and the photons'. Over the four side faces' 18 such texels at the default seed: in
+ * the polar strata 0.80-1.23 of the reference with 400 strata, 0.90-1.03 with 1,600, 0.95-1.01 with a bounce
+ * pass as well; in the upright strata (hemicube_rim.c, since 2026-12-06) 0.92-1.02, 0.90-1.01 and 0.95-1.00.
+ * Within 10% at 400 there is this seed's draw: gather seeds 1-4 read 0.79-1.14 with 400 upright strata (the
+ * polar ones 0.86-1.16), so 400 is asserted within 15%; 1,600 with a bounce pass within 10% (docs/gather.md,
+ * "Strata"; as baked, where 69 texels a face show the spread, test_iim_bake_density). */
 static void test_contact_texels_strata(void **state)
 {
     (void)state;
@@ -408,9 +410,9 @@ static void test_contact_texels_strata(void **state)
                   "%.3f-%.3f with 1,600, %.3f-%.3f with 1,600 and a bounce pass\n", sub.texel_count, lo[0], hi[0],
                   lo[1], hi[1], lo[2], hi[2]);
     assert_true(sub.texel_count >= 8);
-    assert_true(lo[0] < 0.9 || hi[0] > 1.1); /* the noise this guards against (0.80-1.23 measured) */
-    assert_true(hi[1] - lo[1] < 0.5 * (hi[0] - lo[0])); /* 1,600 strata: 0.90-1.03 */
-    assert_true(lo[2] > 0.9 && hi[2] < 1.1); /* and the bounce pass: 0.95-1.01 */
+    assert_true(lo[0] > 0.85 && hi[0] < 1.15); /* 0.92-1.02 measured (the polar strata: 0.80-1.23) */
+    assert_true(lo[1] > 0.85 && hi[1] < 1.15); /* 1,600 strata: 0.90-1.01 */
+    assert_true(lo[2] > 0.9 && hi[2] < 1.1);   /* and the bounce pass: 0.95-1.00 */
     lm_ref_result_free(&ref);
     free(sub.texels);
     free(index);
@@ -561,9 +563,9 @@ static void surface_means(const lmgi_scene *sc, const float *iim, const uint8_t 
 /* The displayed IIM (what `lmgi run` exports as iim.exr, before invalid texels are filled) of sc's first full
  * solution under ls against the reference's E_iim: per surface over its valid texels, asserted for surfaces of
  * at least min_texels; with box_tol > 0, every face of the small box of 100+ texels per channel within box_tol
- * too (issue 33, item 1). */
+ * too (issue 33, item 1). The IIM into *iim (caller frees) unless iim is NULL. */
 static void check_iim(lmgi_scene *sc, lm_frame_loop_settings *ls, float ref_error, uint32_t min_texels,
-                      double box_tol)
+                      double box_tol, float **iim)
 {
     float *rgba = first_iim(sc, ls);
     lm_error err;
@@ -615,7 +617,10 @@ static void check_iim(lmgi_scene *sc, lm_frame_loop_settings *ls, float ref_erro
     free(n);
     free(valid);
     free(est);
-    free(rgba);
+    if (iim)
+        *iim = rgba;
+    else
+        free(rgba);
     lm_ref_result_free(&ref);
     lm_emitters_free(&em);
 }
@@ -629,7 +634,7 @@ static void test_iim_run_density(void **state)
     lmgi_scene *sc = load_as_run(path, 0);
     lm_frame_loop_settings ls;
     lm_frame_loop_settings_default(&ls);
-    check_iim(sc, &ls, REF_ERROR, 100, 0.0);
+    check_iim(sc, &ls, REF_ERROR, 100, 0.0, NULL);
     lmgi_free(sc);
 }
 
@@ -652,6 +657,49 @@ static lmgi_scene *load_as_bake(const char *path, lm_frame_loop_settings *ls)
     return sc;
 }
 
+/* As baked, the small box's side faces' texels in the first 20 mm above the floor (69 a face) against the
+ * reference's texels at 0.02 (those alone): per face the spread (standard deviation) of the luminance
+ * ratios, the most at the face towards the open front (12), whose light comes mostly from a band of lit
+ * floor 1-2 degrees below the level (docs/gather.md, "Strata"). In the polar strata that band cut each of
+ * many strata somewhere else: spread 16.7% at the default seed (15.2% at gather seed 3), range 0.76-1.95.
+ * In the upright strata (hemicube_rim.c) its rows lie along it: 11.5% (7.9%), range 0.84-1.41; the other
+ * faces 1.8-2.8% either way. Not yet the 10% per texel of issue 33, item 1 (1,600 strata: 6.2%). */
+static void contact_faces(const lmgi_scene *sc, const float *iim)
+{
+    uint32_t *index;
+    lm_atlas sub = contact_texels(sc, &index);
+    lm_ref_result ref;
+    contact_reference(sc, &sub, 0.02f, &ref);
+    double sum[64] = {0}, sq[64] = {0}, lo = INFINITY, hi = 0.0;
+    int n[64] = {0};
+    for (uint32_t j = 0; j < sub.texel_count; j++) {
+        const lm_texel *t = &sc->atlas.texels[index[j]];
+        const float *v = iim + 4 * ((size_t)t->y * sc->atlas.width + t->x), *r = ref.iim + 3 * (size_t)j;
+        double q = (0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]) / (0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2]);
+        assert_true(t->surface >= 0 && t->surface < 64);
+        sum[t->surface] += q, sq[t->surface] += q * q, n[t->surface]++;
+        lo = fmin(lo, q), hi = fmax(hi, q);
+    }
+    double worst = 0.0;
+    int faces = 0;
+    for (int f = 0; f < 64; f++) {
+        if (n[f] < 20)
+            continue;
+        double m = sum[f] / n[f], sd = sqrt(fmax(0.0, sq[f] / n[f] - m * m));
+        print_message("  small box face %d, its %d texels in the first 20 mm: mean %.3f of the reference, "
+                      "spread %.3f\n", f, n[f], m, sd);
+        assert_true(fabs(m - 1.0) < 0.03);
+        worst = fmax(worst, sd), faces++;
+    }
+    print_message("as baked, the small box's %u texels in the first 20 mm: %.3f-%.3f of the reference, the worst "
+                  "face's spread %.3f\n", sub.texel_count, lo, hi, worst);
+    assert_true(faces == 4);
+    assert_true(worst < 0.13); /* 0.115 measured; 0.167 in the polar strata */
+    lm_ref_result_free(&ref);
+    free(sub.texels);
+    free(index);
+}
+
 /* At 66,816 texels, with the photon count `lmgi run` took before the scene's floor (11,520): walls, floor
  * and ceiling within 2%, relative RMSE 0.053; the boxes' faces (529 to 1,035 texels) read -6% to +10%,
  * the AIM's photon noise where they meet the floor (within 2% with 200k photons). Loaded and solved as
@@ -665,7 +713,10 @@ static void test_iim_bake_density(void **state)
     LMT_REQUIRE_SCENE(path, lmt_shared_scene("cornell-box/CornellBox.glb"));
     lm_frame_loop_settings ls;
     lmgi_scene *sc = load_as_bake(path, &ls);
-    check_iim(sc, &ls, 0.05f, 2000, ITEM_1_TOL);
+    float *iim;
+    check_iim(sc, &ls, 0.05f, 2000, ITEM_1_TOL, &iim);
+    contact_faces(sc, iim);
+    free(iim);
     lmgi_free(sc);
 }
 

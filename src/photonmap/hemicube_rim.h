@@ -13,7 +13,10 @@
  * directions restricted to the rim, each weighted by its azimuth's share of it. E_rim is unbiased, and
  * E = pi sum(w L) + E_rim needs no division by F(a). The K directions are a sqrt(K) x sqrt(K)
  * stratified grid in (phi, sin^2 theta), shifted per texel (its index seeds the shift), so a texel gets
- * the same estimate whenever it is gathered.
+ * the same estimate whenever it is gathered. With enlargement 0 (the rays gather) at a standing texel
+ * (|n.y| < 0.05), the grid is upright instead: columns by the angle across the up direction, rows by
+ * the elevation against the level, the same cosine-weighted measure, so that a floor seen at grazing
+ * angles lies along rows (docs/gather.md, "Upright strata").
  * L(hit) is what the hemicube would show there: the AIM at the hit's lightmap uv (bilinear, from the
  * gather's copy of the dilated AIM), plus the emitted radiance when emitters are drawn rather than in
  * closed form; 0 on the back of a single-sided surface, on mirror and glass; the sky where nothing is hit.
