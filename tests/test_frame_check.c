@@ -349,16 +349,23 @@ static lm_atlas contact_texels(const lmgi_scene *sc, uint32_t **index)
     return sub;
 }
 
-/* The luminance of iim (RGBA, sc's displayed IIM) over the reference's E_iim at each texel of sub (from
- * contact_texels: index maps its texels to sc's): the least and the most, in *lo and *hi. */
+/* The luminance of iim (RGBA, sc's displayed IIM) over the reference's E_iim at texel j of sub (from
+ * contact_texels: index maps its texels to sc's). */
+static double contact_ratio(const lmgi_scene *sc, const float *iim, const uint32_t *index, const lm_ref_result *ref,
+                            uint32_t j)
+{
+    const lm_texel *t = &sc->atlas.texels[index[j]];
+    const float *v = iim + 4 * ((size_t)t->y * sc->atlas.width + t->x), *r = ref->iim + 3 * (size_t)j;
+    return (0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]) / (0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2]);
+}
+
+/* Of contact_ratio over every texel of sub, the least and the most, in *lo and *hi. */
 static void contact_range(const lmgi_scene *sc, const float *iim, const lm_atlas *sub, const uint32_t *index,
                           const lm_ref_result *ref, double *lo, double *hi)
 {
     *lo = INFINITY, *hi = 0.0;
     for (uint32_t j = 0; j < sub->texel_count; j++) {
-        const lm_texel *t = &sc->atlas.texels[index[j]];
-        const float *v = iim + 4 * ((size_t)t->y * sc->atlas.width + t->x), *r = ref->iim + 3 * (size_t)j;
-        double q = (0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]) / (0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2]);
+        double q = contact_ratio(sc, iim, index, ref, j);
         *lo = fmin(*lo, q), *hi = fmax(*hi, q);
     }
 }
@@ -670,15 +677,14 @@ static void contact_faces(const lmgi_scene *sc, const float *iim)
     lm_atlas sub = contact_texels(sc, &index);
     lm_ref_result ref;
     contact_reference(sc, &sub, 0.02f, &ref);
-    double sum[64] = {0}, sq[64] = {0}, lo = INFINITY, hi = 0.0;
+    double sum[64] = {0}, sq[64] = {0}, lo, hi;
     int n[64] = {0};
+    contact_range(sc, iim, &sub, index, &ref, &lo, &hi);
     for (uint32_t j = 0; j < sub.texel_count; j++) {
-        const lm_texel *t = &sc->atlas.texels[index[j]];
-        const float *v = iim + 4 * ((size_t)t->y * sc->atlas.width + t->x), *r = ref.iim + 3 * (size_t)j;
-        double q = (0.2126 * v[0] + 0.7152 * v[1] + 0.0722 * v[2]) / (0.2126 * r[0] + 0.7152 * r[1] + 0.0722 * r[2]);
-        assert_true(t->surface >= 0 && t->surface < 64);
-        sum[t->surface] += q, sq[t->surface] += q * q, n[t->surface]++;
-        lo = fmin(lo, q), hi = fmax(hi, q);
+        int f = sc->atlas.texels[index[j]].surface;
+        double q = contact_ratio(sc, iim, index, &ref, j);
+        assert_true(f >= 0 && f < 64);
+        sum[f] += q, sq[f] += q * q, n[f]++;
     }
     double worst = 0.0;
     int faces = 0;

@@ -100,8 +100,7 @@ typedef struct {
 typedef struct {
     lm_vec3 B, T, N;
     int upright;
-    lm_vec3 A, C;       /* upright: the up direction in the texel's plane, and N x A */
-    const cos_sin *sub; /* upright: the elevations of each row's SUB sub-rows, rows x SUB (strata) */
+    lm_vec3 A, C; /* upright: the up direction in the texel's plane, and N x A */
 } strata_frame;
 
 #define ELEVATION_STEPS 4096
@@ -219,9 +218,10 @@ static void direct_at_hit(const lm_rim *r, const float eye[3], const float dir[3
  * the strata it overlaps instead of being all or nothing for one. Adds the weighted radiance sum (times
  * SUB^2) of each of the nr rims r[k] into sum[k]: one ray and one footprint for all of them (r[0]'s scene,
  * atlas and tracer), each read in its own AIM, emission and direct light. seed: the stratum's own (the
- * texel's and its index), for the emissive triangles' shadow rays at the hit. */
+ * texel's and its index), for the emissive triangles' shadow rays at the hit. fr: the frame (upright or
+ * polar); sub: upright, the elevations of this row's SUB sub-rows (NULL: the polar strata's). */
 static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3], const strata_frame *fr,
-                    lm_vec3 G, double phi0, double dphi, double u0, double du, double at,
+                    const cos_sin *sub, lm_vec3 G, double phi0, double dphi, double u0, double du, double at,
                     uint32_t seed, double (*sum)[3], double *back)
 {
     const lm_rim *r0 = r[0];
@@ -276,7 +276,6 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
         float lo[4], *hi = lo + 2; /* the chart's footprint stays where its lookups read only it */
         lm_chart_lookup_rect(r0->atlas, r0->atlas->tri_chart[h.tri], lo);
         double num = lm_dot(ng, lm_sub(P, e));
-        const cos_sin *sub = fr->upright ? fr->sub + (size_t)lround(u0 / du) * SUB : NULL; /* this row's */
         for (int i = 0; i < SUB; i++) {
             rim_azimuth az = {0.0f, 0.0f, 0.0};
             cos_sin al = {0.0, 0.0};
@@ -343,7 +342,6 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
             f.upright = 0; /* the polar strata: the same measure */
         for (int k = 0; sub && k < side * SUB; k++)
             sub[k] = elevation((k + 0.5) / (side * SUB));
-        f.sub = sub;
     }
     fr = &f;
     /* the azimuths turned per texel (a turn is periodic; upright, the column it carries past phi = 1 lies
@@ -352,8 +350,8 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
         double phi0 = fmod((i + shift[0]) * d, 1.0), at = fmod(shift[1] + i * LM_GOLDEN_FRACTION, 1.0);
         for (int j = 0; j < side; j++) {
             double before[3] = {sum[0][0], sum[0][1], sum[0][2]};
-            stratum(r, nr, m, eye, fr, G, phi0, d, j * d, d, at, seed * (uint32_t)K + (uint32_t)(i * side + j),
-                    sum, back_w);
+            stratum(r, nr, m, eye, fr, sub ? sub + (size_t)j * SUB : NULL, G, phi0, d, j * d, d, at,
+                    seed * (uint32_t)K + (uint32_t)(i * side + j), sum, back_w);
             for (int c = 0; c < 3; c++) {
                 double x = sum[0][c] - before[c];
                 total[c] += x;
@@ -384,7 +382,7 @@ static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], c
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
     int K = side * side;
     sky_mis m = {r0->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r0->scene), K, SKY_RAYS};
-    strata_frame fr = {B, T, N, 0, N, N, NULL};
+    strata_frame fr = {B, T, N, 0, N, N};
     lm_vec3 up = lm_v3(0.0f, 1.0f, 0.0f);
     if (r0->enlargement == 0.0f && fabsf(lm_dot(up, N)) < UPRIGHT_LEVEL) {
         pthread_once(&elevation_once, elevation_table_fill);
