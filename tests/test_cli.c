@@ -1467,7 +1467,8 @@ static void test_tradeoff_update_lag(void **state)
     int frame = csv_column(header, "frame");
     assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0 && to2 >= 0 && def >= 0 && frame_error >= 0 &&
                 frame_end >= 0 && frame >= 0);
-    int plays = 0, lag5 = -2, lag80 = -2, lag_default = -2, lag2_80 = -2, lag2_default = -2, lag2_surfaces = -2;
+    int plays = 0, lag5 = -2, lag80 = -2, lag_default = -2, lag2_80 = -2, lag2_default = -2, lag_surfaces = -2,
+        lag2_surfaces = -2;
     while (fgets(line, sizeof line, f)) {
         csv_field(line, frame, v, sizeof v);
         int at = atoi(v);
@@ -1511,17 +1512,21 @@ static void test_tradeoff_update_lag(void **state)
         if (is_texels && n == 20)
             lag_default = lag, lag2_default = lag2;
         if (!strcmp(name, "texel_change") && n == 0)
-            lag2_surfaces = lag2;
+            lag_surfaces = lag, lag2_surfaces = lag2;
     }
     fclose(f);
     assert_int_equal(plays, 8); /* the defaults, two values of each of three budgets, the texel change off */
     assert_true(lag80 > 0 && lag5 > 0 && lag_default > 0);
     assert_true(lag5 > lag80);
-    /* to 2%: 7 updates at 80 texels, 21 at the default 20, not in the play's 60 with whole surfaces only
-     * (to 5% that was 34 against 3 until the upright strata, docs/gather.md, took the gather's noise on the
-     * walls down, and with it the distance at the edit; now 2 against 1) */
+    /* to 2%: 7 updates at 80 texels, 21 at the default 20; whole surfaces only are slower at both bounds, by
+     * how much the gather's noise on the walls decides (to 5% / 2%: 34 against 3 and not in 60 before the
+     * upright strata, docs/gather.md; 2 against 1 and not in 60 with them; 33 against 1 and 40 against 21
+     * with each upright row's rays at their own alpha) */
     assert_true(lag2_default > 0 && lag2_80 > 0 && lag2_80 < lag2_default);
-    assert_true(lag2_surfaces == -1 || lag2_surfaces > 2 * lag2_default);
+    assert_true(lag_surfaces == -1 || lag_surfaces > lag_default);
+    assert_true(lag2_surfaces == -1 || lag2_surfaces > lag2_default);
+    assert_true(lag_surfaces == -1 || lag2_surfaces == -1 || lag_surfaces > 2 * lag_default ||
+                lag2_surfaces > 2 * lag2_default);
     snprintf(path, sizeof path, "%s/lag/plot_cornell_lag.png", dir);
     assert_int_equal(access(path, R_OK), 0);
     /* the nudge and the move, one update apart, are one gesture: one panel of the plot, not one each */

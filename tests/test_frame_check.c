@@ -390,7 +390,8 @@ static void contact_reference(const lmgi_scene *sc, const lm_atlas *sub, float e
  * run` and `lmgi check` load it (load_as_check). Their error is the rays gather's noise, fixed per texel by
  * its strata's pattern, and the photons'. Over the four side faces' 18 such texels at the default seed: in
  * the polar strata 0.80-1.23 of the reference with 400 strata, 0.90-1.03 with 1,600, 0.95-1.01 with a bounce
- * pass as well; in the upright strata (hemicube_rim.c, since 2026-12-06) 0.92-1.02, 0.90-1.01 and 0.95-1.00.
+ * pass as well; in the upright strata (hemicube_rim.c, since 2026-12-06) 0.92-1.02, 0.90-1.01 and 0.95-1.00,
+ * and with each row's rays at their own alpha in their columns 0.88-1.02, 0.90-1.02 and 0.95-1.00.
  * Within 10% at 400 there is this seed's draw: gather seeds 1-4 read 0.79-1.14 with 400 upright strata (the
  * polar ones 0.86-1.16), so 400 is asserted within 15%; 1,600 with a bounce pass within 10% (docs/gather.md,
  * "Strata"; as baked, where 69 texels a face show the spread, test_iim_bake_density). */
@@ -417,7 +418,7 @@ static void test_contact_texels_strata(void **state)
                   "%.3f-%.3f with 1,600, %.3f-%.3f with 1,600 and a bounce pass\n", sub.texel_count, lo[0], hi[0],
                   lo[1], hi[1], lo[2], hi[2]);
     assert_true(sub.texel_count >= 8);
-    assert_true(lo[0] > 0.85 && hi[0] < 1.15); /* 0.92-1.02 measured (the polar strata: 0.80-1.23) */
+    assert_true(lo[0] > 0.85 && hi[0] < 1.15); /* 0.88-1.02 measured (the polar strata: 0.80-1.23) */
     assert_true(lo[1] > 0.85 && hi[1] < 1.15); /* 1,600 strata: 0.90-1.01 */
     assert_true(lo[2] > 0.9 && hi[2] < 1.1);   /* and the bounce pass: 0.95-1.00 */
     lm_ref_result_free(&ref);
@@ -670,7 +671,10 @@ static lmgi_scene *load_as_bake(const char *path, lm_frame_loop_settings *ls)
  * floor 1-2 degrees below the level (docs/gather.md, "Strata"). In the polar strata that band cut each of
  * many strata somewhere else: spread 16.7% at the default seed (15.2% at gather seed 3), range 0.76-1.95.
  * In the upright strata (hemicube_rim.c) its rows lie along it: 11.5% (7.9%), range 0.84-1.41; the other
- * faces 1.8-2.8% either way. Not yet the 10% per texel of issue 33, item 1 (1,600 strata: 6.2%). */
+ * faces 1.8-2.8% either way. With each row's rays at their own alpha in their columns (not a column's all at
+ * its middle, which read a wall seen at grazing angles all or none): 5.8%, range 0.855-1.196 (a probe with
+ * another shift for the rows' fractions, gather seeds 0-4: 5.2-5.9%); faces 8, 10 and 13 1.7-1.9%. Not yet
+ * the 10% per texel of issue 33, item 1. */
 static void contact_faces(const lmgi_scene *sc, const float *iim)
 {
     uint32_t *index;
@@ -700,7 +704,8 @@ static void contact_faces(const lmgi_scene *sc, const float *iim)
     print_message("as baked, the small box's %u texels in the first 20 mm: %.3f-%.3f of the reference, the worst "
                   "face's spread %.3f\n", sub.texel_count, lo, hi, worst);
     assert_true(faces == 4);
-    assert_true(worst < 0.13); /* 0.115 measured; 0.167 in the polar strata */
+    assert_true(worst < 0.07);           /* 0.058 measured; 0.115 with a column's rays at one alpha */
+    assert_true(lo > 0.8 && hi < 1.25); /* 0.855-1.196; 0.84-1.41 so */
     lm_ref_result_free(&ref);
     free(sub.texels);
     free(index);

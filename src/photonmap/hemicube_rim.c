@@ -165,6 +165,7 @@ static lm_vec3 upright_dir(const strata_frame *f, cos_sin a, cos_sin b)
  * shift plus i times the golden ratio's fraction (a Kronecker sequence): a ring of strata under a source
  * smaller than one ring then reads it at as many elevations as it has azimuths, not all at one. */
 #define LM_GOLDEN_FRACTION 0.6180339887498949
+#define ACROSS_SEED 0x68e31da4u /* the rows' fractions across their columns: a shift of their own */
 #define SUB 4 /* sub-directions per side of a stratum: its footprint on the hit's plane */
 #define RIMS_AT_ONCE 2 /* the most rims one pass reads over the same rays (lm_rim_irradiance_pair) */
 #define SKY_RAYS 36 /* an image sky's directions drawn by brightness a texel, beside the strata (a square) */
@@ -209,20 +210,21 @@ static void direct_at_hit(const lm_rim *r, const float eye[3], const float dir[3
         out[c] = (float)(kd[c] / LM_PI * E[c]);
 }
 
-/* The stratum (phi0 + [0, dphi), u0 + [0, du)) of the rim: one ray through its middle azimuth at the
- * fraction `at` of its width in u (with every ray at the middle, the elevation's midpoint rule put the same
- * error into every texel that sees a small source, a horizon or a contact line alike: a bias, not noise;
- * docs/gather.md, "Strata") and, on the plane of the triangle it hits, the AIM averaged over the stratum's
- * footprint (SUB x SUB sub-directions met with that plane, their uv from the triangle's uv gradient, kept
- * inside its chart), as a hemicube pixel averages its footprint: a small bright spot is then shared among
- * the strata it overlaps instead of being all or nothing for one. Adds the weighted radiance sum (times
- * SUB^2) of each of the nr rims r[k] into sum[k]: one ray and one footprint for all of them (r[0]'s scene,
- * atlas and tracer), each read in its own AIM, emission and direct light. seed: the stratum's own (the
- * texel's and its index), for the emissive triangles' shadow rays at the hit. fr: the frame (upright or
- * polar); sub: upright, the elevations of this row's SUB sub-rows (NULL: the polar strata's). */
+/* The stratum (phi0 + [0, dphi), u0 + [0, du)) of the rim: one ray at the fraction `ax` of its width in phi
+ * (the hemicube's rim: its middle azimuth, 0.5) and the fraction `at` of its width in u (with every ray at the
+ * middle, the elevation's midpoint rule put the same error into every texel that sees a small source, a
+ * horizon or a contact line alike: a bias, not noise; docs/gather.md, "Strata") and, on the plane of the
+ * triangle it hits, the AIM averaged over the stratum's footprint (SUB x SUB sub-directions met with that
+ * plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel averages its
+ * footprint: a small bright spot is then shared among the strata it overlaps instead of being all or
+ * nothing for one. Adds the weighted radiance sum (times SUB^2) of each of the nr rims r[k] into sum[k]:
+ * one ray and one footprint for all of them (r[0]'s scene, atlas and tracer), each read in its own AIM,
+ * emission and direct light. seed: the stratum's own (the texel's and its index), for the emissive
+ * triangles' shadow rays at the hit. fr: the frame (upright or polar); sub: upright, the elevations of this
+ * row's SUB sub-rows (NULL: the polar strata's). */
 static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3], const strata_frame *fr,
-                    const cos_sin *sub, lm_vec3 G, double phi0, double dphi, double u0, double du, double at,
-                    uint32_t seed, double (*sum)[3], double *back)
+                    const cos_sin *sub, lm_vec3 G, double phi0, double dphi, double u0, double du, double ax,
+                    double at, uint32_t seed, double (*sum)[3], double *back)
 {
     const lm_rim *r0 = r[0];
     lm_vec3 N = fr->N;
@@ -230,9 +232,9 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
     float dir[3];
     if (fr->upright) {
         w = 1.0;
-        lm_v3_store(dir, upright_dir(fr, across(phi0 + 0.5 * dphi), elevation(u0 + at * du)));
+        lm_v3_store(dir, upright_dir(fr, across(phi0 + ax * dphi), elevation(u0 + at * du)));
     } else {
-        rim_azimuth mid = azimuth(r0, phi0 + 0.5 * dphi);
+        rim_azimuth mid = azimuth(r0, phi0 + ax * dphi);
         lm_v3_store(dir, rim_dir(&mid, fr->B, fr->T, N, u0 + at * du, &w));
     }
     if (lm_dot(lm_v3_load(dir), G) <= 0.0f)
@@ -344,13 +346,24 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
             sub[k] = elevation((k + 0.5) / (side * SUB));
     }
     fr = &f;
+    /* the rays gather's rows each put their rays at their own fraction of their columns, a Kronecker sequence
+     * down the rows as `at` is across the columns: a column's rays at one azimuth (its middle) read something
+     * bright and narrow across the columns (a wall seen at grazing angles, from a face standing on the floor)
+     * all or none at once: the shared box's face 12 by the floor spread 11.5% so, 5.8% with the rows' own
+     * fractions (docs/gather.md, "Upright strata"). Not the hemicube's rim (enlargement > 0): there the ray
+     * off its stratum's middle picks the plane its footprint is read on less well, and a wall seeing the
+     * ceiling's bright spot in its rim mottled (test_gather's test_rim_smooth, roughness 0.061 -> 0.134). */
+    int spread = r[0]->enlargement == 0.0f;
+    double across_shift[2];
+    lm_seed_shift(seed ^ ACROSS_SEED, across_shift);
     /* the azimuths turned per texel (a turn is periodic; upright, the column it carries past phi = 1 lies
      * at both ends, alpha near +-90 degrees, the grazing directions along the texel's plane) */
     for (int i = 0; i < side; i++) {
         double phi0 = fmod((i + shift[0]) * d, 1.0), at = fmod(shift[1] + i * LM_GOLDEN_FRACTION, 1.0);
         for (int j = 0; j < side; j++) {
             double before[3] = {sum[0][0], sum[0][1], sum[0][2]};
-            stratum(r, nr, m, eye, fr, sub ? sub + (size_t)j * SUB : NULL, G, phi0, d, j * d, d, at,
+            double ax = spread ? fmod(across_shift[0] + j * LM_GOLDEN_FRACTION, 1.0) : 0.5;
+            stratum(r, nr, m, eye, fr, sub ? sub + (size_t)j * SUB : NULL, G, phi0, d, j * d, d, ax, at,
                     seed * (uint32_t)K + (uint32_t)(i * side + j), sum, back_w);
             for (int c = 0; c < 3; c++) {
                 double x = sum[0][c] - before[c];

@@ -16,7 +16,8 @@
  * the same estimate whenever it is gathered. With enlargement 0 (the rays gather) at a standing texel
  * (|n.y| < 0.05), the grid is upright instead: columns by the angle across the up direction, rows by
  * the elevation against the level, the same cosine-weighted measure, so that a floor seen at grazing
- * angles lies along rows (docs/gather.md, "Upright strata").
+ * angles lies along rows, and each row's rays at its own fraction of their columns, so that a wall seen at
+ * grazing angles is not met by a column all or not at all (docs/gather.md, "Upright strata").
  * L(hit) is what the hemicube would show there: the AIM at the hit's lightmap uv (bilinear, from the
  * gather's copy of the dilated AIM), plus the emitted radiance when emitters are drawn rather than in
  * closed form; 0 on the back of a single-sided surface, on mirror and glass; the sky where nothing is hit.
