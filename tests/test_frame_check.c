@@ -681,14 +681,14 @@ static void contact_faces(const lmgi_scene *sc, const float *iim)
     lm_atlas sub = contact_texels(sc, &index);
     lm_ref_result ref;
     contact_reference(sc, &sub, 0.02f, &ref);
-    double sum[64] = {0}, sq[64] = {0}, lo, hi;
+    double sum[64] = {0}, sq[64] = {0}, lo = INFINITY, hi = 0.0;
     int n[64] = {0};
-    contact_range(sc, iim, &sub, index, &ref, &lo, &hi);
     for (uint32_t j = 0; j < sub.texel_count; j++) {
         int f = sc->atlas.texels[index[j]].surface;
         double q = contact_ratio(sc, iim, index, &ref, j);
         assert_true(f >= 0 && f < 64);
         sum[f] += q, sq[f] += q * q, n[f]++;
+        lo = fmin(lo, q), hi = fmax(hi, q);
     }
     double worst = 0.0;
     int faces = 0;

@@ -220,8 +220,8 @@ static void direct_at_hit(const lm_rim *r, const float eye[3], const float dir[3
  * nothing for one. Adds the weighted radiance sum (times SUB^2) of each of the nr rims r[k] into sum[k]:
  * one ray and one footprint for all of them (r[0]'s scene, atlas and tracer), each read in its own AIM,
  * emission and direct light. seed: the stratum's own (the texel's and its index), for the emissive
- * triangles' shadow rays at the hit. fr: the frame (upright or polar); sub: upright, the elevations of this
- * row's SUB sub-rows (NULL: the polar strata's). */
+ * triangles' shadow rays at the hit. fr: the frame; sub: upright strata, the elevations of this row's SUB
+ * sub-rows (NULL: the polar strata, laid in fr's B, T and N). */
 static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3], const strata_frame *fr,
                     const cos_sin *sub, lm_vec3 G, double phi0, double dphi, double u0, double du, double ax,
                     double at, uint32_t seed, double (*sum)[3], double *back)
@@ -230,7 +230,7 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
     lm_vec3 N = fr->N;
     double w;
     float dir[3];
-    if (fr->upright) {
+    if (sub) {
         w = 1.0;
         lm_v3_store(dir, upright_dir(fr, across(phi0 + ax * dphi), elevation(u0 + at * du)));
     } else {
@@ -336,16 +336,11 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
 {
     double d = 1.0 / side, total[3] = {0, 0, 0}, sq[3] = {0, 0, 0}, first[3] = {0, 0, 0};
     int K = side * side;
-    strata_frame f = *fr;
-    cos_sin *sub = NULL;
-    if (f.upright) { /* every row's sub-rows, shared by its strata */
-        sub = malloc(sizeof *sub * (size_t)side * SUB);
-        if (!sub)
-            f.upright = 0; /* the polar strata: the same measure */
-        for (int k = 0; sub && k < side * SUB; k++)
+    cos_sin *sub = NULL; /* upright: every row's sub-rows, shared by its strata (NULL, out of memory: the polar
+                            strata, the same measure) */
+    if (fr->upright && (sub = malloc(sizeof *sub * (size_t)side * SUB)) != NULL)
+        for (int k = 0; k < side * SUB; k++)
             sub[k] = elevation((k + 0.5) / (side * SUB));
-    }
-    fr = &f;
     /* the rays gather's rows each put their rays at their own fraction of their columns, a Kronecker sequence
      * down the rows as `at` is across the columns: a column's rays at one azimuth (its middle) read something
      * bright and narrow across the columns (a wall seen at grazing angles, from a face standing on the floor)
