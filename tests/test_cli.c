@@ -1204,7 +1204,7 @@ static void test_check_levels_per_channel(void **state)
     check_level_channels(town, 8, 0.05);
 }
 
-/* `lmgi check --as-bake` checks the lightmap `lmgi bake` makes (src/cli/bake_options.h): 4 photons a texel
+/* `lmgi check --as-bake` checks the lightmap `lmgi bake` makes (src/cli/bake_options.h): 16 photons a texel
  * (at least 46,080), a bounce pass and the AIMs' direct light over 4 x 4 parts a texel, which it says; plain
  * `check` solves as `run` does, with none of them. The frame is right either way (measured at 32 x 32:
  * 0.99-1.01 per channel). */
@@ -1231,7 +1231,7 @@ static void test_check_as_bake(void **state)
             print_message("check --as-bake: %u texels, %u photons, %d bounce pass, %d x %d direct parts\n", texels,
                           photons, passes, parts[0], parts[1]);
             assert_true(texels > 9000 && texels < 15000);
-            assert_int_equal(photons, 4 * texels);
+            assert_int_equal(photons, 16 * texels);
             assert_int_equal(passes, 1);
             assert_int_equal(parts[0], 4);
         }

@@ -1,9 +1,14 @@
 #include "bake_options.h"
 
+uint32_t lm_cli_photons_for(uint32_t texels, uint32_t per_texel)
+{
+    uint64_t n = (uint64_t)per_texel * texels;
+    return n < LM_CLI_BAKE_PHOTONS_MIN ? LM_CLI_BAKE_PHOTONS_MIN : n > LM_CLI_BAKE_PHOTONS_MAX ? LM_CLI_BAKE_PHOTONS_MAX : (uint32_t)n;
+}
+
 uint32_t lm_cli_bake_photons(uint32_t texels)
 {
-    uint64_t n = (uint64_t)LM_CLI_BAKE_PHOTONS_PER_TEXEL * texels;
-    return n < LM_CLI_BAKE_PHOTONS_MIN ? LM_CLI_BAKE_PHOTONS_MIN : n > LM_CLI_BAKE_PHOTONS_MAX ? LM_CLI_BAKE_PHOTONS_MAX : (uint32_t)n;
+    return lm_cli_photons_for(texels, LM_CLI_BAKE_PHOTONS_PER_TEXEL);
 }
 
 void lm_cli_bake_solution(const lmgi_info *in, int whole, lmgi_updater_desc *d)

@@ -8,10 +8,19 @@
  * its atlas, within [MIN, MAX]. Its AIMs are as fine as its atlas, and an N-nearest estimate of fewer photons
  * than texels spans several of them: the sunlit living room baked at 65,536 texels from the updater's
  * 46,080 photons read 3-8% bright on its walls and 25-58% on its furniture, mottled, and from 270,716 within
- * 3% and 7% (docs/photons.md, "A bake's photons"). Tracing them costs a few percent of the gather. */
-#define LM_CLI_BAKE_PHOTONS_PER_TEXEL 4u
+ * 3% and 7%; at 4 a texel the shared Cornell box's floor by the small box's foot read a contact shadow
+ * blurred by the kernel, its face towards the open front 2% bright in its first 3 mm and one texel by its
+ * corner 12% (against a reference of a million paths a texel), at 16 within 6% (docs/photons.md, "A bake's
+ * photons"). Tracing and estimating them costs a few percent of the gather (the box: 0.15 + 0.66 s at 4 a
+ * texel, 0.55 + 0.84 s at 16, of a 27 s bake). */
+#define LM_CLI_BAKE_PHOTONS_PER_TEXEL 16u
+/* `lmgi run` and `lmgi check`'s photons where more than the updater's floor (lm_cli_run_desc): a texel's
+ * share as a bake took it before it took 16, since a run traces them again as it updates */
+#define LM_CLI_RUN_PHOTONS_PER_TEXEL 4u
 #define LM_CLI_BAKE_PHOTONS_MIN 46080u
 #define LM_CLI_BAKE_PHOTONS_MAX 1048576u
+/* per_texel photons for each of texels, within [MIN, MAX] */
+uint32_t lm_cli_photons_for(uint32_t texels, uint32_t per_texel);
 uint32_t lm_cli_bake_photons(uint32_t texels);
 /* A bake's bounce passes when --bounce-passes is not given (docs/gather.md, "Bounce passes"): the first
  * solution gathered once more, its bounced light read from the first gather's lightmap. The photons'

@@ -58,7 +58,7 @@ void lm_cli_updater_desc(const lm_cli_args *a, lmgi_updater_desc *d)
 
 uint32_t lm_cli_run_photons(const lmgi_scene *sc)
 {
-    uint32_t n = lm_cli_bake_photons(lmgi_texel_count(sc));
+    uint32_t n = lm_cli_photons_for(lmgi_texel_count(sc), LM_CLI_RUN_PHOTONS_PER_TEXEL);
     return n > LM_CLI_BAKE_PHOTONS_MIN ? n : 0; /* 0: the updater's own default, split among the lights */
 }
 

@@ -17,7 +17,10 @@
  * (|n.y| < 0.05), the grid is upright instead: columns by the angle across the up direction, rows by
  * the elevation against the level, the same cosine-weighted measure, so that a floor seen at grazing
  * angles lies along rows, and each row's rays at its own fraction of their columns, so that a wall seen at
- * grazing angles is not met by a column all or not at all (docs/gather.md, "Upright strata").
+ * grazing angles is not met by a column all or not at all (docs/gather.md, "Upright strata"). Where such
+ * a texel stands within 4 texel widths of what lies under it (one ray straight down), the rows within 15
+ * degrees under the level are traced as 8 rows each, since the lit floor beyond its contact shadow is a
+ * band a fraction of a row high (docs/gather.md, "Contact rows").
  * L(hit) is what the hemicube would show there: the AIM at the hit's lightmap uv (bilinear, from the
  * gather's copy of the dilated AIM), plus the emitted radiance when emitters are drawn rather than in
  * closed form; 0 on the back of a single-sided surface, on mirror and glass; the sky where nothing is hit.
@@ -29,8 +32,9 @@
  * or nearer, where the eye can tell a point from its texel's average; further hits read the whole AIM,
  * for fewer shadow rays (Jensen's final gather treats its near hits apart for the same reason).
  *
- * Cost: K rays and AIM lookups per texel, on the gather's calling thread while the GPU rasterizes
- * (docs/gather.md, "The rim", for the measured time). Noise: the rim is a band near the horizon; a
+ * Cost: K rays and AIM lookups per texel (about K more at a contact texel, and one ray down at a standing
+ * one), on the gather's calling thread while the GPU rasterizes (docs/gather.md, "The rim", for the
+ * measured time). Noise: the rim is a band near the horizon; a
  * small bright spot there (the ceiling over a point light, seen from a wall) is what the K rays must
  * resolve, and too few mottle the IIM from texel to texel. Thread-safe (Embree queries and reads only). */
 #ifndef LM_HEMICUBE_RIM_H
