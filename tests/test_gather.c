@@ -369,6 +369,22 @@ static void test_rim_traced(void **state)
 
 #define EACH_MAX 1024 /* the most texels whose errors errors_under_emitter gives one by one */
 
+/* t's tracer into *rt (caller frees), and the texels of mesh node `node` whose centres lie below height
+ * `below` (INFINITY: all of them), *n of them (caller frees the list). */
+static uint32_t *node_texels(const tscene *t, uint32_t node, float below, lm_rt **rt, uint32_t *n)
+{
+    lm_error err;
+    *rt = NULL;
+    assert_int_equal(lm_rt_build(t->s, &t->su, rt, &err), LM_OK);
+    uint32_t *texels = malloc(sizeof(uint32_t) * (t->a.texel_count ? t->a.texel_count : 1));
+    assert_non_null(texels);
+    *n = 0;
+    for (uint32_t i = 0; i < t->a.texel_count; i++)
+        if (t->s->tri_node[t->a.texels[i].tri] == node && t->a.texels[i].pos[1] < below)
+            texels[(*n)++] = i;
+    return texels;
+}
+
 /* The rays gather under a small emitting square (side 0.3) 1 m over a receiver (half its side: half, its
  * texels that wide), with `set` (its scheme set to rays): the mean and worst relative error of the
  * receiver's texels against pi Le F, (bias, if given) their signed mean, and (each, if given, EACH_MAX)
@@ -378,14 +394,8 @@ static uint32_t errors_facing_emitter(lm_hemicube_settings set, float half, floa
 {
     tscene t;
     receiver_under_emitter_turned(&t, 0.3f, 1.0f, half, texel, upright);
-    lm_rt *rt = NULL;
-    lm_error err;
-    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
-    uint32_t *texels = malloc(sizeof(uint32_t) * t.a.texel_count), n = 0;
-    assert_non_null(texels);
-    for (uint32_t i = 0; i < t.a.texel_count; i++)
-        if (t.s->tri_node[t.a.texels[i].tri] == 1)
-            texels[n++] = i;
+    lm_rt *rt;
+    uint32_t n, *texels = node_texels(&t, 1, INFINITY, &rt, &n);
     assert_true(n >= 4);
     set.scheme = LM_GATHER_RAYS;
     float *rgba = gather_traced(t.s, &t.a, NULL, NULL, rt, &set, texels, n, NULL);
@@ -574,14 +584,8 @@ static void test_contact_rows(void **state)
             "[{}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}}, {\"pbrMetallicRoughness\": "
             "{\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 0.5, 0.25]}]",
             0.01f);
-    lm_rt *rt = NULL;
-    lm_error err;
-    assert_int_equal(lm_rt_build(t.s, &t.su, &rt, &err), LM_OK);
-    uint32_t *texels = malloc(sizeof(uint32_t) * t.a.texel_count), n = 0;
-    assert_non_null(texels);
-    for (uint32_t i = 0; i < t.a.texel_count; i++)
-        if (t.s->tri_node[t.a.texels[i].tri] == 0 && t.a.texels[i].pos[1] < 0.04f)
-            texels[n++] = i;
+    lm_rt *rt;
+    uint32_t n, *texels = node_texels(&t, 0, 0.04f, &rt, &n); /* the lowest 4 rows: 4 floor texels' widths */
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
     set.scheme = LM_GATHER_RAYS;
