@@ -80,8 +80,8 @@ static inline int lmgi_knob_is_pow2(double v)
     /* given: a scene with one light gets 640 a group (docs/tradeoff.md, "Defaults against the front") */             \
     X(photons, count, LMGI_KNOB_COUNT, uint32_t, 0, 1, 100000000, 0, LMGI_NO_RULE, "--photons", "N",                \
       LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                          \
-      "total photon budget (default: groups x per-group, at least 46,080; bake, and\n"                            \
-      "run and check where more: 4 a texel of the atlas, up to 1,048,576)")                                       \
+      "total photon budget (default: groups x per-group, at least 46,080; bake: 16 a\n"                            \
+      "texel of the atlas, run and check where more: 4 a texel; up to 1,048,576)")                                 \
     X(photons, groups, LMGI_KNOB_COUNT, uint32_t, 72, 1, 1 << 20, 0,                                               \
       LMGI_RULE(lmgi_knob_is_2a3b(v), "2^a 3^b groups (1, 2, 3, 4, 6, 8, 9, 12, ..., 72, ...) up to 2^20"),       \
       "--groups", "G", LMGI_CLI_ZERO_NONE, LMGI_NO_CHOICES,                                                        \
