@@ -725,7 +725,7 @@ static void contact_faces(const lmgi_scene *sc, const float *iim)
  * the AIM's photon noise where they meet the floor (within 2% with 200k photons). Loaded and solved as
  * `lmgi bake` solves it (load_as_bake: 16 photons a texel, a bounce pass, 4 x 4 direct parts), the small
  * box's lit faces are issue 33's item 1 at a bake's density: each within 2% per channel (measured within
- * 0.4%, 0.9% at 4 photons a texel; `lmgi check --as-bake`'s frame at 7 of 8 seeds, docs/gather.md,
+ * 0.4%, 0.9% at 4 photons a texel; `lmgi check --as-bake`'s frame at 8 of 8 seeds, docs/gather.md,
  * "Strata"). The reference's 0.05 is enough for means over hundreds of texels (this scene has no rare
  * bright paths: its light is an area light). */
 static void test_iim_bake_density(void **state)

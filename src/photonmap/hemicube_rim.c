@@ -337,12 +337,13 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
 #define CONTACT_BELOW 0.2618 /* 15 degrees */
 #define CONTACT_SPLIT 8
 
-/* Whether row j of side, upright, lies within CONTACT_BELOW under the level: u from the level's 1 / 2 down
- * to the elevation's cdf at -CONTACT_BELOW. */
-static int contact_row(int j, int side)
+/* The rows of side, upright, within CONTACT_BELOW under the level: *lo and the count that follow it, up to
+ * the level's row (u from the elevation's cdf at -CONTACT_BELOW up to the level's 1 / 2); 0 for none. */
+static int contact_rows(int side, int *lo)
 {
     double b = -CONTACT_BELOW, lowest = (b + sin(b) * cos(b) + 0.5 * LM_PI) / LM_PI;
-    return (double)(j + 1) / side <= 0.5 + 1e-12 && (double)j / side >= lowest - 1e-12;
+    *lo = (int)ceil(lowest * side - 1e-9);
+    return (int)floor(0.5 * side + 1e-9) - *lo;
 }
 
 /* The split of a standing texel: CONTACT_SPLIT where straight down (-A) it meets a surface within
@@ -388,16 +389,16 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
     int K = side * side;
     cos_sin *sub = NULL; /* upright: every row's sub-rows, shared by its strata (NULL, out of memory: the polar
                             strata, the same measure) */
-    cos_sin *split = NULL; /* with fr->split: the contact rows' split rows' sub-rows, split x SUB a row (NULL:
-                              every row as one) */
-    int n = fr->split;
+    cos_sin *split = NULL; /* with fr->split: the contact rows' (`rows` from row `lo`) split rows' sub-rows,
+                              split x SUB a row (NULL: every row as one) */
+    int n = fr->split, lo = 0, rows = 0;
     if (fr->upright && (sub = malloc(sizeof *sub * (size_t)side * SUB)) != NULL) {
         for (int k = 0; k < side * SUB; k++)
             sub[k] = elevation((k + 0.5) / (side * SUB));
-        if (n > 1 && (split = malloc(sizeof *split * (size_t)side * n * SUB)) != NULL)
-            for (int j = 0; j < side; j++)
-                for (int k = 0; contact_row(j, side) && k < n * SUB; k++)
-                    split[((size_t)j * n * SUB) + k] = elevation((j + (k + 0.5) / (n * SUB)) * d);
+        if (n > 1 && (rows = contact_rows(side, &lo)) > 0 &&
+            (split = malloc(sizeof *split * (size_t)rows * n * SUB)) != NULL)
+            for (int k = 0; k < rows * n * SUB; k++)
+                split[k] = elevation((lo + k / (n * SUB) + (k % (n * SUB) + 0.5) / (n * SUB)) * d);
     }
     /* the rays gather's rows each put their rays at their own fraction of their columns, a Kronecker sequence
      * down the rows as `at` is across the columns: a column's rays at one azimuth (its middle) read something
@@ -417,9 +418,9 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
             double before[3] = {sum[0][0], sum[0][1], sum[0][2]};
             double ax = spread ? fmod(across_shift[0] + j * LM_GOLDEN_FRACTION, 1.0) : 0.5;
             uint32_t own = seed * (uint32_t)K + (uint32_t)(i * side + j);
-            if (split && contact_row(j, side))
-                split_stratum(r, nr, m, eye, fr, split + (size_t)j * n * SUB, G, phi0, d, j * d, d, ax, at, own, sum,
-                              back_w);
+            if (split && j >= lo && j < lo + rows)
+                split_stratum(r, nr, m, eye, fr, split + (size_t)(j - lo) * n * SUB, G, phi0, d, j * d, d, ax, at, own,
+                              sum, back_w);
             else
                 stratum(r, nr, m, eye, fr, sub ? sub + (size_t)j * SUB : NULL, G, phi0, d, j * d, d, ax, at, own,
                         sum, back_w);
