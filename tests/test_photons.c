@@ -932,8 +932,17 @@ static int edit_cube(world *w, lm_moved_nodes *mv, float *boxes)
     memcpy(m, w->s->nodes[cube].world, sizeof m);
     m[12] -= 0.8f; /* still in room A */
     m[14] += 0.5f;
-    memcpy(w->s->nodes[cube].world, m, sizeof m); /* as its animation would: no box */
-    assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes), 0);
+    memcpy(w->s->nodes[cube].world, m, sizeof m); /* as its animation would: no box without room for it */
+    assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes, 0), 0);
+    float nudged[16];
+    memcpy(nudged, m, sizeof m);
+    nudged[14] += 0.01f;
+    memcpy(w->s->nodes[cube].world, nudged, sizeof m); /* with room: its box where it was, then where it is */
+    assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes, 2), 2);
+    assert_float_equal(boxes[6 + 2] - boxes[2], 0.01, 1e-5);
+    assert_float_equal(boxes[6 + 5] - boxes[5], 0.01, 1e-5);
+    memcpy(w->s->nodes[cube].world, m, sizeof m); /* and back, no room: noted, no box */
+    assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes, 0), 0);
     lm_error err; /* its paths caught up, as the round robin would in time */
     assert_int_equal(lm_rt_set_node_transform(w->rt, cube, w->s->nodes[cube].world, &err), LM_OK);
     lm_photon_frame_stats st;
@@ -941,8 +950,8 @@ static int edit_cube(world *w, lm_moved_nodes *mv, float *boxes)
     m[12] -= 0.1f;
     assert_true(lm_scene_set_node_world(w->s, cube, m)); /* an edit */
     assert_int_equal(lm_rt_set_node_transform(w->rt, cube, w->s->nodes[cube].world, &err), LM_OK);
-    int n = lm_moved_nodes_boxes(mv, w->s, boxes);
-    assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes), 0); /* seen once */
+    int n = lm_moved_nodes_boxes(mv, w->s, boxes, 0);
+    assert_int_equal(lm_moved_nodes_boxes(mv, w->s, boxes, 0), 0); /* seen once */
     return n;
 }
 

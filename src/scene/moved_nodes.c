@@ -41,7 +41,7 @@ static int animated(const lm_scene *s, int node)
     return 0;
 }
 
-int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out)
+int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out, int animated_room)
 {
     int boxes = 0;
     for (int n = 0; n < s->node_count && n < m->node_count; n++) {
@@ -49,7 +49,9 @@ int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out)
         if (!memcmp(seen, s->nodes[n].world, 16 * sizeof(float)))
             continue;
         const float *b = m->local_box + 6 * n;
-        if (b[0] <= b[3] && !animated(s, n)) {
+        int by_animation = animated(s, n);
+        if (b[0] <= b[3] && (!by_animation || animated_room >= 2)) {
+            animated_room -= by_animation ? 2 : 0;
             lm_box_placed(b, seen, out + 6 * boxes++);
             lm_box_placed(b, s->nodes[n].world, out + 6 * boxes++);
         }

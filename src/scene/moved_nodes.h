@@ -2,9 +2,11 @@
  * the photon stage queues the paths of at once (trace/photons.h, lm_photons_invalidate_boxes), where the
  * paper's round robin alone finds a moved object's changed paths one photon a group an update.
  *
- * A node counts when its world matrix changed and no animation drives it (no channel on it or on a node
- * above it that is not itself placed by an edit, lm_node.edited): animated nodes move a little every frame
- * and are the round robin's, as in the paper. Its box is its triangles' box in its local space
+ * A node counts when its world matrix changed. One an animation drives (a channel on it or on a node above
+ * it that is not itself placed by an edit, lm_node.edited) counts only within the caller's room for them:
+ * animated nodes move a little every frame, and the paper leaves them to the round robin, which finds
+ * their changed paths one photon a group an update; a moving cube's own faces then read the floor's AIM
+ * from where the cube stood seconds ago (docs/photons.md, "Animated nodes"). Its box is its triangles' box in its local space
  * (lm_scene_node_local_boxes) placed by the old and the new matrix (lm_box_placed), so a child that follows
  * an edited parent counts too.
  *
@@ -25,10 +27,11 @@ typedef struct {
 
 lm_status lm_moved_nodes_init(lm_moved_nodes *m, const lm_scene *s, lm_error *err);
 void lm_moved_nodes_free(lm_moved_nodes *m);
-/* Into out (room for 12 x node_count floats, LM_MOVED_NODE_BOXES a node): for every node with triangles an
- * edit moved since the last call (or the init), its world box where it was, then where it is; every node's
- * matrix noted. Returns how many boxes (two a moved node). */
+/* Into out (room for 12 x node_count floats, LM_MOVED_NODE_BOXES a node): for every node with triangles that
+ * moved since the last call (or the init), its world box where it was, then where it is, those of animated
+ * nodes only while animated_room (boxes) lasts; every node's matrix noted. Returns how many boxes (two a
+ * moved node). */
 #define LM_MOVED_NODE_BOXES 12
-int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out);
+int lm_moved_nodes_boxes(lm_moved_nodes *m, const lm_scene *s, float *out, int animated_room);
 
 #endif

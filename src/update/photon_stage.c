@@ -888,6 +888,16 @@ static lm_status catch_up(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_er
     return st;
 }
 
+/* The boxes the animated nodes' moves may queue paths with this frame (moved_nodes.h): each costs a test
+ * of every stored photon's path (lm_photons_invalidate_boxes), so past LM_ANIMATED_BOX_WORK photons a box
+ * the round robin alone finds their changed paths, as in the paper. */
+static int animated_room(const lm_photon_stage *ps)
+{
+    uint32_t photons = lm_photons_count(ps->photons);
+    uint32_t room = photons ? LM_ANIMATED_BOX_WORK / photons : LM_MOVED_NODE_BOXES;
+    return room > (uint32_t)(2 * ps->scene->node_count) ? 2 * ps->scene->node_count : (int)room;
+}
+
 /* lm_photon_stage_animate; `bake`: a full trace follows, which traces newly lit emitters with the rest
  * (and counts their paths as changed), so they are not traced at once here. */
 static lm_status animate(lm_photon_stage *ps, float t, int bake, lm_photon_stage_frame *out, lm_error *err)
@@ -905,8 +915,9 @@ static lm_status animate(lm_photon_stage *ps, float t, int bake, lm_photon_stage
     /* what the edits committed since the last frame changed (update/edits.h), taken once */
     const lm_edit_changes *ch = lm_edits_changes(ps->edits);
     int moved = ch->moved && ps->photons && ps->set.trace;
-    if (moved) { /* an edit's move: its paths queued now (moved_nodes.h) */
-        int boxes = lm_moved_nodes_boxes(&ps->moves, ps->scene, ps->move_boxes);
+    int room = ps->scene->animation_count > 0 && ps->photons && ps->set.trace ? animated_room(ps) : 0;
+    if (moved || room > 0) { /* an edit's move, or an animation's: their paths queued now (moved_nodes.h) */
+        int boxes = lm_moved_nodes_boxes(&ps->moves, ps->scene, ps->move_boxes, room);
         lm_photons_invalidate_boxes(ps->photons, ps->move_boxes, boxes);
     }
     int added = 0;
