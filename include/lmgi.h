@@ -611,6 +611,10 @@ typedef struct {
     int aim_surfaces_refreshed; /* for the photons that changed, and at once for a light, emission or colour
                                  * edit (those are in ms_aim too, not ms_animate) */
     uint32_t texels_gathered;  /* IIM texels regathered */
+    uint32_t texels_estimated; /* texels waiting to be regathered whose estimate from a few rays (the change of
+                                * what they see since their gather) this update brought up to date and shows
+                                * (docs/gather.md, "Rays for the texels that wait"); gather.texels_per_frame x
+                                * 16 at most, counted in ms_gather */
     int texels_budget;         /* the texels this update was allowed (budget_ms > 0: from the measured cost) */
     int surfaces_changed;      /* surfaces whose displayed lightmap changed (lmgi_surface_version moved) */
     uint32_t caustic_photons_retraced; /* caustic photons traced (a moved light or mirror/glass node: all its) */

@@ -176,6 +176,13 @@ static inline int lmgi_knob_is_pow2(double v)
       "the changes its neighbours within R texels were gathered with (default 3;\n"                             \
       "0: off, its old value, so a changed region fills in texel by texel;\n"                                      \
       "docs/gather.md, \"Progressive refinement\")")                                                             \
+    X(gather, estimate_rays, LMGI_KNOB_INT, int, 36, 1, 1024, 1, LMGI_NO_RULE, "--estimate-rays", "N",             \
+      LMGI_CLI_ZERO_OFF, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                           \
+      "a texel waiting to be regathered shows, until it is, the change of\n"                                      \
+      "what N rays from it see since its gather, up to 16 texels an update for\n"                                 \
+      "each gathered (default 36; 0: off, its neighbours' changes alone, which\n"                                 \
+      "never reach a texel gathered while a moving node stood beside it;\n"                                        \
+      "docs/gather.md, \"Rays for the texels that wait\")")                                                      \
     X(gather, resolution, LMGI_KNOB_INT, int, 32, 2, 1024, 0, LMGI_NO_RULE, "--hemicube", "R", LMGI_CLI_ZERO_NONE,\
       LMGI_NO_CHOICES, LMGI_SWEEP(5, "hemicube", "hemicube resolution R", (16, 24, 32, 48, 64), (16, 32, 64), 0),\
       "hemicube plane pixels per side (default 32)")                                                               \

@@ -4,9 +4,11 @@
  * surfaces by their photons' change) the moving cube's own faces, whose photons hardly change, wait
  * behind the floor for good: a block of them is 2.1 times off after 60 updates and growing (the mean of
  * the samples' worst blocks 1.11). With texels picked by the change of what they see, the worst block is
- * 0.55 off and that mean 0.32; with the texels still waiting shown from the changes of those gathered
- * (progressive refinement, item 3; gpu/gather/iim.h), 0.46 and 0.27 (0.62 / 0.35 and 0.47 / 0.29 while a
- * commit's own frame showed none of its step, iim.h). The updaters run side by side on the
+ * 0.46 off and that mean 0.30 (0.55 and 0.32 before animated nodes' paths were queued by their boxes and a
+ * texel recommitted soon after its last commit blended over fewer updates); with the texels still waiting
+ * shown from an estimate (progressive refinement, item 3; gpu/gather/iim.h), 0.39 and 0.14 (their
+ * neighbours' changes alone: 0.46 and 0.27; 0.62 / 0.35 and 0.47 / 0.29 while a commit's own frame showed
+ * none of its step, iim.h). The updaters run side by side on the
  * same scene and times, so the test shows the difference it guards. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -26,18 +28,22 @@
 #define FRAMES 60
 #define EVERY 6
 
+static lmgi_updater *updater_with(lmgi_context *ctx, lmgi_scene *sc, const lmgi_updater_desc *d)
+{
+    lmgi_updater *u = NULL;
+    lmgi_error e;
+    if (lmgi_updater_create(ctx, sc, d, &u, &e) != LMGI_OK)
+        fail_msg("%s", e.message);
+    return u;
+}
+
 static lmgi_updater *updater(lmgi_context *ctx, lmgi_scene *sc, float texel_change, int spread)
 {
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
-    d.frame.width = d.frame.height = 0;
     d.gather.texel_change = texel_change;
     d.gather.spread = spread;
-    lmgi_updater *u = NULL;
-    lmgi_error e;
-    if (lmgi_updater_create(ctx, sc, &d, &u, &e) != LMGI_OK)
-        fail_msg("%s", e.message);
-    return u;
+    return updater_with(ctx, sc, &d);
 }
 
 /* The lightmap a fresh updater bakes at time t. */
@@ -56,33 +62,42 @@ static float *converged(lmgi_context *ctx, float t)
     return iim;
 }
 
-/* The largest relative difference of a 4 x 4 block's summed rgb (texels valid in both), against a floor
- * of 5% of the mean texel so that nearly black blocks do not dominate. */
-static double worst_block(const lmgi_info *in, const float *shown, const float *want)
+/* The mean texel's summed rgb of want (its valid texels). */
+static double mean_texel(const lmgi_info *in, const float *want)
 {
     double mean = 0.0;
     int valid = 0;
     for (size_t i = 0; i < 4 * (size_t)in->atlas_width * in->atlas_height; i += 4)
         if (want[i + 3] > 0.0f)
             mean += want[i] + want[i + 1] + want[i + 2], valid++;
-    mean /= valid ? valid : 1;
-    double worst = 0.0;
-    for (int by = 0; by < in->atlas_height; by += 4)
-        for (int bx = 0; bx < in->atlas_width; bx += 4) {
-            double a = 0.0, b = 0.0;
-            int c = 0;
-            for (int y = by; y < by + 4 && y < in->atlas_height; y++)
-                for (int x = bx; x < bx + 4 && x < in->atlas_width; x++) {
-                    size_t k = 4 * ((size_t)y * in->atlas_width + x);
-                    if (!(want[k + 3] > 0.0f) || !(shown[k + 3] > 0.0f))
-                        continue;
-                    a += shown[k] + shown[k + 1] + shown[k + 2];
-                    b += want[k] + want[k + 1] + want[k + 2];
-                    c++;
-                }
-            if (c)
-                worst = fmax(worst, fabs(a - b) / fmax(b, 0.05 * mean * c));
+    return mean / (valid ? valid : 1);
+}
+
+/* The relative difference of the 4 x 4 block at (bx, by)'s summed rgb (texels valid in both), against a floor
+ * of 5% of the mean texel so that nearly black blocks do not dominate; 0 for a block with no such texel. */
+static double block_error(const lmgi_info *in, const float *shown, const float *want, int bx, int by, double mean)
+{
+    double a = 0.0, b = 0.0;
+    int c = 0;
+    for (int y = by; y < by + 4 && y < in->atlas_height; y++)
+        for (int x = bx; x < bx + 4 && x < in->atlas_width; x++) {
+            size_t k = 4 * ((size_t)y * in->atlas_width + x);
+            if (!(want[k + 3] > 0.0f) || !(shown[k + 3] > 0.0f))
+                continue;
+            a += shown[k] + shown[k + 1] + shown[k + 2];
+            b += want[k] + want[k + 1] + want[k + 2];
+            c++;
         }
+    return c ? fabs(a - b) / fmax(b, 0.05 * mean * c) : 0.0;
+}
+
+/* The largest block_error. */
+static double worst_block(const lmgi_info *in, const float *shown, const float *want)
+{
+    double mean = mean_texel(in, want), worst = 0.0;
+    for (int by = 0; by < in->atlas_height; by += 4)
+        for (int bx = 0; bx < in->atlas_width; bx += 4)
+            worst = fmax(worst, block_error(in, shown, want, bx, by, mean));
     return worst;
 }
 
@@ -94,12 +109,7 @@ static double worst_block(const lmgi_info *in, const float *shown, const float *
 static double worst_step(const lmgi_info *in, const float *shown, const float *want, const float *before)
 {
     const int W = in->atlas_width, H = in->atlas_height;
-    double mean = 0.0, worst = 0.0;
-    int valid = 0;
-    for (size_t i = 0; i < 4 * (size_t)W * H; i += 4)
-        if (want[i + 3] > 0.0f)
-            mean += want[i] + want[i + 1] + want[i + 2], valid++;
-    mean /= valid ? valid : 1;
+    double mean = mean_texel(in, want), worst = 0.0;
     for (int y = 0; y < H; y++)
         for (int x = 0; x < W; x++)
             for (int d = 0; d < 2; d++) {
@@ -165,14 +175,14 @@ static void test_moving_cube_followed_texel_by_texel(void **state)
                       "the samples' worst %.2f); worst step between neighbours %.2f of the mean texel (mean %.2f)\n",
                       FRAMES, name[k], worst[k], sum[k] / samples, step[k], step_sum[k] / samples);
     assert_true(worst[0] > 1.5);  /* the stall this guards against (2.06 measured) */
-    /* each alone: 0.55 and 0.32 measured (0.62 and 0.35 while a commit's frame showed none of it; 0.66 and 0.43 with the bar to go ahead at 4 times the atlas's mean
+    /* each alone: 0.46 and 0.30 measured (0.55 and 0.32 before the boxes and the shorter blends; 0.62 and 0.35 while a commit's frame showed none of it; 0.66 and 0.43 with the bar to go ahead at 4 times the atlas's mean
      * change, not its median) (the frame budget, 20 texels, is spent every update); 0.86 and 0.50
      * while the texels a surface's refresh gathered kept their change, and the bar to go ahead with it */
     assert_true(worst[1] < 0.8);
     assert_true(sum[1] / samples < 0.45 * sum[0] / samples); /* 0.32 against 1.11 */
-    /* those waiting shown from their gathered neighbours (progressive refinement, issue 32 item 3) */
-    assert_true(worst[2] < 0.58); /* 0.46 measured */
-    assert_true(sum[2] / samples < 0.85 * sum[1] / samples); /* 0.27 against 0.32 */
+    /* those waiting shown from an estimate (progressive refinement, issue 32 item 3): their own rays' */
+    assert_true(worst[2] < 0.58); /* 0.39 measured (0.46 from their neighbours' changes alone) */
+    assert_true(sum[2] / samples < 0.85 * sum[1] / samples); /* 0.14 against 0.30 */
     for (int k = 0; k < 3; k++) {
         lmgi_updater_free(u[k]);
         lmgi_free(sc[k]);
@@ -360,21 +370,21 @@ static void test_one_move_refined(void **state)
     for (int k = 0; k < 2; k++) {
         r[k] = one_move(ctx, &in, want, k, 1, UPDATES);
         assert_true(r[k].last < 0.1);
-        /* 27 and 24 measured: the move's 66 photon groups re-traced 16 an update and its AIMs refreshed 4 an
+        /* 26 and 7 measured (24 from the neighbours' changes alone, before update/ray_estimate.h): the move's 66 photon groups re-traced 16 an update and its AIMs refreshed 4 an
          * update (photon_stage.c), its texels 15 an update, blended over 8. Before, 0.44 and 0.46 after 40
          * updates, never within 10%: the moved cube's paths were found one photon a group an update, its faces
          * were gathered from AIMs that had not caught up and not again, and a floor texel by its old place held
          * its old contact shadow while the floor's refresh lasted (photons.h lm_photons_invalidate_boxes,
          * texel_change.h lm_texel_change_settle, lightmap_path.c commit_waiting) */
-        assert_true(r[k].within <= (k ? 27 : 30));
+        assert_true(r[k].within <= (k ? 12 : 30));
     }
-    /* the steps a texel gathered among stale ones makes: 0.28 of the mean texel on average over the updates
-     * alone, 0.17 with those waiting shown from it; the worst, 0.81 alone, in the first update (a texel
-     * gathered beside those that came out of the cube's old place, which show at once, blending in from the
-     * old contact shadow), 0.46 with it starting from its neighbours' estimate */
+    /* the steps a texel gathered among stale ones makes: 0.26 of the mean texel on average over the updates
+     * alone, 0.12 with those waiting shown from their own rays' estimate (0.17 from their neighbours' changes
+     * alone); the worst, 0.78 alone, in the first update (a texel gathered beside those that came out of the
+     * cube's old place, which show at once, blending in from the old contact shadow), 0.36 (0.46) */
     assert_true(r[1].step_sum < 0.7 * r[0].step_sum);
     assert_true(r[1].step < 0.6 * r[0].step);
-    assert_true(r[1].block_sum < 1.1 * r[0].block_sum); /* and the blocks no worse (0.27 and 0.25) */
+    assert_true(r[1].block_sum < 1.1 * r[0].block_sum); /* and the blocks no worse (0.09 and 0.25) */
     free(want);
     lmgi_context_free(ctx);
 }
@@ -549,6 +559,123 @@ static void test_recolour_worst_surface_first(void **state)
     lmgi_context_free(ctx);
 }
 
+/* Which 4 x 4 atlas blocks are over 10% off `want` (block_error) into over[]; returns how many. */
+static int blocks_over(const lmgi_info *in, const float *shown, const float *want, uint8_t *over)
+{
+    double mean = mean_texel(in, want);
+    int n = 0, bw = (in->atlas_width + 3) / 4;
+    for (int by = 0; by < in->atlas_height; by += 4)
+        for (int bx = 0; bx < in->atlas_width; bx += 4) {
+            int o = block_error(in, shown, want, bx, by, mean) > 0.1;
+            over[(by / 4) * bw + bx / 4] = (uint8_t)o;
+            n += o;
+        }
+    return n;
+}
+
+/* Per 4 x 4 block of sc's atlas, 1 where a texel of it lies on a dynamic node (a short ray from the texel
+ * into its surface meets one). */
+static uint8_t *moving_blocks(const lmgi_scene *sc, const lmgi_info *in)
+{
+    int bw = (in->atlas_width + 3) / 4;
+    uint8_t *moving = calloc((size_t)bw * ((in->atlas_height + 3) / 4), 1);
+    assert_non_null(moving);
+    for (uint32_t i = 0; i < in->texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        float o[3], dir[3];
+        for (int k = 0; k < 3; k++)
+            o[k] = t.position[k] + 0.01f * t.normal[k], dir[k] = -t.normal[k];
+        lmgi_hit h;
+        lmgi_intersect(sc, o, dir, 0.05f, &h);
+        if (h.hit && lmgi_node_is_dynamic(sc, h.node))
+            moving[(t.y / 4) * bw + t.x / 4] = 1;
+    }
+    return moving;
+}
+
+typedef struct {
+    double over;       /* blocks over 10%, mean over the samples */
+    int trail, moving; /* the longest run of updates a block stayed over 10%: of the static surfaces (the trail
+                        * a node leaves), and of the moving nodes' own */
+    double ms;         /* mean update */
+} trail_stats;
+
+enum { TRAIL_UPDATES = 60, TRAIL_EVERY = 3 };
+
+/* The animated box updated with estimate_rays (0: the default), each TRAIL_EVERY-th update against want. */
+static trail_stats trail_of(lmgi_context *ctx, float *const *want, int estimate_rays)
+{
+    lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
+    lmgi_updater_desc d;
+    memset(&d, 0, sizeof d);
+    d.gather.estimate_rays = estimate_rays;
+    lmgi_updater *u = updater_with(ctx, sc, &d);
+    lmgi_error e;
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    int nb = ((in.atlas_width + 3) / 4) * ((in.atlas_height + 3) / 4), samples = 0, total = 0;
+    int *run = calloc((size_t)nb, sizeof *run);
+    uint8_t *over = calloc((size_t)nb, 1), *moving = moving_blocks(sc, &in);
+    assert_non_null(run);
+    assert_non_null(over);
+    trail_stats r = {0};
+    for (int f = 0; f < TRAIL_UPDATES; f++) {
+        lmgi_update_stats s;
+        if (lmgi_update(u, (float)f / 30.0f, 0.0f, &s, &e) != LMGI_OK)
+            fail_msg("%s", e.message);
+        r.ms += s.ms_total / TRAIL_UPDATES;
+        if (!want[f])
+            continue;
+        size_t n;
+        float *shown = lmt_iim(u, sc, &n);
+        total += blocks_over(&in, shown, want[f], over);
+        samples++;
+        for (int b = 0; b < nb; b++) {
+            run[b] = over[b] ? run[b] + TRAIL_EVERY : 0;
+            int *longest = moving[b] ? &r.moving : &r.trail;
+            *longest = run[b] > *longest ? run[b] : *longest;
+        }
+        free(shown);
+    }
+    r.over = (double)total / samples;
+    free(run);
+    free(over);
+    free(moving);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    return r;
+}
+
+/* Issue 32, item 6 (no trail behind moving objects): the animated Cornell box at `run`'s density, every 3rd of
+ * 60 updates against a fresh updater's bake at that time, per 4 x 4 block of atlas texels: how many blocks
+ * are over 10% off, and the longest run of updates one stayed so, apart for the static surfaces (the trail
+ * a node leaves) and the moving nodes' own faces. The texels that wait show the change their own rays see
+ * (update/ray_estimate.h), against their neighbours' loans alone (estimate_rays off). Measured: 1.50 blocks
+ * over 10% against 6.95, the trail's longest run 12 updates against 33, the moving nodes' own 27 against 48.
+ * The issue's bound, 10 updates, is not met: see docs/tradeoff.md, "Nodes that keep moving". */
+static void test_animated_box_trail(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    float *want[TRAIL_UPDATES] = {0};
+    for (int f = TRAIL_EVERY - 1; f < TRAIL_UPDATES; f += TRAIL_EVERY)
+        want[f] = converged(ctx, (float)f / 30.0f);
+    trail_stats r[2] = {trail_of(ctx, want, 0), trail_of(ctx, want, LMGI_OFF)};
+    static const char *const name[2] = {"rays for the texels that wait", "neighbours' loans alone"};
+    for (int k = 0; k < 2; k++)
+        print_message("animated Cornell box, %d updates, %s: %.2f blocks over 10%% off a fresh bake (mean), the "
+                      "longest run %d updates on static surfaces, %d on the moving nodes' own; mean update %.1f ms\n",
+                      TRAIL_UPDATES, name[k], r[k].over, r[k].trail, r[k].moving, r[k].ms);
+    assert_true(r[1].trail >= 24); /* the trail this guards against */
+    assert_true(r[0].over < 0.4 * r[1].over);
+    assert_true(r[0].trail <= 18);
+    assert_true(r[0].moving < 0.7 * r[1].moving);
+    for (int f = 0; f < TRAIL_UPDATES; f++)
+        free(want[f]);
+    lmgi_context_free(ctx);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -559,6 +686,8 @@ int main(void)
         cmocka_unit_test(test_drag_released_caught_up),
         cmocka_unit_test(test_drag_released_under_budget),
         cmocka_unit_test(test_recolour_worst_surface_first),
+        cmocka_unit_test(test_animated_box_trail),
     };
+    lmt_filter_from_env();
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

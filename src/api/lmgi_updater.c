@@ -14,6 +14,7 @@
 #include "../trace/emitter_light.h"
 #include "../update/bake_checkpoint.h"
 #include "../update/frame_loop.h"
+#include "../update/ray_estimate.h"
 #include "lmgi_camera.h"
 #include "lmgi_context.h"
 #include "lmgi_scene.h"
@@ -110,6 +111,9 @@ static void gather_settings(const lmgi_updater_desc *r, lm_frame_loop_settings *
     s->iim.blend_frames = g->blend_frames == LMGI_OFF ? 0 : g->blend_frames;
     s->iim.texel_change = g->texel_change == LMGI_OFF ? -1.0f : g->texel_change;
     s->iim.spread = g->spread == LMGI_OFF ? 0 : g->spread;
+    /* lmgi_knobs.h's gather.estimate_rays: its default is the estimator's own */
+    _Static_assert(LM_RAY_ESTIMATE_RAYS == 36, "gather.estimate_rays' table line");
+    s->iim.estimate_rays = g->estimate_rays == LMGI_OFF ? 0 : g->estimate_rays;
     s->gather.resolution = g->resolution;
     s->gather.enlargement = g->enlargement;
     s->gather.samples = g->samples;
@@ -460,6 +464,7 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->aim_surfaces_refreshed = st->aim.surfaces_refreshed;
     o->aim_surfaces_at_once = st->aim_at_once;
     o->texels_gathered = fs->texels_gathered;
+    o->texels_estimated = fs->texels_estimated;
     o->texels_budget = fs->plan.texels;
     o->surfaces_changed = changed;
     o->caustic_photons_retraced = st->caustics.traced;

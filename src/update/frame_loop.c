@@ -11,6 +11,7 @@
 #include "frame_passes.h"
 #include "light_scale.h"
 #include "lightmap_path.h"
+#include "ray_estimate.h"
 #include "photon_path.h"
 #include "stage_worker.h"
 
@@ -276,6 +277,7 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
     lm_photon_stage_limit(fl->stage, &l);
     lm_frame_passes_limit_faces(fl->passes, p->faces);
     lm_lightmap_path_set_texels_per_frame(fl->lightmaps, p->texels);
+    lm_lightmap_path_set_ray_budget(fl->lightmaps, LM_RAY_ESTIMATE_PER_TEXEL * (uint32_t)(p->texels > 0 ? p->texels : 0));
     lm_lightmap_path_set_scale_rays(fl->lightmaps, p->scale_rays, p->ms[LM_STAGE_LIGHT_SCALE]);
 }
 
@@ -336,8 +338,10 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     if (st == LM_OK)
         st = prepare_frame(fl, o, err);
     double t1 = lm_now();
-    if (st == LM_OK)
+    if (st == LM_OK) {
         st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
+        o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, NULL);
+    }
     if (st == LM_OK)
         st = lm_lightmap_path_gather(fl->lightmaps, o->texels_gathered, err);
     o->t_photons = t1 - t0;
@@ -358,15 +362,18 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
 {
     double t0 = lm_now();
     lm_status st = animate(fl, t, o, err);
-    if (st == LM_OK)
+    double te = 0.0; /* the ray estimates in the schedule: the gather's time, not the stage's */
+    if (st == LM_OK) {
         st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
+        o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, &te);
+    }
     double t1 = lm_now();
     if (st == LM_OK)
         st = prepare_frame(fl, o, err);
     if (st != LM_OK)
         return st;
     st = lm_lightmap_path_gather(fl->lightmaps, o->texels_gathered, err);
-    o->t_gather = lm_now() - t1;
+    o->t_gather = lm_now() - t1 + te;
     if (st == LM_OK)
         st = blend(fl, o, err);
     double job = job_seconds(&o->stage);
@@ -383,7 +390,7 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
             *err = worker_err;
     }
     note_stage(fl, &o->stage);
-    o->t_photons = (t1 - t0) + (lm_now() - t4); /* what the frame spent on or waiting for the stage */
+    o->t_photons = (t1 - t0 - te) + (lm_now() - t4); /* what the frame spent on or waiting for the stage */
     return st;
 }
 
@@ -430,13 +437,16 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     o->stage.t_photons = done.t_photons;
     o->stage.t_aim += done.t_aim;
     o->stage.t_caustics = done.t_caustics;
-    if (st == LM_OK)
+    double te = 0.0; /* as in step_overlapped */
+    if (st == LM_OK) {
         st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
+        o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, &te);
+    }
     double t1 = lm_now();
-    o->t_photons = t1 - t0;
+    o->t_photons = t1 - t0 - te;
     if (st == LM_OK)
         st = lm_lightmap_path_gather(fl->lightmaps, o->texels_gathered, err);
-    o->t_gather = lm_now() - t1;
+    o->t_gather = lm_now() - t1 + te;
     if (st == LM_OK)
         st = blend_and_render(fl, o, err); /* no frame: the blend alone */
     if (st == LM_OK) {

@@ -90,6 +90,7 @@ void lm_frame_loop_settings_default(lm_frame_loop_settings *s);
 typedef struct {
     lm_photon_stage_frame stage;
     uint32_t texels_gathered;
+    uint32_t texels_estimated; /* waiting texels whose ray estimate was brought up to date (ray_estimate.h) */
     lm_caustic_pass_stats caustic; /* the frame's caustic pass */
     uint32_t caustic_landed, caustic_thin; /* the caustic photons the frame showed, and of those the ones its
                                             * lightmaps carried (photonmap/caustic_split.h) */

@@ -72,17 +72,31 @@ static uint32_t rays_of(const lm_atlas *a, uint32_t lo, uint32_t hi, quality q)
     return n * q.K;
 }
 
-/* Texel i's two gathers (header) into e0 and e1 (3 floats each). */
-static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_rim *now, uint32_t i, float *e0,
-                    float *e1)
+/* Texel i's frame as the gather sees it: its eye, the plane's axes b and t, its normals n and ng. */
+static void texel_frame(const lm_light_scale_world *w, uint32_t i, float eye[3], float b[3], float t[3], float n[3],
+                        float ng[3])
 {
-    float eye[3], n[3], ng[3], b[3], t[3];
     lm_gather_texel_frame(w->set, w->scene, w->atlas, i, eye, n, ng);
     lm_vec3 tv, bv;
     lm_tangents(lm_v3_load(n), &tv, &bv);
     lm_v3_store(t, tv);
     lm_v3_store(b, bv);
+}
+
+/* Texel i's two gathers (header) into e0 and e1 (3 floats each). */
+static void gathers(const lm_light_scale_world *w, const lm_rim *was, const lm_rim *now, uint32_t i, float *e0,
+                    float *e1)
+{
+    float eye[3], n[3], ng[3], b[3], t[3];
+    texel_frame(w, i, eye, b, t, n, ng);
     lm_rim_irradiance_pair(was, now, eye, b, t, n, ng, lm_gather_texel_seed(w->set, i), e0, e1);
+}
+
+void lm_light_scale_texel_rim(const lm_light_scale_world *w, const lm_rim *r, uint32_t i, float e[3])
+{
+    float eye[3], n[3], ng[3], b[3], t[3];
+    texel_frame(w, i, eye, b, t, n, ng);
+    lm_rim_irradiance(r, eye, b, t, n, ng, lm_gather_texel_seed(w->set, i), e, NULL);
 }
 
 /* Whether texel i's window at `at` holds the texel dx, dy from it: on its surface and gathered (done).

@@ -70,6 +70,7 @@
 
 #include "../charts/charts.h"
 #include "../gpu/gather/hemicube.h"
+#include "../photonmap/hemicube_rim.h"
 #include "../scene/scene.h"
 #include "../trace/rt_scene.h"
 
@@ -106,6 +107,12 @@ typedef struct {
     const lm_rt *rt;
     const lm_hemicube_settings *set; /* the gather's (offset, sky) */
 } lm_light_scale_world;
+
+/* Texel i's ray gather by r (photonmap/hemicube_rim.h) into e, from its frame as the gather sees it, with its
+ * seed (lm_gather_texel_seed): the rays every texel gather of this layer casts (a light edit's two,
+ * update/ray_estimate.h's). Thread-safe as lm_rim_irradiance is. */
+void lm_light_scale_texel_rim(const lm_light_scale_world *w, const lm_rim *r, uint32_t i, float e[3]);
+
 
 typedef struct {
     float *before, *emissive_before; /* owned: the dilated AIM and per material emission before the edit */

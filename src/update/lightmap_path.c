@@ -15,6 +15,7 @@
 #include "../trace/emitter_light.h"
 #include "gather_passes.h"
 #include "light_scale.h"
+#include "ray_estimate.h"
 
 struct lm_lightmap_path {
     lm_frame_loop_settings *set; /* the loop's, borrowed */
@@ -39,6 +40,13 @@ struct lm_lightmap_path {
     uint64_t scale_cast;
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
+    lm_ray_estimate rays;      /* with have_rays (from the first gather on, where waiting texels show an
+                                * estimate): their own, from a few rays (ray_estimate.h) */
+    int have_rays;
+    uint32_t *ray_list;        /* scratch: the texels whose ray estimate an update brought up to date */
+    uint32_t ray_budget;       /* at most this many an update (lm_lightmap_path_set_ray_budget) */
+    uint32_t estimated;        /* how many the last schedule did */
+    double estimate_seconds;   /* and the seconds the ray estimates took in it */
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
     int caught_up;             /* the stage caught up with this step's placements before its gather */
     int placed_now;            /* and this step's widen saw them move, or saw moves since the last catch-up
@@ -182,6 +190,8 @@ static lm_status follow_light(lm_lightmap_path *lp, lm_error *err)
     if (!lp->have_iim)
         return LM_OK;
     sync_gather_switches(lp);
+    if (unlit && lp->have_rays) /* what the texels saw is gone with the light; their regathers see anew */
+        lm_ray_estimate_forget(&lp->rays);
     return unlit ? lm_iim_clear(&lp->iim, lp->atlas, err) : LM_OK;
 }
 
@@ -253,6 +263,9 @@ void lm_lightmap_path_free(lm_lightmap_path *lp)
         lm_emitter_light_free(&lp->emitters);
     if (lp->have_change)
         lm_texel_change_free(&lp->change);
+    if (lp->have_rays)
+        lm_ray_estimate_free(&lp->rays);
+    free(lp->ray_list);
     free(lp->texels);
     free(lp->refreshed);
     free(lp->scale);
@@ -351,6 +364,57 @@ static lm_status bounce_passes(lm_lightmap_path *lp, lm_error *err)
     return st;
 }
 
+/* Whether texels that wait show an estimate (iim.h, progressive refinement). */
+static int shows_estimates(const lm_lightmap_path *lp)
+{
+    return lp->change.threshold >= 0.0f && lp->iim.set.spread > 0;
+}
+
+/* The texels' ray estimates begun (ray_estimate.h): every texel's base over the AIM the first gather read. */
+static lm_status start_rays(lm_lightmap_path *lp, lm_error *err)
+{
+    const lm_atlas *a = lp->atlas;
+    lm_status st = lm_ray_estimate_init(&lp->rays, a->texel_count, lp->set->iim.estimate_rays, err);
+    if (st != LM_OK)
+        return st;
+    if (!(lp->ray_list = malloc(sizeof *lp->ray_list * (a->texel_count ? a->texel_count : 1)))) {
+        lm_ray_estimate_free(&lp->rays);
+        return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the texels' ray estimates", lp->scene->path);
+    }
+    lp->have_rays = 1;
+    lm_light_scale_world w = {lp->scene, a, lp->rt, &lp->set->gather};
+    for (uint32_t i = 0; i < a->texel_count; i++)
+        lp->ray_list[i] = i;
+    lm_ray_estimate_gathered(&lp->rays, &w, lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->ray_list,
+                             a->texel_count);
+    return LM_OK;
+}
+
+/* The ray estimates of this update (ray_estimate.h): the bases of the `count` texels gathered now, over the
+ * AIM they are gathered from, and of the `waiting` ones after them in lp->texels, some brought up to date and
+ * shown. */
+static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting, uint32_t budget)
+{
+    lp->estimated = 0;
+    lp->estimate_seconds = 0.0;
+    if (!lp->have_rays)
+        return;
+    double t0 = lm_now();
+    lm_light_scale_world w = {lp->scene, lp->atlas, lp->rt, &lp->set->gather};
+    const float *aim = lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage));
+    lm_iim_sight_gathered(&lp->iim, lp->atlas, lp->texels, count);
+    lm_ray_estimate_gathered(&lp->rays, &w, aim, lp->texels, count);
+    const uint32_t *wait = lp->texels + count;
+    float *change = malloc(sizeof *change * (waiting ? waiting : 1));
+    for (uint32_t k = 0; change && k < waiting; k++)
+        change[k] = lm_texel_change_of(&lp->change, wait[k]);
+    uint32_t m = change ? lm_ray_estimate_update(&lp->rays, &w, aim, wait, change, waiting, budget, lp->ray_list) : 0;
+    free(change);
+    lm_iim_set_sight(&lp->iim, lp->atlas, lp->ray_list, lp->rays.delta, m);
+    lp->estimated = m;
+    lp->estimate_seconds = lm_now() - t0;
+}
+
 lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_error *err)
 {
     double t0 = lm_now();
@@ -368,6 +432,8 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
                                   lp->set->iim.texel_change, err);
         lp->have_change = st == LM_OK;
     }
+    if (st == LM_OK && lp->have_change && !lp->have_rays && shows_estimates(lp) && lp->set->iim.estimate_rays > 0)
+        st = start_rays(lp, err);
     lm_gl_finish(); /* the time holds the GPU's work too: the budget's first guess starts from it */
     if (t_gather)
         *t_gather = lm_now() - t0;
@@ -386,6 +452,8 @@ void lm_lightmap_path_caught_up(lm_lightmap_path *lp)
  * set in scaled. */
 static void scale_iim(lm_lightmap_path *lp, const float *factor, const float *add, uint8_t *scaled)
 {
+    if (lp->have_rays)
+        lm_ray_estimate_scale(&lp->rays, factor, add);
     lm_error e;
     if (lm_iim_scale(&lp->iim, lp->atlas, factor, add, scaled, &e) != LM_OK)
         lm_log(LM_LOG_WARN, "%s", e.msg); /* the regathers the scaled hits call for still come */
@@ -549,6 +617,7 @@ static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int 
             waiting = lm_texel_change_waiting(&lp->change, lp->atlas, lp->iim.sched.off, lp->texels + count);
     }
     lm_iim_set_pending(&lp->iim, lp->atlas, lp->texels + count, waiting);
+    ray_estimates(lp, count, waiting, whole ? 0 : lp->ray_budget);
     lm_light_scale_regathered(&lp->scaling, lp->texels, count); /* fresh: a refined factor would spoil them */
     if (whole) /* a bake: in atlas order, so that where a texel lands in the gather's passes (and its
                 * rounding) depends on which texels are gathered, not on how they were picked */
@@ -636,6 +705,15 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
 
 lm_iim *lm_lightmap_path_iim(lm_lightmap_path *lp) { return &lp->iim; }
 const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp) { return &lp->iim; }
+
+void lm_lightmap_path_set_ray_budget(lm_lightmap_path *lp, uint32_t texels) { lp->ray_budget = texels; }
+
+uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds)
+{
+    if (seconds)
+        *seconds = lp->estimate_seconds;
+    return lp->estimated;
+}
 
 void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels)
 {

@@ -64,6 +64,11 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
 lm_iim *lm_lightmap_path_iim(lm_lightmap_path *lp);
 const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp);
 void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels);
+/* The waiting texels an update brings their ray estimates up to date for (ray_estimate.h; 0: none), and how
+ * many the last schedule did, with their bases, in *seconds (may be NULL): the gather's work, wherever the
+ * step times its schedule. */
+void lm_lightmap_path_set_ray_budget(lm_lightmap_path *lp, uint32_t texels);
+uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds);
 /* The rays a light edit's texel factors may cast an update (update/light_scale.h; 0: no bound, the full
  * quality in the edit's update) and the milliseconds its refinement may take (0: no bound), what its
  * refinement still has to cast, and the rays it cast and the milliseconds it took since the last take

@@ -21,6 +21,7 @@ void lm_iim_settings_default(lm_iim_settings *s)
     s->texel_change = 0.03125f;
     s->backface_limit = 0.1f;
     s->spread = 3;
+    s->estimate_rays = 36; /* LM_RAY_ESTIMATE_RAYS (update/ray_estimate.h, a layer above) */
 }
 
 /* The six atlas textures in binding order (glsl/iim_blend_cs.glsl): fresh, old, new, display, delta, carry. */
@@ -98,6 +99,8 @@ static lm_status init_gl(lm_iim *iim, const lm_atlas *a, lm_error *err)
                  GL_DYNAMIC_DRAW);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
     free(surf);
+    if (!(iim->sight_tex = lm_iim_texture_create(a->width, a->height)))
+        return lm_fail(err, LM_ERR_BACKEND, "IIM: could not make a %dx%d RGBA32F texture", a->width, a->height);
     st = lm_gl_check("IIM: blend buffers", err);
     return st == LM_OK ? init_turn(iim, a, err) : st;
 }
@@ -114,8 +117,10 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
     iim->list = malloc(sizeof *iim->list * (a->texel_count ? a->texel_count : 1));
     iim->version_touch = calloc(S, 1);
     iim->active = calloc(S, 1);
+    iim->sight = calloc(4 * (size_t)a->width * a->height + 4, sizeof *iim->sight);
+    iim->spent = malloc(sizeof *iim->spent * (a->texel_count ? a->texel_count : 1));
     lm_status st = iim->blend_start && iim->version && iim->texel_start && iim->list && iim->version_touch &&
-                           iim->active
+                           iim->active && iim->sight && iim->spent
                        ? lm_iim_sched_init(&iim->sched, a, set->texels_per_frame, set->delta_threshold, err)
                        : lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for %d surfaces", a->surface_count);
     if (st == LM_OK)
@@ -135,6 +140,7 @@ void lm_iim_free(lm_iim *iim)
     textures(iim, tex);
     for (int i = 0; i < IIM_TEXTURES; i++)
         lm_iim_texture_free(*tex[i]);
+    lm_iim_texture_free(iim->sight_tex);
     if (iim->turn_tex[0])
         glDeleteTextures(3, iim->turn_tex);
     if (iim->blend_prog) {
@@ -155,6 +161,8 @@ void lm_iim_free(lm_iim *iim)
     free(iim->version_touch);
     free(iim->active);
     free(iim->version);
+    free(iim->sight);
+    free(iim->spent);
     memset(iim, 0, sizeof *iim);
 }
 
@@ -179,6 +187,57 @@ void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, 
 {
     if (iim->set.spread > 0)
         lm_iim_pending_add(&iim->pending, a, texels, n, iim->version_touch);
+}
+
+void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, uint32_t n)
+{
+    for (uint32_t j = 0; j < n; j++) {
+        const lm_texel *t = &a->texels[texels[j]];
+        float *cell = iim->sight + 4 * ((size_t)t->y * a->width + t->x);
+        memcpy(cell, change + 3 * (size_t)texels[j], 3 * sizeof *cell);
+        cell[3] = 1.0f;
+        for (int dy = -LM_IIM_SIGHT_SPREAD; dy <= LM_IIM_SIGHT_SPREAD; dy++) /* and the neighbours that average it */
+            for (int dx = -LM_IIM_SIGHT_SPREAD; dx <= LM_IIM_SIGHT_SPREAD; dx++) {
+                int x = (int)t->x + dx, y = (int)t->y + dy;
+                int32_t q = x < 0 || y < 0 || x >= a->width || y >= a->height ? -1 : a->texel_index[(size_t)y * a->width + x];
+                if (q >= 0)
+                    lm_iim_pending_redraw(&iim->pending, (uint32_t)q);
+            }
+    }
+    iim->sight_dirty |= n > 0;
+}
+
+void lm_iim_sight_gathered(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n)
+{
+    for (uint32_t j = 0; j < n; j++) {
+        const lm_texel *t = &a->texels[texels[j]];
+        uint32_t c = t->y * a->width + t->x;
+        if (iim->sight[4 * (size_t)c + 3] <= 0.5f || iim->spent_count >= a->texel_count)
+            continue;
+        iim->sight[4 * (size_t)c + 3] = -1.0f;
+        iim->spent[iim->spent_count++] = c;
+        iim->sight_dirty = 1;
+    }
+}
+
+/* The frame's estimates of their own to the GPU, if any changed. */
+static void upload_sight(lm_iim *iim)
+{
+    if (!iim->sight_dirty || !iim->sight_tex)
+        return;
+    glBindTexture(GL_TEXTURE_2D, iim->sight_tex);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, iim->width, iim->height, GL_RGBA, GL_FLOAT, iim->sight);
+    glBindTexture(GL_TEXTURE_2D, 0);
+    iim->sight_dirty = 0;
+}
+
+/* The cells whose texel was gathered this frame hold no estimate of their own from the next on. */
+static void clear_spent(lm_iim *iim)
+{
+    for (uint32_t j = 0; j < iim->spent_count; j++)
+        memset(iim->sight + 4 * (size_t)iim->spent[j], 0, 4 * sizeof *iim->sight);
+    iim->sight_dirty |= iim->spent_count > 0;
+    iim->spent_count = 0;
 }
 
 /* One list pass of iim_blend: mode `mode` over the `count` entries of buffer `buf`, bound at `binding`,
@@ -264,9 +323,11 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     const lm_iim_pending *pend = &iim->pending;
     if (!any_commit && iim->settled && !pend->op_count && !pend->redraw_count) { /* nothing shows differently */
         free(param);
+        clear_spent(iim);
         lm_iim_sched_end_frame(&iim->sched);
         return LM_OK;
     }
+    upload_sight(iim);
     int atlas_pass = any_commit || !iim->settled; /* else only estimates to draw */
     iim->settled = !blending;
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, iim->params_buf);
@@ -278,10 +339,13 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glUniform1i(glGetUniformLocation(iim->blend_prog, "blend_frames"), iim->set.blend_frames);
     glUniform1f(glGetUniformLocation(iim->blend_prog, "limit"), iim->set.backface_limit);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "spread"), iim->set.spread);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "sight_spread"), LM_IIM_SIGHT_SPREAD);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "sight_blend"), LM_IIM_SIGHT_BLEND);
     unsigned *tex[IIM_TEXTURES];
     textures(iim, tex);
     for (int i = 0; i < IIM_TEXTURES; i++)
         glBindImageTexture((GLuint)i, *tex[i], 0, GL_FALSE, 0, i ? GL_READ_WRITE : GL_READ_ONLY, GL_RGBA32F);
+    glBindImageTexture(IIM_TEXTURES, iim->sight_tex, 0, GL_FALSE, 0, GL_READ_ONLY, GL_RGBA32F);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, iim->surface_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, iim->params_buf);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, iim->start_buf);
@@ -302,6 +366,7 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     run_lists(iim, (list_pass){4, iim->list_buf, 3, NULL, rebased},
               (list_pass){2, iim->redraw_buf, 5, pend->redraw, pend->redraw_count});
     iim->list_count = 0;
+    clear_spent(iim);
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     lm_iim_sched_end_frame(&iim->sched);
     return lm_gl_check("IIM blend (iim_blend)", err);
@@ -316,6 +381,12 @@ lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, cons
                                         (add && (add[3 * i] != 0.0f || add[3 * i + 1] != 0.0f || add[3 * i + 2] != 0.0f));
     for (int k = 0; k < iim->sched.surface_count; k++)
         iim->version[k] += scaled[k];
+    for (uint32_t i = 0; i < a->texel_count; i++) { /* the estimates of their own scale with what they add to */
+        float *cell = iim->sight + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
+        for (int c = 0; c < 3 && cell[3] != 0.0f; c++)
+            cell[c] *= factor[3 * i + c];
+        iim->sight_dirty |= cell[3] != 0.0f;
+    }
     if (!iim->blend_prog)
         return LM_OK;
     if (!iim->scale_prog) {

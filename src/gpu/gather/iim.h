@@ -44,6 +44,13 @@
 #include "iim_pending.h"
 
 #define LM_IIM_DEFAULT_TEXELS_PER_FRAME 20 /* the paper's */
+/* Texels either side whose estimates of their own (lm_iim_set_sight) a waiting texel's averages, each weighed
+ * by a tent: one texel's few rays mottle, and its neighbours see about the same change. */
+#define LM_IIM_SIGHT_SPREAD 2
+/* Frames at most a texel that showed an estimate of its own blends in its gather over: the estimate was
+ * already the change, and its gather only refines it. Over blend_frames the moving cube's own faces
+ * trailed their light by 5 updates (10% off for 60 updates in the animated Cornell box), over 2 for 33. */
+#define LM_IIM_SIGHT_BLEND 2
 
 typedef struct {
     int texels_per_frame;  /* gather budget per frame (default LM_IIM_DEFAULT_TEXELS_PER_FRAME) */
@@ -57,6 +64,8 @@ typedef struct {
                             * blend with what it saw from inside geometry (default 0.1) */
     int spread;            /* texels a pending texel borrows changes from (header; default 3, 0: none,
                             * each texel shows its old value until gathered) */
+    int estimate_rays;     /* rays a pending texel's estimate of its own casts (update/ray_estimate.h; default
+                            * 36, 0: none, its neighbours' loans alone); read by the lightmap path */
 } lm_iim_settings;
 
 typedef struct {
@@ -71,9 +80,14 @@ typedef struct {
     uint8_t *active;       /* scratch per surface: a texel of it committed or blending this frame */
     uint32_t *version;     /* per surface: blends that changed its displayed texels (a commit, or a blend
                             * still under way) */
+    float *sight;          /* per atlas cell, 4: a waiting texel's own estimate (lm_iim_set_sight), rgb its change,
+                            * a 1 while it holds one, -1 in the frame its texel is gathered (its commit carries
+                            * what it showed: no rebase), 0 none */
+    uint32_t *spent, spent_count; /* the cells at -1, cleared after the blend */
+    int sight_dirty;       /* sight changed since its upload */
     int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */
-    unsigned fresh_tex, old_tex, new_tex, display_tex, delta_tex, carry_tex;
+    unsigned fresh_tex, old_tex, new_tex, display_tex, delta_tex, carry_tex, sight_tex;
     unsigned turn_tex[3];  /* the footprint texels' turns (hemicube.h, lm_gather_set_turn), RGBA16F, written
                             * by the gather as it goes, not blended: relative, so the value they turn is
                             * the displayed one; all 0 where no texel turns */
@@ -93,6 +107,12 @@ void lm_iim_commit_texels(lm_iim *iim, const lm_atlas *a, const uint32_t *texels
 /* The texels (lm_atlas.texels indices) that wait to be regathered this frame (iim_pending.h): each shows
  * the estimate from its neighbours committed since it was (header). */
 void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n);
+/* Waiting texels[0 .. n) show, until their gather, their own value plus change[3 texels[j] + c] (per texel
+ * index; update/ray_estimate.h) instead of their neighbours' loans. */
+void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, uint32_t n);
+/* Texels[0 .. n) are gathered this frame: what their estimate showed is carried by their commit, and
+ * they hold none from the next frame on. */
+void lm_iim_sight_gathered(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n);
 /* Ends the frame on the GPU: commits the surfaces the scheduler completed (clearing their flags),
  * writes display = mix(old, new, t), then advances the scheduler's frame counter. instant: committed surfaces show new at once (after the first gather). */
 lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err);

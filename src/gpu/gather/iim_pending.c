@@ -17,7 +17,7 @@ lm_status lm_iim_pending_init(lm_iim_pending *p, uint32_t texel_count, lm_error 
     p->surface = malloc(sizeof *p->surface * T);
     p->ops = malloc(sizeof *p->ops * T);
     p->redraw = malloc(sizeof *p->redraw * T);
-    if (p->state && p->texel && p->cell && p->surface && p->ops && p->redraw)
+    if (p->state && p->seen && p->texel && p->cell && p->surface && p->ops && p->redraw)
         return LM_OK;
     lm_iim_pending_free(p);
     return lm_fail(err, LM_ERR_NOMEM, "IIM: no memory for the waiting texels of %u", texel_count);
@@ -51,6 +51,12 @@ void lm_iim_pending_add(lm_iim_pending *p, const lm_atlas *a, const uint32_t *te
     }
 }
 
+void lm_iim_pending_redraw(lm_iim_pending *p, uint32_t t)
+{
+    if (p->seen[t])
+        p->seen[t] = 2;
+}
+
 void lm_iim_pending_committed(lm_iim_pending *p, uint32_t t)
 {
     if (p->state[t])
@@ -65,7 +71,7 @@ void lm_iim_pending_frame(lm_iim_pending *p, const uint8_t *commit, const uint8_
         uint32_t t = p->texel[j];
         int32_t c = p->cell[j];
         int s = p->surface[j];
-        int committed = p->state[t] == COMMITTED || commit[s], listed = p->seen[t];
+        int committed = p->state[t] == COMMITTED || commit[s], listed = p->seen[t], fresh = listed == 2;
         p->seen[t] = 0;
         if (committed || !listed) {
             if (p->state[t] != NEW) /* one that began and ended in this frame was never flagged */
@@ -79,8 +85,10 @@ void lm_iim_pending_frame(lm_iim_pending *p, const uint8_t *commit, const uint8_
         }
         if (p->state[t] == NEW)
             p->ops[p->op_count++] = c + 1;
-        if (p->state[t] == NEW || active[s])
+        if (p->state[t] == NEW || active[s] || fresh)
             p->redraw[p->redraw_count++] = c;
+        if (fresh) /* its own estimate changed (lm_iim_pending_redraw) */
+            touched[s] = touched[s] ? touched[s] : 1;
         p->state[t] = WAITING;
         p->texel[kept] = t, p->cell[kept] = c, p->surface[kept++] = s;
     }

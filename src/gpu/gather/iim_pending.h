@@ -24,7 +24,7 @@
 
 typedef struct {
     uint8_t *state;       /* per texel: 0 not waiting; WAITING, NEW (began this frame), COMMITTED (leaves) */
-    uint8_t *seen;        /* per texel: listed by lm_iim_pending_add this frame */
+    uint8_t *seen;        /* per texel: listed by lm_iim_pending_add this frame (2: and its estimate changed) */
     uint32_t *texel, count; /* the waiting texels */
     int32_t *cell;        /* their atlas cells */
     int *surface;         /* their surfaces */
@@ -40,6 +40,9 @@ void lm_iim_pending_free(lm_iim_pending *p);
 /* The texels that wait this frame (every one: those not listed stop); touched[surface] is set for each
  * that began to. */
 void lm_iim_pending_add(lm_iim_pending *p, const lm_atlas *a, const uint32_t *texels, uint32_t n, uint8_t *touched);
+/* Texel t, listed as waiting this frame, shows an estimate of its own that changed (iim.h, lm_iim_set_sight):
+ * it is drawn again and its surface's version moves. */
+void lm_iim_pending_redraw(lm_iim_pending *p, uint32_t t);
 /* Texel t is committed on its own this frame: it stops waiting at lm_iim_pending_frame. */
 void lm_iim_pending_committed(lm_iim_pending *p, uint32_t t);
 /* The frame's lists: the texels committed (on their own, or with their surface: commit[s]) or no longer

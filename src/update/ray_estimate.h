@@ -1,0 +1,82 @@
+/* A waiting texel's first estimate from a few rays (issue 32, items 3 and 6; docs/gather.md, "Rays for
+ * the texels that wait"): what its hemisphere sees now against what it saw at its last gather, through
+ * the same rays.
+ *
+ * A texel regathered ahead of its surface (photonmap/texel_change.h) waits its turn while nodes keep
+ * moving: in the animated Cornell box at `run`'s 1,800 texels nearly every texel waits, and 20 gathers an
+ * update reach each about once in 90 updates. The neighbours' loans (iim.h, progressive refinement) do not
+ * reach a texel gathered while a cube stood beside it: none of its neighbours changed after it. Here each
+ * gather also keeps its texel's small ray gather over the same AIM and scene the hemicube saw (its base,
+ * E_0), and each update brings some of the waiting texels' ray gathers up to date (E_t); the texel then
+ * shows its gathered value plus
+ *
+ *     E_t - E_0   (rgb; the same K rays, the same seed: lm_gather_texel_seed)
+ *
+ * the change of what it sees since its gather. Both sums meet the same points where nothing moved, so the
+ * difference holds only what changed: the moved nodes where their rays now meet them or no longer do, and
+ * the AIMs' new light; its noise is the changed part's alone. Nothing is added where nothing changed.
+ *
+ * The ray gather is the rays scheme's estimator (photonmap/hemicube_rim.h with enlargement 0), K strata
+ * over the whole hemisphere, each ray's AIM averaged over its footprint, emitters' emission where met, the
+ * sky's mean where nothing is; it reads the whole dilated AIM (its direct part included, as a hemicube
+ * does), so bases and updates stay alike whatever the gather scheme.
+ *
+ * Which texels: those the caller lists as waiting, at most `budget` an update: half by their estimated
+ * change (texel_change.h) times the updates since each was last brought up to date, so that a moving
+ * cube's own faces, whose light changes every update, go every update or two; the other half by those
+ * updates alone, so that the rest go in turn. (In turns alone, each of the animated box's 1,800 waiting
+ * texels once in 6 updates at 320 an update, the cube's faces trailed their light by 6 updates; by change
+ * times wait alone, the floor's texels, whose summed change is a hundredth of the cube's faces', waited
+ * behind them: a floor block by the spheres trailed by 6 updates for 27.) A texel with no base (never
+ * gathered since the estimator began) is skipped.
+ *
+ * Layout: per texel its base (rgb), a flag, its last delta (rgb) and the update it was last brought up
+ * to date. Memory: 32 bytes a texel, and 16 a waiting texel while choosing.
+ * Cost: K rays and K footprints of AIM lookups per texel gathered (its base) and per texel brought up to
+ * date, on every OpenMP thread; choosing them O(waiting). Deterministic (each texel's rays are seeded by its index). Not
+ * thread-safe; the scene and AIM must not change meanwhile. Errors: none but memory at init. */
+#ifndef LM_RAY_ESTIMATE_H
+#define LM_RAY_ESTIMATE_H
+
+#include <stdint.h>
+
+#include "light_scale.h"
+
+/* Rays a texel's two gathers take by default: 4 x 4 strata. On the animated box's trail (docs/gather.md)
+ * fewer leave a texel's change mottled, more cost their time in rays the budget would rather spend on
+ * more texels. */
+#define LM_RAY_ESTIMATE_RAYS 36
+
+/* Waiting texels brought up to date an update for each texel the update gathers. */
+#define LM_RAY_ESTIMATE_PER_TEXEL 16
+
+typedef struct {
+    uint32_t texel_count;
+    int K;          /* rays a texel */
+    float *base;    /* per texel, 3: the ray gather at its last gather */
+    uint8_t *has;   /* per texel: base holds one */
+    float *delta;   /* per texel, 3: E_t - E_0 at its last update (lm_ray_estimate_update) */
+    uint32_t *stamp; /* per texel: the update its base or delta was last computed */
+    uint32_t frame;  /* updates so far (lm_ray_estimate_update calls) */
+} lm_ray_estimate;
+
+/* K rays a texel (rounded down to a square by the rim); no base yet. */
+lm_status lm_ray_estimate_init(lm_ray_estimate *re, uint32_t texel_count, int K, lm_error *err);
+void lm_ray_estimate_free(lm_ray_estimate *re);
+/* Texels[0 .. n) are gathered over aim (the dilated AIM, whole) and the scene as they are: their bases. */
+void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
+                              const uint32_t *texels, uint32_t n);
+/* Of the n waiting texels (change: each one's estimated change, texel_change.h), at most budget with a base,
+ * those with the greatest change times updates since they were last brought up to date (or gathered),
+ * brought up to date over aim: their indices into out (room for budget) and their deltas in re->delta.
+ * Returns how many. */
+uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
+                                const uint32_t *waiting, const float *change, uint32_t n, uint32_t budget,
+                                uint32_t *out);
+/* A light's edit moved every IIM texel to factor x IIM + add (light_scale.h): the bases and deltas follow,
+ * so that a later update counts only what came after it. */
+void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float *add);
+/* Every base forgotten (the IIM cleared: lm_iim_clear). */
+void lm_ray_estimate_forget(lm_ray_estimate *re);
+
+#endif
