@@ -27,7 +27,7 @@
  * updates alone, so that the rest go in turn. (In turns alone, each of the animated box's 1,800 waiting
  * texels once in 6 updates at 320 an update, the cube's faces trailed their light by 6 updates; by change
  * times wait alone, the floor's texels, whose summed change is a hundredth of the cube's faces', waited
- * behind them: a floor block by the spheres trailed by 6 updates for 27.) A texel with no base (never
+ * behind them: over 90 updates a floor block stayed 10% off for 24, against 18 with the halves.) A texel with no base (never
  * gathered since the estimator began) is skipped.
  *
  * Layout: per texel its base (rgb), a flag, its last delta (rgb) and the update it was last brought up
@@ -42,9 +42,9 @@
 
 #include "light_scale.h"
 
-/* Rays a texel's two gathers take by default: 4 x 4 strata. On the animated box's trail (docs/gather.md)
- * fewer leave a texel's change mottled, more cost their time in rays the budget would rather spend on
- * more texels. */
+/* Rays a texel's two gathers take by default: 6 x 6 strata. At 16 a texel's change mottles (one move in a
+ * held drag: the worst step between neighbours 0.52 of the mean texel against 0.44, and the animated box's
+ * trail 24 updates against 12); 64 cost more and did no better (0.46). */
 #define LM_RAY_ESTIMATE_RAYS 36
 
 /* Waiting texels brought up to date an update for each texel the update gathers. */
