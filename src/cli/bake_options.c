@@ -17,6 +17,8 @@ void lm_cli_bake_solution(const lmgi_info *in, int whole, lmgi_updater_desc *d)
         d->photons.count = lm_cli_bake_photons(in->texels);
     if (!d->aim.direct_parts)
         d->aim.direct_parts = LM_CLI_BAKE_DIRECT_PARTS;
+    if (!d->gather.estimate_rays) /* a bake shows every texel it gathers: none waits for an estimate */
+        d->gather.estimate_rays = LMGI_OFF;
     int local_lights = in->lights_by_type[LMGI_LIGHT_POINT] + in->lights_by_type[LMGI_LIGHT_SPOT];
     if (!d->gather.bounce_passes && whole && local_lights <= LM_CLI_BAKE_PASS_MAX_LIGHTS)
         d->gather.bounce_passes = LM_CLI_BAKE_BOUNCE_PASSES;

@@ -40,6 +40,8 @@ uint32_t lm_cli_bake_photons(uint32_t texels);
 /* d (from the command's options) given a bake's photons where neither --photons nor --per-group set them, its
  * AIMs' direct parts where --direct-parts did not, and its bounce passes where --bounce-passes did not and
  * the bake is `whole` (not a shard, whose passes are its merge's) with at most LM_CLI_BAKE_PASS_MAX_LIGHTS
- * point and spot lights; in: the loaded scene's info. */
+ * point and spot lights; no waiting texels' estimates where --estimate-rays did not ask for them (a bake
+ * shows every texel it gathers, and the estimates' bases would cost every texel's rays for nothing); in:
+ * the loaded scene's info. */
 void lm_cli_bake_solution(const lmgi_info *in, int whole, lmgi_updater_desc *d);
 #endif

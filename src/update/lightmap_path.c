@@ -617,7 +617,8 @@ static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int 
             waiting = lm_texel_change_waiting(&lp->change, lp->atlas, lp->iim.sched.off, lp->texels + count);
     }
     lm_iim_set_pending(&lp->iim, lp->atlas, lp->texels + count, waiting);
-    ray_estimates(lp, count, waiting, whole ? 0 : lp->ray_budget);
+    if (!whole) /* a bake's texels take their bases once it is through (lm_lightmap_path_bake) */
+        ray_estimates(lp, count, waiting, lp->ray_budget);
     lm_light_scale_regathered(&lp->scaling, lp->texels, count); /* fresh: a refined factor would spoil them */
     if (whole) /* a bake: in atlas order, so that where a texel lands in the gather's passes (and its
                 * rounding) depends on which texels are gathered, not on how they were picked */
@@ -691,6 +692,7 @@ lm_status lm_lightmap_path_bake(lm_lightmap_path *lp, lm_bake_progress progress,
         uint32_t before = 0, after = 0;
         for (int s = 0; s < S; s++)
             before += lp->iim.version[s];
+        ray_estimates(lp, n, 0, 0); /* what the bake's texels see now, their estimates' bases */
         st = lm_iim_blend(&lp->iim, 1, err);
         for (int s = 0; s < S; s++)
             after += lp->iim.version[s];
