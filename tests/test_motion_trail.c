@@ -512,6 +512,65 @@ static void test_drag_released_under_budget(void **state)
     lmgi_context_free(ctx);
 }
 
+/* A light's power edit while texels wait with estimates of their own (update/ray_estimate.h): the only light
+ * of the box halved during a drag held still, so that hundreds of texels show their own estimate at the
+ * edit. The light edit multiplies every map of the IIM by the texels' factors, exactly 1/2 here (one light),
+ * and the estimates with them (gpu/gather/iim.c, lm_iim_scale; ray_estimate.h, lm_ray_estimate_scale):
+ * the lightmap is half of what it was at the next update, but for the update's own gathers and estimates
+ * of the drag going on. Left unscaled, a waiting texel would show half its value plus its whole change. */
+static void test_estimates_follow_a_light_edit(void **state)
+{
+    (void)state;
+    lmgi_context *ctx = lmt_context();
+    lmgi_scene *sc = lmt_load(lmt_project_scene("cornell.glb"), TEXELS);
+    lmgi_updater *u = updater(ctx, sc, 0.0f, 0);
+    move_cube_by(sc, -0.001f); /* a drag under way: never caught up */
+    lmt_update(u);
+    move_cube_by(sc, -0.5f);
+    uint32_t estimated = 0;
+    for (int f = 0; f < 6; f++) {
+        hold_cube(sc);
+        estimated += lmt_update(u).texels_estimated;
+    }
+    size_t n;
+    float *before = lmt_iim(u, sc, &n);
+    lmgi_light l;
+    lmgi_error e;
+    assert_int_equal(lmgi_get_light(sc, 0, &l, &e), LMGI_OK);
+    l.intensity *= 0.5f;
+    assert_int_equal(lmgi_set_light(sc, 0, &l, &e), LMGI_OK);
+    hold_cube(sc);
+    lmgi_update_stats s = lmt_update(u);
+    float *after = lmt_iim(u, sc, &n);
+    lmgi_info in;
+    lmgi_get_info(sc, &in);
+    uint32_t compared = 0, off = 0;
+    double worst = 0.0;
+    for (uint32_t i = 0; i < in.texels; i++) {
+        lmgi_texel t;
+        lmgi_get_texel(sc, i, &t);
+        size_t k = 4 * ((size_t)t.y * in.atlas_width + t.x);
+        double a = before[k] + before[k + 1] + before[k + 2], b = after[k] + after[k + 1] + after[k + 2];
+        if (!(before[k + 3] > 0.0f) || !(after[k + 3] > 0.0f) || a <= 0.0)
+            continue;
+        double r = fabs(b / a / 0.5 - 1.0);
+        compared++;
+        off += r > 0.05;
+        worst = fmax(worst, r);
+    }
+    print_message("the light halved in a drag held still, %u estimates in the 6 updates before, %u in the edit's: "
+                  "%u of %u texels more than 5%% off half their value at the next update (worst %.3f)\n", estimated,
+                  s.texels_estimated, off, compared, worst);
+    assert_true(estimated > 300);
+    assert_true(s.lights_scaled == 1);
+    assert_true(off < compared / 50);
+    free(before);
+    free(after);
+    lmgi_updater_free(u);
+    lmgi_free(sc);
+    lmgi_context_free(ctx);
+}
+
 /* Material `name` of sc recoloured as bench/cornell_edits.json does the red wall. */
 static void recolour(lmgi_scene *sc, const char *name)
 {
@@ -687,6 +746,7 @@ int main(void)
         cmocka_unit_test(test_drag_released_under_budget),
         cmocka_unit_test(test_recolour_worst_surface_first),
         cmocka_unit_test(test_animated_box_trail),
+        cmocka_unit_test(test_estimates_follow_a_light_edit),
     };
     lmt_filter_from_env();
     return cmocka_run_group_tests(tests, NULL, NULL);
