@@ -118,6 +118,7 @@ lm_status lm_iim_init(lm_iim *iim, const lm_atlas *a, const lm_iim_settings *set
     iim->version_touch = calloc(S, 1);
     iim->active = calloc(S, 1);
     iim->sight = calloc(4 * (size_t)a->width * a->height + 4, sizeof *iim->sight);
+    iim->sight_dirty[0] = 1; /* none */
     iim->spent = malloc(sizeof *iim->spent * (a->texel_count ? a->texel_count : 1));
     lm_status st = iim->blend_start && iim->version && iim->texel_start && iim->list && iim->version_touch &&
                            iim->active && iim->sight && iim->spent
@@ -189,6 +190,16 @@ void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, 
         lm_iim_pending_add(&iim->pending, a, texels, n, iim->version_touch);
 }
 
+/* Cell (x, y)'s sight changed: in the rectangle to upload. */
+static void sight_touched(lm_iim *iim, int x, int y)
+{
+    int *d = iim->sight_dirty;
+    if (d[0] > d[2])
+        d[0] = d[2] = x, d[1] = d[3] = y;
+    d[0] = x < d[0] ? x : d[0], d[1] = y < d[1] ? y : d[1];
+    d[2] = x > d[2] ? x : d[2], d[3] = y > d[3] ? y : d[3];
+}
+
 void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, uint32_t n)
 {
     for (uint32_t j = 0; j < n; j++) {
@@ -196,6 +207,7 @@ void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, co
         float *cell = iim->sight + 4 * ((size_t)t->y * a->width + t->x);
         memcpy(cell, change + 3 * (size_t)texels[j], 3 * sizeof *cell);
         cell[3] = 1.0f;
+        sight_touched(iim, (int)t->x, (int)t->y);
         for (int dy = -LM_IIM_SIGHT_SPREAD; dy <= LM_IIM_SIGHT_SPREAD; dy++) /* and the neighbours that average it */
             for (int dx = -LM_IIM_SIGHT_SPREAD; dx <= LM_IIM_SIGHT_SPREAD; dx++) {
                 int x = (int)t->x + dx, y = (int)t->y + dy;
@@ -204,7 +216,6 @@ void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, co
                     lm_iim_pending_redraw(&iim->pending, (uint32_t)q);
             }
     }
-    iim->sight_dirty |= n > 0;
 }
 
 void lm_iim_sight_gathered(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n)
@@ -216,27 +227,32 @@ void lm_iim_sight_gathered(lm_iim *iim, const lm_atlas *a, const uint32_t *texel
             continue;
         iim->sight[4 * (size_t)c + 3] = -1.0f;
         iim->spent[iim->spent_count++] = c;
-        iim->sight_dirty = 1;
+        sight_touched(iim, (int)t->x, (int)t->y);
     }
 }
 
 /* The frame's estimates of their own to the GPU, if any changed. */
 static void upload_sight(lm_iim *iim)
 {
-    if (!iim->sight_dirty || !iim->sight_tex)
+    int *d = iim->sight_dirty;
+    if (d[0] > d[2] || !iim->sight_tex)
         return;
     glBindTexture(GL_TEXTURE_2D, iim->sight_tex);
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, iim->width, iim->height, GL_RGBA, GL_FLOAT, iim->sight);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, iim->width);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, d[0], d[1], d[2] - d[0] + 1, d[3] - d[1] + 1, GL_RGBA, GL_FLOAT,
+                    iim->sight + 4 * ((size_t)d[1] * iim->width + d[0]));
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
     glBindTexture(GL_TEXTURE_2D, 0);
-    iim->sight_dirty = 0;
+    d[0] = 1, d[2] = 0;
 }
 
 /* The cells whose texel was gathered this frame hold no estimate of their own from the next on. */
 static void clear_spent(lm_iim *iim)
 {
-    for (uint32_t j = 0; j < iim->spent_count; j++)
+    for (uint32_t j = 0; j < iim->spent_count; j++) {
         memset(iim->sight + 4 * (size_t)iim->spent[j], 0, 4 * sizeof *iim->sight);
-    iim->sight_dirty |= iim->spent_count > 0;
+        sight_touched(iim, (int)(iim->spent[j] % (uint32_t)iim->width), (int)(iim->spent[j] / (uint32_t)iim->width));
+    }
     iim->spent_count = 0;
 }
 
@@ -385,7 +401,8 @@ lm_status lm_iim_scale(lm_iim *iim, const lm_atlas *a, const float *factor, cons
         float *cell = iim->sight + 4 * ((size_t)a->texels[i].y * a->width + a->texels[i].x);
         for (int c = 0; c < 3 && cell[3] != 0.0f; c++)
             cell[c] *= factor[3 * i + c];
-        iim->sight_dirty |= cell[3] != 0.0f;
+        if (cell[3] != 0.0f)
+            sight_touched(iim, (int)a->texels[i].x, (int)a->texels[i].y);
     }
     if (!iim->blend_prog)
         return LM_OK;

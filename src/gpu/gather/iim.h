@@ -84,7 +84,9 @@ typedef struct {
                             * a 1 while it holds one, -1 in the frame its texel is gathered (its commit carries
                             * what it showed: no rebase), 0 none */
     uint32_t *spent, spent_count; /* the cells at -1, cleared after the blend */
-    int sight_dirty;       /* sight changed since its upload */
+    int sight_dirty[4];    /* the rectangle of cells whose sight changed since its upload: x0, y0, x1, y1
+                            * (x0 > x1: none), uploaded alone, so that an update's few hundred estimates cost
+                            * their rows, not a page's */
     int settled;           /* display already holds every surface's new map: lm_iim_blend has nothing to do */
     /* GPU side (0 when created without GL) */
     unsigned fresh_tex, old_tex, new_tex, display_tex, delta_tex, carry_tex, sight_tex;
