@@ -410,7 +410,7 @@ static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting
         change[k] = lm_texel_change_of(&lp->change, wait[k]);
     uint32_t m = change ? lm_ray_estimate_update(&lp->rays, &w, aim, wait, change, waiting, budget, lp->ray_list) : 0;
     free(change);
-    lm_iim_set_sight(&lp->iim, lp->atlas, lp->ray_list, lp->rays.delta, m);
+    lm_iim_set_sight(&lp->iim, lp->atlas, lp->ray_list, lp->rays.delta, lp->rays.base, m);
     lp->estimated = m;
     lp->estimate_seconds = lm_now() - t0;
 }

@@ -3,6 +3,7 @@
 
 #include "../gl/gl_api.h"
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -200,12 +201,17 @@ static void sight_touched(lm_iim *iim, int x, int y)
     d[2] = x > d[2] ? x : d[2], d[3] = y > d[3] ? y : d[3];
 }
 
-void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, uint32_t n)
+void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, const float *light,
+                      uint32_t n)
 {
     for (uint32_t j = 0; j < n; j++) {
         const lm_texel *t = &a->texels[texels[j]];
         float *cell = iim->sight + 4 * ((size_t)t->y * a->width + t->x);
-        memcpy(cell, change + 3 * (size_t)texels[j], 3 * sizeof *cell);
+        const float *c = change + 3 * (size_t)texels[j], *e = light + 3 * (size_t)texels[j];
+        float moved = fabsf(c[0] - cell[0]) + fabsf(c[1] - cell[1]) + fabsf(c[2] - cell[2]);
+        if (cell[3] == 1.0f && moved <= LM_IIM_SIGHT_KEEP * (fabsf(e[0]) + fabsf(e[1]) + fabsf(e[2])))
+            continue; /* shown already, to what the eye can tell */
+        memcpy(cell, c, 3 * sizeof *cell);
         cell[3] = 1.0f;
         sight_touched(iim, (int)t->x, (int)t->y);
         for (int dy = -LM_IIM_SIGHT_SPREAD; dy <= LM_IIM_SIGHT_SPREAD; dy++) /* and the neighbours that average it */

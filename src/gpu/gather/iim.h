@@ -51,6 +51,10 @@
  * already the change, and its gather only refines it. Over blend_frames the moving cube's own faces
  * trailed their light by 5 updates (10% off for 60 updates in the animated Cornell box), over 2 for 33. */
 #define LM_IIM_SIGHT_BLEND 2
+/* A waiting texel's estimate brought up to date by less than this share of its light is not drawn again:
+ * about one step of an 8-bit display. Every small change redrawn rewrote 3.5 times as many surfaces as
+ * before the estimates after the shared room's glass was recoloured (lmgi bench --edits). */
+#define LM_IIM_SIGHT_KEEP (1.0f / 256.0f)
 
 typedef struct {
     int texels_per_frame;  /* gather budget per frame (default LM_IIM_DEFAULT_TEXELS_PER_FRAME) */
@@ -110,8 +114,11 @@ void lm_iim_commit_texels(lm_iim *iim, const lm_atlas *a, const uint32_t *texels
  * the estimate from its neighbours committed since it was (header). */
 void lm_iim_set_pending(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n);
 /* Waiting texels[0 .. n) show, until their gather, their own value plus change[3 texels[j] + c] (per texel
- * index; update/ray_estimate.h) instead of their neighbours' loans. */
-void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, uint32_t n);
+ * index; update/ray_estimate.h) instead of their neighbours' loans; one that shows a change already within
+ * LM_IIM_SIGHT_KEEP of light[3 texels[j] + c] (its light, summed over the channels) of the new one keeps it,
+ * and its surface is not rewritten for it. */
+void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, const float *light,
+                      uint32_t n);
 /* Texels[0 .. n) are gathered this frame: what their estimate showed is carried by their commit, and
  * they hold none from the next frame on. */
 void lm_iim_sight_gathered(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, uint32_t n);
