@@ -325,6 +325,15 @@ static void note_stage(lm_frame_loop *fl, const lm_photon_stage_frame *f)
         lm_lightmap_path_aim_changed(fl->lightmaps);
 }
 
+/* The step's texels scheduled (lm_lightmap_path_schedule) and the waiting texels' estimates counted; *te
+ * (may be NULL) gets the estimates' seconds, the gather's time wherever the step times its schedule. */
+static lm_status schedule(lm_frame_loop *fl, lm_frame_stats *o, double *te, lm_error *err)
+{
+    lm_status st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
+    o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, te);
+    return st;
+}
+
 /* The paper's order: photon stage, then the gather over its fresh AIMs, blend, render. */
 static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
@@ -338,10 +347,8 @@ static lm_status step_in_order(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     if (st == LM_OK)
         st = prepare_frame(fl, o, err);
     double t1 = lm_now();
-    if (st == LM_OK) {
-        st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
-        o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, NULL);
-    }
+    if (st == LM_OK)
+        st = schedule(fl, o, NULL, err);
     if (st == LM_OK)
         st = lm_lightmap_path_gather(fl->lightmaps, o->texels_gathered, err);
     o->t_photons = t1 - t0;
@@ -363,10 +370,8 @@ static lm_status step_overlapped(lm_frame_loop *fl, float t, lm_frame_stats *o, 
     double t0 = lm_now();
     lm_status st = animate(fl, t, o, err);
     double te = 0.0; /* the ray estimates in the schedule: the gather's time, not the stage's */
-    if (st == LM_OK) {
-        st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
-        o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, &te);
-    }
+    if (st == LM_OK)
+        st = schedule(fl, o, &te, err);
     double t1 = lm_now();
     if (st == LM_OK)
         st = prepare_frame(fl, o, err);
@@ -438,10 +443,8 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     o->stage.t_aim += done.t_aim;
     o->stage.t_caustics = done.t_caustics;
     double te = 0.0; /* as in step_overlapped */
-    if (st == LM_OK) {
-        st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
-        o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, &te);
-    }
+    if (st == LM_OK)
+        st = schedule(fl, o, &te, err);
     double t1 = lm_now();
     o->t_photons = t1 - t0 - te;
     if (st == LM_OK)

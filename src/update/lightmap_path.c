@@ -613,7 +613,7 @@ static uint32_t pick(lm_lightmap_path *lp, uint32_t budget, uint32_t ahead, int 
         if (!whole) /* a bake shows every surface it gathers at once */
             commit_waiting(lp, lp->texels + n, count - n);
         lm_texel_change_gathered(&lp->change, lp->texels + n, count - n);
-        if (lp->change.threshold >= 0.0f && lp->iim.set.spread > 0) /* else nothing shows them */
+        if (shows_estimates(lp)) /* else nothing shows them */
             waiting = lm_texel_change_waiting(&lp->change, lp->atlas, lp->iim.sched.off, lp->texels + count);
     }
     lm_iim_set_pending(&lp->iim, lp->atlas, lp->texels + count, waiting);

@@ -69,7 +69,6 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
     lm_rim r = rays_over(re, w, aim);
     ray_gathers(w, &r, texels, n, re->base, NULL);
     for (uint32_t j = 0; j < n; j++) {
-        memset(re->delta + 3 * (size_t)texels[j], 0, 3 * sizeof *re->delta);
         re->has[texels[j]] = 1;
         re->stamp[texels[j]] = re->frame;
     }
@@ -147,14 +146,11 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
 
 void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float *add)
 {
-    for (size_t k = 0; k < 3 * (size_t)re->texel_count; k++) {
+    for (size_t k = 0; k < 3 * (size_t)re->texel_count; k++)
         re->base[k] = re->base[k] * factor[k] + (add ? add[k] : 0.0f);
-        re->delta[k] *= factor[k];
-    }
 }
 
 void lm_ray_estimate_forget(lm_ray_estimate *re)
 {
     memset(re->has, 0, re->texel_count ? re->texel_count : 1);
-    memset(re->delta, 0, 3 * sizeof *re->delta * (re->texel_count ? re->texel_count : 1));
 }

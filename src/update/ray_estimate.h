@@ -30,8 +30,9 @@
  * behind them: over 90 updates a floor block stayed 10% off for 24, against 18 with the halves.) A texel with no base (never
  * gathered since the estimator began) is skipped.
  *
- * Layout: per texel its base (rgb), a flag, its last delta (rgb) and the update it was last brought up
- * to date. Memory: 32 bytes a texel, and 16 a waiting texel while choosing.
+ * Layout: per texel its base (rgb), a flag and the update it was last brought up to date; the deltas an
+ * update computes, by texel index, for the caller to show (what is shown is the IIM's, iim.h, which a
+ * light edit scales there). Memory: 32 bytes a texel, and 16 a waiting texel while choosing.
  * Cost: K rays and K footprints of AIM lookups per texel gathered (its base) and per texel brought up to
  * date, on every OpenMP thread; choosing them O(waiting). Deterministic (each texel's rays are seeded by its index). Not
  * thread-safe; the scene and AIM must not change meanwhile. Errors: none but memory at init. */
@@ -55,7 +56,7 @@ typedef struct {
     int K;          /* rays a texel */
     float *base;    /* per texel, 3: the ray gather at its last gather */
     uint8_t *has;   /* per texel: base holds one */
-    float *delta;   /* per texel, 3: E_t - E_0 at its last update (lm_ray_estimate_update) */
+    float *delta;   /* per texel, 3: E_t - E_0, written by lm_ray_estimate_update for the texels it lists */
     uint32_t *stamp; /* per texel: the update its base or delta was last computed */
     uint32_t frame;  /* updates so far (lm_ray_estimate_update calls) */
 } lm_ray_estimate;
@@ -73,7 +74,7 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
 uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
                                 const uint32_t *waiting, const float *change, uint32_t n, uint32_t budget,
                                 uint32_t *out);
-/* A light's edit moved every IIM texel to factor x IIM + add (light_scale.h): the bases and deltas follow,
+/* A light's edit moved every IIM texel to factor x IIM + add (light_scale.h): the bases follow,
  * so that a later update counts only what came after it. */
 void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float *add);
 /* Every base forgotten (the IIM cleared: lm_iim_clear). */
