@@ -1024,6 +1024,55 @@ static void test_moved_node_boxes_queue_its_paths(void **state)
     }
 }
 
+/* An animated node's boxes (lm_photons_retrace_boxes): the photons whose paths cross them are re-traced one
+ * by one at once, and no changed path is left behind, with no group queued, for a fraction of the photons;
+ * the same photons, more than a frame's group budget can take, are queued as whole groups instead. World 0
+ * counts the changed paths (paths_behind traces them), 1 re-traces them, 2 has a budget of one group. */
+static void test_moved_node_boxes_retrace_photons(void **state)
+{
+    (void)state;
+    LMT_REQUIRE_SCENE(path, lmt_project_scene("two_rooms.glb"));
+    lm_error err;
+    world w[3];
+    lm_moved_nodes mv[3];
+    lm_photon_frame_stats st[3];
+    float *boxes = NULL;
+    int n = 0;
+    for (int k = 0; k < 3; k++) {
+        lm_photon_settings set;
+        lm_photon_settings_default(&set);
+        set.group_budget = k == 2 ? 1 : 16;
+        world_load(&w[k], path);
+        world_photons(&w[k], &set);
+        assert_int_equal(lm_moved_nodes_init(&mv[k], w[k].s, &err), LM_OK);
+        boxes = boxes ? boxes : malloc(sizeof *boxes * LM_MOVED_NODE_BOXES * (size_t)w[k].s->node_count);
+        assert_non_null(boxes);
+        n = edit_cube(&w[k], &mv[k], boxes);
+        if (k > 0)
+            assert_int_equal(lm_photons_retrace_boxes(w[k].ph, boxes, n, &st[k], &err), LM_OK);
+    }
+    uint32_t changed = paths_behind(&w[0]), behind = paths_behind(&w[1]), photons = lm_photons_count(w[1].ph);
+    print_message("the cube moved: %u paths changed; %u of %u photons met its boxes and were re-traced (%u paths "
+                  "replaced), %u groups queued, then %u paths differ from a full trace; with one group a frame, "
+                  "%u groups queued\n",
+                  changed, st[1].box_photons, photons, st[1].photons_updated, st[1].pending_groups, behind,
+                  st[2].pending_groups);
+    assert_true(changed > 100);
+    assert_int_equal(st[1].photons_updated, changed);
+    assert_true(st[1].box_photons >= changed && st[1].box_photons < photons / 4);
+    assert_int_equal(st[1].pending_groups, 0);
+    assert_int_equal(behind, 0);
+    assert_true(st[1].box_photons > photons / lm_photons_group_count(w[2].ph)); /* more than one group's worth */
+    assert_int_equal(st[2].box_photons, 0);
+    assert_int_equal(st[2].photons_updated, 0);
+    assert_true(st[2].pending_groups > 0);
+    free(boxes);
+    for (int k = 0; k < 3; k++) {
+        lm_moved_nodes_free(&mv[k]);
+        world_free(&w[k]);
+    }
+}
+
 /* lm_photons_reset keeps the memory but forgets everything else: after some store churn (a move,
  * settling, a move back), a reset and full trace on 3 threads gives the same store, slot for slot,
  * and the same paths as a fresh photon set traced on 1 thread. */
@@ -1280,6 +1329,7 @@ int main(void)
         cmocka_unit_test(test_retrace_emitter_leaves_queue),
         cmocka_unit_test(test_move_and_back),
         cmocka_unit_test(test_moved_node_boxes_queue_its_paths),
+        cmocka_unit_test(test_moved_node_boxes_retrace_photons),
         cmocka_unit_test(test_reset_matches_fresh),
         cmocka_unit_test(test_exact_trace_replaces_noise),
         cmocka_unit_test(test_settings),

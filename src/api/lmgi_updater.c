@@ -454,7 +454,8 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     memset(o, 0, sizeof *o);
     o->frame = st->frame;
     o->time = st->time;
-    o->photons_retraced = st->photons.rr_photons + st->photons.group_photons + st->caught_up.group_photons;
+    o->photons_retraced = st->photons.rr_photons + st->photons.group_photons + st->photons.box_photons +
+                          st->caught_up.group_photons;
     o->groups_invalidated = st->photons.groups_invalidated;
     o->groups_retraced = st->photons.groups_retraced + st->caught_up.groups_retraced;
     o->groups_at_once = st->caught_up.groups_retraced;

@@ -268,6 +268,53 @@ lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_batch *b, const p
     return ok ? LM_OK : fail_store(g, err);
 }
 
+/* The job of photon m among jobs[*k ..] (sorted by m), advancing *k; NULL when m has none. */
+static const ph_job *job_of(const ph_job *jobs, uint32_t n, uint32_t *k, uint32_t m)
+{
+    while (*k < n && jobs[*k].m < m)
+        ++*k;
+    return *k < n && jobs[*k].m == m ? &jobs[*k] : NULL;
+}
+
+lm_status ph_group_apply_some(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs, uint32_t n,
+                              lm_photon_frame_stats *st, lm_error *err)
+{
+    memset(ph->tmp_changed, 0, g->photons);
+    uint32_t changed = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        const ph_job *j = &jobs[k];
+        ph->tmp_changed[j->m] = (uint8_t)ph_path_changed(ph, g, j->m, ph_job_vertices(b, j), j->count);
+        changed += ph->tmp_changed[j->m];
+    }
+    if (!changed) /* the slab stays as it is */
+        return LM_OK;
+    uint32_t total = 0, k = 0;
+    for (uint32_t m = 0; m < g->photons; m++) {
+        const ph_job *j = job_of(jobs, n, &k, m);
+        total += ph->tmp_changed[m] ? j->count : g->offsets[m + 1] - g->offsets[m];
+    }
+    if (!reserve_verts(&ph->tmp_verts, &ph->tmp_cap, total, 0) || !reserve_verts(&g->verts, &g->vert_cap, total, 1))
+        return fail_paths(g, err);
+    int ok = 1;
+    uint32_t at = 0;
+    k = 0;
+    for (uint32_t m = 0; m < g->photons; m++) {
+        const ph_job *j = job_of(jobs, n, &k, m);
+        uint32_t len = ph->tmp_changed[m] ? j->count : g->offsets[m + 1] - g->offsets[m];
+        ph->tmp_offsets[m] = at;
+        if (ph->tmp_changed[m])
+            ok &= replace_path(ph, g, m, ph_job_vertices(b, j), j->count, ph->tmp_verts + at, st);
+        else if (len)
+            memcpy(ph->tmp_verts + at, g->verts + g->offsets[m], (size_t)len * sizeof *g->verts);
+        at += len;
+    }
+    ph->tmp_offsets[g->photons] = at;
+    if (total)
+        memcpy(g->verts, ph->tmp_verts, (size_t)total * sizeof *g->verts);
+    memcpy(g->offsets, ph->tmp_offsets, ((size_t)g->photons + 1) * sizeof *g->offsets);
+    return ok ? LM_OK : fail_store(g, err);
+}
+
 lm_status ph_apply_batch(lm_photons *ph, const ph_batch *b, lm_photon_frame_stats *st, lm_error *err)
 {
     uint64_t stored = 0;

@@ -498,34 +498,137 @@ uint32_t lm_photons_invalidate_materials(lm_photons *ph, const uint8_t *material
     return n;
 }
 
-uint32_t lm_photons_invalidate_boxes(lm_photons *ph, const float *boxes, int n)
+static void finish_stats(const lm_photons *ph, lm_photon_frame_stats *st, double t0)
 {
-    if (n <= 0)
-        return 0;
-    uint8_t *meets = calloc(ph->group_count ? ph->group_count : 1, 1);
+    st->pending_groups = ph->queue_len;
+    st->seconds = lm_now() - t0;
+}
+
+/* Which photons' stored paths cross one of the n boxes, in valid groups: met[first[g] + m] for photon m of
+ * group g (first: group_count + 1 offsets, computed here); with `whole`, a group's test stops at its first
+ * such photon (all its photons are re-traced anyway). Returns how many met one (with whole, at most one a
+ * group), or UINT32_MAX when memory ran out (then nothing is allocated). */
+static uint32_t paths_meeting(const lm_photons *ph, const float *boxes, int n, int whole, uint8_t **met,
+                              uint32_t **first)
+{
+    *first = malloc(sizeof **first * ((size_t)ph->group_count + 1));
     float *padded = malloc(sizeof *padded * 6 * (size_t)n);
-    if (!meets || !padded) { /* the round robin still finds them, later */
-        free(meets);
+    uint64_t photons = 0;
+    for (uint32_t gi = 0; *first && gi < ph->group_count; gi++)
+        (*first)[gi] = (uint32_t)photons, photons += ph->groups[gi].photons;
+    *met = *first ? calloc(photons ? photons : 1, 1) : NULL;
+    if (!*met || !padded) {
+        free(*met);
+        free(*first);
         free(padded);
-        return 0;
+        return UINT32_MAX;
     }
+    (*first)[ph->group_count] = (uint32_t)photons;
     for (int k = 0; k < 6 * n; k++) /* a hit on the node's face lies on its box: rounding must not lose it */
         padded[k] = boxes[k] + (k % 6 < 3 ? -ph->epsilon : ph->epsilon);
-#pragma omp parallel for schedule(dynamic, 1)
+    uint32_t count = 0;
+#pragma omp parallel for schedule(dynamic, 1) reduction(+ : count)
     for (uint32_t gi = 0; gi < ph->group_count; gi++) {
         const ph_group *g = &ph->groups[gi];
-        for (uint32_t m = 0; !g->invalid && g->offsets && m < g->photons && !meets[gi]; m++)
-            meets[gi] = (uint8_t)ph_path_meets_boxes(ph, g, m, padded, n);
+        uint8_t *mine = *met + (*first)[gi];
+        int found = 0;
+        for (uint32_t m = 0; !g->invalid && g->offsets && m < g->photons && !(whole && found); m++)
+            found |= mine[m] = (uint8_t)ph_path_meets_boxes(ph, g, m, padded, n);
+        for (uint32_t m = 0; m < g->photons; m++)
+            count += mine[m];
     }
     free(padded);
+    return count;
+}
+
+/* Queues, in group order, every group with a photon flagged in met; returns how many. */
+static uint32_t queue_met(lm_photons *ph, const uint8_t *met, const uint32_t *first)
+{
     uint32_t count = 0;
     for (uint32_t gi = 0; gi < ph->group_count; gi++) /* in group order: the queue's order is the same */
-        if (meets[gi]) { /* not counted in the group's invalidations: those are the round robin's */
-            mark_invalid(ph, gi);
-            count++;
-        }
-    free(meets);
+        for (uint32_t i = first[gi]; i < first[gi + 1]; i++)
+            if (met[i]) { /* not counted in the group's invalidations: those are the round robin's */
+                mark_invalid(ph, gi);
+                count++;
+                break;
+            }
     return count;
+}
+
+uint32_t lm_photons_invalidate_boxes(lm_photons *ph, const float *boxes, int n)
+{
+    uint8_t *met;
+    uint32_t *first;
+    if (n <= 0 || paths_meeting(ph, boxes, n, 1, &met, &first) == UINT32_MAX)
+        return 0; /* out of memory: the round robin still finds them, later */
+    uint32_t count = queue_met(ph, met, first);
+    free(met);
+    free(first);
+    return count;
+}
+
+/* The photons a frame's group budget re-traces: the budget's groups at the mean photons a group (every
+ * photon without a budget). */
+static uint64_t budget_photons(const lm_photons *ph)
+{
+    uint32_t groups = ph->frame_groups ? ph->frame_groups : ph->set.group_budget;
+    return groups && ph->group_count ? (uint64_t)groups * ph->photon_count / ph->group_count : ph->photon_count;
+}
+
+/* Traces the flagged photons and applies them group by group, in group and photon order. */
+static lm_status retrace_met(lm_photons *ph, const uint8_t *met, const uint32_t *first, lm_photon_frame_stats *st,
+                             lm_error *err)
+{
+    ph_batch *b = &ph->batches[0];
+    ph_batch_clear(b);
+    for (uint32_t gi = 0; gi < ph->group_count; gi++)
+        for (uint32_t i = first[gi]; i < first[gi + 1]; i++)
+            if (met[i] && !ph_batch_push(b, gi, i - first[gi]))
+                return lm_fail(err, LM_ERR_NOMEM, "photons: no memory for the trace list");
+    lm_status s = ph_trace_batch(ph, b, err);
+    st->rays += b->rays;
+    st->box_photons += b->count;
+    if (s != LM_OK)
+        return s;
+    uint64_t stored = 0;
+    for (uint32_t k = 0; k < b->count; k++)
+        stored += b->jobs[k].stored;
+    lm_photon_store_reserve(&ph->store, stored); /* one growth (if it fails, adds fail one by one) */
+    for (uint32_t k = 0; k < b->count && s == LM_OK;) {
+        uint32_t end = k;
+        while (end < b->count && b->jobs[end].group == b->jobs[k].group)
+            end++;
+        s = ph_group_apply_some(ph, &ph->groups[b->jobs[k].group], b, &b->jobs[k], end - k, st, err);
+        k = end;
+    }
+    return s;
+}
+
+lm_status lm_photons_retrace_boxes(lm_photons *ph, const float *boxes, int n, lm_photon_frame_stats *stats,
+                                   lm_error *err)
+{
+    lm_photon_frame_stats local;
+    lm_photon_frame_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    double t0 = lm_now();
+    uint8_t *met;
+    uint32_t *first;
+    uint32_t count = n > 0 ? paths_meeting(ph, boxes, n, 0, &met, &first) : 0;
+    if (count == UINT32_MAX)
+        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory to test %u photons' paths", ph->photon_count);
+    lm_status s = LM_OK;
+    if (count > budget_photons(ph))
+        queue_met(ph, met, first); /* more than a frame's budget: their groups wait their turn */
+    else if (count > 0)
+        s = retrace_met(ph, met, first, st, err);
+    if (count > 0 && count <= budget_photons(ph) && ph->photon_count) /* whole groups, rounded up */
+        ph->box_groups += (uint32_t)(((uint64_t)count * ph->group_count + ph->photon_count - 1) / ph->photon_count);
+    if (n > 0) {
+        free(met);
+        free(first);
+    }
+    finish_stats(ph, st, t0);
+    return s;
 }
 
 /* ---- re-tracing groups: trace in parallel, apply serially in group and photon order ---- */
@@ -549,12 +652,6 @@ lm_status ph_fill_batch(lm_photons *ph, ph_batch *b, const uint32_t *list, uint3
         st->group_photons += g->photons;
     }
     return LM_OK;
-}
-
-static void finish_stats(const lm_photons *ph, lm_photon_frame_stats *st, double t0)
-{
-    st->pending_groups = ph->queue_len;
-    st->seconds = lm_now() - t0;
 }
 
 lm_status lm_photons_trace_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)
@@ -676,7 +773,11 @@ static lm_status step(lm_photons *ph, int anything_moves, uint32_t most, lm_phot
 
 lm_status lm_photons_frame(lm_photons *ph, int anything_moves, lm_photon_frame_stats *stats, lm_error *err)
 {
-    return step(ph, anything_moves, ph->frame_groups ? ph->frame_groups : ph->set.group_budget, stats, err);
+    uint32_t most = ph->set.group_budget;
+    if (ph->frame_groups) /* a time budget's count, less what the boxes' photons took of it (at least one) */
+        most = ph->frame_groups > ph->box_groups ? ph->frame_groups - ph->box_groups : 1;
+    ph->box_groups = 0;
+    return step(ph, anything_moves, most, stats, err);
 }
 
 lm_status lm_photons_drain_all(lm_photons *ph, lm_photon_frame_stats *stats, lm_error *err)

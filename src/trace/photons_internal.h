@@ -74,6 +74,8 @@ struct lm_photons {
     const lm_emitters *em;
     lm_photon_settings set;
     uint32_t frame_groups;     /* lm_photons_limit_groups's (0: set.group_budget) */
+    uint32_t box_groups;       /* the groups' worth of photons lm_photons_retrace_boxes traced since the last
+                                * frame: a time budget's groups (frame_groups) pay for them */
     float epsilon;             /* resolved settings.epsilon */
     int exact;                 /* while lm_photons_trace_all_exact runs: a path is unchanged only when every
                                 * number of it and of its hits is the same to the bit (ph_path_changed) */
@@ -156,6 +158,10 @@ int ph_path_meets_boxes(const lm_photons *ph, const ph_group *g, uint32_t m, con
  * photons whose path changed get their old hits removed and new ones added; the others keep theirs. */
 lm_status ph_group_apply(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs,
                          lm_photon_frame_stats *st, lm_error *err);
+/* ph_group_apply for some of a group's photons: jobs[0 .. n), in increasing m, each re-traced; the changed
+ * ones get their old hits removed and new ones added, the group's other photons keep their paths. */
+lm_status ph_group_apply_some(lm_photons *ph, ph_group *g, const ph_batch *b, const ph_job *jobs, uint32_t n,
+                              lm_photon_frame_stats *st, lm_error *err);
 /* ph_group_apply for every group of a traced batch of whole groups, in batch order. */
 lm_status ph_apply_batch(lm_photons *ph, const ph_batch *b, lm_photon_frame_stats *st, lm_error *err);
 void ph_group_free(ph_group *g);

@@ -462,6 +462,17 @@ static lm_status step_detached(lm_frame_loop *fl, float t, lm_frame_stats *o, lm
     return st;
 }
 
+/* The photon stage's work in groups: those re-traced, and the animated boxes' photons (re-traced one by
+ * one, lm_photons_retrace_boxes) as the groups of the mean size they make. */
+static uint64_t photon_units(const lm_frame_loop *fl, const lm_photon_frame_stats *p)
+{
+    const lm_photons *ph = lm_photon_stage_photons(fl->stage);
+    uint32_t photons = ph ? lm_photons_count(ph) : 0;
+    return p->groups_retraced + (photons ? (uint64_t)llround((double)p->box_photons * lm_photons_group_count(ph) /
+                                                            photons)
+                                         : 0);
+}
+
 /* The stages' costs of a step, each over the units it did (the first step, which uploads everything,
  * is left out by the caller). */
 static void learn(lm_frame_loop *fl, const lm_frame_stats *o)
@@ -469,7 +480,7 @@ static void learn(lm_frame_loop *fl, const lm_frame_stats *o)
     const lm_photon_stage_frame *f = &o->stage;
     const double ms[LM_STAGE_PLANNED] = {1e3 * f->t_photons,     1e3 * f->t_aim, 1e3 * f->t_caustics,
                                          1e3 * o->t_reflections, 1e3 * o->t_gather, 1e3 * o->t_light_scale};
-    const uint64_t units[LM_STAGE_PLANNED] = {f->photons.groups_retraced, f->aim.hits_used, f->caustics.cast,
+    const uint64_t units[LM_STAGE_PLANNED] = {photon_units(fl, &f->photons), f->aim.hits_used, f->caustics.cast,
                                               (uint64_t)o->cube_faces, o->texels_gathered, o->scale_rays};
     lm_budget_learn(&fl->budget, ms, units, 1e3 * o->t_total, 1e3 * (o->t_edits + o->t_waited + o->t_overrun));
 }

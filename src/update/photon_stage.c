@@ -39,7 +39,9 @@ struct lm_photon_stage {
     int edited_before;           /* the last update saw edits of any kind (catch_up) */
     int uncaught;                /* a placement since then was not caught up: the next still update does it */
     int budgeted;                /* this update runs under a time budget (lm_photon_stage_set_budgeted) */
-    float *move_boxes;           /* scratch: LM_MOVED_NODE_BOXES floats a node */
+    float *move_boxes;           /* LM_MOVED_NODE_BOXES floats a node: this frame's, between animate and update */
+    int animated_boxes;          /* of them, those the update half re-traces photon by photon (an animation's
+                                  * moves alone; an edit's are queued in animate for its catch-up) */
     double *delta_before;        /* scratch: per surface, delta_f + owed before a refresh (aim.h) */
     uint32_t *count_before;      /* scratch: per surface, its refresh count before it */
     lm_photons *photons;
@@ -916,9 +918,13 @@ static lm_status animate(lm_photon_stage *ps, float t, int bake, lm_photon_stage
     const lm_edit_changes *ch = lm_edits_changes(ps->edits);
     int moved = ch->moved && ps->photons && ps->set.trace;
     int room = ps->scene->animation_count > 0 && ps->photons && ps->set.trace ? animated_room(ps) : 0;
-    if (moved || room > 0) { /* an edit's move, or an animation's: their paths queued now (moved_nodes.h) */
+    ps->animated_boxes = 0;
+    if (moved || room > 0) { /* an edit's move, or an animation's: their paths found now (moved_nodes.h) */
         int boxes = lm_moved_nodes_boxes(&ps->moves, ps->scene, ps->move_boxes, room);
-        lm_photons_invalidate_boxes(ps->photons, ps->move_boxes, boxes);
+        if (moved || bake) /* queued: the edit's catch-up, or the bake's full trace, takes them */
+            lm_photons_invalidate_boxes(ps->photons, ps->move_boxes, boxes);
+        else /* re-traced photon by photon in the update half, off the calling thread */
+            ps->animated_boxes = boxes;
     }
     int added = 0;
     lm_status st = take_new_emitters(ps, &added, err);
@@ -1004,11 +1010,29 @@ static void release_removed(lm_photon_stage *ps)
             lm_photons_release_emitter(ps->photons, e);
 }
 
+/* A frame's photon stats with the animated boxes' photons (lm_photons_retrace_boxes) added. */
+static void add_box_stats(lm_photon_frame_stats *to, const lm_photon_frame_stats *b)
+{
+    to->box_photons += b->box_photons;
+    to->photons_updated += b->photons_updated;
+    to->hits_added += b->hits_added;
+    to->hits_removed += b->hits_removed;
+    to->rays += b->rays;
+    to->seconds += b->seconds;
+}
+
 lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out, lm_error *err)
 {
     double t1 = lm_now();
-    lm_status st = ps->set.trace ? lm_photons_frame(ps->photons, anything_moves(ps->scene), &out->photons, err)
-                                 : LM_OK;
+    lm_photon_frame_stats boxed;
+    memset(&boxed, 0, sizeof boxed);
+    lm_status st = ps->set.trace && ps->animated_boxes > 0
+                       ? lm_photons_retrace_boxes(ps->photons, ps->move_boxes, ps->animated_boxes, &boxed, err)
+                       : LM_OK;
+    ps->animated_boxes = 0;
+    if (st == LM_OK && ps->set.trace)
+        st = lm_photons_frame(ps->photons, anything_moves(ps->scene), &out->photons, err);
+    add_box_stats(&out->photons, &boxed);
     if (st == LM_OK && ps->set.trace)
         release_removed(ps);
     double t2 = lm_now();
