@@ -11,9 +11,9 @@
 #include "../trace/photons.h"
 #include "world.h"
 
-/* Photon-box pairs an update's animated nodes may test (photon_stage.c, animated_room): queueing the paths
- * that cross where a moving node was and is costs a pass over every stored path a box. The animated
- * Cornell box at `run`'s density (7,200 photons, six boxes) tests 43,200; a level of a million photons
+/* Photon-box pairs an update's animated nodes may test (photon_stage.c, animated_room): re-tracing the paths
+ * that cross where a moving node was and is (lm_photons_retrace_boxes) costs a pass over every stored path
+ * a box. The animated Cornell box (46,080 photons, six boxes) tests 276,480; a level of a million photons
  * leaves its animated nodes to the round robin. */
 #define LM_ANIMATED_BOX_WORK (1u << 19)
 
