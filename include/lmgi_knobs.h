@@ -122,9 +122,9 @@ static inline int lmgi_knob_is_pow2(double v)
       "the AIM estimate's smallest radius, in texels at N = 32 and sqrt(N / 32)\n"                               \
       "times that at another N (default 1): where N hits lie closer, every hit\n"                                \
       "within it is summed; smaller makes the AIM sharper and noisier (docs/aim.md)")                             \
-    X(aim, surfaces_per_frame, LMGI_KNOB_INT, int, 4, 1, 10000000, 1, LMGI_NO_RULE, "--surfaces-per-frame", "K",  \
+    X(aim, surfaces_per_frame, LMGI_KNOB_INT, int, 8, 1, 10000000, 1, LMGI_NO_RULE, "--surfaces-per-frame", "K",  \
       LMGI_CLI_ZERO_DEFAULT, LMGI_NO_CHOICES, LMGI_NO_SWEEP,                                                       \
-      "AIM refreshes a frame (default 4; a node moved after a still frame: all\n"                                  \
+      "AIM refreshes a frame (default 8; a node moved after a still frame: all\n"                                  \
       "that its photons changed)")                                                                                 \
     X(aim, direct, LMGI_KNOB_CHOICE, lmgi_aim_direct, 0, 0, 0, 0, LMGI_NO_RULE,                                   \
       "--aim-direct", "M", LMGI_CLI_ZERO_NONE, LMGI_AIM_DIRECT_CHOICES,                                           \

@@ -968,6 +968,20 @@ static uint32_t paths_behind(world *w)
     return differ;
 }
 
+/* The two rooms with photons traced and their cube moved by edit_cube: its boxes into *boxes (allocated
+ * on the first call, NULL before); returns how many. */
+static int world_with_moved_cube(world *w, lm_moved_nodes *mv, const char *path, const lm_photon_settings *set,
+                                 float **boxes)
+{
+    lm_error err;
+    world_load(w, path);
+    world_photons(w, set);
+    assert_int_equal(lm_moved_nodes_init(mv, w->s, &err), LM_OK);
+    *boxes = *boxes ? *boxes : malloc(sizeof **boxes * LM_MOVED_NODE_BOXES * (size_t)w->s->node_count);
+    assert_non_null(*boxes);
+    return edit_cube(w, mv, *boxes);
+}
+
 /* An edit's move (scene/moved_nodes.h): the groups whose stored paths cross the node's box where it was or
  * where it is now are queued at once (lm_photons_invalidate_boxes), and re-tracing them leaves none of the
  * 346 changed paths behind. An animated node is the round robin's alone: no box (the paths its move changed
@@ -986,12 +1000,7 @@ static void test_moved_node_boxes_queue_its_paths(void **state)
     float *boxes = NULL;
     int n = 0;
     for (int k = 0; k < 2; k++) {
-        world_load(&w[k], path);
-        world_photons(&w[k], &set);
-        assert_int_equal(lm_moved_nodes_init(&mv[k], w[k].s, &err), LM_OK);
-        boxes = boxes ? boxes : malloc(sizeof *boxes * LM_MOVED_NODE_BOXES * (size_t)w[k].s->node_count);
-        assert_non_null(boxes);
-        n = edit_cube(&w[k], &mv[k], boxes);
+        n = world_with_moved_cube(&w[k], &mv[k], path, &set, &boxes);
         assert_int_equal(n, 2);
     }
     uint32_t changed = paths_behind(&w[0]); /* every path the move changed, none re-traced */
@@ -1042,12 +1051,7 @@ static void test_moved_node_boxes_retrace_photons(void **state)
         lm_photon_settings set;
         lm_photon_settings_default(&set);
         set.group_budget = k == 2 ? 1 : 16;
-        world_load(&w[k], path);
-        world_photons(&w[k], &set);
-        assert_int_equal(lm_moved_nodes_init(&mv[k], w[k].s, &err), LM_OK);
-        boxes = boxes ? boxes : malloc(sizeof *boxes * LM_MOVED_NODE_BOXES * (size_t)w[k].s->node_count);
-        assert_non_null(boxes);
-        n = edit_cube(&w[k], &mv[k], boxes);
+        n = world_with_moved_cube(&w[k], &mv[k], path, &set, &boxes);
         if (k > 0)
             assert_int_equal(lm_photons_retrace_boxes(w[k].ph, boxes, n, &st[k], &err), LM_OK);
     }

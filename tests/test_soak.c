@@ -45,6 +45,9 @@ typedef struct {
     uint32_t worst_caustic;
 } soak_run;
 
+/* aim.surfaces_per_frame's default: the AIMs an update refreshes by its budget (docs/aim.md) */
+enum { AIM_BUDGET = 8 };
+
 static void check_update(soak_run *r, int f, const lmgi_update_stats *st)
 {
     if (f == 0)
@@ -57,15 +60,15 @@ static void check_update(soak_run *r, int f, const lmgi_update_stats *st)
     r->worst_caustic = st->caustic_photons_retraced > r->worst_caustic ? st->caustic_photons_retraced
                                                                         : r->worst_caustic;
     /* a light added by this update's edit draws its first map beside the 4 of the budget at most; a light,
-     * emission or colour edit refreshes the AIMs it reaches at once beside the AIM budget's 4 (counted
+     * emission or colour edit refreshes the AIMs it reaches at once beside the AIM budget's AIM_BUDGET (counted
      * since 2026-11-30; lmgi_update_stats.aim_surfaces_at_once); a node or light placed after an update
      * without edits is caught up at once, its groups beside the budget's 16 (counted since 2026-12-02;
      * lmgi_update_stats.groups_at_once; never here, where an edit comes before every update) */
-    if (st->shadow_maps_rendered > 5 || groups > 16 || budgeted > 4 ||
+    if (st->shadow_maps_rendered > 5 || groups > 16 || budgeted > AIM_BUDGET ||
         st->caustic_photons_retraced > r->caustic_cap)
         fail_msg("%s, update %d: %d shadow maps, %d photon groups by the budget, %d AIMs by the budget, %u caustic "
-                 "photons: over the bounds (4 + a new light's, 16, 4, %u)", r->scene, f, st->shadow_maps_rendered,
-                 groups, budgeted, st->caustic_photons_retraced, r->caustic_cap);
+                 "photons: over the bounds (4 + a new light's, 16, %d, %u)", r->scene, f, st->shadow_maps_rendered,
+                 groups, budgeted, st->caustic_photons_retraced, AIM_BUDGET, r->caustic_cap);
     if (st->groups_at_once > st->groups_retraced)
         fail_msg("%s, update %d: %u photon groups at once of %u", r->scene, f, st->groups_at_once,
                  st->groups_retraced);

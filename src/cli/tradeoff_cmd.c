@@ -294,7 +294,7 @@ static const struct {
     int n, values[3], def;
 } BUDGETS[] = {{"texels_per_frame", 3, {5, 20, 80}, 20},
                {"group_budget", 3, {4, 16, 64}, 16},
-               {"surfaces_per_frame", 3, {1, 4, 16}, 4},
+               {"surfaces_per_frame", 3, {2, 8, 32}, 8},
                {"texel_change", 2, {0, 1}, 1}};
 #define BUDGET_COUNT ((int)(sizeof BUDGETS / sizeof *BUDGETS))
 

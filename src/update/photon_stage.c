@@ -83,7 +83,7 @@ void lm_photon_stage_settings_default(lm_photon_stage_settings *s)
     memset(s, 0, sizeof *s);
     lm_photon_settings_default(&s->photons);
     lm_aim_settings_default(&s->aim);
-    s->surfaces_per_frame = 4;
+    s->surfaces_per_frame = 8; /* lmgi_knobs.h's aim.surfaces_per_frame (docs/aim.md, "How many an update") */
     s->trace = 1;
     s->aims = 1;
     s->find_portals = 1;

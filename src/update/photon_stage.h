@@ -20,7 +20,7 @@
 typedef struct {
     lm_photon_settings photons; /* cover_distance 0 (default) is the atlas's texel size here; < 0: off */
     lm_aim_settings aim;
-    int surfaces_per_frame;  /* AIM refreshes per frame, largest delta_f/area first (default 4; < 0 all) */
+    int surfaces_per_frame;  /* AIM refreshes per frame, largest delta_f/area first (default 8; < 0 all) */
     int trace;               /* 0: no photon is traced and no AIM filled, at setup or after (a run without
                               * indirect light: the stage keeps only the emitters and the animations) */
     int aims;                /* 0: photons traced, no AIM filled (an indirect path that gathers from the
