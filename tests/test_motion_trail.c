@@ -687,10 +687,6 @@ static trail_stats trail_of(lmgi_context *ctx, float *const *want, int estimate_
     lmgi_updater_desc d;
     memset(&d, 0, sizeof d);
     d.gather.estimate_rays = estimate_rays;
-    if (getenv("TRAIL_GB")) d.photons.group_budget = atoi(getenv("TRAIL_GB"));
-    if (getenv("TRAIL_SPF")) d.aim.surfaces_per_frame = atoi(getenv("TRAIL_SPF"));
-    if (getenv("TRAIL_TPF")) d.gather.texels_per_frame = atoi(getenv("TRAIL_TPF"));
-    if (getenv("TRAIL_BF")) d.gather.blend_frames = atoi(getenv("TRAIL_BF"));
     lmgi_updater *u = updater_with(ctx, sc, &d);
     lmgi_error e;
     lmgi_info in;
@@ -701,14 +697,6 @@ static trail_stats trail_of(lmgi_context *ctx, float *const *want, int estimate_
     assert_non_null(run);
     assert_non_null(over);
     trail_stats r = {0};
-    if (getenv("TRAIL_DEBUG") && estimate_rays == 0)
-        for (uint32_t i = 0; i < in.texels; i++) {
-            lmgi_texel t;
-            lmgi_get_texel(sc, i, &t);
-            if ((t.x / 4 == 4 && t.y / 4 == 4) || (t.x / 4 == 0 && t.y / 4 == 12) || (t.x / 4 == 3 && t.y / 4 == 0))
-                fprintf(stderr, "TEX (%d,%d) s%d p(%.2f %.2f %.2f) n(%.2f %.2f %.2f)\n", t.x, t.y, t.surface,
-                        t.position[0], t.position[1], t.position[2], t.normal[0], t.normal[1], t.normal[2]);
-        }
     for (int f = 0; f < TRAIL_UPDATES; f++) {
         lmgi_update_stats s;
         if (lmgi_update(u, (float)f / 30.0f, 0.0f, &s, &e) != LMGI_OK)
@@ -720,15 +708,6 @@ static trail_stats trail_of(lmgi_context *ctx, float *const *want, int estimate_
         float *shown = lmt_iim(u, sc, &n);
         total += blocks_over(&in, shown, want[f], over);
         samples++;
-        if (getenv("TRAIL_DEBUG")) {
-            double mean = mean_texel(&in, want[f]);
-            int bw = (in.atlas_width + 3) / 4;
-            for (int b = 0; b < nb; b++)
-                if (over[b] || run[b])
-                    fprintf(stderr, "DBG r%d f%d b(%d,%d) mv%d run%d err%.3f\n", estimate_rays, f, (b % bw) * 4,
-                            (b / bw) * 4, moving[b], over[b] ? run[b] + TRAIL_EVERY : 0,
-                            block_error(&in, shown, want[f], (b % bw) * 4, (b / bw) * 4, mean));
-        }
         for (int b = 0; b < nb; b++) {
             run[b] = over[b] ? run[b] + TRAIL_EVERY : 0;
             int *longest = moving[b] ? &r.moving : &r.trail;
