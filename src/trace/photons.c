@@ -613,17 +613,16 @@ lm_status lm_photons_retrace_boxes(lm_photons *ph, const float *boxes, int n, lm
     double t0 = lm_now();
     uint8_t *met;
     uint32_t *first;
-    uint32_t count = n > 0 ? paths_meeting(ph, boxes, n, 0, &met, &first) : 0;
-    if (count == UINT32_MAX)
-        return lm_fail(err, LM_ERR_NOMEM, "photons: no memory to test %u photons' paths", ph->photon_count);
     lm_status s = LM_OK;
-    if (count > budget_photons(ph))
-        queue_met(ph, met, first); /* more than a frame's budget: their groups wait their turn */
-    else if (count > 0)
-        s = retrace_met(ph, met, first, st, err);
-    if (count > 0 && count <= budget_photons(ph) && ph->photon_count) /* whole groups, rounded up */
-        ph->box_groups += (uint32_t)(((uint64_t)count * ph->group_count + ph->photon_count - 1) / ph->photon_count);
-    if (n > 0) {
+    uint32_t count = n > 0 ? paths_meeting(ph, boxes, n, 0, &met, &first) : UINT32_MAX;
+    if (count != UINT32_MAX) { /* else none met, or no memory to test them: the round robin finds them later */
+        if (count > budget_photons(ph)) {
+            queue_met(ph, met, first); /* more than a frame's budget: their groups wait their turn */
+        } else if (count > 0) {
+            s = retrace_met(ph, met, first, st, err);
+            ph->box_groups += (uint32_t)(((uint64_t)count * ph->group_count + ph->photon_count - 1) /
+                                         ph->photon_count); /* whole groups' worth, rounded up */
+        }
         free(met);
         free(first);
     }

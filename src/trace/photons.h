@@ -170,8 +170,9 @@ uint32_t lm_photons_invalidate_boxes(lm_photons *ph, const float *boxes, int n);
  * for the group budget (docs/photons.md, "Animated nodes"). When more photons meet the boxes than a
  * frame's group budget re-traces (its groups at the mean photons a group), their groups are queued instead
  * (lm_photons_invalidate_boxes). Counted in stats (may be NULL; box_photons, the hits, photons_updated,
- * rays, pending_groups, seconds). The scene and BVH must be those of the boxes' "now". Fails only when
- * memory runs out. */
+ * rays, pending_groups, seconds). The scene and BVH must be those of the boxes' "now". With no memory to
+ * test the paths it does nothing (the round robin finds them later); fails only when the re-trace itself
+ * runs out of memory. */
 lm_status lm_photons_retrace_boxes(lm_photons *ph, const float *boxes, int n, lm_photon_frame_stats *stats,
                                    lm_error *err);
 /* Emitter e changed in power alone (a light's colour or intensity; its place and shape as they were):
