@@ -166,7 +166,7 @@ uint32_t lm_photons_invalidate_boxes(lm_photons *ph, const float *boxes, int n);
  * group's other photons keep theirs). A path that crosses neither where a node was nor where it is has not
  * changed (but for the unstored last leg, left to the round robin), so the store then holds what
  * re-tracing their whole groups would, for the cost of the paths that met a box: the animated Cornell box's
- * cube and spheres meet 8% of its photons an update, and the 72 groups they touch waited 4 updates each
+ * cube and spheres meet 8% of its photons an update, and the 67 groups they touch waited 4 updates each
  * for the group budget (docs/photons.md, "Animated nodes"). When more photons meet the boxes than a
  * frame's group budget re-traces (its groups at the mean photons a group), their groups are queued instead
  * (lm_photons_invalidate_boxes). Counted in stats (may be NULL; box_photons, the hits, photons_updated,
