@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/top_k.h"
 #include "../core/vecmath.h"
 #include "delta_i.h"
 
@@ -354,46 +355,6 @@ static float typical_change(const lm_texel_change *tc, const lm_atlas *a, const 
     return m;
 }
 
-typedef struct {
-    float change;
-    uint32_t texel;
-} candidate;
-
-static int by_change(const void *pa, const void *pb)
-{
-    const candidate *a = pa, *b = pb;
-    if (a->change != b->change)
-        return a->change > b->change ? -1 : 1;
-    return a->texel < b->texel ? -1 : a->texel > b->texel;
-}
-
-/* Keeps the k most changed of the candidates seen so far in a min-heap (the least of them at h[0]). */
-static void heap_offer(candidate *h, uint32_t *n, uint32_t k, candidate c)
-{
-    if (*n == k && by_change(&c, &h[0]) >= 0)
-        return;
-    uint32_t i;
-    if (*n < k) { /* sift up from the end */
-        i = (*n)++;
-        while (i > 0 && by_change(&h[(i - 1) / 2], &c) < 0)
-            h[i] = h[(i - 1) / 2], i = (i - 1) / 2;
-    } else { /* replace the least and sift down */
-        i = 0;
-        for (;;) {
-            uint32_t l = 2 * i + 1, r = l + 1, m = i;
-            const candidate *least = &c;
-            if (l < *n && by_change(&h[l], least) > 0)
-                m = l, least = &h[l];
-            if (r < *n && by_change(&h[r], least) > 0)
-                m = r;
-            if (m == i)
-                break;
-            h[i] = h[m], i = m;
-        }
-    }
-    h[i] = c;
-}
-
 void lm_texel_change_doubt(lm_texel_change *tc, const float *doubt)
 {
     for (uint32_t i = 0; i < tc->texel_count; i++) /* two standard errors: how far off it may well be */
@@ -404,7 +365,7 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
                               int all, uint32_t *out)
 {
     uint32_t k = budget < tc->texel_count ? budget : tc->texel_count, n = 0;
-    candidate *h = k ? malloc(sizeof *h * k) : NULL;
+    lm_ranked *h = k ? malloc(sizeof *h * k) : NULL;
     if (!h)
         return 0;
     /* a change that reached everything alike (a light dimmed) is the surfaces' order's to follow: a texel
@@ -420,12 +381,12 @@ uint32_t lm_texel_change_pick(lm_texel_change *tc, const lm_atlas *a, const uint
         float p = lm_texel_change_of(tc, i);
         if ((p - tc->doubt[i] > floor || tc->doubt[i] > tc->threshold) && p > tc->threshold &&
             !off[a->texels[i].surface])
-            heap_offer(h, &n, k, (candidate){p, i});
+            lm_top_k_offer(h, &n, k, (lm_ranked){p, i});
     }
-    qsort(h, n, sizeof *h, by_change); /* most changed first */
+    qsort(h, n, sizeof *h, lm_ranked_order); /* most changed first */
     for (uint32_t j = 0; j < n; j++) {
-        out[j] = h[j].texel;
-        tc->change[h[j].texel] = tc->lit[h[j].texel] = tc->doubt[h[j].texel] = 0.0f;
+        out[j] = h[j].id;
+        tc->change[h[j].id] = tc->lit[h[j].id] = tc->doubt[h[j].id] = 0.0f;
     }
     free(h);
     return n;

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "../core/top_k.h"
 #include "../photonmap/hemicube_rim.h"
 #include "../scene/sky.h"
 
@@ -74,46 +75,6 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
     }
 }
 
-/* A waiting texel's claim to be brought up to date: how much its hemisphere changed (texel_change.h) times
- * the updates since it last was (or was gathered), or that wait alone. Ties by texel index: the choice is
- * the same on every run. */
-typedef struct {
-    double key;
-    uint32_t texel;
-} claim;
-
-static int before(const claim *a, const claim *b) { return a->key > b->key || (a->key == b->key && a->texel < b->texel); }
-
-/* Reorders c[0 .. n) so that its first k are the k greatest claims (quickselect, middle pivot). */
-static void select_first(claim *c, uint32_t n, uint32_t k)
-{
-    uint32_t lo = 0, hi = n;
-    while (hi - lo > 1) {
-        claim pivot = c[lo + (hi - lo) / 2];
-        uint32_t i = lo, j = hi - 1;
-        while (i <= j) {
-            while (before(&c[i], &pivot))
-                i++;
-            while (before(&pivot, &c[j]))
-                j--;
-            if (i <= j) {
-                claim t = c[i];
-                c[i] = c[j], c[j] = t;
-                i++;
-                if (j == 0)
-                    break;
-                j--;
-            }
-        }
-        if (k <= j + 1 && j + 1 > lo)
-            hi = j + 1;
-        else if (k >= i)
-            lo = i;
-        else
-            return;
-    }
-}
-
 uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
                                 const uint32_t *waiting, const float *change, uint32_t n, uint32_t budget,
                                 uint32_t *out)
@@ -121,24 +82,25 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
     re->frame++;
     if (n == 0 || budget == 0 || re->K <= 0)
         return 0;
-    claim *c = malloc(sizeof *c * n);
-    if (!c) /* no estimate this update: the texels show their neighbours' loans */
+    lm_ranked *h = malloc(sizeof *h * (budget < n ? budget : n));
+    if (!h) /* no estimate this update: the texels show their neighbours' loans */
         return 0;
-    uint32_t m = 0;
+    /* half by change times the updates since each was last brought up to date (or gathered), then the other
+     * half by those updates alone among the rest (header); ties by texel index, the same on every run */
+    uint32_t most = budget - budget / 2, m = 0, got = 0;
     for (uint32_t k = 0; k < n; k++)
         if (re->has[waiting[k]])
-            c[m++] = (claim){(double)change[k] * (double)(re->frame - re->stamp[waiting[k]]), waiting[k]};
-    if (m > budget) { /* half by change times wait, the other half by wait alone (header) */
-        uint32_t most = budget - budget / 2;
-        select_first(c, m, most);
-        for (uint32_t j = most; j < m; j++)
-            c[j].key = (double)(re->frame - re->stamp[c[j].texel]);
-        select_first(c + most, m - most, budget - most);
-        m = budget;
-    }
-    for (uint32_t j = 0; j < m; j++)
-        out[j] = c[j].texel, re->stamp[c[j].texel] = re->frame;
-    free(c);
+            lm_top_k_offer(h, &got, most,
+                           (lm_ranked){(double)change[k] * (double)(re->frame - re->stamp[waiting[k]]), waiting[k]});
+    for (uint32_t j = 0; j < got; j++) /* stamped now: out of the second half's running */
+        out[m++] = h[j].id, re->stamp[h[j].id] = re->frame;
+    got = 0;
+    for (uint32_t k = 0; k < n && budget > most; k++)
+        if (re->has[waiting[k]] && re->stamp[waiting[k]] != re->frame)
+            lm_top_k_offer(h, &got, budget - most, (lm_ranked){(double)(re->frame - re->stamp[waiting[k]]), waiting[k]});
+    for (uint32_t j = 0; j < got; j++)
+        out[m++] = h[j].id, re->stamp[h[j].id] = re->frame;
+    free(h);
     lm_rim r = rays_over(re, w, aim);
     ray_gathers(w, &r, out, m, re->delta, re->base);
     return m;

@@ -34,7 +34,7 @@
  * update computes, by texel index, for the caller to show (what is shown is the IIM's, iim.h, which a
  * light edit scales there). Memory: 32 bytes a texel, and 16 a waiting texel while choosing.
  * Cost: K rays and K footprints of AIM lookups per texel gathered (its base) and per texel brought up to
- * date, on every OpenMP thread; choosing them O(waiting). Deterministic (each texel's rays are seeded by its index). Not
+ * date, on every OpenMP thread; choosing them O(waiting log budget) (core/top_k.h). Deterministic (each texel's rays are seeded by its index). Not
  * thread-safe; the scene and AIM must not change meanwhile. Errors: none but memory at init. */
 #ifndef LM_RAY_ESTIMATE_H
 #define LM_RAY_ESTIMATE_H
