@@ -2149,6 +2149,88 @@ static void test_ray_estimate_change(void **state)
     ts_free(&t);
 }
 
+/* The emissive triangles' light in a waiting texel's estimate (update/ray_estimate.h, lm_ray_estimate_emitters):
+ * a floor (1 m wide, 0.1 m texels) under a small emitting square (0.3 wide, 1 m up) whose light the gather
+ * takes in closed form, and a black square (0.2 wide) halfway up moved 0.3 m across, its shadow with it. With
+ * the gather's emitter light each texel's estimated change is what the gather's own emitter light changed
+ * (lm_gather_emitted_at after less before), to float rounding; the rays alone, which meet the small square
+ * with a few of their 36, read a shadow that moved over a third of the floor's texels far off. */
+static void test_ray_estimate_emitter_shadow(void **state)
+{
+    (void)state;
+    lmt_mesh m[3];
+    square(&m[0], 0.5f, 0.0f, 1);
+    square(&m[1], 0.15f, 1.0f, 0);
+    square(&m[2], 0.1f, 0.5f, 0);
+    tscene t;
+    ts_load(&t, m, 3,
+            "[{\"children\": [1, 2, 3]}, {\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2, \"extras\": {\"lmgi\": {\"dynamic\": true}}}]",
+            "[{}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 0.5, 0.25]}, "
+            "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}}]",
+            0.1f);
+    lm_rt *rt;
+    uint32_t n, *texels = node_texels(&t, 1, INFINITY, &rt, &n);
+    assert_true(n >= 50);
+    lm_error err;
+    lm_emitter_light el;
+    assert_int_equal(lm_emitter_light_init(&el, t.s, rt, LM_EMITTER_LIGHT_DEFAULT_RAYS, &err), LM_OK);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    memset(set.sky, 0, sizeof set.sky); /* the emitter's light alone */
+    lm_gather *g = NULL;
+    assert_int_equal(lm_gather_create(&set, &g, &err), LM_OK);
+    lm_gather_set_emitter_light(g, &el);
+    lm_gather_set_tracer(g, rt);
+    lm_light_scale_world w = {t.s, &t.a, rt, &set};
+    float *black = calloc(4 * (size_t)t.a.width * t.a.height, sizeof *black), *before = malloc(3 * sizeof(float) * n);
+    float *change = malloc(sizeof *change * n);
+    uint32_t *out = malloc(sizeof *out * n);
+    assert_non_null(black), assert_non_null(before), assert_non_null(change), assert_non_null(out);
+    lm_ray_estimate re[2]; /* with the gather's emitter light, and with the rays' alone */
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(lm_ray_estimate_init(&re[k], t.a.texel_count, LM_RAY_ESTIMATE_RAYS, &err), LM_OK);
+        lm_ray_estimate_emitters(&re[k], k == 0 ? g : NULL);
+        lm_ray_estimate_gathered(&re[k], &w, black, texels, n);
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        lm_gather_emitted_at(g, t.s, &t.a, texels[j], before + 3 * j);
+        change[j] = 1.0f;
+    }
+    float world[16];
+    memcpy(world, t.s->nodes[3].world, sizeof world);
+    world[12] += 0.3f;
+    assert_true(lm_scene_set_node_world(t.s, 3, world));
+    assert_int_equal(lm_rt_sync_transforms(rt, t.s, &err), LM_OK);
+    for (int k = 0; k < 2; k++)
+        assert_int_equal(lm_ray_estimate_update(&re[k], &w, black, texels, change, n, n, out), n);
+    uint32_t moved = 0, far_off[2] = {0, 0};
+    double worst[2] = {0.0, 0.0};
+    for (uint32_t j = 0; j < n; j++) {
+        float now[3];
+        lm_gather_emitted_at(g, t.s, &t.a, texels[j], now);
+        double d = now[0] - before[3 * j], scale = fmax(before[3 * j], now[0]);
+        moved += fabs(d) > 0.1 * scale;
+        for (int k = 0; k < 2; k++) {
+            double e = fabs(re[k].delta[3 * (size_t)texels[j]] - d) / scale;
+            worst[k] = fmax(worst[k], e);
+            far_off[k] += e > 0.1;
+        }
+    }
+    print_message("a shadow moved on %u of %u texels under a small emitter: the estimate's worst error %.2g of the texel's "
+                  "light with the gather's emitter light, %.2f with the rays' (%u and %u texels over 10%%)\n",
+                  moved, n, worst[0], worst[1], far_off[0], far_off[1]);
+    assert_true(moved > n / 10); /* the blocker's move changed the light: the test can tell */
+    assert_true(worst[0] < 1e-5);
+    assert_true(far_off[1] > moved / 3);
+    for (int k = 0; k < 2; k++)
+        lm_ray_estimate_free(&re[k]);
+    free(black), free(before), free(change), free(out), free(texels);
+    lm_gather_free(g);
+    lm_emitter_light_free(&el);
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
 /* A copy of n floats (the light scale takes ownership of what it is given). */
 static float *floats_copy(const float *v, size_t n)
 {
@@ -2938,6 +3020,7 @@ int main(void)
         cmocka_unit_test(test_rim_smooth),
         cmocka_unit_test(test_rim_pair_same_as_two),
         cmocka_unit_test(test_ray_estimate_change),
+        cmocka_unit_test(test_ray_estimate_emitter_shadow),
         cmocka_unit_test(test_light_scale_refined_equals_full),
         cmocka_unit_test(test_light_scale_seed),
         cmocka_unit_test(test_light_scale_doubt),

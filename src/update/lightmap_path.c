@@ -382,6 +382,7 @@ static lm_status start_rays(lm_lightmap_path *lp, lm_error *err)
         return lm_fail(err, LM_ERR_NOMEM, "%s: no memory for the texels' ray estimates", lp->scene->path);
     }
     lp->have_rays = 1;
+    lm_ray_estimate_emitters(&lp->rays, lp->have_emitters ? lp->gather : NULL);
     lm_light_scale_world w = {lp->scene, a, lp->rt, &lp->set->gather};
     for (uint32_t i = 0; i < a->texel_count; i++)
         lp->ray_list[i] = i;

@@ -36,28 +36,40 @@ void lm_ray_estimate_free(lm_ray_estimate *re)
 /* The rim over the whole hemisphere reading aim, as the header says. */
 static lm_rim rays_over(const lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim)
 {
-    lm_rim r = {w->scene, w->atlas, w->rt, aim, 1, {w->set->sky[0], w->set->sky[1], w->set->sky[2]}, 0.0f, re->K,
-                NULL, NULL, NULL, 0.0f, 0.0f};
+    lm_rim r = {w->scene, w->atlas, w->rt, aim, !re->emitted, {w->set->sky[0], w->set->sky[1], w->set->sky[2]},
+                0.0f, re->K, NULL, NULL, NULL, 0.0f, 0.0f};
     if (w->scene->has_sky)
         lm_sky_mean(w->scene, r.sky);
     return r;
 }
 
-/* Texels list[0 .. m) gathered by r into out (3 floats a texel, by texel index), less minus's (NULL: none),
- * on every core. */
-static void ray_gathers(const lm_light_scale_world *w, const lm_rim *r, const uint32_t *list, uint32_t m, float *out,
-                        const float *minus)
+/* Texel i's ray gather by r, with the emitter light of re->emitted. */
+static void texel_gather(const lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *r, uint32_t i,
+                         float e[3])
+{
+    float em[3] = {0.0f, 0.0f, 0.0f};
+    lm_light_scale_texel_rim(w, r, i, e);
+    if (re->emitted)
+        lm_gather_emitted_at(re->emitted, w->scene, w->atlas, i, em);
+    for (int c = 0; c < 3; c++)
+        e[c] += em[c];
+}
+
+/* Texels list[0 .. m) gathered (texel_gather) into out (3 floats a texel, by texel index), less minus's
+ * (NULL: none), on every core. */
+static void ray_gathers(const lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *r,
+                        const uint32_t *list, uint32_t m, float *out, const float *minus)
 {
 #pragma omp parallel
     {
         lm_rt_thread_init();
 #pragma omp for schedule(dynamic, 16)
         for (long j = 0; j < (long)m; j++) {
-            size_t i = list[j];
+            uint32_t i = list[j];
             float e[3];
-            lm_light_scale_texel_rim(w, r, (uint32_t)i, e);
+            texel_gather(re, w, r, i, e);
             for (int c = 0; c < 3; c++)
-                out[3 * i + c] = e[c] - (minus ? minus[3 * i + c] : 0.0f);
+                out[3 * (size_t)i + c] = e[c] - (minus ? minus[3 * (size_t)i + c] : 0.0f);
         }
     }
 }
@@ -68,7 +80,7 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
     if (n == 0 || re->K <= 0)
         return;
     lm_rim r = rays_over(re, w, aim);
-    ray_gathers(w, &r, texels, n, re->base, NULL);
+    ray_gathers(re, w, &r, texels, n, re->base, NULL);
     for (uint32_t j = 0; j < n; j++) {
         re->has[texels[j]] = 1;
         re->stamp[texels[j]] = re->frame;
@@ -102,7 +114,7 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
         out[m++] = h[j].id, re->stamp[h[j].id] = re->frame;
     free(h);
     lm_rim r = rays_over(re, w, aim);
-    ray_gathers(w, &r, out, m, re->delta, re->base);
+    ray_gathers(re, w, &r, out, m, re->delta, re->base);
     return m;
 }
 
@@ -111,6 +123,8 @@ void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float
     for (size_t k = 0; k < 3 * (size_t)re->texel_count; k++)
         re->base[k] = re->base[k] * factor[k] + (add ? add[k] : 0.0f);
 }
+
+void lm_ray_estimate_emitters(lm_ray_estimate *re, const lm_gather *g) { re->emitted = g; }
 
 void lm_ray_estimate_forget(lm_ray_estimate *re)
 {
