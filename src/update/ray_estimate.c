@@ -1,6 +1,7 @@
 /* The waiting texels' first estimate from a few rays (ray_estimate.h). */
 #include "ray_estimate.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,7 +19,8 @@ lm_status lm_ray_estimate_init(lm_ray_estimate *re, uint32_t texel_count, int K,
     re->delta = calloc(3 * n, sizeof *re->delta);
     re->has = calloc(n, 1);
     re->stamp = calloc(n, sizeof *re->stamp);
-    if (re->base && re->delta && re->has && re->stamp)
+    re->fine = calloc(n, 1);
+    if (re->base && re->delta && re->has && re->stamp && re->fine)
         return LM_OK;
     lm_ray_estimate_free(re);
     return lm_fail(err, LM_ERR_NOMEM, "ray estimate: no memory for %u texels", texel_count);
@@ -30,6 +32,7 @@ void lm_ray_estimate_free(lm_ray_estimate *re)
     free(re->delta);
     free(re->has);
     free(re->stamp);
+    free(re->fine);
     memset(re, 0, sizeof *re);
 }
 
@@ -55,9 +58,19 @@ static void texel_gather(const lm_ray_estimate *re, const lm_light_scale_world *
         e[c] += em[c];
 }
 
-/* Texels list[0 .. m) gathered (texel_gather) into out (3 floats a texel, by texel index), less minus's
- * (NULL: none), on every core. */
-static void ray_gathers(const lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *r,
+/* Whether K rays misjudge texel i, whose K-ray gather is e: its LM_RAY_ESTIMATE_FINE x K-ray gather (into
+ * ef) differs from it by more than LM_RAY_ESTIMATE_SPLIT of its light (the channels summed). */
+static int misjudged(const lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rf, uint32_t i,
+                     const float e[3], float ef[3])
+{
+    texel_gather(re, w, rf, i, ef);
+    double a = (double)e[0] + e[1] + e[2], b = (double)ef[0] + ef[1] + ef[2];
+    return fabs(a - b) > LM_RAY_ESTIMATE_SPLIT * b;
+}
+
+/* The bases of texels list[0 .. m) (their gathers now, by r, and where r misjudges one, by rf: re->fine), or
+ * with `minus` their changes since (re->delta), each by the rays its base took; on every core. */
+static void ray_gathers(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *r, const lm_rim *rf,
                         const uint32_t *list, uint32_t m, float *out, const float *minus)
 {
 #pragma omp parallel
@@ -66,12 +79,28 @@ static void ray_gathers(const lm_ray_estimate *re, const lm_light_scale_world *w
 #pragma omp for schedule(dynamic, 16)
         for (long j = 0; j < (long)m; j++) {
             uint32_t i = list[j];
-            float e[3];
-            texel_gather(re, w, r, i, e);
+            float e[3], ef[3];
+            if (minus) {
+                texel_gather(re, w, re->fine[i] ? rf : r, i, e);
+            } else {
+                texel_gather(re, w, r, i, e);
+                re->fine[i] = (uint8_t)misjudged(re, w, rf, i, e, ef);
+                if (re->fine[i])
+                    memcpy(e, ef, sizeof e);
+            }
             for (int c = 0; c < 3; c++)
                 out[3 * (size_t)i + c] = e[c] - (minus ? minus[3 * (size_t)i + c] : 0.0f);
         }
     }
+}
+
+/* The rims of K and of LM_RAY_ESTIMATE_FINE x K rays over aim (rays_over). */
+static void rims_over(const lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim, lm_rim *r,
+                      lm_rim *rf)
+{
+    *r = rays_over(re, w, aim);
+    *rf = *r;
+    rf->samples = LM_RAY_ESTIMATE_FINE * re->K;
 }
 
 void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
@@ -79,8 +108,9 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
 {
     if (n == 0 || re->K <= 0)
         return;
-    lm_rim r = rays_over(re, w, aim);
-    ray_gathers(re, w, &r, texels, n, re->base, NULL);
+    lm_rim r, rf;
+    rims_over(re, w, aim, &r, &rf);
+    ray_gathers(re, w, &r, &rf, texels, n, re->base, NULL);
     for (uint32_t j = 0; j < n; j++) {
         re->has[texels[j]] = 1;
         re->stamp[texels[j]] = re->frame;
@@ -113,8 +143,9 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
     for (uint32_t j = 0; j < got; j++)
         out[m++] = h[j].id, re->stamp[h[j].id] = re->frame;
     free(h);
-    lm_rim r = rays_over(re, w, aim);
-    ray_gathers(re, w, &r, out, m, re->delta, re->base);
+    lm_rim r, rf;
+    rims_over(re, w, aim, &r, &rf);
+    ray_gathers(re, w, &r, &rf, out, m, re->delta, re->base);
     return m;
 }
 
