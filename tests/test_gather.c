@@ -2246,7 +2246,8 @@ static void test_ray_estimate_emitter_shadow(void **state)
     square(&m[2], 0.1f, 0.5f, 0);
     tscene t;
     ts_load(&t, m, 3,
-            "[{\"children\": [1, 2, 3]}, {\"mesh\": 0}, {\"mesh\": 1}, {\"mesh\": 2, \"extras\": {\"lmgi\": {\"dynamic\": true}}}]",
+            "[{\"children\": [1, 2, 3]}, {\"mesh\": 0}, {\"mesh\": 1}, "
+            "{\"mesh\": 2, \"extras\": {\"lmgi\": {\"dynamic\": true}}}]",
             "[{}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 0.5, 0.25]}, "
             "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}}]",
             0.1f);
@@ -2298,8 +2299,8 @@ static void test_ray_estimate_emitter_shadow(void **state)
             far_off[k] += e > 0.1;
         }
     }
-    print_message("a shadow moved on %u of %u texels under a small emitter: the estimate's worst error %.2g of the texel's "
-                  "light with the gather's emitter light, %.2f with the rays' (%u and %u texels over 10%%)\n",
+    print_message("a shadow moved on %u of %u texels under a small emitter: the estimate's worst error %.2g of the "
+                  "texel's light with the gather's emitter light, %.2f with the rays' (%u and %u texels over 10%%)\n",
                   moved, n, worst[0], worst[1], far_off[0], far_off[1]);
     assert_true(moved > n / 10); /* the blocker's move changed the light: the test can tell */
     assert_true(worst[0] < 1e-5);
