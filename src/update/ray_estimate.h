@@ -17,8 +17,9 @@
  * the AIMs' new light; its noise is the changed part's alone. Nothing is added where nothing changed.
  *
  * The ray gather is the rays scheme's estimator (photonmap/hemicube_rim.h with enlargement 0), K strata
- * over the whole hemisphere, each ray's AIM averaged over its footprint, emitters' emission where met, the
- * sky's mean where nothing is; it reads the whole dilated AIM (its direct part included, as a hemicube
+ * over the whole hemisphere, each ray's AIM averaged over its footprint, emitters' emission where met (or,
+ * where the gather takes it in closed form, its emitter light: lm_ray_estimate_emitters), the sky's mean
+ * where nothing is; it reads the whole dilated AIM (its direct part included, as a hemicube
  * does), so bases and updates stay alike whatever the gather scheme.
  *
  * Which texels: those the caller lists as waiting, at most `budget` an update: half by their estimated
@@ -35,10 +36,11 @@
  * the mirror sphere stood near: 36 rays read 7.98 where 1,600 read 5.30 (the gather 5.6), and over the next
  * 70 updates, the sphere gone, its estimate showed a quarter of its light's 54% rise. Over 12 seeds 6 x 6
  * strata read 6.0 +- 1.4 there and 12 x 12 6.1 +- 0.6, or 5.75 +- 0.5 with each footprint read at its ray
- * alone: noise, and a bias of the coarse strata. So each base is also taken with LM_RAY_ESTIMATE_FINE x K rays, and a
- * texel whose two differ by more than LM_RAY_ESTIMATE_SPLIT of its light takes those, base and updates
- * alike, until its next gather (`fine`): about a third of the animated box's bases, through the caustics
- * its mirror and glass balls sweep over the walls; few where the light is smooth.
+ * alone: noise, and a bias of the coarse strata. So each base is also taken with LM_RAY_ESTIMATE_FINE x K
+ * rays, and a texel whose two differ by more than LM_RAY_ESTIMATE_SPLIT of its light takes those, base and
+ * updates alike, until its next gather (`fine`): about a third of the animated box's bases, through the
+ * caustics its mirror and glass balls sweep over the walls; few where the light is smooth. The judge is
+ * made at the gather only: a texel that took its base with nothing near keeps its K rays when a node comes.
  *
  * Layout: per texel its base (rgb), two flags (a base; the fine rays) and the update it was last brought
  * up to date; the deltas an update computes, by texel index, for the caller to show (what is shown is the
@@ -66,7 +68,7 @@
 
 /* A texel whose base through K rays differs from one through LM_RAY_ESTIMATE_FINE x K by more than
  * LM_RAY_ESTIMATE_SPLIT of its light takes the latter (header). Over 120 updates of the animated box, three
- * gather seeds, 4 x 4 blocks over 10% off a fresh bake 1.82 / 1.30 / 1.82 -> 0.97 / 0.97 / 0.95 at a split of
+ * seeds, 4 x 4 blocks over 10% off a fresh bake 1.82 / 1.30 / 1.82 -> 0.97 / 0.97 / 0.95 at a split of
  * 0.1 (a third of the bases fine; `lmgi run`'s gather, which holds the estimates, 13.5 -> 23.2 ms an update,
  * the update 67 -> 74 ms); 0.2 (a sixth fine) -> 1.05 on the first seed. Two K-ray bases turned apart as
  * the judge, which sees noise but not the strata's bias: 1.38 / 1.23 / 1.20. */
