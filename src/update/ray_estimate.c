@@ -46,30 +46,28 @@ static lm_rim rays_over(const lm_ray_estimate *re, const lm_light_scale_world *w
     return r;
 }
 
-/* Texel i's ray gather by r, with the emitter light of re->emitted. */
-static void texel_gather(const lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *r, uint32_t i,
-                         float e[3])
+/* The emissive triangles' light re->emitted's gather adds to texel i, into em (0 without one). */
+static void emitted_at(const lm_ray_estimate *re, const lm_light_scale_world *w, uint32_t i, float em[3])
 {
-    float em[3] = {0.0f, 0.0f, 0.0f};
-    lm_light_scale_texel_rim(w, r, i, e);
+    em[0] = em[1] = em[2] = 0.0f;
     if (re->emitted)
         lm_gather_emitted_at(re->emitted, w->scene, w->atlas, i, em);
-    for (int c = 0; c < 3; c++)
-        e[c] += em[c];
 }
 
-/* Whether K rays misjudge texel i, whose K-ray gather is e: its LM_RAY_ESTIMATE_FINE x K-ray gather (into
- * ef) differs from it by more than LM_RAY_ESTIMATE_SPLIT of its light (the channels summed). */
-static int misjudged(const lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rf, uint32_t i,
-                     const float e[3], float ef[3])
+/* Whether K rays misjudge a texel whose K-ray gather is e and whose LM_RAY_ESTIMATE_FINE x K-ray gather is
+ * ef, both with its emitter light em: they differ by more than LM_RAY_ESTIMATE_SPLIT of its light (the
+ * channels summed). */
+static int misjudged(const float e[3], const float ef[3], const float em[3])
 {
-    texel_gather(re, w, rf, i, ef);
-    double a = (double)e[0] + e[1] + e[2], b = (double)ef[0] + ef[1] + ef[2];
+    double a = 0.0, b = 0.0;
+    for (int c = 0; c < 3; c++)
+        a += e[c] + em[c], b += ef[c] + em[c];
     return fabs(a - b) > LM_RAY_ESTIMATE_SPLIT * b;
 }
 
 /* The bases of texels list[0 .. m) (their gathers now, by r, and where r misjudges one, by rf: re->fine), or
- * with `minus` their changes since (re->delta), each by the rays its base took; on every core. */
+ * with `minus` their changes since (re->delta), each by the rays its base took, with its emitter light
+ * (emitted_at); on every core. */
 static void ray_gathers(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *r, const lm_rim *rf,
                         const uint32_t *list, uint32_t m, float *out, const float *minus)
 {
@@ -79,17 +77,20 @@ static void ray_gathers(lm_ray_estimate *re, const lm_light_scale_world *w, cons
 #pragma omp for schedule(dynamic, 16)
         for (long j = 0; j < (long)m; j++) {
             uint32_t i = list[j];
-            float e[3], ef[3];
+            float e[3], em[3];
+            emitted_at(re, w, i, em);
             if (minus) {
-                texel_gather(re, w, re->fine[i] ? rf : r, i, e);
+                lm_light_scale_texel_rim(w, re->fine[i] ? rf : r, i, e);
             } else {
-                texel_gather(re, w, r, i, e);
-                re->fine[i] = (uint8_t)misjudged(re, w, rf, i, e, ef);
+                float ef[3];
+                lm_light_scale_texel_rim(w, r, i, e);
+                lm_light_scale_texel_rim(w, rf, i, ef);
+                re->fine[i] = (uint8_t)misjudged(e, ef, em);
                 if (re->fine[i])
                     memcpy(e, ef, sizeof e);
             }
             for (int c = 0; c < 3; c++)
-                out[3 * (size_t)i + c] = e[c] - (minus ? minus[3 * (size_t)i + c] : 0.0f);
+                out[3 * (size_t)i + c] = e[c] + em[c] - (minus ? minus[3 * (size_t)i + c] : 0.0f);
         }
     }
 }
