@@ -386,6 +386,28 @@ static uint32_t *node_texels(const tscene *t, uint32_t node, float below, lm_rt 
     return texels;
 }
 
+/* pi A F for texel `texel` of a receiver under an emitting square of half side h at height d (receiver_under_emitter
+ * and its like: F from the texel's local point, lifted by the gather's offset, in closed form), for a square
+ * radiance A. */
+static double square_light(const tscene *t, const lm_hemicube_settings *set, uint32_t texel, double h, double d,
+                           double A)
+{
+    const lm_texel *tx = &t->a.texels[texel];
+    double px = tx->local[0], pz = tx->local[2], dd = d - set->offset * lm_scene_size(t->s);
+    return PI * A * lm_form_factor_rect(-h - px, h - px, -h - pz, h - pz, dd);
+}
+
+/* An atlas-sized RGBA map of t's of radiance A in every channel (alpha 1): a uniformly lit AIM. */
+static float *uniform_aim(const tscene *t, float A)
+{
+    size_t n = 4 * (size_t)t->a.width * t->a.height;
+    float *aim = malloc(n * sizeof *aim);
+    assert_non_null(aim);
+    for (size_t c = 0; c < n; c++)
+        aim[c] = c % 4 == 3 ? 1.0f : A;
+    return aim;
+}
+
 /* The rays gather under a small emitting square (side 0.3) 1 m over a receiver (half its side: half, its
  * texels that wide), with `set` (its scheme set to rays): the mean and worst relative error of the
  * receiver's texels against pi Le F, (bias, if given) their signed mean, and (each, if given, EACH_MAX)
@@ -404,10 +426,7 @@ static uint32_t errors_facing_emitter(lm_hemicube_settings set, float half, floa
     if (bias)
         *bias = 0.0;
     for (uint32_t k = 0; k < n; k++) {
-        const lm_texel *tx = &t.a.texels[texels[k]];
-        double h = 0.15, px = tx->local[0], pz = tx->local[2], dd = 1.0 - set.offset * lm_scene_size(t.s);
-        double F = lm_form_factor_rect(-h - px, h - px, -h - pz, h - pz, dd);
-        double e = texel_value(&t, rgba, texels[k])[0] / (PI * F) - 1.0;
+        double e = texel_value(&t, rgba, texels[k])[0] / square_light(&t, &set, texels[k], 0.15, 1.0, 1.0) - 1.0;
         if (each) {
             assert_true(k < EACH_MAX);
             each[k] = e;
@@ -2090,13 +2109,9 @@ static void test_ray_estimate_change(void **state)
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
     lm_light_scale_world w = {t.s, &t.a, rt, &set};
-    size_t cells = (size_t)t.a.width * t.a.height;
-    float *black = calloc(4 * cells, sizeof *black), *lit = malloc(4 * cells * sizeof *lit);
-    assert_non_null(black);
-    assert_non_null(lit);
     const float A = 0.4f;
-    for (size_t c = 0; c < 4 * cells; c++)
-        lit[c] = c % 4 == 3 ? 1.0f : A;
+    float *black = calloc(4 * (size_t)t.a.width * t.a.height, sizeof *black), *lit = uniform_aim(&t, A);
+    assert_non_null(black);
     lm_ray_estimate re;
     lm_error err;
     assert_int_equal(lm_ray_estimate_init(&re, t.a.texel_count, LM_RAY_ESTIMATE_RAYS, &err), LM_OK);
@@ -2115,10 +2130,7 @@ static void test_ray_estimate_change(void **state)
     assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, n, n, out), n);
     double mean = 0.0, worst = 0.0, bias = 0.0;
     for (uint32_t k = 0; k < n; k++) {
-        const lm_texel *tx = &t.a.texels[texels[k]];
-        double px = tx->local[0], pz = tx->local[2], dd = 1.0 - set.offset * lm_scene_size(t.s);
-        double F = lm_form_factor_rect(-1.0 - px, 1.0 - px, -1.0 - pz, 1.0 - pz, dd);
-        double e = re.delta[3 * (size_t)texels[k]] / (PI * A * F) - 1.0;
+        double e = re.delta[3 * (size_t)texels[k]] / square_light(&t, &set, texels[k], 1.0, 1.0, A) - 1.0;
         mean += fabs(e) / n;
         bias += e / n;
         worst = fmax(worst, fabs(e));
@@ -2165,14 +2177,11 @@ static void test_ray_estimate_fine_rays(void **state)
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
     lm_light_scale_world w = {t.s, &t.a, rt, &set};
-    size_t cells = (size_t)t.a.width * t.a.height;
-    float *black = calloc(4 * cells, sizeof *black), *lit = malloc(4 * cells * sizeof *lit);
+    const float A = 0.4f;
+    float *black = calloc(4 * (size_t)t.a.width * t.a.height, sizeof *black), *lit = uniform_aim(&t, A);
     float *change = malloc(sizeof *change * n);
     uint32_t *out = malloc(sizeof *out * n);
-    assert_non_null(black), assert_non_null(lit), assert_non_null(change), assert_non_null(out);
-    const float A = 0.4f;
-    for (size_t c = 0; c < 4 * cells; c++)
-        lit[c] = c % 4 == 3 ? 1.0f : A;
+    assert_non_null(black), assert_non_null(change), assert_non_null(out);
     for (uint32_t k = 0; k < n; k++)
         change[k] = 1.0f;
     lm_error err;
@@ -2188,11 +2197,9 @@ static void test_ray_estimate_fine_rays(void **state)
     double err_fine = 0.0, err_coarse = 0.0;
     for (uint32_t k = 0; k < n; k++) {
         uint32_t i = texels[k];
-        const lm_texel *tx = &t.a.texels[i];
-        double px = tx->local[0], pz = tx->local[2], dd = 1.0 - set.offset * lm_scene_size(t.s);
-        double want = PI * A * lm_form_factor_rect(-0.15 - px, 0.15 - px, -0.15 - pz, 0.15 - pz, dd);
         if (!re.fine[i])
             continue;
+        double want = square_light(&t, &set, i, 0.15, 1.0, A);
         float e0[3], e1[3];
         lm_light_scale_texel_rim(&w, &coarse_was, i, e0);
         lm_light_scale_texel_rim(&w, &coarse_now, i, e1);
