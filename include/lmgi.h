@@ -615,6 +615,10 @@ typedef struct {
                                 * what they see since their gather) this update brought up to date and shows
                                 * (docs/gather.md, "Rays for the texels that wait"); gather.texels_per_frame x
                                 * 16 at most, counted in ms_gather */
+    uint32_t texels_based;     /* texels whose estimate's base (what their few rays see as gathered) was taken
+                                * since the last update: those gathered, and every texel once, at the setup
+                                * in a scene with a dynamic node or an animation, else before its first edit,
+                                * counted here (docs/gather.md, "Rays for the texels that wait") */
     int texels_budget;         /* the texels this update was allowed (budget_ms > 0: from the measured cost) */
     int surfaces_changed;      /* surfaces whose displayed lightmap changed (lmgi_surface_version moved) */
     uint32_t caustic_photons_retraced; /* caustic photons traced (a moved light or mirror/glass node: all its) */

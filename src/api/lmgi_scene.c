@@ -38,7 +38,9 @@ void lmgi_options_init(lmgi_options *o)
     o->open_need = 0.0f; /* off, unless a caller (lmgi run) asks for it */
 }
 
-lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err)
+/* lm_scene_quiet, and with `changes` what the updater takes of the scene before it changes
+ * (lm_frame_loop_before_change). */
+static lmgi_status quiet(const lmgi_scene *sc, const char *fn, int changes, lmgi_error *err)
 {
     if (!sc->loop)
         return LMGI_OK;
@@ -47,11 +49,22 @@ lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err
         return st;
     lm_log_target saved = lm_api_enter(sc->ctx);
     lm_error e;
-    if (lm_frame_loop_sync(sc->loop, &e) != LM_OK) /* reported again by the next update's own work */
+    lm_status s = changes ? lm_frame_loop_before_change(sc->loop, &e) : lm_frame_loop_sync(sc->loop, &e);
+    if (s != LM_OK) /* reported again by the next update's own work */
         lm_log(LM_LOG_ERROR, "%s", e.msg);
     lm_api_leave(saved);
     lm_api_release(sc->ctx);
     return LMGI_OK;
+}
+
+lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err)
+{
+    return quiet(sc, fn, lm_edits_pending(&sc->edits), err); /* staged edits: a commit follows */
+}
+
+lmgi_status lm_scene_before_change(const lmgi_scene *sc, const char *fn, lmgi_error *err)
+{
+    return quiet(sc, fn, 1, err);
 }
 
 lmgi_status lm_scene_commit(const lmgi_scene *sc, lmgi_error *err)
@@ -510,7 +523,7 @@ lmgi_status lmgi_set_node_transform(lmgi_scene *sc, int node, const float world[
     }
     /* The scene model now (children follow through their local matrices), the rays at the commit
      * (update/edits.h); on a failure the node's earlier placement comes back. */
-    if (lm_scene_quiet(sc, "lmgi_set_node_transform", err) != LMGI_OK) /* its photon work may still be reading the scene and BVH */
+    if (lm_scene_before_change(sc, "lmgi_set_node_transform", err) != LMGI_OK) /* its photon work may still be reading the scene and BVH */
         return LMGI_ERR_INVALID;
     lm_node saved = *n;
     lm_status st = lm_scene_set_node_world(sc->scene, node, m)
@@ -542,7 +555,7 @@ lmgi_status lmgi_node_resume_animation(lmgi_scene *sc, int node, lmgi_error *err
         lm_fail(&e, LM_ERR_INVALID, "lmgi_node_resume_animation: %s", sc ? "node id out of range" : "the scene is NULL");
         return lm_export_error(err, &e);
     }
-    if (lm_scene_quiet(sc, "lmgi_node_resume_animation", err) != LMGI_OK)
+    if (lm_scene_before_change(sc, "lmgi_node_resume_animation", err) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_scene_release_node(sc->scene, node);
     return LMGI_OK;
@@ -560,7 +573,8 @@ lmgi_status lmgi_set_time(lmgi_scene *sc, float t, lmgi_error *err)
         lm_fail(&e, LM_ERR_INVALID, "%s: animation time is not a finite number", sc->scene->path);
         return lm_export_error(err, &e);
     }
-    if (lm_scene_quiet(sc, "lmgi_set_time", err) != LMGI_OK)
+    if ((sc->scene->animation_count > 0 ? lm_scene_before_change(sc, "lmgi_set_time", err)
+                                             : lm_scene_quiet(sc, "lmgi_set_time", err)) != LMGI_OK)
         return LMGI_ERR_INVALID;
     lm_scene_eval_animation(sc->scene, -1, t);
     lm_edits_note_moved(&sc->edits); /* the BVH follows at the commit */

@@ -29,9 +29,13 @@ struct lmgi_scene {
 };
 
 /* Before an edit changes what the scene's updater reads (the scene, its BVH, lights, materials, sky):
- * the photon work the last update left running is waited for. Refused (LMGI_ERR_INVALID naming fn)
- * while another thread is inside a call on the updater's context. LMGI_OK at once without an updater. */
+ * the photon work the last update left running is waited for; with staged edits waiting, as
+ * lm_scene_before_change, since a commit follows wherever it is called. Refused (LMGI_ERR_INVALID naming
+ * fn) while another thread is inside a call on the updater's context. LMGI_OK at once without an updater. */
 lmgi_status lm_scene_quiet(const lmgi_scene *sc, const char *fn, lmgi_error *err);
+/* As lm_scene_quiet, before an edit that writes the scene at once (a node's transform, an animation's
+ * time): the updater takes what it must of the scene as it is (lm_frame_loop_before_change). */
+lmgi_status lm_scene_before_change(const lmgi_scene *sc, const char *fn, lmgi_error *err);
 /* The staged edits committed (update/edits.h), after waiting for the photon work when any are staged:
  * before the API traces rays of its own or reads the scene model (exports, reports). */
 lmgi_status lm_scene_commit(const lmgi_scene *sc, lmgi_error *err);

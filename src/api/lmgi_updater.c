@@ -466,6 +466,7 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->aim_surfaces_at_once = st->aim_at_once;
     o->texels_gathered = fs->texels_gathered;
     o->texels_estimated = fs->texels_estimated;
+    o->texels_based = fs->texels_based;
     o->texels_budget = fs->plan.texels;
     o->surfaces_changed = changed;
     o->caustic_photons_retraced = st->caustics.traced;

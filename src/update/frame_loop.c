@@ -35,6 +35,7 @@ struct lm_frame_loop {
     float budget_ms;             /* lm_frame_loop_set_budget's (0: the settings' fixed counts) */
     lm_budget budget;            /* each stage's cost per unit (budget_plan.h) */
     int steps;                   /* steps done */
+    double t_before_change;      /* the seconds the last enter spent on lm_frame_loop_before_change */
 };
 
 int lm_frame_loop_atlas_texels(int texels_per_frame)
@@ -64,8 +65,10 @@ static lm_status follow_edits(lm_frame_loop *fl, lm_error *err)
 static lm_status enter(lm_frame_loop *fl, lm_error *err)
 {
     lm_status st = lm_gl_make_current(fl->gl, err);
+    double t0 = lm_now();
     if (st == LM_OK && lm_edits_pending(fl->world.edits))
-        st = lm_frame_loop_sync(fl, err);
+        st = lm_frame_loop_before_change(fl, err);
+    fl->t_before_change = lm_now() - t0;
     return st == LM_OK ? lm_edits_commit(&fl->world, err) : st;
 }
 
@@ -281,13 +284,21 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
     lm_lightmap_path_set_scale_rays(fl->lightmaps, p->scale_rays, p->ms[LM_STAGE_LIGHT_SCALE]);
 }
 
+/* Before the stage evaluates the scene's animations, which may move its nodes (no photon work runs). */
+static lm_status before_animation(lm_frame_loop *fl, lm_error *err)
+{
+    return fl->world.scene->animation_count > 0 ? lm_lightmap_path_before_change(fl->lightmaps, err) : LM_OK;
+}
+
 /* Animations and the scene bounds that follow from them: written here, on the calling thread, before
  * anything that reads them (the photon thread's update among them) starts; then the step's plan. */
 static lm_status animate(lm_frame_loop *fl, float t, lm_frame_stats *o, lm_error *err)
 {
     double t0 = lm_now();
     lm_photon_stage_set_budgeted(fl->stage, fl->budget_ms > 0.0f);
-    lm_status st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
+    lm_status st = before_animation(fl, err);
+    if (st == LM_OK)
+        st = lm_photon_stage_animate(fl->stage, t, &o->stage, err);
     const lm_photon_stage_frame *f = &o->stage; /* an edit's own work, done at once */
     if (f->emitters_lit > 0 || f->emitters_scaled > 0 || f->materials_changed > 0 || f->aim_at_once > 0 ||
         f->placed)
@@ -419,6 +430,13 @@ static lm_status join_stage(lm_frame_loop *fl, lm_photon_stage_frame *done, lm_e
 }
 
 lm_status lm_frame_loop_sync(lm_frame_loop *fl, lm_error *err) { return join_stage(fl, NULL, err); }
+
+lm_status lm_frame_loop_before_change(lm_frame_loop *fl, lm_error *err)
+{
+    lm_status st = join_stage(fl, NULL, err);
+    return st == LM_OK ? lm_lightmap_path_before_change(fl->lightmaps, err) : st;
+}
+
 int lm_frame_loop_busy(const lm_frame_loop *fl) { return fl->pending_busy; }
 
 /* Detached (overlap without a frame of its own: a game draws between steps): the stage's job begun by
@@ -550,6 +568,8 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
         st = !fl->worker ? step_in_order(fl, t, &o, err)
              : fl->set.width > 0 ? step_overlapped(fl, t, &o, err) : step_detached(fl, t, &o, err);
     o.t_total = lm_now() - t0;
+    o.t_edits += fl->t_before_change; /* a still level's first edit: the rays' bases (lightmap_path.h) */
+    o.texels_based = lm_lightmap_path_take_based(fl->lightmaps);
     double scale_ms = 0.0;
     o.scale_rays = lm_lightmap_path_take_scale_work(fl->lightmaps, &scale_ms);
     o.t_light_scale = 1e-3 * scale_ms;
@@ -576,7 +596,10 @@ lm_status lm_frame_loop_bake(lm_frame_loop *fl, float t, int fresh_plan, lm_bake
         progress(user, 0.0, "photons");
     double t0 = lm_now();
     lm_photon_stage_frame f;
-    st = lm_photon_stage_converge(fl->stage, t, fresh_plan, &f, err);
+    memset(&f, 0, sizeof f);
+    st = before_animation(fl, err);
+    if (st == LM_OK)
+        st = lm_photon_stage_converge(fl->stage, t, fresh_plan, &f, err);
     lm_scene_update_bounds(fl->world.scene);
     out->photons_traced = f.photons.group_photons;
     out->photons_changed = f.photons.photons_updated;

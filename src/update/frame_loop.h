@@ -51,6 +51,10 @@ lm_status lm_frame_loop_step(lm_frame_loop *fl, float t, lm_frame_stats *out, lm
  * it before anything that writes the scene or BVH (a commit of edits, which the loop's own steps make
  * after it) or reads the AIM or photons. */
 lm_status lm_frame_loop_sync(lm_frame_loop *fl, lm_error *err);
+/* lm_frame_loop_sync, then what must be taken of the scene as it is before a change (the waiting texels'
+ * ray bases: lm_lightmap_path_before_change). Call it before anything writes the scene's nodes, lights,
+ * materials or sky (an edit, an animation's time); the loop's own steps call it before their commits. */
+lm_status lm_frame_loop_before_change(lm_frame_loop *fl, lm_error *err);
 /* 1 while that photon work runs (a staged edit leaves it running: update/edits.h). */
 int lm_frame_loop_busy(const lm_frame_loop *fl);
 /* What a bake did: photon paths that changed (of all, re-traced), AIM surfaces refreshed, IIM texels

@@ -91,6 +91,8 @@ typedef struct {
     lm_photon_stage_frame stage;
     uint32_t texels_gathered;
     uint32_t texels_estimated; /* waiting texels whose ray estimate was brought up to date (ray_estimate.h) */
+    uint32_t texels_based;     /* texels whose ray estimate's base was taken since the last step (lightmap_path.h,
+                                * lm_lightmap_path_before_change) */
     lm_caustic_pass_stats caustic; /* the frame's caustic pass */
     uint32_t caustic_landed, caustic_thin; /* the caustic photons the frame showed, and of those the ones its
                                             * lightmaps carried (photonmap/caustic_split.h) */
@@ -112,7 +114,8 @@ typedef struct {
     uint64_t scale_rays;
     /* of t_photons, the edits' work the photon stage did at once (a lit light's photons traced, AIMs
      * refreshed for a light or colour edit: lm_photon_stage_animate), which the budget's model of the
-     * gather's rest leaves out like the texel factors (budget_plan.h) */
+     * gather's rest leaves out like the texel factors (budget_plan.h); and, before t_photons, the rays'
+     * bases a level without dynamic nodes takes at its first edit (lm_lightmap_path_before_change) */
     double t_edits;
     /* of t_photons, how far the photon stage's job that finished in this step ran past what its plan gave
      * it, at most what the step waited for it (in order and overlapped): a price its stages' models learn

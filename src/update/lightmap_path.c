@@ -40,11 +40,12 @@ struct lm_lightmap_path {
     uint64_t scale_cast;
     lm_texel_change change;    /* with have_change (from the first gather on): texels ahead of surfaces */
     int have_change;
-    lm_ray_estimate rays;      /* with have_rays (from the first gather on, where waiting texels show an
-                                * estimate): their own, from a few rays (ray_estimate.h) */
+    lm_ray_estimate rays;      /* with have_rays (from the first change of the scene on, where waiting texels
+                                * show an estimate): their own, from a few rays (ray_estimate.h) */
     int have_rays;
     uint32_t *ray_list;        /* scratch: the texels whose ray estimate an update brought up to date */
     uint32_t ray_budget;       /* at most this many an update (lm_lightmap_path_set_ray_budget) */
+    uint32_t based;            /* the texels whose ray bases were taken since lm_lightmap_path_take_based */
     uint32_t estimated;        /* how many the last schedule did */
     double estimate_seconds;   /* and the seconds the ray estimates took in it */
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
@@ -370,7 +371,18 @@ static int shows_estimates(const lm_lightmap_path *lp)
     return lp->change.threshold >= 0.0f && lp->iim.set.spread > 0;
 }
 
-/* The texels' ray estimates begun (ray_estimate.h): every texel's base over the AIM the first gather read. */
+/* Whether the scene is made to change: a node that may move, or an animation. A level without either may
+ * still be edited (its lights, materials, sky), but most are baked and shown as they are. */
+static int may_change(const lm_scene *s)
+{
+    for (int n = 0; n < s->node_count; n++)
+        if (lm_node_moves(&s->nodes[n]))
+            return 1;
+    return s->animation_count > 0;
+}
+
+/* The texels' ray estimates begun (ray_estimate.h): every texel's base over the AIM the gathers so far read,
+ * the scene still as they saw it (lm_lightmap_path_before_change). */
 static lm_status start_rays(lm_lightmap_path *lp, lm_error *err)
 {
     const lm_atlas *a = lp->atlas;
@@ -388,6 +400,7 @@ static lm_status start_rays(lm_lightmap_path *lp, lm_error *err)
         lp->ray_list[i] = i;
     lm_ray_estimate_gathered(&lp->rays, &w, lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage)), lp->ray_list,
                              a->texel_count);
+    lp->based += a->texel_count;
     return LM_OK;
 }
 
@@ -405,6 +418,7 @@ static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting
     const float *aim = lm_aim_dilated_rgba(lm_photon_stage_aim(lp->stage));
     lm_iim_sight_gathered(&lp->iim, lp->atlas, lp->texels, count);
     lm_ray_estimate_gathered(&lp->rays, &w, aim, lp->texels, count);
+    lp->based += count;
     const uint32_t *wait = lp->texels + count;
     float *change = malloc(sizeof *change * (waiting ? waiting : 1));
     for (uint32_t k = 0; change && k < waiting; k++)
@@ -433,12 +447,20 @@ lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_erro
                                   lp->set->iim.texel_change, err);
         lp->have_change = st == LM_OK;
     }
-    if (st == LM_OK && lp->have_change && !lp->have_rays && shows_estimates(lp) && lp->set->iim.estimate_rays > 0)
-        st = start_rays(lp, err);
+    if (st == LM_OK && may_change(lp->scene)) /* taken now, not in the first edit's update: a drag's first step */
+        st = lm_lightmap_path_before_change(lp, err);
+    lp->based = 0; /* the setup's own work, not an update's */
     lm_gl_finish(); /* the time holds the GPU's work too: the budget's first guess starts from it */
     if (t_gather)
         *t_gather = lm_now() - t0;
     return st;
+}
+
+lm_status lm_lightmap_path_before_change(lm_lightmap_path *lp, lm_error *err)
+{
+    if (!lp || !lp->have_change || lp->have_rays || !shows_estimates(lp) || lp->set->iim.estimate_rays <= 0)
+        return LM_OK;
+    return start_rays(lp, err);
 }
 
 void lm_lightmap_path_aim_changed(lm_lightmap_path *lp) { lp->aim_stale = 1; }
@@ -710,6 +732,13 @@ lm_iim *lm_lightmap_path_iim(lm_lightmap_path *lp) { return &lp->iim; }
 const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp) { return &lp->iim; }
 
 void lm_lightmap_path_set_ray_budget(lm_lightmap_path *lp, uint32_t texels) { lp->ray_budget = texels; }
+
+uint32_t lm_lightmap_path_take_based(lm_lightmap_path *lp)
+{
+    uint32_t n = lp->based;
+    lp->based = 0;
+    return n;
+}
 
 uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds)
 {

@@ -37,6 +37,14 @@ void lm_lightmap_path_free(lm_lightmap_path *lp);
  * settings say: gather_passes.h), shown at once; then the settings' progress, cancel and checkpoint are
  * cleared (per-step gathers are small). *t_gather (may be NULL): its seconds. */
 lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_error *err);
+/* Called before anything changes the scene (an edit, a node moved, an animation evaluated): where waiting
+ * texels show ray estimates and none were begun, every texel's base is taken now, over the scene and AIMs
+ * the gathers so far read (ray_estimate.h). lm_lightmap_path_first takes them at once in a scene with a
+ * dynamic node or an animation, so that a drag's first step does not wait for them; a level without
+ * either pays for them at its first edit, and one that is never edited never does (on truck-town they
+ * were a fifth of the setup). Cheap after the first call. No GL needed; the photon work must be waited
+ * for (lm_frame_loop_sync). Fails only for want of memory. */
+lm_status lm_lightmap_path_before_change(lm_lightmap_path *lp, lm_error *err);
 
 /* Follows the scene's light and its nodes' indirect switches (lm_scene.pass_version): surfaces switched
  * on or off in the scheduler, the IIM cleared when the scene lost its last light. */
@@ -70,6 +78,9 @@ void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels);
  * step times its schedule. */
 void lm_lightmap_path_set_ray_budget(lm_lightmap_path *lp, uint32_t texels);
 uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds);
+/* The texels whose ray estimate's base was taken (those gathered, every texel at the start) since the last
+ * call, which zeroes it; the setup's are not counted. */
+uint32_t lm_lightmap_path_take_based(lm_lightmap_path *lp);
 /* The rays a light edit's texel factors may cast an update (update/light_scale.h; 0: no bound, the full
  * quality in the edit's update) and the milliseconds its refinement may take (0: no bound), what its
  * refinement still has to cast, and the rays it cast and the milliseconds it took since the last take
