@@ -362,6 +362,7 @@ lm_status lm_iim_blend(lm_iim *iim, int instant, lm_error *err)
     glUniform1f(glGetUniformLocation(iim->blend_prog, "limit"), iim->set.backface_limit);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "spread"), iim->set.spread);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "sight_spread"), LM_IIM_SIGHT_SPREAD);
+    glUniform1i(glGetUniformLocation(iim->blend_prog, "sight_apart"), LM_IIM_SIGHT_APART);
     glUniform1i(glGetUniformLocation(iim->blend_prog, "sight_blend"), LM_IIM_SIGHT_BLEND);
     unsigned *tex[IIM_TEXTURES];
     textures(iim, tex);
