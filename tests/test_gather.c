@@ -2096,8 +2096,8 @@ static void test_rim_pair_same_as_two(void **state)
  * gather, through the same rays. Under an emitting square (side 2, 1 m up) whose AIM goes from black to a
  * uniform radiance A, every receiver texel's change is pi A F, F its form factor to the square in closed
  * form; where nothing changed the change is 0 to the bit (the same rays meet the same points); and the
- * texels brought up to date are those whose change times their wait is greatest, so that none waits for
- * good. */
+ * texels brought up to date are those whose change times their wait is greatest, those whose light went on
+ * changing, and those that waited longest, so that none waits for good. */
 static void test_ray_estimate_change(void **state)
 {
     (void)state;
@@ -2123,11 +2123,11 @@ static void test_ray_estimate_change(void **state)
     for (uint32_t k = 0; k < n; k++)
         change[k] = 1.0f;
     /* nothing changed: nothing added, to the bit */
-    assert_int_equal(lm_ray_estimate_update(&re, &w, black, texels, change, n, n, out), n);
+    assert_int_equal(lm_ray_estimate_update(&re, &w, black, texels, change, 1.0f, n, n, out), n);
     for (uint32_t k = 0; k < 3 * n; k++)
         assert_true(re.delta[3 * (size_t)texels[k / 3] + k % 3] == 0.0f);
     /* the square's AIM lit: pi A F at every texel */
-    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, n, n, out), n);
+    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, 1.0f, n, n, out), n);
     double mean = 0.0, worst = 0.0, bias = 0.0;
     for (uint32_t k = 0; k < n; k++) {
         double e = re.delta[3 * (size_t)texels[k]] / square_light(&t, &set, texels[k], 1.0, 1.0, A) - 1.0;
@@ -2143,14 +2143,23 @@ static void test_ray_estimate_change(void **state)
     /* the turn: a budget of 3 takes the most changed first, then those that waited */
     for (uint32_t k = 0; k < n; k++)
         change[k] = k == 5 ? 8.0f : 1.0f;
-    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, n, 3, out), 3);
+    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, 1.0f, n, 3, out), 3);
     assert_true(out[0] == texels[5] || out[1] == texels[5] || out[2] == texels[5]);
     uint32_t first[3];
     memcpy(first, out, sizeof first);
-    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, n, 3, out), 3);
+    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, 1.0f, n, 3, out), 3);
     for (int j = 0; j < 3; j++) /* texel 5 waited one update against the others' two: 8 x 1 > 1 x 2 */
         for (int i = 0; i < 3; i++)
             assert_true(out[j] != first[i] || first[i] == texels[5]);
+    /* and a texel whose light went on changing goes before those whose light holds, though it waited less:
+     * texel 7 alone saw the square lit, an update after all saw it black */
+    lm_ray_estimate_gathered(&re, &w, black, texels, n);
+    for (uint32_t k = 0; k < n; k++)
+        change[k] = 1.0f;
+    assert_int_equal(lm_ray_estimate_update(&re, &w, black, texels, change, 1.0f, n, n, out), n);
+    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels + 7, change, 1.0f, 1, 1, out), 1);
+    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, 1.0f, n, 3, out), 3);
+    assert_true(out[0] == texels[7] || out[1] == texels[7] || out[2] == texels[7]);
     free(change);
     free(out);
     lm_ray_estimate_free(&re);
@@ -2188,7 +2197,7 @@ static void test_ray_estimate_fine_rays(void **state)
     lm_ray_estimate re;
     assert_int_equal(lm_ray_estimate_init(&re, t.a.texel_count, LM_RAY_ESTIMATE_RAYS, &err), LM_OK);
     lm_ray_estimate_gathered(&re, &w, black, texels, n);
-    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, n, n, out), n);
+    assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, 1.0f, n, n, out), n);
     lm_rim coarse_was = {t.s, &t.a, rt, black, 1, {set.sky[0], set.sky[1], set.sky[2]}, 0.0f, LM_RAY_ESTIMATE_RAYS,
                          NULL, NULL, NULL, 0.0f, 0.0f},
            coarse_now = coarse_was;
@@ -2292,7 +2301,7 @@ static void test_ray_estimate_emitter_shadow(void **state)
     assert_true(lm_scene_set_node_world(t.s, 3, world));
     assert_int_equal(lm_rt_sync_transforms(rt, t.s, &err), LM_OK);
     for (int k = 0; k < 2; k++)
-        assert_int_equal(lm_ray_estimate_update(&re[k], &w, black, texels, change, n, n, out), n);
+        assert_int_equal(lm_ray_estimate_update(&re[k], &w, black, texels, change, 1.0f, n, n, out), n);
     uint32_t moved = 0, far_off[2] = {0, 0};
     double worst[2] = {0.0, 0.0};
     for (uint32_t j = 0; j < n; j++) {

@@ -423,7 +423,10 @@ static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting
     float *change = malloc(sizeof *change * (waiting ? waiting : 1));
     for (uint32_t k = 0; change && k < waiting; k++)
         change[k] = lm_texel_change_of(&lp->change, wait[k]);
-    uint32_t m = change ? lm_ray_estimate_update(&lp->rays, &w, aim, wait, change, waiting, budget, lp->ray_list) : 0;
+    /* the change is a share of the scene's mean irradiance (luminance): the rays' light sums the channels */
+    float unit = 3.0f * (float)lp->change.mean_e;
+    uint32_t m = change ? lm_ray_estimate_update(&lp->rays, &w, aim, wait, change, unit, waiting, budget, lp->ray_list)
+                        : 0;
     free(change);
     lm_iim_set_sight(&lp->iim, lp->atlas, lp->ray_list, lp->rays.delta, lp->rays.base, m);
     lp->estimated = m;

@@ -20,7 +20,9 @@ lm_status lm_ray_estimate_init(lm_ray_estimate *re, uint32_t texel_count, int K,
     re->has = calloc(n, 1);
     re->stamp = calloc(n, sizeof *re->stamp);
     re->fine = calloc(n, 1);
-    if (re->base && re->delta && re->has && re->stamp && re->fine)
+    re->rate = calloc(n, sizeof *re->rate);
+    re->rated = calloc(n, 1);
+    if (re->base && re->delta && re->has && re->stamp && re->fine && re->rate && re->rated)
         return LM_OK;
     lm_ray_estimate_free(re);
     return lm_fail(err, LM_ERR_NOMEM, "ray estimate: no memory for %u texels", texel_count);
@@ -33,6 +35,8 @@ void lm_ray_estimate_free(lm_ray_estimate *re)
     free(re->has);
     free(re->stamp);
     free(re->fine);
+    free(re->rate);
+    free(re->rated);
     memset(re, 0, sizeof *re);
 }
 
@@ -112,41 +116,95 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
     lm_rim r, rf;
     rims_over(re, w, aim, &r, &rf);
     ray_gathers(re, w, &r, &rf, texels, n, re->base, NULL);
-    for (uint32_t j = 0; j < n; j++) {
+    for (uint32_t j = 0; j < n; j++) { /* its change starts again from 0, and its rate is unknown */
         re->has[texels[j]] = 1;
         re->stamp[texels[j]] = re->frame;
+        re->rated[texels[j]] = 0;
+        memset(re->delta + 3 * (size_t)texels[j], 0, 3 * sizeof *re->delta);
     }
 }
 
+/* A texel's light as its estimate has it, the channels summed. */
+static double light_of(const lm_ray_estimate *re, uint32_t i)
+{
+    const float *b = re->base + 3 * (size_t)i, *d = re->delta + 3 * (size_t)i;
+    return (double)b[0] + b[1] + b[2] + d[0] + d[1] + d[2];
+}
+
+/* How far texel i's estimate is likely off by now, as a share of its light (at least `least`): the rate its
+ * change went at between its last two estimates times the updates since, or before it has one (rated), its
+ * prior (the change since its gather, from what moved, channels summed). */
+static double stale(const lm_ray_estimate *re, uint32_t i, float prior, double least)
+{
+    double off = re->rated[i] ? (double)re->rate[i] * (double)(re->frame - re->stamp[i]) : (double)prior;
+    return off / fmax(light_of(re, i), least);
+}
+
+/* The texels taken so far this update (out[0 .. m), stamped with the frame) with their stamp and change
+ * before, for their rates; then at most `quota` more of waiting's with a base, by `key`: 0 change times the
+ * updates since each was last brought up to date, 1 stale, 2 those updates alone. Ties by texel index, the
+ * same on every run. Returns the new m. */
+static uint32_t take(lm_ray_estimate *re, const uint32_t *waiting, const float *change, const float *prior, uint32_t n,
+                     int key, uint32_t quota, double least, lm_ranked *h, uint32_t *out, uint32_t m, uint32_t *was,
+                     float *sum)
+{
+    uint32_t got = 0;
+    for (uint32_t k = 0; k < n && quota > 0; k++) {
+        uint32_t i = waiting[k];
+        if (!re->has[i] || re->stamp[i] == re->frame)
+            continue;
+        double since = (double)(re->frame - re->stamp[i]);
+        double v = key == 0 ? (double)change[k] * since : key == 1 ? stale(re, i, prior[k], least) : since;
+        lm_top_k_offer(h, &got, quota, (lm_ranked){v, i});
+    }
+    for (uint32_t j = 0; j < got; j++) {
+        uint32_t i = h[j].id;
+        const float *d = re->delta + 3 * (size_t)i;
+        was[m] = re->stamp[i], sum[m] = d[0] + d[1] + d[2];
+        out[m++] = i;
+        re->stamp[i] = re->frame; /* out of the later keys' running */
+    }
+    return m;
+}
+
 uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
-                                const uint32_t *waiting, const float *change, uint32_t n, uint32_t budget,
-                                uint32_t *out)
+                                const uint32_t *waiting, const float *change, float change_unit, uint32_t n,
+                                uint32_t budget, uint32_t *out)
 {
     re->frame++;
     if (n == 0 || budget == 0 || re->K <= 0)
         return 0;
-    lm_ranked *h = malloc(sizeof *h * (budget < n ? budget : n));
-    if (!h) /* no estimate this update: the texels show their neighbours' loans */
+    uint32_t cap = budget < n ? budget : n;
+    lm_ranked *h = malloc(sizeof *h * cap);
+    uint32_t *was = malloc(sizeof *was * cap);
+    float *sum = malloc(sizeof *sum * cap), *prior = malloc(sizeof *prior * n);
+    if (!h || !was || !sum || !prior) { /* no estimate this update: the texels show their neighbours' loans */
+        free(h), free(was), free(sum), free(prior);
         return 0;
-    /* half by change times the updates since each was last brought up to date (or gathered), then the other
-     * half by those updates alone among the rest (header); ties by texel index, the same on every run */
-    uint32_t most = budget - budget / 2, m = 0, got = 0;
-    for (uint32_t k = 0; k < n; k++)
+    }
+    double mean = 0.0;
+    uint32_t based = 0;
+    for (uint32_t k = 0; k < n; k++) {
+        prior[k] = change[k] * change_unit;
         if (re->has[waiting[k]])
-            lm_top_k_offer(h, &got, most,
-                           (lm_ranked){(double)change[k] * (double)(re->frame - re->stamp[waiting[k]]), waiting[k]});
-    for (uint32_t j = 0; j < got; j++) /* stamped now: out of the second half's running */
-        out[m++] = h[j].id, re->stamp[h[j].id] = re->frame;
-    got = 0;
-    for (uint32_t k = 0; k < n && budget > most; k++)
-        if (re->has[waiting[k]] && re->stamp[waiting[k]] != re->frame)
-            lm_top_k_offer(h, &got, budget - most, (lm_ranked){(double)(re->frame - re->stamp[waiting[k]]), waiting[k]});
-    for (uint32_t j = 0; j < got; j++)
-        out[m++] = h[j].id, re->stamp[h[j].id] = re->frame;
-    free(h);
+            mean += light_of(re, waiting[k]), based++;
+    }
+    double least = LM_RAY_ESTIMATE_DIM * (based ? mean / based : 0.0) + 1e-30;
+    /* a third each by change times wait, by expected staleness, by wait alone (header) */
+    uint32_t third = budget / 3, m = 0;
+    m = take(re, waiting, change, prior, n, 0, third, least, h, out, m, was, sum);
+    m = take(re, waiting, change, prior, n, 1, third, least, h, out, m, was, sum);
+    m = take(re, waiting, change, prior, n, 2, budget - 2 * third, least, h, out, m, was, sum);
     lm_rim r, rf;
     rims_over(re, w, aim, &r, &rf);
     ray_gathers(re, w, &r, &rf, out, m, re->delta, re->base);
+    for (uint32_t j = 0; j < m; j++) { /* the rate each change went at since the texel's last estimate */
+        const float *d = re->delta + 3 * (size_t)out[j];
+        uint32_t since = re->frame - was[j];
+        re->rate[out[j]] = fabsf(d[0] + d[1] + d[2] - sum[j]) / (float)(since ? since : 1);
+        re->rated[out[j]] = 1;
+    }
+    free(h), free(was), free(sum), free(prior);
     return m;
 }
 
@@ -154,6 +212,7 @@ void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float
 {
     for (size_t k = 0; k < 3 * (size_t)re->texel_count; k++)
         re->base[k] = re->base[k] * factor[k] + (add ? add[k] : 0.0f);
+    memset(re->rated, 0, re->texel_count ? re->texel_count : 1); /* the rates came before the edit */
 }
 
 void lm_ray_estimate_emitters(lm_ray_estimate *re, const lm_gather *g) { re->emitted = g; }

@@ -22,14 +22,20 @@
  * where nothing is; it reads the whole dilated AIM (its direct part included, as a hemicube
  * does), so bases and updates stay alike whatever the gather scheme.
  *
- * Which texels: those the caller lists as waiting, at most `budget` an update: half by their estimated
- * change (texel_change.h) times the updates since each was last brought up to date, so that a moving
- * cube's own faces, whose light changes every update, go every update or two; the other half by those
- * updates alone, so that the rest go in turn. (In turns alone, each of the animated box's 1,800 waiting
- * texels once in 6 updates at 320 an update, the cube's faces trailed their light by 6 updates; by change
- * times wait alone, the floor's texels, whose summed change is a hundredth of the cube's faces', waited
- * behind them: over 90 updates a floor block stayed 10% off for 24, against 18 with the halves.) A texel with no base (never
- * gathered since the estimator began) is skipped.
+ * Which texels: those the caller lists as waiting, at most `budget` an update, a third by each of three
+ * keys in turn: their estimated change (texel_change.h) times the updates since each was last brought up
+ * to date, so that a moving cube's own faces, whose light changes every update, go every update or two;
+ * how far each estimate is likely off by now as a share of its light (the rate its rays' change went at
+ * between its last two estimates times the updates since, or before it has one its estimated change, over
+ * its light or LM_RAY_ESTIMATE_DIM of the waiting texels' mean), so that a texel in a shadow sweeping
+ * over it goes before one whose light holds; then those updates alone, so that the rest go in turn. (In
+ * turns alone, each of the animated box's 1,800 waiting texels once in 6 updates at 320 an update, the
+ * cube's faces trailed their light by 6 updates; by change times wait alone, the floor's texels, whose
+ * summed change is a hundredth of the cube's faces', waited behind them: over 90 updates a floor block
+ * stayed 10% off for 24, against 18 with the halves. Over 120 updates, seeds 0 to 4, halves of the first
+ * and third keys: the trail 9 / 9 / 12 / 9 / 12 updates, the moving nodes' own 18 / 12 / 9 / 15 / 9;
+ * thirds: 9 / 9 / 15 / 6 / 9 and 9 / 3 / 6 / 6 / 9; halves of the second and third, 9 / 12 / 15 / 9 / 12
+ * and 9 / 9 / 3 / 9 / 6.) A texel with no base (never gathered since the estimator began) is skipped.
  *
  * K rays misjudge some texels' change badly and for long: what a texel sees through them is fixed until its
  * next gather, so their error is too. In the animated box, a floor texel in the corner took its base while
@@ -42,10 +48,10 @@
  * caustics its mirror and glass balls sweep over the walls; few where the light is smooth. The judge is
  * made at the gather only: a texel that took its base with nothing near keeps its K rays when a node comes.
  *
- * Layout: per texel its base (rgb), two flags (a base; the fine rays) and the update it was last brought
- * up to date; the deltas an update computes, by texel index, for the caller to show (what is shown is the
- * IIM's, iim.h, which a light edit scales there). Memory: 33 bytes a texel, and 16 a waiting texel while
- * choosing.
+ * Layout: per texel its base (rgb), three flags (a base; the fine rays; a rate), the update it was last
+ * brought up to date and the rate its change went at; the deltas an update computes, by texel index, for
+ * the caller to show (what is shown is the IIM's, iim.h, which a light edit scales there). Memory: 38 bytes
+ * a texel, and 20 a waiting texel while choosing.
  * Cost: (1 + LM_RAY_ESTIMATE_FINE) K rays and footprints of AIM lookups per texel gathered (its base), K or
  * LM_RAY_ESTIMATE_FINE x K per texel brought up to date, on every OpenMP thread; choosing them
  * O(waiting log budget) (core/top_k.h). Deterministic (each texel's rays are seeded by its index). Not
@@ -66,6 +72,10 @@
 /* Waiting texels brought up to date an update for each texel the update gathers. */
 #define LM_RAY_ESTIMATE_PER_TEXEL 16
 
+/* The least light a texel's expected staleness is a share of, as a share of the waiting texels' mean: a
+ * black texel's small change is not its whole light. */
+#define LM_RAY_ESTIMATE_DIM 0.1
+
 /* A texel whose base through K rays differs from one through LM_RAY_ESTIMATE_FINE x K by more than
  * LM_RAY_ESTIMATE_SPLIT of its light takes the latter (header). Over 120 updates of the animated box, three
  * seeds, 4 x 4 blocks over 10% off a fresh bake 1.82 / 1.30 / 1.82 -> 0.97 / 0.97 / 0.95 at a split of
@@ -84,6 +94,8 @@ typedef struct {
     uint32_t *stamp; /* per texel: the update its base or delta was last computed */
     uint32_t frame;  /* updates so far (lm_ray_estimate_update calls) */
     uint8_t *fine;   /* per texel: its base and updates take LM_RAY_ESTIMATE_FINE x K rays (header) */
+    float *rate;     /* per texel: |its change's change| an update (channels summed), at its last update */
+    uint8_t *rated;  /* per texel: rate holds one (brought up to date since its gather or a light's edit) */
     const lm_gather *emitted; /* NULL: the rays add the emission of the emitters they meet; else the gather
                                * whose closed-form emitter light a texel's two gathers take instead
                                * (lm_ray_estimate_emitters) */
@@ -95,13 +107,13 @@ void lm_ray_estimate_free(lm_ray_estimate *re);
 /* Texels[0 .. n) are gathered over aim (the dilated AIM, whole) and the scene as they are: their bases. */
 void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
                               const uint32_t *texels, uint32_t n);
-/* Of the n waiting texels (change: each one's estimated change, texel_change.h), at most budget with a base,
- * those with the greatest change times updates since they were last brought up to date (or gathered),
- * brought up to date over aim: their indices into out (room for budget) and their deltas in re->delta.
- * Returns how many. */
+/* Of the n waiting texels (change: each one's estimated change, texel_change.h, in units of change_unit
+ * of the rays' light, the channels summed), at most budget with a base, chosen as the header says, brought
+ * up to date over aim: their indices into out (room for budget) and their deltas in re->delta. Returns how
+ * many. */
 uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
-                                const uint32_t *waiting, const float *change, uint32_t n, uint32_t budget,
-                                uint32_t *out);
+                                const uint32_t *waiting, const float *change, float change_unit, uint32_t n,
+                                uint32_t budget, uint32_t *out);
 /* A light's edit moved every IIM texel to factor x IIM + add (light_scale.h): the bases follow,
  * so that a later update counts only what came after it. */
 void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float *add);
