@@ -478,7 +478,7 @@ static void test_still_level_bases_at_first_edit(void **state)
             assert_int_equal(based[0][f], gathered[0][f]);
         for (int f = 0; f < UPDATES; f++)
             assert_int_equal(based[1][f], 0);
-        /* 0.190 and 0.054 measured, against 0.298 and 0.162 without them; with the bases taken at the first
+        /* 0.172 and 0.051 measured, against 0.298 and 0.162 without them; with the bases taken at the first
          * update with a texel waiting (after the edit's photons and AIMs), 0.296 and 0.155 (0.162 and 0.051
          * against those before a third of the estimates went by their expected staleness) */
         assert_true(rays < 0.7 * alone);

@@ -131,22 +131,39 @@ static double light_of(const lm_ray_estimate *re, uint32_t i)
     return (double)b[0] + b[1] + b[2] + d[0] + d[1] + d[2];
 }
 
-/* How far texel i's estimate is likely off by now, as a share of its light (at least `least`): the rate its
- * change went at between its last two estimates times the updates since, or before it has one (rated), its
- * prior (the change since its gather, from what moved, channels summed). */
-static double stale(const lm_ray_estimate *re, uint32_t i, float prior, double least)
+/* How fast texel i's light changes, as a share of it (at least `least`) an update: the largest such rate of
+ * its own and of its surface's texels within LM_RAY_ESTIMATE_REACH that have one (header), or -1 where none
+ * has. A shadow's edge coming onto a texel whose light held so far shows first in the texels beside it. */
+static double rate_near(const lm_ray_estimate *re, const lm_atlas *a, uint32_t i, double least)
 {
-    double off = re->rated[i] ? (double)re->rate[i] * (double)(re->frame - re->stamp[i]) : (double)prior;
-    return off / fmax(light_of(re, i), least);
+    const lm_texel *t = &a->texels[i];
+    double most = -1.0;
+    for (int dy = -LM_RAY_ESTIMATE_REACH; dy <= LM_RAY_ESTIMATE_REACH; dy++)
+        for (int dx = -LM_RAY_ESTIMATE_REACH; dx <= LM_RAY_ESTIMATE_REACH; dx++) {
+            int x = t->x + dx, y = t->y + dy;
+            int q = x < 0 || y < 0 || x >= a->width || y >= a->height ? -1 : a->texel_index[(size_t)y * a->width + x];
+            if (q >= 0 && a->texels[q].surface == t->surface && re->rated[q])
+                most = fmax(most, (double)re->rate[q] / fmax(light_of(re, (uint32_t)q), least));
+        }
+    return most;
+}
+
+/* How far texel i's estimate is likely off by now, as a share of its light (at least `least`): rate_near
+ * times the updates since its last estimate, or where there is none its prior (the change since its gather,
+ * from what moved, channels summed) over its light. */
+static double stale(const lm_ray_estimate *re, const lm_atlas *a, uint32_t i, float prior, double least)
+{
+    double rate = rate_near(re, a, i, least);
+    return rate >= 0.0 ? rate * (double)(re->frame - re->stamp[i]) : (double)prior / fmax(light_of(re, i), least);
 }
 
 /* The texels taken so far this update (out[0 .. m), stamped with the frame) with their stamp and change
  * before, for their rates; then at most `quota` more of waiting's with a base, by `key`: 0 change times the
  * updates since each was last brought up to date, 1 stale, 2 those updates alone. Ties by texel index, the
  * same on every run. Returns the new m. */
-static uint32_t take(lm_ray_estimate *re, const uint32_t *waiting, const float *change, const float *prior, uint32_t n,
-                     int key, uint32_t quota, double least, lm_ranked *h, uint32_t *out, uint32_t m, uint32_t *was,
-                     float *sum)
+static uint32_t take(lm_ray_estimate *re, const lm_atlas *a, const uint32_t *waiting, const float *change,
+                     const float *prior, uint32_t n, int key, uint32_t quota, double least, lm_ranked *h, uint32_t *out,
+                     uint32_t m, uint32_t *was, float *sum)
 {
     uint32_t got = 0;
     for (uint32_t k = 0; k < n && quota > 0; k++) {
@@ -154,7 +171,7 @@ static uint32_t take(lm_ray_estimate *re, const uint32_t *waiting, const float *
         if (!re->has[i] || re->stamp[i] == re->frame)
             continue;
         double since = (double)(re->frame - re->stamp[i]);
-        double v = key == 0 ? (double)change[k] * since : key == 1 ? stale(re, i, prior[k], least) : since;
+        double v = key == 0 ? (double)change[k] * since : key == 1 ? stale(re, a, i, prior[k], least) : since;
         lm_top_k_offer(h, &got, quota, (lm_ranked){v, i});
     }
     for (uint32_t j = 0; j < got; j++) {
@@ -192,9 +209,9 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
     double least = LM_RAY_ESTIMATE_DIM * (based ? mean / based : 0.0) + 1e-30;
     /* a third each by change times wait, by expected staleness, by wait alone (header) */
     uint32_t third = budget / 3, m = 0;
-    m = take(re, waiting, change, prior, n, 0, third, least, h, out, m, was, sum);
-    m = take(re, waiting, change, prior, n, 1, third, least, h, out, m, was, sum);
-    m = take(re, waiting, change, prior, n, 2, budget - 2 * third, least, h, out, m, was, sum);
+    m = take(re, w->atlas, waiting, change, prior, n, 0, third, least, h, out, m, was, sum);
+    m = take(re, w->atlas, waiting, change, prior, n, 1, third, least, h, out, m, was, sum);
+    m = take(re, w->atlas, waiting, change, prior, n, 2, budget - 2 * third, least, h, out, m, was, sum);
     lm_rim r, rf;
     rims_over(re, w, aim, &r, &rf);
     ray_gathers(re, w, &r, &rf, out, m, re->delta, re->base);

@@ -26,15 +26,17 @@
  * keys in turn: their estimated change (texel_change.h) times the updates since each was last brought up
  * to date, so that a moving cube's own faces, whose light changes every update, go every update or two;
  * how far each estimate is likely off by now as a share of its light (the rate its rays' change went at
- * between its last two estimates times the updates since, or before it has one its estimated change, over
- * its light or LM_RAY_ESTIMATE_DIM of the waiting texels' mean), so that a texel in a shadow sweeping
- * over it goes before one whose light holds; then those updates alone, so that the rest go in turn. (In
+ * between its last two estimates, over its light or LM_RAY_ESTIMATE_DIM of the waiting texels' mean, the
+ * largest of its own and its surface's texels' within LM_RAY_ESTIMATE_REACH, times the updates since; or
+ * where none has a rate, its estimated change over its light), so that a texel a shadow is sweeping onto
+ * goes before one whose light holds; then those updates alone, so that the rest go in turn. (In
  * turns alone, each of the animated box's 1,800 waiting texels once in 6 updates at 320 an update, the
  * cube's faces trailed their light by 6 updates; by change times wait alone, the floor's texels, whose
  * summed change is a hundredth of the cube's faces', waited behind them: over 90 updates a floor block
  * stayed 10% off for 24, against 18 with the halves. Over 120 updates, seeds 0 to 4, halves of the first
  * and third keys: the trail 9 / 9 / 12 / 9 / 12 updates, the moving nodes' own 18 / 12 / 9 / 15 / 9;
- * thirds: 9 / 9 / 15 / 6 / 9 and 9 / 3 / 6 / 6 / 9; halves of the second and third, 9 / 12 / 15 / 9 / 12
+ * thirds, each texel's own rate alone: 9 / 6 / 15 / 6 / 9 and 9 / 6 / 6 / 6 / 9; with its neighbours' rates:
+ * 9 / 6 / 9 / 6 / 9 and 6 / 6 / 3 / 6 / 6; halves of the second and third, own rates: 9 / 12 / 15 / 9 / 12
  * and 9 / 9 / 3 / 9 / 6.) A texel with no base (never gathered since the estimator began) is skipped.
  *
  * K rays misjudge some texels' change badly and for long: what a texel sees through them is fixed until its
@@ -54,7 +56,7 @@
  * a texel, and 20 a waiting texel while choosing.
  * Cost: (1 + LM_RAY_ESTIMATE_FINE) K rays and footprints of AIM lookups per texel gathered (its base), K or
  * LM_RAY_ESTIMATE_FINE x K per texel brought up to date, on every OpenMP thread; choosing them
- * O(waiting log budget) (core/top_k.h). Deterministic (each texel's rays are seeded by its index). Not
+ * O(waiting x (2 LM_RAY_ESTIMATE_REACH + 1)^2 + waiting log budget) (core/top_k.h). Deterministic (each texel's rays are seeded by its index). Not
  * thread-safe; the scene and AIM must not change meanwhile. Errors: none but memory at init. */
 #ifndef LM_RAY_ESTIMATE_H
 #define LM_RAY_ESTIMATE_H
@@ -75,6 +77,11 @@
 /* The least light a texel's expected staleness is a share of, as a share of the waiting texels' mean: a
  * black texel's small change is not its whole light. */
 #define LM_RAY_ESTIMATE_DIM 0.1
+/* Texels either side, on the same surface, whose rate a texel's expected staleness takes where it is larger
+ * than its own (header). Over 120 updates of the animated box, seeds 0 to 4: blocks over 10% 0.72 / 0.57 /
+ * 0.50 / 0.60 / 0.57 with its own rate alone, 0.57 / 0.45 / 0.38 / 0.50 / 0.42 within 1; the trail's longest
+ * run 9 / 6 / 15 / 6 / 9 and 9 / 6 / 9 / 6 / 9. Within 2 did worse (in a probe, 0.55 and 15 at seed 2). */
+#define LM_RAY_ESTIMATE_REACH 1
 
 /* A texel whose base through K rays differs from one through LM_RAY_ESTIMATE_FINE x K by more than
  * LM_RAY_ESTIMATE_SPLIT of its light takes the latter (header). Over 120 updates of the animated box, three
