@@ -5,7 +5,8 @@
  *
  * It owns the gather (gpu/gather/hemicube.h), the IIMs and their scheduler (gpu/gather/iim.h), the closed-form emitter
  * light the gather adds (trace/emitter_light.h), the AIM upload and the waiting texels' estimates from a few
- * rays (ray_estimate.h: every texel's base from the first gather on, each gathered texel's again as it is). It exists on every loop (a loop on a
+ * rays (ray_estimate.h: every texel's base before the scene first changes, lm_lightmap_path_before_change,
+ * each gathered texel's again as it is). It exists on every loop (a loop on a
  * photon path, or one with indirect light off, has every surface switched off: nothing is gathered and
  * the lightmaps stay 0), and follows the scene's light: a scene with no light gathers nothing, and the
  * IIM is cleared when the last light goes; a light that comes back regathers every surface in full.
