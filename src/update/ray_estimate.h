@@ -56,8 +56,9 @@
  * a texel, and 20 a waiting texel while choosing.
  * Cost: (1 + LM_RAY_ESTIMATE_FINE) K rays and footprints of AIM lookups per texel gathered (its base), K or
  * LM_RAY_ESTIMATE_FINE x K per texel brought up to date, on every OpenMP thread; choosing them
- * O(waiting x (2 LM_RAY_ESTIMATE_REACH + 1)^2 + waiting log budget) (core/top_k.h). Deterministic (each texel's rays are seeded by its index). Not
- * thread-safe; the scene and AIM must not change meanwhile. Errors: none but memory at init. */
+ * O(waiting x (2 LM_RAY_ESTIMATE_REACH + 1)^2 + waiting log budget) (core/top_k.h). Deterministic (each
+ * texel's rays are seeded by its index). Not thread-safe; the scene and AIM must not change meanwhile.
+ * Errors: none but memory at init. */
 #ifndef LM_RAY_ESTIMATE_H
 #define LM_RAY_ESTIMATE_H
 

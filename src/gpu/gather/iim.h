@@ -49,8 +49,8 @@
 #define LM_IIM_SIGHT_SPREAD 2
 /* And by exp(-(f / LM_IIM_SIGHT_APART)^2), f the frames between the two texels' last commits: each change is
  * since its own texel's gather, so neighbours gathered at other times saw other parts of a moving shadow's
- * change. Over 120 updates of the animated box, a floor block under the cube's path stayed 10% off for
- * 15 updates averaged with every neighbour alike, 9 with this weight (1, 2, 4 and 8 alike). */
+ * change. Over 120 updates of the animated box (seeds 0 and 1), a floor block under the cube's path stayed
+ * 10% off for 15 updates averaged with every neighbour alike, 9 with this weight (1, 2, 4 and 8 alike). */
 #define LM_IIM_SIGHT_APART 4
 /* Frames at most a texel that showed an estimate of its own blends in its gather over: the estimate was
  * already the change, and its gather only refines it. Over blend_frames the moving cube's own faces
