@@ -162,7 +162,7 @@ static double stale(const lm_ray_estimate *re, const lm_atlas *a, uint32_t i, fl
  * updates since each was last brought up to date, 1 stale, 2 those updates alone. Ties by texel index, the
  * same on every run. Returns the new m. */
 static uint32_t take(lm_ray_estimate *re, const lm_atlas *a, const uint32_t *waiting, const float *change,
-                     const float *prior, uint32_t n, int key, uint32_t quota, double least, lm_ranked *h, uint32_t *out,
+                     float change_unit, uint32_t n, int key, uint32_t quota, double least, lm_ranked *h, uint32_t *out,
                      uint32_t m, uint32_t *was, float *sum)
 {
     uint32_t got = 0;
@@ -171,7 +171,7 @@ static uint32_t take(lm_ray_estimate *re, const lm_atlas *a, const uint32_t *wai
         if (!re->has[i] || re->stamp[i] == re->frame)
             continue;
         double since = (double)(re->frame - re->stamp[i]);
-        double v = key == 0 ? (double)change[k] * since : key == 1 ? stale(re, a, i, prior[k], least) : since;
+        double v = key == 0 ? (double)change[k] * since : key == 1 ? stale(re, a, i, change[k] * change_unit, least) : since;
         lm_top_k_offer(h, &got, quota, (lm_ranked){v, i});
     }
     for (uint32_t j = 0; j < got; j++) {
@@ -194,24 +194,22 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
     uint32_t cap = budget < n ? budget : n;
     lm_ranked *h = malloc(sizeof *h * cap);
     uint32_t *was = malloc(sizeof *was * cap);
-    float *sum = malloc(sizeof *sum * cap), *prior = malloc(sizeof *prior * n);
-    if (!h || !was || !sum || !prior) { /* no estimate this update: the texels show their neighbours' loans */
-        free(h), free(was), free(sum), free(prior);
+    float *sum = malloc(sizeof *sum * cap);
+    if (!h || !was || !sum) { /* no estimate this update: the texels show their neighbours' loans */
+        free(h), free(was), free(sum);
         return 0;
     }
     double mean = 0.0;
     uint32_t based = 0;
-    for (uint32_t k = 0; k < n; k++) {
-        prior[k] = change[k] * change_unit;
+    for (uint32_t k = 0; k < n; k++)
         if (re->has[waiting[k]])
             mean += light_of(re, waiting[k]), based++;
-    }
     double least = LM_RAY_ESTIMATE_DIM * (based ? mean / based : 0.0) + 1e-30;
     /* a third each by change times wait, by expected staleness, by wait alone (header) */
     uint32_t third = budget / 3, m = 0;
-    m = take(re, w->atlas, waiting, change, prior, n, 0, third, least, h, out, m, was, sum);
-    m = take(re, w->atlas, waiting, change, prior, n, 1, third, least, h, out, m, was, sum);
-    m = take(re, w->atlas, waiting, change, prior, n, 2, budget - 2 * third, least, h, out, m, was, sum);
+    m = take(re, w->atlas, waiting, change, change_unit, n, 0, third, least, h, out, m, was, sum);
+    m = take(re, w->atlas, waiting, change, change_unit, n, 1, third, least, h, out, m, was, sum);
+    m = take(re, w->atlas, waiting, change, change_unit, n, 2, budget - 2 * third, least, h, out, m, was, sum);
     lm_rim r, rf;
     rims_over(re, w, aim, &r, &rf);
     ray_gathers(re, w, &r, &rf, out, m, re->delta, re->base);
@@ -221,7 +219,7 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
         re->rate[out[j]] = fabsf(d[0] + d[1] + d[2] - sum[j]) / (float)(since ? since : 1);
         re->rated[out[j]] = 1;
     }
-    free(h), free(was), free(sum), free(prior);
+    free(h), free(was), free(sum);
     return m;
 }
 
