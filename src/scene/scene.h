@@ -247,6 +247,15 @@ static inline uint32_t lm_node_file_tris(const lm_scene *s, const lm_node *n)
 /* 1 for a node with triangles of its own that may move: the BVH instances it apart, the photons' round
  * robin watches it, lmgi info counts it among the dynamic. */
 static inline int lm_node_moves(const lm_node *n) { return n->dynamic && n->tri_count > 0; }
+/* 1 when some node may move (lm_node_moves): else the photons' round robin has nothing to find (lmgi
+ * info's "photon updates: off"). O(nodes); lmgi_set_node_dynamic can change it between updates. */
+static inline int lm_scene_any_node_moves(const lm_scene *s)
+{
+    for (int n = 0; n < s->node_count; n++)
+        if (lm_node_moves(&s->nodes[n]))
+            return 1;
+    return 0;
+}
 /* 1 when triangle t is the twin (the back side) of a file's triangle. */
 static inline int lm_tri_is_back(const lm_scene *s, uint32_t t)
 {

@@ -375,10 +375,7 @@ static int shows_estimates(const lm_lightmap_path *lp)
  * still be edited (its lights, materials, sky), but most are baked and shown as they are. */
 static int may_change(const lm_scene *s)
 {
-    for (int n = 0; n < s->node_count; n++)
-        if (lm_node_moves(&s->nodes[n]))
-            return 1;
-    return s->animation_count > 0;
+    return lm_scene_any_node_moves(s) || s->animation_count > 0;
 }
 
 /* The texels' ray estimates begun (ray_estimate.h): every texel's base over the AIM the gathers so far read,

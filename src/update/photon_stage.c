@@ -991,16 +991,6 @@ static lm_status refresh_all_aims(lm_photon_stage *ps, lm_aim_stats *out, lm_err
     return st;
 }
 
-/* Whether a node with triangles may move (is dynamic): else the photons' round robin has nothing to find
- * (lmgi info's "photon updates: off"). Checked every frame: lmgi_set_node_dynamic can change it. */
-static int anything_moves(const lm_scene *s)
-{
-    for (int n = 0; n < s->node_count; n++)
-        if (lm_node_moves(&s->nodes[n]))
-            return 1;
-    return 0;
-}
-
 /* The photons of lights removed for good given back once their removal's re-trace has emptied them: a
  * soak that adds and removes lights held every removed light's paths (lmgi_remove_light). */
 static void release_removed(lm_photon_stage *ps)
@@ -1031,7 +1021,7 @@ lm_status lm_photon_stage_update(lm_photon_stage *ps, lm_photon_stage_frame *out
                        : LM_OK;
     ps->animated_boxes = 0;
     if (st == LM_OK && ps->set.trace)
-        st = lm_photons_frame(ps->photons, anything_moves(ps->scene), &out->photons, err);
+        st = lm_photons_frame(ps->photons, lm_scene_any_node_moves(ps->scene), &out->photons, err);
     add_box_stats(&out->photons, &boxed);
     if (st == LM_OK && ps->set.trace)
         release_removed(ps);
