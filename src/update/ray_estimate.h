@@ -48,7 +48,10 @@
  * rays, and a texel whose two differ by more than LM_RAY_ESTIMATE_SPLIT of its light takes those, base and
  * updates alike, until its next gather (`fine`): about a third of the animated box's bases, through the
  * caustics its mirror and glass balls sweep over the walls; few where the light is smooth. The judge is
- * made at the gather only: a texel that took its base with nothing near keeps its K rays when a node comes.
+ * made at the gather only: a texel that took its base with nothing near keeps its K rays when a node comes,
+ * and then misjudges its change for as long as the node stands beside it (the scene held with the mirror
+ * sphere by that corner: 7 of 8 such texels 12-59% too bright, after every AIM caught up; docs/tradeoff.md,
+ * "Nodes that keep moving", the whole loop).
  *
  * Layout: per texel its base (rgb), three flags (a base; the fine rays; a rate), the update it was last
  * brought up to date and the rate its change went at; the deltas an update computes, by texel index, for
