@@ -171,7 +171,9 @@ static uint32_t take(lm_ray_estimate *re, const lm_atlas *a, const uint32_t *wai
         if (!re->has[i] || re->stamp[i] == re->frame)
             continue;
         double since = (double)(re->frame - re->stamp[i]);
-        double v = key == 0 ? (double)change[k] * since : key == 1 ? stale(re, a, i, change[k] * change_unit, least) : since;
+        double v = key == 0   ? (double)change[k] * since
+                   : key == 1 ? stale(re, a, i, change[k] * change_unit, least)
+                              : since;
         lm_top_k_offer(h, &got, quota, (lm_ranked){v, i});
     }
     for (uint32_t j = 0; j < got; j++) {
