@@ -2063,7 +2063,7 @@ static void test_rim_pair_same_as_two(void **state)
         emissive[3 * m + 1] = 0.25f * (float)m; /* what the emitters showed before */
     lm_hemicube_settings set;
     lm_hemicube_settings_default(&set);
-    lm_rim was = {p.s, &p.atlas, p.rt, before, 1, {0.1f, 0.2f, 0.3f}, 0.0f, 16, emissive, NULL, NULL, 0.0f, 0.0f}, now = was;
+    lm_rim was = {p.s, &p.atlas, p.rt, before, 1, {0.1f, 0.2f, 0.3f}, 0.0f, 16, emissive, NULL, NULL, 0.0f, 0.0f, 0}, now = was;
     now.aim = after;
     now.emissive = NULL;
     uint32_t tested = 0, differ = 0;
@@ -2206,7 +2206,7 @@ static void test_ray_estimate_fine_rays(void **state)
     lm_ray_estimate_gathered(&re, &w, black, texels, n);
     assert_int_equal(lm_ray_estimate_update(&re, &w, lit, texels, change, 1.0f, n, n, out), n);
     lm_rim coarse_was = {t.s, &t.a, rt, black, 1, {set.sky[0], set.sky[1], set.sky[2]}, 0.0f, LM_RAY_ESTIMATE_RAYS,
-                         NULL, NULL, NULL, 0.0f, 0.0f},
+                         NULL, NULL, NULL, 0.0f, 0.0f, 0},
            coarse_now = coarse_was;
     coarse_now.aim = lit;
     uint32_t fine = 0;
@@ -2254,6 +2254,122 @@ static void test_ray_estimate_fine_rays(void **state)
     ts_free(&t);
 }
 
+/* A floor (1 m, 0.1 m texels; node 1) under two squares facing it (nodes 2 and 3: half their width and their
+ * height each), node `moving` of them dynamic; materials: the glTF list, one for each mesh. */
+static void floor_under_squares(tscene *t, const float half[2], const float up[2], int moving, const char *materials)
+{
+    lmt_mesh m[3];
+    square(&m[0], 0.5f, 0.0f, 1);
+    for (int k = 0; k < 2; k++)
+        square(&m[1 + k], half[k], up[k], 0);
+    const char *dyn = ", \"extras\": {\"lmgi\": {\"dynamic\": true}}";
+    char nodes[256];
+    snprintf(nodes, sizeof nodes,
+             "[{\"children\": [1, 2, 3]}, {\"mesh\": 0}, {\"mesh\": 1%s}, {\"mesh\": 2%s}]",
+             moving == 2 ? dyn : "", moving == 3 ? dyn : "");
+    ts_load(t, m, 3, nodes, materials, 0.1f);
+}
+
+/* Node `node` of t moved dx along x, and the tracer with it. */
+static void move_node_x(tscene *t, lm_rt *rt, int node, float dx)
+{
+    lm_error err;
+    float world[16];
+    memcpy(world, t->s->nodes[node].world, sizeof world);
+    world[12] += dx;
+    assert_true(lm_scene_set_node_world(t->s, node, world));
+    assert_int_equal(lm_rt_sync_transforms(rt, t->s, &err), LM_OK);
+}
+
+/* A texel that a moving node stands beside takes LM_RAY_ESTIMATE_NEAR_FINE x K rays (ray_estimate.h), at its
+ * gather or when the node comes. A floor (1 m, 0.1 m texels) under a square (0.1 wide, 0.15 m up, facing it)
+ * that moves 0.2 m across, and a still one (0.5 wide, 0.6 m up) over both, everything of radiance A and no
+ * sky. The moving square's bounding sphere fills (R / d)^2 of the hemisphere of the texel under its centre
+ * (texel_change.h). The texels it stands beside, some only after its move, read their change (against 4,096
+ * rays a texel before and after) far closer with the near rays than with the 36 or 144 of a floor that no
+ * node's whereabouts reach; those it came beside only through the near rays' own base, taken at the gather,
+ * where the still square's edges fall on the same strata before and after. */
+static void test_ray_estimate_near_node(void **state)
+{
+    (void)state;
+    tscene t;
+    floor_under_squares(&t, (float[2]){0.05f, 0.25f}, (float[2]){0.15f, 0.6f}, 2, "[{}, {}, {}]");
+    lm_rt *rt;
+    uint32_t n, *texels = node_texels(&t, 1, INFINITY, &rt, &n);
+    assert_true(n >= 50);
+    lm_hemicube_settings set;
+    lm_hemicube_settings_default(&set);
+    memset(set.sky, 0, sizeof set.sky);
+    lm_light_scale_world w = {t.s, &t.a, rt, &set};
+    const float A = 0.4f;
+    size_t cells = (size_t)t.a.width * t.a.height;
+    float *aim = uniform_aim(&t, A), *aim_rgb = malloc(3 * sizeof(float) * cells);
+    float *change = malloc(sizeof *change * n), *before = malloc(sizeof *before * n);
+    uint32_t *out = malloc(sizeof *out * n);
+    uint8_t *was_near = malloc(n);
+    assert_non_null(aim_rgb), assert_non_null(change), assert_non_null(before), assert_non_null(out);
+    assert_non_null(was_near);
+    for (size_t k = 0; k < 3 * cells; k++)
+        aim_rgb[k] = A;
+    lm_error err;
+    lm_texel_change tc;
+    assert_int_equal(lm_texel_change_init(&tc, t.s, &t.a, aim_rgb, 0.1f, &err), LM_OK);
+    uint32_t mid = texel_near(&t, 1, 0.0f, 0.0f);
+    float p[3], nrm[3];
+    lm_texel_world(t.s, &t.a.texels[mid], p, nrm);
+    double R = 0.05 * sqrt(2.0), d2 = p[0] * p[0] + (0.15 - p[1]) * (0.15 - p[1]) + p[2] * p[2];
+    assert_true(fabs(lm_texel_change_node_near(&tc, t.s, mid) - R * R / d2) < 1e-4);
+    lm_rim dense = {t.s, &t.a, rt, aim, 1, {0.0f, 0.0f, 0.0f}, 0.0f, 4096, NULL, NULL, NULL, 0.0f, 0.0f, 0};
+    lm_ray_estimate re[2]; /* told where the nodes are, and not */
+    for (int k = 0; k < 2; k++) {
+        assert_int_equal(lm_ray_estimate_init(&re[k], t.a.texel_count, LM_RAY_ESTIMATE_RAYS, &err), LM_OK);
+        lm_ray_estimate_nodes(&re[k], k == 0 ? &tc : NULL);
+        lm_ray_estimate_gathered(&re[k], &w, aim, texels, n);
+    }
+    for (uint32_t j = 0; j < n; j++) {
+        float e[3];
+        lm_light_scale_texel_rim(&w, &dense, texels[j], e);
+        before[j] = e[0];
+        was_near[j] = re[0].fine[texels[j]] == LM_RAY_ESTIMATE_NEAR_RAYS;
+        change[j] = 1.0f;
+    }
+    move_node_x(&t, rt, 2, 0.2f);
+    lm_texel_change_moved(&tc, t.s, &t.a, 1);
+    for (int k = 0; k < 2; k++)
+        assert_int_equal(lm_ray_estimate_update(&re[k], &w, aim, texels, change, 1.0f, n, n, out), n);
+    uint32_t near = 0, came = 0;
+    double e[2][2] = {{0.0, 0.0}, {0.0, 0.0}}; /* [came since][with, without] */
+    for (uint32_t j = 0; j < n; j++) {
+        uint32_t i = texels[j];
+        assert_int_equal(re[1].fine[i] == LM_RAY_ESTIMATE_NEAR_RAYS, 0);
+        if (re[0].fine[i] != LM_RAY_ESTIMATE_NEAR_RAYS) {
+            assert_false(was_near[j]); /* near once, its rays stay until its next gather */
+            continue;
+        }
+        float now[3];
+        lm_light_scale_texel_rim(&w, &dense, i, now);
+        double scale = fmax(before[j], now[0]);
+        near++, came += !was_near[j];
+        for (int k = 0; k < 2; k++)
+            e[!was_near[j]][k] += fabs(re[k].delta[3 * (size_t)i] - (now[0] - before[j])) / scale;
+    }
+    uint32_t stayed = near - came;
+    print_message("a square moved over a floor: %u of %u texels take %d rays; their change's mean error %.4f of their "
+                  "light with them, %.4f without (%u near it at their gather); %.4f and %.4f (%u it came near)\n",
+                  near, n, LM_RAY_ESTIMATE_NEAR_FINE * LM_RAY_ESTIMATE_RAYS, e[0][0] / stayed, e[0][1] / stayed,
+                  stayed, e[1][0] / came, e[1][1] / came, came);
+    assert_true(near > n / 10 && near < n);
+    assert_true(came > 0 && stayed > 0);
+    assert_true(e[0][0] < 0.5 * e[0][1]);
+    assert_true(e[1][0] < 0.4 * e[1][1]); /* against its K-ray base: 0.49 of it */
+    for (int k = 0; k < 2; k++)
+        lm_ray_estimate_free(&re[k]);
+    lm_texel_change_free(&tc);
+    free(aim), free(aim_rgb), free(change), free(before), free(out), free(was_near), free(texels);
+    lm_rt_free(rt);
+    ts_free(&t);
+}
+
 /* The emissive triangles' light in a waiting texel's estimate (update/ray_estimate.h, lm_ray_estimate_emitters):
  * a floor (1 m wide, 0.1 m texels) under a small emitting square (0.3 wide, 1 m up) whose light the gather
  * takes in closed form, and a black square (0.2 wide) halfway up moved 0.3 m across, its shadow with it. With
@@ -2263,17 +2379,10 @@ static void test_ray_estimate_fine_rays(void **state)
 static void test_ray_estimate_emitter_shadow(void **state)
 {
     (void)state;
-    lmt_mesh m[3];
-    square(&m[0], 0.5f, 0.0f, 1);
-    square(&m[1], 0.15f, 1.0f, 0);
-    square(&m[2], 0.1f, 0.5f, 0);
     tscene t;
-    ts_load(&t, m, 3,
-            "[{\"children\": [1, 2, 3]}, {\"mesh\": 0}, {\"mesh\": 1}, "
-            "{\"mesh\": 2, \"extras\": {\"lmgi\": {\"dynamic\": true}}}]",
-            "[{}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 0.5, 0.25]}, "
-            "{\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}}]",
-            0.1f);
+    floor_under_squares(&t, (float[2]){0.15f, 0.1f}, (float[2]){1.0f, 0.5f}, 3,
+                        "[{}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}, \"emissiveFactor\": [1, 0.5, "
+                        "0.25]}, {\"pbrMetallicRoughness\": {\"baseColorFactor\": [0, 0, 0, 1]}}]");
     lm_rt *rt;
     uint32_t n, *texels = node_texels(&t, 1, INFINITY, &rt, &n);
     assert_true(n >= 50);
@@ -2302,11 +2411,7 @@ static void test_ray_estimate_emitter_shadow(void **state)
         lm_gather_emitted_at(g, t.s, &t.a, texels[j], before + 3 * j);
         change[j] = 1.0f;
     }
-    float world[16];
-    memcpy(world, t.s->nodes[3].world, sizeof world);
-    world[12] += 0.3f;
-    assert_true(lm_scene_set_node_world(t.s, 3, world));
-    assert_int_equal(lm_rt_sync_transforms(rt, t.s, &err), LM_OK);
+    move_node_x(&t, rt, 3, 0.3f);
     for (int k = 0; k < 2; k++)
         assert_int_equal(lm_ray_estimate_update(&re[k], &w, black, texels, change, 1.0f, n, n, out), n);
     uint32_t moved = 0, far_off[2] = {0, 0};
@@ -3128,6 +3233,7 @@ int main(void)
         cmocka_unit_test(test_ray_estimate_change),
         cmocka_unit_test(test_ray_estimate_emitter_shadow),
         cmocka_unit_test(test_ray_estimate_fine_rays),
+        cmocka_unit_test(test_ray_estimate_near_node),
         cmocka_unit_test(test_light_scale_refined_equals_full),
         cmocka_unit_test(test_light_scale_seed),
         cmocka_unit_test(test_light_scale_doubt),

@@ -102,6 +102,7 @@ typedef struct {
     int upright;
     lm_vec3 A, C; /* upright: the up direction in the texel's plane, and N x A */
     int split;    /* upright: each row within CONTACT_BELOW under the level traced as this many (1: as one) */
+    int sub;      /* sub-directions per side of a stratum's footprint (lm_rim's footprint, or SUB) */
 } strata_frame;
 
 #define ELEVATION_STEPS 4096
@@ -215,13 +216,14 @@ static void direct_at_hit(const lm_rim *r, const float eye[3], const float dir[3
  * (the hemicube's rim: its middle azimuth, 0.5) and the fraction `at` of its width in u (with every ray at the
  * middle, the elevation's midpoint rule put the same error into every texel that sees a small source, a
  * horizon or a contact line alike: a bias, not noise; docs/gather.md, "Strata") and, on the plane of the
- * triangle it hits, the AIM averaged over the stratum's footprint (SUB x SUB sub-directions met with that
- * plane, their uv from the triangle's uv gradient, kept inside its chart), as a hemicube pixel averages its
- * footprint: a small bright spot is then shared among the strata it overlaps instead of being all or
- * nothing for one. Adds the weighted radiance sum (times SUB^2) of each of the nr rims r[k] into sum[k]:
+ * triangle it hits, the AIM averaged over the stratum's footprint (fr->sub x fr->sub sub-directions met with
+ * that plane, their uv from the triangle's uv gradient, kept inside its chart; of one, the ray's own hit), as
+ * a hemicube pixel averages its footprint: a small bright spot is then shared among the strata it overlaps
+ * instead of being all or nothing for one. Adds the weighted radiance sum (times fr->sub^2) of each of the nr
+ * rims r[k] into sum[k]:
  * one ray and one footprint for all of them (r[0]'s scene, atlas and tracer), each read in its own AIM,
  * emission and direct light. seed: the stratum's own (the texel's and its index), for the emissive
- * triangles' shadow rays at the hit. fr: the frame; sub: upright strata, the elevations of this row's SUB
+ * triangles' shadow rays at the hit. fr: the frame; sub: upright strata, the elevations of this row's fr->sub
  * sub-rows (NULL: the polar strata, laid in fr's B, T and N). */
 static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3], const strata_frame *fr,
                     const cos_sin *sub, lm_vec3 G, double phi0, double dphi, double u0, double du, double ax,
@@ -254,7 +256,7 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
         for (int k = 0; k < nr; k++) {
             const float *sky = by_direction ? scene_sky : r[k]->sky;
             for (int c = 0; c < 3; c++)
-                sum[k][c] += SUB * SUB * w * share * sky[c];
+                sum[k][c] += fr->sub * fr->sub * w * share * sky[c];
         }
         return;
     }
@@ -279,17 +281,23 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
         float lo[4], *hi = lo + 2; /* the chart's footprint stays where its lookups read only it */
         lm_chart_lookup_rect(r0->atlas, r0->atlas->tri_chart[h.tri], lo);
         double num = lm_dot(ng, lm_sub(P, e));
-        for (int i = 0; i < SUB; i++) {
+        for (int k = 0; fr->sub == 1 && k < nr; k++) { /* a footprint of one: the ray's own hit */
+            float L[3];
+            lm_atlas_sample_rgb(r0->atlas, far[k] ? r[k]->whole : r[k]->aim, hit[0], hit[1], L);
+            for (int q = 0; q < 3; q++)
+                sum[k][q] += w * L[q];
+        }
+        for (int i = 0; fr->sub > 1 && i < fr->sub; i++) {
             rim_azimuth az = {0.0f, 0.0f, 0.0};
             cos_sin al = {0.0, 0.0};
             if (sub)
-                al = across(phi0 + (i + 0.5) / SUB * dphi);
+                al = across(phi0 + (i + 0.5) / fr->sub * dphi);
             else
-                az = azimuth(r0, phi0 + (i + 0.5) / SUB * dphi);
-            for (int j = 0; j < SUB; j++) {
+                az = azimuth(r0, phi0 + (i + 0.5) / fr->sub * dphi);
+            for (int j = 0; j < fr->sub; j++) {
                 double ws = 1.0;
                 lm_vec3 ds = sub ? upright_dir(fr, al, sub[j])
-                                 : rim_dir(&az, fr->B, fr->T, N, u0 + (j + 0.5) / SUB * du, &ws);
+                                 : rim_dir(&az, fr->B, fr->T, N, u0 + (j + 0.5) / fr->sub * du, &ws);
                 if (lm_dot(ds, G) <= 0.0f)
                     continue;
                 double den = lm_dot(ng, ds), ts = num / den;
@@ -314,7 +322,7 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
                 float L[3];
                 direct_at_hit(r[k], eye, dir, &h, seed, L);
                 for (int q = 0; q < 3; q++)
-                    sum[k][q] += SUB * SUB * w * L[q];
+                    sum[k][q] += fr->sub * fr->sub * w * L[q];
             }
     }
     for (int k = 0; k < nr; k++)
@@ -322,7 +330,7 @@ static void stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const fl
             const float *em = r[k]->emissive ? r[k]->emissive + 3 * (size_t)r0->scene->tri_material[h.tri]
                                              : m->emissive;
             for (int q = 0; q < 3; q++)
-                sum[k][q] += SUB * SUB * w * em[q];
+                sum[k][q] += fr->sub * fr->sub * w * em[q];
         }
 }
 
@@ -358,7 +366,7 @@ static int contact_split(const lm_rim *r, const float eye[3], lm_vec3 A)
     return h.t < CONTACT_TEXELS * hit_texel_width(r->atlas, &h) ? CONTACT_SPLIT : 1;
 }
 
-/* stratum() over the stratum's fr->split rows of equal measure (rows: their SUB sub-row elevations each),
+/* stratum() over the stratum's fr->split rows of equal measure (rows: their fr->sub sub-row elevations each),
  * each with its ray at the stratum's fraction `at` of it; their sums weighed 1 / split each. */
 static void split_stratum(const lm_rim *const *r, int nr, const sky_mis *mis, const float eye[3],
                           const strata_frame *fr, const cos_sin *rows, lm_vec3 G, double phi0, double dphi,
@@ -368,7 +376,7 @@ static void split_stratum(const lm_rim *const *r, int nr, const sky_mis *mis, co
     double part[RIMS_AT_ONCE][3], part_back = 0.0, h = du / n;
     memset(part, 0, sizeof part);
     for (int s = 0; s < n; s++)
-        stratum(r, nr, mis, eye, fr, rows + (size_t)s * SUB, G, phi0, dphi, u0 + s * h, h,
+        stratum(r, nr, mis, eye, fr, rows + (size_t)s * fr->sub, G, phi0, dphi, u0 + s * h, h,
                 fmod(ax + s * LM_GOLDEN_FRACTION, 1.0), at, seed ^ (uint32_t)s << 28, part, &part_back);
     for (int k = 0; k < nr; k++)
         for (int c = 0; c < 3; c++)
@@ -390,15 +398,15 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
     cos_sin *sub = NULL; /* upright: every row's sub-rows, shared by its strata (NULL, out of memory: the polar
                             strata, the same measure) */
     cos_sin *split = NULL; /* with fr->split: the contact rows' (`rows` from row `lo`) split rows' sub-rows,
-                              split x SUB a row (NULL: every row as one) */
-    int n = fr->split, lo = 0, rows = 0;
-    if (fr->upright && (sub = malloc(sizeof *sub * (size_t)side * SUB)) != NULL) {
-        for (int k = 0; k < side * SUB; k++)
-            sub[k] = elevation((k + 0.5) / (side * SUB));
+                              split x fr->sub a row (NULL: every row as one) */
+    int n = fr->split, lo = 0, rows = 0, S = fr->sub;
+    if (fr->upright && (sub = malloc(sizeof *sub * (size_t)side * S)) != NULL) {
+        for (int k = 0; k < side * S; k++)
+            sub[k] = elevation((k + 0.5) / (side * S));
         if (n > 1 && (rows = contact_rows(side, &lo)) > 0 &&
-            (split = malloc(sizeof *split * (size_t)rows * n * SUB)) != NULL)
-            for (int k = 0; k < rows * n * SUB; k++)
-                split[k] = elevation((lo + k / (n * SUB) + (k % (n * SUB) + 0.5) / (n * SUB)) * d);
+            (split = malloc(sizeof *split * (size_t)rows * n * S)) != NULL)
+            for (int k = 0; k < rows * n * S; k++)
+                split[k] = elevation((lo + k / (n * S) + (k % (n * S) + 0.5) / (n * S)) * d);
     }
     /* the rays gather's rows each put their rays at their own fraction of their columns, a Kronecker sequence
      * down the rows as `at` is across the columns: a column's rays at one azimuth (its middle) read something
@@ -419,10 +427,10 @@ static double strata(const lm_rim *const *r, int nr, const sky_mis *m, const flo
             double ax = spread ? fmod(across_shift[0] + j * LM_GOLDEN_FRACTION, 1.0) : 0.5;
             uint32_t own = seed * (uint32_t)K + (uint32_t)(i * side + j);
             if (split && j >= lo && j < lo + rows)
-                split_stratum(r, nr, m, eye, fr, split + (size_t)(j - lo) * n * SUB, G, phi0, d, j * d, d, ax, at, own,
+                split_stratum(r, nr, m, eye, fr, split + (size_t)(j - lo) * n * S, G, phi0, d, j * d, d, ax, at, own,
                               sum, back_w);
             else
-                stratum(r, nr, m, eye, fr, sub ? sub + (size_t)j * SUB : NULL, G, phi0, d, j * d, d, ax, at, own,
+                stratum(r, nr, m, eye, fr, sub ? sub + (size_t)j * S : NULL, G, phi0, d, j * d, d, ax, at, own,
                         sum, back_w);
             for (int c = 0; c < 3; c++) {
                 double x = sum[0][c] - before[c];
@@ -455,7 +463,7 @@ static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], c
     lm_vec3 B = lm_v3_load(b), T = lm_v3_load(t), N = lm_v3_load(n), G = lm_v3_load(ng);
     int K = side * side;
     sky_mis m = {r0->enlargement == 0.0f && K > 0 && lm_sky_by_brightness(r0->scene), K, SKY_RAYS};
-    strata_frame fr = {B, T, N, 0, N, N, 1};
+    strata_frame fr = {B, T, N, 0, N, N, 1, r0->footprint > 0 ? r0->footprint : SUB};
     lm_vec3 up = lm_v3(0.0f, 1.0f, 0.0f);
     if (r0->enlargement == 0.0f && fabsf(lm_dot(up, N)) < UPRIGHT_LEVEL) {
         pthread_once(&elevation_once, elevation_table_fill);
@@ -482,14 +490,14 @@ static void rim_irradiance(const lm_rim *const *r, int nr, const float eye[3], c
             continue;
         double pdf;
         lm_sky_radiance_pdf(r0->scene, dir, L, &pdf);
-        double f = cos_n / (K * cos_n / LM_PI + m.M * pdf) * K * SUB * SUB / LM_PI;
+        double f = cos_n / (K * cos_n / LM_PI + m.M * pdf) * K * fr.sub * fr.sub / LM_PI;
         for (int k = 0; k < nr; k++)
             for (int c = 0; c < 3; c++)
                 sum[k][c] += f * L[c];
     }
     for (int k = 0; k < nr; k++)
         for (int c = 0; c < 3; c++)
-            out[k][c] = K ? (float)(LM_PI * sum[k][c] / ((double)K * SUB * SUB)) : 0.0f;
+            out[k][c] = K ? (float)(LM_PI * sum[k][c] / ((double)K * fr.sub * fr.sub)) : 0.0f;
     if (back)
         *back = K ? (float)(back_w / K) : 0.0f;
 }

@@ -71,6 +71,10 @@ typedef struct {
                               of their mean's relative standard error in the first rim's worst channel
                               exceeds this, 4 x as many strata more, and the mean of all (not with an image
                               sky's own directions); 0: the strata alone */
+    int footprint;         /* sub-directions per side of a stratum's footprint (0: 4); 1: each ray reads the
+                              AIM at its own hit, for finer strata whose rays are their own footprint (the
+                              waiting texels' near rays, update/ray_estimate.h). A rim read beside another
+                              (lm_rim_irradiance_pair) takes the first's */
 } lm_rim;
 
 /* Irradiance from the rim at eye (lifted off its surface), for the plane's frame: unit b, t (its x and y

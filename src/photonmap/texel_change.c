@@ -135,6 +135,18 @@ static float sphere_factor(const float *p, const float *n, const float sph[4])
     return fminf(1.0f, sin_a * sin_a) * fminf(1.0f, fmaxf(0.0f, c));
 }
 
+float lm_texel_change_node_near(const lm_texel_change *tc, const lm_scene *s, uint32_t texel)
+{
+    float most = 0.0f, at[4];
+    for (int n = 0; n < tc->node_count && n < s->node_count; n++) {
+        if (tc->node_sphere[4 * n + 3] < 0.0f || tc->texel_node[texel] == n || !lm_node_moves(&s->nodes[n]))
+            continue;
+        world_sphere(tc->node_sphere + 4 * n, tc->node_world + 16 * n, at);
+        most = fmaxf(most, sphere_factor(tc->pos + 3 * (size_t)texel, tc->nrm + 3 * (size_t)texel, at));
+    }
+    return most;
+}
+
 /* Node n moved from matrix old to its current one: every other texel sees its sphere at both places;
  * its own texels' hemispheres shifted with them (their positions and normals brought up to date). */
 static void add_moved_node(lm_texel_change *tc, const lm_scene *s, const lm_atlas *a, int n, const float old[16],

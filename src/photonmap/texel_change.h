@@ -119,6 +119,10 @@ uint32_t lm_texel_change_waiting(const lm_texel_change *tc, const lm_atlas *a, c
  * the atlas's typical change up, and with it the bar a texel must pass to go ahead (a moved cube's face
  * stayed 28% too bright for 120 updates below it). */
 void lm_texel_change_gathered(lm_texel_change *tc, const uint32_t *texels, uint32_t count);
+/* The largest share of texel's hemisphere (its form factor, widened near the horizon as the changes' are)
+ * that the bounding sphere of a node that moves (lm_node_moves), other than its own, fills where it was last
+ * seen (lm_texel_change_moved). O(nodes). */
+float lm_texel_change_node_near(const lm_texel_change *tc, const lm_scene *s, uint32_t texel);
 /* Texel t's change (header). */
 float lm_texel_change_of(const lm_texel_change *tc, uint32_t texel);
 /* saved (LM_TEXEL_CHANGE_SAVED x texel_count floats) = every texel's change, for a bake that may be

@@ -215,7 +215,7 @@ static void gather_texels(lm_light_scale *ls, const lm_light_scale_world *w, con
     const lm_atlas *a = w->atlas;
     size_t T = a->texel_count;
     lm_rim was = {w->scene, a, w->rt, ls->before, 1, {w->set->sky[0], w->set->sky[1], w->set->sky[2]}, 0.0f,
-                  (int)q.K, ls->emissive_before, NULL, NULL, 0.0f, 0.0f};
+                  (int)q.K, ls->emissive_before, NULL, NULL, 0.0f, 0.0f, 0};
     if (w->scene->has_sky)
         lm_sky_mean(w->scene, was.sky);
     lm_rim now = was;

@@ -392,6 +392,7 @@ static lm_status start_rays(lm_lightmap_path *lp, lm_error *err)
     }
     lp->have_rays = 1;
     lm_ray_estimate_emitters(&lp->rays, lp->have_emitters ? lp->gather : NULL);
+    lm_ray_estimate_nodes(&lp->rays, &lp->change);
     lm_light_scale_world w = {lp->scene, a, lp->rt, &lp->set->gather};
     for (uint32_t i = 0; i < a->texel_count; i++)
         lp->ray_list[i] = i;

@@ -20,9 +20,10 @@ lm_status lm_ray_estimate_init(lm_ray_estimate *re, uint32_t texel_count, int K,
     re->has = calloc(n, 1);
     re->stamp = calloc(n, sizeof *re->stamp);
     re->fine = calloc(n, 1);
+    re->fine_base = calloc(3 * n, sizeof *re->fine_base);
     re->rate = calloc(n, sizeof *re->rate);
     re->rated = calloc(n, 1);
-    if (re->base && re->delta && re->has && re->stamp && re->fine && re->rate && re->rated)
+    if (re->base && re->delta && re->has && re->stamp && re->fine && re->fine_base && re->rate && re->rated)
         return LM_OK;
     lm_ray_estimate_free(re);
     return lm_fail(err, LM_ERR_NOMEM, "ray estimate: no memory for %u texels", texel_count);
@@ -35,6 +36,7 @@ void lm_ray_estimate_free(lm_ray_estimate *re)
     free(re->has);
     free(re->stamp);
     free(re->fine);
+    free(re->fine_base);
     free(re->rate);
     free(re->rated);
     memset(re, 0, sizeof *re);
@@ -44,7 +46,7 @@ void lm_ray_estimate_free(lm_ray_estimate *re)
 static lm_rim rays_over(const lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim)
 {
     lm_rim r = {w->scene, w->atlas, w->rt, aim, !re->emitted, {w->set->sky[0], w->set->sky[1], w->set->sky[2]},
-                0.0f, re->K, NULL, NULL, NULL, 0.0f, 0.0f};
+                0.0f, re->K, NULL, NULL, NULL, 0.0f, 0.0f, 0};
     if (w->scene->has_sky)
         lm_sky_mean(w->scene, r.sky);
     return r;
@@ -69,12 +71,54 @@ static int misjudged(const float e[3], const float ef[3], const float em[3])
     return fabs(a - b) > LM_RAY_ESTIMATE_SPLIT * b;
 }
 
-/* The bases of texels list[0 .. m) (their gathers now, by r, and where r misjudges one, by rf: re->fine), or
- * with `minus` their changes since (re->delta), each by the rays its base took, with its emitter light
- * (emitted_at); on every core. */
-static void ray_gathers(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *r, const lm_rim *rf,
+/* Whether a node that moves stands beside texel i (header); watch: nodes are known, and some move. */
+static int node_near(const lm_ray_estimate *re, const lm_light_scale_world *w, int watch, uint32_t i)
+{
+    return watch && lm_texel_change_node_near(re->nodes, w->scene, i) > LM_RAY_ESTIMATE_NEAR;
+}
+
+/* Texel i's base into e (its emitter light em left out), by the rays rims[re->fine[i]] that it sets: the
+ * near rays where a node stands beside it, else the fine ones where the K rays misjudge it, else the K;
+ * with watch, also its near rays' gather (em in) into fine_base, for a node that comes later. */
+static void base_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rims, int watch, uint32_t i,
+                    const float em[3], float e[3])
+{
+    float ef[3], en[3];
+    lm_light_scale_texel_rim(w, &rims[0], i, e);
+    lm_light_scale_texel_rim(w, &rims[1], i, ef);
+    re->fine[i] = (uint8_t)misjudged(e, ef, em);
+    if (watch) {
+        lm_light_scale_texel_rim(w, &rims[LM_RAY_ESTIMATE_NEAR_RAYS], i, en);
+        for (int c = 0; c < 3; c++)
+            re->fine_base[3 * (size_t)i + c] = en[c] + em[c];
+        if (node_near(re, w, watch, i))
+            re->fine[i] = LM_RAY_ESTIMATE_NEAR_RAYS;
+    }
+    if (re->fine[i] == 1)
+        memcpy(e, ef, sizeof ef);
+    else if (re->fine[i] == LM_RAY_ESTIMATE_NEAR_RAYS)
+        memcpy(e, en, sizeof en);
+}
+
+/* Texel i's gather now into e (em left out), by the rays its base took; a node come beside it since its
+ * gather turns it to the near rays against the near base it took then (LM_RAY_ESTIMATE_NEW_NEAR). */
+static void now_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rims, int watch, uint32_t i,
+                   float e[3])
+{
+    if (re->fine[i] < LM_RAY_ESTIMATE_NEAR_RAYS && node_near(re, w, watch, i)) {
+        memcpy(re->base + 3 * (size_t)i, re->fine_base + 3 * (size_t)i, 3 * sizeof *re->base);
+        re->fine[i] = LM_RAY_ESTIMATE_NEW_NEAR;
+    }
+    int level = re->fine[i] == LM_RAY_ESTIMATE_NEW_NEAR ? LM_RAY_ESTIMATE_NEAR_RAYS : re->fine[i];
+    lm_light_scale_texel_rim(w, &rims[level], i, e);
+}
+
+/* The bases of texels list[0 .. m) (base_of), or with `minus` their changes since (re->delta: now_of less
+ * the base), each with its emitter light (emitted_at); on every core. */
+static void ray_gathers(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rims,
                         const uint32_t *list, uint32_t m, float *out, const float *minus)
 {
+    int watch = re->nodes && lm_scene_any_node_moves(w->scene);
 #pragma omp parallel
     {
         lm_rt_thread_init();
@@ -83,29 +127,24 @@ static void ray_gathers(lm_ray_estimate *re, const lm_light_scale_world *w, cons
             uint32_t i = list[j];
             float e[3], em[3];
             emitted_at(re, w, i, em);
-            if (minus) {
-                lm_light_scale_texel_rim(w, re->fine[i] ? rf : r, i, e);
-            } else {
-                float ef[3];
-                lm_light_scale_texel_rim(w, r, i, e);
-                lm_light_scale_texel_rim(w, rf, i, ef);
-                re->fine[i] = (uint8_t)misjudged(e, ef, em);
-                if (re->fine[i])
-                    memcpy(e, ef, sizeof e);
-            }
+            if (minus)
+                now_of(re, w, rims, watch, i, e);
+            else
+                base_of(re, w, rims, watch, i, em, e);
             for (int c = 0; c < 3; c++)
                 out[3 * (size_t)i + c] = e[c] + em[c] - (minus ? minus[3 * (size_t)i + c] : 0.0f);
         }
     }
 }
 
-/* The rims of K and of LM_RAY_ESTIMATE_FINE x K rays over aim (rays_over). */
-static void rims_over(const lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim, lm_rim *r,
-                      lm_rim *rf)
+/* The rims over aim (rays_over) by fine level: K rays, LM_RAY_ESTIMATE_FINE x K, and the near rays,
+ * LM_RAY_ESTIMATE_NEAR_FINE x K each read at its own hit (header). */
+static void rims_over(const lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim, lm_rim rims[3])
 {
-    *r = rays_over(re, w, aim);
-    *rf = *r;
-    rf->samples = LM_RAY_ESTIMATE_FINE * re->K;
+    rims[0] = rims[1] = rims[2] = rays_over(re, w, aim);
+    rims[1].samples = LM_RAY_ESTIMATE_FINE * re->K;
+    rims[LM_RAY_ESTIMATE_NEAR_RAYS].samples = LM_RAY_ESTIMATE_NEAR_FINE * re->K;
+    rims[LM_RAY_ESTIMATE_NEAR_RAYS].footprint = 1;
 }
 
 void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w, const float *aim,
@@ -113,9 +152,9 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
 {
     if (n == 0 || re->K <= 0)
         return;
-    lm_rim r, rf;
-    rims_over(re, w, aim, &r, &rf);
-    ray_gathers(re, w, &r, &rf, texels, n, re->base, NULL);
+    lm_rim rims[3];
+    rims_over(re, w, aim, rims);
+    ray_gathers(re, w, rims, texels, n, re->base, NULL);
     for (uint32_t j = 0; j < n; j++) { /* its change starts again from 0, and its rate is unknown */
         re->has[texels[j]] = 1;
         re->stamp[texels[j]] = re->frame;
@@ -212,11 +251,16 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
     m = take(re, w->atlas, waiting, change, change_unit, n, 0, third, least, h, out, m, was, sum);
     m = take(re, w->atlas, waiting, change, change_unit, n, 1, third, least, h, out, m, was, sum);
     m = take(re, w->atlas, waiting, change, change_unit, n, 2, budget - 2 * third, least, h, out, m, was, sum);
-    lm_rim r, rf;
-    rims_over(re, w, aim, &r, &rf);
-    ray_gathers(re, w, &r, &rf, out, m, re->delta, re->base);
+    lm_rim rims[3];
+    rims_over(re, w, aim, rims);
+    ray_gathers(re, w, rims, out, m, re->delta, re->base);
     for (uint32_t j = 0; j < m; j++) { /* the rate each change went at since the texel's last estimate */
         const float *d = re->delta + 3 * (size_t)out[j];
+        if (re->fine[out[j]] == LM_RAY_ESTIMATE_NEW_NEAR) { /* its change, now through other rays: no rate */
+            re->fine[out[j]] = LM_RAY_ESTIMATE_NEAR_RAYS;
+            re->rated[out[j]] = 0;
+            continue;
+        }
         uint32_t since = re->frame - was[j];
         re->rate[out[j]] = fabsf(d[0] + d[1] + d[2] - sum[j]) / (float)(since ? since : 1);
         re->rated[out[j]] = 1;
@@ -228,11 +272,14 @@ uint32_t lm_ray_estimate_update(lm_ray_estimate *re, const lm_light_scale_world 
 void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float *add)
 {
     for (size_t k = 0; k < 3 * (size_t)re->texel_count; k++)
-        re->base[k] = re->base[k] * factor[k] + (add ? add[k] : 0.0f);
+        re->base[k] = re->base[k] * factor[k] + (add ? add[k] : 0.0f),
+        re->fine_base[k] = re->fine_base[k] * factor[k] + (add ? add[k] : 0.0f);
     memset(re->rated, 0, re->texel_count ? re->texel_count : 1); /* the rates came before the edit */
 }
 
 void lm_ray_estimate_emitters(lm_ray_estimate *re, const lm_gather *g) { re->emitted = g; }
+
+void lm_ray_estimate_nodes(lm_ray_estimate *re, const lm_texel_change *tc) { re->nodes = tc; }
 
 void lm_ray_estimate_forget(lm_ray_estimate *re)
 {

@@ -48,17 +48,21 @@
  * rays, and a texel whose two differ by more than LM_RAY_ESTIMATE_SPLIT of its light takes those, base and
  * updates alike, until its next gather (`fine`): about a third of the animated box's bases, through the
  * caustics its mirror and glass balls sweep over the walls; few where the light is smooth. The judge is
- * made at the gather only: a texel that took its base with nothing near keeps its K rays when a node comes,
- * and then misjudges its change for as long as the node stands beside it (the scene held with the mirror
- * sphere by that corner: 7 of 8 such texels 12-59% too bright, after every AIM caught up; docs/tradeoff.md,
- * "Nodes that keep moving", the whole loop).
+ * made at the gather only, and a node that comes later is what K rays misjudge most: held with the mirror
+ * sphere by that corner, 7 of 8 texels on K rays read it 12-59% too bright after every AIM caught up
+ * (docs/tradeoff.md, "Nodes that keep moving", the whole loop). So a texel that a moving node stands beside
+ * (the form factor of its bounding sphere over LM_RAY_ESTIMATE_NEAR: lm_texel_change_node_near) takes the
+ * near rays, LM_RAY_ESTIMATE_NEAR_FINE x K read each at its own hit (a footprint of one: hemicube_rim.h),
+ * at its gather, or from the update the node comes on, against the near rays' base that every gather also
+ * takes while nodes move (fine_base); its rate starts again then. The near rays stay until its next gather.
  *
- * Layout: per texel its base (rgb), three flags (a base; the fine rays; a rate), the update it was last
- * brought up to date and the rate its change went at; the deltas an update computes, by texel index, for
- * the caller to show (what is shown is the IIM's, iim.h, which a light edit scales there). Memory: 38 bytes
- * a texel, and 20 a waiting texel while choosing.
- * Cost: (1 + LM_RAY_ESTIMATE_FINE) K rays and footprints of AIM lookups per texel gathered (its base), K or
- * LM_RAY_ESTIMATE_FINE x K per texel brought up to date, on every OpenMP thread; choosing them
+ * Layout: per texel its base and its near rays' base (rgb each), three flags (a base; which rays; a rate),
+ * the update it was last brought up to date and the rate its change went at; the deltas an update computes,
+ * by texel index, for the caller to show (what is shown is the IIM's, iim.h, which a light edit scales
+ * there). Memory: 50 bytes a texel, and 20 a waiting texel while choosing.
+ * Cost: (1 + LM_RAY_ESTIMATE_FINE) K rays and footprints of AIM lookups per texel gathered (its base), and
+ * while a node moves LM_RAY_ESTIMATE_NEAR_FINE x K rays and lookups more; K, LM_RAY_ESTIMATE_FINE x K or
+ * the near rays per texel brought up to date, and a pass over the nodes, on every OpenMP thread; choosing them
  * O(waiting x (2 LM_RAY_ESTIMATE_REACH + 1)^2 + waiting log budget) (core/top_k.h). Deterministic (each
  * texel's rays are seeded by its index). Not thread-safe; the scene and AIM must not change meanwhile.
  * Errors: none but memory at init. */
@@ -68,6 +72,7 @@
 #include <stdint.h>
 
 #include "../gpu/gather/hemicube.h"
+#include "../photonmap/texel_change.h"
 #include "light_scale.h"
 
 /* Rays a texel's two gathers take by default: 6 x 6 strata. At 16 a texel's change mottles (one move in a
@@ -96,6 +101,18 @@
 #define LM_RAY_ESTIMATE_FINE 4
 #define LM_RAY_ESTIMATE_SPLIT 0.1
 
+/* A texel that a moving node's bounding sphere fills more than LM_RAY_ESTIMATE_NEAR of (its form factor)
+ * takes LM_RAY_ESTIMATE_NEAR_FINE x K rays, each read at its hit (header). Over the animated box's whole loop
+ * (240 updates, photon seeds 0 to 4): the trail 18 / 6 / 15 / 6 / 9 updates -> 6 / 9 / 12 / 9 / 6, blocks
+ * over 10% 0.47 / 0.36 / 0.61 / 0.35 / 0.34 -> 0.12 / 0.23 / 0.23 / 0.20 / 0.21; `lmgi run`'s gather 23 ->
+ * 31 ms an update. At 16 x K: 6 / 6 / 15 / 6 / 6, and 39 ms. With 4 x 4 footprints, as the K rays read
+ * theirs: 16 x K at a bar of 0.05 took 84 ms. Bars of 0.1 and 0.15 left seed 0 at 18, one of 0.02 cost more
+ * and did no better (seed 2: 12). */
+#define LM_RAY_ESTIMATE_NEAR 0.05
+#define LM_RAY_ESTIMATE_NEAR_FINE 9
+#define LM_RAY_ESTIMATE_NEAR_RAYS 2 /* fine: the near rays */
+#define LM_RAY_ESTIMATE_NEW_NEAR 3  /* fine: the near rays, taken at this update (no rate from it) */
+
 typedef struct {
     uint32_t texel_count;
     int K;          /* rays a texel */
@@ -104,12 +121,15 @@ typedef struct {
     float *delta;   /* per texel, 3: E_t - E_0, written by lm_ray_estimate_update for the texels it lists */
     uint32_t *stamp; /* per texel: the update its base or delta was last computed */
     uint32_t frame;  /* updates so far (lm_ray_estimate_update calls) */
-    uint8_t *fine;   /* per texel: its base and updates take LM_RAY_ESTIMATE_FINE x K rays (header) */
+    uint8_t *fine;   /* per texel: its base and updates take K rays (0), LM_RAY_ESTIMATE_FINE x K (1), or
+                      * LM_RAY_ESTIMATE_NEAR_FINE x K (LM_RAY_ESTIMATE_NEAR_RAYS) (header) */
+    float *fine_base; /* per texel, 3: its near rays' gather at its last gather while nodes moved (header) */
     float *rate;     /* per texel: |its change's change| an update (channels summed), at its last update */
     uint8_t *rated;  /* per texel: rate holds one (brought up to date since its gather or a light's edit) */
     const lm_gather *emitted; /* NULL: the rays add the emission of the emitters they meet; else the gather
                                * whose closed-form emitter light a texel's two gathers take instead
                                * (lm_ray_estimate_emitters) */
+    const lm_texel_change *nodes; /* NULL: no node is near any texel; else where the nodes are (header) */
 } lm_ray_estimate;
 
 /* K rays a texel (rounded down to a square by the rim); no base yet. */
@@ -136,6 +156,9 @@ void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float
  * them (test_gather's test_ray_estimate_emitter_shadow). The gather's own light is the same on both sides
  * of E_t - E_0 where nothing moved, to the bit, and exact where a shadow moved. Call before the first base. */
 void lm_ray_estimate_emitters(lm_ray_estimate *re, const lm_gather *g);
+/* With tc (borrowed; NULL: none, as after init), where the nodes are: a texel that a moving node stands
+ * beside takes the near rays (header). */
+void lm_ray_estimate_nodes(lm_ray_estimate *re, const lm_texel_change *tc);
 /* Every base forgotten (the IIM cleared: lm_iim_clear). */
 void lm_ray_estimate_forget(lm_ray_estimate *re);
 

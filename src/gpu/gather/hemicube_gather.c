@@ -779,7 +779,7 @@ static void cpu_irradiance(lm_gather *g, const lm_scene *s, const lm_atlas *a, c
                            uint32_t count)
 {
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]},
-                  g->set.enlargement, g->set.rim_samples, NULL, NULL, NULL, 0.0f, 0.0f};
+                  g->set.enlargement, g->set.rim_samples, NULL, NULL, NULL, 0.0f, 0.0f, 0};
 #pragma omp parallel num_threads(g->cpu_threads) if (g->cpu_threads > 1)
     {
         lm_rt_thread_init(); /* FTZ/DAZ as on this thread: the same numbers on any thread */
@@ -888,7 +888,7 @@ static lm_status gather_rays(lm_gather *g, const lm_scene *s, const lm_atlas *a,
         near_only = at_hits && g->direct.area && g->whole_copy && g->set.direct_near > 0.0f;
     lm_rim rim = {s, a, g->rt, g->aim_copy, !g->emitters, {g->set.sky[0], g->set.sky[1], g->set.sky[2]}, 0.0f,
                   g->set.ray_samples, NULL, at_hits ? &g->direct : NULL, near_only ? g->whole_copy : NULL,
-                  g->set.direct_near, g->set.adapt};
+                  g->set.direct_near, g->set.adapt, 0};
     uint32_t per_pass = (uint32_t)(g->set.tiles * g->set.tiles);
     if (g->turn_tex[0] && !g->turn && !(g->turn = malloc(sizeof(float) * LM_TURN_FLOATS * per_pass)))
         return lm_fail(err, LM_ERR_NOMEM, "ray gather: no memory");
