@@ -1430,8 +1430,9 @@ static void test_tradeoff(void **state)
  *   after it (update/photon_stage.c catch_up, update/lightmap_path.c), whatever the texel budget: its worst
  *   surface within 5% after at most 2 updates in every play.
  * - The red wall recoloured is shown at once from its first guess (update/light_scale.h), then regathered
- *   texel by texel, those it moved most first: its lag is the texel budget's to set, shorter at 80 texels an
- *   update than at 5, and longer with whole surfaces only.
+ *   texel by texel, those it moved most first, the waiting texels showing what their rays see: within 5%
+ *   at once, within 2% in a few updates at 20 or 80 texels an update, more at 5, and far longer with whole
+ *   surfaces only.
  * - The report's lag plot draws the nudge and the move, one update apart, as one gesture's panel.
  * A script for a scene not on the command line is refused. */
 static void test_tradeoff_update_lag(void **state)
@@ -1467,8 +1468,8 @@ static void test_tradeoff_update_lag(void **state)
     int frame = csv_column(header, "frame");
     assert_true(knob >= 0 && value >= 0 && error >= 0 && to5 >= 0 && to2 >= 0 && def >= 0 && frame_error >= 0 &&
                 frame_end >= 0 && frame >= 0);
-    int plays = 0, lag5 = -2, lag80 = -2, lag_default = -2, lag2_80 = -2, lag2_default = -2, lag_surfaces = -2,
-        lag2_surfaces = -2;
+    int plays = 0, lag5 = -2, lag80 = -2, lag_default = -2, lag2_5 = -2, lag2_80 = -2, lag2_default = -2,
+        lag_surfaces = -2, lag2_surfaces = -2;
     while (fgets(line, sizeof line, f)) {
         csv_field(line, frame, v, sizeof v);
         int at = atoi(v);
@@ -1477,7 +1478,6 @@ static void test_tradeoff_update_lag(void **state)
         plays += at == MOVE;
         csv_field(line, error, v, sizeof v);
         double e = atof(v);
-        assert_true(e > 0.02); /* the edit moved some surface's light */
         /* --frame-lag: the default play's frame against the reference of the edited scene, per surface,
          * at the edit and at the end (2-4% when written: the direct light is the frame's own) */
         char fe[64], fend[64];
@@ -1501,12 +1501,16 @@ static void test_tradeoff_update_lag(void **state)
         int lag2 = atoi(v);
         print_message("lag, %s: %s %d: distance at the edit %.3f, within 5%% after %d updates, 2%% after %d\n",
                       at == MOVE ? "the move" : "the recolour", name, n, e, lag, lag2);
+        /* the edit moved some surface's light: the play that gathers least shows over 2% at the edit's own
+         * update (the move 2.8%, the recolour 4.7%); the others at least 1% (the move 1.9-2.2% since the near
+         * rays, ray_estimate.h, 2.6-2.8% before) */
+        assert_true(e > (is_texels && n == 5 ? 0.02 : 0.01));
         if (at == MOVE) {
             assert_true(lag >= 0 && lag <= 2);
             continue;
         }
         if (is_texels && n == 5)
-            lag5 = lag;
+            lag5 = lag, lag2_5 = lag2;
         if (is_texels && n == 80)
             lag80 = lag, lag2_80 = lag2;
         if (is_texels && n == 20)
@@ -1517,12 +1521,15 @@ static void test_tradeoff_update_lag(void **state)
     fclose(f);
     assert_int_equal(plays, 8); /* the defaults, two values of each of three budgets, the texel change off */
     assert_true(lag80 > 0 && lag5 > 0 && lag_default > 0);
-    assert_true(lag5 > lag80);
-    /* to 2%: 7 updates at 80 texels, 21 at the default 20; whole surfaces only are slower at both bounds, by
-     * how much the gather's noise on the walls decides (to 5% / 2%: 34 against 3 and not in 60 before the
-     * upright strata, docs/gather.md; 2 against 1 and not in 60 with them; 33 against 1 and 40 against 21
-     * with each upright row's rays at their own alpha) */
-    assert_true(lag2_default > 0 && lag2_80 > 0 && lag2_80 < lag2_default);
+    assert_true(lag5 >= lag80);
+    /* to 2%: 8 updates at 5 texels, 3 at the default 20, 5 at 80 (13, 15 and 5 before the near rays and
+     * their estimates shown alone, ray_estimate.h and iim.h: the recolour's waiting texels beside the moved
+     * cube now read it right); whole surfaces only are slower at both bounds, by how much the gather's noise
+     * on the walls decides (to 5% / 2%: 34 against 3 and not in 60 before the upright strata,
+     * docs/gather.md; 2 against 1 and not in 60 with them; 33 against 1 and 40 against 21 with each upright
+     * row's rays at their own alpha) */
+    assert_true(lag2_default > 0 && lag2_80 > 0 && lag2_5 > lag2_default && lag2_5 > lag2_80);
+    assert_true(lag2_default <= 6);
     assert_true(lag_surfaces == -1 || lag_surfaces > lag_default);
     assert_true(lag2_surfaces == -1 || lag2_surfaces > lag2_default);
     assert_true(lag_surfaces == -1 || lag2_surfaces == -1 || lag_surfaces > 2 * lag_default ||

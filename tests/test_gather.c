@@ -3042,17 +3042,21 @@ static void test_schedule_order_and_budget(void **state)
     ts_free(&t);
 }
 
-static void set_fresh(const lm_iim *iim, float value)
+/* The fresh map: value x (1 + i % 7 / 100) in every float i; with `valid`, alpha 0 (no back faces seen: a
+ * texel the blend shader draws; else 1 and more, inside as it has it, which the blends treat alike). */
+static void set_fresh_as(const lm_iim *iim, float value, int valid)
 {
     size_t n = 4 * (size_t)iim->width * (size_t)iim->height;
     float *v = malloc(sizeof(float) * n);
     assert_non_null(v);
     for (size_t i = 0; i < n; i++)
-        v[i] = value * (1.0f + 0.01f * (float)(i % 7));
+        v[i] = valid && i % 4 == 3 ? 0.0f : value * (1.0f + 0.01f * (float)(i % 7));
     glBindTexture(GL_TEXTURE_2D, iim->fresh_tex);
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, iim->width, iim->height, GL_RGBA, GL_FLOAT, v);
     free(v);
 }
+
+static void set_fresh(const lm_iim *iim, float value) { set_fresh_as(iim, value, 0); }
 
 /* Every covered texel's display value lies in [lo, hi] (per-texel old and new maps). */
 static void check_between(const tscene *t, const float *d, const float *lo, const float *hi)
@@ -3142,6 +3146,57 @@ static void test_blend_stays_between(void **state)
     blend_case_free(&b);
 }
 
+/* Two waiting neighbours on one surface, each with an estimate of its own (lm_iim_set_sight): the one whose
+ * rays are many (ray_estimate.h's near rays) shows its value plus its own change exactly; the other averages
+ * the two changes (iim.h, LM_IIM_SIGHT_SPREAD), so it shows something strictly between its own and its
+ * neighbour's. */
+static void test_sight_alone(void **state)
+{
+    (void)state;
+    blend_case b;
+    blend_case_init(&b);
+    const lm_atlas *a = &b.t.a;
+    uint32_t pair[2] = {0, 0};
+    for (uint32_t i = 0; i < a->texel_count && !pair[1]; i++) { /* a texel and the one right of it */
+        const lm_texel *t = &a->texels[i];
+        int32_t q = t->x + 1 < a->width ? a->texel_index[(size_t)t->y * a->width + t->x + 1] : -1;
+        if (q >= 0 && a->texels[q].surface == t->surface)
+            pair[0] = i, pair[1] = (uint32_t)q;
+    }
+    assert_true(pair[1] > 0);
+    lm_error err;
+    set_fresh_as(&b.iim, 1.0f, 1); /* shown at once, valid */
+    lm_iim_sched_pick_all(&b.iim.sched, &b.ps, b.all);
+    assert_int_equal(lm_iim_blend(&b.iim, 1, &err), LM_OK);
+    assert_int_equal(lm_iim_texture_read(b.iim.display_tex, a->width, a->height, b.old, &err), LM_OK);
+    float *change = calloc(3 * (size_t)a->texel_count, sizeof *change);
+    float *light = malloc(3 * sizeof(float) * a->texel_count);
+    uint8_t *rays = calloc(a->texel_count, 1);
+    assert_non_null(change), assert_non_null(light), assert_non_null(rays);
+    for (size_t k = 0; k < 3 * (size_t)a->texel_count; k++)
+        light[k] = 1.0f;
+    for (int c = 0; c < 3; c++)
+        change[3 * (size_t)pair[0] + c] = -0.5f, change[3 * (size_t)pair[1] + c] = 0.25f;
+    rays[pair[0]] = 2; /* many */
+    lm_iim_set_pending(&b.iim, a, pair, 2);
+    lm_iim_set_sight(&b.iim, a, pair, change, light, rays, 2, 2);
+    assert_int_equal(lm_iim_blend(&b.iim, 0, &err), LM_OK);
+    assert_int_equal(lm_iim_texture_read(b.iim.display_tex, a->width, a->height, b.d, &err), LM_OK);
+    for (int j = 0; j < 2; j++) {
+        size_t k = 4 * ((size_t)a->texels[pair[j]].y * a->width + a->texels[pair[j]].x);
+        for (int c = 0; c < 3; c++) {
+            float own = b.old[k + c] + change[3 * (size_t)pair[j] + c];
+            float theirs = b.old[k + c] + change[3 * (size_t)pair[1 - j] + c];
+            if (j == 0)
+                assert_float_equal(b.d[k + c], own, 1e-6);
+            else
+                assert_true(b.d[k + c] < own - 1e-3f && b.d[k + c] > theirs + 1e-3f);
+        }
+    }
+    free(change), free(light), free(rays);
+    blend_case_free(&b);
+}
+
 /* A surface committed again every frame (gathered every update beside a node that keeps moving) follows
  * its gathers as a running mean: with fresh held at new, display = new - (new - old)(1 - 1/B)^k after k
  * commits. With a first step of 0 at each commit it showed old for as long as the commits went on (the
@@ -3218,6 +3273,7 @@ int main(void)
         cmocka_unit_test(test_coverage_beyond_the_gl_limit),
         cmocka_unit_test(test_schedule_order_and_budget),
         cmocka_unit_test(test_blend_stays_between),
+        cmocka_unit_test(test_sight_alone),
         cmocka_unit_test(test_blend_recommitted_every_frame),
         cmocka_unit_test(test_fill_invalid),
         cmocka_unit_test(test_furnace),

@@ -426,7 +426,8 @@ static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting
     uint32_t m = change ? lm_ray_estimate_update(&lp->rays, &w, aim, wait, change, unit, waiting, budget, lp->ray_list)
                         : 0;
     free(change);
-    lm_iim_set_sight(&lp->iim, lp->atlas, lp->ray_list, lp->rays.delta, lp->rays.base, m);
+    lm_iim_set_sight(&lp->iim, lp->atlas, lp->ray_list, lp->rays.delta, lp->rays.base, lp->rays.fine,
+                     LM_RAY_ESTIMATE_NEAR_RAYS, m);
     lp->estimated = m;
     lp->estimate_seconds = lm_now() - t0;
 }

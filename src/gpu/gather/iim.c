@@ -202,17 +202,18 @@ static void sight_touched(lm_iim *iim, int x, int y)
 }
 
 void lm_iim_set_sight(lm_iim *iim, const lm_atlas *a, const uint32_t *texels, const float *change, const float *light,
-                      uint32_t n)
+                      const uint8_t *rays, uint8_t many, uint32_t n)
 {
     for (uint32_t j = 0; j < n; j++) {
         const lm_texel *t = &a->texels[texels[j]];
         float *cell = iim->sight + 4 * ((size_t)t->y * a->width + t->x);
         const float *c = change + 3 * (size_t)texels[j], *e = light + 3 * (size_t)texels[j];
         float moved = fabsf(c[0] - cell[0]) + fabsf(c[1] - cell[1]) + fabsf(c[2] - cell[2]);
-        if (cell[3] == 1.0f && moved <= LM_IIM_SIGHT_KEEP * (fabsf(e[0]) + fabsf(e[1]) + fabsf(e[2])))
+        float how = rays && rays[texels[j]] >= many ? LM_IIM_SIGHT_ALONE : 1.0f; /* the shader's flag */
+        if (cell[3] == how && moved <= LM_IIM_SIGHT_KEEP * (fabsf(e[0]) + fabsf(e[1]) + fabsf(e[2])))
             continue; /* shown already, to what the eye can tell */
         memcpy(cell, c, 3 * sizeof *cell);
-        cell[3] = 1.0f;
+        cell[3] = how;
         sight_touched(iim, (int)t->x, (int)t->y);
         for (int dy = -LM_IIM_SIGHT_SPREAD; dy <= LM_IIM_SIGHT_SPREAD; dy++) /* and the neighbours that average it */
             for (int dx = -LM_IIM_SIGHT_SPREAD; dx <= LM_IIM_SIGHT_SPREAD; dx++) {

@@ -15,7 +15,8 @@
 // and by how far each has blended in, divided by at least 1 (a lone far neighbour lends little): the
 // coarse first estimate of progressive refinement. A waiting cell with an estimate of its own (`sight`, a 1:
 // the change of what its rays see since its gather, update/ray_estimate.h) shows its own blend plus that,
-// averaged with its waiting neighbours' within sight_spread texels (iim.h), instead; in the frame its texel is gathered (a -1) its commit carries what it showed, and it is not rebased.
+// averaged with its waiting neighbours' within sight_spread texels (iim.h), instead, or (a 2: many rays) alone; in
+// the frame its texel is gathered (a -1) its commit carries what it showed, and it is not rebased.
 #version 450 core
 layout(local_size_x = 8, local_size_y = 8) in;
 layout(binding = 0, rgba32f) uniform readonly image2D fresh;
@@ -169,7 +170,9 @@ vec4 estimate(ivec2 g, int c)
 {
     vec4 v = shown(g, c);
     if (v.a > limit) return v;
-    if (imageLoad(sight, g).a > 0.5) return vec4(max(v.rgb + seen_change(g, c), vec3(0.0)), v.a);
+    vec4 s = imageLoad(sight, g);
+    if (s.a > 1.5) return vec4(max(v.rgb + s.rgb, vec3(0.0)), v.a); /* alone (iim.h) */
+    if (s.a > 0.5) return vec4(max(v.rgb + seen_change(g, c), vec3(0.0)), v.a);
     return vec4(lent(g, c, v.rgb, start[c], false), v.a);
 }
 
