@@ -734,12 +734,13 @@ static trail_stats trail_of(lmgi_context *ctx, float *const *want, int estimate_
  * texels: how many blocks are over 10% off, and the longest run of updates one stayed so, apart for the
  * static surfaces (the trail a node leaves) and the moving nodes' own faces. The texels that wait show the
  * change their own rays see (update/ray_estimate.h), against their neighbours' loans alone (estimate_rays
- * off). Measured: 0.15 blocks over 10% against 9.28, the trail's longest run 6 updates against 72, the moving
- * nodes' own 3 against 78; 0.57, 9 and 6 before the near rays beside moving nodes (ray_estimate.h). Before a
+ * off). Measured: 0.15 blocks over 10% against 9.28, the trail's longest run 3 updates against 72, the moving
+ * nodes' own 3 against 78; 0.57, 9 and 6 before the near rays beside moving nodes (ray_estimate.h), shown
+ * alone (iim.h). Before a
  * waiting texel's change averaged with neighbours committed near it in time (iim.h, LM_IIM_SIGHT_APART) and
  * a third of the estimates went by their expected staleness (ray_estimate.h), 0.97, 15 and 18. Over the
- * whole loop (240 updates, seeds 0 to 4; probes, not kept) the trail 6, 9, 12, 9 and 6: seed 2 is over the
- * bound, docs/tradeoff.md, "Nodes that keep moving". */
+ * whole loop (240 updates, seeds 0 to 4; probes, not kept) the trail 3, 6, 6, 6 and 6: docs/tradeoff.md,
+ * "Nodes that keep moving". */
 static void test_animated_box_trail(void **state)
 {
     (void)state;
