@@ -2288,7 +2288,9 @@ static void move_node_x(tscene *t, lm_rt *rt, int node, float dx)
  * (texel_change.h). The texels it stands beside, some only after its move, read their change (against 4,096
  * rays a texel before and after) far closer with the near rays than with the 36 or 144 of a floor that no
  * node's whereabouts reach; those it came beside only through the near rays' own base, taken at the gather,
- * where the still square's edges fall on the same strata before and after. */
+ * where the still square's edges fall on the same strata before and after. Gathered while the square did
+ * not move (made dynamic after), a texel has no such base and keeps its rays: the change as if no node
+ * were known, to the bit. */
 static void test_ray_estimate_near_node(void **state)
 {
     (void)state;
@@ -2320,12 +2322,14 @@ static void test_ray_estimate_near_node(void **state)
     double R = 0.05 * sqrt(2.0), d2 = p[0] * p[0] + (0.15 - p[1]) * (0.15 - p[1]) + p[2] * p[2];
     assert_true(fabs(lm_texel_change_node_near(&tc, t.s, mid) - R * R / d2) < 1e-4);
     lm_rim dense = {t.s, &t.a, rt, aim, 1, {0.0f, 0.0f, 0.0f}, 0.0f, 4096, NULL, NULL, NULL, 0.0f, 0.0f, 0};
-    lm_ray_estimate re[2]; /* told where the nodes are, and not */
-    for (int k = 0; k < 2; k++) {
+    lm_ray_estimate re[3]; /* told where the nodes are, and not; told, but gathered while nothing moved */
+    for (int k = 0; k < 3; k++) {
         assert_int_equal(lm_ray_estimate_init(&re[k], t.a.texel_count, LM_RAY_ESTIMATE_RAYS, &err), LM_OK);
-        lm_ray_estimate_nodes(&re[k], k == 0 ? &tc : NULL);
+        lm_ray_estimate_nodes(&re[k], k != 1 ? &tc : NULL);
+        lm_scene_set_dynamic(t.s, 2, k != 2); /* made dynamic only later: no near base to turn to */
         lm_ray_estimate_gathered(&re[k], &w, aim, texels, n);
     }
+    lm_scene_set_dynamic(t.s, 2, 1);
     for (uint32_t j = 0; j < n; j++) {
         float e[3];
         lm_light_scale_texel_rim(&w, &dense, texels[j], e);
@@ -2335,8 +2339,11 @@ static void test_ray_estimate_near_node(void **state)
     }
     move_node_x(&t, rt, 2, 0.2f);
     lm_texel_change_moved(&tc, t.s, &t.a, 1);
-    for (int k = 0; k < 2; k++)
+    for (int k = 0; k < 3; k++)
         assert_int_equal(lm_ray_estimate_update(&re[k], &w, aim, texels, change, 1.0f, n, n, out), n);
+    for (uint32_t j = 0; j < n; j++) /* the one gathered while nothing moved reads as if told nothing */
+        for (int c = 0; c < 3; c++)
+            assert_true(re[2].delta[3 * (size_t)texels[j] + c] == re[1].delta[3 * (size_t)texels[j] + c]);
     uint32_t near = 0, came = 0;
     double e[2][2] = {{0.0, 0.0}, {0.0, 0.0}}; /* [came since][with, without] */
     for (uint32_t j = 0; j < n; j++) {
@@ -2362,7 +2369,7 @@ static void test_ray_estimate_near_node(void **state)
     assert_true(came > 0 && stayed > 0);
     assert_true(e[0][0] < 0.5 * e[0][1]);
     assert_true(e[1][0] < 0.4 * e[1][1]); /* against its K-ray base: 0.49 of it */
-    for (int k = 0; k < 2; k++)
+    for (int k = 0; k < 3; k++)
         lm_ray_estimate_free(&re[k]);
     lm_texel_change_free(&tc);
     free(aim), free(aim_rgb), free(change), free(before), free(out), free(was_near), free(texels);

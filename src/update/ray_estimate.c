@@ -71,7 +71,13 @@ static int misjudged(const float e[3], const float ef[3], const float em[3])
     return fabs(a - b) > LM_RAY_ESTIMATE_SPLIT * b;
 }
 
-/* Whether a node that moves stands beside texel i (header); watch: nodes are known, and some move. */
+/* Whether the gathers watch for nodes beside their texels: nodes are known, and some move. */
+static int watching(const lm_ray_estimate *re, const lm_light_scale_world *w)
+{
+    return re->nodes && lm_scene_any_node_moves(w->scene);
+}
+
+/* Whether a node that moves stands beside texel i (header); watch: watching(). */
 static int node_near(const lm_ray_estimate *re, const lm_light_scale_world *w, int watch, uint32_t i)
 {
     return watch && lm_texel_change_node_near(re->nodes, w->scene, i) > LM_RAY_ESTIMATE_NEAR;
@@ -101,11 +107,13 @@ static void base_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm
 }
 
 /* Texel i's gather now into e (em left out), by the rays its base took; a node come beside it since its
- * gather turns it to the near rays against the near base it took then (LM_RAY_ESTIMATE_NEW_NEAR). */
+ * gather turns it to the near rays against the near base it took then (LM_RAY_ESTIMATE_NEW_NEAR), if it took
+ * one (no node moved then: it keeps its rays). */
 static void now_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rims, int watch, uint32_t i,
                    float e[3])
 {
-    if (re->fine[i] < LM_RAY_ESTIMATE_NEAR_RAYS && node_near(re, w, watch, i)) {
+    if (re->has[i] == LM_RAY_ESTIMATE_NEAR_BASED && re->fine[i] < LM_RAY_ESTIMATE_NEAR_RAYS &&
+        node_near(re, w, watch, i)) {
         memcpy(re->base + 3 * (size_t)i, re->fine_base + 3 * (size_t)i, 3 * sizeof *re->base);
         re->fine[i] = LM_RAY_ESTIMATE_NEW_NEAR;
     }
@@ -118,7 +126,7 @@ static void now_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_
 static void ray_gathers(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rims,
                         const uint32_t *list, uint32_t m, float *out, const float *minus)
 {
-    int watch = re->nodes && lm_scene_any_node_moves(w->scene);
+    int watch = watching(re, w);
 #pragma omp parallel
     {
         lm_rt_thread_init();
@@ -155,8 +163,9 @@ void lm_ray_estimate_gathered(lm_ray_estimate *re, const lm_light_scale_world *w
     lm_rim rims[3];
     rims_over(re, w, aim, rims);
     ray_gathers(re, w, rims, texels, n, re->base, NULL);
+    uint8_t has = watching(re, w) ? LM_RAY_ESTIMATE_NEAR_BASED : 1;
     for (uint32_t j = 0; j < n; j++) { /* its change starts again from 0, and its rate is unknown */
-        re->has[texels[j]] = 1;
+        re->has[texels[j]] = has;
         re->stamp[texels[j]] = re->frame;
         re->rated[texels[j]] = 0;
         memset(re->delta + 3 * (size_t)texels[j], 0, 3 * sizeof *re->delta);

@@ -55,6 +55,8 @@
  * near rays, LM_RAY_ESTIMATE_NEAR_FINE x K read each at its own hit (a footprint of one: hemicube_rim.h),
  * at its gather, or from the update the node comes on, against the near rays' base that every gather also
  * takes while nodes move (fine_base); its rate starts again then. The near rays stay until its next gather.
+ * One gathered while nothing moved (a node made dynamic since: lmgi_set_node_dynamic) has no near base, and
+ * keeps its rays until then.
  *
  * Layout: per texel its base and its near rays' base (rgb each), three flags (a base; which rays; a rate),
  * the update it was last brought up to date and the rate its change went at; the deltas an update computes,
@@ -112,12 +114,13 @@
 #define LM_RAY_ESTIMATE_NEAR_FINE 9
 #define LM_RAY_ESTIMATE_NEAR_RAYS 2 /* fine: the near rays */
 #define LM_RAY_ESTIMATE_NEW_NEAR 3  /* fine: the near rays, taken at this update (no rate from it) */
+#define LM_RAY_ESTIMATE_NEAR_BASED 2 /* has: the near rays' base too (taken while some node moved) */
 
 typedef struct {
     uint32_t texel_count;
     int K;          /* rays a texel */
     float *base;    /* per texel, 3: the ray gather at its last gather */
-    uint8_t *has;   /* per texel: base holds one */
+    uint8_t *has;   /* per texel: base holds one (1), and fine_base too (LM_RAY_ESTIMATE_NEAR_BASED) */
     float *delta;   /* per texel, 3: E_t - E_0, written by lm_ray_estimate_update for the texels it lists */
     uint32_t *stamp; /* per texel: the update its base or delta was last computed */
     uint32_t frame;  /* updates so far (lm_ray_estimate_update calls) */
