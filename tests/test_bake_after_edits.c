@@ -393,7 +393,9 @@ static void test_error_atlas_marks_wrong_texels(void **state)
         lmgi_updater_free(u);
         rig_free(&r);
     }
-    assert_true(wrong_total > 1000); /* the edits left much to bring */
+    /* the edits left much to bring: 843 texels over 2% since the near rays beside moving nodes (ray_estimate.h)
+     * show a moved cube's change closer at once, 1,125 before; enough to catch an unmarked one */
+    assert_true(wrong_total > 500);
 }
 
 int main(void)
