@@ -20,10 +20,10 @@ lm_status lm_ray_estimate_init(lm_ray_estimate *re, uint32_t texel_count, int K,
     re->has = calloc(n, 1);
     re->stamp = calloc(n, sizeof *re->stamp);
     re->fine = calloc(n, 1);
-    re->fine_base = calloc(3 * n, sizeof *re->fine_base);
+    re->near_base = calloc(3 * n, sizeof *re->near_base);
     re->rate = calloc(n, sizeof *re->rate);
     re->rated = calloc(n, 1);
-    if (re->base && re->delta && re->has && re->stamp && re->fine && re->fine_base && re->rate && re->rated)
+    if (re->base && re->delta && re->has && re->stamp && re->fine && re->near_base && re->rate && re->rated)
         return LM_OK;
     lm_ray_estimate_free(re);
     return lm_fail(err, LM_ERR_NOMEM, "ray estimate: no memory for %u texels", texel_count);
@@ -36,7 +36,7 @@ void lm_ray_estimate_free(lm_ray_estimate *re)
     free(re->has);
     free(re->stamp);
     free(re->fine);
-    free(re->fine_base);
+    free(re->near_base);
     free(re->rate);
     free(re->rated);
     memset(re, 0, sizeof *re);
@@ -85,7 +85,7 @@ static int node_near(const lm_ray_estimate *re, const lm_light_scale_world *w, i
 
 /* Texel i's base into e (its emitter light em left out), by the rays rims[re->fine[i]] that it sets: the
  * near rays where a node stands beside it, else the fine ones where the K rays misjudge it, else the K;
- * with watch, also its near rays' gather (em in) into fine_base, for a node that comes later. */
+ * with watch, also its near rays' gather (em in) into near_base, for a node that comes later. */
 static void base_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_rim *rims, int watch, uint32_t i,
                     const float em[3], float e[3])
 {
@@ -96,7 +96,7 @@ static void base_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm
     if (watch) {
         lm_light_scale_texel_rim(w, &rims[LM_RAY_ESTIMATE_NEAR_RAYS], i, en);
         for (int c = 0; c < 3; c++)
-            re->fine_base[3 * (size_t)i + c] = en[c] + em[c];
+            re->near_base[3 * (size_t)i + c] = en[c] + em[c];
         if (node_near(re, w, watch, i))
             re->fine[i] = LM_RAY_ESTIMATE_NEAR_RAYS;
     }
@@ -114,7 +114,7 @@ static void now_of(lm_ray_estimate *re, const lm_light_scale_world *w, const lm_
 {
     if (re->has[i] == LM_RAY_ESTIMATE_NEAR_BASED && re->fine[i] < LM_RAY_ESTIMATE_NEAR_RAYS &&
         node_near(re, w, watch, i)) {
-        memcpy(re->base + 3 * (size_t)i, re->fine_base + 3 * (size_t)i, 3 * sizeof *re->base);
+        memcpy(re->base + 3 * (size_t)i, re->near_base + 3 * (size_t)i, 3 * sizeof *re->base);
         re->fine[i] = LM_RAY_ESTIMATE_NEW_NEAR;
     }
     int level = re->fine[i] == LM_RAY_ESTIMATE_NEW_NEAR ? LM_RAY_ESTIMATE_NEAR_RAYS : re->fine[i];
@@ -282,7 +282,7 @@ void lm_ray_estimate_scale(lm_ray_estimate *re, const float *factor, const float
 {
     for (size_t k = 0; k < 3 * (size_t)re->texel_count; k++)
         re->base[k] = re->base[k] * factor[k] + (add ? add[k] : 0.0f),
-        re->fine_base[k] = re->fine_base[k] * factor[k] + (add ? add[k] : 0.0f);
+        re->near_base[k] = re->near_base[k] * factor[k] + (add ? add[k] : 0.0f);
     memset(re->rated, 0, re->texel_count ? re->texel_count : 1); /* the rates came before the edit */
 }
 

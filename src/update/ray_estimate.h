@@ -54,7 +54,7 @@
  * (the form factor of its bounding sphere over LM_RAY_ESTIMATE_NEAR: lm_texel_change_node_near) takes the
  * near rays, LM_RAY_ESTIMATE_NEAR_FINE x K read each at its own hit (a footprint of one: hemicube_rim.h),
  * at its gather, or from the update the node comes on, against the near rays' base that every gather also
- * takes while nodes move (fine_base); its rate starts again then. The near rays stay until its next gather.
+ * takes while nodes move (near_base); its rate starts again then. The near rays stay until its next gather.
  * One gathered while nothing moved (a node made dynamic since: lmgi_set_node_dynamic) has no near base, and
  * keeps its rays until then.
  *
@@ -120,13 +120,13 @@ typedef struct {
     uint32_t texel_count;
     int K;          /* rays a texel */
     float *base;    /* per texel, 3: the ray gather at its last gather */
-    uint8_t *has;   /* per texel: base holds one (1), and fine_base too (LM_RAY_ESTIMATE_NEAR_BASED) */
+    uint8_t *has;   /* per texel: base holds one (1), and near_base too (LM_RAY_ESTIMATE_NEAR_BASED) */
     float *delta;   /* per texel, 3: E_t - E_0, written by lm_ray_estimate_update for the texels it lists */
     uint32_t *stamp; /* per texel: the update its base or delta was last computed */
     uint32_t frame;  /* updates so far (lm_ray_estimate_update calls) */
     uint8_t *fine;   /* per texel: its base and updates take K rays (0), LM_RAY_ESTIMATE_FINE x K (1), or
                       * LM_RAY_ESTIMATE_NEAR_FINE x K (LM_RAY_ESTIMATE_NEAR_RAYS) (header) */
-    float *fine_base; /* per texel, 3: its near rays' gather at its last gather while nodes moved (header) */
+    float *near_base; /* per texel, 3: its near rays' gather at its last gather while nodes moved (header) */
     float *rate;     /* per texel: |its change's change| an update (channels summed), at its last update */
     uint8_t *rated;  /* per texel: rate holds one (brought up to date since its gather or a light's edit) */
     const lm_gather *emitted; /* NULL: the rays add the emission of the emitters they meet; else the gather
