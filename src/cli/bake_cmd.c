@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "merge_cmd.h"
 #include "order_stats.h"
@@ -26,6 +27,26 @@ static void on_interrupt(int sig)
     (void)sig;
     g_interrupted = 1;
     g_cancel = 1;
+}
+
+/* Ctrl-C while the scene loads: loading polls no cancel (a level's can take seconds), and no lightmap has
+ * been written, so the command says so and leaves at once, with write and _exit alone (what a handler may
+ * call). Without it the signal's default killed the command without a word. */
+static char g_loading_said[160];
+static size_t g_loading_len;
+
+static void on_interrupt_loading(int sig)
+{
+    (void)sig;
+    ssize_t written = write(STDERR_FILENO, g_loading_said, g_loading_len);
+    (void)written;
+    _exit(130);
+}
+
+static void interrupts_as(void (*handler)(int))
+{
+    signal(SIGINT, handler);
+    signal(SIGTERM, handler); /* a scheduler's stop, as Ctrl-C */
 }
 
 static void show(void *user, float fraction, const char *stage)
@@ -234,13 +255,21 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
 {
     lmgi_scene *sc = NULL;
     lmgi_options o = a->options; /* a bake's density: lmgi_options' own default, not run's */
-    if (!lm_cli_load_scene(a->files[0], &o, 1, &sc))
+    snprintf(g_loading_said, sizeof g_loading_said,
+             "\nlmgi: %s cancelled while loading the scene; no lightmap written (an earlier bake's kept)\n", command);
+    g_loading_len = strlen(g_loading_said);
+    interrupts_as(on_interrupt_loading);
+    int loaded = lm_cli_load_scene(a->files[0], &o, 1, &sc);
+    /* from here a stop is polled: the output folder's files are never left half written */
+    interrupts_as(loaded ? on_interrupt : SIG_DFL);
+    if (!loaded)
         return 1;
     char checkpoint[4200];
     lmgi_info in;
     lmgi_get_info(sc, &in);
     lmgi_output *out = open_out(a, command, in.pages, checkpoint, sizeof checkpoint);
     if (!out) {
+        interrupts_as(SIG_DFL);
         lmgi_free(sc);
         return 1;
     }
@@ -265,8 +294,6 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
         if (share)
             d.photon_exchange = share->photon_exchange, d.claim_pass = share->claim_pass, d.share_user = share->user;
     }
-    signal(SIGINT, on_interrupt);
-    signal(SIGTERM, on_interrupt); /* a scheduler's stop, as Ctrl-C */
     lmgi_context *ctx = NULL;
     lmgi_updater *u = NULL;
     lmgi_error e;
@@ -280,8 +307,7 @@ static int bake(const lm_cli_args *a, const char *command, const char *const *pa
             fprintf(stderr, "lmgi: error: %s\n", e.message);
         rc = e.status == LMGI_ERR_CANCELLED ? 130 : 1;
     }
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
+    interrupts_as(SIG_DFL);
     char name[256] = "";
     if (rc == 0 && a->shards) {
         rc = keep_part(out, checkpoint);
