@@ -738,9 +738,8 @@ static trail_stats trail_of(lmgi_context *ctx, float *const *want, int estimate_
  * nodes' own 3 against 78; 0.57, 9 and 6 before the near rays beside moving nodes (ray_estimate.h), shown
  * alone (iim.h). Before a waiting texel's change averaged with neighbours committed near it in time (iim.h,
  * LM_IIM_SIGHT_APART) and a third of the estimates went by their expected staleness (ray_estimate.h), 0.97,
- * 15 and 18. Over the
- * whole loop (240 updates, seeds 0 to 4; probes, not kept) the trail 3, 6, 6, 6 and 6: docs/tradeoff.md,
- * "Nodes that keep moving". */
+ * 15 and 18. Over the whole loop (240 updates, seeds 0 to 4; probes, not kept) the trail 3, 6, 6, 6 and 6:
+ * docs/tradeoff.md, "Nodes that keep moving". */
 static void test_animated_box_trail(void **state)
 {
     (void)state;
