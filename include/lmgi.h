@@ -614,7 +614,8 @@ typedef struct {
     uint32_t texels_estimated; /* texels waiting to be regathered whose estimate from a few rays (the change of
                                 * what they see since their gather) this update brought up to date and shows
                                 * (docs/gather.md, "Rays for the texels that wait"); gather.texels_per_frame x
-                                * 16 at most, counted in ms_gather */
+                                * 16 at most without a time budget, what the budget gives them with one;
+                                * their time in ms_estimates */
     uint32_t texels_based;     /* texels whose estimate's base (what their few rays see as gathered) was taken
                                 * since the last update: those gathered, and every texel once, at the setup
                                 * in a scene with a dynamic node or an animation, else before its first edit,
@@ -643,8 +644,10 @@ typedef struct {
     int shadow_maps_rendered;  /* punctual lights' shadow maps re-rendered */
     int shadow_maps_stale;     /* stale ones left for the next updates (desc.frame.shadow_maps_per_update) */
     /* the stage that took the update's longest time: "photons" (invalid groups re-traced), "AIM", "caustic
-     * photons", "reflections" (environment map faces), "gather" or "frame" (the picture's own passes), and
-     * why, in words: what it did, what still waits, and what the budget planned for it */
+     * photons", "reflections" (environment map faces), "gather" (the texels gathered), "light scale" (a
+     * light edit's texel factors), "estimates" (the waiting texels' ray estimates) or "frame" (the
+     * picture's own passes), and why, in words: what it did, what still waits, and what the budget planned
+     * for it */
     const char *busiest_stage;
     char why[160];
     int lights_scaled;         /* lights changed in power alone (colour, intensity, switched off) and emitters
@@ -674,6 +677,8 @@ typedef struct {
                                 * gathered and shown at once), whether or not a group was left to re-trace:
                                 * after a still update, or the first update without edits after edits in a
                                 * row (a drag released); never under a time budget */
+    double ms_estimates;       /* of ms_gather: the waiting texels' estimates (texels_estimated), a stage the
+                                * time budget plans on its own (docs/api.md, "The time budget") */
 } lmgi_update_stats;
 
 /* NULL ctx, scene, out: LMGI_ERR_INVALID (NULL desc: the defaults); a value out of range (negative

@@ -1,6 +1,7 @@
 /* One time budget for every stage (update/budget_plan.h; issue 32, item 4): the plan's arithmetic
  * against hand-made cost models, and through the public API, lmgi_update's budget governing each stage's
- * count (photon groups, AIM refreshes, caustic photons, environment map faces, texels): one unit of each
+ * count (photon groups, AIM refreshes, caustic photons, environment map faces, texels, the waiting texels'
+ * estimates): one unit of each
  * stage with work waiting at a budget too small for anything, everything waiting at a generous one, the
  * settings' fixed counts without one; and the stage that took the time named with why. */
 #include <setjmp.h>
@@ -141,14 +142,49 @@ static void test_plan_light_scale(void **state)
     assert_string_equal(lm_stage_name(LM_STAGE_LIGHT_SCALE), "light scale");
 }
 
+/* The waiting texels' ray estimates (update/ray_estimate.h), a stage of their own: the gather's share goes
+ * to pairs of a texel and its 16 estimates, the estimates get what those texels leave short of another
+ * pair, at least one of each; what they take is neither the texels' price nor the gather's rest. */
+static void test_plan_estimates(void **state)
+{
+    (void)state;
+    lm_budget b;
+    const double price[LM_STAGE_PLANNED] = {2.0, 1.0 / 8192, 1.0 / 1024, 1.0, 0.125, 1.0 / 1024, 1.0 / 64};
+    lm_budget_seed(&b, price);
+    lm_budget_plan p;
+    lm_budget_work w = {.texels = 5000, .estimates_per_texel = 16};
+    lm_budget_plan_step(&b, 16.0, &w, &p);
+    assert_int_equal(p.texels, 42);       /* 16 ms at 0.125 + 16 / 64 ms a pair */
+    assert_int_equal(p.estimates, 688);   /* 16 x 42, and 16 more in the 0.25 ms short of a 43rd pair */
+    assert_true(p.ms[LM_STAGE_GATHER] + p.ms[LM_STAGE_ESTIMATES] <= 16.0);
+    lm_budget_plan_step(&b, 1e-3, &w, &p); /* too small for anything: one of each */
+    assert_int_equal(p.texels, 1);
+    assert_int_equal(p.estimates, 1);
+    w.estimates_per_texel = 0;            /* the lightmaps keep no estimates: the gather's share is the texels' */
+    lm_budget_plan_step(&b, 16.0, &w, &p);
+    assert_int_equal(p.texels, 128);
+    assert_int_equal(p.estimates, 0);
+
+    const double ms[LM_STAGE_PLANNED] = {12.0, 0.0, 0.0, 0.0, 7.5, 0.0, 4.0};
+    const uint64_t units[LM_STAGE_PLANNED] = {3, 0, 0, 0, 30, 0, 256};
+    for (int i = 0; i < LM_COST_WINDOW; i++)
+        lm_budget_learn(&b, ms, units, 15.5, 0.0);
+    w.estimates_per_texel = 16;
+    lm_budget_plan_step(&b, 16.0, &w, &p);
+    assert_int_equal(p.texels, 24);       /* (16 - 4 ms of rest, the estimates' 4 not in it) at 0.5 ms a pair */
+    assert_int_equal(p.estimates, 384);
+    assert_string_equal(lm_stage_name(LM_STAGE_ESTIMATES), "estimates");
+}
+
 static void update(lmgi_updater *u, float budget, lmgi_update_stats *st)
 {
     lmgi_error e;
     if (lmgi_update(u, 0.0f, budget, st, &e) != LMGI_OK)
         fail_msg("%s", e.message);
-    const char *stages[] = {"photons", "AIM", "caustic photons", "reflections", "gather", "light scale", "frame"};
+    const char *stages[] = {"photons", "AIM", "caustic photons", "reflections", "gather", "light scale", "estimates",
+                            "frame"};
     int known = 0;
-    for (int i = 0; i < 7; i++)
+    for (int i = 0; i < 8; i++)
         known |= st->busiest_stage && strcmp(st->busiest_stage, stages[i]) == 0;
     assert_true(known);
     assert_true(strlen(st->why) > 10);
@@ -233,8 +269,8 @@ static void test_budget_governs_photons_and_aims(void **state)
     lmgi_context_free(ctx);
 }
 
-/* The Cornell box's cube moved every update, with a frame: its mirror's and glass's faces and the caustic
- * photons follow the budget too. */
+/* The Cornell box's cube moved every update, with a frame: its mirror's and glass's faces, the caustic
+ * photons and the waiting texels' estimates follow the budget too. */
 static void test_budget_governs_faces_and_caustics(void **state)
 {
     (void)state;
@@ -248,17 +284,21 @@ static void test_budget_governs_faces_and_caustics(void **state)
     lmgi_update_stats st;
     update(u, 0.0f, &st);
     int faces_tiny = 0, faces_big = 0;
-    uint32_t caustic_tiny = 0, caustic_big = 0;
+    uint32_t caustic_tiny = 0, caustic_big = 0, estimated_tiny = 0, estimated_none = UINT32_MAX;
     for (int f = 0; f < 12; f++) {
         m[12] += 0.01f;
         assert_int_equal(lmgi_set_node_transform(sc, cube, m, &e), LMGI_OK);
         float budget = f < 6 ? 1e-3f : 5000.0f;
         update(u, budget, &st);
-        print_message("%g ms: %d faces, %u caustic photons; busiest %s: %s\n", (double)budget,
-                      st.cube_faces_rendered, st.caustic_photons_retraced, st.busiest_stage, st.why);
+        print_message("%g ms: %d faces, %u caustic photons, %u estimates in %.2f ms; busiest %s: %s\n",
+                      (double)budget, st.cube_faces_rendered, st.caustic_photons_retraced, st.texels_estimated,
+                      st.ms_estimates, st.busiest_stage, st.why);
+        assert_true(st.ms_estimates <= st.ms_gather);
         if (f > 0 && f < 6) { /* the first update after a change of budget was planned for the work before */
             faces_tiny = st.cube_faces_rendered > faces_tiny ? st.cube_faces_rendered : faces_tiny;
             caustic_tiny = st.caustic_photons_retraced > caustic_tiny ? st.caustic_photons_retraced : caustic_tiny;
+            estimated_tiny = st.texels_estimated > estimated_tiny ? st.texels_estimated : estimated_tiny;
+            estimated_none = st.texels_estimated < estimated_none ? st.texels_estimated : estimated_none;
         } else if (f > 6) {
             faces_big = st.cube_faces_rendered > faces_big ? st.cube_faces_rendered : faces_big;
             caustic_big = st.caustic_photons_retraced > caustic_big ? st.caustic_photons_retraced : caustic_big;
@@ -268,6 +308,10 @@ static void test_budget_governs_faces_and_caustics(void **state)
     assert_true(faces_big > 1);
     assert_int_equal(caustic_tiny, 1);
     assert_true(caustic_big > 1000);      /* a round robin turn of every pair: 1,024 a pair */
+    /* the waiting texels' estimates: one, not the 16 that came with the least texel before they were a
+     * stage of their own (4 ms budgets took 7 ms while a node moved: docs/bench.md) */
+    assert_int_equal(estimated_tiny, 1);
+    assert_int_equal(estimated_none, 1);
     lmgi_updater_free(u);
     lmgi_free(sc);
     lmgi_context_free(ctx);
@@ -279,6 +323,7 @@ int main(void)
         cmocka_unit_test(test_plan_shares),
         cmocka_unit_test(test_plan_learns),
         cmocka_unit_test(test_plan_light_scale),
+        cmocka_unit_test(test_plan_estimates),
         cmocka_unit_test(test_budget_governs_photons_and_aims),
         cmocka_unit_test(test_budget_governs_faces_and_caustics),
     };

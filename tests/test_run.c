@@ -62,8 +62,8 @@ static int count_lines(const char *path)
 }
 
 /* `lmgi run --budget MS`: frames.csv gives each update's texels allowed, the stage that took its longest
- * time and why, in words that name the budget (docs/api.md, "The time budget"); without it, the fixed
- * counts (20 texels). */
+ * time and why, in words that name the budget (docs/api.md, "The time budget"), and the waiting texels'
+ * estimates with their time; without it, the fixed counts (20 texels). */
 static void test_run_budget_in_csv(void **state)
 {
     (void)state;
@@ -76,6 +76,7 @@ static void test_run_budget_in_csv(void **state)
         assert_non_null(f);
         assert_non_null(fgets(line, sizeof line, f));
         assert_non_null(strstr(line, ",texels_budget,busiest_stage,why"));
+        assert_non_null(strstr(line, ",texels_estimated,estimates_ms\n"));
         int rows = 0;
         while (fgets(line, sizeof line, f)) {
             const char *why = strchr(line, '"');
@@ -84,9 +85,10 @@ static void test_run_budget_in_csv(void **state)
             while (stage > line && stage[-1] != ',')
                 stage--;
             print_message("%s", line);
-            const char *names[] = {"photons,", "AIM,", "caustic photons,", "reflections,", "gather,", "frame,"};
+            const char *names[] = {"photons,", "AIM,",         "caustic photons,", "reflections,",
+                                   "gather,",  "light scale,", "estimates,",       "frame,"};
             int known = 0;
-            for (int i = 0; i < 6; i++)
+            for (int i = 0; i < 8; i++)
                 known |= strncmp(stage, names[i], strlen(names[i])) == 0;
             assert_true(known);
             const char *texels = stage - 1; /* the field before: the texels allowed */

@@ -495,6 +495,7 @@ static void export_stats(const lm_frame_stats *fs, int changed, lmgi_update_stat
     o->ms_composite = 1e3 * fs->t_composite;
     o->ms_total = 1e3 * fs->t_total;
     o->ms_light_scale = 1e3 * fs->t_light_scale;
+    o->ms_estimates = 1e3 * fs->t_estimates;
     o->light_scale_rays = fs->scale_rays > UINT32_MAX ? UINT32_MAX : (uint32_t)fs->scale_rays;
     o->busiest_stage = lm_stage_name(fs->busiest);
     snprintf(o->why, sizeof o->why, "%s", fs->why);

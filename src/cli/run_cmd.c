@@ -75,7 +75,7 @@ void lm_cli_run_desc(const lm_cli_args *a, lmgi_scene *sc, lmgi_updater_desc *d)
  * faces rendered), the per-pixel photon gathers (run, list entries, record pages sent), the composite, a
  * light edit's texel factors (of the photon work or the gather);
  * the texels the update was allowed, the stage that took its longest time and why (its time budget), and the
- * waiting texels whose ray estimates it brought up to date. */
+ * waiting texels whose ray estimates it brought up to date, with their milliseconds (of the gather's). */
 static void csv_header(FILE *f)
 {
     fprintf(f, "frame,time_s,photons_retraced,groups_invalidated,groups_retraced,aim_surfaces_refreshed,"
@@ -84,21 +84,21 @@ static void csv_header(FILE *f)
                "cube_faces_rendered,planar_maps_rendered,photon_gathers,photon_entries,photon_pages_uploaded,"
                "animate_ms,trace_ms,aim_ms,"
                "caustic_trace_ms,photons_ms,gather_ms,blend_ms,direct_ms,caustics_ms,reflections_ms,composite_ms,frame_ms,"
-               "light_scale_ms,texels_budget,busiest_stage,why,texels_estimated\n");
+               "light_scale_ms,texels_budget,busiest_stage,why,texels_estimated,estimates_ms\n");
 }
 
 /* Flushed row by row: a full disk stops the run at the row it hits, not after the last frame. */
 static int csv_row(FILE *f, const lmgi_update_stats *s)
 {
     fprintf(f, "%d,%.4f,%u,%u,%u,%d,%u,%u,%d,%d,%llu,%u,%u,%d,%d,%d,%llu,%u,"
-               "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%s,\"%s\",%u\n",
+               "%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%d,%s,\"%s\",%u,%.3f\n",
             s->frame, (double)s->time, s->photons_retraced, s->groups_invalidated, s->groups_retraced,
             s->aim_surfaces_refreshed, s->texels_gathered, s->caustic_photons_retraced, s->caustic_tiles,
             s->caustic_tiles_lit, (unsigned long long)s->caustic_pixels_filtered, s->caustic_photons_landed,
             s->caustic_photons_thin, s->cube_faces_rendered, s->planar_maps_rendered,
             s->photon_gathers, (unsigned long long)s->photon_entries, s->photon_pages_uploaded, s->ms_animate,
             s->ms_trace, s->ms_aim, s->ms_caustic_trace, s->ms_photons, s->ms_gather, s->ms_blend, s->ms_direct, s->ms_caustics, s->ms_reflections, s->ms_composite, s->ms_total,
-            s->ms_light_scale, s->texels_budget, s->busiest_stage, s->why, s->texels_estimated);
+            s->ms_light_scale, s->texels_budget, s->busiest_stage, s->why, s->texels_estimated, s->ms_estimates);
     return fflush(f) == 0 && !ferror(f);
 }
 

@@ -6,7 +6,7 @@
 const char *lm_stage_name(lm_stage s)
 {
     static const char *names[LM_STAGE_COUNT] = {"photons", "AIM", "caustic photons", "reflections", "gather",
-                                                "light scale", "frame"};
+                                                "light scale", "estimates", "frame"};
     return s >= 0 && s < LM_STAGE_COUNT ? names[s] : "none";
 }
 
@@ -22,6 +22,32 @@ static int take(const lm_budget *b, lm_stage s, double ms, long most, double *ex
     int n = lm_cost_model_units(&b->cost[s], ms, most > INT_MAX ? INT_MAX : (int)most);
     *expected = n * lm_cost_model_price(&b->cost[s]);
     return n;
+}
+
+/* At least 1, at most `most`: x rounded down. */
+static long clamp_units(double x, long most)
+{
+    return x < 1.0 ? 1 : x > (double)most ? most : (long)x;
+}
+
+/* The gather's ms less its rest, shared by texels and the waiting texels' estimates (header): the
+ * (texel, estimates_per_texel estimates) pairs that fit, then the estimates those texels leave room for,
+ * the pairs' and what is left short of another pair (at most one a texel of the atlas). */
+static void gather_and_estimates(const lm_budget *b, double ms, const lm_budget_work *w, lm_budget_plan *out)
+{
+    const lm_cost_model *g = &b->cost[LM_STAGE_GATHER], *e = &b->cost[LM_STAGE_ESTIMATES];
+    double room = ms - lm_cost_model_rest(g), texel = lm_cost_model_price(g);
+    double estimate = w->estimates_per_texel > 0 ? lm_cost_model_price(e) : 0.0;
+    double pair = texel + w->estimates_per_texel * estimate;
+    long texels = clamp_units(room / (pair > 1e-6 ? pair : 1e-6), w->texels > 0 ? w->texels : 1);
+    out->texels = (int)texels;
+    out->ms[LM_STAGE_GATHER] = texels * texel;
+    if (w->estimates_per_texel <= 0)
+        return;
+    long n = clamp_units((room - out->ms[LM_STAGE_GATHER]) / (estimate > 1e-6 ? estimate : 1e-6),
+                         w->texels > 0 ? w->texels : 1);
+    out->estimates = (uint32_t)n;
+    out->ms[LM_STAGE_ESTIMATES] = n * estimate;
 }
 
 void lm_budget_plan_step(const lm_budget *b, double budget_ms, const lm_budget_work *w, lm_budget_plan *out)
@@ -52,7 +78,7 @@ void lm_budget_plan_step(const lm_budget *b, double budget_ms, const lm_budget_w
     out->scale_rays = (uint32_t)take(b, LM_STAGE_LIGHT_SCALE, spare, w->scale_rays > 0 ? w->scale_rays : INT_MAX,
                                      &ms[LM_STAGE_LIGHT_SCALE]);
     double gather = (w->scale_rays > 0 ? budget_ms - ms[LM_STAGE_LIGHT_SCALE] : budget_ms) - w->ms_spent;
-    out->texels = take(b, LM_STAGE_GATHER, gather, w->texels, &ms[LM_STAGE_GATHER]);
+    gather_and_estimates(b, gather, w, out);
 }
 
 void lm_budget_learn(lm_budget *b, const double ms[LM_STAGE_PLANNED], const uint64_t units[LM_STAGE_PLANNED],
@@ -60,8 +86,9 @@ void lm_budget_learn(lm_budget *b, const double ms[LM_STAGE_PLANNED], const uint
 {
     for (int s = 0; s < LM_STAGE_PLANNED; s++) {
         uint32_t n = units[s] > UINT32_MAX ? UINT32_MAX : (uint32_t)units[s];
-        if (s == LM_STAGE_GATHER) { /* its rest: everything else the update did but the texel factors, aside */
-            double rest = ms_total - ms[s] - ms[LM_STAGE_LIGHT_SCALE] - ms_aside;
+        if (s == LM_STAGE_GATHER) { /* its rest: everything else the update did but the estimates, the texel
+                                    * factors and what is aside */
+            double rest = ms_total - ms[s] - ms[LM_STAGE_ESTIMATES] - ms[LM_STAGE_LIGHT_SCALE] - ms_aside;
             lm_cost_model_learn(&b->cost[s], ms[s], n, rest > 0.0 ? rest : 0.0);
         }
         else if (n > 0)

@@ -271,16 +271,18 @@ static void plan(lm_frame_loop *fl, lm_frame_stats *o)
         w.scale_edit = lm_photon_stage_scale_waiting(fl->stage);
         w.scale_rays = w.scale_edit ? LM_LIGHT_SCALE_WORK : lm_lightmap_path_scale_waiting(fl->lightmaps);
         w.ms_spent = 1e3 * o->t_waited;
+        w.estimates_per_texel = lm_lightmap_path_has_rays(fl->lightmaps) ? LM_RAY_ESTIMATE_PER_TEXEL : 0;
         lm_budget_plan_step(&fl->budget, fl->budget_ms, &w, p);
     } else {
         memset(p, 0, sizeof *p);
         p->texels = fl->set.iim.texels_per_frame;
+        p->estimates = LM_RAY_ESTIMATE_PER_TEXEL * (uint32_t)(p->texels > 0 ? p->texels : 0);
     }
     lm_photon_stage_limits l = {p->groups, p->aim_hits, p->caustic_photons};
     lm_photon_stage_limit(fl->stage, &l);
     lm_frame_passes_limit_faces(fl->passes, p->faces);
     lm_lightmap_path_set_texels_per_frame(fl->lightmaps, p->texels);
-    lm_lightmap_path_set_ray_budget(fl->lightmaps, LM_RAY_ESTIMATE_PER_TEXEL * (uint32_t)(p->texels > 0 ? p->texels : 0));
+    lm_lightmap_path_set_ray_budget(fl->lightmaps, p->estimates);
     lm_lightmap_path_set_scale_rays(fl->lightmaps, p->scale_rays, p->ms[LM_STAGE_LIGHT_SCALE]);
 }
 
@@ -341,7 +343,7 @@ static void note_stage(lm_frame_loop *fl, const lm_photon_stage_frame *f)
 static lm_status schedule(lm_frame_loop *fl, lm_frame_stats *o, double *te, lm_error *err)
 {
     lm_status st = lm_lightmap_path_schedule(fl->lightmaps, &o->texels_gathered, err);
-    o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, te);
+    o->texels_estimated = lm_lightmap_path_estimated(fl->lightmaps, te, &o->t_estimates);
     return st;
 }
 
@@ -496,10 +498,13 @@ static uint64_t photon_units(const lm_frame_loop *fl, const lm_photon_frame_stat
 static void learn(lm_frame_loop *fl, const lm_frame_stats *o)
 {
     const lm_photon_stage_frame *f = &o->stage;
-    const double ms[LM_STAGE_PLANNED] = {1e3 * f->t_photons,     1e3 * f->t_aim, 1e3 * f->t_caustics,
-                                         1e3 * o->t_reflections, 1e3 * o->t_gather, 1e3 * o->t_light_scale};
+    const double ms[LM_STAGE_PLANNED] = {1e3 * f->t_photons,     1e3 * f->t_aim,
+                                         1e3 * f->t_caustics,    1e3 * o->t_reflections,
+                                         1e3 * (o->t_gather - o->t_estimates), 1e3 * o->t_light_scale,
+                                         1e3 * o->t_estimates};
     const uint64_t units[LM_STAGE_PLANNED] = {photon_units(fl, &f->photons), f->aim.hits_used, f->caustics.cast,
-                                              (uint64_t)o->cube_faces, o->texels_gathered, o->scale_rays};
+                                              (uint64_t)o->cube_faces, o->texels_gathered, o->scale_rays,
+                                              o->texels_estimated};
     lm_budget_learn(&fl->budget, ms, units, 1e3 * o->t_total, 1e3 * (o->t_edits + o->t_waited + o->t_overrun));
 }
 
@@ -517,7 +522,7 @@ static void report(const lm_frame_loop *fl, lm_frame_stats *o)
 {
     const lm_photon_stage_frame *f = &o->stage;
     const double t[LM_STAGE_COUNT] = {f->t_photons, f->t_aim, f->t_caustics, o->t_reflections,
-                                      o->t_gather,  o->t_light_scale,
+                                      o->t_gather - o->t_estimates, o->t_light_scale, o->t_estimates,
                                       o->t_blend + o->t_direct + o->t_caustics + o->t_composite};
     lm_stage b = LM_STAGE_PHOTONS;
     for (int s = 1; s < LM_STAGE_COUNT; s++)
@@ -549,6 +554,9 @@ static void report(const lm_frame_loop *fl, lm_frame_stats *o)
     case LM_STAGE_LIGHT_SCALE:
         snprintf(w, n, "a light edit's texel factors: %llu rays, %u still to cast (%s)",
                  (unsigned long long)o->scale_rays, lm_lightmap_path_scale_waiting(fl->lightmaps), plan);
+        break;
+    case LM_STAGE_ESTIMATES:
+        snprintf(w, n, "%u waiting texels' ray estimates brought up to date (%s)", o->texels_estimated, plan);
         break;
     default:
         snprintf(w, n, "the frame's passes: blend %.2f ms, direct light %.2f ms, caustics %.2f ms, composite %.2f ms",

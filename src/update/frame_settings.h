@@ -112,6 +112,9 @@ typedef struct {
      * their seconds and the rays of one of their gathers */
     double t_light_scale;
     uint64_t scale_rays;
+    /* of t_gather, the waiting texels' ray estimates brought up to date (the gathered texels' bases are the
+     * gather's own): a stage of the budget's */
+    double t_estimates;
     /* of t_photons, the edits' work the photon stage did at once (a lit light's photons traced, AIMs
      * refreshed for a light or colour edit: lm_photon_stage_animate), which the budget's model of the
      * gather's rest leaves out like the texel factors (budget_plan.h); and, before t_photons, the rays'

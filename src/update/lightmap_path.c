@@ -47,7 +47,8 @@ struct lm_lightmap_path {
     uint32_t ray_budget;       /* at most this many an update (lm_lightmap_path_set_ray_budget) */
     uint32_t based;            /* the texels whose ray bases were taken since lm_lightmap_path_take_based */
     uint32_t estimated;        /* how many the last schedule did */
-    double estimate_seconds;   /* and the seconds the ray estimates took in it */
+    double estimate_seconds;   /* and the seconds the ray estimates took in it, bases included */
+    double update_seconds;     /* of those, the seconds of the waiting texels' estimates alone */
     int aim_stale;             /* the AIM changed since the gather last uploaded it */
     int caught_up;             /* the stage caught up with this step's placements before its gather */
     int placed_now;            /* and this step's widen saw them move, or saw moves since the last catch-up
@@ -408,7 +409,7 @@ static lm_status start_rays(lm_lightmap_path *lp, lm_error *err)
 static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting, uint32_t budget)
 {
     lp->estimated = 0;
-    lp->estimate_seconds = 0.0;
+    lp->estimate_seconds = lp->update_seconds = 0.0;
     if (!lp->have_rays)
         return;
     double t0 = lm_now();
@@ -417,6 +418,7 @@ static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting
     lm_iim_sight_gathered(&lp->iim, lp->atlas, lp->texels, count);
     lm_ray_estimate_gathered(&lp->rays, &w, aim, lp->texels, count);
     lp->based += count;
+    double t1 = lm_now();
     const uint32_t *wait = lp->texels + count;
     float *change = malloc(sizeof *change * (waiting ? waiting : 1));
     for (uint32_t k = 0; change && k < waiting; k++)
@@ -429,7 +431,9 @@ static void ray_estimates(lm_lightmap_path *lp, uint32_t count, uint32_t waiting
     lm_iim_set_sight(&lp->iim, lp->atlas, lp->ray_list, lp->rays.delta, lp->rays.base, lp->rays.fine,
                      LM_RAY_ESTIMATE_NEAR_RAYS, m);
     lp->estimated = m;
-    lp->estimate_seconds = lm_now() - t0;
+    double t2 = lm_now();
+    lp->estimate_seconds = t2 - t0;
+    lp->update_seconds = t2 - t1;
 }
 
 lm_status lm_lightmap_path_first(lm_lightmap_path *lp, double *t_gather, lm_error *err)
@@ -734,6 +738,7 @@ lm_iim *lm_lightmap_path_iim(lm_lightmap_path *lp) { return &lp->iim; }
 const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp) { return &lp->iim; }
 
 void lm_lightmap_path_set_ray_budget(lm_lightmap_path *lp, uint32_t texels) { lp->ray_budget = texels; }
+int lm_lightmap_path_has_rays(const lm_lightmap_path *lp) { return lp->have_rays; }
 
 uint32_t lm_lightmap_path_take_based(lm_lightmap_path *lp)
 {
@@ -742,10 +747,12 @@ uint32_t lm_lightmap_path_take_based(lm_lightmap_path *lp)
     return n;
 }
 
-uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds)
+uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds, double *waiting_seconds)
 {
     if (seconds)
         *seconds = lp->estimate_seconds;
+    if (waiting_seconds)
+        *waiting_seconds = lp->update_seconds;
     return lp->estimated;
 }
 

@@ -76,9 +76,11 @@ const lm_iim *lm_lightmap_path_iim_const(const lm_lightmap_path *lp);
 void lm_lightmap_path_set_texels_per_frame(lm_lightmap_path *lp, int texels);
 /* The waiting texels an update brings their ray estimates up to date for (ray_estimate.h; 0: none), and how
  * many the last schedule did, with their bases, in *seconds (may be NULL): the gather's work, wherever the
- * step times its schedule. */
+ * step times its schedule; of those, the waiting texels' estimates alone in *waiting_seconds (may be NULL;
+ * the budget's stage of their own, budget_plan.h). Whether the lightmaps keep ray estimates now. */
 void lm_lightmap_path_set_ray_budget(lm_lightmap_path *lp, uint32_t texels);
-uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds);
+uint32_t lm_lightmap_path_estimated(const lm_lightmap_path *lp, double *seconds, double *waiting_seconds);
+int lm_lightmap_path_has_rays(const lm_lightmap_path *lp);
 /* The texels whose ray estimate's base was taken (those gathered, every texel at the start) since the last
  * call, which zeroes it; the setup's are not counted. */
 uint32_t lm_lightmap_path_take_based(lm_lightmap_path *lp);
