@@ -32,11 +32,15 @@ static int window(const lm_cost_model *m) { return m->samples < LM_COST_WINDOW ?
 double lm_cost_model_price(const lm_cost_model *m) { return p95(m->per_unit, window(m)); }
 double lm_cost_model_rest(const lm_cost_model *m) { return p95(m->rest, window(m)); }
 
+int lm_cost_units(double ms, double per_unit, int most)
+{
+    double units = ms / (per_unit > 1e-6 ? per_unit : 1e-6);
+    double top = most > 0 ? most : 1;
+    return units < 1.0 ? 1 : units > top ? (int)top : (int)units;
+}
+
 int lm_cost_model_units(const lm_cost_model *m, double budget_ms, int most)
 {
     int n = window(m);
-    double per = p95(m->per_unit, n), rest = p95(m->rest, n);
-    double units = (budget_ms - rest) / (per > 1e-6 ? per : 1e-6);
-    double top = most > 0 ? most : 1;
-    return units < 1.0 ? 1 : units > top ? (int)top : (int)units;
+    return lm_cost_units(budget_ms - p95(m->rest, n), p95(m->per_unit, n), most);
 }

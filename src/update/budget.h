@@ -33,6 +33,10 @@ void lm_cost_model_seed(lm_cost_model *m, double ms_per_unit);
 void lm_cost_model_learn(lm_cost_model *m, double ms_stage, uint32_t units, double ms_rest);
 /* The units that fit in budget_ms, at least 1, at most `most`. */
 int lm_cost_model_units(const lm_cost_model *m, double budget_ms, int most);
+/* The units at per_unit ms each (at least 1e-6) that fit in ms, at least 1, at most `most` (1 if most <= 0):
+ * lm_cost_model_units' rule, for a unit priced from several models (budget_plan.c: a texel and its
+ * estimates). */
+int lm_cost_units(double ms, double per_unit, int most);
 /* The 95th percentile of the milliseconds per unit (what lm_cost_model_units prices a unit at). */
 double lm_cost_model_price(const lm_cost_model *m);
 /* The 95th percentile of the milliseconds of the rest of the step. */

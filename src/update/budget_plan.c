@@ -24,30 +24,19 @@ static int take(const lm_budget *b, lm_stage s, double ms, long most, double *ex
     return n;
 }
 
-/* At least 1, at most `most`: x rounded down. */
-static long clamp_units(double x, long most)
-{
-    return x < 1.0 ? 1 : x > (double)most ? most : (long)x;
-}
-
 /* The gather's ms less its rest, shared by texels and the waiting texels' estimates (header): the
  * (texel, estimates_per_texel estimates) pairs that fit, then the estimates those texels leave room for,
  * the pairs' and what is left short of another pair (at most one a texel of the atlas). */
 static void gather_and_estimates(const lm_budget *b, double ms, const lm_budget_work *w, lm_budget_plan *out)
 {
-    const lm_cost_model *g = &b->cost[LM_STAGE_GATHER], *e = &b->cost[LM_STAGE_ESTIMATES];
+    const lm_cost_model *g = &b->cost[LM_STAGE_GATHER];
     double room = ms - lm_cost_model_rest(g), texel = lm_cost_model_price(g);
-    double estimate = w->estimates_per_texel > 0 ? lm_cost_model_price(e) : 0.0;
-    double pair = texel + w->estimates_per_texel * estimate;
-    long texels = clamp_units(room / (pair > 1e-6 ? pair : 1e-6), w->texels > 0 ? w->texels : 1);
-    out->texels = (int)texels;
-    out->ms[LM_STAGE_GATHER] = texels * texel;
-    if (w->estimates_per_texel <= 0)
-        return;
-    long n = clamp_units((room - out->ms[LM_STAGE_GATHER]) / (estimate > 1e-6 ? estimate : 1e-6),
-                         w->texels > 0 ? w->texels : 1);
-    out->estimates = (uint32_t)n;
-    out->ms[LM_STAGE_ESTIMATES] = n * estimate;
+    double estimate = w->estimates_per_texel > 0 ? lm_cost_model_price(&b->cost[LM_STAGE_ESTIMATES]) : 0.0;
+    out->texels = lm_cost_units(room, texel + w->estimates_per_texel * estimate, w->texels);
+    out->ms[LM_STAGE_GATHER] = out->texels * texel;
+    if (w->estimates_per_texel > 0)
+        out->estimates = (uint32_t)take(b, LM_STAGE_ESTIMATES, room - out->ms[LM_STAGE_GATHER], w->texels,
+                                        &out->ms[LM_STAGE_ESTIMATES]);
 }
 
 void lm_budget_plan_step(const lm_budget *b, double budget_ms, const lm_budget_work *w, lm_budget_plan *out)
